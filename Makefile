@@ -1,0 +1,58 @@
+# tunnelkit — every command a newcomer needs. `make test` and `make lab` work from a fresh clone.
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed-stamp
+KERNEL := tunnelkit
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
+
+.PHONY: help install lab test lint format unit notebooks bench clean
+
+help:
+	@echo "make lab     create .venv if needed, install, register the kernel, open JupyterLab on notebooks/"
+	@echo "make test    create .venv if needed, install, lint, unit tests and every notebook in quick mode"
+	@echo "make bench   benchmarks (medians and ratios measured in one run)"
+	@echo "make format  apply ruff formatting and strip notebook outputs"
+	@echo "make clean   remove .venv and caches"
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[lab,dev]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+lab: install
+	$(PY) -m ipykernel install --sys-prefix --name $(KERNEL) --display-name "Python (tunnelkit)"
+	$(VENV)/bin/jupyter lab notebooks/
+
+LINTED := tunnelkit tests benchmarks tools notebooks/src
+
+lint: install
+	$(VENV)/bin/ruff check $(LINTED)
+	$(VENV)/bin/ruff format --check $(LINTED)
+	$(PY) tools/nbbuild.py --check
+	$(PY) tools/check_notebooks.py notebooks
+
+unit: install
+	$(PY) -m pytest -q -n 2 tests
+
+notebooks: install
+	TUNNELKIT_QUICK=1 $(PY) -m pytest -q -n 2 --nbmake --nbmake-timeout=900 notebooks
+
+test: lint unit notebooks
+
+bench: install
+	$(PY) benchmarks/run.py
+
+format: install
+	$(VENV)/bin/ruff format $(LINTED)
+	$(VENV)/bin/ruff check --fix $(LINTED)
+	$(PY) tools/nbbuild.py
+	$(PY) tools/check_notebooks.py --strip notebooks
+
+clean:
+	rm -rf $(VENV) build .pytest_cache .ruff_cache
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +

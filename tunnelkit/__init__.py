@@ -1,0 +1,62 @@
+"""tunnelkit — locating a vehicle inside a road tunnel with a single base station.
+
+A small package under a sequence of notebooks (``notebooks/01-...`` to ``06-...``). Submodules
+mirror the notebooks and load on first use, so ``import tunnelkit as tk`` stays fast:
+
+``constants, geometry, crlb, positioning`` (01) · ``fresnel`` (02) · ``arrays, propagation,
+channel, extraction`` (03) · ``tracking`` (04-06) · ``scenarios, metrics, montecarlo, plots,
+widgets, reference, reproduce`` (all).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from .montecarlo import QUICK, mc_count, quick_mode
+from .scenarios import list_scenarios, load_scenario
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "QUICK",
+    "__version__",
+    "list_scenarios",
+    "load_scenario",
+    "mc_count",
+    "quick_mode",
+    "setup_notebook",
+]
+
+
+def __getattr__(name: str) -> Any:
+    """Load submodules lazily: ``tk.fresnel`` imports ``tunnelkit.fresnel`` on first access."""
+    if name.startswith("_"):
+        raise AttributeError(name)
+    try:
+        module = importlib.import_module(f".{name}", __name__)
+    except ModuleNotFoundError as exc:
+        if exc.name == f"{__name__}.{name}":
+            raise AttributeError(f"module 'tunnelkit' has no attribute {name!r}") from None
+        raise
+    globals()[name] = module
+    return module
+
+
+def setup_notebook(*, renderer: str | None = None) -> dict[str, Any]:
+    """The one setup call every notebook makes after ``import tunnelkit as tk``.
+
+    Sets a plotly renderer that works both in JupyterLab and when the notebook is executed
+    headless (CI, static site), and prints the package version and whether quick mode is on.
+    Returns the settings so a Checks cell can assert on them.
+    """
+    import plotly.io as pio
+
+    if renderer is not None:
+        pio.renderers.default = renderer
+    elif pio.renderers.default in (None, "", "browser"):
+        pio.renderers.default = "notebook_connected+plotly_mimetype"
+    pio.templates.default = "plotly_white"
+    mode = "quick (TUNNELKIT_QUICK=1: Monte-Carlo counts shrunk for CI)" if quick_mode() else "full"
+    print(f"tunnelkit {__version__} · mode: {mode}")
+    return {"version": __version__, "quick": quick_mode(), "renderer": pio.renderers.default}

@@ -1,0 +1,45 @@
+"""Physical constants and unit helpers (SI units, radians inside; dB only at the edges)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validate import positive
+
+#: speed of light in vacuum [m/s]
+C = 299_792_458.0
+#: Boltzmann constant [J/K]
+K_B = 1.380649e-23
+
+
+def wavelength(fc: float) -> float:
+    """Carrier wavelength ``lambda = c / fc`` [m] for a carrier ``fc`` [Hz]."""
+    return C / positive("fc", fc)
+
+
+def db2lin(x_db):
+    """Power ratio from decibels."""
+    return 10.0 ** (np.asarray(x_db, dtype=float) / 10.0)
+
+
+def lin2db(x):
+    """Decibels from a positive power ratio."""
+    x = np.asarray(x, dtype=float)
+    if np.any(x <= 0):
+        raise ValueError("x: power ratios must be > 0 to be expressed in dB")
+    return 10.0 * np.log10(x)
+
+
+def dbm2watt(p_dbm):
+    """Watts from dBm."""
+    return 1e-3 * db2lin(p_dbm)
+
+
+def deg(x_rad):
+    """Degrees from radians (for labels and tables only)."""
+    return np.degrees(x_rad)
+
+
+def rad(x_deg):
+    """Radians from degrees (sliders and presets speak degrees)."""
+    return np.radians(x_deg)

@@ -1,0 +1,188 @@
+"""Fisher information and Cramer-Rao bounds for joint TOA/DOA positioning (Jiang et al. 2023).
+
+Measurement model (Jiang eq. 5 and 11): from station ``i`` at ``(x_i, y_i)`` (the base station
+itself in LOS, or a virtual station),
+
+    d_i     = sqrt((x - x_i)^2 + (y - y_i)^2)          range,   noise sigma_d
+    theta_i = atan2(y - y_i, x - x_i)                   bearing, noise sigma_theta
+
+The Fisher information of the position is ``F = sum_i grad(theta_i) grad(theta_i)^T / sigma_theta^2
++ grad(d_i) grad(d_i)^T / sigma_d^2`` (eq. 20-27) and the bound on the position MSE is
+``tr(F^-1)`` (eq. 28 / A17).
+
+**Correction.** ``d theta_i / d x = -(y - y_i) / d_i^2`` (the paper's eq. A2 drops the minus sign),
+so the angle part of ``F_xy`` is ``-(x - x_i)(y - y_i) / (sigma_theta^2 d_i^4)``; the paper's
+eq. 27 / A16 prints ``+``. :func:`fim_toa_doa` implements the corrected form by default and the
+printed one with ``form="paper"``; :func:`numeric_fim` is the brute-force twin both are tested
+against.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ._validate import finite_array, positive
+
+__all__ = [
+    "crlb_rmse",
+    "crlb_trace",
+    "fim_toa_doa",
+    "numeric_fim",
+    "numeric_jacobian",
+    "toa_doa",
+    "toa_doa_jacobian",
+    "wrap_angle",
+]
+
+
+def wrap_angle(a):
+    """Wrap angle(s) to ``(-pi, pi]``."""
+    a = np.asarray(a, dtype=float)
+    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+
+
+def _points_and_stations(p, stations) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    p = finite_array("p", p)
+    st = finite_array("stations", stations, ndim=2)
+    if p.ndim == 0 or p.shape[-1] != 2:
+        raise ValueError(f"p: expected 2-D position(s) with shape (..., 2), got {p.shape}")
+    if st.shape[1] != 2 or st.shape[0] < 1:
+        raise ValueError(f"stations: expected shape (N, 2) with N >= 1, got {st.shape}")
+    dx = p[..., None, 0] - st[:, 0]
+    dy = p[..., None, 1] - st[:, 1]
+    d2 = dx * dx + dy * dy
+    if np.any(d2 == 0):
+        raise ValueError("p: coincides with a station, range and bearing are undefined there")
+    return p, st, dx, dy
+
+
+def toa_doa(p, stations) -> tuple[np.ndarray, np.ndarray]:
+    """Ranges ``d`` and bearings ``theta`` from each station to ``p`` (Jiang eq. 5, 11).
+
+    ``p`` has shape (..., 2), ``stations`` (N, 2); both outputs have shape (..., N).
+    """
+    _, _, dx, dy = _points_and_stations(p, stations)
+    return np.hypot(dx, dy), np.arctan2(dy, dx)
+
+
+def toa_doa_jacobian(p, stations) -> np.ndarray:
+    """Analytic Jacobian of ``[d_1..d_N, theta_1..theta_N]`` w.r.t. ``(x, y)``: shape (..., 2N, 2).
+
+    ``dd/dx = (x - x_i)/d``, ``dd/dy = (y - y_i)/d``, ``dtheta/dx = -(y - y_i)/d^2``,
+    ``dtheta/dy = (x - x_i)/d^2`` (Jiang eq. A2-A3, A8-A9 with the sign of A2 corrected).
+    """
+    _, _, dx, dy = _points_and_stations(p, stations)
+    d2 = dx * dx + dy * dy
+    d = np.sqrt(d2)
+    jd = np.stack([dx / d, dy / d], axis=-1)
+    jt = np.stack([-dy / d2, dx / d2], axis=-1)
+    return np.concatenate([jd, jt], axis=-2)
+
+
+def _sigmas(name: str, sigma, n: int) -> np.ndarray | None:
+    if sigma is None:
+        return None
+    s = finite_array(name, sigma)
+    if s.ndim > 1 or (s.ndim == 1 and s.shape[0] not in (1, n)):
+        raise ValueError(f"{name}: expected a scalar or one value per station ({n}), got shape {s.shape}")
+    if np.any(s <= 0):
+        raise ValueError(f"{name}: must be > 0 (use None to leave this measurement out), got {s}")
+    return np.broadcast_to(s, (n,)).astype(float)
+
+
+def fim_toa_doa(p, stations, sigma_theta, sigma_d, *, form: str = "corrected") -> np.ndarray:
+    """Fisher information of the position, shape (..., 2, 2) (Jiang eq. 20-27).
+
+    ``sigma_theta`` [rad] and ``sigma_d`` [m] are scalars or one value per station; pass ``None``
+    for either to drop that measurement (TOA-only or DOA-only). ``form="paper"`` reproduces the
+    printed eq. 27 with its ``+`` sign on the angle term of ``F_xy``, for comparison only.
+    """
+    if form not in ("corrected", "paper"):
+        raise ValueError(f"form: expected 'corrected' or 'paper', got {form!r}")
+    _, st, dx, dy = _points_and_stations(p, stations)
+    n = st.shape[0]
+    st_ = _sigmas("sigma_theta", sigma_theta, n)
+    sd_ = _sigmas("sigma_d", sigma_d, n)
+    if st_ is None and sd_ is None:
+        raise ValueError("sigma_theta, sigma_d: at least one measurement type is needed")
+    d2 = dx * dx + dy * dy
+    fxx = np.zeros(dx.shape[:-1])
+    fyy = np.zeros_like(fxx)
+    fxy = np.zeros_like(fxx)
+    if st_ is not None:
+        w = 1.0 / (st_**2 * d2 * d2)
+        sign = -1.0 if form == "corrected" else 1.0
+        fxx = fxx + np.sum(w * dy * dy, axis=-1)
+        fyy = fyy + np.sum(w * dx * dx, axis=-1)
+        fxy = fxy + sign * np.sum(w * dx * dy, axis=-1)
+    if sd_ is not None:
+        w = 1.0 / (sd_**2 * d2)
+        fxx = fxx + np.sum(w * dx * dx, axis=-1)
+        fyy = fyy + np.sum(w * dy * dy, axis=-1)
+        fxy = fxy + np.sum(w * dx * dy, axis=-1)
+    return np.stack([np.stack([fxx, fxy], -1), np.stack([fxy, fyy], -1)], -2)
+
+
+def numeric_jacobian(h: Callable[[np.ndarray], np.ndarray], p, *, step: float = 1e-6,
+                     angle_mask=None) -> np.ndarray:
+    """Central-difference Jacobian of a vectorised ``h: (..., n) -> (..., m)``: shape (..., m, n).
+
+    Components flagged in ``angle_mask`` (bool, length m) have their differences wrapped to
+    ``(-pi, pi]`` so a bearing crossing the branch cut does not explode.
+    """
+    p = finite_array("p", p)
+    step = positive("step", step)
+    n = p.shape[-1]
+    cols = []
+    for k in range(n):
+        e = np.zeros(n)
+        e[k] = step
+        diff = np.asarray(h(p + e), dtype=float) - np.asarray(h(p - e), dtype=float)
+        if angle_mask is not None:
+            mask = np.asarray(angle_mask, dtype=bool)
+            diff = np.where(mask, wrap_angle(diff), diff)
+        cols.append(diff / (2.0 * step))
+    return np.stack(cols, axis=-1)
+
+
+def numeric_fim(h: Callable[[np.ndarray], np.ndarray], p, R, *, step: float = 1e-6,
+                angle_mask=None) -> np.ndarray:
+    """Brute-force Fisher information ``J^T R^-1 J`` for Gaussian noise of covariance ``R``.
+
+    ``J`` is the central-difference Jacobian of ``h`` at ``p``; works for any measurement
+    function, so every closed-form FIM in the package has a numeric twin.
+    """
+    R = finite_array("R", R, ndim=2)
+    if R.shape[0] != R.shape[1]:
+        raise ValueError(f"R: must be square, got {R.shape}")
+    try:
+        np.linalg.cholesky(R)
+    except np.linalg.LinAlgError as exc:
+        raise ValueError("R: must be symmetric positive definite") from exc
+    J = numeric_jacobian(h, p, step=step, angle_mask=angle_mask)
+    if J.shape[-2] != R.shape[0]:
+        raise ValueError(f"R: has size {R.shape[0]} but h returns {J.shape[-2]} measurements")
+    return np.swapaxes(J, -1, -2) @ np.linalg.solve(R, J)
+
+
+def crlb_trace(F) -> np.ndarray:
+    """``tr(F^-1)``, the bound on the position mean-square error (Jiang eq. 28 / A17)."""
+    F = finite_array("F", F)
+    if F.ndim < 2 or F.shape[-1] != F.shape[-2]:
+        raise ValueError(f"F: expected square matrices (..., n, n), got {F.shape}")
+    if F.shape[-1] == 2:  # closed form of eq. A17, no inverse needed
+        det = F[..., 0, 0] * F[..., 1, 1] - F[..., 0, 1] * F[..., 1, 0]
+        if np.any(det <= 0):
+            raise ValueError("F: singular Fisher information, the position is not identifiable")
+        return (F[..., 0, 0] + F[..., 1, 1]) / det
+    ev = np.linalg.eigvalsh(F)
+    if np.any(ev <= 0):
+        raise ValueError("F: singular Fisher information, the position is not identifiable")
+    return np.sum(1.0 / ev, axis=-1)
+
+
+def crlb_rmse(p, stations, sigma_theta, sigma_d) -> np.ndarray:
+    """``sqrt(tr(F^-1))`` [m]: the smallest RMSE an unbiased estimator can reach at ``p``."""
+    return np.sqrt(crlb_trace(fim_toa_doa(p, stations, sigma_theta, sigma_d)))

@@ -1,0 +1,51 @@
+"""Error metrics used across the notebooks and the ``reproduce`` command."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validate import finite_array
+
+__all__ = ["ecdf", "error_stats", "position_errors", "rmse"]
+
+
+def position_errors(estimate, truth) -> np.ndarray:
+    """Euclidean error per sample, shape (...,), from positions of shape (..., dim)."""
+    est = finite_array("estimate", estimate)
+    tru = finite_array("truth", truth)
+    try:
+        diff = est - tru
+    except ValueError as exc:
+        raise ValueError(f"estimate, truth: shapes {est.shape} and {tru.shape} do not broadcast") from exc
+    return np.linalg.norm(diff, axis=-1)
+
+
+def rmse(estimate, truth, axis=None) -> np.ndarray:
+    """Root mean squared Euclidean error (Jiang eq. 64)."""
+    e = position_errors(estimate, truth)
+    return np.sqrt(np.mean(e**2, axis=axis))
+
+
+def error_stats(errors) -> dict[str, float]:
+    """min / max / mean / std / variance / RMSE / median / 90th percentile of an error sample."""
+    e = finite_array("errors", errors).ravel()
+    if e.size == 0:
+        raise ValueError("errors: empty sample")
+    return {
+        "min": float(e.min()),
+        "max": float(e.max()),
+        "mean": float(e.mean()),
+        "std": float(e.std()),
+        "variance": float(e.var()),
+        "rmse": float(np.sqrt(np.mean(e**2))),
+        "median": float(np.median(e)),
+        "p90": float(np.percentile(e, 90)),
+    }
+
+
+def ecdf(errors) -> tuple[np.ndarray, np.ndarray]:
+    """Empirical CDF: sorted values and their cumulative probabilities."""
+    e = np.sort(finite_array("errors", errors).ravel())
+    if e.size == 0:
+        raise ValueError("errors: empty sample")
+    return e, np.arange(1, e.size + 1) / e.size

@@ -1,0 +1,68 @@
+"""Registry of interchangeable estimators, grouped by family (``"jiang2023"``, ``"halili2022"``, ...).
+
+Register a factory (a class or a function returning a configured estimator) with::
+
+    @register("jiang2023", "UKF")
+    class VsUKF: ...
+
+and loop with ``family("jiang2023")`` -> ``{"TSWLS": ..., "EKF": ..., "UKF": ..., "UPF": ...}`` in
+registration order. Modules that register are imported on first lookup of their family.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from typing import Any
+
+__all__ = ["family", "families", "get", "register"]
+
+_REG: dict[str, dict[str, Callable[..., Any]]] = {}
+#: family -> modules to import before the family is looked up (keeps ``import tunnelkit`` light)
+_PROVIDERS: dict[str, list[str]] = {}
+
+
+def provide(family_name: str, module: str) -> None:
+    """Declare that importing ``module`` registers members of ``family_name``."""
+    _PROVIDERS.setdefault(family_name, [])
+    if module not in _PROVIDERS[family_name]:
+        _PROVIDERS[family_name].append(module)
+
+
+def register(family_name: str, name: str):
+    """Decorator registering ``obj`` as ``name`` in ``family_name``."""
+
+    def deco(obj):
+        fam = _REG.setdefault(family_name, {})
+        if name in fam and fam[name] is not obj:
+            raise ValueError(f"name: {name!r} registered twice in family {family_name!r}")
+        fam[name] = obj
+        return obj
+
+    return deco
+
+
+def _load(family_name: str) -> None:
+    for mod in _PROVIDERS.get(family_name, []):
+        importlib.import_module(mod)
+
+
+def families() -> list[str]:
+    """Known family names."""
+    return sorted(set(_REG) | set(_PROVIDERS))
+
+
+def family(family_name: str) -> dict[str, Callable[..., Any]]:
+    """All members of a family, in registration order."""
+    _load(family_name)
+    if family_name not in _REG:
+        raise ValueError(f"family_name: unknown family {family_name!r}; known: {families()}")
+    return dict(_REG[family_name])
+
+
+def get(family_name: str, name: str) -> Callable[..., Any]:
+    """One member, e.g. ``get("jiang2023", "UPF")``."""
+    fam = family(family_name)
+    if name not in fam:
+        raise ValueError(f"name: {name!r} is not in family {family_name!r}; members: {list(fam)}")
+    return fam[name]

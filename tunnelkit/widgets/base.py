@@ -1,0 +1,82 @@
+"""A slider panel wired to a pure figure callback, shared by every explorer."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import ipywidgets as widgets
+import plotly.graph_objects as go
+
+__all__ = ["Explorer", "float_slider", "int_slider"]
+
+
+def float_slider(description: str, value: float, lo: float, hi: float, step: float, *,
+                 readout_format: str = ".3g") -> widgets.FloatSlider:
+    """A FloatSlider that only reports on release (``continuous_update=False``)."""
+    return widgets.FloatSlider(value=value, min=lo, max=hi, step=step, description=description,
+                               continuous_update=False, readout_format=readout_format,
+                               style={"description_width": "initial"}, layout={"width": "340px"})
+
+
+def int_slider(description: str, value: int, lo: int, hi: int, step: int = 1) -> widgets.IntSlider:
+    """An IntSlider that only reports on release (``continuous_update=False``)."""
+    return widgets.IntSlider(value=value, min=lo, max=hi, step=step, description=description,
+                             continuous_update=False, style={"description_width": "initial"},
+                             layout={"width": "340px"})
+
+
+class Explorer:
+    """Controls + a plotly ``FigureWidget`` redrawn by ``callback(**values) -> go.Figure``.
+
+    The figure is computed with the initial values *before* display, so a page that connects late
+    (Voila) shows the right state. ``set(name=value, ...)`` moves controls programmatically (tests,
+    lecture scripts) and triggers the same redraw as a user would.
+    """
+
+    def __init__(self, callback: Callable[..., go.Figure], controls: Mapping[str, widgets.ValueWidget],
+                 *, columns: int = 3) -> None:
+        self.callback = callback
+        self.controls = dict(controls)
+        self.figure = go.FigureWidget(callback(**self.values))
+        for w in self.controls.values():
+            w.observe(self._on_change, names="value")
+        boxes = list(self.controls.values())
+        rows = [widgets.HBox(boxes[i:i + columns]) for i in range(0, len(boxes), columns)]
+        self.widget = widgets.VBox([*rows, self.figure])
+
+    @property
+    def values(self) -> dict[str, Any]:
+        """Current value of every control, by name."""
+        return {k: w.value for k, w in self.controls.items()}
+
+    def _on_change(self, _change) -> None:
+        self.refresh()
+
+    def refresh(self) -> None:
+        """Recompute the figure from the current values and push it into the widget."""
+        new = self.callback(**self.values)
+        with self.figure.batch_update():
+            same = len(new.data) == len(self.figure.data) and all(
+                a.type == b.type for a, b in zip(new.data, self.figure.data))
+            if same:
+                for old, tr in zip(self.figure.data, new.data):
+                    old.update(tr.to_plotly_json(), overwrite=True)
+            else:
+                self.figure.data = ()
+                self.figure.add_traces(list(new.data))
+            self.figure.layout.annotations = ()
+            self.figure.layout.shapes = ()
+            self.figure.update_layout(new.layout.to_plotly_json())
+
+    def set(self, **values: Any) -> None:
+        """Move controls by name, e.g. ``explorer.set(M=64)``; unknown names raise."""
+        for k, v in values.items():
+            if k not in self.controls:
+                raise ValueError(f"{k}: no such control; controls are {sorted(self.controls)}")
+            self.controls[k].value = v
+
+    def _ipython_display_(self) -> None:  # pragma: no cover - display hook
+        from IPython.display import display
+
+        display(self.widget)
