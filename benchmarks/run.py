@@ -14,9 +14,9 @@ import json
 import statistics
 import sys
 import timeit
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 HERE = Path(__file__).resolve().parent
 
@@ -50,7 +50,9 @@ def _load_cases(pattern: str | None) -> list[Case]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-k", dest="pattern", default=None, help="only cases whose name or group contains this")
+    ap.add_argument(
+        "-k", dest="pattern", default=None, help="only cases whose name or group contains this"
+    )
     ap.add_argument("--json", default="build/bench.json", help="where to write the results")
     args = ap.parse_args(argv)
     results = []
@@ -58,16 +60,30 @@ def main(argv=None) -> int:
         c.fn()  # warm-up (imports, caches, JIT of BLAS paths)
         times = [t / c.number for t in timeit.repeat(c.fn, repeat=c.repeat, number=c.number)]
         q = statistics.quantiles(times, n=4) if len(times) >= 4 else [min(times), 0, max(times)]
-        results.append({"group": c.group, "name": c.name, "median_s": statistics.median(times),
-                        "q1_s": q[0], "q3_s": q[2], "repeat": c.repeat, "baseline": c.baseline,
-                        "goal_s": c.goal_s})
+        results.append(
+            {
+                "group": c.group,
+                "name": c.name,
+                "median_s": statistics.median(times),
+                "q1_s": q[0],
+                "q3_s": q[2],
+                "repeat": c.repeat,
+                "baseline": c.baseline,
+                "goal_s": c.goal_s,
+            }
+        )
     base = {r["group"]: r["median_s"] for r in results if r["baseline"]}
     print(f"{'group':18s} {'case':46s} {'median':>11s} {'IQR':>19s} {'ratio':>8s}  goal")
     for r in results:
         ratio = r["median_s"] / base[r["group"]] if r["group"] in base else None
         r["ratio_to_baseline"] = ratio
         iqr = f"{r['q1_s'] * 1e3:8.3f}-{r['q3_s'] * 1e3:8.3f} ms"
-        goal = "" if r["goal_s"] is None else f"< {r['goal_s'] * 1e3:g} ms " + ("met" if r["median_s"] < r["goal_s"] else "MISSED")
+        goal = (
+            ""
+            if r["goal_s"] is None
+            else f"< {r['goal_s'] * 1e3:g} ms "
+            + ("met" if r["median_s"] < r["goal_s"] else "MISSED")
+        )
         rs = f"{ratio:8.3f}" if ratio is not None else " " * 8
         print(f"{r['group']:18s} {r['name']:46s} {r['median_s'] * 1e3:8.3f} ms {iqr} {rs}  {goal}")
     out = Path(args.json)

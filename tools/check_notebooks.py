@@ -27,15 +27,33 @@ def problems(path: Path, strip: bool) -> list[str]:
                 c["outputs"], c["execution_count"] = [], None
                 changed = True
             else:
-                out.append(f"{path}: cell {i} has outputs or an execution count (run `make format`)")
-    code = ["".join(c["source"]) if isinstance(c["source"], list) else c["source"] for c in cells if c.get("cell_type") == "code"]
+                out.append(
+                    f"{path}: cell {i} has outputs or an execution count (run `make format`)"
+                )
+    code = [
+        "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        for c in cells
+        if c.get("cell_type") == "code"
+    ]
     if not code or "import tunnelkit as tk" not in code[0] or "tk.setup_notebook(" not in code[0]:
-        out.append(f"{path}: the first code cell must `import tunnelkit as tk` and call `tk.setup_notebook()`")
-    heads = [i for i, c in enumerate(cells) if c.get("cell_type") == "markdown"
-             and any(line.lstrip("# ").lower().startswith("checks") for line in "".join(c["source"]).splitlines() if line.startswith("#"))]
+        out.append(
+            f"{path}: the first code cell must `import tunnelkit as tk` and call `tk.setup_notebook()`"
+        )
+    heads = [
+        i
+        for i, c in enumerate(cells)
+        if c.get("cell_type") == "markdown"
+        and any(
+            line.lstrip("# ").lower().startswith("checks")
+            for line in "".join(c["source"]).splitlines()
+            if line.startswith("#")
+        )
+    ]
     if not heads:
         out.append(f"{path}: no markdown cell headed 'Checks'")
-    elif not any("assert" in "".join(c["source"]) for c in cells[heads[-1]:] if c.get("cell_type") == "code"):
+    elif not any(
+        "assert" in "".join(c["source"]) for c in cells[heads[-1] :] if c.get("cell_type") == "code"
+    ):
         out.append(f"{path}: the Checks section has no assert")
     if changed:
         path.write_text(json.dumps(nb, indent=1, ensure_ascii=False) + "\n")

@@ -23,7 +23,9 @@ def parse(text: str) -> list[dict]:
             return
         src = "\n".join(buf).strip("\n")
         if kind == "markdown":
-            src = "\n".join(line[2:] if line.startswith("# ") else line.lstrip("#") for line in src.splitlines())
+            src = "\n".join(
+                line[2:] if line.startswith("# ") else line.lstrip("#") for line in src.splitlines()
+            )
         if src.strip():
             cell = {"cell_type": kind, "metadata": {}, "source": src.splitlines(keepends=True)}
             if kind == "code":
@@ -41,8 +43,12 @@ def parse(text: str) -> list[dict]:
 
 
 def build(src: Path) -> str:
-    nb = {"cells": parse(src.read_text()), "metadata": {"kernelspec": KERNEL, "language_info": {"name": "python"}},
-          "nbformat": 4, "nbformat_minor": 5}
+    nb = {
+        "cells": parse(src.read_text()),
+        "metadata": {"kernelspec": KERNEL, "language_info": {"name": "python"}},
+        "nbformat": 4,
+        "nbformat_minor": 5,
+    }
     for i, c in enumerate(nb["cells"]):
         c["id"] = f"{src.stem[:2]}-{i:03d}"
     return json.dumps(nb, indent=1, ensure_ascii=False) + "\n"
@@ -51,7 +57,9 @@ def build(src: Path) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("sources", nargs="*", type=Path)
-    ap.add_argument("--check", action="store_true", help="fail if a notebook differs from its source")
+    ap.add_argument(
+        "--check", action="store_true", help="fail if a notebook differs from its source"
+    )
     args = ap.parse_args(argv)
     srcs = args.sources or sorted(Path("notebooks/src").glob("*.py"))
     bad = 0

@@ -14,16 +14,22 @@ import numpy as np
 __all__ = [
     "finite_array",
     "integer",
+    "nonnegative",
     "positive",
     "probability",
-    "nonnegative",
     "rng_or_error",
     "vector",
 ]
 
 
-def finite_array(name: str, value, *, ndim: int | None = None, shape: Sequence[int | None] | None = None,
-                 dtype=float) -> np.ndarray:
+def finite_array(
+    name: str,
+    value,
+    *,
+    ndim: int | None = None,
+    shape: Sequence[int | None] | None = None,
+    dtype=float,
+) -> np.ndarray:
     """Return ``value`` as a float array, refusing NaN/inf, a wrong ``ndim`` or ``shape``.
 
     ``shape`` may hold ``None`` for an axis of any length; a leading ``...`` is not supported, use
@@ -34,11 +40,15 @@ def finite_array(name: str, value, *, ndim: int | None = None, shape: Sequence[i
     try:
         arr = np.asarray(value, dtype=dtype)
     except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name}: expected an array of numbers, got {type(value).__name__}") from exc
+        raise TypeError(
+            f"{name}: expected an array of numbers, got {type(value).__name__}"
+        ) from exc
     if ndim is not None and arr.ndim != ndim:
         raise ValueError(f"{name}: expected {ndim}-D input, got shape {arr.shape}")
     if shape is not None:
-        if arr.ndim != len(shape) or any(s is not None and s != a for s, a in zip(shape, arr.shape)):
+        if arr.ndim != len(shape) or any(
+            s is not None and s != a for s, a in zip(shape, arr.shape)
+        ):
             want = "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
             raise ValueError(f"{name}: expected shape {want}, got {arr.shape}")
     if not np.all(np.isfinite(arr)):

@@ -15,7 +15,9 @@ from . import __version__, commands
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, dict]:
-    parser = argparse.ArgumentParser(prog="tunnelkit", description="Single-base-station tunnel positioning workbook.")
+    parser = argparse.ArgumentParser(
+        prog="tunnelkit", description="Single-base-station tunnel positioning workbook."
+    )
     parser.add_argument("--version", action="version", version=f"tunnelkit {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     handlers = {}

@@ -86,7 +86,9 @@ def _sigmas(name: str, sigma, n: int) -> np.ndarray | None:
         return None
     s = finite_array(name, sigma)
     if s.ndim > 1 or (s.ndim == 1 and s.shape[0] not in (1, n)):
-        raise ValueError(f"{name}: expected a scalar or one value per station ({n}), got shape {s.shape}")
+        raise ValueError(
+            f"{name}: expected a scalar or one value per station ({n}), got shape {s.shape}"
+        )
     if np.any(s <= 0):
         raise ValueError(f"{name}: must be > 0 (use None to leave this measurement out), got {s}")
     return np.broadcast_to(s, (n,)).astype(float)
@@ -125,8 +127,9 @@ def fim_toa_doa(p, stations, sigma_theta, sigma_d, *, form: str = "corrected") -
     return np.stack([np.stack([fxx, fxy], -1), np.stack([fxy, fyy], -1)], -2)
 
 
-def numeric_jacobian(h: Callable[[np.ndarray], np.ndarray], p, *, step: float = 1e-6,
-                     angle_mask=None) -> np.ndarray:
+def numeric_jacobian(
+    h: Callable[[np.ndarray], np.ndarray], p, *, step: float = 1e-6, angle_mask=None
+) -> np.ndarray:
     """Central-difference Jacobian of a vectorised ``h: (..., n) -> (..., m)``: shape (..., m, n).
 
     Components flagged in ``angle_mask`` (bool, length m) have their differences wrapped to
@@ -147,8 +150,9 @@ def numeric_jacobian(h: Callable[[np.ndarray], np.ndarray], p, *, step: float = 
     return np.stack(cols, axis=-1)
 
 
-def numeric_fim(h: Callable[[np.ndarray], np.ndarray], p, R, *, step: float = 1e-6,
-                angle_mask=None) -> np.ndarray:
+def numeric_fim(
+    h: Callable[[np.ndarray], np.ndarray], p, R, *, step: float = 1e-6, angle_mask=None
+) -> np.ndarray:
     """Brute-force Fisher information ``J^T R^-1 J`` for Gaussian noise of covariance ``R``.
 
     ``J`` is the central-difference Jacobian of ``h`` at ``p``; works for any measurement

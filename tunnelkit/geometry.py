@@ -60,7 +60,9 @@ class Plane:
     def _points(self, name: str, p) -> np.ndarray:
         arr = finite_array(name, p)
         if arr.ndim == 0 or arr.shape[-1] != self.dim:
-            raise ValueError(f"{name}: expected points with {self.dim} coordinates in the last axis, got shape {arr.shape}")
+            raise ValueError(
+                f"{name}: expected points with {self.dim} coordinates in the last axis, got shape {arr.shape}"
+            )
         return arr
 
     def signed_distance(self, p) -> np.ndarray:
@@ -139,7 +141,9 @@ def reflector_point(p_u, p_v, p_bs=None) -> np.ndarray:
     pu = finite_array("p_u", p_u)
     pv = finite_array("p_v", p_v)
     if pu.shape[-1:] != pv.shape[-1:] or pu.shape[-1] not in (2, 3):
-        raise ValueError(f"p_u, p_v: expected matching 2-D or 3-D points, got {pu.shape} and {pv.shape}")
+        raise ValueError(
+            f"p_u, p_v: expected matching 2-D or 3-D points, got {pu.shape} and {pv.shape}"
+        )
     bs = np.zeros(pu.shape[-1]) if p_bs is None else vector("p_bs", p_bs, pu.shape[-1])
     n = pv - pu
     nn = np.linalg.norm(n, axis=-1, keepdims=True)
@@ -229,9 +233,12 @@ class Tunnel2D:
     def require_inside(self, name: str, p) -> np.ndarray:
         """Return ``p`` as an array, raising if any point lies outside the tunnel."""
         p = self.walls[0]._points(name, p)
-        if not np.all(self.contains(p)):
-            bad = np.argwhere(~np.atleast_1d(self.contains(p)))[0]
-            raise ValueError(f"{name}: point {np.atleast_2d(p)[tuple(bad)[0]]} lies outside the tunnel walls")
+        inside = np.atleast_1d(self.contains(p))
+        if not np.all(inside):
+            first = int(np.argmin(inside))
+            raise ValueError(
+                f"{name}: point {np.atleast_2d(p)[first]} lies outside the tunnel walls"
+            )
         return p
 
     def virtual_stations(self, base_station) -> np.ndarray:

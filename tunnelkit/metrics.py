@@ -16,7 +16,9 @@ def position_errors(estimate, truth) -> np.ndarray:
     try:
         diff = est - tru
     except ValueError as exc:
-        raise ValueError(f"estimate, truth: shapes {est.shape} and {tru.shape} do not broadcast") from exc
+        raise ValueError(
+            f"estimate, truth: shapes {est.shape} and {tru.shape} do not broadcast"
+        ) from exc
     return np.linalg.norm(diff, axis=-1)
 
 

@@ -46,8 +46,14 @@ def spawn_rngs(seed: int | np.random.Generator, n: int) -> list[np.random.Genera
     return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(n)]
 
 
-def run_trials(trial: Callable[[np.random.Generator], Any], runs: int, seed: int | np.random.Generator,
-               *, progress: bool = False, desc: str = "trials") -> list[Any]:
+def run_trials(
+    trial: Callable[[np.random.Generator], Any],
+    runs: int,
+    seed: int | np.random.Generator,
+    *,
+    progress: bool = False,
+    desc: str = "trials",
+) -> list[Any]:
     """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm."""
     rngs = spawn_rngs(seed, runs)
     it = rngs

@@ -30,7 +30,9 @@ def _inputs(stations, d_hat, theta_hat):
     th = finite_array("theta_hat", theta_hat)
     n = st.shape[0]
     if d.ndim == 0 or d.shape[-1] != n:
-        raise ValueError(f"d_hat: expected one range per station ({n}) in the last axis, got {d.shape}")
+        raise ValueError(
+            f"d_hat: expected one range per station ({n}) in the last axis, got {d.shape}"
+        )
     if th.shape != d.shape:
         raise ValueError(f"theta_hat: shape {th.shape} does not match d_hat {d.shape}")
     if np.any(d <= 0):
@@ -105,8 +107,9 @@ def tswls(stations, d_hat, theta_hat, sigma_d, sigma_theta) -> np.ndarray:
     return np.where(ok2, refined, xy)
 
 
-def simulate_toa_doa(p, stations, sigma_theta, sigma_d, rng: np.random.Generator,
-                     size: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def simulate_toa_doa(
+    p, stations, sigma_theta, sigma_d, rng: np.random.Generator, size: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Noisy ranges and bearings at position(s) ``p`` (Jiang eq. 1-2, 8, 11).
 
     Returns ``(d_hat, theta_hat)``; with ``size`` a leading axis of that many independent trials.

@@ -18,7 +18,9 @@ def load(name: str) -> list[dict[str, str | float | None]]:
     """Rows of a reference table as dicts; numeric cells become floats, empty cells ``None``."""
     path = data_dir() / "reference" / f"{name}.csv"
     if not path.is_file():
-        raise ValueError(f"name: unknown reference table {name!r}; available: {', '.join(available())}")
+        raise ValueError(
+            f"name: unknown reference table {name!r}; available: {', '.join(available())}"
+        )
     rows = []
     with path.open(newline="") as fh:
         for row in csv.DictReader(fh):

@@ -13,6 +13,7 @@ A scenario file has a few top-level keys (``name``, ``paper``, ``description``) 
 
 from __future__ import annotations
 
+import itertools
 import os
 import tomllib
 from collections.abc import Callable
@@ -110,7 +111,10 @@ def _getter(where: str, section: dict, prefix: str):
             arr = np.asarray(val, dtype=float)
         except (TypeError, ValueError):
             raise ScenarioError(f"{where}: '{full}' must be numeric, got {val!r}") from None
-        if shape is not None and (arr.ndim != len(shape) or any(s is not None and s != a for s, a in zip(shape, arr.shape))):
+        if shape is not None and (
+            arr.ndim != len(shape)
+            or any(s is not None and s != a for s, a in zip(shape, arr.shape))
+        ):
             raise ScenarioError(f"{where}: '{full}' must have shape {shape}, got {arr.shape}")
         if not np.all(np.isfinite(arr)):
             raise ScenarioError(f"{where}: '{full}' must be finite")
@@ -148,7 +152,9 @@ class Scenario:
         get = _getter(self.path.name, sec, "tunnel")
         kind = get("kind", str)
         if kind not in _TUNNELS:
-            raise ScenarioError(f"{self.path.name}: unknown tunnel.kind {kind!r}; known: {sorted(_TUNNELS)}")
+            raise ScenarioError(
+                f"{self.path.name}: unknown tunnel.kind {kind!r}; known: {sorted(_TUNNELS)}"
+            )
         return _TUNNELS[kind](sec, get)
 
     def base_station(self) -> np.ndarray:
@@ -162,7 +168,9 @@ class Scenario:
         get = _getter(self.path.name, sec, "trajectory")
         kind = get("kind", str)
         if kind not in _TRAJECTORIES:
-            raise ScenarioError(f"{self.path.name}: unknown trajectory.kind {kind!r}; known: {sorted(_TRAJECTORIES)}")
+            raise ScenarioError(
+                f"{self.path.name}: unknown trajectory.kind {kind!r}; known: {sorted(_TRAJECTORIES)}"
+            )
         return _TRAJECTORIES[kind](sec, get, self.tunnel() if tunnel is None else tunnel)
 
     def noise_levels(self) -> list[tuple[float, float]]:
@@ -182,7 +190,9 @@ def load_scenario(name: str) -> Scenario:
         raise TypeError(f"name: expected a scenario name string, got {name!r}")
     path = Path(name) if name.endswith(".toml") else data_dir() / "scenarios" / f"{name}.toml"
     if not path.is_file():
-        raise ScenarioError(f"name: unknown scenario {name!r}; available: {', '.join(list_scenarios())}")
+        raise ScenarioError(
+            f"name: unknown scenario {name!r}; available: {', '.join(list_scenarios())}"
+        )
     try:
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
@@ -237,7 +247,7 @@ def _piecewise(sec: dict, get, tunnel) -> Trajectory:
     # acceleration as a function of time (zero after the last segment)
     edges = np.concatenate([[0.0], np.cumsum(segs[:, 0])]) if len(segs) else np.array([0.0])
     acc_tf = np.zeros((steps, 2))
-    for (t0, t1), (_, a_al, a_ac) in zip(zip(edges[:-1], edges[1:]), segs):
+    for (t0, t1), (_, a_al, a_ac) in zip(itertools.pairwise(edges), segs):
         acc_tf[(t >= t0) & (t < t1)] = (a_al, a_ac)
     if isinstance(tunnel, Tunnel2D):
         basis = np.stack([tunnel.axis, tunnel.across])  # rows: along, across
@@ -246,8 +256,12 @@ def _piecewise(sec: dict, get, tunnel) -> Trajectory:
     acc = acc_tf @ basis
     # exact integration of piecewise-constant acceleration on the sample grid
     vel_t = np.vstack([vel, vel + np.cumsum(acc[:-1] * period, axis=0)])
-    pos = np.vstack([start, start + np.cumsum(vel_t[:-1] * period + 0.5 * acc[:-1] * period**2, axis=0)])
+    pos = np.vstack(
+        [start, start + np.cumsum(vel_t[:-1] * period + 0.5 * acc[:-1] * period**2, axis=0)]
+    )
     if isinstance(tunnel, Tunnel2D) and not np.all(tunnel.contains(pos)):
         k = int(np.argmin(tunnel.contains(pos)))
-        raise ScenarioError(f"trajectory: leaves the tunnel at sample {k} (t = {t[k]:.2f} s, position {pos[k]})")
+        raise ScenarioError(
+            f"trajectory: leaves the tunnel at sample {k} (t = {t[k]:.2f} s, position {pos[k]})"
+        )
     return Trajectory(t=t, position=pos, velocity=vel_t)

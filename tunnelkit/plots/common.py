@@ -27,26 +27,58 @@ COLORS = {
 }
 
 
-def line_figure(x, series: Mapping[str, np.ndarray], *, title: str = "", xaxis: str = "", yaxis: str = "",
-                dash: Mapping[str, str] | None = None, log_y: bool = False) -> go.Figure:
+def line_figure(
+    x,
+    series: Mapping[str, np.ndarray],
+    *,
+    title: str = "",
+    xaxis: str = "",
+    yaxis: str = "",
+    dash: Mapping[str, str] | None = None,
+    log_y: bool = False,
+) -> go.Figure:
     """One line per entry of ``series`` against ``x``."""
     fig = go.Figure()
     for name, y in series.items():
-        fig.add_scatter(x=np.asarray(x), y=np.asarray(y), mode="lines", name=name,
-                        line={"color": COLORS.get(name.split()[0]), "dash": (dash or {}).get(name)})
-    fig.update_layout(title=title, xaxis_title=xaxis, yaxis_title=yaxis, height=380,
-                      margin={"l": 60, "r": 20, "t": 50, "b": 50})
+        fig.add_scatter(
+            x=np.asarray(x),
+            y=np.asarray(y),
+            mode="lines",
+            name=name,
+            line={"color": COLORS.get(name.split()[0]), "dash": (dash or {}).get(name)},
+        )
+    fig.update_layout(
+        title=title,
+        xaxis_title=xaxis,
+        yaxis_title=yaxis,
+        height=380,
+        margin={"l": 60, "r": 20, "t": 50, "b": 50},
+    )
     if log_y:
         fig.update_yaxes(type="log")
     return fig
 
 
-def cdf_figure(errors: Mapping[str, np.ndarray], *, title: str = "", xaxis: str = "error [m]") -> go.Figure:
+def cdf_figure(
+    errors: Mapping[str, np.ndarray], *, title: str = "", xaxis: str = "error [m]"
+) -> go.Figure:
     """Empirical CDFs of error samples, one line each."""
     fig = go.Figure()
     for name, e in errors.items():
         x, p = ecdf(e)
-        fig.add_scatter(x=x, y=p, mode="lines", name=name, line={"color": COLORS.get(name.split()[0]), "shape": "hv"})
-    fig.update_layout(title=title, xaxis_title=xaxis, yaxis_title="CDF", height=380, yaxis_range=[0, 1.02],
-                      margin={"l": 60, "r": 20, "t": 50, "b": 50})
+        fig.add_scatter(
+            x=x,
+            y=p,
+            mode="lines",
+            name=name,
+            line={"color": COLORS.get(name.split()[0]), "shape": "hv"},
+        )
+    fig.update_layout(
+        title=title,
+        xaxis_title=xaxis,
+        yaxis_title="CDF",
+        height=380,
+        yaxis_range=[0, 1.02],
+        margin={"l": 60, "r": 20, "t": 50, "b": 50},
+    )
     return fig

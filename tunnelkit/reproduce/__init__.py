@@ -46,8 +46,16 @@ class Report:
             return v
 
         recs = [{k: clean(v) for k, v in r.items()} for r in self.records()]
-        return json.dumps({"title": self.title, "meta": self.meta, "columns": list(self.columns),
-                           "rows": recs, "notes": self.notes}, indent=2)
+        return json.dumps(
+            {
+                "title": self.title,
+                "meta": self.meta,
+                "columns": list(self.columns),
+                "rows": recs,
+                "notes": self.notes,
+            },
+            indent=2,
+        )
 
     def to_table(self) -> str:
         """Plain-text table for a terminal."""
@@ -60,8 +68,10 @@ class Report:
             return str(v)
 
         cells = [[fmt(v) for v in r] for r in self.rows]
-        widths = [max(len(str(c)), *(len(r[i]) for r in cells)) if cells else len(str(c))
-                  for i, c in enumerate(self.columns)]
+        widths = [
+            max(len(str(c)), *(len(r[i]) for r in cells)) if cells else len(str(c))
+            for i, c in enumerate(self.columns)
+        ]
         line = "  ".join(str(c).ljust(w) for c, w in zip(self.columns, widths))
         out = [self.title, "=" * len(self.title)]
         out += [f"{k}: {v}" for k, v in self.meta.items()]

@@ -11,19 +11,41 @@ import plotly.graph_objects as go
 __all__ = ["Explorer", "float_slider", "int_slider"]
 
 
-def float_slider(description: str, value: float, lo: float, hi: float, step: float, *,
-                 readout_format: str = ".3g") -> widgets.FloatSlider:
+def float_slider(
+    description: str,
+    value: float,
+    lo: float,
+    hi: float,
+    step: float,
+    *,
+    readout_format: str = ".3g",
+) -> widgets.FloatSlider:
     """A FloatSlider that only reports on release (``continuous_update=False``)."""
-    return widgets.FloatSlider(value=value, min=lo, max=hi, step=step, description=description,
-                               continuous_update=False, readout_format=readout_format,
-                               style={"description_width": "initial"}, layout={"width": "340px"})
+    return widgets.FloatSlider(
+        value=value,
+        min=lo,
+        max=hi,
+        step=step,
+        description=description,
+        continuous_update=False,
+        readout_format=readout_format,
+        style={"description_width": "initial"},
+        layout={"width": "340px"},
+    )
 
 
 def int_slider(description: str, value: int, lo: int, hi: int, step: int = 1) -> widgets.IntSlider:
     """An IntSlider that only reports on release (``continuous_update=False``)."""
-    return widgets.IntSlider(value=value, min=lo, max=hi, step=step, description=description,
-                             continuous_update=False, style={"description_width": "initial"},
-                             layout={"width": "340px"})
+    return widgets.IntSlider(
+        value=value,
+        min=lo,
+        max=hi,
+        step=step,
+        description=description,
+        continuous_update=False,
+        style={"description_width": "initial"},
+        layout={"width": "340px"},
+    )
 
 
 class Explorer:
@@ -34,15 +56,20 @@ class Explorer:
     lecture scripts) and triggers the same redraw as a user would.
     """
 
-    def __init__(self, callback: Callable[..., go.Figure], controls: Mapping[str, widgets.ValueWidget],
-                 *, columns: int = 3) -> None:
+    def __init__(
+        self,
+        callback: Callable[..., go.Figure],
+        controls: Mapping[str, widgets.ValueWidget],
+        *,
+        columns: int = 3,
+    ) -> None:
         self.callback = callback
         self.controls = dict(controls)
         self.figure = go.FigureWidget(callback(**self.values))
         for w in self.controls.values():
             w.observe(self._on_change, names="value")
         boxes = list(self.controls.values())
-        rows = [widgets.HBox(boxes[i:i + columns]) for i in range(0, len(boxes), columns)]
+        rows = [widgets.HBox(boxes[i : i + columns]) for i in range(0, len(boxes), columns)]
         self.widget = widgets.VBox([*rows, self.figure])
 
     @property
@@ -58,7 +85,8 @@ class Explorer:
         new = self.callback(**self.values)
         with self.figure.batch_update():
             same = len(new.data) == len(self.figure.data) and all(
-                a.type == b.type for a, b in zip(new.data, self.figure.data))
+                a.type == b.type for a, b in zip(new.data, self.figure.data)
+            )
             if same:
                 for old, tr in zip(self.figure.data, new.data):
                     old.update(tr.to_plotly_json(), overwrite=True)

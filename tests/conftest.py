@@ -1,0 +1,29 @@
+"""Shared fixtures: Jiang's tunnel and its virtual stations."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tunnelkit as tk
+
+
+@pytest.fixture(scope="session")
+def jiang():
+    sc = tk.load_scenario("jiang2023-straight")
+    tunnel = sc.tunnel()
+    bs = sc.base_station()
+    return {
+        "scenario": sc,
+        "tunnel": tunnel,
+        "bs": bs,
+        "vs": tunnel.virtual_stations(bs),
+        "start": sc.trajectory(tunnel).position[0],
+    }
+
+
+def random_inside(tunnel, n: int, rng: np.random.Generator, along=(-50.0, 150.0), margin=0.2):
+    """Uniform random points inside a 2-D tunnel (tunnel-frame sampling)."""
+    a = rng.uniform(*along, n)
+    c = rng.uniform(margin, tunnel.width - margin, n)
+    return tunnel.from_tunnel_frame(np.stack([a, c], -1))
