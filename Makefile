@@ -1,5 +1,6 @@
 # tunnelkit — every command a newcomer needs. `make test` and `make lab` work from a fresh clone.
 SHELL := /bin/bash
+.SHELLFLAGS := -o pipefail -c
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -18,8 +19,8 @@ help:
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[lab,dev]'
+	$(PY) -m pip install --quiet --upgrade pip 2>&1 | sed '/is ignored/d'
+	$(PY) -m pip install --quiet -e '.[lab,dev]' 2>&1 | sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$/d'
 	touch $(STAMP)
 
 install: $(STAMP)

@@ -41,6 +41,8 @@ def test_spawned_streams_are_reproducible_and_independent():
 
 
 def test_lazy_submodules():
-    assert tk.constants.C == 299_792_458.0 and tk.constants.wavelength(5.9e9) == pytest.approx(0.0508, abs=1e-4)
+    assert tk.constants.C == 299_792_458.0 and tk.constants.wavelength(5.9e9) == pytest.approx(
+        0.0508, abs=1e-4
+    )
     with pytest.raises(AttributeError):
         tk.not_a_module  # noqa: B018

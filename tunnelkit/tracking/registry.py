@@ -15,7 +15,7 @@ import importlib
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["family", "families", "get", "register"]
+__all__ = ["families", "family", "get", "provide", "register"]
 
 _REG: dict[str, dict[str, Callable[..., Any]]] = {}
 #: family -> modules to import before the family is looked up (keeps ``import tunnelkit`` light)
