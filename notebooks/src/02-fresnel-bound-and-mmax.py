@@ -1,0 +1,353 @@
+# %% [markdown]
+# # 02 · How many antennas? The SR-NF validity bound $M_{\max}$
+#
+# *Italiano et al. (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field and
+# Radio-Reflective Road Markings", section 3.1 (Theorems 3.1 and 3.4, eq. 25–42) and section 4.2.*
+#
+# **What you will learn**
+#
+# - what the single-reflector near-field (SR-NF) channel model assumes about a wall-reflected path,
+#   and why it breaks when the array grows;
+# - the proof of Theorem 3.1 step by step (eq. 26 → 34), each approximation checked numerically
+#   against the exact geometry as it is made;
+# - the paper's design example ($M_{\max} = 9.88$, so $M = 100$) and what the *exact* phase mismatch
+#   says about it;
+# - where the closed-form bounds (eq. 25, eq. 37) are tight, where they are loose, and a corrected
+#   second-order bound that holds outside the paraxial regime;
+# - how to size an array for a 5.9 GHz or a 28 GHz tunnel, with sliders and with
+#   `tunnelkit mmax` on the command line.
+
+# %%
+import numpy as np
+
+import tunnelkit as tk
+from tunnelkit import fresnel, geometry
+from tunnelkit.constants import wavelength
+from tunnelkit.plots import (
+    derivation_figure,
+    fresnel_topview,
+    mismatch_figure,
+    mmax_range_figure,
+    ratio_map_figure,
+)
+from tunnelkit.widgets import mmax_explorer, mmax_figure
+
+tk.setup_notebook()
+
+# %% [markdown]
+# ## 1. The setting: one wall, one UE, its virtual UE
+#
+# The base station's reference antenna sits at the origin; the tunnel runs along $x$. A ULA of
+# $M$ antennas lies across the tunnel at $y_m = m d$, $d = \lambda/2$. The reflecting wall is the
+# plane $y = W$; the UE is at $(R, y_u)$ with $y_u < W$. By the image method the wall-reflected
+# path to antenna $m$ is as long as the straight line from the **virtual UE** (VUE)
+#
+# $$\mathbf p_v = (R,\; 2W - y_u).$$
+#
+# The SR-NF model (Italiano et al., after TeNFiLoc) describes the same path instead as a spherical
+# wave from **one point on the wall**, $\mathbf p_{s,0}$, the specular point of the reference
+# antenna. For a small array the two pictures agree; for a large one the wavefront across the
+# array is visibly centred on the VUE, not on the wall. The figure is Fig. 2 of the paper
+# (`tunnelkit.plots.fresnel_topview`); the paper's design example is $R = 3.5$ m, $W = 3$ m,
+# $y_u = 2.5$ m at $f_c = 5.9$ GHz with $\varepsilon_\Phi = 0.15$ rad (section 4.2).
+
+# %%
+R, W, y_u, fc, eps = 3.5, 3.0, 2.5, 5.9e9, 0.15
+lam = wavelength(fc)
+print(f"lambda = {lam * 100:.3f} cm, spacing d = {lam / 2 * 100:.3f} cm")
+print(
+    "VUE p_v =",
+    fresnel.vue(R, W, y_u),
+    " reflector p_s0 =",
+    fresnel.reference_specular_point(R, W, y_u).round(4),
+)
+fresnel_topview(10, R, W, y_u, fc).show()
+
+# %% [markdown]
+# ## 2. The proof of Theorem 3.1, one step at a time
+#
+# ### Eq. 26–27: exact path lengths via the VUE
+#
+# $$d_{v,0} = \sqrt{R^2 + (2W - y_u)^2}, \qquad d_{v,m} = \sqrt{R^2 + (2W - y_u - y_m)^2}.$$
+#
+# Check: fold each path at *its own* specular point on the wall (`geometry.specular_point`) and add
+# the two segments UE → wall → antenna; it must equal $d_{v,m}$.
+
+# %%
+M = 100
+prof = fresnel.aperture_profile(M, R, W, y_u, fc)
+ue = np.array([R, y_u])
+ant = np.column_stack([np.zeros(M), prof.y])
+wall = geometry.line(0.0, 1.0, -W)  # y - W = 0
+s = geometry.specular_point(ue, ant, wall)
+folded = np.linalg.norm(s - ue, axis=1) + np.linalg.norm(ant - s, axis=1)
+err_2627 = np.abs(folded - prof.d_v).max()
+print(f"max |folded path - d_v,m| over {M} antennas: {err_2627:.2e} m")
+
+# %% [markdown]
+# ### Eq. 28: the Fresnel expansion of the true path difference
+#
+# For $|y_m| \ll R$ the paper expands
+#
+# $$\delta^*_m = d_{v,m} - d_{v,0} \approx \frac{y_m^2 - 2(2W - y_u)\,y_m}{2R}. \tag{28}$$
+#
+# That step silently needs more than $|y_m| \ll R$: the denominator $d_{v,m} + d_{v,0}$ is replaced
+# by $2R$, which is only accurate if $|2W - y_u| \ll R$ too (the **paraxial** assumption). In the
+# design example $2W - y_u = 3.5\text{ m} = R$. Phase errors $\frac{2\pi}{\lambda}(\cdot)$ of the
+# expansion at a few antennas:
+
+# %%
+k = 2 * np.pi / lam
+err28 = k * (prof.delta_star_fresnel - prof.delta_star)
+for m in (1, 9, 14, 99):
+    print(
+        f"m = {m:3d}: exact delta* = {prof.delta_star[m] * 100:8.3f} cm, "
+        f"eq. 28 phase error {err28[m]:8.3f} rad"
+    )
+
+# %% [markdown]
+# Already at the second antenna the expansion is off by far more than $\varepsilon_\Phi = 0.15$
+# rad: eq. 28 gets the *linear* term wrong ($2(2W-y_u)y_m/(2R)$ instead of
+# $(2W - y_u) y_m / d_{v,0}$, i.e. $\sin$ of the arrival angle replaced by $\tan$). The proof
+# survives only because the same mistake is made in eq. 31 and cancels in eq. 33, as we check
+# next.
+#
+# ### Eq. 29–32: the single reflector
+#
+# $$d_{p_0,m} = \sqrt{x_{p_0}^2 + (W - y_m)^2}, \qquad x_{p_0} = R\,\frac{W}{2W - y_u}, \tag{29–32}$$
+#
+# $$\delta^{SR}_m = d_{p_0,m} - d_{p_0,0} \approx \frac{y_m^2 - 2W y_m}{2 x_{p_0}}. \tag{31}$$
+
+# %%
+p0 = geometry.specular_point(ue, np.zeros(2), wall)  # reflection point seen by antenna 0
+print(f"eq. 32: x_p0 = {prof.x_p0:.6f} m, specular point from geometry: {p0.round(6)}")
+err31 = k * (prof.delta_sr_fresnel - prof.delta_sr)
+print("eq. 31 phase error at m = 1, 9, 99:", err31[[1, 9, 99]].round(3), "rad")
+lin28 = -2 * (2 * W - y_u) / (2 * R)  # coefficient of y_m in eq. 28
+lin31 = -2 * W / (2 * prof.x_p0)  # coefficient of y_m in eq. 31 with eq. 32
+print(f"linear coefficients: eq. 28 {lin28:.6f}, eq. 31 {lin31:.6f}")
+
+# %% [markdown]
+# ### Eq. 33–34: the linear terms cancel, a quadratic error remains
+#
+# $$\Delta\delta_m = \delta^*_m - \delta^{SR}_m \approx -\frac{W - y_u}{2RW}\, y_m^2, \qquad
+# \frac{2\pi}{\lambda}\,\frac{|W - y_u|}{2RW}(M-1)^2 d^2 \le \varepsilon_\Phi. \tag{33, 34}$$
+#
+# Within the expansions the cancellation is exact (eq. 28 − eq. 31 *is* eq. 33). Against the exact
+# mismatch, eq. 33 is off by a nearly constant factor here — the paraxial error that cancelled in
+# the linear term does not cancel in the quadratic one:
+
+# %%
+cancel = np.abs(k * (prof.delta_star_fresnel - prof.delta_sr_fresnel) - prof.mismatch_paraxial)
+print(f"max |(eq. 28 - eq. 31) - eq. 33| = {cancel.max():.1e} rad")
+print(
+    "eq. 33 / exact mismatch at m = 1, 9, 99:",
+    (prof.mismatch_paraxial[[1, 9, 99]] / prof.mismatch[[1, 9, 99]]).round(3),
+)
+derivation_figure(fresnel.aperture_profile(16, R, W, y_u, fc), lam=lam).show()
+
+# %% [markdown]
+# Solving eq. 34 with $d = \lambda/2$ for $M$ gives Theorem 3.1:
+#
+# $$M_{\max} \le 1 + 2\sqrt{\frac{R\,W\,\varepsilon_\Phi}{\lambda\,|W - y_u|\,\pi}}. \tag{25}$$
+#
+# ## 3. The paper's design example
+#
+# Section 4.2: $R = 3.5$ m, $W = 3$ m, $y_u = 2.5$ m, $\varepsilon_\Phi = 0.15$ rad at 5.9 GHz give
+# $M_{\max} = 9.88$, and the simulations use a URA of $M = M_{\max}^2 \approx 100$ antennas
+# ($10 \times 10$). `fresnel.mmax_exact` finds the largest ULA whose **exact** mismatch
+# $\max_m \frac{2\pi}{\lambda}|\delta^*_m - \delta^{SR}_m|$ stays within $\varepsilon_\Phi$ (no
+# expansion at all); `fresnel.mmax_exact_ura` does the same for the $M\times M$ URA of section 4.1
+# (looking along the tunnel, tilted 30° down).
+
+# %%
+m25 = fresnel.mmax_2d(R, W, y_u, fc, eps)
+edge34 = k * abs(W - y_u) / (2 * R * W) * ((m25 - 1) * lam / 2) ** 2  # eq. 34 at M = eq. 25
+m_exact = fresnel.mmax_exact(R, W, y_u, fc, eps)
+m_ura = fresnel.mmax_exact_ura(R, W, y_u, fc, eps)
+print(f"eq. 25: Mmax = {m25:.2f} (eq. 34 there: {edge34:.4f} rad), M = {round(m25) ** 2}")
+print(
+    f"exact ULA: Mmax = {m_exact}   (mismatch {fresnel.phase_mismatch(m_exact, R, W, y_u, fc):.4f}"
+    f" rad; with {m_exact + 1}: {fresnel.phase_mismatch(m_exact + 1, R, W, y_u, fc):.4f} rad)"
+)
+print(
+    f"exact URA (section 4.1): {m_ura} x {m_ura};  10 x 10 mismatch "
+    f"{fresnel.phase_mismatch_ura(10, R, W, y_u, fc):.4f} rad"
+)
+
+# %% [markdown]
+# So the paper's choice is safe — more than safe: the exact ULA tolerates 15 antennas, not 9.88,
+# and the $10 \times 10$ URA stays within $\varepsilon_\Phi$. Eq. 25 is **conservative** here
+# because the example lies outside its paraxial assumption: $(2W - y_u)/R = 1$, not $\ll 1$.
+#
+# ## 4. The honest comparison: bounds vs exact geometry
+#
+# ### A corrected second-order bound
+#
+# The VUE and the reference specular point lie on **one ray** from the origin, at distances
+# $\rho = \|\mathbf p_v\|$ (eq. 35) and $\rho_s = \rho W/(2W - y_u)$. Expanding both path
+# differences to second order in the aperture (eq. 40 for each source) the linear terms
+# $-\mathbf u^{\mathsf T}\mathbf p_m$ cancel exactly, without any paraxial assumption, and
+#
+# $$\Delta\delta_m \approx \frac{\|\mathbf P^\perp_{\mathbf U}\mathbf p_m\|^2}{2}
+#   \Big(\frac1\rho - \frac1{\rho_s}\Big) = -\frac{W - y_u}{2\rho W}\,
+#   \|\mathbf P^\perp_{\mathbf U}\mathbf p_m\|^2 .$$
+#
+# For the ULA, $\|\mathbf P^\perp_{\mathbf U}\mathbf p_m\|^2 = y_m^2 (R^2 + z_u^2)/\rho^2$, so
+#
+# $$M_{\max} \le 1 + 2\sqrt{\frac{\varepsilon_\Phi\,\rho^3\, W}{\lambda\,\pi\,|W - y_u|\,(R^2 + z_u^2)}}
+#   \quad\xrightarrow{\ \rho \to R\ }\quad \text{eq. 25.}$$
+#
+# (`fresnel.mmax_nonparaxial`). Compare eq. 41 as printed, $|\Delta\delta_m| \approx
+# \|\mathbf P^\perp\mathbf p_m\|^2/(2\rho)$: it keeps the true wavefront's curvature and drops the
+# SR model's own, i.e. it compares the VUE wavefront with a *plane* wave. Far from the anchor, eq.
+# 37 is therefore conservative by $\sqrt{W/(W - y_u)}$ for $0 \le y_u < W$ but **optimistic**
+# (too many antennas) when the UE is on the far side of the array, $y_u < 0$; close to the anchor
+# the projection $\|\mathbf P^\perp\mathbf p_m\| = (M-1)d\,R/\rho < (M-1)d$ makes it conservative
+# again.
+
+# %%
+mismatch_figure(m_exact, R, W, y_u, fc, eps).show()
+for rr, yy in ((3.5, 2.5), (3.5, -3.0), (30.0, 2.5), (30.0, -3.0)):
+    print(
+        f"R = {rr:4.1f}, y_u = {yy:4.1f}: eq. 25 {fresnel.mmax_2d(rr, W, yy, fc, eps):6.2f}, "
+        f"eq. 37 {fresnel.mmax_3d([rr, 2 * W - yy, 0.0], fc, eps):6.2f}, "
+        f"2nd order {fresnel.mmax_nonparaxial(rr, W, yy, fc, eps):6.2f}, "
+        f"exact {fresnel.mmax_exact(rr, W, yy, fc, eps):3d}"
+    )
+
+# %% [markdown]
+# ### Where is eq. 25 tight? A map over $(R, y_u)$
+#
+# Ratio of eq. 25 to the exact $M_{\max}$ over distance and UE position (5.9 GHz, $W = 3$ m,
+# $\varepsilon_\Phi = 0.15$ rad): 1 (white) is tight, blue is conservative, red would be unsafe.
+# `fresnel.mmax_exact_grid` computes the exact value for the whole grid at once.
+
+# %%
+R_grid = np.geomspace(1.0, 300.0, 70)
+y_grid = np.linspace(-5.0, W - 0.05, 60)
+exact_map = fresnel.mmax_exact_grid(R_grid[None, :], W, y_grid[:, None], fc, eps)
+ratio25 = fresnel.mmax_2d(R_grid[None, :], W, y_grid[:, None], fc, eps) / exact_map
+pv_grid = np.stack(np.broadcast_arrays(R_grid[None, :], 2 * W - y_grid[:, None], 0.0), -1)
+ratio37 = fresnel.mmax_3d(pv_grid, fc, eps) / exact_map
+ratio_map_figure(
+    R_grid, y_grid, ratio25, title="eq. 25 / exact Mmax (5.9 GHz, W = 3 m)", W=W
+).show()
+ratio_map_figure(
+    R_grid, y_grid, ratio37, title="eq. 37 / exact Mmax (5.9 GHz, W = 3 m)", W=W
+).show()
+far = R_grid >= 100
+floor_gap = np.floor(fresnel.mmax_2d(R_grid[far], W, y_grid[:, None], fc, eps)) - exact_map[:, far]
+print(f"R >= 100 m: eq. 25 / exact in [{ratio25[:, far].min():.3f}, {ratio25[:, far].max():.3f}]")
+print(f"R >= 100 m: floor(eq. 25) - exact in [{floor_gap.min():.0f}, {floor_gap.max():.0f}]")
+print(f"eq. 37 / exact > 1.05 (unsafe) on {np.mean(ratio37 > 1.05):.0%} of the map")
+
+# %% [markdown]
+# Far from the base station ($R \gg 2W - y_u$) eq. 25 is tight — up to the rounding of the exact
+# value to whole antennas, which alone moves the ratio by up to $1/M_{\max}$; close to it, eq. 25 is
+# conservative by up to a factor of several (the exact $M_{\max}$ even *grows* again at small $R$,
+# where the reflection becomes grazing). Eq. 37 sees $y_u$ only through $\rho$: it is too small on
+# most of the map and too large (unsafe) when the UE is on the far side of the array, $y_u < 0$.
+#
+# ### Bound vs exact at ten geometries
+#
+# Two far-away geometries where eq. 25 is tight, the paper's example, and seven others (one with
+# the UE $3.3$ m below the array, as for a 4.8 m high anchor; the URA is section 4.1's).
+
+# %%
+ten = [
+    dict(label="paper example", R=3.5, W=3.0, y_u=2.5, fc=5.9e9, eps_phi=0.15),
+    dict(label="paraxial A", R=100.0, W=3.0, y_u=2.5, fc=5.9e9, eps_phi=0.15),
+    dict(label="paraxial B", R=200.0, W=2.0, y_u=1.0, fc=28e9, eps_phi=0.15),
+    dict(label="near", R=10.0, W=3.0, y_u=2.5, fc=5.9e9, eps_phi=0.15),
+    dict(label="UE on BS line", R=30.0, W=5.0, y_u=0.0, fc=5.9e9, eps_phi=0.15),
+    dict(label="UE across", R=30.0, W=5.0, y_u=-3.0, fc=5.9e9, eps_phi=0.15),
+    dict(label="28 GHz", R=50.0, W=5.0, y_u=4.5, fc=28e9, eps_phi=0.15),
+    dict(label="short, 28 GHz", R=5.0, W=5.0, y_u=1.0, fc=28e9, eps_phi=0.15),
+    dict(label="UE near wall", R=20.0, W=3.0, y_u=2.9, fc=5.9e9, eps_phi=0.15),
+    dict(label="paper, z_u=-3.3", R=3.5, W=3.0, y_u=2.5, z_u=-3.3, fc=5.9e9, eps_phi=0.15),
+]
+table10 = fresnel.design_report(ten)
+print(table10.to_table())
+
+# %% [markdown]
+# ## 5. Design tables for 5.9 GHz and 28 GHz tunnels
+#
+# A 10 m wide tunnel with the anchor in the middle (section 4.1): wall at $W = 5$ m, anchor 4.8 m
+# high, UE antenna at 1.5 m ($z_u = -3.3$ m), UE in the near lane ($y_u = 1.75$ m) or the far lane
+# ($y_u = -1.75$ m), $\varepsilon_\Phi = 0.15$ rad. Each row: the largest ULA and $M \times M$ URA
+# for which the SR-NF model holds at that distance. The same numbers come from the command line:
+# `tunnelkit mmax --R 50 --W 5 --y-u 1.75 --z-u -3.3 --fc 5.9GHz 28GHz`.
+
+# %%
+design = [
+    dict(label=f"{f / 1e9:g} GHz, {lane}", R=r, W=5.0, y_u=yy, z_u=-3.3, fc=f, eps_phi=0.15)
+    for f in (5.9e9, 28e9)
+    for lane, yy in (("near lane", 1.75), ("far lane", -1.75))
+    for r in (5.0, 20.0, 50.0, 100.0)
+]
+table_design = fresnel.design_report(design, title="SR-NF design table (W = 5 m, z_u = -3.3 m)")
+print(table_design.to_table())
+mmax_range_figure(50.0, 5.0, -1.75, 28e9, 0.15, 64, z_u=-3.3).show()
+
+# %% [markdown]
+# ## 6. Explore
+#
+# Drag the sliders (they update on release). Panel (a) is Fig. 2 for the current geometry,
+# (b) the phase mismatch across the array (exact, eq. 33, corrected second order, and
+# $\varepsilon_\Phi$), (c) $M_{\max}$ against $R$ on log-log axes with the $\sqrt{R/\lambda}$
+# Fraunhofer law for reference; the star is your design ($R$, $M$). The title is the verdict from
+# the exact mismatch. $y_u$ cannot reach the wall: its maximum follows $W$.
+
+# %%
+explorer = mmax_explorer()
+explorer
+
+# %% [markdown]
+# ## Exercises
+#
+# 1. At 5.9 GHz with $W = 3$ m and $y_u = 2.5$ m, from which distance $R$ on is eq. 25 within 5 %
+#    of the exact $M_{\max}$?
+# 2. Put the UE in the opposite lane, $y_u = -2$ m, at $R = 30$ m, 28 GHz. Which of eq. 25,
+#    eq. 37 and the second-order bound is unsafe (larger than the exact value)?
+# 3. An engineer wants a $16 \times 16$ URA at 28 GHz in the tunnel of section 5 (far lane). From
+#    which distance on does the SR-NF model hold for it?
+#
+# <details><summary>Hints and solutions</summary>
+#
+# 1. `Rs = np.geomspace(1, 300, 400)`; `r = fresnel.mmax_2d(Rs, 3, 2.5, 5.9e9, 0.15) /
+#    fresnel.mmax_exact_grid(Rs, 3, 2.5, 5.9e9, 0.15)`; the first `Rs` with `abs(r - 1) < 0.05`
+#    for good is about 10 m, where $(2W - y_u)/R \approx 0.35$: "$\ll 1$" need not be very small.
+# 2. `fresnel.mmax_summary(30, 3, -2, 28e9, 0.15)`: exact 19; eq. 37 says 24.5 — unsafe, it drops
+#    the factor $W/(W - y_u) = 0.6$; eq. 25 says 18.9 (close, $(2W - y_u)/R = 0.27$); the
+#    second-order bound says 19.9.
+# 3. Loop over `R` with `fresnel.phase_mismatch_ura(16, R, 5, -1.75, 28e9, z_u=-3.3) <= 0.15`:
+#    the mismatch falls with distance, 0.171 rad at 15 m and 0.149 rad at 20 m, so from about
+#    20 m on (`fresnel.mmax_exact_ura(20, 5, -1.75, 28e9, 0.15, z_u=-3.3)` is 16).
+#
+# </details>
+
+# %% [markdown]
+# ## Checks
+
+# %%
+assert abs(m25 - 9.88) < 0.01 and round(m25) ** 2 == 100  # section 4.2
+assert abs(edge34 - eps) < 1e-12  # eq. 25 solves eq. 34
+assert err_2627 < 1e-9 and abs(prof.x_p0 - p0[0]) < 1e-12  # eq. 26-27, eq. 32
+assert cancel.max() < 1e-9 and abs(lin28 - lin31) < 1e-12  # linear terms cancel (eq. 33)
+assert np.abs(err28[1:]).min() > eps  # eq. 28 alone is off outside the paraxial regime
+assert m_exact == 15 and m_ura == 11  # exact: the paper's M = 100 (10 x 10) is safe
+assert fresnel.phase_mismatch_ura(10, R, W, y_u, fc) <= eps
+assert np.abs(floor_gap).max() <= 1 and abs(ratio25[:, far] - 1).max() < 0.08  # tight far away
+assert ratio25.min() < 0.5  # ... and loose close to the anchor
+assert (ratio37 > 1.05).any() and (ratio37 < 0.95).any()  # eq. 37: both ways wrong
+rows = table10.records()
+assert (
+    len(rows) == 10
+    and abs(rows[1]["eq.25/exact"] - 1) < 0.02
+    and abs(rows[2]["eq.25/exact"] - 1) < 0.02
+)
+assert all(abs(r["2nd-order"] - r["exact ULA"]) <= 1 + 0.04 * r["exact ULA"] for r in rows)
+assert explorer.figure.layout.title.text.startswith("SR-NF valid for M = 10")
+assert mmax_figure(M=40).layout.title.text.startswith("SR-NF not valid")
+print("all checks passed")
