@@ -13,6 +13,7 @@ A scenario file has a few top-level keys (``name``, ``paper``, ``description``) 
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import os
 import tomllib
@@ -198,6 +199,13 @@ def load_scenario(name: str) -> Scenario:
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path.name}: not valid TOML ({exc})") from None
     get = _getter(path.name, raw, "")
+    # modules that register this preset's tunnel/trajectory kinds (e.g. "tunnelkit.propagation")
+    for mod in raw.get("requires", []):
+        if not isinstance(mod, str) or not mod.startswith("tunnelkit."):
+            raise ScenarioError(
+                f"{path.name}: 'requires' entries must name tunnelkit modules, got {mod!r}"
+            )
+        importlib.import_module(mod)
     sc = Scenario(
         name=get("name", str),
         paper=get("paper", str),

@@ -1,0 +1,208 @@
+import warnings
+
+import numpy as np
+import pytest
+
+from tunnelkit import arrays, channel, extraction
+from tunnelkit import propagation as P
+from tunnelkit.constants import C
+
+FC = 5.9e9
+CFG = channel.SRSConfig()
+
+
+@pytest.fixture(scope="module")
+def route():
+    return channel.SignalRoute.from_scenario("italiano2026-straight")
+
+
+def _extract(H, L, arr, **kw):
+    return extraction.extract_paths(H, L, arr.local, FC, CFG.tone_spacing, CFG.symbol_period, **kw)
+
+
+def _angle_deg(u, v):
+    return np.degrees(np.arccos(np.clip(np.sum(u * v, axis=-1), -1, 1)))
+
+
+def test_noiseless_scenario_epoch_is_recovered_exactly(route):
+    arr, paths = route.paths(20)
+    H = channel.channel_tensor(paths, CFG)
+    est = _extract(H, len(paths), arr)
+    o = np.argsort([p.length for p in paths])
+    np.testing.assert_allclose(est.d, [paths[i].length for i in o], atol=1e-6)
+    np.testing.assert_allclose(est.v, [paths[i].velocity for i in o], atol=1e-5)
+    truth = np.stack([paths[i].direction_local for i in o])
+    assert np.max(_angle_deg(est.direction, truth)) < 0.05
+    # exact physics: the wavefront is centred on the VUE, so kappa is the VUE distance
+    np.testing.assert_allclose(est.kappa, [paths[i].length for i in o], rtol=2e-3)
+    assert np.all(est.near_field) and np.all(est.valid) and est.rel_error < 1e-6
+
+
+def test_srnf_channel_gives_reflection_point_distance(route):
+    arr, paths = route.paths(20)
+    H = channel.channel_tensor(paths, CFG, model="srnf")
+    est = _extract(H, len(paths), arr)
+    o = np.argsort([p.length for p in paths])
+    np.testing.assert_allclose(est.kappa, [paths[i].kappa_srnf for i in o], rtol=2e-3)  # eq. 51
+
+
+def test_psi_follows_eq19_polar_angle_not_eq22():
+    pos = arrays.ura(8, 8, 0.0254)
+    src = np.array([1.5, -2.0, 9.0])  # local frame, in front of the array
+    delta = np.linalg.norm(pos - src, axis=1) - np.linalg.norm(src)
+    x = extraction.solve_near_field(delta[:, None], pos)[0]
+    kappa = np.linalg.norm(src)
+    np.testing.assert_allclose(x, [src[0], src[1], kappa], rtol=1e-9)
+    ang = extraction.angles_from_solution(x[None], np.zeros((1, 2)))
+    u = src / kappa
+    assert ang["psi_nf"][0] == pytest.approx(np.arccos(u[2]), abs=1e-9)  # eq. 19: from the normal
+    eq22 = np.arccos(np.hypot(x[0], x[1]) / x[2])
+    assert eq22 == pytest.approx(np.pi / 2 - np.arccos(u[2]), abs=1e-9)  # eq. 22 is the complement
+    np.testing.assert_allclose(ang["dir_nf"][0], u, atol=1e-9)
+    # far field: delta_m = -u . p_m, LS gives (u_x, u_y)
+    uf = extraction.solve_far_field(-(pos @ u)[:, None], pos)[0]
+    np.testing.assert_allclose(uf, u[:2], atol=1e-12)
+
+
+def test_unwrapping_on_a_grid_and_on_a_scattered_array():
+    rng = np.random.default_rng(2)
+    pos = arrays.ura(6, 7, 0.5)
+    true = pos @ np.array([2.6, -1.9, 0]) + 0.05 * np.sum(
+        pos**2, axis=1
+    )  # ramps of ~pi per element
+    un = extraction.unwrap_spatial(np.exp(1j * true)[:, None], pos)[:, 0]
+    np.testing.assert_allclose(un, true - true[0], atol=1e-9)
+    scattered = np.column_stack(
+        [np.cumsum(rng.uniform(0.3, 0.5, 12)), rng.uniform(0, 0.4, 12), np.zeros(12)]
+    )
+    scattered -= scattered[0]
+    t2 = scattered @ np.array([3.0, 1.0, 0])
+    un2 = extraction.unwrap_spatial(np.exp(1j * t2)[:, None], scattered)[:, 0]
+    np.testing.assert_allclose(un2, t2 - t2[0], atol=1e-9)
+
+
+def test_kruskal_bounds_and_ranks():
+    assert extraction.max_identifiable_rank((100, 410, 12)) == 110
+    assert extraction.max_identifiable_rank((2, 2, 2)) == 2
+    with pytest.raises(ValueError, match=r"n_paths.*Kruskal"):
+        extraction.check_rank((4, 4, 2), 5)
+    v = np.exp(1j * np.outer(np.arange(8), [0.1, 0.7, 1.9]))
+    assert extraction.kruskal_rank(v) == 3
+    assert extraction.kruskal_rank(np.column_stack([v[:, 0], v[:, 0], v[:, 1]])) == 1
+
+
+def test_crlb_matches_finite_difference_fim():
+    rng = np.random.default_rng(4)
+    pos = arrays.ura(2, 2, 0.025)
+    L, nf, nt, n0 = 2, 6, 4, 0.3
+    alpha = rng.normal(size=L) + 1j * rng.normal(size=L)
+    src = np.array([[0.3, 0.2, 1.5], [-0.4, 0.1, 2.0]])
+    mu_f, mu_t = np.array([0.3, -0.8]), np.array([0.05, 0.4])
+    k0 = 2 * np.pi * FC / C
+
+    def model(theta):
+        out = np.zeros((4, nf, nt), complex)
+        for j_ in range(L):
+            a_l = theta[7 * j_] + 1j * theta[7 * j_ + 1]
+            s = theta[7 * j_ + 4 : 7 * j_ + 7]
+            r = np.linalg.norm(pos - s, axis=1)
+            out += a_l * np.einsum(
+                "m,s,k->msk",
+                np.exp(1j * k0 * (r - r[0])),
+                np.exp(1j * np.arange(nf) * theta[7 * j_ + 2]),
+                np.exp(1j * np.arange(nt) * theta[7 * j_ + 3]),
+            )
+        return out.ravel()
+
+    theta = np.concatenate(
+        [[alpha[j_].real, alpha[j_].imag, mu_f[j_], mu_t[j_], *src[j_]] for j_ in range(L)]
+    )
+    J = np.stack(
+        [(model(theta + h) - model(theta - h)) / (2e-6) for h in 1e-6 * np.eye(theta.size)], axis=1
+    )
+    cov = np.linalg.inv(2 / n0 * np.real(J.conj().T @ J))
+    cr = extraction.crlb_paths(alpha, src, pos, mu_f, mu_t, FC, nf, nt, n0)
+    np.testing.assert_allclose(cr["mu_f"], np.sqrt(cov[[2, 9], [2, 9]]), rtol=1e-5)
+    np.testing.assert_allclose(cr["mu_t"], np.sqrt(cov[[3, 10], [3, 10]]), rtol=1e-5)
+    np.testing.assert_allclose(cr["source_cov"][1], cov[11:14, 11:14], rtol=1e-4)
+
+
+def test_los_rmse_within_twice_the_crlb(route):
+    """Seeded snapshots at the paper's SNR and size, L known (LoS + road, no ceiling)."""
+    route_kinds = channel.SignalRoute(
+        route.tunnel, route.arrays, route.trajectory, route.config, kinds=("los", "road")
+    )
+    arr, paths = route_kinds.paths(10)
+    nf = CFG.n_tones
+    H0 = channel.channel_tensor(paths, CFG, n_tones=nf)
+    d0, v0 = paths[0].length, paths[0].velocity
+    err = []
+    for seed in range(25):
+        H = channel.add_noise(H0, CFG.noise_power, np.random.default_rng(seed))
+        est = _extract(H, len(paths), arr)
+        i = int(np.argmin(_angle_deg(est.direction, paths[0].direction_local)))
+        err.append((est.d[i] - d0, est.v[i] - v0))
+    rmse = np.sqrt(np.mean(np.square(err), axis=0))
+    alpha = np.sqrt(CFG.tx_power) * np.array([p.gain for p in paths])
+    src = np.stack([arr.to_local(p.source) for p in paths])
+    mu_f = -2 * np.pi * CFG.tone_spacing * np.array([p.length for p in paths]) / C
+    mu_t = 2 * np.pi * CFG.symbol_period * np.array([p.doppler for p in paths])
+    cr = extraction.crlb_paths(
+        alpha, src, arr.local, mu_f, mu_t, FC, nf, CFG.n_symbols, CFG.noise_power, spatial="free"
+    )
+    sd = C / (2 * np.pi * CFG.tone_spacing) * cr["mu_f"][0]
+    sv = C / (2 * np.pi * FC * CFG.symbol_period) * cr["mu_t"][0]
+    assert rmse[0] < 2 * sd, (rmse, sd)
+    assert rmse[1] < 2 * sv, (rmse, sv)
+
+
+def test_bad_input_names_the_parameter(route):
+    arr, paths = route.paths(20)
+    H = channel.channel_tensor(paths, CFG, n_tones=16)
+    args = (arr.local, FC, CFG.tone_spacing, CFG.symbol_period)
+    bad = H.copy()
+    bad[0, 0, 0] = np.nan
+    with pytest.raises(ValueError, match=r"H.*NaN"):
+        extraction.extract_paths(bad, 2, *args)
+    with pytest.raises(ValueError, match=r"H.*3-D"):
+        extraction.extract_paths(H[:, :, 0], 2, *args)
+    with pytest.raises(ValueError, match="n_paths"):
+        extraction.extract_paths(H, 0, *args)
+    with pytest.raises(ValueError, match=r"n_paths.*Kruskal"):
+        extraction.extract_paths(H[:3, :3, :2], 4, arr.local[:3], *args[1:])
+    with pytest.raises(ValueError, match=r"element_positions.*M = 100"):
+        extraction.extract_paths(H, 2, arr.local[:50], *args[1:])
+    tilted = arr.local.copy()
+    tilted[5, 2] = 0.01
+    with pytest.raises(ValueError, match=r"element_positions.*plane"):
+        extraction.extract_paths(H, 2, tilted, *args[1:])
+    with pytest.raises(ValueError, match="subcarrier_spacing"):
+        extraction.extract_paths(H, 2, arr.local, FC, -1.0, CFG.symbol_period)
+    with pytest.raises(ValueError, match="refine"):
+        extraction.extract_paths(H, 2, *args, refine="maybe")
+
+
+def test_non_convergence_warns_with_the_final_error():
+    rng = np.random.default_rng(0)
+    H = rng.normal(size=(4, 5, 3)) + 1j * rng.normal(size=(4, 5, 3))
+    with pytest.warns(extraction.CPDConvergenceWarning, match="final relative error"):
+        extraction.cpd(H, 3, method="plain", n_iter_max=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = extraction.cpd(H[:, :, :1].repeat(3, axis=2), 1, method="plain")
+    assert res.converged
+
+
+def test_far_field_path_reports_nan_kappa():
+    arr = arrays.make_array(4, 4, fc=FC, azimuth=0.0, elevation=0.0, origin=[0, 0, 2.5])
+    tun = P.semicircular_tunnel(length=4000.0)
+    paths = P.trace_paths(tun, arr, [1500.0, 1.0, 2.3], fc=FC, kinds=("los",))
+    H = channel.add_noise(
+        channel.channel_tensor(paths, CFG, n_tones=64),
+        CFG.noise_power * 1e-6,
+        np.random.default_rng(1),
+    )
+    est = _extract(H, 1, arr)
+    assert _angle_deg(est.direction[0], paths[0].direction_local) < 0.5
+    assert not est.near_field[0] or est.kappa[0] > 200  # curvature unresolvable at 1.5 km
+    assert np.isnan(est.kappa[0]) == (not est.near_field[0])

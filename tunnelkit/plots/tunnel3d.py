@@ -1,0 +1,273 @@
+"""Figures of notebook 03: the tunnel in 3-D with its paths, CPD factors, estimates, wave origins."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import plotly.graph_objects as go
+from plotly.subplots import make_subplots
+
+__all__ = [
+    "PATH_COLORS",
+    "factors_figure",
+    "paths_table_figure",
+    "tunnel3d_figure",
+    "wave_origins_figure",
+]
+
+#: one colour per path family
+PATH_COLORS = {
+    "los": "#2ca02c",
+    "wall": "#8c564b",
+    "ceiling": "#d62728",
+    "road": "#7f7f7f",
+    "rrm": "#9467bd",
+}
+
+
+def _facet_mesh(f, color: str, opacity: float, name: str, show: bool) -> go.Mesh3d:
+    c = f.corners()
+    return go.Mesh3d(
+        x=c[:, 0],
+        y=c[:, 1],
+        z=c[:, 2],
+        i=[0, 0],
+        j=[1, 2],
+        k=[2, 3],
+        color=color,
+        opacity=opacity,
+        name=name,
+        showlegend=show,
+        hoverinfo="name",
+        flatshading=True,
+    )
+
+
+def tunnel3d_figure(
+    tunnel,
+    arrays: Sequence = (),
+    paths: Sequence = (),
+    ue=None,
+    *,
+    title: str = "",
+    x_range: tuple[float, float] | None = None,
+) -> go.Figure:
+    """The tunnel's facets (translucent), RRM plates (purple), arrays, UE and the paths.
+
+    Each path is drawn UE -> reflection point -> array reference antenna, coloured by family.
+    ``x_range`` crops the drawn tunnel along x (facets are clipped to it).
+    """
+    fig = go.Figure()
+    xr = tunnel.x_range if x_range is None else x_range
+    for i, f in enumerate(tunnel.facets):
+        c = f.corner.copy()
+        u = f.edge_u.copy()
+        if abs(u[0]) > 0:  # clip the extrusion along x
+            c[0], u[0] = xr[0], xr[1] - xr[0]
+        clipped = type(f)(c, u, f.edge_v, f.normal, name=f.name, kind=f.kind, material=f.material)
+        col = "#bdbdbd" if f.kind != "road" else "#636363"
+        fig.add_trace(
+            _facet_mesh(
+                clipped,
+                col,
+                0.12 if f.kind != "road" else 0.35,
+                "tunnel facets" if f.kind != "road" else "road",
+                i in (0, len(tunnel.facets) - 1),
+            )
+        )
+    for j, p in enumerate(tunnel.plates):
+        fig.add_trace(_facet_mesh(p, PATH_COLORS["rrm"], 0.9, "RRM plates", j == 0))
+    for b in tunnel.blockers:
+        lo, hi = b.lo, b.hi
+        xs, ys, zs = np.meshgrid([lo[0], hi[0]], [lo[1], hi[1]], [lo[2], hi[2]], indexing="ij")
+        fig.add_trace(
+            go.Mesh3d(
+                x=xs.ravel(),
+                y=ys.ravel(),
+                z=zs.ravel(),
+                alphahull=0,
+                color="#ff7f0e",
+                opacity=0.5,
+                name=b.name,
+            )
+        )
+    for a in arrays:
+        w = a.world
+        fig.add_scatter3d(
+            x=w[:, 0],
+            y=w[:, 1],
+            z=w[:, 2],
+            mode="markers",
+            marker={"size": 2, "color": "black"},
+            name=f"array {a.name}",
+        )
+    seen = set()
+    for p in paths:
+        a0 = p.point - p.direction * p.kappa_srnf  # the array's reference antenna
+        pts = np.stack([p.ue, a0]) if p.kind == "los" else np.stack([p.ue, p.point, a0])
+        fig.add_scatter3d(
+            x=pts[:, 0],
+            y=pts[:, 1],
+            z=pts[:, 2],
+            mode="lines",
+            line={"color": PATH_COLORS.get(p.surface_kind, "black"), "width": 4},
+            name=p.surface_kind,
+            legendgroup=p.surface_kind,
+            showlegend=p.surface_kind not in seen,
+            hovertext=p.surface or "LoS",
+        )
+        seen.add(p.surface_kind)
+    if ue is not None:
+        ue = np.asarray(ue, float)
+        fig.add_scatter3d(
+            x=[ue[0]],
+            y=[ue[1]],
+            z=[ue[2]],
+            mode="markers",
+            marker={"size": 5, "color": "#1f77b4"},
+            name="vehicle (UE)",
+        )
+    fig.update_layout(
+        title=title,
+        height=520,
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+        scene={
+            "aspectmode": "data",
+            "xaxis_title": "x [m]",
+            "yaxis_title": "y [m]",
+            "zaxis_title": "z [m]",
+            "camera": {"eye": {"x": -1.2, "y": -1.6, "z": 0.8}},
+        },
+    )
+    return fig
+
+
+def paths_table_figure(rows: Sequence[dict], *, title: str = "") -> go.Figure:
+    """A plotly table from a list of dicts (same keys; floats shown with 3 significant digits)."""
+    if not rows:
+        return go.Figure(layout={"title": title})
+    keys = list(rows[0])
+
+    def fmt(v):
+        if isinstance(v, float | np.floating):
+            return f"{v:.4g}"
+        return str(v)
+
+    cells = [[fmt(r[k]) for r in rows] for k in keys]
+    fig = go.Figure(
+        go.Table(
+            header={"values": keys, "fill_color": "#f0f0f0", "align": "left"},
+            cells={"values": cells, "align": "left"},
+        )
+    )
+    fig.update_layout(
+        title=title, height=80 + 28 * len(rows), margin={"l": 10, "r": 10, "t": 40, "b": 10}
+    )
+    return fig
+
+
+def factors_figure(
+    factors,
+    *,
+    unwrapped=None,
+    shape: tuple[int, int] | None = None,
+    title: str = "CPD factor matrices (normalised, eq. 12-13)",
+) -> go.Figure:
+    """Phase of the three factor matrices: spatial (unwrapped, per path), frequency, time."""
+    bs, bf, bt = factors
+    fig = make_subplots(
+        rows=1,
+        cols=3,
+        subplot_titles=(
+            "spatial: unwrapped phase (eq. 16) [rad]",
+            "frequency: phase vs tone [rad]",
+            "time: phase vs symbol [rad]",
+        ),
+    )
+    sp = unwrapped if unwrapped is not None else np.unwrap(np.angle(bs), axis=0)
+    for j_ in range(bf.shape[1]):
+        col = f"C{j_}"
+        fig.add_scatter(y=sp[:, j_], mode="lines", name=f"path {j_}", legendgroup=col, row=1, col=1)
+        fig.add_scatter(
+            y=np.unwrap(np.angle(bf[:, j_])),
+            mode="lines",
+            name=f"path {j_}",
+            legendgroup=col,
+            showlegend=False,
+            row=1,
+            col=2,
+        )
+        fig.add_scatter(
+            y=np.unwrap(np.angle(bt[:, j_])),
+            mode="lines+markers",
+            name=f"path {j_}",
+            legendgroup=col,
+            showlegend=False,
+            row=1,
+            col=3,
+        )
+    fig.update_xaxes(title_text="antenna m", row=1, col=1)
+    fig.update_xaxes(title_text="tone s", row=1, col=2)
+    fig.update_xaxes(title_text="symbol k", row=1, col=3)
+    fig.update_layout(title=title, height=360, margin={"l": 50, "r": 10, "t": 70, "b": 40})
+    return fig
+
+
+def wave_origins_figure(
+    origins: dict[str, np.ndarray],
+    trajectory=None,
+    bs=None,
+    *,
+    title: str = "Estimated wave origins, colour = altitude (cf. Fig. 5)",
+    z_range: tuple[float, float] = (0.0, 5.0),
+) -> go.Figure:
+    """Top view (x, y) of estimated wave origins coloured by altitude z, one marker per series."""
+    fig = go.Figure()
+    symbols = ["circle", "x", "diamond", "square"]
+    for i, (name, pts) in enumerate(origins.items()):
+        pts = np.asarray(pts, float).reshape(-1, 3)
+        pts = pts[np.all(np.isfinite(pts), axis=1)]
+        fig.add_scatter(
+            x=pts[:, 0],
+            y=pts[:, 1],
+            mode="markers",
+            name=name,
+            marker={
+                "color": pts[:, 2],
+                "colorscale": "YlOrRd",
+                "cmin": z_range[0],
+                "cmax": z_range[1],
+                "size": 6,
+                "symbol": symbols[i % 4],
+                "colorbar": {"title": "z [m]"} if i == 0 else None,
+                "line": {"width": 0.5, "color": "#444"},
+            },
+        )
+    if trajectory is not None:
+        pos = np.asarray(trajectory)
+        fig.add_scatter(
+            x=pos[:, 0],
+            y=pos[:, 1],
+            mode="lines",
+            name="UE trajectory",
+            line={"color": "#1f77b4", "width": 3},
+        )
+    if bs is not None:
+        fig.add_scatter(
+            x=[bs[0]],
+            y=[bs[1]],
+            mode="markers",
+            name="BS",
+            marker={"symbol": "square", "size": 12, "color": "red"},
+        )
+    fig.update_layout(
+        title=title,
+        height=420,
+        xaxis_title="x [m]",
+        yaxis_title="y [m]",
+        legend={"orientation": "h", "y": -0.2},
+        margin={"l": 60, "r": 20, "t": 50, "b": 40},
+    )
+    fig.update_yaxes(scaleanchor="x", scaleratio=1)
+    return fig
