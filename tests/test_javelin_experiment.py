@@ -1,0 +1,111 @@
+import numpy as np
+import pytest
+
+from tunnelkit.plots.javelin import (
+    epoch_figure,
+    javelin_table_figure,
+    tracks_count_figure,
+    trajectories_figure,
+)
+from tunnelkit.reproduce.javelin_tables import table_rows
+from tunnelkit.tracking.javelin import experiment as ex
+from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
+from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
+
+BS = np.array([0.0, 0.0, 4.8])
+
+
+def _fake_drive(cond="L", n=40, seed=0):
+    """A DriveData from the geometric test source (no signal route)."""
+    rng = np.random.default_rng(seed)
+    c = ex.CONDITIONS[cond]
+    P, V = toy_drive(n, 0.1, amplitude=0.8, speed=5.0)
+    eps = geometric_stream(
+        P,
+        V,
+        toy_reflectors(),
+        rng,
+        los_probability=c.los_probability,
+        bs=BS,
+        sigma_phi=0.02,
+        sigma_psi=0.02,
+        sigma_kappa=1.0,
+        sigma_d=0.3,
+        sigma_v=0.05,
+        clock_bias=lambda r: r.normal(0, 3.0),
+    )
+    planes = toy_reflectors()
+    src = [np.vstack([p] + [pl.mirror(p) for pl in planes]) for p in P]
+    return ex.DriveData(
+        "toy",
+        c,
+        np.arange(n) * 0.1,
+        P,
+        V,
+        np.linalg.norm(V[:, :2], axis=1),
+        np.arctan2(V[:, 1], V[:, 0]),
+        eps,
+        np.full(n, c.los_probability == 1.0),
+        np.full(n, 5),
+        BS,
+        sources=src,
+    )
+
+
+def test_error_metrics():
+    est = np.array([[3.0, 4.0, 9.0], [0.0, -1.0, 0.0]])
+    m = ex.error_metrics(est, np.zeros((2, 3)))
+    assert m["rmse_2d_m"] == pytest.approx(np.sqrt((25 + 1) / 2))
+    assert m["mae_2d_m"] == pytest.approx(3.0) and m["y_mae_m"] == pytest.approx(2.5)
+
+
+def test_evaluate_tables_and_ablation_on_toy_drives():
+    drives = {"L": [_fake_drive("L")], "N": [_fake_drive("N", seed=1)]}
+    ev = ex.evaluate(drives["L"][0], ex.OURS)
+    assert ev.metrics["rmse_2d_m"] < 0.5
+    tf = ex.evaluate(drives["L"][0], method="TeNFiLoc")
+    assert np.all(np.isfinite(tf.estimates))
+    cols, rows = table_rows(drives, "italiano2026_table1")
+    names = [(r[0], r[1]) for r in rows]
+    assert ("JAVELIN-L", "ours") in names and ("TeNFiLoc-L", "paper") in names
+    row = rows[names.index(("JAVELIN-L", "paper"))]
+    assert row[cols.index("paper_rmse_2d_m")] == pytest.approx(0.20)
+    acols, arows = ex.ablation(drives)
+    assert acols == ["design", "L", "N"] and len(arows) == len(ex.ABLATION)
+    with pytest.raises(ValueError, match=r"^method"):
+        ex.evaluate(drives["L"][0], method="UKF")
+
+
+def test_mirror_prediction_is_exact_for_planar_vues():
+    d = _fake_drive("L")
+    assert (
+        np.median(ex.vue_prediction_errors(d, "mirror")) < 0.01
+    )  # only the O(a dt^2) of a curved path
+    assert np.median(ex.vue_prediction_errors(d, "random_walk")) > 0.05
+
+
+def test_figures_and_explorer():
+    d = _fake_drive("L", n=15)
+    ev = ex.evaluate(d, ex.OURS, keep_reports=True)
+    fig = epoch_figure(ev.run.reports[5], truth=d.truth[5], base_station=BS, true_vues=d.sources[5])
+    assert len(fig.data) > 5 and "epoch 5" in fig.layout.title.text
+    assert len(epoch_figure(ev.run.reports[5], plane="xy").data) > 3
+    assert len(trajectories_figure(d.truth, {"JAVELIN": ev.estimates}, base_station=BS).data) == 3
+    assert len(tracks_count_figure(d.t, ev.run.n_tracks, d.los).data) == 2
+    assert javelin_table_figure(["a", "b"], [["x", 1.234], ["y", None]]).data[0].cells.values[
+        1
+    ] == ["1.23", "-"]
+    exp = epoch_explorer(d, ev, k=2)
+    exp.set(k=7)
+    assert "epoch 7" in exp.figure.layout.title.text
+    with pytest.raises(ValueError, match=r"^evaluation"):
+        epoch_view(d, ex.evaluate(d, ex.OURS), 0)
+
+
+def test_signal_route_drive_two_epochs():
+    d = ex.simulate_drive("italiano2026-straight", "N", np.random.default_rng(3), n_epochs=2)
+    assert len(d.epochs) == 2 and not d.los.any()
+    assert all(e is None or np.all(np.isfinite(e.phi)) for e in d.epochs)
+    assert np.allclose(d.base_station, [0.0, 0.0, 4.8])
+    with pytest.raises(KeyError):
+        ex.simulate_drive("italiano2026-straight", "X", np.random.default_rng(0), n_epochs=1)

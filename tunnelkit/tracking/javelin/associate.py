@@ -1,0 +1,105 @@
+"""Data association of Algorithm 2: gated costs, greedy nearest neighbour and a global variant.
+
+For every (track i, path j) pair the three rows ``(phi, psi, kappa)`` of the Jacobian give the
+innovation covariance ``S_ij = H_i P H_i^T + R`` (eq. 56), the innovation ``y_ij`` (eq. 57) and
+``eta^2`` (eq. 58). A far-field path (no curvature) uses its two angular rows only. The paper
+then picks, among gated pairs, the one with the smallest distance, removes its track and path,
+and repeats (:func:`greedy_nearest_neighbour`). :func:`global_nearest_neighbour` instead minimises
+the sum of distances over all one-to-one assignments (scipy's ``linear_sum_assignment``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from ...crlb import wrap_angle
+from .gate import ChiSquareGate, mahalanobis2
+from .measurement import PathMeasurements
+
+__all__ = [
+    "ASSOCIATORS",
+    "AssociationCosts",
+    "association_costs",
+    "global_nearest_neighbour",
+    "greedy_nearest_neighbour",
+]
+
+
+@dataclass
+class AssociationCosts:
+    """``eta2`` (n_tracks, n_paths), ``dof`` (n_paths,), ``gated`` (n_tracks, n_paths) bool."""
+
+    eta2: np.ndarray
+    dof: np.ndarray
+    gated: np.ndarray
+    threshold: np.ndarray
+
+
+def association_costs(
+    pred: np.ndarray,
+    J: np.ndarray,
+    P: np.ndarray,
+    meas: PathMeasurements,
+    R3: np.ndarray,
+    gate: ChiSquareGate,
+) -> AssociationCosts:
+    """Squared Mahalanobis distance of every track-path pair (Algorithm 2, lines 2-9).
+
+    ``pred`` (L, 4) and ``J`` (L, 4, D) come from :func:`measurement.track_model`; ``R3`` is the
+    3x3 covariance of ``(phi, psi, kappa)``. Vectorised over pairs: a missing curvature is
+    handled by zeroing its innovation and setting its row/column of ``S`` to the identity, which
+    leaves ``eta^2`` equal to the 2-component distance.
+    """
+    L, n = pred.shape[0], len(meas)
+    if n == 0 or L == 0:
+        e = np.zeros((L, n))
+        return AssociationCosts(e, np.zeros(n, int), e.astype(bool), np.zeros(n))
+    H3 = J[:, :3, :]
+    S0 = H3 @ P @ np.swapaxes(H3, 1, 2) + R3  # (L, 3, 3)
+    z = meas.triples()  # (n, 3)
+    has_k = np.isfinite(z[:, 2])
+    y = z[None, :, :] - pred[:, None, :3]  # (L, n, 3)
+    y[..., 0] = wrap_angle(y[..., 0])
+    y[..., 2] = np.where(has_k[None, :], y[..., 2], 0.0)
+    S = np.broadcast_to(S0[:, None], (L, n, 3, 3)).copy()
+    nk = ~has_k
+    S[:, nk, 2, :] = 0.0
+    S[:, nk, :, 2] = 0.0
+    S[:, nk, 2, 2] = 1.0
+    eta2 = mahalanobis2(y, S)
+    dof = np.where(has_k, 3, 2)
+    thr = np.array([gate.threshold(int(k)) for k in dof])
+    return AssociationCosts(eta2, dof, gate.accepts(eta2, dof[None, :]), thr)
+
+
+def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
+    """Algorithm 2 + the NN choice of section 3.3: repeatedly take the gated pair of smallest
+    ``eta^2``, then drop its track and its path. Returns ``[(track, path), ...]``."""
+    eta = np.where(costs.gated, costs.eta2, np.inf)
+    pairs = []
+    while eta.size and np.isfinite(eta).any():
+        i, j = np.unravel_index(np.argmin(eta), eta.shape)
+        pairs.append((int(i), int(j)))
+        eta[i, :] = np.inf
+        eta[:, j] = np.inf
+    return sorted(pairs)
+
+
+def global_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
+    """The one-to-one assignment of gated pairs with the smallest total ``eta^2`` (ours).
+
+    Ungated pairs get a cost above any gated total, so they are chosen only when nothing else
+    fits and are then dropped; the result is the maximum-cardinality, minimum-cost matching.
+    """
+    if costs.eta2.size == 0 or not costs.gated.any():
+        return []
+    big = float(np.sum(np.where(costs.gated, costs.eta2, 0.0))) + 1.0
+    cost = np.where(costs.gated, costs.eta2, big * 10.0)
+    rows, cols = linear_sum_assignment(cost)
+    return sorted((int(i), int(j)) for i, j in zip(rows, cols) if costs.gated[i, j])
+
+
+ASSOCIATORS = {"greedy": greedy_nearest_neighbour, "gnn": global_nearest_neighbour}

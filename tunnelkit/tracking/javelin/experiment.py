@@ -1,0 +1,364 @@
+"""JAVELIN on the signal route: scenario -> paths -> SRS tensor -> CPD extraction -> tracker.
+
+Section 4 of Italiano et al. (2026) in two steps, so the expensive part is done once:
+
+1. :func:`simulate_drive` runs the signal route of notebook 03 (``channel.SignalRoute``: image
+   method, eq. 1 tensor with noise and clock bias, ``extraction.extract_paths``, Algorithm 1) for
+   every epoch of a scenario's trajectory under a propagation *condition*, plus the V2X speed and
+   heading messages (``sigma_nu``, ``sigma_theta`` of section 4.2);
+2. :func:`evaluate` runs JAVELIN (any :class:`JavelinConfig`) and TeNFiLoc on those measurements
+   and returns the errors; :func:`error_metrics` gives 2-D RMSE, 2-D MAE and Y-MAE (Tables 1-2).
+
+Conditions (section 4.3): ``"L"`` LoS, ``"N@0.5"`` LoS blocked with probability 0.5 per epoch,
+``"N"`` LoS always blocked, ``"NoRRMs"`` the road markings removed. The paper does not say under
+which visibility it ran NoRRMs; its numbers (worse than JAVELIN-N) suggest blocked LoS, and that
+is our reading (``"NoRRMs-L"`` keeps the LoS, for comparison).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..._validate import rng_or_error
+from .config import JavelinConfig
+from .measurement import PathMeasurements
+from .tenfiloc import TeNFiLoc
+from .tracker import JavelinRun, run_javelin
+
+__all__ = [
+    "ABLATION",
+    "CONDITIONS",
+    "OURS",
+    "PAPER",
+    "Condition",
+    "DriveData",
+    "Evaluation",
+    "ablation",
+    "error_metrics",
+    "evaluate",
+    "simulate_drive",
+    "tenfiloc_track",
+    "vue_prediction_errors",
+]
+
+
+@dataclass(frozen=True)
+class Condition:
+    """A propagation condition: probability that the LoS exists in an epoch, RRMs present."""
+
+    name: str
+    los_probability: float
+    rrms: bool = True
+
+
+CONDITIONS: dict[str, Condition] = {
+    c.name: c
+    for c in (
+        Condition("L", 1.0),
+        Condition("N@0.5", 0.5),
+        Condition("N", 0.0),
+        Condition("NoRRMs", 0.0, rrms=False),
+        Condition("NoRRMs-L", 1.0, rrms=False),
+    )
+}
+
+
+@dataclass
+class DriveData:
+    """Measurements of one simulated drive (one Monte-Carlo run of one condition).
+
+    ``epochs[k]`` is the :class:`PathMeasurements` of epoch ``k`` (``None`` if extraction failed),
+    ``truth`` (T, 3) / ``velocity`` (T, 3) the ground truth, ``speed`` / ``heading`` the V2X
+    messages, ``los`` whether the LoS path existed, ``n_true`` the traced path count,
+    ``base_station`` the reference antenna, ``truth_index`` per epoch the matched true path of
+    each measurement (-1: none), ``kinds`` per epoch the surface kind of each true path and
+    ``sources`` its true wave source (the UE or a VUE), shape (n, 3).
+    """
+
+    scenario: str
+    condition: Condition
+    t: np.ndarray
+    truth: np.ndarray
+    velocity: np.ndarray
+    speed: np.ndarray
+    heading: np.ndarray
+    epochs: list[PathMeasurements | None]
+    los: np.ndarray
+    n_true: np.ndarray
+    base_station: np.ndarray
+    truth_index: list[np.ndarray] = field(default_factory=list)
+    kinds: list[list[str]] = field(default_factory=list)
+    faults: list[str] = field(default_factory=list)
+    sources: list[np.ndarray] = field(default_factory=list)
+
+    @property
+    def dt(self) -> float:
+        """Epoch period [s]."""
+        return float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.1
+
+
+_ROUTES: dict[tuple, object] = {}
+
+
+def _route(scenario: str, model: str):
+    from ...channel import SignalRoute
+
+    key = (scenario, model)
+    if key not in _ROUTES:
+        _ROUTES[key] = SignalRoute.from_scenario(scenario, model=model)
+    return _ROUTES[key]
+
+
+def simulate_drive(
+    scenario: str,
+    condition: str | Condition,
+    rng: np.random.Generator,
+    *,
+    model: str = "exact",
+    sigma_speed: float = 0.2,
+    sigma_heading: float = float(np.radians(1.0)),
+    n_epochs: int | None = None,
+) -> DriveData:
+    """Run the signal route over a scenario's trajectory under ``condition`` (``rng`` explicit).
+
+    Per epoch: LoS kept with the condition's probability, RRMs removed for ``NoRRMs``, the noisy
+    SRS tensor synthesised (clock bias drawn per epoch), paths extracted with ``L`` known
+    (Algorithm 1), angles in the world frame. An extraction failure leaves ``None`` (the tracker
+    then predicts only) and is recorded in ``faults``.
+    """
+    rng = rng_or_error("rng", rng)
+    cond = CONDITIONS[condition] if isinstance(condition, str) else condition
+    if not isinstance(cond, Condition):
+        raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
+    route = _route(scenario, model)
+    kinds_all = tuple(route.kinds)
+    no_los = replace(route, kinds=tuple(k for k in kinds_all if k != "los"))
+    tunnel = route.tunnel if cond.rrms else route.tunnel.without_plates()
+    traj = route.trajectory
+    T = len(traj) if n_epochs is None else min(int(n_epochs), len(traj))
+    epochs: list[PathMeasurements | None] = []
+    los = np.zeros(T, bool)
+    n_true = np.zeros(T, int)
+    tidx, kinds, faults, sources = [], [], [], []
+    bs = None
+    for k in range(T):
+        has_los = bool(rng.random() < cond.los_probability)
+        r = route if has_los else no_los
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                ep = r.epoch(k, rng, tunnel=tunnel)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            faults.append(f"epoch {k}: extraction failed ({exc})")
+            epochs.append(None)
+            tidx.append(np.zeros(0, int))
+            kinds.append([])
+            sources.append(np.zeros((0, 3)))
+            continue
+        m = ep.measurements
+        bs = m.origin.copy()
+        los[k] = any(p.kind == "los" for p in ep.paths)
+        n_true[k] = len(ep.paths)
+        epochs.append(PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False))
+        tidx.append(np.asarray(ep.truth_index)[epochs[-1].source])
+        kinds.append([p.surface_kind for p in ep.paths])
+        sources.append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
+    if bs is None:
+        bs = route.arrays[0].origin.copy()
+    vel = traj.velocity[:T]
+    speed = np.linalg.norm(vel[:, :2], axis=1) + sigma_speed * rng.standard_normal(T)
+    heading = np.arctan2(vel[:, 1], vel[:, 0]) + sigma_heading * rng.standard_normal(T)
+    return DriveData(
+        scenario,
+        cond,
+        traj.t[:T].copy(),
+        traj.position[:T].copy(),
+        vel.copy(),
+        speed,
+        heading,
+        epochs,
+        los,
+        n_true,
+        bs,
+        tidx,
+        kinds,
+        faults,
+        sources,
+    )
+
+
+def tenfiloc_track(
+    drive: DriveData, baseline: TeNFiLoc | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """TeNFiLoc fixes per epoch (T, 3) and which epochs had a fix; without a fix the previous
+    one is held (the start position before the first), so every epoch has an estimate."""
+    if baseline is None:
+        baseline = TeNFiLoc(
+            base_station=tuple(drive.base_station),
+            assume_los=drive.condition.los_probability == 1.0,
+        )
+    tf = baseline
+    out = np.empty_like(drive.truth)
+    ok = np.zeros(len(drive.epochs), bool)
+    last = drive.truth[0].copy()
+    for k, m in enumerate(drive.epochs):
+        fix = tf.locate(m, initial=last)
+        if fix.position is not None and np.all(np.isfinite(fix.position)):
+            last = fix.position
+            ok[k] = True
+        out[k] = last
+    return out, ok
+
+
+def error_metrics(estimates, truth) -> dict[str, float]:
+    """2-D RMSE, 2-D MAE (mean Euclidean error in the road plane) and Y-MAE (lateral) [m]."""
+    e = np.asarray(estimates, float)[..., :2] - np.asarray(truth, float)[..., :2]
+    e2 = np.linalg.norm(e, axis=-1)
+    return {
+        "rmse_2d_m": float(np.sqrt(np.mean(e2**2))),
+        "mae_2d_m": float(np.mean(e2)),
+        "y_mae_m": float(np.mean(np.abs(e[..., 1]))),
+    }
+
+
+@dataclass
+class Evaluation:
+    """Tracker output on one drive and its error metrics."""
+
+    estimates: np.ndarray
+    metrics: dict[str, float]
+    run: JavelinRun | None = None
+
+
+def evaluate(
+    drive: DriveData,
+    config: JavelinConfig | None = None,
+    *,
+    method: str = "JAVELIN",
+    keep_reports: bool = False,
+    sigma_p0_ue: float = 1.0,
+) -> Evaluation:
+    """Run ``method`` ("JAVELIN" or "TeNFiLoc") on ``drive`` and score it against the truth.
+
+    JAVELIN starts from the true first position (the open-sky fix the paper assumes) with
+    ``sigma_p0_ue`` [m] of uncertainty unless ``config`` sets it; the base station is the
+    drive's reference antenna.
+    """
+    if method == "TeNFiLoc":
+        est, _ = tenfiloc_track(drive)
+        return Evaluation(est, error_metrics(est, drive.truth))
+    if method != "JAVELIN":
+        raise ValueError(f"method: expected 'JAVELIN' or 'TeNFiLoc', got {method!r}")
+    cfg = JavelinConfig() if config is None else config
+    over = {"base_station": tuple(float(v) for v in drive.base_station)}
+    if cfg.sigma_p0_ue is None:
+        over["sigma_p0_ue"] = sigma_p0_ue
+    cfg = cfg.with_(**over)
+    run = run_javelin(
+        drive.epochs,
+        drive.speed,
+        drive.heading,
+        drive.dt,
+        drive.truth[0],
+        cfg,
+        keep_reports=keep_reports,
+    )
+    return Evaluation(run.estimates, error_metrics(run.estimates, drive.truth), run)
+
+
+#: the paper's design and parameters (section 4.2)
+PAPER = JavelinConfig()
+
+#: our design, tuned on separate seeds (seed 7, 4 drives per condition) and measured in the
+#: ablation: Doppler clutter rejection, measurement noise calibrated on what the CPD extraction
+#: actually delivers (angles ~5 deg, curvature nearly uninformative at 5-45 m for a 10 x 10 URA),
+#: global nearest neighbour, VUEs moved with the mirrored UE displacement, births not used in the
+#: epoch they are born (their angles already placed them).
+OURS = JavelinConfig(
+    doppler_clutter_margin=1.0,
+    sigma_phi=float(np.radians(5.0)),
+    sigma_psi=float(np.radians(5.0)),
+    sigma_kappa=50.0,
+    associator="gnn",
+    vue_motion="mirror",
+    update_with_births=False,
+)
+
+#: the ablation path from the paper's design to ours, one change at a time
+ABLATION: dict[str, JavelinConfig] = {
+    "paper (section 4.2)": PAPER,
+    "+ Doppler clutter rejection": PAPER.with_(doppler_clutter_margin=1.0),
+    "+ noise calibrated on the extraction": PAPER.with_(
+        doppler_clutter_margin=1.0,
+        sigma_phi=OURS.sigma_phi,
+        sigma_psi=OURS.sigma_psi,
+        sigma_kappa=OURS.sigma_kappa,
+    ),
+    "+ global nearest neighbour": PAPER.with_(
+        doppler_clutter_margin=1.0,
+        sigma_phi=OURS.sigma_phi,
+        sigma_psi=OURS.sigma_psi,
+        sigma_kappa=OURS.sigma_kappa,
+        associator="gnn",
+    ),
+    "+ mirrored VUE motion": PAPER.with_(
+        doppler_clutter_margin=1.0,
+        sigma_phi=OURS.sigma_phi,
+        sigma_psi=OURS.sigma_psi,
+        sigma_kappa=OURS.sigma_kappa,
+        associator="gnn",
+        vue_motion="mirror",
+    ),
+    "+ no update at birth (= ours)": OURS,
+}
+
+
+def ablation(
+    drives: dict[str, list[DriveData]], variants: dict[str, JavelinConfig] | None = None
+) -> tuple[list[str], list[list]]:
+    """Mean 2-D RMSE per variant (rows) and condition (columns) over the given drives."""
+    variants = ABLATION if variants is None else variants
+    conds = list(drives)
+    rows = []
+    for name, cfg in variants.items():
+        row: list = [name]
+        for c in conds:
+            row.append(float(np.mean([evaluate(d, cfg).metrics["rmse_2d_m"] for d in drives[c]])))
+        rows.append(row)
+    return ["design", *conds], rows
+
+
+def vue_prediction_errors(drive: DriveData, vue_motion: str) -> np.ndarray:
+    """One-epoch prediction error of the *true* VUEs [m], per VUE and epoch (flattened).
+
+    From the true UE and VUEs of epoch ``k`` and the true velocity, predict epoch ``k + 1`` with
+    ``vue_motion`` ("random_walk": stay; "mirror": mirrored UE displacement) and compare each
+    prediction with the nearest true VUE of epoch ``k + 1`` in (y, z).
+    """
+    from .motion import motion_increment
+    from .state import JavelinState
+
+    out = []
+    for k in range(len(drive.sources) - 1):
+        a, b = drive.sources[k], drive.sources[k + 1]
+        if len(a) < 2 or len(b) < 2 or not drive.los[k]:
+            continue
+        n = len(a) - 1
+        st = JavelinState(
+            np.concatenate([a[0], a[1:, 1:].ravel()]),
+            np.eye(3 + 2 * n),
+            ids=list(range(1, n + 1)),
+            misses=[0] * n,
+            transient=[False] * n,
+        )
+        v = drive.velocity[k]
+        inc, _ = motion_increment(
+            st, float(np.linalg.norm(v[:2])), float(np.arctan2(v[1], v[0])), drive.dt, vue_motion
+        )
+        pred = (st.x[3:] + inc[3:]).reshape(-1, 2)
+        d = np.linalg.norm(pred[:, None, :] - b[None, 1:, 1:], axis=-1)
+        out.extend(d.min(axis=1))
+    return np.asarray(out)

@@ -1,0 +1,153 @@
+"""Track management of Algorithm 3: deaths after zeta misses, births by intersection, the LoS test
+of eq. 60-61 and the Doppler test that tells static from dynamic reflectors."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .config import JavelinConfig
+from .measurement import PathMeasurements
+from .state import JavelinState
+
+__all__ = [
+    "ManageResult",
+    "intersection",
+    "los_test",
+    "manage_tracks",
+    "static_doppler",
+]
+
+
+def los_test(d, kappa, gamma: float, candidates=None) -> int | None:
+    """Index of the LoS path by eq. 60 (``argmin |d - kappa|``) if it passes eq. 61
+    (``1 - gamma <= d / kappa <= 1 + gamma``), else ``None`` (NLoS).
+
+    ``candidates`` restricts the search (we search only paths no VUE track claimed); paths
+    without a curvature or a delay cannot be tested.
+    """
+    d = np.asarray(d, dtype=float)
+    kappa = np.asarray(kappa, dtype=float)
+    ok = np.isfinite(d) & np.isfinite(kappa) & (kappa > 0)
+    if candidates is not None:
+        mask = np.zeros(d.size, bool)
+        mask[np.asarray(list(candidates), dtype=int)] = True
+        ok &= mask
+    if not ok.any():
+        return None
+    gap = np.where(ok, np.abs(d - kappa), np.inf)
+    j = int(np.argmin(gap))
+    ratio = d[j] / kappa[j]
+    return j if (1.0 - gamma) <= ratio <= (1.0 + gamma) else None
+
+
+def intersection(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.ndarray | None:
+    """``Intersection`` of Algorithm 3: the arrival ray from the base station meets the plane
+    ``x = x_u`` (the VUE shares the UE's x). Returns the VUE ``(y, z)`` or ``None`` if the ray
+    runs parallel to that plane or points away from it."""
+    b = np.asarray(bs, dtype=float)
+    u = np.array([np.cos(psi) * np.cos(phi), np.cos(psi) * np.sin(phi), np.sin(psi)])
+    if abs(u[0]) < 1e-6:
+        return None
+    t = (x_u - b[0]) / u[0]
+    if t <= 0:
+        return None
+    p = b + t * u
+    return p[1:].copy()
+
+
+def static_doppler(p_u, p_v, v_u, bs=(0.0, 0.0, 0.0), sign: float = -1.0) -> float:
+    """Radial speed a static reflector would produce: the VUE moves with the UE velocity mirrored
+    in the reflecting plane (normal along ``p_v - p_u``); ``p_v = p_u`` means the LoS path.
+
+    Returns ``sign * d||p_v - b||/dt`` (``sign = -1``: positive when approaching)."""
+    pu, pv, vu = (np.asarray(a, dtype=float) for a in (p_u, p_v, v_u))
+    b = np.asarray(bs, dtype=float)
+    w = pv - pu
+    nw = np.linalg.norm(w)
+    vv = vu if nw < 1e-9 else vu - 2.0 * np.dot(w / nw, vu) * (w / nw)
+    q = pv - b
+    return float(sign * np.dot(q / np.linalg.norm(q), vv))
+
+
+@dataclass
+class ManageResult:
+    """What Algorithm 3 did: pairs to update with, LoS flag/path, born and dead track ids."""
+
+    pairs: list[tuple[int, int]]
+    los: bool
+    los_path: int | None
+    born: list[int] = field(default_factory=list)
+    dead: list[int] = field(default_factory=list)
+    dynamic: list[int] = field(default_factory=list)
+    unborn: list[int] = field(default_factory=list)
+
+
+def manage_tracks(
+    state: JavelinState, meas: PathMeasurements, pairs, config: JavelinConfig, v_u=None
+) -> ManageResult:
+    """Algorithm 3 on ``state`` (modified in place, already predicted).
+
+    1. unassociated VUEs count a miss; at ``misses >= zeta`` they are marginalised out (the UE is
+       never removed); associated VUEs reset their counter;
+    2. LoS (lines 13-23): the path associated with the UE, else eq. 60-61 among the paths no VUE
+       claimed (ours: the paper searches all paths; a claimed path already has a track);
+    3. births (lines 8-12): every other unassociated path starts a VUE at the intersection of its
+       arrival ray with ``x = x_u`` with covariance ``sigma_P^2 I``; with a UE velocity ``v_u``
+       and a Doppler ``v``, a path whose Doppler misses the static prediction by more than
+       ``doppler_tolerance`` is dynamic: its track is ``transient`` (dropped after this epoch).
+
+    Returned ``pairs`` use the track indices after removals and births.
+    """
+    pairs = [(int(i), int(j)) for i, j in pairs]
+    assoc_tracks = {i for i, _ in pairs}
+    assoc_paths = {j for _, j in pairs}
+    # 1. misses and deaths
+    to_remove = []
+    for k in range(state.n_vue):
+        i = k + 1
+        if i in assoc_tracks:
+            state.misses[k] = 0
+        else:
+            state.misses[k] += 1
+            if state.misses[k] >= config.max_misses:
+                to_remove.append(i)
+    state.ue_misses = 0 if 0 in assoc_tracks else state.ue_misses + 1
+    # re-index the surviving pairs before marginalising
+    old_to_new = {}
+    new = 1
+    for i in range(1, state.n_vue + 1):
+        if i not in to_remove:
+            old_to_new[i] = new
+            new += 1
+    old_to_new[0] = 0
+    dead = state.remove(to_remove)
+    pairs = [(old_to_new[i], j) for i, j in pairs if i in old_to_new]
+    # 2. LoS
+    los_path = next((j for i, j in pairs if i == 0), None)
+    free = [j for j in range(len(meas)) if j not in assoc_paths]
+    if los_path is None:
+        los_path = los_test(meas.d, meas.kappa, config.los_gamma, candidates=free)
+        if los_path is not None:
+            pairs.append((0, los_path))
+            free.remove(los_path)
+    # 3. births
+    born, dynamic, unborn = [], [], []
+    for j in free:
+        yz = intersection(meas.phi[j], meas.psi[j], state.x[0], config.bs)
+        if yz is None:
+            unborn.append(j)
+            continue
+        transient = False
+        if v_u is not None and np.isfinite(meas.v[j]):
+            p_v = np.array([state.x[0], yz[0], yz[1]])
+            v_pred = static_doppler(state.ue, p_v, v_u, config.bs, config.doppler_sign)
+            transient = abs(meas.v[j] - v_pred) > config.doppler_tolerance
+        tid = state.append(yz, np.eye(2) * config.sigma_p0**2, transient=transient)
+        born.append(tid)
+        if transient:
+            dynamic.append(tid)
+        if config.update_with_births:
+            pairs.append((state.n_vue, j))
+    return ManageResult(sorted(pairs), los_path is not None, los_path, born, dead, dynamic, unborn)

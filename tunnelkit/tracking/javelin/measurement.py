@@ -1,0 +1,237 @@
+"""JAVELIN measurements: the path parameters of one epoch and the model of eq. 44-52.
+
+Per path ``l`` the extraction (Algorithm 1) gives azimuth ``phi``, elevation ``psi``, curvature
+``kappa`` (near field only), delay distance ``d`` (with the clock bias) and radial speed ``v``.
+The model maps a track position to them (base station ``b`` at the reference antenna):
+
+- UE (eq. 46-48): ``phi_0 = atan2(y_u, x_u)``, ``psi_0 = atan2(z_u, sqrt(x_u^2 + y_u^2))``,
+  ``kappa_0 = ||p_u||``;
+- VUE ``p_v = [x_u, y_v, z_v]`` (eq. 49-52): the same angles of ``p_v``, ``kappa_l = ||p_r||``
+  with the reflector ``p_r`` of eq. 45, and ``Delta d_l = ||p_v|| - ||p_u||``,
+
+all coordinates relative to ``b``. We write eq. 45 as ``kappa = ||p_v|| A / B`` with
+``w = p_v - p_u``, ``A = w . ((p_u + p_v)/2)`` and ``B = w . p_v``, which gives the closed-form
+Jacobian of :func:`track_model` (tested against finite differences). ``atan2`` replaces the
+paper's ``tan^-1(y/x)`` so a UE behind the array (``x < 0``) keeps its true bearing.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..._validate import finite_array, vector
+from ...crlb import wrap_angle
+
+__all__ = [
+    "JavelinWarning",
+    "PathMeasurements",
+    "measurement_model",
+    "track_model",
+]
+
+PHI, PSI, KAPPA, RANGE = 0, 1, 2, 3
+
+
+class JavelinWarning(UserWarning):
+    """A fault in the measurement stream the tracker works around (dropped path, missing message)."""
+
+
+def _opt(name: str, value, n: int) -> np.ndarray:
+    if value is None:
+        return np.full(n, np.nan)
+    arr = np.asarray(value, dtype=float).reshape(-1)
+    if arr.size != n:
+        raise ValueError(f"{name}: expected {n} values (one per path), got {arr.size}")
+    return arr.copy()
+
+
+@dataclass
+class PathMeasurements:
+    """Sanitised path parameters of one epoch (Algorithm 1, lines 4-12).
+
+    Arrays have one entry per kept path; ``kappa`` is NaN where only the far-field estimate is
+    valid, ``d`` / ``v`` NaN where unknown. ``source`` keeps each kept path's index in the input.
+    """
+
+    phi: np.ndarray
+    psi: np.ndarray
+    kappa: np.ndarray
+    d: np.ndarray
+    v: np.ndarray
+    source: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    @classmethod
+    def from_arrays(
+        cls, phi, psi, kappa=None, d=None, v=None, *, warn: bool = True
+    ) -> PathMeasurements:
+        """Apply the consistency checks of Algorithm 1 and drop unusable paths.
+
+        (i) ``d < 0``: path discarded; (ii) ``kappa < 0`` (or NaN): far field, no curvature;
+        ours: a path with a NaN/inf angle is discarded with a :class:`JavelinWarning`.
+        """
+        phi = np.asarray(phi, dtype=float).reshape(-1)
+        n = phi.size
+        psi = _opt("psi", psi, n)
+        kappa, d, v = _opt("kappa", kappa, n), _opt("d", d, n), _opt("v", v, n)
+        bad_angle = ~(np.isfinite(phi) & np.isfinite(psi))
+        if warn and np.any(bad_angle):
+            warnings.warn(
+                f"{int(bad_angle.sum())} path(s) with a NaN angle dropped",
+                JavelinWarning,
+                stacklevel=2,
+            )
+        keep = ~bad_angle & ~(d < 0)
+        kappa = np.where(np.isfinite(kappa) & (kappa > 0), kappa, np.nan)
+        d = np.where(np.isfinite(d), d, np.nan)
+        v = np.where(np.isfinite(v), v, np.nan)
+        idx = np.flatnonzero(keep)
+        return cls(phi[idx], psi[idx], kappa[idx], d[idx], v[idx], idx)
+
+    @classmethod
+    def empty(cls) -> PathMeasurements:
+        """No path this epoch (everything missed)."""
+        z = np.zeros(0)
+        return cls(z, z.copy(), z.copy(), z.copy(), z.copy(), np.zeros(0, dtype=int))
+
+    def __len__(self) -> int:
+        return self.phi.size
+
+    def subset(self, idx) -> PathMeasurements:
+        """The paths at positions ``idx``."""
+        idx = np.asarray(idx, dtype=int)
+        return PathMeasurements(
+            self.phi[idx],
+            self.psi[idx],
+            self.kappa[idx],
+            self.d[idx],
+            self.v[idx],
+            self.source[idx],
+        )
+
+    def triples(self) -> np.ndarray:
+        """``(phi, psi, kappa)`` per path, shape (n, 3) (NaN kappa where far field)."""
+        return np.column_stack([self.phi, self.psi, self.kappa])
+
+    def directions(self) -> np.ndarray:
+        """Unit arrival directions from ``phi``/``psi`` (elevation), shape (n, 3)."""
+        c = np.cos(self.psi)
+        return np.column_stack([c * np.cos(self.phi), c * np.sin(self.phi), np.sin(self.psi)])
+
+
+def _vue_positions(x: np.ndarray) -> np.ndarray:
+    yz = x[3:].reshape(-1, 2)
+    return np.column_stack([np.full(len(yz), x[0]), yz])
+
+
+def track_model(
+    x, bs=(0.0, 0.0, 0.0), kappa_model: str = "reflector"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per-track predictions ``[phi, psi, kappa, range]`` (L_hat, 4) and Jacobians (L_hat, 4, D).
+
+    Eq. 46-51 plus the range ``||p - b||`` from which the TDoA of eq. 52 is differenced.
+    ``kappa_model="vue"`` sets the VUE curvature to its range (wavefront centred on the VUE)
+    instead of eq. 51's reflector distance.
+    """
+    x = finite_array("x", x, ndim=1)
+    if x.size < 3 or (x.size - 3) % 2:
+        raise ValueError(f"x: expected 3 + 2 n entries (eq. 43), got {x.size}")
+    b = vector("bs", bs, 3)
+    if kappa_model not in ("reflector", "vue"):
+        raise ValueError(f"kappa_model: expected 'reflector' or 'vue', got {kappa_model!r}")
+    D = x.size
+    n_v = (D - 3) // 2
+    pos = np.vstack([x[:3], _vue_positions(x)])
+    q = pos - b
+    rho2 = q[:, 0] ** 2 + q[:, 1] ** 2
+    rho = np.sqrt(rho2)
+    r2 = rho2 + q[:, 2] ** 2
+    r = np.sqrt(r2)
+    if np.any(rho < 1e-9):
+        raise ValueError("x: a track lies on the base station's vertical axis, azimuth undefined")
+    pred = np.empty((n_v + 1, 4))
+    pred[:, PHI] = np.arctan2(q[:, 1], q[:, 0])
+    pred[:, PSI] = np.arctan2(q[:, 2], rho)
+    pred[:, RANGE] = r
+    pred[:, KAPPA] = r
+    # derivatives w.r.t. the track point q (L, 4, 3)
+    dq = np.zeros((n_v + 1, 4, 3))
+    dq[:, PHI, 0] = -q[:, 1] / rho2
+    dq[:, PHI, 1] = q[:, 0] / rho2
+    dq[:, PSI, 0] = -q[:, 2] * q[:, 0] / (rho * r2)
+    dq[:, PSI, 1] = -q[:, 2] * q[:, 1] / (rho * r2)
+    dq[:, PSI, 2] = rho / r2
+    dq[:, RANGE] = q / r[:, None]
+    dq[:, KAPPA] = dq[:, RANGE]
+    J = np.zeros((n_v + 1, 4, D))
+    J[0, :, 0:3] = dq[0]
+    if n_v:
+        J[1:, :, 0] = dq[1:, :, 0]
+        cols = 3 + 2 * np.arange(n_v)
+        rows = np.arange(1, n_v + 1)
+        J[rows, :, cols] = dq[1:, :, 1]
+        J[rows, :, cols + 1] = dq[1:, :, 2]
+        if kappa_model == "reflector":
+            kap, dk_u, dk_v = _reflector_kappa(q[0], q[1:])
+            pred[1:, KAPPA] = kap
+            J[1:, KAPPA, :] = 0.0
+            J[1:, KAPPA, 0] = dk_v[:, 0]  # x of the VUE is x_u
+            J[1:, KAPPA, 1] = dk_u[:, 1]
+            J[1:, KAPPA, 2] = dk_u[:, 2]
+            J[rows, KAPPA, cols] = dk_v[:, 1]
+            J[rows, KAPPA, cols + 1] = dk_v[:, 2]
+    return pred, J
+
+
+def _reflector_kappa(qu: np.ndarray, qv: np.ndarray):
+    """``||p_r||`` of eq. 45 for VUEs ``qv`` (n, 3) of UE ``qu`` (3,), with its gradients.
+
+    Returns kappa (n,), d kappa / d q_u (n, 3) (lateral and vertical entries used) and
+    d kappa / d q_v (n, 3) (the x entry carries the shared ``x_u`` dependence).
+    """
+    w = qv - qu  # x component is zero by construction
+    A = 0.5 * (np.sum(qv[:, 1:] ** 2, axis=1) - np.sum(qu[1:] ** 2))
+    B = np.sum(w * qv, 1)
+    rv = np.linalg.norm(qv, axis=1)
+    degenerate = (np.abs(B) < 1e-9) | (np.linalg.norm(w, axis=1) < 1e-9)
+    Bs = np.where(degenerate, 1.0, B)
+    kap = np.where(degenerate, rv, rv * A / Bs)
+    # A = 1/2 (|q_v,yz|^2 - |q_u,yz|^2); B = (q_v - q_u)_yz . q_v,yz
+    dA_u = np.zeros_like(qv)
+    dA_u[:, 1:] = -qu[1:]
+    dA_v = np.zeros_like(qv)
+    dA_v[:, 1:] = qv[:, 1:]
+    dB_u = np.zeros_like(qv)
+    dB_u[:, 1:] = -qv[:, 1:]
+    dB_v = np.zeros_like(qv)
+    dB_v[:, 1:] = 2.0 * qv[:, 1:] - qu[1:]
+    drv_v = qv / rv[:, None]
+    g_u = (rv[:, None] * dA_u) / Bs[:, None] - (rv * A / Bs**2)[:, None] * dB_u
+    g_v = (rv[:, None] * dA_v + A[:, None] * drv_v) / Bs[:, None] - (rv * A / Bs**2)[:, None] * dB_v
+    sgn = np.where(kap < 0, -1.0, 1.0)[:, None]  # ||p_r|| = |t| ||p_v||
+    g_u = np.where(degenerate[:, None], 0.0, sgn * g_u)
+    g_v = np.where(degenerate[:, None], drv_v, sgn * g_v)
+    return np.abs(kap), g_u, g_v
+
+
+def measurement_model(
+    x, bs=(0.0, 0.0, 0.0), kappa_model: str = "reflector"
+) -> tuple[np.ndarray, np.ndarray]:
+    """The stacked model ``h(s)`` of eq. 44 and its Jacobian ``H`` (eq. 55), shape (K,), (K, D).
+
+    ``h = [phi_0..phi_{L-1}, psi_0.., kappa_0.., Delta d_1..Delta d_{L-1}]`` with
+    ``K = 4 L_hat - 1``; the TDoA is relative to the UE (LoS) path as in eq. 52.
+    """
+    pred, J = track_model(x, bs, kappa_model)
+    h = np.concatenate(
+        [pred[:, PHI], pred[:, PSI], pred[:, KAPPA], pred[1:, RANGE] - pred[0, RANGE]]
+    )
+    H = np.concatenate([J[:, PHI], J[:, PSI], J[:, KAPPA], J[1:, RANGE] - J[0, RANGE]])
+    return h, H
+
+
+def angle_residual(z, h) -> np.ndarray:
+    """``z - h`` wrapped to ``(-pi, pi]`` (azimuth residuals across the branch cut)."""
+    return wrap_angle(np.asarray(z, dtype=float) - np.asarray(h, dtype=float))

@@ -1,0 +1,143 @@
+"""The variable-dimension JAVELIN state (Italiano et al. 2026, eq. 43).
+
+``s = [x_u, y_u, z_u, y_v1, z_v1, ..., y_v(L-1), z_v(L-1)]`` with ``D = 2 L_hat + 1``: the UE
+position and, per tracked virtual UE (VUE), its lateral and vertical coordinates (its ``x`` equals
+the UE's because the reflecting surfaces run along the tunnel). Track 0 is the UE; tracks 1.. are
+VUEs, each with a persistent id, a misses counter (zeta of Algorithm 3) and a ``transient`` flag
+for paths from dynamic reflectors (used for one epoch only).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..._validate import finite_array, positive, vector
+
+__all__ = ["JavelinState", "track_slice"]
+
+
+def track_slice(i: int) -> slice:
+    """State indices of track ``i``: ``0:3`` for the UE, ``3 + 2(i-1) : 5 + 2(i-1)`` for VUE i."""
+    if i == 0:
+        return slice(0, 3)
+    return slice(3 + 2 * (i - 1), 5 + 2 * (i - 1))
+
+
+@dataclass
+class JavelinState:
+    """Mean ``x`` (D,), covariance ``P`` (D, D) and per-VUE bookkeeping."""
+
+    x: np.ndarray
+    P: np.ndarray
+    ids: list[int] = field(default_factory=list)
+    misses: list[int] = field(default_factory=list)
+    transient: list[bool] = field(default_factory=list)
+    ue_misses: int = 0
+    next_id: int = 1
+
+    @classmethod
+    def initial(cls, position, sigma: float) -> JavelinState:
+        """UE only, at ``position`` (3,) with covariance ``sigma^2 I_3`` (``P_0|0`` of sec. 4.2)."""
+        p = vector("position", position, 3)
+        s = positive("sigma", sigma)
+        return cls(x=p.copy(), P=np.eye(3) * s * s)
+
+    def __post_init__(self) -> None:
+        self.x = finite_array("x", self.x, ndim=1)
+        self.P = finite_array("P", self.P, shape=(self.x.size, self.x.size))
+        if self.x.size < 3 or (self.x.size - 3) % 2:
+            raise ValueError(f"x: expected 3 + 2 n entries (eq. 43), got {self.x.size}")
+        n = self.n_vue
+        for name in ("ids", "misses", "transient"):
+            if len(getattr(self, name)) != n:
+                raise ValueError(
+                    f"{name}: expected one entry per VUE ({n}), got {len(getattr(self, name))}"
+                )
+
+    @property
+    def dim(self) -> int:
+        """State dimension D = 3 + 2 n_vue."""
+        return self.x.size
+
+    @property
+    def n_vue(self) -> int:
+        """Number of tracked VUEs (L_hat - 1)."""
+        return (self.x.size - 3) // 2
+
+    @property
+    def n_tracks(self) -> int:
+        """Number of tracks including the UE (L_hat)."""
+        return self.n_vue + 1
+
+    @property
+    def ue(self) -> np.ndarray:
+        """UE position (3,)."""
+        return self.x[:3].copy()
+
+    def position(self, i: int) -> np.ndarray:
+        """3-D position of track ``i`` (the UE for 0; ``[x_u, y_v, z_v]`` for a VUE)."""
+        if i == 0:
+            return self.ue
+        yz = self.x[track_slice(i)]
+        return np.array([self.x[0], yz[0], yz[1]])
+
+    def positions(self) -> np.ndarray:
+        """All track positions, shape (L_hat, 3), UE first."""
+        yz = self.x[3:].reshape(-1, 2)
+        vue = np.column_stack([np.full(len(yz), self.x[0]), yz])
+        return np.vstack([self.x[:3], vue])
+
+    def copy(self) -> JavelinState:
+        """A deep copy."""
+        return JavelinState(
+            self.x.copy(),
+            self.P.copy(),
+            list(self.ids),
+            list(self.misses),
+            list(self.transient),
+            self.ue_misses,
+            self.next_id,
+        )
+
+    def remove(self, tracks) -> list[int]:
+        """Marginalise VUE tracks (indices >= 1) out of ``x`` and ``P``; returns their ids.
+
+        Marginalising a Gaussian is dropping rows and columns (section 3.5); the UE cannot be
+        removed.
+        """
+        tracks = sorted({int(i) for i in tracks})
+        if not tracks:
+            return []
+        if tracks[0] < 1 or tracks[-1] > self.n_vue:
+            raise ValueError(f"tracks: VUE indices must lie in 1..{self.n_vue}, got {tracks}")
+        drop = np.concatenate([np.arange(self.dim)[track_slice(i)] for i in tracks])
+        keep = np.setdiff1d(np.arange(self.dim), drop)
+        gone = [self.ids[i - 1] for i in tracks]
+        self.x = self.x[keep]
+        self.P = self.P[np.ix_(keep, keep)]
+        for name in ("ids", "misses", "transient"):
+            lst = getattr(self, name)
+            setattr(self, name, [v for k, v in enumerate(lst) if k + 1 not in tracks])
+        return gone
+
+    def append(self, yz, cov, *, transient: bool = False) -> int:
+        """Append a VUE at ``yz`` (2,) with covariance ``cov`` (2, 2), uncorrelated with the rest.
+
+        Returns the new track's id; its index is the new ``n_vue``.
+        """
+        yz = vector("yz", yz, 2)
+        cov = finite_array("cov", cov, shape=(2, 2))
+        d = self.dim
+        P = np.zeros((d + 2, d + 2))
+        P[:d, :d] = self.P
+        P[d:, d:] = cov
+        self.x = np.concatenate([self.x, yz])
+        self.P = P
+        tid = self.next_id
+        self.next_id += 1
+        self.ids.append(tid)
+        self.misses.append(0)
+        self.transient.append(bool(transient))
+        return tid

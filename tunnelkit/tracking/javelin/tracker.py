@@ -1,0 +1,226 @@
+"""The JAVELIN tracker: :meth:`Javelin.step` reads like Algorithm 4 (Italiano et al. 2026).
+
+    predict  (eq. 62-63)   -> associate (Algorithm 2) -> manage tracks (Algorithm 3)
+    -> update (eq. 64-68)  -> drop the one-epoch tracks of dynamic reflectors
+
+Faults in the input stream never stop a run: an epoch without measurement (``None``) or with no
+usable path is predict-only; a missing speed/heading message reuses the last one with a larger
+speed noise; an update whose innovation covariance is not positive definite is skipped. Each is
+reported with a :class:`JavelinWarning` and in the step report.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..._validate import finite_array, nonnegative, vector
+from .associate import ASSOCIATORS, AssociationCosts, association_costs
+from .config import JavelinConfig
+from .gate import ChiSquareGate
+from .manage import ManageResult, manage_tracks
+from .measurement import JavelinWarning, PathMeasurements, track_model
+from .motion import predict, ue_velocity
+from .state import JavelinState
+from .update import joseph_update, stack_measurement
+
+__all__ = ["Javelin", "JavelinRun", "StepReport", "run_javelin"]
+
+
+@dataclass
+class StepReport:
+    """Everything one epoch did, for plots and the epoch-by-epoch explorer."""
+
+    k: int
+    prior_positions: np.ndarray
+    prior_ids: list[int]
+    prior_cov: list[np.ndarray]
+    costs: AssociationCosts | None
+    associated: list[tuple[int, int]]
+    manage: ManageResult | None
+    n_paths: int
+    n_rows: int
+    nis: float
+    estimate: np.ndarray
+    cov: np.ndarray
+    positions: np.ndarray
+    ids: list[int]
+    paths: PathMeasurements
+    faults: list[str] = field(default_factory=list)
+    clutter: int = 0
+
+
+class Javelin:
+    """Variable-dimension EKF over the UE and its virtual UEs (Algorithm 4).
+
+    >>> trk = Javelin(initial_position=[-40.0, 1.5, -3.3])
+    >>> rep = trk.step(paths, speed=10.0, heading=0.0, dt=0.1)   # doctest: +SKIP
+    """
+
+    def __init__(self, initial_position, config: JavelinConfig | None = None) -> None:
+        self.config = JavelinConfig() if config is None else config
+        if not isinstance(self.config, JavelinConfig):
+            raise TypeError(f"config: expected a JavelinConfig, got {type(self.config).__name__}")
+        p0 = vector("initial_position", initial_position, 3)
+        self.state = JavelinState.initial(p0, self.config.p0_ue)
+        self.gate = ChiSquareGate(self.config.gate_probability)
+        self.associate = ASSOCIATORS[self.config.associator]
+        self.k = 0
+        self._last_motion: tuple[float, float] | None = None
+
+    # -- small pieces -------------------------------------------------------------------------
+    def _motion(self, speed, heading, faults: list[str]) -> tuple[float, float, float | None]:
+        ok = (
+            speed is not None
+            and heading is not None
+            and np.isfinite(speed)
+            and np.isfinite(heading)
+        )
+        if ok:
+            self._last_motion = (float(speed), float(heading))
+            return float(speed), float(heading), None
+        sig = self.config.sigma_speed + self.config.sigma_speed_missing
+        if self._last_motion is None:
+            faults.append("speed/heading message missing, none received yet: UE assumed still")
+            return 0.0, 0.0, sig
+        faults.append("speed/heading message missing: last message reused with inflated noise")
+        return *self._last_motion, sig
+
+    @staticmethod
+    def _paths(paths, faults: list[str]) -> PathMeasurements:
+        if paths is None:
+            faults.append("no measurement this epoch: predict only")
+            return PathMeasurements.empty()
+        if not isinstance(paths, PathMeasurements):
+            raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
+        return paths
+
+    # -- Algorithm 4 --------------------------------------------------------------------------
+    def step(
+        self, paths: PathMeasurements | None, speed: float | None, heading: float | None, dt: float
+    ) -> StepReport:
+        """One epoch: predict with (speed, heading) over ``dt``, associate, manage, update."""
+        cfg = self.config
+        dt = nonnegative("dt", dt)
+        faults: list[str] = []
+        meas = self._paths(paths, faults)
+        nu, theta, sig_nu = self._motion(speed, heading, faults)
+        n_clutter = 0
+        if cfg.doppler_clutter_margin is not None and sig_nu is None and len(meas):
+            fast = np.abs(meas.v) > abs(nu) + cfg.doppler_clutter_margin  # NaN v: kept
+            n_clutter = int(fast.sum())
+            if n_clutter:
+                meas = meas.subset(np.flatnonzero(~fast))
+        # Predict (eq. 62-63)
+        st = self.state
+        st.x, st.P = predict(st, nu, theta, dt, cfg, sigma_speed=sig_nu)
+        prior_pos, prior_ids = st.positions(), list(st.ids)
+        prior_cov = [st.P[:3, :3].copy()] + [
+            st.P[3 + 2 * k : 5 + 2 * k, 3 + 2 * k : 5 + 2 * k].copy() for k in range(st.n_vue)
+        ]
+        costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
+        if len(meas):
+            pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
+            R3 = np.diag([cfg.sigma_phi**2, cfg.sigma_psi**2, cfg.sigma_kappa**2])
+            # Associate (Algorithm 2)
+            costs = association_costs(pred, J, st.P, meas, R3, self.gate)
+            assoc = self.associate(costs)
+            # ManageTracks (Algorithm 3)
+            mres = manage_tracks(
+                st, meas, assoc, cfg, ue_velocity(nu, theta) if sig_nu is None else None
+            )
+            # Update (eq. 64-68)
+            pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
+            m = stack_measurement(pred, J, meas, mres.pairs, cfg, mres.los_path)
+            n_rows = m.z.size
+            try:
+                x_new, P_new, nis = joseph_update(st.x, st.P, m)
+                if not (np.all(np.isfinite(x_new)) and np.all(np.isfinite(P_new))):
+                    raise np.linalg.LinAlgError("non-finite update")
+                st.x, st.P = x_new, P_new
+            except np.linalg.LinAlgError as exc:
+                faults.append(f"update skipped ({exc})")
+            # dynamic reflectors contribute to this epoch only
+            gone = [k + 1 for k, tr in enumerate(st.transient) if tr]
+            mres.dead += st.remove(gone)
+        elif paths is not None:
+            faults.append("no usable path this epoch: predict only")
+            # every VUE missed this epoch
+            mres = manage_tracks(st, meas, [], cfg)
+        for f in faults:
+            warnings.warn(f"epoch {self.k}: {f}", JavelinWarning, stacklevel=2)
+        rep = StepReport(
+            self.k,
+            prior_pos,
+            prior_ids,
+            prior_cov,
+            costs,
+            assoc,
+            mres,
+            len(meas),
+            n_rows,
+            nis,
+            st.ue,
+            st.P[:3, :3].copy(),
+            st.positions(),
+            list(st.ids),
+            meas,
+            faults,
+            n_clutter,
+        )
+        self.k += 1
+        return rep
+
+
+@dataclass
+class JavelinRun:
+    """UE estimates (T, 3), their covariances (T, 3, 3), and the step reports (if kept)."""
+
+    estimates: np.ndarray
+    covariances: np.ndarray
+    n_tracks: np.ndarray
+    reports: list[StepReport]
+    faults: int
+
+
+def run_javelin(
+    epochs: Sequence[PathMeasurements | None],
+    speed,
+    heading,
+    dt: float,
+    initial_position,
+    config: JavelinConfig | None = None,
+    *,
+    keep_reports: bool = False,
+) -> JavelinRun:
+    """Run :class:`Javelin` over a measurement stream.
+
+    ``speed[k]`` / ``heading[k]`` are the V2X message sent at epoch ``k`` (NaN = missing); as in
+    Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k``.
+    Warnings about faults are collected and counted instead of printed.
+    """
+    n = len(epochs)
+    spd = np.asarray(speed, dtype=float).reshape(-1)
+    hdg = np.asarray(heading, dtype=float).reshape(-1)
+    if spd.size != n or hdg.size != n:
+        raise ValueError(
+            f"speed, heading: expected {n} values (one per epoch), got {spd.size} and {hdg.size}"
+        )
+    finite_array("dt", dt, ndim=0)
+    trk = Javelin(initial_position, config)
+    est = np.empty((n, 3))
+    cov = np.empty((n, 3, 3))
+    ntr = np.empty(n, dtype=int)
+    reps, faults = [], 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", JavelinWarning)
+        for k in range(n):
+            r = trk.step(epochs[k], spd[max(k - 1, 0)], hdg[max(k - 1, 0)], dt if k else 0.0)
+            est[k], cov[k], ntr[k] = r.estimate, r.cov, len(r.ids) + 1
+            faults += len(r.faults)
+            if keep_reports:
+                reps.append(r)
+    return JavelinRun(est, cov, ntr, reps, faults)

@@ -1,0 +1,122 @@
+"""The variable-dimension EKF update (eq. 64-68) with the Joseph-form covariance.
+
+From the pairs (track, path) left by association and track management we stack, per pair, the
+rows ``phi, psi`` and ``kappa`` (if the path has a near-field curvature), and the TDoA rows
+``Delta d_j = d_j - d_ref`` against a reference path (the LoS path when there is one, as in eq. 52
+and Algorithm 1 line 13; otherwise, ours, the shortest associated path, since TDoAs between
+reflections are clock-bias free too). The stacked vector is the sorted ``z`` of eq. 54.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve
+
+from ...crlb import wrap_angle
+from .config import JavelinConfig
+from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements
+
+__all__ = ["StackedMeasurement", "joseph_update", "stack_measurement"]
+
+
+@dataclass
+class StackedMeasurement:
+    """``z``, ``h``, ``H`` (K, D), ``R`` (K, K), ``angle`` (K,) bool, row labels and the
+    reference pair of the TDoAs (or ``None``)."""
+
+    z: np.ndarray
+    h: np.ndarray
+    H: np.ndarray
+    R: np.ndarray
+    angle: np.ndarray
+    labels: list[tuple[str, int, int]]
+    reference: tuple[int, int] | None
+
+    def residual(self) -> np.ndarray:
+        """Innovation ``y = z - h(s)`` (eq. 64), azimuths wrapped."""
+        y = self.z - self.h
+        return np.where(self.angle, wrap_angle(y), y)
+
+
+def stack_measurement(
+    pred: np.ndarray,
+    J: np.ndarray,
+    meas: PathMeasurements,
+    pairs,
+    config: JavelinConfig,
+    los_path: int | None = None,
+) -> StackedMeasurement:
+    """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``."""
+    D = J.shape[-1]
+    z, h, H, var, ang, labels = [], [], [], [], [], []
+    sig = {PHI: config.sigma_phi, PSI: config.sigma_psi, KAPPA: config.sigma_kappa}
+    for i, j in pairs:
+        comps = [PHI, PSI] + ([KAPPA] if np.isfinite(meas.kappa[j]) else [])
+        zj = (meas.phi[j], meas.psi[j], meas.kappa[j])
+        for c in comps:
+            z.append(zj[c])
+            h.append(pred[i, c])
+            H.append(J[i, c])
+            var.append(sig[c] ** 2)
+            ang.append(c == PHI)
+            labels.append((("phi", "psi", "kappa")[c], i, j))
+    n_direct = len(z)
+    with_d = [(i, j) for i, j in pairs if np.isfinite(meas.d[j])]
+    ref = None
+    if len(with_d) >= 2:
+        los = [(i, j) for i, j in with_d if i == 0 and (los_path is None or j == los_path)]
+        ref = los[0] if los else min(with_d, key=lambda p: meas.d[p[1]])
+        ir, jr = ref
+        for i, j in with_d:
+            if (i, j) == ref:
+                continue
+            z.append(meas.d[j] - meas.d[jr])
+            h.append(pred[i, RANGE] - pred[ir, RANGE])
+            H.append(J[i, RANGE] - J[ir, RANGE])
+            ang.append(False)
+            labels.append(("delta_d", i, j))
+    K = len(z)
+    R = np.zeros((K, K))
+    R[np.arange(n_direct), np.arange(n_direct)] = var
+    nd = K - n_direct
+    if nd:
+        s2 = config.sigma_delta_d**2
+        blk = (
+            0.5 * s2 * (np.eye(nd) + np.ones((nd, nd)))
+            if config.correlated_delta_d
+            else s2 * np.eye(nd)
+        )
+        R[n_direct:, n_direct:] = blk
+    return StackedMeasurement(
+        np.asarray(z, float),
+        np.asarray(h, float),
+        np.asarray(H, float).reshape(K, D),
+        R,
+        np.asarray(ang, bool),
+        labels,
+        ref,
+    )
+
+
+def joseph_update(
+    x: np.ndarray, P: np.ndarray, m: StackedMeasurement
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """EKF update of eq. 64-68; returns ``(x, P, nis)`` with the normalised innovation squared.
+
+    ``P = (I - K H) P (I - K H)^T + K R K^T`` (Joseph form, eq. 68) stays symmetric positive
+    semi-definite under rounding; we symmetrise once more against round-off.
+    """
+    if m.z.size == 0:
+        return x.copy(), P.copy(), 0.0
+    y = m.residual()
+    S = m.H @ P @ m.H.T + m.R
+    S = 0.5 * (S + S.T)
+    cf = cho_factor(S, lower=True)
+    K = cho_solve(cf, m.H @ P).T  # P H^T S^-1 (P symmetric)
+    x_new = x + K @ y
+    IKH = np.eye(x.size) - K @ m.H
+    P_new = IKH @ P @ IKH.T + K @ m.R @ K.T
+    nis = float(y @ cho_solve(cf, y))
+    return x_new, 0.5 * (P_new + P_new.T), nis
