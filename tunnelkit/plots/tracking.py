@@ -1,0 +1,201 @@
+"""Figures of notebook 05: tracks with a time slider, RMSE against the posterior CRLB, particle clouds."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import plotly.graph_objects as go
+from plotly.subplots import make_subplots
+
+from .common import COLORS, line_figure
+from .topview import tunnel_topview
+
+__all__ = ["particle_cloud_figure", "rmse_bound_figure", "table_figure", "tracks_figure"]
+
+
+def tracks_figure(
+    tunnel,
+    base_station,
+    truth,
+    estimates: Mapping[str, np.ndarray],
+    *,
+    period: float = 0.1,
+    title: str = "One run, four estimators",
+    every: int = 5,
+) -> go.Figure:
+    """Top view with the true track and each estimator's track; a slider (and play button) moves
+    one marker per estimator along time. ``truth`` (T, >=2), ``estimates`` name -> (T, >=2)."""
+    truth = np.asarray(truth)[:, :2]
+    lo, hi = tunnel.to_tunnel_frame(truth)[:, 0][[0, -1]]
+    fig = tunnel_topview(tunnel, base_station, along=(min(lo, -5.0) - 10, hi + 15), title=title)
+    fig.add_scatter(
+        x=truth[:, 0],
+        y=truth[:, 1],
+        mode="lines",
+        name="truth",
+        line={"color": COLORS["truth"], "width": 3},
+    )
+    for name, e in estimates.items():
+        e = np.asarray(e)[:, :2]
+        fig.add_scatter(
+            x=e[:, 0],
+            y=e[:, 1],
+            mode="lines",
+            name=name,
+            opacity=0.6,
+            line={"color": COLORS.get(name), "width": 1},
+        )
+    names = ["truth", *estimates]
+    tracks = {"truth": truth, **{n: np.asarray(e)[:, :2] for n, e in estimates.items()}}
+    first = len(fig.data)
+    for n in names:
+        fig.add_scatter(
+            x=tracks[n][:1, 0],
+            y=tracks[n][:1, 1],
+            mode="markers",
+            name=f"{n} now",
+            showlegend=False,
+            marker={
+                "color": COLORS.get(n),
+                "size": 11 if n == "truth" else 8,
+                "symbol": "circle-open" if n == "truth" else "x",
+            },
+        )
+    idx = list(range(first, first + len(names)))
+    ks = list(range(0, truth.shape[0], every)) + (
+        [truth.shape[0] - 1] if (truth.shape[0] - 1) % every else []
+    )
+    fig.frames = [
+        go.Frame(
+            name=str(k),
+            traces=idx,
+            data=[go.Scatter(x=tracks[n][k : k + 1, 0], y=tracks[n][k : k + 1, 1]) for n in names],
+        )
+        for k in ks
+    ]
+    steps = [
+        {
+            "method": "animate",
+            "label": f"{k * period:.1f}",
+            "args": [[str(k)], {"mode": "immediate", "frame": {"duration": 0, "redraw": False}}],
+        }
+        for k in ks
+    ]
+    fig.update_layout(
+        height=520,
+        sliders=[{"steps": steps, "currentvalue": {"prefix": "t [s] = "}, "pad": {"t": 40}}],
+        updatemenus=[
+            {
+                "type": "buttons",
+                "showactive": False,
+                "x": 0.0,
+                "y": -0.08,
+                "xanchor": "left",
+                "buttons": [
+                    {
+                        "label": "play",
+                        "method": "animate",
+                        "args": [
+                            None,
+                            {"frame": {"duration": 80, "redraw": False}, "fromcurrent": True},
+                        ],
+                    }
+                ],
+            }
+        ],
+    )
+    fig.update_yaxes(scaleanchor="x", scaleratio=1)
+    return fig
+
+
+def rmse_bound_figure(
+    t, rmse: Mapping[str, np.ndarray], bound, *, title: str = "", log_y: bool = True
+) -> go.Figure:
+    """RMSE per epoch of each estimator with sqrt(posterior CRLB) dashed underneath."""
+    series = {**rmse, "PCRLB": np.asarray(bound)}
+    fig = line_figure(
+        t,
+        series,
+        title=title,
+        xaxis="t [s]",
+        yaxis="position RMSE [m]",
+        dash={"PCRLB": "dash"},
+        log_y=log_y,
+    )
+    fig.data[-1].name = "sqrt(PCRLB)"
+    return fig
+
+
+def particle_cloud_figure(
+    snapshots: Sequence[Mapping], *, title: str = "UPF particle clouds", half_width: float = 3.0
+) -> go.Figure:
+    """One panel per snapshot ``{"k", "t", "particles" (N, >=2), "weights" (N,), "truth" (2,),
+    "estimate" (2,)}``; marker area follows the weight. Axes span ``half_width`` around the truth."""
+    fig = make_subplots(
+        rows=1,
+        cols=len(snapshots),
+        subplot_titles=[f"t = {s['t']:.1f} s" for s in snapshots],
+        horizontal_spacing=0.06,
+    )
+    for c, s in enumerate(snapshots, start=1):
+        p = np.asarray(s["particles"])[:, :2]
+        w = np.asarray(s["weights"], dtype=float)
+        size = 4 + 16 * np.sqrt(w / w.max())
+        fig.add_scatter(
+            x=p[:, 0],
+            y=p[:, 1],
+            mode="markers",
+            name="particles",
+            showlegend=c == 1,
+            marker={"size": size, "color": COLORS["UPF"], "opacity": 0.35},
+            row=1,
+            col=c,
+        )
+        tr, est = np.asarray(s["truth"]), np.asarray(s["estimate"])
+        fig.add_scatter(
+            x=[tr[0]],
+            y=[tr[1]],
+            mode="markers",
+            name="truth",
+            showlegend=c == 1,
+            marker={"color": COLORS["truth"], "size": 12, "symbol": "circle-open"},
+            row=1,
+            col=c,
+        )
+        fig.add_scatter(
+            x=[est[0]],
+            y=[est[1]],
+            mode="markers",
+            name="UPF estimate",
+            showlegend=c == 1,
+            marker={"color": "black", "size": 10, "symbol": "x"},
+            row=1,
+            col=c,
+        )
+        fig.update_xaxes(
+            range=[tr[0] - half_width, tr[0] + half_width], title_text="x [m]", row=1, col=c
+        )
+        fig.update_yaxes(range=[tr[1] - half_width, tr[1] + half_width], row=1, col=c)
+    fig.update_layout(title=title, height=360, margin={"l": 50, "r": 20, "t": 70, "b": 50})
+    return fig
+
+
+def table_figure(rows: Sequence[Mapping], columns: Sequence[str], *, title: str = "") -> go.Figure:
+    """A plotly table of dict rows (floats shown with 4 significant digits)."""
+
+    def fmt(v):
+        if v is None:
+            return "-"
+        return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+    fig = go.Figure(
+        go.Table(
+            header={"values": list(columns), "align": "center"},
+            cells={"values": [[fmt(r[c]) for r in rows] for c in columns], "align": "right"},
+        )
+    )
+    fig.update_layout(
+        title=title, height=80 + 28 * len(rows), margin={"l": 10, "r": 10, "t": 50, "b": 10}
+    )
+    return fig

@@ -1,0 +1,80 @@
+"""Posterior Cramer-Rao lower bound for tracking (Tichavsky, Muravchik & Nehorai 1998).
+
+For ``X_k = Phi X_{k-1} + U``, ``U ~ N(0, Q)`` and ``Z_k = h(X_k) + V``, ``V ~ N(0, R)``, the
+information matrix of the state obeys the recursion (Tichavsky et al. 1998, eq. 21 and 34)::
+
+    J_0     = P0^-1 + E[H_0^T R^-1 H_0]                 (the filters update at epoch 0)
+    J_k     = D22 - D21 (J_{k-1} + D11)^-1 D12
+    D11     = Phi^T Q^-1 Phi,   D12 = D21^T = -Phi^T Q^-1,
+    D22     = Q^-1 + E[H_k^T R^-1 H_k],                 H_k = d h / d X at X_k
+
+and ``E[(X_hat_k - X_k)(X_hat_k - X_k)^T] >= J_k^-1`` for any estimator. The expectation over the
+true states is taken over the sample of states passed in (one trajectory: the bound along it; many
+trajectories drawn from the model: the full Bayesian bound). No paper in this workbook gives it;
+notebook 05 puts it under every RMSE curve.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import finite_array
+
+__all__ = ["measurement_information", "pcrlb", "pcrlb_position_rmse", "vs_pcrlb"]
+
+
+def measurement_information(jacobians, R) -> np.ndarray:
+    """``E[H^T R^-1 H]`` over all leading axes but the epoch axis: (..., T, m, n) -> (T, n, n)."""
+    H = finite_array("jacobians", jacobians)
+    if H.ndim < 3:
+        raise ValueError(f"jacobians: expected shape (..., T, m, n), got {H.shape}")
+    R = finite_array("R", R, ndim=2)
+    if R.shape != (H.shape[-2], H.shape[-2]):
+        raise ValueError(f"R: expected shape {(H.shape[-2],) * 2}, got {R.shape}")
+    info = np.swapaxes(H, -1, -2) @ np.linalg.solve(R, H)
+    return info.reshape(-1, *info.shape[-3:]).mean(axis=0)
+
+
+def pcrlb(F, Q, P0, info) -> np.ndarray:
+    """Bound matrices ``J_k^-1`` (T, n, n) from the recursion above; ``info`` (T, n, n) holds
+    ``E[H_k^T R^-1 H_k]`` per epoch."""
+    F = finite_array("F", F, ndim=2)
+    n = F.shape[0]
+    Q = finite_array("Q", Q, shape=(n, n))
+    P0 = finite_array("P0", P0, shape=(n, n))
+    info = finite_array("info", info, ndim=3)
+    if info.shape[1:] != (n, n):
+        raise ValueError(f"info: expected shape (T, {n}, {n}), got {info.shape}")
+    for name, M in (("Q", Q), ("P0", P0)):
+        if np.any(np.linalg.eigvalsh(0.5 * (M + M.T)) <= 0):
+            raise ValueError(f"{name}: must be positive definite for the posterior CRLB")
+    Qi = np.linalg.inv(Q)
+    D11 = F.T @ Qi @ F
+    D12 = -F.T @ Qi
+    J = np.linalg.inv(P0) + info[0]
+    out = np.empty_like(info)
+    out[0] = np.linalg.inv(J)
+    for k in range(1, info.shape[0]):
+        J = Qi + info[k] - D12.T @ np.linalg.solve(J + D11, D12)
+        J = 0.5 * (J + J.T)
+        out[k] = np.linalg.inv(J)
+    return out
+
+
+def pcrlb_position_rmse(bounds) -> np.ndarray:
+    """``sqrt(tr)`` of the position block (first two states) of bound matrices (..., n, n) [m]."""
+    B = finite_array("bounds", bounds)
+    return np.sqrt(B[..., 0, 0] + B[..., 1, 1])
+
+
+def vs_pcrlb(model, states, P0) -> np.ndarray:
+    """Position RMSE bound (T,) [m] for the virtual-station model along ``states``.
+
+    ``states`` is one true trajectory (T, 4) or a sample of them (S, T, 4) (the expectation of
+    the measurement information is the average over the sample).
+    """
+    X = finite_array("states", states)
+    if X.ndim not in (2, 3) or X.shape[-1] != 4:
+        raise ValueError(f"states: expected shape (T, 4) or (S, T, 4), got {X.shape}")
+    info = measurement_information(model.jacobian(X), model.R)
+    return pcrlb_position_rmse(pcrlb(model.F, model.Q, P0, info))
