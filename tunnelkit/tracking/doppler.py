@@ -1,0 +1,746 @@
+"""Doppler and ToA Kalman tracking from one roadside unit (Halili et al. 2022, sections 4-5).
+
+Three interchangeable trackers, registered in family ``"halili2022"``:
+
+* ``"EKF DS"`` - :class:`DopplerEKF`: constant-velocity state ``[x, y, v_x, v_y]`` (eq. 1-3,
+  spectral density ``q``), Doppler measurement eq. 4-5 with the sign pinned (approach positive),
+  the EKF recursion eq. 6-12 (filterpy's ``ExtendedKalmanFilter``), optionally the adaptive
+  measurement covariance of eq. 13-15.
+* ``"KF DS and ToA"`` - a KF on Doppler for the speed (:class:`SpeedKF`, ``H = f_c / c``) feeds a
+  KF on ToA for the distance (:class:`RangeKF`, eq. 17-21, ``H = 1 / c``) as control input; the
+  position follows eq. 16 with the heading from past estimates (:class:`HeadingDeadReckoning`).
+* ``"EKF DS and KF ToA"`` - as before, with the speed taken from the EKF DS.
+
+Every tracker has ``step(doppler, toa) -> position`` and ``run(measurements) -> Track``; a NaN or
+``None`` measurement is a dropped epoch (predict only, with a :class:`MeasurementWarning`).
+
+Corrections to the paper, each shown in notebook 06:
+
+* eq. 5 ``h = v . (s - T) f / (c |s - T|)`` is positive when *receding*; the text (and Fig. 2)
+  has the approaching vehicle at positive Doppler. We use ``h = -(f_c/c) v . (p - T) / r``.
+* eq. 17 ``d_k = d_{k-1} + B u`` "when approaching" would make the distance grow while the
+  vehicle closes in. With ``u`` the approach speed (positive when approaching, Doppler-signed)
+  the distance model is ``d_k = d_{k-1} - dt u``.
+* eq. 14-15 add ``H P_check H^T`` (the *prior* covariance) to the post-fit residual power; the
+  residual ``e_k = y_k - h(s_hat_k)`` has covariance ``R - H P_hat H^T`` (posterior), so the
+  consistent estimate uses the posterior ``P_hat`` (Akhlaghi et al. 2017). ``adaptive_form``
+  selects ``"posterior"`` (default) or ``"paper"``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
+from scipy.stats import chi2
+
+from .._validate import finite_array, nonnegative, positive, probability
+from ..constants import C
+from ..drive import Drive, GnssFix, Measurements, doppler_shift, slant_range
+from .registry import register
+
+__all__ = [
+    "APPROACHES",
+    "SIGMAS",
+    "DopplerEKF",
+    "DopplerSetup",
+    "HeadingDeadReckoning",
+    "MeasurementWarning",
+    "RangeKF",
+    "SpeedKF",
+    "Track",
+    "cv_model",
+    "doppler_jacobian",
+    "error_study",
+    "mean_errors",
+    "posterior_crlb",
+    "run_approaches",
+    "snapshot_fim",
+]
+
+#: the paper's three approaches, in the order of its tables
+APPROACHES = ("EKF DS", "KF DS and ToA", "EKF DS and KF ToA")
+
+
+class MeasurementWarning(UserWarning):
+    """A measurement was dropped or rejected; the filter predicted only."""
+
+
+@dataclass(frozen=True)
+class DopplerSetup:
+    """What the vehicle knows: transmitter (horizontal), its height above the antenna, carrier, epoch."""
+
+    tx: np.ndarray
+    dz: float
+    fc: float
+    dt: float
+
+    def __post_init__(self) -> None:
+        finite_array("tx", self.tx, shape=(2,))
+        finite_array("dz", self.dz, ndim=0)
+        positive("fc", self.fc)
+        positive("dt", self.dt)
+
+    @classmethod
+    def from_drive(cls, drive: Drive) -> DopplerSetup:
+        """The setup of a synthetic drive (transmitter position broadcast by the RSU)."""
+        return cls(tx=np.array(drive.tx_xy), dz=drive.dz, fc=drive.config.fc, dt=drive.config.dt)
+
+    @property
+    def k(self) -> float:
+        """``f_c / c`` [Hz per m/s]: the Doppler of one metre per second of approach speed."""
+        return self.fc / C
+
+
+@dataclass(frozen=True)
+class Track:
+    """Output of a run: times (T,), position estimates (T, 2) and speed estimates (T,) [m/s]."""
+
+    t: np.ndarray
+    position: np.ndarray
+    speed: np.ndarray
+
+
+def _measurement(name: str, z) -> float | None:
+    """``None`` for a dropped epoch (None or NaN), else a float; inf and non-numbers refused."""
+    if z is None:
+        return None
+    try:
+        x = float(z)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected a number or None, got {type(z).__name__}") from None
+    if np.isnan(x):
+        return None
+    if not np.isfinite(x):
+        raise ValueError(f"{name}: must be finite or NaN (dropped), got {x}")
+    return x
+
+
+def _warn(msg: str) -> None:
+    warnings.warn(msg, MeasurementWarning, stacklevel=3)
+
+
+# --- the EKF on Doppler (section 4) ---------------------------------------------------------------
+
+
+def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
+    """``F`` (eq. 2) and ``Q`` (eq. 3) of the constant-velocity model, state ``[x, y, v_x, v_y]``."""
+    dt = positive("dt", dt)
+    q = nonnegative("q", q)
+    F = np.eye(4)
+    F[0, 2] = F[1, 3] = dt
+    Q = q * np.array(
+        [
+            [dt**3 / 3, 0, dt**2 / 2, 0],
+            [0, dt**3 / 3, 0, dt**2 / 2],
+            [dt**2 / 2, 0, dt, 0],
+            [0, dt**2 / 2, 0, dt],
+        ]
+    )
+    return F, Q
+
+
+def doppler_model(s, setup: DopplerSetup) -> np.ndarray:
+    """``h(s)`` of eq. 5 with the pinned sign: ``-(f_c/c) v . (p - T) / r`` [Hz]."""
+    s = np.asarray(s, dtype=float)
+    return doppler_shift(s[..., :2], s[..., 2:], setup.tx, setup.fc, setup.dz)
+
+
+def doppler_jacobian(s, setup: DopplerSetup) -> np.ndarray:
+    """``H_k = dh/ds`` (eq. 7), shape (..., 1, 4), of the pinned-sign Doppler model.
+
+    With ``w = p - T``, ``r = sqrt(|w|^2 + dz^2)``: ``dh/dp = -(f_c/c) (v / r - (v . w) w / r^3)``,
+    ``dh/dv = -(f_c/c) w / r``.
+    """
+    s = np.asarray(s, dtype=float)
+    w = s[..., :2] - setup.tx
+    v = s[..., 2:]
+    r = np.sqrt(np.sum(w * w, -1, keepdims=True) + setup.dz**2)
+    vw = np.sum(v * w, -1, keepdims=True)
+    dp = -setup.k * (v / r - vw * w / r**3)
+    dv = -setup.k * w / r
+    return np.concatenate([dp, dv], -1)[..., None, :]
+
+
+def _adaptive_r(R_prev: float, e: float, H: np.ndarray, P: np.ndarray, a: float) -> float:
+    """Eq. 15: ``R_k = a R_{k-1} + (1 - a) (e_k^2 + H P H^T)`` for a scalar measurement."""
+    return float(a * R_prev + (1 - a) * (e * e + (H @ P @ H.T).item()))
+
+
+class DopplerEKF:
+    """EKF DS: the EKF on Doppler shift, eq. 1-12, optionally with the adaptive R of eq. 13-15.
+
+    ``sigma_hz`` sets the constant ``R = sigma^2`` (the starting value when ``adaptive``); ``q`` is
+    the spectral density of eq. 3 (paper: 0.5). ``a`` weighs the previous R in eq. 15 (the paper
+    does not state it). The state starts at the GNSS fix with its covariance.
+
+    ``gate`` (not in the paper; default off) is a probability: a Doppler whose squared normalised
+    innovation ``y^2 / S`` exceeds the chi-square quantile with one degree of freedom is treated as
+    an outlier (a moving scatterer) and skipped; ``rejected`` counts them.
+    """
+
+    def __init__(
+        self,
+        setup: DopplerSetup,
+        fix: GnssFix,
+        *,
+        sigma_hz: float = 32.79,
+        q: float = 0.5,
+        adaptive: bool = False,
+        a: float = 0.9,
+        adaptive_form: str = "posterior",
+        gate: float | None = None,
+    ) -> None:
+        if not isinstance(setup, DopplerSetup):
+            raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+        if not isinstance(fix, GnssFix):
+            raise TypeError(f"fix: expected a GnssFix, got {type(fix).__name__}")
+        sigma_hz = positive("sigma_hz", sigma_hz)
+        q = nonnegative("q", q)
+        self.a = probability("a", a, open_interval=False)
+        if adaptive_form not in ("posterior", "paper"):
+            raise ValueError(
+                f"adaptive_form: must be 'posterior' or 'paper', got {adaptive_form!r}"
+            )
+        self.setup, self.adaptive, self.adaptive_form = setup, bool(adaptive), adaptive_form
+        kf = ExtendedKalmanFilter(dim_x=4, dim_z=1)
+        kf.F, kf.Q = cv_model(setup.dt, q)
+        kf.x = np.concatenate([fix.position, fix.velocity]).reshape(4, 1)
+        kf.P = fix.covariance
+        kf.R = np.array([[sigma_hz**2]])
+        self.kf = kf
+        self.threshold = None if gate is None else float(chi2.ppf(probability("gate", gate), 1))
+        self.rejected = 0
+
+    def _h(self, x):
+        return doppler_model(x.ravel(), self.setup).reshape(1, 1)
+
+    def _H(self, x):
+        return doppler_jacobian(x.ravel(), self.setup)
+
+    def step(self, z) -> np.ndarray:
+        """Predict (eq. 8-9) and, unless ``z`` is None/NaN, update with Doppler ``z`` [Hz] (eq. 10-12)."""
+        z = _measurement("z", z)
+        kf = self.kf
+        kf.predict()
+        if z is None:
+            _warn("Doppler: dropped epoch (None/NaN); EKF predicted only")
+            kf.update(None, self._H, self._h)
+            return self.position
+        H = self._H(kf.x)
+        if self.threshold is not None:
+            nu = z - float(self._h(kf.x)[0, 0])
+            if nu * nu > self.threshold * float((H @ kf.P @ H.T).item() + kf.R[0, 0]):
+                self.rejected += 1
+                kf.update(None, self._H, self._h)
+                return self.position
+        P_prior = kf.P.copy()
+        kf.update(np.array([[z]]), self._H, self._h)
+        if self.adaptive:
+            e = z - float(self._h(kf.x)[0, 0])  # eq. 13, post-fit residual
+            P = kf.P if self.adaptive_form == "posterior" else P_prior
+            kf.R = np.array([[_adaptive_r(float(kf.R[0, 0]), e, H, P, self.a)]])
+        return self.position
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.kf.x[:2, 0].copy()
+
+    @property
+    def velocity(self) -> np.ndarray:
+        return self.kf.x[2:, 0].copy()
+
+    @property
+    def approach_speed(self) -> float:
+        """``-v . (p - T) / r`` of the current estimate [m/s] (positive when approaching)."""
+        return float(doppler_model(self.kf.x.ravel(), self.setup)) / self.setup.k
+
+
+# --- the KFs on Doppler and ToA (section 5) -------------------------------------------------------
+
+
+class SpeedKF:
+    """KF DS: scalar KF on Doppler for the approach speed ``u`` (sec. 5), ``H = f_c / c``.
+
+    The state is the speed towards the transmitter (positive approaching, negative receding), so
+    ``z = (f_c/c) u + r`` is exactly linear; calling it "the speed" ignores the angle between the
+    heading and the line of sight, which is the paper's simplification. Random-walk model with
+    ``Q = q dt`` (the paper's ``Q = 0.5`` read as a spectral density so it does not depend on
+    the epoch rate).
+    """
+
+    def __init__(
+        self,
+        setup: DopplerSetup,
+        u0: float,
+        *,
+        sigma_hz: float = 32.79,
+        q: float = 0.5,
+        sigma_u0: float = 0.5,
+        adaptive: bool = False,
+        a: float = 0.9,
+        adaptive_form: str = "posterior",
+    ) -> None:
+        if not isinstance(setup, DopplerSetup):
+            raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+        sigma_hz = positive("sigma_hz", sigma_hz)
+        q = nonnegative("q", q)
+        u0 = float(finite_array("u0", u0, ndim=0))
+        self.a = probability("a", a, open_interval=False)
+        if adaptive_form not in ("posterior", "paper"):
+            raise ValueError(
+                f"adaptive_form: must be 'posterior' or 'paper', got {adaptive_form!r}"
+            )
+        self.adaptive, self.adaptive_form = bool(adaptive), adaptive_form
+        kf = KalmanFilter(dim_x=1, dim_z=1)
+        kf.x = np.array([[u0]])
+        kf.P = np.array([[positive("sigma_u0", sigma_u0) ** 2]])
+        kf.F = np.array([[1.0]])
+        kf.Q = np.array([[q * setup.dt]])
+        kf.H = np.array([[setup.k]])
+        kf.R = np.array([[sigma_hz**2]])
+        self.kf = kf
+
+    def step(self, z) -> float:
+        """Predict, then update with Doppler ``z`` [Hz] unless dropped."""
+        z = _measurement("z", z)
+        kf = self.kf
+        kf.predict()
+        if z is None:
+            _warn("Doppler: dropped epoch (None/NaN); speed KF predicted only")
+            kf.update(None)
+            return self.speed
+        P_prior = kf.P.copy()
+        kf.update(np.array([[z]]))
+        if self.adaptive:
+            e = z - float((kf.H @ kf.x)[0, 0])  # eq. 13
+            P = kf.P if self.adaptive_form == "posterior" else P_prior
+            kf.R = np.array([[_adaptive_r(float(kf.R[0, 0]), e, kf.H, P, self.a)]])
+        return self.speed
+
+    @property
+    def speed(self) -> float:
+        return float(self.kf.x[0, 0])
+
+
+class RangeKF:
+    """KF ToA: scalar KF on the transmitter-receiver distance (eq. 17-21).
+
+    Prediction ``d_k = d_{k-1} - dt u_k`` with ``u`` the approach speed from the Doppler (eq. 17,
+    sign corrected), ``Q = q dt``; update with ToA ``z = d / c + r`` (``H = 1/c``, eq. 19-21).
+    ``calibrate`` removes the unknown clock offset with the first valid ToA and the GNSS
+    distance ``d0`` (sec. 5: "perform calibration when using travel time measurements").
+    A ToA implying a distance below ``d_min`` (the transmitter's height above the antenna) is
+    physically impossible and is rejected with a warning.
+    """
+
+    def __init__(
+        self,
+        setup: DopplerSetup,
+        d0: float,
+        *,
+        sigma_toa: float = 3e-9,
+        q: float = 0.5,
+        sigma_d0: float = 2.0,
+        calibrate: bool = True,
+    ) -> None:
+        if not isinstance(setup, DopplerSetup):
+            raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+        d0 = positive("d0", d0)
+        sigma_toa = positive("sigma_toa", sigma_toa)
+        q = nonnegative("q", q)
+        self.setup, self.calibrate = setup, bool(calibrate)
+        self.offset: float | None = None if calibrate else 0.0
+        self.d_min = abs(setup.dz)
+        self._gate = 5 * sigma_toa * C
+        kf = KalmanFilter(dim_x=1, dim_z=1, dim_u=1)
+        kf.x = np.array([[d0]])
+        kf.P = np.array([[positive("sigma_d0", sigma_d0) ** 2]])
+        kf.F = np.array([[1.0]])
+        kf.B = np.array([[setup.dt]])
+        kf.Q = np.array([[q * setup.dt]])
+        kf.H = np.array([[1.0 / C]])
+        kf.R = np.array([[sigma_toa**2]])
+        self.kf = kf
+
+    def step(self, u: float, z) -> float:
+        """Predict with approach speed ``u`` [m/s], update with ToA ``z`` [s] unless dropped/impossible."""
+        u = float(finite_array("u", u, ndim=0))
+        z = _measurement("z", z)
+        kf = self.kf
+        kf.predict(u=np.array([[-u]]))
+        if z is not None and z <= 0:
+            _warn(f"ToA: {z:.3e} s is not a time of flight; KF ToA predicted only")
+            z = None
+        if z is not None and self.offset is None:  # calibrate on the predicted GNSS-based distance
+            self.offset = z - self.distance / C
+        if z is not None and C * (z - self.offset) < self.d_min - self._gate:
+            _warn(
+                f"ToA: distance {C * (z - self.offset):.2f} m is below the physical minimum "
+                f"{self.d_min:.2f} m; KF ToA predicted only"
+            )
+            z = None
+        if z is None:
+            kf.update(None)
+            return self.distance
+        kf.update(np.array([[z - self.offset]]))
+        return self.distance
+
+    @property
+    def distance(self) -> float:
+        return float(self.kf.x[0, 0])
+
+
+class HeadingDeadReckoning:
+    """Eq. 16: ``x_k = x_{k-1} + dr sin(phi)``, ``y_k = y_{k-1} + dr cos(phi)``.
+
+    ``phi`` is the heading from the y axis, taken from the past estimated positions (the last
+    displacement longer than ``min_step``), starting from the GNSS velocity. ``dr`` is the
+    change of the filtered distance, so near the transmitter (where the distance barely
+    changes) the position stalls: the paper's radial-motion approximation.
+    """
+
+    def __init__(self, p0, v0, *, min_step: float = 1e-3) -> None:
+        self.p = finite_array("p0", p0, shape=(2,)).copy()
+        v0 = finite_array("v0", v0, shape=(2,))
+        if np.linalg.norm(v0) < 1e-6:
+            raise ValueError("v0: speed of zero, the initial heading is undefined")
+        self.phi = float(np.arctan2(v0[0], v0[1]))
+        self.min_step = positive("min_step", min_step)
+        self._last = self.p.copy()
+
+    def step(self, dr: float) -> np.ndarray:
+        """Advance by ``dr`` [m] along the current heading; update the heading from the history."""
+        dr = abs(float(dr))
+        self.p = self.p + dr * np.array([np.sin(self.phi), np.cos(self.phi)])
+        disp = self.p - self._last
+        if np.hypot(*disp) >= self.min_step:
+            self.phi = float(np.arctan2(disp[0], disp[1]))
+            self._last = self.p.copy()
+        return self.p.copy()
+
+
+# --- the three approaches, registered -------------------------------------------------------------
+
+
+class _Base:
+    name = ""
+    setup: DopplerSetup
+
+    def step(self, doppler, toa=None) -> np.ndarray:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def speed(self) -> float:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def run(self, meas: Measurements) -> Track:
+        """Run over a whole measurement stream; dropped epochs predict only (one summary warning)."""
+        if not isinstance(meas, Measurements):
+            raise TypeError(f"meas: expected Measurements, got {type(meas).__name__}")
+        n = len(meas.t)
+        pos = np.empty((n, 2))
+        spd = np.empty(n)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", MeasurementWarning)
+            for k in range(n):
+                pos[k] = self.step(meas.doppler[k], meas.toa[k]) if k else self._first()
+                spd[k] = self.speed()
+        other = [w for w in caught if not issubclass(w.category, MeasurementWarning)]
+        for w in other:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        n_bad = len(caught) - len(other)
+        if n_bad:
+            warnings.warn(
+                f"{self.name}: {n_bad} measurement(s) dropped or rejected; "
+                "predicted only at those epochs",
+                MeasurementWarning,
+                stacklevel=2,
+            )
+        return Track(t=meas.t, position=pos, speed=spd)
+
+    def _first(self) -> np.ndarray:  # the first epoch is the GNSS fix itself
+        return self._p0.copy()
+
+
+def _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw) -> DopplerEKF:
+    """The EKF on Doppler shared by "EKF DS" and "EKF DS and KF ToA" (extra keywords filtered)."""
+    extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form", "gate")}
+    return DopplerEKF(setup, fix, sigma_hz=sigma_hz, q=q, adaptive=adaptive, **extra)
+
+
+@register("halili2022", "EKF DS")
+class EkfDS(_Base):
+    """EKF DS (sec. 4): the EKF on Doppler; the ToA is not used."""
+
+    name = "EKF DS"
+
+    def __init__(
+        self,
+        setup: DopplerSetup,
+        fix: GnssFix,
+        *,
+        sigma_hz: float = 32.79,
+        q: float = 0.5,
+        adaptive: bool = False,
+        **kw,
+    ) -> None:
+        self.setup = setup
+        self.ekf = _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw)
+        self._p0 = np.array(fix.position, dtype=float)
+
+    def step(self, doppler, toa=None) -> np.ndarray:
+        return self.ekf.step(doppler)
+
+    def speed(self) -> float:
+        return float(np.linalg.norm(self.ekf.velocity))
+
+
+class _KfToA(_Base):
+    """Shared part of the two section-5 approaches: range KF + eq. 16 dead reckoning."""
+
+    def _init_range(self, setup, fix, q, sigma_toa, calibrate):
+        self.setup = setup
+        self._p0 = np.array(fix.position, dtype=float)
+        d0 = float(slant_range(fix.position, setup.tx, setup.dz))
+        self.range_kf = RangeKF(
+            setup, d0, sigma_toa=sigma_toa, q=q, sigma_d0=fix.sigma_p, calibrate=calibrate
+        )
+        self.dr = HeadingDeadReckoning(fix.position, fix.velocity)
+        w = fix.position - setup.tx
+        self._u0 = -float(fix.velocity @ w) / float(slant_range(fix.position, setup.tx, setup.dz))
+
+    def _advance(self, u: float, toa) -> np.ndarray:
+        d_prev = self.range_kf.distance
+        d = self.range_kf.step(u, toa)
+        return self.dr.step(d - d_prev)
+
+
+@register("halili2022", "KF DS and ToA")
+class KfDSToA(_KfToA):
+    """KF DS and ToA (sec. 5): KF on Doppler for the speed, KF on ToA for the distance, eq. 16."""
+
+    name = "KF DS and ToA"
+
+    def __init__(
+        self,
+        setup: DopplerSetup,
+        fix: GnssFix,
+        *,
+        sigma_hz: float = 32.79,
+        q: float = 0.5,
+        adaptive: bool = False,
+        sigma_toa: float = 3e-9,
+        calibrate: bool = True,
+        **kw,
+    ) -> None:
+        self._init_range(setup, fix, q, sigma_toa, calibrate)
+        self.speed_kf = SpeedKF(
+            setup,
+            self._u0,
+            sigma_hz=sigma_hz,
+            q=q,
+            sigma_u0=fix.sigma_v,
+            adaptive=adaptive,
+            **{k: v for k, v in kw.items() if k in ("a", "adaptive_form")},
+        )
+
+    def step(self, doppler, toa=None) -> np.ndarray:
+        return self._advance(self.speed_kf.step(doppler), toa)
+
+    def speed(self) -> float:
+        return abs(self.speed_kf.speed)
+
+
+@register("halili2022", "EKF DS and KF ToA")
+class EkfDSKfToA(_KfToA):
+    """EKF DS and KF ToA (sec. 5, last paragraph): the EKF's approach speed drives the KF on ToA."""
+
+    name = "EKF DS and KF ToA"
+
+    def __init__(
+        self,
+        setup: DopplerSetup,
+        fix: GnssFix,
+        *,
+        sigma_hz: float = 32.79,
+        q: float = 0.5,
+        adaptive: bool = False,
+        sigma_toa: float = 3e-9,
+        calibrate: bool = True,
+        **kw,
+    ) -> None:
+        self._init_range(setup, fix, q, sigma_toa, calibrate)
+        self.ekf = _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw)
+
+    def step(self, doppler, toa=None) -> np.ndarray:
+        self.ekf.step(doppler)
+        return self._advance(self.ekf.approach_speed, toa)
+
+    def speed(self) -> float:
+        return float(np.linalg.norm(self.ekf.velocity))
+
+
+SIGMAS = {"103.70 Hz": 103.70, "32.79 Hz": 32.79, "10.37 Hz": 10.37, "dynamic": None}
+"""The paper's measurement-noise settings (sec. 6, Fig. 4); ``None`` = adaptive R (eq. 15)."""
+
+
+def run_approaches(
+    drive: Drive,
+    meas: Measurements,
+    fix: GnssFix,
+    *,
+    sigma_hz: float | None = 32.79,
+    q: float = 0.5,
+    approaches=APPROACHES,
+    sigma0_hz: float = 32.79,
+    **kw,
+) -> dict[str, Track]:
+    """Run the registered approaches on one drive; ``sigma_hz=None`` means adaptive R from ``sigma0_hz``."""
+    from .registry import family
+
+    fam = family("halili2022")
+    setup = DopplerSetup.from_drive(drive)
+    adaptive = sigma_hz is None
+    out = {}
+    for name in approaches:
+        if name not in fam:
+            raise ValueError(
+                f"approaches: {name!r} is not in family 'halili2022'; members: {list(fam)}"
+            )
+        trk = fam[name](
+            setup, fix, sigma_hz=sigma0_hz if adaptive else sigma_hz, q=q, adaptive=adaptive, **kw
+        )
+        out[name] = trk.run(meas)
+    return out
+
+
+def error_study(
+    drive: Drive,
+    rng: np.random.Generator,
+    *,
+    sigmas: dict | None = None,
+    q: float = 0.5,
+    approaches=APPROACHES,
+    **kw,
+) -> dict[tuple[str, str], np.ndarray]:
+    """One noisy realisation of ``drive``, every approach at every sigma: position errors (T,) each.
+
+    Keys ``(approach, sigma label)``; all settings see the same measurements and GNSS fix.
+    """
+    from ..drive import gnss_fix, measure
+
+    sigmas = SIGMAS if sigmas is None else dict(sigmas)
+    meas = measure(drive, rng)
+    fix = gnss_fix(drive, rng)
+    out = {}
+    for label, sig in sigmas.items():
+        tracks = run_approaches(drive, meas, fix, sigma_hz=sig, q=q, approaches=approaches, **kw)
+        for name, tr in tracks.items():
+            out[(name, label)] = np.linalg.norm(tr.position - drive.position, axis=-1)
+    return out
+
+
+def mean_errors(
+    drive: Drive,
+    seeds,
+    *,
+    sigma_hz: float | None = 32.79,
+    q: float = 0.5,
+    approaches=APPROACHES,
+    **kw,
+) -> dict[str, float]:
+    """Mean position error of each approach, averaged over drives seeded by ``seeds`` (ints).
+
+    Each seed gives one noise realisation and GNSS fix (``numpy.random.default_rng(seed)``) shared
+    by all approaches; extra keywords (``gate``, ``adaptive_form``, ...) go to the trackers.
+    """
+    from ..drive import gnss_fix, measure
+
+    seeds = [int(s) for s in seeds]
+    if not seeds:
+        raise ValueError("seeds: give at least one seed")
+    acc: dict[str, list[float]] = {name: [] for name in approaches}
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        meas = measure(drive, rng)
+        fix = gnss_fix(drive, rng)
+        tracks = run_approaches(
+            drive, meas, fix, sigma_hz=sigma_hz, q=q, approaches=approaches, **kw
+        )
+        for name, tr in tracks.items():
+            acc[name].append(float(np.mean(np.linalg.norm(tr.position - drive.position, axis=1))))
+    return {name: float(np.mean(v)) for name, v in acc.items()}
+
+
+# --- what one transmitter can observe -------------------------------------------------------------
+
+
+def snapshot_fim(
+    p, v, setup: DopplerSetup, *, sigma_hz: float | None = None, sigma_range: float | None = None
+) -> np.ndarray:
+    """Fisher information on the position ``[x, y]`` from one epoch (velocity known), shape (2, 2).
+
+    Doppler (``sigma_hz``) and/or range from ToA (``sigma_range`` metres); closed form
+    ``sum_i J_i^T J_i / sigma_i^2`` with ``J`` from :func:`doppler_jacobian` and ``w / r``.
+    One scalar measurement gives a rank-one matrix: information along one direction only.
+    """
+    p = finite_array("p", p, shape=(2,))
+    v = finite_array("v", v, shape=(2,))
+    if sigma_hz is None and sigma_range is None:
+        raise ValueError("sigma_hz, sigma_range: give at least one measurement")
+    F = np.zeros((2, 2))
+    if sigma_hz is not None:
+        J = doppler_jacobian(np.concatenate([p, v]), setup)[:, :2]
+        F += J.T @ J / positive("sigma_hz", sigma_hz) ** 2
+    if sigma_range is not None:
+        w = p - setup.tx
+        J = (w / float(slant_range(p, setup.tx, setup.dz)))[None, :]
+        F += J.T @ J / positive("sigma_range", sigma_range) ** 2
+    return F
+
+
+def posterior_crlb(
+    drive: Drive,
+    *,
+    q: float = 0.5,
+    sigma_hz: float | None = 32.79,
+    sigma_range: float | None = None,
+    sigma_p0: float | None = None,
+    sigma_v0: float | None = None,
+) -> np.ndarray:
+    """Posterior CRLB (Tichavsky et al. 1998) of ``[x, y, v_x, v_y]`` along the true drive, (T, 4, 4).
+
+    For linear-Gaussian dynamics the information recursion is
+    ``J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + H_k^T R^{-1} H_k`` with ``H_k`` at the true state;
+    ``J_0 = P_0^{-1} + H_0^T R^{-1} H_0`` from the GNSS fix. Doppler (``sigma_hz``) and/or
+    range (``sigma_range``, metres); both None gives the prior alone (dead reckoning).
+    """
+    if not isinstance(drive, Drive):
+        raise TypeError(f"drive: expected a Drive, got {type(drive).__name__}")
+    cfg = drive.config
+    setup = DopplerSetup.from_drive(drive)
+    q = nonnegative("q", q)
+    sp = positive("sigma_p0", cfg.gnss_sigma_m if sigma_p0 is None else sigma_p0)
+    sv = positive("sigma_v0", cfg.gnss_sigma_v if sigma_v0 is None else sigma_v0)
+    F, Q = cv_model(setup.dt, q)
+    s = np.concatenate([drive.position, drive.velocity], -1)
+    info = np.zeros((len(s), 4, 4))
+    if sigma_hz is not None:
+        H = doppler_jacobian(s, setup)[:, 0, :]
+        info += H[:, :, None] * H[:, None, :] / positive("sigma_hz", sigma_hz) ** 2
+    if sigma_range is not None:
+        w = drive.position - setup.tx
+        H = np.concatenate(
+            [w / slant_range(drive.position, setup.tx, setup.dz)[:, None], np.zeros_like(w)], -1
+        )
+        info += H[:, :, None] * H[:, None, :] / positive("sigma_range", sigma_range) ** 2
+    out = np.empty_like(info)
+    P = np.linalg.inv(np.diag([1 / sp**2, 1 / sp**2, 1 / sv**2, 1 / sv**2]) + info[0])
+    out[0] = P
+    for k in range(1, len(s)):
+        Pp = F @ P @ F.T + Q
+        P = np.linalg.inv(np.linalg.inv(Pp) + info[k])
+        out[k] = 0.5 * (P + P.T)
+    return out
