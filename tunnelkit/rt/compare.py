@@ -1,0 +1,143 @@
+"""Side-by-side comparison of two path lists (image method vs Sionna RT) for tables and checks."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..constants import C
+from ..propagation import Path, Tunnel3D
+
+__all__ = ["compare_paths", "lower_into_tunnel", "plate_occluders", "time_engines", "worst_errors"]
+
+
+def _key(p: Path) -> tuple[str, str]:
+    return (p.kind, p.surface)
+
+
+def plate_occluders(tunnel: Tunnel3D, path: Path, ue, origin) -> list[str]:
+    """Names of the RRM plates that a leg of ``path`` crosses (UE -> point -> ``origin``).
+
+    The image method treats plates as reflectors only; a ray tracer also sees them as obstacles,
+    so such a path exists in the image method and not in Sionna.
+    """
+    ue, origin = np.asarray(ue, float), np.asarray(origin, float)
+    legs = [(ue, origin)] if path.kind == "los" else [(ue, path.point), (path.point, origin)]
+    hit = []
+    for f in tunnel.plates:
+        if f.name == path.surface:
+            continue
+        for a, b in legs:
+            da, db = float(f.plane.signed_distance(a)), float(f.plane.signed_distance(b))
+            if da * db < 0 and bool(f.contains(a + da / (da - db) * (b - a), tol=0.0)):
+                hit.append(f.name)
+                break
+    return hit
+
+
+def compare_paths(image: list[Path], other: list[Path]) -> list[dict]:
+    """One row per path found by either engine, with both values and their differences.
+
+    Columns: path, found ("both", "image only", "sionna only"), delay [ns], |d delay| [s],
+    |d az|, |d el| [deg], |d Doppler| [Hz], |d point| [m], max |d length| over the antennas
+    [m], and |Gamma| of each engine.
+    """
+    a = {_key(p): p for p in image}
+    b = {_key(p): p for p in other}
+    rows = []
+    for key in list(a) + [k for k in b if k not in a]:
+        p, q = a.get(key), b.get(key)
+        row = {
+            "path": key[1] or "LoS",
+            "found": "both" if p and q else ("image only" if p else "sionna only"),
+        }
+        ref = p or q
+        row["delay [ns]"] = ref.length / C * 1e9
+        if p and q:
+            row.update(
+                {
+                    "|d delay| [s]": abs(p.length - q.length) / C,
+                    "|d az| [deg]": abs(np.degrees(np.angle(np.exp(1j * (p.azimuth - q.azimuth))))),
+                    "|d el| [deg]": abs(np.degrees(p.elevation - q.elevation)),
+                    "|d Doppler| [Hz]": abs(p.doppler - q.doppler),
+                    "|d point| [m]": float(np.max(np.abs(p.point - q.point))),
+                    "max |d length_m| [m]": float(np.max(np.abs(p.lengths - q.lengths))),
+                }
+            )
+        else:
+            row.update(
+                {
+                    k: float("nan")
+                    for k in (
+                        "|d delay| [s]",
+                        "|d az| [deg]",
+                        "|d el| [deg]",
+                        "|d Doppler| [Hz]",
+                        "|d point| [m]",
+                        "max |d length_m| [m]",
+                    )
+                }
+            )
+        row["|Gamma| image"] = abs(p.reflection_coefficient) if p else float("nan")
+        row["|Gamma| sionna"] = abs(q.reflection_coefficient) if q else float("nan")
+        rows.append(row)
+    return rows
+
+
+def worst_errors(rows: list[dict]) -> dict[str, float]:
+    """Largest difference per column over the rows found by both engines."""
+    both = [r for r in rows if r["found"] == "both"]
+    cols = [k for k in (both[0] if both else {}) if k.startswith("|d") or k.startswith("max |d")]
+    return {k: max(r[k] for r in both) for k in cols}
+
+
+def time_engines(
+    tunnel: Tunnel3D,
+    array,
+    ue,
+    ue_velocity,
+    *,
+    fc: float,
+    repeat: int = 3,
+    engines: tuple[str, ...] = ("image", "sionna"),
+    **options,
+) -> dict:
+    """Run each engine ``repeat`` times on one epoch; ``{engine: (paths, median seconds)}``.
+
+    The Sionna engine is built (scene export + load) and warmed up (JIT compilation) before the
+    timed runs, so the times are per epoch in steady state. ``options`` go to the Sionna engine.
+    """
+    import time
+
+    from . import compute_paths
+
+    out = {}
+    for eng in engines:
+        opts = options if eng == "sionna" else {}
+        compute_paths(tunnel, array, ue, ue_velocity, fc=fc, engine=eng, **opts)  # warm-up
+        times = []
+        for _ in range(max(1, int(repeat))):
+            t0 = time.perf_counter()
+            paths = compute_paths(tunnel, array, ue, ue_velocity, fc=fc, engine=eng, **opts)
+            times.append(time.perf_counter() - t0)
+        out[eng] = (paths, float(np.median(times)))
+    return out
+
+
+def lower_into_tunnel(tunnel: Tunnel3D, array, *, step: float = 0.05):
+    """``array`` moved down in steps of ``step`` [m] until every element is inside ``tunnel``.
+
+    The JAVELIN preset's reference antenna sits at 4.8 m and the 10 x 10 array tilts its top row
+    up to 4.998 m, above the 12-facet ceiling (4.970 m at y = 0.229 m; even the circle is only 4.995 m there): a ray tracer sees those
+    elements behind the concrete. Returns ``(array, shift)``.
+    """
+    from ..arrays import ArrayGeometry
+
+    shift = 0.0
+    while not np.all(tunnel.contains(array.world - [0.0, 0.0, shift])):
+        shift += step
+        if shift > tunnel.height:
+            raise ValueError("array: cannot be moved inside the tunnel by lowering it")
+    moved = ArrayGeometry(
+        array.local, array.origin - [0.0, 0.0, shift], array.azimuth, array.elevation, array.name
+    )
+    return moved, shift

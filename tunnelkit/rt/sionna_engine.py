@@ -1,0 +1,350 @@
+"""Sionna RT as a second propagation engine, returning :class:`tunnelkit.propagation.Path` lists.
+
+The image method (:func:`tunnelkit.propagation.trace_paths`) mirrors the vehicle (UE) in every
+surface. Here the same tunnel, exported to Mitsuba (:mod:`tunnelkit.rt.mitsuba`), is ray-traced by
+Sionna RT (shoot-and-bounce candidates, then Sionna's own image-method refinement, float32): a
+path is LoS or one specular bounce, exactly the families of the image method.
+
+Set-up (uplink, as in the paper): the UE is the single-antenna transmitter with its velocity, and
+**every antenna of the base-station array is a single-antenna receiver placed at its world
+position**. That sidesteps Sionna's ``PlanarArray`` conventions (elements in the local y-z plane,
+its own element order) and gives, per antenna, an independently traced path length. From
+Sionna's output (per receiver ``m``: delay ``tau_m``, arrival angles ``theta_r, phi_r``,
+interaction vertex, object id, Doppler, complex coefficient ``a``) each path becomes a ``Path``:
+
+* ``lengths[m] = c tau_m``, ``length = lengths[0]`` (the reference antenna);
+* ``direction`` = the unit vector of Sionna's arrival angles at antenna 0; ``source`` (the VUE) =
+  ``p_0 + length * direction`` (the unfolded path), ``point`` = Sionna's interaction vertex;
+* ``doppler`` = Sionna's Doppler shift, ``velocity = c doppler / fc``, ``range_rate = -velocity``
+  (the same sign convention as the image method: positive Doppler when the path shortens);
+* ``gain = a exp(-j 2 pi fc tau)`` (Sionna's ``a`` excludes the carrier phase); with isotropic,
+  vertically polarised antennas ``reflection_coefficient = gain 4 pi length / lambda
+  exp(+j 2 pi length / lambda)`` is Sionna's full-polarimetric ITU-slab coefficient (the image
+  method uses the TE Fresnel coefficient, so gains of reflected paths differ by design).
+
+The same ``kinds`` and ``front_only`` filters as the image method apply. A path that Sionna finds
+at the reference antenna but not at some other antenna (the specular point slides off the edge of
+a plate across the array) keeps the spherical-wavefront length from its VUE for those antennas;
+:attr:`SionnaEngine.last_gaps` counts them and :attr:`SionnaEngine.last_traced` maps each
+path ``(kind, surface)`` to the (M,) mask of antennas at which Sionna traced it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, fields
+from pathlib import Path as FsPath
+
+import numpy as np
+
+from .._validate import integer, positive, vector
+from ..arrays import ArrayGeometry
+from ..constants import C, wavelength
+from ..propagation import Path, Tunnel3D
+from . import require_sionna
+from .mitsuba import MitsubaScene, SceneError, export_tunnel, read_scene
+
+__all__ = ["SionnaEngine", "load_sionna_scene"]
+
+_ALL_KINDS = ("los", "wall", "ceiling", "road", "rrm")
+_PATH_FIELDS = {f.name for f in fields(Path)}
+
+
+def load_sionna_scene(scene: MitsubaScene | str | FsPath, *, fc: float):
+    """Load a Mitsuba XML into a ``sionna.rt.Scene`` with ``merge_shapes=False``.
+
+    Raises :class:`~tunnelkit.rt.mitsuba.SceneError` when the file does not parse, references
+    missing meshes or materials, or has no surfaces; ``ImportError`` when the ``rt`` extra is
+    missing.
+    """
+    require_sionna()
+    import sionna.rt as srt
+
+    ms = scene if isinstance(scene, MitsubaScene) else read_scene(scene)
+    try:
+        sc = srt.load_scene(str(ms.xml), merge_shapes=False)
+    except Exception as exc:  # Mitsuba raises RuntimeError with its own parser message
+        msg = str(exc).strip().splitlines()
+        raise SceneError(
+            f"scene file {str(ms.xml)!r} could not be loaded by Mitsuba: "
+            f"{msg[-1] if msg else type(exc).__name__}"
+        ) from None
+    if not sc.objects:
+        raise SceneError(f"scene file {str(ms.xml)!r} has no surfaces Sionna can trace")
+    sc.frequency = positive("fc", fc)
+    return sc
+
+
+@dataclass
+class _RawPaths:
+    """Sionna's output reduced to numpy, one row per (path key, antenna)."""
+
+    tau: np.ndarray  # (M, P)
+    valid: np.ndarray  # (M, P) bool
+    obj: np.ndarray  # (M, P) uint32 object id of the bounce, INVALID for LoS
+    inter: np.ndarray  # (M, P) interaction type of the first vertex
+    vertex: np.ndarray  # (M, P, 3)
+    theta: np.ndarray  # (M, P)
+    phi: np.ndarray  # (M, P)
+    doppler: np.ndarray  # (M, P)
+    a: np.ndarray  # (M, P) complex
+
+
+def _p3(kind, v):
+    return kind(*(float(x) for x in v))
+
+
+class SionnaEngine:
+    """Trace LoS + single-bounce paths in one tunnel with Sionna RT; reuse it across epochs.
+
+    Parameters
+    ----------
+    tunnel : a :class:`~tunnelkit.propagation.Tunnel3D` (exported to ``workdir``), or a path to a
+        user's Mitsuba XML / a :class:`~tunnelkit.rt.mitsuba.MitsubaScene`
+    fc : carrier frequency [Hz]
+    samples_per_src : rays shot from the UE (deterministic Fibonacci directions); small plates
+        need about 1e5 or more
+    max_num_paths_per_src : path budget per source, shared by all receivers (antennas): at least
+        (number of paths) x M or paths go missing silently; ``None`` = ``max(1000, 100 M)``
+    workdir : where the export goes (a temporary directory by default)
+    """
+
+    def __init__(
+        self,
+        tunnel,
+        *,
+        fc: float,
+        samples_per_src: int = 100_000,
+        max_num_paths_per_src: int | None = None,
+        workdir=None,
+    ) -> None:
+        require_sionna()
+        import sionna.rt as srt
+
+        self.fc = positive("fc", fc)
+        self.samples_per_src = integer("samples_per_src", samples_per_src, minimum=1)
+        self.max_num_paths_per_src = (
+            None
+            if max_num_paths_per_src is None
+            else integer("max_num_paths_per_src", max_num_paths_per_src, minimum=1)
+        )
+        self.tunnel = tunnel if isinstance(tunnel, Tunnel3D) else None
+        if isinstance(tunnel, Tunnel3D):
+            if workdir is None:
+                import tempfile
+
+                self._tmp = tempfile.TemporaryDirectory(prefix="tunnelkit-rt-")
+                workdir = self._tmp.name
+            self.mitsuba = export_tunnel(tunnel, workdir)
+        elif isinstance(tunnel, MitsubaScene):
+            self.mitsuba = tunnel
+        elif isinstance(tunnel, (str, FsPath)):
+            self.mitsuba = read_scene(tunnel)
+        else:
+            raise TypeError(
+                "tunnel: expected a propagation.Tunnel3D, a MitsubaScene or a path to "
+                f"a Mitsuba XML, got {type(tunnel).__name__}"
+            )
+        self.scene = load_sionna_scene(self.mitsuba, fc=self.fc)
+        self.scene.tx_array = srt.PlanarArray(
+            num_rows=1, num_cols=1, pattern="iso", polarization="V"
+        )
+        self.scene.rx_array = srt.PlanarArray(
+            num_rows=1, num_cols=1, pattern="iso", polarization="V"
+        )
+        self._surface_by_id: dict[int, tuple[str, str]] = {}
+        for name, obj in self.scene.objects.items():
+            info = next(
+                (
+                    s
+                    for sid, s in self.mitsuba.surfaces.items()
+                    if srt.SceneObject.shape_id_to_name(sid) == name
+                ),
+                None,
+            )
+            label, kind = (info.name, info.kind) if info else (name, "surface")
+            self._surface_by_id[int(obj.object_id)] = (label, kind)
+        self._solver = srt.PathSolver(deterministic=True)
+        self._n_rx = 0
+        self.last_gaps = 0
+        self.last_traced: dict[tuple[str, str], np.ndarray] = {}
+        self.last_solve_s = 0.0
+
+    # --- devices ------------------------------------------------------------------------------
+    def _place(self, array: ArrayGeometry, ue: np.ndarray, vel: np.ndarray) -> None:
+        import mitsuba as mi
+        import sionna.rt as srt
+
+        sc = self.scene
+        if "ue" not in sc.transmitters:
+            sc.add(
+                srt.Transmitter("ue", position=_p3(mi.Point3f, ue), velocity=_p3(mi.Vector3f, vel))
+            )
+        tx = sc.get("ue")
+        tx.position = _p3(mi.Point3f, ue)
+        tx.velocity = _p3(mi.Vector3f, vel)
+        world = array.world
+        while self._n_rx > array.M:
+            self._n_rx -= 1
+            sc.remove(f"ant-{self._n_rx}")
+        for m in range(array.M):
+            if m >= self._n_rx:
+                sc.add(srt.Receiver(f"ant-{m}", position=_p3(mi.Point3f, world[m])))
+            else:
+                sc.get(f"ant-{m}").position = _p3(mi.Point3f, world[m])
+        self._n_rx = array.M
+
+    def _solve(self) -> _RawPaths:
+        from sionna.rt.constants import InteractionType
+
+        t0 = time.perf_counter()
+        budget = self.max_num_paths_per_src or max(1000, 100 * self._n_rx)
+        p = self._solver(
+            self.scene,
+            max_depth=1,
+            max_num_paths_per_src=budget,
+            samples_per_src=self.samples_per_src,
+            synthetic_array=False,
+            los=True,
+            specular_reflection=True,
+            diffuse_reflection=False,
+            refraction=False,
+            diffraction=False,
+        )
+
+        # shapes: (num_rx, num_rx_ant=1, num_tx=1, num_tx_ant=1, P) -> (M, P)
+        def sq(x) -> np.ndarray:
+            return np.asarray(x.numpy())[:, 0, 0, 0]
+
+        ar, ai = p.a
+        raw = _RawPaths(
+            tau=sq(p.tau).astype(float),
+            valid=sq(p.valid).astype(bool),
+            obj=np.asarray(p.objects.numpy())[0, :, 0, 0, 0],
+            inter=np.asarray(p.interactions.numpy())[0, :, 0, 0, 0],
+            vertex=np.asarray(p.vertices.numpy())[0, :, 0, 0, 0].astype(float),
+            theta=sq(p.theta_r).astype(float),
+            phi=sq(p.phi_r).astype(float),
+            doppler=sq(p.doppler).astype(float),
+            a=sq(ar) + 1j * sq(ai),
+        )
+        self.last_solve_s = time.perf_counter() - t0
+        bad = (
+            raw.valid
+            & (raw.inter != InteractionType.NONE)
+            & (raw.inter != InteractionType.SPECULAR)
+        )
+        if np.any(bad):  # cannot happen with the flags above; guard against API changes
+            raise RuntimeError("Sionna returned non-specular interactions with max_depth=1")
+        return raw
+
+    # --- public -------------------------------------------------------------------------------
+    def trace(
+        self,
+        array: ArrayGeometry,
+        ue,
+        ue_velocity=(0.0, 0.0, 0.0),
+        *,
+        kinds: tuple[str, ...] = _ALL_KINDS,
+        front_only: bool = True,
+    ) -> list[Path]:
+        """All LoS and single-bounce paths from ``ue`` to ``array``, as the image method returns them.
+
+        Same arguments, filters and ordering as :func:`tunnelkit.propagation.trace_paths` (LoS
+        first, then reflections by length). Paths off blocker boxes are dropped (the image method
+        treats boxes as blockers only).
+        """
+        if not isinstance(array, ArrayGeometry):
+            raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
+        ue = vector("ue", ue, 3)
+        if self.tunnel is not None:
+            ue = self.tunnel.require_inside("ue", ue)
+            out = ~np.atleast_1d(self.tunnel.contains(array.world))
+            if np.any(out):
+                top = float(np.max(array.world[:, 2]))
+                raise ValueError(
+                    f"array: {int(out.sum())} of {array.M} antennas of {array.name or 'the array'} "
+                    f"lie outside the tunnel (highest element at z = {top:.3f} m); a ray tracer "
+                    "sees them behind the wall. Move the array inside (e.g. a negative z offset "
+                    "in [[base_station.arrays]])."
+                )
+        vel = vector("ue_velocity", ue_velocity, 3)
+        self._place(array, ue, vel)
+        raw = self._solve()
+        return self._to_paths(raw, array, ue, kinds, front_only)
+
+    def _to_paths(self, raw: _RawPaths, array: ArrayGeometry, ue, kinds, front_only) -> list[Path]:
+        from sionna.rt.constants import INVALID_SHAPE
+
+        lam = wavelength(self.fc)
+        ant = array.world
+        los_key = int(INVALID_SHAPE)
+        # per antenna: path key (object id, or INVALID for LoS) -> column
+        cols = [
+            {int(raw.obj[m, j]): j for j in np.flatnonzero(raw.valid[m])} for m in range(array.M)
+        ]
+        out: list[Path] = []
+        gaps = 0
+        self.last_traced = {}
+        for key, j in cols[0].items():
+            is_los = key == los_key
+            label, kind = (
+                ("", "los") if is_los else self._surface_by_id.get(key, (str(key), "surface"))
+            )
+            if kind == "blocker" or (kind not in kinds and kind != "surface"):
+                continue
+            d0 = float(raw.tau[0, j]) * C
+            th, ph = raw.theta[0, j], raw.phi[0, j]
+            u = np.array([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
+            source = array.origin + d0 * u
+            point = ue.copy() if is_los else raw.vertex[0, j].copy()
+            if front_only and not array.in_front(point):
+                continue
+            lengths = np.empty(array.M)
+            traced = np.zeros(array.M, dtype=bool)
+            for m in range(array.M):
+                jm = cols[m].get(key)
+                if jm is None:
+                    lengths[m] = np.linalg.norm(source - ant[m])
+                    gaps += 1
+                else:
+                    lengths[m] = float(raw.tau[m, jm]) * C
+                    traced[m] = True
+            lengths[0] = d0
+            self.last_traced[("los" if is_los else "reflection", label)] = traced
+            if is_los:
+                lengths_srnf = lengths
+            else:
+                lengths_srnf = np.linalg.norm(ue - point) + np.linalg.norm(point - ant, axis=-1)
+            fd = float(raw.doppler[0, j])
+            vel = C * fd / self.fc
+            gain = complex(raw.a[0, j] * np.exp(-2j * np.pi * self.fc * raw.tau[0, j]))
+            gamma = gain * 4 * np.pi * d0 / lam * np.exp(2j * np.pi * d0 / lam)
+            az = float(np.arctan2(u[1], u[0]))
+            el = float(np.arctan2(u[2], np.hypot(u[0], u[1])))
+            values = dict(
+                kind="los" if is_los else "reflection",
+                surface=label,
+                surface_kind=kind,
+                source=source,
+                point=point,
+                length=d0,
+                lengths=lengths,
+                lengths_srnf=lengths_srnf,
+                direction=u,
+                direction_local=array.dir_to_local(u),
+                azimuth=az,
+                elevation=el,
+                kappa_srnf=float(np.linalg.norm(point - array.origin)),
+                range_rate=-vel,
+                velocity=vel,
+                doppler=fd,
+                reflection_coefficient=complex(gamma),
+                gain=gain,
+                ue=ue.copy(),
+            )
+            out.append(Path(**{k: v for k, v in values.items() if k in _PATH_FIELDS}))
+        self.last_gaps = gaps
+        los = [p for p in out if p.kind == "los"]
+        refl = sorted((p for p in out if p.kind != "los"), key=lambda p: p.length)
+        return los + refl
