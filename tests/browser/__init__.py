@@ -1,0 +1,1 @@
+"""Browser tests (collected only with TUNNELKIT_BROWSER=1; see conftest.py)."""

@@ -1,0 +1,119 @@
+"""Test 1: ``tools/present.py`` serves notebook 02 with Voila; the keyboard moves the Mmax explorer's
+M slider; the figure (read from the page's plotly data) and the verdict change.
+
+Artefacts in build/artifacts/: voila-02-before.png, voila-02-after.png (the page),
+voila-02-explorer-after.png (the explorer alone), voila-02.json (readouts, verdicts, aborted requests)
+and voila-02.log (Voila's log).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+from _lecture import HOST, alive, child_pids, free_port, resolve_notebook, serving
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: the explorer under test: notebook, slider label, how to read the verdict from the figure
+TARGET = {"notebook": "02", "slider": "M", "verdict": re.compile(r"SR-NF (?:not )?valid\b[^<\n]*")}
+
+# Mark the slider labelled `label` and its explorer (the slider's nearest ancestor, inside its own
+# output cell, that holds a rendered plotly figure) so Playwright locators can reach them. Until the
+# explorer's figure has rendered this returns false and Playwright polls again.
+MARK = """label => {
+  const sliders = [...document.querySelectorAll('.widget-slider')];
+  const s = sliders.find(e => (e.querySelector('.widget-label')?.innerText || '').trim() === label);
+  if (!s) return false;
+  // climb no further than the slider's own output cell: another cell's figure is not the explorer's
+  const stop = s.closest('.jp-OutputArea-output, .output_area, .jp-Cell');
+  let box = s.parentElement;
+  while (box && box !== stop && !box.querySelector('.js-plotly-plot .main-svg')) box = box.parentElement;
+  if (!box || !box.querySelector('.js-plotly-plot .main-svg')) return false;  // not rendered yet
+  s.setAttribute('data-test', 'target-slider');
+  box.setAttribute('data-test', 'target-explorer');
+  return true;
+}"""
+
+# What the explorer shows: its figures' trace data and the text of titles, subtitles, annotations.
+READ = """() => {
+  const plots = [...document.querySelectorAll('[data-test=target-explorer] .js-plotly-plot')];
+  const arr = a => (a && a.length !== undefined) ? Array.from(a) : a;
+  const data = plots.map(p => (p.data || []).map(t => ({x: arr(t.x), y: arr(t.y), z: arr(t.z)})));
+  const texts = plots.flatMap(p => {
+    const L = p.layout || {};
+    return [L.title?.text, L.title?.subtitle?.text, ...(L.annotations || []).map(a => a.text)];
+  });
+  return {data: JSON.stringify(data), text: texts.filter(Boolean).join('\\n'),
+          readout: document.querySelector('[data-test=target-slider] .widget-readout')?.innerText};
+}"""
+
+
+def verdict_of(text: str) -> str:
+    m = TARGET["verdict"].search(text)
+    assert m, f"no verdict in the figure's title/annotations: {text!r}"
+    return m.group(0)
+
+
+@pytest.fixture(scope="module")
+def voila_url():
+    nb = resolve_notebook(TARGET["notebook"])
+    port = free_port()
+    url = f"http://{HOST}:{port}/"
+    log = ROOT / "build" / "artifacts" / f"voila-{nb.stem[:2]}.log"
+    log.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick", f"--port={port}"]
+    with serving(cmd, url + "api", log=log, timeout=120) as proc:
+        assert child_pids(proc.pid), "present.py started no Voila"
+        yield url
+        spawned = [*child_pids(proc.pid)]  # Voila (its own process group) and its kernels
+        for pid in spawned:
+            spawned += child_pids(pid)
+    assert proc.poll() is not None, "present.py still runs"
+    left = [pid for pid in spawned if alive(pid, wait=15.0)]
+    assert not left, f"left running after the test: pids {left}"
+
+
+def test_keyboard_moves_m_and_the_verdict_changes(voila_url, watched, artifacts):
+    page = watched.page
+    page.goto(voila_url, timeout=300_000)
+    page.wait_for_function(MARK, arg=TARGET["slider"], timeout=300_000)
+    tag = TARGET["notebook"]
+    before = page.evaluate(READ)
+    first = verdict_of(before["text"])
+    explorer = page.locator("[data-test=target-explorer]")
+    explorer.scroll_into_view_if_needed()
+    page.screenshot(path=str(artifacts / f"voila-{tag}-before.png"))
+
+    handle = page.locator("[data-test=target-slider] .noUi-handle")
+    handle.focus()
+    after = None
+    for key in ("End", "Home"):  # to the top of the range; if the verdict holds there, the bottom
+        handle.press(key)
+        page.wait_for_function(
+            f"old => ({READ})().data !== old", arg=before["data"], timeout=120_000
+        )
+        after = page.evaluate(READ)
+        if verdict_of(after["text"]) != first:
+            break
+    page.wait_for_timeout(300)
+    page.screenshot(path=str(artifacts / f"voila-{tag}-after.png"))
+    explorer.screenshot(path=str(artifacts / f"voila-{tag}-explorer-after.png"))
+    (artifacts / f"voila-{tag}.json").write_text(
+        json.dumps(
+            {
+                "before": {"readout": before["readout"], "verdict": first},
+                "after": {"readout": after["readout"], "verdict": verdict_of(after["text"])},
+                "aborted_requests": watched.blocked,
+            },
+            indent=1,
+            ensure_ascii=False,
+        )
+    )
+
+    assert after["readout"] != before["readout"], "the keyboard did not move the slider"
+    assert after["data"] != before["data"], "the figure's data did not change"
+    assert verdict_of(after["text"]) != first, f"the verdict stayed {first!r}"

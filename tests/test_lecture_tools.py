@@ -1,0 +1,206 @@
+"""Lecture tools without a browser or a kernel: notebook names, ports, servers stopped by pid,
+figures read back from saved widget state, headline marks, static-site figure inlining."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import nbformat
+import numpy as np
+import plotly.graph_objects as go
+import pytest
+
+TOOLS = Path(__file__).resolve().parents[1] / "tools"
+sys.path.insert(0, str(TOOLS))
+
+import _lecture as lec  # noqa: E402
+
+
+def load_tool(name: str):
+    spec = importlib.util.spec_from_file_location(f"tk_tool_{name}", TOOLS / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture
+def books(tmp_path):
+    for stem in (
+        "01-virtual-stations",
+        "02-fresnel-bound",
+        "02b-extra",
+        "03-a-one",
+        "03-a-two",
+        "10-tenth",
+    ):
+        (tmp_path / f"{stem}.ipynb").write_text("{}")
+    return tmp_path
+
+
+def test_resolve_notebook_by_number_name_and_path(books):
+    assert lec.resolve_notebook("01", books).name == "01-virtual-stations.ipynb"
+    assert lec.resolve_notebook("1", books).name == "01-virtual-stations.ipynb"
+    assert lec.resolve_notebook("02", books).name == "02-fresnel-bound.ipynb"  # not 02b-extra
+    assert lec.resolve_notebook("10", books).name == "10-tenth.ipynb"
+    assert lec.resolve_notebook("02-fresnel-bound", books).name == "02-fresnel-bound.ipynb"
+    assert lec.resolve_notebook("02-fresnel-bound.ipynb", books).name == "02-fresnel-bound.ipynb"
+    assert (
+        lec.resolve_notebook(str(books / "10-tenth.ipynb")) == (books / "10-tenth.ipynb").resolve()
+    )
+    assert lec.list_notebooks(books)[0].name == "01-virtual-stations.ipynb"
+
+
+def test_resolve_notebook_unknown_or_ambiguous_names_the_choices(books):
+    with pytest.raises(lec.LectureError, match=r"'07' does not exist; .*01-virtual-stations"):
+        lec.resolve_notebook("07", books)
+    with pytest.raises(lec.LectureError, match="'03' is ambiguous"):
+        lec.resolve_notebook("03", books)
+    with pytest.raises(lec.LectureError, match="ambiguous"):
+        lec.resolve_notebook("03-a", books)
+    with pytest.raises(lec.LectureError, match="does not exist"):
+        lec.resolve_notebook("nope", books)
+
+
+def test_ports_free_and_in_use():
+    port = lec.free_port()
+    assert lec.check_port(port) == port
+    with socket.socket() as s:
+        s.bind((lec.HOST, 0))
+        s.listen()
+        taken = s.getsockname()[1]
+        with pytest.raises(lec.LectureError, match=f"port {taken} on 127.0.0.1 is already in use"):
+            lec.check_port(taken)
+    with pytest.raises(lec.LectureError, match="out of range"):
+        lec.check_port(70000)
+
+
+def test_present_bad_input_exits_2_without_starting_anything(capsys):
+    present = load_tool("present")
+    assert present.main(["no-such-notebook"]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    with socket.socket() as s:
+        s.bind((lec.HOST, 0))
+        s.listen()
+        assert (
+            present.main([lec.list_notebooks()[0].stem[:2], "--port", str(s.getsockname()[1])]) == 2
+        )
+    assert "already in use" in capsys.readouterr().err
+
+
+def test_stop_server_ends_the_process_and_its_children(tmp_path):
+    pidfile = tmp_path / "child.pid"
+    code = (
+        "import subprocess, time, pathlib; c = subprocess.Popen(['sleep', '60']); "
+        f"pathlib.Path({str(pidfile)!r}).write_text(str(c.pid)); time.sleep(60)"
+    )
+    proc = lec.start_server([sys.executable, "-c", code])
+    for _ in range(100):
+        if pidfile.exists() and pidfile.read_text():
+            break
+        time.sleep(0.05)
+    child = int(pidfile.read_text())
+    assert lec.child_pids(proc.pid) == [child] and lec.alive(child)
+    lec.stop_server(proc, timeout=5)
+    assert proc.poll() is not None
+    assert not lec.alive(child, wait=5.0), "the server's child outlived it"
+
+
+def test_wait_http_reports_a_server_that_died():
+    proc = subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"])
+    with pytest.raises(lec.LectureError, match="exited with code 3"):
+        lec.wait_http(f"http://{lec.HOST}:{lec.free_port()}/", proc, timeout=20)
+
+
+def _saved_widget_notebook(fw: go.FigureWidget, holder, source: str):
+    """An 'executed' notebook whose one cell displays ``holder`` (a widget containing fw)."""
+    from ipywidgets.embed import embed_data
+
+    state = embed_data(views=[holder])["manager_state"]
+    nb = nbformat.v4.new_notebook()
+    out = nbformat.v4.new_output(
+        "display_data",
+        data={
+            "text/plain": "VBox()",
+            lec.WIDGET_MIME: {"model_id": holder.model_id, "version_major": 2},
+        },
+    )
+    cell = nbformat.v4.new_code_cell(source, outputs=[out])
+    nb.cells.append(cell)
+    nb.metadata["widgets"] = {lec.WIDGET_STATE: state}
+    return json.loads(json.dumps(nb))  # as saved: plain JSON, base64 buffers
+
+
+def test_figurewidget_is_read_back_from_saved_state_with_its_arrays():
+    import ipywidgets as widgets
+
+    z = np.arange(12.0).reshape(3, 4) ** 1.5
+    x = np.linspace(0.0, 1.0, 4)
+    fw = go.FigureWidget(
+        go.Heatmap(z=z, x=x, y=np.array([1.0, 2.0, 3.0])),
+        layout={"title": {"text": "explorer"}, "height": 321},
+    )
+    holder = widgets.VBox([widgets.IntSlider(description="M"), fw])
+    nb = nbformat.from_dict(_saved_widget_notebook(fw, holder, "# headline: the-map\nexplorer"))
+    (found,) = lec.figures_of(nb)
+    assert found.widget and found.headline == "the-map" and (found.cell, found.output) == (0, 0)
+    trace = found.figure["data"][0]
+    np.testing.assert_allclose(np.asarray(trace["z"], float), z, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(trace["x"], float), x, rtol=0, atol=1e-15)
+    assert found.figure["layout"]["title"]["text"] == "explorer"
+    assert found.figure["layout"]["height"] == 321
+    # a change made after display travels as a delta: the saved state misses it, the dump has it
+    fw.update_layout(title="moved")
+    saved = nbformat.from_dict(_saved_widget_notebook(fw, holder, "explorer"))
+    assert lec.figures_of(saved)[0].figure["layout"]["title"]["text"] == "explorer"
+    saved.metadata["tunnelkit_lecture"] = {"figure_widgets": {fw.model_id: fw.to_plotly_json()}}
+    assert lec.figures_of(saved)[0].figure["layout"]["title"]["text"] == "moved"
+
+
+def test_headline_marks_and_file_names():
+    figures = load_tool("figures")
+    nb = nbformat.v4.new_notebook()
+    fig = go.Figure(go.Scatter(x=[1, 2], y=[3, 4])).to_plotly_json()
+    for src in (
+        "fig_a.show()",
+        "# headline: crlb-map\nfig_b.show()\nfig_c.show()",
+        "# headline:bad name\n",
+    ):
+        outs = [nbformat.v4.new_output("display_data", data={lec.PLOTLY_MIME: fig})] * src.count(
+            "show"
+        )
+        nb.cells.append(nbformat.v4.new_code_cell(src, outputs=outs))
+    found = lec.figures_of(nb)
+    assert [f.headline for f in found] == [None, "crlb-map", "crlb-map"]
+    assert [n for n, _ in figures.headline_files(found)] == ["crlb-map", "crlb-map-2"]
+    assert [n for n, _ in figures.headline_files(found[:1])] == ["fig01"]
+    assert figures.size_of({"layout": {"height": 380}}, 1100, 600) == (1100, 380)
+
+
+def test_site_inlines_figures_without_a_cdn():
+    site = load_tool("site")
+    nb = nbformat.v4.new_notebook()
+    fig = go.Figure(go.Scatter(x=[1, 2], y=[3, 4], name="line")).to_plotly_json()
+    nb.cells.append(
+        nbformat.v4.new_code_cell(
+            "f.show()",
+            outputs=[
+                nbformat.v4.new_output(
+                    "display_data",
+                    data={lec.PLOTLY_MIME: fig, "text/html": "<script src='https://x'>"},
+                )
+            ],
+        )
+    )
+    nb.metadata["widgets"] = {lec.WIDGET_STATE: {"state": {}}}
+    assert site.inline_figures(nb, "07") == 1
+    out = nb.cells[0].outputs[0]
+    assert list(out["data"]) == ["text/html"]
+    page = out["data"]["text/html"]
+    assert "Plotly.newPlot" in page and 'id="fig-07-0-0-0"' in page and "https://" not in page
+    assert "widgets" not in nb.metadata

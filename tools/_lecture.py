@@ -1,0 +1,407 @@
+"""Shared helpers of the lecture tools (present.py, site.py, figures.py) and the browser tests.
+
+* notebook discovery (every ``notebooks/*.ipynb``, so chapters added later are picked up) and
+  resolution of a short name such as ``02`` to its file;
+* loopback ports (a free one, or a clear error when the asked one is taken);
+* starting a server in its own process group and stopping it by its process id;
+* headless execution of a notebook (cached under ``build/executed/``) with plotly figures emitted
+  as JSON (``PLOTLY_RENDERER=plotly_mimetype``) so no output refers to a CDN;
+* extraction of the plotly figures of an executed notebook, including the live ``FigureWidget`` of
+  an explorer (read back from the saved widget state);
+* headline figures: a code cell containing a line ``# headline: <name>`` declares that the figure
+  it displays is a headline figure of its notebook (see tools/figures.py).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+BUILD = ROOT / "build"
+EXECUTED = BUILD / "executed"
+HOST = "127.0.0.1"
+HEADLINE = re.compile(r"^\s*#\s*headline:\s*([A-Za-z0-9][A-Za-z0-9_.-]*)\s*$", re.MULTILINE)
+PLOTLY_MIME = "application/vnd.plotly.v1+json"
+WIDGET_MIME = "application/vnd.jupyter.widget-view+json"
+WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
+
+
+class LectureError(RuntimeError):
+    """A user-facing failure: the tools print its message and exit non-zero."""
+
+
+# ---------------------------------------------------------------- notebooks
+
+
+def list_notebooks(directory: Path = NOTEBOOKS) -> list[Path]:
+    """Every notebook of the workbook, in chapter order."""
+    return sorted(p for p in directory.glob("*.ipynb") if not p.name.startswith("."))
+
+
+def resolve_notebook(name: str, directory: Path = NOTEBOOKS) -> Path:
+    """``02``, ``2``, ``02-fresnel-bound-and-mmax``, its ``.ipynb`` name or a path -> the notebook."""
+    p = Path(name)
+    if p.suffix == ".ipynb" and p.is_file():
+        return p.resolve()
+    books = list_notebooks(directory)
+    stem = p.name.removesuffix(".ipynb")
+    if stem.isdigit():
+        hits = [
+            b
+            for b in books
+            if b.stem.split("-", 1)[0].isdigit() and int(b.stem.split("-", 1)[0]) == int(stem)
+        ]
+    else:
+        hits = [b for b in books if b.stem == stem] or [b for b in books if b.stem.startswith(stem)]
+    if len(hits) == 1:
+        return hits[0]
+    known = ", ".join(b.stem for b in books) or "none"
+    why = "is ambiguous" if hits else "does not exist"
+    raise LectureError(f"notebook {name!r} {why}; notebooks in {directory}: {known}")
+
+
+def title_of(nb: dict[str, Any], fallback: str) -> str:
+    """The first markdown heading of a notebook (its chapter title)."""
+    for cell in nb.get("cells", []):
+        if cell.get("cell_type") == "markdown":
+            for line in _source(cell).splitlines():
+                if line.startswith("#"):
+                    return line.lstrip("#").strip()
+    return fallback
+
+
+def _source(cell: dict[str, Any]) -> str:
+    src = cell.get("source", "")
+    return "".join(src) if isinstance(src, list) else src
+
+
+# ---------------------------------------------------------------- ports and servers
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nothing listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((HOST, 0))
+        return s.getsockname()[1]
+
+
+def check_port(port: int) -> int:
+    """Return ``port`` if it can be bound on 127.0.0.1, else raise a clear LectureError."""
+    if not 1 <= port <= 65535:
+        raise LectureError(f"port {port} is out of range (1-65535)")
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        try:
+            s.bind((HOST, port))
+        except OSError as exc:
+            raise LectureError(
+                f"port {port} on {HOST} is already in use ({exc.strerror}); "
+                "pick another with PORT=... or leave it out for a free one"
+            ) from None
+    return port
+
+
+def start_server(
+    cmd: list[str], *, env: dict[str, str] | None = None, log: Path | None = None, cwd: Path = ROOT
+) -> subprocess.Popen:
+    """Start ``cmd`` in a new process group (so stop_server can end it and its kernels)."""
+    with open(log or os.devnull, "wb") as out:  # the child keeps its own copy of the descriptor
+        return subprocess.Popen(
+            cmd,
+            cwd=cwd,
+            env=env,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+
+
+def stop_server(proc: subprocess.Popen, timeout: float = 15.0) -> int | None:
+    """SIGTERM the process group led by ``proc.pid``, SIGKILL it if it lingers; return the code."""
+    for sig, wait in ((signal.SIGTERM, timeout), (signal.SIGKILL, 5.0)):
+        if proc.poll() is not None:
+            break
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, sig)
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            proc.wait(wait)
+    # children (kernels) may outlive the leader: end what is left of its group
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(proc.pid, signal.SIGKILL)
+    return proc.poll()
+
+
+def child_pids(pid: int) -> list[int]:
+    """Direct children of ``pid`` (Linux /proc); empty if it is gone."""
+    try:
+        return [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+    except (FileNotFoundError, ProcessLookupError):
+        return []
+
+
+def alive(pid: int, wait: float = 0.0) -> bool:
+    """True while ``pid`` runs (a zombie counts as ended); polls up to ``wait`` seconds for it to end."""
+    deadline = time.monotonic() + wait
+    while True:
+        try:
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except (FileNotFoundError, ProcessLookupError):
+            return False
+        if state == "Z":
+            return False
+        if time.monotonic() >= deadline:
+            return True
+        time.sleep(0.05)
+
+
+def wait_http(url: str, proc: subprocess.Popen, timeout: float = 90.0) -> None:
+    """Poll ``url`` until it answers; raise if the server exits or the time runs out."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise LectureError(
+                f"the server exited with code {proc.returncode} before answering at {url}"
+            )
+        try:
+            with urllib.request.urlopen(url, timeout=2):
+                return
+        except urllib.error.HTTPError:
+            return  # it answers (a 404 still means it is up)
+        except (urllib.error.URLError, OSError):
+            time.sleep(0.3)
+    raise LectureError(f"no answer from {url} within {timeout:.0f} s")
+
+
+@contextlib.contextmanager
+def serving(
+    cmd: list[str],
+    url: str,
+    *,
+    env: dict[str, str] | None = None,
+    log: Path | None = None,
+    timeout: float = 90.0,
+) -> Iterator[subprocess.Popen]:
+    """Context manager: start a server, wait until ``url`` answers, always stop it by pid."""
+    proc = start_server(cmd, env=env, log=log)
+    try:
+        wait_http(url, proc, timeout)
+        yield proc
+    finally:
+        stop_server(proc)
+
+
+# ---------------------------------------------------------------- execution
+
+
+def kernel_env(quick: bool) -> dict[str, str]:
+    """Environment of an executing kernel: quick mode or not, plotly figures as JSON."""
+    env = dict(os.environ)
+    env["PLOTLY_RENDERER"] = "plotly_mimetype"
+    if quick:
+        env["TUNNELKIT_QUICK"] = "1"
+    else:
+        env.pop("TUNNELKIT_QUICK", None)
+    return env
+
+
+def _inputs_digest(path: Path, quick: bool) -> str:
+    h = hashlib.sha256(path.read_bytes())
+    h.update(b"quick" if quick else b"full")
+    h.update(Path(__file__).read_bytes())  # this module decides how notebooks are executed
+    for base in (ROOT / "tunnelkit", ROOT / "data"):
+        for f in sorted(base.rglob("*")):
+            if f.is_file() and "__pycache__" not in f.parts:
+                h.update(str(f.relative_to(ROOT)).encode())
+                h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+_DUMP_MARK = "@@tunnelkit-figure-widgets@@"
+# Run after the last cell: the final figure of every live FigureWidget, by model id. The saved widget
+# state alone can be stale: a FigureWidget sends later changes as deltas, not in its state.
+_DUMP_FIGURE_WIDGETS = f"""
+import json as _json
+import sys as _sys
+_figs = {{}}
+if "plotly.basewidget" in _sys.modules:
+    import plotly.io as _pio
+    from ipywidgets.widgets import widget as _w
+    _inst = getattr(_w, "_instances", None) or getattr(_w.Widget, "widgets", {{}})
+    _base = _sys.modules["plotly.basewidget"].BaseFigureWidget
+    _figs = {{k: _json.loads(_pio.to_json(v, validate=False))
+             for k, v in list(_inst.items()) if isinstance(v, _base)}}
+print("{_DUMP_MARK}" + _json.dumps(_figs))
+"""
+
+
+def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = True):
+    """Execute a notebook headless (widget state kept) and return it as a NotebookNode.
+
+    The result is cached in ``build/executed/`` keyed on the notebook, the package sources, the
+    data files and the mode, so ``make figures`` after ``make site`` does not run it again.
+    """
+    import nbformat
+    from nbclient import NotebookClient
+    from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
+
+    EXECUTED.mkdir(parents=True, exist_ok=True)
+    digest = _inputs_digest(path, quick)
+    cached = EXECUTED / f"{path.stem}.{'quick' if quick else 'full'}.ipynb"
+    if use_cache and cached.exists():
+        nb = nbformat.read(cached, as_version=4)
+        if nb.metadata.get("tunnelkit_lecture", {}).get("digest") == digest:
+            return nb
+    nb = nbformat.read(path, as_version=4)
+    saved = dict(os.environ)
+    os.environ.clear()
+    os.environ.update(kernel_env(quick))  # the kernel inherits this process's environment
+    try:
+        nb.cells.append(nbformat.v4.new_code_cell(_DUMP_FIGURE_WIDGETS))
+        client = NotebookClient(
+            nb,
+            timeout=timeout,
+            kernel_name="python3",
+            store_widget_state=True,
+            resources={"metadata": {"path": str(path.parent)}},
+        )
+        client.execute()
+        dump = nb.cells.pop()
+    except (CellExecutionError, CellTimeoutError, DeadKernelError) as exc:
+        plain = re.sub(r"\x1b\[[0-9;]*m", "", str(exc))  # the traceback comes with ANSI colours
+        raise LectureError(f"{path.name} failed to execute:\n{plain}") from None
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+    text = "".join(o.get("text", "") for o in dump.get("outputs", []) if o.get("name") == "stdout")
+    live = json.loads(text.split(_DUMP_MARK, 1)[1]) if _DUMP_MARK in text else {}
+    nb.metadata["tunnelkit_lecture"] = {"digest": digest, "quick": quick, "figure_widgets": live}
+    nbformat.write(nb, cached)
+    return nb
+
+
+# ---------------------------------------------------------------- figures in an executed notebook
+
+
+@dataclass
+class FoundFigure:
+    """One plotly figure displayed by a code cell of an executed notebook."""
+
+    cell: int  #: index of the code cell in the notebook
+    output: int  #: index of the output in that cell
+    figure: dict[str, Any]  #: plotly JSON: {"data": [...], "layout": {...}}
+    widget: bool  #: True when it is the live FigureWidget of an explorer
+    headline: str | None  #: name from a ``# headline: <name>`` line of the cell, if any
+
+
+def live_figures(nb) -> dict[str, dict[str, Any]]:
+    """model_id -> final figure of each FigureWidget, as dumped by ``execute`` (empty if none)."""
+    return nb.metadata.get("tunnelkit_lecture", {}).get("figure_widgets", {})
+
+
+def widget_states(nb) -> dict[str, dict[str, Any]]:
+    """model_id -> widget model state saved with the notebook (empty if none)."""
+    return nb.metadata.get("widgets", {}).get(WIDGET_STATE, {}).get("state", {})
+
+
+def with_buffers(model: dict[str, Any]) -> dict[str, Any]:
+    """A widget model's state with its binary buffers (numpy arrays) put back as plain lists.
+
+    Saved widget state keeps arrays apart, as base64 ``buffers`` with a path into the state; the
+    state holds ``{"dtype", "shape"}`` at that path.
+    """
+    import base64
+    import copy
+
+    import numpy as np
+
+    state = copy.deepcopy(model.get("state", {}))
+    for buf in model.get("buffers", []):
+        *path, last = buf["path"]
+        node = state
+        for key in path[:-1]:
+            node = node[key]
+        spec = node[path[-1]] if path else None
+        raw = (
+            base64.b64decode(buf["data"])
+            if buf.get("encoding", "base64") == "base64"
+            else buf["data"]
+        )
+        if isinstance(spec, dict) and last == "buffer" and "dtype" in spec:
+            arr = np.frombuffer(raw, dtype=spec["dtype"]).reshape(spec.get("shape", -1))
+            node[path[-1]] = arr.tolist()
+        else:
+            node = node[path[-1]] if path else node
+            node[last] = raw
+    return state
+
+
+def widget_figures(
+    model_id: str, states: dict[str, dict[str, Any]], live: dict[str, dict[str, Any]] | None = None
+) -> list[dict[str, Any]]:
+    """Plotly figures held by a widget or any of its descendants (a FigureWidget in an explorer).
+
+    ``live`` (model id -> figure, dumped from the kernel after the last cell) wins over the saved
+    widget state, which misses the changes a FigureWidget sent as deltas.
+    """
+    found, todo, seen = [], [model_id], set()
+    while todo:
+        mid = todo.pop(0)
+        if mid in seen or mid not in states:
+            continue
+        seen.add(mid)
+        st = with_buffers(states[mid])
+        if live and mid in live:
+            found.append(live[mid])
+        elif "_widget_data" in st and "_widget_layout" in st:
+            found.append({"data": st["_widget_data"], "layout": st["_widget_layout"]})
+        for child in st.get("children", []) or []:
+            if isinstance(child, str) and child.startswith("IPY_MODEL_"):
+                todo.append(child.removeprefix("IPY_MODEL_"))
+    return found
+
+
+def figures_of(nb) -> list[FoundFigure]:
+    """Every plotly figure an executed notebook displays, in order."""
+    states = widget_states(nb)
+    live = live_figures(nb)
+    out: list[FoundFigure] = []
+    for ci, cell in enumerate(nb.cells):
+        if cell.cell_type != "code":
+            continue
+        m = HEADLINE.search(_source(cell))
+        name = m.group(1) if m else None
+        for oi, o in enumerate(cell.get("outputs", [])):
+            data = o.get("data", {})
+            if PLOTLY_MIME in data:
+                fig = data[PLOTLY_MIME]
+                out.append(
+                    FoundFigure(
+                        ci, oi, json.loads(fig) if isinstance(fig, str) else dict(fig), False, name
+                    )
+                )
+            elif WIDGET_MIME in data:
+                for fig in widget_figures(data[WIDGET_MIME]["model_id"], states, live):
+                    out.append(FoundFigure(ci, oi, fig, True, name))
+    return out
+
+
+def die(message: str, code: int = 2) -> int:
+    """Print a user-facing error to stderr and return the exit code."""
+    print(f"error: {message}", file=sys.stderr)
+    return code

@@ -1,0 +1,102 @@
+"""Serve one notebook as a live dashboard with Voila on 127.0.0.1 (code hidden, widgets live).
+
+    python tools/present.py 02            # free port, full mode
+    python tools/present.py 02 --port 8866 --quick
+
+The notebook is executed by Voila's kernel when the page opens; explorers build their figure with
+its initial state before display, so the page shows the right state when it connects. Ctrl-C (or
+SIGTERM) stops Voila and its kernel. Exit status 2 for an unknown notebook or a port in use, 1 when
+Voila does not come up.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _lecture import (
+    BUILD,
+    HOST,
+    LectureError,
+    check_port,
+    die,
+    free_port,
+    kernel_env,
+    resolve_notebook,
+    start_server,
+    stop_server,
+    wait_http,
+)
+
+
+def voila_command(notebook: Path, port: int) -> list[str]:
+    """The Voila command line for one notebook on 127.0.0.1:port, sources stripped."""
+    return [
+        sys.executable,
+        "-m",
+        "voila",
+        str(notebook),
+        f"--port={port}",
+        f"--Voila.ip={HOST}",
+        "--no-browser",
+        "--strip_sources=True",
+        "--theme=light",
+        "--VoilaConfiguration.show_tracebacks=True",
+        "--Voila.open_browser=False",
+    ]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("notebook", help="chapter number (02), name (02-fresnel-...) or path")
+    ap.add_argument(
+        "--port", type=int, default=None, help="port on 127.0.0.1 (default: a free one)"
+    )
+    ap.add_argument(
+        "--quick", action="store_true", help="TUNNELKIT_QUICK=1 (small Monte-Carlo counts)"
+    )
+    ap.add_argument(
+        "--timeout", type=float, default=90.0, help="seconds to wait for Voila to answer"
+    )
+    args = ap.parse_args(argv)
+    try:
+        nb = resolve_notebook(args.notebook)
+        port = check_port(args.port) if args.port is not None else free_port()
+    except LectureError as exc:
+        return die(str(exc))
+    url = f"http://{HOST}:{port}/"
+    log = BUILD / "logs" / f"voila-{port}.log"
+    log.parent.mkdir(parents=True, exist_ok=True)
+
+    def _stop(signum, _frame):
+        raise KeyboardInterrupt
+
+    # SIGTERM acts like Ctrl-C, installed before the start so that a stop always reaches `finally`
+    signal.signal(signal.SIGTERM, _stop)
+    proc = None
+    try:
+        proc = start_server(voila_command(nb, port), env=kernel_env(args.quick), log=log)
+        wait_http(url + "api", proc, args.timeout)
+        mode = "quick" if args.quick else "full"
+        print(
+            f"presenting {nb.name} ({mode} mode) at {url}  (log: {log}; Ctrl-C to stop)", flush=True
+        )
+        proc.wait()
+        return die(f"Voila exited with code {proc.returncode}; see {log}", 1)
+    except LectureError as exc:
+        tail = log.read_text(errors="replace").splitlines()[-15:] if log.exists() else []
+        return die(f"{exc}\n" + "\n".join(tail), 1)
+    except KeyboardInterrupt:
+        print("stopping Voila", flush=True)
+        return 0
+    finally:
+        if proc is not None:
+            stop_server(proc, timeout=8.0)  # well inside the 15 s a caller's stop_server grants
+
+
+if __name__ == "__main__":
+    sys.exit(main())
