@@ -7,12 +7,23 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 KERNEL := tunnelkit
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
+# pip --quiet still relays setuptools' build warnings and a site-wide config's "is ignored" notes
+PIP_FILTER := sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$\|Please be careful\|name as your package\|take precedence during\|with strategy, WheelFile\|warnings.warn(/d'
 
 .PHONY: help install lab test lint format unit notebooks bench clean
+
+.DEFAULT_GOAL := help
+include make/lecture.mk
+include make/rt.mk
 
 help:
 	@echo "make lab     create .venv if needed, install, register the kernel, open JupyterLab on notebooks/"
 	@echo "make test    create .venv if needed, install, lint, unit tests and every notebook in quick mode"
+	@echo "make present NB=02   one notebook as a Voila dashboard on 127.0.0.1 (code hidden)"
+	@echo "make site    execute every notebook into a static HTML site in build/site/ (QUICK=1 for quick mode)"
+	@echo "make figures headline figures as PNG and SVG in build/figures/ (QUICK=1 for quick mode)"
+	@echo "make browser Playwright + Chromium tests of the dashboard and the site (part of make test)"
+	@echo "make rt-deps Sionna RT extra and Debian's libllvm19 (part of make test)"
 	@echo "make bench   benchmarks (medians and ratios measured in one run)"
 	@echo "make format  apply ruff formatting and strip notebook outputs"
 	@echo "make clean   remove .venv and caches"
@@ -20,7 +31,7 @@ help:
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip 2>&1 | sed '/is ignored/d'
-	$(PY) -m pip install --quiet -e '.[lab,dev]' 2>&1 | sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$/d'
+	$(PY) -m pip install --quiet -e '.[lab,dev,lecture]' 2>&1 | $(PIP_FILTER)
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -37,13 +48,13 @@ lint: install
 	$(PY) tools/nbbuild.py --check
 	$(PY) tools/check_notebooks.py notebooks
 
-unit: install
+unit: install rt-deps
 	$(PY) -m pytest -q -n 2 tests
 
-notebooks: install
+notebooks: install rt-deps
 	TUNNELKIT_QUICK=1 $(PY) -m pytest -q -n 2 --nbmake --nbmake-timeout=900 notebooks
 
-test: lint unit notebooks
+test: lint unit notebooks browser
 
 bench: install
 	$(PY) benchmarks/run.py

@@ -9,4 +9,10 @@ setting they solve), so notebooks, tests and the command line loop over them::
 
 from . import registry
 
+# families -> modules that register them; imported on first lookup so `import tunnelkit` stays light
+registry.provide("jiang2023", "tunnelkit.tracking.virtual_station")  # TSWLS, EKF, UKF
+registry.provide("jiang2023", "tunnelkit.tracking.upf")  # UPF
+registry.provide("halili2022", "tunnelkit.tracking.doppler")  # KF/EKF on Doppler and ToA
+registry.provide("italiano2026", "tunnelkit.tracking.javelin")  # JAVELIN, TeNFiLoc
+
 __all__ = ["registry"]

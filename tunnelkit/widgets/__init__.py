@@ -6,7 +6,48 @@ is built with its initial state before it is displayed (a FigureWidget changed b
 connects shows stale in Voila).
 """
 
-from .base import Explorer
-from .crlb import crlb_explorer, crlb_figure
+from .base import (
+    Explorer,
+)
+from .cpd import (
+    cpd_explorer,
+    curvature_figure,
+    curvature_study,
+)
+from .crlb import (
+    crlb_explorer,
+    crlb_figure,
+)
+from .doppler import (
+    doppler_explorer,
+    doppler_figure,
+)
+from .javelin import (
+    epoch_explorer,
+    epoch_view,
+)
+from .mmax import (
+    mmax_explorer,
+    mmax_figure,
+)
+from .tracking import (
+    upf_explorer,
+    upf_figure,
+)
 
-__all__ = ["Explorer", "crlb_explorer", "crlb_figure"]
+__all__ = [
+    "Explorer",
+    "cpd_explorer",
+    "crlb_explorer",
+    "crlb_figure",
+    "curvature_figure",
+    "curvature_study",
+    "doppler_explorer",
+    "doppler_figure",
+    "epoch_explorer",
+    "epoch_view",
+    "mmax_explorer",
+    "mmax_figure",
+    "upf_explorer",
+    "upf_figure",
+]
