@@ -321,3 +321,26 @@ def test_figures_and_explorer(drive, setup):
     P = dp.posterior_crlb(drive, sigma_hz=30.0)
     assert len(pl.pcrlb_figure(drive, {"Doppler": P}).data) == 2
     assert len(pl.information_figure(drive, setup).data) == 4
+
+
+def test_cv_model_equals_the_tracking_cv_model():
+    """Halili eq. 2-3 and the filterpy-built Jiang eq. 41 / white-noise-acceleration Q agree."""
+    from tunnelkit.tracking.cv import cv_process_noise, cv_transition
+
+    F, Q = dp.cv_model(0.032, 0.5)
+    assert np.allclose(F, cv_transition(0.032)) and np.allclose(Q, cv_process_noise(0.032, 0.5))
+
+
+def test_range_kf_step_is_eq_17_to_21_by_hand(setup):
+    """One predict/update of the ToA KF computed by hand: d = d - dt u, P + q dt, H = 1/c."""
+    d0, sig_d0, q, s_toa, u = 120.0, 2.0, 0.5, 3e-9, 24.0
+    kf = dp.RangeKF(setup, d0, sigma_toa=s_toa, q=q, sigma_d0=sig_d0, calibrate=False)
+    z = 117.9 / C
+    got = kf.step(u, z)
+    d_pred = d0 - setup.dt * u  # eq. 17 with the approach sign
+    P_pred = sig_d0**2 + q * setup.dt  # eq. 18
+    H = 1.0 / C
+    K = P_pred * H / (H * P_pred * H + s_toa**2)  # eq. 19
+    d_post = d_pred + K * (z - H * d_pred)  # eq. 20
+    assert got == pytest.approx(d_post, rel=1e-12)
+    assert kf.kf.P[0, 0] == pytest.approx((1 - K * H) * P_pred, rel=1e-9)  # eq. 21

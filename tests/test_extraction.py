@@ -206,3 +206,107 @@ def test_far_field_path_reports_nan_kappa():
     assert _angle_deg(est.direction[0], paths[0].direction_local) < 0.5
     assert not est.near_field[0] or est.kappa[0] > 200  # curvature unresolvable at 1.5 km
     assert np.isnan(est.kappa[0]) == (not est.near_field[0])
+
+
+@pytest.mark.parametrize("shape", [(1, 8), (8, 1)])
+def test_linear_array_along_either_local_axis_keeps_the_curvature(shape):
+    """A ULA along local y (an ``n x 1`` URA) is as linear as one along x: TLS must not degrade."""
+    pos = arrays.ura(*shape, 0.0254)
+    e = pos[-1, :2] / np.linalg.norm(pos[-1, :2])
+    src = np.array([1.5, -2.0, 9.0])
+    delta = np.linalg.norm(pos - src, axis=1) - np.linalg.norm(src)
+    x = extraction.solve_near_field(delta[:, None], pos)[0]
+    np.testing.assert_allclose(x, [*((src[:2] @ e) * e), np.linalg.norm(src)], rtol=1e-9, atol=1e-9)
+    u = src / np.linalg.norm(src)
+    uf = extraction.solve_far_field(-(pos @ u)[:, None], pos)[0]
+    np.testing.assert_allclose(uf, (u[:2] @ e) * e, atol=1e-12)
+    # through the whole route: the LoS stays near-field with kappa = distance
+    arr = arrays.make_array(
+        *shape, fc=FC, azimuth=0.0, elevation=np.radians(-30), origin=[0, 0, 4.8]
+    )
+    paths = P.trace_paths(P.semicircular_tunnel(), arr, [18.0, -2.5, 1.5], fc=FC, kinds=("los",))
+    est = _extract(channel.channel_tensor(paths, CFG, n_tones=64, n_symbols=4), 1, arr)
+    assert est.near_field[0]
+    assert est.kappa[0] == pytest.approx(paths[0].length, rel=1e-6)
+    assert est.direction[0, :2] @ e == pytest.approx(paths[0].direction_local[:2] @ e, abs=1e-6)
+
+
+@pytest.mark.parametrize("fc", [3.5e9, 5.9e9, 28e9])
+def test_half_wavelength_ura_is_recognised_as_a_grid(fc):
+    """Rounding positions to the tolerance first made the step drift along a long axis."""
+    pos = arrays.ura(32, 24, C / fc / 2)
+    r, c, nr, nc = extraction._grid_index(pos)
+    assert (nr, nc) == (32, 24)
+    np.testing.assert_array_equal(r * 24 + c, np.arange(pos.shape[0]))
+    assert len(extraction._shift_pairs(pos)) == 2
+
+
+def test_refine_joint_reaches_a_stationary_point_of_the_projected_cost():
+    """Brute-force twin of the Kaufman Jacobian: central differences of the variable-projection
+    cost ``min_A ||H - A W^T||^2`` vanish at the returned roots, and the cost went down."""
+    rng = np.random.default_rng(1)
+    M, nf, nt, L = 6, 40, 8, 3
+    A = rng.normal(size=(M, L)) + 1j * rng.normal(size=(M, L))
+    muf, mut = np.array([0.3, 0.35, -1.0]), np.array([0.1, -0.2, 0.15])
+    s, k = np.arange(nf)[:, None], np.arange(nt)[:, None]
+    H = np.einsum("ml,sl,kl->msk", A, np.exp(1j * s * muf), np.exp(1j * k * mut))
+    H = H + 0.3 * (rng.normal(size=H.shape) + 1j * rng.normal(size=H.shape))
+    X = H.reshape(M, nf * nt)
+
+    def cost(mu):
+        W = np.einsum("sl,kl->skl", np.exp(1j * s * mu[:L]), np.exp(1j * k * mu[L:]))
+        W = W.reshape(nf * nt, L)
+        Ahat = np.linalg.lstsq(W, X.T, rcond=None)[0].T
+        return np.linalg.norm(X - Ahat @ W.T) ** 2
+
+    start = np.concatenate([muf + 0.01, mut - 0.01])
+    mf, mt, _ = extraction.refine_joint(H, start[:L], start[L:], n_steps=20)
+    mu = np.concatenate([mf, mt])
+    h = 1e-6
+    grad = np.array([(cost(mu + e) - cost(mu - e)) / (2 * h) for e in h * np.eye(2 * L)])
+    g0 = np.array([(cost(start + e) - cost(start - e)) / (2 * h) for e in h * np.eye(2 * L)])
+    assert cost(mu) < cost(start)
+    assert np.max(np.abs(grad)) < 1e-5 * np.max(np.abs(g0))
+
+
+def test_free_spatial_crlb_matches_finite_difference_fim():
+    """``spatial="free"``: unknowns Re/Im alpha, mu_f, mu_t and every a_m (m >= 1, a_0 = 1)."""
+    rng = np.random.default_rng(5)
+    M, L, nf, nt, n0 = 4, 2, 6, 4, 0.3
+    pos = arrays.ura(2, 2, 0.025)
+    alpha = rng.normal(size=L) + 1j * rng.normal(size=L)
+    src = np.array([[0.3, 0.2, 1.5], [-0.4, 0.1, 2.0]])
+    mu_f, mu_t = np.array([0.3, -0.8]), np.array([0.05, 0.4])
+    k0 = 2 * np.pi * FC / C
+    r = np.linalg.norm(pos[:, None, :] - src[None], axis=-1)
+    a = np.exp(1j * k0 * (r - r[0]))
+    n_per = 4 + 2 * (M - 1)
+
+    def model(theta):
+        out = np.zeros((M, nf, nt), complex)
+        for j_ in range(L):
+            t = theta[n_per * j_ : n_per * (j_ + 1)]
+            am = np.concatenate([[1.0], t[4 : 4 + M - 1] + 1j * t[4 + M - 1 :]])
+            out += (t[0] + 1j * t[1]) * np.einsum(
+                "m,s,k->msk",
+                am,
+                np.exp(1j * np.arange(nf) * t[2]),
+                np.exp(1j * np.arange(nt) * t[3]),
+            )
+        return out.ravel()
+
+    theta = np.concatenate(
+        [
+            [alpha[j_].real, alpha[j_].imag, mu_f[j_], mu_t[j_], *a[1:, j_].real, *a[1:, j_].imag]
+            for j_ in range(L)
+        ]
+    )
+    h = 1e-6
+    J = np.stack(
+        [(model(theta + e) - model(theta - e)) / (2 * h) for e in h * np.eye(theta.size)], 1
+    )
+    cov = np.linalg.inv(2 / n0 * np.real(J.conj().T @ J))
+    cr = extraction.crlb_paths(alpha, src, pos, mu_f, mu_t, FC, nf, nt, n0, spatial="free")
+    idx = np.arange(L) * n_per
+    np.testing.assert_allclose(cr["mu_f"], np.sqrt(cov[idx + 2, idx + 2]), rtol=1e-5)
+    np.testing.assert_allclose(cr["mu_t"], np.sqrt(cov[idx + 3, idx + 3]), rtol=1e-5)

@@ -109,3 +109,15 @@ def test_signal_route_drive_two_epochs():
     assert np.allclose(d.base_station, [0.0, 0.0, 4.8])
     with pytest.raises(KeyError):
         ex.simulate_drive("italiano2026-straight", "X", np.random.default_rng(0), n_epochs=1)
+
+
+def test_vue_prediction_skips_the_los_only_when_it_exists():
+    # epoch k + 1 without LoS: its first source is a VUE and must stay among the candidates
+    d = _fake_drive("L")
+    full = ex.vue_prediction_errors(d, "mirror")
+    odd = np.arange(d.t.size) % 2 == 1
+    d.los = ~odd
+    d.sources = [s[1:] if o else s for s, o in zip(d.sources, odd)]
+    e = ex.vue_prediction_errors(d, "mirror")
+    assert e.size == 4 * int(np.sum(d.los[:-1]))  # 4 VUEs per epoch k with a LoS
+    assert np.max(e) < 0.05 and np.max(e) <= np.max(full) + 1e-12

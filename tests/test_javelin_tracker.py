@@ -159,3 +159,37 @@ def test_constructor_checks():
         Javelin([0.0, 1.0, 1.0], config={"max_misses": 1})
     with pytest.raises(ValueError, match=r"^speed, heading"):
         run_javelin([None, None], [1.0], [0.0, 0.0], 0.1, [0, 1, 1])
+
+
+def test_directly_built_paths_never_stop_a_run():
+    # PathMeasurements(...) built without from_arrays: no ``source`` (the Doppler clutter filter
+    # subsets it) and a NaN angle / a negative delay Algorithm 1 would have dropped
+    P, _, eps, spd, hdg = _drive(5, 7)
+    m = eps[1]
+    raw = PathMeasurements(
+        np.append(m.phi, [np.nan, 0.3]),
+        np.append(m.psi, [0.0, -0.1]),
+        np.append(m.kappa, [np.nan, 10.0]),
+        np.append(m.d, [20.0, -4.0]),
+        np.append(m.v, [500.0, 0.0]),
+    )
+    np.testing.assert_array_equal(raw.source, np.arange(len(m) + 2))
+    trk = Javelin(P[0], CFG.with_(doppler_clutter_margin=1.0))
+    trk.step(eps[0], spd[0], hdg[0], 0.0)
+    with pytest.warns(JavelinWarning, match="Algorithm 1"):
+        r = trk.step(raw, spd[0], hdg[0], 0.1)
+    assert r.n_paths == len(m) and np.all(np.isfinite(trk.state.x))
+    np.testing.assert_array_equal(r.paths.source, np.arange(len(m)))
+    assert np.linalg.norm(r.estimate[:2] - P[1, :2]) < 0.5
+    with pytest.raises(ValueError, match=r"^psi"):
+        PathMeasurements(np.zeros(2), np.zeros(1), np.zeros(2), np.zeros(2), np.zeros(2))
+
+
+def test_a_ue_on_the_base_station_axis_is_predict_only():
+    trk = Javelin([0.0, 0.0, 1.0])  # under the reference antenna: azimuth undefined
+    m = PathMeasurements.from_arrays([0.1], [-0.5], [5.0], [5.0])
+    with pytest.warns(JavelinWarning, match="measurement model undefined"):
+        r = trk.step(m, 1.0, 0.0, 0.0)
+    np.testing.assert_allclose(r.estimate, [0.0, 0.0, 1.0])
+    r = trk.step(m, 1.0, 0.0, 0.1)  # moved off the axis: a normal epoch again
+    assert not r.faults and r.n_rows > 0

@@ -230,3 +230,39 @@ def test_figures_and_explorer_callback(exp_hi):
     assert len(particle_cloud_figure([snap, snap]).data) == 6
     fig = upf_figure(n_particles=20, seed=1)
     assert len(fig.data) == 5 and "RMSE" in fig.data[0].name
+
+
+def test_cv_process_noise_equals_van_loan_discretisation():
+    """Brute force for eq. 40's Q: Van Loan's matrix exponential of the continuous white-noise
+    acceleration model dX = A X dt + G dW, E[dW dW^T] = q I dt."""
+    from scipy.linalg import expm
+
+    T, q = 0.37, 1.7
+    A = np.zeros((4, 4))
+    A[0, 2] = A[1, 3] = 1.0
+    G = np.zeros((4, 2))
+    G[2, 0] = G[3, 1] = 1.0
+    M = np.block([[-A, q * G @ G.T], [np.zeros((4, 4)), A.T]]) * T
+    E = expm(M)
+    Phi = E[4:, 4:].T
+    Qd = Phi @ E[:4, 4:]
+    assert np.allclose(Phi, cv_transition(T), atol=1e-12)
+    assert np.allclose(Qd, cv_process_noise(T, q), rtol=1e-10, atol=1e-14)
+
+
+def test_tswls_velocity_spans_missed_epochs(exp_hi):
+    """Noise-free fixes on the constant-velocity truth: the velocity is the truth's even right
+    after a missed epoch (the time between fixes is then two periods), and run() equals update()."""
+    m = exp_hi.model
+    truth = exp_hi.truth[:9]
+    Z = m.hx(truth)
+    Z[[0, 3, 5, 6]] = np.nan
+    x0 = truth[0] + np.array([0.5, -0.5, 1.0, -1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        one = vs.track(vs.VsTSWLS(m, x0, exp_hi.P0), Z)
+    run = vs.VsTSWLS.run(m, Z[None], x0[None], exp_hi.P0)[0]
+    assert np.allclose(one, run, atol=1e-9)
+    assert np.allclose(run[0], x0) and np.allclose(run[1, 2:], x0[2:])  # prior until 2nd fix
+    assert np.allclose(run[1:, :2], truth[[1, 2, 2, 4, 4, 4, 7, 8], :2], atol=1e-6)  # held fixes
+    assert np.allclose(run[2:, 2:], truth[2:, 2:], atol=1e-5)

@@ -468,13 +468,17 @@ def _grid_index(p: np.ndarray, tol: float = 1e-6):
     """(rows, cols) integer grid coordinates if the xy positions form a full rectangular lattice."""
     out = []
     for ax in (1, 0):
-        vals = np.unique(np.round(p[:, ax] / max(tol, 1e-12)))
-        if vals.size == 1:
+        v = p[:, ax]
+        u = np.unique(v)
+        levels = u[np.concatenate([[True], np.diff(u) > tol])]  # values closer than tol merge
+        if levels.size == 1:
             out.append((np.zeros(p.shape[0], int), 1))
             continue
-        step = np.min(np.diff(vals))
-        idx = np.round((np.round(p[:, ax] / max(tol, 1e-12)) - vals[0]) / step).astype(int)
-        if not np.allclose((idx * step + vals[0]) * tol, p[:, ax], atol=10 * tol):
+        # the step from the float positions (rounding them to tol first lets the rounding error
+        # accumulate along the axis: a 32 x 32 URA at 28 GHz was not recognised as a grid)
+        idx = np.round((v - levels[0]) / np.min(np.diff(levels))).astype(int)
+        step = float(np.sum(idx * (v - levels[0])) / np.sum(idx * idx))
+        if not np.allclose(levels[0] + idx * step, v, rtol=0.0, atol=10 * tol):
             return None
         out.append((idx, int(idx.max()) + 1))
     (r, nr), (c, nc) = out
@@ -522,22 +526,42 @@ def unwrap_spatial(b, element_positions) -> np.ndarray:
     return out - out[0]
 
 
+def _line_direction(p: np.ndarray, rtol: float = 1e-12):
+    """Unit in-plane direction ``e`` (2,) if the elements' xy positions are collinear, else None.
+
+    The reference antenna is at the origin, so a linear array lies on the line ``t e``; any
+    direction counts (a ULA along local x *or* y, or diagonal).
+    """
+    xy = p[:, :2]
+    far = int(np.argmax(np.linalg.norm(xy, axis=1)))
+    size = float(np.linalg.norm(xy[far]))
+    if size == 0:
+        return None
+    e = xy[far] / size
+    off = np.abs(xy[:, 0] * e[1] - xy[:, 1] * e[0])  # distance from the line through 0 along e
+    return e if np.max(off) <= rtol * size else None
+
+
 def solve_near_field(delta, element_positions) -> np.ndarray:
     """TLS solution ``x = (x_l, y_l, kappa_l)`` of eq. 18 for each column of ``delta`` (M, L).
 
     Rows ``2 [x_m, y_m, delta_m] x = r_m^2 - delta_m^2`` (m >= 1); the TLS solution is the last
-    right singular vector of ``[2 A, -y]`` scaled to a unit last entry. For a linear array the
-    y column is dropped (returned y = 0). Returns (L, 3).
+    right singular vector of ``[2 A, -y]`` scaled to a unit last entry. For a linear array (a
+    ULA along any direction ``e`` of the array plane) the columns ``x_m, y_m`` are replaced by the
+    coordinate ``t_m = e . p_m`` along the line and the returned ``(x, y)`` is ``t e`` (the
+    component across the line is unobservable and returned as 0). Returns (L, 3).
     """
     delta = np.atleast_2d(np.asarray(delta, float).T).T
     p = np.asarray(element_positions, float)
     xm, ym = p[1:, 0], p[1:, 1]
     r2 = np.sum(p[1:] ** 2, axis=1)
-    linear = np.ptp(ym) < 1e-12 * max(np.ptp(xm), 1e-12)
+    line = _line_direction(p)
+    linear = line is not None
+    tm = p[1:, :2] @ line if linear else None  # coordinate along the array's line
     out = np.empty((delta.shape[1], 3))
     for j_ in range(delta.shape[1]):
         dm = delta[1:, j_]
-        cols = [xm, dm] if linear else [xm, ym, dm]
+        cols = [tm, dm] if linear else [xm, ym, dm]
         A = 2 * np.stack(cols, axis=1)
         aug = np.column_stack([A, -(r2 - dm**2)])
         aug_scale = np.linalg.norm(aug, axis=0)
@@ -545,7 +569,7 @@ def solve_near_field(delta, element_positions) -> np.ndarray:
         _, _, vh = np.linalg.svd(aug / aug_scale, full_matrices=False)
         v = vh[-1] / aug_scale
         sol = v[:-1] / v[-1] if abs(v[-1]) > 1e-300 else np.full(len(cols), np.nan)
-        out[j_] = [sol[0], 0.0, sol[1]] if linear else sol
+        out[j_] = [*(sol[0] * line), sol[1]] if linear else sol
     return out
 
 
@@ -553,14 +577,14 @@ def solve_far_field(delta, element_positions) -> np.ndarray:
     """LS far-field solution of ``[x_m, y_m] u = -delta_m``: ``u = (cos phi sin psi, sin phi sin psi)``.
 
     In the far field ``delta_m = -u . p_m`` (eq. 17 with ``kappa -> inf``). Returns (L, 2); for a
-    linear array the second component is 0.
+    linear array along ``e`` only ``u . e`` is observable and ``(u . e) e`` is returned.
     """
     delta = np.atleast_2d(np.asarray(delta, float).T).T
     p = np.asarray(element_positions, float)
-    linear = np.ptp(p[:, 1]) < 1e-12 * max(np.ptp(p[:, 0]), 1e-12)
-    A = p[1:, :1] if linear else p[1:, :2]
+    line = _line_direction(p)
+    A = (p[1:, :2] @ line)[:, None] if line is not None else p[1:, :2]
     sol = np.linalg.lstsq(A, -delta[1:], rcond=None)[0].T
-    return np.column_stack([sol, np.zeros(len(sol))]) if linear else sol
+    return sol[:, :1] * line[None, :] if line is not None else sol
 
 
 def angles_from_solution(x_nf, u_ff):

@@ -340,8 +340,9 @@ class VsTSWLS(EstimatorBase):
     """Snapshot TSWLS (Jiang eq. 29-39) behind the filter interface; no motion model.
 
     ``update(z)`` replaces the position by the TSWLS solution of this epoch alone; the velocity is
-    the difference of successive fixes. ``P`` holds the inverse snapshot Fisher information in the
-    position block. On a missed epoch the previous fix is held (a snapshot method has nothing to
+    the difference of successive fixes divided by the time between them (the prior velocity until
+    the second fix). ``P`` holds the inverse snapshot Fisher information in the position block. On
+    a missed epoch the previous fix (and velocity) is held (a snapshot method has nothing to
     predict with).
     """
 
@@ -351,9 +352,10 @@ class VsTSWLS(EstimatorBase):
         self.model = _check_model(model)
         self.x, self.P = _check_prior(x0, P0)
         self._has_fix = False
+        self._since = 0  # epochs (predict calls) since the last fix
 
     def predict(self) -> None:
-        pass
+        self._since += 1
 
     def update(self, z) -> None:
         z = measurement_ok(z, self.model.dim_z, who="TSWLS")
@@ -361,11 +363,12 @@ class VsTSWLS(EstimatorBase):
             return
         n, m = self.model.n_stations, self.model
         p = positioning.tswls(m.stations, z[:n], z[n:], m.sigma_d, m.sigma_theta)
-        if self._has_fix:
-            self.x[2:] = (p - self.x[:2]) / m.period
+        if self._has_fix and self._since > 0:  # a missed epoch in between doubles the time
+            self.x[2:] = (p - self.x[:2]) / (self._since * m.period)
         self.x[:2] = p
         self.P[:2, :2] = np.linalg.inv(m.position_fim(p))
         self._has_fix = True
+        self._since = 0
 
     @classmethod
     def run(cls, model, Z, x0, P0, *, rng=None, **options) -> np.ndarray:
@@ -379,13 +382,21 @@ class VsTSWLS(EstimatorBase):
             model.stations, Zf[..., :n], Zf[..., n:], model.sigma_d, model.sigma_theta
         )
         # hold the last fix over missed epochs (the prior before the first fix)
-        idx = np.where(ok, np.arange(Z.shape[1]), -1)
-        idx = np.maximum.accumulate(idx, axis=1)
-        prior = np.broadcast_to(np.asarray(x0)[:, None, :2], p.shape)
+        ep = np.arange(Z.shape[1])
+        idx = np.maximum.accumulate(np.where(ok, ep, -1), axis=1)  # last fix at or before k
+        x0 = np.asarray(x0, dtype=float)
+        prior = np.broadcast_to(x0[:, None, :2], p.shape)
         held = np.take_along_axis(p, np.maximum(idx, 0)[..., None], axis=1)
         pos = np.where((idx >= 0)[..., None], held, prior)
-        vel = np.zeros_like(pos)
-        vel[:, 1:] = np.diff(pos, axis=1) / model.period
+        # velocity at a fix: displacement from the previous fix over the time between them (as
+        # in update()); held over missed epochs; the prior velocity until the second fix
+        prev = np.concatenate([np.full((Z.shape[0], 1), -1), idx[:, :-1]], axis=1)
+        p_prev = np.take_along_axis(p, np.maximum(prev, 0)[..., None], axis=1)
+        v_prior = np.broadcast_to(x0[:, None, 2:], p.shape)
+        gap = ((ep - prev) * model.period)[..., None]
+        v_fix = np.where((ok & (prev >= 0))[..., None], (p - p_prev) / gap, v_prior)
+        held_v = np.take_along_axis(v_fix, np.maximum(idx, 0)[..., None], axis=1)
+        vel = np.where((idx >= 0)[..., None], held_v, v_prior)
         return np.concatenate([pos, vel], axis=-1)
 
 

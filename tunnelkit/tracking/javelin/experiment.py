@@ -344,7 +344,7 @@ def vue_prediction_errors(drive: DriveData, vue_motion: str) -> np.ndarray:
     out = []
     for k in range(len(drive.sources) - 1):
         a, b = drive.sources[k], drive.sources[k + 1]
-        if len(a) < 2 or len(b) < 2 or not drive.los[k]:
+        if len(a) < 2 or len(b) < 1 + int(drive.los[k + 1]) or not drive.los[k]:
             continue
         n = len(a) - 1
         st = JavelinState(
@@ -359,6 +359,8 @@ def vue_prediction_errors(drive: DriveData, vue_motion: str) -> np.ndarray:
             st, float(np.linalg.norm(v[:2])), float(np.arctan2(v[1], v[0])), drive.dt, vue_motion
         )
         pred = (st.x[3:] + inc[3:]).reshape(-1, 2)
-        d = np.linalg.norm(pred[:, None, :] - b[None, 1:, 1:], axis=-1)
+        # the LoS (first source when present) is not a VUE; epoch k + 1 may have lost it
+        vues_next = b[1:] if drive.los[k + 1] else b
+        d = np.linalg.norm(pred[:, None, :] - vues_next[None, :, 1:], axis=-1)
         out.extend(d.min(axis=1))
     return np.asarray(out)

@@ -63,6 +63,34 @@ class PathMeasurements:
     v: np.ndarray
     source: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
+    def __post_init__(self) -> None:
+        # built directly (not through from_arrays): 1-D float arrays of one length, and a
+        # default ``source`` so that ``subset`` works
+        for name in ("phi", "psi", "kappa", "d", "v"):
+            setattr(self, name, np.asarray(getattr(self, name), dtype=float).reshape(-1))
+        n = self.phi.size
+        for name in ("psi", "kappa", "d", "v"):
+            if getattr(self, name).size != n:
+                raise ValueError(
+                    f"{name}: expected {n} values (one per path), got {getattr(self, name).size}"
+                )
+        src = np.asarray(self.source, dtype=int).reshape(-1)
+        if src.size == 0 and n:
+            src = np.arange(n)
+        if src.size != n:
+            raise ValueError(f"source: expected {n} values (one per path), got {src.size}")
+        self.source = src
+
+    def sanitised(self) -> tuple[PathMeasurements, int]:
+        """These paths through the checks of Algorithm 1 (idempotent), and how many were dropped.
+
+        ``source`` keeps pointing into the original input."""
+        clean = PathMeasurements.from_arrays(
+            self.phi, self.psi, self.kappa, self.d, self.v, warn=False
+        )
+        clean.source = self.source[clean.source]
+        return clean, len(self) - len(clean)
+
     @classmethod
     def from_arrays(
         cls, phi, psi, kappa=None, d=None, v=None, *, warn: bool = True

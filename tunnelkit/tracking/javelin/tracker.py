@@ -96,7 +96,11 @@ class Javelin:
             return PathMeasurements.empty()
         if not isinstance(paths, PathMeasurements):
             raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
-        return paths
+        # a PathMeasurements built directly may still hold NaN angles or d < 0 (Algorithm 1)
+        clean, dropped = paths.sanitised()
+        if dropped:
+            faults.append(f"{dropped} path(s) failing the checks of Algorithm 1 dropped")
+        return clean
 
     # -- Algorithm 4 --------------------------------------------------------------------------
     def step(
@@ -122,8 +126,14 @@ class Javelin:
             st.P[3 + 2 * k : 5 + 2 * k, 3 + 2 * k : 5 + 2 * k].copy() for k in range(st.n_vue)
         ]
         costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
+        geometry_ok = True
         if len(meas):
-            pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
+            try:
+                pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
+            except ValueError as exc:  # a track on the base station's axis: azimuth undefined
+                geometry_ok = False
+                faults.append(f"measurement model undefined ({exc}): predict only")
+        if len(meas) and geometry_ok:
             R3 = np.diag([cfg.sigma_phi**2, cfg.sigma_psi**2, cfg.sigma_kappa**2])
             # Associate (Algorithm 2)
             costs = association_costs(pred, J, st.P, meas, R3, self.gate)
@@ -146,7 +156,7 @@ class Javelin:
             # dynamic reflectors contribute to this epoch only
             gone = [k + 1 for k, tr in enumerate(st.transient) if tr]
             mres.dead += st.remove(gone)
-        elif paths is not None:
+        elif paths is not None and geometry_ok:
             faults.append("no usable path this epoch: predict only")
             # every VUE missed this epoch
             mres = manage_tracks(st, meas, [], cfg)
