@@ -121,3 +121,9 @@ def test_vue_prediction_skips_the_los_only_when_it_exists():
     e = ex.vue_prediction_errors(d, "mirror")
     assert e.size == 4 * int(np.sum(d.los[:-1]))  # 4 VUEs per epoch k with a LoS
     assert np.max(e) < 0.05 and np.max(e) <= np.max(full) + 1e-12
+
+
+def test_ablation_path_goes_from_the_paper_design_to_ours_one_change_at_a_time():
+    cfgs = list(ex.ABLATION.values())
+    assert cfgs[0] == ex.PAPER and cfgs[-1] == ex.OURS
+    assert len(set(map(repr, cfgs))) == len(cfgs)  # every step changes something

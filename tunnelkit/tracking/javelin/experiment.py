@@ -287,33 +287,29 @@ OURS = JavelinConfig(
     update_with_births=False,
 )
 
-#: the ablation path from the paper's design to ours, one change at a time
-ABLATION: dict[str, JavelinConfig] = {
-    "paper (section 4.2)": PAPER,
-    "+ Doppler clutter rejection": PAPER.with_(doppler_clutter_margin=1.0),
-    "+ noise calibrated on the extraction": PAPER.with_(
-        doppler_clutter_margin=1.0,
-        sigma_phi=OURS.sigma_phi,
-        sigma_psi=OURS.sigma_psi,
-        sigma_kappa=OURS.sigma_kappa,
+#: the ablation path from the paper's design to ours, one change at a time (each row keeps the
+#: changes of the rows above it)
+_STEPS: tuple[tuple[str, dict], ...] = (
+    ("+ Doppler clutter rejection", {"doppler_clutter_margin": OURS.doppler_clutter_margin}),
+    (
+        "+ noise calibrated on the extraction",
+        {"sigma_phi": OURS.sigma_phi, "sigma_psi": OURS.sigma_psi, "sigma_kappa": OURS.sigma_kappa},
     ),
-    "+ global nearest neighbour": PAPER.with_(
-        doppler_clutter_margin=1.0,
-        sigma_phi=OURS.sigma_phi,
-        sigma_psi=OURS.sigma_psi,
-        sigma_kappa=OURS.sigma_kappa,
-        associator="gnn",
-    ),
-    "+ mirrored VUE motion": PAPER.with_(
-        doppler_clutter_margin=1.0,
-        sigma_phi=OURS.sigma_phi,
-        sigma_psi=OURS.sigma_psi,
-        sigma_kappa=OURS.sigma_kappa,
-        associator="gnn",
-        vue_motion="mirror",
-    ),
-    "+ no update at birth (= ours)": OURS,
-}
+    ("+ global nearest neighbour", {"associator": OURS.associator}),
+    ("+ mirrored VUE motion", {"vue_motion": OURS.vue_motion}),
+    ("+ no update at birth (= ours)", {"update_with_births": OURS.update_with_births}),
+)
+
+
+def _ablation_path() -> dict[str, JavelinConfig]:
+    out, changes = {"paper (section 4.2)": PAPER}, {}
+    for label, step in _STEPS:
+        changes = {**changes, **step}
+        out[label] = PAPER.with_(**changes)
+    return out
+
+
+ABLATION: dict[str, JavelinConfig] = _ablation_path()
 
 
 def ablation(
