@@ -498,30 +498,10 @@ class EkfDS(_Base):
 
 
 class _KfToA(_Base):
-    """Shared part of the two section-5 approaches: range KF + eq. 16 dead reckoning."""
+    """Shared part of the two section-5 approaches: range KF + eq. 16 dead reckoning.
 
-    def _init_range(self, setup, fix, q, sigma_toa, calibrate):
-        self.setup = setup
-        self._p0 = np.array(fix.position, dtype=float)
-        d0 = float(slant_range(fix.position, setup.tx, setup.dz))
-        self.range_kf = RangeKF(
-            setup, d0, sigma_toa=sigma_toa, q=q, sigma_d0=fix.sigma_p, calibrate=calibrate
-        )
-        self.dr = HeadingDeadReckoning(fix.position, fix.velocity)
-        w = fix.position - setup.tx
-        self._u0 = -float(fix.velocity @ w) / float(slant_range(fix.position, setup.tx, setup.dz))
-
-    def _advance(self, u: float, toa) -> np.ndarray:
-        d_prev = self.range_kf.distance
-        d = self.range_kf.step(u, toa)
-        return self.dr.step(d - d_prev)
-
-
-@register("halili2022", "KF DS and ToA")
-class KfDSToA(_KfToA):
-    """KF DS and ToA (sec. 5): KF on Doppler for the speed, KF on ToA for the distance, eq. 16."""
-
-    name = "KF DS and ToA"
+    Subclasses say where the approach speed comes from (``_init_speed`` and ``_approach_speed``).
+    """
 
     def __init__(
         self,
@@ -535,7 +515,37 @@ class KfDSToA(_KfToA):
         calibrate: bool = True,
         **kw,
     ) -> None:
-        self._init_range(setup, fix, q, sigma_toa, calibrate)
+        self.setup = setup
+        self._p0 = np.array(fix.position, dtype=float)
+        d0 = float(slant_range(fix.position, setup.tx, setup.dz))
+        self.range_kf = RangeKF(
+            setup, d0, sigma_toa=sigma_toa, q=q, sigma_d0=fix.sigma_p, calibrate=calibrate
+        )
+        self.dr = HeadingDeadReckoning(fix.position, fix.velocity)
+        w = fix.position - setup.tx
+        self._u0 = -float(fix.velocity @ w) / d0
+        self._init_speed(setup, fix, sigma_hz, q, adaptive, kw)
+
+    def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
+        raise NotImplementedError
+
+    def _approach_speed(self, doppler) -> float:
+        raise NotImplementedError
+
+    def step(self, doppler, toa=None) -> np.ndarray:
+        d_prev = self.range_kf.distance
+        d = self.range_kf.step(self._approach_speed(doppler), toa)
+        return self.dr.step(d - d_prev)
+
+
+@register("halili2022", "KF DS and ToA")
+class KfDSToA(_KfToA):
+    """KF DS and ToA (sec. 5): KF on Doppler for the speed, KF on ToA for the distance, eq. 16."""
+
+    name = "KF DS and ToA"
+
+    def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
+        extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form")}
         self.speed_kf = SpeedKF(
             setup,
             self._u0,
@@ -543,11 +553,11 @@ class KfDSToA(_KfToA):
             q=q,
             sigma_u0=fix.sigma_v,
             adaptive=adaptive,
-            **{k: v for k, v in kw.items() if k in ("a", "adaptive_form")},
+            **extra,
         )
 
-    def step(self, doppler, toa=None) -> np.ndarray:
-        return self._advance(self.speed_kf.step(doppler), toa)
+    def _approach_speed(self, doppler) -> float:
+        return self.speed_kf.step(doppler)
 
     def speed(self) -> float:
         return abs(self.speed_kf.speed)
@@ -559,24 +569,12 @@ class EkfDSKfToA(_KfToA):
 
     name = "EKF DS and KF ToA"
 
-    def __init__(
-        self,
-        setup: DopplerSetup,
-        fix: GnssFix,
-        *,
-        sigma_hz: float = 32.79,
-        q: float = 0.5,
-        adaptive: bool = False,
-        sigma_toa: float = 3e-9,
-        calibrate: bool = True,
-        **kw,
-    ) -> None:
-        self._init_range(setup, fix, q, sigma_toa, calibrate)
+    def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
         self.ekf = _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw)
 
-    def step(self, doppler, toa=None) -> np.ndarray:
+    def _approach_speed(self, doppler) -> float:
         self.ekf.step(doppler)
-        return self._advance(self.ekf.approach_speed, toa)
+        return self.ekf.approach_speed
 
     def speed(self) -> float:
         return float(np.linalg.norm(self.ekf.velocity))
