@@ -332,6 +332,20 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 #   uncertainty rather than its $\sigma_P = 10$ m.
 # - **Drive length.** 29 epochs per drive (40 m at 50 km/h), so start-up transients weigh in the
 #   averages.
+# - **Why, here, fewer paths track better (NoRRMs beats L on the straight drive).** All paths
+#   fall in one delay bin (100 MHz: about 3 m) and one Doppler bin (12 symbols), so only the
+#   10 x 10 array's angles tell them apart. The road bounce arrives 4-8 deg from the LoS, about
+#   the 5 deg our design assumes for angle noise; the ceiling path sits 3 cm behind the LoS. With
+#   LoS and RRMs present the CPD merges or misplaces these near-coincident paths (the ceiling is
+#   lost in over half the epochs, and the leftover component is spurious), and association hands
+#   reflections to the UE track: in L the road path, not the LoS, updates the UE in most epochs
+#   beyond 35 m; in N the RRM paths do so in a quarter of the epochs between 20 and 30 m. With LoS
+#   and RRMs gone, two well-separated paths remain (ceiling and road) and the CPD extracts them
+#   almost exactly. Removing, in the simulation, only the mis-resolved ceiling/spurious estimates
+#   (L) or only the RRM estimates (N) brings both to about the NoRRMs error. In the paper's ray
+#   tracer the paths were better separated; the ordering L < N < NoRRMs depends on that.
+#   (A semicircular tunnel with the BS at the crown has no side-wall specular path in the
+#   cross-section: the only wall-like bounce is the ceiling facet next to the crown.)
 #
 # ## Exercises
 #
