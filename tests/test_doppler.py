@@ -344,3 +344,13 @@ def test_range_kf_step_is_eq_17_to_21_by_hand(setup):
     d_post = d_pred + K * (z - H * d_pred)  # eq. 20
     assert got == pytest.approx(d_post, rel=1e-12)
     assert kf.kf.P[0, 0] == pytest.approx((1 - K * H) * P_pred, rel=1e-9)  # eq. 21
+
+
+def test_cv_model_is_bitwise_the_tracking_cv_model_and_allows_zero_q():
+    from tunnelkit.tracking.cv import cv_process_noise, cv_transition
+
+    F, Q = dp.cv_model(0.032, 0.5)
+    assert np.array_equal(F, cv_transition(0.032)) and np.array_equal(
+        Q, cv_process_noise(0.032, 0.5)
+    )
+    assert np.array_equal(dp.cv_model(0.032, 0.0)[1], np.zeros((4, 4)))

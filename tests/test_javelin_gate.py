@@ -87,3 +87,24 @@ def test_greedy_and_global_nearest_neighbour_differ_where_they_should():
             assert all(e[i, j] < 11.34 for i, j in pairs)
         g = global_nearest_neighbour(_costs(e))
         assert len(g) >= len(greedy_nearest_neighbour(_costs(e)))
+
+
+def test_association_gate_matches_chi_square_gate_accepts():
+    """association_costs gates with the same quantiles as ChiSquareGate.accepts (3 and 2 dof)."""
+    from tunnelkit.tracking.javelin.associate import association_costs
+    from tunnelkit.tracking.javelin.measurement import PathMeasurements, track_model
+
+    x = np.array([-20.0, 1.5, 1.0, -4.5, 1.0])
+    pred, J = track_model(x)
+    rng = np.random.default_rng(4)
+    n = 6
+    meas = PathMeasurements.from_arrays(
+        pred[rng.integers(0, 2, n), 0] + 0.05 * rng.standard_normal(n),
+        pred[rng.integers(0, 2, n), 1] + 0.05 * rng.standard_normal(n),
+        np.where(np.arange(n) % 2, 20.0 + rng.standard_normal(n), np.nan),
+    )
+    gate = ChiSquareGate(0.99)
+    R3 = np.diag([0.03**2, 0.03**2, 1.5**2])
+    c = association_costs(pred, J, np.eye(5), meas, R3, gate)
+    np.testing.assert_array_equal(c.gated, gate.accepts(c.eta2, c.dof[None, :]))
+    assert set(c.dof.tolist()) == {2, 3}

@@ -204,3 +204,23 @@ def test_site_inlines_figures_without_a_cdn():
     page = out["data"]["text/html"]
     assert "Plotly.newPlot" in page and 'id="fig-07-0-0-0"' in page and "https://" not in page
     assert "widgets" not in nb.metadata
+
+
+def test_site_inlines_explorers_as_snapshots_with_a_note():
+    import ipywidgets as widgets
+
+    site = load_tool("site")
+    fw = go.FigureWidget(go.Scatter(x=[1, 2], y=[3, 4]))
+    with_fig = nbformat.from_dict(
+        _saved_widget_notebook(fw, widgets.VBox([widgets.IntSlider(), fw]), "explorer")
+    )
+    assert site.inline_figures(with_fig, "02") == 1
+    page = with_fig.cells[0].outputs[0]["data"]["text/html"]
+    assert 'id="fig-02-0-0-0"' in page and "Plotly.newPlot" in page
+    assert page.endswith("</p>") and "make present NB=02" in page
+    slider = widgets.VBox([widgets.IntSlider()])
+    no_fig = nbformat.from_dict(_saved_widget_notebook(fw, slider, "explorer"))
+    assert site.inline_figures(no_fig, "02") == 0
+    (only,) = no_fig.cells[0].outputs[0]["data"].values()
+    assert "tk-static-note" in only and "Plotly.newPlot" not in only
+    assert "widgets" not in with_fig.metadata and "widgets" not in no_fig.metadata

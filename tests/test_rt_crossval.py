@@ -222,7 +222,7 @@ def test_crossval_truck_blocks_alike(tmp_path):
     rt.require_sionna()
     sc = tk.load_scenario("italiano2026-straight")
     tun = sc.tunnel().with_blockers(propagation.truck_box(20.0, -2.5))
-    arrs = [rt.lower_into_tunnel(tun, a)[0] for a in propagation.scenario_arrays(sc)]
+    arrs = inside_arrays(sc, tun)
     traj = sc.trajectory(sc.tunnel())
     for k in (0, 9):
         ue, v = traj.position[k], traj.velocity[k]
@@ -240,10 +240,7 @@ def test_user_scene_file_traces_like_the_tunnel(tmp_path):
     sc = tk.load_scenario("italiano2026-straight")
     tun = sc.tunnel()
     xml = rt.export_tunnel(tun, tmp_path / "blender", name="user").xml
-    arr = propagation.select_array(
-        [rt.lower_into_tunnel(tun, a)[0] for a in propagation.scenario_arrays(sc)],
-        [32.5, -2.5, 1.5],
-    )
+    arr = propagation.select_array(inside_arrays(sc, tun), [32.5, -2.5, 1.5])
     ue, v = [32.5, -2.5, 1.5], [-13.89, 0.0, 0.0]
     img = rt.compute_paths(tun, arr, ue, v, fc=5.9e9)
     usr = rt.compute_paths(str(xml), arr, ue, v, fc=5.9e9, engine="sionna")

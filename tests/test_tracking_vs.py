@@ -266,3 +266,12 @@ def test_tswls_velocity_spans_missed_epochs(exp_hi):
     assert np.allclose(run[0], x0) and np.allclose(run[1, 2:], x0[2:])  # prior until 2nd fix
     assert np.allclose(run[1:, :2], truth[[1, 2, 2, 4, 4, 4, 7, 8], :2], atol=1e-6)  # held fixes
     assert np.allclose(run[2:, 2:], truth[2:, 2:], atol=1e-5)
+
+
+def test_cv_process_noise_allows_zero_q_but_simulate_cv_refuses_it():
+    """q = 0 is the noise-free CV model (Halili's cv_model builds on it); sampling needs q > 0."""
+    assert np.array_equal(cv_process_noise(0.1, 0.0), np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="q: must be > 0"):
+        simulate_cv([0, 0, 1, 1], 0.1, 0.0, 3, np.random.default_rng(0))
+    with pytest.raises(ValueError, match="q: must be >= 0"):
+        cv_process_noise(0.1, -1.0)

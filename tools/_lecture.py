@@ -40,6 +40,8 @@ HEADLINE = re.compile(r"^\s*#\s*headline:\s*([A-Za-z0-9][A-Za-z0-9_.-]*)\s*$", r
 PLOTLY_MIME = "application/vnd.plotly.v1+json"
 WIDGET_MIME = "application/vnd.jupyter.widget-view+json"
 WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
+#: Debian's Chromium: kaleido (tools/figures.py) and the browser tests drive it.
+CHROMIUM = "/usr/bin/chromium"
 
 
 class LectureError(RuntimeError):
@@ -376,6 +378,23 @@ def widget_figures(
     return found
 
 
+def output_figures(
+    output: dict[str, Any], states: dict[str, dict[str, Any]], live: dict[str, dict[str, Any]]
+) -> tuple[list[dict[str, Any]], bool]:
+    """The plotly figures one cell output displays, and whether the output is a widget.
+
+    A plotly output gives its one figure; a widget output (an explorer) the figures held by the
+    widget or its descendants (possibly none); any other output none.
+    """
+    data = output.get("data", {})
+    if PLOTLY_MIME in data:
+        fig = data[PLOTLY_MIME]
+        return [json.loads(fig) if isinstance(fig, str) else dict(fig)], False
+    if WIDGET_MIME in data:
+        return widget_figures(data[WIDGET_MIME]["model_id"], states, live), True
+    return [], False
+
+
 def figures_of(nb) -> list[FoundFigure]:
     """Every plotly figure an executed notebook displays, in order."""
     states = widget_states(nb)
@@ -387,17 +406,8 @@ def figures_of(nb) -> list[FoundFigure]:
         m = HEADLINE.search(_source(cell))
         name = m.group(1) if m else None
         for oi, o in enumerate(cell.get("outputs", [])):
-            data = o.get("data", {})
-            if PLOTLY_MIME in data:
-                fig = data[PLOTLY_MIME]
-                out.append(
-                    FoundFigure(
-                        ci, oi, json.loads(fig) if isinstance(fig, str) else dict(fig), False, name
-                    )
-                )
-            elif WIDGET_MIME in data:
-                for fig in widget_figures(data[WIDGET_MIME]["model_id"], states, live):
-                    out.append(FoundFigure(ci, oi, fig, True, name))
+            figs, widget = output_figures(o, states, live)
+            out.extend(FoundFigure(ci, oi, fig, widget, name) for fig in figs)
     return out
 
 

@@ -27,6 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _lecture import (
     BUILD,
+    CHROMIUM,
     FoundFigure,
     LectureError,
     die,
@@ -35,8 +36,6 @@ from _lecture import (
     list_notebooks,
     resolve_notebook,
 )
-
-CHROMIUM = "/usr/bin/chromium"
 
 
 def headline_files(figs: list[FoundFigure]) -> list[tuple[str, FoundFigure]]:

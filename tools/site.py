@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import html
-import json
 import shutil
 import sys
 import time
@@ -25,15 +24,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _lecture import (
     BUILD,
-    PLOTLY_MIME,
-    WIDGET_MIME,
     LectureError,
     die,
     execute,
     list_notebooks,
     live_figures,
+    output_figures,
     title_of,
-    widget_figures,
     widget_states,
 )
 
@@ -93,13 +90,9 @@ def inline_figures(nb, chapter: str) -> int:
         if cell.cell_type != "code":
             continue
         for oi, out in enumerate(cell.get("outputs", [])):
-            data = out.get("data", {})
-            figs, note = [], ""
-            if PLOTLY_MIME in data:
-                fig = data[PLOTLY_MIME]
-                figs = [json.loads(fig) if isinstance(fig, str) else dict(fig)]
-            elif WIDGET_MIME in data:
-                figs = widget_figures(data[WIDGET_MIME]["model_id"], states, live)
+            figs, widget = output_figures(out, states, live)
+            note = ""
+            if widget:
                 note = f'<p class="tk-static-note">{STATIC_NOTE.format(nb=chapter)}</p>'
                 if not figs:  # a widget without a figure: say it needs a kernel instead of nothing
                     out["data"] = {"text/html": note}
@@ -139,10 +132,11 @@ def render_chapter(
         exclude_output_prompt=True,
     )
     mode = "quick mode (small Monte-Carlo counts)" if quick else "full mode"
+    title = title_of(nb, path.stem)
     body, _ = exporter.from_notebook_node(
         nb,
         resources={
-            "metadata": {"name": title_of(nb, path.stem)},
+            "metadata": {"name": title},
             "tk_prev": prev,
             "tk_next": nxt,
             "tk_mathjax": MATHJAX_HEAD,
@@ -151,7 +145,7 @@ def render_chapter(
     )
     page = f"{path.stem}.html"
     (out_dir / page).write_text(body, encoding="utf-8")
-    return {"page": page, "title": title_of(nb, path.stem), "figures": n_figs, "seconds": t_exec}
+    return {"page": page, "title": title, "figures": n_figs, "seconds": t_exec}
 
 
 def index_html(entries: list[dict], quick: bool) -> str:

@@ -162,7 +162,8 @@ def sample_clock_bias(
     return float(out[0]) if size is None else out
 
 
-def _check_paths(paths, m: int | None) -> list:
+def _check_paths(paths) -> list:
+    """``paths`` as a non-empty list of :class:`~tunnelkit.propagation.Path` for one array."""
     from .propagation import Path
 
     paths = list(paths)
@@ -171,7 +172,9 @@ def _check_paths(paths, m: int | None) -> list:
     for i, p in enumerate(paths):
         if not isinstance(p, Path):
             raise TypeError(f"paths[{i}]: expected a propagation.Path, got {type(p).__name__}")
-        if m is not None and p.lengths.shape[0] != m:
+    m = paths[0].lengths.shape[0]
+    for i, p in enumerate(paths):
+        if p.lengths.shape[0] != m:
             raise ValueError(f"paths[{i}]: traced for {p.lengths.shape[0]} antennas, expected {m}")
     return paths
 
@@ -195,9 +198,7 @@ def channel_tensor(
         raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
     if model not in _MODELS:
         raise ValueError(f"model: expected one of {_MODELS}, got {model!r}")
-    paths = _check_paths(paths, None)
-    m = paths[0].lengths.shape[0]
-    _check_paths(paths, m)
+    paths = _check_paths(paths)
     bias = float(finite_array("clock_bias", clock_bias, ndim=0))
     nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=2)
     nt = config.n_symbols if n_symbols is None else integer("n_symbols", n_symbols, minimum=2)

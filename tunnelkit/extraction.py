@@ -406,14 +406,12 @@ def refine_joint(H, mu_f, mu_t, n_steps: int = 6):
     approaches ``crlb_paths(spatial="free")`` where per-column estimates (eq. 13) do not.
     Returns ``(mu_f, mu_t, A)``.
     """
-    _M, nf, nt = H.shape
+    M, nf, nt = H.shape
     s = np.arange(nf)[:, None]
     k = np.arange(nt)[:, None]
     mu = np.concatenate([np.asarray(mu_f, float), np.asarray(mu_t, float)])
     L = mu.size // 2
     x2 = float(np.vdot(H, H).real)
-
-    M = H.shape[0]
     Hm = H.reshape(M * nf, nt)
 
     def fit(m):
@@ -739,8 +737,6 @@ def extract_paths(
         A = Q @ Ac
         alpha = A[0].copy()
         bs = A / A[0][None, :]
-    elif refine not in ("none", "column"):
-        raise ValueError(f"refine: expected 'joint', 'column' or 'none', got {refine!r}")
     d = -C / (2 * np.pi * df) * mu_f  # eq. 14
     v = C / (2 * np.pi * fc * T0) * mu_t  # eq. 15
     delta = C / (2 * np.pi * fc) * unwrap_spatial(bs, pos)  # eq. 16

@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from . import arrays
-from ._validate import finite_array, integer, positive
+from ._validate import finite_array, integer
 from .constants import C, wavelength
 
 __all__ = [
@@ -229,7 +229,7 @@ def mismatch_profile(positions, R, W, y_u, fc, *, z_u=0.0) -> np.ndarray:
         raise ValueError(
             f"positions: expected 3 coordinates in the last axis, got shape {pos.shape}"
         )
-    lam = wavelength(float(positive("fc", fc)))
+    lam = wavelength(fc)
     R, W, y_u, z_u = (
         float(v) for v in (_real("R", R), _real("W", W), _real("y_u", y_u), _real("z_u", z_u))
     )
@@ -248,7 +248,7 @@ def phase_mismatch(M: int, R: float, W: float, y_u: float, fc: float, *, z_u: fl
     """
     M = integer("M", M, minimum=2)
     _geometry(R, W, y_u, z_u)
-    fc, _ = _fc_eps(fc, 1.0)
+    fc = _real("fc", fc, pos=True)
     return float(
         np.max(np.abs(mismatch_profile(ula_positions(M, float(fc)), R, W, y_u, fc, z_u=z_u)))
     )
@@ -272,7 +272,7 @@ def phase_mismatch_ura(
     """
     M = integer("M", M, minimum=2)
     _geometry(R, W, y_u, z_u)
-    fc, _ = _fc_eps(fc, 1.0)
+    fc = _real("fc", fc, pos=True)
     pos = ura_positions(M, float(fc), N=N, tilt=tilt)
     return float(np.max(np.abs(mismatch_profile(pos, R, W, y_u, fc, z_u=z_u))))
 
@@ -331,11 +331,13 @@ def mmax_nonparaxial(R, W, y_u, fc, eps_phi, *, z_u=0.0):
     """
     R, W, y_u, z_u = _geometry(R, W, y_u, z_u)
     fc, eps = _fc_eps(fc, eps_phi)
-    lam = C / fc
+    return _out(_nonparaxial(R, W, y_u, z_u, C / fc, eps))
+
+
+def _nonparaxial(R, W, y_u, z_u, lam, eps):
+    """:func:`mmax_nonparaxial` on validated inputs (also the exact searches' first guess)."""
     rho = np.sqrt(R**2 + (2.0 * W - y_u) ** 2 + z_u**2)
-    return _out(
-        1.0 + 2.0 * np.sqrt(eps * rho**3 * W / (lam * np.pi * np.abs(W - y_u) * (R**2 + z_u**2)))
-    )
+    return 1.0 + 2.0 * np.sqrt(eps * rho**3 * W / (lam * np.pi * np.abs(W - y_u) * (R**2 + z_u**2)))
 
 
 def aperture(M, fc):
@@ -383,8 +385,7 @@ def _mmax_exact_flat(R, W, y_u, z_u, lam, eps, m_limit: int) -> np.ndarray:
     a = 2.0 * W - y_u
     pv = np.stack([R, a, z_u], axis=-1)
     ps = pv * (W / a)[:, None]
-    rho = np.linalg.norm(pv, axis=-1)
-    guess = 1.0 + 2.0 * np.sqrt(eps * rho**3 * W / (lam * np.pi * (W - y_u) * (R**2 + z_u**2)))
+    guess = _nonparaxial(R, W, y_u, z_u, lam, eps)
     need = np.clip(np.ceil(1.25 * guess) + 8, 32, m_limit).astype(np.int64)
     order = np.argsort(need, kind="stable")
     budget = 2_000_000  # antenna-geometry pairs evaluated per block
@@ -482,7 +483,7 @@ def mmax_exact_ura(
     lam = C / fc
     pv = vue(R, W, y_u, z_u)
     ps = reference_specular_point(R, W, y_u, z_u)
-    guess = float(mmax_nonparaxial(R, W, y_u, fc, eps, z_u=z_u))
+    guess = float(_nonparaxial(R, W, y_u, z_u, lam, eps))
     K = int(min(m_limit, max(16, math.ceil(1.25 * guess) + 8)))
     while True:
         ph = np.abs(_mismatch(pv, ps, ura_positions(K, fc, tilt=tilt), lam))

@@ -28,6 +28,7 @@ Sign conventions (pinned by tests): ``range_rate`` is the time derivative of the
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -134,9 +135,9 @@ class Facet:
         """Centre of the rectangle."""
         return self.corner + 0.5 * (self.edge_u + self.edge_v)
 
-    @property
+    @cached_property
     def plane(self) -> Plane:
-        """The infinite plane, normal pointing into the tunnel."""
+        """The infinite plane, normal pointing into the tunnel (built once per facet)."""
         return Plane(self.normal, -float(self.normal @ self.corner), name=self.name)
 
     def contains(self, p, tol: float = 1e-9) -> np.ndarray:
@@ -182,12 +183,10 @@ class Box:
             inv = 1.0 / d
             t1 = (self.lo - a) * inv
             t2 = (self.hi - a) * inv
-        tmin = np.where(
-            d == 0, np.where((a >= self.lo) & (a <= self.hi), -np.inf, np.inf), np.minimum(t1, t2)
-        )
-        tmax = np.where(
-            d == 0, np.where((a >= self.lo) & (a <= self.hi), np.inf, -np.inf), np.maximum(t1, t2)
-        )
+        # a segment parallel to a slab never leaves it if it starts inside, never enters otherwise
+        inside = (a >= self.lo) & (a <= self.hi)
+        tmin = np.where(d == 0, np.where(inside, -np.inf, np.inf), np.minimum(t1, t2))
+        tmax = np.where(d == 0, np.where(inside, np.inf, -np.inf), np.maximum(t1, t2))
         t_enter = np.max(tmin, axis=-1)
         t_exit = np.min(tmax, axis=-1)
         return (t_enter <= t_exit) & (t_exit >= 0.0) & (t_enter <= 1.0)
@@ -446,7 +445,9 @@ def _make_path(kind, surface, skind, source, point, ue, src_vel, array, fc, gamm
     leg = float(np.linalg.norm(ue - point))
     lengths_srnf = leg + np.linalg.norm(point - ant, axis=-1) if kind != "los" else lengths
     d0 = float(lengths[0])
-    u = (point - array.origin) / np.linalg.norm(point - array.origin)
+    to_point = point - array.origin
+    dist = np.linalg.norm(to_point)
+    u = to_point / dist
     rr = float((source - array.origin) @ src_vel / d0)
     vel = -rr
     az, el = _angles(u)
@@ -464,7 +465,7 @@ def _make_path(kind, surface, skind, source, point, ue, src_vel, array, fc, gamm
         array.dir_to_local(u),
         az,
         el,
-        float(np.linalg.norm(point - array.origin)),
+        float(dist),
         rr,
         vel,
         fc * vel / C,

@@ -143,20 +143,9 @@ print("wrapped mean bearing:", round(float(m1.z_mean(sig, w)[1]), 4), "rad")
 # %%
 Z1, x01 = exp.simulate(1, np.random.default_rng(4))
 for prop in ("carried", "conditional"):
-    f = upf.UnscentedParticleFilter(
-        m,
-        x01[0],
-        exp.P0,
-        rng=np.random.default_rng(1),
-        n_particles=200,
-        proposal=prop,
-        resample_threshold=1e-9,
+    ess = upf.one_epoch_ess(
+        m, Z1[0], x01[0], exp.P0, rng=np.random.default_rng(1), proposal=prop, epochs=30
     )
-    ess = []
-    for k in range(30):
-        f.step(Z1[0, k], first=(k == 0))
-        ess.append(upf.effective_sample_size(f.weights))
-        f.log_w[:] = -np.log(200)  # look at one epoch's weights at a time
     print(f"{prop:11s}: median ESS of one epoch's weights = {np.median(ess[5:]):6.1f} of 200")
 
 # %% [markdown]

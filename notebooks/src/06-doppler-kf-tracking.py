@@ -231,20 +231,8 @@ print({k: round(v, 1) for k, v in r_est.items()}, "(true R = 400)")
 # the pass. On a noise-free drive:
 
 # %%
-clean = dv.make_drive(
-    cfg.replace(
-        doppler_noise_hz=0.0,
-        toa_noise_s=0.0,
-        doppler_bias_hz=0.0,
-        toa_bias_m=0.0,
-        outlier_prob=0.0,
-        clock_offset_s=0.0,
-        clock_drift=0.0,
-        cfo_walk_hz=0.0,
-        reflection_coeff=0.0,
-        speed_amplitude=0.0,
-    )
-)
+# every random error and clock effect off (dv.IDEAL), single path, constant speed
+clean = dv.make_drive(cfg, **dv.IDEAL, reflection_coeff=0.0, speed_amplitude=0.0)
 clean_meas = dv.measure(clean, np.random.default_rng(0))
 exact = dv.GnssFix(clean.position[0].copy(), clean.velocity[0].copy(), 0.5, 0.05)
 clean_tracks = dp.run_approaches(clean, clean_meas, exact, sigma_hz=1.0)

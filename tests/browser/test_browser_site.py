@@ -9,13 +9,11 @@ from __future__ import annotations
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import pytest
-from _lecture import HOST, free_port, list_notebooks, serving
+from _lecture import BUILD, HOST, ROOT, free_port, list_notebooks, serving
 
-ROOT = Path(__file__).resolve().parents[2]
-SITE = ROOT / "build" / "browser-site"
+SITE = BUILD / "browser-site"
 
 
 @pytest.fixture(scope="module")

@@ -11,12 +11,9 @@ from __future__ import annotations
 import json
 import re
 import sys
-from pathlib import Path
 
 import pytest
-from _lecture import HOST, alive, child_pids, free_port, resolve_notebook, serving
-
-ROOT = Path(__file__).resolve().parents[2]
+from _lecture import BUILD, HOST, ROOT, alive, child_pids, free_port, resolve_notebook, serving
 
 #: the explorer under test: notebook, slider label, how to read the verdict from the figure
 TARGET = {"notebook": "02", "slider": "M", "verdict": re.compile(r"SR-NF (?:not )?valid\b[^<\n]*")}
@@ -63,7 +60,7 @@ def voila_url():
     nb = resolve_notebook(TARGET["notebook"])
     port = free_port()
     url = f"http://{HOST}:{port}/"
-    log = ROOT / "build" / "artifacts" / f"voila-{nb.stem[:2]}.log"
+    log = BUILD / "artifacts" / f"voila-{nb.stem[:2]}.log"
     log.parent.mkdir(parents=True, exist_ok=True)
     cmd = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick", f"--port={port}"]
     with serving(cmd, url + "api", log=log, timeout=120) as proc:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import plotly.graph_objects as go
@@ -65,14 +66,13 @@ def tunnel3d_figure(
         u = f.edge_u.copy()
         if abs(u[0]) > 0:  # clip the extrusion along x
             c[0], u[0] = xr[0], xr[1] - xr[0]
-        clipped = type(f)(c, u, f.edge_v, f.normal, name=f.name, kind=f.kind, material=f.material)
-        col = "#bdbdbd" if f.kind != "road" else "#636363"
+        road = f.kind == "road"
         fig.add_trace(
             _facet_mesh(
-                clipped,
-                col,
-                0.12 if f.kind != "road" else 0.35,
-                "tunnel facets" if f.kind != "road" else "road",
+                replace(f, corner=c, edge_u=u),
+                "#636363" if road else "#bdbdbd",
+                0.35 if road else 0.12,
+                "road" if road else "tunnel facets",
                 i in (0, len(tunnel.facets) - 1),
             )
         )
@@ -187,26 +187,21 @@ def factors_figure(
     )
     sp = unwrapped if unwrapped is not None else np.unwrap(np.angle(bs), axis=0)
     for j_ in range(bf.shape[1]):
-        col = f"C{j_}"
-        fig.add_scatter(y=sp[:, j_], mode="lines", name=f"path {j_}", legendgroup=col, row=1, col=1)
-        fig.add_scatter(
-            y=np.unwrap(np.angle(bf[:, j_])),
-            mode="lines",
-            name=f"path {j_}",
-            legendgroup=col,
-            showlegend=False,
-            row=1,
-            col=2,
+        panels = (
+            (sp[:, j_], "lines"),
+            (np.unwrap(np.angle(bf[:, j_])), "lines"),
+            (np.unwrap(np.angle(bt[:, j_])), "lines+markers"),
         )
-        fig.add_scatter(
-            y=np.unwrap(np.angle(bt[:, j_])),
-            mode="lines+markers",
-            name=f"path {j_}",
-            legendgroup=col,
-            showlegend=False,
-            row=1,
-            col=3,
-        )
+        for col, (y, mode) in enumerate(panels, start=1):
+            fig.add_scatter(
+                y=y,
+                mode=mode,
+                name=f"path {j_}",
+                legendgroup=f"C{j_}",
+                showlegend=None if col == 1 else False,  # one legend entry per path
+                row=1,
+                col=col,
+            )
     fig.update_xaxes(title_text="antenna m", row=1, col=1)
     fig.update_xaxes(title_text="tone s", row=1, col=2)
     fig.update_xaxes(title_text="symbol k", row=1, col=3)

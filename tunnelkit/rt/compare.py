@@ -2,12 +2,26 @@
 
 from __future__ import annotations
 
+import dataclasses
+import time
+
 import numpy as np
 
 from ..constants import C
 from ..propagation import Path, Tunnel3D
 
 __all__ = ["compare_paths", "lower_into_tunnel", "plate_occluders", "time_engines", "worst_errors"]
+
+
+#: The difference columns of :func:`compare_paths` (NaN unless both engines found the path).
+_DIFF_COLS = (
+    "|d delay| [s]",
+    "|d az| [deg]",
+    "|d el| [deg]",
+    "|d Doppler| [Hz]",
+    "|d point| [m]",
+    "max |d length_m| [m]",
+)
 
 
 def _key(p: Path) -> tuple[str, str]:
@@ -53,30 +67,17 @@ def compare_paths(image: list[Path], other: list[Path]) -> list[dict]:
         ref = p or q
         row["delay [ns]"] = ref.length / C * 1e9
         if p and q:
-            row.update(
-                {
-                    "|d delay| [s]": abs(p.length - q.length) / C,
-                    "|d az| [deg]": abs(np.degrees(np.angle(np.exp(1j * (p.azimuth - q.azimuth))))),
-                    "|d el| [deg]": abs(np.degrees(p.elevation - q.elevation)),
-                    "|d Doppler| [Hz]": abs(p.doppler - q.doppler),
-                    "|d point| [m]": float(np.max(np.abs(p.point - q.point))),
-                    "max |d length_m| [m]": float(np.max(np.abs(p.lengths - q.lengths))),
-                }
+            diffs = (
+                abs(p.length - q.length) / C,
+                abs(np.degrees(np.angle(np.exp(1j * (p.azimuth - q.azimuth))))),
+                abs(np.degrees(p.elevation - q.elevation)),
+                abs(p.doppler - q.doppler),
+                float(np.max(np.abs(p.point - q.point))),
+                float(np.max(np.abs(p.lengths - q.lengths))),
             )
+            row.update(zip(_DIFF_COLS, diffs, strict=True))
         else:
-            row.update(
-                {
-                    k: float("nan")
-                    for k in (
-                        "|d delay| [s]",
-                        "|d az| [deg]",
-                        "|d el| [deg]",
-                        "|d Doppler| [Hz]",
-                        "|d point| [m]",
-                        "max |d length_m| [m]",
-                    )
-                }
-            )
+            row.update(dict.fromkeys(_DIFF_COLS, float("nan")))
         row["|Gamma| image"] = abs(p.reflection_coefficient) if p else float("nan")
         row["|Gamma| sionna"] = abs(q.reflection_coefficient) if q else float("nan")
         rows.append(row)
@@ -86,8 +87,7 @@ def compare_paths(image: list[Path], other: list[Path]) -> list[dict]:
 def worst_errors(rows: list[dict]) -> dict[str, float]:
     """Largest difference per column over the rows found by both engines."""
     both = [r for r in rows if r["found"] == "both"]
-    cols = [k for k in (both[0] if both else {}) if k.startswith("|d") or k.startswith("max |d")]
-    return {k: max(r[k] for r in both) for k in cols}
+    return {k: max(r[k] for r in both) for k in _DIFF_COLS} if both else {}
 
 
 def time_engines(
@@ -106,8 +106,6 @@ def time_engines(
     The Sionna engine is built (scene export + load) and warmed up (JIT compilation) before the
     timed runs, so the times are per epoch in steady state. ``options`` go to the Sionna engine.
     """
-    import time
-
     from . import compute_paths
 
     out = {}
@@ -130,14 +128,9 @@ def lower_into_tunnel(tunnel: Tunnel3D, array, *, step: float = 0.05):
     up to 4.998 m, above the 12-facet ceiling (4.970 m at y = 0.229 m; even the circle is only 4.995 m there): a ray tracer sees those
     elements behind the concrete. Returns ``(array, shift)``.
     """
-    from ..arrays import ArrayGeometry
-
     shift = 0.0
     while not np.all(tunnel.contains(array.world - [0.0, 0.0, shift])):
         shift += step
         if shift > tunnel.height:
             raise ValueError("array: cannot be moved inside the tunnel by lowering it")
-    moved = ArrayGeometry(
-        array.local, array.origin - [0.0, 0.0, shift], array.azimuth, array.elevation, array.name
-    )
-    return moved, shift
+    return dataclasses.replace(array, origin=array.origin - [0.0, 0.0, shift]), shift

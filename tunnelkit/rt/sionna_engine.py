@@ -31,8 +31,7 @@ path ``(kind, surface)`` to the (M,) mask of antennas at which Sionna traced it.
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path as FsPath
 
 import numpy as np
@@ -40,14 +39,13 @@ import numpy as np
 from .._validate import integer, positive, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
-from ..propagation import Path, Tunnel3D
+from ..propagation import Path, Tunnel3D, _angles
 from . import require_sionna
 from .mitsuba import MitsubaScene, SceneError, export_tunnel, read_scene
 
 __all__ = ["SionnaEngine", "load_sionna_scene"]
 
 _ALL_KINDS = ("los", "wall", "ceiling", "road", "rrm")
-_PATH_FIELDS = {f.name for f in fields(Path)}
 
 
 def load_sionna_scene(scene: MitsubaScene | str | FsPath, *, fc: float):
@@ -152,23 +150,17 @@ class SionnaEngine:
         self.scene.rx_array = srt.PlanarArray(
             num_rows=1, num_cols=1, pattern="iso", polarization="V"
         )
-        self._surface_by_id: dict[int, tuple[str, str]] = {}
-        for name, obj in self.scene.objects.items():
-            info = next(
-                (
-                    s
-                    for sid, s in self.mitsuba.surfaces.items()
-                    if srt.SceneObject.shape_id_to_name(sid) == name
-                ),
-                None,
-            )
-            label, kind = (info.name, info.kind) if info else (name, "surface")
-            self._surface_by_id[int(obj.object_id)] = (label, kind)
+        by_name: dict[str, tuple[str, str]] = {}
+        for sid, info in self.mitsuba.surfaces.items():  # the first shape of a name wins
+            by_name.setdefault(srt.SceneObject.shape_id_to_name(sid), (info.name, info.kind))
+        self._surface_by_id: dict[int, tuple[str, str]] = {
+            int(obj.object_id): by_name.get(name, (name, "surface"))
+            for name, obj in self.scene.objects.items()
+        }
         self._solver = srt.PathSolver(deterministic=True)
         self._n_rx = 0
         self.last_gaps = 0
         self.last_traced: dict[tuple[str, str], np.ndarray] = {}
-        self.last_solve_s = 0.0
 
     # --- devices ------------------------------------------------------------------------------
     def _place(self, array: ArrayGeometry, ue: np.ndarray, vel: np.ndarray) -> None:
@@ -197,7 +189,6 @@ class SionnaEngine:
     def _solve(self) -> _RawPaths:
         from sionna.rt.constants import InteractionType
 
-        t0 = time.perf_counter()
         budget = self.max_num_paths_per_src or max(1000, 100 * self._n_rx)
         p = self._solver(
             self.scene,
@@ -228,7 +219,6 @@ class SionnaEngine:
             doppler=sq(p.doppler).astype(float),
             a=sq(ar) + 1j * sq(ai),
         )
-        self.last_solve_s = time.perf_counter() - t0
         bad = (
             raw.valid
             & (raw.inter != InteractionType.NONE)
@@ -320,30 +310,30 @@ class SionnaEngine:
             vel = C * fd / self.fc
             gain = complex(raw.a[0, j] * np.exp(-2j * np.pi * self.fc * raw.tau[0, j]))
             gamma = gain * 4 * np.pi * d0 / lam * np.exp(2j * np.pi * d0 / lam)
-            az = float(np.arctan2(u[1], u[0]))
-            el = float(np.arctan2(u[2], np.hypot(u[0], u[1])))
-            values = dict(
-                kind="los" if is_los else "reflection",
-                surface=label,
-                surface_kind=kind,
-                source=source,
-                point=point,
-                length=d0,
-                lengths=lengths,
-                lengths_srnf=lengths_srnf,
-                direction=u,
-                direction_local=array.dir_to_local(u),
-                azimuth=az,
-                elevation=el,
-                kappa_srnf=float(np.linalg.norm(point - array.origin)),
-                range_rate=-vel,
-                velocity=vel,
-                doppler=fd,
-                reflection_coefficient=complex(gamma),
-                gain=gain,
-                ue=ue.copy(),
+            az, el = _angles(u)
+            out.append(
+                Path(
+                    kind="los" if is_los else "reflection",
+                    surface=label,
+                    surface_kind=kind,
+                    source=source,
+                    point=point,
+                    length=d0,
+                    lengths=lengths,
+                    lengths_srnf=lengths_srnf,
+                    direction=u,
+                    direction_local=array.dir_to_local(u),
+                    azimuth=az,
+                    elevation=el,
+                    kappa_srnf=float(np.linalg.norm(point - array.origin)),
+                    range_rate=-vel,
+                    velocity=vel,
+                    doppler=fd,
+                    reflection_coefficient=complex(gamma),
+                    gain=gain,
+                    ue=ue.copy(),
+                )
             )
-            out.append(Path(**{k: v for k, v in values.items() if k in _PATH_FIELDS}))
         self.last_gaps = gaps
         los = [p for p in out if p.kind == "los"]
         refl = sorted((p for p in out if p.kind != "los"), key=lambda p: p.length)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from filterpy.common import Q_continuous_white_noise
 
-from .._validate import finite_array, integer, positive, rng_or_error
+from .._validate import finite_array, integer, nonnegative, positive, rng_or_error
 
 __all__ = ["STATE_DIM", "cv_process_noise", "cv_transition", "simulate_cv"]
 
@@ -31,10 +31,11 @@ def cv_transition(period: float) -> np.ndarray:
 def cv_process_noise(period: float, q: float) -> np.ndarray:
     """Process-noise covariance ``Q_k`` of eq. 40 for white-noise acceleration of density ``q``.
 
-    Per axis ``q [[T^3/3, T^2/2], [T^2/2, T]]``, ordered ``[x, y, vx, vy]`` like ``Phi``.
+    Per axis ``q [[T^3/3, T^2/2], [T^2/2, T]]``, ordered ``[x, y, vx, vy]`` like ``Phi``;
+    ``q = 0`` gives the zero matrix (no process noise).
     """
     t = positive("period", period)
-    q = positive("q", q)
+    q = nonnegative("q", q)
     return np.asarray(
         Q_continuous_white_noise(dim=2, dt=t, spectral_density=q, block_size=2, order_by_dim=False),
         dtype=float,
@@ -52,7 +53,8 @@ def simulate_cv(
     x0 = finite_array("x0", x0, shape=(STATE_DIM,))
     steps = integer("steps", steps, minimum=1)
     rng = rng_or_error("rng", rng)
-    F, Q = cv_transition(period), cv_process_noise(period, q)
+    # q > 0 here: a zero Q has no Cholesky factor
+    F, Q = cv_transition(period), cv_process_noise(period, positive("q", q))
     lead = () if size is None else (integer("size", size, minimum=1),)
     L = np.linalg.cholesky(Q)
     noise = rng.standard_normal((*lead, steps - 1, STATE_DIM)) @ L.T

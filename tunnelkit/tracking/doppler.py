@@ -39,6 +39,7 @@ from scipy.stats import chi2
 from .._validate import finite_array, nonnegative, positive, probability
 from ..constants import C
 from ..drive import Drive, GnssFix, Measurements, doppler_shift, slant_range
+from .cv import cv_process_noise, cv_transition
 from .registry import register
 
 __all__ = [
@@ -122,6 +123,18 @@ def _warn(msg: str) -> None:
     warnings.warn(msg, MeasurementWarning, stacklevel=3)
 
 
+def _check_setup(setup) -> DopplerSetup:
+    if not isinstance(setup, DopplerSetup):
+        raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+    return setup
+
+
+def _check_adaptive_form(adaptive_form: str) -> str:
+    if adaptive_form not in ("posterior", "paper"):
+        raise ValueError(f"adaptive_form: must be 'posterior' or 'paper', got {adaptive_form!r}")
+    return adaptive_form
+
+
 # --- the EKF on Doppler (section 4) ---------------------------------------------------------------
 
 
@@ -129,17 +142,7 @@ def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
     """``F`` (eq. 2) and ``Q`` (eq. 3) of the constant-velocity model, state ``[x, y, v_x, v_y]``."""
     dt = positive("dt", dt)
     q = nonnegative("q", q)
-    F = np.eye(4)
-    F[0, 2] = F[1, 3] = dt
-    Q = q * np.array(
-        [
-            [dt**3 / 3, 0, dt**2 / 2, 0],
-            [0, dt**3 / 3, 0, dt**2 / 2],
-            [dt**2 / 2, 0, dt, 0],
-            [0, dt**2 / 2, 0, dt],
-        ]
-    )
-    return F, Q
+    return cv_transition(dt), cv_process_noise(dt, q)  # the same model as Jiang eq. 40-41
 
 
 def doppler_model(s, setup: DopplerSetup) -> np.ndarray:
@@ -193,17 +196,13 @@ class DopplerEKF:
         adaptive_form: str = "posterior",
         gate: float | None = None,
     ) -> None:
-        if not isinstance(setup, DopplerSetup):
-            raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+        _check_setup(setup)
         if not isinstance(fix, GnssFix):
             raise TypeError(f"fix: expected a GnssFix, got {type(fix).__name__}")
         sigma_hz = positive("sigma_hz", sigma_hz)
         q = nonnegative("q", q)
         self.a = probability("a", a, open_interval=False)
-        if adaptive_form not in ("posterior", "paper"):
-            raise ValueError(
-                f"adaptive_form: must be 'posterior' or 'paper', got {adaptive_form!r}"
-            )
+        _check_adaptive_form(adaptive_form)
         self.setup, self.adaptive, self.adaptive_form = setup, bool(adaptive), adaptive_form
         kf = ExtendedKalmanFilter(dim_x=4, dim_z=1)
         kf.F, kf.Q = cv_model(setup.dt, q)
@@ -229,7 +228,8 @@ class DopplerEKF:
             _warn("Doppler: dropped epoch (None/NaN); EKF predicted only")
             kf.update(None, self._H, self._h)
             return self.position
-        H = self._H(kf.x)
+        # the prior Jacobian is only needed by the gate and the adaptive R (kf.update makes its own)
+        H = self._H(kf.x) if self.threshold is not None or self.adaptive else None
         if self.threshold is not None:
             nu = z - float(self._h(kf.x)[0, 0])
             if nu * nu > self.threshold * float((H @ kf.P @ H.T).item() + kf.R[0, 0]):
@@ -283,16 +283,12 @@ class SpeedKF:
         a: float = 0.9,
         adaptive_form: str = "posterior",
     ) -> None:
-        if not isinstance(setup, DopplerSetup):
-            raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+        _check_setup(setup)
         sigma_hz = positive("sigma_hz", sigma_hz)
         q = nonnegative("q", q)
         u0 = float(finite_array("u0", u0, ndim=0))
         self.a = probability("a", a, open_interval=False)
-        if adaptive_form not in ("posterior", "paper"):
-            raise ValueError(
-                f"adaptive_form: must be 'posterior' or 'paper', got {adaptive_form!r}"
-            )
+        _check_adaptive_form(adaptive_form)
         self.adaptive, self.adaptive_form = bool(adaptive), adaptive_form
         kf = KalmanFilter(dim_x=1, dim_z=1)
         kf.x = np.array([[u0]])
@@ -346,8 +342,7 @@ class RangeKF:
         sigma_d0: float = 2.0,
         calibrate: bool = True,
     ) -> None:
-        if not isinstance(setup, DopplerSetup):
-            raise TypeError(f"setup: expected a DopplerSetup, got {type(setup).__name__}")
+        _check_setup(setup)
         d0 = positive("d0", d0)
         sigma_toa = positive("sigma_toa", sigma_toa)
         q = nonnegative("q", q)

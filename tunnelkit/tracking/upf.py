@@ -25,6 +25,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+from filterpy.kalman import MerweScaledSigmaPoints
 
 from .._validate import finite_array, integer, positive, probability, rng_or_error
 from .cv import STATE_DIM
@@ -42,6 +43,7 @@ __all__ = [
     "UnscentedParticleFilter",
     "effective_sample_size",
     "merwe_weights",
+    "one_epoch_ess",
     "systematic_resample",
     "ukf_proposal",
     "ukf_proposal_reference",
@@ -51,15 +53,12 @@ __all__ = [
 def merwe_weights(
     n: int, alpha: float, beta: float, kappa: float
 ) -> tuple[np.ndarray, np.ndarray, float]:
-    """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points."""
+    """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points (filterpy's Merwe weights)."""
     lam = alpha**2 * (n + kappa) - n
     if n + lam <= 0:
         raise ValueError(f"alpha, kappa: n + lambda = {n + lam} must be > 0")
-    Wm = np.full(2 * n + 1, 0.5 / (n + lam))
-    Wc = Wm.copy()
-    Wm[0] = lam / (n + lam)
-    Wc[0] = lam / (n + lam) + (1.0 - alpha**2 + beta)
-    return Wm, Wc, lam
+    pts = MerweScaledSigmaPoints(n, alpha=alpha, beta=beta, kappa=kappa)
+    return pts.Wm, pts.Wc, lam
 
 
 def ukf_proposal(
@@ -365,3 +364,39 @@ class UnscentedParticleFilter(EstimatorBase):
             f.update(Z[:, k])
             out[:, k] = f._x
         return out
+
+
+def one_epoch_ess(
+    model: VsModel,
+    Z,
+    x0,
+    P0,
+    *,
+    rng: np.random.Generator,
+    n_particles: int = 200,
+    proposal: str = "conditional",
+    epochs: int | None = None,
+) -> np.ndarray:
+    """Effective sample size of *one* epoch's weights, epoch by epoch, for one run ``Z`` (T, 2N).
+
+    The filter never resamples; after each epoch its weights are reset to uniform, so the ESS at
+    epoch k measures how well the proposal of that epoch alone matches the posterior (the
+    diagnostic of the eq. 52 trap in notebook 05). Returns (epochs,).
+    """
+    Z = np.asarray(Z, dtype=float)
+    T = Z.shape[0] if epochs is None else integer("epochs", epochs, minimum=1)
+    f = UnscentedParticleFilter(
+        model,
+        x0,
+        P0,
+        rng=rng,
+        n_particles=n_particles,
+        proposal=proposal,
+        resample_threshold=1e-9,
+    )
+    ess = np.empty(T)
+    for k in range(T):
+        f.step(Z[k], first=(k == 0))
+        ess[k] = effective_sample_size(f.weights)
+        f.log_w[:] = -np.log(f.n_particles)
+    return ess

@@ -25,6 +25,8 @@ from .base import Explorer, float_slider, int_slider
 __all__ = ["cpd_explorer", "curvature_figure", "curvature_study"]
 
 _KINDS = ("los", "wall", "road", "rrm")
+#: array sides n of the mismatch-vs-M curve (right panel)
+_SIDES = range(2, 21)
 
 
 @lru_cache(maxsize=4)
@@ -69,6 +71,13 @@ def mismatch(path, fc: float) -> float:
     return float(2 * np.pi * fc / C * np.max(np.abs(path.delta("exact") - path.delta("srnf"))))
 
 
+@lru_cache(maxsize=32)
+def _mismatch_curve(k: int, scenario: str) -> tuple[float, ...]:
+    """:func:`mismatch` of the target path for every side in ``_SIDES`` (slider-independent)."""
+    fc = _route(scenario).config.fc
+    return tuple(mismatch(_target(_paths_for(s, k, scenario)[2]), fc) for s in _SIDES)
+
+
 def curvature_study(
     side: int,
     snr_offset_db: float = 0.0,
@@ -85,7 +94,6 @@ def curvature_study(
 
     route, arr, paths = _paths_for(side, k, scenario)
     tgt = _target(paths)
-    i_t = paths.index(tgt)
     cfg = route.config
     kap = []
     for r in np.random.default_rng(seed).spawn(n_snapshots):
@@ -95,7 +103,7 @@ def curvature_study(
         est = extract_paths(
             snap.H, len(paths), arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period
         )
-        j = int(np.argmin(np.linalg.norm(est.direction - paths[i_t].direction_local, axis=1)))
+        j = int(np.argmin(np.linalg.norm(est.direction - tgt.direction_local, axis=1)))
         kap.append(est.kappa_nf[j])
     return {
         "kappa": np.array(kap),
@@ -153,14 +161,9 @@ def curvature_figure(
             row=1,
             col=1,
         )
-    sides = np.arange(2, 21)
-    mm = [
-        mismatch(_target(_paths_for(int(s), k, scenario)[2]), _route(scenario).config.fc)
-        for s in sides
-    ]
     fig.add_scatter(
-        x=sides**2,
-        y=mm,
+        x=np.array(_SIDES) ** 2,
+        y=list(_mismatch_curve(k, scenario)),
         mode="lines+markers",
         name="max phase mismatch",
         line={"color": "#9467bd"},

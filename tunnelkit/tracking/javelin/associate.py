@@ -72,7 +72,8 @@ def association_costs(
     eta2 = mahalanobis2(y, S)
     dof = np.where(has_k, 3, 2)
     thr = np.array([gate.threshold(int(k)) for k in dof])
-    return AssociationCosts(eta2, dof, gate.accepts(eta2, dof[None, :]), thr)
+    gated = np.isfinite(eta2) & (eta2 < thr)  # ChiSquareGate.accepts with the quantiles at hand
+    return AssociationCosts(eta2, dof, gated, thr)
 
 
 def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:

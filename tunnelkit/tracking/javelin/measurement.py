@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._validate import finite_array, vector
-from ...crlb import wrap_angle
+from .state import _vue_positions
 
 __all__ = [
     "JavelinWarning",
@@ -149,11 +149,6 @@ class PathMeasurements:
         return np.column_stack([c * np.cos(self.phi), c * np.sin(self.phi), np.sin(self.psi)])
 
 
-def _vue_positions(x: np.ndarray) -> np.ndarray:
-    yz = x[3:].reshape(-1, 2)
-    return np.column_stack([np.full(len(yz), x[0]), yz])
-
-
 def track_model(
     x, bs=(0.0, 0.0, 0.0), kappa_model: str = "reflector"
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -258,8 +253,3 @@ def measurement_model(
     )
     H = np.concatenate([J[:, PHI], J[:, PSI], J[:, KAPPA], J[1:, RANGE] - J[0, RANGE]])
     return h, H
-
-
-def angle_residual(z, h) -> np.ndarray:
-    """``z - h`` wrapped to ``(-pi, pi]`` (azimuth residuals across the branch cut)."""
-    return wrap_angle(np.asarray(z, dtype=float) - np.asarray(h, dtype=float))

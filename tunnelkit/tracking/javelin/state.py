@@ -25,6 +25,12 @@ def track_slice(i: int) -> slice:
     return slice(3 + 2 * (i - 1), 5 + 2 * (i - 1))
 
 
+def _vue_positions(x: np.ndarray) -> np.ndarray:
+    """3-D VUE positions ``[x_u, y_v, z_v]`` (n_vue, 3) of a state vector ``x`` (eq. 43)."""
+    yz = x[3:].reshape(-1, 2)
+    return np.column_stack([np.full(len(yz), x[0]), yz])
+
+
 @dataclass
 class JavelinState:
     """Mean ``x`` (D,), covariance ``P`` (D, D) and per-VUE bookkeeping."""
@@ -85,9 +91,7 @@ class JavelinState:
 
     def positions(self) -> np.ndarray:
         """All track positions, shape (L_hat, 3), UE first."""
-        yz = self.x[3:].reshape(-1, 2)
-        vue = np.column_stack([np.full(len(yz), self.x[0]), yz])
-        return np.vstack([self.x[:3], vue])
+        return np.vstack([self.x[:3], _vue_positions(self.x)])
 
     def copy(self) -> JavelinState:
         """A deep copy."""

@@ -24,7 +24,7 @@ from .gate import ChiSquareGate
 from .manage import ManageResult, manage_tracks
 from .measurement import JavelinWarning, PathMeasurements, track_model
 from .motion import predict, ue_velocity
-from .state import JavelinState
+from .state import JavelinState, track_slice
 from .update import joseph_update, stack_measurement
 
 __all__ = ["Javelin", "JavelinRun", "StepReport", "run_javelin"]
@@ -122,9 +122,7 @@ class Javelin:
         st = self.state
         st.x, st.P = predict(st, nu, theta, dt, cfg, sigma_speed=sig_nu)
         prior_pos, prior_ids = st.positions(), list(st.ids)
-        prior_cov = [st.P[:3, :3].copy()] + [
-            st.P[3 + 2 * k : 5 + 2 * k, 3 + 2 * k : 5 + 2 * k].copy() for k in range(st.n_vue)
-        ]
+        prior_cov = [st.P[track_slice(i), track_slice(i)].copy() for i in range(st.n_tracks)]
         costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
         geometry_ok = True
         if len(meas):
