@@ -14,7 +14,7 @@ import tensorly as tl
 from run import Case
 from tensorly.decomposition import parafac
 
-from tunnelkit import channel, extraction, propagation
+from tunnelkit import channel, coherent, extraction, propagation
 
 
 def _tensor():
@@ -42,8 +42,18 @@ def cases() -> list[Case]:
             warnings.simplefilter("ignore")
             return parafac(tl.tensor(H), L, init="svd")
 
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.extract_paths(H, L, *args)
+
     g = "extract_paths"
     return [
+        Case(
+            f"resolve_coherent L={L} (after extract_paths)",
+            lambda: coherent.resolve_coherent(H, est, *args),
+            group=g,
+            repeat=7,
+        ),
         Case(f"extract_paths L={L}, fast + joint ML refine", lambda: run(), group=g, goal_s=0.1),
         Case(
             f"extract_paths L={L}, fast + eq. 13 roots",

@@ -1,5 +1,6 @@
 """Notebook 04: one JAVELIN step (association, management, Joseph update; extraction excluded)
-and one whole epoch of the signal route (channel synthesis + CPD extraction + the step)."""
+and one whole epoch of the signal route (channel synthesis + CPD extraction + the step), with
+the paper's extraction and with coherent paths separated (``tunnelkit.coherent``)."""
 
 from __future__ import annotations
 
@@ -51,9 +52,11 @@ def cases() -> list[Case]:
     )
     ks = itertools.cycle(range(1, 20))
 
-    def signal_epoch():
+    def signal_epoch(separated: bool = False):
         k = next(ks)
         ep = route.epoch(k, sig_rng)
+        if separated:
+            ep = ex.separate_epoch(ep, route.config)
         m = ep.measurements
         paths = ex.PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False)
         v = route.trajectory.velocity[k]
@@ -81,6 +84,14 @@ def cases() -> list[Case]:
         Case(
             "signal-route epoch: synth + CPD + step",
             signal_epoch,
+            group="javelin",
+            repeat=7,
+            number=1,
+            goal_s=0.5,
+        ),
+        Case(
+            "signal-route epoch: synth + CPD + separation + step",
+            lambda: signal_epoch(separated=True),
             group="javelin",
             repeat=7,
             number=1,

@@ -72,6 +72,23 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     assert row[cols.index("paper_rmse_2d_m")] == pytest.approx(0.20)
     acols, arows = ex.ablation(drives)
     assert acols == ["design", "L", "N"] and len(arows) == len(ex.ABLATION)
+    # a second measurement route: its rows are labelled, scored and sorted after the paper's
+    cols, rows = table_rows(drives, "italiano2026_table1", separated=drives)
+    keys = [tuple(r[:3]) for r in rows]
+    assert keys.index(("JAVELIN-L", "paper", "paper")) < keys.index(
+        ("JAVELIN-L", "ours", "separated")
+    )
+    assert ("TeNFiLoc-L", "paper", "separated") in keys and (
+        "JAVELIN-N",
+        "paper",
+        "separated",
+    ) not in keys
+    row = rows[keys.index(("JAVELIN-L", "ours", "separated"))]
+    expect = ex.evaluate(drives["L"][0], ex.OURS_SEPARATED).metrics["rmse_2d_m"]
+    assert row[3] == pytest.approx(expect)
+    _, arows2 = ex.ablation(drives, separated=drives)
+    assert len(arows2) == len(ex.ABLATION) + 2
+    assert arows2[-2][1] == pytest.approx(arows[-1][1]) and arows2[-1][1] == pytest.approx(expect)
     with pytest.raises(ValueError, match=r"^method"):
         ex.evaluate(drives["L"][0], method="UKF")
 
@@ -109,6 +126,31 @@ def test_signal_route_drive_two_epochs():
     assert np.allclose(d.base_station, [0.0, 0.0, 4.8])
     with pytest.raises(KeyError):
         ex.simulate_drive("italiano2026-straight", "X", np.random.default_rng(0), n_epochs=1)
+    with pytest.raises(ValueError, match=r"^extraction"):
+        ex.simulate_drive("italiano2026-straight", "L", np.random.default_rng(0), extraction="x")
+
+
+def test_separated_drive_uses_the_same_tensors():
+    """Same seed, both routes: identical truth and V2X; where the CPD kept every path and the
+    separation changes nothing, identical measurements; the separated route loses no path."""
+    kw = {"n_epochs": 3}
+    a = ex.simulate_drive("italiano2026-straight", "L", np.random.default_rng(5), **kw)
+    b = ex.simulate_drive(
+        "italiano2026-straight", "L", np.random.default_rng(5), extraction="separated", **kw
+    )
+    assert a.extraction == "paper" and b.extraction == "separated"
+    np.testing.assert_array_equal(a.speed, b.speed)
+    np.testing.assert_array_equal(a.los, b.los)
+    matched = [int(np.sum(t >= 0)) for t in b.truth_index]
+    assert matched == [len(s) for s in b.sources]  # every true path found in every epoch
+    assert sum(matched) >= sum(int(np.sum(t >= 0)) for t in a.truth_index)
+    cols, rows = ex.path_errors([a])
+    found = {r[0]: r for r in rows}
+    assert cols[:3] == ["path", "true", "found"] and found["los"][1] == 3
+    _, rows_b = ex.path_errors([b])
+    best = {r[0]: r for r in rows_b}
+    assert best["los"][2] == 3 and best["los"][3] < found["los"][3]  # LoS: found, and sharper
+    assert best["no true path"][2] == 0
 
 
 def test_vue_prediction_skips_the_los_only_when_it_exists():

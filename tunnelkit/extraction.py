@@ -57,6 +57,7 @@ __all__ = [
     "kruskal_rank",
     "max_identifiable_rank",
     "normalize_factors",
+    "path_estimates",
     "refine_joint",
     "refine_roots",
     "solve_far_field",
@@ -744,6 +745,28 @@ def extract_paths(
     u_ff = solve_far_field(delta, pos)
     ang = angles_from_solution(x_nf, u_ff)
     near = np.isfinite(ang["kappa_nf"]) & (ang["kappa_nf"] > 0)
+    return path_estimates(
+        alpha,
+        d,
+        v,
+        ang,
+        near,
+        delta.T,
+        mu_f,
+        mu_t,
+        (bs, bf, bt),
+        res.rel_error,
+        res.n_iter,
+        res.converged,
+    )
+
+
+def path_estimates(
+    alpha, d, v, ang: dict, near, delta, mu_f, mu_t, factors, rel_error, n_iter, converged
+) -> PathEstimates:
+    """Assemble :class:`PathEstimates` sorted by ``d``: near-field paths take the eq. 19-21
+    angles and curvature of ``ang`` (:func:`angles_from_solution`), the others the far-field
+    ones (``kappa`` NaN); ``delta`` is (L, M), ``factors`` the three (., L) factor matrices."""
     direction = np.where(near[:, None], ang["dir_nf"], ang["dir_ff"])
     kappa = np.where(near, ang["kappa_nf"], np.nan)
     phi = np.where(near, ang["phi_nf"], ang["phi_ff"])
@@ -760,13 +783,13 @@ def extract_paths(
         psi[o],
         d[o] >= 0,
         ang["kappa_nf"][o],
-        delta[:, o].T,
+        delta[o],
         mu_f[o],
         mu_t[o],
-        (bs[:, o], bf[:, o], bt[:, o]),
-        res.rel_error,
-        res.n_iter,
-        res.converged,
+        tuple(B[:, o] for B in factors),
+        rel_error,
+        n_iter,
+        converged,
     )
 
 

@@ -2,7 +2,10 @@
 
 Every run simulates the drive through the signal route (image method -> SRS tensor with noise and
 clock bias -> CPD extraction -> Algorithm 1) once per condition, then scores on it JAVELIN with
-the paper's design, JAVELIN with ours (``experiment.OURS``) and TeNFiLoc.
+the paper's design, JAVELIN with ours (``experiment.OURS``) and TeNFiLoc. The same seeded drives
+go through our measurement route too (the CPD, then coherent paths separated by the array:
+``tunnelkit.coherent``), on which JAVELIN (ours) and TeNFiLoc are scored again: the tensors are
+identical, only the extraction differs.
 """
 
 from __future__ import annotations
@@ -25,9 +28,11 @@ def collect_drives(
     seed: int,
     progress: bool = False,
     n_epochs: int | None = None,
+    extraction: str = "paper",
 ) -> dict[str, list]:
     """``runs`` seeded drives per condition through the signal route (the expensive part);
-    ``n_epochs`` truncates each drive (quick mode)."""
+    ``n_epochs`` truncates each drive (quick mode); ``extraction`` as in
+    :func:`~tunnelkit.tracking.javelin.experiment.simulate_drive` (same seed, same tensors)."""
     from ..tracking.javelin import experiment as ex
 
     rngs = spawn_rngs(seed, runs * len(conditions))
@@ -36,40 +41,61 @@ def collect_drives(
     if progress:
         from tqdm.auto import tqdm
 
-        it = tqdm(it, desc=f"{scenario} drives", leave=False)
+        it = tqdm(it, desc=f"{scenario} drives ({extraction})", leave=False)
     drives: dict[str, list] = {c: [] for c in conditions}
     for cond, rng in it:
-        drives[cond].append(ex.simulate_drive(scenario, cond, rng, n_epochs=n_epochs))
+        drives[cond].append(
+            ex.simulate_drive(scenario, cond, rng, n_epochs=n_epochs, extraction=extraction)
+        )
     return drives
 
 
-def table_rows(drives: dict[str, list], reference: str) -> tuple[list[str], list[list]]:
-    """Rows ``[configuration, design, metric, paper metric, ...]``: JAVELIN with the paper's
-    design and ours on every condition, TeNFiLoc on the LoS drives; means over runs."""
+#: table rows per measurement route: (design label, method, config name in ``experiment``)
+_ROWS = {
+    "paper": (
+        ("paper", "JAVELIN", "PAPER"),
+        ("ours", "JAVELIN", "OURS"),
+        ("paper", "TeNFiLoc", ""),
+    ),
+    "separated": (("ours", "JAVELIN", "OURS_SEPARATED"), ("paper", "TeNFiLoc", "")),
+}
+
+
+def table_rows(
+    drives: dict[str, list], reference: str, separated: dict[str, list] | None = None
+) -> tuple[list[str], list[list]]:
+    """Rows ``[configuration, design, extraction, metric, paper metric, ...]``, means over runs.
+
+    On ``drives`` (the paper's extraction): JAVELIN with the paper's design and ours on every
+    condition, TeNFiLoc on the LoS drives. On ``separated`` (the same drives through our
+    extraction, optional): JAVELIN with ours (``OURS_SEPARATED``), and TeNFiLoc.
+    """
     from ..tracking.javelin import experiment as ex
 
     ref = {r["configuration"]: r for r in load_reference(reference)}
-    scores: dict[tuple[str, str], list[dict[str, float]]] = {}
-    for cond, lst in drives.items():
-        for drive in lst:
-            for design, cfg in (("paper", ex.PAPER), ("ours", ex.OURS)):
-                scores.setdefault((f"JAVELIN-{cond}", design), []).append(
-                    ex.evaluate(drive, cfg).metrics
-                )
-            if cond == "L":
-                scores.setdefault(("TeNFiLoc-L", "paper"), []).append(
-                    ex.evaluate(drive, method="TeNFiLoc").metrics
-                )
+    scores: dict[tuple[str, str, str], list[dict[str, float]]] = {}
+    routes = {"paper": drives, "separated": separated or {}}
+    for extraction, by_cond in routes.items():
+        for cond, lst in by_cond.items():
+            for drive in lst:
+                for design, method, cfg in _ROWS[extraction]:
+                    if method == "TeNFiLoc" and cond != "L":
+                        continue
+                    name = f"{method}-{cond}"
+                    config = getattr(ex, cfg) if cfg else None
+                    scores.setdefault((name, design, extraction), []).append(
+                        ex.evaluate(drive, config, method=method).metrics
+                    )
     rows = []
-    for (name, design), lst in scores.items():
+    for (name, design, extraction), lst in scores.items():
         paper = ref.get(name, {})
-        row: list = [name, design]
+        row: list = [name, design, extraction]
         for k in _METRICS:
             row += [float(np.mean([m[k] for m in lst])), paper.get(k)]
         rows.append(row)
     order = {n: i for i, n in enumerate(ref)}
-    rows.sort(key=lambda r: (order.get(r[0], 99), r[1] != "paper"))
-    cols = ["configuration", "design"]
+    rows.sort(key=lambda r: (order.get(r[0], 99), r[2] != "paper", r[1] != "paper"))
+    cols = ["configuration", "design", "extraction"]
     for k in _METRICS:
         cols += [k, f"paper_{k}"]
     return cols, rows
@@ -84,16 +110,22 @@ NOTES = [
     "NoRRMs: road markings removed with the LoS blocked (our reading of the paper).",
     "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails and holds its last fix on epochs "
     "without one.",
+    "extraction 'paper': CPD and eq. 11-24 as published; 'separated': the same tensors, then paths "
+    "merged in one CPD component separated by the array (tunnelkit.coherent, ours). On it, our "
+    "design models each path's curvature as its VUE distance (experiment.OURS_SEPARATED), the "
+    "radius of the exact wavefront; its other settings were tuned on the paper's extraction.",
 ]
 
 
 def javelin_table(
     scenario: str, reference: str, conditions: tuple[str, ...], runs: int, seed: int, progress: bool
 ) -> Report:
-    """One table: rows per configuration and design (paper / ours), the paper's numbers beside."""
+    """One table: rows per configuration, design (paper / ours) and extraction, the paper's
+    numbers beside."""
     drives = collect_drives(scenario, conditions, runs, seed, progress)
-    cols, rows = table_rows(drives, reference)
-    n_fault = sum(len(d.faults) for lst in drives.values() for d in lst)
+    separated = collect_drives(scenario, conditions, runs, seed, progress, extraction="separated")
+    cols, rows = table_rows(drives, reference, separated)
+    n_fault = sum(len(d.faults) for r in (drives, separated) for lst in r.values() for d in lst)
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}: JAVELIN vs TeNFiLoc",
         columns=cols,

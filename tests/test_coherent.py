@@ -1,0 +1,149 @@
+"""Coherent-path separation (tunnelkit.coherent): Jacobian, source fits, and the JAVELIN epoch."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from tunnelkit import arrays, channel, coherent, extraction
+
+FC = 5.9e9
+LAM = 299792458.0 / FC
+POS = arrays.ura(10, 10, LAM / 2)
+CFG = channel.SRSConfig()
+
+
+def _theta(u, kappa):
+    return [u[0], u[1], 1.0 / kappa]
+
+
+def test_steering_jacobian_matches_finite_differences():
+    th = np.array([[0.12, -0.31, 1 / 7.0], [-0.4, 0.2, 1 / 40.0]])
+    k0 = 2 * np.pi * FC / 299792458.0
+    S, dS = coherent._steering_and_jacobian(th, POS, k0)
+    np.testing.assert_allclose(S, coherent.spherical_steering(coherent.source_points(th), POS, FC))
+    h = np.array([1e-6, 1e-6, 1e-6])  # phases are ~1e3 rad: smaller steps drown in round-off
+    for n in range(2):
+        for p in range(3):
+            tp, tm = th.copy(), th.copy()
+            tp[n, p] += h[p]
+            tm[n, p] -= h[p]
+            fd = (
+                coherent.spherical_steering(coherent.source_points(tp), POS, FC)[:, n]
+                - coherent.spherical_steering(coherent.source_points(tm), POS, FC)[:, n]
+            ) / (2 * h[p])
+            np.testing.assert_allclose(dS[:, n, p], fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max())
+
+
+def test_steering_is_the_channel_spatial_factor():
+    """The steering of a VUE is ``exp(j k0 delta)`` with eq. 2's ``delta_m = d_m - d_0``."""
+    q = np.array([1.0, -2.0, 9.0])
+    delta = np.linalg.norm(q - POS, axis=1) - np.linalg.norm(q)
+    s = coherent.spherical_steering(q, POS, FC)[:, 0]
+    np.testing.assert_allclose(s, np.exp(2j * np.pi * FC / 299792458.0 * delta))
+
+
+def test_fit_one_source_from_a_rough_start():
+    q_true = _theta([0.2, 0.35], 12.0)
+    b = 0.8j * coherent.spherical_steering(coherent.source_points(q_true), POS, FC)[:, 0]
+    th, g, rel = coherent.fit_sources(b, _theta([0.23, 0.31], 30.0), POS, FC)
+    np.testing.assert_allclose(th[0], q_true, atol=1e-6)
+    assert abs(g[0] - 0.8j) < 1e-6 and rel < 1e-12
+
+
+def test_split_separates_two_coherent_sources_below_a_beamwidth():
+    """LoS-and-ceiling-like pair 0.14 apart in (u_x, u_y) (beamwidth ~ 2 / 10): one component."""
+    rng = np.random.default_rng(3)
+    t1, t2 = _theta([-0.065, 0.422], 38.3), _theta([-0.087, 0.563], 38.3)
+    S = coherent.spherical_steering(coherent.source_points([t1, t2]), POS, FC)
+    b = S @ np.array([1.0, 0.9 * np.exp(0.7j)])
+    b = b + 1e-3 * (rng.standard_normal(100) + 1j * rng.standard_normal(100))
+    b = b / b[0]
+    _, _, rel1 = coherent.fit_sources(b, _theta([-0.07, 0.48], 30.0), POS, FC)
+    assert rel1 > 1e-2  # one source cannot explain the mixture
+    th, _, rel = coherent.split_component(b, _theta([-0.07, 0.48], 30.0), POS, FC)
+    assert th.shape == (2, 3) and rel < 1e-4
+    got = th[np.argsort(th[:, 1]), :2]
+    np.testing.assert_allclose(got, [t1[:2], t2[:2]], atol=2e-3)
+
+
+def test_split_keeps_a_single_source_single():
+    rng = np.random.default_rng(4)
+    t1 = _theta([0.3, -0.1], 9.0)
+    b = coherent.spherical_steering(coherent.source_points(t1), POS, FC)[:, 0]
+    b = b + 1e-3 * (rng.standard_normal(100) + 1j * rng.standard_normal(100))
+    th, _, rel = coherent.split_component(b, _theta([0.28, -0.12], 20.0), POS, FC)
+    assert th.shape == (1, 3) and rel < 1e-4
+    np.testing.assert_allclose(th[0, :2], t1[:2], atol=1e-3)
+
+
+@pytest.fixture(scope="module")
+def javelin_epoch():
+    """Straight drive, x = 38 m: five paths within 0.8 m and 0.35 m/s of each other."""
+    route = channel.SignalRoute.from_scenario("italiano2026-straight")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ep = route.epoch(5, np.random.default_rng(1))
+    return route, ep
+
+
+def _errors_deg(meas, paths, truth):
+    return {
+        (paths[t].surface or "los"): float(
+            np.degrees(np.arccos(np.clip(meas.direction[j] @ paths[t].direction, -1, 1)))
+        )
+        for j, t in enumerate(truth)
+        if t >= 0
+    }
+
+
+def test_resolve_coherent_finds_every_path_the_cpd_merged(javelin_epoch):
+    route, ep = javelin_epoch
+    cfg = route.config
+    before = _errors_deg(ep.measurements, ep.paths, ep.truth_index)
+    # the paper's route: LoS biased by the ceiling bounce it absorbed, ceiling and road missed
+    assert before["los"] > 2.0 and "facet 6" not in before and "road" not in before
+    est = coherent.resolve_coherent(
+        ep.snapshot.H, ep.estimates, ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period
+    )
+    assert len(est) == len(ep.paths) and np.all(np.isfinite(est.d)) and np.all(np.isfinite(est.v))
+    meas = channel.measurements_from_estimates(est, ep.array)
+    truth = channel.match_paths(meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias)
+    after = _errors_deg(meas, ep.paths, truth)
+    assert sorted(after) == ["RRM bottom right", "RRM top left", "facet 6", "los", "road"]
+    assert after["los"] < 1.0 and after["facet 6"] < 1.5 and max(after.values()) < 3.0
+    # each separated path gets its own delay: within 0.3 m of its true length (+ clock bias)
+    d_true = np.array([p.length for p in ep.paths])[truth] + 299792458.0 * ep.snapshot.clock_bias
+    assert np.max(np.abs(meas.d - d_true)) < 0.3
+
+
+def test_resolve_coherent_leaves_resolved_paths_alone():
+    """Noiseless, well separated paths: the separation returns the extraction's answer."""
+    route = channel.SignalRoute.from_scenario("italiano2026-straight")
+    arr, paths = route.paths(26)
+    H = channel.channel_tensor(paths, CFG)
+    est = extraction.extract_paths(
+        H, len(paths), arr.local, FC, CFG.tone_spacing, CFG.symbol_period
+    )
+    out = coherent.resolve_coherent(H, est, arr.local, FC, CFG.tone_spacing, CFG.symbol_period)
+    np.testing.assert_allclose(out.d, est.d, atol=1e-4)
+    np.testing.assert_allclose(out.v, est.v, atol=1e-3)
+    np.testing.assert_allclose(out.direction, est.direction, atol=1e-5)
+
+
+def test_resolve_coherent_bad_input(javelin_epoch):
+    route, ep = javelin_epoch
+    cfg = route.config
+    args = (ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    with pytest.raises(TypeError, match="est"):
+        coherent.resolve_coherent(ep.snapshot.H, "paths", *args)
+    H = ep.snapshot.H.copy()
+    H[0, 0, 0] = np.nan
+    with pytest.raises(ValueError, match="H"):
+        coherent.resolve_coherent(H, ep.estimates, *args)
+    with pytest.raises(ValueError, match="n_paths"):
+        coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, n_paths=0)
+    with pytest.raises(ValueError, match="tol"):
+        coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, tol=-1.0)
+    with pytest.raises(ValueError, match="min_power"):
+        coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, min_power=-0.1)
