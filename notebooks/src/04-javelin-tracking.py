@@ -395,16 +395,20 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 #   uncertainty rather than its $\sigma_P = 10$ m.
 # - **Drive length.** 29 epochs per drive (40 m at 50 km/h), so start-up transients weigh in the
 #   averages.
-# - **Road markings do not help here (NoRRMs vs N).** Without LoS no VUE measures the UE's
-#   lateral position (with the VUE curvature model a VUE fixes itself and the shared $x$); it
-#   comes from the V2X dead reckoning and the VUE tracks' coupling to it. With the paths separated,
-#   the RRM paths are measured well (0.3° RMS), yet on our tuning drives (seed 7) removing their
-#   estimates by oracle lowers JAVELIN-N from 0.46 to 0.33 m, below NoRRMs (0.39 m). The RRM
-#   paths appear and vanish only about three times per drive and add about 2.7 births per drive
-#   (5.2 against 2.5); why accurate RRM paths do not help our tracker is not settled yet. With
-#   LoS and RRMs gone, two well-separated paths remain (ceiling and road) and both are extracted
-#   almost exactly. (A semicircular tunnel with the BS at the crown has no side-wall specular path
-#   in the cross-section: the only wall-like bounce is the ceiling facet next to the crown.)
+# - **Road markings do not help here (NoRRMs vs N).** Without LoS, our tracker updates the UE
+#   with the road bounce in most epochs (on our tuning drives, seed 7, straight: 157 of 174
+#   epochs in N, 165 of 174 in NoRRMs): the road image sits at $(x_u, y_u, -z_u)$, a few degrees
+#   below the blocked LoS, inside the 5° angle gate. It has the UE's $x$ and $y$, so the lateral
+#   error stays at about 0.1 m, but the estimated height drifts down towards the image (2.4 m too
+#   low at the end of the drive) and $x$ is biased towards the BS, by 0.6–0.7 m over the last
+#   10 m: the 2-D error grows as the vehicle approaches. With the paths separated the RRM paths are
+#   measured well (0.3° RMS), yet removing their estimates by oracle lowers JAVELIN-N from 0.46 to
+#   0.33 m (NoRRMs: 0.39 m). They update the UE in only 4 of 174 epochs, appear and vanish about
+#   three times per drive and add about 2.7 births per drive (5.2 against 2.5); which of these
+#   costs the most is not settled. With LoS and RRMs gone, two well-separated paths remain
+#   (ceiling and road) and both are extracted almost exactly. (A semicircular tunnel with the BS
+#   at the crown has no side-wall specular path in the cross-section: the only wall-like bounce
+#   is the ceiling facet next to the crown.)
 #
 # ## Exercises
 #
