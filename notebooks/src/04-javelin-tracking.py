@@ -382,7 +382,7 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 #   a metre behind. The CPD of eq. 11 cannot separate such paths (section 3); on the paper's route
 #   our design stops at about 0.8 m (straight, L). The paper does not mention the problem, and its
 #   ray tracer may have produced weaker or better separated ceiling paths. With the paths
-#   separated by the array (ours), JAVELIN-L reaches 0.15 m on the straight drive and 0.29 m on
+#   separated by the array (ours), JAVELIN-L reaches 0.17 m on the straight drive and 0.31 m on
 #   the slalom in our 20-run tables (paper: 0.20 and 0.41 m).
 # - **Curvature.** The paper assumes $\sigma_\kappa = 1.5$ m; our extraction of a 23 cm aperture
 #   delivers far worse beyond ~10 m (tens of metres RMS, merged or separated). Eq. 51 ties
@@ -396,16 +396,16 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 # - **Drive length.** 29 epochs per drive (40 m at 50 km/h), so start-up transients weigh in the
 #   averages.
 # - **Road markings do not help here (NoRRMs vs N).** Without LoS, our tracker updates the UE
-#   with the road bounce in most epochs (on our tuning drives, seed 7, straight: 157 of 174
+#   with the road bounce in most epochs (on our tuning drives, seed 7, straight: 155 of 174
 #   epochs in N, 165 of 174 in NoRRMs): the road image sits at $(x_u, y_u, -z_u)$, a few degrees
 #   below the blocked LoS, inside the 5° angle gate. It has the UE's $x$ and $y$, so the lateral
 #   error stays at about 0.1 m, but the estimated height drifts down towards the image (2.4 m too
 #   low at the end of the drive) and $x$ is biased towards the BS, by 0.6–0.7 m over the last
 #   10 m: the 2-D error grows as the vehicle approaches. With the paths separated the RRM paths are
-#   measured well (0.3° RMS), yet removing their estimates by oracle lowers JAVELIN-N from 0.46 to
-#   0.33 m (NoRRMs: 0.39 m). They update the UE in only 4 of 174 epochs, appear and vanish about
-#   three times per drive and add about 2.7 births per drive (5.2 against 2.5); which of these
-#   costs the most is not settled. With LoS and RRMs gone, two well-separated paths remain
+#   found in every epoch and measured to about 1° RMS, yet removing their estimates by oracle
+#   lowers JAVELIN-N from 0.47 to 0.33 m (NoRRMs: 0.39 m). They update the UE in only 1 of 174
+#   epochs, appear and vanish about three times per drive and add about 2.8 births per drive
+#   (5.3 against 2.5); which of these costs the most is not settled. With LoS and RRMs gone, two well-separated paths remain
 #   (ceiling and road) and both are extracted almost exactly. (A semicircular tunnel with the BS
 #   at the crown has no side-wall specular path in the cross-section: the only wall-like bounce
 #   is the ceiling facet next to the crown.)
@@ -437,12 +437,12 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 # 3. The exact channel's wavefront is centred on the VUE, so its curvature radius is the VUE
 #    distance, not eq. 51's reflector distance (for the ceiling bounce, tens of metres against
 #    half a metre). On the separated route each path is fitted as a point source and
-#    $\hat\kappa$ estimates exactly that distance: the VUE model more than halves the error on
-#    our tuning drives (0.24 m to 0.11 m, straight, L). On the paper's route the merged
+#    $\hat\kappa$ estimates exactly that distance: the VUE model nearly halves the error on
+#    our tuning drives (0.26 m to 0.15 m, straight, L). On the paper's route the merged
 #    components' curvature belongs to no single path, and the VUE model is worse (0.67 m to
 #    1.1 m): a better model only pays on measurements that follow it.
 # 4. With `max_sources=1` nothing is split: the LoS stays 3.3° off (it still carries the ceiling
-#    bounce), the ceiling and one RRM path are missing and one estimate is spurious. With 2, all
+#    bounce), the ceiling and one RRM path are missing and two estimates match no true path. With 2, all
 #    five paths are found, the LoS within 0.44°, the ceiling within 1.1°. A third source adds
 #    nothing in this epoch: no component holds three paths here (it can at x = 28 m, where LoS,
 #    ceiling and road share one).
