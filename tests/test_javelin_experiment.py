@@ -139,6 +139,15 @@ def test_separated_drive_uses_the_same_tensors():
         "italiano2026-straight", "L", np.random.default_rng(5), extraction="separated", **kw
     )
     assert a.extraction == "paper" and b.extraction == "separated"
+    # one pass through both routes (one synthesis and CPD per epoch) gives the same drives
+    both = ex.simulate_routes("italiano2026-straight", "L", np.random.default_rng(5), **kw)
+    for one, shared in ((a, both["paper"]), (b, both["separated"])):
+        assert shared.extraction == one.extraction
+        np.testing.assert_array_equal(shared.speed, one.speed)
+        for m1, m2 in zip(one.epochs, shared.epochs):
+            np.testing.assert_array_equal(m1.phi, m2.phi)
+            np.testing.assert_array_equal(m1.d, m2.d)
+        assert [t.tolist() for t in one.truth_index] == [t.tolist() for t in shared.truth_index]
     np.testing.assert_array_equal(a.speed, b.speed)
     np.testing.assert_array_equal(a.los, b.los)
     matched = [int(np.sum(t >= 0)) for t in b.truth_index]

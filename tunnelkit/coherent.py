@@ -47,6 +47,7 @@ from .extraction import (
     PathEstimates,
     _check_tensor,
     angles_from_solution,
+    cp_rel_error,
     normalize_factors,
     path_estimates,
     refine_roots,
@@ -418,8 +419,7 @@ def resolve_coherent(
     bs = col["spatial"].T
     bf = np.exp(1j * np.arange(nf)[:, None] * col["mu_f"][None, :])
     bt = np.exp(1j * np.arange(nt)[:, None] * col["mu_t"][None, :])
-    model = np.einsum("ml,sl,kl->msk", bs * col["alpha"][None, :], bf, bt)
-    rel = float(np.linalg.norm(H - model) / np.linalg.norm(H))
+    rel = cp_rel_error(H, (bs * col["alpha"][None, :], bf, bt))
     ang = {  # per candidate the near/far choice is already made
         f"{key}_{side}": col[key if key != "dir" else "direction"]
         for key in ("dir", "phi", "psi")

@@ -51,6 +51,7 @@ __all__ = [
     "algorithm1",
     "angles_from_solution",
     "check_rank",
+    "cp_rel_error",
     "cpd",
     "crlb_paths",
     "extract_paths",
@@ -333,11 +334,7 @@ def _cpd_fast(
     nh2 = float(np.vdot(H, H).real)
     if polish:
         factors = _als_polish(H, factors, polish)
-        A, B, Cm = factors
-        fit = _contract(H, B.conj(), Cm.conj())  # <H, model> per component before summing
-        gram = (A.conj().T @ A) * (B.conj().T @ B) * (Cm.conj().T @ Cm)
-        err2 = nh2 - 2 * float(np.sum(np.real(A.conj() * fit))) + float(np.real(gram.sum()))
-        rel = float(np.sqrt(max(err2, 0.0) / nh2))
+        rel = cp_rel_error(H, factors, nh2)
     else:  # ||H - Hhat||^2 = ||H||^2 - ||G||^2 + ||G - Ghat||^2 (orthonormal bases)
         rel = float(np.sqrt((max(nh2 - np.linalg.norm(G) ** 2, 0.0) + err**2) / nh2))
     return CPDResult(tuple(factors), rel, n_it, n_it < n_iter_max, "fast")
@@ -387,6 +384,17 @@ def refine_roots(B, mu, n_steps: int = 4) -> tuple[np.ndarray, np.ndarray]:
         mu = mu + np.clip(step, -np.pi / (2 * N), np.pi / (2 * N))
     beta = np.mean(B * np.exp(-1j * n * mu[None, :]), axis=0)
     return np.angle(np.exp(1j * mu)), beta
+
+
+def cp_rel_error(H: np.ndarray, factors, nh2: float | None = None) -> float:
+    """``||H - [[A, B, C]]|| / ||H||`` without forming the model tensor: the cross term is one
+    contraction of ``H``, the model's energy the Hadamard product of the factors' Gram matrices."""
+    A, B, Cm = factors
+    nh2 = float(np.vdot(H, H).real) if nh2 is None else nh2
+    fit = _contract(H, B.conj(), Cm.conj())  # <H, model> per component before summing
+    gram = (A.conj().T @ A) * (B.conj().T @ B) * (Cm.conj().T @ Cm)
+    err2 = nh2 - 2 * float(np.sum(np.real(A.conj() * fit))) + float(np.real(gram.sum()))
+    return float(np.sqrt(max(err2, 0.0) / nh2))
 
 
 def _contract(H: np.ndarray, F: np.ndarray, T: np.ndarray) -> np.ndarray:

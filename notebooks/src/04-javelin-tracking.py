@@ -33,7 +33,7 @@ from tunnelkit.plots import (
     tracks_count_figure,
     trajectories_figure,
 )
-from tunnelkit.reproduce.javelin_tables import collect_drives, table_rows
+from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows
 from tunnelkit.tracking.javelin import experiment as ex
 from tunnelkit.tracking.javelin import measurement_model
 from tunnelkit.widgets import epoch_explorer
@@ -58,14 +58,15 @@ runs = tk.mc_count(20, 1)
 n_epochs = 12 if tk.quick_mode() else None  # quick mode: the first 12 epochs (1.2 s) of each drive
 straight_conditions = ("L", "N@0.5", "N", "NoRRMs")
 slalom_conditions = ("L",) if tk.quick_mode() else ("L", "N@0.5", "N")
-straight, slalom, straight_sep, slalom_sep = (
-    collect_drives(scenario, conds, runs, seed, n_epochs=n_epochs, extraction=extraction)
-    for extraction in ("paper", "separated")
+routes = {
+    scenario: collect_routes(scenario, conds, runs, seed, n_epochs=n_epochs)
     for scenario, conds, seed in (
         ("italiano2026-straight", straight_conditions, 0),
         ("italiano2026-slalom", slalom_conditions, 1),
     )
-)
+}
+straight, straight_sep = (routes["italiano2026-straight"][e] for e in ("paper", "separated"))
+slalom, slalom_sep = (routes["italiano2026-slalom"][e] for e in ("paper", "separated"))
 drive, drive_sep = straight["L"][0], straight_sep["L"][0]
 n_paths = [0 if m is None else len(m) for m in drive.epochs]
 print(f"{len(drive.epochs)} epochs, {drive.dt:.1f} s apart; paths kept per epoch: {n_paths}")
@@ -161,13 +162,11 @@ javelin_table_figure(cols, model_rows(drive_sep, k), title=f"epoch {k}: separate
 # direction is.
 
 # %%
-for name, d in (("paper's extraction", straight["L"]), ("separated", straight_sep["L"])):
+los_rms = {}
+for name, d in (("paper", straight["L"]), ("separated", straight_sep["L"])):
     pcols, prows = ex.path_errors(d)
-    display(javelin_table_figure(pcols, prows, title=f"straight, L: {name}"))
-los_rms = {
-    name: {r[0]: r[3] for r in ex.path_errors(d)[1]}["los"]
-    for name, d in (("paper", straight["L"]), ("separated", straight_sep["L"]))
-}
+    los_rms[name] = {r[0]: r[3] for r in prows}["los"]
+    display(javelin_table_figure(pcols, prows, title=f"straight, L: {name} extraction"))
 
 # %% [markdown]
 # The curvature does not improve much: separating the sources fixes their directions, but a 23 cm

@@ -16,9 +16,41 @@ from ..montecarlo import spawn_rngs
 from ..reference import load as load_reference
 from . import Report, register
 
-__all__ = ["NOTES", "collect_drives", "javelin_table", "table_rows"]
+__all__ = ["NOTES", "collect_drives", "collect_routes", "javelin_table", "table_rows"]
 
 _METRICS = ("rmse_2d_m", "mae_2d_m", "y_mae_m")
+
+
+def collect_routes(
+    scenario: str,
+    conditions: tuple[str, ...],
+    runs: int,
+    seed: int,
+    progress: bool = False,
+    n_epochs: int | None = None,
+    extractions: tuple[str, ...] = ("paper", "separated"),
+) -> dict[str, dict[str, list]]:
+    """``runs`` seeded drives per condition through the signal route (the expensive part), each
+    measured through every route in ``extractions`` from the same tensors and CPD
+    (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`); ``n_epochs`` truncates each
+    drive (quick mode). Returns ``{extraction: {condition: [DriveData, ...]}}``."""
+    from ..tracking.javelin import experiment as ex
+
+    rngs = spawn_rngs(seed, runs * len(conditions))
+    jobs = [c for _ in range(runs) for c in conditions]
+    it = list(zip(jobs, rngs))
+    if progress:
+        from tqdm.auto import tqdm
+
+        it = tqdm(it, desc=f"{scenario} drives", leave=False)
+    out: dict[str, dict[str, list]] = {e: {c: [] for c in conditions} for e in extractions}
+    for cond, rng in it:
+        routes = ex.simulate_routes(
+            scenario, cond, rng, n_epochs=n_epochs, extractions=tuple(extractions)
+        )
+        for e, drive in routes.items():
+            out[e][cond].append(drive)
+    return out
 
 
 def collect_drives(
@@ -30,35 +62,21 @@ def collect_drives(
     n_epochs: int | None = None,
     extraction: str = "paper",
 ) -> dict[str, list]:
-    """``runs`` seeded drives per condition through the signal route (the expensive part);
-    ``n_epochs`` truncates each drive (quick mode); ``extraction`` as in
-    :func:`~tunnelkit.tracking.javelin.experiment.simulate_drive` (same seed, same tensors)."""
-    from ..tracking.javelin import experiment as ex
-
-    rngs = spawn_rngs(seed, runs * len(conditions))
-    jobs = [c for _ in range(runs) for c in conditions]
-    it = list(zip(jobs, rngs))
-    if progress:
-        from tqdm.auto import tqdm
-
-        it = tqdm(it, desc=f"{scenario} drives ({extraction})", leave=False)
-    drives: dict[str, list] = {c: [] for c in conditions}
-    for cond, rng in it:
-        drives[cond].append(
-            ex.simulate_drive(scenario, cond, rng, n_epochs=n_epochs, extraction=extraction)
-        )
-    return drives
+    """:func:`collect_routes` through one route: ``{condition: [DriveData, ...]}``."""
+    routes = collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (extraction,))
+    return routes[extraction]
 
 
-#: table rows per measurement route: (design label, method, config name in ``experiment``)
-_ROWS = {
-    "paper": (
-        ("paper", "JAVELIN", "PAPER"),
-        ("ours", "JAVELIN", "OURS"),
-        ("paper", "TeNFiLoc", ""),
-    ),
-    "separated": (("ours", "JAVELIN", "OURS_SEPARATED"), ("paper", "TeNFiLoc", "")),
-}
+def _row_specs(ex) -> dict[str, tuple]:
+    """Per measurement route: (design label, method, JAVELIN config or None for TeNFiLoc)."""
+    return {
+        "paper": (
+            ("paper", "JAVELIN", ex.PAPER),
+            ("ours", "JAVELIN", ex.OURS),
+            ("paper", "TeNFiLoc", None),
+        ),
+        "separated": (("ours", "JAVELIN", ex.OURS_SEPARATED), ("paper", "TeNFiLoc", None)),
+    }
 
 
 def table_rows(
@@ -74,16 +92,15 @@ def table_rows(
 
     ref = {r["configuration"]: r for r in load_reference(reference)}
     scores: dict[tuple[str, str, str], list[dict[str, float]]] = {}
+    specs = _row_specs(ex)
     routes = {"paper": drives, "separated": separated or {}}
     for extraction, by_cond in routes.items():
         for cond, lst in by_cond.items():
             for drive in lst:
-                for design, method, cfg in _ROWS[extraction]:
+                for design, method, config in specs[extraction]:
                     if method == "TeNFiLoc" and cond != "L":
                         continue
-                    name = f"{method}-{cond}"
-                    config = getattr(ex, cfg) if cfg else None
-                    scores.setdefault((name, design, extraction), []).append(
+                    scores.setdefault((f"{method}-{cond}", design, extraction), []).append(
                         ex.evaluate(drive, config, method=method).metrics
                     )
     rows = []
@@ -122,8 +139,8 @@ def javelin_table(
 ) -> Report:
     """One table: rows per configuration, design (paper / ours) and extraction, the paper's
     numbers beside."""
-    drives = collect_drives(scenario, conditions, runs, seed, progress)
-    separated = collect_drives(scenario, conditions, runs, seed, progress, extraction="separated")
+    routes = collect_routes(scenario, conditions, runs, seed, progress)
+    drives, separated = routes["paper"], routes["separated"]
     cols, rows = table_rows(drives, reference, separated)
     n_fault = sum(len(d.faults) for r in (drives, separated) for lst in r.values() for d in lst)
     return Report(

@@ -44,6 +44,7 @@ __all__ = [
     "path_errors",
     "separate_epoch",
     "simulate_drive",
+    "simulate_routes",
     "tenfiloc_track",
     "vue_prediction_errors",
 ]
@@ -157,73 +158,122 @@ def simulate_drive(
     (Algorithm 1), angles in the world frame. ``extraction`` is ``"paper"`` (the CPD route of
     eq. 11-24) or ``"separated"`` (the same, then coherent paths merged in one CPD component
     separated by the array, :func:`tunnelkit.coherent.resolve_coherent`); the same ``rng`` gives
-    the same tensors either way. An extraction failure leaves ``None`` (the tracker then predicts
-    only) and is recorded in ``faults``.
+    the same tensors either way (:func:`simulate_routes` measures one drive both ways). An
+    extraction failure leaves ``None`` (the tracker then predicts only) and is recorded in
+    ``faults``.
+    """
+    return simulate_routes(
+        scenario,
+        condition,
+        rng,
+        model=model,
+        sigma_speed=sigma_speed,
+        sigma_heading=sigma_heading,
+        n_epochs=n_epochs,
+        extractions=(extraction,),
+    )[extraction]
+
+
+def simulate_routes(
+    scenario: str,
+    condition: str | Condition,
+    rng: np.random.Generator,
+    *,
+    model: str = "exact",
+    sigma_speed: float = 0.2,
+    sigma_heading: float = float(np.radians(1.0)),
+    n_epochs: int | None = None,
+    extractions: tuple[str, ...] = EXTRACTIONS,
+) -> dict[str, DriveData]:
+    """One drive (:func:`simulate_drive`) measured through every route in ``extractions``.
+
+    Each epoch's tensor is synthesised and decomposed once; the separated route starts from the
+    paper's CPD estimates of that same tensor. Returns ``{extraction: DriveData}``.
     """
     rng = rng_or_error("rng", rng)
     cond = CONDITIONS[condition] if isinstance(condition, str) else condition
     if not isinstance(cond, Condition):
         raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
-    if extraction not in EXTRACTIONS:
-        raise ValueError(f"extraction: expected one of {EXTRACTIONS}, got {extraction!r}")
+    extractions = tuple(extractions)
+    if not extractions or any(e not in EXTRACTIONS for e in extractions):
+        raise ValueError(f"extraction: expected one of {EXTRACTIONS}, got {extractions!r}")
     route = _route(scenario, model)
     kinds_all = tuple(route.kinds)
     no_los = replace(route, kinds=tuple(k for k in kinds_all if k != "los"))
     tunnel = route.tunnel if cond.rrms else route.tunnel.without_plates()
     traj = route.trajectory
     T = len(traj) if n_epochs is None else min(int(n_epochs), len(traj))
-    epochs: list[PathMeasurements | None] = []
-    los = np.zeros(T, bool)
-    n_true = np.zeros(T, int)
-    tidx, kinds, faults, sources = [], [], [], []
+    acc = {
+        e: {
+            "epochs": [],
+            "los": np.zeros(T, bool),
+            "n_true": np.zeros(T, int),
+            "tidx": [],
+            "kinds": [],
+            "faults": [],
+            "sources": [],
+        }
+        for e in extractions
+    }
     bs = None
     for k in range(T):
         has_los = bool(rng.random() < cond.los_probability)
         r = route if has_los else no_los
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                ep = r.epoch(k, rng, tunnel=tunnel)
-                if extraction == "separated":
-                    ep = separate_epoch(ep, route.config)
-        except (ValueError, np.linalg.LinAlgError) as exc:
-            faults.append(f"epoch {k}: extraction failed ({exc})")
-            epochs.append(None)
-            tidx.append(np.zeros(0, int))
-            kinds.append([])
-            sources.append(np.zeros((0, 3)))
-            continue
-        m = ep.measurements
-        bs = m.origin.copy()
-        los[k] = any(p.kind == "los" for p in ep.paths)
-        n_true[k] = len(ep.paths)
-        epochs.append(PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False))
-        tidx.append(np.asarray(ep.truth_index)[epochs[-1].source])
-        kinds.append([p.surface_kind for p in ep.paths])
-        sources.append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                ep0 = r.epoch(k, rng, tunnel=tunnel)
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                ep0, failure = None, exc
+            for e, a in acc.items():
+                ep = ep0
+                if ep is not None and e == "separated":
+                    try:
+                        ep = separate_epoch(ep0, route.config)
+                    except (ValueError, np.linalg.LinAlgError) as exc:
+                        ep, failure = None, exc
+                if ep is None:
+                    a["faults"].append(f"epoch {k}: extraction failed ({failure})")
+                    a["epochs"].append(None)
+                    a["tidx"].append(np.zeros(0, int))
+                    a["kinds"].append([])
+                    a["sources"].append(np.zeros((0, 3)))
+                    continue
+                m = ep.measurements
+                bs = m.origin.copy()
+                a["los"][k] = any(p.kind == "los" for p in ep.paths)
+                a["n_true"][k] = len(ep.paths)
+                pm = PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False)
+                a["epochs"].append(pm)
+                a["tidx"].append(np.asarray(ep.truth_index)[pm.source])
+                a["kinds"].append([p.surface_kind for p in ep.paths])
+                a["sources"].append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
     if bs is None:
         bs = route.arrays[0].origin.copy()
     vel = traj.velocity[:T]
     speed = np.linalg.norm(vel[:, :2], axis=1) + sigma_speed * rng.standard_normal(T)
     heading = np.arctan2(vel[:, 1], vel[:, 0]) + sigma_heading * rng.standard_normal(T)
-    return DriveData(
-        scenario,
-        cond,
-        traj.t[:T].copy(),
-        traj.position[:T].copy(),
-        vel.copy(),
-        speed,
-        heading,
-        epochs,
-        los,
-        n_true,
-        bs,
-        tidx,
-        kinds,
-        faults,
-        sources,
-        extraction,
-    )
+    return {
+        e: DriveData(
+            scenario,
+            cond,
+            traj.t[:T].copy(),
+            traj.position[:T].copy(),
+            vel.copy(),
+            speed.copy(),
+            heading.copy(),
+            a["epochs"],
+            a["los"],
+            a["n_true"],
+            bs.copy(),
+            a["tidx"],
+            a["kinds"],
+            a["faults"],
+            a["sources"],
+            e,
+        )
+        for e, a in acc.items()
+    }
 
 
 def tenfiloc_track(
