@@ -1,14 +1,20 @@
-"""Scenario presets: each paper's setup as a TOML file under ``data/scenarios/`` loaded by name.
+"""Scenarios: each paper's setup, and your own tunnel, as a validated TOML file.
 
-A scenario file has a few top-level keys (``name``, ``paper``, ``description``) and sections
-(``[tunnel]``, ``[base_station]``, ``[trajectory]``, ``[noise]``, ``[radio]`` ...). Sections with a
-``kind`` key are built into objects by a registered builder (``tunnel.kind = "walls2d"`` gives a
-:class:`tunnelkit.geometry.Tunnel2D`); later chapters register their own kinds with
-:func:`register_tunnel` / :func:`register_trajectory`. Errors name the file and the key.
+Presets live in ``data/scenarios/`` and load by name; your own file loads by path
+(``load_scenario("my-tunnel.toml")``). A file has a few top-level keys (``name``, ``paper``,
+``description``) and sections (``[tunnel]``, ``[base_station]``, ``[radio]``, ``[trajectory]``
+...). Its ``paper`` key picks the family whose schema (:mod:`tunnelkit.schema`) it is validated
+against on load; without ``paper`` it is your own tunnel (family ``user``, shapes in
+:mod:`tunnelkit.tunnels`). Sections with a ``kind`` key are built into objects by a registered
+builder (``tunnel.kind = "walls2d"`` gives a :class:`tunnelkit.geometry.Tunnel2D`,
+``"rectangular"`` a :class:`tunnelkit.propagation.Tunnel3D`), see :func:`register_tunnel` /
+:func:`register_trajectory`. Errors are :class:`ScenarioError` naming the file and the key.
 
     >>> import tunnelkit as tk
     >>> sc = tk.load_scenario("jiang2023-straight")
     >>> traj = sc.trajectory()          # times, positions, velocities
+    >>> mine = tk.scenarios.with_values(tk.load_scenario("example-rectangular-28ghz"),
+    ...                                 {"base_station.arrays[*].shape": [16, 16]})
 """
 
 from __future__ import annotations

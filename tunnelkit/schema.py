@@ -99,12 +99,6 @@ class Table:
     def allowed(self, kind: str | None) -> tuple[Key, ...]:
         return self.keys + tuple(self.variants.get(kind, ()))
 
-    def all_names(self) -> list[str]:
-        names = [k.name for k in self.keys]
-        for ks in self.variants.values():
-            names += [k.name for k in ks if k.name not in names]
-        return names
-
 
 def _num(x) -> str:
     return f"{x:g}" if isinstance(x, float) else str(x)
@@ -901,14 +895,21 @@ def key_comment(key: Key) -> str:
     return "; ".join([bits[0], *bits[1:]]) if len(bits) > 1 else bits[0]
 
 
+def _render_absent(lines: list[str], spec: Table, full: str, indent: str = "#   ") -> None:
+    """Document the keys of a table the template leaves out (commented, one line each)."""
+    for k in spec.keys:
+        lines.append(f"{indent}{k.name}: {key_comment(k)}")
+        if k.table is not None:
+            _render_absent(lines, k.table, f"{full}.{k.name}", indent + "  ")
+    for v, ks in spec.variants.items():
+        for k in ks:
+            lines.append(f"{indent}{k.name} (kind = {v!r}): {key_comment(k)}")
+
+
 def _render(lines: list[str], spec: Table, values: dict, path: str) -> None:
     kind = values.get("kind") if spec.variants else None
     scalars = [k for k in spec.allowed(kind) if k.type not in ("table", "tables")]
     subs = [k for k in spec.allowed(kind) if k.type in ("table", "tables")]
-    if spec.variants:
-        for v, ks in spec.variants.items():
-            extra = ", ".join(k.name for k in ks) or "no extra keys"
-            lines.append(f"#   kind = {v!r}: {extra}")
     for k in scalars:
         lines.append(f"# {key_comment(k)}")
         if k.name in values:
@@ -917,17 +918,25 @@ def _render(lines: list[str], spec: Table, values: dict, path: str) -> None:
             lines.append(f"# {k.name} = {_fmt(k.default)}")
         else:
             lines.append(f"# {k.name} = ")
+    for v, ks in spec.variants.items():
+        if v != kind and ks:
+            lines.append(f"# with kind = {v!r} also:")
+            lines += [f"#   {k.name}: {key_comment(k)}" for k in ks]
     for k in subs:
         full = f"{path}.{k.name}" if path else k.name
         v = values.get(k.name)
         if k.type == "table":
             if v is None and not k.required:
-                lines += ["", f"# [{full}]  {key_comment(k)}"]
+                lines += ["", f"# [{full}]  {key_comment(k)}; keys:"]
+                _render_absent(lines, k.table, full)
                 continue
             lines += ["", f"# {key_comment(k)}", f"[{full}]"]
             _render(lines, k.table, v or {}, full)
         else:
-            lines += ["", f"# [[{full}]]  {key_comment(k)}"]
+            lines += ["", f"# [[{full}]]  {key_comment(k)}; one table per item"]
+            if not v:
+                lines[-1] += ", keys:"
+                _render_absent(lines, k.table, full)
             for j, item in enumerate(v or []):
                 lines += [""] * (j > 0) + [f"[[{full}]]"]
                 _render(lines, k.table, item, full)
