@@ -309,6 +309,18 @@ MALFORMED = [
     (HAL, "outlier_prob = 0.02", "outlier_prob = 1.5", r"'errors\.outlier_prob' must be <= 1"),
     (HAL, "spacing = 0.8 ", "spacing = 1e-9 ", r"'vehicle\.spacing' .* more than"),
     (HAL, "[gnss]", "[gnss]\nsigma = 1.0", r"unknown key 'gnss\.sigma'"),
+    (
+        HAL,
+        "speed_amplitude = 1.0",
+        "speed_amplitude = 30.0",
+        r"'vehicle\.speed_amplitude': must be below speed",
+    ),
+    (
+        HAL,
+        "pass_time = 37.0",
+        "pass_time = 60.0",
+        r"'transmitter\.pass_time': must be within the drive",
+    ),
 ]
 
 

@@ -415,6 +415,15 @@ def _check_placement(sc: Scenario) -> None:
                 raise ScenarioError(
                     f"{where}: '{key}' = {val:g} m lies outside the {h:g} m high tube (0 < z < {h:g})"
                 )
+        from .drive import DriveConfig
+
+        owner = {k: name for name, tab in sec.items() if isinstance(tab, dict) for k in tab}
+        try:
+            DriveConfig(**{k: sec[s][k] for k, s in owner.items()})
+        except ValueError as exc:
+            field_name, _, msg = str(exc).partition(":")
+            key = f"{owner.get(field_name, '?')}.{field_name}"
+            raise ScenarioError(f"{where}: '{key}': {msg.strip()}") from None
         veh = sec["vehicle"]
         n = veh["speed"] * veh["duration"] / veh["spacing"]
         if n > MAX_SAMPLES:

@@ -620,7 +620,7 @@ HALILI = Table(
                     _i(
                         "window_snapshots",
                         "local stationarity window M",
-                        ge=1,
+                        ge=2,
                         le=100_000,
                         default=32,
                     ),
@@ -634,7 +634,7 @@ HALILI = Table(
             Table(
                 (
                     _h("reflection_coeff", "amplitude per bounce", ge=0.0, le=1.0, default=0.6),
-                    _i("max_order", "highest reflection order", ge=0, le=10, default=2),
+                    _i("max_order", "highest reflection order", ge=0, le=6, default=2),
                 ),
                 "image-method multipath",
             ),
