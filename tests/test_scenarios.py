@@ -491,3 +491,98 @@ def test_every_key_has_a_doc_and_sane_spec():
 
     for fam in schema.FAMILIES.values():
         walk(fam, "")
+
+
+def test_symlink_out_of_the_data_directory_is_refused(tmp_path, monkeypatch):
+    (tmp_path / "scenarios").mkdir()
+    outside = tmp_path / "outside.toml"
+    outside.write_text(_text("jiang2023-straight"))
+    (tmp_path / "scenarios" / "evil.toml").symlink_to(outside)
+    (tmp_path / "scenarios" / "good.toml").write_text(_text("jiang2023-straight"))
+    monkeypatch.setenv("TUNNELKIT_DATA", str(tmp_path))
+    assert tk.load_scenario("good").name == "jiang2023-straight"
+    with pytest.raises(S.ScenarioError, match="unknown scenario 'evil'"):
+        tk.load_scenario("evil")
+
+
+# --- property: any mutation of a valid file loads or raises ScenarioError, nothing else --------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_VALUES = [
+    None,
+    0,
+    -1,
+    1,
+    2.5,
+    10.5,
+    -1e30,
+    1e30,
+    float("nan"),
+    float("inf"),
+    True,
+    "x",
+    [],
+    [1, 2],
+    [0.0, 0.0, 0.0],
+    [[1.0, 2.0]],
+    {},
+    {"a": 1},
+]
+
+
+def _leaves(tab, path=()):
+    for k, v in tab.items():
+        if isinstance(v, dict):
+            yield from _leaves(v, (*path, k))
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            for i, x in enumerate(v):
+                yield from _leaves(x, (*path, k, i))
+        else:
+            yield (*path, k)
+
+
+_RAWS = {n: tk.load_scenario(n).raw for n in (JAV, USR, HAL, "jiang2023-curved")}
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(sorted(_RAWS)),
+    picks=st.lists(
+        st.tuples(st.integers(0, 10**6), st.sampled_from(_VALUES)), min_size=1, max_size=3
+    ),
+)
+def test_mutated_files_load_or_raise_scenario_error(name, picks):
+    import copy
+
+    raw = copy.deepcopy(_RAWS[name])
+    leaves = list(_leaves(raw))
+    for idx, value in picks:
+        *parents, last = leaves[idx % len(leaves)]
+        tab = raw
+        for p in parents:
+            tab = tab[p]
+        if value is None:
+            tab.pop(last, None)
+        else:
+            tab[last] = copy.deepcopy(value)
+    try:
+        sc = S.scenario_from_dict(raw, "mutant.toml")
+    except S.ScenarioError as exc:
+        assert str(exc).startswith("mutant.toml: ")
+        return
+    # what loads is usable: tunnel, trajectory (and arrays/radio) build without error
+    if sc.family == "halili2022":
+        assert isinstance(
+            drive.DriveConfig(
+                **{k: v for t in sc.sections.values() if isinstance(t, dict) for k, v in t.items()}
+            ),
+            drive.DriveConfig,
+        )
+        return
+    tun = sc.tunnel()
+    tr = sc.trajectory(tun)
+    assert np.all(np.isfinite(tr.position))
+    if sc.family in ("user", "italiano2026"):
+        assert all(np.all(np.isfinite(a.world)) for a in sc.arrays())
