@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import tomllib
 from pathlib import Path
 
 NAME = "scenarios"
@@ -38,7 +39,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from ..scenarios import check_all, load_scenario, template
+    from ..scenarios import check_all, load_scenario, scenario_from_dict, template
 
     words = list(args.words)
     if words and words[0] == "new":
@@ -54,8 +55,8 @@ def main(args: argparse.Namespace) -> int:
         path = out / f"{name}.toml"
         if path.exists():
             raise ValueError(f"NAME: {str(path)!r} already exists; choose another name or --out")
+        scenario_from_dict(tomllib.loads(text), path)  # the template validates before it is written
         path.write_text(text)
-        load_scenario(path)  # the template must validate
         print(f"wrote {path} (from {args.preset}); edit it, then: tunnelkit scenarios {path}")
         return 0
     if words == ["doc"]:
