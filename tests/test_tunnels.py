@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import tunnelkit as tk
-from tunnelkit import arrays, channel, geometry, propagation, tunnels
+from tunnelkit import arrays, geometry, propagation, signal_route, tunnels
 from tunnelkit import scenarios as S
 from tunnelkit.constants import C
 
@@ -179,7 +179,7 @@ def test_user_scenario_runs_the_signal_route(shape):
             "radio.comb": 8,
         },
     )
-    route = channel.SignalRoute.from_scenario(sc)
+    route = signal_route.SignalRoute.from_scenario(sc)
     ep = route.epoch(5, np.random.default_rng(1))
     assert ep.paths[0].kind == "los" and len(ep.paths) >= 3
     kinds = {p.surface_kind for p in ep.paths}
