@@ -166,10 +166,10 @@ def test_profiles(drive):
 def test_scenario_file_matches_defaults(tmp_path):
     assert dv.load_drive_config("halili2022-drive") == dv.DriveConfig()
     bad = tmp_path / "bad.toml"
-    bad.write_text('name = "x"\npaper = "y"\n[vehicle]\nspeed = 25.0\nwarp = 9\n')
+    bad.write_text('name = "x"\npaper = "halili2022"\n[vehicle]\nspeed = 25.0\nwarp = 9\n')
     with pytest.raises(ScenarioError, match=r"vehicle\.warp"):
         dv.load_drive_config(str(bad))
-    bad.write_text('name = "x"\npaper = "y"\n[vehicle]\nspeed = 0.0\n')
+    bad.write_text('name = "x"\npaper = "halili2022"\n[vehicle]\nspeed = 0.0\n')
     with pytest.raises(ScenarioError, match="speed"):
         dv.load_drive_config(str(bad))
 

@@ -46,10 +46,12 @@ def test_unknown_scenario_names_available_ones():
 
 GOOD = """
 name = "t"
-paper = "test"
+paper = "jiang2023"
 [tunnel]
 kind = "walls2d"
 walls = [[3.0, -3.0, 40.0], [3.0, -3.0, -23.6396]]
+[base_station]
+position = [0.0, 0.0]
 [trajectory]
 kind = "piecewise_acceleration"
 start = [10.0, 14.8481]
@@ -68,16 +70,24 @@ steps = 10
             "walls = [[3.0, -3.0, 40.0]]",
             "'tunnel.walls' must have shape",
         ),
-        ('kind = "walls2d"', 'kind = "round"', "unknown tunnel.kind 'round'"),
+        (
+            'kind = "walls2d"',
+            'kind = "round"',
+            "'tunnel.kind' must be one of \\['walls2d'\\], got 'round'",
+        ),
         (
             "walls = [[3.0, -3.0, 40.0], [3.0, -3.0, -23.6396]]",
             "walls = [[0.0, 0.0, 40.0], [3.0, -3.0, 1.0]]",
             "tunnel.walls: A, B: degenerate",
         ),
         ("steps = 10", 'steps = "ten"', "'trajectory.steps' must be an integer"),
-        ("period = 0.1", "period = -0.1", "trajectory.period: must be > 0"),
+        ("period = 0.1", "period = -0.1", r"'trajectory.period' must be > 0"),
         ("velocity = [10.0, 10.0]", "velocity = [-10.0, 10.0]", "trajectory: leaves the tunnel"),
-        ("start = [10.0, 14.8481]", 'start = ["a", 1]', "'trajectory.start' must be numeric"),
+        (
+            "start = [10.0, 14.8481]",
+            'start = ["a", 1]',
+            r"'trajectory.start\[0\]' must be a number",
+        ),
         ("[tunnel]", "[tunnel", "not valid TOML"),
     ],
 )

@@ -576,6 +576,11 @@ def load_drive_config(name: str = "halili2022-drive") -> DriveConfig:
     errors naming the key.
     """
     sc = load_scenario(name)
+    if sc.family != "halili2022":
+        raise ScenarioError(
+            f"name: {sc.name!r} is a {sc.family!r} scenario, not a Halili drive; "
+            'load_drive_config reads paper = "halili2022" files ([tube], [transmitter], ...)'
+        )
     fields = {f.name: f for f in dataclasses.fields(DriveConfig)}
     kw = {}
     for sec in _SECTIONS:

@@ -671,6 +671,7 @@ def scenario_arrays(scenario) -> list[ArrayGeometry]:
                     azimuth=np.radians(float(t["azimuth_deg"])),
                     elevation=np.radians(float(t["elevation_deg"])),
                     origin=bs + np.asarray(t.get("offset", [0, 0, 0]), float),
+                    spacing=t.get("spacing"),
                     name=str(t.get("name", f"array {i}")),
                 )
             )

@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib
 import itertools
 import os
+import re
 import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -25,21 +26,22 @@ from typing import Any
 import numpy as np
 
 from .geometry import Tunnel2D
+from .schema import ScenarioError, render_template, validate
 
 __all__ = [
+    "ALLOWED_REQUIRES",
     "Scenario",
     "ScenarioError",
     "Trajectory",
+    "check_all",
     "data_dir",
     "list_scenarios",
     "load_scenario",
     "register_trajectory",
     "register_tunnel",
+    "scenario_path",
+    "template",
 ]
-
-
-class ScenarioError(ValueError):
-    """A scenario that does not exist or whose file is malformed (the message names the key)."""
 
 
 def data_dir() -> Path:
@@ -126,13 +128,22 @@ def _getter(where: str, section: dict, prefix: str):
 
 @dataclass(frozen=True)
 class Scenario:
-    """A loaded preset. ``sections`` holds the raw TOML tables; helpers build objects from them."""
+    """A loaded, validated scenario.
+
+    ``family`` is ``"jiang2023"``, ``"italiano2026"``, ``"halili2022"`` or ``"user"`` (your own
+    tunnel, no ``paper`` key; ``paper`` is then ``""``). ``sections`` holds the validated tables with
+    defaults filled in (for ``user`` files also the derived keys the builders read:
+    ``base_station.arrays[i].elevation_deg = -tilt_deg``, ``.spacing`` in metres and
+    ``radio.n_rb``); ``raw`` is the file exactly as parsed.
+    """
 
     name: str
     paper: str
     description: str
     path: Path
     sections: dict[str, Any] = field(repr=False)
+    family: str = ""
+    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def section(self, key: str) -> dict[str, Any]:
         """A raw TOML table (``ScenarioError`` naming it if absent)."""
@@ -163,6 +174,12 @@ class Scenario:
         sec = self.section("base_station")
         return _getter(self.path.name, sec, "base_station")("position", shape=(None,))
 
+    def arrays(self) -> list:
+        """The arrays of ``[[base_station.arrays]]`` (:func:`tunnelkit.propagation.scenario_arrays`)."""
+        from .propagation import scenario_arrays
+
+        return scenario_arrays(self)
+
     def trajectory(self, tunnel=None) -> Trajectory:
         """Ground-truth trajectory built from ``[trajectory]`` by its registered ``kind``."""
         sec = self.section("trajectory")
@@ -185,40 +202,240 @@ def list_scenarios() -> list[str]:
     return sorted(p.stem for p in (data_dir() / "scenarios").glob("*.toml"))
 
 
-def load_scenario(name: str) -> Scenario:
-    """Load a preset by name, e.g. ``"jiang2023-straight"`` (``ScenarioError`` if unknown/malformed)."""
+#: modules a file's ``requires`` may name (they register tunnel/trajectory kinds on import)
+ALLOWED_REQUIRES = ("tunnelkit.propagation", "tunnelkit.tunnels")
+#: modules imported for every file of a family (their builders)
+_FAMILY_MODULES = {
+    "italiano2026": ("tunnelkit.propagation",),
+    "user": ("tunnelkit.propagation", "tunnelkit.tunnels"),
+}
+_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
+
+
+def scenario_path(name: str | os.PathLike) -> Path:
+    """The file a scenario name or path refers to (``ScenarioError`` if it is not allowed).
+
+    A plain name (letters, digits, ``.``, ``_``, ``-``; no directory part) resolves inside
+    ``data/scenarios/`` only; anything else (a :class:`~pathlib.Path`, or a string with a
+    directory part or ending in ``.toml``) must be an existing ``.toml`` file.
+    """
+    if isinstance(name, os.PathLike) or (
+        isinstance(name, str) and (name.endswith(".toml") or "/" in name or os.sep in name)
+    ):
+        path = Path(name)
+        if path.suffix != ".toml":
+            raise ScenarioError(
+                f"name: {str(name)!r} is neither a preset name nor a path to a .toml file"
+            )
+        if not path.is_file():
+            raise ScenarioError(f"name: no such scenario file {str(path)!r}")
+        return path
     if not isinstance(name, str) or not name:
-        raise TypeError(f"name: expected a scenario name string, got {name!r}")
-    path = Path(name) if name.endswith(".toml") else data_dir() / "scenarios" / f"{name}.toml"
-    if not path.is_file():
+        raise TypeError(f"name: expected a scenario name string or a path, got {name!r}")
+    root = (data_dir() / "scenarios").resolve()
+    path = (root / f"{name}.toml").resolve()
+    if not _NAME_RE.fullmatch(name) or not path.is_relative_to(root) or not path.is_file():
         raise ScenarioError(
             f"name: unknown scenario {name!r}; available: {', '.join(list_scenarios())}"
         )
+    return path
+
+
+def load_scenario(name: str | os.PathLike) -> Scenario:
+    """Load and validate a scenario: a preset name (``"jiang2023-straight"``) or a ``.toml`` path.
+
+    Names resolve inside ``data/scenarios/`` only (see :func:`scenario_path`); a path such as
+    ``"my-tunnel.toml"`` or ``Path("tunnels/mine.toml")`` loads your own file. The file is checked
+    against its family's schema (:mod:`tunnelkit.schema`): required keys, types, ranges, unknown
+    keys (with the nearest valid name), the base station, its arrays and the trajectory inside
+    the tunnel. Any problem is a :class:`ScenarioError` naming the file and the key.
+    """
+    path = scenario_path(name)
     try:
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path.name}: not valid TOML ({exc})") from None
-    get = _getter(path.name, raw, "")
-    # modules that register this preset's tunnel/trajectory kinds (e.g. "tunnelkit.propagation")
-    for mod in raw.get("requires", []):
-        if not isinstance(mod, str) or not mod.startswith("tunnelkit."):
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"{path.name}: cannot read ({exc})") from None
+    where = path.name
+    family, sections = validate(raw, where)
+    for mod in sections.get("requires", []):
+        if mod not in ALLOWED_REQUIRES:
             raise ScenarioError(
-                f"{path.name}: 'requires' entries must name tunnelkit modules, got {mod!r}"
+                f"{where}: 'requires' entries must be one of {list(ALLOWED_REQUIRES)}, got {mod!r}"
             )
+    for mod in (*_FAMILY_MODULES.get(family, ()), *sections.get("requires", [])):
         importlib.import_module(mod)
+    if family == "user":
+        _derive_user(sections, raw, where)
     sc = Scenario(
-        name=get("name", str),
-        paper=get("paper", str),
-        description=get("description", str, default=""),
+        name=sections["name"],
+        paper=sections.get("paper", ""),
+        description=sections.get("description", ""),
         path=path,
-        sections=raw,
+        sections=sections,
+        family=family,
+        raw=raw,
     )
-    # build once so a malformed file fails at load time, naming the key
-    if "tunnel" in raw:
-        sc.tunnel()
-    if "trajectory" in raw:
-        sc.trajectory()
+    _check_placement(sc)
     return sc
+
+
+def _derive_user(sec: dict, raw: dict, where: str) -> None:
+    """Fill the keys the shared builders read from a ``user`` file's friendlier ones."""
+    from .constants import wavelength
+
+    radio = sec["radio"]
+    lam = float(wavelength(radio["fc"]))
+    for i, (arr, given) in enumerate(
+        zip(sec["base_station"]["arrays"], raw["base_station"]["arrays"])
+    ):
+        if "spacing_m" in given and "spacing_wavelengths" in given:
+            raise ScenarioError(
+                f"{where}: 'base_station.arrays[{i}].spacing_m' and '.spacing_wavelengths' both "
+                "given; keep one"
+            )
+        arr["elevation_deg"] = -arr["tilt_deg"]
+        arr["spacing"] = (
+            arr["spacing_m"] if "spacing_m" in arr else arr["spacing_wavelengths"] * lam
+        )
+    if "n_rb" not in radio:
+        n_rb = int(np.floor(0.983 * radio["bandwidth"] / (12 * radio["scs"]) + 1e-9))
+        if n_rb < 1:
+            raise ScenarioError(
+                f"{where}: 'radio.bandwidth' {radio['bandwidth']:g} Hz holds no resource block of "
+                f"12 subcarriers at radio.scs = {radio['scs']:g} Hz"
+            )
+        radio["n_rb"] = n_rb
+
+
+def _check_placement(sc: Scenario) -> None:
+    """Build tunnel and trajectory once; base station, arrays and route must lie inside."""
+    where, sec = sc.path.name, sc.sections
+    if sc.family == "halili2022":
+        w, h = sec["tube"]["width"], sec["tube"]["height"]
+        for key, val, lim in (
+            ("transmitter.tx_y", sec["transmitter"]["tx_y"], w / 2),
+            ("vehicle.lane_y", sec["vehicle"]["lane_y"], w / 2),
+        ):
+            if not abs(val) < lim:
+                raise ScenarioError(
+                    f"{where}: '{key}' = {val:g} m lies outside the {w:g} m wide tube (|y| < {lim:g})"
+                )
+        for key, val in (
+            ("transmitter.tx_z", sec["transmitter"]["tx_z"]),
+            ("vehicle.rx_height", sec["vehicle"]["rx_height"]),
+        ):
+            if not 0 < val < h:
+                raise ScenarioError(
+                    f"{where}: '{key}' = {val:g} m lies outside the {h:g} m high tube (0 < z < {h:g})"
+                )
+        return
+    tun = sc.tunnel()
+    bs = np.asarray(sec["base_station"]["position"], dtype=float)
+    if sc.family == "jiang2023":
+        if not tun.contains(bs):
+            raise ScenarioError(
+                f"{where}: 'base_station.position' {bs.tolist()} lies outside the tunnel walls"
+            )
+    else:
+        _check_arrays_inside(sc, tun, bs)
+    sc.trajectory(tun)
+
+
+def _check_arrays_inside(sc: Scenario, tun, bs: np.ndarray) -> None:
+    where = sc.path.name
+    if not tun.contains(bs, margin=1e-6):
+        raise ScenarioError(
+            f"{where}: 'base_station.position' {bs.tolist()} lies outside the tunnel "
+            "(in a wall, above the roof, under the road or beyond its ends)"
+        )
+    try:
+        arrays = sc.arrays()
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, ScenarioError):
+            raise
+        raise ScenarioError(f"{where}: base_station.arrays: {exc}") from None
+    lo = np.array([tun.x_range[0], -tun.width / 2, 0.0])
+    hi = np.array([tun.x_range[1], tun.width / 2, tun.height])
+    for i, arr in enumerate(arrays):
+        full = f"base_station.arrays[{i}]"
+        if not tun.contains(arr.origin, margin=1e-6):
+            raise ScenarioError(
+                f"{where}: '{full}.offset' puts the reference antenna at {arr.origin.tolist()}, "
+                "outside the tunnel"
+            )
+        # elements: inside the tunnel's bounding box (the paper's 10 x 10 URA at 4.8 m reaches a
+        # few cm above the 12-facet polygon near the crown, so facets would reject the paper)
+        out = ~np.all((arr.world > lo - 1e-9) & (arr.world < hi + 1e-9), axis=-1)
+        if np.any(out):
+            raise ScenarioError(
+                f"{where}: '{full}.shape' {arr.M} elements reach {arr.world[int(np.argmax(out))].round(3).tolist()}, "
+                f"outside the tunnel's cross-section (|y| <= {tun.width / 2:g}, 0 <= z <= {tun.height:g} m)"
+            )
+
+
+def template(name: str, preset: str | os.PathLike) -> str:
+    """A commented TOML template named ``name`` holding ``preset``'s values.
+
+    Every key is documented in a comment from the schema (doc, unit, range, default). A preset of
+    the JAVELIN family (``italiano2026-*``) becomes a ``user`` file (your own tunnel): kind
+    ``semicircular``, arrays with ``tilt_deg``, the trajectory as ``lane`` or ``slalom``; a
+    ``user`` preset is copied; Jiang and Halili presets keep their family.
+    """
+    if not isinstance(name, str) or not _NAME_RE.fullmatch(name):
+        raise ValueError(
+            f"name: expected a scenario name of letters, digits, '.', '_' or '-', got {name!r}"
+        )
+    sc = load_scenario(preset)
+    vals = {k: v for k, v in sc.raw.items()}
+    family = sc.family
+    if family == "italiano2026":
+        family, vals = "user", _italiano_to_user(sc.raw)
+    vals["name"] = name
+    vals["description"] = f"My tunnel, from {sc.name}: {sc.description}".strip()
+    head = (
+        f"Scenario {name!r}, written by `tunnelkit scenarios new {name} --from {sc.name}`.\n"
+        f"Load it with tk.load_scenario('{name}.toml'); check it with `tunnelkit scenarios {name}.toml`.\n"
+        "Units: SI (m, s, Hz) and degrees; x along the tunnel, y across (+y = left), z up, road at z = 0."
+    )
+    return render_template(family, vals, head)
+
+
+def _italiano_to_user(raw: dict) -> dict:
+    out = {k: v for k, v in raw.items() if k not in ("paper", "requires")}
+    tun = dict(raw["tunnel"])
+    tun["kind"] = "semicircular"
+    out["tunnel"] = tun
+    bs = dict(raw["base_station"])
+    arrs = []
+    for a in bs.get("arrays", []):
+        a = dict(a)
+        a["tilt_deg"] = -a.pop("elevation_deg")
+        arrs.append(a)
+    bs["arrays"] = arrs
+    out["base_station"] = bs
+    tr = dict(raw["trajectory"])
+    amp = tr.pop("slalom_amplitude", 0.0)
+    wl = tr.pop("slalom_wavelength", 20.0)
+    if amp > 0:
+        tr.update(kind="slalom", amplitude=amp, wavelength=wl)
+    else:
+        tr["kind"] = "lane"
+    out["trajectory"] = tr
+    return out
+
+
+def check_all(paths=None) -> list[tuple[str, str | None]]:
+    """``[(name, error or None), ...]`` for every preset (or the given names/paths)."""
+    out = []
+    for n in list_scenarios() if paths is None else paths:
+        try:
+            load_scenario(n)
+            out.append((str(n), None))
+        except (ScenarioError, TypeError) as exc:
+            out.append((str(n), str(exc)))
+    return out
 
 
 # --- builders for Jiang et al. 2023 -------------------------------------------------------------
