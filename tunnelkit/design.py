@@ -64,6 +64,7 @@ __all__ = [
     "path_bounds",
     "recommend",
     "route_bounds",
+    "smallest_meeting",
     "trace_route",
 ]
 
@@ -195,7 +196,25 @@ class DesignSetup:
                 f"scenario: {sc.name!r} has a 2-D tunnel; the design needs a 3-D tunnel "
                 "(semicircular, rectangular or horseshoe)"
             )
-        cfg = SRSConfig.from_scenario(sc)
+        mounts = tuple(
+            Mount(a.name, a.origin.copy(), a.azimuth, a.elevation)
+            for a in propagation.scenario_arrays(sc)
+        )
+        setup = cls(sc.name, tun, mounts, sc.trajectory(tun), SRSConfig.from_scenario(sc))
+        return setup.variant(
+            fc=fc, bandwidth=bandwidth, tilt_deg=tilt_deg, mount_height=mount_height
+        )
+
+    def variant(
+        self,
+        *,
+        fc: float | None = None,
+        bandwidth: float | None = None,
+        tilt_deg: float | None = None,
+        mount_height: float | None = None,
+    ) -> DesignSetup:
+        """A copy with another carrier, bandwidth, down-tilt or mount height (``None`` keeps)."""
+        cfg = self.config
         if fc is not None:
             cfg = replace(cfg, fc=positive("fc", fc))
         if bandwidth is not None:
@@ -205,9 +224,8 @@ class DesignSetup:
                 raise ValueError(f"bandwidth: {bw:g} Hz is narrower than one resource block")
             cfg = replace(cfg, bandwidth=bw, n_rb=n_rb)
         mounts = []
-        for a in propagation.scenario_arrays(sc):
-            centre = a.origin.copy()
-            el = a.elevation
+        for m in self.mounts:
+            el, centre = m.elevation, m.centre
             if tilt_deg is not None:
                 t = float(finite_array("tilt_deg", tilt_deg, ndim=0))
                 if not -90.0 <= t <= 90.0:
@@ -216,15 +234,13 @@ class DesignSetup:
             if mount_height is not None:
                 centre = centre.copy()
                 centre[2] = float(finite_array("mount_height", mount_height, ndim=0))
-            mounts.append(Mount(a.name, centre, a.azimuth, float(el)))
-        setup = cls(sc.name, tun, tuple(mounts), sc.trajectory(tun), cfg)
-        for m in setup.mounts:
-            if not np.all(tun.contains(m.centre, margin=0.0)):
+            if not np.all(self.tunnel.contains(centre, margin=0.0)):
                 raise ValueError(
-                    f"mount: the base-station mount {m.centre.round(3).tolist()} of array "
+                    f"mount: the base-station mount {centre.round(3).tolist()} of array "
                     f"{m.name!r} lies outside the tunnel"
                 )
-        return setup
+            mounts.append(Mount(m.name, centre, m.azimuth, float(el)))
+        return replace(self, mounts=tuple(mounts), config=cfg)
 
     @property
     def fc(self) -> float:
@@ -373,7 +389,7 @@ def trace_route(
 class RouteBounds:
     """Per-epoch results of :func:`route_bounds` for one array.
 
-    ``peb`` (T,) [m] (``inf`` where the position is not identifiable); ``mismatch`` (T, P) exact
+    ``peb`` (T,) [m] (``inf`` where the position is not identifiable; ``None`` if not asked); ``mismatch`` (T, P) exact
     SR-NF phase mismatch of each candidate path [rad] (0 for LoS and absent paths);
     ``used`` (T, P) the paths the bound combines; ``srnf_valid`` (T,) every used path below
     ``eps_phi``; ``x`` (T,) the vehicle's position along the tunnel.
@@ -471,54 +487,9 @@ def _position_covariance(G: np.ndarray, n_pos: int, rcond: float = 1e-12) -> np.
     return cov
 
 
-def route_bounds(
-    setup: DesignSetup,
-    spec,
-    *,
-    markings: bool = True,
-    curvature: bool = True,
-    clock_bias: str = "unknown",
-    height_known: bool = True,
-    eps_phi: float = 0.15,
-    geometry: RouteGeometry | None = None,
-    epochs=None,
-) -> RouteBounds:
-    """PEB and exact SR-NF validity of ``spec`` along ``setup``'s route (module docstring).
-
-    ``markings=False`` leaves the RRM paths out; ``curvature=False`` makes each path's wavefront
-    radius a nuisance; ``clock_bias="known"`` drops the common delay bias; ``height_known``
-    (default, as JAVELIN) bounds the horizontal position with the antenna height known.
-    ``epochs`` (indices) subsamples the route; ``geometry`` reuses a :func:`trace_route`.
-    """
-    if not isinstance(setup, DesignSetup):
-        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
-    spec = parse_array(spec)
-    if clock_bias not in _CLOCK:
-        raise ValueError(f"clock_bias: expected one of {_CLOCK}, got {clock_bias!r}")
-    eps_phi = positive("eps_phi", eps_phi)
-    cfg = setup.config
-    traj = setup.trajectory
-    sl = slice(None) if epochs is None else np.asarray(epochs, int)
-    if geometry is None:
-        geometry = trace_route(
-            setup.tunnel,
-            setup.arrays(spec),
-            traj.position[sl],
-            traj.velocity[sl],
-            fc=cfg.fc,
-            kinds=setup.kinds,
-        )
-    g = geometry
-    pos = spec.local(cfg.fc)
-    kinds = np.array(g.kinds)
-    used = g.exists & (markings | (kinds != "rrm"))[None, :]
-    idx, mask = _compress(used)
+def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature):
+    """Per-epoch PEB from the joint eq. 1 FIM (see :func:`route_bounds`)."""
     T, L = idx.shape
-    take = lambda a: np.take_along_axis(a, idx[..., None] if a.ndim == 3 else idx, axis=1)  # noqa: E731
-    src, pnt = take(g.source), take(g.point)
-    a0, R = g.origin, g.rotation
-    s_loc = np.einsum("tlj,tjk->tlk", src - a0[:, None, :], R)
-    d0 = np.linalg.norm(s_loc, axis=-1)
     alpha = np.sqrt(cfg.tx_power) * take(g.gain)
     mu_f = -2 * np.pi * cfg.tone_spacing * d0 / C
     mu_t = 2 * np.pi * cfg.symbol_period * take(g.doppler)
@@ -555,6 +526,63 @@ def route_bounds(
     cov = _position_covariance(Gth, n_pos)
     peb = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     peb = np.where(mask.any(axis=1), peb, np.inf)
+    return peb
+
+
+def route_bounds(
+    setup: DesignSetup,
+    spec,
+    *,
+    markings: bool = True,
+    curvature: bool = True,
+    clock_bias: str = "unknown",
+    height_known: bool = True,
+    eps_phi: float = 0.15,
+    geometry: RouteGeometry | None = None,
+    epochs=None,
+    peb: bool = True,
+) -> RouteBounds:
+    """PEB and exact SR-NF validity of ``spec`` along ``setup``'s route (module docstring).
+
+    ``markings=False`` leaves the RRM paths out; ``curvature=False`` makes each path's wavefront
+    radius a nuisance; ``clock_bias="known"`` drops the common delay bias; ``height_known``
+    (default, as JAVELIN) bounds the horizontal position with the antenna height known.
+    ``epochs`` (indices) subsamples the route; ``geometry`` reuses a :func:`trace_route`;
+    ``peb=False`` computes the SR-NF part only (``RouteBounds.peb`` is then ``None``).
+    """
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    spec = parse_array(spec)
+    if clock_bias not in _CLOCK:
+        raise ValueError(f"clock_bias: expected one of {_CLOCK}, got {clock_bias!r}")
+    eps_phi = positive("eps_phi", eps_phi)
+    cfg = setup.config
+    traj = setup.trajectory
+    sl = slice(None) if epochs is None else np.asarray(epochs, int)
+    if geometry is None:
+        geometry = trace_route(
+            setup.tunnel,
+            setup.arrays(spec),
+            traj.position[sl],
+            traj.velocity[sl],
+            fc=cfg.fc,
+            kinds=setup.kinds,
+        )
+    g = geometry
+    pos = spec.local(cfg.fc)
+    kinds = np.array(g.kinds)
+    used = g.exists & (markings | (kinds != "rrm"))[None, :]
+    idx, mask = _compress(used)
+    take = lambda a: np.take_along_axis(a, idx[..., None] if a.ndim == 3 else idx, axis=1)  # noqa: E731
+    src, pnt = take(g.source), take(g.point)
+    a0, R = g.origin, g.rotation
+    s_loc = np.einsum("tlj,tjk->tlk", src - a0[:, None, :], R)
+    d0 = np.linalg.norm(s_loc, axis=-1)
+    pe = None
+    if peb:
+        pe = _peb(
+            cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature
+        )
     # exact SR-NF mismatch of every used path (fresnel's cancellation-free form)
     from .fresnel import _mismatch
 
@@ -573,7 +601,7 @@ def route_bounds(
     mismatch = np.where(used, mismatch, 0.0)
     valid = ~np.any(mismatch > eps_phi, axis=1)
     return RouteBounds(
-        spec, g.ue[:, 0].copy(), peb, mismatch, used, valid, g.kinds, eps_phi, used.sum(axis=1)
+        spec, g.ue[:, 0].copy(), pe, mismatch, used, valid, g.kinds, eps_phi, used.sum(axis=1)
     )
 
 
@@ -621,8 +649,13 @@ def path_bounds(setup: DesignSetup, spec, *, epochs=None) -> dict[str, np.ndarra
         proj = np.eye(3)[None] - u[:, :, None] * u[:, None, :]
         cov = res["source_cov"]
         out["d"].append(C / (2 * np.pi * cfg.tone_spacing) * res["mu_f"])
-        out["direction"].append(np.sqrt(np.einsum("lij,ljk,lki->l", proj, cov, proj)) / d0)
-        out["kappa"].append(np.sqrt(np.einsum("li,lij,lj->l", u, cov, u)))
+        var_dir = np.einsum("lij,ljk,lki->l", proj, cov, proj)
+        var_kap = np.einsum("li,lij,lj->l", u, cov, u)
+        # a variance that is not positive: the parameter is not identifiable (e.g. curvature
+        # with 2 x 2 elements) and the inversion lost it in round-off -> an infinite bound
+        with np.errstate(invalid="ignore"):
+            out["direction"].append(np.where(var_dir > 0, np.sqrt(var_dir), np.inf) / d0)
+            out["kappa"].append(np.where(var_kap > 0, np.sqrt(var_kap), np.inf))
         out["kind"].append(np.array(g.kinds)[j])
     return {k: np.concatenate(v) if v else np.zeros(0) for k, v in out.items()}
 
@@ -689,7 +722,7 @@ class DesignReport:
         )
 
         def m(v):
-            return f"{v:8.3f}m" if np.isfinite(v) else "      inf"
+            return f"{100 * v:7.3g}cm" if np.isfinite(v) else "      inf"
 
         lines = [
             f"Array design for {self.scenario}: fc {s['fc'] / 1e9:g} GHz, bandwidth "
@@ -704,7 +737,8 @@ class DesignReport:
                 else "-"
             )
             lines.append(
-                f"{r.array:>7s} {r.n_elements:5d} {r.aperture_m:8.3f}m {100 * r.srnf_valid_share:8.1f}% "
+                f"{r.array:>7s} {r.n_elements:5d} {100 * r.aperture_m:7.3g}cm "
+                f"{100 * r.srnf_valid_share:8.1f}% "
                 f"{m(r.peb_median_m)} {m(r.peb_p90_m)} {100 * r.met_share:5.1f}% "
                 f"{m(r.variants.get('no_curvature', np.nan))} "
                 f"{m(r.variants.get('no_markings', np.nan))} {rm:>22s}"
@@ -731,14 +765,60 @@ def recommend(rows: list[DesignRow], target: float, share: float) -> dict:
                 f"{best.peb_median_m:.3g} m"
             ),
         }
-    top = max(rows, key=lambda r: r.met_share)
+    top = max(rows, key=lambda r: (r.met_share, -r.n_elements))
+    why = ""
+    if top.surfaces:
+        worst = min(top.surfaces, key=top.surfaces.get)
+        if top.surfaces[worst] < share:
+            why = (
+                f"; SR-NF binds on the {worst} (valid on {100 * top.surfaces[worst]:.0f} % of "
+                f"epochs for {top.array})"
+            )
     return {
         "array": None,
         "reason": (
             f"no candidate meets PEB <= {target:g} m with SR-NF valid on {100 * share:.0f} % of "
-            f"the route; best is {top.array} with {100 * top.met_share:.0f} %"
+            f"the route; best is {top.array} with {100 * top.met_share:.0f} %{why}"
         ),
     }
+
+
+def smallest_meeting(
+    setup: DesignSetup,
+    arrays,
+    *,
+    target: float = 0.2,
+    share: float = 0.9,
+    eps_phi: float = 0.15,
+) -> tuple[ArraySpec | None, float]:
+    """The first array of ``arrays`` (in the order given) whose PEB <= ``target`` with SR-NF
+    valid on ``share`` of the route, and its met share; ``(None, best share)`` if none.
+
+    The SR-NF part is computed first (cheap); the PEB only where SR-NF alone leaves ``share``
+    within reach. Arrays that do not fit in the tunnel are skipped. For the explorer.
+    """
+    best = 0.0
+    for spec in (parse_array(a) for a in arrays):
+        try:
+            g = trace_route(
+                setup.tunnel,
+                setup.arrays(spec),
+                setup.trajectory.position,
+                setup.trajectory.velocity,
+                fc=setup.fc,
+                kinds=setup.kinds,
+            )
+        except ValueError:
+            continue
+        b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
+        if b.srnf_valid.mean() < share:
+            continue
+        b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g)
+        met = float(np.mean((b.peb <= target) & b.srnf_valid))
+        if met >= share:
+            return spec, met
+        best = max(best, met)
+    return None, best
 
 
 def _summary(b: RouteBounds, target: float) -> tuple[float, float, float]:
