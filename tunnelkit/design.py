@@ -790,21 +790,24 @@ def smallest_meeting(
     target: float = 0.2,
     share: float = 0.9,
     eps_phi: float = 0.15,
+    epochs=None,
 ) -> tuple[ArraySpec | None, float]:
     """The first array of ``arrays`` (in the order given) whose PEB <= ``target`` with SR-NF
     valid on ``share`` of the route, and its met share; ``(None, best share)`` if none.
 
     The SR-NF part is computed first (cheap); the PEB only where SR-NF alone leaves ``share``
-    within reach. Arrays that do not fit in the tunnel are skipped. For the explorer.
+    within reach. Arrays that do not fit in the tunnel are skipped; ``epochs`` subsamples the
+    route. For the explorer.
     """
     best = 0.0
+    sl = slice(None) if epochs is None else np.asarray(epochs, int)
     for spec in (parse_array(a) for a in arrays):
         try:
             g = trace_route(
                 setup.tunnel,
                 setup.arrays(spec),
-                setup.trajectory.position,
-                setup.trajectory.velocity,
+                setup.trajectory.position[sl],
+                setup.trajectory.velocity[sl],
                 fc=setup.fc,
                 kinds=setup.kinds,
             )
