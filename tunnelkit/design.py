@@ -1031,7 +1031,8 @@ def javelin_rmse(
     crlb: dict | None = None,
     calibrate: bool = True,
 ) -> dict:
-    """Monte-Carlo 2-D RMSE of JAVELIN on ``spec`` with a t-interval (95 %) over ``runs`` drives.
+    """Monte-Carlo 2-D RMSE of JAVELIN on ``spec`` with a 95 % t-interval over ``runs`` drives
+    (LoS condition, the scenario's route; the interval is clipped at 0).
 
     Measurement sigmas come from the design (:func:`javelin_config`): the route-median CRLBs and,
     with ``calibrate``, the extraction error measured on one calibration drive drawn from its own
@@ -1079,4 +1080,10 @@ def javelin_rmse(
         "kappa_m": cfg.sigma_kappa,
         "delta_d_m": cfg.sigma_delta_d,
     }
-    return {"rmse_m": mean, "ci95_m": [mean - half, mean + half], "runs": res, "sigmas": sig}
+    # a t-interval on the per-run RMSEs, clipped at 0 (an RMSE is not negative)
+    return {
+        "rmse_m": mean,
+        "ci95_m": [max(mean - half, 0.0), mean + half],
+        "runs": res,
+        "sigmas": sig,
+    }
