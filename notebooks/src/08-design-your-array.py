@@ -138,6 +138,7 @@ print(
 # 20 cm above the array, is so close that its reflection point is deep in the array's near field.
 
 # %%
+# headline: peb-along-the-tunnel
 route_figure(b8, variants=variants, target=0.15, title="8x8 URA at 28 GHz under the ceiling").show()
 print("SR-NF valid share per surface:", b8.surface_validity())
 
@@ -167,6 +168,7 @@ print(answer.to_table())
 # `kappa_model="vue"`), not with the SR-NF model.
 
 # %%
+# headline: peb-srnf-vs-size-28ghz
 size_figure(answer.rows, mark=None, title="28 GHz, 8 m x 6 m tunnel: PEB and SR-NF share").show()
 
 # %% [markdown]
@@ -180,6 +182,7 @@ size_figure(answer.rows, mark=None, title="28 GHz, 8 m x 6 m tunnel: PEB and SR-
 paper = design.DesignSetup.from_scenario("italiano2026-straight", mount_height=4.5)
 sizes = ["4x4", "8x8", "10x10", "16x16", "24x24", "32x32"]
 sweep = design.design_sweep(paper, sizes, target=0.2)
+# headline: peb-srnf-vs-size-paper
 size_figure(sweep.rows, mark="10x10", title="Paper's tunnel, 5.9 GHz: PEB and SR-NF share").show()
 print(sweep.to_table())
 
@@ -221,6 +224,7 @@ print("sigmas used:", {k: round(float(v), 4) for k, v in mc["sigmas"].items()})
 # Monte-Carlo on the current design with a progress bar.
 
 # %%
+# headline: explorer
 explorer = design_explorer(target=0.15, runs=tk.mc_count(6, 2))
 explorer
 
