@@ -24,7 +24,9 @@ def _paths(setup, arr, ue, vel):
     return {p.surface or "LoS": p for p in ps}
 
 
-def brute_force_peb(setup, spec, k, *, curvature=True, clock_bias="unknown", h=1e-5):
+def brute_force_peb(
+    setup, spec, k, *, curvature=True, clock_bias="unknown", height_known=True, h=1e-5
+):
     """PEB from finite differences of the synthesised tensor (channel.channel_tensor).
 
     Columns: d H / d (x, y) by re-tracing the paths from a perturbed UE (central differences),
@@ -39,7 +41,8 @@ def brute_force_peb(setup, spec, k, *, curvature=True, clock_bias="unknown", h=1
     names = list(base)
     H0 = lambda ps, b=0.0: channel.channel_tensor(ps, cfg, clock_bias=b)  # noqa: E731
     cols = []
-    for i in range(2):
+    n_pos = 2 if height_known else 3
+    for i in range(n_pos):
         e = np.zeros(3)
         e[i] = h
         pp, pm = _paths(setup, arr, ue + e, vel), _paths(setup, arr, ue - e, vel)
@@ -66,21 +69,24 @@ def brute_force_peb(setup, spec, k, *, curvature=True, clock_bias="unknown", h=1
     F = 2.0 / cfg.noise_power * (J.conj().T @ J).real
     sc = 1 / np.sqrt(np.diag(F))
     cov = sc[:, None] * np.linalg.inv(sc[:, None] * F * sc[None, :]) * sc[None, :]
-    return float(np.sqrt(cov[0, 0] + cov[1, 1]))
+    return float(np.sqrt(np.trace(cov[:n_pos, :n_pos])))
 
 
 @pytest.mark.parametrize(
-    ("spec", "k", "curvature", "clock"),
+    ("spec", "k", "curvature", "clock", "height_known"),
     [
-        ("4x4", 5, True, "unknown"),
-        ("4x4", 20, True, "known"),
-        ("4x4", 12, False, "unknown"),
-        ("3x5", 25, True, "unknown"),
+        ("4x4", 5, True, "unknown", True),
+        ("4x4", 20, True, "known", True),
+        ("4x4", 12, False, "unknown", True),
+        ("3x5", 25, True, "unknown", True),
+        ("4x4", 16, True, "unknown", False),
+        ("4x4", 16, False, "known", False),
     ],
 )
-def test_peb_matches_brute_force_fisher_information(setup, spec, k, curvature, clock):
-    closed = design.route_bounds(setup, spec, epochs=[k], curvature=curvature, clock_bias=clock)
-    brute = brute_force_peb(setup, spec, k, curvature=curvature, clock_bias=clock)
+def test_peb_matches_brute_force_fisher_information(setup, spec, k, curvature, clock, height_known):
+    kw = {"curvature": curvature, "clock_bias": clock, "height_known": height_known}
+    closed = design.route_bounds(setup, spec, epochs=[k], **kw)
+    brute = brute_force_peb(setup, spec, k, **kw)
     # central differences with h = 10 um on a phase slope of 2 pi / lambda: ~1e-6 relative
     assert closed.peb[0] == pytest.approx(brute, rel=1e-4)
 

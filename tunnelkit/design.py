@@ -435,6 +435,25 @@ def _gram(X: np.ndarray) -> np.ndarray:
     return out
 
 
+def _vandermonde_pair(mu: np.ndarray, n: int) -> np.ndarray:
+    """``[e^{j s mu_l}, j s e^{j s mu_l}]`` for ``s = 0..n-1``, interleaved per path: (T, n, 2L).
+
+    ``e^{j s mu} = e^{j q B mu} e^{j r mu}`` with ``s = q B + r``: about ``2 sqrt(n)`` complex
+    exponentials per path instead of ``n``.
+    """
+    T, L = mu.shape
+    B = max(int(np.ceil(np.sqrt(n))), 1)
+    q = np.arange(-(-n // B))
+    r = np.arange(B)
+    hi = np.exp(1j * (q * B)[None, :, None] * mu[:, None, :])  # (T, Q, L)
+    lo = np.exp(1j * r[None, :, None] * mu[:, None, :])  # (T, B, L)
+    v = (hi[:, :, None, :] * lo[:, None, :, :]).reshape(T, -1, L)[:, :n]
+    out = np.empty((T, n, L, 2), complex)
+    out[..., 0] = v
+    out[..., 1] = 1j * np.arange(n)[None, :, None] * v
+    return out.reshape(T, n, 2 * L)
+
+
 def _fim_eta(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols, noise_power):
     """Joint Fisher information (T, 7L, 7L) of eq. 1 over ``eta_l = [Re a, Im a, mu_f, mu_t,
     s (3, local)]`` per path, assembled from the three modes' Gram matrices."""
@@ -445,16 +464,12 @@ def _fim_eta(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols, noise_
     a = np.exp(1j * k0 * (rng_m - rng_m[:, :1]))
     u = diff / rng_m[..., None]
     da = 1j * k0 * a[..., None] * (u - u[:, :1])
-    A = np.concatenate([a[..., None], da], axis=-1).reshape(T, pos.shape[0], 4 * L)
-    Gs = _gram(A)
-    s = np.arange(n_tones)[None, :, None]
-    F = np.exp(1j * s * mu_f[:, None, :])
-    F = np.stack([F, 1j * s * F], axis=-1).reshape(T, n_tones, 2 * L)
-    Gf = _gram(F)
-    k = np.arange(n_symbols)[None, :, None]
-    Z = np.exp(1j * k * mu_t[:, None, :])
-    Z = np.stack([Z, 1j * k * Z], axis=-1).reshape(T, n_symbols, 2 * L)
-    Gt = _gram(Z)
+    A = np.empty((T, pos.shape[0], L, 4), complex)
+    A[..., 0] = a
+    A[..., 1:] = da
+    Gs = _gram(A.reshape(T, pos.shape[0], 4 * L))
+    Gf = _gram(_vandermonde_pair(mu_f, n_tones))
+    Gt = _gram(_vandermonde_pair(mu_t, n_symbols))
     li = np.repeat(np.arange(L), 7)
     kk = np.tile(np.arange(7), L)
     si = 4 * li + np.array([0, 0, 0, 0, 1, 2, 3])[kk]

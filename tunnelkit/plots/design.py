@@ -26,8 +26,13 @@ def _finite(v: np.ndarray) -> list:
     return [float(x) if np.isfinite(x) else None for x in np.asarray(v, float)]
 
 
+def _scatter(**kw) -> dict:
+    """A scatter trace as a plain dict (validated once, by the figure that receives it)."""
+    return {"type": "scatter", **kw}
+
+
 def route_traces(bounds, *, variants: dict | None = None, target: float | None = None) -> list:
-    """Traces on axes (x, y) PEB [cm] along the tunnel and (x, y2) SR-NF mismatch per surface.
+    """Trace dicts on axes (x, y) PEB [cm] along the tunnel and (x, y2) SR-NF mismatch per surface.
 
     Order: 0 PEB, 1 SR-NF not valid (markers on the PEB), 2.. one dashed trace per variant
     (``{"no curvature": RouteBounds, ...}``), then the target line (if given), then one mismatch
@@ -37,7 +42,7 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
     peb_cm = 100 * bounds.peb
     bad = ~bounds.srnf_valid
     traces = [
-        go.Scatter(
+        _scatter(
             x=x,
             y=_finite(peb_cm),
             mode="lines+markers",
@@ -45,7 +50,7 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
             line={"color": COLORS.get("ours", "#1f77b4"), "width": 2.5},
             marker={"size": 5},
         ),
-        go.Scatter(
+        _scatter(
             x=x[bad],
             y=_finite(peb_cm[bad]),
             mode="markers",
@@ -55,7 +60,7 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
     ]
     for i, (name, b) in enumerate((variants or {}).items()):
         traces.append(
-            go.Scatter(
+            _scatter(
                 x=b.x,
                 y=_finite(100 * b.peb),
                 mode="lines",
@@ -65,7 +70,7 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
         )
     if target is not None:
         traces.append(
-            go.Scatter(
+            _scatter(
                 x=[float(x.min()), float(x.max())],
                 y=[100 * target, 100 * target],
                 mode="lines",
@@ -85,7 +90,7 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
                 used.any(axis=1), np.nanmax(np.where(used, mis, -np.inf), axis=1), np.nan
             )
         traces.append(
-            go.Scatter(
+            _scatter(
                 x=x,
                 y=_finite(worst),
                 mode="lines+markers",
@@ -97,7 +102,7 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
             )
         )
     traces.append(
-        go.Scatter(
+        _scatter(
             x=[float(x.min()), float(x.max())],
             y=[bounds.eps_phi, bounds.eps_phi],
             mode="lines",
