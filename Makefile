@@ -5,7 +5,13 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
-KERNEL := tunnelkit
+# One kernel name everywhere: the notebooks declare `python3`, which inside .venv is this venv's
+# Python; `make lab` registers it in .venv with the display name the notebooks carry, so saving in
+# JupyterLab writes back the same kernelspec (tools/check_notebooks.py checks it).
+KERNEL := python3
+KERNEL_DISPLAY := Python (tunnelkit)
+# JupyterLab refuses to start as root unless told; pass --allow-root only then.
+LAB_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 # pip --quiet still relays setuptools' build warnings and a site-wide config's "is ignored" notes
 PIP_FILTER := sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$\|Please be careful\|name as your package\|take precedence during\|with strategy, WheelFile\|warnings.warn(/d'
@@ -25,7 +31,7 @@ help:
 	@echo "make browser Playwright + Chromium tests of the dashboard and the site (part of make test)"
 	@echo "make rt-deps Sionna RT extra and Debian's libllvm19 (part of make test)"
 	@echo "make bench   benchmarks (medians and ratios measured in one run)"
-	@echo "make format  apply ruff formatting and strip notebook outputs"
+	@echo "make format  ruff formatting; rebuild notebooks/*.ipynb from notebooks/.src/*.py without outputs"
 	@echo "make clean   remove .venv and caches"
 
 $(STAMP): pyproject.toml
@@ -36,16 +42,18 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
+# allow_hidden: the notebooks' sources live in notebooks/.src/ (hidden in the file browser) and
+# jupytext must be allowed to write them when a notebook is saved.
 lab: install
-	$(PY) -m ipykernel install --sys-prefix --name $(KERNEL) --display-name "Python (tunnelkit)"
-	$(VENV)/bin/jupyter lab notebooks/
+	$(PY) -m ipykernel install --sys-prefix --name $(KERNEL) --display-name "$(KERNEL_DISPLAY)" >/dev/null
+	$(if $(filter-out 0,$(QUICK)),TUNNELKIT_QUICK=1) $(VENV)/bin/jupyter lab $(LAB_ROOT) \
+	  --ContentsManager.allow_hidden=True notebooks/
 
-LINTED := tunnelkit tests benchmarks tools notebooks/src
+LINTED := tunnelkit tests benchmarks tools notebooks/.src
 
 lint: install
 	$(VENV)/bin/ruff check $(LINTED)
 	$(VENV)/bin/ruff format --check $(LINTED)
-	$(PY) tools/nbbuild.py --check
 	$(PY) tools/check_notebooks.py notebooks
 
 unit: install rt-deps
@@ -62,8 +70,7 @@ bench: install
 format: install
 	$(VENV)/bin/ruff format $(LINTED)
 	$(VENV)/bin/ruff check --fix $(LINTED)
-	$(PY) tools/nbbuild.py
-	$(PY) tools/check_notebooks.py --strip notebooks
+	$(PY) tools/check_notebooks.py --build --strip notebooks
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .ruff_cache

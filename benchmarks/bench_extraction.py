@@ -14,11 +14,12 @@ import tensorly as tl
 from run import Case
 from tensorly.decomposition import parafac
 
-from tunnelkit import channel, coherent, extraction, propagation
+from tunnelkit import channel, extraction, propagation, signal_route
+from tunnelkit.extraction import coherent
 
 
 def _tensor():
-    route = channel.SignalRoute.from_scenario("italiano2026-straight")
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     arr, paths = route.paths(10)  # LoS, ceiling, road, two RRMs
     extra = propagation.trace_paths(
         route.tunnel, arr, [25.0, 2.0, 1.5], [-10.0, 0, 0], fc=route.config.fc, kinds=("los",)

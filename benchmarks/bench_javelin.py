@@ -1,6 +1,6 @@
 """Notebook 04: one JAVELIN step (association, management, Joseph update; extraction excluded)
 and one whole epoch of the signal route (channel synthesis + CPD extraction + the step), with
-the paper's extraction and with coherent paths separated (``tunnelkit.coherent``)."""
+the paper's extraction and with coherent paths separated (``tunnelkit.extraction.coherent``)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from tunnelkit import channel
+from tunnelkit import channel, signal_route
 from tunnelkit import propagation as P
 from tunnelkit.arrays import make_array
 from tunnelkit.constants import K_B, C
@@ -89,7 +89,7 @@ def test_bad_input(small):
 
 
 def test_simulate_epoch_route_recovers_the_los():
-    ep = channel.simulate_epoch(
+    ep = signal_route.simulate_epoch(
         "italiano2026-straight", 20, np.random.default_rng(5), kinds=("los", "road", "rrm")
     )
     m = ep.measurements
@@ -103,4 +103,4 @@ def test_simulate_epoch_route_recovers_the_los():
     assert m.v[i] == pytest.approx(los.velocity, abs=0.05)
     assert m.z.shape == (4 * len(m) - 1,) and m.delta_d[0] == 0
     with pytest.raises(ValueError, match="k"):
-        channel.simulate_epoch("italiano2026-straight", 999, np.random.default_rng(0))
+        signal_route.simulate_epoch("italiano2026-straight", 999, np.random.default_rng(0))

@@ -1,11 +1,12 @@
-"""Coherent-path separation (tunnelkit.coherent): Jacobian, source fits, and the JAVELIN epoch."""
+"""Coherent-path separation (tunnelkit.extraction.coherent): Jacobian, source fits, and the JAVELIN epoch."""
 
 import warnings
 
 import numpy as np
 import pytest
 
-from tunnelkit import arrays, channel, coherent, extraction
+from tunnelkit import arrays, channel, evaluation, extraction, signal_route
+from tunnelkit.extraction import coherent
 
 FC = 5.9e9
 LAM = 299792458.0 / FC
@@ -37,7 +38,7 @@ def test_steering_jacobian_matches_finite_differences():
 
 def test_steering_is_the_channel_spatial_factor():
     """The steering of a traced path's VUE is the spatial factor of ``channel_tensor``."""
-    route = channel.SignalRoute.from_scenario("italiano2026-straight")
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     arr, paths = route.paths(20)
     for p in paths:
         H = channel.channel_tensor([p], CFG, n_tones=2, n_symbols=2)
@@ -82,7 +83,7 @@ def test_split_keeps_a_single_source_single():
 @pytest.fixture(scope="module")
 def javelin_epoch():
     """Straight drive, x = 38 m: five paths within 0.8 m and 0.35 m/s of each other."""
-    route = channel.SignalRoute.from_scenario("italiano2026-straight")
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ep = route.epoch(5, np.random.default_rng(1))
@@ -109,8 +110,10 @@ def test_resolve_coherent_finds_every_path_the_cpd_merged(javelin_epoch):
         ep.snapshot.H, ep.estimates, ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period
     )
     assert len(est) == len(ep.paths) and np.all(np.isfinite(est.d)) and np.all(np.isfinite(est.v))
-    meas = channel.measurements_from_estimates(est, ep.array)
-    truth = channel.match_paths(meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias)
+    meas = signal_route.measurements_from_estimates(est, ep.array)
+    truth = evaluation.match_paths(
+        meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias
+    )
     after = _errors_deg(meas, ep.paths, truth)
     assert sorted(after) == ["RRM bottom right", "RRM top left", "facet 6", "los", "road"]
     assert after["los"] < 1.0 and after["facet 6"] < 1.5 and max(after.values()) < 3.0
@@ -123,7 +126,7 @@ def test_resolve_coherent_finds_every_path_the_cpd_merged(javelin_epoch):
 
 def test_resolve_coherent_leaves_resolved_paths_alone():
     """Noiseless, well separated paths: the separation returns the extraction's answer."""
-    route = channel.SignalRoute.from_scenario("italiano2026-straight")
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     arr, paths = route.paths(26)
     H = channel.channel_tensor(paths, CFG)
     est = extraction.extract_paths(
@@ -189,8 +192,10 @@ def test_without_splits_the_merged_pair_stays_merged(javelin_epoch):
     cfg = route.config
     args = (ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
     est = coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, max_sources=1)
-    meas = channel.measurements_from_estimates(est, ep.array)
-    truth = channel.match_paths(meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias)
+    meas = signal_route.measurements_from_estimates(est, ep.array)
+    truth = evaluation.match_paths(
+        meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias
+    )
     got = _errors_deg(meas, ep.paths, truth)
     assert got["los"] > 2.0 and "facet 6" not in got  # one source per component: no separation
 

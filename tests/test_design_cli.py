@@ -104,3 +104,13 @@ def test_monte_carlo_is_seeded_and_reported():
     pb = design.path_bounds(setup, "4x4")
     assert a["sigmas"]["direction_rad"] >= np.median(pb["direction"])
     assert a["sigmas"]["delta_d_m"] >= np.sqrt(2) * np.median(pb["d"])
+
+
+def test_a_scheduler_that_does_not_answer_fails_fast(capsys):
+    import time
+
+    t0 = time.perf_counter()
+    argv = ["design", "italiano2026-straight", "--arrays", "4x4", "--runs", "2"]
+    rc = main([*argv, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "2"])
+    assert rc != 0 and time.perf_counter() - t0 < 120
+    assert "scheduler" in capsys.readouterr().err

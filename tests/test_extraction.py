@@ -3,7 +3,7 @@ import warnings
 import numpy as np
 import pytest
 
-from tunnelkit import arrays, channel, extraction
+from tunnelkit import arrays, channel, extraction, signal_route
 from tunnelkit import propagation as P
 from tunnelkit.constants import C
 
@@ -13,7 +13,7 @@ CFG = channel.SRSConfig()
 
 @pytest.fixture(scope="module")
 def route():
-    return channel.SignalRoute.from_scenario("italiano2026-straight")
+    return signal_route.SignalRoute.from_scenario("italiano2026-straight")
 
 
 def _extract(H, L, arr, **kw):
@@ -129,7 +129,7 @@ def test_crlb_matches_finite_difference_fim():
 
 def test_los_rmse_within_twice_the_crlb(route):
     """Seeded snapshots at the paper's SNR and size, L known (LoS + road, no ceiling)."""
-    route_kinds = channel.SignalRoute(
+    route_kinds = signal_route.SignalRoute(
         route.tunnel, route.arrays, route.trajectory, route.config, kinds=("los", "road")
     )
     arr, paths = route_kinds.paths(10)
@@ -235,10 +235,10 @@ def test_linear_array_along_either_local_axis_keeps_the_curvature(shape):
 def test_half_wavelength_ura_is_recognised_as_a_grid(fc):
     """Rounding positions to the tolerance first made the step drift along a long axis."""
     pos = arrays.ura(32, 24, C / fc / 2)
-    r, c, nr, nc = extraction._grid_index(pos)
+    r, c, nr, nc = extraction.decomposition._grid_index(pos)
     assert (nr, nc) == (32, 24)
     np.testing.assert_array_equal(r * 24 + c, np.arange(pos.shape[0]))
-    assert len(extraction._shift_pairs(pos)) == 2
+    assert len(extraction.decomposition._shift_pairs(pos)) == 2
 
 
 def test_refine_joint_reaches_a_stationary_point_of_the_projected_cost():

@@ -115,3 +115,367 @@ def test_reference_tables_load():
     assert any(r["p90_m"] is None for r in p90)
     with pytest.raises(ValueError, match="name: unknown reference table"):
         tk.reference.load("nope")
+
+
+# --- the schema -----------------------------------------------------------------------------------
+
+from pathlib import Path  # noqa: E402
+
+from tunnelkit import cli, drive, schema  # noqa: E402
+from tunnelkit import scenarios as S  # noqa: E402
+
+PRESETS = Path(__file__).resolve().parent.parent / "data" / "scenarios"
+
+
+def _text(name: str) -> str:
+    return (PRESETS / f"{name}.toml").read_text()
+
+
+def _load_text(tmp_path, text: str):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    return tk.load_scenario(str(path))
+
+
+JAV, USR, HAL = "italiano2026-straight", "example-rectangular-28ghz", "halili2022-drive"
+JIANG_GOOD = GOOD + "[noise]\nlevels = [[0.5, 0.1], [1.0, 1.0]]\n"
+
+# (base file, old, new, regex the ScenarioError must match: it names the key)
+MALFORMED = [
+    # the issue's malformed files
+    (
+        JAV,
+        "shape = [10, 10]",
+        "shape = [0, 10]",
+        r"'base_station\.arrays\[0\]\.shape\[0\]' must be >= 1",
+    ),
+    (JAV, "comb = 8 ", "comb = 0 ", r"'radio\.comb' must be >= 1"),
+    (JAV, "fc = 5.9e9", "fc = -5.9e9", r"'radio\.fc' must be > 0"),
+    (
+        JAV,
+        "elevation_deg = -30.0",
+        "elevation_deg = 200.0",
+        r"arrays\[0\]\.elevation_deg' must be <= 90",
+    ),
+    (JAV, "fc = 5.9e9 ", "", r"missing key 'radio\.fc'"),
+    (
+        JAV,
+        "noise_figure_db = 5.0",
+        "noise_figure_db = nan",
+        r"'radio\.noise_figure_db' must be finite",
+    ),
+    (
+        JAV,
+        "shape = [10, 10]",
+        "shape = [10.5, 10]",
+        r"'base_station\.arrays\[0\]\.shape\[0\]' must be an integer",
+    ),
+    (
+        JAV,
+        "bandwidth = 100e6",
+        "bandwith = 100e6",
+        r"unknown key 'radio\.bandwith'; did you mean 'radio\.bandwidth'",
+    ),
+    (
+        JAV,
+        "position = [0.0, 0.0, 4.8]",
+        "position = [0.0, 0.0, 5.5]",
+        r"'base_station\.position' \[0\.0, 0\.0, 5\.5\] lies outside",
+    ),
+    (
+        JAV,
+        "position = [0.0, 0.0, 4.8]",
+        "position = [0.0, 5.0, 1.0]",
+        r"'base_station\.position' .* lies outside",
+    ),
+    (
+        JAV,
+        "position = [0.0, 0.0, 4.8]",
+        "position = [0.0, 0.0, -0.5]",
+        r"'base_station\.position' .* lies outside",
+    ),
+    (
+        JIANG_GOOD,
+        "position = [0.0, 0.0]",
+        "position = [-100.0, 100.0]",
+        r"'base_station\.position' \[-100\.0, 100\.0\] lies outside the tunnel walls",
+    ),
+    (
+        JAV,
+        '"tunnelkit.propagation"]',
+        '"tunnelkit.__main__"]',
+        r"'requires' entries must be one of",
+    ),
+    # more: types, ranges, unknown keys and sections, placement
+    (
+        JAV,
+        "tx_power_dbm = 23.0",
+        "tx_power_dbm = true",
+        r"'radio\.tx_power_dbm' must be a number, got True",
+    ),
+    (JAV, "speed = 13.89", 'speed = "fast"', r"'trajectory\.speed' must be a number"),
+    (JAV, "n_symbols = 12", "n_symbols = 12.0", r"'radio\.n_symbols' must be an integer"),
+    (JAV, "[radio]", "[radoi]", r"unknown key 'radoi'; did you mean 'radio'"),
+    (
+        JAV,
+        'paper = "italiano2026"',
+        'paper = "italiano2025"',
+        r"'paper' must be one of .*did you mean 'italiano2026'",
+    ),
+    (JAV, "y = -2.5 ", "y = -6.0 ", r"trajectory: leaves the tunnel"),
+    (JAV, "y = 4.6 ", "y = 5.5 ", r"tunnel\.plates\[0\]|sticks out"),
+    (
+        JAV,
+        "inclination_deg = 55.0",
+        "inclination_deg = 0.0",
+        r"'tunnel\.plates\[0\]\.inclination_deg' must be > 0",
+    ),
+    (
+        JAV,
+        "shape = [10, 10]",
+        "shape = [200, 200]",
+        r"'base_station\.arrays\[0\]\.shape' \[200, 200\] has 40000 elements, more than 4096",
+    ),
+    (
+        JAV,
+        "shape = [10, 10]",
+        "shape = [40, 40]",
+        r"'base_station\.arrays\[0\]\.shape' .* outside the tunnel's cross-section",
+    ),
+    (
+        _text(USR).replace("comb = 4 ", "comb = 1 "),
+        "n_symbols = 12 ",
+        "n_symbols = 1000 ",
+        r"'base_station\.arrays\[0\]\.shape' \[8, 8\] x 3168 tones x 1000 symbols needs a 3\.0 GiB",
+    ),
+    (
+        JAV,
+        "shape = [10, 10]",
+        "shape = [10, 10, 1]",
+        r"'base_station\.arrays\[0\]\.shape' must have shape \(2,\)",
+    ),
+    (JAV, "n_facets = 12 ", "n_facets = 1000000 ", r"'tunnel\.n_facets' must be <= 360"),
+    (JAV, "period = 0.1 ", "period = 1e-9 ", r"'trajectory\.period' .* more than"),
+    (
+        JIANG_GOOD,
+        "walls = [[",
+        "wall = [[",
+        r"unknown key 'tunnel\.wall'; did you mean 'tunnel\.walls'",
+    ),
+    (JIANG_GOOD, "[0.5, 0.1]", "[nan, 0.1]", r"'noise\.levels\[0\]\[0\]' must be finite"),
+    (JIANG_GOOD, "[0.5, 0.1]", "[200.0, 0.1]", r"'noise\.levels' angle sigmas must be <= 180"),
+    (JIANG_GOOD, "[0.5, 0.1]", "[0.5, -0.1]", r"'noise\.levels\[0\]\[1\]' must be >= 0"),
+    (
+        USR,
+        'kind = "rectangular"',
+        'kind = "rectangle"',
+        r"'tunnel\.kind' must be one of .*did you mean 'rectangular'",
+    ),
+    (
+        USR,
+        "tilt_deg = 20.0",
+        "tilt_deg = 100.0",
+        r"'base_station\.arrays\[0\]\.tilt_deg' must be <= 90",
+    ),
+    (
+        USR,
+        "height = 6.0 ",
+        "height = 6.0\nwall_height = 3.0 ",
+        r"'tunnel\.wall_height' is not a key of kind 'rectangular'",
+    ),
+    (USR, 'kind = "lane"', 'kind = "slalom"', r"missing key 'trajectory\.amplitude'"),
+    (USR, 'name = "example', 'paper = "me"\nname = "example', r"'paper' must be one of"),
+    (USR, 'name = "example', 'requires = ["os"]\nname = "example', r"unknown key 'requires'"),
+    (
+        USR,
+        "position = [0.0, 0.0, 5.8]",
+        "position = [0.0, 0.0, 6.0]",
+        r"'base_station\.position' .* lies outside",
+    ),
+    (
+        USR,
+        "[[base_station.arrays]]",
+        "[base_station.array]",
+        r"unknown key 'base_station\.array'; did you mean 'base_station\.arrays'",
+    ),
+    (
+        USR,
+        "scs = 120e3",
+        "scs = 240e3",
+        r"'radio\.n_rb' 264 resource blocks at radio\.scs = 240000 Hz",
+    ),
+    (HAL, "tx_y = 4.5 ", "tx_y = 6.0 ", r"'transmitter\.tx_y' = 6 m lies outside"),
+    (HAL, "rx_height = 2.0 ", "rx_height = 5.0 ", r"'vehicle\.rx_height' = 5 m lies outside"),
+    (HAL, "outlier_prob = 0.02", "outlier_prob = 1.5", r"'errors\.outlier_prob' must be <= 1"),
+    (HAL, "spacing = 0.8 ", "spacing = 1e-9 ", r"'vehicle\.spacing' .* more than"),
+    (HAL, "[gnss]", "[gnss]\nsigma = 1.0", r"unknown key 'gnss\.sigma'"),
+]
+
+
+@pytest.mark.parametrize(("base", "old", "new", "match"), MALFORMED)
+def test_malformed_scenario_files_name_the_key(tmp_path, base, old, new, match):
+    text = base if "\n" in base else _text(base)
+    assert old in text, f"{old!r} not in {base}"
+    with pytest.raises(S.ScenarioError, match=match) as err:
+        _load_text(tmp_path, text.replace(old, new, 1))
+    assert str(err.value).startswith("bad.toml: ")  # the file is named first
+
+
+def test_every_preset_loads_and_is_validated():
+    names = tk.list_scenarios()
+    assert {"jiang2023-straight", "italiano2026-straight", HAL, USR} <= set(names)
+    fams = {tk.load_scenario(n).family for n in names}
+    assert fams == {"jiang2023", "italiano2026", "halili2022", "user"}
+    assert all(err is None for _, err in S.check_all())
+
+
+def test_presets_keep_their_meaning():
+    sc = tk.load_scenario(JAV)
+    # defaults filled in equal what the builders assumed before (n_facets 12, offset 0, slalom 0)
+    assert sc.sections["tunnel"]["n_facets"] == 12
+    assert sc.sections["trajectory"]["slalom_amplitude"] == 0.0
+    assert "n_rb" not in sc.sections["radio"]
+    assert drive.load_drive_config(HAL) == drive.DriveConfig()
+
+
+def test_names_resolve_only_inside_the_data_directory(tmp_path):
+    for bad in ("../../pyproject", "../scenarios/jiang2023-straight", "..", "/etc/passwd", ""):
+        with pytest.raises((S.ScenarioError, TypeError), match="name"):
+            tk.load_scenario(bad)
+    # an explicit path must be an existing .toml file, and a scenario
+    with pytest.raises(S.ScenarioError, match="no such scenario file"):
+        tk.load_scenario(str(tmp_path / "missing.toml"))
+    pyproject = PRESETS.parent.parent / "pyproject.toml"
+    with pytest.raises(S.ScenarioError, match=r"pyproject\.toml: unknown key"):
+        tk.load_scenario(pyproject)
+    # a Path object works like a string path
+    copy = tmp_path / "copy.toml"
+    copy.write_text(_text("jiang2023-straight"))
+    assert tk.load_scenario(copy).name == "jiang2023-straight"
+
+
+def test_main_module_is_guarded():
+    import importlib
+
+    mod = importlib.import_module("tunnelkit.__main__")  # no SystemExit on import
+    assert callable(mod.main)
+
+
+def test_load_drive_config_refuses_other_families():
+    with pytest.raises(S.ScenarioError, match="'jiang2023-straight' is a 'jiang2023' scenario"):
+        drive.load_drive_config("jiang2023-straight")
+    with pytest.raises(S.ScenarioError, match="not a Halili drive"):
+        drive.load_drive_config(USR)
+
+
+def test_with_values_revalidates():
+    sc = tk.load_scenario(USR)
+    s2 = S.with_values(sc, {"radio.fc": 5.9e9, "base_station.arrays[*].shape": [4, 4]})
+    assert s2.get("radio.fc") == 5.9e9 and [a.M for a in s2.arrays()] == [16, 16]
+    assert sc.get("radio.fc") == 28e9  # the original is untouched
+    with pytest.raises(S.ScenarioError, match=r"'radio\.fc' must be > 0"):
+        S.with_values(sc, {"radio.fc": 0.0})
+    with pytest.raises(S.ScenarioError, match="arrays has 2 tables"):
+        S.with_values(sc, {"base_station.arrays[5].shape": [4, 4]})
+    s3 = S.scenario_from_dict(sc.raw, "mine.toml")
+    assert s3.sections == sc.sections and s3.path.name == "mine.toml"
+
+
+# --- templates and the command line ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("preset", [USR, JAV, "italiano2026-slalom", "jiang2023-curved", HAL])
+def test_template_round_trip(tmp_path, preset):
+    text = S.template("mine", preset)
+    path = tmp_path / "mine.toml"
+    path.write_text(text)
+    sc, src = tk.load_scenario(path), tk.load_scenario(preset)
+    assert sc.name == "mine"
+    # every key line is preceded by its comment from the schema
+    lines = text.splitlines()
+    for i, ln in enumerate(lines):
+        if ln and not ln.startswith(("#", "[")):
+            assert lines[i - 1].startswith("# "), ln
+    strip = ("name", "description")
+    if src.family == "italiano2026":  # a JAVELIN preset becomes your own semicircular tunnel
+        assert sc.family == "user"
+        a, b = sc.tunnel(), src.tunnel()
+        assert [f.name for f in a.surfaces] == [f.name for f in b.surfaces]
+        for fa, fb in zip(a.surfaces, b.surfaces, strict=True):
+            np.testing.assert_allclose(fa.corners(), fb.corners(), atol=1e-12)
+        for aa, ab in zip(sc.arrays(), src.arrays(), strict=True):
+            np.testing.assert_allclose(aa.world, ab.world, atol=1e-12)
+        np.testing.assert_allclose(sc.trajectory().position, src.trajectory().position)
+        assert {k: v for k, v in sc.sections["radio"].items() if k != "n_rb"} == src.sections[
+            "radio"
+        ]
+    else:
+        assert sc.family == src.family
+        assert {k: v for k, v in sc.sections.items() if k not in strip} == {
+            k: v for k, v in src.sections.items() if k not in strip
+        }
+
+
+def test_cli_validates_and_exits_nonzero(tmp_path, capsys):
+    assert cli.main(["scenarios"]) == 0
+    out = capsys.readouterr().out
+    assert "example-rectangular-28ghz" in out and "[user]" in out
+    bad = tmp_path / "bad.toml"
+    bad.write_text(_text(JAV).replace("comb = 8 ", "comb = 0 "))
+    assert cli.main(["scenarios", str(bad), "jiang2023-straight"]) == 1
+    err = capsys.readouterr()
+    assert "'radio.comb' must be >= 1" in err.err and "jiang2023-straight" in err.out
+    assert cli.main(["scenarios", "../../pyproject"]) == 1
+    assert "neither a preset name" in capsys.readouterr().err
+    assert cli.main(["scenarios", "show", USR]) == 0
+    assert '"n_rb": 264' in capsys.readouterr().out
+
+
+def test_cli_new_writes_a_template_and_refuses_to_overwrite(tmp_path, capsys):
+    args = ["scenarios", "new", "my-tunnel", "--from", JAV, "--out", str(tmp_path)]
+    assert cli.main(args) == 0
+    path = tmp_path / "my-tunnel.toml"
+    assert tk.load_scenario(path).family == "user"
+    before = path.read_text()
+    assert cli.main(args) == 2
+    assert "already exists" in capsys.readouterr().err and path.read_text() == before
+    assert cli.main(["scenarios", "new", "../evil", "--out", str(tmp_path)]) == 2
+    assert cli.main(["scenarios", "new", "x", "--out", str(tmp_path / "nope")]) == 2
+    # the subprocess entry point exits non-zero on a malformed file too
+    import subprocess
+    import sys
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text(_text(USR).replace("fc = 28e9", "fc = -1.0"))
+    r = subprocess.run(
+        [sys.executable, "-m", "tunnelkit", "scenarios", str(bad)], capture_output=True, text=True
+    )
+    assert r.returncode == 1 and "'radio.fc' must be > 0" in r.stderr
+
+
+def test_schema_documentation_is_current():
+    """data/scenarios/README.md holds the tables generated from the spec."""
+    readme = (PRESETS / "README.md").read_text()
+    assert schema.to_markdown() in readme
+
+
+def test_every_key_has_a_doc_and_sane_spec():
+    def walk(table, path):
+        for k in table.keys + tuple(x for ks in table.variants.values() for x in ks):
+            assert k.doc and k.type in (
+                "float",
+                "int",
+                "str",
+                "floats",
+                "ints",
+                "strs",
+                "table",
+                "tables",
+            ), path + k.name
+            if k.table is not None:
+                walk(k.table, path + k.name + ".")
+            if k.has_default and k.type in ("float", "int"):
+                schema._check_number("spec", path + k.name, k, k.default, k.type == "int")
+
+    for fam in schema.FAMILIES.values():
+        walk(fam, "")

@@ -1,17 +1,113 @@
-"""Check (or with --strip, enforce) the notebook conventions.
+"""Check (or with --strip / --build, enforce) the notebook conventions.
 
+* every ``notebooks/NN-name.ipynb`` is paired (jupytext, ``notebooks/.jupytext.toml``) with its
+  percent-format source ``notebooks/.src/NN-name.py`` and agrees with it;
 * committed without outputs or execution counts;
+* the kernelspec is the one ``make lab`` registers (``python3``, "Python (tunnelkit)");
 * the first code cell imports tunnelkit and calls ``tk.setup_notebook()``;
 * a markdown cell headed "Checks" followed by code that asserts.
-Exit status 1 with one line per problem.
+
+``--build`` rewrites each notebook from its source (cell ids, metadata kept; outputs dropped);
+``--strip`` only removes outputs. Files are replaced whole (written to a temporary file, then
+renamed), so an interrupted run leaves no half-written notebook. Exit status 1 with one line per
+problem.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import tempfile
 from pathlib import Path
+
+SOURCES = ".src"
+KERNELSPEC = {"display_name": "Python (tunnelkit)", "language": "python", "name": "python3"}
+
+
+def source_of(notebook: Path) -> Path:
+    """The paired percent-format source of a notebook."""
+    return notebook.parent / SOURCES / f"{notebook.stem}.py"
+
+
+def notebook_of(source: Path) -> Path:
+    """The paired notebook of a source in ``notebooks/.src/``."""
+    return source.parent.parent / f"{source.stem}.ipynb"
+
+
+def _config(path: Path):
+    from jupytext.config import load_jupytext_config
+
+    return load_jupytext_config(str(path.resolve()))
+
+
+def _fmt() -> dict:
+    return {"extension": ".py", "format_name": "percent"}
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _dump(nb: dict) -> str:
+    return json.dumps(nb, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
+
+
+def sync_problems(path: Path) -> list[str]:
+    """Whether a notebook and its source say the same thing (the notebook written as its source)."""
+    import jupytext
+
+    src = source_of(path)
+    if not src.exists():
+        return [f"{path}: no paired source {src} (see notebooks/.jupytext.toml)"]
+    nb = jupytext.read(path)
+    written = jupytext.writes(nb, fmt=_fmt(), config=_config(path))
+    text = src.read_text()
+    if written == text:
+        return []
+    for n, (a, b) in enumerate(zip(text.splitlines(), written.splitlines(), strict=False), 1):
+        if a != b:
+            where = f"source line {n}: {a.strip()[:60]!r} vs notebook {b.strip()[:60]!r}"
+            break
+    else:
+        n_src, n_nb = len(text.splitlines()), len(written.splitlines())
+        where = f"the source has {n_src} lines, the notebook {n_nb}"
+    return [
+        f"{path}: disagrees with its source {src} ({where}); "
+        f"run `make format` to rebuild the notebook from the source"
+    ]
+
+
+def build(src: Path) -> Path:
+    """Rewrite the notebook paired with ``src`` from it: outputs dropped, ids/metadata kept."""
+    import jupytext
+    import nbformat
+    from jupytext.combine import combine_inputs_with_outputs
+
+    target = notebook_of(src)
+    nb = jupytext.read(src, fmt=_fmt(), config=_config(src))
+    if target.exists():
+        nb = combine_inputs_with_outputs(nb, jupytext.read(target), fmt=_fmt())
+    nb.metadata["kernelspec"] = dict(KERNELSPEC)
+    nb.metadata.setdefault("language_info", {"name": "python"})
+    nb.metadata.pop("jupytext", None)
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            cell.outputs, cell.execution_count = [], None
+    nbformat.validate(nb)
+    text = nbformat.writes(nb) + "\n"
+    if not target.exists() or target.read_text() != text:
+        _atomic_write(target, text)
+        print(f"wrote {target}")
+    return target
 
 
 def problems(path: Path, strip: bool) -> list[str]:
@@ -30,6 +126,12 @@ def problems(path: Path, strip: bool) -> list[str]:
                 out.append(
                     f"{path}: cell {i} has outputs or an execution count (run `make format`)"
                 )
+    spec = nb.get("metadata", {}).get("kernelspec", {})
+    if spec.get("name") != KERNELSPEC["name"]:
+        out.append(
+            f"{path}: kernelspec name {spec.get('name')!r}, expected {KERNELSPEC['name']!r} "
+            "(the kernel `make lab` registers; run `make format`)"
+        )
     code = [
         "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
         for c in cells
@@ -56,17 +158,39 @@ def problems(path: Path, strip: bool) -> list[str]:
     ):
         out.append(f"{path}: the Checks section has no assert")
     if changed:
-        path.write_text(json.dumps(nb, indent=1, ensure_ascii=False) + "\n")
+        _atomic_write(path, _dump(nb))
     return out
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("paths", nargs="+", type=Path)
+    ap.add_argument("paths", nargs="+", type=Path, help="notebooks or directories of notebooks")
     ap.add_argument("--strip", action="store_true", help="remove outputs in place")
+    ap.add_argument(
+        "--build", action="store_true", help="rebuild each notebook from its .src/ source first"
+    )
     args = ap.parse_args(argv)
     files = [f for p in args.paths for f in (sorted(p.glob("*.ipynb")) if p.is_dir() else [p])]
-    errs = [e for f in files for e in problems(f, args.strip)]
+    if args.build:
+        sources = {
+            s
+            for p in args.paths
+            for s in (sorted((p / SOURCES).glob("*.py")) if p.is_dir() else [source_of(p)])
+        }
+        missing = [s for s in sorted(sources) if not s.exists()]
+        for s in missing:
+            print(f"{s}: no such source")
+        if missing:
+            return 1
+        files = sorted(set(files) | {build(s) for s in sorted(sources)})
+    orphans = [
+        f"{s}: a source without its notebook {notebook_of(s)} (run `make format`)"
+        for p in args.paths
+        if p.is_dir()
+        for s in sorted((p / SOURCES).glob("*.py"))
+        if not notebook_of(s).exists()
+    ]
+    errs = orphans + [e for f in files for e in sync_problems(f) + problems(f, args.strip)]
     for e in errs:
         print(e)
     print(f"checked {len(files)} notebook(s): {'ok' if not errs else f'{len(errs)} problem(s)'}")

@@ -4,7 +4,7 @@ A small package under a sequence of notebooks (``notebooks/01-...`` to ``06-...`
 mirror the notebooks and load on first use, so ``import tunnelkit as tk`` stays fast:
 
 ``constants, geometry, crlb, positioning`` (01) · ``fresnel`` (02) · ``arrays, propagation,
-channel, extraction`` (03) · ``tracking`` (04-06) · ``scenarios, metrics, montecarlo, plots,
+channel, extraction, signal_route, evaluation`` (03) · ``tracking`` (04-06) · ``scenarios, metrics, montecarlo, plots,
 widgets, reference, reproduce`` (all).
 """
 

@@ -860,8 +860,14 @@ def design_sweep(
     scheduler: str | None = None,
     progress: bool = False,
     n_epochs: int | None = None,
+    timeout: float | None = None,
 ) -> DesignReport:
-    """Bounds (and with ``runs >= 2`` a JAVELIN Monte-Carlo) for each array in ``arrays``."""
+    """Bounds (and with ``runs >= 2`` a JAVELIN Monte-Carlo) for each array in ``arrays``.
+
+    ``workers`` / ``scheduler`` / ``timeout`` go to :func:`tunnelkit.montecarlo.run_trials`.
+    """
+    from .montecarlo import parallel_options
+
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     specs = [parse_array(a) for a in arrays]
@@ -872,6 +878,7 @@ def design_sweep(
     runs = integer("runs", runs, minimum=0)
     if runs == 1:
         raise ValueError("runs: a 95 % interval needs at least 2 runs (or 0 for bounds only)")
+    workers, scheduler = parallel_options(workers, scheduler)
     for s in specs:
         setup.arrays(s)  # fail early, naming the array that does not fit
     rows = []
@@ -910,6 +917,7 @@ def design_sweep(
                 progress=progress,
                 n_epochs=n_epochs,
                 crlb=crlb,
+                timeout=timeout,
             )
             row.rmse_m, row.rmse_ci95_m, row.sigmas = mc["rmse_m"], mc["ci95_m"], mc["sigmas"]
         rows.append(row)
@@ -956,7 +964,7 @@ def javelin_config(crlb: dict, measured: dict | None = None):
 
 
 def _route(setup: DesignSetup, spec: ArraySpec):
-    from .channel import SignalRoute
+    from .signal_route import SignalRoute
 
     return SignalRoute(
         setup.tunnel, setup.arrays(spec), setup.trajectory, setup.config, kinds=setup.kinds
@@ -1045,6 +1053,7 @@ def javelin_rmse(
     n_epochs: int | None = None,
     crlb: dict | None = None,
     calibrate: bool = True,
+    timeout: float | None = None,
 ) -> dict:
     """Monte-Carlo 2-D RMSE of JAVELIN on ``spec`` with a 95 % t-interval over ``runs`` drives
     (LoS condition, the scenario's route; the interval is clipped at 0).
@@ -1077,6 +1086,8 @@ def javelin_rmse(
         kw["workers"] = workers
     if scheduler is not None:
         kw["scheduler"] = scheduler
+    if timeout is not None:
+        kw["timeout"] = timeout
     res = np.asarray(
         run_trials(
             _JavelinTrial(setup, spec, cfg, n_epochs),

@@ -13,6 +13,7 @@ A scenario file has a few top-level keys (``name``, ``paper``, ``description``) 
 
 from __future__ import annotations
 
+import copy
 import importlib
 import itertools
 import os
@@ -39,8 +40,10 @@ __all__ = [
     "load_scenario",
     "register_trajectory",
     "register_tunnel",
+    "scenario_from_dict",
     "scenario_path",
     "template",
+    "with_values",
 ]
 
 
@@ -167,7 +170,7 @@ class Scenario:
             raise ScenarioError(
                 f"{self.path.name}: unknown tunnel.kind {kind!r}; known: {sorted(_TUNNELS)}"
             )
-        return _TUNNELS[kind](sec, get)
+        return _prefixed(self.path.name, _TUNNELS[kind], sec, get)
 
     def base_station(self) -> np.ndarray:
         """Base-station (reference antenna) position from ``[base_station] position``."""
@@ -189,12 +192,24 @@ class Scenario:
             raise ScenarioError(
                 f"{self.path.name}: unknown trajectory.kind {kind!r}; known: {sorted(_TRAJECTORIES)}"
             )
-        return _TRAJECTORIES[kind](sec, get, self.tunnel() if tunnel is None else tunnel)
+        tun = self.tunnel() if tunnel is None else tunnel
+        return _prefixed(self.path.name, _TRAJECTORIES[kind], sec, get, tun)
 
     def noise_levels(self) -> list[tuple[float, float]]:
         """``[(sigma_theta [rad], sigma_d [m]), ...]`` from ``[noise] levels`` given in (deg, m)."""
         lv = self.get("noise.levels", shape=(None, 2))
         return [(float(np.radians(a)), float(b)) for a, b in lv]
+
+
+def _prefixed(where: str, builder, *args):
+    """Run a registered builder; its ``ScenarioError`` s name the file first."""
+    try:
+        return builder(*args)
+    except ScenarioError as exc:
+        msg = str(exc)
+        if msg.startswith(f"{where}: "):
+            raise
+        raise ScenarioError(f"{where}: {msg}") from None
 
 
 def list_scenarios() -> list[str]:
@@ -257,6 +272,17 @@ def load_scenario(name: str | os.PathLike) -> Scenario:
         raise ScenarioError(f"{path.name}: not valid TOML ({exc})") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"{path.name}: cannot read ({exc})") from None
+    return scenario_from_dict(raw, path)
+
+
+def scenario_from_dict(raw: dict, path: str | os.PathLike = "<dict>") -> Scenario:
+    """Validate and build a scenario from a parsed table (what :func:`load_scenario` does after
+    reading the file); ``path`` only labels the messages. No file is read or written.
+    """
+    if not isinstance(raw, dict):
+        raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
+    raw = copy.deepcopy(raw)
+    path = Path(path)
     where = path.name
     family, sections = validate(raw, where)
     for mod in sections.get("requires", []):
@@ -279,6 +305,59 @@ def load_scenario(name: str | os.PathLike) -> Scenario:
     )
     _check_placement(sc)
     return sc
+
+
+_INDEX_RE = re.compile(r"(\w+)\[(\d+|\*)\]")
+
+
+def with_values(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
+    """A copy of ``scenario`` with dotted keys of its file replaced, validated again.
+
+    ``{"radio.fc": 28e9, "base_station.position": [0, 0, 5.5],
+    "base_station.arrays[*].shape": [16, 16], "base_station.arrays[0].tilt_deg": 10.0}``;
+    ``[*]`` sets the key in every table of the array. Setting a value to ``None`` removes the key.
+    Raises :class:`ScenarioError` naming the key if the result is invalid (design sweeps).
+    """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
+    if not isinstance(changes, dict):
+        raise TypeError(f"changes: expected a dict of dotted keys, got {type(changes).__name__}")
+    raw = copy.deepcopy(scenario.raw)
+    for dotted, value in changes.items():
+        if not isinstance(dotted, str) or not dotted:
+            raise TypeError(f"changes: keys must be dotted key strings, got {dotted!r}")
+        *parents, last = dotted.split(".")
+        targets = [raw]
+        for part in parents:
+            m = _INDEX_RE.fullmatch(part)
+            name, idx = (m.group(1), m.group(2)) if m else (part, None)
+            nxt = []
+            for t in targets:
+                if idx is None:
+                    nxt.append(t.setdefault(name, {}))
+                    continue
+                arr = t.get(name)
+                if not isinstance(arr, list):
+                    raise ScenarioError(
+                        f"{scenario.path.name}: '{dotted}': no array of tables {name!r}"
+                    )
+                if idx == "*":
+                    nxt.extend(arr)
+                elif int(idx) < len(arr):
+                    nxt.append(arr[int(idx)])
+                else:
+                    raise ScenarioError(
+                        f"{scenario.path.name}: '{dotted}': {name} has {len(arr)} tables"
+                    )
+            targets = nxt
+        for t in targets:
+            if not isinstance(t, dict):
+                raise ScenarioError(f"{scenario.path.name}: '{dotted}': not a table")
+            if value is None:
+                t.pop(last, None)
+            else:
+                t[last] = copy.deepcopy(value)
+    return scenario_from_dict(raw, scenario.path)
 
 
 def _derive_user(sec: dict, raw: dict, where: str) -> None:
@@ -330,7 +409,15 @@ def _check_placement(sc: Scenario) -> None:
                 raise ScenarioError(
                     f"{where}: '{key}' = {val:g} m lies outside the {h:g} m high tube (0 < z < {h:g})"
                 )
+        veh = sec["vehicle"]
+        n = veh["speed"] * veh["duration"] / veh["spacing"]
+        if n > MAX_SAMPLES:
+            raise ScenarioError(
+                f"{where}: 'vehicle.spacing' {veh['spacing']:g} m gives {n:.3g} samples over the "
+                f"drive (speed x duration / spacing), more than {MAX_SAMPLES:g}"
+            )
         return
+    _check_sizes(sc)
     tun = sc.tunnel()
     bs = np.asarray(sec["base_station"]["position"], dtype=float)
     if sc.family == "jiang2023":
@@ -341,6 +428,55 @@ def _check_placement(sc: Scenario) -> None:
     else:
         _check_arrays_inside(sc, tun, bs)
     sc.trajectory(tun)
+
+
+#: most trajectory samples a scenario file may ask for
+MAX_SAMPLES = 1_000_000
+#: most elements per array (64 x 64)
+MAX_ELEMENTS = 4096
+#: largest channel tensor (elements x tones x symbols, complex128) a file may ask for
+MAX_TENSOR_BYTES = 2 * 2**30
+
+
+def _check_sizes(sc: Scenario) -> None:
+    """Refuse sizes that would exhaust memory before anything is allocated."""
+    where, sec = sc.path.name, sc.sections
+    tr = sec["trajectory"]
+    if sc.family == "jiang2023":
+        levels = np.asarray(sec.get("noise", {}).get("levels", np.zeros((0, 2))), dtype=float)
+        if levels.size and np.any(levels[:, 0] > 180.0):
+            raise ScenarioError(f"{where}: 'noise.levels' angle sigmas must be <= 180 deg")
+        return
+    radio = sec["radio"]
+    n_rb = radio.get("n_rb", 273)
+    if 12 * n_rb * radio["scs"] > radio["bandwidth"] * 1.0001:
+        raise ScenarioError(
+            f"{where}: 'radio.n_rb' {n_rb} resource blocks at radio.scs = {radio['scs']:g} Hz "
+            f"occupy {12 * n_rb * radio['scs']:g} Hz, more than radio.bandwidth = "
+            f"{radio['bandwidth']:g} Hz"
+        )
+    n_tones = -(-12 * n_rb // radio["comb"])
+    for i, arr in enumerate(sec["base_station"]["arrays"]):
+        m = arr["shape"][0] * arr["shape"][1]
+        if m > MAX_ELEMENTS:
+            raise ScenarioError(
+                f"{where}: 'base_station.arrays[{i}].shape' {arr['shape']} has {m} elements, "
+                f"more than {MAX_ELEMENTS}"
+            )
+        size = 16 * m * n_tones * radio["n_symbols"]
+        if size > MAX_TENSOR_BYTES:
+            raise ScenarioError(
+                f"{where}: 'base_station.arrays[{i}].shape' {arr['shape']} x {n_tones} tones x "
+                f"{radio['n_symbols']} symbols needs a {size / 2**30:.1f} GiB channel tensor, "
+                f"more than {MAX_TENSOR_BYTES / 2**30:g} GiB (fewer elements, radio.n_symbols or "
+                "a larger radio.comb)"
+            )
+    n = abs(tr["x_end"] - tr["x_start"]) / (tr["speed"] * tr["period"])
+    if n > MAX_SAMPLES:
+        raise ScenarioError(
+            f"{where}: 'trajectory.period' {tr['period']:g} s gives {n:.3g} epochs "
+            f"(|x_end - x_start| / (speed period)), more than {MAX_SAMPLES:g}"
+        )
 
 
 def _check_arrays_inside(sc: Scenario, tun, bs: np.ndarray) -> None:

@@ -10,7 +10,7 @@ A scenario file belongs to one *family*, chosen by its ``paper`` key:
 
 Each family is a :class:`Table` of :class:`Key` s (type, unit, range, default, doc string). The same
 spec validates a file (:func:`validate`), writes a commented template (:func:`render_template`) and
-documents the schema (:func:`to_markdown`), so the three never drift apart. Validation is strict:
+documents the schema (:func:`to_markdown`, printed by ``tunnelkit scenarios doc``), so the three never drift apart. Validation is strict:
 ``shape = [10.5, 10]``, a bool or a string where a number is expected, NaN, a value out of range,
 a missing required key and an unknown key (reported with the nearest valid name) are all a
 :class:`ScenarioError` naming the file, the section and the key.
@@ -421,7 +421,7 @@ _BLOCKER = Table(
 )
 
 _MAX_SIDE = 256
-_SHAPE_DOC = "[rows, columns] of the URA (a ULA of n elements is [1, n])"
+_SHAPE_DOC = "[rows, columns] of the URA (a ULA of n elements is [1, n]); at most 4096 elements"
 
 _ITALIANO_ARRAY = Table(
     (
@@ -983,7 +983,8 @@ def _md_row(full: str, k: Key, prefix: str) -> str:
 def to_markdown() -> str:
     """The schema of every family as Markdown tables (``data/scenarios/README.md``)."""
     out = []
-    for fam, spec in FAMILIES.items():
+    for fam in ("user", "italiano2026", "jiang2023", "halili2022"):
+        spec = FAMILIES[fam]
         title = "`user` (no `paper` key)" if fam == "user" else f'`paper = "{fam}"`'
         out += [f"### {title}: {spec.doc}", ""]
         out += [

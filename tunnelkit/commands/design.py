@@ -1,4 +1,5 @@
-"""``tunnelkit design SCENARIO --arrays 4x4 8x8 16x16 [--fc 28GHz] [--bandwidth 400MHz] ...``.
+"""``tunnelkit design SCENARIO --arrays 4x4 8x8 16x16 [--fc 28GHz] [--bandwidth 400MHz]
+[--target 0.2] [--share 0.9] [--runs N] [--workers N | --scheduler ADDRESS] [--format table|json]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
 the share of the route where the SR-NF model holds for every reflected path, the position error
@@ -11,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import sys
 
 NAME = "design"
 HELP = "size an antenna array for a tunnel: SR-NF validity, position error bound, recommendation"
@@ -78,14 +80,36 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--runs", type=int, default=0, help="JAVELIN Monte-Carlo drives per array (0: bounds only)"
     )
     p.add_argument("--seed", type=int, default=0, help="Monte-Carlo seed (0)")
+    from ..montecarlo import CONNECT_TIMEOUT_S
+
     par = p.add_mutually_exclusive_group()
-    par.add_argument("--workers", type=int, default=None, help="local Dask worker processes")
-    par.add_argument("--scheduler", default=None, help="an existing Dask scheduler tcp://HOST:PORT")
+    par.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="run the Monte-Carlo on a local Dask cluster of N processes (default: serial)",
+    )
+    par.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="run the Monte-Carlo on a running Dask cluster, e.g. tcp://HOST:8786",
+    )
+    p.add_argument(
+        "--connect-timeout",
+        type=float,
+        default=CONNECT_TIMEOUT_S,
+        metavar="SECONDS",
+        help=f"give up on --scheduler after this long (default {CONNECT_TIMEOUT_S:g})",
+    )
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--format", choices=["table", "json"], default="table")
 
 
 def main(args: argparse.Namespace) -> int:
     from .. import design
+    from ..montecarlo import TrialLost
 
     specs = [design.parse_array(a, args.spacing) for a in args.arrays]
     setup = design.DesignSetup.from_scenario(
@@ -95,18 +119,23 @@ def main(args: argparse.Namespace) -> int:
         tilt_deg=args.tilt,
         mount_height=args.mount_height,
     )
-    rep = design.design_sweep(
-        setup,
-        specs,
-        target=args.target,
-        share=args.share,
-        eps_phi=args.eps,
-        runs=args.runs,
-        seed=args.seed,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=args.runs > 0 and args.format == "table",
-    )
+    try:
+        rep = design.design_sweep(
+            setup,
+            specs,
+            target=args.target,
+            share=args.share,
+            eps_phi=args.eps,
+            runs=args.runs,
+            seed=args.seed,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            timeout=args.connect_timeout,
+            progress=args.runs > 0 and args.format == "table" and not args.no_progress,
+        )
+    except TrialLost as exc:
+        print(f"tunnelkit design: error: {exc}", file=sys.stderr)
+        return 1
     if args.format == "json":
         print(json.dumps(rep.to_json(), indent=2))
     else:

@@ -3,7 +3,7 @@
 Without an action every named scenario (default: every preset in ``data/scenarios/``) is loaded
 and validated against its family's schema; one line per scenario, and exit status 1 with the
 message if any is malformed. ``show`` prints one scenario's validated sections (defaults filled);
-``new`` writes ``NAME.toml``, a commented template holding the preset's values, into the current
+``doc`` prints the schema as Markdown tables (``data/scenarios/README.md``); ``new`` writes ``NAME.toml``, a commented template holding the preset's values, into the current
 directory (or ``--out DIR``) and refuses to overwrite an existing file.
 """
 
@@ -24,7 +24,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         nargs="*",
         metavar="ARG",
         help="scenario names or .toml paths to validate (default: every preset); "
-        "or `show NAME`; or `new NAME --from PRESET [--out DIR]`",
+        "or `show NAME`; or `new NAME --from PRESET [--out DIR]`; or `doc` (the schema)",
     )
     p.add_argument(
         "--from",
@@ -57,6 +57,11 @@ def main(args: argparse.Namespace) -> int:
         path.write_text(text)
         load_scenario(path)  # the template must validate
         print(f"wrote {path} (from {args.preset}); edit it, then: tunnelkit scenarios {path}")
+        return 0
+    if words == ["doc"]:
+        from ..schema import to_markdown
+
+        print(to_markdown())
         return 0
     if words and words[0] == "show":
         if len(words) != 2:

@@ -4,7 +4,7 @@ Every run simulates the drive through the signal route (image method -> SRS tens
 clock bias -> CPD extraction -> Algorithm 1) once per condition, then scores on it JAVELIN with
 the paper's design, JAVELIN with ours (``experiment.OURS``) and TeNFiLoc. The same seeded drives
 go through our measurement route too (the CPD, then coherent paths separated by the array:
-``tunnelkit.coherent``), on which JAVELIN (ours) and TeNFiLoc are scored again: the tensors are
+``tunnelkit.extraction.coherent``), on which JAVELIN (ours) and TeNFiLoc are scored again: the tensors are
 identical, only the extraction differs.
 """
 
@@ -142,7 +142,7 @@ NOTES = [
     "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails and holds its last fix on epochs "
     "without one.",
     "extraction 'paper': CPD and eq. 11-24 as published; 'separated': the same tensors, then paths "
-    "merged in one CPD component separated by the array (tunnelkit.coherent, ours). On it, our "
+    "merged in one CPD component separated by the array (tunnelkit.extraction.coherent, ours). On it, our "
     "design models each path's curvature as its VUE distance (experiment.OURS_SEPARATED), the "
     "radius of the exact wavefront; its other settings were tuned on the paper's extraction.",
 ]

@@ -31,7 +31,7 @@ _SIDES = range(2, 21)
 
 @lru_cache(maxsize=4)
 def _route(scenario: str):
-    from ..channel import SignalRoute
+    from ..signal_route import SignalRoute
 
     return SignalRoute.from_scenario(scenario)
 

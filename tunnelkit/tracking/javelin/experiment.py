@@ -2,7 +2,7 @@
 
 Section 4 of Italiano et al. (2026) in two steps, so the expensive part is done once:
 
-1. :func:`simulate_drive` runs the signal route of notebook 03 (``channel.SignalRoute``: image
+1. :func:`simulate_drive` runs the signal route of notebook 03 (``signal_route.SignalRoute``: image
    method, eq. 1 tensor with noise and clock bias, ``extraction.extract_paths``, Algorithm 1) for
    every epoch of a scenario's trajectory under a propagation *condition*, plus the V2X speed and
    heading messages (``sigma_nu``, ``sigma_theta`` of section 4.2);
@@ -115,8 +115,9 @@ EXTRACTIONS = ("paper", "separated")
 
 def separate_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
-    from ...channel import match_paths, measurements_from_estimates
-    from ...coherent import resolve_coherent
+    from ...evaluation import match_paths
+    from ...extraction.coherent import resolve_coherent
+    from ...signal_route import measurements_from_estimates
 
     est = resolve_coherent(
         ep.snapshot.H,
@@ -132,7 +133,7 @@ def separate_epoch(ep, config):
 
 
 def _route(scenario: str, model: str):
-    from ...channel import SignalRoute
+    from ...signal_route import SignalRoute
 
     key = (scenario, model)
     if key not in _ROUTES:
@@ -157,7 +158,7 @@ def simulate_drive(
     SRS tensor synthesised (clock bias drawn per epoch), paths extracted with ``L`` known
     (Algorithm 1), angles in the world frame. ``extraction`` is ``"paper"`` (the CPD route of
     eq. 11-24) or ``"separated"`` (the same, then coherent paths merged in one CPD component
-    separated by the array, :func:`tunnelkit.coherent.resolve_coherent`); the same ``rng`` gives
+    separated by the array, :func:`tunnelkit.extraction.coherent.resolve_coherent`); the same ``rng`` gives
     the same tensors either way (:func:`simulate_routes` measures one drive both ways). An
     extraction failure leaves ``None`` (the tracker then predicts only) and is recorded in
     ``faults``.

@@ -21,7 +21,7 @@
 import numpy as np
 
 import tunnelkit as tk
-from tunnelkit import channel, extraction
+from tunnelkit import channel, evaluation, extraction, signal_route
 from tunnelkit.constants import C
 from tunnelkit.plots import factors_figure, paths_table_figure, tunnel3d_figure, wave_origins_figure
 from tunnelkit.widgets import cpd_explorer, curvature_study
@@ -45,7 +45,7 @@ tk.setup_notebook()
 # $d_{\ell,m} = \lVert p_v - p_m\rVert$ (eq. 2, 38): a spherical wavefront centred on the VUE.
 
 # %%
-route = channel.SignalRoute.from_scenario("italiano2026-straight")
+route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
 k_demo = 12
 array, paths = route.paths(k_demo)
 ue = route.trajectory.position[k_demo]
@@ -60,7 +60,7 @@ tunnel3d_figure(
 )
 
 # %%
-paths_table_figure(channel.path_rows(paths), title="True paths (world-frame angles, eq. 46-50)")
+paths_table_figure(evaluation.path_rows(paths), title="True paths (world-frame angles, eq. 46-50)")
 
 # %% [markdown]
 # Two things to notice. The ceiling bounce is only a few centimetres longer than the LoS and has
@@ -159,7 +159,7 @@ print("fast          ", fast.d.round(3))
 # on the far-field angles when $\hat\kappa<0$.
 
 # %%
-rows = channel.comparison_rows(est, paths, array, snap.clock_bias)
+rows = evaluation.comparison_rows(est, paths, array, snap.clock_bias)
 paths_table_figure(rows, title="Extracted vs true (kappa: NaN = far-field fallback of Algorithm 1)")
 
 # %% [markdown]
@@ -190,10 +190,12 @@ print("Kruskal rank (frequency, time) at tolerance 1e-6 and 1e-2:", kr)
 # We compare them on LoS + road (no ceiling, so the comparison is not dominated by it).
 
 # %%
-two = channel.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "road"))
+two = signal_route.SignalRoute(
+    route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "road")
+)
 n_cmp = tk.mc_count(40, 8)
 cmp = {
-    m: channel.rmse_study(two, k_demo, n_cmp, seed=7, refine=m)[0]
+    m: evaluation.rmse_study(two, k_demo, n_cmp, seed=7, refine=m)[0]
     for m in ("none", "column", "joint")
 }
 paths_table_figure(
@@ -222,8 +224,8 @@ paths_table_figure(
 
 # %%
 n_mc = tk.mc_count(200, 12)
-study_all = channel.rmse_study(route, k_demo, n_mc, seed=11)
-study_noceil = channel.rmse_study(two, k_demo, n_mc, seed=11)
+study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11)
+study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11)
 paths_table_figure(study_all, title=f"All paths at epoch {k_demo}, {n_mc} snapshots")
 
 # %%
@@ -250,7 +252,7 @@ paths_table_figure(study_noceil, title=f"LoS + road only, {n_mc} snapshots")
 step = 4 if tk.quick_mode() else 1
 origins = {}
 for model in ("srnf", "exact"):
-    r_m = channel.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
+    r_m = signal_route.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
     eps = [
         r_m.epoch(k, np.random.default_rng(100 + k)) for k in range(0, len(route.trajectory), step)
     ]
@@ -297,7 +299,7 @@ print(
 # 2. Remove the ceiling from the path families (`kinds=("los", "wall", "road", "rrm")`) and
 #    compare the LoS RMSE of section 6 with and without it. Why does one path that is 3 cm
 #    longer than the LoS spoil the LoS estimate?
-# 3. Lower the SNR with `channel.SignalRoute(..., snr_offset_db=-20)`: at what offset does the
+# 3. Lower the SNR with `signal_route.SignalRoute(..., snr_offset_db=-20)`: at what offset does the
 #    CPD stop finding the RRM paths (count `missed`)?
 #
 # <details><summary>Hints and solutions</summary>
@@ -310,9 +312,9 @@ print(
 #    without it, and 0.2 mm with LoS + road only: the ceiling path has the same delay and
 #    Doppler as the LoS within the noise, so the CPD must split their sum with the spatial factor
 #    alone, and a free spatial factor can rotate between them (Kruskal rank 1 in time, section 4).
-#    The free-model CRLB grows accordingly (compare `channel.path_crlb` with and without it).
-# 3. Loop `snr_offset_db` over `range(0, -40, -5)` and call `channel.rmse_study(r, 12, 10, 0)`
-#    with `r = channel.SignalRoute(..., snr_offset_db=off)`; watch `missed` grow, weakest path
+#    The free-model CRLB grows accordingly (compare `extraction.path_crlb` with and without it).
+# 3. Loop `snr_offset_db` over `range(0, -40, -5)` and call `evaluation.rmse_study(r, 12, 10, 0)`
+#    with `r = signal_route.SignalRoute(..., snr_offset_db=off)`; watch `missed` grow, weakest path
 #    first (compare `snap.snr_db`).
 #
 # </details>

@@ -40,16 +40,13 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import least_squares
 
-from ._validate import integer, nonnegative, positive, probability
-from .arrays import check_element_positions
-from .constants import C
-from .extraction import (
-    PathEstimates,
-    _check_tensor,
+from .._validate import integer, nonnegative, positive, probability
+from ..arrays import check_element_positions
+from ..constants import C
+from .decomposition import check_tensor, cp_rel_error, normalize_factors
+from .estimates import PathEstimates, path_estimates
+from .paper import (
     angles_from_solution,
-    cp_rel_error,
-    normalize_factors,
-    path_estimates,
     refine_roots,
     vandermonde_roots,
 )
@@ -336,7 +333,7 @@ def resolve_coherent(
     """
     if not isinstance(est, PathEstimates):
         raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
-    H = _check_tensor(H)
+    H = check_tensor(H)
     M, nf, nt = H.shape
     pos = check_element_positions("element_positions", element_positions, m=M)
     fc = positive("fc", fc)

@@ -151,7 +151,7 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 # $10^{-3}$ of the factor's energy; a split must halve it). The sources of all components are
 # pooled, duplicates dropped, the $L$ strongest kept, and every path gets its own delay and
 # Doppler from the tensor beamformed onto the separated steering matrix, $\mathbf S^+\mathbf H_{(1)}$
-# (eq. 13–15 on each row). `tunnelkit.coherent.resolve_coherent` does this; the paper does not.
+# (eq. 13–15 on each row). `tunnelkit.extraction.coherent.resolve_coherent` does this; the paper does not.
 # The same epoch, same tensor:
 
 # %%
@@ -417,11 +417,11 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 # 3. Use `ex.OURS.with_(kappa_model="vue")` on `drive` (the paper's extraction) and on
 #    `drive_sep`. Why does the VUE curvature fit an exact (non-SR-NF) channel better, and why does
 #    it help on one route only?
-# 4. Take one epoch, `ep = tk.channel.SignalRoute.from_scenario("italiano2026-straight").epoch(5,
-#    np.random.default_rng(1))`, and run `tk.coherent.resolve_coherent` on it with
+# 4. Take one epoch, `ep = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight").epoch(5,
+#    np.random.default_rng(1))`, and run `tk.extraction.coherent.resolve_coherent` on it with
 #    `max_sources=1`, 2 and 3 (the other arguments: `ep.snapshot.H, ep.estimates,
 #    ep.array.local` and the route's `config.fc, config.tone_spacing, config.symbol_period`).
-#    Match the results to the true paths with `tk.channel.match_paths`. What does each extra
+#    Match the results to the true paths with `tk.evaluation.match_paths`. What does each extra
 #    source buy?
 #
 # <details><summary>Solutions</summary>

@@ -1,0 +1,273 @@
+"""Stage 2 of the extraction: the paper's route from CPD factors to path parameters (Italiano et al. 2026, eq. 13-24, Algorithm 1).
+
+1. :func:`vandermonde_roots` — eq. 13 shift-invariance roots, then eq. 14 (``d``) and eq. 15
+   (``v``). Eq. 13 is unbiased but not efficient for long factors (its error telescopes to the end
+   samples); :func:`refine_roots` polishes each root to the periodogram peak of its column (the
+   single-tone maximum-likelihood estimate); :func:`refine_joint` refines all roots together with
+   free spatial factors.
+2. :func:`unwrap_spatial` — eq. 16: phase of the spatial factor unwrapped in 2-D on a URA grid
+   (``skimage.restoration.unwrap_phase``, Herráez et al. 2002, the paper's ref. 25), along a
+   minimum spanning tree otherwise.
+3. :func:`solve_near_field` (TLS of eq. 17-18) and :func:`solve_far_field` (LS).
+4. :func:`angles_from_solution` — eq. 19-24. **Convention**: eq. 19 writes the wave origin as
+   ``kappa (cos phi sin psi, sin phi sin psi, .)`` so ``psi`` is the *polar angle from the array
+   normal*; eq. 22/24 instead return ``acos(rho / kappa)``, which is the angle *above the array
+   plane* (``pi/2 - psi``). We follow eq. 19 (``psi = asin(rho / kappa)``) and report an unambiguous
+   unit ``direction`` in the local frame (front half-space, local z > 0).
+5. :func:`algorithm1` — ExtractMeas' consistency checks: discard ``d < 0``; far-field when
+   ``kappa < 0``; near-field otherwise.
+6. :func:`paper_route` — steps 1-4 from a CPD to :class:`~tunnelkit.extraction.PathEstimates`.
+
+``H`` follows eq. 1 exactly as printed (spatial phase ``+2 pi fc/c delta``, frequency phase
+``-2 pi s Df tau``, time phase ``+2 pi k f_d T0``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .decomposition import _contract, _grid_index
+from .estimates import PathEstimates
+
+__all__ = [
+    "algorithm1",
+    "angles_from_solution",
+    "refine_joint",
+    "refine_roots",
+    "solve_far_field",
+    "solve_near_field",
+    "unwrap_spatial",
+    "vandermonde_roots",
+]
+
+
+def vandermonde_roots(B) -> np.ndarray:
+    """Eq. 13: ``mu = angle(diag(B_-^H B_+))`` for a (normalised) Vandermonde factor ``B`` (N, L)."""
+    B = np.asarray(B)
+    return np.angle(np.sum(B[:-1].conj() * B[1:], axis=0))
+
+
+def refine_roots(B, mu, n_steps: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Newton steps to the peak of ``|sum_n B[n] exp(-j mu n)|^2`` per column (single-tone ML).
+
+    Returns the refined roots and the fitted amplitude ``beta = mean_n B[n] exp(-j mu n)`` (1 for
+    a perfect normalised Vandermonde column). Steps are limited to a quarter of a bin.
+    """
+    B = np.asarray(B)
+    N = B.shape[0]
+    n = np.arange(N)[:, None]
+    mu = np.array(mu, dtype=float)
+    for _ in range(n_steps):
+        e = np.exp(-1j * n * mu[None, :])
+        S = np.sum(B * e, axis=0)
+        S1 = np.sum(-1j * n * B * e, axis=0)
+        S2 = np.sum(-(n**2) * B * e, axis=0)
+        d1 = 2 * np.real(S.conj() * S1)
+        d2 = 2 * (np.abs(S1) ** 2 + np.real(S.conj() * S2))
+        step = np.where(d2 < 0, -d1 / np.where(d2 < 0, d2, -1.0), 0.0)
+        mu = mu + np.clip(step, -np.pi / (2 * N), np.pi / (2 * N))
+    beta = np.mean(B * np.exp(-1j * n * mu[None, :]), axis=0)
+    return np.angle(np.exp(1j * mu)), beta
+
+
+def refine_joint(H, mu_f, mu_t, n_steps: int = 6):
+    """Joint ML refinement of all roots with free spatial factors (variable projection).
+
+    Model ``H[m, s, k] = sum_l A[m, l] exp(j mu_f,l s) exp(j mu_t,l k)``: for fixed roots the
+    spatial factors ``A`` are linear least squares; the roots take damped Gauss-Newton steps with
+    the Kaufman Jacobian ``a_l o P_perp dw_l/dmu`` (``w_l = f_l kron t_l``). All Gram matrices
+    factorise over the two Vandermonde modes, so one step costs three contractions of ``H``. This
+    is the maximum-likelihood estimate of the model a CPD fits plus the Vandermonde structure; it
+    approaches ``crlb_paths(spatial="free")`` where per-column estimates (eq. 13) do not.
+    Returns ``(mu_f, mu_t, A)``.
+    """
+    M, nf, nt = H.shape
+    s = np.arange(nf)[:, None]
+    k = np.arange(nt)[:, None]
+    mu = np.concatenate([np.asarray(mu_f, float), np.asarray(mu_t, float)])
+    L = mu.size // 2
+    x2 = float(np.vdot(H, H).real)
+    Hm = H.reshape(M * nf, nt)
+
+    def fit(m):
+        F, T = np.exp(1j * s * m[None, :L]), np.exp(1j * k * m[None, L:])
+        G = (F.conj().T @ F) * (T.conj().T @ T)  # W^H W
+        HT = (Hm @ T.conj()).reshape(M, nf, L)  # reused by the next gradient
+        B = np.einsum("msl,sl->ml", HT, F.conj())  # X conj(W)
+        A = np.linalg.solve(G, B.T).T
+        return F, T, G, A, HT, x2 - float(np.sum(np.real(A.conj() * B)))
+
+    F, T, G, A, HT, cost = fit(mu)
+    max_step = np.concatenate([np.full(L, np.pi / (2 * nf)), np.full(L, np.pi / (2 * nt))])
+    lam = 1e-6
+    for _ in range(n_steps):
+        Fs, Tk = s * F, k * T
+        FF, TT = F.conj().T @ F, T.conj().T @ T
+        WD = np.concatenate([1j * (F.conj().T @ Fs) * TT, 1j * FF * (T.conj().T @ Tk)], axis=1)
+        XD = -1j * np.concatenate(
+            [np.einsum("msl,sl->ml", HT, Fs.conj()), _contract(H, F.conj(), Tk.conj())], axis=1
+        )
+        RD = XD - A @ WD.conj()  # R conj(D)
+        Aa = np.concatenate([A, A], axis=1)
+        grad = np.real(np.sum(Aa.conj() * RD, axis=0))
+        Dff = (Fs.conj().T @ Fs) * TT
+        Dft = (Fs.conj().T @ F) * (T.conj().T @ Tk)
+        Dtt = FF * (Tk.conj().T @ Tk)
+        DD = np.block([[Dff, Dft], [Dft.conj().T, Dtt]])
+        PP = DD - WD.conj().T @ np.linalg.solve(G, WD)
+        JtJ = np.real((Aa.conj().T @ Aa) * PP)
+        improved = done = False
+        for _ in range(10):
+            step = np.linalg.solve(JtJ + lam * np.diag(np.diag(JtJ)), grad)
+            step = np.clip(step, -max_step, max_step)  # trust region: a quarter of a bin
+            out = fit(mu + step)
+            if out[-1] <= cost:
+                mu = mu + step
+                F, T, G, A, HT, new = out
+                # converged when the step is far below the noise-limited precision of the roots
+                done = np.max(np.abs(step)) < 1e-9 or cost - new <= 1e-12 * cost
+                cost, lam, improved = new, max(lam / 10, 1e-12), True
+                break
+            lam *= 10
+        if not improved or done:
+            break
+    return mu[:L], mu[L:], A
+
+
+def unwrap_spatial(b, element_positions) -> np.ndarray:
+    """Eq. 16 without the ``c / (2 pi fc)`` factor: unwrapped phase (M, L) of the spatial factor.
+
+    ``b`` (M, L) normalised so that ``b[0] = 1``. On a full rectangular grid (a URA, or a ULA) the
+    phase image is unwrapped with scikit-image's ``unwrap_phase`` (Herráez et al. 2002); for other
+    planar layouts it is unwrapped along a minimum spanning tree of the elements. The result is
+    shifted so that the reference element has phase 0 (eq. 2: ``delta_0 = 0``).
+    """
+    b = np.asarray(b)
+    p = np.asarray(element_positions, float)
+    ph = np.angle(b)
+    grid = _grid_index(p)
+    out = np.empty_like(ph)
+    if grid is not None and min(grid[2], grid[3]) > 1:
+        from skimage.restoration import unwrap_phase
+
+        r, c, nr, nc = grid
+        for j_ in range(ph.shape[1]):
+            img = np.zeros((nr, nc))
+            img[r, c] = ph[:, j_]
+            un = unwrap_phase(img)
+            out[:, j_] = un[r, c]
+    elif grid is not None:  # one row or column: 1-D unwrap in element order along the line
+        r, c, nr, nc = grid
+        order = np.argsort(r * nc + c)
+        out[order] = np.unwrap(ph[order], axis=0)
+    else:
+        from scipy.sparse.csgraph import breadth_first_order, minimum_spanning_tree
+
+        dist = np.linalg.norm(p[:, None, :2] - p[None, :, :2], axis=-1)
+        tree = minimum_spanning_tree(dist)
+        order, pred = breadth_first_order(tree, 0, directed=False)
+        out[0] = ph[0]
+        for i in order[1:]:
+            j = pred[i]
+            out[i] = out[j] + np.angle(np.exp(1j * (ph[i] - ph[j])))
+    return out - out[0]
+
+
+def _line_direction(p: np.ndarray, rtol: float = 1e-12):
+    """Unit in-plane direction ``e`` (2,) if the elements' xy positions are collinear, else None.
+
+    The reference antenna is at the origin, so a linear array lies on the line ``t e``; any
+    direction counts (a ULA along local x *or* y, or diagonal).
+    """
+    xy = p[:, :2]
+    far = int(np.argmax(np.linalg.norm(xy, axis=1)))
+    size = float(np.linalg.norm(xy[far]))
+    if size == 0:
+        return None
+    e = xy[far] / size
+    off = np.abs(xy[:, 0] * e[1] - xy[:, 1] * e[0])  # distance from the line through 0 along e
+    return e if np.max(off) <= rtol * size else None
+
+
+def solve_near_field(delta, element_positions) -> np.ndarray:
+    """TLS solution ``x = (x_l, y_l, kappa_l)`` of eq. 18 for each column of ``delta`` (M, L).
+
+    Rows ``2 [x_m, y_m, delta_m] x = r_m^2 - delta_m^2`` (m >= 1); the TLS solution is the last
+    right singular vector of ``[2 A, -y]`` scaled to a unit last entry. For a linear array (a
+    ULA along any direction ``e`` of the array plane) the columns ``x_m, y_m`` are replaced by the
+    coordinate ``t_m = e . p_m`` along the line and the returned ``(x, y)`` is ``t e`` (the
+    component across the line is unobservable and returned as 0). Returns (L, 3).
+    """
+    delta = np.atleast_2d(np.asarray(delta, float).T).T
+    p = np.asarray(element_positions, float)
+    xm, ym = p[1:, 0], p[1:, 1]
+    r2 = np.sum(p[1:] ** 2, axis=1)
+    line = _line_direction(p)
+    linear = line is not None
+    tm = p[1:, :2] @ line if linear else None  # coordinate along the array's line
+    out = np.empty((delta.shape[1], 3))
+    for j_ in range(delta.shape[1]):
+        dm = delta[1:, j_]
+        cols = [tm, dm] if linear else [xm, ym, dm]
+        A = 2 * np.stack(cols, axis=1)
+        aug = np.column_stack([A, -(r2 - dm**2)])
+        aug_scale = np.linalg.norm(aug, axis=0)
+        aug_scale[aug_scale == 0] = 1.0
+        _, _, vh = np.linalg.svd(aug / aug_scale, full_matrices=False)
+        v = vh[-1] / aug_scale
+        sol = v[:-1] / v[-1] if abs(v[-1]) > 1e-300 else np.full(len(cols), np.nan)
+        out[j_] = [*(sol[0] * line), sol[1]] if linear else sol
+    return out
+
+
+def solve_far_field(delta, element_positions) -> np.ndarray:
+    """LS far-field solution of ``[x_m, y_m] u = -delta_m``: ``u = (cos phi sin psi, sin phi sin psi)``.
+
+    In the far field ``delta_m = -u . p_m`` (eq. 17 with ``kappa -> inf``). Returns (L, 2); for a
+    linear array along ``e`` only ``u . e`` is observable and ``(u . e) e`` is returned.
+    """
+    delta = np.atleast_2d(np.asarray(delta, float).T).T
+    p = np.asarray(element_positions, float)
+    line = _line_direction(p)
+    A = (p[1:, :2] @ line)[:, None] if line is not None else p[1:, :2]
+    sol = np.linalg.lstsq(A, -delta[1:], rcond=None)[0].T
+    return sol[:, :1] * line[None, :] if line is not None else sol
+
+
+def angles_from_solution(x_nf, u_ff):
+    """Eq. 19-24 in the eq. 19 convention; returns dict of phi/psi/direction for NF and FF.
+
+    NF: ``rho = ||(x, y)||``, ``psi = asin(rho / kappa)`` (polar angle from the array normal),
+    ``direction = (x, y, sqrt(kappa^2 - rho^2)) / kappa``. FF: ``direction = (u_x, u_y,
+    sqrt(1 - |u|^2))``. Ratios above 1 (noise) are clipped to 1.
+    """
+    x_nf = np.atleast_2d(x_nf)
+    u_ff = np.atleast_2d(u_ff)
+    kap = x_nf[:, 2]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s_nf = np.clip(np.hypot(x_nf[:, 0], x_nf[:, 1]) / np.abs(kap), 0.0, 1.0)
+    phi_nf = np.arctan2(x_nf[:, 1], x_nf[:, 0])
+    dir_nf = np.column_stack([s_nf * np.cos(phi_nf), s_nf * np.sin(phi_nf), np.sqrt(1 - s_nf**2)])
+    s_ff = np.clip(np.hypot(u_ff[:, 0], u_ff[:, 1]), 0.0, 1.0)
+    phi_ff = np.arctan2(u_ff[:, 1], u_ff[:, 0])
+    dir_ff = np.column_stack([s_ff * np.cos(phi_ff), s_ff * np.sin(phi_ff), np.sqrt(1 - s_ff**2)])
+    return {
+        "phi_nf": phi_nf,
+        "psi_nf": np.arcsin(s_nf),
+        "dir_nf": dir_nf,
+        "kappa_nf": kap,
+        "phi_ff": phi_ff,
+        "psi_ff": np.arcsin(s_ff),
+        "dir_ff": dir_ff,
+    }
+
+
+def algorithm1(est: PathEstimates) -> np.ndarray:
+    """Algorithm 1 (ExtractMeas) checks: indices of the kept paths (``d >= 0``).
+
+    The near/far choice (``kappa < 0`` -> far-field angles, no kappa) is already applied in
+    :func:`extract_paths`; this returns the paths that survive line 5-6.
+    """
+    if not isinstance(est, PathEstimates):
+        raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
+    return np.flatnonzero(est.valid)

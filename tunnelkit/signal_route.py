@@ -1,0 +1,219 @@
+"""The measurement route of notebooks 03-04: scenario -> propagation -> channel tensor -> extraction -> Algorithm 1.
+
+:class:`SignalRoute` builds the scenario's objects once; :meth:`SignalRoute.epoch` traces the paths
+of one SRS slot (:mod:`tunnelkit.propagation`), synthesises the tensor with noise and clock bias
+(:mod:`tunnelkit.channel`), extracts the path parameters (:mod:`tunnelkit.extraction`) and applies
+Algorithm 1's checks (:func:`measurements_from_estimates`). Matching estimates to the truth lives in
+:mod:`tunnelkit.evaluation`. In one line::
+
+    import numpy as np
+    from tunnelkit import signal_route
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")   # build once
+    ep = route.epoch(k=10, rng=np.random.default_rng(0))                     # one SRS slot
+    ep.measurements.z            # eq. 54: [phi; psi; kappa; Delta d] of the kept paths
+    ep.measurements.origin       # world position of the array's reference antenna
+    ep.paths                     # ground truth (tunnelkit.propagation.Path list)
+
+or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a single call. Angles in
+``ep.measurements`` are world-frame azimuth/elevation (eq. 46-47, 49-50) seen from ``origin``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._validate import integer, rng_or_error
+from .arrays import ArrayGeometry
+from .channel import ChannelSnapshot, SRSConfig, synthesize
+from .evaluation import match_paths
+
+__all__ = ["Epoch", "Measurements", "SignalRoute", "measurements_from_estimates", "simulate_epoch"]
+
+
+@dataclass(frozen=True)
+class Measurements:
+    """Algorithm 1 output for one array, angles in the **world** frame, seen from ``origin``.
+
+    Per kept path (sorted by ``d``; path 0 is the earliest arrival): ``phi``/``psi`` azimuth and
+    elevation (eq. 46-47), ``kappa`` (NaN when far-field), ``near_field``, ``d`` (biased distance),
+    ``delta_d = d - d[0]`` (eq. 52, ``delta_d[0] = 0``), ``v`` (m/s), ``direction`` (K, 3) world unit
+    vectors, ``alpha``. ``z`` is eq. 54, ``[phi; psi; kappa; delta_d[1:]]``. ``index`` maps each
+    kept path to its row in the raw :class:`tunnelkit.extraction.PathEstimates`.
+    """
+
+    origin: np.ndarray
+    array: str
+    phi: np.ndarray
+    psi: np.ndarray
+    kappa: np.ndarray
+    near_field: np.ndarray
+    d: np.ndarray
+    delta_d: np.ndarray
+    v: np.ndarray
+    direction: np.ndarray
+    alpha: np.ndarray
+    index: np.ndarray
+
+    def __len__(self) -> int:
+        return self.d.shape[0]
+
+    @property
+    def z(self) -> np.ndarray:
+        """Eq. 54 stacked vector ``[phi; psi; kappa; delta_d[1:]]`` (kappa NaN for far-field)."""
+        return np.concatenate([self.phi, self.psi, self.kappa, self.delta_d[1:]])
+
+    @property
+    def wave_origins(self) -> np.ndarray:
+        """``origin + kappa * direction`` (K, 3), NaN rows for far-field paths (Fig. 5)."""
+        return self.origin + self.kappa[:, None] * self.direction
+
+
+@dataclass(frozen=True)
+class Epoch:
+    """Everything about one simulated epoch (truth, tensor, raw estimates, measurements)."""
+
+    k: int
+    t: float
+    ue: np.ndarray
+    velocity: np.ndarray
+    array: ArrayGeometry = field(repr=False)
+    paths: list = field(repr=False)
+    snapshot: ChannelSnapshot = field(repr=False)
+    estimates: object = field(repr=False)
+    measurements: Measurements
+    truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
+
+
+def measurements_from_estimates(est, array: ArrayGeometry) -> Measurements:
+    """Apply Algorithm 1's checks to raw estimates and express them in the world frame."""
+    from .extraction import algorithm1
+
+    keep = algorithm1(est)
+    u = array.dir_to_world(est.direction[keep]) if keep.size else np.zeros((0, 3))
+    phi = np.arctan2(u[:, 1], u[:, 0])
+    psi = np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1]))
+    d = est.d[keep]
+    return Measurements(
+        array.origin.copy(),
+        array.name,
+        phi,
+        psi,
+        est.kappa[keep],
+        est.near_field[keep],
+        d,
+        d - d[0] if d.size else d,
+        est.v[keep],
+        u,
+        est.alpha[keep],
+        keep,
+    )
+
+
+@dataclass
+class SignalRoute:
+    """Scenario objects built once; :meth:`epoch` runs propagation -> channel -> extraction.
+
+    ``kinds`` selects path families (see :func:`tunnelkit.propagation.trace_paths`);
+    ``n_paths=None`` means L known (the number of traced paths, as in the paper).
+    """
+
+    tunnel: object
+    arrays: list
+    trajectory: object
+    config: SRSConfig
+    model: str = "exact"
+    kinds: tuple[str, ...] = ("los", "wall", "ceiling", "road", "rrm")
+    snr_offset_db: float = 0.0
+
+    @classmethod
+    def from_scenario(cls, scenario, **kw) -> SignalRoute:
+        """Build from a scenario name or a loaded :class:`tunnelkit.scenarios.Scenario`."""
+        from . import propagation
+        from .scenarios import Scenario, load_scenario
+
+        sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
+        if not isinstance(sc, Scenario):
+            raise TypeError(
+                f"scenario: expected a name or a Scenario, got {type(scenario).__name__}"
+            )
+        tun = sc.tunnel()
+        return cls(
+            tun,
+            propagation.scenario_arrays(sc),
+            sc.trajectory(tun),
+            SRSConfig.from_scenario(sc),
+            **kw,
+        )
+
+    def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
+        """The array facing the vehicle and the true paths at epoch ``k``."""
+        from . import propagation
+
+        k = integer("k", k, minimum=0)
+        if k >= len(self.trajectory):
+            raise ValueError(f"k: epoch {k} beyond the trajectory ({len(self.trajectory)} epochs)")
+        ue, vel = self.trajectory.position[k], self.trajectory.velocity[k]
+        arr = propagation.select_array(self.arrays, ue)
+        tun = self.tunnel if tunnel is None else tunnel
+        return arr, propagation.trace_paths(tun, arr, ue, vel, fc=self.config.fc, kinds=self.kinds)
+
+    def epoch(
+        self,
+        k: int,
+        rng: np.random.Generator,
+        *,
+        n_paths: int | None = None,
+        tunnel=None,
+        clock_bias: float | None = None,
+        **extract_kw,
+    ) -> Epoch:
+        """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1."""
+        from .extraction import extract_paths
+
+        rng = rng_or_error("rng", rng)
+        arr, paths = self.paths(k, tunnel)
+        snap = synthesize(
+            paths,
+            self.config,
+            rng,
+            model=self.model,
+            clock_bias=clock_bias,
+            snr_offset_db=self.snr_offset_db,
+        )
+        L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
+        est = extract_paths(
+            snap.H,
+            L,
+            arr.local,
+            self.config.fc,
+            self.config.tone_spacing,
+            self.config.symbol_period,
+            **extract_kw,
+        )
+        meas = measurements_from_estimates(est, arr)
+        truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
+        return Epoch(
+            k,
+            float(self.trajectory.t[k]),
+            self.trajectory.position[k].copy(),
+            self.trajectory.velocity[k].copy(),
+            arr,
+            paths,
+            snap,
+            est,
+            meas,
+            truth,
+        )
+
+
+def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
+    """One-call signal route: ``simulate_epoch("italiano2026-straight", 10, rng).measurements``.
+
+    Keyword arguments go to :class:`SignalRoute` (``model``, ``kinds``, ``snr_offset_db``) or to
+    :meth:`SignalRoute.epoch` (``n_paths``, ``tunnel``, ``clock_bias``, extraction options).
+    For loops over epochs build a :class:`SignalRoute` once instead.
+    """
+    route_kw = {key: kw.pop(key) for key in ("model", "kinds", "snr_offset_db") if key in kw}
+    return SignalRoute.from_scenario(scenario, **route_kw).epoch(k, rng, **kw)
