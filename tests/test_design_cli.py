@@ -114,3 +114,10 @@ def test_a_scheduler_that_does_not_answer_fails_fast(capsys):
     rc = main([*argv, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "2"])
     assert rc != 0 and time.perf_counter() - t0 < 120
     assert "scheduler" in capsys.readouterr().err
+
+
+def test_monte_carlo_identical_on_two_workers():
+    setup = design.DesignSetup.from_scenario("italiano2026-straight")
+    serial = design.javelin_rmse(setup, "4x4", 2, 7, n_epochs=3)
+    dask = design.javelin_rmse(setup, "4x4", 2, 7, n_epochs=3, workers=2)
+    assert np.array_equal(serial["runs"], dask["runs"])
