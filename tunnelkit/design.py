@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -263,8 +264,16 @@ class DesignSetup:
                     f"inside the tunnel cross-section ({int((~inside).sum())} of {spec.n_elements} "
                     "elements outside); choose a smaller array or move the mount"
                 )
-            out.append(ArrayGeometry(loc, origin, m.azimuth, m.elevation, name=m.name))
+            out.append(
+                _placed(spec, self.fc, tuple(origin.tolist()), m.azimuth, m.elevation, m.name)
+            )
         return out
+
+
+@lru_cache(maxsize=64)
+def _placed(spec: ArraySpec, fc: float, origin: tuple, azimuth: float, elevation: float, name: str):
+    """An :class:`ArrayGeometry` (cached: its constructor checks every pair of elements)."""
+    return ArrayGeometry(spec.local(fc), np.array(origin), azimuth, elevation, name=name)
 
 
 # --- vectorised image method over a route -------------------------------------------------------
