@@ -70,6 +70,9 @@ __all__ = [
 ]
 
 KINDS = ("los", "wall", "ceiling", "road", "rrm")
+
+#: V2X speed [m/s] and heading [rad] message noise of the Monte-Carlo drives (section 4.2)
+SIGMA_SPEED, SIGMA_HEADING = 0.2, float(np.radians(1.0))
 _CLOCK = ("unknown", "known")
 
 
@@ -1015,8 +1018,8 @@ def _drive(route, rng: np.random.Generator, n_epochs: int | None):
                 dd = (m.d[j] - m.d[ref]) - (p.length - ep.paths[ti[ref]].length)
                 errs.append((np.arccos(cos), m.kappa[j] - p.length, dd / np.sqrt(2.0)))
     vel = traj.velocity[:T]
-    speed = np.linalg.norm(vel[:, :2], axis=1) + 0.2 * rng.standard_normal(T)
-    heading = np.arctan2(vel[:, 1], vel[:, 0]) + np.radians(1.0) * rng.standard_normal(T)
+    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
+    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
     drive = DriveData(
         "design",
         CONDITIONS["L"],
@@ -1054,7 +1057,7 @@ def javelin_rmse(
     setup: DesignSetup,
     spec,
     runs: int,
-    seed: int,
+    seed: int | np.random.Generator,
     *,
     workers: int | None = None,
     scheduler: str | None = None,
@@ -1069,8 +1072,9 @@ def javelin_rmse(
 
     Measurement sigmas come from the design (:func:`javelin_config`): the route-median CRLBs and,
     with ``calibrate``, the extraction error measured on one calibration drive drawn from its own
-    seed (``seed + 1``'s first child), never from the scored drives. Runs go through
-    :func:`tunnelkit.montecarlo.run_trials` (``workers`` / ``scheduler`` passed on when given).
+    seed (``seed + 1``'s first child, or a child of a Generator), never from the scored drives.
+    Runs go through :func:`tunnelkit.montecarlo.run_trials` (``workers`` / ``scheduler`` /
+    ``timeout`` passed on when given).
     """
     from scipy import stats
 
@@ -1078,13 +1082,17 @@ def javelin_rmse(
 
     spec = parse_array(spec)
     runs = integer("runs", runs, minimum=2)
-    seed = integer("seed", seed, minimum=0)
+    if isinstance(seed, np.random.Generator):
+        cal_rng, seed = seed.spawn(2)
+    else:
+        seed = integer("seed", seed, minimum=0)
+        cal_rng = spawn_rngs(seed + 1, 1)[0]
     if crlb is None:
         pb = path_bounds(setup, spec)
         crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
     measured = None
     if calibrate:
-        _, err = _drive(_route(setup, spec), spawn_rngs(seed + 1, 1)[0], n_epochs)
+        _, err = _drive(_route(setup, spec), cal_rng, n_epochs)
         if err.size:
             with np.errstate(invalid="ignore"):
                 rms = np.sqrt(np.nanmean(err**2, axis=0))
