@@ -9,6 +9,10 @@ from .common import (
     cdf_figure,
     line_figure,
 )
+from .design import (
+    route_figure,
+    size_figure,
+)
 from .doppler import (
     approach_cdfs,
     doppler_delay_figure,
@@ -71,6 +75,8 @@ __all__ = [
     "ratio_map_figure",
     "regime_figure",
     "rmse_bound_figure",
+    "route_figure",
+    "size_figure",
     "table_figure",
     "tracks_count_figure",
     "tracks_figure",

@@ -10,9 +10,11 @@ identical, only the extraction differs.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from ..montecarlo import spawn_rngs
+from ..montecarlo import run_trials
 from ..reference import load as load_reference
 from . import Report, register
 
@@ -29,28 +31,37 @@ def collect_routes(
     progress: bool = False,
     n_epochs: int | None = None,
     extractions: tuple[str, ...] = ("paper", "separated"),
+    **parallel,
 ) -> dict[str, dict[str, list]]:
     """``runs`` seeded drives per condition through the signal route (the expensive part), each
     measured through every route in ``extractions`` from the same tensors and CPD
     (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`); ``n_epochs`` truncates each
-    drive (quick mode). Returns ``{extraction: {condition: [DriveData, ...]}}``."""
-    from ..tracking.javelin import experiment as ex
-
-    rngs = spawn_rngs(seed, runs * len(conditions))
+    drive (quick mode). One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``:
+    its ``workers`` / ``scheduler`` / ``timeout``). Returns ``{extraction: {condition: [DriveData,
+    ...]}}``."""
     jobs = [c for _ in range(runs) for c in conditions]
-    it = list(zip(jobs, rngs))
-    if progress:
-        from tqdm.auto import tqdm
-
-        it = tqdm(it, desc=f"{scenario} drives", leave=False)
+    trial = functools.partial(_simulate, scenario, n_epochs, tuple(extractions))
+    results = run_trials(
+        trial,
+        len(jobs),
+        seed,
+        inputs=jobs,
+        progress=progress,
+        desc=f"{scenario} drives",
+        **parallel,
+    )
     out: dict[str, dict[str, list]] = {e: {c: [] for c in conditions} for e in extractions}
-    for cond, rng in it:
-        routes = ex.simulate_routes(
-            scenario, cond, rng, n_epochs=n_epochs, extractions=tuple(extractions)
-        )
+    for cond, routes in zip(jobs, results):
         for e, drive in routes.items():
             out[e][cond].append(drive)
     return out
+
+
+def _simulate(scenario: str, n_epochs: int | None, extractions: tuple[str, ...], cond: str, rng):
+    """One drive of ``cond`` through the signal route, measured through every extraction."""
+    from ..tracking.javelin import experiment as ex
+
+    return ex.simulate_routes(scenario, cond, rng, n_epochs=n_epochs, extractions=extractions)
 
 
 def collect_drives(
@@ -61,9 +72,12 @@ def collect_drives(
     progress: bool = False,
     n_epochs: int | None = None,
     extraction: str = "paper",
+    **parallel,
 ) -> dict[str, list]:
     """:func:`collect_routes` through one route: ``{condition: [DriveData, ...]}``."""
-    routes = collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (extraction,))
+    routes = collect_routes(
+        scenario, conditions, runs, seed, progress, n_epochs, (extraction,), **parallel
+    )
     return routes[extraction]
 
 
@@ -135,11 +149,17 @@ NOTES = [
 
 
 def javelin_table(
-    scenario: str, reference: str, conditions: tuple[str, ...], runs: int, seed: int, progress: bool
+    scenario: str,
+    reference: str,
+    conditions: tuple[str, ...],
+    runs: int,
+    seed: int,
+    progress: bool,
+    **parallel,
 ) -> Report:
     """One table: rows per configuration, design (paper / ours) and extraction, the paper's
     numbers beside."""
-    routes = collect_routes(scenario, conditions, runs, seed, progress)
+    routes = collect_routes(scenario, conditions, runs, seed, progress, **parallel)
     drives, separated = routes["paper"], routes["separated"]
     cols, rows = table_rows(drives, reference, separated)
     n_fault = sum(len(d.faults) for r in (drives, separated) for lst in r.values() for d in lst)
@@ -157,7 +177,7 @@ def javelin_table(
     help="Italiano 2026 Table 1: straight drive, JAVELIN (L, N@0.5, N, NoRRMs) vs TeNFiLoc-L",
     default_runs=20,
 )
-def javelin_table1(runs: int, seed: int, progress: bool) -> Report:
+def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """Table 1 (straight trajectory)."""
     return javelin_table(
         "italiano2026-straight",
@@ -166,6 +186,7 @@ def javelin_table1(runs: int, seed: int, progress: bool) -> Report:
         runs,
         seed,
         progress,
+        **parallel,
     )
 
 
@@ -174,8 +195,14 @@ def javelin_table1(runs: int, seed: int, progress: bool) -> Report:
     help="Italiano 2026 Table 2: slalom drive, JAVELIN (L, N@0.5, N) vs TeNFiLoc-L",
     default_runs=20,
 )
-def javelin_table2(runs: int, seed: int, progress: bool) -> Report:
+def javelin_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """Table 2 (slalom trajectory)."""
     return javelin_table(
-        "italiano2026-slalom", "italiano2026_table2", ("L", "N@0.5", "N"), runs, seed, progress
+        "italiano2026-slalom",
+        "italiano2026_table2",
+        ("L", "N@0.5", "N"),
+        runs,
+        seed,
+        progress,
+        **parallel,
     )

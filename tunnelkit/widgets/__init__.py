@@ -18,6 +18,10 @@ from .crlb import (
     crlb_explorer,
     crlb_figure,
 )
+from .design import (
+    design_explorer,
+    design_figure,
+)
 from .doppler import (
     doppler_explorer,
     doppler_figure,
@@ -42,6 +46,8 @@ __all__ = [
     "crlb_figure",
     "curvature_figure",
     "curvature_study",
+    "design_explorer",
+    "design_figure",
     "doppler_explorer",
     "doppler_figure",
     "epoch_explorer",

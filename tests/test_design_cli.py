@@ -1,0 +1,123 @@
+"""``tunnelkit design``: JSON shape, the 28 GHz question, bad input naming the parameter."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from tunnelkit import design
+from tunnelkit.cli import main
+
+KEYS = {
+    "array",
+    "n_elements",
+    "aperture_m",
+    "srnf_valid_share",
+    "peb_median_m",
+    "peb_p90_m",
+    "rmse_m",
+    "rmse_ci95_m",
+}
+
+
+def test_json_answers_the_28ghz_question(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "2x2", "3x3", "4x4", "8x8"]
+    assert main([*argv, "--target", "0.15", "--format", "json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) == {"scenario", "arrays", "recommendation"}
+    assert out["scenario"] == "example-rectangular-28ghz"
+    assert [a["array"] for a in out["arrays"]] == ["2x2", "3x3", "4x4", "8x8"]
+    for a in out["arrays"]:
+        assert set(a) == KEYS
+        assert a["rmse_m"] is None and a["rmse_ci95_m"] is None
+    by = {a["array"]: a for a in out["arrays"]}
+    assert by["8x8"]["n_elements"] == 64
+    # lambda/2 at 28 GHz: 7 spacings along each side, diagonal 7 sqrt(2) lambda/2
+    assert by["8x8"]["aperture_m"] == pytest.approx(7 * np.sqrt(2) * 299792458 / 28e9 / 2)
+    # the ceiling 20 cm above the array: SR-NF fails for 8x8 everywhere, holds for 2x2
+    assert by["8x8"]["srnf_valid_share"] == 0.0 and by["2x2"]["srnf_valid_share"] == 1.0
+    assert by["2x2"]["peb_median_m"] > by["8x8"]["peb_median_m"]
+    assert set(out["recommendation"]) == {"array", "reason"}
+    assert out["recommendation"]["array"] == "3x3"
+
+
+def test_table_and_overrides(capsys):
+    argv = ["design", "italiano2026-straight", "--arrays", "4x4", "10x10", "--fc", "28GHz"]
+    assert main([*argv, "--bandwidth", "400MHz", "--tilt", "20", "--target", "0.05"]) == 0
+    out = capsys.readouterr().out
+    assert "fc 28 GHz, bandwidth 400 MHz" in out and "recommendation:" in out
+    assert "10x10" in out
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--arrays", "8y8"], "arrays: cannot read '8y8'"),
+        (["--arrays", "64x64"], "arrays: the 64x64 array"),
+        (["--mount-height", "9"], "mount:"),
+        (["--runs", "1"], "runs:"),
+        (["--share", "1.5"], "share"),
+    ],
+)
+def test_bad_input_names_the_parameter(capsys, extra, message):
+    assert main(["design", "italiano2026-straight", *extra]) == 2
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--fc", "0GHz"], "fc: must be > 0"),
+        (["--fc=-28GHz"], "fc: must be > 0"),
+        (["--fc", "28 parsecs"], "fc: cannot read"),
+        (["--bandwidth", "0"], "bandwidth: must be > 0"),
+        (["--target", "0"], "target: must be > 0"),
+        (["--target", "-1"], "target: must be > 0"),
+        (["--workers", "2", "--scheduler", "tcp://x:1"], "not allowed with"),
+    ],
+)
+def test_argument_errors_exit_non_zero(capsys, extra, message):
+    with pytest.raises(SystemExit) as exc:
+        main(["design", "italiano2026-straight", *extra])
+    assert exc.value.code != 0
+    assert message in capsys.readouterr().err
+
+
+def test_unknown_scenario_and_2d_tunnel(capsys):
+    assert main(["design", "no-such-tunnel"]) == 2
+    assert "unknown scenario" in capsys.readouterr().err
+    with pytest.raises(ValueError, match=r"scenario: .* 2-D tunnel"):
+        design.DesignSetup.from_scenario("jiang2023-straight")
+
+
+def test_monte_carlo_is_seeded_and_reported():
+    setup = design.DesignSetup.from_scenario("italiano2026-straight")
+    a = design.javelin_rmse(setup, "4x4", 2, 5, n_epochs=3)
+    b = design.javelin_rmse(setup, "4x4", 2, 5, n_epochs=3)
+    assert np.array_equal(a["runs"], b["runs"])
+    assert a["rmse_m"] == pytest.approx(np.mean(a["runs"]))
+    lo, hi = a["ci95_m"]
+    assert 0.0 <= lo <= a["rmse_m"] <= hi and np.all(np.isfinite(a["runs"]))
+    # sigmas from this design, not 5.9 GHz constants: at least the CRLB, finite, positive
+    pb = design.path_bounds(setup, "4x4")
+    assert a["sigmas"]["direction_rad"] >= np.median(pb["direction"])
+    assert a["sigmas"]["delta_d_m"] >= np.sqrt(2) * np.median(pb["d"])
+
+
+def test_a_scheduler_that_does_not_answer_fails_fast(capsys):
+    import time
+
+    t0 = time.perf_counter()
+    argv = ["design", "italiano2026-straight", "--arrays", "4x4", "--runs", "2"]
+    rc = main([*argv, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "2"])
+    assert rc != 0 and time.perf_counter() - t0 < 120
+    assert "scheduler" in capsys.readouterr().err
+
+
+def test_monte_carlo_identical_on_two_workers():
+    setup = design.DesignSetup.from_scenario("italiano2026-straight")
+    serial = design.javelin_rmse(setup, "4x4", 2, 7, n_epochs=3)
+    dask = design.javelin_rmse(setup, "4x4", 2, 7, n_epochs=3, workers=2)
+    assert np.array_equal(serial["runs"], dask["runs"])

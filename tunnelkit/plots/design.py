@@ -1,0 +1,241 @@
+"""Notebook 08 figures: the position error bound along the route with the SR-NF overlay, and the
+PEB / SR-NF share against array size.
+
+Builders are pure (data -> figure) and take the results of :mod:`tunnelkit.design`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import plotly.graph_objects as go
+
+from .common import COLORS
+
+__all__ = ["route_figure", "route_traces", "size_figure"]
+
+_KIND_COLORS = {
+    "wall": "#1f77b4",
+    "ceiling": "#d62728",
+    "road": "#8c564b",
+    "rrm": "#2ca02c",
+}
+
+
+def _finite(v: np.ndarray) -> list:
+    """Plotly-friendly list: non-finite values become gaps (None)."""
+    return [float(x) if np.isfinite(x) else None for x in np.asarray(v, float)]
+
+
+def _scatter(**kw) -> dict:
+    """A scatter trace as a plain dict (validated once, by the figure that receives it)."""
+    return {"type": "scatter", **kw}
+
+
+def route_traces(bounds, *, variants: dict | None = None, target: float | None = None) -> list:
+    """Trace dicts on axes (x, y) PEB [cm] along the tunnel and (x, y2) SR-NF mismatch per surface.
+
+    Order: 0 PEB, 1 SR-NF not valid (markers on the PEB), 2.. one dashed trace per variant
+    (``{"no curvature": RouteBounds, ...}``), then the target line (if given), then one mismatch
+    trace per surface kind and the ``eps_phi`` line on (x, y2).
+    """
+    x = bounds.x
+    peb_cm = 100 * bounds.peb
+    bad = ~bounds.srnf_valid
+    traces = [
+        _scatter(
+            x=x,
+            y=_finite(peb_cm),
+            mode="lines+markers",
+            name=f"PEB {bounds.spec.label}",
+            line={"color": COLORS.get("ours", "#1f77b4"), "width": 2.5},
+            marker={"size": 5},
+        ),
+        _scatter(
+            x=x[bad],
+            y=_finite(peb_cm[bad]),
+            mode="markers",
+            name="SR-NF not valid",
+            marker={"symbol": "x", "size": 10, "color": "#d62728"},
+        ),
+    ]
+    for i, (name, b) in enumerate((variants or {}).items()):
+        traces.append(
+            _scatter(
+                x=b.x,
+                y=_finite(100 * b.peb),
+                mode="lines",
+                name=f"PEB, {name}",
+                line={"dash": ["dash", "dot", "dashdot"][i % 3], "width": 1.5},
+            )
+        )
+    if target is not None:
+        traces.append(
+            _scatter(
+                x=[float(x.min()), float(x.max())],
+                y=[100 * target, 100 * target],
+                mode="lines",
+                name="target",
+                line={"color": "black", "dash": "dot", "width": 1},
+            )
+        )
+    kinds = np.array(bounds.kinds)
+    for k in dict.fromkeys(bounds.kinds[1:]):
+        cols = kinds == k
+        used = bounds.used[:, cols]
+        if not used.any():
+            continue
+        mis = np.where(used, bounds.mismatch[:, cols], np.nan)
+        with np.errstate(all="ignore"):
+            worst = np.where(
+                used.any(axis=1), np.nanmax(np.where(used, mis, -np.inf), axis=1), np.nan
+            )
+        traces.append(
+            _scatter(
+                x=x,
+                y=_finite(worst),
+                mode="lines+markers",
+                name=f"mismatch, {k}",
+                line={"color": _KIND_COLORS.get(k), "width": 1.5},
+                marker={"size": 4},
+                xaxis="x",
+                yaxis="y2",
+            )
+        )
+    traces.append(
+        _scatter(
+            x=[float(x.min()), float(x.max())],
+            y=[bounds.eps_phi, bounds.eps_phi],
+            mode="lines",
+            name="ε_Φ",
+            line={"color": "black", "dash": "dash", "width": 1},
+            xaxis="x",
+            yaxis="y2",
+        )
+    )
+    return traces
+
+
+def route_figure(
+    bounds,
+    *,
+    variants: dict | None = None,
+    target: float | None = None,
+    title: str = "",
+    subtitle: str = "",
+    meta: dict | None = None,
+) -> go.Figure:
+    """PEB along the tunnel (top, log) with SR-NF failures marked; per-surface mismatch (bottom).
+
+    ``layout.meta`` carries ``meta`` (for tests and lecture scripts).
+    """
+    layout = {
+        "title": {"text": title, "subtitle": {"text": subtitle}, "x": 0.01, "xanchor": "left"},
+        "height": 620,
+        "width": 980,
+        "margin": {"l": 70, "r": 20, "t": 90, "b": 50},
+        "xaxis": {"anchor": "y2", "title": {"text": "vehicle position x along the tunnel [m]"}},
+        "yaxis": {"domain": [0.42, 1.0], "type": "log", "title": {"text": "PEB [cm]"}},
+        "yaxis2": {
+            "domain": [0.0, 0.34],
+            "type": "log",
+            "title": {"text": "SR-NF mismatch [rad]"},
+        },
+        "legend": {"font": {"size": 10}, "bgcolor": "rgba(255,255,255,0.7)"},
+        "meta": meta or {},
+    }
+    return go.Figure(
+        {"data": route_traces(bounds, variants=variants, target=target), "layout": layout}
+    )
+
+
+def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figure:
+    """PEB (median, 90th percentile) and SR-NF valid share against the number of elements.
+
+    ``rows``: :class:`tunnelkit.design.DesignRow` list (one sweep). ``mark`` highlights one
+    array label (the paper's 10 x 10) when present.
+    """
+    n = np.array([r.n_elements for r in rows])
+    labels = [r.array for r in rows]
+    med = 100 * np.array([r.peb_median_m for r in rows])
+    p90 = 100 * np.array([r.peb_p90_m for r in rows])
+    share = 100 * np.array([r.srnf_valid_share for r in rows])
+    traces = [
+        go.Scatter(x=n, y=_finite(med), mode="lines+markers", name="PEB median", text=labels),
+        go.Scatter(
+            x=n, y=_finite(p90), mode="lines+markers", name="PEB 90th pct", line={"dash": "dash"}
+        ),
+        go.Scatter(
+            x=n,
+            y=share,
+            mode="lines+markers",
+            name="SR-NF valid share",
+            yaxis="y2",
+            line={"color": "#d62728"},
+        ),
+    ]
+    rm = [r.rmse_m for r in rows]
+    if any(v is not None for v in rm):
+        lo = [r.rmse_ci95_m[0] if r.rmse_ci95_m else None for r in rows]
+        hi = [r.rmse_ci95_m[1] if r.rmse_ci95_m else None for r in rows]
+        y = [100 * v if v is not None else None for v in rm]
+        traces.append(
+            go.Scatter(
+                x=n,
+                y=y,
+                mode="markers",
+                name="JAVELIN RMSE (95 % CI)",
+                marker={"symbol": "diamond", "size": 9, "color": "black"},
+                error_y={
+                    "type": "data",
+                    "symmetric": False,
+                    "array": [100 * (h - v) if v is not None else None for v, h in zip(rm, hi)],
+                    "arrayminus": [
+                        100 * (v - lo_) if v is not None else None for v, lo_ in zip(rm, lo)
+                    ],
+                },
+            )
+        )
+    shapes = []
+    if mark in labels:
+        x0 = n[labels.index(mark)]
+        shapes.append(
+            {
+                "type": "line",
+                "x0": x0,
+                "x1": x0,
+                "y0": 0,
+                "y1": 1,
+                "yref": "paper",
+                "line": {"color": "grey", "dash": "dot"},
+            }
+        )
+    layout = {
+        "title": {"text": title, "x": 0.01, "xanchor": "left"},
+        "height": 460,
+        "width": 900,
+        "xaxis": {"type": "log", "title": {"text": "number of elements M"}},
+        "yaxis": {"type": "log", "title": {"text": "position error [cm]"}},
+        "yaxis2": {
+            "overlaying": "y",
+            "side": "right",
+            "range": [0, 105],
+            "title": {"text": "SR-NF valid share [%]"},
+        },
+        "legend": {"x": 0.02, "y": 0.02, "bgcolor": "rgba(255,255,255,0.7)"},
+        "shapes": shapes,
+        "annotations": (
+            [
+                {
+                    "x": float(np.log10(n[labels.index(mark)])),
+                    "y": 1.0,
+                    "yref": "paper",
+                    "text": f"paper's {mark}",
+                    "showarrow": False,
+                    "yanchor": "bottom",
+                }
+            ]
+            if mark in labels
+            else []
+        ),
+    }
+    return go.Figure({"data": traces, "layout": layout})
