@@ -132,7 +132,7 @@ def ukf_proposal_reference(
     out_m = np.empty_like(particles)
     out_P = np.empty_like(covs)
     for i in range(particles.shape[0]):
-        f = VsUKF(model, particles[i], covs[i], alpha=alpha, beta=beta, kappa=kappa)
+        f = VsUKF(model, particles[i], covs[i], alpha=alpha, beta=beta, kappa=kappa, gate=None)
         f.predict()
         f.update(z)
         out_m[i], out_P[i] = f.x, f.P
