@@ -348,7 +348,11 @@ class UnscentedParticleFilter(EstimatorBase):
             upd = _ukf_update(self.model, m_pred, P_pred, zb, self.alpha, self.beta, self.kappa)
             m_post, P_post = upd[:2]
             if self.gate.enabled:
-                w = np.exp(log_w[sel])
+                lw = log_w[sel]
+                mx = np.max(lw, axis=-1, keepdims=True)
+                live = np.isfinite(mx)  # a run whose weights all vanished gates on uniform ones
+                w = np.where(live, np.exp(lw - np.where(live, mx, 0.0)), 1.0)
+                w = w / np.sum(w, axis=-1, keepdims=True)
                 d2, S = _mixture_d2(self.model, w, upd[2], upd[3], Z[sel])
                 verdict = self.gate.judge(d2, self.model.dim_z, rows=sel)
                 re = np.flatnonzero(verdict == REOPEN)
