@@ -536,6 +536,12 @@ class _Base:
     def _first(self) -> np.ndarray:  # the first epoch is the GNSS fix itself
         return self._p0.copy()
 
+    @property
+    def n_rejected(self) -> int:
+        """Doppler and ToA samples the gates of this approach rejected (predicted only)."""
+        parts = (getattr(self, a, None) for a in ("ekf", "speed_kf", "range_kf"))
+        return sum(f.n_rejected for f in parts if f is not None)
+
 
 #: keywords of the gates, passed to every filter of an approach
 _GATE_KEYS = ("gate", "reopen_after")
