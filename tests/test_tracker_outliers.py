@@ -159,7 +159,7 @@ def test_halili_tracker_survives_one_gross_outlier(drive, noisy, name, d_hz, d_m
 
 def test_range_kf_calibration_survives_an_outlier_in_the_first_toa(drive, noisy):
     """+100 m on the first ToA: the one-sample calibration shifts the track by about 100 m; the
-    robust calibration (10 ToAs, Theil-Sen line, MAD) leaves the median error within 0.2 m."""
+    robust calibration (first of 10 ToAs that is not an outlier by median/MAD) leaves the median error within 0.2 m."""
     meas, fix = noisy
     setup = dp.DopplerSetup.from_drive(drive)
     toa = meas.toa.copy()

@@ -227,9 +227,10 @@ print({k: round(v, 1) for k, v in r_est.items()}, "(true R = 400)")
 # The ToA is calibrated against the GNSS distance (this removes the clock offset; the drift
 # stays). The paper does not say how; one sample would carry its own error into the whole drive
 # (100 m of NLOS excess in it shifts every later epoch by 100 m), so the first ten ToAs are
-# compared with the dead-reckoned distance: a robust (Theil–Sen) line through the differences
-# removes the dead-reckoning drift, samples more than five robust standard deviations (MAD) off
-# it are left out, and the offset is the line's value at the first sample. The position then
+# compared with the dead-reckoned distance; those more than five robust standard deviations
+# (MAD) from their median are outliers, and the offset comes from the first one that is not: the
+# paper's one-sample calibration, with the sample checked against nine others (averaging them
+# would average the dead-reckoning drift of the window into the offset). The position then
 # follows eq. 16 with the heading $\phi$ from past estimates:
 #
 # $$x_k = x_{k-1} + \Delta r\sin\phi_{k-1},\qquad y_k = y_{k-1} + \Delta r\cos\phi_{k-1},

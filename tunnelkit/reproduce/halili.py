@@ -124,7 +124,8 @@ def halili_report(errs: dict[tuple[str, str], np.ndarray]) -> Report:
             "dynamic = adaptive R (eq. 15, posterior form, a = 0.9, started at 32.79 Hz).",
             "Filters as in the paper: no innovation gate (tunnelkit's default gate = 0.999 is switched off "
             "here; notebook 06 shows what it changes). The KF on ToA calibrates on its first 10 ToAs "
-            "(robust Theil-Sen line) and eq. 16 keeps the sign of the range change.",
+            "(the first one that is not an outlier among them) and eq. 16 keeps the sign of the range "
+            "change.",
             "Our first epoch carries the GNSS error of the entrance fix (the paper starts from the true position).",
             "Synthetic errors follow our documented assumptions (tunnelkit.drive), not fitted to the paper.",
         ],

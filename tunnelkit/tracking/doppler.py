@@ -41,7 +41,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
-from scipy.stats import theilslopes
 
 from .._validate import finite_array, integer, nonnegative, positive, probability
 from ..constants import C
@@ -361,12 +360,13 @@ class RangeKF:
     "perform calibration when using travel time measurements"). The paper does not say how; one
     sample would carry any error of that sample into every later epoch (a 100 m NLOS excess
     shifts the whole drive by 100 m), so the first ``calibration_epochs`` valid ToAs are
-    compared with the dead-reckoned distance (predict only meanwhile). The differences drift with
-    the dead-reckoning error (a Doppler bias), so a robust line (Theil-Sen) is fitted through
-    them; samples more than ``5 max(1.4826 MAD, sigma_toa)`` off it are left out
-    (``calibration_outliers`` counts them) and the offset is the line's mean value over the
-    others, carried back to the first sample. ``calibration_epochs=1`` is the single-sample
-    calibration.
+    compared with the dead-reckoned distance (predict only meanwhile); samples more than
+    ``5 max(1.4826 MAD, sigma_toa)`` from their median are outliers (``calibration_outliers``
+    counts them) and the offset is that of the first other sample: the paper's one-sample
+    calibration, with the sample checked against the others. (Averaging the samples instead
+    would average the dead-reckoning drift of the calibration window into the offset: a Doppler
+    bias of 2 m/s over ten epochs moves it by about 0.3 m.) ``calibration_epochs=1`` is the
+    unchecked single-sample calibration.
 
     Every later ToA passes a chi-square gate (``gate``, ``reopen_after``; see
     :mod:`tunnelkit.tracking.gating`); ``n_rejected`` counts the rejected ToAs (gate and
@@ -395,8 +395,7 @@ class RangeKF:
         self.setup, self.calibrate, self.sigma_toa = setup, bool(calibrate), sigma_toa
         self.offset: float | None = None if calibrate else 0.0
         self.calibration_outliers = 0
-        self._calib: list[tuple[int, float]] = []  # (epoch, ToA minus predicted distance / c)
-        self._epoch = 0
+        self._calib: list[float] = []  # ToA minus predicted distance / c
         self.d_min = abs(setup.dz)
         self._d_min_margin = 5 * sigma_toa * C
         kf = KalmanFilter(dim_x=1, dim_z=1, dim_u=1)
@@ -417,17 +416,14 @@ class RangeKF:
 
     def _calibrated(self, z: float) -> bool:
         """Collect one calibration sample; True once the offset is set."""
-        self._calib.append((self._epoch, z - self.distance / C))
+        self._calib.append(z - self.distance / C)
         if len(self._calib) < self.calibration_epochs:
             return False
-        k, o = (np.asarray(a, dtype=float) for a in zip(*self._calib))
-        k = k - k[0]
-        slope = float(theilslopes(o, k)[0]) if len(o) > 2 else 0.0
-        level = o - slope * k  # each sample carried back to the first one
-        med = float(np.median(level))
-        spread = max(1.4826 * float(np.median(np.abs(level - med))), self.sigma_toa)
-        keep = np.abs(level - med) <= 5 * spread
-        self.offset = float(np.mean(level[keep]))
+        o = np.asarray(self._calib)
+        med = float(np.median(o))
+        spread = max(1.4826 * float(np.median(np.abs(o - med))), self.sigma_toa)
+        keep = np.abs(o - med) <= 5 * spread
+        self.offset = float(o[np.argmax(keep)])  # the first sample that is not an outlier
         self.calibration_outliers = int(np.sum(~keep))
         return True
 
@@ -437,7 +433,6 @@ class RangeKF:
         z = _measurement("z", z)
         kf = self.kf
         kf.predict(u=np.array([[-u]]))
-        self._epoch += 1
         if z is not None and z <= 0:
             _warn(f"ToA: {z:.3e} s is not a time of flight; KF ToA predicted only")
             z = None
