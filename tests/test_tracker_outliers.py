@@ -158,8 +158,9 @@ def test_halili_tracker_survives_one_gross_outlier(drive, noisy, name, d_hz, d_m
 
 
 def test_range_kf_calibration_survives_an_outlier_in_the_first_toa(drive, noisy):
-    """+100 m on the first ToA: the one-sample calibration shifts the track by about 100 m; the
-    robust calibration (first of 10 ToAs that is not an outlier by median/MAD) leaves the median error within 0.2 m."""
+    """+100 m on the first ToA: the one-sample calibration shifts the track by about 100 m. The
+    checked calibration takes the second ToA instead, so the median error moves by that sample's
+    own noise (NLOS excess and white noise, about 1 m), not by the outlier: bound 3 m."""
     meas, fix = noisy
     setup = dp.DopplerSetup.from_drive(drive)
     toa = meas.toa.copy()
@@ -171,7 +172,7 @@ def test_range_kf_calibration_survives_an_outlier_in_the_first_toa(drive, noisy)
 
     clean = med(dp.KfDSToA(setup, fix), meas)
     trk = dp.KfDSToA(setup, fix)
-    assert abs(med(trk, bad) - clean) < 0.2
+    assert abs(med(trk, bad) - clean) < 3.0
     assert trk.range_kf.calibration_outliers == 1
     single = med(dp.KfDSToA(setup, fix, calibration_epochs=1), bad)
     assert single > clean + 80.0
