@@ -14,6 +14,13 @@ Three interchangeable trackers, registered in family ``"halili2022"``:
 Every tracker has ``step(doppler, toa) -> position`` and ``run(measurements) -> Track``; a NaN or
 ``None`` measurement is a dropped epoch (predict only, with a :class:`MeasurementWarning`).
 
+Not in the paper, on by default: every Kalman filter here gates its measurement
+(:mod:`tunnelkit.tracking.gating`, chi-square with one degree of freedom at ``gate = 0.999``): a
+Doppler locked on a moving scatterer or a ToA off by a gross NLOS excess is a missed epoch,
+counted in ``n_rejected``. ``gate=None`` gives the paper's filters. The KF on ToA calibrates the
+clock offset on a robust statistic of its first ToAs (not on one sample), and eq. 16 keeps the
+sign of the range change (a correction that is later undone cancels instead of adding up).
+
 Corrections to the paper, each shown in notebook 06:
 
 * eq. 5 ``h = v . (s - T) f / (c |s - T|)`` is positive when *receding*; the text (and Fig. 2)
@@ -34,12 +41,18 @@ from dataclasses import dataclass
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
-from scipy.stats import chi2
 
-from .._validate import finite_array, nonnegative, positive, probability
+from .._validate import finite_array, integer, nonnegative, positive, probability
 from ..constants import C
 from ..drive import Drive, GnssFix, Measurements, doppler_shift, slant_range
 from .cv import cv_process_noise, cv_transition
+from .gating import (
+    DEFAULT_GATE,
+    DEFAULT_REOPEN_AFTER,
+    REJECT,
+    InnovationGate,
+    gated_filterpy_update,
+)
 from .registry import register
 
 __all__ = [
@@ -179,9 +192,11 @@ class DopplerEKF:
     the spectral density of eq. 3 (paper: 0.5). ``a`` weighs the previous R in eq. 15 (the paper
     does not state it). The state starts at the GNSS fix with its covariance.
 
-    ``gate`` (not in the paper; default off) is a probability: a Doppler whose squared normalised
-    innovation ``y^2 / S`` exceeds the chi-square quantile with one degree of freedom is treated as
-    an outlier (a moving scatterer) and skipped; ``rejected`` counts them.
+    ``gate`` (not in the paper; default 0.999, ``None`` switches it off) is a probability: a
+    Doppler whose squared normalised innovation ``y^2 / S`` exceeds the chi-square quantile with
+    one degree of freedom is treated as an outlier (a moving scatterer) and skipped (predict
+    only); ``n_rejected`` counts them. After ``reopen_after`` consecutive rejections the next
+    Doppler is taken with an inflated covariance (:mod:`tunnelkit.tracking.gating`).
     """
 
     def __init__(
@@ -194,7 +209,8 @@ class DopplerEKF:
         adaptive: bool = False,
         a: float = 0.9,
         adaptive_form: str = "posterior",
-        gate: float | None = None,
+        gate: float | None = DEFAULT_GATE,
+        reopen_after: int = DEFAULT_REOPEN_AFTER,
     ) -> None:
         _check_setup(setup)
         if not isinstance(fix, GnssFix):
@@ -210,8 +226,12 @@ class DopplerEKF:
         kf.P = fix.covariance
         kf.R = np.array([[sigma_hz**2]])
         self.kf = kf
-        self.threshold = None if gate is None else float(chi2.ppf(probability("gate", gate), 1))
-        self.rejected = 0
+        self.gate = InnovationGate(gate, reopen_after=reopen_after)
+
+    @property
+    def n_rejected(self) -> int:
+        """Doppler samples the gate rejected (predicted only)."""
+        return self.gate.n_rejected
 
     def _h(self, x):
         return doppler_model(x.ravel(), self.setup).reshape(1, 1)
@@ -224,20 +244,19 @@ class DopplerEKF:
         z = _measurement("z", z)
         kf = self.kf
         kf.predict()
+        kf.P = 0.5 * (kf.P + kf.P.T)  # F P F^T and the Joseph form leave rounding asymmetry
         if z is None:
             _warn("Doppler: dropped epoch (None/NaN); EKF predicted only")
             kf.update(None, self._H, self._h)
             return self.position
-        # the prior Jacobian is only needed by the gate and the adaptive R (kf.update makes its own)
-        H = self._H(kf.x) if self.threshold is not None or self.adaptive else None
-        if self.threshold is not None:
-            nu = z - float(self._h(kf.x)[0, 0])
-            if nu * nu > self.threshold * float((H @ kf.P @ H.T).item() + kf.R[0, 0]):
-                self.rejected += 1
-                kf.update(None, self._H, self._h)
-                return self.position
+        # the prior Jacobian is only needed by the adaptive R (kf.update makes its own)
+        H = self._H(kf.x) if self.adaptive else None
         P_prior = kf.P.copy()
-        kf.update(np.array([[z]]), self._H, self._h)
+        zz = np.array([[z]])
+        verdict = gated_filterpy_update(kf, lambda: kf.update(zz, self._H, self._h), self.gate)
+        kf.P = 0.5 * (kf.P + kf.P.T)
+        if verdict == REJECT:
+            return self.position
         if self.adaptive:
             e = z - float(self._h(kf.x)[0, 0])  # eq. 13, post-fit residual
             P = kf.P if self.adaptive_form == "posterior" else P_prior
@@ -268,7 +287,7 @@ class SpeedKF:
     ``z = (f_c/c) u + r`` is exactly linear; calling it "the speed" ignores the angle between the
     heading and the line of sight, which is the paper's simplification. Random-walk model with
     ``Q = q dt`` (the paper's ``Q = 0.5`` read as a spectral density so it does not depend on
-    the epoch rate).
+    the epoch rate). ``gate``/``reopen_after`` as in :class:`DopplerEKF`.
     """
 
     def __init__(
@@ -282,6 +301,8 @@ class SpeedKF:
         adaptive: bool = False,
         a: float = 0.9,
         adaptive_form: str = "posterior",
+        gate: float | None = DEFAULT_GATE,
+        reopen_after: int = DEFAULT_REOPEN_AFTER,
     ) -> None:
         _check_setup(setup)
         sigma_hz = positive("sigma_hz", sigma_hz)
@@ -298,6 +319,12 @@ class SpeedKF:
         kf.H = np.array([[setup.k]])
         kf.R = np.array([[sigma_hz**2]])
         self.kf = kf
+        self.gate = InnovationGate(gate, reopen_after=reopen_after)
+
+    @property
+    def n_rejected(self) -> int:
+        """Doppler samples the gate rejected (predicted only)."""
+        return self.gate.n_rejected
 
     def step(self, z) -> float:
         """Predict, then update with Doppler ``z`` [Hz] unless dropped."""
@@ -309,7 +336,9 @@ class SpeedKF:
             kf.update(None)
             return self.speed
         P_prior = kf.P.copy()
-        kf.update(np.array([[z]]))
+        zz = np.array([[z]])
+        if gated_filterpy_update(kf, lambda: kf.update(zz), self.gate) == REJECT:
+            return self.speed
         if self.adaptive:
             e = z - float((kf.H @ kf.x)[0, 0])  # eq. 13
             P = kf.P if self.adaptive_form == "posterior" else P_prior
@@ -326,10 +355,23 @@ class RangeKF:
 
     Prediction ``d_k = d_{k-1} - dt u_k`` with ``u`` the approach speed from the Doppler (eq. 17,
     sign corrected), ``Q = q dt``; update with ToA ``z = d / c + r`` (``H = 1/c``, eq. 19-21).
-    ``calibrate`` removes the unknown clock offset with the first valid ToA and the GNSS
-    distance ``d0`` (sec. 5: "perform calibration when using travel time measurements").
-    A ToA implying a distance below ``d_min`` (the transmitter's height above the antenna) is
-    physically impossible and is rejected with a warning.
+
+    ``calibrate`` removes the unknown clock offset against the GNSS distance ``d0`` (sec. 5:
+    "perform calibration when using travel time measurements"). The paper does not say how; one
+    sample would carry any error of that sample into every later epoch (a 100 m NLOS excess
+    shifts the whole drive by 100 m), so the first ``calibration_epochs`` valid ToAs are
+    compared with the dead-reckoned distance (predict only meanwhile); samples more than
+    ``5 max(1.4826 MAD, sigma_toa)`` from their median are outliers (``calibration_outliers``
+    counts them) and the offset is that of the first other sample: the paper's one-sample
+    calibration, with the sample checked against the others. (Averaging the samples instead
+    would average the dead-reckoning drift of the calibration window into the offset: a Doppler
+    bias of 2 m/s over ten epochs moves it by about 0.3 m.) ``calibration_epochs=1`` is the
+    unchecked single-sample calibration.
+
+    Every later ToA passes a chi-square gate (``gate``, ``reopen_after``; see
+    :mod:`tunnelkit.tracking.gating`); ``n_rejected`` counts the rejected ToAs (gate and
+    calibration). A ToA implying a distance below ``d_min`` (the transmitter's height above the
+    antenna) is physically impossible and is rejected with a warning.
     """
 
     def __init__(
@@ -341,15 +383,21 @@ class RangeKF:
         q: float = 0.5,
         sigma_d0: float = 2.0,
         calibrate: bool = True,
+        calibration_epochs: int = 10,
+        gate: float | None = DEFAULT_GATE,
+        reopen_after: int = DEFAULT_REOPEN_AFTER,
     ) -> None:
         _check_setup(setup)
         d0 = positive("d0", d0)
         sigma_toa = positive("sigma_toa", sigma_toa)
         q = nonnegative("q", q)
-        self.setup, self.calibrate = setup, bool(calibrate)
+        self.calibration_epochs = integer("calibration_epochs", calibration_epochs, minimum=1)
+        self.setup, self.calibrate, self.sigma_toa = setup, bool(calibrate), sigma_toa
         self.offset: float | None = None if calibrate else 0.0
+        self.calibration_outliers = 0
+        self._calib: list[float] = []  # ToA minus predicted distance / c
         self.d_min = abs(setup.dz)
-        self._gate = 5 * sigma_toa * C
+        self._d_min_margin = 5 * sigma_toa * C
         kf = KalmanFilter(dim_x=1, dim_z=1, dim_u=1)
         kf.x = np.array([[d0]])
         kf.P = np.array([[positive("sigma_d0", sigma_d0) ** 2]])
@@ -359,6 +407,25 @@ class RangeKF:
         kf.H = np.array([[1.0 / C]])
         kf.R = np.array([[sigma_toa**2]])
         self.kf = kf
+        self.gate = InnovationGate(gate, reopen_after=reopen_after)
+
+    @property
+    def n_rejected(self) -> int:
+        """ToAs rejected by the gate or left out of the calibration."""
+        return self.gate.n_rejected + self.calibration_outliers
+
+    def _calibrated(self, z: float) -> bool:
+        """Collect one calibration sample; True once the offset is set."""
+        self._calib.append(z - self.distance / C)
+        if len(self._calib) < self.calibration_epochs:
+            return False
+        o = np.asarray(self._calib)
+        med = float(np.median(o))
+        spread = max(1.4826 * float(np.median(np.abs(o - med))), self.sigma_toa)
+        keep = np.abs(o - med) <= 5 * spread
+        self.offset = float(o[np.argmax(keep)])  # the first sample that is not an outlier
+        self.calibration_outliers = int(np.sum(~keep))
+        return True
 
     def step(self, u: float, z) -> float:
         """Predict with approach speed ``u`` [m/s], update with ToA ``z`` [s] unless dropped/impossible."""
@@ -369,9 +436,9 @@ class RangeKF:
         if z is not None and z <= 0:
             _warn(f"ToA: {z:.3e} s is not a time of flight; KF ToA predicted only")
             z = None
-        if z is not None and self.offset is None:  # calibrate on the predicted GNSS-based distance
-            self.offset = z - self.distance / C
-        if z is not None and C * (z - self.offset) < self.d_min - self._gate:
+        if z is not None and self.offset is None and not self._calibrated(z):
+            z = None  # still calibrating: predict only
+        if z is not None and C * (z - self.offset) < self.d_min - self._d_min_margin:
             _warn(
                 f"ToA: distance {C * (z - self.offset):.2f} m is below the physical minimum "
                 f"{self.d_min:.2f} m; KF ToA predicted only"
@@ -380,7 +447,8 @@ class RangeKF:
         if z is None:
             kf.update(None)
             return self.distance
-        kf.update(np.array([[z - self.offset]]))
+        zz = np.array([[z - self.offset]])
+        gated_filterpy_update(kf, lambda: kf.update(zz), self.gate)
         return self.distance
 
     @property
@@ -392,9 +460,11 @@ class HeadingDeadReckoning:
     """Eq. 16: ``x_k = x_{k-1} + dr sin(phi)``, ``y_k = y_{k-1} + dr cos(phi)``.
 
     ``phi`` is the heading from the y axis, taken from the past estimated positions (the last
-    displacement longer than ``min_step``), starting from the GNSS velocity. ``dr`` is the
-    change of the filtered distance, so near the transmitter (where the distance barely
-    changes) the position stalls: the paper's radial-motion approximation.
+    displacement longer than ``min_step``, oriented forward), starting from the GNSS velocity.
+    ``dr`` is the signed change of the filtered distance along the direction of travel (positive
+    forward): the paper takes ``|d_k - d_{k-1}|``, which turns a range correction that is later
+    undone into two forward steps. Near the transmitter (where the distance barely changes) the
+    position stalls: the paper's radial-motion approximation.
     """
 
     def __init__(self, p0, v0, *, min_step: float = 1e-3) -> None:
@@ -407,12 +477,15 @@ class HeadingDeadReckoning:
         self._last = self.p.copy()
 
     def step(self, dr: float) -> np.ndarray:
-        """Advance by ``dr`` [m] along the current heading; update the heading from the history."""
-        dr = abs(float(dr))
+        """Advance by ``dr`` [m] along the current heading (back if negative); update the heading."""
+        dr = float(finite_array("dr", dr, ndim=0))
         self.p = self.p + dr * np.array([np.sin(self.phi), np.cos(self.phi)])
         disp = self.p - self._last
         if np.hypot(*disp) >= self.min_step:
-            self.phi = float(np.arctan2(disp[0], disp[1]))
+            phi = float(np.arctan2(disp[0], disp[1]))
+            if np.cos(phi - self.phi) < 0:  # a net step back: the vehicle still faces forward
+                phi = float(np.arctan2(-disp[0], -disp[1]))
+            self.phi = phi
             self._last = self.p.copy()
         return self.p.copy()
 
@@ -458,10 +531,20 @@ class _Base:
     def _first(self) -> np.ndarray:  # the first epoch is the GNSS fix itself
         return self._p0.copy()
 
+    @property
+    def n_rejected(self) -> int:
+        """Doppler and ToA samples the gates of this approach rejected (predicted only)."""
+        parts = (getattr(self, a, None) for a in ("ekf", "speed_kf", "range_kf"))
+        return sum(f.n_rejected for f in parts if f is not None)
+
+
+#: keywords of the gates, passed to every filter of an approach
+_GATE_KEYS = ("gate", "reopen_after")
+
 
 def _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw) -> DopplerEKF:
     """The EKF on Doppler shared by "EKF DS" and "EKF DS and KF ToA" (extra keywords filtered)."""
-    extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form", "gate")}
+    extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form", *_GATE_KEYS)}
     return DopplerEKF(setup, fix, sigma_hz=sigma_hz, q=q, adaptive=adaptive, **extra)
 
 
@@ -508,17 +591,28 @@ class _KfToA(_Base):
         adaptive: bool = False,
         sigma_toa: float = 3e-9,
         calibrate: bool = True,
+        calibration_epochs: int = 10,
         **kw,
     ) -> None:
         self.setup = setup
         self._p0 = np.array(fix.position, dtype=float)
         d0 = float(slant_range(fix.position, setup.tx, setup.dz))
+        gates = {k: v for k, v in kw.items() if k in _GATE_KEYS}
         self.range_kf = RangeKF(
-            setup, d0, sigma_toa=sigma_toa, q=q, sigma_d0=fix.sigma_p, calibrate=calibrate
+            setup,
+            d0,
+            sigma_toa=sigma_toa,
+            q=q,
+            sigma_d0=fix.sigma_p,
+            calibrate=calibrate,
+            calibration_epochs=calibration_epochs,
+            **gates,
         )
         self.dr = HeadingDeadReckoning(fix.position, fix.velocity)
         w = fix.position - setup.tx
         self._u0 = -float(fix.velocity @ w) / d0
+        self._recent: list[float] = []  # the last Doppler samples, for the phase of eq. 16
+        self._phase = 1.0 if self._u0 >= 0 else -1.0
         self._init_speed(setup, fix, sigma_hz, q, adaptive, kw)
 
     def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
@@ -527,10 +621,28 @@ class _KfToA(_Base):
     def _approach_speed(self, doppler) -> float:
         raise NotImplementedError
 
+    def _phase_of(self, doppler) -> float:
+        """+1 approaching, -1 receding: the sign of the median of the last ``PHASE_WINDOW`` valid
+        Doppler samples (a median, so one outlier cannot flip it; no filter lag at the pass)."""
+        z = _measurement("doppler", doppler)
+        if z is not None:
+            self._recent = [*self._recent[-(self.PHASE_WINDOW - 1) :], z]
+            med = float(np.median(self._recent))
+            if med != 0:
+                self._phase = 1.0 if med > 0 else -1.0
+        return self._phase
+
+    #: Doppler samples whose median gives the phase (approaching/receding) of eq. 16
+    PHASE_WINDOW = 5
+
     def step(self, doppler, toa=None) -> np.ndarray:
+        """Eq. 16-21 with the sign kept: a range change counts forward if it shrinks while
+        approaching or grows while receding, backward otherwise (phase: :meth:`_phase_of`)."""
+        phase = self._phase_of(doppler)
+        u = self._approach_speed(doppler)
         d_prev = self.range_kf.distance
-        d = self.range_kf.step(self._approach_speed(doppler), toa)
-        return self.dr.step(d - d_prev)
+        d = self.range_kf.step(u, toa)
+        return self.dr.step(phase * (d_prev - d))
 
 
 @register("halili2022", "KF DS and ToA")
@@ -540,7 +652,7 @@ class KfDSToA(_KfToA):
     name = "KF DS and ToA"
 
     def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
-        extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form")}
+        extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form", *_GATE_KEYS)}
         self.speed_kf = SpeedKF(
             setup,
             self._u0,

@@ -13,6 +13,16 @@ Every particle ``i`` carries a state sample ``X^i`` and its own covariance ``P^i
    ``resample_threshold = 1``);
 6. output (eq. 62-63): weighted mean and spread of the particles.
 
+Not in the paper, on by default: before step 3 the measurement passes a chi-square gate
+(:mod:`tunnelkit.tracking.gating`) on the innovation of the particle mixture, ``y = Z - z_bar``
+with ``z_bar = sum_i w^i z_hat^i`` and ``S = sum_i w^i (Pzz^i + (z_hat^i - z_bar)(.)^T)`` (law of
+total covariance over the particles' UKF predictions). A rejected measurement is a missed epoch
+(particles drawn from the transition, weights unchanged). A reopened one (after ``reopen_after``
+rejections in a row) widens every particle's predicted Gaussian, and the transition density its
+weight uses, to the predicted cloud's covariance plus ``Q`` with the position block scaled by the
+gate's inflation factor, so each particle's UKF update can reach the measurement (widening the
+velocities too would let the particles pick random velocities from one position fix).
+
 Everything is vectorised over particles *and* over any leading batch axis (independent
 Monte-Carlo runs), with batched Cholesky factors and ``np.linalg.solve``; there is no Python
 loop over particles. At the first epoch the transition density is the prior ``N(x0, P0)``.
@@ -29,6 +39,7 @@ from filterpy.kalman import MerweScaledSigmaPoints
 
 from .._validate import finite_array, integer, positive, probability, rng_or_error
 from .cv import STATE_DIM
+from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, REJECT, REOPEN, InnovationGate
 from .registry import register
 from .virtual_station import (
     FAMILY,
@@ -69,6 +80,11 @@ def ukf_proposal(
     ``m_pred`` (..., 4) and ``P_pred`` (..., 4, 4) are the predicted means and covariances,
     ``z`` (..., 2N) broadcasts against them.
     """
+    return _ukf_update(model, m_pred, P_pred, z, alpha, beta, kappa)[:2]
+
+
+def _ukf_update(model, m_pred, P_pred, z, alpha, beta, kappa):
+    """:func:`ukf_proposal` plus the predicted measurement ``z_hat`` (..., 2N) and ``Pzz``."""
     n = m_pred.shape[-1]
     Wm, Wc, lam = merwe_weights(n, alpha, beta, kappa)
     L = regularized_cholesky((n + lam) * P_pred, name="UPF sigma-point covariance")
@@ -86,7 +102,21 @@ def ukf_proposal(
     innov = model.residual_z(np.broadcast_to(z, zhat.shape), zhat)
     m_post = m_pred + np.einsum("...ij,...j->...i", K, innov)  # eq. 54
     P_post = P_pred - K @ Pzz @ np.swapaxes(K, -1, -2)  # eq. 55
-    return m_post, 0.5 * (P_post + np.swapaxes(P_post, -1, -2))
+    return m_post, 0.5 * (P_post + np.swapaxes(P_post, -1, -2)), zhat, Pzz
+
+
+def _mixture_d2(model: VsModel, w, zhat, Pzz, z) -> tuple[np.ndarray, np.ndarray]:
+    """Squared Mahalanobis distance of ``z`` (B, 2N) under the particle mixture, (B,), and ``S``.
+
+    ``w`` (B, N) are the particle weights, ``zhat`` (B, N, 2N) and ``Pzz`` (B, N, 2N, 2N) each
+    particle's predicted measurement and its covariance (R included).
+    """
+    ref = zhat[:, :1, :]
+    zbar = ref[:, 0, :] + np.einsum("bn,bnj->bj", w, model.residual_z(zhat, ref))
+    dz = model.residual_z(zhat, zbar[:, None, :])
+    S = np.einsum("bn,bnij->bij", w, Pzz) + np.einsum("bn,bni,bnj->bij", w, dz, dz)
+    y = model.residual_z(z, zbar)
+    return np.einsum("bi,bi->b", y, np.linalg.solve(S, y[..., None])[..., 0]), S
 
 
 def ukf_proposal_reference(
@@ -102,7 +132,7 @@ def ukf_proposal_reference(
     out_m = np.empty_like(particles)
     out_P = np.empty_like(covs)
     for i in range(particles.shape[0]):
-        f = VsUKF(model, particles[i], covs[i], alpha=alpha, beta=beta, kappa=kappa)
+        f = VsUKF(model, particles[i], covs[i], alpha=alpha, beta=beta, kappa=kappa, gate=None)
         f.predict()
         f.update(z)
         out_m[i], out_P[i] = f.x, f.P
@@ -154,7 +184,8 @@ class UnscentedParticleFilter(EstimatorBase):
     ``x0`` is (4,) for one track or (B, 4) for ``B`` independent runs filtered together
     (``update`` then takes ``z`` of shape (B, 2N); a row with NaN is a missed epoch for that run).
     ``n_particles >= 1``; ``resample_threshold`` in (0, 1] is the effective-sample-size fraction
-    that triggers resampling; ``rng`` is required.
+    that triggers resampling; ``rng`` is required. ``gate``/``reopen_after``: the innovation gate
+    (module docstring); ``n_rejected`` counts rejections per run.
     """
 
     name = "UPF"
@@ -172,6 +203,8 @@ class UnscentedParticleFilter(EstimatorBase):
         beta: float = 2.0,
         kappa: float = 0.0,
         proposal: str = "conditional",
+        gate: float | None = DEFAULT_GATE,
+        reopen_after: int = DEFAULT_REOPEN_AFTER,
     ) -> None:
         self.model = _check_model(model)
         if proposal not in ("conditional", "carried"):
@@ -193,6 +226,7 @@ class UnscentedParticleFilter(EstimatorBase):
             raise ValueError(f"x0: expected shape (4,) or (B, 4), got {x0.shape}")
         _, P0 = _check_prior(x0b[0], P0)
         self.batch = x0b.shape[0]
+        self.gate = InnovationGate(gate, reopen_after=reopen_after, batch=self.batch)
         L0 = np.linalg.cholesky(P0)
         N = self.n_particles
         # step (1): X_0^i ~ p(X_0) = N(x0, P0), each particle with covariance P0
@@ -236,6 +270,18 @@ class UnscentedParticleFilter(EstimatorBase):
     @property
     def position(self) -> np.ndarray:
         return self.x[..., :2].copy()
+
+    @property
+    def n_rejected(self):
+        """Measurements the gate rejected: an int, or one count per run when batched."""
+        n = self.gate.n_rejected
+        return n if self._batched else int(n[0])
+
+    @property
+    def n_reopened(self):
+        """Measurements taken with an inflated prior after ``reopen_after`` rejections in a row."""
+        n = self.gate.n_reopened
+        return n if self._batched else int(n[0])
 
     # -- filter steps -----------------------------------------------------------------------------
     def predict(self) -> None:
@@ -293,21 +339,56 @@ class UnscentedParticleFilter(EstimatorBase):
         new_p = prior_draw
         new_P = self._P_pred
         log_w = self.log_w
-        if np.any(ok):
-            sel = np.flatnonzero(ok)
+        sel = np.flatnonzero(ok)
+        if sel.size:
             m_pred, P_pred = self._m_pred[sel], self._P_pred[sel]
+            t_mean = self._trans_mean[sel]
+            tc = trans_chol if trans_chol.ndim == 2 else trans_chol[sel]
             zb = Z[sel][:, None, :]
-            m_post, P_post = ukf_proposal(
-                self.model, m_pred, P_pred, zb, alpha=self.alpha, beta=self.beta, kappa=self.kappa
-            )
+            upd = _ukf_update(self.model, m_pred, P_pred, zb, self.alpha, self.beta, self.kappa)
+            m_post, P_post = upd[:2]
+            if self.gate.enabled:
+                lw = log_w[sel]
+                mx = np.max(lw, axis=-1, keepdims=True)
+                live = np.isfinite(mx)  # a run whose weights all vanished gates on uniform ones
+                w = np.where(live, np.exp(lw - np.where(live, mx, 0.0)), 1.0)
+                w = w / np.sum(w, axis=-1, keepdims=True)
+                d2, S = _mixture_d2(self.model, w, upd[2], upd[3], Z[sel])
+                verdict = self.gate.judge(d2, self.model.dim_z, rows=sel)
+                re = np.flatnonzero(verdict == REOPEN)
+                if re.size:  # widen every particle's prediction to the inflated cloud
+                    alpha = self.gate.inflation(d2[re], self.model.dim_z, S[re], self.model.R)
+                    mean = np.einsum("bn,bni->bi", w[re], m_pred[re])
+                    dm = m_pred[re] - mean[:, None, :]
+                    Pc = np.einsum("bn,bni,bnj->bij", w[re], dm, dm) + self.model.Q
+                    g = np.ones((re.size, STATE_DIM))
+                    g[:, :2] = np.sqrt(alpha)[:, None]  # the position block only
+                    Pw = g[:, :, None] * 0.5 * (Pc + np.swapaxes(Pc, -1, -2)) * g[:, None, :]
+                    P_pred = P_pred.copy()
+                    P_pred[re] = Pw[:, None]
+                    tc = np.broadcast_to(tc, (sel.size, 1, *tc.shape[-2:])).copy()
+                    tc[re] = regularized_cholesky(Pw, name="UPF reopened prior")[:, None]
+                    m_post, P_post = _ukf_update(
+                        self.model, m_pred, P_pred, zb, self.alpha, self.beta, self.kappa
+                    )[:2]
+                keep = verdict != REJECT  # rejected rows stay missed epochs
+                sel, m_pred, P_pred, t_mean, zb = (
+                    sel[keep],
+                    m_pred[keep],
+                    P_pred[keep],
+                    t_mean[keep],
+                    zb[keep],
+                )
+                m_post, P_post = m_post[keep], P_post[keep]
+                tc = tc if tc.ndim == 2 else tc[keep]
+        if sel.size:
             Lq = regularized_cholesky(P_post, name="UPF proposal covariance")
             e = eps[sel]
             x_new = m_post + np.einsum("...ij,...j->...i", Lq, e)  # eq. 59
             log_q = -0.5 * np.sum(e * e, axis=-1) - np.sum(
                 np.log(np.diagonal(Lq, axis1=-2, axis2=-1)), axis=-1
             )
-            tc = trans_chol if trans_chol.ndim == 2 else trans_chol[sel]
-            log_trans = _log_gauss_chol(x_new - self._trans_mean[sel], tc)
+            log_trans = _log_gauss_chol(x_new - t_mean, tc)
             log_lik = self.model.log_likelihood(zb, x_new)
             lw = log_w[sel] + log_lik + log_trans - log_q  # eq. 60
             new_p = new_p.copy()

@@ -21,6 +21,11 @@ All speak filterpy: ``x``, ``P``, ``predict()``, ``update(z)`` with ``update(Non
 epoch. A measurement containing NaN is treated as missed (predict only) with a warning. Bearing
 residuals are wrapped to ``(-pi, pi]`` and bearing means are taken relative to a reference, so a
 bearing near +-pi does not average to zero.
+
+Not in the paper, on by default: the EKF, UKF and UPF gate each measurement vector on the squared
+Mahalanobis distance of its innovation against ``chi2_2N(gate)`` (``gate = 0.999``,
+:mod:`tunnelkit.tracking.gating`); a rejected vector (a gross range or bearing outlier) is a
+missed epoch, counted in ``n_rejected``; ``gate=None`` gives the paper's filters.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from .. import positioning
 from .._validate import finite_array, integer, positive, rng_or_error
 from ..crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from .cv import STATE_DIM, cv_process_noise, cv_transition
+from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, InnovationGate, gated_filterpy_update
 from .registry import register
 
 __all__ = [
@@ -401,9 +407,23 @@ class VsTSWLS(EstimatorBase):
 
 
 class _FilterpyEstimator(EstimatorBase):
-    """An estimator wrapping a filterpy filter in ``self.filter``; P is kept symmetric."""
+    """An estimator wrapping a filterpy filter in ``self.filter``; P is kept symmetric.
+
+    ``gate`` is the chi-square gate of the innovation (probability, or None for none).
+    """
 
     filter: ExtendedKalmanFilter | UnscentedKalmanFilter
+    gate: InnovationGate
+
+    @property
+    def n_rejected(self) -> int:
+        """Measurements the gate rejected (predicted only)."""
+        return self.gate.n_rejected
+
+    @property
+    def n_reopened(self) -> int:
+        """Measurements taken with an inflated covariance after repeated rejections."""
+        return self.gate.n_reopened
 
     @property
     def x(self) -> np.ndarray:
@@ -421,12 +441,22 @@ class _FilterpyEstimator(EstimatorBase):
 @register(FAMILY, "EKF")
 class VsEKF(_FilterpyEstimator):
     """filterpy ``ExtendedKalmanFilter`` on eq. 40-45 with the analytic Jacobian and wrapped
-    bearing residuals."""
+    bearing residuals; ``gate``/``reopen_after`` as in :mod:`tunnelkit.tracking.gating`."""
 
     name = "EKF"
 
-    def __init__(self, model: VsModel, x0, P0, *, rng: np.random.Generator | None = None) -> None:
+    def __init__(
+        self,
+        model: VsModel,
+        x0,
+        P0,
+        *,
+        rng: np.random.Generator | None = None,
+        gate: float | None = DEFAULT_GATE,
+        reopen_after: int = DEFAULT_REOPEN_AFTER,
+    ) -> None:
         self.model = _check_model(model)
+        self.gate = InnovationGate(gate, reopen_after=reopen_after)
         x0, P0 = _check_prior(x0, P0)
         f = ExtendedKalmanFilter(dim_x=STATE_DIM, dim_z=model.dim_z)
         f.x, f.P = x0, P0
@@ -439,9 +469,14 @@ class VsEKF(_FilterpyEstimator):
 
     def update(self, z) -> None:
         z = measurement_ok(z, self.model.dim_z, who="EKF")
-        m = self.model
+        m, f = self.model, self.filter
+        if z is None:
+            f.update(None, m.jacobian, m.hx)
+            return
         # filterpy updates P in Joseph form; symmetrise to remove rounding asymmetry
-        self.filter.update(z, m.jacobian, m.hx, residual=m.residual_z)
+        gated_filterpy_update(
+            f, lambda: f.update(z, m.jacobian, m.hx, residual=m.residual_z), self.gate
+        )
         self._symmetrize()
 
 
@@ -451,7 +486,9 @@ class VsUKF(_FilterpyEstimator):
 
     ``alpha, beta, kappa`` are the scaling parameters of eq. 47-50. The square root of the
     sigma-point covariance is a regularised Cholesky factor (warns instead of failing). Bearings
-    use the wrapped residual and reference-based mean of :class:`VsModel`.
+    use the wrapped residual and reference-based mean of :class:`VsModel`. ``gate`` and
+    ``reopen_after`` as in :mod:`tunnelkit.tracking.gating` (a reopened measurement redraws the
+    sigma points from the inflated prior).
     """
 
     name = "UKF"
@@ -466,8 +503,11 @@ class VsUKF(_FilterpyEstimator):
         alpha: float = 1.0,
         beta: float = 2.0,
         kappa: float = 0.0,
+        gate: float | None = DEFAULT_GATE,
+        reopen_after: int = DEFAULT_REOPEN_AFTER,
     ) -> None:
         self.model = _check_model(model)
+        self.gate = InnovationGate(gate, reopen_after=reopen_after)
         x0, P0 = _check_prior(x0, P0)
         pts = MerweScaledSigmaPoints(
             STATE_DIM,
@@ -497,7 +537,15 @@ class VsUKF(_FilterpyEstimator):
 
     def update(self, z) -> None:
         z = measurement_ok(z, self.model.dim_z, who="UKF")
-        self.filter.update(z)
+        f = self.filter
+        if z is None:
+            f.update(None)
+            return
+
+        def redraw() -> None:  # sigma points of the inflated prior
+            f.sigmas_f = f.points_fn.sigma_points(f.x, f.P)
+
+        gated_filterpy_update(f, lambda: f.update(z), self.gate, redraw=redraw)
         self._symmetrize()
 
 
