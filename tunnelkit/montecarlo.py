@@ -14,9 +14,13 @@ from typing import Any
 
 import numpy as np
 
-from ._validate import integer
+from ._validate import callable_, integer
+from .budget import check_bytes
 
-__all__ = ["QUICK", "mc_count", "quick_mode", "run_trials", "spawn_rngs"]
+__all__ = ["QUICK", "RUN_BYTES", "mc_count", "quick_mode", "run_trials", "spawn_rngs"]
+
+#: memory one run holds at least: its generator (about 1 KiB measured) and its result slot
+RUN_BYTES = 1024
 
 _TRUE = {"1", "true", "yes", "on"}
 
@@ -40,6 +44,7 @@ def mc_count(full: int, quick: int) -> int:
 def spawn_rngs(seed: int | np.random.Generator, n: int) -> list[np.random.Generator]:
     """``n`` independent generators derived from ``seed`` (an int or a Generator)."""
     n = integer("n", n, minimum=1)
+    check_bytes("n", n * RUN_BYTES, f"{n} generators of about {RUN_BYTES} B")
     if isinstance(seed, np.random.Generator):
         return list(seed.spawn(n))
     seed = integer("seed", seed, minimum=0)
@@ -55,6 +60,9 @@ def run_trials(
     desc: str = "trials",
 ) -> list[Any]:
     """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm."""
+    callable_("trial", trial)
+    runs = integer("runs", runs, minimum=1)
+    check_bytes("runs", runs * RUN_BYTES, f"{runs} runs of at least {RUN_BYTES} B each")
     rngs = spawn_rngs(seed, runs)
     it = rngs
     if progress:

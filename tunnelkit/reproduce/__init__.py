@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from .._validate import integer
+from ..budget import check_bytes
+from ..montecarlo import RUN_BYTES
 
 __all__ = ["Report", "Target", "register", "run", "targets"]
 
@@ -90,19 +92,24 @@ class Target:
     help: str
     default_runs: int
     fn: Callable[[int, int, bool], Report]
+    bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
 
 
 _REGISTRY: dict[str, Target] = {}
 _DISCOVERED = False
 
 
-def register(name: str, *, help: str, default_runs: int):
-    """Decorator registering a reproduction target under ``name``."""
+def register(name: str, *, help: str, default_runs: int, bytes_per_run: int = RUN_BYTES):
+    """Decorator registering a reproduction target under ``name``.
+
+    ``bytes_per_run`` is what one Monte-Carlo run keeps in memory until the report is built;
+    ``runs * bytes_per_run`` is checked against :mod:`tunnelkit.budget` before anything runs.
+    """
 
     def deco(fn):
         if name in _REGISTRY:
             raise ValueError(f"name: reproduce target {name!r} registered twice")
-        _REGISTRY[name] = Target(name, help, default_runs, fn)
+        _REGISTRY[name] = Target(name, help, default_runs, fn, bytes_per_run)
         return fn
 
     return deco
@@ -126,6 +133,7 @@ def run(name: str, *, runs: int | None = None, seed: int = 0, progress: bool = F
     tgt = reg[name]
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
+    check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")
     rep = tgt.fn(runs, seed, progress)
     rep.meta = {"target": name, "runs": runs, "seed": seed, **rep.meta}
     return rep

@@ -106,6 +106,7 @@ def _report(table: str, title: str, los: bool, runs: int, seed: int, progress: b
     "jiang-table2",
     help="Table 2 (NLOS): mean/variance of the error of TSWLS, EKF, UKF, UPF, paper beside ours",
     default_runs=100,
+    bytes_per_run=64 * 1024,
 )
 def jiang_table2(runs: int, seed: int, progress: bool) -> Report:
     return _report(
@@ -122,6 +123,7 @@ def jiang_table2(runs: int, seed: int, progress: bool) -> Report:
     "jiang-table3",
     help="Table 3 (LOS): mean/variance of the error of TSWLS, EKF, UKF, UPF, paper beside ours",
     default_runs=100,
+    bytes_per_run=64 * 1024,
 )
 def jiang_table3(runs: int, seed: int, progress: bool) -> Report:
     return _report(

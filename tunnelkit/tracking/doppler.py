@@ -36,7 +36,7 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 from scipy.stats import chi2
 
-from .._validate import finite_array, nonnegative, positive, probability
+from .._validate import finite_array, nonnegative, positive, probability, real
 from ..constants import C
 from ..drive import Drive, GnssFix, Measurements, doppler_shift, slant_range
 from .cv import cv_process_noise, cv_transition
@@ -138,6 +138,14 @@ def _check_adaptive_form(adaptive_form: str) -> str:
 # --- the EKF on Doppler (section 4) ---------------------------------------------------------------
 
 
+def _state(name: str, s) -> np.ndarray:
+    """States ``[x, y, v_x, v_y]`` (..., 4): finite and real."""
+    s = finite_array(name, s)
+    if s.ndim == 0 or s.shape[-1] != 4:
+        raise ValueError(f"{name}: expected states [x, y, v_x, v_y] (..., 4), got shape {s.shape}")
+    return s
+
+
 def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
     """``F`` (eq. 2) and ``Q`` (eq. 3) of the constant-velocity model, state ``[x, y, v_x, v_y]``."""
     dt = positive("dt", dt)
@@ -147,7 +155,8 @@ def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
 
 def doppler_model(s, setup: DopplerSetup) -> np.ndarray:
     """``h(s)`` of eq. 5 with the pinned sign: ``-(f_c/c) v . (p - T) / r`` [Hz]."""
-    s = np.asarray(s, dtype=float)
+    s = _state("s", s)
+    setup = _check_setup(setup)
     return doppler_shift(s[..., :2], s[..., 2:], setup.tx, setup.fc, setup.dz)
 
 
@@ -157,7 +166,8 @@ def doppler_jacobian(s, setup: DopplerSetup) -> np.ndarray:
     With ``w = p - T``, ``r = sqrt(|w|^2 + dz^2)``: ``dh/dp = -(f_c/c) (v / r - (v . w) w / r^3)``,
     ``dh/dv = -(f_c/c) w / r``.
     """
-    s = np.asarray(s, dtype=float)
+    s = _state("s", s)
+    setup = _check_setup(setup)
     w = s[..., :2] - setup.tx
     v = s[..., 2:]
     r = np.sqrt(np.sum(w * w, -1, keepdims=True) + setup.dz**2)
@@ -408,7 +418,7 @@ class HeadingDeadReckoning:
 
     def step(self, dr: float) -> np.ndarray:
         """Advance by ``dr`` [m] along the current heading; update the heading from the history."""
-        dr = abs(float(dr))
+        dr = abs(real("dr", dr))
         self.p = self.p + dr * np.array([np.sin(self.phi), np.cos(self.phi)])
         disp = self.p - self._last
         if np.hypot(*disp) >= self.min_step:

@@ -27,7 +27,9 @@ import warnings
 import numpy as np
 from filterpy.kalman import MerweScaledSigmaPoints
 
-from .._validate import finite_array, integer, positive, probability, rng_or_error
+from .._validate import finite_array, integer, positive, probability, real, rng_or_error
+from .._validate import weights as _weights
+from ..budget import check_elements
 from .cv import STATE_DIM
 from .registry import register
 from .virtual_station import (
@@ -54,6 +56,8 @@ def merwe_weights(
     n: int, alpha: float, beta: float, kappa: float
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points (filterpy's Merwe weights)."""
+    n = integer("n", n, minimum=1)
+    alpha, beta, kappa = positive("alpha", alpha), real("beta", beta), real("kappa", kappa)
     lam = alpha**2 * (n + kappa) - n
     if n + lam <= 0:
         raise ValueError(f"alpha, kappa: n + lambda = {n + lam} must be > 0")
@@ -110,8 +114,16 @@ def ukf_proposal_reference(
 
 
 def effective_sample_size(weights) -> np.ndarray:
-    """``1 / sum(w^2)`` over the last axis of normalised weights."""
-    w = np.asarray(weights, dtype=float)
+    """``1 / sum(w^2)`` over the last axis of the weights (normalised here: ``w / sum(w)``).
+
+    ``weights`` must be finite, ``>= 0`` and have a positive sum in every row.
+    """
+    w = _weights("weights", weights)
+    return _ess(w / w.sum(axis=-1, keepdims=True))
+
+
+def _ess(w: np.ndarray) -> np.ndarray:
+    """:func:`effective_sample_size` of weights already normalised (inner loops)."""
     return 1.0 / np.sum(w * w, axis=-1)
 
 
@@ -122,7 +134,7 @@ def systematic_resample(weights, rng: np.random.Generator) -> np.ndarray:
     ``(u + j) / N``. Rows are searched in one ``searchsorted`` by shifting row ``b`` by ``b``.
     """
     rng = rng_or_error("rng", rng)
-    w = np.asarray(weights, dtype=float)
+    w = _weights("weights", weights)
     n = w.shape[-1]
     flat = w.reshape(-1, n)
     b = flat.shape[0]
@@ -195,6 +207,8 @@ class UnscentedParticleFilter(EstimatorBase):
         self.batch = x0b.shape[0]
         L0 = np.linalg.cholesky(P0)
         N = self.n_particles
+        # particles, their covariances and the predicted copies: about 3 x 20 floats each
+        check_elements("n_particles", self.batch * N * 60, what=f"{self.batch} x {N} particles")
         # step (1): X_0^i ~ p(X_0) = N(x0, P0), each particle with covariance P0
         self.particles = (
             x0b[:, None, :] + self.rng.standard_normal((self.batch, N, STATE_DIM)) @ L0.T
@@ -338,7 +352,7 @@ class UnscentedParticleFilter(EstimatorBase):
 
     def _resample_if_needed(self) -> None:
         w = np.exp(self.log_w)
-        low = effective_sample_size(w) < self.resample_threshold * self.n_particles - 1e-9
+        low = _ess(w) < self.resample_threshold * self.n_particles - 1e-9
         if self.resample_threshold >= 1.0:
             low[:] = True
         if not np.any(low):
@@ -397,6 +411,6 @@ def one_epoch_ess(
     ess = np.empty(T)
     for k in range(T):
         f.step(Z[k], first=(k == 0))
-        ess[k] = effective_sample_size(f.weights)
+        ess[k] = _ess(f.weights)
         f.log_w[:] = -np.log(f.n_particles)
     return ess
