@@ -16,8 +16,17 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from tunnelkit import constants, crlb, drive, fresnel, geometry, metrics, positioning, propagation
-from tunnelkit import budget
+from tunnelkit import (
+    budget,
+    constants,
+    crlb,
+    drive,
+    fresnel,
+    geometry,
+    metrics,
+    positioning,
+    propagation,
+)
 from tunnelkit.tracking import pcrlb, upf
 from tunnelkit.tracking.javelin.gate import mahalanobis2
 
