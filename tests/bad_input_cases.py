@@ -1182,7 +1182,7 @@ def build_cases() -> list[Case]:
 
 def build_cli_cases() -> list[CliCase]:
     c = [
-        CliCase("mmax --fc -1e9", ("mmax", "--fc", "-1e9"), ("fc",)),
+        CliCase("mmax --fc=-1e9", ("mmax", "--fc=-1e9", "--no-ura"), ("fc",)),
         CliCase("mmax --fc nan", ("mmax", "--fc", "nan"), ("fc",)),
         CliCase("mmax --R nan", ("mmax", "--R", "nan"), ("R",)),
         CliCase("mmax --R -1", ("mmax", "--R", "-1", "--no-ura"), ("R",)),

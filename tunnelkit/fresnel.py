@@ -430,6 +430,8 @@ def mmax_exact_grid(R, W, y_u, fc, eps_phi, *, z_u=0.0, m_limit: int = M_LIMIT) 
     R, W, y_u, z_u = _geometry(R, W, y_u, z_u)
     fc, eps = _fc_eps(fc, eps_phi)
     m_limit = integer("m_limit", m_limit, minimum=2)
+    # the search may run up to m_limit antennas for one geometry (about 10 temporaries each)
+    check_elements("m_limit", m_limit, 80, f"the exact search up to M = {m_limit}")
     shape = np.broadcast_shapes(R.shape, fc.shape, eps.shape)
     flat = [np.broadcast_to(v, shape).ravel().astype(float) for v in (R, W, y_u, z_u, C / fc, eps)]
     return _mmax_exact_flat(*flat, m_limit).reshape(shape)
@@ -488,6 +490,7 @@ def mmax_exact_ura(
     R, W, y_u, z_u = (float(v) for v in _geometry(R, W, y_u, z_u))
     fc, eps = (float(v) for v in _fc_eps(fc, eps_phi))
     m_limit = integer("m_limit", m_limit, minimum=2)
+    check_elements("m_limit", 16 * m_limit**2, what=f"the exact URA search up to {m_limit}^2")
     lam = C / fc
     pv = vue(R, W, y_u, z_u)
     ps = reference_specular_point(R, W, y_u, z_u)
