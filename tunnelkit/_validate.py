@@ -31,6 +31,7 @@ __all__ = [
     "weights",
 ]
 
+_F64 = np.dtype(float)
 _BAD_KINDS = {"U": "text", "S": "bytes", "b": "booleans", "c": "complex numbers", "O": "objects"}
 
 
@@ -86,7 +87,10 @@ def finite_array(
     ``None`` for an axis of any length; a leading ``...`` is not supported, use ``ndim=None`` and a
     trailing-axis check instead.
     """
-    arr = _real_array(name, value, dtype)
+    if type(value) is np.ndarray and value.dtype == _F64 and dtype is float:
+        arr = value  # the common case in inner loops: no conversion at all
+    else:
+        arr = _real_array(name, value, dtype)
     if ndim is not None and arr.ndim != ndim:
         raise ValueError(f"{name}: expected {ndim}-D input, got shape {arr.shape}")
     if shape is not None:

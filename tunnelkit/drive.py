@@ -313,11 +313,18 @@ def doppler_shift(p, v, tx, fc: float, dz: float = 0.0) -> np.ndarray:
     position at the transmitter with ``dz = 0`` (range zero) raises.
     """
     p, v = _planar("p", p), _planar("v", v)
-    fc, dz = positive("fc", fc), real("dz", dz)
-    w = p - finite_array("tx", tx, shape=(2,))
-    r = np.sqrt(np.sum(w * w, axis=-1) + dz**2)
-    if np.any(r == 0):
-        raise ValueError("p: coincides with the transmitter (tx, dz = 0), the Doppler is undefined")
+    fc, dz, tx = positive("fc", fc), real("dz", dz), finite_array("tx", tx, shape=(2,))
+    return _doppler_shift(p, v, tx, fc, dz)
+
+
+def _doppler_shift(p, v, tx, fc: float, dz: float, name: str = "p") -> np.ndarray:
+    """:func:`doppler_shift` on checked float inputs (filters call it every epoch)."""
+    w = p - tx
+    r = np.sqrt(np.sum(w * w, axis=-1) + dz * dz)
+    if not np.all(r):
+        raise ValueError(
+            f"{name}: coincides with the transmitter (dz = 0), the Doppler is undefined"
+        )
     return -(fc / C) * np.sum(v * w, axis=-1) / r
 
 

@@ -38,7 +38,7 @@ from scipy.stats import chi2
 
 from .._validate import finite_array, nonnegative, positive, probability, real
 from ..constants import C
-from ..drive import Drive, GnssFix, Measurements, doppler_shift, slant_range
+from ..drive import Drive, GnssFix, Measurements, slant_range
 from .cv import cv_process_noise, cv_transition
 from .registry import register
 
@@ -155,9 +155,11 @@ def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
 
 def doppler_model(s, setup: DopplerSetup) -> np.ndarray:
     """``h(s)`` of eq. 5 with the pinned sign: ``-(f_c/c) v . (p - T) / r`` [Hz]."""
-    s = _state("s", s)
-    setup = _check_setup(setup)
-    return doppler_shift(s[..., :2], s[..., 2:], setup.tx, setup.fc, setup.dz)
+    s, setup = _state("s", s), _check_setup(setup)
+    out = _doppler_model(s, setup)
+    if not np.isfinite(out).all():
+        raise ValueError("s: a position coincides with the transmitter, the Doppler is undefined")
+    return out
 
 
 def doppler_jacobian(s, setup: DopplerSetup) -> np.ndarray:
@@ -166,8 +168,21 @@ def doppler_jacobian(s, setup: DopplerSetup) -> np.ndarray:
     With ``w = p - T``, ``r = sqrt(|w|^2 + dz^2)``: ``dh/dp = -(f_c/c) (v / r - (v . w) w / r^3)``,
     ``dh/dv = -(f_c/c) w / r``.
     """
-    s = _state("s", s)
-    setup = _check_setup(setup)
+    s, setup = _state("s", s), _check_setup(setup)
+    out = _doppler_jacobian(s, setup)
+    if not np.isfinite(out).all():
+        raise ValueError("s: a position coincides with the transmitter, the Jacobian is undefined")
+    return out
+
+
+# the filters call these every epoch on states they built themselves: no checks, no overhead
+def _doppler_model(s: np.ndarray, setup: DopplerSetup) -> np.ndarray:
+    w = s[..., :2] - setup.tx
+    v = s[..., 2:]
+    return -setup.k * np.sum(v * w, -1) / np.sqrt(np.sum(w * w, -1) + setup.dz**2)
+
+
+def _doppler_jacobian(s: np.ndarray, setup: DopplerSetup) -> np.ndarray:
     w = s[..., :2] - setup.tx
     v = s[..., 2:]
     r = np.sqrt(np.sum(w * w, -1, keepdims=True) + setup.dz**2)
@@ -224,10 +239,10 @@ class DopplerEKF:
         self.rejected = 0
 
     def _h(self, x):
-        return doppler_model(x.ravel(), self.setup).reshape(1, 1)
+        return _doppler_model(x.ravel(), self.setup).reshape(1, 1)
 
     def _H(self, x):
-        return doppler_jacobian(x.ravel(), self.setup)
+        return _doppler_jacobian(x.ravel(), self.setup)
 
     def step(self, z) -> np.ndarray:
         """Predict (eq. 8-9) and, unless ``z`` is None/NaN, update with Doppler ``z`` [Hz] (eq. 10-12)."""
