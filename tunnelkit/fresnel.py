@@ -177,7 +177,7 @@ def ura_positions(
     M = integer("M", M, minimum=1)
     N = M if N is None else integer("N", N, minimum=1)
     t = float(_real("tilt", tilt))
-    check_elements("M", 16 * M * N, what=f"an {M} x {N} URA and its mismatch map")
+    check_elements("M", 16 * M * N, what=f"a {M} x {N} URA and its mismatch map")
     local = arrays.ura(N, M, wavelength(fc) / 2.0)  # element r * M + c at (c d, r d, 0)
     world = local @ arrays.rotation(0.0, -t).T
     return world.reshape(N, M, 3).transpose(1, 0, 2)
