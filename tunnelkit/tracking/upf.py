@@ -22,6 +22,7 @@ systematic resampler on the explicit ``rng``.
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numpy as np
@@ -55,14 +56,33 @@ __all__ = [
 def merwe_weights(
     n: int, alpha: float, beta: float, kappa: float
 ) -> tuple[np.ndarray, np.ndarray, float]:
-    """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points (filterpy's Merwe weights)."""
-    n = integer("n", n, minimum=1)
-    alpha, beta, kappa = positive("alpha", alpha), real("beta", beta), real("kappa", kappa)
+    """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points (filterpy's Merwe weights).
+
+    The weight arrays are read-only (the result is cached per ``(n, alpha, beta, kappa)``).
+    """
+    try:
+        hash((n, alpha, beta, kappa))
+    except TypeError:  # an array or a list: let the checks name it
+        _check_merwe(n, alpha, beta, kappa)
+    return _merwe_weights(n, alpha, beta, kappa)
+
+
+@functools.lru_cache(maxsize=32, typed=True)  # filters ask every epoch; checked once per setting
+def _merwe_weights(n, alpha, beta, kappa) -> tuple[np.ndarray, np.ndarray, float]:
+    n, alpha, beta, kappa = _check_merwe(n, alpha, beta, kappa)
     lam = alpha**2 * (n + kappa) - n
     if n + lam <= 0:
         raise ValueError(f"alpha, kappa: n + lambda = {n + lam} must be > 0")
     pts = MerweScaledSigmaPoints(n, alpha=alpha, beta=beta, kappa=kappa)
+    pts.Wm.setflags(write=False)
+    pts.Wc.setflags(write=False)
     return pts.Wm, pts.Wc, lam
+
+
+def _check_merwe(n, alpha, beta, kappa):
+    n = integer("n", n, minimum=1)
+    alpha, beta, kappa = positive("alpha", alpha), real("beta", beta), real("kappa", kappa)
+    return n, alpha, beta, kappa
 
 
 def ukf_proposal(
