@@ -21,9 +21,8 @@ def mahalanobis2(y, S) -> np.ndarray:
     S = finite_array("S", S)
     if S.shape[-2:] != (y.shape[-1], y.shape[-1]):
         raise ValueError(f"S: expected (..., {y.shape[-1]}, {y.shape[-1]}), got {S.shape}")
-    # S is an innovation covariance: symmetric, and positive definite (Cholesky) or no gate
-    scale = float(np.max(np.abs(S)))
-    if np.max(np.abs(S - np.swapaxes(S, -1, -2))) > 1e-9 * scale:
+    # S is an innovation covariance: symmetric and positive definite (its Cholesky factor exists)
+    if abs(S - np.swapaxes(S, -1, -2)).max() > 1e-9 * abs(S).max():
         raise ValueError("S: must be symmetric positive definite (it is not symmetric)")
     try:
         np.linalg.cholesky(S)
