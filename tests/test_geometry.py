@@ -77,7 +77,7 @@ def test_reflector_point_eq45_on_bisector_and_on_bs_vue_line():
     [
         (lambda: line(0, 0, 1), "A, B: degenerate"),
         (lambda: Plane(np.array([0.0, 0.0, 0.0]), 1.0), "normal: degenerate"),
-        (lambda: line(1, np.nan, 0), "line coefficients"),
+        (lambda: line(1, np.nan, 0), "B: must be finite"),
         (lambda: Tunnel2D.from_lines((1, 0, 0), (0, 1, 0)), "parallel"),
         (lambda: Tunnel2D.from_lines((1, 0, 0), (2, 0, 0)), "zero width"),
         (lambda: geometry.specular_point([0, 1], [0, -1], line(0, 1, 0)), "same side"),

@@ -46,3 +46,233 @@ def test_lazy_submodules():
     )
     with pytest.raises(AttributeError):
         tk.not_a_module  # noqa: B018
+
+
+# --- the strict validators and the domain checks ---------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "value, exc, match",
+    [
+        ([1.0, 2.0 + 1e-3j], TypeError, "x: expected real numbers, got complex"),
+        (np.array([1.0, 2.0], dtype=complex), TypeError, "x: expected real numbers, got complex"),
+        ("0.1", TypeError, "x: expected numbers, got text"),
+        (["0.1", "0.2"], TypeError, "x: expected real numbers, got text"),
+        ([True, False], TypeError, "x: expected real numbers, got booleans"),
+        (None, TypeError, "x: expected an array of numbers, got None"),
+        ([[1.0, 2.0], [3.0]], TypeError, "x: expected an array of numbers"),
+        ([1.0, np.inf], ValueError, "x: contains NaN or infinite"),
+    ],
+)
+def test_finite_array_refuses_what_is_not_a_real_number(value, exc, match):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no ComplexWarning either: the error comes first
+        with pytest.raises(exc, match=match):
+            v.finite_array("x", value)
+
+
+def test_finite_array_keeps_real_input_and_complex_when_asked():
+    a = np.array([1.0, 2.0])
+    assert v.finite_array("x", a) is a  # float input is not copied
+    np.testing.assert_array_equal(v.finite_array("x", [1, 2]), [1.0, 2.0])
+    z = v.finite_array("H", [1j, 2.0], dtype=complex)
+    assert z.dtype == complex and z[0] == 1j
+
+
+@pytest.mark.parametrize("value", [10.5, 10.0, True, np.float64(3.0), "10", None])
+def test_counts_must_be_integers(value):
+    with pytest.raises(TypeError, match="shape: expected an integer"):
+        v.integer("shape", value)
+
+
+def test_integer_bounds_and_scalars():
+    assert v.integer("n", np.int32(7), minimum=1, maximum=7) == 7
+    with pytest.raises(ValueError, match="n: must be <= 7"):
+        v.integer("n", 8, maximum=7)
+    for bad, exc in (
+        (1 + 1j, TypeError),
+        (np.array([1.0, 2.0]), TypeError),
+        (np.bool_(1), TypeError),
+    ):
+        with pytest.raises(exc, match="fc:"):
+            v.positive("fc", bad)
+    assert v.real("y", np.float32(-2.5)) == -2.5
+
+
+def test_domain_checks():
+    np.testing.assert_array_equal(v.cosine("cos_i", [0.0, 1.0]), [0.0, 1.0])
+    with pytest.raises(ValueError, match=r"cos_i: must lie in \[0, 1\], got 5.0"):
+        v.cosine("cos_i", 5.0)
+    w = v.weights("weights", [[0.0, 1.0], [2.0, 2.0]])
+    assert w.shape == (2, 2)
+    for bad, match in (([0.5, -0.1], ">= 0"), ([0.0, 0.0], "positive sum"), ([], "at least one")):
+        with pytest.raises(ValueError, match=f"weights: .*{match}"):
+            v.weights("weights", bad)
+    v.spd_matrix("F", [[2.0, 0.5], [0.5, 1.0]])
+    for bad, match in (
+        (-np.eye(2), "not positive definite"),
+        ([[2.0, 1.0], [0.0, 2.0]], "not symmetric"),
+        (np.ones((2, 3)), "square"),
+    ):
+        with pytest.raises(ValueError, match=f"F: .*{match}"):
+            v.spd_matrix("F", bad)
+    with pytest.raises(ValueError, match="stations: need at least 2 stations, got 1"):
+        v.distinct_points("stations", [[0.0, 0.0]], dim=2)
+    with pytest.raises(ValueError, match="stations: need at least 2 distinct stations"):
+        v.distinct_points("stations", [[1.0, 2.0], [1.0, 2.0]], dim=2)
+    assert v.choice("kinds", "los", ("los", "wall")) == "los"
+    with pytest.raises(TypeError, match="front_only: expected True or False"):
+        v.boolean("front_only", "no")
+
+
+def test_findings_of_the_issue_raise_naming_the_parameter():
+    from tunnelkit import crlb, drive, metrics, positioning, propagation
+    from tunnelkit.channel import SRSConfig
+    from tunnelkit.tracking import pcrlb, upf
+    from tunnelkit.tracking.javelin.gate import mahalanobis2
+
+    rng = np.random.default_rng(0)
+    cases = [
+        (lambda: crlb.crlb_trace(-np.eye(2)), "F: singular or not positive definite"),
+        (
+            lambda: crlb.crlb_trace([[2.0, 1.0], [0.0, 2.0]]),
+            "F: a Fisher information matrix must be symmetric",
+        ),
+        (
+            lambda: positioning.tswls([[0.0, 0.0]], [30.0], [0.1], 0.5, 0.01),
+            "stations: need at least 2",
+        ),
+        (
+            lambda: positioning.tswls([[0, 0], [0, 0]], [30, 30], [0.1, 0.1], 0.5, 0.01),
+            "stations: need at least 2 distinct",
+        ),
+        (
+            lambda: pcrlb.pcrlb_position_rmse(-np.eye(2)),
+            "bounds: must be symmetric positive semi-definite",
+        ),
+        (lambda: mahalanobis2([1.0, 2.0], -np.eye(2)), "S: must be symmetric positive definite"),
+        (lambda: propagation.fresnel_te(np.nan, 0.5), "eps_r: must be finite"),
+        (lambda: propagation.fresnel_te(5.24, 5.0), r"cos_i: must lie in \[0, 1\]"),
+        (
+            lambda: drive.doppler_shift([[1.0, 0.0]], [[1.0, 0.0]], [0.0, 4.5], -1e9),
+            "fc: must be > 0",
+        ),
+        (lambda: crlb.wrap_angle([0.1, np.nan]), "a: contains NaN"),
+        (lambda: drive.slant_range([[np.nan, 0.0]], [0.0, 4.5]), "p: contains NaN"),
+        (lambda: upf.effective_sample_size([0.5, np.nan]), "weights: contains NaN"),
+        (lambda: upf.systematic_resample([1.5, -0.5], rng), "weights: must be >= 0"),
+        (lambda: metrics.rmse([], []), "estimate: expected positions"),
+        (lambda: metrics.rmse(np.zeros((0, 2)), np.zeros((0, 2))), "estimate, truth: no positions"),
+        (lambda: SRSConfig(tx_power_dbm=np.nan), "tx_power_dbm: must be finite"),
+        (
+            lambda: propagation.lane_trajectory(
+                x_start=0, x_end=10, speed=1, period=1, y=np.nan, height=1
+            ),
+            "y: must be finite",
+        ),
+    ]
+    for call, match in cases:
+        with pytest.raises((ValueError, TypeError), match=match):
+            call()
+    tun = propagation.semicircular_tunnel()
+    arr = tk.arrays.make_array(2, 2, fc=5.9e9, azimuth=0.0, elevation=-0.5, origin=[0, 0, 4.8])
+    with pytest.raises(ValueError, match="kinds: expected one or more of"):
+        propagation.trace_paths(tun, arr, [10.0, -2.0, 1.5], fc=5.9e9, kinds=("bogus",))
+
+
+# --- the memory budget ---------------------------------------------------------------------------
+
+
+@pytest.fixture
+def budget(monkeypatch):
+    from tunnelkit import budget as b
+
+    monkeypatch.delenv(b.ENV, raising=False)
+    prev = b.set_memory_budget(None)
+    yield b
+    b.set_memory_budget(prev)
+
+
+def test_budget_default_env_and_override(budget, monkeypatch):
+    assert budget.memory_budget() == 2 * 1024**3
+    monkeypatch.setenv(budget.ENV, "512MiB")
+    assert budget.memory_budget() == 512 * 2**20
+    monkeypatch.setenv(budget.ENV, "4e9")
+    assert budget.memory_budget() == 4_000_000_000
+    budget.set_memory_budget("1GB")
+    assert budget.memory_budget() == 10**9  # the function wins over the variable
+    budget.set_memory_budget(None)
+    monkeypatch.setenv(budget.ENV, "lots")
+    with pytest.raises(ValueError, match="TUNNELKIT_MEMORY_BUDGET: cannot read 'lots'"):
+        budget.memory_budget()
+    with pytest.raises(ValueError, match="nbytes: must be a positive"):
+        budget.set_memory_budget(-1)
+
+
+def test_budget_error_names_parameter_and_size(budget):
+    with pytest.raises(
+        ValueError,
+        match=r"n_particles: would need 29.1 TiB \(10\^12 elements of 32 B\), above the memory budget of 2 GiB",
+    ):
+        budget.check_elements("n_particles", 10**12, 32)
+    budget.check_elements("n", 2**28, 8)  # exactly 2 GiB is allowed
+
+
+def test_sizes_are_checked_before_allocating(budget):
+    from tunnelkit import arrays, fresnel, montecarlo, propagation, reproduce
+
+    with pytest.raises(ValueError, match="n_rows, n_cols: would need 596 GiB"):
+        arrays.make_array(10**5, 10**5, fc=5.9e9, azimuth=0.0, elevation=0.0)
+    with pytest.raises(ValueError, match=r"n_facets: would need 3\.81 GiB"):
+        propagation.semicircular_tunnel(n_facets=10**6)
+    with pytest.raises(ValueError, match="runs: would need 931 TiB"):
+        montecarlo.run_trials(lambda r: 0, 10**12, 0)
+    with pytest.raises(ValueError, match="runs: would need"):
+        reproduce.run("halili", runs=10**18)
+    with pytest.raises(ValueError, match="M: would need"):
+        fresnel.phase_mismatch_ura(100_000, 3.5, 3.0, 2.5, 5.9e9)
+    with pytest.raises(ValueError, match="m_limit: would need"):
+        fresnel.mmax_exact(3.5, 3.0, 2.5, 5.9e9, 0.15, m_limit=10**12)
+    budget.set_memory_budget(10**4)  # a small budget turns an ordinary array into an error
+    with pytest.raises(ValueError, match="n_rows, n_cols: would need 100 KiB"):
+        arrays.make_array(40, 40, fc=5.9e9, azimuth=0.0, elevation=0.0)
+    budget.set_memory_budget(None)
+    assert arrays.make_array(40, 40, fc=5.9e9, azimuth=0.0, elevation=0.0).M == 1600
+
+
+def test_duplicate_elements_match_brute_force():
+    from tunnelkit import arrays
+
+    rng = np.random.default_rng(3)
+    for trial in range(20):
+        p = np.zeros((30, 3))
+        p[1:, :2] = rng.uniform(-1, 1, (29, 2))
+        if trial % 2:
+            i, j = rng.choice(np.arange(1, 30), 2, replace=False)
+            p[j, :2] = p[i, :2] + rng.uniform(-1, 1, 2) * 1e-12
+        d = np.linalg.norm(p[:, None, :2] - p[None, :, :2], axis=-1)
+        d[np.diag_indices_from(d)] = np.inf
+        brute = np.min(d) <= 1e-9 * np.max(np.abs(p))
+        if brute:
+            with pytest.raises(ValueError, match="positions: two elements coincide"):
+                arrays.check_element_positions("positions", p)
+        else:
+            arrays.check_element_positions("positions", p)
+        assert brute == bool(trial % 2)
+
+
+def test_mmax_json_marks_a_capped_search(capsys):
+    import json
+
+    from tunnelkit import cli
+
+    with pytest.warns(RuntimeWarning, match="returned as a lower bound"):
+        assert cli.main(["mmax", "--eps", "1000", "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert row["exact ULA"] == ">= 1048576" and row["exact URA MxM"] == ">= 1024"
+    assert row["eq.25/exact"] is None
+    assert cli.main(["mmax", "--format", "json"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert row["exact ULA"] == 15 and row["exact URA MxM"] == 11

@@ -12,14 +12,64 @@ from collections.abc import Sequence
 import numpy as np
 
 __all__ = [
+    "boolean",
+    "callable_",
+    "choice",
+    "cosine",
+    "distinct_points",
     "finite_array",
     "integer",
     "nonnegative",
+    "nonnegative_array",
     "positive",
+    "positive_array",
     "probability",
+    "real",
     "rng_or_error",
+    "spd_matrix",
     "vector",
+    "weights",
 ]
+
+_F64 = np.dtype(float)
+_BAD_KINDS = {"U": "text", "S": "bytes", "b": "booleans", "c": "complex numbers", "O": "objects"}
+
+
+def _real_array(name: str, value, dtype=float) -> np.ndarray:
+    """``value`` as a real array; strings, bools, complex and non-numbers raise ``TypeError``."""
+    if value is None:
+        raise TypeError(f"{name}: expected an array of numbers, got None")
+    if isinstance(value, str | bytes):
+        raise TypeError(f"{name}: expected numbers, got text {value!r}")
+    if isinstance(value, np.ndarray):
+        raw = value
+    else:
+        try:
+            raw = np.asarray(value)
+        except (TypeError, ValueError) as exc:  # ragged nested lists
+            raise TypeError(
+                f"{name}: expected an array of numbers, got {type(value).__name__} ({exc})"
+            ) from None
+    kind = raw.dtype.kind
+    want_complex = np.dtype(dtype).kind == "c"
+    if kind in "iuf" or (kind == "c" and want_complex):
+        return raw.astype(dtype, copy=False)
+    if kind == "O":
+        try:
+            arr = np.asarray(raw.tolist(), dtype=dtype)
+        except (TypeError, ValueError):
+            raise TypeError(
+                f"{name}: expected an array of numbers, got {type(value).__name__} holding "
+                "non-numeric items"
+            ) from None
+        if not want_complex and any(
+            isinstance(v, bool | complex | np.bool_ | np.complexfloating)
+            for v in np.asarray(raw, dtype=object).ravel()
+        ):
+            raise TypeError(f"{name}: expected real numbers, got booleans or complex numbers")
+        return arr
+    what = _BAD_KINDS.get(kind, f"dtype {raw.dtype}")
+    raise TypeError(f"{name}: expected real numbers, got {what}")
 
 
 def finite_array(
@@ -32,17 +82,15 @@ def finite_array(
 ) -> np.ndarray:
     """Return ``value`` as a float array, refusing NaN/inf, a wrong ``ndim`` or ``shape``.
 
-    ``shape`` may hold ``None`` for an axis of any length; a leading ``...`` is not supported, use
-    ``ndim=None`` and a trailing-axis check instead.
+    Strings, booleans, ``None`` and complex numbers (unless ``dtype`` is complex) raise
+    ``TypeError`` naming ``name``: an imaginary part is never dropped silently. ``shape`` may hold
+    ``None`` for an axis of any length; a leading ``...`` is not supported, use ``ndim=None`` and a
+    trailing-axis check instead.
     """
-    if value is None:
-        raise TypeError(f"{name}: expected an array of numbers, got None")
-    try:
-        arr = np.asarray(value, dtype=dtype)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(
-            f"{name}: expected an array of numbers, got {type(value).__name__}"
-        ) from exc
+    if type(value) is np.ndarray and value.dtype == _F64 and dtype is float:
+        arr = value  # the common case in inner loops: no conversion at all
+    else:
+        arr = _real_array(name, value, dtype)
     if ndim is not None and arr.ndim != ndim:
         raise ValueError(f"{name}: expected {ndim}-D input, got shape {arr.shape}")
     if shape is not None:
@@ -51,8 +99,24 @@ def finite_array(
         ):
             want = "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
             raise ValueError(f"{name}: expected shape {want}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    if not np.isfinite(arr).all():
         raise ValueError(f"{name}: contains NaN or infinite values")
+    return arr
+
+
+def positive_array(name: str, value, **kw) -> np.ndarray:
+    """A finite real array whose every entry is > 0."""
+    arr = finite_array(name, value, **kw)
+    if arr.size and arr.min() <= 0:
+        raise ValueError(f"{name}: must be > 0 everywhere, got {float(arr.min())}")
+    return arr
+
+
+def nonnegative_array(name: str, value, **kw) -> np.ndarray:
+    """A finite real array whose every entry is >= 0."""
+    arr = finite_array(name, value, **kw)
+    if arr.size and arr.min() < 0:
+        raise ValueError(f"{name}: must be >= 0 everywhere, got {float(arr.min())}")
     return arr
 
 
@@ -67,15 +131,22 @@ def vector(name: str, value, size: int | tuple[int, ...]) -> np.ndarray:
 
 
 def _scalar(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real | np.ndarray):
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real | np.ndarray):
         raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim != 0:
-        raise TypeError(f"{name}: expected a scalar, got an array of shape {arr.shape}")
-    x = float(arr)
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "iuf":
+            raise TypeError(f"{name}: expected a real number, got an array of {value.dtype}")
+        if value.ndim != 0:
+            raise TypeError(f"{name}: expected a scalar, got an array of shape {value.shape}")
+    x = float(value)
     if not np.isfinite(x):
         raise ValueError(f"{name}: must be finite, got {x}")
     return x
+
+
+def real(name: str, value) -> float:
+    """A finite real scalar (bools, strings and complex numbers refused)."""
+    return _scalar(name, value)
 
 
 def positive(name: str, value) -> float:
@@ -104,14 +175,99 @@ def probability(name: str, value, *, open_interval: bool = True) -> float:
     return x
 
 
-def integer(name: str, value, *, minimum: int | None = None) -> int:
-    """An integer (numpy integers accepted, floats refused) not below ``minimum``."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+def integer(name: str, value, *, minimum: int | None = None, maximum: int | None = None) -> int:
+    """An integer (numpy integers accepted; floats, even ``10.0`` or ``10.5``, and bools refused)
+    within ``[minimum, maximum]``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name}: expected an integer, got {value!r}")
     n = int(value)
     if minimum is not None and n < minimum:
         raise ValueError(f"{name}: must be >= {minimum}, got {n}")
+    if maximum is not None and n > maximum:
+        raise ValueError(f"{name}: must be <= {maximum}, got {n}")
     return n
+
+
+def boolean(name: str, value) -> bool:
+    """A real ``True``/``False`` (numpy bools accepted; ``"no"``, 0 and 1 refused)."""
+    if not isinstance(value, bool | np.bool_):
+        raise TypeError(f"{name}: expected True or False, got {value!r}")
+    return bool(value)
+
+
+def choice(name: str, value, options: Sequence[str]) -> str:
+    """One of the strings ``options``."""
+    if not isinstance(value, str) or value not in options:
+        raise ValueError(f"{name}: expected one of {', '.join(map(repr, options))}, got {value!r}")
+    return value
+
+
+def callable_(name: str, value):
+    """Anything callable."""
+    if not callable(value):
+        raise TypeError(f"{name}: expected a callable, got {type(value).__name__}")
+    return value
+
+
+def cosine(name: str, value) -> np.ndarray:
+    """The cosine of an incidence angle: finite and in ``[0, 1]`` everywhere."""
+    c = finite_array(name, value)
+    if c.size and (c.min() < 0 or c.max() > 1):
+        bad = float(c.min()) if c.min() < 0 else float(c.max())
+        raise ValueError(f"{name}: must lie in [0, 1], got {bad}")
+    return c
+
+
+def weights(name: str, value) -> np.ndarray:
+    """Particle weights (..., N): finite, ``>= 0``, ``N >= 1`` and a positive sum in every row."""
+    w = finite_array(name, value)
+    if w.ndim == 0 or w.shape[-1] == 0:
+        raise ValueError(f"{name}: expected at least one weight in the last axis, got {w.shape}")
+    if w.min() < 0:
+        raise ValueError(f"{name}: must be >= 0, got {float(w.min())}")
+    if np.any(w.sum(axis=-1) <= 0):
+        raise ValueError(f"{name}: every row must have a positive sum (all weights are zero)")
+    return w
+
+
+def spd_matrix(name: str, value, *, n: int | None = None, rtol: float = 1e-9) -> np.ndarray:
+    """Symmetric positive definite matrix (or stack (..., n, n)) such as a covariance or an
+    information matrix: finite, real, square, symmetric to ``rtol`` and Cholesky-factorable."""
+    A = finite_array(name, value)
+    if A.ndim < 2 or A.shape[-1] != A.shape[-2]:
+        raise ValueError(f"{name}: expected square matrices (..., n, n), got shape {A.shape}")
+    if n is not None and A.shape[-1] != n:
+        raise ValueError(f"{name}: expected {n} x {n} matrices, got shape {A.shape}")
+    if A.size == 0:
+        raise ValueError(f"{name}: empty matrix")
+    At = np.swapaxes(A, -1, -2)
+    scale = np.max(np.abs(A))
+    if np.max(np.abs(A - At)) > rtol * max(scale, np.finfo(float).tiny):
+        raise ValueError(f"{name}: must be symmetric positive definite (it is not symmetric)")
+    try:
+        np.linalg.cholesky(0.5 * (A + At))
+    except np.linalg.LinAlgError:
+        raise ValueError(
+            f"{name}: must be symmetric positive definite (it is not positive definite)"
+        ) from None
+    return A
+
+
+def distinct_points(name: str, value, *, dim: int, minimum: int = 2, atol: float = 0.0):
+    """Points (N, dim) with at least ``minimum`` distinct rows (e.g. stations for positioning)."""
+    P = finite_array(name, value, ndim=2)
+    if P.shape[1] != dim:
+        raise ValueError(f"{name}: expected shape (N, {dim}), got {P.shape}")
+    if P.shape[0] < minimum:
+        raise ValueError(f"{name}: need at least {minimum} stations, got {P.shape[0]}")
+    if minimum > 1:
+        scale = max(float(np.max(np.abs(P))), 1.0)
+        key = np.round(P / (max(atol, 1e-12) * scale))
+        if np.unique(key, axis=0).shape[0] < minimum:
+            raise ValueError(
+                f"{name}: need at least {minimum} distinct stations, the {P.shape[0]} given coincide"
+            )
+    return P
 
 
 def rng_or_error(name: str, rng) -> np.random.Generator:

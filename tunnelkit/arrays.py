@@ -28,8 +28,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from ._validate import finite_array, integer, positive, vector
+from ._validate import finite_array, integer, positive, real, vector
+from .budget import check_elements
 from .constants import wavelength
 
 __all__ = [
@@ -51,12 +53,16 @@ def ura(n_rows: int, n_cols: int, spacing: float) -> np.ndarray:
     n_rows = integer("n_rows", n_rows, minimum=1)
     n_cols = integer("n_cols", n_cols, minimum=1)
     spacing = positive("spacing", spacing)
+    # positions (M, 3) plus the index grids and the world copy every array makes
+    check_elements("n_rows, n_cols", n_rows * n_cols * 8, what=f"a {n_rows} x {n_cols} array")
     r, c = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
     return np.stack([c.ravel() * spacing, r.ravel() * spacing, np.zeros(r.size)], axis=-1)
 
 
 def ula(n: int, spacing: float) -> np.ndarray:
     """Element positions (M, 3) of an ``n``-element ULA along the local x-axis, element 0 at 0."""
+    n = integer("n", n, minimum=1)
+    check_elements("n", n * 8, what=f"a {n}-element ULA")
     return ura(1, n, spacing)
 
 
@@ -65,8 +71,8 @@ def rotation(azimuth: float, elevation: float) -> np.ndarray:
 
     ``world = origin + R @ local``; ``local = R.T @ (world - origin)``.
     """
-    az = float(finite_array("azimuth", azimuth, ndim=0))
-    el = float(finite_array("elevation", elevation, ndim=0))
+    az = real("azimuth", azimuth)
+    el = real("elevation", elevation)
     if abs(el) > np.pi / 2:
         raise ValueError(f"elevation: must lie in [-pi/2, pi/2] rad, got {el}")
     ez = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
@@ -101,9 +107,9 @@ def check_element_positions(
         raise ValueError(
             f"{name}: the reference antenna (row 0) must sit at the origin, got {p[0]}"
         )
-    d = np.linalg.norm(p[:, None, :2] - p[None, :, :2], axis=-1)
-    d[np.diag_indices_from(d)] = np.inf
-    if np.min(d) <= atol * scale:
+    # nearest other element of each one in the array plane: a k-d tree, O(M log M) time, O(M) memory
+    d, _ = cKDTree(p[:, :2]).query(p[:, :2], k=2)
+    if np.min(d[:, 1]) <= atol * scale:
         raise ValueError(f"{name}: two elements coincide")
     return p
 
@@ -188,6 +194,5 @@ def make_array(
     simulator's frame, whose y-axis runs along the tunnel).
     """
     d = wavelength(fc) / 2 if spacing is None else positive("spacing", spacing)
-    return ArrayGeometry(
-        ura(n_rows, n_cols, d), np.asarray(origin, dtype=float), azimuth, elevation, name=name
-    )
+    origin = vector("origin", origin, 3)
+    return ArrayGeometry(ura(n_rows, n_cols, d), origin, azimuth, elevation, name=name)

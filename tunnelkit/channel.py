@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import finite_array, integer, nonnegative, positive, rng_or_error
+from ._validate import finite_array, integer, nonnegative, positive, real, rng_or_error
+from .budget import check_elements
 from .constants import K_B, C, db2lin, dbm2watt
 
 __all__ = [
@@ -64,6 +65,7 @@ class SRSConfig:
             positive(k, getattr(self, k))
         for k in ("clock_bias_sigma", "clock_bias_limit", "noise_figure_db"):
             nonnegative(k, getattr(self, k))
+        real("tx_power_dbm", self.tx_power_dbm)
         integer("comb", self.comb, minimum=1)
         integer("n_symbols", self.n_symbols, minimum=2)
         integer("n_rb", self.n_rb, minimum=1)
@@ -71,6 +73,13 @@ class SRSConfig:
             raise ValueError(
                 f"n_rb: {self.n_rb} RBs at {self.scs:g} Hz exceed the bandwidth {self.bandwidth:g} Hz"
             )
+        # one antenna's tensor (complex, plus a noise draw of the same size) must fit
+        check_elements(
+            "n_symbols",
+            2 * self.n_tones * self.n_symbols,
+            itemsize=16,
+            what=f"{self.n_tones} tones x {self.n_symbols} symbols per antenna",
+        )
 
     @property
     def n_tones(self) -> int:
@@ -130,6 +139,7 @@ def sample_clock_bias(
     rng = rng_or_error("rng", rng)
     sigma, limit = nonnegative("sigma", sigma), nonnegative("limit", limit)
     n = 1 if size is None else integer("size", size, minimum=1)
+    check_elements("size", 3 * n)
     if sigma == 0 or limit == 0:
         out = np.zeros(n)
     else:
@@ -181,6 +191,8 @@ def channel_tensor(
     bias = float(finite_array("clock_bias", clock_bias, ndim=0))
     nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=2)
     nt = config.n_symbols if n_symbols is None else integer("n_symbols", n_symbols, minimum=2)
+    m = paths[0].lengths.shape[0]
+    check_elements("n_tones, n_symbols", 2 * m * nf * nt, 16, f"a {m} x {nf} x {nt} channel tensor")
     k0 = 2 * np.pi * config.fc / C
     delta = np.stack([p.delta(model) for p in paths], axis=1)  # (M, L)
     tau = (

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import positive
+from ._validate import finite_array, positive
 
 #: speed of light in vacuum [m/s]
 C = 299_792_458.0
@@ -19,12 +19,12 @@ def wavelength(fc: float) -> float:
 
 def db2lin(x_db):
     """Power ratio from decibels."""
-    return 10.0 ** (np.asarray(x_db, dtype=float) / 10.0)
+    return 10.0 ** (finite_array("x_db", x_db) / 10.0)
 
 
 def lin2db(x):
     """Decibels from a positive power ratio."""
-    x = np.asarray(x, dtype=float)
+    x = finite_array("x", x)
     if np.any(x <= 0):
         raise ValueError("x: power ratios must be > 0 to be expressed in dB")
     return 10.0 * np.log10(x)
@@ -32,14 +32,14 @@ def lin2db(x):
 
 def dbm2watt(p_dbm):
     """Watts from dBm."""
-    return 1e-3 * db2lin(p_dbm)
+    return 1e-3 * 10.0 ** (finite_array("p_dbm", p_dbm) / 10.0)
 
 
 def deg(x_rad):
     """Degrees from radians (for labels and tables only)."""
-    return np.degrees(x_rad)
+    return np.degrees(finite_array("x_rad", x_rad))
 
 
 def rad(x_deg):
     """Radians from degrees (sliders and presets speak degrees)."""
-    return np.radians(x_deg)
+    return np.radians(finite_array("x_deg", x_deg))

@@ -23,7 +23,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validate import finite_array, positive
+from ._validate import callable_, finite_array, positive, spd_matrix
 
 __all__ = [
     "crlb_rmse",
@@ -38,8 +38,12 @@ __all__ = [
 
 
 def wrap_angle(a):
-    """Wrap angle(s) to ``(-pi, pi]``."""
-    a = np.asarray(a, dtype=float)
+    """Wrap angle(s) to ``(-pi, pi]``; ``a`` must be finite and real."""
+    return _wrap(finite_array("a", a))
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """:func:`wrap_angle` without the input check (inner loops that already hold floats)."""
     return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
 
 
@@ -53,7 +57,8 @@ def _points_and_stations(p, stations) -> tuple[np.ndarray, np.ndarray, np.ndarra
     dx = p[..., None, 0] - st[:, 0]
     dy = p[..., None, 1] - st[:, 1]
     d2 = dx * dx + dy * dy
-    if np.any(d2 == 0):
+    scale = max(float(np.max(np.abs(p), initial=0.0)), float(np.max(np.abs(st))), 1.0)
+    if np.any(d2 <= (1e-12 * scale) ** 2):
         raise ValueError("p: coincides with a station, range and bearing are undefined there")
     return p, st, dx, dy
 
@@ -135,8 +140,11 @@ def numeric_jacobian(
     Components flagged in ``angle_mask`` (bool, length m) have their differences wrapped to
     ``(-pi, pi]`` so a bearing crossing the branch cut does not explode.
     """
+    callable_("h", h)
     p = finite_array("p", p)
     step = positive("step", step)
+    if p.ndim == 0:
+        raise ValueError("p: expected a point (..., n), got a scalar")
     n = p.shape[-1]
     cols = []
     for k in range(n):
@@ -145,7 +153,7 @@ def numeric_jacobian(
         diff = np.asarray(h(p + e), dtype=float) - np.asarray(h(p - e), dtype=float)
         if angle_mask is not None:
             mask = np.asarray(angle_mask, dtype=bool)
-            diff = np.where(mask, wrap_angle(diff), diff)
+            diff = np.where(mask, _wrap(diff), diff)
         cols.append(diff / (2.0 * step))
     return np.stack(cols, axis=-1)
 
@@ -161,10 +169,7 @@ def numeric_fim(
     R = finite_array("R", R, ndim=2)
     if R.shape[0] != R.shape[1]:
         raise ValueError(f"R: must be square, got {R.shape}")
-    try:
-        np.linalg.cholesky(R)
-    except np.linalg.LinAlgError as exc:
-        raise ValueError("R: must be symmetric positive definite") from exc
+    R = spd_matrix("R", R)
     J = numeric_jacobian(h, p, step=step, angle_mask=angle_mask)
     if J.shape[-2] != R.shape[0]:
         raise ValueError(f"R: has size {R.shape[0]} but h returns {J.shape[-2]} measurements")
@@ -176,14 +181,20 @@ def crlb_trace(F) -> np.ndarray:
     F = finite_array("F", F)
     if F.ndim < 2 or F.shape[-1] != F.shape[-2]:
         raise ValueError(f"F: expected square matrices (..., n, n), got {F.shape}")
+    scale = float(np.max(np.abs(F))) if F.size else 0.0
+    if np.max(np.abs(F - np.swapaxes(F, -1, -2)), initial=0.0) > 1e-9 * scale:
+        raise ValueError("F: a Fisher information matrix must be symmetric")
+    bad = (
+        "F: singular or not positive definite Fisher information, the position is not identifiable"
+    )
     if F.shape[-1] == 2:  # closed form of eq. A17, no inverse needed
         det = F[..., 0, 0] * F[..., 1, 1] - F[..., 0, 1] * F[..., 1, 0]
-        if np.any(det <= 0):
-            raise ValueError("F: singular Fisher information, the position is not identifiable")
+        if np.any(det <= 0) or np.any(F[..., 0, 0] <= 0):
+            raise ValueError(bad)
         return (F[..., 0, 0] + F[..., 1, 1]) / det
     ev = np.linalg.eigvalsh(F)
     if np.any(ev <= 0):
-        raise ValueError("F: singular Fisher information, the position is not identifiable")
+        raise ValueError(bad)
     return np.sum(1.0 / ev, axis=-1)
 
 

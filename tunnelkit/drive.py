@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
-from ._validate import finite_array, nonnegative, positive, probability, rng_or_error
+from ._validate import finite_array, nonnegative, positive, probability, real, rng_or_error
 from .constants import C
 from .scenarios import ScenarioError, Trajectory, load_scenario
 
@@ -292,22 +292,39 @@ class GnssFix:
 # --- geometry -------------------------------------------------------------------------------------
 
 
+def _planar(name: str, value) -> np.ndarray:
+    a = finite_array(name, value)
+    if a.ndim == 0 or a.shape[-1] != 2:
+        raise ValueError(f"{name}: expected horizontal positions (..., 2), got shape {a.shape}")
+    return a
+
+
 def slant_range(p, tx, dz: float = 0.0) -> np.ndarray:
     """``sqrt(|p - T|^2 + dz^2)`` for horizontal positions ``p`` (..., 2) and transmitter ``tx`` (2,)."""
-    w = np.asarray(p, dtype=float) - np.asarray(tx, dtype=float)
-    return np.sqrt(np.sum(w * w, axis=-1) + float(dz) ** 2)
+    w = _planar("p", p) - finite_array("tx", tx, shape=(2,))
+    return np.sqrt(np.sum(w * w, axis=-1) + real("dz", dz) ** 2)
 
 
 def doppler_shift(p, v, tx, fc: float, dz: float = 0.0) -> np.ndarray:
     """Doppler shift [Hz] of the line of sight, Halili eq. 5 with the sign pinned (approach > 0).
 
     ``f_D = -(f_c / c) v . (p - T) / r`` with ``r`` the slant range (transmitter ``dz`` above the
-    receiving antenna). Vectorised over leading axes of ``p`` and ``v`` (..., 2).
+    receiving antenna). Vectorised over leading axes of ``p`` and ``v`` (..., 2). ``fc > 0``; a
+    position at the transmitter with ``dz = 0`` (range zero) raises.
     """
-    p = np.asarray(p, dtype=float)
-    v = np.asarray(v, dtype=float)
-    w = p - np.asarray(tx, dtype=float)
-    r = np.sqrt(np.sum(w * w, axis=-1) + float(dz) ** 2)
+    p, v = _planar("p", p), _planar("v", v)
+    fc, dz, tx = positive("fc", fc), real("dz", dz), finite_array("tx", tx, shape=(2,))
+    return _doppler_shift(p, v, tx, fc, dz)
+
+
+def _doppler_shift(p, v, tx, fc: float, dz: float, name: str = "p") -> np.ndarray:
+    """:func:`doppler_shift` on checked float inputs (filters call it every epoch)."""
+    w = p - tx
+    r = np.sqrt(np.sum(w * w, axis=-1) + dz * dz)
+    if not np.all(r):
+        raise ValueError(
+            f"{name}: coincides with the transmitter (dz = 0), the Doppler is undefined"
+        )
     return -(fc / C) * np.sum(v * w, axis=-1) / r
 
 

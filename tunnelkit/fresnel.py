@@ -38,6 +38,7 @@ import numpy as np
 
 from . import arrays
 from ._validate import finite_array, integer
+from .budget import check_elements
 from .constants import C, wavelength
 
 __all__ = [
@@ -75,6 +76,8 @@ SECTION_4_1_TILT = math.radians(30.0)
 
 #: the exact search stops here (an array this long is kilometres wide; see mmax_exact)
 M_LIMIT = 2**20
+#: the exact M x M URA search stops here by default
+M_LIMIT_URA = 1024
 
 # ---------------------------------------------------------------------------------------------
 # input checks
@@ -155,6 +158,7 @@ def ula_positions(M: int, fc: float) -> np.ndarray:
     :func:`tunnelkit.arrays.ula` placed looking along +x (azimuth 0, elevation 0).
     """
     M = integer("M", M, minimum=1)
+    check_elements("M", 8 * M, what=f"a {M}-element ULA")
     return arrays.ula(M, wavelength(fc) / 2.0) @ arrays.rotation(0.0, 0.0).T
 
 
@@ -173,6 +177,7 @@ def ura_positions(
     M = integer("M", M, minimum=1)
     N = M if N is None else integer("N", N, minimum=1)
     t = float(_real("tilt", tilt))
+    check_elements("M", 16 * M * N, what=f"a {M} x {N} URA and its mismatch map")
     local = arrays.ura(N, M, wavelength(fc) / 2.0)  # element r * M + c at (c d, r d, 0)
     world = local @ arrays.rotation(0.0, -t).T
     return world.reshape(N, M, 3).transpose(1, 0, 2)
@@ -398,6 +403,9 @@ def _mmax_exact_flat(R, W, y_u, z_u, lam, eps, m_limit: int) -> np.ndarray:
         rows = order[start:stop]
         K = int(need[rows[-1]])
         while rows.size:
+            check_elements(
+                "m_limit", rows.size * K, 80, f"the exact search up to M = {K} (10 temporaries)"
+            )
             y = np.arange(K) * (lam[rows] / 2.0)[:, None]
             ph = np.abs(_mismatch_ula(pv[rows], ps[rows], y, lam[rows, None]))
             hit, first = _first_exceed(ph, eps[rows])
@@ -422,6 +430,8 @@ def mmax_exact_grid(R, W, y_u, fc, eps_phi, *, z_u=0.0, m_limit: int = M_LIMIT) 
     R, W, y_u, z_u = _geometry(R, W, y_u, z_u)
     fc, eps = _fc_eps(fc, eps_phi)
     m_limit = integer("m_limit", m_limit, minimum=2)
+    # the search may run up to m_limit antennas for one geometry (about 10 temporaries each)
+    check_elements("m_limit", m_limit, 80, f"the exact search up to M = {m_limit}")
     shape = np.broadcast_shapes(R.shape, fc.shape, eps.shape)
     flat = [np.broadcast_to(v, shape).ravel().astype(float) for v in (R, W, y_u, z_u, C / fc, eps)]
     return _mmax_exact_flat(*flat, m_limit).reshape(shape)
@@ -468,7 +478,7 @@ def mmax_exact_ura(
     *,
     z_u: float = 0.0,
     tilt: float = SECTION_4_1_TILT,
-    m_limit: int = 1024,
+    m_limit: int = M_LIMIT_URA,
 ) -> int:
     """The largest ``M`` such that the ``M x M`` URA of section 4.1 keeps the exact mismatch
     ``<= eps_phi`` (Theorem 3.4's setting, no expansion).
@@ -480,12 +490,14 @@ def mmax_exact_ura(
     R, W, y_u, z_u = (float(v) for v in _geometry(R, W, y_u, z_u))
     fc, eps = (float(v) for v in _fc_eps(fc, eps_phi))
     m_limit = integer("m_limit", m_limit, minimum=2)
+    check_elements("m_limit", 16 * m_limit**2, what=f"the exact URA search up to {m_limit}^2")
     lam = C / fc
     pv = vue(R, W, y_u, z_u)
     ps = reference_specular_point(R, W, y_u, z_u)
     guess = float(_nonparaxial(R, W, y_u, z_u, lam, eps))
     K = int(min(m_limit, max(16, math.ceil(1.25 * guess) + 8)))
     while True:
+        check_elements("m_limit", 16 * K * K, what=f"the exact URA search up to {K} x {K}")
         ph = np.abs(_mismatch(pv, ps, ura_positions(K, fc, tilt=tilt), lam))
         run = np.maximum.accumulate(np.maximum.accumulate(ph, axis=0), axis=1)
         over = np.diagonal(run) > eps
@@ -531,6 +543,7 @@ def aperture_profile(M: int, R: float, W: float, y_u: float, fc: float) -> Apert
     M = integer("M", M, minimum=2)
     R, W, y_u, _ = (float(v) for v in _geometry(R, W, y_u))
     lam = wavelength(fc)
+    check_elements("M", 16 * M, what=f"{M} antennas x 16 profiles")
     y = np.arange(M) * lam / 2.0
     a = 2.0 * W - y_u
     x_p0 = R * W / a
@@ -574,11 +587,13 @@ class MmaxSummary:
     exact: int  #: mmax_exact (ULA)
     exact_ura: int  #: mmax_exact_ura (M x M URA of section 4.1)
     fraunhofer: float  #: mmax_fraunhofer(R)
+    exact_capped: bool = False  #: the ULA search hit its limit: ``exact`` is a lower bound only
+    exact_ura_capped: bool = False  #: the URA search hit its limit: ``exact_ura`` is a lower bound
 
     @property
-    def ratio(self) -> float:
-        """eq. 25 over the exact ULA value (< 1: the bound is conservative)."""
-        return self.eq25 / self.exact
+    def ratio(self) -> float | None:
+        """eq. 25 over the exact ULA value (< 1: the bound is conservative); None when capped."""
+        return None if self.exact_capped else self.eq25 / self.exact
 
     def as_dict(self) -> dict[str, float]:
         return {**asdict(self), "ratio": self.ratio}
@@ -590,6 +605,9 @@ def mmax_summary(
     """All bounds and exact values for one design point (``ura=False`` skips the URA search)."""
     s = dict(R=R, W=W, y_u=y_u, fc=fc, eps_phi=eps_phi)
     R_, W_, y_, z_ = (float(v) for v in _geometry(R, W, y_u, z_u))
+    exact = mmax_exact(R_, W_, y_, float(fc), float(eps_phi), z_u=z_)
+    exact_ura = mmax_exact_ura(R_, W_, y_, float(fc), float(eps_phi), z_u=z_) if ura else -1
+    # an exact answer is always below the search limit; equal to it means the search stopped
     return MmaxSummary(
         R=R_,
         W=W_,
@@ -601,9 +619,11 @@ def mmax_summary(
         eq25=float(mmax_2d(**s)),
         eq37=float(mmax_3d([R_, 2 * W_ - y_, z_], fc, eps_phi)),
         nonparaxial=float(mmax_nonparaxial(**s, z_u=z_u)),
-        exact=mmax_exact(R_, W_, y_, float(fc), float(eps_phi), z_u=z_),
-        exact_ura=mmax_exact_ura(R_, W_, y_, float(fc), float(eps_phi), z_u=z_) if ura else -1,
+        exact=exact,
+        exact_ura=exact_ura,
         fraunhofer=float(mmax_fraunhofer(R, fc)),
+        exact_capped=exact >= M_LIMIT,
+        exact_ura_capped=exact_ura >= M_LIMIT_URA,
     )
 
 
@@ -634,9 +654,9 @@ def design_report(points, *, title: str = "SR-NF validity: bounds vs exact Mmax"
                 s.eq25,
                 s.eq37,
                 s.nonparaxial,
-                s.exact,
-                s.exact_ura if ura else None,
-                round(s.ratio, 3),
+                f">= {s.exact}" if s.exact_capped else s.exact,
+                (f">= {s.exact_ura}" if s.exact_ura_capped else s.exact_ura) if ura else None,
+                None if s.ratio is None else round(s.ratio, 3),
             ]
         )
     cols = [
@@ -660,4 +680,9 @@ def design_report(points, *, title: str = "SR-NF validity: bounds vs exact Mmax"
         "2nd-order: eq. 41 corrected (SR curvature kept, no paraxial assumption)",
         "exact: largest M whose exact phase mismatch over the array stays <= eps (no expansion)",
     ]
+    if any(s.exact_capped or s.exact_ura_capped for s in recs):
+        notes.append(
+            "'>= N': the exact search stopped at its limit N with the mismatch still <= eps; "
+            "N is a lower bound, not the exact value (and eq.25/exact is left out)"
+        )
     return Report(title=title, columns=cols, rows=rows, notes=notes)

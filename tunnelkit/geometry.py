@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import finite_array, vector
+from ._validate import finite_array, real, vector
 
 __all__ = [
     "Plane",
@@ -48,9 +48,9 @@ class Plane:
         norm = float(np.linalg.norm(n))
         if norm == 0.0:
             raise ValueError("normal: degenerate plane, all coefficients are zero (A = B = 0)")
-        off = finite_array("offset", self.offset, ndim=0)
+        off = real("offset", self.offset)
         object.__setattr__(self, "normal", n / norm)
-        object.__setattr__(self, "offset", float(off) / norm)
+        object.__setattr__(self, "offset", off / norm)
 
     @property
     def dim(self) -> int:
@@ -87,7 +87,7 @@ class Plane:
 
 def line(A: float, B: float, C: float, name: str = "") -> Plane:
     """The 2-D line ``A x + B y + C = 0``; raises if ``A = B = 0``."""
-    coeffs = finite_array("line coefficients (A, B, C)", [A, B, C], ndim=1)
+    coeffs = np.array([real(k, v) for k, v in (("A", A), ("B", B), ("C", C))])
     if coeffs[0] == 0 and coeffs[1] == 0:
         raise ValueError("A, B: degenerate line, A = B = 0 describes no line")
     return Plane(coeffs[:2], coeffs[2], name=name)

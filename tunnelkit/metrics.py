@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.lib.array_utils import normalize_axis_tuple
 
 from ._validate import finite_array
 
@@ -13,6 +14,9 @@ def position_errors(estimate, truth) -> np.ndarray:
     """Euclidean error per sample, shape (...,), from positions of shape (..., dim)."""
     est = finite_array("estimate", estimate)
     tru = finite_array("truth", truth)
+    for name, a in (("estimate", est), ("truth", tru)):
+        if a.ndim == 0 or a.shape[-1] == 0:
+            raise ValueError(f"{name}: expected positions (..., dim), got shape {a.shape}")
     try:
         diff = est - tru
     except ValueError as exc:
@@ -25,6 +29,17 @@ def position_errors(estimate, truth) -> np.ndarray:
 def rmse(estimate, truth, axis=None) -> np.ndarray:
     """Root mean squared Euclidean error (Jiang eq. 64)."""
     e = position_errors(estimate, truth)
+    if e.size == 0:
+        raise ValueError("estimate, truth: no positions, the RMSE of an empty sample is undefined")
+    if axis is not None:
+        try:
+            axes = normalize_axis_tuple(axis, e.ndim)
+        except (TypeError, ValueError, np.exceptions.AxisError):
+            raise ValueError(
+                f"axis: {axis!r} is not an axis of errors with shape {e.shape}"
+            ) from None
+        if any(e.shape[a] == 0 for a in axes):
+            raise ValueError("estimate, truth: an empty axis, the RMSE is undefined")
     return np.sqrt(np.mean(e**2, axis=axis))
 
 

@@ -31,11 +31,13 @@ from urllib.parse import urlsplit
 
 import numpy as np
 
-from ._validate import integer, positive
+from ._validate import callable_, integer, positive
+from .budget import check_bytes
 
 __all__ = [
     "CONNECT_TIMEOUT_S",
     "QUICK",
+    "RUN_BYTES",
     "SchedulerUnreachable",
     "TrialLost",
     "mc_count",
@@ -44,6 +46,9 @@ __all__ = [
     "run_trials",
     "spawn_rngs",
 ]
+
+#: memory one run holds at least: its generator (about 1 KiB measured) and its result slot
+RUN_BYTES = 1024
 
 _TRUE = {"1", "true", "yes", "on"}
 
@@ -67,6 +72,7 @@ def mc_count(full: int, quick: int) -> int:
 def spawn_rngs(seed: int | np.random.Generator, n: int) -> list[np.random.Generator]:
     """``n`` independent generators derived from ``seed`` (an int or a Generator)."""
     n = integer("n", n, minimum=1)
+    check_bytes("n", n * RUN_BYTES, f"{n} generators of about {RUN_BYTES} B")
     if isinstance(seed, np.random.Generator):
         return list(seed.spawn(n))
     seed = integer("seed", seed, minimum=0)
@@ -99,6 +105,9 @@ def run_trials(
     timeout: float = CONNECT_TIMEOUT_S,
 ) -> list[Any]:
     """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm."""
+    callable_("trial", trial)
+    runs = integer("runs", runs, minimum=1)
+    check_bytes("runs", runs * RUN_BYTES, f"{runs} runs of at least {RUN_BYTES} B each")
     rngs = spawn_rngs(seed, runs)
     # ``trial(inputs[i], rng_i)`` when ``inputs`` is given; parallel options: module docstring
     calls = _calls(rngs, inputs)

@@ -16,16 +16,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import finite_array, integer, rng_or_error
+from ._validate import distinct_points, finite_array, integer, rng_or_error
+from .budget import check_elements
 from .crlb import _sigmas, toa_doa
 
 __all__ = ["ls_toa_doa", "simulate_toa_doa", "toa_only_candidates", "tswls"]
 
 
+_SINGULAR = (
+    "stations, d_hat, theta_hat: the stations and measurements leave the position undetermined "
+    "(singular least-squares system)"
+)
+
+
 def _inputs(stations, d_hat, theta_hat):
-    st = finite_array("stations", stations, ndim=2)
-    if st.shape[1] != 2:
-        raise ValueError(f"stations: expected shape (N, 2), got {st.shape}")
+    # one station (or several at one place) gives 2 equations for 3 unknowns: no fix at all
+    st = distinct_points("stations", stations, dim=2, minimum=2, atol=1e-9)
     d = finite_array("d_hat", d_hat)
     th = finite_array("theta_hat", theta_hat)
     n = st.shape[0]
@@ -58,7 +64,10 @@ def _wls(G, H, w_inv_diag):
     GtW = np.swapaxes(G, -1, -2) * w_inv_diag[..., None, :]
     A = GtW @ G
     b = np.einsum("...ij,...j->...i", GtW, H)
-    A_inv = np.linalg.inv(A)
+    try:
+        A_inv = np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        raise ValueError(_SINGULAR) from None
     return np.einsum("...ij,...j->...i", A_inv, b), A_inv
 
 
@@ -98,10 +107,13 @@ def tswls(stations, d_hat, theta_hat, sigma_d, sigma_theta) -> np.ndarray:
     scale = np.maximum(np.abs(xy).max(axis=-1), 1.0)
     ok = np.all(np.abs(xy) > 1e-6 * scale[..., None], axis=-1)
     W1 = np.where(ok[..., None, None], W1, np.eye(3))
-    W1_inv = np.linalg.inv(W1)
-    A = G1.T @ W1_inv @ G1
-    b = np.einsum("ij,...jk,...k->...i", G1.T, W1_inv, H1)
-    Z1 = np.linalg.solve(A, b[..., None])[..., 0]
+    try:
+        W1_inv = np.linalg.inv(W1)
+        A = G1.T @ W1_inv @ G1
+        b = np.einsum("ij,...jk,...k->...i", G1.T, W1_inv, H1)
+        Z1 = np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        raise ValueError(_SINGULAR) from None
     ok2 = ok[..., None] & (Z1 >= 0)
     refined = np.sign(xy) * np.sqrt(np.where(ok2, Z1, 0.0))
     return np.where(ok2, refined, xy)
@@ -122,6 +134,9 @@ def simulate_toa_doa(
     if sd is None or sth is None:
         raise ValueError("sigma_d, sigma_theta: both noise levels are needed to simulate")
     shape = d.shape if size is None else (integer("size", size, minimum=1), *d.shape)
+    check_elements(
+        "size", 4 * int(np.prod(shape, dtype=object)), what="the noisy ranges and bearings"
+    )
     d_hat = d + sd * rng.standard_normal(shape)
     th_hat = th + sth * rng.standard_normal(shape)
     return d_hat, th_hat

@@ -27,13 +27,15 @@ Sign conventions (pinned by tests): ``range_rate`` is the time derivative of the
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
 
-from ._validate import finite_array, integer, positive, vector
+from ._validate import boolean, cosine, finite_array, integer, positive, real, vector
 from .arrays import ArrayGeometry, make_array
+from .budget import check_bytes
 from .constants import C, wavelength
 from .geometry import Plane
 from .scenarios import ScenarioError, Trajectory, register_trajectory, register_tunnel
@@ -55,6 +57,10 @@ __all__ = [
 ]
 
 _EPS0 = 8.8541878128e-12
+#: memory one facet takes while tracing: the facet (about 0.6 KiB measured), its plane and the
+#: candidate path with two per-antenna length arrays (1.6 KiB at M = 100)
+FACET_BYTES = 4096
+_KINDS = ("los", "wall", "ceiling", "road", "rrm")
 
 
 # --- materials ----------------------------------------------------------------------------------
@@ -76,8 +82,25 @@ def fresnel_te(eps_r: complex, cos_i) -> np.ndarray:
     ``Gamma = (cos i - sqrt(eps - sin^2 i)) / (cos i + sqrt(eps - sin^2 i))``; ``cos_i`` is the
     cosine of the incidence angle from the surface normal. A perfect conductor is ``Gamma = -1``.
     """
-    ci = np.clip(np.abs(np.asarray(cos_i, dtype=float)), 0.0, 1.0)
-    root = np.sqrt(complex(eps_r) - (1.0 - ci**2))
+    ci = cosine("cos_i", cos_i)
+    return _fresnel_te(_permittivity("eps_r", eps_r), ci)
+
+
+def _permittivity(name: str, eps_r) -> complex:
+    """A finite (complex) relative permittivity."""
+    if isinstance(eps_r, bool | np.bool_) or not isinstance(eps_r, numbers.Number):
+        raise TypeError(f"{name}: expected a (complex) number, got {type(eps_r).__name__}")
+    e = complex(eps_r)
+    if not (np.isfinite(e.real) and np.isfinite(e.imag)):
+        raise ValueError(f"{name}: must be finite, got {e}")
+    if e == 0:
+        raise ValueError(f"{name}: must be non-zero")
+    return e
+
+
+def _fresnel_te(eps_r: complex, ci) -> np.ndarray:
+    """:func:`fresnel_te` on checked inputs (``ci`` in [0, 1])."""
+    root = np.sqrt(eps_r - (1.0 - ci**2))
     return (ci - root) / (ci + root)
 
 
@@ -154,9 +177,11 @@ class Facet:
 
     def reflection_coefficient(self, fc: float, cos_i) -> np.ndarray:
         """``-1`` for metal, TE Fresnel coefficient of concrete at ``fc`` otherwise."""
+        ci = cosine("cos_i", cos_i)
+        fc = positive("fc", fc)
         if self.material == "metal":
-            return -np.ones_like(np.asarray(cos_i, dtype=float)) + 0j
-        return fresnel_te(concrete_permittivity(fc), cos_i)
+            return -np.ones_like(ci) + 0j
+        return _fresnel_te(concrete_permittivity(fc), ci)
 
 
 @dataclass(frozen=True)
@@ -205,7 +230,7 @@ def truck_box(
     length, width, height = (
         positive(k, v) for k, v in (("length", length), ("width", width), ("height", height))
     )
-    c = np.array([float(x_center), float(y_center), 0.0])
+    c = np.array([real("x_center", x_center), real("y_center", y_center), 0.0])
     half = np.array([length / 2, width / 2, 0.0])
     return Box(c - half, c + half + np.array([0, 0, height]), name=name)
 
@@ -292,7 +317,8 @@ def semicircular_tunnel(
         positive("height", height),
     )
     n = integer("n_facets", n_facets, minimum=2)
-    x0 = -length / 2 if x_start is None else float(x_start)
+    check_bytes("n_facets", n * FACET_BYTES, f"{n} facets of about {FACET_BYTES} B while tracing")
+    x0 = -length / 2 if x_start is None else real("x_start", x_start)
     ax = np.array([length, 0.0, 0.0])
     t = np.linspace(0.0, np.pi, n + 1)
     verts = np.stack([np.zeros_like(t), width / 2 * np.cos(t), height * np.sin(t)], axis=-1)
@@ -346,6 +372,8 @@ def road_marking(
     """
     xr = finite_array("x_range", x_range, shape=(2,))
     width = positive("width", width)
+    y, z = real("y", y), real("z", z)
+    inclination_deg = real("inclination_deg", inclination_deg)
     if xr[1] <= xr[0]:
         raise ValueError(f"{name}: x_range must be increasing with non-zero length, got {xr}")
     if y == 0:
@@ -498,6 +526,12 @@ def trace_paths(
     if not isinstance(array, ArrayGeometry):
         raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
     fc = positive("fc", fc)
+    if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
+        raise TypeError(f"kinds: expected a tuple of path kinds from {_KINDS}, got {kinds!r}")
+    unknown = [k for k in kinds if k not in _KINDS]
+    if unknown or not kinds:
+        raise ValueError(f"kinds: expected one or more of {_KINDS}, got {tuple(kinds)!r}")
+    front_only = boolean("front_only", front_only)
     ue = tunnel.require_inside("ue", vector("ue", ue, 3))
     vel = vector("ue_velocity", ue_velocity, 3)
     a0 = array.origin
@@ -520,7 +554,7 @@ def trace_paths(
             continue
         if front_only and not array.in_front(point):
             continue
-        cos_i = du / float(np.linalg.norm(ue - point))
+        cos_i = min(du / float(np.linalg.norm(ue - point)), 1.0)  # rounding may give 1 + 1e-16
         gamma = s.reflection_coefficient(fc, cos_i)
         vvue = vel - 2.0 * (vel @ pl.normal) * pl.normal
         refl.append(
@@ -608,10 +642,17 @@ def lane_trajectory(
     """
     speed, period = positive("speed", speed), positive("period", period)
     lam = positive("slalom_wavelength", slalom_wavelength)
-    span = float(x_end) - float(x_start)
+    x_start, x_end = real("x_start", x_start), real("x_end", x_end)
+    y, height = real("y", y), real("height", height)
+    slalom_amplitude = real("slalom_amplitude", slalom_amplitude)
+    span = x_end - x_start
     if span == 0:
         raise ValueError("x_end: must differ from x_start")
-    n = int(np.floor(abs(span) / (speed * period))) + 1
+    steps = abs(span) / (speed * period)
+    if not np.isfinite(steps):
+        raise ValueError(f"period: {period:g} s at {speed:g} m/s gives no finite number of samples")
+    n = int(np.floor(steps)) + 1
+    check_bytes("period", 8 * 8 * n, f"{n} samples of t, position and velocity")
     t = np.arange(n) * period
     sgn = np.sign(span)
     x = x_start + sgn * speed * t

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from .._validate import integer, positive
-from ..montecarlo import CONNECT_TIMEOUT_S, parallel_options
+from ..budget import check_bytes
+from ..montecarlo import CONNECT_TIMEOUT_S, RUN_BYTES, parallel_options
 
 __all__ = ["Report", "Target", "register", "run", "targets"]
 
@@ -96,19 +97,24 @@ class Target:
     help: str
     default_runs: int
     fn: Callable[..., Report]
+    bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
 
 
 _REGISTRY: dict[str, Target] = {}
 _DISCOVERED = False
 
 
-def register(name: str, *, help: str, default_runs: int):
-    """Decorator registering a reproduction target under ``name``."""
+def register(name: str, *, help: str, default_runs: int, bytes_per_run: int = RUN_BYTES):
+    """Decorator registering a reproduction target under ``name``.
+
+    ``bytes_per_run`` is what one Monte-Carlo run keeps in memory until the report is built;
+    ``runs * bytes_per_run`` is checked against :mod:`tunnelkit.budget` before anything runs.
+    """
 
     def deco(fn):
         if name in _REGISTRY:
             raise ValueError(f"name: reproduce target {name!r} registered twice")
-        _REGISTRY[name] = Target(name, help, default_runs, fn)
+        _REGISTRY[name] = Target(name, help, default_runs, fn, bytes_per_run)
         return fn
 
     return deco
@@ -143,6 +149,7 @@ def run(
     tgt = reg[name]
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
+    check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")
     workers, scheduler = parallel_options(workers, scheduler)
     timeout = positive("timeout", timeout)
     rep = tgt.fn(runs, seed, progress, workers=workers, scheduler=scheduler, timeout=timeout)

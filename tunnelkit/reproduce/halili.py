@@ -52,6 +52,7 @@ def pooled_errors(
     help="EKF DS / KF DS and ToA / EKF DS and KF ToA on the synthetic drive beside the "
     "paper's measured-data statistics and 90 % error points",
     default_runs=20,
+    bytes_per_run=256 * 1024,
 )
 def halili(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """One paper row per approach (stats), then our rows per sigma with the paper's p90 beside."""

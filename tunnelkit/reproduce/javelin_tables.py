@@ -176,6 +176,7 @@ def javelin_table(
     "javelin-table1",
     help="Italiano 2026 Table 1: straight drive, JAVELIN (L, N@0.5, N, NoRRMs) vs TeNFiLoc-L",
     default_runs=20,
+    bytes_per_run=1024 * 1024,
 )
 def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """Table 1 (straight trajectory)."""
@@ -194,6 +195,7 @@ def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
     "javelin-table2",
     help="Italiano 2026 Table 2: slalom drive, JAVELIN (L, N@0.5, N) vs TeNFiLoc-L",
     default_runs=20,
+    bytes_per_run=1024 * 1024,
 )
 def javelin_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """Table 2 (slalom trajectory)."""

@@ -16,6 +16,7 @@ from . import Report, register
     "jiang-crlb",
     help="RMSE of LS and TSWLS beside sqrt(CRLB) at the straight trajectory's start, three noise levels",
     default_runs=2000,
+    bytes_per_run=4 * 1024,
 )
 def jiang_crlb(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """One row per noise level of Tables 2-3; all trials at the straight trajectory's start point."""

@@ -131,6 +131,7 @@ def _report(
     "jiang-table2",
     help="Table 2 (NLOS): mean/variance of the error of TSWLS, EKF, UKF, UPF, paper beside ours",
     default_runs=100,
+    bytes_per_run=64 * 1024,
 )
 def jiang_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
     return _report(
@@ -148,6 +149,7 @@ def jiang_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
     "jiang-table3",
     help="Table 3 (LOS): mean/variance of the error of TSWLS, EKF, UKF, UPF, paper beside ours",
     default_runs=100,
+    bytes_per_run=64 * 1024,
 )
 def jiang_table3(runs: int, seed: int, progress: bool, **parallel) -> Report:
     return _report(

@@ -13,6 +13,7 @@ import numpy as np
 from filterpy.common import Q_continuous_white_noise
 
 from .._validate import finite_array, integer, nonnegative, positive, rng_or_error
+from ..budget import check_elements
 
 __all__ = ["STATE_DIM", "cv_process_noise", "cv_transition", "simulate_cv"]
 
@@ -56,6 +57,9 @@ def simulate_cv(
     # q > 0 here: a zero Q has no Cholesky factor
     F, Q = cv_transition(period), cv_process_noise(period, positive("q", q))
     lead = () if size is None else (integer("size", size, minimum=1),)
+    check_elements(
+        "steps", 2 * (lead[0] if lead else 1) * steps * STATE_DIM, what="states and noise"
+    )
     L = np.linalg.cholesky(Q)
     noise = rng.standard_normal((*lead, steps - 1, STATE_DIM)) @ L.T
     out = np.empty((*lead, steps, STATE_DIM))

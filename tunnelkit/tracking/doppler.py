@@ -42,9 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 
-from .._validate import finite_array, integer, nonnegative, positive, probability
+from .._validate import finite_array, integer, nonnegative, positive, probability, real
 from ..constants import C
-from ..drive import Drive, GnssFix, Measurements, doppler_shift, slant_range
+from ..drive import Drive, GnssFix, Measurements, slant_range
 from .cv import cv_process_noise, cv_transition
 from .gating import (
     DEFAULT_GATE,
@@ -151,6 +151,14 @@ def _check_adaptive_form(adaptive_form: str) -> str:
 # --- the EKF on Doppler (section 4) ---------------------------------------------------------------
 
 
+def _state(name: str, s) -> np.ndarray:
+    """States ``[x, y, v_x, v_y]`` (..., 4): finite and real."""
+    s = finite_array(name, s)
+    if s.ndim == 0 or s.shape[-1] != 4:
+        raise ValueError(f"{name}: expected states [x, y, v_x, v_y] (..., 4), got shape {s.shape}")
+    return s
+
+
 def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
     """``F`` (eq. 2) and ``Q`` (eq. 3) of the constant-velocity model, state ``[x, y, v_x, v_y]``."""
     dt = positive("dt", dt)
@@ -160,8 +168,11 @@ def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
 
 def doppler_model(s, setup: DopplerSetup) -> np.ndarray:
     """``h(s)`` of eq. 5 with the pinned sign: ``-(f_c/c) v . (p - T) / r`` [Hz]."""
-    s = np.asarray(s, dtype=float)
-    return doppler_shift(s[..., :2], s[..., 2:], setup.tx, setup.fc, setup.dz)
+    s, setup = _state("s", s), _check_setup(setup)
+    out = _doppler_model(s, setup)
+    if not np.isfinite(out).all():
+        raise ValueError("s: a position coincides with the transmitter, the Doppler is undefined")
+    return out
 
 
 def doppler_jacobian(s, setup: DopplerSetup) -> np.ndarray:
@@ -170,7 +181,21 @@ def doppler_jacobian(s, setup: DopplerSetup) -> np.ndarray:
     With ``w = p - T``, ``r = sqrt(|w|^2 + dz^2)``: ``dh/dp = -(f_c/c) (v / r - (v . w) w / r^3)``,
     ``dh/dv = -(f_c/c) w / r``.
     """
-    s = np.asarray(s, dtype=float)
+    s, setup = _state("s", s), _check_setup(setup)
+    out = _doppler_jacobian(s, setup)
+    if not np.isfinite(out).all():
+        raise ValueError("s: a position coincides with the transmitter, the Jacobian is undefined")
+    return out
+
+
+# the filters call these every epoch on states they built themselves: no checks, no overhead
+def _doppler_model(s: np.ndarray, setup: DopplerSetup) -> np.ndarray:
+    w = s[..., :2] - setup.tx
+    v = s[..., 2:]
+    return -setup.k * np.sum(v * w, -1) / np.sqrt(np.sum(w * w, -1) + setup.dz**2)
+
+
+def _doppler_jacobian(s: np.ndarray, setup: DopplerSetup) -> np.ndarray:
     w = s[..., :2] - setup.tx
     v = s[..., 2:]
     r = np.sqrt(np.sum(w * w, -1, keepdims=True) + setup.dz**2)
@@ -234,10 +259,10 @@ class DopplerEKF:
         return self.gate.n_rejected
 
     def _h(self, x):
-        return doppler_model(x.ravel(), self.setup).reshape(1, 1)
+        return _doppler_model(x.ravel(), self.setup).reshape(1, 1)
 
     def _H(self, x):
-        return doppler_jacobian(x.ravel(), self.setup)
+        return _doppler_jacobian(x.ravel(), self.setup)
 
     def step(self, z) -> np.ndarray:
         """Predict (eq. 8-9) and, unless ``z`` is None/NaN, update with Doppler ``z`` [Hz] (eq. 10-12)."""
@@ -478,7 +503,7 @@ class HeadingDeadReckoning:
 
     def step(self, dr: float) -> np.ndarray:
         """Advance by ``dr`` [m] along the current heading (back if negative); update the heading."""
-        dr = float(finite_array("dr", dr, ndim=0))
+        dr = real("dr", dr)
         self.p = self.p + dr * np.array([np.sin(self.phi), np.cos(self.phi)])
         disp = self.p - self._last
         if np.hypot(*disp) >= self.min_step:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array
+from .._validate import finite_array, spd_matrix
 
 __all__ = ["measurement_information", "pcrlb", "pcrlb_position_rmse", "vs_pcrlb"]
 
@@ -31,6 +31,7 @@ def measurement_information(jacobians, R) -> np.ndarray:
     R = finite_array("R", R, ndim=2)
     if R.shape != (H.shape[-2], H.shape[-2]):
         raise ValueError(f"R: expected shape {(H.shape[-2],) * 2}, got {R.shape}")
+    spd_matrix("R", R)
     info = np.swapaxes(H, -1, -2) @ np.linalg.solve(R, H)
     return info.reshape(-1, *info.shape[-3:]).mean(axis=0)
 
@@ -45,9 +46,9 @@ def pcrlb(F, Q, P0, info) -> np.ndarray:
     info = finite_array("info", info, ndim=3)
     if info.shape[1:] != (n, n):
         raise ValueError(f"info: expected shape (T, {n}, {n}), got {info.shape}")
-    for name, M in (("Q", Q), ("P0", P0)):
-        if np.any(np.linalg.eigvalsh(0.5 * (M + M.T)) <= 0):
-            raise ValueError(f"{name}: must be positive definite for the posterior CRLB")
+    spd_matrix("Q", Q)
+    spd_matrix("P0", P0)
+    _psd("info", info)
     Qi = np.linalg.inv(Q)
     D11 = F.T @ Qi @ F
     D12 = -F.T @ Qi
@@ -61,9 +62,27 @@ def pcrlb(F, Q, P0, info) -> np.ndarray:
     return out
 
 
+def _psd(name: str, A: np.ndarray) -> None:
+    """Symmetric positive semi-definite (an expected information may be singular, never negative)."""
+    scale = float(np.max(np.abs(A))) if A.size else 0.0
+    if np.max(np.abs(A - np.swapaxes(A, -1, -2)), initial=0.0) > 1e-9 * scale:
+        raise ValueError(f"{name}: must be symmetric positive semi-definite (it is not symmetric)")
+    ev = np.linalg.eigvalsh(0.5 * (A + np.swapaxes(A, -1, -2)))
+    if np.any(ev < -1e-9 * max(scale, np.finfo(float).tiny)):
+        raise ValueError(
+            f"{name}: must be symmetric positive semi-definite (eigenvalue {float(ev.min()):.3g})"
+        )
+
+
 def pcrlb_position_rmse(bounds) -> np.ndarray:
-    """``sqrt(tr)`` of the position block (first two states) of bound matrices (..., n, n) [m]."""
+    """``sqrt(tr)`` of the position block (first two states) of bound matrices (..., n, n) [m].
+
+    The bounds must be symmetric positive semi-definite (a negative "bound" raises).
+    """
     B = finite_array("bounds", bounds)
+    if B.ndim < 2 or B.shape[-1] != B.shape[-2] or B.shape[-1] < 2:
+        raise ValueError(f"bounds: expected square matrices (..., n, n) with n >= 2, got {B.shape}")
+    _psd("bounds", B)
     return np.sqrt(B[..., 0, 0] + B[..., 1, 1])
 
 

@@ -32,12 +32,15 @@ systematic resampler on the explicit ``rng``.
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numpy as np
 from filterpy.kalman import MerweScaledSigmaPoints
 
-from .._validate import finite_array, integer, positive, probability, rng_or_error
+from .._validate import finite_array, integer, positive, probability, real, rng_or_error
+from .._validate import weights as _weights
+from ..budget import check_elements
 from .cv import STATE_DIM
 from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, REJECT, REOPEN, InnovationGate
 from .registry import register
@@ -64,12 +67,33 @@ __all__ = [
 def merwe_weights(
     n: int, alpha: float, beta: float, kappa: float
 ) -> tuple[np.ndarray, np.ndarray, float]:
-    """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points (filterpy's Merwe weights)."""
+    """``(Wm, Wc, lambda)`` of eq. 47-50 for ``2n + 1`` sigma points (filterpy's Merwe weights).
+
+    The weight arrays are read-only (the result is cached per ``(n, alpha, beta, kappa)``).
+    """
+    try:
+        hash((n, alpha, beta, kappa))
+    except TypeError:  # an array or a list: let the checks name it
+        _check_merwe(n, alpha, beta, kappa)
+    return _merwe_weights(n, alpha, beta, kappa)
+
+
+@functools.lru_cache(maxsize=32, typed=True)  # filters ask every epoch; checked once per setting
+def _merwe_weights(n, alpha, beta, kappa) -> tuple[np.ndarray, np.ndarray, float]:
+    n, alpha, beta, kappa = _check_merwe(n, alpha, beta, kappa)
     lam = alpha**2 * (n + kappa) - n
     if n + lam <= 0:
         raise ValueError(f"alpha, kappa: n + lambda = {n + lam} must be > 0")
     pts = MerweScaledSigmaPoints(n, alpha=alpha, beta=beta, kappa=kappa)
+    pts.Wm.setflags(write=False)
+    pts.Wc.setflags(write=False)
     return pts.Wm, pts.Wc, lam
+
+
+def _check_merwe(n, alpha, beta, kappa):
+    n = integer("n", n, minimum=1)
+    alpha, beta, kappa = positive("alpha", alpha), real("beta", beta), real("kappa", kappa)
+    return n, alpha, beta, kappa
 
 
 def ukf_proposal(
@@ -140,8 +164,16 @@ def ukf_proposal_reference(
 
 
 def effective_sample_size(weights) -> np.ndarray:
-    """``1 / sum(w^2)`` over the last axis of normalised weights."""
-    w = np.asarray(weights, dtype=float)
+    """``1 / sum(w^2)`` over the last axis of the weights (normalised here: ``w / sum(w)``).
+
+    ``weights`` must be finite, ``>= 0`` and have a positive sum in every row.
+    """
+    w = _weights("weights", weights)
+    return _ess(w / w.sum(axis=-1, keepdims=True))
+
+
+def _ess(w: np.ndarray) -> np.ndarray:
+    """:func:`effective_sample_size` of weights already normalised (inner loops)."""
     return 1.0 / np.sum(w * w, axis=-1)
 
 
@@ -152,7 +184,7 @@ def systematic_resample(weights, rng: np.random.Generator) -> np.ndarray:
     ``(u + j) / N``. Rows are searched in one ``searchsorted`` by shifting row ``b`` by ``b``.
     """
     rng = rng_or_error("rng", rng)
-    w = np.asarray(weights, dtype=float)
+    w = _weights("weights", weights)
     n = w.shape[-1]
     flat = w.reshape(-1, n)
     b = flat.shape[0]
@@ -229,6 +261,8 @@ class UnscentedParticleFilter(EstimatorBase):
         self.gate = InnovationGate(gate, reopen_after=reopen_after, batch=self.batch)
         L0 = np.linalg.cholesky(P0)
         N = self.n_particles
+        # particles, their covariances and the predicted copies: about 3 x 20 floats each
+        check_elements("n_particles", self.batch * N * 60, what=f"{self.batch} x {N} particles")
         # step (1): X_0^i ~ p(X_0) = N(x0, P0), each particle with covariance P0
         self.particles = (
             x0b[:, None, :] + self.rng.standard_normal((self.batch, N, STATE_DIM)) @ L0.T
@@ -419,7 +453,7 @@ class UnscentedParticleFilter(EstimatorBase):
 
     def _resample_if_needed(self) -> None:
         w = np.exp(self.log_w)
-        low = effective_sample_size(w) < self.resample_threshold * self.n_particles - 1e-9
+        low = _ess(w) < self.resample_threshold * self.n_particles - 1e-9
         if self.resample_threshold >= 1.0:
             low[:] = True
         if not np.any(low):
@@ -478,6 +512,6 @@ def one_epoch_ess(
     ess = np.empty(T)
     for k in range(T):
         f.step(Z[k], first=(k == 0))
-        ess[k] = effective_sample_size(f.weights)
+        ess[k] = _ess(f.weights)
         f.log_w[:] = -np.log(f.n_particles)
     return ess

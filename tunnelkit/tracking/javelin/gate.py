@@ -8,17 +8,28 @@ from functools import lru_cache
 import numpy as np
 from scipy.stats import chi2
 
-from ..._validate import integer, probability
+from ..._validate import finite_array, integer, probability
 
 __all__ = ["ChiSquareGate", "mahalanobis2"]
 
 
 def mahalanobis2(y, S) -> np.ndarray:
     """``eta^2 = y^T S^-1 y`` (eq. 58), vectorised over leading axes of ``y`` (..., n), ``S`` (..., n, n)."""
-    y = np.asarray(y, dtype=float)
-    S = np.asarray(S, dtype=float)
+    y = finite_array("y", y)
+    if y.ndim == 0:
+        raise ValueError("y: expected residual vector(s) (..., n), got a scalar")
+    S = finite_array("S", S)
     if S.shape[-2:] != (y.shape[-1], y.shape[-1]):
         raise ValueError(f"S: expected (..., {y.shape[-1]}, {y.shape[-1]}), got {S.shape}")
+    # S is an innovation covariance: symmetric and positive definite (its Cholesky factor exists)
+    if abs(S - np.swapaxes(S, -1, -2)).max() > 1e-9 * abs(S).max():
+        raise ValueError("S: must be symmetric positive definite (it is not symmetric)")
+    try:
+        np.linalg.cholesky(S)
+    except np.linalg.LinAlgError:
+        raise ValueError(
+            "S: must be symmetric positive definite (an innovation covariance)"
+        ) from None
     sol = np.linalg.solve(S, y[..., None])[..., 0]
     return np.sum(y * sol, axis=-1)
 

@@ -1,0 +1,130 @@
+"""The memory budget: sizes asked for by the user are checked before anything is allocated.
+
+Every allocation whose size comes from an argument (array elements, tones x symbols x antennas,
+particles x steps, Monte-Carlo runs, facets, ``m_limit``) is compared with the budget first; above
+it the call raises ``ValueError`` naming the parameter and the size it would take, instead of a
+``MemoryError`` traceback, a swapping machine or a run that never ends.
+
+The budget is 2 GiB by default. Raise or lower it for a session with :func:`set_memory_budget`
+or for a process with the environment variable ``TUNNELKIT_MEMORY_BUDGET`` (bytes, or a number
+with a unit: ``8GiB``, ``500MB``, ``4e9``). :func:`set_memory_budget` wins over the variable.
+
+    >>> from tunnelkit import budget
+    >>> budget.memory_budget() == 2 * 1024**3
+    True
+
+``budget.check_elements("n_particles", 10**12, itemsize=32)`` raises ``ValueError: n_particles:
+would need 29.1 TiB (10^12 elements of 32 B), above the memory budget of 2 GiB; ...``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+
+__all__ = [
+    "DEFAULT_BUDGET",
+    "check_bytes",
+    "check_elements",
+    "format_bytes",
+    "memory_budget",
+    "set_memory_budget",
+]
+
+#: the default budget [bytes]
+DEFAULT_BUDGET = 2 * 1024**3
+ENV = "TUNNELKIT_MEMORY_BUDGET"
+
+_UNITS = {
+    "": 1,
+    "b": 1,
+    "kb": 10**3,
+    "mb": 10**6,
+    "gb": 10**9,
+    "tb": 10**12,
+    "kib": 2**10,
+    "mib": 2**20,
+    "gib": 2**30,
+    "tib": 2**40,
+}
+_override: int | None = None
+
+
+def _parse(text: str) -> int:
+    m = re.fullmatch(r"\s*([0-9.eE+]+)\s*([A-Za-z]*)\s*", text)
+    unit = m.group(2).lower() if m else ""
+    if not m or unit not in _UNITS:
+        raise ValueError(f"{ENV}: cannot read {text!r} (e.g. 2147483648, 8GiB, 500MB)")
+    try:
+        value = float(m.group(1)) * _UNITS[unit]
+    except ValueError:
+        raise ValueError(f"{ENV}: cannot read {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"{ENV}: must be a positive size, got {text!r}")
+    return int(value)
+
+
+def memory_budget() -> int:
+    """The budget in bytes: :func:`set_memory_budget`, else ``TUNNELKIT_MEMORY_BUDGET``, else 2 GiB."""
+    if _override is not None:
+        return _override
+    env = os.environ.get(ENV, "").strip()
+    return _parse(env) if env else DEFAULT_BUDGET
+
+
+def set_memory_budget(nbytes: int | str | None) -> int | None:
+    """Set the budget for this process (``None`` goes back to the variable/default).
+
+    Returns the previous setting so a caller can restore it.
+    """
+    global _override
+    prev = _override
+    if nbytes is None:
+        _override = None
+    elif isinstance(nbytes, str):
+        _override = _parse(nbytes)
+    else:
+        if isinstance(nbytes, bool) or not isinstance(nbytes, int | float):
+            raise TypeError(f"nbytes: expected a number of bytes, got {type(nbytes).__name__}")
+        if not math.isfinite(nbytes) or nbytes <= 0:
+            raise ValueError(f"nbytes: must be a positive number of bytes, got {nbytes}")
+        _override = int(nbytes)
+    return prev
+
+
+def format_bytes(n: float) -> str:
+    """``1536`` -> ``'1.5 KiB'``."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
+        if n < 1024 or unit == "EiB":
+            return f"{n:.3g} {unit}" if unit != "B" else f"{int(n)} B"
+        n /= 1024
+    return f"{n:.3g} EiB"  # pragma: no cover
+
+
+def _count(n: int) -> str:
+    if n >= 10**6:
+        e = math.floor(math.log10(n))
+        m = n / 10**e
+        return f"10^{e} elements" if abs(m - 1) < 1e-9 else f"{m:.3g}x10^{e} elements"
+    return f"{n} elements"
+
+
+def check_bytes(name: str, nbytes, what: str = "") -> None:
+    """Raise ``ValueError`` naming ``name`` if ``nbytes`` exceeds the budget."""
+    nbytes = int(nbytes)
+    limit = memory_budget()
+    if nbytes > limit:
+        detail = f" ({what})" if what else ""
+        raise ValueError(
+            f"{name}: would need {format_bytes(nbytes)}{detail}, above the memory budget of "
+            f"{format_bytes(limit)}; reduce {name} or raise the budget "
+            f"(tunnelkit.budget.set_memory_budget or {ENV})"
+        )
+
+
+def check_elements(name: str, count, itemsize: int = 8, what: str = "") -> None:
+    """:func:`check_bytes` for ``count`` elements of ``itemsize`` bytes (exact integer product)."""
+    count = int(count)
+    desc = what or f"{_count(count)} of {itemsize} B"
+    check_bytes(name, count * int(itemsize), desc)
