@@ -139,7 +139,12 @@ def fit_sources(
     """
     b = np.asarray(b, complex)
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])
-    k0 = 2 * np.pi * positive("fc", fc) / C
+    return _fit_sources(b, theta0, p, positive("fc", fc), max_nfev)
+
+
+def _fit_sources(b, theta0, p, fc, max_nfev=40):
+    """:func:`fit_sources` on checked arguments."""
+    k0 = 2 * np.pi * fc / C
     th0 = np.asarray(theta0, float).reshape(-1, 3)
     n = th0.shape[0]
     v0 = _to_plane(th0[:, :2])
@@ -206,11 +211,11 @@ def _scan_grid(pos_bytes: bytes, m: int, fc: float, n_grid: int):
     return u, A
 
 
-def _scan_peak(r, p, fc: float, n_grid: int = 121) -> np.ndarray:
+def _scan_peak(r, p, fc: float, n_grid: int = 61) -> np.ndarray:
     """Direction cosines ``(u_x, u_y)`` of the strongest far-field beam of residual ``r``."""
     p = np.ascontiguousarray(p, float)
     u, A = _scan_grid(p.tobytes(), p.shape[0], float(fc), n_grid)
-    return u[int(np.argmax(np.abs(A.conj().T @ r)))]
+    return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H
 
 
 def split_component(
@@ -235,13 +240,13 @@ def split_component(
     """
     b = np.asarray(b, complex)
     p = np.asarray(element_positions, float)
-    th, g, rel = fit_sources(b, theta0, p, fc)
+    th, g, rel = _fit_sources(b, theta0, p, fc)
     scale = float(np.sqrt(np.mean(np.abs(b) ** 2)))
     while rel > tol and th.shape[0] < max_sources:
         S = spherical_steering(source_points(th), p, fc)
         u = _scan_peak(b - S @ g, p, fc)
         start = np.vstack([th, [u[0], u[1], 1 / 30.0]])
-        th2, g2, rel2 = fit_sources(b, start, p, fc)
+        th2, g2, rel2 = _fit_sources(b, start, p, fc)
         du = np.linalg.norm(th2[:, None, :2] - th2[None, :, :2], axis=-1)
         distinct = np.min(du[np.triu_indices(len(th2), 1)]) >= min_separation
         if not (rel2 < 0.5 * rel and distinct and np.max(np.abs(g2)) <= max_gain * scale):

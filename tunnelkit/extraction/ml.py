@@ -89,6 +89,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.linalg.blas import zherk
 
 from .._validate import integer, positive
 from ..arrays import check_element_positions
@@ -186,7 +187,7 @@ class _Problem:
     def __init__(self, H, pos, fc):
         self.H = H
         self.M, self.nf, self.nt = H.shape
-        self.H2 = H.reshape(self.M * self.nf, self.nt)
+        self.Hp = np.ascontiguousarray(H.transpose(0, 2, 1)).reshape(self.M * self.nt, self.nf)
         self.pos = pos
         self.k0 = 2 * np.pi * fc / C
         self.s = np.arange(self.nf, dtype=float)[:, None]
@@ -201,17 +202,13 @@ class _Problem:
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])
         if not derivatives:
-            Ht = (self.H2 @ T.conj()).reshape(self.M, self.nf, L)
-            b = np.einsum("ml,ml->l", a.conj(), np.einsum("msl,sl->ml", Ht, F.conj()))
+            b = np.einsum("ml,ml->l", a.conj(), self._contract(T, F))
             G = (a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T)
             c, cost = _solve_gains(G, b, self.h2)
             return {"c": c, "cost": cost, "G": G, "b": b}
         sF = 1j * self.s * F
         kT = 1j * self.kk * T
-        Ht = (self.H2 @ np.concatenate([T, kT], axis=1).conj()).reshape(self.M, self.nf, 2 * L)
-        W_ft = np.einsum("msl,sl->ml", Ht[:, :, :L], F.conj())
-        W_sft = np.einsum("msl,sl->ml", Ht[:, :, :L], sF.conj())
-        W_fkt = np.einsum("msl,sl->ml", Ht[:, :, L:], F.conj())
+        W_ft, W_sft, W_fkt = self._contract(T, F, sF, kT)
         ax, ay, aw = 1j * dx * a, 1j * dy * a, 1j * dw * a
         # atoms: L model atoms, then per path (u_x, u_y, w, mu_f, mu_t)
         X = np.concatenate([a, np.stack([ax, ay, aw, a, a], axis=2).reshape(self.M, 5 * L)], 1)
@@ -242,6 +239,21 @@ class _Problem:
         JJ = DD - DB @ _solve(G, DB.conj().T)
         return {"c": c, "cost": cost, "G": G, "b": b, "A": JJ.real, "g": Dr.real, "a": a}
 
+    def _contract(self, T, F, sF=None, kT=None):
+        """``W[m, l] = sum_{s,k} H[m, s, k] conj(F[s, l] T[k, l])`` (M, L); with ``sF`` and ``kT``
+        also the same with ``sF`` for ``F`` and with ``kT`` for ``T``. ``H``, stored once as
+        (M Nt) x Nf, meets the frequency vectors first (one BLAS product with a long inner
+        dimension), then each path its time vectors (small)."""
+        L = T.shape[1]
+        if kT is None:
+            Hf = (self.Hp @ F.conj()).reshape(self.M, self.nt, L)
+            return np.einsum("mkl,kl->ml", Hf, T.conj())
+        Hf = (self.Hp @ np.concatenate([F, sF], axis=1).conj()).reshape(self.M, self.nt, 2 * L)
+        W_ft = np.einsum("mkl,kl->ml", Hf[:, :, :L], T.conj())
+        W_sft = np.einsum("mkl,kl->ml", Hf[:, :, L:], T.conj())
+        W_fkt = np.einsum("mkl,kl->ml", Hf[:, :, :L], kT.conj())
+        return W_ft, W_sft, W_fkt
+
     def model(self, theta, mu_f, mu_t, c) -> np.ndarray:
         a = np.exp(1j * spatial_phase(theta, self.pos, self.k0)[0])
         F = np.exp(1j * self.s * mu_f[None, :])
@@ -267,8 +279,9 @@ def noise_floor(H, n_paths: int) -> float:
     M, nf, nt = H.shape
     L = integer("n_paths", n_paths, minimum=0)
     if L < nt:
-        U = H.reshape(M * nf, nt)
-        ev = np.linalg.eigvalsh(U.conj().T @ U)[: nt - L]
+        # time-mode Gram by a rank-k update (zherk): conj(H_(3) H_(3)^H), same eigenvalues
+        G = zherk(1.0, H.reshape(M * nf, nt).T, trans=0)
+        ev = np.linalg.eigvalsh(G, UPLO="U")[: nt - L]
         return float(max(np.sum(ev), 0.0) / ((nt - L) * (M * nf - L)))
     if L < M:
         U = H.reshape(M, nf * nt)
