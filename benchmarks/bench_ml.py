@@ -58,10 +58,20 @@ def cases() -> list[Case]:
 
     g = "ml"
     return [
-        Case(f"extract_paths L={L}, CPD + coherent split", lambda: run(refine="coherent"),
-             group=g, baseline=True, repeat=7),
-        Case(f"extract_paths L={L}, default (CPD + search + ML)", lambda: run(), group=g,
-             repeat=7, goal_s=0.25),
+        Case(
+            f"extract_paths L={L}, CPD + coherent split",
+            lambda: run(refine="coherent"),
+            group=g,
+            baseline=True,
+            repeat=7,
+        ),
+        Case(
+            f"extract_paths L={L}, default (CPD + search + ML)",
+            lambda: run(),
+            group=g,
+            repeat=7,
+            goal_s=0.25,
+        ),
     ]
 
 
@@ -82,10 +92,16 @@ def _scene_errors(rng):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         est = extraction.extract_paths(
-            sc.tensor(rng), len(sc.d), sc.element_positions, sc.config.fc,
-            sc.config.tone_spacing, sc.config.symbol_period,
+            sc.tensor(rng),
+            len(sc.d),
+            sc.element_positions,
+            sc.config.fc,
+            sc.config.tone_spacing,
+            sc.config.symbol_period,
         )
-    return evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb()), ["scene"] * len(sc.d)
+    return evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb()), ["scene"] * len(
+        sc.d
+    )
 
 
 def study(n_snapshots: int = 200, seed: int = 14) -> dict:
@@ -106,23 +122,33 @@ def study(n_snapshots: int = 200, seed: int = 14) -> dict:
         for e, kind in zip(err, kinds):
             rows.setdefault(kind if tag == "scene" else f"{kind}", []).append(e)
             rows.setdefault(f"all {tag}", []).append(e)
-    return {"errors": {k: np.array(v) for k, v in rows.items()},
-            "seconds": time.perf_counter() - t0}
+    return {
+        "errors": {k: np.array(v) for k, v in rows.items()},
+        "seconds": time.perf_counter() - t0,
+    }
 
 
 def table(res: dict) -> str:
     lines = [
-        f"{'path kind':16s} {'n':>5s} " + " ".join(f"{'RMS ' + p:>14s}" for p in PARAMS)
-        + " " + " ".join(f"{'>6sig ' + p:>14s}" for p in PARAMS)
+        f"{'path kind':16s} {'n':>5s} "
+        + " ".join(f"{'RMS ' + p:>14s}" for p in PARAMS)
+        + " "
+        + " ".join(f"{'>6sig ' + p:>14s}" for p in PARAMS)
     ]
     for kind, e in sorted(res["errors"].items()):
         fin = np.isfinite(e)
         with np.errstate(invalid="ignore"):
-            rms = [np.sqrt(np.mean(e[fin[:, j], j] ** 2)) if fin[:, j].any() else np.nan
-                   for j in range(4)]
+            rms = [
+                np.sqrt(np.mean(e[fin[:, j], j] ** 2)) if fin[:, j].any() else np.nan
+                for j in range(4)
+            ]
         beyond = np.mean(~(np.abs(e) <= 6.0), axis=0) * 100
-        lines.append(f"{kind:16s} {len(e):5d} " + " ".join(f"{r:14.2f}" for r in rms) + " "
-                     + " ".join(f"{b:13.1f}%" for b in beyond))
+        lines.append(
+            f"{kind:16s} {len(e):5d} "
+            + " ".join(f"{r:14.2f}" for r in rms)
+            + " "
+            + " ".join(f"{b:13.1f}%" for b in beyond)
+        )
     return "\n".join(lines)
 
 
@@ -130,8 +156,10 @@ def report(n_snapshots: int | None = None) -> str:
     n = n_snapshots or int(os.environ.get("TUNNELKIT_BENCH_SNAPSHOTS", 200))
     with threadpool_limits(1):
         res = study(n)
-    return (f"RMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
-            f"({res['seconds']:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(res))
+    return (
+        f"RMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
+        f"({res['seconds']:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(res)
+    )
 
 
 if __name__ == "__main__":
@@ -141,7 +169,12 @@ if __name__ == "__main__":
     a = ap.parse_args()
     with threadpool_limits(1):
         r = study(a.snapshots, a.seed)
-    print(f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
-          f"load {os.getloadavg()[0]:.1f}")
+    print(
+        f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
+        f"load {os.getloadavg()[0]:.1f}"
+    )
     print(table(r))
-    np.savez(f"/tmp/bench_ml_{a.snapshots}_{a.seed}.npz", **{k.replace(' ', '_'): v for k, v in r["errors"].items()})
+    np.savez(
+        f"/tmp/bench_ml_{a.snapshots}_{a.seed}.npz",
+        **{k.replace(" ", "_"): v for k, v in r["errors"].items()},
+    )
