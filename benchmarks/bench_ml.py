@@ -25,11 +25,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from run import Case  # noqa: E402
+from run import Case
 
-from tunnelkit import channel, evaluation, extraction, propagation, signal_route  # noqa: E402
-from tunnelkit.constants import C  # noqa: E402
-from tunnelkit.montecarlo import spawn_rngs  # noqa: E402
+from tunnelkit import channel, evaluation, extraction, propagation, signal_route
+from tunnelkit.constants import C
+from tunnelkit.montecarlo import spawn_rngs
 
 PARAMS = ("d", "v", "direction", "kappa")
 DRIVES = ("italiano2026-straight", "italiano2026-slalom")

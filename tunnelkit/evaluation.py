@@ -248,15 +248,21 @@ def rmse_study(
     n_snapshots: int,
     seed: int,
     *,
-    refine: str = "joint",
+    refine: str = "ml",
     progress: bool = False,
+    spatial: str | None = None,
 ) -> list[dict]:
     """RMSE of ``d``, ``v``, direction and ``kappa`` per true path over seeded snapshots, with CRLBs.
 
     Each snapshot draws noise and a clock bias; estimates are matched to true paths (Hungarian);
     ``d`` errors are taken against ``length + c b`` (the bias is part of the truth), ``kappa``
     against the VUE distance (exact physics). Unmatched paths count in ``missed``.
+    ``refine`` is the extraction route (``extract_paths``); ``spatial`` the model of the ``d``/``v``
+    bound (:func:`~tunnelkit.extraction.path_crlb`): by default "free" for the paper's routes
+    ("joint", "column", "none": what a CPD can reach) and "structured" for "ml" and "coherent".
     """
+    if spatial is None:
+        spatial = "free" if refine in ("joint", "column", "none") else "structured"
     from .channel import synthesize
     from .extraction import extract_paths, path_crlb
     from .montecarlo import spawn_rngs
@@ -298,7 +304,7 @@ def rmse_study(
                 )
             )
         missed += np.isin(np.arange(len(paths)), match, invert=True)
-    bound = path_crlb(paths, arr, cfg)
+    bound = path_crlb(paths, arr, cfg, spatial=spatial)
     rows = []
     for j, p in enumerate(paths):
         e = np.array(err[j]).reshape(-1, 4)
