@@ -298,17 +298,17 @@ def _lm(prob: _Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
     ev = prob.evaluate(theta, mu_f, mu_t)
     lam, it, converged = 1e-3, 0, False
     for it in range(1, max_iter + 1):  # noqa: B007
-        A, g = ev["A"], ev["g"]
-        dA = np.maximum(np.diag(A), 1e-300)
-        sc = 1.0 / np.sqrt(dA)  # Jacobi scaling: the parameters differ by orders of magnitude
-        As, gs = sc[:, None] * A * sc[None, :], sc * g
+        lower = np.zeros((L, 5), bool)
+        lower[:, 2] = theta[:, 2] <= 0.0
+        upper = np.zeros((L, 5), bool)
+        upper[:, 2] = theta[:, 2] >= W_MAX
         # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
-        if float(gs @ np.linalg.lstsq(As, gs, rcond=1e-12)[0]) < STEP_TOL * sigma2:
+        free, dec = _free_newton(ev["A"], ev["g"], lower.ravel(), upper.ravel())
+        if dec < STEP_TOL * sigma2:
             converged = True
             break
-        try:
-            step = sc * np.linalg.solve(As + lam * np.eye(As.shape[0]), gs)
-        except np.linalg.LinAlgError:
+        step = _damped_step(ev["A"], ev["g"], free, lam)
+        if step is None:
             lam *= 4.0
             continue
         st = step.reshape(L, 5)
@@ -324,6 +324,39 @@ def _lm(prob: _Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
                 converged = True  # no descent direction left at working precision
                 break
     return theta, mu_f, mu_t, ev, it, converged
+
+
+def _free_newton(A, g, lower, upper):
+    """Coordinates free to move and the Newton decrement ``g^T A^{-1} g`` over them.
+
+    A coordinate at its lower (upper) bound whose Gauss-Newton step points down (up) is held:
+    the projection would undo its step. ``A`` is Jacobi-scaled before the solve (the
+    parameters differ by orders of magnitude)."""
+    free = np.ones(g.size, bool)
+    for _ in range(3):
+        sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
+        As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+        gs = sc * g[free]
+        newton = np.zeros(g.size)
+        newton[free] = sc * np.linalg.lstsq(As, gs, rcond=1e-12)[0]
+        out = (lower & (newton < 0)) | (upper & (newton > 0))
+        if not out.any():
+            break
+        free &= ~out
+    return free, float(g[free] @ newton[free])
+
+
+def _damped_step(A, g, free, lam):
+    """Levenberg-Marquardt step on the ``free`` coordinates (Marquardt's diagonal scaling)."""
+    sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
+    As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+    try:
+        sub = sc * np.linalg.solve(As + lam * np.eye(As.shape[0]), sc * g[free])
+    except np.linalg.LinAlgError:
+        return None
+    step = np.zeros(g.size)
+    step[free] = sub
+    return step
 
 
 def _significance(ev, sigma2) -> np.ndarray:
