@@ -80,7 +80,8 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     ``est`` a :class:`~tunnelkit.extraction.PathEstimates`, ``d_true`` (with the clock bias),
     ``v_true``, ``sources`` (L, 3) the true wave origins in the array's local frame, ``bound`` a
     dict of standard deviations (``path_crlb`` / ``source_crlb`` units: m, m/s, rad, m). A true
-    path no estimate is matched to gets ``inf`` in every column; a far-field estimate (kappa NaN)
+    path no estimate is matched to gets ``inf`` in every column (every estimate of the route is
+    matched, not only Algorithm 1's ``d >= 0``; on the ML route those above the noise); a far-field estimate (kappa NaN)
     of a near-field path gets ``inf`` in the kappa column. The direction error is the angle
     between the unit vectors (non-negative).
     """
@@ -88,7 +89,12 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     rng_ = np.linalg.norm(src, axis=1)
     u = src / rng_[:, None]
     out = np.full((src.shape[0], 4), np.inf)
-    keep = np.flatnonzero(est.valid)
+    if est.significance is None:  # every estimate of the route (not Algorithm 1's d >= 0)
+        keep = np.arange(len(est))
+    else:  # the ML route: the paths that stand above the noise
+        from .extraction.ml import MIN_SIGNIFICANCE
+
+        keep = np.flatnonzero(est.significance >= MIN_SIGNIFICANCE)
     match = match_points(est.d[keep], est.direction[keep], d_true, u)
     for i, j in zip(keep, match):
         if j < 0:
