@@ -129,6 +129,7 @@ def study(n_snapshots: int = 200, seed: int = 14) -> dict:
     return {
         "errors": {k: np.array(v) for k, v in rows.items()},
         "seconds": time.perf_counter() - t0,
+        "fits": {k: np.array(v, float).reshape(-1, 3) for k, v in fits.items()},
     }
 
 
