@@ -401,13 +401,13 @@ def _power_rank_one(R, n_iter: int = 6):
     """Dominant rank-one term ``x o y o z`` of ``R`` by alternating power iterations."""
     M, nf, nt = R.shape
     R2 = R.reshape(M * nf, nt)
-    _, V = np.linalg.eigh(R2.conj().T @ R2)
-    z = V[:, -1]
+    _, V = np.linalg.eigh(zherk(1.0, R2.T, trans=0), UPLO="U")  # conj of the time-mode Gram
+    z = V[:, -1].conj()
     Rz = (R2 @ z.conj()).reshape(M, nf)
     u, _, vh = np.linalg.svd(Rz, full_matrices=False)
     x, y = u[:, 0], vh[0].conj()
     for _ in range(n_iter):
-        z = np.einsum("msk,m,s->k", R, x.conj(), y.conj())
+        z = np.einsum("msk,m,s->k", R, x.conj(), y.conj(), optimize=True)
         z /= np.linalg.norm(z)
         Rz = (R2 @ z.conj()).reshape(M, nf)
         y = Rz.T @ x.conj()
