@@ -72,9 +72,14 @@ estimate of the right model, ``2 ||r||^2 / sigma^2`` is chi-square with ``2N - 5
 freedom (``N = M Nf Nt``, the gains included), so ``rho = ||r||^2 / ((N - 2.5 L) sigma^2)`` is
 ``1 +- sqrt(1 / N)``. A fit with ``rho`` above ``1 + RHO_Z sqrt(1 / N + 1 / N_sigma)`` (plus
 the allowance) has not found the right basin
-(a path missed, merged or counted twice) and is re-seeded, SAGE-like, alternating two moves,
-each kept only if the likelihood rises:
+(a path missed, merged or counted twice) and is re-seeded, SAGE-like, each move kept only if
+the likelihood rises:
 
+- *merge and split* (once), when two atoms are nearly collinear (``|G_ij| / sqrt(G_ii G_jj) >
+  0.9``: one path counted twice, usually because two others closer than a beamwidth were
+  fitted as one): the weaker of the two out, the ``L - 1`` fitted, then each of them in turn
+  split into two halves an eighth of a beamwidth apart and all ``L`` fitted, until the basin
+  test passes; then, or otherwise, alternating:
 - *birth and death*: one path more, sought in the pure residual ``r``, all ``L + 1`` fitted
   jointly, the least significant one out and the ``L`` fitted again;
 - *replace the weakest*: the path whose removal raises the cost least (``|c_l|^2 /
@@ -358,6 +363,42 @@ def _birth_death(prob: _Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
     return res, big[4] + res[4]
 
 
+#: offsets in (u_x, u_y) of the two halves of a split path (an eighth of a 10 x 10 beamwidth)
+SPLIT_STEPS = ((0.012, 0.0), (0.0, 0.012))
+
+
+def _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coherence=0.9):
+    """If two atoms are nearly collinear (one path counted twice, ``|G_ij| / sqrt(G_ii G_jj) >
+    coherence``): drop the weaker, fit the ``L - 1``, then split one of them into two halves
+    ``u -+ SPLIT_STEPS`` (two sources closer than a beamwidth fitted as one) and fit all ``L``;
+    the first split whose cost is below ``cost_ok`` (the basin test), else the best. ``None``
+    when no two atoms are that alike."""
+    G = ev["G"]
+    dg = np.sqrt(np.maximum(np.real(np.diag(G)), 1e-300))
+    coh = np.abs(G) / np.outer(dg, dg)
+    np.fill_diagonal(coh, 0.0)
+    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
+    if coh[i, j] < coherence:
+        return None
+    drop = j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i
+    keep = np.arange(theta.shape[0]) != drop
+    th, mf, mt, ev_s, its, _ = _lm(prob, theta[keep], mu_f[keep], mu_t[keep], sigma2, max_iter)
+    best = None
+    for l_ in np.argsort(-np.abs(ev_s["c"])):
+        for du in SPLIT_STEPS:
+            t2 = np.vstack([th, th[l_]])
+            t2[l_, :2] += du
+            t2[-1, :2] -= du
+            mf2, mt2 = np.append(mf, mf[l_]), np.append(mt, mt[l_])
+            res = _lm(prob, _project(t2), mf2, mt2, sigma2, max_iter)
+            its += res[4]
+            if best is None or res[3]["cost"] < best[3]["cost"]:
+                best = res
+            if best[3]["cost"] <= cost_ok:
+                return best, its
+    return best, its
+
+
 def _free_newton(A, g, lower, upper):
     """Coordinates free to move and the Newton decrement ``g^T A^{-1} g`` over them.
 
@@ -528,11 +569,18 @@ def fit_ml(
     n_it, kept = best[4], 0
     history = [best[3]["cost"] / (dof * sigma2)]
     tried: set = set()
+    split_tried = False
     for attempt in range(n_reseed):
         theta, mu_f, mu_t, ev = best[:4]
         if ev["cost"] / (dof * sigma2) <= rho_max:
             break
-        if attempt % 2 == 0:  # birth and death: a path from the residual, then the weakest out
+        merged = None
+        if not split_tried:  # one path counted twice: merge it, split another (once)
+            merged = _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, rho_max * dof)
+        if merged is not None:
+            cand, its = merged
+            split_tried = True
+        elif attempt % 2 == 0:  # birth and death: a path from the residual, the weakest out
             cand, its = _birth_death(prob, theta, mu_f, mu_t, ev, sigma2, max_iter)
         else:  # the weakest path re-sought in the residual plus its own contribution
             sig = _significance(ev, sigma2)
