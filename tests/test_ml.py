@@ -298,3 +298,22 @@ def test_too_few_paths_fail_the_basin_test_and_warn():
     with pytest.warns(ml.MLConvergenceWarning, match="noise floor"):
         est = extraction.extract_paths(H, 2, *_args(sc))
     assert est.fit.rho > est.fit.rho_max and np.all(np.isfinite(est.d))
+
+
+def test_reseeding_recovers_a_path_counted_twice():
+    """Started with one source counted twice and another missing, the local fit stays in that
+    basin (residual far above the noise floor); the re-seeding finds the missing source."""
+    sc = _scene(71, n_paths=3, snr_db=(0.0, 5.0))
+    H = sc.tensor(np.random.default_rng(8))
+    pos, fc = _args(sc)[:2]
+    th, mf, mt = _truth(sc)
+    th_bad, mf_bad, mt_bad = th.copy(), mf.copy(), mt.copy()
+    th_bad[2], mf_bad[2], mt_bad[2] = th[1] + [0.004, 0.0, 0.0], mf[1], mt[1]
+    with pytest.warns(ml.MLConvergenceWarning, match="noise floor"):
+        local = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, fc, n_reseed=0)
+    assert local.rho > local.rho_max
+    fit = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, fc)
+    assert fit.rho <= fit.rho_max and fit.n_reseed >= 1
+    est = ml.estimates_from_fit(fit, pos, fc, *_args(sc)[2:], SMALL.n_tones, SMALL.n_symbols, 0.0)
+    err = evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb())
+    assert np.all(np.abs(err) < 5.0), err
