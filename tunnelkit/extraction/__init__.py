@@ -126,9 +126,11 @@ def extract_paths(
     if refine not in ROUTES:
         raise ValueError(f"refine: expected one of {ROUTES}, got {refine!r}")
     if refine == "ml":
-        from .ml import ml_paths
+        from .ml import _ml_paths
 
-        return ml_paths(H, L, pos, fc, df, T0, noise_power=noise_power)
+        if noise_power is not None:
+            noise_power = positive("noise_power", noise_power)
+        return _ml_paths(H, L, pos, fc, df, T0, noise_power=noise_power)
     if noise_power is not None:
         raise ValueError(f"noise_power: only used by refine='ml', not {refine!r}")
     if refine == "coherent":

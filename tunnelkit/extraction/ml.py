@@ -295,9 +295,12 @@ def _solve_gains(G, b, h2):
 
 def noise_floor(H, n_paths: int) -> float:
     """Noise power per sample estimated without the model (see the module text)."""
-    H = check_tensor(H)
+    return _noise_floor(check_tensor(H), integer("n_paths", n_paths, minimum=0))
+
+
+def _noise_floor(H, L: int) -> float:
+    """:func:`noise_floor` on checked arguments."""
     M, nf, nt = H.shape
-    L = integer("n_paths", n_paths, minimum=0)
     if L < nt:
         # time-mode Gram by a rank-k update (zherk): conj(H_(3) H_(3)^H), same eigenvalues
         G = zherk(1.0, H.reshape(M * nf, nt).T, trans=0)
@@ -547,10 +550,17 @@ def fit_ml(
     theta, mu_f, mu_t = _check_start(start, L)
     max_iter = integer("max_iter", max_iter, minimum=1)
     n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0)
-    prob = _Problem(H, pos, fc)
+    return _fit(_Problem(H, pos, fc), theta, mu_f, mu_t, noise_power, max_iter, n_reseed)
+
+
+def _fit(prob: _Problem, theta, mu_f, mu_t, noise_power, max_iter, n_reseed) -> MLFit:
+    """:func:`fit_ml` on checked arguments (``theta`` on the feasible set)."""
+    H = prob.H
+    M, L = H.shape[0], theta.shape[0]
+    start = (theta, mu_f, mu_t)
     bias = 0.0
     if noise_power is None:
-        sigma2 = noise_floor(H, L)
+        sigma2 = _noise_floor(H, L)
         nt, rest = (H.shape[2], M * H.shape[1]) if L < H.shape[2] else (M, H.shape[1] * H.shape[2])
         n_sigma = (nt - L) * (rest - L)
         # the L largest eigenvalues also take the largest noise eigenvalues of the directions
@@ -608,7 +618,7 @@ def fit_ml(
             MLConvergenceWarning,
             stacklevel=2,
         )
-        theta, mu_f, mu_t, ev = (*_check_start(start, L), ev0)
+        theta, mu_f, mu_t, ev = (*start, ev0)
     if not np.all(np.isfinite(ev["c"])):
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
@@ -716,16 +726,27 @@ def ml_paths(
     ``fit`` the :class:`MLFit` (noise power, basin test).
     """
     H = check_tensor(H)
-    M, nf, nt = H.shape
+    M = H.shape[0]
     L = check_rank(H.shape, n_paths)
     pos = check_element_positions("element_positions", element_positions, m=M)
     fc = positive("fc", fc)
     df = positive("subcarrier_spacing", subcarrier_spacing)
     T0 = positive("symbol_period", symbol_period)
+    if start is not None and not isinstance(start, PathEstimates):
+        start = _check_start(start, L)
+    return _ml_paths(H, L, pos, fc, df, T0, start, noise_power, max_iter, n_reseed)
+
+
+def _ml_paths(H, L, pos, fc, df, T0, start=None, noise_power=None, max_iter=60, n_reseed=None):
+    """:func:`ml_paths` on checked arguments (``start`` None, estimates or a checked tuple)."""
+    M, nf, nt = H.shape
     if L >= M:
         raise ValueError(
             f"n_paths: at most {M - 1} paths can be told apart by {M} antennas, got {L}"
         )
+    max_iter = integer("max_iter", max_iter, minimum=1)
+    n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0)
+    prob = _Problem(H, pos, fc)
     if start is None:
         from . import _paper_route
         from .coherent import resolve_coherent
@@ -736,15 +757,13 @@ def ml_paths(
             est0 = resolve_coherent(H, est0, pos, fc, df, T0, L)
         theta, mu_f, mu_t = start_from_estimates(est0)
         if len(est0) < L:  # the split found fewer distinct paths: seed the rest from the residual
-            theta, mu_f, mu_t = _complete(H, pos, fc, theta, mu_f, mu_t, L)
+            theta, mu_f, mu_t = _complete(prob, theta, mu_f, mu_t, L)
         start = (theta, mu_f, mu_t)
     elif isinstance(start, PathEstimates):
         if len(start) != L:
             raise ValueError(f"start: has {len(start)} paths, n_paths = {L}")
         start = start_from_estimates(start)
-    else:
-        start = _check_start(start, L)
-    fit = fit_ml(H, start, pos, fc, noise_power=noise_power, max_iter=max_iter, n_reseed=n_reseed)
+    fit = _fit(prob, *start, noise_power, max_iter, n_reseed)
     n_sig = int(np.sum(fit.significance >= MIN_SIGNIFICANCE))
     if n_sig < L:
         warnings.warn(
@@ -753,14 +772,12 @@ def ml_paths(
             MLDetectionWarning,
             stacklevel=2,
         )
-    return estimates_from_fit(
-        fit, pos, fc, df, T0, nf, nt, fit.cost / max(float(np.vdot(H, H).real), 1e-300)
-    )
+    return estimates_from_fit(fit, pos, fc, df, T0, nf, nt, fit.cost / max(prob.h2, 1e-300))
 
 
-def _complete(H, pos, fc, theta, mu_f, mu_t, L):
+def _complete(prob: _Problem, theta, mu_f, mu_t, L):
     """Add paths found in the residual until there are ``L`` (successive cancellation)."""
-    prob = _Problem(H, pos, fc)
+    H = prob.H
     while theta.shape[0] < L:
         if theta.shape[0]:
             ev = prob.evaluate(theta, mu_f, mu_t, derivatives=False)
