@@ -5,6 +5,8 @@ One module per stage, :func:`extract_paths` in front:
 - :mod:`.decomposition` — the CP decomposition of ``H`` (eq. 3, 11, 12) with tensorly, rank checks;
 - :mod:`.paper` — the paper's route from CPD factors to path parameters (eq. 13-24, Algorithm 1);
 - :mod:`.coherent` — paths the CPD merged, separated by the array (beyond the paper);
+- :mod:`.ml` — the joint maximum-likelihood fit of eq. 1 at the Cramér-Rao bound, started from
+  the two above (the default route of :func:`extract_paths`);
 - :mod:`.bounds` — Cramér-Rao bounds of the eq. 1 model;
 - :mod:`.estimates` — :class:`PathEstimates`, the container every route returns.
 
