@@ -103,10 +103,10 @@ def run_trials(
     # ``trial(inputs[i], rng_i)`` when ``inputs`` is given; parallel options: module docstring
     calls = _calls(rngs, inputs)
     workers, scheduler = parallel_options(workers, scheduler)
-    if workers is None and scheduler is None:
-        return _run_serial(trial, calls, progress, desc)
     retries = integer("retries", retries, minimum=0)
     timeout = positive("timeout", timeout)
+    if workers is None and scheduler is None:
+        return _run_serial(trial, calls, progress, desc)
     with _client(workers, scheduler, timeout) as client:
         return _run_dask(client, trial, calls, progress, desc, retries)
 
@@ -115,6 +115,8 @@ def _calls(rngs: list[np.random.Generator], inputs) -> list[tuple[tuple, np.rand
     """``(leading arguments, rng)`` per trial."""
     if inputs is None:
         return [((), r) for r in rngs]
+    if isinstance(inputs, np.ndarray):
+        inputs = list(inputs)
     if isinstance(inputs, str | bytes) or not isinstance(inputs, Sequence):
         raise TypeError(f"inputs: expected a sequence (one item per trial), got {inputs!r}")
     if len(inputs) != len(rngs):
