@@ -83,6 +83,7 @@ def test_same_seed_same_results_serial_and_on_two_workers(cluster):
     serial = run_trials(_draw, 12, seed=11)
     remote = run_trials(_draw, 12, seed=11, scheduler=cluster.scheduler_address)
     assert remote == serial and len({tuple(r) for r in serial}) == 12
+    assert run_trials(_draw, 12, seed=11, workers=1) == serial  # a LocalCluster of one process
     gen = run_trials(_draw, 5, np.random.default_rng(3), scheduler=cluster.scheduler_address)
     assert gen == run_trials(_draw, 5, np.random.default_rng(3))
     sizes = [1, 50, 3, 7, 2, 9]
@@ -196,3 +197,13 @@ def test_javelin_drives_identical_on_a_running_cluster(cluster):
         "italiano2026-straight", ("L",), 2, 7, scheduler=cluster.scheduler_address, **kw
     )["paper"]
     assert table_rows(remote, "italiano2026_table1") == table_rows(serial, "italiano2026_table1")
+
+
+def test_cli_bad_parallel_options(capsys):
+    assert main(["reproduce", "jiang-crlb", "--runs", "10", "--workers", "0"]) == 2
+    assert "workers: must be >= 1" in capsys.readouterr().err
+    assert main(["reproduce", "jiang-crlb", "--scheduler", "tcp://127.0.0.1"]) == 2
+    assert "scheduler: expected an address" in capsys.readouterr().err
+    with pytest.raises(SystemExit):  # argparse: not allowed with argument --workers
+        main(["reproduce", "jiang-crlb", "--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"])
+    assert "not allowed with" in capsys.readouterr().err
