@@ -225,7 +225,7 @@ def _client(workers: int | None, scheduler: str | None, timeout: float) -> Itera
             # no dashboard; the scheduler's health/metrics HTTP server on a free loopback port
             dashboard_address="127.0.0.1:0",
             scheduler_kwargs={"dashboard": False},
-            silence_logs=logging.ERROR,
+            silence_logs=logging.CRITICAL,  # shutdown races log heartbeat errors
         ) as cluster,
         Client(cluster, set_as_default=False) as client,
     ):
