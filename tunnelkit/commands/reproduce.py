@@ -21,6 +21,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the random generator (default 0)")
     p.add_argument("--format", choices=["table", "json"], default="table")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_parallel_arguments(p)
+
+
+def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
+    """``--workers N | --scheduler ADDRESS`` and ``--connect-timeout`` (any command whose trials
+    go through :func:`tunnelkit.montecarlo.run_trials`; pass them on with :func:`parallel_kwargs`)."""
     from ..montecarlo import CONNECT_TIMEOUT_S
 
     par = p.add_mutually_exclusive_group()
@@ -46,6 +52,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+def parallel_kwargs(args: argparse.Namespace) -> dict:
+    """``workers``, ``scheduler`` and ``timeout`` for ``run_trials`` from the parsed arguments."""
+    return {"workers": args.workers, "scheduler": args.scheduler, "timeout": args.connect_timeout}
+
+
 def main(args: argparse.Namespace) -> int:
     from ..montecarlo import TrialLost
     from ..reproduce import run
@@ -56,9 +67,7 @@ def main(args: argparse.Namespace) -> int:
             runs=args.runs,
             seed=args.seed,
             progress=(args.format == "table" and not args.no_progress),
-            workers=args.workers,
-            scheduler=args.scheduler,
-            timeout=args.connect_timeout,
+            **parallel_kwargs(args),
         )
     except TrialLost as exc:
         print(f"tunnelkit reproduce: error: {exc}", file=sys.stderr)
