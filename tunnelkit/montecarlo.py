@@ -278,9 +278,9 @@ def _run_dask(client, trial, calls, progress: bool, desc: str, retries: int) -> 
                 out[i] = fut.result()
             except KilledWorker as exc:
                 raise TrialLost(
-                    f"trial {i} of {len(futures)} ({desc}): its worker died each time it ran "
-                    "(Dask's distributed.scheduler.allowed-failures); the run is stopped rather "
-                    "than reported without it"
+                    f"trial {i} of {len(futures)} ({desc}) was lost: the workers holding it died "
+                    "more often than Dask allows (distributed.scheduler.allowed-failures); the "
+                    "run is stopped rather than reported without it"
                 ) from exc
             except Exception as exc:
                 exc.add_note(f"raised by trial {i} of {len(futures)} ({desc}) on a Dask worker")
