@@ -1,8 +1,10 @@
 # %% [markdown]
 # # 02 · How many antennas? The SR-NF validity bound $M_{\max}$
 #
-# *Italiano et al. (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field and
-# Radio-Reflective Road Markings", section 3.1 (Theorems 3.1 and 3.4, eq. 25–42) and section 4.2.*
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# section 3.1 (Theorems 3.1 and 3.4, eq. 25–42) and section 4.2.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -220,7 +222,10 @@ for rr, yy in ((3.5, 2.5), (3.5, -3.0), (30.0, 2.5), (30.0, -3.0)):
 # ### Where is eq. 25 tight? A map over $(R, y_u)$
 #
 # Ratio of eq. 25 to the exact $M_{\max}$ over distance and UE position (5.9 GHz, $W = 3$ m,
-# $\varepsilon_\Phi = 0.15$ rad): 1 (white) is tight, blue is conservative, red would be unsafe.
+# $\varepsilon_\Phi = 0.15$ rad), on a log colour scale centred on 1: white is tight, **red** is a
+# ratio below 1 — the bound allows fewer antennas than the exact limit, which is *conservative*
+# (safe) — and **blue** a ratio above 1, a bound that allows more antennas than the geometry
+# tolerates (*unsafe*). The paper's example in section 4.2 (ratio 0.66) is red.
 # `fresnel.mmax_exact_grid` computes the exact value for the whole grid at once.
 
 # %%

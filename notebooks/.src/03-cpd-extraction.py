@@ -1,8 +1,10 @@
 # %% [markdown]
 # # 03 · From the tunnel to the channel tensor and back: CPD channel-parameter extraction
 #
-# *Italiano et al. (2026), "JAVELIN: near-field localization in tunnels with radio-reflective
-# road markings", sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2.*
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -92,6 +94,11 @@ print(
     f"clock bias = {snap.clock_bias * 1e9:.1f} ns = {snap.clock_bias * 3e8:.2f} m"
 )
 print("per-element SNR of each path [dB]:", snap.snr_db.round(1))
+doppler_res = 1 / (cfg.n_symbols * cfg.symbol_period)  # 1/(N_t T_0) [Hz]
+print(
+    f"Doppler resolution 1/(N_t T_0) = {doppler_res / 1e3:.2f} kHz "
+    f"= {doppler_res * C / cfg.fc:.0f} m/s in radial speed"
+)
 
 # %% [markdown]
 # ## 3. CPD and the three factor matrices (eq. 11–16)
@@ -116,7 +123,8 @@ factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
 # **How the CPD is computed here.** A plain `parafac(H, L, init="svd")` on the full
 # $100\times410\times12$ tensor is about ten times slower (see `benchmarks/bench_extraction.py`)
 # and, even on a noiseless tensor, stops in a wrong decomposition: the time factor hardly varies
-# between paths over 12 symbols (Doppler resolution $1/(N_tT_0) \approx 2.3$ kHz, i.e. 120 m/s),
+# between paths over 12 symbols (Doppler resolution $1/(N_tT_0) \approx 2.3$ kHz, i.e. 119 m/s,
+# printed in section 2),
 # and the frequency factor barely separates paths closer than $c/BW = 3$ m. So
 # `extract_paths` (1) compresses $\mathcal{H}$ to an $L\times L\times L$ core (truncated HOSVD),
 # (2) initialises the core's CPD algebraically from a *shift invariance* — of the URA rows

@@ -2,7 +2,9 @@
 # # 05 · Tracking with EKF, UKF and the unscented particle filter, against the posterior CRLB
 #
 # *Jiang, Wang & Peng (2023), "A Single-Site Vehicle Positioning Method in the Rectangular Tunnel
-# Environment", sections 4.2 and 5; Tichavsky, Muravchik & Nehorai (1998) for the bound.*
+# Environment", Remote Sensing 15, 527, [doi:10.3390/rs15020527](https://doi.org/10.3390/rs15020527),
+# sections 4.2 and 5; Tichavský, Muravchik & Nehorai (1998) for the bound.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #

@@ -32,10 +32,15 @@ from .javelin import (
     tracks_count_figure,
     trajectories_figure,
 )
+from .tables import (
+    TableFigure,
+    table,
+)
 from .topview import (
     tunnel_topview,
 )
 from .tracking import (
+    bound_ratio_figure,
     particle_cloud_figure,
     rmse_bound_figure,
     table_figure,
@@ -50,7 +55,9 @@ from .tunnel3d import (
 
 __all__ = [
     "COLORS",
+    "TableFigure",
     "approach_cdfs",
+    "bound_ratio_figure",
     "cdf_figure",
     "derivation_figure",
     "doppler_delay_figure",
@@ -71,6 +78,7 @@ __all__ = [
     "ratio_map_figure",
     "regime_figure",
     "rmse_bound_figure",
+    "table",
     "table_figure",
     "tracks_count_figure",
     "tracks_figure",
