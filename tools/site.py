@@ -25,9 +25,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _lecture import (
     BUILD,
+    WIDGET_MIME,
     LectureError,
     die,
     execute,
+    is_progress_bar,
     list_notebooks,
     live_figures,
     output_figures,
@@ -91,6 +93,14 @@ def inline_figures(nb, chapter: str) -> int:
     for ci, cell in enumerate(nb.cells):
         if cell.cell_type != "code":
             continue
+        bars = [
+            o
+            for o in cell.get("outputs", [])
+            if WIDGET_MIME in o.get("data", {})
+            and is_progress_bar(o["data"][WIDGET_MIME]["model_id"], states)
+        ]
+        if bars:  # a progress bar means nothing on a static page
+            cell["outputs"] = [o for o in cell["outputs"] if not any(o is b for b in bars)]
         for oi, out in enumerate(cell.get("outputs", [])):
             figs, widget = output_figures(out, states, live)
             note = ""

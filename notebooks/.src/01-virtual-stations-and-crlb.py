@@ -150,7 +150,7 @@ line_figure(
 ).show()
 print(f"ratio range: {np.min(b_paper / b_fixed):.3f} … {np.max(b_paper / b_fixed):.3f}")
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 3. The bound over the whole tunnel
 #
 # $\mathrm{RMSE} \ge \sqrt{\operatorname{tr}(F^{-1})}$ (eq. 28, A17). Move the sliders: the angle
@@ -158,7 +158,7 @@ print(f"ratio range: {np.min(b_paper / b_fixed):.3f} … {np.max(b_paper / b_fix
 # term does not, so far from the base station the bound is set by DOA. Tick *LOS path too* to add
 # the direct path from the BS as a third station.
 
-# %%
+# %% tags=["explorer"]
 crlb_explorer()
 
 # %% [markdown]

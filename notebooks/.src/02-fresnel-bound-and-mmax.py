@@ -295,7 +295,7 @@ table_design = fresnel.design_report(design, title="SR-NF design table (W = 5 m,
 print(table_design.to_table())
 mmax_range_figure(50.0, 5.0, -1.75, 28e9, 0.15, 64, z_u=-3.3).show()
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 6. Explore
 #
 # Drag the sliders (they update on release). Panel (a) is Fig. 2 for the current geometry,
@@ -304,7 +304,7 @@ mmax_range_figure(50.0, 5.0, -1.75, 28e9, 0.15, 64, z_u=-3.3).show()
 # Fraunhofer law for reference; the star is your design ($R$, $M$). The title is the verdict from
 # the exact mismatch. $y_u$ cannot reach the wall: its maximum follows $W$.
 
-# %%
+# %% tags=["explorer"]
 explorer = mmax_explorer()
 explorer
 

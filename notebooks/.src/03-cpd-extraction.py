@@ -21,6 +21,7 @@
 
 # %%
 import numpy as np
+from tqdm.auto import tqdm
 
 import tunnelkit as tk
 from tunnelkit import channel, extraction
@@ -201,7 +202,7 @@ print("Kruskal rank (frequency, time) at tolerance 1e-6 and 1e-2:", kr)
 two = channel.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "road"))
 n_cmp = tk.mc_count(40, 8)
 cmp = {
-    m: channel.rmse_study(two, k_demo, n_cmp, seed=7, refine=m)[0]
+    m: channel.rmse_study(two, k_demo, n_cmp, seed=7, refine=m, progress=True)[0]
     for m in ("none", "column", "joint")
 }
 paths_table_figure(
@@ -230,8 +231,8 @@ paths_table_figure(
 
 # %%
 n_mc = tk.mc_count(200, 12)
-study_all = channel.rmse_study(route, k_demo, n_mc, seed=11)
-study_noceil = channel.rmse_study(two, k_demo, n_mc, seed=11)
+study_all = channel.rmse_study(route, k_demo, n_mc, seed=11, progress=True)
+study_noceil = channel.rmse_study(two, k_demo, n_mc, seed=11, progress=True)
 paths_table_figure(study_all, title=f"All paths at epoch {k_demo}, {n_mc} snapshots")
 
 # %%
@@ -259,13 +260,12 @@ step = 4 if tk.quick_mode() else 1
 origins = {}
 for model in ("srnf", "exact"):
     r_m = channel.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
-    eps = [
-        r_m.epoch(k, np.random.default_rng(100 + k)) for k in range(0, len(route.trajectory), step)
-    ]
+    ks = range(0, len(route.trajectory), step)
+    eps = [r_m.epoch(k, np.random.default_rng(100 + k)) for k in tqdm(ks, desc=model, leave=False)]
     origins[f"{model} channel"] = np.concatenate([e.measurements.wave_origins for e in eps])
 wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 8. What does the curvature measure? (M and SNR sliders)
 #
 # Theorem 3.1/3.4 (notebook 02): up to $M_{\max}$ antennas the exact channel of a reflected path
@@ -275,7 +275,7 @@ wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
 # $\hat\kappa$ of the strongest road-marking path between the two candidates; on the right, the
 # largest SR-NF phase mismatch over the aperture against $\varepsilon_\Phi = 0.15$ rad.
 
-# %%
+# %% tags=["explorer"]
 explorer = cpd_explorer()
 explorer
 

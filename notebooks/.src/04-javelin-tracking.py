@@ -61,7 +61,7 @@ n_epochs = 12 if tk.quick_mode() else None  # quick mode: the first 12 epochs (1
 straight_conditions = ("L", "N@0.5", "N", "NoRRMs")
 slalom_conditions = ("L",) if tk.quick_mode() else ("L", "N@0.5", "N")
 routes = {
-    scenario: collect_routes(scenario, conds, runs, seed, n_epochs=n_epochs)
+    scenario: collect_routes(scenario, conds, runs, seed, progress=True, n_epochs=n_epochs)
     for scenario, conds, seed in (
         ("italiano2026-straight", straight_conditions, 0),
         ("italiano2026-slalom", slalom_conditions, 1),

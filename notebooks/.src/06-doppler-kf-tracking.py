@@ -394,14 +394,14 @@ before = {
 }  # half-way to the pass
 print({k: round(v, 2) for k, v in before.items()})
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 8. Explorer: filter sigma and process noise
 #
 # Drag the filter's assumed Doppler noise $\sigma$ ($R=\sigma^2$), the process-noise density $q$ of
 # eq. 3, and the drive's true traffic bias on the Doppler. Each change reruns the three filters on
 # one seeded drive (about a second). Try $\sigma$ = 10 Hz with a 10 Hz bias, then with none.
 
-# %%
+# %% tags=["explorer"]
 explorer = doppler_explorer(sigma_hz=32.79, q=0.5, doppler_bias_hz=10.0, seed=0)
 explorer
 
