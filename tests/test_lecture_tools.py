@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import socket
 import subprocess
 import sys
@@ -212,6 +213,18 @@ def test_methods_get_distinct_markers():
     pairs = [(v["symbol"], v["color"]) for v in st.values()]
     assert len(set(pairs)) == 4 and len({v["symbol"] for v in st.values()}) == 4
     assert st["JAVELIN (ours)"]["symbol"] == "circle-open" and st["TeNFiLoc"]["symbol"] == "x"
+
+
+def test_execute_keeps_the_callers_environment(tmp_path, monkeypatch):
+    """The kernel sees the caller's environment (PATH, PYTHONPATH, ...) plus quick mode."""
+    monkeypatch.setattr(lec, "EXECUTED", tmp_path / "executed")
+    monkeypatch.setenv("TK_ENV_MARK", "kept")
+    path = tmp_path / "09-env.ipynb"
+    code = "import os\nprint(os.environ.get('TK_ENV_MARK'), os.environ.get('TUNNELKIT_QUICK'))"
+    nbformat.write(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)]), path)
+    nb = lec.execute(path, quick=True, use_cache=False, timeout=120)
+    assert nb.cells[0].outputs[0]["text"].strip() == "kept 1"
+    assert os.environ["TK_ENV_MARK"] == "kept" and "PATH" in os.environ  # restored afterwards
 
 
 def test_stop_server_ends_the_process_and_its_children(tmp_path):

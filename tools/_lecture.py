@@ -327,8 +327,9 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
             return nb
     nb = nbformat.read(path, as_version=4)
     saved = dict(os.environ)
+    env = kernel_env(quick)  # computed before the clear below, or it would start from nothing
     os.environ.clear()
-    os.environ.update(kernel_env(quick))  # the kernel inherits this process's environment
+    os.environ.update(env)  # the kernel inherits this process's environment
     try:
         nb.cells.append(nbformat.v4.new_code_cell(_DUMP_FIGURE_WIDGETS))
         client = NotebookClient(

@@ -26,6 +26,7 @@
 
 # %%
 import numpy as np
+from tqdm.auto import tqdm
 
 import tunnelkit as tk
 from tunnelkit import crlb
@@ -303,7 +304,7 @@ regime = {
     label: dp.mean_errors(
         dv.make_drive(cfg.replace(**kw)), seeds, sigma_hz=103.70, approaches=names
     )
-    for label, kw in settings.items()
+    for label, kw in tqdm(settings.items(), desc="error regimes", leave=False)
 }
 series = {n: [regime[label][n] for label in settings] for n in names}
 # headline: which-approach-wins
