@@ -158,17 +158,17 @@ def factors_figure(
     *,
     unwrapped=None,
     shape: tuple[int, int] | None = None,
-    title: str = "CPD factor matrices (normalised, eq. 12-13)",
+    title: str = "Phase [rad] of the CPD factor matrices (normalised, eq. 12-13)",
 ) -> go.Figure:
     """Phase of the three factor matrices: spatial (unwrapped, per path), frequency, time."""
     bs, bf, bt = factors
     fig = make_subplots(
         rows=1,
         cols=3,
-        subplot_titles=(
-            "spatial: unwrapped phase (eq. 16) [rad]",
-            "frequency: phase vs tone [rad]",
-            "time: phase vs symbol [rad]",
+        subplot_titles=(  # short: three panels side by side in a narrow output area
+            "(a) spatial, unwrapped (eq. 16)",
+            "(b) frequency",
+            "(c) time",
         ),
     )
     sp = unwrapped if unwrapped is not None else np.unwrap(np.angle(bs), axis=0)
