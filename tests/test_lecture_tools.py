@@ -204,6 +204,12 @@ def test_tables_render_as_html_and_size_the_plotly_export():
     assert tall - short == 18 * 22 and wrapped > short
     with pytest.raises(ValueError, match=r"^rows: row 1 has 1 values for 2 columns"):
         table(["a", "b"], [[1, 2], [3]])
+    from tunnelkit.plots import report_table
+    from tunnelkit.reproduce import Report
+
+    rep = Report("R", ["x", "y"], [["a", 0.5]], notes=["a note"], meta={"runs": 3})
+    page = report_table(rep).to_html_table()
+    assert "R (runs: 3)</caption>" in page and "<li>a note</li>" in page and page.count("<tr>") == 2
 
 
 def test_methods_get_distinct_markers():

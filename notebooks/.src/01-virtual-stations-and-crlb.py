@@ -22,7 +22,7 @@ import numpy as np
 
 import tunnelkit as tk
 from tunnelkit import crlb, geometry, positioning
-from tunnelkit.plots import line_figure, tunnel_topview
+from tunnelkit.plots import line_figure, report_table, tunnel_topview
 from tunnelkit.widgets import crlb_explorer, crlb_figure
 
 tk.setup_notebook()
@@ -212,7 +212,7 @@ fig.update_xaxes(type="log").show()
 
 # %%
 rep = tk.reproduce.run("jiang-crlb", runs=runs, seed=0)
-print(rep.to_table())
+report_table(rep)
 
 # %% [markdown]
 # ## 5. The mirror ambiguity of TOA alone

@@ -31,6 +31,7 @@ from tunnelkit.plots import (
     mismatch_figure,
     mmax_range_figure,
     ratio_map_figure,
+    report_table,
 )
 from tunnelkit.widgets import mmax_explorer, mmax_figure
 
@@ -273,7 +274,7 @@ ten = [
     dict(label="paper, z_u=-3.3", R=3.5, W=3.0, y_u=2.5, z_u=-3.3, fc=5.9e9, eps_phi=0.15),
 ]
 table10 = fresnel.design_report(ten)
-print(table10.to_table())
+report_table(table10)
 
 # %% [markdown]
 # ## 5. Design tables for 5.9 GHz and 28 GHz tunnels
@@ -292,7 +293,7 @@ design = [
     for r in (5.0, 20.0, 50.0, 100.0)
 ]
 table_design = fresnel.design_report(design, title="SR-NF design table (W = 5 m, z_u = -3.3 m)")
-print(table_design.to_table())
+report_table(table_design).show()
 mmax_range_figure(50.0, 5.0, -1.75, 28e9, 0.15, 64, z_u=-3.3).show()
 
 # %% [markdown] tags=["explorer"]

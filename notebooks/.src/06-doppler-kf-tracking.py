@@ -40,6 +40,7 @@ from tunnelkit.plots import (
     pcrlb_figure,
     profiles_figure,
     regime_figure,
+    report_table,
 )
 from tunnelkit.reproduce.halili import halili_report, pooled_errors
 from tunnelkit.tracking import doppler as dp
@@ -272,7 +273,7 @@ error_time_figure(drive, {k: v.position for k, v in tracks.items()}).show()
 runs = tk.mc_count(20, 3)
 errs = pooled_errors(runs, seed=0, progress=True)
 report = halili_report(errs)
-print(report.to_table())
+report_table(report)
 
 # %%
 p90_paper = {(r["approach"], r["sigma"]): r["p90_m"] for r in tk.reference.load("halili2022_p90")}

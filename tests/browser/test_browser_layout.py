@@ -4,11 +4,10 @@ Measured in the DOM of each chapter page (quick mode) at a wide (1400 px) and a 
 viewport, as a laptop's JupyterLab output area is, per figure:
 
 * the figure is not wider than its output area (a fixed-width figure is cut there);
-* each legend box (``g.legend*`` > ``rect.bg``) lies inside the figure's SVG — a legend pushed past
-  the edge is clipped ("wa" for "wall");
-* each title — the figure title and subtitle, subplot titles (annotations whose text is also a
-  layout annotation with ``xref="paper"`` at the top of a subplot) and axis titles — lies inside
-  the figure's SVG;
+* each legend box (``g.legend*`` > ``rect.bg``) lies inside the visible figure (its SVG, cut by
+  any clipping ancestor and the page) — a legend pushed past the edge is clipped ("wa" for "wall");
+* each title — the figure title and subtitle, subplot titles (annotations anchored at their
+  bottom above a subplot, ``xref=yref="paper"``) and axis titles — lies inside the visible figure;
 * no two titles overlap, and no title overlaps a legend.
 
 A tolerance of 1 px absorbs sub-pixel rounding. The screenshots of each chapter go to

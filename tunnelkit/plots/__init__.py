@@ -34,6 +34,7 @@ from .javelin import (
 )
 from .tables import (
     TableFigure,
+    report_table,
     table,
 )
 from .topview import (
@@ -77,6 +78,7 @@ __all__ = [
     "profiles_figure",
     "ratio_map_figure",
     "regime_figure",
+    "report_table",
     "rmse_bound_figure",
     "table",
     "table_figure",

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-__all__ = ["TableFigure", "table"]
+__all__ = ["TableFigure", "report_table", "table"]
 
 _ROW_PX, _HEADER_PX, _CHAR_PX, _TITLE_PX = 22, 26, 7.2, 36
 
@@ -40,7 +40,13 @@ def _numeric(text: str) -> bool:
 class TableFigure(go.Figure):
     """A plotly table figure that a notebook displays as an HTML table (see module docstring)."""
 
-    def __init__(self, columns: Sequence[str], cells: Sequence[Sequence[str]], title: str = ""):
+    def __init__(
+        self,
+        columns: Sequence[str],
+        cells: Sequence[Sequence[str]],
+        title: str = "",
+        notes: Sequence[str] = (),
+    ):
         columns = [str(c) for c in columns]
         cells = [[str(v) for v in col] for col in cells]
         n_rows = len(cells[0]) if cells else 0
@@ -56,6 +62,7 @@ class TableFigure(go.Figure):
             margin={"l": 10, "r": 10, "t": _TITLE_PX + 4 if title else 4, "b": 4},
         )
         self._tk_columns, self._tk_cells, self._tk_title = columns, cells, title
+        self._tk_notes = [str(n) for n in notes]
 
     def to_html_table(self) -> str:
         """The table as an HTML fragment (a caption, a header row, one row per row)."""
@@ -77,9 +84,11 @@ class TableFigure(go.Figure):
             if self._tk_title
             else ""
         )
+        notes = "".join(f"<li>{html.escape(n)}</li>" for n in self._tk_notes)
         return (
             f'<table class="tk-table">{cap}<thead><tr>{head}</tr></thead>'
             f"<tbody>{rows}</tbody></table>"
+            + (f'<ul class="tk-notes">{notes}</ul>' if notes else "")
         )
 
     def _repr_html_(self) -> str:
@@ -121,11 +130,21 @@ def table(
     *,
     title: str = "",
     fmt: Callable[[Any], str] = _fmt_default,
+    notes: Sequence[str] = (),
 ) -> TableFigure:
-    """A :class:`TableFigure` from row sequences, each value formatted by ``fmt``."""
+    """A :class:`TableFigure` from row sequences, each value formatted by ``fmt``; ``notes`` are
+    listed under the HTML table."""
     columns = list(columns)
     for i, r in enumerate(rows):
         if len(r) != len(columns):
             raise ValueError(f"rows: row {i} has {len(r)} values for {len(columns)} columns")
     cells = [[fmt(r[i]) for r in rows] for i in range(len(columns))]
-    return TableFigure(columns, cells, title)
+    return TableFigure(columns, cells, title, notes)
+
+
+def report_table(report) -> TableFigure:
+    """A :class:`tunnelkit.reproduce.Report` (what ``tunnelkit reproduce`` prints as text) as a
+    table: its title with its settings, its rows, its notes."""
+    meta = ", ".join(f"{k}: {v}" for k, v in report.meta.items())
+    title = f"{report.title} ({meta})" if meta else report.title
+    return table(report.columns, report.rows, title=title, notes=report.notes)
