@@ -1,4 +1,4 @@
-# tunnelkit — every command a newcomer needs. `make test` and `make lab` work from a fresh clone.
+# tunnelkit — every command a newcomer needs. `make lab` and `make test` work from a fresh clone.
 SHELL := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 PYTHON ?= python3
@@ -24,17 +24,22 @@ include make/rt.mk
 
 help:
 	@echo "make lab     create .venv if needed, install, register the kernel, open JupyterLab on notebooks/"
-	@echo "make test    create .venv if needed, install, lint, unit tests and every notebook in quick mode"
+	@echo "             QUICK=1 make lab: quick mode (small Monte-Carlo counts); PYTHON=python3.12: another Python"
+	@echo "make test    the CI check: lint, unit tests, every notebook in quick mode, browser tests"
 	@echo "make present NB=02   one notebook as a Voila dashboard on 127.0.0.1 (code hidden)"
+	@echo "             VIEW=explorers: only its interactive explorers"
 	@echo "make site    execute every notebook into a static HTML site in build/site/ (QUICK=1 for quick mode)"
 	@echo "make figures headline figures as PNG and SVG in build/figures/ (QUICK=1 for quick mode)"
 	@echo "make browser Playwright + Chromium tests of the dashboard and the site (part of make test)"
-	@echo "make rt-deps Sionna RT extra and Debian's libllvm19 (part of make test)"
+	@echo "make rt-deps Sionna RT extra and Debian's libllvm19, needed by notebook 07 (part of make test)"
 	@echo "make bench   benchmarks (medians and ratios measured in one run)"
 	@echo "make format  ruff formatting; rebuild notebooks/*.ipynb from notebooks/.src/*.py without outputs"
 	@echo "make clean   remove .venv and caches"
 
 $(STAMP): pyproject.toml
+	@test -x $(PY) || $(PYTHON) -c 'import sys; sys.exit(not (3, 11) <= sys.version_info[:2] <= (3, 13))' \
+	  || { echo "tunnelkit needs Python 3.11-3.13; $(PYTHON) is $$($(PYTHON) -V 2>&1)." \
+	       "Point make at another one: PYTHON=python3.12 make lab" >&2; exit 1; }
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip 2>&1 | sed '/is ignored/d'
 	$(PY) -m pip install --quiet -e '.[lab,dev,lecture]' 2>&1 | $(PIP_FILTER)
@@ -46,6 +51,7 @@ install: $(STAMP)
 # jupytext must be allowed to write them when a notebook is saved.
 lab: install
 	$(PY) -m ipykernel install --sys-prefix --name $(KERNEL) --display-name "$(KERNEL_DISPLAY)" >/dev/null
+	@echo "JupyterLab on notebooks/ in $(if $(filter-out 0,$(QUICK)),quick mode (QUICK=1),full mode (QUICK=1 for quick mode))"
 	$(if $(filter-out 0,$(QUICK)),TUNNELKIT_QUICK=1) $(VENV)/bin/jupyter lab $(LAB_ROOT) \
 	  --ContentsManager.allow_hidden=True notebooks/
 

@@ -2,6 +2,7 @@
 # and the browser tests of both. Included from the Makefile, whose $(PY), $(VENV) and $(STAMP) it uses.
 #
 #   make present NB=02 [PORT=8866] [QUICK=1]   Voila on 127.0.0.1 (code hidden, widgets live)
+#   make present NB=02 VIEW=explorers          only the explorers (cells tagged "explorer")
 #   make site [QUICK=1]                         execute every notebook -> build/site/index.html
 #   make figures [QUICK=1]                      headline figures -> build/figures/<notebook>/*.png|svg
 #   make browser                                Playwright + Chromium tests of Voila and the site
@@ -12,6 +13,7 @@
 
 NB ?= 02
 PORT ?=
+VIEW ?= all
 QUICK ?=
 CHROMIUM := /usr/bin/chromium
 LECTURE_QUICK = $(if $(filter-out 0,$(QUICK)),--quick)
@@ -19,7 +21,7 @@ LECTURE_QUICK = $(if $(filter-out 0,$(QUICK)),--quick)
 .PHONY: present site figures browser chromium
 
 present: install
-	$(PY) tools/present.py $(NB) $(if $(PORT),--port $(PORT)) $(LECTURE_QUICK)
+	$(PY) tools/present.py $(NB) --view '$(VIEW)' $(if $(PORT),--port $(PORT)) $(LECTURE_QUICK)
 
 site: install
 	$(PY) tools/site.py $(LECTURE_QUICK)

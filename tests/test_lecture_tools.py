@@ -1,10 +1,12 @@
 """Lecture tools without a browser or a kernel: notebook names, ports, servers stopped by pid,
-figures read back from saved widget state, headline marks, static-site figure inlining."""
+figures read back from saved widget state, headline marks, static-site figure inlining, the
+explorers view, the notebook/source sync check, HTML tables and per-method markers."""
 
 from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import socket
 import subprocess
 import sys
@@ -91,6 +93,144 @@ def test_present_bad_input_exits_2_without_starting_anything(capsys):
             present.main([lec.list_notebooks()[0].stem[:2], "--port", str(s.getsockname()[1])]) == 2
         )
     assert "already in use" in capsys.readouterr().err
+
+
+def test_present_unknown_view_or_no_explorer_exits_2_writing_nothing(capsys, tmp_path):
+    present = load_tool("present")
+    before = set((lec.BUILD / "present").glob("*")) if (lec.BUILD / "present").exists() else set()
+    assert present.main(["02", "--view", "nonsense"]) == 2
+    assert "unknown view 'nonsense'" in capsys.readouterr().err
+    assert present.main(["99", "--view", "explorers"]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    nb = nbformat.v4.new_notebook(
+        cells=[nbformat.v4.new_code_cell("import tunnelkit as tk\ntk.setup_notebook()")]
+    )
+    path = tmp_path / "09-none.ipynb"
+    nbformat.write(nb, path)
+    with pytest.raises(lec.LectureError, match="no code cell tagged 'explorer'"):
+        lec.explorers_notebook(path, tmp_path / "out")
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    after = set((lec.BUILD / "present").glob("*")) if (lec.BUILD / "present").exists() else set()
+    assert after == before
+
+
+def test_explorers_notebook_keeps_setup_and_tagged_cells_only(tmp_path):
+    v4 = nbformat.v4
+    cells = [
+        v4.new_markdown_cell("# 09 · A chapter\n\ntext"),
+        v4.new_code_cell("import tunnelkit as tk\ntk.setup_notebook()"),
+        v4.new_code_cell("slow = sum(range(10))"),
+        v4.new_code_cell("data = [1, 2]\nprint('noisy')", metadata={"tags": ["explorer-setup"]}),
+        v4.new_markdown_cell("## Explore", metadata={"tags": ["explorer"]}),
+        v4.new_code_cell("explorer(data)", metadata={"tags": ["explorer"]}),
+        v4.new_markdown_cell("## Checks"),
+        v4.new_code_cell("assert slow == 45"),
+    ]
+    path = tmp_path / "09-chapter.ipynb"
+    nbformat.write(v4.new_notebook(cells=cells), path)
+    out = lec.explorers_notebook(path, tmp_path / "present")
+    assert out == tmp_path / "present" / "09-chapter.explorers.ipynb"
+    got = nbformat.read(out, as_version=4)
+    src = ["".join(c.source) for c in got.cells]
+    assert src[0].startswith("# 09 · A chapter: the explorers")
+    assert src[1:] == [
+        "import tunnelkit as tk\ntk.setup_notebook()",
+        "%%capture\ndata = [1, 2]\nprint('noisy')",
+        "## Explore",
+        "explorer(data)",
+    ]
+    assert [p.name for p in (tmp_path / "present").iterdir()] == [out.name]  # no temporary left
+
+
+def _pair(root: Path, text: str) -> Path:
+    """A notebooks/ folder with one notebook built from a percent source by check_notebooks."""
+    (root / ".src").mkdir(parents=True)
+    repo_config = lec.NOTEBOOKS / ".jupytext.toml"  # the workbook's own pairing
+    (root / ".jupytext.toml").write_text(repo_config.read_text())
+    (root / ".src" / "09-pair.py").write_text(text)
+    return root / "09-pair.ipynb"
+
+
+PAIRED = (
+    "# %% [markdown]\n# # 09 · Pair\n\n# %%\nimport tunnelkit as tk\n\ntk.setup_notebook()\n\n"
+    "# %% [markdown]\n# ## Checks\n\n# %%\nassert 1 + 1 == 2\n"
+)
+
+
+def test_notebook_and_source_sync_is_checked_and_rebuilt(tmp_path, capsys):
+    check = load_tool("check_notebooks")
+    nbdir = tmp_path / "notebooks"
+    nb = _pair(nbdir, PAIRED)
+    assert check.main(["--build", str(nbdir)]) == 0
+    built = json.loads(nb.read_text())
+    assert built["metadata"]["kernelspec"]["name"] == "python3"
+    ids = [c["id"] for c in built["cells"]]
+    capsys.readouterr()
+    # the source changes, the notebook does not: a clear message naming both, exit 1, no write
+    src = nbdir / ".src" / "09-pair.py"
+    src.write_text(PAIRED.replace("1 + 1 == 2", "2 + 2 == 4"))
+    stamp = nb.read_text()
+    assert check.main([str(nbdir)]) == 1
+    out = capsys.readouterr().out
+    assert f"{nb}: disagrees with its source {src}" in out and "make format" in out
+    assert nb.read_text() == stamp
+    # --build brings it back in line, keeping the cell ids
+    assert check.main(["--build", str(nbdir)]) == 0
+    assert [c["id"] for c in json.loads(nb.read_text())["cells"]] == ids
+    assert "2 + 2 == 4" in nb.read_text()
+    # a wrong kernelspec and a source without a notebook are named too
+    bad = json.loads(nb.read_text())
+    bad["metadata"]["kernelspec"]["name"] = "tunnelkit"
+    nb.write_text(json.dumps(bad, indent=1))
+    (nbdir / ".src" / "10-orphan.py").write_text(PAIRED)
+    capsys.readouterr()
+    assert check.main([str(nbdir)]) == 1
+    out = capsys.readouterr().out
+    assert "kernelspec name 'tunnelkit', expected 'python3'" in out
+    assert "10-orphan.py: a source without its notebook" in out
+
+
+def test_tables_render_as_html_and_size_the_plotly_export():
+    from tunnelkit.plots import javelin_table_figure, table
+
+    t = javelin_table_figure(["a", "b"], [["x", 1.234], ["y", None]], title="T <1>")
+    assert list(t.data[0].cells.values[1]) == ["1.23", "-"]
+    html_text = t._repr_mimebundle_()["text/html"]
+    assert html_text.count("<tr>") == 3 and "T &lt;1&gt;" in html_text
+    assert '<td style="text-align:right">1.23</td>' in html_text  # numbers right-aligned
+    short = table(["a"], [[1.0]] * 2).layout.height
+    tall = table(["a"], [[1.0]] * 20).layout.height
+    wrapped = table(["a", "b"], [["w" * 400, 1.0]] * 2).layout.height
+    assert tall - short == 18 * 22 and wrapped > short
+    with pytest.raises(ValueError, match=r"^rows: row 1 has 1 values for 2 columns"):
+        table(["a", "b"], [[1, 2], [3]])
+    from tunnelkit.plots import report_table
+    from tunnelkit.reproduce import Report
+
+    rep = Report("R", ["x", "y"], [["a", 0.5]], notes=["a note"], meta={"runs": 3})
+    page = report_table(rep).to_html_table()
+    assert "R (runs: 3)</caption>" in page and "<li>a note</li>" in page and page.count("<tr>") == 2
+
+
+def test_methods_get_distinct_markers():
+    from tunnelkit.plots.javelin import method_styles
+
+    st = method_styles(["JAVELIN (ours)", "JAVELIN (paper)", "TeNFiLoc", "TeNFiLoc-N"])
+    pairs = [(v["symbol"], v["color"]) for v in st.values()]
+    assert len(set(pairs)) == 4 and len({v["symbol"] for v in st.values()}) == 4
+    assert st["JAVELIN (ours)"]["symbol"] == "circle-open" and st["TeNFiLoc"]["symbol"] == "x"
+
+
+def test_execute_keeps_the_callers_environment(tmp_path, monkeypatch):
+    """The kernel sees the caller's environment (PATH, PYTHONPATH, ...) plus quick mode."""
+    monkeypatch.setattr(lec, "EXECUTED", tmp_path / "executed")
+    monkeypatch.setenv("TK_ENV_MARK", "kept")
+    path = tmp_path / "09-env.ipynb"
+    code = "import os\nprint(os.environ.get('TK_ENV_MARK'), os.environ.get('TUNNELKIT_QUICK'))"
+    nbformat.write(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)]), path)
+    nb = lec.execute(path, quick=True, use_cache=False, timeout=120)
+    assert nb.cells[0].outputs[0]["text"].strip() == "kept 1"
+    assert os.environ["TK_ENV_MARK"] == "kept" and "PATH" in os.environ  # restored afterwards
 
 
 def test_stop_server_ends_the_process_and_its_children(tmp_path):
@@ -224,3 +364,17 @@ def test_site_inlines_explorers_as_snapshots_with_a_note():
     (only,) = no_fig.cells[0].outputs[0]["data"].values()
     assert "tk-static-note" in only and "Plotly.newPlot" not in only
     assert "widgets" not in with_fig.metadata and "widgets" not in no_fig.metadata
+
+
+def test_site_drops_progress_bars():
+    import ipywidgets as widgets
+
+    site = load_tool("site")
+    fw = go.FigureWidget(go.Scatter(x=[1, 2], y=[3, 4]))
+    bar = widgets.HBox([widgets.HTML("runs"), widgets.FloatProgress(value=3, max=10)])
+    nb = nbformat.from_dict(_saved_widget_notebook(fw, bar, "for r in tqdm(runs): ..."))
+    nb.cells[0].outputs.append(nbformat.v4.new_output("stream", name="stdout", text="done\n"))
+    assert site.inline_figures(nb, "05") == 0
+    assert [o.get("text") for o in nb.cells[0].outputs] == ["done\n"]  # the bar is gone
+    # a bar closed since it was displayed (tqdm's leave=False) is not in the saved state
+    assert lec.is_progress_bar("no-such-model", {}) is True

@@ -78,6 +78,62 @@ def resolve_notebook(name: str, directory: Path = NOTEBOOKS) -> Path:
     raise LectureError(f"notebook {name!r} {why}; notebooks in {directory}: {known}")
 
 
+EXPLORER_TAG = "explorer"
+EXPLORER_SETUP_TAG = "explorer-setup"
+VIEWS = ("all", "explorers")
+
+
+def _tags(cell) -> list[str]:
+    return list(cell.get("metadata", {}).get("tags", []))
+
+
+def explorers_notebook(path: Path, out_dir: Path | None = None) -> Path:
+    """A reduced copy of a notebook for a lecture: its setup cell, then only the cells tagged
+    ``explorer`` (the explorers and the text that introduces them).
+
+    Cells tagged ``explorer-setup`` (what an explorer needs from earlier cells) run too, their
+    output captured. Written whole to ``build/present/<name>.explorers.ipynb``; raises
+    LectureError, writing nothing, when the notebook tags no explorer.
+    """
+    import nbformat
+
+    nb = nbformat.read(path, as_version=4)
+    cells = nb.cells
+    code = [i for i, c in enumerate(cells) if c.cell_type == "code"]
+    picked = [i for i, c in enumerate(cells) if EXPLORER_TAG in _tags(c)]
+    if not code or not any(cells[i].cell_type == "code" for i in picked):
+        src = path.parent / ".src" / f"{path.stem}.py"
+        raise LectureError(
+            f"{path.name} has no code cell tagged {EXPLORER_TAG!r}, so VIEW=explorers has nothing "
+            f"to show (tag a cell in {src.relative_to(ROOT) if src.is_relative_to(ROOT) else src}: "
+            f'`# %% tags=["{EXPLORER_TAG}"]`); VIEW=all serves the whole notebook'
+        )
+    title = title_of(nb, path.stem)
+    out_cells = [
+        nbformat.v4.new_markdown_cell(
+            f"# {title}: the explorers\n\nOnly the interactive parts of `{path.name}`; the whole "
+            f"chapter is `make present NB={path.stem.split('-', 1)[0]}`."
+        )
+    ]
+    for i, c in enumerate(cells):
+        tags = _tags(c)
+        if i == code[0] or EXPLORER_TAG in tags:
+            out_cells.append(c)
+        elif EXPLORER_SETUP_TAG in tags and c.cell_type == "code":
+            quiet = nbformat.v4.new_code_cell("%%capture\n" + _source(c))
+            out_cells.append(quiet)
+    reduced = nbformat.v4.new_notebook(cells=out_cells, metadata=nb.metadata)
+    for k, c in enumerate(reduced.cells):
+        c["id"] = f"explorers-{k:03d}"
+    out_dir = out_dir or BUILD / "present"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    target = out_dir / f"{path.stem}.explorers.ipynb"
+    tmp = target.with_name(f".{target.name}.tmp")
+    nbformat.write(reduced, tmp)
+    tmp.replace(target)
+    return target
+
+
 def title_of(nb: dict[str, Any], fallback: str) -> str:
     """The first markdown heading of a notebook (its chapter title)."""
     for cell in nb.get("cells", []):
@@ -271,8 +327,9 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
             return nb
     nb = nbformat.read(path, as_version=4)
     saved = dict(os.environ)
+    env = kernel_env(quick)  # computed before the clear below, or it would start from nothing
     os.environ.clear()
-    os.environ.update(kernel_env(quick))  # the kernel inherits this process's environment
+    os.environ.update(env)  # the kernel inherits this process's environment
     try:
         nb.cells.append(nbformat.v4.new_code_cell(_DUMP_FIGURE_WIDGETS))
         client = NotebookClient(
@@ -393,6 +450,16 @@ def output_figures(
     if WIDGET_MIME in data:
         return widget_figures(data[WIDGET_MIME]["model_id"], states, live), True
     return [], False
+
+
+def is_progress_bar(model_id: str, states: dict[str, dict[str, Any]]) -> bool:
+    """True for a tqdm progress bar (an HBox holding a FloatProgress) or a widget closed since it
+    was displayed (tqdm's ``leave=False`` bars): outputs a static page should drop."""
+    if model_id not in states:
+        return True
+    children = states[model_id].get("state", {}).get("children", []) or []
+    kids = [str(c).removeprefix("IPY_MODEL_") for c in children]
+    return any(states.get(k, {}).get("model_name") == "FloatProgressModel" for k in kids)
 
 
 def figures_of(nb) -> list[FoundFigure]:

@@ -7,7 +7,8 @@
 * the first code cell imports tunnelkit and calls ``tk.setup_notebook()``;
 * a markdown cell headed "Checks" followed by code that asserts.
 
-``--build`` rewrites each notebook from its source (cell ids, metadata kept; outputs dropped);
+``--build`` rewrites each notebook from its source (cell ids and tags kept; outputs, execution
+counts and the metadata JupyterLab adds on save dropped);
 ``--strip`` only removes outputs. Files are replaced whole (written to a temporary file, then
 renamed), so an interrupted run leaves no half-written notebook. Exit status 1 with one line per
 problem.
@@ -96,9 +97,11 @@ def build(src: Path) -> Path:
     nb = jupytext.read(src, fmt=_fmt(), config=_config(src))
     if target.exists():
         nb = combine_inputs_with_outputs(nb, jupytext.read(target), fmt=_fmt())
-    nb.metadata["kernelspec"] = dict(KERNELSPEC)
-    nb.metadata.setdefault("language_info", {"name": "python"})
-    nb.metadata.pop("jupytext", None)
+    # what JupyterLab adds on save (language_info details, widget state) is dropped: the
+    # committed notebook carries only the kernel it runs on
+    nb.metadata = nbformat.from_dict(
+        {"kernelspec": dict(KERNELSPEC), "language_info": {"name": "python"}}
+    )
     for cell in nb.cells:
         if cell.cell_type == "code":
             cell.outputs, cell.execution_count = [], None

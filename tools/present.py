@@ -2,11 +2,14 @@
 
     python tools/present.py 02            # free port, full mode
     python tools/present.py 02 --port 8866 --quick
+    python tools/present.py 02 --view explorers   # only the cells tagged "explorer"
 
 The notebook is executed by Voila's kernel when the page opens; explorers build their figure with
 its initial state before display, so the page shows the right state when it connects. Ctrl-C (or
-SIGTERM) stops Voila and its kernel. Exit status 2 for an unknown notebook or a port in use, 1 when
-Voila does not come up.
+SIGTERM) stops Voila and its kernel. ``--view explorers`` serves a reduced copy of the notebook
+(``build/present/NN-name.explorers.ipynb``: the setup cell and the cells tagged ``explorer``).
+Exit status 2 for an unknown notebook or view, a notebook without explorers, or a port in use; 1
+when Voila does not come up.
 """
 
 from __future__ import annotations
@@ -21,9 +24,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _lecture import (
     BUILD,
     HOST,
+    VIEWS,
     LectureError,
     check_port,
     die,
+    explorers_notebook,
     free_port,
     kernel_env,
     resolve_notebook,
@@ -62,10 +67,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--timeout", type=float, default=90.0, help="seconds to wait for Voila to answer"
     )
+    ap.add_argument(
+        "--view",
+        default="all",
+        help=f"what to serve: {' or '.join(VIEWS)} (only the cells tagged 'explorer')",
+    )
     args = ap.parse_args(argv)
     try:
+        if args.view not in VIEWS:
+            raise LectureError(f"unknown view {args.view!r}; choose one of: {', '.join(VIEWS)}")
         nb = resolve_notebook(args.notebook)
         port = check_port(args.port) if args.port is not None else free_port()
+        if args.view == "explorers":
+            nb = explorers_notebook(nb)
     except LectureError as exc:
         return die(str(exc))
     url = f"http://{HOST}:{port}/"
@@ -83,7 +97,9 @@ def main(argv: list[str] | None = None) -> int:
         wait_http(url + "api", proc, args.timeout)
         mode = "quick" if args.quick else "full"
         print(
-            f"presenting {nb.name} ({mode} mode) at {url}  (log: {log}; Ctrl-C to stop)", flush=True
+            f"presenting {nb.name} ({mode} mode, view {args.view}) at {url}  "
+            f"(log: {log}; Ctrl-C to stop)",
+            flush=True,
         )
         proc.wait()
         return die(f"Voila exited with code {proc.returncode}; see {log}", 1)

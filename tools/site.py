@@ -2,6 +2,7 @@
 
     python tools/site.py            # full mode: the papers' Monte-Carlo counts
     python tools/site.py --quick    # TUNNELKIT_QUICK=1: small counts, as in CI
+    python tools/site.py --quick 02 06   # only these chapters (the index lists only them)
 
 Plotly figures stay interactive (zoom, pan, hover) without a kernel: each figure is written as a
 ``Plotly.newPlot`` call and plotly.js is shipped once in ``static/`` (no CDN). An explorer's live
@@ -24,12 +25,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _lecture import (
     BUILD,
+    WIDGET_MIME,
     LectureError,
     die,
     execute,
+    is_progress_bar,
     list_notebooks,
     live_figures,
     output_figures,
+    resolve_notebook,
     title_of,
     widget_states,
 )
@@ -89,6 +93,14 @@ def inline_figures(nb, chapter: str) -> int:
     for ci, cell in enumerate(nb.cells):
         if cell.cell_type != "code":
             continue
+        bars = [
+            o
+            for o in cell.get("outputs", [])
+            if WIDGET_MIME in o.get("data", {})
+            and is_progress_bar(o["data"][WIDGET_MIME]["model_id"], states)
+        ]
+        if bars:  # a progress bar means nothing on a static page
+            cell["outputs"] = [o for o in cell["outputs"] if not any(o is b for b in bars)]
         for oi, out in enumerate(cell.get("outputs", [])):
             figs, widget = output_figures(out, states, live)
             note = ""
@@ -204,6 +216,7 @@ def _render(args: tuple) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("notebooks", nargs="*", help="chapter numbers or names (default: all)")
     ap.add_argument(
         "--quick", action="store_true", help="TUNNELKIT_QUICK=1 (small Monte-Carlo counts)"
     )
@@ -215,7 +228,10 @@ def main(argv: list[str] | None = None) -> int:
         "--jobs", type=int, default=2, help="notebooks executed in parallel (default 2)"
     )
     args = ap.parse_args(argv)
-    books = list_notebooks()
+    try:
+        books = [resolve_notebook(n) for n in args.notebooks] or list_notebooks()
+    except LectureError as exc:
+        return die(str(exc))
     if not books:
         return die("no notebooks in notebooks/")
     t0 = time.perf_counter()

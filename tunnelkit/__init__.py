@@ -11,6 +11,7 @@ widgets, reference, reproduce`` (all).
 from __future__ import annotations
 
 import importlib
+from pathlib import Path
 from typing import Any
 
 from .montecarlo import QUICK, mc_count, quick_mode
@@ -21,6 +22,7 @@ __version__ = "0.1.0"
 __all__ = [
     "QUICK",
     "__version__",
+    "build_dir",
     "list_scenarios",
     "load_scenario",
     "mc_count",
@@ -43,12 +45,12 @@ def __getattr__(name: str) -> Any:
     return module
 
 
-def setup_notebook(*, renderer: str | None = None) -> dict[str, Any]:
+def setup_notebook(*, renderer: str | None = None) -> None:
     """The one setup call every notebook makes after ``import tunnelkit as tk``.
 
     Sets a plotly renderer that works both in JupyterLab and when the notebook is executed
-    headless (CI, static site), and prints the package version and whether quick mode is on.
-    Returns the settings so a Checks cell can assert on them.
+    headless (CI, static site) and prints one line: the package version and whether quick mode
+    is on. Returns None, so the call is not echoed as a cell result.
     """
     import plotly.io as pio
 
@@ -59,4 +61,16 @@ def setup_notebook(*, renderer: str | None = None) -> dict[str, Any]:
     pio.templates.default = "plotly_white"
     mode = "quick (TUNNELKIT_QUICK=1: Monte-Carlo counts shrunk for CI)" if quick_mode() else "full"
     print(f"tunnelkit {__version__} · mode: {mode}")
-    return {"version": __version__, "quick": quick_mode(), "renderer": pio.renderers.default}
+
+
+def build_dir(*parts: str) -> Path:
+    """A directory under the repository's ``build/`` (created), for files a notebook writes.
+
+    The repository is the nearest directory at or above the working directory that holds
+    ``pyproject.toml`` (a notebook runs in ``notebooks/``); elsewhere ``./build``.
+    """
+    here = Path.cwd().resolve()
+    root = next((p for p in (here, *here.parents) if (p / "pyproject.toml").is_file()), here)
+    out = root.joinpath("build", *parts)
+    out.mkdir(parents=True, exist_ok=True)
+    return out

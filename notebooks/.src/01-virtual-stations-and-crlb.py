@@ -2,7 +2,9 @@
 # # 01 · Virtual stations and the Cramér–Rao bound
 #
 # *Jiang, Wang & Peng (2023), "A Single-Site Vehicle Positioning Method in the Rectangular Tunnel
-# Environment", sections 2, 3 and 4.1, Appendix A.*
+# Environment", Remote Sensing 15, 527, [doi:10.3390/rs15020527](https://doi.org/10.3390/rs15020527),
+# sections 2, 3 and 4.1, Appendix A.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -20,7 +22,7 @@ import numpy as np
 
 import tunnelkit as tk
 from tunnelkit import crlb, geometry, positioning
-from tunnelkit.plots import line_figure, tunnel_topview
+from tunnelkit.plots import line_figure, report_table, tunnel_topview
 from tunnelkit.widgets import crlb_explorer, crlb_figure
 
 tk.setup_notebook()
@@ -148,7 +150,7 @@ line_figure(
 ).show()
 print(f"ratio range: {np.min(b_paper / b_fixed):.3f} … {np.max(b_paper / b_fixed):.3f}")
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 3. The bound over the whole tunnel
 #
 # $\mathrm{RMSE} \ge \sqrt{\operatorname{tr}(F^{-1})}$ (eq. 28, A17). Move the sliders: the angle
@@ -156,7 +158,7 @@ print(f"ratio range: {np.min(b_paper / b_fixed):.3f} … {np.max(b_paper / b_fix
 # term does not, so far from the base station the bound is set by DOA. Tick *LOS path too* to add
 # the direct path from the BS as a third station.
 
-# %%
+# %% tags=["explorer"]
 crlb_explorer()
 
 # %% [markdown]
@@ -210,7 +212,7 @@ fig.update_xaxes(type="log").show()
 
 # %%
 rep = tk.reproduce.run("jiang-crlb", runs=runs, seed=0)
-print(rep.to_table())
+report_table(rep)
 
 # %% [markdown]
 # ## 5. The mirror ambiguity of TOA alone
@@ -279,8 +281,11 @@ line_figure(
 # 1. Near the walls' *station line* the range gradients of the two virtual stations are
 #    (anti)parallel, so range says little about the along-track coordinate; the smallest bound is a
 #    few metres along the tunnel, where range and bearing gradients are closest to orthogonal.
-# 2. `np.median(crlb_map(...))` with `np.vstack([bs, vs])` as stations; the direct path is the
-#    shortest, so its bearing is the most informative.
+# 2. `crlb_map` lives in `tunnelkit.widgets.crlb` (it is what the explorer above draws):
+#    `from tunnelkit.widgets.crlb import crlb_map`, then compare
+#    `np.median(crlb_map(tunnel, vs, np.radians(0.5), 0.1)[2])` with the same call on
+#    `np.vstack([bs, vs])` (the BS added as a station). The direct path is the shortest, so its
+#    bearing is the most informative.
 # 3. `crlb.crlb_rmse(pts, vs, None, 0.1)` along a line of `pts`: it blows up within a few metres of
 #    the station line (the singularity seen above).
 #

@@ -1,8 +1,10 @@
 # %% [markdown]
 # # 02 · How many antennas? The SR-NF validity bound $M_{\max}$
 #
-# *Italiano et al. (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field and
-# Radio-Reflective Road Markings", section 3.1 (Theorems 3.1 and 3.4, eq. 25–42) and section 4.2.*
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# section 3.1 (Theorems 3.1 and 3.4, eq. 25–42) and section 4.2.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -29,6 +31,7 @@ from tunnelkit.plots import (
     mismatch_figure,
     mmax_range_figure,
     ratio_map_figure,
+    report_table,
 )
 from tunnelkit.widgets import mmax_explorer, mmax_figure
 
@@ -220,7 +223,10 @@ for rr, yy in ((3.5, 2.5), (3.5, -3.0), (30.0, 2.5), (30.0, -3.0)):
 # ### Where is eq. 25 tight? A map over $(R, y_u)$
 #
 # Ratio of eq. 25 to the exact $M_{\max}$ over distance and UE position (5.9 GHz, $W = 3$ m,
-# $\varepsilon_\Phi = 0.15$ rad): 1 (white) is tight, blue is conservative, red would be unsafe.
+# $\varepsilon_\Phi = 0.15$ rad), on a log colour scale centred on 1: white is tight, **red** is a
+# ratio below 1 — the bound allows fewer antennas than the exact limit, which is *conservative*
+# (safe) — and **blue** a ratio above 1, a bound that allows more antennas than the geometry
+# tolerates (*unsafe*). The paper's example in section 4.2 (ratio 0.66) is red.
 # `fresnel.mmax_exact_grid` computes the exact value for the whole grid at once.
 
 # %%
@@ -268,7 +274,7 @@ ten = [
     dict(label="paper, z_u=-3.3", R=3.5, W=3.0, y_u=2.5, z_u=-3.3, fc=5.9e9, eps_phi=0.15),
 ]
 table10 = fresnel.design_report(ten)
-print(table10.to_table())
+report_table(table10)
 
 # %% [markdown]
 # ## 5. Design tables for 5.9 GHz and 28 GHz tunnels
@@ -287,10 +293,10 @@ design = [
     for r in (5.0, 20.0, 50.0, 100.0)
 ]
 table_design = fresnel.design_report(design, title="SR-NF design table (W = 5 m, z_u = -3.3 m)")
-print(table_design.to_table())
+report_table(table_design).show()
 mmax_range_figure(50.0, 5.0, -1.75, 28e9, 0.15, 64, z_u=-3.3).show()
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 6. Explore
 #
 # Drag the sliders (they update on release). Panel (a) is Fig. 2 for the current geometry,
@@ -299,7 +305,7 @@ mmax_range_figure(50.0, 5.0, -1.75, 28e9, 0.15, 64, z_u=-3.3).show()
 # Fraunhofer law for reference; the star is your design ($R$, $M$). The title is the verdict from
 # the exact mismatch. $y_u$ cannot reach the wall: its maximum follows $W$.
 
-# %%
+# %% tags=["explorer"]
 explorer = mmax_explorer()
 explorer
 

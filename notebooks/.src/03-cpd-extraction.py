@@ -1,8 +1,10 @@
 # %% [markdown]
 # # 03 · From the tunnel to the channel tensor and back: CPD channel-parameter extraction
 #
-# *Italiano et al. (2026), "JAVELIN: near-field localization in tunnels with radio-reflective
-# road markings", sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2.*
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -19,6 +21,7 @@
 
 # %%
 import numpy as np
+from tqdm.auto import tqdm
 
 import tunnelkit as tk
 from tunnelkit import channel, evaluation, extraction, signal_route
@@ -92,6 +95,11 @@ print(
     f"clock bias = {snap.clock_bias * 1e9:.1f} ns = {snap.clock_bias * 3e8:.2f} m"
 )
 print("per-element SNR of each path [dB]:", snap.snr_db.round(1))
+doppler_res = 1 / (cfg.n_symbols * cfg.symbol_period)  # 1/(N_t T_0) [Hz]
+print(
+    f"Doppler resolution 1/(N_t T_0) = {doppler_res / 1e3:.2f} kHz "
+    f"= {doppler_res * C / cfg.fc:.0f} m/s in radial speed"
+)
 
 # %% [markdown]
 # ## 3. CPD and the three factor matrices (eq. 11–16)
@@ -116,7 +124,8 @@ factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
 # **How the CPD is computed here.** A plain `parafac(H, L, init="svd")` on the full
 # $100\times410\times12$ tensor is about ten times slower (see `benchmarks/bench_extraction.py`)
 # and, even on a noiseless tensor, stops in a wrong decomposition: the time factor hardly varies
-# between paths over 12 symbols (Doppler resolution $1/(N_tT_0) \approx 2.3$ kHz, i.e. 120 m/s),
+# between paths over 12 symbols (Doppler resolution $1/(N_tT_0) \approx 2.3$ kHz, i.e. 119 m/s,
+# printed in section 2),
 # and the frequency factor barely separates paths closer than $c/BW = 3$ m. So
 # `extract_paths` (1) compresses $\mathcal{H}$ to an $L\times L\times L$ core (truncated HOSVD),
 # (2) initialises the core's CPD algebraically from a *shift invariance* — of the URA rows
@@ -195,7 +204,7 @@ two = signal_route.SignalRoute(
 )
 n_cmp = tk.mc_count(40, 8)
 cmp = {
-    m: evaluation.rmse_study(two, k_demo, n_cmp, seed=7, refine=m)[0]
+    m: evaluation.rmse_study(two, k_demo, n_cmp, seed=7, refine=m, progress=True)[0]
     for m in ("none", "column", "joint")
 }
 paths_table_figure(
@@ -224,8 +233,8 @@ paths_table_figure(
 
 # %%
 n_mc = tk.mc_count(200, 12)
-study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11)
-study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11)
+study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11, progress=True)
+study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11, progress=True)
 paths_table_figure(study_all, title=f"All paths at epoch {k_demo}, {n_mc} snapshots")
 
 # %%
@@ -253,13 +262,12 @@ step = 4 if tk.quick_mode() else 1
 origins = {}
 for model in ("srnf", "exact"):
     r_m = signal_route.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
-    eps = [
-        r_m.epoch(k, np.random.default_rng(100 + k)) for k in range(0, len(route.trajectory), step)
-    ]
+    ks = range(0, len(route.trajectory), step)
+    eps = [r_m.epoch(k, np.random.default_rng(100 + k)) for k in tqdm(ks, desc=model, leave=False)]
     origins[f"{model} channel"] = np.concatenate([e.measurements.wave_origins for e in eps])
 wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 8. What does the curvature measure? (M and SNR sliders)
 #
 # Theorem 3.1/3.4 (notebook 02): up to $M_{\max}$ antennas the exact channel of a reflected path
@@ -269,7 +277,7 @@ wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
 # $\hat\kappa$ of the strongest road-marking path between the two candidates; on the right, the
 # largest SR-NF phase mismatch over the aperture against $\varepsilon_\Phi = 0.15$ rad.
 
-# %%
+# %% tags=["explorer"]
 explorer = cpd_explorer()
 explorer
 

@@ -1,8 +1,10 @@
 # %% [markdown]
 # # 04 · JAVELIN: tracking a vehicle and its virtual UEs with one base station
 #
-# *Italiano, Brambilla & Nicoli (2026), "JAVELIN: near-field single-anchor localization with
-# radio-reflective road markings", sections 3.2–3.5 (eq. 43–69, Algorithms 1–4) and 4.*
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# sections 3.2–3.5 (eq. 43–69, Algorithms 1–4) and 4.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -59,7 +61,7 @@ n_epochs = 12 if tk.quick_mode() else None  # quick mode: the first 12 epochs (1
 straight_conditions = ("L", "N@0.5", "N", "NoRRMs")
 slalom_conditions = ("L",) if tk.quick_mode() else ("L", "N@0.5", "N")
 routes = {
-    scenario: collect_routes(scenario, conds, runs, seed, n_epochs=n_epochs)
+    scenario: collect_routes(scenario, conds, runs, seed, progress=True, n_epochs=n_epochs)
     for scenario, conds, seed in (
         ("italiano2026-straight", straight_conditions, 0),
         ("italiano2026-slalom", slalom_conditions, 1),
@@ -133,7 +135,7 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 #
 # In this tunnel every path of an epoch arrives within about a metre of the LoS (the 100 MHz SRS
 # resolves 3 m) and within a fraction of a metre per second in Doppler (12 symbols resolve about
-# 140 m/s). Take two paths with the same delay and Doppler: their frequency and time factors are
+# 119 m/s, $c/(f_c N_t T_0)$, computed in notebook 03). Take two paths with the same delay and Doppler: their frequency and time factors are
 # the same vectors $\mathbf b_f$, $\mathbf b_t$, and in the CPD of eq. 3/11
 #
 # $$\alpha_1\,\mathbf s(\mathbf q_1)\circ\mathbf b_f\circ\mathbf b_t + \alpha_2\,\mathbf s(\mathbf q_2)\circ\mathbf b_f\circ\mathbf b_t

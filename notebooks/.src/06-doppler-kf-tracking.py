@@ -3,7 +3,8 @@
 #
 # *Halili, BniLam, Yusuf, Tanghe, Joseph, Weyn & Berkvens (2022), "Vehicle Localization Using
 # Doppler Shift and Time of Arrival Measurements in a Tunnel Environment", Sensors 22, 847,
-# sections 2–6.*
+# [doi:10.3390/s22030847](https://doi.org/10.3390/s22030847), sections 2–6.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -27,6 +28,7 @@
 
 # %%
 import numpy as np
+from tqdm.auto import tqdm
 
 import tunnelkit as tk
 from tunnelkit import crlb
@@ -40,6 +42,7 @@ from tunnelkit.plots import (
     pcrlb_figure,
     profiles_figure,
     regime_figure,
+    report_table,
 )
 from tunnelkit.reproduce.halili import halili_report, pooled_errors
 from tunnelkit.tracking import doppler as dp
@@ -286,7 +289,7 @@ error_time_figure(drive, {k: v.position for k, v in tracks.items()}).show()
 runs = tk.mc_count(20, 3)
 errs = pooled_errors(runs, seed=0, progress=True)
 report = halili_report(errs)
-print(report.to_table())
+report_table(report)
 
 # %%
 p90_paper = {(r["approach"], r["sigma"]): r["p90_m"] for r in tk.reference.load("halili2022_p90")}
@@ -318,7 +321,7 @@ regime = {
     label: dp.mean_errors(
         dv.make_drive(cfg.replace(**kw)), seeds, sigma_hz=103.70, approaches=names, **PAPER
     )
-    for label, kw in settings.items()
+    for label, kw in tqdm(settings.items(), desc="error regimes", leave=False)
 }
 series = {n: [regime[label][n] for label in settings] for n in names}
 # headline: which-approach-wins
@@ -435,14 +438,14 @@ before = {
 }  # half-way to the pass
 print({k: round(v, 2) for k, v in before.items()})
 
-# %% [markdown]
+# %% [markdown] tags=["explorer"]
 # ## 8. Explorer: filter sigma and process noise
 #
 # Drag the filter's assumed Doppler noise $\sigma$ ($R=\sigma^2$), the process-noise density $q$ of
 # eq. 3, and the drive's true traffic bias on the Doppler. Each change reruns the three filters on
 # one seeded drive (about a second). Try $\sigma$ = 10 Hz with a 10 Hz bias, then with none.
 
-# %%
+# %% tags=["explorer"]
 explorer = doppler_explorer(sigma_hz=32.79, q=0.5, doppler_bias_hz=10.0, seed=0)
 explorer
 

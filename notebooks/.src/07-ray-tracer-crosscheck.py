@@ -1,9 +1,12 @@
 # %% [markdown]
 # # 07 · Appendix: a real ray tracer beside the image method
 #
-# *Italiano et al. (2026), section 4.1: the JAVELIN tunnel, which the paper modelled in Blender and
-# ray-traced. Here the same tunnel is traced twice: by tunnelkit's image method and by Sionna RT
-# (NVIDIA, on Mitsuba 3 / Dr.Jit), an independent ray tracer that loads Blender-exported scenes.*
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# section 4.1: the JAVELIN tunnel, which the paper modelled in Blender and ray-traced. Here the same
+# tunnel is traced twice: by tunnelkit's image method and by Sionna RT (NVIDIA, on Mitsuba 3 /
+# Dr.Jit), an independent ray tracer that loads Blender-exported scenes.
+# All references: `REFERENCES.md` at the top of the repository.*
 #
 # **What you will learn**
 #
@@ -39,7 +42,7 @@ tk.setup_notebook()
 # %%
 sc = tk.load_scenario("italiano2026-straight")
 tun, fc = sc.tunnel(), sc.get("radio.fc")
-scene = rt.export_tunnel(tun, "build/rt/javelin", name="javelin")
+scene = rt.export_tunnel(tun, tk.build_dir("rt", "javelin"), name="javelin")
 print(scene.xml, "-", scene.n_surfaces, "surfaces")
 for sid in ("facet-0", "road", "rrm-top-left"):
     print(f"  {sid:14s} -> {scene.surfaces[sid]}")
@@ -78,7 +81,7 @@ traj = sc.trajectory(tun)
 k = 9
 ue, vel = traj.position[k], traj.velocity[k]
 arr = propagation.select_array(arrays_in, ue)
-runs = rt.time_engines(tun, arr, ue, vel, fc=fc, repeat=3, workdir="build/rt/engine")
+runs = rt.time_engines(tun, arr, ue, vel, fc=fc, repeat=3, workdir=tk.build_dir("rt", "engine"))
 (p_img, t_img), (p_srt, t_srt) = runs["image"], runs["sionna"]
 print(f"UE at {ue.round(2)}; image method {t_img * 1e3:.1f} ms, Sionna RT {t_srt:.2f} s per epoch")
 rows = rt.compare_paths(p_img, p_srt)
@@ -113,7 +116,9 @@ for kk in epochs:
     u, v = trs.position[kk], trs.velocity[kk]
     a = propagation.select_array(arrays_in, u)
     pi = rt.compute_paths(tun, a, u, v, fc=fc)
-    ps = rt.compute_paths(tun, a, u, v, fc=fc, engine="sionna", workdir="build/rt/engine")
+    ps = rt.compute_paths(
+        tun, a, u, v, fc=fc, engine="sionna", workdir=tk.build_dir("rt", "engine")
+    )
     by_name = {p.surface or "LoS": p for p in pi}
     for r in rt.compare_paths(pi, ps):
         rows_all.append({"epoch": int(kk), **r})

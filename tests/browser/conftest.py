@@ -8,7 +8,9 @@ runs on a free loopback port and is stopped by its process id; screenshots go to
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -16,7 +18,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 
-from _lecture import BUILD, CHROMIUM  # noqa: E402
+from _lecture import BUILD, CHROMIUM, HOST, free_port, serving  # noqa: E402
 
 if os.environ.get("TUNNELKIT_BROWSER") != "1":
     collect_ignore_glob = ["test_*.py"]
@@ -86,3 +88,32 @@ def watched(browser):
         yield Watched(context.new_page())
     finally:
         context.close()
+
+
+SITE = BUILD / "browser-site"
+
+
+@pytest.fixture(scope="session")
+def site_url():
+    """The static site built in quick mode (tools/site.py, as ``make site QUICK=1``), served locally.
+
+    ``TUNNELKIT_SITE_DIR=<dir>`` serves an already built site instead of building one.
+    """
+    given = os.environ.get("TUNNELKIT_SITE_DIR")
+    site = Path(given).resolve() if given else SITE
+    if not given:
+        t0 = time.perf_counter()
+        run = subprocess.run(
+            [sys.executable, str(ROOT / "tools" / "site.py"), "--quick", "--out", str(SITE)],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=1800,
+        )
+        assert run.returncode == 0, f"tools/site.py failed:\n{run.stdout}\n{run.stderr}"
+        print(f"site built in {time.perf_counter() - t0:.0f} s")
+    port = free_port()
+    url = f"http://{HOST}:{port}/"
+    cmd = [sys.executable, "-m", "http.server", str(port), "--bind", HOST, "--directory", str(site)]
+    with serving(cmd, url, timeout=30):
+        yield url

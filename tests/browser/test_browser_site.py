@@ -1,38 +1,12 @@
 """Test 2: the static site opens from its index, every chapter renders plotly figures, no errors.
 
 The site is built in quick mode into build/browser-site/ by tools/site.py (the same code as
-``make site``) and served by ``python -m http.server`` on a free loopback port.
+``make site``) and served by ``python -m http.server`` on a free loopback port (conftest.py).
 """
 
 from __future__ import annotations
 
-import subprocess
-import sys
-import time
-
-import pytest
-from _lecture import BUILD, HOST, ROOT, free_port, list_notebooks, serving
-
-SITE = BUILD / "browser-site"
-
-
-@pytest.fixture(scope="module")
-def site_url():
-    t0 = time.perf_counter()
-    run = subprocess.run(
-        [sys.executable, str(ROOT / "tools" / "site.py"), "--quick", "--out", str(SITE)],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=1800,
-    )
-    assert run.returncode == 0, f"tools/site.py failed:\n{run.stdout}\n{run.stderr}"
-    print(f"site built in {time.perf_counter() - t0:.0f} s")
-    port = free_port()
-    url = f"http://{HOST}:{port}/"
-    cmd = [sys.executable, "-m", "http.server", str(port), "--bind", HOST, "--directory", str(SITE)]
-    with serving(cmd, url, timeout=30):
-        yield url
+from _lecture import list_notebooks
 
 
 def test_index_links_every_chapter_and_each_renders(site_url, watched, artifacts):

@@ -1,5 +1,7 @@
-"""Test 1: ``tools/present.py`` serves notebook 02 with Voila; the keyboard moves the Mmax explorer's
-M slider; the figure (read from the page's plotly data) and the verdict change.
+"""Test 1: ``tools/present.py`` serves notebook 02 with Voila, whole (``--view all``) and as the
+lecturer's view (``--view explorers``); the keyboard moves the Mmax explorer's M slider; the figure
+(read from the page's plotly data) and the verdict change. In the explorers view the slider is in
+the first screen and the page is short.
 
 Artefacts in build/artifacts/: voila-02-before.png, voila-02-after.png (the page),
 voila-02-explorer-after.png (the explorer alone), voila-02.json (readouts, verdicts, aborted requests)
@@ -55,17 +57,24 @@ def verdict_of(text: str) -> str:
     return m.group(0)
 
 
-@pytest.fixture(scope="module")
-def voila_url():
+@pytest.fixture(scope="module", params=["all", "explorers"])
+def voila_url(request):
     nb = resolve_notebook(TARGET["notebook"])
     port = free_port()
     url = f"http://{HOST}:{port}/"
-    log = BUILD / "artifacts" / f"voila-{nb.stem[:2]}.log"
+    log = BUILD / "artifacts" / f"voila-{nb.stem[:2]}-{request.param}.log"
     log.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick", f"--port={port}"]
+    cmd = [
+        sys.executable,
+        str(ROOT / "tools" / "present.py"),
+        str(nb),
+        "--quick",
+        f"--port={port}",
+        f"--view={request.param}",
+    ]
     with serving(cmd, url + "api", log=log, timeout=120) as proc:
         assert child_pids(proc.pid), "present.py started no Voila"
-        yield url
+        yield url, request.param
         spawned = [*child_pids(proc.pid)]  # Voila (its own process group) and its kernels
         for pid in spawned:
             spawned += child_pids(pid)
@@ -75,10 +84,18 @@ def voila_url():
 
 
 def test_keyboard_moves_m_and_the_verdict_changes(voila_url, watched, artifacts):
+    url, view = voila_url
     page = watched.page
-    page.goto(voila_url, timeout=300_000)
+    page.goto(url, timeout=300_000)
     page.wait_for_function(MARK, arg=TARGET["slider"], timeout=300_000)
-    tag = TARGET["notebook"]
+    tag = f"{TARGET['notebook']}-{view}"
+    if view == "explorers":  # the lecturer's view: no long scroll to reach the slider
+        top = page.evaluate(
+            "document.querySelector('[data-test=target-slider]').getBoundingClientRect().top"
+        )
+        height = page.evaluate("document.documentElement.scrollHeight")
+        assert top < 1000, f"the slider starts {top:.0f} px down the page"
+        assert height < 2500, f"the explorers page is {height} px tall"
     before = page.evaluate(READ)
     first = verdict_of(before["text"])
     explorer = page.locator("[data-test=target-explorer]")

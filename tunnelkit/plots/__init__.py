@@ -36,10 +36,16 @@ from .javelin import (
     tracks_count_figure,
     trajectories_figure,
 )
+from .tables import (
+    TableFigure,
+    report_table,
+    table,
+)
 from .topview import (
     tunnel_topview,
 )
 from .tracking import (
+    bound_ratio_figure,
     particle_cloud_figure,
     rmse_bound_figure,
     table_figure,
@@ -54,7 +60,9 @@ from .tunnel3d import (
 
 __all__ = [
     "COLORS",
+    "TableFigure",
     "approach_cdfs",
+    "bound_ratio_figure",
     "cdf_figure",
     "derivation_figure",
     "doppler_delay_figure",
@@ -74,9 +82,11 @@ __all__ = [
     "profiles_figure",
     "ratio_map_figure",
     "regime_figure",
+    "report_table",
     "rmse_bound_figure",
     "route_figure",
     "size_figure",
+    "table",
     "table_figure",
     "tracks_count_figure",
     "tracks_figure",

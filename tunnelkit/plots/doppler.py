@@ -34,6 +34,8 @@ APPROACH_COLORS = {
 }
 _SIGMA_DASH = {"103.70 Hz": "solid", "32.79 Hz": "dash", "10.37 Hz": "dot", "dynamic": "dashdot"}
 _MARGIN = {"l": 60, "r": 20, "t": 50, "b": 50}
+# figures with subplot titles: the figure title gets its own band above them
+_MARGIN_SUB = {**_MARGIN, "t": 90}
 
 
 def drive_topview(
@@ -156,7 +158,7 @@ def doppler_delay_figure(drive, meas=None) -> go.Figure:
     fig.update_xaxes(title_text="time [s] (dotted: the pass)")
     fig.update_layout(
         height=400,
-        margin={**_MARGIN, "t": 70},
+        margin=_MARGIN_SUB,
         title="Approach: Doppler > 0; after the pass: Doppler < 0",
     )
     return fig
@@ -192,7 +194,7 @@ def profiles_figure(profiles: Mapping[str, np.ndarray]) -> go.Figure:
     fig.update_xaxes(title_text="time [s]")
     fig.update_yaxes(title_text="delay [us]", row=1, col=1)
     fig.update_yaxes(title_text="Doppler [Hz]", row=1, col=2)
-    fig.update_layout(height=400, margin=_MARGIN)
+    fig.update_layout(height=400, margin=_MARGIN_SUB)
     return fig
 
 
@@ -234,7 +236,7 @@ def error_time_figure(drive, tracks: Mapping[str, np.ndarray], *, title: str = "
     fig.update_xaxes(title_text="time [s]", row=3, col=1)
     fig.update_layout(
         height=620,
-        margin=_MARGIN,
+        margin=_MARGIN_SUB,
         title=title or "Estimation error over the drive (dotted: the pass)",
     )
     return fig
@@ -292,7 +294,7 @@ def approach_cdfs(
     fig.update_yaxes(title_text="CDF", range=[0, 1.02], row=1, col=1)
     fig.update_layout(
         height=400,
-        margin=_MARGIN,
+        margin=_MARGIN_SUB,
         title="CDF of the position error per sigma (lines: synthetic; crosses: paper's measured p90)",
     )
     return fig
@@ -331,7 +333,7 @@ def pcrlb_figure(drive, bounds: Mapping[str, np.ndarray], *, title: str = "") ->
     fig.update_xaxes(title_text="time [s]")
     fig.update_layout(
         height=400,
-        margin=_MARGIN,
+        margin=_MARGIN_SUB,
         title=title or "What one transmitter can observe: posterior CRLB",
     )
     return fig
@@ -373,7 +375,7 @@ def information_figure(
     fig.update_xaxes(title_text="time [s]")
     fig.update_layout(
         height=380,
-        margin=_MARGIN,
+        margin=_MARGIN_SUB,
         title=f"One epoch's Fisher information (sigma_D = {sigma_hz:g} Hz, sigma_r = {sigma_range:g} m"
         f" = {sigma_range / C * 1e9:.2f} ns)",
     )

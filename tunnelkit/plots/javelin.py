@@ -9,6 +9,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .common import COLORS
+from .tables import TableFigure, table
 
 __all__ = ["epoch_figure", "javelin_table_figure", "tracks_count_figure", "trajectories_figure"]
 
@@ -17,6 +18,31 @@ _PALETTE = ["#1f77b4", "#d62728", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#
 
 def _color(name: str, i: int) -> str:
     return COLORS.get(name.split()[0].split("-")[0], _PALETTE[i % len(_PALETTE)])
+
+
+_FAMILY_SYMBOL = {"JAVELIN": "circle-open", "TeNFiLoc": "x"}
+_MORE_SYMBOLS = ["diamond-open", "square-open", "triangle-up-open", "cross", "star-open"]
+
+
+def method_styles(names) -> dict[str, dict]:
+    """A distinct (symbol, colour) per method name: the paper's style (JAVELIN blue circles,
+    TeNFiLoc red crosses) for the first of each family, other symbols and colours after it, so
+    "JAVELIN (ours)" and "JAVELIN (paper)" never share a marker."""
+    out, used_sym, used_col = {}, set(), set()
+    spare_sym = iter(_MORE_SYMBOLS * 3)
+    spare_col = iter([c for c in _PALETTE if c not in COLORS.values()] + _PALETTE)
+    for i, name in enumerate(names):
+        fam = name.split()[0].split("-")[0]
+        sym = _FAMILY_SYMBOL.get(fam, "circle")
+        col = _color(name, i)
+        while sym in used_sym:
+            sym = next(spare_sym)
+        while col in used_col:
+            col = next(spare_col)
+        used_sym.add(sym)
+        used_col.add(col)
+        out[name] = {"symbol": sym, "color": col}
+    return out
 
 
 def trajectories_figure(
@@ -33,19 +59,11 @@ def trajectories_figure(
         marker={"symbol": "asterisk", "size": 6, "color": COLORS["truth"]},
         line={"color": COLORS["truth"]},
     )
-    symbols = {"JAVELIN": "circle-open", "TeNFiLoc": "x"}
-    for i, (name, est) in enumerate(estimates.items()):
+    styles = method_styles(list(estimates))
+    for name, est in estimates.items():
         est = np.asarray(est, float)
         fig.add_scatter(
-            x=est[:, 0],
-            y=est[:, 1],
-            mode="markers",
-            name=name,
-            marker={
-                "symbol": symbols.get(name.split()[0].split("-")[0], "circle"),
-                "size": 7,
-                "color": _color(name, i),
-            },
+            x=est[:, 0], y=est[:, 1], mode="markers", name=name, marker={**styles[name], "size": 7}
         )
     if base_station is not None:
         fig.add_scatter(
@@ -263,8 +281,8 @@ def tracks_count_figure(
 
 def javelin_table_figure(
     columns: Sequence[str], rows: Sequence[Sequence], *, title: str = "", digits: int = 2
-) -> go.Figure:
-    """A plotly table (numbers rounded, ``None`` as a dash)."""
+) -> TableFigure:
+    """A table (numbers rounded to ``digits``, ``None`` or NaN as a dash), shown as HTML."""
 
     def fmt(v):
         if v is None:
@@ -273,14 +291,4 @@ def javelin_table_figure(
             return f"{v:.{digits}f}" if np.isfinite(v) else "-"
         return str(v)
 
-    cells = [[fmt(r[i]) for r in rows] for i in range(len(columns))]
-    fig = go.Figure(
-        go.Table(
-            header={"values": list(columns), "align": "left"},
-            cells={"values": cells, "align": "left"},
-        )
-    )
-    fig.update_layout(
-        title=title, height=80 + 28 * (len(rows) + 1), margin={"l": 10, "r": 10, "t": 40, "b": 10}
-    )
-    return fig
+    return table(columns, rows, title=title, fmt=fmt)

@@ -11,6 +11,11 @@ from .common import COLORS
 __all__ = ["tunnel_topview"]
 
 
+def _text_away(d) -> str:
+    """A plotly ``textposition`` that puts a marker's label on the side ``d`` points to."""
+    return ("top" if d[1] >= 0 else "bottom") + " " + ("right" if d[0] >= 0 else "left")
+
+
 def tunnel_topview(
     tunnel: Tunnel2D,
     base_station,
@@ -43,7 +48,8 @@ def tunnel_topview(
         mode="markers+text",
         name="base station",
         text=["BS"],
-        textposition="bottom right",
+        # away from both virtual stations (they lie across the walls): back along the tunnel
+        textposition=_text_away(-np.asarray(tunnel.axis, dtype=float)[:2]),
         marker={"symbol": "triangle-up", "size": 14, "color": COLORS["bs"]},
     )
     fig.add_scatter(
@@ -52,7 +58,7 @@ def tunnel_topview(
         mode="markers+text",
         name="virtual stations",
         text=["VS1", "VS2"],
-        textposition="top center",
+        textposition=[_text_away(v - bs) for v in vs],
         marker={"symbol": "triangle-up-open", "size": 14, "color": COLORS["vs"]},
     )
     if trajectory is not None:

@@ -9,9 +9,16 @@ import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
 from .common import COLORS, line_figure
+from .tables import TableFigure, table
 from .topview import tunnel_topview
 
-__all__ = ["particle_cloud_figure", "rmse_bound_figure", "table_figure", "tracks_figure"]
+__all__ = [
+    "bound_ratio_figure",
+    "particle_cloud_figure",
+    "rmse_bound_figure",
+    "table_figure",
+    "tracks_figure",
+]
 
 
 def tracks_figure(
@@ -127,6 +134,47 @@ def rmse_bound_figure(
     return fig
 
 
+def bound_ratio_figure(
+    t,
+    panels: Mapping[str, tuple[Mapping[str, np.ndarray], np.ndarray]],
+    *,
+    title: str = "RMSE / sqrt(PCRLB) per epoch",
+) -> go.Figure:
+    """One panel per truth: each filter's RMSE divided by sqrt(PCRLB), epoch by epoch, with the
+    bound's level 1 dashed. ``panels`` maps a panel title to ``(rmse per filter (T,), bound (T,))``."""
+    fig = make_subplots(
+        rows=1,
+        cols=len(panels),
+        subplot_titles=list(panels),
+        shared_yaxes=True,
+        horizontal_spacing=0.05,
+    )
+    t = np.asarray(t)
+    for c, (rmse, bound) in enumerate(panels.values(), start=1):
+        b = np.asarray(bound, dtype=float)
+        for name, r in rmse.items():
+            fig.add_scatter(
+                x=t,
+                y=np.asarray(r) / b,
+                mode="lines",
+                name=name,
+                legendgroup=name,
+                showlegend=c == 1,
+                line={"color": COLORS.get(name)},
+                row=1,
+                col=c,
+            )
+        fig.add_hline(y=1.0, line={"dash": "dash", "color": COLORS["CRLB"]}, row=1, col=c)
+        fig.update_xaxes(title_text="t [s]", row=1, col=c)
+    fig.update_yaxes(title_text="RMSE / sqrt(PCRLB)", row=1, col=1)
+    fig.update_layout(
+        title=title,
+        height=380,
+        margin={"l": 60, "r": 20, "t": 90, "b": 50},
+    )
+    return fig
+
+
 def particle_cloud_figure(
     snapshots: Sequence[Mapping], *, title: str = "UPF particle clouds", half_width: float = 3.0
 ) -> go.Figure:
@@ -177,25 +225,12 @@ def particle_cloud_figure(
             range=[tr[0] - half_width, tr[0] + half_width], title_text="x [m]", row=1, col=c
         )
         fig.update_yaxes(range=[tr[1] - half_width, tr[1] + half_width], row=1, col=c)
-    fig.update_layout(title=title, height=360, margin={"l": 50, "r": 20, "t": 70, "b": 50})
+    fig.update_layout(title=title, height=380, margin={"l": 50, "r": 20, "t": 90, "b": 50})
     return fig
 
 
-def table_figure(rows: Sequence[Mapping], columns: Sequence[str], *, title: str = "") -> go.Figure:
-    """A plotly table of dict rows (floats shown with 4 significant digits)."""
-
-    def fmt(v):
-        if v is None:
-            return "-"
-        return f"{v:.4g}" if isinstance(v, float) else str(v)
-
-    fig = go.Figure(
-        go.Table(
-            header={"values": list(columns), "align": "center"},
-            cells={"values": [[fmt(r[c]) for r in rows] for c in columns], "align": "right"},
-        )
-    )
-    fig.update_layout(
-        title=title, height=80 + 28 * len(rows), margin={"l": 10, "r": 10, "t": 50, "b": 10}
-    )
-    return fig
+def table_figure(
+    rows: Sequence[Mapping], columns: Sequence[str], *, title: str = ""
+) -> TableFigure:
+    """A table of dict rows (floats shown with 4 significant digits), shown as HTML."""
+    return table(columns, [[r[c] for c in columns] for r in rows], title=title)

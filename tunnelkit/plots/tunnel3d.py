@@ -9,6 +9,8 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .tables import TableFigure, table
+
 __all__ = [
     "PATH_COLORS",
     "factors_figure",
@@ -143,28 +145,12 @@ def tunnel3d_figure(
     return fig
 
 
-def paths_table_figure(rows: Sequence[dict], *, title: str = "") -> go.Figure:
-    """A plotly table from a list of dicts (same keys; floats shown with 3 significant digits)."""
+def paths_table_figure(rows: Sequence[dict], *, title: str = "") -> TableFigure:
+    """A table from a list of dicts (same keys; floats shown with 4 significant digits), as HTML."""
     if not rows:
-        return go.Figure(layout={"title": title})
+        return table([], [], title=title)
     keys = list(rows[0])
-
-    def fmt(v):
-        if isinstance(v, float | np.floating):
-            return f"{v:.4g}"
-        return str(v)
-
-    cells = [[fmt(r[k]) for r in rows] for k in keys]
-    fig = go.Figure(
-        go.Table(
-            header={"values": keys, "fill_color": "#f0f0f0", "align": "left"},
-            cells={"values": cells, "align": "left"},
-        )
-    )
-    fig.update_layout(
-        title=title, height=80 + 28 * len(rows), margin={"l": 10, "r": 10, "t": 40, "b": 10}
-    )
-    return fig
+    return table(keys, [[r[k] for k in keys] for r in rows], title=title)
 
 
 def factors_figure(
@@ -172,17 +158,17 @@ def factors_figure(
     *,
     unwrapped=None,
     shape: tuple[int, int] | None = None,
-    title: str = "CPD factor matrices (normalised, eq. 12-13)",
+    title: str = "Phase [rad] of the CPD factor matrices (normalised, eq. 12-13)",
 ) -> go.Figure:
     """Phase of the three factor matrices: spatial (unwrapped, per path), frequency, time."""
     bs, bf, bt = factors
     fig = make_subplots(
         rows=1,
         cols=3,
-        subplot_titles=(
-            "spatial: unwrapped phase (eq. 16) [rad]",
-            "frequency: phase vs tone [rad]",
-            "time: phase vs symbol [rad]",
+        subplot_titles=(  # short: three panels side by side in a narrow output area
+            "(a) spatial, unwrapped (eq. 16)",
+            "(b) frequency",
+            "(c) time",
         ),
     )
     sp = unwrapped if unwrapped is not None else np.unwrap(np.angle(bs), axis=0)
@@ -205,7 +191,7 @@ def factors_figure(
     fig.update_xaxes(title_text="antenna m", row=1, col=1)
     fig.update_xaxes(title_text="tone s", row=1, col=2)
     fig.update_xaxes(title_text="symbol k", row=1, col=3)
-    fig.update_layout(title=title, height=360, margin={"l": 50, "r": 10, "t": 70, "b": 40})
+    fig.update_layout(title=title, height=380, margin={"l": 50, "r": 10, "t": 90, "b": 40})
     return fig
 
 

@@ -200,7 +200,7 @@ def curvature_figure(
     fig.update_layout(
         title=f"epoch {k}, SNR offset {snr_offset_db:+.0f} dB: {verdict}",
         height=420,
-        margin={"l": 60, "r": 20, "t": 80, "b": 50},
+        margin={"l": 60, "r": 20, "t": 90, "b": 50},
         legend={"orientation": "h", "y": -0.25},
     )
     return fig

@@ -134,8 +134,7 @@ def mmax_figure(
             "xanchor": "left",
             "font": {"size": 16, "color": "#2ca02c" if valid else "#d62728"},
         },
-        "height": 820,
-        "width": 1150,
+        "height": 820,  # no fixed width: the figure takes its output area's width
         "margin": {"l": 60, "r": 20, "t": 100, "b": 50},
         "xaxis": {
             "domain": [0.0, 0.78],
@@ -156,9 +155,11 @@ def mmax_figure(
             "title": {"text": "R [m]"},
         },
         "yaxis3": {"domain": [0.0, 0.44], "anchor": "x3", "type": "log", "title": {"text": "Mmax"}},
-        "legend": {**legend, "x": 0.8, "y": 1.0, "xanchor": "left", "yanchor": "top"},
+        # legends anchored to the figure's right edge: inside it at any width (over the plot's
+        # margin when the output area is narrow, never clipped)
+        "legend": {**legend, "x": 1.0, "y": 1.0, "xanchor": "right", "yanchor": "top"},
         "legend2": {**legend, "x": 0.01, "y": 0.44, "xanchor": "left", "yanchor": "top"},
-        "legend3": {**legend, "x": 0.8, "y": 0.44, "xanchor": "left", "yanchor": "top"},
+        "legend3": {**legend, "x": 1.0, "y": 0.44, "xanchor": "right", "yanchor": "top"},
         "annotations": [
             {**label, "x": 0.0, "y": 1.0, "text": "(a) top view (Fig. 2)"},
             {**label, "x": 0.0, "y": 0.445, "text": "(b) phase mismatch across the aperture"},
