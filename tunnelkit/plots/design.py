@@ -131,7 +131,7 @@ def route_figure(
     layout = {
         "title": {"text": title, "subtitle": {"text": subtitle}, "x": 0.01, "xanchor": "left"},
         "height": 620,
-        "width": 980,
+        "autosize": True,
         "margin": {"l": 70, "r": 20, "t": 90, "b": 50},
         "xaxis": {"anchor": "y2", "title": {"text": "vehicle position x along the tunnel [m]"}},
         "yaxis": {"domain": [0.42, 1.0], "type": "log", "title": {"text": "PEB [cm]"}},
@@ -140,7 +140,14 @@ def route_figure(
             "type": "log",
             "title": {"text": "SR-NF mismatch [rad]"},
         },
-        "legend": {"font": {"size": 10}, "bgcolor": "rgba(255,255,255,0.7)"},
+        "legend": {
+            "font": {"size": 10},
+            "bgcolor": "rgba(255,255,255,0.7)",
+            "x": 0.99,
+            "xanchor": "right",
+            "y": 0.99,
+            "yanchor": "top",
+        },
         "meta": meta or {},
     }
     return go.Figure(
@@ -212,7 +219,8 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
     layout = {
         "title": {"text": title, "x": 0.01, "xanchor": "left"},
         "height": 460,
-        "width": 900,
+        "autosize": True,
+        "margin": {"l": 70, "r": 80, "t": 60, "b": 50},
         "xaxis": {"type": "log", "title": {"text": "number of elements M"}},
         "yaxis": {"type": "log", "title": {"text": "position error [cm]"}},
         "yaxis2": {

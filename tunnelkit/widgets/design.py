@@ -70,7 +70,7 @@ def design_figure(
             layout={
                 "title": {"text": f"Recommended: none — {exc}", "font": {"size": 12}},
                 "height": 620,
-                "width": 980,
+                "autosize": True,
                 "meta": {"fits": False, "recommended": None},
             }
         )
