@@ -23,6 +23,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..._validate import rng_or_error
+from ...constants import C
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 from .tenfiloc import TeNFiLoc
@@ -81,7 +82,8 @@ class DriveData:
     ``base_station`` the reference antenna, ``truth_index`` per epoch the matched true path of
     each measurement (-1: none), ``kinds`` per epoch the surface kind of each true path and
     ``sources`` its true wave source (the UE or a VUE), shape (n, 3), ``extraction`` the
-    measurement route (:data:`EXTRACTIONS`).
+    measurement route (:data:`EXTRACTIONS`), ``clock_bias_limit`` [s] the support of the clock
+    bias (TeNFiLoc's consistency check of a LoS curvature against the delay).
     """
 
     scenario: str
@@ -100,6 +102,7 @@ class DriveData:
     faults: list[str] = field(default_factory=list)
     sources: list[np.ndarray] = field(default_factory=list)
     extraction: str = "paper"
+    clock_bias_limit: float = 100e-9
 
     @property
     def dt(self) -> float:
@@ -272,6 +275,7 @@ def simulate_routes(
             a["faults"],
             a["sources"],
             e,
+            route.config.clock_bias_limit,
         )
         for e, a in acc.items()
     }
@@ -286,6 +290,7 @@ def tenfiloc_track(
         baseline = TeNFiLoc(
             base_station=tuple(drive.base_station),
             assume_los=drive.condition.los_probability == 1.0,
+            bias_limit=C * max(drive.clock_bias_limit, 1e-12),
         )
     tf = baseline
     out = np.empty_like(drive.truth)
