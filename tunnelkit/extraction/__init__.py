@@ -54,6 +54,7 @@ __all__ = [
     "cp_rel_error",
     "cpd",
     "crlb_paths",
+    "ROUTES",
     "extract_paths",
     "kruskal_rank",
     "max_identifiable_rank",
@@ -69,6 +70,9 @@ __all__ = [
 ]
 
 
+ROUTES = ("ml", "coherent", "joint", "column", "none")
+
+
 def extract_paths(
     H,
     n_paths: int,
@@ -78,12 +82,13 @@ def extract_paths(
     symbol_period: float,
     *,
     method: str = "fast",
-    refine: str = "joint",
+    refine: str = "ml",
     n_iter_max: int = 200,
     tol: float = 1e-10,
     polish: int | None = None,
+    noise_power: float | None = None,
 ) -> PathEstimates:
-    """Path parameters from the channel tensor (eq. 11-24), one entry per CPD component.
+    """Path parameters from the channel tensor, one entry per path.
 
     Parameters
     ----------
@@ -93,15 +98,23 @@ def extract_paths(
     fc : carrier [Hz]; subcarrier_spacing : spacing ``Delta f`` of the tones along axis 1 [Hz];
     symbol_period : ``T0`` between the samples along axis 2 [s].
     method : "fast" (compressed, ESPRIT-initialised) or "plain" (``parafac(init='svd')``).
-    refine : "joint" (default) — after eq. 13, maximum-likelihood refinement of all roots
-        together with free spatial factors (:func:`refine_joint`); "column" — each root to the
-        periodogram peak of its own factor column (:func:`refine_roots`); "none" — the paper's
-        eq. 13 roots and eq. 12 gains as they are.
+    refine : the route.
+
+        - "ml" (default) — the joint maximum-likelihood fit of the exact eq. 1 model, started from
+          the CPD and the coherent split, with SAGE-like re-seeding (:mod:`.ml`): efficient (at
+          the structured CRLB, :func:`path_crlb`) in direction, curvature, delay and Doppler;
+        - "coherent" — "joint", then the coherent split (:func:`.coherent.resolve_coherent`);
+        - the paper's route (eq. 13-24): "joint" — after eq. 13, maximum-likelihood refinement
+          of all roots together with free spatial factors (:func:`refine_joint`); "column" —
+          each root to the periodogram peak of its own factor column (:func:`refine_roots`);
+          "none" — the paper's eq. 13 roots and eq. 12 gains as they are.
     polish : ALS sweeps on the full tensor after the compressed CPD (default 2, or 0 with
         ``refine="joint"``, which supersedes them).
+    noise_power : noise power per sample for the "ml" route (default: estimated from ``H``).
 
     Returns a :class:`PathEstimates` (``alpha, d, v, direction, kappa, near_field`` and more); it
-    also supports ``est["d"]``.
+    also supports ``est["d"]``. On the "ml" route see :func:`.ml.ml_paths` for what each field
+    holds (``kappa`` is finite for every near-field wave; ``fit`` has the noise floor test).
     """
     H = check_tensor(H)
     M, _Nf, _Nt = H.shape
@@ -110,8 +123,26 @@ def extract_paths(
     fc = positive("fc", fc)
     df = positive("subcarrier_spacing", subcarrier_spacing)
     T0 = positive("symbol_period", symbol_period)
-    if refine not in ("none", "column", "joint"):
-        raise ValueError(f"refine: expected 'joint', 'column' or 'none', got {refine!r}")
+    if refine not in ROUTES:
+        raise ValueError(f"refine: expected one of {ROUTES}, got {refine!r}")
+    if refine == "ml":
+        from .ml import ml_paths
+
+        return ml_paths(H, L, pos, fc, df, T0, noise_power=noise_power)
+    if noise_power is not None:
+        raise ValueError(f"noise_power: only used by refine='ml', not {refine!r}")
+    if refine == "coherent":
+        from .coherent import resolve_coherent
+
+        est = _paper_route(H, L, pos, fc, df, T0, "joint", method, n_iter_max, tol, polish)
+        return resolve_coherent(H, est, pos, fc, df, T0, L)
+    return _paper_route(H, L, pos, fc, df, T0, refine, method, n_iter_max, tol, polish)
+
+
+def _paper_route(
+    H, L, pos, fc, df, T0, refine, method="fast", n_iter_max=200, tol=1e-10, polish=None
+) -> PathEstimates:
+    """CPD and eq. 13-24 on checked arguments (``refine`` in "joint", "column", "none")."""
     if polish is None:
         polish = 0 if refine == "joint" else 2
     res = cpd(

@@ -19,6 +19,8 @@ class PathEstimates:
     far-field), ``near_field`` (bool), ``phi``/``psi`` local azimuth and polar angle (eq. 19
     convention), ``valid`` = Algorithm 1 keeps the path (``d >= 0``), ``kappa_nf`` the raw TLS
     value, ``delta`` (L, M) unwrapped path-length offsets (eq. 16), ``mu_f``/``mu_t`` the roots.
+    ``fit`` holds the maximum-likelihood stage's :class:`~tunnelkit.extraction.ml.MLFit` (noise
+    power, basin test, per-path significance) on that route, ``None`` on the others.
     """
 
     alpha: np.ndarray
@@ -38,6 +40,7 @@ class PathEstimates:
     rel_error: float = 0.0
     n_iter: int = 0
     converged: bool = True
+    fit: object = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return self.d.shape[0]
