@@ -86,7 +86,7 @@ def javelin_epoch():
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ep = route.epoch(5, np.random.default_rng(1))
+        ep = route.epoch(5, np.random.default_rng(1), refine="joint")  # the paper's route
     return route, ep
 
 
@@ -130,7 +130,7 @@ def test_resolve_coherent_leaves_resolved_paths_alone():
     arr, paths = route.paths(26)
     H = channel.channel_tensor(paths, CFG)
     est = extraction.extract_paths(
-        H, len(paths), arr.local, FC, CFG.tone_spacing, CFG.symbol_period
+        H, len(paths), arr.local, FC, CFG.tone_spacing, CFG.symbol_period, refine="joint"
     )
     out = coherent.resolve_coherent(H, est, arr.local, FC, CFG.tone_spacing, CFG.symbol_period)
     np.testing.assert_allclose(out.d, est.d, atol=1e-4)
@@ -169,7 +169,7 @@ def _resolve(H, n, **kw):
     args = (POS, FC, CFG.tone_spacing, CFG.symbol_period)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", extraction.CPDConvergenceWarning)
-        est = extraction.extract_paths(H, n, *args)
+        est = extraction.extract_paths(H, n, *args, refine="joint")
     return est, coherent.resolve_coherent(H, est, *args, **kw)
 
 

@@ -17,6 +17,8 @@ def route():
 
 
 def _extract(H, L, arr, **kw):
+    """The paper's route (eq. 13-24) unless ``refine`` says otherwise (the ML route: test_ml.py)."""
+    kw.setdefault("refine", "joint")
     return extraction.extract_paths(H, L, arr.local, FC, CFG.tone_spacing, CFG.symbol_period, **kw)
 
 

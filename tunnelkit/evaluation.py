@@ -2,12 +2,23 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .arrays import ArrayGeometry
 from .constants import C
 
-__all__ = ["comparison_rows", "match_paths", "path_rows", "rmse_study"]
+__all__ = [
+    "Scene",
+    "comparison_rows",
+    "match_paths",
+    "match_points",
+    "normalized_errors",
+    "path_rows",
+    "random_scene",
+    "rmse_study",
+]
 
 
 def match_paths(
@@ -24,22 +35,167 @@ def match_paths(
     Cost: ``|d_est - (length + c b)| / range_scale + ||u_est - u_true|| / direction_scale``;
     assignments costing more than 10 are refused.
     """
+    d_est = np.atleast_1d(np.asarray(d_est, float))
+    if not len(paths) or not d_est.size:
+        return -np.ones(d_est.shape[0], dtype=int)
+    d_true = np.array([p.length for p in paths]) + C * clock_bias
+    u_true = np.stack([p.direction for p in paths])
+    return match_points(
+        d_est,
+        dir_est,
+        d_true,
+        u_true,
+        direction_scale=direction_scale,
+        range_scale=range_scale,
+    )
+
+
+def match_points(
+    d_est, dir_est, d_true, dir_true, *, direction_scale: float = 0.1, range_scale: float = 1.0
+) -> np.ndarray:
+    """:func:`match_paths` on plain arrays (distances and unit directions in one frame)."""
     from scipy.optimize import linear_sum_assignment
 
     d_est = np.atleast_1d(np.asarray(d_est, float))
     out = -np.ones(d_est.shape[0], dtype=int)
-    if not len(paths) or not d_est.size:
+    d_true = np.atleast_1d(np.asarray(d_true, float))
+    if not d_true.size or not d_est.size:
         return out
-    d_true = np.array([p.length for p in paths]) + C * clock_bias
-    u_true = np.stack([p.direction for p in paths])
     cost = (
         np.abs(d_est[:, None] - d_true[None, :]) / range_scale
-        + np.linalg.norm(np.asarray(dir_est)[:, None, :] - u_true[None], axis=-1) / direction_scale
+        + np.linalg.norm(
+            np.asarray(dir_est, float)[:, None, :] - np.asarray(dir_true, float)[None], axis=-1
+        )
+        / direction_scale
     )
     r, c = linear_sum_assignment(cost)
     ok = cost[r, c] < 10.0
     out[r[ok]] = c[ok]
     return out
+
+
+def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
+    """Errors over the CRLB standard deviation, (L_true, 4) for ``d, v, direction, kappa``.
+
+    ``est`` a :class:`~tunnelkit.extraction.PathEstimates`, ``d_true`` (with the clock bias),
+    ``v_true``, ``sources`` (L, 3) the true wave origins in the array's local frame, ``bound`` a
+    dict of standard deviations (``path_crlb`` / ``source_crlb`` units: m, m/s, rad, m). A true
+    path no estimate is matched to gets ``inf`` in every column; a far-field estimate (kappa NaN)
+    of a near-field path gets ``inf`` in the kappa column. The direction error is the angle
+    between the unit vectors (non-negative).
+    """
+    src = np.atleast_2d(np.asarray(sources, float))
+    rng_ = np.linalg.norm(src, axis=1)
+    u = src / rng_[:, None]
+    out = np.full((src.shape[0], 4), np.inf)
+    keep = np.flatnonzero(est.valid)
+    match = match_points(est.d[keep], est.direction[keep], d_true, u)
+    for i, j in zip(keep, match):
+        if j < 0:
+            continue
+        kap = est.kappa[i] if np.isfinite(est.kappa[i]) else np.inf
+        out[j] = (
+            (est.d[i] - d_true[j]) / bound["d"][j],
+            (est.v[i] - v_true[j]) / bound["v"][j],
+            np.arccos(np.clip(est.direction[i] @ u[j], -1.0, 1.0)) / bound["direction"][j],
+            (kap - rng_[j]) / bound["kappa"][j],
+        )
+    return out
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A free-space scene in front of one array: point sources (wave origins) in the local
+    frame, their gains (incl. ``sqrt(P_t)``), delay-distances ``d`` [m] and speeds ``v`` [m/s];
+    the radio of ``config`` (tones, symbols, noise power)."""
+
+    sources: np.ndarray
+    alpha: np.ndarray
+    d: np.ndarray
+    v: np.ndarray
+    element_positions: np.ndarray
+    config: object
+
+    @property
+    def mu_f(self) -> np.ndarray:
+        return -2 * np.pi * self.config.tone_spacing * self.d / C
+
+    @property
+    def mu_t(self) -> np.ndarray:
+        return 2 * np.pi * self.config.fc * self.config.symbol_period * self.v / C
+
+    def tensor(self, rng: np.random.Generator | None = None) -> np.ndarray:
+        """Eq. 1 for the sources, plus ``CN(0, noise_power)`` noise when ``rng`` is given."""
+        from .channel import add_noise
+        from .extraction.coherent import spherical_steering
+
+        cfg = self.config
+        a = spherical_steering(self.sources, self.element_positions, cfg.fc)
+        f = np.exp(1j * np.arange(cfg.n_tones)[:, None] * self.mu_f[None, :])
+        t = np.exp(1j * np.arange(cfg.n_symbols)[:, None] * self.mu_t[None, :])
+        H = np.einsum("ml,sl,kl->msk", a * self.alpha[None, :], f, t, optimize=True)
+        return H if rng is None else add_noise(H, cfg.noise_power, rng)
+
+    def crlb(self, spatial: str = "structured") -> dict:
+        """Standard deviations ``d`` [m], ``v`` [m/s], ``direction`` [rad], ``kappa`` [m]."""
+        from .extraction.bounds import source_crlb
+
+        cfg = self.config
+        b = source_crlb(
+            self.alpha,
+            self.sources,
+            self.element_positions,
+            self.mu_f,
+            self.mu_t,
+            cfg.fc,
+            cfg.n_tones,
+            cfg.n_symbols,
+            cfg.noise_power,
+            spatial=spatial,
+        )
+        return {
+            "d": C / (2 * np.pi * cfg.tone_spacing) * b["mu_f"],
+            "v": C / (2 * np.pi * cfg.fc * cfg.symbol_period) * b["mu_t"],
+            "direction": b["direction"],
+            "kappa": b["kappa"],
+        }
+
+
+def random_scene(
+    rng: np.random.Generator,
+    n_paths: int = 3,
+    *,
+    element_positions=None,
+    config=None,
+    ranges=(2.0, 8.0),
+    max_sine: float = 0.8,
+    snr_db=(-10.0, 10.0),
+    spread_d: float = 30.0,
+    speeds=(-20.0, 20.0),
+) -> Scene:
+    """Random near-field scene: ``n_paths`` sources at ``ranges`` [m] from the reference antenna
+    of a 10 x 10 half-wavelength URA (default), directions with ``|u_xy| < max_sine``, per-sample
+    SNR uniform in ``snr_db`` (the noise power of ``config``, default :class:`SRSConfig`), delay
+    distances ``range + U(0, spread_d)`` (a clock bias and extra path length), speeds uniform."""
+    from ._validate import integer, rng_or_error
+    from .arrays import ura
+    from .channel import SRSConfig
+    from .constants import wavelength
+
+    rng = rng_or_error("rng", rng)
+    L = integer("n_paths", n_paths, minimum=1)
+    cfg = SRSConfig() if config is None else config
+    pos = ura(10, 10, wavelength(cfg.fc) / 2) if element_positions is None else element_positions
+    pos = np.asarray(pos, float)
+    r = rng.uniform(*ranges, L)
+    rad = max_sine * np.sqrt(rng.uniform(0, 1, L))
+    ang = rng.uniform(0, 2 * np.pi, L)
+    u = np.column_stack([rad * np.cos(ang), rad * np.sin(ang), np.sqrt(1 - rad**2)])
+    amp = np.sqrt(cfg.noise_power * 10 ** (rng.uniform(*snr_db, L) / 10))
+    alpha = amp * np.exp(2j * np.pi * rng.uniform(0, 1, L))
+    d = r + rng.uniform(0, spread_d, L)
+    v = rng.uniform(*speeds, L)
+    return Scene(u * r[:, None], alpha, d, v, pos, cfg)
 
 
 def path_rows(paths) -> list[dict]:

@@ -44,6 +44,7 @@ from .paper import (
 )
 
 __all__ = [
+    "ROUTES",
     "CPDConvergenceWarning",
     "CPDResult",
     "PathEstimates",
@@ -54,7 +55,6 @@ __all__ = [
     "cp_rel_error",
     "cpd",
     "crlb_paths",
-    "ROUTES",
     "extract_paths",
     "kruskal_rank",
     "max_identifiable_rank",

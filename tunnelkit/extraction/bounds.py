@@ -6,7 +6,7 @@ import numpy as np
 
 from ..constants import C
 
-__all__ = ["crlb_paths", "path_crlb"]
+__all__ = ["crlb_paths", "path_crlb", "source_crlb"]
 
 
 def crlb_paths(
@@ -81,18 +81,28 @@ def crlb_paths(
     return out
 
 
-def path_crlb(paths, array, config, *, n_tones: int | None = None) -> dict:
+def path_crlb(
+    paths, array, config, *, n_tones: int | None = None, spatial: str = "structured"
+) -> dict:
     """Cramér-Rao bounds for every path of one epoch at the configured SNR.
 
-    ``d``/``v`` from the free-spatial-factor model (what a CPD fits, plus Vandermonde structure);
-    ``direction`` [rad] and ``kappa`` [m] from the exact spherical model (wave origin = VUE).
+    ``spatial="structured"`` (default): every parameter from the exact spherical model of eq. 1
+    (wave origin = VUE, 3 numbers per path): the bound the maximum-likelihood route
+    (``extract_paths(refine="ml")``) is judged against. ``spatial="free"``: ``d``/``v`` from the
+    free-spatial-factor model (what a CPD fits, plus Vandermonde structure), the bound of the
+    paper's route; ``direction`` [rad] and ``kappa`` [m] are always the structured ones (a free
+    spatial factor has no direction). Returns standard deviations ``d`` [m], ``v`` [m/s],
+    ``direction`` [rad] (angle between unit vectors: ``sqrt(trace)`` of the direction's
+    covariance), ``kappa`` [m] (range of the wave origin).
     """
+    if spatial not in ("structured", "free"):
+        raise ValueError(f"spatial: expected 'structured' or 'free', got {spatial!r}")
     nf = config.n_tones if n_tones is None else n_tones
     alpha = np.sqrt(config.tx_power) * np.array([p.gain for p in paths])
     src = np.stack([array.to_local(p.source) for p in paths])
     mu_f = -2 * np.pi * config.tone_spacing * np.array([p.length for p in paths]) / C
     mu_t = 2 * np.pi * config.symbol_period * np.array([p.doppler for p in paths])
-    args = (
+    out = source_crlb(
         alpha,
         src,
         array.local,
@@ -102,17 +112,39 @@ def path_crlb(paths, array, config, *, n_tones: int | None = None) -> dict:
         nf,
         config.n_symbols,
         config.noise_power,
+        spatial=spatial,
     )
-    free = crlb_paths(*args, spatial="free")
+    return {
+        "d": C / (2 * np.pi * config.tone_spacing) * out["mu_f"],
+        "v": C / (2 * np.pi * config.fc * config.symbol_period) * out["mu_t"],
+        "direction": out["direction"],
+        "kappa": out["kappa"],
+    }
+
+
+def source_crlb(
+    alpha,
+    sources,
+    element_positions,
+    mu_f,
+    mu_t,
+    fc,
+    n_tones,
+    n_symbols,
+    noise_power,
+    *,
+    spatial: str = "structured",
+) -> dict[str, np.ndarray]:
+    """:func:`crlb_paths` read out per path: ``mu_f``, ``mu_t`` (rad; from the ``spatial`` model),
+    ``direction`` [rad] and ``kappa`` [m] of the wave origin (structured model), for sources
+    given in the array's local frame (any scene, not only traced paths)."""
+    args = (alpha, sources, element_positions, mu_f, mu_t, fc, n_tones, n_symbols, noise_power)
     st = crlb_paths(*args, spatial="structured")
+    roots = st if spatial == "structured" else crlb_paths(*args, spatial="free")
+    src = np.atleast_2d(np.asarray(sources, float))
     u = src / np.linalg.norm(src, axis=1, keepdims=True)
     rng_ = np.linalg.norm(src, axis=1)
     proj = np.eye(3)[None] - u[:, :, None] * u[:, None, :]
     ang = np.sqrt(np.einsum("lij,ljk,lki->l", proj, st["source_cov"], proj)) / rng_
     kap = np.sqrt(np.einsum("li,lij,lj->l", u, st["source_cov"], u))
-    return {
-        "d": C / (2 * np.pi * config.tone_spacing) * free["mu_f"],
-        "v": C / (2 * np.pi * config.fc * config.symbol_period) * free["mu_t"],
-        "direction": ang,
-        "kappa": kap,
-    }
+    return {"mu_f": roots["mu_f"], "mu_t": roots["mu_t"], "direction": ang, "kappa": kap}

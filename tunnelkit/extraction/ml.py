@@ -323,10 +323,10 @@ def _power_rank_one(R, n_iter: int = 6):
     """Dominant rank-one term ``x o y o z`` of ``R`` by alternating power iterations."""
     M, nf, nt = R.shape
     R2 = R.reshape(M * nf, nt)
-    ev, V = np.linalg.eigh(R2.conj().T @ R2)
+    _, V = np.linalg.eigh(R2.conj().T @ R2)
     z = V[:, -1]
     Rz = (R2 @ z.conj()).reshape(M, nf)
-    u, s_, vh = np.linalg.svd(Rz, full_matrices=False)
+    u, _, vh = np.linalg.svd(Rz, full_matrices=False)
     x, y = u[:, 0], vh[0].conj()
     for _ in range(n_iter):
         z = np.einsum("msk,m,s->k", R, x.conj(), y.conj())
@@ -599,6 +599,8 @@ def ml_paths(
         if len(start) != L:
             raise ValueError(f"start: has {len(start)} paths, n_paths = {L}")
         start = start_from_estimates(start)
+    else:
+        start = _check_start(start, L)
     fit = fit_ml(H, start, pos, fc, noise_power=noise_power, max_iter=max_iter, n_reseed=n_reseed)
     n_sig = int(np.sum(fit.significance >= MIN_SIGNIFICANCE))
     if n_sig < L:

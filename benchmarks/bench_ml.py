@@ -1,0 +1,147 @@
+"""Issue 14: the default extraction (CPD, coherent split, joint ML) against the structured CRLB.
+
+Timing (``cases``): the whole default extraction at M = 100, Nf = 410, Nt = 12, L = 6 on one
+BLAS thread, with today's CPD + coherent route as the baseline of the group.
+
+Accuracy (``report``, printed by ``benchmarks/run.py`` after the timings, or alone with
+``python benchmarks/bench_ml.py --snapshots 200``): over seeded snapshots of random near-field
+scenes (2-4 sources 2-8 m from a 10 x 10 URA, per-sample SNR -10..10 dB) and of tunnel epochs
+drawn across both drives (``italiano2026-straight`` and ``-slalom``, :class:`SignalRoute`), the
+RMS of error / CRLB standard deviation per parameter (d, v, direction, kappa) and per path kind,
+and the share of errors beyond 6 sigma (a missed path counts as beyond). Goal: RMS <= 1.5 and
+<= 2 % beyond 6 sigma.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run import Case  # noqa: E402
+
+from tunnelkit import channel, evaluation, extraction, propagation, signal_route  # noqa: E402
+from tunnelkit.constants import C  # noqa: E402
+from tunnelkit.montecarlo import spawn_rngs  # noqa: E402
+
+PARAMS = ("d", "v", "direction", "kappa")
+DRIVES = ("italiano2026-straight", "italiano2026-slalom")
+
+
+def _tensor():
+    """bench_extraction's tensor: epoch 10 of the straight drive plus a second vehicle (L = 6)."""
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    arr, paths = route.paths(10)
+    extra = propagation.trace_paths(
+        route.tunnel, arr, [25.0, 2.0, 1.5], [-10.0, 0, 0], fc=route.config.fc, kinds=("los",)
+    )
+    paths = paths + extra
+    snap = channel.synthesize(paths, route.config, np.random.default_rng(0))
+    return snap.H, arr, route.config, len(paths)
+
+
+def cases() -> list[Case]:
+    H, arr, cfg, L = _tensor()
+    args = (arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+
+    def run(**kw):
+        with threadpool_limits(1), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return extraction.extract_paths(H, L, *args, **kw)
+
+    g = "ml"
+    return [
+        Case(f"extract_paths L={L}, CPD + coherent split", lambda: run(refine="coherent"),
+             group=g, baseline=True, repeat=7),
+        Case(f"extract_paths L={L}, default (CPD + search + ML)", lambda: run(), group=g,
+             repeat=7, goal_s=0.25),
+    ]
+
+
+def _tunnel_errors(route, rng, k):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ep = route.epoch(k, rng)
+    src = np.stack([ep.array.to_local(p.source) for p in ep.paths])
+    d_true = np.array([p.length for p in ep.paths]) + C * ep.snapshot.clock_bias
+    v_true = np.array([p.velocity for p in ep.paths])
+    bound = extraction.path_crlb(ep.paths, ep.array, route.config)
+    err = evaluation.normalized_errors(ep.estimates, d_true, v_true, src, bound)
+    return err, [p.surface_kind for p in ep.paths]
+
+
+def _scene_errors(rng):
+    sc = evaluation.random_scene(rng, int(rng.integers(2, 5)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.extract_paths(
+            sc.tensor(rng), len(sc.d), sc.element_positions, sc.config.fc,
+            sc.config.tone_spacing, sc.config.symbol_period,
+        )
+    return evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb()), ["scene"] * len(sc.d)
+
+
+def study(n_snapshots: int = 200, seed: int = 14) -> dict:
+    """Normalised errors of ``n_snapshots`` random scenes and ``n_snapshots`` tunnel epochs
+    (half per drive), grouped by path kind; also the wall-clock time per snapshot."""
+    routes = [signal_route.SignalRoute.from_scenario(d) for d in DRIVES]
+    rows: dict[str, list] = {}
+    t0 = time.perf_counter()
+    for i, rng in enumerate(spawn_rngs(seed, 2 * n_snapshots)):
+        if i < n_snapshots:
+            err, kinds = _scene_errors(rng)
+            tag = "scene"
+        else:
+            route = routes[i % 2]
+            k = int(rng.integers(0, len(route.trajectory)))
+            err, kinds = _tunnel_errors(route, rng, k)
+            tag = DRIVES[i % 2].split("-")[1]
+        for e, kind in zip(err, kinds):
+            rows.setdefault(kind if tag == "scene" else f"{kind}", []).append(e)
+            rows.setdefault(f"all {tag}", []).append(e)
+    return {"errors": {k: np.array(v) for k, v in rows.items()},
+            "seconds": time.perf_counter() - t0}
+
+
+def table(res: dict) -> str:
+    lines = [
+        f"{'path kind':16s} {'n':>5s} " + " ".join(f"{'RMS ' + p:>14s}" for p in PARAMS)
+        + " " + " ".join(f"{'>6sig ' + p:>14s}" for p in PARAMS)
+    ]
+    for kind, e in sorted(res["errors"].items()):
+        fin = np.isfinite(e)
+        with np.errstate(invalid="ignore"):
+            rms = [np.sqrt(np.mean(e[fin[:, j], j] ** 2)) if fin[:, j].any() else np.nan
+                   for j in range(4)]
+        beyond = np.mean(~(np.abs(e) <= 6.0), axis=0) * 100
+        lines.append(f"{kind:16s} {len(e):5d} " + " ".join(f"{r:14.2f}" for r in rms) + " "
+                     + " ".join(f"{b:13.1f}%" for b in beyond))
+    return "\n".join(lines)
+
+
+def report(n_snapshots: int | None = None) -> str:
+    n = n_snapshots or int(os.environ.get("TUNNELKIT_BENCH_SNAPSHOTS", 200))
+    with threadpool_limits(1):
+        res = study(n)
+    return (f"RMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
+            f"({res['seconds']:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(res))
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--snapshots", type=int, default=200)
+    ap.add_argument("--seed", type=int, default=14)
+    a = ap.parse_args()
+    with threadpool_limits(1):
+        r = study(a.snapshots, a.seed)
+    print(f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
+          f"load {os.getloadavg()[0]:.1f}")
+    print(table(r))
+    np.savez(f"/tmp/bench_ml_{a.snapshots}_{a.seed}.npz", **{k.replace(' ', '_'): v for k, v in r["errors"].items()})
