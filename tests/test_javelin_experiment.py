@@ -77,13 +77,14 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
         ev_paper := ex.evaluate(drives["L"][0], ex.PAPER).metrics["rmse_2d_m"]
     )
     assert row[3] == pytest.approx(ex.evaluate(routes["ml"]["L"][0], ex.PAPER).metrics["rmse_2d_m"])
-    assert row[4] == pytest.approx(
-        ex.evaluate(routes["ml"]["L"][0], ex.OURS_ML).metrics["rmse_2d_m"]
-    )
+    ml0 = routes["ml"]["L"][0]
+    assert row[4] == pytest.approx(ex.evaluate(ml0, ex.PAPER_VUE).metrics["rmse_2d_m"])
+    assert row[5] == pytest.approx(ex.evaluate(ml0, ex.OURS_ML).metrics["rmse_2d_m"])
     assert ev_paper != row[3]
     tf = at[("TeNFiLoc-L", "y_mae_m")]
     assert tf[2] == pytest.approx(ex.evaluate(drives["L"][0], method="TeNFiLoc").metrics["y_mae_m"])
-    assert tf[4] is None  # TeNFiLoc has no design of ours
+    assert tf[3] == pytest.approx(ex.evaluate(ml0, method="TeNFiLoc").metrics["y_mae_m"])
+    assert tf[4] is None and tf[5] is None  # TeNFiLoc: in the paper design's columns only
     # a coherent route adds its column; a missing route drops its columns
     cols3, _ = table_rows({**routes, "coherent": drives}, "italiano2026_table1")
     assert cols3[-2] == "our design, coherent route"
@@ -94,10 +95,10 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     acols, arows = ex.ablation(drives)
     assert acols == ["design", "L", "N"] and len(arows) == len(ex.ABLATION)
     _, arows2 = ex.ablation(drives, separated=drives, ml=routes["ml"])
-    assert len(arows2) == len(ex.ABLATION) + 4
+    assert len(arows2) == len(ex.ABLATION) + 5
     expect = ex.evaluate(drives["L"][0], ex.OURS_COHERENT).metrics["rmse_2d_m"]
-    assert arows2[-4][1] == pytest.approx(arows[-1][1]) and arows2[-3][1] == pytest.approx(expect)
-    assert arows2[-1][1] == pytest.approx(row[4]) and arows2[-2][1] == pytest.approx(row[3])
+    assert arows2[-5][1] == pytest.approx(arows[-1][1]) and arows2[-4][1] == pytest.approx(expect)
+    assert [r[1] for r in arows2[-3:]] == pytest.approx(row[3:6])
     with pytest.raises(ValueError, match=r"^method"):
         ex.evaluate(drives["L"][0], method="UKF")
 

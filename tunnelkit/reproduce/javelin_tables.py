@@ -4,8 +4,9 @@ Every run simulates a drive through the signal route (image method -> SRS tensor
 clock bias) once per condition and measures each epoch's tensor through several extraction
 routes (:data:`tunnelkit.tracking.javelin.experiment.EXTRACTIONS`): the paper's (CPD, eq. 11-24)
 and the joint maximum-likelihood fit of eq. 1 (``ml``); the tensors are identical, only the
-extraction differs. The table has four columns per configuration and metric: the paper's design
-(section 4.2) on the paper's route, the paper's design on the ML route, our design on the ML route
+extraction differs. The table has five columns per configuration and metric: the paper's design
+(section 4.2) on the paper's route, the paper's design on the ML route, the same with the
+curvature of a reflection centred on its VUE (``PAPER_VUE``), our design on the ML route
 (:data:`~tunnelkit.tracking.javelin.experiment.OURS_ML`, its noise set from the measured
 extraction error), and the paper's published number.
 """
@@ -35,6 +36,7 @@ _METRICS = ("rmse_2d_m", "mae_2d_m", "y_mae_m")
 COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("paper design, paper route", "paper", "paper"),
     ("paper design, ML route", "ml", "paper"),
+    ("paper design + VUE curvature, ML route", "ml", "paper-vue"),
     ("our design, ML route", "ml", "ours"),
 )
 #: the column added when the coherent route was measured too
@@ -44,7 +46,12 @@ COHERENT_COLUMN = ("our design, coherent route", "coherent", "ours-coherent")
 def _designs() -> dict:
     from ..tracking.javelin import experiment as ex
 
-    return {"paper": ex.PAPER, "ours": ex.OURS_ML, "ours-coherent": ex.OURS_COHERENT}
+    return {
+        "paper": ex.PAPER,
+        "paper-vue": ex.PAPER_VUE,
+        "ours": ex.OURS_ML,
+        "ours-coherent": ex.OURS_COHERENT,
+    }
 
 
 @dataclass(frozen=True)
@@ -143,7 +150,7 @@ def table_rows(
         for cond, drives in routes[route].items():
             for drive in drives:
                 entries = [(f"JAVELIN-{cond}", "JAVELIN", design)]
-                if cond == "L" and design == "paper":
+                if cond == "L" and design == "paper":  # once per route
                     entries.append(("TeNFiLoc-L", "TeNFiLoc", "none"))
                 for name, method, dname in entries:
                     key = (id(drive), method, dname)
@@ -174,7 +181,9 @@ NOTES = [
     "route with coherent paths separated by the array (refine='coherent').",
     "design 'paper': section 4.2 as printed (sigma_phi = sigma_psi = 2 deg, sigma_kappa = "
     "sigma_dd = 1.5 m, sigma_nu = 0.2 m/s, sigma_theta = 1 deg, sigma_P = 10 m, p = 0.99, "
-    "zeta = 1, gamma = 0.2, curvature of a reflection = distance to the reflection point, eq. 51).",
+    "zeta = 1, gamma = 0.2, curvature of a reflection = distance to the reflection point, eq. 51). "
+    "'paper design + VUE curvature': the same parameters, the curvature of a reflection modelled "
+    "as the distance to its VUE (the exact wavefront's radius, what the ML route measures).",
     "design 'ours' on the ML route (experiment.OURS_ML): Doppler clutter rejection, global "
     "nearest neighbour, mirrored VUE motion, no update at birth, curvature centred on the VUE, "
     "measurement noise = the RMS extraction error of the ML route measured on seed 0 drives.",
