@@ -210,7 +210,7 @@ print("Kruskal rank (frequency, time) at tolerance 1e-6 and 1e-2:", kr)
 two = signal_route.SignalRoute(
     route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "road")
 )
-n_cmp = tk.mc_count(40, 8)
+n_cmp = tk.mc_count(40, 4)
 cmp = {
     m: evaluation.rmse_study(two, k_demo, n_cmp, seed=7, refine=m)[0]
     for m in ("none", "column", "joint", "ml")
@@ -240,7 +240,7 @@ paths_table_figure(
 # truth for $d$), the paper's route first. Full mode: 200 snapshots.
 
 # %%
-n_mc = tk.mc_count(200, 12)
+n_mc = tk.mc_count(200, 6)
 study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11)
 study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11)
 paths_table_figure(study_all, title=f"Paper's route, all paths at epoch {k_demo}, {n_mc} snapshots")
@@ -249,8 +249,10 @@ paths_table_figure(study_all, title=f"Paper's route, all paths at epoch {k_demo}
 paths_table_figure(study_noceil, title=f"Paper's route, LoS + road only, {n_mc} snapshots")
 
 # %% [markdown]
-# With two well-separated paths (LoS + road) the paper's route gets $d$ and $v$ close to their
-# bound, but direction and $\kappa$ stay several times above it. With the whole cluster at 30 m —
+# The `CRLB` columns are the bound of eq. 1 itself (the structured model). With two
+# well-separated paths (LoS + road) the paper's route gets $d$ and $v$ close to the bound of the
+# model it fits (a free spatial factor, section 7), but direction and $\kappa$ stay several times
+# above theirs. With the whole cluster at 30 m —
 # LoS, ceiling, road and a road marking within a metre of each other and with the same Doppler —
 # the errors are orders of magnitude above the bound: decimetres in $d$, degrees in direction,
 # tens of metres in $\kappa$. That is the estimator, not the physics: the bound says a 23 cm
@@ -289,7 +291,7 @@ b_free = extraction.path_crlb(paths, array, cfg, spatial="free")
 b_struct = extraction.path_crlb(paths, array, cfg)
 print("CRLB d [mm], free spatial factor:", np.round(1e3 * b_free["d"], 2))
 print("CRLB d [mm], structured (eq. 1): ", np.round(1e3 * b_struct["d"], 2))
-study_ml = evaluation.rmse_study(route, k_demo, tk.mc_count(40, 3), seed=11, refine="ml")
+study_ml = evaluation.rmse_study(route, k_demo, tk.mc_count(40, 2), seed=11, refine="ml")
 paths_table_figure(study_ml, title=f"ML route, all paths at epoch {k_demo}")
 
 # %% [markdown]
@@ -298,10 +300,10 @@ paths_table_figure(study_ml, title=f"ML route, all paths at epoch {k_demo}")
 # The same comparison at several epochs of the drive, for the LoS path: the paper's route, the
 # coherent split and the ML stage against the bound, direction and $\kappa$ against the UE's
 # range (`tunnelkit.efficiency.drive_efficiency`, plotted by `tunnelkit.plots.efficiency_figure`).
-# Quick mode: three epochs, one snapshot each; full mode: every third epoch, 10 snapshots.
+# Quick mode: two epochs, one snapshot each; full mode: every third epoch, 10 snapshots.
 
 # %%
-drive_epochs = [2, 14, 26] if tk.quick_mode() else list(range(0, len(route.trajectory), 3))
+drive_epochs = [4, 24] if tk.quick_mode() else list(range(0, len(route.trajectory), 3))
 eff = drive_efficiency(route, drive_epochs, tk.mc_count(10, 1), seed=5)
 efficiency_figure(eff, "los")
 
@@ -319,7 +321,7 @@ efficiency_figure(eff, "los")
 # physics they are the VUEs, mirrored *outside* the tunnel.
 
 # %%
-step = 9 if tk.quick_mode() else 1
+step = 14 if tk.quick_mode() else 1
 origins = {}
 for model in ("srnf", "exact"):
     r_m = signal_route.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
@@ -514,12 +516,15 @@ assert np.max(np.abs(fast.d - d_true)) < 0.05  # noiseless small tensor: fast CP
 assert kr[1e-2][1] == 1  # the time factor is numerically rank one
 assert cmp["joint"]["RMSE d [m]"] < cmp["none"]["RMSE d [m]"]  # eq. 13 is not efficient
 assert cmp["ml"]["RMSE d [m]"] < 3 * cmp["ml"]["CRLB d [m]"]
-assert study_noceil[0]["RMSE d [m]"] < 2 * study_noceil[0]["CRLB d [m]"]  # LoS within 2x CRLB
-assert study_noceil[0]["RMSE v [m/s]"] < 2 * study_noceil[0]["CRLB v [m/s]"]
+# the paper's route on two separated paths: d and v within 2x the bound of the model it fits
+arr_two, paths_two = two.paths(k_demo)
+free_two = extraction.path_crlb(paths_two, arr_two, cfg, spatial="free")
+assert study_noceil[0]["RMSE d [m]"] < 2 * free_two["d"][0]
+assert study_noceil[0]["RMSE v [m/s]"] < 2 * free_two["v"][0]
 assert study_noceil[0]["RMSE dir [deg]"] < 2.0
 # the ML stage at the bound (loose in quick mode: RMS over few snapshots), the paper's route not
 ml_rows = {r["path"]: r for r in study_ml}
-assert ml_rows["los"]["matched"] >= 3 and ml_rows["los"]["missed"] == 0
+assert ml_rows["los"]["matched"] >= 2 and ml_rows["los"]["missed"] == 0
 for kind in ("los", "road", "ceiling"):
     lim = 4.0 if tk.quick_mode() else 1.5
     assert ml_rows[kind]["RMSE kappa [m]"] < lim * ml_rows[kind]["CRLB kappa [m]"], kind
