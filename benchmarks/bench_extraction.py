@@ -1,4 +1,5 @@
-"""Notebook 03: ``extract_paths`` at the paper's size (M = 100, Nf = 410, Nt = 12, L = 6).
+"""Notebook 03: the paper's route of ``extract_paths`` at the paper's size (M = 100, Nf = 410,
+Nt = 12, L = 6); the default (maximum-likelihood) route is timed in ``bench_ml.py``.
 
 Run single-threaded BLAS on a shared machine for stable numbers:
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/run.py -k extraction``. The baseline is tensorly's
@@ -45,7 +46,7 @@ def cases() -> list[Case]:
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        est = extraction.extract_paths(H, L, *args)
+        est = extraction.extract_paths(H, L, *args, refine="joint")
 
     g = "extract_paths"
     return [
@@ -55,7 +56,12 @@ def cases() -> list[Case]:
             group=g,
             repeat=7,
         ),
-        Case(f"extract_paths L={L}, fast + joint ML refine", lambda: run(), group=g, goal_s=0.1),
+        Case(
+            f"extract_paths L={L}, fast + joint roots (paper)",
+            lambda: run(refine="joint"),
+            group=g,
+            goal_s=0.1,
+        ),
         Case(
             f"extract_paths L={L}, fast + eq. 13 roots",
             lambda: run(refine="none"),

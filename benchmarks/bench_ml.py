@@ -25,11 +25,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from run import Case  # noqa: E402
+from run import Case
 
-from tunnelkit import channel, evaluation, extraction, propagation, signal_route  # noqa: E402
-from tunnelkit.constants import C  # noqa: E402
-from tunnelkit.montecarlo import spawn_rngs  # noqa: E402
+from tunnelkit import channel, evaluation, extraction, propagation, signal_route
+from tunnelkit.constants import C
+from tunnelkit.montecarlo import spawn_rngs
 
 PARAMS = ("d", "v", "direction", "kappa")
 DRIVES = ("italiano2026-straight", "italiano2026-slalom")
@@ -58,10 +58,20 @@ def cases() -> list[Case]:
 
     g = "ml"
     return [
-        Case(f"extract_paths L={L}, CPD + coherent split", lambda: run(refine="coherent"),
-             group=g, baseline=True, repeat=7),
-        Case(f"extract_paths L={L}, default (CPD + search + ML)", lambda: run(), group=g,
-             repeat=7, goal_s=0.25),
+        Case(
+            f"extract_paths L={L}, CPD + coherent split",
+            lambda: run(refine="coherent"),
+            group=g,
+            baseline=True,
+            repeat=7,
+        ),
+        Case(
+            f"extract_paths L={L}, default (CPD + search + ML)",
+            lambda: run(),
+            group=g,
+            repeat=7,
+            goal_s=0.25,
+        ),
     ]
 
 
@@ -74,7 +84,7 @@ def _tunnel_errors(route, rng, k):
     v_true = np.array([p.velocity for p in ep.paths])
     bound = extraction.path_crlb(ep.paths, ep.array, route.config)
     err = evaluation.normalized_errors(ep.estimates, d_true, v_true, src, bound)
-    return err, [p.surface_kind for p in ep.paths]
+    return err, [p.surface_kind for p in ep.paths], ep.estimates.fit
 
 
 def _scene_errors(rng):
@@ -82,10 +92,15 @@ def _scene_errors(rng):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         est = extraction.extract_paths(
-            sc.tensor(rng), len(sc.d), sc.element_positions, sc.config.fc,
-            sc.config.tone_spacing, sc.config.symbol_period,
+            sc.tensor(rng),
+            len(sc.d),
+            sc.element_positions,
+            sc.config.fc,
+            sc.config.tone_spacing,
+            sc.config.symbol_period,
         )
-    return evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb()), ["scene"] * len(sc.d)
+    err = evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb())
+    return err, ["scene"] * len(sc.d), est.fit
 
 
 def study(n_snapshots: int = 200, seed: int = 14) -> dict:
@@ -93,36 +108,58 @@ def study(n_snapshots: int = 200, seed: int = 14) -> dict:
     (half per drive), grouped by path kind; also the wall-clock time per snapshot."""
     routes = [signal_route.SignalRoute.from_scenario(d) for d in DRIVES]
     rows: dict[str, list] = {}
+    fits = {"scene": [], "tunnel": []}
     t0 = time.perf_counter()
     for i, rng in enumerate(spawn_rngs(seed, 2 * n_snapshots)):
         if i < n_snapshots:
-            err, kinds = _scene_errors(rng)
+            err, kinds, fit = _scene_errors(rng)
             tag = "scene"
         else:
             route = routes[i % 2]
             k = int(rng.integers(0, len(route.trajectory)))
-            err, kinds = _tunnel_errors(route, rng, k)
+            err, kinds, fit = _tunnel_errors(route, rng, k)
             tag = DRIVES[i % 2].split("-")[1]
+        fits["scene" if tag == "scene" else "tunnel"].append(
+            (fit.n_reseed, fit.rho > fit.rho_max, fit.n_iter)
+        )
         for e, kind in zip(err, kinds):
-            rows.setdefault(kind if tag == "scene" else f"{kind}", []).append(e)
+            if tag != "scene":
+                rows.setdefault(kind, []).append(e)
             rows.setdefault(f"all {tag}", []).append(e)
-    return {"errors": {k: np.array(v) for k, v in rows.items()},
-            "seconds": time.perf_counter() - t0}
+    return {
+        "errors": {k: np.array(v) for k, v in rows.items()},
+        "seconds": time.perf_counter() - t0,
+        "fits": {k: np.array(v, float).reshape(-1, 3) for k, v in fits.items()},
+    }
 
 
 def table(res: dict) -> str:
     lines = [
-        f"{'path kind':16s} {'n':>5s} " + " ".join(f"{'RMS ' + p:>14s}" for p in PARAMS)
-        + " " + " ".join(f"{'>6sig ' + p:>14s}" for p in PARAMS)
+        f"{'path kind':16s} {'n':>5s} "
+        + " ".join(f"{'RMS ' + p:>14s}" for p in PARAMS)
+        + " "
+        + " ".join(f"{'>6sig ' + p:>14s}" for p in PARAMS)
     ]
     for kind, e in sorted(res["errors"].items()):
         fin = np.isfinite(e)
         with np.errstate(invalid="ignore"):
-            rms = [np.sqrt(np.mean(e[fin[:, j], j] ** 2)) if fin[:, j].any() else np.nan
-                   for j in range(4)]
+            rms = [
+                np.sqrt(np.mean(e[fin[:, j], j] ** 2)) if fin[:, j].any() else np.nan
+                for j in range(4)
+            ]
         beyond = np.mean(~(np.abs(e) <= 6.0), axis=0) * 100
-        lines.append(f"{kind:16s} {len(e):5d} " + " ".join(f"{r:14.2f}" for r in rms) + " "
-                     + " ".join(f"{b:13.1f}%" for b in beyond))
+        lines.append(
+            f"{kind:16s} {len(e):5d} "
+            + " ".join(f"{r:14.2f}" for r in rms)
+            + " "
+            + " ".join(f"{b:13.1f}%" for b in beyond)
+        )
+    for tag, f in res["fits"].items():
+        lines.append(
+            f"{tag}: {len(f)} fits, re-seeded {np.mean(f[:, 0] > 0) * 100:.1f} %, basin test "
+            f"still failed {np.mean(f[:, 1]) * 100:.1f} %, median LM iterations "
+            f"{np.median(f[:, 2]):.0f}"
+        )
     return "\n".join(lines)
 
 
@@ -130,18 +167,26 @@ def report(n_snapshots: int | None = None) -> str:
     n = n_snapshots or int(os.environ.get("TUNNELKIT_BENCH_SNAPSHOTS", 200))
     with threadpool_limits(1):
         res = study(n)
-    return (f"RMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
-            f"({res['seconds']:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(res))
+    return (
+        f"RMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
+        f"({res['seconds']:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(res)
+    )
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--snapshots", type=int, default=200)
     ap.add_argument("--seed", type=int, default=14)
+    ap.add_argument("--save", default=None, help="write the normalised errors to this .npz")
     a = ap.parse_args()
     with threadpool_limits(1):
         r = study(a.snapshots, a.seed)
-    print(f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
-          f"load {os.getloadavg()[0]:.1f}")
+    print(
+        f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
+        f"load {os.getloadavg()[0]:.1f}"
+    )
     print(table(r))
-    np.savez(f"/tmp/bench_ml_{a.snapshots}_{a.seed}.npz", **{k.replace(' ', '_'): v for k, v in r["errors"].items()})
+    np.savez(
+        f"/tmp/bench_ml_{a.snapshots}_{a.seed}.npz",
+        **{k.replace(" ", "_"): v for k, v in r["errors"].items()},
+    )

@@ -1,6 +1,7 @@
 """Benchmark runner: ``make bench`` (or ``python benchmarks/run.py [-k PATTERN] [--json FILE]``).
 
-Every ``benchmarks/bench_*.py`` defines ``cases() -> list[Case]``. Each case is timed with
+Every ``benchmarks/bench_*.py`` defines ``cases() -> list[Case]`` (and may define
+``report() -> str``, an accuracy table printed after the timings). Each case is timed with
 ``timeit`` (repeats after a warm-up); we report the median and the interquartile range, and within
 a ``group`` the ratio of every case to the group's ``baseline`` case, all measured in the same run.
 Benchmarks are not tests: nothing here asserts a time.
@@ -86,11 +87,26 @@ def main(argv=None) -> int:
         )
         rs = f"{ratio:8.3f}" if ratio is not None else " " * 8
         print(f"{r['group']:18s} {r['name']:46s} {r['median_s'] * 1e3:8.3f} ms {iqr} {rs}  {goal}")
+    for rep in _load_reports(args.pattern):
+        print()
+        print(rep())
     out = Path(args.json)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(results, indent=2))
     print(f"\nwritten {out}")
     return 0
+
+
+def _load_reports(pattern: str | None) -> list[Callable[[], str]]:
+    """``report() -> str`` of the benchmark modules that define one (accuracy tables measured
+    alongside the timings, e.g. estimator error over its bound); filtered like the cases."""
+    out = []
+    for path in sorted(HERE.glob("bench_*.py")):
+        mod = sys.modules.get(path.stem)
+        group = path.stem.removeprefix("bench_")
+        if mod is not None and hasattr(mod, "report") and (pattern is None or pattern in group):
+            out.append(mod.report)
+    return out
 
 
 if __name__ == "__main__":

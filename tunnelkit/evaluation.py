@@ -80,7 +80,8 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     ``est`` a :class:`~tunnelkit.extraction.PathEstimates`, ``d_true`` (with the clock bias),
     ``v_true``, ``sources`` (L, 3) the true wave origins in the array's local frame, ``bound`` a
     dict of standard deviations (``path_crlb`` / ``source_crlb`` units: m, m/s, rad, m). A true
-    path no estimate is matched to gets ``inf`` in every column; a far-field estimate (kappa NaN)
+    path no estimate is matched to gets ``inf`` in every column (every estimate of the route is
+    matched, not only Algorithm 1's ``d >= 0``; on the ML route those above the noise); a far-field estimate (kappa NaN)
     of a near-field path gets ``inf`` in the kappa column. The direction error is the angle
     between the unit vectors (non-negative).
     """
@@ -88,7 +89,12 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     rng_ = np.linalg.norm(src, axis=1)
     u = src / rng_[:, None]
     out = np.full((src.shape[0], 4), np.inf)
-    keep = np.flatnonzero(est.valid)
+    if est.significance is None:  # every estimate of the route (not Algorithm 1's d >= 0)
+        keep = np.arange(len(est))
+    else:  # the ML route: the paths that stand above the noise
+        from .extraction.ml import MIN_SIGNIFICANCE
+
+        keep = np.flatnonzero(est.significance >= MIN_SIGNIFICANCE)
     match = match_points(est.d[keep], est.direction[keep], d_true, u)
     for i, j in zip(keep, match):
         if j < 0:
@@ -248,15 +254,21 @@ def rmse_study(
     n_snapshots: int,
     seed: int,
     *,
-    refine: str = "joint",
+    refine: str = "ml",
     progress: bool = False,
+    spatial: str | None = None,
 ) -> list[dict]:
     """RMSE of ``d``, ``v``, direction and ``kappa`` per true path over seeded snapshots, with CRLBs.
 
     Each snapshot draws noise and a clock bias; estimates are matched to true paths (Hungarian);
     ``d`` errors are taken against ``length + c b`` (the bias is part of the truth), ``kappa``
     against the VUE distance (exact physics). Unmatched paths count in ``missed``.
+    ``refine`` is the extraction route (``extract_paths``); ``spatial`` the model of the ``d``/``v``
+    bound (:func:`~tunnelkit.extraction.path_crlb`): by default "free" for the paper's routes
+    ("joint", "column", "none": what a CPD can reach) and "structured" for "ml" and "coherent".
     """
+    if spatial is None:
+        spatial = "free" if refine in ("joint", "column", "none") else "structured"
     from .channel import synthesize
     from .extraction import extract_paths, path_crlb
     from .montecarlo import spawn_rngs
@@ -298,7 +310,7 @@ def rmse_study(
                 )
             )
         missed += np.isin(np.arange(len(paths)), match, invert=True)
-    bound = path_crlb(paths, arr, cfg)
+    bound = path_crlb(paths, arr, cfg, spatial=spatial)
     rows = []
     for j, p in enumerate(paths):
         e = np.array(err[j]).reshape(-1, 4)

@@ -38,7 +38,6 @@ import warnings
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from .._validate import integer, nonnegative, positive, probability
 from ..arrays import check_element_positions
@@ -107,87 +106,82 @@ def _steering_and_jacobian(theta, p, k0):
     return S, 1j * S[..., None] * dphase
 
 
-def _to_plane(u) -> np.ndarray:
-    """Unconstrained ``v`` with ``u = v / sqrt(1 + |v|^2)`` (starts pulled inside |u| <= 0.99)."""
-    u = np.asarray(u, float).reshape(-1, 2)
-    r = np.linalg.norm(u, axis=1, keepdims=True)
-    u = np.where(r > 0.99, u * 0.99 / np.maximum(r, 1e-300), u)
-    return u / np.sqrt(1.0 - np.sum(u**2, axis=1, keepdims=True))
-
-
-def _to_disc(v) -> tuple[np.ndarray, np.ndarray]:
-    """``u = v / sqrt(1 + |v|^2)`` (n, 2), always inside the unit disc, and ``du/dv`` (n, 2, 2)."""
-    v = np.asarray(v, float).reshape(-1, 2)
-    s = np.sqrt(1.0 + np.sum(v**2, axis=1))
-    u = v / s[:, None]
-    J = np.eye(2)[None] / s[:, None, None] - v[:, :, None] * v[:, None, :] / s[:, None, None] ** 3
-    return u, J
-
-
 def fit_sources(
     b, theta0, element_positions, fc: float, *, max_nfev: int = 40
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """Least-squares fit of ``b ~ S(theta) g`` (point sources, complex gains ``g``).
 
     ``theta0`` (n, 3) starts ``(u_x, u_y, 1 / kappa)`` per source; the gains start at their
-    least-squares values. The directions are searched as ``u = v / sqrt(1 + |v|^2)``, so a
-    source can never leave the front half-space, the curvature within ``[1 / KAPPA_MAX,
-    1 / KAPPA_MIN]``. All parameters take bounded trust-region steps (scipy's
-    ``least_squares``) with the analytic Jacobian of the model (real and imaginary parts
-    stacked), and the gains are re-solved exactly at the optimum.
+    least-squares values and stay concentrated out (variable projection). Levenberg-Marquardt
+    steps with the analytic Jacobian (Kaufman's form) are projected onto ``|u| <= 0.999`` (the
+    front half-space) and the curvature onto ``[1 / KAPPA_MAX, 1 / KAPPA_MIN]``; at most
+    ``max_nfev`` steps, stopping when a full Gauss-Newton step would lower the residual by
+    less than a relative ``1e-6``.
     Returns ``(theta (n, 3), g (n,), relative residual energy ||b - S g||^2 / ||b||^2)``.
     """
     b = np.asarray(b, complex)
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])
-    k0 = 2 * np.pi * positive("fc", fc) / C
-    th0 = np.asarray(theta0, float).reshape(-1, 3)
-    n = th0.shape[0]
-    v0 = _to_plane(th0[:, :2])
-    w0 = np.clip(th0[:, 2], 1 / KAPPA_MAX + 1e-12, 1 / KAPPA_MIN - 1e-12)
+    return _fit_sources(b, theta0, p, positive("fc", fc), max_nfev)
 
-    def theta(x):
-        vw = x[: 3 * n].reshape(n, 3)
-        u, du = _to_disc(vw[:, :2])
-        return np.column_stack([u, vw[:, 2]]), du
 
-    S0 = spherical_steering(source_points(np.column_stack([_to_disc(v0)[0], w0])), p, fc)
-    g0 = np.linalg.lstsq(S0, b, rcond=None)[0]
-    x0 = np.concatenate([np.column_stack([v0, w0]).ravel(), g0.real, g0.imag])
-    lb = np.concatenate([np.tile([-np.inf, -np.inf, 1 / KAPPA_MAX], n), np.full(2 * n, -np.inf)])
-    ub = np.concatenate([np.tile([np.inf, np.inf, 1 / KAPPA_MIN], n), np.full(2 * n, np.inf)])
+def _fit_sources(b, theta0, p, fc, max_nfev=40):
+    """:func:`fit_sources` on checked arguments: variable projection (the gains are
+    ``S^+ b``), Levenberg-Marquardt on ``(u_x, u_y, w)`` with Kaufman's Jacobian (as in
+    :mod:`.ml`, one spatial mode only), every step projected onto ``|u| <= 0.999``,
+    ``w in [1 / KAPPA_MAX, 1 / KAPPA_MIN]``."""
+    from .ml import _damped_step, _free_newton, _solve, spatial_phase
 
-    def gains(x):
-        return x[3 * n : 4 * n] + 1j * x[4 * n :]
+    k0 = 2 * np.pi * fc / C
+    th = np.asarray(theta0, float).reshape(-1, 3).copy()
+    n, m = th.shape[0], p.shape[0]
+    b2 = max(float(np.vdot(b, b).real), 1e-300)
 
-    def resid(x):
-        S = spherical_steering(source_points(theta(x)[0]), p, fc)
-        e = S @ gains(x) - b
-        return np.concatenate([e.real, e.imag])
+    def project(t):
+        r = np.hypot(t[:, 0], t[:, 1])
+        big = r > 0.999
+        t[big, :2] *= (0.999 / r[big])[:, None]
+        t[:, 2] = np.clip(t[:, 2], 1 / KAPPA_MAX, 1 / KAPPA_MIN)
+        return t
 
-    def jac(x):
-        th, du = theta(x)
-        S, dS = _steering_and_jacobian(th, p, k0)
-        dSv = dS.copy()
-        dSv[:, :, :2] = np.einsum("mni,nij->mnj", dS[:, :, :2], du)  # chain rule through u(v)
-        Jt = (dSv * gains(x)[None, :, None]).reshape(p.shape[0], 3 * n)
-        J = np.concatenate([Jt, S, 1j * S], axis=1)
-        return np.concatenate([J.real, J.imag], axis=0)
+    def evaluate(t):
+        psi, dx, dy, dw = spatial_phase(t, p, k0)
+        S = np.exp(1j * psi)
+        G = S.conj().T @ S
+        g = _solve(G, S.conj().T @ b)
+        r = b - S @ g
+        return S, np.stack([dx, dy, dw], axis=2), G, g, r, float(np.vdot(r, r).real)
 
-    sol = least_squares(
-        resid,
-        x0,
-        jac=jac,
-        bounds=(lb, ub),
-        method="trf",
-        x_scale="jac",
-        ftol=1e-6,
-        xtol=1e-6,
-        max_nfev=max_nfev,
-    )
-    th = theta(sol.x)[0]
-    S = spherical_steering(source_points(th), p, fc)
+    th = project(th)
+    cur = evaluate(th)
+    lam = 1e-3
+    for _ in range(max_nfev):
+        S, dpsi, G, g, r, cost = cur
+        D = (1j * dpsi * (S * g[None, :])[..., None]).reshape(m, 3 * n)
+        DS = D.conj().T @ S
+        A = (D.conj().T @ D - DS @ _solve(G, DS.conj().T)).real
+        grad = (D.conj().T @ r).real
+        lower = np.zeros((n, 3), bool)
+        lower[:, 2] = th[:, 2] <= 1 / KAPPA_MAX
+        upper = np.zeros((n, 3), bool)
+        upper[:, 2] = th[:, 2] >= 1 / KAPPA_MIN
+        free, dec = _free_newton(A, grad, lower.ravel(), upper.ravel())
+        if dec <= 1e-6 * cost + 1e-14 * b2:
+            break  # the full Gauss-Newton step would gain less than ftol = 1e-6
+        step = _damped_step(A, grad, free, lam)
+        if step is None:
+            lam *= 4.0
+            continue
+        th_new = project(th + step.reshape(n, 3))
+        new = evaluate(th_new)
+        if new[-1] < cost:
+            th, cur, lam = th_new, new, max(lam / 3.0, 1e-9)
+        else:
+            lam *= 4.0
+            if lam > 1e10:
+                break
+    S = cur[0]
     g = np.linalg.lstsq(S, b, rcond=None)[0]  # exact projection at the optimum
-    rel = float(np.linalg.norm(b - S @ g) ** 2 / max(np.linalg.norm(b) ** 2, 1e-300))
+    rel = float(np.linalg.norm(b - S @ g) ** 2 / b2)
     return th, g, rel
 
 
@@ -206,11 +200,11 @@ def _scan_grid(pos_bytes: bytes, m: int, fc: float, n_grid: int):
     return u, A
 
 
-def _scan_peak(r, p, fc: float, n_grid: int = 121) -> np.ndarray:
+def _scan_peak(r, p, fc: float, n_grid: int = 61) -> np.ndarray:
     """Direction cosines ``(u_x, u_y)`` of the strongest far-field beam of residual ``r``."""
     p = np.ascontiguousarray(p, float)
     u, A = _scan_grid(p.tobytes(), p.shape[0], float(fc), n_grid)
-    return u[int(np.argmax(np.abs(A.conj().T @ r)))]
+    return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H
 
 
 def split_component(
@@ -235,13 +229,13 @@ def split_component(
     """
     b = np.asarray(b, complex)
     p = np.asarray(element_positions, float)
-    th, g, rel = fit_sources(b, theta0, p, fc)
+    th, g, rel = _fit_sources(b, theta0, p, fc)
     scale = float(np.sqrt(np.mean(np.abs(b) ** 2)))
     while rel > tol and th.shape[0] < max_sources:
         S = spherical_steering(source_points(th), p, fc)
         u = _scan_peak(b - S @ g, p, fc)
         start = np.vstack([th, [u[0], u[1], 1 / 30.0]])
-        th2, g2, rel2 = fit_sources(b, start, p, fc)
+        th2, g2, rel2 = _fit_sources(b, start, p, fc)
         du = np.linalg.norm(th2[:, None, :2] - th2[None, :, :2], axis=-1)
         distinct = np.min(du[np.triu_indices(len(th2), 1)]) >= min_separation
         if not (rel2 < 0.5 * rel and distinct and np.max(np.abs(g2)) <= max_gain * scale):

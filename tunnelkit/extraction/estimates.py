@@ -20,7 +20,8 @@ class PathEstimates:
     convention), ``valid`` = Algorithm 1 keeps the path (``d >= 0``), ``kappa_nf`` the raw TLS
     value, ``delta`` (L, M) unwrapped path-length offsets (eq. 16), ``mu_f``/``mu_t`` the roots.
     ``fit`` holds the maximum-likelihood stage's :class:`~tunnelkit.extraction.ml.MLFit` (noise
-    power, basin test, per-path significance) on that route, ``None`` on the others.
+    power, basin test) on that route, ``None`` on the others; ``significance`` each path's
+    log-likelihood ratio against noise on that route (sorted like the rest), ``None`` elsewhere.
     """
 
     alpha: np.ndarray
@@ -41,6 +42,7 @@ class PathEstimates:
     n_iter: int = 0
     converged: bool = True
     fit: object = field(default=None, repr=False)
+    significance: np.ndarray | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return self.d.shape[0]

@@ -43,34 +43,47 @@ per parameter). Then
     J^H J = D^H D - (D^H B) G^{-1} (B^H D),      J^H r = -D^H r = -conj(c_l) (<dX_i, H> - (B^H dX_i)^H c),
 
 every inner product again a Hadamard product of mode Grams, and ``<dX_i, H>`` a contraction of
-``H`` with mode vectors: ``H`` is contracted with ``conj(t_l)`` and ``conj(k t_l)`` first
-(``M Nf Nt 2L`` products), then with the frequency vectors and the spatial ones. One iteration
-therefore costs two passes over ``H`` and a ``5L x 5L`` solve; no ``(M Nf Nt) x 5L`` matrix is
-ever formed. Levenberg-Marquardt: ``(Re J^H J + lambda diag(Re J^H J)) delta = Re(D^H r)``, a step
+``H`` with mode vectors: ``H``, stored once as an (M Nt) x Nf matrix, is multiplied by the
+``2L`` frequency vectors ``conj(f_l)``, ``conj(s f_l)`` (one BLAS product with a long inner
+dimension, ``M Nf Nt 2L`` products), then each path meets its time and spatial vectors (small).
+One iteration therefore costs one pass over ``H`` and a ``5L x 5L`` solve; no
+``(M Nf Nt) x 5L`` matrix is ever formed. Levenberg-Marquardt: ``(Re J^H J + lambda diag(Re J^H J)) delta = Re(D^H r)``, a step
 is kept only if the cost drops, ``lambda`` shrinks by 3 on success and grows by 4 on failure.
 
 Stopping rule
 -------------
-In units of the noise, ``delta^T Re(J^H J) delta / sigma^2`` is the squared step length
+The Newton decrement ``g^T (Re J^H J)^{-1} g`` (``g = Re D^H r``) is the cost decrease a full
+Gauss-Newton step promises; in units of ``sigma^2`` it is the squared distance to the optimum
 measured in standard deviations of the estimate (the Fisher information of the concentrated
-model is ``2 Re(J^H J) / sigma^2``). The iteration stops when the kept step is below
-``STEP_TOL`` (0.01 sigma in every direction together) or ``lambda`` exceeds ``1e10``.
+model is ``2 Re(J^H J) / sigma^2``). The iteration stops when it is below ``STEP_TOL``
+(0.01 sigma in every direction together), or when ``lambda`` exceeds ``1e10`` (no descent left
+at working precision: the cost is resolved to about ``1e-5 sigma^2``).
 
 Noise floor and basin test
 --------------------------
 The noise power is estimated without the model from the time-mode unfolding ``H_(3)`` (Nt x
 M Nf): the signal occupies at most ``L`` of its ``Nt`` dimensions, so the ``Nt - L`` smallest
 eigenvalues of ``H_(3) H_(3)^H`` hold noise only, ``sigma^2 ~ sum / ((Nt - L)(M Nf - L))`` (the
-space mode is used when ``L >= Nt``); or it is given by the caller. At the maximum-likelihood
+space mode is used when ``L >= Nt``); or it is given by the caller. The estimate runs low by up
+to about ``L sqrt(Nt / (M Nf)) / (Nt - L)`` (1 % for five paths) when paths share a Doppler bin
+(the ``L`` largest eigenvalues then include noise maxima); half of that is added to the
+threshold below. At the maximum-likelihood
 estimate of the right model, ``2 ||r||^2 / sigma^2`` is chi-square with ``2N - 5L`` degrees of
 freedom (``N = M Nf Nt``, the gains included), so ``rho = ||r||^2 / ((N - 2.5 L) sigma^2)`` is
-``1 +- sqrt(1 / N)``. A fit with ``rho`` above ``1 + RHO_Z sqrt(1 / N + 1 / N_sigma)`` has not
-found the right basin (a path missed, merged or counted twice): the worst path (the one whose
-removal raises the cost least, ``|c_l|^2 / [G^{-1}]_ll``) is dropped and re-seeded by a SAGE-like
-search of the residual (plus, as an alternative, the residual plus its own contribution):
-rank-one power iterations for its frequency and time vectors, a periodogram peak for
-``mu_f`` and ``mu_t``, a far-field beam scan for ``u``, a 1-D scan of ``w``, a local
-single-source fit, then the joint fit of all ``L`` paths again; kept only if the likelihood rises.
+``1 +- sqrt(1 / N)``. A fit with ``rho`` above ``1 + RHO_Z sqrt(1 / N + 1 / N_sigma)`` (plus
+the allowance) has not found the right basin
+(a path missed, merged or counted twice) and is re-seeded, SAGE-like, alternating two moves,
+each kept only if the likelihood rises:
+
+- *birth and death*: one path more, sought in the pure residual ``r``, all ``L + 1`` fitted
+  jointly, the least significant one out and the ``L`` fitted again;
+- *replace the weakest*: the path whose removal raises the cost least (``|c_l|^2 /
+  [G^{-1}]_ll``) is dropped and sought again in ``H`` less the other paths (the residual plus
+  its own contribution).
+
+A search takes the dominant rank-one term of its tensor (power iterations), the periodogram peaks
+of its frequency and time vectors for ``mu_f`` and ``mu_t``, a far-field beam scan of its spatial
+vector for ``u``, a 1-D scan of ``w`` and a local single-source fit.
 
 Each path's significance ``|c_l|^2 / ([G^{-1}]_ll sigma^2)`` is its log-likelihood ratio; a path
 below ``MIN_SIGNIFICANCE`` is indistinguishable from noise: it is returned with ``valid = False``
@@ -86,9 +99,10 @@ and algorithms (RIMAX)", PhD thesis, TU Ilmenau, 2005; Golub & Pereyra, SIAM J. 
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.linalg.blas import zherk
 
 from .._validate import integer, positive
 from ..arrays import check_element_positions
@@ -186,7 +200,7 @@ class _Problem:
     def __init__(self, H, pos, fc):
         self.H = H
         self.M, self.nf, self.nt = H.shape
-        self.H2 = H.reshape(self.M * self.nf, self.nt)
+        self.Hp = np.ascontiguousarray(H.transpose(0, 2, 1)).reshape(self.M * self.nt, self.nf)
         self.pos = pos
         self.k0 = 2 * np.pi * fc / C
         self.s = np.arange(self.nf, dtype=float)[:, None]
@@ -201,17 +215,13 @@ class _Problem:
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])
         if not derivatives:
-            Ht = (self.H2 @ T.conj()).reshape(self.M, self.nf, L)
-            b = np.einsum("ml,ml->l", a.conj(), np.einsum("msl,sl->ml", Ht, F.conj()))
+            b = np.einsum("ml,ml->l", a.conj(), self._contract(T, F))
             G = (a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T)
             c, cost = _solve_gains(G, b, self.h2)
             return {"c": c, "cost": cost, "G": G, "b": b}
         sF = 1j * self.s * F
         kT = 1j * self.kk * T
-        Ht = (self.H2 @ np.concatenate([T, kT], axis=1).conj()).reshape(self.M, self.nf, 2 * L)
-        W_ft = np.einsum("msl,sl->ml", Ht[:, :, :L], F.conj())
-        W_sft = np.einsum("msl,sl->ml", Ht[:, :, :L], sF.conj())
-        W_fkt = np.einsum("msl,sl->ml", Ht[:, :, L:], F.conj())
+        W_ft, W_sft, W_fkt = self._contract(T, F, sF, kT)
         ax, ay, aw = 1j * dx * a, 1j * dy * a, 1j * dw * a
         # atoms: L model atoms, then per path (u_x, u_y, w, mu_f, mu_t)
         X = np.concatenate([a, np.stack([ax, ay, aw, a, a], axis=2).reshape(self.M, 5 * L)], 1)
@@ -242,6 +252,21 @@ class _Problem:
         JJ = DD - DB @ _solve(G, DB.conj().T)
         return {"c": c, "cost": cost, "G": G, "b": b, "A": JJ.real, "g": Dr.real, "a": a}
 
+    def _contract(self, T, F, sF=None, kT=None):
+        """``W[m, l] = sum_{s,k} H[m, s, k] conj(F[s, l] T[k, l])`` (M, L); with ``sF`` and ``kT``
+        also the same with ``sF`` for ``F`` and with ``kT`` for ``T``. ``H``, stored once as
+        (M Nt) x Nf, meets the frequency vectors first (one BLAS product with a long inner
+        dimension), then each path its time vectors (small)."""
+        L = T.shape[1]
+        if kT is None:
+            Hf = (self.Hp @ F.conj()).reshape(self.M, self.nt, L)
+            return np.einsum("mkl,kl->ml", Hf, T.conj())
+        Hf = (self.Hp @ np.concatenate([F, sF], axis=1).conj()).reshape(self.M, self.nt, 2 * L)
+        W_ft = np.einsum("mkl,kl->ml", Hf[:, :, :L], T.conj())
+        W_sft = np.einsum("mkl,kl->ml", Hf[:, :, L:], T.conj())
+        W_fkt = np.einsum("mkl,kl->ml", Hf[:, :, :L], kT.conj())
+        return W_ft, W_sft, W_fkt
+
     def model(self, theta, mu_f, mu_t, c) -> np.ndarray:
         a = np.exp(1j * spatial_phase(theta, self.pos, self.k0)[0])
         F = np.exp(1j * self.s * mu_f[None, :])
@@ -267,8 +292,9 @@ def noise_floor(H, n_paths: int) -> float:
     M, nf, nt = H.shape
     L = integer("n_paths", n_paths, minimum=0)
     if L < nt:
-        U = H.reshape(M * nf, nt)
-        ev = np.linalg.eigvalsh(U.conj().T @ U)[: nt - L]
+        # time-mode Gram by a rank-k update (zherk): conj(H_(3) H_(3)^H), same eigenvalues
+        G = zherk(1.0, H.reshape(M * nf, nt).T, trans=0)
+        ev = np.linalg.eigvalsh(G, UPLO="U")[: nt - L]
         return float(max(np.sum(ev), 0.0) / ((nt - L) * (M * nf - L)))
     if L < M:
         U = H.reshape(M, nf * nt)
@@ -283,11 +309,17 @@ def _lm(prob: _Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
     ev = prob.evaluate(theta, mu_f, mu_t)
     lam, it, converged = 1e-3, 0, False
     for it in range(1, max_iter + 1):  # noqa: B007
-        A, g = ev["A"], ev["g"]
-        dA = np.maximum(np.diag(A), 1e-300)
-        try:
-            step = np.linalg.solve(A + lam * np.diag(dA), g)
-        except np.linalg.LinAlgError:
+        lower = np.zeros((L, 5), bool)
+        lower[:, 2] = theta[:, 2] <= 0.0
+        upper = np.zeros((L, 5), bool)
+        upper[:, 2] = theta[:, 2] >= W_MAX
+        # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
+        free, dec = _free_newton(ev["A"], ev["g"], lower.ravel(), upper.ravel())
+        if dec < STEP_TOL * sigma2:
+            converged = True
+            break
+        step = _damped_step(ev["A"], ev["g"], free, lam)
+        if step is None:
             lam *= 4.0
             continue
         st = step.reshape(L, 5)
@@ -295,22 +327,66 @@ def _lm(prob: _Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
         mf_new, mt_new = mu_f + st[:, 3], mu_t + st[:, 4]
         ev_new = prob.evaluate(th_new, mf_new, mt_new)
         if ev_new["cost"] < ev["cost"]:
-            # the step actually taken (after projection), measured in standard deviations
-            taken = np.concatenate(
-                [th_new - theta, (mf_new - mu_f)[:, None], (mt_new - mu_t)[:, None]], 1
-            ).ravel()
-            size = float(taken @ A @ taken) / sigma2
             theta, mu_f, mu_t, ev = th_new, mf_new, mt_new, ev_new
             lam = max(lam / 3.0, 1e-9)
-            if size < STEP_TOL:
-                converged = True
-                break
         else:
             lam *= 4.0
             if lam > 1e10:
                 converged = True  # no descent direction left at working precision
                 break
     return theta, mu_f, mu_t, ev, it, converged
+
+
+def _birth_death(prob: _Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
+    """One path more, sought in the pure residual; all ``L + 1`` fitted jointly; the least
+    significant one out and the ``L`` fitted again (a path missed while another was counted
+    twice, or two paths merged, leave a structured residual that this move picks up)."""
+    r = prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
+    th_n, mf_n, mt_n = _search_path(r, prob)
+    big = _lm(
+        prob,
+        np.vstack([theta, th_n]),
+        np.append(mu_f, mf_n),
+        np.append(mu_t, mt_n),
+        sigma2,
+        max_iter,
+    )
+    keep = np.arange(theta.shape[0] + 1) != int(np.argmin(_significance(big[3], sigma2)))
+    res = _lm(prob, big[0][keep], big[1][keep], big[2][keep], sigma2, max_iter)
+    return res, big[4] + res[4]
+
+
+def _free_newton(A, g, lower, upper):
+    """Coordinates free to move and the Newton decrement ``g^T A^{-1} g`` over them.
+
+    A coordinate at its lower (upper) bound whose Gauss-Newton step points down (up) is held:
+    the projection would undo its step. ``A`` is Jacobi-scaled before the solve (the
+    parameters differ by orders of magnitude)."""
+    free = np.ones(g.size, bool)
+    for _ in range(3):
+        sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
+        As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+        gs = sc * g[free]
+        newton = np.zeros(g.size)
+        newton[free] = sc * np.linalg.lstsq(As, gs, rcond=1e-12)[0]
+        out = (lower & (newton < 0)) | (upper & (newton > 0))
+        if not out.any():
+            break
+        free &= ~out
+    return free, float(g[free] @ newton[free])
+
+
+def _damped_step(A, g, free, lam):
+    """Levenberg-Marquardt step on the ``free`` coordinates (Marquardt's diagonal scaling)."""
+    sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
+    As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+    try:
+        sub = sc * np.linalg.solve(As + lam * np.eye(As.shape[0]), sc * g[free])
+    except np.linalg.LinAlgError:
+        return None
+    step = np.zeros(g.size)
+    step[free] = sub
+    return step
 
 
 def _significance(ev, sigma2) -> np.ndarray:
@@ -418,7 +494,7 @@ def fit_ml(
     ``theta`` (L, 3) is ``(u_x, u_y, 1/kappa)`` per path (local frame, ``|u| < 1``, ``w >= 0``);
     ``mu_f``, ``mu_t`` (L,) the Vandermonde frequencies. ``noise_power`` per sample (default:
     estimated, :func:`noise_floor`). ``n_reseed`` bounds the SAGE-like re-seedings (default
-    ``2 L``; 0 = local fit only). See the module text for the algorithm.
+    ``L``; 0 = local fit only). See the module text for the algorithm.
     """
     H = check_tensor(H)
     M = H.shape[0]
@@ -427,17 +503,22 @@ def fit_ml(
     L = np.atleast_2d(np.asarray(start[0])).shape[0]
     theta, mu_f, mu_t = _check_start(start, L)
     max_iter = integer("max_iter", max_iter, minimum=1)
-    n_reseed = 2 * L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0)
+    n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0)
     prob = _Problem(H, pos, fc)
+    bias = 0.0
     if noise_power is None:
         sigma2 = noise_floor(H, L)
-        n_sigma = (H.shape[2] - L) * (M * H.shape[1] - L) if L < H.shape[2] else prob.N
+        nt, rest = (H.shape[2], M * H.shape[1]) if L < H.shape[2] else (M, H.shape[1] * H.shape[2])
+        n_sigma = (nt - L) * (rest - L)
+        # the L largest eigenvalues also take the largest noise eigenvalues of the directions
+        # the signal barely occupies (paths sharing a Doppler bin): up to ~ L sqrt(nt/rest)/(nt-L)
+        bias = 0.5 * L * np.sqrt(nt / rest) / (nt - L)
     else:
         sigma2 = positive("noise_power", noise_power)
         n_sigma = np.inf
     sigma2 = max(sigma2, 1e-300 * max(prob.h2, 1e-300))
     dof = prob.N - 2.5 * L
-    rho_max = 1.0 + RHO_Z * np.sqrt(1.0 / prob.N + 1.0 / n_sigma)
+    rho_max = 1.0 + RHO_Z * np.sqrt(1.0 / prob.N + 1.0 / n_sigma) + bias
 
     ev0 = prob.evaluate(theta, mu_f, mu_t, derivatives=False)
     cost0 = ev0["cost"]
@@ -445,23 +526,27 @@ def fit_ml(
     n_it, kept = best[4], 0
     history = [best[3]["cost"] / (dof * sigma2)]
     tried: set = set()
-    for _ in range(n_reseed):
+    for attempt in range(n_reseed):
         theta, mu_f, mu_t, ev = best[:4]
         if ev["cost"] / (dof * sigma2) <= rho_max:
             break
-        sig = _significance(ev, sigma2)
-        order = [int(i) for i in np.argsort(sig) if int(i) not in tried]
-        if not order:
-            break
-        worst = order[0]
-        tried.add(worst)
-        keep = np.arange(L) != worst
-        R = H - prob.model(theta[keep], mu_f[keep], mu_t[keep], ev["c"][keep])
-        th_n, mf_n, mt_n = _search_path(R, prob)
-        th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
-        th2[worst], mf2[worst], mt2[worst] = th_n, mf_n, mt_n
-        cand = _lm(prob, th2, mf2, mt2, sigma2, max_iter)
-        n_it += cand[4]
+        if attempt % 2 == 0:  # birth and death: a path from the residual, then the weakest out
+            cand, its = _birth_death(prob, theta, mu_f, mu_t, ev, sigma2, max_iter)
+        else:  # the weakest path re-sought in the residual plus its own contribution
+            sig = _significance(ev, sigma2)
+            order = [int(i) for i in np.argsort(sig) if int(i) not in tried]
+            if not order:
+                continue
+            worst = order[0]
+            tried.add(worst)
+            keep = np.arange(L) != worst
+            R = H - prob.model(theta[keep], mu_f[keep], mu_t[keep], ev["c"][keep])
+            th_n, mf_n, mt_n = _search_path(R, prob)
+            th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
+            th2[worst], mf2[worst], mt2[worst] = th_n, mf_n, mt_n
+            cand = _lm(prob, th2, mf2, mt2, sigma2, max_iter)
+            its = cand[4]
+        n_it += its
         history.append(cand[3]["cost"] / (dof * sigma2))
         if cand[3]["cost"] < ev["cost"]:
             best, kept = cand, kept + 1
@@ -536,11 +621,10 @@ def estimates_from_fit(
         fit.n_iter,
         fit.converged,
     )
-    o = np.argsort(d)
-    signif = fit.significance[o] >= MIN_SIGNIFICANCE
-    from dataclasses import replace
-
-    return replace(est, valid=est.valid & signif, fit=fit)
+    signif = fit.significance[np.argsort(d)]
+    return replace(
+        est, valid=est.valid & (signif >= MIN_SIGNIFICANCE), fit=fit, significance=signif
+    )
 
 
 def ml_paths(
@@ -568,9 +652,10 @@ def ml_paths(
     ``near_field = kappa`` finite, ``phi``/``psi`` the local angles, ``kappa_nf`` = ``1/w``
     (``inf`` at ``w = 0``), ``delta`` (L, M) the model's path-length offsets
     ``||q - p_m|| - ||q||``, ``factors`` the model's unit-gain mode vectors ``(a, f, t)``,
-    ``rel_error`` = ``||r||^2 / ||H||^2``, ``valid`` = ``d >= 0`` and significant against the
-    noise (:data:`MIN_SIGNIFICANCE`), ``fit`` the :class:`MLFit` (noise power, basin test,
-    per-path significance).
+    ``rel_error`` = ``||r||^2 / ||H||^2``, ``valid`` = ``d >= 0`` (Algorithm 1: with a
+    negative clock bias a near vehicle can have ``d < 0``) and significant against the noise
+    (``significance >= MIN_SIGNIFICANCE``), ``significance`` each path's log-likelihood ratio,
+    ``fit`` the :class:`MLFit` (noise power, basin test).
     """
     H = check_tensor(H)
     M, nf, nt = H.shape

@@ -276,7 +276,7 @@ def simulate_routes(
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
-                ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
+                ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")  # the paper's route
             except (ValueError, np.linalg.LinAlgError) as exc:
                 ep0, failure = None, exc
             for e, a in acc.items():
