@@ -241,18 +241,18 @@ paths_table_figure(
 
 # %%
 n_mc = tk.mc_count(200, 6)
-study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11)
-study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11)
+study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11, refine="joint")
+study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11, refine="joint")
 paths_table_figure(study_all, title=f"Paper's route, all paths at epoch {k_demo}, {n_mc} snapshots")
 
 # %%
 paths_table_figure(study_noceil, title=f"Paper's route, LoS + road only, {n_mc} snapshots")
 
 # %% [markdown]
-# The `CRLB` columns are the bound of eq. 1 itself (the structured model). With two
-# well-separated paths (LoS + road) the paper's route gets $d$ and $v$ close to the bound of the
-# model it fits (a free spatial factor, section 7), but direction and $\kappa$ stay several times
-# above theirs. With the whole cluster at 30 m —
+# The bounds of $d$ and $v$ in these tables are those of the model the paper's route fits (a free
+# spatial factor, section 7); direction and $\kappa$ are bounded by eq. 1 itself. With two
+# well-separated paths (LoS + road) the paper's route gets $d$ and $v$ close to their bound, but
+# direction and $\kappa$ stay several times above theirs. With the whole cluster at 30 m —
 # LoS, ceiling, road and a road marking within a metre of each other and with the same Doppler —
 # the errors are orders of magnitude above the bound: decimetres in $d$, degrees in direction,
 # tens of metres in $\kappa$. That is the estimator, not the physics: the bound says a 23 cm
@@ -315,18 +315,21 @@ efficiency_figure(eff, "los")
 
 # ## 8. Estimated wave origins along the trajectory (cf. Fig. 5)
 #
-# For every epoch we place each near-field estimate (ML route) at
+# For every epoch we place each near-field estimate of the paper's route at
 # $p = \text{origin} + \hat\kappa\,\hat u$ and colour it by altitude. With the SR-NF channel
 # the origins are the reflection points (road markings low, the ceiling high); with the exact
-# physics they are the VUEs, mirrored *outside* the tunnel.
+# physics they are the VUEs, mirrored *outside* the tunnel. (The ML route places them to
+# centimetres, section 7; its search keeps $\kappa \ge 0.5$ m, which excludes the SR-NF ceiling
+# reflection point 0.2 m above the array.)
 
 # %%
-step = 14 if tk.quick_mode() else 1
+step = 7 if tk.quick_mode() else 1
 origins = {}
 for model in ("srnf", "exact"):
     r_m = signal_route.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
     eps = [
-        r_m.epoch(k, np.random.default_rng(100 + k)) for k in range(0, len(route.trajectory), step)
+        r_m.epoch(k, np.random.default_rng(100 + k), refine="joint")
+        for k in range(0, len(route.trajectory), step)
     ]
     origins[f"{model} channel"] = np.concatenate([e.measurements.wave_origins for e in eps])
 wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
@@ -424,14 +427,17 @@ paths_table_figure(imp_rows, title="ML route with and without impairments (LoS +
 #    `arr, ps = route.paths(12, tunnel=tun)`: the LoS and the road bounce are gone, the RRM and
 #    ceiling paths remain; the earliest arrival (path 0, the reference of $\Delta d$) is then a
 #    reflection, which is why JAVELIN tracks VUEs rather than assuming a LoS.
-# 2. At epoch 12 (200 snapshots) the LoS $d$ RMSE is about 0.47 m with the ceiling, 0.12 m
+# 2. On the paper's route (`refine="joint"`), at epoch 12 (200 snapshots) the LoS $d$ RMSE is
+#    about 0.47 m with the ceiling, 0.12 m
 #    without it, and 0.2 mm with LoS + road only: the ceiling path has the same delay and
 #    Doppler as the LoS within the noise, so the CPD must split their sum with the spatial factor
 #    alone, and a free spatial factor can rotate between them (Kruskal rank 1 in time, section 4).
 #    The free-model CRLB grows accordingly (compare `extraction.path_crlb` with and without it).
-# 3. Loop `snr_offset_db` over `range(0, -40, -5)` and call `evaluation.rmse_study(r, 12, 10, 0)`
-#    with `r = signal_route.SignalRoute(..., snr_offset_db=off)`; watch `missed` grow, weakest path
-#    first (compare `snap.snr_db`).
+# 3. Loop `snr_offset_db` over `range(0, -40, -5)` and call
+#    `evaluation.rmse_study(r, 12, 10, 0, refine="joint")` with
+#    `r = signal_route.SignalRoute(..., snr_offset_db=off)`; watch `missed` grow, weakest path
+#    first (compare `snap.snr_db`). Then the same with `refine="ml"`: the ML route keeps the paths
+#    longer, and its `MLDetectionWarning` says when one no longer stands above the noise.
 #
 # </details>
 #
