@@ -7,7 +7,7 @@ from tunnelkit.plots.javelin import (
     tracks_count_figure,
     trajectories_figure,
 )
-from tunnelkit.reproduce.javelin_tables import COLUMNS, collect_routes, table_rows
+from tunnelkit.reproduce.javelin_tables import COLUMNS, collect_routes, javelin_table, table_rows
 from tunnelkit.tracking.javelin import experiment as ex
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
@@ -203,6 +203,12 @@ def test_collect_routes_runs_through_run_trials_with_the_condition_per_child():
     np.testing.assert_array_equal(d.speed, out["paper"]["N"][0].speed)
     with pytest.raises(ValueError, match=r"^extraction"):
         collect_routes("italiano2026-straight", ("L",), 1, 0, n_epochs=1, extractions=("x",))
+    rep = javelin_table(
+        "italiano2026-straight", "italiano2026_table1", ("L",), 1, 3, False, ("paper",), 1
+    )
+    assert rep.columns == ["configuration", "metric", "paper design, paper route", "paper"]
+    assert [r[0] for r in rep.rows] == ["JAVELIN-L"] * 3 + ["TeNFiLoc-L"] * 3
+    assert rep.meta["extraction_failures"] == {"paper": 0} and rep.notes
 
 
 def test_vue_prediction_skips_the_los_only_when_it_exists():

@@ -205,10 +205,13 @@ def javelin_table(
     seed: int,
     progress: bool,
     extractions: tuple[str, ...] = ("paper", "ml"),
+    n_epochs: int | None = None,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
-    paper's number beside."""
-    routes = collect_routes(scenario, conditions, runs, seed, progress, extractions=extractions)
+    paper's number beside (``n_epochs`` truncates the drives, for quick checks)."""
+    routes = collect_routes(
+        scenario, conditions, runs, seed, progress, n_epochs=n_epochs, extractions=extractions
+    )
     cols, rows = table_rows(routes, reference)
     faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
     return Report(
