@@ -24,7 +24,8 @@ HERE = Path(__file__).resolve().parent
 
 @dataclass
 class Case:
-    """One timed callable. ``number`` calls per repeat; ``goal_s`` is informational only."""
+    """One timed callable. ``number`` calls per repeat; ``goal_s`` is informational only;
+    ``warmup=False`` skips the untimed first call (for whole commands run in a fresh process)."""
 
     name: str
     fn: Callable[[], object]
@@ -33,6 +34,7 @@ class Case:
     repeat: int = 15
     number: int = 1
     goal_s: float | None = None
+    warmup: bool = True
 
 
 def _load_cases(pattern: str | None) -> list[Case]:
@@ -58,7 +60,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     results = []
     for c in _load_cases(args.pattern):
-        c.fn()  # warm-up (imports, caches, JIT of BLAS paths)
+        if c.warmup:
+            c.fn()  # warm-up (imports, caches, JIT of BLAS paths)
         times = [t / c.number for t in timeit.repeat(c.fn, repeat=c.repeat, number=c.number)]
         q = statistics.quantiles(times, n=4) if len(times) >= 4 else [min(times), 0, max(times)]
         results.append(

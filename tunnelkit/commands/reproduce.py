@@ -1,8 +1,10 @@
-"""``tunnelkit reproduce TARGET [--runs N] [--seed S] [--format table|json]``."""
+"""``tunnelkit reproduce TARGET [--runs N] [--seed S] [--workers N | --scheduler ADDRESS]
+[--format table|json]``."""
 
 from __future__ import annotations
 
 import argparse
+import sys
 
 NAME = "reproduce"
 HELP = "reproduce a paper's result (Monte-Carlo), paper beside ours"
@@ -19,16 +21,56 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the random generator (default 0)")
     p.add_argument("--format", choices=["table", "json"], default="table")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_parallel_arguments(p)
+
+
+def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
+    """``--workers N | --scheduler ADDRESS`` and ``--connect-timeout`` (any command whose trials
+    go through :func:`tunnelkit.montecarlo.run_trials`; pass them on with :func:`parallel_kwargs`)."""
+    from ..montecarlo import CONNECT_TIMEOUT_S
+
+    par = p.add_mutually_exclusive_group()
+    par.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="run the trials on a local Dask cluster of N processes (default: serial)",
+    )
+    par.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="run the trials on a running Dask cluster, e.g. tcp://HOST:8786",
+    )
+    p.add_argument(
+        "--connect-timeout",
+        type=float,
+        default=CONNECT_TIMEOUT_S,
+        metavar="SECONDS",
+        help=f"give up on --scheduler after this long (default {CONNECT_TIMEOUT_S:g})",
+    )
+
+
+def parallel_kwargs(args: argparse.Namespace) -> dict:
+    """``workers``, ``scheduler`` and ``timeout`` for ``run_trials`` from the parsed arguments."""
+    return {"workers": args.workers, "scheduler": args.scheduler, "timeout": args.connect_timeout}
 
 
 def main(args: argparse.Namespace) -> int:
+    from ..montecarlo import TrialLost
     from ..reproduce import run
 
-    rep = run(
-        args.target,
-        runs=args.runs,
-        seed=args.seed,
-        progress=(args.format == "table" and not args.no_progress),
-    )
+    try:
+        rep = run(
+            args.target,
+            runs=args.runs,
+            seed=args.seed,
+            progress=(args.format == "table" and not args.no_progress),
+            **parallel_kwargs(args),
+        )
+    except TrialLost as exc:
+        print(f"tunnelkit reproduce: error: {exc}", file=sys.stderr)
+        return 1
     print(rep.to_json() if args.format == "json" else rep.to_table())
     return 0

@@ -3,7 +3,12 @@
 Adding a target is one module in this package with one decorated function::
 
     @register("jiang-crlb", help="...", default_runs=2000)
-    def jiang_crlb(runs: int, seed: int, progress: bool) -> Report: ...
+    def jiang_crlb(runs: int, seed: int, progress: bool, **parallel) -> Report: ...
+
+``parallel`` holds ``workers``, ``scheduler`` and ``timeout``; the target passes them on to
+:func:`tunnelkit.montecarlo.run_trials`, through which all its random trials go (module-level
+trial functions bound with ``functools.partial``, so Dask can ship them to other processes). The
+report must not depend on them: the same seed gives the same numbers serially or on N workers.
 
 Modules here are imported on first use of :data:`REGISTRY` via :func:`targets`.
 """
@@ -18,7 +23,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from .._validate import integer
+from .._validate import integer, positive
+from ..montecarlo import CONNECT_TIMEOUT_S, parallel_options
 
 __all__ = ["Report", "Target", "register", "run", "targets"]
 
@@ -84,12 +90,12 @@ class Report:
 
 @dataclass(frozen=True)
 class Target:
-    """A registered reproduction: ``fn(runs, seed, progress) -> Report``."""
+    """A registered reproduction: ``fn(runs, seed, progress, **parallel) -> Report``."""
 
     name: str
     help: str
     default_runs: int
-    fn: Callable[[int, int, bool], Report]
+    fn: Callable[..., Report]
 
 
 _REGISTRY: dict[str, Target] = {}
@@ -118,14 +124,27 @@ def targets() -> dict[str, Target]:
     return dict(sorted(_REGISTRY.items()))
 
 
-def run(name: str, *, runs: int | None = None, seed: int = 0, progress: bool = False) -> Report:
-    """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``."""
+def run(
+    name: str,
+    *,
+    runs: int | None = None,
+    seed: int = 0,
+    progress: bool = False,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    timeout: float = CONNECT_TIMEOUT_S,
+) -> Report:
+    """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
+    serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
+    :func:`tunnelkit.montecarlo.run_trials`). The report is the same either way."""
     reg = targets()
     if name not in reg:
         raise ValueError(f"name: unknown reproduce target {name!r}; available: {', '.join(reg)}")
     tgt = reg[name]
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
-    rep = tgt.fn(runs, seed, progress)
+    workers, scheduler = parallel_options(workers, scheduler)
+    timeout = positive("timeout", timeout)
+    rep = tgt.fn(runs, seed, progress, workers=workers, scheduler=scheduler, timeout=timeout)
     rep.meta = {"target": name, "runs": runs, "seed": seed, **rep.meta}
     return rep

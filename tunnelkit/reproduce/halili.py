@@ -7,11 +7,13 @@ is which; the comparison is qualitative, nothing is fitted to the paper's figure
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..drive import load_drive_config, make_drive
 from ..metrics import error_stats
-from ..montecarlo import spawn_rngs
+from ..montecarlo import run_trials
 from ..reference import load as load_reference
 from . import Report, register
 
@@ -20,20 +22,20 @@ OURS = "ours: synthetic"
 
 
 def pooled_errors(
-    runs: int, seed: int, progress: bool = False, config=None
+    runs: int, seed: int, progress: bool = False, config=None, **parallel
 ) -> dict[tuple[str, str], np.ndarray]:
-    """Errors of every (approach, sigma) over ``runs`` synthetic drives, pooled: (runs * T,) each."""
+    """Errors of every (approach, sigma) over ``runs`` synthetic drives, pooled: (runs * T,) each.
+
+    One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its
+    ``workers`` / ``scheduler`` / ``timeout``)."""
     from ..tracking.doppler import error_study
 
     drive = make_drive(load_drive_config() if config is None else config)
-    rngs = spawn_rngs(seed, runs)
-    if progress:
-        from tqdm.auto import tqdm
-
-        rngs = tqdm(rngs, desc="synthetic drives", leave=False)
+    trial = functools.partial(error_study, drive)
+    studies = run_trials(trial, runs, seed, progress=progress, desc="synthetic drives", **parallel)
     acc: dict[tuple[str, str], list[np.ndarray]] = {}
-    for rng in rngs:
-        for key, e in error_study(drive, rng).items():
+    for study in studies:
+        for key, e in study.items():
             acc.setdefault(key, []).append(e)
     return {k: np.concatenate(v) for k, v in acc.items()}
 
@@ -44,9 +46,9 @@ def pooled_errors(
     "paper's measured-data statistics and 90 % error points",
     default_runs=20,
 )
-def halili(runs: int, seed: int, progress: bool) -> Report:
+def halili(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """One paper row per approach (stats), then our rows per sigma with the paper's p90 beside."""
-    return halili_report(pooled_errors(runs, seed, progress))
+    return halili_report(pooled_errors(runs, seed, progress, **parallel))
 
 
 def halili_report(errs: dict[tuple[str, str], np.ndarray]) -> Report:

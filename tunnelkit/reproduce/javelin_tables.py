@@ -13,7 +13,7 @@ extraction error), and the paper's published number.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
 
 import numpy as np
 
@@ -54,26 +54,11 @@ def _designs() -> dict:
     }
 
 
-@dataclass(frozen=True)
-class _DriveTrial:
-    """One drive of :func:`collect_routes` (picklable for parallel runners). Trial ``i`` (the
-    last entry of its generator's ``SeedSequence`` spawn key) is run ``i // n`` under condition
-    ``conditions[i % n]``."""
+def _simulate(scenario: str, n_epochs: int | None, extractions: tuple[str, ...], cond: str, rng):
+    """One drive of ``cond`` through the signal route, measured through every extraction."""
+    from ..tracking.javelin import experiment as ex
 
-    scenario: str
-    conditions: tuple[str, ...]
-    extractions: tuple[str, ...]
-    n_epochs: int | None
-
-    def __call__(self, rng: np.random.Generator):
-        from ..tracking.javelin import experiment as ex
-
-        i = rng.bit_generator.seed_seq.spawn_key[-1]
-        cond = self.conditions[i % len(self.conditions)]
-        routes = ex.simulate_routes(
-            self.scenario, cond, rng, n_epochs=self.n_epochs, extractions=self.extractions
-        )
-        return cond, routes
+    return ex.simulate_routes(scenario, cond, rng, n_epochs=n_epochs, extractions=extractions)
 
 
 def collect_routes(
@@ -84,23 +69,32 @@ def collect_routes(
     progress: bool = False,
     n_epochs: int | None = None,
     extractions: tuple[str, ...] = ("paper", "ml"),
+    **parallel,
 ) -> dict[str, dict[str, list]]:
     """``runs`` seeded drives per condition through the signal route (the expensive part), each
     measured through every route in ``extractions`` from the same tensors
-    (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`), run by
-    :func:`tunnelkit.montecarlo.run_trials`: drive ``i`` (run ``i // n``, condition
-    ``i % n``) draws from the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive
-    (quick mode). Returns ``{extraction: {condition: [DriveData, ...]}}``."""
+    (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`). One trial of
+    :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its ``workers`` /
+    ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
+    the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode). Returns
+    ``{extraction: {condition: [DriveData, ...]}}``."""
     from ..tracking.javelin import experiment as ex
 
     conditions = tuple(conditions)
     extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
-    trial = _DriveTrial(scenario, conditions, extractions, n_epochs)
-    done = run_trials(
-        trial, runs * len(conditions), seed, progress=progress, desc=f"{scenario} drives"
+    jobs = [c for _ in range(runs) for c in conditions]
+    trial = functools.partial(_simulate, scenario, n_epochs, extractions)
+    results = run_trials(
+        trial,
+        len(jobs),
+        seed,
+        inputs=jobs,
+        progress=progress,
+        desc=f"{scenario} drives",
+        **parallel,
     )
     out: dict[str, dict[str, list]] = {e: {c: [] for c in conditions} for e in extractions}
-    for cond, routes in done:
+    for cond, routes in zip(jobs, results):
         for e, drive in routes.items():
             out[e][cond].append(drive)
     return out
@@ -114,12 +108,13 @@ def collect_drives(
     progress: bool = False,
     n_epochs: int | None = None,
     extraction: str = "paper",
+    **parallel,
 ) -> dict[str, list]:
     """:func:`collect_routes` through one route: ``{condition: [DriveData, ...]}``."""
     from ..tracking.javelin import experiment as ex
 
     e = ex.route_name(extraction)
-    return collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (e,))[e]
+    return collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (e,), **parallel)[e]
 
 
 def table_rows(
@@ -206,11 +201,20 @@ def javelin_table(
     progress: bool,
     extractions: tuple[str, ...] = ("paper", "ml"),
     n_epochs: int | None = None,
+    **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
-    paper's number beside (``n_epochs`` truncates the drives, for quick checks)."""
+    paper's number beside (``n_epochs`` truncates the drives, for quick checks; ``parallel``
+    goes to :func:`~tunnelkit.montecarlo.run_trials`)."""
     routes = collect_routes(
-        scenario, conditions, runs, seed, progress, n_epochs=n_epochs, extractions=extractions
+        scenario,
+        conditions,
+        runs,
+        seed,
+        progress,
+        n_epochs=n_epochs,
+        extractions=extractions,
+        **parallel,
     )
     cols, rows = table_rows(routes, reference)
     faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
@@ -229,7 +233,7 @@ def javelin_table(
     "paper and ML routes",
     default_runs=20,
 )
-def javelin_table1(runs: int, seed: int, progress: bool) -> Report:
+def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """Table 1 (straight trajectory)."""
     return javelin_table(
         "italiano2026-straight",
@@ -238,6 +242,7 @@ def javelin_table1(runs: int, seed: int, progress: bool) -> Report:
         runs,
         seed,
         progress,
+        **parallel,
     )
 
 
@@ -247,8 +252,14 @@ def javelin_table1(runs: int, seed: int, progress: bool) -> Report:
     "ML routes",
     default_runs=20,
 )
-def javelin_table2(runs: int, seed: int, progress: bool) -> Report:
+def javelin_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """Table 2 (slalom trajectory)."""
     return javelin_table(
-        "italiano2026-slalom", "italiano2026_table2", ("L", "N@0.5", "N"), runs, seed, progress
+        "italiano2026-slalom",
+        "italiano2026_table2",
+        ("L", "N@0.5", "N"),
+        runs,
+        seed,
+        progress,
+        **parallel,
     )

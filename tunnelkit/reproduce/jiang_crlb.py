@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .. import crlb, positioning
-from ..montecarlo import spawn_rngs
+from ..montecarlo import run_trials
 from ..scenarios import load_scenario
 from . import Report, register
 
@@ -15,26 +17,23 @@ from . import Report, register
     help="RMSE of LS and TSWLS beside sqrt(CRLB) at the straight trajectory's start, three noise levels",
     default_runs=2000,
 )
-def jiang_crlb(runs: int, seed: int, progress: bool) -> Report:
+def jiang_crlb(runs: int, seed: int, progress: bool, **parallel) -> Report:
     """One row per noise level of Tables 2-3; all trials at the straight trajectory's start point."""
     sc = load_scenario("jiang2023-straight")
     tunnel = sc.tunnel()
     stations = tunnel.virtual_stations(sc.base_station())
     p = sc.trajectory(tunnel).position[0]
-    rows = []
     levels = sc.noise_levels()
-    for (sth, sd), rng in zip(levels, spawn_rngs(seed, len(levels))):
-        bound = float(crlb.crlb_rmse(p, stations, sth, sd))
-        d_hat, th_hat = positioning.simulate_toa_doa(p, stations, sth, sd, rng, size=runs)
-        ls = float(
-            np.sqrt(np.mean(np.sum((positioning.ls_toa_doa(stations, d_hat, th_hat) - p) ** 2, -1)))
-        )
-        tw = float(
-            np.sqrt(
-                np.mean(np.sum((positioning.tswls(stations, d_hat, th_hat, sd, sth) - p) ** 2, -1))
-            )
-        )
-        rows.append([float(np.degrees(sth)), sd, ls, tw, bound, ls / bound, tw / bound])
+    trial = functools.partial(_level_row, p, stations, runs)
+    rows = run_trials(
+        trial,
+        len(levels),
+        seed,
+        inputs=list(levels),
+        progress=progress,
+        desc="noise levels",
+        **parallel,
+    )
     return Report(
         title="Jiang 2023 - NLOS joint TOA/DOA from two virtual stations: RMSE vs sqrt(CRLB)",
         columns=[
@@ -53,3 +52,17 @@ def jiang_crlb(runs: int, seed: int, progress: bool) -> Report:
             "The paper reports no per-point RMSE table for this experiment; the bound is the reference.",
         ],
     )
+
+
+def _level_row(p, stations, runs: int, level: tuple[float, float], rng) -> list[float]:
+    """One noise level: ``runs`` vectorised draws at ``p``, RMSE of LS and TSWLS beside the bound."""
+    sth, sd = level
+    bound = float(crlb.crlb_rmse(p, stations, sth, sd))
+    d_hat, th_hat = positioning.simulate_toa_doa(p, stations, sth, sd, rng, size=runs)
+    ls = float(
+        np.sqrt(np.mean(np.sum((positioning.ls_toa_doa(stations, d_hat, th_hat) - p) ** 2, -1)))
+    )
+    tw = float(
+        np.sqrt(np.mean(np.sum((positioning.tswls(stations, d_hat, th_hat, sd, sth) - p) ** 2, -1)))
+    )
+    return [float(np.degrees(sth)), sd, ls, tw, bound, ls / bound, tw / bound]

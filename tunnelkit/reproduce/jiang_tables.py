@@ -7,9 +7,11 @@ paper's numbers beside ours, plus our RMSE and its ratio to the posterior CRLB a
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from ..montecarlo import spawn_rngs
+from ..montecarlo import run_trials, spawn_rngs
 from ..reference import load as load_reference
 from ..scenarios import load_scenario
 from . import Report, register
@@ -28,52 +30,73 @@ def table_rows(
     scenario: str = "jiang2023-straight",
     n_particles: int = N_PARTICLES,
     levels: list[int] | None = None,
+    **parallel,
 ) -> list[dict]:
-    """One dict per (level, algorithm): paper and our mean/variance, RMSE, RMSE / sqrt(PCRLB)."""
+    """One dict per (level, algorithm): paper and our mean/variance, RMSE, RMSE / sqrt(PCRLB).
+
+    One trial of :func:`~tunnelkit.montecarlo.run_trials` per noise level (``parallel``: its
+    ``workers`` / ``scheduler`` / ``timeout``): its ``runs`` drives, every algorithm on them."""
     from ..tracking import registry
-    from ..tracking.pcrlb import vs_pcrlb
-    from ..tracking.virtual_station import FAMILY, experiment
+    from ..tracking.virtual_station import FAMILY
 
     paper = {
         (r["algorithm"], r["sigma_theta_deg"], r["sigma_d_m"]): r for r in load_reference(table)
     }
-    names = list(registry.family(FAMILY))
+    names = tuple(registry.family(FAMILY))
     n_levels = len(load_scenario(scenario).noise_levels())
     levels = list(range(n_levels)) if levels is None else levels
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
+    trial = functools.partial(_level_rows, scenario, los, runs, n_particles, names, paper)
+    per_level = run_trials(
+        trial,
+        len(levels),
+        seed,
+        inputs=levels,
+        progress=progress,
+        desc=f"{table} ({runs} runs, per noise level)",
+        **parallel,
+    )
+    return [row for rows in per_level for row in rows]
 
-        bar = tqdm(total=len(levels) * len(names), desc=f"{table} ({runs} runs)", leave=False)
+
+def _level_rows(
+    scenario: str,
+    los: bool,
+    runs: int,
+    n_particles: int,
+    names: tuple[str, ...],
+    paper: dict,
+    lv: int,
+    rng: np.random.Generator,
+) -> list[dict]:
+    """Noise level ``lv``: ``runs`` simulated drives, every algorithm in ``names`` on them."""
+    from ..tracking import registry
+    from ..tracking.pcrlb import vs_pcrlb
+    from ..tracking.virtual_station import FAMILY, experiment
+
+    exp = experiment(scenario, level=lv, los=los)
+    bound = vs_pcrlb(exp.model, exp.truth, exp.P0)
+    rng_data, *rng_alg = spawn_rngs(rng, 1 + len(names))
+    Z, x0 = exp.simulate(runs, rng_data)
+    sth_deg, sd = round(float(np.degrees(exp.model.sigma_theta)), 6), exp.model.sigma_d
     rows = []
-    for lv, rng in zip(levels, spawn_rngs(seed, len(levels))):
-        exp = experiment(scenario, level=lv, los=los)
-        bound = vs_pcrlb(exp.model, exp.truth, exp.P0)
-        rng_data, *rng_alg = spawn_rngs(rng, 1 + len(names))
-        Z, x0 = exp.simulate(runs, rng_data)
-        sth_deg, sd = round(float(np.degrees(exp.model.sigma_theta)), 6), exp.model.sigma_d
-        for name, r in zip(names, rng_alg):
-            opts = {"n_particles": n_particles} if name == "UPF" else {}
-            est = registry.get(FAMILY, name).run(exp.model, Z, x0, exp.P0, rng=r, **opts)
-            err = np.linalg.norm(est[..., :2] - exp.truth[:, :2], axis=-1)
-            ref = paper.get((name, sth_deg, sd), {})
-            rows.append(
-                {
-                    "algorithm": name,
-                    "sigma_theta_deg": sth_deg,
-                    "sigma_d_m": sd,
-                    "paper_mean_m": ref.get("mean_m"),
-                    "ours_mean_m": float(err.mean()),
-                    "paper_var_m2": ref.get("variance_m2"),
-                    "ours_var_m2": float(err.var()),
-                    "ours_rmse_m": float(np.sqrt(np.mean(err**2))),
-                    "rmse_over_pcrlb": float(np.sqrt(np.mean(err**2) / np.mean(bound**2))),
-                }
-            )
-            if bar is not None:
-                bar.update(1)
-    if bar is not None:
-        bar.close()
+    for name, r in zip(names, rng_alg):
+        opts = {"n_particles": n_particles} if name == "UPF" else {}
+        est = registry.get(FAMILY, name).run(exp.model, Z, x0, exp.P0, rng=r, **opts)
+        err = np.linalg.norm(est[..., :2] - exp.truth[:, :2], axis=-1)
+        ref = paper.get((name, sth_deg, sd), {})
+        rows.append(
+            {
+                "algorithm": name,
+                "sigma_theta_deg": sth_deg,
+                "sigma_d_m": sd,
+                "paper_mean_m": ref.get("mean_m"),
+                "ours_mean_m": float(err.mean()),
+                "paper_var_m2": ref.get("variance_m2"),
+                "ours_var_m2": float(err.var()),
+                "ours_rmse_m": float(np.sqrt(np.mean(err**2))),
+                "rmse_over_pcrlb": float(np.sqrt(np.mean(err**2) / np.mean(bound**2))),
+            }
+        )
     return rows
 
 
@@ -90,8 +113,10 @@ _NOTES = [
 ]
 
 
-def _report(table: str, title: str, los: bool, runs: int, seed: int, progress: bool) -> Report:
-    rows = table_rows(table, los=los, runs=runs, seed=seed, progress=progress)
+def _report(
+    table: str, title: str, los: bool, runs: int, seed: int, progress: bool, **parallel
+) -> Report:
+    rows = table_rows(table, los=los, runs=runs, seed=seed, progress=progress, **parallel)
     cols = list(rows[0])
     return Report(
         title=title,
@@ -107,7 +132,7 @@ def _report(table: str, title: str, los: bool, runs: int, seed: int, progress: b
     help="Table 2 (NLOS): mean/variance of the error of TSWLS, EKF, UKF, UPF, paper beside ours",
     default_runs=100,
 )
-def jiang_table2(runs: int, seed: int, progress: bool) -> Report:
+def jiang_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
     return _report(
         "jiang2023_table2",
         "Jiang 2023 Table 2 - NLOS (two virtual stations), straight trajectory",
@@ -115,6 +140,7 @@ def jiang_table2(runs: int, seed: int, progress: bool) -> Report:
         runs,
         seed,
         progress,
+        **parallel,
     )
 
 
@@ -123,7 +149,7 @@ def jiang_table2(runs: int, seed: int, progress: bool) -> Report:
     help="Table 3 (LOS): mean/variance of the error of TSWLS, EKF, UKF, UPF, paper beside ours",
     default_runs=100,
 )
-def jiang_table3(runs: int, seed: int, progress: bool) -> Report:
+def jiang_table3(runs: int, seed: int, progress: bool, **parallel) -> Report:
     return _report(
         "jiang2023_table3",
         "Jiang 2023 Table 3 - LOS (base station + two virtual stations), straight trajectory",
@@ -131,4 +157,5 @@ def jiang_table3(runs: int, seed: int, progress: bool) -> Report:
         runs,
         seed,
         progress,
+        **parallel,
     )

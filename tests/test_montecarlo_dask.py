@@ -1,0 +1,210 @@
+"""Monte-Carlo trials on Dask: the same seed gives the same numbers serially and on 2 workers,
+a scheduler that does not answer fails fast, a dead worker never drops a trial.
+
+One 2-process LocalCluster on 127.0.0.1 is shared by the module (``--scheduler`` path); the CLI
+tests start their own with ``--workers 2``. Trial functions live at module level so the worker
+processes can import them (pytest puts ``tests/`` on ``sys.path``, which spawned workers inherit).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import json
+import os
+import socket
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from distributed import LocalCluster
+
+from tunnelkit.cli import main
+from tunnelkit.drive import load_drive_config
+from tunnelkit.montecarlo import SchedulerUnreachable, TrialLost, parallel_options, run_trials
+from tunnelkit.reproduce.halili import pooled_errors
+from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """Two single-threaded worker processes; a trial may kill its worker once (not twice)."""
+    with LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",
+        scheduler_kwargs={"allowed_failures": 1, "dashboard": False},
+        silence_logs=40,
+    ) as c:
+        yield c
+
+
+def _noisy_mean(n: int, rng: np.random.Generator) -> float:
+    return float(rng.standard_normal(n).mean())
+
+
+def _draw(rng: np.random.Generator) -> list[float]:
+    return rng.standard_normal(3).tolist()
+
+
+def _die_once(marker: str, n: int, rng: np.random.Generator) -> float:
+    """Trial 1 kills its worker process the first time it runs, then behaves."""
+    if n == 1 and not os.path.exists(marker):
+        open(marker, "w").close()
+        os._exit(1)
+    return _noisy_mean(n, rng)
+
+
+def _die_always(n: int, rng: np.random.Generator) -> float:
+    if n == 1:
+        time.sleep(0.3)  # let the other trials finish on their own workers first
+        os._exit(1)
+    return _noisy_mean(n, rng)
+
+
+def _fail(n: int, rng: np.random.Generator) -> float:
+    if n == 2:
+        raise ArithmeticError("bad draw")
+    return _noisy_mean(n, rng)
+
+
+def _closed_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_same_seed_same_results_serial_and_on_two_workers(cluster):
+    serial = run_trials(_draw, 12, seed=11)
+    remote = run_trials(_draw, 12, seed=11, scheduler=cluster.scheduler_address)
+    assert remote == serial and len({tuple(r) for r in serial}) == 12
+    assert run_trials(_draw, 12, seed=11, workers=1) == serial  # a LocalCluster of one process
+    gen = run_trials(_draw, 5, np.random.default_rng(3), scheduler=cluster.scheduler_address)
+    assert gen == run_trials(_draw, 5, np.random.default_rng(3))
+    sizes = [1, 50, 3, 7, 2, 9]
+    trial = functools.partial(_noisy_mean)
+    serial = run_trials(trial, 6, seed=2, inputs=sizes)
+    assert run_trials(trial, 6, seed=2, inputs=sizes, scheduler=cluster.scheduler_address) == serial
+    # trial i always gets child stream i, whatever the inputs: same as a hand loop
+    rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(2).spawn(6)]
+    assert serial == [_noisy_mean(n, r) for n, r in zip(sizes, rngs)]
+    assert run_trials(trial, 6, seed=2, inputs=np.array(sizes)) == serial
+
+
+def test_worker_death_reruns_the_trial(cluster, tmp_path):
+    marker = str(tmp_path / "died")
+    sizes = [4, 1, 5, 6]
+    trial = functools.partial(_die_once, marker)
+    out = run_trials(trial, 4, seed=9, inputs=sizes, scheduler=cluster.scheduler_address)
+    assert os.path.exists(marker)  # the worker did die
+    assert out == run_trials(_noisy_mean, 4, seed=9, inputs=sizes)  # and nothing was dropped
+
+
+def test_worker_dying_every_time_stops_the_run_naming_the_trial(cluster):
+    with pytest.raises(TrialLost, match=r"trial 1 of 3"):
+        run_trials(_die_always, 3, seed=0, inputs=[2, 1, 3], scheduler=cluster.scheduler_address)
+
+
+def test_trial_exception_propagates_with_its_index(cluster):
+    with pytest.raises(ArithmeticError, match="bad draw") as info:
+        run_trials(_fail, 4, seed=0, inputs=[1, 3, 2, 5], scheduler=cluster.scheduler_address)
+    assert any("trial 2 of 4" in n for n in info.value.__notes__)
+
+
+def test_dead_scheduler_fails_within_the_timeout():
+    addr = f"tcp://127.0.0.1:{_closed_port()}"
+    t0 = time.perf_counter()
+    with pytest.raises(SchedulerUnreachable, match=r"scheduler: no Dask scheduler .* within 1 s"):
+        run_trials(_draw, 3, seed=0, scheduler=addr, timeout=1.0)
+    assert time.perf_counter() - t0 < 6.0
+    assert issubclass(SchedulerUnreachable, ValueError)  # the CLI reports it as bad input
+
+
+def test_cli_dead_scheduler_is_an_error_not_a_hang(capsys):
+    addr = f"tcp://127.0.0.1:{_closed_port()}"
+    argv = ["reproduce", "jiang-crlb", "--runs", "10", "--scheduler", addr]
+    assert main([*argv, "--connect-timeout", "1"]) == 2
+    assert "scheduler: no Dask scheduler answered" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "exc", "match"),
+    [
+        ({"workers": 0}, ValueError, "workers: must be >= 1"),
+        ({"workers": 2.0}, TypeError, "workers: expected an integer"),
+        ({"workers": "2"}, TypeError, "workers: expected an integer"),
+        ({"workers": True}, TypeError, "workers: expected an integer"),
+        ({"workers": 2, "scheduler": "tcp://127.0.0.1:8786"}, ValueError, "workers, scheduler"),
+        ({"scheduler": 8786}, TypeError, "scheduler: expected an address"),
+        ({"scheduler": "tcp://127.0.0.1"}, ValueError, "scheduler: expected an address"),
+        ({"scheduler": "http://127.0.0.1:8786"}, ValueError, "scheduler: expected an address"),
+        ({"scheduler": "tcp://:8786"}, ValueError, "scheduler: expected an address"),
+        ({"scheduler": "tcp://h:99999"}, ValueError, "scheduler: expected an address"),
+        ({"scheduler": "tcp://h:8786/x"}, ValueError, "scheduler: expected an address"),
+        ({"inputs": [1, 2]}, ValueError, "inputs: expected 3 items"),
+        ({"inputs": "abc"}, TypeError, "inputs: expected a sequence"),
+        ({"timeout": 0}, ValueError, "timeout: must be > 0"),
+        ({"retries": -1}, ValueError, "retries: must be >= 0"),
+    ],
+)
+def test_bad_parallel_options(kwargs, exc, match):
+    with pytest.raises(exc, match=match):
+        run_trials(_noisy_mean if "inputs" in kwargs else _draw, 3, seed=0, **kwargs)
+
+
+def test_scheduler_address_is_normalised():
+    assert parallel_options(None, "10.0.0.5:8786") == (None, "tcp://10.0.0.5:8786")
+    assert parallel_options(3, None) == (3, None)
+    assert parallel_options(None, None) == (None, None)
+
+
+def _reproduce_json(capsys, *argv: str) -> dict:
+    assert main(["reproduce", *argv, "--format", "json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_reproduce_json_identical_serially_and_with_two_local_workers(capsys):
+    args = ("jiang-crlb", "--runs", "300", "--seed", "5")
+    serial = _reproduce_json(capsys, *args)
+    parallel = _reproduce_json(capsys, *args, "--workers", "2")
+    assert parallel == serial
+    assert serial["rows"][0]["rmse_ls_m"] > 0
+
+
+def test_reproduce_json_identical_on_a_running_cluster(cluster, capsys):
+    args = ("jiang-table3", "--runs", "1", "--seed", "2")
+    serial = _reproduce_json(capsys, *args)
+    assert _reproduce_json(capsys, *args, "--scheduler", cluster.scheduler_address) == serial
+
+
+def test_halili_errors_identical_on_a_running_cluster(cluster):
+    short = dataclasses.replace(load_drive_config(), duration=8.0, pass_time=4.0)
+    serial = pooled_errors(3, 4, config=short)
+    remote = pooled_errors(3, 4, config=short, scheduler=cluster.scheduler_address)
+    assert serial.keys() == remote.keys()
+    assert all(np.array_equal(serial[k], remote[k]) for k in serial)
+
+
+def test_javelin_drives_identical_on_a_running_cluster(cluster):
+    kw = {"n_epochs": 3, "extractions": ("paper",)}
+    serial = collect_routes("italiano2026-straight", ("L",), 2, 7, **kw)["paper"]
+    remote = collect_routes(
+        "italiano2026-straight", ("L",), 2, 7, scheduler=cluster.scheduler_address, **kw
+    )["paper"]
+    ref = "italiano2026_table1"
+    assert table_rows({"paper": remote}, ref) == table_rows({"paper": serial}, ref)
+
+
+def test_cli_bad_parallel_options(capsys):
+    assert main(["reproduce", "jiang-crlb", "--runs", "10", "--workers", "0"]) == 2
+    assert "workers: must be >= 1" in capsys.readouterr().err
+    assert main(["reproduce", "jiang-crlb", "--scheduler", "tcp://127.0.0.1"]) == 2
+    assert "scheduler: expected an address" in capsys.readouterr().err
+    with pytest.raises(SystemExit):  # argparse: not allowed with argument --workers
+        main(["reproduce", "jiang-crlb", "--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"])
+    assert "not allowed with" in capsys.readouterr().err
