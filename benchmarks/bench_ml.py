@@ -163,12 +163,41 @@ def table(res: dict) -> str:
     return "\n".join(lines)
 
 
+def cpu_times(repeat: int = 15) -> str:
+    """Median process (CPU) time of the default extraction and of the CPD + coherent route on
+    bench_extraction's tensor, one BLAS thread, interleaved: on a shared machine the wall-clock
+    medians of ``cases`` grow with the load, the CPU times much less."""
+    H, arr, cfg, L = _tensor()
+    args = (arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    out = {"default": [], "coherent": [], "cpd": []}
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        extraction.extract_paths(H, L, *args)  # warm-up (scan grid cache)
+        for _ in range(repeat):
+            for key, fn in (
+                ("default", lambda: extraction.extract_paths(H, L, *args)),
+                ("coherent", lambda: extraction.extract_paths(H, L, *args, refine="coherent")),
+                ("cpd", lambda: extraction.cpd(H, L, element_positions=arr.local)),
+            ):
+                t = time.process_time()
+                fn()
+                out[key].append(time.process_time() - t)
+    med = {k: float(np.median(v)) for k, v in out.items()}
+    return (
+        f"CPU time per extraction (L = {L}, M = {H.shape[0]}, Nf = {H.shape[1]}, "
+        f"Nt = {H.shape[2]}, median of {repeat}): default {med['default'] * 1e3:.0f} ms, "
+        f"CPD + coherent {med['coherent'] * 1e3:.0f} ms (ratio "
+        f"{med['default'] / med['coherent']:.2f}), CPD alone {med['cpd'] * 1e3:.0f} ms; goal 250 ms"
+    )
+
+
 def report(n_snapshots: int | None = None) -> str:
     n = n_snapshots or int(os.environ.get("TUNNELKIT_BENCH_SNAPSHOTS", 200))
     with threadpool_limits(1):
         res = study(n)
     return (
-        f"RMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
+        cpu_times()
+        + f"\nRMS(error / CRLB) and share beyond 6 sigma, {n} random scenes + {n} tunnel epochs "
         f"({res['seconds']:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(res)
     )
 
@@ -178,15 +207,17 @@ if __name__ == "__main__":
     ap.add_argument("--snapshots", type=int, default=200)
     ap.add_argument("--seed", type=int, default=14)
     ap.add_argument("--save", default=None, help="write the normalised errors to this .npz")
+    ap.add_argument("--cpu", action="store_true", help="also the CPU times of the extraction")
     a = ap.parse_args()
-    with threadpool_limits(1):
-        r = study(a.snapshots, a.seed)
-    print(
-        f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
-        f"load {os.getloadavg()[0]:.1f}"
-    )
-    print(table(r))
-    np.savez(
-        f"/tmp/bench_ml_{a.snapshots}_{a.seed}.npz",
-        **{k.replace(" ", "_"): v for k, v in r["errors"].items()},
-    )
+    if a.cpu:
+        print(cpu_times())
+    if a.snapshots > 0:
+        with threadpool_limits(1):
+            r = study(a.snapshots, a.seed)
+        print(
+            f"{a.snapshots} + {a.snapshots} snapshots, {r['seconds']:.0f} s, "
+            f"load {os.getloadavg()[0]:.1f}"
+        )
+        print(table(r))
+        if a.save:
+            np.savez(a.save, **{k.replace(" ", "_"): v for k, v in r["errors"].items()})

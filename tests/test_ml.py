@@ -289,3 +289,12 @@ def test_a_failed_fit_keeps_its_start_and_warns(monkeypatch):
 
 def _array():
     return signal_route.SignalRoute.from_scenario("italiano2026-straight").arrays[0]
+
+
+def test_too_few_paths_fail_the_basin_test_and_warn():
+    """Three strong sources fitted with n_paths = 2: the residual keeps the third one."""
+    sc = _scene(61, n_paths=3, snr_db=(0.0, 5.0))
+    H = sc.tensor(np.random.default_rng(4))
+    with pytest.warns(ml.MLConvergenceWarning, match="noise floor"):
+        est = extraction.extract_paths(H, 2, *_args(sc))
+    assert est.fit.rho > est.fit.rho_max and np.all(np.isfinite(est.d))

@@ -88,7 +88,8 @@ vector for ``u``, a 1-D scan of ``w`` and a local single-source fit.
 Each path's significance ``|c_l|^2 / ([G^{-1}]_ll sigma^2)`` is its log-likelihood ratio; a path
 below ``MIN_SIGNIFICANCE`` is indistinguishable from noise: it is returned with ``valid = False``
 and a :class:`MLDetectionWarning` says how many of the ``n_paths`` were found. If the fit cannot
-improve on its start it keeps the start and warns (:class:`MLConvergenceWarning`).
+improve on its start it keeps the start and warns (:class:`MLConvergenceWarning`); so does a
+fit whose residual still fails the basin test after the re-seedings.
 
 References: Fleury et al., "Channel parameter estimation in mobile radio environments using the
 SAGE algorithm", IEEE JSAC 17(3), 1999; Richter, "Estimation of radio channel parameters: models
@@ -127,13 +128,14 @@ U_MAX = 0.999
 W_MAX = 2.0  # kappa >= 0.5 m
 #: curvature below which a path is reported far-field (kappa = NaN), as in the coherent split
 W_FAR = 1e-3
-STEP_TOL = 1e-4  # squared step length in standard deviations
+STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
 MIN_SIGNIFICANCE = 25.0  # log-likelihood ratio of a path against noise
 
 
 class MLConvergenceWarning(RuntimeWarning):
-    """The maximum-likelihood stage could not improve on its start (the start is returned)."""
+    """The maximum-likelihood stage could not improve on its start (the start is returned), or
+    its residual stays above the noise floor after the re-seedings (basin test failed)."""
 
 
 class MLDetectionWarning(RuntimeWarning):
@@ -399,13 +401,13 @@ def _power_rank_one(R, n_iter: int = 6):
     """Dominant rank-one term ``x o y o z`` of ``R`` by alternating power iterations."""
     M, nf, nt = R.shape
     R2 = R.reshape(M * nf, nt)
-    _, V = np.linalg.eigh(R2.conj().T @ R2)
-    z = V[:, -1]
+    _, V = np.linalg.eigh(zherk(1.0, R2.T, trans=0), UPLO="U")  # conj of the time-mode Gram
+    z = V[:, -1].conj()
     Rz = (R2 @ z.conj()).reshape(M, nf)
     u, _, vh = np.linalg.svd(Rz, full_matrices=False)
     x, y = u[:, 0], vh[0].conj()
     for _ in range(n_iter):
-        z = np.einsum("msk,m,s->k", R, x.conj(), y.conj())
+        z = np.einsum("msk,m,s->k", R, x.conj(), y.conj(), optimize=True)
         z /= np.linalg.norm(z)
         Rz = (R2 @ z.conj()).reshape(M, nf)
         y = Rz.T @ x.conj()
@@ -561,6 +563,14 @@ def fit_ml(
         theta, mu_f, mu_t, ev = (*_check_start(start, L), ev0)
     if not np.all(np.isfinite(ev["c"])):
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
+    rho = float(ev["cost"] / (dof * sigma2))
+    if rho > rho_max:
+        warnings.warn(
+            f"fit_ml: the residual stays {rho:.4f} times the noise floor (test: {rho_max:.4f}) "
+            "after the re-seedings: a path may be missed or merged, or n_paths is too small",
+            MLConvergenceWarning,
+            stacklevel=2,
+        )
     return MLFit(
         theta,
         np.angle(np.exp(1j * mu_f)),
@@ -568,7 +578,7 @@ def fit_ml(
         ev["c"],
         float(ev["cost"]),
         float(sigma2),
-        float(ev["cost"] / (dof * sigma2)),
+        rho,
         float(rho_max),
         _significance(ev, sigma2),
         int(n_it),
