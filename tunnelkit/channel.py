@@ -24,7 +24,8 @@ Two impairments eq. 1 leaves out, both off by default (the tensor is then bit-id
 - **spatial wideband**: eq. 1 gives every element the delay of the reference antenna; the wave
   reaches element ``m`` ``delta_lm / c`` later, so the frequency phase depends on the element,
   ``exp(-j 2 pi s Df (tau_l + delta_lm / c))`` (``spatial_wideband=True``). Across the 100 MHz
-  band and a 23 cm aperture that is up to about 0.4 rad at the band edge.
+  band and a 23 cm aperture that is up to about 0.4 rad at the band edge. (The delay follows
+  the geometry; the carrier's spatial phase keeps eq. 1's printed sign.)
 
 :class:`Impairments` bundles the two for :class:`tunnelkit.signal_route.SignalRoute`.
 """
