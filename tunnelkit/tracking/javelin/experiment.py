@@ -432,7 +432,8 @@ ML_ERRORS_SEED0 = {"phi_deg": 0.228, "psi_deg": 0.309, "kappa_m": 3.60, "delta_d
 
 #: our design, tuned on separate seeds (seed 7, 4 drives per condition) and measured in the
 #: ablation: Doppler clutter rejection, measurement noise calibrated on what the CPD extraction
-#: actually delivers (angles ~5 deg, curvature nearly uninformative at 5-45 m for a 10 x 10 URA),
+#: actually delivers (angles ~5 deg, curvature tens of metres off at 5-45 m: the CPD route is far
+#: from the bound, which is centimetres; see :data:`OURS_ML` for the ML route),
 #: global nearest neighbour, VUEs moved with the mirrored UE displacement, births not used in the
 #: epoch they are born (their angles already placed them).
 OURS = JavelinConfig(
@@ -445,12 +446,12 @@ OURS = JavelinConfig(
     update_with_births=False,
 )
 
-#: our design on our measurement route (the separated extraction): as :data:`OURS`, with each
+#: our design on the coherent route (the separated extraction): as :data:`OURS`, with each
 #: path's curvature modelled as the distance to its VUE. That is the radius of the exact
 #: wavefront the channel carries (an image source), and what the separated extraction measures
 #: (each path is fitted as a point source). The paper's eq. 51 (the distance to the reflection
-#: point, SR-NF) stays in :data:`OURS` for the CPD route, whose merged components carry no
-#: usable curvature. Chosen on the tuning seed (7) for that physical reason, measured in the
+#: point, SR-NF) stays in :data:`OURS` for the CPD route, whose merged components' curvature
+#: belongs to no single path. Chosen on the tuning seed (7) for that physical reason, measured in the
 #: ablation on the others.
 OURS_COHERENT = OURS.with_(kappa_model="vue")
 OURS_SEPARATED = OURS_COHERENT  # older name
