@@ -402,13 +402,14 @@ for name, imp in impairments.items():
 paths_table_figure(imp_rows, title="ML route with and without impairments (LoS + road, epoch 12)")
 
 # %% [markdown]
-# Each impairment lifts the estimate one to three orders of magnitude off the bound: at 70 dB
+# Each impairment lifts the estimate two to four orders of magnitude off the bound: at 70 dB
 # of effective SNR even a 2° phase error per element is a bias far larger than the noise, and
 # the estimator, fitting the wrong model, converts it into a wrong direction and curvature. The
-# two are not alike, though. The spatial-wideband term is deterministic and known (it follows
-# from the geometry the fit estimates anyway): putting it in the model removes it at no cost.
-# The calibration error is not known; it is what limits a real array, and what a designer must
-# budget for — the bound of a real array is set by its calibration, not by its noise.
+# two are not alike, though. The spatial-wideband term is deterministic and follows from the
+# geometry the fit estimates anyway: it can be put in the model (the ML stage here does not), and
+# then it costs nothing. The calibration error is not known; even 0.5° and 0.05 dB leave the LoS
+# curvature metres off at 29 m. It is what limits a real array, and what a designer must budget
+# for — the bound of a real array is set by its calibration, not by its noise.
 #
 # ## Exercises
 #
