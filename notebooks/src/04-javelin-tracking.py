@@ -173,9 +173,12 @@ ecols, erows = ex.extraction_errors(straight_ml["L"] + slalom_ml["L"])
 javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per kind of path")
 
 # %% [markdown]
-# Directions to about a thousandth of a degree, curvature to about a decimetre, TDoAs to a
-# fraction of a millimetre: two to four orders of magnitude below the paper's assumed
-# $\sigma_\phi = \sigma_\psi = 2°$, $\sigma_\kappa = \sigma_{\Delta d} = 1.5$ m. The curvature the
+# Where the paths are well apart (the road markings) the ML route measures directions to about a
+# thousandth of a degree, curvature to about a decimetre and TDoAs to a fraction of a millimetre
+# — its Cramér–Rao bound, two to four orders of magnitude below the paper's assumed
+# $\sigma_\phi = \sigma_\psi = 2°$, $\sigma_\kappa = \sigma_{\Delta d} = 1.5$ m. The RMS of the
+# other kinds is set by a few epochs (mostly on the slalom) where two nearly coincident paths —
+# LoS, ceiling and road bounce — were swapped or merged: tenths of a degree and metres. The curvature the
 # ML route measures for a reflection is the distance to its **VUE** (the exact wavefront's
 # radius), not eq. 51's distance to the reflection point (the SR-NF model) — for the ceiling
 # bounce tens of metres against half a metre. The paper's design as printed uses eq. 51; we run
