@@ -1,6 +1,7 @@
 """Notebook 04: one JAVELIN step (association, management, Joseph update; extraction excluded)
 and one whole epoch of the signal route (channel synthesis + CPD extraction + the step), with
-the paper's extraction and with coherent paths separated (``tunnelkit.extraction.coherent``)."""
+the paper's extraction, with coherent paths separated (``tunnelkit.extraction.coherent``) and on
+the maximum-likelihood route (``extract_paths(refine="ml")``)."""
 
 from __future__ import annotations
 
@@ -52,9 +53,9 @@ def cases() -> list[Case]:
     )
     ks = itertools.cycle(range(1, 20))
 
-    def signal_epoch(separated: bool = False):
+    def signal_epoch(separated: bool = False, refine: str = "joint"):
         k = next(ks)
-        ep = route.epoch(k, sig_rng)
+        ep = route.epoch(k, sig_rng, refine=refine)
         if separated:
             ep = ex.separate_epoch(ep, route.config)
         m = ep.measurements
@@ -96,5 +97,12 @@ def cases() -> list[Case]:
             repeat=7,
             number=1,
             goal_s=0.5,
+        ),
+        Case(
+            "signal-route epoch: synth + ML extraction + step",
+            lambda: signal_epoch(refine="ml"),
+            group="javelin",
+            repeat=7,
+            number=1,
         ),
     ]

@@ -104,3 +104,115 @@ def test_simulate_epoch_route_recovers_the_los():
     assert m.z.shape == (4 * len(m) - 1,) and m.delta_d[0] == 0
     with pytest.raises(ValueError, match="k"):
         signal_route.simulate_epoch("italiano2026-straight", 999, np.random.default_rng(0))
+
+
+def _eq1_reference(paths, cfg, bias, nf, nt):
+    """Eq. 1 evaluated as the unimpaired code path does (for bit-identity)."""
+    k0 = 2 * np.pi * cfg.fc / C
+    delta = np.stack([p.delta() for p in paths], axis=1)
+    tau = np.array([p.lengths[0] for p in paths]) / C + bias
+    fd = np.array([p.doppler for p in paths])
+    alpha = np.sqrt(cfg.tx_power) * np.array([p.gain for p in paths])
+    bs = np.exp(1j * k0 * delta)
+    bf = np.exp(-2j * np.pi * cfg.tone_spacing * np.arange(nf)[:, None] * tau[None, :])
+    bt = np.exp(2j * np.pi * cfg.symbol_period * np.arange(nt)[:, None] * fd[None, :])
+    return np.einsum("ml,sl,kl->msk", bs * alpha, bf, bt, optimize=True)
+
+
+def test_impairments_off_leave_the_tensor_bit_identical(small):
+    _arr, paths = small
+    cfg = channel.SRSConfig()
+    H = channel.channel_tensor(paths, cfg, clock_bias=7e-9)
+    assert np.array_equal(H, _eq1_reference(paths, cfg, 7e-9, cfg.n_tones, cfg.n_symbols))
+    off = channel.channel_tensor(
+        paths, cfg, clock_bias=7e-9, calibration=None, spatial_wideband=False
+    )
+    assert np.array_equal(H, off)
+    a = channel.synthesize(paths, cfg, np.random.default_rng(3), n_tones=16)
+    b = channel.synthesize(
+        paths, cfg, np.random.default_rng(3), n_tones=16, calibration=None, spatial_wideband=False
+    )
+    assert np.array_equal(a.H, b.H) and a.clock_bias == b.clock_bias
+    # a route with no impairment (default, or all-zero impairments) draws nothing and
+    # synthesises exactly the same epochs from the same generator
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight", kinds=("los", "road"))
+    zero = route.with_impairments(channel.Impairments(), np.random.default_rng(5))
+    assert zero.calibration == {}
+    e1 = route.epoch(10, np.random.default_rng(9))
+    e2 = zero.epoch(10, np.random.default_rng(9))
+    assert np.array_equal(e1.snapshot.H, e2.snapshot.H)
+
+
+def test_spatial_wideband_matches_a_direct_per_element_computation(small):
+    arr, paths = small
+    cfg = channel.SRSConfig()
+    bias, nf, nt = -20e-9, 7, 3
+    H = channel.channel_tensor(
+        paths, cfg, clock_bias=bias, n_tones=nf, n_symbols=nt, spatial_wideband=True
+    )
+    ref = np.zeros((arr.M, nf, nt), complex)
+    for p in paths:
+        for m in range(arr.M):
+            dm = p.lengths[m] - p.lengths[0]
+            for s in range(nf):
+                for k in range(nt):
+                    ref[m, s, k] += (
+                        np.sqrt(cfg.tx_power)
+                        * p.gain
+                        * np.exp(2j * np.pi * cfg.fc / C * dm)
+                        * np.exp(
+                            -2j * np.pi * s * cfg.tone_spacing * (p.length / C + bias + dm / C)
+                        )
+                        * np.exp(2j * np.pi * k * p.doppler * cfg.symbol_period)
+                    )
+    np.testing.assert_allclose(H, ref, rtol=1e-12, atol=0)
+    # the reference antenna sees no change; the others a phase growing with the tone index
+    H0 = channel.channel_tensor(paths, cfg, clock_bias=bias, n_tones=nf, n_symbols=nt)
+    np.testing.assert_allclose(H[0], H0[0], rtol=1e-12, atol=0)
+    assert np.max(np.abs(H[1:, -1] - H0[1:, -1])) > 1e-4 * np.max(np.abs(H0))
+
+
+def test_calibration_error_has_the_stated_statistics(small):
+    arr, paths = small
+    g = channel.draw_calibration(np.random.default_rng(0), 40_000, 3.0, 0.5)
+    phase_deg = np.degrees(np.angle(g))
+    gain_db = 20 * np.log10(np.abs(g))
+    # 40 000 draws: the sample std is within 1.5 % (about 4 standard errors) of sigma
+    assert np.std(phase_deg) == pytest.approx(3.0, rel=0.015)
+    assert np.std(gain_db) == pytest.approx(0.5, rel=0.015)
+    assert abs(np.mean(phase_deg)) < 0.06 and abs(np.mean(gain_db)) < 0.01
+    assert abs(np.corrcoef(phase_deg, gain_db)[0, 1]) < 0.02
+    # explicit calibration multiplies each element's slice, nothing else
+    cfg = channel.SRSConfig()
+    cal = channel.draw_calibration(np.random.default_rng(1), arr.M, 5.0, 1.0)
+    H0 = channel.channel_tensor(paths, cfg, n_tones=6, n_symbols=2)
+    H1 = channel.channel_tensor(paths, cfg, n_tones=6, n_symbols=2, calibration=cal)
+    np.testing.assert_allclose(H1, cal[:, None, None] * H0, rtol=1e-14, atol=0)
+    # drawn once per array: every epoch of an impaired route uses the same vector
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    imp = channel.Impairments(phase_sigma_deg=2.0, gain_sigma_db=0.5)
+    bad = route.with_impairments(imp, np.random.default_rng(2))
+    assert set(bad.calibration) == {a.name for a in route.arrays}
+    again = route.with_impairments(imp, np.random.default_rng(2))
+    for name, v in bad.calibration.items():
+        assert np.array_equal(v, again.calibration[name]) and v.shape == (100,)
+
+
+def test_impairment_bad_input(small):
+    _arr, paths = small
+    cfg = channel.SRSConfig()
+    with pytest.raises(ValueError, match=r"^phase_sigma_deg"):
+        channel.Impairments(phase_sigma_deg=-1.0)
+    with pytest.raises(ValueError, match=r"^gain_sigma_db"):
+        channel.draw_calibration(np.random.default_rng(0), 4, 1.0, float("nan"))
+    with pytest.raises(TypeError, match=r"^spatial_wideband"):
+        channel.channel_tensor(paths, cfg, n_tones=4, spatial_wideband=1)
+    with pytest.raises(ValueError, match=r"^calibration"):
+        channel.channel_tensor(paths, cfg, n_tones=4, calibration=np.ones(3))
+    with pytest.raises(ValueError, match=r"^calibration"):
+        channel.channel_tensor(paths, cfg, n_tones=4, calibration=np.zeros(paths[0].lengths.size))
+    with pytest.raises(TypeError, match=r"^rng"):
+        channel.draw_calibration(0, 4, 1.0)
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    with pytest.raises(TypeError, match=r"^impairments"):
+        route.with_impairments({"phase_sigma_deg": 1.0}, np.random.default_rng(0))

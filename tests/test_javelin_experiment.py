@@ -7,7 +7,7 @@ from tunnelkit.plots.javelin import (
     tracks_count_figure,
     trajectories_figure,
 )
-from tunnelkit.reproduce.javelin_tables import table_rows
+from tunnelkit.reproduce.javelin_tables import COLUMNS, collect_routes, javelin_table, table_rows
 from tunnelkit.tracking.javelin import experiment as ex
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
@@ -65,30 +65,40 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     assert ev.metrics["rmse_2d_m"] < 0.5
     tf = ex.evaluate(drives["L"][0], method="TeNFiLoc")
     assert np.all(np.isfinite(tf.estimates))
-    cols, rows = table_rows(drives, "italiano2026_table1")
-    names = [(r[0], r[1]) for r in rows]
-    assert ("JAVELIN-L", "ours") in names and ("TeNFiLoc-L", "paper") in names
-    row = rows[names.index(("JAVELIN-L", "paper"))]
-    assert row[cols.index("paper_rmse_2d_m")] == pytest.approx(0.20)
+    # the table: one column per (route, design), the paper's number last
+    routes = {"paper": drives, "ml": {c: [_fake_drive(c, seed=5)] for c in drives}}
+    cols, rows = table_rows(routes, "italiano2026_table1")
+    assert cols == ["configuration", "metric", *(c[0] for c in COLUMNS), "paper"]
+    at = {(r[0], r[1]): r for r in rows}
+    assert [r[0] for r in rows[::3]] == ["JAVELIN-L", "JAVELIN-N", "TeNFiLoc-L"]  # paper's order
+    row = at[("JAVELIN-L", "rmse_2d_m")]
+    assert row[-1] == pytest.approx(0.20)
+    assert row[2] == pytest.approx(
+        ev_paper := ex.evaluate(drives["L"][0], ex.PAPER).metrics["rmse_2d_m"]
+    )
+    assert row[3] == pytest.approx(ex.evaluate(routes["ml"]["L"][0], ex.PAPER).metrics["rmse_2d_m"])
+    ml0 = routes["ml"]["L"][0]
+    assert row[4] == pytest.approx(ex.evaluate(ml0, ex.PAPER_VUE).metrics["rmse_2d_m"])
+    assert row[5] == pytest.approx(ex.evaluate(ml0, ex.OURS_ML).metrics["rmse_2d_m"])
+    assert ev_paper != row[3]
+    tf = at[("TeNFiLoc-L", "y_mae_m")]
+    assert tf[2] == pytest.approx(ex.evaluate(drives["L"][0], method="TeNFiLoc").metrics["y_mae_m"])
+    assert tf[3] == pytest.approx(ex.evaluate(ml0, method="TeNFiLoc").metrics["y_mae_m"])
+    assert tf[4] is None and tf[5] is None  # TeNFiLoc: in the paper design's columns only
+    # a coherent route adds its column; a missing route drops its columns
+    cols3, _ = table_rows({**routes, "coherent": drives}, "italiano2026_table1")
+    assert cols3[-2] == "our design, coherent route"
+    cols4, _ = table_rows({"paper": drives}, "italiano2026_table1")
+    assert cols4 == ["configuration", "metric", "paper design, paper route", "paper"]
+    with pytest.raises(ValueError, match=r"^routes"):
+        table_rows({"x": drives}, "italiano2026_table1")
     acols, arows = ex.ablation(drives)
     assert acols == ["design", "L", "N"] and len(arows) == len(ex.ABLATION)
-    # a second measurement route: its rows are labelled, scored and sorted after the paper's
-    cols, rows = table_rows(drives, "italiano2026_table1", separated=drives)
-    keys = [tuple(r[:3]) for r in rows]
-    assert keys.index(("JAVELIN-L", "paper", "paper")) < keys.index(
-        ("JAVELIN-L", "ours", "separated")
-    )
-    assert ("TeNFiLoc-L", "paper", "separated") in keys and (
-        "JAVELIN-N",
-        "paper",
-        "separated",
-    ) not in keys
-    row = rows[keys.index(("JAVELIN-L", "ours", "separated"))]
-    expect = ex.evaluate(drives["L"][0], ex.OURS_SEPARATED).metrics["rmse_2d_m"]
-    assert row[3] == pytest.approx(expect)
-    _, arows2 = ex.ablation(drives, separated=drives)
-    assert len(arows2) == len(ex.ABLATION) + 2
-    assert arows2[-2][1] == pytest.approx(arows[-1][1]) and arows2[-1][1] == pytest.approx(expect)
+    _, arows2 = ex.ablation(drives, separated=drives, ml=routes["ml"])
+    assert len(arows2) == len(ex.ABLATION) + 5
+    expect = ex.evaluate(drives["L"][0], ex.OURS_COHERENT).metrics["rmse_2d_m"]
+    assert arows2[-5][1] == pytest.approx(arows[-1][1]) and arows2[-4][1] == pytest.approx(expect)
+    assert [r[1] for r in arows2[-3:]] == pytest.approx(row[3:6])
     with pytest.raises(ValueError, match=r"^method"):
         ex.evaluate(drives["L"][0], method="UKF")
 
@@ -138,10 +148,11 @@ def test_separated_drive_uses_the_same_tensors():
     b = ex.simulate_drive(
         "italiano2026-straight", "L", np.random.default_rng(5), extraction="separated", **kw
     )
-    assert a.extraction == "paper" and b.extraction == "separated"
+    assert a.extraction == "paper" and b.extraction == "coherent"  # the route's name now
     # one pass through both routes (one synthesis and CPD per epoch) gives the same drives
     both = ex.simulate_routes("italiano2026-straight", "L", np.random.default_rng(5), **kw)
-    for one, shared in ((a, both["paper"]), (b, both["separated"])):
+    assert list(both) == list(ex.EXTRACTIONS)
+    for one, shared in ((a, both["paper"]), (b, both["coherent"])):
         assert shared.extraction == one.extraction
         np.testing.assert_array_equal(shared.speed, one.speed)
         for m1, m2 in zip(one.epochs, shared.epochs):
@@ -160,6 +171,44 @@ def test_separated_drive_uses_the_same_tensors():
     best = {r[0]: r for r in rows_b}
     assert best["los"][2] == 3 and best["los"][3] < found["los"][3]  # LoS: found, and sharper
     assert best["no true path"][2] == 0
+    # the ML route on the same tensors: every path found, curvature usable (the UE/VUE range
+    # within a metre at 44 m), the LoS direction sharper than the coherent split's
+    ml = both["ml"]
+    np.testing.assert_array_equal(ml.speed, a.speed)
+    assert [int(np.sum(t >= 0)) for t in ml.truth_index] == [len(s) for s in ml.sources]
+    ecols, erows = ex.extraction_errors([ml])
+    err = {r[0]: dict(zip(ecols, r)) for r in erows}
+    assert err["all"]["matched"] == sum(len(s) for s in ml.sources)
+    assert err["los"]["kappa [m]"] < 1.0 and err["all"]["no kappa"] == 0
+    _, erows_b = ex.extraction_errors([b])
+    los_b = {r[0]: r for r in erows_b}["los"]
+    assert err["los"]["phi [deg]"] < los_b[2] and err["los"]["kappa [m]"] < los_b[4]
+    cfg = ex.design_from_errors(erows)
+    assert cfg.sigma_kappa == pytest.approx(err["all"]["kappa [m]"])
+    assert cfg.sigma_phi == pytest.approx(np.radians(err["all"]["phi [deg]"]))
+    assert cfg.kappa_model == "vue" and cfg.associator == ex.OURS_COHERENT.associator
+    with pytest.raises(ValueError, match=r"^drives"):
+        ex.extraction_errors([])
+
+
+def test_collect_routes_runs_through_run_trials_with_the_condition_per_child():
+    out = collect_routes(
+        "italiano2026-straight", ("L", "N"), 1, 3, n_epochs=1, extractions=("paper",)
+    )
+    assert list(out) == ["paper"] and [len(v) for v in out["paper"].values()] == [1, 1]
+    assert out["paper"]["L"][0].los.all() and not out["paper"]["N"][0].los.any()
+    # drive i draws from child i of the seed: the N drive is child 1
+    rng = np.random.default_rng(np.random.SeedSequence(3).spawn(2)[1])
+    d = ex.simulate_drive("italiano2026-straight", "N", rng, n_epochs=1)
+    np.testing.assert_array_equal(d.speed, out["paper"]["N"][0].speed)
+    with pytest.raises(ValueError, match=r"^extraction"):
+        collect_routes("italiano2026-straight", ("L",), 1, 0, n_epochs=1, extractions=("x",))
+    rep = javelin_table(
+        "italiano2026-straight", "italiano2026_table1", ("L",), 1, 3, False, ("paper",), 1
+    )
+    assert rep.columns == ["configuration", "metric", "paper design, paper route", "paper"]
+    assert [r[0] for r in rep.rows] == ["JAVELIN-L"] * 3 + ["TeNFiLoc-L"] * 3
+    assert rep.meta["extraction_failures"] == {"paper": 0} and rep.notes
 
 
 def test_vue_prediction_skips_the_los_only_when_it_exists():

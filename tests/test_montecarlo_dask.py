@@ -197,7 +197,8 @@ def test_javelin_drives_identical_on_a_running_cluster(cluster):
     remote = collect_routes(
         "italiano2026-straight", ("L",), 2, 7, scheduler=cluster.scheduler_address, **kw
     )["paper"]
-    assert table_rows(remote, "italiano2026_table1") == table_rows(serial, "italiano2026_table1")
+    ref = "italiano2026_table1"
+    assert table_rows({"paper": remote}, ref) == table_rows({"paper": serial}, ref)
 
 
 def test_cli_bad_parallel_options(capsys):

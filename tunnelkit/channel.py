@@ -14,6 +14,20 @@ the UE clock bias (truncated Gaussian, section 4.2). Noise is ``CN(0, N0)`` per 
 ``N0 = k_B BW T_e``, ``T_e = T_ant + 290 (NF - 1)`` (section 4.2, taken literally: the noise of the
 whole band on every tensor element). ``model="srnf"`` synthesises the SR-NF channel (wavefront
 centred on the reflection point) instead of the exact physics (centred on the VUE).
+
+Two impairments eq. 1 leaves out, both off by default (the tensor is then bit-identical to eq. 1):
+
+- **calibration error** of the array: element ``m`` multiplies everything it receives by
+  ``g_m = 10^(e_m / 20) exp(j phi_m)``, gain error ``e_m ~ N(0, sigma_dB^2)`` [dB] and phase error
+  ``phi_m ~ N(0, sigma_deg^2)`` [deg], drawn once per array (:func:`draw_calibration`, or passed
+  explicitly as ``calibration=``);
+- **spatial wideband**: eq. 1 gives every element the delay of the reference antenna; the wave
+  reaches element ``m`` ``delta_lm / c`` later, so the frequency phase depends on the element,
+  ``exp(-j 2 pi s Df (tau_l + delta_lm / c))`` (``spatial_wideband=True``). Across the 100 MHz
+  band and a 23 cm aperture that is up to about 0.4 rad at the band edge. (The delay follows
+  the geometry; the carrier's spatial phase keeps eq. 1's printed sign.)
+
+:class:`Impairments` bundles the two for :class:`tunnelkit.signal_route.SignalRoute`.
 """
 
 from __future__ import annotations
@@ -28,9 +42,11 @@ from .constants import K_B, C, db2lin, dbm2watt
 
 __all__ = [
     "ChannelSnapshot",
+    "Impairments",
     "SRSConfig",
     "add_noise",
     "channel_tensor",
+    "draw_calibration",
     "sample_clock_bias",
     "synthesize",
 ]
@@ -151,6 +167,65 @@ def sample_clock_bias(
     return float(out[0]) if size is None else out
 
 
+def draw_calibration(
+    rng: np.random.Generator, m: int, phase_sigma_deg: float = 0.0, gain_sigma_db: float = 0.0
+) -> np.ndarray:
+    """Per-element calibration error (M,) complex: ``10^(e/20) exp(j phi)`` with gain error
+    ``e ~ N(0, gain_sigma_db^2)`` [dB] and phase error ``phi ~ N(0, phase_sigma_deg^2)`` [deg],
+    independent over elements (the reference antenna included). Draw it once per array: it is a
+    property of the hardware, not of a snapshot."""
+    rng = rng_or_error("rng", rng)
+    m = integer("m", m, minimum=1)
+    sp = nonnegative("phase_sigma_deg", phase_sigma_deg)
+    sg = nonnegative("gain_sigma_db", gain_sigma_db)
+    phase = np.radians(sp) * rng.standard_normal(m)
+    gain_db = sg * rng.standard_normal(m)
+    return 10.0 ** (gain_db / 20.0) * np.exp(1j * phase)
+
+
+@dataclass(frozen=True)
+class Impairments:
+    """What a real array adds to eq. 1 (module docstring): per-element calibration error with
+    ``phase_sigma_deg`` [deg] and ``gain_sigma_db`` [dB], and the ``spatial_wideband`` term.
+    All zero / False (the default) is eq. 1 exactly."""
+
+    phase_sigma_deg: float = 0.0
+    gain_sigma_db: float = 0.0
+    spatial_wideband: bool = False
+
+    def __post_init__(self) -> None:
+        nonnegative("phase_sigma_deg", self.phase_sigma_deg)
+        nonnegative("gain_sigma_db", self.gain_sigma_db)
+        if not isinstance(self.spatial_wideband, bool):
+            raise TypeError(
+                f"spatial_wideband: expected True or False, got {self.spatial_wideband!r}"
+            )
+
+    @property
+    def calibrated(self) -> bool:
+        """True when there is no calibration error to draw."""
+        return self.phase_sigma_deg == 0 and self.gain_sigma_db == 0
+
+    def draw(self, rng: np.random.Generator, m: int) -> np.ndarray | None:
+        """One array's calibration vector (:func:`draw_calibration`), ``None`` if calibrated."""
+        if self.calibrated:
+            return None
+        return draw_calibration(rng, m, self.phase_sigma_deg, self.gain_sigma_db)
+
+
+def _check_calibration(calibration, m: int) -> np.ndarray | None:
+    if calibration is None:
+        return None
+    g = np.asarray(calibration)
+    if g.shape != (m,) or not np.all(np.isfinite(g)):
+        raise ValueError(f"calibration: expected {m} finite complex gains, got shape {g.shape}")
+    if np.any(g == 0):
+        raise ValueError(
+            "calibration: an element gain of zero (a dead element) is not a calibration error"
+        )
+    return g.astype(complex)
+
+
 def _check_paths(paths) -> list:
     """``paths`` as a non-empty list of :class:`~tunnelkit.propagation.Path` for one array."""
     from .propagation import Path
@@ -176,12 +251,17 @@ def channel_tensor(
     model: str = "exact",
     n_tones: int | None = None,
     n_symbols: int | None = None,
+    calibration=None,
+    spatial_wideband: bool = False,
 ) -> np.ndarray:
     """The noiseless tensor ``H`` (M x Nf x Nt) of eq. 1 / eq. 3 for a list of paths.
 
     Amplitudes include ``sqrt(P_t)`` (so ``|H|^2`` is a received power in W). ``model`` is
     "exact" (spherical wavefront from the VUE, eq. 2) or "srnf" (from the reflection point).
     ``n_tones`` / ``n_symbols`` override the configuration (small tensors for tests and sliders).
+    Impairments (module docstring), off by default: ``calibration`` (M,) complex per-element
+    gains (:func:`draw_calibration`); ``spatial_wideband`` the per-element delay
+    ``tau_l + delta_lm / c`` in the frequency phase.
     """
     if not isinstance(config, SRSConfig):
         raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
@@ -189,6 +269,9 @@ def channel_tensor(
         raise ValueError(f"model: expected one of {_MODELS}, got {model!r}")
     paths = _check_paths(paths)
     bias = float(finite_array("clock_bias", clock_bias, ndim=0))
+    if not isinstance(spatial_wideband, bool):
+        raise TypeError(f"spatial_wideband: expected True or False, got {spatial_wideband!r}")
+    cal = _check_calibration(calibration, paths[0].lengths.shape[0])
     nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=2)
     nt = config.n_symbols if n_symbols is None else integer("n_symbols", n_symbols, minimum=2)
     m = paths[0].lengths.shape[0]
@@ -202,9 +285,17 @@ def channel_tensor(
     fd = np.array([p.doppler for p in paths])
     alpha = np.sqrt(config.tx_power) * np.array([p.gain for p in paths])
     bs = np.exp(1j * k0 * delta)
-    bf = np.exp(-2j * np.pi * config.tone_spacing * np.arange(nf)[:, None] * tau[None, :])
     bt = np.exp(2j * np.pi * config.symbol_period * np.arange(nt)[:, None] * fd[None, :])
-    return np.einsum("ml,sl,kl->msk", bs * alpha, bf, bt, optimize=True)
+    if spatial_wideband:
+        # element m's delay is tau_l + delta_lm / c: the frequency factor depends on m
+        tau_m = tau[None, :] + delta / C  # (M, L)
+        w = -2j * np.pi * config.tone_spacing * np.arange(nf)
+        bsf = (bs * alpha)[:, None, :] * np.exp(w[None, :, None] * tau_m[:, None, :])
+        H = np.einsum("msl,kl->msk", bsf, bt, optimize=True)
+    else:
+        bf = np.exp(-2j * np.pi * config.tone_spacing * np.arange(nf)[:, None] * tau[None, :])
+        H = np.einsum("ml,sl,kl->msk", bs * alpha, bf, bt, optimize=True)
+    return H if cal is None else cal[:, None, None] * H
 
 
 def add_noise(H, noise_power: float, rng: np.random.Generator) -> np.ndarray:
@@ -245,17 +336,28 @@ def synthesize(
     snr_offset_db: float = 0.0,
     n_tones: int | None = None,
     n_symbols: int | None = None,
+    calibration=None,
+    spatial_wideband: bool = False,
 ) -> ChannelSnapshot:
     """Noisy tensor for ``paths``: eq. 1 + CN(0, N0) noise, clock bias drawn from ``rng`` if None.
 
     ``snr_offset_db`` raises (positive) or lowers the SNR by scaling the noise power.
+    ``calibration`` / ``spatial_wideband``: the impairments of :func:`channel_tensor` (off by
+    default; the calibration vector is not drawn here, it belongs to the array).
     """
     rng = rng_or_error("rng", rng)
     off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
     if clock_bias is None:
         clock_bias = sample_clock_bias(rng, config.clock_bias_sigma, config.clock_bias_limit)
     H = channel_tensor(
-        paths, config, clock_bias=clock_bias, model=model, n_tones=n_tones, n_symbols=n_symbols
+        paths,
+        config,
+        clock_bias=clock_bias,
+        model=model,
+        n_tones=n_tones,
+        n_symbols=n_symbols,
+        calibration=calibration,
+        spatial_wideband=spatial_wideband,
     )
     n0 = config.noise_power / float(db2lin(off))
     return ChannelSnapshot(

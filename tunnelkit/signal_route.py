@@ -20,13 +20,13 @@ or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a singl
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ._validate import integer, rng_or_error
 from .arrays import ArrayGeometry
-from .channel import ChannelSnapshot, SRSConfig, synthesize
+from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
 from .evaluation import match_paths
 
 __all__ = ["Epoch", "Measurements", "SignalRoute", "measurements_from_estimates", "simulate_epoch"]
@@ -117,6 +117,9 @@ class SignalRoute:
 
     ``kinds`` selects path families (see :func:`tunnelkit.propagation.trace_paths`);
     ``n_paths=None`` means L known (the number of traced paths, as in the paper).
+    ``impairments`` (off by default) adds what eq. 1 leaves out (:class:`tunnelkit.channel.Impairments`);
+    build an impaired route with :meth:`with_impairments`, which draws each array's calibration
+    error once (``calibration``: array name -> (M,) complex gains).
     """
 
     tunnel: object
@@ -126,6 +129,20 @@ class SignalRoute:
     model: str = "exact"
     kinds: tuple[str, ...] = ("los", "wall", "ceiling", "road", "rrm")
     snr_offset_db: float = 0.0
+    impairments: Impairments = field(default_factory=Impairments)
+    calibration: dict = field(default_factory=dict)
+
+    def with_impairments(self, impairments: Impairments, rng: np.random.Generator) -> SignalRoute:
+        """A copy of this route whose arrays carry ``impairments``: each array's calibration error
+        drawn once from ``rng`` (in the order of ``arrays``), the same in every epoch."""
+        if not isinstance(impairments, Impairments):
+            raise TypeError(
+                f"impairments: expected a channel.Impairments, got {type(impairments).__name__}"
+            )
+        rng = rng_or_error("rng", rng)
+        cal = {a.name: impairments.draw(rng, a.M) for a in self.arrays}
+        cal = {k: v for k, v in cal.items() if v is not None}
+        return replace(self, impairments=impairments, calibration=cal)
 
     @classmethod
     def from_scenario(cls, scenario, **kw) -> SignalRoute:
@@ -181,6 +198,8 @@ class SignalRoute:
             model=self.model,
             clock_bias=clock_bias,
             snr_offset_db=self.snr_offset_db,
+            calibration=self.calibration.get(arr.name),
+            spatial_wideband=self.impairments.spatial_wideband,
         )
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
         est = extract_paths(

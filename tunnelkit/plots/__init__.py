@@ -23,6 +23,9 @@ from .doppler import (
     profiles_figure,
     regime_figure,
 )
+from .efficiency import (
+    efficiency_figure,
+)
 from .fresnel import (
     derivation_figure,
     fresnel_topview,
@@ -67,6 +70,7 @@ __all__ = [
     "derivation_figure",
     "doppler_delay_figure",
     "drive_topview",
+    "efficiency_figure",
     "epoch_figure",
     "error_time_figure",
     "factors_figure",

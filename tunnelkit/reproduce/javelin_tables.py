@@ -1,11 +1,14 @@
 """Italiano et al. 2026, Tables 1-2: JAVELIN and TeNFiLoc on the straight and slalom drives.
 
-Every run simulates the drive through the signal route (image method -> SRS tensor with noise and
-clock bias -> CPD extraction -> Algorithm 1) once per condition, then scores on it JAVELIN with
-the paper's design, JAVELIN with ours (``experiment.OURS``) and TeNFiLoc. The same seeded drives
-go through our measurement route too (the CPD, then coherent paths separated by the array:
-``tunnelkit.extraction.coherent``), on which JAVELIN (ours) and TeNFiLoc are scored again: the tensors are
-identical, only the extraction differs.
+Every run simulates a drive through the signal route (image method -> SRS tensor with noise and
+clock bias) once per condition and measures each epoch's tensor through several extraction
+routes (:data:`tunnelkit.tracking.javelin.experiment.EXTRACTIONS`): the paper's (CPD, eq. 11-24)
+and the joint maximum-likelihood fit of eq. 1 (``ml``); the tensors are identical, only the
+extraction differs. The table has five columns per configuration and metric: the paper's design
+(section 4.2) on the paper's route, the paper's design on the ML route, the same with the
+curvature of a reflection centred on its VUE (``PAPER_VUE``), our design on the ML route
+(:data:`~tunnelkit.tracking.javelin.experiment.OURS_ML`, its noise set from the measured
+extraction error), and the paper's published number.
 """
 
 from __future__ import annotations
@@ -18,9 +21,44 @@ from ..montecarlo import run_trials
 from ..reference import load as load_reference
 from . import Report, register
 
-__all__ = ["NOTES", "collect_drives", "collect_routes", "javelin_table", "table_rows"]
+__all__ = [
+    "COLUMNS",
+    "NOTES",
+    "collect_drives",
+    "collect_routes",
+    "javelin_table",
+    "table_rows",
+]
 
 _METRICS = ("rmse_2d_m", "mae_2d_m", "y_mae_m")
+
+#: the table's columns: (label, measurement route, design); a design is a name of :func:`_designs`
+COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("paper design, paper route", "paper", "paper"),
+    ("paper design, ML route", "ml", "paper"),
+    ("paper design + VUE curvature, ML route", "ml", "paper-vue"),
+    ("our design, ML route", "ml", "ours"),
+)
+#: the column added when the coherent route was measured too
+COHERENT_COLUMN = ("our design, coherent route", "coherent", "ours-coherent")
+
+
+def _designs() -> dict:
+    from ..tracking.javelin import experiment as ex
+
+    return {
+        "paper": ex.PAPER,
+        "paper-vue": ex.PAPER_VUE,
+        "ours": ex.OURS_ML,
+        "ours-coherent": ex.OURS_COHERENT,
+    }
+
+
+def _simulate(scenario: str, n_epochs: int | None, extractions: tuple[str, ...], cond: str, rng):
+    """One drive of ``cond`` through the signal route, measured through every extraction."""
+    from ..tracking.javelin import experiment as ex
+
+    return ex.simulate_routes(scenario, cond, rng, n_epochs=n_epochs, extractions=extractions)
 
 
 def collect_routes(
@@ -30,17 +68,22 @@ def collect_routes(
     seed: int,
     progress: bool = False,
     n_epochs: int | None = None,
-    extractions: tuple[str, ...] = ("paper", "separated"),
+    extractions: tuple[str, ...] = ("paper", "ml"),
     **parallel,
 ) -> dict[str, dict[str, list]]:
     """``runs`` seeded drives per condition through the signal route (the expensive part), each
-    measured through every route in ``extractions`` from the same tensors and CPD
-    (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`); ``n_epochs`` truncates each
-    drive (quick mode). One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``:
-    its ``workers`` / ``scheduler`` / ``timeout``). Returns ``{extraction: {condition: [DriveData,
-    ...]}}``."""
+    measured through every route in ``extractions`` from the same tensors
+    (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`). One trial of
+    :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its ``workers`` /
+    ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
+    the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode). Returns
+    ``{extraction: {condition: [DriveData, ...]}}``."""
+    from ..tracking.javelin import experiment as ex
+
+    conditions = tuple(conditions)
+    extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
     jobs = [c for _ in range(runs) for c in conditions]
-    trial = functools.partial(_simulate, scenario, n_epochs, tuple(extractions))
+    trial = functools.partial(_simulate, scenario, n_epochs, extractions)
     results = run_trials(
         trial,
         len(jobs),
@@ -57,13 +100,6 @@ def collect_routes(
     return out
 
 
-def _simulate(scenario: str, n_epochs: int | None, extractions: tuple[str, ...], cond: str, rng):
-    """One drive of ``cond`` through the signal route, measured through every extraction."""
-    from ..tracking.javelin import experiment as ex
-
-    return ex.simulate_routes(scenario, cond, rng, n_epochs=n_epochs, extractions=extractions)
-
-
 def collect_drives(
     scenario: str,
     conditions: tuple[str, ...],
@@ -75,76 +111,84 @@ def collect_drives(
     **parallel,
 ) -> dict[str, list]:
     """:func:`collect_routes` through one route: ``{condition: [DriveData, ...]}``."""
-    routes = collect_routes(
-        scenario, conditions, runs, seed, progress, n_epochs, (extraction,), **parallel
-    )
-    return routes[extraction]
+    from ..tracking.javelin import experiment as ex
 
-
-def _row_specs(ex) -> dict[str, tuple]:
-    """Per measurement route: (design label, method, JAVELIN config or None for TeNFiLoc)."""
-    return {
-        "paper": (
-            ("paper", "JAVELIN", ex.PAPER),
-            ("ours", "JAVELIN", ex.OURS),
-            ("paper", "TeNFiLoc", None),
-        ),
-        "separated": (("ours", "JAVELIN", ex.OURS_SEPARATED), ("paper", "TeNFiLoc", None)),
-    }
+    e = ex.route_name(extraction)
+    return collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (e,), **parallel)[e]
 
 
 def table_rows(
-    drives: dict[str, list], reference: str, separated: dict[str, list] | None = None
+    routes: dict[str, dict[str, list]],
+    reference: str,
+    columns: tuple[tuple[str, str, str], ...] | None = None,
 ) -> tuple[list[str], list[list]]:
-    """Rows ``[configuration, design, extraction, metric, paper metric, ...]``, means over runs.
+    """Rows ``[configuration, metric, <one value per column>, paper]``, means over runs.
 
-    On ``drives`` (the paper's extraction): JAVELIN with the paper's design and ours on every
-    condition, TeNFiLoc on the LoS drives. On ``separated`` (the same drives through our
-    extraction, optional): JAVELIN with ours (``OURS_SEPARATED``), and TeNFiLoc.
+    ``routes`` is :func:`collect_routes`' output (``{route: {condition: drives}}``); ``columns``
+    (default :data:`COLUMNS`, plus :data:`COHERENT_COLUMN` when that route is present) name a
+    route and a design each; columns whose route is missing are left out. JAVELIN is scored on
+    every condition; TeNFiLoc (no design of its own) on the LoS drives, in the columns of the
+    paper's design. Configurations follow the paper's table, extra ones (e.g. NoRRMs-L) after.
     """
     from ..tracking.javelin import experiment as ex
 
+    if columns is None:
+        columns = COLUMNS + ((COHERENT_COLUMN,) if "coherent" in routes else ())
+    columns = tuple(c for c in columns if c[1] in routes)
+    if not columns:
+        raise ValueError(f"routes: none of the table's routes present, got {list(routes)}")
+    designs = _designs()
     ref = {r["configuration"]: r for r in load_reference(reference)}
-    scores: dict[tuple[str, str, str], list[dict[str, float]]] = {}
-    specs = _row_specs(ex)
-    routes = {"paper": drives, "separated": separated or {}}
-    for extraction, by_cond in routes.items():
-        for cond, lst in by_cond.items():
-            for drive in lst:
-                for design, method, config in specs[extraction]:
-                    if method == "TeNFiLoc" and cond != "L":
-                        continue
-                    scores.setdefault((f"{method}-{cond}", design, extraction), []).append(
-                        ex.evaluate(drive, config, method=method).metrics
-                    )
-    rows = []
-    for (name, design, extraction), lst in scores.items():
-        paper = ref.get(name, {})
-        row: list = [name, design, extraction]
-        for k in _METRICS:
-            row += [float(np.mean([m[k] for m in lst])), paper.get(k)]
-        rows.append(row)
+    scores: dict[tuple[str, str], list[dict[str, float]]] = {}
+    cache: dict[tuple[int, str, str], dict[str, float]] = {}
+    for label, route, design in columns:
+        for cond, drives in routes[route].items():
+            for drive in drives:
+                entries = [(f"JAVELIN-{cond}", "JAVELIN", design)]
+                if cond == "L" and design == "paper":  # once per route
+                    entries.append(("TeNFiLoc-L", "TeNFiLoc", "none"))
+                for name, method, dname in entries:
+                    key = (id(drive), method, dname)
+                    if key not in cache:
+                        cfg = designs.get(dname)
+                        cache[key] = ex.evaluate(drive, cfg, method=method).metrics
+                    scores.setdefault((name, label), []).append(cache[key])
+    names = list(dict.fromkeys(n for n, _ in scores))
     order = {n: i for i, n in enumerate(ref)}
-    rows.sort(key=lambda r: (order.get(r[0], 99), r[2] != "paper", r[1] != "paper"))
-    cols = ["configuration", "design", "extraction"]
-    for k in _METRICS:
-        cols += [k, f"paper_{k}"]
-    return cols, rows
+    names.sort(key=lambda n: order.get(n, len(order)))
+    rows = []
+    for name in names:
+        for metric in _METRICS:
+            row: list = [name, metric]
+            for label, _, _ in columns:
+                lst = scores.get((name, label))
+                row.append(float(np.mean([m[metric] for m in lst])) if lst else None)
+            row.append(ref.get(name, {}).get(metric))
+            rows.append(row)
+    return ["configuration", "metric", *(c[0] for c in columns), "paper"], rows
 
 
 NOTES = [
-    "ours: mean over runs of per-run metrics; each run is one drive through the signal route.",
-    "design 'paper': section 4.2 parameters; 'ours': Doppler clutter rejection, measurement noise "
-    "calibrated on the extraction, global nearest neighbour, mirrored VUE motion, no update at "
-    "birth (tunnelkit.tracking.javelin.experiment.OURS, tuned on seed 7, not on these seeds).",
+    "ours: mean over runs of per-run metrics; each run is one drive through the signal route, "
+    "measured through every route from the same tensors.",
+    "route 'paper': CPD and eq. 11-24 as published (extract_paths(refine='joint')); 'ML': the "
+    "joint maximum-likelihood fit of eq. 1 (refine='ml', at the CRLB); 'coherent': the paper's "
+    "route with coherent paths separated by the array (refine='coherent').",
+    "design 'paper': section 4.2 as printed (sigma_phi = sigma_psi = 2 deg, sigma_kappa = "
+    "sigma_dd = 1.5 m, sigma_nu = 0.2 m/s, sigma_theta = 1 deg, sigma_P = 10 m, p = 0.99, "
+    "zeta = 1, gamma = 0.2, curvature of a reflection = distance to the reflection point, eq. 51). "
+    "'paper design + VUE curvature': the same parameters, the curvature of a reflection modelled "
+    "as the distance to its VUE (the exact wavefront's radius, what the ML route measures).",
+    "design 'ours' on the ML route (experiment.OURS_ML): Doppler clutter rejection, global "
+    "nearest neighbour, mirrored VUE motion, no update at birth, curvature centred on the VUE, "
+    "measurement noise = the RMS extraction error of the ML route measured on seed 0 drives.",
     "Both designs start from the true first position with 1 m uncertainty (the paper's open-sky fix).",
     "NoRRMs: road markings removed with the LoS blocked (our reading of the paper).",
-    "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails and holds its last fix on epochs "
-    "without one.",
-    "extraction 'paper': CPD and eq. 11-24 as published; 'separated': the same tensors, then paths "
-    "merged in one CPD component separated by the array (tunnelkit.extraction.coherent, ours). On it, our "
-    "design models each path's curvature as its VUE distance (experiment.OURS_SEPARATED), the "
-    "radius of the exact wavefront; its other settings were tuned on the paper's extraction.",
+    "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails, uses its curvature only when "
+    "plausible (|d - kappa| within the clock-bias support, range within 200 m), else its delay "
+    "distance, and holds its last fix on epochs without one.",
+    "Seeds: designs were chosen on seed 0 (and seed 7); experiment.HELD_OUT_SEED (20261202) was "
+    "never looked at while choosing anything.",
 ]
 
 
@@ -155,26 +199,38 @@ def javelin_table(
     runs: int,
     seed: int,
     progress: bool,
+    extractions: tuple[str, ...] = ("paper", "ml"),
+    n_epochs: int | None = None,
     **parallel,
 ) -> Report:
-    """One table: rows per configuration, design (paper / ours) and extraction, the paper's
-    numbers beside."""
-    routes = collect_routes(scenario, conditions, runs, seed, progress, **parallel)
-    drives, separated = routes["paper"], routes["separated"]
-    cols, rows = table_rows(drives, reference, separated)
-    n_fault = sum(len(d.faults) for r in (drives, separated) for lst in r.values() for d in lst)
+    """One table: per configuration and metric, one value per (route, design) column and the
+    paper's number beside (``n_epochs`` truncates the drives, for quick checks; ``parallel``
+    goes to :func:`~tunnelkit.montecarlo.run_trials`)."""
+    routes = collect_routes(
+        scenario,
+        conditions,
+        runs,
+        seed,
+        progress,
+        n_epochs=n_epochs,
+        extractions=extractions,
+        **parallel,
+    )
+    cols, rows = table_rows(routes, reference)
+    faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}: JAVELIN vs TeNFiLoc",
         columns=cols,
         rows=rows,
-        meta={"scenario": scenario, "extraction_failures": n_fault},
+        meta={"scenario": scenario, "extraction_failures": faults},
         notes=list(NOTES),
     )
 
 
 @register(
     "javelin-table1",
-    help="Italiano 2026 Table 1: straight drive, JAVELIN (L, N@0.5, N, NoRRMs) vs TeNFiLoc-L",
+    help="Italiano 2026 Table 1: straight drive, JAVELIN (L, N@0.5, N, NoRRMs) vs TeNFiLoc-L, "
+    "paper and ML routes",
     default_runs=20,
     bytes_per_run=1024 * 1024,
 )
@@ -193,7 +249,8 @@ def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
 
 @register(
     "javelin-table2",
-    help="Italiano 2026 Table 2: slalom drive, JAVELIN (L, N@0.5, N) vs TeNFiLoc-L",
+    help="Italiano 2026 Table 2: slalom drive, JAVELIN (L, N@0.5, N) vs TeNFiLoc-L, paper and "
+    "ML routes",
     default_runs=20,
     bytes_per_run=1024 * 1024,
 )

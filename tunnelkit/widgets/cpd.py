@@ -87,8 +87,12 @@ def curvature_study(
     n_tones: int | None = None,
     scenario: str = "italiano2026-straight",
     seed: int = 0,
+    refine: str = "joint",
 ) -> dict:
-    """Numbers behind :func:`curvature_figure`: kappa estimates, both candidates, the mismatch."""
+    """Numbers behind :func:`curvature_figure`: kappa estimates, both candidates, the mismatch.
+
+    ``refine`` picks the extraction route (default the paper's, whose eq. 17-18 TLS the figure
+    shows; ``"ml"`` the joint maximum-likelihood fit, which needs more antennas than paths)."""
     from ..channel import synthesize
     from ..extraction import extract_paths
 
@@ -101,7 +105,13 @@ def curvature_study(
             paths, cfg, r, clock_bias=0.0, snr_offset_db=snr_offset_db, n_tones=n_tones
         )
         est = extract_paths(
-            snap.H, len(paths), arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period
+            snap.H,
+            len(paths),
+            arr.local,
+            cfg.fc,
+            cfg.tone_spacing,
+            cfg.symbol_period,
+            refine=refine,
         )
         j = int(np.argmin(np.linalg.norm(est.direction - tgt.direction_local, axis=1)))
         kap.append(est.kappa_nf[j])

@@ -3,13 +3,21 @@
 Per epoch, without memory:
 
 - LoS: the tuple ``(phi, psi, kappa)`` of the LoS path gives ``p_u = b + kappa u(phi, psi)``;
-  without a curvature the delay distance ``d`` (carrying the clock bias) replaces ``kappa``;
+  without a curvature the delay distance ``d`` (carrying the clock bias) replaces ``kappa``.
+  Ours: a curvature is used only if it is *plausible* — positive, within ``max_range``, and
+  consistent with the delay, ``|d - kappa| <= bias_limit`` (on the LoS, ``d - kappa`` is the clock
+  bias times c, whose support is ``[-bias_limit, bias_limit]``); otherwise ``d`` replaces it, as
+  the paper does without a curvature. The paper does not say what TeNFiLoc does with a curvature
+  of kilometres on a 45 m path; taken as is it puts the fix kilometres away;
 - NLoS: minimise eq. 69 over ``p_u``. The paper prints a plain sum of residuals
   ``sum_l w_l (||p_u - p_s,l|| - d_l + kappa_l)``, which is unbounded below; we minimise the sum of
   *squared* residuals (least squares, the form the paper's "LS algorithm" needs) and, ours,
   optionally solve for the clock bias as a fourth unknown (``d_l = kappa_l + ||p_u - p_s,l|| + beta``)
   instead of assuming perfect synchronisation. ``p_s,l = b + kappa_l u_l`` is the reflector of
-  eq. 19.
+  eq. 19. A fitted bias outside the support (``|beta| > bias_limit``) refuses the fix.
+
+Every branch refuses a fix farther than ``max_range`` from the base station (``mode="none"``);
+the tracking loop then holds the previous fix.
 """
 
 from __future__ import annotations
@@ -20,6 +28,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..._validate import positive, vector
+from ...constants import C
 from .manage import los_test
 from .measurement import PathMeasurements
 
@@ -41,7 +50,10 @@ class TeNFiLoc:
 
     The LoS path is the one passing eq. 60-61; with ``assume_los`` (the paper's TeNFiLoc-L, LoS
     known to exist) the earliest arrival is taken when the test fails, as it is when no path has a
-    curvature. NLoS fixes farther than ``max_range`` from the base station are refused.
+    curvature. Its curvature gives the range if plausible (``0 < kappa <= max_range`` and
+    ``|d - kappa| <= bias_limit``), else its delay distance ``d`` does. ``bias_limit`` [m] is the
+    support of the clock bias times c (default: the 100 ns of section 4.2, 30 m). Fixes farther
+    than ``max_range`` from the base station are refused on every branch.
     """
 
     los_gamma: float = 0.2
@@ -50,9 +62,11 @@ class TeNFiLoc:
     nlos: bool = True
     assume_los: bool = False
     max_range: float = 200.0
+    bias_limit: float = C * 100e-9
 
     def __post_init__(self) -> None:
         positive("max_range", self.max_range)
+        positive("bias_limit", self.bias_limit)
         g = positive("los_gamma", self.los_gamma)
         if g > 1:
             raise ValueError(f"los_gamma: must lie in (0, 1], got {g}")
@@ -71,16 +85,32 @@ class TeNFiLoc:
         if j is None and (no_kappa or self.assume_los) and np.isfinite(paths.d).any():
             j = int(np.nanargmin(paths.d))  # the LoS is the earliest arrival
         if j is not None:
-            if np.isfinite(paths.kappa[j]):
-                return TeNFiLocFix(b + paths.kappa[j] * u[j], "los-kappa", (int(j),))
-            if np.isfinite(paths.d[j]):
-                return TeNFiLocFix(b + paths.d[j] * u[j], "los-d", (int(j),))
+            fix = self._los(paths, u, b, int(j))
+            if fix is not None:
+                return fix
         if not self.nlos:
             return TeNFiLocFix(None, "none")
         return self._nlos(paths, u, b, initial)
 
+    def plausible_kappa(self, kappa: float, d: float) -> bool:
+        """Whether a LoS curvature can be a range: positive, within ``max_range``, and (when the
+        delay is known) within the clock-bias support of it, ``|d - kappa| <= bias_limit``."""
+        if not (np.isfinite(kappa) and 0.0 < kappa <= self.max_range):
+            return False
+        return not np.isfinite(d) or abs(d - kappa) <= self.bias_limit
+
+    def _los(self, paths, u, b, j: int) -> TeNFiLocFix | None:
+        """LoS fix from path ``j``: its curvature if plausible, else its delay distance."""
+        kappa, d = float(paths.kappa[j]), float(paths.d[j])
+        if self.plausible_kappa(kappa, d):
+            return TeNFiLocFix(b + kappa * u[j], "los-kappa", (j,))
+        if np.isfinite(d) and 0.0 < d <= self.max_range:
+            return TeNFiLocFix(b + d * u[j], "los-d", (j,))
+        return None
+
     def _nlos(self, paths, u, b, initial) -> TeNFiLocFix:
-        ok = np.flatnonzero(np.isfinite(paths.kappa) & np.isfinite(paths.d))
+        kappa = np.where(np.isfinite(paths.kappa), paths.kappa, -1.0)
+        ok = np.flatnonzero((kappa > 0) & (kappa <= self.max_range) & np.isfinite(paths.d))
         need = 4 if self.estimate_bias else 3
         if ok.size < need:
             return TeNFiLocFix(None, "none")
@@ -97,6 +127,7 @@ class TeNFiLoc:
         if (
             not (sol.success and np.all(np.isfinite(sol.x)))
             or np.linalg.norm(sol.x[:3] - b) > self.max_range
+            or (self.estimate_bias and abs(sol.x[3]) > self.bias_limit)
         ):
             return TeNFiLocFix(None, "none")
         return TeNFiLocFix(sol.x[:3], "nlos", tuple(int(k) for k in ok))
