@@ -342,9 +342,19 @@ def semicircular_tunnel(
                 material=wall_material,
             )
         )
+    return close_tunnel(
+        facets, x0, length, -width / 2, width, height, road_material, plates, blockers
+    )
+
+
+def close_tunnel(
+    facets, x0, length, y_right, width, height, road_material, plates=(), blockers=()
+) -> Tunnel3D:
+    """Add the road (``width`` across from ``y_right``, along x from ``x0``) to the wall/ceiling
+    ``facets`` and check that every plate lies inside the tunnel and every blocker is a Box."""
     road = Facet(
-        np.array([x0, -width / 2, 0.0]),
-        ax,
+        np.array([x0, y_right, 0.0]),
+        np.array([length, 0.0, 0.0]),
         np.array([0.0, width, 0.0]),
         np.array([0.0, 0.0, 1.0]),
         name="road",
@@ -352,11 +362,14 @@ def semicircular_tunnel(
         material=road_material,
     )
     tun = Tunnel3D(tuple([*facets, road]), (x0, x0 + length), (), tuple(blockers), width, height)
-    for p in plates:
+    for i, p in enumerate(plates):
         if not isinstance(p, Facet):
-            raise TypeError(f"plates: expected propagation.Facet items, got {type(p).__name__}")
+            raise TypeError(f"plates[{i}]: expected a propagation.Facet, got {type(p).__name__}")
         if not np.all(tun.contains(p.corners(), margin=-1e-6)):
             raise ValueError(f"{p.name or 'plate'}: the plate sticks out of the tunnel")
+    for i, b in enumerate(blockers):
+        if not isinstance(b, Box):
+            raise TypeError(f"blockers[{i}]: expected a propagation.Box, got {type(b).__name__}")
     return replace(tun, plates=tuple(plates))
 
 

@@ -33,6 +33,7 @@ from .propagation import (
     Facet,
     Tunnel3D,
     _plate_from_table,
+    close_tunnel,
     lane_trajectory,
     semicircular_tunnel,
 )
@@ -92,26 +93,8 @@ def extruded_tunnel(
             nrm = -nrm
         kind = "ceiling" if abs(nrm[2]) > np.cos(np.radians(45)) else "wall"
         facets.append(Facet(a, ax, e, nrm, name=name, kind=kind, material=wall_material))
-    road = Facet(
-        np.array([x0, prof[-1, 0], 0.0]),
-        ax,
-        np.array([0.0, width, 0.0]),
-        np.array([0.0, 0.0, 1.0]),
-        name="road",
-        kind="road",
-        material=road_material,
-    )
-    tun = Tunnel3D(tuple([*facets, road]), (x0, x0 + length), (), tuple(blockers), width, height)
-    for i, p in enumerate(plates):
-        if not isinstance(p, Facet):
-            raise TypeError(f"plates[{i}]: expected a propagation.Facet, got {type(p).__name__}")
-        if not np.all(tun.contains(p.corners(), margin=-1e-6)):
-            raise ValueError(f"{p.name or 'plate'}: the plate sticks out of the tunnel")
-    for i, b in enumerate(blockers):
-        if not isinstance(b, Box):
-            raise TypeError(f"blockers[{i}]: expected a propagation.Box, got {type(b).__name__}")
-    return Tunnel3D(
-        tuple([*facets, road]), tun.x_range, tuple(plates), tuple(blockers), width, height
+    return close_tunnel(
+        facets, x0, length, prof[-1, 0], width, height, road_material, plates, blockers
     )
 
 
