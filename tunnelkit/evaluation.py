@@ -144,7 +144,7 @@ class Scene:
 
     def crlb(self, spatial: str = "structured") -> dict:
         """Standard deviations ``d`` [m], ``v`` [m/s], ``direction`` [rad], ``kappa`` [m]."""
-        from .extraction.bounds import source_crlb
+        from .extraction.bounds import in_path_units, source_crlb
 
         cfg = self.config
         b = source_crlb(
@@ -159,12 +159,7 @@ class Scene:
             cfg.noise_power,
             spatial=spatial,
         )
-        return {
-            "d": C / (2 * np.pi * cfg.tone_spacing) * b["mu_f"],
-            "v": C / (2 * np.pi * cfg.fc * cfg.symbol_period) * b["mu_t"],
-            "direction": b["direction"],
-            "kappa": b["kappa"],
-        }
+        return in_path_units(b, cfg)
 
 
 def random_scene(

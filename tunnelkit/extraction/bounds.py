@@ -6,7 +6,7 @@ import numpy as np
 
 from ..constants import C
 
-__all__ = ["crlb_paths", "path_crlb", "source_crlb"]
+__all__ = ["crlb_paths", "in_path_units", "path_crlb", "source_crlb"]
 
 
 def crlb_paths(
@@ -114,11 +114,17 @@ def path_crlb(
         config.noise_power,
         spatial=spatial,
     )
+    return in_path_units(out, config)
+
+
+def in_path_units(bound: dict, config) -> dict[str, np.ndarray]:
+    """:func:`source_crlb`'s standard deviations as ``d`` [m], ``v`` [m/s], ``direction`` [rad]
+    and ``kappa`` [m], with the tone spacing, carrier and symbol period of ``config``."""
     return {
-        "d": C / (2 * np.pi * config.tone_spacing) * out["mu_f"],
-        "v": C / (2 * np.pi * config.fc * config.symbol_period) * out["mu_t"],
-        "direction": out["direction"],
-        "kappa": out["kappa"],
+        "d": C / (2 * np.pi * config.tone_spacing) * bound["mu_f"],
+        "v": C / (2 * np.pi * config.fc * config.symbol_period) * bound["mu_t"],
+        "direction": bound["direction"],
+        "kappa": bound["kappa"],
     }
 
 
