@@ -38,7 +38,7 @@ from filterpy.kalman import ExtendedKalmanFilter, MerweScaledSigmaPoints, Unscen
 
 from .. import positioning
 from .._validate import finite_array, integer, positive, rng_or_error
-from ..crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
+from ..crlb import _wrap, fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from .cv import STATE_DIM, cv_process_noise, cv_transition
 from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, InnovationGate, gated_filterpy_update
 from .registry import register
@@ -173,7 +173,7 @@ class VsModel:
         """``a - b`` with the bearing components wrapped to ``(-pi, pi]``."""
         r = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
         n = self.n_stations
-        r[..., n:] = wrap_angle(r[..., n:])
+        r[..., n:] = _wrap(r[..., n:])  # inner loop: inputs are checked where they enter
         return r
 
     def z_mean(self, sigmas, Wm) -> np.ndarray:
@@ -188,7 +188,7 @@ class VsModel:
             "s,...sj->...j", np.asarray(Wm, float), self.residual_z(sig, ref)
         )
         n = self.n_stations
-        m[..., n:] = wrap_angle(m[..., n:])
+        m[..., n:] = _wrap(m[..., n:])
         return m
 
     def log_likelihood(self, z, x) -> np.ndarray:
