@@ -53,3 +53,12 @@ def test_size_figure_marks_the_papers_array():
     b = design.route_bounds(setup, "10x10")
     rf = route_figure(b, target=0.2)
     assert np.allclose([v for v in rf.data[0].y if v is not None], 100 * b.peb[np.isfinite(b.peb)])
+
+
+def test_monte_carlo_summary_states_the_settled_ratio():
+    from tunnelkit.widgets.design import monte_carlo_summary
+
+    res = {"rmse_m": 0.05, "ci95_m": [0.01, 0.09], "rmse_settled_m": None}
+    assert monte_carlo_summary(res, 3) == "JAVELIN 2-D RMSE 5 cm, 95 % CI [1, 9] cm over 3 drives"
+    res.update(rmse_settled_m=0.002, peb_rms_settled_m=0.0005)
+    assert monte_carlo_summary(res, 3).endswith("after the first 1 s 2 mm, 4 x the RMS PEB")

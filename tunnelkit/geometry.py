@@ -25,8 +25,40 @@ __all__ = [
     "mirror",
     "reflector_point",
     "specular_point",
+    "spherical",
+    "spherical_jacobian",
     "virtual_stations",
 ]
+
+
+def spherical(q) -> np.ndarray:
+    """Azimuth, elevation and range of the offsets ``q`` (..., 3) (Italiano eq. 46-47): the
+    ``(phi, psi, r)`` a base station measures towards a point ``q`` away from it."""
+    q = finite_array("q", q)
+    rho = np.hypot(q[..., 0], q[..., 1])
+    return np.stack(
+        [np.arctan2(q[..., 1], q[..., 0]), np.arctan2(q[..., 2], rho), np.linalg.norm(q, axis=-1)],
+        axis=-1,
+    )
+
+
+def spherical_jacobian(q) -> np.ndarray:
+    """d(phi, psi, r) / dq of :func:`spherical`, shape (..., 3, 3) (rows: azimuth, elevation,
+    range). Undefined on the vertical axis (``q_x = q_y = 0``), where it raises."""
+    q = finite_array("q", q)
+    rho2 = q[..., 0] ** 2 + q[..., 1] ** 2
+    if np.any(rho2 < 1e-18):
+        raise ValueError("q: a point on the vertical axis has no azimuth")
+    rho = np.sqrt(rho2)
+    r2 = rho2 + q[..., 2] ** 2
+    J = np.zeros((*q.shape[:-1], 3, 3))
+    J[..., 0, 0] = -q[..., 1] / rho2
+    J[..., 0, 1] = q[..., 0] / rho2
+    J[..., 1, 0] = -q[..., 2] * q[..., 0] / (rho * r2)
+    J[..., 1, 1] = -q[..., 2] * q[..., 1] / (rho * r2)
+    J[..., 1, 2] = rho / r2
+    J[..., 2, :] = q / np.sqrt(r2)[..., None]
+    return J
 
 
 @dataclass(frozen=True)

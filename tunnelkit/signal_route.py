@@ -41,6 +41,9 @@ class Measurements:
     ``delta_d = d - d[0]`` (eq. 52, ``delta_d[0] = 0``), ``v`` (m/s), ``direction`` (K, 3) world unit
     vectors, ``alpha``. ``z`` is eq. 54, ``[phi; psi; kappa; delta_d[1:]]``. ``index`` maps each
     kept path to its row in the raw :class:`tunnelkit.extraction.PathEstimates`.
+    ``cov`` (K, 3, 3) / ``sigma_d`` (K,): the uncertainty the extraction reports for
+    ``(phi, psi, kappa)`` and ``d`` (:func:`reported_covariance`), ``None`` unless the route
+    was asked for it.
     """
 
     origin: np.ndarray
@@ -55,6 +58,8 @@ class Measurements:
     direction: np.ndarray
     alpha: np.ndarray
     index: np.ndarray
+    cov: np.ndarray | None = None
+    sigma_d: np.ndarray | None = None
 
     def __len__(self) -> int:
         return self.d.shape[0]
@@ -86,8 +91,35 @@ class Epoch:
     truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
 
 
-def measurements_from_estimates(est, array: ArrayGeometry) -> Measurements:
-    """Apply Algorithm 1's checks to raw estimates and express them in the world frame."""
+def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
+    """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
+    ``keep``, as the covariance of the world-frame ``(phi, psi, kappa)`` (K, 3, 3) and the
+    standard deviation of ``d`` (K,). The wave origin's covariance is rotated to the world frame
+    and mapped through d(phi, psi, r)/dq (:func:`tunnelkit.geometry.spherical_jacobian`).
+    Returns ``(None, None)`` when the maximum-likelihood fit failed its own residual test
+    (``fit.rho > fit.rho_max``: a wrong basin, where the bound at the estimate says nothing about
+    the error) or the Fisher information is singular at the estimate."""
+    from .extraction import estimate_crlb
+    from .geometry import spherical_jacobian
+
+    fit = getattr(est, "fit", None)
+    if fit is not None and not fit.rho <= fit.rho_max:
+        return None, None
+    try:
+        b = estimate_crlb(est, array.local, config)
+    except np.linalg.LinAlgError:
+        return None, None
+    rot = array.R  # local -> world: u_world = R u_local
+    cov_w = rot @ b["source_cov"][keep] @ rot.T
+    G = spherical_jacobian(array.dir_to_world(b["source"][keep]))
+    return G @ cov_w @ np.swapaxes(G, 1, 2), b["d"][keep]
+
+
+def measurements_from_estimates(
+    est, array: ArrayGeometry, config: SRSConfig | None = None
+) -> Measurements:
+    """Apply Algorithm 1's checks to raw estimates and express them in the world frame; with
+    ``config``, also the covariance the extraction reports (:func:`reported_covariance`)."""
     from .extraction import algorithm1
 
     keep = algorithm1(est)
@@ -95,6 +127,9 @@ def measurements_from_estimates(est, array: ArrayGeometry) -> Measurements:
     phi = np.arctan2(u[:, 1], u[:, 0])
     psi = np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1]))
     d = est.d[keep]
+    cov = sigma_d = None
+    if config is not None and keep.size:
+        cov, sigma_d = reported_covariance(est, keep, array, config)
     return Measurements(
         array.origin.copy(),
         array.name,
@@ -108,6 +143,8 @@ def measurements_from_estimates(est, array: ArrayGeometry) -> Measurements:
         u,
         est.alpha[keep],
         keep,
+        cov,
+        sigma_d,
     )
 
 
@@ -117,6 +154,8 @@ class SignalRoute:
 
     ``kinds`` selects path families (see :func:`tunnelkit.propagation.trace_paths`);
     ``n_paths=None`` means L known (the number of traced paths, as in the paper).
+    ``report_covariance``: each epoch's measurements carry the CRLB at the estimate
+    (:func:`reported_covariance`), what the ML route's error follows; off by default.
     ``impairments`` (off by default) adds what eq. 1 leaves out (:class:`tunnelkit.channel.Impairments`);
     build an impaired route with :meth:`with_impairments`, which draws each array's calibration
     error once (``calibration``: array name -> (M,) complex gains).
@@ -131,6 +170,7 @@ class SignalRoute:
     snr_offset_db: float = 0.0
     impairments: Impairments = field(default_factory=Impairments)
     calibration: dict = field(default_factory=dict)
+    report_covariance: bool = False
 
     def with_impairments(self, impairments: Impairments, rng: np.random.Generator) -> SignalRoute:
         """A copy of this route whose arrays carry ``impairments``: each array's calibration error
@@ -211,7 +251,9 @@ class SignalRoute:
             self.config.symbol_period,
             **extract_kw,
         )
-        meas = measurements_from_estimates(est, arr)
+        meas = measurements_from_estimates(
+            est, arr, self.config if self.report_covariance else None
+        )
         truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
         return Epoch(
             k,

@@ -190,32 +190,48 @@ print(sweep.to_table())
 # ## 7. Does a tracker reach the bound? Monte-Carlo JAVELIN
 #
 # A bound is only useful beside an estimator. `design.javelin_rmse` drives the route through the
-# whole signal chain (tensor, noise, clock bias, the default extraction, Algorithm 1) and tracks
-# with JAVELIN (our design, curvature centred on the VUE). Its measurement sigmas come from *this*
-# design, not from 5.9 GHz constants: the larger of the route-median CRLB and the extraction error
-# measured on one calibration drive (its own seed), so a sweep is fair at any carrier and size.
-# The interval is a 95 % t-interval over the drives (quick mode: 2 short drives).
+# whole signal chain (tensor, noise, clock bias, the maximum-likelihood extraction of notebook 03,
+# Algorithm 1) and tracks with JAVELIN (our design, curvature centred on the VUE). No 5.9 GHz
+# constant enters: each path arrives with the covariance the extraction reports for itself,
+# the CRLB evaluated at its estimate (`extraction.estimate_crlb`), which the ML stage attains
+# (notebook 03). The tracker uses these per path (`measurement_noise="reported"`), so a sweep is
+# fair at any carrier and size. Two safeguards make such tight measurements usable:
+#
+# - an epoch whose fit fails its own residual test (a wrong basin, where the bound at the
+#   estimate says nothing about the error) is predict-only;
+# - association ranks pairs by the negative log-likelihood $\eta^2 + \ln\det S$ instead of
+#   eq. 58's $\eta^2$ alone, so a new track born with $\sigma_P = 10$ m cannot take a path that
+#   an established track predicts to a millimetre.
+#
+# The first second of each drive is the tracker's start-up from a 1 m fix; the **settled** RMSE
+# leaves it out and is set beside the RMS of the PEB over the same epochs. The interval is a
+# 95 % t-interval over the drives (quick mode: 2 drives of 14 epochs).
 
 # %%
 runs = tk.mc_count(6, 2)
-n_epochs = 8 if tk.quick_mode() else None
+n_epochs = 14 if tk.quick_mode() else None
 mc = design.javelin_rmse(paper, "10x10", runs, seed=2026, n_epochs=n_epochs)
-peb10 = next(r for r in sweep.rows if r.array == "10x10").peb_median_m
+settled_ratio = mc["rmse_settled_m"] / mc["peb_rms_settled_m"]
 print(
-    f"10x10: JAVELIN RMSE {mc['rmse_m']:.3g} m, 95 % CI [{mc['ci95_m'][0]:.3g}, "
-    f"{mc['ci95_m'][1]:.3g}] m over {runs} drives; median PEB {100 * peb10:.3g} cm; "
-    f"RMSE / PEB = {mc['rmse_m'] / peb10:.0f}"
+    f"10x10 over {runs} drives: whole-drive RMSE {100 * mc['rmse_m']:.3g} cm "
+    f"[{100 * mc['ci95_m'][0]:.3g}, {100 * mc['ci95_m'][1]:.3g}]; settled RMSE "
+    f"{1000 * mc['rmse_settled_m']:.3g} mm [{1000 * mc['settled_ci95_m'][0]:.3g}, "
+    f"{1000 * mc['settled_ci95_m'][1]:.3g}] against an RMS PEB of "
+    f"{1000 * mc['peb_rms_settled_m']:.3g} mm: {settled_ratio:.1f} x the bound"
 )
-print("sigmas used:", {k: round(float(v), 4) for k, v in mc["sigmas"].items()})
 
 # %% [markdown]
-# The tracker sits orders of magnitude above the bound (the ratio is printed above). The bound
-# is a snapshot bound for an efficient estimator of every path: with the noise model of section
-# 4.2 and 410 tones x 12 symbols x 100 antennas integrated, the SNR per path is near 90 dB, and
-# delay differences alone are then good to a fraction of a millimetre. The gap is the price of the
-# extraction (see the sigmas it measured) and of the tracker's models, not of the physics, which
-# is why notebook 03 pursues an extraction at the CRLB. Re-run this cell after changing the
-# extraction to see how much of the gap it closes.
+# Once settled, the tracker sits within a small factor of the snapshot bound (printed above).
+# The bound is that small because, with the noise model of section 4.2 and 410 tones x 12
+# symbols x 100 antennas integrated, the SNR per path is near 90 dB. The remaining factor is the
+# tracker's: its motion model (speed and heading messages with 0.2 m/s and 1° of noise) and the
+# VUEs it must carry. The whole-drive RMSE is set by the start-up, as in the paper's tables.
+#
+# Why per path? Along one drive the paths' bounds differ by two orders of magnitude (an RRM
+# path near the array against the LoS and road paths 45 m away, a few degrees apart). One fixed
+# sigma per quantity is then either loose, and throws the good paths' information away (the
+# paper's 2° and 1.5 m), or, set to the median bound, too tight for the worst paths: the gate
+# rejects the LoS, the VUE tracks die and are reborn, and the drive diverges.
 
 # %% [markdown]
 # ## 8. Explorer
@@ -277,7 +293,8 @@ peb_paper = [r.peb_median_m for r in sweep.rows]
 assert np.all(np.diff(peb_paper) < 0)  # PEB falls with size
 assert sweep.rows[0].srnf_valid_share >= sweep.rows[-1].srnf_valid_share
 assert 0 <= mc["ci95_m"][0] <= mc["rmse_m"] <= mc["ci95_m"][1]
-assert mc["rmse_m"] > 10 * peb10  # the tracker is far above the bound (section 7)
+assert 1.0 < settled_ratio < 20.0  # settled JAVELIN within a small factor of the PEB (section 7)
+assert mc["rmse_settled_m"] < 0.01  # millimetres once settled, on the paper's 10 x 10
 assert explorer.figure.layout.title.text.startswith("Recommended: ")
 assert design_figure(n=4, target=0.15).layout.meta["recommended"] == "3x3"
 print("all checks passed")

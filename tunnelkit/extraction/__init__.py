@@ -21,7 +21,7 @@ import numpy as np
 from .._validate import positive
 from ..arrays import check_element_positions
 from ..constants import C
-from .bounds import crlb_paths, path_crlb
+from .bounds import crlb_paths, estimate_crlb, path_crlb
 from .decomposition import (
     CPDConvergenceWarning,
     CPDResult,
@@ -57,6 +57,7 @@ __all__ = [
     "cp_rel_error",
     "cpd",
     "crlb_paths",
+    "estimate_crlb",
     "extract_paths",
     "kruskal_rank",
     "max_identifiable_rank",

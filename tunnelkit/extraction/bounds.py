@@ -6,7 +6,7 @@ import numpy as np
 
 from ..constants import C
 
-__all__ = ["crlb_paths", "in_path_units", "path_crlb", "source_crlb"]
+__all__ = ["crlb_paths", "estimate_crlb", "in_path_units", "path_crlb", "source_crlb"]
 
 
 def crlb_paths(
@@ -154,3 +154,50 @@ def source_crlb(
     ang = np.sqrt(np.einsum("lij,ljk,lki->l", proj, st["source_cov"], proj)) / rng_
     kap = np.sqrt(np.einsum("li,lij,lj->l", u, st["source_cov"], u))
     return {"mu_f": roots["mu_f"], "mu_t": roots["mu_t"], "direction": ang, "kappa": kap}
+
+
+def estimate_crlb(est, element_positions, config, *, noise_power: float | None = None) -> dict:
+    """The structured CRLB evaluated at the estimates: the covariance an efficient estimator
+    reports for its own output (the ML route sits on this bound, notebook 03; a CPD route does
+    not, so for it this understates the error).
+
+    ``est`` is a :class:`~tunnelkit.extraction.PathEstimates`; every path enters the joint Fisher
+    information (each path's bound accounts for the others). A far-field estimate (no curvature)
+    is placed on its direction at the range ``d``, at least the Fraunhofer distance of the array;
+    its curvature bound is then meaningless and not used downstream. ``noise_power`` defaults to
+    the ML fit's estimate (``est.fit.noise_power``), else ``config.noise_power``.
+
+    Returns ``source`` (L, 3) the wave origins used (local frame), ``source_cov`` (L, 3, 3)
+    [m^2] their covariance, and ``d`` (L,) [m], the delay-distance standard deviation. Raises
+    ``numpy.linalg.LinAlgError`` when the Fisher information is singular at the estimate.
+    """
+    p = np.asarray(element_positions, float)
+    if len(est) == 0:
+        return {"source": np.zeros((0, 3)), "source_cov": np.zeros((0, 3, 3)), "d": np.zeros(0)}
+    if noise_power is None:
+        fit = getattr(est, "fit", None)
+        noise_power = fit.noise_power if fit is not None else config.noise_power
+    lam = C / config.fc
+    aperture = float(np.max(np.linalg.norm(p - p.mean(axis=0), axis=1))) * 2.0
+    far = max(2.0 * aperture**2 / lam, 1.0)
+    rng_ = np.where(np.isfinite(est.kappa), est.kappa, np.maximum(est.d, far))
+    src = est.direction * rng_[:, None]
+    res = crlb_paths(
+        est.alpha,
+        src,
+        p,
+        est.mu_f,
+        est.mu_t,
+        config.fc,
+        config.n_tones,
+        config.n_symbols,
+        float(noise_power),
+        spatial="structured",
+    )
+    cov = res["source_cov"]
+    d = C / (2 * np.pi * config.tone_spacing) * res["mu_f"]
+    ok = np.all(np.isfinite(cov)) and np.all(np.isfinite(d))
+    ok = ok and np.all(np.linalg.eigvalsh(0.5 * (cov + np.swapaxes(cov, 1, 2))) > 0)
+    if not ok:
+        raise np.linalg.LinAlgError("estimate_crlb: Fisher information singular at the estimate")
+    return {"source": src, "source_cov": cov, "d": d}

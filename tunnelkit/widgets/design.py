@@ -145,11 +145,23 @@ class DesignExplorer(Explorer):
             except ValueError as exc:
                 print(f"Monte-Carlo not run: {exc}")
                 return
-            lo, hi = res["ci95_m"]
-            print(
-                f"JAVELIN 2-D RMSE {100 * res['rmse_m']:.3g} cm, 95 % CI [{100 * lo:.3g}, "
-                f"{100 * hi:.3g}] cm over {self.runs} drives"
-            )
+            print(monte_carlo_summary(res, self.runs))
+
+
+def monte_carlo_summary(res: dict, runs: int) -> str:
+    """One line for :func:`tunnelkit.design.javelin_rmse`'s result: whole-drive RMSE with its
+    interval and, when the drives outlast the start-up, the settled RMSE against the PEB."""
+    lo, hi = res["ci95_m"]
+    text = (
+        f"JAVELIN 2-D RMSE {100 * res['rmse_m']:.3g} cm, 95 % CI [{100 * lo:.3g}, "
+        f"{100 * hi:.3g}] cm over {runs} drives"
+    )
+    if res.get("rmse_settled_m") is not None:
+        text += (
+            f"; after the first {design.SETTLE_S:g} s {1000 * res['rmse_settled_m']:.3g} mm, "
+            f"{res['rmse_settled_m'] / res['peb_rms_settled_m']:.3g} x the RMS PEB"
+        )
+    return text
 
 
 def design_explorer(

@@ -30,12 +30,18 @@ __all__ = [
 
 @dataclass
 class AssociationCosts:
-    """``eta2`` (n_tracks, n_paths), ``dof`` (n_paths,), ``gated`` (n_tracks, n_paths) bool."""
+    """``eta2`` (n_tracks, n_paths), ``dof`` (n_paths,), ``gated`` (n_tracks, n_paths) bool;
+    ``cost`` what the associators minimise (``eta2`` unless set: see :func:`association_costs`)."""
 
     eta2: np.ndarray
     dof: np.ndarray
     gated: np.ndarray
     threshold: np.ndarray
+    cost: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.cost is None:
+            self.cost = self.eta2
 
 
 def association_costs(
@@ -45,26 +51,34 @@ def association_costs(
     meas: PathMeasurements,
     R3: np.ndarray,
     gate: ChiSquareGate,
+    cost: str = "mahalanobis",
 ) -> AssociationCosts:
     """Squared Mahalanobis distance of every track-path pair (Algorithm 2, lines 2-9).
 
     ``pred`` (L, 4) and ``J`` (L, 4, D) come from :func:`measurement.track_model`; ``R3`` is the
-    3x3 covariance of ``(phi, psi, kappa)``. Vectorised over pairs: a missing curvature is
+    3x3 covariance of ``(phi, psi, kappa)``, or (n, 3, 3), one per path. Vectorised over pairs: a missing curvature is
     handled by zeroing its innovation and setting its row/column of ``S`` to the identity, which
     leaves ``eta^2`` equal to the 2-component distance.
+
+    ``cost="mahalanobis"`` (the paper, section 3.3) ranks pairs by ``eta^2``;
+    ``cost="likelihood"`` (ours) by the negative log-likelihood ``eta^2 + ln det S``. The second
+    stops a wide new track (``P = sigma_P^2 I`` at birth) from taking a path that an established
+    track predicts well: its large ``S`` makes ``eta^2`` small, but ``ln det S`` large.
     """
     L, n = pred.shape[0], len(meas)
     if n == 0 or L == 0:
         e = np.zeros((L, n))
         return AssociationCosts(e, np.zeros(n, int), e.astype(bool), np.zeros(n))
     H3 = J[:, :3, :]
-    S0 = H3 @ P @ np.swapaxes(H3, 1, 2) + R3  # (L, 3, 3)
+    R3 = np.asarray(R3, dtype=float)
+    per_path = R3.ndim == 3  # (n, 3, 3): each path's reported covariance
+    S0 = H3 @ P @ np.swapaxes(H3, 1, 2) + (0.0 if per_path else R3)  # (L, 3, 3)
     z = meas.triples()  # (n, 3)
     has_k = np.isfinite(z[:, 2])
     y = z[None, :, :] - pred[:, None, :3]  # (L, n, 3)
     y[..., 0] = wrap_angle(y[..., 0])
     y[..., 2] = np.where(has_k[None, :], y[..., 2], 0.0)
-    S = np.broadcast_to(S0[:, None], (L, n, 3, 3)).copy()
+    S = S0[:, None] + R3[None] if per_path else np.broadcast_to(S0[:, None], (L, n, 3, 3)).copy()
     nk = ~has_k
     S[:, nk, 2, :] = 0.0
     S[:, nk, :, 2] = 0.0
@@ -73,13 +87,19 @@ def association_costs(
     dof = np.where(has_k, 3, 2)
     thr = np.array([gate.threshold(int(k)) for k in dof])
     gated = np.isfinite(eta2) & (eta2 < thr)  # ChiSquareGate.accepts with the quantiles at hand
-    return AssociationCosts(eta2, dof, gated, thr)
+    if cost == "mahalanobis":
+        return AssociationCosts(eta2, dof, gated, thr)
+    if cost != "likelihood":
+        raise ValueError(f"cost: expected 'mahalanobis' or 'likelihood', got {cost!r}")
+    # the substituted identity row of a far-field path adds ln 1 = 0
+    return AssociationCosts(eta2, dof, gated, thr, eta2 + np.linalg.slogdet(S)[1])
 
 
 def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
     """Algorithm 2 + the NN choice of section 3.3: repeatedly take the gated pair of smallest
-    ``eta^2``, then drop its track and its path. Returns ``[(track, path), ...]``."""
-    eta = np.where(costs.gated, costs.eta2, np.inf)
+    cost (``eta^2`` in the paper), then drop its track and its path. Returns
+    ``[(track, path), ...]``."""
+    eta = np.where(costs.gated, costs.cost, np.inf)
     pairs = []
     while eta.size and np.isfinite(eta).any():
         i, j = np.unravel_index(np.argmin(eta), eta.shape)
@@ -90,15 +110,18 @@ def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
 
 
 def global_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
-    """The one-to-one assignment of gated pairs with the smallest total ``eta^2`` (ours).
+    """The one-to-one assignment of gated pairs with the smallest total cost (ours).
 
     Ungated pairs get a cost above any gated total, so they are chosen only when nothing else
     fits and are then dropped; the result is the maximum-cardinality, minimum-cost matching.
     """
     if costs.eta2.size == 0 or not costs.gated.any():
         return []
-    big = float(np.sum(np.where(costs.gated, costs.eta2, 0.0))) + 1.0
-    cost = np.where(costs.gated, costs.eta2, big * 10.0)
+    # shift to non-negative costs (a log-likelihood cost can be negative), then price every
+    # ungated pair above any gated total
+    c = costs.cost - np.min(np.where(costs.gated, costs.cost, np.inf), initial=0.0)
+    big = float(np.sum(np.where(costs.gated, c, 0.0))) + 1.0
+    cost = np.where(costs.gated, c, big * 10.0)
     rows, cols = linear_sum_assignment(cost)
     return sorted((int(i), int(j)) for i, j in zip(rows, cols) if costs.gated[i, j])
 

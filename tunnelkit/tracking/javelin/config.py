@@ -13,9 +13,18 @@ import numpy as np
 
 from ..._validate import integer, nonnegative, positive, probability, vector
 
-__all__ = ["ASSOCIATORS", "KAPPA_MODELS", "VUE_MOTIONS", "JavelinConfig"]
+__all__ = [
+    "ASSOCIATION_COSTS",
+    "ASSOCIATORS",
+    "KAPPA_MODELS",
+    "MEASUREMENT_NOISE",
+    "VUE_MOTIONS",
+    "JavelinConfig",
+]
 
 ASSOCIATORS = ("greedy", "gnn")
+ASSOCIATION_COSTS = ("mahalanobis", "likelihood")
+MEASUREMENT_NOISE = ("fixed", "reported")
 VUE_MOTIONS = ("random_walk", "mirror")
 KAPPA_MODELS = ("reflector", "vue")
 
@@ -50,12 +59,17 @@ class JavelinConfig:
       speed/heading message is missing, ``sigma_p0_ue`` [m] initial UE uncertainty (the paper
       starts from an open-sky GNSS fix; ``None`` uses ``sigma_p0``).
     - design switches: ``associator`` ``"greedy"`` (Algorithm 2) or ``"gnn"`` (global nearest
-      neighbour, ours); ``vue_motion`` ``"random_walk"`` (paper) or ``"mirror"`` (a wall-fixed
+      neighbour, ours); ``association_cost`` ``"mahalanobis"`` (the paper's ``eta^2``) or
+      ``"likelihood"`` (``eta^2 + ln det S``, ours); ``vue_motion`` ``"random_walk"`` (paper) or ``"mirror"`` (a wall-fixed
       VUE mirrors the UE displacement, ours); ``kappa_model`` ``"reflector"`` (eq. 51) or
       ``"vue"`` (curvature centred on the VUE); ``correlated_delta_d``: the TDoAs share the
       reference path's delay, so their covariance is ``sigma_dd^2 (I + 1 1^T) / 2`` (ours; the
       paper uses a diagonal ``sigma_dd^2 I``); ``update_with_births``: measurements that give
-      birth to a track also update the state in that epoch (the paper's Algorithm 4).
+      birth to a track also update the state in that epoch (the paper's Algorithm 4);
+      ``measurement_noise``: ``"fixed"`` (the paper: one ``sigma_phi`` ... ``sigma_delta_d`` for
+      every path) or ``"reported"`` (ours: each path's own covariance as the extraction reports
+      it, ``PathMeasurements.cov`` / ``sigma_d``; an epoch without one falls back to the fixed
+      sigmas, reported as a fault).
     - ``doppler_clutter_margin`` [m/s] (ours; ``None`` = off as in the paper): a path whose
       radial speed exceeds the vehicle speed by more than this margin cannot come from a static
       reflector (``|v| <= ||v_u||`` for any mirror image) and is dropped as clutter before
@@ -81,10 +95,12 @@ class JavelinConfig:
     doppler_tolerance: float = 1.0
     sigma_speed_missing: float = 1.0
     associator: str = "greedy"
+    association_cost: str = "mahalanobis"
     vue_motion: str = "random_walk"
     kappa_model: str = "reflector"
     correlated_delta_d: bool = False
     update_with_births: bool = True
+    measurement_noise: str = "fixed"
     doppler_clutter_margin: float | None = None
     doppler_sign: float = -1.0
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -103,8 +119,10 @@ class JavelinConfig:
             nonnegative("doppler_clutter_margin", self.doppler_clutter_margin)
         for name, allowed in (
             ("associator", ASSOCIATORS),
+            ("association_cost", ASSOCIATION_COSTS),
             ("vue_motion", VUE_MOTIONS),
             ("kappa_model", KAPPA_MODELS),
+            ("measurement_noise", MEASUREMENT_NOISE),
         ):
             if getattr(self, name) not in allowed:
                 raise ValueError(f"{name}: expected one of {allowed}, got {getattr(self, name)!r}")

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._validate import finite_array, vector
+from ...geometry import spherical_jacobian
 from .state import _vue_positions
 
 __all__ = [
@@ -48,12 +49,41 @@ def _opt(name: str, value, n: int) -> np.ndarray:
     return arr.copy()
 
 
+def _reported(cov, sigma_d, n: int):
+    """Checked ``cov`` (n, 3, 3) and ``sigma_d`` (n,): both given or both ``None``."""
+    if cov is None and sigma_d is None:
+        return None, None
+    if cov is None or sigma_d is None:
+        raise ValueError("cov, sigma_d: give both (the reported uncertainty) or neither")
+    cov = np.array(cov, dtype=float)
+    if cov.shape != (n, 3, 3):
+        raise ValueError(f"cov: expected shape ({n}, 3, 3), got {cov.shape}")
+    sd = np.array(sigma_d, dtype=float).reshape(-1)
+    if sd.size != n:
+        raise ValueError(f"sigma_d: expected {n} values (one per path), got {sd.size}")
+    if not (np.all(np.isfinite(sd)) and np.all(sd > 0)):
+        raise ValueError("sigma_d: every value must be finite and > 0")
+    if not np.all(np.isfinite(cov)):
+        raise ValueError("cov: every entry must be finite")
+    cov = 0.5 * (cov + np.swapaxes(cov, 1, 2))
+    # the curvature block may be absent (far field): only the angular block must be positive
+    if n and not np.all(np.linalg.eigvalsh(cov[:, :2, :2]) > 0):
+        raise ValueError("cov: the (phi, psi) block of every path must be positive definite")
+    return cov, sd
+
+
 @dataclass
 class PathMeasurements:
     """Sanitised path parameters of one epoch (Algorithm 1, lines 4-12).
 
     Arrays have one entry per kept path; ``kappa`` is NaN where only the far-field estimate is
     valid, ``d`` / ``v`` NaN where unknown. ``source`` keeps each kept path's index in the input.
+
+    Optionally the extraction reports its own uncertainty per path (ours, not in the paper):
+    ``cov`` (n, 3, 3) the covariance of ``(phi, psi, kappa)`` [rad^2, rad m, m^2] and ``sigma_d``
+    (n,) [m] the standard deviation of ``d``, e.g. the CRLB at the estimate of an efficient
+    estimator (:func:`tunnelkit.extraction.estimate_crlb`). Both or neither; a tracker with
+    ``measurement_noise="reported"`` uses them instead of its fixed sigmas.
     """
 
     phi: np.ndarray
@@ -62,6 +92,8 @@ class PathMeasurements:
     d: np.ndarray
     v: np.ndarray
     source: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    cov: np.ndarray | None = None
+    sigma_d: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # built directly (not through from_arrays): 1-D float arrays of one length, and a
@@ -80,6 +112,12 @@ class PathMeasurements:
         if src.size != n:
             raise ValueError(f"source: expected {n} values (one per path), got {src.size}")
         self.source = src
+        self.cov, self.sigma_d = _reported(self.cov, self.sigma_d, n)
+
+    @property
+    def reported(self) -> bool:
+        """Whether the extraction reported a covariance for every path."""
+        return self.cov is not None
 
     def sanitised(self) -> tuple[PathMeasurements, int]:
         """These paths through the checks of Algorithm 1 (idempotent), and how many were dropped.
@@ -88,17 +126,29 @@ class PathMeasurements:
         clean = PathMeasurements.from_arrays(
             self.phi, self.psi, self.kappa, self.d, self.v, warn=False
         )
+        if self.reported:
+            clean.cov, clean.sigma_d = self.cov[clean.source], self.sigma_d[clean.source]
         clean.source = self.source[clean.source]
         return clean, len(self) - len(clean)
 
     @classmethod
     def from_arrays(
-        cls, phi, psi, kappa=None, d=None, v=None, *, warn: bool = True
+        cls,
+        phi,
+        psi,
+        kappa=None,
+        d=None,
+        v=None,
+        *,
+        warn: bool = True,
+        cov=None,
+        sigma_d=None,
     ) -> PathMeasurements:
         """Apply the consistency checks of Algorithm 1 and drop unusable paths.
 
         (i) ``d < 0``: path discarded; (ii) ``kappa < 0`` (or NaN): far field, no curvature;
         ours: a path with a NaN/inf angle is discarded with a :class:`JavelinWarning`.
+        ``cov`` / ``sigma_d``: the reported uncertainty of every input path (see the class).
         """
         phi = np.asarray(phi, dtype=float).reshape(-1)
         n = phi.size
@@ -116,7 +166,10 @@ class PathMeasurements:
         d = np.where(np.isfinite(d), d, np.nan)
         v = np.where(np.isfinite(v), v, np.nan)
         idx = np.flatnonzero(keep)
-        return cls(phi[idx], psi[idx], kappa[idx], d[idx], v[idx], idx)
+        cov, sigma_d = _reported(cov, sigma_d, n)
+        if cov is not None:
+            cov, sigma_d = cov[idx], sigma_d[idx]
+        return cls(phi[idx], psi[idx], kappa[idx], d[idx], v[idx], idx, cov, sigma_d)
 
     @classmethod
     def empty(cls) -> PathMeasurements:
@@ -137,6 +190,8 @@ class PathMeasurements:
             self.d[idx],
             self.v[idx],
             self.source[idx],
+            None if self.cov is None else self.cov[idx],
+            None if self.sigma_d is None else self.sigma_d[idx],
         )
 
     def triples(self) -> np.ndarray:
@@ -181,12 +236,8 @@ def track_model(
     pred[:, KAPPA] = r
     # derivatives w.r.t. the track point q (L, 4, 3)
     dq = np.zeros((n_v + 1, 4, 3))
-    dq[:, PHI, 0] = -q[:, 1] / rho2
-    dq[:, PHI, 1] = q[:, 0] / rho2
-    dq[:, PSI, 0] = -q[:, 2] * q[:, 0] / (rho * r2)
-    dq[:, PSI, 1] = -q[:, 2] * q[:, 1] / (rho * r2)
-    dq[:, PSI, 2] = rho / r2
-    dq[:, RANGE] = q / r[:, None]
+    sph = spherical_jacobian(q)
+    dq[:, PHI], dq[:, PSI], dq[:, RANGE] = sph[:, 0], sph[:, 1], sph[:, 2]
     dq[:, KAPPA] = dq[:, RANGE]
     J = np.zeros((n_v + 1, 4, D))
     J[0, :, 0:3] = dq[0]

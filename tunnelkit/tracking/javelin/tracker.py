@@ -132,9 +132,14 @@ class Javelin:
                 geometry_ok = False
                 faults.append(f"measurement model undefined ({exc}): predict only")
         if len(meas) and geometry_ok:
-            R3 = np.diag([cfg.sigma_phi**2, cfg.sigma_psi**2, cfg.sigma_kappa**2])
+            if cfg.measurement_noise == "reported" and meas.reported:
+                R3 = meas.cov
+            else:
+                if cfg.measurement_noise == "reported":
+                    faults.append("no reported covariance this epoch: the fixed sigmas used")
+                R3 = np.diag([cfg.sigma_phi**2, cfg.sigma_psi**2, cfg.sigma_kappa**2])
             # Associate (Algorithm 2)
-            costs = association_costs(pred, J, st.P, meas, R3, self.gate)
+            costs = association_costs(pred, J, st.P, meas, R3, self.gate, cfg.association_cost)
             assoc = self.associate(costs)
             # ManageTracks (Algorithm 3)
             mres = manage_tracks(

@@ -50,8 +50,9 @@ def stack_measurement(
 ) -> StackedMeasurement:
     """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``."""
     D = J.shape[-1]
-    z, h, H, var, ang, labels = [], [], [], [], [], []
-    sig = {PHI: config.sigma_phi, PSI: config.sigma_psi, KAPPA: config.sigma_kappa}
+    reported = config.measurement_noise == "reported" and meas.reported
+    z, h, H, blocks, ang, labels = [], [], [], [], [], []
+    sig = np.array([config.sigma_phi, config.sigma_psi, config.sigma_kappa])
     for i, j in pairs:
         comps = [PHI, PSI] + ([KAPPA] if np.isfinite(meas.kappa[j]) else [])
         zj = (meas.phi[j], meas.psi[j], meas.kappa[j])
@@ -59,9 +60,9 @@ def stack_measurement(
             z.append(zj[c])
             h.append(pred[i, c])
             H.append(J[i, c])
-            var.append(sig[c] ** 2)
             ang.append(c == PHI)
             labels.append((("phi", "psi", "kappa")[c], i, j))
+        blocks.append(meas.cov[j][np.ix_(comps, comps)] if reported else np.diag(sig[comps] ** 2))
     n_direct = len(z)
     with_d = [(i, j) for i, j in pairs if np.isfinite(meas.d[j])]
     ref = None
@@ -79,9 +80,16 @@ def stack_measurement(
             labels.append(("delta_d", i, j))
     K = len(z)
     R = np.zeros((K, K))
-    R[np.arange(n_direct), np.arange(n_direct)] = var
+    at = 0
+    for b in blocks:
+        R[at : at + len(b), at : at + len(b)] = b
+        at += len(b)
     nd = K - n_direct
-    if nd:
+    if nd and reported:
+        # Delta d_j = d_j - d_ref: var = s_j^2 + s_ref^2, the reference shared by every row
+        others = [j for i, j in with_d if (i, j) != ref]
+        R[n_direct:, n_direct:] = np.diag(meas.sigma_d[others] ** 2) + meas.sigma_d[jr] ** 2
+    elif nd:
         s2 = config.sigma_delta_d**2
         blk = (
             0.5 * s2 * (np.eye(nd) + np.ones((nd, nd)))
