@@ -375,8 +375,13 @@ fig7.update_xaxes(type="log", range=[-2, 2])
 
 # %% [markdown]
 # Read a CDF left to right: the higher a curve at a given error, the larger the share of epochs
-# within it. With the LoS (JAVELIN-L) the tracker stays at centimetres to a decimetre; blocking
-# the LoS costs it the best-measured path, and the curves move right.
+# within it. In full mode JAVELIN-L keeps 90 % of its epochs within about a decimetre. Blocking
+# the LoS hardly hurts on the ML route: the ceiling and road bounces, measured at their bound,
+# locate the UE through their VUEs; where the LoS comes and goes (N@0.5) the tail is heavier,
+# since every return of the LoS is a track to be born again. TeNFiLoc-L has a median as good as
+# JAVELIN's but a long tail: a snapshot fix has no memory, so every epoch whose LoS curvature is
+# implausible falls back to the clock-biased delay, metres off. That tail is what a tracker buys.
+# (Quick mode's six-epoch drives show little of this.)
 #
 # ## Exercises
 #
@@ -449,20 +454,23 @@ for n_src in (1, 2, 3):
         if t >= 0
     }
     missing = [lab for lab in labels if lab not in off]
-    print(f"max_sources={n_src}: angle error [deg]", {k: round(v, 3) for k, v in off.items()})
+    print(
+        f"max_sources={n_src}: angle error [deg]", {k: round(float(v), 3) for k, v in off.items()}
+    )
     print(f"    true paths missed: {missing}; estimates matching no path: {int(np.sum(idx < 0))}")
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
 #
-# 1. Honest curvature noise makes the true pairs pass the gate again, so the tracker stops
-#    dying and being reborn, but the spurious CPD components (a radial speed no static reflector
-#    can have) still get associated; the Doppler test removes them. On our tuning drives (seed 7)
-#    $\sigma_\kappa = 50$ m alone left the paper's design metres off (about 7 m) and the Doppler
-#    test brought it below a metre; notebook 04b measures each step of that ablation over 20
-#    runs. On one short drive (quick mode) the differences are small.
-# 2. With $\zeta = 3$ a track survives missed epochs, so fewer are reborn; the RMSE moves by
-#    centimetres (0.56 → 0.48 m on our tuning drives), within run-to-run spread.
+# 1. Honest curvature noise alone does not rescue the paper's design on the paper's route: the
+#    true pairs pass the gate again, but so do the spurious CPD components (a radial speed no
+#    static reflector can have), and the tracker stays metres off — on the full first drive even
+#    further off than before. The Doppler test removes those components and brings it below a
+#    metre: both changes are needed. Notebook 04b measures each step of that path over 20 runs.
+#    On one short drive (quick mode) the differences are small.
+# 2. With $\zeta = 3$ a track survives missed epochs, so fewer are born again and more states are
+#    tracked at a time; the RMSE hardly moves (on the full first drive not at all; on our tuning
+#    drives, seed 7, 0.56 → 0.48 m, within run-to-run spread).
 # 3. The exact channel's wavefront is centred on the VUE, so its curvature radius is the VUE
 #    distance, not eq. 51's reflector distance (for the ceiling bounce, tens of metres against
 #    half a metre). The ML route fits each path as a point source and $\hat\kappa$ estimates
@@ -494,4 +502,8 @@ assert np.array_equal(straight_ml["L"][0].truth, drive_ml.truth)
 assert los_rms["ML"] < 0.05 < los_rms["paper"]  # the ML route: the LoS direction to 0.001 deg
 err_all = {r[0]: r for r in erows}["all"]
 assert err_all[2] < 1.0 and err_all[5] < 0.1  # RMS over every path, gross errors included
+# Fig. 7: JAVELIN's tail (90th percentile) is shorter than the snapshot baseline's (full mode:
+# about 0.12 m against 1.4 m on the three runs)
+p90 = {n: float(np.percentile(cdfs[n], 90)) for n in ("JAVELIN-L", "TeNFiLoc-L")}
+assert p90["JAVELIN-L"] < p90["TeNFiLoc-L"], p90
 print("all checks passed")
