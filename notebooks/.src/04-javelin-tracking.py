@@ -151,7 +151,7 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 # the coherent split, with a residual test against the noise floor. The same epoch, same tensor:
 
 # %%
-javelin_table_figure(cols, model_rows(drive_ml, k), title=f"epoch {k}: ML route vs model")
+javelin_table_figure(cols, model_rows(drive_ml, k), title=f"epoch {k}: ML route vs model", digits=4)
 
 # %% [markdown]
 # One drive is one draw of the noise. Over a few drives per condition (the first three runs of
@@ -180,9 +180,9 @@ los_rms = {}
 for name, d in (("paper", straight["L"]), ("ML", straight_ml["L"])):
     pcols, prows = ex.path_errors(d)
     los_rms[name] = {r[0]: r[3] for r in prows}["los"]
-    display(javelin_table_figure(pcols, prows, title=f"straight, L: {name} route"))
+    display(javelin_table_figure(pcols, prows, title=f"straight, L: {name} route", digits=4))
 ecols, erows = ex.extraction_errors(straight_ml["L"] + slalom_ml["L"])
-javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per kind of path")
+javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per path", digits=4)
 
 # %% [markdown]
 # Where the paths are well apart the ML route measures directions to about a thousandth of a

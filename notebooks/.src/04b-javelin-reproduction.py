@@ -184,7 +184,9 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 # %%
 ecols, erows = ex.extraction_errors(straight_ml["L"] + slalom_ml["L"])
 display_rows = [*erows, ["OURS_ML assumes", None, *ex.ML_ERRORS_SEED0.values(), None]]
-javelin_table_figure(ecols, display_rows, title=f"ML route: RMS measurement error, {runs} run(s)")
+javelin_table_figure(
+    ecols, display_rows, title=f"ML route: RMS measurement error, {runs} run(s)", digits=4
+)
 
 # %% [markdown]
 # ## 6. Where our tunnel differs from the paper's, and what we measured on the way
