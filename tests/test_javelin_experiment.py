@@ -227,3 +227,20 @@ def test_ablation_path_goes_from_the_paper_design_to_ours_one_change_at_a_time()
     cfgs = list(ex.ABLATION.values())
     assert cfgs[0] == ex.PAPER and cfgs[-1] == ex.OURS
     assert len(set(map(repr, cfgs))) == len(cfgs)  # every step changes something
+
+
+def test_table_and_ablation_progress_bars_change_no_number(capsys):
+    """The bars over the scored drives leave every number as it is."""
+    drives = {"L": [_fake_drive("L"), _fake_drive("L", seed=2)], "N": [_fake_drive("N", seed=1)]}
+    routes = {"paper": drives, "ml": {c: [_fake_drive(c, seed=5)] for c in drives}}
+    quiet = table_rows(routes, "italiano2026_table1")
+    shown = table_rows(routes, "italiano2026_table1", progress=True)
+    assert "scoring drives" in capsys.readouterr().err
+    assert shown == quiet
+    a_quiet = ex.ablation(drives, ml=routes["ml"])
+    a_shown = ex.ablation(drives, ml=routes["ml"], progress=True)
+    assert "ablation" in capsys.readouterr().err
+    assert a_shown == a_quiet
+    assert a_quiet[1][0][1] == pytest.approx(
+        np.mean([ex.evaluate(d, ex.PAPER).metrics["rmse_2d_m"] for d in drives["L"]])
+    )

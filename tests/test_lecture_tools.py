@@ -378,3 +378,18 @@ def test_site_drops_progress_bars():
     assert [o.get("text") for o in nb.cells[0].outputs] == ["done\n"]  # the bar is gone
     # a bar closed since it was displayed (tqdm's leave=False) is not in the saved state
     assert lec.is_progress_bar("no-such-model", {}) is True
+
+
+def test_notebook_04_and_its_appendix_04b_resolve_and_04_has_an_explorers_view(tmp_path):
+    """`make present NB=04` is the lesson, `NB=04b` its appendix; 04's explorers view keeps the
+    epoch explorer and, output hidden, the cells it needs (the drive, the epoch, the tracker)."""
+    assert lec.resolve_notebook("04").name == "04-javelin-tracking.ipynb"
+    assert lec.resolve_notebook("04b").name == "04b-javelin-reproduction.ipynb"
+    out = lec.explorers_notebook(lec.resolve_notebook("04"), tmp_path)
+    src = ["".join(c.source) for c in nbformat.read(out, as_version=4).cells]
+    assert "tk.setup_notebook()" in src[1]
+    setup = [s for s in src if s.startswith("%%capture\n")]
+    assert len(setup) == 3 and "collect_routes" in setup[0] and "ev_ml = " in setup[2]
+    assert src[-1].startswith("explorer = epoch_explorer(drive_ml, ev_ml, k=k)")
+    with pytest.raises(lec.LectureError, match="no code cell tagged 'explorer'"):
+        lec.explorers_notebook(lec.resolve_notebook("04b"), tmp_path / "b")

@@ -289,3 +289,17 @@ def test_cv_process_noise_allows_zero_q_but_simulate_cv_refuses_it():
         simulate_cv([0, 0, 1, 1], 0.1, 0.0, 3, np.random.default_rng(0))
     with pytest.raises(ValueError, match="q: must be >= 0"):
         cv_process_noise(0.1, -1.0)
+
+
+def test_monte_carlo_progress_bar_draws_nothing(exp_hi, capsys):
+    """The bar changes no random stream: the same seed gives identical estimates (UPF included)."""
+    kw = {"names": ["EKF", "UPF"], "options": {"UPF": {"n_particles": 40}}}
+    quiet = vs.monte_carlo(exp_hi, 3, 11, **kw)
+    shown = vs.monte_carlo(exp_hi, 3, 11, progress=True, **kw)
+    assert "3 runs" in capsys.readouterr().err  # tqdm writes to stderr outside a notebook
+    assert list(shown) == ["EKF", "UPF"]
+    for n in quiet:
+        np.testing.assert_array_equal(shown[n], quiet[n])
+    # one estimator per call draws the UPF from another child seed: not the same numbers
+    alone = vs.monte_carlo(exp_hi, 3, 11, names=["UPF"], options=kw["options"])
+    assert not np.array_equal(alone["UPF"], quiet["UPF"])

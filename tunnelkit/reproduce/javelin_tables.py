@@ -121,6 +121,7 @@ def table_rows(
     routes: dict[str, dict[str, list]],
     reference: str,
     columns: tuple[tuple[str, str, str], ...] | None = None,
+    progress: bool = False,
 ) -> tuple[list[str], list[list]]:
     """Rows ``[configuration, metric, <one value per column>, paper]``, means over runs.
 
@@ -129,7 +130,10 @@ def table_rows(
     route and a design each; columns whose route is missing are left out. JAVELIN is scored on
     every condition; TeNFiLoc (no design of its own) on the LoS drives, in the columns of the
     paper's design. Configurations follow the paper's table, extra ones (e.g. NoRRMs-L) after.
+    ``progress``: a tqdm bar over the drives scored (nothing here draws random numbers).
     """
+    from tqdm.auto import tqdm
+
     from ..tracking.javelin import experiment as ex
 
     if columns is None:
@@ -141,9 +145,12 @@ def table_rows(
     ref = {r["configuration"]: r for r in load_reference(reference)}
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
     cache: dict[tuple[int, str, str], dict[str, float]] = {}
+    total = sum(len(d) for _, route, _ in columns for d in routes[route].values())
+    bar = tqdm(total=total, desc=f"{reference}: scoring drives", leave=False, disable=not progress)
     for label, route, design in columns:
         for cond, drives in routes[route].items():
             for drive in drives:
+                bar.update()
                 entries = [(f"JAVELIN-{cond}", "JAVELIN", design)]
                 if cond == "L" and design == "paper":  # once per route
                     entries.append(("TeNFiLoc-L", "TeNFiLoc", "none"))
@@ -153,6 +160,7 @@ def table_rows(
                         cfg = designs.get(dname)
                         cache[key] = ex.evaluate(drive, cfg, method=method).metrics
                     scores.setdefault((name, label), []).append(cache[key])
+    bar.close()
     names = list(dict.fromkeys(n for n, _ in scores))
     order = {n: i for i, n in enumerate(ref)}
     names.sort(key=lambda n: order.get(n, len(order)))
@@ -216,7 +224,7 @@ def javelin_table(
         extractions=extractions,
         **parallel,
     )
-    cols, rows = table_rows(routes, reference)
+    cols, rows = table_rows(routes, reference, progress=progress)
     faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}: JAVELIN vs TeNFiLoc",

@@ -638,11 +638,17 @@ def monte_carlo(
     *,
     names=None,
     options: dict | None = None,
+    progress: bool = False,
 ) -> dict[str, np.ndarray]:
     """Estimates (runs, T, 4) of each registry member on the same simulated runs.
 
     ``options`` maps an algorithm name to keyword options (e.g. ``{"UPF": {"n_particles": 200}}``).
+    Every estimator gets its own child generator of ``seed`` by its position in ``names``, so a
+    call with the same ``names`` gives the same numbers. ``progress``: a tqdm bar over the
+    estimators (it draws no random numbers).
     """
+    from tqdm.auto import tqdm
+
     from ..montecarlo import spawn_rngs
     from .registry import family
 
@@ -651,7 +657,9 @@ def monte_carlo(
     rng_data, *rng_alg = spawn_rngs(seed, 1 + len(names))
     Z, x0 = exp.simulate(runs, rng_data)
     opts = options or {}
-    return {
-        n: run_estimator(n, exp.model, Z, x0, exp.P0, rng=r, **opts.get(n, {}))
-        for n, r in zip(names, rng_alg)
-    }
+    out = {}
+    with tqdm(names, desc=f"{runs} runs", leave=False, disable=not progress) as bar:
+        for n, r in zip(bar, rng_alg):
+            bar.set_postfix_str(n)
+            out[n] = run_estimator(n, exp.model, Z, x0, exp.P0, rng=r, **opts.get(n, {}))
+    return out

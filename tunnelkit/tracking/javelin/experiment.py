@@ -497,6 +497,7 @@ def ablation(
     variants: dict[str, JavelinConfig] | None = None,
     separated: dict[str, list[DriveData]] | None = None,
     ml: dict[str, list[DriveData]] | None = None,
+    progress: bool = False,
 ) -> tuple[list[str], list[list]]:
     """Mean 2-D RMSE per variant (rows) and condition (columns) over the given drives.
 
@@ -504,7 +505,10 @@ def ablation(
     last variant on those (the measurement route as one more step), then
     :data:`OURS_COHERENT` (our design on that route). With ``ml`` (the same drives through the
     ML route) three more: the paper's design on it, :data:`PAPER_VUE`, then :data:`OURS_ML`.
+    ``progress``: a tqdm bar over the (variant, drive) evaluations; nothing here is random.
     """
+    from tqdm.auto import tqdm
+
     variants = ABLATION if variants is None else variants
     conds = list(drives)
     steps = [(name, cfg, drives) for name, cfg in variants.items()]
@@ -515,12 +519,19 @@ def ablation(
         steps.append(("paper design, ML route", PAPER, ml))
         steps.append(("paper design + VUE curvature, ML route", PAPER_VUE, ml))
         steps.append(("our design, ML route", OURS_ML, ml))
+    total = sum(len(by_cond[c]) for _, _, by_cond in steps for c in conds)
+    bar = tqdm(total=total, desc="ablation: drives", leave=False, disable=not progress)
     rows = []
     for name, cfg, by_cond in steps:
         row: list = [name]
         for c in conds:
-            row.append(float(np.mean([evaluate(d, cfg).metrics["rmse_2d_m"] for d in by_cond[c]])))
+            rmse = []
+            for d in by_cond[c]:
+                rmse.append(evaluate(d, cfg).metrics["rmse_2d_m"])
+                bar.update()
+            row.append(float(np.mean(rmse)))
         rows.append(row)
+    bar.close()
     return ["design", *conds], rows
 
 

@@ -1,0 +1,337 @@
+# %% [markdown]
+# # 04b · Appendix: JAVELIN's Tables 1–2, the road-marking ablation and our design, measured
+#
+# *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
+# and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
+# sections 4.2–4.3 (Tables 1–2, Fig. 7) and the JAVELIN design of sections 3.2–3.5 (eq. 43–68).
+# All references: `REFERENCES.md` at the top of the repository. Read notebook 04 first: it teaches
+# the tracker; this appendix measures it.*
+#
+# **What you will learn**
+#
+# - Tables 1–2 of the paper beside ours, over 20 runs per condition, with the paper's design and
+#   ours on the paper's measurement route (CPD) and on the maximum-likelihood route, and how the
+#   designs were chosen on some seeds and reported on one never looked at;
+# - the error CDFs of Fig. 7 for both trajectories;
+# - the road-marking ablation (JAVELIN-N against JAVELIN-NoRRMs), which we do not reproduce;
+# - our changes to the paper's design, one at a time, and what each is worth;
+# - where our tunnel and our reading of the paper differ from the paper's setup.
+
+# %%
+import numpy as np
+from tqdm.auto import tqdm
+
+import tunnelkit as tk
+from tunnelkit.metrics import position_errors
+from tunnelkit.plots import cdf_figure, javelin_table_figure
+from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows
+from tunnelkit.tracking.javelin import experiment as ex
+
+tk.setup_notebook()
+
+# %% [markdown]
+# ## 1. The drives of Tables 1–2
+#
+# The setup of notebook 04 (section 4.1–4.2 of the paper: the 100 m semicircular tunnel, the BS
+# with two 10 × 10 URAs, four RRMs, 50 km/h, one SRS slot every 0.1 s) under the paper's four
+# conditions on the straight drive — **L** (LoS), **N@0.5** (LoS blocked with probability 0.5 per
+# epoch), **N** (always blocked), **NoRRMs** (no road markings, LoS blocked: our reading of the
+# paper) — and three on the slalom. Every drive goes through the signal route once and is measured
+# twice from the same tensors: the paper's CPD route (eq. 11–24) and the ML route (notebook 03,
+# section 7). Full mode: the 20 runs of Tables 1–2 on seed 0 (140 drives, minutes: the progress
+# bar shows the estimate); quick mode: one run of the first 6 epochs, fewer conditions.
+
+# %%
+runs = tk.mc_count(20, 1)
+n_epochs = 6 if tk.quick_mode() else None
+straight_conditions = ("L", "N", "NoRRMs") if tk.quick_mode() else ("L", "N@0.5", "N", "NoRRMs")
+slalom_conditions = ("L",) if tk.quick_mode() else ("L", "N@0.5", "N")
+routes = {
+    scenario: collect_routes(scenario, conds, runs, 0, progress=True, n_epochs=n_epochs)
+    for scenario, conds in (
+        ("italiano2026-straight", straight_conditions),
+        ("italiano2026-slalom", slalom_conditions),
+    )
+}
+straight, straight_ml = (routes["italiano2026-straight"][e] for e in ("paper", "ml"))
+slalom, slalom_ml = (routes["italiano2026-slalom"][e] for e in ("paper", "ml"))
+print({sc: {c: len(d) for c, d in r["ml"].items()} for sc, r in routes.items()})
+
+# %% [markdown]
+# ## 2. Tables 1–2 beside the paper
+#
+# The paper scores each configuration by three numbers over the epochs $k = 1..K$ of a run
+# (section 4.3), averaged over runs: the 2-D RMSE
+# $\sqrt{\tfrac1K\sum_k\|\hat{\mathbf p}_{xy,k} - \mathbf p_{xy,k}\|^2}$, the 2-D MAE
+# $\tfrac1K\sum_k\|\hat{\mathbf p}_{xy,k} - \mathbf p_{xy,k}\|$ and the lateral Y-MAE
+# $\tfrac1K\sum_k|\hat y_k - y_k|$ (lane detection). Its JAVELIN-L reaches 0.20 m 2-D RMSE on the
+# straight drive (Table 1) and 0.41 m on the slalom (Table 2).
+#
+# Columns: the paper's design (section 4.2) on the paper's route; the paper's design on the ML
+# route, as printed (eq. 51) and with the curvature centred on the VUE; our design on the ML
+# route; the paper's numbers. The same computation runs from the command line:
+# `tunnelkit reproduce javelin-table1` / `javelin-table2 [--seed S]` (20 runs by default). The
+# designs were chosen on seed 0 (and seed 7); `ex.HELD_OUT_SEED` (20261202) is the seed the tables
+# are reported on as well, never looked at while choosing anything.
+
+# %%
+cols1, rows1 = table_rows(routes["italiano2026-straight"], "italiano2026_table1", progress=True)
+javelin_table_figure(cols1, rows1, title=f"Table 1 (straight), {runs} run(s) per condition")
+
+# %%
+cols2, rows2 = table_rows(routes["italiano2026-slalom"], "italiano2026_table2", progress=True)
+javelin_table_figure(cols2, rows2, title=f"Table 2 (slalom), {runs} run(s) per condition")
+
+# %% [markdown]
+# On the paper's route the paper's design is metres off: its CPD merges the paths that arrive
+# together (notebook 04, section 3), and curvatures tens of metres off fail a gate built for
+# $\sigma_\kappa = 1.5$ m. On the ML route the same design with eq. 51 still fails, because the
+# exact channel's wavefront is centred on the VUE; with the VUE curvature, nothing else changed,
+# it tracks to centimetres on the straight drive (20 runs, seed 0 / held-out seed: 0.065 / 0.074
+# m against the paper's 0.20 m) and to decimetres on the slalom (0.46 / 0.21 m against 0.41 m),
+# where a few runs lose the track to swapped paths. Our design on the ML route: 0.052 / 0.046 m
+# and 0.24 / 0.28 m.
+#
+# ## 3. Error CDFs (Fig. 7)
+#
+# The 2-D error of every epoch of every run, per configuration and trajectory: JAVELIN with the
+# paper's design and the VUE curvature on the ML route, TeNFiLoc-L on the ML route.
+
+
+# %%
+def errors(drives, cfg=ex.PAPER_VUE, method="JAVELIN"):
+    """2-D position errors of every epoch of ``drives``, pooled."""
+    return np.concatenate(
+        [
+            position_errors(ex.evaluate(d, cfg, method=method).estimates[:, :2], d.truth[:, :2])
+            for d in drives
+        ]
+    )
+
+
+cdfs = {}
+for scenario, by_cond in tqdm(
+    (("straight", straight_ml), ("slalom", slalom_ml)), desc="Fig. 7: scoring", leave=False
+):
+    cdfs[scenario] = {f"JAVELIN-{c}": errors(ds) for c, ds in by_cond.items()}
+    cdfs[scenario]["TeNFiLoc-L"] = errors(by_cond["L"], method="TeNFiLoc")
+
+# %%
+fig7a = cdf_figure(cdfs["straight"], title=f"2-D error CDF, straight, {runs} run(s)")
+fig7a.update_xaxes(type="log", range=[-2, 2])
+
+# %%
+fig7b = cdf_figure(cdfs["slalom"], title=f"2-D error CDF, slalom, {runs} run(s)")
+fig7b.update_xaxes(type="log", range=[-2, 2])
+
+# %% [markdown]
+# ## 4. The road-marking ablation
+#
+# Removing the four RRMs removes up to four paths in the stretch $10 \le x \le 30$ m. The paper
+# finds that it hurts most of all (JAVELIN-NoRRMs 2.26 m against JAVELIN-N 0.88 m, Table 1).
+# Compare JAVELIN-N (LoS blocked, RRMs present) with JAVELIN-NoRRMs (LoS blocked, no RRMs), and
+# count the paths each condition delivers — with a usable curvature on every path.
+
+# %%
+rmse = {(r[0], c): v for r in rows1 if r[1] == "rmse_2d_m" for c, v in zip(cols1[2:], r[2:])}
+for cond in ("N", "NoRRMs"):
+    paths = np.mean(
+        [np.mean([0 if e is None else len(e) for e in d.epochs]) for d in straight_ml[cond]]
+    )
+    print(
+        f"JAVELIN-{cond:7s} paths/epoch {paths:4.2f}   2-D RMSE [m]: "
+        + ", ".join(f"{c} {rmse[(f'JAVELIN-{cond}', c)]:.2f}" for c in cols1[2:-1])
+    )
+
+# %% [markdown]
+# In our tunnel removing the markings hardly matters — centimetres either way on the ML route
+# (section 6 says why we think so, and what we measured on the way).
+#
+# ## 5. Our design, one change at a time
+#
+# Our design changes the paper's one step at a time: (1) Doppler clutter rejection — a static
+# reflector's path cannot have a radial speed above the vehicle's speed, so faster CPD components
+# are dropped before association (the Doppler test of Algorithm 3, applied to every path);
+# (2) the measurement noise $\mathbf R$ of eq. 64–68 calibrated on what the CPD extraction
+# delivers (angles ~5°, $\sigma_\kappa = 50$ m, where section 4.2 of the paper assumes 2° and
+# 1.5 m); (3) global nearest neighbour (scipy's `linear_sum_assignment`) instead of the greedy
+# Algorithm 2; (4) VUEs moved with the mirrored UE displacement instead of eq. 63's random walk
+# (notebook 04, section 4); (5) a newborn track is not used to update in its birth epoch (its
+# position came from the very angles it would update with). Settings (1)–(5) were tuned on the
+# paper's extraction, on other seeds (seed 7) than these. The last rows change the measurement
+# route: the paper's design on the ML route (eq. 51 as printed, then the curvature centred on the
+# VUE, the radius of the exact wavefront that the ML route measures), and our design on it
+# (`ex.OURS_ML`: (1)–(5), the VUE curvature, and the measurement noise set to the measured
+# extraction error). Mean 2-D RMSE [m]:
+
+# %%
+abl_cols, abl_rows = ex.ablation(straight, ml=straight_ml, progress=True)
+javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives: 2-D RMSE [m]")
+
+# %% [markdown]
+# On the paper's route one step carries the table (full mode, seed 0): the calibrated noise (2).
+# Before it every variant is metres off (the Doppler test alone only changes by how much); after
+# it the remaining steps move the result by decimetres, some up in one condition and down in
+# another. On the ML route the paper's own parameters with the VUE curvature are already within
+# centimetres of our design: with measurements at their bound, the design matters far less than
+# what the tracker is fed.
+#
+# `ex.OURS_ML` sets its four measurement sigmas to the pooled RMS extraction error of the ML
+# route on the first three seed-0 LoS drives of each trajectory, as measured when the design was
+# made (`ex.ML_ERRORS_SEED0`; notebook 04, section 3 measures the same drives with today's
+# extraction). The same table over all the LoS drives here, and what `OURS_ML` assumes:
+
+# %%
+ecols, erows = ex.extraction_errors(straight_ml["L"] + slalom_ml["L"])
+display_rows = [*erows, ["OURS_ML assumes", None, *ex.ML_ERRORS_SEED0.values(), None]]
+javelin_table_figure(
+    ecols, display_rows, title=f"ML route: RMS measurement error, {runs} run(s)", digits=4
+)
+
+# %% [markdown]
+# ## 6. Where our tunnel differs from the paper's, and what we measured on the way
+#
+# The history of the numbers above, kept because each item changed what we built.
+#
+# - **Propagation.** The paper used a ray tracer on a Blender model with a single bounce; we use
+#   the image method on 12 planar facets plus the road and four finite RRM plates. Both are
+#   single-bounce, but our facets give fewer, cleaner wall paths, and the RRMs only exist for
+#   $10 \le x \le 30$ m.
+# - **The LoS/ceiling pair.** With the BS 0.2 m under the ceiling, the ceiling reflection is
+#   centimetres behind the LoS in delay and shares its Doppler; the road bounce is a few tenths of
+#   a metre behind. The CPD of eq. 11 cannot separate such paths (notebook 04, section 3); on the paper's route
+#   our design stops at about 0.8 m (straight, L). The paper does not mention the problem, and its
+#   ray tracer may have produced weaker or better separated ceiling paths. The ML route fits all
+#   paths jointly and separates them (notebook 03).
+# - **Curvature.** The paper assumes $\sigma_\kappa = 1.5$ m. The paper's CPD route delivers tens
+#   of metres RMS; the ML route about a decimetre where paths are apart (its Cramér–Rao bound: centimetres at
+#   10 m, decimetres at 45 m). Eq. 51 ties $\kappa$ to the reflection point (SR-NF), while our
+#   channel is exact: the wavefront is centred on the VUE (notebooks 02/03 show when the two
+#   agree). With accurate curvatures this matters: the paper's design as printed (eq. 51) fails
+#   on the ML route, the same design with the VUE curvature (`ex.PAPER_VUE`) tracks to about a
+#   decimetre on the straight drive.
+# - **Clock bias.** We read "variance 50 ns" as a 50 ns standard deviation (15 m); TDoAs cancel
+#   it, but the LoS test of eq. 61 and TeNFiLoc's $\hat d$ fallback suffer.
+# - **Start.** The paper assumes the open-sky position is known; we start at the truth with 1 m
+#   uncertainty rather than its $\sigma_P = 10$ m.
+# - **Drive length.** 29 epochs per drive (40 m at 50 km/h), so start-up transients weigh in the
+#   averages.
+# - **Road markings, revisited with usable curvature (NoRRMs vs N).** On the ML route every path,
+#   the four RRM paths included, is measured at its bound, so the question is no longer blurred by
+#   the extraction. Seed 0, straight, 3 runs per condition (2-D RMSE): the paper's parameters with
+#   the VUE curvature give 0.18 m in N and 0.08 m in NoRRMs, our design 0.60 m and 0.15 m (the
+#   paper: 0.88 m and 2.26 m); on the held-out seed 0.34 / 0.06 m and 0.11 / 0.12 m;
+#   over 20 runs (section 4) the same parameters give 0.069 m in both N and NoRRMs (held-out
+#   seed: 0.070 and 0.061 m). Removing the markings still does not hurt in our tunnel: without
+#   LoS the road and ceiling bounces remain, well separated and measured to centimetres, and they
+#   locate the UE through their VUEs; the RRM paths appear and vanish as the vehicle passes
+#   $10 \le x \le 30$ m, and each appearance is a birth the tracker must absorb. The paper's
+#   benefit from RRMs may come from a geometry where the LoS-less paths are fewer or weaker than
+#   ours (its ray tracer, its tunnel model), which we cannot check.
+# - **Road markings on the CPD route (measured before the ML route).** Without LoS, our tracker
+#   updates the UE with the road bounce in most epochs (on our tuning drives, seed 7, straight: 155 of 174
+#   epochs in N, 165 of 174 in NoRRMs): the road image sits at $(x_u, y_u, -z_u)$, a few degrees
+#   below the blocked LoS, inside the 5° angle gate. It has the UE's $x$ and $y$, so the lateral
+#   error stays at about 0.1 m, but the estimated height drifts down towards the image (2.4 m too
+#   low at the end of the drive) and $x$ is biased towards the BS, by 0.6–0.7 m over the last
+#   10 m: the 2-D error grows as the vehicle approaches. With the paths separated the RRM paths are
+#   found in every epoch and measured to about 1° RMS, yet removing their estimates by oracle
+#   lowers JAVELIN-N from 0.47 to 0.33 m (NoRRMs: 0.39 m). They update the UE in only 1 of 174
+#   epochs, appear and vanish about three times per drive and add about 2.8 births per drive
+#   (5.3 against 2.5). (A semicircular tunnel with the BS at the crown has no side-wall specular
+#   path in the cross-section: the only wall-like bounce is the ceiling facet next to the crown.)
+
+# %% [markdown]
+# ## Exercises
+#
+# 1. Run the ablation of section 5 on the slalom drives (`ex.ablation(slalom, ml=slalom_ml)`).
+#    Does every step of our design help there too?
+# 2. `ex.OURS_ML` took its measurement noise from three LoS drives per trajectory. Set it from
+#    all the LoS drives of section 1 instead (`ex.design_from_errors` on the table of section 5)
+#    and score JAVELIN-L on both trajectories with both designs. Does more calibration data
+#    change the result?
+# 3. Why do the road markings not help in our tunnel? For JAVELIN-N and JAVELIN-NoRRMs on the ML
+#    route (`ex.PAPER_VUE`), count per drive the births (`keep_reports=True`, then
+#    `r.manage.born` of each report) and the share of epochs that deliver an RRM path
+#    (`d.kinds[k][t]` of each matched path `t` in `d.truth_index[k]`).
+#
+# The solutions are in the collapsed cells below (click to expand, then run).
+
+# %% jupyter={"source_hidden": true}
+# Solution 1
+sl_cols, sl_rows = ex.ablation(slalom, ml=slalom_ml, progress=True)
+javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D RMSE [m]")
+
+# %% jupyter={"source_hidden": true}
+# Solution 2
+refit = ex.design_from_errors(erows)
+for name, by_cond in (("straight", straight_ml), ("slalom", slalom_ml)):
+    scores = {
+        label: np.mean([ex.evaluate(d, cfg).metrics["rmse_2d_m"] for d in by_cond["L"]])
+        for label, cfg in (("OURS_ML (3 drives)", ex.OURS_ML), ("refit (all drives)", refit))
+    }
+    print(name, {k: round(float(v), 3) for k, v in scores.items()})
+
+
+# %% jupyter={"source_hidden": true}
+# Solution 3
+def rrm_share_and_births(d):
+    """Share of epochs with a matched RRM path, and JAVELIN's births on the drive."""
+    rrm = [
+        any(d.kinds[k][t] == "rrm" for t in d.truth_index[k] if t >= 0)
+        for k, m in enumerate(d.epochs)
+        if m is not None
+    ]
+    run = ex.evaluate(d, ex.PAPER_VUE, keep_reports=True).run
+    return np.mean(rrm), sum(len(r.manage.born) for r in run.reports if r.manage)
+
+
+for cond in ("N", "NoRRMs"):
+    share, births = np.mean([rrm_share_and_births(d) for d in straight_ml[cond]], axis=0)
+    print(f"JAVELIN-{cond:7s} epochs with an RRM path {share:5.1%}, births per drive {births:4.1f}")
+
+# %% [markdown]
+# <details><summary>What to read in the solutions</summary>
+#
+# 1. Not every step is a gain on the slalom (full mode, seed 0): the Doppler test alone makes
+#    JAVELIN-L worse (tens of metres), the noise calibrated on the extraction is again the step
+#    that matters, and not updating with newborn tracks helps in LoS but costs in N@0.5 and N.
+#    The ablation of section 5 was one trajectory; a design choice has to be checked on the
+#    other as well. On the ML route the ranking of the last three rows holds in LoS.
+# 2. More data is not automatically a better design. The pooled RMS over all the LoS drives has
+#    angle sigmas several times smaller than `OURS_ML`'s; with them the straight drive loses a
+#    few centimetres and the slalom loses the track in some runs (metres, full mode). The
+#    extraction error is heavy-tailed — at the bound in most epochs, off by metres in the few
+#    where nearly coincident paths are swapped or merged — and a Gaussian $\mathbf R$ set to its
+#    RMS makes the gate reject the next good measurement after such an epoch. How wide to make
+#    $\mathbf R$ is a choice about the tails, to be made on tuning drives and checked on unseen
+#    ones (the held-out seed), not read off one table.
+# 3. With the markings present the RRM paths exist only for $10 \le x \le 30$ m, so they appear
+#    and vanish within each drive, and every appearance is a birth; without them the road and
+#    ceiling bounces, measured at their bound, carry the UE alone. More paths are not better
+#    when the extra ones come and go.
+#
+# </details>
+
+# %% [markdown]
+# ## Checks
+
+# %%
+col_pp, col_pm, col_pv, col_om = cols1[2:6]
+paper_route = rmse[("JAVELIN-L", col_pp)]
+ml_vue, ml_51 = rmse[("JAVELIN-L", col_pv)], rmse[("JAVELIN-L", col_pm)]
+# the paper's design on measurements at the bound: at or below the paper's JAVELIN-L (0.20 m)
+# on the straight drive (20 runs, seed 0 / held-out: 0.065 / 0.074 m); quick mode looser
+assert ml_vue < (0.5 if tk.quick_mode() else 0.20), rmse
+assert ml_vue < paper_route and ml_vue < rmse[("TeNFiLoc-L", col_pm)]
+assert ml_vue < ml_51  # eq. 51 does not describe the exact channel's wavefront
+# slalom: the ML route beats the paper's route with either design; on the slalom the paper's
+# parameters (VUE curvature) lose some runs to swapped paths (metres), our design stays below 1 m
+# (20 runs, seed 0 / held-out: 0.24 / 0.28 m against the paper's 0.41 m)
+sl = {r[0]: dict(zip(cols2[2:], r[2:])) for r in rows2 if r[1] == "rmse_2d_m"}["JAVELIN-L"]
+assert sl[col_om] < 1.0 and sl[col_om] < sl[col_pp], sl
+assert sl[col_pv] < sl[col_pp], sl
+assert abl_rows[-2][1] < abl_rows[0][1]  # the ML route with the paper's design beats the paper's
+# the ablation row and the table column of the paper design + VUE on the ML route: one computation
+assert abs(abl_rows[-2][1] - ml_vue) < 1e-12
+print("all checks passed")
