@@ -22,6 +22,7 @@ KEYS = {
     "rmse_settled_m",
     "rmse_settled_ci95_m",
     "peb_rms_settled_m",
+    "median_settled_m",
 }
 
 
@@ -34,7 +35,7 @@ def test_json_answers_the_28ghz_question(capsys):
     assert [a["array"] for a in out["arrays"]] == ["2x2", "3x3", "4x4", "8x8"]
     for a in out["arrays"]:
         assert set(a) == KEYS
-        assert all(a[k] is None for k in KEYS if k.startswith(("rmse", "peb_rms")))
+        assert all(a[k] is None for k in KEYS if k.startswith(("rmse", "peb_rms", "median")))
     by = {a["array"]: a for a in out["arrays"]}
     assert by["8x8"]["n_elements"] == 64
     # lambda/2 at 28 GHz: 7 spacings along each side, diagonal 7 sqrt(2) lambda/2

@@ -244,3 +244,17 @@ def test_table_and_ablation_progress_bars_change_no_number(capsys):
     assert a_quiet[1][0][1] == pytest.approx(
         np.mean([ex.evaluate(d, ex.PAPER).metrics["rmse_2d_m"] for d in drives["L"]])
     )
+
+
+def test_table_scored_on_the_workers_equals_table_rows_on_the_drives():
+    """javelin_table scores each drive inside its trial; the rows are those of table_rows on
+    the same drives (same seed), in the same order, to the last bit."""
+    args = ("italiano2026-straight", ("L", "N"), 2, 11)
+    routes = collect_routes(*args, n_epochs=2, extractions=("paper", "ml"))
+    cols, rows = table_rows(routes, "italiano2026_table1")
+    rep = javelin_table(
+        "italiano2026-straight", "italiano2026_table1", ("L", "N"), 2, 11, False, ("paper", "ml"), 2
+    )
+    assert rep.columns == cols and rep.rows == rows
+    faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
+    assert rep.meta["extraction_failures"] == faults

@@ -202,3 +202,74 @@ def test_design_monte_carlo_settles_near_the_bound():
     assert mc["rmse_settled_m"] < mc["rmse_m"]  # the start-up dominates the whole-drive RMSE
     short = design.javelin_rmse(setup, "4x4", 2, 5, n_epochs=3)
     assert short["rmse_settled_m"] is None and short["peb_rms_settled_m"] is None
+
+
+def test_measured_birth_covariance_matches_sampling_the_intersection():
+    """Linearised birth (angles' covariance and the UE's x through the ray-plane intersection,
+    with the cross-covariance) against 200 000 samples pushed through ``intersection``."""
+    from tunnelkit.tracking.javelin.manage import birth_covariance, intersection
+    from tunnelkit.tracking.javelin.state import JavelinState
+
+    bs = (0.0, 0.0, 4.8)
+    cfg = JavelinConfig(base_station=bs, birth_covariance="measured")
+    st = JavelinState.initial([30.0, -2.5, 1.5], 0.05)
+    st.P[0, 1] = st.P[1, 0] = 0.001  # some correlation with y, carried into the cross term
+    phi, psi = np.arctan2(-4.0, 30.0), np.arctan2(6.0 - 4.8, 30.5)
+    R = np.array([[4e-6, 1e-6], [1e-6, 9e-6]])
+    cov3 = np.zeros((1, 3, 3))
+    cov3[0, :2, :2] = R
+    cov3[0, 2, 2] = 1.0
+    meas = PathMeasurements.from_arrays([phi], [psi], d=[31.0], cov=cov3, sigma_d=[1e-3])
+    cov, cross = birth_covariance(st, meas, 0, cfg.with_(measurement_noise="reported"))
+    rng = np.random.default_rng(8)
+    n = 200_000
+    ue = rng.multivariate_normal(st.x, st.P, n)
+    ang = rng.multivariate_normal([phi, psi], R, n)
+    yz = np.array([intersection(a, b, x, bs) for (a, b), x in zip(ang, ue[:, 0])])
+    np.testing.assert_allclose(cov, np.cov(yz.T), rtol=0.03)
+    emp = ((yz - yz.mean(0)).T @ (ue - ue.mean(0))) / (n - 1)
+    np.testing.assert_allclose(cross, emp, rtol=0.05, atol=2e-5)
+    # the fixed sigmas stand in when nothing was reported
+    fixed, _ = birth_covariance(st, meas, 0, cfg)
+    assert fixed[0, 0] > 100 * cov[0, 0]
+    # the appended state keeps the cross-covariance and stays symmetric positive definite
+    st.append(intersection(phi, psi, st.x[0], bs), cov, cross=cross)
+    np.testing.assert_array_equal(st.P, st.P.T)
+    assert np.all(np.linalg.eigvalsh(st.P) > 0)
+
+
+def test_joint_innovation_test_leaves_out_the_wrong_pair():
+    """A LoS taken from the wrong path (as eq. 61 can after the gate missed the true one) makes
+    the stacked innovation inconsistent; the exclusion drops exactly that pair."""
+    from tunnelkit.tracking.javelin.update import exclude_inconsistent
+
+    bs = (0.0, 0.0, 4.8)
+    x = np.array([30.0, -2.5, 1.5, -3.3, 7.7, -2.5, -1.5])
+    P = np.diag([1e-4, 1e-4, 1e-6, 1e-4, 1e-4, 1e-4, 1e-4])
+    pred, J = track_model(x, bs, "vue")
+    z = pred.copy()
+    z[0] = pred[2]  # the UE "measured" at the road image's angles and range
+    cov = np.tile(np.diag([1e-8, 1e-8, 1e-4]), (3, 1, 1))
+    meas = PathMeasurements.from_arrays(
+        z[:, 0], z[:, 1], kappa=z[:, 2], d=z[:, 3] + 3.0, cov=cov, sigma_d=np.full(3, 1e-3)
+    )
+    cfg = JavelinConfig(base_station=bs, kappa_model="vue", measurement_noise="reported")
+    pairs = [(0, 0), (1, 1), (2, 2)]
+    m, out = exclude_inconsistent(x, P, pred, J, meas, pairs, cfg, 0, 0.999)
+    assert out == [(0, 0)]
+    assert all(lab[1] != 0 for lab in m.labels)
+    # consistent measurements: nothing left out
+    good = PathMeasurements.from_arrays(
+        pred[:, 0],
+        pred[:, 1],
+        kappa=pred[:, 2],
+        d=pred[:, 3] + 3.0,
+        cov=cov,
+        sigma_d=np.full(3, 1e-3),
+    )
+    m2, out2 = exclude_inconsistent(x, P, pred, J, good, pairs, cfg, 0, 0.999)
+    assert out2 == [] and m2.z.size == stack_measurement(pred, J, good, pairs, cfg, 0).z.size
+    with pytest.raises(ValueError, match="update_gate"):
+        JavelinConfig(update_gate=1.5)
+    with pytest.raises(ValueError, match="birth_covariance"):
+        JavelinConfig(birth_covariance="guess")

@@ -27,6 +27,8 @@ __all__ = [
     "collect_drives",
     "collect_routes",
     "javelin_table",
+    "score_drive",
+    "table_columns",
     "table_rows",
 ]
 
@@ -117,50 +119,50 @@ def collect_drives(
     return collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (e,), **parallel)[e]
 
 
-def table_rows(
-    routes: dict[str, dict[str, list]],
-    reference: str,
-    columns: tuple[tuple[str, str, str], ...] | None = None,
-    progress: bool = False,
-) -> tuple[list[str], list[list]]:
-    """Rows ``[configuration, metric, <one value per column>, paper]``, means over runs.
-
-    ``routes`` is :func:`collect_routes`' output (``{route: {condition: drives}}``); ``columns``
-    (default :data:`COLUMNS`, plus :data:`COHERENT_COLUMN` when that route is present) name a
-    route and a design each; columns whose route is missing are left out. JAVELIN is scored on
-    every condition; TeNFiLoc (no design of its own) on the LoS drives, in the columns of the
-    paper's design. Configurations follow the paper's table, extra ones (e.g. NoRRMs-L) after.
-    ``progress``: a tqdm bar over the drives scored (nothing here draws random numbers).
-    """
-    from tqdm.auto import tqdm
-
-    from ..tracking.javelin import experiment as ex
-
+def table_columns(
+    routes, columns: tuple[tuple[str, str, str], ...] | None = None
+) -> tuple[tuple[str, str, str], ...]:
+    """The columns a table of ``routes`` (names of measured routes) has: ``columns`` (default
+    :data:`COLUMNS`, plus :data:`COHERENT_COLUMN` when that route is present) without those whose
+    route is missing."""
+    routes = tuple(routes)
     if columns is None:
         columns = COLUMNS + ((COHERENT_COLUMN,) if "coherent" in routes else ())
     columns = tuple(c for c in columns if c[1] in routes)
     if not columns:
         raise ValueError(f"routes: none of the table's routes present, got {list(routes)}")
+    return columns
+
+
+def score_drive(
+    drives: dict, cond: str, columns: tuple[tuple[str, str, str], ...]
+) -> dict[tuple[str, str], dict[str, float]]:
+    """One drive of condition ``cond``, measured through each route (``{route: DriveData}``),
+    scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
+    column's design; TeNFiLoc (no design of its own) on LoS drives, in the paper design's
+    columns. Each (route, method, design) is evaluated once. Draws no random numbers."""
+    from ..tracking.javelin import experiment as ex
+
     designs = _designs()
-    ref = {r["configuration"]: r for r in load_reference(reference)}
-    scores: dict[tuple[str, str], list[dict[str, float]]] = {}
-    cache: dict[tuple[int, str, str], dict[str, float]] = {}
-    total = sum(len(d) for _, route, _ in columns for d in routes[route].values())
-    bar = tqdm(total=total, desc=f"{reference}: scoring drives", leave=False, disable=not progress)
+    cache: dict[tuple[str, str, str], dict[str, float]] = {}
+    out = {}
     for label, route, design in columns:
-        for cond, drives in routes[route].items():
-            for drive in drives:
-                bar.update()
-                entries = [(f"JAVELIN-{cond}", "JAVELIN", design)]
-                if cond == "L" and design == "paper":  # once per route
-                    entries.append(("TeNFiLoc-L", "TeNFiLoc", "none"))
-                for name, method, dname in entries:
-                    key = (id(drive), method, dname)
-                    if key not in cache:
-                        cfg = designs.get(dname)
-                        cache[key] = ex.evaluate(drive, cfg, method=method).metrics
-                    scores.setdefault((name, label), []).append(cache[key])
-    bar.close()
+        entries = [(f"JAVELIN-{cond}", "JAVELIN", design)]
+        if cond == "L" and design == "paper":  # once per route
+            entries.append(("TeNFiLoc-L", "TeNFiLoc", "none"))
+        for name, method, dname in entries:
+            key = (route, method, dname)
+            if key not in cache:
+                cfg = designs.get(dname)
+                cache[key] = ex.evaluate(drives[route], cfg, method=method).metrics
+            out[(name, label)] = cache[key]
+    return out
+
+
+def _rows(scores: dict, reference: str, columns) -> tuple[list[str], list[list]]:
+    """Rows ``[configuration, metric, <mean per column>, paper]`` from ``{(name, label): [metrics
+    per drive]}``; configurations in the paper's order, extra ones after."""
+    ref = {r["configuration"]: r for r in load_reference(reference)}
     names = list(dict.fromkeys(n for n, _ in scores))
     order = {n: i for i, n in enumerate(ref)}
     names.sort(key=lambda n: order.get(n, len(order)))
@@ -174,6 +176,36 @@ def table_rows(
             row.append(ref.get(name, {}).get(metric))
             rows.append(row)
     return ["configuration", "metric", *(c[0] for c in columns), "paper"], rows
+
+
+def table_rows(
+    routes: dict[str, dict[str, list]],
+    reference: str,
+    columns: tuple[tuple[str, str, str], ...] | None = None,
+    progress: bool = False,
+) -> tuple[list[str], list[list]]:
+    """Rows ``[configuration, metric, <one value per column>, paper]``, means over runs.
+
+    ``routes`` is :func:`collect_routes`' output (``{route: {condition: drives}}``); ``columns``
+    as :func:`table_columns`; each drive is scored by :func:`score_drive`. ``progress``: a tqdm
+    bar over the drives scored (nothing here draws random numbers).
+    """
+    from tqdm.auto import tqdm
+
+    columns = table_columns(routes, columns)
+    used = list(dict.fromkeys(route for _, route, _ in columns))
+    total = sum(len(d) for r in used for d in routes[r].values())
+    bar = tqdm(total=total, desc=f"{reference}: scoring drives", leave=False, disable=not progress)
+    scores: dict[tuple[str, str], list[dict[str, float]]] = {}
+    for route in used:
+        mine = tuple(c for c in columns if c[1] == route)
+        for cond, drives in routes[route].items():
+            for drive in drives:
+                for key, metrics in score_drive({route: drive}, cond, mine).items():
+                    scores.setdefault(key, []).append(metrics)
+                bar.update()
+    bar.close()
+    return _rows(scores, reference, columns)
 
 
 NOTES = [
@@ -200,6 +232,15 @@ NOTES = [
 ]
 
 
+def _simulate_and_score(scenario, n_epochs, extractions, columns, cond, rng):
+    """One trial of :func:`javelin_table`: a drive (:func:`_simulate`) scored in every column on
+    the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
+    count."""
+    drives = _simulate(scenario, n_epochs, extractions, cond, rng)
+    faults = {e: len(d.faults) for e, d in drives.items()}
+    return score_drive(drives, cond, columns), faults
+
+
 def javelin_table(
     scenario: str,
     reference: str,
@@ -213,19 +254,38 @@ def javelin_table(
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
     paper's number beside (``n_epochs`` truncates the drives, for quick checks; ``parallel``
-    goes to :func:`~tunnelkit.montecarlo.run_trials`)."""
-    routes = collect_routes(
-        scenario,
-        conditions,
-        runs,
+    goes to :func:`~tunnelkit.montecarlo.run_trials`). Each trial simulates one drive and scores
+    it where it ran, so scoring runs in parallel too; the drives are the same as
+    :func:`collect_routes`' (drive ``i`` draws from the ``i``-th child of ``seed``) and the table
+    equals :func:`table_rows` on them."""
+    from ..tracking.javelin import experiment as ex
+
+    conditions = tuple(conditions)
+    extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
+    columns = table_columns(extractions)
+    jobs = [c for _ in range(runs) for c in conditions]
+    trial = functools.partial(_simulate_and_score, scenario, n_epochs, extractions, columns)
+    results = run_trials(
+        trial,
+        len(jobs),
         seed,
-        progress,
-        n_epochs=n_epochs,
-        extractions=extractions,
+        inputs=jobs,
+        progress=progress,
+        desc=f"{scenario} drives",
         **parallel,
     )
-    cols, rows = table_rows(routes, reference, progress=progress)
-    faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
+    scores: dict[tuple[str, str], list[dict[str, float]]] = {}
+    faults = dict.fromkeys(extractions, 0)
+    for cond in conditions:  # the order of table_rows: condition, then run
+        for (one, _), c in zip(results, jobs):
+            if c != cond:
+                continue
+            for key, metrics in one.items():
+                scores.setdefault(key, []).append(metrics)
+    for _, nf in results:
+        for e, n in nf.items():
+            faults[e] += n
+    cols, rows = _rows(scores, reference, columns)
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}: JAVELIN vs TeNFiLoc",
         columns=cols,

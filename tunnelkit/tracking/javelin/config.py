@@ -25,6 +25,7 @@ __all__ = [
 ASSOCIATORS = ("greedy", "gnn")
 ASSOCIATION_COSTS = ("mahalanobis", "likelihood")
 MEASUREMENT_NOISE = ("fixed", "reported")
+BIRTH_COVARIANCES = ("fixed", "measured")
 VUE_MOTIONS = ("random_walk", "mirror")
 KAPPA_MODELS = ("reflector", "vue")
 
@@ -69,7 +70,12 @@ class JavelinConfig:
       ``measurement_noise``: ``"fixed"`` (the paper: one ``sigma_phi`` ... ``sigma_delta_d`` for
       every path) or ``"reported"`` (ours: each path's own covariance as the extraction reports
       it, ``PathMeasurements.cov`` / ``sigma_d``; an epoch without one falls back to the fixed
-      sigmas, reported as a fault).
+      sigmas, reported as a fault); ``birth_covariance``: ``"fixed"`` (the paper's
+      ``sigma_P^2 I``) or ``"measured"`` (ours: the path's angle covariance and the UE's ``x``
+      uncertainty carried through the intersection of Algorithm 3, with the cross-covariance);
+      ``update_gate`` (ours; ``None`` = off as in the paper): the probability of a chi-square
+      test on the whole stacked innovation; pairs are left out until it passes
+      (:func:`~tunnelkit.tracking.javelin.update.exclude_inconsistent`).
     - ``doppler_clutter_margin`` [m/s] (ours; ``None`` = off as in the paper): a path whose
       radial speed exceeds the vehicle speed by more than this margin cannot come from a static
       reflector (``|v| <= ||v_u||`` for any mirror image) and is dropped as clutter before
@@ -101,6 +107,8 @@ class JavelinConfig:
     correlated_delta_d: bool = False
     update_with_births: bool = True
     measurement_noise: str = "fixed"
+    birth_covariance: str = "fixed"
+    update_gate: float | None = None
     doppler_clutter_margin: float | None = None
     doppler_sign: float = -1.0
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -115,6 +123,8 @@ class JavelinConfig:
             positive(name, getattr(self, name))
         if self.sigma_p0_ue is not None:
             positive("sigma_p0_ue", self.sigma_p0_ue)
+        if self.update_gate is not None:
+            probability("update_gate", self.update_gate)
         if self.doppler_clutter_margin is not None:
             nonnegative("doppler_clutter_margin", self.doppler_clutter_margin)
         for name, allowed in (
@@ -123,6 +133,7 @@ class JavelinConfig:
             ("vue_motion", VUE_MOTIONS),
             ("kappa_model", KAPPA_MODELS),
             ("measurement_noise", MEASUREMENT_NOISE),
+            ("birth_covariance", BIRTH_COVARIANCES),
         ):
             if getattr(self, name) not in allowed:
                 raise ValueError(f"{name}: expected one of {allowed}, got {getattr(self, name)!r}")

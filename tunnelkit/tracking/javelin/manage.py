@@ -57,6 +57,37 @@ def intersection(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.n
     return p[1:].copy()
 
 
+def intersection_jacobian(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """d(y, z) / d(phi, psi, x_u) of :func:`intersection` (2, 3): with ``h = x_u - b_x``,
+    ``y = b_y + h tan(phi)`` and ``z = b_z + h tan(psi) / cos(phi)``."""
+    h = x_u - float(np.asarray(bs, dtype=float)[0])
+    c, t = np.cos(phi), np.tan(phi)
+    tp = np.tan(psi)
+    return np.array(
+        [
+            [h / c**2, 0.0, t],
+            [h * tp * t / c, h / (np.cos(psi) ** 2 * c), tp / c],
+        ]
+    )
+
+
+def birth_covariance(state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig):
+    """The covariance (2, 2) of a VUE born from path ``j`` and its cross-covariance (2, D) with
+    the state, by linearising :func:`intersection` in the path's angles and the UE's ``x``
+    (ours; ``birth_covariance="measured"``): ``F_z R F_z^T + f P_xx f^T`` and ``f P_x,:``. ``R``
+    is the path's reported angle covariance under ``measurement_noise="reported"``, else
+    ``diag(sigma_phi^2, sigma_psi^2)``."""
+    F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
+    if config.measurement_noise == "reported" and meas.reported:
+        R = meas.cov[j][:2, :2]
+    else:
+        R = np.diag([config.sigma_phi**2, config.sigma_psi**2])
+    f = F[:, 2:3]  # d(y, z) / d x_u
+    cross = f @ state.P[0:1, :]
+    cov = F[:, :2] @ R @ F[:, :2].T + f @ state.P[0:1, 0:1] @ f.T
+    return 0.5 * (cov + cov.T), cross
+
+
 def static_doppler(p_u, p_v, v_u, bs=(0.0, 0.0, 0.0), sign: float = -1.0) -> float:
     """Radial speed a static reflector would produce: the VUE moves with the UE velocity mirrored
     in the reflecting plane (normal along ``p_v - p_u``); ``p_v = p_u`` means the LoS path.
@@ -94,7 +125,8 @@ def manage_tracks(
     2. LoS (lines 13-23): the path associated with the UE, else eq. 60-61 among the paths no VUE
        claimed (ours: the paper searches all paths; a claimed path already has a track);
     3. births (lines 8-12): every other unassociated path starts a VUE at the intersection of its
-       arrival ray with ``x = x_u`` with covariance ``sigma_P^2 I``; with a UE velocity ``v_u``
+       arrival ray with ``x = x_u`` with covariance ``sigma_P^2 I`` (or, with
+       ``birth_covariance="measured"``, :func:`birth_covariance`); with a UE velocity ``v_u``
        and a Doppler ``v``, a path whose Doppler misses the static prediction by more than
        ``doppler_tolerance`` is dynamic: its track is ``transient`` (dropped after this epoch).
 
@@ -144,7 +176,11 @@ def manage_tracks(
             p_v = np.array([state.x[0], yz[0], yz[1]])
             v_pred = static_doppler(state.ue, p_v, v_u, config.bs, config.doppler_sign)
             transient = abs(meas.v[j] - v_pred) > config.doppler_tolerance
-        tid = state.append(yz, np.eye(2) * config.sigma_p0**2, transient=transient)
+        if config.birth_covariance == "measured":
+            cov, cross = birth_covariance(state, meas, j, config)
+            tid = state.append(yz, cov, transient=transient, cross=cross)
+        else:
+            tid = state.append(yz, np.eye(2) * config.sigma_p0**2, transient=transient)
         born.append(tid)
         if transient:
             dynamic.append(tid)

@@ -126,8 +126,9 @@ class JavelinState:
             setattr(self, name, [v for k, v in enumerate(lst) if k + 1 not in tracks])
         return gone
 
-    def append(self, yz, cov, *, transient: bool = False) -> int:
-        """Append a VUE at ``yz`` (2,) with covariance ``cov`` (2, 2), uncorrelated with the rest.
+    def append(self, yz, cov, *, transient: bool = False, cross=None) -> int:
+        """Append a VUE at ``yz`` (2,) with covariance ``cov`` (2, 2) and cross-covariance
+        ``cross`` (2, D) with the current state (default: uncorrelated with the rest).
 
         Returns the new track's id; its index is the new ``n_vue``.
         """
@@ -137,6 +138,10 @@ class JavelinState:
         P = np.zeros((d + 2, d + 2))
         P[:d, :d] = self.P
         P[d:, d:] = cov
+        if cross is not None:
+            cross = finite_array("cross", cross, shape=(2, d))
+            P[d:, :d] = cross
+            P[:d, d:] = cross.T
         self.x = np.concatenate([self.x, yz])
         self.P = P
         tid = self.next_id

@@ -25,7 +25,7 @@ from .manage import ManageResult, manage_tracks
 from .measurement import JavelinWarning, PathMeasurements, track_model
 from .motion import predict, ue_velocity
 from .state import JavelinState, track_slice
-from .update import joseph_update, stack_measurement
+from .update import exclude_inconsistent, joseph_update, stack_measurement
 
 __all__ = ["Javelin", "JavelinRun", "StepReport", "run_javelin"]
 
@@ -147,7 +147,14 @@ class Javelin:
             )
             # Update (eq. 64-68)
             pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
-            m = stack_measurement(pred, J, meas, mres.pairs, cfg, mres.los_path)
+            if cfg.update_gate is None:
+                m = stack_measurement(pred, J, meas, mres.pairs, cfg, mres.los_path)
+            else:
+                m, left_out = exclude_inconsistent(
+                    st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, cfg.update_gate
+                )
+                if left_out:
+                    faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
             n_rows = m.z.size
             try:
                 x_new, P_new, nis = joseph_update(st.x, st.P, m)

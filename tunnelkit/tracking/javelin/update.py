@@ -18,7 +18,7 @@ from ...crlb import wrap_angle
 from .config import JavelinConfig
 from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements
 
-__all__ = ["StackedMeasurement", "joseph_update", "stack_measurement"]
+__all__ = ["StackedMeasurement", "exclude_inconsistent", "joseph_update", "stack_measurement"]
 
 
 @dataclass
@@ -128,3 +128,45 @@ def joseph_update(
     P_new = IKH @ P @ IKH.T + K @ m.R @ K.T
     nis = float(y @ cho_solve(cf, y))
     return x_new, 0.5 * (P_new + P_new.T), nis
+
+
+def _nis(x: np.ndarray, P: np.ndarray, m: StackedMeasurement) -> float:
+    y = m.residual()
+    S = m.H @ P @ m.H.T + m.R
+    return float(y @ cho_solve(cho_factor(0.5 * (S + S.T), lower=True), y))
+
+
+def exclude_inconsistent(
+    x: np.ndarray,
+    P: np.ndarray,
+    pred: np.ndarray,
+    J: np.ndarray,
+    meas: PathMeasurements,
+    pairs,
+    config: JavelinConfig,
+    los_path: int | None,
+    probability: float,
+) -> tuple[StackedMeasurement, list[tuple[int, int]]]:
+    """Fault detection and exclusion on the stacked update (ours, RAIM-like): while the joint
+    innovation fails its chi-square test, ``y^T S^-1 y > chi2_K(probability)`` with ``K`` the
+    number of rows, leave out the (track, path) pair whose removal lowers the normalised
+    innovation most, and stack again. Catches what the per-pair gates of Algorithm 2 cannot: a
+    wrong LoS from eq. 61 and the TDoA rows, which no gate sees. Returns the stacked measurement
+    of the kept pairs and the pairs left out (in order)."""
+    from .gate import _threshold
+
+    pairs = list(pairs)
+    out: list[tuple[int, int]] = []
+    m = stack_measurement(pred, J, meas, pairs, config, los_path)
+    while m.z.size and _nis(x, P, m) > _threshold(probability, int(m.z.size)):
+        best = None
+        for p in pairs:
+            rest = [q for q in pairs if q != p]
+            trial = stack_measurement(pred, J, meas, rest, config, los_path)
+            score = _nis(x, P, trial) / _threshold(probability, max(int(trial.z.size), 1))
+            if best is None or score < best[0]:
+                best = (score, p, trial)
+        _, p, m = best
+        pairs.remove(p)
+        out.append(p)
+    return m, out
