@@ -153,7 +153,7 @@ def _epoch(array="10x10", k=3, seed=2026):
     from tunnelkit.montecarlo import spawn_rngs
 
     setup = design.DesignSetup.from_scenario("italiano2026-straight", mount_height=4.5)
-    route = design._route(setup, design.parse_array(array))
+    route = setup.signal_route(array)
     return route, route.epoch(k, spawn_rngs(seed, 1)[0])
 
 
@@ -273,3 +273,40 @@ def test_joint_innovation_test_leaves_out_the_wrong_pair():
         JavelinConfig(update_gate=1.5)
     with pytest.raises(ValueError, match="birth_covariance"):
         JavelinConfig(birth_covariance="guess")
+
+
+def test_bias_aware_delay_check_keeps_paths_a_negative_clock_bias_pushed_below_zero():
+    """Algorithm 1 as printed drops d < 0; with a -60 ns bias every path of an epoch 9 m from
+    the array has d < 0 and the epoch is lost. The bias-aware check keeps them all, and the
+    TDoAs (bias-free) are unchanged."""
+    from dataclasses import replace
+
+    from tunnelkit.constants import C
+    from tunnelkit.extraction import algorithm1
+    from tunnelkit.montecarlo import spawn_rngs
+
+    route, _ = _epoch(k=0)
+    assert route.bias_aware_delay_check  # the design's route
+    route = replace(route, bias_aware_delay_check=False)
+    printed = route.epoch(26, spawn_rngs(3, 1)[0], clock_bias=-60e-9)
+    aware = replace(route, bias_aware_delay_check=True).epoch(
+        26, spawn_rngs(3, 1)[0], clock_bias=-60e-9
+    )
+    assert np.all(printed.estimates.d < 0) and len(printed.measurements) == 0
+    assert len(aware.measurements) == len(aware.paths) and aware.measurements.cov is not None
+    assert replace(route, bias_aware_delay_check=True).min_d == -C * route.config.clock_bias_limit
+    lengths = np.sort([p.length for p in aware.paths])
+    np.testing.assert_allclose(
+        np.sort(aware.measurements.d) - aware.measurements.d.min(), lengths - lengths[0], atol=1e-3
+    )
+    est = aware.estimates
+    np.testing.assert_array_equal(algorithm1(est), [])  # the printed rule on the same estimates
+    assert algorithm1(est, -30.0).size == len(est)
+    with pytest.raises(ValueError, match="min_d"):
+        algorithm1(est, 1.0)
+    # the tracker's own check of Algorithm 1 follows the same bound
+    m = PathMeasurements.from_arrays([0.1, 0.2], [0.0, 0.1], d=[-5.0, -40.0], min_d=-30.0)
+    assert len(m) == 1 and m.source.tolist() == [0]
+    assert len(PathMeasurements.from_arrays([0.1], [0.0], d=[-5.0])) == 0
+    with pytest.raises(ValueError, match="min_d"):
+        JavelinConfig(min_d=3.0)

@@ -253,6 +253,22 @@ class DesignSetup:
     def fc(self) -> float:
         return float(self.config.fc)
 
+    def signal_route(self, spec):
+        """The measurement route of ``spec`` on this design as the Monte-Carlo drives it
+        (:class:`tunnelkit.signal_route.SignalRoute`): each epoch's paths carry the CRLB at their
+        estimate, and Algorithm 1 drops only what no clock bias explains."""
+        from .signal_route import SignalRoute
+
+        return SignalRoute(
+            self.tunnel,
+            self.arrays(parse_array(spec)),
+            self.trajectory,
+            self.config,
+            kinds=self.kinds,
+            report_covariance=True,
+            bias_aware_delay_check=True,
+        )
+
     def arrays(self, spec) -> list[ArrayGeometry]:
         """``spec`` placed, centred, on every mount; ``ValueError`` naming ``arrays`` if an
         element falls outside the tunnel (the array is wider than the cross-section there)."""
@@ -980,7 +996,7 @@ def design_sweep(
 # --- Monte-Carlo: JAVELIN on the design ---------------------------------------------------------
 
 
-def javelin_config(crlb: dict):
+def javelin_config(crlb: dict, min_d: float = 0.0):
     """JAVELIN (our design, curvature centred on the VUE) for a design sweep at any carrier and
     array size: every path's measurement covariance is the one the extraction reports (the CRLB
     at its estimate, which the ML route attains: ``measurement_noise="reported"``), so no
@@ -990,7 +1006,8 @@ def javelin_config(crlb: dict):
     placed it (``birth_covariance="measured"``), not 10 m, so two new tracks a few degrees apart
     cannot swap their paths in the next epoch; and pairs whose stacked innovation is
     inconsistent are left out of the update (``update_gate=0.999``), which catches a wrong LoS
-    taken by eq. 61 after the per-pair gate missed the true one. The fixed sigmas, used only in an epoch whose Fisher information is
+    taken by eq. 61 after the per-pair gate missed the true one. ``min_d``: Algorithm 1's delay
+    check (``-c b_max`` keeps the paths a negative clock bias pushed below zero). The fixed sigmas, used only in an epoch whose Fisher information is
     singular at the estimate, are ``crlb`` (``d`` [m], ``direction`` [rad], ``kappa`` [m]; e.g.
     an upper percentile of the route's per-path bounds); ``sigma_delta_d`` is ``sqrt(2)`` times
     the delay-distance sigma (a difference of two delays).
@@ -1010,6 +1027,7 @@ def javelin_config(crlb: dict):
         association_cost="likelihood",
         birth_covariance="measured",
         update_gate=0.999,
+        min_d=float(min_d),
         sigma_phi=ang,
         sigma_psi=ang,
         sigma_kappa=kap,
@@ -1018,16 +1036,7 @@ def javelin_config(crlb: dict):
 
 
 def _route(setup: DesignSetup, spec: ArraySpec):
-    from .signal_route import SignalRoute
-
-    return SignalRoute(
-        setup.tunnel,
-        setup.arrays(spec),
-        setup.trajectory,
-        setup.config,
-        kinds=setup.kinds,
-        report_covariance=True,
-    )
+    return setup.signal_route(spec)
 
 
 def _drive(route, rng: np.random.Generator, n_epochs: int | None):
@@ -1062,7 +1071,15 @@ def _drive(route, rng: np.random.Generator, n_epochs: int | None):
             continue
         epochs.append(
             PathMeasurements.from_arrays(
-                m.phi, m.psi, m.kappa, m.d, m.v, warn=False, cov=m.cov, sigma_d=m.sigma_d
+                m.phi,
+                m.psi,
+                m.kappa,
+                m.d,
+                m.v,
+                warn=False,
+                cov=m.cov,
+                sigma_d=m.sigma_d,
+                min_d=route.min_d,
             )
         )
         ti = np.asarray(ep.truth_index)
@@ -1171,7 +1188,7 @@ def javelin_rmse(
     if crlb is None:
         pb = path_bounds(setup, spec)
         crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-    cfg = javelin_config(crlb)
+    cfg = javelin_config(crlb, _route(setup, spec).min_d)
     kw = (("workers", workers), ("scheduler", scheduler), ("timeout", timeout))
     res = np.asarray(
         run_trials(

@@ -27,6 +27,7 @@ import numpy as np
 from ._validate import integer, rng_or_error
 from .arrays import ArrayGeometry
 from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
+from .constants import C
 from .evaluation import match_paths
 
 __all__ = ["Epoch", "Measurements", "SignalRoute", "measurements_from_estimates", "simulate_epoch"]
@@ -116,13 +117,14 @@ def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
 
 
 def measurements_from_estimates(
-    est, array: ArrayGeometry, config: SRSConfig | None = None
+    est, array: ArrayGeometry, config: SRSConfig | None = None, *, min_d: float = 0.0
 ) -> Measurements:
-    """Apply Algorithm 1's checks to raw estimates and express them in the world frame; with
+    """Apply Algorithm 1's checks to raw estimates (``min_d``: see
+    :func:`tunnelkit.extraction.algorithm1`) and express them in the world frame; with
     ``config``, also the covariance the extraction reports (:func:`reported_covariance`)."""
     from .extraction import algorithm1
 
-    keep = algorithm1(est)
+    keep = algorithm1(est, min_d)
     u = array.dir_to_world(est.direction[keep]) if keep.size else np.zeros((0, 3))
     phi = np.arctan2(u[:, 1], u[:, 0])
     psi = np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1]))
@@ -156,6 +158,8 @@ class SignalRoute:
     ``n_paths=None`` means L known (the number of traced paths, as in the paper).
     ``report_covariance``: each epoch's measurements carry the CRLB at the estimate
     (:func:`reported_covariance`), what the ML route's error follows; off by default.
+    ``bias_aware_delay_check``: Algorithm 1 drops only ``d < -c b_max`` (the clock bias's
+    support) instead of the printed ``d < 0`` (:func:`tunnelkit.extraction.algorithm1`).
     ``impairments`` (off by default) adds what eq. 1 leaves out (:class:`tunnelkit.channel.Impairments`);
     build an impaired route with :meth:`with_impairments`, which draws each array's calibration
     error once (``calibration``: array name -> (M,) complex gains).
@@ -171,6 +175,13 @@ class SignalRoute:
     impairments: Impairments = field(default_factory=Impairments)
     calibration: dict = field(default_factory=dict)
     report_covariance: bool = False
+    bias_aware_delay_check: bool = False
+
+    @property
+    def min_d(self) -> float:
+        """Algorithm 1's delay check ``d >= min_d`` on this route: 0 as printed, ``-c b_max`` with
+        ``bias_aware_delay_check``."""
+        return -C * self.config.clock_bias_limit if self.bias_aware_delay_check else 0.0
 
     def with_impairments(self, impairments: Impairments, rng: np.random.Generator) -> SignalRoute:
         """A copy of this route whose arrays carry ``impairments``: each array's calibration error
@@ -252,7 +263,10 @@ class SignalRoute:
             **extract_kw,
         )
         meas = measurements_from_estimates(
-            est, arr, self.config if self.report_covariance else None
+            est,
+            arr,
+            self.config if self.report_covariance else None,
+            min_d=self.min_d,
         )
         truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
         return Epoch(

@@ -325,10 +325,11 @@ tf_ml, _ = ex.tenfiloc_track(drive_ml)
 fig6a = trajectories_figure(
     drive.truth,
     {
+        # the ML-route pair first, as in the slalom figure below: a method keeps its marker
         "JAVELIN (paper design, ML route)": ev_ml.estimates,
+        "TeNFiLoc (ML route)": tf_ml,
         "JAVELIN (paper design, paper route)": ev_paper.estimates,
         "TeNFiLoc (paper route)": tf_est,
-        "TeNFiLoc (ML route)": tf_ml,
     },
     base_station=drive.base_station,
     title="straight, L",

@@ -262,12 +262,29 @@ def angles_from_solution(x_nf, u_ff):
     }
 
 
-def algorithm1(est: PathEstimates) -> np.ndarray:
-    """Algorithm 1 (ExtractMeas) checks: indices of the kept paths (``d >= 0``).
+def algorithm1(est: PathEstimates, min_d: float = 0.0) -> np.ndarray:
+    """Algorithm 1 (ExtractMeas) checks: indices of the kept paths (``d >= min_d``).
 
     The near/far choice (``kappa < 0`` -> far-field angles, no kappa) is already applied in
-    :func:`extract_paths`; this returns the paths that survive line 5-6.
+    :func:`extract_paths`; this returns the paths that survive line 5-6. As printed, line 5
+    drops ``d < 0`` (``min_d = 0``, :attr:`PathEstimates.valid`). But ``d`` carries the clock
+    bias, up to ``b_max = 100`` ns either way in section 4.2, so a path nearer than
+    ``c b_max = 30`` m can arrive with ``d < 0`` and still be good; ``min_d = -c b_max`` is the
+    check that only drops what no bias explains. Paths the maximum-likelihood route finds
+    indistinguishable from noise stay dropped either way.
     """
     if not isinstance(est, PathEstimates):
         raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
-    return np.flatnonzero(est.valid)
+    min_d = float(min_d)
+    if not np.isfinite(min_d) or min_d > 0:
+        raise ValueError(f"min_d: expected a finite value <= 0, got {min_d}")
+    if min_d == 0.0:
+        return np.flatnonzero(est.valid)
+    from .ml import MIN_SIGNIFICANCE
+
+    detected = (
+        np.ones(len(est), bool)
+        if est.significance is None
+        else np.asarray(est.significance) >= MIN_SIGNIFICANCE
+    )
+    return np.flatnonzero(detected & (est.d >= min_d))

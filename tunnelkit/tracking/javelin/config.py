@@ -75,7 +75,9 @@ class JavelinConfig:
       uncertainty carried through the intersection of Algorithm 3, with the cross-covariance);
       ``update_gate`` (ours; ``None`` = off as in the paper): the probability of a chi-square
       test on the whole stacked innovation; pairs are left out until it passes
-      (:func:`~tunnelkit.tracking.javelin.update.exclude_inconsistent`).
+      (:func:`~tunnelkit.tracking.javelin.update.exclude_inconsistent`); ``min_d`` [m]
+      Algorithm 1's delay check, ``d >= min_d``: 0 as printed, ``-c b_max`` to keep the paths a
+      negative clock bias pushed below zero (ours).
     - ``doppler_clutter_margin`` [m/s] (ours; ``None`` = off as in the paper): a path whose
       radial speed exceeds the vehicle speed by more than this margin cannot come from a static
       reflector (``|v| <= ||v_u||`` for any mirror image) and is dropped as clutter before
@@ -109,6 +111,7 @@ class JavelinConfig:
     measurement_noise: str = "fixed"
     birth_covariance: str = "fixed"
     update_gate: float | None = None
+    min_d: float = 0.0
     doppler_clutter_margin: float | None = None
     doppler_sign: float = -1.0
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -123,6 +126,8 @@ class JavelinConfig:
             positive(name, getattr(self, name))
         if self.sigma_p0_ue is not None:
             positive("sigma_p0_ue", self.sigma_p0_ue)
+        if not (np.isfinite(self.min_d) and self.min_d <= 0):
+            raise ValueError(f"min_d: expected a finite value <= 0, got {self.min_d!r}")
         if self.update_gate is not None:
             probability("update_gate", self.update_gate)
         if self.doppler_clutter_margin is not None:

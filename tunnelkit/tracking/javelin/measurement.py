@@ -119,12 +119,12 @@ class PathMeasurements:
         """Whether the extraction reported a covariance for every path."""
         return self.cov is not None
 
-    def sanitised(self) -> tuple[PathMeasurements, int]:
+    def sanitised(self, min_d: float = 0.0) -> tuple[PathMeasurements, int]:
         """These paths through the checks of Algorithm 1 (idempotent), and how many were dropped.
 
         ``source`` keeps pointing into the original input."""
         clean = PathMeasurements.from_arrays(
-            self.phi, self.psi, self.kappa, self.d, self.v, warn=False
+            self.phi, self.psi, self.kappa, self.d, self.v, warn=False, min_d=min_d
         )
         if self.reported:
             clean.cov, clean.sigma_d = self.cov[clean.source], self.sigma_d[clean.source]
@@ -143,12 +143,15 @@ class PathMeasurements:
         warn: bool = True,
         cov=None,
         sigma_d=None,
+        min_d: float = 0.0,
     ) -> PathMeasurements:
         """Apply the consistency checks of Algorithm 1 and drop unusable paths.
 
-        (i) ``d < 0``: path discarded; (ii) ``kappa < 0`` (or NaN): far field, no curvature;
-        ours: a path with a NaN/inf angle is discarded with a :class:`JavelinWarning`.
-        ``cov`` / ``sigma_d``: the reported uncertainty of every input path (see the class).
+        (i) ``d < min_d``: path discarded (``min_d = 0`` as printed; ``-c b_max`` keeps what the
+        clock bias explains, see :func:`tunnelkit.extraction.algorithm1`); (ii) ``kappa < 0``
+        (or NaN): far field, no curvature; ours: a path with a NaN/inf angle is discarded with a
+        :class:`JavelinWarning`. ``cov`` / ``sigma_d``: the reported uncertainty of every input
+        path (see the class).
         """
         phi = np.asarray(phi, dtype=float).reshape(-1)
         n = phi.size
@@ -161,7 +164,7 @@ class PathMeasurements:
                 JavelinWarning,
                 stacklevel=2,
             )
-        keep = ~bad_angle & ~(d < 0)
+        keep = ~bad_angle & ~(d < min_d)
         kappa = np.where(np.isfinite(kappa) & (kappa > 0), kappa, np.nan)
         d = np.where(np.isfinite(d), d, np.nan)
         v = np.where(np.isfinite(v), v, np.nan)

@@ -90,14 +90,14 @@ class Javelin:
         return *self._last_motion, sig
 
     @staticmethod
-    def _paths(paths, faults: list[str]) -> PathMeasurements:
+    def _paths(paths, faults: list[str], min_d: float = 0.0) -> PathMeasurements:
         if paths is None:
             faults.append("no measurement this epoch: predict only")
             return PathMeasurements.empty()
         if not isinstance(paths, PathMeasurements):
             raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
         # a PathMeasurements built directly may still hold NaN angles or d < 0 (Algorithm 1)
-        clean, dropped = paths.sanitised()
+        clean, dropped = paths.sanitised(min_d)
         if dropped:
             faults.append(f"{dropped} path(s) failing the checks of Algorithm 1 dropped")
         return clean
@@ -110,7 +110,7 @@ class Javelin:
         cfg = self.config
         dt = nonnegative("dt", dt)
         faults: list[str] = []
-        meas = self._paths(paths, faults)
+        meas = self._paths(paths, faults, cfg.min_d)
         nu, theta, sig_nu = self._motion(speed, heading, faults)
         n_clutter = 0
         if cfg.doppler_clutter_margin is not None and sig_nu is None and len(meas):
