@@ -147,16 +147,16 @@ class Javelin:
             )
             # Update (eq. 64-68)
             pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
-            if cfg.update_gate is None:
-                m = stack_measurement(pred, J, meas, mres.pairs, cfg, mres.los_path)
-            else:
-                m, left_out = exclude_inconsistent(
-                    st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, cfg.update_gate
-                )
-                if left_out:
-                    faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
-            n_rows = m.z.size
             try:
+                if cfg.update_gate is None:
+                    m = stack_measurement(pred, J, meas, mres.pairs, cfg, mres.los_path)
+                else:
+                    m, left_out = exclude_inconsistent(
+                        st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, cfg.update_gate
+                    )
+                    if left_out:
+                        faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
+                n_rows = m.z.size
                 x_new, P_new, nis = joseph_update(st.x, st.P, m)
                 if not (np.all(np.isfinite(x_new)) and np.all(np.isfinite(P_new))):
                     raise np.linalg.LinAlgError("non-finite update")

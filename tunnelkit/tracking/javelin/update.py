@@ -131,6 +131,9 @@ def joseph_update(
 
 
 def _nis(x: np.ndarray, P: np.ndarray, m: StackedMeasurement) -> float:
+    """``y^T S^-1 y`` of the stacked measurement at the prior (0 without rows)."""
+    if m.z.size == 0:
+        return 0.0
     y = m.residual()
     S = m.H @ P @ m.H.T + m.R
     return float(y @ cho_solve(cho_factor(0.5 * (S + S.T), lower=True), y))
@@ -152,18 +155,20 @@ def exclude_inconsistent(
     number of rows, leave out the (track, path) pair whose removal lowers the normalised
     innovation most, and stack again. Catches what the per-pair gates of Algorithm 2 cannot: a
     wrong LoS from eq. 61 and the TDoA rows, which no gate sees. Returns the stacked measurement
-    of the kept pairs and the pairs left out (in order)."""
-    from .gate import _threshold
+    of the kept pairs and the pairs left out (in order). Raises ``numpy.linalg.LinAlgError`` if
+    an innovation covariance is not positive definite (the tracker then skips the update)."""
+    from .gate import ChiSquareGate
 
+    gate = ChiSquareGate(probability)
     pairs = list(pairs)
     out: list[tuple[int, int]] = []
     m = stack_measurement(pred, J, meas, pairs, config, los_path)
-    while m.z.size and _nis(x, P, m) > _threshold(probability, int(m.z.size)):
+    while m.z.size and _nis(x, P, m) > gate.threshold(int(m.z.size)):
         best = None
         for p in pairs:
             rest = [q for q in pairs if q != p]
             trial = stack_measurement(pred, J, meas, rest, config, los_path)
-            score = _nis(x, P, trial) / _threshold(probability, max(int(trial.z.size), 1))
+            score = _nis(x, P, trial) / gate.threshold(max(int(trial.z.size), 1))
             if best is None or score < best[0]:
                 best = (score, p, trial)
         _, p, m = best
