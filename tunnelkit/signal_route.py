@@ -94,7 +94,7 @@ class Epoch:
 
 def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
     """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
-    ``keep``, as the covariance of the world-frame ``(phi, psi, kappa)`` (K, 3, 3) and the
+    ``keep`` (the Fisher information of those paths jointly), as the covariance of the world-frame ``(phi, psi, kappa)`` (K, 3, 3) and the
     standard deviation of ``d`` (K,). The wave origin's covariance is rotated to the world frame
     and mapped through d(phi, psi, r)/dq (:func:`tunnelkit.geometry.spherical_jacobian`).
     Returns ``(None, None)`` when the maximum-likelihood fit failed its own residual test
@@ -107,13 +107,13 @@ def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
     if fit is not None and not fit.rho <= fit.rho_max:
         return None, None
     try:
-        b = estimate_crlb(est, array.local, config)
+        b = estimate_crlb(est, array.local, config, paths=keep)
     except np.linalg.LinAlgError:
         return None, None
     rot = array.R  # local -> world: u_world = R u_local
-    cov_w = rot @ b["source_cov"][keep] @ rot.T
-    G = spherical_jacobian(array.dir_to_world(b["source"][keep]))
-    return G @ cov_w @ np.swapaxes(G, 1, 2), b["d"][keep]
+    cov_w = rot @ b["source_cov"] @ rot.T
+    G = spherical_jacobian(array.dir_to_world(b["source"]))
+    return G @ cov_w @ np.swapaxes(G, 1, 2), b["d"]
 
 
 def measurements_from_estimates(

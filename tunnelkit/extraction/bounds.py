@@ -156,23 +156,28 @@ def source_crlb(
     return {"mu_f": roots["mu_f"], "mu_t": roots["mu_t"], "direction": ang, "kappa": kap}
 
 
-def estimate_crlb(est, element_positions, config, *, noise_power: float | None = None) -> dict:
+def estimate_crlb(
+    est, element_positions, config, *, noise_power: float | None = None, paths=None
+) -> dict:
     """The structured CRLB evaluated at the estimates: the covariance an efficient estimator
     reports for its own output (the ML route sits on this bound, notebook 03; a CPD route does
     not, so for it this understates the error).
 
-    ``est`` is a :class:`~tunnelkit.extraction.PathEstimates`; every path enters the joint Fisher
-    information (each path's bound accounts for the others). A far-field estimate (no curvature)
+    ``est`` is a :class:`~tunnelkit.extraction.PathEstimates`; the paths ``paths`` (indices,
+    default all) enter the joint Fisher information, so each one's bound accounts for the others;
+    leave out what the extraction rejected as noise. A far-field estimate (no curvature)
     is placed on its direction at the range ``d``, at least the Fraunhofer distance of the array;
     its curvature bound is then meaningless and not used downstream. ``noise_power`` defaults to
     the ML fit's estimate (``est.fit.noise_power``), else ``config.noise_power``.
 
-    Returns ``source`` (L, 3) the wave origins used (local frame), ``source_cov`` (L, 3, 3)
-    [m^2] their covariance, and ``d`` (L,) [m], the delay-distance standard deviation. Raises
+    Returns, per path of ``paths``: ``source`` (L, 3) the wave origins used (local frame),
+    ``source_cov`` (L, 3, 3) [m^2] their covariance, and ``d`` (L,) [m], the delay-distance
+    standard deviation. Raises
     ``numpy.linalg.LinAlgError`` when the Fisher information is singular at the estimate.
     """
     p = np.asarray(element_positions, float)
-    if len(est) == 0:
+    sel = np.arange(len(est)) if paths is None else np.asarray(paths, int).reshape(-1)
+    if sel.size == 0:
         return {"source": np.zeros((0, 3)), "source_cov": np.zeros((0, 3, 3)), "d": np.zeros(0)}
     if noise_power is None:
         fit = getattr(est, "fit", None)
@@ -180,14 +185,15 @@ def estimate_crlb(est, element_positions, config, *, noise_power: float | None =
     lam = C / config.fc
     aperture = float(np.max(np.linalg.norm(p - p.mean(axis=0), axis=1))) * 2.0
     far = max(2.0 * aperture**2 / lam, 1.0)
-    rng_ = np.where(np.isfinite(est.kappa), est.kappa, np.maximum(est.d, far))
-    src = est.direction * rng_[:, None]
+    kap, d_est = est.kappa[sel], est.d[sel]
+    rng_ = np.where(np.isfinite(kap), kap, np.maximum(d_est, far))
+    src = est.direction[sel] * rng_[:, None]
     res = crlb_paths(
-        est.alpha,
+        est.alpha[sel],
         src,
         p,
-        est.mu_f,
-        est.mu_t,
+        est.mu_f[sel],
+        est.mu_t[sel],
         config.fc,
         config.n_tones,
         config.n_symbols,
