@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -123,6 +123,20 @@ def test_wrap_angle(a, kind):
     d=arrays(float, 4, elements=pos),
     th=arrays(float, 4, elements=st.floats(-3.14, 3.14)),
     kind=bad_kind,
+)
+# found by the search: numerically singular systems (stations 1e-253 m apart in x; two stations
+# on the y axis with every bearing 1e-103 rad from x)
+@example(
+    s=np.array([[2.4819217e-253, 1.0], [0.0, 0.0]]),
+    d=np.ones(4),
+    th=np.zeros(4),
+    kind="complex",
+)
+@example(
+    s=np.array([[0.0, 1.0], [0.0, 0.0]]),
+    d=np.ones(4),
+    th=np.full(4, 1.36688833e-103),
+    kind="complex",
 )
 def test_positioning(s, d, th, kind):
     n = s.shape[0]

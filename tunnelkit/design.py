@@ -1035,12 +1035,8 @@ def javelin_config(crlb: dict, min_d: float = 0.0):
     )
 
 
-def _route(setup: DesignSetup, spec: ArraySpec):
-    return setup.signal_route(spec)
-
-
 def _drive(route, rng: np.random.Generator, n_epochs: int | None):
-    """One LoS drive through the signal route (default extraction); also the matched errors."""
+    """One LoS drive through the design's signal route (:meth:`DesignSetup.signal_route`)."""
     import warnings
 
     from .tracking.javelin.experiment import CONDITIONS, DriveData
@@ -1048,7 +1044,7 @@ def _drive(route, rng: np.random.Generator, n_epochs: int | None):
 
     traj = route.trajectory
     T = len(traj) if n_epochs is None else min(int(n_epochs), len(traj))
-    epochs, faults, errs = [], [], []
+    epochs, faults = [], []
     n_true = np.zeros(T, int)
     bs = route.arrays[0].origin.copy()
     for k in range(T):
@@ -1082,15 +1078,6 @@ def _drive(route, rng: np.random.Generator, n_epochs: int | None):
                 min_d=route.min_d,
             )
         )
-        ti = np.asarray(ep.truth_index)
-        ok = np.flatnonzero(ti >= 0)
-        if ok.size >= 1:
-            ref = ok[np.argmin(m.d[ok])]
-            for j in ok:
-                p = ep.paths[ti[j]]
-                cos = float(np.clip(m.direction[j] @ p.direction, -1.0, 1.0))
-                dd = (m.d[j] - m.d[ref]) - (p.length - ep.paths[ti[ref]].length)
-                errs.append((np.arccos(cos), m.kappa[j] - p.length, dd / np.sqrt(2.0)))
     vel = traj.velocity[:T]
     speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
     heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
@@ -1108,7 +1095,7 @@ def _drive(route, rng: np.random.Generator, n_epochs: int | None):
         bs,
         faults=faults,
     )
-    return drive, np.array(errs).reshape(-1, 3)
+    return drive
 
 
 #: the first second of a drive is the tracker's start-up (an open-sky fix with 1 m of
@@ -1135,7 +1122,7 @@ class _JavelinTrial:
     def __call__(self, rng: np.random.Generator) -> tuple[float, float, float]:
         from .tracking.javelin.experiment import evaluate
 
-        drive, _ = _drive(_route(self.setup, self.spec), rng, self.n_epochs)
+        drive = _drive(self.setup.signal_route(self.spec), rng, self.n_epochs)
         ev = evaluate(drive, self.config)
         idx = _settled(drive.t)
         e = np.linalg.norm(ev.estimates[idx, :2] - drive.truth[idx, :2], axis=1)
@@ -1188,7 +1175,7 @@ def javelin_rmse(
     if crlb is None:
         pb = path_bounds(setup, spec)
         crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-    cfg = javelin_config(crlb, _route(setup, spec).min_d)
+    cfg = javelin_config(crlb, setup.signal_route(spec).min_d)
     kw = (("workers", workers), ("scheduler", scheduler), ("timeout", timeout))
     res = np.asarray(
         run_trials(

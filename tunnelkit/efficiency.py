@@ -22,35 +22,16 @@ __all__ = ["drive_efficiency", "efficiency_rows"]
 
 
 def _epoch_errors(route, k, rngs, refines):
-    from .channel import synthesize
     from .evaluation import match_paths
-    from .extraction import extract_paths
 
     arr, paths = route.paths(k)
-    cfg = route.config
     err = {r: {j: [] for j in range(len(paths))} for r in refines}
     for rng in rngs:
-        snap = synthesize(
-            paths,
-            cfg,
-            rng,
-            model=route.model,
-            snr_offset_db=route.snr_offset_db,
-            calibration=route.calibration.get(arr.name),
-            spatial_wideband=route.impairments.spatial_wideband,
-        )
+        snap = route.snapshot(paths, arr, rng)
         for refine in refines:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                est = extract_paths(
-                    snap.H,
-                    len(paths),
-                    arr.local,
-                    cfg.fc,
-                    cfg.tone_spacing,
-                    cfg.symbol_period,
-                    refine=refine,
-                )
+                est = route.extract(snap.H, arr, len(paths), refine=refine)
             u = arr.dir_to_world(est.direction)
             match = match_paths(est.d, u, paths, clock_bias=snap.clock_bias)
             for i, j in enumerate(match):

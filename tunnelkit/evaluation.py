@@ -264,8 +264,7 @@ def rmse_study(
     """
     if spatial is None:
         spatial = "free" if refine in ("joint", "column", "none") else "structured"
-    from .channel import synthesize
-    from .extraction import extract_paths, path_crlb
+    from .extraction import path_crlb
     from .montecarlo import spawn_rngs
 
     arr, paths = route.paths(k)
@@ -278,16 +277,8 @@ def rmse_study(
 
         it = tqdm(it, desc="snapshots", leave=False)
     for r in it:
-        snap = synthesize(paths, cfg, r, model=route.model, snr_offset_db=route.snr_offset_db)
-        est = extract_paths(
-            snap.H,
-            len(paths),
-            arr.local,
-            cfg.fc,
-            cfg.tone_spacing,
-            cfg.symbol_period,
-            refine=refine,
-        )
+        snap = route.snapshot(paths, arr, r)
+        est = route.extract(snap.H, arr, len(paths), refine=refine)
         match = match_paths(
             est.d, arr.dir_to_world(est.direction), paths, clock_bias=snap.clock_bias
         )

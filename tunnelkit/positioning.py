@@ -64,10 +64,13 @@ def _wls(G, H, w_inv_diag):
     GtW = np.swapaxes(G, -1, -2) * w_inv_diag[..., None, :]
     A = GtW @ G
     b = np.einsum("...ij,...j->...i", GtW, H)
-    try:
-        A_inv = np.linalg.inv(A)
-    except np.linalg.LinAlgError:
-        raise ValueError(_SINGULAR) from None
+    # numerically singular without being exactly so (e.g. stations 1e-253 m apart, or every
+    # bearing 1e-103 rad from the axis): the inverse then overflows instead of raising
+    with np.errstate(all="ignore"):
+        well_posed = np.all(np.linalg.cond(A) < 1.0 / np.finfo(float).eps)
+    if not well_posed:
+        raise ValueError(_SINGULAR)
+    A_inv = np.linalg.inv(A)
     return np.einsum("...ij,...j->...i", A_inv, b), A_inv
 
 

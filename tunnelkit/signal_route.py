@@ -91,6 +91,19 @@ class Epoch:
     measurements: Measurements
     truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
 
+    def with_estimates(self, est, config: SRSConfig | None = None, *, min_d: float = 0.0):
+        """This epoch with other estimates of the same tensor (another extraction route):
+        Algorithm 1, the world frame and the match to the true paths redone
+        (``config`` / ``min_d`` as in :func:`measurements_from_estimates`)."""
+        meas, truth = _measure(est, self.array, self.paths, self.snapshot, config, min_d)
+        return replace(self, estimates=est, measurements=meas, truth_index=truth)
+
+
+def _measure(est, array, paths, snap, config, min_d):
+    """Measurements of ``est`` (Algorithm 1, world frame) and their match to the true paths."""
+    meas = measurements_from_estimates(est, array, config, min_d=min_d)
+    return meas, match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
+
 
 def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
     """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
@@ -227,6 +240,30 @@ class SignalRoute:
         tun = self.tunnel if tunnel is None else tunnel
         return arr, propagation.trace_paths(tun, arr, ue, vel, fc=self.config.fc, kinds=self.kinds)
 
+    def snapshot(self, paths, arr: ArrayGeometry, rng: np.random.Generator, **kw):
+        """The SRS tensor of ``paths`` at ``arr`` (:func:`tunnelkit.channel.synthesize`) with
+        this route's model, SNR offset and impairments; ``kw`` (``clock_bias``, ...) passed on."""
+        return synthesize(
+            paths,
+            self.config,
+            rng,
+            model=self.model,
+            snr_offset_db=self.snr_offset_db,
+            calibration=self.calibration.get(arr.name),
+            spatial_wideband=self.impairments.spatial_wideband,
+            **kw,
+        )
+
+    def extract(self, H, arr: ArrayGeometry, n_paths: int, **extract_kw):
+        """:func:`tunnelkit.extraction.extract_paths` of ``H`` at ``arr`` with this route's
+        radio (``refine``, ... in ``extract_kw``)."""
+        from .extraction import extract_paths
+
+        cfg = self.config
+        return extract_paths(
+            H, n_paths, arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period, **extract_kw
+        )
+
     def epoch(
         self,
         k: int,
@@ -238,37 +275,13 @@ class SignalRoute:
         **extract_kw,
     ) -> Epoch:
         """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1."""
-        from .extraction import extract_paths
-
         rng = rng_or_error("rng", rng)
         arr, paths = self.paths(k, tunnel)
-        snap = synthesize(
-            paths,
-            self.config,
-            rng,
-            model=self.model,
-            clock_bias=clock_bias,
-            snr_offset_db=self.snr_offset_db,
-            calibration=self.calibration.get(arr.name),
-            spatial_wideband=self.impairments.spatial_wideband,
-        )
+        snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
-        est = extract_paths(
-            snap.H,
-            L,
-            arr.local,
-            self.config.fc,
-            self.config.tone_spacing,
-            self.config.symbol_period,
-            **extract_kw,
-        )
-        meas = measurements_from_estimates(
-            est,
-            arr,
-            self.config if self.report_covariance else None,
-            min_d=self.min_d,
-        )
-        truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
+        est = self.extract(snap.H, arr, L, **extract_kw)
+        cfg = self.config if self.report_covariance else None
+        meas, truth = _measure(est, arr, paths, snap, cfg, self.min_d)
         return Epoch(
             k,
             float(self.trajectory.t[k]),

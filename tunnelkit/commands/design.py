@@ -80,29 +80,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--runs", type=int, default=0, help="JAVELIN Monte-Carlo drives per array (0: bounds only)"
     )
     p.add_argument("--seed", type=int, default=0, help="Monte-Carlo seed (0)")
-    from ..montecarlo import CONNECT_TIMEOUT_S
+    from .reproduce import add_parallel_arguments
 
-    par = p.add_mutually_exclusive_group()
-    par.add_argument(
-        "--workers",
-        type=int,
-        default=None,
-        metavar="N",
-        help="run the Monte-Carlo on a local Dask cluster of N processes (default: serial)",
-    )
-    par.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="ADDRESS",
-        help="run the Monte-Carlo on a running Dask cluster, e.g. tcp://HOST:8786",
-    )
-    p.add_argument(
-        "--connect-timeout",
-        type=float,
-        default=CONNECT_TIMEOUT_S,
-        metavar="SECONDS",
-        help=f"give up on --scheduler after this long (default {CONNECT_TIMEOUT_S:g})",
-    )
+    add_parallel_arguments(p)
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--format", choices=["table", "json"], default="table")
 
@@ -110,6 +90,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from .. import design
     from ..montecarlo import TrialLost
+    from .reproduce import parallel_kwargs
 
     specs = [design.parse_array(a, args.spacing) for a in args.arrays]
     setup = design.DesignSetup.from_scenario(
@@ -128,9 +109,7 @@ def main(args: argparse.Namespace) -> int:
             eps_phi=args.eps,
             runs=args.runs,
             seed=args.seed,
-            workers=args.workers,
-            scheduler=args.scheduler,
-            timeout=args.connect_timeout,
+            **parallel_kwargs(args),
             progress=args.runs > 0 and args.format == "table" and not args.no_progress,
         )
     except TrialLost as exc:

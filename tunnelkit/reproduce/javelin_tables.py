@@ -63,6 +63,27 @@ def _simulate(scenario: str, n_epochs: int | None, extractions: tuple[str, ...],
     return ex.simulate_routes(scenario, cond, rng, n_epochs=n_epochs, extractions=extractions)
 
 
+def _per_drive(scenario, conditions, runs, seed, progress, extractions, make_trial, **parallel):
+    """One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive: drive ``i`` (run
+    ``i // n``, condition ``i % n``) draws from the ``i``-th child of ``seed``. ``make_trial``
+    gets the route names (``extractions``, normalised) and returns the trial ``(cond, rng)``.
+    Returns the route names and ``[(condition, result), ...]`` in drive order."""
+    from ..tracking.javelin import experiment as ex
+
+    extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
+    jobs = [c for _ in range(runs) for c in tuple(conditions)]
+    results = run_trials(
+        make_trial(extractions),
+        len(jobs),
+        seed,
+        inputs=jobs,
+        progress=progress,
+        desc=f"{scenario} drives",
+        **parallel,
+    )
+    return extractions, list(zip(jobs, results))
+
+
 def collect_routes(
     scenario: str,
     conditions: tuple[str, ...],
@@ -80,23 +101,18 @@ def collect_routes(
     ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
     the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode). Returns
     ``{extraction: {condition: [DriveData, ...]}}``."""
-    from ..tracking.javelin import experiment as ex
-
-    conditions = tuple(conditions)
-    extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
-    jobs = [c for _ in range(runs) for c in conditions]
-    trial = functools.partial(_simulate, scenario, n_epochs, extractions)
-    results = run_trials(
-        trial,
-        len(jobs),
+    extractions, done = _per_drive(
+        scenario,
+        conditions,
+        runs,
         seed,
-        inputs=jobs,
-        progress=progress,
-        desc=f"{scenario} drives",
+        progress,
+        extractions,
+        lambda e: functools.partial(_simulate, scenario, n_epochs, e),
         **parallel,
     )
     out: dict[str, dict[str, list]] = {e: {c: [] for c in conditions} for e in extractions}
-    for cond, routes in zip(jobs, results):
+    for cond, routes in done:
         for e, drive in routes.items():
             out[e][cond].append(drive)
     return out
@@ -258,31 +274,25 @@ def javelin_table(
     it where it ran, so scoring runs in parallel too; the drives are the same as
     :func:`collect_routes`' (drive ``i`` draws from the ``i``-th child of ``seed``) and the table
     equals :func:`table_rows` on them."""
-    from ..tracking.javelin import experiment as ex
-
-    conditions = tuple(conditions)
-    extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
-    columns = table_columns(extractions)
-    jobs = [c for _ in range(runs) for c in conditions]
-    trial = functools.partial(_simulate_and_score, scenario, n_epochs, extractions, columns)
-    results = run_trials(
-        trial,
-        len(jobs),
+    extractions, done = _per_drive(
+        scenario,
+        conditions,
+        runs,
         seed,
-        inputs=jobs,
-        progress=progress,
-        desc=f"{scenario} drives",
+        progress,
+        extractions,
+        lambda e: functools.partial(_simulate_and_score, scenario, n_epochs, e, table_columns(e)),
         **parallel,
     )
+    columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
     faults = dict.fromkeys(extractions, 0)
     for cond in conditions:  # the order of table_rows: condition, then run
-        for (one, _), c in zip(results, jobs):
-            if c != cond:
-                continue
-            for key, metrics in one.items():
-                scores.setdefault(key, []).append(metrics)
-    for _, nf in results:
+        for c, (one, _) in done:
+            if c == cond:
+                for key, metrics in one.items():
+                    scores.setdefault(key, []).append(metrics)
+    for _, (_, nf) in done:
         for e, n in nf.items():
             faults[e] += n
     cols, rows = _rows(scores, reference, columns)

@@ -94,7 +94,6 @@ def curvature_study(
     ``refine`` picks the extraction route (default the paper's, whose eq. 17-18 TLS the figure
     shows; ``"ml"`` the joint maximum-likelihood fit, which needs more antennas than paths)."""
     from ..channel import synthesize
-    from ..extraction import extract_paths
 
     route, arr, paths = _paths_for(side, k, scenario)
     tgt = _target(paths)
@@ -104,15 +103,7 @@ def curvature_study(
         snap = synthesize(
             paths, cfg, r, clock_bias=0.0, snr_offset_db=snr_offset_db, n_tones=n_tones
         )
-        est = extract_paths(
-            snap.H,
-            len(paths),
-            arr.local,
-            cfg.fc,
-            cfg.tone_spacing,
-            cfg.symbol_period,
-            refine=refine,
-        )
+        est = route.extract(snap.H, arr, len(paths), refine=refine)
         j = int(np.argmin(np.linalg.norm(est.direction - tgt.direction_local, axis=1)))
         kap.append(est.kappa_nf[j])
     return {

@@ -146,40 +146,18 @@ def route_name(extraction: str) -> str:
 def ml_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by the maximum-likelihood route
     (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor."""
-    from ...evaluation import match_paths
     from ...extraction.ml import ml_paths
-    from ...signal_route import measurements_from_estimates
 
-    est = ml_paths(
-        ep.snapshot.H,
-        len(ep.paths),
-        ep.array.local,
-        config.fc,
-        config.tone_spacing,
-        config.symbol_period,
-    )
-    meas = measurements_from_estimates(est, ep.array)
-    truth = match_paths(meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias)
-    return replace(ep, estimates=est, measurements=meas, truth_index=truth)
+    args = (ep.array.local, config.fc, config.tone_spacing, config.symbol_period)
+    return ep.with_estimates(ml_paths(ep.snapshot.H, len(ep.paths), *args))
 
 
 def separate_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
-    from ...evaluation import match_paths
     from ...extraction.coherent import resolve_coherent
-    from ...signal_route import measurements_from_estimates
 
-    est = resolve_coherent(
-        ep.snapshot.H,
-        ep.estimates,
-        ep.array.local,
-        config.fc,
-        config.tone_spacing,
-        config.symbol_period,
-    )
-    meas = measurements_from_estimates(est, ep.array)
-    truth = match_paths(meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias)
-    return replace(ep, estimates=est, measurements=meas, truth_index=truth)
+    args = (ep.array.local, config.fc, config.tone_spacing, config.symbol_period)
+    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, *args))
 
 
 def _route(scenario: str, model: str):

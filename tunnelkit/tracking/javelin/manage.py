@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import JavelinConfig
-from .measurement import PathMeasurements
+from .measurement import PathMeasurements, path_covariances
 from .state import JavelinState
 
 __all__ = [
@@ -78,10 +78,7 @@ def birth_covariance(state: JavelinState, meas: PathMeasurements, j: int, config
     is the path's reported angle covariance under ``measurement_noise="reported"``, else
     ``diag(sigma_phi^2, sigma_psi^2)``."""
     F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
-    if config.measurement_noise == "reported" and meas.reported:
-        R = meas.cov[j][:2, :2]
-    else:
-        R = np.diag([config.sigma_phi**2, config.sigma_psi**2])
+    R = path_covariances(meas, config)[j, :2, :2]
     f = F[:, 2:3]  # d(y, z) / d x_u
     cross = f @ state.P[0:1, :]
     cov = F[:, :2] @ R @ F[:, :2].T + f @ state.P[0:1, 0:1] @ f.T

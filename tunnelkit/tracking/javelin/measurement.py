@@ -30,6 +30,7 @@ __all__ = [
     "JavelinWarning",
     "PathMeasurements",
     "measurement_model",
+    "path_covariances",
     "track_model",
 ]
 
@@ -205,6 +206,16 @@ class PathMeasurements:
         """Unit arrival directions from ``phi``/``psi`` (elevation), shape (n, 3)."""
         c = np.cos(self.psi)
         return np.column_stack([c * np.cos(self.phi), c * np.sin(self.phi), np.sin(self.psi)])
+
+
+def path_covariances(meas: PathMeasurements, config) -> np.ndarray:
+    """The covariance of each path's ``(phi, psi, kappa)`` (n, 3, 3) the tracker uses: the
+    reported one under ``measurement_noise="reported"`` when the epoch carries it, else
+    ``diag(sigma_phi^2, sigma_psi^2, sigma_kappa^2)`` for every path (the paper)."""
+    if config.measurement_noise == "reported" and meas.reported:
+        return meas.cov
+    var = np.array([config.sigma_phi, config.sigma_psi, config.sigma_kappa]) ** 2
+    return np.broadcast_to(np.diag(var), (len(meas), 3, 3))
 
 
 def track_model(

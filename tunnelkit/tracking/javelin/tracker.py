@@ -22,7 +22,7 @@ from .associate import ASSOCIATORS, AssociationCosts, association_costs
 from .config import JavelinConfig
 from .gate import ChiSquareGate
 from .manage import ManageResult, manage_tracks
-from .measurement import JavelinWarning, PathMeasurements, track_model
+from .measurement import JavelinWarning, PathMeasurements, path_covariances, track_model
 from .motion import predict, ue_velocity
 from .state import JavelinState, track_slice
 from .update import exclude_inconsistent, joseph_update, stack_measurement
@@ -132,13 +132,10 @@ class Javelin:
                 geometry_ok = False
                 faults.append(f"measurement model undefined ({exc}): predict only")
         if len(meas) and geometry_ok:
-            if cfg.measurement_noise == "reported" and meas.reported:
-                R3 = meas.cov
-            else:
-                if cfg.measurement_noise == "reported":
-                    faults.append("no reported covariance this epoch: the fixed sigmas used")
-                R3 = np.diag([cfg.sigma_phi**2, cfg.sigma_psi**2, cfg.sigma_kappa**2])
+            if cfg.measurement_noise == "reported" and not meas.reported:
+                faults.append("no reported covariance this epoch: the fixed sigmas used")
             # Associate (Algorithm 2)
+            R3 = path_covariances(meas, cfg)
             costs = association_costs(pred, J, st.P, meas, R3, self.gate, cfg.association_cost)
             assoc = self.associate(costs)
             # ManageTracks (Algorithm 3)

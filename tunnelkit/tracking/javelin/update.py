@@ -16,7 +16,7 @@ from scipy.linalg import cho_factor, cho_solve
 
 from ...crlb import wrap_angle
 from .config import JavelinConfig
-from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements
+from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements, path_covariances
 
 __all__ = ["StackedMeasurement", "exclude_inconsistent", "joseph_update", "stack_measurement"]
 
@@ -51,8 +51,8 @@ def stack_measurement(
     """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``."""
     D = J.shape[-1]
     reported = config.measurement_noise == "reported" and meas.reported
+    cov = path_covariances(meas, config)
     z, h, H, blocks, ang, labels = [], [], [], [], [], []
-    sig = np.array([config.sigma_phi, config.sigma_psi, config.sigma_kappa])
     for i, j in pairs:
         comps = [PHI, PSI] + ([KAPPA] if np.isfinite(meas.kappa[j]) else [])
         zj = (meas.phi[j], meas.psi[j], meas.kappa[j])
@@ -62,7 +62,7 @@ def stack_measurement(
             H.append(J[i, c])
             ang.append(c == PHI)
             labels.append((("phi", "psi", "kappa")[c], i, j))
-        blocks.append(meas.cov[j][np.ix_(comps, comps)] if reported else np.diag(sig[comps] ** 2))
+        blocks.append(cov[j][np.ix_(comps, comps)])
     n_direct = len(z)
     with_d = [(i, j) for i, j in pairs if np.isfinite(meas.d[j])]
     ref = None
