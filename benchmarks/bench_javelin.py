@@ -11,8 +11,8 @@ import warnings
 import numpy as np
 from run import Case
 
-from tunnelkit.tracking.javelin import Javelin, JavelinWarning
-from tunnelkit.tracking.javelin import experiment as ex
+from tunnelkit import studies as ex
+from tunnelkit.tracking.javelin import Javelin, JavelinWarning, designs
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 
 
@@ -35,7 +35,7 @@ def cases() -> list[Case]:
     )
     spd, hdg = np.linalg.norm(V[:, :2], axis=1), np.arctan2(V[:, 1], V[:, 0])
     trackers = {}
-    for name, cfg in (("paper", ex.PAPER), ("ours", ex.OURS)):
+    for name, cfg in (("paper", designs.paper()), ("ours", designs.ours())):
         trk = Javelin(P[0], cfg.with_(base_station=bs, sigma_p0_ue=1.0))
         trackers[name] = (trk, itertools.cycle(range(1, n)))
 
@@ -49,7 +49,8 @@ def cases() -> list[Case]:
     route = ex._route("italiano2026-straight", "exact")
     sig_rng = np.random.default_rng(1)
     trk_sig = Javelin(
-        route.trajectory.position[0], ex.OURS.with_(base_station=(0.0, 0.0, 4.8), sigma_p0_ue=1.0)
+        route.trajectory.position[0],
+        designs.ours().with_(base_station=(0.0, 0.0, 4.8), sigma_p0_ue=1.0),
     )
     ks = itertools.cycle(range(1, 20))
 

@@ -72,7 +72,7 @@ def _child(case, heavy: bool, conn) -> None:
 _WARM = (
     "constants geometry crlb positioning fresnel arrays propagation metrics montecarlo drive "
     "scenarios channel tracking.doppler tracking.upf tracking.pcrlb tracking.cv "
-    "tracking.virtual_station tracking.javelin.gate"
+    "tracking.virtual_station tracking.gating"
 ).split()
 
 

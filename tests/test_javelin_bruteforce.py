@@ -6,6 +6,7 @@ import pytest
 from tunnelkit.crlb import numeric_jacobian, wrap_angle
 from tunnelkit.geometry import reflector_point
 from tunnelkit.tracking.javelin import (
+    FixedNoise,
     JavelinConfig,
     JavelinState,
     PathMeasurements,
@@ -80,9 +81,10 @@ def test_correlated_tdoa_covariance_is_the_sample_covariance_of_differenced_dela
     bs = (0.0, 0.0, 4.8)
     x = np.array([-20.0, 1.0, 1.0, 8.0, 1.0, -10.0, 1.0, 1.0, -1.2])
     pred, J = track_model(x, bs)
-    cfg = JavelinConfig(base_station=bs, correlated_delta_d=True)
+    cfg = JavelinConfig(base_station=bs)
+    corr = FixedNoise(correlated_delta_d=True)
     meas = PathMeasurements.from_arrays(pred[:, 0], pred[:, 1], d=pred[:, 3])
-    m = stack_measurement(pred, J, meas, [(i, i) for i in range(4)], cfg, los_path=0)
+    m = stack_measurement(pred, J, meas, [(i, i) for i in range(4)], cfg, los_path=0, noise=corr)
     dd = [k for k, lab in enumerate(m.labels) if lab[0] == "delta_d"]
     rng = np.random.default_rng(3)
     e = rng.normal(0.0, cfg.sigma_delta_d / np.sqrt(2.0), (200_000, 4))
@@ -118,9 +120,9 @@ def test_process_noise_is_the_covariance_of_the_sampled_motion(vue_motion):
     for pl in toy_reflectors():
         st.append(pl.mirror(st.ue)[1:], np.eye(2))
     st.P = np.zeros_like(st.P)
-    cfg = JavelinConfig(vue_motion=vue_motion, sigma_vue_walk=1e-6, sigma_height=1e-6)
+    cfg = JavelinConfig(sigma_vue_walk=1e-6, sigma_height=1e-6)
     speed, heading, dt = 10.0, 0.3, 0.1
-    _, Q = predict(st, speed, heading, dt, cfg)
+    _, Q = predict(st, speed, heading, dt, cfg, vue_motion=vue_motion)
     rng = np.random.default_rng(5)
     nu = speed + cfg.sigma_speed * rng.standard_normal(40_000)
     th = heading + cfg.sigma_heading * rng.standard_normal(40_000)

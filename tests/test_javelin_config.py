@@ -24,7 +24,7 @@ def test_paper_defaults():
         ({"gate_probability": 0.0}, "gate_probability"),
         ({"max_misses": -1}, "max_misses"),
         ({"los_gamma": 1.5}, "los_gamma"),
-        ({"associator": "jpda"}, "associator"),
+        ({"sigma_p0_ue": 0.0}, "sigma_p0_ue"),
         ({"base_station": (0, 0)}, "base_station"),
     ],
 )
@@ -38,7 +38,9 @@ def test_type_errors_and_with():
         JavelinConfig(max_misses=1.5)
     with pytest.raises(ValueError, match=r"^zeta"):
         JavelinConfig().with_(zeta=2)
-    assert JavelinConfig().with_(associator="gnn").associator == "gnn"
+    assert JavelinConfig().with_(sigma_kappa=3.0).sigma_kappa == 3.0
+    with pytest.raises(TypeError, match=r"associator"):
+        JavelinConfig(associator="gnn")  # behaviour is a role, not a number
 
 
 def test_registry_family_loads_lazily():

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from tunnelkit import studies as ex
 from tunnelkit.plots.javelin import (
     epoch_figure,
     javelin_table_figure,
@@ -8,7 +9,7 @@ from tunnelkit.plots.javelin import (
     trajectories_figure,
 )
 from tunnelkit.reproduce.javelin_tables import COLUMNS, collect_routes, javelin_table, table_rows
-from tunnelkit.tracking.javelin import experiment as ex
+from tunnelkit.tracking.javelin import designs
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
 
@@ -61,7 +62,7 @@ def test_error_metrics():
 
 def test_evaluate_tables_and_ablation_on_toy_drives():
     drives = {"L": [_fake_drive("L")], "N": [_fake_drive("N", seed=1)]}
-    ev = ex.evaluate(drives["L"][0], ex.OURS)
+    ev = ex.evaluate(drives["L"][0], designs.ours())
     assert ev.metrics["rmse_2d_m"] < 0.5
     tf = ex.evaluate(drives["L"][0], method="TeNFiLoc")
     assert np.all(np.isfinite(tf.estimates))
@@ -74,12 +75,14 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     row = at[("JAVELIN-L", "rmse_2d_m")]
     assert row[-1] == pytest.approx(0.20)
     assert row[2] == pytest.approx(
-        ev_paper := ex.evaluate(drives["L"][0], ex.PAPER).metrics["rmse_2d_m"]
+        ev_paper := ex.evaluate(drives["L"][0], designs.paper()).metrics["rmse_2d_m"]
     )
-    assert row[3] == pytest.approx(ex.evaluate(routes["ml"]["L"][0], ex.PAPER).metrics["rmse_2d_m"])
+    assert row[3] == pytest.approx(
+        ex.evaluate(routes["ml"]["L"][0], designs.paper()).metrics["rmse_2d_m"]
+    )
     ml0 = routes["ml"]["L"][0]
-    assert row[4] == pytest.approx(ex.evaluate(ml0, ex.PAPER_VUE).metrics["rmse_2d_m"])
-    assert row[5] == pytest.approx(ex.evaluate(ml0, ex.OURS_ML).metrics["rmse_2d_m"])
+    assert row[4] == pytest.approx(ex.evaluate(ml0, designs.paper_vue()).metrics["rmse_2d_m"])
+    assert row[5] == pytest.approx(ex.evaluate(ml0, designs.ours_ml()).metrics["rmse_2d_m"])
     assert ev_paper != row[3]
     tf = at[("TeNFiLoc-L", "y_mae_m")]
     assert tf[2] == pytest.approx(ex.evaluate(drives["L"][0], method="TeNFiLoc").metrics["y_mae_m"])
@@ -93,10 +96,10 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     with pytest.raises(ValueError, match=r"^routes"):
         table_rows({"x": drives}, "italiano2026_table1")
     acols, arows = ex.ablation(drives)
-    assert acols == ["design", "L", "N"] and len(arows) == len(ex.ABLATION)
+    assert acols == ["design", "L", "N"] and len(arows) == len(designs.ablation_path())
     _, arows2 = ex.ablation(drives, separated=drives, ml=routes["ml"])
-    assert len(arows2) == len(ex.ABLATION) + 5
-    expect = ex.evaluate(drives["L"][0], ex.OURS_COHERENT).metrics["rmse_2d_m"]
+    assert len(arows2) == len(designs.ablation_path()) + 5
+    expect = ex.evaluate(drives["L"][0], designs.ours_coherent()).metrics["rmse_2d_m"]
     assert arows2[-5][1] == pytest.approx(arows[-1][1]) and arows2[-4][1] == pytest.approx(expect)
     assert [r[1] for r in arows2[-3:]] == pytest.approx(row[3:6])
     with pytest.raises(ValueError, match=r"^method"):
@@ -113,7 +116,7 @@ def test_mirror_prediction_is_exact_for_planar_vues():
 
 def test_figures_and_explorer():
     d = _fake_drive("L", n=15)
-    ev = ex.evaluate(d, ex.OURS, keep_reports=True)
+    ev = ex.evaluate(d, designs.ours(), keep_reports=True)
     fig = epoch_figure(ev.run.reports[5], truth=d.truth[5], base_station=BS, true_vues=d.sources[5])
     assert len(fig.data) > 5 and "epoch 5" in fig.layout.title.text
     assert len(epoch_figure(ev.run.reports[5], plane="xy").data) > 3
@@ -126,32 +129,44 @@ def test_figures_and_explorer():
     exp.set(k=7)
     assert "epoch 7" in exp.figure.layout.title.text
     with pytest.raises(ValueError, match=r"^evaluation"):
-        epoch_view(d, ex.evaluate(d, ex.OURS), 0)
+        epoch_view(d, ex.evaluate(d, designs.ours()), 0)
 
 
 def test_signal_route_drive_two_epochs():
-    d = ex.simulate_drive("italiano2026-straight", "N", np.random.default_rng(3), n_epochs=2)
+    d = ex.simulate_drive(
+        "italiano2026-straight", np.random.default_rng(3), condition="N", n_epochs=2
+    )
     assert len(d.epochs) == 2 and not d.los.any()
     assert all(e is None or np.all(np.isfinite(e.phi)) for e in d.epochs)
     assert np.allclose(d.base_station, [0.0, 0.0, 4.8])
-    with pytest.raises(KeyError):
-        ex.simulate_drive("italiano2026-straight", "X", np.random.default_rng(0), n_epochs=1)
+    with pytest.raises(ValueError, match=r"^condition"):
+        ex.simulate_drive(
+            "italiano2026-straight", np.random.default_rng(0), condition="X", n_epochs=1
+        )
     with pytest.raises(ValueError, match=r"^extraction"):
-        ex.simulate_drive("italiano2026-straight", "L", np.random.default_rng(0), extraction="x")
+        ex.simulate_drive(
+            "italiano2026-straight", np.random.default_rng(0), condition="L", extraction="x"
+        )
 
 
 def test_separated_drive_uses_the_same_tensors():
     """Same seed, both routes: identical truth and V2X; where the CPD kept every path and the
     separation changes nothing, identical measurements; the separated route loses no path."""
     kw = {"n_epochs": 3}
-    a = ex.simulate_drive("italiano2026-straight", "L", np.random.default_rng(5), **kw)
+    a = ex.simulate_drive("italiano2026-straight", np.random.default_rng(5), condition="L", **kw)
     b = ex.simulate_drive(
-        "italiano2026-straight", "L", np.random.default_rng(5), extraction="separated", **kw
+        "italiano2026-straight",
+        np.random.default_rng(5),
+        condition="L",
+        extraction="separated",
+        **kw,
     )
     assert a.extraction == "paper" and b.extraction == "coherent"  # the route's name now
     # one pass through both routes (one synthesis and CPD per epoch) gives the same drives
-    both = ex.simulate_routes("italiano2026-straight", "L", np.random.default_rng(5), **kw)
-    assert list(both) == list(ex.EXTRACTIONS)
+    both = ex.simulate_routes(
+        "italiano2026-straight", np.random.default_rng(5), condition="L", **kw
+    )
+    assert list(both) == ["paper", "coherent", "ml"]
     for one, shared in ((a, both["paper"]), (b, both["coherent"])):
         assert shared.extraction == one.extraction
         np.testing.assert_array_equal(shared.speed, one.speed)
@@ -183,10 +198,11 @@ def test_separated_drive_uses_the_same_tensors():
     _, erows_b = ex.extraction_errors([b])
     los_b = {r[0]: r for r in erows_b}["los"]
     assert err["los"]["phi [deg]"] < los_b[2] and err["los"]["kappa [m]"] < los_b[4]
-    cfg = ex.design_from_errors(erows)
-    assert cfg.sigma_kappa == pytest.approx(err["all"]["kappa [m]"])
-    assert cfg.sigma_phi == pytest.approx(np.radians(err["all"]["phi [deg]"]))
-    assert cfg.kappa_model == "vue" and cfg.associator == ex.OURS_COHERENT.associator
+    cfg = designs.design_from_errors(erows)
+    assert cfg.config.sigma_kappa == pytest.approx(err["all"]["kappa [m]"])
+    assert cfg.config.sigma_phi == pytest.approx(np.radians(err["all"]["phi [deg]"]))
+    assert cfg.curvature == designs.ours_coherent().curvature
+    assert cfg.associator == designs.ours_coherent().associator
     with pytest.raises(ValueError, match=r"^drives"):
         ex.extraction_errors([])
 
@@ -199,7 +215,7 @@ def test_collect_routes_runs_through_run_trials_with_the_condition_per_child():
     assert out["paper"]["L"][0].los.all() and not out["paper"]["N"][0].los.any()
     # drive i draws from child i of the seed: the N drive is child 1
     rng = np.random.default_rng(np.random.SeedSequence(3).spawn(2)[1])
-    d = ex.simulate_drive("italiano2026-straight", "N", rng, n_epochs=1)
+    d = ex.simulate_drive("italiano2026-straight", rng, condition="N", n_epochs=1)
     np.testing.assert_array_equal(d.speed, out["paper"]["N"][0].speed)
     with pytest.raises(ValueError, match=r"^extraction"):
         collect_routes("italiano2026-straight", ("L",), 1, 0, n_epochs=1, extractions=("x",))
@@ -224,8 +240,8 @@ def test_vue_prediction_skips_the_los_only_when_it_exists():
 
 
 def test_ablation_path_goes_from_the_paper_design_to_ours_one_change_at_a_time():
-    cfgs = list(ex.ABLATION.values())
-    assert cfgs[0] == ex.PAPER and cfgs[-1] == ex.OURS
+    cfgs = list(designs.ablation_path().values())
+    assert cfgs[0] == designs.paper() and cfgs[-1] == designs.ours()
     assert len(set(map(repr, cfgs))) == len(cfgs)  # every step changes something
 
 
@@ -242,7 +258,7 @@ def test_table_and_ablation_progress_bars_change_no_number(capsys):
     assert "ablation" in capsys.readouterr().err
     assert a_shown == a_quiet
     assert a_quiet[1][0][1] == pytest.approx(
-        np.mean([ex.evaluate(d, ex.PAPER).metrics["rmse_2d_m"] for d in drives["L"]])
+        np.mean([ex.evaluate(d, designs.paper()).metrics["rmse_2d_m"] for d in drives["L"]])
     )
 
 

@@ -2,13 +2,13 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
+from tunnelkit.tracking.gating import mahalanobis2
 from tunnelkit.tracking.javelin import ChiSquareGate
 from tunnelkit.tracking.javelin.associate import (
     association_costs,
     global_nearest_neighbour,
     greedy_nearest_neighbour,
 )
-from tunnelkit.tracking.javelin.gate import mahalanobis2
 from tunnelkit.tracking.javelin.measurement import PathMeasurements
 
 
@@ -44,7 +44,7 @@ def test_costs_match_a_pair_by_pair_loop():
     meas = PathMeasurements.from_arrays(
         rng.uniform(-3, 3, n), rng.uniform(-1, 1, n), kappa=[10.0, np.nan, 30.0, 20.0]
     )
-    c = association_costs(pred, J, P, meas, R3, ChiSquareGate())
+    c = association_costs(pred, J, P, meas, R3, ChiSquareGate(0.99))
     for i in range(L):
         for j in range(n):
             comp = [0, 1, 2] if np.isfinite(meas.kappa[j]) else [0, 1]

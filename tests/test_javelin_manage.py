@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from tunnelkit.tracking.javelin import JavelinConfig, JavelinState, PathMeasurements
+from tunnelkit.tracking.javelin import FixedBirth, JavelinConfig, JavelinState, PathMeasurements
 from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
 from tunnelkit.tracking.javelin.manage import intersection, los_test, manage_tracks, static_doppler
 
@@ -75,5 +75,5 @@ def test_births_los_and_dynamic_paths():
     assert (0, 0) in res.pairs and len(res.pairs) == 6
     # without update_with_births the newborns wait for the next epoch
     st2 = JavelinState.initial(PU, 1.0)
-    res2 = manage_tracks(st2, m, [], cfg.with_(update_with_births=False), v_u=VU)
+    res2 = manage_tracks(st2, m, [], cfg, v_u=VU, initiator=FixedBirth(update_at_birth=False))
     assert res2.pairs == [(0, 0)]

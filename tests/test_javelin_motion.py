@@ -38,7 +38,7 @@ def test_mirror_motion_is_exact_for_planar_reflectors():
     pu0 = np.array([-30.0, 1.0, 1.0])
     st = _state_with_wall_vues(pu0)
     speed, heading, dt = 10.0, np.radians(20), 0.1
-    x, _ = predict(st, speed, heading, dt, JavelinConfig(vue_motion="mirror"))
+    x, _ = predict(st, speed, heading, dt, JavelinConfig(), vue_motion="mirror")
     pu1 = pu0 + dt * speed * np.array([np.cos(heading), np.sin(heading), 0.0])
     truth = np.concatenate([pu1] + [pl.mirror(pu1)[1:] for pl in toy_reflectors()])
     np.testing.assert_allclose(x, truth, atol=1e-12)

@@ -12,9 +12,18 @@ import pytest
 from scipy.linalg import block_diag
 
 from tunnelkit.geometry import spherical, spherical_jacobian
-from tunnelkit.tracking.javelin import JavelinConfig, PathMeasurements, track_model
+from tunnelkit.tracking.gating import ChiSquareGate
+from tunnelkit.tracking.javelin import (
+    DelayCheck,
+    FixedNoise,
+    JavelinConfig,
+    JointTestUpdater,
+    MeasuredBirth,
+    PathMeasurements,
+    ReportedNoise,
+    track_model,
+)
 from tunnelkit.tracking.javelin.associate import association_costs, global_nearest_neighbour
-from tunnelkit.tracking.javelin.gate import ChiSquareGate
 from tunnelkit.tracking.javelin.update import stack_measurement
 
 
@@ -73,8 +82,8 @@ def test_stacked_covariance_is_the_linear_map_of_the_reported_one():
         sigma_d=sd,
     )
     pairs = [(0, 0), (1, 1), (2, 2)]
-    cfg = JavelinConfig(kappa_model="vue", measurement_noise="reported")
-    m = stack_measurement(pred, J, meas, pairs, cfg, los_path=0)
+    cfg = JavelinConfig()
+    m = stack_measurement(pred, J, meas, pairs, cfg, los_path=0, noise=ReportedNoise())
     # brute force: the full (phi, psi, kappa) x 3 paths + d x 3 covariance, then the selection
     # and differencing matrix A that produces the stacked rows
     full = block_diag(*cov, np.diag(sd**2))
@@ -89,7 +98,7 @@ def test_stacked_covariance_is_the_linear_map_of_the_reported_one():
     A = np.array(rows)
     np.testing.assert_allclose(m.R, A @ full @ A.T, rtol=1e-12, atol=0)
     # the paper's fixed sigmas are untouched by the reported covariance
-    fixed = stack_measurement(pred, J, meas, pairs, JavelinConfig(kappa_model="vue"), los_path=0)
+    fixed = stack_measurement(pred, J, meas, pairs, cfg, los_path=0, noise=FixedNoise())
     n_dir = sum(lab[0] != "delta_d" for lab in fixed.labels)
     assert (
         np.count_nonzero(fixed.R[:n_dir, :n_dir] - np.diag(np.diag(fixed.R[:n_dir, :n_dir]))) == 0
@@ -123,10 +132,12 @@ def test_likelihood_cost_keeps_a_path_on_the_track_that_predicts_it():
         )
     with pytest.raises(ValueError, match="cost: expected"):
         association_costs(pred, J, P, meas, R3, gate, "nearest")
-    with pytest.raises(ValueError, match="association_cost"):
-        JavelinConfig(association_cost="nearest")
-    with pytest.raises(ValueError, match="measurement_noise"):
-        JavelinConfig(measurement_noise="guess")
+    from tunnelkit.tracking.javelin import Associator
+
+    with pytest.raises(ValueError, match=r"^cost"):
+        Associator(cost="nearest")
+    with pytest.raises(TypeError, match=r"^fallback"):
+        ReportedNoise(fallback="guess")
 
 
 def test_per_path_covariance_in_association_equals_a_pair_loop():
@@ -214,7 +225,7 @@ def test_measured_birth_covariance_matches_sampling_the_intersection():
     from tunnelkit.tracking.javelin.state import JavelinState
 
     bs = (0.0, 0.0, 4.8)
-    cfg = JavelinConfig(base_station=bs, birth_covariance="measured")
+    cfg = JavelinConfig(base_station=bs)
     st = JavelinState.initial([30.0, -2.5, 1.5], 0.05)
     st.P[0, 1] = st.P[1, 0] = 0.001  # some correlation with y, carried into the cross term
     phi, psi = np.arctan2(-4.0, 30.0), np.arctan2(6.0 - 4.8, 30.5)
@@ -223,7 +234,11 @@ def test_measured_birth_covariance_matches_sampling_the_intersection():
     cov3[0, :2, :2] = R
     cov3[0, 2, 2] = 1.0
     meas = PathMeasurements.from_arrays([phi], [psi], d=[31.0], cov=cov3, sigma_d=[1e-3])
-    cov, cross = birth_covariance(st, meas, 0, cfg.with_(measurement_noise="reported"))
+    cov, cross = birth_covariance(st, meas, 0, cfg, ReportedNoise())
+    # the initiator role gives the same
+    np.testing.assert_array_equal(
+        MeasuredBirth().covariance(st, meas, 0, cfg, ReportedNoise())[0], cov
+    )
     rng = np.random.default_rng(8)
     n = 200_000
     ue = rng.multivariate_normal(st.x, st.P, n)
@@ -256,9 +271,10 @@ def test_joint_innovation_test_leaves_out_the_wrong_pair():
     meas = PathMeasurements.from_arrays(
         z[:, 0], z[:, 1], kappa=z[:, 2], d=z[:, 3] + 3.0, cov=cov, sigma_d=np.full(3, 1e-3)
     )
-    cfg = JavelinConfig(base_station=bs, kappa_model="vue", measurement_noise="reported")
+    cfg = JavelinConfig(base_station=bs)
+    rep = ReportedNoise()
     pairs = [(0, 0), (1, 1), (2, 2)]
-    m, out = exclude_inconsistent(x, P, pred, J, meas, pairs, cfg, 0, 0.999)
+    m, out = exclude_inconsistent(x, P, pred, J, meas, pairs, cfg, 0, 0.999, rep)
     assert out == [(0, 0)]
     assert all(lab[1] != 0 for lab in m.labels)
     # consistent measurements: nothing left out
@@ -270,12 +286,15 @@ def test_joint_innovation_test_leaves_out_the_wrong_pair():
         cov=cov,
         sigma_d=np.full(3, 1e-3),
     )
-    m2, out2 = exclude_inconsistent(x, P, pred, J, good, pairs, cfg, 0, 0.999)
-    assert out2 == [] and m2.z.size == stack_measurement(pred, J, good, pairs, cfg, 0).z.size
-    with pytest.raises(ValueError, match="update_gate"):
-        JavelinConfig(update_gate=1.5)
-    with pytest.raises(ValueError, match="birth_covariance"):
-        JavelinConfig(birth_covariance="guess")
+    m2, out2 = exclude_inconsistent(x, P, pred, J, good, pairs, cfg, 0, 0.999, rep)
+    assert out2 == [] and m2.z.size == stack_measurement(pred, J, good, pairs, cfg, 0, rep).z.size
+    # the updater role runs the same test
+    m3, out3 = JointTestUpdater(0.999).stack(x, P, pred, J, meas, pairs, cfg, 0, rep)
+    assert out3 == out and m3.labels == m.labels
+    with pytest.raises(ValueError, match="probability"):
+        JointTestUpdater(1.5)
+    with pytest.raises(ValueError, match="probability"):
+        JointTestUpdater(1e-300)
 
 
 def test_bias_aware_delay_check_keeps_paths_a_negative_clock_bias_pushed_below_zero():
@@ -312,4 +331,4 @@ def test_bias_aware_delay_check_keeps_paths_a_negative_clock_bias_pushed_below_z
     assert len(m) == 1 and m.source.tolist() == [0]
     assert len(PathMeasurements.from_arrays([0.1], [0.0], d=[-5.0])) == 0
     with pytest.raises(ValueError, match="min_d"):
-        JavelinConfig(min_d=3.0)
+        DelayCheck(min_d=3.0)

@@ -2,9 +2,15 @@ import numpy as np
 import pytest
 
 from tunnelkit.tracking.javelin import (
+    Associator,
+    DopplerClutter,
+    FixedBirth,
+    FixedNoise,
     Javelin,
     JavelinConfig,
+    JavelinDesign,
     JavelinWarning,
+    MirrorMotion,
     PathMeasurements,
     run_javelin,
 )
@@ -24,7 +30,7 @@ NOISE = dict(
     sigma_d=0.3,
     sigma_v=0.2,
 )
-CFG = JavelinConfig(base_station=BS, sigma_p0_ue=1.0)
+CFG = JavelinDesign(JavelinConfig(base_station=BS, sigma_p0_ue=1.0))
 
 
 def _drive(n, seed, *, amplitude=0.0, los_probability=1.0, speed=4.0):
@@ -65,10 +71,10 @@ def test_tracks_the_geometric_truth(amplitude, los_probability, goal):
 @pytest.mark.parametrize(
     "variant",
     [
-        {"associator": "gnn"},
-        {"vue_motion": "mirror"},
-        {"correlated_delta_d": True},
-        {"update_with_births": False},
+        {"associator": Associator(solver="gnn")},
+        {"vue_motion": MirrorMotion()},
+        {"noise": FixedNoise(correlated_delta_d=True)},
+        {"initiator": FixedBirth(update_at_birth=False)},
     ],
 )
 def test_variants_track_too(variant):
@@ -135,7 +141,7 @@ def test_2000_epochs_finite_and_covariances_symmetric_psd():
     rng = np.random.default_rng(6)
     for k in rng.choice(n, 100, replace=False):
         eps[k] = None
-    trk = Javelin(P[0], CFG.with_(associator="gnn"))
+    trk = Javelin(P[0], CFG.with_(associator=Associator(solver="gnn")))
     worst = 0.0
     import warnings
 
@@ -155,8 +161,8 @@ def test_2000_epochs_finite_and_covariances_symmetric_psd():
 def test_constructor_checks():
     with pytest.raises(ValueError, match=r"^initial_position"):
         Javelin([0.0, 1.0])
-    with pytest.raises(TypeError, match=r"^config"):
-        Javelin([0.0, 1.0, 1.0], config={"max_misses": 1})
+    with pytest.raises(TypeError, match=r"^design"):
+        Javelin([0.0, 1.0, 1.0], design={"max_misses": 1})
     with pytest.raises(ValueError, match=r"^speed, heading"):
         run_javelin([None, None], [1.0], [0.0, 0.0], 0.1, [0, 1, 1])
 
@@ -174,7 +180,7 @@ def test_directly_built_paths_never_stop_a_run():
         np.append(m.v, [500.0, 0.0]),
     )
     np.testing.assert_array_equal(raw.source, np.arange(len(m) + 2))
-    trk = Javelin(P[0], CFG.with_(doppler_clutter_margin=1.0))
+    trk = Javelin(P[0], CFG.with_prefilter(DopplerClutter(1.0)))
     trk.step(eps[0], spd[0], hdg[0], 0.0)
     with pytest.warns(JavelinWarning, match="Algorithm 1"):
         r = trk.step(raw, spd[0], hdg[0], 0.1)

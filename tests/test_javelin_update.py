@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from filterpy.kalman import KalmanFilter
 
-from tunnelkit.tracking.javelin import JavelinConfig, PathMeasurements, track_model
+from tunnelkit.tracking.javelin import FixedNoise, JavelinConfig, PathMeasurements, track_model
 from tunnelkit.tracking.javelin.update import StackedMeasurement, joseph_update, stack_measurement
 
 
@@ -34,8 +34,9 @@ def test_stack_uses_los_as_tdoa_reference_and_correlated_blocks():
     meas = PathMeasurements.from_arrays(
         pred[:, 0], pred[:, 1], kappa=[pred[0, 2], np.nan, pred[2, 2]], d=pred[:, 3] + bias
     )
-    cfg = JavelinConfig(correlated_delta_d=True)
-    m = stack_measurement(pred, J, meas, [(0, 0), (1, 1), (2, 2)], cfg, los_path=0)
+    cfg = JavelinConfig()
+    corr = FixedNoise(correlated_delta_d=True)
+    m = stack_measurement(pred, J, meas, [(0, 0), (1, 1), (2, 2)], cfg, los_path=0, noise=corr)
     assert m.reference == (0, 0)
     assert [lab[0] for lab in m.labels].count("kappa") == 2
     dd = [k for k, lab in enumerate(m.labels) if lab[0] == "delta_d"]

@@ -131,7 +131,7 @@ def test_findings_of_the_issue_raise_naming_the_parameter():
     from tunnelkit import crlb, drive, metrics, positioning, propagation
     from tunnelkit.channel import SRSConfig
     from tunnelkit.tracking import pcrlb, upf
-    from tunnelkit.tracking.javelin.gate import mahalanobis2
+    from tunnelkit.tracking.gating import mahalanobis2
 
     rng = np.random.default_rng(0)
     cases = [

@@ -28,7 +28,7 @@ from tunnelkit import (
     propagation,
 )
 from tunnelkit.tracking import pcrlb, upf
-from tunnelkit.tracking.javelin.gate import mahalanobis2
+from tunnelkit.tracking.gating import mahalanobis2
 
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 coord = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)

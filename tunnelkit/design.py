@@ -53,6 +53,7 @@ import numpy as np
 from ._validate import finite_array, integer, positive, probability
 from .arrays import ArrayGeometry, rotation, ura
 from .constants import C, wavelength
+from .studies.scoring import SETTLE_S
 
 __all__ = [
     "ArraySpec",
@@ -75,7 +76,7 @@ __all__ = [
 KINDS = ("los", "wall", "ceiling", "road", "rrm")
 
 #: V2X speed [m/s] and heading [rad] message noise of the Monte-Carlo drives (section 4.2)
-SIGMA_SPEED, SIGMA_HEADING = 0.2, float(np.radians(1.0))
+
 _CLOCK = ("unknown", "known")
 
 
@@ -997,122 +998,17 @@ def design_sweep(
 
 
 def javelin_config(crlb: dict, min_d: float = 0.0):
-    """JAVELIN (our design, curvature centred on the VUE) for a design sweep at any carrier and
-    array size: every path's measurement covariance is the one the extraction reports (the CRLB
-    at its estimate, which the ML route attains: ``measurement_noise="reported"``), so no
-    5.9 GHz constant enters; pairs are ranked by ``eta^2 + ln det S``
-    (``association_cost="likelihood"``), so a new, wide track cannot take a path an established
-    track predicts to a millimetre; and a VUE is born with the covariance of the angles that
-    placed it (``birth_covariance="measured"``), not 10 m, so two new tracks a few degrees apart
-    cannot swap their paths in the next epoch; and pairs whose stacked innovation is
-    inconsistent are left out of the update (``update_gate=0.999``), which catches a wrong LoS
-    taken by eq. 61 after the per-pair gate missed the true one. ``min_d``: Algorithm 1's delay
-    check (``-c b_max`` keeps the paths a negative clock bias pushed below zero). The fixed sigmas, used only in an epoch whose Fisher information is
-    singular at the estimate, are ``crlb`` (``d`` [m], ``direction`` [rad], ``kappa`` [m]; e.g.
-    an upper percentile of the route's per-path bounds); ``sigma_delta_d`` is ``sqrt(2)`` times
-    the delay-distance sigma (a difference of two delays).
-    """
-    from .tracking.javelin.experiment import OURS
+    """The design's JAVELIN (:func:`tunnelkit.tracking.javelin.designs.array_design`)."""
+    from .tracking.javelin.designs import array_design
 
-    def pick(k):
-        v = crlb.get(k)
-        if v is None or not np.isfinite(v) or v <= 0:
-            raise ValueError(f"crlb: {k!r} must be finite and > 0, got {v!r}")
-        return float(v)
-
-    ang, kap, d = pick("direction"), pick("kappa"), pick("d")
-    return OURS.with_(
-        kappa_model="vue",
-        measurement_noise="reported",
-        association_cost="likelihood",
-        birth_covariance="measured",
-        update_gate=0.999,
-        min_d=float(min_d),
-        sigma_phi=ang,
-        sigma_psi=ang,
-        sigma_kappa=kap,
-        sigma_delta_d=float(np.sqrt(2.0) * d),
-    )
-
-
-def _drive(route, rng: np.random.Generator, n_epochs: int | None):
-    """One LoS drive through the design's signal route (:meth:`DesignSetup.signal_route`)."""
-    import warnings
-
-    from .tracking.javelin.experiment import CONDITIONS, DriveData
-    from .tracking.javelin.measurement import PathMeasurements
-
-    traj = route.trajectory
-    T = len(traj) if n_epochs is None else min(int(n_epochs), len(traj))
-    epochs, faults = [], []
-    n_true = np.zeros(T, int)
-    bs = route.arrays[0].origin.copy()
-    for k in range(T):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ep = route.epoch(k, rng)
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                faults.append(f"epoch {k}: extraction failed ({exc})")
-                epochs.append(None)
-                continue
-        m = ep.measurements
-        bs = m.origin.copy()
-        n_true[k] = len(ep.paths)
-        if m.cov is None and len(m):
-            # the fit failed its residual test (or its Fisher information is singular): no
-            # covariance to trust, so no measurement this epoch
-            faults.append(f"epoch {k}: extraction failed its residual test")
-            epochs.append(None)
-            continue
-        epochs.append(
-            PathMeasurements.from_arrays(
-                m.phi,
-                m.psi,
-                m.kappa,
-                m.d,
-                m.v,
-                warn=False,
-                cov=m.cov,
-                sigma_d=m.sigma_d,
-                min_d=route.min_d,
-            )
-        )
-    vel = traj.velocity[:T]
-    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
-    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
-    drive = DriveData(
-        "design",
-        CONDITIONS["L"],
-        traj.t[:T].copy(),
-        traj.position[:T].copy(),
-        vel.copy(),
-        speed,
-        heading,
-        epochs,
-        n_true > 0,
-        n_true,
-        bs,
-        faults=faults,
-    )
-    return drive
-
-
-#: the first second of a drive is the tracker's start-up (an open-sky fix with 1 m of
-#: uncertainty, the VUE tracks born over the first epochs): the settled RMSE leaves it out
-SETTLE_S = 1.0
-
-
-def _settled(t: np.ndarray) -> np.ndarray:
-    """Indices of the epochs at least :data:`SETTLE_S` after the start."""
-    return np.flatnonzero(t - t[0] >= SETTLE_S - 1e-9)
+    return array_design(crlb, min_d)
 
 
 @dataclass(frozen=True)
 class _JavelinTrial:
-    """One Monte-Carlo run (picklable for Dask workers): a drive, JAVELIN, its 2-D RMSE over the
-    whole drive, and the RMSE and median of the 2-D error over the settled epochs (NaN when the
-    drive is shorter than the start-up)."""
+    """One Monte-Carlo run (picklable for Dask workers): a drive (no visibility draw, the route's
+    own extraction), JAVELIN, its 2-D RMSE over the whole drive, and the RMSE and median of the
+    2-D error over the settled epochs (NaN when the drive is shorter than the start-up)."""
 
     setup: DesignSetup
     spec: ArraySpec
@@ -1120,14 +1016,13 @@ class _JavelinTrial:
     n_epochs: int | None
 
     def __call__(self, rng: np.random.Generator) -> tuple[float, float, float]:
-        from .tracking.javelin.experiment import evaluate
+        from .studies import evaluate, settled_errors, simulate_drive
 
-        drive = _drive(self.setup.signal_route(self.spec), rng, self.n_epochs)
-        ev = evaluate(drive, self.config)
-        idx = _settled(drive.t)
-        e = np.linalg.norm(ev.estimates[idx, :2] - drive.truth[idx, :2], axis=1)
-        rmse, med = (np.sqrt(np.mean(e**2)), np.median(e)) if idx.size else (np.nan, np.nan)
-        return float(ev.metrics["rmse_2d_m"]), float(rmse), float(med)
+        route = self.setup.signal_route(self.spec)
+        drive = simulate_drive(
+            route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
+        )
+        return settled_errors(evaluate(drive, self.config), drive)
 
 
 def _t_interval(x: np.ndarray) -> tuple[float, list[float]]:
@@ -1199,13 +1094,15 @@ def javelin_rmse(
         "median_settled_m": None,
         "runs_settled": res[:, 1],
         "sigmas": {
-            "direction_rad": cfg.sigma_phi,
-            "kappa_m": cfg.sigma_kappa,
-            "delta_d_m": cfg.sigma_delta_d,
+            "direction_rad": cfg.config.sigma_phi,
+            "kappa_m": cfg.config.sigma_kappa,
+            "delta_d_m": cfg.config.sigma_delta_d,
         },
     }
+    from .studies import settled
+
     T = len(setup.trajectory) if n_epochs is None else min(int(n_epochs), len(setup.trajectory))
-    idx = _settled(setup.trajectory.t[:T])
+    idx = settled(setup.trajectory.t[:T])
     if idx.size:
         out["rmse_settled_m"], out["settled_ci95_m"] = _t_interval(res[:, 1])
         out["median_settled_m"] = float(np.median(res[:, 2]))

@@ -29,6 +29,7 @@ import numpy as np
 from IPython.display import display
 
 import tunnelkit as tk
+from tunnelkit import studies as ex
 from tunnelkit.crlb import numeric_jacobian
 from tunnelkit.evaluation import match_paths
 from tunnelkit.extraction.coherent import resolve_coherent
@@ -39,10 +40,9 @@ from tunnelkit.plots import (
     tracks_count_figure,
     trajectories_figure,
 )
-from tunnelkit.reproduce.javelin_tables import collect_routes
 from tunnelkit.signal_route import SignalRoute, measurements_from_estimates
-from tunnelkit.tracking.javelin import experiment as ex
-from tunnelkit.tracking.javelin import measurement_model
+from tunnelkit.studies import collect_routes
+from tunnelkit.tracking.javelin import designs, measurement_model
 from tunnelkit.widgets import epoch_explorer
 
 tk.setup_notebook()
@@ -194,24 +194,24 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 # of magnitude. The curvature the ML route measures for a reflection is the distance to its
 # **VUE** (the exact wavefront's radius), not eq. 51's distance to the reflection point (the SR-NF
 # model) — for the ceiling bounce tens of metres against half a metre. The paper's design as
-# printed uses eq. 51; we run it both ways (`ex.PAPER` and `ex.PAPER_VUE`, which changes only
+# printed uses eq. 51; we run it both ways (`designs.paper()` and `designs.paper_vue()`, which changes only
 # that).
 #
 # A tracker's measurement noise $\mathbf R$ should say what the extraction delivers:
-# `ex.design_from_errors` turns the pooled row "all" into the four sigmas. Our design on this
-# route, `ex.OURS_ML` (notebook 04b), holds the row measured on these same drives when it was
-# designed (`ex.ML_ERRORS_SEED0`), when the ML route still swapped or merged paths in a few
+# `designs.design_from_errors` turns the pooled row "all" into the four sigmas. Our design on this
+# route, `designs.ours_ml()` (notebook 04b), holds the row measured on these same drives when it was
+# designed (`designs.ML_ERRORS_SEED0`), when the ML route still swapped or merged paths in a few
 # slalom epochs; the extraction has improved since (notebook 03). Beside the paper's values:
 
 # %%
-measured = ex.design_from_errors(erows)
-for name, cfg in (("the paper (section 4.2)", ex.PAPER), ("measured here", measured)):
+measured = designs.design_from_errors(erows)
+for name, cfg in (("the paper (section 4.2)", designs.paper()), ("measured here", measured)):
     print(
-        f"{name:24s} sigma_phi {np.degrees(cfg.sigma_phi):6.3f} deg  sigma_psi "
-        f"{np.degrees(cfg.sigma_psi):6.3f} deg  sigma_kappa {cfg.sigma_kappa:6.2f} m  "
-        f"sigma_dd {cfg.sigma_delta_d:6.4f} m"
+        f"{name:24s} sigma_phi {np.degrees(cfg.config.sigma_phi):6.3f} deg  sigma_psi "
+        f"{np.degrees(cfg.config.sigma_psi):6.3f} deg  sigma_kappa {cfg.config.sigma_kappa:6.2f} m  "
+        f"sigma_dd {cfg.config.sigma_delta_d:6.4f} m"
     )
-print("ex.ML_ERRORS_SEED0 (what OURS_ML uses):", ex.ML_ERRORS_SEED0)
+print("designs.ML_ERRORS_SEED0 (what OURS_ML uses):", designs.ML_ERRORS_SEED0)
 
 # %% [markdown]
 # ## 4. Prediction (eq. 62–63)
@@ -249,8 +249,8 @@ for mode, e in vue_err.items():
 # %% tags=["explorer-setup"]
 gate = tk.tracking.javelin.ChiSquareGate(0.99)
 print(f"chi2_3(0.99) = {gate.threshold(3):.3f}, chi2_2(0.99) = {gate.threshold(2):.3f}")
-ev_paper = ex.evaluate(drive, ex.PAPER, keep_reports=True)
-ev_ml = ex.evaluate(drive_ml, ex.PAPER_VUE, keep_reports=True)
+ev_paper = ex.evaluate(drive, designs.paper(), keep_reports=True)
+ev_ml = ex.evaluate(drive_ml, designs.paper_vue(), keep_reports=True)
 rep = ev_ml.run.reports[k]
 print(f"epoch {k}: eta^2 (rows: tracks UE, VUE {rep.prior_ids}; columns: paths)")
 print(np.round(rep.costs.eta2, 1))
@@ -340,7 +340,7 @@ fig6a.update_xaxes(range=[0, 50])
 fig6b = trajectories_figure(
     sl_ml.truth,
     {
-        "JAVELIN (paper design, ML route)": ex.evaluate(sl_ml, ex.PAPER_VUE).estimates,
+        "JAVELIN (paper design, ML route)": ex.evaluate(sl_ml, designs.paper_vue()).estimates,
         "TeNFiLoc (ML route)": ex.tenfiloc_track(sl_ml)[0],
     },
     base_station=sl_ml.base_station,
@@ -359,8 +359,10 @@ fig6b.update_xaxes(range=[0, 50])
 
 
 # %%
-def errors(drives, cfg=ex.PAPER_VUE, method="JAVELIN"):
-    """2-D position errors of every epoch of ``drives``, pooled."""
+def errors(drives, cfg=None, method="JAVELIN"):
+    """2-D position errors of every epoch of ``drives``, pooled (``cfg``: the paper's design
+    with the VUE curvature unless given)."""
+    cfg = designs.paper_vue() if cfg is None else cfg
     return np.concatenate(
         [
             position_errors(ex.evaluate(d, cfg, method=method).estimates[:, :2], d.truth[:, :2])
@@ -386,11 +388,11 @@ fig7.update_xaxes(type="log", range=[-2, 2])
 #
 # ## Exercises
 #
-# 1. Rerun section 5 on the paper's route with `ex.PAPER.with_(sigma_kappa=50.0)`. Does honest
+# 1. Rerun section 5 on the paper's route with `designs.paper().with_(sigma_kappa=50.0)`. Does honest
 #    curvature noise alone rescue the paper's design there? What else is needed?
-# 2. Set `max_misses=3` in our design for the paper's route (`ex.OURS`). Do tracks live longer?
+# 2. Set `max_misses=3` in our design for the paper's route (`designs.ours()`). Do tracks live longer?
 #    Does the RMSE change?
-# 3. Run `ex.PAPER` (eq. 51) and `ex.PAPER_VUE` on `drive_ml` and on `drive`. Why does the VUE
+# 3. Run `designs.paper()` (eq. 51) and `designs.paper_vue()` on `drive_ml` and on `drive`. Why does the VUE
 #    curvature fit an exact (non-SR-NF) channel better, and why does it matter on one route only?
 # 4. Take one epoch through the paper's route, `ep = SignalRoute.from_scenario(
 #    "italiano2026-straight").epoch(5, np.random.default_rng(1), refine="joint")`, and run
@@ -405,10 +407,10 @@ fig7.update_xaxes(type="log", range=[-2, 2])
 # %% jupyter={"source_hidden": true}
 # Solution 1: the paper's design on the paper's route, one change, then a second
 steps = {
-    "paper (section 4.2)": ex.PAPER,
-    "sigma_kappa = 50 m": ex.PAPER.with_(sigma_kappa=50.0),
-    "sigma_kappa = 50 m + Doppler test": ex.PAPER.with_(
-        sigma_kappa=50.0, doppler_clutter_margin=1.0
+    "paper (section 4.2)": designs.paper(),
+    "sigma_kappa = 50 m": designs.paper().with_(sigma_kappa=50.0),
+    "sigma_kappa = 50 m + Doppler test": designs.paper(sigma_kappa=50.0).with_prefilter(
+        tk.tracking.javelin.DopplerClutter(1.0)
     ),
 }
 for name, cfg in steps.items():
@@ -416,8 +418,8 @@ for name, cfg in steps.items():
 
 # %% jupyter={"source_hidden": true}
 # Solution 2: tracks that survive up to three missed epochs
-for zeta in (ex.OURS.max_misses, 3):
-    ev_z = ex.evaluate(drive, ex.OURS.with_(max_misses=zeta), keep_reports=True)
+for zeta in (designs.ours().config.max_misses, 3):
+    ev_z = ex.evaluate(drive, designs.ours().with_(max_misses=zeta), keep_reports=True)
     reps = [r for r in ev_z.run.reports if r.manage]
     births = sum(len(r.manage.born) for r in reps)
     print(
@@ -428,7 +430,9 @@ for zeta in (ex.OURS.max_misses, 3):
 # %% jupyter={"source_hidden": true}
 # Solution 3: the curvature model on both routes
 for route_name, d in (("ML route", drive_ml), ("paper route", drive)):
-    rmse_51, rmse_vue = (ex.evaluate(d, c).metrics["rmse_2d_m"] for c in (ex.PAPER, ex.PAPER_VUE))
+    rmse_51, rmse_vue = (
+        ex.evaluate(d, c).metrics["rmse_2d_m"] for c in (designs.paper(), designs.paper_vue())
+    )
     print(f"{route_name:11s} eq. 51: {rmse_51:6.2f} m   VUE curvature: {rmse_vue:6.2f} m")
 
 # %% jupyter={"source_hidden": true}

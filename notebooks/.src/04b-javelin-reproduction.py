@@ -22,10 +22,12 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import tunnelkit as tk
+from tunnelkit import studies as ex
 from tunnelkit.metrics import position_errors
 from tunnelkit.plots import cdf_figure, javelin_table_figure
-from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows
-from tunnelkit.tracking.javelin import experiment as ex
+from tunnelkit.reproduce.javelin_tables import table_rows
+from tunnelkit.studies import collect_routes
+from tunnelkit.tracking.javelin import designs
 
 tk.setup_notebook()
 
@@ -99,8 +101,10 @@ javelin_table_figure(cols2, rows2, title=f"Table 2 (slalom), {runs} run(s) per c
 
 
 # %%
-def errors(drives, cfg=ex.PAPER_VUE, method="JAVELIN"):
-    """2-D position errors of every epoch of ``drives``, pooled."""
+def errors(drives, cfg=None, method="JAVELIN"):
+    """2-D position errors of every epoch of ``drives``, pooled (``cfg``: the paper's design
+    with the VUE curvature unless given)."""
+    cfg = designs.paper_vue() if cfg is None else cfg
     return np.concatenate(
         [
             position_errors(ex.evaluate(d, cfg, method=method).estimates[:, :2], d.truth[:, :2])
@@ -161,7 +165,7 @@ for cond in ("N", "NoRRMs"):
 # paper's extraction, on other seeds (seed 7) than these. The last rows change the measurement
 # route: the paper's design on the ML route (eq. 51 as printed, then the curvature centred on the
 # VUE, the radius of the exact wavefront that the ML route measures), and our design on it
-# (`ex.OURS_ML`: (1)–(5), the VUE curvature, and the measurement noise set to the measured
+# (`designs.ours_ml()`: (1)–(5), the VUE curvature, and the measurement noise set to the measured
 # extraction error). Mean 2-D RMSE [m]:
 
 # %%
@@ -176,14 +180,14 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 # centimetres of our design: with measurements at their bound, the design matters far less than
 # what the tracker is fed.
 #
-# `ex.OURS_ML` sets its four measurement sigmas to the pooled RMS extraction error of the ML
+# `designs.ours_ml()` sets its four measurement sigmas to the pooled RMS extraction error of the ML
 # route on the first three seed-0 LoS drives of each trajectory, as measured when the design was
-# made (`ex.ML_ERRORS_SEED0`; notebook 04, section 3 measures the same drives with today's
+# made (`designs.ML_ERRORS_SEED0`; notebook 04, section 3 measures the same drives with today's
 # extraction). The same table over all the LoS drives here, and what `OURS_ML` assumes:
 
 # %%
 ecols, erows = ex.extraction_errors(straight_ml["L"] + slalom_ml["L"])
-display_rows = [*erows, ["OURS_ML assumes", None, *ex.ML_ERRORS_SEED0.values(), None]]
+display_rows = [*erows, ["OURS_ML assumes", None, *designs.ML_ERRORS_SEED0.values(), None]]
 javelin_table_figure(
     ecols, display_rows, title=f"ML route: RMS measurement error, {runs} run(s)", digits=4
 )
@@ -208,7 +212,7 @@ javelin_table_figure(
 #   10 m, decimetres at 45 m). Eq. 51 ties $\kappa$ to the reflection point (SR-NF), while our
 #   channel is exact: the wavefront is centred on the VUE (notebooks 02/03 show when the two
 #   agree). With accurate curvatures this matters: the paper's design as printed (eq. 51) fails
-#   on the ML route, the same design with the VUE curvature (`ex.PAPER_VUE`) tracks to about a
+#   on the ML route, the same design with the VUE curvature (`designs.paper_vue()`) tracks to about a
 #   decimetre on the straight drive.
 # - **Clock bias.** We read "variance 50 ns" as a 50 ns standard deviation (15 m); TDoAs cancel
 #   it, but the LoS test of eq. 61 and TeNFiLoc's $\hat d$ fallback suffer.
@@ -246,12 +250,12 @@ javelin_table_figure(
 #
 # 1. Run the ablation of section 5 on the slalom drives (`ex.ablation(slalom, ml=slalom_ml)`).
 #    Does every step of our design help there too?
-# 2. `ex.OURS_ML` took its measurement noise from three LoS drives per trajectory. Set it from
-#    all the LoS drives of section 1 instead (`ex.design_from_errors` on the table of section 5)
+# 2. `designs.ours_ml()` took its measurement noise from three LoS drives per trajectory. Set it from
+#    all the LoS drives of section 1 instead (`designs.design_from_errors` on the table of section 5)
 #    and score JAVELIN-L on both trajectories with both designs. Does more calibration data
 #    change the result?
 # 3. Why do the road markings not help in our tunnel? For JAVELIN-N and JAVELIN-NoRRMs on the ML
-#    route (`ex.PAPER_VUE`), count per drive the births (`keep_reports=True`, then
+#    route (`designs.paper_vue()`), count per drive the births (`keep_reports=True`, then
 #    `r.manage.born` of each report) and the share of epochs that deliver an RRM path
 #    (`d.kinds[k][t]` of each matched path `t` in `d.truth_index[k]`).
 #
@@ -264,11 +268,11 @@ javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D
 
 # %% jupyter={"source_hidden": true}
 # Solution 2
-refit = ex.design_from_errors(erows)
+refit = designs.design_from_errors(erows)
 for name, by_cond in (("straight", straight_ml), ("slalom", slalom_ml)):
     scores = {
         label: np.mean([ex.evaluate(d, cfg).metrics["rmse_2d_m"] for d in by_cond["L"]])
-        for label, cfg in (("OURS_ML (3 drives)", ex.OURS_ML), ("refit (all drives)", refit))
+        for label, cfg in (("OURS_ML (3 drives)", designs.ours_ml()), ("refit (all drives)", refit))
     }
     print(name, {k: round(float(v), 3) for k, v in scores.items()})
 
@@ -282,7 +286,7 @@ def rrm_share_and_births(d):
         for k, m in enumerate(d.epochs)
         if m is not None
     ]
-    run = ex.evaluate(d, ex.PAPER_VUE, keep_reports=True).run
+    run = ex.evaluate(d, designs.paper_vue(), keep_reports=True).run
     return np.mean(rrm), sum(len(r.manage.born) for r in run.reports if r.manage)
 
 

@@ -2,12 +2,12 @@
 
 Every run simulates a drive through the signal route (image method -> SRS tensor with noise and
 clock bias) once per condition and measures each epoch's tensor through several extraction
-routes (:data:`tunnelkit.tracking.javelin.experiment.EXTRACTIONS`): the paper's (CPD, eq. 11-24)
+routes (:data:`tunnelkit.studies.EXTRACTIONS`): the paper's (CPD, eq. 11-24)
 and the joint maximum-likelihood fit of eq. 1 (``ml``); the tensors are identical, only the
 extraction differs. The table has five columns per configuration and metric: the paper's design
 (section 4.2) on the paper's route, the paper's design on the ML route, the same with the
-curvature of a reflection centred on its VUE (``PAPER_VUE``), our design on the ML route
-(:data:`~tunnelkit.tracking.javelin.experiment.OURS_ML`, its noise set from the measured
+curvature of a reflection centred on its VUE (:func:`~tunnelkit.tracking.javelin.designs.paper_vue`), our design on the ML route
+(:func:`~tunnelkit.tracking.javelin.designs.ours_ml`, its noise set from the measured
 extraction error), and the paper's published number.
 """
 
@@ -17,8 +17,10 @@ import functools
 
 import numpy as np
 
-from ..montecarlo import run_trials
 from ..reference import load as load_reference
+from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
+from ..studies.scoring import evaluate
+from ..tracking.javelin import designs
 from . import Report, register
 
 __all__ = [
@@ -46,93 +48,12 @@ COHERENT_COLUMN = ("our design, coherent route", "coherent", "ours-coherent")
 
 
 def _designs() -> dict:
-    from ..tracking.javelin import experiment as ex
-
     return {
-        "paper": ex.PAPER,
-        "paper-vue": ex.PAPER_VUE,
-        "ours": ex.OURS_ML,
-        "ours-coherent": ex.OURS_COHERENT,
+        "paper": designs.paper(),
+        "paper-vue": designs.paper_vue(),
+        "ours": designs.ours_ml(),
+        "ours-coherent": designs.ours_coherent(),
     }
-
-
-def _simulate(scenario: str, n_epochs: int | None, extractions: tuple[str, ...], cond: str, rng):
-    """One drive of ``cond`` through the signal route, measured through every extraction."""
-    from ..tracking.javelin import experiment as ex
-
-    return ex.simulate_routes(scenario, cond, rng, n_epochs=n_epochs, extractions=extractions)
-
-
-def _per_drive(scenario, conditions, runs, seed, progress, extractions, make_trial, **parallel):
-    """One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive: drive ``i`` (run
-    ``i // n``, condition ``i % n``) draws from the ``i``-th child of ``seed``. ``make_trial``
-    gets the route names (``extractions``, normalised) and returns the trial ``(cond, rng)``.
-    Returns the route names and ``[(condition, result), ...]`` in drive order."""
-    from ..tracking.javelin import experiment as ex
-
-    extractions = tuple(dict.fromkeys(ex.route_name(e) for e in extractions))
-    jobs = [c for _ in range(runs) for c in tuple(conditions)]
-    results = run_trials(
-        make_trial(extractions),
-        len(jobs),
-        seed,
-        inputs=jobs,
-        progress=progress,
-        desc=f"{scenario} drives",
-        **parallel,
-    )
-    return extractions, list(zip(jobs, results))
-
-
-def collect_routes(
-    scenario: str,
-    conditions: tuple[str, ...],
-    runs: int,
-    seed: int,
-    progress: bool = False,
-    n_epochs: int | None = None,
-    extractions: tuple[str, ...] = ("paper", "ml"),
-    **parallel,
-) -> dict[str, dict[str, list]]:
-    """``runs`` seeded drives per condition through the signal route (the expensive part), each
-    measured through every route in ``extractions`` from the same tensors
-    (:func:`~tunnelkit.tracking.javelin.experiment.simulate_routes`). One trial of
-    :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its ``workers`` /
-    ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
-    the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode). Returns
-    ``{extraction: {condition: [DriveData, ...]}}``."""
-    extractions, done = _per_drive(
-        scenario,
-        conditions,
-        runs,
-        seed,
-        progress,
-        extractions,
-        lambda e: functools.partial(_simulate, scenario, n_epochs, e),
-        **parallel,
-    )
-    out: dict[str, dict[str, list]] = {e: {c: [] for c in conditions} for e in extractions}
-    for cond, routes in done:
-        for e, drive in routes.items():
-            out[e][cond].append(drive)
-    return out
-
-
-def collect_drives(
-    scenario: str,
-    conditions: tuple[str, ...],
-    runs: int,
-    seed: int,
-    progress: bool = False,
-    n_epochs: int | None = None,
-    extraction: str = "paper",
-    **parallel,
-) -> dict[str, list]:
-    """:func:`collect_routes` through one route: ``{condition: [DriveData, ...]}``."""
-    from ..tracking.javelin import experiment as ex
-
-    e = ex.route_name(extraction)
-    return collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (e,), **parallel)[e]
 
 
 def table_columns(
@@ -157,9 +78,7 @@ def score_drive(
     scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
     column's design; TeNFiLoc (no design of its own) on LoS drives, in the paper design's
     columns. Each (route, method, design) is evaluated once. Draws no random numbers."""
-    from ..tracking.javelin import experiment as ex
-
-    designs = _designs()
+    table_designs = _designs()
     cache: dict[tuple[str, str, str], dict[str, float]] = {}
     out = {}
     for label, route, design in columns:
@@ -169,8 +88,9 @@ def score_drive(
         for name, method, dname in entries:
             key = (route, method, dname)
             if key not in cache:
-                cfg = designs.get(dname)
-                cache[key] = ex.evaluate(drives[route], cfg, method=method).metrics
+                cache[key] = evaluate(
+                    drives[route], table_designs.get(dname), method=method
+                ).metrics
             out[(name, label)] = cache[key]
     return out
 
@@ -249,10 +169,10 @@ NOTES = [
 
 
 def _simulate_and_score(scenario, n_epochs, extractions, columns, cond, rng):
-    """One trial of :func:`javelin_table`: a drive (:func:`_simulate`) scored in every column on
+    """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.studies.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count."""
-    drives = _simulate(scenario, n_epochs, extractions, cond, rng)
+    drives = simulate_condition(scenario, n_epochs, extractions, cond, rng)
     faults = {e: len(d.faults) for e, d in drives.items()}
     return score_drive(drives, cond, columns), faults
 
@@ -274,7 +194,7 @@ def javelin_table(
     it where it ran, so scoring runs in parallel too; the drives are the same as
     :func:`collect_routes`' (drive ``i`` draws from the ``i``-th child of ``seed``) and the table
     equals :func:`table_rows` on them."""
-    extractions, done = _per_drive(
+    extractions, done = per_drive(
         scenario,
         conditions,
         runs,

@@ -22,15 +22,23 @@ predict-only epoch; a burst of more than ``reopen_after`` outliers gets through 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 from scipy.stats import chi2
 
-from .._validate import integer
+from .._validate import finite_array, integer
 from .._validate import probability as _probability
 
-__all__ = ["DEFAULT_GATE", "DEFAULT_REOPEN_AFTER", "InnovationGate", "gated_filterpy_update"]
+__all__ = [
+    "DEFAULT_GATE",
+    "DEFAULT_REOPEN_AFTER",
+    "ChiSquareGate",
+    "InnovationGate",
+    "gated_filterpy_update",
+    "mahalanobis2",
+]
 
 #: default gate probability of every tracker (chi-square quantile of the innovation)
 DEFAULT_GATE = 0.999
@@ -45,8 +53,57 @@ def _quantile(p: float, dof: int) -> float:
     return float(chi2.ppf(p, dof))
 
 
+def mahalanobis2(y, S) -> np.ndarray:
+    """``d2 = y^T S^-1 y`` (Italiano eq. 58), vectorised over leading axes of ``y`` (..., n) and
+    ``S`` (..., n, n); ``S`` must be symmetric positive definite (an innovation covariance)."""
+    y = finite_array("y", y)
+    if y.ndim == 0:
+        raise ValueError("y: expected residual vector(s) (..., n), got a scalar")
+    S = finite_array("S", S)
+    if S.shape[-2:] != (y.shape[-1], y.shape[-1]):
+        raise ValueError(f"S: expected (..., {y.shape[-1]}, {y.shape[-1]}), got {S.shape}")
+    if abs(S - np.swapaxes(S, -1, -2)).max() > 1e-9 * abs(S).max():
+        raise ValueError("S: must be symmetric positive definite (it is not symmetric)")
+    try:
+        np.linalg.cholesky(S)
+    except np.linalg.LinAlgError:
+        raise ValueError(
+            "S: must be symmetric positive definite (an innovation covariance)"
+        ) from None
+    sol = np.linalg.solve(S, y[..., None])[..., 0]
+    return np.sum(y * sol, axis=-1)
+
+
+@dataclass(frozen=True)
+class ChiSquareGate:
+    """The chi-square test every tracker uses: accept when ``d2 < chi2_dof(p)``.
+
+    One default, :data:`DEFAULT_GATE` (0.999). JAVELIN's association gate (Italiano eq. 59) is
+    this test at the paper's ``p = 0.99`` (``JavelinConfig.gate_probability``), with ``dof`` the
+    components a path carries (3 for ``(phi, psi, kappa)``, 2 without curvature).
+    :class:`InnovationGate` is the same test with the reopening policy of the filters.
+    """
+
+    probability: float = DEFAULT_GATE
+
+    def __post_init__(self) -> None:
+        _probability("probability", self.probability)
+
+    def threshold(self, dof: int = 3) -> float:
+        """The chi-square quantile ``chi2_dof(p)`` (11.34 for 3 dof at p = 0.99)."""
+        return _quantile(float(self.probability), integer("dof", int(dof), minimum=1))
+
+    def accepts(self, d2, dof) -> np.ndarray:
+        """Elementwise ``d2 < chi2_dof(p)``; ``dof`` broadcasts against ``d2``."""
+        d2 = np.asarray(d2, dtype=float)
+        dof = np.broadcast_to(np.asarray(dof, dtype=int), d2.shape)
+        thr = np.vectorize(self.threshold, otypes=[float])(dof) if dof.size else np.zeros(dof.shape)
+        return np.isfinite(d2) & (d2 < thr)
+
+
 class InnovationGate:
-    """Chi-square gate on ``d2 = y^T S^-1 y`` with reopening; ``probability=None`` switches it off.
+    """:class:`ChiSquareGate` on ``d2 = y^T S^-1 y`` with reopening, for the filters;
+    ``probability=None`` switches it off.
 
     ``batch`` (None for one filter) keeps one set of counters per independent run (the batched
     UPF). ``n_rejected`` and ``n_reopened`` are ints, or arrays of shape (batch,).
@@ -61,6 +118,7 @@ class InnovationGate:
         name: str = "gate",
     ) -> None:
         self.probability = None if probability is None else _probability(name, probability)
+        self.test = None if probability is None else ChiSquareGate(self.probability)
         self.reopen_after = integer("reopen_after", reopen_after, minimum=1)
         shape = () if batch is None else (integer("batch", batch, minimum=1),)
         self._rejected = np.zeros(shape, dtype=int)
@@ -83,9 +141,9 @@ class InnovationGate:
 
     def threshold(self, dof: int) -> float:
         """``chi2_dof(p)``: 10.83 for one degree of freedom at p = 0.999, 18.47 for four."""
-        if self.probability is None:
+        if self.test is None:
             return np.inf
-        return _quantile(self.probability, integer("dof", int(dof), minimum=1))
+        return self.test.threshold(dof)
 
     def judge(self, d2, dof: int, rows=None) -> np.ndarray:
         """Verdict per measurement (``ACCEPT``, ``REJECT`` or ``REOPEN``) and update the counters.

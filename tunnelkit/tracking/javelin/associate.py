@@ -10,18 +10,19 @@ the sum of distances over all one-to-one assignments (scipy's ``linear_sum_assig
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from ...crlb import wrap_angle
-from .gate import ChiSquareGate, mahalanobis2
+from ..gating import ChiSquareGate, mahalanobis2
 from .measurement import PathMeasurements
 
 __all__ = [
-    "ASSOCIATORS",
     "AssociationCosts",
+    "Associator",
     "association_costs",
     "global_nearest_neighbour",
     "greedy_nearest_neighbour",
@@ -126,4 +127,30 @@ def global_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
     return sorted((int(i), int(j)) for i, j in zip(rows, cols) if costs.gated[i, j])
 
 
-ASSOCIATORS = {"greedy": greedy_nearest_neighbour, "gnn": global_nearest_neighbour}
+_SOLVERS: dict[str, Callable[[AssociationCosts], list[tuple[int, int]]]] = {
+    "greedy": greedy_nearest_neighbour,
+    "gnn": global_nearest_neighbour,
+}
+
+
+@dataclass(frozen=True)
+class Associator:
+    """Gated costs (eq. 56-59) and a solver: ``cost`` ``"mahalanobis"`` (the paper's ``eta^2``)
+    or ``"likelihood"`` (``eta^2 + ln det S``, ours); ``solver`` ``"greedy"`` (Algorithm 2) or
+    ``"gnn"`` (global nearest neighbour, ours)."""
+
+    cost: str = "mahalanobis"
+    solver: str = "greedy"
+
+    def __post_init__(self) -> None:
+        if self.cost not in ("mahalanobis", "likelihood"):
+            raise ValueError(f"cost: expected 'mahalanobis' or 'likelihood', got {self.cost!r}")
+        if self.solver not in _SOLVERS:
+            raise ValueError(f"solver: expected one of {tuple(_SOLVERS)}, got {self.solver!r}")
+
+    def __call__(
+        self, pred, J, P, meas: PathMeasurements, R3, gate: ChiSquareGate
+    ) -> tuple[AssociationCosts, list[tuple[int, int]]]:
+        """The costs of every (track, path) pair and the chosen ``[(track, path), ...]``."""
+        costs = association_costs(pred, J, P, meas, R3, gate, self.cost)
+        return costs, _SOLVERS[self.solver](costs)

@@ -8,11 +8,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import JavelinConfig
-from .measurement import PathMeasurements, path_covariances
+from .measurement import PathMeasurements
+from .noise import FixedNoise
 from .state import JavelinState
 
 __all__ = [
+    "FixedBirth",
     "ManageResult",
+    "MeasuredBirth",
     "intersection",
     "los_test",
     "manage_tracks",
@@ -71,14 +74,17 @@ def intersection_jacobian(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)
     )
 
 
-def birth_covariance(state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig):
+def birth_covariance(
+    state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig, noise=None
+):
     """The covariance (2, 2) of a VUE born from path ``j`` and its cross-covariance (2, D) with
     the state, by linearising :func:`intersection` in the path's angles and the UE's ``x``
-    (ours; ``birth_covariance="measured"``): ``F_z R F_z^T + f P_xx f^T`` and ``f P_x,:``. ``R``
-    is the path's reported angle covariance under ``measurement_noise="reported"``, else
-    ``diag(sigma_phi^2, sigma_psi^2)``."""
+    (ours; the initiator ``MeasuredBirth``): ``F_z R F_z^T + f P_xx f^T`` and ``f P_x,:``. ``R``
+    is the path's angle covariance from the measurement-noise role ``noise`` (the reported one
+    under ``ReportedNoise``; default the paper's ``diag(sigma_phi^2, sigma_psi^2)``)."""
+    noise = FixedNoise() if noise is None else noise
     F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
-    R = path_covariances(meas, config)[j, :2, :2]
+    R = noise.covariances(meas, config)[j, :2, :2]
     f = F[:, 2:3]  # d(y, z) / d x_u
     cross = f @ state.P[0:1, :]
     cov = F[:, :2] @ R @ F[:, :2].T + f @ state.P[0:1, 0:1] @ f.T
@@ -99,6 +105,40 @@ def static_doppler(p_u, p_v, v_u, bs=(0.0, 0.0, 0.0), sign: float = -1.0) -> flo
     return float(sign * np.dot(q / np.linalg.norm(q), vv))
 
 
+@dataclass(frozen=True)
+class FixedBirth:
+    """A new VUE with covariance ``sigma_P^2 I`` (the paper, Algorithm 3); ``update_at_birth``:
+    the path that gave birth also updates the state in that epoch (the paper's Algorithm 4);
+    ``doppler_sign``: the measured radial speed is ``doppler_sign * d(range)/dt`` in the test
+    that tells static from dynamic reflectors (-1: the channel convention ``v = c f_d / f_c``
+    with ``f_d > 0`` when approaching)."""
+
+    update_at_birth: bool = True
+    doppler_sign: float = -1.0
+
+    def __post_init__(self) -> None:
+        if self.doppler_sign not in (-1.0, 1.0):
+            raise ValueError(f"doppler_sign: expected +1 or -1, got {self.doppler_sign!r}")
+        if not isinstance(self.update_at_birth, bool):
+            raise TypeError(
+                f"update_at_birth: expected True or False, got {self.update_at_birth!r}"
+            )
+
+    def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
+        """Covariance (2, 2) of the VUE born from path ``j`` and its cross-covariance (or None)."""
+        return np.eye(2) * config.sigma_p0**2, None
+
+
+@dataclass(frozen=True)
+class MeasuredBirth(FixedBirth):
+    """A new VUE with the covariance of the angles that placed it and of the UE's ``x``, carried
+    through the intersection of Algorithm 3 with the cross-covariance (ours:
+    :func:`~tunnelkit.tracking.javelin.manage.birth_covariance`)."""
+
+    def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
+        return birth_covariance(state, meas, j, config, noise)
+
+
 @dataclass
 class ManageResult:
     """What Algorithm 3 did: pairs to update with, LoS flag/path, born and dead track ids."""
@@ -113,7 +153,14 @@ class ManageResult:
 
 
 def manage_tracks(
-    state: JavelinState, meas: PathMeasurements, pairs, config: JavelinConfig, v_u=None
+    state: JavelinState,
+    meas: PathMeasurements,
+    pairs,
+    config: JavelinConfig,
+    v_u=None,
+    *,
+    initiator=None,
+    noise=None,
 ) -> ManageResult:
     """Algorithm 3 on ``state`` (modified in place, already predicted).
 
@@ -122,13 +169,16 @@ def manage_tracks(
     2. LoS (lines 13-23): the path associated with the UE, else eq. 60-61 among the paths no VUE
        claimed (ours: the paper searches all paths; a claimed path already has a track);
     3. births (lines 8-12): every other unassociated path starts a VUE at the intersection of its
-       arrival ray with ``x = x_u`` with covariance ``sigma_P^2 I`` (or, with
-       ``birth_covariance="measured"``, :func:`birth_covariance`); with a UE velocity ``v_u``
+       arrival ray with ``x = x_u`` with the covariance the ``initiator`` role gives
+       (``FixedBirth``: ``sigma_P^2 I``, the default; ``MeasuredBirth``: :func:`birth_covariance`
+       with the ``noise`` role's angle covariance); with a UE velocity ``v_u``
        and a Doppler ``v``, a path whose Doppler misses the static prediction by more than
-       ``doppler_tolerance`` is dynamic: its track is ``transient`` (dropped after this epoch).
+       ``doppler_tolerance`` is dynamic: its track is ``transient`` (dropped after this epoch);
+       the born path also updates the state this epoch when ``initiator.update_at_birth``.
 
     Returned ``pairs`` use the track indices after removals and births.
     """
+    initiator = FixedBirth() if initiator is None else initiator
     pairs = [(int(i), int(j)) for i, j in pairs]
     assoc_tracks = {i for i, _ in pairs}
     assoc_paths = {j for _, j in pairs}
@@ -171,16 +221,13 @@ def manage_tracks(
         transient = False
         if v_u is not None and np.isfinite(meas.v[j]):
             p_v = np.array([state.x[0], yz[0], yz[1]])
-            v_pred = static_doppler(state.ue, p_v, v_u, config.bs, config.doppler_sign)
+            v_pred = static_doppler(state.ue, p_v, v_u, config.bs, initiator.doppler_sign)
             transient = abs(meas.v[j] - v_pred) > config.doppler_tolerance
-        if config.birth_covariance == "measured":
-            cov, cross = birth_covariance(state, meas, j, config)
-            tid = state.append(yz, cov, transient=transient, cross=cross)
-        else:
-            tid = state.append(yz, np.eye(2) * config.sigma_p0**2, transient=transient)
+        cov, cross = initiator.covariance(state, meas, j, config, noise)
+        tid = state.append(yz, cov, transient=transient, cross=cross)
         born.append(tid)
         if transient:
             dynamic.append(tid)
-        if config.update_with_births:
+        if initiator.update_at_birth:
             pairs.append((state.n_vue, j))
     return ManageResult(sorted(pairs), los_path is not None, los_path, born, dead, dynamic, unborn)

@@ -22,15 +22,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, vector
+from ..._validate import finite_array, nonnegative, real, vector
 from ...geometry import spherical_jacobian
-from .state import _vue_positions
+from .state import vue_positions
 
 __all__ = [
+    "DelayCheck",
+    "DopplerClutter",
     "JavelinWarning",
     "PathMeasurements",
+    "ReflectorCurvature",
+    "VueCurvature",
     "measurement_model",
-    "path_covariances",
     "track_model",
 ]
 
@@ -208,16 +211,6 @@ class PathMeasurements:
         return np.column_stack([c * np.cos(self.phi), c * np.sin(self.phi), np.sin(self.psi)])
 
 
-def path_covariances(meas: PathMeasurements, config) -> np.ndarray:
-    """The covariance of each path's ``(phi, psi, kappa)`` (n, 3, 3) the tracker uses: the
-    reported one under ``measurement_noise="reported"`` when the epoch carries it, else
-    ``diag(sigma_phi^2, sigma_psi^2, sigma_kappa^2)`` for every path (the paper)."""
-    if config.measurement_noise == "reported" and meas.reported:
-        return meas.cov
-    var = np.array([config.sigma_phi, config.sigma_psi, config.sigma_kappa]) ** 2
-    return np.broadcast_to(np.diag(var), (len(meas), 3, 3))
-
-
 def track_model(
     x, bs=(0.0, 0.0, 0.0), kappa_model: str = "reflector"
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -235,7 +228,7 @@ def track_model(
         raise ValueError(f"kappa_model: expected 'reflector' or 'vue', got {kappa_model!r}")
     D = x.size
     n_v = (D - 3) // 2
-    pos = np.vstack([x[:3], _vue_positions(x)])
+    pos = np.vstack([x[:3], vue_positions(x)])
     q = pos - b
     rho2 = q[:, 0] ** 2 + q[:, 1] ** 2
     rho = np.sqrt(rho2)
@@ -318,3 +311,62 @@ def measurement_model(
     )
     H = np.concatenate([J[:, PHI], J[:, PSI], J[:, KAPPA], J[1:, RANGE] - J[0, RANGE]])
     return h, H
+
+
+@dataclass(frozen=True)
+class ReflectorCurvature:
+    """The curvature of a reflected path is the distance to the reflection point (eq. 51, the
+    SR-NF model)."""
+
+    name = "reflector"
+
+    def predict(self, x, bs):
+        """Predicted ``(phi, psi, kappa, range)`` per track (L, 4) and the Jacobian (L, 4, D)."""
+        return track_model(x, bs, self.name)
+
+
+@dataclass(frozen=True)
+class VueCurvature(ReflectorCurvature):
+    """The curvature of a reflected path is the distance to its VUE (the radius of the exact
+    wavefront, what the maximum-likelihood route measures; ours)."""
+
+    name = "vue"
+
+
+CurvatureModel = ReflectorCurvature
+
+
+@dataclass(frozen=True)
+class DelayCheck:
+    """Algorithm 1's checks: a path with a NaN angle or ``d < min_d`` is dropped; ``min_d = 0``
+    as printed, ``-c b_max`` keeps the paths a negative clock bias pushed below zero (ours)."""
+
+    min_d: float = 0.0
+
+    def __post_init__(self) -> None:
+        v = real("min_d", self.min_d)
+        if not (np.isfinite(v) and v <= 0):
+            raise ValueError(f"min_d: expected a finite value <= 0, got {self.min_d!r}")
+
+    def __call__(self, meas: PathMeasurements, speed: float | None) -> tuple[PathMeasurements, int]:
+        """The kept paths and how many were dropped (``speed`` unused)."""
+        return meas.sanitised(self.min_d)
+
+
+@dataclass(frozen=True)
+class DopplerClutter:
+    """A path whose radial speed exceeds the vehicle speed by more than ``margin`` [m/s] cannot
+    come from a static reflector (``|v| <= ||v_u||`` for any mirror image) and is dropped before
+    association (ours). Applies only while the speed message is present (``speed`` not None)."""
+
+    margin: float = 1.0
+
+    def __post_init__(self) -> None:
+        nonnegative("margin", self.margin)
+
+    def __call__(self, meas: PathMeasurements, speed: float | None) -> tuple[PathMeasurements, int]:
+        if speed is None or not len(meas):
+            return meas, 0
+        fast = np.abs(meas.v) > abs(speed) + self.margin  # NaN v: kept
+        n = int(fast.sum())
+        return (meas.subset(np.flatnonzero(~fast)), n) if n else (meas, 0)

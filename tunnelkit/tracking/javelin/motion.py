@@ -14,6 +14,8 @@ correlated through one ``G``; the random walk stays on top for curved surfaces.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..._validate import nonnegative
@@ -66,15 +68,16 @@ def predict(
     dt: float,
     config: JavelinConfig,
     *,
+    vue_motion: str = "random_walk",
     sigma_speed: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Predicted ``(x, P)`` (eq. 62-63) with ``F = I`` (the motion enters as a known input).
 
-    ``sigma_speed`` overrides the configured speed noise (used while the V2X message is
-    missing and the last one is reused).
+    ``vue_motion`` as in :func:`motion_increment`; ``sigma_speed`` overrides the configured speed
+    noise (used while the V2X message is missing and the last one is reused).
     """
     dt = nonnegative("dt", dt)
-    inc, G = motion_increment(state, speed, heading, dt, config.vue_motion)
+    inc, G = motion_increment(state, speed, heading, dt, vue_motion)
     s_nu = config.sigma_speed if sigma_speed is None else sigma_speed
     Q = G @ np.diag([s_nu**2, config.sigma_heading**2]) @ G.T
     Q[2, 2] += config.sigma_height**2 * dt
@@ -83,3 +86,22 @@ def predict(
     x = state.x + inc
     P = state.P + Q
     return x, 0.5 * (P + P.T)
+
+
+@dataclass(frozen=True)
+class RandomWalk:
+    """Each VUE follows a random walk, ``Q_v = sigma_w^2 T I_2`` (the paper, section 3.5)."""
+
+    name = "random_walk"
+
+    def increment(self, state, speed: float, heading: float, dt: float):
+        """State increment ``f(s) - s`` (D,) and its sensitivity ``G`` (D, 2) to the motion."""
+        return motion_increment(state, speed, heading, dt, self.name)
+
+
+@dataclass(frozen=True)
+class MirrorMotion(RandomWalk):
+    """A wall-fixed VUE moves by the UE displacement mirrored in its surface (ours), with the
+    random walk on top for curved surfaces."""
+
+    name = "mirror"

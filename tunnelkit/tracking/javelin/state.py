@@ -25,7 +25,7 @@ def track_slice(i: int) -> slice:
     return slice(3 + 2 * (i - 1), 5 + 2 * (i - 1))
 
 
-def _vue_positions(x: np.ndarray) -> np.ndarray:
+def vue_positions(x: np.ndarray) -> np.ndarray:
     """3-D VUE positions ``[x_u, y_v, z_v]`` (n_vue, 3) of a state vector ``x`` (eq. 43)."""
     yz = x[3:].reshape(-1, 2)
     return np.column_stack([np.full(len(yz), x[0]), yz])
@@ -91,7 +91,7 @@ class JavelinState:
 
     def positions(self) -> np.ndarray:
         """All track positions, shape (L_hat, 3), UE first."""
-        return np.vstack([self.x[:3], _vue_positions(self.x)])
+        return np.vstack([self.x[:3], vue_positions(self.x)])
 
     def copy(self) -> JavelinState:
         """A deep copy."""

@@ -18,14 +18,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._validate import finite_array, nonnegative, vector
-from .associate import ASSOCIATORS, AssociationCosts, association_costs
-from .config import JavelinConfig
-from .gate import ChiSquareGate
+from ..gating import ChiSquareGate
+from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
-from .measurement import JavelinWarning, PathMeasurements, path_covariances, track_model
+from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
 from .motion import predict, ue_velocity
+from .roles import JavelinDesign
 from .state import JavelinState, track_slice
-from .update import exclude_inconsistent, joseph_update, stack_measurement
 
 __all__ = ["Javelin", "JavelinRun", "StepReport", "run_javelin"]
 
@@ -54,20 +53,24 @@ class StepReport:
 
 
 class Javelin:
-    """Variable-dimension EKF over the UE and its virtual UEs (Algorithm 4).
+    """Variable-dimension EKF over the UE and its virtual UEs (Algorithm 4), built from the
+    roles of a :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign` (default: the paper's).
 
     >>> trk = Javelin(initial_position=[-40.0, 1.5, -3.3])
     >>> rep = trk.step(paths, speed=10.0, heading=0.0, dt=0.1)   # doctest: +SKIP
     """
 
-    def __init__(self, initial_position, config: JavelinConfig | None = None) -> None:
-        self.config = JavelinConfig() if config is None else config
-        if not isinstance(self.config, JavelinConfig):
-            raise TypeError(f"config: expected a JavelinConfig, got {type(self.config).__name__}")
+    def __init__(self, initial_position, design: JavelinDesign | None = None) -> None:
+        self.design = JavelinDesign() if design is None else design
+        if not isinstance(self.design, JavelinDesign):
+            raise TypeError(
+                f"design: expected a JavelinDesign (tracking.javelin.designs), got "
+                f"{type(self.design).__name__}"
+            )
+        self.config = self.design.config
         p0 = vector("initial_position", initial_position, 3)
-        self.state = JavelinState.initial(p0, self.config.p0_ue)
+        self.state = JavelinState.initial(p0, self.config.sigma_p0_ue)
         self.gate = ChiSquareGate(self.config.gate_probability)
-        self.associate = ASSOCIATORS[self.config.associator]
         self.k = 0
         self._last_motion: tuple[float, float] | None = None
 
@@ -89,72 +92,76 @@ class Javelin:
         faults.append("speed/heading message missing: last message reused with inflated noise")
         return *self._last_motion, sig
 
-    @staticmethod
-    def _paths(paths, faults: list[str], min_d: float = 0.0) -> PathMeasurements:
+    def _paths(self, paths, faults: list[str]) -> PathMeasurements:
         if paths is None:
             faults.append("no measurement this epoch: predict only")
             return PathMeasurements.empty()
         if not isinstance(paths, PathMeasurements):
             raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
         # a PathMeasurements built directly may still hold NaN angles or d < 0 (Algorithm 1)
-        clean, dropped = paths.sanitised(min_d)
+        clean, dropped = self.design.prefilters[0](paths, None)
         if dropped:
             faults.append(f"{dropped} path(s) failing the checks of Algorithm 1 dropped")
         return clean
+
+    def _prefilter(
+        self, meas: PathMeasurements, speed: float | None
+    ) -> tuple[PathMeasurements, int]:
+        """The pre-filters after Algorithm 1's check; returns the paths kept and the clutter
+        count (paths the Doppler test dropped)."""
+        n_clutter = 0
+        for pre in self.design.prefilters[1:]:
+            meas, n = pre(meas, speed)
+            if isinstance(pre, DopplerClutter):
+                n_clutter += n
+        return meas, n_clutter
 
     # -- Algorithm 4 --------------------------------------------------------------------------
     def step(
         self, paths: PathMeasurements | None, speed: float | None, heading: float | None, dt: float
     ) -> StepReport:
         """One epoch: predict with (speed, heading) over ``dt``, associate, manage, update."""
-        cfg = self.config
+        cfg, roles = self.config, self.design
         dt = nonnegative("dt", dt)
         faults: list[str] = []
-        meas = self._paths(paths, faults, cfg.min_d)
+        meas = self._paths(paths, faults)
         nu, theta, sig_nu = self._motion(speed, heading, faults)
-        n_clutter = 0
-        if cfg.doppler_clutter_margin is not None and sig_nu is None and len(meas):
-            fast = np.abs(meas.v) > abs(nu) + cfg.doppler_clutter_margin  # NaN v: kept
-            n_clutter = int(fast.sum())
-            if n_clutter:
-                meas = meas.subset(np.flatnonzero(~fast))
+        meas, n_clutter = self._prefilter(meas, nu if sig_nu is None else None)
         # Predict (eq. 62-63)
         st = self.state
-        st.x, st.P = predict(st, nu, theta, dt, cfg, sigma_speed=sig_nu)
+        st.x, st.P = predict(
+            st, nu, theta, dt, cfg, vue_motion=roles.vue_motion.name, sigma_speed=sig_nu
+        )
         prior_pos, prior_ids = st.positions(), list(st.ids)
         prior_cov = [st.P[track_slice(i), track_slice(i)].copy() for i in range(st.n_tracks)]
         costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
         geometry_ok = True
         if len(meas):
             try:
-                pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
+                pred, J = roles.curvature.predict(st.x, cfg.bs)
             except ValueError as exc:  # a track on the base station's axis: azimuth undefined
                 geometry_ok = False
                 faults.append(f"measurement model undefined ({exc}): predict only")
         if len(meas) and geometry_ok:
-            if cfg.measurement_noise == "reported" and not meas.reported:
+            noise = roles.noise
+            if noise.needs_reported and not noise.uses_reported(meas):
                 faults.append("no reported covariance this epoch: the fixed sigmas used")
             # Associate (Algorithm 2)
-            R3 = path_covariances(meas, cfg)
-            costs = association_costs(pred, J, st.P, meas, R3, self.gate, cfg.association_cost)
-            assoc = self.associate(costs)
+            R3 = noise.covariances(meas, cfg)
+            costs, assoc = roles.associator(pred, J, st.P, meas, R3, self.gate)
             # ManageTracks (Algorithm 3)
-            mres = manage_tracks(
-                st, meas, assoc, cfg, ue_velocity(nu, theta) if sig_nu is None else None
-            )
+            v_u = ue_velocity(nu, theta) if sig_nu is None else None
+            mres = manage_tracks(st, meas, assoc, cfg, v_u, initiator=roles.initiator, noise=noise)
             # Update (eq. 64-68)
-            pred, J = track_model(st.x, cfg.bs, cfg.kappa_model)
+            pred, J = roles.curvature.predict(st.x, cfg.bs)
             try:
-                if cfg.update_gate is None:
-                    m = stack_measurement(pred, J, meas, mres.pairs, cfg, mres.los_path)
-                else:
-                    m, left_out = exclude_inconsistent(
-                        st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, cfg.update_gate
-                    )
-                    if left_out:
-                        faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
+                m, left_out = roles.updater.stack(
+                    st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, noise
+                )
+                if left_out:
+                    faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
                 n_rows = m.z.size
-                x_new, P_new, nis = joseph_update(st.x, st.P, m)
+                x_new, P_new, nis = roles.updater.update(st.x, st.P, m)
                 if not (np.all(np.isfinite(x_new)) and np.all(np.isfinite(P_new))):
                     raise np.linalg.LinAlgError("non-finite update")
                 st.x, st.P = x_new, P_new
@@ -166,7 +173,7 @@ class Javelin:
         elif paths is not None and geometry_ok:
             faults.append("no usable path this epoch: predict only")
             # every VUE missed this epoch
-            mres = manage_tracks(st, meas, [], cfg)
+            mres = manage_tracks(st, meas, [], cfg, initiator=roles.initiator, noise=roles.noise)
         for f in faults:
             warnings.warn(f"epoch {self.k}: {f}", JavelinWarning, stacklevel=2)
         rep = StepReport(
@@ -209,11 +216,11 @@ def run_javelin(
     heading,
     dt: float,
     initial_position,
-    config: JavelinConfig | None = None,
+    design: JavelinDesign | None = None,
     *,
     keep_reports: bool = False,
 ) -> JavelinRun:
-    """Run :class:`Javelin` over a measurement stream.
+    """Run :class:`Javelin` (built from ``design``, default the paper's) over a measurement stream.
 
     ``speed[k]`` / ``heading[k]`` are the V2X message sent at epoch ``k`` (NaN = missing); as in
     Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k``.
@@ -227,7 +234,7 @@ def run_javelin(
             f"speed, heading: expected {n} values (one per epoch), got {spd.size} and {hdg.size}"
         )
     finite_array("dt", dt, ndim=0)
-    trk = Javelin(initial_position, config)
+    trk = Javelin(initial_position, design)
     est = np.empty((n, 3))
     cov = np.empty((n, 3, 3))
     ntr = np.empty(n, dtype=int)

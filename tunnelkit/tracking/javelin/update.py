@@ -14,9 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
+from ..._validate import probability
 from ...crlb import wrap_angle
+from ..gating import ChiSquareGate
 from .config import JavelinConfig
-from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements, path_covariances
+from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements
+from .noise import FixedNoise
 
 __all__ = ["StackedMeasurement", "exclude_inconsistent", "joseph_update", "stack_measurement"]
 
@@ -47,11 +50,14 @@ def stack_measurement(
     pairs,
     config: JavelinConfig,
     los_path: int | None = None,
+    noise=None,
 ) -> StackedMeasurement:
-    """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``."""
+    """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``;
+    ``noise`` the measurement-noise role (:mod:`~tunnelkit.tracking.javelin.roles`; default the
+    paper's fixed sigmas) gives the covariance of every row."""
+    noise = FixedNoise() if noise is None else noise
     D = J.shape[-1]
-    reported = config.measurement_noise == "reported" and meas.reported
-    cov = path_covariances(meas, config)
+    cov = noise.covariances(meas, config)
     z, h, H, blocks, ang, labels = [], [], [], [], [], []
     for i, j in pairs:
         comps = [PHI, PSI] + ([KAPPA] if np.isfinite(meas.kappa[j]) else [])
@@ -85,18 +91,9 @@ def stack_measurement(
         R[at : at + len(b), at : at + len(b)] = b
         at += len(b)
     nd = K - n_direct
-    if nd and reported:
-        # Delta d_j = d_j - d_ref: var = s_j^2 + s_ref^2, the reference shared by every row
+    if nd:
         others = [j for i, j in with_d if (i, j) != ref]
-        R[n_direct:, n_direct:] = np.diag(meas.sigma_d[others] ** 2) + meas.sigma_d[jr] ** 2
-    elif nd:
-        s2 = config.sigma_delta_d**2
-        blk = (
-            0.5 * s2 * (np.eye(nd) + np.ones((nd, nd)))
-            if config.correlated_delta_d
-            else s2 * np.eye(nd)
-        )
-        R[n_direct:, n_direct:] = blk
+        R[n_direct:, n_direct:] = noise.tdoa_covariance(meas, others, jr, config)
     return StackedMeasurement(
         np.asarray(z, float),
         np.asarray(h, float),
@@ -149,6 +146,7 @@ def exclude_inconsistent(
     config: JavelinConfig,
     los_path: int | None,
     probability: float,
+    noise=None,
 ) -> tuple[StackedMeasurement, list[tuple[int, int]]]:
     """Fault detection and exclusion on the stacked update (ours, RAIM-like): while the joint
     innovation fails its chi-square test, ``y^T S^-1 y > chi2_K(probability)`` with ``K`` the
@@ -157,17 +155,15 @@ def exclude_inconsistent(
     wrong LoS from eq. 61 and the TDoA rows, which no gate sees. Returns the stacked measurement
     of the kept pairs and the pairs left out (in order). Raises ``numpy.linalg.LinAlgError`` if
     an innovation covariance is not positive definite (the tracker then skips the update)."""
-    from .gate import ChiSquareGate
-
     gate = ChiSquareGate(probability)
     pairs = list(pairs)
     out: list[tuple[int, int]] = []
-    m = stack_measurement(pred, J, meas, pairs, config, los_path)
+    m = stack_measurement(pred, J, meas, pairs, config, los_path, noise)
     while m.z.size and _nis(x, P, m) > gate.threshold(int(m.z.size)):
         best = None
         for p in pairs:
             rest = [q for q in pairs if q != p]
-            trial = stack_measurement(pred, J, meas, rest, config, los_path)
+            trial = stack_measurement(pred, J, meas, rest, config, los_path, noise)
             score = _nis(x, P, trial) / gate.threshold(max(int(trial.z.size), 1))
             if best is None or score < best[0]:
                 best = (score, p, trial)
@@ -175,3 +171,35 @@ def exclude_inconsistent(
         pairs.remove(p)
         out.append(p)
     return m, out
+
+
+@dataclass(frozen=True)
+class JosephUpdater:
+    """The EKF update of eq. 64-68 with the Joseph-form covariance on every kept pair."""
+
+    def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise):
+        """The stacked measurement of the pairs to update with and the pairs left out."""
+        return stack_measurement(pred, J, meas, pairs, config, los_path, noise), []
+
+    def update(self, x, P, m: StackedMeasurement):
+        """``(x, P, nis)`` after the update (:func:`~.update.joseph_update`)."""
+        return joseph_update(x, P, m)
+
+
+@dataclass(frozen=True)
+class JointTestUpdater(JosephUpdater):
+    """The Joseph update after a chi-square test on the whole stacked innovation at
+    ``probability``: while it fails, the pair whose removal lowers it most is left out (ours,
+    RAIM-like: :func:`~.update.exclude_inconsistent`)."""
+
+    probability: float = 0.999
+
+    def __post_init__(self) -> None:
+        p = probability("probability", self.probability)
+        if ChiSquareGate(p).threshold(1) <= 0:
+            raise ValueError(f"probability: too small to give a chi-square threshold, got {p!r}")
+
+    def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise):
+        return exclude_inconsistent(
+            x, P, pred, J, meas, pairs, config, los_path, self.probability, noise
+        )
