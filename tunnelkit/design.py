@@ -630,11 +630,11 @@ def route_bounds(
             cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature
         )
     # exact SR-NF mismatch of every used path (fresnel's cancellation-free form)
-    from .fresnel import _mismatch
+    from .fresnel import signed_mismatch
 
     pos_w = pos @ R.transpose(0, 2, 1)  # (T, M, 3) element offsets from p_0, world
     mis_c = np.abs(
-        _mismatch(
+        signed_mismatch(
             (src - a0[:, None, :])[:, None],
             (pnt - a0[:, None, :])[:, None],
             pos_w[:, :, None],
