@@ -123,7 +123,7 @@ def test_eta_fisher_information_matches_crlb_paths(setup):
     mu_f = -2 * np.pi * cfg.tone_spacing * d0 / C
     mu_t = 2 * np.pi * cfg.symbol_period * g.doppler[0, j]
     pos = spec.local(cfg.fc)
-    G = design._fim_eta(
+    G = design.bounds._fim_eta(
         src[None],
         pos,
         alpha[None],
@@ -231,3 +231,17 @@ def test_overrides_change_the_radio(setup):
     assert s28.config.fc == 28e9 and s28.config.bandwidth == 400e6
     assert s28.config.n_rb == int(400e6 // (12 * s28.config.scs))
     assert all(m.elevation == pytest.approx(-np.radians(10.0)) for m in s28.mounts)
+
+
+def test_every_public_name_resolves():
+    import importlib
+
+    import tunnelkit as tk
+
+    for name in design.__all__:
+        assert getattr(tk.design, name) is getattr(design, name), name
+    # every submodule's public names are re-exported by the package
+    for sub in ("setup", "geometry", "bounds", "report", "montecarlo"):
+        mod = importlib.import_module(f"tunnelkit.design.{sub}")
+        for name in mod.__all__:
+            assert name in design.__all__ and getattr(design, name) is getattr(mod, name), name

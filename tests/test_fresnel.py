@@ -294,3 +294,29 @@ def test_cli_mmax(capsys):
     assert "y_u" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         cli.main(["mmax", "--fc", "fast"])
+
+
+def test_every_public_name_resolves():
+    import importlib
+
+    for name in fresnel.__all__:
+        assert getattr(fresnel, name) is not None, name
+    for sub in ("bounds", "exact", "summary"):
+        mod = importlib.import_module(f"tunnelkit.fresnel.{sub}")
+        for name in mod.__all__:
+            assert getattr(mod, name) is not None, name
+
+
+def test_signed_mismatch_checks_its_arguments():
+    pv, ps = fresnel.vue(3.5, 3.0, 2.5), fresnel.reference_specular_point(3.5, 3.0, 2.5)
+    pos = fresnel.ula_positions(8, 5.9e9)
+    np.testing.assert_array_equal(
+        fresnel.signed_mismatch(pv, ps, pos, C / 5.9e9),
+        fresnel.mismatch_profile(pos, 3.5, 3.0, 2.5, 5.9e9),
+    )
+    with pytest.raises(ValueError, match="pos"):
+        fresnel.signed_mismatch(pv, ps, pos[:, :2], 0.05)
+    with pytest.raises(ValueError, match="lam"):
+        fresnel.signed_mismatch(pv, ps, pos, 0.0)
+    with pytest.raises(ValueError, match="pv"):
+        fresnel.signed_mismatch([np.nan, 0, 0], ps, pos, 0.05)

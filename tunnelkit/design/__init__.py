@@ -1,0 +1,53 @@
+"""Size an antenna array for a tunnel: SR-NF validity, per-path CRLBs and a position error bound.
+
+For every candidate array (ULA ``n``, URA ``n x m``, spacing in wavelengths) placed at the
+scenario's base-station mount, along the scenario's route, the design computes the exact SR-NF
+validity of every path, the per-path CRLBs and a position error bound (PEB), and optionally the
+settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per module:
+
+* :mod:`~tunnelkit.design.setup`: candidate arrays (:class:`ArraySpec`, :func:`parse_array`)
+  and the scenario reduced to tunnel, mounts, route and radio (:class:`DesignSetup`);
+* :mod:`~tunnelkit.design.geometry`: the image method for a whole route at once
+  (:func:`trace_route`, :class:`RouteGeometry`);
+* :mod:`~tunnelkit.design.bounds`: exact SR-NF validity, the PEB from the joint Fisher
+  information of eq. 1 and the per-path CRLBs (:func:`route_bounds`, :func:`path_bounds`);
+* :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design (:func:`javelin_rmse`);
+* :mod:`~tunnelkit.design.report`: the sweep, its table and the recommendation
+  (:func:`design_sweep`, :func:`recommend`, :func:`smallest_meeting`).
+
+    >>> import tunnelkit as tk
+    >>> setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
+    >>> b = tk.design.route_bounds(setup, "10x10")
+    >>> float(np.median(b.peb)), b.srnf_valid.mean()          # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from .bounds import RouteBounds, path_bounds, route_bounds
+from .geometry import KINDS, RouteGeometry, trace_route
+from .montecarlo import SETTLE_S, SIGMA_HEADING, SIGMA_SPEED, javelin_config, javelin_rmse
+from .report import DesignReport, DesignRow, design_sweep, recommend, smallest_meeting
+from .setup import ArraySpec, DesignSetup, Mount, parse_array
+
+__all__ = [
+    "KINDS",
+    "SETTLE_S",
+    "SIGMA_HEADING",
+    "SIGMA_SPEED",
+    "ArraySpec",
+    "DesignReport",
+    "DesignRow",
+    "DesignSetup",
+    "Mount",
+    "RouteBounds",
+    "RouteGeometry",
+    "design_sweep",
+    "javelin_config",
+    "javelin_rmse",
+    "parse_array",
+    "path_bounds",
+    "recommend",
+    "route_bounds",
+    "smallest_meeting",
+    "trace_route",
+]

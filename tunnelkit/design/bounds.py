@@ -1,0 +1,332 @@
+"""Bounds of a candidate array along the route: exact SR-NF validity, per-path CRLBs and the
+position error bound (PEB).
+
+* **SR-NF validity for every surface a path reflects on** (walls, ceiling/roof facets, road,
+  markings): the exact phase mismatch of :mod:`tunnelkit.fresnel`
+  (:func:`tunnelkit.fresnel.signed_mismatch`) between the true wavefront (centred on the virtual
+  UE) and the SR-NF model's (centred on the reflection point), across the whole array; an epoch
+  is valid when every path it uses stays below ``eps_phi``;
+* **per-path CRLBs** of delay distance, direction and curvature
+  (:func:`tunnelkit.extraction.crlb_paths`, structured eq. 1 model; :func:`path_bounds`);
+* a **position error bound (PEB)**: the Fisher information of the eq. 1 tensor over each path's
+  parameters ``eta_l = [Re alpha, Im alpha, mu_f, mu_t, wave origin (3)]`` (all paths jointly,
+  cross terms included), mapped through the known geometry ``theta -> eta`` and reduced to the UE
+  position by the Schur complement::
+
+      J_theta = T^T J_eta T,      PEB = sqrt(trace([J_theta^-1]_pos))
+
+  ``theta`` holds the UE position (x, y; and z unless ``height_known``), the clock bias (the
+  channel adds one bias ``b`` to every path's delay, ``tau_l = d_l / c + b``; a nuisance unless
+  ``clock_bias="known"``) and per-path nuisances (complex gain, Doppler ``mu_t``). The wave
+  origin of the LoS path is the UE; of a specular path the UE mirrored in the known plane
+  (``S_l = I - 2 n n^T``); the delay distance is ``||origin - p_0||``. *Without curvature* the
+  wavefront radius of each path is one more nuisance (the array then gives directions only);
+  *without markings* the RRM paths are left out.
+
+The tensor sums are evaluated from the rank-1 structure (inner products factorise over array,
+tones and symbols) and vectorised over epochs, so a whole route takes milliseconds: notebook 08's
+explorer redraws from :func:`route_bounds` alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import extraction
+from .._validate import positive
+from ..constants import C, wavelength
+from ..fresnel import signed_mismatch
+from .geometry import RouteGeometry, trace_route
+from .setup import ArraySpec, DesignSetup, parse_array
+
+__all__ = ["RouteBounds", "path_bounds", "route_bounds"]
+
+_CLOCK = ("unknown", "known")
+
+
+@dataclass(frozen=True)
+class RouteBounds:
+    """Per-epoch results of :func:`route_bounds` for one array.
+
+    ``peb`` (T,) [m] (``inf`` where the position is not identifiable; ``None`` if not asked); ``mismatch`` (T, P) exact
+    SR-NF phase mismatch of each candidate path [rad] (0 for LoS and absent paths);
+    ``used`` (T, P) the paths the bound combines; ``srnf_valid`` (T,) every used path below
+    ``eps_phi``; ``x`` (T,) the vehicle's position along the tunnel.
+    """
+
+    spec: ArraySpec
+    x: np.ndarray
+    peb: np.ndarray
+    mismatch: np.ndarray
+    used: np.ndarray
+    srnf_valid: np.ndarray
+    kinds: tuple[str, ...]
+    eps_phi: float
+    n_paths: np.ndarray = field(repr=False)
+
+    def surface_validity(self) -> dict[str, float]:
+        """Per surface kind: share of epochs where every used path off that kind is valid."""
+        out = {}
+        kinds = np.array(self.kinds)
+        for k in dict.fromkeys(self.kinds[1:]):
+            cols = kinds == k
+            used = self.used[:, cols]
+            if not used.any():
+                continue
+            bad = (self.mismatch[:, cols] > self.eps_phi) & used
+            out[k] = float(np.mean(~bad.any(axis=1)))
+        return out
+
+
+def _compress(used: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gather indices (T, L) of the used slots, padded; and the mask of real ones."""
+    order = np.argsort(~used, axis=1, kind="stable")
+    L = max(int(used.sum(axis=1).max()), 1)
+    idx = order[:, :L]
+    return idx, np.take_along_axis(used, idx, axis=1)
+
+
+def _gram(X: np.ndarray) -> np.ndarray:
+    """``X[t]^H X[t]`` for every ``t`` (small BLAS products; faster than a batched matmul)."""
+    out = np.empty((X.shape[0], X.shape[2], X.shape[2]), complex)
+    for t in range(X.shape[0]):
+        out[t] = X[t].conj().T @ X[t]
+    return out
+
+
+def _vandermonde_pair(mu: np.ndarray, n: int) -> np.ndarray:
+    """``[e^{j s mu_l}, j s e^{j s mu_l}]`` for ``s = 0..n-1``, interleaved per path: (T, n, 2L).
+
+    ``e^{j s mu} = e^{j q B mu} e^{j r mu}`` with ``s = q B + r``: about ``2 sqrt(n)`` complex
+    exponentials per path instead of ``n``.
+    """
+    T, L = mu.shape
+    B = max(int(np.ceil(np.sqrt(n))), 1)
+    q = np.arange(-(-n // B))
+    r = np.arange(B)
+    hi = np.exp(1j * (q * B)[None, :, None] * mu[:, None, :])  # (T, Q, L)
+    lo = np.exp(1j * r[None, :, None] * mu[:, None, :])  # (T, B, L)
+    v = (hi[:, :, None, :] * lo[:, None, :, :]).reshape(T, -1, L)[:, :n]
+    out = np.empty((T, n, L, 2), complex)
+    out[..., 0] = v
+    out[..., 1] = 1j * np.arange(n)[None, :, None] * v
+    return out.reshape(T, n, 2 * L)
+
+
+def _fim_eta(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols, noise_power):
+    """Joint Fisher information (T, 7L, 7L) of eq. 1 over ``eta_l = [Re a, Im a, mu_f, mu_t,
+    s (3, local)]`` per path, assembled from the three modes' Gram matrices."""
+    T, L, _ = s_loc.shape
+    k0 = 2 * np.pi * fc / C
+    diff = s_loc[:, None, :, :] - pos[None, :, None, :]  # (T, M, L, 3)
+    rng_m = np.linalg.norm(diff, axis=-1)
+    a = np.exp(1j * k0 * (rng_m - rng_m[:, :1]))
+    u = diff / rng_m[..., None]
+    da = 1j * k0 * a[..., None] * (u - u[:, :1])
+    A = np.empty((T, pos.shape[0], L, 4), complex)
+    A[..., 0] = a
+    A[..., 1:] = da
+    Gs = _gram(A.reshape(T, pos.shape[0], 4 * L))
+    Gf = _gram(_vandermonde_pair(mu_f, n_tones))
+    Gt = _gram(_vandermonde_pair(mu_t, n_symbols))
+    li = np.repeat(np.arange(L), 7)
+    kk = np.tile(np.arange(7), L)
+    si = 4 * li + np.array([0, 0, 0, 0, 1, 2, 3])[kk]
+    fi = 2 * li + (kk == 2)
+    ti = 2 * li + (kk == 3)
+    coef = np.where(kk[None] == 0, 1.0 + 0j, np.where(kk[None] == 1, 1j, alpha[:, li]))
+    coef = coef * mask[:, li]
+    gram = (
+        np.conj(coef)[:, :, None]
+        * coef[:, None, :]
+        * Gs[:, si[:, None], si[None, :]]
+        * Gf[:, fi[:, None], fi[None, :]]
+        * Gt[:, ti[:, None], ti[None, :]]
+    )
+    return 2.0 / noise_power * gram.real
+
+
+def _position_covariance(G: np.ndarray, n_pos: int, rcond: float = 1e-12) -> np.ndarray:
+    """``[G^-1]`` (T, n_pos, n_pos) with Jacobi scaling; ``inf`` where ``G`` is singular."""
+    d = np.diagonal(G, axis1=1, axis2=2)
+    sc = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
+    Gs = sc[:, :, None] * G * sc[:, None, :]
+    w, V = np.linalg.eigh(Gs)
+    sing = (w[:, 0] <= rcond * w[:, -1]) | np.any(d[:, :n_pos] <= 0, axis=1)
+    w = np.where(w > 0, w, 1.0)
+    Vp = V[:, :n_pos, :]
+    cov = (Vp / w[:, None, :]) @ Vp.transpose(0, 2, 1)
+    cov = sc[:, :n_pos, None] * cov * sc[:, None, :n_pos]
+    cov[sing] = np.inf
+    return cov
+
+
+def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature):
+    """Per-epoch PEB from the joint eq. 1 FIM (see :func:`route_bounds`)."""
+    T, L = idx.shape
+    alpha = np.sqrt(cfg.tx_power) * take(g.gain)
+    mu_f = -2 * np.pi * cfg.tone_spacing * d0 / C
+    mu_t = 2 * np.pi * cfg.symbol_period * take(g.doppler)
+    G_eta = _fim_eta(
+        s_loc, pos, alpha, mu_f, mu_t, mask, cfg.fc, cfg.n_tones, cfg.n_symbols, cfg.noise_power
+    )
+    # theta = [UE position, (clock bias c b), per path: Re a, Im a, mu_t, (radius)]
+    n_pos = 2 if height_known else 3
+    n_b = int(clock_bias == "unknown")
+    n_nui = 3 + int(not curvature)
+    base = n_pos + n_b
+    n_theta = base + n_nui * L
+    Tm = np.zeros((T, 7 * L, n_theta))
+    lr = np.arange(L)
+    S = g.mirror[idx]  # (T, L, 3, 3) d source / d UE (world)
+    u_w = (src - a0[:, None, :]) / d0[..., None]
+    dmuf = -2 * np.pi * cfg.tone_spacing / C
+    Tm[:, 7 * lr, base + n_nui * lr] = 1.0
+    Tm[:, 7 * lr + 1, base + n_nui * lr + 1] = 1.0
+    Tm[:, 7 * lr + 3, base + n_nui * lr + 2] = 1.0
+    Tm[:, 7 * lr + 2, :n_pos] = dmuf * np.einsum("tli,tlij->tlj", u_w, S)[..., :n_pos]
+    if n_b:
+        Tm[:, 7 * lr + 2, n_pos] = dmuf
+    dsrc = np.einsum("tji,tljk->tlik", R, S)[..., :n_pos]  # R^T S: (T, L, 3, n_pos)
+    for i in range(3):
+        Tm[:, 7 * lr + 4 + i, :n_pos] = dsrc[:, :, i, :]
+        if not curvature:
+            Tm[:, 7 * lr + 4 + i, base + n_nui * lr + 3] = s_loc[:, :, i] / d0
+    Gth = Tm.transpose(0, 2, 1) @ G_eta @ Tm
+    # absent (padding) paths: their nuisances decouple
+    pad = np.zeros((T, n_theta), bool)
+    pad[:, base:] = np.repeat(~mask, n_nui, axis=1)
+    Gth[:, np.arange(n_theta), np.arange(n_theta)] += pad
+    cov = _position_covariance(Gth, n_pos)
+    peb = np.sqrt(np.trace(cov, axis1=1, axis2=2))
+    peb = np.where(mask.any(axis=1), peb, np.inf)
+    return peb
+
+
+def route_bounds(
+    setup: DesignSetup,
+    spec,
+    *,
+    markings: bool = True,
+    curvature: bool = True,
+    clock_bias: str = "unknown",
+    height_known: bool = True,
+    eps_phi: float = 0.15,
+    geometry: RouteGeometry | None = None,
+    epochs=None,
+    peb: bool = True,
+) -> RouteBounds:
+    """PEB and exact SR-NF validity of ``spec`` along ``setup``'s route (module docstring).
+
+    ``markings=False`` leaves the RRM paths out; ``curvature=False`` makes each path's wavefront
+    radius a nuisance; ``clock_bias="known"`` drops the common delay bias; ``height_known``
+    (default, as JAVELIN) bounds the horizontal position with the antenna height known.
+    ``epochs`` (indices) subsamples the route; ``geometry`` reuses a :func:`trace_route`;
+    ``peb=False`` computes the SR-NF part only (``RouteBounds.peb`` is then ``None``).
+    """
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    spec = parse_array(spec)
+    if clock_bias not in _CLOCK:
+        raise ValueError(f"clock_bias: expected one of {_CLOCK}, got {clock_bias!r}")
+    eps_phi = positive("eps_phi", eps_phi)
+    cfg = setup.config
+    traj = setup.trajectory
+    sl = slice(None) if epochs is None else np.asarray(epochs, int)
+    if geometry is None:
+        geometry = trace_route(
+            setup.tunnel,
+            setup.arrays(spec),
+            traj.position[sl],
+            traj.velocity[sl],
+            fc=cfg.fc,
+            kinds=setup.kinds,
+        )
+    g = geometry
+    pos = spec.local(cfg.fc)
+    kinds = np.array(g.kinds)
+    used = g.exists & (markings | (kinds != "rrm"))[None, :]
+    idx, mask = _compress(used)
+    take = lambda a: np.take_along_axis(a, idx[..., None] if a.ndim == 3 else idx, axis=1)  # noqa: E731
+    src, pnt = take(g.source), take(g.point)
+    a0, R = g.origin, g.rotation
+    s_loc = np.einsum("tlj,tjk->tlk", src - a0[:, None, :], R)
+    d0 = np.linalg.norm(s_loc, axis=-1)
+    pe = None
+    if peb:
+        pe = _peb(
+            cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature
+        )
+    # exact SR-NF mismatch of every used path (fresnel's cancellation-free form)
+    pos_w = pos @ R.transpose(0, 2, 1)  # (T, M, 3) element offsets from p_0, world
+    mis_c = np.abs(
+        signed_mismatch(
+            (src - a0[:, None, :])[:, None],
+            (pnt - a0[:, None, :])[:, None],
+            pos_w[:, :, None],
+            wavelength(cfg.fc),
+        )
+    ).max(axis=1)
+    mis_c = np.where(mask, mis_c, 0.0)
+    mismatch = np.zeros(used.shape)
+    np.put_along_axis(mismatch, idx, mis_c, axis=1)
+    mismatch = np.where(used, mismatch, 0.0)
+    valid = ~np.any(mismatch > eps_phi, axis=1)
+    return RouteBounds(
+        spec, g.ue[:, 0].copy(), pe, mismatch, used, valid, g.kinds, eps_phi, used.sum(axis=1)
+    )
+
+
+def path_bounds(setup: DesignSetup, spec, *, epochs=None) -> dict[str, np.ndarray]:
+    """Per-path CRLBs along the route from :func:`tunnelkit.extraction.crlb_paths` (structured).
+
+    Returns flat arrays over every (epoch, path): ``d`` [m] delay distance, ``direction`` [rad],
+    ``kappa`` [m] (wavefront radius = distance to the VUE), ``kind`` (surface kind).
+    """
+    spec = parse_array(spec)
+    cfg = setup.config
+    traj = setup.trajectory
+    sl = slice(None) if epochs is None else np.asarray(epochs, int)
+    g = trace_route(
+        setup.tunnel,
+        setup.arrays(spec),
+        traj.position[sl],
+        traj.velocity[sl],
+        fc=cfg.fc,
+        kinds=setup.kinds,
+    )
+    pos = spec.local(cfg.fc)
+    out = {"d": [], "direction": [], "kappa": [], "kind": []}
+    for t in range(len(g.ue)):
+        j = np.flatnonzero(g.exists[t])
+        if not j.size:
+            continue
+        src = (g.source[t, j] - g.origin[t]) @ g.rotation[t]
+        d0 = np.linalg.norm(src, axis=1)
+        res = extraction.crlb_paths(
+            np.sqrt(cfg.tx_power) * g.gain[t, j],
+            src,
+            pos,
+            -2 * np.pi * cfg.tone_spacing * d0 / C,
+            2 * np.pi * cfg.symbol_period * g.doppler[t, j],
+            cfg.fc,
+            cfg.n_tones,
+            cfg.n_symbols,
+            cfg.noise_power,
+            spatial="structured",
+        )
+        u = src / d0[:, None]
+        proj = np.eye(3)[None] - u[:, :, None] * u[:, None, :]
+        cov = res["source_cov"]
+        out["d"].append(C / (2 * np.pi * cfg.tone_spacing) * res["mu_f"])
+        var_dir = np.einsum("lij,ljk,lki->l", proj, cov, proj)
+        var_kap = np.einsum("li,lij,lj->l", u, cov, u)
+        # a variance that is not positive: the parameter is not identifiable (e.g. curvature
+        # with 2 x 2 elements) and the inversion lost it in round-off -> an infinite bound
+        with np.errstate(invalid="ignore"):
+            out["direction"].append(np.where(var_dir > 0, np.sqrt(var_dir), np.inf) / d0)
+            out["kappa"].append(np.where(var_kap > 0, np.sqrt(var_kap), np.inf))
+        out["kind"].append(np.array(g.kinds)[j])
+    return {k: np.concatenate(v) if v else np.zeros(0) for k, v in out.items()}
