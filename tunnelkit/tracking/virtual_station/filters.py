@@ -31,7 +31,10 @@ def _upper_sqrt(P):
 
 
 class EstimatorBase:
-    """Common surface: ``x`` (4,), ``P`` (4, 4), ``position``, ``predict()``, ``update(z)``."""
+    """Common surface: ``x`` (4,), ``P`` (4, 4), ``position``, ``predict()``, ``update(z)``.
+
+    The call protocol of family ``"jiang2023"`` (:mod:`tunnelkit.tracking.registry`).
+    """
 
     name = "base"
     model: VsModel
