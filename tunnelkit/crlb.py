@@ -23,7 +23,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validate import callable_, finite_array, positive, spd_matrix
+from ._validate import callable_, finite_array, integer, positive, spd_matrix
 
 __all__ = [
     "crlb_rmse",
@@ -31,6 +31,7 @@ __all__ = [
     "fim_toa_doa",
     "numeric_fim",
     "numeric_jacobian",
+    "station_sigmas",
     "toa_doa",
     "toa_doa_jacobian",
     "wrap_angle",
@@ -86,7 +87,13 @@ def toa_doa_jacobian(p, stations) -> np.ndarray:
     return np.concatenate([jd, jt], axis=-2)
 
 
-def _sigmas(name: str, sigma, n: int) -> np.ndarray | None:
+def station_sigmas(name: str, sigma, n: int) -> np.ndarray | None:
+    """Noise level ``sigma`` as one value per station, shape (n,); ``None`` stays ``None``.
+
+    ``sigma`` is a scalar or one value per station (shape (1,) or (n,)), every value finite and
+    > 0; ``None`` leaves that measurement type out. Errors name the parameter ``name``.
+    """
+    n = integer("n", n, minimum=1)
     if sigma is None:
         return None
     s = finite_array(name, sigma)
@@ -110,8 +117,8 @@ def fim_toa_doa(p, stations, sigma_theta, sigma_d, *, form: str = "corrected") -
         raise ValueError(f"form: expected 'corrected' or 'paper', got {form!r}")
     _, st, dx, dy = _points_and_stations(p, stations)
     n = st.shape[0]
-    st_ = _sigmas("sigma_theta", sigma_theta, n)
-    sd_ = _sigmas("sigma_d", sigma_d, n)
+    st_ = station_sigmas("sigma_theta", sigma_theta, n)
+    sd_ = station_sigmas("sigma_d", sigma_d, n)
     if st_ is None and sd_ is None:
         raise ValueError("sigma_theta, sigma_d: at least one measurement type is needed")
     d2 = dx * dx + dy * dy

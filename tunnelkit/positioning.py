@@ -18,7 +18,7 @@ import numpy as np
 
 from ._validate import distinct_points, finite_array, integer, rng_or_error
 from .budget import check_elements
-from .crlb import _sigmas, toa_doa
+from .crlb import station_sigmas, toa_doa
 
 __all__ = ["ls_toa_doa", "simulate_toa_doa", "toa_only_candidates", "tswls"]
 
@@ -94,8 +94,8 @@ def tswls(stations, d_hat, theta_hat, sigma_d, sigma_theta) -> np.ndarray:
     """
     st, d, th = _inputs(stations, d_hat, theta_hat)
     n = st.shape[0]
-    sd = _sigmas("sigma_d", sigma_d, n)
-    sth = _sigmas("sigma_theta", sigma_theta, n)
+    sd = station_sigmas("sigma_d", sigma_d, n)
+    sth = station_sigmas("sigma_theta", sigma_theta, n)
     if sd is None or sth is None:
         raise ValueError("sigma_d, sigma_theta: TSWLS needs both noise levels")
     G, H = _linear_system(st, d, th)
@@ -132,8 +132,8 @@ def simulate_toa_doa(
     rng = rng_or_error("rng", rng)
     d, th = toa_doa(p, stations)
     n = d.shape[-1]
-    sd = _sigmas("sigma_d", sigma_d, n)
-    sth = _sigmas("sigma_theta", sigma_theta, n)
+    sd = station_sigmas("sigma_d", sigma_d, n)
+    sth = station_sigmas("sigma_theta", sigma_theta, n)
     if sd is None or sth is None:
         raise ValueError("sigma_d, sigma_theta: both noise levels are needed to simulate")
     shape = d.shape if size is None else (integer("size", size, minimum=1), *d.shape)

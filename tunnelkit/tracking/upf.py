@@ -44,14 +44,8 @@ from ..budget import check_elements
 from .cv import STATE_DIM
 from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, REJECT, REOPEN, InnovationGate
 from .registry import register
-from .virtual_station import (
-    FAMILY,
-    EstimatorBase,
-    VsModel,
-    _check_model,
-    _check_prior,
-    regularized_cholesky,
-)
+from .virtual_station.filters import EstimatorBase, VsUKF
+from .virtual_station.model import FAMILY, VsModel, check_model, check_prior, regularized_cholesky
 
 __all__ = [
     "UnscentedParticleFilter",
@@ -151,8 +145,6 @@ def ukf_proposal_reference(
     A slow loop kept as the reference the vectorised :func:`ukf_proposal` is tested and
     benchmarked against. ``particles`` (N, 4) are the previous samples, ``covs`` (N, 4, 4) theirs.
     """
-    from .virtual_station import VsUKF
-
     out_m = np.empty_like(particles)
     out_P = np.empty_like(covs)
     for i in range(particles.shape[0]):
@@ -238,7 +230,7 @@ class UnscentedParticleFilter(EstimatorBase):
         gate: float | None = DEFAULT_GATE,
         reopen_after: int = DEFAULT_REOPEN_AFTER,
     ) -> None:
-        self.model = _check_model(model)
+        self.model = check_model(model)
         if proposal not in ("conditional", "carried"):
             raise ValueError(f"proposal: expected 'conditional' or 'carried', got {proposal!r}")
         self.proposal = proposal
@@ -256,7 +248,7 @@ class UnscentedParticleFilter(EstimatorBase):
         x0b = np.atleast_2d(x0)
         if x0b.ndim != 2 or x0b.shape[1] != STATE_DIM:
             raise ValueError(f"x0: expected shape (4,) or (B, 4), got {x0.shape}")
-        _, P0 = _check_prior(x0b[0], P0)
+        _, P0 = check_prior(x0b[0], P0)
         self.batch = x0b.shape[0]
         self.gate = InnovationGate(gate, reopen_after=reopen_after, batch=self.batch)
         L0 = np.linalg.cholesky(P0)

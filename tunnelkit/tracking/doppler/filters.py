@@ -1,37 +1,12 @@
-"""Doppler and ToA Kalman tracking from one roadside unit (Halili et al. 2022, sections 4-5).
+"""What the vehicle knows and measures, and the Kalman filters on it (Halili et al. 2022,
+sections 4-5).
 
-Three interchangeable trackers, registered in family ``"halili2022"``:
-
-* ``"EKF DS"`` - :class:`DopplerEKF`: constant-velocity state ``[x, y, v_x, v_y]`` (eq. 1-3,
-  spectral density ``q``), Doppler measurement eq. 4-5 with the sign pinned (approach positive),
-  the EKF recursion eq. 6-12 (filterpy's ``ExtendedKalmanFilter``), optionally the adaptive
-  measurement covariance of eq. 13-15.
-* ``"KF DS and ToA"`` - a KF on Doppler for the speed (:class:`SpeedKF`, ``H = f_c / c``) feeds a
-  KF on ToA for the distance (:class:`RangeKF`, eq. 17-21, ``H = 1 / c``) as control input; the
-  position follows eq. 16 with the heading from past estimates (:class:`HeadingDeadReckoning`).
-* ``"EKF DS and KF ToA"`` - as before, with the speed taken from the EKF DS.
-
-Every tracker has ``step(doppler, toa) -> position`` and ``run(measurements) -> Track``; a NaN or
-``None`` measurement is a dropped epoch (predict only, with a :class:`MeasurementWarning`).
-
-Not in the paper, on by default: every Kalman filter here gates its measurement
-(:mod:`tunnelkit.tracking.gating`, chi-square with one degree of freedom at ``gate = 0.999``): a
-Doppler locked on a moving scatterer or a ToA off by a gross NLOS excess is a missed epoch,
-counted in ``n_rejected``. ``gate=None`` gives the paper's filters. The KF on ToA calibrates the
-clock offset on a robust statistic of its first ToAs (not on one sample), and eq. 16 keeps the
-sign of the range change (a correction that is later undone cancels instead of adding up).
-
-Corrections to the paper, each shown in notebook 06:
-
-* eq. 5 ``h = v . (s - T) f / (c |s - T|)`` is positive when *receding*; the text (and Fig. 2)
-  has the approaching vehicle at positive Doppler. We use ``h = -(f_c/c) v . (p - T) / r``.
-* eq. 17 ``d_k = d_{k-1} + B u`` "when approaching" would make the distance grow while the
-  vehicle closes in. With ``u`` the approach speed (positive when approaching, Doppler-signed)
-  the distance model is ``d_k = d_{k-1} - dt u``.
-* eq. 14-15 add ``H P_check H^T`` (the *prior* covariance) to the post-fit residual power; the
-  residual ``e_k = y_k - h(s_hat_k)`` has covariance ``R - H P_hat H^T`` (posterior), so the
-  consistent estimate uses the posterior ``P_hat`` (Akhlaghi et al. 2017). ``adaptive_form``
-  selects ``"posterior"`` (default) or ``"paper"``.
+:class:`DopplerSetup` (transmitter, carrier, epoch), the constant-velocity model
+(:func:`cv_model`), the pinned-sign Doppler model and its Jacobian (:func:`doppler_model`,
+:func:`doppler_jacobian`), the EKF on Doppler with the adaptive R of eq. 13-15
+(:class:`DopplerEKF`), the scalar KFs on Doppler and ToA (:class:`SpeedKF`, :class:`RangeKF`) and
+the dead reckoning of eq. 16 (:class:`HeadingDeadReckoning`). :func:`scalar_measurement` is the
+input check of one epoch's measurement shared by the filters and the approaches.
 """
 
 from __future__ import annotations
@@ -42,40 +17,30 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 
-from .._validate import finite_array, integer, nonnegative, positive, probability, real
-from ..constants import C
-from ..drive import Drive, GnssFix, Measurements, slant_range
-from .cv import cv_process_noise, cv_transition
-from .gating import (
+from ..._validate import finite_array, integer, nonnegative, positive, probability, real
+from ...constants import C
+from ...drive import Drive, GnssFix
+from ..cv import cv_process_noise, cv_transition
+from ..gating import (
     DEFAULT_GATE,
     DEFAULT_REOPEN_AFTER,
     REJECT,
     InnovationGate,
     gated_filterpy_update,
 )
-from .registry import register
 
 __all__ = [
-    "APPROACHES",
-    "SIGMAS",
     "DopplerEKF",
     "DopplerSetup",
     "HeadingDeadReckoning",
     "MeasurementWarning",
     "RangeKF",
     "SpeedKF",
-    "Track",
     "cv_model",
     "doppler_jacobian",
-    "error_study",
-    "mean_errors",
-    "posterior_crlb",
-    "run_approaches",
-    "snapshot_fim",
+    "doppler_model",
+    "scalar_measurement",
 ]
-
-#: the paper's three approaches, in the order of its tables
-APPROACHES = ("EKF DS", "KF DS and ToA", "EKF DS and KF ToA")
 
 
 class MeasurementWarning(UserWarning):
@@ -108,17 +73,9 @@ class DopplerSetup:
         return self.fc / C
 
 
-@dataclass(frozen=True)
-class Track:
-    """Output of a run: times (T,), position estimates (T, 2) and speed estimates (T,) [m/s]."""
-
-    t: np.ndarray
-    position: np.ndarray
-    speed: np.ndarray
-
-
-def _measurement(name: str, z) -> float | None:
-    """``None`` for a dropped epoch (None or NaN), else a float; inf and non-numbers refused."""
+def scalar_measurement(name: str, z) -> float | None:
+    """One epoch's measurement ``z`` (parameter ``name``): ``None`` for a dropped epoch (``None``
+    or NaN), else a float; infinities and non-numbers are refused."""
     if z is None:
         return None
     try:
@@ -266,7 +223,7 @@ class DopplerEKF:
 
     def step(self, z) -> np.ndarray:
         """Predict (eq. 8-9) and, unless ``z`` is None/NaN, update with Doppler ``z`` [Hz] (eq. 10-12)."""
-        z = _measurement("z", z)
+        z = scalar_measurement("z", z)
         kf = self.kf
         kf.predict()
         kf.P = 0.5 * (kf.P + kf.P.T)  # F P F^T and the Joseph form leave rounding asymmetry
@@ -353,7 +310,7 @@ class SpeedKF:
 
     def step(self, z) -> float:
         """Predict, then update with Doppler ``z`` [Hz] unless dropped."""
-        z = _measurement("z", z)
+        z = scalar_measurement("z", z)
         kf = self.kf
         kf.predict()
         if z is None:
@@ -455,7 +412,7 @@ class RangeKF:
     def step(self, u: float, z) -> float:
         """Predict with approach speed ``u`` [m/s], update with ToA ``z`` [s] unless dropped/impossible."""
         u = float(finite_array("u", u, ndim=0))
-        z = _measurement("z", z)
+        z = scalar_measurement("z", z)
         kf = self.kf
         kf.predict(u=np.array([[-u]]))
         if z is not None and z <= 0:
@@ -513,364 +470,3 @@ class HeadingDeadReckoning:
             self.phi = phi
             self._last = self.p.copy()
         return self.p.copy()
-
-
-# --- the three approaches, registered -------------------------------------------------------------
-
-
-class _Base:
-    name = ""
-    setup: DopplerSetup
-
-    def step(self, doppler, toa=None) -> np.ndarray:  # pragma: no cover - interface
-        raise NotImplementedError
-
-    def speed(self) -> float:  # pragma: no cover - interface
-        raise NotImplementedError
-
-    def run(self, meas: Measurements) -> Track:
-        """Run over a whole measurement stream; dropped epochs predict only (one summary warning)."""
-        if not isinstance(meas, Measurements):
-            raise TypeError(f"meas: expected Measurements, got {type(meas).__name__}")
-        n = len(meas.t)
-        pos = np.empty((n, 2))
-        spd = np.empty(n)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", MeasurementWarning)
-            for k in range(n):
-                pos[k] = self.step(meas.doppler[k], meas.toa[k]) if k else self._first()
-                spd[k] = self.speed()
-        other = [w for w in caught if not issubclass(w.category, MeasurementWarning)]
-        for w in other:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        n_bad = len(caught) - len(other)
-        if n_bad:
-            warnings.warn(
-                f"{self.name}: {n_bad} measurement(s) dropped or rejected; "
-                "predicted only at those epochs",
-                MeasurementWarning,
-                stacklevel=2,
-            )
-        return Track(t=meas.t, position=pos, speed=spd)
-
-    def _first(self) -> np.ndarray:  # the first epoch is the GNSS fix itself
-        return self._p0.copy()
-
-    @property
-    def n_rejected(self) -> int:
-        """Doppler and ToA samples the gates of this approach rejected (predicted only)."""
-        parts = (getattr(self, a, None) for a in ("ekf", "speed_kf", "range_kf"))
-        return sum(f.n_rejected for f in parts if f is not None)
-
-
-#: keywords of the gates, passed to every filter of an approach
-_GATE_KEYS = ("gate", "reopen_after")
-
-
-def _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw) -> DopplerEKF:
-    """The EKF on Doppler shared by "EKF DS" and "EKF DS and KF ToA" (extra keywords filtered)."""
-    extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form", *_GATE_KEYS)}
-    return DopplerEKF(setup, fix, sigma_hz=sigma_hz, q=q, adaptive=adaptive, **extra)
-
-
-@register("halili2022", "EKF DS")
-class EkfDS(_Base):
-    """EKF DS (sec. 4): the EKF on Doppler; the ToA is not used."""
-
-    name = "EKF DS"
-
-    def __init__(
-        self,
-        setup: DopplerSetup,
-        fix: GnssFix,
-        *,
-        sigma_hz: float = 32.79,
-        q: float = 0.5,
-        adaptive: bool = False,
-        **kw,
-    ) -> None:
-        self.setup = setup
-        self.ekf = _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw)
-        self._p0 = np.array(fix.position, dtype=float)
-
-    def step(self, doppler, toa=None) -> np.ndarray:
-        return self.ekf.step(doppler)
-
-    def speed(self) -> float:
-        return float(np.linalg.norm(self.ekf.velocity))
-
-
-class _KfToA(_Base):
-    """Shared part of the two section-5 approaches: range KF + eq. 16 dead reckoning.
-
-    Subclasses say where the approach speed comes from (``_init_speed`` and ``_approach_speed``).
-    """
-
-    def __init__(
-        self,
-        setup: DopplerSetup,
-        fix: GnssFix,
-        *,
-        sigma_hz: float = 32.79,
-        q: float = 0.5,
-        adaptive: bool = False,
-        sigma_toa: float = 3e-9,
-        calibrate: bool = True,
-        calibration_epochs: int = 10,
-        **kw,
-    ) -> None:
-        self.setup = setup
-        self._p0 = np.array(fix.position, dtype=float)
-        d0 = float(slant_range(fix.position, setup.tx, setup.dz))
-        gates = {k: v for k, v in kw.items() if k in _GATE_KEYS}
-        self.range_kf = RangeKF(
-            setup,
-            d0,
-            sigma_toa=sigma_toa,
-            q=q,
-            sigma_d0=fix.sigma_p,
-            calibrate=calibrate,
-            calibration_epochs=calibration_epochs,
-            **gates,
-        )
-        self.dr = HeadingDeadReckoning(fix.position, fix.velocity)
-        w = fix.position - setup.tx
-        self._u0 = -float(fix.velocity @ w) / d0
-        self._recent: list[float] = []  # the last Doppler samples, for the phase of eq. 16
-        self._phase = 1.0 if self._u0 >= 0 else -1.0
-        self._init_speed(setup, fix, sigma_hz, q, adaptive, kw)
-
-    def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
-        raise NotImplementedError
-
-    def _approach_speed(self, doppler) -> float:
-        raise NotImplementedError
-
-    def _phase_of(self, doppler) -> float:
-        """+1 approaching, -1 receding: the sign of the median of the last ``PHASE_WINDOW`` valid
-        Doppler samples (a median, so one outlier cannot flip it; no filter lag at the pass)."""
-        z = _measurement("doppler", doppler)
-        if z is not None:
-            self._recent = [*self._recent[-(self.PHASE_WINDOW - 1) :], z]
-            med = float(np.median(self._recent))
-            if med != 0:
-                self._phase = 1.0 if med > 0 else -1.0
-        return self._phase
-
-    #: Doppler samples whose median gives the phase (approaching/receding) of eq. 16
-    PHASE_WINDOW = 5
-
-    def step(self, doppler, toa=None) -> np.ndarray:
-        """Eq. 16-21 with the sign kept: a range change counts forward if it shrinks while
-        approaching or grows while receding, backward otherwise (phase: :meth:`_phase_of`)."""
-        phase = self._phase_of(doppler)
-        u = self._approach_speed(doppler)
-        d_prev = self.range_kf.distance
-        d = self.range_kf.step(u, toa)
-        return self.dr.step(phase * (d_prev - d))
-
-
-@register("halili2022", "KF DS and ToA")
-class KfDSToA(_KfToA):
-    """KF DS and ToA (sec. 5): KF on Doppler for the speed, KF on ToA for the distance, eq. 16."""
-
-    name = "KF DS and ToA"
-
-    def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
-        extra = {k: v for k, v in kw.items() if k in ("a", "adaptive_form", *_GATE_KEYS)}
-        self.speed_kf = SpeedKF(
-            setup,
-            self._u0,
-            sigma_hz=sigma_hz,
-            q=q,
-            sigma_u0=fix.sigma_v,
-            adaptive=adaptive,
-            **extra,
-        )
-
-    def _approach_speed(self, doppler) -> float:
-        return self.speed_kf.step(doppler)
-
-    def speed(self) -> float:
-        return abs(self.speed_kf.speed)
-
-
-@register("halili2022", "EKF DS and KF ToA")
-class EkfDSKfToA(_KfToA):
-    """EKF DS and KF ToA (sec. 5, last paragraph): the EKF's approach speed drives the KF on ToA."""
-
-    name = "EKF DS and KF ToA"
-
-    def _init_speed(self, setup, fix, sigma_hz, q, adaptive, kw) -> None:
-        self.ekf = _doppler_ekf(setup, fix, sigma_hz, q, adaptive, kw)
-
-    def _approach_speed(self, doppler) -> float:
-        self.ekf.step(doppler)
-        return self.ekf.approach_speed
-
-    def speed(self) -> float:
-        return float(np.linalg.norm(self.ekf.velocity))
-
-
-SIGMAS = {"103.70 Hz": 103.70, "32.79 Hz": 32.79, "10.37 Hz": 10.37, "dynamic": None}
-"""The paper's measurement-noise settings (sec. 6, Fig. 4); ``None`` = adaptive R (eq. 15)."""
-
-
-def run_approaches(
-    drive: Drive,
-    meas: Measurements,
-    fix: GnssFix,
-    *,
-    sigma_hz: float | None = 32.79,
-    q: float = 0.5,
-    approaches=APPROACHES,
-    sigma0_hz: float = 32.79,
-    **kw,
-) -> dict[str, Track]:
-    """Run the registered approaches on one drive; ``sigma_hz=None`` means adaptive R from ``sigma0_hz``."""
-    from .registry import family
-
-    fam = family("halili2022")
-    setup = DopplerSetup.from_drive(drive)
-    adaptive = sigma_hz is None
-    out = {}
-    for name in approaches:
-        if name not in fam:
-            raise ValueError(
-                f"approaches: {name!r} is not in family 'halili2022'; members: {list(fam)}"
-            )
-        trk = fam[name](
-            setup, fix, sigma_hz=sigma0_hz if adaptive else sigma_hz, q=q, adaptive=adaptive, **kw
-        )
-        out[name] = trk.run(meas)
-    return out
-
-
-def error_study(
-    drive: Drive,
-    rng: np.random.Generator,
-    *,
-    sigmas: dict | None = None,
-    q: float = 0.5,
-    approaches=APPROACHES,
-    **kw,
-) -> dict[tuple[str, str], np.ndarray]:
-    """One noisy realisation of ``drive``, every approach at every sigma: position errors (T,) each.
-
-    Keys ``(approach, sigma label)``; all settings see the same measurements and GNSS fix.
-    """
-    from ..drive import gnss_fix, measure
-
-    sigmas = SIGMAS if sigmas is None else dict(sigmas)
-    meas = measure(drive, rng)
-    fix = gnss_fix(drive, rng)
-    out = {}
-    for label, sig in sigmas.items():
-        tracks = run_approaches(drive, meas, fix, sigma_hz=sig, q=q, approaches=approaches, **kw)
-        for name, tr in tracks.items():
-            out[(name, label)] = np.linalg.norm(tr.position - drive.position, axis=-1)
-    return out
-
-
-def mean_errors(
-    drive: Drive,
-    seeds,
-    *,
-    sigma_hz: float | None = 32.79,
-    q: float = 0.5,
-    approaches=APPROACHES,
-    **kw,
-) -> dict[str, float]:
-    """Mean position error of each approach, averaged over drives seeded by ``seeds`` (ints).
-
-    Each seed gives one noise realisation and GNSS fix (``numpy.random.default_rng(seed)``) shared
-    by all approaches; extra keywords (``gate``, ``adaptive_form``, ...) go to the trackers.
-    """
-    from ..drive import gnss_fix, measure
-
-    seeds = [int(s) for s in seeds]
-    if not seeds:
-        raise ValueError("seeds: give at least one seed")
-    acc: dict[str, list[float]] = {name: [] for name in approaches}
-    for seed in seeds:
-        rng = np.random.default_rng(seed)
-        meas = measure(drive, rng)
-        fix = gnss_fix(drive, rng)
-        tracks = run_approaches(
-            drive, meas, fix, sigma_hz=sigma_hz, q=q, approaches=approaches, **kw
-        )
-        for name, tr in tracks.items():
-            acc[name].append(float(np.mean(np.linalg.norm(tr.position - drive.position, axis=1))))
-    return {name: float(np.mean(v)) for name, v in acc.items()}
-
-
-# --- what one transmitter can observe -------------------------------------------------------------
-
-
-def snapshot_fim(
-    p, v, setup: DopplerSetup, *, sigma_hz: float | None = None, sigma_range: float | None = None
-) -> np.ndarray:
-    """Fisher information on the position ``[x, y]`` from one epoch (velocity known), shape (2, 2).
-
-    Doppler (``sigma_hz``) and/or range from ToA (``sigma_range`` metres); closed form
-    ``sum_i J_i^T J_i / sigma_i^2`` with ``J`` from :func:`doppler_jacobian` and ``w / r``.
-    One scalar measurement gives a rank-one matrix: information along one direction only.
-    """
-    p = finite_array("p", p, shape=(2,))
-    v = finite_array("v", v, shape=(2,))
-    if sigma_hz is None and sigma_range is None:
-        raise ValueError("sigma_hz, sigma_range: give at least one measurement")
-    F = np.zeros((2, 2))
-    if sigma_hz is not None:
-        J = doppler_jacobian(np.concatenate([p, v]), setup)[:, :2]
-        F += J.T @ J / positive("sigma_hz", sigma_hz) ** 2
-    if sigma_range is not None:
-        w = p - setup.tx
-        J = (w / float(slant_range(p, setup.tx, setup.dz)))[None, :]
-        F += J.T @ J / positive("sigma_range", sigma_range) ** 2
-    return F
-
-
-def posterior_crlb(
-    drive: Drive,
-    *,
-    q: float = 0.5,
-    sigma_hz: float | None = 32.79,
-    sigma_range: float | None = None,
-    sigma_p0: float | None = None,
-    sigma_v0: float | None = None,
-) -> np.ndarray:
-    """Posterior CRLB (Tichavsky et al. 1998) of ``[x, y, v_x, v_y]`` along the true drive, (T, 4, 4).
-
-    For linear-Gaussian dynamics the information recursion is
-    ``J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + H_k^T R^{-1} H_k`` with ``H_k`` at the true state;
-    ``J_0 = P_0^{-1} + H_0^T R^{-1} H_0`` from the GNSS fix. Doppler (``sigma_hz``) and/or
-    range (``sigma_range``, metres); both None gives the prior alone (dead reckoning).
-    """
-    if not isinstance(drive, Drive):
-        raise TypeError(f"drive: expected a Drive, got {type(drive).__name__}")
-    cfg = drive.config
-    setup = DopplerSetup.from_drive(drive)
-    q = nonnegative("q", q)
-    sp = positive("sigma_p0", cfg.gnss_sigma_m if sigma_p0 is None else sigma_p0)
-    sv = positive("sigma_v0", cfg.gnss_sigma_v if sigma_v0 is None else sigma_v0)
-    F, Q = cv_model(setup.dt, q)
-    s = np.concatenate([drive.position, drive.velocity], -1)
-    info = np.zeros((len(s), 4, 4))
-    if sigma_hz is not None:
-        H = doppler_jacobian(s, setup)[:, 0, :]
-        info += H[:, :, None] * H[:, None, :] / positive("sigma_hz", sigma_hz) ** 2
-    if sigma_range is not None:
-        w = drive.position - setup.tx
-        H = np.concatenate(
-            [w / slant_range(drive.position, setup.tx, setup.dz)[:, None], np.zeros_like(w)], -1
-        )
-        info += H[:, :, None] * H[:, None, :] / positive("sigma_range", sigma_range) ** 2
-    out = np.empty_like(info)
-    P = np.linalg.inv(np.diag([1 / sp**2, 1 / sp**2, 1 / sv**2, 1 / sv**2]) + info[0])
-    out[0] = P
-    for k in range(1, len(s)):
-        Pp = F @ P @ F.T + Q
-        P = np.linalg.inv(np.linalg.inv(Pp) + info[k])
-        out[k] = 0.5 * (P + P.T)
-    return out
