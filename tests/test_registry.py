@@ -53,10 +53,23 @@ def _halili2022(name, cls):
     assert np.isfinite(trk.speed()) and isinstance(trk.n_rejected, int)
 
 
+def _italiano2026(name, cls):
+    from tunnelkit import studies
+
+    drive = studies.simulate_drive(
+        "italiano2026-straight", np.random.default_rng(0), condition="L", n_epochs=3
+    )
+    trk = cls.for_drive(drive)
+    est, details = trk.track(drive)
+    assert est.shape == (3, 3) and np.all(np.isfinite(est))
+    assert len(details.estimates if hasattr(details, "estimates") else details) == 3
+    np.testing.assert_array_equal(est, studies.evaluate(drive, method=name).estimates)
+
+
 #: family -> how one member is built and run (the protocol of ``registry``'s docstring)
-PROTOCOLS = {"jiang2023": _jiang2023, "halili2022": _halili2022}
+PROTOCOLS = {"jiang2023": _jiang2023, "halili2022": _halili2022, "italiano2026": _italiano2026}
 #: families whose members share no protocol yet (listed in ``registry``'s docstring)
-WITHOUT_PROTOCOL = {"italiano2026"}
+WITHOUT_PROTOCOL: set[str] = set()
 
 
 def test_every_family_has_a_protocol_or_is_listed_without_one():

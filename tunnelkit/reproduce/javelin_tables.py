@@ -155,7 +155,7 @@ NOTES = [
     "zeta = 1, gamma = 0.2, curvature of a reflection = distance to the reflection point, eq. 51). "
     "'paper design + VUE curvature': the same parameters, the curvature of a reflection modelled "
     "as the distance to its VUE (the exact wavefront's radius, what the ML route measures).",
-    "design 'ours' on the ML route (experiment.OURS_ML): Doppler clutter rejection, global "
+    "design 'ours' on the ML route (designs.ours_ml): Doppler clutter rejection, global "
     "nearest neighbour, mirrored VUE motion, no update at birth, curvature centred on the VUE, "
     "measurement noise = the RMS extraction error of the ML route measured on seed 0 drives.",
     "Both designs start from the true first position with 1 m uncertainty (the paper's open-sky fix).",
@@ -163,7 +163,7 @@ NOTES = [
     "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails, uses its curvature only when "
     "plausible (|d - kappa| within the clock-bias support, range within 200 m), else its delay "
     "distance, and holds its last fix on epochs without one.",
-    "Seeds: designs were chosen on seed 0 (and seed 7); experiment.HELD_OUT_SEED (20261202) was "
+    "Seeds: designs were chosen on seed 0 (and seed 7); studies.HELD_OUT_SEED (20261202) was "
     "never looked at while choosing anything.",
 ]
 

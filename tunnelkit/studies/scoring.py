@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import C
+from ..tracking import registry
 from ..tracking.javelin.designs import paper
 from ..tracking.javelin.roles import JavelinDesign
 from ..tracking.javelin.tenfiloc import TeNFiLoc
-from ..tracking.javelin.tracker import JavelinRun, run_javelin
+from ..tracking.javelin.tracker import JavelinRun
 from .drives import DriveData
 
 __all__ = [
@@ -43,25 +43,14 @@ def settled(t: np.ndarray) -> np.ndarray:
 def tenfiloc_track(
     drive: DriveData, baseline: TeNFiLoc | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """TeNFiLoc fixes per epoch (T, 3) and which epochs had a fix; without a fix the previous
-    one is held (the start position before the first), so every epoch has an estimate."""
-    if baseline is None:
-        baseline = TeNFiLoc(
-            base_station=tuple(drive.base_station),
-            assume_los=drive.condition is None or drive.condition.los_probability == 1.0,
-            bias_limit=C * max(drive.clock_bias_limit, 1e-12),
-        )
-    tf = baseline
-    out = np.empty_like(drive.truth)
-    ok = np.zeros(len(drive.epochs), bool)
-    last = drive.truth[0].copy()
-    for k, m in enumerate(drive.epochs):
-        fix = tf.locate(m, initial=last)
-        if fix.position is not None and np.all(np.isfinite(fix.position)):
-            last = fix.position
-            ok[k] = True
-        out[k] = last
-    return out, ok
+    """TeNFiLoc fixes per epoch (T, 3) and which epochs had a fix (:meth:`TeNFiLoc.track`; the
+    baseline defaults to :meth:`TeNFiLoc.for_drive`)."""
+    if not isinstance(drive, DriveData):
+        raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
+    tf = TeNFiLoc.for_drive(drive) if baseline is None else baseline
+    if not isinstance(tf, TeNFiLoc):
+        raise TypeError(f"baseline: expected a TeNFiLoc, got {type(tf).__name__}")
+    return tf.track(drive)
 
 
 def error_metrics(estimates, truth) -> dict[str, float]:
@@ -100,11 +89,12 @@ def evaluate(
     """
     if not isinstance(drive, DriveData):
         raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
-    if method == "TeNFiLoc":
-        est, _ = tenfiloc_track(drive)
-        return Evaluation(est, error_metrics(est, drive.truth))
-    if method != "JAVELIN":
+    if method not in registry.family("italiano2026"):
         raise ValueError(f"method: expected 'JAVELIN' or 'TeNFiLoc', got {method!r}")
+    cls = registry.get("italiano2026", method)
+    if method == "TeNFiLoc":
+        est, _ = cls.for_drive(drive).track(drive)
+        return Evaluation(est, error_metrics(est, drive.truth))
     d = paper() if design is None else design
     if not isinstance(d, JavelinDesign):
         raise TypeError(f"design: expected a JavelinDesign, got {type(d).__name__}")
@@ -114,15 +104,8 @@ def evaluate(
             f"each path's covariance, but the drive's route ({drive.extraction!r}) reports none "
             "(SignalRoute(report_covariance=True))"
         )
-    d = d.with_(base_station=tuple(float(v) for v in drive.base_station), sigma_p0_ue=sigma_p0_ue)
-    run = run_javelin(
-        drive.epochs,
-        drive.speed,
-        drive.heading,
-        drive.dt,
-        drive.truth[0],
-        d,
-        keep_reports=keep_reports,
+    est, run = cls.for_drive(drive, d, sigma_p0_ue=sigma_p0_ue).track(
+        drive, keep_reports=keep_reports
     )
     return Evaluation(run.estimates, error_metrics(run.estimates, drive.truth), run)
 

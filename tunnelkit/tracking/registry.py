@@ -30,11 +30,12 @@ every member through it). Each member's ``name`` attribute is its registered nam
     ``Measurements`` stream (epoch 0 is the GNSS fix), or ``trk.step(doppler, toa)`` -> the
     position (2,) of one further epoch; ``trk.speed()``, ``trk.n_rejected``.
 
-``"italiano2026"`` (JAVELIN; :mod:`tunnelkit.tracking.javelin`)
-    No shared protocol: ``Javelin(initial_position, config)`` is a tracker
-    (``step(paths, speed, heading, dt)`` -> ``StepReport``; streams with ``run_javelin``), while
-    ``TeNFiLoc(**settings)`` is a snapshot locator (``locate(paths, initial=...)`` ->
-    ``TeNFiLocFix``; streams with ``javelin.experiment.tenfiloc_track``).
+``"italiano2026"`` (JAVELIN, TeNFiLoc; :mod:`tunnelkit.tracking.javelin`)
+    Build for a simulated drive with ``cls.for_drive(drive, design=None)`` (JAVELIN takes a
+    :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign`, TeNFiLoc none), run with
+    ``trk.track(drive)`` -> ``(estimates (T, 3), details)`` (the ``JavelinRun``, or which epochs
+    had a fix). ``Javelin.step(paths, speed, heading, dt)`` and ``TeNFiLoc.locate(paths)`` are
+    the per-epoch calls under it.
 """
 
 from __future__ import annotations

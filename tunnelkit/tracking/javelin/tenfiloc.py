@@ -23,6 +23,7 @@ the tracking loop then holds the previous fix.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -56,6 +57,7 @@ class TeNFiLoc:
     than ``max_range`` from the base station are refused on every branch.
     """
 
+    name: ClassVar[str] = "TeNFiLoc"
     los_gamma: float = 0.2
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
     estimate_bias: bool = True
@@ -71,6 +73,35 @@ class TeNFiLoc:
         if g > 1:
             raise ValueError(f"los_gamma: must lie in (0, 1], got {g}")
         self.base_station = tuple(float(v) for v in vector("base_station", self.base_station, 3))
+
+    # -- the family protocol (tunnelkit.tracking.registry, "italiano2026") ----------------------
+    @classmethod
+    def for_drive(cls, drive, design=None) -> TeNFiLoc:
+        """The baseline for a simulated drive: the base station at its reference antenna, LoS
+        assumed when the drive's condition keeps it (TeNFiLoc-L), the clock-bias support of its
+        route. ``design`` must be ``None`` (TeNFiLoc has no tracker design)."""
+        if design is not None:
+            raise ValueError(f"design: TeNFiLoc takes no tracker design, got {design!r}")
+        cond = drive.condition
+        return cls(
+            base_station=tuple(float(v) for v in drive.base_station),
+            assume_los=cond is None or cond.los_probability == 1.0,
+            bias_limit=C * max(drive.clock_bias_limit, 1e-12),
+        )
+
+    def track(self, drive) -> tuple[np.ndarray, np.ndarray]:
+        """Fixes per epoch (T, 3) and which epochs had a fix; without a fix the previous one is
+        held (the true start position before the first), so every epoch has an estimate."""
+        out = np.empty_like(np.asarray(drive.truth, dtype=float))
+        ok = np.zeros(len(drive.epochs), bool)
+        last = np.asarray(drive.truth[0], dtype=float).copy()
+        for k, m in enumerate(drive.epochs):
+            fix = self.locate(m, initial=last)
+            if fix.position is not None and np.all(np.isfinite(fix.position)):
+                last = fix.position
+                ok[k] = True
+            out[k] = last
+        return out, ok
 
     def locate(
         self, paths: PathMeasurements | None, *, los_path: int | None = None, initial=None

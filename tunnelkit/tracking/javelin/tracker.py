@@ -60,6 +60,8 @@ class Javelin:
     >>> rep = trk.step(paths, speed=10.0, heading=0.0, dt=0.1)   # doctest: +SKIP
     """
 
+    name = "JAVELIN"
+
     def __init__(self, initial_position, design: JavelinDesign | None = None) -> None:
         self.design = JavelinDesign() if design is None else design
         if not isinstance(self.design, JavelinDesign):
@@ -73,6 +75,52 @@ class Javelin:
         self.gate = ChiSquareGate(self.config.gate_probability)
         self.k = 0
         self._last_motion: tuple[float, float] | None = None
+
+    # -- the family protocol (tunnelkit.tracking.registry, "italiano2026") ----------------------
+    @classmethod
+    def for_drive(cls, drive, design: JavelinDesign | None = None, *, sigma_p0_ue: float = 1.0):
+        """A tracker for a simulated drive (anything with ``truth``, ``base_station``,
+        ``epochs``, ``speed``, ``heading``, ``dt``): it starts from the true first position (the
+        open-sky fix the paper assumes) with ``sigma_p0_ue`` [m] of uncertainty, the base station
+        at the drive's reference antenna, the roles of ``design`` (default the paper's)."""
+        d = JavelinDesign() if design is None else design
+        if not isinstance(d, JavelinDesign):
+            raise TypeError(f"design: expected a JavelinDesign, got {type(d).__name__}")
+        d = d.with_(
+            base_station=tuple(float(v) for v in drive.base_station), sigma_p0_ue=sigma_p0_ue
+        )
+        return cls(drive.truth[0], d)
+
+    def track(self, drive, *, keep_reports: bool = False) -> tuple[np.ndarray, JavelinRun]:
+        """UE estimates (T, 3) over ``drive``'s measurement stream and the :class:`JavelinRun`."""
+        run = self.run(
+            drive.epochs, drive.speed, drive.heading, drive.dt, keep_reports=keep_reports
+        )
+        return run.estimates, run
+
+    def run(self, epochs, speed, heading, dt: float, *, keep_reports: bool = False) -> JavelinRun:
+        """Step through a measurement stream (:func:`run_javelin`)."""
+        n = len(epochs)
+        spd = np.asarray(speed, dtype=float).reshape(-1)
+        hdg = np.asarray(heading, dtype=float).reshape(-1)
+        if spd.size != n or hdg.size != n:
+            raise ValueError(
+                f"speed, heading: expected {n} values (one per epoch), got {spd.size} and {hdg.size}"
+            )
+        finite_array("dt", dt, ndim=0)
+        est = np.empty((n, 3))
+        cov = np.empty((n, 3, 3))
+        ntr = np.empty(n, dtype=int)
+        reps, faults = [], 0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", JavelinWarning)
+            for k in range(n):
+                r = self.step(epochs[k], spd[max(k - 1, 0)], hdg[max(k - 1, 0)], dt if k else 0.0)
+                est[k], cov[k], ntr[k] = r.estimate, r.cov, len(r.ids) + 1
+                faults += len(r.faults)
+                if keep_reports:
+                    reps.append(r)
+        return JavelinRun(est, cov, ntr, reps, faults)
 
     # -- small pieces -------------------------------------------------------------------------
     def _motion(self, speed, heading, faults: list[str]) -> tuple[float, float, float | None]:
@@ -226,25 +274,6 @@ def run_javelin(
     Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k``.
     Warnings about faults are collected and counted instead of printed.
     """
-    n = len(epochs)
-    spd = np.asarray(speed, dtype=float).reshape(-1)
-    hdg = np.asarray(heading, dtype=float).reshape(-1)
-    if spd.size != n or hdg.size != n:
-        raise ValueError(
-            f"speed, heading: expected {n} values (one per epoch), got {spd.size} and {hdg.size}"
-        )
-    finite_array("dt", dt, ndim=0)
-    trk = Javelin(initial_position, design)
-    est = np.empty((n, 3))
-    cov = np.empty((n, 3, 3))
-    ntr = np.empty(n, dtype=int)
-    reps, faults = [], 0
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", JavelinWarning)
-        for k in range(n):
-            r = trk.step(epochs[k], spd[max(k - 1, 0)], hdg[max(k - 1, 0)], dt if k else 0.0)
-            est[k], cov[k], ntr[k] = r.estimate, r.cov, len(r.ids) + 1
-            faults += len(r.faults)
-            if keep_reports:
-                reps.append(r)
-    return JavelinRun(est, cov, ntr, reps, faults)
+    return Javelin(initial_position, design).run(
+        epochs, speed, heading, dt, keep_reports=keep_reports
+    )
