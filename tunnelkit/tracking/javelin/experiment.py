@@ -148,16 +148,14 @@ def ml_epoch(ep, config):
     (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor."""
     from ...extraction.ml import ml_paths
 
-    args = (ep.array.local, config.fc, config.tone_spacing, config.symbol_period)
-    return ep.with_estimates(ml_paths(ep.snapshot.H, len(ep.paths), *args))
+    return ep.with_estimates(ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config))
 
 
 def separate_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
     from ...extraction.coherent import resolve_coherent
 
-    args = (ep.array.local, config.fc, config.tone_spacing, config.symbol_period)
-    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, *args))
+    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 
 def _route(scenario: str, model: str):
