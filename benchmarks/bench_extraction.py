@@ -32,7 +32,7 @@ def _tensor():
 
 def cases() -> list[Case]:
     H, arr, cfg, L = _tensor()
-    args = (arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    args = (arr, cfg)
 
     def run(**kw):
         with warnings.catch_warnings():

@@ -49,7 +49,7 @@ def _tensor():
 
 def cases() -> list[Case]:
     H, arr, cfg, L = _tensor()
-    args = (arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    args = (arr, cfg)
 
     def run(**kw):
         with threadpool_limits(1), warnings.catch_warnings():
@@ -91,14 +91,7 @@ def _scene_errors(rng):
     sc = evaluation.random_scene(rng, int(rng.integers(2, 5)))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        est = extraction.extract_paths(
-            sc.tensor(rng),
-            len(sc.d),
-            sc.element_positions,
-            sc.config.fc,
-            sc.config.tone_spacing,
-            sc.config.symbol_period,
-        )
+        est = extraction.extract_paths(sc.tensor(rng), len(sc.d), sc.element_positions, sc.config)
     err = evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb())
     return err, ["scene"] * len(sc.d), est.fit
 
@@ -168,7 +161,7 @@ def cpu_times(repeat: int = 15) -> str:
     bench_extraction's tensor, one BLAS thread, interleaved: on a shared machine the wall-clock
     medians of ``cases`` grow with the load, the CPU times much less."""
     H, arr, cfg, L = _tensor()
-    args = (arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    args = (arr, cfg)
     out = {"default": [], "coherent": [], "cpd": []}
     with threadpool_limits(1), warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -106,9 +106,7 @@ def test_resolve_coherent_finds_every_path_the_cpd_merged(javelin_epoch):
     before = _errors_deg(ep.measurements, ep.paths, ep.truth_index)
     # the paper's route: LoS biased by the ceiling bounce it absorbed, ceiling and road missed
     assert before["los"] > 2.0 and "facet 6" not in before and "road" not in before
-    est = coherent.resolve_coherent(
-        ep.snapshot.H, ep.estimates, ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period
-    )
+    est = coherent.resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, cfg)
     assert len(est) == len(ep.paths) and np.all(np.isfinite(est.d)) and np.all(np.isfinite(est.v))
     meas = signal_route.measurements_from_estimates(est, ep.array)
     truth = evaluation.match_paths(
@@ -129,10 +127,8 @@ def test_resolve_coherent_leaves_resolved_paths_alone():
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     arr, paths = route.paths(26)
     H = channel.channel_tensor(paths, CFG)
-    est = extraction.extract_paths(
-        H, len(paths), arr.local, FC, CFG.tone_spacing, CFG.symbol_period, refine="joint"
-    )
-    out = coherent.resolve_coherent(H, est, arr.local, FC, CFG.tone_spacing, CFG.symbol_period)
+    est = extraction.extract_paths(H, len(paths), arr, CFG, refine="joint")
+    out = coherent.resolve_coherent(H, est, arr, CFG)
     np.testing.assert_allclose(out.d, est.d, atol=1e-4)
     np.testing.assert_allclose(out.v, est.v, atol=1e-3)
     np.testing.assert_allclose(out.direction, est.direction, atol=1e-5)
@@ -141,7 +137,7 @@ def test_resolve_coherent_leaves_resolved_paths_alone():
 def test_resolve_coherent_bad_input(javelin_epoch):
     route, ep = javelin_epoch
     cfg = route.config
-    args = (ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    args = (ep.array, cfg)
     with pytest.raises(TypeError, match="est"):
         coherent.resolve_coherent(ep.snapshot.H, "paths", *args)
     H = ep.snapshot.H.copy()
@@ -154,6 +150,10 @@ def test_resolve_coherent_bad_input(javelin_epoch):
         coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, tol=-1.0)
     with pytest.raises(ValueError, match="min_power"):
         coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, min_power=-0.1)
+    with pytest.raises(TypeError, match="srs"):  # the old positional radio arguments
+        coherent.resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, cfg.fc)
+    with pytest.raises(ValueError, match="array"):
+        coherent.resolve_coherent(ep.snapshot.H, ep.estimates, ep.array.local[:-1], cfg)
 
 
 def _tensor(thetas, dists, speeds, gains):
@@ -166,7 +166,7 @@ def _tensor(thetas, dists, speeds, gains):
 
 
 def _resolve(H, n, **kw):
-    args = (POS, FC, CFG.tone_spacing, CFG.symbol_period)
+    args = (POS, CFG)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", extraction.CPDConvergenceWarning)
         est = extraction.extract_paths(H, n, *args, refine="joint")
@@ -190,7 +190,7 @@ def test_paths_resolved_in_delay_stay_apart_even_with_one_direction():
 def test_without_splits_the_merged_pair_stays_merged(javelin_epoch):
     route, ep = javelin_epoch
     cfg = route.config
-    args = (ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    args = (ep.array, cfg)
     est = coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, max_sources=1)
     meas = signal_route.measurements_from_estimates(est, ep.array)
     truth = evaluation.match_paths(
@@ -203,7 +203,7 @@ def test_without_splits_the_merged_pair_stays_merged(javelin_epoch):
 def test_fewer_paths_than_asked_warns_and_too_many_raise(javelin_epoch):
     route, ep = javelin_epoch
     cfg = route.config
-    args = (ep.array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+    args = (ep.array, cfg)
     with pytest.warns(RuntimeWarning, match="fewer than n_paths"):
         est = coherent.resolve_coherent(ep.snapshot.H, ep.estimates, *args, n_paths=40)
     assert 5 <= len(est) < 40 and np.all(np.isfinite(est.d))

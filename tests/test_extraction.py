@@ -19,7 +19,7 @@ def route():
 def _extract(H, L, arr, **kw):
     """The paper's route (eq. 13-24) unless ``refine`` says otherwise (the ML route: test_ml.py)."""
     kw.setdefault("refine", "joint")
-    return extraction.extract_paths(H, L, arr.local, FC, CFG.tone_spacing, CFG.symbol_period, **kw)
+    return extraction.extract_paths(H, L, arr, CFG, **kw)
 
 
 def _angle_deg(u, v):
@@ -161,27 +161,120 @@ def test_los_rmse_within_twice_the_crlb(route):
 def test_bad_input_names_the_parameter(route):
     arr, paths = route.paths(20)
     H = channel.channel_tensor(paths, CFG, n_tones=16)
-    args = (arr.local, FC, CFG.tone_spacing, CFG.symbol_period)
     bad = H.copy()
     bad[0, 0, 0] = np.nan
     with pytest.raises(ValueError, match=r"H.*NaN"):
-        extraction.extract_paths(bad, 2, *args)
+        extraction.extract_paths(bad, 2, arr, CFG)
     with pytest.raises(ValueError, match=r"H.*3-D"):
-        extraction.extract_paths(H[:, :, 0], 2, *args)
+        extraction.extract_paths(H[:, :, 0], 2, arr, CFG)
     with pytest.raises(ValueError, match="n_paths"):
-        extraction.extract_paths(H, 0, *args)
+        extraction.extract_paths(H, 0, arr, CFG)
     with pytest.raises(ValueError, match=r"n_paths.*Kruskal"):
-        extraction.extract_paths(H[:3, :3, :2], 4, arr.local[:3], *args[1:])
-    with pytest.raises(ValueError, match=r"element_positions.*M = 100"):
-        extraction.extract_paths(H, 2, arr.local[:50], *args[1:])
+        extraction.extract_paths(H[:3, :3, :2], 4, arr.local[:3], CFG)
+    with pytest.raises(ValueError, match=r"array.*M = 100"):
+        extraction.extract_paths(H, 2, arr.local[:50], CFG)
+    with pytest.raises(ValueError, match=r"array.*M = 100"):  # an ArrayGeometry of another size
+        small = arrays.make_array(4, 4, fc=FC, azimuth=0.0, elevation=0.0, origin=[0, 0, 2.5])
+        extraction.extract_paths(H, 2, small, CFG)
     tilted = arr.local.copy()
     tilted[5, 2] = 0.01
-    with pytest.raises(ValueError, match=r"element_positions.*plane"):
-        extraction.extract_paths(H, 2, tilted, *args[1:])
-    with pytest.raises(ValueError, match="subcarrier_spacing"):
-        extraction.extract_paths(H, 2, arr.local, FC, -1.0, CFG.symbol_period)
+    with pytest.raises(ValueError, match=r"array.*plane"):
+        extraction.extract_paths(H, 2, tilted, CFG)
+    with pytest.raises(ValueError, match=r"array.*shape"):
+        extraction.extract_paths(H, 2, arr.local[:, :2], CFG)
+    with pytest.raises(TypeError, match="array"):
+        extraction.extract_paths(H, 2, "ura", CFG)
+    with pytest.raises(TypeError, match="array"):
+        extraction.extract_paths(H, 2, None, CFG)
+    with pytest.raises(TypeError, match="srs"):
+        extraction.extract_paths(H, 2, arr, {"fc": FC})
+    with pytest.raises(TypeError, match="srs"):
+        extraction.extract_paths(H, 2, arr, FC)  # the old positional radio arguments
+    with pytest.raises(TypeError, match="srs"):
+        extraction.extract_paths(H, 2, arr, None, refine="joint")
     with pytest.raises(ValueError, match="refine"):
-        extraction.extract_paths(H, 2, *args, refine="maybe")
+        extraction.extract_paths(H, 2, arr, CFG, refine="maybe")
+
+
+def _same_estimates(a, b):
+    """Two :class:`PathEstimates` equal to the last bit (fit and factors included)."""
+    assert len(a) == len(b)
+    for key in ("alpha", "d", "v", "direction", "kappa", "near_field", "phi", "psi", "valid"):
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+    for key in ("kappa_nf", "delta", "mu_f", "mu_t"):
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+    for fa, fb in zip(a.factors, b.factors):
+        np.testing.assert_array_equal(fa, fb)
+    assert (a.rel_error, a.n_iter, a.converged) == (b.rel_error, b.n_iter, b.converged)
+    assert (a.fit is None) == (b.fit is None)
+    if a.fit is not None:
+        np.testing.assert_array_equal(a.fit.theta, b.fit.theta)
+        np.testing.assert_array_equal(a.significance, b.significance)
+        assert (a.fit.cost, a.fit.rho, a.fit.n_iter) == (b.fit.cost, b.fit.rho, b.fit.n_iter)
+
+
+@pytest.fixture(scope="module")
+def small_tensor(route):
+    """A noisy 100 x 32 x 12 tensor of a straight-drive epoch (five paths)."""
+    arr, paths = route.paths(20)
+    H0 = channel.channel_tensor(paths, CFG, n_tones=32)
+    return channel.add_noise(H0, CFG.noise_power, np.random.default_rng(3)), arr, len(paths)
+
+
+@pytest.mark.parametrize("refine", ["joint", "column", "none"])
+def test_one_call_form_equals_the_paper_stage(small_tensor, refine):
+    """``extract_paths(H, L, array, srs)`` is the paper's stage called directly, whether the
+    array comes as an ArrayGeometry or as its local positions."""
+    H, arr, L = small_tensor
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.extract_paths(H, L, arr, CFG, refine=refine)
+        stage = extraction.paper_route(H, L, arr.local, CFG, refine=refine)
+    _same_estimates(est, stage)
+
+
+def test_one_call_form_equals_the_coherent_and_ml_stages(small_tensor):
+    from tunnelkit.extraction import coherent, ml
+
+    H, arr, L = small_tensor
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.extract_paths(H, L, arr, CFG, refine="coherent")
+        joint = extraction.paper_route(H, L, arr, CFG, refine="joint")
+        _same_estimates(est, coherent.resolve_coherent(H, joint, arr.local, CFG, L))
+        est = extraction.extract_paths(H, L, arr.local, CFG)
+        _same_estimates(est, ml.ml_paths(H, L, arr, CFG))
+        noise = extraction.extract_paths(H, L, arr, CFG, noise_power=CFG.noise_power)
+        _same_estimates(noise, ml.ml_paths(H, L, arr, CFG, noise_power=CFG.noise_power))
+
+
+def test_stage_entry_points_name_array_and_srs(small_tensor):
+    from tunnelkit.extraction import coherent, ml
+
+    H, arr, L = small_tensor
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.paper_route(H, L, arr, CFG, refine="none")
+    calls = {
+        "paper_route": lambda a, s: extraction.paper_route(H, L, a, s),
+        "resolve_coherent": lambda a, s: coherent.resolve_coherent(H, est, a, s),
+        "ml_paths": lambda a, s: ml.ml_paths(H, L, a, s),
+        "fit_ml": lambda a, s: ml.fit_ml(H, ml.start_from_estimates(est), a, s),
+        "estimate_crlb": lambda a, s: extraction.estimate_crlb(est, a, s),
+    }
+    for call in calls.values():
+        with pytest.raises(TypeError, match="srs"):
+            call(arr, CFG.fc)
+        with pytest.raises(ValueError, match=r"array.*M = 100"):
+            call(arr.local[:50], CFG)
+        with pytest.raises(TypeError, match="array"):
+            call("ura", CFG)
+    with pytest.raises(ValueError, match="refine"):
+        extraction.paper_route(H, L, arr, CFG, refine="ml")
+    with pytest.raises(TypeError, match="array"):
+        extraction.path_crlb([], arr.local, CFG)
+    with pytest.raises(TypeError, match="srs"):
+        extraction.path_crlb([], arr, "srs")
 
 
 def test_non_convergence_warns_with_the_final_error():
@@ -237,7 +330,7 @@ def test_linear_array_along_either_local_axis_keeps_the_curvature(shape):
 def test_half_wavelength_ura_is_recognised_as_a_grid(fc):
     """Rounding positions to the tolerance first made the step drift along a long axis."""
     pos = arrays.ura(32, 24, C / fc / 2)
-    r, c, nr, nc = extraction.decomposition._grid_index(pos)
+    r, c, nr, nc = extraction.numerics.grid_index(pos)
     assert (nr, nc) == (32, 24)
     np.testing.assert_array_equal(r * 24 + c, np.arange(pos.shape[0]))
     assert len(extraction.decomposition._shift_pairs(pos)) == 2

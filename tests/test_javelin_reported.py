@@ -179,7 +179,7 @@ def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles
     assert m.cov is not None and m.cov.shape == (len(m), 3, 3)
     # brute force: push the local wave-origin covariance through finite differences of
     # (phi, psi, r) of the world point origin + R src
-    b = estimate_crlb(est, arr.local, route.config, paths=m.index)
+    b = estimate_crlb(est, arr, route.config, paths=m.index)
     h = 1e-5
     for jj in range(len(m)):
         src = b["source"][jj]
@@ -187,7 +187,7 @@ def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles
         G = np.stack([(f(src + h * e) - f(src - h * e)) / (2 * h) for e in np.eye(3)], axis=1)
         np.testing.assert_allclose(m.cov[jj], G @ b["source_cov"][jj] @ G.T, rtol=1e-5)
     # with every path kept (as here), the subset is the whole joint bound
-    full = estimate_crlb(est, arr.local, route.config)
+    full = estimate_crlb(est, arr, route.config)
     np.testing.assert_allclose(full["source_cov"][m.index], b["source_cov"], rtol=1e-10)
     # at the estimate vs at the truth: the same bound to within the estimate's own scatter
     truth = path_crlb(ep.paths, arr, route.config)

@@ -25,8 +25,8 @@ def _truth(sc):
 
 
 def _args(sc):
-    cfg = sc.config
-    return sc.element_positions, cfg.fc, cfg.tone_spacing, cfg.symbol_period
+    """The radio arguments ``(array, srs)`` of a scene."""
+    return sc.element_positions, sc.config
 
 
 # --- derivatives against central differences -------------------------------------------------
@@ -69,7 +69,7 @@ def test_varpro_gradient_matches_central_differences_of_the_projected_cost():
     """``Re <D_i, r>`` (Kaufman) is minus half the exact gradient of ``||P_perp h||^2``."""
     sc = _scene(11)
     H = sc.tensor(np.random.default_rng(1))
-    prob = ml._Problem(H, sc.element_positions, FC)
+    prob = ml.Problem(H, sc.element_positions, FC)
     th, mf, mt = _truth(sc)
     th = th + np.array([0.01, -0.008, 0.02])  # away from the optimum: a gradient to see
     x = _flat(th, mf + 0.01, mt - 0.02)
@@ -90,7 +90,7 @@ def test_gauss_newton_matrix_is_the_hessian_at_a_noiseless_optimum():
     Hessian of the projected cost (central differences of the analytic gradient)."""
     sc = _scene(12, n_paths=2)
     H = sc.tensor()
-    prob = ml._Problem(H, sc.element_positions, FC)
+    prob = ml.Problem(H, sc.element_positions, FC)
     x = _flat(*_truth(sc))
     A = prob.evaluate(*_unflat(x))["A"]
     steps = np.tile([1e-6, 1e-6, 1e-5, 1e-6, 1e-6], 2)
@@ -153,8 +153,8 @@ def _normalized(est, sc):
 def test_started_at_the_truth_a_noiseless_fit_stays_there():
     sc = _scene(21)
     H = sc.tensor()
-    pos, fc, df, T0 = _args(sc)
-    est = ml.ml_paths(H, 3, pos, fc, df, T0, start=_truth(sc), noise_power=sc.config.noise_power)
+    pos, srs = _args(sc)
+    est = ml.ml_paths(H, 3, pos, srs, start=_truth(sc), noise_power=sc.config.noise_power)
     err = _normalized(est, sc)
     assert np.all(np.abs(err) < 1e-3), err
     np.testing.assert_allclose(np.sort(np.abs(est.alpha)), np.sort(np.abs(sc.alpha)), rtol=1e-6)
@@ -163,8 +163,8 @@ def test_started_at_the_truth_a_noiseless_fit_stays_there():
 def test_started_at_the_truth_a_noisy_fit_moves_by_the_bound_only():
     sc = _scene(22)
     H = sc.tensor(np.random.default_rng(5))
-    pos, fc, df, T0 = _args(sc)
-    est = ml.ml_paths(H, 3, pos, fc, df, T0, start=_truth(sc))
+    pos, srs = _args(sc)
+    est = ml.ml_paths(H, 3, pos, srs, start=_truth(sc))
     err = _normalized(est, sc)
     assert np.all(np.abs(err) < 4.0), err
     assert abs(est.fit.rho - 1) < 0.05 and est.fit.rho <= est.fit.rho_max
@@ -221,30 +221,36 @@ def test_javelin_epoch_resolves_los_and_ceiling_at_the_bound(javelin_epoch):
 def test_bad_input_is_refused_by_name():
     sc = _scene(31, n_paths=2)
     H = sc.tensor(np.random.default_rng(0))
-    pos, fc, df, T0 = _args(sc)
+    pos, srs = _args(sc)
     th, mf, mt = _truth(sc)
     with pytest.raises(ValueError, match="start"):
-        ml.ml_paths(H, 2, pos, fc, df, T0, start=(th + np.array([0.9, 0.9, 0]), mf, mt))  # |u| > 1
+        ml.ml_paths(H, 2, pos, srs, start=(th + np.array([0.9, 0.9, 0]), mf, mt))  # |u| > 1
     with pytest.raises(ValueError, match="start"):
-        ml.ml_paths(H, 2, pos, fc, df, T0, start=(th * [1, 1, -1], mf, mt))  # behind the array
+        ml.ml_paths(H, 2, pos, srs, start=(th * [1, 1, -1], mf, mt))  # behind the array
     with pytest.raises(ValueError, match="start"):
-        ml.ml_paths(H, 2, pos, fc, df, T0, start=(th[:1], mf[:1], mt[:1]))
+        ml.ml_paths(H, 2, pos, srs, start=(th[:1], mf[:1], mt[:1]))
     bad = H.copy()
     bad[3, 4, 1] = np.nan
     with pytest.raises(ValueError, match="H"):
-        extraction.extract_paths(bad, 2, pos, fc, df, T0)
+        extraction.extract_paths(bad, 2, pos, srs)
     dup = pos.copy()
     dup[5] = dup[6]
-    with pytest.raises(ValueError, match="element_positions"):
-        extraction.extract_paths(H, 2, dup, fc, df, T0)
+    with pytest.raises(ValueError, match="array"):
+        extraction.extract_paths(H, 2, dup, srs)
+    with pytest.raises(TypeError, match="srs"):
+        ml.ml_paths(H, 2, pos, srs.fc)
+    with pytest.raises(TypeError, match="srs"):
+        ml.fit_ml(H, (th, mf, mt), pos, srs.fc)
+    with pytest.raises(ValueError, match="array"):
+        ml.fit_ml(H, (th, mf, mt), pos[:10], srs)
     with pytest.raises(ValueError, match="n_paths"):
-        extraction.extract_paths(H, 500, pos, fc, df, T0)
+        extraction.extract_paths(H, 500, pos, srs)
     with pytest.raises(ValueError, match="n_paths"):
-        ml.ml_paths(H[:4, :6, :6], 4, pos[:4], fc, df, T0)  # as many paths as antennas
+        ml.ml_paths(H[:4, :6, :6], 4, pos[:4], srs)  # as many paths as antennas
     with pytest.raises(ValueError, match="noise_power"):
-        extraction.extract_paths(H, 2, pos, fc, df, T0, noise_power=-1.0)
+        extraction.extract_paths(H, 2, pos, srs, noise_power=-1.0)
     with pytest.raises(ValueError, match="noise_power"):
-        extraction.extract_paths(H, 2, pos, fc, df, T0, refine="joint", noise_power=1.0)
+        extraction.extract_paths(H, 2, pos, srs, refine="joint", noise_power=1.0)
 
 
 def test_pure_noise_warns_and_marks_every_path_invalid():
@@ -252,7 +258,7 @@ def test_pure_noise_warns_and_marks_every_path_invalid():
     pos = arrays.ura(10, 10, LAM / 2)
     H = channel.add_noise(np.zeros((100, SMALL.n_tones, SMALL.n_symbols)), 1.0, rng)
     with pytest.warns(ml.MLDetectionWarning, match="0 of n_paths = 3"):
-        est = extraction.extract_paths(H, 3, pos, FC, SMALL.tone_spacing, SMALL.symbol_period)
+        est = extraction.extract_paths(H, 3, pos, SMALL)
     assert not np.any(est.valid) and np.all(np.isfinite(est.d))
     assert abs(est.fit.noise_power - 1.0) < 0.05
     assert len(signal_route.measurements_from_estimates(est, _array())) == 0
@@ -271,7 +277,7 @@ def test_too_many_paths_for_the_scene_are_flagged_not_invented():
 def test_a_failed_fit_keeps_its_start_and_warns(monkeypatch):
     sc = _scene(51, n_paths=2)
     H = sc.tensor(np.random.default_rng(2))
-    pos, fc = _args(sc)[:2]
+    pos, srs = _args(sc)
     start = _truth(sc)
 
     def worse(prob, theta, mu_f, mu_t, sigma2, max_iter):  # a stage that only makes it worse
@@ -280,9 +286,9 @@ def test_a_failed_fit_keeps_its_start_and_warns(monkeypatch):
         ev = prob.evaluate(th, mu_f, mu_t)
         return th, mu_f, mu_t, ev, 1, False
 
-    monkeypatch.setattr(ml, "_lm", worse)
+    monkeypatch.setattr(ml.fitting, "_lm", worse)
     with pytest.warns(ml.MLConvergenceWarning):
-        fit = ml.fit_ml(H, start, pos, fc, n_reseed=0)
+        fit = ml.fit_ml(H, start, pos, srs, n_reseed=0)
     np.testing.assert_allclose(fit.theta, start[0])
     assert np.all(np.isfinite(fit.alpha))
 
@@ -305,15 +311,15 @@ def test_reseeding_recovers_a_path_counted_twice():
     basin (residual far above the noise floor); the re-seeding finds the missing source."""
     sc = _scene(71, n_paths=3, snr_db=(0.0, 5.0))
     H = sc.tensor(np.random.default_rng(8))
-    pos, fc = _args(sc)[:2]
+    pos, srs = _args(sc)
     th, mf, mt = _truth(sc)
     th_bad, mf_bad, mt_bad = th.copy(), mf.copy(), mt.copy()
     th_bad[2], mf_bad[2], mt_bad[2] = th[1] + [0.004, 0.0, 0.0], mf[1], mt[1]
     with pytest.warns(ml.MLConvergenceWarning, match="noise floor"):
-        local = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, fc, n_reseed=0)
+        local = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, srs, n_reseed=0)
     assert local.rho > local.rho_max
-    fit = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, fc)
+    fit = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, srs)
     assert fit.rho <= fit.rho_max and fit.n_reseed >= 1
-    est = ml.estimates_from_fit(fit, pos, fc, *_args(sc)[2:], SMALL.n_tones, SMALL.n_symbols, 0.0)
+    est = ml.estimates_from_fit(fit, pos, srs, SMALL.n_tones, SMALL.n_symbols, 0.0)
     err = evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb())
     assert np.all(np.abs(err) < 5.0), err

@@ -92,7 +92,7 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     if est.significance is None:  # every estimate of the route (not Algorithm 1's d >= 0)
         keep = np.arange(len(est))
     else:  # the ML route: the paths that stand above the noise
-        from .extraction.ml import MIN_SIGNIFICANCE
+        from .extraction import MIN_SIGNIFICANCE
 
         keep = np.flatnonzero(est.significance >= MIN_SIGNIFICANCE)
     match = match_points(est.d[keep], est.direction[keep], d_true, u)

@@ -120,7 +120,7 @@ def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
     if fit is not None and not fit.rho <= fit.rho_max:
         return None, None
     try:
-        b = estimate_crlb(est, array.local, config, paths=keep)
+        b = estimate_crlb(est, array, config, paths=keep)
     except np.linalg.LinAlgError:
         return None, None
     rot = array.R  # local -> world: u_world = R u_local
@@ -259,10 +259,7 @@ class SignalRoute:
         radio (``refine``, ... in ``extract_kw``)."""
         from .extraction import extract_paths
 
-        cfg = self.config
-        return extract_paths(
-            H, n_paths, arr.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period, **extract_kw
-        )
+        return extract_paths(H, n_paths, arr, self.config, **extract_kw)
 
     def epoch(
         self,

@@ -129,9 +129,7 @@ print(
 # Herráez et al. algorithm, the paper's ref. 25), gives the path-length offsets $\hat\delta_m$.
 
 # %%
-est = extraction.extract_paths(
-    snap.H, len(paths), array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period, refine="joint"
-)
+est = extraction.extract_paths(snap.H, len(paths), array, cfg, refine="joint")
 print(f"CPD relative error {est.rel_error:.4f} (the noise floor), core iterations {est.n_iter}")
 factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
 
@@ -151,19 +149,9 @@ factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
 # %%
 small = channel.channel_tensor(paths, cfg, n_tones=64, clock_bias=snap.clock_bias)
 plain = extraction.extract_paths(
-    small,
-    len(paths),
-    array.local,
-    cfg.fc,
-    cfg.tone_spacing,
-    cfg.symbol_period,
-    method="plain",
-    n_iter_max=60,
-    refine="joint",
+    small, len(paths), array, cfg, method="plain", n_iter_max=60, refine="joint"
 )  # may warn
-fast = extraction.extract_paths(
-    small, len(paths), array.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period, refine="joint"
-)
+fast = extraction.extract_paths(small, len(paths), array, cfg, refine="joint")
 d_true = np.sort([p.length for p in paths]) + C * snap.clock_bias
 print("true d      ", d_true.round(3))
 print("plain parafac", plain.d.round(3), "| converged:", plain.converged)
@@ -479,9 +467,9 @@ def truth_start(paths, array, clock_bias):
 
 paper_start = ml.start_from_estimates(est)  # the paper's route (section 3) as the start
 fits = {
-    "truth": ml.fit_ml(snap.H, truth_start(paths, array, snap.clock_bias), array.local, cfg.fc),
-    "paper's route, no re-seeding": ml.fit_ml(snap.H, paper_start, array.local, cfg.fc, n_reseed=0),
-    "paper's route, re-seeding": ml.fit_ml(snap.H, paper_start, array.local, cfg.fc),
+    "truth": ml.fit_ml(snap.H, truth_start(paths, array, snap.clock_bias), array, cfg),
+    "paper's route, no re-seeding": ml.fit_ml(snap.H, paper_start, array, cfg, n_reseed=0),
+    "paper's route, re-seeding": ml.fit_ml(snap.H, paper_start, array, cfg),
 }
 for name, f in fits.items():
     print(f"{name:30s} rho = {f.rho:9.3f} (basin test passes below {f.rho_max:.4f})")
@@ -490,7 +478,7 @@ for name, f in fits.items():
 # Exercise 4, solution (b): the wrong number of paths, on a LoS + road tensor
 arr2, paths2 = two.paths(k_demo)
 snap2 = channel.synthesize(paths2, cfg, np.random.default_rng(4))
-args2 = (arr2.local, cfg.fc, cfg.tone_spacing, cfg.symbol_period)
+args2 = (arr2, cfg)
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
     wrong_L = {L: ml.ml_paths(snap2.H, L, *args2, n_reseed=0) for L in (1, 2, 3)}

@@ -442,15 +442,7 @@ ep = route.epoch(5, np.random.default_rng(1), refine="joint")
 cfg = route.config
 labels = ["LoS" if p.kind == "los" else p.surface for p in ep.paths]
 for n_src in (1, 2, 3):
-    est = resolve_coherent(
-        ep.snapshot.H,
-        ep.estimates,
-        ep.array.local,
-        cfg.fc,
-        cfg.tone_spacing,
-        cfg.symbol_period,
-        max_sources=n_src,
-    )
+    est = resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, cfg, max_sources=n_src)
     meas = measurements_from_estimates(est, ep.array)
     idx = match_paths(meas.d, meas.direction, ep.paths, clock_bias=ep.snapshot.clock_bias)
     off = {

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import ArrayGeometry
 from ..constants import C
+from .estimates import PathEstimates
+from .radio import check_array, check_srs
 
 __all__ = ["crlb_paths", "estimate_crlb", "in_path_units", "path_crlb", "source_crlb"]
 
@@ -82,7 +85,7 @@ def crlb_paths(
 
 
 def path_crlb(
-    paths, array, config, *, n_tones: int | None = None, spatial: str = "structured"
+    paths, array, srs, *, n_tones: int | None = None, spatial: str = "structured"
 ) -> dict:
     """Cramér-Rao bounds for every path of one epoch at the configured SNR.
 
@@ -94,9 +97,16 @@ def path_crlb(
     spatial factor has no direction). Returns standard deviations ``d`` [m], ``v`` [m/s],
     ``direction`` [rad] (angle between unit vectors: ``sqrt(trace)`` of the direction's
     covariance), ``kappa`` [m] (range of the wave origin).
+
+    ``paths`` are the traced paths (:class:`tunnelkit.propagation.Path`) of ``array`` (an
+    :class:`~tunnelkit.arrays.ArrayGeometry`: the wave origins are taken to its local frame),
+    ``srs`` the :class:`~tunnelkit.channel.SRSConfig` (``n_tones`` overrides its tone count).
     """
     if spatial not in ("structured", "free"):
         raise ValueError(f"spatial: expected 'structured' or 'free', got {spatial!r}")
+    if not isinstance(array, ArrayGeometry):
+        raise TypeError(f"array: expected an ArrayGeometry, got {type(array).__name__}")
+    config = check_srs(srs)
     nf = config.n_tones if n_tones is None else n_tones
     alpha = np.sqrt(config.tx_power) * np.array([p.gain for p in paths])
     src = np.stack([array.to_local(p.source) for p in paths])
@@ -156,9 +166,7 @@ def source_crlb(
     return {"mu_f": roots["mu_f"], "mu_t": roots["mu_t"], "direction": ang, "kappa": kap}
 
 
-def estimate_crlb(
-    est, element_positions, config, *, noise_power: float | None = None, paths=None
-) -> dict:
+def estimate_crlb(est, array, srs, *, noise_power: float | None = None, paths=None) -> dict:
     """The structured CRLB evaluated at the estimates: the covariance an efficient estimator
     reports for its own output (the ML route sits on this bound, notebook 03; a CPD route does
     not, so for it this understates the error).
@@ -168,14 +176,18 @@ def estimate_crlb(
     leave out what the extraction rejected as noise. A far-field estimate (no curvature)
     is placed on its direction at the range ``d``, at least the Fraunhofer distance of the array;
     its curvature bound is then meaningless and not used downstream. ``noise_power`` defaults to
-    the ML fit's estimate (``est.fit.noise_power``), else ``config.noise_power``.
+    the ML fit's estimate (``est.fit.noise_power``), else ``srs.noise_power``. ``array`` and
+    ``srs`` as in :func:`~tunnelkit.extraction.extract_paths`.
 
     Returns, per path of ``paths``: ``source`` (L, 3) the wave origins used (local frame),
     ``source_cov`` (L, 3, 3) [m^2] their covariance, and ``d`` (L,) [m], the delay-distance
     standard deviation. Raises
     ``numpy.linalg.LinAlgError`` when the Fisher information is singular at the estimate.
     """
-    p = np.asarray(element_positions, float)
+    if not isinstance(est, PathEstimates):
+        raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
+    p = check_array(array, m=est.delta.shape[1] if est.delta.ndim == 2 else None)
+    config = check_srs(srs)
     sel = np.arange(len(est)) if paths is None else np.asarray(paths, int).reshape(-1)
     if sel.size == 0:
         return {"source": np.zeros((0, 3)), "source_cov": np.zeros((0, 3, 3)), "d": np.zeros(0)}

@@ -37,7 +37,6 @@ a 23 cm array).
 from __future__ import annotations
 
 import warnings
-from functools import lru_cache
 
 import numpy as np
 
@@ -46,11 +45,9 @@ from ..arrays import check_element_positions
 from ..constants import C
 from .decomposition import check_tensor, cp_rel_error, normalize_factors
 from .estimates import PathEstimates, path_estimates
-from .paper import (
-    angles_from_solution,
-    refine_roots,
-    vandermonde_roots,
-)
+from .numerics import damped_step, free_newton, scan_peak, solve, spatial_phase
+from .paper import angles_from_solution, refine_roots, vandermonde_roots
+from .radio import check_array, check_srs
 
 __all__ = [
     "fit_sources",
@@ -131,8 +128,6 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
     ``S^+ b``), Levenberg-Marquardt on ``(u_x, u_y, w)`` with Kaufman's Jacobian (as in
     :mod:`.ml`, one spatial mode only), every step projected onto ``|u| <= 0.999``,
     ``w in [1 / KAPPA_MAX, 1 / KAPPA_MIN]``."""
-    from .ml import _damped_step, _free_newton, _solve, spatial_phase
-
     k0 = 2 * np.pi * fc / C
     th = np.asarray(theta0, float).reshape(-1, 3).copy()
     n, m = th.shape[0], p.shape[0]
@@ -149,7 +144,7 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
         psi, dx, dy, dw = spatial_phase(t, p, k0)
         S = np.exp(1j * psi)
         G = S.conj().T @ S
-        g = _solve(G, S.conj().T @ b)
+        g = solve(G, S.conj().T @ b)
         r = b - S @ g
         return S, np.stack([dx, dy, dw], axis=2), G, g, r, float(np.vdot(r, r).real)
 
@@ -160,16 +155,16 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
         S, dpsi, G, g, r, cost = cur
         D = (1j * dpsi * (S * g[None, :])[..., None]).reshape(m, 3 * n)
         DS = D.conj().T @ S
-        A = (D.conj().T @ D - DS @ _solve(G, DS.conj().T)).real
+        A = (D.conj().T @ D - DS @ solve(G, DS.conj().T)).real
         grad = (D.conj().T @ r).real
         lower = np.zeros((n, 3), bool)
         lower[:, 2] = th[:, 2] <= 1 / KAPPA_MAX
         upper = np.zeros((n, 3), bool)
         upper[:, 2] = th[:, 2] >= 1 / KAPPA_MIN
-        free, dec = _free_newton(A, grad, lower.ravel(), upper.ravel())
+        free, dec = free_newton(A, grad, lower.ravel(), upper.ravel())
         if dec <= 1e-6 * cost + 1e-14 * b2:
             break  # the full Gauss-Newton step would gain less than ftol = 1e-6
-        step = _damped_step(A, grad, free, lam)
+        step = damped_step(A, grad, free, lam)
         if step is None:
             lam *= 4.0
             continue
@@ -185,28 +180,6 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
     g = np.linalg.lstsq(S, b, rcond=None)[0]  # exact projection at the optimum
     rel = float(np.linalg.norm(b - S @ g) ** 2 / b2)
     return th, g, rel
-
-
-@lru_cache(maxsize=2)
-def _scan_grid(pos_bytes: bytes, m: int, fc: float, n_grid: int):
-    """Far-field beam-scan grid of one array: directions (G, 2) and the steering matrix (M, G)
-    (read-only: it is shared by every call with the same array)."""
-    p = np.frombuffer(pos_bytes).reshape(m, 3)
-    g = np.linspace(-1, 1, n_grid)
-    ux, uy = np.meshgrid(g, g)
-    keep = ux**2 + uy**2 < 0.99
-    u = np.column_stack([ux[keep], uy[keep]])
-    A = np.exp(-2j * np.pi * fc / C * (p[:, :2] @ u.T))  # far field: delta_m = -u . p_m
-    u.flags.writeable = False
-    A.flags.writeable = False
-    return u, A
-
-
-def _scan_peak(r, p, fc: float, n_grid: int = 61) -> np.ndarray:
-    """Direction cosines ``(u_x, u_y)`` of the strongest far-field beam of residual ``r``."""
-    p = np.ascontiguousarray(p, float)
-    u, A = _scan_grid(p.tobytes(), p.shape[0], float(fc), n_grid)
-    return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H
 
 
 def split_component(
@@ -235,7 +208,7 @@ def split_component(
     scale = float(np.sqrt(np.mean(np.abs(b) ** 2)))
     while rel > tol and th.shape[0] < max_sources:
         S = spherical_steering(source_points(th), p, fc)
-        u = _scan_peak(b - S @ g, p, fc)
+        u = scan_peak(b - S @ g, p, fc)
         start = np.vstack([th, [u[0], u[1], 1 / 30.0]])
         th2, g2, rel2 = _fit_sources(b, start, p, fc)
         du = np.linalg.norm(th2[:, None, :2] - th2[None, :, :2], axis=-1)
@@ -291,10 +264,8 @@ def _point_source_path(theta, pos, fc) -> dict:
 def resolve_coherent(
     H,
     est: PathEstimates,
-    element_positions,
-    fc: float,
-    subcarrier_spacing: float,
-    symbol_period: float,
+    array,
+    srs,
     n_paths: int | None = None,
     *,
     max_sources: int = 3,
@@ -305,8 +276,9 @@ def resolve_coherent(
 ) -> PathEstimates:
     """Separate coherent paths merged in the CPD components of ``est`` (see the module text).
 
-    ``H`` is the tensor ``est`` was extracted from, ``n_paths`` the number of paths to return
-    (default ``len(est)``, at most the number of antennas). Per CPD component:
+    ``H`` is the tensor ``est`` was extracted from, ``array`` and ``srs`` its array and SRS
+    configuration (as in :func:`~tunnelkit.extraction.extract_paths`), ``n_paths`` the number of
+    paths to return (default ``len(est)``, at most the number of antennas). Per CPD component:
 
     - split into two or three sources: each source is a path with its own direction and
       curvature (NaN = far field when the fit sits on the ``KAPPA_MAX`` bound), and its own
@@ -331,10 +303,9 @@ def resolve_coherent(
         raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
     H = check_tensor(H)
     M, nf, nt = H.shape
-    pos = check_element_positions("element_positions", element_positions, m=M)
-    fc = positive("fc", fc)
-    df = positive("subcarrier_spacing", subcarrier_spacing)
-    T0 = positive("symbol_period", symbol_period)
+    pos = check_array(array, m=M)
+    srs = check_srs(srs)
+    fc, df, T0 = srs.fc, srs.tone_spacing, srs.symbol_period
     L = len(est) if n_paths is None else integer("n_paths", n_paths, minimum=1)
     if L > M:
         raise ValueError(f"n_paths: at most the {M} antennas can be separated, got {L}")

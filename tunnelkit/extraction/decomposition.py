@@ -21,6 +21,7 @@ from tensorly.cp_tensor import CPTensor
 from tensorly.decomposition import parafac
 
 from .._validate import integer, positive
+from .numerics import contract, grid_index
 
 __all__ = [
     "CPDConvergenceWarning",
@@ -145,7 +146,7 @@ def _shift_pairs(element_positions) -> list[tuple[np.ndarray, np.ndarray]]:
     """Index pairs (m, m') of neighbouring elements along each grid axis of a URA/ULA."""
     if element_positions is None:
         return []
-    grid = _grid_index(np.asarray(element_positions, float))
+    grid = grid_index(np.asarray(element_positions, float))
     if grid is None:
         return []
     r, c, nr, nc = grid
@@ -338,37 +339,7 @@ def cp_rel_error(H: np.ndarray, factors, nh2: float | None = None) -> float:
     contraction of ``H``, the model's energy the Hadamard product of the factors' Gram matrices."""
     A, B, Cm = factors
     nh2 = float(np.vdot(H, H).real) if nh2 is None else nh2
-    fit = _contract(H, B.conj(), Cm.conj())  # <H, model> per component before summing
+    fit = contract(H, B.conj(), Cm.conj())  # <H, model> per component before summing
     gram = (A.conj().T @ A) * (B.conj().T @ B) * (Cm.conj().T @ Cm)
     err2 = nh2 - 2 * float(np.sum(np.real(A.conj() * fit))) + float(np.real(gram.sum()))
     return float(np.sqrt(max(err2, 0.0) / nh2))
-
-
-def _grid_index(p: np.ndarray, tol: float = 1e-6):
-    """(rows, cols) integer grid coordinates if the xy positions form a full rectangular lattice."""
-    out = []
-    for ax in (1, 0):
-        v = p[:, ax]
-        u = np.unique(v)
-        levels = u[np.concatenate([[True], np.diff(u) > tol])]  # values closer than tol merge
-        if levels.size == 1:
-            out.append((np.zeros(p.shape[0], int), 1))
-            continue
-        # the step from the float positions (rounding them to tol first lets the rounding error
-        # accumulate along the axis: a 32 x 32 URA at 28 GHz was not recognised as a grid)
-        idx = np.round((v - levels[0]) / np.min(np.diff(levels))).astype(int)
-        step = float(np.sum(idx * (v - levels[0])) / np.sum(idx * idx))
-        if not np.allclose(levels[0] + idx * step, v, rtol=0.0, atol=10 * tol):
-            return None
-        out.append((idx, int(idx.max()) + 1))
-    (r, nr), (c, nc) = out
-    if nr * nc != p.shape[0] or len(set(zip(r.tolist(), c.tolist()))) != p.shape[0]:
-        return None
-    return r, c, nr, nc
-
-
-def _contract(H: np.ndarray, F: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """``sum_{s,k} H[m, s, k] F[s, l] T[k, l]`` (M, L) via one matrix product and a reduction."""
-    M, nf, nt = H.shape
-    tmp = (H.reshape(M * nf, nt) @ T).reshape(M, nf, -1)
-    return np.einsum("msl,sl->ml", tmp, F)

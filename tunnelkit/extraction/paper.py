@@ -26,12 +26,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .decomposition import _contract, _grid_index
-from .estimates import PathEstimates
+from ..constants import C
+from .decomposition import check_rank, check_tensor, cpd, normalize_factors
+from .estimates import PathEstimates, path_estimates
+from .numerics import MIN_SIGNIFICANCE, contract, grid_index
+from .radio import check_array, check_srs
 
 __all__ = [
     "algorithm1",
     "angles_from_solution",
+    "paper_route",
     "refine_joint",
     "refine_roots",
     "solve_far_field",
@@ -105,7 +109,7 @@ def refine_joint(H, mu_f, mu_t, n_steps: int = 6):
         FF, TT = F.conj().T @ F, T.conj().T @ T
         WD = np.concatenate([1j * (F.conj().T @ Fs) * TT, 1j * FF * (T.conj().T @ Tk)], axis=1)
         XD = -1j * np.concatenate(
-            [np.einsum("msl,sl->ml", HT, Fs.conj()), _contract(H, F.conj(), Tk.conj())], axis=1
+            [np.einsum("msl,sl->ml", HT, Fs.conj()), contract(H, F.conj(), Tk.conj())], axis=1
         )
         RD = XD - A @ WD.conj()  # R conj(D)
         Aa = np.concatenate([A, A], axis=1)
@@ -145,7 +149,7 @@ def unwrap_spatial(b, element_positions) -> np.ndarray:
     b = np.asarray(b)
     p = np.asarray(element_positions, float)
     ph = np.angle(b)
-    grid = _grid_index(p)
+    grid = grid_index(p)
     out = np.empty_like(ph)
     if grid is not None and min(grid[2], grid[3]) > 1:
         from skimage.restoration import unwrap_phase
@@ -280,11 +284,85 @@ def algorithm1(est: PathEstimates, min_d: float = 0.0) -> np.ndarray:
         raise ValueError(f"min_d: expected a finite value <= 0, got {min_d}")
     if min_d == 0.0:
         return np.flatnonzero(est.valid)
-    from .ml import MIN_SIGNIFICANCE
-
     detected = (
         np.ones(len(est), bool)
         if est.significance is None
         else np.asarray(est.significance) >= MIN_SIGNIFICANCE
     )
     return np.flatnonzero(detected & (est.d >= min_d))
+
+
+#: the refinements of the paper's route (see :func:`paper_route`)
+PAPER_REFINES = ("joint", "column", "none")
+
+
+def paper_route(
+    H,
+    n_paths: int,
+    array,
+    srs,
+    *,
+    refine: str = "joint",
+    method: str = "fast",
+    n_iter_max: int = 200,
+    tol: float = 1e-10,
+    polish: int | None = None,
+) -> PathEstimates:
+    """The CPD of ``H`` and eq. 13-24: path parameters from the CPD factors.
+
+    ``array`` (:class:`~tunnelkit.arrays.ArrayGeometry` or (M, 3) local positions) and ``srs``
+    (:class:`~tunnelkit.channel.SRSConfig`) as in :func:`~tunnelkit.extraction.extract_paths`.
+    ``refine``: "joint" — after eq. 13, maximum-likelihood refinement of all roots together with
+    free spatial factors (:func:`refine_joint`); "column" — each root to the periodogram peak of
+    its own factor column (:func:`refine_roots`); "none" — eq. 13 roots and eq. 12 gains as
+    they are. ``method``, ``n_iter_max``, ``tol`` go to :func:`~tunnelkit.extraction.cpd`;
+    ``polish`` ALS sweeps on the full tensor after the compressed CPD (default 2, or 0 with
+    ``refine="joint"``, which supersedes them).
+    """
+    H = check_tensor(H)
+    L = check_rank(H.shape, n_paths)
+    pos = check_array(array, m=H.shape[0])
+    srs = check_srs(srs)
+    if refine not in PAPER_REFINES:
+        raise ValueError(f"refine: expected one of {PAPER_REFINES}, got {refine!r}")
+    fc, df, T0 = srs.fc, srs.tone_spacing, srs.symbol_period
+    if polish is None:
+        polish = 0 if refine == "joint" else 2
+    res = cpd(
+        H, L, method=method, n_iter_max=n_iter_max, tol=tol, element_positions=pos, polish=polish
+    )
+    (bs, bf, bt), alpha = normalize_factors(res.factors)
+    mu_f, mu_t = vandermonde_roots(bf), vandermonde_roots(bt)  # eq. 13
+    if refine in ("column", "joint"):
+        mu_f, beta_f = refine_roots(bf, mu_f)
+        mu_t, beta_t = refine_roots(bt, mu_t)
+        alpha = alpha * beta_f * beta_t
+    if refine == "joint":
+        # project the spatial mode on the span of the CPD's spatial factors first: the roots'
+        # information lies there, and each Gauss-Newton step gets M / L times cheaper
+        Q, _ = np.linalg.qr(res.factors[0])
+        mu_f, mu_t, Ac = refine_joint(np.tensordot(Q.conj(), H, axes=(0, 0)), mu_f, mu_t)
+        A = Q @ Ac
+        alpha = A[0].copy()
+        bs = A / A[0][None, :]
+    d = -C / (2 * np.pi * df) * mu_f  # eq. 14
+    v = C / (2 * np.pi * fc * T0) * mu_t  # eq. 15
+    delta = C / (2 * np.pi * fc) * unwrap_spatial(bs, pos)  # eq. 16
+    x_nf = solve_near_field(delta, pos)
+    u_ff = solve_far_field(delta, pos)
+    ang = angles_from_solution(x_nf, u_ff)
+    near = np.isfinite(ang["kappa_nf"]) & (ang["kappa_nf"] > 0)
+    return path_estimates(
+        alpha,
+        d,
+        v,
+        ang,
+        near,
+        delta.T,
+        mu_f,
+        mu_t,
+        (bs, bf, bt),
+        res.rel_error,
+        res.n_iter,
+        res.converged,
+    )

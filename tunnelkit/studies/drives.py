@@ -143,14 +143,12 @@ _ROUTES: dict[tuple, SignalRoute] = {}
 def ml_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by the maximum-likelihood route
     (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor."""
-    args = (ep.array.local, config.fc, config.tone_spacing, config.symbol_period)
-    return ep.with_estimates(ml_paths(ep.snapshot.H, len(ep.paths), *args))
+    return ep.with_estimates(ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config))
 
 
 def separate_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
-    args = (ep.array.local, config.fc, config.tone_spacing, config.symbol_period)
-    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, *args))
+    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 
 def scenario_route(route, model: str = "exact") -> SignalRoute:

@@ -1,0 +1,215 @@
+"""The numerics every extraction stage shares, below all of them.
+
+- :data:`MIN_SIGNIFICANCE` — the log-likelihood ratio a path needs to stand above the noise;
+- :func:`solve` — a linear solve that falls back to least squares on a singular system;
+- :func:`free_newton` and :func:`damped_step` — the bound-constrained Gauss-Newton decrement and
+  the Levenberg-Marquardt step of the variable-projection fits (:mod:`.coherent`, :mod:`.ml`);
+- :func:`contract` — ``sum_{s,k} H[m, s, k] F[s, l] T[k, l]``, the contraction of the channel
+  tensor with frequency and time vectors;
+- :func:`grid_index` — the rectangular-lattice coordinates of a URA (or ULA) layout;
+- :func:`spatial_phase` — the exact spherical spatial phase of eq. 1 and its derivatives in
+  ``(u_x, u_y, w = 1 / kappa)``;
+- :func:`scan_peak` — the far-field beam-scan peak of a spatial vector.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from .._validate import integer, positive
+from ..constants import C
+
+__all__ = [
+    "MIN_SIGNIFICANCE",
+    "contract",
+    "damped_step",
+    "free_newton",
+    "grid_index",
+    "scan_peak",
+    "solve",
+    "spatial_phase",
+]
+
+#: log-likelihood ratio of a path against noise below which it is indistinguishable from noise
+MIN_SIGNIFICANCE = 25.0
+
+
+def _square(name: str, A) -> np.ndarray:
+    A = np.asarray(A)
+    if A.ndim != 2 or A.shape[0] != A.shape[1]:
+        raise ValueError(f"{name}: expected a square matrix, got shape {A.shape}")
+    return A
+
+
+def _masks(g, *masks):
+    if g.ndim != 1:
+        raise ValueError(f"g: expected a vector, got shape {g.shape}")
+    for name, m in masks:
+        if np.shape(m) != g.shape:
+            raise ValueError(f"{name}: expected shape {g.shape}, got {np.shape(m)}")
+
+
+def solve(G, B) -> np.ndarray:
+    """``G^{-1} B`` for a square ``G`` (n, n) and ``B`` (n,) or (n, k); the least-squares
+    solution when ``G`` is singular."""
+    G = _square("G", G)
+    B = np.asarray(B)
+    if B.ndim not in (1, 2) or B.shape[0] != G.shape[0]:
+        raise ValueError(f"B: expected {G.shape[0]} rows, got shape {B.shape}")
+    try:
+        return np.linalg.solve(G, B)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(G, B, rcond=None)[0]
+
+
+def free_newton(A, g, lower, upper) -> tuple[np.ndarray, float]:
+    """Coordinates free to move and the Newton decrement ``g^T A^{-1} g`` over them.
+
+    ``A`` (n, n) is the (real) Gauss-Newton matrix, ``g`` (n,) the descent direction, ``lower``
+    and ``upper`` (n,) flag the coordinates at their lower and upper bounds. A coordinate at its
+    lower (upper) bound whose Gauss-Newton step points down (up) is held: the projection would
+    undo its step. ``A`` is Jacobi-scaled before the solve (the parameters differ by orders of
+    magnitude). Returns ``(free (n,) bool, decrement)``.
+    """
+    A = _square("A", A)
+    g = np.asarray(g)
+    _masks(g, ("A", A[0]), ("lower", lower), ("upper", upper))
+    free = np.ones(g.size, bool)
+    for _ in range(3):
+        sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
+        As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+        gs = sc * g[free]
+        newton = np.zeros(g.size)
+        newton[free] = sc * np.linalg.lstsq(As, gs, rcond=1e-12)[0]
+        out = (lower & (newton < 0)) | (upper & (newton > 0))
+        if not out.any():
+            break
+        free &= ~out
+    return free, float(g[free] @ newton[free])
+
+
+def damped_step(A, g, free, lam: float) -> np.ndarray | None:
+    """Levenberg-Marquardt step ``(A_s + lam I)^{-1} g`` on the ``free`` coordinates (n,) bool,
+    with Marquardt's diagonal scaling ``A_s = D^{-1/2} A D^{-1/2}``; zero on the held ones.
+    ``None`` when the damped system is singular (the caller raises ``lam``)."""
+    A = _square("A", A)
+    g = np.asarray(g)
+    _masks(g, ("A", A[0]), ("free", free))
+    lam = positive("lam", lam)
+    sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
+    As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+    try:
+        sub = sc * np.linalg.solve(As + lam * np.eye(As.shape[0]), sc * g[free])
+    except np.linalg.LinAlgError:
+        return None
+    step = np.zeros(g.size)
+    step[free] = sub
+    return step
+
+
+def contract(H, F, T) -> np.ndarray:
+    """``sum_{s,k} H[m, s, k] F[s, l] T[k, l]`` (M, L) via one matrix product and a reduction,
+    for a tensor ``H`` (M, Nf, Nt) and mode matrices ``F`` (Nf, L), ``T`` (Nt, L)."""
+    H, F, T = np.asarray(H), np.asarray(F), np.asarray(T)
+    if H.ndim != 3:
+        raise ValueError(f"H: expected a 3-D tensor (M x Nf x Nt), got shape {H.shape}")
+    M, nf, nt = H.shape
+    if F.ndim != 2 or F.shape[0] != nf:
+        raise ValueError(f"F: expected ({nf}, L), got shape {F.shape}")
+    if T.ndim != 2 or T.shape != (nt, F.shape[1]):
+        raise ValueError(f"T: expected ({nt}, {F.shape[1]}), got shape {T.shape}")
+    tmp = (H.reshape(M * nf, nt) @ T).reshape(M, nf, -1)
+    return np.einsum("msl,sl->ml", tmp, F)
+
+
+def grid_index(element_positions, tol: float = 1e-6):
+    """``(rows, cols, n_rows, n_cols)`` integer grid coordinates of the elements if their xy
+    positions (M, >= 2) form a full rectangular lattice (a URA, or a ULA along x or y), else
+    ``None``. Positions closer than ``tol`` along an axis count as one level."""
+    p = np.asarray(element_positions, float)
+    if p.ndim != 2 or p.shape[1] < 2:
+        raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
+    tol = positive("tol", tol)
+    out = []
+    for ax in (1, 0):
+        v = p[:, ax]
+        u = np.unique(v)
+        levels = u[np.concatenate([[True], np.diff(u) > tol])]  # values closer than tol merge
+        if levels.size == 1:
+            out.append((np.zeros(p.shape[0], int), 1))
+            continue
+        # the step from the float positions (rounding them to tol first lets the rounding error
+        # accumulate along the axis: a 32 x 32 URA at 28 GHz was not recognised as a grid)
+        idx = np.round((v - levels[0]) / np.min(np.diff(levels))).astype(int)
+        step = float(np.sum(idx * (v - levels[0])) / np.sum(idx * idx))
+        if not np.allclose(levels[0] + idx * step, v, rtol=0.0, atol=10 * tol):
+            return None
+        out.append((idx, int(idx.max()) + 1))
+    (r, nr), (c, nc) = out
+    if nr * nc != p.shape[0] or len(set(zip(r.tolist(), c.tolist()))) != p.shape[0]:
+        return None
+    return r, c, nr, nc
+
+
+def spatial_phase(theta, element_positions, k0: float):
+    """Spatial phase ``psi`` (M, L) of eq. 1 and its derivatives (M, L) for ``u_x, u_y, w``.
+
+    ``theta`` (L, 3) = ``(u_x, u_y, w)`` per wave: the direction cosines in the array plane and
+    the curvature ``w = 1 / kappa``; ``element_positions`` (M, 3) in the local frame (``z = 0``,
+    reference at the origin), ``k0 = 2 pi fc / c``. With ``D = ||u - w p|| = sqrt(1 - 2 w u.p +
+    w^2 |p|^2)``, ``N = w |p|^2 - 2 u.p`` and ``Q = 1 + D``, ``psi_m = k0 (||q - p_m|| - ||q||) =
+    k0 N / Q`` (``q = u / w``), a form smooth through the far field ``w = 0``:
+
+        d psi / d u_x = k0 p_x (-2 / Q + N w / (Q^2 D))         (likewise u_y with p_y),
+        d psi / d w   = k0 (|p|^2 / Q - N (w |p|^2 - u.p) / (Q^2 D)).
+    """
+    th = np.atleast_2d(np.asarray(theta, float))
+    if th.ndim != 2 or th.shape[1] != 3:
+        raise ValueError(f"theta: expected shape (L, 3), got {th.shape}")
+    p = np.asarray(element_positions, float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
+    k0 = positive("k0", k0)
+    p2 = np.sum(p**2, axis=1)[:, None]
+    up = p[:, :2] @ th[:, :2].T
+    w = th[None, :, 2]
+    D = np.sqrt(np.maximum(1.0 - 2.0 * w * up + w * w * p2, 1e-300))
+    Q = 1.0 + D
+    N = w * p2 - 2.0 * up
+    psi = k0 * N / Q
+    common = k0 * (-2.0 / Q + N * w / (Q * Q * D))
+    dx = common * p[:, 0:1]
+    dy = common * p[:, 1:2]
+    dw = k0 * (p2 / Q - N * (w * p2 - up) / (Q * Q * D))
+    return psi, dx, dy, dw
+
+
+@lru_cache(maxsize=2)
+def _scan_grid(pos_bytes: bytes, m: int, fc: float, n_grid: int):
+    """Far-field beam-scan grid of one array: directions (G, 2) and the steering matrix (M, G)
+    (read-only: it is shared by every call with the same array)."""
+    p = np.frombuffer(pos_bytes).reshape(m, 3)
+    g = np.linspace(-1, 1, n_grid)
+    ux, uy = np.meshgrid(g, g)
+    keep = ux**2 + uy**2 < 0.99
+    u = np.column_stack([ux[keep], uy[keep]])
+    A = np.exp(-2j * np.pi * fc / C * (p[:, :2] @ u.T))  # far field: delta_m = -u . p_m
+    u.flags.writeable = False
+    A.flags.writeable = False
+    return u, A
+
+
+def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:
+    """Direction cosines ``(u_x, u_y)`` of the strongest far-field beam of the spatial vector
+    ``r`` (M,) on an ``n_grid x n_grid`` grid of the unit disc (the steering matrix of the last
+    two arrays is cached)."""
+    p = np.ascontiguousarray(element_positions, float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
+    if np.shape(r) != (p.shape[0],):
+        raise ValueError(f"r: expected shape ({p.shape[0]},), got {np.shape(r)}")
+    n_grid = integer("n_grid", n_grid, minimum=2)
+    u, A = _scan_grid(p.tobytes(), p.shape[0], positive("fc", fc), n_grid)
+    return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H

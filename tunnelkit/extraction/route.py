@@ -1,0 +1,79 @@
+"""The front of the extraction: :func:`extract_paths`, one call for every route."""
+
+from __future__ import annotations
+
+from .._validate import positive
+from .coherent import resolve_coherent
+from .decomposition import check_rank, check_tensor
+from .estimates import PathEstimates
+from .ml import ml_paths
+from .paper import paper_route
+from .radio import check_array, check_srs
+
+__all__ = ["ROUTES", "extract_paths"]
+
+#: the routes of :func:`extract_paths` (``refine``)
+ROUTES = ("ml", "coherent", "joint", "column", "none")
+
+
+def extract_paths(
+    H,
+    n_paths: int,
+    array,
+    srs,
+    *,
+    refine: str = "ml",
+    method: str = "fast",
+    n_iter_max: int = 200,
+    tol: float = 1e-10,
+    polish: int | None = None,
+    noise_power: float | None = None,
+) -> PathEstimates:
+    """Path parameters from the channel tensor, one entry per path.
+
+    Parameters
+    ----------
+    H : (M, Nf, Nt) complex tensor following eq. 1 as printed (see the package docstring).
+    n_paths : number of paths L (known, as in the paper); refused beyond Kruskal's condition.
+    array : a :class:`tunnelkit.arrays.ArrayGeometry` (its ``local`` element positions are used)
+        or an (M, 3) array of local-frame positions (``z = 0``, reference antenna at the origin).
+    srs : a :class:`tunnelkit.channel.SRSConfig`: the carrier ``fc``, the spacing ``Delta f`` of
+        the tones along axis 1 (``tone_spacing``) and the period ``T0`` of the samples along
+        axis 2 (``symbol_period``).
+    refine : the route.
+
+        - "ml" (default) — the joint maximum-likelihood fit of the exact eq. 1 model, started from
+          the CPD and the coherent split, with SAGE-like re-seeding (:mod:`.ml`): efficient (at
+          the structured CRLB, :func:`path_crlb`) in direction, curvature, delay and Doppler;
+        - "coherent" — "joint", then the coherent split (:func:`.coherent.resolve_coherent`);
+        - the paper's route (eq. 13-24, :func:`.paper.paper_route`): "joint" — after eq. 13,
+          maximum-likelihood refinement of all roots together with free spatial factors
+          (:func:`refine_joint`); "column" — each root to the periodogram peak of its own factor
+          column (:func:`refine_roots`); "none" — the paper's eq. 13 roots and eq. 12 gains as
+          they are.
+    method : "fast" (compressed, ESPRIT-initialised) or "plain" (``parafac(init='svd')``).
+    polish : ALS sweeps on the full tensor after the compressed CPD (default 2, or 0 with
+        ``refine="joint"``, which supersedes them).
+    noise_power : noise power per sample for the "ml" route (default: estimated from ``H``).
+
+    Returns a :class:`PathEstimates` (``alpha, d, v, direction, kappa, near_field`` and more); it
+    also supports ``est["d"]``. On the "ml" route see :func:`.ml.ml_paths` for what each field
+    holds (``kappa`` is finite for every near-field wave; ``fit`` has the noise floor test).
+    """
+    H = check_tensor(H)
+    L = check_rank(H.shape, n_paths)
+    pos = check_array(array, m=H.shape[0])
+    srs = check_srs(srs)
+    if refine not in ROUTES:
+        raise ValueError(f"refine: expected one of {ROUTES}, got {refine!r}")
+    if refine == "ml":
+        if noise_power is not None:
+            noise_power = positive("noise_power", noise_power)
+        return ml_paths(H, L, pos, srs, noise_power=noise_power)
+    if noise_power is not None:
+        raise ValueError(f"noise_power: only used by refine='ml', not {refine!r}")
+    cpd_kw = {"method": method, "n_iter_max": n_iter_max, "tol": tol, "polish": polish}
+    if refine == "coherent":
+        est = paper_route(H, L, pos, srs, refine="joint", **cpd_kw)
+        return resolve_coherent(H, est, pos, srs, L)
+    return paper_route(H, L, pos, srs, refine=refine, **cpd_kw)
