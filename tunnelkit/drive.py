@@ -44,7 +44,14 @@ from scipy.signal import lfilter
 
 from ._validate import finite_array, nonnegative, positive, probability, real, rng_or_error
 from .constants import C
-from .scenarios import ScenarioError, Trajectory, load_scenario
+from .scenarios import (
+    MAX_SAMPLES,
+    Scenario,
+    ScenarioError,
+    Trajectory,
+    load_scenario,
+    register_check,
+)
 
 __all__ = [
     "IDEAL",
@@ -615,3 +622,41 @@ def load_drive_config(name: str = "halili2022-drive") -> DriveConfig:
         return DriveConfig(**kw)
     except (TypeError, ValueError) as exc:
         raise ScenarioError(f"{sc.path.name}: {exc}") from None
+
+
+@register_check("halili2022")
+def _check_tube(sc: Scenario) -> None:
+    """Transmitter and vehicle inside the tube, every value a valid :class:`DriveConfig` field
+    and a drive of at most ``MAX_SAMPLES`` epochs (run on load of a ``halili2022`` file)."""
+    where, sec = sc.path.name, sc.sections
+    w, h = sec["tube"]["width"], sec["tube"]["height"]
+    for key, val, lim in (
+        ("transmitter.tx_y", sec["transmitter"]["tx_y"], w / 2),
+        ("vehicle.lane_y", sec["vehicle"]["lane_y"], w / 2),
+    ):
+        if not abs(val) < lim:
+            raise ScenarioError(
+                f"{where}: '{key}' = {val:g} m lies outside the {w:g} m wide tube (|y| < {lim:g})"
+            )
+    for key, val in (
+        ("transmitter.tx_z", sec["transmitter"]["tx_z"]),
+        ("vehicle.rx_height", sec["vehicle"]["rx_height"]),
+    ):
+        if not 0 < val < h:
+            raise ScenarioError(
+                f"{where}: '{key}' = {val:g} m lies outside the {h:g} m high tube (0 < z < {h:g})"
+            )
+    owner = {k: name for name, tab in sec.items() if isinstance(tab, dict) for k in tab}
+    try:
+        DriveConfig(**{k: sec[s][k] for k, s in owner.items()})
+    except ValueError as exc:
+        field_name, _, msg = str(exc).partition(":")
+        key = f"{owner.get(field_name, '?')}.{field_name}"
+        raise ScenarioError(f"{where}: '{key}': {msg.strip()}") from None
+    veh = sec["vehicle"]
+    n = veh["speed"] * veh["duration"] / veh["spacing"]
+    if n > MAX_SAMPLES:
+        raise ScenarioError(
+            f"{where}: 'vehicle.spacing' {veh['spacing']:g} m gives {n:.3g} samples over the "
+            f"drive (speed x duration / spacing), more than {MAX_SAMPLES:g}"
+        )

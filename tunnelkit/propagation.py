@@ -14,7 +14,7 @@ point, the model of the paper's reference 13).
 
     >>> import tunnelkit as tk
     >>> from tunnelkit import propagation
-    >>> sc = tk.load_scenario("italiano2026-straight")     # needs this module imported
+    >>> sc = tk.load_scenario("italiano2026-straight")     # its builders are in this module
     >>> tun, arrs = sc.tunnel(), propagation.scenario_arrays(sc)
     >>> traj = sc.trajectory()
     >>> paths = propagation.trace_paths(tun, arrs[1], traj.position[0], traj.velocity[0], fc=5.9e9)
@@ -38,7 +38,13 @@ from .arrays import ArrayGeometry, make_array
 from .budget import check_bytes
 from .constants import C, wavelength
 from .geometry import Plane
-from .scenarios import ScenarioError, Trajectory, register_trajectory, register_tunnel
+from .scenarios import (
+    ScenarioError,
+    Trajectory,
+    register_arrays,
+    register_trajectory,
+    register_tunnel,
+)
 
 __all__ = [
     "Box",
@@ -702,6 +708,7 @@ def _lane(sec: dict, get, tunnel) -> Trajectory:
     return traj
 
 
+@register_arrays("italiano2026", "user")
 def scenario_arrays(scenario) -> list[ArrayGeometry]:
     """The arrays of ``[[base_station.arrays]]`` (shape, azimuth/elevation in degrees, offset).
 
