@@ -7,6 +7,7 @@ import pytest
 
 from tunnelkit import drive as dv
 from tunnelkit.constants import C
+from tunnelkit.drive import measurement, route
 from tunnelkit.geometry import Plane, mirror, specular_point
 from tunnelkit.scenarios import ScenarioError
 
@@ -202,7 +203,9 @@ def test_bad_calls(drive):
 
 
 def test_gauss_markov_is_stationary_from_the_first_sample():
-    x = np.array([dv._gauss_markov(np.random.default_rng(s), 5, 2.0, 0.9) for s in range(20000)])
+    x = np.array(
+        [measurement._gauss_markov(np.random.default_rng(s), 5, 2.0, 0.9) for s in range(20000)]
+    )
     assert np.allclose(x.std(axis=0), 2.0, rtol=0.03)
     assert np.corrcoef(x[:, 0], x[:, 1])[0, 1] == pytest.approx(0.9, abs=0.01)
     assert np.corrcoef(x[:, 3], x[:, 4])[0, 1] == pytest.approx(0.9, abs=0.01)
@@ -212,7 +215,7 @@ def test_speed_profile_distance_is_the_integral_of_the_speed():
     """Brute force for the closed-form distance: trapezoidal integral of v(t) on a fine grid."""
     cfg = dv.DriveConfig(speed_amplitude=3.0, speed_period=11.0)
     t = np.linspace(0.0, cfg.duration, 200_001)
-    s, v = dv._speed_profile(cfg, t)
+    s, v = route._speed_profile(cfg, t)
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
     assert np.allclose(s, integral, atol=1e-6)
 
@@ -221,4 +224,4 @@ def test_parabolic_peak_is_exact_on_a_parabola():
     grid = np.tile(np.linspace(-2.0, 2.0, 41), (3, 1))
     true = np.array([-0.537, 0.0, 1.234])
     mag = 5.0 - (grid - true[:, None]) ** 2
-    assert np.allclose(dv._peak(grid, mag), true, atol=1e-12)
+    assert np.allclose(route._peak(grid, mag), true, atol=1e-12)

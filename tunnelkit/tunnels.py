@@ -32,9 +32,9 @@ from .propagation import (
     Box,
     Facet,
     Tunnel3D,
-    _plate_from_table,
     close_tunnel,
     lane_trajectory,
+    plate_from_table,
     semicircular_tunnel,
 )
 from .scenarios import ScenarioError, Trajectory, register_trajectory, register_tunnel
@@ -212,7 +212,7 @@ def _user_tunnel(shape: str):
             height=get("height"),
             length=get("length"),
             x_start=get("x_start", default=None),
-            plates=tuple(_plate_from_table(i, t) for i, t in enumerate(sec.get("plates", []))),
+            plates=tuple(plate_from_table(i, t) for i, t in enumerate(sec.get("plates", []))),
             blockers=_boxes(sec),
             wall_material=get("wall_material", str, default="concrete"),
             road_material=get("road_material", str, default="concrete"),

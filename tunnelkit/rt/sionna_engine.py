@@ -39,7 +39,7 @@ import numpy as np
 from .._validate import integer, positive, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
-from ..propagation import Path, Tunnel3D, _angles
+from ..propagation import Path, Tunnel3D, arrival_angles
 from . import require_sionna
 from .mitsuba import MitsubaScene, SceneError, export_tunnel, read_scene
 
@@ -310,7 +310,7 @@ class SionnaEngine:
             vel = C * fd / self.fc
             gain = complex(raw.a[0, j] * np.exp(-2j * np.pi * self.fc * raw.tau[0, j]))
             gamma = gain * 4 * np.pi * d0 / lam * np.exp(2j * np.pi * d0 / lam)
-            az, el = _angles(u)
+            az, el = arrival_angles(u)
             out.append(
                 Path(
                     kind="los" if is_los else "reflection",

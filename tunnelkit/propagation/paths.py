@@ -1,0 +1,203 @@
+"""Single-bounce paths by the image method: LoS plus one specular reflection per surface, with
+the exact length to every antenna and the SR-NF lengths for comparison (see the package
+docstring for the model and the sign conventions)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._validate import boolean, positive, vector
+from ..arrays import ArrayGeometry
+from ..constants import C, wavelength
+from .surfaces import Tunnel3D
+
+__all__ = ["PATH_KINDS", "Path", "arrival_angles", "select_array", "trace_paths"]
+
+#: the path families :func:`trace_paths` can select
+PATH_KINDS = ("los", "wall", "ceiling", "road", "rrm")
+
+
+@dataclass(frozen=True)
+class Path:
+    """One propagation path from the UE to an array, at one epoch.
+
+    Attributes
+    ----------
+    kind : "los" or "reflection"
+    surface, surface_kind : name and kind ("wall", "ceiling", "road", "rrm") of the reflector
+        ("" and "los" for the direct path)
+    source : (3,) the VUE (the UE itself for LoS), world frame
+    point : (3,) the reflection point (the UE for LoS), world frame
+    length : exact path length to the reference antenna [m] (``||VUE - p_0||``)
+    lengths : (M,) exact length to every antenna (spherical wavefront from the VUE)
+    lengths_srnf : (M,) SR-NF lengths: ``||UE - point|| + ||point - p_m||``
+    direction : (3,) unit vector of arrival, world frame, from the reference antenna towards
+        ``point`` (and the VUE, which is collinear)
+    direction_local : (3,) the same in the array's local frame
+    azimuth, elevation : world-frame angles of ``direction`` (Italiano eq. 46-47, 49-50) [rad]
+    kappa_srnf : ``||point - p_0||``, the SR-NF curvature radius (eq. 51; ``length`` for LoS)
+    range_rate : d(length)/dt [m/s]; ``velocity = -range_rate``; ``doppler = fc velocity / c``
+    reflection_coefficient : complex ``Gamma`` (1 for LoS)
+    gain : complex amplitude ``Gamma lambda / (4 pi length) exp(-j 2 pi length / lambda)``
+    ue : (3,) the vehicle position the path was traced from
+    """
+
+    kind: str
+    surface: str
+    surface_kind: str
+    source: np.ndarray
+    point: np.ndarray
+    length: float
+    lengths: np.ndarray = field(repr=False)
+    lengths_srnf: np.ndarray = field(repr=False)
+    direction: np.ndarray
+    direction_local: np.ndarray
+    azimuth: float
+    elevation: float
+    kappa_srnf: float
+    range_rate: float
+    velocity: float
+    doppler: float
+    reflection_coefficient: complex
+    gain: complex
+    ue: np.ndarray = field(default=None, repr=False)
+
+    def delta(self, model: str = "exact") -> np.ndarray:
+        """Path-length offsets ``delta_m = d_m - d_0`` (eq. 2) for ``model`` "exact" or "srnf"."""
+        if model == "exact":
+            return self.lengths - self.lengths[0]
+        if model == "srnf":
+            return self.lengths_srnf - self.lengths_srnf[0]
+        raise ValueError(f"model: expected 'exact' or 'srnf', got {model!r}")
+
+    def kappa(self, model: str = "exact") -> float:
+        """Radius of the wavefront at the reference antenna: ``length`` (VUE) or ``kappa_srnf``."""
+        if model == "exact":
+            return self.length
+        if model == "srnf":
+            return self.kappa_srnf
+        raise ValueError(f"model: expected 'exact' or 'srnf', got {model!r}")
+
+    def wave_origin(self, model: str = "exact") -> np.ndarray:
+        """Where the wavefront is centred: the VUE (exact) or the reflection point (SR-NF)."""
+        return self.source if model == "exact" else self.point
+
+
+def arrival_angles(u) -> tuple[float, float]:
+    """World-frame azimuth and elevation [rad] of the direction ``u`` (3,) (eq. 46-47, 49-50):
+    ``atan2(u_y, u_x)`` and ``atan2(u_z, hypot(u_x, u_y))``."""
+    return _angles(vector("u", u, 3))
+
+
+def _angles(u: np.ndarray) -> tuple[float, float]:
+    return float(np.arctan2(u[1], u[0])), float(np.arctan2(u[2], np.hypot(u[0], u[1])))
+
+
+def _make_path(kind, surface, skind, source, point, ue, src_vel, array, fc, gamma) -> Path:
+    lam = wavelength(fc)
+    ant = array.world
+    lengths = np.linalg.norm(source - ant, axis=-1)
+    leg = float(np.linalg.norm(ue - point))
+    lengths_srnf = leg + np.linalg.norm(point - ant, axis=-1) if kind != "los" else lengths
+    d0 = float(lengths[0])
+    to_point = point - array.origin
+    dist = np.linalg.norm(to_point)
+    u = to_point / dist
+    rr = float((source - array.origin) @ src_vel / d0)
+    vel = -rr
+    az, el = _angles(u)
+    g = complex(gamma) * lam / (4 * np.pi * d0) * np.exp(-2j * np.pi * d0 / lam)
+    return Path(
+        kind,
+        surface,
+        skind,
+        source.copy(),
+        point.copy(),
+        d0,
+        lengths,
+        lengths_srnf,
+        u,
+        array.dir_to_local(u),
+        az,
+        el,
+        float(dist),
+        rr,
+        vel,
+        fc * vel / C,
+        complex(gamma),
+        g,
+        ue.copy(),
+    )
+
+
+def trace_paths(
+    tunnel: Tunnel3D,
+    array: ArrayGeometry,
+    ue,
+    ue_velocity=(0.0, 0.0, 0.0),
+    *,
+    fc: float,
+    kinds: tuple[str, ...] = ("los", "wall", "ceiling", "road", "rrm"),
+    front_only: bool = True,
+) -> list[Path]:
+    """All single-bounce paths from ``ue`` to ``array`` (image method), LoS first.
+
+    A reflection off surface S exists when UE and array are on S's inner side, the segment from
+    the reference antenna to the VUE crosses S inside the finite rectangle, and neither leg is
+    blocked. With ``front_only`` paths arriving from behind the array face (local z <= 0) are
+    dropped (the elements' back lobe). ``kinds`` selects the path families. Reflected paths are
+    sorted by length after the LoS path.
+    """
+    if not isinstance(tunnel, Tunnel3D):
+        raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
+    if not isinstance(array, ArrayGeometry):
+        raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
+    fc = positive("fc", fc)
+    if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
+        raise TypeError(f"kinds: expected a tuple of path kinds from {PATH_KINDS}, got {kinds!r}")
+    unknown = [k for k in kinds if k not in PATH_KINDS]
+    if unknown or not kinds:
+        raise ValueError(f"kinds: expected one or more of {PATH_KINDS}, got {tuple(kinds)!r}")
+    front_only = boolean("front_only", front_only)
+    ue = tunnel.require_inside("ue", vector("ue", ue, 3))
+    vel = vector("ue_velocity", ue_velocity, 3)
+    a0 = array.origin
+    out: list[Path] = []
+    if "los" in kinds and not tunnel.blocked(ue, a0) and (not front_only or array.in_front(ue)):
+        out.append(_make_path("los", "", "los", ue, ue, ue, vel, array, fc, 1.0))
+    refl = []
+    for s in tunnel.surfaces:
+        if s.kind not in kinds:
+            continue
+        pl = s.plane
+        du, da = float(pl.signed_distance(ue)), float(pl.signed_distance(a0))
+        if du <= 0 or da <= 0:
+            continue
+        vue = pl.mirror(ue)
+        point = a0 + da / (da + du) * (vue - a0)  # where reference-antenna -> VUE crosses S
+        if not s.contains(point, tol=1e-9):
+            continue
+        if tunnel.blocked(ue, point) or tunnel.blocked(point, a0):
+            continue
+        if front_only and not array.in_front(point):
+            continue
+        cos_i = min(du / float(np.linalg.norm(ue - point)), 1.0)  # rounding may give 1 + 1e-16
+        gamma = s.reflection_coefficient(fc, cos_i)
+        vvue = vel - 2.0 * (vel @ pl.normal) * pl.normal
+        refl.append(
+            _make_path("reflection", s.name, s.kind, vue, point, ue, vvue, array, fc, gamma)
+        )
+    refl.sort(key=lambda p: p.length)
+    return out + refl
+
+
+def select_array(arrays, ue) -> ArrayGeometry:
+    """The array whose boresight points most towards ``ue`` (the one the vehicle drives into)."""
+    arrays = list(arrays)
+    if not arrays:
+        raise ValueError("arrays: need at least one array")
+    ue = vector("ue", ue, 3)
+    scores = [float(a.boresight @ (ue - a.origin)) for a in arrays]
+    return arrays[int(np.argmax(scores))]

@@ -1,0 +1,221 @@
+"""Finding, reading and validating scenario files: presets by name in ``data/scenarios/``, your
+own files by path, parsed tables (:func:`scenario_from_dict`) and edited copies
+(:func:`with_values`)."""
+
+from __future__ import annotations
+
+import copy
+import os
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..constants import wavelength
+from ..schema import ScenarioError, validate
+from .checks import check_placement
+from .model import Scenario
+from .registry import require
+
+__all__ = [
+    "ALLOWED_REQUIRES",
+    "NAME_RE",
+    "check_all",
+    "data_dir",
+    "list_scenarios",
+    "load_scenario",
+    "scenario_from_dict",
+    "scenario_path",
+    "with_values",
+]
+
+
+def data_dir() -> Path:
+    """The repository's ``data/`` folder (override with ``TUNNELKIT_DATA``)."""
+    env = os.environ.get("TUNNELKIT_DATA")
+    return Path(env) if env else Path(__file__).resolve().parents[2] / "data"
+
+
+def list_scenarios() -> list[str]:
+    """Names of the presets in ``data/scenarios/``."""
+    return sorted(p.stem for p in (data_dir() / "scenarios").glob("*.toml"))
+
+
+#: modules a file's ``requires`` may name (they register tunnel/trajectory kinds on import;
+#: loaded through :func:`tunnelkit.scenarios.registry.require`)
+ALLOWED_REQUIRES = ("tunnelkit.propagation", "tunnelkit.tunnels")
+#: a preset name: letters, digits, ".", "_" and "-", no directory part
+NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
+
+
+def scenario_path(name: str | os.PathLike) -> Path:
+    """The file a scenario name or path refers to (``ScenarioError`` if it is not allowed).
+
+    A plain name (letters, digits, ``.``, ``_``, ``-``; no directory part) resolves inside
+    ``data/scenarios/`` only; anything else (a :class:`~pathlib.Path`, or a string with a
+    directory part or ending in ``.toml``) must be an existing ``.toml`` file.
+    """
+    if isinstance(name, os.PathLike) or (
+        isinstance(name, str) and (name.endswith(".toml") or "/" in name or os.sep in name)
+    ):
+        path = Path(name)
+        if path.suffix != ".toml":
+            raise ScenarioError(
+                f"name: {str(name)!r} is neither a preset name nor a path to a .toml file"
+            )
+        if not path.is_file():
+            raise ScenarioError(f"name: no such scenario file {str(path)!r}")
+        return path
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"name: expected a scenario name string or a path, got {name!r}")
+    root = (data_dir() / "scenarios").resolve()
+    path = (root / f"{name}.toml").resolve()
+    if not NAME_RE.fullmatch(name) or not path.is_relative_to(root) or not path.is_file():
+        raise ScenarioError(
+            f"name: unknown scenario {name!r}; available: {', '.join(list_scenarios())}"
+        )
+    return path
+
+
+def load_scenario(name: str | os.PathLike) -> Scenario:
+    """Load and validate a scenario: a preset name (``"jiang2023-straight"``) or a ``.toml`` path.
+
+    Names resolve inside ``data/scenarios/`` only (see :func:`scenario_path`); a path such as
+    ``"my-tunnel.toml"`` or ``Path("tunnels/mine.toml")`` loads your own file. The file is checked
+    against its family's schema (:mod:`tunnelkit.schema`): required keys, types, ranges, unknown
+    keys (with the nearest valid name), the base station, its arrays and the trajectory inside
+    the tunnel. Any problem is a :class:`ScenarioError` naming the file and the key.
+    """
+    path = scenario_path(name)
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path.name}: not valid TOML ({exc})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"{path.name}: cannot read ({exc})") from None
+    return scenario_from_dict(raw, path)
+
+
+def scenario_from_dict(raw: dict, path: str | os.PathLike = "<dict>") -> Scenario:
+    """Validate and build a scenario from a parsed table (what :func:`load_scenario` does after
+    reading the file); ``path`` only labels the messages. No file is read or written.
+    """
+    if not isinstance(raw, dict):
+        raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
+    raw = copy.deepcopy(raw)
+    path = Path(path)
+    where = path.name
+    family, sections = validate(raw, where)
+    for mod in sections.get("requires", []):
+        if mod not in ALLOWED_REQUIRES:
+            raise ScenarioError(
+                f"{where}: 'requires' entries must be one of {list(ALLOWED_REQUIRES)}, got {mod!r}"
+            )
+    for mod in sections.get("requires", []):
+        require(mod, where)
+    if family == "user":
+        _derive_user(sections, raw, where)
+    sc = Scenario(
+        name=sections["name"],
+        paper=sections.get("paper", ""),
+        description=sections.get("description", ""),
+        path=path,
+        sections=sections,
+        family=family,
+        raw=raw,
+    )
+    check_placement(sc)
+    return sc
+
+
+_INDEX_RE = re.compile(r"(\w+)\[(\d+|\*)\]")
+
+
+def with_values(scenario: Scenario, changes: dict[str, Any]) -> Scenario:
+    """A copy of ``scenario`` with dotted keys of its file replaced, validated again.
+
+    ``{"radio.fc": 28e9, "base_station.position": [0, 0, 5.5],
+    "base_station.arrays[*].shape": [16, 16], "base_station.arrays[0].tilt_deg": 10.0}``;
+    ``[*]`` sets the key in every table of the array. Setting a value to ``None`` removes the key.
+    Raises :class:`ScenarioError` naming the key if the result is invalid (design sweeps).
+    """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
+    if not isinstance(changes, dict):
+        raise TypeError(f"changes: expected a dict of dotted keys, got {type(changes).__name__}")
+    raw = copy.deepcopy(scenario.raw)
+    for dotted, value in changes.items():
+        if not isinstance(dotted, str) or not dotted:
+            raise TypeError(f"changes: keys must be dotted key strings, got {dotted!r}")
+        *parents, last = dotted.split(".")
+        targets = [raw]
+        for part in parents:
+            m = _INDEX_RE.fullmatch(part)
+            name, idx = (m.group(1), m.group(2)) if m else (part, None)
+            nxt = []
+            for t in targets:
+                if idx is None:
+                    nxt.append(t.setdefault(name, {}))
+                    continue
+                arr = t.get(name)
+                if not isinstance(arr, list):
+                    raise ScenarioError(
+                        f"{scenario.path.name}: '{dotted}': no array of tables {name!r}"
+                    )
+                if idx == "*":
+                    nxt.extend(arr)
+                elif int(idx) < len(arr):
+                    nxt.append(arr[int(idx)])
+                else:
+                    raise ScenarioError(
+                        f"{scenario.path.name}: '{dotted}': {name} has {len(arr)} tables"
+                    )
+            targets = nxt
+        for t in targets:
+            if not isinstance(t, dict):
+                raise ScenarioError(f"{scenario.path.name}: '{dotted}': not a table")
+            if value is None:
+                t.pop(last, None)
+            else:
+                t[last] = copy.deepcopy(value)
+    return scenario_from_dict(raw, scenario.path)
+
+
+def _derive_user(sec: dict, raw: dict, where: str) -> None:
+    """Fill the keys the shared builders read from a ``user`` file's friendlier ones."""
+    radio = sec["radio"]
+    lam = float(wavelength(radio["fc"]))
+    for i, (arr, given) in enumerate(
+        zip(sec["base_station"]["arrays"], raw["base_station"]["arrays"])
+    ):
+        if "spacing_m" in given and "spacing_wavelengths" in given:
+            raise ScenarioError(
+                f"{where}: 'base_station.arrays[{i}].spacing_m' and '.spacing_wavelengths' both "
+                "given; keep one"
+            )
+        arr["elevation_deg"] = -arr["tilt_deg"]
+        arr["spacing"] = (
+            arr["spacing_m"] if "spacing_m" in arr else arr["spacing_wavelengths"] * lam
+        )
+    if "n_rb" not in radio:
+        n_rb = int(np.floor(0.983 * radio["bandwidth"] / (12 * radio["scs"]) + 1e-9))
+        if n_rb < 1:
+            raise ScenarioError(
+                f"{where}: 'radio.bandwidth' {radio['bandwidth']:g} Hz holds no resource block of "
+                f"12 subcarriers at radio.scs = {radio['scs']:g} Hz"
+            )
+        radio["n_rb"] = n_rb
+
+
+def check_all(paths=None) -> list[tuple[str, str | None]]:
+    """``[(name, error or None), ...]`` for every preset (or the given names/paths)."""
+    out = []
+    for n in list_scenarios() if paths is None else paths:
+        try:
+            load_scenario(n)
+            out.append((str(n), None))
+        except (ScenarioError, TypeError) as exc:
+            out.append((str(n), str(exc)))
+    return out
