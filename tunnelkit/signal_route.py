@@ -30,11 +30,17 @@ from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
 from .constants import C
 from .evaluation import match_paths
 
-__all__ = ["Epoch", "Measurements", "SignalRoute", "measurements_from_estimates", "simulate_epoch"]
+__all__ = [
+    "Epoch",
+    "RouteMeasurements",
+    "SignalRoute",
+    "measurements_from_estimates",
+    "simulate_epoch",
+]
 
 
 @dataclass(frozen=True)
-class Measurements:
+class RouteMeasurements:
     """Algorithm 1 output for one array, angles in the **world** frame, seen from ``origin``.
 
     Per kept path (sorted by ``d``; path 0 is the earliest arrival): ``phi``/``psi`` azimuth and
@@ -88,7 +94,7 @@ class Epoch:
     paths: list = field(repr=False)
     snapshot: ChannelSnapshot = field(repr=False)
     estimates: object = field(repr=False)
-    measurements: Measurements
+    measurements: RouteMeasurements
     truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
 
     def with_estimates(self, est, config: SRSConfig | None = None, *, min_d: float = 0.0):
@@ -131,7 +137,7 @@ def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
 
 def measurements_from_estimates(
     est, array: ArrayGeometry, config: SRSConfig | None = None, *, min_d: float = 0.0
-) -> Measurements:
+) -> RouteMeasurements:
     """Apply Algorithm 1's checks to raw estimates (``min_d``: see
     :func:`tunnelkit.extraction.algorithm1`) and express them in the world frame; with
     ``config``, also the covariance the extraction reports (:func:`reported_covariance`)."""
@@ -145,7 +151,7 @@ def measurements_from_estimates(
     cov = sigma_d = None
     if config is not None and keep.size:
         cov, sigma_d = reported_covariance(est, keep, array, config)
-    return Measurements(
+    return RouteMeasurements(
         array.origin.copy(),
         array.name,
         phi,

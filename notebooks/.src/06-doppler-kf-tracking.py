@@ -353,7 +353,7 @@ print(f"EKF DS at 32.79 Hz on the default drive: plain {plain:.2f} m, gated {gat
 
 # %%
 k_glitch = len(drive.t) // 2
-glitch = dv.Measurements(
+glitch = dv.DopplerToaMeasurements(
     meas.t, meas.doppler.copy(), meas.toa, meas.dropped, meas.outlier, meas.parts
 )
 glitch.doppler[k_glitch] += 2000.0

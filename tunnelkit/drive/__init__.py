@@ -43,7 +43,7 @@ One module per job, re-exported here:
 from __future__ import annotations
 
 from .config import IDEAL, DriveConfig, load_drive_config
-from .measurement import GnssFix, Measurements, gnss_fix, measure
+from .measurement import DopplerToaMeasurements, GnssFix, gnss_fix, measure
 from .route import (
     Drive,
     channel_paths,
@@ -56,10 +56,10 @@ from .route import (
 
 __all__ = [
     "IDEAL",
+    "DopplerToaMeasurements",
     "Drive",
     "DriveConfig",
     "GnssFix",
-    "Measurements",
     "channel_paths",
     "delay_doppler_profiles",
     "doppler_shift",

@@ -13,11 +13,11 @@ from .._validate import finite_array, positive, rng_or_error
 from ..constants import C
 from .route import Drive
 
-__all__ = ["GnssFix", "Measurements", "gnss_fix", "measure"]
+__all__ = ["DopplerToaMeasurements", "GnssFix", "gnss_fix", "measure"]
 
 
 @dataclass(frozen=True)
-class Measurements:
+class DopplerToaMeasurements:
     """One noisy realisation: Doppler [Hz] and ToA [s] per epoch; dropped epochs are NaN in both.
 
     ``dropped`` marks them explicitly; ``outlier`` marks Doppler samples that locked on a moving
@@ -68,7 +68,7 @@ def _gauss_markov(rng: np.random.Generator, n: int, sigma: float, rho: float) ->
     return sigma * np.concatenate([w[:1], tail])
 
 
-def measure(drive: Drive, rng: np.random.Generator) -> Measurements:
+def measure(drive: Drive, rng: np.random.Generator) -> DopplerToaMeasurements:
     """One noisy realisation of the Doppler and ToA streams (model in the module docstring)."""
     if not isinstance(drive, Drive):
         raise TypeError(
@@ -105,7 +105,7 @@ def measure(drive: Drive, rng: np.random.Generator) -> Measurements:
         "toa_white": white_t,
         "clock": clock,
     }
-    return Measurements(
+    return DopplerToaMeasurements(
         t=drive.t,
         doppler=doppler,
         toa=toa,

@@ -168,7 +168,7 @@ def scenario_route(route, model: str = "exact") -> SignalRoute:
 
 def path_measurements(ep, route: SignalRoute) -> tuple[PathMeasurements | None, str | None]:
     """The tracker's measurements of one simulated epoch (the one adapter from
-    :class:`tunnelkit.signal_route.Measurements` to :class:`PathMeasurements`), or ``None`` and
+    :class:`tunnelkit.signal_route.RouteMeasurements` to :class:`PathMeasurements`), or ``None`` and
     the reason: a route that reports covariances (``report_covariance``) gives none for a fit
     that failed its own residual test (or whose Fisher information is singular), and such an
     epoch carries no measurement (the tracker predicts only)."""

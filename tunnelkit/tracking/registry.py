@@ -27,7 +27,7 @@ every member through it). Each member's ``name`` attribute is its registered nam
     ``trk = cls(setup, fix, sigma_hz=..., q=..., adaptive=..., **kw)`` with a ``DopplerSetup``
     and a ``GnssFix``; keywords a member does not use are ignored, so one set of keywords serves
     the whole family (``doppler.run_approaches``). ``trk.run(meas)`` -> ``Track`` over a whole
-    ``Measurements`` stream (epoch 0 is the GNSS fix), or ``trk.step(doppler, toa)`` -> the
+    ``DopplerToaMeasurements`` stream (epoch 0 is the GNSS fix), or ``trk.step(doppler, toa)`` -> the
     position (2,) of one further epoch; ``trk.speed()``, ``trk.n_rejected``.
 
 ``"italiano2026"`` (JAVELIN, TeNFiLoc; :mod:`tunnelkit.tracking.javelin`)

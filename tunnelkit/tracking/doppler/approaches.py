@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...drive import Drive, GnssFix, Measurements, gnss_fix, measure, slant_range
+from ...drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
 from ..registry import family, register
 from .filters import (
     DopplerEKF,
@@ -65,10 +65,10 @@ class _Base:
     def speed(self) -> float:  # pragma: no cover - interface
         raise NotImplementedError
 
-    def run(self, meas: Measurements) -> Track:
+    def run(self, meas: DopplerToaMeasurements) -> Track:
         """Run over a whole measurement stream; dropped epochs predict only (one summary warning)."""
-        if not isinstance(meas, Measurements):
-            raise TypeError(f"meas: expected Measurements, got {type(meas).__name__}")
+        if not isinstance(meas, DopplerToaMeasurements):
+            raise TypeError(f"meas: expected DopplerToaMeasurements, got {type(meas).__name__}")
         n = len(meas.t)
         pos = np.empty((n, 2))
         spd = np.empty(n)
@@ -255,7 +255,7 @@ SIGMAS = {"103.70 Hz": 103.70, "32.79 Hz": 32.79, "10.37 Hz": 10.37, "dynamic": 
 
 def run_approaches(
     drive: Drive,
-    meas: Measurements,
+    meas: DopplerToaMeasurements,
     fix: GnssFix,
     *,
     sigma_hz: float | None = 32.79,
