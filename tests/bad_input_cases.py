@@ -1048,7 +1048,7 @@ def build_cases() -> list[Case]:
             ("R",),
         )
     )
-    g = lambda: _mod("tracking.javelin.gate")  # noqa: E731
+    g = lambda: _mod("tracking.gating")  # noqa: E731
     for label, y, S in (
         ("S=-eye", [1.0, 2.0], -np.eye(2)),
         ("S=nonsym", [1.0, 2.0], np.array([[1.0, 0.5], [0.0, 1.0]])),
