@@ -285,7 +285,8 @@ def notebook_client(nb, **kwargs):
     port: the kernel dies with ``ZMQError: Address already in use``, or one kernel's messages reach
     another's client ("Invalid Signature"). Here the five channels (and the connection file) live
     in a new directory of this process's own under the system temporary directory, which no other
-    kernel uses; it is removed with the client. ``kwargs`` go to ``NotebookClient``.
+    kernel uses; it is removed once the notebook has run and its kernel is shut down (or, if the
+    kernel never started, when the client is collected). ``kwargs`` go to ``NotebookClient``.
     """
     from nbclient import NotebookClient
     from traitlets.config import Config
@@ -295,7 +296,13 @@ def notebook_client(nb, **kwargs):
     config.KernelManager.transport = "ipc"
     config.KernelManager.ip = str(ipc_dir / "kernel")  # sockets kernel-1 ... kernel-5
     config.KernelManager.connection_file = str(ipc_dir / "kernel.json")
-    client = NotebookClient(nb, config=config, **kwargs)
+    then = kwargs.pop("on_notebook_complete", None)
+
+    def complete(**hook):  # nbclient runs this after the kernel's shutdown
+        shutil.rmtree(ipc_dir, ignore_errors=True)
+        return then(**hook) if then else None
+
+    client = NotebookClient(nb, config=config, on_notebook_complete=complete, **kwargs)
     weakref.finalize(client, shutil.rmtree, ipc_dir, ignore_errors=True)
     return client
 
