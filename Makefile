@@ -55,7 +55,7 @@ lab: install
 	$(if $(filter-out 0,$(QUICK)),TUNNELKIT_QUICK=1) $(VENV)/bin/jupyter lab $(LAB_ROOT) \
 	  --ContentsManager.allow_hidden=True notebooks/
 
-LINTED := tunnelkit tests benchmarks tools notebooks/.src
+LINTED := tunnelkit tests benchmarks tools notebooks/.src notebooks/conftest.py
 
 lint: install
 	$(VENV)/bin/ruff check $(LINTED)

@@ -4,6 +4,8 @@
   resolution of a short name such as ``02`` to its file;
 * loopback ports (a free one, or a clear error when the asked one is taken);
 * starting a server in its own process group and stopping it by its process id;
+* kernels that talk over Unix sockets in a private temporary directory, not TCP ports (see
+  ``notebook_client``);
 * headless execution of a notebook (cached under ``build/executed/``) with plotly figures emitted
   as JSON (``PLOTLY_RENDERER=plotly_mimetype``) so no output refers to a CDN;
 * extraction of the plotly figures of an executed notebook, including the live ``FigureWidget`` of
@@ -19,13 +21,16 @@ import hashlib
 import json
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 import urllib.error
 import urllib.request
+import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -267,6 +272,41 @@ def serving(
 # ---------------------------------------------------------------- execution
 
 
+#: Voila's command-line switch for the same transport; Voila keeps each kernel's sockets in its own
+#: temporary connection directory (``voila_*`` under the system temporary directory).
+IPC_TRANSPORT_FLAG = "--KernelManager.transport=ipc"
+
+
+def notebook_client(nb, **kwargs):
+    """An nbclient ``NotebookClient`` whose kernel listens on Unix sockets, not on TCP ports.
+
+    With jupyter_client's default TCP transport the kernel manager picks five free ports by binding
+    and releasing them, so two processes starting kernels at the same moment can be handed the same
+    port: the kernel dies with ``ZMQError: Address already in use``, or one kernel's messages reach
+    another's client ("Invalid Signature"). Here the five channels (and the connection file) live
+    in a new directory of this process's own under the system temporary directory, which no other
+    kernel uses; it is removed once the notebook has run and its kernel is shut down (or, if the
+    kernel never started, when the client is collected). ``kwargs`` go to ``NotebookClient``.
+    """
+    from nbclient import NotebookClient
+    from traitlets.config import Config
+
+    ipc_dir = Path(tempfile.mkdtemp(prefix="tunnelkit-kernel-"))
+    config = Config(kwargs.pop("config", None) or {})
+    config.KernelManager.transport = "ipc"
+    config.KernelManager.ip = str(ipc_dir / "kernel")  # sockets kernel-1 ... kernel-5
+    config.KernelManager.connection_file = str(ipc_dir / "kernel.json")
+    then = kwargs.pop("on_notebook_complete", None)
+
+    def complete(**hook):  # nbclient runs this after the kernel's shutdown
+        shutil.rmtree(ipc_dir, ignore_errors=True)
+        return then(**hook) if then else None
+
+    client = NotebookClient(nb, config=config, on_notebook_complete=complete, **kwargs)
+    weakref.finalize(client, shutil.rmtree, ipc_dir, ignore_errors=True)
+    return client
+
+
 def kernel_env(quick: bool) -> dict[str, str]:
     """Environment of an executing kernel: quick mode or not, plotly figures as JSON."""
     env = dict(os.environ)
@@ -315,7 +355,6 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
     data files and the mode, so ``make figures`` after ``make site`` does not run it again.
     """
     import nbformat
-    from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
     EXECUTED.mkdir(parents=True, exist_ok=True)
@@ -332,7 +371,7 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
     os.environ.update(env)  # the kernel inherits this process's environment
     try:
         nb.cells.append(nbformat.v4.new_code_cell(_DUMP_FIGURE_WIDGETS))
-        client = NotebookClient(
+        client = notebook_client(
             nb,
             timeout=timeout,
             kernel_name="python3",

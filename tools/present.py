@@ -24,6 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _lecture import (
     BUILD,
     HOST,
+    IPC_TRANSPORT_FLAG,
     VIEWS,
     LectureError,
     check_port,
@@ -39,7 +40,12 @@ from _lecture import (
 
 
 def voila_command(notebook: Path, port: int) -> list[str]:
-    """The Voila command line for one notebook on 127.0.0.1:port, sources stripped."""
+    """The Voila command line for one notebook on 127.0.0.1:port, sources stripped.
+
+    Its kernels talk over Unix sockets in Voila's own temporary directory, not TCP ports, so a
+    kernel started beside another process's cannot be handed a port that one takes
+    (``notebook_client`` in _lecture.py says more).
+    """
     return [
         sys.executable,
         "-m",
@@ -52,6 +58,7 @@ def voila_command(notebook: Path, port: int) -> list[str]:
         "--theme=light",
         "--VoilaConfiguration.show_tracebacks=True",
         "--Voila.open_browser=False",
+        IPC_TRANSPORT_FLAG,
     ]
 
 
