@@ -46,7 +46,7 @@ def cases() -> list[Case]:
             warnings.simplefilter("ignore", JavelinWarning)
             trk.step(eps[k], spd[k - 1], hdg[k - 1], 0.1)
 
-    route = ex._route("italiano2026-straight", "exact")
+    route = ex.scenario_route("italiano2026-straight", "exact")
     sig_rng = np.random.default_rng(1)
     trk_sig = Javelin(
         route.trajectory.position[0],
