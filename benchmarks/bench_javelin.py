@@ -12,7 +12,7 @@ import numpy as np
 from run import Case
 
 from tunnelkit import studies as ex
-from tunnelkit.tracking.javelin import Javelin, JavelinWarning, designs
+from tunnelkit.tracking.javelin import Javelin, JavelinWarning, PathMeasurements, designs
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 
 
@@ -60,7 +60,7 @@ def cases() -> list[Case]:
         if separated:
             ep = ex.separate_epoch(ep, route.config)
         m = ep.measurements
-        paths = ex.PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False)
+        paths = PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False)
         v = route.trajectory.velocity[k]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", JavelinWarning)

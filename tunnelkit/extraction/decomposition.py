@@ -40,7 +40,21 @@ class CPDConvergenceWarning(UserWarning):
     """The CP decomposition stopped at ``n_iter_max`` before reaching ``tol``."""
 
 
+class CheckedTensor(np.ndarray):
+    """A channel tensor that passed :func:`check_tensor` (a view of it, no copy), so the stages
+    it is handed on to (CPD, the paper's route, the coherent split, the ML fit) need not scan it
+    again. Arithmetic on it gives plain arrays: only the checked tensor itself is marked."""
+
+    def __array_wrap__(self, arr, context=None, return_scalar=False):
+        out = np.asarray(arr).view(np.ndarray)
+        return out[()] if return_scalar else out
+
+
 def check_tensor(H) -> np.ndarray:
+    """``H`` as a complex 3-D tensor, every dimension >= 2, finite and not all zeros, else an
+    error naming ``H``; returned as a :class:`CheckedTensor` view, which passes again at once."""
+    if isinstance(H, CheckedTensor) and H.ndim == 3 and min(H.shape) >= 2:
+        return H
     if H is None:
         raise TypeError("H: expected a complex 3-D array, got None")
     try:
@@ -55,7 +69,7 @@ def check_tensor(H) -> np.ndarray:
         raise ValueError("H: contains NaN or infinite values")
     if not np.any(arr):
         raise ValueError("H: is all zeros")
-    return arr
+    return arr.view(CheckedTensor)
 
 
 def max_identifiable_rank(shape) -> int:
