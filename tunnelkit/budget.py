@@ -87,14 +87,24 @@ def set_memory_budget(nbytes: int | str | None) -> int | None:
     else:
         if isinstance(nbytes, bool) or not isinstance(nbytes, int | float):
             raise TypeError(f"nbytes: expected a number of bytes, got {type(nbytes).__name__}")
-        if not math.isfinite(nbytes) or nbytes <= 0:
-            raise ValueError(f"nbytes: must be a positive number of bytes, got {nbytes}")
+        try:
+            finite = math.isfinite(nbytes)
+        except OverflowError:  # an int beyond float range
+            finite = False
+        if not finite or nbytes <= 0:
+            big_int = isinstance(nbytes, int) and not finite
+            shown = f"an integer of {len(str(nbytes))} digits" if big_int else f"{nbytes}"
+            raise ValueError(f"nbytes: must be a positive, finite number of bytes, got {shown}")
         _override = int(nbytes)
     return prev
 
 
 def format_bytes(n: float) -> str:
-    """``1536`` -> ``'1.5 KiB'``."""
+    """``1536`` -> ``'1.5 KiB'``; ``n`` a finite size >= 0 [B]."""
+    if isinstance(n, bool) or not isinstance(n, int | float):
+        raise TypeError(f"n: expected a number of bytes, got {type(n).__name__}")
+    if not math.isfinite(n) or n < 0:
+        raise ValueError(f"n: expected a finite number of bytes >= 0, got {n}")
     for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
         if n < 1024 or unit == "EiB":
             return f"{n:.3g} {unit}" if unit != "B" else f"{int(n)} B"

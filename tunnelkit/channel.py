@@ -79,6 +79,15 @@ class SRSConfig:
     def __post_init__(self) -> None:
         for k in ("fc", "bandwidth", "scs", "t_ant"):
             positive(k, getattr(self, k))
+        if self.fc < 1e6:
+            raise ValueError(
+                f"fc: {self.fc:g} Hz is below 1 MHz; fc is in Hz (did you mean {self.fc:g}e9?)"
+            )
+        if self.bandwidth >= 2 * self.fc:
+            raise ValueError(
+                f"bandwidth: {self.bandwidth:g} Hz around fc = {self.fc:g} Hz reaches 0 Hz (the band "
+                "must lie inside (0, inf): bandwidth < 2 fc; both are in Hz)"
+            )
         for k in ("clock_bias_sigma", "clock_bias_limit", "noise_figure_db"):
             nonnegative(k, getattr(self, k))
         real("tx_power_dbm", self.tx_power_dbm)

@@ -183,6 +183,10 @@ def smallest_meeting(
     within reach. Arrays that do not fit in the tunnel are skipped; ``epochs`` subsamples the
     route. For the explorer.
     """
+    target = positive("target", target)
+    share = probability("share", share, open_interval=False)
+    if share == 0:
+        raise ValueError("share: expected a share in (0, 1], got 0")
     best = 0.0
     sl = slice(None) if epochs is None else np.asarray(epochs, int)
     for spec in (parse_array(a) for a in arrays):

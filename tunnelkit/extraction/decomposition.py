@@ -57,6 +57,13 @@ def check_tensor(H) -> np.ndarray:
         return H
     if H is None:
         raise TypeError("H: expected a complex 3-D array, got None")
+    raw = np.asarray(H) if not isinstance(H, np.ndarray) else H
+    if raw.dtype.kind in "biuf":
+        raise TypeError(
+            f"H: expected a complex channel tensor, got real values ({raw.dtype}); the phase "
+            "carries delay, direction and Doppler, so a real part or a magnitude (np.abs(H)) "
+            "cannot be fitted"
+        )
     try:
         arr = np.asarray(H, dtype=complex)
     except (TypeError, ValueError) as exc:

@@ -33,7 +33,13 @@ def fresnel_te(eps_r: complex, cos_i) -> np.ndarray:
     cosine of the incidence angle from the surface normal. A perfect conductor is ``Gamma = -1``.
     """
     ci = cosine("cos_i", cos_i)
-    return _fresnel_te(_permittivity("eps_r", eps_r), ci)
+    eps = _permittivity("eps_r", eps_r)
+    if eps == 1 and np.any(np.asarray(ci) == 0):
+        raise ValueError(
+            "eps_r, cos_i: eps_r = 1 (no boundary) at grazing incidence (cos_i = 0) is 0/0; "
+            "there is no reflection to compute"
+        )
+    return _fresnel_te(eps, ci)
 
 
 def _permittivity(name: str, eps_r) -> complex:
