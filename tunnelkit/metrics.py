@@ -7,7 +7,19 @@ from numpy.lib.array_utils import normalize_axis_tuple
 
 from ._validate import finite_array
 
-__all__ = ["ecdf", "error_stats", "position_errors", "rmse"]
+__all__ = ["SETTLE_S", "ecdf", "error_stats", "position_errors", "rmse", "settled"]
+
+#: the first second of a drive is a tracker's start-up (an open-sky fix with 1 m of uncertainty,
+#: the VUE tracks born over the first epochs): the settled errors leave it out
+SETTLE_S = 1.0
+
+
+def settled(t) -> np.ndarray:
+    """Indices of the epochs of ``t`` [s] at least :data:`SETTLE_S` after its start."""
+    t = finite_array("t", t, ndim=1)
+    if not t.size:
+        raise ValueError("t: expected at least one epoch time")
+    return np.flatnonzero(t - t[0] >= SETTLE_S - 1e-9)
 
 
 def position_errors(estimate, truth) -> np.ndarray:

@@ -23,17 +23,15 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
 
 from __future__ import annotations
 
-from .bounds import RouteBounds, path_bounds, route_bounds
+from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .geometry import KINDS, RouteGeometry, trace_route
-from .montecarlo import SETTLE_S, SIGMA_HEADING, SIGMA_SPEED, javelin_config, javelin_rmse
+from .montecarlo import SETTLE_S, javelin_config, javelin_rmse
 from .report import DesignReport, DesignRow, design_sweep, recommend, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 
 __all__ = [
     "KINDS",
     "SETTLE_S",
-    "SIGMA_HEADING",
-    "SIGMA_SPEED",
     "ArraySpec",
     "DesignReport",
     "DesignRow",
@@ -48,6 +46,7 @@ __all__ = [
     "path_bounds",
     "recommend",
     "route_bounds",
+    "route_geometry",
     "smallest_meeting",
     "trace_route",
 ]

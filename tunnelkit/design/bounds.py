@@ -34,14 +34,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import extraction
 from .._validate import positive
 from ..constants import C, wavelength
 from ..fresnel import signed_mismatch
 from .geometry import RouteGeometry, trace_route
 from .setup import ArraySpec, DesignSetup, parse_array
 
-__all__ = ["RouteBounds", "path_bounds", "route_bounds"]
+__all__ = ["RouteBounds", "path_bounds", "route_bounds", "route_geometry"]
 
 _CLOCK = ("unknown", "known")
 
@@ -205,6 +204,22 @@ def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height
     return peb
 
 
+def route_geometry(setup: DesignSetup, spec, *, epochs=None) -> RouteGeometry:
+    """:func:`trace_route` of ``spec`` mounted as ``setup`` says, along its route (``epochs``:
+    indices that subsample it), at its carrier and path kinds."""
+    spec = parse_array(spec)
+    traj = setup.trajectory
+    sl = slice(None) if epochs is None else np.asarray(epochs, int)
+    return trace_route(
+        setup.tunnel,
+        setup.arrays(spec),
+        traj.position[sl],
+        traj.velocity[sl],
+        fc=setup.config.fc,
+        kinds=setup.kinds,
+    )
+
+
 def route_bounds(
     setup: DesignSetup,
     spec,
@@ -233,17 +248,8 @@ def route_bounds(
         raise ValueError(f"clock_bias: expected one of {_CLOCK}, got {clock_bias!r}")
     eps_phi = positive("eps_phi", eps_phi)
     cfg = setup.config
-    traj = setup.trajectory
-    sl = slice(None) if epochs is None else np.asarray(epochs, int)
     if geometry is None:
-        geometry = trace_route(
-            setup.tunnel,
-            setup.arrays(spec),
-            traj.position[sl],
-            traj.velocity[sl],
-            fc=cfg.fc,
-            kinds=setup.kinds,
-        )
+        geometry = route_geometry(setup, spec, epochs=epochs)
     g = geometry
     pos = spec.local(cfg.fc)
     kinds = np.array(g.kinds)
@@ -285,18 +291,11 @@ def path_bounds(setup: DesignSetup, spec, *, epochs=None) -> dict[str, np.ndarra
     Returns flat arrays over every (epoch, path): ``d`` [m] delay distance, ``direction`` [rad],
     ``kappa`` [m] (wavefront radius = distance to the VUE), ``kind`` (surface kind).
     """
+    from ..extraction import crlb_paths  # tensorly and the extraction load only here
+
     spec = parse_array(spec)
     cfg = setup.config
-    traj = setup.trajectory
-    sl = slice(None) if epochs is None else np.asarray(epochs, int)
-    g = trace_route(
-        setup.tunnel,
-        setup.arrays(spec),
-        traj.position[sl],
-        traj.velocity[sl],
-        fc=cfg.fc,
-        kinds=setup.kinds,
-    )
+    g = route_geometry(setup, spec, epochs=epochs)
     pos = spec.local(cfg.fc)
     out = {"d": [], "direction": [], "kappa": [], "kind": []}
     for t in range(len(g.ue)):
@@ -305,7 +304,7 @@ def path_bounds(setup: DesignSetup, spec, *, epochs=None) -> dict[str, np.ndarra
             continue
         src = (g.source[t, j] - g.origin[t]) @ g.rotation[t]
         d0 = np.linalg.norm(src, axis=1)
-        res = extraction.crlb_paths(
+        res = crlb_paths(
             np.sqrt(cfg.tx_power) * g.gain[t, j],
             src,
             pos,

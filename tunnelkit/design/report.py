@@ -15,8 +15,7 @@ import numpy as np
 
 from .._validate import integer, positive, probability
 from ..montecarlo import parallel_options
-from .bounds import RouteBounds, path_bounds, route_bounds
-from .geometry import trace_route
+from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .montecarlo import SETTLE_S, javelin_rmse
 from .setup import ArraySpec, DesignSetup, parse_array
 
@@ -188,17 +187,9 @@ def smallest_meeting(
     if share == 0:
         raise ValueError("share: expected a share in (0, 1], got 0")
     best = 0.0
-    sl = slice(None) if epochs is None else np.asarray(epochs, int)
     for spec in (parse_array(a) for a in arrays):
         try:
-            g = trace_route(
-                setup.tunnel,
-                setup.arrays(spec),
-                setup.trajectory.position[sl],
-                setup.trajectory.velocity[sl],
-                fc=setup.fc,
-                kinds=setup.kinds,
-            )
+            g = route_geometry(setup, spec, epochs=epochs)
         except ValueError:
             continue
         b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)

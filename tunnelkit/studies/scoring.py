@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..metrics import SETTLE_S, settled
 from ..tracking import registry
 from ..tracking.javelin.designs import paper
 from ..tracking.javelin.roles import JavelinDesign
@@ -29,15 +30,6 @@ __all__ = [
     "settled_errors",
     "tenfiloc_track",
 ]
-
-#: the first second of a drive is the tracker's start-up: the settled errors leave it out
-SETTLE_S = 1.0
-
-
-def settled(t: np.ndarray) -> np.ndarray:
-    """Indices of the epochs at least :data:`SETTLE_S` after the start of ``t``."""
-    t = np.asarray(t, dtype=float)
-    return np.flatnonzero(t - t[0] >= SETTLE_S - 1e-9)
 
 
 def tenfiloc_track(

@@ -333,9 +333,6 @@ class VueCurvature(ReflectorCurvature):
     name = "vue"
 
 
-CurvatureModel = ReflectorCurvature
-
-
 @dataclass(frozen=True)
 class DelayCheck:
     """Algorithm 1's checks: a path with a NaN angle or ``d < min_d`` is dropped; ``min_d = 0``

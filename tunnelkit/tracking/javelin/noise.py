@@ -10,6 +10,7 @@ questions: the (n, 3, 3) covariance of each path's ``(phi, psi, kappa)``
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -26,17 +27,14 @@ class FixedNoise:
     share the reference path's delay, ``sigma_dd^2 (I + 1 1^T) / 2``."""
 
     correlated_delta_d: bool = False
-    needs_reported: bool = field(default=False, init=False, repr=False)
+    #: whether the route must report a covariance per path
+    needs_reported: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.correlated_delta_d, bool):
             raise TypeError(
                 f"correlated_delta_d: expected True or False, got {self.correlated_delta_d!r}"
             )
-
-    def uses_reported(self, meas: PathMeasurements) -> bool:
-        """Whether this epoch's reported covariances are used (never, for fixed noise)."""
-        return False
 
     def covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
         """The (n, 3, 3) covariance of each path's ``(phi, psi, kappa)``."""
@@ -62,15 +60,11 @@ class ReportedNoise:
     measurement route that reports covariances (``SignalRoute(report_covariance=True)``)."""
 
     fallback: FixedNoise = field(default_factory=FixedNoise)
-    needs_reported: bool = field(default=True, init=False, repr=False)
+    needs_reported: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.fallback, FixedNoise):
             raise TypeError(f"fallback: expected a FixedNoise, got {type(self.fallback).__name__}")
-
-    def uses_reported(self, meas: PathMeasurements) -> bool:
-        """Whether this epoch carries the reported covariances."""
-        return meas.reported
 
     def covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
         """The reported (n, 3, 3) covariances, or the fallback's."""

@@ -192,7 +192,7 @@ class Javelin:
                 faults.append(f"measurement model undefined ({exc}): predict only")
         if len(meas) and geometry_ok:
             noise = roles.noise
-            if noise.needs_reported and not noise.uses_reported(meas):
+            if noise.needs_reported and not meas.reported:
                 faults.append("no reported covariance this epoch: the fixed sigmas used")
             # Associate (Algorithm 2)
             R3 = noise.covariances(meas, cfg)
