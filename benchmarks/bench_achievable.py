@@ -10,6 +10,10 @@ predicted ``sqrt(bias^2 + E[calibration bias^2] + var)`` of
 along the route per array, ideal and impaired, and the time per array (median of three runs).
 
     PYTHONPATH=$PWD python benchmarks/bench_achievable.py [--trials N] [--part 1|2|both]
+
+Under ``benchmarks/run.py`` (:func:`cases`) only the route bounds are timed (the ideal PEB and
+the achievable bound of the 28 GHz tunnel, 8 x 8 and 32 x 32); the tables come from the command
+line above (the Monte-Carlo part takes minutes).
 """
 
 from __future__ import annotations
@@ -194,6 +198,33 @@ def part2() -> None:
                     f"{np.percentile(b.achievable, 90):9.3g} {np.median(b.calibration):9.3g} "
                     f"{np.median(b.wideband):9.3g} {dt:7.2f}"
                 )
+
+
+def cases() -> list:
+    from run import Case
+
+    setup = DesignSetup.from_scenario("example-rectangular-28ghz")
+    imp = DesignImpairments(0.5, 0.2, True, 0.1)
+    out = []
+    for spec in ("8x8", "32x32"):
+        out.append(
+            Case(
+                f"route PEB only, 28 GHz {spec}",
+                lambda s=spec: achievable_bound(setup, s),
+                group=f"achievable_{spec}",
+                baseline=True,
+                repeat=5,
+            )
+        )
+        out.append(
+            Case(
+                f"achievable, 0.5 deg 0.2 dB wideband DMC 0.1, 28 GHz {spec}",
+                lambda s=spec: achievable_bound(setup, s, imp),
+                group=f"achievable_{spec}",
+                repeat=5,
+            )
+        )
+    return out
 
 
 def main() -> None:
