@@ -11,6 +11,11 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
   (:func:`trace_route`, :class:`RouteGeometry`);
 * :mod:`~tunnelkit.design.bounds`: exact SR-NF validity, the PEB from the joint Fisher
   information of eq. 1 and the per-path CRLBs (:func:`route_bounds`, :func:`path_bounds`);
+* :mod:`~tunnelkit.design.achievable`: impairments as design inputs
+  (:class:`DesignImpairments`), the extraction's per-path error model along the route
+  (:func:`path_error_model`, :class:`PathErrorModel`) and the achievable (misspecified) position
+  bound beside the PEB (:func:`achievable_bound`); the misspecified bound itself is
+  :mod:`~tunnelkit.design.mcrb`;
 * :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design (:func:`javelin_rmse`);
 * :mod:`~tunnelkit.design.report`: the sweep, its table and the recommendation
   (:func:`design_sweep`, :func:`recommend`, :func:`smallest_meeting`).
@@ -23,7 +28,9 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
 
 from __future__ import annotations
 
+from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
+from .errormodel import PathErrorModel
 from .geometry import KINDS, RouteGeometry, trace_route
 from .montecarlo import SETTLE_S, javelin_config, javelin_rmse
 from .report import DesignReport, DesignRow, design_sweep, recommend, smallest_meeting
@@ -32,18 +39,23 @@ from .setup import ArraySpec, DesignSetup, Mount, parse_array
 __all__ = [
     "KINDS",
     "SETTLE_S",
+    "AchievableBound",
     "ArraySpec",
+    "DesignImpairments",
     "DesignReport",
     "DesignRow",
     "DesignSetup",
     "Mount",
+    "PathErrorModel",
     "RouteBounds",
     "RouteGeometry",
+    "achievable_bound",
     "design_sweep",
     "javelin_config",
     "javelin_rmse",
     "parse_array",
     "path_bounds",
+    "path_error_model",
     "recommend",
     "route_bounds",
     "route_geometry",
