@@ -171,7 +171,9 @@ def _stream_rngs(seed, runs: int, streams) -> list[np.random.Generator]:
     if streams is None:
         return spawn_rngs(seed, runs)
     if isinstance(streams, str | bytes) or not isinstance(streams, Sequence | np.ndarray):
-        raise TypeError(f"streams: expected a sequence of integers (one per trial), got {streams!r}")
+        raise TypeError(
+            f"streams: expected a sequence of integers (one per trial), got {streams!r}"
+        )
     idx = [integer("streams", s, minimum=0) for s in streams]
     if len(idx) != runs:
         raise ValueError(f"streams: expected {runs} values (runs), got {len(idx)}")

@@ -21,10 +21,9 @@ the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
   Algorithm 1's ``d >= min_d`` applied as the route does (``SignalRoute.min_d``);
 * the V2X speed and heading messages as :func:`tunnelkit.studies.simulate_drive` draws them.
 
-:func:`ideal_error_model` is the ideal model of an efficient extraction (each epoch's joint
-structured CRLB of eq. 1 over the existing paths, :func:`tunnelkit.extraction.crlb_paths`; each
-path's ``(phi, psi, kappa)`` block and ``d`` variance, cross-path terms left out, no bias): the
-bound route's default when no model is given.
+The model comes from :func:`tunnelkit.design.achievable.path_error_model` (the joint ideal CRLB
+and, under impairments, the misspecified covariance, bias and calibration sensitivities);
+:func:`model_truth` gives the true ``z`` of a route geometry in the same convention.
 """
 
 from __future__ import annotations
@@ -36,7 +35,7 @@ from ..constants import C
 from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 
-__all__ = ["SIGMA_V", "bound_drive", "ideal_error_model", "model_truth"]
+__all__ = ["SIGMA_V", "bound_drive", "model_truth"]
 
 #: standard deviation [m/s] of the radial speed handed to the tracker on the bound route
 SIGMA_V = 0.05
@@ -53,72 +52,6 @@ def model_truth(g, fc: float) -> tuple[np.ndarray, np.ndarray]:
     z = np.where(g.exists[..., None], z, np.nan)
     v = np.where(g.exists, C * g.doppler / fc, np.nan)
     return z, v
-
-
-def ideal_error_model(setup: DesignSetup, spec, *, epochs=None) -> PathErrorModel:
-    """The ideal error model of an efficient extraction along ``setup``'s route for ``spec``
-    (module docstring): per epoch the joint structured CRLB over the existing paths, each path's
-    block ``(phi, psi, kappa, d)`` kept (``phi, psi, kappa`` from the wave origin's covariance
-    through :func:`tunnelkit.geometry.spherical_jacobian`, ``d`` from ``mu_f``), ``cov = crlb``,
-    no bias. ``epochs`` subsamples the route."""
-    from ..extraction import crlb_paths  # the extraction loads with the first model
-    from ..geometry import spherical_jacobian
-    from .bounds import route_geometry
-
-    if not isinstance(setup, DesignSetup):
-        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
-    spec = parse_array(spec)
-    cfg = setup.config
-    g = route_geometry(setup, spec, epochs=epochs)
-    pos = spec.local(cfg.fc)
-    T, P = g.exists.shape
-    truth, v = model_truth(g, cfg.fc)
-    crlb = np.zeros((T, 4 * P, 4 * P))
-    exists = g.exists.copy()
-    for t in range(T):
-        j = np.flatnonzero(exists[t])
-        if not j.size:
-            continue
-        src = (g.source[t, j] - g.origin[t]) @ g.rotation[t]
-        d0 = np.linalg.norm(src, axis=1)
-        res = crlb_paths(
-            np.sqrt(cfg.tx_power) * g.gain[t, j],
-            src,
-            pos,
-            -2 * np.pi * cfg.tone_spacing * d0 / C,
-            2 * np.pi * cfg.symbol_period * g.doppler[t, j],
-            cfg.fc,
-            cfg.n_tones,
-            cfg.n_symbols,
-            cfg.noise_power,
-            spatial="structured",
-        )
-        R = g.rotation[t]
-        cov_w = R @ res["source_cov"] @ R.T
-        G = spherical_jacobian(g.source[t, j] - g.origin[t])
-        blk = G @ cov_w @ np.swapaxes(G, 1, 2)
-        var_d = (C / (2 * np.pi * cfg.tone_spacing) * res["mu_f"]) ** 2
-        ok = np.all(np.isfinite(blk), axis=(1, 2)) & np.isfinite(var_d) & (var_d > 0)
-        ok &= np.all(np.linalg.eigvalsh(0.5 * (blk + np.swapaxes(blk, 1, 2))) > 0, axis=1)
-        for i, p in enumerate(j):
-            if not ok[i]:  # not identifiable at this epoch: the extraction reports no path
-                exists[t, p] = False
-                continue
-            s = slice(4 * p, 4 * p + 3)
-            crlb[t, s, s] = blk[i]
-            crlb[t, 4 * p + 3, 4 * p + 3] = var_d[i]
-    truth = np.where(exists[..., None], truth, np.nan)
-    v = np.where(exists, v, np.nan)
-    return PathErrorModel(
-        t=setup.trajectory.t[slice(None) if epochs is None else np.asarray(epochs, int)].copy(),
-        exists=exists,
-        kinds=tuple(g.kinds),
-        truth=truth,
-        v=v,
-        crlb=crlb,
-        cov=crlb.copy(),
-        bias=np.zeros((T, P, 4)),
-    )
 
 
 def bound_drive(

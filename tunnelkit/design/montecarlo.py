@@ -216,12 +216,12 @@ def drive_pcrlb(
 
 
 def _models(setup, specs, error_models) -> list[PathErrorModel]:
-    from .fastroute import ideal_error_model
+    from .achievable import path_error_model
 
     out = []
     for spec in specs:
         if error_models is None:
-            m = ideal_error_model(setup, spec)
+            m = path_error_model(setup, spec)
         elif callable(error_models):
             m = error_models(setup, spec)
         elif isinstance(error_models, dict) and spec.label in error_models:
@@ -261,8 +261,9 @@ def sweep_montecarlo(
     ``mode``: ``"bound"`` (measurements drawn from each array's error model) or ``"channel"``
     (the full signal chain). ``error_models``: per array a
     :class:`~tunnelkit.design.errormodel.PathErrorModel` (a dict by label, or a callable
-    ``(setup, spec) -> model``); default the ideal model of an efficient extraction
-    (:func:`tunnelkit.design.fastroute.ideal_error_model`). The bound mode draws from it, and
+    ``(setup, spec) -> model``, e.g. :func:`tunnelkit.design.achievable.path_error_model` with
+    impairments); default the ideal model (``path_error_model(setup, spec)``: an efficient
+    extraction without impairments). The bound mode draws from it, and
     both modes take the posterior CRLB from its reported bound (on the channel route only when
     models are given). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
     route-median per-path bounds). ``workers`` / ``scheduler`` / ``timeout`` /
