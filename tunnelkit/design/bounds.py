@@ -40,15 +40,8 @@ from ..fresnel import signed_mismatch
 from .geometry import RouteGeometry, trace_route
 from .setup import ArraySpec, DesignSetup, parse_array
 
-__all__ = [
-    "RouteBounds",
-    "compress_slots",
-    "path_bounds",
-    "route_bounds",
-    "route_geometry",
-    "theta_fim",
-    "theta_jacobian",
-]
+# compress_slots, theta_jacobian and theta_fim are shared with design.achievable (not exported)
+__all__ = ["RouteBounds", "path_bounds", "route_bounds", "route_geometry"]
 
 _CLOCK = ("unknown", "known")
 
