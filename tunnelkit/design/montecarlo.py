@@ -266,8 +266,8 @@ def sweep_montecarlo(
     extraction without impairments). The bound mode draws from it, and
     both modes take the posterior CRLB from its reported bound (on the channel route only when
     models are given). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
-    route-median per-path bounds). ``workers`` / ``scheduler`` / ``timeout`` /
-    ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
+    route-median per-path bounds, from the model when there is one). ``workers`` /
+    ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
     sweep); ``seed`` an int or a Generator: run ``r`` of every array uses child generator ``r``.
     """
     if not isinstance(setup, DesignSetup):
@@ -292,8 +292,10 @@ def sweep_montecarlo(
     if mode == "bound" or error_models is not None:
         models = _models(setup, specs, error_models)
     designs = []
-    for spec in specs:
+    for a, spec in enumerate(specs):
         crlb = None if crlbs is None else crlbs.get(spec.label)
+        if crlb is None and models is not None:
+            crlb = _median_sigmas(models[a])
         if crlb is None:
             pb = path_bounds(setup, spec)
             crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
@@ -353,6 +355,19 @@ def sweep_montecarlo(
             },
         )
     return out
+
+
+def _median_sigmas(m: PathErrorModel) -> dict[str, float]:
+    """Route-median standard deviations of ``d`` [m], direction [rad] and ``kappa`` [m] in a
+    model's reported bound (what :func:`path_bounds` gives, without evaluating it again)."""
+    T, P = m.exists.shape
+    var = np.diagonal(m.crlb, axis1=1, axis2=2).reshape(T, P, 4)[m.exists]
+    psi = m.truth[..., 1][m.exists]
+    return {
+        "d": float(np.median(np.sqrt(var[:, 3]))),
+        "direction": float(np.median(np.sqrt(var[:, 0] * np.cos(psi) ** 2 + var[:, 1]))),
+        "kappa": float(np.median(np.sqrt(var[:, 2]))),
+    }
 
 
 def _head(m: PathErrorModel, T: int) -> PathErrorModel:
