@@ -17,8 +17,9 @@ rescheduled by Dask (up to ``distributed.scheduler.allowed-failures`` deaths, de
 that the run stops with :class:`TrialLost` naming the trial, never a statistic without it.
 ``retries`` re-runs a trial that raised (off by default: a seeded trial fails the same way twice).
 Trial functions must be picklable: module-level functions, bound with ``functools.partial``; the
-trial object is sent to the workers once per run (scattered to every worker), not with every
-task, so a trial that carries a large model costs one transfer per worker.
+trial object is sent to the cluster once per run (the result of one task that every trial
+depends on, fetched once by each worker and recomputed if its holder dies), not with every task,
+so a trial that carries a large model costs one transfer per worker.
 
 Bad input and stalls: ``workers`` beyond the cores this process may use is capped to them (with a
 :class:`RuntimeWarning`: more single-threaded processes than cores only add overhead); a
@@ -377,6 +378,11 @@ def _probe_scheduler(scheduler: str, timeout: float) -> None:
         )
 
 
+def _hold(trial):
+    """Worker side: the trial object itself (see :func:`_run_dask`)."""
+    return trial
+
+
 def _one_trial(trial, args: tuple, rng_bytes: bytes):
     """Worker side: a fresh copy of the trial's generator, so a rerun replays the same stream."""
     with _one_blas_thread():
@@ -390,8 +396,9 @@ def _run_dask(
     from distributed.scheduler import KilledWorker
 
     tag = uuid.uuid4().hex[:8]
-    # the trial (it may carry a large model) goes to every worker once, not with every task
-    shared = client.scatter(trial, broadcast=True, hash=False)
+    # the trial (it may carry a large model) is one task's result, fetched once per worker, not
+    # sent with every task; unlike scattered data it is recomputed if a worker holding it dies
+    shared = client.submit(_hold, trial, key=f"{desc}-trial-{tag}", pure=False)
     futures = [
         client.submit(
             _one_trial,
