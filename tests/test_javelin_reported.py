@@ -128,7 +128,7 @@ def test_likelihood_cost_keeps_a_path_on_the_track_that_predicts_it():
         S = H @ P @ H.T + R3
         y = meas.triples()[0] - pred[i, :3]
         assert like.cost[i, 0] == pytest.approx(
-            y @ np.linalg.solve(S, y) + np.log(np.linalg.det(S))
+            y @ np.linalg.solve(S, y) + np.log(np.linalg.det(S[:2, :2]))
         )
     with pytest.raises(ValueError, match="cost: expected"):
         association_costs(pred, J, P, meas, R3, gate, "nearest")
@@ -332,3 +332,32 @@ def test_bias_aware_delay_check_keeps_paths_a_negative_clock_bias_pushed_below_z
     assert len(PathMeasurements.from_arrays([0.1], [0.0], d=[-5.0])) == 0
     with pytest.raises(ValueError, match="min_d"):
         DelayCheck(min_d=3.0)
+
+
+def test_likelihood_cost_does_not_favour_a_far_field_path_for_its_missing_curvature():
+    """A track predicts a near-field path to 0.6 sigma; a far-field path (no curvature) 3.3 sigma
+    off in azimuth competes for it. Without the curvature row, ln det S of a far-field pair lacks
+    ln S_kappa (about 11 at a 300 m curvature sigma): ranked on the angles' ln det, the
+    near-field path keeps the track."""
+    x = np.array([60.0, -2.0, 1.5])
+    P = np.diag([1.0, 1.0, 1e-4])
+    pred, J = track_model(x, (0, 0, 4.8), "vue")
+    s_ang = 0.03
+    H = J[0, :2]
+    sd = np.sqrt(np.diag(H @ P @ H.T) + s_ang**2)
+    meas = PathMeasurements.from_arrays(
+        [pred[0, 0] + 0.6 * sd[0], pred[0, 0] + 3.3 * sd[0]],
+        [pred[0, 1], pred[0, 1]],
+        kappa=[pred[0, 2] + 100.0, np.nan],
+        d=[pred[0, 3], pred[0, 3] + 0.3],
+    )
+    R3 = np.array([np.diag([s_ang**2, s_ang**2, 300.0**2])] * 2)
+    like = association_costs(pred, J, P, meas, R3, ChiSquareGate(1 - 1e-6), "likelihood")
+    assert like.gated.all()
+    assert global_nearest_neighbour(like) == [(0, 0)]
+    for j in range(2):
+        S = J[0, :3] @ P @ J[0, :3].T + R3[j]
+        k = 3 if j == 0 else 2
+        y = (meas.triples()[j] - pred[0, :3])[:k]
+        want = y @ np.linalg.solve(S[:k, :k], y) + np.log(np.linalg.det(S[:2, :2]))
+        assert like.cost[0, j] == pytest.approx(want)

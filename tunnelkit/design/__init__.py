@@ -16,7 +16,10 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
   (:func:`path_error_model`, :class:`PathErrorModel`) and the achievable (misspecified) position
   bound beside the PEB (:func:`achievable_bound`); the misspecified bound itself is
   :mod:`~tunnelkit.design.mcrb`;
-* :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design (:func:`javelin_rmse`);
+* :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design, every array x run as one task
+  set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
+  :class:`MonteCarloResult` with the posterior CRLB; :func:`javelin_rmse` for one array);
+  :mod:`~tunnelkit.design.fastroute`: the bound-driven drive (:func:`bound_drive`);
 * :mod:`~tunnelkit.design.report`: the sweep, its table and the recommendation
   (:func:`design_sweep`, :func:`recommend`, :func:`smallest_meeting`).
 
@@ -31,13 +34,24 @@ from __future__ import annotations
 from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .errormodel import PathErrorModel
+from .fastroute import bound_drive
 from .geometry import KINDS, RouteGeometry, trace_route
-from .montecarlo import SETTLE_S, javelin_config, javelin_rmse
+from .montecarlo import (
+    MODES,
+    SETTLE_S,
+    MonteCarloResult,
+    drive_pcrlb,
+    javelin_config,
+    javelin_rmse,
+    position_information,
+    sweep_montecarlo,
+)
 from .report import DesignReport, DesignRow, design_sweep, recommend, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 
 __all__ = [
     "KINDS",
+    "MODES",
     "SETTLE_S",
     "AchievableBound",
     "ArraySpec",
@@ -45,20 +59,25 @@ __all__ = [
     "DesignReport",
     "DesignRow",
     "DesignSetup",
+    "MonteCarloResult",
     "Mount",
     "PathErrorModel",
     "RouteBounds",
     "RouteGeometry",
     "achievable_bound",
+    "bound_drive",
     "design_sweep",
+    "drive_pcrlb",
     "javelin_config",
     "javelin_rmse",
     "parse_array",
     "path_bounds",
     "path_error_model",
+    "position_information",
     "recommend",
     "route_bounds",
     "route_geometry",
     "smallest_meeting",
+    "sweep_montecarlo",
     "trace_route",
 ]

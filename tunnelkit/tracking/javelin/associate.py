@@ -62,7 +62,9 @@ def association_costs(
     leaves ``eta^2`` equal to the 2-component distance.
 
     ``cost="mahalanobis"`` (the paper, section 3.3) ranks pairs by ``eta^2``;
-    ``cost="likelihood"`` (ours) by the negative log-likelihood ``eta^2 + ln det S``. The second
+    ``cost="likelihood"`` (ours) by the negative log-likelihood ``eta^2 + ln det S_angles``
+    (``S_angles`` the ``(phi, psi)`` block, which every path carries, so pairs with and without
+    a curvature are ranked on the same terms). The second
     stops a wide new track (``P = sigma_P^2 I`` at birth) from taking a path that an established
     track predicts well: its large ``S`` makes ``eta^2`` small, but ``ln det S`` large.
     """
@@ -92,8 +94,10 @@ def association_costs(
         return AssociationCosts(eta2, dof, gated, thr)
     if cost != "likelihood":
         raise ValueError(f"cost: expected 'mahalanobis' or 'likelihood', got {cost!r}")
-    # the substituted identity row of a far-field path adds ln 1 = 0
-    return AssociationCosts(eta2, dof, gated, thr, eta2 + np.linalg.slogdet(S)[1])
+    # ln det over the components every pair carries (the angles): a far-field path has no
+    # curvature row, and ln det of the full S would hand it a bonus of -ln S_kappa (about -11 at
+    # a curvature sigma of 300 m), enough to take a track's path from the LoS it predicts
+    return AssociationCosts(eta2, dof, gated, thr, eta2 + np.linalg.slogdet(S[..., :2, :2])[1])
 
 
 def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
