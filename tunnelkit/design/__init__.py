@@ -12,8 +12,10 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
 * :mod:`~tunnelkit.design.bounds`: exact SR-NF validity, the PEB from the joint Fisher
   information of eq. 1 and the per-path CRLBs (:func:`route_bounds`, :func:`path_bounds`);
 * :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design (:func:`javelin_rmse`);
-* :mod:`~tunnelkit.design.report`: the sweep, its table and the recommendation
-  (:func:`design_sweep`, :func:`recommend`, :func:`smallest_meeting`).
+* :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile with its bootstrap
+  interval, the verdict per array and the recommendation (:func:`judge`, :func:`recommend`);
+* :mod:`~tunnelkit.design.report`: the sweep and its table (:func:`design_sweep`,
+  :func:`smallest_meeting`).
 
     >>> import tunnelkit as tk
     >>> setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
@@ -26,12 +28,27 @@ from __future__ import annotations
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .geometry import KINDS, RouteGeometry, trace_route
 from .montecarlo import SETTLE_S, javelin_config, javelin_rmse
-from .report import DesignReport, DesignRow, design_sweep, recommend, smallest_meeting
+from .report import MODES, DesignReport, DesignRow, design_sweep, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
+from .verdict import (
+    CRITERIA,
+    MIN_RUNS_CI,
+    STATUSES,
+    bootstrap_quantile_ci,
+    counted_epochs,
+    gate,
+    judge,
+    recommend,
+    share_quantile,
+)
 
 __all__ = [
+    "CRITERIA",
     "KINDS",
+    "MIN_RUNS_CI",
+    "MODES",
     "SETTLE_S",
+    "STATUSES",
     "ArraySpec",
     "DesignReport",
     "DesignRow",
@@ -39,14 +56,19 @@ __all__ = [
     "Mount",
     "RouteBounds",
     "RouteGeometry",
+    "bootstrap_quantile_ci",
+    "counted_epochs",
     "design_sweep",
+    "gate",
     "javelin_config",
     "javelin_rmse",
+    "judge",
     "parse_array",
     "path_bounds",
     "recommend",
     "route_bounds",
     "route_geometry",
+    "share_quantile",
     "smallest_meeting",
     "trace_route",
 ]
