@@ -209,3 +209,83 @@ def test_cli_bad_parallel_options(capsys):
     with pytest.raises(SystemExit):  # argparse: not allowed with argument --workers
         main(["reproduce", "jiang-crlb", "--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"])
     assert "not allowed with" in capsys.readouterr().err
+
+
+def _sleep(seconds: float, rng: np.random.Generator) -> float:
+    time.sleep(seconds)
+    return float(rng.random())
+
+
+def test_silent_scheduler_fails_within_the_timeout():
+    """A server that accepts the TCP connection and never answers: a clear error, no hang."""
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    held = []
+
+    def accept():
+        while True:
+            try:
+                held.append(srv.accept()[0])
+            except OSError:
+                return
+
+    threading.Thread(target=accept, daemon=True).start()
+    addr = f"127.0.0.1:{srv.getsockname()[1]}"
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(SchedulerUnreachable, match=r"no Dask scheduler answered .* within 1 s"):
+            run_trials(_draw, 3, seed=0, scheduler=addr, timeout=1.0)
+    finally:
+        srv.close()
+        for c in held:
+            c.close()
+    assert time.perf_counter() - t0 < 4.0
+    assert held  # the connection was accepted: the probe, not the connect, timed out
+
+
+def test_a_trial_past_its_timeout_stops_the_run_serially_and_on_dask(cluster):
+    from tunnelkit.montecarlo import TrialTimeout
+
+    t0 = time.perf_counter()
+    with pytest.raises(TrialTimeout, match="trial 1 of 2"):
+        run_trials(_sleep, 2, seed=0, inputs=[0.0, 5.0], trial_timeout=0.5)
+    assert time.perf_counter() - t0 < 3.0
+    # a run whose trials each finish in time is unchanged by the limit (and the workers have
+    # imported this module before the clock starts)
+    ok = run_trials(_draw, 4, seed=3, scheduler=cluster.scheduler_address, trial_timeout=30.0)
+    assert ok == run_trials(_draw, 4, seed=3)
+    t0 = time.perf_counter()
+    with pytest.raises(TrialTimeout, match=r"trials \[1\] of 3"):
+        run_trials(
+            _sleep,
+            3,
+            seed=0,
+            inputs=[0.0, 12.0, 0.0],
+            scheduler=cluster.scheduler_address,
+            trial_timeout=1.0,
+        )
+    assert time.perf_counter() - t0 < 8.0  # the 12 s trial was not waited for
+
+
+def test_workers_beyond_the_cores_are_capped_with_a_warning(monkeypatch):
+    import tunnelkit.montecarlo as mc
+
+    monkeypatch.setattr(mc, "available_cores", lambda: 1)
+    with pytest.warns(RuntimeWarning, match="workers: 64 processes on 1 core"):
+        out = run_trials(_draw, 2, seed=5, workers=64)
+    assert out == run_trials(_draw, 2, seed=5)
+
+
+def test_trials_sharing_a_stream_see_the_same_numbers():
+    out = run_trials(_draw, 4, seed=9, streams=[0, 1, 0, 1])
+    assert out[0] == out[2] and out[1] == out[3] and out[0] != out[1]
+    assert out[:2] == run_trials(_draw, 2, seed=9)
+    with pytest.raises(ValueError, match="streams: expected 4 values"):
+        run_trials(_draw, 4, seed=9, streams=[0, 1])
+    with pytest.raises(ValueError, match="streams: must be >= 0"):
+        run_trials(_draw, 2, seed=9, streams=[0, -1])
+    with pytest.raises(ValueError, match="trial_timeout: must be > 0"):
+        run_trials(_draw, 2, seed=9, trial_timeout=0)

@@ -27,7 +27,25 @@ Two impairments eq. 1 leaves out, both off by default (the tensor is then bit-id
   band and a 23 cm aperture that is up to about 0.4 rad at the band edge. (The delay follows
   the geometry; the carrier's spatial phase keeps eq. 1's printed sign.)
 
-:class:`Impairments` bundles the two for :class:`tunnelkit.signal_route.SignalRoute`.
+A third term is random per slot, off by default:
+
+- **dense diffuse multipath (DMC)** (``dmc=DiffuseSpec(share, decay_s)``): the power a rough
+  tunnel scatters in every direction, as a sum of taps on a delay grid ``dtau = 1 / (K Nf Df)``
+  (``K = oversample``, finer than the resolution ``1 / (Nf Df)``) starting at the first path's
+  delay ``tau_0`` with an exponential power-delay profile ``w_p ~ exp(-p dtau / decay_s)``
+  (``sum w_p = 1``, ``span`` decays long, at most one unambiguous delay ``1 / Df``). Spatially
+  white (independent over elements), constant over the slot's symbols::
+
+      D[m, s, k] = exp(-j 2 pi s Df tau_0) sum_p beta_mp exp(-j 2 pi s p / (K Nf)),
+      beta_mp ~ CN(0, P_D w_p),   P_D = share / (1 - share) sum_l |sqrt(P_t) alpha_l|^2,
+
+  so that the diffuse power is ``share`` of the received power (specular plus diffuse) per
+  element. Its covariance is ``E[D D^H] = P_D I_M (x) R_f (x) 1 1^T`` with
+  ``R_f[s, s'] = sum_p w_p exp(-j 2 pi (s - s') Df (tau_0 + p dtau))``
+  (:meth:`DiffuseSpec.tone_covariance`). The sum over taps is one zero-padded FFT of length
+  ``K Nf`` per element. The calibration error multiplies it like everything an element receives.
+
+:class:`Impairments` bundles the three for :class:`tunnelkit.signal_route.SignalRoute`.
 """
 
 from __future__ import annotations
@@ -42,10 +60,12 @@ from .constants import K_B, C, db2lin, dbm2watt
 
 __all__ = [
     "ChannelSnapshot",
+    "DiffuseSpec",
     "Impairments",
     "SRSConfig",
     "add_noise",
     "channel_tensor",
+    "diffuse_tensor",
     "draw_calibration",
     "sample_clock_bias",
     "synthesize",
@@ -193,14 +213,86 @@ def draw_calibration(
 
 
 @dataclass(frozen=True)
+class DiffuseSpec:
+    """Dense diffuse multipath (module docstring): ``share`` in [0, 1) of the received power,
+    exponential power-delay profile with time constant ``decay_s`` [s] (20 ns by default, a
+    short concrete tunnel), taps ``oversample`` times finer than the delay resolution, ``span``
+    time constants long."""
+
+    share: float
+    decay_s: float = 20e-9
+    oversample: int = 4
+    span: float = 10.0
+
+    def __post_init__(self) -> None:
+        share = nonnegative("share", self.share)
+        if share >= 1.0:
+            raise ValueError(f"share: the diffuse share must lie in [0, 1), got {share}")
+        positive("decay_s", self.decay_s)
+        integer("oversample", self.oversample, minimum=1)
+        positive("span", self.span)
+
+    def power(self, specular_power: float) -> float:
+        """Diffuse power per tensor element [W] for a specular power ``specular_power``."""
+        return self.share / (1.0 - self.share) * nonnegative("specular_power", specular_power)
+
+    def taps(self, tone_spacing: float, n_tones: int) -> tuple[float, np.ndarray]:
+        """The delay step ``dtau`` [s] and the tap weights ``w`` (P,) (sum 1) for a band of
+        ``n_tones`` tones ``tone_spacing`` apart."""
+        df = positive("tone_spacing", tone_spacing)
+        nf = integer("n_tones", n_tones, minimum=1)
+        n_fft = self.oversample * nf
+        dtau = 1.0 / (n_fft * df)
+        n_taps = int(min(max(np.ceil(self.span * self.decay_s / dtau), 1), n_fft))
+        w = np.exp(-np.arange(n_taps) * dtau / self.decay_s)
+        return dtau, w / w.sum()
+
+    def tone_covariance(self, tone_spacing: float, n_tones: int, tau0: float = 0.0) -> np.ndarray:
+        """``R_f`` (Nf, Nf) of a unit diffuse power starting at delay ``tau0`` [s] (closed form:
+        the sum over taps)."""
+        dtau, w = self.taps(tone_spacing, n_tones)
+        tau = float(finite_array("tau0", tau0, ndim=0)) + dtau * np.arange(w.size)
+        V = np.exp(-2j * np.pi * tone_spacing * np.arange(n_tones)[:, None] * tau[None, :])
+        return (V * w) @ V.conj().T
+
+
+def diffuse_tensor(
+    spec: DiffuseSpec,
+    shape,
+    tone_spacing: float,
+    tau0: float,
+    specular_power: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """One realisation (M, Nf, Nt) of the dense diffuse multipath of ``spec`` (module
+    docstring), starting at delay ``tau0`` [s], with diffuse power ``spec.power(specular_power)``
+    per element; drawn from ``rng``."""
+    if not isinstance(spec, DiffuseSpec):
+        raise TypeError(f"dmc: expected a channel.DiffuseSpec, got {type(spec).__name__}")
+    rng = rng_or_error("rng", rng)
+    m, nf, nt = (integer("shape", v, minimum=1) for v in shape)
+    tau0 = float(finite_array("tau0", tau0, ndim=0))
+    _, w = spec.taps(tone_spacing, nf)
+    p = spec.power(specular_power)
+    beta = (rng.standard_normal((m, w.size)) + 1j * rng.standard_normal((m, w.size))) * np.sqrt(
+        p * w / 2
+    )
+    spec_f = np.fft.fft(beta, n=spec.oversample * nf, axis=1)[:, :nf]
+    spec_f *= np.exp(-2j * np.pi * tone_spacing * tau0 * np.arange(nf))[None, :]
+    return np.repeat(spec_f[:, :, None], nt, axis=2)
+
+
+@dataclass(frozen=True)
 class Impairments:
     """What a real array adds to eq. 1 (module docstring): per-element calibration error with
-    ``phase_sigma_deg`` [deg] and ``gain_sigma_db`` [dB], and the ``spatial_wideband`` term.
-    All zero / False (the default) is eq. 1 exactly."""
+    ``phase_sigma_deg`` [deg] and ``gain_sigma_db`` [dB], the ``spatial_wideband`` term and
+    dense diffuse multipath ``dmc`` (a :class:`DiffuseSpec`, drawn per slot). All zero / False /
+    None (the default) is eq. 1 exactly."""
 
     phase_sigma_deg: float = 0.0
     gain_sigma_db: float = 0.0
     spatial_wideband: bool = False
+    dmc: DiffuseSpec | None = None
 
     def __post_init__(self) -> None:
         nonnegative("phase_sigma_deg", self.phase_sigma_deg)
@@ -209,6 +301,8 @@ class Impairments:
             raise TypeError(
                 f"spatial_wideband: expected True or False, got {self.spatial_wideband!r}"
             )
+        if self.dmc is not None and not isinstance(self.dmc, DiffuseSpec):
+            raise TypeError(f"dmc: expected a channel.DiffuseSpec or None, got {self.dmc!r}")
 
     @property
     def calibrated(self) -> bool:
@@ -262,6 +356,8 @@ def channel_tensor(
     n_symbols: int | None = None,
     calibration=None,
     spatial_wideband: bool = False,
+    dmc: DiffuseSpec | None = None,
+    rng: np.random.Generator | None = None,
 ) -> np.ndarray:
     """The noiseless tensor ``H`` (M x Nf x Nt) of eq. 1 / eq. 3 for a list of paths.
 
@@ -270,7 +366,9 @@ def channel_tensor(
     ``n_tones`` / ``n_symbols`` override the configuration (small tensors for tests and sliders).
     Impairments (module docstring), off by default: ``calibration`` (M,) complex per-element
     gains (:func:`draw_calibration`); ``spatial_wideband`` the per-element delay
-    ``tau_l + delta_lm / c`` in the frequency phase.
+    ``tau_l + delta_lm / c`` in the frequency phase; ``dmc`` a :class:`DiffuseSpec` whose
+    realisation (:func:`diffuse_tensor`, from ``rng``, starting at the first path's delay) is
+    added (the tensor is then random, not noiseless).
     """
     if not isinstance(config, SRSConfig):
         raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
@@ -281,6 +379,12 @@ def channel_tensor(
     if not isinstance(spatial_wideband, bool):
         raise TypeError(f"spatial_wideband: expected True or False, got {spatial_wideband!r}")
     cal = _check_calibration(calibration, paths[0].lengths.shape[0])
+    if dmc is not None:
+        if not isinstance(dmc, DiffuseSpec):
+            raise TypeError(f"dmc: expected a channel.DiffuseSpec, got {type(dmc).__name__}")
+        if rng is None:
+            raise ValueError("rng: diffuse multipath (dmc) is random; pass a numpy Generator")
+        rng = rng_or_error("rng", rng)
     nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=2)
     nt = config.n_symbols if n_symbols is None else integer("n_symbols", n_symbols, minimum=2)
     m = paths[0].lengths.shape[0]
@@ -304,6 +408,9 @@ def channel_tensor(
     else:
         bf = np.exp(-2j * np.pi * config.tone_spacing * np.arange(nf)[:, None] * tau[None, :])
         H = np.einsum("ml,sl,kl->msk", bs * alpha, bf, bt, optimize=True)
+    if dmc is not None and dmc.share > 0:
+        p_spec = float(np.sum(np.abs(alpha) ** 2))
+        H = H + diffuse_tensor(dmc, H.shape, config.tone_spacing, float(tau.min()), p_spec, rng)
     return H if cal is None else cal[:, None, None] * H
 
 
@@ -347,12 +454,14 @@ def synthesize(
     n_symbols: int | None = None,
     calibration=None,
     spatial_wideband: bool = False,
+    dmc: DiffuseSpec | None = None,
 ) -> ChannelSnapshot:
     """Noisy tensor for ``paths``: eq. 1 + CN(0, N0) noise, clock bias drawn from ``rng`` if None.
 
     ``snr_offset_db`` raises (positive) or lowers the SNR by scaling the noise power.
-    ``calibration`` / ``spatial_wideband``: the impairments of :func:`channel_tensor` (off by
-    default; the calibration vector is not drawn here, it belongs to the array).
+    ``calibration`` / ``spatial_wideband`` / ``dmc``: the impairments of :func:`channel_tensor`
+    (off by default; the calibration vector is not drawn here, it belongs to the array; the
+    diffuse multipath is drawn from ``rng`` after the clock bias and before the noise).
     """
     rng = rng_or_error("rng", rng)
     off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
@@ -367,6 +476,8 @@ def synthesize(
         n_symbols=n_symbols,
         calibration=calibration,
         spatial_wideband=spatial_wideband,
+        dmc=dmc,
+        rng=rng,
     )
     n0 = config.noise_power / float(db2lin(off))
     return ChannelSnapshot(

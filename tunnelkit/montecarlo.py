@@ -16,7 +16,18 @@ identical results serially, on 1 or on N workers. A trial whose worker dies is
 rescheduled by Dask (up to ``distributed.scheduler.allowed-failures`` deaths, default 3); past
 that the run stops with :class:`TrialLost` naming the trial, never a statistic without it.
 ``retries`` re-runs a trial that raised (off by default: a seeded trial fails the same way twice).
-Trial functions must be picklable: module-level functions, bound with ``functools.partial``.
+Trial functions must be picklable: module-level functions, bound with ``functools.partial``; the
+trial object is sent to the workers once per run (scattered to every worker), not with every
+task, so a trial that carries a large model costs one transfer per worker.
+
+Bad input and stalls: ``workers`` beyond the cores this process may use is capped to them (with a
+:class:`RuntimeWarning`: more single-threaded processes than cores only add overhead); a
+scheduler address that accepts the connection but never answers fails with
+:class:`SchedulerUnreachable` after ``timeout`` seconds (the address is probed with Dask's
+``identity`` call under a hard deadline before a client is built); ``trial_timeout`` stops a run
+with :class:`TrialTimeout` when a trial runs longer than that serially, or when no trial has
+finished for that long on Dask. ``streams`` lets several trials share one child generator
+(common random numbers: e.g. the same drive noise for every candidate array).
 """
 
 from __future__ import annotations
@@ -40,6 +51,8 @@ __all__ = [
     "RUN_BYTES",
     "SchedulerUnreachable",
     "TrialLost",
+    "TrialTimeout",
+    "available_cores",
     "mc_count",
     "parallel_options",
     "quick_mode",
@@ -91,6 +104,19 @@ class TrialLost(RuntimeError):
     """A trial's worker died more often than Dask allows; the run stops rather than drop it."""
 
 
+class TrialTimeout(TimeoutError):
+    """A trial ran past ``trial_timeout`` (serially), or no trial finished for that long (Dask)."""
+
+
+def available_cores() -> int:
+    """The number of CPU cores this process may run on (its affinity mask where the platform
+    has one, else ``os.cpu_count()``)."""
+    try:
+        return max(len(os.sched_getaffinity(0)), 1)
+    except AttributeError:  # pragma: no cover - platforms without sched_getaffinity
+        return max(os.cpu_count() or 1, 1)
+
+
 def run_trials(
     trial: Callable[..., Any],
     runs: int,
@@ -103,21 +129,56 @@ def run_trials(
     scheduler: str | None = None,
     retries: int = 0,
     timeout: float = CONNECT_TIMEOUT_S,
+    trial_timeout: float | None = None,
+    streams: Sequence[int] | None = None,
 ) -> list[Any]:
-    """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm."""
+    """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm.
+
+    ``streams`` (one non-negative integer per trial): trial ``i`` gets a fresh copy of child
+    generator ``streams[i]`` of ``seed`` (trials with the same stream see the same random
+    numbers); default: trial ``i`` gets child ``i``. ``trial_timeout`` [s]: see the module
+    docstring. Other options: module docstring."""
     callable_("trial", trial)
     runs = integer("runs", runs, minimum=1)
     check_bytes("runs", runs * RUN_BYTES, f"{runs} runs of at least {RUN_BYTES} B each")
-    rngs = spawn_rngs(seed, runs)
+    rngs = _stream_rngs(seed, runs, streams)
     # ``trial(inputs[i], rng_i)`` when ``inputs`` is given; parallel options: module docstring
     calls = _calls(rngs, inputs)
     workers, scheduler = parallel_options(workers, scheduler)
     retries = integer("retries", retries, minimum=0)
     timeout = positive("timeout", timeout)
+    if trial_timeout is not None:
+        trial_timeout = positive("trial_timeout", trial_timeout)
+    if workers is not None and workers > available_cores():
+        import warnings
+
+        warnings.warn(
+            f"workers: {workers} processes on {available_cores()} core(s): capped to "
+            f"{available_cores()} (give a scheduler address to use a larger cluster)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        workers = available_cores()
     if workers is None and scheduler is None:
-        return _run_serial(trial, calls, progress, desc)
+        return _run_serial(trial, calls, progress, desc, trial_timeout)
     with _client(workers, scheduler, timeout) as client:
-        return _run_dask(client, trial, calls, progress, desc, retries)
+        return _run_dask(client, trial, calls, progress, desc, retries, trial_timeout)
+
+
+def _stream_rngs(seed, runs: int, streams) -> list[np.random.Generator]:
+    """One generator per trial: child ``i`` of ``seed``, or child ``streams[i]`` (copied, so
+    trials sharing a stream start from the same state)."""
+    if streams is None:
+        return spawn_rngs(seed, runs)
+    if isinstance(streams, str | bytes) or not isinstance(streams, Sequence | np.ndarray):
+        raise TypeError(
+            f"streams: expected a sequence of integers (one per trial), got {streams!r}"
+        )
+    idx = [integer("streams", s, minimum=0) for s in streams]
+    if len(idx) != runs:
+        raise ValueError(f"streams: expected {runs} values (runs), got {len(idx)}")
+    children = spawn_rngs(seed, max(idx) + 1)
+    return [pickle.loads(pickle.dumps(children[i])) for i in idx]
 
 
 def _calls(rngs: list[np.random.Generator], inputs) -> list[tuple[tuple, np.random.Generator]]:
@@ -147,11 +208,41 @@ def _one_blas_thread():
     return threadpool_limits(limits=1, user_api="blas")
 
 
-def _run_serial(trial, calls, progress: bool, desc: str) -> list[Any]:
+@contextlib.contextmanager
+def _alarm(seconds: float | None, what: str) -> Iterator[None]:
+    """Raise :class:`TrialTimeout` in this thread after ``seconds`` (``SIGALRM``; only where
+    signals reach this thread: the main thread of a POSIX process, else no limit)."""
+    import signal
+    import threading
+
+    if (
+        seconds is None
+        or not hasattr(signal, "setitimer")
+        or threading.current_thread() is not threading.main_thread()
+    ):
+        yield
+        return
+
+    def _fire(signum, frame):
+        raise TrialTimeout(f"{what} ran longer than trial_timeout = {seconds:g} s")
+
+    old = signal.signal(signal.SIGALRM, _fire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def _run_serial(
+    trial, calls, progress: bool, desc: str, trial_timeout: float | None = None
+) -> list[Any]:
     out = []
     with _bar(len(calls), progress, desc) as bar, _one_blas_thread():
-        for args, rng in calls:
-            out.append(trial(*args, rng))
+        for i, (args, rng) in enumerate(calls):
+            with _alarm(trial_timeout, f"trial {i} of {len(calls)} ({desc})"):
+                out.append(trial(*args, rng))
             bar.update()
     return out
 
@@ -215,13 +306,11 @@ def _client(workers: int | None, scheduler: str | None, timeout: float) -> Itera
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
+        _probe_scheduler(scheduler, timeout)
         try:
             client = Client(scheduler, timeout=timeout, set_as_default=False)
         except (OSError, TimeoutError) as exc:
-            raise SchedulerUnreachable(
-                f"scheduler: no Dask scheduler answered at {scheduler} within {timeout:g} s "
-                "(is `dask scheduler` running there, and the port reachable?)"
-            ) from exc
+            raise _unreachable(scheduler, timeout) from exc
         with client:
             yield client
         return
@@ -246,21 +335,67 @@ def _client(workers: int | None, scheduler: str | None, timeout: float) -> Itera
         yield client
 
 
+def _unreachable(scheduler: str, timeout: float) -> SchedulerUnreachable:
+    return SchedulerUnreachable(
+        f"scheduler: no Dask scheduler answered at {scheduler} within {timeout:g} s "
+        "(is `dask scheduler` running there, and the port reachable?)"
+    )
+
+
+def _probe_scheduler(scheduler: str, timeout: float) -> None:
+    """Ask ``scheduler`` for its identity under a hard deadline of ``timeout`` seconds: a server
+    that accepts the TCP connection and never answers would otherwise hold ``Client()`` past
+    its own connect timeout. Runs on a private event loop in a helper thread (the caller may
+    already run one, e.g. a notebook kernel)."""
+    import asyncio
+    import concurrent.futures
+
+    from distributed.comm import connect
+
+    async def identity():
+        comm = await connect(scheduler, timeout=timeout)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    async def bounded():
+        return await asyncio.wait_for(identity(), timeout)
+
+    pool = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="tunnelkit-probe")
+    try:
+        reply = pool.submit(asyncio.run, bounded()).result(timeout + 5.0)
+    except (OSError, TimeoutError, concurrent.futures.TimeoutError) as exc:
+        raise _unreachable(scheduler, timeout) from exc
+    finally:
+        pool.shutdown(wait=False)
+    if not isinstance(reply, dict) or reply.get("type") != "Scheduler":
+        raise SchedulerUnreachable(
+            f"scheduler: the server at {scheduler} answered, but not as a Dask scheduler "
+            f"(identity reply {str(reply)[:80]!r})"
+        )
+
+
 def _one_trial(trial, args: tuple, rng_bytes: bytes):
     """Worker side: a fresh copy of the trial's generator, so a rerun replays the same stream."""
     with _one_blas_thread():
         return trial(*args, pickle.loads(rng_bytes))
 
 
-def _run_dask(client, trial, calls, progress: bool, desc: str, retries: int) -> list[Any]:
+def _run_dask(
+    client, trial, calls, progress: bool, desc: str, retries: int, trial_timeout=None
+) -> list[Any]:
     from distributed import as_completed
     from distributed.scheduler import KilledWorker
 
     tag = uuid.uuid4().hex[:8]
+    # the trial (it may carry a large model) goes to every worker once, not with every task
+    shared = client.scatter(trial, broadcast=True, hash=False)
     futures = [
         client.submit(
             _one_trial,
-            trial,
+            shared,
             args,
             pickle.dumps(rng),
             key=f"{desc}-{i}-{tag}",
@@ -272,7 +407,7 @@ def _run_dask(client, trial, calls, progress: bool, desc: str, retries: int) -> 
     index = {f.key: i for i, f in enumerate(futures)}
     out: list[Any] = [None] * len(futures)
     with _bar(len(futures), progress, desc) as bar:
-        for fut in as_completed(futures, loop=client.loop):
+        for fut in _as_completed(as_completed, futures, client, trial_timeout, index, desc):
             i = index[fut.key]
             try:
                 out[i] = fut.result()
@@ -287,3 +422,30 @@ def _run_dask(client, trial, calls, progress: bool, desc: str, retries: int) -> 
                 raise
             bar.update()
     return out
+
+
+def _as_completed(as_completed, futures, client, trial_timeout, index, desc) -> Iterator[Any]:
+    """Futures as they finish; :class:`TrialTimeout` when none finished for ``trial_timeout``."""
+    import time
+
+    ac = as_completed(futures, loop=client.loop)
+    if trial_timeout is None:
+        yield from ac
+        return
+    left, last = len(futures), time.monotonic()
+    while left:
+        batch = ac.next_batch(block=False) if ac.has_ready() else []
+        if not batch:
+            if time.monotonic() - last > trial_timeout:
+                late = sorted(index[f.key] for f in futures if not f.done())
+                for f in futures:
+                    f.cancel()
+                raise TrialTimeout(
+                    f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of {len(futures)} "
+                    f"({desc}): none finished within trial_timeout = {trial_timeout:g} s"
+                )
+            time.sleep(0.02)
+            continue
+        last = time.monotonic()
+        left -= len(batch)
+        yield from sorted(batch, key=lambda f: index[f.key])

@@ -257,6 +257,7 @@ class SignalRoute:
             snr_offset_db=self.snr_offset_db,
             calibration=self.calibration.get(arr.name),
             spatial_wideband=self.impairments.spatial_wideband,
+            dmc=self.impairments.dmc,
             **kw,
         )
 

@@ -11,6 +11,11 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
   (:func:`trace_route`, :class:`RouteGeometry`);
 * :mod:`~tunnelkit.design.bounds`: exact SR-NF validity, the PEB from the joint Fisher
   information of eq. 1 and the per-path CRLBs (:func:`route_bounds`, :func:`path_bounds`);
+* :mod:`~tunnelkit.design.achievable`: impairments as design inputs
+  (:class:`DesignImpairments`), the extraction's per-path error model along the route
+  (:func:`path_error_model`, :class:`PathErrorModel`) and the achievable (misspecified) position
+  bound beside the PEB (:func:`achievable_bound`); the misspecified bound itself is
+  :mod:`~tunnelkit.design.mcrb`;
 * :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design (:func:`javelin_rmse`);
 * :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile with its bootstrap
   interval, the verdict per array and the recommendation (:func:`judge`, :func:`recommend`);
@@ -25,10 +30,29 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
 
 from __future__ import annotations
 
-from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
+from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
+from .bounds import (
+    RouteBounds,
+    compress_slots,
+    path_bounds,
+    route_bounds,
+    route_geometry,
+    theta_fim,
+    theta_jacobian,
+)
+from .errormodel import PathErrorModel
 from .geometry import KINDS, RouteGeometry, trace_route
-from .montecarlo import SETTLE_S, javelin_config, javelin_rmse
-from .report import MODES, DesignReport, DesignRow, design_sweep, smallest_meeting
+from .montecarlo import (
+    MODES,
+    SETTLE_S,
+    MonteCarloResult,
+    drive_pcrlb,
+    javelin_config,
+    javelin_rmse,
+    position_information,
+    sweep_montecarlo,
+)
+from .report import DesignReport, DesignRow, design_sweep, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 from .verdict import (
     CRITERIA,
@@ -49,26 +73,38 @@ __all__ = [
     "MODES",
     "SETTLE_S",
     "STATUSES",
+    "AchievableBound",
     "ArraySpec",
+    "DesignImpairments",
     "DesignReport",
     "DesignRow",
     "DesignSetup",
+    "MonteCarloResult",
     "Mount",
+    "PathErrorModel",
     "RouteBounds",
     "RouteGeometry",
+    "achievable_bound",
     "bootstrap_quantile_ci",
+    "compress_slots",
     "counted_epochs",
     "design_sweep",
+    "drive_pcrlb",
     "gate",
     "javelin_config",
     "javelin_rmse",
     "judge",
     "parse_array",
     "path_bounds",
+    "path_error_model",
+    "position_information",
     "recommend",
     "route_bounds",
     "route_geometry",
     "share_quantile",
     "smallest_meeting",
+    "sweep_montecarlo",
+    "theta_fim",
+    "theta_jacobian",
     "trace_route",
 ]

@@ -40,7 +40,15 @@ from ..fresnel import signed_mismatch
 from .geometry import RouteGeometry, trace_route
 from .setup import ArraySpec, DesignSetup, parse_array
 
-__all__ = ["RouteBounds", "path_bounds", "route_bounds", "route_geometry"]
+__all__ = [
+    "RouteBounds",
+    "compress_slots",
+    "path_bounds",
+    "route_bounds",
+    "route_geometry",
+    "theta_fim",
+    "theta_jacobian",
+]
 
 _CLOCK = ("unknown", "known")
 
@@ -79,7 +87,7 @@ class RouteBounds:
         return out
 
 
-def _compress(used: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def compress_slots(used: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gather indices (T, L) of the used slots, padded; and the mask of real ones."""
     order = np.argsort(~used, axis=1, kind="stable")
     L = max(int(used.sum(axis=1).max()), 1)
@@ -162,16 +170,12 @@ def _position_covariance(G: np.ndarray, n_pos: int, rcond: float = 1e-12) -> np.
     return cov
 
 
-def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature):
-    """Per-epoch PEB from the joint eq. 1 FIM (see :func:`route_bounds`)."""
+def theta_jacobian(cfg, s_loc, d0, src, a0, R, g, idx, mask, clock_bias, height_known, curvature):
+    """``T = d eta / d theta`` (T, 7L, n_theta) of :func:`route_bounds` (module docstring) and
+    the number of position coordinates ``n_pos``, the nuisances per path ``n_nui`` and the
+    index ``base`` of the first path nuisance: ``theta = [UE position, (clock bias c b), per
+    path: Re a, Im a, mu_t, (radius)]``."""
     T, L = idx.shape
-    alpha = np.sqrt(cfg.tx_power) * take(g.gain)
-    mu_f = -2 * np.pi * cfg.tone_spacing * d0 / C
-    mu_t = 2 * np.pi * cfg.symbol_period * take(g.doppler)
-    G_eta = _fim_eta(
-        s_loc, pos, alpha, mu_f, mu_t, mask, cfg.fc, cfg.n_tones, cfg.n_symbols, cfg.noise_power
-    )
-    # theta = [UE position, (clock bias c b), per path: Re a, Im a, mu_t, (radius)]
     n_pos = 2 if height_known else 3
     n_b = int(clock_bias == "unknown")
     n_nui = 3 + int(not curvature)
@@ -193,11 +197,32 @@ def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height
         Tm[:, 7 * lr + 4 + i, :n_pos] = dsrc[:, :, i, :]
         if not curvature:
             Tm[:, 7 * lr + 4 + i, base + n_nui * lr + 3] = s_loc[:, :, i] / d0
+    return Tm, n_pos, n_nui, base
+
+
+def theta_fim(G_eta, Tm, mask, n_nui, base):
+    """``Tm^T G_eta Tm`` with the absent (padding) paths' nuisances decoupled (unit diagonal)."""
+    T = mask.shape[0]
+    n_theta = Tm.shape[2]
     Gth = Tm.transpose(0, 2, 1) @ G_eta @ Tm
-    # absent (padding) paths: their nuisances decouple
     pad = np.zeros((T, n_theta), bool)
     pad[:, base:] = np.repeat(~mask, n_nui, axis=1)
     Gth[:, np.arange(n_theta), np.arange(n_theta)] += pad
+    return Gth
+
+
+def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height_known, curvature):
+    """Per-epoch PEB from the joint eq. 1 FIM (see :func:`route_bounds`)."""
+    alpha = np.sqrt(cfg.tx_power) * take(g.gain)
+    mu_f = -2 * np.pi * cfg.tone_spacing * d0 / C
+    mu_t = 2 * np.pi * cfg.symbol_period * take(g.doppler)
+    G_eta = _fim_eta(
+        s_loc, pos, alpha, mu_f, mu_t, mask, cfg.fc, cfg.n_tones, cfg.n_symbols, cfg.noise_power
+    )
+    Tm, n_pos, n_nui, base = theta_jacobian(
+        cfg, s_loc, d0, src, a0, R, g, idx, mask, clock_bias, height_known, curvature
+    )
+    Gth = theta_fim(G_eta, Tm, mask, n_nui, base)
     cov = _position_covariance(Gth, n_pos)
     peb = np.sqrt(np.trace(cov, axis1=1, axis2=2))
     peb = np.where(mask.any(axis=1), peb, np.inf)
@@ -254,7 +279,7 @@ def route_bounds(
     pos = spec.local(cfg.fc)
     kinds = np.array(g.kinds)
     used = g.exists & (markings | (kinds != "rrm"))[None, :]
-    idx, mask = _compress(used)
+    idx, mask = compress_slots(used)
     take = lambda a: np.take_along_axis(a, idx[..., None] if a.ndim == 3 else idx, axis=1)  # noqa: E731
     src, pnt = take(g.source), take(g.point)
     a0, R = g.origin, g.rotation

@@ -1,14 +1,28 @@
-"""JAVELIN on a design: Monte-Carlo drives through the design's signal route.
+"""JAVELIN on a design: Monte-Carlo drives of every candidate array as one task set.
 
-:func:`javelin_rmse` runs the tracker over drives of the scenario's route through
-:func:`tunnelkit.montecarlo.run_trials`; JAVELIN there takes each path's covariance as the
-extraction reports it (the CRLB at the estimate, which the ML route attains), so the tracker is
-tuned by the design itself at any carrier and size (:func:`javelin_config`), and its settled
-RMSE (after the first :data:`SETTLE_S`) is set beside the PEB over the same epochs.
+:func:`sweep_montecarlo` runs the tracker over drives of the scenario's route for every array
+and run through ONE :func:`tunnelkit.montecarlo.run_trials` call (one Dask cluster for the whole
+sweep; run ``r`` of every array shares child generator ``r``, so arrays are compared on the same
+random numbers). Each trial returns the per-epoch 2-D position error of its drive, so the result
+is identical serially and on any number of workers. Two measurement routes:
+
+* ``mode="channel"``: the route's own signal chain (:func:`tunnelkit.studies.simulate_drive`,
+  ``extraction="route"``: the ``M x Nf x Nt`` tensor and the ML extraction every epoch);
+* ``mode="bound"``: each epoch's path measurements drawn from a
+  :class:`~tunnelkit.design.errormodel.PathErrorModel` and reported with its CRLB
+  (:func:`tunnelkit.design.fastroute.bound_drive`): the cost no longer grows with the array.
+
+JAVELIN there takes each path's covariance as the extraction reports it (the CRLB at the
+estimate, which the ML route attains), so the tracker is tuned by the design itself at any
+carrier and size (:func:`javelin_config`); its settled error (after the first :data:`SETTLE_S`)
+is set beside the PEB and the posterior CRLB over the drive (:func:`drive_pcrlb`, Tichavsky et
+al. 1998 with JAVELIN's motion model and the position information of the model's reported bound).
+:func:`javelin_rmse` is the one-array summary on top of it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,10 +30,23 @@ import numpy as np
 from .._validate import integer
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import run_trials
-from .bounds import path_bounds, route_bounds
+from .bounds import path_bounds, route_bounds, route_geometry
+from .errormodel import PathErrorModel
 from .setup import ArraySpec, DesignSetup, parse_array
 
-__all__ = ["SETTLE_S", "javelin_config", "javelin_rmse"]
+__all__ = [
+    "MODES",
+    "SETTLE_S",
+    "MonteCarloResult",
+    "drive_pcrlb",
+    "javelin_config",
+    "javelin_rmse",
+    "position_information",
+    "sweep_montecarlo",
+]
+
+#: the measurement routes of :func:`sweep_montecarlo`
+MODES = ("bound", "channel")
 
 
 def javelin_config(crlb: dict, min_d: float = 0.0):
@@ -33,25 +60,312 @@ def javelin_config(crlb: dict, min_d: float = 0.0):
 
 
 @dataclass(frozen=True)
-class _JavelinTrial:
-    """One Monte-Carlo run (picklable for Dask workers): a drive of the design's route (no
-    visibility draw, the route's own extraction: :func:`tunnelkit.studies.simulate_drive`),
-    JAVELIN, its 2-D RMSE over the whole drive, and the RMSE and median of the 2-D error over the
-    settled epochs (NaN when the drive is shorter than the start-up)."""
+class MonteCarloResult:
+    """One array's Monte-Carlo over the drive (:func:`sweep_montecarlo`).
+
+    ``t`` (T,) [s] and ``x`` (T,) [m] the epochs and the vehicle's position along the tunnel;
+    ``errors`` (runs, T) [m] the 2-D position error of every run and epoch; ``rmse_runs``
+    (runs,) each run's RMSE over the settled epochs (the whole drive when it is shorter than
+    :data:`SETTLE_S`); ``settled`` the indices of the settled epochs
+    (:func:`tunnelkit.metrics.settled`); ``mode`` the measurement route; ``peb`` (T,) [m] the
+    snapshot PEB; ``pcrlb`` (T,) [m] the posterior CRLB of the 2-D position over the drive
+    (``None`` on the channel route without a model); ``sigmas`` the tracker's fallback sigmas.
+    """
+
+    spec: ArraySpec
+    mode: str
+    t: np.ndarray
+    x: np.ndarray
+    errors: np.ndarray
+    rmse_runs: np.ndarray
+    settled: np.ndarray
+    peb: np.ndarray
+    pcrlb: np.ndarray | None
+    sigmas: dict
+
+    @property
+    def runs(self) -> int:
+        return int(self.errors.shape[0])
+
+    @property
+    def rmse_settled(self) -> float:
+        """RMSE over every run and settled epoch [m]."""
+        return float(np.sqrt(np.mean(self.errors[:, self.settled] ** 2)))
+
+    @property
+    def median_settled(self) -> float:
+        """Median 2-D error over every run and settled epoch [m]."""
+        return float(np.median(self.errors[:, self.settled]))
+
+    def settled_rms(self, bound: np.ndarray) -> float:
+        """RMS of a per-epoch bound (T,) over the settled epochs [m]."""
+        return float(np.sqrt(np.mean(np.asarray(bound)[self.settled] ** 2)))
+
+
+def _trial_errors(estimates: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(estimates[:, :2] - truth[:, :2], axis=1)
+
+
+@dataclass(frozen=True)
+class _SweepTrial:
+    """One Monte-Carlo run of one array (picklable for Dask workers; sent to each worker once):
+    a drive of the design's route through the chosen measurement route, JAVELIN, the 2-D error
+    per epoch (T,)."""
 
     setup: DesignSetup
-    spec: ArraySpec
-    design: object  # a tracking.javelin.JavelinDesign
+    specs: tuple[ArraySpec, ...]
+    designs: tuple  # tracking.javelin.JavelinDesign per array
+    models: tuple  # PathErrorModel per array (bound mode) or None
+    mode: str
     n_epochs: int | None
 
-    def __call__(self, rng: np.random.Generator) -> tuple[float, float, float]:
-        from ..studies import evaluate, settled_errors, simulate_drive
+    def __call__(self, a: int, rng: np.random.Generator) -> np.ndarray:
+        from ..studies import evaluate, simulate_drive
 
-        route = self.setup.signal_route(self.spec)
-        drive = simulate_drive(
-            route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
+        spec = self.specs[a]
+        if self.mode == "bound":
+            from .fastroute import bound_drive
+
+            drive = bound_drive(self.models[a], self.setup, spec, rng, n_epochs=self.n_epochs)
+        else:
+            route = self.setup.signal_route(spec)
+            drive = simulate_drive(
+                route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
+            )
+        return _trial_errors(evaluate(drive, self.designs[a]).estimates, drive.truth)
+
+
+def position_information(model: PathErrorModel, geometry) -> np.ndarray:
+    """Fisher information (T, 2, 2) [1/m^2] of the UE's horizontal position (height known, as
+    JAVELIN and the PEB) in what the extraction reports: ``H^T crlb^-1 H`` over the existing
+    paths' ``z = [phi, psi, kappa, d]``, with the clock bias (common to every ``d``) a nuisance
+    removed by the Schur complement. ``H`` maps the UE position through each path's wave origin
+    (the UE, or its mirror image in the known surface: ``geometry.mirror``)."""
+    from ..geometry import spherical_jacobian
+
+    if not isinstance(model, PathErrorModel):
+        raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
+    T, P = model.exists.shape
+    if geometry.exists.shape != (T, P):
+        raise ValueError(f"geometry: expected {T} epochs and {P} path slots like the model")
+    out = np.zeros((T, 2, 2))
+    rel = geometry.source - geometry.origin[:, None, :]
+    for k in range(T):
+        j = np.flatnonzero(model.exists[k] & geometry.exists[k])
+        if not j.size:
+            continue
+        Js = spherical_jacobian(rel[k, j]) @ geometry.mirror[j]  # (n, 3, 3) d(phi,psi,r)/d UE
+        H = np.zeros((j.size, 4, 3))
+        H[:, :3, :2] = Js[:, :, :2]
+        H[:, 3, :2] = Js[:, 2, :2]
+        H[:, 3, 2] = 1.0  # c b in every delay distance
+        H = H.reshape(-1, 3)
+        rows = (4 * j[:, None] + np.arange(4)).ravel()
+        R = model.crlb[k][np.ix_(rows, rows)]
+        J = H.T @ np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True) @ H
+        J = 0.5 * (J + J.T)
+        if J[2, 2] > 0:
+            J = J[:2, :2] - np.outer(J[:2, 2], J[2, :2]) / J[2, 2]
+        else:
+            J = J[:2, :2]
+        out[k] = 0.5 * (J + J.T)
+    return out
+
+
+def drive_pcrlb(
+    setup: DesignSetup,
+    info: np.ndarray,
+    *,
+    sigma_p0: float = 1.0,
+    sigma_speed: float | None = None,
+    sigma_heading: float | None = None,
+) -> np.ndarray:
+    """Posterior CRLB (T,) [m] of the 2-D position along ``setup``'s drive
+    (:func:`tunnelkit.tracking.pcrlb.pcrlb`, Tichavsky et al. 1998): JAVELIN's motion model
+    (``x_k = x_{k-1} + dt nu (cos theta, sin theta)`` driven by the V2X speed and heading with
+    noise ``sigma_speed`` / ``sigma_heading``, default the messages' own: 0.2 m/s, 1 deg), the
+    start from an open-sky fix of ``sigma_p0`` [m] (as the studies start JAVELIN), and ``info``
+    (T, 2, 2) the position information per epoch (:func:`position_information`)."""
+    from .._validate import positive
+    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED
+    from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
+
+    sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
+    sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
+    sigma_p0 = positive("sigma_p0", sigma_p0)
+    traj = setup.trajectory
+    T = info.shape[0]
+    vel = traj.velocity[:T]
+    nu = np.linalg.norm(vel[:, :2], axis=1)
+    th = np.arctan2(vel[:, 1], vel[:, 0])
+    dt = np.diff(traj.t[:T], prepend=traj.t[0])
+    dt[0] = dt[1] if T > 1 else 0.1
+    # the message of epoch k-1 drives the prediction into epoch k (Algorithm 4, line 7)
+    nu_p, th_p = np.roll(nu, 1), np.roll(th, 1)
+    G = dt[:, None, None] * np.stack(
+        [
+            np.stack([np.cos(th_p), -nu_p * np.sin(th_p)], axis=-1),
+            np.stack([np.sin(th_p), nu_p * np.cos(th_p)], axis=-1),
+        ],
+        axis=1,
+    )
+    Q = G @ np.diag([sig_nu**2, sig_th**2]) @ np.swapaxes(G, 1, 2)
+    Q += 1e-12 * np.eye(2)  # a standing vehicle: no motion noise, still a valid recursion
+    B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
+    return pcrlb_position_rmse(B)
+
+
+def _models(setup, specs, error_models) -> list[PathErrorModel]:
+    from .achievable import path_error_model
+
+    out = []
+    for spec in specs:
+        if error_models is None:
+            m = path_error_model(setup, spec)
+        elif callable(error_models):
+            m = error_models(setup, spec)
+        elif isinstance(error_models, dict) and spec.label in error_models:
+            m = error_models[spec.label]
+        else:
+            raise ValueError(
+                f"error_models: expected None, a callable (setup, spec) -> PathErrorModel or a "
+                f"dict by array label holding {spec.label!r}"
+            )
+        if not isinstance(m, PathErrorModel):
+            raise TypeError(
+                f"error_models: expected PathErrorModel for {spec.label}, got {type(m).__name__}"
+            )
+        out.append(m)
+    return out
+
+
+def sweep_montecarlo(
+    setup: DesignSetup,
+    specs,
+    runs: int,
+    seed: int | np.random.Generator,
+    *,
+    mode: str = "bound",
+    error_models: dict | Callable | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    timeout: float | None = None,
+    trial_timeout: float | None = None,
+    progress: bool = False,
+    n_epochs: int | None = None,
+    crlbs: dict | None = None,
+) -> dict[str, MonteCarloResult]:
+    """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
+    set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
+
+    ``mode``: ``"bound"`` (measurements drawn from each array's error model) or ``"channel"``
+    (the full signal chain). ``error_models``: per array a
+    :class:`~tunnelkit.design.errormodel.PathErrorModel` (a dict by label, or a callable
+    ``(setup, spec) -> model``, e.g. :func:`tunnelkit.design.achievable.path_error_model` with
+    impairments); default the ideal model (``path_error_model(setup, spec)``: an efficient
+    extraction without impairments). The bound mode draws from it, and
+    both modes take the posterior CRLB from its reported bound (on the channel route only when
+    models are given). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
+    route-median per-path bounds). ``workers`` / ``scheduler`` / ``timeout`` /
+    ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
+    sweep); ``seed`` an int or a Generator: run ``r`` of every array uses child generator ``r``.
+    """
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    if isinstance(specs, str | ArraySpec) or not isinstance(specs, Sequence | tuple):
+        specs = [specs]
+    specs = tuple(parse_array(s) for s in specs)
+    if not specs:
+        raise ValueError("specs: expected at least one array")
+    if len({s.label for s in specs}) != len(specs):
+        raise ValueError(f"specs: every array once, got {[s.label for s in specs]}")
+    if mode not in MODES:
+        raise ValueError(f"mode: expected one of {MODES}, got {mode!r}")
+    runs = integer("runs", runs, minimum=1)
+    if not isinstance(seed, np.random.Generator):
+        seed = integer("seed", seed, minimum=0)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    if crlbs is not None and not isinstance(crlbs, dict):
+        raise TypeError(f"crlbs: expected a dict by array label, got {type(crlbs).__name__}")
+    models = None
+    if mode == "bound" or error_models is not None:
+        models = _models(setup, specs, error_models)
+    designs = []
+    for spec in specs:
+        crlb = None if crlbs is None else crlbs.get(spec.label)
+        if crlb is None:
+            pb = path_bounds(setup, spec)
+            crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
+        designs.append(javelin_config(crlb, setup.signal_route(spec).min_d))
+    trial = _SweepTrial(
+        setup,
+        specs,
+        tuple(designs),
+        tuple(models) if mode == "bound" else (None,) * len(specs),
+        mode,
+        n_epochs,
+    )
+    A = len(specs)
+    kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
+    kw["trial_timeout"] = trial_timeout
+    res = run_trials(
+        trial,
+        A * runs,
+        seed,
+        inputs=[a for a in range(A) for _ in range(runs)],
+        streams=[r for _ in range(A) for r in range(runs)],
+        progress=progress,
+        desc=f"JAVELIN {mode} " + " ".join(s.label for s in specs),
+        **{k: v for k, v in kw.items() if v is not None},
+    )
+    traj = setup.trajectory
+    T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
+    t = traj.t[:T].copy()
+    idx = settled(t)
+    use = idx if idx.size else np.arange(T)
+    out = {}
+    for a, spec in enumerate(specs):
+        err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
+        ep = np.arange(T)
+        peb = route_bounds(setup, spec, epochs=ep).peb
+        pc = None
+        if models is not None:
+            g = route_geometry(setup, spec, epochs=ep)
+            m = models[a]
+            info = position_information(_head(m, T), g)
+            pc = drive_pcrlb(setup, info)
+        cfg = designs[a].config
+        out[spec.label] = MonteCarloResult(
+            spec,
+            mode,
+            t,
+            traj.position[:T, 0].copy(),
+            err,
+            np.sqrt(np.mean(err[:, use] ** 2, axis=1)),
+            idx,
+            peb,
+            pc,
+            {
+                "direction_rad": cfg.sigma_phi,
+                "kappa_m": cfg.sigma_kappa,
+                "delta_d_m": cfg.sigma_delta_d,
+            },
         )
-        return settled_errors(evaluate(drive, self.design), drive)
+    return out
+
+
+def _head(m: PathErrorModel, T: int) -> PathErrorModel:
+    """The first ``T`` epochs of a model."""
+    if m.exists.shape[0] == T:
+        return m
+    from dataclasses import replace
+
+    cut = {k: getattr(m, k)[:T] for k in ("t", "exists", "truth", "v", "crlb", "cov", "bias")}
+    for k in ("k_phase", "k_gain"):
+        if getattr(m, k) is not None:
+            cut[k] = getattr(m, k)[:T]
+    return replace(m, **cut)
 
 
 def _t_interval(x: np.ndarray) -> tuple[float, list[float]]:
@@ -97,19 +411,26 @@ def javelin_rmse(
     if crlb is None:
         pb = path_bounds(setup, spec)
         crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-    cfg = javelin_config(crlb, setup.signal_route(spec).min_d)
-    kw = (("workers", workers), ("scheduler", scheduler), ("timeout", timeout))
-    res = np.asarray(
-        run_trials(
-            _JavelinTrial(setup, spec, cfg, n_epochs),
-            runs,
-            seed,
-            progress=progress,
-            desc=f"JAVELIN {spec.label}",
-            **{k: v for k, v in kw if v is not None},
-        ),
-        float,
-    ).reshape(runs, 3)
+    r = sweep_montecarlo(
+        setup,
+        [spec],
+        runs,
+        seed,
+        mode="channel",
+        workers=workers,
+        scheduler=scheduler,
+        timeout=timeout,
+        progress=progress,
+        n_epochs=n_epochs,
+        crlbs={spec.label: crlb},
+    )[spec.label]
+    e = r.errors
+    whole = np.sqrt(np.mean(e**2, axis=1))
+    if r.settled.size:
+        es = e[:, r.settled]
+        res = np.stack([whole, np.sqrt(np.mean(es**2, axis=1)), np.median(es, axis=1)], axis=1)
+    else:
+        res = np.stack([whole, np.full(runs, np.nan), np.full(runs, np.nan)], axis=1)
     mean, ci = _t_interval(res[:, 0])
     out = {
         "rmse_m": mean,
@@ -120,11 +441,7 @@ def javelin_rmse(
         "peb_rms_settled_m": None,
         "median_settled_m": None,
         "runs_settled": res[:, 1],
-        "sigmas": {
-            "direction_rad": cfg.config.sigma_phi,
-            "kappa_m": cfg.config.sigma_kappa,
-            "delta_d_m": cfg.config.sigma_delta_d,
-        },
+        "sigmas": r.sigmas,
     }
     T = len(setup.trajectory) if n_epochs is None else min(int(n_epochs), len(setup.trajectory))
     idx = settled(setup.trajectory.t[:T])

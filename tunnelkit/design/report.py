@@ -22,13 +22,16 @@ tracker achieves.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
+from functools import partial
 
 import numpy as np
 
 from .._validate import choice, integer, positive, probability
 from ..montecarlo import parallel_options
+from .achievable import DesignImpairments, achievable_bound, path_error_model
 from .bounds import route_bounds, route_geometry
+from .montecarlo import MODES, sweep_montecarlo
 from .setup import ArraySpec, DesignSetup, parse_array
 from .verdict import (
     CRITERIA,
@@ -41,17 +44,7 @@ from .verdict import (
     share_quantile,
 )
 
-__all__ = ["MODES", "DesignReport", "DesignRow", "design_sweep", "smallest_meeting"]
-
-#: Monte-Carlo measurement routes: drawn from the bound's error model, or the full channel
-MODES = ("bound", "channel")
-#: the impairment fields (``DesignImpairments``) and their ideal values
-IMPAIRMENT_FIELDS = {
-    "phase_error_deg": 0.0,
-    "gain_error_db": 0.0,
-    "spatial_wideband": False,
-    "dmc_share": 0.0,
-}
+__all__ = ["DesignReport", "DesignRow", "design_sweep", "smallest_meeting"]
 
 
 def _fin(v):
@@ -269,37 +262,14 @@ def smallest_meeting(
 # --- the sweep ------------------------------------------------------------------------------
 
 
-def _impairment_fields(impairments) -> dict:
+def _impairment_fields(imp: DesignImpairments) -> dict:
     """The impairment settings as plain values (the report's inputs)."""
-    if impairments is None:
-        return dict(IMPAIRMENT_FIELDS)
-    get = (lambda k, d: impairments.get(k, d)) if isinstance(impairments, dict) else None
-    if get is None:
-        get = lambda k, d: getattr(impairments, k, d)  # noqa: E731
-    out = {k: get(k, d) for k, d in IMPAIRMENT_FIELDS.items()}
-    for k in ("dmc_decay_s", "dmc_spatial"):
-        v = get(k, None)
-        if v is not None:
-            out[k] = v
-    return {k: (v if isinstance(v, (bool, str)) else float(v)) for k, v in out.items()}
+    return {k: (v if isinstance(v, (bool, str)) else float(v)) for k, v in asdict(imp).items()}
 
 
-def _is_ideal(fields: dict) -> bool:
-    return all(fields[k] == d for k, d in IMPAIRMENT_FIELDS.items())
-
-
-def _design_impairments(impairments):
-    """``impairments`` (None, a dict of fields or a ``DesignImpairments``) as the achievable
-    bound's object; ``None`` when that module is not installed (then only the ideal case)."""
-    try:
-        from .achievable import DesignImpairments
-    except ImportError:
-        if impairments is not None and not _is_ideal(_impairment_fields(impairments)):
-            raise ValueError(
-                "impairments: the achievable bound under impairments needs "
-                "tunnelkit.design.achievable"
-            ) from None
-        return None
+def _design_impairments(impairments) -> DesignImpairments:
+    """``impairments`` (None, a dict of fields or a ``DesignImpairments``) as the object the
+    achievable bound and the error model take."""
     if impairments is None:
         return DesignImpairments()
     if isinstance(impairments, dict):
@@ -313,32 +283,23 @@ def _design_impairments(impairments):
 
 
 def _achievable_bound(setup, spec, impairments, epochs):
-    """Per-epoch ``x``, ``peb`` and ``achievable`` (T,) of ``spec``; without the achievable
-    module (ideal impairments only) the achievable bound is the PEB itself."""
-    if impairments is None:
-        b = route_bounds(setup, spec, epochs=epochs)
-        return b.x, b.peb, b.peb
-    from .achievable import achievable_bound
-
+    """Per-epoch ``x``, ``peb`` and ``achievable`` (T,) of ``spec`` along the route
+    (:func:`tunnelkit.design.achievable.achievable_bound`)."""
     res = achievable_bound(setup, spec, impairments, epochs=epochs)
-    get = lambda k: np.asarray(res[k] if isinstance(res, dict) else getattr(res, k), float)  # noqa: E731
-    return get("x"), get("peb"), get("achievable")
+    return res.x, res.peb, res.achievable
 
 
 def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
     """:func:`tunnelkit.design.montecarlo.sweep_montecarlo` (one task set for every array)."""
-    from . import montecarlo
-
-    return montecarlo.sweep_montecarlo(setup, specs, runs, seed, **kw)
+    return sweep_montecarlo(setup, specs, runs, seed, **kw)
 
 
-def _error_models(setup, specs, impairments, mode):
-    """Per array the error model the bound route draws from (``None``: the ideal default)."""
-    if mode != "bound" or impairments is None or _is_ideal(_impairment_fields(impairments)):
+def _error_models(impairments: DesignImpairments, mode: str):
+    """The bound route's error model per array under ``impairments`` (``None``: the ideal
+    default of :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`)."""
+    if mode != "bound" or impairments.ideal:
         return None
-    from .achievable import path_error_model
-
-    return {s.label: path_error_model(setup, s, impairments) for s in specs}
+    return partial(path_error_model, impairments=impairments)
 
 
 def _run_montecarlo(setup, specs, runs, seed, kw) -> tuple[dict, dict]:
@@ -480,8 +441,8 @@ def design_sweep(
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     workers, scheduler = parallel_options(workers, scheduler)
     imp = _design_impairments(impairments)
-    fields = _impairment_fields(imp if imp is not None else impairments)
-    if mode == "channel" and not _is_ideal(fields) and runs:
+    fields = _impairment_fields(imp)
+    if mode == "channel" and not imp.ideal and runs:
         raise ValueError(
             "mode: the channel Monte-Carlo route synthesises the ideal channel; use mode='bound' "
             "for a Monte-Carlo under impairments"
@@ -500,7 +461,7 @@ def design_sweep(
     if runs and todo:
         kw = {
             "mode": mode,
-            "error_models": _error_models(setup, todo, imp, mode),
+            "error_models": _error_models(imp, mode),
             "workers": workers,
             "scheduler": scheduler,
             "timeout": timeout,

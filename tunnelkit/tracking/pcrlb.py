@@ -38,24 +38,29 @@ def measurement_information(jacobians, R) -> np.ndarray:
 
 def pcrlb(F, Q, P0, info) -> np.ndarray:
     """Bound matrices ``J_k^-1`` (T, n, n) from the recursion above; ``info`` (T, n, n) holds
-    ``E[H_k^T R^-1 H_k]`` per epoch."""
+    ``E[H_k^T R^-1 H_k]`` per epoch. ``Q`` is one (n, n) matrix or one per epoch (T, n, n),
+    ``Q[k]`` the process noise of the step into epoch ``k`` (``Q[0]`` unused)."""
     F = finite_array("F", F, ndim=2)
     n = F.shape[0]
-    Q = finite_array("Q", Q, shape=(n, n))
-    P0 = finite_array("P0", P0, shape=(n, n))
     info = finite_array("info", info, ndim=3)
     if info.shape[1:] != (n, n):
         raise ValueError(f"info: expected shape (T, {n}, {n}), got {info.shape}")
-    spd_matrix("Q", Q)
+    Q = finite_array("Q", Q)
+    if Q.shape not in ((n, n), (info.shape[0], n, n)):
+        raise ValueError(f"Q: expected shape ({n}, {n}) or {(info.shape[0], n, n)}, got {Q.shape}")
+    P0 = finite_array("P0", P0, shape=(n, n))
+    Qs = np.broadcast_to(Q, info.shape)
+    for k in range(1 if Q.ndim == 3 else 0, Qs.shape[0] if Q.ndim == 3 else 1):
+        spd_matrix("Q", Qs[k])
     spd_matrix("P0", P0)
     _psd("info", info)
-    Qi = np.linalg.inv(Q)
-    D11 = F.T @ Qi @ F
-    D12 = -F.T @ Qi
     J = np.linalg.inv(P0) + info[0]
     out = np.empty_like(info)
     out[0] = np.linalg.inv(J)
     for k in range(1, info.shape[0]):
+        Qi = np.linalg.inv(Qs[k])
+        D11 = F.T @ Qi @ F
+        D12 = -F.T @ Qi
         J = Qi + info[k] - D12.T @ np.linalg.solve(J + D11, D12)
         J = 0.5 * (J + J.T)
         out[k] = np.linalg.inv(J)

@@ -1,0 +1,169 @@
+"""The design's Monte-Carlo: one task set, the bound-driven measurement route, the posterior bound.
+
+The bound route is tested on a model built here from the route geometry with a diagonal
+covariance (no dependence on how the achievable model is filled); the position information is
+checked against finite differences of the geometry and against the PEB it must reproduce.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tunnelkit.constants import C
+from tunnelkit.design import DesignSetup
+from tunnelkit.design.bounds import route_bounds, route_geometry
+from tunnelkit.design.errormodel import PathErrorModel
+from tunnelkit.design.fastroute import bound_drive, model_truth
+from tunnelkit.design.geometry import trace_route
+from tunnelkit.design.montecarlo import (
+    MonteCarloResult,
+    drive_pcrlb,
+    position_information,
+    sweep_montecarlo,
+)
+
+SCENARIO = "example-rectangular-28ghz"
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return DesignSetup.from_scenario(SCENARIO)
+
+
+def _diag_model(setup, spec, sig=(1e-3, 1e-3, 0.05, 0.01), scale=1.0):
+    """Truth from the route geometry, diagonal covariance ``sig**2`` per path."""
+    g = route_geometry(setup, spec)
+    z, v = model_truth(g, setup.fc)
+    T, P = g.exists.shape
+    var = np.tile((scale * np.asarray(sig)) ** 2, P)
+    crlb = np.broadcast_to(np.diag(var), (T, 4 * P, 4 * P)).copy()
+    return PathErrorModel(
+        t=setup.trajectory.t.copy(),
+        exists=g.exists.copy(),
+        kinds=tuple(g.kinds),
+        truth=z,
+        v=v,
+        crlb=crlb,
+        cov=crlb.copy(),
+        bias=np.zeros((T, P, 4)),
+    )
+
+
+def test_bound_drive_hands_the_tracker_truth_plus_clock_bias_and_the_reported_bound(setup):
+    m = _diag_model(setup, "8x8", scale=1e-6)  # errors far below what the test resolves
+    drive = bound_drive(m, setup, "8x8", np.random.default_rng(0))
+    assert drive.reports_covariance and drive.extraction == "bound"
+    limit = C * setup.config.clock_bias_limit
+    biases = []
+    for k, pm in enumerate(drive.epochs):
+        slots = drive.truth_index[k]
+        assert len(pm) == m.exists[k].sum()  # every path kept (min_d = -c b_max)
+        assert np.all(np.diff(pm.d) >= 0)  # ordered by measured delay, not by slot
+        assert np.allclose(pm.phi, m.truth[k, slots, 0], atol=1e-8)
+        assert np.allclose(pm.kappa, m.truth[k, slots, 2], atol=1e-6)
+        b = pm.d - m.truth[k, slots, 3]
+        assert np.ptp(b) < 1e-6 and abs(b[0]) <= limit  # one clock bias, within its support
+        biases.append(b[0])
+        assert np.allclose(pm.cov[:, 0, 0], 1e-18) and np.allclose(pm.sigma_d, 1e-8)
+        assert np.allclose(pm.v, m.v[k, slots], atol=0.5)
+    assert np.std(biases) > 0.1 * C * setup.config.clock_bias_sigma  # drawn per epoch
+    assert drive.truth.shape == (len(setup.trajectory), 3)
+
+
+def test_bound_drive_errors_follow_the_model_covariance(setup):
+    m = _diag_model(setup, "4x4", sig=(2e-3, 3e-3, 0.2, 0.05))
+    rng = np.random.default_rng(1)
+    err = []
+    for _ in range(40):
+        dr = bound_drive(m, setup, "4x4", rng)
+        for k, pm in enumerate(dr.epochs):
+            err.append(pm.phi - m.truth[k, dr.truth_index[k], 0])
+    s = np.std(np.concatenate(err))
+    assert 0.9 * 2e-3 < s < 1.1 * 2e-3
+
+
+def test_position_information_matches_finite_differences_of_the_geometry(setup):
+    spec = "8x8"
+    m = _diag_model(setup, spec)
+    g = route_geometry(setup, spec)
+    info = position_information(m, g)
+    traj = setup.trajectory
+    arrays = setup.arrays(spec)
+    k = 12
+    h = 1e-5
+
+    def z_at(p):
+        gg = trace_route(
+            setup.tunnel, arrays, p[None], traj.velocity[k : k + 1], fc=setup.fc, kinds=setup.kinds
+        )
+        return model_truth(gg, setup.fc)[0][0]  # (P, 4)
+
+    p0 = traj.position[k]
+    ex = m.exists[k]
+    H = np.zeros((ex.sum(), 4, 3))
+    for i in range(2):
+        dp = np.zeros(3)
+        dp[i] = h
+        H[:, :, i] = ((z_at(p0 + dp) - z_at(p0 - dp)) / (2 * h))[ex]
+    H[:, 3, 2] = 1.0  # the clock bias
+    H = H.reshape(-1, 3)
+    var = np.tile(np.array([1e-3, 1e-3, 0.05, 0.01]) ** 2, ex.sum())
+    J = H.T @ (H / var[:, None])
+    want = J[:2, :2] - np.outer(J[:2, 2], J[2, :2]) / J[2, 2]
+    assert np.allclose(info[k], want, rtol=1e-5)
+
+
+def test_position_information_of_the_joint_model_reproduces_the_peb(setup):
+    from tunnelkit.design.achievable import path_error_model
+
+    for spec in ("4x4", "16x16"):
+        m = path_error_model(setup, spec)
+        info = position_information(m, route_geometry(setup, spec))
+        snap = np.sqrt(np.trace(np.linalg.inv(info), axis1=1, axis2=2))
+        assert np.allclose(snap, route_bounds(setup, spec).peb, rtol=1e-3)
+
+
+def test_posterior_bound_is_below_the_snapshot_bound_and_reaches_it_without_motion_noise(setup):
+    m = _diag_model(setup, "8x8", scale=20.0)  # snapshot bound of decimetres
+    info = position_information(m, route_geometry(setup, "8x8"))
+    snap = np.sqrt(np.trace(np.linalg.inv(info), axis1=1, axis2=2))
+    pc = drive_pcrlb(setup, info)
+    assert np.all(pc <= snap * (1 + 1e-9))
+    assert pc[-1] < 0.7 * snap[-1]  # the motion model carries information over the drive
+    loose = drive_pcrlb(setup, info, sigma_speed=1e3, sigma_heading=10.0)
+    assert np.allclose(loose[1:], snap[1:], rtol=1e-3)
+
+
+@pytest.mark.parametrize("mode", ["bound"])
+def test_sweep_is_one_task_set_with_the_same_numbers_serially_and_on_two_workers(setup, mode):
+    specs = ["4x4", "8x8"]
+    models = {s: _diag_model(setup, s) for s in specs}
+    kw = dict(mode=mode, error_models=models, n_epochs=14)
+    serial = sweep_montecarlo(setup, specs, 2, 3, **kw)
+    two = sweep_montecarlo(setup, specs, 2, 3, workers=2, **kw)
+    assert list(serial) == specs
+    for s in specs:
+        r = serial[s]
+        assert isinstance(r, MonteCarloResult) and r.mode == mode
+        assert r.errors.shape == (2, 14) and np.all(np.isfinite(r.errors))
+        assert np.array_equal(r.errors, two[s].errors)
+        assert np.allclose(r.rmse_runs, np.sqrt(np.mean(r.errors[:, r.settled] ** 2, axis=1)))
+        assert r.pcrlb.shape == (14,) and np.all(r.pcrlb > 0)
+        assert r.settled[0] == 10  # 1 s at 0.1 s
+    # the runs of one array do not depend on which other arrays are swept with it
+    alone = sweep_montecarlo(setup, ["8x8"], 2, 3, **kw)["8x8"]
+    assert np.array_equal(alone.errors, serial["8x8"].errors)
+
+
+def test_sweep_bad_input_is_refused_by_name(setup):
+    with pytest.raises(ValueError, match="mode"):
+        sweep_montecarlo(setup, ["4x4"], 2, 0, mode="fast")
+    with pytest.raises(ValueError, match="specs"):
+        sweep_montecarlo(setup, ["4x4", "4x4"], 2, 0)
+    with pytest.raises(ValueError, match="error_models"):
+        sweep_montecarlo(setup, ["4x4"], 2, 0, error_models={"8x8": None})
+    with pytest.raises(ValueError, match="runs"):
+        sweep_montecarlo(setup, ["4x4"], 0, 0)
+    with pytest.raises(TypeError, match="setup"):
+        sweep_montecarlo("x", ["4x4"], 2, 0)

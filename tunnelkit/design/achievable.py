@@ -1,0 +1,407 @@
+"""What an array achieves, not only what it could: impairments as design inputs, the per-path
+error model of the extraction and the achievable (misspecified) position bound.
+
+* :class:`DesignImpairments`: per-element calibration error (phase [deg], gain [dB]), the
+  spatial-wideband term and dense diffuse multipath (share of the received power, exponential
+  power-delay profile, spatially white), as the design takes them;
+* :func:`path_error_model`: per epoch and candidate path of the route, the truth in the
+  tracker's measurement space ``z = [phi, psi, kappa, d]`` and the error of the joint ML
+  extraction under the impairments (:class:`~tunnelkit.design.errormodel.PathErrorModel`:
+  ideal CRLB, misspecified covariance, bias, calibration sensitivities);
+* :func:`achievable_bound`: the ideal PEB of :func:`~tunnelkit.design.bounds.route_bounds`
+  beside ``sqrt(E ||position bias||^2 + trace(position MCRB))``, mapped to the position exactly
+  as the PEB (horizontal position, antenna height known, clock bias and per-path gains and
+  Dopplers nuisances).
+
+The misspecified bound and its factorised evaluation are :mod:`tunnelkit.design.mcrb`. The
+calibration bias is linear in the per-element errors, ``b = K_phi phi + K_g e``; averaged over
+the calibration draw (independent, ``N(0, sigma^2)`` per element) it contributes
+``sigma_phi^2 ||K_phi||_F^2 + sigma_g^2 ||K_g||_F^2`` to ``E ||b||^2``. All linearised: at a
+large calibration error (degrees on a large array) the true bias outgrows the first order (see
+``benchmarks/bench_achievable.py``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import boolean, nonnegative, positive
+from ..channel import DiffuseSpec, Impairments
+from ..constants import C
+from ..geometry import spherical_jacobian
+from .bounds import compress_slots, route_bounds, route_geometry, theta_fim, theta_jacobian
+from .errormodel import PathErrorModel
+from .geometry import RouteGeometry
+from .mcrb import EtaModes, scaled_inverse
+from .setup import DesignSetup, parse_array
+
+__all__ = ["AchievableBound", "DesignImpairments", "achievable_bound", "path_error_model"]
+
+_DMC_SPATIAL = ("white", "per-surface")
+LN10_20 = np.log(10.0) / 20.0
+#: epochs evaluated together (bounds the memory of the mode vectors)
+_CHUNK_BYTES = 64e6
+
+
+@dataclass(frozen=True)
+class DesignImpairments:
+    """The impairments a design carries (module docstring).
+
+    ``phase_error_deg`` / ``gain_error_db``: standard deviations of the per-element calibration
+    error; ``spatial_wideband``: the per-element delay across the aperture; ``dmc_share`` in
+    [0, 1): the diffuse share of the received power, with time constant ``dmc_decay_s`` (20 ns
+    by default, a short concrete tunnel); ``dmc_spatial``: ``"white"`` (independent over the
+    elements). ``"per-surface"`` (diffuse power spread in angle around each specular path) is
+    not implemented and refused.
+    """
+
+    phase_error_deg: float = 0.0
+    gain_error_db: float = 0.0
+    spatial_wideband: bool = False
+    dmc_share: float = 0.0
+    dmc_decay_s: float = 20e-9
+    dmc_spatial: str = "white"
+
+    def __post_init__(self) -> None:
+        nonnegative("phase_error_deg", self.phase_error_deg)
+        nonnegative("gain_error_db", self.gain_error_db)
+        boolean("spatial_wideband", self.spatial_wideband)
+        share = nonnegative("dmc_share", self.dmc_share)
+        if share >= 1.0:
+            raise ValueError(f"dmc_share: the diffuse share must lie in [0, 1), got {share}")
+        positive("dmc_decay_s", self.dmc_decay_s)
+        if self.dmc_spatial not in _DMC_SPATIAL:
+            raise ValueError(f"dmc_spatial: expected 'white', got {self.dmc_spatial!r}")
+        if self.dmc_spatial == "per-surface":
+            raise ValueError(
+                "dmc_spatial: 'per-surface' (diffuse power spread around each specular path) is "
+                "not implemented; use 'white'"
+            )
+
+    @property
+    def ideal(self) -> bool:
+        """True when the channel is eq. 1 exactly (no impairment)."""
+        return (
+            self.phase_error_deg == 0
+            and self.gain_error_db == 0
+            and not self.spatial_wideband
+            and self.dmc_share == 0
+        )
+
+    @property
+    def dmc(self) -> DiffuseSpec | None:
+        """The :class:`~tunnelkit.channel.DiffuseSpec` of the diffuse multipath (None if off)."""
+        return DiffuseSpec(self.dmc_share, self.dmc_decay_s) if self.dmc_share > 0 else None
+
+    def channel_impairments(self) -> Impairments:
+        """The :class:`~tunnelkit.channel.Impairments` that synthesise this channel."""
+        return Impairments(
+            phase_sigma_deg=float(self.phase_error_deg),
+            gain_sigma_db=float(self.gain_error_db),
+            spatial_wideband=bool(self.spatial_wideband),
+            dmc=self.dmc,
+        )
+
+
+def _check(setup, impairments):
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    if not isinstance(impairments, DesignImpairments):
+        raise TypeError(
+            f"impairments: expected a design.DesignImpairments, got {type(impairments).__name__}"
+        )
+
+
+@dataclass(frozen=True)
+class _Frame:
+    """The used paths of a route, compressed to (T, L) (padding masked), in the bounds' terms."""
+
+    g: RouteGeometry
+    idx: np.ndarray
+    mask: np.ndarray
+    src: np.ndarray
+    s_loc: np.ndarray
+    d0: np.ndarray
+    alpha: np.ndarray
+    mu_f: np.ndarray
+    mu_t: np.ndarray
+    pos: np.ndarray
+
+
+def _frame(setup, spec, g) -> _Frame:
+    cfg = setup.config
+    idx, mask = compress_slots(g.exists)
+    take = lambda a: np.take_along_axis(a, idx[..., None] if a.ndim == 3 else idx, axis=1)  # noqa: E731
+    src = take(g.source)
+    s_loc = np.einsum("tlj,tjk->tlk", src - g.origin[:, None, :], g.rotation)
+    d0 = np.linalg.norm(s_loc, axis=-1)
+    return _Frame(
+        g,
+        idx,
+        mask,
+        src,
+        s_loc,
+        d0,
+        np.sqrt(cfg.tx_power) * take(g.gain),
+        -2 * np.pi * cfg.tone_spacing * d0 / C,
+        2 * np.pi * cfg.symbol_period * take(g.doppler),
+        spec.local(cfg.fc),
+    )
+
+
+def _chunks(setup, fr: _Frame, imp: DesignImpairments):
+    """Per chunk of epochs: the slice, the FIM ``A``, the diffuse excess ``E`` (or None), the
+    wideband score ``s`` (or None) and the calibration scores per unit phase [rad] and gain
+    [dB] (or None): all in eta space (module :mod:`~tunnelkit.design.mcrb`)."""
+    cfg = setup.config
+    T, L = fr.idx.shape
+    M = fr.pos.shape[0]
+    per = 16 * L * (cfg.n_tones * 4 + M * 8 + cfg.n_symbols * 2) + 8 * (7 * L) ** 2 * 6
+    size = max(1, int(_CHUNK_BYTES // per))
+    s2 = cfg.noise_power
+    for lo in range(0, T, size):
+        sl = slice(lo, min(lo + size, T))
+        mk = fr.mask[sl]
+        md = EtaModes(
+            fr.s_loc[sl],
+            fr.pos,
+            fr.alpha[sl],
+            fr.mu_f[sl],
+            fr.mu_t[sl],
+            mk,
+            cfg.fc,
+            cfg.n_tones,
+            cfg.n_symbols,
+        )
+        out = {"slice": sl, "A": md.fim(s2), "E": None, "s_wb": None, "S_ph": None, "S_g": None}
+        if imp.dmc_share > 0:
+            spec = imp.dmc
+            tau0 = np.where(mk, fr.d0[sl], np.inf).min(axis=1) / C
+            tau0 = np.where(np.isfinite(tau0), tau0, 0.0)
+            p_d = spec.power(1.0) * np.sum(np.abs(md.alpha) ** 2, axis=1)  # (T,)
+            G = md.diffuse_gram(spec, cfg.tone_spacing, tau0).real
+            out["E"] = 2.0 / s2**2 * p_d[:, None, None] * G
+        if imp.spatial_wideband:
+            out["s_wb"] = 2.0 / s2 * md.wideband_score(cfg.tone_spacing).real
+        if imp.phase_error_deg > 0 or imp.gain_error_db > 0:
+            S = md.calibration_scores()
+            out["S_ph"] = 2.0 / s2 * (1j * S).real
+            out["S_g"] = 2.0 / s2 * LN10_20 * S.real
+        yield out
+
+
+def _z_jacobian(fr: _Frame, g: RouteGeometry, cfg) -> np.ndarray:
+    """``d z / d eta`` per path (T, L, 4, 7): ``z = [phi, psi, kappa, d]``."""
+    T, L = fr.idx.shape
+    rel = fr.src - g.origin[:, None, :]
+    # padding slots: any point off the vertical axis (their rows are masked out later)
+    rel = np.where(fr.mask[..., None], rel, np.array([1.0, 1.0, 0.0]))
+    Js = spherical_jacobian(rel) @ g.rotation[:, None, :, :]  # d(phi, psi, r) / d s_loc
+    Jz = np.zeros((T, L, 4, 7))
+    Jz[:, :, :3, 4:] = Js
+    Jz[:, :, 3, 2] = -C / (2 * np.pi * cfg.tone_spacing)
+    return Jz
+
+
+def _block_diag(Jz: np.ndarray) -> np.ndarray:
+    """(T, L, 4, 7) -> (T, 4L, 7L) block diagonal."""
+    T, L = Jz.shape[:2]
+    out = np.zeros((T, L, 4, L, 7))
+    out[:, np.arange(L), :, np.arange(L), :] = Jz.transpose(1, 0, 2, 3)
+    return out.reshape(T, 4 * L, 7 * L)
+
+
+def path_error_model(
+    setup: DesignSetup,
+    spec,
+    impairments: DesignImpairments | None = None,
+    *,
+    epochs=None,
+    geometry: RouteGeometry | None = None,
+) -> PathErrorModel:
+    """The joint ML extraction's per-path error along ``setup``'s route for array ``spec`` under
+    ``impairments`` (module docstring; fields in :class:`PathErrorModel`).
+
+    Every existing path of the route geometry (``geometry``, or traced at ``epochs``) enters
+    the joint model. ``crlb`` is the ideal bound of all paths' ``z`` (gains and Dopplers
+    eliminated), ``cov`` the sandwich covariance with diffuse multipath (``crlb`` without it),
+    ``bias`` the spatial-wideband bias, ``k_phase`` [per rad] and ``k_gain`` [per dB] the
+    calibration sensitivities (None when the calibration is perfect). Raises ``ValueError``
+    naming ``spec`` where the Fisher information of an epoch is singular (a parameter the
+    array cannot resolve, e.g. curvature with 2 x 2 elements).
+    """
+    imp = DesignImpairments() if impairments is None else impairments
+    _check(setup, imp)
+    spec = parse_array(spec)
+    cfg = setup.config
+    g = route_geometry(setup, spec, epochs=epochs) if geometry is None else geometry
+    fr = _frame(setup, spec, g)
+    T, L = fr.idx.shape
+    P = g.exists.shape[1]
+    M = fr.pos.shape[0]
+    Jz = _block_diag(_z_jacobian(fr, g, cfg))  # (T, 4L, 7L)
+    crlb_c = np.zeros((T, 4 * L, 4 * L))
+    cov_c = np.zeros((T, 4 * L, 4 * L))
+    bias_c = np.zeros((T, 4 * L))
+    cal = imp.phase_error_deg > 0 or imp.gain_error_db > 0
+    kph_c = np.zeros((T, 4 * L, M)) if cal else None
+    kg_c = np.zeros((T, 4 * L, M)) if cal else None
+    bad = np.zeros(T, bool)
+    for ch in _chunks(setup, fr, imp):
+        sl = ch["slice"]
+        mk = np.repeat(fr.mask[sl], 7, axis=1)
+        A = ch["A"] + np.eye(7 * L)[None] * ~mk[:, :, None]  # padding decoupled
+        Ainv, sing = scaled_inverse(A)
+        bad[sl] = sing & fr.mask[sl].any(axis=1)
+        Ainv = np.where(mk[:, :, None] & mk[:, None, :], Ainv, 0.0)
+        J = Jz[sl]
+        JA = J @ Ainv
+        crlb_c[sl] = JA @ J.transpose(0, 2, 1)
+        cov_c[sl] = crlb_c[sl]
+        if ch["E"] is not None:
+            cov_c[sl] += JA @ ch["E"] @ JA.transpose(0, 2, 1)
+        if ch["s_wb"] is not None:
+            bias_c[sl] = (JA @ ch["s_wb"][..., None])[..., 0]
+        if cal:
+            kph_c[sl] = JA @ ch["S_ph"]
+            kg_c[sl] = JA @ ch["S_g"]
+    if bad.any():
+        raise ValueError(
+            f"spec: the per-path bound of the {spec.label} array is undefined (singular Fisher "
+            f"information) at {int(bad.sum())} of {T} epochs; a parameter of some path "
+            "(e.g. its curvature) is not resolvable by this array"
+        )
+    # scatter the compressed paths into the route's slots
+    rows = (4 * fr.idx[:, :, None] + np.arange(4)).reshape(T, 4 * L)
+    keep = np.repeat(fr.mask, 4, axis=1)
+    tt = np.arange(T)[:, None]
+
+    def scatter_mat(Xc):
+        out = np.zeros((T, 4 * P, 4 * P))
+        r = np.where(keep, rows, 0)
+        Xc = np.where(keep[:, :, None] & keep[:, None, :], Xc, 0.0)
+        np.add.at(out, (tt[:, :, None], r[:, :, None], r[:, None, :]), Xc)
+        return out
+
+    def scatter_vec(Xc):  # (T, 4L, ...) -> (T, 4P, ...)
+        out = np.zeros((T, 4 * P, *Xc.shape[2:]))
+        r = np.where(keep, rows, 0)
+        Xc = np.where(keep.reshape(T, 4 * L, *([1] * (Xc.ndim - 2))), Xc, 0.0)
+        np.add.at(out, (tt, r), Xc)
+        return out
+
+    rel = g.source - g.origin[:, None, :]
+    rng_ = np.linalg.norm(rel, axis=-1)
+    truth = np.stack(
+        [
+            np.arctan2(rel[..., 1], rel[..., 0]),
+            np.arctan2(rel[..., 2], np.hypot(rel[..., 0], rel[..., 1])),
+            rng_,
+            rng_,
+        ],
+        axis=-1,
+    )
+    ex = g.exists
+    k_ph = k_g = None
+    if cal:
+        k_ph = scatter_vec(kph_c).reshape(T, P, 4, M)
+        k_g = scatter_vec(kg_c).reshape(T, P, 4, M)
+    return PathErrorModel(
+        t=_epoch_times(setup, g),
+        exists=ex.copy(),
+        kinds=tuple(g.kinds),
+        truth=np.where(ex[..., None], truth, 0.0),
+        v=np.where(ex, C * g.doppler / cfg.fc, 0.0),
+        crlb=scatter_mat(crlb_c),
+        cov=scatter_mat(cov_c),
+        bias=scatter_vec(bias_c).reshape(T, P, 4),
+        k_phase=k_ph,
+        k_gain=k_g,
+        phase_sigma_rad=float(np.radians(imp.phase_error_deg)),
+        gain_sigma_db=float(imp.gain_error_db),
+    )
+
+
+def _epoch_times(setup, g: RouteGeometry) -> np.ndarray:
+    """The trajectory times of the geometry's epochs (matched by the UE position)."""
+    traj = setup.trajectory
+    d = np.linalg.norm(g.ue[:, None, :] - np.asarray(traj.position)[None, :, :], axis=-1)
+    return np.asarray(traj.t, float)[np.argmin(d, axis=1)]
+
+
+@dataclass(frozen=True)
+class AchievableBound:
+    """Per-epoch results of :func:`achievable_bound` [m]: ``x`` position along the tunnel,
+    ``peb`` the ideal PEB (as :func:`~tunnelkit.design.bounds.route_bounds`), ``achievable``
+    ``sqrt(peb^2 + calibration^2 + wideband^2 + diffuse^2)`` and its parts: ``calibration`` the
+    RMS position bias over the calibration draw, ``wideband`` the spatial-wideband position
+    bias, ``diffuse`` the excess standard deviation the diffuse multipath adds (root of the
+    trace). ``inf`` where the position is not identifiable."""
+
+    spec: object
+    impairments: DesignImpairments
+    x: np.ndarray
+    peb: np.ndarray
+    achievable: np.ndarray
+    calibration: np.ndarray
+    wideband: np.ndarray
+    diffuse: np.ndarray
+
+
+def achievable_bound(
+    setup: DesignSetup,
+    spec,
+    impairments: DesignImpairments | None = None,
+    *,
+    geometry: RouteGeometry | None = None,
+    epochs=None,
+) -> AchievableBound:
+    """The ideal PEB and the achievable (misspecified) position bound of ``spec`` along
+    ``setup``'s route under ``impairments`` (module docstring); ``geometry`` reuses a traced
+    route, ``epochs`` (indices) subsamples it."""
+    imp = DesignImpairments() if impairments is None else impairments
+    _check(setup, imp)
+    spec = parse_array(spec)
+    cfg = setup.config
+    g = route_geometry(setup, spec, epochs=epochs) if geometry is None else geometry
+    peb = route_bounds(setup, spec, geometry=g).peb
+    fr = _frame(setup, spec, g)
+    T = fr.idx.shape[0]
+    Tm, n_pos, n_nui, base = theta_jacobian(
+        cfg,
+        fr.s_loc,
+        fr.d0,
+        fr.src,
+        g.origin,
+        g.rotation,
+        g,
+        fr.idx,
+        fr.mask,
+        "unknown",
+        True,
+        True,
+    )
+    sph, sg = np.radians(imp.phase_error_deg), imp.gain_error_db
+    cal2, wb, dif2 = np.zeros(T), np.zeros(T), np.zeros(T)
+    if not imp.ideal:
+        for ch in _chunks(setup, fr, imp):
+            sl = ch["slice"]
+            Tc = Tm[sl]
+            Ginv, _ = scaled_inverse(theta_fim(ch["A"], Tc, fr.mask[sl], n_nui, base))
+            Pm = Ginv[:, :n_pos, :] @ Tc.transpose(0, 2, 1)  # d position / d score (n_pos, 7L)
+            if ch["E"] is not None:
+                dif2[sl] = np.trace(Pm @ ch["E"] @ Pm.transpose(0, 2, 1), axis1=1, axis2=2)
+            if ch["s_wb"] is not None:
+                wb[sl] = np.linalg.norm((Pm @ ch["s_wb"][..., None])[..., 0], axis=1)
+            if ch["S_ph"] is not None:
+                cal2[sl] = sph**2 * np.sum((Pm @ ch["S_ph"]) ** 2, axis=(1, 2))
+                cal2[sl] += sg**2 * np.sum((Pm @ ch["S_g"]) ** 2, axis=(1, 2))
+    fin = np.isfinite(peb)
+    cal = np.where(fin, np.sqrt(np.clip(cal2, 0, None)), np.inf)
+    wb = np.where(fin, wb, np.inf)
+    dif = np.where(fin, np.sqrt(np.clip(dif2, 0, None)), np.inf)
+    with np.errstate(invalid="ignore"):
+        ach = np.where(fin, np.sqrt(peb**2 + cal**2 + wb**2 + dif**2), np.inf)
+    return AchievableBound(spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif)

@@ -1,0 +1,144 @@
+"""The design's fast measurement route: a drive whose path measurements are drawn from a
+:class:`~tunnelkit.design.errormodel.PathErrorModel` instead of synthesised and extracted.
+
+The channel route (:func:`tunnelkit.studies.simulate_drive` with ``extraction="route"``) builds
+the ``M x Nf x Nt`` tensor of every epoch and runs the maximum-likelihood extraction on it; its
+cost grows with the array (580 s for two 32 x 32 drives). An efficient extraction above its
+threshold delivers the true path parameters plus an error the model describes, and *reports*
+the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
+
+* ``z = [phi, psi, kappa, d]`` of every existing path from :meth:`PathErrorModel.draw` (truth,
+  bias, one array's calibration error, Gaussian error with the model's ``cov``);
+* the reported covariance: the ``(phi, psi, kappa)`` block and the ``d`` standard deviation of
+  the model's ``crlb`` (what an efficient extraction reports: it does not know the impairments);
+* the clock bias drawn per epoch as the channel route draws it
+  (:func:`tunnelkit.channel.sample_clock_bias`, the radio's sigma and limit) and added to every
+  ``d``;
+* the radial speed ``v`` from the truth plus :data:`SIGMA_V` of white noise (the Doppler
+  clutter test only compares it with the vehicle speed at metre-per-second level; the ideal
+  bound on ``v`` is far smaller, so this is a conservative, documented stand-in);
+* the paths ordered by measured ``d`` (an extraction does not know which path is the LoS) and
+  Algorithm 1's ``d >= min_d`` applied as the route does (``SignalRoute.min_d``);
+* the V2X speed and heading messages as :func:`tunnelkit.studies.simulate_drive` draws them.
+
+The model comes from :func:`tunnelkit.design.achievable.path_error_model` (the joint ideal CRLB
+and, under impairments, the misspecified covariance, bias and calibration sensitivities);
+:func:`model_truth` gives the true ``z`` of a route geometry in the same convention.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import nonnegative, rng_or_error
+from ..constants import C
+from .errormodel import PathErrorModel
+from .setup import DesignSetup, parse_array
+
+__all__ = ["SIGMA_V", "bound_drive", "model_truth"]
+
+#: standard deviation [m/s] of the radial speed handed to the tracker on the bound route
+SIGMA_V = 0.05
+
+
+def model_truth(g, fc: float) -> tuple[np.ndarray, np.ndarray]:
+    """True ``z = [phi, psi, kappa, d]`` (T, P, 4) and radial speed ``v`` (T, P) [m/s] of every
+    slot of a :class:`~tunnelkit.design.geometry.RouteGeometry` (NaN where a path is absent)."""
+    rel = g.source - g.origin[:, None, :]
+    r = np.linalg.norm(rel, axis=-1)
+    phi = np.arctan2(rel[..., 1], rel[..., 0])
+    psi = np.arctan2(rel[..., 2], np.hypot(rel[..., 0], rel[..., 1]))
+    z = np.stack([phi, psi, r, r], axis=-1)
+    z = np.where(g.exists[..., None], z, np.nan)
+    v = np.where(g.exists, C * g.doppler / fc, np.nan)
+    return z, v
+
+
+def bound_drive(
+    model: PathErrorModel,
+    setup: DesignSetup,
+    spec,
+    rng: np.random.Generator,
+    *,
+    n_epochs: int | None = None,
+    sigma_v: float = SIGMA_V,
+):
+    """One drive of ``setup``'s route for ``spec`` measured through ``model`` (module docstring):
+    a :class:`tunnelkit.studies.DriveData` the tracker runs on exactly as on the channel route
+    (``extraction="bound"``, reported covariances). ``n_epochs`` keeps the first epochs only."""
+    from ..channel import sample_clock_bias
+    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
+    from ..tracking.javelin.measurement import PathMeasurements
+
+    if not isinstance(model, PathErrorModel):
+        raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    spec = parse_array(spec)
+    rng = rng_or_error("rng", rng)
+    sigma_v = nonnegative("sigma_v", sigma_v)
+    traj, cfg = setup.trajectory, setup.config
+    T = model.exists.shape[0]
+    if T != len(traj):
+        raise ValueError(f"model: expected {len(traj)} epochs (the route's), got {T}")
+    if n_epochs is not None:
+        from .._validate import integer
+
+        T = min(integer("n_epochs", n_epochs, minimum=1), T)
+    route = setup.signal_route(spec)
+    min_d = route.min_d
+    z = model.draw(rng)[:T]
+    ex = model.exists[:T]
+    P = ex.shape[1]
+    bias = sample_clock_bias(rng, cfg.clock_bias_sigma, cfg.clock_bias_limit, size=T)
+    v = model.v[:T] + sigma_v * rng.standard_normal((T, P))
+    crlb = model.crlb[:T]
+    epochs, tidx, kinds, los = [], [], [], np.zeros(T, bool)
+    n_true = ex.sum(axis=1)
+    for k in range(T):
+        j = np.flatnonzero(ex[k])
+        d = z[k, j, 3] + C * bias[k]
+        o = j[np.argsort(d, kind="stable")]
+        d = z[k, o, 3] + C * bias[k]
+        blocks = crlb[k].reshape(P, 4, P, 4)[o, :, o, :]  # (n, 4, 4)
+        pm = PathMeasurements.from_arrays(
+            z[k, o, 0],
+            z[k, o, 1],
+            z[k, o, 2],
+            d,
+            v[k, o],
+            warn=False,
+            cov=blocks[:, :3, :3],
+            sigma_d=np.sqrt(blocks[:, 3, 3]),
+            min_d=min_d,
+        )
+        epochs.append(pm)
+        tidx.append(o[pm.source])
+        kinds.append([model.kinds[p] for p in o])
+        los[k] = bool(ex[k, 0]) and model.kinds[0] == "los"
+    from .bounds import route_geometry
+
+    origin = route_geometry(setup, spec, epochs=np.arange(T)).origin
+    vel = traj.velocity[:T]
+    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
+    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
+    return DriveData(
+        setup.name,
+        None,
+        traj.t[:T].copy(),
+        traj.position[:T].copy(),
+        vel.copy(),
+        speed,
+        heading,
+        epochs,
+        los,
+        n_true,
+        origin[-1].copy(),
+        tidx,
+        kinds,
+        [],
+        [np.zeros((0, 3)) for _ in range(T)],
+        "bound",
+        cfg.clock_bias_limit,
+        True,
+    )

@@ -1,0 +1,193 @@
+"""The misspecified bound of eq. 1, in the factorised form the design's bounds use.
+
+An estimator fits the eq. 1 model ``f(eta)`` (per path ``eta_l = [Re a, Im a, mu_f, mu_t,
+s (3, local)]``, as :mod:`tunnelkit.design.bounds`) to data whose mean is ``f(eta) + delta`` and
+whose covariance is ``C = sigma^2 I + C_D``. To first order (Richmond & Horowitz 2015;
+Fortunati et al. 2017) it converges to the pseudo-true parameter
+
+    eta_0 - eta = (Re J^H J)^-1 Re J^H delta = A^-1 s,        s = (2 / sigma^2) Re J^H delta
+
+(one Gauss-Newton step from the truth: the bias), with the sandwich covariance
+
+    A^-1 B A^-1,    A = (2 / sigma^2) Re J^H J,    B = (2 / sigma^4) Re J^H C J
+                  = A^-1 + A^-1 E A^-1,          E = (2 / sigma^4) Re J^H C_D J.
+
+``A`` drops the second-order term ``-(2 / sigma^2) Re sum r^* d^2 f`` of the Hessian (``r`` the
+residual at ``eta_0``), which is of the order of the bias times ``delta``; the tests measure how
+much it matters. ``J``'s columns are rank-one tensors ``coef_i x_i (x) y_i (x) z_i`` (array,
+tones, symbols), so every inner product above is a Hadamard product of the three modes' inner
+products, and each perturbation is written as a (short) sum of rank-one terms too:
+
+* **calibration**: element ``m`` multiplies what it receives by ``1 + j phi_m + (ln 10 / 20)
+  e_m`` to first order: ``delta = sum_m (j phi_m + ln10/20 e_m) e_m (x) H_m`` is linear in the
+  errors; :meth:`EtaModes.calibration_scores` gives ``Re J^H`` of each element's unit term;
+* **spatial wideband**: ``delta_l = alpha_l a_l f_l t_l (exp(-j s eps_lm) - 1)`` with
+  ``eps_lm = 2 pi Df delta_lm / c``; about the band centre ``s_c``,
+  ``exp(-j s eps) = exp(-j s_c eps) sum_n (-j (s - s_c) eps)^n / n!``: the series keeps every
+  term separable, truncated where the next term is below ``WB_TOL`` (checked against the exact
+  sum in the tests);
+* **dense diffuse multipath** (:class:`tunnelkit.channel.DiffuseSpec`, spatially white):
+  ``C_D = P_D I_M (x) R_f (x) 1 1^T`` with ``R_f = V diag(w) V^H``, the taps on the delay grid
+  ``1 / (K Nf Df)``, so ``F^H V`` is one zero-padded FFT per frequency atom.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..channel import DiffuseSpec
+from ..constants import C
+
+__all__ = ["WB_TOL", "EtaModes", "scaled_inverse"]
+
+#: truncation of the spatial-wideband series (relative size of the first term left out)
+WB_TOL = 1e-13
+
+
+def _pair(mu: np.ndarray, n: int) -> np.ndarray:
+    """``[e^{j s mu_l}, j s e^{j s mu_l}]`` for ``s = 0..n-1``, interleaved per path: (T, n, 2L)."""
+    s = np.arange(n, dtype=float)
+    v = np.exp(1j * s[None, :, None] * mu[:, None, :])
+    out = np.empty((*v.shape, 2), complex)
+    out[..., 0] = v
+    out[..., 1] = 1j * s[None, :, None] * v
+    return out.reshape(mu.shape[0], n, 2 * mu.shape[1])
+
+
+def _gram(X: np.ndarray, Y: np.ndarray | None = None) -> np.ndarray:
+    """``X[t]^H Y[t]`` for every ``t``."""
+    return np.conj(X).transpose(0, 2, 1) @ (X if Y is None else Y)
+
+
+def scaled_inverse(G: np.ndarray, rcond: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+    """Inverse of a stack of symmetric positive (semi-)definite matrices (T, n, n) with Jacobi
+    scaling, and a (T,) flag of the singular ones (their inverse is NaN)."""
+    d = np.diagonal(G, axis1=1, axis2=2)
+    sc = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
+    Gs = sc[:, :, None] * G * sc[:, None, :]
+    w, V = np.linalg.eigh(0.5 * (Gs + Gs.transpose(0, 2, 1)))
+    sing = (w[:, 0] <= rcond * w[:, -1]) | np.any(d <= 0, axis=1)
+    w = np.where(w > 0, w, 1.0)
+    inv = (V / w[:, None, :]) @ V.transpose(0, 2, 1)
+    inv = sc[:, :, None] * inv * sc[:, None, :]
+    inv[sing] = np.nan
+    return inv, sing
+
+
+class EtaModes:
+    """The mode vectors of ``J`` for a stack of epochs (module docstring).
+
+    ``s_loc`` (T, L, 3) wave origins (local frame), ``pos`` (M, 3) elements, ``alpha`` (T, L)
+    gains with ``sqrt(P_t)``, ``mu_f`` / ``mu_t`` (T, L), ``mask`` (T, L) the real paths (the
+    others are padding and contribute nothing). Columns of ``J`` per path: ``Re a, Im a, mu_f,
+    mu_t, s_x, s_y, s_z``.
+    """
+
+    def __init__(self, s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols):
+        T, L, _ = s_loc.shape
+        self.k0 = 2 * np.pi * fc / C
+        self.n_tones, self.n_symbols = int(n_tones), int(n_symbols)
+        diff = s_loc[:, None, :, :] - pos[None, :, None, :]  # (T, M, L, 3)
+        rng_m = np.linalg.norm(diff, axis=-1)
+        self.offset = rng_m - rng_m[:, :1]  # (T, M, L) path-length offsets delta_lm
+        a = np.exp(1j * self.k0 * self.offset)
+        u = diff / rng_m[..., None]
+        A = np.empty((T, pos.shape[0], L, 4), complex)
+        A[..., 0] = a
+        A[..., 1:] = 1j * self.k0 * a[..., None] * (u - u[:, :1])
+        self.a = a
+        self.X = A.reshape(T, pos.shape[0], 4 * L)
+        self.F2 = _pair(mu_f, self.n_tones)
+        self.T2 = _pair(mu_t, self.n_symbols)
+        self.alpha = np.where(mask, alpha, 0.0)
+        li = np.repeat(np.arange(L), 7)
+        kk = np.tile(np.arange(7), L)
+        self.si = 4 * li + np.array([0, 0, 0, 0, 1, 2, 3])[kk]
+        self.fi = 2 * li + (kk == 2)
+        self.ti = 2 * li + (kk == 3)
+        coef = np.where(kk[None] == 0, 1.0 + 0j, np.where(kk[None] == 1, 1j, alpha[:, li]))
+        self.coef = coef * mask[:, li]
+        self._grams = None
+
+    @property
+    def grams(self):
+        """``X^H X``, ``F^H F``, ``T^H T`` (cached)."""
+        if self._grams is None:
+            self._grams = (_gram(self.X), _gram(self.F2), _gram(self.T2))
+        return self._grams
+
+    def assemble(self, Gs, Gf, Gt) -> np.ndarray:
+        """``J_i^H (S (x) F (x) T) J_j`` (T, 7L, 7L) from the modes' matrices (complex)."""
+        si, fi, ti = self.si, self.fi, self.ti
+        return (
+            np.conj(self.coef)[:, :, None]
+            * self.coef[:, None, :]
+            * Gs[:, si[:, None], si[None, :]]
+            * Gf[:, fi[:, None], fi[None, :]]
+            * Gt[:, ti[:, None], ti[None, :]]
+        )
+
+    def fim(self, noise_power: float) -> np.ndarray:
+        """``A = (2 / sigma^2) Re J^H J`` (T, 7L, 7L)."""
+        return 2.0 / noise_power * self.assemble(*self.grams).real
+
+    def calibration_scores(self) -> np.ndarray:
+        """``J^H (e_m (x) H_m)`` (T, 7L, M) complex: the inner products of ``J`` with element
+        ``m``'s received noiseless tensor (a unit phase error is ``j`` times it, a unit dB gain
+        error ``ln 10 / 20`` times it)."""
+        _, Gf, Gt = self.grams
+        L = self.alpha.shape[1]
+        col = 2 * np.arange(L)  # the plain atoms f_l, t_l
+        W = self.alpha[:, None, :] * Gf[:, self.fi][:, :, col] * Gt[:, self.ti][:, :, col]
+        Hm = np.einsum("til,tml->tim", W, self.a)  # sum_l (...) alpha_l a_lm
+        Xs = np.conj(self.X[:, :, self.si]).transpose(0, 2, 1)  # (T, 7L, M)
+        return np.conj(self.coef)[:, :, None] * Xs * Hm
+
+    def wideband_terms(self, tone_spacing: float) -> int:
+        """Number of series terms the spatial-wideband ``delta`` needs (``WB_TOL``)."""
+        eps = 2 * np.pi * tone_spacing * np.abs(self.offset).max() / C
+        x = 0.5 * (self.n_tones - 1) * eps
+        n, term = 0, 1.0
+        while term > WB_TOL and n < 200:
+            n += 1
+            term *= x / n
+        return n
+
+    def wideband_score(self, tone_spacing: float, n_terms: int | None = None) -> np.ndarray:
+        """``J^H delta`` (T, 7L) complex of the spatial-wideband term (series about the band
+        centre, ``n_terms`` terms, :meth:`wideband_terms` by default)."""
+        N = self.wideband_terms(tone_spacing) if n_terms is None else int(n_terms)
+        sc = 0.5 * (self.n_tones - 1)
+        eps = 2 * np.pi * tone_spacing * self.offset / C  # (T, M, L)
+        n = np.arange(N + 1)
+        fact = np.cumprod(np.concatenate([[1.0], np.arange(1, N + 1)]))
+        # spatial: alpha_l a_lm exp(-j s_c eps) eps^n; frequency: (-j (s - s_c))^n / n! f_l
+        x = (self.alpha[:, None, :] * self.a * np.exp(-1j * sc * eps))[..., None] * eps[
+            ..., None
+        ] ** n
+        ds = np.arange(self.n_tones) - sc
+        q = (-1j * ds[:, None]) ** n / fact  # (Nf, N+1)
+        f = self.F2[:, :, 0::2]  # (T, Nf, L)
+        PX = np.einsum("tmc,tmln->tcln", np.conj(self.X), x)  # (T, 4L, L, N+1)
+        PF = np.einsum("tsc,tsl,sn->tcln", np.conj(self.F2), f, q)  # (T, 2L, L, N+1)
+        L = self.alpha.shape[1]
+        col = 2 * np.arange(L)
+        _, Gf, Gt = self.grams
+        # the exact factor minus one: the series less the unperturbed atom
+        PX0 = np.einsum("tmc,tml->tcl", np.conj(self.X), self.alpha[:, None, :] * self.a)
+        S = np.einsum("tiln,tiln->til", PX[:, self.si], PF[:, self.fi])
+        S = S - PX0[:, self.si] * Gf[:, self.fi][:, :, col]
+        S = S * Gt[:, self.ti][:, :, col]
+        return np.conj(self.coef) * S.sum(axis=2)
+
+    def diffuse_gram(self, spec: DiffuseSpec, tone_spacing: float, tau0) -> np.ndarray:
+        """``J^H C_D J / P_D`` (T, 7L, 7L) complex for unit diffuse power starting at delay
+        ``tau0`` (T,) [s] (module docstring)."""
+        _, w = spec.taps(tone_spacing, self.n_tones)
+        n_fft = spec.oversample * self.n_tones
+        ph = np.exp(-2j * np.pi * tone_spacing * np.arange(self.n_tones)[None, :] * tau0[:, None])
+        Q = np.fft.fft(np.conj(self.F2) * ph[:, :, None], n=n_fft, axis=1)[:, : w.size]  # (T,P,2L)
+        Gf = (Q.transpose(0, 2, 1) * w) @ np.conj(Q)  # sum_p w_p Q[c, p] conj(Q[c', p])
+        st = self.T2.sum(axis=1)  # (T, 2L)
+        Gt = np.conj(st)[:, :, None] * st[:, None, :]
+        return self.assemble(self.grams[0], Gf, Gt)
