@@ -297,3 +297,10 @@ def test_the_design_refuses_an_array_poking_through_the_ceiling():
     rep = design.design_sweep(high, ["10x10", "2x2"])
     assert rep.rows[0].status == "error" and f"{n_out} of 100" in rep.rows[0].reason
     assert rep.rows[1].status != "error"
+
+
+def test_over_target_names_the_failing_stretches():
+    x = np.array([45.0, 43.6, 42.2, 40.8, 39.4, 38.0])
+    y = np.array([0.3, 0.2, 0.05, np.nan, 0.01, 0.5])
+    assert design.over_target(x, y, 0.1) == "45.0..43.6 m, 40.8 m, 38.0 m"
+    assert design.over_target(x, np.zeros(6), 0.1) == ""

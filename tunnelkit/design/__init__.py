@@ -52,7 +52,7 @@ from .montecarlo import (
     position_information,
     sweep_montecarlo,
 )
-from .report import DesignReport, DesignRow, design_sweep, smallest_meeting
+from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 from .verdict import (
     CRITERIA,
@@ -94,6 +94,7 @@ __all__ = [
     "javelin_config",
     "javelin_rmse",
     "judge",
+    "over_target",
     "parse_array",
     "path_bounds",
     "path_error_model",

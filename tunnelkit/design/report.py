@@ -44,7 +44,7 @@ from .verdict import (
     share_quantile,
 )
 
-__all__ = ["DesignReport", "DesignRow", "design_sweep", "smallest_meeting"]
+__all__ = ["DesignReport", "DesignRow", "design_sweep", "over_target", "smallest_meeting"]
 
 
 def _fin(v):
@@ -175,7 +175,7 @@ class DesignReport:
             f"{'err ' + q:>9s} {'95% CI':>21s} {'RMSE':>9s}  status",
         ]
         for r in self.rows:
-            if r.status == "error":
+            if r.peb_median_m is None:  # nothing computed: the reason only
                 lines.append(
                     f"{r.array:>7s} {r.n_elements:5d} {_cm(r.aperture_diagonal_m)}  {r.reason}"
                 )
@@ -198,13 +198,39 @@ class DesignReport:
             "over runs; SR-NF ok: share of the route where SR-NF holds on every surface."
         )
         for r in self.rows:
-            if r.status != "error" and r.srnf_valid_share_by_surface:
+            if r.srnf_valid_share_by_surface:
                 per = ", ".join(
                     f"{k} {100 * v:.0f} %" for k, v in r.srnf_valid_share_by_surface.items()
                 )
                 lines.append(f"  SR-NF valid, {r.array}: {per}")
+            for what, y in (
+                ("achievable bound", r.achievable_m),
+                ("median error", r.error_median_epoch_m),
+            ):
+                if y is not None and r.x_m is not None:
+                    spans = over_target(r.x_m[: len(y)], y, s["target"])
+                    if spans:
+                        lines.append(f"  {r.array}: {what} above the target at x = {spans}")
         lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
+
+
+def over_target(x, y, target: float) -> str:
+    """The stretches of the route where ``y > target`` (non-finite counts), as text:
+    ``"45.0..38.1 m, 12.5 m"`` in route order; ``""`` when none."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    bad = ~(y <= target)
+    out, i = [], 0
+    while i < bad.size:
+        if not bad[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < bad.size and bad[j + 1]:
+            j += 1
+        out.append(f"{x[i]:.1f} m" if i == j else f"{x[i]:.1f}..{x[j]:.1f} m")
+        i = j + 1
+    return ", ".join(out)
 
 
 _CRITERION_TEXT = {
