@@ -304,3 +304,31 @@ def test_over_target_names_the_failing_stretches():
     y = np.array([0.3, 0.2, 0.05, np.nan, 0.01, 0.5])
     assert design.over_target(x, y, 0.1) == "45.0..43.6 m, 40.8 m, 38.0 m"
     assert design.over_target(x, np.zeros(6), 0.1) == ""
+
+
+def test_sweep_carries_the_impairments_into_bound_and_monte_carlo(setup):
+    kw = {"target": 10.0, "runs": 2, "n_epochs": 12, "seed": 1}
+    imp = design.design_sweep(setup, ["4x4"], impairments={"phase_error_deg": 2.0}, **kw)
+    ideal = design.design_sweep(setup, ["4x4"], **kw)
+    r, r0 = imp.rows[0], ideal.rows[0]
+    assert np.array_equal(r.peb_m, r0.peb_m) and np.array_equal(r0.achievable_m, r0.peb_m)
+    assert np.all(r.achievable_m >= r.peb_m) and np.median(r.achievable_m / r.peb_m) > 1.5
+    assert r.runs == r0.runs == 2 and r.error_p90_m != r0.error_p90_m
+    assert imp.to_json()["inputs"]["impairments"]["phase_error_deg"] == 2.0
+    assert "phase 2 deg" in imp.to_table()
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [
+        ({"impairments": {"phase_error_deg": -1.0}}, "phase_error_deg"),
+        ({"impairments": {"gain_error_db": float("nan")}}, "gain_error_db"),
+        ({"impairments": {"dmc_share": 1.0}}, "dmc_share"),
+        ({"impairments": {"dmc_share": -0.1}}, "dmc_share"),
+        ({"impairments": 3}, "impairments"),
+        ({"impairments": {"phase_error_deg": 1.0}, "mode": "channel", "runs": 2}, "mode"),
+    ],
+)
+def test_bad_impairments_name_the_field(setup, kw, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        design.design_sweep(setup, ["4x4"], **kw)

@@ -1,9 +1,12 @@
-"""Size an antenna array for a tunnel: SR-NF validity, per-path CRLBs and a position error bound.
+"""Size an antenna array for a tunnel: bounds, achievable accuracy, the tracker's Monte-Carlo and
+a recommendation from what the system achieves.
 
 For every candidate array (ULA ``n``, URA ``n x m``, spacing in wavelengths) placed at the
-scenario's base-station mount, along the scenario's route, the design computes the exact SR-NF
-validity of every path, the per-path CRLBs and a position error bound (PEB), and optionally the
-settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per module:
+scenario's base-station mount (refused if an element lies outside the cross-section), along the
+scenario's route, the design computes the exact SR-NF validity of every path, the ideal position
+error bound (PEB), the achievable (misspecified) bound under the stated impairments, and the
+Monte-Carlo error of the design's tracker; a candidate is met when the 95 % interval of its error
+quantile lies below the target. One job per module:
 
 * :mod:`~tunnelkit.design.setup`: candidate arrays (:class:`ArraySpec`, :func:`parse_array`)
   and the scenario reduced to tunnel, mounts, route and radio (:class:`DesignSetup`);
