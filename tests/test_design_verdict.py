@@ -225,8 +225,8 @@ def test_srnf_criterion_gates_and_achievable_informs(setup):
 def test_an_undefined_bound_is_reported_per_array(setup, monkeypatch):
     real = rep_mod._achievable_bound
 
-    def nan_for_2x2(setup, spec, impairments, epochs):
-        x, peb, ach = real(setup, spec, impairments, epochs)
+    def nan_for_2x2(setup, spec, impairments, geometry):
+        x, peb, ach = real(setup, spec, impairments, geometry)
         return (x, np.full_like(peb, np.nan), ach) if spec.label == "2x2" else (x, peb, ach)
 
     monkeypatch.setattr(rep_mod, "_achievable_bound", nan_for_2x2)

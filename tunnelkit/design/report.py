@@ -308,10 +308,10 @@ def _design_impairments(impairments) -> DesignImpairments:
     return impairments
 
 
-def _achievable_bound(setup, spec, impairments, epochs):
-    """Per-epoch ``x``, ``peb`` and ``achievable`` (T,) of ``spec`` along the route
-    (:func:`tunnelkit.design.achievable.achievable_bound`)."""
-    res = achievable_bound(setup, spec, impairments, epochs=epochs)
+def _achievable_bound(setup, spec, impairments, geometry):
+    """Per-epoch ``x``, ``peb`` and ``achievable`` (T,) of ``spec`` along the traced route
+    ``geometry`` (:func:`tunnelkit.design.achievable.achievable_bound`)."""
+    res = achievable_bound(setup, spec, impairments, geometry=geometry)
     return res.x, res.peb, res.achievable
 
 
@@ -356,7 +356,7 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
         setup.arrays(spec)
         g = route_geometry(setup, spec, epochs=epochs)
         sr = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
-        x, peb, ach = _achievable_bound(setup, spec, impairments, epochs)
+        x, peb, ach = _achievable_bound(setup, spec, impairments, g)
     except (ValueError, ArithmeticError) as exc:
         row.reason = str(exc)
         return row
@@ -393,10 +393,11 @@ def _score(row, res, criterion, target, share, seed, n_boot) -> None:
     runs = errors.shape[0]
     k = counted_epochs(t)
     valid = row.srnf_valid[: t.size]
-    e = gate(np.where(np.isfinite(errors), errors, np.inf), valid, criterion)[:, k]
-    rng = np.random.default_rng([0xB007, int(seed), row.n_elements, len(row.array)])
+    lost = np.where(np.isfinite(errors), errors, np.inf)  # no estimate: an infinite error
+    e = gate(lost, valid, criterion)[:, k]
+    rng = np.random.default_rng([0xB007, int(seed), *row.array.encode()])
     row.runs = runs
-    row.error_median_epoch_m = np.median(errors, axis=0)
+    row.error_median_epoch_m = np.median(lost, axis=0)
     row.error_median_m = float(np.median(e))
     row.error_p90_m = share_quantile(e, share)
     row.error_p90_ci95_m = bootstrap_quantile_ci(e, share, rng, n_boot=n_boot)
