@@ -544,6 +544,7 @@ def design_sweep(
         "min_runs_ci": MIN_RUNS_CI,
         "workers": workers,
         "scheduler": scheduler,
+        "timeout_s": timeout,
     }
     rec = recommend([r for r in rows if r.status != "error"], target, share, runs)
     return DesignReport(setup.name, rows, rec, settings, warnings)
