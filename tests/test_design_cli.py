@@ -13,45 +13,78 @@ from tunnelkit.cli import main
 KEYS = {
     "array",
     "n_elements",
-    "aperture_m",
+    "aperture_diagonal_m",
+    "status",
+    "reason",
     "srnf_valid_share",
+    "srnf_valid_share_by_surface",
     "peb_median_m",
     "peb_p90_m",
+    "achievable_median_m",
+    "achievable_p90_m",
+    "met_share",
+    "error_median_m",
+    "error_p90_m",
+    "error_p90_ci95_m",
     "rmse_m",
     "rmse_ci95_m",
-    "rmse_settled_m",
-    "rmse_settled_ci95_m",
-    "peb_rms_settled_m",
-    "median_settled_m",
+    "runs",
+    "per_epoch",
 }
+INPUTS = {"scenario", "arrays", "fc", "bandwidth", "target", "share", "criterion", "impairments"}
 
 
 def test_json_answers_the_28ghz_question(capsys):
     argv = ["design", "example-rectangular-28ghz", "--arrays", "2x2", "3x3", "4x4", "8x8"]
     assert main([*argv, "--target", "0.15", "--format", "json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert set(out) == {"scenario", "arrays", "recommendation"}
-    assert out["scenario"] == "example-rectangular-28ghz"
+    assert set(out) == {"scenario", "inputs", "criterion", "arrays", "recommendation", "warnings"}
+    assert out["scenario"] == "example-rectangular-28ghz" and out["criterion"] == "achievable"
+    assert INPUTS | {"seed", "runs", "mode", "eps_phi", "spacing_wl"} <= set(out["inputs"])
+    assert out["inputs"]["impairments"]["phase_error_deg"] == 0.0
     assert [a["array"] for a in out["arrays"]] == ["2x2", "3x3", "4x4", "8x8"]
     for a in out["arrays"]:
         assert set(a) == KEYS
-        assert all(a[k] is None for k in KEYS if k.startswith(("rmse", "peb_rms", "median")))
+        assert a["runs"] == 0 and a["status"] in ("bound only", "hopeless")
+        assert all(a[k] is None for k in KEYS if k.startswith(("error", "rmse")))
+        ep = a["per_epoch"]
+        assert len(ep["x_m"]) == len(ep["peb_m"]) == len(ep["achievable_m"]) == 40
+        assert ep["error_median_m"] is None
+        # no impairments: the achievable bound is the PEB
+        assert ep["achievable_m"] == ep["peb_m"]
     by = {a["array"]: a for a in out["arrays"]}
     assert by["8x8"]["n_elements"] == 64
     # lambda/2 at 28 GHz: 7 spacings along each side, diagonal 7 sqrt(2) lambda/2
-    assert by["8x8"]["aperture_m"] == pytest.approx(7 * np.sqrt(2) * 299792458 / 28e9 / 2)
-    # the ceiling 20 cm above the array: SR-NF fails for 8x8 everywhere, holds for 2x2
+    assert by["8x8"]["aperture_diagonal_m"] == pytest.approx(7 * np.sqrt(2) * 299792458 / 28e9 / 2)
+    # the ceiling 20 cm above the array: SR-NF fails for 8x8 everywhere, holds for 2x2; it is
+    # information under the achievable criterion, not a gate
     assert by["8x8"]["srnf_valid_share"] == 0.0 and by["2x2"]["srnf_valid_share"] == 1.0
+    assert by["8x8"]["srnf_valid_share_by_surface"]["ceiling"] == 0.0
+    assert by["8x8"]["status"] == "bound only"
     assert by["2x2"]["peb_median_m"] > by["8x8"]["peb_median_m"]
-    assert set(out["recommendation"]) == {"array", "reason"}
-    assert out["recommendation"]["array"] == "3x3"
+    assert set(out["recommendation"]) == {"array", "reason", "basis"}
+    assert out["recommendation"]["basis"] == "bounds"
+    assert "necessary condition, not an answer" in out["recommendation"]["reason"]
+    assert any("rests on bounds only" in w for w in out["warnings"])
+
+
+def test_srnf_criterion_keeps_the_gate(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "2x2", "3x3", "4x4", "8x8"]
+    assert main([*argv, "--target", "0.15", "--criterion", "srnf", "--format", "json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    by = {a["array"]: a for a in out["arrays"]}
+    # SR-NF breaks on the ceiling path from 4x4 on: the gate makes 4x4 and 8x8 hopeless
+    assert out["criterion"] == "srnf"
+    assert [by[a]["status"] for a in ("3x3", "4x4", "8x8")] == ["bound only", *["hopeless"] * 2]
+    assert by["4x4"]["srnf_valid_share_by_surface"]["ceiling"] < 0.9
 
 
 def test_table_and_overrides(capsys):
     argv = ["design", "italiano2026-straight", "--arrays", "4x4", "10x10", "--fc", "28GHz"]
     assert main([*argv, "--bandwidth", "400MHz", "--tilt", "20", "--target", "0.05"]) == 0
     out = capsys.readouterr().out
-    assert "fc 28 GHz, bandwidth 400 MHz" in out and "recommendation:" in out
+    assert "fc 28 GHz, bandwidth 400 MHz" in out and "recommendation (bounds):" in out
+    assert "diagonal" in out and "criterion: achievable" in out
     assert "10x10" in out
 
 
@@ -61,13 +94,23 @@ def test_table_and_overrides(capsys):
         (["--arrays", "8y8"], "arrays: cannot read '8y8'"),
         (["--arrays", "64x64"], "arrays: the 64x64 array"),
         (["--mount-height", "9"], "mount:"),
-        (["--runs", "1"], "runs:"),
         (["--share", "1.5"], "share"),
     ],
 )
 def test_bad_input_names_the_parameter(capsys, extra, message):
     assert main(["design", "italiano2026-straight", *extra]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_an_array_that_does_not_fit_is_reported_beside_the_others(capsys):
+    argv = ["design", "italiano2026-straight", "--arrays", "4x4", "64x64", "--format", "json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    bad = out["arrays"][1]
+    assert bad["status"] == "error" and "elements outside" in bad["reason"]
+    assert "mount '-x'" in bad["reason"] and bad["peb_median_m"] is None
+    assert out["arrays"][0]["status"] in ("bound only", "hopeless")
+    assert any(w.startswith("64x64: arrays: the 64x64 array") for w in out["warnings"])
 
 
 @pytest.mark.parametrize(
@@ -80,12 +123,21 @@ def test_bad_input_names_the_parameter(capsys, extra, message):
         (["--target", "0"], "target: must be > 0"),
         (["--target", "-1"], "target: must be > 0"),
         (["--workers", "2", "--scheduler", "tcp://x:1"], "not allowed with"),
+        (["--phase-error-deg", "-1"], "phase_error_deg: must be a finite number >= 0"),
+        (["--phase-error-deg", "nan"], "phase_error_deg: must be"),
+        (["--gain-error-db", "inf"], "gain_error_db: must be"),
+        (["--dmc-share", "1"], "dmc_share: must be [0, 1)"),
+        (["--dmc-share", "-0.1"], "dmc_share: must be [0, 1)"),
+        (["--runs", "-1"], "runs: must be >= 0"),
+        (["--runs", "two"], "runs: expected an integer"),
+        (["--criterion", "eq51"], "invalid choice"),
+        (["--mode", "fast"], "invalid choice"),
     ],
 )
 def test_argument_errors_exit_non_zero(capsys, extra, message):
     with pytest.raises(SystemExit) as exc:
         main(["design", "italiano2026-straight", *extra])
-    assert exc.value.code != 0
+    assert exc.value.code == 2
     assert message in capsys.readouterr().err
 
 

@@ -138,7 +138,7 @@ def test_signal_route_drive_two_epochs():
     )
     assert len(d.epochs) == 2 and not d.los.any()
     assert all(e is None or np.all(np.isfinite(e.phi)) for e in d.epochs)
-    assert np.allclose(d.base_station, [0.0, 0.0, 4.8])
+    assert np.allclose(d.base_station, [0.0, 0.0, 4.75])  # reference antenna, 5 cm below the BS
     with pytest.raises(ValueError, match=r"^condition"):
         ex.simulate_drive(
             "italiano2026-straight", np.random.default_rng(0), condition="X", n_epochs=1

@@ -403,7 +403,8 @@ paths_table_figure(imp_rows, title="ML route with and without impairments (LoS +
 # %% [markdown]
 # Each impairment lifts the estimate two to four orders of magnitude off the bound: at 70 dB
 # of effective SNR even a 2° phase error per element is a bias far larger than the noise, and
-# the estimator, fitting the wrong model, converts it into a wrong direction and curvature. The
+# the estimator, fitting the wrong model, converts it into a wrong direction and curvature (with
+# 2° and 0.2 dB it loses the LoS curvature altogether here: `no kappa`, a plane-wave fit). The
 # two are not alike, though. The spatial-wideband term is deterministic and follows from the
 # geometry the fit estimates anyway: it can be put in the model (the ML stage here does not), and
 # then it costs nothing. The calibration error is not known; even 0.5° and 0.05 dB leave the LoS
@@ -543,7 +544,10 @@ for r in eff:
 imp_los = {r["impairment"]: r for r in imp_rows if r["path"] == "los"}
 assert imp_los["none"]["RMSE kappa [m]"] < 5 * imp_los["none"]["CRLB kappa [m]"]
 for name in ("calibration 2 deg, 0.2 dB", "spatial wideband"):
-    assert imp_los[name]["RMSE kappa [m]"] > 10 * imp_los[name]["CRLB kappa [m]"], name
+    r = imp_los[name]
+    lost = r["no kappa"] == r["matched"]  # the curvature lost altogether: a plane-wave fit
+    assert lost or r["RMSE kappa [m]"] > 10 * r["CRLB kappa [m]"], name
+    assert r["RMSE dir [deg]"] > 10 * r["CRLB dir [deg]"], name
 # exercise 4: the basin test
 assert fits["truth"].rho < fits["truth"].rho_max
 assert fits["paper's route, no re-seeding"].rho > 10 * fits["truth"].rho

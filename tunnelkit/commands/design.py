@@ -1,10 +1,14 @@
 """``tunnelkit design SCENARIO --arrays 4x4 8x8 16x16 [--fc 28GHz] [--bandwidth 400MHz]
-[--target 0.2] [--share 0.9] [--runs N] [--workers N | --scheduler ADDRESS] [--format table|json]``.
+[--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--dmc-share S]
+[--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
+[--criterion achievable|srnf] [--format table|json]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
-the share of the route where the SR-NF model holds for every reflected path, the position error
-bound (median and 90th percentile), optionally a JAVELIN Monte-Carlo RMSE with a 95 % interval
-(``--runs``), and the smallest array meeting ``--target`` on ``--share`` of the route.
+the ideal position error bound, the achievable bound under the stated impairments, SR-NF validity
+per surface, and with ``--runs`` the Monte-Carlo error of the design's tracker (its
+``share``-quantile over the settled route with a bootstrap 95 % interval); the smallest array
+whose interval lies below ``--target`` is recommended. Every input, the criterion and the
+warnings are in the JSON.
 """
 
 from __future__ import annotations
@@ -15,7 +19,9 @@ import re
 import sys
 
 NAME = "design"
-HELP = "size an antenna array for a tunnel: SR-NF validity, position error bound, recommendation"
+HELP = (
+    "size an antenna array for a tunnel: bounds, achievable accuracy, Monte-Carlo, recommendation"
+)
 
 _UNITS = {"": 1.0, "hz": 1.0, "khz": 1e3, "mhz": 1e6, "ghz": 1e9}
 
@@ -53,6 +59,37 @@ def _positive(param: str):
     return parse
 
 
+def _level(param: str, upper: float | None = None):
+    """argparse type: a finite number >= 0 (and < ``upper``); errors name ``param``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{param}: expected a number, got {text!r}") from None
+        if not value >= 0 or not value < (upper if upper is not None else float("inf")):
+            rng = f"[0, {upper:g})" if upper is not None else "a finite number >= 0"
+            raise argparse.ArgumentTypeError(f"{param}: must be {rng}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _count(param: str, minimum: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{param}: expected an integer, got {text!r}"
+            ) from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{param}: must be >= {minimum}, got {text!r}")
+        return value
+
+    return parse
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="preset name (tunnelkit scenarios) or a .toml path")
     p.add_argument(
@@ -68,18 +105,65 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--mount-height", type=float, default=None, help="height of the arrays' centre [m]"
     )
-    p.add_argument("--target", type=_positive("target"), default=0.2, help="PEB target [m] (0.2)")
+    p.add_argument(
+        "--target", type=_positive("target"), default=0.2, help="position error target [m] (0.2)"
+    )
     p.add_argument(
         "--share",
         type=float,
         default=0.9,
-        help="share of the route that must meet the target with SR-NF valid (0.9)",
+        help="share of the settled route on which the error must meet the target (0.9)",
+    )
+    imp = p.add_argument_group("impairments (the achievable bound and the Monte-Carlo)")
+    imp.add_argument(
+        "--phase-error-deg",
+        type=_level("phase_error_deg"),
+        default=0.0,
+        help="per-element phase calibration error, standard deviation [deg] (0)",
+    )
+    imp.add_argument(
+        "--gain-error-db",
+        type=_level("gain_error_db"),
+        default=0.0,
+        help="per-element gain calibration error, standard deviation [dB] (0)",
+    )
+    imp.add_argument(
+        "--wideband",
+        action=argparse.BooleanOptionalAction,
+        default=False,
+        help="the spatial-wideband term (delay across the aperture) in the channel (off)",
+    )
+    imp.add_argument(
+        "--dmc-share",
+        type=_level("dmc_share", 1.0),
+        default=0.0,
+        help="dense diffuse multipath: share of the received power, in [0, 1) (0)",
+    )
+    p.add_argument(
+        "--criterion",
+        choices=["achievable", "srnf"],
+        default="achievable",
+        help="achievable: the design's VUE-curvature tracker, SR-NF as information (default); "
+        "srnf: an eq. 51 estimator, SR-NF validity a gate",
     )
     p.add_argument("--eps", type=_positive("eps"), default=0.15, help="eps_phi [rad] (0.15)")
     p.add_argument(
-        "--runs", type=int, default=0, help="JAVELIN Monte-Carlo drives per array (0: bounds only)"
+        "--runs",
+        type=_count("runs", 0),
+        default=0,
+        help="Monte-Carlo drives per array (0: bounds only; 20 for a decision)",
     )
-    p.add_argument("--seed", type=int, default=0, help="Monte-Carlo seed (0)")
+    p.add_argument(
+        "--mode",
+        choices=["bound", "channel"],
+        default="bound",
+        help="Monte-Carlo measurements: drawn from the error model (bound, fast) or "
+        "synthesised and extracted (channel)",
+    )
+    p.add_argument(
+        "--n-epochs", type=_count("n_epochs", 1), default=None, help="first N epochs of the route"
+    )
+    p.add_argument("--seed", type=_count("seed", 0), default=0, help="Monte-Carlo seed (0)")
     from .reproduce import add_parallel_arguments
 
     add_parallel_arguments(p)
@@ -100,21 +184,38 @@ def main(args: argparse.Namespace) -> int:
         tilt_deg=args.tilt,
         mount_height=args.mount_height,
     )
+    impairments = {
+        "phase_error_deg": args.phase_error_deg,
+        "gain_error_db": args.gain_error_db,
+        "spatial_wideband": args.wideband,
+        "dmc_share": args.dmc_share,
+    }
     try:
         rep = design.design_sweep(
             setup,
             specs,
             target=args.target,
             share=args.share,
+            criterion=args.criterion,
+            impairments=impairments,
             eps_phi=args.eps,
             runs=args.runs,
             seed=args.seed,
+            mode=args.mode,
+            n_epochs=args.n_epochs,
             **parallel_kwargs(args),
             progress=args.runs > 0 and args.format == "table" and not args.no_progress,
         )
     except TrialLost as exc:
         print(f"tunnelkit design: error: {exc}", file=sys.stderr)
         return 1
+    rep.settings.update(
+        spacing_wl=args.spacing, tilt_deg=args.tilt, mount_height_m=args.mount_height
+    )
+    if all(r.status == "error" for r in rep.rows):
+        for r in rep.rows:
+            print(f"tunnelkit design: error: {r.reason}", file=sys.stderr)
+        return 2
     if args.format == "json":
         print(json.dumps(rep.to_json(), indent=2))
     else:

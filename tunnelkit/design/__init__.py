@@ -1,9 +1,12 @@
-"""Size an antenna array for a tunnel: SR-NF validity, per-path CRLBs and a position error bound.
+"""Size an antenna array for a tunnel: bounds, achievable accuracy, the tracker's Monte-Carlo and
+a recommendation from what the system achieves.
 
 For every candidate array (ULA ``n``, URA ``n x m``, spacing in wavelengths) placed at the
-scenario's base-station mount, along the scenario's route, the design computes the exact SR-NF
-validity of every path, the per-path CRLBs and a position error bound (PEB), and optionally the
-settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per module:
+scenario's base-station mount (refused if an element lies outside the cross-section), along the
+scenario's route, the design computes the exact SR-NF validity of every path, the ideal position
+error bound (PEB), the achievable (misspecified) bound under the stated impairments, and the
+Monte-Carlo error of the design's tracker; a candidate is met when the 95 % interval of its error
+quantile lies below the target. One job per module:
 
 * :mod:`~tunnelkit.design.setup`: candidate arrays (:class:`ArraySpec`, :func:`parse_array`)
   and the scenario reduced to tunnel, mounts, route and radio (:class:`DesignSetup`);
@@ -20,8 +23,10 @@ settled RMSE of JAVELIN over Monte-Carlo drives beside the PEB. One job per modu
   set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
   :class:`MonteCarloResult` with the posterior CRLB; :func:`javelin_rmse` for one array);
   :mod:`~tunnelkit.design.fastroute`: the bound-driven drive (:func:`bound_drive`);
-* :mod:`~tunnelkit.design.report`: the sweep, its table and the recommendation
-  (:func:`design_sweep`, :func:`recommend`, :func:`smallest_meeting`).
+* :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile with its bootstrap
+  interval, the verdict per array and the recommendation (:func:`judge`, :func:`recommend`);
+* :mod:`~tunnelkit.design.report`: the sweep and its table (:func:`design_sweep`,
+  :func:`smallest_meeting`).
 
     >>> import tunnelkit as tk
     >>> setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
@@ -46,13 +51,27 @@ from .montecarlo import (
     position_information,
     sweep_montecarlo,
 )
-from .report import DesignReport, DesignRow, design_sweep, recommend, smallest_meeting
+from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
+from .verdict import (
+    CRITERIA,
+    MIN_RUNS_CI,
+    STATUSES,
+    bootstrap_quantile_ci,
+    counted_epochs,
+    gate,
+    judge,
+    recommend,
+    share_quantile,
+)
 
 __all__ = [
+    "CRITERIA",
     "KINDS",
+    "MIN_RUNS_CI",
     "MODES",
     "SETTLE_S",
+    "STATUSES",
     "AchievableBound",
     "ArraySpec",
     "DesignImpairments",
@@ -65,11 +84,16 @@ __all__ = [
     "RouteBounds",
     "RouteGeometry",
     "achievable_bound",
+    "bootstrap_quantile_ci",
     "bound_drive",
+    "counted_epochs",
     "design_sweep",
     "drive_pcrlb",
+    "gate",
     "javelin_config",
     "javelin_rmse",
+    "judge",
+    "over_target",
     "parse_array",
     "path_bounds",
     "path_error_model",
@@ -77,6 +101,7 @@ __all__ = [
     "recommend",
     "route_bounds",
     "route_geometry",
+    "share_quantile",
     "smallest_meeting",
     "sweep_montecarlo",
     "trace_route",

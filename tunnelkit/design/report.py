@@ -1,169 +1,251 @@
-"""A design sweep and its recommendation: one summary row per candidate array.
+"""A design sweep and its recommendation: one row per candidate array, decided from what the
+tracker achieves.
 
-:func:`design_sweep` bounds every candidate (and with ``runs >= 2`` adds the JAVELIN Monte-Carlo
-of :mod:`tunnelkit.design.montecarlo`) into a :class:`DesignReport` of :class:`DesignRow`
-entries, the JSON and text table of ``tunnelkit design``; :func:`recommend` picks the smallest
-array that meets the target, :func:`smallest_meeting` searches a list of arrays in order (for
-the explorer).
+:func:`design_sweep` evaluates every candidate along the route:
+
+1. it is placed on the mount (an array with an element outside the cross-section is refused,
+   per array, with the reason: :meth:`DesignSetup.arrays`);
+2. the **ideal PEB** and the **achievable bound** of the estimator under the stated impairments
+   (:func:`tunnelkit.design.achievable.achievable_bound`; with no impairments the two coincide,
+   the misspecified bound of a well-specified model being the CRLB), and SR-NF validity per
+   surface (information under ``criterion="achievable"``, a gate under ``"srnf"``);
+3. the **pre-screen**: a candidate whose achievable bound already misses the target on ``share``
+   of the counted epochs is hopeless and gets no Monte-Carlo;
+4. the **Monte-Carlo** of the design's tracker on the others, all arrays x runs as one task set
+   (:func:`tunnelkit.design.montecarlo.sweep_montecarlo`), and the verdict of
+   :mod:`tunnelkit.design.verdict` (error quantile with a bootstrap 95 % interval).
+
+:class:`DesignReport` holds the rows, the recommendation, every input and the warnings, as JSON
+(:meth:`DesignReport.to_json`) or a text table (:meth:`DesignReport.to_table`).
+:func:`smallest_meeting` is the explorer's bound-only search (PEB and SR-NF).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
+from functools import partial
 
 import numpy as np
 
-from .._validate import integer, positive, probability
+from .._validate import choice, integer, positive, probability
 from ..montecarlo import parallel_options
-from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
-from .montecarlo import SETTLE_S, javelin_rmse
+from .achievable import DesignImpairments, achievable_bound, path_error_model
+from .bounds import route_bounds, route_geometry
+from .montecarlo import MODES, sweep_montecarlo
 from .setup import ArraySpec, DesignSetup, parse_array
+from .verdict import (
+    CRITERIA,
+    MIN_RUNS_CI,
+    bootstrap_quantile_ci,
+    counted_epochs,
+    gate,
+    judge,
+    recommend,
+    share_quantile,
+)
 
-__all__ = ["DesignReport", "DesignRow", "design_sweep", "recommend", "smallest_meeting"]
+__all__ = ["DesignReport", "DesignRow", "design_sweep", "over_target", "smallest_meeting"]
+
+
+def _fin(v):
+    return float(v) if v is not None and np.isfinite(v) else None
+
+
+def _fins(v):
+    return None if v is None else [_fin(x) for x in np.asarray(v, float).ravel()]
 
 
 @dataclass
 class DesignRow:
-    """One candidate array's summary (the JSON entry of ``tunnelkit design``)."""
+    """One candidate array (the JSON entry of ``tunnelkit design``, :meth:`to_json`).
+
+    Bound and error statistics are over the counted (settled) epochs; ``*_p90_m`` is the
+    ``share``-quantile (the 90th percentile at the default share). ``status`` is a verdict of
+    :func:`tunnelkit.design.verdict.judge` or ``"error"`` (``reason`` says why). Per-epoch
+    arrays cover the whole route: ``x_m``, ``peb_m``, ``achievable_m`` and, with runs,
+    ``error_median_epoch_m`` (median over runs).
+    """
 
     array: str
     n_elements: int
-    aperture_m: float
-    srnf_valid_share: float
-    peb_median_m: float
-    peb_p90_m: float
-    met_share: float
-    variants: dict = field(default_factory=dict)
-    surfaces: dict = field(default_factory=dict)
-    crlb: dict = field(default_factory=dict)
+    aperture_diagonal_m: float
+    status: str = "error"
+    reason: str = ""
+    srnf_valid_share: float | None = None
+    srnf_valid_share_by_surface: dict = field(default_factory=dict)
+    peb_median_m: float | None = None
+    peb_p90_m: float | None = None
+    achievable_median_m: float | None = None
+    achievable_p90_m: float | None = None
+    met_share: float | None = None
+    error_median_m: float | None = None
+    error_p90_m: float | None = None
+    error_p90_ci95_m: list | None = None
     rmse_m: float | None = None
     rmse_ci95_m: list | None = None
-    sigmas: dict | None = None
-    rmse_settled_m: float | None = None
-    rmse_settled_ci95_m: list | None = None
-    peb_rms_settled_m: float | None = None
-    median_settled_m: float | None = None
+    runs: int = 0
+    x_m: np.ndarray | None = None
+    peb_m: np.ndarray | None = None
+    achievable_m: np.ndarray | None = None
+    error_median_epoch_m: np.ndarray | None = None
+    screen_m: float | None = field(default=None, repr=False)
+    srnf_valid: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def aperture_m(self) -> float:
+        """The aperture's diagonal [m] (largest distance between two elements)."""
+        return self.aperture_diagonal_m
 
     def to_json(self) -> dict:
-        """The CLI's JSON entry: ``array, n_elements, aperture_m, srnf_valid_share,
-        peb_median_m, peb_p90_m, rmse_m, rmse_ci95_m``, then the settled RMSE after the
-        start-up, its interval, the RMS PEB over the same epochs and the median settled error
-        (``rmse_settled_m, rmse_settled_ci95_m, peb_rms_settled_m, median_settled_m``);
-        non-finite values and anything not computed are null."""
-        fin = lambda v: float(v) if v is not None and np.isfinite(v) else None  # noqa: E731
-        ci = lambda v: None if v is None else [fin(x) for x in v]  # noqa: E731
+        """``array, n_elements, aperture_diagonal_m, status, reason, srnf_valid_share,
+        srnf_valid_share_by_surface, peb_median_m, peb_p90_m, achievable_median_m,
+        achievable_p90_m, met_share, error_median_m, error_p90_m, error_p90_ci95_m, rmse_m,
+        rmse_ci95_m, runs`` and ``per_epoch {x_m, peb_m, achievable_m, error_median_m}``
+        (non-finite values and anything not computed are null)."""
         return {
             "array": self.array,
             "n_elements": int(self.n_elements),
-            "aperture_m": fin(self.aperture_m),
-            "srnf_valid_share": fin(self.srnf_valid_share),
-            "peb_median_m": fin(self.peb_median_m),
-            "peb_p90_m": fin(self.peb_p90_m),
-            "rmse_m": fin(self.rmse_m),
-            "rmse_ci95_m": ci(self.rmse_ci95_m),
-            "rmse_settled_m": fin(self.rmse_settled_m),
-            "rmse_settled_ci95_m": ci(self.rmse_settled_ci95_m),
-            "peb_rms_settled_m": fin(self.peb_rms_settled_m),
-            "median_settled_m": fin(self.median_settled_m),
+            "aperture_diagonal_m": _fin(self.aperture_diagonal_m),
+            "status": self.status,
+            "reason": self.reason,
+            "srnf_valid_share": _fin(self.srnf_valid_share),
+            "srnf_valid_share_by_surface": {
+                k: _fin(v) for k, v in self.srnf_valid_share_by_surface.items()
+            },
+            "peb_median_m": _fin(self.peb_median_m),
+            "peb_p90_m": _fin(self.peb_p90_m),
+            "achievable_median_m": _fin(self.achievable_median_m),
+            "achievable_p90_m": _fin(self.achievable_p90_m),
+            "met_share": _fin(self.met_share),
+            "error_median_m": _fin(self.error_median_m),
+            "error_p90_m": _fin(self.error_p90_m),
+            "error_p90_ci95_m": _fins(self.error_p90_ci95_m),
+            "rmse_m": _fin(self.rmse_m),
+            "rmse_ci95_m": _fins(self.rmse_ci95_m),
+            "runs": int(self.runs),
+            "per_epoch": {
+                "x_m": _fins(self.x_m),
+                "peb_m": _fins(self.peb_m),
+                "achievable_m": _fins(self.achievable_m),
+                "error_median_m": _fins(self.error_median_epoch_m),
+            },
         }
 
 
 @dataclass
 class DesignReport:
-    """A sweep: rows per array, the recommendation and the settings it was made with."""
+    """A sweep: rows per array, the recommendation, every input and the warnings."""
 
     scenario: str
     rows: list[DesignRow]
     recommendation: dict
     settings: dict
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def criterion(self) -> str:
+        return self.settings["criterion"]
 
     def to_json(self) -> dict:
         return {
             "scenario": self.scenario,
+            "inputs": dict(self.settings),
+            "criterion": self.criterion,
             "arrays": [r.to_json() for r in self.rows],
             "recommendation": dict(self.recommendation),
+            "warnings": list(self.warnings),
         }
 
     def to_table(self) -> str:
-        """A fixed-width text table, the recommendation and the settings below it."""
+        """A fixed-width text table; the criterion above it, recommendation and warnings below."""
         s = self.settings
-        head = (
-            f"{'array':>7s} {'M':>5s} {'aperture':>9s} {'SR-NF ok':>9s} {'PEB med':>9s} "
-            f"{'PEB p90':>9s} {'met':>6s} {'no curv.':>9s} {'no RRMs':>9s} {'RMSE [95% CI]':>22s}"
-            f" {'settled RMSE':>12s} {'median':>9s} {'/ PEB':>7s}"
-        )
-
-        def m(v):
-            return f"{100 * v:7.3g}cm" if np.isfinite(v) else "      inf"
-
+        imp = s["impairments"]
+        q = f"p{100 * s['share']:g}"
         lines = [
             f"Array design for {self.scenario}: fc {s['fc'] / 1e9:g} GHz, bandwidth "
-            f"{s['bandwidth'] / 1e6:g} MHz, target PEB <= {s['target']:g} m on "
-            f"{100 * s['share']:.0f} % of the route with SR-NF valid (eps {s['eps_phi']:g} rad)",
-            head,
+            f"{s['bandwidth'] / 1e6:g} MHz; target {s['target']:g} m on {100 * s['share']:g} % "
+            "of the settled route",
+            f"impairments: phase {imp['phase_error_deg']:g} deg, gain {imp['gain_error_db']:g} "
+            f"dB, spatial wideband {'on' if imp['spatial_wideband'] else 'off'}, diffuse share "
+            f"{imp['dmc_share']:g}; Monte-Carlo: {s['runs']} runs ({s['mode']} route), seed "
+            f"{s['seed']}",
+            f"criterion: {_CRITERION_TEXT[s['criterion']]}",
+            f"{'array':>7s} {'M':>5s} {'diagonal':>9s} {'SR-NF ok':>9s} {'PEB med':>9s} "
+            f"{'PEB ' + q:>9s} {'ach. med':>9s} {'ach. ' + q:>9s} {'err med':>9s} "
+            f"{'err ' + q:>9s} {'95% CI':>21s} {'RMSE':>9s}  status",
         ]
         for r in self.rows:
-            rm = (
-                f"{r.rmse_m:6.3f} [{r.rmse_ci95_m[0]:.3f}, {r.rmse_ci95_m[1]:.3f}]"
-                if r.rmse_m is not None
-                else "-"
-            )
-            settled, median, ratio = "-", "-", "-"
-            if r.rmse_settled_m is not None:
-                settled = f"{100 * r.rmse_settled_m:9.3g} cm"
-                median = f"{100 * r.median_settled_m:6.3g} cm"
-                if r.peb_rms_settled_m and np.isfinite(r.peb_rms_settled_m):
-                    ratio = f"{r.rmse_settled_m / r.peb_rms_settled_m:6.3g}x"
+            if r.peb_median_m is None:  # nothing computed: the reason only
+                lines.append(
+                    f"{r.array:>7s} {r.n_elements:5d} {_cm(r.aperture_diagonal_m)}  {r.reason}"
+                )
+                continue
+            ci = r.error_p90_ci95_m
+            cis = f"[{_cm(ci[0]).strip()}, {_cm(ci[1]).strip()}]" if ci else "-"
             lines.append(
-                f"{r.array:>7s} {r.n_elements:5d} {100 * r.aperture_m:7.3g}cm "
-                f"{100 * r.srnf_valid_share:8.1f}% "
-                f"{m(r.peb_median_m)} {m(r.peb_p90_m)} {100 * r.met_share:5.1f}% "
-                f"{m(r.variants.get('no_curvature', np.nan))} "
-                f"{m(r.variants.get('no_markings', np.nan))} {rm:>22s} {settled:>12s} {median:>9s} {ratio:>7s}"
+                f"{r.array:>7s} {r.n_elements:5d} {_cm(r.aperture_diagonal_m)} "
+                f"{100 * r.srnf_valid_share:8.1f}% {_cm(r.peb_median_m)} {_cm(r.peb_p90_m)} "
+                f"{_cm(r.achievable_median_m)} {_cm(r.achievable_p90_m)} "
+                f"{_cm(r.error_median_m)} {_cm(r.error_p90_m)} {cis:>21s} {_cm(r.rmse_m)}  "
+                f"{r.status}"
             )
         rec = self.recommendation
-        lines.append(f"recommendation: {rec['array'] or 'none'} — {rec['reason']}")
+        lines.append(f"recommendation ({rec['basis']}): {rec['array'] or 'none'} — {rec['reason']}")
         lines.append(
-            "PEB: horizontal position bound with the antenna height known, clock bias and per-path "
-            "gains/Dopplers as nuisances; 'met' = share of epochs with PEB <= target and SR-NF valid."
+            f"diagonal: the aperture's diagonal; PEB: ideal position error bound; ach.: the "
+            f"achievable bound under the impairments; err: Monte-Carlo 2-D error; {q}: the "
+            f"{s['share']:g}-quantile over the settled epochs (pooled over runs), CI: bootstrap "
+            "over runs; SR-NF ok: share of the route where SR-NF holds on every surface."
         )
-        if any(r.rmse_m is not None for r in self.rows):
-            lines.append(
-                f"RMSE: JAVELIN over whole drives [m]; settled: after the first {SETTLE_S:g} s "
-                "(RMSE, median error, and RMSE / RMS PEB over the same epochs)."
-            )
+        for r in self.rows:
+            if r.srnf_valid_share_by_surface:
+                per = ", ".join(
+                    f"{k} {100 * v:.0f} %" for k, v in r.srnf_valid_share_by_surface.items()
+                )
+                lines.append(f"  SR-NF valid, {r.array}: {per}")
+            for what, y in (
+                ("achievable bound", r.achievable_m),
+                ("median error", r.error_median_epoch_m),
+            ):
+                if y is not None and r.x_m is not None:
+                    spans = over_target(r.x_m[: len(y)], y, s["target"])
+                    if spans:
+                        lines.append(f"  {r.array}: {what} above the target at x = {spans}")
+        lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 
 
-def recommend(rows: list[DesignRow], target: float, share: float) -> dict:
-    """The smallest array (fewest elements) whose ``met_share >= share``, with the reason."""
-    ok = [r for r in rows if r.met_share >= share]
-    if ok:
-        best = min(ok, key=lambda r: (r.n_elements, r.aperture_m))
-        return {
-            "array": best.array,
-            "reason": (
-                f"smallest candidate with PEB <= {target:g} m and SR-NF valid on "
-                f"{100 * best.met_share:.0f} % of the route (>= {100 * share:.0f} %); median PEB "
-                f"{best.peb_median_m:.3g} m"
-            ),
-        }
-    top = max(rows, key=lambda r: (r.met_share, -r.n_elements))
-    why = ""
-    if top.surfaces:
-        worst = min(top.surfaces, key=top.surfaces.get)
-        if top.surfaces[worst] < share:
-            why = (
-                f"; SR-NF binds on the {worst} (valid on {100 * top.surfaces[worst]:.0f} % of "
-                f"epochs for {top.array})"
-            )
-    return {
-        "array": None,
-        "reason": (
-            f"no candidate meets PEB <= {target:g} m with SR-NF valid on {100 * share:.0f} % of "
-            f"the route; best is {top.array} with {100 * top.met_share:.0f} %{why}"
-        ),
-    }
+def over_target(x, y, target: float) -> str:
+    """The stretches of the route where ``y > target`` (non-finite counts), as text:
+    ``"45.0..38.1 m, 12.5 m"`` in route order; ``""`` when none."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    bad = ~(y <= target)
+    out, i = [], 0
+    while i < bad.size:
+        if not bad[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < bad.size and bad[j + 1]:
+            j += 1
+        out.append(f"{x[i]:.1f} m" if i == j else f"{x[i]:.1f}..{x[j]:.1f} m")
+        i = j + 1
+    return ", ".join(out)
+
+
+_CRITERION_TEXT = {
+    "achievable": (
+        "achievable (the design's tracker models each reflection's wavefront on its virtual UE; "
+        "SR-NF validity is information, not a gate)"
+    ),
+    "srnf": ("srnf (an eq. 51 estimator: an epoch counts only where SR-NF holds on every surface)"),
+}
+
+
+def _cm(v) -> str:
+    if v is None:
+        return "        -"
+    return f"{100 * v:7.3g}cm" if np.isfinite(v) else "      inf"
 
 
 def smallest_meeting(
@@ -178,9 +260,9 @@ def smallest_meeting(
     """The first array of ``arrays`` (in the order given) whose PEB <= ``target`` with SR-NF
     valid on ``share`` of the route, and its met share; ``(None, best share)`` if none.
 
-    The SR-NF part is computed first (cheap); the PEB only where SR-NF alone leaves ``share``
-    within reach. Arrays that do not fit in the tunnel are skipped; ``epochs`` subsamples the
-    route. For the explorer.
+    A bound-only search with the SR-NF gate (an eq. 51 estimator), for the explorer: the SR-NF
+    part is computed first (cheap); the PEB only where SR-NF alone leaves ``share`` within
+    reach. Arrays that do not fit in the tunnel are skipped; ``epochs`` subsamples the route.
     """
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
@@ -203,12 +285,135 @@ def smallest_meeting(
     return None, best
 
 
-def _summary(b: RouteBounds, target: float) -> tuple[float, float, float]:
-    peb = b.peb
-    med = float(np.median(peb))
-    p90 = float(np.quantile(peb, 0.9, method="higher"))
-    met = float(np.mean((peb <= target) & b.srnf_valid))
-    return med, p90, met
+# --- the sweep ------------------------------------------------------------------------------
+
+
+def _impairment_fields(imp: DesignImpairments) -> dict:
+    """The impairment settings as plain values (the report's inputs)."""
+    return {k: (v if isinstance(v, (bool, str)) else float(v)) for k, v in asdict(imp).items()}
+
+
+def _design_impairments(impairments) -> DesignImpairments:
+    """``impairments`` (None, a dict of fields or a ``DesignImpairments``) as the object the
+    achievable bound and the error model take."""
+    if impairments is None:
+        return DesignImpairments()
+    if isinstance(impairments, dict):
+        return DesignImpairments(**impairments)
+    if not isinstance(impairments, DesignImpairments):
+        raise TypeError(
+            f"impairments: expected a design.DesignImpairments or a dict of its fields, got "
+            f"{type(impairments).__name__}"
+        )
+    return impairments
+
+
+def _achievable_bound(setup, spec, impairments, geometry):
+    """Per-epoch ``x``, ``peb`` and ``achievable`` (T,) of ``spec`` along the traced route
+    ``geometry`` (:func:`tunnelkit.design.achievable.achievable_bound`)."""
+    res = achievable_bound(setup, spec, impairments, geometry=geometry)
+    return res.x, res.peb, res.achievable
+
+
+def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
+    """:func:`tunnelkit.design.montecarlo.sweep_montecarlo` (one task set for every array)."""
+    return sweep_montecarlo(setup, specs, runs, seed, **kw)
+
+
+def _error_models(impairments: DesignImpairments, mode: str):
+    """The bound route's error model per array under ``impairments`` (``None``: the ideal
+    default of :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`)."""
+    if mode != "bound" or impairments.ideal:
+        return None
+    return partial(path_error_model, impairments=impairments)
+
+
+def _run_montecarlo(setup, specs, runs, seed, kw) -> tuple[dict, dict]:
+    """One task set for all ``specs``; if it fails on an array's input, each array alone, so
+    one undefined array is reported with its reason instead of losing the sweep."""
+    try:
+        return _sweep_montecarlo(setup, specs, runs, seed, **kw), {}
+    except (ValueError, ArithmeticError) as exc:
+        if len(specs) == 1:
+            return {}, {specs[0].label: f"Monte-Carlo failed: {exc}"}
+    out, failed = {}, {}
+    for s in specs:
+        try:
+            out.update(_sweep_montecarlo(setup, [s], runs, seed, **kw))
+        except (ValueError, ArithmeticError) as exc:
+            failed[s.label] = f"Monte-Carlo failed: {exc}"
+    return out, failed
+
+
+def _field(res, name):
+    return res[name] if isinstance(res, dict) else getattr(res, name)
+
+
+def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epochs) -> DesignRow:
+    """The bound part of one candidate's row (placement checked first)."""
+    row = DesignRow(spec.label, spec.n_elements, spec.aperture(setup.fc))
+    try:
+        setup.arrays(spec)
+        g = route_geometry(setup, spec, epochs=epochs)
+        sr = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
+        x, peb, ach = _achievable_bound(setup, spec, impairments, g)
+    except (ValueError, ArithmeticError) as exc:
+        row.reason = str(exc)
+        return row
+    bad = np.isnan(peb) | np.isnan(ach)
+    if bad.any():
+        row.reason = (
+            f"bound undefined (NaN) at {int(bad.sum())} of {bad.size} epochs: the array cannot "
+            "be evaluated on this route"
+        )
+        return row
+    t = setup.trajectory.t[: len(x)]
+    k = counted_epochs(t)
+    row.x_m, row.peb_m, row.achievable_m = x, peb, ach
+    row.srnf_valid_share = float(sr.srnf_valid.mean())
+    row.srnf_valid_share_by_surface = sr.surface_validity()
+    gated = gate(ach, sr.srnf_valid, criterion)[k]
+    row.peb_median_m = float(np.median(peb[k]))
+    row.peb_p90_m = share_quantile(peb[k], share)
+    row.achievable_median_m = float(np.median(ach[k]))
+    row.achievable_p90_m = share_quantile(ach[k], share)
+    row.met_share = float(np.mean(gated <= target))
+    row.screen_m = share_quantile(gated, share)  # the pre-screen under the criterion
+    row.srnf_valid = sr.srnf_valid
+    row.status, row.reason = judge(target, row.screen_m, share=share)
+    return row
+
+
+def _score(row, res, criterion, target, share, seed, n_boot) -> None:
+    """Fill ``row`` from one array's Monte-Carlo result (errors (runs, T)) and judge it."""
+    errors = np.asarray(_field(res, "errors"), float)
+    t = np.asarray(_field(res, "t"), float)
+    if errors.ndim != 2 or errors.shape[1] != t.size:
+        raise ValueError(f"errors: expected (runs, {t.size}), got shape {errors.shape}")
+    runs = errors.shape[0]
+    k = counted_epochs(t)
+    valid = row.srnf_valid[: t.size]
+    lost = np.where(np.isfinite(errors), errors, np.inf)  # no estimate: an infinite error
+    e = gate(lost, valid, criterion)[:, k]
+    rng = np.random.default_rng([0xB007, int(seed), *row.array.encode()])
+    row.runs = runs
+    row.error_median_epoch_m = np.median(lost, axis=0)
+    row.error_median_m = float(np.median(e))
+    row.error_p90_m = share_quantile(e, share)
+    row.error_p90_ci95_m = bootstrap_quantile_ci(e, share, rng, n_boot=n_boot)
+    sq = np.where(np.isfinite(errors[:, k]), errors[:, k], np.inf) ** 2
+    row.rmse_m = float(np.sqrt(sq.mean()))
+    idx = rng.integers(0, runs, size=(n_boot, runs))
+    boot = np.sqrt(sq.mean(axis=1)[idx].mean(axis=1))
+    row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
+    row.status, row.reason = judge(
+        target,
+        row.screen_m,
+        runs=runs,
+        error_q=row.error_p90_m,
+        ci=row.error_p90_ci95_m,
+        share=share,
+    )
 
 
 def design_sweep(
@@ -217,83 +422,129 @@ def design_sweep(
     *,
     target: float = 0.2,
     share: float = 0.9,
+    criterion: str = "achievable",
+    impairments=None,
     eps_phi: float = 0.15,
     runs: int = 0,
     seed: int = 0,
+    mode: str = "bound",
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = False,
     n_epochs: int | None = None,
     timeout: float | None = None,
+    n_boot: int = 2000,
 ) -> DesignReport:
-    """Bounds (and with ``runs >= 2`` a JAVELIN Monte-Carlo) for each array in ``arrays``.
+    """Every candidate of ``arrays`` evaluated and judged (module docstring).
 
-    ``workers`` / ``scheduler`` / ``timeout`` go to :func:`tunnelkit.montecarlo.run_trials`.
+    ``target`` [m] on ``share`` of the settled route; ``criterion`` ``"achievable"`` (default,
+    the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a gate);
+    ``impairments``: a ``design.DesignImpairments`` or a dict of its fields (``None``: ideal);
+    ``runs`` Monte-Carlo drives per array (0: bounds only) on the ``mode`` route (``"bound"``:
+    measurements drawn from the error model; ``"channel"``: synthesis and extraction), seeded
+    by ``seed``; ``workers`` / ``scheduler`` / ``timeout`` go to the one task set;
+    ``n_epochs`` truncates the route; ``n_boot`` bootstrap resamples. An array that does not
+    fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
+    reason; the sweep goes on.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
-    specs = [parse_array(a) for a in arrays]
+    if isinstance(arrays, (str, ArraySpec)):
+        arrays = [arrays]
+    specs = list(dict.fromkeys(parse_array(a) for a in arrays))
     if not specs:
         raise ValueError("arrays: give at least one candidate array")
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
+    if share == 0:
+        raise ValueError("share: expected a share in (0, 1], got 0")
+    criterion = choice("criterion", criterion, CRITERIA)
+    mode = choice("mode", mode, MODES)
+    eps_phi = positive("eps_phi", eps_phi)
     runs = integer("runs", runs, minimum=0)
-    if runs == 1:
-        raise ValueError("runs: a 95 % interval needs at least 2 runs (or 0 for bounds only)")
+    seed = integer("seed", seed, minimum=0)
+    n_boot = integer("n_boot", n_boot, minimum=100)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
     workers, scheduler = parallel_options(workers, scheduler)
-    for s in specs:
-        setup.arrays(s)  # fail early, naming the array that does not fit
-    rows = []
-    for spec in specs:
-        b = route_bounds(setup, spec, eps_phi=eps_phi)
-        med, p90, met = _summary(b, target)
-        variants = {
-            "no_curvature": float(np.median(route_bounds(setup, spec, curvature=False).peb)),
-            "no_markings": float(np.median(route_bounds(setup, spec, markings=False).peb)),
-            "no_curvature_no_markings": float(
-                np.median(route_bounds(setup, spec, curvature=False, markings=False).peb)
-            ),
-        }
-        pb = path_bounds(setup, spec)
-        crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa") if pb[k].size}
-        row = DesignRow(
-            spec.label,
-            spec.n_elements,
-            spec.aperture(setup.fc),
-            float(b.srnf_valid.mean()),
-            med,
-            p90,
-            met,
-            variants,
-            b.surface_validity(),
-            crlb,
+    imp = _design_impairments(impairments)
+    fields = _impairment_fields(imp)
+    if mode == "channel" and not imp.ideal and runs:
+        raise ValueError(
+            "mode: the channel Monte-Carlo route synthesises the ideal channel; use mode='bound' "
+            "for a Monte-Carlo under impairments"
         )
-        if runs:
-            mc = javelin_rmse(
-                setup,
-                spec,
-                runs,
-                seed,
-                workers=workers,
-                scheduler=scheduler,
-                progress=progress,
-                n_epochs=n_epochs,
-                crlb=crlb,
-                timeout=timeout,
-            )
-            row.rmse_m, row.rmse_ci95_m, row.sigmas = mc["rmse_m"], mc["ci95_m"], mc["sigmas"]
-            row.rmse_settled_m = mc["rmse_settled_m"]
-            row.rmse_settled_ci95_m = mc["settled_ci95_m"]
-            row.peb_rms_settled_m = mc["peb_rms_settled_m"]
-            row.median_settled_m = mc["median_settled_m"]
-        rows.append(row)
+    T = len(setup.trajectory)
+    epochs = None if n_epochs is None or n_epochs >= T else np.arange(n_epochs)
+    rows = [_bound_row(setup, s, imp, criterion, target, share, eps_phi, epochs) for s in specs]
+    warnings = [f"{r.array}: {r.reason}" for r in rows if r.status == "error"]
+    todo = [s for s, r in zip(specs, rows) if r.status == "bound only"]
+    hopeless = [r.array for r in rows if r.status == "hopeless"]
+    if runs and hopeless:
+        warnings.append(
+            f"{', '.join(hopeless)}: the achievable bound already misses {target:g} m on "
+            f"{100 * share:g} % of the route; Monte-Carlo skipped"
+        )
+    if runs and todo:
+        kw = {
+            "mode": mode,
+            "error_models": _error_models(imp, mode),
+            "workers": workers,
+            "scheduler": scheduler,
+            "timeout": timeout,
+            "progress": progress,
+            "n_epochs": n_epochs,
+        }
+        results, failed = _run_montecarlo(setup, todo, runs, seed, kw)
+        for r in rows:
+            if r.array in failed:
+                r.status, r.reason = "error", failed[r.array]
+                warnings.append(f"{r.array}: {r.reason}")
+            elif r.array in results:
+                _score(r, results[r.array], criterion, target, share, seed, n_boot)
+    if runs == 0:
+        warnings.append(
+            "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a necessary "
+            "condition, not an answer"
+        )
+    elif runs == 1:
+        warnings.append(
+            "runs 1: one drive gives no confidence interval; every verdict is undecided "
+            f"(use --runs {2 * MIN_RUNS_CI})"
+        )
+    elif runs < MIN_RUNS_CI:
+        warnings.append(
+            f"runs {runs}: too few for a 95 % interval to decide (at least {MIN_RUNS_CI}); the "
+            "intervals are shown, every verdict is undecided"
+        )
+    straddle = [r.array for r in rows if r.status == "undecided" and r.runs >= MIN_RUNS_CI]
+    if straddle:
+        warnings.append(f"{', '.join(straddle)}: the 95 % interval straddles the target; add runs")
+    if criterion == "srnf" and runs:
+        warnings.append(
+            "criterion srnf: the Monte-Carlo tracker models the VUE curvature; the SR-NF gate "
+            "stands for an eq. 51 estimator"
+        )
     settings = {
+        "scenario": setup.name,
+        "arrays": [s.label for s in specs],
+        "spacing_wl": [s.spacing_wl for s in specs],
         "fc": setup.fc,
         "bandwidth": float(setup.config.bandwidth),
         "target": target,
         "share": share,
+        "criterion": criterion,
+        "impairments": fields,
         "eps_phi": eps_phi,
         "runs": runs,
         "seed": seed,
+        "mode": mode,
+        "n_epochs": n_epochs,
+        "n_boot": n_boot,
+        "min_runs_ci": MIN_RUNS_CI,
+        "workers": workers,
+        "scheduler": scheduler,
+        "timeout_s": timeout,
     }
-    return DesignReport(setup.name, rows, recommend(rows, target, share), settings)
+    rec = recommend([r for r in rows if r.status != "error"], target, share, runs)
+    return DesignReport(setup.name, rows, rec, settings, warnings)

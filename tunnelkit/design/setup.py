@@ -212,8 +212,9 @@ class DesignSetup:
         )
 
     def arrays(self, spec) -> list[ArrayGeometry]:
-        """``spec`` placed, centred, on every mount; ``ValueError`` naming ``arrays`` if an
-        element falls outside the tunnel (the array is wider than the cross-section there)."""
+        """``spec`` placed, centred, on every mount; refused (``ValueError`` naming ``arrays``,
+        the array, the mount and how many elements lie outside) if any element falls outside
+        the tunnel's exact cross-section at its mount (facets included)."""
         spec = parse_array(spec)
         loc = spec.local(self.fc)
         out = []
@@ -223,10 +224,11 @@ class DesignSetup:
             inside = self.tunnel.contains(origin + loc @ rot.T, margin=0.0)
             if not np.all(inside):
                 raise ValueError(
-                    f"arrays: the {spec.label} array ({spec.aperture(self.fc):.3f} m aperture at "
-                    f"{self.fc / 1e9:g} GHz) centred at {m.centre.round(3).tolist()} does not fit "
-                    f"inside the tunnel cross-section ({int((~inside).sum())} of {spec.n_elements} "
-                    "elements outside); choose a smaller array or move the mount"
+                    f"arrays: the {spec.label} array ({spec.aperture(self.fc):.3f} m diagonal at "
+                    f"{self.fc / 1e9:g} GHz) on mount {m.name!r}, centred at "
+                    f"{m.centre.round(3).tolist()}, does not fit inside the tunnel cross-section: "
+                    f"{int((~inside).sum())} of {spec.n_elements} elements outside; choose a "
+                    "smaller array or move the mount"
                 )
             out.append(
                 _placed(spec, self.fc, tuple(origin.tolist()), m.azimuth, m.elevation, m.name)

@@ -1,0 +1,334 @@
+"""The design's decision: criterion, error quantile, bootstrap interval, verdict, recommendation
+(plain arrays), and the sweep wired to a Monte-Carlo of the documented shape."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from tunnelkit import design
+from tunnelkit.design import report as rep_mod
+from tunnelkit.design import verdict as v
+
+
+def _brute_quantile(values, share):
+    """The smallest observed value x_(k) with k = ceil(share (n - 1)) (0-based, sorted)."""
+    x = sorted(np.where(np.isfinite(values), values, np.inf).ravel())
+    return x[int(np.ceil(share * (len(x) - 1)))]
+
+
+@pytest.mark.parametrize("share", [0.5, 0.9, 0.95, 1.0])
+def test_share_quantile_matches_order_statistic(share):
+    rng = np.random.default_rng(1)
+    e = rng.exponential(0.05, size=(7, 33))
+    e[2, 5] = np.nan  # a missing estimate counts as a failure
+    assert v.share_quantile(e, share) == _brute_quantile(e, share)
+    # the share of pooled values at or below the quantile is at least `share`
+    q = v.share_quantile(e, share)
+    assert np.mean(np.where(np.isfinite(e), e, np.inf) <= q) >= share
+
+
+def test_bootstrap_interval_matches_a_loop_and_brackets_the_estimate():
+    rng = np.random.default_rng(2)
+    e = rng.exponential(0.05, size=(12, 40)) * rng.uniform(0.5, 2.0, size=(12, 1))
+    ci = v.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(7), n_boot=300)
+    # the same resamples by hand
+    draws = np.random.default_rng(7).integers(0, 12, size=(300, 12))
+    qs = [_brute_quantile(e[d], 0.9) for d in draws]
+    assert ci == pytest.approx(list(np.quantile(qs, [0.025, 0.975])))
+    assert ci[0] <= v.share_quantile(e, 0.9) <= ci[1]
+    # reproducible from the Generator, and narrower with more runs of the same law
+    assert ci == v.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(7), n_boot=300)
+    wide = v.bootstrap_quantile_ci(e[:3], 0.9, np.random.default_rng(7), n_boot=300)
+    big = rng.exponential(0.05, size=(120, 40)) * rng.uniform(0.5, 2.0, size=(120, 1))
+    narrow = v.bootstrap_quantile_ci(big, 0.9, np.random.default_rng(7), n_boot=300)
+    assert narrow[1] - narrow[0] < wide[1] - wide[0]
+
+
+def test_bootstrap_interval_covers_the_true_quantile():
+    """Coverage of the run-bootstrap over 150 repetitions: about 95 % (at least 85 %)."""
+    share, runs, T = 0.9, 15, 30
+    true_q = -np.log(1 - share)  # unit exponential, pooled over runs and epochs
+    hit = 0
+    for k in range(150):
+        e = np.random.default_rng(100 + k).exponential(1.0, size=(runs, T))
+        lo, hi = v.bootstrap_quantile_ci(e, share, np.random.default_rng(k), n_boot=200)
+        hit += lo <= true_q <= hi
+    assert hit / 150 >= 0.85
+
+
+def test_bootstrap_with_failures_and_one_run():
+    e = np.full((4, 10), 0.01)
+    e[:, :2] = np.inf  # 20 % of every drive lost: the 0.9-quantile is infinite
+    assert v.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(0), n_boot=100) == [
+        np.inf,
+        np.inf,
+    ]
+    one = np.array([[0.01, 0.02, 0.03]])
+    lo, hi = v.bootstrap_quantile_ci(one, 0.5, np.random.default_rng(0), n_boot=100)
+    assert lo == hi == 0.02  # one run: degenerate, never decides (judge below)
+    with pytest.raises(ValueError, match="errors"):
+        v.bootstrap_quantile_ci(np.zeros(3), 0.9, np.random.default_rng(0))
+    with pytest.raises(ValueError, match="errors"):
+        v.bootstrap_quantile_ci(-np.ones((2, 2)), 0.9, np.random.default_rng(0))
+    with pytest.raises(TypeError, match="rng"):
+        v.bootstrap_quantile_ci(one, 0.9, 3)
+
+
+def test_gate_applies_the_criterion():
+    x = np.array([[0.1, 0.2, 0.3]])
+    ok = np.array([True, False, True])
+    assert np.array_equal(v.gate(x, ok, "achievable"), x)
+    assert np.array_equal(v.gate(x, ok, "srnf"), [[0.1, np.inf, 0.3]])
+    with pytest.raises(ValueError, match="criterion"):
+        v.gate(x, ok, "eq51")
+    with pytest.raises(ValueError, match="srnf_valid"):
+        v.gate(x, ok[:2], "srnf")
+
+
+@pytest.mark.parametrize(
+    ("kw", "status"),
+    [
+        ({"bound_q": 0.2}, "hopeless"),
+        ({"bound_q": np.inf}, "hopeless"),
+        ({"bound_q": 0.05}, "bound only"),
+        ({"bound_q": 0.05, "runs": 20, "error_q": 0.05, "ci": [0.04, 0.09]}, "met"),
+        ({"bound_q": 0.05, "runs": 20, "error_q": 0.12, "ci": [0.10, 0.15]}, "not met"),
+        ({"bound_q": 0.05, "runs": 20, "error_q": 0.09, "ci": [0.07, 0.12]}, "undecided"),
+        # too few runs: even a narrow interval below the target does not decide
+        ({"bound_q": 0.05, "runs": 2, "error_q": 0.01, "ci": [0.01, 0.02]}, "undecided"),
+        ({"bound_q": 0.05, "runs": 1, "error_q": 0.01, "ci": [0.01, 0.01]}, "undecided"),
+    ],
+)
+def test_judge(kw, status):
+    got, reason = v.judge(0.1, **kw)
+    assert got == status and reason
+    if status == "hopeless":
+        assert "Monte-Carlo skipped" in reason
+    if kw.get("runs", 0) and kw["runs"] < v.MIN_RUNS_CI:
+        assert "too few" in reason
+
+
+def _row(array, n, status, reason="r"):
+    return SimpleNamespace(
+        array=array, n_elements=n, aperture_diagonal_m=0.01 * n, status=status, reason=reason
+    )
+
+
+def test_recommend():
+    rows = [_row("16x16", 256, "met"), _row("4x4", 16, "undecided"), _row("8x8", 64, "met")]
+    r = v.recommend(rows, 0.1, 0.9, runs=20)
+    assert r["array"] == "8x8" and r["basis"] == "monte-carlo"
+    assert "4x4 undecided" in r["reason"]
+    r = v.recommend([_row("4x4", 16, "not met"), _row("8x8", 64, "hopeless")], 0.1, 0.9, 20)
+    assert r["array"] is None
+    r = v.recommend([_row("4x4", 16, "undecided")], 0.1, 0.9, 2)
+    assert r["array"] is None and "add runs" in r["reason"]
+    r = v.recommend([_row("8x8", 64, "bound only"), _row("4x4", 16, "hopeless")], 0.1, 0.9, 0)
+    assert r["array"] == "8x8" and r["basis"] == "bounds"
+    assert "necessary condition, not an answer" in r["reason"]
+
+
+# --- the sweep with a Monte-Carlo of the documented shape -------------------------------------
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return design.DesignSetup.from_scenario("example-rectangular-28ghz")
+
+
+def _fake_montecarlo(levels, calls, fail=()):
+    """A stand-in of ``sweep_montecarlo`` returning, per array, errors (runs, T) drawn around
+    ``levels[label]`` (a seeded Generator), recording which arrays it was asked for."""
+
+    def run(setup, specs, runs, seed, **kw):
+        calls.append(([s.label for s in specs], runs, kw["mode"]))
+        out = {}
+        for s in specs:
+            if s.label in fail:
+                raise ValueError(f"crlb: 'd' must be finite and > 0, got nan ({s.label})")
+            T = len(setup.trajectory) if kw["n_epochs"] is None else kw["n_epochs"]
+            t = setup.trajectory.t[:T]
+            rng = np.random.default_rng([seed, s.n_elements])
+            e = levels[s.label] * rng.uniform(0.2, 1.0, size=(runs, T))
+            out[s.label] = SimpleNamespace(t=t, x=setup.trajectory.position[:T, 0], errors=e)
+        return out
+
+    return run
+
+
+def test_sweep_recommends_from_the_monte_carlo(setup, monkeypatch):
+    calls = []
+    levels = {"2x2": 0.5, "4x4": 0.3, "8x8": 0.05}
+    monkeypatch.setattr(rep_mod, "_sweep_montecarlo", _fake_montecarlo(levels, calls))
+    rep = design.design_sweep(setup, ["8x8", "2x2", "4x4"], target=0.1, runs=12, seed=3)
+    # one task set for every array the bound leaves in play (2x2's misses 10 cm: hopeless)
+    assert calls == [(["8x8", "4x4"], 12, "bound")]
+    by = {r.array: r for r in rep.rows}
+    assert by["2x2"].status == "hopeless" and by["2x2"].error_p90_m is None
+    assert by["8x8"].status == "met" and by["4x4"].status == "not met"
+    assert rep.recommendation["array"] == "8x8"
+    r = by["8x8"]
+    k = design.counted_epochs(setup.trajectory.t)
+    e = 0.05 * np.random.default_rng([3, 64]).uniform(0.2, 1.0, size=(12, len(setup.trajectory)))
+    assert r.error_p90_m == design.share_quantile(e[:, k], 0.9)
+    assert r.error_p90_ci95_m[0] <= r.error_p90_m <= r.error_p90_ci95_m[1] < 0.1
+    assert r.rmse_m == pytest.approx(np.sqrt(np.mean(e[:, k] ** 2)))
+    j = rep.to_json()
+    assert j["criterion"] == "achievable" and j["inputs"]["seed"] == 3
+    assert len(j["arrays"][0]["per_epoch"]["error_median_m"]) == len(setup.trajectory)
+    # the interval is seeded: the same sweep gives the same JSON
+    again = design.design_sweep(setup, ["8x8", "2x2", "4x4"], target=0.1, runs=12, seed=3)
+    assert again.to_json() == j
+
+
+def test_sweep_skips_hopeless_and_isolates_a_failing_array(setup, monkeypatch):
+    calls = []
+    levels = {"4x4": 0.01, "8x8": 0.001, "16x16": 0.001}
+    fake = _fake_montecarlo(levels, calls, fail=("8x8",))
+    monkeypatch.setattr(rep_mod, "_sweep_montecarlo", fake)
+    rep = design.design_sweep(setup, ["4x4", "8x8", "16x16"], target=0.01, runs=10)
+    by = {r.array: r for r in rep.rows}
+    # 4x4's bound misses 1 cm on 90 % of the route: hopeless, never simulated
+    assert by["4x4"].status == "hopeless" and by["4x4"].runs == 0
+    assert all("4x4" not in labels for labels, *_ in calls)
+    assert by["8x8"].status == "error" and "crlb" in by["8x8"].reason
+    assert by["16x16"].status == "met" and rep.recommendation["array"] == "16x16"
+    assert any("Monte-Carlo skipped" in w for w in rep.warnings)
+    assert any(w.startswith("8x8: Monte-Carlo failed") for w in rep.warnings)
+
+
+def test_few_runs_warn_and_never_decide(setup, monkeypatch):
+    calls = []
+    monkeypatch.setattr(rep_mod, "_sweep_montecarlo", _fake_montecarlo({"8x8": 0.01}, calls))
+    for runs in (1, 2):
+        rep = design.design_sweep(setup, ["8x8"], target=0.1, runs=runs)
+        assert rep.rows[0].status == "undecided" and rep.recommendation["array"] is None
+        assert any(f"runs {runs}" in w for w in rep.warnings)
+
+
+def test_srnf_criterion_gates_and_achievable_informs(setup):
+    ach = design.design_sweep(setup, ["4x4", "8x8"], target=0.2)
+    srnf = design.design_sweep(setup, ["4x4", "8x8"], target=0.2, criterion="srnf")
+    a, s = {r.array: r for r in ach.rows}, {r.array: r for r in srnf.rows}
+    # SR-NF never holds for 8x8 under the ceiling: a gate fails it, information does not
+    assert a["8x8"].srnf_valid_share == 0.0 and a["8x8"].srnf_valid_share_by_surface["ceiling"] == 0
+    assert a["8x8"].status == "bound only" and s["8x8"].status == "hopeless"
+    assert ach.to_json()["criterion"] == "achievable" and srnf.criterion == "srnf"
+    assert "criterion: srnf" in srnf.to_table()
+    assert ach.recommendation["basis"] == "bounds"
+    assert "necessary condition" in ach.recommendation["reason"]
+
+
+def test_an_undefined_bound_is_reported_per_array(setup, monkeypatch):
+    real = rep_mod._achievable_bound
+
+    def nan_for_2x2(setup, spec, impairments, geometry):
+        x, peb, ach = real(setup, spec, impairments, geometry)
+        return (x, np.full_like(peb, np.nan), ach) if spec.label == "2x2" else (x, peb, ach)
+
+    monkeypatch.setattr(rep_mod, "_achievable_bound", nan_for_2x2)
+    rep = design.design_sweep(setup, ["2x2", "200x200", "4x4"])
+    by = {r.array: r for r in rep.rows}
+    assert by["2x2"].status == "error" and "undefined" in by["2x2"].reason
+    assert by["200x200"].status == "error"
+    assert "200x200 array" in by["200x200"].reason and "elements outside" in by["200x200"].reason
+    assert by["4x4"].status == "bound only" and rep.recommendation["array"] == "4x4"
+    j = rep.to_json()["arrays"][0]
+    assert j["status"] == "error" and j["peb_median_m"] is None
+
+
+def test_sweep_bad_input(setup):
+    with pytest.raises(ValueError, match="criterion"):
+        design.design_sweep(setup, ["4x4"], criterion="eq51")
+    with pytest.raises(ValueError, match="mode"):
+        design.design_sweep(setup, ["4x4"], mode="fast")
+    with pytest.raises(ValueError, match="runs"):
+        design.design_sweep(setup, ["4x4"], runs=-1)
+    with pytest.raises(ValueError, match="share"):
+        design.design_sweep(setup, ["4x4"], share=0.0)
+    with pytest.raises(ValueError, match="arrays"):
+        design.design_sweep(setup, [])
+
+
+# --- placement: every element inside the cross-section ----------------------------------------
+
+
+def test_presets_hang_their_arrays_inside_the_tunnel():
+    """Every 3-D preset's arrays lie inside the exact cross-section (facets included); the
+    paper's 10 x 10 with at least 1 cm to spare."""
+    import tunnelkit as tk
+    from tunnelkit import propagation
+
+    checked = 0
+    for name in tk.scenarios.list_scenarios():
+        sc = tk.load_scenario(name)
+        if "tunnel" not in sc.sections or "arrays" not in sc.sections.get("base_station", {}):
+            continue
+        tun = sc.tunnel()
+        if not isinstance(tun, propagation.Tunnel3D):
+            continue
+        checked += 1
+        for a in propagation.scenario_arrays(sc):
+            assert np.all(tun.contains(a.world, margin=0.0)), (name, a.name)
+            if name.startswith("italiano2026"):
+                assert np.all(tun.contains(a.world, margin=0.01)), (name, a.name)
+    assert checked >= 3
+
+
+def test_the_design_refuses_an_array_poking_through_the_ceiling():
+    """The paper's 10 x 10 centred 4.95 m high: some elements above the facets, counted."""
+    from tunnelkit.arrays import rotation
+
+    high = design.DesignSetup.from_scenario("italiano2026-straight", mount_height=4.95)
+    spec = design.parse_array("10x10")
+    m = high.mounts[0]
+    loc = spec.local(high.fc)
+    world = m.centre + (loc - loc.mean(axis=0)) @ rotation(m.azimuth, m.elevation).T
+    n_out = int((~high.tunnel.contains(world, margin=0.0)).sum())
+    assert n_out > 0
+    with pytest.raises(
+        ValueError, match=rf"^arrays: the 10x10 array .* mount '-x'.*: {n_out} of 100"
+    ):
+        high.arrays(spec)
+    # the same sweep reports it per array and goes on
+    rep = design.design_sweep(high, ["10x10", "2x2"])
+    assert rep.rows[0].status == "error" and f"{n_out} of 100" in rep.rows[0].reason
+    assert rep.rows[1].status != "error"
+
+
+def test_over_target_names_the_failing_stretches():
+    x = np.array([45.0, 43.6, 42.2, 40.8, 39.4, 38.0])
+    y = np.array([0.3, 0.2, 0.05, np.nan, 0.01, 0.5])
+    assert design.over_target(x, y, 0.1) == "45.0..43.6 m, 40.8 m, 38.0 m"
+    assert design.over_target(x, np.zeros(6), 0.1) == ""
+
+
+def test_sweep_carries_the_impairments_into_bound_and_monte_carlo(setup):
+    kw = {"target": 10.0, "runs": 2, "n_epochs": 12, "seed": 1}
+    imp = design.design_sweep(setup, ["4x4"], impairments={"phase_error_deg": 2.0}, **kw)
+    ideal = design.design_sweep(setup, ["4x4"], **kw)
+    r, r0 = imp.rows[0], ideal.rows[0]
+    assert np.array_equal(r.peb_m, r0.peb_m) and np.array_equal(r0.achievable_m, r0.peb_m)
+    assert np.all(r.achievable_m >= r.peb_m) and np.median(r.achievable_m / r.peb_m) > 1.5
+    assert r.runs == r0.runs == 2 and r.error_p90_m != r0.error_p90_m
+    assert imp.to_json()["inputs"]["impairments"]["phase_error_deg"] == 2.0
+    assert "phase 2 deg" in imp.to_table()
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [
+        ({"impairments": {"phase_error_deg": -1.0}}, "phase_error_deg"),
+        ({"impairments": {"gain_error_db": float("nan")}}, "gain_error_db"),
+        ({"impairments": {"dmc_share": 1.0}}, "dmc_share"),
+        ({"impairments": {"dmc_share": -0.1}}, "dmc_share"),
+        ({"impairments": 3}, "impairments"),
+        ({"impairments": {"phase_error_deg": 1.0}, "mode": "channel", "runs": 2}, "mode"),
+    ],
+)
+def test_bad_impairments_name_the_field(setup, kw, match):
+    with pytest.raises((ValueError, TypeError), match=match):
+        design.design_sweep(setup, ["4x4"], **kw)

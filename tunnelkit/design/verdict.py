@@ -1,0 +1,209 @@
+"""Deciding a candidate array from what the system achieves: the criterion, the error quantile
+with its bootstrap interval, the verdict per array and the recommendation.
+
+Everything here works on plain arrays, so it is the same whether the errors come from the
+bound-driven or the channel Monte-Carlo.
+
+* **Counted epochs**: the settled epochs of the drive (:func:`tunnelkit.metrics.settled`, the
+  first :data:`~tunnelkit.metrics.SETTLE_S` left out: the tracker's start-up from a coarse fix
+  is not the array's accuracy); the whole route if it is shorter than that.
+* **The criterion** says which epochs can count as met. ``"achievable"`` (the design's
+  tracker, which models a reflection's wavefront on its virtual UE) scores every counted epoch;
+  SR-NF validity is reported as information. ``"srnf"`` (a route that uses eq. 51, the
+  wavefront centred on the reflection point) also requires SR-NF validity: an epoch where a
+  used path breaks it counts as an infinite error (:func:`gate`).
+* **The error quantile** (:func:`share_quantile`): the ``share``-quantile (``method="higher"``,
+  an observed value) of the per-epoch 2-D error, pooled over runs and over the counted epochs.
+  A non-finite error (no estimate) counts as infinite. This is the ``*_p90_m`` of the report at
+  the default ``share = 0.9``.
+* **Its 95 % interval** (:func:`bootstrap_quantile_ci`): percentile bootstrap over runs (whole
+  drives resampled with replacement, an explicit :class:`numpy.random.Generator`), since the
+  epochs of one drive are correlated.
+* **The verdict** (:func:`judge`): ``"hopeless"`` when the achievable bound's quantile already
+  misses the target (its Monte-Carlo is skipped); ``"bound only"`` with no Monte-Carlo;
+  ``"met"`` only when the interval's upper end is below the target; ``"not met"`` when its lower
+  end is at or above it; ``"undecided"`` when it straddles the target or when fewer than
+  :data:`MIN_RUNS_CI` runs stand behind it (a 2-run interval is not an answer).
+* **The recommendation** (:func:`recommend`): the smallest candidate (fewest elements, then
+  aperture) that is met; with bounds only, the smallest that passes the pre-screen, said to be
+  a necessary condition, not an answer.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import finite_array, integer, positive, probability, rng_or_error
+
+__all__ = [
+    "CRITERIA",
+    "MIN_RUNS_CI",
+    "STATUSES",
+    "bootstrap_quantile_ci",
+    "counted_epochs",
+    "gate",
+    "judge",
+    "recommend",
+    "share_quantile",
+]
+
+#: the pass/fail criteria: the design's VUE-curvature tracker, or a route using eq. 51
+CRITERIA = ("achievable", "srnf")
+#: fewer runs than this: the interval is reported but never decides (a warning says so)
+MIN_RUNS_CI = 10
+#: verdicts of :func:`judge`, and ``"error"`` for a candidate that could not be evaluated
+STATUSES = ("met", "undecided", "not met", "hopeless", "bound only", "error")
+
+
+def counted_epochs(t) -> np.ndarray:
+    """Indices of the epochs that count: the settled ones of ``t`` [s], all if none settle."""
+    from ..metrics import settled
+
+    t = finite_array("t", t, ndim=1)
+    idx = settled(t)
+    return idx if idx.size else np.arange(t.size)
+
+
+def gate(values, srnf_valid, criterion: str) -> np.ndarray:
+    """``values`` (..., T) with the criterion applied: for ``"srnf"`` an epoch where SR-NF does
+    not hold (``srnf_valid`` (T,) False) becomes ``inf``; ``"achievable"`` leaves them."""
+    if criterion not in CRITERIA:
+        raise ValueError(f"criterion: expected one of {CRITERIA}, got {criterion!r}")
+    v = np.asarray(values, float)
+    ok = np.asarray(srnf_valid, bool)
+    if ok.shape != v.shape[-1:]:
+        raise ValueError(f"srnf_valid: expected shape {v.shape[-1:]}, got {ok.shape}")
+    return v if criterion == "achievable" else np.where(ok, v, np.inf)
+
+
+def share_quantile(values, share: float) -> float:
+    """The ``share``-quantile of ``values`` (any shape, pooled), non-finite counted as ``inf``;
+    ``method="higher"``: an observed value, so ``inf`` once more than ``1 - share`` fail."""
+    share = probability("share", share, open_interval=False)
+    v = np.asarray(values, float).ravel()
+    if not v.size:
+        raise ValueError("values: expected at least one value")
+    if np.any(v < 0):
+        raise ValueError("values: errors and bounds are not negative")
+    v = np.where(np.isfinite(v), v, np.inf)
+    return float(np.quantile(v, share, method="higher"))
+
+
+def bootstrap_quantile_ci(
+    errors, share: float, rng: np.random.Generator, *, n_boot: int = 2000, level: float = 0.95
+) -> list[float]:
+    """Percentile-bootstrap ``level`` interval of :func:`share_quantile` of ``errors``
+    (runs, T): runs resampled with replacement (``n_boot`` resamples from ``rng``), the pooled
+    quantile of each resample, and the ``(1 -+ level) / 2`` quantiles of those. One run gives
+    the degenerate interval ``[q, q]`` (callers warn; :func:`judge` never decides on it)."""
+    rng = rng_or_error("rng", rng)
+    share = probability("share", share, open_interval=False)
+    level = probability("level", level)
+    n_boot = integer("n_boot", n_boot, minimum=1)
+    e = np.asarray(errors, float)
+    if e.ndim != 2 or not e.size:
+        raise ValueError(f"errors: expected (runs, T) with runs, T >= 1, got shape {e.shape}")
+    if np.any(e < 0):
+        raise ValueError("errors: a position error is not negative")
+    e = np.where(np.isfinite(e), e, np.inf)
+    runs, T = e.shape
+    draws = rng.integers(0, runs, size=(n_boot, runs))
+    qs = np.empty(n_boot)
+    step = max(1, 2_000_000 // (runs * T))  # bounded memory per chunk
+    for i in range(0, n_boot, step):
+        block = e[draws[i : i + step]].reshape(-1, runs * T)
+        qs[i : i + step] = np.quantile(block, share, axis=1, method="higher")
+    p = [(1 - level) / 2, (1 + level) / 2]
+    if np.all(np.isfinite(qs)):
+        lo, hi = np.quantile(qs, p, method="linear")
+    else:  # inf - inf has no interpolation: the bracketing order statistics
+        lo, hi = np.quantile(qs, p[0], method="lower"), np.quantile(qs, p[1], method="higher")
+    return [float(lo), float(hi)]
+
+
+def judge(
+    target: float,
+    bound_q: float,
+    *,
+    runs: int = 0,
+    error_q: float | None = None,
+    ci: list | None = None,
+    share: float = 0.9,
+) -> tuple[str, str]:
+    """``(status, reason)`` of one candidate (module docstring): ``bound_q`` the achievable
+    bound's quantile over the counted epochs, ``error_q`` and ``ci`` the Monte-Carlo error's
+    quantile and interval from ``runs`` drives (``runs = 0``: none)."""
+    target = positive("target", target)
+    runs = integer("runs", runs, minimum=0)
+    pct = f"{100 * share:g} %"
+    if not bound_q <= target:
+        return "hopeless", (
+            f"the achievable bound already misses the target on {pct} of the route "
+            f"({_m(bound_q)} > {target:g} m): Monte-Carlo skipped"
+        )
+    if runs == 0:
+        return "bound only", (
+            f"achievable bound {_m(bound_q)} <= {target:g} m on {pct} of the route: a necessary "
+            "condition only (no Monte-Carlo)"
+        )
+    if error_q is None or ci is None:
+        raise ValueError("error_q: give the Monte-Carlo quantile and its interval when runs > 0")
+    lo, hi = ci
+    head = f"error on {pct} of the settled route {_m(error_q)}, 95 % CI [{_m(lo)}, {_m(hi)}]"
+    if runs < MIN_RUNS_CI:
+        return "undecided", (
+            f"{head} from {runs} run{'s' * (runs != 1)}: too few for the interval to decide "
+            f"(use >= {MIN_RUNS_CI})"
+        )
+    if hi < target:
+        return "met", f"{head} below {target:g} m"
+    if lo >= target:
+        return "not met", f"{head} at or above {target:g} m"
+    return "undecided", f"{head} straddles {target:g} m: add runs"
+
+
+def recommend(rows, target: float, share: float, runs: int) -> dict:
+    """The recommendation from candidates with ``.array``, ``.n_elements``,
+    ``.aperture_diagonal_m``, ``.status``, ``.reason``: ``{array, reason, basis}``; ``basis``
+    is ``"monte-carlo"`` or ``"bounds"`` (no runs: a necessary condition, not an answer)."""
+    pct = f"{100 * share:g} %"
+    order = sorted(rows, key=lambda r: (r.n_elements, r.aperture_diagonal_m))
+    if runs == 0:
+        ok = [r for r in order if r.status == "bound only"]
+        if ok:
+            return {
+                "array": ok[0].array,
+                "basis": "bounds",
+                "reason": (
+                    f"rests on bounds only: {ok[0].array} is the smallest candidate whose "
+                    f"achievable bound meets {target:g} m on {pct} of the route, a necessary "
+                    "condition, not an answer; run the Monte-Carlo (--runs 20) to decide"
+                ),
+            }
+        return {
+            "array": None,
+            "basis": "bounds",
+            "reason": f"no candidate's achievable bound meets {target:g} m on {pct} of the route",
+        }
+    met = [r for r in order if r.status == "met"]
+    smaller_open = [
+        r.array
+        for r in order
+        if r.status == "undecided" and (not met or r.n_elements < met[0].n_elements)
+    ]
+    if met:
+        best = met[0]
+        why = f"smallest candidate met: {best.reason}"
+        if smaller_open:
+            why += f"; smaller {', '.join(smaller_open)} undecided (add runs)"
+        return {"array": best.array, "basis": "monte-carlo", "reason": why}
+    if smaller_open:
+        why = f"none met yet; undecided: {', '.join(smaller_open)} (add runs)"
+    else:
+        why = f"no candidate meets {target:g} m on {pct} of the settled route"
+    return {"array": None, "basis": "monte-carlo", "reason": why}
+
+
+def _m(v: float) -> str:
+    """A length for a sentence: ``inf`` or 3 significant digits in m."""
+    return "inf" if not np.isfinite(v) else f"{v:.3g} m"
