@@ -77,7 +77,7 @@ def drive_efficiency(
     rows = []
     for k, rng in it:
         arr, paths, err = _epoch_errors(route, k, rng.spawn(n), refines)
-        bound = path_crlb(paths, arr, route.config)
+        bound = path_crlb(paths, arr, route.config, snr_offset_db=route.snr_offset_db)
         rng_ue = float(np.linalg.norm(route.trajectory.position[k] - arr.origin))
         for refine in refines:
             for j, p in enumerate(paths):

@@ -296,7 +296,7 @@ def rmse_study(
                 )
             )
         missed += np.isin(np.arange(len(paths)), match, invert=True)
-    bound = path_crlb(paths, arr, cfg, spatial=spatial)
+    bound = path_crlb(paths, arr, cfg, spatial=spatial, snr_offset_db=route.snr_offset_db)
     rows = []
     for j, p in enumerate(paths):
         e = np.array(err[j]).reshape(-1, 4)
