@@ -83,36 +83,9 @@ def long_route(drive: str, snr_offset_db: float = 0.0) -> signal_route.SignalRou
 
 
 def _errors(est, d_true, v_true, src, bound) -> np.ndarray:
-    """(L_true, 4) errors over the bound (``d, v, direction, w``); ``inf`` for a missed path.
-
-    Estimates (those above the noise) are assigned to true paths by the Hungarian method on the
-    sum of squared normalised errors (clustered paths a centimetre and a degree apart cannot be
-    told apart by a metric in metres and radians); a pair beyond 1,000 sigma counts as missed."""
-    from scipy.optimize import linear_sum_assignment
-
-    rng_ = np.linalg.norm(src, axis=1)
-    u = src / rng_[:, None]
-    out = np.full((src.shape[0], 4), np.inf)
-    keep = np.flatnonzero(est.significance >= extraction.MIN_SIGNIFICANCE)
-    if not keep.size:
-        return out
-    w_est = 1.0 / np.asarray(est.kappa_nf, float)[keep]  # 1/inf = 0 at an exact far-field wave
-    cosang = np.clip(est.direction[keep] @ u.T, -1.0, 1.0)
-    e = np.stack(
-        [
-            (est.d[keep][:, None] - d_true[None]) / bound["d"][None],
-            (est.v[keep][:, None] - v_true[None]) / bound["v"][None],
-            np.arccos(cosang) / bound["direction"][None],
-            (w_est[:, None] - 1.0 / rng_[None]) / (bound["kappa"] / rng_**2)[None],
-        ],
-        axis=-1,
-    )  # (K, L, 4)
-    cost = np.sum(np.minimum(e**2, 1e12), axis=-1)
-    r, c = linear_sum_assignment(cost)
-    for i, j in zip(r, c):
-        if cost[i, j] < 1e6:
-            out[j] = e[i, j]
-    return out
+    """(L_true, 4) errors over the bound, ``d, v, direction, w``; ``inf`` for a missed path
+    (:func:`tunnelkit.evaluation.bound_errors`)."""
+    return evaluation.bound_errors(est, d_true, v_true, src, bound)
 
 
 def _drive_snapshot(drive, band, off, rng, search):

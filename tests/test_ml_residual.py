@@ -214,3 +214,58 @@ def test_the_drive_adapter_drops_a_flagged_epoch():
     flagged = replace(ep, estimates=replace(ep.estimates, fit_ok=False))
     pm, why = studies.path_measurements(flagged, route)
     assert pm is None and why == studies.drives.FLAGGED
+
+
+def test_mie_threshold_is_where_a_noise_cell_beats_the_path_half_the_time():
+    """Brute force: K unit exponentials (noise cells) against the path's cell |sqrt(eta) + n|^2
+    (n ~ CN(0, 1)) at eta = the threshold: the path loses about half the time."""
+    from tunnelkit import efficiency
+
+    K = 300
+    eta = 10 ** (efficiency.mie_threshold_db(K) / 10)
+    assert eta == pytest.approx(np.log(2 * K))
+    rng = np.random.default_rng(0)
+    n = (rng.standard_normal(4000) + 1j * rng.standard_normal(4000)) / np.sqrt(2)
+    path = np.abs(np.sqrt(eta) + n) ** 2
+    noise = rng.exponential(size=(4000, K)).max(axis=1)
+    assert 0.2 < np.mean(noise > path) < 0.6
+    with pytest.raises(ValueError, match="n_cells"):
+        efficiency.mie_threshold_db(0)
+
+
+def test_bound_errors_assign_clustered_paths_by_the_bound():
+    sc = _scene(9, n_paths=2, snr_db=(5.0, 10.0))
+    est = extraction.extract_paths(
+        sc.tensor(np.random.default_rng(4)), 2, sc.element_positions, sc.config
+    )
+    b = sc.crlb()
+    e = evaluation.bound_errors(est, sc.d, sc.v, sc.sources, b)
+    assert e.shape == (2, 4) and np.all(np.abs(e) < 5.0)
+    # the truth moved by exactly 2 sigma in d: the error column reads -2 more
+    e2 = evaluation.bound_errors(est, sc.d + 2 * b["d"], sc.v, sc.sources, b)
+    np.testing.assert_allclose(e2[:, 0], e[:, 0] - 2.0, atol=1e-9)
+    none = replace(est, significance=np.zeros(2))
+    assert np.all(np.isinf(evaluation.bound_errors(none, sc.d, sc.v, sc.sources, b)))
+
+
+def test_threshold_study_finds_the_bound_above_and_flags_below():
+    from tunnelkit import efficiency
+
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    cfg = replace(route.config, n_rb=10, comb=4)
+    los = signal_route.SignalRoute(
+        route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los",)
+    )
+    arr, paths = los.paths(12)
+    N = arr.M * cfg.n_tones * cfg.n_symbols
+    eta0 = 10 * np.log10(abs(paths[0].gain) ** 2 * cfg.tx_power * N / cfg.noise_power)
+    th = efficiency.mie_threshold_db(N)
+    rows = efficiency.threshold_study(los, [12], [th + 20 - eta0, th - 8 - eta0], 3, seed=1)
+    hi, lo = rows
+    assert hi["integrated SNR [dB]"] == pytest.approx(th + 20)
+    assert hi["beyond 6 sigma"] == 0.0 and hi["RMS/CRLB direction"] < 3.0 and hi["flagged"] == 0
+    assert lo["beyond 6 sigma"] == 1.0 and lo["flagged"] == 1.0
+    with pytest.raises(ValueError, match="snr_offsets_db"):
+        efficiency.threshold_study(los, [12], [np.nan], 1, seed=1)
+    with pytest.raises(ValueError, match="n_snapshots"):
+        efficiency.threshold_study(los, [12], [0.0], 0, seed=1)
