@@ -232,9 +232,43 @@ def cases() -> list[Case]:
     return out
 
 
+def cpu_times(repeat: int = 9) -> str:
+    """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction and of
+    the basic search (the route before issue 23: re-seeding on the residual energy only) on
+    bench_ml's L = 6 tensor and on two long-range tensors (UE at x = 110 m and 85 m)."""
+    from bench_ml import _tensor
+
+    tensors = {"L=6 (bench_ml)": _tensor()}
+    for x in (110.0, 85.0):
+        H, arr, cfg, L = _long_tensor(x=x)
+        tensors[f"L={L} x={x:.0f} m"] = (H, arr, cfg, L)
+    lines = [f"CPU time per extraction, median of {repeat} (one BLAS thread)"]
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name, (H, arr, cfg, L) in tensors.items():
+            t = {"residual": [], "basic": []}
+            extraction.extract_paths(H, L, arr, cfg)  # warm-up
+            for _ in range(repeat):
+                for search in t:
+                    t0 = time.process_time()
+                    est = extraction.extract_paths(H, L, arr, cfg, search=search)
+                    t[search].append(time.process_time() - t0)
+                    if search == "residual":
+                        ok = est.fit_ok
+                    else:
+                        ok_basic = est.fit_ok
+            med = {k: float(np.median(v)) for k, v in t.items()}
+            lines.append(
+                f"  {name:18s} default {med['residual'] * 1e3:6.0f} ms (fit_ok {ok}), basic "
+                f"{med['basic'] * 1e3:6.0f} ms (fit_ok {ok_basic}), ratio "
+                f"{med['residual'] / med['basic']:.2f}"
+            )
+    return "\n".join(lines)
+
+
 def report(n: int | None = None) -> str:
     n = n or int(os.environ.get("TUNNELKIT_BENCH_STRESS", 30))
-    parts = []
+    parts = [cpu_times()]
     for seed, tag in ((DESIGN_SEED, "design seed"), (HELD_OUT_SEED, "held-out seed")):
         t0 = time.perf_counter()
         with threadpool_limits(1):
@@ -252,7 +286,11 @@ if __name__ == "__main__":
     ap.add_argument("--seed", type=int, default=HELD_OUT_SEED)
     ap.add_argument("--search", default="residual", choices=("residual", "basic"))
     ap.add_argument("-k", dest="pattern", default=None, help="only cases containing this")
+    ap.add_argument("--cpu", action="store_true", help="only the CPU times of the extraction")
     a = ap.parse_args()
+    if a.cpu:
+        print(cpu_times())
+        sys.exit(0)
     sel = [c for c in CASES if a.pattern is None or a.pattern in c[0]]
     t0 = time.perf_counter()
     with threadpool_limits(1):
