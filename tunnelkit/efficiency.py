@@ -18,7 +18,7 @@ import numpy as np
 
 from ._validate import integer
 
-__all__ = ["drive_efficiency", "efficiency_rows"]
+__all__ = ["drive_efficiency", "efficiency_rows", "mie_threshold_db", "threshold_study"]
 
 
 def _epoch_errors(route, k, rngs, refines):
@@ -77,7 +77,7 @@ def drive_efficiency(
     rows = []
     for k, rng in it:
         arr, paths, err = _epoch_errors(route, k, rng.spawn(n), refines)
-        bound = path_crlb(paths, arr, route.config)
+        bound = path_crlb(paths, arr, route.config, snr_offset_db=route.snr_offset_db)
         rng_ue = float(np.linalg.norm(route.trajectory.position[k] - arr.origin))
         for refine in refines:
             for j, p in enumerate(paths):
@@ -128,3 +128,95 @@ def efficiency_rows(rows: list[dict], path: str = "los") -> dict[str, dict[str, 
         order = np.argsort(o["range"])
         res[route] = {q: np.asarray(v, float)[order] for q, v in o.items()}
     return res
+
+
+def threshold_study(
+    route, epochs, snr_offsets_db, n_snapshots: int, seed: int, *, progress: bool = False
+) -> list[dict]:
+    """The ML route against its bound as the SNR falls and the range grows: where it leaves the
+    bound (the threshold region) and whether its own test (``PathEstimates.fit_ok``) says so.
+
+    For every epoch of ``epochs`` and offset of ``snr_offsets_db`` (the route's SNR lowered or
+    raised, :class:`~tunnelkit.signal_route.SignalRoute` ``snr_offset_db``), ``n_snapshots``
+    seeded snapshots, extracted by the route's default (ML) extraction; errors over the CRLB at
+    that SNR (:func:`tunnelkit.evaluation.bound_errors`). One row per (epoch, offset, true path):
+    ``epoch``, ``range [m]``, ``SNR offset [dB]``, ``path``, ``integrated SNR [dB]`` (``eta =
+    P_t |gain|^2 M Nf Nt / N0``), ``RMS/CRLB d``, ``... v``, ``... direction``, ``... w`` (over
+    the snapshots in which the path was found), ``beyond 6 sigma`` (share of snapshots with this
+    path beyond 6 sigma or missed) and ``flagged`` (share of snapshots the extraction flagged).
+    """
+    from dataclasses import replace
+
+    from .constants import C, db2lin
+    from .evaluation import bound_errors
+    from .extraction import path_crlb
+    from .montecarlo import spawn_rngs
+
+    epochs = [integer("epochs", k, minimum=0) for k in np.atleast_1d(epochs).tolist()]
+    offsets = [float(o) for o in np.atleast_1d(np.asarray(snr_offsets_db, float))]
+    if not epochs or not offsets:
+        raise ValueError("epochs, snr_offsets_db: need at least one of each")
+    if not np.all(np.isfinite(offsets)):
+        raise ValueError(f"snr_offsets_db: expected finite values, got {offsets}")
+    n = integer("n_snapshots", n_snapshots, minimum=1)
+    grid = [(k, o) for k in epochs for o in offsets]
+    it = list(zip(grid, spawn_rngs(seed, len(grid))))
+    if progress:
+        from tqdm.auto import tqdm
+
+        it = tqdm(it, desc="threshold study", leave=False)
+    rows = []
+    for (k, off), rng in it:
+        r_off = replace(route, snr_offset_db=off)
+        arr, paths = r_off.paths(k)
+        bound = path_crlb(paths, arr, r_off.config, snr_offset_db=off)
+        src = np.stack([arr.to_local(p.source) for p in paths])
+        errs, flags = [], []
+        for r in rng.spawn(n):
+            snap = r_off.snapshot(paths, arr, r)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                est = r_off.extract(snap.H, arr, len(paths))
+            d_true = np.array([p.length for p in paths]) + C * snap.clock_bias
+            v_true = np.array([p.velocity for p in paths])
+            errs.append(bound_errors(est, d_true, v_true, src, bound))
+            flags.append(est.fit_ok is False)
+        e = np.stack(errs)  # (n, L, 4)
+        eta = (
+            np.abs([p.gain for p in paths]) ** 2
+            * r_off.config.tx_power
+            * snap.H.size
+            / (r_off.config.noise_power / float(db2lin(off)))
+        )
+        rng_ue = float(np.linalg.norm(route.trajectory.position[k] - arr.origin))
+        for j, p in enumerate(paths):
+            ej = e[:, j]
+            found = np.all(np.isfinite(ej), axis=1)
+            rms = np.sqrt(np.mean(ej[found] ** 2, axis=0)) if found.any() else np.full(4, np.nan)
+            rows.append(
+                {
+                    "epoch": k,
+                    "range [m]": rng_ue,
+                    "SNR offset [dB]": off,
+                    "path": p.surface_kind,
+                    "integrated SNR [dB]": float(10 * np.log10(eta[j])),
+                    **{
+                        f"RMS/CRLB {q}": float(x) for q, x in zip(("d", "v", "direction", "w"), rms)
+                    },
+                    "beyond 6 sigma": float(np.mean(np.any(~(np.abs(ej) <= 6.0), axis=1))),
+                    "flagged": float(np.mean(flags)),
+                }
+            )
+    return rows
+
+
+def mie_threshold_db(n_cells: int) -> float:
+    """Integrated SNR ``eta`` [dB] below which a maximum-likelihood search over ``n_cells``
+    independent cells (beams x delays x Dopplers, ``M Nf Nt``) starts to pick a noise cell over
+    the path: the probability of such an outlier is about ``n_cells e^{-eta}`` (each noise cell
+    of the normalised periodogram is exponential with mean 1, the path's cell is ``eta`` above
+    it), 1/2 at ``eta = ln(2 n_cells)``. This is where the method of interval errors and the
+    Ziv-Zakai bound leave the CRLB: above it they coincide with it, below it the mean square
+    error is set by the outliers (the width of the search space), not by the local curvature."""
+    K = integer("n_cells", n_cells, minimum=1)
+    return float(10 * np.log10(np.log(2.0 * K)))

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validate import finite_array, integer
 from ..arrays import ArrayGeometry
-from ..constants import C
+from ..constants import C, db2lin
 from .estimates import PathEstimates
 from .radio import check_array, check_srs
 
@@ -85,9 +86,18 @@ def crlb_paths(
 
 
 def path_crlb(
-    paths, array, srs, *, n_tones: int | None = None, spatial: str = "structured"
+    paths,
+    array,
+    srs,
+    *,
+    n_tones: int | None = None,
+    spatial: str = "structured",
+    snr_offset_db: float = 0.0,
 ) -> dict:
-    """Cramér-Rao bounds for every path of one epoch at the configured SNR.
+    """Cramér-Rao bounds for every path of one epoch at the SNR the tensor was synthesised with:
+    the configured one raised (positive) or lowered by ``snr_offset_db``, as
+    :func:`tunnelkit.channel.synthesize` and :class:`tunnelkit.signal_route.SignalRoute` apply it
+    (the noise power ``srs.noise_power / 10^(snr_offset_db / 10)``).
 
     ``spatial="structured"`` (default): every parameter from the exact spherical model of eq. 1
     (wave origin = VUE, 3 numbers per path): the bound the maximum-likelihood route
@@ -107,7 +117,9 @@ def path_crlb(
     if not isinstance(array, ArrayGeometry):
         raise TypeError(f"array: expected an ArrayGeometry, got {type(array).__name__}")
     config = check_srs(srs)
-    nf = config.n_tones if n_tones is None else n_tones
+    nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=1)
+    off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
+    noise_power = config.noise_power / float(db2lin(off))
     alpha = np.sqrt(config.tx_power) * np.array([p.gain for p in paths])
     src = np.stack([array.to_local(p.source) for p in paths])
     mu_f = -2 * np.pi * config.tone_spacing * np.array([p.length for p in paths]) / C
@@ -121,7 +133,7 @@ def path_crlb(
         config.fc,
         nf,
         config.n_symbols,
-        config.noise_power,
+        noise_power,
         spatial=spatial,
     )
     return in_path_units(out, config)

@@ -24,6 +24,7 @@ from .._validate import integer, positive
 from .numerics import contract, grid_index
 
 __all__ = [
+    "MAX_SWEEPS",
     "CPDConvergenceWarning",
     "CPDResult",
     "check_rank",
@@ -34,6 +35,11 @@ __all__ = [
     "max_identifiable_rank",
     "normalize_factors",
 ]
+
+#: cap on the iterations of the CPD (``n_iter_max``) and its ALS sweeps (``polish``): one sweep
+#: costs about one pass over the tensor (~10 ms at M = 100, Nf = 410, Nt = 12), so 10,000 are
+#: minutes, the time budget of one snapshot many times over; more is a mistake, refused
+MAX_SWEEPS = 10_000
 
 
 class CPDConvergenceWarning(UserWarning):
@@ -268,9 +274,9 @@ def cpd(
     """
     H = check_tensor(H)
     L = check_rank(H.shape, n_paths)
-    n_iter_max = integer("n_iter_max", n_iter_max, minimum=1)
+    n_iter_max = integer("n_iter_max", n_iter_max, minimum=1, maximum=MAX_SWEEPS)
     tol = positive("tol", tol)
-    polish = integer("polish", polish, minimum=0)
+    polish = integer("polish", polish, minimum=0, maximum=MAX_SWEEPS)
     if method == "plain":
         cp, errs = parafac(
             tl.tensor(H),

@@ -21,7 +21,9 @@ class PathEstimates:
     value, ``delta`` (L, M) unwrapped path-length offsets (eq. 16), ``mu_f``/``mu_t`` the roots.
     ``fit`` holds the maximum-likelihood stage's :class:`~tunnelkit.extraction.ml.MLFit` (noise
     power, basin test) on that route, ``None`` on the others; ``significance`` each path's
-    log-likelihood ratio against noise on that route (sorted like the rest), ``None`` elsewhere.
+    log-likelihood ratio against noise on that route (sorted like the rest), ``None`` elsewhere;
+    ``fit_ok`` the ML stage's verdict on its own fit (``MLFit.fit_ok``: no structured residual
+    left, every path above the noise), ``None`` on the routes that do not test themselves.
     """
 
     alpha: np.ndarray
@@ -43,6 +45,7 @@ class PathEstimates:
     converged: bool = True
     fit: object = field(default=None, repr=False)
     significance: np.ndarray | None = field(default=None, repr=False)
+    fit_ok: bool | None = None
 
     def __len__(self) -> int:
         return self.d.shape[0]

@@ -27,6 +27,7 @@ __all__ = [
     "damped_step",
     "free_newton",
     "grid_index",
+    "scan_grid",
     "scan_peak",
     "solve",
     "spatial_phase",
@@ -186,19 +187,30 @@ def spatial_phase(theta, element_positions, k0: float):
     return psi, dx, dy, dw
 
 
-@lru_cache(maxsize=2)
-def _scan_grid(pos_bytes: bytes, m: int, fc: float, n_grid: int):
-    """Far-field beam-scan grid of one array: directions (G, 2) and the steering matrix (M, G)
-    (read-only: it is shared by every call with the same array)."""
+@lru_cache(maxsize=4)
+def _scan_grid(pos_bytes: bytes, m: int, fc: float, n_grid: int, edge: float = 0.99):
+    """Far-field beam-scan grid of one array: directions (G, 2) with ``|u|^2 < edge`` and the
+    steering matrix (M, G) (read-only: it is shared by every call with the same array)."""
     p = np.frombuffer(pos_bytes).reshape(m, 3)
     g = np.linspace(-1, 1, n_grid)
     ux, uy = np.meshgrid(g, g)
-    keep = ux**2 + uy**2 < 0.99
+    keep = ux**2 + uy**2 < edge
     u = np.column_stack([ux[keep], uy[keep]])
     A = np.exp(-2j * np.pi * fc / C * (p[:, :2] @ u.T))  # far field: delta_m = -u . p_m
     u.flags.writeable = False
     A.flags.writeable = False
     return u, A
+
+
+def scan_grid(element_positions, fc: float, n_grid: int = 61):
+    """The far-field beam-scan grid of an array over the whole visible region ``|u| <= 1`` (to
+    end-fire): directions ``u`` (G, 2) on an ``n_grid x n_grid`` lattice and the steering matrix
+    ``A`` (M, G), ``A[m, g] = exp(-j k0 u_g . p_m)`` (cached, read-only)."""
+    p = np.ascontiguousarray(element_positions, float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
+    n_grid = integer("n_grid", n_grid, minimum=2)
+    return _scan_grid(p.tobytes(), p.shape[0], positive("fc", fc), n_grid, 1.0 + 1e-12)
 
 
 def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:

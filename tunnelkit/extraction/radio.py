@@ -19,7 +19,12 @@ import numpy as np
 from ..arrays import ArrayGeometry, check_element_positions
 from ..channel import SRSConfig
 
-__all__ = ["check_array", "check_srs"]
+__all__ = ["MAX_CARRIER", "MIN_SYMBOL_PERIOD", "check_array", "check_srs"]
+
+#: the radio the extraction accepts: carriers up to 1 THz, OFDM symbols of at least 1 ns
+#: (5G NR's shortest, at 960 kHz subcarrier spacing, lasts about 1.1 us)
+MAX_CARRIER = 1e12
+MIN_SYMBOL_PERIOD = 1e-9
 
 
 def check_array(array, m: int | None = None) -> np.ndarray:
@@ -32,7 +37,19 @@ def check_array(array, m: int | None = None) -> np.ndarray:
 
 
 def check_srs(srs) -> SRSConfig:
-    """``srs`` if it is a :class:`SRSConfig`, else ``TypeError`` naming ``srs``."""
+    """``srs`` if it is a :class:`SRSConfig` with a carrier up to ``MAX_CARRIER`` and a symbol
+    period of at least ``MIN_SYMBOL_PERIOD`` (else ``TypeError`` / ``ValueError`` naming ``srs``
+    and the field)."""
     if not isinstance(srs, SRSConfig):
         raise TypeError(f"srs: expected a tunnelkit.channel.SRSConfig, got {type(srs).__name__}")
+    if srs.fc > MAX_CARRIER:
+        raise ValueError(
+            f"srs: fc = {srs.fc:g} Hz is above {MAX_CARRIER:g} Hz (1 THz): not a radio carrier "
+            "the eq. 1 model describes (fc is in Hz)"
+        )
+    if srs.symbol_period < MIN_SYMBOL_PERIOD:
+        raise ValueError(
+            f"srs: symbol_period = {srs.symbol_period:g} s is below {MIN_SYMBOL_PERIOD:g} s "
+            f"(scs = {srs.scs:g} Hz): no OFDM numerology has symbols that short"
+        )
     return srs

@@ -28,6 +28,7 @@ def extract_paths(
     tol: float = 1e-10,
     polish: int | None = None,
     noise_power: float | None = None,
+    search: str = "residual",
 ) -> PathEstimates:
     """Path parameters from the channel tensor, one entry per path.
 
@@ -55,6 +56,10 @@ def extract_paths(
     polish : ALS sweeps on the full tensor after the compressed CPD (default 2, or 0 with
         ``refine="joint"``, which supersedes them).
     noise_power : noise power per sample for the "ml" route (default: estimated from ``H``).
+    search : the "ml" route's search: "residual" (default: re-initialisation on the residual's
+        periodogram peak until the residual test passes) or "basic" (re-seeding on the residual
+        energy alone, the route before issue 23, kept for comparison); see
+        :func:`.ml.fitting.fit_problem`.
 
     Returns a :class:`PathEstimates` (``alpha, d, v, direction, kappa, near_field`` and more); it
     also supports ``est["d"]``. On the "ml" route see :func:`.ml.ml_paths` for what each field
@@ -69,9 +74,11 @@ def extract_paths(
     if refine == "ml":
         if noise_power is not None:
             noise_power = positive("noise_power", noise_power)
-        return ml_paths(H, L, pos, srs, noise_power=noise_power)
+        return ml_paths(H, L, pos, srs, noise_power=noise_power, search=search)
     if noise_power is not None:
         raise ValueError(f"noise_power: only used by refine='ml', not {refine!r}")
+    if search != "residual":
+        raise ValueError(f"search: only used by refine='ml', not {refine!r}")
     cpd_kw = {"method": method, "n_iter_max": n_iter_max, "tol": tol, "polish": polish}
     if refine == "coherent":
         est = paper_route(H, L, pos, srs, refine="joint", **cpd_kw)

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..reference import load as load_reference
 from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
+from ..studies.drives import FLAGGED
 from ..studies.scoring import evaluate
 from ..tracking.javelin import designs
 from . import Report, register
@@ -173,7 +174,10 @@ def _simulate_and_score(scenario, n_epochs, extractions, columns, cond, rng):
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count."""
     drives = simulate_condition(scenario, n_epochs, extractions, cond, rng)
-    faults = {e: len(d.faults) for e, d in drives.items()}
+    faults = {
+        e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
+        for e, d in drives.items()
+    }
     return score_drive(drives, cond, columns), faults
 
 
@@ -207,21 +211,37 @@ def javelin_table(
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
     faults = dict.fromkeys(extractions, 0)
+    flagged = dict.fromkeys(extractions, 0)
+    epochs = dict.fromkeys(extractions, 0)
     for cond in conditions:  # the order of table_rows: condition, then run
         for c, (one, _) in done:
             if c == cond:
                 for key, metrics in one.items():
                     scores.setdefault(key, []).append(metrics)
     for _, (_, nf) in done:
-        for e, n in nf.items():
+        for e, (n, n_flag, n_ep) in nf.items():
             faults[e] += n
+            flagged[e] += n_flag
+            epochs[e] += n_ep
     cols, rows = _rows(scores, reference, columns)
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}: JAVELIN vs TeNFiLoc",
         columns=cols,
         rows=rows,
-        meta={"scenario": scenario, "extraction_failures": faults},
-        notes=list(NOTES),
+        meta={
+            "scenario": scenario,
+            "extraction_failures": faults,
+            "flagged_epochs": flagged,
+            "epochs": epochs,
+        },
+        notes=[
+            *NOTES,
+            "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
+            "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
+            "(the tracker predicts only); flagged epochs per route: "
+            + ", ".join(f"{e} {flagged[e]} of {epochs[e]}" for e in extractions)
+            + ".",
+        ],
     )
 
 

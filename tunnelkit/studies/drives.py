@@ -33,6 +33,7 @@ from ..tracking.javelin.measurement import PathMeasurements
 __all__ = [
     "CONDITIONS",
     "EXTRACTIONS",
+    "FLAGGED",
     "HELD_OUT_SEED",
     "SIGMA_HEADING",
     "SIGMA_SPEED",
@@ -166,13 +167,22 @@ def scenario_route(route, model: str = "exact") -> SignalRoute:
     return _ROUTES[key]
 
 
+#: the reason an epoch the extraction flagged itself (``fit_ok = False``) carries no measurement
+FLAGGED = "extraction flagged its own fit (fit_ok = False)"
+
+
 def path_measurements(ep, route: SignalRoute) -> tuple[PathMeasurements | None, str | None]:
     """The tracker's measurements of one simulated epoch (the one adapter from
     :class:`tunnelkit.signal_route.RouteMeasurements` to :class:`PathMeasurements`), or ``None`` and
     the reason: a route that reports covariances (``report_covariance``) gives none for a fit
     that failed its own residual test (or whose Fisher information is singular), and such an
-    epoch carries no measurement (the tracker predicts only)."""
+    epoch carries no measurement (the tracker predicts only). An extraction that tests its own
+    fit (the ML route: ``PathEstimates.fit_ok``) and flags it — a path missed, merged or in a wrong
+    basin of the likelihood, or the snapshot in the threshold region — gives none either, with
+    the reason :data:`FLAGGED`."""
     m = ep.measurements
+    if getattr(ep.estimates, "fit_ok", None) is False:
+        return None, FLAGGED
     if route.report_covariance and m.cov is None and len(m):
         return None, "extraction failed its residual test"
     pm = PathMeasurements.from_arrays(

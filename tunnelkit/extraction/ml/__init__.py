@@ -26,7 +26,7 @@ smooth through the far field ``w = 0``,
     d psi / d u_x = k0 p_x (-2 / Q + N w / (Q^2 D))         (likewise u_y with p_y),
     d psi / d w   = k0 (|p|^2 / Q - N (w |p|^2 - u.p) / (Q^2 D)).
 
-The feasible set is ``|u| <= U_MAX`` (front half-space, away from end-fire) and
+The feasible set is ``|u| <= U_MAX = 0.99999`` (front half-space up to 0.26 deg from end-fire) and
 ``0 <= w <= W_MAX``; every step is projected onto it, so no estimate leaves the front half-space,
 and ``w = 0`` is an exact far-field wave (reported as ``kappa = NaN``).
 
@@ -86,6 +86,25 @@ the likelihood rises:
   [G^{-1}]_ll``) is dropped and sought again in ``H`` less the other paths (the residual plus
   its own contribution).
 
+Residual test and re-initialisation on the residual
+---------------------------------------------------
+The energy test above spreads a wrong basin's structured residual over all ``N`` dimensions: at
+long range, where the ceiling, road and wall images lie a fraction of a beamwidth and of the
+delay resolution from the line of sight, a fit that merged two of them and counted a third twice
+leaves thousands of noise powers in the residual and still passes it. The residual test of
+:mod:`.residual` looks at the largest peak of the residual's single-path periodogram instead
+(exponential with mean 1 per grid point under noise; threshold at the false-alarm rate
+``FALSE_ALARM`` = 1 %). While it fails, a path is started at the peak (grid direction, delay
+and Doppler, a curvature scan and a single-source fit) and several starts are made from it —
+birth and death, the new path in place of the one whose atom is most like it or of the weakest
+(the weaker of two nearly collinear atoms, if any), and the nearest path split in two in place
+of the weakest — each given ``RANK_ITER`` iterations, ranked by the likelihood, the best fitted
+to convergence and kept if the likelihood rises (SAGE / RIMAX re-initialisation; the moves on
+``rho`` below follow when the energy test still fails). ``MLFit.fit_ok`` (and
+``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their
+thresholds and every path above the noise (``MIN_SIGNIFICANCE``). ``search="basic"`` skips the
+re-initialisation (the route before it, for comparison).
+
 A search takes the dominant rank-one term of its tensor (power iterations), the periodogram peaks
 of its frequency and time vectors for ``mu_f`` and ``mu_t``, a far-field beam scan of its spatial
 vector for ``u``, a 1-D scan of ``w`` and a local single-source fit.
@@ -107,6 +126,7 @@ Modules, each importing only from the ones above it:
   feasible set, the noise floor;
 - :mod:`.search` — the starts: one path from a (residual) tensor, successive cancellation,
   starts from estimates;
+- :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
 - :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
   re-seedings: :func:`fit_ml`, :class:`MLFit`;
 - :mod:`.paths` — :func:`ml_paths` and :func:`estimates_from_fit`.
@@ -116,12 +136,30 @@ live in :mod:`tunnelkit.extraction.numerics`.
 """
 
 from ..numerics import spatial_phase
-from .fitting import MLConvergenceWarning, MLDetectionWarning, MLFit, fit_ml, fit_problem
+from .fitting import (
+    MAX_ITER,
+    SEARCHES,
+    MLConvergenceWarning,
+    MLDetectionWarning,
+    MLFit,
+    fit_ml,
+    fit_problem,
+)
 from .model import Problem, noise_floor, project_feasible
-from .paths import estimates_from_fit, ml_paths
-from .search import check_start, complete_paths, search_path, start_from_estimates
+from .paths import estimates_from_fit, ml_paths, physical
+from .residual import FALSE_ALARM, peak_threshold, residual_peak
+from .search import (
+    check_start,
+    complete_paths,
+    path_from_peak,
+    search_path,
+    start_from_estimates,
+)
 
 __all__ = [
+    "FALSE_ALARM",
+    "MAX_ITER",
+    "SEARCHES",
     "MLConvergenceWarning",
     "MLDetectionWarning",
     "MLFit",
@@ -133,7 +171,11 @@ __all__ = [
     "fit_problem",
     "ml_paths",
     "noise_floor",
+    "path_from_peak",
+    "peak_threshold",
+    "physical",
     "project_feasible",
+    "residual_peak",
     "search_path",
     "spatial_phase",
     "start_from_estimates",

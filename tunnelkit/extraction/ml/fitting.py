@@ -11,14 +11,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._validate import integer, positive
+from ...constants import C
 from ..decomposition import check_tensor
-from ..numerics import damped_step, free_newton
+from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
 from ..radio import check_array, check_srs
 from .model import W_MAX, Problem, project_feasible
-from .search import check_start, search_path
+from .residual import FALSE_ALARM, peak_threshold, residual_peak
+from .search import check_start, path_from_peak, search_path
 
 __all__ = [
+    "MAX_ITER",
     "RHO_Z",
+    "SEARCHES",
     "SPLIT_STEPS",
     "STEP_TOL",
     "MLConvergenceWarning",
@@ -30,6 +34,12 @@ __all__ = [
 
 STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
+#: cap on ``max_iter`` (Levenberg-Marquardt iterations per fit) and on ``n_reseed``: an iteration
+#: is one pass over the tensor (~5-10 ms at M = 100, Nf = 410, Nt = 12); a fit that has not
+#: converged in 1,000 is not converging, and more would take hours over a drive
+MAX_ITER = 1000
+#: the searches of :func:`fit_problem`
+SEARCHES = ("residual", "basic")
 
 
 class MLConvergenceWarning(RuntimeWarning):
@@ -48,7 +58,10 @@ class MLFit:
     residual over the noise floor (1 at the right optimum), ``rho_max`` the basin test's
     threshold, ``significance`` (L,) each path's log-likelihood ratio against noise,
     ``n_iter`` Levenberg-Marquardt iterations in all, ``n_reseed`` kept re-seedings,
-    ``converged`` the stopping rule was met."""
+    ``converged`` the stopping rule was met; ``peak`` the largest peak of the residual's
+    single-path periodogram in noise powers and ``peak_max`` its threshold at the false-alarm
+    rate ``FALSE_ALARM`` (:mod:`.residual`); ``fit_ok`` the fit passed every test: the
+    residual peak and ``rho`` below their thresholds and all ``L`` paths above the noise."""
 
     theta: np.ndarray
     mu_f: np.ndarray
@@ -63,6 +76,9 @@ class MLFit:
     n_reseed: int
     converged: bool
     history: list = field(default_factory=list, repr=False)
+    peak: float = 0.0
+    peak_max: float = np.inf
+    fit_ok: bool = True
 
 
 def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
@@ -154,103 +170,119 @@ def _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coh
     return best, its
 
 
-def _significance(ev, sigma2) -> np.ndarray:
-    """Per path: the cost increase if it were removed (gains re-projected), over ``sigma2``."""
-    Gi = np.linalg.pinv(ev["G"])
-    return np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(Gi)), 1e-300) / sigma2
+def _residual_of(prob: Problem, res):
+    theta, mu_f, mu_t, ev = res[:4]
+    return prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
 
 
-def fit_ml(
-    H,
-    start,
-    array,
-    srs,
-    *,
-    noise_power: float | None = None,
-    max_iter: int = 60,
-    n_reseed: int | None = None,
-) -> MLFit:
-    """Joint maximum-likelihood fit of ``L`` paths started at ``start = (theta, mu_f, mu_t)``.
-
-    ``theta`` (L, 3) is ``(u_x, u_y, 1/kappa)`` per path (local frame, ``|u| < 1``, ``w >= 0``);
-    ``mu_f``, ``mu_t`` (L,) the Vandermonde frequencies. ``noise_power`` per sample (default:
-    estimated, :func:`~.model.noise_floor`). ``n_reseed`` bounds the SAGE-like re-seedings (default
-    ``L``; 0 = local fit only). ``array`` and ``srs`` as in
-    :func:`~tunnelkit.extraction.extract_paths` (only the carrier of ``srs`` enters). See the
-    package text for the algorithm.
-    """
-    H = check_tensor(H)
-    pos = check_array(array, m=H.shape[0])
-    srs = check_srs(srs)
-    L = np.atleast_2d(np.asarray(start[0])).shape[0]
-    start = check_start(start, L)
-    return fit_problem(
-        Problem(H, pos, srs.fc),
-        start,
-        noise_power=noise_power,
-        max_iter=max_iter,
-        n_reseed=n_reseed,
-    )
+def _peak_of(prob: Problem, res, sigma2):
+    fc = prob.k0 * C / (2 * np.pi)
+    return residual_peak(_residual_of(prob, res), prob.pos, fc, sigma2)
 
 
-def fit_problem(
-    prob: Problem,
-    start,
-    *,
-    noise_power: float | None = None,
-    max_iter: int = 60,
-    n_reseed: int | None = None,
-) -> MLFit:
-    """:func:`fit_ml` on a :class:`~.model.Problem`, from ``start = (theta (L, 3), mu_f (L,),
-    mu_t (L,))`` on the feasible set (:func:`~.search.check_start`,
-    :func:`~.search.start_from_estimates` or :func:`~.search.complete_paths` give one)."""
-    if not isinstance(prob, Problem):
-        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
-    try:
-        theta, mu_f, mu_t = start
-    except (TypeError, ValueError) as exc:
-        raise ValueError("start: expected a tuple (theta, mu_f, mu_t)") from exc
-    theta, mu_f, mu_t = (np.asarray(v) for v in (theta, mu_f, mu_t))
-    L = theta.shape[0] if theta.ndim == 2 else -1
-    if theta.shape != (L, 3) or mu_f.shape != (L,) or mu_t.shape != (L,):
-        raise ValueError(
-            f"start: expected theta (L, 3), mu_f (L,), mu_t (L,); got "
-            f"{theta.shape}, {mu_f.shape}, {mu_t.shape}"
+#: Levenberg-Marquardt iterations each start of a re-initialisation gets before the starts are
+#: ranked by their likelihood (the best one is then fitted to convergence)
+RANK_ITER = 8
+
+
+def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves):
+    """Re-initialisation on the residual (SAGE / RIMAX): while the residual's periodogram has a
+    peak above ``peak_max``, a path is started there (its grid direction, delay and Doppler, a
+    curvature scan and a single-source fit) and several starts are made from it: *birth and
+    death* (all ``L + 1`` fitted, the least significant out) and *replace* (it takes the place
+    of the path nearest to it in delay and Doppler, or of the least significant one). Each start
+    gets ``RANK_ITER`` iterations; the most likely is fitted to convergence and kept if it beats
+    the current fit. Returns the fit, its peak, the iterations spent and the kept moves."""
+    n_it = kept = 0
+    L = best[0].shape[0]
+    short = min(RANK_ITER, max_iter)
+    for _ in range(n_moves):
+        if peak[0] <= peak_max:
+            break
+        theta, mu_f, mu_t, ev = best[:4]
+        th_n, mf_n, mt_n = path_from_peak(prob, peak[1], peak[2])
+        big = _lm(
+            prob,
+            np.vstack([theta, th_n]),
+            np.append(mu_f, mf_n),
+            np.append(mu_t, mt_n),
+            sigma2,
+            short,
         )
-    max_iter = integer("max_iter", max_iter, minimum=1)
-    n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0)
-    H = prob.H
-    M, L = H.shape[0], theta.shape[0]
-    start = (theta, mu_f, mu_t)
-    bias = 0.0
-    if noise_power is None:
-        sigma2 = prob.noise_floor(L)
-        nt, rest = (H.shape[2], M * H.shape[1]) if L < H.shape[2] else (M, H.shape[1] * H.shape[2])
-        n_sigma = (nt - L) * (rest - L)
-        # the L largest eigenvalues also take the largest noise eigenvalues of the directions
-        # the signal barely occupies (paths sharing a Doppler bin): up to ~ L sqrt(nt/rest)/(nt-L)
-        bias = 0.5 * L * np.sqrt(nt / rest) / (nt - L)
-    else:
-        sigma2 = positive("noise_power", noise_power)
-        n_sigma = np.inf
-    sigma2 = max(sigma2, 1e-300 * max(prob.h2, 1e-300))
-    dof = prob.N - 2.5 * L
-    rho_max = 1.0 + RHO_Z * np.sqrt(1.0 / prob.N + 1.0 / n_sigma) + bias
+        n_it += big[4]
+        keep = np.arange(L + 1) != int(np.argmin(_significance(big[3], sigma2)))
+        starts = [(big[0][keep], big[1][keep], big[2][keep])]
+        near = _nearest_atom(prob, theta, mu_f, mu_t, th_n, mf_n, mt_n)
+        out = _weakest(ev, sigma2)
+        for worst in sorted({near, out}):  # the new path in place of the nearest, the weakest
+            th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
+            th2[worst], mf2[worst], mt2[worst] = th_n, mf_n, mt_n
+            starts.append((th2, mf2, mt2))
+        if near != out:  # the nearest split in two (a cluster fitted as one), the weakest out
+            for du in SPLIT_STEPS:
+                th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
+                th2[out], mf2[out], mt2[out] = theta[near], mu_f[near], mu_t[near]
+                th2[near, :2] += du
+                th2[out, :2] -= du
+                starts.append((project_feasible(th2), mf2, mt2))
+        cands = [_lm(prob, *st, sigma2, short) for st in starts]
+        n_it += sum(c[4] for c in cands)
+        cand = min(cands, key=lambda c: c[3]["cost"])
+        if not cand[5]:
+            cand = _lm(prob, *cand[:3], sigma2, max_iter)
+            n_it += cand[4]
+        if not cand[3]["cost"] < ev["cost"]:
+            break
+        best, kept = cand, kept + 1
+        peak = _peak_of(prob, best, sigma2)
+    return best, peak, n_it, kept
 
-    ev0 = prob.evaluate(theta, mu_f, mu_t, derivatives=False)
-    cost0 = ev0["cost"]
-    best = _lm(prob, theta, mu_f, mu_t, sigma2, max_iter)
-    n_it, kept = best[4], 0
-    history = [best[3]["cost"] / (dof * sigma2)]
+
+def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
+    """The path whose atom is most like the new one ``(th_n, mf_n, mt_n)`` (normalised inner
+    product, a product over the three modes)."""
+    a = np.exp(1j * spatial_phase(np.vstack([theta, th_n]), prob.pos, prob.k0)[0])
+    ca = np.abs(a[:, :-1].conj().T @ a[:, -1]) / prob.M
+    cf = np.abs(_dirichlet(mu_f - mf_n, prob.nf))
+    ct = np.abs(_dirichlet(mu_t - mt_n, prob.nt))
+    return int(np.argmax(ca * cf * ct))
+
+
+def _dirichlet(dmu, n: int) -> np.ndarray:
+    """``|sum_k e^{j k dmu}| / n`` for ``k = 0 .. n-1``."""
+    k = np.arange(n)[:, None]
+    return np.abs(np.sum(np.exp(1j * k * np.asarray(dmu)[None, :]), axis=0)) / n
+
+
+def _weakest(ev, sigma2) -> int:
+    """The weaker of the two most collinear atoms when two are nearly one (``|G_ij| / sqrt(G_ii
+    G_jj) > 0.9``: a path counted twice), else the least significant path."""
+    G = ev["G"]
+    dg = np.sqrt(np.maximum(np.real(np.diag(G)), 1e-300))
+    coh = np.abs(G) / np.outer(dg, dg)
+    np.fill_diagonal(coh, 0.0)
+    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
+    if coh[i, j] > 0.9:
+        return int(j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i)
+    return int(np.argmin(_significance(ev, sigma2)))
+
+
+def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
+    """The re-seedings on the residual energy (package text): while the cost is above
+    ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
+    and the weakest path re-sought, each kept if the likelihood rises. Returns the fit, the
+    iterations spent and the number of kept moves."""
     tried: set = set()
+    n_it = kept = 0
+    H, L = prob.H, best[0].shape[0]
     split_tried = False
     for attempt in range(n_reseed):
         theta, mu_f, mu_t, ev = best[:4]
-        if ev["cost"] / (dof * sigma2) <= rho_max:
+        if ev["cost"] <= cost_ok:
             break
         merged = None
         if not split_tried:  # one path counted twice: merge it, split another (once)
-            merged = _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, rho_max * dof)
+            merged = _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok)
         if merged is not None:
             cand, its = merged
             split_tried = True
@@ -275,6 +307,122 @@ def fit_problem(
         if cand[3]["cost"] < ev["cost"]:
             best, kept = cand, kept + 1
             tried = set()
+    return best, n_it, kept
+
+
+def _significance(ev, sigma2) -> np.ndarray:
+    """Per path: the cost increase if it were removed (gains re-projected), over ``sigma2``."""
+    Gi = np.linalg.pinv(ev["G"])
+    return np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(Gi)), 1e-300) / sigma2
+
+
+def fit_ml(
+    H,
+    start,
+    array,
+    srs,
+    *,
+    noise_power: float | None = None,
+    max_iter: int = 60,
+    n_reseed: int | None = None,
+    search: str = "residual",
+) -> MLFit:
+    """Joint maximum-likelihood fit of ``L`` paths started at ``start = (theta, mu_f, mu_t)``.
+
+    ``theta`` (L, 3) is ``(u_x, u_y, 1/kappa)`` per path (local frame, ``|u| < 1``, ``w >= 0``);
+    ``mu_f``, ``mu_t`` (L,) the Vandermonde frequencies. ``noise_power`` per sample (default:
+    estimated, :func:`~.model.noise_floor`). ``n_reseed`` bounds the SAGE-like re-seedings (default
+    ``L``; 0 = local fit only), ``search`` as in :func:`fit_problem`. ``array`` and ``srs`` as in
+    :func:`~tunnelkit.extraction.extract_paths` (only the carrier of ``srs`` enters). See the
+    package text for the algorithm.
+    """
+    H = check_tensor(H)
+    pos = check_array(array, m=H.shape[0])
+    srs = check_srs(srs)
+    L = np.atleast_2d(np.asarray(start[0])).shape[0]
+    start = check_start(start, L)
+    return fit_problem(
+        Problem(H, pos, srs.fc),
+        start,
+        noise_power=noise_power,
+        max_iter=max_iter,
+        n_reseed=n_reseed,
+        search=search,
+    )
+
+
+def fit_problem(
+    prob: Problem,
+    start,
+    *,
+    noise_power: float | None = None,
+    max_iter: int = 60,
+    n_reseed: int | None = None,
+    search: str = "residual",
+) -> MLFit:
+    """:func:`fit_ml` on a :class:`~.model.Problem`, from ``start = (theta (L, 3), mu_f (L,),
+    mu_t (L,))`` on the feasible set (:func:`~.search.check_start`,
+    :func:`~.search.start_from_estimates` or :func:`~.search.complete_paths` give one).
+
+    ``search``: ``"residual"`` (default) — after the re-seedings on ``rho``, re-initialisation on
+    the residual's periodogram peak while it fails the residual test (:func:`_peak_reseed`);
+    ``"basic"`` — the re-seedings on ``rho`` alone (the route before the residual test existed,
+    kept for comparison; the residual test is still computed for ``fit_ok``)."""
+    if search not in SEARCHES:
+        raise ValueError(f"search: expected one of {SEARCHES}, got {search!r}")
+    if not isinstance(prob, Problem):
+        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
+    try:
+        theta, mu_f, mu_t = start
+    except (TypeError, ValueError) as exc:
+        raise ValueError("start: expected a tuple (theta, mu_f, mu_t)") from exc
+    theta, mu_f, mu_t = (np.asarray(v) for v in (theta, mu_f, mu_t))
+    L = theta.shape[0] if theta.ndim == 2 else -1
+    if theta.shape != (L, 3) or mu_f.shape != (L,) or mu_t.shape != (L,):
+        raise ValueError(
+            f"start: expected theta (L, 3), mu_f (L,), mu_t (L,); got "
+            f"{theta.shape}, {mu_f.shape}, {mu_t.shape}"
+        )
+    max_iter = integer("max_iter", max_iter, minimum=1, maximum=MAX_ITER)
+    n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0, maximum=MAX_ITER)
+    H = prob.H
+    M, L = H.shape[0], theta.shape[0]
+    start = (theta, mu_f, mu_t)
+    bias = 0.0
+    if noise_power is None:
+        sigma2 = prob.noise_floor(L)
+        nt, rest = (H.shape[2], M * H.shape[1]) if L < H.shape[2] else (M, H.shape[1] * H.shape[2])
+        n_sigma = (nt - L) * (rest - L)
+        # the L largest eigenvalues also take the largest noise eigenvalues of the directions
+        # the signal barely occupies (paths sharing a Doppler bin): up to ~ L sqrt(nt/rest)/(nt-L)
+        bias = 0.5 * L * np.sqrt(nt / rest) / (nt - L)
+    else:
+        sigma2 = positive("noise_power", noise_power)
+        n_sigma = np.inf
+    sigma2 = max(sigma2, 1e-300 * max(prob.h2, 1e-300))
+    dof = prob.N - 2.5 * L
+    rho_max = 1.0 + RHO_Z * np.sqrt(1.0 / prob.N + 1.0 / n_sigma) + bias
+
+    ev0 = prob.evaluate(theta, mu_f, mu_t, derivatives=False)
+    cost0 = ev0["cost"]
+    best = _lm(prob, theta, mu_f, mu_t, sigma2, max_iter)
+    n_it, kept = best[4], 0
+    history = [best[3]["cost"] / (dof * sigma2)]
+    peak_max = peak_threshold(prob.N, FALSE_ALARM)
+    peak = _peak_of(prob, best, sigma2)
+    if n_reseed and search == "residual":
+        best, peak, its, n_kept = _peak_reseed(
+            prob, best, sigma2, max_iter, peak, peak_max, n_reseed
+        )
+        n_it, kept = n_it + its, kept + n_kept
+        history.append(best[3]["cost"] / (dof * sigma2))
+    if best[3]["cost"] / (dof * sigma2) > rho_max:
+        best, its, n_kept = _rho_reseed(
+            prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof
+        )
+        n_it, kept = n_it + its, kept + n_kept
+        if n_kept:
+            peak = _peak_of(prob, best, sigma2)
     theta, mu_f, mu_t, ev, _, converged = best
     if not ev["cost"] < cost0 and not np.isclose(ev["cost"], cost0, rtol=1e-12, atol=0):
         warnings.warn(
@@ -283,9 +431,22 @@ def fit_problem(
             stacklevel=2,
         )
         theta, mu_f, mu_t, ev = (*start, ev0)
+        peak = _peak_of(prob, (theta, mu_f, mu_t, ev), sigma2)
     if not np.all(np.isfinite(ev["c"])):
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
+    significance = _significance(ev, sigma2)
+    fit_ok = bool(
+        rho <= rho_max and peak[0] <= peak_max and np.all(significance >= MIN_SIGNIFICANCE)
+    )
+    if peak[0] > peak_max:
+        warnings.warn(
+            f"fit_ml: the residual's periodogram peaks at {peak[0]:.0f} noise powers (test: "
+            f"{peak_max:.1f} at false-alarm rate {FALSE_ALARM}): a path is missed or in a wrong "
+            "basin (fit_ok = False)",
+            MLConvergenceWarning,
+            stacklevel=2,
+        )
     if rho > rho_max:
         warnings.warn(
             f"fit_ml: the residual stays {rho:.4f} times the noise floor (test: {rho_max:.4f}) "
@@ -302,9 +463,12 @@ def fit_problem(
         float(sigma2),
         rho,
         float(rho_max),
-        _significance(ev, sigma2),
+        significance,
         int(n_it),
         int(kept),
         bool(converged),
         history,
+        float(peak[0]),
+        float(peak_max),
+        fit_ok,
     )

@@ -16,8 +16,10 @@ from ..numerics import solve, spatial_phase
 
 __all__ = ["U_MAX", "W_FAR", "W_MAX", "Problem", "noise_floor", "project_feasible"]
 
-#: feasible set: direction cosines within U_MAX of the array plane's unit disc, curvature <= W_MAX
-U_MAX = 0.999
+#: feasible set: direction cosines within U_MAX of the array plane's unit disc (u_z >= 0.0045,
+#: 0.26 deg from end-fire: a ceiling image seen from a tilted array can lie at u_z = 0.011),
+#: curvature <= W_MAX
+U_MAX = 0.99999
 W_MAX = 2.0  # kappa >= 0.5 m
 #: curvature below which a path is reported far-field (kappa = NaN), as in the coherent split
 W_FAR = 1e-3

@@ -16,11 +16,11 @@ from ..estimates import PathEstimates, path_estimates
 from ..numerics import MIN_SIGNIFICANCE, spatial_phase
 from ..paper import angles_from_solution, paper_route
 from ..radio import check_array, check_srs
-from .fitting import MLDetectionWarning, MLFit, fit_problem
-from .model import W_FAR, Problem
+from .fitting import MAX_ITER, SEARCHES, MLDetectionWarning, MLFit, fit_problem
+from .model import W_FAR, W_MAX, Problem
 from .search import check_start, complete_paths, start_from_estimates
 
-__all__ = ["estimates_from_fit", "ml_paths"]
+__all__ = ["estimates_from_fit", "ml_paths", "physical"]
 
 
 def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: float) -> PathEstimates:
@@ -70,8 +70,27 @@ def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: floa
     )
     signif = fit.significance[np.argsort(d)]
     return replace(
-        est, valid=est.valid & (signif >= MIN_SIGNIFICANCE), fit=fit, significance=signif
+        est,
+        valid=est.valid & (signif >= MIN_SIGNIFICANCE) & physical(est, srs),
+        fit=fit,
+        significance=signif,
+        fit_ok=bool(fit.fit_ok),
     )
+
+
+def physical(est: PathEstimates, srs) -> np.ndarray:
+    """Per path: the estimate is physically possible — finite, ``|v| < c``, ``|d|`` within the
+    unambiguous range ``c / (2 Delta f)``, a unit direction in the front half-space (``u_z >=
+    0``) and a curvature radius, where near-field, at least ``1 / W_MAX``."""
+    srs = check_srs(srs)
+    u = np.asarray(est.direction, float)
+    kap = np.asarray(est.kappa, float)
+    ok = np.isfinite(est.d) & np.isfinite(est.v) & np.all(np.isfinite(u), axis=1)
+    ok &= np.abs(est.v) < C
+    ok &= np.abs(est.d) <= C / (2 * srs.tone_spacing) * (1 + 1e-9)
+    ok &= (u[:, 2] >= 0) & np.isclose(np.linalg.norm(u, axis=1), 1.0, atol=1e-9)
+    ok &= np.where(np.isfinite(kap), kap >= 1.0 / W_MAX * (1 - 1e-9), True)
+    return ok
 
 
 def ml_paths(
@@ -84,10 +103,12 @@ def ml_paths(
     noise_power: float | None = None,
     max_iter: int = 60,
     n_reseed: int | None = None,
+    search: str = "residual",
 ) -> PathEstimates:
     """Joint maximum-likelihood extraction (package text of :mod:`tunnelkit.extraction.ml`); the
     default route of :func:`~tunnelkit.extraction.extract_paths`.
 
+    ``search``: ``"residual"`` (default) or ``"basic"`` (:func:`~.fitting.fit_problem`).
     ``start``: a :class:`PathEstimates` (any route; projected onto the front half-space), a tuple
     ``(theta (L, 3), mu_f, mu_t)`` (checked: ``ValueError`` outside the front half-space), or
     ``None`` — the CPD, the paper's roots and the coherent split (:func:`resolve_coherent`).
@@ -102,7 +123,10 @@ def ml_paths(
     ``rel_error`` = ``||r||^2 / ||H||^2``, ``valid`` = ``d >= 0`` (Algorithm 1: with a
     negative clock bias a near vehicle can have ``d < 0``) and significant against the noise
     (``significance >= MIN_SIGNIFICANCE``), ``significance`` each path's log-likelihood ratio,
-    ``fit`` the :class:`MLFit` (noise power, basin test).
+    ``fit`` the :class:`MLFit` (noise power, basin test), ``fit_ok`` its verdict
+    (:attr:`MLFit.fit_ok`; ``False``: the snapshot is in the threshold region or the search
+    missed the likelihood's basin: a path missed, merged or off by many standard deviations).
+    A path marked ``valid`` is physically possible (:func:`physical`).
     """
     H = check_tensor(H)
     M, nf, nt = H.shape
@@ -115,8 +139,8 @@ def ml_paths(
         raise ValueError(
             f"n_paths: at most {M - 1} paths can be told apart by {M} antennas, got {L}"
         )
-    max_iter = integer("max_iter", max_iter, minimum=1)
-    n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0)
+    max_iter = integer("max_iter", max_iter, minimum=1, maximum=MAX_ITER)
+    n_reseed = L if n_reseed is None else integer("n_reseed", n_reseed, minimum=0, maximum=MAX_ITER)
     prob = Problem(H, pos, srs.fc)
     if start is None:
         with warnings.catch_warnings():
@@ -130,7 +154,11 @@ def ml_paths(
         if len(start) != L:
             raise ValueError(f"start: has {len(start)} paths, n_paths = {L}")
         start = start_from_estimates(start)
-    fit = fit_problem(prob, start, noise_power=noise_power, max_iter=max_iter, n_reseed=n_reseed)
+    if search not in SEARCHES:
+        raise ValueError(f"search: expected one of {SEARCHES}, got {search!r}")
+    fit = fit_problem(
+        prob, start, noise_power=noise_power, max_iter=max_iter, n_reseed=n_reseed, search=search
+    )
     n_sig = int(np.sum(fit.significance >= MIN_SIGNIFICANCE))
     if n_sig < L:
         warnings.warn(

@@ -22,7 +22,13 @@ from ..numerics import scan_peak, spatial_phase
 from ..paper import refine_roots
 from .model import Problem, project_feasible
 
-__all__ = ["check_start", "complete_paths", "search_path", "start_from_estimates"]
+__all__ = [
+    "check_start",
+    "complete_paths",
+    "path_from_peak",
+    "search_path",
+    "start_from_estimates",
+]
 
 
 def _power_rank_one(R, n_iter: int = 6):
@@ -45,13 +51,14 @@ def _power_rank_one(R, n_iter: int = 6):
     return x, y, z
 
 
-def _spatial_search(x, prob: Problem, n_grid: int = 61):
-    """Direction and curvature of one wave from a spatial vector ``x`` (M,): far-field beam scan,
-    then a 1-D scan in ``w``, then a local single-source fit."""
+def _spatial_search(x, prob: Problem, n_grid: int = 61, u=None):
+    """Direction and curvature of one wave from a spatial vector ``x`` (M,): far-field beam scan
+    (or the direction ``u`` given), then a 1-D scan in ``w``, then a local single-source fit."""
     p = prob.pos
     fc = prob.k0 * C / (2 * np.pi)
-    u = scan_peak(x, p, fc, n_grid=n_grid)
-    u = u * min(1.0, 0.98 / max(np.linalg.norm(u), 1e-12))
+    if u is None:
+        u = scan_peak(x, p, fc, n_grid=n_grid)
+    u = np.asarray(u, float) * min(1.0, 0.98 / max(np.linalg.norm(u), 1e-12))
     ws = np.concatenate([[0.0], 1.0 / np.geomspace(0.6, 300.0, 40)])
     th = np.column_stack([np.tile(u, (ws.size, 1)), ws])
     a = np.exp(1j * spatial_phase(th, p, prob.k0)[0])
@@ -81,6 +88,17 @@ def search_path(R, prob: Problem) -> tuple[np.ndarray, float, float]:
     mt, _ = refine_roots(z[:, None] / z[0], np.array([mt0]), n_steps=6)
     th = _spatial_search(x, prob)
     return th, float(mf[0]), float(mt[0])
+
+
+def path_from_peak(prob: Problem, loc, x) -> tuple[np.ndarray, float, float]:
+    """One path ``(theta (3,), mu_f, mu_t)`` at a peak of the residual's periodogram
+    (:func:`~.residual.residual_peak`: ``loc = (u_x, u_y, mu_f, mu_t)`` on its grid and ``x`` the
+    spatial vector of its delay-Doppler cell): the curvature by a 1-D scan and a single-source
+    fit of ``x`` from the grid direction."""
+    _check_problem(prob)
+    ux, uy, mf, mt = (float(v) for v in loc)
+    th = _spatial_search(np.asarray(x), prob, u=(ux, uy))
+    return th, mf, mt
 
 
 def complete_paths(prob: Problem, start, n_paths: int):

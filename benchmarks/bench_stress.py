@@ -1,0 +1,304 @@
+"""Issue 23: the default extraction stressed over its whole operating range, and its failure test.
+
+Cases (``CASES``): both drives (``italiano2026-straight`` and ``-slalom``) on a 300 m variant of
+the tunnel whose trajectory runs from x = 122 m to x = 0.5 m (``long_route``: the ranges the
+presets' 100 m tunnel cannot reach), UE ranges 4-8 m (near the base station, where the ceiling
+and road images of the tilted arrays approach end-fire; 4.1 m is the closest a UE in the lane
+gets), 15-45 m (the presets' own drive) and 80-120 m (clustered images a few degrees and
+centimetres from the LoS), at the presets' SNR and 10 and 20 dB below it; and free-space scenes
+in front of the paper's 10 x 10 URA: ``L = 10`` sources 2-8 m away, and a close pair (two sources
+a third of a beamwidth and a third of the delay resolution apart, among four).
+
+Per case, ``n`` snapshots (noise, clock bias and the epoch within the range band drawn from the
+seed): RMS(error / CRLB) per parameter over the matched paths, ``d`` (with the clock bias),
+``v``, ``direction`` (angle), ``w = 1 / kappa`` (the curvature the fit estimates, normalised by
+its bound ``sigma_kappa / kappa^2``; it stays finite for a far-field estimate), the share of
+paths beyond 6 sigma in any parameter (a missed path counts as beyond), and for the failure test
+(``PathEstimates.fit_ok``) the share of bad snapshots (a path beyond 6 sigma) flagged and of good
+ones flagged. The CRLB takes the SNR the tensor was made with (``snr_offset_db``).
+
+``python benchmarks/bench_stress.py --seed S --snapshots 30`` prints the table; the
+settings were chosen on seed 23 and are reported on the held-out seed 2026 too. ``make bench``
+runs ``report()`` (both seeds, ``TUNNELKIT_BENCH_STRESS`` snapshots per case, default 30).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run import Case
+
+from tunnelkit import evaluation, extraction, scenarios, signal_route
+from tunnelkit.constants import C
+from tunnelkit.montecarlo import spawn_rngs
+
+PARAMS = ("d", "v", "direction", "w")
+DESIGN_SEED, HELD_OUT_SEED = 23, 2026
+DRIVES = ("italiano2026-straight", "italiano2026-slalom")
+BANDS = {"near": (4.0, 8.0), "mid": (15.0, 45.0), "far": (80.0, 120.0)}
+#: (name, drive or scene kind, band, SNR offset [dB])
+CASES = [
+    *[
+        (f"{d.split('-')[1]} {b} {off:+.0f} dB", d, b, off)
+        for d in DRIVES
+        for b, off in (
+            ("near", 0.0),
+            ("mid", 0.0),
+            ("far", 0.0),
+            ("mid", -10.0),
+            ("far", -10.0),
+            ("near", -20.0),
+            ("mid", -20.0),
+            ("far", -20.0),
+        )
+    ],
+    ("scene L=10", "scene10", None, 0.0),
+    ("scene close pair", "pair", None, 0.0),
+]
+
+_ROUTES: dict = {}
+
+
+def long_route(drive: str, snr_offset_db: float = 0.0) -> signal_route.SignalRoute:
+    """``drive`` in a 300 m tunnel, the trajectory from x = 122 m to x = 0.5 m (same lane, speed
+    and epoch period), at ``snr_offset_db``."""
+    key = (drive, snr_offset_db)
+    if key not in _ROUTES:
+        sc = scenarios.with_values(
+            scenarios.load_scenario(drive),
+            {"tunnel.length": 300.0, "trajectory.x_start": 122.0, "trajectory.x_end": 0.5},
+        )
+        _ROUTES[key] = signal_route.SignalRoute.from_scenario(sc, snr_offset_db=snr_offset_db)
+    return _ROUTES[key]
+
+
+def _errors(est, d_true, v_true, src, bound) -> np.ndarray:
+    """(L_true, 4) errors over the bound, ``d, v, direction, w``; ``inf`` for a missed path
+    (:func:`tunnelkit.evaluation.bound_errors`)."""
+    return evaluation.bound_errors(est, d_true, v_true, src, bound)
+
+
+def _drive_snapshot(drive, band, off, rng, search):
+    route = long_route(drive, off)
+    pos = route.trajectory.position
+    dist = np.linalg.norm(pos - route.arrays[0].origin, axis=1)
+    lo, hi = BANDS[band]
+    k = int(rng.choice(np.flatnonzero((dist >= lo) & (dist <= hi))))
+    arr, paths = route.paths(k)
+    snap = route.snapshot(paths, arr, rng)
+    t = time.process_time()
+    est = route.extract(snap.H, arr, len(paths), search=search)
+    dt = time.process_time() - t
+    src = np.stack([arr.to_local(p.source) for p in paths])
+    d_true = np.array([p.length for p in paths]) + C * snap.clock_bias
+    v_true = np.array([p.velocity for p in paths])
+    bound = extraction.path_crlb(paths, arr, route.config, snr_offset_db=off)
+    return _errors(est, d_true, v_true, src, bound), est, dt
+
+
+def close_pair(rng) -> evaluation.Scene:
+    """Four sources 2-8 m from the URA, the second a third of a beamwidth (0.067 in direction
+    cosine) and a third of the delay resolution ``c / (Nf Delta f)`` from the first."""
+    sc = evaluation.random_scene(rng, 4, snr_db=(0.0, 10.0))
+    src, d = sc.sources.copy(), sc.d.copy()
+    r0 = np.linalg.norm(src[0])
+    u0 = src[0] / r0
+    ang = rng.uniform(0, 2 * np.pi)
+    u1 = u0[:2] + (0.2 / 3) * np.array([np.cos(ang), np.sin(ang)])
+    u1 = u1 * min(1.0, 0.8 / np.linalg.norm(u1))
+    src[1] = r0 * 1.02 * np.append(u1, np.sqrt(1 - u1 @ u1))
+    cfg = sc.config
+    d[1] = d[0] + C / (cfg.n_tones * cfg.tone_spacing) / 3
+    return replace(sc, sources=src, d=d)
+
+
+def _scene_snapshot(kind, rng, search):
+    sc = evaluation.random_scene(rng, 10) if kind == "scene10" else close_pair(rng)
+    H = sc.tensor(rng)
+    t = time.process_time()
+    est = extraction.extract_paths(H, len(sc.d), sc.element_positions, sc.config, search=search)
+    dt = time.process_time() - t
+    return _errors(est, sc.d, sc.v, sc.sources, sc.crlb()), est, dt
+
+
+def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "residual") -> list:
+    """Per case: the rows of errors, the flags and the CPU seconds of ``n`` snapshots."""
+    out = []
+    for case in cases or CASES:
+        name, kind, band, off = case
+        ci = CASES.index(case)  # the seed of a case does not depend on the selection
+        errs, flags, bad, secs = [], [], [], []
+        for rng in spawn_rngs(seed * 1000 + ci, n):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                if band is None:
+                    e, est, dt = _scene_snapshot(kind, rng, search)
+                else:
+                    e, est, dt = _drive_snapshot(kind, band, off, rng, search)
+            errs.append(e)
+            flags.append(not est.fit_ok)
+            bad.append(bool(np.any(~(np.abs(e) <= 6.0))))
+            secs.append(dt)
+        out.append(
+            {
+                "case": name,
+                "errors": np.concatenate(errs),
+                "flagged": np.array(flags),
+                "bad": np.array(bad),
+                "seconds": np.array(secs),
+            }
+        )
+    return out
+
+
+def table(rows: list) -> str:
+    head = (
+        f"{'case':26s} {'paths':>5s} "
+        + " ".join(f"{'RMS ' + p:>11s}" for p in PARAMS)
+        + f" {'>6sig':>6s} {'bad':>4s} {'bad flagged':>11s} {'good flagged':>12s} {'median s':>8s}"
+    )
+    lines = [head]
+    for r in rows:
+        e = r["errors"]
+        fin = np.all(np.isfinite(e), axis=1)
+        with np.errstate(invalid="ignore"):
+            rms = np.sqrt(np.mean(e[fin] ** 2, axis=0)) if fin.any() else np.full(4, np.nan)
+        beyond = np.mean(np.any(~(np.abs(e) <= 6.0), axis=1)) * 100
+        bad, fl = r["bad"], r["flagged"]
+        bf = f"{fl[bad].sum()}/{bad.sum()}"
+        gf = f"{fl[~bad].sum()}/{(~bad).sum()}"
+        lines.append(
+            f"{r['case']:26s} {len(e):5d} "
+            + " ".join(f"{x:11.2f}" for x in rms)
+            + f" {beyond:5.1f}% {bad.sum():4d} {bf:>11s} {gf:>12s} {np.median(r['seconds']):8.3f}"
+        )
+    allbad = np.concatenate([r["bad"] for r in rows])
+    allfl = np.concatenate([r["flagged"] for r in rows])
+    lines.append(
+        f"all: {allbad.size} snapshots, {allbad.sum()} with a path beyond 6 sigma, "
+        f"{allfl[allbad].sum()} of them flagged; {allfl[~allbad].sum()} of "
+        f"{(~allbad).sum()} good snapshots flagged"
+    )
+    return "\n".join(lines)
+
+
+def _long_tensor(drive="italiano2026-straight", x=110.0, seed=0):
+    route = long_route(drive)
+    k = int(np.argmin(np.abs(route.trajectory.position[:, 0] - x)))
+    arr, paths = route.paths(k)
+    snap = route.snapshot(paths, arr, np.random.default_rng(seed))
+    return snap.H, arr, route.config, len(paths)
+
+
+def cases() -> list[Case]:
+    """The default extraction at long range (UE ~110 m and ~85 m on the straight drive), and the
+    basic search (the route before issue 23) on the same tensors as the baseline."""
+    out = []
+    for x in (110.0, 85.0):
+        H, arr, cfg, L = _long_tensor(x=x)
+
+        def run(search, H=H, arr=arr, cfg=cfg, L=L):
+            with threadpool_limits(1), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                return extraction.extract_paths(H, L, arr, cfg, search=search)
+
+        g = f"stress x={x:.0f}m"
+        out.append(
+            Case(
+                f"extract_paths L={L} UE x={x:.0f} m, basic",
+                lambda run=run: run("basic"),
+                group=g,
+                baseline=True,
+                repeat=5,
+            )
+        )
+        out.append(
+            Case(
+                f"extract_paths L={L} UE x={x:.0f} m, default",
+                lambda run=run: run("residual"),
+                group=g,
+                repeat=5,
+                goal_s=0.4,
+            )
+        )
+    return out
+
+
+def cpu_times(repeat: int = 9) -> str:
+    """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction and of
+    the basic search (the route before issue 23: re-seeding on the residual energy only) on
+    bench_ml's L = 6 tensor and on two long-range tensors (UE at x = 110 m and 85 m)."""
+    from bench_ml import _tensor
+
+    tensors = {"L=6 (bench_ml)": _tensor()}
+    for x in (110.0, 85.0):
+        H, arr, cfg, L = _long_tensor(x=x)
+        tensors[f"L={L} x={x:.0f} m"] = (H, arr, cfg, L)
+    lines = [f"CPU time per extraction, median of {repeat} (one BLAS thread)"]
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name, (H, arr, cfg, L) in tensors.items():
+            t = {"residual": [], "basic": []}
+            extraction.extract_paths(H, L, arr, cfg)  # warm-up
+            for _ in range(repeat):
+                for search in t:
+                    t0 = time.process_time()
+                    est = extraction.extract_paths(H, L, arr, cfg, search=search)
+                    t[search].append(time.process_time() - t0)
+                    if search == "residual":
+                        ok = est.fit_ok
+                    else:
+                        ok_basic = est.fit_ok
+            med = {k: float(np.median(v)) for k, v in t.items()}
+            lines.append(
+                f"  {name:18s} default {med['residual'] * 1e3:6.0f} ms (fit_ok {ok}), basic "
+                f"{med['basic'] * 1e3:6.0f} ms (fit_ok {ok_basic}), ratio "
+                f"{med['residual'] / med['basic']:.2f}"
+            )
+    return "\n".join(lines)
+
+
+def report(n: int | None = None) -> str:
+    n = n or int(os.environ.get("TUNNELKIT_BENCH_STRESS", 30))
+    parts = [cpu_times()]
+    for seed, tag in ((DESIGN_SEED, "design seed"), (HELD_OUT_SEED, "held-out seed")):
+        t0 = time.perf_counter()
+        with threadpool_limits(1):
+            rows = study(n, seed)
+        parts.append(
+            f"Stress matrix, {tag} {seed}, {n} snapshots per case "
+            f"({time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f})\n" + table(rows)
+        )
+    return "\n\n".join(parts)
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--snapshots", type=int, default=30)
+    ap.add_argument("--seed", type=int, default=HELD_OUT_SEED)
+    ap.add_argument("--search", default="residual", choices=("residual", "basic"))
+    ap.add_argument("-k", dest="pattern", default=None, help="only cases containing this")
+    ap.add_argument("--cpu", action="store_true", help="only the CPU times of the extraction")
+    a = ap.parse_args()
+    if a.cpu:
+        print(cpu_times())
+        sys.exit(0)
+    sel = [c for c in CASES if a.pattern is None or a.pattern in c[0]]
+    t0 = time.perf_counter()
+    with threadpool_limits(1):
+        res = study(a.snapshots, a.seed, sel, a.search)
+    print(
+        f"seed {a.seed}, {a.snapshots} snapshots per case, search {a.search}, "
+        f"{time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f}"
+    )
+    print(table(res))

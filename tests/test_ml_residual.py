@@ -1,0 +1,277 @@
+"""Issue 23: the residual test of the ML stage (fit_ok), the re-initialisation on the residual,
+the bounds at the SNR used, the feasible set to end-fire, caps and physically possible paths."""
+
+import warnings
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tunnelkit import arrays, channel, evaluation, extraction, signal_route
+from tunnelkit.constants import C
+from tunnelkit.extraction import ml
+from tunnelkit.extraction.ml import residual
+
+FC = 5.9e9
+LAM = C / FC
+SMALL = channel.SRSConfig(n_rb=20, comb=4, n_symbols=6)  # 60 tones x 6 symbols
+
+
+def _scene(seed, n_paths=3, **kw):
+    return evaluation.random_scene(np.random.default_rng(seed), n_paths, config=SMALL, **kw)
+
+
+def _truth(sc):
+    r = np.linalg.norm(sc.sources, axis=1)
+    return np.column_stack([sc.sources[:, :2] / r[:, None], 1 / r]), sc.mu_f, sc.mu_t
+
+
+def test_peak_threshold_is_the_quantile_of_the_largest_of_k_exponentials():
+    """Closed form against brute force: the largest of K unit exponentials exceeds the threshold
+    with the stated probability."""
+    n, pfa = 50, 0.1
+    t = residual.peak_threshold(n, pfa)
+    K = int(residual.OVERSAMPLING_CELLS * n)
+    rng = np.random.default_rng(0)
+    mx = rng.exponential(size=(20000, K)).max(axis=1)
+    assert abs(np.mean(mx > t) - pfa) < 0.012
+    assert residual.peak_threshold(10**6, 0.01) > residual.peak_threshold(10**3, 0.01)
+    with pytest.raises(ValueError, match="false_alarm"):
+        residual.peak_threshold(100, 1.0)
+    with pytest.raises(ValueError, match="n_samples"):
+        residual.peak_threshold(0)
+
+
+def test_residual_peak_of_one_atom_is_its_energy_over_the_noise_and_finds_it():
+    """A far-field atom on the grid of the test: the peak is |c|^2 N / sigma^2 (exact), at its
+    direction, delay and Doppler."""
+    pos = arrays.ura(4, 4, LAM / 2)
+    nf, nt = 32, 6
+    u = np.array([0.3, -0.2])
+    mf, mt = 2 * np.pi * 5 / (2 * nf), -2 * np.pi * 2 / (2 * nt)
+    a = np.exp(-1j * 2 * np.pi / LAM * (pos[:, :2] @ u))
+    X = np.einsum("m,s,k->msk", a, np.exp(1j * np.arange(nf) * mf), np.exp(1j * np.arange(nt) * mt))
+    c, sigma2 = 0.7 - 0.2j, 0.05
+    peak, loc, x = residual.residual_peak(c * X, pos, FC, sigma2)
+    # the grid point nearest to u (the scan grid's step is 1/30); brute-force inner product there
+    ug, A = extraction.numerics.scan_grid(pos, FC)
+    g = int(np.argmin(np.linalg.norm(ug - u, axis=1)))
+    brute = abs(np.vdot(A[:, g], (c * X).reshape(16, -1) @ np.conj(X[0].ravel()))) ** 2
+    assert peak == pytest.approx(brute / (X.size * sigma2), rel=1e-5)
+    assert peak == pytest.approx(abs(c) ** 2 * X.size / sigma2, rel=0.05)
+    np.testing.assert_allclose(loc[:2], ug[g])
+    assert loc[2] == pytest.approx(mf) and loc[3] == pytest.approx(mt)
+    assert x.shape == (16,)
+
+
+def test_residual_peak_of_noise_stays_below_the_threshold_at_the_stated_rate():
+    """Calibration of OVERSAMPLING_CELLS: noise alone exceeds the threshold at no more than the
+    stated false-alarm rate (binomial allowance for 300 draws)."""
+    rng = np.random.default_rng(3)
+    pos = arrays.ura(4, 4, LAM / 2)
+    shape = (16, 32, 6)
+    thr = residual.peak_threshold(int(np.prod(shape)), 0.05)
+    peaks = [
+        residual.residual_peak(channel.add_noise(np.zeros(shape), 1.0, rng), pos, FC, 1.0)[0]
+        for _ in range(300)
+    ]
+    assert np.mean(np.array(peaks) > thr) <= 0.05 + 2.5 * np.sqrt(0.05 * 0.95 / 300)
+    assert np.median(peaks) > 5.0  # not a test that cannot fail: the statistic is not tiny
+
+
+def test_residual_peak_refuses_bad_input_by_name():
+    pos = arrays.ura(4, 4, LAM / 2)
+    R = np.zeros((16, 8, 4), complex)
+    with pytest.raises(ValueError, match="R"):
+        residual.residual_peak(R.real, pos, FC, 1.0)
+    with pytest.raises(ValueError, match="element_positions"):
+        residual.residual_peak(R, pos[:4], FC, 1.0)
+    with pytest.raises(ValueError, match="noise_power"):
+        residual.residual_peak(R, pos, FC, 0.0)
+    with pytest.raises(ValueError, match="n_cells"):
+        residual.residual_peak(R, pos, FC, 1.0, n_cells=0)
+
+
+def test_a_wrong_basin_is_flagged_and_the_search_leaves_it():
+    """Started with one source counted twice and another missing, the local fit stays there:
+    the residual test flags it (fit_ok False) even with no re-seeding; the default search
+    re-initialises on the residual's peak, finds the missing source and passes the test."""
+    sc = _scene(71, n_paths=3, snr_db=(0.0, 5.0))
+    H = sc.tensor(np.random.default_rng(8))
+    pos, srs = sc.element_positions, sc.config
+    th, mf, mt = _truth(sc)
+    th_bad, mf_bad, mt_bad = th.copy(), mf.copy(), mt.copy()
+    th_bad[2], mf_bad[2], mt_bad[2] = th[1] + [0.004, 0.0, 0.0], mf[1], mt[1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ml.MLConvergenceWarning)
+        local = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, srs, n_reseed=0)
+    assert not local.fit_ok and local.peak > local.peak_max
+    fit = ml.fit_ml(H, (th_bad, mf_bad, mt_bad), pos, srs, n_reseed=3, search="residual")
+    assert fit.fit_ok and fit.peak <= fit.peak_max and fit.rho <= fit.rho_max
+    est = ml.estimates_from_fit(fit, pos, srs, SMALL.n_tones, SMALL.n_symbols, 0.0)
+    assert est.fit_ok is True
+    err = evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb())
+    assert np.all(np.abs(err) < 5.0), err
+
+
+def test_a_right_fit_passes_and_a_missed_path_is_flagged():
+    sc = _scene(11, n_paths=3, snr_db=(0.0, 10.0))
+    H = sc.tensor(np.random.default_rng(5))
+    est = extraction.extract_paths(H, 3, sc.element_positions, sc.config)
+    assert est.fit_ok is True and est.fit.peak < est.fit.peak_max
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ml.MLConvergenceWarning)
+        two = extraction.extract_paths(H, 2, sc.element_positions, sc.config)
+    assert two.fit_ok is False and two.fit.peak > 10 * two.fit.peak_max
+    assert (
+        extraction.extract_paths(H, 3, sc.element_positions, sc.config, refine="joint").fit_ok
+        is None
+    )
+
+
+def test_a_path_near_end_fire_is_inside_the_feasible_set():
+    """A source at u_z = 0.011 (|u| = 0.99994, outside the former |u| <= 0.999): found at the
+    bound, not pinned to the edge of the feasible set."""
+    rng = np.random.default_rng(2)
+    sc = _scene(5, n_paths=2, snr_db=(5.0, 10.0))
+    src = sc.sources.copy()
+    uz = 0.011
+    src[1] = 5.0 * np.array([np.sqrt(1 - uz**2), 0.0, uz])
+    sc = replace(sc, sources=src)
+    est = extraction.extract_paths(sc.tensor(rng), 2, sc.element_positions, sc.config)
+    assert est.fit_ok
+    err = evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, sc.crlb())
+    assert np.all(np.abs(err) < 5.0), err
+    assert ml.model.U_MAX > np.sqrt(1 - uz**2)
+
+
+def test_path_crlb_takes_the_snr_actually_used():
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    arr, paths = route.paths(10)
+    b0 = extraction.path_crlb(paths, arr, route.config)
+    b = extraction.path_crlb(paths, arr, route.config, snr_offset_db=-20.0)
+    for key in ("d", "v", "direction", "kappa"):
+        np.testing.assert_allclose(b[key], 10.0 * b0[key], rtol=1e-6)
+    with pytest.raises(ValueError, match="snr_offset_db"):
+        extraction.path_crlb(paths, arr, route.config, snr_offset_db=np.nan)
+    # the same SNR as the synthesis: the noise power of a snapshot at that offset
+    snap = channel.synthesize(paths, route.config, np.random.default_rng(0), snr_offset_db=-20.0)
+    assert snap.noise_power == pytest.approx(route.config.noise_power * 100.0)
+
+
+def test_iteration_caps_and_search_are_checked_by_name():
+    sc = _scene(31, n_paths=2)
+    H = sc.tensor(np.random.default_rng(0))
+    pos, srs = sc.element_positions, sc.config
+    with pytest.raises(ValueError, match="max_iter"):
+        ml.ml_paths(H, 2, pos, srs, max_iter=10**7)
+    with pytest.raises(ValueError, match="n_reseed"):
+        ml.ml_paths(H, 2, pos, srs, n_reseed=10**7)
+    with pytest.raises(ValueError, match="max_iter"):
+        ml.fit_ml(H, _truth(sc), pos, srs, max_iter=10**7)
+    with pytest.raises(ValueError, match="polish"):
+        extraction.extract_paths(H, 2, pos, srs, refine="joint", polish=10**7)
+    with pytest.raises(ValueError, match="n_iter_max"):
+        extraction.extract_paths(H, 2, pos, srs, refine="joint", n_iter_max=10**7)
+    with pytest.raises(ValueError, match="search"):
+        extraction.extract_paths(H, 2, pos, srs, search="fast")
+    with pytest.raises(ValueError, match="search"):
+        extraction.extract_paths(H, 2, pos, srs, refine="joint", search="basic")
+    with pytest.raises(ValueError, match="search"):
+        ml.fit_ml(H, _truth(sc), pos, srs, search="x")
+    tiny = channel.SRSConfig(scs=1e300, bandwidth=1e305, fc=1e306)  # T0 = 1e-300 s
+    with pytest.raises(ValueError, match="fc"):
+        extraction.extract_paths(H, 2, pos, tiny)
+    odd = channel.SRSConfig(scs=1e11, bandwidth=1.5e12, fc=9e11, n_rb=1, comb=1)
+    with pytest.raises(ValueError, match="symbol_period"):
+        extraction.extract_paths(H, 2, pos, odd)
+
+
+def test_a_physically_impossible_path_is_never_valid():
+    sc = _scene(21, n_paths=2, snr_db=(5.0, 10.0))
+    est = extraction.extract_paths(
+        sc.tensor(np.random.default_rng(1)), 2, sc.element_positions, sc.config
+    )
+    ok = ml.physical(est, sc.config)
+    assert ok.all()
+    fast = replace(est, v=est.v + np.array([0.0, 2 * C]))
+    np.testing.assert_array_equal(ml.physical(fast, sc.config), [True, False])
+    behind = est.direction.copy()
+    behind[0, 2] = -behind[0, 2]
+    np.testing.assert_array_equal(
+        ml.physical(replace(est, direction=behind), sc.config), [False, True]
+    )
+    close = replace(est, kappa=np.array([0.1, est.kappa[1]]))
+    assert not ml.physical(close, sc.config)[0]
+    with pytest.raises(TypeError, match="srs"):
+        ml.physical(est, 5.9e9)
+
+
+def test_the_drive_adapter_drops_a_flagged_epoch():
+    from tunnelkit import studies
+
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ep = route.epoch(10, np.random.default_rng(0))
+    assert ep.estimates.fit_ok is True
+    pm, why = studies.path_measurements(ep, route)
+    assert pm is not None and why is None
+    flagged = replace(ep, estimates=replace(ep.estimates, fit_ok=False))
+    pm, why = studies.path_measurements(flagged, route)
+    assert pm is None and why == studies.drives.FLAGGED
+
+
+def test_mie_threshold_is_where_a_noise_cell_beats_the_path_half_the_time():
+    """Brute force: K unit exponentials (noise cells) against the path's cell |sqrt(eta) + n|^2
+    (n ~ CN(0, 1)) at eta = the threshold: the path loses about half the time."""
+    from tunnelkit import efficiency
+
+    K = 300
+    eta = 10 ** (efficiency.mie_threshold_db(K) / 10)
+    assert eta == pytest.approx(np.log(2 * K))
+    rng = np.random.default_rng(0)
+    n = (rng.standard_normal(4000) + 1j * rng.standard_normal(4000)) / np.sqrt(2)
+    path = np.abs(np.sqrt(eta) + n) ** 2
+    noise = rng.exponential(size=(4000, K)).max(axis=1)
+    assert 0.2 < np.mean(noise > path) < 0.6
+    with pytest.raises(ValueError, match="n_cells"):
+        efficiency.mie_threshold_db(0)
+
+
+def test_bound_errors_assign_clustered_paths_by_the_bound():
+    sc = _scene(9, n_paths=2, snr_db=(5.0, 10.0))
+    est = extraction.extract_paths(
+        sc.tensor(np.random.default_rng(4)), 2, sc.element_positions, sc.config
+    )
+    b = sc.crlb()
+    e = evaluation.bound_errors(est, sc.d, sc.v, sc.sources, b)
+    assert e.shape == (2, 4) and np.all(np.abs(e) < 5.0)
+    # the truth moved by exactly 2 sigma in d: the error column reads -2 more
+    e2 = evaluation.bound_errors(est, sc.d + 2 * b["d"], sc.v, sc.sources, b)
+    np.testing.assert_allclose(e2[:, 0], e[:, 0] - 2.0, atol=1e-9)
+    none = replace(est, significance=np.zeros(2))
+    assert np.all(np.isinf(evaluation.bound_errors(none, sc.d, sc.v, sc.sources, b)))
+
+
+def test_threshold_study_finds_the_bound_above_and_flags_below():
+    from tunnelkit import efficiency
+
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    cfg = replace(route.config, n_rb=10, comb=4)
+    los = signal_route.SignalRoute(
+        route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los",)
+    )
+    arr, paths = los.paths(12)
+    N = arr.M * cfg.n_tones * cfg.n_symbols
+    eta0 = 10 * np.log10(abs(paths[0].gain) ** 2 * cfg.tx_power * N / cfg.noise_power)
+    th = efficiency.mie_threshold_db(N)
+    rows = efficiency.threshold_study(los, [12], [th + 20 - eta0, th - 8 - eta0], 3, seed=1)
+    hi, lo = rows
+    assert hi["integrated SNR [dB]"] == pytest.approx(th + 20)
+    assert hi["beyond 6 sigma"] == 0.0 and hi["RMS/CRLB direction"] < 3.0 and hi["flagged"] == 0
+    assert lo["beyond 6 sigma"] == 1.0 and lo["flagged"] == 1.0
+    with pytest.raises(ValueError, match="snr_offsets_db"):
+        efficiency.threshold_study(los, [12], [np.nan], 1, seed=1)
+    with pytest.raises(ValueError, match="n_snapshots"):
+        efficiency.threshold_study(los, [12], [0.0], 0, seed=1)
