@@ -146,7 +146,7 @@ print(
 # $\hat\mu = \angle\,\mathrm{diag}(\hat B_-^H \hat B_+)$, giving
 # $\hat d = -\frac{c}{2\pi\Delta f}\hat\mu^f$ (eq. 14) and $\hat v = \frac{c}{2\pi f_c T_0}\hat\mu^t$
 # (eq. 15). The spatial factor's phase, unwrapped in 2-D over the URA grid (eq. 16, scikit-image's
-# Herráez et al. algorithm, the paper's ref. 25), gives the path-length offsets $\hat\delta_m$.
+# Herráez et al. 2002 algorithm, the paper's ref. 25), gives the path-length offsets $\hat\delta_m$.
 
 # %%
 est = extraction.extract_paths(snap.H, len(paths), array, cfg, refine="joint")

@@ -399,7 +399,9 @@ information_figure(drive, setup, sigma_hz=32.79, sigma_range=1.0).show()
 # %% [markdown]
 # Over time the posterior CRLB (Tichavský et al. 1998) adds the motion model: for the linear
 # constant-velocity dynamics $J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + H_k^T R^{-1} H_k$, started from
-# the GNSS fix, $J_0 = P_0^{-1}$. It bounds the error of *any* unbiased tracker under that model.
+# the GNSS fix, $J_0 = P_0^{-1}$. It bounds the mean-square error of *any* tracker under that
+# model and prior, biased or not: a Bayesian bound averages over the prior and the
+# noise together and needs no unbiasedness (notebook 05 says the same of its filters).
 
 # %%
 bounds = {
