@@ -393,3 +393,11 @@ def test_notebook_04_and_its_appendix_04b_resolve_and_04_has_an_explorers_view(t
     assert src[-1].startswith("explorer = epoch_explorer(drive_ml, ev_ml, k=k)")
     with pytest.raises(lec.LectureError, match="no code cell tagged 'explorer'"):
         lec.explorers_notebook(lec.resolve_notebook("04b"), tmp_path / "b")
+
+
+def test_title_of_drops_markdown_emphasis_but_keeps_tex():
+    nb = {"cells": [{"cell_type": "markdown", "source": "# 08 · How many for *your* `tunnel`?"}]}
+    assert lec.title_of(nb, "x") == "08 · How many for your tunnel?"
+    nb = {"cells": [{"cell_type": "markdown", "source": "# 02 · **Bold** $M_{\\max}$ bound"}]}
+    assert lec.title_of(nb, "x") == "02 · Bold $M_{\\max}$ bound"
+    assert lec.title_of({"cells": []}, "fallback") == "fallback"

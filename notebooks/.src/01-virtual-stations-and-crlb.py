@@ -4,7 +4,8 @@
 # *Jiang, Wang & Peng (2023), "A Single-Site Vehicle Positioning Method in the Rectangular Tunnel
 # Environment", Remote Sensing 15, 527, [doi:10.3390/rs15020527](https://doi.org/10.3390/rs15020527),
 # sections 2, 3 and 4.1, Appendix A.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #

@@ -4,7 +4,8 @@
 # *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
 # and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
 # section 3.1 (Theorems 3.1 and 3.4, eq. 25–42) and section 4.2.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #
@@ -48,7 +49,7 @@ tk.setup_notebook()
 #
 # $$\mathbf p_v = (R,\; 2W - y_u).$$
 #
-# The SR-NF model (Italiano et al., after TeNFiLoc) describes the same path instead as a spherical
+# The SR-NF model (Italiano et al., after [TeNFiLoc](GLOSSARY.md#tenfiloc), the snapshot method of notebook 04) describes the same path instead as a spherical
 # wave from **one point on the wall**, $\mathbf p_{s,0}$, the specular point of the reference
 # antenna. For a small array the two pictures agree; for a large one the wavefront across the
 # array is visibly centred on the VUE, not on the wall. The figure is Fig. 2 of the paper

@@ -4,14 +4,15 @@
 # *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
 # and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
 # sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #
 # - how the image method turns a tunnel (semicircular facets, road, metallic road markings)
 #   into a handful of paths, each with a virtual UE (VUE), a reflection point, a delay, an
 #   angle, a Doppler shift and an exact length to *every* antenna;
-# - how those paths build the uplink SRS channel tensor $\mathcal{H}$ (eq. 1, 3) and why its
+# - how those paths build the uplink [SRS](GLOSSARY.md#srs) (sounding reference signal) channel tensor $\mathcal{H}$ (eq. 1, 3) and why its
 #   canonical polyadic decomposition (CPD) hands the paths back one rank-1 term each;
 # - the paper's extraction chain: scaling fix and Vandermonde roots (eq. 12–15), 2-D phase
 #   unwrapping (eq. 16), TLS near-field / LS far-field solutions (eq. 17–24), Algorithm 1;
@@ -160,7 +161,7 @@ factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
 # between paths over 12 symbols (Doppler resolution $1/(N_tT_0) \approx 2.3$ kHz, i.e. 119 m/s,
 # printed in section 2),
 # and the frequency factor barely separates paths closer than $c/BW = 3$ m. So
-# `extract_paths` (1) compresses $\mathcal{H}$ to an $L\times L\times L$ core (truncated HOSVD),
+# `extract_paths` (1) compresses $\mathcal{H}$ to an $L\times L\times L$ core (truncated [HOSVD](GLOSSARY.md#hosvd), the higher-order SVD),
 # (2) initialises the core's CPD algebraically from a *shift invariance* — of the URA rows
 # (angles differ by degrees) and of the Vandermonde frequency factor — (3) refines with
 # tensorly's `parafac(init=..., linesearch=True)` on the core, (4) lifts back and polishes with
@@ -198,7 +199,7 @@ paths_table_figure(rows, title="Extracted vs true (kappa: NaN = far-field fallba
 # %% [markdown]
 # The ceiling path and the LoS share delay and Doppler within a fraction of the resolution, so
 # only the spatial factor tells them apart, and a CPD with a free spatial factor struggles:
-# Kruskal's condition $\mathrm{kr}(B^s)+\mathrm{kr}(B^f)+\mathrm{kr}(B^t)\ge 2L+2$ holds in exact
+# [Kruskal's](GLOSSARY.md#kruskal-rank) condition $\mathrm{kr}(B^s)+\mathrm{kr}(B^f)+\mathrm{kr}(B^t)\ge 2L+2$ holds in exact
 # arithmetic but, numerically, the time factor has Kruskal rank 1.
 
 # %%
@@ -218,7 +219,7 @@ print("Kruskal rank (frequency, time) at tolerance 1e-6 and 1e-2:", kr)
 # Eq. 13 sums $\bar b_n b_{n+1}$: its phase error telescopes to the two end samples, so its
 # variance falls as $1/N^2$ instead of the $1/N^3$ of the maximum-likelihood (periodogram) root.
 # `extract_paths(refine=...)` offers the paper's `"none"`, a per-column periodogram `"column"`
-# and `"joint"`: all roots refined together with free spatial factors (variable projection), the
+# and `"joint"`: all roots refined together with free spatial factors ([variable projection](GLOSSARY.md#variable-projection)), the
 # ML estimate of exactly the model a CPD fits plus the Vandermonde structure; and `"ml"`, the
 # fit of eq. 1 itself (section 7). We compare them on LoS + road (no ceiling, so the comparison
 # is not dominated by it).
@@ -334,9 +335,9 @@ print(
 # A **structured** fit estimates the five numbers per path (direction, $\kappa$, $d$, $v$) plus
 # the gain directly from the whole tensor with the exact model of eq. 1: maximum likelihood,
 # which at this SNR is efficient — it reaches the CRLB. `extraction.ml` does it by variable
-# projection (gains by linear least squares), Levenberg–Marquardt with analytic derivatives built
+# projection (gains by linear least squares), [Levenberg–Marquardt](GLOSSARY.md#levenberg-marquardt) with analytic derivatives built
 # from the rank-one structure (never an $MN_fN_t \times 5L$ matrix), started from the CPD and the
-# coherent split, with SAGE-like re-seeding of a path when the residual stands above the noise
+# coherent split, with [SAGE](GLOSSARY.md#sage)-like re-seeding of a path when the residual stands above the noise
 # floor (the *basin test*: at the right optimum $\rho = \lVert r\rVert^2/(\text{dof}\,\sigma^2) \approx 1$).
 # It is `extract_paths`' default. The bounds of the two models differ too: the free-factor model
 # has more unknowns, so even its own bound on $d$ is looser.
@@ -556,10 +557,11 @@ for name, r in imp_los.items():
 #    `fit.rho_max` (the basin test) and `fit.significance`. What went wrong, and how does the
 #    fit tell you?
 #
-# The solution runs in the next cells.
+# The solution cells below run with the notebook; click the collapsed cell (or its blue bar)
+# to see the code and its output once you have tried.
 
 
-# %%
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Exercise 4, solution (a): starts in the wrong basin, on the tensor of sections 2-4
 def truth_start(paths, array, clock_bias):
     """(theta, mu_f, mu_t) of the true paths: (u_x, u_y, 1/kappa) in the array frame, roots."""
@@ -582,7 +584,7 @@ fits = {
 for name, f in fits.items():
     print(f"{name:30s} rho = {f.rho:9.3f} (basin test passes below {f.rho_max:.4f})")
 
-# %%
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Exercise 4, solution (b): the wrong number of paths, on a LoS + road tensor
 arr2, paths2 = two.paths(k_demo)
 snap2 = channel.synthesize(paths2, cfg, np.random.default_rng(4))

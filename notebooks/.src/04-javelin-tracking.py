@@ -5,7 +5,8 @@
 # and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
 # sections 3.2–3.5 (eq. 43–68, Algorithms 1–4) and 4 (Figs. 6–7; the TeNFiLoc baseline's eq. 69
 # is in section 4.3).
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #
@@ -19,7 +20,7 @@
 # - the chi-square gate (eq. 56–59), nearest-neighbour association (Algorithm 2), births, deaths,
 #   the LoS test (eq. 60–61) and the Doppler test (Algorithm 3), epoch by epoch with a slider;
 # - the Joseph-form EKF update (eq. 64–68) and the whole loop of Algorithm 4;
-# - the trajectories of Fig. 6 (JAVELIN against the snapshot baseline TeNFiLoc) and the error
+# - the trajectories of Fig. 6 (JAVELIN against the snapshot baseline [TeNFiLoc](GLOSSARY.md#tenfiloc)) and the error
 #   CDFs of Fig. 7 on a few drives.
 #
 # The reproduction of Tables 1–2 over 20 runs, the road-marking ablation and how our design was
@@ -431,10 +432,11 @@ print("90th percentile of the 2-D error [m]:", {n: round(v, 3) for n, v in p90.i
 #    `config.fc, config.tone_spacing, config.symbol_period`). Match the results to the true paths
 #    with `match_paths` (`tunnelkit.evaluation`). What does each extra source buy?
 #
-# The solutions are in the collapsed cells below (click to expand, then run); what to read in
-# their output follows them.
+# The solutions are the collapsed cells below: they run with the notebook, and clicking one
+# (or its blue bar) shows its code and output once you have tried. What to read in their output
+# follows them.
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: the paper's design on the paper's route, one change, then a second
 steps = {
     "paper (section 4.2)": designs.paper(),
@@ -446,7 +448,7 @@ steps = {
 for name, cfg in steps.items():
     print(f"{name:34s} 2-D RMSE {ex.evaluate(drive, cfg).metrics['rmse_2d_m']:6.2f} m")
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 2: tracks that survive up to three missed epochs
 for zeta in (designs.ours().config.max_misses, 3):
     ev_z = ex.evaluate(drive, designs.ours().with_(max_misses=zeta), keep_reports=True)
@@ -457,7 +459,7 @@ for zeta in (designs.ours().config.max_misses, 3):
         f"{np.mean(ev_z.run.n_tracks):4.1f}, 2-D RMSE {ev_z.metrics['rmse_2d_m']:.2f} m"
     )
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 3: the curvature model on both routes
 sol3 = {}
 for route_name, d in (("ML route", drive_ml), ("paper route", drive)):
@@ -469,7 +471,7 @@ for route_name, d in (("ML route", drive_ml), ("paper route", drive)):
         f"{sol3[route_name][1]:6.2f} m"
     )
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 4: split merged CPD components into 1, 2 or 3 sources
 route = SignalRoute.from_scenario("italiano2026-straight")
 ep = route.epoch(5, np.random.default_rng(1), refine="joint")

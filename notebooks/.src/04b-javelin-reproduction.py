@@ -4,7 +4,8 @@
 # *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
 # and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
 # sections 4.2–4.3 (Tables 1–2, Fig. 7) and the JAVELIN design of sections 3.2–3.5 (eq. 43–68).
-# All references: `REFERENCES.md` at the top of the repository. Read notebook 04 first: it teaches
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md). Read notebook 04 first: it teaches
 # the tracker; this appendix measures it.*
 #
 # **What you will learn**
@@ -266,14 +267,15 @@ javelin_table_figure(
 #    `r.manage.born` of each report) and the share of epochs that deliver an RRM path
 #    (`d.kinds[k][t]` of each matched path `t` in `d.truth_index[k]`).
 #
-# The solutions are in the collapsed cells below (click to expand, then run).
+# The solutions are the collapsed cells below: they run with the notebook, and clicking one
+# (or its blue bar) shows its code and output once you have tried.
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1
 sl_cols, sl_rows = ex.ablation(slalom, ml=slalom_ml, progress=True)
 javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D RMSE [m]")
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 2
 refit = designs.design_from_errors(erows)
 for name, by_cond in (("straight", straight_ml), ("slalom", slalom_ml)):
@@ -284,7 +286,7 @@ for name, by_cond in (("straight", straight_ml), ("slalom", slalom_ml)):
     print(name, {k: round(float(v), 3) for k, v in scores.items()})
 
 
-# %% jupyter={"source_hidden": true}
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 3
 def rrm_share_and_births(d):
     """Share of epochs with a matched RRM path, and JAVELIN's births on the drive."""

@@ -4,7 +4,8 @@
 # *Halili, BniLam, Yusuf, Tanghe, Joseph, Weyn & Berkvens (2022), "Vehicle Localization Using
 # Doppler Shift and Time of Arrival Measurements in a Tunnel Environment", Sensors 22, 847,
 # [doi:10.3390/s22030847](https://doi.org/10.3390/s22030847), sections 2–6.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #
