@@ -264,10 +264,20 @@ ratio25 = fresnel.mmax_2d(R_grid[None, :], W, y_grid[:, None], fc, eps) / exact_
 pv_grid = np.stack(np.broadcast_arrays(R_grid[None, :], 2 * W - y_grid[:, None], 0.0), -1)
 ratio37 = fresnel.mmax_3d(pv_grid, fc, eps) / exact_map
 ratio_map_figure(
-    R_grid, y_grid, ratio25, title="eq. 25 / exact Mmax (5.9 GHz, W = 3 m)", W=W
+    R_grid,
+    y_grid,
+    ratio25,
+    title="eq. 25 / exact Mmax (5.9 GHz, W = 3 m)",
+    W=W,
+    colorbar_title="eq. 25 / exact",
 ).show()
 ratio_map_figure(
-    R_grid, y_grid, ratio37, title="eq. 37 / exact Mmax (5.9 GHz, W = 3 m)", W=W
+    R_grid,
+    y_grid,
+    ratio37,
+    title="eq. 37 / exact Mmax (5.9 GHz, W = 3 m)",
+    W=W,
+    colorbar_title="eq. 37 / exact",
 ).show()
 far = R_grid >= 100
 floor_gap = np.floor(fresnel.mmax_2d(R_grid[far], W, y_grid[:, None], fc, eps)) - exact_map[:, far]
