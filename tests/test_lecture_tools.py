@@ -401,3 +401,24 @@ def test_title_of_drops_markdown_emphasis_but_keeps_tex():
     nb = {"cells": [{"cell_type": "markdown", "source": "# 02 · **Bold** $M_{\\max}$ bound"}]}
     assert lec.title_of(nb, "x") == "02 · Bold $M_{\\max}$ bound"
     assert lec.title_of({"cells": []}, "fallback") == "fallback"
+
+
+def test_site_collapses_solution_cells():
+    from nbconvert import HTMLExporter
+
+    site = load_tool("site")
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [
+        nbformat.v4.new_markdown_cell("# 09 · x"),
+        nbformat.v4.new_code_cell("print('shown')"),
+        nbformat.v4.new_code_cell("print('answer')", metadata={"tags": ["solution"]}),
+    ]
+    exporter = HTMLExporter(
+        template_name="lab",
+        extra_template_paths=[str(site.TEMPLATE_DIR)],
+        template_file="chapter.html.j2",
+    )
+    body, _ = exporter.from_notebook_node(nb, resources={"tk_mathjax": ""})
+    assert body.count('<details class="tk-solution">') == 1
+    details = body.split('<details class="tk-solution">', 1)[1].split("</details>", 1)[0]
+    assert "answer" in details and "shown" not in details

@@ -356,17 +356,40 @@ explorer
 # 3. An engineer wants a $16 \times 16$ URA at 28 GHz in the tunnel of section 5 (far lane). From
 #    which distance on does the SR-NF model hold for it?
 #
-# <details><summary>Hints and solutions</summary>
+# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
+# its blue bar) shows its code and output once you have tried. What to read in them follows.
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 1: from which distance on is eq. 25 within 5 % of the exact Mmax?
+Rs = np.geomspace(1, 300, 400)
+r_ex = fresnel.mmax_2d(Rs, 3, 2.5, 5.9e9, 0.15) / fresnel.mmax_exact_grid(Rs, 3, 2.5, 5.9e9, 0.15)
+off = np.abs(r_ex - 1) >= 0.05
+r_from = Rs[np.flatnonzero(off)[-1] + 1]
+print(f"eq. 25 within 5 % for every R >= {r_from:.1f} m, where (2W - y_u)/R = {3.5 / r_from:.2f}")
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 2: the opposite lane at 28 GHz
+summ = fresnel.mmax_summary(30, 3, -2, 28e9, 0.15)
+for name in ("exact", "eq25", "eq37", "nonparaxial"):
+    v = getattr(summ, name)
+    print(f"{name:12s} {v:6.2f}  {'unsafe' if v > summ.exact + 0.5 else 'safe'}")
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 3: a 16 x 16 URA at 28 GHz in the far lane of section 5's tunnel
+R_try = np.arange(5.0, 60.0, 0.5)
+mis16 = np.array([fresnel.phase_mismatch_ura(16, R, 5, -1.75, 28e9, z_u=-3.3) for R in R_try])
+r16 = R_try[np.flatnonzero(mis16 > 0.15)[-1] + 1]
+print(f"mismatch {mis16[R_try == 15][0]:.3f} rad at 15 m; within 0.15 rad from R = {r16:.1f} m on")
+print("exact URA Mmax there:", fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15, z_u=-3.3))
+
+# %% [markdown]
+# <details><summary>What to read in the solutions</summary>
 #
-# 1. `Rs = np.geomspace(1, 300, 400)`; `r = fresnel.mmax_2d(Rs, 3, 2.5, 5.9e9, 0.15) /
-#    fresnel.mmax_exact_grid(Rs, 3, 2.5, 5.9e9, 0.15)`; the first `Rs` with `abs(r - 1) < 0.05`
-#    for good is about 10 m, where $(2W - y_u)/R \approx 0.35$: "$\ll 1$" need not be very small.
-# 2. `fresnel.mmax_summary(30, 3, -2, 28e9, 0.15)`: exact 19; eq. 37 says 24.5 — unsafe, it drops
-#    the factor $W/(W - y_u) = 0.6$; eq. 25 says 18.9 (close, $(2W - y_u)/R = 0.27$); the
-#    second-order bound says 19.9.
-# 3. Loop over `R` with `fresnel.phase_mismatch_ura(16, R, 5, -1.75, 28e9, z_u=-3.3) <= 0.15`:
-#    the mismatch falls with distance, 0.171 rad at 15 m and 0.149 rad at 20 m, so from about
-#    20 m on (`fresnel.mmax_exact_ura(20, 5, -1.75, 28e9, 0.15, z_u=-3.3)` is 16).
+# 1. "$\ll 1$" need not be very small: eq. 25 is within 5 % once $(2W - y_u)/R$ is about a third.
+# 2. Eq. 37 is unsafe here: it drops the factor $W/(W - y_u)$; eq. 25 is close (its paraxial
+#    ratio $(2W - y_u)/R$ is small) and the second-order bound is close too.
+# 3. The mismatch falls with distance; from the printed distance on the SR-NF model holds for the
+#    $16 \times 16$ URA, where the exact $M_{\max}$ of the URA reaches 16.
 #
 # </details>
 
@@ -382,6 +405,9 @@ assert np.abs(err28[1:]).min() > eps  # eq. 28 alone is off outside the paraxial
 assert m_exact == 15 and m_ura == 11  # exact: the paper's M = 100 (10 x 10) is safe (side wall)
 # ... but not for the ceiling of the section 4.1 tunnel, at any epoch of the drive
 assert min(mism["ceiling"]) > eps, mism["ceiling"]
+# exercises: the solutions' readings
+assert 0.2 < 3.5 / r_from < 0.5 and summ.eq37 > summ.exact + 0.5 > summ.eq25
+assert fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15, z_u=-3.3) >= 16
 assert fresnel.phase_mismatch_ura(10, R, W, y_u, fc) <= eps
 assert np.abs(floor_gap).max() <= 1 and abs(ratio25[:, far] - 1).max() < 0.08  # tight far away
 assert ratio25.min() < 0.5  # ... and loose close to the anchor
