@@ -37,7 +37,6 @@ SOURCES = ".src"
 SOLUTION_TAG = "solution"
 #: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
 MARKDOWN_SOLUTIONS = {
-    "01-virtual-stations-and-crlb",
     "05-upf-tracking",
     "06-doppler-kf-tracking",
     "07-ray-tracer-crosscheck",
