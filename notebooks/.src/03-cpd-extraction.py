@@ -536,9 +536,9 @@ for name, r in imp_los.items():
 #    `arr, ps = route.paths(12, tunnel=tun)`: the LoS and the road bounce are gone, the RRM and
 #    ceiling paths remain; the earliest arrival (path 0, the reference of $\Delta d$) is then a
 #    reflection, which is why JAVELIN tracks VUEs rather than assuming a LoS.
-# 2. On the paper's route (`refine="joint"`), at epoch 12 (200 snapshots) the LoS $d$ RMSE is
-#    about 0.47 m with the ceiling, 0.12 m
-#    without it, and 0.2 mm with LoS + road only: the ceiling path has the same delay and
+# 2. On the paper's route (`refine="joint"`) the LoS $d$ RMSE is decimetres with the ceiling
+#    (the first table of section 6), several times smaller without it, and a fraction of a
+#    millimetre with LoS + road only (the second table): the ceiling path has the same delay and
 #    Doppler as the LoS within the noise, so the CPD must split their sum with the spatial factor
 #    alone, and a free spatial factor can rotate between them (Kruskal rank 1 in time, section 4).
 #    The free-model CRLB grows accordingly (compare `extraction.path_crlb` with and without it).

@@ -123,7 +123,7 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 
 # %% [markdown]
 # Two things stand out. (i) The LoS path and the ceiling reflection arrive almost together (the
-# BS hangs 0.2 m under the ceiling): the CPD mixes them, so their angles are off by degrees and
+# array hangs just under the ceiling): the CPD mixes them, so their angles are off by degrees and
 # their curvature belongs to neither. (ii) The paper's route reads $\hat\kappa$ tens of metres
 # away from both eq. 51 and the VUE distance — not because a 23 cm aperture cannot measure it
 # (notebook 03: its Cramér–Rao bound is centimetres), but because a CPD with free spatial factors
@@ -143,7 +143,7 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 #
 # is **one** rank-one term. The CPD returns one component whose spatial factor is a mixture, and
 # eq. 16–24 read one biased direction from it; the spare component of the rank-$L$ fit goes to
-# noise. The ceiling bounce (0.2 m above the BS, centimetres longer than the LoS) is the worst
+# noise. The ceiling bounce (just above the array, centimetres longer than the LoS) is the worst
 # case, and the road bounce is not far behind.
 #
 # The array still tells them apart: the steering vector of a point source $\mathbf q$ (eq. 1–2,
