@@ -140,7 +140,7 @@ def tunnel3d_figure(
             "yaxis_title": "y [m]",
             "zaxis_title": "z [m]",
             # far enough out that both ends (the base station's included) stay in the view
-            "camera": {"eye": {"x": -1.6, "y": -2.2, "z": 1.1}},
+            "camera": {"eye": {"x": -0.7, "y": -3.0, "z": 1.3}},
         },
     )
     return fig
