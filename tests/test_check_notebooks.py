@@ -98,3 +98,17 @@ def test_git_commits_a_notebook_without_the_outputs_in_its_working_copy(tmp_path
     assert git("show", "HEAD:nb.ipynb") == src.read_text()
     assert "autosaved" in (tmp_path / "nb.ipynb").read_text()  # the working copy keeps them
     assert git("status", "--porcelain") == ""
+
+
+def test_every_glossary_link_of_the_notebooks_has_its_entry():
+    import re
+
+    glossary = (ROOT / "notebooks" / "GLOSSARY.md").read_text()
+    anchors = set(re.findall(r'<a id="([\w-]+)"></a>', glossary))
+    links = {
+        (src.name, a)
+        for src in (ROOT / "notebooks" / ".src").glob("*.py")
+        for a in re.findall(r"GLOSSARY\.md#([\w-]+)", src.read_text())
+    }
+    assert links, "no notebook links a glossary entry"
+    assert {a for _, a in links} <= anchors, sorted(links)

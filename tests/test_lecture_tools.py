@@ -422,3 +422,12 @@ def test_site_collapses_solution_cells():
     assert body.count('<details class="tk-solution">') == 1
     details = body.split('<details class="tk-solution">', 1)[1].split("</details>", 1)[0]
     assert "answer" in details and "shown" not in details
+
+
+def test_site_glossary_page_and_links():
+    site = load_tool("site")
+    text = (Path(__file__).resolve().parents[1] / "notebooks" / "GLOSSARY.md").read_text()
+    page = site.glossary_html(text)
+    assert '<a id="srs"></a>' in page and "sounding reference signal" in page
+    body = '<a href="GLOSSARY.md#srs">SRS</a> and <a href="GLOSSARY.md">glossary</a>'
+    assert site.glossary_links(body).count('href="glossary.html') == 2
