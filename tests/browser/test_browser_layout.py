@@ -146,6 +146,7 @@ def test_no_hidden_trace_no_repeated_legend_entry_no_unnamed_colour(chapter, sit
     page.goto(site_url + f"{chapter}.html", wait_until="load")
     page.wait_for_selector(".js-plotly-plot .main-svg", timeout=30_000)
     figures = page.evaluate(FIGURES)
+    assert figures and any(fig["data"] for fig in figures), f"{chapter}: no figure data read"
     problems = [
         p
         for i, fig in enumerate(figures)
