@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import plotly.graph_objects as go
+import pytest
 
 from tunnelkit.plots import cdf_figure, factors_figure, wave_origins_figure
 from tunnelkit.plots.common import line_figure, reveal_overlaps
@@ -49,6 +50,8 @@ def test_coinciding_lines_are_revealed_and_distinct_ones_left_alone():
     cdf = cdf_figure({"EKF": y, "UKF": y})
     assert figcheck.figure_problems(_json(cdf)) == []
     assert reveal_overlaps(go.Figure()) is not None
+    with pytest.raises(TypeError, match="fig"):
+        reveal_overlaps({"data": []})
 
 
 def test_factor_panels_and_the_cdf_panels_name_every_colour_once():

@@ -50,6 +50,8 @@ def reveal_overlaps(fig: go.Figure) -> go.Figure:
     """Keep every line visible where two coincide: a line drawn over an earlier one with the same
     points (EKF and UKF on a nearly linear problem) is dashed, and the earlier one widened, so
     both can be seen and told apart. Returns ``fig``, changed in place."""
+    if not isinstance(fig, go.Figure):
+        raise TypeError(f"fig: expected a plotly Figure, got {type(fig).__name__}")
     lines = [t for t in fig.data if "lines" in (getattr(t, "mode", None) or "lines")]
     for j, late in enumerate(lines):
         n_under = 0
