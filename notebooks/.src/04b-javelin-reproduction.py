@@ -128,11 +128,17 @@ for scenario, by_cond in tqdm(
     cdfs[scenario]["TeNFiLoc-L"] = errors(by_cond["L"], method="TeNFiLoc")
 
 # %%
-fig7a = cdf_figure(cdfs["straight"], title=f"2-D error CDF, straight, {runs} run(s)")
+fig7a = cdf_figure(
+    cdfs["straight"],
+    title=f"2-D error CDF, straight, ML route, JAVELIN = paper design + VUE κ, {runs} run(s)",
+)
 fig7a.update_xaxes(type="log", range=[-2, 2])
 
 # %%
-fig7b = cdf_figure(cdfs["slalom"], title=f"2-D error CDF, slalom, {runs} run(s)")
+fig7b = cdf_figure(
+    cdfs["slalom"],
+    title=f"2-D error CDF, slalom, ML route, JAVELIN = paper design + VUE κ, {runs} run(s)",
+)
 fig7b.update_xaxes(type="log", range=[-2, 2])
 
 # %% [markdown]
