@@ -38,7 +38,6 @@ SOLUTION_TAG = "solution"
 #: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
 MARKDOWN_SOLUTIONS = {
     "05-upf-tracking",
-    "06-doppler-kf-tracking",
     "07-ray-tracer-crosscheck",
     "08-design-your-array",  # rewritten with the design work
 }
