@@ -37,7 +37,6 @@ SOURCES = ".src"
 SOLUTION_TAG = "solution"
 #: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
 MARKDOWN_SOLUTIONS = {
-    "05-upf-tracking",
     "07-ray-tracer-crosscheck",
     "08-design-your-array",  # rewritten with the design work
 }
