@@ -61,7 +61,6 @@ lab: install hooks
 hooks:
 	@if git rev-parse --git-dir >/dev/null 2>&1; then \
 	  git config filter.nbstrip.clean "$(abspath $(PY)) tools/check_notebooks.py --clean-filter" && \
-	  git config filter.nbstrip.required true && \
 	  echo "git filter nbstrip installed: notebooks are committed without outputs"; fi
 
 LINTED := tunnelkit tests benchmarks tools notebooks/.src notebooks/conftest.py
