@@ -16,7 +16,7 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 # pip --quiet still relays setuptools' build warnings and a site-wide config's "is ignored" notes
 PIP_FILTER := sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$\|Please be careful\|name as your package\|take precedence during\|with strategy, WheelFile\|warnings.warn(/d'
 
-.PHONY: help install lab test lint format unit notebooks bench clean
+.PHONY: help install hooks lab test lint format unit notebooks bench clean
 
 .DEFAULT_GOAL := help
 include make/lecture.mk
@@ -24,6 +24,7 @@ include make/rt.mk
 
 help:
 	@echo "make lab     create .venv if needed, install, register the kernel, open JupyterLab on notebooks/"
+	@echo "             (installs the git filter that keeps notebook outputs out of commits: make hooks)"
 	@echo "             QUICK=1 make lab: quick mode (small Monte-Carlo counts); PYTHON=python3.12: another Python"
 	@echo "make test    the CI check: lint, unit tests, every notebook in quick mode, browser tests"
 	@echo "make present NB=02   one notebook as a Voila dashboard on 127.0.0.1 (code hidden)"
@@ -49,11 +50,18 @@ install: $(STAMP)
 
 # allow_hidden: the notebooks' sources live in notebooks/.src/ (hidden in the file browser) and
 # jupytext must be allowed to write them when a notebook is saved.
-lab: install
+lab: install hooks
 	$(PY) -m ipykernel install --sys-prefix --name $(KERNEL) --display-name "$(KERNEL_DISPLAY)" >/dev/null
 	@echo "JupyterLab on notebooks/ in $(if $(filter-out 0,$(QUICK)),quick mode (QUICK=1),full mode (QUICK=1 for quick mode))"
 	$(if $(filter-out 0,$(QUICK)),TUNNELKIT_QUICK=1) $(VENV)/bin/jupyter lab $(LAB_ROOT) \
 	  --ContentsManager.allow_hidden=True notebooks/
+
+# The clean filter named in .gitattributes: a notebook's outputs (what JupyterLab autosaves) stay
+# in the working tree and never reach a commit; `make lint` checks the notebook as committed.
+hooks:
+	@if git rev-parse --git-dir >/dev/null 2>&1; then \
+	  git config filter.nbstrip.clean "$(abspath $(PY)) tools/check_notebooks.py --clean-filter" && \
+	  echo "git filter nbstrip installed: notebooks are committed without outputs"; fi
 
 LINTED := tunnelkit tests benchmarks tools notebooks/.src notebooks/conftest.py
 

@@ -393,3 +393,41 @@ def test_notebook_04_and_its_appendix_04b_resolve_and_04_has_an_explorers_view(t
     assert src[-1].startswith("explorer = epoch_explorer(drive_ml, ev_ml, k=k)")
     with pytest.raises(lec.LectureError, match="no code cell tagged 'explorer'"):
         lec.explorers_notebook(lec.resolve_notebook("04b"), tmp_path / "b")
+
+
+def test_title_of_drops_markdown_emphasis_but_keeps_tex():
+    nb = {"cells": [{"cell_type": "markdown", "source": "# 08 · How many for *your* `tunnel`?"}]}
+    assert lec.title_of(nb, "x") == "08 · How many for your tunnel?"
+    nb = {"cells": [{"cell_type": "markdown", "source": "# 02 · **Bold** $M_{\\max}$ bound"}]}
+    assert lec.title_of(nb, "x") == "02 · Bold $M_{\\max}$ bound"
+    assert lec.title_of({"cells": []}, "fallback") == "fallback"
+
+
+def test_site_collapses_solution_cells():
+    from nbconvert import HTMLExporter
+
+    site = load_tool("site")
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [
+        nbformat.v4.new_markdown_cell("# 09 · x"),
+        nbformat.v4.new_code_cell("print('shown')"),
+        nbformat.v4.new_code_cell("print('answer')", metadata={"tags": ["solution"]}),
+    ]
+    exporter = HTMLExporter(
+        template_name="lab",
+        extra_template_paths=[str(site.TEMPLATE_DIR)],
+        template_file="chapter.html.j2",
+    )
+    body, _ = exporter.from_notebook_node(nb, resources={"tk_mathjax": ""})
+    assert body.count('<details class="tk-solution">') == 1
+    details = body.split('<details class="tk-solution">', 1)[1].split("</details>", 1)[0]
+    assert "answer" in details and "shown" not in details
+
+
+def test_site_glossary_page_and_links():
+    site = load_tool("site")
+    text = (Path(__file__).resolve().parents[1] / "notebooks" / "GLOSSARY.md").read_text()
+    page = site.glossary_html(text)
+    assert '<a id="srs"></a>' in page and "sounding reference signal" in page
+    body = '<a href="GLOSSARY.md#srs">SRS</a> and <a href="GLOSSARY.md">glossary</a>'
+    assert site.glossary_links(body).count('href="glossary.html') == 2

@@ -145,7 +145,8 @@ def title_of(nb: dict[str, Any], fallback: str) -> str:
         if cell.get("cell_type") == "markdown":
             for line in _source(cell).splitlines():
                 if line.startswith("#"):
-                    return line.lstrip("#").strip()
+                    # markdown emphasis and code marks are not shown as such in an HTML title
+                    return re.sub(r"(\*{1,2}|`)([^*`]+)\1", r"\2", line.lstrip("#").strip())
     return fallback
 
 

@@ -5,7 +5,17 @@
 * committed without outputs or execution counts;
 * the kernelspec is the one ``make lab`` registers (``python3``, "Python (tunnelkit)");
 * the first code cell imports tunnelkit and calls ``tk.setup_notebook()``;
-* a markdown cell headed "Checks" followed by code that asserts.
+* a markdown cell headed "Checks" followed by code that asserts;
+* one exercise format: every code cell between the "Exercises" heading and "Checks" is a
+  solution (tag ``solution``, cell metadata ``jupyter.source_hidden`` and
+  ``jupyter.outputs_hidden`` true), so it runs with Run All and in CI while the student sees
+  neither its code nor its output until they expand it; a solution is code, not a markdown code
+  block. A notebook whose solutions are still markdown only is named in ``MARKDOWN_SOLUTIONS``.
+
+The committed notebook is what is checked. In a clone where ``make lab`` installed the output
+filter (``git config filter.nbstrip.clean``), that is the notebook as the filter cleans it, so
+JupyterLab's autosaved outputs in the working tree do not fail ``make lint``;
+``--clean-filter`` is the filter itself (a notebook on stdin, the committed form on stdout).
 
 ``--build`` rewrites each notebook from its source (cell ids and tags kept; outputs, execution
 counts and the metadata JupyterLab adds on save dropped);
@@ -24,6 +34,13 @@ import tempfile
 from pathlib import Path
 
 SOURCES = ".src"
+SOLUTION_TAG = "solution"
+#: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
+MARKDOWN_SOLUTIONS = {
+    "07-ray-tracer-crosscheck",
+    "08-design-your-array",  # rewritten with the design work
+}
+FILTER = "nbstrip"
 KERNELSPEC = {"display_name": "Python (tunnelkit)", "language": "python", "name": "python3"}
 
 
@@ -113,8 +130,100 @@ def build(src: Path) -> Path:
     return target
 
 
+def clean(nb: dict) -> dict:
+    """The committed form of a notebook: no outputs, no execution counts, the notebook metadata
+    reduced to the kernel (what ``--build`` writes), JupyterLab's per-cell timing dropped."""
+    nb = dict(nb)
+    nb["metadata"] = {"kernelspec": dict(KERNELSPEC), "language_info": {"name": "python"}}
+    cells = []
+    for c in nb.get("cells", []):
+        c = dict(c)
+        meta = {
+            k: v for k, v in c.get("metadata", {}).items() if k not in ("execution", "scrolled")
+        }
+        c["metadata"] = meta
+        if c.get("cell_type") == "code":
+            c["outputs"], c["execution_count"] = [], None
+        cells.append(c)
+    nb["cells"] = cells
+    return nb
+
+
+def clean_filter(stdin=sys.stdin, stdout=sys.stdout) -> int:
+    """git's clean filter: the notebook on stdin, its committed form on stdout."""
+    text = stdin.read()
+    try:
+        nb = json.loads(text)
+    except json.JSONDecodeError:
+        stdout.write(text)  # not a notebook git can parse as one: leave it alone
+        return 0
+    stdout.write(_dump(clean(nb)))
+    return 0
+
+
+def _filter_installed(path: Path) -> bool:
+    import subprocess
+
+    r = subprocess.run(
+        ["git", "-C", str(path.parent), "config", "--get", f"filter.{FILTER}.clean"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    return r.returncode == 0 and bool(r.stdout.strip())
+
+
+def _heading_index(cells: list[dict], word: str) -> int | None:
+    for i, c in enumerate(cells):
+        if c.get("cell_type") != "markdown":
+            continue
+        src = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        if any(
+            line.startswith("#") and line.lstrip("# ").lower().startswith(word)
+            for line in src.splitlines()
+        ):
+            return i
+    return None
+
+
+def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
+    """The one exercise format (see the module docstring)."""
+    out = []
+    for i, c in enumerate(cells):
+        meta = c.get("metadata", {})
+        hidden = meta.get("jupyter", {})
+        if SOLUTION_TAG in meta.get("tags", []) and not (
+            hidden.get("source_hidden") and hidden.get("outputs_hidden")
+        ):
+            out.append(
+                f"{path}: cell {i} is a solution but does not hide its source and outputs "
+                "(jupyter.source_hidden and jupyter.outputs_hidden)"
+            )
+    start, end = _heading_index(cells, "exercises"), _heading_index(cells, "checks")
+    if start is None or path.stem in MARKDOWN_SOLUTIONS:
+        return out
+    section = cells[start : end if end is not None and end > start else len(cells)]
+    n_solutions = 0
+    for j, c in enumerate(section):
+        i = start + j
+        src = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        if c.get("cell_type") == "code":
+            if SOLUTION_TAG not in c.get("metadata", {}).get("tags", []):
+                out.append(f"{path}: cell {i} is code in the exercises but not tagged 'solution'")
+            n_solutions += 1
+        elif "```" in src:
+            out.append(
+                f"{path}: cell {i}: a solution in a markdown code block; make it a solution cell"
+            )
+    if n_solutions == 0:
+        out.append(f"{path}: an Exercises section without a solution cell")
+    return out
+
+
 def problems(path: Path, strip: bool) -> list[str]:
     nb = json.loads(path.read_text())
+    if not strip and _filter_installed(path):
+        nb = clean(nb)  # what git commits from this clone
     out = []
     changed = False
     cells = nb.get("cells", [])
@@ -154,6 +263,7 @@ def problems(path: Path, strip: bool) -> list[str]:
             if line.startswith("#")
         )
     ]
+    out += exercise_problems(path, cells)
     if not heads:
         out.append(f"{path}: no markdown cell headed 'Checks'")
     elif not any(
@@ -167,12 +277,21 @@ def problems(path: Path, strip: bool) -> list[str]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("paths", nargs="+", type=Path, help="notebooks or directories of notebooks")
+    ap.add_argument("paths", nargs="*", type=Path, help="notebooks or directories of notebooks")
+    ap.add_argument(
+        "--clean-filter",
+        action="store_true",
+        help="act as git's clean filter: a notebook on stdin, its committed form on stdout",
+    )
     ap.add_argument("--strip", action="store_true", help="remove outputs in place")
     ap.add_argument(
         "--build", action="store_true", help="rebuild each notebook from its .src/ source first"
     )
     args = ap.parse_args(argv)
+    if args.clean_filter:
+        return clean_filter()
+    if not args.paths:
+        ap.error("give notebooks or directories of notebooks")
     files = [f for p in args.paths for f in (sorted(p.glob("*.ipynb")) if p.is_dir() else [p])]
     if args.build:
         sources = {

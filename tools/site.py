@@ -25,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _lecture import (
     BUILD,
+    NOTEBOOKS,
     WIDGET_MIME,
     LectureError,
     die,
@@ -156,8 +157,42 @@ def render_chapter(
         },
     )
     page = f"{path.stem}.html"
-    (out_dir / page).write_text(body, encoding="utf-8")
+    (out_dir / page).write_text(glossary_links(body), encoding="utf-8")
     return {"page": page, "title": title, "figures": n_figs, "seconds": t_exec}
+
+
+GLOSSARY = "GLOSSARY.md"
+GLOSSARY_PAGE = "glossary.html"
+
+
+def glossary_links(body: str) -> str:
+    """The notebooks link their glossary page (``GLOSSARY.md#term``); the site's page is HTML."""
+    return body.replace(f'href="{GLOSSARY}', f'href="{GLOSSARY_PAGE}')
+
+
+def glossary_html(markdown_text: str) -> str:
+    """The glossary page of the site, from notebooks/GLOSSARY.md (its anchors kept)."""
+    import mistune
+
+    body = mistune.html(markdown_text)
+    return f"""<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1.0">
+<title>tunnelkit: glossary</title>
+<link rel="icon" href="data:,">
+{MATHJAX_HEAD}<style>
+body {{ font-family: system-ui, sans-serif; max-width: 46em; margin: 3em auto; padding: 0 1em;
+  line-height: 1.5; color: #222; }}
+</style>
+</head>
+<body>
+<p><a href="index.html">&#8962; all chapters</a></p>
+{body}
+</body>
+</html>
+"""
 
 
 def index_html(entries: list[dict], quick: bool) -> str:
@@ -273,6 +308,9 @@ def main(argv: list[str] | None = None) -> int:
             entries.append(e)
     entries.sort(key=lambda e: e["page"])
     (out / "index.html").write_text(index_html(entries, args.quick), encoding="utf-8")
+    glossary = NOTEBOOKS / GLOSSARY
+    if glossary.exists():
+        (out / GLOSSARY_PAGE).write_text(glossary_html(glossary.read_text()), encoding="utf-8")
     size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
     print(
         f"wrote {out}/index.html: {len(entries)} chapter(s), {size / 2**20:.1f} MiB, "

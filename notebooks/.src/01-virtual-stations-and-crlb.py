@@ -4,7 +4,8 @@
 # *Jiang, Wang & Peng (2023), "A Single-Site Vehicle Positioning Method in the Rectangular Tunnel
 # Environment", Remote Sensing 15, 527, [doi:10.3390/rs15020527](https://doi.org/10.3390/rs15020527),
 # sections 2, 3 and 4.1, Appendix A.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #
@@ -276,18 +277,58 @@ line_figure(
 # 3. Drop the DOA (`sigma_theta=None`) and find the along-tunnel positions where the TOA-only bound
 #    exceeds 10 m.
 #
-# <details><summary>Hints and solutions</summary>
+# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
+# its blue bar) shows its code and output once you have tried. What to read in them follows.
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 1: where is the bound smallest at (2 deg, 2 m)?
+from tunnelkit.widgets.crlb import crlb_map
+
+al, ac, rm = crlb_map(tunnel, vs, np.radians(2.0), 2.0)
+i_min, j_min = np.unravel_index(np.nanargmin(rm), rm.shape)
+j_bs = int(np.argmin(np.abs(al - tunnel.to_tunnel_frame(bs)[0])))
+print(
+    f"smallest bound {rm[i_min, j_min]:.2f} m at {al[j_min]:.0f} m along, {ac[i_min]:.1f} m "
+    f"across; best at the BS's along position: {np.nanmin(rm[:, j_bs]):.2f} m"
+)
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 2: the LOS path added (the BS as a third station), median over the map
+med = {
+    name: float(np.nanmedian(crlb_map(tunnel, st, np.radians(0.5), 0.1)[2]))
+    for name, st in (("NLOS", vs), ("LOS", np.vstack([bs, vs])))
+}
+print(
+    f"median bound at (0.5 deg, 0.1 m): NLOS {med['NLOS']:.3f} m, LOS {med['LOS']:.3f} m "
+    f"({100 * (1 - med['LOS'] / med['NLOS']):.0f} % lower)"
+)
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 3: TOA only, along the line of the last figure (offset so as not to sit exactly on
+# the station line, where the information is singular)
+along3 = np.linspace(-20.05, 19.95, 401)
+pts3 = tunnel.from_tunnel_frame(
+    np.stack([tunnel.to_tunnel_frame(bs)[0] + along3, np.full_like(along3, 7.5)], -1)
+)
+b_toa = crlb.crlb_rmse(pts3, vs, None, 0.1)
+above = along3[b_toa > 10]
+print(
+    f"TOA-only bound above 10 m for {above.min():+.2f}..{above.max():+.2f} m along the tunnel "
+    f"(step 0.1 m); largest {b_toa.max():.1f} m, at 1 m from the line "
+    f"{b_toa[np.argmin(np.abs(along3 - 1.0))]:.2f} m"
+)
+
+# %% [markdown]
+# <details><summary>What to read in the solutions</summary>
 #
-# 1. Near the walls' *station line* the range gradients of the two virtual stations are
-#    (anti)parallel, so range says little about the along-track coordinate; the smallest bound is a
-#    few metres along the tunnel, where range and bearing gradients are closest to orthogonal.
-# 2. `crlb_map` lives in `tunnelkit.widgets.crlb` (it is what the explorer above draws):
-#    `from tunnelkit.widgets.crlb import crlb_map`, then compare
-#    `np.median(crlb_map(tunnel, vs, np.radians(0.5), 0.1)[2])` with the same call on
-#    `np.vstack([bs, vs])` (the BS added as a station). The direct path is the shortest, so its
-#    bearing is the most informative.
-# 3. `crlb.crlb_rmse(pts, vs, None, 0.1)` along a line of `pts`: it blows up within a few metres of
-#    the station line (the singularity seen above).
+# 1. Not at the base station: near the stations' line (across the tunnel at the BS) the range
+#    gradients of the two virtual stations are (anti)parallel, so range says little about the
+#    along-track coordinate. The smallest bound lies some metres along the tunnel, where range and
+#    bearing gradients are closest to orthogonal.
+# 2. The direct path is the shortest, so its bearing is the most informative: the median drops
+#    by the percentage printed.
+# 3. The singularity is sharp: the TOA-only bound passes 10 m only within about a decimetre of the
+#    station line and is below it a metre away.
 #
 # </details>
 
@@ -308,4 +349,8 @@ assert np.all(ls_r / bound > 1.5)  # plain LS clearly is not
 assert np.allclose(cands[0], vehicle, atol=1e-6) or np.allclose(cands[1], vehicle, atol=1e-6)
 assert np.allclose(pick, vehicle, atol=1e-6)
 assert cond_toa.max() > 1e3 * cond_both.max()
+# exercises: the solutions' readings
+assert abs(al[j_min] - al[j_bs]) > 2.0 and rm[i_min, j_min] < np.nanmin(rm[:, j_bs])
+assert med["LOS"] < med["NLOS"]
+assert above.max() - above.min() < 0.5 and b_toa[np.argmin(np.abs(along3 - 1.0))] < 10
 print("all checks passed")

@@ -4,7 +4,8 @@
 # *Halili, BniLam, Yusuf, Tanghe, Joseph, Weyn & Berkvens (2022), "Vehicle Localization Using
 # Doppler Shift and Time of Arrival Measurements in a Tunnel Environment", Sensors 22, 847,
 # [doi:10.3390/s22030847](https://doi.org/10.3390/s22030847), sections 2–6.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #
@@ -399,7 +400,9 @@ information_figure(drive, setup, sigma_hz=32.79, sigma_range=1.0).show()
 # %% [markdown]
 # Over time the posterior CRLB (Tichavský et al. 1998) adds the motion model: for the linear
 # constant-velocity dynamics $J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + H_k^T R^{-1} H_k$, started from
-# the GNSS fix, $J_0 = P_0^{-1}$. It bounds the error of *any* unbiased tracker under that model.
+# the GNSS fix, $J_0 = P_0^{-1}$. It bounds the mean-square error of *any* tracker under that
+# model and prior, biased or not: a Bayesian bound averages over the prior and the
+# noise together and needs no unbiasedness (notebook 05 says the same of its filters).
 
 # %%
 bounds = {
@@ -462,24 +465,71 @@ explorer
 # 4. **Lateral drift.** Why does the EKF DS lateral error grow far from the transmitter? Compute
 #    $\sqrt{\mathrm{PCRLB}_{yy}}$ with `sigma_hz=32.79` and `q=0.05` and compare.
 #
-# <details><summary>Hints and solutions</summary>
+# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
+# its blue bar) shows its code and output once you have tried. What to read in them follows.
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 1: the CFO of the preset's clock drift, and 5 Hz (mean error of EKF DS over seeds)
+cfo_drift = cfg.clock_drift * cfg.fc
+print(
+    f"drift {cfg.clock_drift:.1e} s/s -> CFO {cfo_drift:.2f} Hz "
+    f"= {cfo_drift * tk.constants.C / cfg.fc:.3f} m/s of apparent approach speed"
+)
+seeds_x = range(tk.mc_count(8, 4))
+sol1 = {
+    c: dp.mean_errors(
+        dv.make_drive(cfg.replace(cfo_hz=c)),
+        seeds_x,
+        sigma_hz=32.79,
+        approaches=("EKF DS",),
+        **PAPER,
+    )["EKF DS"]
+    for c in (0.0, cfo_drift, 5.0)
+}
+for c, v in sol1.items():
+    print(f"cfo_hz = {c:4.2f} Hz ({c * tk.constants.C / cfg.fc:5.2f} m/s): mean error {v:5.1f} m")
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 2: the radial loss 2h at the pass, h the closest distance, for a ceiling mount
+h_side = drive.range.min()
+h_ceil = dv.make_drive(cfg.replace(tx_y=0.0, tx_z=4.9)).range.min()
+print(f"preset: h = {h_side:.2f} m, loss about {2 * h_side:.1f} m")
+print(f"ceiling mount: h = {h_ceil:.2f} m, loss about {2 * h_ceil:.1f} m")
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 3: adaptive R with the posterior (ours) and the prior (as printed) covariance
+sol3 = {
+    form: dp.mean_errors(
+        drive, seeds_x, sigma_hz=None, approaches=("EKF DS",), adaptive_form=form, **PAPER
+    )["EKF DS"]
+    for form in ("posterior", "paper")
+}
+print({form: round(v, 1) for form, v in sol3.items()}, "m mean error, EKF DS dynamic R")
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 4: the lateral bound for q = 0.5 (the filters') and q = 0.05
+lat = {q: np.sqrt(dp.posterior_crlb(drive, sigma_hz=32.79, q=q)[:, 1, 1]) for q in (0.5, 0.05)}
+for q, b in lat.items():
+    print(f"q = {q}: sqrt(PCRLB_yy) largest {b.max():5.1f} m, at the end {b[-1]:5.1f} m")
+
+# %% [markdown]
+# <details><summary>What to read in the solutions</summary>
 #
-# 1. $\delta = 2\times10^{-10}$, so $\delta f_c = 0.27$ Hz, i.e. $0.27 \cdot c/f_c = 0.06$ m/s of
-#    apparent approach speed: about 3 m over the drive. With `cfo_hz=5` the EKF reads 1.1 m/s of
-#    extra speed towards the transmitter; the along-track error grows by roughly that times the
-#    time to the pass, then the sign flip of the Doppler after the pass turns the bias the other way.
-#    `dv.make_drive(cfg.replace(cfo_hz=5.0))`, then `dp.error_study(...)`.
+# 1. $\delta f_c$ is a fraction of a hertz, a few centimetres per second of apparent approach
+#    speed: metres over the drive. 5 Hz is a metre per second; the along-track error grows by
+#    about that times the time to the pass, and the Doppler's sign flip after the pass turns the
+#    bias the other way. Whether the *mean* error grows or shrinks then depends on the other
+#    biases: here the CFO's apparent approach partly offsets the along-track deficit of the radial
+#    approximation (section 4), so the mean error may even drop — for the wrong reason.
 # 2. $h = \sqrt{(y_T - y)^2 + \Delta z^2}$ is the closest distance; the loss is $2h$ for long legs.
-#    Ceiling mount: $h = \sqrt{2.5^2 + 2.9^2} = 3.83$ m, loss $\approx 7.7$ m instead of 14.9 m
-#    (`dv.make_drive(cfg.replace(tx_y=0.0, tx_z=4.9)).range.min()`).
-# 3. `dp.run_approaches(drive, meas, fix, sigma_hz=None, adaptive_form="paper")`: the prior form
-#    over-estimates $R$ (section 3), so the dynamic filter trusts the Doppler less than the noise
-#    warrants. Whichever way the mean error moves on this drive, it moves for the wrong reason: the
-#    printed form does not estimate the noise it claims to.
+#    A ceiling mount nearly halves it (the output).
+# 3. The prior form over-estimates $R$ (section 3), so the dynamic filter trusts the Doppler less
+#    than the noise warrants. Whichever way the mean error moves on these drives, it moves for the
+#    wrong reason: the printed form does not estimate the noise it claims to.
 # 4. The lateral velocity is a random walk of density $q$ and the Doppler barely observes it far
-#    away (section 7), so the lateral position diffuses like $\sqrt{q}\,t^{3/2}/\sqrt 3$. A road
-#    constrains the lateral motion far more than $q = 0.5$ says; a smaller lateral $q$ (or a lane
-#    constraint) is the fix.
+#    away (section 7), so the lateral position diffuses like $\sqrt{q}\,t^{3/2}/\sqrt 3$: ten
+#    times smaller $q$, about $\sqrt{10}$ times smaller bound. A road constrains the lateral
+#    motion far more than $q = 0.5$ says; a smaller lateral $q$ (or a lane constraint) is the fix.
 #
 # </details>
 
@@ -512,4 +562,9 @@ assert sx[k_pass + 30] < 0.5 * sx[k_pass - 30]  # the pass pins the along-track 
 assert np.sqrt(bounds["ToA 1 m"][625, 0, 0]) < 1.0 < np.sqrt(bounds["Doppler 32.79 Hz"][625, 0, 0])
 assert before["Doppler, GNSS sigma 20 m"] > 3 * before["Doppler, GNSS sigma 1 m"]
 assert len(explorer.figure.data) == 9
+# exercises: the solutions' readings
+assert 0.1 < cfo_drift < 1.0 and 0.5 < 5.0 * tk.constants.C / cfg.fc < 2.0
+assert 0.4 < h_ceil / h_side < 0.65
+ratio_q = lat[0.5].max() / lat[0.05].max()
+assert 2.5 < ratio_q < 3.6, ratio_q
 print("all checks passed")

@@ -6,7 +6,8 @@
 # section 4.1: the JAVELIN tunnel, which the paper modelled in Blender and ray-traced. Here the same
 # tunnel is traced twice: by tunnelkit's image method and by Sionna RT (NVIDIA, on Mitsuba 3 /
 # Dr.Jit), an independent ray tracer that loads Blender-exported scenes.
-# All references: `REFERENCES.md` at the top of the repository.*
+# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
+# [glossary](GLOSSARY.md).*
 #
 # **What you will learn**
 #

@@ -106,3 +106,52 @@ def test_legends_and_titles_fit_their_figures(chapter, width, site_url, watched,
     page.screenshot(path=str(artifacts / f"layout-{chapter}-{width}.png"), full_page=True)
     assert result["figures"] >= 1, f"{chapter}: no rendered figure"
     assert result["problems"] == [], f"{chapter} at {width} px:\n" + "\n".join(result["problems"])
+
+
+# The figures as plotly.js holds them in the page (typed arrays turned into lists), for the three
+# defects no layout box shows: a trace fully hidden under another, a legend entry repeated, a
+# colour used in a panel but absent from its legend (tools/figcheck.py).
+FIGURES = """() => [...document.querySelectorAll('.js-plotly-plot')].map(p => {
+  const arr = v => (v && typeof v !== 'string' && v.length !== undefined) ? Array.from(v) : v;
+  const pick = (o, keys) => { const r = {}; keys.forEach(k => { if (o && o[k] !== undefined
+      && (typeof o[k] !== 'object' || o[k] === null)) r[k] = o[k]; }); return r; };
+  const data = (p.data || []).map(t => {
+    const r = pick(t, ['type', 'name', 'mode', 'showlegend', 'visible', 'legendgroup', 'legend',
+                       'xaxis', 'yaxis', 'scene']);
+    ['x', 'y', 'z'].forEach(k => { if (t[k] !== undefined) r[k] = arr(t[k]); });
+    r.line = pick(t.line, ['color', 'width', 'dash']);
+    r.marker = pick(t.marker, ['color', 'size', 'symbol']);
+    if (t.marker && typeof t.marker.color !== 'string' && t.marker.color !== undefined)
+      r.marker.color = arr(t.marker.color);
+    return r;
+  });
+  const lay = p.layout || {};
+  const title = lay.title && (lay.title.text || lay.title);
+  return {data, layout: {showlegend: lay.showlegend, colorway: lay.colorway,
+                         title: {text: typeof title === 'string' ? title : ''}}};
+})"""
+
+
+@pytest.mark.parametrize("chapter", [nb.stem for nb in list_notebooks()])
+def test_no_hidden_trace_no_repeated_legend_entry_no_unnamed_colour(chapter, site_url, watched):
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location(
+        "figcheck", Path(__file__).resolve().parents[2] / "tools" / "figcheck.py"
+    )
+    figcheck = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(figcheck)
+    page = watched.page
+    page.goto(site_url + f"{chapter}.html", wait_until="load")
+    page.wait_for_selector(".js-plotly-plot .main-svg", timeout=30_000)
+    figures = page.evaluate(FIGURES)
+    assert figures and any(fig["data"] for fig in figures), f"{chapter}: no figure data read"
+    problems = [
+        p
+        for i, fig in enumerate(figures)
+        for p in figcheck.figure_problems(
+            fig, f"figure {i} ({fig['layout']['title']['text'][:50]})"
+        )
+    ]
+    assert problems == [], f"{chapter}:\n" + "\n".join(problems)

@@ -9,7 +9,7 @@ import plotly.graph_objects as go
 
 from ..metrics import ecdf
 
-__all__ = ["COLORS", "cdf_figure", "line_figure"]
+__all__ = ["COLORS", "cdf_figure", "line_figure", "reveal_overlaps"]
 
 #: one colour per role/algorithm, used by every notebook so legends read the same everywhere
 COLORS = {
@@ -25,6 +25,47 @@ COLORS = {
     "JAVELIN": "#1f77b4",
     "TeNFiLoc": "#d62728",
 }
+
+
+_DASHES = ("dash", "dot", "dashdot", "longdash")
+
+
+def _close(u, v) -> bool:
+    """Whether two coordinate arrays draw the same points (within 0.3 % of their span)."""
+    if u is None or v is None:
+        return u is None and v is None
+    try:
+        u, v = np.asarray(u, float), np.asarray(v, float)
+    except (TypeError, ValueError):
+        return False
+    if u.shape != v.shape:
+        return False
+    both = np.concatenate([u.ravel(), v.ravel()])
+    both = both[np.isfinite(both)]
+    span = float(np.ptp(both)) if both.size else 0.0
+    return bool(np.allclose(u, v, rtol=0, atol=3e-3 * span + 1e-300, equal_nan=True))
+
+
+def reveal_overlaps(fig: go.Figure) -> go.Figure:
+    """Keep every line visible where two coincide: a line drawn over an earlier one with the same
+    points (EKF and UKF on a nearly linear problem) is dashed, and the earlier one widened, so
+    both can be seen and told apart. Returns ``fig``, changed in place."""
+    if not isinstance(fig, go.Figure):
+        raise TypeError(f"fig: expected a plotly Figure, got {type(fig).__name__}")
+    lines = [t for t in fig.data if "lines" in (getattr(t, "mode", None) or "lines")]
+    for j, late in enumerate(lines):
+        n_under = 0
+        for early in lines[:j]:
+            same_axes = (getattr(early, "xaxis", None), getattr(early, "yaxis", None)) == (
+                getattr(late, "xaxis", None),
+                getattr(late, "yaxis", None),
+            )
+            if same_axes and _close(early.x, late.x) and _close(early.y, late.y):
+                if (late.line.dash or "solid") == (early.line.dash or "solid"):
+                    late.line.dash = _DASHES[n_under % len(_DASHES)]
+                early.line.width = max(early.line.width or 2, (late.line.width or 2) + 2)
+                n_under += 1
+    return fig
 
 
 def line_figure(
@@ -56,7 +97,7 @@ def line_figure(
     )
     if log_y:
         fig.update_yaxes(type="log")
-    return fig
+    return reveal_overlaps(fig)
 
 
 def cdf_figure(
@@ -81,4 +122,4 @@ def cdf_figure(
         yaxis_range=[0, 1.02],
         margin={"l": 60, "r": 20, "t": 50, "b": 50},
     )
-    return fig
+    return reveal_overlaps(fig)

@@ -10,6 +10,7 @@ from plotly.subplots import make_subplots
 
 from ..constants import C
 from ..metrics import ecdf
+from .common import reveal_overlaps
 
 __all__ = [
     "APPROACH_COLORS",
@@ -94,7 +95,7 @@ def drive_topview(
         margin=_MARGIN,
         yaxis_range=[lo, hi],
     )
-    return fig
+    return reveal_overlaps(fig)
 
 
 def doppler_delay_figure(drive, meas=None) -> go.Figure:
@@ -239,7 +240,7 @@ def error_time_figure(drive, tracks: Mapping[str, np.ndarray], *, title: str = "
         margin=_MARGIN_SUB,
         title=title or "Estimation error over the drive (dotted: the pass)",
     )
-    return fig
+    return reveal_overlaps(fig)
 
 
 def approach_cdfs(
@@ -251,13 +252,20 @@ def approach_cdfs(
     """Fig. 4 in synthetic form: CDF of the error per sigma, one panel per approach.
 
     ``paper_p90`` (approach, sigma) -> the paper's measured 90 % point, drawn as a cross at 0.9.
+    The panels (one per approach) share their x range; a line's colour and dash name its sigma,
+    the same in every panel, so the legend (one entry per sigma) reads for all three.
     """
     fig = make_subplots(
         rows=1,
         cols=len(approaches),
         shared_yaxes=True,
+        shared_xaxes=True,
         subplot_titles=[f"({'abc'[i]}) {a}" for i, a in enumerate(approaches)],
     )
+    labels = list(dict.fromkeys(label for _, label in errors))
+    palette = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#ff7f0e")
+    sigma_color = {lab: palette[i % len(palette)] for i, lab in enumerate(labels)}
+    paper_in_legend = False
     for col, name in enumerate(approaches, start=1):
         for (approach, label), e in errors.items():
             if approach != name:
@@ -271,7 +279,7 @@ def approach_cdfs(
                 name=f"ours {label}",
                 legendgroup=label,
                 showlegend=col == 1,
-                line={"color": APPROACH_COLORS[name], "dash": _SIGMA_DASH.get(label)},
+                line={"color": sigma_color[label], "dash": _SIGMA_DASH.get(label)},
                 row=1,
                 col=col,
             )
@@ -284,12 +292,14 @@ def approach_cdfs(
                     marker={"symbol": "x", "size": 9, "color": "#000"},
                     name="paper p90 (measured)",
                     legendgroup="paper",
-                    showlegend=col == 1,
+                    showlegend=not paper_in_legend,
                     hovertext=f"paper, measured: {label}",
                     row=1,
                     col=col,
                 )
+                paper_in_legend = True
     fig.add_hline(y=0.9, line={"dash": "dot", "color": "#999"})
+    fig.update_xaxes(matches="x")
     fig.update_xaxes(title_text="error [m]")
     fig.update_yaxes(title_text="CDF", range=[0, 1.02], row=1, col=1)
     fig.update_layout(
@@ -297,7 +307,7 @@ def approach_cdfs(
         margin=_MARGIN_SUB,
         title="CDF of the position error per sigma (lines: synthetic; crosses: paper's measured p90)",
     )
-    return fig
+    return reveal_overlaps(fig)
 
 
 def pcrlb_figure(drive, bounds: Mapping[str, np.ndarray], *, title: str = "") -> go.Figure:
@@ -336,7 +346,7 @@ def pcrlb_figure(drive, bounds: Mapping[str, np.ndarray], *, title: str = "") ->
         margin=_MARGIN_SUB,
         title=title or "What one transmitter can observe: posterior CRLB",
     )
-    return fig
+    return reveal_overlaps(fig)
 
 
 def information_figure(

@@ -436,10 +436,18 @@ def derivation_figure(profile: fresnel.ApertureProfile, *, lam: float) -> go.Fig
 
 
 def ratio_map_figure(
-    R_grid, y_grid, ratio, *, title: str = "eq. 25 / exact Mmax", W: float | None = None
+    R_grid,
+    y_grid,
+    ratio,
+    *,
+    title: str = "eq. 25 / exact Mmax",
+    W: float | None = None,
+    colorbar_title: str | None = None,
 ) -> go.Figure:
     """Heat map of a ratio (e.g. bound / exact Mmax) over (R, y_u), 1 = tight, log colour scale."""
     r = np.asarray(ratio, dtype=float)
+    # the colour bar names the ratio it shows (the title's, unless told), not just "ratio"
+    colorbar_title = title if colorbar_title is None else colorbar_title
     ticks = np.array([0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0])
     fig = go.Figure(
         go.Heatmap(
@@ -450,7 +458,7 @@ def ratio_map_figure(
             colorscale="RdBu",
             customdata=r,
             colorbar={
-                "title": "ratio",
+                "title": {"text": colorbar_title, "side": "right"},
                 "tickvals": np.log2(ticks),
                 "ticktext": [f"{t:g}" for t in ticks],
             },

@@ -8,7 +8,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from .common import COLORS, line_figure
+from .common import COLORS, line_figure, reveal_overlaps
 from .tables import TableFigure, table
 from .topview import tunnel_topview
 
@@ -113,7 +113,7 @@ def tracks_figure(
         ],
     )
     fig.update_yaxes(scaleanchor="x", scaleratio=1)
-    return fig
+    return reveal_overlaps(fig)
 
 
 def rmse_bound_figure(
@@ -172,7 +172,7 @@ def bound_ratio_figure(
         height=380,
         margin={"l": 60, "r": 20, "t": 90, "b": 50},
     )
-    return fig
+    return reveal_overlaps(fig)
 
 
 def particle_cloud_figure(
@@ -221,11 +221,13 @@ def particle_cloud_figure(
             row=1,
             col=c,
         )
-        fig.update_xaxes(
-            range=[tr[0] - half_width, tr[0] + half_width], title_text="x [m]", row=1, col=c
-        )
-        fig.update_yaxes(range=[tr[1] - half_width, tr[1] + half_width], row=1, col=c)
-    fig.update_layout(title=title, height=380, margin={"l": 50, "r": 20, "t": 90, "b": 50})
+        # wide enough for the cloud (its 99th percentile around the truth), never narrower than
+        # half_width: a cloud cut at the panel's edge hides the very spread it is drawn for
+        hw = max(half_width, 1.1 * float(np.percentile(np.abs(p - tr[:2]), 99)))
+        fig.update_xaxes(range=[tr[0] - hw, tr[0] + hw], title_text="x [m]", row=1, col=c)
+        fig.update_yaxes(range=[tr[1] - hw, tr[1] + hw], row=1, col=c)
+    fig.update_yaxes(title_text="y [m]", row=1, col=1)
+    fig.update_layout(title=title, height=380, margin={"l": 60, "r": 20, "t": 90, "b": 50})
     return fig
 
 

@@ -74,7 +74,7 @@ def tunnel3d_figure(
                 replace(f, corner=c, edge_u=u),
                 "#636363" if road else "#bdbdbd",
                 0.35 if road else 0.12,
-                "road" if road else "tunnel facets",
+                "road surface" if road else "tunnel facets",
                 i in (0, len(tunnel.facets) - 1),
             )
         )
@@ -139,7 +139,8 @@ def tunnel3d_figure(
             "xaxis_title": "x [m]",
             "yaxis_title": "y [m]",
             "zaxis_title": "z [m]",
-            "camera": {"eye": {"x": -1.2, "y": -1.6, "z": 0.8}},
+            # far enough out that both ends (the base station's included) stay in the view
+            "camera": {"eye": {"x": -0.7, "y": -3.0, "z": 1.3}},
         },
     )
     return fig
@@ -172,7 +173,11 @@ def factors_figure(
         ),
     )
     sp = unwrapped if unwrapped is not None else np.unwrap(np.angle(bs), axis=0)
+    # one colour per path in all three panels (left to itself, plotly would colour each trace
+    # by its index, so panels (b) and (c) would show colours the legend does not have)
+    palette = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2")
     for j_ in range(bf.shape[1]):
+        color = palette[j_ % len(palette)]
         panels = (
             (sp[:, j_], "lines"),
             (np.unwrap(np.angle(bf[:, j_])), "lines"),
@@ -185,6 +190,8 @@ def factors_figure(
                 name=f"path {j_}",
                 legendgroup=f"C{j_}",
                 showlegend=None if col == 1 else False,  # one legend entry per path
+                line={"color": color},
+                marker={"color": color},
                 row=1,
                 col=col,
             )
@@ -202,13 +209,28 @@ def wave_origins_figure(
     *,
     title: str = "Estimated wave origins, colour = altitude (cf. Fig. 5)",
     z_range: tuple[float, float] = (0.0, 5.0),
+    margin_m: float = 30.0,
 ) -> go.Figure:
-    """Top view (x, y) of estimated wave origins coloured by altitude z, one marker per series."""
+    """Top view (x, y) of estimated wave origins coloured by altitude z, one marker per series.
+
+    With a ``trajectory`` or ``bs``, the view spans their x extent plus ``margin_m`` on each side;
+    origins beyond it (a wild estimate metres or kilometres away would squash the rest into a
+    strip) are left out and counted in the title."""
     fig = go.Figure()
     symbols = ["circle", "x", "diamond", "square"]
+    anchors = [np.asarray(a, float).reshape(-1, 3)[:, 0] for a in (trajectory, bs) if a is not None]
+    x_lim = None
+    if anchors:
+        xs = np.concatenate(anchors)
+        x_lim = (float(xs.min()) - margin_m, float(xs.max()) + margin_m)
+    n_out = 0
     for i, (name, pts) in enumerate(origins.items()):
         pts = np.asarray(pts, float).reshape(-1, 3)
         pts = pts[np.all(np.isfinite(pts), axis=1)]
+        if x_lim is not None:
+            keep = (pts[:, 0] >= x_lim[0]) & (pts[:, 0] <= x_lim[1])
+            n_out += int(np.sum(~keep))
+            pts = pts[keep]
         fig.add_scatter(
             x=pts[:, 0],
             y=pts[:, 1],
@@ -242,6 +264,8 @@ def wave_origins_figure(
             name="BS",
             marker={"symbol": "square", "size": 12, "color": "red"},
         )
+    if n_out:
+        title = f"{title}; {n_out} origin(s) beyond x = {x_lim[0]:.0f}..{x_lim[1]:.0f} m not shown"
     fig.update_layout(
         title=title,
         height=420,

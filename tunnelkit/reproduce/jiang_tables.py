@@ -107,7 +107,7 @@ _NOTES = [
     "P0 = diag(1 m^2, 1 m^2, 1 (m/s)^2, 1 (m/s)^2) ([tracking] in the scenario file).",
     f"UPF: {N_PARTICLES} particles, UKF proposal conditioned on each particle, systematic resampling at "
     "ESS < N/2.",
-    "rmse_over_pcrlb = sqrt(mean MSE / mean PCRLB) along the run (Tichavsky 1998 recursion at the true states).",
+    "rmse_over_pcrlb = sqrt(mean MSE / mean PCRLB) along the run (Tichavský 1998 recursion at the true states).",
     "The paper's UPF means (0.011 m at sigma_d = 0.1 m) lie far below the measurement noise: they need a filter "
     "started at the true state with (almost) no process noise, or a mean of signed errors; see notebook 05.",
 ]

@@ -1,7 +1,7 @@
-"""Posterior Cramer-Rao lower bound for tracking (Tichavsky, Muravchik & Nehorai 1998).
+"""Posterior Cramer-Rao lower bound for tracking (Tichavský, Muravchik & Nehorai 1998).
 
 For ``X_k = Phi X_{k-1} + U``, ``U ~ N(0, Q)`` and ``Z_k = h(X_k) + V``, ``V ~ N(0, R)``, the
-information matrix of the state obeys the recursion (Tichavsky et al. 1998, eq. 21 and 34)::
+information matrix of the state obeys the recursion (Tichavský et al. 1998, eq. 21 and 34)::
 
     J_0     = P0^-1 + E[H_0^T R^-1 H_0]                 (the filters update at epoch 0)
     J_k     = D22 - D21 (J_{k-1} + D11)^-1 D12

@@ -46,7 +46,7 @@ def posterior_crlb(
     sigma_p0: float | None = None,
     sigma_v0: float | None = None,
 ) -> np.ndarray:
-    """Posterior CRLB (Tichavsky et al. 1998) of ``[x, y, v_x, v_y]`` along the true drive, (T, 4, 4).
+    """Posterior CRLB (Tichavský et al. 1998) of ``[x, y, v_x, v_y]`` along the true drive, (T, 4, 4).
 
     For linear-Gaussian dynamics the information recursion is
     ``J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + H_k^T R^{-1} H_k`` with ``H_k`` at the true state;
