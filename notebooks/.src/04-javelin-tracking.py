@@ -197,9 +197,10 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 
 # %% [markdown]
 # Read the last table against the paper's assumed noise, $\sigma_\phi = \sigma_\psi = 2°$,
-# $\sigma_\kappa = \sigma_{\Delta d} = 1.5$ m: the ML route's RMS errors are smaller, by orders
-# of magnitude in the angles and the TDoA and by less in the curvature (the ratios are printed
-# below). An RMS is ruled by its gross errors: an epoch where
+# $\sigma_\kappa = \sigma_{\Delta d} = 1.5$ m: the ML route's RMS errors are smaller by one to
+# three orders of magnitude in the angles and the TDoA, while its curvature RMS is of the order of
+# the paper's 1.5 m, above or below it depending on the drives (the ratios are printed below). An
+# RMS is ruled by its gross errors: an epoch where
 # two nearly coincident paths (LoS, ceiling and road bounce) are swapped or merged costs tenths
 # of a degree and metres, and lifts the RMS of its kinds by orders of magnitude. The curvature
 # the ML route measures for a reflection is the distance to its **VUE** (the exact wavefront's
@@ -500,10 +501,10 @@ for n_src in (1, 2, 3):
 #
 # 1. Honest curvature noise alone does not rescue the paper's design on the paper's route: the
 #    true pairs pass the gate again, but so do the spurious CPD components (a radial speed no
-#    static reflector can have), and the tracker stays metres off, possibly further off than
-#    before (the second line). The Doppler test removes those components and brings it below a
-#    metre (the third line): both changes are needed. Notebook 04b measures each step of that
-#    path over 20 runs.
+#    static reflector can have), so the tracker stays well off the ML route (the second
+#    line). The Doppler test removes those components and lowers the error further (the third
+#    line): both changes are needed, and on one drive neither brings the paper's route to the ML
+#    route's centimetres. Notebook 04b measures each step of that path over 20 runs.
 # 2. With $\zeta = 3$ a track survives missed epochs, so it need not be born again; whether that
 #    happens on this drive the births and tracked states of the output say. The RMSE hardly
 #    moves.
@@ -545,7 +546,7 @@ assert p90["JAVELIN-L"] < p90["TeNFiLoc-L"], p90
 # the paper's sigmas are orders of magnitude above what the ML route measures, OURS_ML's wider
 assert vue_ceil > 5 * kappa51_ceil, (kappa51_ceil, vue_ceil)
 ratio_paper = sig["the paper (section 4.2)"] / sig["measured here"]
-assert np.all(ratio_paper[[0, 1, 3]] > 100) and ratio_paper[2] > 1, ratio_paper
+assert np.all(ratio_paper[[0, 1, 3]] > 10) and 0.1 < ratio_paper[2] < 10, ratio_paper
 assert np.all(sig["OURS_ML assumes"] > sig["measured here"]), sig
 # solution 3: the VUE curvature pays on the ML route; on the paper's route both are metres off
 assert sol3["ML route"][1] < sol3["ML route"][0], sol3
@@ -553,6 +554,6 @@ assert min(sol3["paper route"]) > 1.0, sol3
 # solutions 1 and 2: both changes needed (below a metre only with the Doppler test); zeta barely
 # matters
 last = sol1["sigma_kappa = 50 m + Doppler test"]
-assert last < 1.0 and last < min(sol1["paper (section 4.2)"], sol1["sigma_kappa = 50 m"]), sol1
+assert last < min(sol1["paper (section 4.2)"], sol1["sigma_kappa = 50 m"]), sol1
 assert abs(sol2[3] - sol2[designs.ours().config.max_misses]) < 0.25 * max(sol2.values()), sol2
 print("all checks passed")
