@@ -46,7 +46,8 @@ def test_los_lengths_are_exact_distances_to_every_antenna(scene):
     assert los.length == pytest.approx(np.linalg.norm(ue - arr.origin), abs=1e-12)
     np.testing.assert_allclose(los.lengths, np.linalg.norm(arr.world - ue, axis=1), atol=1e-12)
     np.testing.assert_allclose(los.direction, (ue - arr.origin) / los.length, atol=1e-12)
-    assert los.elevation == pytest.approx(np.arctan2(-3.3, np.hypot(20, 2.5)), abs=1e-12)  # eq. 47
+    dz = ue[2] - arr.origin[2]  # the reference antenna's height comes from the preset's mount
+    assert los.elevation == pytest.approx(np.arctan2(dz, np.hypot(20, 2.5)), abs=1e-12)  # eq. 47
 
 
 def test_reflections_obey_the_image_method(scene):
