@@ -55,10 +55,23 @@ def test_size_figure_marks_the_papers_array():
     assert np.allclose([v for v in rf.data[0].y if v is not None], 100 * b.peb[np.isfinite(b.peb)])
 
 
-def test_monte_carlo_summary_states_the_settled_ratio():
+def test_impairment_sliders_move_the_achievable_bound_not_the_peb():
+    ideal = design_figure(n=8, target=0.1).layout.meta
+    cal = design_figure(n=8, target=0.1, phase_error_deg=2.0, gain_error_db=0.2).layout.meta
+    assert ideal["achievable_median_m"] == ideal["peb_median_m"]  # no impairment: the PEB
+    assert cal["peb_median_m"] == ideal["peb_median_m"]
+    assert cal["achievable_median_m"] > 10 * ideal["achievable_median_m"]
+    assert cal["met_share"] < ideal["met_share"]
+    fig = design_figure(n=8, target=0.1, dmc_share=0.1)
+    assert "achievable, impaired" in [t.name for t in fig.data]
+
+
+def test_monte_carlo_summary_states_the_verdict_and_interval():
     from tunnelkit.widgets.design import monte_carlo_summary
 
-    res = {"rmse_m": 0.05, "ci95_m": [0.01, 0.09], "rmse_settled_m": None}
-    assert monte_carlo_summary(res, 3) == "JAVELIN 2-D RMSE 5 cm, 95 % CI [1, 9] cm over 3 drives"
-    res.update(rmse_settled_m=0.002, peb_rms_settled_m=0.0005)
-    assert monte_carlo_summary(res, 3).endswith("after the first 1 s 2 mm, 4 x the RMS PEB")
+    row = design.DesignRow("4x4", 16, 0.02, status="undecided", reason="few runs")
+    row.error_p90_m, row.error_p90_ci95_m = 0.05, [0.01, 0.09]
+    row.achievable_p90_m, row.peb_p90_m = 0.02, 0.01
+    text = monte_carlo_summary(row, 3)
+    assert text.startswith("4x4: undecided") and "[1, 9] cm over 3 drives" in text
+    assert monte_carlo_summary(design.DesignRow("2x2", 4, 0.01, reason="x"), 3).endswith(": x")

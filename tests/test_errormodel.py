@@ -75,3 +75,17 @@ def test_absent_paths_are_nan_and_may_hold_nan():
 def test_bad_fields_are_refused_by_name(kw, param):
     with pytest.raises((ValueError, TypeError), match=param):
         _model(**kw)
+
+
+def test_budget_is_the_second_moment_of_the_drawn_error():
+    m = _model(phase_sigma_rad=0.1, bias=np.full((2, 2, 4), 0.05))
+    rng = np.random.default_rng(11)
+    e = np.stack([m.draw(rng) - m.truth for _ in range(6000)])  # (N, T, P, 4)
+    emp = np.einsum("ntpi,ntpj->tpij", e, e) / e.shape[0]
+    want = m.budget()
+    scale = np.abs(want).max()
+    assert np.abs(emp - want).max() < 0.06 * scale
+    ideal = _model(k_phase=None)
+    idx = np.arange(2)
+    crlb = np.moveaxis(ideal.crlb.reshape(2, 2, 4, 2, 4)[:, idx, :, idx, :], 0, 1)
+    assert np.allclose(ideal.budget(), crlb)

@@ -38,7 +38,6 @@ SOLUTION_TAG = "solution"
 #: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
 MARKDOWN_SOLUTIONS = {
     "07-ray-tracer-crosscheck",
-    "08-design-your-array",  # rewritten with the design work
 }
 FILTER = "nbstrip"
 KERNELSPEC = {"display_name": "Python (tunnelkit)", "language": "python", "name": "python3"}

@@ -120,6 +120,24 @@ class PathErrorModel:
             out += self.k_gain @ finite_array("gain_db", gain_db, shape=(self.n_elements,))
         return out
 
+    def budget(self) -> np.ndarray:
+        """The per-path error budget (T, P, 4, 4): the second moment of the error about the
+        truth, ``cov`` plus the calibration covariance over the calibration draw
+        (``sigma_phi^2 K_phase K_phase^T + sigma_g^2 K_gain K_gain^T``) plus the deterministic
+        bias' outer product. What an extraction that knows its array's calibration tolerance and
+        its model's shortcuts (but not the draw) can report; equal to the ``crlb`` blocks for an
+        ideal model."""
+        T, P = self.exists.shape
+        idx = np.arange(P)
+        out = np.asarray(self.cov).reshape(T, P, 4, P, 4)[:, idx, :, idx, :]  # (P, T, 4, 4)
+        out = np.moveaxis(out, 0, 1).copy()
+        for k, sig in ((self.k_phase, self.phase_sigma_rad), (self.k_gain, self.gain_sigma_db)):
+            if k is not None and sig > 0:
+                out += sig**2 * (np.asarray(k) @ np.swapaxes(k, -1, -2))
+        b = np.asarray(self.bias)
+        out += b[..., :, None] * b[..., None, :]
+        return np.where(self.exists[..., None, None], out, 0.0)
+
     def draw(self, rng: np.random.Generator) -> np.ndarray:
         """One drive's measured ``z`` (T, P, 4): the truth plus the deterministic bias, one
         array's calibration bias (phase and gain errors drawn once from ``rng``) and a Gaussian

@@ -10,7 +10,13 @@ the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
 * ``z = [phi, psi, kappa, d]`` of every existing path from :meth:`PathErrorModel.draw` (truth,
   bias, one array's calibration error, Gaussian error with the model's ``cov``);
 * the reported covariance: the ``(phi, psi, kappa)`` block and the ``d`` standard deviation of
-  the model's ``crlb`` (what an efficient extraction reports: it does not know the impairments);
+  the model's ``crlb`` (``report="crlb"``: what an efficient extraction reports when it ignores
+  the impairments) or of its error budget (``report="budget"``,
+  :meth:`PathErrorModel.budget`: the CRLB plus the covariance of the stated calibration
+  tolerance and the bias of the terms the model leaves out, what an extraction reports that
+  knows its array's tolerance but not its draw); the default ``"auto"`` is the CRLB for an
+  ideal model and the budget otherwise. A tracker told micrometres while its measurements carry
+  centimetres of calibration bias gates out the truth and diverges: notebook 08, section 7;
 * the clock bias drawn per epoch as the channel route draws it
   (:func:`tunnelkit.channel.sample_clock_bias`, the radio's sigma and limit) and added to every
   ``d``;
@@ -30,12 +36,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import nonnegative, rng_or_error
+from .._validate import choice, nonnegative, rng_or_error
 from ..constants import C
 from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 
-__all__ = ["SIGMA_V", "bound_drive", "model_truth"]
+__all__ = ["REPORTS", "SIGMA_V", "bound_drive", "model_truth"]
+
+#: what the bound route reports to the tracker (:func:`bound_drive`)
+REPORTS = ("auto", "crlb", "budget")
 
 #: standard deviation [m/s] of the radial speed handed to the tracker on the bound route
 SIGMA_V = 0.05
@@ -62,6 +71,7 @@ def bound_drive(
     *,
     n_epochs: int | None = None,
     sigma_v: float = SIGMA_V,
+    report: str = "auto",
 ):
     """One drive of ``setup``'s route for ``spec`` measured through ``model`` (module docstring):
     a :class:`tunnelkit.studies.DriveData` the tracker runs on exactly as on the channel route
@@ -77,6 +87,7 @@ def bound_drive(
     spec = parse_array(spec)
     rng = rng_or_error("rng", rng)
     sigma_v = nonnegative("sigma_v", sigma_v)
+    report = choice("report", report, REPORTS)
     traj, cfg = setup.trajectory, setup.config
     T = model.exists.shape[0]
     if T != len(traj):
@@ -92,7 +103,13 @@ def bound_drive(
     P = ex.shape[1]
     bias = sample_clock_bias(rng, cfg.clock_bias_sigma, cfg.clock_bias_limit, size=T)
     v = model.v[:T] + sigma_v * rng.standard_normal((T, P))
-    crlb = model.crlb[:T]
+    ideal = model.phase_sigma_rad == 0 and model.gain_sigma_db == 0
+    ideal = ideal and not np.any(model.bias) and np.array_equal(model.cov, model.crlb)
+    if report == "crlb" or (report == "auto" and ideal):
+        idx = np.arange(P)
+        per_path = np.moveaxis(model.crlb[:T].reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1)
+    else:
+        per_path = model.budget()[:T]
     epochs, tidx, kinds, los = [], [], [], np.zeros(T, bool)
     n_true = ex.sum(axis=1)
     for k in range(T):
@@ -100,7 +117,7 @@ def bound_drive(
         d = z[k, j, 3] + C * bias[k]
         o = j[np.argsort(d, kind="stable")]
         d = z[k, o, 3] + C * bias[k]
-        blocks = crlb[k].reshape(P, 4, P, 4)[o, :, o, :]  # (n, 4, 4)
+        blocks = per_path[k, o]  # (n, 4, 4)
         pm = PathMeasurements.from_arrays(
             z[k, o, 0],
             z[k, o, 1],

@@ -17,7 +17,8 @@ tracker achieves.
 
 :class:`DesignReport` holds the rows, the recommendation, every input and the warnings, as JSON
 (:meth:`DesignReport.to_json`) or a text table (:meth:`DesignReport.to_table`).
-:func:`smallest_meeting` is the explorer's bound-only search (PEB and SR-NF).
+:func:`smallest_meeting` is the explorer's bound-only pre-screen (achievable bound, or PEB and SR-NF
+under ``criterion="srnf"``).
 """
 
 from __future__ import annotations
@@ -254,20 +255,26 @@ def smallest_meeting(
     *,
     target: float = 0.2,
     share: float = 0.9,
+    criterion: str = "achievable",
+    impairments=None,
     eps_phi: float = 0.15,
     epochs=None,
 ) -> tuple[ArraySpec | None, float]:
-    """The first array of ``arrays`` (in the order given) whose PEB <= ``target`` with SR-NF
-    valid on ``share`` of the route, and its met share; ``(None, best share)`` if none.
+    """The first array of ``arrays`` (in the order given) whose **bound** meets ``target`` on
+    ``share`` of the route, and its met share; ``(None, best share)`` if none.
 
-    A bound-only search with the SR-NF gate (an eq. 51 estimator), for the explorer: the SR-NF
-    part is computed first (cheap); the PEB only where SR-NF alone leaves ``share`` within
-    reach. Arrays that do not fit in the tunnel are skipped; ``epochs`` subsamples the route.
+    A bound-only pre-screen for the explorer, a necessary condition, not an answer (the answer
+    is :func:`design_sweep` with Monte-Carlo runs): with ``criterion="achievable"`` (default) the
+    achievable bound under ``impairments`` (``None``: ideal, the PEB), SR-NF only information;
+    with ``"srnf"`` (an eq. 51 estimator) an epoch where SR-NF fails counts as missed. Arrays
+    that do not fit in the tunnel are skipped; ``epochs`` subsamples the route.
     """
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
     if share == 0:
         raise ValueError("share: expected a share in (0, 1], got 0")
+    criterion = choice("criterion", criterion, CRITERIA)
+    imp = _design_impairments(impairments)
     best = 0.0
     for spec in (parse_array(a) for a in arrays):
         try:
@@ -275,10 +282,10 @@ def smallest_meeting(
         except ValueError:
             continue
         b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
-        if b.srnf_valid.mean() < share:
+        if criterion == "srnf" and b.srnf_valid.mean() < share:
             continue
-        b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g)
-        met = float(np.mean((b.peb <= target) & b.srnf_valid))
+        a = achievable_bound(setup, spec, imp, geometry=g)
+        met = float(np.mean(gate(a.achievable, b.srnf_valid, criterion) <= target))
         if met >= share:
             return spec, met
         best = max(best, met)

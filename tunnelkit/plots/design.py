@@ -21,6 +21,10 @@ _KIND_COLORS = {
 }
 
 
+#: colours of the achievable-bound lines, one per impairment level
+_ACHIEVABLE_COLORS = ("#ff7f0e", "#9467bd", "#17becf", "#e377c2")
+
+
 def _finite(v: np.ndarray) -> list:
     """Plotly-friendly list: non-finite values become gaps (None)."""
     return [float(x) if np.isfinite(x) else None for x in np.asarray(v, float)]
@@ -31,12 +35,19 @@ def _scatter(**kw) -> dict:
     return {"type": "scatter", **kw}
 
 
-def route_traces(bounds, *, variants: dict | None = None, target: float | None = None) -> list:
+def route_traces(
+    bounds,
+    *,
+    variants: dict | None = None,
+    target: float | None = None,
+    achievable: dict | None = None,
+) -> list:
     """Trace dicts on axes (x, y) PEB [cm] along the tunnel and (x, y2) SR-NF mismatch per surface.
 
     Order: 0 PEB, 1 SR-NF not valid (markers on the PEB), 2.. one dashed trace per variant
-    (``{"no curvature": RouteBounds, ...}``), then the target line (if given), then one mismatch
-    trace per surface kind and the ``eps_phi`` line on (x, y2).
+    (``{"no curvature": RouteBounds, ...}``), then one solid trace per achievable bound
+    (``{"0.5° phase error": design.AchievableBound, ...}``), then the target line (if given), then
+    one mismatch trace per surface kind and the ``eps_phi`` line on (x, y2).
     """
     x = bounds.x
     peb_cm = 100 * bounds.peb
@@ -66,6 +77,16 @@ def route_traces(bounds, *, variants: dict | None = None, target: float | None =
                 mode="lines",
                 name=f"PEB, {name}",
                 line={"dash": ["dash", "dot", "dashdot"][i % 3], "width": 1.5},
+            )
+        )
+    for i, (name, a) in enumerate((achievable or {}).items()):
+        traces.append(
+            _scatter(
+                x=a.x,
+                y=_finite(100 * a.achievable),
+                mode="lines",
+                name=f"achievable, {name}",
+                line={"color": _ACHIEVABLE_COLORS[i % len(_ACHIEVABLE_COLORS)], "width": 2},
             )
         )
     if target is not None:
@@ -120,11 +141,13 @@ def route_figure(
     *,
     variants: dict | None = None,
     target: float | None = None,
+    achievable: dict | None = None,
     title: str = "",
     subtitle: str = "",
     meta: dict | None = None,
 ) -> go.Figure:
-    """PEB along the tunnel (top, log) with SR-NF failures marked; per-surface mismatch (bottom).
+    """PEB along the tunnel (top, log) with SR-NF failures marked and the achievable bound under
+    impairments beside it; per-surface mismatch (bottom).
 
     ``layout.meta`` carries ``meta`` (for tests and lecture scripts).
     """
@@ -134,7 +157,11 @@ def route_figure(
         "autosize": True,
         "margin": {"l": 70, "r": 20, "t": 90, "b": 50},
         "xaxis": {"anchor": "y2", "title": {"text": "vehicle position x along the tunnel [m]"}},
-        "yaxis": {"domain": [0.42, 1.0], "type": "log", "title": {"text": "PEB [cm]"}},
+        "yaxis": {
+            "domain": [0.42, 1.0],
+            "type": "log",
+            "title": {"text": "position bound [cm]"},
+        },
         "yaxis2": {
             "domain": [0.0, 0.34],
             "type": "log",
@@ -151,7 +178,10 @@ def route_figure(
         "meta": meta or {},
     }
     return go.Figure(
-        {"data": route_traces(bounds, variants=variants, target=target), "layout": layout}
+        {
+            "data": route_traces(bounds, variants=variants, target=target, achievable=achievable),
+            "layout": layout,
+        }
     )
 
 

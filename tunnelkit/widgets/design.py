@@ -1,13 +1,18 @@
-"""Notebook 08 explorer: carrier, bandwidth, array size, tilt and mount height -> the position error
-bound along the tunnel, the SR-NF overlay and the smallest array meeting the target.
+"""Notebook 08 explorer: carrier, bandwidth, array size, tilt, mount height and the impairments
+(per-element phase and gain calibration error, diffuse multipath share, spatial wideband) -> the
+ideal position error bound and the achievable bound along the tunnel, the SR-NF overlay and the
+smallest square array whose achievable bound meets the target.
 
-:func:`design_figure` is the pure callback (bounds only, vectorised: no Monte-Carlo). The explorer
-adds a button that runs a JAVELIN Monte-Carlo for the current design with a progress bar.
+:func:`design_figure` is the pure callback (bounds only, vectorised: no Monte-Carlo); its
+recommendation is a bound-based pre-screen (:func:`tunnelkit.design.smallest_meeting`), a
+necessary condition: the explorer adds a button that runs the design's Monte-Carlo (the tracker on
+the bound-driven route under the same impairments) for the current design with a progress bar.
 
 Figure layout (stable, for tests and lecture scripts): ``layout.title.text`` starts with
 ``"Recommended: "`` followed by the array label or ``"none"``; ``layout.meta`` holds ``array``,
-``n_elements``, ``peb_median_m``, ``srnf_valid_share``, ``met_share``, ``recommended``,
-``fits`` (False when the array does not fit at this mount); traces as in
+``n_elements``, ``peb_median_m``, ``achievable_median_m``, ``srnf_valid_share``, ``met_share``
+(share of the route where the achievable bound meets the target), ``recommended``, ``fits``
+(False when the array does not fit at this mount); traces as in
 :func:`tunnelkit.plots.design.route_traces`.
 """
 
@@ -43,17 +48,29 @@ def design_figure(
     n: int = 8,
     tilt_deg: float = 20.0,
     mount_height: float = 5.8,
+    phase_error_deg: float = 0.0,
+    gain_error_db: float = 0.0,
+    dmc_share: float = 0.0,
+    wideband: bool = False,
     *,
     scenario: str = "example-rectangular-28ghz",
     target: float = 0.2,
     share: float = 0.9,
     eps_phi: float = 0.15,
 ) -> go.Figure:
-    """PEB of an ``n x n`` URA along the route, SR-NF failures marked, and the recommendation.
+    """PEB and achievable bound of an ``n x n`` URA along the route under the impairments, SR-NF
+    failures marked (information: the design's tracker does not need it), and the bound-based
+    recommendation.
 
     Pure: the same arguments give the same figure. A design that does not fit (array outside the
     tunnel at this mount) gives an empty figure whose title says so instead of raising.
     """
+    imp = design.DesignImpairments(
+        phase_error_deg=phase_error_deg,
+        gain_error_db=gain_error_db,
+        spatial_wideband=bool(wideband),
+        dmc_share=dmc_share,
+    )
     try:
         setup = _base(scenario).variant(
             fc=fc_ghz * 1e9,
@@ -64,7 +81,9 @@ def design_figure(
         spec = design.ArraySpec(int(n), int(n))
         T = len(setup.trajectory)
         ep = np.unique(np.linspace(0, T - 1, min(T, MAX_POINTS)).round().astype(int))
-        b = design.route_bounds(setup, spec, eps_phi=eps_phi, epochs=ep)
+        g = design.route_geometry(setup, spec, epochs=ep)
+        b = design.route_bounds(setup, spec, eps_phi=eps_phi, geometry=g)
+        a = design.achievable_bound(setup, spec, imp, geometry=g)
     except ValueError as exc:
         return go.Figure(
             layout={
@@ -79,46 +98,65 @@ def design_figure(
         [f"{k}x{k}" for k in SIZES],
         target=target,
         share=share,
+        impairments=imp,
         eps_phi=eps_phi,
         epochs=ep,
     )
-    met = float(np.mean((b.peb <= target) & b.srnf_valid))
+    met = float(np.mean(a.achievable <= target))
     med = float(np.median(b.peb))
+    med_a = float(np.median(a.achievable))
     if rec is None:
         title = (
-            f"Recommended: none — no square URA up to {SIZES[-1]}x{SIZES[-1]} meets PEB ≤ "
-            f"{100 * target:g} cm with SR-NF valid on {100 * share:.0f} % of the route"
+            f"Recommended: none — no square URA up to {SIZES[-1]}x{SIZES[-1]} has an achievable "
+            f"bound ≤ {100 * target:g} cm on {100 * share:.0f} % of the route"
         )
     else:
         title = (
-            f"Recommended: {rec.label} — the smallest square URA with PEB ≤ {100 * target:g} cm "
-            f"and SR-NF valid on ≥ {100 * share:.0f} % of the route"
+            f"Recommended: {rec.label} — the smallest square URA whose achievable bound is ≤ "
+            f"{100 * target:g} cm on ≥ {100 * share:.0f} % of the route (a bound: confirm with "
+            "Monte-Carlo)"
         )
     sub = (
         f"{spec.label} at {fc_ghz:g} GHz, {bandwidth_mhz:g} MHz, tilt {tilt_deg:g}°, mount "
-        f"{mount_height:g} m: median PEB {100 * med:.3g} cm · SR-NF valid "
-        f"{100 * b.srnf_valid.mean():.0f} % · target met {100 * met:.0f} % · aperture "
-        f"{100 * spec.aperture(setup.fc):.3g} cm"
+        f"{mount_height:g} m, {phase_error_deg:g}° / {gain_error_db:g} dB calibration, diffuse "
+        f"{100 * dmc_share:g} %: median PEB {100 * med:.3g} cm, achievable {100 * med_a:.3g} cm · "
+        f"target met {100 * met:.0f} % · SR-NF valid {100 * b.srnf_valid.mean():.0f} % "
+        f"(eq. 51 only) · aperture diagonal {100 * spec.aperture(setup.fc):.3g} cm"
     )
     meta = {
         "array": spec.label,
         "n_elements": spec.n_elements,
         "peb_median_m": med,
+        "achievable_median_m": med_a,
         "srnf_valid_share": float(b.srnf_valid.mean()),
         "met_share": met,
         "recommended": None if rec is None else rec.label,
         "fits": True,
     }
-    return route_figure(b, target=target, title=title, subtitle=sub, meta=meta)
+    label = "ideal" if imp.ideal else "impaired"
+    return route_figure(
+        b, target=target, achievable={label: a}, title=title, subtitle=sub, meta=meta
+    )
 
 
 class DesignExplorer(Explorer):
     """The sliders and figure of :class:`~tunnelkit.widgets.base.Explorer`, plus a Monte-Carlo
     button (JAVELIN on the current design, progress bar, result printed below)."""
 
-    def __init__(self, callback, controls, *, scenario: str, runs: int, seed: int) -> None:
+    def __init__(
+        self,
+        callback,
+        controls,
+        *,
+        scenario: str,
+        runs: int,
+        seed: int,
+        target: float = 0.2,
+        share: float = 0.9,
+    ) -> None:
         super().__init__(callback, controls, columns=3)
         self.scenario, self.runs, self.seed = scenario, runs, seed
+        self.target, self.share = target, share
         self.button = widgets.Button(
             description=f"Monte-Carlo ({runs} drives)", icon="play", layout={"width": "220px"}
         )
@@ -126,8 +164,11 @@ class DesignExplorer(Explorer):
         self.button.on_click(self._run)
         self.widget = widgets.VBox([*self.widget.children, self.button, self.output])
 
-    def run_monte_carlo(self) -> dict:
-        """JAVELIN RMSE (95 % CI) of the current design; what the button runs."""
+    def run_monte_carlo(self):
+        """The design's Monte-Carlo of the current design under the current impairments (the
+        tracker on the bound-driven route, :func:`tunnelkit.design.design_sweep` on this one
+        array): its :class:`~tunnelkit.design.DesignRow`, verdict and error quantile with its
+        interval; what the button runs."""
         v = self.values
         setup = _base(self.scenario).variant(
             fc=v["fc_ghz"] * 1e9,
@@ -135,7 +176,23 @@ class DesignExplorer(Explorer):
             tilt_deg=v["tilt_deg"],
             mount_height=v["mount_height"],
         )
-        return design.javelin_rmse(setup, f"{v['n']}x{v['n']}", self.runs, self.seed, progress=True)
+        imp = design.DesignImpairments(
+            phase_error_deg=v["phase_error_deg"],
+            gain_error_db=v["gain_error_db"],
+            spatial_wideband=bool(v["wideband"]),
+            dmc_share=v["dmc_share"],
+        )
+        rep = design.design_sweep(
+            setup,
+            [f"{v['n']}x{v['n']}"],
+            target=self.target,
+            share=self.share,
+            impairments=imp,
+            runs=self.runs,
+            seed=self.seed,
+            progress=True,
+        )
+        return rep.rows[0]
 
     def _run(self, _button) -> None:  # pragma: no cover - needs a browser click
         self.output.clear_output()
@@ -148,20 +205,19 @@ class DesignExplorer(Explorer):
             print(monte_carlo_summary(res, self.runs))
 
 
-def monte_carlo_summary(res: dict, runs: int) -> str:
-    """One line for :func:`tunnelkit.design.javelin_rmse`'s result: whole-drive RMSE with its
-    interval and, when the drives outlast the start-up, the settled RMSE against the PEB."""
-    lo, hi = res["ci95_m"]
-    text = (
-        f"JAVELIN 2-D RMSE {100 * res['rmse_m']:.3g} cm, 95 % CI [{100 * lo:.3g}, "
-        f"{100 * hi:.3g}] cm over {runs} drives"
+def monte_carlo_summary(row, runs: int) -> str:
+    """One line for a :class:`tunnelkit.design.DesignRow` with Monte-Carlo runs: its verdict, the
+    error quantile with its 95 % interval and the achievable bound beside it."""
+    if row.status == "error":
+        return f"Monte-Carlo not run: {row.reason}"
+    if row.error_p90_m is None:
+        return f"{row.array}: {row.status} — {row.reason}"
+    lo, hi = row.error_p90_ci95_m
+    return (
+        f"{row.array}: {row.status} — tracker error quantile {100 * row.error_p90_m:.3g} cm, "
+        f"95 % CI [{100 * lo:.3g}, {100 * hi:.3g}] cm over {runs} drives; achievable bound "
+        f"{100 * row.achievable_p90_m:.3g} cm, ideal PEB {100 * row.peb_p90_m:.3g} cm"
     )
-    if res.get("rmse_settled_m") is not None:
-        text += (
-            f"; after the first {design.SETTLE_S:g} s {1000 * res['rmse_settled_m']:.3g} mm, "
-            f"{res['rmse_settled_m'] / res['peb_rms_settled_m']:.3g} x the RMS PEB"
-        )
-    return text
 
 
 def design_explorer(
@@ -172,13 +228,18 @@ def design_explorer(
     n: int = 8,
     tilt_deg: float = 20.0,
     mount_height: float = 5.8,
+    phase_error_deg: float = 0.0,
+    gain_error_db: float = 0.0,
+    dmc_share: float = 0.0,
+    wideband: bool = False,
     target: float = 0.2,
     share: float = 0.9,
     runs: int = 10,
     seed: int = 0,
 ) -> DesignExplorer:
-    """Sliders for carrier, bandwidth, array size, tilt and mount height redrawing
-    :func:`design_figure`; a button runs ``runs`` JAVELIN drives on the current design."""
+    """Sliders for carrier, bandwidth, array size, tilt, mount height and the impairments
+    redrawing :func:`design_figure`; a button runs ``runs`` Monte-Carlo drives of the design's
+    tracker on the current design."""
     from functools import partial
 
     height = float(_base(scenario).tunnel.height)
@@ -198,6 +259,12 @@ def design_explorer(
         "mount_height": float_slider(
             "mount height [m]", mount_height, 0.5, round(height - 0.05, 2), 0.05
         ),
+        "phase_error_deg": float_slider("phase error [°]", phase_error_deg, 0.0, 3.0, 0.1),
+        "gain_error_db": float_slider("gain error [dB]", gain_error_db, 0.0, 0.5, 0.05),
+        "dmc_share": float_slider("diffuse share", dmc_share, 0.0, 0.3, 0.01),
+        "wideband": widgets.Checkbox(value=bool(wideband), description="spatial wideband"),
     }
     cb = partial(design_figure, scenario=scenario, target=target, share=share)
-    return DesignExplorer(cb, controls, scenario=scenario, runs=runs, seed=seed)
+    return DesignExplorer(
+        cb, controls, scenario=scenario, runs=runs, seed=seed, target=target, share=share
+    )
