@@ -147,15 +147,14 @@ print(
 # averaged over the calibration draw in closed form (`design.achievable_bound`; its closed forms are
 # tested against finite differences and an exact nonlinear fit in `tests/test_achievable.py`, and
 # against Monte-Carlo of the ML extraction in `benchmarks/bench_achievable.py`). With no
-# impairment it is the PEB. Below, the 8 × 8 array at three calibration qualities, the spatial
-# wideband term on and 0.2 dB of gain error:
+# impairment it is the PEB. Below, the 8 × 8 array at three calibration qualities (phase error
+# per element, with 0.2 dB of gain error); the spatial wideband term and diffuse power are left to
+# exercise 3, so that what moves here is the calibration alone:
 
 # %%
 levels = {"ideal": 0.0, "0.5°": 0.5, "2°": 2.0}
 imps = {
-    k: design.DesignImpairments(
-        phase_error_deg=v, gain_error_db=0.2 if v else 0.0, spatial_wideband=v > 0
-    )
+    k: design.DesignImpairments(phase_error_deg=v, gain_error_db=0.2 if v else 0.0)
     for k, v in levels.items()
 }
 ach8 = {k: design.achievable_bound(setup, "8x8", imp) for k, imp in imps.items()}
@@ -166,6 +165,7 @@ for k, a in ach8.items():
         f" wideband {100 * np.median(a.wideband):.3g} cm)"
     )
 ratio_cal = np.median(ach8["0.5°"].achievable) / np.median(ach8["ideal"].peb)
+print(f"0.5° and 0.2 dB lift the median bound by a factor {ratio_cal:.2g}")
 
 # %%
 # headline: peb-and-achievable-along-the-tunnel
@@ -179,7 +179,8 @@ route_figure(
 
 # %% [markdown]
 # The ideal bound of an 8 × 8 array is millimetres; half a degree of phase error per element
-# lifts the achievable bound by the factor printed above (`ratio_cal`), to centimetres. That
+# (with 0.2 dB of gain error) lifts the achievable bound by the factor printed above, to
+# centimetres. That
 # factor, not the PEB, is what an engineer buys against. Where a term is *known* (the spatial
 # wideband delay follows from the geometry the fit estimates anyway) it can be put in the model
 # and stops costing; an unknown calibration error cannot.
@@ -216,8 +217,10 @@ print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.i
 # the achievable model (the calibration error drawn once per drive, as it belongs to the array;
 # the noise and diffuse term per epoch) and reported to the tracker with the **error budget**
 # of the stated impairments (the CRLB plus the covariance of the calibration tolerance and the
-# bias of the terms the model leaves out: `PathErrorModel.budget`). An extraction that reported
-# only its CRLB, micrometres, would hand the tracker centimetres of calibration bias it is told
+# bias of the terms the model leaves out: `PathErrorModel.budget`); a curvature the array cannot
+# resolve (its budget above a tenth of the range) is handed on as far field, as a plane-wave fit
+# would report it. An extraction that reported only its CRLB (sub-millimetre in delay) would
+# hand the tracker centimetres of calibration bias it is told
 # cannot exist: it then weighs biased paths as exact and its error grows (exercise 4). A
 # candidate is **met** when the 95 % bootstrap interval of its error quantile (the 90th
 # percentile of the per-epoch 2-D error over the settled epochs and the runs) lies below the
@@ -251,7 +254,7 @@ size_figure(
 # %% [markdown]
 # Read the three tables top to bottom. With an ideal array every candidate's tracker error sits
 # within a small factor of its PEB and the smallest array passes; with half a degree of phase
-# error the achievable bound and the tracker's median error rise by one to two orders of
+# error the achievable bound and the tracker's median error rise by more than an order of
 # magnitude over the PEB, the tracker staying within a small factor of the achievable bound;
 # with 2° the smaller arrays are hopeless before any Monte-Carlo. The recommendation (printed
 # above, `recs`) follows the calibration, not the PEB. (In quick mode, with few drives, read the
@@ -287,11 +290,12 @@ pc_ratio = np.sqrt(np.mean(bound6.errors[:, bound6.settled] ** 2)) / np.sqrt(
 print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g}")
 
 # %% [markdown]
-# The two routes agree within the sampling spread of a few drives (the printed medians); they
-# part ways where the extraction leaves its bound (notebook 03, the threshold region): a 4 × 4
-# array at 60 m is below it, and there the channel route loses epochs the bound route cannot
-# lose. The tracker sits a small factor above the posterior bound (printed): JAVELIN estimates
-# each reflection's VUE as an unknown, where the bound knows the surfaces.
+# Compare the two printed medians: where the extraction is above its threshold (notebook 03,
+# section 11), as for this 6 × 6 array, the two routes agree within the spread of a few drives.
+# Where it is not — a 4 × 4 array 60 m away — the channel route loses epochs that the bound route
+# cannot lose, so the fast route is trusted only above the threshold. The tracker's settled RMSE
+# against the posterior bound is the printed ratio: JAVELIN estimates each reflection's VUE as an
+# unknown, where the bound knows the surfaces.
 
 # %% [markdown]
 # ## 8. The paper's tunnel, 4 × 4 to 16 × 16, and the SR-NF criterion
@@ -417,8 +421,8 @@ print(f"factor: {sol4['crlb'] / sol4['budget']:.2g}")
 # the ideal PEB is millimetres; the achievable bound equals it with no impairment
 assert np.allclose(ach8["ideal"].achievable, ach8["ideal"].peb, equal_nan=True)
 assert np.median(ach8["ideal"].peb) < 0.01
-# calibration lifts the bound by more than an order of magnitude (the prose's ratio_cal)
-assert ratio_cal > 10, ratio_cal
+# calibration lifts the bound several-fold (the printed ratio_cal)
+assert ratio_cal > 5, ratio_cal
 assert np.all(ach8["2°"].achievable >= ach8["ideal"].peb * (1 - 1e-9))
 # SR-NF: the ceiling binds for 8x8 under the ceiling, and the default criterion does not gate on it
 assert srnf8["ceiling"] == 0.0
@@ -446,7 +450,9 @@ for r in answers["0.5°"].rows:
 assert {r.array: r.status for r in answers["2°"].rows}["4x4"] == "hopeless"
 # the bound-driven route and the posterior bound
 assert all(np.all(np.isfinite(r.errors)) for r in val.values())
-assert 0.5 < pc_ratio < 20, pc_ratio
+assert 0.8 < pc_ratio < 5, pc_ratio
+med_b, med_c = (np.median(r.errors[:, r.settled]) for r in (val["bound"], val["channel"]))
+assert 1 / 3 < med_b / med_c < 3, (med_b, med_c)  # the two routes agree above the threshold
 # the paper's tunnel under the SR-NF criterion
 assert sweep.criterion == "srnf"
 peb_paper = [r.peb_median_m for r in sweep.rows]

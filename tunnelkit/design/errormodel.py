@@ -102,8 +102,11 @@ class PathErrorModel:
             k = getattr(self, name)
             if k is not None and (np.ndim(k) != 4 or np.shape(k)[:3] != (T, P, 4)):
                 raise ValueError(f"{name}: expected shape ({T}, {P}, 4, M), got {np.shape(k)}")
-        nonnegative("phase_sigma_rad", self.phase_sigma_rad)
-        nonnegative("gain_sigma_db", self.gain_sigma_db)
+        for name, k in (("phase_sigma_rad", "k_phase"), ("gain_sigma_db", "k_gain")):
+            if nonnegative(name, getattr(self, name)) > 0 and getattr(self, k) is None:
+                raise ValueError(f"{name}: a calibration error needs its sensitivity {k}")
+            if getattr(self, k) is not None and not np.all(np.isfinite(getattr(self, k))):
+                raise ValueError(f"{k}: every entry must be finite")
 
     @property
     def n_elements(self) -> int | None:

@@ -23,6 +23,10 @@ the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
 * the radial speed ``v`` from the truth plus :data:`SIGMA_V` of white noise (the Doppler
   clutter test only compares it with the vehicle speed at metre-per-second level; the ideal
   bound on ``v`` is far smaller, so this is a conservative, documented stand-in);
+* a curvature the array cannot resolve is not reported: where the reported budget's standard
+  deviation of ``kappa`` exceeds :data:`KAPPA_RESOLVED` of the path's range the path is handed
+  on without curvature (``kappa`` NaN, the far-field case an extraction reports as a plane-wave
+  fit), instead of a draw that would be negative or a kilometre off;
 * the paths ordered by measured ``d`` (an extraction does not know which path is the LoS) and
   Algorithm 1's ``d >= min_d`` applied as the route does (``SignalRoute.min_d``);
 * the V2X speed and heading messages as :func:`tunnelkit.studies.simulate_drive` draws them.
@@ -41,7 +45,11 @@ from ..constants import C
 from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 
-__all__ = ["REPORTS", "SIGMA_V", "bound_drive", "model_truth"]
+__all__ = ["KAPPA_RESOLVED", "REPORTS", "SIGMA_V", "bound_drive", "model_truth"]
+
+#: a curvature is reported only where its reported standard deviation is below this share of the
+#: path's range (otherwise the path goes on as far field, as a plane-wave fit would report it)
+KAPPA_RESOLVED = 0.1
 
 #: what the bound route reports to the tracker (:func:`bound_drive`)
 REPORTS = ("auto", "crlb", "budget")
@@ -85,6 +93,11 @@ def bound_drive(
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     spec = parse_array(spec)
+    if model.n_elements is not None and model.n_elements != spec.n_elements:
+        raise ValueError(
+            f"spec: the model was built for {model.n_elements} elements, {spec.label} has "
+            f"{spec.n_elements}"
+        )
     rng = rng_or_error("rng", rng)
     sigma_v = nonnegative("sigma_v", sigma_v)
     report = choice("report", report, REPORTS)
@@ -118,10 +131,14 @@ def bound_drive(
         o = j[np.argsort(d, kind="stable")]
         d = z[k, o, 3] + C * bias[k]
         blocks = per_path[k, o]  # (n, 4, 4)
+        kap = z[k, o, 2]
+        kap = np.where(
+            np.sqrt(blocks[:, 2, 2]) <= KAPPA_RESOLVED * model.truth[k, o, 3], kap, np.nan
+        )
         pm = PathMeasurements.from_arrays(
             z[k, o, 0],
             z[k, o, 1],
-            z[k, o, 2],
+            kap,
             d,
             v[k, o],
             warn=False,

@@ -68,7 +68,8 @@ class MonteCarloResult:
     (runs,) each run's RMSE over the settled epochs (the whole drive when it is shorter than
     :data:`SETTLE_S`); ``settled`` the indices of the settled epochs
     (:func:`tunnelkit.metrics.settled`); ``mode`` the measurement route; ``peb`` (T,) [m] the
-    snapshot PEB; ``pcrlb`` (T,) [m] the posterior CRLB of the 2-D position over the drive
+    snapshot PEB; ``pcrlb`` (T,) [m] the posterior CRLB of the 2-D position over the drive,
+    from the ideal per-path CRLB (under impairments the ideal posterior bound, not an achievable one)
     (``None`` on the channel route without a model); ``sigmas`` the tracker's fallback sigmas.
     """
 

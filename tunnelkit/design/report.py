@@ -9,8 +9,8 @@ tracker achieves.
    (:func:`tunnelkit.design.achievable.achievable_bound`; with no impairments the two coincide,
    the misspecified bound of a well-specified model being the CRLB), and SR-NF validity per
    surface (information under ``criterion="achievable"``, a gate under ``"srnf"``);
-3. the **pre-screen**: a candidate whose achievable bound already misses the target on ``share``
-   of the counted epochs is hopeless and gets no Monte-Carlo;
+3. the **pre-screen**: a candidate on which even an estimator at the achievable bound would miss
+   the target on ``share`` of the counted epochs is hopeless and gets no Monte-Carlo;
 4. the **Monte-Carlo** of the design's tracker on the others, all arrays x runs as one task set
    (:func:`tunnelkit.design.montecarlo.sweep_montecarlo`), and the verdict of
    :mod:`tunnelkit.design.verdict` (error quantile with a bootstrap 95 % interval).
@@ -40,6 +40,7 @@ from .verdict import (
     bootstrap_quantile_ci,
     counted_epochs,
     gate,
+    implied_quantile,
     judge,
     recommend,
     share_quantile,
@@ -385,7 +386,7 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
     row.achievable_median_m = float(np.median(ach[k]))
     row.achievable_p90_m = share_quantile(ach[k], share)
     row.met_share = float(np.mean(gated <= target))
-    row.screen_m = share_quantile(gated, share)  # the pre-screen under the criterion
+    row.screen_m = implied_quantile(gated, share)  # the pre-screen under the criterion
     row.srnf_valid = sr.srnf_valid
     row.status, row.reason = judge(target, row.screen_m, share=share)
     return row

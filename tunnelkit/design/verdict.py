@@ -12,15 +12,21 @@ bound-driven or the channel Monte-Carlo.
   SR-NF validity is reported as information. ``"srnf"`` (a route that uses eq. 51, the
   wavefront centred on the reflection point) also requires SR-NF validity: an epoch where a
   used path breaks it counts as an infinite error (:func:`gate`).
-* **The error quantile** (:func:`share_quantile`): the ``share``-quantile (``method="higher"``,
-  an observed value) of the per-epoch 2-D error, pooled over runs and over the counted epochs.
-  A non-finite error (no estimate) counts as infinite. This is the ``*_p90_m`` of the report at
-  the default ``share = 0.9``.
+* **The error quantile** (:func:`share_quantile`): the ``share``-quantile
+  (``method="inverted_cdf"``, an observed value: it is <= the target exactly when the share of
+  values <= the target is >= ``share``) of the per-epoch 2-D error, pooled over runs and over the
+  counted epochs. A non-finite error (no estimate) counts as infinite. This is the ``*_p90_m`` of
+  the report at the default ``share = 0.9``.
 * **Its 95 % interval** (:func:`bootstrap_quantile_ci`): percentile bootstrap over runs (whole
   drives resampled with replacement, an explicit :class:`numpy.random.Generator`), since the
   epochs of one drive are correlated.
-* **The verdict** (:func:`judge`): ``"hopeless"`` when the achievable bound's quantile already
-  misses the target (its Monte-Carlo is skipped); ``"bound only"`` with no Monte-Carlo;
+* **The pre-screen** (:func:`implied_quantile`): the error quantile an estimator *at* the
+  achievable bound would have, each counted epoch's 2-D error a circular Gaussian whose RMS is
+  the bound there. A bound's own quantile is not a lower bound of the error's quantile (a
+  1-cm bound on 89 % of the route and 20 cm elsewhere still lets 90 % of the errors lie under
+  5 cm); this one is the quantile of an estimator that attains the bound everywhere.
+* **The verdict** (:func:`judge`): ``"hopeless"`` when that implied quantile misses the target
+  (its Monte-Carlo is skipped); ``"bound only"`` with no Monte-Carlo;
   ``"met"`` only when the interval's upper end is below the target; ``"not met"`` when its lower
   end is at or above it; ``"undecided"`` when it straddles the target or when fewer than
   :data:`MIN_RUNS_CI` runs stand behind it (a 2-run interval is not an answer).
@@ -42,6 +48,7 @@ __all__ = [
     "bootstrap_quantile_ci",
     "counted_epochs",
     "gate",
+    "implied_quantile",
     "judge",
     "recommend",
     "share_quantile",
@@ -78,7 +85,8 @@ def gate(values, srnf_valid, criterion: str) -> np.ndarray:
 
 def share_quantile(values, share: float) -> float:
     """The ``share``-quantile of ``values`` (any shape, pooled), non-finite counted as ``inf``;
-    ``method="higher"``: an observed value, so ``inf`` once more than ``1 - share`` fail."""
+    ``method="inverted_cdf"``: the smallest observed ``q`` with at least ``share`` of the values
+    <= ``q`` (so ``inf`` once fewer than ``share`` are finite)."""
     share = probability("share", share, open_interval=False)
     v = np.asarray(values, float).ravel()
     if not v.size:
@@ -86,7 +94,36 @@ def share_quantile(values, share: float) -> float:
     if np.any(v < 0):
         raise ValueError("values: errors and bounds are not negative")
     v = np.where(np.isfinite(v), v, np.inf)
-    return float(np.quantile(v, share, method="higher"))
+    return float(np.quantile(v, share, method="inverted_cdf"))
+
+
+def implied_quantile(bounds, share: float) -> float:
+    """The ``share``-quantile of the 2-D error of an estimator that attains ``bounds`` (T,) [m]
+    at every epoch: each epoch's error a circular Gaussian with ``E|e|^2 = bound^2``, so
+    ``P(|e| <= x) = 1 - exp(-x^2 / bound^2)``, pooled over the epochs (a non-finite bound is an
+    epoch never met). Solved by bisection on the pooled distribution function."""
+    share = probability("share", share, open_interval=False)
+    b = np.asarray(bounds, float).ravel()
+    if not b.size:
+        raise ValueError("bounds: expected at least one value")
+    if np.any(b < 0):
+        raise ValueError("bounds: a bound is not negative")
+    fin = np.isfinite(b)
+    if fin.mean() < share:
+        return float("inf")
+    bf = b[fin]
+
+    def cdf(x: float) -> float:
+        with np.errstate(divide="ignore"):
+            return float(np.sum(1.0 - np.exp(-(x**2) / np.where(bf > 0, bf**2, 1e-300)))) / b.size
+
+    lo, hi = 0.0, max(float(bf.max()), 1e-12)
+    while cdf(hi) < share:
+        hi *= 2.0
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if cdf(mid) < share else (lo, mid)
+    return hi
 
 
 def bootstrap_quantile_ci(
@@ -112,7 +149,7 @@ def bootstrap_quantile_ci(
     step = max(1, 2_000_000 // (runs * T))  # bounded memory per chunk
     for i in range(0, n_boot, step):
         block = e[draws[i : i + step]].reshape(-1, runs * T)
-        qs[i : i + step] = np.quantile(block, share, axis=1, method="higher")
+        qs[i : i + step] = np.quantile(block, share, axis=1, method="inverted_cdf")
     p = [(1 - level) / 2, (1 + level) / 2]
     if np.all(np.isfinite(qs)):
         lo, hi = np.quantile(qs, p, method="linear")
@@ -130,25 +167,32 @@ def judge(
     ci: list | None = None,
     share: float = 0.9,
 ) -> tuple[str, str]:
-    """``(status, reason)`` of one candidate (module docstring): ``bound_q`` the achievable
-    bound's quantile over the counted epochs, ``error_q`` and ``ci`` the Monte-Carlo error's
-    quantile and interval from ``runs`` drives (``runs = 0``: none)."""
+    """``(status, reason)`` of one candidate (module docstring): ``bound_q`` the error quantile
+    implied by the achievable bound (:func:`implied_quantile`) over the counted epochs,
+    ``error_q`` and ``ci`` the Monte-Carlo error's quantile and interval from ``runs`` drives
+    (``runs = 0``: none)."""
     target = positive("target", target)
     runs = integer("runs", runs, minimum=0)
+    share = probability("share", share, open_interval=False)
+    if np.isnan(bound_q) or bound_q < 0:
+        raise ValueError(f"bound_q: expected a quantile >= 0 (inf allowed), got {bound_q!r}")
     pct = f"{100 * share:g} %"
     if not bound_q <= target:
         return "hopeless", (
-            f"the achievable bound already misses the target on {pct} of the route "
-            f"({_m(bound_q)} > {target:g} m): Monte-Carlo skipped"
+            f"even an estimator at the achievable bound would err by more than {target:g} m on "
+            f"{100 - 100 * share:g} % of the route or more (its {pct} quantile {_m(bound_q)}): "
+            "Monte-Carlo skipped"
         )
     if runs == 0:
         return "bound only", (
-            f"achievable bound {_m(bound_q)} <= {target:g} m on {pct} of the route: a necessary "
-            "condition only (no Monte-Carlo)"
+            f"an estimator at the achievable bound would stay within {_m(bound_q)} <= {target:g} m"
+            f" on {pct} of the route: a necessary condition only (no Monte-Carlo)"
         )
     if error_q is None or ci is None:
         raise ValueError("error_q: give the Monte-Carlo quantile and its interval when runs > 0")
     lo, hi = ci
+    if not lo <= error_q <= hi:
+        raise ValueError(f"ci: expected [lo, hi] around error_q = {error_q!r}, got {ci!r}")
     head = f"error on {pct} of the settled route {_m(error_q)}, 95 % CI [{_m(lo)}, {_m(hi)}]"
     if runs < MIN_RUNS_CI:
         return "undecided", (
@@ -189,7 +233,7 @@ def recommend(rows, target: float, share: float, runs: int) -> dict:
     smaller_open = [
         r.array
         for r in order
-        if r.status == "undecided" and (not met or r.n_elements < met[0].n_elements)
+        if r.status == "undecided" and (not met or order.index(r) < order.index(met[0]))
     ]
     if met:
         best = met[0]
