@@ -211,8 +211,9 @@ print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.i
 # ## 6. The answer: what the tracker achieves, and how it changes with calibration
 #
 # `design.design_sweep` puts it together for each candidate: the ideal PEB and the achievable
-# bound; a **pre-screen** (a candidate whose achievable bound already misses the target is
-# hopeless and gets no Monte-Carlo); then JAVELIN (our design) over Monte-Carlo drives. The
+# bound; a **pre-screen** (a candidate on which even an estimator *at* the achievable bound —
+# each epoch's error a circular Gaussian of that RMS — would miss the target on the share is
+# hopeless and gets no Monte-Carlo: `design.implied_quantile`); then JAVELIN (our design) over Monte-Carlo drives. The
 # drives are measured on the **bound-driven route**: each epoch's path parameters are drawn from
 # the achievable model (the calibration error drawn once per drive, as it belongs to the array;
 # the noise and diffuse term per epoch) and reported to the tracker with the **error budget**

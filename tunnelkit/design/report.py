@@ -490,8 +490,8 @@ def design_sweep(
     hopeless = [r.array for r in rows if r.status == "hopeless"]
     if runs and hopeless:
         warnings.append(
-            f"{', '.join(hopeless)}: the achievable bound already misses {target:g} m on "
-            f"{100 * share:g} % of the route; Monte-Carlo skipped"
+            f"{', '.join(hopeless)}: even an estimator at the achievable bound would miss "
+            f"{target:g} m on {100 * share:g} % of the route; Monte-Carlo skipped"
         )
     if runs and todo:
         kw = {
