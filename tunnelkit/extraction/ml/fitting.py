@@ -115,13 +115,10 @@ def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
     return theta, mu_f, mu_t, ev, it, converged
 
 
-def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
-    """One path more, sought in the pure residual; all ``L + 1`` fitted jointly; the least
-    significant one out and the ``L`` fitted again (a path missed while another was counted
-    twice, or two paths merged, leave a structured residual that this move picks up)."""
-    r = prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
-    th_n, mf_n, mt_n = search_path(r, prob)
-    big = _lm(
+def _lm_with(prob: Problem, theta, mu_f, mu_t, new, sigma2, max_iter):
+    """:func:`_lm` on the ``L`` paths plus one more, ``new = (theta, mu_f, mu_t)`` of it."""
+    th_n, mf_n, mt_n = new
+    return _lm(
         prob,
         np.vstack([theta, th_n]),
         np.append(mu_f, mf_n),
@@ -129,6 +126,14 @@ def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
         sigma2,
         max_iter,
     )
+
+
+def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
+    """One path more, sought in the pure residual; all ``L + 1`` fitted jointly; the least
+    significant one out and the ``L`` fitted again (a path missed while another was counted
+    twice, or two paths merged, leave a structured residual that this move picks up)."""
+    r = prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
+    big = _lm_with(prob, theta, mu_f, mu_t, search_path(r, prob), sigma2, max_iter)
     keep = np.arange(theta.shape[0] + 1) != int(np.argmin(_significance(big[3], sigma2)))
     res = _lm(prob, big[0][keep], big[1][keep], big[2][keep], sigma2, max_iter)
     return res, big[4] + res[4]
@@ -201,14 +206,7 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves)
             break
         theta, mu_f, mu_t, ev = best[:4]
         th_n, mf_n, mt_n = path_from_peak(prob, peak[1], peak[2])
-        big = _lm(
-            prob,
-            np.vstack([theta, th_n]),
-            np.append(mu_f, mf_n),
-            np.append(mu_t, mt_n),
-            sigma2,
-            short,
-        )
+        big = _lm_with(prob, theta, mu_f, mu_t, (th_n, mf_n, mt_n), sigma2, short)
         n_it += big[4]
         keep = np.arange(L + 1) != int(np.argmin(_significance(big[3], sigma2)))
         starts = [(big[0][keep], big[1][keep], big[2][keep])]
