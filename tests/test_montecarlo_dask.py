@@ -242,7 +242,7 @@ def test_silent_scheduler_fails_within_the_timeout():
         srv.close()
         for c in held:
             c.close()
-    assert time.perf_counter() - t0 < 4.0
+    assert time.perf_counter() - t0 < 10.0  # not the 120 s it hung before (loaded CI: margin)
     assert held  # the connection was accepted: the probe, not the connect, timed out
 
 
@@ -251,23 +251,25 @@ def test_a_trial_past_its_timeout_stops_the_run_serially_and_on_dask(cluster):
 
     t0 = time.perf_counter()
     with pytest.raises(TrialTimeout, match="trial 1 of 2"):
-        run_trials(_sleep, 2, seed=0, inputs=[0.0, 5.0], trial_timeout=0.5)
-    assert time.perf_counter() - t0 < 3.0
+        run_trials(_sleep, 2, seed=0, inputs=[0.0, 30.0], trial_timeout=0.5)
+    assert time.perf_counter() - t0 < 15.0  # the 30 s trial was stopped, not waited for
     # a run whose trials each finish in time is unchanged by the limit (and the workers have
     # imported this module before the clock starts)
     ok = run_trials(_draw, 4, seed=3, scheduler=cluster.scheduler_address, trial_timeout=30.0)
     assert ok == run_trials(_draw, 4, seed=3)
     t0 = time.perf_counter()
-    with pytest.raises(TrialTimeout, match=r"trials \[1\] of 3"):
+    # the hung trial is named (on a loaded machine the quick ones may be named with it: the limit
+    # runs from the last finished trial, and their start may be late)
+    with pytest.raises(TrialTimeout, match=r"trials \[(0, )?1(, 2)?\] of 3"):
         run_trials(
             _sleep,
             3,
             seed=0,
-            inputs=[0.0, 12.0, 0.0],
+            inputs=[0.0, 60.0, 0.0],
             scheduler=cluster.scheduler_address,
-            trial_timeout=1.0,
+            trial_timeout=3.0,
         )
-    assert time.perf_counter() - t0 < 8.0  # the 12 s trial was not waited for
+    assert time.perf_counter() - t0 < 30.0  # the 60 s trial was not waited for
 
 
 def test_workers_beyond_the_cores_are_capped_with_a_warning(monkeypatch):
