@@ -183,20 +183,24 @@ def epoch_figure(
     post = np.asarray(report.positions)
     born = set(report.manage.born) if report.manage is not None else set()
     ids = [0, *report.ids]
+    shown = set()
     for i, p in enumerate(post):
         is_born = ids[i] in born
+        name = "birth" if is_born else ("UE posterior" if i == 0 else "VUE posterior")
         fig.add_scatter(
             x=[p[ax[0]]],
             y=[p[ax[1]]],
             mode="markers",
-            name="birth" if is_born else ("UE posterior" if i == 0 else "VUE posterior"),
-            showlegend=False,
+            name=name,
+            legendgroup=name,
+            showlegend=name not in shown,
             marker={
                 "symbol": "star" if is_born else "circle",
                 "size": 11 if is_born else 7,
                 "color": "#2ca02c" if is_born else ("#1f77b4" if i == 0 else "#444"),
             },
         )
+        shown.add(name)
     if truth is not None:
         t = np.asarray(truth, float)
         fig.add_scatter(

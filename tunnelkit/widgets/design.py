@@ -108,20 +108,18 @@ def design_figure(
     if rec is None:
         title = (
             f"Recommended: none — no square URA up to {SIZES[-1]}x{SIZES[-1]} has an achievable "
-            f"bound ≤ {100 * target:g} cm on {100 * share:.0f} % of the route"
+            f"bound ≤ {100 * target:g} cm on {100 * share:.0f} %"
         )
     else:
         title = (
-            f"Recommended: {rec.label} — the smallest square URA whose achievable bound is ≤ "
-            f"{100 * target:g} cm on ≥ {100 * share:.0f} % of the route (a bound: confirm with "
-            "Monte-Carlo)"
+            f"Recommended: {rec.label} — smallest square URA with achievable bound ≤ "
+            f"{100 * target:g} cm on {100 * share:.0f} % (a bound)"
         )
     sub = (
-        f"{spec.label} at {fc_ghz:g} GHz, {bandwidth_mhz:g} MHz, tilt {tilt_deg:g}°, mount "
-        f"{mount_height:g} m, {phase_error_deg:g}° / {gain_error_db:g} dB calibration, diffuse "
-        f"{100 * dmc_share:g} %: median PEB {100 * med:.3g} cm, achievable {100 * med_a:.3g} cm · "
-        f"target met {100 * met:.0f} % · SR-NF valid {100 * b.srnf_valid.mean():.0f} % "
-        f"(eq. 51 only) · aperture diagonal {100 * spec.aperture(setup.fc):.3g} cm"
+        f"{spec.label}, {fc_ghz:g} GHz, {bandwidth_mhz:g} MHz, {phase_error_deg:g}°/"
+        f"{gain_error_db:g} dB, diffuse {100 * dmc_share:g} %: median PEB {100 * med:.3g} cm, "
+        f"achievable {100 * med_a:.3g} cm · met {100 * met:.0f} % · SR-NF (eq. 51) "
+        f"{100 * b.srnf_valid.mean():.0f} %"
     )
     meta = {
         "array": spec.label,
