@@ -14,13 +14,13 @@ import importlib
 from pathlib import Path
 from typing import Any
 
+from . import scenarios
 from .montecarlo import QUICK, mc_count, quick_mode
 from .scenarios import list_scenarios, load_scenario
-from .scenarios import registry as _builders
 
 # the builders of a scenario's tunnel, trajectory and arrays live in the modules that define those
 # objects and register themselves on import; the first lookup of a built-in kind imports its module
-_builders.set_loader(importlib.import_module)
+scenarios.registry.set_loader(importlib.import_module)
 
 __version__ = "0.1.0"
 

@@ -29,7 +29,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from .._validate import finite_array, integer
-from .._validate import probability as _probability
+from .._validate import probability as check_probability
 
 __all__ = [
     "DEFAULT_GATE",
@@ -87,7 +87,7 @@ class ChiSquareGate:
     probability: float = DEFAULT_GATE
 
     def __post_init__(self) -> None:
-        _probability("probability", self.probability)
+        check_probability("probability", self.probability)
 
     def threshold(self, dof: int = 3) -> float:
         """The chi-square quantile ``chi2_dof(p)`` (11.34 for 3 dof at p = 0.99)."""
@@ -117,7 +117,7 @@ class InnovationGate:
         batch: int | None = None,
         name: str = "gate",
     ) -> None:
-        self.probability = None if probability is None else _probability(name, probability)
+        self.probability = None if probability is None else check_probability(name, probability)
         self.test = None if probability is None else ChiSquareGate(self.probability)
         self.reopen_after = integer("reopen_after", reopen_after, minimum=1)
         shape = () if batch is None else (integer("batch", batch, minimum=1),)

@@ -39,7 +39,7 @@ import numpy as np
 from filterpy.kalman import MerweScaledSigmaPoints
 
 from .._validate import finite_array, integer, positive, probability, real, rng_or_error
-from .._validate import weights as _weights
+from .._validate import weights as check_weights
 from ..budget import check_elements
 from .cv import STATE_DIM
 from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, REJECT, REOPEN, InnovationGate
@@ -160,7 +160,7 @@ def effective_sample_size(weights) -> np.ndarray:
 
     ``weights`` must be finite, ``>= 0`` and have a positive sum in every row.
     """
-    w = _weights("weights", weights)
+    w = check_weights("weights", weights)
     return _ess(w / w.sum(axis=-1, keepdims=True))
 
 
@@ -176,7 +176,7 @@ def systematic_resample(weights, rng: np.random.Generator) -> np.ndarray:
     ``(u + j) / N``. Rows are searched in one ``searchsorted`` by shifting row ``b`` by ``b``.
     """
     rng = rng_or_error("rng", rng)
-    w = _weights("weights", weights)
+    w = check_weights("weights", weights)
     n = w.shape[-1]
     flat = w.reshape(-1, n)
     b = flat.shape[0]
