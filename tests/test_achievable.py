@@ -145,20 +145,7 @@ def test_calibration_scores_are_the_element_inner_products(small):
 def test_wideband_series_equals_the_exact_sum(small, df):
     """The separable series about the band centre against the exact per-element delay; at
     60 MHz x 8 tones the phase across the aperture reaches about 0.1 rad (several terms)."""
-    pos, eta, _ = small
-    src = eta.reshape(-1, 7)[:, 4:]
-    e = eta.reshape(-1, 7)
-    md = EtaModes(
-        src[None],
-        pos,
-        (e[:, 0] + 1j * e[:, 1])[None],
-        e[None, :, 2],
-        e[None, :, 3],
-        np.ones((1, 2), bool),
-        FC,
-        NF,
-        NT,
-    )
+    pos, eta, md = small  # the modes of the same two paths
     J = _jacobian(eta, pos)
     delta = _model(eta, pos, wideband=True, df=df) - _model(eta, pos)
     ref = J.conj().T @ delta.ravel()
@@ -250,20 +237,7 @@ def test_calibration_bias_is_the_exact_fit_to_first_order(small, calibrated_fit)
 def test_wideband_bias_is_the_exact_fit_to_first_order(small, df):
     """8 tones 6 and 60 MHz apart (48 and 480 MHz) on 4 x 4 elements at 1.5 m: the first
     order within 5 % of the exact fit in every significant component (printed: 0.2 %, 2 %)."""
-    pos, eta, _ = small
-    e = eta.reshape(-1, 7)
-    src = e[:, 4:]
-    mdw = EtaModes(
-        src[None],
-        pos,
-        (e[:, 0] + 1j * e[:, 1])[None],
-        e[None, :, 2],
-        e[None, :, 3],
-        np.ones((1, 2), bool),
-        FC,
-        NF,
-        NT,
-    )
+    pos, eta, mdw = small  # the modes of the same two paths
     H = _model(eta, pos, wideband=True, df=df)
     got = _nls(eta, pos, H) - eta
     pred = np.linalg.solve(mdw.fim(S2)[0], 2 / S2 * mdw.wideband_score(df)[0].real)
