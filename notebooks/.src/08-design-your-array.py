@@ -462,6 +462,18 @@ assert all(r.srnf_valid_share_by_surface["ceiling"] == 0.0 for r in sweep.rows)
 peb_paper = [r.peb_median_m for r in sweep.rows]
 assert np.all(np.diff(peb_paper) < 0)  # PEB falls with size
 assert sweep.rows[0].srnf_valid_share >= sweep.rows[-1].srnf_valid_share
+# numbers the prose quotes: the radio (792 tones x 12 symbols), the ceiling 20 cm above the
+# mount, a 32 x 32 URA 0.8 m on a side at 5.9 GHz that does not fit, exercise 2's 4.7 and 4
+assert cfg.n_tones == 792 and cfg.n_symbols == 12
+assert abs(setup.tunnel.height - setup.mounts[0].centre[2] - 0.2) < 1e-9
+assert abs(31 * design.parse_array("32x32").spacing(5.9e9) - 0.8) < 0.02
+try:
+    paper.arrays("32x32")
+    fits32 = True
+except ValueError:
+    fits32 = False
+assert not fits32
+assert round(28e9 / 5.9e9, 1) == 4.7 and 400e6 / 100e6 == 4
 assert explorer.figure.layout.title.text.startswith("Recommended: ")
 assert design_figure(n=4, target=0.1).layout.meta["achievable_median_m"] > 0
 assert sol4["crlb"] > sol4["budget"], sol4  # exercise 4: what the extraction reports matters
