@@ -100,8 +100,9 @@ def _model(eta, pos, wideband=False, df=DF):
         off = r - r[0]
         a = np.exp(1j * K0 * off)
         f = np.exp(1j * s * e[2])[None, :] * np.ones((pos.shape[0], 1))
-        if wideband:
-            f = f * np.exp(-2j * np.pi * s[None, :] * df * off[:, None] / C)
+        if wideband:  # tone s at f_s = FC + (s - s_c) df: the delay's phase at f_s - FC
+            f_s = FC + (s - 0.5 * (NF - 1)) * df
+            f = f * np.exp(-2j * np.pi * (f_s - FC)[None, :] * off[:, None] / C)
         H += (e[0] + 1j * e[1]) * a[:, None, None] * f[:, :, None] * np.exp(1j * k * e[3])
     return H
 

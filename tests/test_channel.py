@@ -144,32 +144,52 @@ def test_impairments_off_leave_the_tensor_bit_identical(small):
 
 
 def test_spatial_wideband_matches_a_direct_per_element_computation(small):
+    """Per element and tone, the physical phase ``-2 pi f_s tau_lm`` of the exact per-element
+    delay ``tau_lm = ||s_l - p_m|| / c + b`` at the tone's frequency ``f_s = fc + (s - s_c) Df``
+    (the band centred on fc), times two tone-independent conventions of eq. 1: the carrier's
+    spatial phase with the printed sign (``exp(+j k0 delta_lm)`` for the physical
+    ``exp(-j k0 delta_lm)``) and the path's phase taken at the lowest tone ``f_0``."""
     arr, paths = small
     cfg = channel.SRSConfig()
     bias, nf, nt = -20e-9, 7, 3
     H = channel.channel_tensor(
         paths, cfg, clock_bias=bias, n_tones=nf, n_symbols=nt, spatial_wideband=True
     )
+    k0 = 2 * np.pi * cfg.fc / C
+    f0 = cfg.fc - 0.5 * (nf - 1) * cfg.tone_spacing
     ref = np.zeros((arr.M, nf, nt), complex)
     for p in paths:
+        tau_l = p.length / C + bias
         for m in range(arr.M):
+            tau_lm = p.lengths[m] / C + bias
             dm = p.lengths[m] - p.lengths[0]
             for s in range(nf):
+                f_s = f0 + s * cfg.tone_spacing
                 for k in range(nt):
                     ref[m, s, k] += (
                         np.sqrt(cfg.tx_power)
                         * p.gain
-                        * np.exp(2j * np.pi * cfg.fc / C * dm)
-                        * np.exp(
-                            -2j * np.pi * s * cfg.tone_spacing * (p.length / C + bias + dm / C)
-                        )
+                        * np.exp(-2j * np.pi * f_s * tau_lm)
+                        * np.exp(2j * k0 * dm)  # eq. 1's printed sign of the carrier phase
+                        * np.exp(2j * np.pi * f0 * tau_l)  # eq. 1: the phase at f_0 is the gain's
                         * np.exp(2j * np.pi * k * p.doppler * cfg.symbol_period)
                     )
-    np.testing.assert_allclose(H, ref, rtol=1e-12, atol=0)
-    # the reference antenna sees no change; the others a phase growing with the tone index
+    np.testing.assert_allclose(H, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+    # tone to tone, element m's phase advances by -2 pi Df tau_lm: its exact delay (one path)
+    H1 = channel.channel_tensor(
+        paths[:1], cfg, clock_bias=bias, n_tones=nf, n_symbols=nt, spatial_wideband=True
+    )
+    step = np.angle(H1[:, 1:, 0] / H1[:, :-1, 0])
+    want = np.angle(np.exp(-2j * np.pi * cfg.tone_spacing * (paths[0].lengths / C + bias)))
+    np.testing.assert_allclose(step, np.broadcast_to(want[:, None], step.shape), atol=1e-9)
+    # at the band centre the tensor is eq. 1's: the term changes nothing there ...
     H0 = channel.channel_tensor(paths, cfg, clock_bias=bias, n_tones=nf, n_symbols=nt)
-    np.testing.assert_allclose(H[0], H0[0], rtol=1e-12, atol=0)
-    assert np.max(np.abs(H[1:, -1] - H0[1:, -1])) > 1e-4 * np.max(np.abs(H0))
+    sc = (nf - 1) // 2
+    np.testing.assert_allclose(H[:, sc], H0[:, sc], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(H[0], H0[0], rtol=1e-12, atol=0)  # nor at the reference antenna
+    # ... and grows towards both band edges
+    for edge in (0, -1):
+        assert np.max(np.abs(H[1:, edge] - H0[1:, edge])) > 1e-4 * np.max(np.abs(H0))
 
 
 def test_calibration_error_has_the_stated_statistics(small):

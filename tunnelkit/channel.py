@@ -22,10 +22,18 @@ Two impairments eq. 1 leaves out, both off by default (the tensor is then bit-id
   ``phi_m ~ N(0, sigma_deg^2)`` [deg], drawn once per array (:func:`draw_calibration`, or passed
   explicitly as ``calibration=``);
 - **spatial wideband**: eq. 1 gives every element the delay of the reference antenna; the wave
-  reaches element ``m`` ``delta_lm / c`` later, so the frequency phase depends on the element,
-  ``exp(-j 2 pi s Df (tau_l + delta_lm / c))`` (``spatial_wideband=True``). Across the 100 MHz
-  band and a 23 cm aperture that is up to about 0.4 rad at the band edge. (The delay follows
-  the geometry; the carrier's spatial phase keeps eq. 1's printed sign.)
+  reaches element ``m`` ``delta_lm / c`` later, so the phase of tone ``s`` depends on the
+  element. The carrier ``fc`` is the centre of the band (as :class:`SRSConfig` checks it), tone
+  ``s`` lies at ``f_s = fc + (s - s_c) Df``, ``s_c = (Nf - 1) / 2``; eq. 1's spatial factor is
+  the phase of ``delta_lm`` at ``fc``, and the term adds its phase at ``f_s - fc``:
+  ``exp(-j 2 pi s Df tau_l) exp(-j 2 pi (s - s_c) Df delta_lm / c)``
+  (``spatial_wideband=True``): element ``m``'s delay is ``tau_l + delta_lm / c``. Across the
+  100 MHz band and a 23 cm aperture that is up to about 0.2 rad at the band edges. (The delay
+  follows the geometry; the carrier's spatial phase keeps eq. 1's printed sign.) Measured from
+  the lowest tone instead (``f_0 = fc``, as this term was first written), the term would carry
+  ``exp(-j 2 pi s_c Df delta_lm / c)``: a carrier ``s_c Df`` off ``fc``, which scales every
+  direction cosine by ``1 - s_c Df / fc`` (0.68 % at 28 GHz / 380 MHz) and biases the position
+  by centimetres whatever the array size.
 
 A third term is random per slot, off by default:
 
@@ -399,14 +407,15 @@ def channel_tensor(
     alpha = np.sqrt(config.tx_power) * np.array([p.gain for p in paths])
     bs = np.exp(1j * k0 * delta)
     bt = np.exp(2j * np.pi * config.symbol_period * np.arange(nt)[:, None] * fd[None, :])
+    bf = np.exp(-2j * np.pi * config.tone_spacing * np.arange(nf)[:, None] * tau[None, :])
     if spatial_wideband:
-        # element m's delay is tau_l + delta_lm / c: the frequency factor depends on m
-        tau_m = tau[None, :] + delta / C  # (M, L)
-        w = -2j * np.pi * config.tone_spacing * np.arange(nf)
-        bsf = (bs * alpha)[:, None, :] * np.exp(w[None, :, None] * tau_m[:, None, :])
+        # element m's delay is tau_l + delta_lm / c; the carrier phase of delta_lm at fc (the
+        # band centre) is eq. 1's spatial factor, the rest is its phase at f_s - fc
+        fs = config.tone_spacing * (np.arange(nf) - 0.5 * (nf - 1))  # f_s - fc
+        wb = np.exp(-2j * np.pi * fs[None, :, None] * delta[:, None, :] / C)  # (M, Nf, L)
+        bsf = (bs * alpha)[:, None, :] * bf[None, :, :] * wb
         H = np.einsum("msl,kl->msk", bsf, bt, optimize=True)
     else:
-        bf = np.exp(-2j * np.pi * config.tone_spacing * np.arange(nf)[:, None] * tau[None, :])
         H = np.einsum("ml,sl,kl->msk", bs * alpha, bf, bt, optimize=True)
     if dmc is not None and dmc.share > 0:
         p_spec = float(np.sum(np.abs(alpha) ** 2))

@@ -25,9 +25,10 @@ products, and each perturbation is written as a (short) sum of rank-one terms to
 * **calibration**: element ``m`` multiplies what it receives by ``1 + j phi_m + (ln 10 / 20)
   e_m`` to first order: ``delta = sum_m (j phi_m + ln10/20 e_m) e_m (x) H_m`` is linear in the
   errors; :meth:`EtaModes.calibration_scores` gives ``Re J^H`` of each element's unit term;
-* **spatial wideband**: ``delta_l = alpha_l a_l f_l t_l (exp(-j s eps_lm) - 1)`` with
-  ``eps_lm = 2 pi Df delta_lm / c``; about the band centre ``s_c``,
-  ``exp(-j s eps) = exp(-j s_c eps) sum_n (-j (s - s_c) eps)^n / n!``: the series keeps every
+* **spatial wideband** (:func:`tunnelkit.channel.channel_tensor`: ``fc`` the band centre):
+  ``delta_l = alpha_l a_l f_l t_l (exp(-j (s - s_c) eps_lm) - 1)`` with
+  ``eps_lm = 2 pi Df delta_lm / c`` and ``s_c = (Nf - 1) / 2``;
+  ``exp(-j (s - s_c) eps) = sum_n (-j (s - s_c) eps)^n / n!``: the series keeps every
   term separable, truncated where the next term is below ``WB_TOL`` (checked against the exact
   sum in the tests);
 * **dense diffuse multipath** (:class:`tunnelkit.channel.DiffuseSpec`, spatially white):
@@ -167,17 +168,17 @@ class EtaModes:
         return n
 
     def wideband_score(self, tone_spacing: float, n_terms: int | None = None) -> np.ndarray:
-        """``J^H delta`` (T, 7L) complex of the spatial-wideband term (series about the band
-        centre, ``n_terms`` terms, :meth:`wideband_terms` by default)."""
+        """``J^H delta`` (T, 7L) complex of the spatial-wideband term (series in the tone's
+        offset from the band centre, ``n_terms`` terms, :meth:`wideband_terms` by default)."""
         N = self.wideband_terms(tone_spacing) if n_terms is None else int(n_terms)
         sc = 0.5 * (self.n_tones - 1)
         eps = 2 * np.pi * tone_spacing * self.offset / C  # (T, M, L)
         n = np.arange(N + 1)
         fact = np.cumprod(np.concatenate([[1.0], np.arange(1, N + 1)]))
-        # spatial: alpha_l a_lm exp(-j s_c eps) eps^n; frequency: (-j (s - s_c))^n / n! f_l
+        # spatial: alpha_l a_lm eps^n; frequency: (-j (s - s_c))^n / n! f_l
         T, M, L = eps.shape
         x = np.empty((T, M, L, N + 1), complex)
-        x[..., 0] = self.alpha[:, None, :] * self.a * np.exp(-1j * sc * eps)
+        x[..., 0] = self.alpha[:, None, :] * self.a
         for k in range(1, N + 1):
             x[..., k] = x[..., k - 1] * eps
         ds = np.arange(self.n_tones) - sc
