@@ -129,7 +129,10 @@ Modules, each importing only from the ones above it:
 - :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
 - :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
   re-seedings: :func:`fit_ml`, :class:`MLFit`;
-- :mod:`.paths` — :func:`ml_paths` and :func:`estimates_from_fit`.
+- :mod:`.wideband` — :class:`WidebandProblem`, the model with the spatial-wideband term (each
+  element its own delay across the band), a :class:`Problem` the fit runs on unchanged;
+- :mod:`.paths` — :func:`ml_paths` (``wideband=True``: the eq. 1 fit refined on that model) and
+  :func:`estimates_from_fit`.
 
 The shared numerics (the spatial phase, the damped step, the decrement, ``MIN_SIGNIFICANCE``)
 live in :mod:`tunnelkit.extraction.numerics`.
@@ -155,6 +158,7 @@ from .search import (
     search_path,
     start_from_estimates,
 )
+from .wideband import WidebandProblem
 
 __all__ = [
     "FALSE_ALARM",
@@ -164,6 +168,7 @@ __all__ = [
     "MLDetectionWarning",
     "MLFit",
     "Problem",
+    "WidebandProblem",
     "check_start",
     "complete_paths",
     "estimates_from_fit",

@@ -43,7 +43,8 @@ def project_feasible(theta) -> np.ndarray:
     return th
 
 
-def _check_paths(theta, mu_f, mu_t) -> None:
+def check_paths(theta, mu_f, mu_t) -> None:
+    """``ValueError`` unless ``theta`` is (L, 3) and ``mu_f``, ``mu_t`` are (L,)."""
     L = _check_theta(theta).shape[0]
     if np.shape(mu_f) != (L,) or np.shape(mu_t) != (L,):
         raise ValueError(
@@ -75,7 +76,7 @@ class Problem:
         ``theta`` (L, 3), ``mu_f``, ``mu_t`` (L,); with ``derivatives`` also the Gauss-Newton
         matrix ``A = Re J^H J`` (5L, 5L), the descent direction ``g = Re D^H r`` (5L,) and the
         steering vectors ``a`` (M, L)."""
-        _check_paths(theta, mu_f, mu_t)
+        check_paths(theta, mu_f, mu_t)
         L = theta.shape[0]
         psi, dx, dy, dw = spatial_phase(theta, self.pos, self.k0)
         a = np.exp(1j * psi)
@@ -84,7 +85,7 @@ class Problem:
         if not derivatives:
             b = np.einsum("ml,ml->l", a.conj(), self._contract(T, F))
             G = (a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T)
-            c, cost = _solve_gains(G, b, self.h2)
+            c, cost = self._gains(G, b)
             return {"c": c, "cost": cost, "G": G, "b": b}
         sF = 1j * self.s * F
         kT = 1j * self.kk * T
@@ -111,7 +112,7 @@ class Problem:
         )
         Gram = (X.conj().T @ X) * (Y.conj().T @ Y) * (Z.conj().T @ Z)
         G, b = Gram[:L, :L], P[:L]
-        c, cost = _solve_gains(G, b, self.h2)
+        c, cost = self._gains(G, b)
         cd = np.repeat(c, 5)  # the gain of each derivative atom's path
         Dr = cd.conj() * (P[L:] - Gram[L:, :L] @ c)  # <D_i, r>
         DB = cd.conj()[:, None] * Gram[L:, :L]
@@ -137,11 +138,15 @@ class Problem:
     def model(self, theta, mu_f, mu_t, c) -> np.ndarray:
         """The model tensor ``sum_l c_l X_l`` (M, Nf, Nt) of the paths ``theta``, ``mu_f``,
         ``mu_t`` with gains ``c`` (L,)."""
-        _check_paths(theta, mu_f, mu_t)
+        check_paths(theta, mu_f, mu_t)
         a = np.exp(1j * spatial_phase(theta, self.pos, self.k0)[0])
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])
         return np.einsum("ml,sl,kl->msk", a * c[None, :], F, T, optimize=True)
+
+    def _gains(self, G, b):
+        """The gains ``c = G^-1 b`` and the concentrated cost ``||H||^2 - Re b^H c``."""
+        return _solve_gains(G, b, self.h2)
 
     def noise_floor(self, n_paths: int) -> float:
         """:func:`noise_floor` of this problem's tensor."""

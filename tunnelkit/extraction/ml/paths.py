@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._validate import integer, nonnegative
+from ..._validate import boolean, integer, nonnegative
 from ...constants import C
 from ..coherent import resolve_coherent
 from ..decomposition import check_rank, check_tensor
@@ -19,6 +19,7 @@ from ..radio import check_array, check_srs
 from .fitting import MAX_ITER, SEARCHES, MLDetectionWarning, MLFit, fit_problem
 from .model import W_FAR, W_MAX, Problem
 from .search import check_start, complete_paths, start_from_estimates
+from .wideband import WidebandProblem
 
 __all__ = ["estimates_from_fit", "ml_paths", "physical"]
 
@@ -104,6 +105,7 @@ def ml_paths(
     max_iter: int = 60,
     n_reseed: int | None = None,
     search: str = "residual",
+    wideband: bool = False,
 ) -> PathEstimates:
     """Joint maximum-likelihood extraction (package text of :mod:`tunnelkit.extraction.ml`); the
     default route of :func:`~tunnelkit.extraction.extract_paths`.
@@ -127,6 +129,12 @@ def ml_paths(
     (:attr:`MLFit.fit_ok`; ``False``: the snapshot is in the threshold region or the search
     missed the likelihood's basin: a path missed, merged or off by many standard deviations).
     A path marked ``valid`` is physically possible (:func:`physical`).
+
+    ``wideband``: the model carries the spatial-wideband term (:mod:`.wideband`: element ``m``
+    delayed by its path-length offset, the tones around ``srs.fc``); the eq. 1 fit (search and
+    re-seedings as above) is refined on it by Levenberg-Marquardt, and the estimates, ``fit`` and
+    ``fit_ok`` are the refined fit's (``factors`` and ``delta`` stay eq. 1's mode vectors at the
+    refined parameters). Off by default: eq. 1 exactly.
     """
     H = check_tensor(H)
     M, nf, nt = H.shape
@@ -156,9 +164,20 @@ def ml_paths(
         start = start_from_estimates(start)
     if search not in SEARCHES:
         raise ValueError(f"search: expected one of {SEARCHES}, got {search!r}")
+    wideband = boolean("wideband", wideband)
     fit = fit_problem(
         prob, start, noise_power=noise_power, max_iter=max_iter, n_reseed=n_reseed, search=search
     )
+    if wideband:  # the eq. 1 fit refined on the model with the spatial-wideband term
+        prob = WidebandProblem(H, pos, srs.fc, srs.tone_spacing)
+        fit = fit_problem(
+            prob,
+            (fit.theta, fit.mu_f, fit.mu_t),
+            noise_power=noise_power,
+            max_iter=max_iter,
+            n_reseed=0,
+            search="basic",
+        )
     n_sig = int(np.sum(fit.significance >= MIN_SIGNIFICANCE))
     if n_sig < L:
         warnings.warn(
