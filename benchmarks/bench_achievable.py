@@ -45,9 +45,14 @@ def predicted_rmse(model, t: int = 0) -> np.ndarray:
     return np.sqrt(mse)
 
 
-def extraction_errors(setup, spec, imp, epoch: int, n_trials: int, rng, n_reseed=0) -> tuple:
+def extraction_errors(
+    setup, spec, imp, epoch: int, n_trials: int, rng, n_reseed=0, wideband: bool | None = None
+) -> tuple:
     """Monte-Carlo of the ML extraction at ``epoch``: errors (n_trials, P, 4) in ``z`` (NaN
-    where a path is absent or reported far field), the route slots ``exists`` (P,)."""
+    where a path is absent or reported far field), the route slots ``exists`` (P,). The
+    extraction models the spatial-wideband term (``ml_paths(..., wideband=True)``) when
+    ``wideband``, by default when ``imp.wideband_model``."""
+    wideband = imp.wideband_model if wideband is None else wideband
     spec = parse_array(spec)
     traj = setup.trajectory
     ue, vel = traj.position[epoch], traj.velocity[epoch]
@@ -85,7 +90,9 @@ def extraction_errors(setup, spec, imp, epoch: int, n_trials: int, rng, n_reseed
         )
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            est = ml_paths(snap.H, len(paths), arr, cfg, start=start, n_reseed=n_reseed)
+            est = ml_paths(
+                snap.H, len(paths), arr, cfg, start=start, n_reseed=n_reseed, wideband=wideband
+            )
         dw = est.direction @ arr.R.T  # world unit vectors
         z = np.column_stack(
             [

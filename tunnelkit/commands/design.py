@@ -1,5 +1,6 @@
 """``tunnelkit design SCENARIO --arrays 4x4 8x8 16x16 [--fc 28GHz] [--bandwidth 400MHz]
-[--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--dmc-share S]
+[--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--wideband-model]
+[--dmc-share S]
 [--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
 [--criterion achievable|srnf] [--format table|json]``.
 
@@ -134,6 +135,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="the spatial-wideband term (delay across the aperture) in the channel (off)",
     )
     imp.add_argument(
+        "--wideband-model",
+        action=argparse.BooleanOptionalAction,
+        default=False,
+        help="the estimator models the spatial-wideband term (ML with the per-element delay), so "
+        "it leaves no bias; needs --wideband (off: the estimator fits eq. 1)",
+    )
+    imp.add_argument(
         "--dmc-share",
         type=_level("dmc_share", 1.0),
         default=0.0,
@@ -188,6 +196,7 @@ def main(args: argparse.Namespace) -> int:
         "phase_error_deg": args.phase_error_deg,
         "gain_error_db": args.gain_error_db,
         "spatial_wideband": args.wideband,
+        "wideband_model": args.wideband_model,
         "dmc_share": args.dmc_share,
     }
     try:

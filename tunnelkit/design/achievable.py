@@ -60,7 +60,10 @@ class DesignImpairments:
     """The impairments a design carries (module docstring).
 
     ``phase_error_deg`` / ``gain_error_db``: standard deviations of the per-element calibration
-    error; ``spatial_wideband``: the per-element delay across the aperture; ``dmc_share`` in
+    error; ``spatial_wideband``: the per-element delay across the aperture, in the channel;
+    ``wideband_model``: the estimator models that term too (the ML extraction with
+    ``wideband=True``, :mod:`tunnelkit.extraction.ml.wideband`), so it leaves no bias (needs
+    ``spatial_wideband``: a model term the channel lacks is refused); ``dmc_share`` in
     [0, 1): the diffuse share of the received power, with time constant ``dmc_decay_s`` (20 ns
     by default, a short concrete tunnel); ``dmc_spatial``: ``"white"`` (independent over the
     elements). ``"per-surface"`` (diffuse power spread in angle around each specular path) is
@@ -73,11 +76,17 @@ class DesignImpairments:
     dmc_share: float = 0.0
     dmc_decay_s: float = 20e-9
     dmc_spatial: str = "white"
+    wideband_model: bool = False
 
     def __post_init__(self) -> None:
         nonnegative("phase_error_deg", self.phase_error_deg)
         nonnegative("gain_error_db", self.gain_error_db)
         boolean("spatial_wideband", self.spatial_wideband)
+        if boolean("wideband_model", self.wideband_model) and not self.spatial_wideband:
+            raise ValueError(
+                "wideband_model: the estimator models the spatial-wideband term of the channel; "
+                "set spatial_wideband=True too (a model term the channel lacks is not an option)"
+            )
         share = nonnegative("dmc_share", self.dmc_share)
         if share >= 1.0:
             raise ValueError(f"dmc_share: the diffuse share must lie in [0, 1), got {share}")
@@ -193,7 +202,7 @@ def _chunks(setup, fr: _Frame, imp: DesignImpairments):
             p_d = spec.power(1.0) * np.sum(np.abs(md.alpha) ** 2, axis=1)  # (T,)
             G = md.diffuse_gram(spec, cfg.tone_spacing, tau0).real
             out["E"] = 2.0 / s2**2 * p_d[:, None, None] * G
-        if imp.spatial_wideband:
+        if imp.spatial_wideband and not imp.wideband_model:
             out["s_wb"] = 2.0 / s2 * md.wideband_score(cfg.tone_spacing).real
         if imp.phase_error_deg > 0 or imp.gain_error_db > 0:
             S = md.calibration_scores()
@@ -237,7 +246,9 @@ def path_error_model(
     Every existing path of the route geometry (``geometry``, or traced at ``epochs``) enters
     the joint model. ``crlb`` is the ideal bound of all paths' ``z`` (gains and Dopplers
     eliminated), ``cov`` the sandwich covariance with diffuse multipath (``crlb`` without it),
-    ``bias`` the spatial-wideband bias, ``k_phase`` [per rad] and ``k_gain`` [per dB] the
+    ``bias`` the spatial-wideband bias (zero when the estimator models the term,
+    ``impairments.wideband_model``: its Fisher information is eq. 1's to within 1 %, module
+    docstring), ``k_phase`` [per rad] and ``k_gain`` [per dB] the
     calibration sensitivities (None when the calibration is perfect). Raises ``ValueError``
     naming ``spec`` where the Fisher information of an epoch is singular (a parameter the
     array cannot resolve, e.g. curvature with 2 x 2 elements).
@@ -347,7 +358,7 @@ class AchievableBound:
     ``peb`` the ideal PEB (as :func:`~tunnelkit.design.bounds.route_bounds`), ``achievable``
     ``sqrt(peb^2 + calibration^2 + wideband^2 + diffuse^2)`` and its parts: ``calibration`` the
     RMS position bias over the calibration draw, ``wideband`` the spatial-wideband position
-    bias, ``diffuse`` the excess standard deviation the diffuse multipath adds (root of the
+    bias (zero when the estimator models the term), ``diffuse`` the excess standard deviation the diffuse multipath adds (root of the
     trace). ``inf`` where the position is not identifiable."""
 
     spec: object

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .._validate import positive
+from .._validate import boolean, positive
 from .coherent import resolve_coherent
 from .decomposition import check_rank, check_tensor
 from .estimates import PathEstimates
@@ -29,6 +29,7 @@ def extract_paths(
     polish: int | None = None,
     noise_power: float | None = None,
     search: str = "residual",
+    wideband: bool = False,
 ) -> PathEstimates:
     """Path parameters from the channel tensor, one entry per path.
 
@@ -60,6 +61,8 @@ def extract_paths(
         periodogram peak until the residual test passes) or "basic" (re-seeding on the residual
         energy alone, the route before issue 23, kept for comparison); see
         :func:`.ml.fitting.fit_problem`.
+    wideband : the "ml" route's model carries the spatial-wideband term (each element its own
+        delay across the band, :mod:`.ml.wideband`); off by default (eq. 1).
 
     Returns a :class:`PathEstimates` (``alpha, d, v, direction, kappa, near_field`` and more); it
     also supports ``est["d"]``. On the "ml" route see :func:`.ml.ml_paths` for what each field
@@ -71,14 +74,17 @@ def extract_paths(
     srs = check_srs(srs)
     if refine not in ROUTES:
         raise ValueError(f"refine: expected one of {ROUTES}, got {refine!r}")
+    wideband = boolean("wideband", wideband)
     if refine == "ml":
         if noise_power is not None:
             noise_power = positive("noise_power", noise_power)
-        return ml_paths(H, L, pos, srs, noise_power=noise_power, search=search)
+        return ml_paths(H, L, pos, srs, noise_power=noise_power, search=search, wideband=wideband)
     if noise_power is not None:
         raise ValueError(f"noise_power: only used by refine='ml', not {refine!r}")
     if search != "residual":
         raise ValueError(f"search: only used by refine='ml', not {refine!r}")
+    if wideband:
+        raise ValueError(f"wideband: only modelled by refine='ml', not {refine!r}")
     cpd_kw = {"method": method, "n_iter_max": n_iter_max, "tol": tol, "polish": polish}
     if refine == "coherent":
         est = paper_route(H, L, pos, srs, refine="joint", **cpd_kw)
