@@ -1177,6 +1177,21 @@ def build_cases() -> list[Case]:
             ("sigma",),
         )
     )
+    # the ML model with the spatial-wideband term
+    wb_good = {
+        "H": np.ones((4, 6, 2), complex),
+        "element_positions": np.array([[0, 0, 0], [0.005, 0, 0], [0, 0.005, 0], [0.005, 0.005, 0]]),
+        "fc": 28e9,
+        "tone_spacing": 480e3,
+    }
+    _scalar_cases(
+        c,
+        "WidebandProblem",
+        lambda: _mod("extraction.ml").WidebandProblem,
+        wb_good,
+        ["fc", "tone_spacing"],
+        {k: SCALAR_BAD[k] for k in ("nan", "inf", "str")} | {"zero": 0.0, "neg": -1.0},
+    )
     return c
 
 

@@ -68,6 +68,21 @@ def test_json_answers_the_28ghz_question(capsys):
     assert any("rests on bounds only" in w for w in out["warnings"])
 
 
+def test_wideband_model_drops_the_wideband_bias_and_is_an_input(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "8x8", "--format", "json"]
+    out = {}
+    for extra in ([], ["--wideband"], ["--wideband", "--wideband-model"]):
+        assert main([*argv, *extra]) == 0
+        out[" ".join(extra)] = json.loads(capsys.readouterr().out)
+    imp = out["--wideband --wideband-model"]["inputs"]["impairments"]
+    assert imp["spatial_wideband"] is True and imp["wideband_model"] is True
+    assert out["--wideband"]["inputs"]["impairments"]["wideband_model"] is False
+    ach = {k: v["arrays"][0]["achievable_p90_m"] for k, v in out.items()}
+    peb = out[""]["arrays"][0]["peb_p90_m"]
+    assert ach["--wideband"] > 2 * peb  # the plain fit's wideband bias
+    assert ach["--wideband --wideband-model"] == ach[""] == peb
+
+
 def test_srnf_criterion_keeps_the_gate(capsys):
     argv = ["design", "example-rectangular-28ghz", "--arrays", "2x2", "3x3", "4x4", "8x8"]
     assert main([*argv, "--target", "0.15", "--criterion", "srnf", "--format", "json"]) == 0
@@ -95,6 +110,7 @@ def test_table_and_overrides(capsys):
         (["--arrays", "64x64"], "arrays: the 64x64 array"),
         (["--mount-height", "9"], "mount:"),
         (["--share", "1.5"], "share"),
+        (["--wideband-model"], "wideband_model: the estimator models the spatial-wideband"),
     ],
 )
 def test_bad_input_names_the_parameter(capsys, extra, message):
