@@ -25,10 +25,21 @@ range). Beyond that (0.5 deg and more of calibration error, or diffuse multipath
 (``kappa >= 0.5 m``, far field beyond 1 km) bounds the error, and the angles correlated with it
 come out up to 2-3 times better than predicted (conservative).
 
-The spatial-wideband position bias does not shrink with the array: at 28 GHz / 380 MHz its
-median along the 28 GHz example's route is 2.7 cm (4 x 4), 4.3 cm (8 x 8), 4.9 cm (16 x 16),
-5.0 cm (32 x 32), so above 16 x 16 it dominates the achievable bound unless the estimator models
-the term.
+The spatial-wideband term (:func:`tunnelkit.channel.channel_tensor`: tones around the band
+centre ``fc``) biases eq. 1's fit in two ways: the delay distance is measured to about the
+array's centre rather than to its reference antenna (a corner element), a bias that grows with
+the aperture (0.3-0.6 cm on 4 x 4, 1-1.2 cm on 8 x 8, 1.3-2.6 cm on 16 x 16 at the 28 GHz
+example's near end), and angle biases that shrink with it (up to 3.5, 0.6 and 0.3 mrad
+there). Along that route
+(``benchmarks/bench_wideband.py``, 28 GHz / 380 MHz) the position bias has median 2.0 cm
+(4 x 4), 2.5 cm (8 x 8), 1.6 cm (16 x 16), 1.1 cm (32 x 32) and p90 8.0, 6.6, 6.0, 3.4 cm:
+above the ideal PEB at every size (median 0.9, 0.2, 0.06, 0.01 cm). (Tones counted from ``fc`` instead, as the term was first
+written, put a carrier ``s_c Df`` = 190 MHz off ``fc`` in every element's phase: direction
+cosines scaled by ``1 - s_c Df / fc``, 0.68 %, a bias of 2.7-5.0 cm whatever the size.) An
+estimator that models the term (``wideband_model``: ``ml_paths(..., wideband=True)``) has no
+such bias; its Fisher information is eq. 1's to within 1 % (the term changes the phase of tone
+``s`` by a fraction ``(s - s_c) Df / fc`` of the carrier's, ``tests/test_achievable.py``), so
+its bound is the ideal one (with the other impairments' parts).
 """
 
 from __future__ import annotations
