@@ -478,8 +478,9 @@ print(
 #   keeps a degree or two and a few tenths of a dB; below we try a quarter of that, 0.5° and
 #   0.05 dB);
 # - **spatial wideband**: eq. 1 gives every element the reference antenna's delay; the wave
-#   reaches element $m$ $\delta_{\ell m}/c$ later, so the frequency phase becomes
-#   $e^{-j2\pi s\Delta f(\tau_\ell+\delta_{\ell m}/c)}$ — up to about 0.4 rad at the band edge
+#   reaches element $m$ $\delta_{\ell m}/c$ later, so tone $s$, at $f_s = f_c + (s - s_c)\Delta f$
+#   around the band centre, carries the extra phase
+#   $e^{-j2\pi (s - s_c)\Delta f\,\delta_{\ell m}/c}$ — up to about 0.2 rad at the band edges
 #   across 23 cm.
 #
 # `SignalRoute.with_impairments` builds an impaired route; the ML stage (which still fits eq. 1)
