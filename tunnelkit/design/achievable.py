@@ -26,11 +26,13 @@ range). Beyond that (0.5 deg and more of calibration error, or diffuse multipath
 come out up to 2-3 times better than predicted (conservative).
 
 The spatial-wideband term (:func:`tunnelkit.channel.channel_tensor`: tones around the band
-centre ``fc``) biases eq. 1's fit in two ways: the delay distance is measured to about the
-array's centre rather than to its reference antenna (a corner element), a bias that grows with
-the aperture (0.3-0.6 cm on 4 x 4, 1-1.2 cm on 8 x 8, 1.3-2.6 cm on 16 x 16 at the 28 GHz
-example's near end), and angle biases that shrink with it (up to 3.5, 0.6 and 0.3 mrad
-there). Along that route
+centre ``fc``) biases eq. 1's fit in two ways: the delay distance is measured to the array's
+centre rather than to its reference antenna (a corner element), a bias equal to the mean
+path-length offset over the elements that grows with the aperture (0.3-0.5 cm on 4 x 4,
+0.6-1.2 cm on 8 x 8, 1.3-2.6 cm on 16 x 16, 2.6-5.3 cm on 32 x 32 at the 28 GHz example's near
+end), and angle biases that shrink with it (up to 3.5, 0.6 and 0.3 mrad on 4 x 4 ... 16 x 16
+there). The position, which the larger arrays take more and more from the angles and the
+curvature (the clock bias absorbs the delays' common part), moves less. Along that route
 (``benchmarks/bench_wideband.py``, 28 GHz / 380 MHz) the position bias has median 2.0 cm
 (4 x 4), 2.5 cm (8 x 8), 1.6 cm (16 x 16), 1.1 cm (32 x 32) and p90 8.0, 6.6, 6.0, 3.4 cm:
 above the ideal PEB at every size (median 0.9, 0.2, 0.06, 0.01 cm). (Tones counted from ``fc`` instead, as the term was first
