@@ -15,9 +15,17 @@ is identical serially and on any number of workers. Two measurement routes:
 JAVELIN there takes each path's covariance as the extraction reports it (the CRLB at the
 estimate, which the ML route attains), so the tracker is tuned by the design itself at any
 carrier and size (:func:`javelin_config`); its settled error (after the first :data:`SETTLE_S`)
-is set beside the PEB and the posterior CRLB over the drive (:func:`drive_pcrlb`, Tichavsky et
-al. 1998 with JAVELIN's motion model and the position information of the model's reported bound).
-:func:`javelin_rmse` is the one-array summary on top of it.
+is set beside the PEB, the posterior CRLB over the drive (:func:`drive_pcrlb`, Tichavsky et
+al. 1998 with JAVELIN's motion model and the position information of the model's reported bound)
+and the bound over the drive under the impairments (:func:`drive_bound`: the posterior CRLB with
+the position bias of the array's one calibration draw and of the wideband term added, which no
+number of epochs averages down). :func:`javelin_rmse` is the one-array summary on top of it.
+
+Cost: the per-array work (error model, the bound route's shared part
+:func:`~tunnelkit.design.fastroute.bound_route`, PEB and the bounds over the drive) is one task
+per array and the drives one task each, both on the same cluster
+(:func:`tunnelkit.montecarlo.trial_pool`, started once), so two workers also split the models;
+a drive on the bound route then costs its random draws and the tracker.
 """
 
 from __future__ import annotations
