@@ -14,11 +14,13 @@ from tunnelkit.constants import C
 from tunnelkit.design import DesignSetup
 from tunnelkit.design.bounds import route_bounds, route_geometry
 from tunnelkit.design.errormodel import PathErrorModel
-from tunnelkit.design.fastroute import bound_drive, model_truth
+from tunnelkit.design.fastroute import BoundRoute, bound_drive, bound_route, model_truth
 from tunnelkit.design.geometry import trace_route
 from tunnelkit.design.montecarlo import (
     MonteCarloResult,
+    drive_bound,
     drive_pcrlb,
+    position_bias_rms,
     position_information,
     sweep_montecarlo,
 )
@@ -150,6 +152,7 @@ def test_sweep_is_one_task_set_with_the_same_numbers_serially_and_on_two_workers
         assert np.array_equal(r.errors, two[s].errors)
         assert np.allclose(r.rmse_runs, np.sqrt(np.mean(r.errors[:, r.settled] ** 2, axis=1)))
         assert r.pcrlb.shape == (14,) and np.all(r.pcrlb > 0)
+        assert np.allclose(r.drive, r.pcrlb)  # a model without bias: the bound over the drive
         assert r.settled[0] == 10  # 1 s at 0.1 s
     # the runs of one array do not depend on which other arrays are swept with it
     alone = sweep_montecarlo(setup, ["8x8"], 2, 3, **kw)["8x8"]
@@ -167,3 +170,81 @@ def test_sweep_bad_input_is_refused_by_name(setup):
         sweep_montecarlo(setup, ["4x4"], 0, 0)
     with pytest.raises(TypeError, match="setup"):
         sweep_montecarlo("x", ["4x4"], 2, 0)
+
+
+def test_a_prepared_route_gives_the_same_drive_and_is_checked(setup):
+    m = _diag_model(setup, "4x4", sig=(2e-3, 3e-3, 0.2, 0.05))
+    route = bound_route(m, setup, "4x4")
+    assert isinstance(route, BoundRoute) and route.min_d == setup.signal_route("4x4").min_d
+    a = bound_drive(m, setup, "4x4", np.random.default_rng(4), n_epochs=9)
+    b = bound_drive(route, setup, "4x4", np.random.default_rng(4), n_epochs=9)
+    for pa, pb in zip(a.epochs, b.epochs):
+        assert np.array_equal(pa.phi, pb.phi) and np.array_equal(pa.d, pb.d)
+        assert np.array_equal(pa.cov, pb.cov)
+    assert np.array_equal(a.base_station, b.base_station)
+    with pytest.raises(ValueError, match="spec"):
+        bound_drive(route, setup, "8x8", np.random.default_rng(4))
+    with pytest.raises(ValueError, match="correlated_scale"):
+        bound_route(m, setup, "4x4", report="budget", correlated_scale=0.5)
+
+
+def test_position_bias_rms_is_the_rms_of_the_least_squares_fix_over_calibration_draws(setup):
+    """Brute force: whitened least squares (lstsq) of the UE position and clock bias from the
+    error ``bias + K_phase phi`` of many drawn calibration vectors; RMS of the position part."""
+    from dataclasses import replace
+
+    spec, M = "4x4", 5
+    m0 = _diag_model(setup, spec)
+    g = route_geometry(setup, spec)
+    rng = np.random.default_rng(2)
+    T, P = m0.exists.shape
+    K = rng.standard_normal((T, P, 4, M)) * np.array([1e-3, 1e-3, 0.1, 0.01])[None, None, :, None]
+    b = rng.standard_normal((T, P, 4)) * np.array([1e-3, 1e-3, 0.1, 0.01])
+    m = replace(m0, bias=np.where(m0.exists[..., None], b, 0.0), k_phase=K, phase_sigma_rad=0.3)
+    got = position_bias_rms(m, g)
+    assert np.allclose(position_bias_rms(m0, g), 0.0)
+    info = position_information(m, g)
+    for k in (3, 20):
+        j = np.flatnonzero(m.exists[k])
+        eps = 1e-6
+        H = np.zeros((j.size, 4, 3))
+        for i in range(3):  # finite differences of the wave origins in the UE position
+            dp = np.zeros(3)
+            dp[i] = eps
+            if i < 2:
+                za = model_truth(_moved(g, k, dp), setup.fc)[0][0, j]
+                zb = model_truth(_moved(g, k, -dp), setup.fc)[0][0, j]
+                H[:, :, i] = (za - zb) / (2 * eps)
+        H[:, 3, 2] = 1.0
+        H = H.reshape(-1, 3)
+        w = 1.0 / np.sqrt(np.diagonal(m.crlb[k]).reshape(P, 4)[j].ravel())
+        phis = 0.3 * rng.standard_normal((M, 4000))
+        e = (b[k, j][..., None] + np.einsum("pim,mn->pin", K[k, j], phis)).reshape(-1, 4000)
+        sol = np.linalg.lstsq(H * w[:, None], e * w[:, None], rcond=None)[0]
+        rms = np.sqrt(np.mean(np.sum(sol[:2] ** 2, axis=0)))
+        assert abs(rms - got[k]) < 0.05 * got[k]
+        assert np.all(np.linalg.eigvalsh(info[k]) > 0)
+    pc = drive_pcrlb(setup, info)
+    assert np.allclose(drive_bound(pc, got), np.hypot(pc, got))
+    with pytest.raises(ValueError, match="bias_rms"):
+        drive_bound(pc, got[:-1])
+
+
+def _moved(g, k, dp):
+    """Geometry of epoch ``k`` alone with the UE moved by ``dp``: every wave origin moves
+    through its mirror (the known surface)."""
+    from dataclasses import replace
+
+    src = g.source[k : k + 1] + np.einsum("pij,j->pi", g.mirror, dp)[None]
+    return replace(
+        g,
+        ue=g.ue[k : k + 1] + dp,
+        exists=g.exists[k : k + 1],
+        source=src,
+        point=g.point[k : k + 1],
+        gain=g.gain[k : k + 1],
+        doppler=g.doppler[k : k + 1],
+        array_index=g.array_index[k : k + 1],
+        origin=g.origin[k : k + 1],
+        rotation=g.rotation[k : k + 1],
+    )

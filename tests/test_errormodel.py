@@ -89,3 +89,26 @@ def test_budget_is_the_second_moment_of_the_drawn_error():
     idx = np.arange(2)
     crlb = np.moveaxis(ideal.crlb.reshape(2, 2, 4, 2, 4)[:, idx, :, idx, :], 0, 1)
     assert np.allclose(ideal.budget(), crlb)
+
+
+def test_draw_with_the_noise_root_computed_once_is_the_same_draw():
+    m = _model(phase_sigma_rad=0.1, bias=np.full((2, 2, 4), 0.05))
+    root = m.noise_sqrt()
+    assert np.allclose(root @ root.transpose(0, 2, 1), m.cov)
+    a = m.draw(np.random.default_rng(5))
+    b = m.draw(np.random.default_rng(5), noise_sqrt=root)
+    assert np.array_equal(a, b)
+    with pytest.raises(ValueError, match="noise_sqrt"):
+        m.draw(np.random.default_rng(5), noise_sqrt=root[:, :4, :4])
+
+
+def test_budget_scales_only_its_correlated_share():
+    m = _model(phase_sigma_rad=0.1, bias=np.full((2, 2, 4), 0.05))
+    ideal = _model(k_phase=None)  # same cov, nothing correlated: the scale changes nothing
+    assert np.allclose(ideal.budget(4.0), ideal.budget())
+    idx = np.arange(2)
+    cov = np.moveaxis(m.cov.reshape(2, 2, 4, 2, 4)[:, idx, :, idx, :], 0, 1)
+    assert np.allclose(m.budget(3.0) - cov, 3.0 * (m.budget() - cov))
+    for bad in (0.5, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="correlated_scale"):
+            m.budget(bad)

@@ -291,3 +291,22 @@ def test_trials_sharing_a_stream_see_the_same_numbers():
         run_trials(_draw, 2, seed=9, streams=[0, -1])
     with pytest.raises(ValueError, match="trial_timeout: must be > 0"):
         run_trials(_draw, 2, seed=9, trial_timeout=0)
+
+
+def test_a_pool_shares_one_cluster_between_steps_with_the_serial_numbers():
+    from tunnelkit.montecarlo import TrialPool, trial_pool
+
+    serial = run_trials(_draw, 6, seed=4)
+    with trial_pool() as pool:
+        assert isinstance(pool, TrialPool) and not pool.parallel
+        assert pool.map(abs, [-1, 2, -3]) == [1, 2, 3]
+        assert run_trials(_draw, 6, seed=4, pool=pool) == serial
+    with trial_pool(workers=2) as pool:
+        assert pool.parallel
+        assert pool.map(abs, [-1, 2, -3]) == [1, 2, 3]  # in order
+        assert run_trials(_draw, 6, seed=4, pool=pool) == serial
+        assert run_trials(_draw, 6, seed=4, pool=pool) == serial  # the same cluster, twice
+    with pytest.raises(ValueError, match="pool"), trial_pool() as pool:
+        run_trials(_draw, 2, seed=0, pool=pool, workers=1)
+    with pytest.raises(TypeError, match="pool"):
+        run_trials(_draw, 2, seed=0, pool="cluster")

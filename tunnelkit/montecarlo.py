@@ -52,6 +52,7 @@ __all__ = [
     "RUN_BYTES",
     "SchedulerUnreachable",
     "TrialLost",
+    "TrialPool",
     "TrialTimeout",
     "available_cores",
     "mc_count",
@@ -59,6 +60,7 @@ __all__ = [
     "quick_mode",
     "run_trials",
     "spawn_rngs",
+    "trial_pool",
 ]
 
 #: memory one run holds at least: its generator (about 1 KiB measured) and its result slot
@@ -132,13 +134,15 @@ def run_trials(
     timeout: float = CONNECT_TIMEOUT_S,
     trial_timeout: float | None = None,
     streams: Sequence[int] | None = None,
+    pool: TrialPool | None = None,
 ) -> list[Any]:
     """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm.
 
     ``streams`` (one non-negative integer per trial): trial ``i`` gets a fresh copy of child
     generator ``streams[i]`` of ``seed`` (trials with the same stream see the same random
     numbers); default: trial ``i`` gets child ``i``. ``trial_timeout`` [s]: see the module
-    docstring. Other options: module docstring."""
+    docstring. ``pool``: a :func:`trial_pool` already open (instead of ``workers`` /
+    ``scheduler``), so several steps share one cluster. Other options: module docstring."""
     callable_("trial", trial)
     runs = integer("runs", runs, minimum=1)
     check_bytes("runs", runs * RUN_BYTES, f"{runs} runs of at least {RUN_BYTES} B each")
@@ -150,6 +154,24 @@ def run_trials(
     timeout = positive("timeout", timeout)
     if trial_timeout is not None:
         trial_timeout = positive("trial_timeout", trial_timeout)
+    if pool is not None:
+        if not isinstance(pool, TrialPool):
+            raise TypeError(f"pool: expected a montecarlo.TrialPool, got {type(pool).__name__}")
+        if workers is not None or scheduler is not None:
+            raise ValueError(
+                "pool, workers, scheduler: give a pool or where to start one, not both"
+            )
+        if pool.client is None:
+            return _run_serial(trial, calls, progress, desc, trial_timeout)
+        return _run_dask(pool.client, trial, calls, progress, desc, retries, trial_timeout)
+    workers = _capped(workers)
+    if workers is None and scheduler is None:
+        return _run_serial(trial, calls, progress, desc, trial_timeout)
+    with _client(workers, scheduler, timeout) as client:
+        return _run_dask(client, trial, calls, progress, desc, retries, trial_timeout)
+
+
+def _capped(workers: int | None) -> int | None:
     if workers is not None and workers > available_cores():
         import warnings
 
@@ -157,13 +179,64 @@ def run_trials(
             f"workers: {workers} processes on {available_cores()} core(s): capped to "
             f"{available_cores()} (give a scheduler address to use a larger cluster)",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
-        workers = available_cores()
+        return available_cores()
+    return workers
+
+
+class TrialPool:
+    """Where a Monte-Carlo runs (:func:`trial_pool`): serially in this process (``client``
+    None) or on one Dask client that several steps share, e.g. a sweep that first builds a model
+    per array (:meth:`map`) and then runs its trials (``run_trials(..., pool=pool)``) on the same
+    cluster, started once."""
+
+    def __init__(self, client=None) -> None:
+        self.client = client
+
+    @property
+    def parallel(self) -> bool:
+        return self.client is not None
+
+    def map(self, fn: Callable[[Any], Any], items: Sequence[Any], desc: str = "tasks") -> list:
+        """``[fn(x) for x in items]`` in order, one task per item on the cluster (single-threaded
+        BLAS, as the trials), serially without one. ``fn`` and the items must be picklable."""
+        callable_("fn", fn)
+        items = list(items)
+        if self.client is None:
+            with _one_blas_thread():
+                return [fn(x) for x in items]
+        tag = uuid.uuid4().hex[:8]
+        futures = [
+            self.client.submit(_one_call, fn, x, key=f"{desc}-{i}-{tag}", pure=False)
+            for i, x in enumerate(items)
+        ]
+        return self.client.gather(futures)
+
+
+@contextlib.contextmanager
+def trial_pool(
+    workers: int | None = None,
+    scheduler: str | None = None,
+    timeout: float = CONNECT_TIMEOUT_S,
+) -> Iterator[TrialPool]:
+    """A :class:`TrialPool`: serial without ``workers`` / ``scheduler``, else one local cluster
+    of ``workers`` processes (capped to the cores, as :func:`run_trials`) or the cluster at
+    ``scheduler``, closed on exit."""
+    workers, scheduler = parallel_options(workers, scheduler)
+    timeout = positive("timeout", timeout)
+    workers = _capped(workers)
     if workers is None and scheduler is None:
-        return _run_serial(trial, calls, progress, desc, trial_timeout)
+        yield TrialPool(None)
+        return
     with _client(workers, scheduler, timeout) as client:
-        return _run_dask(client, trial, calls, progress, desc, retries, trial_timeout)
+        yield TrialPool(client)
+
+
+def _one_call(fn, x):
+    """Worker side of :meth:`TrialPool.map`."""
+    with _one_blas_thread():
+        return fn(x)
 
 
 def _stream_rngs(seed, runs: int, streams) -> list[np.random.Generator]:

@@ -21,8 +21,10 @@ quantile lies below the target. One job per module:
   :mod:`~tunnelkit.design.mcrb`;
 * :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design, every array x run as one task
   set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
-  :class:`MonteCarloResult` with the posterior CRLB; :func:`javelin_rmse` for one array);
-  :mod:`~tunnelkit.design.fastroute`: the bound-driven drive (:func:`bound_drive`);
+  :class:`MonteCarloResult` with the posterior CRLB and the bound over the drive with the bias
+  that does not average down, :func:`drive_bound`; :func:`javelin_rmse` for one array);
+  :mod:`~tunnelkit.design.fastroute`: the bound-driven drive (:func:`bound_drive`, its
+  per-array share computed once by :func:`bound_route`);
 * :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile with its bootstrap
   interval, the verdict per array and the recommendation (:func:`judge`, :func:`recommend`);
 * :mod:`~tunnelkit.design.report`: the sweep and its table (:func:`design_sweep`,
@@ -39,15 +41,17 @@ from __future__ import annotations
 from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .errormodel import PathErrorModel
-from .fastroute import bound_drive
+from .fastroute import BoundRoute, bound_drive, bound_route
 from .geometry import KINDS, RouteGeometry, trace_route
 from .montecarlo import (
     MODES,
     SETTLE_S,
     MonteCarloResult,
+    drive_bound,
     drive_pcrlb,
     javelin_config,
     javelin_rmse,
+    position_bias_rms,
     position_information,
     sweep_montecarlo,
 )
@@ -75,6 +79,7 @@ __all__ = [
     "STATUSES",
     "AchievableBound",
     "ArraySpec",
+    "BoundRoute",
     "DesignImpairments",
     "DesignReport",
     "DesignRow",
@@ -87,8 +92,10 @@ __all__ = [
     "achievable_bound",
     "bootstrap_quantile_ci",
     "bound_drive",
+    "bound_route",
     "counted_epochs",
     "design_sweep",
+    "drive_bound",
     "drive_pcrlb",
     "gate",
     "implied_quantile",
@@ -99,6 +106,7 @@ __all__ = [
     "parse_array",
     "path_bounds",
     "path_error_model",
+    "position_bias_rms",
     "position_information",
     "recommend",
     "route_bounds",

@@ -123,38 +123,57 @@ class PathErrorModel:
             out += self.k_gain @ finite_array("gain_db", gain_db, shape=(self.n_elements,))
         return out
 
-    def budget(self) -> np.ndarray:
+    def budget(self, correlated_scale: float = 1.0) -> np.ndarray:
         """The per-path error budget (T, P, 4, 4): the second moment of the error about the
         truth, ``cov`` plus the calibration covariance over the calibration draw
         (``sigma_phi^2 K_phase K_phase^T + sigma_g^2 K_gain K_gain^T``) plus the deterministic
         bias' outer product. What an extraction that knows its array's calibration tolerance and
         its model's shortcuts (but not the draw) can report; equal to the ``crlb`` blocks for an
-        ideal model."""
+        ideal model. ``correlated_scale`` (>= 1) multiplies the two terms that are the same
+        from one epoch to the next (calibration and bias; ``cov`` is drawn afresh every epoch):
+        the white-equivalent variance of an error a filter would otherwise count once per epoch
+        (:data:`tunnelkit.design.fastroute.CORRELATED_SCALE`)."""
+        c = nonnegative("correlated_scale", correlated_scale)
+        if c < 1.0:
+            raise ValueError(f"correlated_scale: expected >= 1, got {correlated_scale!r}")
         T, P = self.exists.shape
         idx = np.arange(P)
         out = np.asarray(self.cov).reshape(T, P, 4, P, 4)[:, idx, :, idx, :]  # (P, T, 4, 4)
         out = np.moveaxis(out, 0, 1).copy()
         for k, sig in ((self.k_phase, self.phase_sigma_rad), (self.k_gain, self.gain_sigma_db)):
             if k is not None and sig > 0:
-                out += sig**2 * (np.asarray(k) @ np.swapaxes(k, -1, -2))
+                out += c * sig**2 * (np.asarray(k) @ np.swapaxes(k, -1, -2))
         b = np.asarray(self.bias)
-        out += b[..., :, None] * b[..., None, :]
+        out += c * (b[..., :, None] * b[..., None, :])
         return np.where(self.exists[..., None, None], out, 0.0)
 
-    def draw(self, rng: np.random.Generator) -> np.ndarray:
+    def noise_sqrt(self) -> np.ndarray:
+        """A square root (T, 4P, 4P) of ``cov`` over the existing paths (absent slots zero):
+        what :meth:`draw` multiplies its standard normals by. It depends on the model only, so
+        a Monte-Carlo computes it once per array and hands it to every :meth:`draw`."""
+        m = np.repeat(self.exists, 4, axis=1)
+        return psd_sqrt(np.where(m[:, :, None] & m[:, None, :], self.cov, 0.0))
+
+    def draw(self, rng: np.random.Generator, *, noise_sqrt: np.ndarray | None = None) -> np.ndarray:
         """One drive's measured ``z`` (T, P, 4): the truth plus the deterministic bias, one
         array's calibration bias (phase and gain errors drawn once from ``rng``) and a Gaussian
-        error with covariance ``cov`` per epoch; NaN where a path does not exist."""
+        error with covariance ``cov`` per epoch; NaN where a path does not exist.
+        ``noise_sqrt``: :meth:`noise_sqrt` computed once (the same draw, without its cost)."""
         rng = rng_or_error("rng", rng)
         T, P = self.exists.shape
         M = self.n_elements
+        if noise_sqrt is None:
+            noise_sqrt = self.noise_sqrt()
+        elif np.shape(noise_sqrt) != (T, 4 * P, 4 * P):
+            raise ValueError(
+                f"noise_sqrt: expected shape {(T, 4 * P, 4 * P)} (the model's noise_sqrt()), "
+                f"got {np.shape(noise_sqrt)}"
+            )
         phase = gain = None
         if M is not None and self.phase_sigma_rad > 0:
             phase = self.phase_sigma_rad * rng.standard_normal(M)
         if M is not None and self.gain_sigma_db > 0:
             gain = self.gain_sigma_db * rng.standard_normal(M)
-        m = np.repeat(self.exists, 4, axis=1)
-        S = np.where(m[:, :, None] & m[:, None, :], self.cov, 0.0)
-        noise = (psd_sqrt(S) @ rng.standard_normal((T, 4 * P, 1)))[..., 0].reshape(T, P, 4)
+        noise = (noise_sqrt @ rng.standard_normal((T, 4 * P, 1)))[..., 0].reshape(T, P, 4)
         z = self.truth + self.bias + self.calibration_bias(phase, gain) + noise
         return np.where(self.exists[..., None], z, np.nan)

@@ -15,9 +15,17 @@ is identical serially and on any number of workers. Two measurement routes:
 JAVELIN there takes each path's covariance as the extraction reports it (the CRLB at the
 estimate, which the ML route attains), so the tracker is tuned by the design itself at any
 carrier and size (:func:`javelin_config`); its settled error (after the first :data:`SETTLE_S`)
-is set beside the PEB and the posterior CRLB over the drive (:func:`drive_pcrlb`, Tichavsky et
-al. 1998 with JAVELIN's motion model and the position information of the model's reported bound).
-:func:`javelin_rmse` is the one-array summary on top of it.
+is set beside the PEB, the posterior CRLB over the drive (:func:`drive_pcrlb`, Tichavsky et
+al. 1998 with JAVELIN's motion model and the position information of the model's reported bound)
+and the bound over the drive under the impairments (:func:`drive_bound`: the posterior CRLB with
+the position bias of the array's one calibration draw and of the wideband term added, which no
+number of epochs averages down). :func:`javelin_rmse` is the one-array summary on top of it.
+
+Cost: the per-array work (error model, the bound route's shared part
+:func:`~tunnelkit.design.fastroute.bound_route`, PEB and the bounds over the drive) is one task
+per array and the drives one task each, both on the same cluster
+(:func:`tunnelkit.montecarlo.trial_pool`, started once), so two workers also split the models;
+a drive on the bound route then costs its random draws and the tracker.
 """
 
 from __future__ import annotations
@@ -29,7 +37,7 @@ import numpy as np
 
 from .._validate import integer
 from ..metrics import SETTLE_S, settled
-from ..montecarlo import run_trials
+from ..montecarlo import run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
 from .errormodel import PathErrorModel
 from .setup import ArraySpec, DesignSetup, parse_array
@@ -38,9 +46,11 @@ __all__ = [
     "MODES",
     "SETTLE_S",
     "MonteCarloResult",
+    "drive_bound",
     "drive_pcrlb",
     "javelin_config",
     "javelin_rmse",
+    "position_bias_rms",
     "position_information",
     "sweep_montecarlo",
 ]
@@ -70,7 +80,9 @@ class MonteCarloResult:
     (:func:`tunnelkit.metrics.settled`); ``mode`` the measurement route; ``peb`` (T,) [m] the
     snapshot PEB; ``pcrlb`` (T,) [m] the posterior CRLB of the 2-D position over the drive,
     from the ideal per-path CRLB (under impairments the ideal posterior bound, not an achievable one)
-    (``None`` on the channel route without a model); ``sigmas`` the tracker's fallback sigmas.
+    (``None`` on the channel route without a model); ``sigmas`` the tracker's fallback sigmas;
+    ``drive`` (T,) [m] the achievable bound over the drive (:func:`drive_bound`: the posterior
+    CRLB with the bias that does not average down; equal to ``pcrlb`` for an ideal model).
     """
 
     spec: ArraySpec
@@ -83,6 +95,7 @@ class MonteCarloResult:
     peb: np.ndarray
     pcrlb: np.ndarray | None
     sigmas: dict
+    drive: np.ndarray | None = None
 
     @property
     def runs(self) -> int:
@@ -116,7 +129,7 @@ class _SweepTrial:
     setup: DesignSetup
     specs: tuple[ArraySpec, ...]
     designs: tuple  # tracking.javelin.JavelinDesign per array
-    models: tuple  # PathErrorModel per array (bound mode) or None
+    routes: tuple  # fastroute.BoundRoute per array (bound mode) or None
     mode: str
     n_epochs: int | None
 
@@ -127,7 +140,7 @@ class _SweepTrial:
         if self.mode == "bound":
             from .fastroute import bound_drive
 
-            drive = bound_drive(self.models[a], self.setup, spec, rng, n_epochs=self.n_epochs)
+            drive = bound_drive(self.routes[a], self.setup, spec, rng, n_epochs=self.n_epochs)
         else:
             route = self.setup.signal_route(spec)
             drive = simulate_drive(
@@ -136,32 +149,47 @@ class _SweepTrial:
         return _trial_errors(evaluate(drive, self.designs[a]).estimates, drive.truth)
 
 
+def _position_rows(model: PathErrorModel, geometry, k: int):
+    """Epoch ``k``: the rows of the existing paths in ``z`` and ``H`` (4n, 3), the map of the
+    UE's horizontal position and ``c b`` into them (``None`` without a path)."""
+    from ..geometry import spherical_jacobian
+
+    j = np.flatnonzero(model.exists[k] & geometry.exists[k])
+    if not j.size:
+        return None, None, j
+    rel = geometry.source[k, j] - geometry.origin[k]
+    Js = spherical_jacobian(rel) @ geometry.mirror[j]  # (n, 3, 3) d(phi,psi,r)/d UE
+    H = np.zeros((j.size, 4, 3))
+    H[:, :3, :2] = Js[:, :, :2]
+    H[:, 3, :2] = Js[:, 2, :2]
+    H[:, 3, 2] = 1.0  # c b in every delay distance
+    rows = (4 * j[:, None] + np.arange(4)).ravel()
+    return rows, H.reshape(-1, 3), j
+
+
+def _check_geometry(model, geometry) -> None:
+    if not isinstance(model, PathErrorModel):
+        raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
+    if geometry.exists.shape != model.exists.shape:
+        raise ValueError(
+            f"geometry: expected {model.exists.shape[0]} epochs and {model.exists.shape[1]} "
+            "path slots like the model"
+        )
+
+
 def position_information(model: PathErrorModel, geometry) -> np.ndarray:
     """Fisher information (T, 2, 2) [1/m^2] of the UE's horizontal position (height known, as
     JAVELIN and the PEB) in what the extraction reports: ``H^T crlb^-1 H`` over the existing
     paths' ``z = [phi, psi, kappa, d]``, with the clock bias (common to every ``d``) a nuisance
     removed by the Schur complement. ``H`` maps the UE position through each path's wave origin
     (the UE, or its mirror image in the known surface: ``geometry.mirror``)."""
-    from ..geometry import spherical_jacobian
-
-    if not isinstance(model, PathErrorModel):
-        raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
-    T, P = model.exists.shape
-    if geometry.exists.shape != (T, P):
-        raise ValueError(f"geometry: expected {T} epochs and {P} path slots like the model")
+    _check_geometry(model, geometry)
+    T = model.exists.shape[0]
     out = np.zeros((T, 2, 2))
-    rel = geometry.source - geometry.origin[:, None, :]
     for k in range(T):
-        j = np.flatnonzero(model.exists[k] & geometry.exists[k])
-        if not j.size:
+        rows, H, _ = _position_rows(model, geometry, k)
+        if rows is None:
             continue
-        Js = spherical_jacobian(rel[k, j]) @ geometry.mirror[j]  # (n, 3, 3) d(phi,psi,r)/d UE
-        H = np.zeros((j.size, 4, 3))
-        H[:, :3, :2] = Js[:, :, :2]
-        H[:, 3, :2] = Js[:, 2, :2]
-        H[:, 3, 2] = 1.0  # c b in every delay distance
-        H = H.reshape(-1, 3)
-        rows = (4 * j[:, None] + np.arange(4)).ravel()
         R = model.crlb[k][np.ix_(rows, rows)]
         J = H.T @ np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True) @ H
         J = 0.5 * (J + J.T)
@@ -171,6 +199,52 @@ def position_information(model: PathErrorModel, geometry) -> np.ndarray:
             J = J[:2, :2]
         out[k] = 0.5 * (J + J.T)
     return out
+
+
+def position_bias_rms(model: PathErrorModel, geometry) -> np.ndarray:
+    """RMS (T,) [m] of the horizontal position bias of the snapshot estimator of
+    :func:`position_information` (weights ``crlb^-1``, clock bias estimated) under the model's
+    deterministic ``bias`` and calibration error, over the calibration draw:
+    ``sqrt(|G b|^2 + sigma_phi^2 ||G K_phase||_F^2 + sigma_g^2 ||G K_gain||_F^2)`` with ``G``
+    the position rows of ``(H^T W H)^-1 H^T W``. A bias that does not average down over the
+    drive: one array's calibration error is drawn once, the wideband bias is deterministic
+    (:func:`drive_bound`). Zero for an ideal model."""
+    _check_geometry(model, geometry)
+    T, P = model.exists.shape
+    out = np.zeros(T)
+    b_all = np.asarray(model.bias).reshape(T, 4 * P)
+    ks = [
+        (np.asarray(K).reshape(T, 4 * P, -1), sig)
+        for K, sig in ((model.k_phase, model.phase_sigma_rad), (model.k_gain, model.gain_sigma_db))
+        if K is not None and sig > 0
+    ]
+    for k in range(T):
+        rows, H, _ = _position_rows(model, geometry, k)
+        if rows is None:
+            continue
+        R = model.crlb[k][np.ix_(rows, rows)]
+        W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
+        J = H.T @ W @ H
+        G = (np.linalg.pinv(0.5 * (J + J.T), rcond=1e-15, hermitian=True) @ H.T @ W)[:2]
+        v = float(np.sum((G @ b_all[k, rows]) ** 2))
+        for K, sig in ks:
+            v += sig**2 * float(np.sum((G @ K[k, rows]) ** 2))
+        out[k] = np.sqrt(v)
+    return out
+
+
+def drive_bound(pcrlb: np.ndarray, bias_rms: np.ndarray) -> np.ndarray:
+    """The achievable bound over the drive (T,) [m]: the posterior CRLB of the noise
+    (:func:`drive_pcrlb`, which averages down along the drive) and the position bias that does
+    not average down (:func:`position_bias_rms`, the array's one calibration draw and the
+    deterministic wideband bias) added in quadrature, ``sqrt(pcrlb^2 + bias_rms^2)``. The bias
+    part is that of the snapshot estimator with the ideal weights (the achievable bound's), not
+    minimised over the drive: a reference a tracker can approach, not a strict lower bound."""
+    p = np.asarray(pcrlb, float)
+    b = np.asarray(bias_rms, float)
+    if p.shape != b.shape:
+        raise ValueError(f"bias_rms: expected shape {p.shape} like pcrlb, got {b.shape}")
+    return np.sqrt(p**2 + b**2)
 
 
 def drive_pcrlb(
@@ -216,28 +290,55 @@ def drive_pcrlb(
     return pcrlb_position_rmse(B)
 
 
-def _models(setup, specs, error_models) -> list[PathErrorModel]:
+def _model(setup, spec, error_models) -> PathErrorModel:
     from .achievable import path_error_model
 
-    out = []
-    for spec in specs:
-        if error_models is None:
-            m = path_error_model(setup, spec)
-        elif callable(error_models):
-            m = error_models(setup, spec)
-        elif isinstance(error_models, dict) and spec.label in error_models:
-            m = error_models[spec.label]
-        else:
-            raise ValueError(
-                f"error_models: expected None, a callable (setup, spec) -> PathErrorModel or a "
-                f"dict by array label holding {spec.label!r}"
-            )
-        if not isinstance(m, PathErrorModel):
-            raise TypeError(
-                f"error_models: expected PathErrorModel for {spec.label}, got {type(m).__name__}"
-            )
-        out.append(m)
-    return out
+    if error_models is None:
+        m = path_error_model(setup, spec)
+    elif callable(error_models):
+        m = error_models(setup, spec)
+    elif isinstance(error_models, dict) and spec.label in error_models:
+        m = error_models[spec.label]
+    else:
+        raise ValueError(
+            f"error_models: expected None, a callable (setup, spec) -> PathErrorModel or a "
+            f"dict by array label holding {spec.label!r}"
+        )
+    if not isinstance(m, PathErrorModel):
+        raise TypeError(
+            f"error_models: expected PathErrorModel for {spec.label}, got {type(m).__name__}"
+        )
+    return m
+
+
+@dataclass(frozen=True)
+class _ArrayJob:
+    """Everything a sweep computes once per array, before its drives (one task per array, on
+    the sweep's cluster when it has one): the error model, the bound route's shared part, the
+    PEB and the bounds over the drive."""
+
+    setup: DesignSetup
+    error_models: object
+    mode: str
+    T: int
+    with_model: bool
+
+    def __call__(self, spec: ArraySpec):
+        ep = np.arange(self.T)
+        peb = route_bounds(self.setup, spec, epochs=ep).peb
+        if not self.with_model:
+            return None, None, peb, None, None
+        m = _model(self.setup, spec, self.error_models)
+        route = None
+        if self.mode == "bound":
+            from .fastroute import bound_route
+
+            route = bound_route(m, self.setup, spec)
+        g = route_geometry(self.setup, spec, epochs=ep)
+        head = _head(m, self.T)
+        pc = drive_pcrlb(self.setup, position_information(head, g))
+        drive = drive_bound(pc, position_bias_rms(head, g))
+        return m, route, peb, pc, drive
 
 
 def sweep_montecarlo(
@@ -289,55 +390,45 @@ def sweep_montecarlo(
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     if crlbs is not None and not isinstance(crlbs, dict):
         raise TypeError(f"crlbs: expected a dict by array label, got {type(crlbs).__name__}")
-    models = None
-    if mode == "bound" or error_models is not None:
-        models = _models(setup, specs, error_models)
-    designs = []
-    for a, spec in enumerate(specs):
-        crlb = None if crlbs is None else crlbs.get(spec.label)
-        if crlb is None and models is not None:
-            crlb = _median_sigmas(models[a])
-        if crlb is None:
-            pb = path_bounds(setup, spec)
-            crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-        designs.append(javelin_config(crlb, setup.signal_route(spec).min_d))
-    trial = _SweepTrial(
-        setup,
-        specs,
-        tuple(designs),
-        tuple(models) if mode == "bound" else (None,) * len(specs),
-        mode,
-        n_epochs,
-    )
-    A = len(specs)
-    kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
-    kw["trial_timeout"] = trial_timeout
-    res = run_trials(
-        trial,
-        A * runs,
-        seed,
-        inputs=[a for a in range(A) for _ in range(runs)],
-        streams=[r for _ in range(A) for r in range(runs)],
-        progress=progress,
-        desc=f"JAVELIN {mode} " + " ".join(s.label for s in specs),
-        **{k: v for k, v in kw.items() if v is not None},
-    )
     traj = setup.trajectory
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
+    A = len(specs)
+    with_model = mode == "bound" or error_models is not None
+    job = _ArrayJob(setup, error_models, mode, T, with_model)
+    kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
+    with trial_pool(**{k: v for k, v in kw.items() if v is not None}) as pool:
+        # the per-array work (models, bounds) runs on the cluster too, one task per array
+        built = pool.map(job, specs, desc="design arrays")
+        designs = []
+        for a, spec in enumerate(specs):
+            crlb = None if crlbs is None else crlbs.get(spec.label)
+            if crlb is None and with_model:
+                crlb = _median_sigmas(built[a][0])
+            if crlb is None:
+                pb = path_bounds(setup, spec)
+                crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
+            designs.append(javelin_config(crlb, setup.signal_route(spec).min_d))
+        trial = _SweepTrial(
+            setup, specs, tuple(designs), tuple(b[1] for b in built), mode, n_epochs
+        )
+        res = run_trials(
+            trial,
+            A * runs,
+            seed,
+            inputs=[a for a in range(A) for _ in range(runs)],
+            streams=[r for _ in range(A) for r in range(runs)],
+            progress=progress,
+            desc=f"JAVELIN {mode} " + " ".join(s.label for s in specs),
+            trial_timeout=trial_timeout,
+            pool=pool,
+        )
     t = traj.t[:T].copy()
     idx = settled(t)
     use = idx if idx.size else np.arange(T)
     out = {}
     for a, spec in enumerate(specs):
         err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
-        ep = np.arange(T)
-        peb = route_bounds(setup, spec, epochs=ep).peb
-        pc = None
-        if models is not None:
-            g = route_geometry(setup, spec, epochs=ep)
-            m = models[a]
-            info = position_information(_head(m, T), g)
-            pc = drive_pcrlb(setup, info)
+        _, _, peb, pc, drive = built[a]
         cfg = designs[a].config
         out[spec.label] = MonteCarloResult(
             spec,
@@ -354,6 +445,7 @@ def sweep_montecarlo(
                 "kappa_m": cfg.sigma_kappa,
                 "delta_d_m": cfg.sigma_delta_d,
             },
+            drive,
         )
     return out
 
