@@ -297,6 +297,45 @@ def test_joint_innovation_test_leaves_out_the_wrong_pair():
         JointTestUpdater(1e-300)
 
 
+def test_our_ml_design_leaves_out_a_wrong_los_taken_by_eq61():
+    """The slalom's N@0.5 failure: the LoS blocked, a road-marking reflection whose VUE is as far
+    from the array as the UE (so eq. 61 passes it, d / kappa = 1.09) and 20 deg off the UE's
+    direction is the only free path. With the joint innovation test (``designs.ours_ml``) the UE
+    stays on its track; with the plain Joseph update the same pair pulls it metres away."""
+    from tunnelkit.tracking.javelin import Javelin, JosephUpdater, designs
+    from tunnelkit.tracking.javelin.manage import los_test
+
+    bs = np.array([0.0, 0.0, 4.8])
+    dt, speed, bias = 0.1, 14.0, 3.0
+    ue0 = np.array([45.0, -3.0, 1.5])
+
+    def paths(k, blocked):
+        ue = ue0 - [speed * dt * k, 0.0, 0.0]
+        src = [ue, ue * [1, 1, 0] + [0, 0, 2 * 7.0 - ue[2]], ue * [1, 1, -1]]  # LoS, ceiling, road
+        if blocked:
+            src = [*src[1:], np.array([ue[0], 9.6, 1.5])]  # a marking's VUE across the tunnel
+        q = np.array(src) - bs
+        r = np.linalg.norm(q, axis=1)
+        phi, psi = np.arctan2(q[:, 1], q[:, 0]), np.arcsin(q[:, 2] / r)
+        return PathMeasurements.from_arrays(phi, psi, kappa=r, d=r + bias)
+
+    epochs = [paths(k, k == 6) for k in range(7)]
+    blocked = epochs[-1]
+    # the two images are claimed by their tracks; eq. 61 takes the free marking as the LoS
+    assert los_test(blocked.d, blocked.kappa, 0.2, candidates=[2]) == 2
+    truth = ue0 - [speed * dt * 6, 0.0, 0.0]
+    err = {}
+    for name, design in (
+        ("ours_ml", designs.ours_ml()),
+        ("joseph", designs.ours_ml(updater=JosephUpdater())),
+    ):
+        trk = Javelin(ue0, design.with_(base_station=tuple(bs)))
+        run = trk.run(epochs, np.full(7, speed), np.full(7, np.pi), dt)
+        err[name] = float(np.linalg.norm(run.estimates[-1, :2] - truth[:2]))
+    assert err["ours_ml"] < 0.1
+    assert err["joseph"] > 1.0
+
+
 def test_bias_aware_delay_check_keeps_paths_a_negative_clock_bias_pushed_below_zero():
     """Algorithm 1 as printed drops d < 0; with a -60 ns bias every path of an epoch 9 m from
     the array has d < 0 and the epoch is lost. The bias-aware check keeps them all, and the

@@ -181,6 +181,7 @@ def test_named_designs():
     assert o.initiator.update_at_birth is False and o.prefilters[1] == DopplerClutter(1.0)
     assert isinstance(designs.paper_vue().curvature, VueCurvature)
     assert designs.ours_ml().config.sigma_kappa == designs.ML_ERRORS_SEED0["kappa_m"]
+    assert designs.ours_ml().updater == JointTestUpdater(0.999)
     a = designs.array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.01}, min_d=-30.0)
     assert a.requires_reported_covariance() and a.min_d == -30.0
     assert isinstance(a.updater, JointTestUpdater) and isinstance(a.initiator, MeasuredBirth)

@@ -98,7 +98,9 @@ leaves thousands of noise powers in the residual and still passes it. The residu
 and Doppler, a curvature scan and a single-source fit) and several starts are made from it —
 birth and death, the new path in place of the one whose atom is most like it or of the weakest
 (the weaker of two nearly collinear atoms, if any), and the nearest path split in two in place
-of the weakest — each given ``RANK_ITER`` iterations, ranked by the likelihood, the best fitted
+of the weakest (halves an eighth of a beamwidth apart along each axis, and along the line from
+the nearest path to the peak, full and half length: a merged pair leaves its missing energy on
+that side) — each given ``RANK_ITER`` iterations, ranked by the likelihood, the best fitted
 to convergence and kept if the likelihood rises (SAGE / RIMAX re-initialisation; the moves on
 ``rho`` below follow when the energy test still fails). ``MLFit.fit_ok`` (and
 ``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their

@@ -217,7 +217,10 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves)
             th2[worst], mf2[worst], mt2[worst] = th_n, mf_n, mt_n
             starts.append((th2, mf2, mt2))
         if near != out:  # the nearest split in two (a cluster fitted as one), the weakest out
-            for du in SPLIT_STEPS:
+            # halves an eighth of a beamwidth apart along each axis, and along the line from the
+            # nearest path to the peak (a merged pair leaves its missing energy on that side)
+            to_peak = np.asarray(peak[1][:2], float) - theta[near, :2]
+            for du in (*SPLIT_STEPS, to_peak, 0.5 * to_peak):
                 th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
                 th2[out], mf2[out], mt2[out] = theta[near], mu_f[near], mu_t[near]
                 th2[near, :2] += du
