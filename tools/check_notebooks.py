@@ -10,7 +10,7 @@
   solution (tag ``solution``, cell metadata ``jupyter.source_hidden`` and
   ``jupyter.outputs_hidden`` true), so it runs with Run All and in CI while the student sees
   neither its code nor its output until they expand it; a solution is code, not a markdown code
-  block. A notebook whose solutions are still markdown only is named in ``MARKDOWN_SOLUTIONS``.
+  block.
 
 The committed notebook is what is checked. In a clone where ``make lab`` installed the output
 filter (``git config filter.nbstrip.clean``), that is the notebook as the filter cleans it, so
@@ -35,10 +35,6 @@ from pathlib import Path
 
 SOURCES = ".src"
 SOLUTION_TAG = "solution"
-#: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
-MARKDOWN_SOLUTIONS = {
-    "07-ray-tracer-crosscheck",
-}
 FILTER = "nbstrip"
 KERNELSPEC = {"display_name": "Python (tunnelkit)", "language": "python", "name": "python3"}
 
@@ -199,7 +195,7 @@ def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
                 "(jupyter.source_hidden and jupyter.outputs_hidden)"
             )
     start, end = _heading_index(cells, "exercises"), _heading_index(cells, "checks")
-    if start is None or path.stem in MARKDOWN_SOLUTIONS:
+    if start is None:
         return out
     section = cells[start : end if end is not None and end > start else len(cells)]
     n_solutions = 0
