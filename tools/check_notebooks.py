@@ -10,7 +10,8 @@
   solution (tag ``solution``, cell metadata ``jupyter.source_hidden`` and
   ``jupyter.outputs_hidden`` true), so it runs with Run All and in CI while the student sees
   neither its code nor its output until they expand it; a solution is code, not a markdown code
-  block, and every numbered exercise has one (its first line names it: ``# Solution 2: ...``).
+  block, and every numbered exercise has one (its first line names it: ``# Solution 2: ...``;
+  by that line ``tunnelkit.solutions`` collapses the cell's output when it runs in JupyterLab).
 
 The committed notebook is what is checked. In a clone where ``make lab`` installed the output
 filter (``git config filter.nbstrip.clean``), that is the notebook as the filter cleans it, so
@@ -189,10 +190,18 @@ def _heading_index(cells: list[dict], word: str) -> int | None:
 
 def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
     """The one exercise format (see the module docstring)."""
+    from tunnelkit.solutions import is_solution
+
     out = []
     for i, c in enumerate(cells):
         meta = c.get("metadata", {})
         hidden = meta.get("jupyter", {})
+        src = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        if SOLUTION_TAG in meta.get("tags", []) and not is_solution(src):
+            out.append(
+                f"{path}: cell {i} is a solution but its first line does not say so "
+                "('# Solution N: ...'), so the kernel would not collapse its output"
+            )
         if SOLUTION_TAG in meta.get("tags", []) and not (
             hidden.get("source_hidden") and hidden.get("outputs_hidden")
         ):

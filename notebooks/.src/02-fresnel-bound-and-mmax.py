@@ -358,8 +358,9 @@ explorer
 # 3. An engineer wants a $16 \times 16$ URA at 28 GHz in the tunnel of section 5 (far lane). From
 #    which distance on does the SR-NF model hold for it?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: from which distance on is eq. 25 within 5 % of the exact Mmax?

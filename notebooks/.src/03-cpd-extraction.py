@@ -606,8 +606,9 @@ fig_thr.update_layout(
 #    `fit.rho_max` (the basin test) and `fit.significance`. What went wrong, and how does the
 #    fit tell you?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: a truck between the vehicle and the BS, epoch 12

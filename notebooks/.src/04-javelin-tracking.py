@@ -433,8 +433,9 @@ print("90th percentile of the 2-D error [m]:", {n: round(v, 3) for n, v in p90.i
 #    `config.fc, config.tone_spacing, config.symbol_period`). Match the results to the true paths
 #    with `match_paths` (`tunnelkit.evaluation`). What does each extra source buy?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one
-# (or its blue bar) shows its code and output once you have tried. What to read in their output
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in their output
 # follows them.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]

@@ -273,13 +273,16 @@ javelin_table_figure(
 #    `r.manage.born` of each report) and the share of epochs that deliver an RRM path
 #    (`d.kinds[k][t]` of each matched path `t` in `d.truth_index[k]`).
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one
-# (or its blue bar) shows its code and output once you have tried.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1
+from IPython.display import display
+
 sl_cols, sl_rows = ex.ablation(slalom, ml=slalom_ml, progress=True)
-javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D RMSE [m]")
+display(javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D RMSE [m]"))
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 2

@@ -465,8 +465,9 @@ explorer
 # 4. **Lateral drift.** Why does the EKF DS lateral error grow far from the transmitter? Compute
 #    $\sqrt{\mathrm{PCRLB}_{yy}}$ with `sigma_hz=32.79` and `q=0.05` and compare.
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: the CFO of the preset's clock drift, and 5 Hz (mean error of EKF DS over seeds)

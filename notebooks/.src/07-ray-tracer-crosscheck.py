@@ -189,8 +189,9 @@ print(f"H: {H_img.shape}, {len(alike(p_img))} paths, max relative difference {re
 # 3. Would a finer ceiling (`n_facets` = 24, 48, 96 in `propagation.semicircular_tunnel`) let the
 #    preset's array fit under it?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: the slalom epochs of section 4 in the tunnel without RRMs, both engines
