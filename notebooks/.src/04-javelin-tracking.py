@@ -205,7 +205,7 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 # of a degree and metres, and lifts the RMS of its kinds by orders of magnitude. The curvature
 # the ML route measures for a reflection is the distance to its **VUE** (the exact wavefront's
 # radius), not eq. 51's distance to the reflection point (the SR-NF model) — for the ceiling
-# bounce the two differ most (printed under the second table of this section). The paper's
+# bounce the two differ most (printed under this section's first table). The paper's
 # design as printed uses eq. 51; we run it both ways (`designs.paper()` and
 # `designs.paper_vue()`, which changes only that).
 #

@@ -39,7 +39,7 @@ from tunnelkit.widgets import upf_explorer
 
 tk.setup_notebook()
 RUNS = tk.mc_count(100, 8)  # Monte-Carlo runs per experiment (paper: 100)
-PARTICLES = tk.mc_count(500, 300)  # UPF particles
+PARTICLES = tk.mc_count(500, 200)  # UPF particles (quick mode: fewer, see "How many particles?")
 print(f"{RUNS} runs, {PARTICLES} particles")
 
 # %% [markdown]
