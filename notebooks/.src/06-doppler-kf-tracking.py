@@ -169,7 +169,7 @@ J_num = crlb.numeric_jacobian(lambda s: dp.doppler_model(s, setup)[..., None], s
 jac_err = np.max(np.abs(J_closed - J_num) / np.maximum(np.abs(J_num), 1e-9))
 print(f"max relative |closed - finite difference| = {jac_err:.1e}")
 F, Q = dp.cv_model(cfg.dt, 0.5)
-print("Q (q = 0.5) =\n", Q.round(6))
+print("Q (q = 0.5) =\n", np.array2string(Q, formatter={"float_kind": lambda v: f"{v:9.3g}"}))
 
 # %% [markdown]
 # The three approaches sit in a registry (family `"halili2022"`), so the rest of the notebook loops

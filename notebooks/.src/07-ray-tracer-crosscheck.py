@@ -245,9 +245,10 @@ print(
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
 #
-# 1. Yes: without plates nothing shadows the wall facets, and both engines find every path at
-#    every epoch (LoS, the wall facets, the road). `rt.compute_paths` builds a new Sionna scene
-#    for the new tunnel object (it caches one scene at a time).
+# 1. Yes: without plates nothing shadows the facets behind them (the occluded paths listed in
+#    section 4), and both engines find every path at every epoch (LoS, the ceiling and wall
+#    facets, the road). `rt.compute_paths` builds a new Sionna scene for the new tunnel object
+#    (it caches one scene at a time).
 # 2. With 300 rays all paths are still found; with 100 rays both RRM paths are lost: the rays
 #    leave the UE on a Fibonacci lattice and a surface is found only if a ray hits it, so the
 #    narrow plates (0.3 m and 0.8 m wide) go first. It is not monotonic (with 30 rays one RRM
