@@ -97,7 +97,7 @@ paths_table_figure(rows, title=f"Epoch {k}: image method vs Sionna RT").show()
 # %% [markdown]
 # The two engines agree to about $10^{-14}$ s in delay (a few µm), $10^{-3}$ deg in angle and
 # $10^{-2}$ Hz in Doppler: Sionna works in float32, whose resolution at 30 m is a few µm.
-# The scene with both engines' paths:
+# The scene with Sionna's paths (the image method's coincide with them to that precision):
 
 # %%
 tunnel3d_figure(
