@@ -331,9 +331,10 @@ for cond in ("N", "NoRRMs"):
 #    ones (the held-out seed), not read off one table.
 # 3. With the markings present the RRM paths exist over part of each drive only (section 4
 #    prints where, and how many at a time: on the straight drive from its start until the
-#    vehicle comes within a few metres of the plates' near end), so they appear and vanish, and every
-#    appearance is a birth; without them the road and ceiling bounces, measured at their bound,
-#    carry the UE alone. More paths are not better when the extra ones come and go.
+#    vehicle comes within a few metres of the plates' near end; quick mode's short drives end
+#    before that, so its output shows them in every epoch), so they appear and vanish, and
+#    every appearance is a birth; without them the road and ceiling bounces, measured at their
+#    bound, carry the UE alone. More paths are not better when the extra ones come and go.
 #
 # </details>
 
