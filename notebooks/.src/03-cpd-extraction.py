@@ -594,8 +594,8 @@ fig_thr.update_layout(
 #    the vehicle's lane) and rerun section 1–3 at
 #    epoch 12: which paths survive, and which one does Algorithm 1 now call "path 0"?
 # 2. Remove the ceiling from the path families (`kinds=("los", "wall", "road", "rrm")`) and
-#    compare the LoS RMSE of section 6 with and without it. Why does one path that is 3 cm
-#    longer than the LoS spoil the LoS estimate?
+#    compare the LoS RMSE of section 6 with and without it. Why does one path that is a few
+#    centimetres longer than the LoS (section 1 prints how many) spoil the LoS estimate?
 # 3. Lower the SNR with `signal_route.SignalRoute(..., snr_offset_db=-20)`: at what offset does the
 #    CPD stop finding the RRM paths (count `missed`)?
 #
