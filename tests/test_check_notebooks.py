@@ -39,7 +39,13 @@ HIDDEN = {"jupyter": {"source_hidden": True, "outputs_hidden": True}, "tags": ["
 
 
 def test_the_one_exercise_format_passes():
-    cells = [_md("## Exercises\n1. Do it."), _code("print(1)", **HIDDEN), _md("## Checks")]
+    cells = [
+        _md("## Exercises\n1. Do it.\n2. And this."),
+        _code("# Solution 1: it\nprint(1)", **HIDDEN),
+        _code("# Exercise 2, solution (a): this\nprint(2)", **HIDDEN),
+        _md("<details><summary>What to read</summary>\n\n1. One.\n3. A reading, not an exercise."),
+        _md("## Checks"),
+    ]
     assert cn.exercise_problems(Path("09-x.ipynb"), cells) == []
 
 
@@ -50,6 +56,14 @@ def test_the_one_exercise_format_passes():
         ([_md("## Exercises"), _code("x", tags=["solution"])], "does not hide its source"),
         ([_md("## Exercises\n<details>\n```python\nx\n```"), _md("## Checks")], "markdown code"),
         ([_md("## Exercises\n<details>answer</details>"), _md("## Checks")], "without a solution"),
+        (
+            [
+                _md("## Exercises\n1. Do it.\n2. And this.\n<details>\n2. answer in prose"),
+                _code("# Solution 1: it\nprint(1)", **HIDDEN),
+                _md("## Checks"),
+            ],
+            "exercise 2 has no solution cell",
+        ),
     ],
 )
 def test_other_formats_are_refused(cells, message):

@@ -10,7 +10,8 @@
   solution (tag ``solution``, cell metadata ``jupyter.source_hidden`` and
   ``jupyter.outputs_hidden`` true), so it runs with Run All and in CI while the student sees
   neither its code nor its output until they expand it; a solution is code, not a markdown code
-  block. A notebook whose solutions are still markdown only is named in ``MARKDOWN_SOLUTIONS``.
+  block, and every numbered exercise has one (its first line names it: ``# Solution 2: ...``;
+  by that line ``tunnelkit.solutions`` collapses the cell's output when it runs in JupyterLab).
 
 The committed notebook is what is checked. In a clone where ``make lab`` installed the output
 filter (``git config filter.nbstrip.clean``), that is the notebook as the filter cleans it, so
@@ -29,16 +30,18 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 import tempfile
 from pathlib import Path
 
 SOURCES = ".src"
 SOLUTION_TAG = "solution"
-#: notebooks not yet in the one exercise format (markdown-only solutions still to be converted)
-MARKDOWN_SOLUTIONS = {
-    "07-ray-tracer-crosscheck",
-}
+#: a numbered exercise in the Exercises section's markdown ("1. ..." at the start of a line)
+EXERCISE = re.compile(r"^(\d+)\. ", re.MULTILINE)
+#: the exercise a solution cell answers, from its first line ("# Solution 2: ...",
+#: "# Exercise 4, solution (a): ...")
+SOLVES = re.compile(r"(?i)(?:solution|exercise)s?\s+(\d+)")
 FILTER = "nbstrip"
 KERNELSPEC = {"display_name": "Python (tunnelkit)", "language": "python", "name": "python3"}
 
@@ -187,10 +190,18 @@ def _heading_index(cells: list[dict], word: str) -> int | None:
 
 def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
     """The one exercise format (see the module docstring)."""
+    from tunnelkit.solutions import is_solution
+
     out = []
     for i, c in enumerate(cells):
         meta = c.get("metadata", {})
         hidden = meta.get("jupyter", {})
+        src = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        if SOLUTION_TAG in meta.get("tags", []) and not is_solution(src):
+            out.append(
+                f"{path}: cell {i} is a solution but its first line does not say so "
+                "('# Solution N: ...'), so the kernel would not collapse its output"
+            )
         if SOLUTION_TAG in meta.get("tags", []) and not (
             hidden.get("source_hidden") and hidden.get("outputs_hidden")
         ):
@@ -199,7 +210,7 @@ def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
                 "(jupyter.source_hidden and jupyter.outputs_hidden)"
             )
     start, end = _heading_index(cells, "exercises"), _heading_index(cells, "checks")
-    if start is None or path.stem in MARKDOWN_SOLUTIONS:
+    if start is None:
         return out
     section = cells[start : end if end is not None and end > start else len(cells)]
     n_solutions = 0
@@ -216,6 +227,19 @@ def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
             )
     if n_solutions == 0:
         out.append(f"{path}: an Exercises section without a solution cell")
+    asked, answered = set(), set()
+    for c in section:
+        src = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
+        if c.get("cell_type") == "markdown":
+            text = src.split("<details", 1)[0]  # what follows is a reading, not an exercise
+            asked |= {int(m) for m in EXERCISE.findall(text)}
+        elif SOLUTION_TAG in c.get("metadata", {}).get("tags", []):
+            first = src.strip().splitlines()[0] if src.strip() else ""
+            answered |= {int(m) for m in SOLVES.findall(first)}
+    for n in sorted(asked - answered):
+        out.append(
+            f"{path}: exercise {n} has no solution cell (its first line: '# Solution {n}: ...')"
+        )
     return out
 
 

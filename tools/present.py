@@ -15,6 +15,7 @@ when Voila does not come up.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 from pathlib import Path
@@ -38,6 +39,21 @@ from _lecture import (
     wait_http,
 )
 
+#: Voila's lab template with the exercises' solutions collapsed (tools/jupyter/voila/templates/);
+#: Voila finds it through JUPYTER_PATH (voila_env)
+TEMPLATE = "tunnelkit"
+JUPYTER_DATA = Path(__file__).resolve().parent / "jupyter"
+
+
+def voila_env(quick: bool) -> dict[str, str]:
+    """The environment of Voila and its kernel: kernel_env, and JUPYTER_PATH led by the directory
+    that holds the tunnelkit template."""
+    env = kernel_env(quick)
+    env["JUPYTER_PATH"] = os.pathsep.join(
+        p for p in (str(JUPYTER_DATA), env.get("JUPYTER_PATH", "")) if p
+    )
+    return env
+
 
 def voila_command(notebook: Path, port: int) -> list[str]:
     """The Voila command line for one notebook on 127.0.0.1:port, sources stripped.
@@ -56,6 +72,7 @@ def voila_command(notebook: Path, port: int) -> list[str]:
         "--no-browser",
         "--strip_sources=True",
         "--theme=light",
+        f"--template={TEMPLATE}",
         "--VoilaConfiguration.show_tracebacks=True",
         "--Voila.open_browser=False",
         IPC_TRANSPORT_FLAG,
@@ -100,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, _stop)
     proc = None
     try:
-        proc = start_server(voila_command(nb, port), env=kernel_env(args.quick), log=log)
+        proc = start_server(voila_command(nb, port), env=voila_env(args.quick), log=log)
         wait_http(url + "api", proc, args.timeout)
         mode = "quick" if args.quick else "full"
         print(

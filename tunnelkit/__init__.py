@@ -54,7 +54,8 @@ def setup_notebook(*, renderer: str | None = None) -> None:
     """The one setup call every notebook makes after ``import tunnelkit as tk``.
 
     Sets a plotly renderer that works both in JupyterLab and when the notebook is executed
-    headless (CI, static site) and prints one line: the package version and whether quick mode
+    headless (CI, static site), collapses the output of exercise solution cells
+    (:mod:`tunnelkit.solutions`) and prints one line: the package version and whether quick mode
     is on. Returns None, so the call is not echoed as a cell result.
     """
     import plotly.io as pio
@@ -64,6 +65,9 @@ def setup_notebook(*, renderer: str | None = None) -> None:
     elif pio.renderers.default in (None, "", "browser"):
         pio.renderers.default = "notebook_connected+plotly_mimetype"
     pio.templates.default = "plotly_white"
+    from .solutions import install
+
+    install()  # exercise solutions: output collapsed until asked for (tunnelkit.solutions)
     mode = "quick (TUNNELKIT_QUICK=1: Monte-Carlo counts shrunk for CI)" if quick_mode() else "full"
     print(f"tunnelkit {__version__} · mode: {mode}")
 

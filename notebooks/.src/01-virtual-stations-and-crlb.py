@@ -277,8 +277,9 @@ line_figure(
 # 3. Drop the DOA (`sigma_theta=None`) and find the along-tunnel positions where the TOA-only bound
 #    exceeds 10 m.
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: where is the bound smallest at (2 deg, 2 m)?

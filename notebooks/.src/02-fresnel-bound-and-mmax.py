@@ -16,7 +16,8 @@
 # - the paper's design example ($M_{\max} = 9.88$, so $M = 100$) and what the *exact* phase mismatch
 #   says about it;
 # - where the closed-form bounds (eq. 25, eq. 37) are tight, where they are loose, and a corrected
-#   second-order bound that holds outside the paraxial regime;
+#   second-order bound that stays within about one antenna of the exact value outside the
+#   paraxial regime (an expansion, so it can be that one antenna too generous);
 # - how to size an array for a 5.9 GHz or a 28 GHz tunnel, with sliders and with
 #   `tunnelkit mmax` on the command line.
 
@@ -209,7 +210,8 @@ for surf, v in mism.items():
         f"{surf:8s} {v.min():7.3f}-{v.max():7.3f} rad; within eps_Phi = {eps} rad on "
         f"{np.mean(v <= eps):.0%} of its {v.size} path-epochs"
     )
-#
+
+# %% [markdown]
 # ## 4. The honest comparison: bounds vs exact geometry
 #
 # ### A corrected second-order bound
@@ -356,8 +358,9 @@ explorer
 # 3. An engineer wants a $16 \times 16$ URA at 28 GHz in the tunnel of section 5 (far lane). From
 #    which distance on does the SR-NF model hold for it?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: from which distance on is eq. 25 within 5 % of the exact Mmax?
@@ -386,8 +389,10 @@ print("exact URA Mmax there:", fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15,
 # <details><summary>What to read in the solutions</summary>
 #
 # 1. "$\ll 1$" need not be very small: eq. 25 is within 5 % once $(2W - y_u)/R$ is about a third.
-# 2. Eq. 37 is unsafe here: it drops the factor $W/(W - y_u)$; eq. 25 is close (its paraxial
-#    ratio $(2W - y_u)/R$ is small) and the second-order bound is close too.
+# 2. Eq. 37 is unsafe by several antennas: it drops the factor $W/(W - y_u)$. Eq. 25 is close
+#    and just safe (its paraxial ratio $(2W - y_u)/R$ is small). The second-order bound is
+#    unsafe too, but by less than one antenna: it is an expansion to second order, not a
+#    rigorous bound, and here the third-order terms tip it just above the exact value.
 # 3. The mismatch falls with distance; from the printed distance on the SR-NF model holds for the
 #    $16 \times 16$ URA, where the exact $M_{\max}$ of the URA reaches 16.
 #
@@ -407,6 +412,7 @@ assert m_exact == 15 and m_ura == 11  # exact: the paper's M = 100 (10 x 10) is 
 assert min(mism["ceiling"]) > eps, mism["ceiling"]
 # exercises: the solutions' readings
 assert 0.2 < 3.5 / r_from < 0.5 and summ.eq37 > summ.exact + 0.5 > summ.eq25
+assert summ.exact < summ.nonparaxial < summ.exact + 1  # unsafe, by less than one antenna
 assert fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15, z_u=-3.3) >= 16
 assert fresnel.phase_mismatch_ura(10, R, W, y_u, fc) <= eps
 assert np.abs(floor_gap).max() <= 1 and abs(ratio25[:, far] - 1).max() < 0.08  # tight far away

@@ -591,33 +591,14 @@ fig_thr.update_layout(
 # ## Exercises
 #
 # 1. Put a truck between the vehicle and the BS
-#    (`route.tunnel.with_blockers(propagation.truck_box(20, -2.5))`) and rerun section 1–3 at
+#    (`route.tunnel.with_blockers(propagation.truck_box(15, -2.5))`, 12 m long, 4 m high, in
+#    the vehicle's lane) and rerun section 1–3 at
 #    epoch 12: which paths survive, and which one does Algorithm 1 now call "path 0"?
 # 2. Remove the ceiling from the path families (`kinds=("los", "wall", "road", "rrm")`) and
-#    compare the LoS RMSE of section 6 with and without it. Why does one path that is 3 cm
-#    longer than the LoS spoil the LoS estimate?
+#    compare the LoS RMSE of section 6 with and without it. Why does one path that is a few
+#    centimetres longer than the LoS (section 1 prints how many) spoil the LoS estimate?
 # 3. Lower the SNR with `signal_route.SignalRoute(..., snr_offset_db=-20)`: at what offset does the
 #    CPD stop finding the RRM paths (count `missed`)?
-#
-# <details><summary>Hints and solutions</summary>
-#
-# 1. `tun = route.tunnel.with_blockers(propagation.truck_box(20, -2.5))`,
-#    `arr, ps = route.paths(12, tunnel=tun)`: the LoS and the road bounce are gone, the RRM and
-#    ceiling paths remain; the earliest arrival (path 0, the reference of $\Delta d$) is then a
-#    reflection, which is why JAVELIN tracks VUEs rather than assuming a LoS.
-# 2. On the paper's route (`refine="joint"`) the LoS $d$ RMSE is decimetres with the ceiling
-#    (the first table of section 6), several times smaller without it, and a fraction of a
-#    millimetre with LoS + road only (the second table): the ceiling path has the same delay and
-#    Doppler as the LoS within the noise, so the CPD must split their sum with the spatial factor
-#    alone, and a free spatial factor can rotate between them (Kruskal rank 1 in time, section 4).
-#    The free-model CRLB grows accordingly (compare `extraction.path_crlb` with and without it).
-# 3. Loop `snr_offset_db` over `range(0, -40, -5)` and call
-#    `evaluation.rmse_study(r, 12, 10, 0, refine="joint")` with
-#    `r = signal_route.SignalRoute(..., snr_offset_db=off)`; watch `missed` grow, weakest path
-#    first (compare `snap.snr_db`). Then the same with `refine="ml"`: the ML route keeps the paths
-#    longer, and its `MLDetectionWarning` says when one no longer stands above the noise.
-#
-# </details>
 #
 # 4. **Break the ML stage.** (a) On the tensor of sections 2–4 (`snap`), start `ml.fit_ml` at
 #    the truth, then at the paper's route estimates `est` (`ml.start_from_estimates(est)`), with
@@ -626,8 +607,60 @@ fig_thr.update_layout(
 #    `fit.rho_max` (the basin test) and `fit.significance`. What went wrong, and how does the
 #    fit tell you?
 #
-# The solution cells below run with the notebook; click the collapsed cell (or its blue bar)
-# to see the code and its output once you have tried.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 1: a truck between the vehicle and the BS, epoch 12
+from tunnelkit import propagation
+
+tun_truck = route.tunnel.with_blockers(propagation.truck_box(15, -2.5))
+arr_t1, ps_t1 = route.paths(k_demo, tunnel=tun_truck)
+print("without the truck:", ", ".join(p.surface_kind for p in paths))
+print("with the truck:   ", ", ".join(p.surface_kind for p in ps_t1))
+snap_t1 = channel.synthesize(ps_t1, cfg, np.random.default_rng(1))
+est_t1 = extraction.extract_paths(snap_t1.H, len(ps_t1), arr_t1, cfg, refine="joint")
+first_t1 = min(ps_t1, key=lambda p: p.length)
+print(
+    f"earliest arrival: {first_t1.surface_kind} ({first_t1.surface}), {first_t1.length:.3f} m; "
+    f"path 0 of the extraction: d = {est_t1.d[0]:.3f} m "
+    f"(= length + clock bias {C * snap_t1.clock_bias:.3f} m)"
+)
+
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 2: the LoS estimate with and without the ceiling bounce (the paper's route, section 6)
+no_ceil = signal_route.SignalRoute(
+    route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "wall", "road", "rrm")
+)
+study_nc = evaluation.rmse_study(no_ceil, k_demo, n_mc, seed=11, refine="joint")
+sol2 = {"all paths": study_all[0], "no ceiling": study_nc[0], "LoS + road": study_noceil[0]}
+for name, r in sol2.items():
+    print(
+        f"{name:11s} LoS d RMSE {r['RMSE d [m]']:.4f} m, free-factor CRLB {r['CRLB d [m]']:.4f} m, "
+        f"direction RMSE {r['RMSE dir [deg]']:.3f} deg"
+    )
+
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 3: the SNR lowered on the paper's route: how often is each path missed?
+n_sol3 = tk.mc_count(10, 2)
+sol3 = {}
+for off in range(0, -40, -5 if not tk.quick_mode() else -10):
+    r3 = signal_route.SignalRoute(
+        route.tunnel, route.arrays, route.trajectory, cfg, snr_offset_db=off
+    )
+    rows3 = evaluation.rmse_study(r3, k_demo, n_sol3, seed=0, refine="joint")
+    sol3[off] = {r["surface"] if r["path"] == "rrm" else r["path"]: r["missed"] for r in rows3}
+    print(f"SNR {off:+3d} dB: missed of {n_sol3} snapshots {sol3[off]}")
+print(
+    "per-element SNR at 0 dB offset [dB]:",
+    {
+        r["surface"] if r["path"] == "rrm" else r["path"]: v
+        for r, v in zip(rows3, snap.snr_db.round(1))
+    },
+)
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
@@ -669,7 +702,28 @@ for L, e in wrong_L.items():
 print("warnings:", sorted({type(w.message).__name__ for w in caught}))
 
 # %% [markdown]
-# <details><summary>What happened</summary>
+# <details><summary>What to read in the solutions</summary>
+#
+# 1. The 12 m truck in the vehicle's lane shadows the LoS, the ceiling bounce and the road
+#    bounce; only a road-marking reflection gets past it. The earliest arrival, "path 0" of
+#    Algorithm 1 and the reference of $\Delta d$, is then a reflection, which is why JAVELIN
+#    tracks VUEs rather than assuming a LoS.
+# 2. On the paper's route the LoS $d$ RMSE is decimetres with the ceiling bounce, an order of
+#    magnitude smaller without it, and a fraction of a millimetre with LoS + road only (printed).
+#    The ceiling path has the same delay and Doppler as the LoS within the noise, so the CPD must
+#    split their sum with the spatial factor alone, and a free spatial factor can rotate between
+#    them (Kruskal rank 1 in time, section 4); the free-factor CRLB grows accordingly.
+# 3. The CPD loses paths long before the noise hides them, and not the weakest first: already at
+#    the presets' SNR the LoS and the ceiling bounce are often merged (one of them missed), the
+#    bottom-right road marking goes from about 10 dB below on, while the road bounce, the
+#    weakest per element, is found throughout. What a free spatial factor cannot separate goes
+#    first. (Quick mode: two snapshots per level, so the counts are coarse.) Try the same with
+#    `refine="ml"` (slower): its `MLDetectionWarning` says when a path no longer stands above
+#    the noise.
+#
+# </details>
+#
+# <details><summary>What happened in exercise 4</summary>
 #
 # (a) From the truth the fit stays there and $\rho \approx 1$: the residual is the noise. The
 # paper's route merged the LoS and the ceiling bounce into one component and left a spare one
@@ -758,4 +812,11 @@ below = [r for r in snr_rows + rng_rows if r["integrated SNR [dB]"] <= eta_th - 
 assert above and below and 9.0 < eta_th < 13.0
 assert all(r["RMS/CRLB direction"] < 3.0 and r["beyond 6 sigma"] == 0.0 for r in above), above
 assert all(r["beyond 6 sigma"] >= 0.5 and r["flagged"] >= 0.5 for r in below), below
+# exercises 1-3: the solutions' readings
+assert "los" not in {p.kind for p in ps_t1} and first_t1.surface_kind == "rrm"
+assert abs(est_t1.d[0] - first_t1.length - C * snap_t1.clock_bias) < 0.1
+d_rmse = [sol2[n]["RMSE d [m]"] for n in ("all paths", "no ceiling", "LoS + road")]
+assert d_rmse[0] > 5 * d_rmse[1] > 5 * d_rmse[2], d_rmse
+assert sol3[0]["road"] == 0 and sol3[-30]["RRM bottom right"] > 0, sol3
+assert sum(sol3[-30].values()) >= sum(sol3[0].values()), sol3
 print("all checks passed")

@@ -205,7 +205,7 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 # of a degree and metres, and lifts the RMS of its kinds by orders of magnitude. The curvature
 # the ML route measures for a reflection is the distance to its **VUE** (the exact wavefront's
 # radius), not eq. 51's distance to the reflection point (the SR-NF model) — for the ceiling
-# bounce the two differ most (printed under the second table of this section). The paper's
+# bounce the two differ most (printed under this section's first table). The paper's
 # design as printed uses eq. 51; we run it both ways (`designs.paper()` and
 # `designs.paper_vue()`, which changes only that).
 #
@@ -433,8 +433,9 @@ print("90th percentile of the 2-D error [m]:", {n: round(v, 3) for n, v in p90.i
 #    `config.fc, config.tone_spacing, config.symbol_period`). Match the results to the true paths
 #    with `match_paths` (`tunnelkit.evaluation`). What does each extra source buy?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one
-# (or its blue bar) shows its code and output once you have tried. What to read in their output
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in their output
 # follows them.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]

@@ -279,13 +279,16 @@ javelin_table_figure(
 #    `r.manage.born` of each report) and the share of epochs that deliver an RRM path
 #    (`d.kinds[k][t]` of each matched path `t` in `d.truth_index[k]`).
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one
-# (or its blue bar) shows its code and output once you have tried.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1
+from IPython.display import display
+
 sl_cols, sl_rows = ex.ablation(slalom, ml=slalom_ml, progress=True)
-javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D RMSE [m]")
+display(javelin_table_figure(sl_cols, sl_rows, title="ablation on the slalom drives: 2-D RMSE [m]"))
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 2
@@ -334,9 +337,10 @@ for cond in ("N", "NoRRMs"):
 #    ones (the held-out seed), not read off one table.
 # 3. With the markings present the RRM paths exist over part of each drive only (section 4
 #    prints where, and how many at a time: on the straight drive from its start until the
-#    vehicle comes within a few metres of the plates' near end), so they appear and vanish, and every
-#    appearance is a birth; without them the road and ceiling bounces, measured at their bound,
-#    carry the UE alone. More paths are not better when the extra ones come and go.
+#    vehicle comes within a few metres of the plates' near end; quick mode's short drives end
+#    before that, so its output shows them in every epoch), so they appear and vanish, and
+#    every appearance is a birth; without them the road and ceiling bounces, measured at their
+#    bound, carry the UE alone. More paths are not better when the extra ones come and go.
 #
 # </details>
 

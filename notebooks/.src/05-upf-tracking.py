@@ -39,7 +39,7 @@ from tunnelkit.widgets import upf_explorer
 
 tk.setup_notebook()
 RUNS = tk.mc_count(100, 8)  # Monte-Carlo runs per experiment (paper: 100)
-PARTICLES = tk.mc_count(500, 300)  # UPF particles
+PARTICLES = tk.mc_count(500, 200)  # UPF particles (quick mode: fewer, see "How many particles?")
 print(f"{RUNS} runs, {PARTICLES} particles")
 
 # %% [markdown]
@@ -399,8 +399,9 @@ upf_explorer(n_particles=min(PARTICLES, 200))
 # 3. Drop every third epoch (`Z[:, ::3] = np.nan`) and rerun. How much does each filter lose? What
 #    does TSWLS do on a missed epoch?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: q ten times larger and smaller, straight and curved (UKF; EKF alike here)

@@ -169,7 +169,7 @@ J_num = crlb.numeric_jacobian(lambda s: dp.doppler_model(s, setup)[..., None], s
 jac_err = np.max(np.abs(J_closed - J_num) / np.maximum(np.abs(J_num), 1e-9))
 print(f"max relative |closed - finite difference| = {jac_err:.1e}")
 F, Q = dp.cv_model(cfg.dt, 0.5)
-print("Q (q = 0.5) =\n", Q.round(6))
+print("Q (q = 0.5) =\n", np.array2string(Q, formatter={"float_kind": lambda v: f"{v:9.3g}"}))
 
 # %% [markdown]
 # The three approaches sit in a registry (family `"halili2022"`), so the rest of the notebook loops
@@ -465,8 +465,9 @@ explorer
 # 4. **Lateral drift.** Why does the EKF DS lateral error grow far from the transmitter? Compute
 #    $\sqrt{\mathrm{PCRLB}_{yy}}$ with `sigma_hz=32.79` and `q=0.05` and compare.
 #
-# The solutions are the collapsed cells below: they run with the notebook, and clicking one (or
-# its blue bar) shows its code and output once you have tried. What to read in them follows.
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # Solution 1: the CFO of the preset's clock drift, and 5 Hz (mean error of EKF DS over seeds)

@@ -97,7 +97,7 @@ paths_table_figure(rows, title=f"Epoch {k}: image method vs Sionna RT").show()
 # %% [markdown]
 # The two engines agree to about $10^{-14}$ s in delay (a few µm), $10^{-3}$ deg in angle and
 # $10^{-2}$ Hz in Doppler: Sionna works in float32, whose resolution at 30 m is a few µm.
-# The scene with both engines' paths:
+# The scene with Sionna's paths (the image method's coincide with them to that precision):
 
 # %%
 tunnel3d_figure(
@@ -189,19 +189,74 @@ print(f"H: {H_img.shape}, {len(alike(p_img))} paths, max relative difference {re
 # 3. Would a finer ceiling (`n_facets` = 24, 48, 96 in `propagation.semicircular_tunnel`) let the
 #    preset's array fit under it?
 #
-# <details><summary>Hints and solutions</summary>
+# The solutions are the collapsed cells below: they run with the notebook, and once you have
+# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
+# what it printed. What to read in them follows.
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 1: the slalom epochs of section 4 in the tunnel without RRMs, both engines
+bare = tun.without_plates()
+sol1 = {}
+for kk in epochs:
+    u, v = trs.position[kk], trs.velocity[kk]
+    a = propagation.select_array(arrays_in, u)
+    pi = rt.compute_paths(bare, a, u, v, fc=fc)
+    ps = rt.compute_paths(
+        bare, a, u, v, fc=fc, engine="sionna", workdir=tk.build_dir("rt", "engine-bare")
+    )
+    found = {r["path"]: r["found"] for r in rt.compare_paths(pi, ps)}
+    sol1[int(kk)] = found
+    print(f"epoch {kk:3d}: " + ", ".join(f"{n} ({f})" for n, f in found.items()))
+sol1_image_only = [(kk, n) for kk, f in sol1.items() for n, w in f.items() if w != "both"]
+print("paths not found by both engines:", sol1_image_only)
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 2: fewer rays from the UE at epoch 9 (section 3); one Sionna engine per value
+sol2 = {}
+for n_rays in (300, 100, 30):
+    ps = rt.compute_paths(
+        tun,
+        arr,
+        ue,
+        vel,
+        fc=fc,
+        engine="sionna",
+        samples_per_src=n_rays,
+        workdir=tk.build_dir("rt", "engine-rays"),
+    )
+    lost = [r["path"] for r in rt.compare_paths(p_img, ps) if r["found"] == "image only"]
+    sol2[n_rays] = lost
+    print(f"{n_rays:4d} rays per source: {len(ps)} paths found, lost: {lost or 'none'}")
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# Solution 3: finer ceilings, the array at the paper's 4.8 m
+sol3 = {
+    n: int((~propagation.semicircular_tunnel(n_facets=n).contains(arrays[0].world + up)).sum())
+    for n in (12, 24, 48, 96)
+}
+top = arrays[0].world + up
+y_top = abs(top[np.argmax(top[:, 2]), 1])
+print("elements outside at 4.8 m, per number of facets:", sol3)
+print(
+    f"top element z = {top[:, 2].max():.4f} m at |y| = {y_top:.3f} m; "
+    f"the exact circle there: {np.sqrt(5.0**2 - y_top**2):.4f} m"
+)
+
+# %% [markdown]
+# <details><summary>What to read in the solutions</summary>
 #
-# 1. Yes: without plates nothing shadows facet 9 at slalom epochs 3 and 6, and both engines find
-#    LoS, facets 6, 8, 9 and the road. `rt.compute_paths` builds a new Sionna scene for the new
-#    tunnel object (it caches one scene at a time).
-# 2. With 300 rays all five paths are still found; with 100 rays both RRM paths are lost: the
-#    rays leave the UE on a Fibonacci lattice and a surface is found only if a ray hits it, so the
-#    narrow plates (0.3 m and 0.8 m wide) go first. It is not monotonic (with 30 rays one RRM path
-#    comes back by lattice luck), which is why the engine defaults to 1e5 rays per source.
-# 3. No. `[int((~propagation.semicircular_tunnel(n_facets=n).contains(a.world + up)).sum()) for n
-#    in (24, 48, 96)]` gives 8, 7, 5 elements outside at 4.8 m: even the exact circle is at
-#    $\sqrt{25 - 0.229^2} = 4.9948$ m above the top element's $y = 0.229$ m, lower than its
-#    4.998 m. The array itself must come down, which is why the preset hangs it 5 cm lower.
+# 1. Yes: without plates nothing shadows the facets behind them (the occluded paths listed in
+#    section 4), and both engines find every path at every epoch (LoS, the ceiling and wall
+#    facets, the road). `rt.compute_paths` builds a new Sionna scene for the new tunnel object
+#    (it caches one scene at a time).
+# 2. With 300 rays all paths are still found; with 100 rays both RRM paths are lost: the rays
+#    leave the UE on a Fibonacci lattice and a surface is found only if a ray hits it, so the
+#    narrow plates (0.3 m and 0.8 m wide) go first. It is not monotonic (with 30 rays one RRM
+#    path comes back by lattice luck), which is why the engine defaults to 1e5 rays per source.
+# 3. No. Finer ceilings leave fewer elements outside, but never none: even the exact circle
+#    is lower above the top element's $|y| = 0.229$ m ($\sqrt{25 - 0.229^2} = 4.9948$ m) than
+#    the element itself (4.998 m). The array itself must come down, which is why the preset
+#    hangs it 5 cm lower.
 #
 # </details>
 
@@ -220,4 +275,8 @@ assert worst["|d az| [deg]"] < 0.01 and worst["|d el| [deg]"] < 0.01
 assert not unexplained and not any(r["found"] == "sionna only" for r in rows_all)
 assert t_img < t_srt  # the image method is the fast default
 assert rel_h < 2e-3
+# exercises: the solutions' readings
+assert sol1 and not sol1_image_only, sol1_image_only
+assert sol2[300] == [] and {"RRM top left", "RRM bottom right"} <= set(sol2[100]), sol2
+assert all(sol3[a] > sol3[b] > 0 for a, b in zip((12, 24, 48), (24, 48, 96))), sol3
 print("all checks passed")

@@ -1,0 +1,114 @@
+"""Test 4: an exercise's solution shows nothing until the student asks for it.
+
+Every cell tagged ``solution`` runs with the notebook (so its output exists), but on the static
+site (tools/site.py) and in Voila (tools/present.py) its output must not be on screen when the
+page opens: it sits in a closed ``<details>``, and one click on its summary shows it. Solution
+cells are found from the notebook itself (their cell ids on the site, their position in Voila,
+which numbers its cells from 1), so a template that forgets to collapse them fails here.
+
+Artefacts in build/artifacts/: solutions-site-NN.png (each chapter with solutions, as it opens),
+solutions-site-NN-open.png (its first solution opened), solutions-voila-02.png and
+solutions-voila-02-open.png.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import nbformat
+import pytest
+from _lecture import BUILD, HOST, ROOT, free_port, list_notebooks, resolve_notebook, serving
+
+SOLUTION = "solution"
+
+
+def solution_cells(path) -> list[tuple[int, str]]:
+    """(position, cell id) of every solution cell of a notebook."""
+    nb = nbformat.read(path, as_version=4)
+    return [
+        (i, c.get("id", ""))
+        for i, c in enumerate(nb.cells)
+        if SOLUTION in c.get("metadata", {}).get("tags", [])
+    ]
+
+
+# For each selector: how many elements match, how many of the outputs inside them are on screen
+# (a box with a size and not inside a closed <details>), and whether each sits in a closed
+# <details class="tk-solution">.
+STATE = """sels => sels.map(sel => {
+  const cells = [...document.querySelectorAll(sel)];
+  const outs = cells.flatMap(c => [...c.querySelectorAll('.jp-OutputArea-output')]);
+  const shown = outs.filter(o => {
+    const r = o.getBoundingClientRect();
+    return r.width > 0 && r.height > 0 && o.checkVisibility();
+  });
+  return {sel, cells: cells.length, outputs: outs.length, shown: shown.length,
+          closed: cells.filter(c => { const d = c.closest('details.tk-solution');
+                                      return d && !d.open; }).length};
+})"""
+
+
+def _assert_hidden(states: list[dict], where: str) -> None:
+    for s in states:
+        assert s["cells"] == 1, f"{where}: {s['sel']} matches {s['cells']} cells"
+        assert s["closed"] == 1, f"{where}: {s['sel']} is not inside a closed <details>"
+        assert s["shown"] == 0, f"{where}: {s['sel']} shows {s['shown']} output(s) unasked"
+    assert sum(s["outputs"] for s in states) > 0, f"{where}: the solutions have no output at all"
+
+
+def _open_first(page, selector: str) -> int:
+    """Click the first solution's summary; the number of its outputs now on screen."""
+    page.locator(selector).locator("xpath=ancestor::details[1]/summary").click()
+    page.wait_for_timeout(300)
+    page.locator(selector).locator(".jp-OutputArea-output").first.scroll_into_view_if_needed()
+    return page.evaluate(STATE, [selector])[0]["shown"]
+
+
+def test_site_solutions_are_collapsed(site_url, watched, artifacts):
+    page = watched.page
+    books = [(b, solution_cells(b)) for b in list_notebooks()]
+    books = [(b, cells) for b, cells in books if cells]
+    assert len(books) >= 7, "fewer notebooks with solution cells than expected"
+    for book, cells in books:
+        page.goto(site_url + f"{book.stem}.html", wait_until="load")
+        page.wait_for_load_state("networkidle")
+        sels = [f'[id="cell-id={cid}"]' for _, cid in cells]
+        _assert_hidden(page.evaluate(STATE, sels), book.stem)
+        tag = book.stem.split("-", 1)[0]
+        page.locator(sels[0]).locator("xpath=ancestor::details[1]").scroll_into_view_if_needed()
+        page.screenshot(path=str(artifacts / f"solutions-site-{tag}.png"))
+        assert _open_first(page, sels[0]) > 0, f"{book.stem}: the opened solution shows nothing"
+        page.screenshot(path=str(artifacts / f"solutions-site-{tag}-open.png"))
+
+
+@pytest.fixture(scope="module")
+def voila_02():
+    nb = resolve_notebook("02")
+    port = free_port()
+    url = f"http://{HOST}:{port}/"
+    log = BUILD / "artifacts" / "voila-solutions-02.log"
+    log.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick", f"--port={port}"]
+    with serving(cmd, url + "api", log=log, timeout=120):
+        yield nb, url
+
+
+def test_voila_solutions_are_collapsed(voila_02, watched, artifacts):
+    nb, url = voila_02
+    cells = solution_cells(nb)
+    assert cells, f"{nb.name} has no solution cell"
+    page = watched.page
+    page.goto(url, timeout=300_000)
+    # Voila numbers its cells from 1 and shows the page once the last cell has run
+    sels = [f'[cell-index="{i + 1}"] .jp-CodeCell' for i, _ in cells]
+    page.wait_for_selector("#rendered_cells", state="visible", timeout=300_000)
+    page.wait_for_function(
+        "sels => sels.every(s => document.querySelector(s + ' .jp-OutputArea-output'))",
+        arg=sels,
+        timeout=300_000,
+    )
+    _assert_hidden(page.evaluate(STATE, sels), f"Voila {nb.stem}")
+    page.locator(sels[0]).locator("xpath=ancestor::details[1]").scroll_into_view_if_needed()
+    page.screenshot(path=str(artifacts / "solutions-voila-02.png"))
+    assert _open_first(page, sels[0]) > 0, "the opened solution shows nothing"
+    page.screenshot(path=str(artifacts / "solutions-voila-02-open.png"))
