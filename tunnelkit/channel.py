@@ -205,6 +205,7 @@ def draw_calibration(
     property of the hardware, not of a snapshot."""
     rng = rng_or_error("rng", rng)
     m = integer("m", m, minimum=1)
+    check_elements("m", 4 * m)
     sp = nonnegative("phase_sigma_deg", phase_sigma_deg)
     sg = nonnegative("gain_sigma_db", gain_sigma_db)
     phase = np.radians(sp) * rng.standard_normal(m)
