@@ -70,7 +70,6 @@ def test_toa_only_candidates_with_negative_ranges():
     _raises(ValueError, r"^d_hat", tk.positioning.toa_only_candidates, st, np.array([-5.0, 8.0]))
 
 
-@pytest.mark.xfail(strict=True, reason="open: accepted")
 def test_vsmodel_los_not_a_bool():
     import dataclasses
 
@@ -145,7 +144,6 @@ def test_spherical_steering_at_zero_carrier():
     _raises(ValueError, r"^fc", spherical_steering, np.array([[1.0, 2.0, 5.0]]), p, 0.0)
 
 
-@pytest.mark.xfail(strict=True, reason="open: accepted")
 def test_plots_refuse_series_of_different_lengths():
     _raises(
         ValueError,
@@ -167,7 +165,7 @@ def test_format_bytes_of_nan():
 
 @pytest.mark.parametrize(
     "gain_db",
-    [pytest.param(200.0, marks=pytest.mark.xfail(strict=True, reason="open: no upper bound")), INF],
+    [200.0, INF],
 )
 def test_calibration_gains_out_of_range(gain_db):
     _raises(
@@ -187,12 +185,10 @@ def test_draw_calibration_beyond_the_memory_budget():
     _raises(ValueError, r"^m", tk.channel.draw_calibration, np.random.default_rng(0), 10**12)
 
 
-@pytest.mark.xfail(strict=True, reason="open: the drive's sample count bypasses the memory budget")
 def test_drive_config_beyond_the_memory_budget():
     _raises(ValueError, r"duration|spacing", tk.drive.DriveConfig, duration=1e6, spacing=1e-3)
 
 
-@pytest.mark.xfail(strict=True, reason="open: the map grid bypasses the memory budget")
 def test_crlb_map_beyond_the_memory_budget(jiang):
     from tunnelkit.widgets.crlb import crlb_map
 
