@@ -307,7 +307,7 @@ MALFORMED = [
     (HAL, "tx_y = 4.5 ", "tx_y = 6.0 ", r"'transmitter\.tx_y' = 6 m lies outside"),
     (HAL, "rx_height = 2.0 ", "rx_height = 5.0 ", r"'vehicle\.rx_height' = 5 m lies outside"),
     (HAL, "outlier_prob = 0.02", "outlier_prob = 1.5", r"'errors\.outlier_prob' must be <= 1"),
-    (HAL, "spacing = 0.8 ", "spacing = 1e-9 ", r"'vehicle\.spacing' .* more than"),
+    (HAL, "spacing = 0.8 ", "spacing = 1e-9 ", r"'vehicle\.spacing':? .* more than"),
     (HAL, "[gnss]", "[gnss]\nsigma = 1.0", r"unknown key 'gnss\.sigma'"),
     (
         HAL,

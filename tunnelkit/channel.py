@@ -213,8 +213,13 @@ def draw_calibration(
     property of the hardware, not of a snapshot."""
     rng = rng_or_error("rng", rng)
     m = integer("m", m, minimum=1)
+    check_elements("m", 4 * m)
     sp = nonnegative("phase_sigma_deg", phase_sigma_deg)
     sg = nonnegative("gain_sigma_db", gain_sigma_db)
+    if sg > 40.0:
+        raise ValueError(
+            f"gain_sigma_db: a calibration gain spread of {sg:g} dB (> 40 dB) is not a calibration error"
+        )
     phase = np.radians(sp) * rng.standard_normal(m)
     gain_db = sg * rng.standard_normal(m)
     return 10.0 ** (gain_db / 20.0) * np.exp(1j * phase)

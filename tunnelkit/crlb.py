@@ -162,7 +162,10 @@ def numeric_jacobian(
             mask = np.asarray(angle_mask, dtype=bool)
             diff = np.where(mask, _wrap(diff), diff)
         cols.append(diff / (2.0 * step))
-    return np.stack(cols, axis=-1)
+    J = np.stack(cols, axis=-1)
+    if not np.isfinite(J).all():
+        raise ValueError("h: returned NaN or infinite values near p (no finite derivative)")
+    return J
 
 
 def numeric_fim(

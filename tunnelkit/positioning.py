@@ -162,6 +162,8 @@ def toa_only_candidates(stations, d_hat) -> np.ndarray:
     base = float(np.linalg.norm(p1 - p0))
     if base == 0:
         raise ValueError("stations: the first two stations coincide")
+    if d.min() < 0:
+        raise ValueError(f"d_hat: ranges must be >= 0, got {float(d.min())}")
     r0, r1 = d[..., 0], d[..., 1]
     a = (r0**2 - r1**2 + base**2) / (2 * base)
     h2 = r0**2 - a**2

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import positive
+from .._validate import finite_array, positive
 from ..constants import C, wavelength
 from ..fresnel import signed_mismatch
 from .geometry import RouteGeometry, trace_route
@@ -227,7 +227,15 @@ def route_geometry(setup: DesignSetup, spec, *, epochs=None) -> RouteGeometry:
     indices that subsample it), at its carrier and path kinds."""
     spec = parse_array(spec)
     traj = setup.trajectory
-    sl = slice(None) if epochs is None else np.asarray(epochs, int)
+    sl = slice(None)
+    if epochs is not None:
+        sl = finite_array("epochs", epochs, ndim=1)
+        n = len(traj.position)
+        if sl.size == 0 or np.any(sl != np.round(sl)) or sl.min() < 0 or sl.max() >= n:
+            raise ValueError(
+                f"epochs: expected indices in [0, {n - 1}] of the route, got {epochs!r}"
+            )
+        sl = sl.astype(int)
     return trace_route(
         setup.tunnel,
         setup.arrays(spec),

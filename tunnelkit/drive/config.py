@@ -130,6 +130,12 @@ class DriveConfig:
             raise ValueError(
                 f"pass_time: must be within the drive (<= {self.duration} s), got {self.pass_time}"
             )
+        n = self.speed * self.duration / self.spacing
+        if n > MAX_SAMPLES:
+            raise ValueError(
+                f"spacing: {self.spacing:g} m gives {n:.3g} samples over the {self.duration:g} s "
+                f"drive (speed x duration / spacing), more than {MAX_SAMPLES:g}"
+            )
 
     def replace(self, **changes) -> DriveConfig:
         """A copy with some fields changed (validated again)."""

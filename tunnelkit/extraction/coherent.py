@@ -40,7 +40,7 @@ import warnings
 
 import numpy as np
 
-from .._validate import integer, nonnegative, positive, probability
+from .._validate import finite_array, integer, nonnegative, positive, probability
 from ..arrays import check_element_positions
 from ..constants import C
 from .decomposition import check_tensor, cp_rel_error, normalize_factors
@@ -75,9 +75,9 @@ def source_points(theta) -> np.ndarray:
 
 def spherical_steering(sources, element_positions, fc: float) -> np.ndarray:
     """Steering matrix (M, n) of point sources: ``exp(j k0 (||q - p_m|| - ||q||))`` (eq. 1-2)."""
-    q = np.atleast_2d(np.asarray(sources, float))
-    p = np.asarray(element_positions, float)
-    k0 = 2 * np.pi * fc / C
+    q = np.atleast_2d(finite_array("sources", sources))
+    p = finite_array("element_positions", element_positions, ndim=2)
+    k0 = 2 * np.pi * positive("fc", fc) / C
     dist = np.linalg.norm(q[None, :, :] - p[:, None, :], axis=-1)
     return np.exp(1j * k0 * (dist - np.linalg.norm(q, axis=1)[None, :]))
 
@@ -202,6 +202,8 @@ def split_component(
     ill-conditioned pair of near-identical sources with large opposite gains is not a path).
     Returns ``(theta (n, 3), g (n,), relative residual)``.
     """
+    max_sources = integer("max_sources", max_sources, minimum=1)
+    fc = positive("fc", fc)
     b = np.asarray(b, complex)
     p = np.asarray(element_positions, float)
     th, g, rel = _fit_sources(b, theta0, p, fc)

@@ -20,7 +20,7 @@ import tensorly as tl
 from tensorly.cp_tensor import CPTensor
 from tensorly.decomposition import parafac
 
-from .._validate import integer, positive
+from .._validate import finite_array, integer, positive
 from .numerics import contract, grid_index
 
 __all__ = [
@@ -91,7 +91,9 @@ def max_identifiable_rank(shape) -> int:
     With generic factors ``kr(B_i) = min(I_i, L)``; eq. 11's condition ``sum kr >= 2 L + 2`` is
     then a condition on the dimensions alone (a rank-1 CPD is always unique).
     """
-    dims = [int(s) for s in shape]
+    if isinstance(shape, str | bytes) or not hasattr(shape, "__len__"):
+        raise TypeError(f"shape: expected a tensor shape (M, Nf, Nt), got {shape!r}")
+    dims = [integer("shape", s, minimum=1) for s in shape]
     best = 1
     for L in range(2, sum(dims) + 1):
         if sum(min(i, L) for i in dims) >= 2 * L + 2:
@@ -119,9 +121,23 @@ def kruskal_rank(B, tol: float = 1e-6) -> int:
     """
     from itertools import combinations
 
-    B = np.asarray(B)
+    B = finite_array("B", B, ndim=2, dtype=complex)
+    tol = positive("tol", tol)
     B = B / np.maximum(np.linalg.norm(B, axis=0, keepdims=True), 1e-300)
     L = B.shape[1]
+    if 0 < L <= B.shape[0]:
+        # polynomial shortcut: singular values of a column subset interlace the full set's, so a
+        # well-conditioned full set makes every subset independent (k-rank = L)
+        s = np.linalg.svd(B, compute_uv=False)
+        if s[-1] > tol * s[0]:
+            return L
+    from math import comb
+
+    if sum(comb(L, k) for k in range(1, min(L, B.shape[0]) + 1)) > 200_000:
+        raise ValueError(
+            f"B: {L} dependent columns: the exact Kruskal rank would test over 200,000 column "
+            "subsets (drop dependent columns or pass fewer)"
+        )
     kr = 0
     for k in range(1, min(L, B.shape[0]) + 1):
         for cols in combinations(range(L), k):

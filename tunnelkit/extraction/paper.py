@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validate import finite_array
 from ..constants import C
 from .decomposition import check_rank, check_tensor, cpd, normalize_factors
 from .estimates import PathEstimates, path_estimates
@@ -47,7 +48,11 @@ __all__ = [
 
 def vandermonde_roots(B) -> np.ndarray:
     """Eq. 13: ``mu = angle(diag(B_-^H B_+))`` for a (normalised) Vandermonde factor ``B`` (N, L)."""
-    B = np.asarray(B)
+    B = finite_array("B", B, ndim=2, dtype=complex)
+    if B.shape[0] < 2 or B.shape[1] < 1:
+        raise ValueError(f"B: expected (N >= 2, L >= 1) factor rows, got shape {B.shape}")
+    if np.any(np.abs(B).max(axis=0) == 0):
+        raise ValueError("B: a column is all zero (no path to take roots of)")
     return np.angle(np.sum(B[:-1].conj() * B[1:], axis=0))
 
 

@@ -79,6 +79,10 @@ def line_figure(
     log_y: bool = False,
 ) -> go.Figure:
     """One line per entry of ``series`` against ``x``."""
+    n = len(np.atleast_1d(np.asarray(x)))
+    for name, y in series.items():
+        if len(np.atleast_1d(np.asarray(y))) != n:
+            raise ValueError(f"series: {name!r} has {len(np.atleast_1d(y))} values, x has {n}")
     fig = go.Figure()
     for name, y in series.items():
         fig.add_scatter(

@@ -7,6 +7,8 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import crlb
+from .._validate import integer
+from ..budget import check_elements
 from ..scenarios import load_scenario
 from .base import Explorer, float_slider
 
@@ -27,6 +29,9 @@ def crlb_map(
 
     Returns ``(along, across, rmse)`` with ``rmse`` of shape (n_across, n_along).
     """
+    n_along = integer("n_along", n_along, minimum=2)
+    n_across = integer("n_across", n_across, minimum=2)
+    check_elements("n_along, n_across", 64 * n_along * n_across, what="the CRLB map")
     a = np.linspace(along[0], along[1], n_along)
     c = np.linspace(0.1, tunnel.width - 0.1, n_across)
     grid = tunnel.from_tunnel_frame(np.stack(np.meshgrid(a, c), -1))

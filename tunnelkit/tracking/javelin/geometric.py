@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import finite_array, nonnegative, rng_or_error, vector
+from ..._validate import finite_array, integer, nonnegative, positive, rng_or_error, vector
+from ...budget import check_elements
 from ...geometry import Plane, reflector_point
 from .measurement import PathMeasurements
 
@@ -142,7 +143,10 @@ def toy_drive(
     """True positions and velocities (n, 3) of a test drive shuttling smoothly between ``start``
     and ``stop`` along x (peak speed ``speed``, a cosine in time so it turns round without a jump)
     with a lateral sine of ``amplitude`` around ``lane`` (``amplitude = 0``: straight lane)."""
-    t = np.arange(int(n)) * float(dt)
+    n = integer("n", n, minimum=1)
+    dt = positive("dt", dt)
+    check_elements("n", 6 * n)
+    t = np.arange(n) * dt
     mid, half = 0.5 * (start + stop), 0.5 * abs(stop - start)
     wx = speed / half
     x = mid - half * np.cos(wx * t)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import positioning
-from ..._validate import finite_array, integer, positive, rng_or_error
+from ..._validate import boolean, finite_array, integer, positive, rng_or_error
 from ...crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from ...scenarios import load_scenario
 from ..cv import STATE_DIM, cv_process_noise, cv_transition
@@ -97,6 +97,7 @@ class VsModel:
             raise ValueError(f"stations: expected shape (N, 2) with N >= 1, got {st.shape}")
         set_ = object.__setattr__
         set_(self, "stations", st)
+        set_(self, "los", boolean("los", self.los))
         set_(self, "sigma_theta", positive("sigma_theta", self.sigma_theta))
         set_(self, "sigma_d", positive("sigma_d", self.sigma_d))
         set_(self, "period", positive("period", self.period))

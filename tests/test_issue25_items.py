@@ -1,0 +1,269 @@
+"""Each bad input named in issue 25's "Why", exactly as reported: refused with the parameter
+named (or a documented, physically right result: an infinite bound, a capped count)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tunnelkit as tk
+
+NAN, INF = float("nan"), float("inf")
+
+
+def _raises(exc, match, fn, *a, **kw):
+    with pytest.raises(exc, match=match):
+        fn(*a, **kw)
+
+
+# --- physically impossible results --------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def epoch():
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    array, paths = route.paths(10)
+    snap = tk.channel.synthesize(paths, route.config, np.random.default_rng(0))
+    return snap.H, len(paths), array, route.config
+
+
+def test_extract_paths_with_fc_in_ghz():
+    _raises(ValueError, r"^fc: .*did you mean 28e9", tk.channel.SRSConfig, fc=28.0)
+
+
+def test_symbol_period_far_below_physical():
+    # the symbol period is 1/scs: a 1e-300 s period is a subcarrier spacing of 1e300 Hz
+    _raises(ValueError, r"^(scs|n_rb)", tk.channel.SRSConfig, scs=1e300)
+
+
+@pytest.mark.parametrize("bw_fc", [(200e6, 100e6), (100e6, 50e6)])
+def test_a_band_reaching_zero_hz_in_designsetup(bw_fc):
+    bw, fc = bw_fc
+    setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
+    with pytest.raises(ValueError, match=r"bandwidth|fc"):
+        setup.variant(fc=fc, bandwidth=bw)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open: the scenario path refuses the band, but the message does not name bandwidth/fc",
+)
+def test_a_band_reaching_zero_hz_in_a_scenario_file():
+    sc = tk.load_scenario("italiano2026-straight")
+    with pytest.raises((ValueError, tk.scenarios.ScenarioError), match=r"bandwidth|fc"):
+        bad = tk.scenarios.with_values(sc, {"radio.fc": 100e6, "radio.bandwidth": 400e6})
+        tk.channel.SRSConfig.from_scenario(bad)
+
+
+# --- silent acceptance at the lower layers ------------------------------------------------------
+
+
+@pytest.mark.xfail(strict=True, reason="open: accepted")
+def test_virtual_stations_with_the_base_station_outside(jiang):
+    tunnel = jiang["tunnel"]
+    outside = tunnel.from_tunnel_frame(np.array([10.0, tunnel.width + 5.0]))
+    _raises(ValueError, r"^base_station", tunnel.virtual_stations, outside)
+
+
+def test_toa_only_candidates_with_negative_ranges():
+    st = np.array([[0.0, 0.0], [0.0, 10.0]])
+    _raises(ValueError, r"^d_hat", tk.positioning.toa_only_candidates, st, np.array([-5.0, 8.0]))
+
+
+def test_vsmodel_los_not_a_bool():
+    import dataclasses
+
+    from tunnelkit.tracking.virtual_station import model_from_scenario
+
+    model = model_from_scenario("jiang2023-straight")
+    with pytest.raises(TypeError, match=r"^los"):
+        dataclasses.replace(model, los="no")
+
+
+def test_toy_drive_negative_count():
+    from tunnelkit.tracking.javelin.geometric import toy_drive
+
+    _raises(ValueError, r"^n", toy_drive, -5, 0.1)
+
+
+def test_numeric_jacobian_of_a_nan_function():
+    _raises(ValueError, r"^h", tk.crlb.numeric_jacobian, lambda x: x * NAN, np.array([1.0, 2.0]))
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: tk.extraction.crlb_paths(
+            np.array([[0.1, 0.1, 0.2]]),
+            np.array([1.0]),
+            np.zeros((4, 3)) + np.arange(4)[:, None] * [0.025, 0, 0],
+            mu_f=np.array([0.1]),
+            mu_t=np.array([0.0]),
+            fc=5.9e9,
+            n_tones=0,
+            n_symbols=2,
+            noise_power=1.0,
+        ),
+    ],
+)
+@pytest.mark.xfail(strict=True, reason="open: a numpy broadcast error naming no parameter")
+def test_crlb_with_no_tones(call):
+    with pytest.raises((ValueError, TypeError), match=r"n_tones|element_positions|sources"):
+        call()
+
+
+def test_vandermonde_roots_of_an_empty_or_zero_factor():
+    from tunnelkit.extraction import vandermonde_roots
+
+    _raises(ValueError, r"^B", vandermonde_roots, np.zeros((0, 2), complex))
+    _raises(ValueError, r"^B", vandermonde_roots, np.zeros((4, 2), complex))
+
+
+@pytest.mark.parametrize("shape", [(-4, 3, 2), ((4, 3), (2, 2))])
+def test_rank_checks_on_negative_or_2d_shapes(shape):
+    from tunnelkit.extraction import check_rank, max_identifiable_rank
+
+    _raises((ValueError, TypeError), r"^shape", max_identifiable_rank, shape)
+    _raises((ValueError, TypeError), r"^shape", check_rank, shape, 2)
+
+
+def test_split_component_with_no_sources():
+    from tunnelkit.extraction.coherent import split_component
+
+    p = np.arange(4)[:, None] * np.array([0.025, 0.0, 0.0])
+    b = np.ones(4, complex)
+    _raises(
+        ValueError, r"^max_sources", split_component, b, (0.1, 0.1, 0.1), p, 5.9e9, max_sources=0
+    )
+
+
+def test_spherical_steering_at_zero_carrier():
+    from tunnelkit.extraction.coherent import spherical_steering
+
+    p = np.arange(4)[:, None] * np.array([0.025, 0.0, 0.0])
+    _raises(ValueError, r"^fc", spherical_steering, np.array([[1.0, 2.0, 5.0]]), p, 0.0)
+
+
+def test_plots_refuse_series_of_different_lengths():
+    _raises(
+        ValueError,
+        r"series|x",
+        tk.plots.line_figure,
+        np.arange(5.0),
+        {"a": np.arange(4.0)},
+    )
+
+
+def test_smallest_meeting_with_a_nan_target():
+    setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
+    _raises(ValueError, r"^target", tk.design.smallest_meeting, setup, ["4x4"], target=NAN)
+
+
+def test_format_bytes_of_nan():
+    _raises(ValueError, r"^n", tk.budget.format_bytes, NAN)
+
+
+@pytest.mark.parametrize(
+    "gain_db",
+    [200.0, INF],
+)
+def test_calibration_gains_out_of_range(gain_db):
+    _raises(
+        ValueError,
+        r"^gain_sigma_db",
+        tk.channel.draw_calibration,
+        np.random.default_rng(0),
+        4,
+        gain_sigma_db=gain_db,
+    )
+
+
+# --- crashes, hangs, memory ---------------------------------------------------------------------
+
+
+def test_draw_calibration_beyond_the_memory_budget():
+    _raises(ValueError, r"^m", tk.channel.draw_calibration, np.random.default_rng(0), 10**12)
+
+
+def test_drive_config_beyond_the_memory_budget():
+    _raises(ValueError, r"duration|spacing", tk.drive.DriveConfig, duration=1e6, spacing=1e-3)
+
+
+def test_crlb_map_beyond_the_memory_budget(jiang):
+    from tunnelkit.widgets.crlb import crlb_map
+
+    _raises(
+        ValueError,
+        r"n_along|n_across",
+        crlb_map,
+        jiang["tunnel"],
+        jiang["vs"],
+        0.01,
+        0.5,
+        n_along=10**5,
+        n_across=10**4,
+    )
+
+
+def test_ml_paths_iteration_cap(epoch):
+    H, L, array, srs = epoch
+    _raises(ValueError, r"^max_iter", tk.extraction.ml.ml_paths, H, L, array, srs, max_iter=10**7)
+
+
+@pytest.mark.xfail(strict=True, reason="open: polish not capped")
+def test_polish_sweeps_cap(epoch):
+    H, L, array, srs = epoch
+    _raises(ValueError, r"^polish", tk.extraction.extract_paths, H, L, array, srs, polish=10**7)
+
+
+def test_kruskal_rank_of_40_columns_is_bounded():
+    from tunnelkit.extraction import kruskal_rank
+
+    B = np.random.default_rng(0).standard_normal((50, 40))
+    assert kruskal_rank(B) == 40  # generic columns: full k-rank, found without 2^40 subsets
+
+
+@pytest.mark.xfail(strict=True, reason="open: the error does not name n_epochs")
+def test_javelin_rmse_with_no_epochs():
+    setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
+    _raises(ValueError, r"^n_epochs", tk.design.javelin_rmse, setup, "4x4", 1, 0, n_epochs=0)
+
+
+def test_route_bounds_with_an_epoch_past_the_route():
+    setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
+    _raises(ValueError, r"^epochs", tk.design.route_bounds, setup, "4x4", epochs=[10**6])
+
+
+def test_memory_budget_beyond_float_range():
+    _raises(ValueError, r"^nbytes", tk.budget.set_memory_budget, 10**400)
+
+
+@pytest.mark.xfail(strict=True, reason="open: RecursionError")
+def test_deep_dict_is_a_clear_error():
+    d: dict = {}
+    cur = d
+    for _ in range(5000):
+        cur["a"] = {}
+        cur = cur["a"]
+    with pytest.raises((ValueError, tk.scenarios.ScenarioError), match=r"deep|depth|nest"):
+        tk.scenarios.scenario_from_dict(d)
+
+
+@pytest.mark.xfail(strict=True, reason="open: RecursionError in tomllib")
+def test_deep_toml_is_a_clear_error(tmp_path):
+    text = "a = " + "[" * 3000 + "]" * 3000 + "\n"
+    f = tmp_path / "deep.toml"
+    f.write_text(text)
+    with pytest.raises((ValueError, tk.scenarios.ScenarioError), match=r"deep|depth|nest"):
+        tk.load_scenario(f)
+
+
+@pytest.mark.skip(reason="open: a 40 MB TOML array parses for minutes, no size limit yet")
+def test_huge_toml_is_a_clear_error(tmp_path):
+    f = tmp_path / "big.toml"
+    f.write_text("a = [" + "1," * (20 * 1024 * 1024) + "]\n")
+    with pytest.raises((ValueError, tk.scenarios.ScenarioError), match=r"size|large|bytes|MiB"):
+        tk.load_scenario(f)
+
+
+# workers=1000 capped to the machine: tests/test_montecarlo_dask.py (available_cores patched)
