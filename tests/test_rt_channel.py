@@ -285,3 +285,21 @@ def test_cache_reuses_and_rebuilds(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         rc3.epoch(20)
+
+
+def test_design_channel_plumbing(capsys):
+    from tunnelkit import design
+    from tunnelkit.cli import main
+
+    setup = design.DesignSetup.from_scenario("italiano2026-straight", channel="sionna")
+    route = setup.signal_route("4x4")
+    assert route.channel == "sionna" and route.raytraced.label.endswith("design-4x4")
+    assert route.raytraced.arrays[0].M == 16
+    assert (
+        design.DesignSetup.from_scenario("italiano2026-straight").signal_route("4x4").raytraced
+        is None
+    )
+    with pytest.raises(ValueError, match="channel"):
+        design.DesignSetup.from_scenario("italiano2026-straight", channel="rt")
+    assert main(["design", "italiano2026-straight", "--arrays", "4x4", "--channel", "sionna"]) == 2
+    assert "--mode channel" in capsys.readouterr().err
