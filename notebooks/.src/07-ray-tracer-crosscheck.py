@@ -247,8 +247,8 @@ from tunnelkit import studies
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.tracking.javelin import designs
 
-n_ep = tk.mc_count(len(traj), 4)
-settings = rt.RTSettings(samples_per_src=tk.mc_count(20_000, 5_000))
+n_ep = tk.mc_count(len(traj), 3)
+settings = rt.RTSettings(samples_per_src=tk.mc_count(20_000, 2_000))
 route_img = SignalRoute.from_scenario(sc)
 route_rt = SignalRoute.from_scenario(
     sc, channel="sionna", rt_settings=settings, cache_dir=tk.build_dir("rt", "cache")

@@ -27,6 +27,14 @@ at the reference antenna but not at some other antenna (the specular point slide
 a plate across the array) keeps the spherical-wavefront length from its VUE for those antennas;
 :attr:`SionnaEngine.last_gaps` counts them and :attr:`SionnaEngine.last_traced` maps each
 path ``(kind, surface)`` to the (M,) mask of antennas at which Sionna traced it.
+
+Every path, per element (the ray-traced channel): :meth:`SionnaEngine.apply_settings` gives the
+shapes the materials, scattering coefficients and lobe of a
+:class:`~tunnelkit.rt.settings.RTSettings` and the element receivers their pattern (oriented
+along the array's boresight); :meth:`SionnaEngine.trace_elements` then returns everything Sionna
+traces up to ``max_depth`` (LoS, specular of any order, diffuse) as an
+:class:`~tunnelkit.rt.elements.ElementPaths`, which :mod:`tunnelkit.rt.cache` turns into eq. 1's
+tensor.
 """
 
 from __future__ import annotations
