@@ -244,8 +244,7 @@ def javelin_table(
             "extraction_failures": faults,
             "flagged_epochs": flagged,
             "epochs": epochs,
-            "channel": channel,
-            **rt_info,
+            **({"channel": channel, **rt_info} if channel != "image" else {}),
         },
         notes=[
             *NOTES,
