@@ -185,14 +185,17 @@ class SionnaEngine:
         for obj in self.scene.objects.values():
             _, kind = self._surface_by_id.get(int(obj.object_id), ("", "surface"))
             name, itu, thickness, s = settings.material_for(kind)
-            if name not in made:
+            tag = f"tk-{name}-{settings.fingerprint()[:12]}"  # one per material and settings
+            if made.get(name) is None:
+                made[name] = self.scene.get(tag)
+            if made[name] is None:
                 extra = (
                     {"alpha_r": settings.alpha_r}
                     if settings.scattering_pattern == "directive"
                     else {}
                 )
                 made[name] = srt.ITURadioMaterial(
-                    f"tk-{name}",
+                    tag,
                     itu,
                     thickness=thickness,
                     scattering_coefficient=s,
