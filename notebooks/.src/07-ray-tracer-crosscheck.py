@@ -283,15 +283,16 @@ print(
 # %% [markdown]
 # ### The same epochs, both channels: what each path's estimate does
 #
-# Same random draws (noise, clock bias) on both channels; the route's own extraction with $L$ the
-# image method's number of paths. Errors of the delay distance $d$ of each true first-order path
+# Same random draws (noise, clock bias) on both channels; the route's own extraction (the ML fit;
+# quick mode: the paper's CPD route, faster) with $L$ the image method's number of paths. Errors of the delay distance $d$ of each true first-order path
 # (clock bias removed), in cm.
 
 # %%
+extract_kw = {"refine": "joint"} if tk.QUICK else {}
 rows_d = []
 for k in range(n_ep):
     for label, route in (("image", route_img), ("sionna", route_rt)):
-        ep = route.epoch(k, np.random.default_rng(700 + k))
+        ep = route.epoch(k, np.random.default_rng(700 + k), **extract_kw)
         d_true = np.array([p.length for p in ep.paths]) + 299792458.0 * ep.snapshot.clock_bias
         for j, t in enumerate(ep.truth_index):
             if t >= 0:
@@ -307,7 +308,8 @@ for label in ("image", "sionna"):
 # %% [markdown]
 # ### The track
 #
-# One drive per channel (condition L, the ML route, our design), same seed.
+# One drive per channel (condition L, the ML route and our design for it; quick mode: the paper's
+# route and design), same seed.
 
 # %%
 drives = {
@@ -315,13 +317,14 @@ drives = {
         "italiano2026-straight",
         np.random.default_rng(7),
         condition="L",
-        extraction="ml",
+        extraction="paper" if tk.QUICK else "ml",
         n_epochs=n_ep,
         channel=ch,
     )
     for ch in ("image", "sionna")
 }
-evals = {ch: studies.evaluate(d, designs.ours_ml()) for ch, d in drives.items()}
+design = designs.paper() if tk.QUICK else designs.ours_ml()
+evals = {ch: studies.evaluate(d, design) for ch, d in drives.items()}
 fig = go.Figure(
     [go.Scatter(x=traj.position[:n_ep, 0], y=traj.position[:n_ep, 1], name="truth", mode="lines")]
     + [
