@@ -77,6 +77,7 @@ __all__ = [
     "draw_calibration",
     "sample_clock_bias",
     "synthesize",
+    "tensor_snapshot",
 ]
 
 _MODELS = ("exact", "srnf")
@@ -497,3 +498,38 @@ def synthesize(
     return ChannelSnapshot(
         add_noise(H, n0, rng), n0, float(clock_bias), model, tuple(paths), config
     )
+
+
+def tensor_snapshot(
+    H0,
+    config: SRSConfig,
+    rng: np.random.Generator,
+    *,
+    paths=(),
+    clock_bias: float | None = None,
+    snr_offset_db: float = 0.0,
+    calibration=None,
+) -> ChannelSnapshot:
+    """A noisy snapshot from a noiseless tensor ``H0`` (M, Nf, Nt) given for a unit transmit
+    power and no clock bias (a ray-traced channel, :mod:`tunnelkit.rt.cache`): scaled by
+    ``sqrt(P_t)``, the clock bias (drawn from ``rng`` if None, as in :func:`synthesize`) applied
+    as ``exp(-j 2 pi s Df b)`` on tone ``s`` (eq. 1's ``tau_l = d_l / c + b`` for every path),
+    ``calibration`` (M,) per element, then CN(0, N0) noise (``snr_offset_db`` as in
+    :func:`synthesize`). ``paths``: the true paths recorded in the snapshot (model "exact")."""
+    if not isinstance(config, SRSConfig):
+        raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
+    H0 = np.asarray(H0)
+    if H0.ndim != 3 or not np.all(np.isfinite(H0)):
+        raise ValueError(f"H0: expected a finite 3-D tensor, got shape {H0.shape}")
+    rng = rng_or_error("rng", rng)
+    off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
+    cal = _check_calibration(calibration, H0.shape[0])
+    if clock_bias is None:
+        clock_bias = sample_clock_bias(rng, config.clock_bias_sigma, config.clock_bias_limit)
+    bias = float(finite_array("clock_bias", clock_bias, ndim=0))
+    ramp = np.exp(-2j * np.pi * config.tone_spacing * np.arange(H0.shape[1]) * bias)
+    H = np.sqrt(config.tx_power) * H0 * ramp[None, :, None]
+    if cal is not None:
+        H = cal[:, None, None] * H
+    n0 = config.noise_power / float(db2lin(off))
+    return ChannelSnapshot(add_noise(H, n0, rng), n0, bias, "exact", tuple(paths), config)

@@ -485,6 +485,68 @@ def _radio(user: bool) -> Table:
     )
 
 
+#: the ray-traced channel's settings (``tunnelkit.rt.settings.RTSettings``; the same defaults,
+#: material names and ranges, checked by tests/test_rt_channel.py)
+_RT_MATERIALS = (
+    "concrete",
+    "asphalt",
+    "metal",
+    "brick",
+    "marble",
+    "glass",
+    "medium_dry_ground",
+    "wet_ground",
+)
+_RAYTRACING = Table(
+    (
+        _f(
+            "scattering_coefficient",
+            "diffuse scattering coefficient S of the shell and the road (0: specular only)",
+            ge=0.0,
+            le=1.0,
+            default=0.3,
+        ),
+        _f(
+            "metal_scattering_coefficient",
+            "scattering coefficient of the metal plates and blockers",
+            ge=0.0,
+            le=1.0,
+            default=0.0,
+        ),
+        _s(
+            "scattering_pattern",
+            "lobe of the scattered power",
+            choices=("lambertian", "directive"),
+            default="lambertian",
+        ),
+        _i(
+            "alpha_r",
+            "width parameter of the directive lobe (larger: narrower)",
+            ge=1,
+            le=100,
+            default=4,
+        ),
+        _i("max_depth", "bounces traced (2: second-order specular on)", ge=1, le=5, default=2),
+        _i("samples_per_src", "rays shot from the vehicle", ge=100, le=10_000_000, default=20_000),
+        _s(
+            "wall_material",
+            "material of the shell (walls and ceiling)",
+            choices=_RT_MATERIALS,
+            default="concrete",
+        ),
+        _s(
+            "road_material",
+            "material of the road ('asphalt': ITU very_dry_ground, there is no ITU asphalt)",
+            choices=_RT_MATERIALS,
+            default="asphalt",
+        ),
+        _s("rrm_material", "material of the road markings", choices=_RT_MATERIALS, default="metal"),
+        _s("antenna_pattern", "element pattern", choices=("iso", "tr38901"), default="iso"),
+    ),
+    "the ray-traced channel (Sionna RT, `--channel sionna`): materials, diffuse scattering, depth",
+)
+
+
 _LANE_KEYS = (
     _f("x_start", "where the vehicle starts along the tunnel", "m"),
     _f("x_end", "where it stops (!= x_start)", "m"),
@@ -529,6 +591,7 @@ ITALIANO = Table(
             ),
         ),
         _t("radio", _radio(False)),
+        _t("raytracing", _RAYTRACING, optional=True),
         _t(
             "trajectory",
             Table(
@@ -829,6 +892,7 @@ USER = Table(
             ),
         ),
         _t("radio", _radio(True)),
+        _t("raytracing", _RAYTRACING, optional=True),
         _t(
             "trajectory",
             Table(

@@ -24,19 +24,25 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ._validate import integer, rng_or_error
+from ._validate import choice, integer, rng_or_error
 from .arrays import ArrayGeometry
-from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
+from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from .constants import C
 from .evaluation import match_paths
 
 __all__ = [
+    "CHANNELS",
     "Epoch",
     "RouteMeasurements",
     "SignalRoute",
     "measurements_from_estimates",
     "simulate_epoch",
 ]
+
+
+#: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
+#: ``"sionna"`` (the tensor of every path Sionna RT traces per element, :mod:`tunnelkit.rt.cache`)
+CHANNELS = ("image", "sionna")
 
 
 @dataclass(frozen=True)
@@ -182,6 +188,16 @@ class SignalRoute:
     ``impairments`` (off by default) adds what eq. 1 leaves out (:class:`tunnelkit.channel.Impairments`);
     build an impaired route with :meth:`with_impairments`, which draws each array's calibration
     error once (``calibration``: array name -> (M,) complex gains).
+    ``channel`` (:data:`CHANNELS`): ``"image"`` (default) synthesises eq. 1 from the image
+    method's paths; ``"sionna"`` takes each epoch's noiseless tensor from ``raytraced`` (a
+    :class:`tunnelkit.rt.cache.RayTracedChannel`: every path Sionna RT returns per element,
+    specular of any order and diffuse, traced once and cached) and draws the clock bias and
+    the noise on it per run. The true paths (``Epoch.paths``, the number of paths to extract,
+    the matching) stay the image method's first-order specular paths; the LoS filter of
+    ``kinds`` and the epoch's ``tunnel`` (road markings removed) apply to the ray tracer too,
+    the other ``kinds`` filters do not. With ``"sionna"`` the spatial-wideband term is in the
+    tensor by construction and ``impairments.dmc`` is refused (the ray tracer has its own
+    diffuse power).
     """
 
     tunnel: object
@@ -195,6 +211,24 @@ class SignalRoute:
     calibration: dict = field(default_factory=dict)
     report_covariance: bool = False
     bias_aware_delay_check: bool = False
+    channel: str = "image"
+    raytraced: object = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        choice("channel", self.channel, CHANNELS)
+        if self.channel == "sionna":
+            from .rt.cache import RayTracedChannel
+
+            if not isinstance(self.raytraced, RayTracedChannel):
+                raise TypeError(
+                    "raytraced: channel='sionna' needs an rt.cache.RayTracedChannel, got "
+                    f"{type(self.raytraced).__name__}"
+                )
+            if self.impairments.dmc is not None:
+                raise ValueError(
+                    "impairments: dmc (synthetic diffuse multipath) cannot be added to the "
+                    "ray-traced channel, which has its own diffuse power"
+                )
 
     @property
     def min_d(self) -> float:
@@ -215,8 +249,13 @@ class SignalRoute:
         return replace(self, impairments=impairments, calibration=cal)
 
     @classmethod
-    def from_scenario(cls, scenario, **kw) -> SignalRoute:
-        """Build from a scenario name or a loaded :class:`tunnelkit.scenarios.Scenario`."""
+    def from_scenario(
+        cls, scenario, *, channel: str = "image", rt_settings=None, cache_dir=None, **kw
+    ) -> SignalRoute:
+        """Build from a scenario name or a loaded :class:`tunnelkit.scenarios.Scenario`;
+        ``channel="sionna"`` attaches the scenario's ray-traced channel (settings from its
+        ``[raytracing]`` section unless ``rt_settings`` is given, cache under ``cache_dir``,
+        :mod:`tunnelkit.rt.cache`)."""
         from . import propagation
         from .scenarios import Scenario, load_scenario
 
@@ -225,14 +264,19 @@ class SignalRoute:
             raise TypeError(
                 f"scenario: expected a name or a Scenario, got {type(scenario).__name__}"
             )
+        choice("channel", channel, CHANNELS)
         tun = sc.tunnel()
-        return cls(
-            tun,
-            propagation.scenario_arrays(sc),
-            sc.trajectory(tun),
-            SRSConfig.from_scenario(sc),
-            **kw,
-        )
+        arrays = propagation.scenario_arrays(sc)
+        traj = sc.trajectory(tun)
+        config = SRSConfig.from_scenario(sc)
+        if channel == "sionna":
+            from .rt import RayTracedChannel, RTSettings
+
+            settings = RTSettings.from_scenario(sc) if rt_settings is None else rt_settings
+            kw["raytraced"] = RayTracedChannel(
+                tun, arrays, traj, config, settings, label=sc.name, cache_dir=cache_dir
+            )
+        return cls(tun, arrays, traj, config, channel=channel, **kw)
 
     def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
         """The array facing the vehicle and the true paths at epoch ``k``."""
@@ -261,6 +305,30 @@ class SignalRoute:
             **kw,
         )
 
+    def raytraced_snapshot(
+        self, k: int, arr: ArrayGeometry, paths, rng: np.random.Generator, tunnel=None, **kw
+    ) -> ChannelSnapshot:
+        """The SRS snapshot of epoch ``k`` on the ray-traced channel (``channel="sionna"``): the
+        cached noiseless tensor (LoS left out unless "los" is in ``kinds``), clock bias, this
+        route's calibration and SNR offset, noise (:func:`tunnelkit.channel.tensor_snapshot`);
+        ``paths`` (the true paths) are recorded in the snapshot."""
+        if self.raytraced is None:
+            raise ValueError("channel: this route has no ray-traced channel (channel='image')")
+        name, H0 = self.raytraced.tensor(
+            k, tunnel=self.tunnel if tunnel is None else tunnel, los="los" in self.kinds
+        )
+        if name != arr.name:
+            raise RuntimeError(f"ray-traced epoch {k} is for array {name!r}, not {arr.name!r}")
+        return tensor_snapshot(
+            H0,
+            self.config,
+            rng,
+            paths=paths,
+            snr_offset_db=self.snr_offset_db,
+            calibration=self.calibration.get(arr.name),
+            **kw,
+        )
+
     def extract(self, H, arr: ArrayGeometry, n_paths: int, **extract_kw):
         """:func:`tunnelkit.extraction.extract_paths` of ``H`` at ``arr`` with this route's
         radio (``refine``, ... in ``extract_kw``)."""
@@ -281,7 +349,10 @@ class SignalRoute:
         """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1."""
         rng = rng_or_error("rng", rng)
         arr, paths = self.paths(k, tunnel)
-        snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
+        if self.channel == "sionna":
+            snap = self.raytraced_snapshot(k, arr, paths, rng, tunnel, clock_bias=clock_bias)
+        else:
+            snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
         est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None

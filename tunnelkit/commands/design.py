@@ -169,6 +169,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "synthesised and extracted (channel)",
     )
     p.add_argument(
+        "--channel",
+        choices=["image", "sionna"],
+        default="image",
+        help="channel source of --mode channel: eq. 1 from the image method (default) or the "
+        "ray-traced channel (Sionna RT, traced once per array and cached)",
+    )
+    p.add_argument(
         "--n-epochs", type=_count("n_epochs", 1), default=None, help="first N epochs of the route"
     )
     p.add_argument("--seed", type=_count("seed", 0), default=0, help="Monte-Carlo seed (0)")
@@ -185,12 +192,20 @@ def main(args: argparse.Namespace) -> int:
     from .reproduce import parallel_kwargs
 
     specs = [design.parse_array(a, args.spacing) for a in args.arrays]
+    if args.channel != "image" and (args.mode != "channel" or args.runs == 0):
+        print(
+            "tunnelkit design: error: --channel sionna needs --mode channel and --runs > 0 "
+            "(the bounds and the bound mode use the eq. 1 model)",
+            file=sys.stderr,
+        )
+        return 2
     setup = design.DesignSetup.from_scenario(
         args.scenario,
         fc=args.fc,
         bandwidth=args.bandwidth,
         tilt_deg=args.tilt,
         mount_height=args.mount_height,
+        channel=args.channel,
     )
     impairments = {
         "phase_error_deg": args.phase_error_deg,
@@ -219,7 +234,10 @@ def main(args: argparse.Namespace) -> int:
         print(f"tunnelkit design: error: {exc}", file=sys.stderr)
         return 1
     rep.settings.update(
-        spacing_wl=args.spacing, tilt_deg=args.tilt, mount_height_m=args.mount_height
+        spacing_wl=args.spacing,
+        tilt_deg=args.tilt,
+        mount_height_m=args.mount_height,
+        **({"channel": args.channel} if args.channel != "image" else {}),
     )
     if all(r.status == "error" for r in rep.rows):
         for r in rep.rows:

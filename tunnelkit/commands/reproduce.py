@@ -1,5 +1,5 @@
-"""``tunnelkit reproduce TARGET [--runs N] [--seed S] [--workers N | --scheduler ADDRESS]
-[--format table|json]``."""
+"""``tunnelkit reproduce TARGET [--runs N] [--seed S] [--channel image|sionna]
+[--workers N | --scheduler ADDRESS] [--format table|json]``."""
 
 from __future__ import annotations
 
@@ -21,6 +21,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the random generator (default 0)")
     p.add_argument("--format", choices=["table", "json"], default="table")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument(
+        "--channel",
+        choices=["image", "sionna"],
+        default="image",
+        help="channel source: the image method's eq. 1 (default) or the ray-traced channel "
+        "(Sionna RT, every path per element, traced once and cached; javelin-table1|2 only)",
+    )
     add_parallel_arguments(p)
 
 
@@ -59,17 +66,27 @@ def parallel_kwargs(args: argparse.Namespace) -> dict:
 
 def main(args: argparse.Namespace) -> int:
     from ..montecarlo import TrialLost
-    from ..reproduce import run
+    from ..reproduce import run, targets
+    from ..rt import RTUnavailableError
 
+    chans = targets()[args.target].channels
+    if args.channel not in chans:
+        print(
+            f"tunnelkit reproduce: error: --channel {args.channel}: {args.target} runs on "
+            f"{', '.join(chans)} only",
+            file=sys.stderr,
+        )
+        return 2
     try:
         rep = run(
             args.target,
             runs=args.runs,
             seed=args.seed,
             progress=(args.format == "table" and not args.no_progress),
+            channel=args.channel,
             **parallel_kwargs(args),
         )
-    except TrialLost as exc:
+    except (TrialLost, RTUnavailableError) as exc:
         print(f"tunnelkit reproduce: error: {exc}", file=sys.stderr)
         return 1
     print(rep.to_json() if args.format == "json" else rep.to_table())

@@ -19,12 +19,12 @@ from functools import lru_cache
 import numpy as np
 
 from .. import propagation
-from .._validate import finite_array, integer, positive
+from .._validate import choice, finite_array, integer, positive
 from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
 from ..constants import wavelength
 from ..scenarios import Scenario, load_scenario
-from ..signal_route import SignalRoute
+from ..signal_route import CHANNELS, SignalRoute
 from .geometry import KINDS
 
 __all__ = ["ArraySpec", "DesignSetup", "Mount", "parse_array"]
@@ -110,6 +110,9 @@ class DesignSetup:
 
     Build with :meth:`from_scenario` (overriding carrier, bandwidth, tilt, mount height);
     :meth:`arrays` places a candidate array on every mount (validated inside the tunnel).
+    ``channel`` is the channel source of :meth:`signal_route` (the Monte-Carlo's ``"channel"``
+    mode): ``"image"`` (eq. 1) or ``"sionna"`` (the ray-traced channel with ``rt_settings``,
+    cached per scenario and array, :class:`tunnelkit.rt.cache.RayTracedChannel`).
     """
 
     name: str
@@ -118,6 +121,8 @@ class DesignSetup:
     trajectory: object
     config: object
     kinds: tuple[str, ...] = KINDS
+    channel: str = "image"
+    rt_settings: object = None
 
     @classmethod
     def from_scenario(
@@ -128,13 +133,15 @@ class DesignSetup:
         bandwidth: float | None = None,
         tilt_deg: float | None = None,
         mount_height: float | None = None,
+        channel: str = "image",
     ) -> DesignSetup:
         """From a scenario name/path or a loaded scenario.
 
         ``fc`` [Hz] and ``bandwidth`` [Hz] replace the radio's (the SRS keeps its subcarrier
         spacing and comb and fills the band: ``n_rb = floor(bandwidth / (12 scs))``);
         ``tilt_deg`` (down-tilt, every array: elevation ``-tilt``) and ``mount_height`` [m]
-        (every array's centre height) move the mount.
+        (every array's centre height) move the mount. ``channel``: "image" or "sionna" (the
+        ray-traced channel, settings from the scenario's ``[raytracing]``).
         """
         sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
         if not isinstance(sc, Scenario):
@@ -151,7 +158,21 @@ class DesignSetup:
             Mount(a.name, a.origin.copy(), a.azimuth, a.elevation)
             for a in propagation.scenario_arrays(sc)
         )
-        setup = cls(sc.name, tun, mounts, sc.trajectory(tun), SRSConfig.from_scenario(sc))
+        choice("channel", channel, CHANNELS)
+        rts = None
+        if channel == "sionna":
+            from ..rt import RTSettings
+
+            rts = RTSettings.from_scenario(sc)
+        setup = cls(
+            sc.name,
+            tun,
+            mounts,
+            sc.trajectory(tun),
+            SRSConfig.from_scenario(sc),
+            channel=channel,
+            rt_settings=rts,
+        )
         return setup.variant(
             fc=fc, bandwidth=bandwidth, tilt_deg=tilt_deg, mount_height=mount_height
         )
@@ -163,6 +184,7 @@ class DesignSetup:
         bandwidth: float | None = None,
         tilt_deg: float | None = None,
         mount_height: float | None = None,
+        channel: str = "image",
     ) -> DesignSetup:
         """A copy with another carrier, bandwidth, down-tilt or mount height (``None`` keeps)."""
         cfg = self.config
@@ -201,14 +223,30 @@ class DesignSetup:
         """The measurement route of ``spec`` on this design as the Monte-Carlo drives it
         (:class:`tunnelkit.signal_route.SignalRoute`): each epoch's paths carry the CRLB at their
         estimate, and Algorithm 1 drops only what no clock bias explains."""
+        spec = parse_array(spec)
+        arrays = self.arrays(spec)
+        raytraced = None
+        if self.channel == "sionna":
+            from ..rt import RayTracedChannel
+
+            raytraced = RayTracedChannel(
+                self.tunnel,
+                arrays,
+                self.trajectory,
+                self.config,
+                self.rt_settings,
+                label=f"{self.name}-design-{spec.label}",
+            )
         return SignalRoute(
             self.tunnel,
-            self.arrays(parse_array(spec)),
+            arrays,
             self.trajectory,
             self.config,
             kinds=self.kinds,
             report_covariance=True,
             bias_aware_delay_check=True,
+            channel=self.channel,
+            raytraced=raytraced,
         )
 
     def arrays(self, spec) -> list[ArrayGeometry]:

@@ -37,23 +37,33 @@ class Target:
     default_runs: int
     fn: Callable[..., Report]
     bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
+    channels: tuple[str, ...] = ("image",)  #: channel sources it runs on (``fn(channel=...)``)
 
 
 _REGISTRY: dict[str, Target] = {}
 _DISCOVERED = False
 
 
-def register(name: str, *, help: str, default_runs: int, bytes_per_run: int = RUN_BYTES):
+def register(
+    name: str,
+    *,
+    help: str,
+    default_runs: int,
+    bytes_per_run: int = RUN_BYTES,
+    channels: tuple[str, ...] = ("image",),
+):
     """Decorator registering a reproduction target under ``name``.
 
     ``bytes_per_run`` is what one Monte-Carlo run keeps in memory until the report is built;
     ``runs * bytes_per_run`` is checked against :mod:`tunnelkit.budget` before anything runs.
+    ``channels``: the channel sources the target runs on; with more than "image" its function
+    takes ``channel=``.
     """
 
     def deco(fn):
         if name in _REGISTRY:
             raise ValueError(f"name: reproduce target {name!r} registered twice")
-        _REGISTRY[name] = Target(name, help, default_runs, fn, bytes_per_run)
+        _REGISTRY[name] = Target(name, help, default_runs, fn, bytes_per_run, tuple(channels))
         return fn
 
     return deco
@@ -78,19 +88,27 @@ def run(
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float = CONNECT_TIMEOUT_S,
+    channel: str = "image",
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
-    :func:`tunnelkit.montecarlo.run_trials`). The report is the same either way."""
+    :func:`tunnelkit.montecarlo.run_trials`). The report is the same either way. ``channel``:
+    "image" (default) or, for the targets that support it, "sionna" (the ray-traced channel)."""
     reg = targets()
     if name not in reg:
         raise ValueError(f"name: unknown reproduce target {name!r}; available: {', '.join(reg)}")
     tgt = reg[name]
+    if channel not in tgt.channels:
+        raise ValueError(
+            f"channel: target {name!r} runs on {', '.join(map(repr, tgt.channels))}, "
+            f"not {channel!r}"
+        )
+    on = {} if channel == "image" else {"channel": channel}
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
     check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")
     workers, scheduler = parallel_options(workers, scheduler)
     timeout = positive("timeout", timeout)
-    rep = tgt.fn(runs, seed, progress, workers=workers, scheduler=scheduler, timeout=timeout)
+    rep = tgt.fn(runs, seed, progress, workers=workers, scheduler=scheduler, timeout=timeout, **on)
     rep.meta = {"target": name, "runs": runs, "seed": seed, **rep.meta}
     return rep

@@ -169,11 +169,11 @@ NOTES = [
 ]
 
 
-def _simulate_and_score(scenario, n_epochs, extractions, columns, cond, rng):
+def _simulate_and_score(scenario, n_epochs, extractions, columns, cond, rng, channel="image"):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.studies.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count."""
-    drives = simulate_condition(scenario, n_epochs, extractions, cond, rng)
+    drives = simulate_condition(scenario, n_epochs, extractions, cond, rng, channel=channel)
     faults = {
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
@@ -190,6 +190,7 @@ def javelin_table(
     progress: bool,
     extractions: tuple[str, ...] = ("paper", "ml"),
     n_epochs: int | None = None,
+    channel: str = "image",
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -197,7 +198,13 @@ def javelin_table(
     goes to :func:`~tunnelkit.montecarlo.run_trials`). Each trial simulates one drive and scores
     it where it ran, so scoring runs in parallel too; the drives are the same as
     :func:`collect_routes`' (drive ``i`` draws from the ``i``-th child of ``seed``) and the table
-    equals :func:`table_rows` on them."""
+    equals :func:`table_rows` on them.
+
+    ``channel="sionna"`` runs every drive on the ray-traced channel
+    (:class:`~tunnelkit.rt.cache.RayTracedChannel`): the epochs the conditions need (with and,
+    for NoRRMs, without the road markings) are traced here first, once, into the cache; the
+    trials then read the cache and draw noise and clock bias per run."""
+    rt_info = _prepare_channel(scenario, conditions, n_epochs, channel, progress)
     extractions, done = per_drive(
         scenario,
         conditions,
@@ -205,7 +212,9 @@ def javelin_table(
         seed,
         progress,
         extractions,
-        lambda e: functools.partial(_simulate_and_score, scenario, n_epochs, e, table_columns(e)),
+        lambda e: functools.partial(
+            _simulate_and_score, scenario, n_epochs, e, table_columns(e), channel=channel
+        ),
         **parallel,
     )
     columns = table_columns(extractions)
@@ -224,8 +233,10 @@ def javelin_table(
             flagged[e] += n_flag
             epochs[e] += n_ep
     cols, rows = _rows(scores, reference, columns)
+    on = "" if channel == "image" else ", ray-traced channel (Sionna RT)"
     return Report(
-        title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}: JAVELIN vs TeNFiLoc",
+        title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}{on}: JAVELIN vs "
+        "TeNFiLoc",
         columns=cols,
         rows=rows,
         meta={
@@ -233,9 +244,11 @@ def javelin_table(
             "extraction_failures": faults,
             "flagged_epochs": flagged,
             "epochs": epochs,
+            **({"channel": channel, **rt_info} if channel != "image" else {}),
         },
         notes=[
             *NOTES,
+            *(_RT_NOTES if channel == "sionna" else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
             "(the tracker predicts only); flagged epochs per route: "
@@ -245,14 +258,55 @@ def javelin_table(
     )
 
 
+_RT_NOTES = [
+    "Ray-traced channel: each epoch's tensor is every path Sionna RT 2.2 traces per antenna "
+    "element (LoS, specular up to the scenario's max_depth, diffuse scattering; ITU concrete "
+    "shell, asphalt road as ITU very_dry_ground, metal RRMs; tunnelkit.rt.settings), in eq. 1's "
+    "sign convention (tunnelkit.rt.elements); noise and clock bias drawn per run. The number of "
+    "paths to extract and the truth are the image method's first-order specular paths; "
+    "the trackers' designs are unchanged (chosen on the image channel).",
+]
+
+
+def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
+    """Trace the epochs a ray-traced table needs into the cache (nothing for the image channel);
+    returns the cache's numbers for the report's meta."""
+    from ..signal_route import CHANNELS
+    from ..studies.drives import CONDITIONS, scenario_route
+
+    if channel not in CHANNELS:
+        raise ValueError(f"channel: expected one of {CHANNELS}, got {channel!r}")
+    if channel == "image":
+        return {}
+    route = scenario_route(scenario, channel=channel)
+    T = len(route.trajectory) if n_epochs is None else min(int(n_epochs), len(route.trajectory))
+    tunnels = [route.tunnel] if any(CONDITIONS[c].rrms for c in conditions) else []
+    if not all(CONDITIONS[c].rrms for c in conditions):
+        tunnels.append(route.tunnel.without_plates())
+    info = {"rt_settings": dict(vars(route.raytraced.settings))}
+    for tun in tunnels:
+        st = route.raytraced.prepare(tun, range(T), progress=progress)
+        var = route.raytraced.variant(tun)
+        info[f"rt_cache_{var}"] = {
+            "directory": st["directory"],
+            "bytes": st["bytes"],
+            "newly_traced": st["traced"],
+            "median_trace_s": float(np.median(st["trace_s"])),
+        }
+    return info
+
+
 @register(
     "javelin-table1",
     help="Italiano 2026 Table 1: straight drive, JAVELIN (L, N@0.5, N, NoRRMs) vs TeNFiLoc-L, "
     "paper and ML routes",
     default_runs=20,
     bytes_per_run=1024 * 1024,
+    channels=("image", "sionna"),
 )
-def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
+def javelin_table1(
+    runs: int, seed: int, progress: bool, channel: str = "image", **parallel
+) -> Report:
     """Table 1 (straight trajectory)."""
     return javelin_table(
         "italiano2026-straight",
@@ -261,6 +315,7 @@ def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
         runs,
         seed,
         progress,
+        channel=channel,
         **parallel,
     )
 
@@ -271,8 +326,11 @@ def javelin_table1(runs: int, seed: int, progress: bool, **parallel) -> Report:
     "ML routes",
     default_runs=20,
     bytes_per_run=1024 * 1024,
+    channels=("image", "sionna"),
 )
-def javelin_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
+def javelin_table2(
+    runs: int, seed: int, progress: bool, channel: str = "image", **parallel
+) -> Report:
     """Table 2 (slalom trajectory)."""
     return javelin_table(
         "italiano2026-slalom",
@@ -281,5 +339,6 @@ def javelin_table2(runs: int, seed: int, progress: bool, **parallel) -> Report:
         runs,
         seed,
         progress,
+        channel=channel,
         **parallel,
     )

@@ -223,6 +223,7 @@ def compute_paths(
     raise ValueError(f"engine: expected one of {ENGINES}, got {engine!r}")
 
 
+from .cache import RayTracedChannel, default_cache_dir  # noqa: E402
 from .compare import (  # noqa: E402
     compare_paths,
     lower_into_tunnel,
@@ -230,11 +231,18 @@ from .compare import (  # noqa: E402
     time_engines,
     worst_errors,
 )
+from .elements import ElementPaths, element_tensor  # noqa: E402
+from .settings import RTSettings  # noqa: E402
 
 __all__ += [
+    "ElementPaths",
     "MitsubaScene",
+    "RTSettings",
+    "RayTracedChannel",
     "SceneError",
     "compare_paths",
+    "default_cache_dir",
+    "element_tensor",
     "lower_into_tunnel",
     "plate_occluders",
     "time_engines",

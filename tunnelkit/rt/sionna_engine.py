@@ -27,6 +27,14 @@ at the reference antenna but not at some other antenna (the specular point slide
 a plate across the array) keeps the spherical-wavefront length from its VUE for those antennas;
 :attr:`SionnaEngine.last_gaps` counts them and :attr:`SionnaEngine.last_traced` maps each
 path ``(kind, surface)`` to the (M,) mask of antennas at which Sionna traced it.
+
+Every path, per element (the ray-traced channel): :meth:`SionnaEngine.apply_settings` gives the
+shapes the materials, scattering coefficients and lobe of a
+:class:`~tunnelkit.rt.settings.RTSettings` and the element receivers their pattern (oriented
+along the array's boresight); :meth:`SionnaEngine.trace_elements` then returns everything Sionna
+traces up to ``max_depth`` (LoS, specular of any order, diffuse) as an
+:class:`~tunnelkit.rt.elements.ElementPaths`, which :mod:`tunnelkit.rt.cache` turns into eq. 1's
+tensor.
 """
 
 from __future__ import annotations
@@ -41,7 +49,9 @@ from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from ..propagation import Path, Tunnel3D, arrival_angles
 from . import require_sionna
+from .elements import ElementPaths
 from .mitsuba import MitsubaScene, SceneError, export_tunnel, read_scene
+from .settings import RTSettings
 
 __all__ = ["SionnaEngine", "load_sionna_scene"]
 
@@ -161,6 +171,101 @@ class SionnaEngine:
         self._n_rx = 0
         self.last_gaps = 0
         self.last_traced: dict[tuple[str, str], np.ndarray] = {}
+
+    # --- every path, per element ---------------------------------------------------------------
+    def apply_settings(self, settings: RTSettings) -> None:
+        """Give every shape the material of ``settings`` for its kind (ITU type, slab thickness,
+        scattering coefficient and lobe; :class:`~tunnelkit.rt.settings.RTSettings`) and every
+        element receiver its antenna pattern, oriented along the array's boresight."""
+        import sionna.rt as srt
+
+        if not isinstance(settings, RTSettings):
+            raise TypeError(f"settings: expected an RTSettings, got {type(settings).__name__}")
+        made: dict[str, object] = {}
+        for obj in self.scene.objects.values():
+            _, kind = self._surface_by_id.get(int(obj.object_id), ("", "surface"))
+            name, itu, thickness, s = settings.material_for(kind)
+            tag = f"tk-{name}-{settings.fingerprint()[:12]}"  # one per material and settings
+            if made.get(name) is None:
+                made[name] = self.scene.get(tag)
+            if made[name] is None:
+                extra = (
+                    {"alpha_r": settings.alpha_r}
+                    if settings.scattering_pattern == "directive"
+                    else {}
+                )
+                made[name] = srt.ITURadioMaterial(
+                    tag,
+                    itu,
+                    thickness=thickness,
+                    scattering_coefficient=s,
+                    scattering_pattern=settings.scattering_pattern,
+                    **extra,
+                )
+            obj.radio_material = made[name]
+        self.scene.rx_array = srt.PlanarArray(
+            num_rows=1, num_cols=1, pattern=settings.antenna_pattern, polarization="V"
+        )
+        self.settings = settings
+
+    def trace_elements(self, array: ArrayGeometry, ue, ue_velocity=(0.0, 0.0, 0.0)) -> ElementPaths:
+        """Every path Sionna returns from ``ue`` to each element of ``array`` (LoS, specular of
+        any order up to the settings' ``max_depth``, diffuse), as an
+        :class:`~tunnelkit.rt.elements.ElementPaths`; call :meth:`apply_settings` first."""
+        import mitsuba as mi
+        from sionna.rt.constants import InteractionType
+
+        st = getattr(self, "settings", None)
+        if st is None:
+            raise RuntimeError("trace_elements: call apply_settings(settings) first")
+        if not isinstance(array, ArrayGeometry):
+            raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
+        ue = vector("ue", ue, 3)
+        vel = vector("ue_velocity", ue_velocity, 3)
+        if self.tunnel is not None:
+            ue = self.tunnel.require_inside("ue", ue)
+        self._place(array, ue, vel)
+        b = array.boresight
+        yaw, pitch = float(np.arctan2(b[1], b[0])), float(-np.arcsin(np.clip(b[2], -1, 1)))
+        for m in range(array.M):
+            self.scene.get(f"ant-{m}").orientation = mi.Point3f(yaw, pitch, 0.0)
+        p = self._solver(
+            self.scene,
+            max_depth=st.max_depth,
+            max_num_paths_per_src=10_000_000,
+            samples_per_src=st.samples_per_src,
+            synthetic_array=False,
+            los=True,
+            specular_reflection=True,
+            diffuse_reflection=st.diffuse,
+            refraction=False,
+            diffraction=False,
+        )
+
+        def sq(x) -> np.ndarray:
+            return np.asarray(x.numpy())[:, 0, 0, 0]
+
+        ar, ai = p.a
+        tau = sq(p.tau).astype(float)
+        inter = np.asarray(p.interactions.numpy())[:, :, 0, 0, 0]  # (depth, M, P)
+        valid = sq(p.valid).astype(bool)
+        return ElementPaths(
+            tau=tau,
+            gain=(sq(ar) + 1j * sq(ai)) * np.exp(-2j * np.pi * self.fc * tau),
+            doppler=sq(p.doppler).astype(float),
+            valid=valid,
+            order=np.sum(inter != InteractionType.NONE, axis=0),
+            diffuse=np.any(inter == InteractionType.DIFFUSE, axis=0),
+            first_object=np.asarray(p.objects.numpy())[0, :, 0, 0, 0].astype(np.int64),
+        )
+
+    def surface_of(self, object_id: int) -> tuple[str, str]:
+        """``(surface name, kind)`` of a Sionna object id (``("", "los")`` for none)."""
+        from sionna.rt.constants import INVALID_SHAPE
+
+        if int(object_id) == int(INVALID_SHAPE):
+            return "", "los"
+        return self._surface_by_id.get(int(object_id), (str(object_id), "surface"))
 
     # --- devices ------------------------------------------------------------------------------
     def _place(self, array: ArrayGeometry, ue: np.ndarray, vel: np.ndarray) -> None:

@@ -18,13 +18,20 @@ __all__ = ["collect_drives", "collect_routes", "per_drive", "simulate_condition"
 
 
 def simulate_condition(
-    scenario: str, n_epochs: int | None, extractions: tuple[str, ...], cond: str, rng
+    scenario: str,
+    n_epochs: int | None,
+    extractions: tuple[str, ...],
+    cond: str,
+    rng,
+    *,
+    channel: str = "image",
 ):
-    """One drive of condition ``cond`` of ``scenario`` through the signal route, measured through
-    every route in ``extractions`` (:func:`~tunnelkit.studies.drives.simulate_routes`); the
-    argument order suits ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``."""
+    """One drive of condition ``cond`` of ``scenario`` through the signal route on ``channel``
+    ("image" or "sionna"), measured through every route in ``extractions``
+    (:func:`~tunnelkit.studies.drives.simulate_routes`); the argument order suits
+    ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``."""
     return simulate_routes(
-        scenario, rng, condition=cond, n_epochs=n_epochs, extractions=extractions
+        scenario, rng, condition=cond, n_epochs=n_epochs, extractions=extractions, channel=channel
     )
 
 
@@ -55,6 +62,7 @@ def collect_routes(
     progress: bool = False,
     n_epochs: int | None = None,
     extractions: tuple[str, ...] = ("paper", "ml"),
+    channel: str = "image",
     **parallel,
 ) -> dict[str, dict[str, list]]:
     """``runs`` seeded drives per condition through the signal route (the expensive part), each
@@ -62,7 +70,8 @@ def collect_routes(
     (:func:`~tunnelkit.studies.drives.simulate_routes`). One trial of
     :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its ``workers`` /
     ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
-    the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode). Returns
+    the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode); ``channel``
+    the channel source (:data:`tunnelkit.signal_route.CHANNELS`). Returns
     ``{extraction: {condition: [DriveData, ...]}}``."""
     extractions, done = per_drive(
         scenario,
@@ -71,7 +80,7 @@ def collect_routes(
         seed,
         progress,
         extractions,
-        lambda e: functools.partial(simulate_condition, scenario, n_epochs, e),
+        lambda e: functools.partial(simulate_condition, scenario, n_epochs, e, channel=channel),
         **parallel,
     )
     out: dict[str, dict[str, list]] = {e: {c: [] for c in conditions} for e in extractions}

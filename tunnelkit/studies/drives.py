@@ -152,18 +152,23 @@ def separate_epoch(ep, config):
     return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 
-def scenario_route(route, model: str = "exact") -> SignalRoute:
-    """``route`` itself (a :class:`SignalRoute`), or the route of a scenario name built once per
-    ``(name, model)`` and kept."""
+def scenario_route(route, model: str = "exact", channel: str | None = None) -> SignalRoute:
+    """``route`` itself (a :class:`SignalRoute`; ``channel``, if given, must be its own), or the
+    route of a scenario name built once per ``(name, model, channel)`` and kept (``channel``
+    :data:`~tunnelkit.signal_route.CHANNELS`, "image" by default)."""
     if isinstance(route, SignalRoute):
+        if channel is not None and channel != route.channel:
+            raise ValueError(
+                f"channel: the route given runs on the {route.channel!r} channel, not {channel!r}"
+            )
         return route
     if not isinstance(route, str):
         raise TypeError(
             f"route: expected a SignalRoute or a scenario name, got {type(route).__name__}"
         )
-    key = (route, model)
+    key = (route, model, channel or "image")
     if key not in _ROUTES:
-        _ROUTES[key] = SignalRoute.from_scenario(route, model=model)
+        _ROUTES[key] = SignalRoute.from_scenario(route, model=model, channel=channel or "image")
     return _ROUTES[key]
 
 
@@ -209,6 +214,7 @@ def simulate_drive(
     sigma_speed: float = SIGMA_SPEED,
     sigma_heading: float = SIGMA_HEADING,
     n_epochs: int | None = None,
+    channel: str | None = None,
 ) -> DriveData:
     """Drive ``route`` (a :class:`SignalRoute` or a scenario name, built with ``model``) under
     ``condition`` and measure every epoch through ``extraction`` (``rng`` explicit).
@@ -222,7 +228,8 @@ def simulate_drive(
     :func:`tunnelkit.extraction.coherent.resolve_coherent`; alias ``"separated"``), ``"ml"`` (the
     joint maximum-likelihood fit from its own start) or ``"route"`` (the route's own extraction,
     :meth:`SignalRoute.epoch`). An extraction failure leaves ``None`` (the tracker then predicts
-    only) and is recorded in ``faults``.
+    only) and is recorded in ``faults``. ``channel``: the route's channel source
+    (:func:`scenario_route`; "sionna" is the ray-traced channel).
     """
     return simulate_routes(
         route,
@@ -233,6 +240,7 @@ def simulate_drive(
         sigma_speed=sigma_speed,
         sigma_heading=sigma_heading,
         n_epochs=n_epochs,
+        channel=channel,
     )[route_name(extraction)]
 
 
@@ -254,13 +262,15 @@ def simulate_routes(
     sigma_speed: float = SIGMA_SPEED,
     sigma_heading: float = SIGMA_HEADING,
     n_epochs: int | None = None,
+    channel: str | None = None,
 ) -> dict[str, DriveData]:
     """One drive (:func:`simulate_drive`) measured through every route in ``extractions``.
 
     Each epoch's tensor is synthesised and decomposed once: the paper's route (CPD, joint root
     refinement) runs on it and the coherent route starts from those estimates, the ML route runs
     its own start on the same tensor; ``"route"`` is the route's own extraction and cannot be
-    combined with the others (it draws the tensor itself). Returns ``{extraction: DriveData}``.
+    combined with the others (it draws the tensor itself). ``channel`` as in
+    :func:`scenario_route`. Returns ``{extraction: DriveData}``.
     """
     rng = rng_or_error("rng", rng)
     cond = _condition(condition)
@@ -273,7 +283,7 @@ def simulate_routes(
             f"{[e for e in extractions if e != 'route']}"
         )
     label = route if isinstance(route, str) else "route"
-    route = scenario_route(route, model)
+    route = scenario_route(route, model, channel)
     if n_epochs is not None:
         integer("n_epochs", n_epochs, minimum=1)
     kinds_all = tuple(route.kinds)

@@ -1,0 +1,187 @@
+"""The chain on the ray-traced channel: trace cost, cache size, extraction error against the bound.
+
+For the straight and slalom drives at the preset's 10 x 10 arrays, with the scenario's
+``[raytracing]`` settings (defaults: 20,000 rays, max_depth 2, scattering coefficient 0.3
+Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
+
+1. per epoch: trace time, tensor synthesis time, paths per element and power per kind of path
+   (LoS, first-order specular, higher-order specular, diffuse), from the cache
+   (:class:`tunnelkit.rt.RayTracedChannel`, traced on a miss); the cache size per drive;
+2. the extraction error (the route's own extraction, ``L`` = the image method's first-order
+   paths) of the delay ``d`` and direction of each true first-order path, over the CRLB standard
+   deviation (:func:`tunnelkit.extraction.path_crlb`), on both channels from the same draws.
+   On the ray-traced channel the bound is also given with the noise floor raised by the power the
+   model leaves out, ``N0' = N0 + P_t P_diffuse`` (diffuse only) and ``N0 + P_t (P_diffuse +
+   P_specular2+)`` (every unmodelled path), with the mean power per element of those paths:
+   their sum over many paths of random phase acts on each tensor entry like noise of that power
+   (white across tones and elements for the diffuse part; the higher-order specular paths are
+   not white, so the second bound is optimistic about what they cost).
+
+    TUNNELKIT_RT_CACHE=/tmp/rt python benchmarks/bench_rt_channel.py --epochs-every 4 --draws 3
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tunnelkit import evaluation, extraction
+from tunnelkit.constants import C
+from tunnelkit.montecarlo import spawn_rngs
+from tunnelkit.signal_route import SignalRoute
+
+DRIVES = ("italiano2026-straight", "italiano2026-slalom")
+
+
+def trace_costs(route) -> dict:
+    """Per-epoch trace/synthesis times, path counts and powers of ``route``'s ray-traced channel."""
+    rc = route.raytraced
+    t0 = time.perf_counter()
+    st = rc.prepare(progress=False)
+    eps = [rc.epoch(k) for k in range(len(route.trajectory))]
+    return {
+        "epochs": len(eps),
+        "newly_traced": st["traced"],
+        "wall_s": time.perf_counter() - t0,
+        "trace_s": [e["trace_s"] for e in eps],
+        "synth_s": [e["synth_s"] for e in eps],
+        "cache_bytes": st["bytes"],
+        "power": [e["power"] for e in eps],
+        "count": [e["count"] for e in eps],
+    }
+
+
+def _errors(ep, config, snr_offset_db=0.0) -> np.ndarray:
+    src = np.stack([ep.array.to_local(p.source) for p in ep.paths])
+    d_true = np.array([p.length for p in ep.paths]) + C * ep.snapshot.clock_bias
+    v_true = np.array([p.velocity for p in ep.paths])
+    bound = extraction.path_crlb(ep.paths, ep.array, config, snr_offset_db=snr_offset_db)
+    return evaluation.normalized_errors(ep.estimates, d_true, v_true, src, bound)
+
+
+def extraction_study(name: str, every: int, draws: int, seed: int) -> dict:
+    """Normalised errors of the first-order paths on both channels (same rng per draw)."""
+    img = SignalRoute.from_scenario(name)
+    srt = SignalRoute.from_scenario(name, channel="sionna")
+    ks = list(range(0, len(img.trajectory), every))
+    cfg = img.config
+    out: dict[str, list] = {
+        "image": [],
+        "sionna": [],
+        "sionna_diffuse_floor": [],
+        "sionna_all_floor": [],
+    }
+    kinds: list[str] = []
+    for i, rng in enumerate(spawn_rngs(seed, len(ks) * draws)):
+        k = ks[i // draws]
+        state = rng.bit_generator.state
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ep_i = img.epoch(k, rng)
+            rng.bit_generator.state = state
+            ep_s = srt.epoch(k, rng)
+        pw = srt.raytraced.epoch(k)["power"]
+        n0 = cfg.noise_power
+        floors = {
+            "sionna_diffuse_floor": n0 + cfg.tx_power * pw["diffuse"],
+            "sionna_all_floor": n0 + cfg.tx_power * (pw["diffuse"] + pw["specular2+"]),
+        }
+        out["image"].append(_errors(ep_i, cfg))
+        out["sionna"].append(_errors(ep_s, cfg))
+        for key, n in floors.items():
+            out[key].append(_errors(ep_s, cfg, snr_offset_db=-10 * np.log10(n / n0)))
+        kinds += [p.surface_kind for p in ep_i.paths]
+    res = {key: np.concatenate(v) for key, v in out.items()}
+    return {"errors": res, "kinds": np.array(kinds), "epochs": ks, "draws": draws}
+
+
+def _summary(e: np.ndarray) -> dict:
+    """Median and RMS of |error| / CRLB over the paths found, the fraction missed."""
+    found = np.isfinite(e)
+    f = e[found]
+    return {
+        "n": int(e.size),
+        "missed": float(1 - found.mean()) if e.size else float("nan"),
+        "median": float(np.median(np.abs(f))) if f.size else float("nan"),
+        "rms": float(np.sqrt(np.mean(f**2))) if f.size else float("nan"),
+    }
+
+
+def report(costs: dict, studies: dict) -> str:
+    lines = []
+    for name, c in costs.items():
+        p = {k: np.array([x[k] for x in c["power"]]) for k in c["power"][0]}
+        tot = sum(p.values())
+        lines.append(
+            f"{name}: {c['epochs']} epochs, trace median {np.median(c['trace_s']):.2f} s/epoch "
+            f"(IQR {np.percentile(c['trace_s'], 25):.2f}-{np.percentile(c['trace_s'], 75):.2f}), "
+            f"tensor synthesis median {np.median(c['synth_s']):.2f} s/epoch, cache "
+            f"{c['cache_bytes'] / 1e6:.1f} MB, paths/element median "
+            f"{np.median([sum(x.values()) for x in c['count']]):.0f}"
+        )
+        lines.append(
+            "  power share per epoch (median [min, max]): "
+            + ", ".join(
+                f"{k} {np.median(v / tot):.3f} [{np.min(v / tot):.3f}, {np.max(v / tot):.3f}]"
+                for k, v in p.items()
+            )
+        )
+    for name, st in studies.items():
+        lines.append(f"{name}: |error| / CRLB of the first-order paths (median / RMS, missed)")
+        for col, label in ((0, "d"), (2, "direction")):
+            for key, e in st["errors"].items():
+                for kind in ["all", *sorted(set(st["kinds"]))]:
+                    sel = np.ones(len(st["kinds"]), bool) if kind == "all" else st["kinds"] == kind
+                    s = _summary(e[sel, col])
+                    lines.append(
+                        f"  {label:9s} {key:22s} {kind:8s} n={s['n']:3d} median {s['median']:10.2f}"
+                        f"  RMS {s['rms']:10.2f}  missed {s['missed']:.2f}"
+                    )
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--epochs-every", type=int, default=4)
+    ap.add_argument("--draws", type=int, default=3)
+    ap.add_argument("--seed", type=int, default=26)
+    ap.add_argument("--json", type=Path, default=None)
+    a = ap.parse_args(argv)
+    costs = {n: trace_costs(SignalRoute.from_scenario(n, channel="sionna")) for n in DRIVES}
+    studies = {n: extraction_study(n, a.epochs_every, a.draws, a.seed) for n in DRIVES}
+    print(report(costs, studies))
+    if a.json:
+        a.json.write_text(
+            json.dumps(
+                {
+                    "costs": costs,
+                    "studies": {
+                        n: {
+                            "epochs": s["epochs"],
+                            "draws": s["draws"],
+                            "kinds": s["kinds"].tolist(),
+                            "errors": {
+                                k: np.where(np.isfinite(v), v, -1).tolist()
+                                for k, v in s["errors"].items()
+                            },
+                        }
+                        for n, s in studies.items()
+                    },
+                },
+                indent=1,
+            )
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

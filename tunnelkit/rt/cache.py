@@ -1,0 +1,290 @@
+"""The ray-traced channel of a drive, traced once per epoch and cached on disk.
+
+:class:`RayTracedChannel` traces every epoch of a trajectory with Sionna RT
+(:meth:`~tunnelkit.rt.sionna_engine.SionnaEngine.trace_elements`: every path per element, LoS,
+specular of any order, diffuse) and stores the noiseless tensor of eq. 1's form
+(:func:`~tunnelkit.rt.elements.element_tensor`, unit transmit power, no clock bias) without the
+LoS, plus the LoS path per element (so a blocked-LoS epoch drops it), the power per kind of path
+and the trace time. Noise and clock bias are drawn per run on top
+(:func:`tunnelkit.channel.tensor_snapshot`), so a 20-run table traces each epoch once.
+
+Cache layout: ``<cache_dir>/<label>/<rrms|no-rrms>/meta.json`` and ``epoch-NNN.npz``.
+``cache_dir`` is ``$TUNNELKIT_RT_CACHE`` if set, else ``~/.cache/tunnelkit/rt``. ``meta.json``
+holds the key: a hash of everything that changes the trace (the exported scene's XML and
+meshes, the :class:`~tunnelkit.rt.settings.RTSettings`, the arrays' element positions, the
+trajectory, the tensor's tones and symbols, the cache format and the sionna-rt version). A
+directory written under another key (another version of the scene) is detected, emptied and
+rebuilt, never reused.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import tempfile
+import time
+import warnings
+from pathlib import Path as FsPath
+
+import numpy as np
+
+from .._validate import integer
+from .elements import ElementPaths, element_tensor
+from .mitsuba import export_tunnel
+from .settings import RTSettings
+
+__all__ = ["CACHE_ENV", "FORMAT", "RayTracedChannel", "default_cache_dir"]
+
+#: environment variable naming the cache directory
+CACHE_ENV = "TUNNELKIT_RT_CACHE"
+#: version of the cache's file format (part of the key)
+FORMAT = 1
+
+
+def default_cache_dir() -> FsPath:
+    """``$TUNNELKIT_RT_CACHE`` or ``~/.cache/tunnelkit/rt``."""
+    env = os.environ.get(CACHE_ENV)
+    return FsPath(env) if env else FsPath.home() / ".cache" / "tunnelkit" / "rt"
+
+
+def _sionna_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("sionna-rt")
+    except PackageNotFoundError:
+        return "absent"
+
+
+def _digest(*parts) -> str:
+    h = hashlib.sha256()
+    for p in parts:
+        h.update(p if isinstance(p, bytes) else np.ascontiguousarray(p, float).tobytes())
+    return h.hexdigest()
+
+
+def scene_hash(tunnel) -> str:
+    """Hash of ``tunnel`` as exported for Sionna (XML and every mesh file)."""
+    with tempfile.TemporaryDirectory(prefix="tunnelkit-rt-hash-") as tmp:
+        export_tunnel(tunnel, tmp, name="scene")
+        files = sorted(FsPath(tmp).rglob("*"))
+        return _digest(
+            *(f.relative_to(tmp).as_posix().encode() + f.read_bytes() for f in files if f.is_file())
+        )
+
+
+class RayTracedChannel:
+    """Ray-traced tensors of one drive (module docstring), built lazily, cached on disk.
+
+    Parameters
+    ----------
+    tunnel : the scenario's :class:`~tunnelkit.propagation.Tunnel3D`
+    arrays : its arrays (the one facing the vehicle is used per epoch, as in the image route)
+    trajectory : the drive (positions and velocities per epoch)
+    config : the :class:`~tunnelkit.channel.SRSConfig` (carrier, tones, symbols)
+    settings : :class:`~tunnelkit.rt.settings.RTSettings`
+    label : the cache subdirectory (the scenario name)
+    cache_dir : where the cache lives (:func:`default_cache_dir` by default)
+    """
+
+    def __init__(
+        self,
+        tunnel,
+        arrays,
+        trajectory,
+        config,
+        settings: RTSettings | None = None,
+        *,
+        label: str = "custom",
+        cache_dir=None,
+    ) -> None:
+        need = ("fc", "tone_spacing", "n_tones", "symbol_period", "n_symbols")
+        if not all(hasattr(config, a) for a in need):
+            raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
+        settings = RTSettings() if settings is None else settings
+        if not isinstance(settings, RTSettings):
+            raise TypeError(f"settings: expected an RTSettings, got {type(settings).__name__}")
+        if not isinstance(label, str) or not label or "/" in label:
+            raise ValueError(f"label: expected a non-empty name without '/', got {label!r}")
+        self.tunnel, self.arrays, self.trajectory = tunnel, list(arrays), trajectory
+        self.config, self.settings, self.label = config, settings, label
+        self.cache_dir = default_cache_dir() if cache_dir is None else FsPath(cache_dir)
+        self._engines: dict[str, object] = {}
+        self._checked: dict[str, FsPath] = {}
+        self._memo: dict[tuple[str, int], dict] = {}
+
+    # --- key and directory --------------------------------------------------------------------
+    def key(self, tunnel=None) -> dict:
+        """Everything the trace of ``tunnel`` (this drive's by default) depends on, hashed."""
+        tun = self.tunnel if tunnel is None else tunnel
+        cfg = self.config
+        return {
+            "format": FORMAT,
+            "sionna_rt": _sionna_version(),
+            "scene": scene_hash(tun),
+            "settings": self.settings.fingerprint(),
+            "arrays": _digest(
+                *(a.world for a in self.arrays), "|".join(a.name for a in self.arrays).encode()
+            ),
+            "trajectory": _digest(self.trajectory.position, self.trajectory.velocity),
+            "radio": [cfg.fc, cfg.tone_spacing, cfg.n_tones, cfg.symbol_period, cfg.n_symbols],
+        }
+
+    @staticmethod
+    def variant(tunnel) -> str:
+        """The cache subdirectory of ``tunnel``: "rrms" with road markings, else "no-rrms"."""
+        return "rrms" if getattr(tunnel, "plates", ()) else "no-rrms"
+
+    def directory(self, tunnel=None) -> FsPath:
+        """The checked cache directory of ``tunnel`` (emptied first if written under another key)."""
+        tun = self.tunnel if tunnel is None else tunnel
+        var = self.variant(tun)
+        if var in self._checked:
+            return self._checked[var]
+        d = self.cache_dir / self.label / var
+        key = self.key(tun)
+        meta = d / "meta.json"
+        if meta.is_file():
+            try:
+                old = json.loads(meta.read_text())
+            except ValueError:
+                old = None
+            if old != key:
+                warnings.warn(
+                    f"ray-tracing cache {d} was written for another scene, settings or drive; "
+                    "rebuilding it",
+                    stacklevel=2,
+                )
+                shutil.rmtree(d)
+        if not meta.is_file():
+            d.mkdir(parents=True, exist_ok=True)
+            tmp = d / f".meta-{os.getpid()}.json"
+            tmp.write_text(json.dumps(key, indent=1, sort_keys=True))
+            os.replace(tmp, meta)
+        self._checked[var] = d
+        return d
+
+    # --- tracing ------------------------------------------------------------------------------
+    def engine(self, tunnel=None):
+        """The Sionna engine of ``tunnel`` with this channel's settings (built on first use)."""
+        from .sionna_engine import SionnaEngine
+
+        tun = self.tunnel if tunnel is None else tunnel
+        var = self.variant(tun)
+        if var not in self._engines:
+            eng = SionnaEngine(tun, fc=self.config.fc)
+            eng.apply_settings(self.settings)
+            self._engines[var] = eng
+        return self._engines[var]
+
+    def trace(self, k: int, tunnel=None) -> tuple[object, ElementPaths, float]:
+        """Trace epoch ``k`` now (no cache): the array, the :class:`ElementPaths` and the seconds
+        the trace took."""
+        from ..propagation import select_array
+
+        k = integer("k", k, minimum=0, maximum=len(self.trajectory) - 1)
+        ue, vel = self.trajectory.position[k], self.trajectory.velocity[k]
+        arr = select_array(self.arrays, ue)
+        eng = self.engine(tunnel)
+        t0 = time.perf_counter()
+        ep = eng.trace_elements(arr, ue, vel)
+        return arr, ep, time.perf_counter() - t0
+
+    def epoch(self, k: int, tunnel=None) -> dict:
+        """Epoch ``k`` from the cache (traced and stored on a miss): ``array`` (name), ``H``
+        (M, Nf, Nt) without the LoS, ``los_tau`` / ``los_gain`` / ``los_doppler`` / ``los_valid``
+        (M,), ``power`` {kind: mean power per element}, ``count`` {kind: paths per element},
+        ``trace_s`` / ``synth_s`` [s]."""
+        tun = self.tunnel if tunnel is None else tunnel
+        k = integer("k", k, minimum=0, maximum=len(self.trajectory) - 1)
+        memo = (self.variant(tun), k)
+        if memo in self._memo:
+            return self._memo[memo]
+        f = self.directory(tun) / f"epoch-{k:03d}.npz"
+        if not f.is_file():
+            self._store(k, tun, f)
+        with np.load(f) as z:
+            out = {name: z[name] for name in z.files}
+        out["array"] = str(out["array"])
+        out["power"] = json.loads(str(out.pop("power_json")))
+        out["count"] = json.loads(str(out.pop("count_json")))
+        out["trace_s"], out["synth_s"] = float(out["trace_s"]), float(out["synth_s"])
+        if len(self._memo) > 4:  # a few epochs in memory (one drive reads each epoch per run)
+            self._memo.clear()
+        self._memo[memo] = out
+        return out
+
+    def _store(self, k: int, tunnel, f: FsPath) -> None:
+        cfg = self.config
+        arr, ep, trace_s = self.trace(k, tunnel)
+        t0 = time.perf_counter()
+        H = element_tensor(
+            ep,
+            cfg.tone_spacing,
+            cfg.n_tones,
+            cfg.symbol_period,
+            cfg.n_symbols,
+            select=ep.valid & (ep.order > 0),
+        )
+        los = ep.mask("los")
+        j = np.argmax(los, axis=1)
+        rows = np.arange(ep.M)
+        kinds = ("los", "specular1", "specular2+", "diffuse")
+        tmp = f.with_name(f".{f.stem}-{os.getpid()}.npz")
+        np.savez(
+            tmp,
+            array=np.array(arr.name),
+            H=H.astype(np.complex64),
+            los_tau=ep.tau[rows, j],
+            los_gain=ep.gain[rows, j],
+            los_doppler=ep.doppler[rows, j],
+            los_valid=los[rows, j],
+            power_json=np.array(json.dumps({kd: ep.power(kd) for kd in kinds})),
+            count_json=np.array(json.dumps({kd: ep.count(kd) for kd in kinds})),
+            trace_s=np.array(trace_s),
+            synth_s=np.array(time.perf_counter() - t0),
+        )
+        os.replace(tmp, f)
+
+    def tensor(self, k: int, *, tunnel=None, los: bool = True) -> tuple[str, np.ndarray]:
+        """``(array name, H)``: the noiseless tensor (M, Nf, Nt) of epoch ``k``, unit transmit
+        power, no clock bias; ``los=False`` leaves the LoS path out (a blocked LoS)."""
+        e = self.epoch(k, tunnel)
+        H = e["H"].astype(complex)
+        if los:
+            cfg = self.config
+            v = e["los_valid"]
+            ep = ElementPaths(
+                e["los_tau"][:, None],
+                e["los_gain"][:, None],
+                e["los_doppler"][:, None],
+                v[:, None],
+                np.zeros((v.size, 1), int),
+                np.zeros((v.size, 1), bool),
+                np.zeros((v.size, 1), np.int64),
+            )
+            H = H + element_tensor(
+                ep, cfg.tone_spacing, cfg.n_tones, cfg.symbol_period, cfg.n_symbols
+            )
+        return e["array"], H
+
+    def prepare(self, tunnel=None, epochs=None, progress: bool = False) -> dict:
+        """Trace (or find in the cache) ``epochs`` (all by default) of ``tunnel``; returns
+        ``{"traced": n newly traced, "trace_s": [...] per epoch, "bytes": cache size}``."""
+        from tqdm.auto import tqdm
+
+        tun = self.tunnel if tunnel is None else tunnel
+        ks = range(len(self.trajectory)) if epochs is None else epochs
+        d = self.directory(tun)
+        traced, times = 0, []
+        for k in tqdm(
+            ks, desc=f"ray tracing {self.label} ({self.variant(tun)})", disable=not progress
+        ):
+            fresh = not (d / f"epoch-{int(k):03d}.npz").is_file()
+            e = self.epoch(int(k), tun)
+            traced += fresh
+            times.append(e["trace_s"])
+        size = sum(f.stat().st_size for f in d.iterdir() if f.is_file())
+        return {"traced": traced, "trace_s": times, "bytes": size, "directory": str(d)}

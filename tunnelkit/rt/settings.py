@@ -1,0 +1,137 @@
+"""What the ray-traced channel needs besides the tunnel: materials, diffuse scattering, depth.
+
+:class:`RTSettings` is the optional ``[raytracing]`` section of a scenario (all keys have
+defaults, :meth:`RTSettings.from_scenario`). Materials are ITU-R P.2040 models, evaluated by
+Sionna RT at the scenario's carrier:
+
+* the tunnel shell (walls and ceiling facets): ``"concrete"`` (ITU concrete, 0.3 m slab);
+* the road: ``"asphalt"``. ITU-R P.2040 has no asphalt; tunnelkit maps it to the ITU
+  ``"very_dry_ground"`` model (relative permittivity 3, conductivity 1.5e-4 f_GHz^2.52 S/m,
+  valid 1-10 GHz; about 0.013 S/m at 5.9 GHz), the nearest of the ITU models to the permittivity
+  of dry asphalt (about 3-6 at 5-6 GHz), on a 0.05 m slab;
+* the road markings (RRMs) and blocker boxes: ``"metal"``.
+
+Diffuse scattering (Sionna's model, Degli-Esposti 2007): a surface with scattering coefficient
+``S`` in [0, 1] keeps ``sqrt(1 - S^2)`` of the specular field and scatters ``S^2`` of the
+reflected power in a ``"lambertian"`` lobe or a ``"directive"`` one of width parameter
+``alpha_r`` (an integer >= 1; larger is narrower, around the specular direction). ``S`` applies
+to the shell and the road; ``metal_scattering_coefficient`` (0 by default: smooth plates) to the
+plates and blockers. ``max_depth`` is the number of bounces traced (2: second-order specular
+paths and diffuse paths of up to two interactions). ``samples_per_src`` is the number of rays
+shot from the vehicle (Fibonacci directions); the diffuse power is a Monte-Carlo estimate over
+them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict, dataclass
+
+from .._validate import choice, integer, nonnegative
+
+__all__ = [
+    "ANTENNA_PATTERNS",
+    "MATERIALS",
+    "SCATTERING_PATTERNS",
+    "RTSettings",
+]
+
+#: tunnelkit material name -> (ITU-R P.2040 material type in Sionna RT, slab thickness [m])
+MATERIALS: dict[str, tuple[str, float]] = {
+    "concrete": ("concrete", 0.3),
+    "asphalt": ("very_dry_ground", 0.05),
+    "metal": ("metal", 0.01),
+    "brick": ("brick", 0.2),
+    "marble": ("marble", 0.05),
+    "glass": ("glass", 0.01),
+    "medium_dry_ground": ("medium_dry_ground", 0.1),
+    "wet_ground": ("wet_ground", 0.1),
+}
+#: Sionna's scattering lobes
+SCATTERING_PATTERNS = ("lambertian", "directive")
+#: element patterns (one receiver per element, oriented along the array's boresight):
+#: ``"iso"`` (isotropic, as the image method) or Sionna's ``"tr38901"`` (3GPP TR 38.901 element)
+ANTENNA_PATTERNS = ("iso", "tr38901")
+
+
+def _material(name: str, value) -> str:
+    if not isinstance(value, str) or value not in MATERIALS:
+        raise ValueError(
+            f"{name}: unknown material {value!r}; expected one of {', '.join(sorted(MATERIALS))}"
+        )
+    return value
+
+
+def _coefficient(name: str, value) -> float:
+    s = nonnegative(name, value)
+    if s > 1.0:
+        raise ValueError(f"{name}: a scattering coefficient must lie in [0, 1], got {s}")
+    return s
+
+
+@dataclass(frozen=True)
+class RTSettings:
+    """The ray tracer's scene and solver settings (module docstring); defaults documented there.
+
+    >>> RTSettings(scattering_coefficient=1.5)
+    Traceback (most recent call last):
+    ...
+    ValueError: scattering_coefficient: a scattering coefficient must lie in [0, 1], got 1.5
+    """
+
+    scattering_coefficient: float = 0.3
+    metal_scattering_coefficient: float = 0.0
+    scattering_pattern: str = "lambertian"
+    alpha_r: int = 4
+    max_depth: int = 2
+    samples_per_src: int = 20_000
+    wall_material: str = "concrete"
+    road_material: str = "asphalt"
+    rrm_material: str = "metal"
+    antenna_pattern: str = "iso"
+
+    def __post_init__(self) -> None:
+        _coefficient("scattering_coefficient", self.scattering_coefficient)
+        _coefficient("metal_scattering_coefficient", self.metal_scattering_coefficient)
+        choice("scattering_pattern", self.scattering_pattern, SCATTERING_PATTERNS)
+        integer("alpha_r", self.alpha_r, minimum=1, maximum=100)
+        integer("max_depth", self.max_depth, minimum=1, maximum=5)
+        integer("samples_per_src", self.samples_per_src, minimum=100, maximum=10_000_000)
+        for key in ("wall_material", "road_material", "rrm_material"):
+            _material(key, getattr(self, key))
+        choice("antenna_pattern", self.antenna_pattern, ANTENNA_PATTERNS)
+
+    @property
+    def diffuse(self) -> bool:
+        """True when some surface scatters (a coefficient above zero)."""
+        return self.scattering_coefficient > 0 or self.metal_scattering_coefficient > 0
+
+    def material_for(self, kind: str) -> tuple[str, str, float, float]:
+        """``(tunnelkit material, ITU type, thickness [m], scattering coefficient)`` of a surface
+        of ``kind`` ("wall", "ceiling", "road", "rrm", "blocker"; anything else is shell)."""
+        if kind == "road":
+            name = self.road_material
+        elif kind in ("rrm", "blocker"):
+            name = self.rrm_material if kind == "rrm" else "metal"
+        else:
+            name = self.wall_material
+        itu, thickness = MATERIALS[name]
+        s = self.metal_scattering_coefficient if name == "metal" else self.scattering_coefficient
+        return name, itu, thickness, s
+
+    def fingerprint(self) -> str:
+        """A stable hash of every setting (part of the ray-tracing cache key)."""
+        return hashlib.sha256(json.dumps(asdict(self), sort_keys=True).encode()).hexdigest()
+
+    @classmethod
+    def from_scenario(cls, scenario, **overrides) -> RTSettings:
+        """The scenario's ``[raytracing]`` section (absent: every default), ``overrides`` on top."""
+        kw = dict(scenario.sections.get("raytracing") or {})
+        kw.update(overrides)
+        unknown = sorted(set(kw) - set(cls.__dataclass_fields__))
+        if unknown:
+            raise ValueError(
+                f"raytracing: unknown key(s) {unknown}; expected {sorted(cls.__dataclass_fields__)}"
+            )
+        return cls(**kw)
