@@ -310,3 +310,22 @@ def test_a_pool_shares_one_cluster_between_steps_with_the_serial_numbers():
         run_trials(_draw, 2, seed=0, pool=pool, workers=1)
     with pytest.raises(TypeError, match="pool"):
         run_trials(_draw, 2, seed=0, pool="cluster")
+
+
+def test_a_cluster_without_workers_stops_the_run_instead_of_hanging(monkeypatch):
+    # workers killed and never restarted (seen on a loaded machine) left a run waiting for ever
+    import tunnelkit.montecarlo as mc
+
+    monkeypatch.setattr(mc, "NO_WORKER_WAIT_S", 2.0)
+    with LocalCluster(
+        n_workers=0,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",
+        scheduler_kwargs={"dashboard": False},
+        silence_logs=40,
+    ) as empty:
+        t0 = time.perf_counter()
+        with pytest.raises(TrialLost, match=r"no worker for 2 s"):
+            run_trials(_draw, 3, seed=0, scheduler=empty.scheduler_address)
+        assert time.perf_counter() - t0 < 60.0

@@ -504,19 +504,36 @@ def _run_dask(
     return out
 
 
+NO_WORKER_WAIT_S = 120.0
+"""Seconds a Dask run waits for a worker when its cluster has none (a nanny restarting a killed
+worker on a loaded machine takes seconds; a cluster whose workers are all gone never finishes)."""
+
+
 def _as_completed(as_completed, futures, client, trial_timeout, index, desc) -> Iterator[Any]:
-    """Futures as they finish; :class:`TrialTimeout` when none finished for ``trial_timeout``."""
+    """Futures as they finish; :class:`TrialTimeout` when none finished for ``trial_timeout``,
+    :class:`TrialLost` when the cluster has had no worker for ``NO_WORKER_WAIT_S``."""
     import time
 
     ac = as_completed(futures, loop=client.loop)
-    if trial_timeout is None:
-        yield from ac
-        return
     left, last = len(futures), time.monotonic()
+    checked, workerless = last, None
     while left:
         batch = ac.next_batch(block=False) if ac.has_ready() else []
         if not batch:
-            if time.monotonic() - last > trial_timeout:
+            now = time.monotonic()
+            if now - checked > 1.0:  # a cluster left without workers never finishes anything
+                checked = now
+                workerless = None if client.nthreads() else (workerless or now)
+                if workerless is not None and now - workerless > NO_WORKER_WAIT_S:
+                    late = sorted(index[f.key] for f in futures if not f.done())
+                    for f in futures:
+                        f.cancel()
+                    raise TrialLost(
+                        f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of "
+                        f"{len(futures)} ({desc}) were lost: the cluster has had no worker for "
+                        f"{NO_WORKER_WAIT_S:g} s (workers died and were not restarted)"
+                    )
+            if trial_timeout is not None and now - last > trial_timeout:
                 late = sorted(index[f.key] for f in futures if not f.done())
                 for f in futures:
                     f.cancel()
