@@ -504,6 +504,14 @@ def _run_dask(
     return out
 
 
+def _cancel_late(futures, index) -> str:
+    """Cancel every future and name the trials that had not finished ("trials [..] of N")."""
+    late = sorted(index[f.key] for f in futures if not f.done())
+    for f in futures:
+        f.cancel()
+    return f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of {len(futures)}"
+
+
 NO_WORKER_WAIT_S = 120.0
 """Seconds a Dask run waits for a worker when its cluster has none (a nanny restarting a killed
 worker on a loaded machine takes seconds; a cluster whose workers are all gone never finishes)."""
@@ -525,21 +533,14 @@ def _as_completed(as_completed, futures, client, trial_timeout, index, desc) -> 
                 checked = now
                 workerless = None if client.nthreads() else (workerless or now)
                 if workerless is not None and now - workerless > NO_WORKER_WAIT_S:
-                    late = sorted(index[f.key] for f in futures if not f.done())
-                    for f in futures:
-                        f.cancel()
                     raise TrialLost(
-                        f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of "
-                        f"{len(futures)} ({desc}) were lost: the cluster has had no worker for "
-                        f"{NO_WORKER_WAIT_S:g} s (workers died and were not restarted)"
+                        f"{_cancel_late(futures, index)} ({desc}) were lost: the cluster has had "
+                        f"no worker for {NO_WORKER_WAIT_S:g} s (workers died and were not restarted)"
                     )
             if trial_timeout is not None and now - last > trial_timeout:
-                late = sorted(index[f.key] for f in futures if not f.done())
-                for f in futures:
-                    f.cancel()
                 raise TrialTimeout(
-                    f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of {len(futures)} "
-                    f"({desc}): none finished within trial_timeout = {trial_timeout:g} s"
+                    f"{_cancel_late(futures, index)} ({desc}): none finished within "
+                    f"trial_timeout = {trial_timeout:g} s"
                 )
             time.sleep(0.02)
             continue
