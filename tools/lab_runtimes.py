@@ -1,0 +1,193 @@
+"""How long Run All takes in JupyterLab itself: every notebook opened in a real JupyterLab in
+Chromium, Run > Run All Cells clicked, the time until its last cell has run.
+
+    python tools/lab_runtimes.py              # quick mode (TUNNELKIT_QUICK=1), every notebook
+    python tools/lab_runtimes.py 05 06        # only these chapters
+    python tools/lab_runtimes.py --markdown   # the table as markdown
+
+``tools/runtimes.py`` runs the notebooks with nbclient (the same kernel messages as Run All); this
+tool is the lecturer's view: JupyterLab (served on a free loopback port from a temporary copy of
+the notebooks, stopped by its process id) renders every output, every plotly figure and widget,
+in headless Chromium (``make chromium``). A copy of each notebook gets one extra last cell that
+writes the wall-clock time and the kernel's CPU time to a file; the clock starts when "Run All
+Cells" is clicked, after the kernel has reported Idle (the kernel's start-up is not included; the
+page's rendering of outputs is). A cell that fails stops Run All, so a notebook whose last cell
+never runs within ``--timeout`` is reported as failed. Each notebook gets its own JupyterLab server,
+stopped before the next one starts, so they run one after the other on an otherwise idle machine; the load average
+before and after is printed beside each time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _lecture import (
+    CHROMIUM,
+    HOST,
+    ROOT,
+    LectureError,
+    die,
+    free_port,
+    kernel_env,
+    list_notebooks,
+    resolve_notebook,
+    serving,
+)
+
+STAMP = """import json as _json, resource as _resource, time as _time
+_s, _c = _resource.getrusage(_resource.RUSAGE_SELF), _resource.getrusage(_resource.RUSAGE_CHILDREN)
+open({path!r}, "w").write(_json.dumps({{"t": _time.time(), "cpu": _s.ru_utime + _s.ru_stime + _c.ru_utime + _c.ru_stime}}))
+"""
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-sync"]
+
+
+def _stamped_copy(src: Path, work: Path) -> tuple[Path, Path]:
+    """A copy of ``src`` in ``work`` with the time-stamp cell appended; the stamp file's path."""
+    import nbformat
+
+    nb = nbformat.read(src, as_version=4)
+    stamp = work / f"{src.stem}.done.json"
+    nb.cells.append(nbformat.v4.new_code_cell(STAMP.format(path=str(stamp))))
+    dest = work / src.name
+    nbformat.write(nb, dest)
+    return dest, stamp
+
+
+def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout: float) -> dict:
+    """Serve ``root`` with JupyterLab, open ``nb_path``, click Run All, wait for ``stamp``."""
+    port = free_port()
+    base = f"http://{HOST}:{port}/"
+    cmd = [
+        sys.executable,
+        "-m",
+        "jupyterlab",
+        "--no-browser",
+        f"--port={port}",
+        f"--ServerApp.ip={HOST}",
+        "--IdentityProvider.token=",
+        "--ServerApp.password=",
+        f"--ServerApp.root_dir={root}",
+        "--LabApp.news_url=",
+        f"--LabApp.workspaces_dir={root / ('workspaces-' + nb_path.stem)}",  # no restored tabs
+        "--allow-root",
+    ]
+    env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{nb_path.stem}")}  # no user settings
+    with serving(cmd, base + "api", env=env, log=root / f"{nb_path.stem}.log", timeout=180):
+        page = browser.new_page(viewport={"width": 1400, "height": 900})
+        try:
+            page.goto(base + f"lab/tree/{nb_path.name}", timeout=180_000)
+            page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
+            page.wait_for_function("document.body.innerText.includes('| Idle')", timeout=180_000)
+            load0 = os.getloadavg()[0]
+            page.get_by_role("menuitem", name="Run", exact=True).click()
+            t0 = time.time()
+            page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
+            while not stamp.exists() and time.time() - t0 < timeout:
+                page.wait_for_timeout(200)
+            page.wait_for_timeout(300)  # the stamp file is being written: let it close
+        finally:
+            page.close()
+    if not stamp.exists():
+        raise LectureError(
+            f"{nb_path.name}: Run All did not reach its last cell within {timeout:.0f} s "
+            "(a failing cell stops Run All)"
+        )
+    done = json.loads(stamp.read_text())
+    return {
+        "notebook": nb_path.stem,
+        "wall_s": done["t"] - t0,
+        "cpu_s": done["cpu"],
+        "load_before": load0,
+        "load_after": os.getloadavg()[0],
+    }
+
+
+def measure_all(books: list[Path], *, timeout: float) -> list[dict]:
+    from playwright.sync_api import sync_playwright
+
+    if not os.access(CHROMIUM, os.X_OK):
+        raise LectureError(f"{CHROMIUM} is missing: run `make chromium`")
+    tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-"))
+    try:
+        copies = [_stamped_copy(b, tmp) for b in books]
+        env = kernel_env(quick=True)
+        env["PYTHONPATH"] = str(ROOT)
+        rows = []
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
+            try:
+                for nb_path, stamp in copies:  # a fresh server per notebook: nothing carried over
+                    rows.append(_run_all(browser, nb_path, stamp, tmp, env, timeout))
+                    r = rows[-1]
+                    print(
+                        f"  {r['notebook']}: Run All {r['wall_s']:.1f} s, kernel CPU "
+                        f"{r['cpu_s']:.1f} s (load {r['load_before']:.1f}-{r['load_after']:.1f})",
+                        flush=True,
+                    )
+            finally:
+                browser.close()
+        return rows
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def table(rows: list[dict], markdown: bool) -> str:
+    head = ("notebook", "Run All in JupyterLab [s]", "kernel CPU [s]", "load avg (1 min)")
+    body = [
+        (
+            r["notebook"],
+            f"{r['wall_s']:.1f}",
+            f"{r['cpu_s']:.1f}",
+            f"{r['load_before']:.1f}-{r['load_after']:.1f}",
+        )
+        for r in rows
+    ]
+    if markdown:
+        lines = ["| " + " | ".join(head) + " |", "| " + " | ".join("---" for _ in head) + " |"]
+        return "\n".join(lines + ["| " + " | ".join(b) + " |" for b in body])
+    widths = [max(len(x) for x in col) for col in zip(head, *body, strict=True)]
+    return "\n".join(
+        "  ".join(x.ljust(w) if i == 0 else x.rjust(w) for i, (x, w) in enumerate(zip(r, widths)))
+        for r in (head, *body)
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("notebooks", nargs="*", help="chapter numbers or names (default: all)")
+    ap.add_argument("--timeout", type=float, default=600.0, help="seconds per notebook (600)")
+    ap.add_argument("--markdown", action="store_true", help="print the table as markdown")
+    ap.add_argument("--json", type=Path, default=None, help="also write the rows to this file")
+    args = ap.parse_args(argv)
+    if not args.timeout > 0:
+        return die(f"--timeout must be > 0, got {args.timeout}")
+    try:
+        books = [resolve_notebook(n) for n in args.notebooks] or list_notebooks()
+    except LectureError as exc:
+        return die(str(exc))
+    print(
+        f"{len(books)} notebook(s), quick mode, JupyterLab in Chromium, {os.cpu_count()} CPU(s), "
+        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}",
+        flush=True,
+    )
+    try:
+        rows = measure_all(books, timeout=args.timeout)
+    except LectureError as exc:
+        return die(str(exc), 1)
+    print(table(rows, args.markdown))
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
