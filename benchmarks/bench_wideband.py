@@ -29,8 +29,8 @@ from bench_achievable import extraction_errors
 
 from tunnelkit import propagation
 from tunnelkit.channel import synthesize
-from tunnelkit.constants import C
 from tunnelkit.design import DesignImpairments, DesignSetup, achievable_bound
+from tunnelkit.extraction import ml_truth
 from tunnelkit.extraction.ml import ml_paths
 
 SCEN = "example-rectangular-28ghz"
@@ -113,13 +113,7 @@ def cases() -> list:
     paths = propagation.trace_paths(setup.tunnel, arr, ue, vel, fc=setup.fc, kinds=setup.kinds)
     cfg = setup.config
     H = synthesize(paths, cfg, np.random.default_rng(0), clock_bias=0.0, spatial_wideband=True).H
-    src = np.stack([arr.to_local(p.source) for p in paths])
-    r = np.linalg.norm(src, axis=1)
-    start = (
-        np.column_stack([src[:, :2] / r[:, None], 1 / r]),
-        -2 * np.pi * cfg.tone_spacing * np.array([p.length for p in paths]) / C,
-        2 * np.pi * cfg.symbol_period * np.array([p.doppler for p in paths]),
-    )
+    start = ml_truth(paths, arr, cfg)
 
     def fit(wb):
         with warnings.catch_warnings():

@@ -121,7 +121,7 @@ def _jiang():
 
 def _signal_route():
     from tunnelkit import signal_route
-    from tunnelkit.extraction import extract_paths, path_crlb
+    from tunnelkit.extraction import extract_paths, ml_truth, path_crlb
 
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     rng = np.random.default_rng(0)
@@ -130,6 +130,7 @@ def _signal_route():
     snap = route.snapshot(paths, arr, rng)
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
+    ml_truth(paths, arr, route.config)
     del ep
 
 

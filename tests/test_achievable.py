@@ -447,7 +447,7 @@ def test_the_wideband_model_s_fisher_information_is_eq1_s_to_one_percent():
     Gauss-Newton matrix at the truth, :class:`~tunnelkit.extraction.ml.WidebandProblem`) are
     within 1 % of eq. 1's for every path parameter, near (9.8 m) and far (60 m), 8 x 8."""
     from tunnelkit import propagation
-    from tunnelkit.extraction import ml
+    from tunnelkit.extraction import ml, ml_truth
 
     setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
     cfg = setup.config
@@ -455,13 +455,7 @@ def test_the_wideband_model_s_fisher_information_is_eq1_s_to_one_percent():
         ue, vel = setup.trajectory.position[ep], setup.trajectory.velocity[ep]
         arr = propagation.select_array(setup.arrays("8x8"), ue)
         paths = propagation.trace_paths(setup.tunnel, arr, ue, vel, fc=setup.fc, kinds=setup.kinds)
-        src = np.stack([arr.to_local(p.source) for p in paths])
-        r = np.linalg.norm(src, axis=1)
-        truth = (
-            np.column_stack([src[:, :2] / r[:, None], 1 / r]),
-            -2 * np.pi * cfg.tone_spacing * np.array([p.length for p in paths]) / C,
-            2 * np.pi * cfg.symbol_period * np.array([p.doppler for p in paths]),
-        )
+        truth = ml_truth(paths, arr, cfg)
         H = channel.channel_tensor(paths, cfg, n_symbols=2, spatial_wideband=True)
         wb = ml.WidebandProblem(H, arr.local, cfg.fc, cfg.tone_spacing).evaluate(*truth)["A"]
         H0 = channel.channel_tensor(paths, cfg, n_symbols=2)

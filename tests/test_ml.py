@@ -4,6 +4,7 @@ import warnings
 
 import numpy as np
 import pytest
+from fd_helpers import central_differences, flat, unflat
 
 from tunnelkit import arrays, channel, evaluation, extraction, signal_route
 from tunnelkit.constants import C
@@ -56,15 +57,6 @@ def test_spatial_phase_derivatives_match_central_differences(w):
         np.testing.assert_allclose(ana, fd, rtol=1e-6, atol=1e-7 * np.abs(fd).max())
 
 
-def _flat(th, mf, mt):
-    return np.column_stack([th, mf, mt]).ravel()
-
-
-def _unflat(x):
-    x = x.reshape(-1, 5)
-    return x[:, :3].copy(), x[:, 3].copy(), x[:, 4].copy()
-
-
 def test_varpro_gradient_matches_central_differences_of_the_projected_cost():
     """``Re <D_i, r>`` (Kaufman) is minus half the exact gradient of ``||P_perp h||^2``."""
     sc = _scene(11)
@@ -72,16 +64,12 @@ def test_varpro_gradient_matches_central_differences_of_the_projected_cost():
     prob = ml.Problem(H, sc.element_positions, FC)
     th, mf, mt = _truth(sc)
     th = th + np.array([0.01, -0.008, 0.02])  # away from the optimum: a gradient to see
-    x = _flat(th, mf + 0.01, mt - 0.02)
-    ev = prob.evaluate(*_unflat(x))
+    x = flat(th, mf + 0.01, mt - 0.02)
+    ev = prob.evaluate(*unflat(x))
     steps = np.tile([1e-7, 1e-7, 1e-6, 1e-7, 1e-7], 3)
-    fd = np.empty(x.size)
-    for i in range(x.size):
-        e = np.zeros(x.size)
-        e[i] = steps[i]
-        cp = prob.evaluate(*_unflat(x + e), derivatives=False)["cost"]
-        cm = prob.evaluate(*_unflat(x - e), derivatives=False)["cost"]
-        fd[i] = (cp - cm) / (2 * steps[i])
+    fd = central_differences(
+        lambda y: prob.evaluate(*unflat(y), derivatives=False)["cost"], x, steps
+    )
     np.testing.assert_allclose(-2 * ev["g"], fd, rtol=2e-4, atol=1e-4 * np.abs(fd).max())
 
 
@@ -91,16 +79,10 @@ def test_gauss_newton_matrix_is_the_hessian_at_a_noiseless_optimum():
     sc = _scene(12, n_paths=2)
     H = sc.tensor()
     prob = ml.Problem(H, sc.element_positions, FC)
-    x = _flat(*_truth(sc))
-    A = prob.evaluate(*_unflat(x))["A"]
+    x = flat(*_truth(sc))
+    A = prob.evaluate(*unflat(x))["A"]
     steps = np.tile([1e-6, 1e-6, 1e-5, 1e-6, 1e-6], 2)
-    hess = np.empty_like(A)
-    for i in range(x.size):
-        e = np.zeros(x.size)
-        e[i] = steps[i]
-        gp = -2 * prob.evaluate(*_unflat(x + e))["g"]
-        gm = -2 * prob.evaluate(*_unflat(x - e))["g"]
-        hess[:, i] = (gp - gm) / (2 * steps[i])
+    hess = central_differences(lambda y: -2 * prob.evaluate(*unflat(y))["g"], x, steps)
     np.testing.assert_allclose(2 * A, hess, rtol=1e-4, atol=1e-5 * np.abs(hess).max())
 
 

@@ -6,27 +6,19 @@ import warnings
 
 import numpy as np
 import pytest
+from fd_helpers import central_differences, flat, unflat
 
 from tunnelkit import arrays, channel, propagation
 from tunnelkit.channel import channel_tensor
 from tunnelkit.constants import C
 from tunnelkit.design import DesignImpairments, DesignSetup, path_error_model
-from tunnelkit.extraction import ml
+from tunnelkit.extraction import ml, ml_truth
 
 FC = 28e9
 LAM = C / FC
 K0 = 2 * np.pi / LAM
 DF = 40e6  # 16 tones x 40 MHz: 640 MHz around 28 GHz, a term large enough to see
 SRS = channel.SRSConfig(fc=FC, bandwidth=400e6, scs=120e3, n_rb=264, comb=4)
-
-
-def _flat(th, mf, mt):
-    return np.column_stack([th, mf, mt]).ravel()
-
-
-def _unflat(x):
-    x = x.reshape(-1, 5)
-    return x[:, :3].copy(), x[:, 3].copy(), x[:, 4].copy()
 
 
 @pytest.fixture(scope="module")
@@ -69,33 +61,23 @@ def test_gradient_matches_central_differences_of_the_projected_cost(toy):
     rng = np.random.default_rng(5)
     H = prob.H + 0.05 * (rng.standard_normal(prob.H.shape) + 1j * rng.standard_normal(prob.H.shape))
     prob = ml.WidebandProblem(H, prob.pos, FC, DF)
-    x = _flat(th + np.array([0.004, -0.003, 0.01]), mf + 0.01, mt - 0.02)
-    ev = prob.evaluate(*_unflat(x))
+    x = flat(th + np.array([0.004, -0.003, 0.01]), mf + 0.01, mt - 0.02)
+    ev = prob.evaluate(*unflat(x))
     steps = np.tile([1e-7, 1e-7, 1e-6, 1e-7, 1e-7], 2)
-    fd = np.empty(x.size)
-    for i in range(x.size):
-        e = np.zeros(x.size)
-        e[i] = steps[i]
-        cp = prob.evaluate(*_unflat(x + e), derivatives=False)["cost"]
-        cm = prob.evaluate(*_unflat(x - e), derivatives=False)["cost"]
-        fd[i] = (cp - cm) / (2 * steps[i])
+    fd = central_differences(
+        lambda y: prob.evaluate(*unflat(y), derivatives=False)["cost"], x, steps
+    )
     np.testing.assert_allclose(-2 * ev["g"], fd, rtol=2e-4, atol=1e-4 * np.abs(fd).max())
 
 
 def test_gauss_newton_matrix_is_the_hessian_at_a_noiseless_optimum(toy):
     prob, truth, c = toy
-    x = _flat(*truth)
+    x = flat(*truth)
     ev = prob.evaluate(*truth)
     np.testing.assert_allclose(ev["c"], c, rtol=1e-10)
     assert ev["cost"] < 1e-12 * prob.h2
     steps = np.tile([1e-6, 1e-6, 1e-5, 1e-6, 1e-6], 2)
-    hess = np.empty_like(ev["A"])
-    for i in range(x.size):
-        e = np.zeros(x.size)
-        e[i] = steps[i]
-        gp = -2 * prob.evaluate(*_unflat(x + e))["g"]
-        gm = -2 * prob.evaluate(*_unflat(x - e))["g"]
-        hess[:, i] = (gp - gm) / (2 * steps[i])
+    hess = central_differences(lambda y: -2 * prob.evaluate(*unflat(y))["g"], x, steps)
     np.testing.assert_allclose(2 * ev["A"], hess, rtol=1e-4, atol=1e-5 * np.abs(hess).max())
 
 
@@ -108,14 +90,7 @@ def route_epoch():
     ue, vel = setup.trajectory.position[ep], setup.trajectory.velocity[ep]
     arr = propagation.select_array(setup.arrays("4x4"), ue)
     paths = propagation.trace_paths(setup.tunnel, arr, ue, vel, fc=setup.fc, kinds=setup.kinds)
-    cfg = setup.config
-    src = np.stack([arr.to_local(p.source) for p in paths])
-    r = np.linalg.norm(src, axis=1)
-    truth = (
-        np.column_stack([src[:, :2] / r[:, None], 1 / r]),
-        -2 * np.pi * cfg.tone_spacing * np.array([p.length for p in paths]) / C,
-        2 * np.pi * cfg.symbol_period * np.array([p.doppler for p in paths]),
-    )
+    truth = ml_truth(paths, arr, setup.config)
     return setup, arr, paths, truth
 
 
@@ -128,6 +103,31 @@ def test_the_model_is_the_channel_s_synthesis(route_epoch):
     prob = ml.WidebandProblem(H, arr.local, cfg.fc, cfg.tone_spacing)
     c = np.sqrt(cfg.tx_power) * np.array([p.gain for p in paths])
     np.testing.assert_allclose(prob.model(*truth, c), H, rtol=1e-9, atol=1e-9 * np.abs(H).max())
+
+
+def test_ml_truth_points_at_the_wave_origins_and_refuses_bad_input_by_name(route_epoch):
+    """``(u_x, u_y, u_z) / w`` (``u_z > 0``: the origins face the array) is each path's VUE in
+    the array's frame, ``mu_f`` / ``mu_t`` the phase steps of its length and Doppler; the test
+    above checks the same values against the channel's synthesis."""
+    setup, arr, paths, (th, mf, mt) = route_epoch
+    cfg = setup.config
+    uz = np.sqrt(1 - th[:, 0] ** 2 - th[:, 1] ** 2)
+    origin = np.column_stack([th[:, :2], uz]) / th[:, 2:]
+    np.testing.assert_allclose(arr.to_world(origin), [p.source for p in paths], atol=1e-9)
+    tau = np.array([p.length for p in paths]) / C
+    np.testing.assert_allclose(np.exp(1j * mf), np.exp(-2j * np.pi * cfg.tone_spacing * tau))
+    dop = np.array([p.doppler for p in paths])
+    np.testing.assert_allclose(np.exp(1j * mt), np.exp(2j * np.pi * cfg.symbol_period * dop))
+    with pytest.raises(ValueError, match=r"^paths"):
+        ml_truth([], arr, cfg)
+    with pytest.raises(TypeError, match=r"^paths\[1\]"):
+        ml_truth([paths[0], "los"], arr, cfg)
+    with pytest.raises(TypeError, match=r"^paths"):
+        ml_truth(paths[0], arr, cfg)
+    with pytest.raises(TypeError, match=r"^array"):
+        ml_truth(paths, arr.local, cfg)
+    with pytest.raises(TypeError, match=r"^srs"):
+        ml_truth(paths, arr, cfg.fc)
 
 
 def test_the_wideband_fit_is_unbiased_where_eq1_s_is_not(route_epoch):

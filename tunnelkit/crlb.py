@@ -44,8 +44,20 @@ def wrap_angle(a):
 
 
 def _wrap(a: np.ndarray) -> np.ndarray:
-    """:func:`wrap_angle` without the input check (inner loops that already hold floats)."""
-    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+    """:func:`wrap_angle` without the input check (inner loops that already hold floats).
+
+    ``pi - mod(pi - a, 2 pi)``; ``mod`` returns its argument unchanged where it already lies in
+    ``[0, 2 pi)`` (most residuals), so the slow floating-point ``mod`` runs only on the others:
+    the result is bit for bit the same.
+    """
+    b = np.pi - a
+    if b.size < 64:  # a few angles: the plain formula is quicker than the test
+        return np.pi - np.mod(b, 2.0 * np.pi)
+    out = np.pi - b
+    far = (b < 0.0) | (b >= 2.0 * np.pi)
+    if far.any():
+        out[far] = np.pi - np.mod(b[far], 2.0 * np.pi)
+    return out
 
 
 def _points_and_stations(p, stations) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -58,9 +70,10 @@ def _points_and_stations(p, stations) -> tuple[np.ndarray, np.ndarray, np.ndarra
     dx = p[..., None, 0] - st[:, 0]
     dy = p[..., None, 1] - st[:, 1]
     d2 = dx * dx + dy * dy
-    scale = max(float(np.max(np.abs(p), initial=0.0)), float(np.max(np.abs(st))), 1.0)
-    if np.any(d2 <= (1e-12 * scale) ** 2):
-        raise ValueError("p: coincides with a station, range and bearing are undefined there")
+    if d2.size:  # a station closer than 1e-12 of the largest coordinate (at least 1 m)
+        scale = max(float(p.max()), -float(p.min()), float(st.max()), -float(st.min()), 1.0)
+        if d2.min() <= (1e-12 * scale) ** 2:
+            raise ValueError("p: coincides with a station, range and bearing are undefined there")
     return p, st, dx, dy
 
 

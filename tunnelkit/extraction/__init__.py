@@ -25,7 +25,7 @@ a :class:`tunnelkit.arrays.ArrayGeometry` (or (M, 3) local element positions), `
 
 from __future__ import annotations
 
-from .bounds import crlb_paths, estimate_crlb, path_crlb
+from .bounds import crlb_paths, estimate_crlb, ml_truth, path_crlb
 from .decomposition import (
     CPDConvergenceWarning,
     CPDResult,
@@ -69,6 +69,7 @@ __all__ = [
     "extract_paths",
     "kruskal_rank",
     "max_identifiable_rank",
+    "ml_truth",
     "normalize_factors",
     "paper_route",
     "path_crlb",

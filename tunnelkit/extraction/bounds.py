@@ -10,7 +10,14 @@ from ..constants import C, db2lin
 from .estimates import PathEstimates
 from .radio import check_array, check_srs
 
-__all__ = ["crlb_paths", "estimate_crlb", "in_path_units", "path_crlb", "source_crlb"]
+__all__ = [
+    "crlb_paths",
+    "estimate_crlb",
+    "in_path_units",
+    "ml_truth",
+    "path_crlb",
+    "source_crlb",
+]
 
 
 def crlb_paths(
@@ -120,10 +127,9 @@ def path_crlb(
     nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=1)
     off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
     noise_power = config.noise_power / float(db2lin(off))
+    _, mu_f, mu_t = ml_truth(paths, array, config)  # checks paths too
     alpha = np.sqrt(config.tx_power) * np.array([p.gain for p in paths])
     src = np.stack([array.to_local(p.source) for p in paths])
-    mu_f = -2 * np.pi * config.tone_spacing * np.array([p.length for p in paths]) / C
-    mu_t = 2 * np.pi * config.symbol_period * np.array([p.doppler for p in paths])
     out = source_crlb(
         alpha,
         src,
@@ -137,6 +143,48 @@ def path_crlb(
         spatial=spatial,
     )
     return in_path_units(out, config)
+
+
+def ml_truth(paths, array, srs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The true values of the maximum-likelihood model's parameters for traced paths: what
+    :mod:`tunnelkit.extraction.ml` (``Problem``, ``WidebandProblem``, ``ml_paths``) estimates.
+
+    Returns ``(theta, mu_f, mu_t)``:
+
+    - ``theta`` (L, 3): per path ``(u_x, u_y, w)``: the direction cosines [-] of the unit vector
+      from the array's reference element towards the wave origin (the VUE; the vehicle itself for
+      LoS) in the array's local frame, and ``w = 1 / r`` [1/m], the wavefront's curvature, ``r``
+      [m] the distance to the wave origin (the wave origin is ``(u_x, u_y, u_z) / w``);
+    - ``mu_f`` (L,): the delay as the phase step between adjacent tones,
+      ``-2 pi Delta_f d / c`` [rad], ``d`` the path length [m], ``Delta_f`` the tone spacing of
+      ``srs`` [Hz];
+    - ``mu_t`` (L,): the Doppler as the phase step between symbols, ``2 pi T_s f_D`` [rad],
+      ``T_s`` the symbol period [s], ``f_D`` the path's Doppler shift [Hz].
+
+    ``paths`` are the :class:`tunnelkit.propagation.Path` traced to ``array`` (an
+    :class:`~tunnelkit.arrays.ArrayGeometry`), ``srs`` the :class:`~tunnelkit.channel.SRSConfig`.
+    """
+    from ..propagation import Path
+
+    if not isinstance(array, ArrayGeometry):
+        raise TypeError(f"array: expected an ArrayGeometry, got {type(array).__name__}")
+    config = check_srs(srs)
+    if isinstance(paths, Path) or not hasattr(paths, "__iter__"):
+        raise TypeError(
+            f"paths: expected a sequence of propagation.Path, got {type(paths).__name__}"
+        )
+    paths = list(paths)
+    if not paths:
+        raise ValueError("paths: need at least one path")
+    for i, p in enumerate(paths):
+        if not isinstance(p, Path):
+            raise TypeError(f"paths[{i}]: expected a propagation.Path, got {type(p).__name__}")
+    src = np.stack([array.to_local(p.source) for p in paths])
+    r = np.linalg.norm(src, axis=1)
+    theta = np.column_stack([src[:, :2] / r[:, None], 1 / r])
+    mu_f = -2 * np.pi * config.tone_spacing * np.array([p.length for p in paths]) / C
+    mu_t = 2 * np.pi * config.symbol_period * np.array([p.doppler for p in paths])
+    return theta, mu_f, mu_t
 
 
 def in_path_units(bound: dict, config) -> dict[str, np.ndarray]:

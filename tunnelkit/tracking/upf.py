@@ -110,14 +110,14 @@ def _ukf_update(model, m_pred, P_pred, z, alpha, beta, kappa):
     sig = m_pred[..., None, :] + np.concatenate(
         [np.zeros_like(offs[..., :1, :]), offs, -offs], axis=-2
     )
-    Zs = model.hx(sig)  # (..., 2n+1, m)
+    Zs = model._h(sig)  # (..., 2n+1, m); the unchecked twins of hx / residual_z (own states)
     zhat = model.z_mean(Zs, Wm)
-    dz = model.residual_z(Zs, zhat[..., None, :])
+    dz = model._residual(Zs, zhat[..., None, :])
     dx = sig - m_pred[..., None, :]
     Pzz = np.einsum("s,...si,...sj->...ij", Wc, dz, dz) + model.R
     Pxz = np.einsum("s,...si,...sj->...ij", Wc, dx, dz)
     K = np.swapaxes(np.linalg.solve(Pzz, np.swapaxes(Pxz, -1, -2)), -1, -2)  # eq. 58
-    innov = model.residual_z(np.broadcast_to(z, zhat.shape), zhat)
+    innov = model._residual(np.broadcast_to(z, zhat.shape), zhat)
     m_post = m_pred + np.einsum("...ij,...j->...i", K, innov)  # eq. 54
     P_post = P_pred - K @ Pzz @ np.swapaxes(K, -1, -2)  # eq. 55
     return m_post, 0.5 * (P_post + np.swapaxes(P_post, -1, -2)), zhat, Pzz
@@ -130,8 +130,8 @@ def _mixture_d2(model: VsModel, w, zhat, Pzz, z) -> tuple[np.ndarray, np.ndarray
     particle's predicted measurement and its covariance (R included).
     """
     ref = zhat[:, :1, :]
-    zbar = ref[:, 0, :] + np.einsum("bn,bnj->bj", w, model.residual_z(zhat, ref))
-    dz = model.residual_z(zhat, zbar[:, None, :])
+    zbar = ref[:, 0, :] + np.einsum("bn,bnj->bj", w, model._residual(zhat, ref))
+    dz = model._residual(zhat, zbar[:, None, :])
     S = np.einsum("bn,bnij->bij", w, Pzz) + np.einsum("bn,bni,bnj->bij", w, dz, dz)
     y = model.residual_z(z, zbar)
     return np.einsum("bi,bi->b", y, np.linalg.solve(S, y[..., None])[..., 0]), S

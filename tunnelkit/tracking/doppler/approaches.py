@@ -189,7 +189,7 @@ class _KfToA(_Base):
         z = scalar_measurement("doppler", doppler)
         if z is not None:
             self._recent = [*self._recent[-(self.PHASE_WINDOW - 1) :], z]
-            med = float(np.median(self._recent))
+            med = _median(self._recent)
             if med != 0:
                 self._phase = 1.0 if med > 0 else -1.0
         return self._phase
@@ -205,6 +205,14 @@ class _KfToA(_Base):
         d_prev = self.range_kf.distance
         d = self.range_kf.step(u, toa)
         return self.dr.step(phase * (d_prev - d))
+
+
+def _median(values: list[float]) -> float:
+    """``np.median`` of a few floats (no NaN): the middle one, or the mean of the two middle ones
+    computed as numpy does, ``(a + b) / 2``, without numpy's overhead on a five-element list."""
+    v = sorted(values)
+    n = len(v)
+    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2.0
 
 
 @register("halili2022", "KF DS and ToA")

@@ -11,6 +11,7 @@ input check of one epoch's measurement shared by the filters and the approaches.
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -82,9 +83,9 @@ def scalar_measurement(name: str, z) -> float | None:
         x = float(z)
     except (TypeError, ValueError):
         raise TypeError(f"{name}: expected a number or None, got {type(z).__name__}") from None
-    if np.isnan(x):
+    if math.isnan(x):
         return None
-    if not np.isfinite(x):
+    if not math.isfinite(x):
         raise ValueError(f"{name}: must be finite or NaN (dropped), got {x}")
     return x
 
@@ -209,17 +210,35 @@ class DopplerEKF:
         kf.R = np.array([[sigma_hz**2]])
         self.kf = kf
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
+        self._tx = tuple(float(t) for t in setup.tx)
+        self._k, self._dz2 = setup.k, setup.dz**2
 
     @property
     def n_rejected(self) -> int:
         """Doppler samples the gate rejected (predicted only)."""
         return self.gate.n_rejected
 
+    # one state per call (filterpy's column x): the arithmetic of _doppler_model and
+    # _doppler_jacobian on Python floats, operation for operation (bit for bit the same result)
+    # without the cost of numpy calls on two-element arrays
     def _h(self, x):
-        return _doppler_model(x.ravel(), self.setup).reshape(1, 1)
+        x0, x1, v0, v1 = x.ravel().tolist()
+        tx0, tx1 = self._tx
+        w0, w1 = x0 - tx0, x1 - tx1
+        r = math.sqrt(w0 * w0 + w1 * w1 + self._dz2)
+        return np.array([[-self._k * (v0 * w0 + v1 * w1) / r]])
 
     def _H(self, x):
-        return _doppler_jacobian(x.ravel(), self.setup)
+        x0, x1, v0, v1 = x.ravel().tolist()
+        tx0, tx1 = self._tx
+        w0, w1 = x0 - tx0, x1 - tx1
+        r = math.sqrt(w0 * w0 + w1 * w1 + self._dz2)
+        vw = v0 * w0 + v1 * w1
+        r3 = float(np.power(np.array([r]), 3)[0])  # numpy's power, as _doppler_jacobian
+        mk = -self._k
+        return np.array(
+            [[mk * (v0 / r - vw * w0 / r3), mk * (v1 / r - vw * w1 / r3), mk * w0 / r, mk * w1 / r]]
+        )
 
     def step(self, z) -> np.ndarray:
         """Predict (eq. 8-9) and, unless ``z`` is None/NaN, update with Doppler ``z`` [Hz] (eq. 10-12)."""
@@ -256,7 +275,12 @@ class DopplerEKF:
     @property
     def approach_speed(self) -> float:
         """``-v . (p - T) / r`` of the current estimate [m/s] (positive when approaching)."""
-        return float(doppler_model(self.kf.x.ravel(), self.setup)) / self.setup.k
+        f = float(self._h(self.kf.x)[0, 0])
+        if not math.isfinite(f):
+            raise ValueError(
+                "the estimate coincides with the transmitter, the Doppler is undefined"
+            )
+        return f / self.setup.k
 
 
 # --- the KFs on Doppler and ToA (section 5) -------------------------------------------------------

@@ -198,11 +198,11 @@ class VsEKF(_FilterpyEstimator):
         z = measurement_ok(z, self.model.dim_z, who="EKF")
         m, f = self.model, self.filter
         if z is None:
-            f.update(None, m.jacobian, m.hx)
+            f.update(None, m.jacobian, m._h)
             return
         # filterpy updates P in Joseph form; symmetrise to remove rounding asymmetry
         gated_filterpy_update(
-            f, lambda: f.update(z, m.jacobian, m.hx, residual=m.residual_z), self.gate
+            f, lambda: f.update(z, m.jacobian, m._h, residual=m._residual), self.gate
         )
         self._symmetrize()
 
@@ -247,11 +247,11 @@ class VsUKF(_FilterpyEstimator):
             dim_x=STATE_DIM,
             dim_z=model.dim_z,
             dt=model.period,
-            hx=model.hx,
+            hx=model._h,  # the unchecked twins: filterpy calls them once per sigma point
             fx=lambda x, dt: model.F @ x,
             points=pts,
             z_mean_fn=model.z_mean,
-            residual_z=model.residual_z,
+            residual_z=model._residual,
         )
         f.x, f.P = x0, P0
         f.Q, f.R = model.Q.copy(), model.R.copy()

@@ -129,6 +129,27 @@ class VsModel:
         d, th = toa_doa(np.asarray(x)[..., :2], self.stations)
         return np.concatenate([d, th], axis=-1)
 
+    # the filters' own states and predictions (finite by construction, never at a station):
+    # the arithmetic of hx / residual_z without their input checks, which cost more than the
+    # arithmetic on one sigma point (filterpy's UKF calls them once per sigma point)
+    def _h(self, x) -> np.ndarray:
+        """:meth:`hx` unchecked (bit for bit the same result)."""
+        p = np.asarray(x, dtype=float)[..., :2]
+        st = self.stations
+        dx = p[..., None, 0] - st[:, 0]
+        dy = p[..., None, 1] - st[:, 1]
+        return np.concatenate([np.hypot(dx, dy), np.arctan2(dy, dx)], axis=-1)
+
+    def _residual(self, a, b) -> np.ndarray:
+        """:meth:`residual_z` unchecked (bit for bit the same result)."""
+        r = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+        n = self.stations.shape[0]
+        if r.size < 64:  # one sigma point: the formula of wrap_angle inline
+            r[..., n:] = np.pi - np.mod(np.pi - r[..., n:], 2.0 * np.pi)
+        else:  # a particle cloud: the check is cheap beside wrap_angle's fast path
+            r[..., n:] = wrap_angle(r[..., n:])
+        return r
+
     def jacobian(self, x) -> np.ndarray:
         """``d f_2 / d X`` (..., 2N, 4): the position block of eq. A2-A9 (sign-corrected), zeros
         for the velocities."""

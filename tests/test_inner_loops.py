@@ -1,0 +1,79 @@
+"""The filters' inner loops are bit for bit the checked public functions they stand in for.
+
+The Monte-Carlo filters call their measurement models once per sigma point, particle cloud or
+epoch; there the model's own input checks cost more than its arithmetic, so the filters call
+unchecked twins (and ``wrap_angle`` skips its floating-point ``mod`` where it changes nothing).
+Each twin must return exactly the bytes of the checked form, or the reproduced tables move.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tunnelkit import crlb
+from tunnelkit import drive as dv
+from tunnelkit.tracking import doppler as dp
+from tunnelkit.tracking import virtual_station as vs
+from tunnelkit.tracking.doppler import approaches
+
+
+def _same(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def _angles(rng, shape):
+    """Angles inside (-pi, pi], far outside, and on the edges of the wrap."""
+    a = rng.uniform(-np.pi, np.pi, shape)
+    flat = a.reshape(-1)
+    flat[::7] *= 40.0
+    edges = [np.pi, -np.pi, 0.0, -0.0, 3 * np.pi, -3 * np.pi, 2 * np.pi, np.nextafter(np.pi, 0)]
+    k = min(len(edges), flat.size - 1)
+    flat[1 : 1 + k] = edges[:k]
+    return a
+
+
+@pytest.mark.parametrize("shape", [(5,), (9, 2), (8, 50, 9, 2), ()])
+def test_wrap_angle_equals_the_plain_formula(shape):
+    rng = np.random.default_rng(3)
+    a = _angles(rng, shape) if shape else np.float64(7.5)
+    plain = np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+    assert _same(crlb.wrap_angle(a), plain)
+    w = crlb.wrap_angle(a)
+    assert np.all((w > -np.pi) & (w <= np.pi))
+
+
+@pytest.mark.parametrize("los", [False, True])
+def test_the_model_s_unchecked_twins_equal_hx_and_residual_z(los):
+    m = vs.model_from_scenario("jiang2023-straight", level=2, los=los)
+    rng = np.random.default_rng(4)
+    for shape in [(4,), (9, 4), (8, 40, 9, 4)]:
+        x = rng.normal(size=shape) * 30.0 + np.array([40.0, 1.0, 10.0, 0.0])
+        assert _same(m._h(x), m.hx(x))
+        z = m.hx(x)
+        b = z + rng.normal(size=z.shape) * 4.0  # bearings well outside (-pi, pi]
+        assert _same(m._residual(z, b), m.residual_z(z, b))
+        if z.ndim > 1:  # broadcasting against one reference row, as z_mean does
+            assert _same(m._residual(z, b[..., :1, :]), m.residual_z(z, b[..., :1, :]))
+
+
+def test_the_doppler_ekf_s_measurement_functions_equal_the_checked_model():
+    drive = dv.make_drive(dv.load_drive_config("halili2022-drive"))
+    setup = dp.DopplerSetup.from_drive(drive)
+    fix = dv.gnss_fix(drive, np.random.default_rng(0))
+    ekf = dp.DopplerEKF(setup, fix)
+    s = np.concatenate([drive.position, drive.velocity], axis=1)[::37]
+    s = np.vstack([s, [[setup.tx[0], setup.tx[1], 20.0, 0.5]]])  # under the transmitter
+    for row in s:
+        col = row.reshape(4, 1)
+        assert _same(ekf._h(col), dp.doppler_model(row, setup).reshape(1, 1))
+        assert _same(ekf._H(col), dp.doppler_jacobian(row, setup))
+
+
+def test_the_phase_median_is_numpy_s():
+    rng = np.random.default_rng(5)
+    for n in range(1, 6):
+        for _ in range(50):
+            v = list(rng.normal(size=n) * 100)
+            assert approaches._median(v) == float(np.median(v))
