@@ -265,8 +265,9 @@ def _profile_end(pool, prof: dict) -> str:
     return f"worker CPU {'+'.join(f'{u:.2f}' for u in used)} s; tasks: {parts}"
 
 
-def _timed(workers, mode, arrays, runs, n_epochs, warm: bool) -> dict:
-    """One run: start (a pool of ``workers``; serial without), sweep, sweep again on the same
+def _timed(workers, mode, arrays, runs, n_epochs, warm: bool, schedulers=None) -> dict:
+    """One run: start (a pool of ``workers``; serial without; with ``schedulers`` {workers:
+    address} a connection to that running cluster instead), sweep, sweep again on the same
     cluster (``warm``), stop; wall times [s], main-process CPU, load, the numbers as JSON."""
     import os
     import time
@@ -279,7 +280,10 @@ def _timed(workers, mode, arrays, runs, n_epochs, warm: bool) -> dict:
     kw = dict(mode=mode, n_epochs=n_epochs)
     out = {"load": os.getloadavg()[0]}
     cpu0, t0 = time.process_time(), time.perf_counter()
-    with trial_pool(workers=workers) as pool:
+    where = {"workers": workers}
+    if schedulers and workers in schedulers:
+        where = {"scheduler": schedulers[workers]}
+    with trial_pool(**where) as pool:
         t1 = time.perf_counter()
         prof = _profile_start(pool)
         res = sweep_montecarlo(setup, arrays, runs, 0, pool=pool, **kw)
@@ -334,7 +338,11 @@ def _table(title: str, rows: dict, warm: bool) -> list[str]:
     if None in med and 2 in med:
         lines.append(
             f"  serial / 2 workers: {med[None]['total'] / med[2]['total']:.2f}x (total), "
-            + (f"{med[None]['warm'] / med[2]['warm']:.2f}x (warm)" if warm else "")
+            + (
+                f"{med[None]['warm'] / med[2]['warm']:.2f}x (a second serial sweep / warm)"
+                if warm
+                else ""
+            )
         )
     same = {j for rs in rows.values() for r in rs for j in r["json"]}
     lines.append(f"  byte-identical JSON of errors and bounds in every run: {len(same) == 1}")
@@ -371,7 +379,17 @@ def main(argv=None) -> int:
     ap.add_argument("--channel-runs", type=int, default=4)
     ap.add_argument("--channel-epochs", type=int, default=8)
     ap.add_argument("--channel-warm", action="store_true", help="time a warm channel sweep too")
+    ap.add_argument(
+        "--schedulers",
+        default=None,
+        help="ADDR1,ADDR2: running clusters of 1 and of 2 workers used instead of local ones "
+        "(start = connecting)",
+    )
     args = ap.parse_args(argv)
+    sched = None
+    if args.schedulers:
+        a1, a2 = args.schedulers.split(",")
+        sched = {1: a1, 2: a2}
     import os
 
     from tunnelkit.design import DesignSetup
@@ -383,7 +401,7 @@ def main(argv=None) -> int:
     sweep_montecarlo(setup, ["4x4"], 1, 0, mode="bound", n_epochs=3)
     lines = [f"bound route: {' '.join(SWEEP_ARRAYS)} x {args.runs} runs, 28 GHz example, seed 0"]
     print(lines[0], flush=True)
-    kw = dict(mode="bound", arrays=SWEEP_ARRAYS, runs=args.runs, n_epochs=None)
+    kw = dict(mode="bound", arrays=SWEEP_ARRAYS, runs=args.runs, n_epochs=None, schedulers=sched)
     lines = _series(lines[0], [None, 1, 2], args.reps, True, **kw)
     if args.channel_reps:
         t = (
@@ -396,6 +414,7 @@ def main(argv=None) -> int:
             arrays=("4x4", "8x8"),
             runs=args.channel_runs,
             n_epochs=args.channel_epochs,
+            schedulers=sched,
         )
         lines += _series(t, [1, 2], args.channel_reps, args.channel_warm, **kw)
     print("\n".join(lines))
