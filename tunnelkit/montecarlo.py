@@ -189,9 +189,9 @@ def _capped(workers: int | None) -> int | None:
 
 class TrialPool:
     """Where a Monte-Carlo runs (:func:`trial_pool`): serially in this process (``client``
-    None) or on one Dask client that several steps share, e.g. a sweep that first builds a model
-    per array (:meth:`map`) and then runs its trials (``run_trials(..., pool=pool)``) on the same
-    cluster, started once."""
+    None) or on one Dask client that several steps share, e.g. a sweep that builds a model per
+    array (:meth:`prepare`) and runs its trials on them (``run_trials(..., pool=pool)``) on the
+    same cluster, started once."""
 
     def __init__(self, client=None) -> None:
         self.client = client
@@ -206,14 +206,11 @@ class TrialPool:
         return self.gather(self.prepare(fn, items, desc))
 
     def prepare(self, fn: Callable[[Any], Any], items: Sequence[Any], desc: str = "tasks") -> list:
-        """:meth:`map` without bringing the results back: on a cluster one future per item,
-        left on the worker that computed it (serially the values). Given to :func:`run_trials`
-        as ``inputs``, each trial's task depends on its item's: the trials of an item start as
-        soon as it is ready (no barrier between the two steps), and the item goes to each
-        worker that needs it once, worker to worker, never through this process. Items are
-        submitted in the order given (the first run first: put the longest first)."""
+        """:meth:`map` leaving each result on its worker (a future; serially the value). As
+        :func:`run_trials` ``inputs``, a trial's task depends on its item's only (no barrier)
+        and fetches it worker to worker. Submitted in order: put the longest item first."""
         callable_("fn", fn)
-        items = list(items)
+        items = _sequence("items", items)
         if self.client is None:
             with _one_blas_thread():
                 return [fn(x) for x in items]
@@ -225,8 +222,14 @@ class TrialPool:
 
     def gather(self, handles: Sequence[Any]) -> list:
         """The values of :meth:`prepare`'s handles, in order."""
-        handles = list(handles)
+        handles = _sequence("handles", handles)
         return handles if self.client is None else self.client.gather(handles)
+
+
+def _sequence(name: str, x) -> list:
+    if isinstance(x, str | bytes) or not isinstance(x, Sequence | np.ndarray):
+        raise TypeError(f"{name}: expected a sequence, got {type(x).__name__}")
+    return list(x)
 
 
 @contextlib.contextmanager
@@ -495,10 +498,6 @@ def _chunk_size(n: int, threads: int, trial_timeout: float | None) -> int:
     return 1 if trial_timeout is not None else -(-n // (CHUNKS_PER_THREAD * max(threads, 1)))
 
 
-def _named(idx: Sequence[int], n: int) -> str:
-    return f"trial {idx[0]} of {n}" if len(idx) == 1 else f"trials {idx[0]}-{idx[-1]} of {n}"
-
-
 def _run_dask(
     client, trial, calls, progress: bool, desc: str, retries: int, trial_timeout=None
 ) -> list[Any]:
@@ -533,8 +532,9 @@ def _run_dask(
             try:
                 out[idx[0] : idx[-1] + 1] = fut.result()
             except KilledWorker as exc:
+                who = f"trial {idx[0]}" if len(idx) == 1 else f"trials {idx[0]}-{idx[-1]}"
                 raise TrialLost(
-                    f"{_named(idx, n)} ({desc}) was lost: the workers holding it died more "
+                    f"{who} of {n} ({desc}) was lost: the workers holding it died more "
                     "often than Dask allows (distributed.scheduler.allowed-failures); the run is "
                     "stopped rather than reported without it"
                 ) from exc
@@ -561,9 +561,8 @@ WORKER_CHECK_S = 1.0
 
 def _as_completed(as_completed, futures, client, trial_timeout, chunks, index, desc):
     """Futures as they finish; :class:`TrialTimeout` when none finished for ``trial_timeout``,
-    :class:`TrialLost` when the cluster has had no worker for ``NO_WORKER_WAIT_S``. Blocks on
-    Dask's iterator between finishes (woken by the next one), waking at most every
-    :data:`WORKER_CHECK_S` to ask the scheduler for its workers, or at the timeout."""
+    :class:`TrialLost` when the cluster has had no worker for ``NO_WORKER_WAIT_S``. Blocks
+    until a finish, the timeout or :data:`WORKER_CHECK_S` (then asks for the workers)."""
     import time
 
     ac = as_completed(futures, loop=client.loop)
