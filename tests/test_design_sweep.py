@@ -159,6 +159,28 @@ def test_sweep_is_one_task_set_with_the_same_numbers_serially_and_on_two_workers
     assert np.array_equal(alone.errors, serial["8x8"].errors)
 
 
+def test_sweeps_sharing_one_cluster_give_the_serial_numbers(setup):
+    from tunnelkit.montecarlo import trial_pool
+
+    specs = ["8x8", "4x4"]
+    models = {s: _diag_model(setup, s) for s in specs}
+    kw = dict(error_models=models, n_epochs=12)
+    serial = sweep_montecarlo(setup, specs, 3, 5, **kw)
+    with trial_pool(workers=2) as pool:
+        first = sweep_montecarlo(setup, specs, 3, 5, pool=pool, **kw)
+        again = sweep_montecarlo(setup, specs[::-1], 3, 5, pool=pool, **kw)  # the same cluster
+    for s in specs:
+        for other in (first[s], again[s]):
+            assert np.array_equal(other.errors, serial[s].errors)
+            assert np.array_equal(other.peb, serial[s].peb)
+            assert np.array_equal(other.pcrlb, serial[s].pcrlb)
+            assert other.sigmas == serial[s].sigmas
+    with pytest.raises(TypeError, match="pool"):
+        sweep_montecarlo(setup, specs, 2, 0, pool="cluster")
+    with trial_pool() as pool, pytest.raises(ValueError, match="pool, workers"):
+        sweep_montecarlo(setup, specs, 2, 0, pool=pool, workers=2)
+
+
 def test_sweep_bad_input_is_refused_by_name(setup):
     with pytest.raises(ValueError, match="mode"):
         sweep_montecarlo(setup, ["4x4"], 2, 0, mode="fast")

@@ -18,8 +18,10 @@ that the run stops with :class:`TrialLost` naming the trial, never a statistic w
 ``retries`` re-runs a trial that raised (off by default: a seeded trial fails the same way twice).
 Trial functions must be picklable: module-level functions, bound with ``functools.partial``; the
 trial object is sent to the cluster once per run (the result of one task that every trial
-depends on, fetched once by each worker and recomputed if its holder dies), not with every task,
-so a trial that carries a large model costs one transfer per worker.
+depends on, fetched once by each worker and recomputed if its holder dies), not with every task.
+Trials go in tasks of a few trials each (:data:`CHUNKS_PER_THREAD`), and an input may be a handle of
+:meth:`TrialPool.prepare` (per-item state built on the cluster, e.g. one model per array, that
+its trials fetch worker to worker).
 
 Bad input and stalls: ``workers`` beyond the cores this process may use is capped to them (with a
 :class:`RuntimeWarning`: more single-threaded processes than cores only add overhead); a
@@ -187,9 +189,9 @@ def _capped(workers: int | None) -> int | None:
 
 class TrialPool:
     """Where a Monte-Carlo runs (:func:`trial_pool`): serially in this process (``client``
-    None) or on one Dask client that several steps share, e.g. a sweep that first builds a model
-    per array (:meth:`map`) and then runs its trials (``run_trials(..., pool=pool)``) on the same
-    cluster, started once."""
+    None) or on one Dask client that several steps share, e.g. a sweep that builds a model per
+    array (:meth:`prepare`) and runs its trials on them (``run_trials(..., pool=pool)``) on the
+    same cluster, started once."""
 
     def __init__(self, client=None) -> None:
         self.client = client
@@ -201,17 +203,33 @@ class TrialPool:
     def map(self, fn: Callable[[Any], Any], items: Sequence[Any], desc: str = "tasks") -> list:
         """``[fn(x) for x in items]`` in order, one task per item on the cluster (single-threaded
         BLAS, as the trials), serially without one. ``fn`` and the items must be picklable."""
+        return self.gather(self.prepare(fn, items, desc))
+
+    def prepare(self, fn: Callable[[Any], Any], items: Sequence[Any], desc: str = "tasks") -> list:
+        """:meth:`map` leaving each result on its worker (a future; serially the value). As
+        :func:`run_trials` ``inputs``, a trial's task depends on its item's only (no barrier)
+        and fetches it worker to worker. Submitted in order: put the longest item first."""
         callable_("fn", fn)
-        items = list(items)
+        items = _sequence("items", items)
         if self.client is None:
             with _one_blas_thread():
                 return [fn(x) for x in items]
         tag = uuid.uuid4().hex[:8]
-        futures = [
+        return [
             self.client.submit(_one_call, fn, x, key=f"{desc}-{i}-{tag}", pure=False)
             for i, x in enumerate(items)
         ]
-        return self.client.gather(futures)
+
+    def gather(self, handles: Sequence[Any]) -> list:
+        """The values of :meth:`prepare`'s handles, in order."""
+        handles = _sequence("handles", handles)
+        return handles if self.client is None else self.client.gather(handles)
+
+
+def _sequence(name: str, x) -> list:
+    if isinstance(x, str | bytes) or not isinstance(x, Sequence | np.ndarray):
+        raise TypeError(f"{name}: expected a sequence, got {type(x).__name__}")
+    return list(x)
 
 
 @contextlib.contextmanager
@@ -456,10 +474,28 @@ def _hold(trial):
     return trial
 
 
-def _one_trial(trial, args: tuple, rng_bytes: bytes):
-    """Worker side: a fresh copy of the trial's generator, so a rerun replays the same stream."""
+def _trial_chunk(trial, chunk: list, n: int, desc: str) -> list:
+    """Worker side: the trials ``chunk`` = ``[(i, args, rng_bytes)]`` in order, each on a fresh
+    copy of its generator (a rerun replays the same streams), single-threaded BLAS."""
+    out = []
     with _one_blas_thread():
-        return trial(*args, pickle.loads(rng_bytes))
+        for i, args, rng_bytes in chunk:
+            try:
+                out.append(trial(*args, pickle.loads(rng_bytes)))
+            except Exception as exc:
+                exc.add_note(f"raised by trial {i} of {n} ({desc}) on a Dask worker")
+                raise
+    return out
+
+
+#: trials go in about this many tasks per worker thread (a task costs the scheduler and the
+#: worker a few ms; several per thread keep the end of the run balanced); one trial per task
+#: with a ``trial_timeout`` (it counts from the last finished task)
+CHUNKS_PER_THREAD = 8
+
+
+def _chunk_size(n: int, threads: int, trial_timeout: float | None) -> int:
+    return 1 if trial_timeout is not None else -(-n // (CHUNKS_PER_THREAD * max(threads, 1)))
 
 
 def _run_dask(
@@ -469,81 +505,95 @@ def _run_dask(
     from distributed.scheduler import KilledWorker
 
     tag = uuid.uuid4().hex[:8]
+    n = len(calls)
     # the trial (it may carry a large model) is one task's result, fetched once per worker, not
     # sent with every task; unlike scattered data it is recomputed if a worker holding it dies
     shared = client.submit(_hold, trial, key=f"{desc}-trial-{tag}", pure=False)
+    size = _chunk_size(n, sum(client.nthreads().values()), trial_timeout)
+    chunks = [list(range(i, min(i + size, n))) for i in range(0, n, size)]
     futures = [
         client.submit(
-            _one_trial,
+            _trial_chunk,
             shared,
-            args,
-            pickle.dumps(rng),
-            key=f"{desc}-{i}-{tag}",
+            [(i, calls[i][0], pickle.dumps(calls[i][1])) for i in idx],
+            n,
+            desc,
+            key=f"{desc}-{idx[0]}-{tag}",
             pure=False,
             retries=retries,
         )
-        for i, (args, rng) in enumerate(calls)
+        for idx in chunks
     ]
-    index = {f.key: i for i, f in enumerate(futures)}
-    out: list[Any] = [None] * len(futures)
-    with _bar(len(futures), progress, desc) as bar:
-        for fut in _as_completed(as_completed, futures, client, trial_timeout, index, desc):
-            i = index[fut.key]
+    index = {f.key: c for c, f in enumerate(futures)}
+    out: list[Any] = [None] * n
+    with _bar(n, progress, desc) as bar:
+        for fut in _as_completed(as_completed, futures, client, trial_timeout, chunks, index, desc):
+            idx = chunks[index[fut.key]]
             try:
-                out[i] = fut.result()
+                out[idx[0] : idx[-1] + 1] = fut.result()
             except KilledWorker as exc:
+                who = f"trial {idx[0]}" if len(idx) == 1 else f"trials {idx[0]}-{idx[-1]}"
                 raise TrialLost(
-                    f"trial {i} of {len(futures)} ({desc}) was lost: the workers holding it died "
-                    "more often than Dask allows (distributed.scheduler.allowed-failures); the "
-                    "run is stopped rather than reported without it"
+                    f"{who} of {n} ({desc}) was lost: the workers holding it died more "
+                    "often than Dask allows (distributed.scheduler.allowed-failures); the run is "
+                    "stopped rather than reported without it"
                 ) from exc
-            except Exception as exc:
-                exc.add_note(f"raised by trial {i} of {len(futures)} ({desc}) on a Dask worker")
-                raise
-            bar.update()
+            bar.update(len(idx))
     return out
 
 
-def _cancel_late(futures, index) -> str:
+def _cancel_late(futures, chunks, index) -> str:
     """Cancel every future and name the trials that had not finished ("trials [..] of N")."""
-    late = sorted(index[f.key] for f in futures if not f.done())
+    late = sorted(i for f in futures if not f.done() for i in chunks[index[f.key]])
     for f in futures:
         f.cancel()
-    return f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of {len(futures)}"
+    n = sum(len(c) for c in chunks)
+    return f"trials {late[:10]}{' ...' if len(late) > 10 else ''} of {n}"
 
 
 NO_WORKER_WAIT_S = 120.0
 """Seconds a Dask run waits for a worker when its cluster has none (a nanny restarting a killed
 worker on a loaded machine takes seconds; a cluster whose workers are all gone never finishes)."""
 
+#: seconds between the checks for a cluster left without workers while a Dask run waits
+WORKER_CHECK_S = 1.0
 
-def _as_completed(as_completed, futures, client, trial_timeout, index, desc) -> Iterator[Any]:
+
+def _as_completed(as_completed, futures, client, trial_timeout, chunks, index, desc):
     """Futures as they finish; :class:`TrialTimeout` when none finished for ``trial_timeout``,
-    :class:`TrialLost` when the cluster has had no worker for ``NO_WORKER_WAIT_S``."""
+    :class:`TrialLost` when the cluster has had no worker for ``NO_WORKER_WAIT_S``. Blocks
+    until a finish, the timeout or :data:`WORKER_CHECK_S` (then asks for the workers)."""
     import time
 
     ac = as_completed(futures, loop=client.loop)
+    cond = ac.thread_condition  # notified by Dask when a future joins the finished queue
     left, last = len(futures), time.monotonic()
-    checked, workerless = last, None
+    workerless = None
     while left:
+        now = time.monotonic()
+        tick = WORKER_CHECK_S
+        if trial_timeout is not None:
+            tick = min(tick, max(trial_timeout - (now - last), 0.0) + 1e-3)
+        with cond:  # checked under the lock: a finish between the check and the wait wakes it
+            if not ac.has_ready():
+                cond.wait(timeout=tick)
         batch = ac.next_batch(block=False) if ac.has_ready() else []
+        now = time.monotonic()
         if not batch:
-            now = time.monotonic()
-            if now - checked > 1.0:  # a cluster left without workers never finishes anything
-                checked = now
-                workerless = None if client.nthreads() else (workerless or now)
-                if workerless is not None and now - workerless > NO_WORKER_WAIT_S:
-                    raise TrialLost(
-                        f"{_cancel_late(futures, index)} ({desc}) were lost: the cluster has had "
-                        f"no worker for {NO_WORKER_WAIT_S:g} s (workers died and were not restarted)"
-                    )
+            # a cluster left without workers never finishes anything
+            workerless = None if client.nthreads() else (workerless or now)
+            if workerless is not None and now - workerless > NO_WORKER_WAIT_S:
+                raise TrialLost(
+                    f"{_cancel_late(futures, chunks, index)} ({desc}) were lost: the cluster "
+                    f"has had no worker for {NO_WORKER_WAIT_S:g} s (workers died and were not "
+                    "restarted)"
+                )
             if trial_timeout is not None and now - last > trial_timeout:
                 raise TrialTimeout(
-                    f"{_cancel_late(futures, index)} ({desc}): none finished within "
+                    f"{_cancel_late(futures, chunks, index)} ({desc}): none finished within "
                     f"trial_timeout = {trial_timeout:g} s"
                 )
-            time.sleep(0.02)
             continue
-        last = time.monotonic()
+        last = now
         left -= len(batch)
         yield from sorted(batch, key=lambda f: index[f.key])

@@ -22,22 +22,26 @@ the position bias of the array's one calibration draw and of the wideband term a
 number of epochs averages down). :func:`javelin_rmse` is the one-array summary on top of it.
 
 Cost: the per-array work (error model, the bound route's shared part
-:func:`~tunnelkit.design.fastroute.bound_route`, PEB and the bounds over the drive) is one task
-per array and the drives one task each, both on the same cluster
-(:func:`tunnelkit.montecarlo.trial_pool`, started once), so two workers also split the models;
-a drive on the bound route then costs its random draws and the tracker.
+:func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
+is one task per array (:meth:`tunnelkit.montecarlo.TrialPool.prepare`, the largest array first)
+and the drives go in a few tasks per worker, each depending on its array's task only: one task
+set on one cluster (:func:`tunnelkit.montecarlo.trial_pool`, started once, or ``pool`` shared by
+several sweeps), no barrier between models and drives, the array's state fetched worker to
+worker once per worker and only the bounds brought back. A drive on the bound route then costs
+its random draws and the tracker.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._validate import integer
 from ..metrics import SETTLE_S, settled
-from ..montecarlo import run_trials, trial_pool
+from ..montecarlo import TrialPool, run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
 from .errormodel import PathErrorModel
 from .setup import ArraySpec, DesignSetup, parse_array
@@ -124,29 +128,27 @@ def _trial_errors(estimates: np.ndarray, truth: np.ndarray) -> np.ndarray:
 class _SweepTrial:
     """One Monte-Carlo run of one array (picklable for Dask workers; sent to each worker once):
     a drive of the design's route through the chosen measurement route, JAVELIN, the 2-D error
-    per epoch (T,)."""
+    per epoch (T,). ``prep`` is the array's :class:`_Prepared` (built once per array on the
+    sweep's cluster, fetched once by each worker that runs its drives)."""
 
     setup: DesignSetup
-    specs: tuple[ArraySpec, ...]
-    designs: tuple  # tracking.javelin.JavelinDesign per array
-    routes: tuple  # fastroute.BoundRoute per array (bound mode) or None
     mode: str
     n_epochs: int | None
 
-    def __call__(self, a: int, rng: np.random.Generator) -> np.ndarray:
+    def __call__(self, prep: _Prepared, rng: np.random.Generator) -> np.ndarray:
         from ..studies import evaluate, simulate_drive
 
-        spec = self.specs[a]
+        spec = prep.spec
         if self.mode == "bound":
             from .fastroute import bound_drive
 
-            drive = bound_drive(self.routes[a], self.setup, spec, rng, n_epochs=self.n_epochs)
+            drive = bound_drive(prep.route, self.setup, spec, rng, n_epochs=self.n_epochs)
         else:
             route = self.setup.signal_route(spec)
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
             )
-        return _trial_errors(evaluate(drive, self.designs[a]).estimates, drive.truth)
+        return _trial_errors(evaluate(drive, prep.design).estimates, drive.truth)
 
 
 def _position_rows(model: PathErrorModel, geometry, k: int):
@@ -312,33 +314,61 @@ def _model(setup, spec, error_models) -> PathErrorModel:
 
 
 @dataclass(frozen=True)
+class _Prepared:
+    """What the drives of one array share (:class:`_ArrayJob`): the bound route's shared part
+    (``route``, bound mode), the tracker (``design``) and the bounds reported beside them."""
+
+    spec: ArraySpec
+    route: object  # fastroute.BoundRoute (bound mode) or None
+    design: object  # tracking.javelin.JavelinDesign
+    peb: np.ndarray
+    pcrlb: np.ndarray | None
+    drive: np.ndarray | None
+
+    def summary(self) -> tuple:
+        """What the sweep's result keeps (not the model and route the drives need)."""
+        return self.peb, self.pcrlb, self.drive, self.design.config
+
+
+@dataclass(frozen=True)
 class _ArrayJob:
     """Everything a sweep computes once per array, before its drives (one task per array, on
     the sweep's cluster when it has one): the error model, the bound route's shared part, the
-    PEB and the bounds over the drive."""
+    PEB, the bounds over the drive and the tracker (:class:`_Prepared`)."""
 
     setup: DesignSetup
     error_models: object
     mode: str
     T: int
     with_model: bool
+    crlbs: dict | None
 
-    def __call__(self, spec: ArraySpec):
+    def __call__(self, spec: ArraySpec) -> _Prepared:
         ep = np.arange(self.T)
         peb = route_bounds(self.setup, spec, epochs=ep).peb
-        if not self.with_model:
-            return None, None, peb, None, None
-        m = _model(self.setup, spec, self.error_models)
-        route = None
-        if self.mode == "bound":
-            from .fastroute import bound_route
+        m = route = pc = drive = None
+        if self.with_model:
+            m = _model(self.setup, spec, self.error_models)
+            if self.mode == "bound":
+                from .fastroute import bound_route
 
-            route = bound_route(m, self.setup, spec)
-        g = route_geometry(self.setup, spec, epochs=ep)
-        head = _head(m, self.T)
-        pc = drive_pcrlb(self.setup, position_information(head, g))
-        drive = drive_bound(pc, position_bias_rms(head, g))
-        return m, route, peb, pc, drive
+                route = bound_route(m, self.setup, spec)
+            g = route_geometry(self.setup, spec, epochs=ep)
+            head = _head(m, self.T)
+            pc = drive_pcrlb(self.setup, position_information(head, g))
+            drive = drive_bound(pc, position_bias_rms(head, g))
+        crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
+        if crlb is None and m is not None:
+            crlb = _median_sigmas(m)
+        if crlb is None:
+            pb = path_bounds(self.setup, spec)
+            crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
+        design = javelin_config(crlb, self.setup.signal_route(spec).min_d)
+        return _Prepared(spec, route, design, peb, pc, drive)
+
+
+def _summary(prep: _Prepared) -> tuple:
+    return prep.summary()
 
 
 def sweep_montecarlo(
@@ -356,6 +386,7 @@ def sweep_montecarlo(
     progress: bool = False,
     n_epochs: int | None = None,
     crlbs: dict | None = None,
+    pool: TrialPool | None = None,
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -370,7 +401,9 @@ def sweep_montecarlo(
     models are given). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
     route-median per-path bounds, from the model when there is one). ``workers`` /
     ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
-    sweep); ``seed`` an int or a Generator: run ``r`` of every array uses child generator ``r``.
+    sweep), or ``pool`` (a :func:`tunnelkit.montecarlo.trial_pool` already open, so several
+    sweeps share one cluster, started once); ``seed`` an int or a Generator: run ``r`` of every
+    array uses child generator ``r``.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -394,42 +427,40 @@ def sweep_montecarlo(
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
     A = len(specs)
     with_model = mode == "bound" or error_models is not None
-    job = _ArrayJob(setup, error_models, mode, T, with_model)
+    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
-    with trial_pool(**{k: v for k, v in kw.items() if v is not None}) as pool:
-        # the per-array work (models, bounds) runs on the cluster too, one task per array
-        built = pool.map(job, specs, desc="design arrays")
-        designs = []
-        for a, spec in enumerate(specs):
-            crlb = None if crlbs is None else crlbs.get(spec.label)
-            if crlb is None and with_model:
-                crlb = _median_sigmas(built[a][0])
-            if crlb is None:
-                pb = path_bounds(setup, spec)
-                crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-            designs.append(javelin_config(crlb, setup.signal_route(spec).min_d))
-        trial = _SweepTrial(
-            setup, specs, tuple(designs), tuple(b[1] for b in built), mode, n_epochs
-        )
+    kw = {k: v for k, v in kw.items() if v is not None}
+    if pool is not None:
+        if not isinstance(pool, TrialPool):
+            raise TypeError(f"pool: expected a montecarlo.TrialPool, got {type(pool).__name__}")
+        if kw:
+            raise ValueError(f"pool, {', '.join(kw)}: give a pool or where to start one, not both")
+    # the largest array's model first (the longest task); its drives wait only for it
+    order = sorted(range(A), key=lambda a: -specs[a].n_elements)
+    with nullcontext(pool) if pool is not None else trial_pool(**kw) as pool:
+        # one task set: the per-array work (models, bounds, tracker) and every drive, each drive
+        # depending on its array's task only (no barrier; the state goes worker to worker)
+        handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
+        prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(
-            trial,
+            _SweepTrial(setup, mode, n_epochs),
             A * runs,
             seed,
-            inputs=[a for a in range(A) for _ in range(runs)],
+            inputs=[prepared[a] for a in range(A) for _ in range(runs)],
             streams=[r for _ in range(A) for r in range(runs)],
             progress=progress,
             desc=f"JAVELIN {mode} " + " ".join(s.label for s in specs),
             trial_timeout=trial_timeout,
             pool=pool,
         )
+        built = pool.map(_summary, prepared, desc="design summaries")
     t = traj.t[:T].copy()
     idx = settled(t)
     use = idx if idx.size else np.arange(T)
     out = {}
     for a, spec in enumerate(specs):
         err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
-        _, _, peb, pc, drive = built[a]
-        cfg = designs[a].config
+        peb, pc, drive, cfg = built[a]
         out[spec.label] = MonteCarloResult(
             spec,
             mode,
