@@ -45,6 +45,22 @@ __all__ = [
 CHANNELS = ("image", "sionna")
 
 
+def _check_arrays(arrays) -> None:
+    """A non-empty list of ArrayGeometry with distinct names (calibration is keyed by name)."""
+    if isinstance(arrays, str) or not isinstance(arrays, list | tuple) or not arrays:
+        raise TypeError(f"arrays: expected a non-empty list of ArrayGeometry, got {arrays!r:.80}")
+    names = {}
+    for i, a in enumerate(arrays):
+        if not isinstance(a, ArrayGeometry):
+            raise TypeError(f"arrays[{i}]: expected an ArrayGeometry, got {type(a).__name__}")
+        if a.name in names:
+            raise ValueError(
+                f"arrays: arrays[{i}] and arrays[{names[a.name]}] are both named {a.name!r}; "
+                "names must be distinct (the calibration is keyed by name)"
+            )
+        names[a.name] = i
+
+
 @dataclass(frozen=True)
 class RouteMeasurements:
     """Algorithm 1 output for one array, angles in the **world** frame, seen from ``origin``.
@@ -216,6 +232,7 @@ class SignalRoute:
 
     def __post_init__(self) -> None:
         choice("channel", self.channel, CHANNELS)
+        _check_arrays(self.arrays)
         if self.channel == "sionna":
             from .rt.cache import RayTracedChannel
 

@@ -29,6 +29,7 @@ from functools import partial
 import numpy as np
 
 from .._validate import choice, integer, positive, probability
+from ..budget import check_elements
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
 from .bounds import route_bounds, route_geometry
@@ -481,6 +482,17 @@ def design_sweep(
         raise ValueError(
             "mode: the channel Monte-Carlo route synthesises the ideal channel; use mode='bound' "
             "for a Monte-Carlo under impairments"
+        )
+    if mode == "channel" and runs:
+        # each drive synthesises the largest candidate's tensor and a noise draw of its size:
+        # the band's tone count is refused here, before any bound is computed
+        cfg, big = setup.config, max(s.n_elements for s in specs)
+        check_elements(
+            "bandwidth",
+            2 * big * cfg.n_tones * cfg.n_symbols,
+            16,
+            f"a {big} x {cfg.n_tones} tones x {cfg.n_symbols} symbols channel tensor and its noise "
+            f"at bandwidth = {cfg.bandwidth:g} Hz",
         )
     T = len(setup.trajectory)
     epochs = None if n_epochs is None or n_epochs >= T else np.arange(n_epochs)
