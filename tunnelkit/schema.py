@@ -241,6 +241,8 @@ def _copy(v):
 
 def family_of(raw: dict, where: str) -> str:
     """The family of a parsed file: its ``paper`` key, or ``"user"`` without one."""
+    if not isinstance(raw, dict):
+        raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
     paper = raw.get("paper")
     if paper is None:
         return "user"

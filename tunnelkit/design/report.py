@@ -28,7 +28,7 @@ from functools import partial
 
 import numpy as np
 
-from .._validate import choice, integer, positive, probability
+from .._validate import choice, finite_array, integer, positive, probability
 from ..budget import check_elements
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
@@ -221,7 +221,14 @@ class DesignReport:
 def over_target(x, y, target: float) -> str:
     """The stretches of the route where ``y > target`` (non-finite counts), as text:
     ``"45.0..38.1 m, 12.5 m"`` in route order; ``""`` when none."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
+    x = finite_array("x", x, ndim=1)
+    try:
+        y = np.asarray(y, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"y: expected real numbers (NaN allowed), got {type(y).__name__}") from None
+    if y.shape != x.shape:
+        raise ValueError(f"y: expected one value per x, shape {x.shape}, got {y.shape}")
+    target = positive("target", target)
     bad = ~(y <= target)
     out, i = [], 0
     while i < bad.size:

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, integer, positive
+from .._validate import finite_array, instance, integer, positive
 from ..arrays import ArrayGeometry
 from ..budget import check_elements
+from ..channel import SRSConfig
 from ..constants import C, db2lin
 from .estimates import PathEstimates
 from .radio import check_array, check_srs
@@ -167,6 +168,11 @@ def path_crlb(
 def in_path_units(bound: dict, config) -> dict[str, np.ndarray]:
     """:func:`source_crlb`'s standard deviations as ``d`` [m], ``v`` [m/s], ``direction`` [rad]
     and ``kappa`` [m], with the tone spacing, carrier and symbol period of ``config``."""
+    instance("config", config, SRSConfig)
+    instance("bound", bound, dict)
+    missing = [k for k in ("mu_f", "mu_t", "direction", "kappa") if k not in bound]
+    if missing:
+        raise ValueError(f"bound: missing {missing} (a source_crlb result)")
     return {
         "d": C / (2 * np.pi * config.tone_spacing) * bound["mu_f"],
         "v": C / (2 * np.pi * config.fc * config.symbol_period) * bound["mu_t"],
@@ -191,6 +197,8 @@ def source_crlb(
     """:func:`crlb_paths` read out per path: ``mu_f``, ``mu_t`` (rad; from the ``spatial`` model),
     ``direction`` [rad] and ``kappa`` [m] of the wave origin (structured model), for sources
     given in the array's local frame (any scene, not only traced paths)."""
+    if spatial not in ("structured", "free"):
+        raise ValueError(f"spatial: expected 'structured' or 'free', got {spatial!r}")
     args = (alpha, sources, element_positions, mu_f, mu_t, fc, n_tones, n_symbols, noise_power)
     st = crlb_paths(*args, spatial="structured")
     roots = st if spatial == "structured" else crlb_paths(*args, spatial="free")
