@@ -277,6 +277,32 @@ def _baselines():
     tk.scenarios.with_values(tk.load_scenario("italiano2026-straight"), {"radio.fc": 28e9})
 
 
+def _baselines_tracking():
+    """More valid calls: the JAVELIN containers, a random scene, the route's impairments and a
+    template (callables the workflows reach only through their results)."""
+    from tunnelkit import evaluation, signal_route
+    from tunnelkit.channel import Impairments
+    from tunnelkit.scenarios import template
+    from tunnelkit.tracking.javelin.measurement import PathMeasurements
+    from tunnelkit.tracking.javelin.motion import RandomWalk
+    from tunnelkit.tracking.javelin.state import JavelinState
+
+    rng = np.random.default_rng(0)
+    pm = PathMeasurements.from_arrays(
+        np.array([0.1, 0.5]), np.array([0.2, 0.3]), np.array([5.0, np.nan]), np.array([4.0, 6.0])
+    )
+    pm.subset([0])
+    st = JavelinState(np.array([0.0, 1.0, 1.5, 2.0, 3.0]), np.eye(5), [1], [0], [False], next_id=2)
+    st.position(0)
+    RandomWalk().increment(st, 10.0, 0.0, 0.1)
+    scene = evaluation.random_scene(rng, 2)
+    scene.crlb()
+    scene.tensor(rng)
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    route.with_impairments(Impairments(phase_sigma_deg=1.0), rng)
+    template("my-tunnel", "italiano2026-straight")
+
+
 DRIVERS = (
     _jiang,
     _javelin,
@@ -287,6 +313,7 @@ DRIVERS = (
     _fresnel,
     _design,
     _baselines,
+    _baselines_tracking,
 )
 
 

@@ -189,6 +189,13 @@ class PathMeasurements:
 
     def subset(self, idx) -> PathMeasurements:
         """The paths at positions ``idx``."""
+        raw = np.asarray(idx) if not isinstance(idx, str | bytes) else None
+        if raw is None or raw.ndim != 1 or (raw.size and raw.dtype.kind not in "iu"):
+            raise TypeError(f"idx: expected a 1-D array of path indices, got {idx!r:.40}")
+        if raw.size and (raw.min() < -len(self) or raw.max() >= len(self)):
+            raise ValueError(
+                f"idx: path indices must lie in [0, {len(self) - 1}], got {raw.tolist()}"
+            )
         idx = np.asarray(idx, dtype=int)
         return PathMeasurements(
             self.phi[idx],
