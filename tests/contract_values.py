@@ -34,6 +34,8 @@ def _code_of(target: Target):
 
 
 def _keep(value):
+    if type(value).__name__ == "_HAS_DEFAULT_FACTORY_CLASS":
+        return value  # a dataclass's "use the default factory" marker: only the object itself works
     if isinstance(value, np.ndarray):
         return value.copy()
     if isinstance(value, np.random.Generator):
@@ -213,7 +215,107 @@ def _widgets():
     widgets.curvature_figure(side=4)
 
 
-DRIVERS = (_jiang, _javelin, _widgets, _signal_route, _studies, _doppler, _fresnel, _design)
+def _baselines():
+    """Short valid calls of callables the teaching workflows do not reach (so their contracts
+    are tested at all): geometry, propagation, channel pieces, bounds, verdicts, plots."""
+    import tunnelkit as tk
+    from tunnelkit import budget, crlb, geometry, metrics, propagation
+    from tunnelkit.channel import DiffuseSpec, diffuse_tensor
+    from tunnelkit.design import errormodel, mcrb, report, verdict
+    from tunnelkit.design.montecarlo import drive_bound, javelin_config
+    from tunnelkit.extraction.decomposition import kruskal_rank
+    from tunnelkit.fresnel.bounds import fraunhofer_distance
+    from tunnelkit.plots import common, tables, topview
+    from tunnelkit.tracking import cv, gating
+    from tunnelkit.tracking.javelin.measurement import measurement_model
+
+    rng = np.random.default_rng(0)
+    budget.set_memory_budget(budget.memory_budget())
+    spec = DiffuseSpec(0.1)
+    spec.power(1.0)
+    spec.taps(240e3, 16)
+    spec.tone_covariance(240e3, 16)
+    diffuse_tensor(spec, (4, 16, 2), 240e3, 1e-7, 1.0, rng)
+    h = lambda p: np.array([p[0] + p[1], p[0] * p[1]])  # noqa: E731
+    crlb.numeric_jacobian(h, np.array([1.0, 2.0]))
+    crlb.numeric_fim(h, np.array([1.0, 2.0]), np.eye(2))
+    sc = tk.load_scenario("jiang2023-straight")
+    tunnel, bs = sc.tunnel(), sc.base_station()
+    wall = tunnel.walls[0]
+    p = np.asarray(sc.trajectory().position[5], float)
+    wall.project(p)
+    tunnel.require_inside("p", p)
+    tunnel.wall_distances(p)
+    geometry.mirror(p, wall)
+    geometry.specular_point(bs, p, wall)
+    geometry.spherical(np.array([1.0, 2.0, 3.0]))
+    metrics.settled(np.arange(0.0, 30.0, 0.5))
+    propagation.fresnel_te(5.0 - 0.5j, np.array([0.3, 0.9]))
+    propagation.arrival_angles(np.array([0.0, 0.6, 0.8]))
+    box = propagation.Box(np.array([0.0, -1.0, 0.0]), np.array([10.0, 1.0, 4.0]))
+    box.blocks(np.array([-5.0, 0.0, 1.0]), np.array([15.0, 0.0, 1.0]))
+    fraunhofer_distance(0.25, 28e9)
+    kruskal_rank(rng.standard_normal((6, 3)))
+    errormodel.psd_sqrt(np.array([[2.0, 0.5], [0.5, 1.0]]))
+    mcrb.scaled_inverse(np.array([[[2.0, 0.5], [0.5, 1.0]]]))
+    e = np.abs(rng.standard_normal(50))
+    verdict.share_quantile(e, 0.9)
+    verdict.implied_quantile(e, 0.9)
+    verdict.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
+    verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
+    verdict.gate(e, np.ones(50, bool), "achievable")
+    report.over_target(np.arange(5.0), np.array([0.1, 0.3, 0.25, 0.1, 0.4]), 0.2)
+    drive_bound(np.full(5, 0.1), np.full(5, 0.02))
+    javelin_config({"d": 0.05, "direction": 0.01, "kappa": 2.0})
+    cv.simulate_cv(np.array([0.0, 0.0, 10.0, 0.0]), 0.1, 0.5, 20, rng)
+    gating.ChiSquareGate(0.99).accepts(np.array([1.0, 30.0]), 2)
+    measurement_model(np.array([0.0, 1.0, 1.5, 2.0, 3.0]), (0.0, 0.0, 4.8))
+    common.cdf_figure({"a": e})
+    tables.table(["x", "y"], [[1, 2.5], [2, 3.5]])
+    topview.tunnel_topview(tunnel, bs)
+    setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
+    tk.design.path_bounds(setup, "4x4", epochs=[5, 10])
+    tk.scenarios.with_values(tk.load_scenario("italiano2026-straight"), {"radio.fc": 28e9})
+
+
+def _baselines_tracking():
+    """More valid calls: the JAVELIN containers, a random scene, the route's impairments and a
+    template (callables the workflows reach only through their results)."""
+    from tunnelkit import evaluation, signal_route
+    from tunnelkit.channel import Impairments
+    from tunnelkit.scenarios import template
+    from tunnelkit.tracking.javelin.measurement import PathMeasurements
+    from tunnelkit.tracking.javelin.motion import RandomWalk
+    from tunnelkit.tracking.javelin.state import JavelinState
+
+    rng = np.random.default_rng(0)
+    pm = PathMeasurements.from_arrays(
+        np.array([0.1, 0.5]), np.array([0.2, 0.3]), np.array([5.0, np.nan]), np.array([4.0, 6.0])
+    )
+    pm.subset([0])
+    st = JavelinState(np.array([0.0, 1.0, 1.5, 2.0, 3.0]), np.eye(5), [1], [0], [False], next_id=2)
+    st.position(0)
+    RandomWalk().increment(st, 10.0, 0.0, 0.1)
+    scene = evaluation.random_scene(rng, 2)
+    scene.crlb()
+    scene.tensor(rng)
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    route.with_impairments(Impairments(phase_sigma_deg=1.0), rng)
+    template("my-tunnel", "italiano2026-straight")
+
+
+DRIVERS = (
+    _jiang,
+    _javelin,
+    _widgets,
+    _signal_route,
+    _studies,
+    _doppler,
+    _fresnel,
+    _design,
+    _baselines,
+    _baselines_tracking,
+)
 
 
 def _safe(fn):

@@ -276,3 +276,48 @@ def test_mmax_json_marks_a_capped_search(capsys):
     assert cli.main(["mmax", "--format", "json"]) == 0
     row = json.loads(capsys.readouterr().out)["rows"][0]
     assert row["exact ULA"] == 15 and row["exact URA MxM"] == 11
+
+
+def test_interval_refuses_nan_reversed_and_wrong_length():
+    assert v.interval("ranges", (2.0, 8.0), lower=1e-3) == (2.0, 8.0)
+    assert v.interval("speeds", np.array([-20, 20])) == (-20.0, 20.0)
+    for bad, exc in [
+        ("x", TypeError),
+        (3.0, TypeError),
+        ((1.0,), ValueError),
+        ((np.nan, 1.0), ValueError),
+        ((5.0, 1.0), ValueError),
+    ]:
+        with pytest.raises(exc, match=r"^ranges"):
+            v.interval("ranges", bad)
+    with pytest.raises(ValueError, match=r"^ranges: must be >= 0.001"):
+        v.interval("ranges", (0.0, 1.0), lower=1e-3)
+
+
+def test_instance_names_the_parameter_and_the_class():
+    cfg = tk.channel.SRSConfig()
+    assert v.instance("config", cfg, tk.channel.SRSConfig) is cfg
+    with pytest.raises(TypeError, match=r"^config: expected a channel\.SRSConfig, got str"):
+        v.instance("config", "x", tk.channel.SRSConfig)
+    with pytest.raises(TypeError, match=r"^x: expected a dict or a list, got int"):
+        v.instance("x", 3, (dict, list), "a dict or a list")
+
+
+def test_slider_values_are_checked_against_the_slider_range():
+    from tunnelkit.widgets.base import float_slider, int_slider, slider_value
+
+    assert slider_value("q", 0.5, 0.01, 10.0) == 0.5
+    assert slider_value(None, -1.0, 0.0, 1.0) == -1.0  # the explorer's own constant
+    for bad, exc in [
+        ("x", TypeError),
+        (np.nan, ValueError),
+        (-1.0, ValueError),
+        (11.0, ValueError),
+    ]:
+        with pytest.raises(exc, match=r"^q"):
+            float_slider("q [m^2/s^3]", bad, 0.01, 10.0, 0.01, name="q")
+    with pytest.raises(TypeError, match=r"^seed"):
+        int_slider("seed", 2.5, 0, 20, name="seed")
+    with pytest.raises(ValueError, match=r"^seed"):
+        int_slider("seed", -1, 0, 20, name="seed")
+    assert int_slider("seed", 3, 0, 20, name="seed").value == 3

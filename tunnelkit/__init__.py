@@ -60,6 +60,11 @@ def setup_notebook(*, renderer: str | None = None) -> None:
     """
     import plotly.io as pio
 
+    if renderer is not None and (not isinstance(renderer, str) or renderer not in pio.renderers):
+        raise ValueError(
+            f"renderer: expected one of plotly's renderers ({', '.join(list(pio.renderers)[:6])}, "
+            f"...), got {renderer!r}"
+        )
     if renderer is not None:
         pio.renderers.default = renderer
     elif pio.renderers.default in (None, "", "browser"):

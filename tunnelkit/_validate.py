@@ -18,7 +18,9 @@ __all__ = [
     "cosine",
     "distinct_points",
     "finite_array",
+    "instance",
     "integer",
+    "interval",
     "nonnegative",
     "nonnegative_array",
     "positive",
@@ -268,6 +270,36 @@ def distinct_points(name: str, value, *, dim: int, minimum: int = 2, atol: float
                 f"{name}: need at least {minimum} distinct stations, the {P.shape[0]} given coincide"
             )
     return P
+
+
+def interval(name: str, value, *, lower: float | None = None) -> tuple[float, float]:
+    """A range ``(lo, hi)`` of two finite reals with ``lo <= hi`` (and ``lo >= lower`` when
+    given), e.g. the bounds a uniform draw takes: NaN, a reversed or a wrong-length range named."""
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise TypeError(f"{name}: expected a (low, high) pair, got {type(value).__name__}")
+    pair = finite_array(name, value)
+    if pair.shape != (2,):
+        raise ValueError(f"{name}: expected a (low, high) pair, got shape {pair.shape}")
+    lo, hi = float(pair[0]), float(pair[1])
+    if lo > hi:
+        raise ValueError(f"{name}: low {lo:g} is above high {hi:g}")
+    if lower is not None and lo < lower:
+        raise ValueError(f"{name}: must be >= {lower:g}, got low {lo:g}")
+    return lo, hi
+
+
+def instance(name: str, value, cls: type | tuple[type, ...], what: str | None = None):
+    """``value`` if it is an instance of ``cls`` (a class or a tuple of classes), else
+    ``TypeError`` naming ``name`` and what was expected (``what``, default the class names), so a
+    wrong object is refused at the boundary instead of failing later with an ``AttributeError``."""
+    if not isinstance(value, cls):
+        if what is None:
+            classes = cls if isinstance(cls, tuple) else (cls,)
+            what = " or ".join(
+                f"a {c.__module__.removeprefix('tunnelkit.')}.{c.__qualname__}" for c in classes
+            )
+        raise TypeError(f"{name}: expected {what}, got {type(value).__name__}")
+    return value
 
 
 def rng_or_error(name: str, rng) -> np.random.Generator:

@@ -62,7 +62,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import finite_array, integer, nonnegative, positive, real, rng_or_error
+from ._validate import choice, finite_array, integer, nonnegative, positive, real, rng_or_error
 from .budget import check_elements
 from .constants import K_B, C, db2lin, dbm2watt
 
@@ -168,6 +168,11 @@ class SRSConfig:
     @classmethod
     def from_scenario(cls, scenario) -> SRSConfig:
         """Read ``[radio]`` of a scenario (clock-bias keys in ns)."""
+        if not (callable(getattr(scenario, "get", None)) and hasattr(scenario, "section")):
+            raise TypeError(
+                f"scenario: expected a loaded scenarios.Scenario (tk.load_scenario(name)), got "
+                f"{type(scenario).__name__}"
+            )
         g = scenario.get
         kw = {
             "fc": g("radio.fc"),
@@ -325,6 +330,8 @@ class Impairments:
 
     def draw(self, rng: np.random.Generator, m: int) -> np.ndarray | None:
         """One array's calibration vector (:func:`draw_calibration`), ``None`` if calibrated."""
+        rng = rng_or_error("rng", rng)
+        m = integer("m", m, minimum=1)
         if self.calibrated:
             return None
         return draw_calibration(rng, m, self.phase_sigma_deg, self.gain_sigma_db)
@@ -347,6 +354,8 @@ def _check_paths(paths) -> list:
     """``paths`` as a non-empty list of :class:`~tunnelkit.propagation.Path` for one array."""
     from .propagation import Path
 
+    if isinstance(paths, str | bytes) or not isinstance(paths, list | tuple):
+        raise TypeError(f"paths: expected a list of propagation.Path, got {type(paths).__name__}")
     paths = list(paths)
     if not paths:
         raise ValueError("paths: need at least one path (the vehicle is fully blocked)")
@@ -449,6 +458,25 @@ class ChannelSnapshot:
     model: str
     paths: tuple = field(repr=False)
     config: SRSConfig = field(repr=False)
+
+    def __post_init__(self) -> None:
+        H = self.H
+        if not isinstance(H, np.ndarray) or H.dtype.kind != "c":
+            raise TypeError(
+                f"H: expected a complex channel tensor (numpy array), got {type(H).__name__}"
+                + (f" of {H.dtype}" if isinstance(H, np.ndarray) else "")
+            )
+        if H.ndim != 3:
+            raise ValueError(f"H: expected a 3-D tensor (M x Nf x Nt), got shape {H.shape}")
+        if not np.isfinite(H).all():
+            raise ValueError("H: contains NaN or infinite values")
+        positive("noise_power", self.noise_power)
+        real("clock_bias", self.clock_bias)
+        choice("model", self.model, _MODELS)
+        if not isinstance(self.paths, tuple):
+            raise TypeError(f"paths: expected a tuple of paths, got {type(self.paths).__name__}")
+        if not isinstance(self.config, SRSConfig):
+            raise TypeError(f"config: expected an SRSConfig, got {type(self.config).__name__}")
 
     @property
     def snr_db(self) -> np.ndarray:

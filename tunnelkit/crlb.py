@@ -170,7 +170,12 @@ def numeric_jacobian(
     for k in range(n):
         e = np.zeros(n)
         e[k] = step
-        diff = np.asarray(h(p + e), dtype=float) - np.asarray(h(p - e), dtype=float)
+        try:
+            diff = np.asarray(h(p + e), dtype=float) - np.asarray(h(p - e), dtype=float)
+        except (IndexError, ValueError, TypeError) as exc:
+            raise ValueError(
+                f"h: fails on p of shape {p.shape} ({type(exc).__name__}: {exc})"
+            ) from None
         if angle_mask is not None:
             mask = np.asarray(angle_mask, dtype=bool)
             diff = np.where(mask, _wrap(diff), diff)

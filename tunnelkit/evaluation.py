@@ -225,15 +225,24 @@ def random_scene(
     of a 10 x 10 half-wavelength URA (default), directions with ``|u_xy| < max_sine``, per-sample
     SNR uniform in ``snr_db`` (the noise power of ``config``, default :class:`SRSConfig`), delay
     distances ``range + U(0, spread_d)`` (a clock bias and extra path length), speeds uniform."""
-    from ._validate import integer, rng_or_error
-    from .arrays import ura
+    from ._validate import instance, integer, interval, nonnegative, real, rng_or_error
+    from .arrays import check_element_positions, ura
     from .channel import SRSConfig
     from .constants import wavelength
 
     rng = rng_or_error("rng", rng)
     L = integer("n_paths", n_paths, minimum=1)
-    cfg = SRSConfig() if config is None else config
+    cfg = SRSConfig() if config is None else instance("config", config, SRSConfig)
+    ranges = interval("ranges", ranges, lower=1e-3)
+    max_sine = real("max_sine", max_sine)
+    if not 0 < max_sine <= 1:
+        raise ValueError(f"max_sine: must lie in (0, 1], got {max_sine}")
+    snr_db = interval("snr_db", snr_db)
+    spread_d = nonnegative("spread_d", spread_d)
+    speeds = interval("speeds", speeds)
     pos = ura(10, 10, wavelength(cfg.fc) / 2) if element_positions is None else element_positions
+    if element_positions is not None:
+        pos = check_element_positions("element_positions", element_positions)
     pos = np.asarray(pos, float)
     r = rng.uniform(*ranges, L)
     rad = max_sine * np.sqrt(rng.uniform(0, 1, L))

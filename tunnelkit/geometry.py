@@ -274,8 +274,10 @@ class Tunnel2D:
         return p
 
     def virtual_stations(self, base_station) -> np.ndarray:
-        """The base station mirrored in wall 1 and wall 2 (Jiang eq. 3-4), shape (2, 2)."""
-        return virtual_stations(base_station, self.walls)
+        """The base station mirrored in wall 1 and wall 2 (Jiang eq. 3-4), shape (2, 2); the base
+        station must lie between the walls (``ValueError`` naming ``base_station`` otherwise)."""
+        bs = vector("base_station", base_station, 2)
+        return virtual_stations(self.require_inside("base_station", bs), self.walls)
 
     def to_tunnel_frame(self, p) -> np.ndarray:
         """(along, across) coordinates; ``across`` measured from wall 2."""

@@ -241,6 +241,8 @@ def _copy(v):
 
 def family_of(raw: dict, where: str) -> str:
     """The family of a parsed file: its ``paper`` key, or ``"user"`` without one."""
+    if not isinstance(raw, dict):
+        raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
     paper = raw.get("paper")
     if paper is None:
         return "user"
@@ -1008,6 +1010,14 @@ def _render(lines: list[str], spec: Table, values: dict, path: str) -> None:
 
 def render_template(family: str, values: dict, header: str = "") -> str:
     """A commented TOML file of ``family`` holding ``values``, every key documented from the spec."""
+    if not isinstance(family, str) or family not in FAMILIES:
+        raise ValueError(f"family: expected one of {list(FAMILIES)}, got {family!r}")
+    if not isinstance(values, dict):
+        raise TypeError(
+            f"values: expected a dict of the file's tables, got {type(values).__name__}"
+        )
+    if not isinstance(header, str):
+        raise TypeError(f"header: expected text, got {type(header).__name__}")
     spec = FAMILIES[family]
     lines = [f"# {ln}" if ln else "#" for ln in header.splitlines()]
     lines.append(

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ._validate import choice, integer, rng_or_error
+from ._validate import boolean, choice, instance, integer, real, rng_or_error
 from .arrays import ArrayGeometry
 from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from .constants import C
@@ -43,6 +43,22 @@ __all__ = [
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
 #: ``"sionna"`` (the tensor of every path Sionna RT traces per element, :mod:`tunnelkit.rt.cache`)
 CHANNELS = ("image", "sionna")
+
+
+def _check_arrays(arrays) -> None:
+    """A non-empty list of ArrayGeometry with distinct names (calibration is keyed by name)."""
+    if isinstance(arrays, str) or not isinstance(arrays, list | tuple) or not arrays:
+        raise TypeError(f"arrays: expected a non-empty list of ArrayGeometry, got {arrays!r:.80}")
+    names = {}
+    for i, a in enumerate(arrays):
+        if not isinstance(a, ArrayGeometry):
+            raise TypeError(f"arrays[{i}]: expected an ArrayGeometry, got {type(a).__name__}")
+        if a.name in names:
+            raise ValueError(
+                f"arrays: arrays[{i}] and arrays[{names[a.name]}] are both named {a.name!r}; "
+                "names must be distinct (the calibration is keyed by name)"
+            )
+        names[a.name] = i
 
 
 @dataclass(frozen=True)
@@ -149,6 +165,9 @@ def measurements_from_estimates(
     ``config``, also the covariance the extraction reports (:func:`reported_covariance`)."""
     from .extraction import algorithm1
 
+    instance("array", array, ArrayGeometry)
+    if config is not None:
+        instance("config", config, SRSConfig)
     keep = algorithm1(est, min_d)
     u = array.dir_to_world(est.direction[keep]) if keep.size else np.zeros((0, 3))
     phi = np.arctan2(u[:, 1], u[:, 0])
@@ -215,7 +234,26 @@ class SignalRoute:
     raytraced: object = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
+        from .propagation import PATH_KINDS, Tunnel3D
+        from .scenarios import Trajectory
+
         choice("channel", self.channel, CHANNELS)
+        instance("tunnel", self.tunnel, Tunnel3D)
+        _check_arrays(self.arrays)
+        instance("trajectory", self.trajectory, Trajectory)
+        instance("config", self.config, SRSConfig)
+        choice("model", self.model, ("exact", "srnf"))
+        if not isinstance(self.kinds, tuple | list) or not self.kinds:
+            raise TypeError(
+                f"kinds: expected a non-empty tuple of path kinds, got {self.kinds!r:.60}"
+            )
+        for k in self.kinds:
+            choice("kinds", k, PATH_KINDS)
+        real("snr_offset_db", self.snr_offset_db)
+        instance("impairments", self.impairments, Impairments)
+        instance("calibration", self.calibration, dict)
+        boolean("report_covariance", self.report_covariance)
+        boolean("bias_aware_delay_check", self.bias_aware_delay_check)
         if self.channel == "sionna":
             from .rt.cache import RayTracedChannel
 
@@ -293,6 +331,7 @@ class SignalRoute:
     def snapshot(self, paths, arr: ArrayGeometry, rng: np.random.Generator, **kw):
         """The SRS tensor of ``paths`` at ``arr`` (:func:`tunnelkit.channel.synthesize`) with
         this route's model, SNR offset and impairments; ``kw`` (``clock_bias``, ...) passed on."""
+        instance("arr", arr, ArrayGeometry)
         return synthesize(
             paths,
             self.config,

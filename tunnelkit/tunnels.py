@@ -27,7 +27,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validate import integer, positive
+from ._validate import finite_array, integer, positive, real
 from .propagation import (
     Box,
     Facet,
@@ -69,18 +69,21 @@ def extruded_tunnel(
     ``names[i]``, extruded over ``[x_start, x_start + length]`` (centred on x = 0 by default). The
     road closes the section. Normals point into the tunnel; plates must lie inside.
     """
-    prof = np.asarray(profile, dtype=float)
+    prof = finite_array("profile", profile)
     if prof.ndim != 2 or prof.shape[1] != 2 or prof.shape[0] < 3:
         raise ValueError(f"profile: expected (K >= 3, 2) vertices, got shape {prof.shape}")
+    if isinstance(names, str) or not isinstance(names, list | tuple):
+        raise TypeError(f"names: expected a list of facet names, got {type(names).__name__}")
     names = list(names)
     if len(names) != prof.shape[0] - 1:
         raise ValueError(f"names: expected {prof.shape[0] - 1} facet names, got {len(names)}")
     if abs(prof[0, 1]) > 1e-12 or abs(prof[-1, 1]) > 1e-12 or prof[0, 0] <= prof[-1, 0]:
         raise ValueError("profile: must run from (width/2, 0) to (-width/2, 0) over the roof")
+    _check_convex_profile(prof)
     length = positive("length", length)
     width = float(prof[0, 0] - prof[-1, 0])
     height = float(prof[:, 1].max())
-    x0 = -length / 2 if x_start is None else float(x_start)
+    x0 = -length / 2 if x_start is None else real("x_start", x_start)
     ax = np.array([length, 0.0, 0.0])
     centre = np.array([0.0, 0.5 * (prof[0, 0] + prof[-1, 0]), 0.5 * height])
     verts = np.column_stack([np.full(len(prof), x0), prof])
@@ -96,6 +99,29 @@ def extruded_tunnel(
     return close_tunnel(
         facets, x0, length, prof[-1, 0], width, height, road_material, plates, blockers
     )
+
+
+def _check_convex_profile(prof: np.ndarray) -> None:
+    """The cross-section closed by the road must be a convex polygon traversed once,
+    counter-clockwise in (y, z) (right road corner, up over the roof, down to the left corner):
+    every turn to the left (collinear edges allowed) and the turns adding up to one revolution.
+    A concave or self-intersecting profile (a wall folding inwards, a crossed edge) is refused:
+    the tracer's inside test and the facets' inward normals assume a convex section."""
+    closed = np.vstack([prof, prof[:1]])
+    e = np.diff(closed, axis=0)  # the K - 1 profile edges and the road
+    lengths = np.linalg.norm(e, axis=1)
+    if np.any(lengths <= 1e-9 * max(float(lengths.max()), 1.0)):
+        raise ValueError(f"profile: edge {int(np.argmin(lengths))} has zero length")
+    nxt = np.roll(e, -1, axis=0)
+    cross = e[:, 0] * nxt[:, 1] - e[:, 1] * nxt[:, 0]
+    turn = np.arctan2(cross, np.einsum("ij,ij->i", e, nxt))
+    tol = 1e-9 * lengths.max() ** 2
+    if np.any(cross < -tol) or abs(turn.sum() - 2 * np.pi) > 1e-6:
+        bad = int(np.argmin(cross)) + 1
+        raise ValueError(
+            "profile: the cross-section (closed by the road) must be convex and not cross itself; "
+            f"it turns the wrong way or winds more than once (near vertex {bad % len(prof)})"
+        )
 
 
 def rectangular_tunnel(*, width: float, height: float, length: float, **kw) -> Tunnel3D:

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import boolean, nonnegative, positive
+from .._validate import boolean, instance, nonnegative, positive
 from ..channel import DiffuseSpec, Impairments
 from ..constants import C
 from ..geometry import spherical_jacobian
@@ -271,6 +271,7 @@ def path_error_model(
     spec = parse_array(spec)
     cfg = setup.config
     g = route_geometry(setup, spec, epochs=epochs) if geometry is None else geometry
+    instance("geometry", g, RouteGeometry)
     fr = _frame(setup, spec, g)
     T, L = fr.idx.shape
     P = g.exists.shape[1]
@@ -400,6 +401,7 @@ def achievable_bound(
     spec = parse_array(spec)
     cfg = setup.config
     g = route_geometry(setup, spec, epochs=epochs) if geometry is None else geometry
+    instance("geometry", g, RouteGeometry)
     peb = route_bounds(setup, spec, geometry=g).peb
     fr = _frame(setup, spec, g)
     T = fr.idx.shape[0]

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_array, positive
+from .._validate import finite_array, instance, positive
 from ..constants import C, wavelength
 from ..fresnel import signed_mismatch
 from .geometry import RouteGeometry, trace_route
@@ -225,6 +225,7 @@ def _peb(cfg, s_loc, d0, src, a0, R, pos, take, g, idx, mask, clock_bias, height
 def route_geometry(setup: DesignSetup, spec, *, epochs=None) -> RouteGeometry:
     """:func:`trace_route` of ``spec`` mounted as ``setup`` says, along its route (``epochs``:
     indices that subsample it), at its carrier and path kinds."""
+    instance("setup", setup, DesignSetup)
     spec = parse_array(spec)
     traj = setup.trajectory
     sl = slice(None)
@@ -276,7 +277,7 @@ def route_bounds(
     cfg = setup.config
     if geometry is None:
         geometry = route_geometry(setup, spec, epochs=epochs)
-    g = geometry
+    g = instance("geometry", geometry, RouteGeometry)
     pos = spec.local(cfg.fc)
     kinds = np.array(g.kinds)
     used = g.exists & (markings | (kinds != "rrm"))[None, :]
@@ -319,6 +320,7 @@ def path_bounds(setup: DesignSetup, spec, *, epochs=None) -> dict[str, np.ndarra
     """
     from ..extraction import crlb_paths  # tensorly and the extraction load only here
 
+    instance("setup", setup, DesignSetup)
     spec = parse_array(spec)
     cfg = setup.config
     g = route_geometry(setup, spec, epochs=epochs)

@@ -547,6 +547,8 @@ def javelin_rmse(
     runs = integer("runs", runs, minimum=2)
     if not isinstance(seed, np.random.Generator):
         seed = integer("seed", seed, minimum=0)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
     if crlb is None:
         pb = path_bounds(setup, spec)
         crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}

@@ -28,7 +28,8 @@ from functools import partial
 
 import numpy as np
 
-from .._validate import choice, integer, positive, probability
+from .._validate import choice, finite_array, integer, positive, probability
+from ..budget import check_elements
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
 from .bounds import route_bounds, route_geometry
@@ -220,7 +221,14 @@ class DesignReport:
 def over_target(x, y, target: float) -> str:
     """The stretches of the route where ``y > target`` (non-finite counts), as text:
     ``"45.0..38.1 m, 12.5 m"`` in route order; ``""`` when none."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
+    x = finite_array("x", x, ndim=1)
+    try:
+        y = np.asarray(y, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"y: expected real numbers (NaN allowed), got {type(y).__name__}") from None
+    if y.shape != x.shape:
+        raise ValueError(f"y: expected one value per x, shape {x.shape}, got {y.shape}")
+    target = positive("target", target)
     bad = ~(y <= target)
     out, i = [], 0
     while i < bad.size:
@@ -481,6 +489,17 @@ def design_sweep(
         raise ValueError(
             "mode: the channel Monte-Carlo route synthesises the ideal channel; use mode='bound' "
             "for a Monte-Carlo under impairments"
+        )
+    if mode == "channel" and runs:
+        # each drive synthesises the largest candidate's tensor and a noise draw of its size:
+        # the band's tone count is refused here, before any bound is computed
+        cfg, big = setup.config, max(s.n_elements for s in specs)
+        check_elements(
+            "bandwidth",
+            2 * big * cfg.n_tones * cfg.n_symbols,
+            16,
+            f"a {big} x {cfg.n_tones} tones x {cfg.n_symbols} symbols channel tensor and its noise "
+            f"at bandwidth = {cfg.bandwidth:g} Hz",
         )
     T = len(setup.trajectory)
     epochs = None if n_epochs is None or n_epochs >= T else np.arange(n_epochs)

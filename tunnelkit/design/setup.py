@@ -23,7 +23,7 @@ from .._validate import choice, finite_array, integer, positive
 from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
 from ..constants import wavelength
-from ..scenarios import Scenario, load_scenario
+from ..scenarios import Scenario, Trajectory, load_scenario
 from ..signal_route import CHANNELS, SignalRoute
 from .geometry import KINDS
 
@@ -124,6 +124,33 @@ class DesignSetup:
     channel: str = "image"
     rt_settings: object = None
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise TypeError(f"name: expected the scenario's name, got {self.name!r}")
+        if not isinstance(self.tunnel, propagation.Tunnel3D):
+            raise TypeError(
+                f"tunnel: expected a propagation.Tunnel3D, got {type(self.tunnel).__name__}"
+            )
+        if not isinstance(self.mounts, tuple) or not self.mounts:
+            raise TypeError(f"mounts: expected a non-empty tuple of Mount, got {self.mounts!r:.60}")
+        for i, m in enumerate(self.mounts):
+            if not isinstance(m, Mount):
+                raise TypeError(f"mounts[{i}]: expected a Mount, got {type(m).__name__}")
+        if not isinstance(self.trajectory, Trajectory):
+            raise TypeError(
+                f"trajectory: expected a scenarios.Trajectory, got {type(self.trajectory).__name__}"
+            )
+        if not isinstance(self.config, SRSConfig):
+            raise TypeError(
+                f"config: expected a channel.SRSConfig, got {type(self.config).__name__}"
+            )
+        kinds = self.kinds
+        if not isinstance(kinds, tuple) or not kinds:
+            raise TypeError(f"kinds: expected a non-empty tuple of path kinds, got {kinds!r:.60}")
+        for k in kinds:
+            choice("kinds", k, propagation.PATH_KINDS)
+        choice("channel", self.channel, CHANNELS)
+
     @classmethod
     def from_scenario(
         cls,
@@ -187,6 +214,7 @@ class DesignSetup:
         channel: str = "image",
     ) -> DesignSetup:
         """A copy with another carrier, bandwidth, down-tilt or mount height (``None`` keeps)."""
+        choice("channel", channel, CHANNELS)
         cfg = self.config
         if fc is not None:
             cfg = replace(cfg, fc=positive("fc", fc))

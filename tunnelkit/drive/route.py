@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_array, positive, real
+from .._validate import finite_array, instance, positive, real, vector
 from ..constants import C
 from ..scenarios import Trajectory
 from .config import DriveConfig
@@ -123,6 +123,8 @@ def image_sources(cfg: DriveConfig, tx: np.ndarray) -> tuple[np.ndarray, np.ndar
     Walls at ``y = +-W/2``: images at ``y_m = m W + (-1)^m y_T``; floor/ceiling likewise about
     ``z = H/2``. Returns positions (P, 3) and bounce counts (P,), line of sight first.
     """
+    instance("cfg", cfg, DriveConfig)
+    tx = vector("tx", tx, 3)
     n = cfg.max_order
     ms = np.arange(-n, n + 1)
     my, mz = np.meshgrid(ms, ms, indexing="ij")
@@ -143,7 +145,11 @@ def channel_paths(cfg: DriveConfig, position, velocity, tx) -> dict[str, np.ndar
     ``position``/``velocity`` (T, 2) horizontal; the receiving antenna is at ``rx_height``.
     Amplitude ``(-Gamma)^k lambda / (4 pi r) exp(-j 2 pi f_c tau)`` for ``k`` bounces.
     """
-    src, order = image_sources(cfg, np.asarray(tx, dtype=float))
+    instance("cfg", cfg, DriveConfig)
+    tx = vector("tx", tx, 3)
+    position = finite_array("position", position, shape=(None, 2))
+    velocity = finite_array("velocity", velocity, shape=(len(position), 2))
+    src, order = image_sources(cfg, tx)
     p3 = np.concatenate([position, np.full((len(position), 1), cfg.rx_height)], -1)
     v3 = np.concatenate([velocity, np.zeros((len(velocity), 1))], -1)
     w = p3[:, None, :] - src[None, :, :]

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, integer
+from .._validate import finite_array, instance, integer, positive
 from ..arrays import ArrayGeometry
+from ..budget import check_elements
+from ..channel import SRSConfig
 from ..constants import C, db2lin
 from .estimates import PathEstimates
 from .radio import check_array, check_srs
@@ -45,10 +47,34 @@ def crlb_paths(
     """
     if spatial not in ("structured", "free"):
         raise ValueError(f"spatial: expected 'structured' or 'free', got {spatial!r}")
-    alpha = np.atleast_1d(np.asarray(alpha, complex))
-    src = np.atleast_2d(np.asarray(sources, float))
-    p = np.asarray(element_positions, float)
+    alpha = np.atleast_1d(finite_array("alpha", alpha, dtype=complex))
+    if alpha.ndim != 1 or alpha.size == 0:
+        raise ValueError(f"alpha: expected one complex gain per path (L,), got shape {alpha.shape}")
     L = alpha.size
+    src = finite_array("sources", np.atleast_2d(sources) if np.ndim(sources) == 1 else sources)
+    if src.shape != (L, 3):
+        raise ValueError(f"sources: expected shape ({L}, 3) (one per alpha), got {src.shape}")
+    p = finite_array("element_positions", element_positions, ndim=2)
+    if p.shape[0] < 2 or p.shape[1] != 3:
+        raise ValueError(f"element_positions: expected shape (M >= 2, 3), got {p.shape}")
+    if np.any(np.linalg.norm(src[None, :, :] - p[:, None, :], axis=-1) == 0):
+        raise ValueError("sources: a wave origin coincides with an element")
+    mu_f = np.atleast_1d(finite_array("mu_f", mu_f))
+    mu_t = np.atleast_1d(finite_array("mu_t", mu_t))
+    for name, v in (("mu_f", mu_f), ("mu_t", mu_t)):
+        if v.shape != (L,):
+            raise ValueError(f"{name}: expected shape ({L},) (one per alpha), got {v.shape}")
+    fc = positive("fc", fc)
+    n_tones = integer("n_tones", n_tones, minimum=2)
+    n_symbols = integer("n_symbols", n_symbols, minimum=2)
+    noise_power = positive("noise_power", noise_power)
+    n_per = 4 + (3 if spatial == "structured" else 2 * (p.shape[0] - 1))
+    check_elements(
+        "n_tones, n_symbols",
+        (p.shape[0] + n_tones + n_symbols) * n_per * L,
+        16,
+        f"the mode vectors of {L} paths",
+    )
     k0 = 2 * np.pi * fc / C
     s = np.arange(n_tones)[:, None]
     kk = np.arange(n_symbols)[:, None]
@@ -124,7 +150,7 @@ def path_crlb(
     if not isinstance(array, ArrayGeometry):
         raise TypeError(f"array: expected an ArrayGeometry, got {type(array).__name__}")
     config = check_srs(srs)
-    nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=1)
+    nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=2)
     off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
     noise_power = config.noise_power / float(db2lin(off))
     _, mu_f, mu_t = ml_truth(paths, array, config)  # checks paths too
@@ -190,6 +216,11 @@ def ml_truth(paths, array, srs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def in_path_units(bound: dict, config) -> dict[str, np.ndarray]:
     """:func:`source_crlb`'s standard deviations as ``d`` [m], ``v`` [m/s], ``direction`` [rad]
     and ``kappa`` [m], with the tone spacing, carrier and symbol period of ``config``."""
+    instance("config", config, SRSConfig)
+    instance("bound", bound, dict)
+    missing = [k for k in ("mu_f", "mu_t", "direction", "kappa") if k not in bound]
+    if missing:
+        raise ValueError(f"bound: missing {missing} (a source_crlb result)")
     return {
         "d": C / (2 * np.pi * config.tone_spacing) * bound["mu_f"],
         "v": C / (2 * np.pi * config.fc * config.symbol_period) * bound["mu_t"],
@@ -214,6 +245,8 @@ def source_crlb(
     """:func:`crlb_paths` read out per path: ``mu_f``, ``mu_t`` (rad; from the ``spatial`` model),
     ``direction`` [rad] and ``kappa`` [m] of the wave origin (structured model), for sources
     given in the array's local frame (any scene, not only traced paths)."""
+    if spatial not in ("structured", "free"):
+        raise ValueError(f"spatial: expected 'structured' or 'free', got {spatial!r}")
     args = (alpha, sources, element_positions, mu_f, mu_t, fc, n_tones, n_symbols, noise_power)
     st = crlb_paths(*args, spatial="structured")
     roots = st if spatial == "structured" else crlb_paths(*args, spatial="free")

@@ -6,7 +6,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validate import boolean, integer, nonnegative
+
 __all__ = ["PathEstimates", "path_estimates"]
+
+_KINDS = {"real": "iuf", "complex": "iufc", "bool": "b"}
+
+
+def _per_path(name: str, value, n: int, kind: str, *, ndim: int = 1, width: int | None = None):
+    """A per-path array of ``n`` rows: numbers of ``kind`` (NaN allowed: a far-field path has no
+    curvature), ``ndim`` axes and ``width`` columns when given; errors name ``name``."""
+    if isinstance(value, str | bytes) or not isinstance(value, np.ndarray | list | tuple):
+        raise TypeError(
+            f"{name}: expected an array with one row per path, got {type(value).__name__}"
+        )
+    arr = np.asarray(value)
+    if arr.dtype.kind not in _KINDS[kind]:
+        raise TypeError(f"{name}: expected {kind} values, got dtype {arr.dtype}")
+    if arr.ndim != ndim or arr.shape[0] != n or (width is not None and arr.shape[1] != width):
+        want = f"({n},)" if ndim == 1 else f"({n}, {width if width is not None else 'M'})"
+        raise ValueError(f"{name}: expected shape {want} (one row per path), got {arr.shape}")
 
 
 @dataclass(frozen=True)
@@ -47,6 +66,29 @@ class PathEstimates:
     significance: np.ndarray | None = field(default=None, repr=False)
     fit_ok: bool | None = None
 
+    def __post_init__(self) -> None:
+        d = self.d
+        if isinstance(d, str | bytes) or np.ndim(d) != 1:
+            raise ValueError(f"d: expected one distance per path (L,), got shape {np.shape(d)}")
+        n = np.shape(d)[0]
+        _per_path("d", d, n, "real")
+        _per_path("alpha", self.alpha, n, "complex")
+        for name in ("v", "kappa", "phi", "psi", "kappa_nf", "mu_f", "mu_t"):
+            _per_path(name, getattr(self, name), n, "real")
+        _per_path("near_field", self.near_field, n, "bool")
+        _per_path("valid", self.valid, n, "bool")
+        _per_path("direction", self.direction, n, "real", ndim=2, width=3)
+        _per_path("delta", self.delta, n, "real", ndim=2)
+        if not isinstance(self.factors, tuple) or len(self.factors) != 3:
+            raise TypeError("factors: expected the three factor matrices (A, F, T) as a tuple")
+        nonnegative("rel_error", self.rel_error)
+        integer("n_iter", self.n_iter, minimum=0)
+        boolean("converged", self.converged)
+        if self.significance is not None:
+            _per_path("significance", self.significance, n, "real")
+        if self.fit_ok is not None:
+            boolean("fit_ok", self.fit_ok)
+
     def __len__(self) -> int:
         return self.d.shape[0]
 
@@ -64,6 +106,21 @@ def path_estimates(
     """Assemble :class:`PathEstimates` sorted by ``d``: near-field paths take the eq. 19-21
     angles and curvature of ``ang`` (:func:`angles_from_solution`), the others the far-field
     ones (``kappa`` NaN); ``delta`` is (L, M), ``factors`` the three (., L) factor matrices."""
+    L = np.shape(d)[0] if np.ndim(d) == 1 else -1
+    for name, a, nd in (
+        ("d", d, 1),
+        ("alpha", alpha, 1),
+        ("v", v, 1),
+        ("near", near, 1),
+        ("delta", delta, 2),
+        ("mu_f", mu_f, 1),
+        ("mu_t", mu_t, 1),
+    ):
+        if isinstance(a, str) or np.ndim(a) != nd or np.shape(a)[0] != L:
+            want = "(L,)" if nd == 1 else "(L, M)"
+            raise ValueError(f"{name}: expected shape {want} with L = len(d), got {np.shape(a)}")
+    if not isinstance(ang, dict):
+        raise TypeError(f"ang: expected the dict of angles_from_solution, got {type(ang).__name__}")
     direction = np.where(near[:, None], ang["dir_nf"], ang["dir_ff"])
     kappa = np.where(near, ang["kappa_nf"], np.nan)
     phi = np.where(near, ang["phi_nf"], ang["phi_ff"])

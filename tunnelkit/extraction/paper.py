@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array
+from .._validate import finite_array, integer
 from ..constants import C
 from .decomposition import check_rank, check_tensor, cpd, normalize_factors
 from .estimates import PathEstimates, path_estimates
@@ -56,15 +56,36 @@ def vandermonde_roots(B) -> np.ndarray:
     return np.angle(np.sum(B[:-1].conj() * B[1:], axis=0))
 
 
+def _numeric(name: str, value, ndim: tuple[int, ...], last: int | None = None) -> np.ndarray:
+    """``value`` as a numeric (real or complex) array with ``ndim`` in ``ndim`` and, when given,
+    ``last`` entries in the last axis; NaN allowed (the inner stages pass noise-driven values
+    through). Errors name ``name``."""
+    if value is None or isinstance(value, str | bytes):
+        raise TypeError(f"{name}: expected a numeric array, got {type(value).__name__}")
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "iufc":
+        raise TypeError(f"{name}: expected numbers, got dtype {arr.dtype}")
+    if arr.ndim not in ndim or (last is not None and arr.shape[-1] != last):
+        want = " or ".join(f"{d}-D" for d in ndim) + (f" with {last} columns" if last else "")
+        raise ValueError(f"{name}: expected {want}, got shape {arr.shape}")
+    return arr
+
+
 def refine_roots(B, mu, n_steps: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """Newton steps to the peak of ``|sum_n B[n] exp(-j mu n)|^2`` per column (single-tone ML).
 
     Returns the refined roots and the fitted amplitude ``beta = mean_n B[n] exp(-j mu n)`` (1 for
     a perfect normalised Vandermonde column). Steps are limited to a quarter of a bin.
     """
-    B = np.asarray(B)
+    B = _numeric("B", B, (2,))
     N = B.shape[0]
     n = np.arange(N)[:, None]
+    mu = _numeric("mu", mu, (1,))
+    if mu.shape[0] != B.shape[1] or mu.dtype.kind == "c":
+        raise ValueError(
+            f"mu: expected {B.shape[1]} real roots (one per column of B), got {mu.shape}"
+        )
+    n_steps = integer("n_steps", n_steps, minimum=0, maximum=1000)
     mu = np.array(mu, dtype=float)
     for _ in range(n_steps):
         e = np.exp(-1j * n * mu[None, :])
@@ -90,6 +111,11 @@ def refine_joint(H, mu_f, mu_t, n_steps: int = 6):
     approaches ``crlb_paths(spatial="free")`` where per-column estimates (eq. 13) do not.
     Returns ``(mu_f, mu_t, A)``.
     """
+    H = _numeric("H", H, (3,))
+    for name, m in (("mu_f", mu_f), ("mu_t", mu_t)):
+        if _numeric(name, m, (1,)).shape != np.shape(mu_f):
+            raise ValueError(f"{name}: mu_f and mu_t need one root per path each")
+    n_steps = integer("n_steps", n_steps, minimum=0, maximum=1000)
     M, nf, nt = H.shape
     s = np.arange(nf)[:, None]
     k = np.arange(nt)[:, None]
@@ -151,8 +177,10 @@ def unwrap_spatial(b, element_positions) -> np.ndarray:
     planar layouts it is unwrapped along a minimum spanning tree of the elements. The result is
     shifted so that the reference element has phase 0 (eq. 2: ``delta_0 = 0``).
     """
-    b = np.asarray(b)
-    p = np.asarray(element_positions, float)
+    b = finite_array("b", b, dtype=complex)
+    p = finite_array("element_positions", element_positions, ndim=2)
+    if b.ndim not in (1, 2) or b.shape[0] != p.shape[0]:
+        raise ValueError(f"b: expected (M, L) with M = {p.shape[0]} elements, got shape {b.shape}")
     ph = np.angle(b)
     grid = grid_index(p)
     out = np.empty_like(ph)
@@ -198,6 +226,21 @@ def _line_direction(p: np.ndarray, rtol: float = 1e-12):
     return e if np.max(off) <= rtol * size else None
 
 
+def _delta_positions(delta, element_positions) -> tuple[np.ndarray, np.ndarray]:
+    """``delta`` as (M, L) real (NaN allowed) and the (M, 3) element positions, M matching."""
+    delta = _numeric("delta", delta, (1, 2))
+    if delta.dtype.kind == "c":
+        raise TypeError("delta: expected real phase distances, got complex numbers")
+    delta = np.atleast_2d(np.asarray(delta, float).T).T
+    p = finite_array("element_positions", element_positions, ndim=2)
+    if p.shape[1] != 3 or p.shape[0] != delta.shape[0] or p.shape[0] < 2:
+        raise ValueError(
+            f"element_positions: expected ({delta.shape[0]}, 3) (one row per row of delta), "
+            f"got {p.shape}"
+        )
+    return delta, p
+
+
 def solve_near_field(delta, element_positions) -> np.ndarray:
     """TLS solution ``x = (x_l, y_l, kappa_l)`` of eq. 18 for each column of ``delta`` (M, L).
 
@@ -207,8 +250,7 @@ def solve_near_field(delta, element_positions) -> np.ndarray:
     coordinate ``t_m = e . p_m`` along the line and the returned ``(x, y)`` is ``t e`` (the
     component across the line is unobservable and returned as 0). Returns (L, 3).
     """
-    delta = np.atleast_2d(np.asarray(delta, float).T).T
-    p = np.asarray(element_positions, float)
+    delta, p = _delta_positions(delta, element_positions)
     xm, ym = p[1:, 0], p[1:, 1]
     r2 = np.sum(p[1:] ** 2, axis=1)
     line = _line_direction(p)
@@ -235,8 +277,7 @@ def solve_far_field(delta, element_positions) -> np.ndarray:
     In the far field ``delta_m = -u . p_m`` (eq. 17 with ``kappa -> inf``). Returns (L, 2); for a
     linear array along ``e`` only ``u . e`` is observable and ``(u . e) e`` is returned.
     """
-    delta = np.atleast_2d(np.asarray(delta, float).T).T
-    p = np.asarray(element_positions, float)
+    delta, p = _delta_positions(delta, element_positions)
     line = _line_direction(p)
     A = (p[1:, :2] @ line)[:, None] if line is not None else p[1:, :2]
     sol = np.linalg.lstsq(A, -delta[1:], rcond=None)[0].T
@@ -250,8 +291,12 @@ def angles_from_solution(x_nf, u_ff):
     ``direction = (x, y, sqrt(kappa^2 - rho^2)) / kappa``. FF: ``direction = (u_x, u_y,
     sqrt(1 - |u|^2))``. Ratios above 1 (noise) are clipped to 1.
     """
-    x_nf = np.atleast_2d(x_nf)
-    u_ff = np.atleast_2d(u_ff)
+    x_nf = np.atleast_2d(_numeric("x_nf", x_nf, (1, 2), last=3))
+    u_ff = np.atleast_2d(_numeric("u_ff", u_ff, (1, 2), last=2))
+    if x_nf.shape[0] != u_ff.shape[0]:
+        raise ValueError(
+            f"u_ff: expected {x_nf.shape[0]} rows (one per row of x_nf), got {u_ff.shape[0]}"
+        )
     kap = x_nf[:, 2]
     with np.errstate(invalid="ignore", divide="ignore"):
         s_nf = np.clip(np.hypot(x_nf[:, 0], x_nf[:, 1]) / np.abs(kap), 0.0, 1.0)

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from .._validate import boolean, positive
+from .._validate import boolean, choice, integer, positive
 from .coherent import resolve_coherent
-from .decomposition import check_rank, check_tensor
+from .decomposition import MAX_SWEEPS, check_rank, check_tensor
 from .estimates import PathEstimates
 from .ml import ml_paths
 from .paper import paper_route
@@ -75,6 +75,12 @@ def extract_paths(
     if refine not in ROUTES:
         raise ValueError(f"refine: expected one of {ROUTES}, got {refine!r}")
     wideband = boolean("wideband", wideband)
+    # the CPD's knobs are checked on every route (the "ml" route starts from its own CPD)
+    choice("method", method, ("fast", "plain"))
+    integer("n_iter_max", n_iter_max, minimum=1, maximum=MAX_SWEEPS)
+    positive("tol", tol)
+    if polish is not None:
+        integer("polish", polish, minimum=0, maximum=MAX_SWEEPS)
     if refine == "ml":
         if noise_power is not None:
             noise_power = positive("noise_power", noise_power)

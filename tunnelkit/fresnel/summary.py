@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from .._validate import boolean, positive
 from ..report import Report
 from .bounds import (
     mmax_2d,
@@ -60,6 +61,8 @@ def mmax_summary(
     R: float, W: float, y_u: float, fc: float, eps_phi: float, *, z_u: float = 0.0, ura: bool = True
 ) -> MmaxSummary:
     """All bounds and exact values for one design point (``ura=False`` skips the URA search)."""
+    fc, eps_phi = positive("fc", fc), positive("eps_phi", eps_phi)
+    ura = boolean("ura", ura)
     s = dict(R=R, W=W, y_u=y_u, fc=fc, eps_phi=eps_phi)
     R_, W_, y_, z_ = (float(v) for v in wall_geometry(R, W, y_u, z_u))
     exact = mmax_exact(R_, W_, y_, float(fc), float(eps_phi), z_u=z_)

@@ -79,6 +79,10 @@ def line_figure(
     log_y: bool = False,
 ) -> go.Figure:
     """One line per entry of ``series`` against ``x``."""
+    if not isinstance(series, Mapping):
+        raise TypeError(f"series: expected a mapping name -> values, got {type(series).__name__}")
+    if dash is not None and not isinstance(dash, Mapping):
+        raise TypeError(f"dash: expected a mapping name -> dash style, got {type(dash).__name__}")
     n = len(np.atleast_1d(np.asarray(x)))
     for name, y in series.items():
         if len(np.atleast_1d(np.asarray(y))) != n:
@@ -108,6 +112,8 @@ def cdf_figure(
     errors: Mapping[str, np.ndarray], *, title: str = "", xaxis: str = "error [m]"
 ) -> go.Figure:
     """Empirical CDFs of error samples, one line each."""
+    if not isinstance(errors, Mapping):
+        raise TypeError(f"errors: expected a mapping name -> samples, got {type(errors).__name__}")
     fig = go.Figure()
     for name, e in errors.items():
         x, p = ecdf(e)

@@ -11,6 +11,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import fresnel
+from .._validate import integer
 from ..constants import wavelength
 from .common import COLORS
 
@@ -68,6 +69,7 @@ def geometry_traces(
     """Top view of Fig. 2: wall, ULA, UE, VUE, true paths (solid), VUE paths (dashed) and the
     SR-NF paths (dotted red) for the first and the last antenna. Eight traces, fixed order:
     wall, BS array, UE, VUE, true paths, VUE paths, SR-NF paths, reflector p0."""
+    M = integer("M", M, minimum=2, maximum=100_000)
     y = np.arange(M) * wavelength(fc) / 2.0
     a = 2.0 * W - y_u
     ue, pv = np.array([R, y_u]), np.array([R, a])

@@ -27,6 +27,8 @@ def tunnel_topview(
 ) -> go.Figure:
     """Walls over an ``along`` range, the base station, both virtual stations and, for a vehicle,
     the two wall-reflected paths (solid) with their virtual-station equivalents (dotted)."""
+    if not isinstance(tunnel, Tunnel2D):
+        raise TypeError(f"tunnel: expected a geometry.Tunnel2D, got {type(tunnel).__name__}")
     bs = np.asarray(base_station, dtype=float)
     vs = tunnel.virtual_stations(bs)
     fig = go.Figure()

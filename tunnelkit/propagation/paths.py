@@ -164,6 +164,7 @@ def trace_paths(
     ue = tunnel.require_inside("ue", vector("ue", ue, 3))
     vel = vector("ue_velocity", ue_velocity, 3)
     a0 = array.origin
+    _check_array_placement(tunnel, array, ue, fc)
     out: list[Path] = []
     if "los" in kinds and not tunnel.blocked(ue, a0) and (not front_only or array.in_front(ue)):
         out.append(_make_path("los", "", "los", ue, ue, ue, vel, array, fc, 1.0))
@@ -191,6 +192,29 @@ def trace_paths(
         )
     refl.sort(key=lambda p: p.length)
     return out + refl
+
+
+def _check_array_placement(tunnel: Tunnel3D, array: ArrayGeometry, ue: np.ndarray, fc: float):
+    """The array's reference antenna inside the tunnel (not in a wall, under the road or inside
+    a blocker) and the UE in the radiating field of every element (farther than a wavelength)."""
+    a0 = array.origin
+    if not bool(tunnel.contains(a0, margin=1e-6)):
+        raise ValueError(
+            f"array: the reference antenna at {a0.tolist()} lies outside the tunnel (in a wall, "
+            "under the road, above the roof or beyond its ends)"
+        )
+    for box in tunnel.blockers:
+        if np.all(a0 >= box.lo) and np.all(a0 <= box.hi):
+            raise ValueError(
+                f"array: the reference antenna at {a0.tolist()} lies inside {box.name!r}"
+            )
+    lam = float(wavelength(fc))
+    gap = float(np.min(np.linalg.norm(array.world - ue, axis=-1)))
+    if gap < lam:
+        raise ValueError(
+            f"ue: {gap:.3g} m from an element of the array, closer than one wavelength "
+            f"({lam:.3g} m): the UE must be in the array's radiating field"
+        )
 
 
 def select_array(arrays, ue) -> ArrayGeometry:

@@ -170,4 +170,11 @@ def scenario_arrays(scenario) -> list[ArrayGeometry]:
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise ScenarioError(f"base_station.arrays[{i}]: {exc}") from None
+        first = next((j for j, a in enumerate(out[:-1]) if a.name == out[-1].name), None)
+        if first is not None:
+            raise ScenarioError(
+                f"{scenario.path.name}: 'base_station.arrays[{i}].name' {out[-1].name!r} is also "
+                f"the name of base_station.arrays[{first}]; array names must be distinct (the "
+                "calibration and the ray-traced channel are keyed by name)"
+            )
     return out

@@ -55,6 +55,12 @@ def _check_sizes(sc: Scenario) -> None:
             raise ScenarioError(f"{where}: 'noise.levels' angle sigmas must be <= 180 deg")
         return
     radio = sec["radio"]
+    if radio["bandwidth"] >= 2 * radio["fc"]:
+        raise ScenarioError(
+            f"{where}: 'radio.bandwidth' {radio['bandwidth']:g} Hz around radio.fc = "
+            f"{radio['fc']:g} Hz reaches 0 Hz (the band must lie inside (0, inf): bandwidth < 2 fc; "
+            "both are in Hz)"
+        )
     n_rb = radio.get("n_rb", 273)
     if 12 * n_rb * radio["scs"] > radio["bandwidth"] * 1.0001:
         raise ScenarioError(
@@ -99,6 +105,12 @@ def _check_arrays_inside(sc: Scenario, tun, bs: np.ndarray) -> None:
         if isinstance(exc, ScenarioError):
             raise
         raise ScenarioError(f"{where}: base_station.arrays: {exc}") from None
+    for i, box in enumerate(getattr(tun, "blockers", ())):
+        if np.all(bs >= box.lo) and np.all(bs <= box.hi):
+            raise ScenarioError(
+                f"{where}: 'tunnel.blockers[{i}]' ({box.name}) encloses 'base_station.position' "
+                f"{bs.tolist()}: every path would be blocked"
+            )
     lo = np.array([tun.x_range[0], -tun.width / 2, 0.0])
     hi = np.array([tun.x_range[1], tun.width / 2, tun.height])
     for i, arr in enumerate(arrays):

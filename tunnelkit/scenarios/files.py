@@ -21,6 +21,9 @@ from .registry import require
 
 __all__ = [
     "ALLOWED_REQUIRES",
+    "MAX_DEPTH",
+    "MAX_FILE_BYTES",
+    "MAX_NAME_LENGTH",
     "NAME_RE",
     "check_all",
     "data_dir",
@@ -48,6 +51,12 @@ def list_scenarios() -> list[str]:
 ALLOWED_REQUIRES = ("tunnelkit.propagation", "tunnelkit.tunnels")
 #: a preset name: letters, digits, ".", "_" and "-", no directory part
 NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
+#: longest preset or template name (a file name, ``NAME.toml``, must fit the file system's 255)
+MAX_NAME_LENGTH = 100
+#: largest scenario file read (the presets are a few KiB; a bigger file is refused before parsing)
+MAX_FILE_BYTES = 1024 * 1024
+#: deepest nesting of tables and arrays a scenario may have (the schema needs 4)
+MAX_DEPTH = 32
 
 
 def scenario_path(name: str | os.PathLike) -> Path:
@@ -70,6 +79,10 @@ def scenario_path(name: str | os.PathLike) -> Path:
         return path
     if not isinstance(name, str) or not name:
         raise TypeError(f"name: expected a scenario name string or a path, got {name!r}")
+    if len(name) > MAX_NAME_LENGTH:
+        raise ScenarioError(
+            f"name: {len(name)} characters, longer than the {MAX_NAME_LENGTH} a scenario name may have"
+        )
     root = (data_dir() / "scenarios").resolve()
     path = (root / f"{name}.toml").resolve()
     if not NAME_RE.fullmatch(name) or not path.is_relative_to(root) or not path.is_file():
@@ -90,9 +103,19 @@ def load_scenario(name: str | os.PathLike) -> Scenario:
     """
     path = scenario_path(name)
     try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError(
+                f"{path.name}: the file is {size / 2**20:.1f} MiB, larger than the "
+                f"{MAX_FILE_BYTES / 2**20:g} MiB a scenario file may have"
+            )
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path.name}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise ScenarioError(
+            f"{path.name}: tables or arrays nested too deep to parse (at most {MAX_DEPTH} levels)"
+        ) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"{path.name}: cannot read ({exc})") from None
     return scenario_from_dict(raw, path)
@@ -104,9 +127,10 @@ def scenario_from_dict(raw: dict, path: str | os.PathLike = "<dict>") -> Scenari
     """
     if not isinstance(raw, dict):
         raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
-    raw = copy.deepcopy(raw)
     path = Path(path)
     where = path.name
+    _check_depth(raw, where)
+    raw = copy.deepcopy(raw)
     family, sections = validate(raw, where)
     for mod in sections.get("requires", []):
         if mod not in ALLOWED_REQUIRES:
@@ -128,6 +152,20 @@ def scenario_from_dict(raw: dict, path: str | os.PathLike = "<dict>") -> Scenari
     )
     check_placement(sc)
     return sc
+
+
+def _check_depth(raw: dict, where: str) -> None:
+    """Refuse tables/arrays nested deeper than :data:`MAX_DEPTH` (walked without recursion, so a
+    5,000-deep dict is an error naming the depth, not a ``RecursionError``)."""
+    stack = [(raw, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ScenarioError(
+                f"{where}: raw: tables or arrays nested deeper than {MAX_DEPTH} levels"
+            )
+        items = node.values() if isinstance(node, dict) else node
+        stack.extend((v, depth + 1) for v in items if isinstance(v, dict | list | tuple))
 
 
 _INDEX_RE = re.compile(r"(\w+)\[(\d+|\*)\]")

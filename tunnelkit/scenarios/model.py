@@ -42,6 +42,8 @@ class Scenario:
 
     def get(self, key: str, kind: type = float, **kw):
         """Read ``"section.key"`` with type/shape checks, e.g. ``sc.get("radio.fc")``."""
+        if not isinstance(key, str) or not key:
+            raise TypeError(f"key: expected a dotted key such as 'radio.fc', got {key!r}")
         sec_name, _, k = key.rpartition(".")
         sec = self.section(sec_name) if sec_name else self.sections
         return getter(self.path.name, sec, sec_name)(k, kind, **kw)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from ..schema import render_template
-from .files import NAME_RE, load_scenario
+from .files import MAX_NAME_LENGTH, NAME_RE, load_scenario
 
 __all__ = ["template"]
 
@@ -22,6 +22,11 @@ def template(name: str, preset: str | os.PathLike) -> str:
     if not isinstance(name, str) or not NAME_RE.fullmatch(name):
         raise ValueError(
             f"name: expected a scenario name of letters, digits, '.', '_' or '-', got {name!r}"
+        )
+    if len(name) > MAX_NAME_LENGTH:
+        raise ValueError(
+            f"name: {len(name)} characters, longer than the {MAX_NAME_LENGTH} a scenario name may "
+            "have (it becomes the file name NAME.toml)"
         )
     sc = load_scenario(preset)
     vals = {k: v for k, v in sc.raw.items()}

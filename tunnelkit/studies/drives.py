@@ -24,10 +24,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import integer, rng_or_error
+from .._validate import choice, instance, integer, nonnegative, rng_or_error
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
-from ..signal_route import SignalRoute
+from ..signal_route import CHANNELS, Epoch, SignalRoute
 from ..tracking.javelin.measurement import PathMeasurements
 
 __all__ = [
@@ -185,6 +185,8 @@ def path_measurements(ep, route: SignalRoute) -> tuple[PathMeasurements | None, 
     fit (the ML route: ``PathEstimates.fit_ok``) and flags it — a path missed, merged or in a wrong
     basin of the likelihood, or the snapshot in the threshold region — gives none either, with
     the reason :data:`FLAGGED`."""
+    instance("ep", ep, Epoch)
+    instance("route", route, SignalRoute)
     m = ep.measurements
     if getattr(ep.estimates, "fit_ok", None) is False:
         return None, FLAGGED
@@ -274,6 +276,12 @@ def simulate_routes(
     """
     rng = rng_or_error("rng", rng)
     cond = _condition(condition)
+    sigma_speed = nonnegative("sigma_speed", sigma_speed)
+    sigma_heading = nonnegative("sigma_heading", sigma_heading)
+    if channel is not None:
+        choice("channel", channel, CHANNELS)
+    if n_epochs is not None:
+        integer("n_epochs", n_epochs, minimum=1)
     if not tuple(extractions):
         raise ValueError(f"extraction: expected one of {EXTRACTIONS}, got {extractions!r}")
     extractions = tuple(dict.fromkeys(route_name(e) for e in extractions))

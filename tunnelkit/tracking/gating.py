@@ -28,7 +28,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.stats import chi2
 
-from .._validate import finite_array, integer
+from .._validate import finite_array, instance, integer
 from .._validate import probability as check_probability
 
 __all__ = [
@@ -152,6 +152,12 @@ class InnovationGate:
         when None). A non-finite ``d2`` is rejected.
         """
         d2 = np.asarray(d2, dtype=float)
+        if rows is not None and (
+            isinstance(rows, str | bytes) or np.asarray(rows).dtype.kind not in "iub"
+        ):
+            raise TypeError(
+                f"rows: expected batch row indices (integers or a mask), got {rows!r:.40}"
+            )
         idx = ... if rows is None else rows
         if self.probability is None:
             return np.zeros(d2.shape, dtype=int)
@@ -185,6 +191,11 @@ def gated_filterpy_update(f, update, gate: InnovationGate, *, redraw=None) -> in
     scaled by :meth:`InnovationGate.inflation` (``redraw()`` then rebuilds whatever depends on it,
     e.g. a UKF's sigma points) and the update is made again.
     """
+    instance("gate", gate, InnovationGate)
+    if not (hasattr(f, "x") and hasattr(f, "P")):
+        raise TypeError(f"f: expected a filterpy filter (with x and P), got {type(f).__name__}")
+    if not callable(update):
+        raise TypeError(f"update: expected a callable, got {type(update).__name__}")
     if not gate.enabled:
         update()
         return ACCEPT

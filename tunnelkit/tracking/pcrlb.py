@@ -97,6 +97,10 @@ def vs_pcrlb(model, states, P0) -> np.ndarray:
     ``states`` is one true trajectory (T, 4) or a sample of them (S, T, 4) (the expectation of
     the measurement information is the average over the sample).
     """
+    if not all(hasattr(model, a) for a in ("jacobian", "R", "F", "Q")):
+        raise TypeError(
+            f"model: expected a virtual-station model (jacobian, R, F, Q), got {type(model).__name__}"
+        )
     X = finite_array("states", states)
     if X.ndim not in (2, 3) or X.shape[-1] != 4:
         raise ValueError(f"states: expected shape (T, 4) or (S, T, 4), got {X.shape}")

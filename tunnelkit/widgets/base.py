@@ -8,7 +8,24 @@ from typing import Any
 import ipywidgets as widgets
 import plotly.graph_objects as go
 
-__all__ = ["Explorer", "float_slider", "int_slider"]
+from .._validate import boolean, integer, real
+
+__all__ = ["Explorer", "checkbox", "float_slider", "int_slider", "slider_value"]
+
+
+def slider_value(name: str | None, value, lo: float, hi: float, *, whole: bool = False):
+    """``value`` checked against a slider's range before the slider exists (ipywidgets would
+    clamp it silently, or fail with a ``TraitError`` naming no parameter): a real number (an
+    integer when ``whole``) in ``[lo, hi]``, errors naming ``name``. ``name=None``: unchecked (the
+    explorer's own constant)."""
+    if name is None:
+        return value
+    if whole:
+        return integer(name, value, minimum=int(lo), maximum=int(hi))
+    x = real(name, value)
+    if not lo <= x <= hi:
+        raise ValueError(f"{name}: must lie in [{lo:g}, {hi:g}] (the slider's range), got {x:g}")
+    return x
 
 
 def float_slider(
@@ -19,8 +36,12 @@ def float_slider(
     step: float,
     *,
     readout_format: str = ".3g",
+    name: str | None = None,
 ) -> widgets.FloatSlider:
-    """A FloatSlider that only reports on release (``continuous_update=False``)."""
+    """A FloatSlider that only reports on release (``continuous_update=False``); with ``name``
+    (the explorer's parameter) ``value`` is checked against ``[lo, hi]`` first
+    (:func:`slider_value`)."""
+    value = slider_value(name, value, lo, hi)
     return widgets.FloatSlider(
         value=value,
         min=lo,
@@ -34,8 +55,12 @@ def float_slider(
     )
 
 
-def int_slider(description: str, value: int, lo: int, hi: int, step: int = 1) -> widgets.IntSlider:
-    """An IntSlider that only reports on release (``continuous_update=False``)."""
+def int_slider(
+    description: str, value: int, lo: int, hi: int, step: int = 1, *, name: str | None = None
+) -> widgets.IntSlider:
+    """An IntSlider that only reports on release (``continuous_update=False``); ``name`` as in
+    :func:`float_slider`."""
+    value = slider_value(name, value, lo, hi, whole=True)
     return widgets.IntSlider(
         value=value,
         min=lo,
@@ -45,6 +70,13 @@ def int_slider(description: str, value: int, lo: int, hi: int, step: int = 1) ->
         continuous_update=False,
         style={"description_width": "initial"},
         layout={"width": "340px"},
+    )
+
+
+def checkbox(description: str, value: bool, *, name: str | None = None) -> widgets.Checkbox:
+    """A Checkbox; with ``name`` the value must be a real ``True``/``False``."""
+    return widgets.Checkbox(
+        value=boolean(name, value) if name else bool(value), description=description
     )
 
 

@@ -19,6 +19,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .._validate import integer, positive, real
 from ..constants import C
 from .base import Explorer, float_slider, int_slider
 
@@ -95,6 +96,18 @@ def curvature_study(
     shows; ``"ml"`` the joint maximum-likelihood fit, which needs more antennas than paths)."""
     from ..channel import synthesize
 
+    side = integer("side", side, minimum=2, maximum=64)
+    real("snr_offset_db", snr_offset_db)
+    k = integer("k", k, minimum=0)
+    n_snapshots = integer("n_snapshots", n_snapshots, minimum=1, maximum=1000)
+    if n_tones is not None:
+        n_tones = integer("n_tones", n_tones, minimum=2)
+    seed = integer("seed", seed, minimum=0)
+    if not isinstance(scenario, str) or not scenario:
+        raise TypeError(f"scenario: expected a scenario name, got {scenario!r}")
+    n_epochs = len(_route(scenario).trajectory)
+    if k >= n_epochs:
+        raise ValueError(f"k: the route has {n_epochs} epochs (0 .. {n_epochs - 1}), got {k}")
     route, arr, paths = _paths_for(side, k, scenario)
     tgt = _target(paths)
     cfg = route.config
@@ -154,6 +167,7 @@ def curvature_figure(
     scenario: str = "italiano2026-straight",
 ) -> go.Figure:
     """The explorer's pure callback (see the module docstring)."""
+    eps_phi = positive("eps_phi", eps_phi)
     st = curvature_study(
         side, snr_offset_db, k, n_snapshots=n_snapshots, n_tones=n_tones, scenario=scenario
     )

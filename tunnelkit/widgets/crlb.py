@@ -7,8 +7,9 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import crlb
-from .._validate import integer
+from .._validate import finite_array, integer
 from ..budget import check_elements
+from ..geometry import Tunnel2D
 from ..scenarios import load_scenario
 from .base import Explorer, float_slider
 
@@ -29,6 +30,9 @@ def crlb_map(
 
     Returns ``(along, across, rmse)`` with ``rmse`` of shape (n_across, n_along).
     """
+    if not isinstance(tunnel, Tunnel2D):
+        raise TypeError(f"tunnel: expected a geometry.Tunnel2D, got {type(tunnel).__name__}")
+    along = finite_array("along", along, shape=(2,))
     n_along = integer("n_along", n_along, minimum=2)
     n_across = integer("n_across", n_across, minimum=2)
     check_elements("n_along, n_across", 64 * n_along * n_across, what="the CRLB map")
@@ -96,6 +100,9 @@ def crlb_figure(
 
 def crlb_explorer(scenario: str = "jiang2023-straight") -> Explorer:
     """Sliders for sigma_theta [deg] and sigma_d [m] and a LOS switch, redrawing the heat map."""
+    if not isinstance(scenario, str) or not scenario:
+        raise TypeError(f"scenario: expected a scenario name or a .toml path, got {scenario!r}")
+    load_scenario(scenario)  # a wrong name is refused before the first map is computed
     controls = {
         "sigma_theta_deg": float_slider("σθ [deg]", 0.5, 0.1, 5.0, 0.1),
         "sigma_d": float_slider("σd [m]", 0.1, 0.05, 5.0, 0.05),

@@ -25,8 +25,9 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import design
+from .._validate import integer, positive, probability, real
 from ..plots.design import route_figure
-from .base import Explorer, float_slider, int_slider
+from .base import Explorer, checkbox, float_slider, int_slider
 
 __all__ = ["MAX_POINTS", "SIZES", "DesignExplorer", "design_explorer", "design_figure"]
 
@@ -35,6 +36,10 @@ SIZES = (2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32)
 
 #: the explorer evaluates at most this many epochs, evenly spread along the route
 MAX_POINTS = 24
+
+
+#: the bandwidths the explorer's dropdown offers [MHz]
+BANDWIDTHS_MHZ = (20.0, 50.0, 100.0, 200.0, 400.0, 800.0)
 
 
 @lru_cache(maxsize=8)
@@ -65,6 +70,7 @@ def design_figure(
     Pure: the same arguments give the same figure. A design that does not fit (array outside the
     tunnel at this mount) gives an empty figure whose title says so instead of raising.
     """
+    wideband = checkbox("", wideband, name="wideband").value
     imp = design.DesignImpairments(
         phase_error_deg=phase_error_deg,
         gain_error_db=gain_error_db,
@@ -240,27 +246,42 @@ def design_explorer(
     tracker on the current design."""
     from functools import partial
 
+    if not isinstance(scenario, str) or not scenario:
+        raise TypeError(f"scenario: expected a scenario name, got {scenario!r}")
+    target = positive("target", target)
+    share = probability("share", share, open_interval=False)
+    runs = integer("runs", runs, minimum=0)
+    seed = integer("seed", seed, minimum=0)
+    if bandwidth_mhz not in BANDWIDTHS_MHZ:
+        raise ValueError(
+            f"bandwidth_mhz: choose one of {list(BANDWIDTHS_MHZ)}, got {bandwidth_mhz!r}"
+        )
+    mount_height = real("mount_height", mount_height)
     height = float(_base(scenario).tunnel.height)
     if not 0.5 <= mount_height < height:
         raise ValueError(f"mount_height: must lie in [0.5, {height:g}) m, got {mount_height}")
     controls = {
-        "fc_ghz": float_slider("fc [GHz]", fc_ghz, 1.0, 60.0, 0.5),
+        "fc_ghz": float_slider("fc [GHz]", fc_ghz, 1.0, 60.0, 0.5, name="fc_ghz"),
         "bandwidth_mhz": widgets.Dropdown(
-            options=[20.0, 50.0, 100.0, 200.0, 400.0, 800.0],
+            options=list(BANDWIDTHS_MHZ),
             value=bandwidth_mhz,
             description="bandwidth [MHz]",
             style={"description_width": "initial"},
             layout={"width": "220px"},
         ),
-        "n": int_slider("array n × n", n, 2, 32),
-        "tilt_deg": float_slider("down-tilt [°]", tilt_deg, 0.0, 60.0, 1.0),
+        "n": int_slider("array n × n", n, 2, 32, name="n"),
+        "tilt_deg": float_slider("down-tilt [°]", tilt_deg, 0.0, 60.0, 1.0, name="tilt_deg"),
         "mount_height": float_slider(
             "mount height [m]", mount_height, 0.5, round(height - 0.05, 2), 0.05
         ),
-        "phase_error_deg": float_slider("phase error [°]", phase_error_deg, 0.0, 3.0, 0.1),
-        "gain_error_db": float_slider("gain error [dB]", gain_error_db, 0.0, 0.5, 0.05),
-        "dmc_share": float_slider("diffuse share", dmc_share, 0.0, 0.3, 0.01),
-        "wideband": widgets.Checkbox(value=bool(wideband), description="spatial wideband"),
+        "phase_error_deg": float_slider(
+            "phase error [°]", phase_error_deg, 0.0, 3.0, 0.1, name="phase_error_deg"
+        ),
+        "gain_error_db": float_slider(
+            "gain error [dB]", gain_error_db, 0.0, 0.5, 0.05, name="gain_error_db"
+        ),
+        "dmc_share": float_slider("diffuse share", dmc_share, 0.0, 0.3, 0.01, name="dmc_share"),
+        "wideband": checkbox("spatial wideband", wideband, name="wideband"),
     }
     cb = partial(design_figure, scenario=scenario, target=target, share=share)
     return DesignExplorer(

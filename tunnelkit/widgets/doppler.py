@@ -47,12 +47,14 @@ def doppler_explorer(
     return Explorer(
         doppler_figure,
         {
-            "sigma_hz": float_slider("filter sigma [Hz]", sigma_hz, 2.0, 150.0, 0.5),
-            "q": float_slider("q [m^2/s^3]", q, 0.01, 10.0, 0.01),
-            "doppler_bias_hz": float_slider(
-                "drive's Doppler bias [Hz]", doppler_bias_hz, 0.0, 30.0, 1.0
+            "sigma_hz": float_slider(
+                "filter sigma [Hz]", sigma_hz, 2.0, 150.0, 0.5, name="sigma_hz"
             ),
-            "seed": int_slider("noise seed", seed, 0, 20),
+            "q": float_slider("q [m^2/s^3]", q, 0.01, 10.0, 0.01, name="q"),
+            "doppler_bias_hz": float_slider(
+                "drive's Doppler bias [Hz]", doppler_bias_hz, 0.0, 30.0, 1.0, name="doppler_bias_hz"
+            ),
+            "seed": int_slider("noise seed", seed, 0, 20, name="seed"),
         },
         columns=2,
     )

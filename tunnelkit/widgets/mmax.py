@@ -24,8 +24,9 @@ import ipywidgets as widgets
 import plotly.graph_objects as go
 
 from .. import fresnel
+from .._validate import real
 from ..plots.fresnel import geometry_traces, mismatch_traces, mmax_range_traces
-from .base import Explorer, float_slider, int_slider
+from .base import Explorer, float_slider, int_slider, slider_value
 
 __all__ = ["TRACE_INDEX", "Y_U_MARGIN", "mmax_explorer", "mmax_figure", "verdict"]
 
@@ -198,18 +199,20 @@ def mmax_explorer(
     presets = list(fresnel.FC_PRESETS.items())
     if fc not in fresnel.FC_PRESETS.values():
         raise ValueError(f"fc: choose one of the presets {[v for _, v in presets]} Hz, got {fc}")
+    W = slider_value("W", W, 1.0, 10.0)
+    y_u = real("y_u", y_u)
     if not y_u <= W - Y_U_MARGIN:
         raise ValueError(f"y_u: must be <= W - {Y_U_MARGIN} m for the explorer, got {y_u}")
     controls = {
-        "R": float_slider("R [m]", R, 1.0, 150.0, 0.5),
-        "W": float_slider("W [m]", W, 1.0, 10.0, 0.1),
-        "y_u": float_slider("y_u [m]", y_u, -8.0, W - Y_U_MARGIN, 0.05),
-        "z_u": float_slider("z_u [m]", z_u, -5.0, 5.0, 0.1),
-        "eps_phi": float_slider("ε_Φ [rad]", eps_phi, 0.01, 1.0, 0.01),
+        "R": float_slider("R [m]", R, 1.0, 150.0, 0.5, name="R"),
+        "W": float_slider("W [m]", W, 1.0, 10.0, 0.1, name="W"),
+        "y_u": float_slider("y_u [m]", y_u, -8.0, W - Y_U_MARGIN, 0.05, name="y_u"),
+        "z_u": float_slider("z_u [m]", z_u, -5.0, 5.0, 0.1, name="z_u"),
+        "eps_phi": float_slider("ε_Φ [rad]", eps_phi, 0.01, 1.0, 0.01, name="eps_phi"),
         "fc": widgets.Dropdown(
             options=presets, value=fc, description="fc", layout={"width": "200px"}
         ),
-        "M": int_slider("M", M, 2, 256),
+        "M": int_slider("M", M, 2, 256, name="M"),
     }
 
     def clamp_y_u(change) -> None:  # registered before the Explorer's redraw hook: runs first

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import ipywidgets as widgets
 import numpy as np
 import plotly.graph_objects as go
 
-from .base import Explorer, float_slider, int_slider
+from .._validate import boolean, integer, positive
+from .base import Explorer, checkbox, float_slider, int_slider
 
 __all__ = ["upf_explorer", "upf_figure"]
 
@@ -25,6 +25,11 @@ def upf_figure(
     from ..tracking.pcrlb import vs_pcrlb
     from ..tracking.virtual_station import experiment, monte_carlo
 
+    sigma_theta_deg = positive("sigma_theta_deg", sigma_theta_deg)
+    sigma_d = positive("sigma_d", sigma_d)
+    n_particles = integer("n_particles", n_particles, minimum=1, maximum=100_000)
+    los, curved = boolean("los", los), boolean("curved", curved)
+    seed = integer("seed", seed, minimum=0)
     scenario = "jiang2023-curved" if curved else "jiang2023-straight"
     exp = experiment(scenario, level=(float(np.radians(sigma_theta_deg)), float(sigma_d)), los=los)
     res = monte_carlo(exp, 1, int(seed), options={"UPF": {"n_particles": int(n_particles)}})
@@ -50,11 +55,15 @@ def upf_explorer(**initial) -> Explorer:
         **initial,
     }
     controls = {
-        "sigma_theta_deg": float_slider("sigma_theta [deg]", v["sigma_theta_deg"], 0.1, 5.0, 0.1),
-        "sigma_d": float_slider("sigma_d [m]", v["sigma_d"], 0.05, 5.0, 0.05),
-        "n_particles": int_slider("UPF particles", v["n_particles"], 1, 1000, 1),
-        "los": widgets.Checkbox(value=v["los"], description="LOS (direct path)"),
-        "curved": widgets.Checkbox(value=v["curved"], description="curved trajectory"),
-        "seed": int_slider("seed", v["seed"], 0, 50),
+        "sigma_theta_deg": float_slider(
+            "sigma_theta [deg]", v["sigma_theta_deg"], 0.1, 5.0, 0.1, name="sigma_theta_deg"
+        ),
+        "sigma_d": float_slider("sigma_d [m]", v["sigma_d"], 0.05, 5.0, 0.05, name="sigma_d"),
+        "n_particles": int_slider(
+            "UPF particles", v["n_particles"], 1, 1000, 1, name="n_particles"
+        ),
+        "los": checkbox("LOS (direct path)", v["los"], name="los"),
+        "curved": checkbox("curved trajectory", v["curved"], name="curved"),
+        "seed": int_slider("seed", v["seed"], 0, 50, name="seed"),
     }
     return Explorer(upf_figure, controls)

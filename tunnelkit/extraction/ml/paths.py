@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._validate import boolean, integer, nonnegative
+from ..._validate import boolean, integer, nonnegative, positive
 from ...constants import C
 from ..coherent import resolve_coherent
 from ..decomposition import check_rank, check_tensor
@@ -83,6 +83,8 @@ def physical(est: PathEstimates, srs) -> np.ndarray:
     """Per path: the estimate is physically possible — finite, ``|v| < c``, ``|d|`` within the
     unambiguous range ``c / (2 Delta f)``, a unit direction in the front half-space (``u_z >=
     0``) and a curvature radius, where near-field, at least ``1 / W_MAX``."""
+    if not isinstance(est, PathEstimates):
+        raise TypeError(f"est: expected extraction.PathEstimates, got {type(est).__name__}")
     srs = check_srs(srs)
     u = np.asarray(est.direction, float)
     kap = np.asarray(est.kappa, float)
@@ -141,6 +143,11 @@ def ml_paths(
     L = check_rank(H.shape, n_paths)
     pos = check_array(array, m=M)
     srs = check_srs(srs)
+    if noise_power is not None:
+        noise_power = positive("noise_power", noise_power)
+    if search not in SEARCHES:
+        raise ValueError(f"search: expected one of {SEARCHES}, got {search!r}")
+    wideband = boolean("wideband", wideband)
     if start is not None and not isinstance(start, PathEstimates):
         start = check_start(start, L)
     if L >= M:

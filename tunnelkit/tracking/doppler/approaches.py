@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._validate import instance, positive
 from ...drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
 from ..registry import family, register
 from .filters import (
@@ -156,7 +157,8 @@ class _KfToA(_Base):
         calibration_epochs: int = 10,
         **kw,
     ) -> None:
-        self.setup = setup
+        self.setup = instance("setup", setup, DopplerSetup)
+        instance("fix", fix, GnssFix)
         self._p0 = np.array(fix.position, dtype=float)
         d0 = float(slant_range(fix.position, setup.tx, setup.dz))
         gates = {k: v for k, v in kw.items() if k in _GATE_KEYS}
@@ -274,14 +276,21 @@ def run_approaches(
 ) -> dict[str, Track]:
     """Run the registered approaches on one drive; ``sigma_hz=None`` means adaptive R from ``sigma0_hz``."""
     fam = family("halili2022")
-    setup = DopplerSetup.from_drive(drive)
-    adaptive = sigma_hz is None
-    out = {}
+    if isinstance(approaches, str) or not isinstance(approaches, list | tuple):
+        raise TypeError(f"approaches: expected a tuple of names, got {approaches!r:.60}")
     for name in approaches:
         if name not in fam:
             raise ValueError(
                 f"approaches: {name!r} is not in family 'halili2022'; members: {list(fam)}"
             )
+    instance("drive", drive, Drive)
+    instance("meas", meas, DopplerToaMeasurements)
+    instance("fix", fix, GnssFix)
+    sigma0_hz = positive("sigma0_hz", sigma0_hz)
+    setup = DopplerSetup.from_drive(drive)
+    adaptive = sigma_hz is None
+    out = {}
+    for name in approaches:
         trk = fam[name](
             setup, fix, sigma_hz=sigma0_hz if adaptive else sigma_hz, q=q, adaptive=adaptive, **kw
         )

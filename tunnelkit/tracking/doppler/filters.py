@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 
-from ..._validate import finite_array, integer, nonnegative, positive, probability, real
+from ..._validate import finite_array, instance, integer, nonnegative, positive, probability, real
 from ...constants import C
 from ...drive import Drive, GnssFix
 from ..cv import cv_process_noise, cv_transition
@@ -66,6 +66,7 @@ class DopplerSetup:
     @classmethod
     def from_drive(cls, drive: Drive) -> DopplerSetup:
         """The setup of a synthetic drive (transmitter position broadcast by the RSU)."""
+        instance("drive", drive, Drive)
         return cls(tx=np.array(drive.tx_xy), dz=drive.dz, fc=drive.config.fc, dt=drive.config.dt)
 
     @property

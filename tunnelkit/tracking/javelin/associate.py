@@ -16,9 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from ..._validate import instance
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate, mahalanobis2
-from .measurement import PathMeasurements
+from .measurement import PathMeasurements, check_track_model
 
 __all__ = [
     "AssociationCosts",
@@ -68,6 +69,13 @@ def association_costs(
     stops a wide new track (``P = sigma_P^2 I`` at birth) from taking a path that an established
     track predicts well: its large ``S`` makes ``eta^2`` small, but ``ln det S`` large.
     """
+    pred, J = check_track_model(pred, J)
+    instance("meas", meas, PathMeasurements)
+    instance("gate", gate, ChiSquareGate)
+    if isinstance(P, str) or np.ndim(P) != 2 or np.shape(P) != (J.shape[-1], J.shape[-1]):
+        raise ValueError(
+            f"P: expected the ({J.shape[-1]}, {J.shape[-1]}) state covariance, got shape {np.shape(P)}"
+        )
     L, n = pred.shape[0], len(meas)
     if n == 0 or L == 0:
         e = np.zeros((L, n))
@@ -104,6 +112,7 @@ def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
     """Algorithm 2 + the NN choice of section 3.3: repeatedly take the gated pair of smallest
     cost (``eta^2`` in the paper), then drop its track and its path. Returns
     ``[(track, path), ...]``."""
+    instance("costs", costs, AssociationCosts)
     eta = np.where(costs.gated, costs.cost, np.inf)
     pairs = []
     while eta.size and np.isfinite(eta).any():

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._validate import instance
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 from .noise import FixedNoise
@@ -126,6 +127,7 @@ class FixedBirth:
 
     def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
         """Covariance (2, 2) of the VUE born from path ``j`` and its cross-covariance (or None)."""
+        instance("config", config, JavelinConfig)
         return np.eye(2) * config.sigma_p0**2, None
 
 
@@ -178,7 +180,10 @@ def manage_tracks(
 
     Returned ``pairs`` use the track indices after removals and births.
     """
-    initiator = FixedBirth() if initiator is None else initiator
+    instance("state", state, JavelinState)
+    instance("meas", meas, PathMeasurements)
+    instance("config", config, JavelinConfig)
+    initiator = FixedBirth() if initiator is None else instance("initiator", initiator, FixedBirth)
     pairs = [(int(i), int(j)) for i, j in pairs]
     assoc_tracks = {i for i, _ in pairs}
     assoc_paths = {j for _, j in pairs}

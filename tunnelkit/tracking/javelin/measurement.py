@@ -189,6 +189,13 @@ class PathMeasurements:
 
     def subset(self, idx) -> PathMeasurements:
         """The paths at positions ``idx``."""
+        raw = np.asarray(idx) if not isinstance(idx, str | bytes) else None
+        if raw is None or raw.ndim != 1 or (raw.size and raw.dtype.kind not in "iu"):
+            raise TypeError(f"idx: expected a 1-D array of path indices, got {idx!r:.40}")
+        if raw.size and (raw.min() < -len(self) or raw.max() >= len(self)):
+            raise ValueError(
+                f"idx: path indices must lie in [0, {len(self) - 1}], got {raw.tolist()}"
+            )
         idx = np.asarray(idx, dtype=int)
         return PathMeasurements(
             self.phi[idx],
@@ -264,6 +271,26 @@ def track_model(
             J[rows, KAPPA, cols] = dk_v[:, 1]
             J[rows, KAPPA, cols + 1] = dk_v[:, 2]
     return pred, J
+
+
+def check_track_model(pred, J) -> tuple[np.ndarray, np.ndarray]:
+    """``pred`` (L, 4) and ``J`` (L, 4, D) as :func:`track_model` returns them: numeric arrays of
+    matching shapes (the boundary check of every stage that takes them; NaN allowed, a far
+    track's curvature can be undefined). Errors name ``pred`` or ``J``."""
+    out = []
+    for name, a, nd in (("pred", pred, 2), ("J", J, 3)):
+        if isinstance(a, str | bytes) or a is None:
+            raise TypeError(f"{name}: expected a numeric array from track_model, got {a!r:.40}")
+        arr = np.asarray(a)
+        if arr.dtype.kind not in "iuf":
+            raise TypeError(f"{name}: expected real numbers, got dtype {arr.dtype}")
+        if arr.ndim != nd or arr.shape[1:2] != (4,):
+            want = "(L, 4)" if nd == 2 else "(L, 4, D)"
+            raise ValueError(f"{name}: expected shape {want} (track_model), got {arr.shape}")
+        out.append(arr)
+    if out[0].shape[0] != out[1].shape[0]:
+        raise ValueError(f"J: {out[1].shape[0]} tracks, pred has {out[0].shape[0]}")
+    return out[0], out[1]
 
 
 def _reflector_kappa(qu: np.ndarray, qv: np.ndarray):

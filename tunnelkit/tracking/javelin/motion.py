@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import nonnegative
+from ..._validate import instance, nonnegative
 from .config import JavelinConfig
 from .state import JavelinState
 
@@ -34,6 +34,7 @@ def motion_increment(
     state: JavelinState, speed: float, heading: float, dt: float, vue_motion: str = "random_walk"
 ) -> tuple[np.ndarray, np.ndarray]:
     """State increment ``f(s) - s`` (D,) and its sensitivity ``G`` (D, 2) to ``(nu, theta)``."""
+    instance("state", state, JavelinState)
     D = state.dim
     du = dt * ue_velocity(speed, heading)
     Gu = dt * np.array(
@@ -77,6 +78,8 @@ def predict(
     noise (used while the V2X message is missing and the last one is reused).
     """
     dt = nonnegative("dt", dt)
+    instance("state", state, JavelinState)
+    instance("config", config, JavelinConfig)
     inc, G = motion_increment(state, speed, heading, dt, vue_motion)
     s_nu = config.sigma_speed if sigma_speed is None else sigma_speed
     Q = G @ np.diag([s_nu**2, config.sigma_heading**2]) @ G.T

@@ -14,6 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..._validate import instance
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 
@@ -38,6 +39,8 @@ class FixedNoise:
 
     def covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
         """The (n, 3, 3) covariance of each path's ``(phi, psi, kappa)``."""
+        instance("meas", meas, PathMeasurements)
+        instance("config", config, JavelinConfig)
         var = np.array([config.sigma_phi, config.sigma_psi, config.sigma_kappa]) ** 2
         return np.broadcast_to(np.diag(var), (len(meas), 3, 3))
 
@@ -45,6 +48,7 @@ class FixedNoise:
         self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
     ) -> np.ndarray:
         """Covariance of the TDoA rows ``d_j - d_ref`` for the paths ``others``."""
+        instance("config", config, JavelinConfig)
         nd = len(others)
         s2 = config.sigma_delta_d**2
         if self.correlated_delta_d:

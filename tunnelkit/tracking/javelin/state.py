@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, positive, vector
+from ..._validate import finite_array, integer, positive, vector
 
 __all__ = ["JavelinState", "track_slice"]
 
@@ -84,6 +84,7 @@ class JavelinState:
 
     def position(self, i: int) -> np.ndarray:
         """3-D position of track ``i`` (the UE for 0; ``[x_u, y_v, z_v]`` for a VUE)."""
+        i = integer("i", i, minimum=0, maximum=self.n_vue)
         if i == 0:
             return self.ue
         yz = self.x[track_slice(i)]

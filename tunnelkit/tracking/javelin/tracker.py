@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, nonnegative, vector
+from ..._validate import boolean, finite_array, nonnegative, vector
 from ..gating import ChiSquareGate
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
@@ -100,9 +100,13 @@ class Javelin:
 
     def run(self, epochs, speed, heading, dt: float, *, keep_reports: bool = False) -> JavelinRun:
         """Step through a measurement stream (:func:`run_javelin`)."""
+        if isinstance(epochs, str | bytes) or not isinstance(epochs, Sequence | np.ndarray):
+            raise TypeError(
+                f"epochs: expected a sequence of PathMeasurements or None, got {type(epochs).__name__}"
+            )
         n = len(epochs)
-        spd = np.asarray(speed, dtype=float).reshape(-1)
-        hdg = np.asarray(heading, dtype=float).reshape(-1)
+        keep_reports = boolean("keep_reports", keep_reports)
+        spd, hdg = (_v2x(k, v) for k, v in (("speed", speed), ("heading", heading)))
         if spd.size != n or hdg.size != n:
             raise ValueError(
                 f"speed, heading: expected {n} values (one per epoch), got {spd.size} and {hdg.size}"
@@ -256,6 +260,21 @@ class JavelinRun:
     n_tracks: np.ndarray
     reports: list[StepReport]
     faults: int
+
+
+def _v2x(name: str, value) -> np.ndarray:
+    """A V2X series (one value per epoch, NaN = the message is missing) as a flat float array."""
+    if isinstance(value, str | bytes):
+        raise TypeError(f"{name}: expected numbers (one per epoch), got text")
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(
+            f"{name}: expected numbers (one per epoch), got {type(value).__name__}"
+        ) from None
+    if arr.ndim > 1:
+        raise ValueError(f"{name}: expected one value per epoch (1-D), got shape {arr.shape}")
+    return arr.reshape(-1)
 
 
 def run_javelin(

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from ..._validate import probability
+from ..._validate import instance, probability
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
-from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements
+from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements, check_track_model
 from .noise import FixedNoise
 
 __all__ = ["StackedMeasurement", "exclude_inconsistent", "joseph_update", "stack_measurement"]
@@ -55,7 +55,12 @@ def stack_measurement(
     """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``;
     ``noise`` the measurement-noise role (:mod:`~tunnelkit.tracking.javelin.roles`; default the
     paper's fixed sigmas) gives the covariance of every row."""
+    pred, J = check_track_model(pred, J)
+    instance("meas", meas, PathMeasurements)
+    instance("config", config, JavelinConfig)
     noise = FixedNoise() if noise is None else noise
+    if not callable(getattr(noise, "covariances", None)):
+        raise TypeError(f"noise: expected a measurement-noise role, got {type(noise).__name__}")
     D = J.shape[-1]
     cov = noise.covariances(meas, config)
     z, h, H, blocks, ang, labels = [], [], [], [], [], []
@@ -113,6 +118,7 @@ def joseph_update(
     ``P = (I - K H) P (I - K H)^T + K R K^T`` (Joseph form, eq. 68) stays symmetric positive
     semi-definite under rounding; we symmetrise once more against round-off.
     """
+    instance("m", m, StackedMeasurement)
     if m.z.size == 0:
         return x.copy(), P.copy(), 0.0
     y = m.residual()

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import finite_array, integer, rng_or_error
+from ..._validate import finite_array, instance, integer, rng_or_error
 from ...montecarlo import spawn_rngs
-from ...scenarios import load_scenario
+from ...scenarios import Scenario, load_scenario
 from ..registry import family
 from .filters import run_estimator
 from .model import FAMILY, VsModel, initial_states, model_from_scenario
@@ -54,6 +54,10 @@ def experiment(
 ) -> VsExperiment:
     """Model, ground truth and prior of a scenario (its ``[tracking]`` section supplies ``q`` and
     ``p0_sigma`` unless given)."""
+    if not isinstance(scenario, str | Scenario):
+        raise TypeError(
+            f"scenario: expected a scenario name or a Scenario, got {type(scenario).__name__}"
+        )
     sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
     model = model_from_scenario(sc, level=level, los=los, q=q)
     traj = sc.trajectory()
@@ -87,6 +91,11 @@ def monte_carlo(
     """
     from tqdm.auto import tqdm
 
+    instance("exp", exp, VsExperiment)
+    if options is not None and not isinstance(options, dict):
+        raise TypeError(
+            f"options: expected a dict name -> keyword options, got {type(options).__name__}"
+        )
     fam = family(FAMILY)
     names = list(fam) if names is None else list(names)
     rng_data, *rng_alg = spawn_rngs(seed, 1 + len(names))

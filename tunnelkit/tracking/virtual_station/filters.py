@@ -108,6 +108,11 @@ class VsTSWLS(EstimatorBase):
         """Vectorised over runs and epochs in one :func:`tunnelkit.positioning.tswls` call."""
         model = check_model(model)
         Z = np.asarray(Z, dtype=float)
+        x0 = finite_array("x0", x0)
+        if x0.ndim != 2 or x0.shape[-1] != STATE_DIM:
+            raise ValueError(
+                f"x0: expected one prior state per run (runs, {STATE_DIM}), got {x0.shape}"
+            )
         n = model.n_stations
         ok = np.all(np.isfinite(Z), axis=-1)
         Zf = np.where(ok[..., None], Z, model.hx(np.asarray(x0)[:, None, :]))  # placeholder rows
@@ -281,6 +286,10 @@ def track(estimator, Z) -> np.ndarray:
 
     Epoch 0 updates the prior directly; every later epoch predicts, then updates.
     """
+    if not callable(getattr(estimator, "step", None)):
+        raise TypeError(
+            f"estimator: expected a filter with a step() method, got {type(estimator).__name__}"
+        )
     out = np.empty((len(Z), STATE_DIM))
     for k, z in enumerate(Z):
         z = None if z is None or not np.all(np.isfinite(np.asarray(z, dtype=float))) else z

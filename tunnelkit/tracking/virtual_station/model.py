@@ -126,7 +126,12 @@ class VsModel:
     # eq. 42-45
     def hx(self, x) -> np.ndarray:
         """``f_2(X)`` of eq. 45 for state(s) ``x`` (..., 4) -> (..., 2N)."""
-        d, th = toa_doa(np.asarray(x)[..., :2], self.stations)
+        x = np.asarray(x)
+        if x.dtype.kind not in "iuf" or x.ndim == 0 or x.shape[-1] != STATE_DIM:
+            raise ValueError(
+                f"x: expected real state(s) (..., {STATE_DIM}), got {x.dtype} of shape {x.shape}"
+            )
+        d, th = toa_doa(x[..., :2], self.stations)
         return np.concatenate([d, th], axis=-1)
 
     # the filters' own states and predictions (finite by construction, never at a station):
