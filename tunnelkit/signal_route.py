@@ -197,7 +197,8 @@ class SignalRoute:
     ``kinds`` and the epoch's ``tunnel`` (road markings removed) apply to the ray tracer too,
     the other ``kinds`` filters do not. With ``"sionna"`` the spatial-wideband term is in the
     tensor by construction and ``impairments.dmc`` is refused (the ray tracer has its own
-    diffuse power).
+    diffuse power). ``wideband_model``: the extraction models the spatial-wideband term (the ML
+    route's ``wideband=True``, :func:`tunnelkit.extraction.extract_paths`) in every epoch.
     """
 
     tunnel: object
@@ -213,9 +214,12 @@ class SignalRoute:
     bias_aware_delay_check: bool = False
     channel: str = "image"
     raytraced: object = field(default=None, repr=False)
+    wideband_model: bool = False
 
     def __post_init__(self) -> None:
         choice("channel", self.channel, CHANNELS)
+        if not isinstance(self.wideband_model, bool):
+            raise TypeError(f"wideband_model: expected True or False, got {self.wideband_model!r}")
         if self.channel == "sionna":
             from .rt.cache import RayTracedChannel
 
@@ -354,6 +358,8 @@ class SignalRoute:
         else:
             snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
+        if self.wideband_model:
+            extract_kw.setdefault("wideband", True)
         est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None
         meas, truth = _measure(est, arr, paths, snap, cfg, self.min_d)

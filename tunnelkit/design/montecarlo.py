@@ -132,6 +132,7 @@ class _SweepTrial:
     routes: tuple  # fastroute.BoundRoute per array (bound mode) or None
     mode: str
     n_epochs: int | None
+    impairments: object = None  # achievable.DesignImpairments: the channel mode's
 
     def __call__(self, a: int, rng: np.random.Generator) -> np.ndarray:
         from ..studies import evaluate, simulate_drive
@@ -143,6 +144,14 @@ class _SweepTrial:
             drive = bound_drive(self.routes[a], self.setup, spec, rng, n_epochs=self.n_epochs)
         else:
             route = self.setup.signal_route(spec)
+            imp = self.impairments
+            if imp is not None and not imp.ideal:
+                # this run's array: its calibration error drawn once, for the whole drive
+                route = route.with_impairments(imp.channel_impairments(), rng)
+            if imp is not None and imp.wideband_model:
+                from dataclasses import replace
+
+                route = replace(route, wideband_model=True)
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
             )
@@ -290,11 +299,11 @@ def drive_pcrlb(
     return pcrlb_position_rmse(B)
 
 
-def _model(setup, spec, error_models) -> PathErrorModel:
+def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
     from .achievable import path_error_model
 
     if error_models is None:
-        m = path_error_model(setup, spec)
+        m = path_error_model(setup, spec, impairments=impairments)
     elif callable(error_models):
         m = error_models(setup, spec)
     elif isinstance(error_models, dict) and spec.label in error_models:
@@ -322,13 +331,14 @@ class _ArrayJob:
     mode: str
     T: int
     with_model: bool
+    impairments: object = None
 
     def __call__(self, spec: ArraySpec):
         ep = np.arange(self.T)
         peb = route_bounds(self.setup, spec, epochs=ep).peb
         if not self.with_model:
             return None, None, peb, None, None
-        m = _model(self.setup, spec, self.error_models)
+        m = _model(self.setup, spec, self.error_models, self.impairments)
         route = None
         if self.mode == "bound":
             from .fastroute import bound_route
@@ -356,6 +366,7 @@ def sweep_montecarlo(
     progress: bool = False,
     n_epochs: int | None = None,
     crlbs: dict | None = None,
+    impairments=None,
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -371,6 +382,10 @@ def sweep_montecarlo(
     route-median per-path bounds, from the model when there is one). ``workers`` /
     ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
     sweep); ``seed`` an int or a Generator: run ``r`` of every array uses child generator ``r``.
+    ``impairments`` (a :class:`~tunnelkit.design.achievable.DesignImpairments`, default none):
+    on the channel route each run's array carries them (its calibration error drawn once per
+    run, the wideband term and diffuse power in the tensor, the extraction modelling the
+    wideband term with ``wideband_model``); the default error model carries them too.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -384,6 +399,14 @@ def sweep_montecarlo(
     if mode not in MODES:
         raise ValueError(f"mode: expected one of {MODES}, got {mode!r}")
     runs = integer("runs", runs, minimum=1)
+    if impairments is not None:
+        from .achievable import DesignImpairments
+
+        if not isinstance(impairments, DesignImpairments):
+            raise TypeError(
+                "impairments: expected a design.DesignImpairments or None, got "
+                f"{type(impairments).__name__}"
+            )
     if not isinstance(seed, np.random.Generator):
         seed = integer("seed", seed, minimum=0)
     if n_epochs is not None:
@@ -394,7 +417,7 @@ def sweep_montecarlo(
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
     A = len(specs)
     with_model = mode == "bound" or error_models is not None
-    job = _ArrayJob(setup, error_models, mode, T, with_model)
+    job = _ArrayJob(setup, error_models, mode, T, with_model, impairments)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
     with trial_pool(**{k: v for k, v in kw.items() if v is not None}) as pool:
         # the per-array work (models, bounds) runs on the cluster too, one task per array
@@ -409,7 +432,7 @@ def sweep_montecarlo(
                 crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
             designs.append(javelin_config(crlb, setup.signal_route(spec).min_d))
         trial = _SweepTrial(
-            setup, specs, tuple(designs), tuple(b[1] for b in built), mode, n_epochs
+            setup, specs, tuple(designs), tuple(b[1] for b in built), mode, n_epochs, impairments
         )
         res = run_trials(
             trial,

@@ -477,11 +477,6 @@ def design_sweep(
     workers, scheduler = parallel_options(workers, scheduler)
     imp = _design_impairments(impairments)
     fields = _impairment_fields(imp)
-    if mode == "channel" and not imp.ideal and runs:
-        raise ValueError(
-            "mode: the channel Monte-Carlo route synthesises the ideal channel; use mode='bound' "
-            "for a Monte-Carlo under impairments"
-        )
     T = len(setup.trajectory)
     epochs = None if n_epochs is None or n_epochs >= T else np.arange(n_epochs)
     rows = [_bound_row(setup, s, imp, criterion, target, share, eps_phi, epochs) for s in specs]
@@ -497,6 +492,7 @@ def design_sweep(
         kw = {
             "mode": mode,
             "error_models": _error_models(imp, mode),
+            "impairments": None if imp.ideal else imp,
             "workers": workers,
             "scheduler": scheduler,
             "timeout": timeout,
