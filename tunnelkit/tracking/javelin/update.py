@@ -305,9 +305,10 @@ class JosephUpdater:
         cross-covariance ``C`` and ``m.B``, ``(x, P, nis, C)`` (:func:`consider_update`)."""
         if C is not None:
             C = finite_array("C", C, ndim=2)
-        if C is not None and m.B is not None:
+        if C is not None and m.B is not None and (np.any(m.B) or np.any(C)):
             x, P, C, nis = consider_update(x, P, C, m)
             return x, P, nis, C
+        # no bias anywhere (C = 0, B = 0): the consider update is the Joseph update exactly
         return joseph_update(x, P, m)
 
 
