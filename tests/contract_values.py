@@ -204,6 +204,29 @@ def _javelin():
         JavelinDesign(JavelinConfig(base_station=bs, sigma_p0_ue=1.0)),
         keep_reports=True,
     )
+    # the bias-aware design: reported covariances with a repeating share (consider parameters)
+    from tunnelkit.tracking.javelin import ConsiderNoise, PathMeasurements
+
+    def reported(pm):
+        if pm is None:
+            return None
+        n = len(pm)
+        cov = np.broadcast_to(np.diag([0.02**2, 0.02**2, 1.0]), (n, 3, 3)).copy()
+        rep = np.zeros((n, 4, 4))
+        rep[:, :3, :3] = 0.5 * cov
+        rep[:, 3, 3] = 0.5 * 0.3**2
+        return PathMeasurements.from_arrays(
+            pm.phi, pm.psi, pm.kappa, pm.d, pm.v, cov=cov, sigma_d=np.full(n, 0.3), bias_cov=rep
+        )
+
+    run_javelin(
+        [reported(pm) for pm in eps],
+        spd,
+        hdg,
+        0.1,
+        P[0],
+        JavelinDesign(JavelinConfig(base_station=bs, sigma_p0_ue=1.0), noise=ConsiderNoise()),
+    )
 
 
 def _widgets():

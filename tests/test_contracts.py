@@ -74,6 +74,14 @@ DOCUMENTED: tuple[Documented, ...] = (
         "zero",
         "zero switches the effect off (no error, no motion, no margin, never)",
     ),
+    _doc(
+        r".*\.ConsiderNoise",
+        r"tau_s",
+        "inf huge",
+        "inf: the repeating error is one draw for the whole drive; any long time constant",
+    ),
+    _doc(r".*\.ConsiderNoise\.decay", r"dt", "zero huge", "no time passed, or a long gap"),
+    _doc(r".*\.bias_slice", r"i", "zero huge", "track 0 is the UE; any track index"),
 )
 
 

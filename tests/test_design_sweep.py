@@ -206,8 +206,20 @@ def test_a_prepared_route_gives_the_same_drive_and_is_checked(setup):
     assert np.array_equal(a.base_station, b.base_station)
     with pytest.raises(ValueError, match="spec"):
         bound_drive(route, setup, "8x8", np.random.default_rng(4))
-    with pytest.raises(ValueError, match="correlated_scale"):
-        bound_route(m, setup, "4x4", report="budget", correlated_scale=0.5)
+    # the budget report hands the tracker its repeating share beside it
+    from dataclasses import replace
+
+    mb = replace(m, bias=np.where(m.exists[..., None], np.full(m.truth.shape, 0.01), 0.0))
+    rb = bound_route(mb, setup, "4x4", report="budget")
+    white, rep = mb.split()
+    assert np.allclose(rb.blocks, white + rep) and np.allclose(rb.repeating, rep)
+    drive = bound_drive(rb, setup, "4x4", np.random.default_rng(4), n_epochs=3)
+    for pm in drive.epochs:
+        assert pm.bias_cov is not None and pm.bias_cov.shape == (len(pm), 4, 4)
+        assert np.all(
+            pm.bias_cov[:, :3, :3].diagonal(axis1=1, axis2=2)
+            <= pm.cov.diagonal(axis1=1, axis2=2) + 1e-15
+        )
 
 
 def test_position_bias_rms_is_the_rms_of_the_least_squares_fix_over_calibration_draws(setup):

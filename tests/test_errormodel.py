@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tunnelkit.design.errormodel import PathErrorModel, psd_sqrt
+from tunnelkit.design.errormodel import PathErrorModel, _repetition, psd_sqrt
 
 
 def _model(T=2, P=2, M=3, **kw):
@@ -102,13 +102,50 @@ def test_draw_with_the_noise_root_computed_once_is_the_same_draw():
         m.draw(np.random.default_rng(5), noise_sqrt=root[:, :4, :4])
 
 
-def test_budget_scales_only_its_correlated_share():
-    m = _model(phase_sigma_rad=0.1, bias=np.full((2, 2, 4), 0.05))
-    ideal = _model(k_phase=None)  # same cov, nothing correlated: the scale changes nothing
-    assert np.allclose(ideal.budget(4.0), ideal.budget())
-    idx = np.arange(2)
-    cov = np.moveaxis(m.cov.reshape(2, 2, 4, 2, 4)[:, idx, :, idx, :], 0, 1)
-    assert np.allclose(m.budget(3.0) - cov, 3.0 * (m.budget() - cov))
-    for bad in (0.5, -1.0, float("nan")):
-        with pytest.raises(ValueError, match="correlated_scale"):
-            m.budget(bad)
+def test_repetition_is_the_mean_pairwise_correlation_brute_force():
+    m = _model(T=5, P=2, M=4, phase_sigma_rad=0.1)
+    k = m.k_phase
+    want = np.zeros((2, 4))
+    for p in range(2):
+        for c in range(4):
+            u = k[:, p, c] / np.linalg.norm(k[:, p, c], axis=1, keepdims=True)
+            want[p, c] = np.mean([u[t] @ u[s] for t in range(5) for s in range(5) if t != s])
+    assert np.allclose(_repetition(m.exists, k), np.clip(want, 0, 1))
+    # a sensitivity that is the same every epoch repeats entirely
+    same = np.repeat(k[:1], 5, axis=0)
+    assert np.allclose(_repetition(m.exists, same), 1.0)
+    # a bias (normalise=False): the sum over pairs of b_t b_s over (n - 1) sum b_t^2
+    b = np.random.default_rng(3).standard_normal((5, 2, 4, 1))
+    w = np.zeros((2, 4))
+    for p in range(2):
+        for c in range(4):
+            x = b[:, p, c, 0]
+            w[p, c] = (x.sum() ** 2 - (x**2).sum()) / (4 * (x**2).sum())
+    assert np.allclose(_repetition(m.exists, b, normalise=False), np.clip(w, 0, 1))
+
+
+def test_split_keeps_every_variance_and_repeats_what_one_draw_repeats():
+    m = _model(T=4, P=2, phase_sigma_rad=0.1, bias=np.full((4, 2, 4), 0.05))
+    white, rep = m.split()
+    budget = m.budget()
+    d = np.diagonal
+    assert np.allclose(d(white + rep, axis1=-2, axis2=-1), d(budget, axis1=-2, axis2=-1))
+    assert np.all(np.linalg.eigvalsh(white) > -1e-12) and np.all(np.linalg.eigvalsh(rep) > -1e-12)
+    # a calibration sensitivity the same every epoch and a constant bias repeat entirely:
+    # brute force, the covariance of one drive's errors at two different epochs
+    k1 = np.repeat(m.k_phase[:1], 4, axis=0)
+    small = 0.01 * m.cov  # the white error only adds sampling noise to the cross moment
+    const = _model(
+        T=4,
+        P=2,
+        phase_sigma_rad=0.1,
+        k_phase=k1,
+        bias=np.full((4, 2, 4), 0.05),
+        cov=small,
+        crlb=small,
+    )
+    _, rep1 = const.split()
+    rng = np.random.default_rng(2)
+    e = np.stack([const.draw(rng) - const.truth for _ in range(6000)])  # (N, T, P, 4)
+    cross = np.einsum("npi,npj->pij", e[:, 0], e[:, 2]) / e.shape[0]
+    assert np.abs(cross - rep1[0]).max() < 0.06 * np.abs(rep1[0]).max()

@@ -216,7 +216,8 @@ class SignalRoute:
     ``kinds`` and the epoch's ``tunnel`` (road markings removed) apply to the ray tracer too,
     the other ``kinds`` filters do not. With ``"sionna"`` the spatial-wideband term is in the
     tensor by construction and ``impairments.dmc`` is refused (the ray tracer has its own
-    diffuse power).
+    diffuse power). ``wideband_model``: the extraction models the spatial-wideband term (the ML
+    route's ``wideband=True``, :func:`tunnelkit.extraction.extract_paths`) in every epoch.
     """
 
     tunnel: object
@@ -232,6 +233,7 @@ class SignalRoute:
     bias_aware_delay_check: bool = False
     channel: str = "image"
     raytraced: object = field(default=None, repr=False)
+    wideband_model: bool = False
 
     def __post_init__(self) -> None:
         from .propagation import PATH_KINDS, Tunnel3D
@@ -254,6 +256,7 @@ class SignalRoute:
         instance("calibration", self.calibration, dict)
         boolean("report_covariance", self.report_covariance)
         boolean("bias_aware_delay_check", self.bias_aware_delay_check)
+        boolean("wideband_model", self.wideband_model)
         if self.channel == "sionna":
             from .rt.cache import RayTracedChannel
 
@@ -393,6 +396,8 @@ class SignalRoute:
         else:
             snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
+        if self.wideband_model:
+            extract_kw.setdefault("wideband", True)
         est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None
         meas, truth = _measure(est, arr, paths, snap, cfg, self.min_d)

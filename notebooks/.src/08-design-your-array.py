@@ -218,7 +218,11 @@ print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.i
 # the achievable model (the calibration error drawn once per drive, as it belongs to the array;
 # the noise and diffuse term per epoch) and reported to the tracker with the **error budget**
 # of the stated impairments (the CRLB plus the covariance of the calibration tolerance and the
-# bias of the terms the model leaves out: `PathErrorModel.budget`); a curvature the array cannot
+# bias of the terms the model leaves out: `PathErrorModel.budget`) and the share of it one drive
+# repeats (`PathErrorModel.split`: what one calibration draw keeps from epoch to epoch, the bias
+# that keeps its sign), which the tracker carries as a consider parameter of the path's track (a
+# Schmidt–Kalman update: `tracking.javelin.ConsiderNoise`) instead of averaging it down as if it
+# were drawn afresh every epoch; a curvature the array cannot
 # resolve (its budget above a tenth of the range) is handed on as far field, as a plane-wave fit
 # would report it. An extraction that reported only its CRLB (sub-millimetre in delay) would
 # hand the tracker centimetres of calibration bias it is told

@@ -45,6 +45,27 @@ def psd_sqrt(S: np.ndarray) -> np.ndarray:
     return V * np.sqrt(np.clip(w, 0.0, None))[..., None, :]
 
 
+def _repetition(exists: np.ndarray, k: np.ndarray, normalise: bool = True) -> np.ndarray:
+    """``rho`` (P, 4) in [0, 1]: the mean correlation, over every pair of distinct epochs of
+    the drive where the path exists, of a calibration sensitivity ``k`` (T, P, 4, M)
+    (:meth:`PathErrorModel.split`; 1 for a path seen at one epoch only); ``normalise=False`` for a bias
+    (``M = 1``): ``sum_{t != s} b_t b_s / ((n - 1) sum_t b_t^2)``, its magnitude counted."""
+    k = np.asarray(k, float)
+    u = k
+    if normalise:
+        nrm = np.linalg.norm(k, axis=-1, keepdims=True)
+        u = np.where(nrm > 0, k / np.where(nrm > 0, nrm, 1.0), 0.0)
+    u = np.where(exists[..., None, None], u, 0.0)
+    n = exists.sum(axis=0).astype(float)[:, None]  # (P, 1)
+    tot = np.sum(u, axis=0)  # (P, 4, M)
+    self_ = np.sum(np.sum(u * u, axis=-1), axis=0)  # (P, 4): n for unit vectors
+    pairs = (n - 1) * self_
+    rho = np.where(
+        pairs > 0, (np.sum(tot * tot, axis=-1) - self_) / np.where(pairs > 0, pairs, 1.0), 1.0
+    )
+    return np.clip(rho, 0.0, 1.0)
+
+
 @dataclass(frozen=True)
 class PathErrorModel:
     """Per-epoch, per-path truth and estimator error along a route (module docstring).
@@ -123,29 +144,67 @@ class PathErrorModel:
             out += self.k_gain @ finite_array("gain_db", gain_db, shape=(self.n_elements,))
         return out
 
-    def budget(self, correlated_scale: float = 1.0) -> np.ndarray:
+    def budget(self) -> np.ndarray:
         """The per-path error budget (T, P, 4, 4): the second moment of the error about the
         truth, ``cov`` plus the calibration covariance over the calibration draw
         (``sigma_phi^2 K_phase K_phase^T + sigma_g^2 K_gain K_gain^T``) plus the deterministic
-        bias' outer product. What an extraction that knows its array's calibration tolerance and
-        its model's shortcuts (but not the draw) can report; equal to the ``crlb`` blocks for an
-        ideal model. ``correlated_scale`` (>= 1) multiplies the two terms that are the same
-        from one epoch to the next (calibration and bias; ``cov`` is drawn afresh every epoch):
-        the white-equivalent variance of an error a filter would otherwise count once per epoch
-        (:data:`tunnelkit.design.fastroute.CORRELATED_SCALE`)."""
-        c = nonnegative("correlated_scale", correlated_scale)
-        if c < 1.0:
-            raise ValueError(f"correlated_scale: expected >= 1, got {correlated_scale!r}")
+        bias' outer product (:meth:`split`: the share of it one drive repeats). What an extraction that knows its array's
+        calibration tolerance and its model's shortcuts (but not the draw) can report; equal to
+        the ``crlb`` blocks for an ideal model."""
         T, P = self.exists.shape
         idx = np.arange(P)
         out = np.asarray(self.cov).reshape(T, P, 4, P, 4)[:, idx, :, idx, :]  # (P, T, 4, 4)
         out = np.moveaxis(out, 0, 1).copy()
         for k, sig in ((self.k_phase, self.phase_sigma_rad), (self.k_gain, self.gain_sigma_db)):
             if k is not None and sig > 0:
-                out += c * sig**2 * (np.asarray(k) @ np.swapaxes(k, -1, -2))
+                out += sig**2 * (np.asarray(k) @ np.swapaxes(k, -1, -2))
         b = np.asarray(self.bias)
-        out += c * (b[..., :, None] * b[..., None, :])
+        out += b[..., :, None] * b[..., None, :]
         return np.where(self.exists[..., None, None], out, 0.0)
+
+    def split(self) -> tuple[np.ndarray, np.ndarray]:
+        """The per-path error budget split into what one drive repeats and what it draws afresh
+        every epoch, ``(white, repeating)``, each (T, P, 4, 4) and positive semi-definite.
+
+        The calibration bias of path ``p``, component ``c`` at epoch ``t`` is ``K_t e`` for one
+        draw ``e`` of the array; between two epochs it correlates as the sensitivities do,
+        ``rho_pc = mean_{t != s} k_t . k_s / (|k_t| |k_s|)`` (``_repetition``: about
+        0.4-0.9 for the angles and the curvature, about 0 for the delay, whose sensitivity turns
+        with the path's phase every epoch). The repeating share is
+        ``diag(sqrt(rho)) Sigma_cal diag(sqrt(rho))``, the rest of each variance,
+        ``(1 - rho_pc) Sigma_cal,cc``, counts as drawn afresh (its cross terms dropped: the
+        split keeps every variance of :meth:`budget` and both shares positive semi-definite).
+        The deterministic bias ``b_t`` (the wideband term) is split alike with ``k_t = b_t``
+        (one element: ``rho`` the mean product of its signs over pairs of epochs; the
+        curvature's flips sign from one epoch to the next). ``cov`` is white. A tracker that
+        counts the repeating share once per epoch averages it down
+        (:class:`tunnelkit.tracking.javelin.ConsiderNoise` carries it as a consider parameter
+        instead)."""
+        T, P = self.exists.shape
+        idx = np.arange(P)
+        white = np.asarray(self.cov).reshape(T, P, 4, P, 4)[:, idx, :, idx, :]
+        white = np.moveaxis(white, 0, 1).copy()
+        rep = np.zeros((T, P, 4, 4))
+        terms = [
+            (np.asarray(k), sig)
+            for k, sig in ((self.k_phase, self.phase_sigma_rad), (self.k_gain, self.gain_sigma_db))
+            if k is not None and sig > 0
+        ]
+        terms.append((np.asarray(self.bias)[..., None], 1.0))
+        for i, (k, sig) in enumerate(terms):
+            rho = _repetition(self.exists, k, normalise=i < len(terms) - 1)  # (P, 4)
+            # one share for the direction and curvature (their errors stay correlated as the
+            # sensitivities are), one for the delay
+            rho = np.concatenate(
+                [np.repeat(rho[:, :3].mean(axis=1, keepdims=True), 3, 1), rho[:, 3:]], 1
+            )[None]
+            kk = np.sqrt(rho)[..., None] * k
+            rep += sig**2 * (kk @ np.swapaxes(kk, -1, -2))
+            S = sig**2 * (k @ np.swapaxes(k, -1, -2))
+            S[..., :3, 3] = S[..., 3, :3] = 0.0
+            white += (1.0 - rho)[..., :, None] ** 0.5 * S * (1.0 - rho)[..., None, :] ** 0.5
+        m = self.exists[..., None, None]
+        return np.where(m, white, 0.0), np.where(m, rep, 0.0)
 
     def noise_sqrt(self) -> np.ndarray:
         """A square root (T, 4P, 4P) of ``cov`` over the existing paths (absent slots zero):

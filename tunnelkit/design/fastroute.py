@@ -23,9 +23,12 @@ the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
 * the radial speed ``v`` from the truth plus :data:`SIGMA_V` of white noise (the Doppler
   clutter test only compares it with the vehicle speed at metre-per-second level; the ideal
   bound on ``v`` is far smaller, so this is a conservative, documented stand-in);
-* the reported budget's correlated share (calibration and bias, the same every epoch) is
-  scaled by :data:`CORRELATED_SCALE` so that the tracker does not average it down as if it were
-  drawn afresh every epoch;
+* the share of that budget which repeats every epoch (:meth:`PathErrorModel.split`: one
+  array's calibration error, the bias of the terms the model leaves out, as far as they keep
+  their value from one epoch to the next) handed over beside it
+  (``PathMeasurements.bias_cov``; the budget report only), so that the tracker carries it as a
+  bias of the path's track (:class:`tunnelkit.tracking.javelin.ConsiderNoise`) instead of
+  averaging it down as if it were drawn afresh every epoch;
 * a curvature the array cannot resolve is not reported: where the reported budget's standard
   deviation of ``kappa`` exceeds :data:`KAPPA_RESOLVED` of the path's range the path is handed
   on without curvature (``kappa`` NaN, the far-field case an extraction reports as a plane-wave
@@ -51,7 +54,6 @@ from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 
 __all__ = [
-    "CORRELATED_SCALE",
     "KAPPA_RESOLVED",
     "REPORTS",
     "SIGMA_V",
@@ -64,18 +66,6 @@ __all__ = [
 #: a curvature is reported only where its reported standard deviation is below this share of the
 #: path's range (otherwise the path goes on as far field, as a plane-wave fit would report it)
 KAPPA_RESOLVED = 0.1
-
-#: the factor on the correlated share of the budget the bound route reports (calibration and
-#: bias, :meth:`PathErrorModel.budget`): the same error every epoch, which a filter that takes
-#: each epoch's report as independent averages down, ending confident of a biased track (its
-#: error plateaus at the bias while its covariance shrinks) or, where the bias dominates the
-#: budget, starved of the information the other directions carry. Handed over
-#: ``CORRELATED_SCALE`` times its variance, the correlated error weighs about as much as the
-#: few independent looks it is worth over the tracker's memory. Chosen on seed 0 (1, 2, 3, 5, 8
-#: tried, 8 runs each, 8x8 / 16x16 / 32x32 of the 28 GHz example at 0.5 and 2 deg of phase error
-#: with 0.2 dB and the wideband term; summed settled RMSE 66.6 / 61.4 / 59.5 / 56.7 / 55.8 cm,
-#: 8 losing 11 % on 32x32 at 2 deg against 5), checked on the held-out seed
-CORRELATED_SCALE = 5.0
 
 #: what the bound route reports to the tracker (:func:`bound_drive`)
 REPORTS = ("auto", "crlb", "budget")
@@ -102,7 +92,10 @@ class BoundRoute:
     """What every drive of one array on the bound route shares (:func:`bound_route`): the
     ``model``, the ``report`` it hands the tracker, the reported per-path blocks (T, P, 4, 4),
     the square root of the model's ``cov`` (T, 4P, 4P) the draws multiply, the array's
-    reference antenna per epoch ``origin`` (T, 3) and Algorithm 1's ``min_d``. Computed once
+    reference antenna per epoch ``origin`` (T, 3), Algorithm 1's ``min_d`` and ``repeating``
+    (T, P, 4, 4): the share of the reported blocks that repeats every epoch (``None`` for the
+    CRLB report; :meth:`PathErrorModel.split` for the budget, whose two shares the blocks
+    add). Computed once
     per array, so a drive costs its random draws and nothing else."""
 
     model: PathErrorModel
@@ -112,16 +105,18 @@ class BoundRoute:
     noise_sqrt: np.ndarray
     origin: np.ndarray
     min_d: float
+    repeating: np.ndarray | None = None
 
 
-def _reported_blocks(model: PathErrorModel, report: str, scale: float) -> np.ndarray:
+def _reported_blocks(model: PathErrorModel, report: str) -> tuple[np.ndarray, np.ndarray | None]:
     T, P = model.exists.shape
     ideal = model.phase_sigma_rad == 0 and model.gain_sigma_db == 0
     ideal = ideal and not np.any(model.bias) and np.array_equal(model.cov, model.crlb)
     if report == "crlb" or (report == "auto" and ideal):
         idx = np.arange(P)
-        return np.moveaxis(model.crlb.reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1)
-    return model.budget(scale)
+        return np.moveaxis(model.crlb.reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1), None
+    white, repeating = model.split()
+    return white + repeating, repeating
 
 
 def bound_route(
@@ -130,10 +125,8 @@ def bound_route(
     spec,
     *,
     report: str = "auto",
-    correlated_scale: float = CORRELATED_SCALE,
 ) -> BoundRoute:
-    """The per-array part of :func:`bound_drive`, computed once (:class:`BoundRoute`);
-    ``correlated_scale``: :data:`CORRELATED_SCALE` (the budget's correlated share)."""
+    """The per-array part of :func:`bound_drive`, computed once (:class:`BoundRoute`)."""
     from .bounds import route_geometry
 
     if not isinstance(model, PathErrorModel):
@@ -151,14 +144,16 @@ def bound_route(
     if T != len(setup.trajectory):
         raise ValueError(f"model: expected {len(setup.trajectory)} epochs (the route's), got {T}")
     origin = route_geometry(setup, spec, epochs=np.arange(T)).origin
+    blocks, repeating = _reported_blocks(model, report)
     return BoundRoute(
         model,
         spec.label,
         report,
-        _reported_blocks(model, report, correlated_scale),
+        blocks,
         model.noise_sqrt(),
         origin,
         float(setup.signal_route(spec).min_d),
+        repeating,
     )
 
 
@@ -210,6 +205,7 @@ def bound_drive(
     bias = sample_clock_bias(rng, cfg.clock_bias_sigma, cfg.clock_bias_limit, size=T)
     v = model.v[:T] + sigma_v * rng.standard_normal((T, P))
     per_path = prepared.blocks[:T]
+    rep = None if prepared.repeating is None else prepared.repeating[:T]
     epochs, tidx, kinds, los = [], [], [], np.zeros(T, bool)
     n_true = ex.sum(axis=1)
     for k in range(T):
@@ -232,6 +228,7 @@ def bound_drive(
             cov=blocks[:, :3, :3],
             sigma_d=np.sqrt(blocks[:, 3, 3]),
             min_d=min_d,
+            bias_cov=None if rep is None else rep[k, o],
         )
         epochs.append(pm)
         tidx.append(o[pm.source])

@@ -134,6 +134,7 @@ class _SweepTrial:
     setup: DesignSetup
     mode: str
     n_epochs: int | None
+    impairments: object = None  # achievable.DesignImpairments: the channel mode's
 
     def __call__(self, prep: _Prepared, rng: np.random.Generator) -> np.ndarray:
         from ..studies import evaluate, simulate_drive
@@ -145,6 +146,14 @@ class _SweepTrial:
             drive = bound_drive(prep.route, self.setup, spec, rng, n_epochs=self.n_epochs)
         else:
             route = self.setup.signal_route(spec)
+            imp = self.impairments
+            if imp is not None and not imp.ideal:
+                # this run's array: its calibration error drawn once, for the whole drive
+                route = route.with_impairments(imp.channel_impairments(), rng)
+            if imp is not None and imp.wideband_model:
+                from dataclasses import replace
+
+                route = replace(route, wideband_model=True)
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
             )
@@ -292,11 +301,11 @@ def drive_pcrlb(
     return pcrlb_position_rmse(B)
 
 
-def _model(setup, spec, error_models) -> PathErrorModel:
+def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
     from .achievable import path_error_model
 
     if error_models is None:
-        m = path_error_model(setup, spec)
+        m = path_error_model(setup, spec, impairments=impairments)
     elif callable(error_models):
         m = error_models(setup, spec)
     elif isinstance(error_models, dict) and spec.label in error_models:
@@ -342,13 +351,14 @@ class _ArrayJob:
     T: int
     with_model: bool
     crlbs: dict | None
+    impairments: object = None
 
     def __call__(self, spec: ArraySpec) -> _Prepared:
         ep = np.arange(self.T)
         peb = route_bounds(self.setup, spec, epochs=ep).peb
         m = route = pc = drive = None
         if self.with_model:
-            m = _model(self.setup, spec, self.error_models)
+            m = _model(self.setup, spec, self.error_models, self.impairments)
             if self.mode == "bound":
                 from .fastroute import bound_route
 
@@ -387,6 +397,7 @@ def sweep_montecarlo(
     n_epochs: int | None = None,
     crlbs: dict | None = None,
     pool: TrialPool | None = None,
+    impairments=None,
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -404,6 +415,10 @@ def sweep_montecarlo(
     sweep), or ``pool`` (a :func:`tunnelkit.montecarlo.trial_pool` already open, so several
     sweeps share one cluster, started once); ``seed`` an int or a Generator: run ``r`` of every
     array uses child generator ``r``.
+    ``impairments`` (a :class:`~tunnelkit.design.achievable.DesignImpairments`, default none):
+    on the channel route each run's array carries them (its calibration error drawn once per
+    run, the wideband term and diffuse power in the tensor, the extraction modelling the
+    wideband term with ``wideband_model``); the default error model carries them too.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -417,6 +432,14 @@ def sweep_montecarlo(
     if mode not in MODES:
         raise ValueError(f"mode: expected one of {MODES}, got {mode!r}")
     runs = integer("runs", runs, minimum=1)
+    if impairments is not None:
+        from .achievable import DesignImpairments
+
+        if not isinstance(impairments, DesignImpairments):
+            raise TypeError(
+                "impairments: expected a design.DesignImpairments or None, got "
+                f"{type(impairments).__name__}"
+            )
     if not isinstance(seed, np.random.Generator):
         seed = integer("seed", seed, minimum=0)
     if n_epochs is not None:
@@ -427,7 +450,7 @@ def sweep_montecarlo(
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
     A = len(specs)
     with_model = mode == "bound" or error_models is not None
-    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs)
+    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
     kw = {k: v for k, v in kw.items() if v is not None}
     if pool is not None:
@@ -443,7 +466,7 @@ def sweep_montecarlo(
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(
-            _SweepTrial(setup, mode, n_epochs),
+            _SweepTrial(setup, mode, n_epochs, impairments),
             A * runs,
             seed,
             inputs=[prepared[a] for a in range(A) for _ in range(runs)],

@@ -485,11 +485,6 @@ def design_sweep(
     workers, scheduler = parallel_options(workers, scheduler)
     imp = _design_impairments(impairments)
     fields = _impairment_fields(imp)
-    if mode == "channel" and not imp.ideal and runs:
-        raise ValueError(
-            "mode: the channel Monte-Carlo route synthesises the ideal channel; use mode='bound' "
-            "for a Monte-Carlo under impairments"
-        )
     if mode == "channel" and runs:
         # each drive synthesises the largest candidate's tensor and a noise draw of its size:
         # the band's tone count is refused here, before any bound is computed
@@ -516,6 +511,7 @@ def design_sweep(
         kw = {
             "mode": mode,
             "error_models": _error_models(imp, mode),
+            "impairments": None if imp.ideal else imp,
             "workers": workers,
             "scheduler": scheduler,
             "timeout": timeout,

@@ -22,6 +22,7 @@ from .config import JavelinConfig
 from .measurement import JavelinWarning, PathMeasurements, measurement_model, track_model
 from .roles import (
     Associator,
+    ConsiderNoise,
     DelayCheck,
     DopplerClutter,
     FixedBirth,
@@ -43,6 +44,7 @@ from .tracker import Javelin, JavelinRun, StepReport, run_javelin
 __all__ = [
     "Associator",
     "ChiSquareGate",
+    "ConsiderNoise",
     "DelayCheck",
     "DopplerClutter",
     "FixedBirth",

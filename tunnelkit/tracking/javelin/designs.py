@@ -28,7 +28,7 @@ from .associate import Associator
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, VueCurvature
 from .motion import MirrorMotion
-from .noise import ReportedNoise
+from .noise import ConsiderNoise
 from .roles import JavelinDesign
 from .update import JointTestUpdater
 
@@ -133,8 +133,11 @@ ARRAY_DESIGN_VUE_WALK = 1e-3
 def array_design(crlb: dict, min_d: float = 0.0, **overrides) -> JavelinDesign:
     """JAVELIN for an array-design sweep at any carrier and array size (our design, curvature
     centred on the VUE): every path's measurement covariance is the one the extraction reports
-    (the CRLB at its estimate, which the ML route attains: :class:`ReportedNoise`), so no 5.9 GHz
-    constant enters; pairs are ranked by ``eta^2 + ln det S`` (``Associator(cost="likelihood")``),
+    (the CRLB at its estimate, which the ML route attains), so no 5.9 GHz constant enters, and
+    the share of it that repeats every epoch (a calibration error, a model bias:
+    ``PathMeasurements.bias_cov``) is carried as a consider parameter of the path's track, not
+    averaged down (:class:`ConsiderNoise`, a Schmidt-Kalman update:
+    :func:`~.update.consider_update`); pairs are ranked by ``eta^2 + ln det S`` (``Associator(cost="likelihood")``),
     so a new, wide track cannot take a path an established track predicts to a millimetre; a VUE
     is born with the covariance of the angles that placed it (:class:`MeasuredBirth`), so two new
     tracks a few degrees apart cannot swap their paths in the next epoch; and pairs whose stacked
@@ -162,7 +165,7 @@ def array_design(crlb: dict, min_d: float = 0.0, **overrides) -> JavelinDesign:
     return (
         base.with_(
             curvature=VueCurvature(),
-            noise=ReportedNoise(fallback=base.noise),
+            noise=ConsiderNoise(fallback=base.noise),
             associator=Associator(cost="likelihood", solver=base.associator.solver),
             initiator=MeasuredBirth(update_at_birth=base.initiator.update_at_birth),
             updater=JointTestUpdater(0.999),

@@ -92,6 +92,21 @@ def birth_covariance(
     return 0.5 * (cov + cov.T), cross
 
 
+def birth_bias_cross(
+    state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig, noise
+) -> np.ndarray:
+    """The cross-covariance (2, 4 L_hat + 4) of a VUE born from path ``j`` with every track's
+    normalised bias (consider parameters, :class:`~.noise.ConsiderNoise`), the new track's own
+    last: through the UE's ``x`` (``f C[0]``) and through the path's angles, whose repeating
+    error is ``L_j[:2] u_new`` (``F_z L_j[:2]``), as :func:`birth_covariance` linearises
+    :func:`intersection`."""
+    F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
+    out = np.zeros((2, state.C.shape[1] + 4))
+    out[:, :-4] = F[:, 2:3] @ state.C[0:1, :]
+    out[:, -4:] = F[:, :2] @ noise.factors(meas)[j, :2, :]
+    return out
+
+
 def static_doppler(p_u, p_v, v_u, bs=(0.0, 0.0, 0.0), sign: float = -1.0) -> float:
     """Radial speed a static reflector would produce: the VUE moves with the UE velocity mirrored
     in the reflecting plane (normal along ``p_v - p_u``); ``p_v = p_u`` means the LoS path.
@@ -229,7 +244,10 @@ def manage_tracks(
             v_pred = static_doppler(state.ue, p_v, v_u, config.bs, initiator.doppler_sign)
             transient = abs(meas.v[j] - v_pred) > config.doppler_tolerance
         cov, cross = initiator.covariance(state, meas, j, config, noise)
-        tid = state.append(yz, cov, transient=transient, cross=cross)
+        bias_cross = None
+        if state.C is not None and cross is not None and getattr(noise, "consider", False):
+            bias_cross = birth_bias_cross(state, meas, j, config, noise)
+        tid = state.append(yz, cov, transient=transient, cross=cross, bias_cross=bias_cross)
         born.append(tid)
         if transient:
             dynamic.append(tid)

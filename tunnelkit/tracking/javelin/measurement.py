@@ -76,6 +76,31 @@ def _reported(cov, sigma_d, n: int):
     return cov, sd
 
 
+def _bias(bias_cov, cov, sigma_d, n: int):
+    """Checked ``bias_cov`` (n, 4, 4): symmetric, positive semi-definite, and no larger than the
+    reported covariance it is a share of (``cov`` / ``sigma_d``) in any direction."""
+    if bias_cov is None:
+        return None
+    if cov is None:
+        raise ValueError("bias_cov: needs the reported covariance (cov, sigma_d) it is a share of")
+    b = np.array(bias_cov, dtype=float)
+    if b.shape != (n, 4, 4):
+        raise ValueError(f"bias_cov: expected shape ({n}, 4, 4), got {b.shape}")
+    if not np.all(np.isfinite(b)):
+        raise ValueError("bias_cov: every entry must be finite")
+    b = 0.5 * (b + np.swapaxes(b, 1, 2))
+    total = np.zeros((n, 4, 4))
+    total[:, :3, :3] = cov
+    total[:, 3, 3] = sigma_d**2
+    total[:, :3, 3] = total[:, 3, :3] = b[:, :3, 3]  # the d cross terms are not reported
+    scale = np.sqrt(np.clip(np.diagonal(total, axis1=1, axis2=2), 1e-300, None))
+    tol = 1e-9
+    for name, m in (("bias_cov", b), ("cov - bias_cov", total - b)):
+        if n and np.min(np.linalg.eigvalsh(m / scale[:, :, None] / scale[:, None, :])) < -tol:
+            raise ValueError(f"bias_cov: {name} must be positive semi-definite for every path")
+    return b
+
+
 @dataclass
 class PathMeasurements:
     """Sanitised path parameters of one epoch (Algorithm 1, lines 4-12).
@@ -87,7 +112,11 @@ class PathMeasurements:
     ``cov`` (n, 3, 3) the covariance of ``(phi, psi, kappa)`` [rad^2, rad m, m^2] and ``sigma_d``
     (n,) [m] the standard deviation of ``d``, e.g. the CRLB at the estimate of an efficient
     estimator (:func:`tunnelkit.extraction.estimate_crlb`). Both or neither; a tracker with
-    ``measurement_noise="reported"`` uses them instead of its fixed sigmas.
+    ``measurement_noise="reported"`` uses them instead of its fixed sigmas. ``bias_cov``
+    (n, 4, 4), with a reported covariance only: the share of it over ``(phi, psi, kappa, d)``
+    that repeats from one epoch to the next (a calibration error drawn once per array, a bias of
+    the estimator's model), which a bias-aware tracker (:class:`~.noise.ConsiderNoise`) keeps
+    apart from the white share ``cov - bias_cov``.
     """
 
     phi: np.ndarray
@@ -98,6 +127,7 @@ class PathMeasurements:
     source: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     cov: np.ndarray | None = None
     sigma_d: np.ndarray | None = None
+    bias_cov: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # built directly (not through from_arrays): 1-D float arrays of one length, and a
@@ -117,6 +147,7 @@ class PathMeasurements:
             raise ValueError(f"source: expected {n} values (one per path), got {src.size}")
         self.source = src
         self.cov, self.sigma_d = _reported(self.cov, self.sigma_d, n)
+        self.bias_cov = _bias(self.bias_cov, self.cov, self.sigma_d, n)
 
     @property
     def reported(self) -> bool:
@@ -132,6 +163,8 @@ class PathMeasurements:
         )
         if self.reported:
             clean.cov, clean.sigma_d = self.cov[clean.source], self.sigma_d[clean.source]
+            if self.bias_cov is not None:
+                clean.bias_cov = self.bias_cov[clean.source]
         clean.source = self.source[clean.source]
         return clean, len(self) - len(clean)
 
@@ -148,14 +181,15 @@ class PathMeasurements:
         cov=None,
         sigma_d=None,
         min_d: float = 0.0,
+        bias_cov=None,
     ) -> PathMeasurements:
         """Apply the consistency checks of Algorithm 1 and drop unusable paths.
 
         (i) ``d < min_d``: path discarded (``min_d = 0`` as printed; ``-c b_max`` keeps what the
         clock bias explains, see :func:`tunnelkit.extraction.algorithm1`); (ii) ``kappa < 0``
         (or NaN): far field, no curvature; ours: a path with a NaN/inf angle is discarded with a
-        :class:`JavelinWarning`. ``cov`` / ``sigma_d``: the reported uncertainty of every input
-        path (see the class).
+        :class:`JavelinWarning`. ``cov`` / ``sigma_d`` / ``bias_cov``: the reported uncertainty
+        of every input path and its repeating share (see the class).
         """
         phi = np.asarray(phi, dtype=float).reshape(-1)
         n = phi.size
@@ -174,9 +208,12 @@ class PathMeasurements:
         v = np.where(np.isfinite(v), v, np.nan)
         idx = np.flatnonzero(keep)
         cov, sigma_d = _reported(cov, sigma_d, n)
+        bias_cov = _bias(bias_cov, cov, sigma_d, n)
         if cov is not None:
             cov, sigma_d = cov[idx], sigma_d[idx]
-        return cls(phi[idx], psi[idx], kappa[idx], d[idx], v[idx], idx, cov, sigma_d)
+        if bias_cov is not None:
+            bias_cov = bias_cov[idx]
+        return cls(phi[idx], psi[idx], kappa[idx], d[idx], v[idx], idx, cov, sigma_d, bias_cov)
 
     @classmethod
     def empty(cls) -> PathMeasurements:
@@ -206,6 +243,7 @@ class PathMeasurements:
             self.source[idx],
             None if self.cov is None else self.cov[idx],
             None if self.sigma_d is None else self.sigma_d[idx],
+            None if self.bias_cov is None else self.bias_cov[idx],
         )
 
     def triples(self) -> np.ndarray:

@@ -5,6 +5,12 @@ position and, per tracked virtual UE (VUE), its lateral and vertical coordinates
 the UE's because the reflecting surfaces run along the tunnel). Track 0 is the UE; tracks 1.. are
 VUEs, each with a persistent id, a misses counter (zeta of Algorithm 3) and a ``transient`` flag
 for paths from dynamic reflectors (used for one epoch only).
+
+A bias-aware tracker (:class:`~tunnelkit.tracking.javelin.noise.ConsiderNoise`) also keeps ``C``
+(D, 4 L_hat): the cross-covariance of the state with every track's normalised measurement bias
+``u_i`` (4,: ``phi, psi, kappa, d``; columns ``4 i : 4 i + 4``, :func:`bias_slice`). The biases
+are consider parameters: never estimated, their own covariance stays ``I``, so ``C`` is all the
+filter has to carry about them.
 """
 
 from __future__ import annotations
@@ -15,7 +21,7 @@ import numpy as np
 
 from ..._validate import finite_array, integer, positive, vector
 
-__all__ = ["JavelinState", "track_slice"]
+__all__ = ["JavelinState", "bias_slice", "track_slice"]
 
 
 def track_slice(i: int) -> slice:
@@ -23,6 +29,12 @@ def track_slice(i: int) -> slice:
     if i == 0:
         return slice(0, 3)
     return slice(3 + 2 * (i - 1), 5 + 2 * (i - 1))
+
+
+def bias_slice(i: int) -> slice:
+    """Columns of track ``i``'s normalised bias in the consider cross-covariance ``C``."""
+    i = integer("i", i, minimum=0)
+    return slice(4 * i, 4 * i + 4)
 
 
 def vue_positions(x: np.ndarray) -> np.ndarray:
@@ -42,6 +54,7 @@ class JavelinState:
     transient: list[bool] = field(default_factory=list)
     ue_misses: int = 0
     next_id: int = 1
+    C: np.ndarray | None = None
 
     @classmethod
     def initial(cls, position, sigma: float) -> JavelinState:
@@ -56,6 +69,8 @@ class JavelinState:
         if self.x.size < 3 or (self.x.size - 3) % 2:
             raise ValueError(f"x: expected 3 + 2 n entries (eq. 43), got {self.x.size}")
         n = self.n_vue
+        if self.C is not None:
+            self.C = finite_array("C", self.C, shape=(self.x.size, 4 * (n + 1)))
         for name in ("ids", "misses", "transient"):
             if len(getattr(self, name)) != n:
                 raise ValueError(
@@ -104,6 +119,7 @@ class JavelinState:
             list(self.transient),
             self.ue_misses,
             self.next_id,
+            None if self.C is None else self.C.copy(),
         )
 
     def remove(self, tracks) -> list[int]:
@@ -122,14 +138,23 @@ class JavelinState:
         gone = [self.ids[i - 1] for i in tracks]
         self.x = self.x[keep]
         self.P = self.P[np.ix_(keep, keep)]
+        if self.C is not None:
+            cols = np.setdiff1d(
+                np.arange(self.C.shape[1]),
+                np.concatenate([np.arange(self.C.shape[1])[bias_slice(i)] for i in tracks]),
+            )
+            self.C = self.C[np.ix_(keep, cols)]
         for name in ("ids", "misses", "transient"):
             lst = getattr(self, name)
             setattr(self, name, [v for k, v in enumerate(lst) if k + 1 not in tracks])
         return gone
 
-    def append(self, yz, cov, *, transient: bool = False, cross=None) -> int:
+    def append(self, yz, cov, *, transient: bool = False, cross=None, bias_cross=None) -> int:
         """Append a VUE at ``yz`` (2,) with covariance ``cov`` (2, 2) and cross-covariance
-        ``cross`` (2, D) with the current state (default: uncorrelated with the rest).
+        ``cross`` (2, D) with the current state (default: uncorrelated with the rest); with a
+        consider cross-covariance ``C``, the new track's bias (4 columns, uncorrelated with the
+        state) and ``bias_cross`` (2, 4 L_hat + 4): the new VUE's cross-covariance with every
+        track's bias, its own last (default zero).
 
         Returns the new track's id; its index is the new ``n_vue``.
         """
@@ -143,6 +168,15 @@ class JavelinState:
             cross = finite_array("cross", cross, shape=(2, d))
             P[d:, :d] = cross
             P[:d, d:] = cross.T
+        if self.C is not None:
+            L = self.C.shape[1]
+            C = np.zeros((d + 2, L + 4))
+            C[:d, :L] = self.C
+            if bias_cross is not None:
+                C[d:] = finite_array("bias_cross", bias_cross, shape=(2, L + 4))
+            self.C = C
+        elif bias_cross is not None:
+            raise ValueError("bias_cross: the state carries no consider cross-covariance C")
         self.x = np.concatenate([self.x, yz])
         self.P = P
         tid = self.next_id

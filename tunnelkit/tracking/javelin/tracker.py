@@ -72,6 +72,8 @@ class Javelin:
         self.config = self.design.config
         p0 = vector("initial_position", initial_position, 3)
         self.state = JavelinState.initial(p0, self.config.sigma_p0_ue)
+        if getattr(self.design.noise, "consider", False):
+            self.state.C = np.zeros((3, 4))  # the UE's bias, uncorrelated with the start
         self.gate = ChiSquareGate(self.config.gate_probability)
         self.k = 0
         self._last_motion: tuple[float, float] | None = None
@@ -184,6 +186,8 @@ class Javelin:
         st.x, st.P = predict(
             st, nu, theta, dt, cfg, vue_motion=roles.vue_motion.name, sigma_speed=sig_nu
         )
+        if st.C is not None:  # F = I: the cross-covariance only decays with the biases
+            st.C = st.C * roles.noise.decay(dt)
         prior_pos, prior_ids = st.positions(), list(st.ids)
         prior_cov = [st.P[track_slice(i), track_slice(i)].copy() for i in range(st.n_tracks)]
         costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
@@ -208,15 +212,17 @@ class Javelin:
             pred, J = roles.curvature.predict(st.x, cfg.bs)
             try:
                 m, left_out = roles.updater.stack(
-                    st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, noise
+                    st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, noise, st.C
                 )
                 if left_out:
                     faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
                 n_rows = m.z.size
-                x_new, P_new, nis = roles.updater.update(st.x, st.P, m)
+                out = roles.updater.update(st.x, st.P, m, st.C)
+                x_new, P_new, nis = out[:3]
+                C_new = out[3] if len(out) == 4 else st.C
                 if not (np.all(np.isfinite(x_new)) and np.all(np.isfinite(P_new))):
                     raise np.linalg.LinAlgError("non-finite update")
-                st.x, st.P = x_new, P_new
+                st.x, st.P, st.C = x_new, P_new, C_new
             except np.linalg.LinAlgError as exc:
                 faults.append(f"update skipped ({exc})")
             # dynamic reflectors contribute to this epoch only

@@ -5,6 +5,26 @@ rows ``phi, psi`` and ``kappa`` (if the path has a near-field curvature), and th
 ``Delta d_j = d_j - d_ref`` against a reference path (the LoS path when there is one, as in eq. 52
 and Algorithm 1 line 13; otherwise, ours, the shortest associated path, since TDoAs between
 reflections are clock-bias free too). The stacked vector is the sorted ``z`` of eq. 54.
+
+A bias-aware tracker (ours, :class:`~tunnelkit.tracking.javelin.noise.ConsiderNoise`) updates
+as a Schmidt-Kalman *consider* filter (:func:`consider_update`, :func:`schmidt_update`): the
+error a path's measurement repeats from epoch to epoch (one array's calibration draw, the
+estimator's model bias) is ``L_j u_i`` with ``u_i`` a normalised bias per track, carried through
+its cross-covariance ``C`` with the state and never estimated.
+
+Why consider and not estimate (augmented states). A path's bias is observable only through the
+change of the geometry over the drive: at one epoch a bias in ``phi`` of the LoS is the same
+measurement as a UE moved across the tunnel, and the odometry that could tell them apart drifts
+by about as much as the bias moves the fix. Over the few seconds a design drives (40 epochs,
+55 m), the angles of a path seen from tens of metres change by degrees and its delay by tens of
+metres, so four bias states per track (six to eight tracks) would be estimated from a weak
+difference, through a linearised model, by tracks that are born and die (each birth a new,
+unobserved bias): an augmented EKF turns such weakly observable states into position error
+and into gates that accept the wrong paths. The consider filter needs none of it: its gain is
+the best linear gain among filters that leave the bias alone (it knows the bias repeats, so it
+neither averages it down nor ends confident of a biased track), its covariance is the true
+one of its estimate, and it carries ``C`` (D, 4 L_hat) only, because the biases' own covariance
+stays ``I`` (tests: ``tests/test_javelin_consider.py``, against the batch solutions).
 """
 
 from __future__ import annotations
@@ -14,20 +34,28 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from ..._validate import instance, probability
+from ..._validate import finite_array, instance, probability
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
 from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements, check_track_model
 from .noise import FixedNoise
 
-__all__ = ["StackedMeasurement", "exclude_inconsistent", "joseph_update", "stack_measurement"]
+__all__ = [
+    "StackedMeasurement",
+    "consider_update",
+    "exclude_inconsistent",
+    "joseph_update",
+    "schmidt_update",
+    "stack_measurement",
+]
 
 
 @dataclass
 class StackedMeasurement:
     """``z``, ``h``, ``H`` (K, D), ``R`` (K, K), ``angle`` (K,) bool, row labels and the
-    reference pair of the TDoAs (or ``None``)."""
+    reference pair of the TDoAs (or ``None``); for a consider filter ``B`` (K, 4 L_hat), the
+    rows' sensitivity to every track's normalised bias (``R`` then the white share only)."""
 
     z: np.ndarray
     h: np.ndarray
@@ -36,6 +64,13 @@ class StackedMeasurement:
     angle: np.ndarray
     labels: list[tuple[str, int, int]]
     reference: tuple[int, int] | None
+    B: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.B is not None:
+            self.B = finite_array("B", self.B, ndim=2)
+            if self.B.shape[0] != np.size(self.z):
+                raise ValueError(f"B: expected one row per measured row ({np.size(self.z)})")
 
     def residual(self) -> np.ndarray:
         """Innovation ``y = z - h(s)`` (eq. 64), azimuths wrapped."""
@@ -51,10 +86,14 @@ def stack_measurement(
     config: JavelinConfig,
     los_path: int | None = None,
     noise=None,
+    C: np.ndarray | None = None,
 ) -> StackedMeasurement:
     """Rows of eq. 44/54 for the given (track, path) pairs; ``pred``/``J`` from ``track_model``;
     ``noise`` the measurement-noise role (:mod:`~tunnelkit.tracking.javelin.roles`; default the
-    paper's fixed sigmas) gives the covariance of every row."""
+    paper's fixed sigmas) gives the covariance of every row. With a consider cross-covariance
+    ``C`` (D, 4 L_hat) and a noise role that splits off the repeating share
+    (:class:`~.noise.ConsiderNoise`), ``R`` is the white share and ``B`` the rows' map of the
+    tracks' normalised biases (a TDoA row ``L_j[d] u_i - L_ref[d] u_ref``)."""
     pred, J = check_track_model(pred, J)
     instance("meas", meas, PathMeasurements)
     instance("config", config, JavelinConfig)
@@ -62,8 +101,18 @@ def stack_measurement(
     if not callable(getattr(noise, "covariances", None)):
         raise TypeError(f"noise: expected a measurement-noise role, got {type(noise).__name__}")
     D = J.shape[-1]
-    cov = noise.covariances(meas, config)
+    if C is not None:
+        C = finite_array("C", C, ndim=2)
+        if C.shape[0] != D:
+            raise ValueError(f"C: expected {D} rows (one per state entry), got {C.shape[0]}")
+    consider = C is not None and getattr(noise, "consider", False)
+    if consider:
+        cov = noise.white_covariances(meas, config)
+        Lf = noise.factors(meas)
+    else:
+        cov = noise.covariances(meas, config)
     z, h, H, blocks, ang, labels = [], [], [], [], [], []
+    brow = []  # per row: [(track, path, component, sign)]
     for i, j in pairs:
         comps = [PHI, PSI] + ([KAPPA] if np.isfinite(meas.kappa[j]) else [])
         zj = (meas.phi[j], meas.psi[j], meas.kappa[j])
@@ -73,6 +122,7 @@ def stack_measurement(
             H.append(J[i, c])
             ang.append(c == PHI)
             labels.append((("phi", "psi", "kappa")[c], i, j))
+            brow.append([(i, j, c, 1.0)])
         blocks.append(cov[j][np.ix_(comps, comps)])
     n_direct = len(z)
     with_d = [(i, j) for i, j in pairs if np.isfinite(meas.d[j])]
@@ -89,6 +139,7 @@ def stack_measurement(
             H.append(J[i, RANGE] - J[ir, RANGE])
             ang.append(False)
             labels.append(("delta_d", i, j))
+            brow.append([(i, j, RANGE, 1.0), (ir, jr, RANGE, -1.0)])
     K = len(z)
     R = np.zeros((K, K))
     at = 0
@@ -98,7 +149,14 @@ def stack_measurement(
     nd = K - n_direct
     if nd:
         others = [j for i, j in with_d if (i, j) != ref]
-        R[n_direct:, n_direct:] = noise.tdoa_covariance(meas, others, jr, config)
+        tdoa = noise.white_tdoa_covariance if consider else noise.tdoa_covariance
+        R[n_direct:, n_direct:] = tdoa(meas, others, jr, config)
+    B = None
+    if consider:
+        B = np.zeros((K, C.shape[1]))
+        for r, terms in enumerate(brow):
+            for i, j, c, sign in terms:
+                B[r, 4 * i : 4 * i + 4] += sign * Lf[j, c]
     return StackedMeasurement(
         np.asarray(z, float),
         np.asarray(h, float),
@@ -107,7 +165,62 @@ def stack_measurement(
         np.asarray(ang, bool),
         labels,
         ref,
+        B,
     )
+
+
+def schmidt_update(
+    x: np.ndarray,
+    P: np.ndarray,
+    H: np.ndarray,
+    R: np.ndarray,
+    y: np.ndarray,
+    n_est: int | None = None,
+    gain: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The linear update of a state ``x`` (N,) whose first ``n_est`` entries are estimated and
+    the rest are consider parameters (Schmidt 1966): the gain's rows of the consider parameters
+    are zero, so they keep their mean and covariance, and the estimated rows take the best gain
+    under that constraint, ``K = (P H^T S^-1)[:n_est]`` with ``S = H P H^T + R``. Returns
+    ``(x, P, K, nis)``, ``P`` in the Joseph form ``(I - K H) P (I - K H)^T + K R K^T``, which is
+    the true covariance for *any* gain: ``gain`` (n_est, K) replaces the optimal one (to
+    evaluate a filter that ignores the consider parameters). ``n_est = N`` (default) is the
+    Kalman filter on the whole state."""
+    N = x.size
+    n_est = N if n_est is None else int(n_est)
+    if not 0 < n_est <= N:
+        raise ValueError(f"n_est: expected 1..{N} estimated entries, got {n_est}")
+    S = H @ P @ H.T + R
+    S = 0.5 * (S + S.T)
+    cf = cho_factor(S, lower=True)
+    Ka = np.zeros((N, y.size))
+    if gain is None:
+        Ka[:n_est] = cho_solve(cf, H @ P[:, :n_est]).T
+    else:
+        Ka[:n_est] = np.asarray(gain, float).reshape(n_est, y.size)
+    x_new = x + Ka @ y
+    IKH = np.eye(N) - Ka @ H
+    P_new = IKH @ P @ IKH.T + Ka @ R @ Ka.T
+    nis = float(y @ cho_solve(cf, y))
+    return x_new, 0.5 * (P_new + P_new.T), Ka[:n_est], nis
+
+
+def consider_update(
+    x: np.ndarray, P: np.ndarray, C: np.ndarray, m: StackedMeasurement
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The Schmidt-Kalman update of the JAVELIN state with the tracks' normalised biases as
+    consider parameters (module docstring): the augmented covariance ``[[P, C], [C^T, I]]``, the
+    rows ``z = h(x) + B u + w`` (``m.B``, white ``m.R``), :func:`schmidt_update` with the state
+    estimated. Returns ``(x, P, C, nis)``; the biases' block stays ``I``."""
+    D = x.size
+    if m.z.size == 0:
+        return x.copy(), P.copy(), C.copy(), 0.0
+    Lc = C.shape[1]
+    Pa = np.block([[P, C], [C.T, np.eye(Lc)]])
+    xa = np.concatenate([x, np.zeros(Lc)])
+    Ha = np.hstack([m.H, m.B])
+    xa, Pa, _, nis = schmidt_update(xa, Pa, Ha, m.R, m.residual(), n_est=D)
+    return xa[:D], Pa[:D, :D], Pa[:D, D:], nis
 
 
 def joseph_update(
@@ -133,12 +246,16 @@ def joseph_update(
     return x_new, 0.5 * (P_new + P_new.T), nis
 
 
-def _nis(x: np.ndarray, P: np.ndarray, m: StackedMeasurement) -> float:
-    """``y^T S^-1 y`` of the stacked measurement at the prior (0 without rows)."""
+def _nis(x: np.ndarray, P: np.ndarray, m: StackedMeasurement, C=None) -> float:
+    """``y^T S^-1 y`` of the stacked measurement at the prior (0 without rows); with consider
+    parameters ``S`` includes ``H C B^T + B C^T H^T + B B^T``."""
     if m.z.size == 0:
         return 0.0
     y = m.residual()
     S = m.H @ P @ m.H.T + m.R
+    if m.B is not None and C is not None:
+        HCB = m.H @ C @ m.B.T
+        S = S + HCB + HCB.T + m.B @ m.B.T
     return float(y @ cho_solve(cho_factor(0.5 * (S + S.T), lower=True), y))
 
 
@@ -153,6 +270,7 @@ def exclude_inconsistent(
     los_path: int | None,
     probability: float,
     noise=None,
+    C=None,
 ) -> tuple[StackedMeasurement, list[tuple[int, int]]]:
     """Fault detection and exclusion on the stacked update (ours, RAIM-like): while the joint
     innovation fails its chi-square test, ``y^T S^-1 y > chi2_K(probability)`` with ``K`` the
@@ -160,17 +278,18 @@ def exclude_inconsistent(
     innovation most, and stack again. Catches what the per-pair gates of Algorithm 2 cannot: a
     wrong LoS from eq. 61 and the TDoA rows, which no gate sees. Returns the stacked measurement
     of the kept pairs and the pairs left out (in order). Raises ``numpy.linalg.LinAlgError`` if
-    an innovation covariance is not positive definite (the tracker then skips the update)."""
+    an innovation covariance is not positive definite (the tracker then skips the update).
+    ``C``: the consider cross-covariance (:func:`stack_measurement`)."""
     gate = ChiSquareGate(probability)
     pairs = list(pairs)
     out: list[tuple[int, int]] = []
-    m = stack_measurement(pred, J, meas, pairs, config, los_path, noise)
-    while m.z.size and _nis(x, P, m) > gate.threshold(int(m.z.size)):
+    m = stack_measurement(pred, J, meas, pairs, config, los_path, noise, C)
+    while m.z.size and _nis(x, P, m, C) > gate.threshold(int(m.z.size)):
         best = None
         for p in pairs:
             rest = [q for q in pairs if q != p]
-            trial = stack_measurement(pred, J, meas, rest, config, los_path, noise)
-            score = _nis(x, P, trial) / gate.threshold(max(int(trial.z.size), 1))
+            trial = stack_measurement(pred, J, meas, rest, config, los_path, noise, C)
+            score = _nis(x, P, trial, C) / gate.threshold(max(int(trial.z.size), 1))
             if best is None or score < best[0]:
                 best = (score, p, trial)
         _, p, m = best
@@ -183,12 +302,19 @@ def exclude_inconsistent(
 class JosephUpdater:
     """The EKF update of eq. 64-68 with the Joseph-form covariance on every kept pair."""
 
-    def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise):
+    def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise, C=None):
         """The stacked measurement of the pairs to update with and the pairs left out."""
-        return stack_measurement(pred, J, meas, pairs, config, los_path, noise), []
+        return stack_measurement(pred, J, meas, pairs, config, los_path, noise, C), []
 
-    def update(self, x, P, m: StackedMeasurement):
-        """``(x, P, nis)`` after the update (:func:`~.update.joseph_update`)."""
+    def update(self, x, P, m: StackedMeasurement, C=None):
+        """``(x, P, nis)`` after the update (:func:`~.update.joseph_update`); with a consider
+        cross-covariance ``C`` and ``m.B``, ``(x, P, nis, C)`` (:func:`consider_update`)."""
+        if C is not None:
+            C = finite_array("C", C, ndim=2)
+        if C is not None and m.B is not None and (np.any(m.B) or np.any(C)):
+            x, P, C, nis = consider_update(x, P, C, m)
+            return x, P, nis, C
+        # no bias anywhere (C = 0, B = 0): the consider update is the Joseph update exactly
         return joseph_update(x, P, m)
 
 
@@ -205,7 +331,7 @@ class JointTestUpdater(JosephUpdater):
         if ChiSquareGate(p).threshold(1) <= 0:
             raise ValueError(f"probability: too small to give a chi-square threshold, got {p!r}")
 
-    def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise):
+    def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise, C=None):
         return exclude_inconsistent(
-            x, P, pred, J, meas, pairs, config, los_path, self.probability, noise
+            x, P, pred, J, meas, pairs, config, los_path, self.probability, noise, C
         )

@@ -1,0 +1,73 @@
+"""The design's channel Monte-Carlo carries the impairments into the synthesised tensor and the
+extraction (the bound mode draws them from the error model; the channel mode must synthesise
+them)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tunnelkit.extraction
+import tunnelkit.studies
+from tunnelkit.design import DesignImpairments, DesignSetup, sweep_montecarlo
+
+
+class _Stop(Exception):
+    pass
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return DesignSetup.from_scenario("italiano2026-straight")
+
+
+def test_channel_mode_synthesises_the_impairments_and_models_the_wideband_term(setup, monkeypatch):
+    seen = []
+
+    def fake_drive(route, rng, **kw):
+        seen.append(route)
+        raise _Stop
+
+    monkeypatch.setattr(tunnelkit.studies, "simulate_drive", fake_drive)
+    imp = DesignImpairments(
+        phase_error_deg=1.0, gain_error_db=0.3, spatial_wideband=True, wideband_model=True
+    )
+    with pytest.raises(_Stop):
+        sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", impairments=imp, n_epochs=1)
+    (route,) = seen
+    assert route.impairments.spatial_wideband
+    assert route.impairments.phase_sigma_deg == 1.0 and route.impairments.gain_sigma_db == 0.3
+    # every mounted array's calibration error drawn for this run
+    assert set(route.calibration) == {a.name for a in route.arrays}
+    for cal in route.calibration.values():
+        assert cal.shape == (4,) and not np.allclose(cal, 1.0)
+    assert route.wideband_model
+
+    # and the epoch's extraction is asked to model the wideband term
+    asked = {}
+
+    def fake_extract(H, n_paths, arr, cfg, **kw):
+        asked.update(kw)
+        raise _Stop
+
+    monkeypatch.setattr(tunnelkit.extraction, "extract_paths", fake_extract)
+    with pytest.raises(_Stop):
+        route.epoch(0, np.random.default_rng(0))
+    assert asked.get("wideband") is True
+
+
+def test_ideal_channel_mode_stays_the_ideal_route(setup, monkeypatch):
+    seen = []
+
+    def fake_drive(route, rng, **kw):
+        seen.append(route)
+        raise _Stop
+
+    monkeypatch.setattr(tunnelkit.studies, "simulate_drive", fake_drive)
+    with pytest.raises(_Stop):
+        sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", n_epochs=1)
+    assert not seen[0].calibration and not seen[0].wideband_model
+    with pytest.raises(TypeError, match="impairments"):
+        sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", impairments={"phase": 1.0})
+    with pytest.raises(TypeError, match="wideband_model"):
+        type(seen[0])(**{**seen[0].__dict__, "wideband_model": "yes"})
