@@ -245,7 +245,8 @@ def _baselines():
     from tunnelkit import budget, crlb, geometry, metrics, propagation
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
     from tunnelkit.design import errormodel, mcrb, report, verdict
-    from tunnelkit.design.montecarlo import drive_bound, javelin_config
+    from tunnelkit.design.drivebound import drive_bound
+    from tunnelkit.design.montecarlo import javelin_config
     from tunnelkit.extraction.decomposition import kruskal_rank
     from tunnelkit.fresnel.bounds import fraunhofer_distance
     from tunnelkit.plots import common, tables, topview

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
+from .drivebound import drive_bound, drive_pcrlb, position_bias_rms, position_information
 from .errormodel import PathErrorModel
 from .fastroute import BoundRoute, bound_drive, bound_route
 from .geometry import KINDS, RouteGeometry, trace_route
@@ -47,12 +48,8 @@ from .montecarlo import (
     MODES,
     SETTLE_S,
     MonteCarloResult,
-    drive_bound,
-    drive_pcrlb,
     javelin_config,
     javelin_rmse,
-    position_bias_rms,
-    position_information,
     sweep_montecarlo,
 )
 from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting

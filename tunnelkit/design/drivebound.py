@@ -1,0 +1,160 @@
+"""Bounds over a design's drive: what the position information of each epoch gives a tracker.
+
+:func:`position_information` maps a :class:`~tunnelkit.design.errormodel.PathErrorModel`'s
+reported per-path bound into the UE's horizontal position (the clock bias ``c b`` eliminated, as
+the PEB does); :func:`drive_pcrlb` runs the posterior CRLB of JAVELIN's motion model over the
+drive with it (Tichavsky et al. 1998); :func:`position_bias_rms` is the position bias of the
+array's one calibration draw and of the wideband term, which no number of epochs averages down,
+and :func:`drive_bound` sets the two together. The Monte-Carlo of
+:mod:`tunnelkit.design.montecarlo` is judged against them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errormodel import PathErrorModel
+from .setup import DesignSetup
+
+__all__ = ["drive_bound", "drive_pcrlb", "position_bias_rms", "position_information"]
+
+
+def _position_rows(model: PathErrorModel, geometry, k: int):
+    """Epoch ``k``: the rows of the existing paths in ``z`` and ``H`` (4n, 3), the map of the
+    UE's horizontal position and ``c b`` into them (``None`` without a path)."""
+    from ..geometry import spherical_jacobian
+
+    j = np.flatnonzero(model.exists[k] & geometry.exists[k])
+    if not j.size:
+        return None, None, j
+    rel = geometry.source[k, j] - geometry.origin[k]
+    Js = spherical_jacobian(rel) @ geometry.mirror[j]  # (n, 3, 3) d(phi,psi,r)/d UE
+    H = np.zeros((j.size, 4, 3))
+    H[:, :3, :2] = Js[:, :, :2]
+    H[:, 3, :2] = Js[:, 2, :2]
+    H[:, 3, 2] = 1.0  # c b in every delay distance
+    rows = (4 * j[:, None] + np.arange(4)).ravel()
+    return rows, H.reshape(-1, 3), j
+
+
+def _check_geometry(model, geometry) -> None:
+    if not isinstance(model, PathErrorModel):
+        raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
+    if geometry.exists.shape != model.exists.shape:
+        raise ValueError(
+            f"geometry: expected {model.exists.shape[0]} epochs and {model.exists.shape[1]} "
+            "path slots like the model"
+        )
+
+
+def position_information(model: PathErrorModel, geometry) -> np.ndarray:
+    """Fisher information (T, 2, 2) [1/m^2] of the UE's horizontal position (height known, as
+    JAVELIN and the PEB) in what the extraction reports: ``H^T crlb^-1 H`` over the existing
+    paths' ``z = [phi, psi, kappa, d]``, with the clock bias (common to every ``d``) a nuisance
+    removed by the Schur complement. ``H`` maps the UE position through each path's wave origin
+    (the UE, or its mirror image in the known surface: ``geometry.mirror``)."""
+    _check_geometry(model, geometry)
+    T = model.exists.shape[0]
+    out = np.zeros((T, 2, 2))
+    for k in range(T):
+        rows, H, _ = _position_rows(model, geometry, k)
+        if rows is None:
+            continue
+        R = model.crlb[k][np.ix_(rows, rows)]
+        J = H.T @ np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True) @ H
+        J = 0.5 * (J + J.T)
+        if J[2, 2] > 0:
+            J = J[:2, :2] - np.outer(J[:2, 2], J[2, :2]) / J[2, 2]
+        else:
+            J = J[:2, :2]
+        out[k] = 0.5 * (J + J.T)
+    return out
+
+
+def position_bias_rms(model: PathErrorModel, geometry) -> np.ndarray:
+    """RMS (T,) [m] of the horizontal position bias of the snapshot estimator of
+    :func:`position_information` (weights ``crlb^-1``, clock bias estimated) under the model's
+    deterministic ``bias`` and calibration error, over the calibration draw:
+    ``sqrt(|G b|^2 + sigma_phi^2 ||G K_phase||_F^2 + sigma_g^2 ||G K_gain||_F^2)`` with ``G``
+    the position rows of ``(H^T W H)^-1 H^T W``. A bias that does not average down over the
+    drive: one array's calibration error is drawn once, the wideband bias is deterministic
+    (:func:`drive_bound`). Zero for an ideal model."""
+    _check_geometry(model, geometry)
+    T, P = model.exists.shape
+    out = np.zeros(T)
+    b_all = np.asarray(model.bias).reshape(T, 4 * P)
+    ks = [
+        (np.asarray(K).reshape(T, 4 * P, -1), sig)
+        for K, sig in ((model.k_phase, model.phase_sigma_rad), (model.k_gain, model.gain_sigma_db))
+        if K is not None and sig > 0
+    ]
+    for k in range(T):
+        rows, H, _ = _position_rows(model, geometry, k)
+        if rows is None:
+            continue
+        R = model.crlb[k][np.ix_(rows, rows)]
+        W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
+        J = H.T @ W @ H
+        G = (np.linalg.pinv(0.5 * (J + J.T), rcond=1e-15, hermitian=True) @ H.T @ W)[:2]
+        v = float(np.sum((G @ b_all[k, rows]) ** 2))
+        for K, sig in ks:
+            v += sig**2 * float(np.sum((G @ K[k, rows]) ** 2))
+        out[k] = np.sqrt(v)
+    return out
+
+
+def drive_bound(pcrlb: np.ndarray, bias_rms: np.ndarray) -> np.ndarray:
+    """The achievable bound over the drive (T,) [m]: the posterior CRLB of the noise
+    (:func:`drive_pcrlb`, which averages down along the drive) and the position bias that does
+    not average down (:func:`position_bias_rms`, the array's one calibration draw and the
+    deterministic wideband bias) added in quadrature, ``sqrt(pcrlb^2 + bias_rms^2)``. The bias
+    part is that of the snapshot estimator with the ideal weights (the achievable bound's), not
+    minimised over the drive: a reference a tracker can approach, not a strict lower bound."""
+    p = np.asarray(pcrlb, float)
+    b = np.asarray(bias_rms, float)
+    if p.shape != b.shape:
+        raise ValueError(f"bias_rms: expected shape {p.shape} like pcrlb, got {b.shape}")
+    return np.sqrt(p**2 + b**2)
+
+
+def drive_pcrlb(
+    setup: DesignSetup,
+    info: np.ndarray,
+    *,
+    sigma_p0: float = 1.0,
+    sigma_speed: float | None = None,
+    sigma_heading: float | None = None,
+) -> np.ndarray:
+    """Posterior CRLB (T,) [m] of the 2-D position along ``setup``'s drive
+    (:func:`tunnelkit.tracking.pcrlb.pcrlb`, Tichavsky et al. 1998): JAVELIN's motion model
+    (``x_k = x_{k-1} + dt nu (cos theta, sin theta)`` driven by the V2X speed and heading with
+    noise ``sigma_speed`` / ``sigma_heading``, default the messages' own: 0.2 m/s, 1 deg), the
+    start from an open-sky fix of ``sigma_p0`` [m] (as the studies start JAVELIN), and ``info``
+    (T, 2, 2) the position information per epoch (:func:`position_information`)."""
+    from .._validate import positive
+    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED
+    from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
+
+    sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
+    sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
+    sigma_p0 = positive("sigma_p0", sigma_p0)
+    traj = setup.trajectory
+    T = info.shape[0]
+    vel = traj.velocity[:T]
+    nu = np.linalg.norm(vel[:, :2], axis=1)
+    th = np.arctan2(vel[:, 1], vel[:, 0])
+    dt = np.diff(traj.t[:T], prepend=traj.t[0])
+    dt[0] = dt[1] if T > 1 else 0.1
+    # the message of epoch k-1 drives the prediction into epoch k (Algorithm 4, line 7)
+    nu_p, th_p = np.roll(nu, 1), np.roll(th, 1)
+    G = dt[:, None, None] * np.stack(
+        [
+            np.stack([np.cos(th_p), -nu_p * np.sin(th_p)], axis=-1),
+            np.stack([np.sin(th_p), nu_p * np.cos(th_p)], axis=-1),
+        ],
+        axis=1,
+    )
+    Q = G @ np.diag([sig_nu**2, sig_th**2]) @ np.swapaxes(G, 1, 2)
+    Q += 1e-12 * np.eye(2)  # a standing vehicle: no motion noise, still a valid recursion
+    B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
+    return pcrlb_position_rmse(B)
