@@ -116,6 +116,23 @@ def _check_pfa(false_alarm) -> float:
     return pfa
 
 
+def _check_null_args(element_positions, fc, shape):
+    """``(positions (M, 3), fc, (M, Nf, Nt))`` checked, each error naming its parameter."""
+    try:
+        M, nf, nt = (int(v) for v in shape)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"shape: expected (M, Nf, Nt), got {shape!r}") from exc
+    if min(M, nf, nt) < 1 or M * nf * nt > 10**8:
+        raise ValueError(f"shape: expected positive sizes, at most 1e8 samples, got {shape!r}")
+    try:
+        p = np.ascontiguousarray(element_positions, float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError("element_positions: expected a real (M, 3) array") from exc
+    if p.ndim != 2 or p.shape != (M, 3) or not np.all(np.isfinite(p)):
+        raise ValueError(f"element_positions: expected finite ({M}, 3), got {p.shape}")
+    return p, positive("fc", fc), (M, nf, nt)
+
+
 def peak_null(
     element_positions, fc: float, shape, rng, *, n_draws: int = CALIBRATION_DRAWS, n_cells: int = 8
 ) -> tuple[float, float]:
@@ -126,19 +143,11 @@ def peak_null(
     near-exponential cells; its scale ``s`` the mean excess over ``x_q``, the maximum-likelihood
     estimate). Returns ``(x_q, s)``: ``P(peak > t) = TAIL_SHARE e^{-(t - x_q) / s}`` for ``t >=
     x_q``."""
-    p = np.ascontiguousarray(element_positions, float)
-    try:
-        M, nf, nt = (int(v) for v in shape)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"shape: expected (M, Nf, Nt), got {shape!r}") from exc
-    if min(M, nf, nt) < 1:
-        raise ValueError(f"shape: expected positive sizes, got {shape!r}")
-    if p.ndim != 2 or p.shape != (M, 3):
-        raise ValueError(f"element_positions: expected shape ({M}, 3), got {p.shape}")
+    p, fc, (M, nf, nt) = _check_null_args(element_positions, fc, shape)
     if not isinstance(rng, np.random.Generator):
         raise TypeError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
     n_draws = integer("n_draws", n_draws, minimum=10)
-    fc = positive("fc", fc)
+    n_cells = integer("n_cells", n_cells, minimum=1)
     pk = np.empty(n_draws)
     for i in range(n_draws):
         R = rng.standard_normal((M, nf, nt, 2)).view(complex)[..., 0] * np.sqrt(0.5)
@@ -158,9 +167,8 @@ def calibrated_threshold(
     pfa = _check_pfa(false_alarm)
     if pfa > TAIL_SHARE:
         raise ValueError(f"false_alarm: the calibrated tail holds up to {TAIL_SHARE}, got {pfa}")
-    p = np.ascontiguousarray(element_positions, float)
-    fc = positive("fc", fc)
-    key = (p.shape, np.round(p, 9).tobytes(), round(fc, 3), tuple(int(v) for v in shape))
+    p, fc, shape = _check_null_args(element_positions, fc, shape)
+    key = (p.shape, np.round(p, 9).tobytes(), round(fc, 3), shape)
     if key not in _NULL_CACHE:
         rng = np.random.default_rng(CALIBRATION_SEED)
         _NULL_CACHE[key] = peak_null(p, fc, shape, rng)
