@@ -386,3 +386,25 @@ def test_pair_separation_is_the_mahalanobis_distance_of_the_difference_and_flags
         ml.pair_separation(H, th, mf, mt, sigma2)
     with pytest.raises(ValueError, match="noise_power"):
         ml.pair_separation(prob, th, mf, mt, 0.0)
+
+
+def test_ml_order_adds_paths_while_the_residual_holds_one():
+    """The GLRT per added path: three sources well above the noise give three paths; the same
+    scene without its weakest source gives two; noise alone stops at the first path (not
+    detected)."""
+    sc = _scene(11, n_paths=3, snr_db=(0.0, 10.0))
+    pos, srs = sc.element_positions, sc.config
+    est = ml.ml_order(sc.tensor(np.random.default_rng(5)), pos, srs, max_paths=5)
+    assert len(est) == 3 and est.fit_ok
+    weak = int(np.argmin(np.abs(sc.alpha)))
+    keep = np.arange(3) != weak
+    two = replace(sc, sources=sc.sources[keep], d=sc.d[keep], v=sc.v[keep], alpha=sc.alpha[keep])
+    assert len(ml.ml_order(two.tensor(np.random.default_rng(5)), pos, srs, max_paths=5)) == 2
+    shape = sc.tensor().shape
+    noise = channel.add_noise(np.zeros(shape), srs.noise_power, np.random.default_rng(2))
+    one = ml.ml_order(noise, pos, srs, max_paths=3)
+    assert len(one) == 1 and not one.fit.detected.any()
+    with pytest.raises(ValueError, match="max_paths"):
+        ml.ml_order(noise, pos, srs, max_paths=0)
+    with pytest.raises(TypeError, match="n_paths"):
+        ml.ml_order(noise, pos, srs, n_paths=2)

@@ -97,7 +97,8 @@ leaves thousands of noise powers in the residual and still passes it. The residu
 ``FALSE_ALARM`` = 1 %, calibrated by simulating the statistic on noise-only tensors of the
 same array and shape: :func:`~.residual.calibrated_threshold`). The same statistic is the
 generalised likelihood-ratio test (GLRT) of one path more, so it is also the detection test of
-each path: ``MLFit.detected`` marks the paths whose significance passes it. While it fails, a path is started at the peak (grid direction, delay
+each path: ``MLFit.detected`` marks the paths whose significance passes it, and the model
+order (:func:`~.paths.ml_order`) adds paths while the residual still holds one. While it fails, a path is started at the peak (grid direction, delay
 and Doppler, a curvature scan and a single-source fit) and several starts are made from it —
 birth and death, the new path in place of the one whose atom is most like it or of the weakest
 (the weaker of two nearly collinear atoms, if any), and the nearest path split in two in place
@@ -159,7 +160,7 @@ from .fitting import (
     pair_separation,
 )
 from .model import Problem, noise_floor, project_feasible
-from .paths import estimates_from_fit, ml_paths, physical
+from .paths import estimates_from_fit, ml_order, ml_paths, physical
 from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
 from .search import (
     check_start,
@@ -185,6 +186,7 @@ __all__ = [
     "estimates_from_fit",
     "fit_ml",
     "fit_problem",
+    "ml_order",
     "ml_paths",
     "noise_floor",
     "pair_separation",
