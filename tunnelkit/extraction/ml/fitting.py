@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import integer, positive
+from ..._validate import finite_array, integer, positive
 from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
@@ -338,11 +338,13 @@ def pair_separation(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> flo
     if not isinstance(prob, Problem):
         raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
     sigma2 = positive("noise_power", noise_power)
-    theta = np.asarray(theta, float)
+    theta = finite_array("theta", theta, shape=(None, 3))
     L = theta.shape[0]
+    mu_f = finite_array("mu_f", mu_f, shape=(L,))
+    mu_t = finite_array("mu_t", mu_t, shape=(L,))
     if L < 2:
         return float("inf")
-    ev = prob.evaluate(theta, np.asarray(mu_f, float), np.asarray(mu_t, float))
+    ev = prob.evaluate(theta, mu_f, mu_t)
     cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
     C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)  # (L, L, 5, 5) blocks
     x = np.column_stack([theta, mu_f, mu_t])
