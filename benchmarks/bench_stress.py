@@ -17,8 +17,22 @@ paths beyond 6 sigma in any parameter (a missed path counts as beyond), and for 
 (``PathEstimates.fit_ok``) the share of bad snapshots (a path beyond 6 sigma) flagged and of good
 ones flagged. The CRLB takes the SNR the tensor was made with (``snr_offset_db``).
 
+Each bad snapshot is also told apart as a *search* failure or an *identifiability* limit: the
+fit is restarted at the truth (no re-seeding) and the cost it reaches compared with the
+estimate's; when the truth's basin is significantly more likely (the likelihood-ratio
+``2 Delta cost / sigma^2`` above the 99 % quantile of chi-square with ``5 L`` degrees of
+freedom) the search missed the maximum of the likelihood, otherwise the data cannot tell the
+estimate from the truth (two paths closer than they can be resolved, or a path at the noise),
+and the CRLB of the model with every path resolved is not a bound the estimate can reach:
+such snapshots are judged by the flag (the resolution test, ``MLFit.reason``), not by the bound.
+The table also gives the share of unflagged snapshots with a path beyond 6 sigma (what a
+tracker that skips flagged epochs still sees), and the threshold SNR: the lowest SNR offset
+at which every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5).
+
 ``python benchmarks/bench_stress.py --seed S --snapshots 30`` prints the table; the
-settings were chosen on seed 23 and are reported on the held-out seed 2026 too. ``make bench``
+settings were chosen on seed 23 (the design seed); ``HELD_OUT_SEED`` is a seed the settings
+were never tried on before the final run (the seed 2026 of the session before was seen while
+choosing these). ``make bench``
 runs ``report()`` (both seeds, ``TUNNELKIT_BENCH_STRESS`` snapshots per case, default 30).
 """
 
@@ -33,6 +47,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import chi2
 from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -40,10 +55,11 @@ from run import Case
 
 from tunnelkit import evaluation, extraction, scenarios, signal_route
 from tunnelkit.constants import C
+from tunnelkit.extraction import ml
 from tunnelkit.montecarlo import spawn_rngs
 
 PARAMS = ("d", "v", "direction", "w")
-DESIGN_SEED, HELD_OUT_SEED = 23, 2026
+DESIGN_SEED, HELD_OUT_SEED = 23, 8191
 DRIVES = ("italiano2026-straight", "italiano2026-slalom")
 BANDS = {"near": (4.0, 8.0), "mid": (15.0, 45.0), "far": (80.0, 120.0)}
 #: (name, drive or scene kind, band, SNR offset [dB])
@@ -103,7 +119,8 @@ def _drive_snapshot(drive, band, off, rng, search):
     d_true = np.array([p.length for p in paths]) + C * snap.clock_bias
     v_true = np.array([p.velocity for p in paths])
     bound = extraction.path_crlb(paths, arr, route.config, snr_offset_db=off)
-    return _errors(est, d_true, v_true, src, bound), est, dt
+    e = _errors(est, d_true, v_true, src, bound)
+    return e, est, dt, (snap.H, arr.local, route.config, src, d_true, v_true)
 
 
 def close_pair(rng) -> evaluation.Scene:
@@ -128,7 +145,25 @@ def _scene_snapshot(kind, rng, search):
     t = time.process_time()
     est = extraction.extract_paths(H, len(sc.d), sc.element_positions, sc.config, search=search)
     dt = time.process_time() - t
-    return _errors(est, sc.d, sc.v, sc.sources, sc.crlb()), est, dt
+    e = _errors(est, sc.d, sc.v, sc.sources, sc.crlb())
+    return e, est, dt, (H, sc.element_positions, sc.config, sc.sources, sc.d, sc.v)
+
+
+def search_failed(est, truth) -> bool:
+    """Whether the truth's basin of the likelihood is significantly more likely than the
+    estimate (module text): the fit restarted at the truth, ``2 (cost_est - cost_truth) /
+    sigma^2`` against the 99 % quantile of chi-square with ``5 L`` degrees of freedom."""
+    H, pos, cfg, src, d, v = truth
+    r = np.linalg.norm(src, axis=1)
+    th = np.column_stack([src[:, :2] / r[:, None], 1 / r])
+    mf = -2 * np.pi * cfg.tone_spacing * d / C
+    mt = 2 * np.pi * cfg.fc * cfg.symbol_period * v / C
+    sigma2 = est.fit.noise_power
+    at_truth = ml.fit_problem(
+        ml.Problem(H, pos, cfg.fc), (th, mf, mt), noise_power=sigma2, n_reseed=0, search="basic"
+    )
+    lr = 2.0 * (est.fit.cost - at_truth.cost) / sigma2
+    return bool(lr > chi2.ppf(0.99, 5 * len(d)))
 
 
 def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "residual") -> list:
@@ -137,25 +172,32 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
     for case in cases or CASES:
         name, kind, band, off = case
         ci = CASES.index(case)  # the seed of a case does not depend on the selection
-        errs, flags, bad, secs = [], [], [], []
+        errs, flags, bad, secs, srch, reasons = [], [], [], [], [], []
         for rng in spawn_rngs(seed * 1000 + ci, n):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 if band is None:
-                    e, est, dt = _scene_snapshot(kind, rng, search)
+                    e, est, dt, truth = _scene_snapshot(kind, rng, search)
                 else:
-                    e, est, dt = _drive_snapshot(kind, band, off, rng, search)
+                    e, est, dt, truth = _drive_snapshot(kind, band, off, rng, search)
+                b = bool(np.any(~(np.abs(e) <= 6.0)))
+                srch.append(b and search_failed(est, truth))
             errs.append(e)
             flags.append(not est.fit_ok)
-            bad.append(bool(np.any(~(np.abs(e) <= 6.0))))
+            bad.append(b)
             secs.append(dt)
+            reasons.append(est.fit.reason)
         out.append(
             {
                 "case": name,
+                "offset": off,
+                "drive": band is not None,
                 "errors": np.concatenate(errs),
                 "flagged": np.array(flags),
                 "bad": np.array(bad),
+                "search": np.array(srch),
                 "seconds": np.array(secs),
+                "reasons": reasons,
             }
         )
     return out
@@ -165,9 +207,11 @@ def table(rows: list) -> str:
     head = (
         f"{'case':26s} {'paths':>5s} "
         + " ".join(f"{'RMS ' + p:>11s}" for p in PARAMS)
-        + f" {'>6sig':>6s} {'bad':>4s} {'bad flagged':>11s} {'good flagged':>12s} {'median s':>8s}"
+        + f" {'>6sig':>6s} {'bad':>4s} {'search':>6s} {'bad flagged':>11s}"
+        + f" {'good flagged':>12s} {'unflagged>6sig':>14s} {'median s':>8s}"
     )
     lines = [head]
+    meets: dict = {}
     for r in rows:
         e = r["errors"]
         fin = np.all(np.isfinite(e), axis=1)
@@ -177,11 +221,16 @@ def table(rows: list) -> str:
         bad, fl = r["bad"], r["flagged"]
         bf = f"{fl[bad].sum()}/{bad.sum()}"
         gf = f"{fl[~bad].sum()}/{(~bad).sum()}"
+        uf = f"{(bad & ~fl).sum()}/{(~fl).sum()}"
         lines.append(
             f"{r['case']:26s} {len(e):5d} "
             + " ".join(f"{x:11.2f}" for x in rms)
-            + f" {beyond:5.1f}% {bad.sum():4d} {bf:>11s} {gf:>12s} {np.median(r['seconds']):8.3f}"
+            + f" {beyond:5.1f}% {bad.sum():4d} {r['search'].sum():6d} {bf:>11s} {gf:>12s}"
+            + f" {uf:>14s} {np.median(r['seconds']):8.3f}"
         )
+        if r.get("drive"):
+            ok = beyond <= 2.0 and bool(np.all(rms <= 1.5))
+            meets[r["offset"]] = meets.get(r["offset"], True) and ok
     allbad = np.concatenate([r["bad"] for r in rows])
     allfl = np.concatenate([r["flagged"] for r in rows])
     lines.append(
@@ -189,6 +238,26 @@ def table(rows: list) -> str:
         f"{allfl[allbad].sum()} of them flagged; {allfl[~allbad].sum()} of "
         f"{(~allbad).sum()} good snapshots flagged"
     )
+    allsearch = np.concatenate([r["search"] for r in rows])
+    lines.append(
+        f"bad snapshots: {allsearch.sum()} search failures (the truth's basin significantly more "
+        f"likely), {allbad.sum() - allsearch.sum()} identifiability limits"
+    )
+    reasons: dict = {}
+    for r in rows:
+        for why, f in zip(r["reasons"], r["flagged"]):
+            for k in why.split(", ") if f else ():
+                reasons[k] = reasons.get(k, 0) + 1
+    lines.append("flag reasons: " + (", ".join(f"{k} {v}" for k, v in reasons.items()) or "none"))
+    if meets:
+        passing = [o for o in sorted(meets) if all(meets[p] for p in meets if p >= o)]
+        lines.append(
+            "threshold SNR: every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5) "
+            + (f"at offsets >= {passing[0]:+.0f} dB" if passing else "at no offset tried")
+            + " ("
+            + ", ".join(f"{o:+.0f} dB {'met' if meets[o] else 'not met'}" for o in sorted(meets))
+            + ")"
+        )
     return "\n".join(lines)
 
 

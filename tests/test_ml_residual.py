@@ -311,3 +311,100 @@ def test_a_merged_pair_at_long_range_is_split_toward_the_residual_peak():
         assert est.fit.cost <= at_truth.cost + at_truth.noise_power
         err = evaluation.bound_errors(est, d, v, src, bound)
         assert np.all(np.abs(err) < 5.0), err
+
+
+def test_calibrated_threshold_holds_its_false_alarm_rate_on_noise_only_residuals():
+    """The GLRT of one path more at a stated false-alarm rate, calibrated by simulation
+    (``residual.calibrated_threshold``): fresh noise-only tensors (a generator the calibration
+    never saw) exceed it at the stated rate, within the binomial 99 % interval of 400 draws."""
+    pos = arrays.ura(4, 4, LAM / 2)
+    shape = (16, 32, 6)
+    pfa = 0.1
+    thr = residual.calibrated_threshold(pos, FC, shape, pfa)
+    rng = np.random.default_rng(12345)
+    n = 400
+    peaks = np.array(
+        [
+            residual.residual_peak(channel.add_noise(np.zeros(shape), 1.0, rng), pos, FC, 1.0)[0]
+            for _ in range(n)
+        ]
+    )
+    half = 2.58 * np.sqrt(pfa * (1 - pfa) / n)
+    assert abs(np.mean(peaks > thr) - pfa) < half
+    assert residual.calibrated_threshold(pos, FC, shape, 0.01) > thr
+    with pytest.raises(ValueError, match="false_alarm"):
+        residual.calibrated_threshold(pos, FC, shape, 0.5)
+    with pytest.raises(TypeError, match="rng"):
+        residual.peak_null(pos, FC, shape, 0)
+    with pytest.raises(ValueError, match="shape"):
+        residual.peak_null(pos, FC, (16, 32), np.random.default_rng(0))
+    with pytest.raises(ValueError, match="n_draws"):
+        residual.peak_null(pos, FC, shape, np.random.default_rng(0), n_draws=1)
+
+
+def test_pair_separation_is_the_mahalanobis_distance_of_the_difference_and_flags_a_pair():
+    """Brute force: the distance of each pair from the inverse Fisher information computed from
+    a finite-difference Jacobian of the model tensor; two sources closer than their bound can
+    resolve are flagged ``unresolved pair``, the same sources far apart are not."""
+    sc = _scene(41, n_paths=2, snr_db=(5.0, 10.0))
+    H = sc.tensor(np.random.default_rng(3))
+    pos, srs = sc.element_positions, sc.config
+    prob = ml.Problem(H, pos, srs.fc)
+    th, mf, mt = _truth(sc)
+    sigma2 = 0.7
+    sep = ml.pair_separation(prob, th, mf, mt, sigma2)
+    # finite-difference Jacobian of the residual r(theta) = P_perp h over the 10 parameters
+    x0 = np.column_stack([th, mf, mt]).ravel()
+
+    def resid(x):
+        x = x.reshape(2, 5)
+        ev = prob.evaluate(x[:, :3], x[:, 3], x[:, 4], derivatives=False)
+        return (H - prob.model(x[:, :3], x[:, 3], x[:, 4], ev["c"])).ravel()
+
+    h = 1e-7
+    J = np.stack([(resid(x0 + h * e) - resid(x0 - h * e)) / (2 * h) for e in np.eye(10)], 1)
+    cov = np.linalg.inv(2 * np.real(J.conj().T @ J) / sigma2)
+    D = x0[:5] - x0[5:]
+    S = cov[:5, :5] + cov[5:, 5:] - cov[:5, 5:] - cov[5:, :5]
+    assert sep == pytest.approx(np.sqrt(D @ np.linalg.solve(S, D)), rel=1e-3)
+    assert ml.pair_separation(prob, th[:1], mf[:1], mt[:1], sigma2) == np.inf
+    # the second source moved onto the first (a fortieth of a beamwidth, same delay/Doppler)
+    src = sc.sources.copy()
+    r0 = np.linalg.norm(src[0])
+    u = src[0, :2] / r0 + [0.005, 0.0]
+    src[1] = r0 * np.append(u, np.sqrt(1 - u @ u))
+    close = replace(sc, sources=src, d=np.array([sc.d[0], sc.d[0]]), v=np.array([sc.v[0]] * 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.extract_paths(close.tensor(np.random.default_rng(3)), 2, pos, srs)
+        far = extraction.extract_paths(H, 2, pos, srs)
+    assert est.fit_ok is False and "unresolved pair" in est.fit.reason
+    assert est.fit.separation < ml.fitting.RESOLVE_Z
+    assert far.fit_ok is True and far.fit.reason == "" and far.fit.separation > 50.0
+    assert far.fit.detected.all()
+    with pytest.raises(TypeError, match="prob"):
+        ml.pair_separation(H, th, mf, mt, sigma2)
+    with pytest.raises(ValueError, match="noise_power"):
+        ml.pair_separation(prob, th, mf, mt, 0.0)
+
+
+def test_ml_order_adds_paths_while_the_residual_holds_one():
+    """The GLRT per added path: three sources well above the noise give three paths; the same
+    scene without its weakest source gives two; noise alone stops at the first path (not
+    detected)."""
+    sc = _scene(11, n_paths=3, snr_db=(0.0, 10.0))
+    pos, srs = sc.element_positions, sc.config
+    est = ml.ml_order(sc.tensor(np.random.default_rng(5)), pos, srs, max_paths=5)
+    assert len(est) == 3 and est.fit_ok
+    weak = int(np.argmin(np.abs(sc.alpha)))
+    keep = np.arange(3) != weak
+    two = replace(sc, sources=sc.sources[keep], d=sc.d[keep], v=sc.v[keep], alpha=sc.alpha[keep])
+    assert len(ml.ml_order(two.tensor(np.random.default_rng(5)), pos, srs, max_paths=5)) == 2
+    shape = sc.tensor().shape
+    noise = channel.add_noise(np.zeros(shape), srs.noise_power, np.random.default_rng(2))
+    one = ml.ml_order(noise, pos, srs, max_paths=3)
+    assert len(one) == 1 and not one.fit.detected.any()
+    with pytest.raises(ValueError, match="max_paths"):
+        ml.ml_order(noise, pos, srs, max_paths=0)
+    with pytest.raises(TypeError, match="n_paths"):
+        ml.ml_order(noise, pos, srs, n_paths=2)

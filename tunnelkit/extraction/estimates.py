@@ -42,7 +42,8 @@ class PathEstimates:
     power, basin test) on that route, ``None`` on the others; ``significance`` each path's
     log-likelihood ratio against noise on that route (sorted like the rest), ``None`` elsewhere;
     ``fit_ok`` the ML stage's verdict on its own fit (``MLFit.fit_ok``: no structured residual
-    left, every path above the noise), ``None`` on the routes that do not test themselves.
+    left, every path above the noise, every two paths resolved; ``fit.reason`` names a failed
+    test), ``None`` on the routes that do not test themselves.
     """
 
     alpha: np.ndarray

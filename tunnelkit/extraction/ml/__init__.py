@@ -94,7 +94,11 @@ delay resolution from the line of sight, a fit that merged two of them and count
 leaves thousands of noise powers in the residual and still passes it. The residual test of
 :mod:`.residual` looks at the largest peak of the residual's single-path periodogram instead
 (exponential with mean 1 per grid point under noise; threshold at the false-alarm rate
-``FALSE_ALARM`` = 1 %). While it fails, a path is started at the peak (grid direction, delay
+``FALSE_ALARM`` = 1 %, calibrated by simulating the statistic on noise-only tensors of the
+same array and shape: :func:`~.residual.calibrated_threshold`). The same statistic is the
+generalised likelihood-ratio test (GLRT) of one path more, so it is also the detection test of
+each path: ``MLFit.detected`` marks the paths whose significance passes it, and the model
+order (:func:`~.paths.ml_order`) adds paths while the residual still holds one. While it fails, a path is started at the peak (grid direction, delay
 and Doppler, a curvature scan and a single-source fit) and several starts are made from it —
 birth and death, the new path in place of the one whose atom is most like it or of the weakest
 (the weaker of two nearly collinear atoms, if any), and the nearest path split in two in place
@@ -104,7 +108,11 @@ that side) — each given ``RANK_ITER`` iterations, ranked by the likelihood, th
 to convergence and kept if the likelihood rises (SAGE / RIMAX re-initialisation; the moves on
 ``rho`` below follow when the energy test still fails). ``MLFit.fit_ok`` (and
 ``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their
-thresholds and every path above the noise (``MIN_SIGNIFICANCE``). ``search="basic"`` skips the
+thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
+further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical
+resolution limit, :func:`~.fitting.pair_separation`: below it the likelihood has no separate
+peak for each and the errors leave the local bound however well the search does);
+``MLFit.reason`` names the tests a fit failed. ``search="basic"`` skips the
 re-initialisation (the route before it, for comparison).
 
 A search takes the dominant rank-one term of its tensor (power iterations), the periodogram peaks
@@ -149,10 +157,11 @@ from .fitting import (
     MLFit,
     fit_ml,
     fit_problem,
+    pair_separation,
 )
 from .model import Problem, noise_floor, project_feasible
-from .paths import estimates_from_fit, ml_paths, physical
-from .residual import FALSE_ALARM, peak_threshold, residual_peak
+from .paths import estimates_from_fit, ml_order, ml_paths, physical
+from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
 from .search import (
     check_start,
     complete_paths,
@@ -171,14 +180,18 @@ __all__ = [
     "MLFit",
     "Problem",
     "WidebandProblem",
+    "calibrated_threshold",
     "check_start",
     "complete_paths",
     "estimates_from_fit",
     "fit_ml",
     "fit_problem",
+    "ml_order",
     "ml_paths",
     "noise_floor",
+    "pair_separation",
     "path_from_peak",
+    "peak_null",
     "peak_threshold",
     "physical",
     "project_feasible",

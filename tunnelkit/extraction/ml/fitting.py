@@ -10,17 +10,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import integer, positive
+from ..._validate import finite_array, integer, positive
 from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
 from ..radio import check_array, check_srs
 from .model import W_MAX, Problem, project_feasible
-from .residual import FALSE_ALARM, peak_threshold, residual_peak
+from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .search import check_start, path_from_peak, search_path
 
 __all__ = [
     "MAX_ITER",
+    "RESOLVE_Z",
     "RHO_Z",
     "SEARCHES",
     "SPLIT_STEPS",
@@ -30,10 +31,15 @@ __all__ = [
     "MLFit",
     "fit_ml",
     "fit_problem",
+    "pair_separation",
 ]
 
 STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
+#: resolution test: two paths closer than this many standard deviations of their difference
+#: (:func:`pair_separation`) are in the threshold region of resolution: the likelihood cannot
+#: place them, and the local bound does not describe their errors
+RESOLVE_Z = 5.0
 #: cap on ``max_iter`` (Levenberg-Marquardt iterations per fit) and on ``n_reseed``: an iteration
 #: is one pass over the tensor (~5-10 ms at M = 100, Nf = 410, Nt = 12); a fit that has not
 #: converged in 1,000 is not converging, and more would take hours over a drive
@@ -60,8 +66,16 @@ class MLFit:
     ``n_iter`` Levenberg-Marquardt iterations in all, ``n_reseed`` kept re-seedings,
     ``converged`` the stopping rule was met; ``peak`` the largest peak of the residual's
     single-path periodogram in noise powers and ``peak_max`` its threshold at the false-alarm
-    rate ``FALSE_ALARM`` (:mod:`.residual`); ``fit_ok`` the fit passed every test: the
-    residual peak and ``rho`` below their thresholds and all ``L`` paths above the noise."""
+    rate ``FALSE_ALARM`` (:mod:`.residual`, calibrated on noise-only tensors: the GLRT of one
+    path more); ``detected`` (L,) each path's GLRT against that threshold (``significance >=
+    peak_max``: the path would have been added from the noise with probability below
+    ``FALSE_ALARM``); ``separation`` the smallest distance of two paths in standard deviations
+    of their difference (:func:`pair_separation`); ``fit_ok`` the fit passed every test: the
+    residual peak and ``rho`` below their thresholds, all ``L`` paths above the noise and every
+    two paths resolved (``separation >= RESOLVE_Z``); ``reason`` the tests it failed
+    (``"residual peak"``: a path missed or a wrong basin; ``"residual energy"``; ``"path below
+    the noise"``; ``"unresolved pair"``: the threshold region of two paths closer than their
+    bound can tell), ``""`` when it passed."""
 
     theta: np.ndarray
     mu_f: np.ndarray
@@ -79,6 +93,9 @@ class MLFit:
     peak: float = 0.0
     peak_max: float = np.inf
     fit_ok: bool = True
+    detected: np.ndarray | None = field(default=None, repr=False)
+    separation: float = np.inf
+    reason: str = ""
 
 
 def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
@@ -311,6 +328,33 @@ def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, histor
     return best, n_it, kept
 
 
+def pair_separation(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> float:
+    """The smallest distance between two paths in standard deviations of their difference: for
+    each pair ``(i, j)`` the Mahalanobis length of ``Delta = (u_x, u_y, w, mu_f, mu_t)_i - (...)_j``
+    under the covariance of that difference, ``Sigma_ii + Sigma_jj - Sigma_ij - Sigma_ji``,
+    ``Sigma = (sigma^2 / 2) (Re J^H J)^+`` (the inverse Fisher information of the concentrated
+    model at the fit). ``inf`` for one path. A pair a few standard deviations apart is below the
+    statistical resolution limit: the likelihood has no single peak for it to sit on."""
+    if not isinstance(prob, Problem):
+        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
+    sigma2 = positive("noise_power", noise_power)
+    theta = finite_array("theta", theta, shape=(None, 3))
+    L = theta.shape[0]
+    mu_f = finite_array("mu_f", mu_f, shape=(L,))
+    mu_t = finite_array("mu_t", mu_t, shape=(L,))
+    if L < 2:
+        return float("inf")
+    ev = prob.evaluate(theta, mu_f, mu_t)
+    cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
+    C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)  # (L, L, 5, 5) blocks
+    x = np.column_stack([theta, mu_f, mu_t])
+    i, j = np.triu_indices(L, 1)
+    S = C5[i, i] + C5[j, j] - C5[i, j] - C5[j, i]  # (P, 5, 5)
+    D = x[i] - x[j]
+    q = np.einsum("pa,pa->p", D, np.linalg.solve(S + 1e-300 * np.eye(5), D[..., None])[..., 0])
+    return float(np.sqrt(max(float(np.min(q)), 0.0)))
+
+
 def _significance(ev, sigma2) -> np.ndarray:
     """Per path: the cost increase if it were removed (gains re-projected), over ``sigma2``."""
     Gi = np.linalg.pinv(ev["G"])
@@ -409,7 +453,7 @@ def fit_problem(
     best = _lm(prob, theta, mu_f, mu_t, sigma2, max_iter)
     n_it, kept = best[4], 0
     history = [best[3]["cost"] / (dof * sigma2)]
-    peak_max = peak_threshold(prob.N, FALSE_ALARM)
+    peak_max = calibrated_threshold(prob.pos, prob.k0 * C / (2 * np.pi), prob.H.shape, FALSE_ALARM)
     peak = _peak_of(prob, best, sigma2)
     if n_reseed and search == "residual":
         best, peak, its, n_kept = _peak_reseed(
@@ -437,9 +481,15 @@ def fit_problem(
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
     significance = _significance(ev, sigma2)
-    fit_ok = bool(
-        rho <= rho_max and peak[0] <= peak_max and np.all(significance >= MIN_SIGNIFICANCE)
-    )
+    separation = pair_separation(prob, theta, mu_f, mu_t, sigma2)
+    failed = {
+        "residual peak": peak[0] > peak_max,
+        "residual energy": rho > rho_max,
+        "path below the noise": not np.all(significance >= MIN_SIGNIFICANCE),
+        "unresolved pair": not separation >= RESOLVE_Z,
+    }
+    reason = ", ".join(k for k, v in failed.items() if v)
+    fit_ok = not reason
     if peak[0] > peak_max:
         warnings.warn(
             f"fit_ml: the residual's periodogram peaks at {peak[0]:.0f} noise powers (test: "
@@ -472,4 +522,7 @@ def fit_problem(
         float(peak[0]),
         float(peak_max),
         fit_ok,
+        significance >= peak_max,
+        float(separation),
+        reason,
     )
