@@ -17,6 +17,11 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    (white across tones and elements for the diffuse part; the higher-order specular paths are
    not white, so the second bound is optimistic about what they cost).
 
+3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
+   direct path-by-path sum against the non-uniform FFT (``method="nufft"``, ``eps=1e-9``), on
+   ``--synthesis-epochs`` epochs traced afresh per drive (not from the cache, which keeps only the
+   tensor): median seconds per epoch of each, their ratio per epoch, and the relative error.
+
     TUNNELKIT_RT_CACHE=/tmp/rt python benchmarks/bench_rt_channel.py --epochs-every 4 --draws 3
 """
 
@@ -58,6 +63,28 @@ def trace_costs(route) -> dict:
         "power": [e["power"] for e in eps],
         "count": [e["count"] for e in eps],
     }
+
+
+def synthesis_speed(route, n_epochs: int) -> dict:
+    """Direct sum vs NUFFT on ``n_epochs`` epochs spread over the drive, traced afresh."""
+    from tunnelkit.rt import element_tensor
+
+    rc, cfg = route.raytraced, route.config
+    ks = np.linspace(0, len(route.trajectory) - 1, n_epochs).round().astype(int)
+    out = {"epochs": ks.tolist(), "direct_s": [], "nufft_s": [], "rel_error": [], "paths": []}
+    for k in ks:
+        _, ep, _ = rc.trace(int(k))
+        sel = ep.valid & (ep.order > 0)
+        args = (ep, cfg.tone_spacing, cfg.n_tones, cfg.symbol_period, cfg.n_symbols)
+        H = {}
+        for method in ("direct", "nufft"):
+            t0 = time.perf_counter()
+            H[method] = element_tensor(*args, select=sel, method=method)
+            out[f"{method}_s"].append(time.perf_counter() - t0)
+        ref = np.linalg.norm(H["direct"])
+        out["rel_error"].append(float(np.linalg.norm(H["nufft"] - H["direct"]) / ref))
+        out["paths"].append(float(sel.sum() / ep.M))
+    return out
 
 
 def _errors(ep, config, snr_offset_db=0.0) -> np.ndarray:
@@ -116,8 +143,15 @@ def _summary(e: np.ndarray) -> dict:
     }
 
 
-def report(costs: dict, studies: dict) -> str:
+def report(costs: dict, studies: dict, synth: dict | None = None) -> str:
     lines = []
+    for name, s in (synth or {}).items():
+        d, n = np.array(s["direct_s"]), np.array(s["nufft_s"])
+        lines.append(
+            f"{name}: synthesis on {len(d)} epochs ({np.median(s['paths']):.0f} paths/element): "
+            f"direct median {np.median(d):.2f} s, NUFFT median {np.median(n):.3f} s, speed-up "
+            f"median {np.median(d / n):.0f}x, relative error max {max(s['rel_error']):.1e}"
+        )
     for name, c in costs.items():
         p = {k: np.array([x[k] for x in c["power"]]) for k in c["power"][0]}
         tot = sum(p.values())
@@ -154,15 +188,27 @@ def main(argv=None) -> int:
     ap.add_argument("--epochs-every", type=int, default=4)
     ap.add_argument("--draws", type=int, default=3)
     ap.add_argument("--seed", type=int, default=26)
+    ap.add_argument("--synthesis-epochs", type=int, default=3)
+    ap.add_argument(
+        "--only", choices=("all", "synthesis"), default="all", help="synthesis: item 3 alone"
+    )
     ap.add_argument("--json", type=Path, default=None)
     a = ap.parse_args(argv)
-    costs = {n: trace_costs(SignalRoute.from_scenario(n, channel="sionna")) for n in DRIVES}
-    studies = {n: extraction_study(n, a.epochs_every, a.draws, a.seed) for n in DRIVES}
-    print(report(costs, studies))
+    synth = {
+        n: synthesis_speed(SignalRoute.from_scenario(n, channel="sionna"), a.synthesis_epochs)
+        for n in DRIVES
+    }
+    costs: dict = {}
+    studies: dict = {}
+    if a.only == "all":
+        costs = {n: trace_costs(SignalRoute.from_scenario(n, channel="sionna")) for n in DRIVES}
+        studies = {n: extraction_study(n, a.epochs_every, a.draws, a.seed) for n in DRIVES}
+    print(report(costs, studies, synth))
     if a.json:
         a.json.write_text(
             json.dumps(
                 {
+                    "synthesis": synth,
                     "costs": costs,
                     "studies": {
                         n: {
