@@ -413,3 +413,48 @@ def test_element_pattern_is_oriented_along_the_boresight():
     assert abs(measured - expected(b)) < 1.0, (measured, expected(b))
     up = np.array([b[0], b[1], -b[2]])  # the same boresight tilted up
     assert abs(measured - expected(up)) > 1.0
+
+
+# --- bad input without Sionna: a cache of another scene version ------------------------------------
+def test_cache_of_another_scene_version_is_rebuilt_without_sionna(tmp_path):
+    """The key hashes the exported scene: a tunnel changed under the same label (a road marking
+    moved) is detected on the directory check and the cache emptied, before any trace; a
+    corrupt meta.json is treated the same way; the same scene keeps its files."""
+    sc = tk.load_scenario("italiano2026-straight")
+    tun, cfg = sc.tunnel(), channel.SRSConfig.from_scenario(sc)
+    arrays, traj = propagation.scenario_arrays(sc), sc.trajectory(tun)
+    rc = rt.RayTracedChannel(tun, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    d = rc.directory()
+    (d / "epoch-000.npz").write_bytes(b"old")
+    same = rt.RayTracedChannel(tun, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert same.directory() == d and (d / "epoch-000.npz").is_file()
+    plate = tun.plates[0]
+    moved = dataclasses.replace(
+        tun,
+        plates=(
+            dataclasses.replace(plate, corner=plate.corner + np.array([1.0, 0.0, 0.0])),
+            *tun.plates[1:],
+        ),
+    )
+    other = rt.RayTracedChannel(moved, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    assert other.key()["scene"] != rc.key()["scene"]
+    with pytest.warns(UserWarning, match="another scene"):
+        assert other.directory() == d
+    assert not (d / "epoch-000.npz").exists()
+    assert json.loads((d / "meta.json").read_text()) == other.key()
+    (d / "epoch-001.npz").write_bytes(b"old")
+    (d / "meta.json").write_text("{not json")
+    again = rt.RayTracedChannel(moved, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    with pytest.warns(UserWarning, match="another scene"):
+        again.directory()
+    assert not (d / "epoch-001.npz").exists()
+
+
+def test_scenario_refuses_unknown_material_for_each_surface(tmp_path):
+    for key in ("wall_material", "road_material", "rrm_material"):
+        with pytest.raises(ScenarioError, match=key):
+            _scenario_with(tmp_path, f'{key} = "unobtainium"')
+    with pytest.raises(ScenarioError, match="metal_scattering_coefficient"):
+        _scenario_with(tmp_path, "metal_scattering_coefficient = -0.5")

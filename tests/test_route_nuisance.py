@@ -1,0 +1,109 @@
+"""The route's nuisance model: second-order paths in the model, the diffuse floor of the ML test."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from tunnelkit import channel, propagation, rt
+from tunnelkit.arrays import make_array
+from tunnelkit.signal_route import SignalRoute
+from tunnelkit.studies import drives
+
+
+def _small_route(**kw) -> SignalRoute:
+    """The straight preset with 4 x 4 arrays at the preset's mounts (fast ML fits)."""
+    route = SignalRoute.from_scenario("italiano2026-straight", **kw)
+    small = [
+        make_array(
+            4,
+            4,
+            fc=route.config.fc,
+            azimuth=np.arctan2(a.boresight[1], a.boresight[0]),
+            elevation=np.radians(-30.0),
+            origin=a.origin,
+            name=a.name,
+        )
+        for a in route.arrays
+    ]
+    return dataclasses.replace(route, arrays=small)
+
+
+def test_second_order_paths_in_the_model():
+    k = 12
+    base = SignalRoute.from_scenario("italiano2026-straight")
+    arr, first = base.paths(k)
+    every = propagation.second_order_paths(
+        base.tunnel,
+        arr,
+        base.trajectory.position[k],
+        base.trajectory.velocity[k],
+        fc=base.config.fc,
+    )
+    assert len(every) >= 3
+    for n in (1, 2, 30):
+        _, ps = dataclasses.replace(base, second_order=n).paths(k)
+        assert [p.length for p in ps[: len(first)]] == [p.length for p in first]
+        extra = ps[len(first) :]
+        assert len(extra) == min(n, len(every))
+        strongest = sorted(abs(p.gain) for p in every)[::-1][: len(extra)]
+        assert sorted(abs(p.gain) for p in extra)[::-1] == strongest
+        assert all(p.kind == propagation.SECOND_ORDER for p in extra)
+
+
+def test_image_channel_with_second_order_paths_is_fitted_and_they_are_dropped():
+    """On the image channel with the second-order paths synthesised (option (a)), the ML route
+    with them in its model passes its own fit test; the first-order-only model on the same
+    tensor does not. The estimates of the second-order paths never reach the measurements."""
+    route = _small_route(second_order=3)
+    k = 12
+    ep = route.epoch(k, np.random.default_rng(3))
+    n1 = sum(p.kind != propagation.SECOND_ORDER for p in ep.paths)
+    assert len(ep.paths) > n1 and len(ep.estimates) == len(ep.paths)
+    assert ep.estimates.fit_ok is True
+    ti = np.asarray(ep.truth_index)
+    assert ti.size and np.all((ti >= 0) & (ti < n1))
+    assert len(ep.measurements) >= n1 - 1
+    # same tensor, first-order model: the second-order power is a structured residual
+    with pytest.warns(UserWarning, match="fit_ok = False"):
+        est = route.extract(ep.snapshot.H, ep.array, n1)
+    assert est.fit_ok is False
+
+
+def test_route_nuisance_options_validate(tmp_path):
+    with pytest.raises(ValueError, match="second_order"):
+        SignalRoute.from_scenario("italiano2026-straight", second_order=-1)
+    with pytest.raises(ValueError, match="second_order"):
+        SignalRoute.from_scenario("italiano2026-straight", second_order=1000)
+    with pytest.raises(ValueError, match="diffuse_floor"):
+        SignalRoute.from_scenario("italiano2026-straight", diffuse_floor=True)
+    with pytest.raises((TypeError, ValueError), match="diffuse_floor"):
+        SignalRoute.from_scenario(
+            "italiano2026-straight", channel="sionna", diffuse_floor="yes", cache_dir=tmp_path
+        )
+    with pytest.raises(ValueError, match="nuisance"):
+        drives.scenario_route("italiano2026-straight", nuisance={"third_order": 1})
+
+
+def test_diffuse_floor_is_noise_plus_diffuse_power(tmp_path, monkeypatch):
+    route = SignalRoute.from_scenario(
+        "italiano2026-straight", channel="sionna", diffuse_floor=True, cache_dir=tmp_path
+    )
+    assert isinstance(route.raytraced, rt.RayTracedChannel)
+    monkeypatch.setattr(
+        route.raytraced, "epoch", lambda k, tunnel=None: {"power": {"diffuse": 2e-9 * (k + 1)}}
+    )
+    snap = channel.ChannelSnapshot(
+        np.zeros((1, 1, 1), complex), 1e-12, 0.0, "exact", (), route.config
+    )
+    got = route.ml_noise_power(4, snap)
+    assert got == pytest.approx(1e-12 + route.config.tx_power * 1e-8)
+    assert dataclasses.replace(route, diffuse_floor=False).ml_noise_power(4, snap) is None
+    # the routes built by name are kept per nuisance setting
+    a = drives.scenario_route("italiano2026-straight", nuisance={"second_order": 2})
+    assert a.second_order == 2 and a is drives.scenario_route(
+        "italiano2026-straight", nuisance={"second_order": 2}
+    )
+    assert drives.scenario_route("italiano2026-straight").second_order == 0
