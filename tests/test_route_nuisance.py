@@ -88,3 +88,15 @@ def test_diffuse_floor_is_noise_plus_diffuse_power(tmp_path, monkeypatch):
         "italiano2026-straight", nuisance={"second_order": 2}
     )
     assert drives.scenario_route("italiano2026-straight").second_order == 0
+
+
+def test_reproduce_nuisance_options_are_refused_where_they_do_not_apply(capsys):
+    from tunnelkit.cli import main
+    from tunnelkit.reproduce import run
+
+    with pytest.raises(ValueError, match="nuisance"):
+        run("jiang-crlb", runs=1, nuisance={"second_order": 2})
+    assert main(["reproduce", "jiang-crlb", "--second-order", "2"]) == 2
+    assert "--second-order" in capsys.readouterr().err
+    assert main(["reproduce", "javelin-table1", "--diffuse-floor"]) == 2
+    assert "--channel sionna" in capsys.readouterr().err

@@ -333,9 +333,14 @@ def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     channels=("image", "sionna"),
 )
 def javelin_table1(
-    runs: int, seed: int, progress: bool, channel: str = "image", **parallel
+    runs: int,
+    seed: int,
+    progress: bool,
+    channel: str = "image",
+    nuisance: dict | None = None,
+    **parallel,
 ) -> Report:
-    """Table 1 (straight trajectory)."""
+    """Table 1 (straight trajectory); ``nuisance`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-straight",
         "italiano2026_table1",
@@ -344,6 +349,7 @@ def javelin_table1(
         seed,
         progress,
         channel=channel,
+        nuisance=nuisance,
         **parallel,
     )
 
@@ -357,9 +363,14 @@ def javelin_table1(
     channels=("image", "sionna"),
 )
 def javelin_table2(
-    runs: int, seed: int, progress: bool, channel: str = "image", **parallel
+    runs: int,
+    seed: int,
+    progress: bool,
+    channel: str = "image",
+    nuisance: dict | None = None,
+    **parallel,
 ) -> Report:
-    """Table 2 (slalom trajectory)."""
+    """Table 2 (slalom trajectory); ``nuisance`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-slalom",
         "italiano2026_table2",
@@ -368,5 +379,6 @@ def javelin_table2(
         seed,
         progress,
         channel=channel,
+        nuisance=nuisance,
         **parallel,
     )

@@ -155,6 +155,30 @@ def separate_epoch(ep, config):
     return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 
+def _nuisance(nuisance) -> dict:
+    """``nuisance`` checked: ``None`` or a dict of ``second_order`` (int) / ``diffuse_floor``."""
+    from .._validate import boolean
+    from ..signal_route import MAX_SECOND_ORDER
+
+    if nuisance is None:
+        return {}
+    if not isinstance(nuisance, dict):
+        raise TypeError(
+            f"nuisance: expected a dict of second_order / diffuse_floor, got {type(nuisance).__name__}"
+        )
+    unknown = sorted(map(str, set(nuisance) - {"second_order", "diffuse_floor"}))
+    if unknown:
+        raise ValueError(f"nuisance: expected second_order / diffuse_floor, got {unknown}")
+    out = {}
+    if "second_order" in nuisance:
+        out["second_order"] = integer(
+            "nuisance.second_order", nuisance["second_order"], minimum=0, maximum=MAX_SECOND_ORDER
+        )
+    if "diffuse_floor" in nuisance:
+        out["diffuse_floor"] = boolean("nuisance.diffuse_floor", nuisance["diffuse_floor"])
+    return out
+
+
 def scenario_route(
     route, model: str = "exact", channel: str | None = None, nuisance: dict | None = None
 ) -> SignalRoute:
@@ -162,10 +186,7 @@ def scenario_route(
     route of a scenario name built once per ``(name, model, channel, nuisance)`` and kept
     (``channel`` :data:`~tunnelkit.signal_route.CHANNELS`, "image" by default; ``nuisance`` the
     route's ``second_order`` / ``diffuse_floor`` fields, none by default)."""
-    nuisance = dict(nuisance or {})
-    unknown = sorted(set(nuisance) - {"second_order", "diffuse_floor"})
-    if unknown:
-        raise ValueError(f"nuisance: expected second_order / diffuse_floor, got {unknown}")
+    nuisance = _nuisance(nuisance)
     if isinstance(route, SignalRoute):
         if channel is not None and channel != route.channel:
             raise ValueError(
