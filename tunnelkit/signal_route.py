@@ -397,6 +397,15 @@ class SignalRoute:
         """The noise power the ML extraction tests its fit against at epoch ``k``: ``None``
         (estimated from the tensor) unless ``diffuse_floor``, then the snapshot's noise power
         plus the transmit power times the epoch's diffuse power per element (ray tracer)."""
+        k = integer("k", k, minimum=0, maximum=len(self.trajectory) - 1)
+        if not isinstance(snapshot, ChannelSnapshot):
+            raise TypeError(
+                f"snapshot: expected a channel.ChannelSnapshot, got {type(snapshot).__name__}"
+            )
+        if tunnel is not None and type(tunnel) is not type(self.tunnel):
+            raise TypeError(
+                f"tunnel: expected a {type(self.tunnel).__name__}, got {type(tunnel).__name__}"
+            )
         if not self.diffuse_floor:
             return None
         tun = self.tunnel if tunnel is None else tunnel
