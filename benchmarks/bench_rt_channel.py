@@ -15,8 +15,12 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    P_specular2+)`` (every unmodelled path), with the mean power per element of those paths:
    their sum over many paths of random phase acts on each tensor entry like noise of that power
    (white across tones and elements for the diffuse part; the higher-order specular paths are
-   not white, so the second bound is optimistic about what they cost).
-
+   not white, so the second bound is optimistic about what they cost). Routes (``--routes``):
+   ``image``, ``sionna`` (first-order model), ``sionna_floor`` (the same, its fit tested against
+   noise + diffuse power, ``SignalRoute(diffuse_floor=True)``), ``sionna_2nd`` (the model also
+   carries the ``--second-order`` strongest second-order images, ``SignalRoute(second_order=N)``;
+   the bound is then the whole model's CRLB) and ``sionna_2nd_floor`` (both). Also the number of
+   draws each route's extraction flags (``fit_ok`` False).
 3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
    direct path-by-path sum against the non-uniform FFT (``method="nufft"``, ``eps=1e-9``), on
    ``--synthesis-epochs`` epochs traced afresh per drive (not from the cache, which keeps only the
