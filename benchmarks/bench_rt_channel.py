@@ -15,7 +15,16 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    P_specular2+)`` (every unmodelled path), with the mean power per element of those paths:
    their sum over many paths of random phase acts on each tensor entry like noise of that power
    (white across tones and elements for the diffuse part; the higher-order specular paths are
-   not white, so the second bound is optimistic about what they cost).
+   not white, so the second bound is optimistic about what they cost). Routes (``--routes``):
+   ``image``, ``sionna`` (first-order model), ``sionna_floor`` (the same, its fit tested against
+   noise + diffuse power, ``SignalRoute(diffuse_floor=True)``), ``sionna_2nd`` (the model also
+   carries the ``--second-order`` strongest second-order images, ``SignalRoute(second_order=N)``;
+   the bound is then the whole model's CRLB) and ``sionna_2nd_floor`` (both). Also the number of
+   draws each route's extraction flags (``fit_ok`` False).
+3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
+   direct path-by-path sum against the non-uniform FFT (``method="nufft"``, ``eps=1e-9``), on
+   ``--synthesis-epochs`` epochs traced afresh per drive (not from the cache, which keeps only the
+   tensor): median seconds per epoch of each, their ratio per epoch, and the relative error.
 
     TUNNELKIT_RT_CACHE=/tmp/rt python benchmarks/bench_rt_channel.py --epochs-every 4 --draws 3
 """
@@ -37,6 +46,7 @@ sys.path.insert(0, str(ROOT))
 from tunnelkit import evaluation, extraction
 from tunnelkit.constants import C
 from tunnelkit.montecarlo import spawn_rngs
+from tunnelkit.propagation import SECOND_ORDER
 from tunnelkit.signal_route import SignalRoute
 
 DRIVES = ("italiano2026-straight", "italiano2026-slalom")
@@ -60,48 +70,107 @@ def trace_costs(route) -> dict:
     }
 
 
+def synthesis_speed(route, n_epochs: int) -> dict:
+    """Direct sum vs NUFFT on ``n_epochs`` epochs spread over the drive, traced afresh."""
+    from tunnelkit.rt import element_tensor
+
+    rc, cfg = route.raytraced, route.config
+    ks = np.linspace(0, len(route.trajectory) - 1, n_epochs).round().astype(int)
+    out = {"epochs": ks.tolist(), "direct_s": [], "nufft_s": [], "rel_error": [], "paths": []}
+    for k in ks:
+        _, ep, _ = rc.trace(int(k))
+        sel = ep.valid & (ep.order > 0)
+        args = (ep, cfg.tone_spacing, cfg.n_tones, cfg.symbol_period, cfg.n_symbols)
+        H = {}
+        for method in ("direct", "nufft"):
+            t0 = time.perf_counter()
+            H[method] = element_tensor(*args, select=sel, method=method)
+            out[f"{method}_s"].append(time.perf_counter() - t0)
+        ref = np.linalg.norm(H["direct"])
+        out["rel_error"].append(float(np.linalg.norm(H["nufft"] - H["direct"]) / ref))
+        out["paths"].append(float(sel.sum() / ep.M))
+    return out
+
+
 def _errors(ep, config, snr_offset_db=0.0) -> np.ndarray:
+    """|error| / CRLB of the first-order paths of ``ep`` (the bound of the route's whole model:
+    with second-order nuisance paths in it, they are in the Fisher information too)."""
     src = np.stack([ep.array.to_local(p.source) for p in ep.paths])
     d_true = np.array([p.length for p in ep.paths]) + C * ep.snapshot.clock_bias
     v_true = np.array([p.velocity for p in ep.paths])
     bound = extraction.path_crlb(ep.paths, ep.array, config, snr_offset_db=snr_offset_db)
-    return evaluation.normalized_errors(ep.estimates, d_true, v_true, src, bound)
+    e = evaluation.normalized_errors(ep.estimates, d_true, v_true, src, bound)
+    return e[[p.kind != SECOND_ORDER for p in ep.paths]]
 
 
-def extraction_study(name: str, every: int, draws: int, seed: int) -> dict:
-    """Normalised errors of the first-order paths on both channels (same rng per draw)."""
+ROUTES = ("image", "sionna", "sionna_floor", "sionna_2nd", "sionna_2nd_floor")
+
+
+def extraction_study(
+    name: str, every: int, draws: int, seed: int, second_order: int, which=ROUTES
+) -> dict:
+    """Normalised errors of the first-order paths on both channels (same rng per draw), and on
+    the ray-traced channel with ``second_order`` second-order paths in the model; the share of
+    draws each route's extraction flags (``fit_ok`` False), also with the fit tested against
+    noise + diffuse power (``diffuse_floor``)."""
     img = SignalRoute.from_scenario(name)
     srt = SignalRoute.from_scenario(name, channel="sionna")
+    srt2 = SignalRoute.from_scenario(name, channel="sionna", second_order=second_order)
+    routes = {
+        "image": img,
+        "sionna": srt,
+        "sionna_floor": SignalRoute.from_scenario(name, channel="sionna", diffuse_floor=True),
+        "sionna_2nd": srt2,
+        "sionna_2nd_floor": SignalRoute.from_scenario(
+            name, channel="sionna", second_order=second_order, diffuse_floor=True
+        ),
+    }
+    routes = {key: r for key, r in routes.items() if key in which}
     ks = list(range(0, len(img.trajectory), every))
     cfg = img.config
-    out: dict[str, list] = {
-        "image": [],
-        "sionna": [],
-        "sionna_diffuse_floor": [],
-        "sionna_all_floor": [],
-    }
+    out: dict[str, list] = {}
+    flagged = dict.fromkeys(routes, 0)
+    n_second = []
     kinds: list[str] = []
     for i, rng in enumerate(spawn_rngs(seed, len(ks) * draws)):
         k = ks[i // draws]
         state = rng.bit_generator.state
+        eps = {}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            ep_i = img.epoch(k, rng)
-            rng.bit_generator.state = state
-            ep_s = srt.epoch(k, rng)
+            for key, route in routes.items():
+                rng.bit_generator.state = state
+                eps[key] = route.epoch(k, rng)
+                flagged[key] += eps[key].estimates.fit_ok is False
+        two = [e for key, e in eps.items() if "2nd" in key]
+        n_second.append(sum(p.kind == SECOND_ORDER for p in two[0].paths) if two else 0)
         pw = srt.raytraced.epoch(k)["power"]
         n0 = cfg.noise_power
         floors = {
-            "sionna_diffuse_floor": n0 + cfg.tx_power * pw["diffuse"],
-            "sionna_all_floor": n0 + cfg.tx_power * (pw["diffuse"] + pw["specular2+"]),
+            "diffuse_floor": n0 + cfg.tx_power * pw["diffuse"],
+            "all_floor": n0 + cfg.tx_power * (pw["diffuse"] + pw["specular2+"]),
         }
-        out["image"].append(_errors(ep_i, cfg))
-        out["sionna"].append(_errors(ep_s, cfg))
-        for key, n in floors.items():
-            out[key].append(_errors(ep_s, cfg, snr_offset_db=-10 * np.log10(n / n0)))
-        kinds += [p.surface_kind for p in ep_i.paths]
+        for key, ep in eps.items():
+            out.setdefault(key, []).append(_errors(ep, cfg))
+            if key == "image":
+                continue
+            for fkey, n in floors.items():
+                if fkey == "all_floor" and "2nd" in key:
+                    continue  # the second-order power is in the model, not the floor
+                out.setdefault(f"{key}+{fkey}", []).append(
+                    _errors(ep, cfg, snr_offset_db=-10 * np.log10(n / n0))
+                )
+        kinds += [p.surface_kind for p in next(iter(eps.values())).paths if p.kind != SECOND_ORDER]
     res = {key: np.concatenate(v) for key, v in out.items()}
-    return {"errors": res, "kinds": np.array(kinds), "epochs": ks, "draws": draws}
+    return {
+        "errors": res,
+        "kinds": np.array(kinds),
+        "epochs": ks,
+        "draws": draws,
+        "flagged": flagged,
+        "n": len(ks) * draws,
+        "second_order_paths": n_second,
+    }
 
 
 def _summary(e: np.ndarray) -> dict:
@@ -116,8 +185,15 @@ def _summary(e: np.ndarray) -> dict:
     }
 
 
-def report(costs: dict, studies: dict) -> str:
+def report(costs: dict, studies: dict, synth: dict | None = None) -> str:
     lines = []
+    for name, s in (synth or {}).items():
+        d, n = np.array(s["direct_s"]), np.array(s["nufft_s"])
+        lines.append(
+            f"{name}: synthesis on {len(d)} epochs ({np.median(s['paths']):.0f} paths/element): "
+            f"direct median {np.median(d):.2f} s, NUFFT median {np.median(n):.3f} s, speed-up "
+            f"median {np.median(d / n):.0f}x, relative error max {max(s['rel_error']):.1e}"
+        )
     for name, c in costs.items():
         p = {k: np.array([x[k] for x in c["power"]]) for k in c["power"][0]}
         tot = sum(p.values())
@@ -136,6 +212,13 @@ def report(costs: dict, studies: dict) -> str:
             )
         )
     for name, st in studies.items():
+        lines.append(
+            f"{name}: epochs flagged by the extraction's own fit test (fit_ok False) of "
+            f"{st['n']} draws: "
+            + ", ".join(f"{k} {v}" for k, v in st["flagged"].items())
+            + f"; second-order paths in the model per epoch: median "
+            f"{np.median(st['second_order_paths']):.0f}"
+        )
         lines.append(f"{name}: |error| / CRLB of the first-order paths (median / RMS, missed)")
         for col, label in ((0, "d"), (2, "direction")):
             for key, e in st["errors"].items():
@@ -154,20 +237,47 @@ def main(argv=None) -> int:
     ap.add_argument("--epochs-every", type=int, default=4)
     ap.add_argument("--draws", type=int, default=3)
     ap.add_argument("--seed", type=int, default=26)
+    ap.add_argument("--synthesis-epochs", type=int, default=3)
+    ap.add_argument(
+        "--second-order", type=int, default=8, help="second-order paths in the model (strongest)"
+    )
+    ap.add_argument(
+        "--only",
+        choices=("all", "synthesis", "extraction"),
+        default="all",
+        help="synthesis: item 3 alone; extraction: item 2 alone (epochs from the cache)",
+    )
+    ap.add_argument("--drives", nargs="+", default=list(DRIVES), choices=DRIVES)
+    ap.add_argument("--routes", nargs="+", default=list(ROUTES), choices=ROUTES)
     ap.add_argument("--json", type=Path, default=None)
     a = ap.parse_args(argv)
-    costs = {n: trace_costs(SignalRoute.from_scenario(n, channel="sionna")) for n in DRIVES}
-    studies = {n: extraction_study(n, a.epochs_every, a.draws, a.seed) for n in DRIVES}
-    print(report(costs, studies))
+    synth = {
+        n: synthesis_speed(SignalRoute.from_scenario(n, channel="sionna"), a.synthesis_epochs)
+        for n in a.drives
+        if a.only in ("all", "synthesis")
+    }
+    costs: dict = {}
+    studies: dict = {}
+    if a.only == "all":
+        costs = {n: trace_costs(SignalRoute.from_scenario(n, channel="sionna")) for n in a.drives}
+    if a.only in ("all", "extraction"):
+        studies = {
+            n: extraction_study(n, a.epochs_every, a.draws, a.seed, a.second_order, a.routes)
+            for n in a.drives
+        }
+    print(report(costs, studies, synth))
     if a.json:
         a.json.write_text(
             json.dumps(
                 {
+                    "synthesis": synth,
                     "costs": costs,
                     "studies": {
                         n: {
                             "epochs": s["epochs"],
                             "draws": s["draws"],
+                            "flagged": s["flagged"],
+                            "second_order_paths": s["second_order_paths"],
                             "kinds": s["kinds"].tolist(),
                             "errors": {
                                 k: np.where(np.isfinite(v), v, -1).tolist()

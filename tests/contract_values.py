@@ -130,9 +130,14 @@ def _signal_route():
     ep = route.epoch(10, rng)
     arr, paths = route.paths(10)
     snap = route.snapshot(paths, arr, rng)
+    route.ml_noise_power(10, snap)
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
     ml_truth(paths, arr, route.config)
+    from tunnelkit.propagation import second_order_paths
+
+    traj = route.trajectory
+    second_order_paths(route.tunnel, arr, traj.position[10], traj.velocity[10], fc=route.config.fc)
     del ep
 
 

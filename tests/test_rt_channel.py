@@ -128,6 +128,71 @@ def test_element_tensor_against_the_sum():
         )
 
 
+@needs_sionna  # finufft comes with the rt extra
+@pytest.mark.parametrize(("nf", "nt", "P"), [(410, 12, 3000), (51, 5, 200), (1, 1, 80)])
+def test_element_tensor_nufft_against_the_direct_sum(nf, nt, P):
+    """The NUFFT synthesis equals the path-by-path sum to the tolerance asked (relative error
+    <= 1e-6 at eps = 1e-9, the default), for even and odd tone and symbol counts, with delays
+    past one period of the tone spacing (folded) and gains over 80 dB of dynamic range."""
+    rng = np.random.default_rng(7)
+    M = 3
+    ep = ElementPaths(
+        tau=rng.uniform(2e-8, 6e-6, (M, P)),
+        gain=(rng.standard_normal((M, P)) + 1j * rng.standard_normal((M, P)))
+        * 10 ** rng.uniform(-4, 0, (M, P)),
+        doppler=rng.uniform(-800, 800, (M, P)),
+        valid=rng.random((M, P)) < 0.9,
+        order=rng.integers(0, 3, (M, P)),
+        diffuse=rng.random((M, P)) < 0.5,
+        first_object=np.zeros((M, P), np.int64),
+    )
+    df, T0 = 240e3, 3.5677e-5
+    ref = element_tensor(ep, df, nf, T0, nt, method="direct")
+    for eps, tol in ((1e-9, 1e-6), (1e-12, 1e-9)):
+        H = element_tensor(ep, df, nf, T0, nt, method="nufft", eps=eps)
+        assert np.linalg.norm(H - ref) <= tol * np.linalg.norm(ref)
+        assert np.abs(H - ref).max() <= tol * np.abs(ref).max()
+    # a loose tolerance is visibly loose: the test can tell the two apart
+    H = element_tensor(ep, df, nf, T0, nt, method="nufft", eps=1e-3)
+    if nf * nt > 1:
+        assert np.linalg.norm(H - ref) > 1e-9 * np.linalg.norm(ref)
+    sel = ep.mask("diffuse")
+    auto = element_tensor(ep, df, nf, T0, nt, select=sel)  # auto: nufft above 64 paths
+    np.testing.assert_allclose(
+        auto,
+        element_tensor(ep, df, nf, T0, nt, select=sel, method="direct"),
+        rtol=0,
+        atol=1e-6 * np.abs(auto).max(),
+    )
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"),
+    [
+        ({"method": "fft"}, "method"),
+        ({"eps": 0.0}, "eps"),
+        ({"eps": 0.1}, "eps"),
+        ({"tone_spacing": -1.0}, "tone_spacing"),
+        ({"symbol_period": 0.0}, "symbol_period"),
+    ],
+)
+def test_element_tensor_refuses_bad_input(kw, name):
+    ep = _random_paths(np.random.default_rng(0))
+    args = {"tone_spacing": 240e3, "n_tones": 8, "symbol_period": 3.57e-5, "n_symbols": 2} | kw
+    with pytest.raises(ValueError, match=name):
+        element_tensor(ep, **args)
+
+
+def test_element_tensor_without_finufft(monkeypatch):
+    """Without finufft, "auto" sums directly and "nufft" is an install hint."""
+    ep = _random_paths(np.random.default_rng(2), P=100)
+    ref = element_tensor(ep, 240e3, 16, 3.57e-5, 3, method="direct")
+    monkeypatch.setitem(sys.modules, "finufft", None)
+    np.testing.assert_array_equal(element_tensor(ep, 240e3, 16, 3.57e-5, 3), ref)
+    with pytest.raises(ImportError, match="finufft"):
+        element_tensor(ep, 240e3, 16, 3.57e-5, 3, method="nufft")
+
+
 def test_tensor_snapshot_equals_synthesize():
     """Unit-power tensor + clock-bias ramp + noise = eq. 1 with that clock bias (same draws)."""
     sc = tk.load_scenario("italiano2026-straight")
@@ -348,3 +413,48 @@ def test_element_pattern_is_oriented_along_the_boresight():
     assert abs(measured - expected(b)) < 1.0, (measured, expected(b))
     up = np.array([b[0], b[1], -b[2]])  # the same boresight tilted up
     assert abs(measured - expected(up)) > 1.0
+
+
+# --- bad input without Sionna: a cache of another scene version ------------------------------------
+def test_cache_of_another_scene_version_is_rebuilt_without_sionna(tmp_path):
+    """The key hashes the exported scene: a tunnel changed under the same label (a road marking
+    moved) is detected on the directory check and the cache emptied, before any trace; a
+    corrupt meta.json is treated the same way; the same scene keeps its files."""
+    sc = tk.load_scenario("italiano2026-straight")
+    tun, cfg = sc.tunnel(), channel.SRSConfig.from_scenario(sc)
+    arrays, traj = propagation.scenario_arrays(sc), sc.trajectory(tun)
+    rc = rt.RayTracedChannel(tun, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    d = rc.directory()
+    (d / "epoch-000.npz").write_bytes(b"old")
+    same = rt.RayTracedChannel(tun, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert same.directory() == d and (d / "epoch-000.npz").is_file()
+    plate = tun.plates[0]
+    moved = dataclasses.replace(
+        tun,
+        plates=(
+            dataclasses.replace(plate, corner=plate.corner + np.array([1.0, 0.0, 0.0])),
+            *tun.plates[1:],
+        ),
+    )
+    other = rt.RayTracedChannel(moved, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    assert other.key()["scene"] != rc.key()["scene"]
+    with pytest.warns(UserWarning, match="another scene"):
+        assert other.directory() == d
+    assert not (d / "epoch-000.npz").exists()
+    assert json.loads((d / "meta.json").read_text()) == other.key()
+    (d / "epoch-001.npz").write_bytes(b"old")
+    (d / "meta.json").write_text("{not json")
+    again = rt.RayTracedChannel(moved, arrays, traj, cfg, label="t", cache_dir=tmp_path)
+    with pytest.warns(UserWarning, match="another scene"):
+        again.directory()
+    assert not (d / "epoch-001.npz").exists()
+
+
+def test_scenario_refuses_unknown_material_for_each_surface(tmp_path):
+    for key in ("wall_material", "road_material", "rrm_material"):
+        with pytest.raises(ScenarioError, match=key):
+            _scenario_with(tmp_path, f'{key} = "unobtainium"')
+    with pytest.raises(ScenarioError, match="metal_scattering_coefficient"):
+        _scenario_with(tmp_path, "metal_scattering_coefficient = -0.5")

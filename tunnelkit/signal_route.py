@@ -32,6 +32,7 @@ from .evaluation import match_paths
 
 __all__ = [
     "CHANNELS",
+    "MAX_SECOND_ORDER",
     "Epoch",
     "RouteMeasurements",
     "SignalRoute",
@@ -43,6 +44,8 @@ __all__ = [
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
 #: ``"sionna"`` (the tensor of every path Sionna RT traces per element, :mod:`tunnelkit.rt.cache`)
 CHANNELS = ("image", "sionna")
+#: the most second-order paths a route models (:attr:`SignalRoute.second_order`)
+MAX_SECOND_ORDER = 32
 
 
 def _check_arrays(arrays) -> None:
@@ -128,9 +131,38 @@ class Epoch:
 
 
 def _measure(est, array, paths, snap, config, min_d):
-    """Measurements of ``est`` (Algorithm 1, world frame) and their match to the true paths."""
+    """Measurements of ``est`` (Algorithm 1, world frame) and their match to the true paths; the
+    estimates matched to a second-order path (a nuisance path the model carries,
+    :attr:`SignalRoute.second_order`) are left out of the measurements."""
+    from .propagation import SECOND_ORDER
+
     meas = measurements_from_estimates(est, array, config, min_d=min_d)
-    return meas, match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
+    truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
+    nuisance = [i for i, p in enumerate(paths) if p.kind == SECOND_ORDER]
+    if nuisance and len(meas):
+        rows = np.flatnonzero(~np.isin(truth, nuisance))
+        meas, truth = _rows(meas, rows), truth[rows]
+    return meas, truth
+
+
+def _rows(m: RouteMeasurements, rows: np.ndarray) -> RouteMeasurements:
+    """``m`` restricted to ``rows`` (``delta_d`` re-referenced to the first row kept)."""
+    d = m.d[rows]
+    return replace(
+        m,
+        phi=m.phi[rows],
+        psi=m.psi[rows],
+        kappa=m.kappa[rows],
+        near_field=m.near_field[rows],
+        d=d,
+        delta_d=d - d[0] if d.size else d,
+        v=m.v[rows],
+        direction=m.direction[rows],
+        alpha=m.alpha[rows],
+        index=m.index[rows],
+        cov=None if m.cov is None else m.cov[rows],
+        sigma_d=None if m.sigma_d is None else m.sigma_d[rows],
+    )
 
 
 def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
@@ -218,6 +250,20 @@ class SignalRoute:
     tensor by construction and ``impairments.dmc`` is refused (the ray tracer has its own
     diffuse power). ``wideband_model``: the extraction models the spatial-wideband term (the ML
     route's ``wideband=True``, :func:`tunnelkit.extraction.extract_paths`) in every epoch.
+    ``second_order`` (0 by default: the first-order model): the route's model also carries the
+    ``second_order`` strongest second-order specular paths the image method predicts at each
+    epoch (:func:`tunnelkit.propagation.second_order_paths`, by ``|gain|`` at the reference
+    antenna; fewer when fewer exist). They are in ``Epoch.paths`` after the first-order ones, so
+    the extraction fits them (``L`` = first-order + second-order paths) and, on the image
+    channel, they are synthesised too; they are nuisance paths for the tracker: the estimates
+    matched to them (by range and direction, :func:`tunnelkit.evaluation.match_paths`, against
+    the geometry's prediction, as ``L`` itself is) are left out of the measurements.
+    ``diffuse_floor`` (``channel="sionna"`` only, off by default): the ML extraction judges its
+    own fit (``fit_ok``: residual, periodogram peak, significance) against the noise power plus
+    the epoch's diffuse power (the ray tracer's mean power per element of the paths with a
+    diffuse interaction, times the transmit power; :meth:`ml_noise_power`) instead of the noise
+    alone: the diffuse paths as a known noise-like nuisance. The fitted parameters are the
+    same least-squares fit; only the tests and the re-seeding they trigger change.
     """
 
     tunnel: object
@@ -234,6 +280,8 @@ class SignalRoute:
     channel: str = "image"
     raytraced: object = field(default=None, repr=False)
     wideband_model: bool = False
+    second_order: int = 0
+    diffuse_floor: bool = False
 
     def __post_init__(self) -> None:
         from .propagation import PATH_KINDS, Tunnel3D
@@ -257,6 +305,11 @@ class SignalRoute:
         boolean("report_covariance", self.report_covariance)
         boolean("bias_aware_delay_check", self.bias_aware_delay_check)
         boolean("wideband_model", self.wideband_model)
+        integer("second_order", self.second_order, minimum=0, maximum=MAX_SECOND_ORDER)
+        if boolean("diffuse_floor", self.diffuse_floor) and self.channel != "sionna":
+            raise ValueError(
+                "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
+            )
         if self.channel == "sionna":
             from .rt.cache import RayTracedChannel
 
@@ -320,7 +373,8 @@ class SignalRoute:
         return cls(tun, arrays, traj, config, channel=channel, **kw)
 
     def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
-        """The array facing the vehicle and the true paths at epoch ``k``."""
+        """The array facing the vehicle and the true paths at epoch ``k`` (first order, then the
+        strongest ``second_order`` second-order paths)."""
         from . import propagation
 
         k = integer("k", k, minimum=0)
@@ -329,7 +383,17 @@ class SignalRoute:
         ue, vel = self.trajectory.position[k], self.trajectory.velocity[k]
         arr = propagation.select_array(self.arrays, ue)
         tun = self.tunnel if tunnel is None else tunnel
-        return arr, propagation.trace_paths(tun, arr, ue, vel, fc=self.config.fc, kinds=self.kinds)
+        if not self.second_order:
+            return arr, propagation.trace_paths(
+                tun, arr, ue, vel, fc=self.config.fc, kinds=self.kinds
+            )
+        every = propagation.trace_paths(
+            tun, arr, ue, vel, fc=self.config.fc, kinds=self.kinds, order=2
+        )
+        first = [p for p in every if p.kind != propagation.SECOND_ORDER]
+        second = [p for p in every if p.kind == propagation.SECOND_ORDER]
+        second.sort(key=lambda p: -abs(p.gain))
+        return arr, first + sorted(second[: self.second_order], key=lambda p: p.length)
 
     def snapshot(self, paths, arr: ArrayGeometry, rng: np.random.Generator, **kw):
         """The SRS tensor of ``paths`` at ``arr`` (:func:`tunnelkit.channel.synthesize`) with
@@ -371,6 +435,25 @@ class SignalRoute:
             **kw,
         )
 
+    def ml_noise_power(self, k: int, snapshot: ChannelSnapshot, tunnel=None) -> float | None:
+        """The noise power the ML extraction tests its fit against at epoch ``k``: ``None``
+        (estimated from the tensor) unless ``diffuse_floor``, then the snapshot's noise power
+        plus the transmit power times the epoch's diffuse power per element (ray tracer)."""
+        k = integer("k", k, minimum=0, maximum=len(self.trajectory) - 1)
+        if not isinstance(snapshot, ChannelSnapshot):
+            raise TypeError(
+                f"snapshot: expected a channel.ChannelSnapshot, got {type(snapshot).__name__}"
+            )
+        if tunnel is not None and type(tunnel) is not type(self.tunnel):
+            raise TypeError(
+                f"tunnel: expected a {type(self.tunnel).__name__}, got {type(tunnel).__name__}"
+            )
+        if not self.diffuse_floor:
+            return None
+        tun = self.tunnel if tunnel is None else tunnel
+        p_diffuse = self.raytraced.epoch(k, tun)["power"]["diffuse"]
+        return float(snapshot.noise_power + self.config.tx_power * p_diffuse)
+
     def extract(self, H, arr: ArrayGeometry, n_paths: int, **extract_kw):
         """:func:`tunnelkit.extraction.extract_paths` of ``H`` at ``arr`` with this route's
         radio (``refine``, ... in ``extract_kw``)."""
@@ -398,6 +481,8 @@ class SignalRoute:
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
         if self.wideband_model:
             extract_kw.setdefault("wideband", True)
+        if self.diffuse_floor and extract_kw.get("refine", "ml") == "ml":
+            extract_kw.setdefault("noise_power", self.ml_noise_power(k, snap, tunnel))
         est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None
         meas, truth = _measure(est, arr, paths, snap, cfg, self.min_d)

@@ -1,5 +1,5 @@
 """``tunnelkit reproduce TARGET [--runs N] [--seed S] [--channel image|sionna]
-[--workers N | --scheduler ADDRESS] [--format table|json]``."""
+[--second-order N] [--diffuse-floor] [--workers N | --scheduler ADDRESS] [--format table|json]``."""
 
 from __future__ import annotations
 
@@ -27,6 +27,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default="image",
         help="channel source: the image method's eq. 1 (default) or the ray-traced channel "
         "(Sionna RT, every path per element, traced once and cached; javelin-table1|2 only)",
+    )
+    p.add_argument(
+        "--second-order",
+        type=int,
+        default=0,
+        metavar="N",
+        help="the route's model also fits the N strongest second-order specular paths the image "
+        "method predicts, left out of the tracker's measurements (javelin-table1|2 only; 0)",
+    )
+    p.add_argument(
+        "--diffuse-floor",
+        action="store_true",
+        help="with --channel sionna: the ML fit tested against noise + the epoch's diffuse power",
     )
     add_parallel_arguments(p)
 
@@ -77,6 +90,24 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    nuisance = {}
+    if args.second_order:
+        nuisance["second_order"] = args.second_order
+    if args.diffuse_floor:
+        if args.channel != "sionna":
+            print(
+                "tunnelkit reproduce: error: --diffuse-floor needs --channel sionna",
+                file=sys.stderr,
+            )
+            return 2
+        nuisance["diffuse_floor"] = True
+    if nuisance and len(chans) == 1:
+        print(
+            f"tunnelkit reproduce: error: --second-order/--diffuse-floor: {args.target} has no "
+            "route model to extend (javelin-table1|2 only)",
+            file=sys.stderr,
+        )
+        return 2
     try:
         rep = run(
             args.target,
@@ -84,6 +115,7 @@ def main(args: argparse.Namespace) -> int:
             seed=args.seed,
             progress=(args.format == "table" and not args.no_progress),
             channel=args.channel,
+            nuisance=nuisance or None,
             **parallel_kwargs(args),
         )
     except (TrialLost, RTUnavailableError) as exc:

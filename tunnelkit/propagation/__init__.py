@@ -36,7 +36,15 @@ One module per job, re-exported here:
 from __future__ import annotations
 
 from .materials import MATERIALS, concrete_permittivity, fresnel_te, reflection_coefficient
-from .paths import PATH_KINDS, Path, arrival_angles, select_array, trace_paths
+from .paths import (
+    PATH_KINDS,
+    SECOND_ORDER,
+    Path,
+    arrival_angles,
+    second_order_paths,
+    select_array,
+    trace_paths,
+)
 from .scenes import lane_trajectory, plate_from_table, scenario_arrays
 from .surfaces import (
     FACET_BYTES,
@@ -53,6 +61,7 @@ __all__ = [
     "FACET_BYTES",
     "MATERIALS",
     "PATH_KINDS",
+    "SECOND_ORDER",
     "Box",
     "Facet",
     "Path",
@@ -66,6 +75,7 @@ __all__ = [
     "reflection_coefficient",
     "road_marking",
     "scenario_arrays",
+    "second_order_paths",
     "select_array",
     "semicircular_tunnel",
     "trace_paths",

@@ -1,6 +1,8 @@
-"""Single-bounce paths by the image method: LoS plus one specular reflection per surface, with
-the exact length to every antenna and the SR-NF lengths for comparison (see the package
-docstring for the model and the sign conventions)."""
+"""Paths by the image method: LoS plus one specular reflection per surface, with the exact length
+to every antenna and the SR-NF lengths for comparison (see the package docstring for the model
+and the sign conventions), and, on request (``order=2``), the second-order specular paths: the
+UE mirrored in one surface, then that image mirrored in another (ceiling then road, wall then
+wall, ...), each bounce checked inside its finite surface."""
 
 from __future__ import annotations
 
@@ -8,15 +10,25 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import boolean, positive, vector
+from .._validate import boolean, integer, positive, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from .surfaces import Tunnel3D
 
-__all__ = ["PATH_KINDS", "Path", "arrival_angles", "select_array", "trace_paths"]
+__all__ = [
+    "PATH_KINDS",
+    "SECOND_ORDER",
+    "Path",
+    "arrival_angles",
+    "second_order_paths",
+    "select_array",
+    "trace_paths",
+]
 
 #: the path families :func:`trace_paths` can select
 PATH_KINDS = ("los", "wall", "ceiling", "road", "rrm")
+#: ``Path.kind`` (and ``surface_kind``) of a second-order specular path
+SECOND_ORDER = "reflection2"
 
 
 @dataclass(frozen=True)
@@ -25,21 +37,26 @@ class Path:
 
     Attributes
     ----------
-    kind : "los" or "reflection"
+    kind : "los", "reflection" or "reflection2" (:data:`SECOND_ORDER`: two specular bounces)
     surface, surface_kind : name and kind ("wall", "ceiling", "road", "rrm") of the reflector
-        ("" and "los" for the direct path)
-    source : (3,) the VUE (the UE itself for LoS), world frame
-    point : (3,) the reflection point (the UE for LoS), world frame
+        ("" and "los" for the direct path; for a second-order path ``"first > second"`` and
+        "reflection2")
+    source : (3,) the VUE (the UE itself for LoS; the UE mirrored twice for a second-order
+        path), world frame
+    point : (3,) the reflection point (the UE for LoS; the last bounce for a second-order path),
+        world frame
     length : exact path length to the reference antenna [m] (``||VUE - p_0||``)
     lengths : (M,) exact length to every antenna (spherical wavefront from the VUE)
-    lengths_srnf : (M,) SR-NF lengths: ``||UE - point|| + ||point - p_m||``
+    lengths_srnf : (M,) SR-NF lengths: ``||UE - point|| + ||point - p_m||`` (second order:
+        the length up to the last bounce plus ``||point - p_m||``)
     direction : (3,) unit vector of arrival, world frame, from the reference antenna towards
         ``point`` (and the VUE, which is collinear)
     direction_local : (3,) the same in the array's local frame
     azimuth, elevation : world-frame angles of ``direction`` (Italiano eq. 46-47, 49-50) [rad]
     kappa_srnf : ``||point - p_0||``, the SR-NF curvature radius (eq. 51; ``length`` for LoS)
     range_rate : d(length)/dt [m/s]; ``velocity = -range_rate``; ``doppler = fc velocity / c``
-    reflection_coefficient : complex ``Gamma`` (1 for LoS)
+    reflection_coefficient : complex ``Gamma`` (1 for LoS; the product of both bounces' for a
+        second-order path)
     gain : complex amplitude ``Gamma lambda / (4 pi length) exp(-j 2 pi length / lambda)``
     ue : (3,) the vehicle position the path was traced from
     """
@@ -95,11 +112,13 @@ def _angles(u: np.ndarray) -> tuple[float, float]:
     return float(np.arctan2(u[1], u[0])), float(np.arctan2(u[2], np.hypot(u[0], u[1])))
 
 
-def _make_path(kind, surface, skind, source, point, ue, src_vel, array, fc, gamma) -> Path:
+def _make_path(
+    kind, surface, skind, source, point, ue, src_vel, array, fc, gamma, leg=None
+) -> Path:
     lam = wavelength(fc)
     ant = array.world
     lengths = np.linalg.norm(source - ant, axis=-1)
-    leg = float(np.linalg.norm(ue - point))
+    leg = float(np.linalg.norm(ue - point)) if leg is None else float(leg)
     lengths_srnf = leg + np.linalg.norm(point - ant, axis=-1) if kind != "los" else lengths
     d0 = float(lengths[0])
     to_point = point - array.origin
@@ -141,8 +160,11 @@ def trace_paths(
     fc: float,
     kinds: tuple[str, ...] = ("los", "wall", "ceiling", "road", "rrm"),
     front_only: bool = True,
+    order: int = 1,
 ) -> list[Path]:
-    """All single-bounce paths from ``ue`` to ``array`` (image method), LoS first.
+    """All single-bounce paths from ``ue`` to ``array`` (image method), LoS first; with
+    ``order=2`` the second-order specular paths after them (:func:`second_order_paths`, both
+    surfaces' kinds in ``kinds``), sorted by length.
 
     A reflection off surface S exists when UE and array are on S's inner side, the segment from
     the reference antenna to the VUE crosses S inside the finite rectangle, and neither leg is
@@ -161,6 +183,7 @@ def trace_paths(
     if unknown or not kinds:
         raise ValueError(f"kinds: expected one or more of {PATH_KINDS}, got {tuple(kinds)!r}")
     front_only = boolean("front_only", front_only)
+    order = integer("order", order, minimum=1, maximum=2)
     ue = tunnel.require_inside("ue", vector("ue", ue, 3))
     vel = vector("ue_velocity", ue_velocity, 3)
     a0 = array.origin
@@ -191,6 +214,8 @@ def trace_paths(
             _make_path("reflection", s.name, s.kind, vue, point, ue, vvue, array, fc, gamma)
         )
     refl.sort(key=lambda p: p.length)
+    if order == 2:
+        refl += _second_order(tunnel, array, ue, vel, fc, kinds, front_only)
     return out + refl
 
 
@@ -215,6 +240,100 @@ def _check_array_placement(tunnel: Tunnel3D, array: ArrayGeometry, ue: np.ndarra
             f"ue: {gap:.3g} m from an element of the array, closer than one wavelength "
             f"({lam:.3g} m): the UE must be in the array's radiating field"
         )
+
+
+def second_order_paths(
+    tunnel: Tunnel3D,
+    array: ArrayGeometry,
+    ue,
+    ue_velocity=(0.0, 0.0, 0.0),
+    *,
+    fc: float,
+    kinds: tuple[str, ...] = ("wall", "ceiling", "road", "rrm"),
+    front_only: bool = True,
+) -> list[Path]:
+    """The second-order specular paths from ``ue`` to ``array`` (image method), sorted by length.
+
+    For every ordered pair of distinct surfaces (S1, S2) whose kinds are in ``kinds``: the UE's
+    image in S1, ``V1``, mirrored in S2 gives the source ``V2``. The path exists when the UE and
+    the array are on the inner sides of S1 and S2 respectively and ``V1`` on S2's inner side, the
+    line from the reference antenna to ``V2`` crosses S2 inside its rectangle (point ``P2``), the
+    line from ``P2`` to ``V1`` crosses S1 inside its rectangle (``P1``) with ``P2`` on S1's
+    inner side and ``P1`` on S2's, and no leg (UE-P1, P1-P2, P2-array) is blocked. Its length is
+    ``||V2 - p_m||`` at antenna ``m`` (= ``|UE P1| + |P1 P2| + |P2 p_m|`` at the reference
+    antenna), its reflection coefficient the product of both bounces' (:meth:`Facet.reflection_coefficient`
+    at each incidence), its source velocity the UE's mirrored twice.
+    """
+    if not isinstance(tunnel, Tunnel3D):
+        raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
+    if not isinstance(array, ArrayGeometry):
+        raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
+    fc = positive("fc", fc)
+    if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
+        raise TypeError(f"kinds: expected a tuple of path kinds from {PATH_KINDS}, got {kinds!r}")
+    unknown = [k for k in kinds if k not in PATH_KINDS]
+    if unknown or not kinds:
+        raise ValueError(f"kinds: expected one or more of {PATH_KINDS}, got {tuple(kinds)!r}")
+    front_only = boolean("front_only", front_only)
+    ue = tunnel.require_inside("ue", vector("ue", ue, 3))
+    vel = vector("ue_velocity", ue_velocity, 3)
+    return _second_order(tunnel, array, ue, vel, fc, kinds, front_only)
+
+
+def _second_order(tunnel, array, ue, vel, fc, kinds, front_only) -> list[Path]:
+    """:func:`second_order_paths` on checked arguments."""
+    a0 = array.origin
+    surf = [s for s in tunnel.surfaces if s.kind in kinds]
+    out: list[Path] = []
+    for s1 in surf:
+        p1 = s1.plane
+        du = float(p1.signed_distance(ue))
+        if du <= 0:
+            continue
+        v1 = p1.mirror(ue)
+        vel1 = vel - 2.0 * (vel @ p1.normal) * p1.normal
+        for s2 in surf:
+            if s2 is s1:
+                continue
+            p2 = s2.plane
+            da, dv = float(p2.signed_distance(a0)), float(p2.signed_distance(v1))
+            if da <= 0 or dv <= 0:
+                continue
+            v2 = p2.mirror(v1)
+            q2 = a0 + da / (da + dv) * (v2 - a0)  # the reference antenna -> V2 crosses S2
+            if not s2.contains(q2, tol=1e-9):
+                continue
+            e2 = float(p1.signed_distance(q2))
+            if e2 <= 0:
+                continue
+            q1 = q2 + e2 / (e2 + du) * (v1 - q2)  # P2 -> V1 crosses S1
+            if not s1.contains(q1, tol=1e-9) or float(p2.signed_distance(q1)) <= 0:
+                continue
+            if tunnel.blocked(ue, q1) or tunnel.blocked(q1, q2) or tunnel.blocked(q2, a0):
+                continue
+            if front_only and not array.in_front(q2):
+                continue
+            leg1, leg2 = float(np.linalg.norm(ue - q1)), float(np.linalg.norm(q1 - q2))
+            g1 = s1.reflection_coefficient(fc, min(du / leg1, 1.0))
+            g2 = s2.reflection_coefficient(fc, min(float(p2.signed_distance(q1)) / leg2, 1.0))
+            vel2 = vel1 - 2.0 * (vel1 @ p2.normal) * p2.normal
+            out.append(
+                _make_path(
+                    SECOND_ORDER,
+                    f"{s1.name} > {s2.name}",
+                    SECOND_ORDER,
+                    v2,
+                    q2,
+                    ue,
+                    vel2,
+                    array,
+                    fc,
+                    complex(g1 * g2),
+                    leg=leg1 + leg2,
+                )
+            )
+    out.sort(key=lambda p: p.length)
+    return out
 
 
 def select_array(arrays, ue) -> ArrayGeometry:

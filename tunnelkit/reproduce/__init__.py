@@ -89,11 +89,14 @@ def run(
     scheduler: str | None = None,
     timeout: float = CONNECT_TIMEOUT_S,
     channel: str = "image",
+    nuisance: dict | None = None,
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
     :func:`tunnelkit.montecarlo.run_trials`). The report is the same either way. ``channel``:
-    "image" (default) or, for the targets that support it, "sionna" (the ray-traced channel)."""
+    "image" (default) or, for the targets that support it, "sionna" (the ray-traced channel).
+    ``nuisance`` (those targets only): the route's ``second_order`` / ``diffuse_floor``
+    (:class:`tunnelkit.signal_route.SignalRoute`)."""
     reg = targets()
     if name not in reg:
         raise ValueError(f"name: unknown reproduce target {name!r}; available: {', '.join(reg)}")
@@ -104,6 +107,15 @@ def run(
             f"not {channel!r}"
         )
     on = {} if channel == "image" else {"channel": channel}
+    if nuisance is not None:
+        if tgt.channels == ("image",):
+            raise ValueError(
+                f"nuisance: target {name!r} has no route model to extend (only the targets with "
+                "a channel switch do)"
+            )
+        if not isinstance(nuisance, dict):
+            raise TypeError(f"nuisance: expected a dict, got {type(nuisance).__name__}")
+        on["nuisance"] = nuisance
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
     check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")

@@ -169,11 +169,15 @@ NOTES = [
 ]
 
 
-def _simulate_and_score(scenario, n_epochs, extractions, columns, cond, rng, channel="image"):
+def _simulate_and_score(
+    scenario, n_epochs, extractions, columns, cond, rng, channel="image", nuisance=None
+):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.studies.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count."""
-    drives = simulate_condition(scenario, n_epochs, extractions, cond, rng, channel=channel)
+    drives = simulate_condition(
+        scenario, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance
+    )
     faults = {
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
@@ -191,6 +195,7 @@ def javelin_table(
     extractions: tuple[str, ...] = ("paper", "ml"),
     n_epochs: int | None = None,
     channel: str = "image",
+    nuisance: dict | None = None,
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -203,7 +208,9 @@ def javelin_table(
     ``channel="sionna"`` runs every drive on the ray-traced channel
     (:class:`~tunnelkit.rt.cache.RayTracedChannel`): the epochs the conditions need (with and,
     for NoRRMs, without the road markings) are traced here first, once, into the cache; the
-    trials then read the cache and draw noise and clock bias per run."""
+    trials then read the cache and draw noise and clock bias per run. ``nuisance``: the route's
+    ``second_order`` (second-order paths in the model) and ``diffuse_floor`` (the ML fit tested
+    against noise + diffuse power), :class:`~tunnelkit.signal_route.SignalRoute`."""
     rt_info = _prepare_channel(scenario, conditions, n_epochs, channel, progress)
     extractions, done = per_drive(
         scenario,
@@ -213,7 +220,13 @@ def javelin_table(
         progress,
         extractions,
         lambda e: functools.partial(
-            _simulate_and_score, scenario, n_epochs, e, table_columns(e), channel=channel
+            _simulate_and_score,
+            scenario,
+            n_epochs,
+            e,
+            table_columns(e),
+            channel=channel,
+            nuisance=nuisance,
         ),
         **parallel,
     )
@@ -245,10 +258,12 @@ def javelin_table(
             "flagged_epochs": flagged,
             "epochs": epochs,
             **({"channel": channel, **rt_info} if channel != "image" else {}),
+            **({"nuisance": dict(nuisance)} if nuisance else {}),
         },
         notes=[
             *NOTES,
             *(_RT_NOTES if channel == "sionna" else []),
+            *([_nuisance_note(nuisance)] if nuisance else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
             "(the tracker predicts only); flagged epochs per route: "
@@ -266,6 +281,19 @@ _RT_NOTES = [
     "paths to extract and the truth are the image method's first-order specular paths; "
     "the trackers' designs are unchanged (chosen on the image channel).",
 ]
+
+
+def _nuisance_note(nuisance: dict) -> str:
+    n2, floor = nuisance.get("second_order", 0), nuisance.get("diffuse_floor", False)
+    return (
+        f"Route model: the first-order paths plus up to {n2} strongest second-order specular "
+        "paths the image method predicts (fitted, then left out of the tracker's measurements)"
+        + (
+            "; the ML fit tested against noise + the epoch's diffuse power (ray tracer)."
+            if floor
+            else "."
+        )
+    )
 
 
 def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
@@ -305,9 +333,14 @@ def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     channels=("image", "sionna"),
 )
 def javelin_table1(
-    runs: int, seed: int, progress: bool, channel: str = "image", **parallel
+    runs: int,
+    seed: int,
+    progress: bool,
+    channel: str = "image",
+    nuisance: dict | None = None,
+    **parallel,
 ) -> Report:
-    """Table 1 (straight trajectory)."""
+    """Table 1 (straight trajectory); ``nuisance`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-straight",
         "italiano2026_table1",
@@ -316,6 +349,7 @@ def javelin_table1(
         seed,
         progress,
         channel=channel,
+        nuisance=nuisance,
         **parallel,
     )
 
@@ -329,9 +363,14 @@ def javelin_table1(
     channels=("image", "sionna"),
 )
 def javelin_table2(
-    runs: int, seed: int, progress: bool, channel: str = "image", **parallel
+    runs: int,
+    seed: int,
+    progress: bool,
+    channel: str = "image",
+    nuisance: dict | None = None,
+    **parallel,
 ) -> Report:
-    """Table 2 (slalom trajectory)."""
+    """Table 2 (slalom trajectory); ``nuisance`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-slalom",
         "italiano2026_table2",
@@ -340,5 +379,6 @@ def javelin_table2(
         seed,
         progress,
         channel=channel,
+        nuisance=nuisance,
         **parallel,
     )

@@ -25,13 +25,21 @@ def simulate_condition(
     rng,
     *,
     channel: str = "image",
+    nuisance: dict | None = None,
 ):
     """One drive of condition ``cond`` of ``scenario`` through the signal route on ``channel``
     ("image" or "sionna"), measured through every route in ``extractions``
     (:func:`~tunnelkit.studies.drives.simulate_routes`); the argument order suits
-    ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``."""
+    ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``; ``nuisance`` the route's
+    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.studies.drives.scenario_route`)."""
     return simulate_routes(
-        scenario, rng, condition=cond, n_epochs=n_epochs, extractions=extractions, channel=channel
+        scenario,
+        rng,
+        condition=cond,
+        n_epochs=n_epochs,
+        extractions=extractions,
+        channel=channel,
+        nuisance=nuisance,
     )
 
 

@@ -141,10 +141,13 @@ def route_name(extraction: str) -> str:
 _ROUTES: dict[tuple, SignalRoute] = {}
 
 
-def ml_epoch(ep, config):
+def ml_epoch(ep, config, noise_power: float | None = None):
     """``ep`` with its estimates and measurements redone by the maximum-likelihood route
-    (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor."""
-    return ep.with_estimates(ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config))
+    (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor (``noise_power``:
+    what its fit is tested against, estimated from the tensor by default)."""
+    return ep.with_estimates(
+        ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config, noise_power=noise_power)
+    )
 
 
 def separate_epoch(ep, config):
@@ -152,23 +155,53 @@ def separate_epoch(ep, config):
     return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 
-def scenario_route(route, model: str = "exact", channel: str | None = None) -> SignalRoute:
+def _nuisance(nuisance) -> dict:
+    """``nuisance`` checked: ``None`` or a dict of ``second_order`` (int) / ``diffuse_floor``."""
+    from .._validate import boolean
+    from ..signal_route import MAX_SECOND_ORDER
+
+    if nuisance is None:
+        return {}
+    if not isinstance(nuisance, dict):
+        raise TypeError(
+            f"nuisance: expected a dict of second_order / diffuse_floor, got {type(nuisance).__name__}"
+        )
+    unknown = sorted(map(str, set(nuisance) - {"second_order", "diffuse_floor"}))
+    if unknown:
+        raise ValueError(f"nuisance: expected second_order / diffuse_floor, got {unknown}")
+    out = {}
+    if "second_order" in nuisance:
+        out["second_order"] = integer(
+            "nuisance.second_order", nuisance["second_order"], minimum=0, maximum=MAX_SECOND_ORDER
+        )
+    if "diffuse_floor" in nuisance:
+        out["diffuse_floor"] = boolean("nuisance.diffuse_floor", nuisance["diffuse_floor"])
+    return out
+
+
+def scenario_route(
+    route, model: str = "exact", channel: str | None = None, nuisance: dict | None = None
+) -> SignalRoute:
     """``route`` itself (a :class:`SignalRoute`; ``channel``, if given, must be its own), or the
-    route of a scenario name built once per ``(name, model, channel)`` and kept (``channel``
-    :data:`~tunnelkit.signal_route.CHANNELS`, "image" by default)."""
+    route of a scenario name built once per ``(name, model, channel, nuisance)`` and kept
+    (``channel`` :data:`~tunnelkit.signal_route.CHANNELS`, "image" by default; ``nuisance`` the
+    route's ``second_order`` / ``diffuse_floor`` fields, none by default)."""
+    nuisance = _nuisance(nuisance)
     if isinstance(route, SignalRoute):
         if channel is not None and channel != route.channel:
             raise ValueError(
                 f"channel: the route given runs on the {route.channel!r} channel, not {channel!r}"
             )
-        return route
+        return replace(route, **nuisance) if nuisance else route
     if not isinstance(route, str):
         raise TypeError(
             f"route: expected a SignalRoute or a scenario name, got {type(route).__name__}"
         )
-    key = (route, model, channel or "image")
+    key = (route, model, channel or "image", tuple(sorted(nuisance.items())))
     if key not in _ROUTES:
-        _ROUTES[key] = SignalRoute.from_scenario(route, model=model, channel=channel or "image")
+        _ROUTES[key] = SignalRoute.from_scenario(
+            route, model=model, channel=channel or "image", **nuisance
+        )
     return _ROUTES[key]
 
 
@@ -217,6 +250,7 @@ def simulate_drive(
     sigma_heading: float = SIGMA_HEADING,
     n_epochs: int | None = None,
     channel: str | None = None,
+    nuisance: dict | None = None,
 ) -> DriveData:
     """Drive ``route`` (a :class:`SignalRoute` or a scenario name, built with ``model``) under
     ``condition`` and measure every epoch through ``extraction`` (``rng`` explicit).
@@ -231,7 +265,8 @@ def simulate_drive(
     joint maximum-likelihood fit from its own start) or ``"route"`` (the route's own extraction,
     :meth:`SignalRoute.epoch`). An extraction failure leaves ``None`` (the tracker then predicts
     only) and is recorded in ``faults``. ``channel``: the route's channel source
-    (:func:`scenario_route`; "sionna" is the ray-traced channel).
+    (:func:`scenario_route`; "sionna" is the ray-traced channel); ``nuisance`` the route's
+    ``second_order`` / ``diffuse_floor`` (:func:`scenario_route`).
     """
     return simulate_routes(
         route,
@@ -243,14 +278,15 @@ def simulate_drive(
         sigma_heading=sigma_heading,
         n_epochs=n_epochs,
         channel=channel,
+        nuisance=nuisance,
     )[route_name(extraction)]
 
 
-def _redo(ep0, e: str, config):
+def _redo(ep0, e: str, route: SignalRoute, tunnel):
     if e == "coherent":
-        return separate_epoch(ep0, config)
+        return separate_epoch(ep0, route.config)
     if e == "ml":
-        return ml_epoch(ep0, config)
+        return ml_epoch(ep0, route.config, route.ml_noise_power(ep0.k, ep0.snapshot, tunnel))
     return ep0
 
 
@@ -265,13 +301,14 @@ def simulate_routes(
     sigma_heading: float = SIGMA_HEADING,
     n_epochs: int | None = None,
     channel: str | None = None,
+    nuisance: dict | None = None,
 ) -> dict[str, DriveData]:
     """One drive (:func:`simulate_drive`) measured through every route in ``extractions``.
 
     Each epoch's tensor is synthesised and decomposed once: the paper's route (CPD, joint root
     refinement) runs on it and the coherent route starts from those estimates, the ML route runs
     its own start on the same tensor; ``"route"`` is the route's own extraction and cannot be
-    combined with the others (it draws the tensor itself). ``channel`` as in
+    combined with the others (it draws the tensor itself). ``channel`` and ``nuisance`` as in
     :func:`scenario_route`. Returns ``{extraction: DriveData}``.
     """
     rng = rng_or_error("rng", rng)
@@ -291,7 +328,7 @@ def simulate_routes(
             f"{[e for e in extractions if e != 'route']}"
         )
     label = route if isinstance(route, str) else "route"
-    route = scenario_route(route, model, channel)
+    route = scenario_route(route, model, channel, nuisance)
     if n_epochs is not None:
         integer("n_epochs", n_epochs, minimum=1)
     kinds_all = tuple(route.kinds)
@@ -326,7 +363,7 @@ def simulate_routes(
                 ep, reason = ep0, None
                 if ep is not None and e not in ("paper", "route"):
                     try:
-                        ep = _redo(ep0, e, route.config)
+                        ep = _redo(ep0, e, r, tunnel)
                     except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
                         ep, failure = None, exc
                 if ep is not None:
