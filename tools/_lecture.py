@@ -270,6 +270,37 @@ def serving(
         stop_server(proc)
 
 
+def lab_command(port: int, root: Path, *extra: str) -> list[str]:
+    """JupyterLab serving ``root`` on ``HOST:port``: no browser, no token or password, no news
+    feed (every request stays on the loopback), as root where need be; ``extra`` switches after."""
+    return [
+        sys.executable,
+        "-m",
+        "jupyterlab",
+        "--no-browser",
+        f"--port={port}",
+        f"--ServerApp.ip={HOST}",
+        "--IdentityProvider.token=",
+        "--ServerApp.password=",
+        f"--ServerApp.root_dir={root}",
+        "--LabApp.news_url=",
+        *extra,
+        "--allow-root",
+    ]
+
+
+def render_table(head: tuple[str, ...], body: list[tuple[str, ...]], markdown: bool) -> str:
+    """Rows of strings as a markdown table or as aligned text (first column left-aligned)."""
+    if markdown:
+        lines = ["| " + " | ".join(head) + " |", "| " + " | ".join("---" for _ in head) + " |"]
+        return "\n".join(lines + ["| " + " | ".join(b) + " |" for b in body])
+    widths = [max(len(x) for x in col) for col in zip(head, *body, strict=True)]
+    return "\n".join(
+        "  ".join(x.ljust(w) if i == 0 else x.rjust(w) for i, (x, w) in enumerate(zip(r, widths)))
+        for r in (head, *body)
+    )
+
+
 # ---------------------------------------------------------------- execution
 
 

@@ -38,7 +38,9 @@ from _lecture import (
     die,
     free_port,
     kernel_env,
+    lab_command,
     list_notebooks,
+    render_table,
     resolve_notebook,
     serving,
 )
@@ -66,20 +68,11 @@ def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout
     """Serve ``root`` with JupyterLab, open ``nb_path``, click Run All, wait for ``stamp``."""
     port = free_port()
     base = f"http://{HOST}:{port}/"
-    cmd = [
-        sys.executable,
-        "-m",
-        "jupyterlab",
-        "--no-browser",
-        f"--port={port}",
-        f"--ServerApp.ip={HOST}",
-        "--IdentityProvider.token=",
-        "--ServerApp.password=",
-        f"--ServerApp.root_dir={root}",
-        "--LabApp.news_url=",
+    cmd = lab_command(
+        port,
+        root,
         f"--LabApp.workspaces_dir={root / ('workspaces-' + nb_path.stem)}",  # no restored tabs
-        "--allow-root",
-    ]
+    )
     env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{nb_path.stem}")}  # no user settings
     with serving(cmd, base + "api", env=env, log=root / f"{nb_path.stem}.log", timeout=180):
         page = browser.new_page(viewport={"width": 1400, "height": 900})
@@ -151,14 +144,7 @@ def table(rows: list[dict], markdown: bool) -> str:
         )
         for r in rows
     ]
-    if markdown:
-        lines = ["| " + " | ".join(head) + " |", "| " + " | ".join("---" for _ in head) + " |"]
-        return "\n".join(lines + ["| " + " | ".join(b) + " |" for b in body])
-    widths = [max(len(x) for x in col) for col in zip(head, *body, strict=True)]
-    return "\n".join(
-        "  ".join(x.ljust(w) if i == 0 else x.rjust(w) for i, (x, w) in enumerate(zip(r, widths)))
-        for r in (head, *body)
-    )
+    return render_table(head, body, markdown)
 
 
 def main(argv: list[str] | None = None) -> int:

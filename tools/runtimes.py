@@ -37,6 +37,7 @@ from _lecture import (
     kernel_env,
     list_notebooks,
     notebook_client,
+    render_table,
     resolve_notebook,
 )
 
@@ -105,15 +106,7 @@ def table(rows: list[dict], markdown: bool) -> str:
         )
         for r in rows
     ]
-    if markdown:
-        lines = ["| " + " | ".join(head) + " |", "| " + " | ".join("---" for _ in head) + " |"]
-        lines += ["| " + " | ".join(b) + " |" for b in body]
-        return "\n".join(lines)
-    widths = [max(len(x) for x in col) for col in zip(head, *body, strict=True)]
-    return "\n".join(
-        "  ".join(x.ljust(w) if i == 0 else x.rjust(w) for i, (x, w) in enumerate(zip(r, widths)))
-        for r in (head, *body)
-    )
+    return render_table(head, body, markdown)
 
 
 def main(argv: list[str] | None = None) -> int:

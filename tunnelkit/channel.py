@@ -352,16 +352,9 @@ def _check_calibration(calibration, m: int) -> np.ndarray | None:
 
 def _check_paths(paths) -> list:
     """``paths`` as a non-empty list of :class:`~tunnelkit.propagation.Path` for one array."""
-    from .propagation import Path
+    from .propagation import as_path_list
 
-    if isinstance(paths, str | bytes) or not isinstance(paths, list | tuple):
-        raise TypeError(f"paths: expected a list of propagation.Path, got {type(paths).__name__}")
-    paths = list(paths)
-    if not paths:
-        raise ValueError("paths: need at least one path (the vehicle is fully blocked)")
-    for i, p in enumerate(paths):
-        if not isinstance(p, Path):
-            raise TypeError(f"paths[{i}]: expected a propagation.Path, got {type(p).__name__}")
+    paths = as_path_list(paths)
     m = paths[0].lengths.shape[0]
     for i, p in enumerate(paths):
         if p.lengths.shape[0] != m:

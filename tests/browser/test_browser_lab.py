@@ -13,10 +13,9 @@ Artefacts in build/artifacts/: lab-01-solutions.png (the exercises after Run All
 from __future__ import annotations
 
 import shutil
-import sys
 
 import nbformat
-from _lecture import HOST, ROOT, free_port, kernel_env, resolve_notebook, serving
+from _lecture import HOST, ROOT, free_port, kernel_env, lab_command, resolve_notebook, serving
 
 from tunnelkit.solutions import SUMMARY
 
@@ -51,19 +50,7 @@ def test_run_all_keeps_solutions_collapsed(tmp_path, watched, artifacts):
     env = kernel_env(quick=True)
     env["PYTHONPATH"] = str(ROOT)
     env["JUPYTER_CONFIG_DIR"] = str(tmp_path / "config")  # no user settings, no news prompt
-    cmd = [
-        sys.executable,
-        "-m",
-        "jupyterlab",
-        "--no-browser",
-        f"--port={port}",
-        f"--ServerApp.ip={HOST}",
-        "--IdentityProvider.token=",
-        "--ServerApp.password=",
-        f"--ServerApp.root_dir={work}",
-        "--LabApp.news_url=",
-        "--allow-root",
-    ]
+    cmd = lab_command(port, work)
     with serving(cmd, url + "api", env=env, log=artifacts / "lab-01.log", timeout=180):
         page = watched.page
         page.goto(url + f"lab/tree/{src.name}", timeout=180_000)

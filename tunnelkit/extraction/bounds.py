@@ -190,21 +190,12 @@ def ml_truth(paths, array, srs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ``paths`` are the :class:`tunnelkit.propagation.Path` traced to ``array`` (an
     :class:`~tunnelkit.arrays.ArrayGeometry`), ``srs`` the :class:`~tunnelkit.channel.SRSConfig`.
     """
-    from ..propagation import Path
+    from ..propagation import as_path_list
 
     if not isinstance(array, ArrayGeometry):
         raise TypeError(f"array: expected an ArrayGeometry, got {type(array).__name__}")
     config = check_srs(srs)
-    if isinstance(paths, Path) or not hasattr(paths, "__iter__"):
-        raise TypeError(
-            f"paths: expected a sequence of propagation.Path, got {type(paths).__name__}"
-        )
-    paths = list(paths)
-    if not paths:
-        raise ValueError("paths: need at least one path")
-    for i, p in enumerate(paths):
-        if not isinstance(p, Path):
-            raise TypeError(f"paths[{i}]: expected a propagation.Path, got {type(p).__name__}")
+    paths = as_path_list(paths)
     src = np.stack([array.to_local(p.source) for p in paths])
     r = np.linalg.norm(src, axis=1)
     theta = np.column_stack([src[:, :2] / r[:, None], 1 / r])

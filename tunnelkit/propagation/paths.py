@@ -20,6 +20,7 @@ __all__ = [
     "SECOND_ORDER",
     "Path",
     "arrival_angles",
+    "as_path_list",
     "second_order_paths",
     "select_array",
     "trace_paths",
@@ -172,22 +173,11 @@ def trace_paths(
     dropped (the elements' back lobe). ``kinds`` selects the path families. Reflected paths are
     sorted by length after the LoS path.
     """
-    if not isinstance(tunnel, Tunnel3D):
-        raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
-    if not isinstance(array, ArrayGeometry):
-        raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
-    fc = positive("fc", fc)
-    if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
-        raise TypeError(f"kinds: expected a tuple of path kinds from {PATH_KINDS}, got {kinds!r}")
-    unknown = [k for k in kinds if k not in PATH_KINDS]
-    if unknown or not kinds:
-        raise ValueError(f"kinds: expected one or more of {PATH_KINDS}, got {tuple(kinds)!r}")
-    front_only = boolean("front_only", front_only)
     order = integer("order", order, minimum=1, maximum=2)
-    ue = tunnel.require_inside("ue", vector("ue", ue, 3))
-    vel = vector("ue_velocity", ue_velocity, 3)
+    fc, kinds, front_only, ue, vel = _trace_arguments(
+        tunnel, array, ue, ue_velocity, fc, kinds, front_only
+    )
     a0 = array.origin
-    _check_array_placement(tunnel, array, ue, fc)
     out: list[Path] = []
     if "los" in kinds and not tunnel.blocked(ue, a0) and (not front_only or array.in_front(ue)):
         out.append(_make_path("los", "", "los", ue, ue, ue, vel, array, fc, 1.0))
@@ -217,6 +207,41 @@ def trace_paths(
     if order == 2:
         refl += _second_order(tunnel, array, ue, vel, fc, kinds, front_only)
     return out + refl
+
+
+def _trace_arguments(tunnel, array, ue, ue_velocity, fc, kinds, front_only):
+    """The checked arguments of :func:`trace_paths` and :func:`second_order_paths`:
+    ``(fc, kinds, front_only, ue, ue_velocity)``, the array placed inside the tunnel and the UE
+    in its radiating field (:func:`_check_array_placement`)."""
+    if not isinstance(tunnel, Tunnel3D):
+        raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
+    if not isinstance(array, ArrayGeometry):
+        raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
+    fc = positive("fc", fc)
+    if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
+        raise TypeError(f"kinds: expected a tuple of path kinds from {PATH_KINDS}, got {kinds!r}")
+    unknown = [k for k in kinds if k not in PATH_KINDS]
+    if unknown or not kinds:
+        raise ValueError(f"kinds: expected one or more of {PATH_KINDS}, got {tuple(kinds)!r}")
+    front_only = boolean("front_only", front_only)
+    ue = tunnel.require_inside("ue", vector("ue", ue, 3))
+    vel = vector("ue_velocity", ue_velocity, 3)
+    _check_array_placement(tunnel, array, ue, fc)
+    return fc, tuple(kinds), front_only, ue, vel
+
+
+def as_path_list(paths, name: str = "paths") -> list[Path]:
+    """``paths`` as a non-empty list of :class:`Path` (a ``TypeError``/``ValueError`` naming
+    ``name`` otherwise): the check every consumer of traced paths makes."""
+    if isinstance(paths, Path | str | bytes) or not isinstance(paths, list | tuple):
+        raise TypeError(f"{name}: expected a list of propagation.Path, got {type(paths).__name__}")
+    paths = list(paths)
+    if not paths:
+        raise ValueError(f"{name}: need at least one path (the vehicle is fully blocked)")
+    for i, p in enumerate(paths):
+        if not isinstance(p, Path):
+            raise TypeError(f"{name}[{i}]: expected a propagation.Path, got {type(p).__name__}")
+    return paths
 
 
 def _check_array_placement(tunnel: Tunnel3D, array: ArrayGeometry, ue: np.ndarray, fc: float):
@@ -264,19 +289,9 @@ def second_order_paths(
     antenna), its reflection coefficient the product of both bounces' (:meth:`Facet.reflection_coefficient`
     at each incidence), its source velocity the UE's mirrored twice.
     """
-    if not isinstance(tunnel, Tunnel3D):
-        raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
-    if not isinstance(array, ArrayGeometry):
-        raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
-    fc = positive("fc", fc)
-    if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
-        raise TypeError(f"kinds: expected a tuple of path kinds from {PATH_KINDS}, got {kinds!r}")
-    unknown = [k for k in kinds if k not in PATH_KINDS]
-    if unknown or not kinds:
-        raise ValueError(f"kinds: expected one or more of {PATH_KINDS}, got {tuple(kinds)!r}")
-    front_only = boolean("front_only", front_only)
-    ue = tunnel.require_inside("ue", vector("ue", ue, 3))
-    vel = vector("ue_velocity", ue_velocity, 3)
+    fc, kinds, front_only, ue, vel = _trace_arguments(
+        tunnel, array, ue, ue_velocity, fc, kinds, front_only
+    )
     return _second_order(tunnel, array, ue, vel, fc, kinds, front_only)
 
 

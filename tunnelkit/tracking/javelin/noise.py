@@ -16,11 +16,22 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..._validate import instance, nonnegative, positive
+from ..._validate import finite_array, instance, integer, nonnegative, positive
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 
 __all__ = ["ConsiderNoise", "FixedNoise", "ReportedNoise", "bias_factors"]
+
+
+def _tdoa_rows(meas, others, reference: int, config) -> tuple[list[int], int]:
+    """The checked arguments of a ``tdoa_covariance``: path indices of ``meas``."""
+    instance("meas", meas, PathMeasurements)
+    instance("config", config, JavelinConfig)
+    n = len(meas)
+    if isinstance(others, str) or not hasattr(others, "__len__"):
+        raise TypeError(f"others: expected a sequence of path indices, got {others!r:.60}")
+    rows = [integer("others", j, minimum=0, maximum=n - 1) for j in others]
+    return rows, integer("reference", reference, minimum=0, maximum=n - 1)
 
 
 @dataclass(frozen=True)
@@ -74,6 +85,8 @@ class ReportedNoise:
 
     def covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
         """The reported (n, 3, 3) covariances, or the fallback's."""
+        instance("meas", meas, PathMeasurements)
+        instance("config", config, JavelinConfig)
         if meas.reported:
             return meas.cov
         return self.fallback.covariances(meas, config)
@@ -82,9 +95,10 @@ class ReportedNoise:
         self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
     ) -> np.ndarray:
         """``Delta d_j = d_j - d_ref``: ``var = s_j^2 + s_ref^2``, the reference shared."""
+        others, reference = _tdoa_rows(meas, others, reference, config)
         if not meas.reported:
             return self.fallback.tdoa_covariance(meas, others, reference, config)
-        return np.diag(meas.sigma_d[list(others)] ** 2) + meas.sigma_d[reference] ** 2
+        return np.diag(meas.sigma_d[others] ** 2) + meas.sigma_d[reference] ** 2
 
 
 def bias_factors(bias_cov: np.ndarray) -> np.ndarray:
@@ -93,7 +107,9 @@ def bias_factors(bias_cov: np.ndarray) -> np.ndarray:
     factorisable; rows of a zero block stay zero). Lower-triangular, so the factor of a bias
     covariance that changes smoothly along the drive changes smoothly too (an eigenvector
     factor may flip its signs from one epoch to the next)."""
-    b = np.asarray(bias_cov, dtype=float)
+    b = finite_array("bias_cov", bias_cov, ndim=3)
+    if b.shape[1:] != (4, 4):
+        raise ValueError(f"bias_cov: expected shape (n, 4, 4), got {b.shape}")
     n = b.shape[0]
     out = np.zeros((n, 4, 4))
     for k in range(n):
@@ -145,13 +161,15 @@ class ConsiderNoise(ReportedNoise):
         self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
     ) -> np.ndarray:
         """The white share of :meth:`tdoa_covariance`."""
+        others, reference = _tdoa_rows(meas, others, reference, config)
         if not (meas.reported and meas.bias_cov is not None):
             return self.tdoa_covariance(meas, others, reference, config)
         var = meas.sigma_d**2 - meas.bias_cov[:, 3, 3]
-        return np.diag(var[list(others)]) + var[reference]
+        return np.diag(var[others]) + var[reference]
 
     def factors(self, meas: PathMeasurements) -> np.ndarray:
         """``L`` (n, 4, 4) of every path's repeating share (zeros without ``bias_cov``)."""
+        instance("meas", meas, PathMeasurements)
         if not (meas.reported and meas.bias_cov is not None):
             return np.zeros((len(meas), 4, 4))
         return bias_factors(meas.bias_cov)

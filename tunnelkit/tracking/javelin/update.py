@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from ..._validate import finite_array, instance, probability
+from ..._validate import finite_array, instance, integer, probability
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
@@ -186,10 +186,13 @@ def schmidt_update(
     the true covariance for *any* gain: ``gain`` (n_est, K) replaces the optimal one (to
     evaluate a filter that ignores the consider parameters). ``n_est = N`` (default) is the
     Kalman filter on the whole state."""
+    x = finite_array("x", x, ndim=1)
     N = x.size
-    n_est = N if n_est is None else int(n_est)
-    if not 0 < n_est <= N:
-        raise ValueError(f"n_est: expected 1..{N} estimated entries, got {n_est}")
+    P = finite_array("P", P, shape=(N, N))
+    y = finite_array("y", y, ndim=1)
+    H = finite_array("H", H, shape=(y.size, N))
+    R = finite_array("R", R, shape=(y.size, y.size))
+    n_est = N if n_est is None else integer("n_est", n_est, minimum=1, maximum=N)
     S = H @ P @ H.T + R
     S = 0.5 * (S + S.T)
     cf = cho_factor(S, lower=True)
@@ -212,7 +215,13 @@ def consider_update(
     consider parameters (module docstring): the augmented covariance ``[[P, C], [C^T, I]]``, the
     rows ``z = h(x) + B u + w`` (``m.B``, white ``m.R``), :func:`schmidt_update` with the state
     estimated. Returns ``(x, P, C, nis)``; the biases' block stays ``I``."""
+    x = finite_array("x", x, ndim=1)
     D = x.size
+    P = finite_array("P", P, shape=(D, D))
+    C = finite_array("C", C, ndim=2)
+    if C.shape[0] != D:
+        raise ValueError(f"C: expected {D} rows (one per state entry), got {C.shape[0]}")
+    instance("m", m, StackedMeasurement)
     if m.z.size == 0:
         return x.copy(), P.copy(), C.copy(), 0.0
     Lc = C.shape[1]
