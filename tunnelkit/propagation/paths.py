@@ -233,6 +233,8 @@ def _trace_arguments(tunnel, array, ue, ue_velocity, fc, kinds, front_only):
 def as_path_list(paths, name: str = "paths") -> list[Path]:
     """``paths`` as a non-empty list of :class:`Path` (a ``TypeError``/``ValueError`` naming
     ``name`` otherwise): the check every consumer of traced paths makes."""
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"name: expected the parameter's name (a non-empty str), got {name!r}")
     if isinstance(paths, Path | str | bytes) or not isinstance(paths, list | tuple):
         raise TypeError(f"{name}: expected a list of propagation.Path, got {type(paths).__name__}")
     paths = list(paths)

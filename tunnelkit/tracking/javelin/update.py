@@ -200,7 +200,7 @@ def schmidt_update(
     if gain is None:
         Ka[:n_est] = cho_solve(cf, H @ P[:, :n_est]).T
     else:
-        Ka[:n_est] = np.asarray(gain, float).reshape(n_est, y.size)
+        Ka[:n_est] = finite_array("gain", gain, shape=(n_est, y.size))
     x_new = x + Ka @ y
     IKH = np.eye(N) - Ka @ H
     P_new = IKH @ P @ IKH.T + Ka @ R @ Ka.T
