@@ -138,6 +138,11 @@ def _signal_route():
 
     traj = route.trajectory
     second_order_paths(route.tunnel, arr, traj.position[10], traj.velocity[10], fc=route.config.fc)
+    # called directly: calibrated_threshold reaches it only when its per-process cache misses,
+    # which depends on what ran before in the same process
+    from tunnelkit.extraction.ml.residual import peak_null
+
+    peak_null(arr.local, route.config.fc, (arr.M, 8, 4), rng, n_draws=10)
     del ep
 
 

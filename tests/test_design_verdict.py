@@ -327,7 +327,6 @@ def test_sweep_carries_the_impairments_into_bound_and_monte_carlo(setup):
         ({"impairments": {"dmc_share": 1.0}}, "dmc_share"),
         ({"impairments": {"dmc_share": -0.1}}, "dmc_share"),
         ({"impairments": 3}, "impairments"),
-        ({"impairments": {"phase_error_deg": 1.0}, "mode": "channel", "runs": 2}, "mode"),
     ],
 )
 def test_bad_impairments_name_the_field(setup, kw, match):
