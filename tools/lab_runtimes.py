@@ -104,30 +104,35 @@ def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout
     }
 
 
-def measure_all(books: list[Path], *, timeout: float) -> list[dict]:
-    from playwright.sync_api import sync_playwright
+def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict]:
+    """Run All of every notebook in ``books``, one after the other (a row each). ``browser``: a
+    Playwright browser already running in this thread (a second ``sync_playwright`` cannot
+    start beside it); default: Chromium started here and closed at the end."""
+    if browser is None:
+        from playwright.sync_api import sync_playwright
 
-    if not os.access(CHROMIUM, os.X_OK):
-        raise LectureError(f"{CHROMIUM} is missing: run `make chromium`")
+        if not os.access(CHROMIUM, os.X_OK):
+            raise LectureError(f"{CHROMIUM} is missing: run `make chromium`")
+        with sync_playwright() as pw:
+            own = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
+            try:
+                return measure_all(books, timeout=timeout, browser=own)
+            finally:
+                own.close()
     tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-"))
     try:
         copies = [_stamped_copy(b, tmp) for b in books]
         env = kernel_env(quick=True)
         env["PYTHONPATH"] = str(ROOT)
         rows = []
-        with sync_playwright() as pw:
-            browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
-            try:
-                for nb_path, stamp in copies:  # a fresh server per notebook: nothing carried over
-                    rows.append(_run_all(browser, nb_path, stamp, tmp, env, timeout))
-                    r = rows[-1]
-                    print(
-                        f"  {r['notebook']}: Run All {r['wall_s']:.1f} s, kernel CPU "
-                        f"{r['cpu_s']:.1f} s (load {r['load_before']:.1f}-{r['load_after']:.1f})",
-                        flush=True,
-                    )
-            finally:
-                browser.close()
+        for nb_path, stamp in copies:  # a fresh server per notebook: nothing carried over
+            rows.append(_run_all(browser, nb_path, stamp, tmp, env, timeout))
+            r = rows[-1]
+            print(
+                f"  {r['notebook']}: Run All {r['wall_s']:.1f} s, kernel CPU "
+                f"{r['cpu_s']:.1f} s (load {r['load_before']:.1f}-{r['load_after']:.1f})",
+                flush=True,
+            )
         return rows
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -3,6 +3,7 @@
 Notebook 02 (the shortest) is run through the tool: one row, a positive wall time not shorter
 than a tenth of the kernel's CPU time (the stamp cell ran after every other cell), and a notebook
 whose second cell fails is reported as failed (Run All stops there, the stamp never comes).
+Both run in the session's browser (a second Playwright cannot start beside it in one thread).
 """
 
 from __future__ import annotations
@@ -13,15 +14,15 @@ from _lecture import LectureError, resolve_notebook
 from lab_runtimes import measure_all
 
 
-def test_run_all_of_notebook_02_is_timed():
-    rows = measure_all([resolve_notebook("02")], timeout=300)
+def test_run_all_of_notebook_02_is_timed(browser):
+    rows = measure_all([resolve_notebook("02")], timeout=300, browser=browser)
     assert [r["notebook"] for r in rows] == ["02-fresnel-bound-and-mmax"]
     r = rows[0]
     assert r["wall_s"] > 0 and r["cpu_s"] > 0, r
     assert r["wall_s"] > 0.1 * r["cpu_s"], r
 
 
-def test_a_failing_cell_is_reported(tmp_path):
+def test_a_failing_cell_is_reported(tmp_path, browser):
     nb = nbformat.v4.new_notebook()
     nb.cells = [
         nbformat.v4.new_code_cell("x = 1"),
@@ -36,4 +37,4 @@ def test_a_failing_cell_is_reported(tmp_path):
     path = tmp_path / "failing.ipynb"
     nbformat.write(nb, path)
     with pytest.raises(LectureError, match="did not reach its last cell"):
-        measure_all([path], timeout=20)
+        measure_all([path], timeout=20, browser=browser)
