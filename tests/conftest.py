@@ -1,4 +1,5 @@
-"""Shared fixtures: Jiang's tunnel and its virtual stations."""
+"""Shared fixtures: Jiang's tunnel and its virtual stations; one synthesised epoch of the straight
+drive for the extraction's bad-input tests."""
 
 from __future__ import annotations
 
@@ -27,3 +28,14 @@ def random_inside(tunnel, n: int, rng: np.random.Generator, along=(-50.0, 150.0)
     a = rng.uniform(*along, n)
     c = rng.uniform(margin, tunnel.width - margin, n)
     return tunnel.from_tunnel_frame(np.stack([a, c], -1))
+
+
+@pytest.fixture(scope="session")
+def epoch():
+    """Epoch 10 of the straight drive: ``(H, n_paths, array, config)`` (noise seeded 0)."""
+    import tunnelkit as tk
+
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    array, paths = route.paths(10)
+    snap = tk.channel.synthesize(paths, route.config, np.random.default_rng(0))
+    return snap.H, len(paths), array, route.config

@@ -21,20 +21,26 @@ def setup():
     return DesignSetup.from_scenario("italiano2026-straight")
 
 
-def test_channel_mode_synthesises_the_impairments_and_models_the_wideband_term(setup, monkeypatch):
+def _first_drive_route(setup, monkeypatch, **kw):
+    """The route the channel-mode sweep hands its first drive (the drive itself not run)."""
     seen = []
 
-    def fake_drive(route, rng, **kw):
+    def fake_drive(route, rng, **_):
         seen.append(route)
         raise _Stop
 
     monkeypatch.setattr(tunnelkit.studies, "simulate_drive", fake_drive)
+    with pytest.raises(_Stop):
+        sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", n_epochs=1, **kw)
+    (route,) = seen
+    return route
+
+
+def test_channel_mode_synthesises_the_impairments_and_models_the_wideband_term(setup, monkeypatch):
     imp = DesignImpairments(
         phase_error_deg=1.0, gain_error_db=0.3, spatial_wideband=True, wideband_model=True
     )
-    with pytest.raises(_Stop):
-        sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", impairments=imp, n_epochs=1)
-    (route,) = seen
+    route = _first_drive_route(setup, monkeypatch, impairments=imp)
     assert route.impairments.spatial_wideband
     assert route.impairments.phase_sigma_deg == 1.0 and route.impairments.gain_sigma_db == 0.3
     # every mounted array's calibration error drawn for this run
@@ -57,17 +63,9 @@ def test_channel_mode_synthesises_the_impairments_and_models_the_wideband_term(s
 
 
 def test_ideal_channel_mode_stays_the_ideal_route(setup, monkeypatch):
-    seen = []
-
-    def fake_drive(route, rng, **kw):
-        seen.append(route)
-        raise _Stop
-
-    monkeypatch.setattr(tunnelkit.studies, "simulate_drive", fake_drive)
-    with pytest.raises(_Stop):
-        sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", n_epochs=1)
-    assert not seen[0].calibration and not seen[0].wideband_model
+    route = _first_drive_route(setup, monkeypatch)
+    assert not route.calibration and not route.wideband_model
     with pytest.raises(TypeError, match="impairments"):
         sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", impairments={"phase": 1.0})
     with pytest.raises(TypeError, match="wideband_model"):
-        type(seen[0])(**{**seen[0].__dict__, "wideband_model": "yes"})
+        type(route)(**{**route.__dict__, "wideband_model": "yes"})

@@ -21,14 +21,6 @@ def _raises(exc, match, fn, *a, **kw):
 # --- physically impossible results --------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def epoch():
-    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
-    array, paths = route.paths(10)
-    snap = tk.channel.synthesize(paths, route.config, np.random.default_rng(0))
-    return snap.H, len(paths), array, route.config
-
-
 def test_extract_paths_with_fc_in_ghz():
     _raises(ValueError, r"^fc: .*did you mean 28e9", tk.channel.SRSConfig, fc=28.0)
 

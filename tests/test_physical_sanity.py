@@ -11,14 +11,6 @@ from tunnelkit.extraction import extract_paths
 from tunnelkit.propagation import fresnel_te
 
 
-@pytest.fixture(scope="module")
-def epoch():
-    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
-    array, paths = route.paths(10)
-    snap = tk.channel.synthesize(paths, route.config, np.random.default_rng(0))
-    return snap.H, len(paths), array, route.config
-
-
 @pytest.mark.parametrize(
     "make", [np.abs, np.real, lambda H: np.real(H).astype(np.float32), lambda H: H != 0]
 )
