@@ -55,6 +55,9 @@ from .setup import ArraySpec, DesignSetup, parse_array
 __all__ = [
     "MODES",
     "SETTLE_S",
+    "STARTS",
+    "START_SIGMA_M",
+    "VUES",
     "MonteCarloResult",
     "javelin_config",
     "javelin_rmse",
@@ -64,15 +67,38 @@ __all__ = [
 #: the measurement routes of :func:`sweep_montecarlo`
 MODES = ("bound", "channel")
 
+#: where a drive's tracker starts (:func:`sweep_montecarlo`): ``"drawn"`` an open-sky fix drawn
+#: from ``N(truth, START_SIGMA_M^2 I_3)`` with the run's generator (the tracker's ``P_0`` is then
+#: its true error), ``"truth"`` the true first position with the same ``P_0`` (the paper tables'
+#: start, which rewards a tracker that trusts its measurements too little)
+STARTS = ("drawn", "truth")
 
-def javelin_config(crlb: dict, min_d: float = 0.0):
+#: how the design's tracker gets its VUEs (:func:`sweep_montecarlo`): ``"known"`` at the UE's
+#: mirror image in the tunnel's known surfaces (the design knows its tunnel), ``"learned"`` from
+#: each path's angles and learnt over the drive (Algorithm 3)
+VUES = ("known", "learned")
+
+#: the open-sky fix's standard deviation per axis [m]: the tracker's ``sigma_p0_ue`` and the
+#: prior of the bounds over the drive (:func:`drive_pcrlb`)
+START_SIGMA_M = 1.0
+
+
+def javelin_config(crlb: dict, min_d: float = 0.0, planes=None):
     """The design's JAVELIN: :func:`tunnelkit.tracking.javelin.designs.array_design` (reported
     covariances, likelihood cost, measured births, the joint innovation test; ``crlb`` sets
-    only the fixed fallback sigmas, ``min_d`` Algorithm 1's delay check)."""
+    only the fixed fallback sigmas, ``min_d`` Algorithm 1's delay check; ``planes`` the
+    tunnel's surfaces when the VUEs come from the known geometry)."""
     # the tracker and the drive simulator load on the first Monte-Carlo, not with the bounds
     from ..tracking.javelin.designs import array_design
 
-    return array_design(crlb, min_d)
+    return array_design(crlb, min_d, planes)
+
+
+def design_planes(setup: DesignSetup) -> list:
+    """The planes of the surfaces a design traces (:data:`tunnelkit.design.geometry.KINDS`)."""
+    from .geometry import KINDS
+
+    return [s.plane for s in setup.tunnel.surfaces if s.kind in KINDS]
 
 
 @dataclass(frozen=True)
@@ -137,9 +163,11 @@ class _SweepTrial:
     mode: str
     n_epochs: int | None
     impairments: object = None  # achievable.DesignImpairments: the channel mode's
+    start: str = "drawn"
 
     def __call__(self, prep: _Prepared, rng: np.random.Generator) -> np.ndarray:
         from ..studies import evaluate, simulate_drive
+        from ..tracking.javelin import draw_start
 
         spec = prep.spec
         if self.mode == "bound":
@@ -159,7 +187,11 @@ class _SweepTrial:
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
             )
-        return _trial_errors(evaluate(drive, prep.design).estimates, drive.truth)
+        sigma = START_SIGMA_M
+        # the open-sky fix: drawn after the drive (the drive's draws do not depend on it)
+        p0 = draw_start(drive.truth[0], sigma, rng) if self.start == "drawn" else None
+        ev = evaluate(drive, prep.design, sigma_p0_ue=sigma, start=p0)
+        return _trial_errors(ev.estimates, drive.truth)
 
 
 def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
@@ -213,6 +245,7 @@ class _ArrayJob:
     with_model: bool
     crlbs: dict | None
     impairments: object = None
+    vues: str = "known"
 
     def __call__(self, spec: ArraySpec) -> _Prepared:
         ep = np.arange(self.T)
@@ -234,7 +267,8 @@ class _ArrayJob:
         if crlb is None:
             pb = path_bounds(self.setup, spec)
             crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-        design = javelin_config(crlb, self.setup.signal_route(spec).min_d)
+        planes = design_planes(self.setup) if self.vues == "known" else None
+        design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
         return _Prepared(spec, route, design, peb, pc, drive)
 
 
@@ -259,6 +293,8 @@ def sweep_montecarlo(
     crlbs: dict | None = None,
     pool: TrialPool | None = None,
     impairments=None,
+    start: str = "drawn",
+    vues: str = "known",
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -280,6 +316,11 @@ def sweep_montecarlo(
     on the channel route each run's array carries them (its calibration error drawn once per
     run, the wideband term and diffuse power in the tensor, the extraction modelling the
     wideband term with ``wideband_model``); the default error model carries them too.
+    ``start`` (:data:`STARTS`): each drive's tracker starts from an open-sky fix drawn with the
+    run's generator after the drive (``"drawn"``, default) or from the true first position
+    (``"truth"``), with :data:`START_SIGMA_M` of uncertainty either way. ``vues``
+    (:data:`VUES`): the tracker's VUEs from the tunnel's known surfaces (``"known"``, default)
+    or learnt from the paths' angles (``"learned"``).
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -292,6 +333,10 @@ def sweep_montecarlo(
         raise ValueError(f"specs: every array once, got {[s.label for s in specs]}")
     if mode not in MODES:
         raise ValueError(f"mode: expected one of {MODES}, got {mode!r}")
+    if start not in STARTS:
+        raise ValueError(f"start: expected one of {STARTS}, got {start!r}")
+    if vues not in VUES:
+        raise ValueError(f"vues: expected one of {VUES}, got {vues!r}")
     runs = integer("runs", runs, minimum=1)
     if impairments is not None:
         from .achievable import DesignImpairments
@@ -311,7 +356,7 @@ def sweep_montecarlo(
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
     A = len(specs)
     with_model = mode == "bound" or error_models is not None
-    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments)
+    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, vues)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
     kw = {k: v for k, v in kw.items() if v is not None}
     if pool is not None:
@@ -327,7 +372,7 @@ def sweep_montecarlo(
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(
-            _SweepTrial(setup, mode, n_epochs, impairments),
+            _SweepTrial(setup, mode, n_epochs, impairments, start),
             A * runs,
             seed,
             inputs=[prepared[a] for a in range(A) for _ in range(runs)],

@@ -72,12 +72,15 @@ def evaluate(
     method: str = "JAVELIN",
     keep_reports: bool = False,
     sigma_p0_ue: float = 1.0,
+    start=None,
 ) -> Evaluation:
     """Run ``method`` ("JAVELIN" with ``design``, default the paper's, or "TeNFiLoc") on
     ``drive`` and score it against the truth.
 
-    JAVELIN starts from the true first position (the open-sky fix the paper assumes) with
-    ``sigma_p0_ue`` [m] of uncertainty; the base station is the drive's reference antenna.
+    JAVELIN starts from ``start`` (3,) [m], default the true first position (the open-sky fix
+    the paper assumes, as the tables do), with ``sigma_p0_ue`` [m] of uncertainty; the base
+    station is the drive's reference antenna. The design's Monte-Carlo gives a start drawn with
+    that uncertainty (:func:`tunnelkit.tracking.javelin.draw_start`).
     """
     if not isinstance(drive, DriveData):
         raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
@@ -85,6 +88,8 @@ def evaluate(
         raise ValueError(f"method: expected 'JAVELIN' or 'TeNFiLoc', got {method!r}")
     cls = registry.get("italiano2026", method)
     if method == "TeNFiLoc":
+        if start is not None:
+            raise ValueError("start: TeNFiLoc is a snapshot method and takes no start")
         est, _ = cls.for_drive(drive).track(drive)
         return Evaluation(est, error_metrics(est, drive.truth))
     d = paper() if design is None else design
@@ -96,7 +101,7 @@ def evaluate(
             f"each path's covariance, but the drive's route ({drive.extraction!r}) reports none "
             "(SignalRoute(report_covariance=True))"
         )
-    est, run = cls.for_drive(drive, d, sigma_p0_ue=sigma_p0_ue).track(
+    est, run = cls.for_drive(drive, d, sigma_p0_ue=sigma_p0_ue, start=start).track(
         drive, keep_reports=keep_reports
     )
     return Evaluation(run.estimates, error_metrics(run.estimates, drive.truth), run)

@@ -39,7 +39,7 @@ from .roles import (
 )
 from .state import JavelinState
 from .tenfiloc import TeNFiLoc
-from .tracker import Javelin, JavelinRun, StepReport, run_javelin
+from .tracker import Javelin, JavelinRun, StepReport, draw_start, run_javelin
 
 __all__ = [
     "Associator",
@@ -67,6 +67,7 @@ __all__ = [
     "TeNFiLoc",
     "VueCurvature",
     "designs",
+    "draw_start",
     "global_nearest_neighbour",
     "greedy_nearest_neighbour",
     "measurement_model",

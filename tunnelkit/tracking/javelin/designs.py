@@ -30,6 +30,7 @@ from .measurement import DelayCheck, DopplerClutter, VueCurvature
 from .motion import MirrorMotion
 from .noise import ConsiderNoise
 from .roles import JavelinDesign
+from .surfaces import GeometricBirth
 from .update import JointTestUpdater
 
 __all__ = [
@@ -130,7 +131,7 @@ ARRAY_DESIGN_GATE = 1.0 - 1e-6
 ARRAY_DESIGN_VUE_WALK = 1e-3
 
 
-def array_design(crlb: dict, min_d: float = 0.0, **overrides) -> JavelinDesign:
+def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> JavelinDesign:
     """JAVELIN for an array-design sweep at any carrier and array size (our design, curvature
     centred on the VUE): every path's measurement covariance is the one the extraction reports
     (the CRLB at its estimate, which the ML route attains), so no 5.9 GHz constant enters, and
@@ -149,7 +150,10 @@ def array_design(crlb: dict, min_d: float = 0.0, **overrides) -> JavelinDesign:
     zero). The fixed sigmas, used only in an epoch whose Fisher information is singular at the
     estimate, are ``crlb`` (``d`` [m], ``direction`` [rad], ``kappa`` [m]; e.g. an upper percentile
     of the route's per-path bounds); ``sigma_delta_d`` is ``sqrt(2)`` times the delay-distance
-    sigma (a difference of two delays).
+    sigma (a difference of two delays). ``planes`` (the tunnel's known surfaces,
+    :class:`tunnelkit.geometry.Plane` or anything with ``normal`` and ``offset``; default none):
+    VUEs are born at the UE's mirror image in the plane that explains their path
+    (:class:`~.surfaces.GeometricBirth`) instead of learnt from their angles.
     """
     if not isinstance(crlb, dict):
         raise TypeError(f"crlb: expected a dict of per-path bounds, got {type(crlb).__name__}")
@@ -162,12 +166,21 @@ def array_design(crlb: dict, min_d: float = 0.0, **overrides) -> JavelinDesign:
 
     ang, kap, d = pick("direction"), pick("kappa"), pick("d")
     base = ours()
+    if planes is None:
+        birth = MeasuredBirth(update_at_birth=base.initiator.update_at_birth)
+    else:
+        if isinstance(planes, str | bytes) or not hasattr(planes, "__iter__"):
+            raise TypeError(f"planes: expected a list of planes, got {type(planes).__name__}")
+        planes = list(planes)
+        if not all(hasattr(p, "normal") and hasattr(p, "offset") for p in planes):
+            raise TypeError("planes: expected planes with a normal and an offset")
+        birth = GeometricBirth.from_planes(planes)
     return (
         base.with_(
             curvature=VueCurvature(),
             noise=ConsiderNoise(fallback=base.noise),
             associator=Associator(cost="likelihood", solver=base.associator.solver),
-            initiator=MeasuredBirth(update_at_birth=base.initiator.update_at_birth),
+            initiator=birth,
             updater=JointTestUpdater(0.999),
             gate_probability=ARRAY_DESIGN_GATE,
             sigma_vue_walk=ARRAY_DESIGN_VUE_WALK,

@@ -188,7 +188,9 @@ def manage_tracks(
     3. births (lines 8-12): every other unassociated path starts a VUE at the intersection of its
        arrival ray with ``x = x_u`` with the covariance the ``initiator`` role gives
        (``FixedBirth``: ``sigma_P^2 I``, the default; ``MeasuredBirth``: :func:`birth_covariance`
-       with the ``noise`` role's angle covariance); with a UE velocity ``v_u``
+       with the ``noise`` role's angle covariance; an initiator with a ``place`` method,
+       :class:`~.surfaces.GeometricBirth`, puts the VUE at the UE's mirror image in a known
+       plane that explains the path instead); with a UE velocity ``v_u``
        and a Doppler ``v``, a path whose Doppler misses the static prediction by more than
        ``doppler_tolerance`` is dynamic: its track is ``transient`` (dropped after this epoch);
        the born path also updates the state this epoch when ``initiator.update_at_birth``.
@@ -234,7 +236,12 @@ def manage_tracks(
     # 3. births
     born, dynamic, unborn = [], [], []
     for j in free:
+        placed = None
+        if callable(getattr(initiator, "place", None)):  # VUEs from known surfaces
+            placed = initiator.place(state, meas, j, config, noise)
         yz = intersection(meas.phi[j], meas.psi[j], state.x[0], config.bs)
+        if placed is not None:
+            yz = placed[0]
         if yz is None:
             unborn.append(j)
             continue
@@ -243,10 +250,15 @@ def manage_tracks(
             p_v = np.array([state.x[0], yz[0], yz[1]])
             v_pred = static_doppler(state.ue, p_v, v_u, config.bs, initiator.doppler_sign)
             transient = abs(meas.v[j] - v_pred) > config.doppler_tolerance
-        cov, cross = initiator.covariance(state, meas, j, config, noise)
-        bias_cross = None
-        if state.C is not None and cross is not None and getattr(noise, "consider", False):
-            bias_cross = birth_bias_cross(state, meas, j, config, noise)
+        if placed is not None:
+            _, cov, cross, bias_cross = placed
+            if not getattr(noise, "consider", False):
+                bias_cross = None
+        else:
+            cov, cross = initiator.covariance(state, meas, j, config, noise)
+            bias_cross = None
+            if state.C is not None and cross is not None and getattr(noise, "consider", False):
+                bias_cross = birth_bias_cross(state, meas, j, config, noise)
         tid = state.append(yz, cov, transient=transient, cross=cross, bias_cross=bias_cross)
         born.append(tid)
         if transient:

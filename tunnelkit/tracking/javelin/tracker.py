@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import boolean, finite_array, nonnegative, vector
+from ..._validate import boolean, finite_array, nonnegative, positive, rng_or_error, vector
 from ..gating import ChiSquareGate
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
@@ -26,7 +26,7 @@ from .motion import predict, ue_velocity
 from .roles import JavelinDesign
 from .state import JavelinState, track_slice
 
-__all__ = ["Javelin", "JavelinRun", "StepReport", "run_javelin"]
+__all__ = ["Javelin", "JavelinRun", "StepReport", "draw_start", "run_javelin"]
 
 
 @dataclass
@@ -80,18 +80,28 @@ class Javelin:
 
     # -- the family protocol (tunnelkit.tracking.registry, "italiano2026") ----------------------
     @classmethod
-    def for_drive(cls, drive, design: JavelinDesign | None = None, *, sigma_p0_ue: float = 1.0):
+    def for_drive(
+        cls,
+        drive,
+        design: JavelinDesign | None = None,
+        *,
+        sigma_p0_ue: float = 1.0,
+        start=None,
+    ):
         """A tracker for a simulated drive (anything with ``truth``, ``base_station``,
-        ``epochs``, ``speed``, ``heading``, ``dt``): it starts from the true first position (the
-        open-sky fix the paper assumes) with ``sigma_p0_ue`` [m] of uncertainty, the base station
-        at the drive's reference antenna, the roles of ``design`` (default the paper's)."""
+        ``epochs``, ``speed``, ``heading``, ``dt``): it starts from ``start`` (3,) [m], default
+        the true first position (the open-sky fix the paper assumes), with ``sigma_p0_ue`` [m]
+        of uncertainty, the base station at the drive's reference antenna, the roles of
+        ``design`` (default the paper's). An honest start (its error drawn with the covariance
+        the tracker is told, :func:`draw_start`) is the caller's to give."""
         d = JavelinDesign() if design is None else design
         if not isinstance(d, JavelinDesign):
             raise TypeError(f"design: expected a JavelinDesign, got {type(d).__name__}")
         d = d.with_(
             base_station=tuple(float(v) for v in drive.base_station), sigma_p0_ue=sigma_p0_ue
         )
-        return cls(drive.truth[0], d)
+        p0 = drive.truth[0] if start is None else vector("start", start, 3)
+        return cls(p0, d)
 
     def track(self, drive, *, keep_reports: bool = False) -> tuple[np.ndarray, JavelinRun]:
         """UE estimates (T, 3) over ``drive``'s measurement stream and the :class:`JavelinRun`."""
@@ -266,6 +276,15 @@ class JavelinRun:
     n_tracks: np.ndarray
     reports: list[StepReport]
     faults: int
+
+
+def draw_start(truth, sigma: float, rng: np.random.Generator) -> np.ndarray:
+    """An open-sky fix (3,) [m] drawn from ``N(truth, sigma^2 I_3)``: the start whose error the
+    tracker's ``P_0 = sigma^2 I`` (``sigma_p0_ue``) describes, not the truth itself."""
+    p = vector("truth", truth, 3)
+    s = positive("sigma", sigma)
+    rng = rng_or_error("rng", rng)
+    return p + s * rng.standard_normal(3)
 
 
 def _v2x(name: str, value) -> np.ndarray:

@@ -1,0 +1,135 @@
+"""VUEs from known surfaces (ours): a tracker that knows its tunnel's planes places a new VUE at
+the mirror image of the UE estimate instead of learning it from the path's angles.
+
+Algorithm 3 places a VUE where the path's arrival ray meets the plane ``x = x_u`` and learns the
+surface over the drive; a design knows its tunnel, so a path from a known surface says where the
+UE is as directly as the LoS does. :class:`GeometricBirth` (an initiator role) matches each free
+path to the known plane whose mirror of the UE estimate best explains its angles (the smallest
+normalised angle innovation, gated at ``probability``) and appends the VUE at
+``v = M_s p_u - 2 o_s n_s`` (``M_s = I - 2 n_s n_s^T``, plane ``n_s . p + o_s = 0`` with
+``n_s`` across the tunnel), its covariance and cross-covariance mapped through the reflection
+(``M P_uu M^T``, ``M P_u,:``): the new VUE is tied to the UE, and with ``MirrorMotion`` it moves
+by the mirrored displacement under the same speed/heading noise, so it stays tied (a reduced
+state up to the VUE random walk). A path no known plane explains (a vehicle, a surface missing
+from the model) is born from its angles as :class:`~.manage.MeasuredBirth` does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._validate import finite_array, instance, probability
+from ...geometry import spherical_jacobian
+from ..gating import ChiSquareGate
+from .config import JavelinConfig
+from .manage import MeasuredBirth
+from .measurement import PathMeasurements
+from .state import JavelinState
+
+__all__ = ["GeometricBirth", "mirror_vue"]
+
+
+def mirror_vue(state: JavelinState, normal, offset: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(y, z)`` (2,) of the UE estimate mirrored in the plane ``normal . p + offset = 0``
+    (``normal`` (3,) unit, no component along the tunnel) and the map ``d(y_v, z_v)/d s``
+    (2, D) of the whole state (only the UE's ``y, z`` enter)."""
+    instance("state", state, JavelinState)
+    n = finite_array("normal", normal, shape=(3,))
+    if abs(np.linalg.norm(n) - 1.0) > 1e-9 or abs(n[0]) > 1e-9:
+        raise ValueError(f"normal: expected a unit normal across the tunnel (n_x = 0), got {n}")
+    m = n[1:]
+    M = np.eye(2) - 2.0 * np.outer(m, m)
+    yz = M @ state.x[1:3] - 2.0 * float(offset) * m
+    A = np.zeros((2, state.dim))
+    A[:, 1:3] = M
+    return yz, A
+
+
+@dataclass(frozen=True)
+class GeometricBirth(MeasuredBirth):
+    """Births at the mirror image of the UE in a known plane (module docstring). ``normals``
+    (S, 3) unit normals across the tunnel and ``offsets`` (S,) [m] of the planes
+    ``n . p + o = 0`` in the tracker's coordinates; ``probability``: the angle gate that decides
+    whether a plane explains a path (2 degrees of freedom). ``update_at_birth`` defaults to
+    True: the VUE was not placed by its path, so the path's information is new."""
+
+    normals: tuple = ()
+    offsets: tuple = ()
+    probability: float = 0.9999
+    update_at_birth: bool = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        n = finite_array("normals", np.asarray(self.normals, float).reshape(-1, 3), ndim=2)
+        o = finite_array("offsets", np.asarray(self.offsets, float).reshape(-1), ndim=1)
+        if n.shape[0] != o.size:
+            raise ValueError(f"offsets: expected one per normal ({n.shape[0]}), got {o.size}")
+        if n.size and (
+            np.any(np.abs(np.linalg.norm(n, axis=1) - 1.0) > 1e-9) or np.any(np.abs(n[:, 0]) > 1e-9)
+        ):
+            raise ValueError("normals: expected unit normals across the tunnel (n_x = 0)")
+        probability("probability", self.probability)
+        object.__setattr__(self, "normals", tuple(map(tuple, n.tolist())))
+        object.__setattr__(self, "offsets", tuple(o.tolist()))
+
+    @classmethod
+    def from_planes(cls, planes, **kw) -> GeometricBirth:
+        """From :class:`tunnelkit.geometry.Plane` objects (or anything with ``normal`` (3,) and
+        ``offset``); planes with a component of their normal along the tunnel are left out (a
+        VUE of JAVELIN shares the UE's ``x``)."""
+        keep = [p for p in planes if abs(float(np.asarray(p.normal, float)[0])) <= 1e-9]
+        return cls(
+            normals=tuple(tuple(float(v) for v in p.normal) for p in keep),
+            offsets=tuple(float(p.offset) for p in keep),
+            **kw,
+        )
+
+    def match(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
+        """The plane index whose mirror of the UE explains path ``j``'s angles best within the
+        gate, or ``None``."""
+        if not self.normals:
+            return None
+        R = noise.covariances(meas, config)[j, :2, :2]
+        z = np.array([meas.phi[j], meas.psi[j]])
+        gate = ChiSquareGate(self.probability).threshold(2)
+        Puu = state.P[1:3, 1:3]
+        best = None
+        for s, (n, o) in enumerate(zip(self.normals, self.offsets, strict=True)):
+            yz, A = mirror_vue(state, n, o)
+            q = np.array([state.x[0], yz[0], yz[1]]) - config.bs
+            try:
+                Js = spherical_jacobian(q)[:2, 1:]  # d(phi, psi) / d(y_v, z_v)
+            except ValueError:
+                continue
+            h = np.array([np.arctan2(q[1], q[0]), np.arctan2(q[2], np.hypot(q[0], q[1]))])
+            y = z - h
+            y[0] = (y[0] + np.pi) % (2 * np.pi) - np.pi
+            M = A[:, 1:3]
+            S = Js @ M @ Puu @ M.T @ Js.T + R
+            try:
+                d2 = float(y @ np.linalg.solve(0.5 * (S + S.T), y))
+            except np.linalg.LinAlgError:
+                continue
+            if d2 <= gate and (best is None or d2 < best[0]):
+                best = (d2, s)
+        return None if best is None else best[1]
+
+    def place(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
+        """``(yz, cov, cross, bias_cross)`` of the VUE born from path ``j`` at the mirror of the
+        UE in the matched plane, or ``None`` when no known plane explains the path (the caller
+        then births it from its angles). ``bias_cross`` (2, 4 L_hat + 4) with a consider
+        cross-covariance ``C``: the UE's bias cross-covariance mirrored, zero for the new
+        track's own bias (it did not place the VUE)."""
+        s = self.match(state, meas, j, config, noise)
+        if s is None:
+            return None
+        yz, A = mirror_vue(state, self.normals[s], self.offsets[s])
+        cross = A @ state.P
+        cov = cross @ A.T
+        bias_cross = None
+        if state.C is not None:
+            bias_cross = np.zeros((2, state.C.shape[1] + 4))
+            bias_cross[:, :-4] = A @ state.C
+        return yz, 0.5 * (cov + cov.T), cross, bias_cross
