@@ -47,6 +47,7 @@ from .geometry import KINDS, RouteGeometry, trace_route
 from .montecarlo import (
     MODES,
     SETTLE_S,
+    START_HEIGHT_SIGMA_M,
     START_SIGMA_M,
     STARTS,
     VUES,
@@ -78,6 +79,7 @@ __all__ = [
     "MODES",
     "SETTLE_S",
     "STARTS",
+    "START_HEIGHT_SIGMA_M",
     "START_SIGMA_M",
     "STATUSES",
     "VUES",

@@ -56,6 +56,7 @@ __all__ = [
     "MODES",
     "SETTLE_S",
     "STARTS",
+    "START_HEIGHT_SIGMA_M",
     "START_SIGMA_M",
     "VUES",
     "MonteCarloResult",
@@ -68,9 +69,10 @@ __all__ = [
 MODES = ("bound", "channel")
 
 #: where a drive's tracker starts (:func:`sweep_montecarlo`): ``"drawn"`` an open-sky fix drawn
-#: from ``N(truth, START_SIGMA_M^2 I_3)`` with the run's generator (the tracker's ``P_0`` is then
-#: its true error), ``"truth"`` the true first position with the same ``P_0`` (the paper tables'
-#: start, which rewards a tracker that trusts its measurements too little)
+#: from ``N(truth, diag(s^2, s^2, s_h^2))`` (``s`` :data:`START_SIGMA_M`, ``s_h``
+#: :data:`START_HEIGHT_SIGMA_M`) with the run's generator, so the tracker's ``P_0`` is its true
+#: error; ``"truth"`` the true first position with the same ``P_0`` (the paper tables' start,
+#: which rewards a tracker that trusts its measurements too little)
 STARTS = ("drawn", "truth")
 
 #: how the design's tracker gets its VUEs (:func:`sweep_montecarlo`): ``"known"`` at the UE's
@@ -81,6 +83,10 @@ VUES = ("known", "learned")
 #: the open-sky fix's standard deviation per axis [m]: the tracker's ``sigma_p0_ue`` and the
 #: prior of the bounds over the drive (:func:`drive_pcrlb`)
 START_SIGMA_M = 1.0
+
+#: the open-sky fix's height standard deviation [m]: a vehicle's antenna height is known (the
+#: PEB and the bounds over the drive take it as known); the start's and the tracker's ``P_0``
+START_HEIGHT_SIGMA_M = 0.05
 
 
 def javelin_config(crlb: dict, min_d: float = 0.0, planes=None):
@@ -189,8 +195,9 @@ class _SweepTrial:
             )
         sigma = START_SIGMA_M
         # the open-sky fix: drawn after the drive (the drive's draws do not depend on it)
-        p0 = draw_start(drive.truth[0], sigma, rng) if self.start == "drawn" else None
-        ev = evaluate(drive, prep.design, sigma_p0_ue=sigma, start=p0)
+        sh = START_HEIGHT_SIGMA_M
+        p0 = draw_start(drive.truth[0], sigma, rng, sh) if self.start == "drawn" else None
+        ev = evaluate(drive, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
         return _trial_errors(ev.estimates, drive.truth)
 
 

@@ -73,13 +73,15 @@ def evaluate(
     keep_reports: bool = False,
     sigma_p0_ue: float = 1.0,
     start=None,
+    sigma_p0_height: float | None = None,
 ) -> Evaluation:
     """Run ``method`` ("JAVELIN" with ``design``, default the paper's, or "TeNFiLoc") on
     ``drive`` and score it against the truth.
 
     JAVELIN starts from ``start`` (3,) [m], default the true first position (the open-sky fix
     the paper assumes, as the tables do), with ``sigma_p0_ue`` [m] of uncertainty; the base
-    station is the drive's reference antenna. The design's Monte-Carlo gives a start drawn with
+    station is the drive's reference antenna; ``sigma_p0_height`` (default ``sigma_p0_ue``) the
+    height's. The design's Monte-Carlo gives a start drawn with
     that uncertainty (:func:`tunnelkit.tracking.javelin.draw_start`).
     """
     if not isinstance(drive, DriveData):
@@ -101,9 +103,9 @@ def evaluate(
             f"each path's covariance, but the drive's route ({drive.extraction!r}) reports none "
             "(SignalRoute(report_covariance=True))"
         )
-    est, run = cls.for_drive(drive, d, sigma_p0_ue=sigma_p0_ue, start=start).track(
-        drive, keep_reports=keep_reports
-    )
+    est, run = cls.for_drive(
+        drive, d, sigma_p0_ue=sigma_p0_ue, start=start, sigma_p0_height=sigma_p0_height
+    ).track(drive, keep_reports=keep_reports)
     return Evaluation(run.estimates, error_metrics(run.estimates, drive.truth), run)
 
 

@@ -47,7 +47,9 @@ class JavelinConfig:
     - V2X velocity-sensor noise ``sigma_speed`` (0.2 m/s), ``sigma_heading`` (1 deg);
     - birth covariance ``sigma_p0`` (10 m, ``P_0|0 = sigma_P^2 I``) and the initial UE
       uncertainty ``sigma_p0_ue`` (10 m as in the paper's ``P_0|0``; the studies start from an
-      open-sky fix of 1 m);
+      open-sky fix of 1 m); ``sigma_p0_height`` (ours) the initial uncertainty of the UE's
+      height when it is known better than its position (a vehicle's antenna height; default
+      ``None``: ``sigma_p0_ue`` on every axis, as the paper);
     - ours (not in the paper): ``sigma_vue_walk`` [m/sqrt(s)] random-walk intensity of a VUE,
       ``sigma_height`` [m/sqrt(s)] drift of the (known) UE height, ``doppler_tolerance`` [m/s]
       for the static/dynamic test, ``sigma_speed_missing`` [m/s] extra speed noise while the
@@ -70,6 +72,7 @@ class JavelinConfig:
     sigma_height: float = 0.01
     doppler_tolerance: float = 1.0
     sigma_speed_missing: float = 1.0
+    sigma_p0_height: float | None = None
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
@@ -80,6 +83,8 @@ class JavelinConfig:
             raise ValueError(f"los_gamma: must lie in (0, 1], got {g}")
         for name in _SIGMAS:
             positive(name, getattr(self, name))
+        if self.sigma_p0_height is not None:
+            positive("sigma_p0_height", self.sigma_p0_height)
         bs = vector("base_station", self.base_station, 3)
         object.__setattr__(self, "base_station", tuple(float(v) for v in bs))
 

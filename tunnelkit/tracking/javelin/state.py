@@ -57,11 +57,13 @@ class JavelinState:
     C: np.ndarray | None = None
 
     @classmethod
-    def initial(cls, position, sigma: float) -> JavelinState:
-        """UE only, at ``position`` (3,) with covariance ``sigma^2 I_3`` (``P_0|0`` of sec. 4.2)."""
+    def initial(cls, position, sigma: float, sigma_height: float | None = None) -> JavelinState:
+        """UE only, at ``position`` (3,) with covariance ``sigma^2 I_3`` (``P_0|0`` of sec. 4.2);
+        ``sigma_height`` (default ``sigma``) replaces the height's standard deviation."""
         p = vector("position", position, 3)
         s = positive("sigma", sigma)
-        return cls(x=p.copy(), P=np.eye(3) * s * s)
+        sh = s if sigma_height is None else positive("sigma_height", sigma_height)
+        return cls(x=p.copy(), P=np.diag([s * s, s * s, sh * sh]))
 
     def __post_init__(self) -> None:
         self.x = finite_array("x", self.x, ndim=1)

@@ -71,7 +71,7 @@ class Javelin:
             )
         self.config = self.design.config
         p0 = vector("initial_position", initial_position, 3)
-        self.state = JavelinState.initial(p0, self.config.sigma_p0_ue)
+        self.state = JavelinState.initial(p0, self.config.sigma_p0_ue, self.config.sigma_p0_height)
         if getattr(self.design.noise, "consider", False):
             self.state.C = np.zeros((3, 4))  # the UE's bias, uncorrelated with the start
         self.gate = ChiSquareGate(self.config.gate_probability)
@@ -87,18 +87,21 @@ class Javelin:
         *,
         sigma_p0_ue: float = 1.0,
         start=None,
+        sigma_p0_height: float | None = None,
     ):
         """A tracker for a simulated drive (anything with ``truth``, ``base_station``,
         ``epochs``, ``speed``, ``heading``, ``dt``): it starts from ``start`` (3,) [m], default
         the true first position (the open-sky fix the paper assumes), with ``sigma_p0_ue`` [m]
-        of uncertainty, the base station at the drive's reference antenna, the roles of
-        ``design`` (default the paper's). An honest start (its error drawn with the covariance
+        of uncertainty (``sigma_p0_height`` for the height when given), the base station at the
+        drive's reference antenna, the roles of ``design`` (default the paper's). An honest start (its error drawn with the covariance
         the tracker is told, :func:`draw_start`) is the caller's to give."""
         d = JavelinDesign() if design is None else design
         if not isinstance(d, JavelinDesign):
             raise TypeError(f"design: expected a JavelinDesign, got {type(d).__name__}")
         d = d.with_(
-            base_station=tuple(float(v) for v in drive.base_station), sigma_p0_ue=sigma_p0_ue
+            base_station=tuple(float(v) for v in drive.base_station),
+            sigma_p0_ue=sigma_p0_ue,
+            sigma_p0_height=sigma_p0_height,
         )
         p0 = drive.truth[0] if start is None else vector("start", start, 3)
         return cls(p0, d)
@@ -278,13 +281,17 @@ class JavelinRun:
     faults: int
 
 
-def draw_start(truth, sigma: float, rng: np.random.Generator) -> np.ndarray:
-    """An open-sky fix (3,) [m] drawn from ``N(truth, sigma^2 I_3)``: the start whose error the
-    tracker's ``P_0 = sigma^2 I`` (``sigma_p0_ue``) describes, not the truth itself."""
+def draw_start(
+    truth, sigma: float, rng: np.random.Generator, sigma_height: float | None = None
+) -> np.ndarray:
+    """An open-sky fix (3,) [m] drawn from ``N(truth, diag(sigma^2, sigma^2, sigma_height^2))``
+    (``sigma_height`` default ``sigma``): the start whose error the tracker's ``P_0``
+    (``sigma_p0_ue``, ``sigma_p0_height``) describes, not the truth itself."""
     p = vector("truth", truth, 3)
     s = positive("sigma", sigma)
+    sh = s if sigma_height is None else positive("sigma_height", sigma_height)
     rng = rng_or_error("rng", rng)
-    return p + s * rng.standard_normal(3)
+    return p + np.array([s, s, sh]) * rng.standard_normal(3)
 
 
 def _v2x(name: str, value) -> np.ndarray:
