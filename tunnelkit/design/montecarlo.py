@@ -120,7 +120,11 @@ class MonteCarloResult:
     from the ideal per-path CRLB (under impairments the ideal posterior bound, not an achievable one)
     (``None`` on the channel route without a model); ``sigmas`` the tracker's fallback sigmas;
     ``drive`` (T,) [m] the achievable bound over the drive (:func:`drive_bound`: the posterior
-    CRLB with the bias that does not average down; equal to ``pcrlb`` for an ideal model).
+    CRLB with the bias that does not average down; equal to ``pcrlb`` for an ideal model), the
+    surfaces known; ``learned`` (T,) [m] the same for a tracker that learns its VUEs
+    (:func:`~tunnelkit.design.learnedbound.learned_pcrlb`: the posterior CRLB of UE + VUEs and
+    the bias of the filter attaining it, in quadrature); ``vues`` how the tracker run got its
+    VUEs (:data:`VUES`), and :attr:`tracker_bound` the bound of that tracker.
     """
 
     spec: ArraySpec
@@ -134,6 +138,14 @@ class MonteCarloResult:
     pcrlb: np.ndarray | None
     sigmas: dict
     drive: np.ndarray | None = None
+    learned: np.ndarray | None = None
+    vues: str = "known"
+
+    @property
+    def tracker_bound(self) -> np.ndarray | None:
+        """The achievable bound over the drive of the tracker that was run (T,) [m]:
+        ``drive`` for VUEs from the known surfaces, ``learned`` for learnt VUEs."""
+        return self.drive if self.vues == "known" else self.learned
 
     @property
     def runs(self) -> int:
@@ -233,10 +245,11 @@ class _Prepared:
     peb: np.ndarray
     pcrlb: np.ndarray | None
     drive: np.ndarray | None
+    learned: np.ndarray | None = None
 
     def summary(self) -> tuple:
         """What the sweep's result keeps (not the model and route the drives need)."""
-        return self.peb, self.pcrlb, self.drive, self.design.config
+        return self.peb, self.pcrlb, self.drive, self.design.config, self.learned
 
 
 @dataclass(frozen=True)
@@ -257,7 +270,7 @@ class _ArrayJob:
     def __call__(self, spec: ArraySpec) -> _Prepared:
         ep = np.arange(self.T)
         peb = route_bounds(self.setup, spec, epochs=ep).peb
-        m = route = pc = drive = None
+        m = route = pc = drive = learned = None
         if self.with_model:
             m = _model(self.setup, spec, self.error_models, self.impairments)
             if self.mode == "bound":
@@ -268,6 +281,9 @@ class _ArrayJob:
             head = _head(m, self.T)
             pc = drive_pcrlb(self.setup, position_information(head, g))
             drive = drive_bound(pc, position_bias_rms(head, g))
+            from .learnedbound import learned_pcrlb
+
+            learned = drive_bound(*learned_pcrlb(head, g, self.setup))
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
             crlb = _median_sigmas(m)
@@ -276,7 +292,7 @@ class _ArrayJob:
             crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
         planes = design_planes(self.setup) if self.vues == "known" else None
         design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
-        return _Prepared(spec, route, design, peb, pc, drive)
+        return _Prepared(spec, route, design, peb, pc, drive, learned)
 
 
 def _summary(prep: _Prepared) -> tuple:
@@ -396,7 +412,7 @@ def sweep_montecarlo(
     out = {}
     for a, spec in enumerate(specs):
         err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
-        peb, pc, drive, cfg = built[a]
+        peb, pc, drive, cfg, learned = built[a]
         out[spec.label] = MonteCarloResult(
             spec,
             mode,
@@ -413,6 +429,8 @@ def sweep_montecarlo(
                 "delta_d_m": cfg.sigma_delta_d,
             },
             drive,
+            learned,
+            vues,
         )
     return out
 

@@ -53,12 +53,15 @@ class GeometricBirth(MeasuredBirth):
     (S, 3) unit normals across the tunnel and ``offsets`` (S,) [m] of the planes
     ``n . p + o = 0`` in the tracker's coordinates; ``probability``: the angle gate that decides
     whether a plane explains a path (2 degrees of freedom). ``update_at_birth`` defaults to
-    True: the VUE was not placed by its path, so the path's information is new."""
+    True: the VUE was not placed by its path, so the path's information is new. ``acquire``:
+    the tracker's first epoch starts with an iterated fix on the shortest path
+    (:meth:`~.tracker.Javelin._acquire`), so the VUEs are placed from a UE on the LoS ray."""
 
     normals: tuple = ()
     offsets: tuple = ()
     probability: float = 0.9999
     update_at_birth: bool = True
+    acquire: bool = True
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -71,6 +74,8 @@ class GeometricBirth(MeasuredBirth):
         ):
             raise ValueError("normals: expected unit normals across the tunnel (n_x = 0)")
         probability("probability", self.probability)
+        if not isinstance(self.acquire, bool):
+            raise TypeError(f"acquire: expected True or False, got {self.acquire!r}")
         object.__setattr__(self, "normals", tuple(map(tuple, n.tolist())))
         object.__setattr__(self, "offsets", tuple(o.tolist()))
 

@@ -25,6 +25,10 @@ from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
 from .motion import predict, ue_velocity
 from .roles import JavelinDesign
 from .state import JavelinState, track_slice
+from .update import stack_measurement
+
+#: iterations of the first fix's iterated EKF at most (:meth:`Javelin._acquire`)
+ACQUIRE_ITERATIONS = 20
 
 __all__ = ["Javelin", "JavelinRun", "StepReport", "draw_start", "run_javelin"]
 
@@ -183,6 +187,40 @@ class Javelin:
                 n_clutter += n
         return meas, n_clutter
 
+    def _acquire(self, meas: PathMeasurements, faults: list[str]) -> int | None:
+        """The first fix (ours; an initiator with ``acquire``, :class:`~.surfaces.GeometricBirth`):
+        before anything is associated or born, the UE is updated with the shortest path (in a
+        tunnel with the array inside, every reflection is longer than the LoS) by an iterated
+        EKF, relinearised at its own estimate until it settles. An open-sky fix a metre off
+        puts the UE's prior where a reflection's wavefront is as likely as the LoS's, and the
+        micro-radian angles of a large array leave a one-step EKF far from the ray; relinearised,
+        the update lands on the ray. Returns the path used (the epoch's update leaves it out,
+        so it counts once), or ``None``."""
+        st, cfg, roles = self.state, self.config, self.design
+        d = np.where(np.isfinite(meas.d), meas.d, np.inf)
+        if st.n_vue or not len(meas) or not np.isfinite(d).any():
+            return None
+        j = int(np.argmin(d))
+        x0, P0, C0 = st.x.copy(), st.P.copy(), None if st.C is None else st.C.copy()
+        xi = x0.copy()
+        for _ in range(ACQUIRE_ITERATIONS):
+            try:
+                pred, J = roles.curvature.predict(xi, cfg.bs)
+                m = stack_measurement(pred, J, meas, [(0, j)], cfg, j, roles.noise, C0)
+                m.h = m.h + m.H @ (x0 - xi)  # linearised at xi, the prior at x0
+                out = roles.updater.update(x0, P0, m, C0)
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                faults.append(f"first fix failed ({exc}): the open-sky fix kept")
+                return None
+            step = np.linalg.norm(out[0] - xi)
+            xi = out[0]
+            if step < 1e-6:
+                break
+        st.x, st.P = out[0], out[1]
+        if len(out) == 4:
+            st.C = out[3]
+        return j
+
     # -- Algorithm 4 --------------------------------------------------------------------------
     def step(
         self, paths: PathMeasurements | None, speed: float | None, heading: float | None, dt: float
@@ -194,6 +232,9 @@ class Javelin:
         meas = self._paths(paths, faults)
         nu, theta, sig_nu = self._motion(speed, heading, faults)
         meas, n_clutter = self._prefilter(meas, nu if sig_nu is None else None)
+        used = None
+        if self.k == 0 and getattr(roles.initiator, "acquire", False) and len(meas):
+            used = self._acquire(meas, faults)
         # Predict (eq. 62-63)
         st = self.state
         st.x, st.P = predict(
@@ -221,7 +262,9 @@ class Javelin:
             # ManageTracks (Algorithm 3)
             v_u = ue_velocity(nu, theta) if sig_nu is None else None
             mres = manage_tracks(st, meas, assoc, cfg, v_u, initiator=roles.initiator, noise=noise)
-            # Update (eq. 64-68)
+            # Update (eq. 64-68); the first fix's path has been used (counted once)
+            if used is not None:
+                mres.pairs = [(i, j) for i, j in mres.pairs if (i, j) != (0, used)]
             pred, J = roles.curvature.predict(st.x, cfg.bs)
             try:
                 m, left_out = roles.updater.stack(
