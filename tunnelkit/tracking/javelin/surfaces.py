@@ -94,8 +94,19 @@ class GeometricBirth(MeasuredBirth):
     def match(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
         """The plane index whose mirror of the UE explains path ``j``'s angles best within the
         gate, or ``None``."""
+        return self.match_distance(state, meas, j, config, noise)[0]
+
+    def inside(self, p, bs) -> bool:
+        """Whether ``p`` (3,) lies on the base station's side of every known plane."""
+        n = np.asarray(self.normals, float).reshape(-1, 3)
+        o = np.asarray(self.offsets, float)
+        return bool(np.all((n @ np.asarray(p, float) + o) * (n @ np.asarray(bs, float) + o) > 0))
+
+    def match_distance(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
+        """``(plane, d2)``: :meth:`match` and its squared normalised angle innovation
+        (``(None, inf)`` when no plane explains the path)."""
         if not self.normals:
-            return None
+            return None, np.inf
         R = noise.covariances(meas, config)[j, :2, :2]
         z = np.array([meas.phi[j], meas.psi[j]])
         gate = ChiSquareGate(self.probability).threshold(2)
@@ -119,7 +130,7 @@ class GeometricBirth(MeasuredBirth):
                 continue
             if d2 <= gate and (best is None or d2 < best[0]):
                 best = (d2, s)
-        return None if best is None else best[1]
+        return (None, np.inf) if best is None else (best[1], best[0])
 
     def place(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
         """``(yz, cov, cross, bias_cross)`` of the VUE born from path ``j`` at the mirror of the

@@ -187,38 +187,61 @@ class Javelin:
                 n_clutter += n
         return meas, n_clutter
 
-    def _acquire(self, meas: PathMeasurements, faults: list[str]) -> int | None:
-        """The first fix (ours; an initiator with ``acquire``, :class:`~.surfaces.GeometricBirth`):
-        before anything is associated or born, the UE is updated with the shortest path (in a
-        tunnel with the array inside, every reflection is longer than the LoS) by an iterated
-        EKF, relinearised at its own estimate until it settles. An open-sky fix a metre off
-        puts the UE's prior where a reflection's wavefront is as likely as the LoS's, and the
-        micro-radian angles of a large array leave a one-step EKF far from the ray; relinearised,
-        the update lands on the ray. Returns the path used (the epoch's update leaves it out,
-        so it counts once), or ``None``."""
+    def _fix(self, meas: PathMeasurements, j: int):
+        """The UE's prior updated with path ``j`` as its LoS by an iterated EKF (relinearised at
+        its own estimate until it settles): ``(x, P, C)``."""
         st, cfg, roles = self.state, self.config, self.design
-        d = np.where(np.isfinite(meas.d), meas.d, np.inf)
-        if st.n_vue or not len(meas) or not np.isfinite(d).any():
-            return None
-        j = int(np.argmin(d))
         x0, P0, C0 = st.x.copy(), st.P.copy(), None if st.C is None else st.C.copy()
         xi = x0.copy()
         for _ in range(ACQUIRE_ITERATIONS):
-            try:
-                pred, J = roles.curvature.predict(xi, cfg.bs)
-                m = stack_measurement(pred, J, meas, [(0, j)], cfg, j, roles.noise, C0)
-                m.h = m.h + m.H @ (x0 - xi)  # linearised at xi, the prior at x0
-                out = roles.updater.update(x0, P0, m, C0)
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                faults.append(f"first fix failed ({exc}): the open-sky fix kept")
-                return None
+            pred, J = roles.curvature.predict(xi, cfg.bs)
+            m = stack_measurement(pred, J, meas, [(0, j)], cfg, j, roles.noise, C0)
+            m.h = m.h + m.H @ (x0 - xi)  # linearised at xi, the prior at x0
+            out = roles.updater.update(x0, P0, m, C0)
             step = np.linalg.norm(out[0] - xi)
             xi = out[0]
             if step < 1e-6:
                 break
-        st.x, st.P = out[0], out[1]
-        if len(out) == 4:
-            st.C = out[3]
+        return out[0], out[1], (out[3] if len(out) == 4 else st.C)
+
+    def _acquire(self, meas: PathMeasurements, faults: list[str]) -> int | None:
+        """The first fix (ours; an initiator with ``acquire``, :class:`~.surfaces.GeometricBirth`):
+        before anything is associated or born, every path is tried as the LoS (:meth:`_fix`) and
+        the hypothesis kept that the known surfaces explain best: a UE inside the tunnel, the
+        smallest ``(x - x_0)^T P_0^-1 (x - x_0)`` plus, per other path, the normalised angle
+        innovation of the plane whose mirror image explains it (the gate's threshold when none
+        does). An open-sky fix a metre off puts the UE's prior where a reflection's wavefront is
+        as likely as the LoS's, the LoS and the ceiling path differ by millimetres in delay, and
+        the micro-radian angles of a large array leave a one-step EKF far from the ray. Returns
+        the path used (the epoch's update leaves it out, so it counts once), or ``None``."""
+        st, cfg, init = self.state, self.config, self.design.initiator
+        if st.n_vue or not len(meas):
+            return None
+        x0, P0 = st.x.copy(), st.P.copy()
+        best = None
+        for j in range(len(meas)):
+            try:
+                x, P, C = self._fix(meas, j)
+            except (ValueError, np.linalg.LinAlgError):
+                continue
+            if not init.inside(x[:3], cfg.bs):
+                continue
+            dx = x - x0
+            score = float(dx @ np.linalg.solve(P0, dx))
+            trial = JavelinState(x, P)
+            gate = ChiSquareGate(init.probability).threshold(2)
+            for k in range(len(meas)):
+                if k != j:
+                    d2 = init.match_distance(trial, meas, k, cfg, self.design.noise)[1]
+                    score += min(d2, gate)
+            if best is None or score < best[0]:
+                best = (score, j, x, P, C)
+        if best is None:
+            faults.append(
+                "first fix failed (no path gives a UE inside the tunnel): open-sky fix kept"
+            )
+            return None
+        _, j, st.x, st.P, st.C = best
         return j
 
     # -- Algorithm 4 --------------------------------------------------------------------------
