@@ -66,7 +66,9 @@ class DesignRow:
     ``share``-quantile (the 90th percentile at the default share). ``status`` is a verdict of
     :func:`tunnelkit.design.verdict.judge` or ``"error"`` (``reason`` says why). Per-epoch
     arrays cover the whole route: ``x_m``, ``peb_m``, ``achievable_m`` and, with runs,
-    ``error_median_epoch_m`` (median over runs).
+    ``error_median_epoch_m`` (median over runs). With runs on the bound route, the bounds over
+    the drive (RMS, counted epochs) of a tracker that knows the surfaces and of one that learns
+    its VUEs (``drive_bound_known_rms_m``, ``drive_bound_learned_rms_m``, :func:`_drive_bounds`).
     """
 
     array: str
@@ -91,6 +93,10 @@ class DesignRow:
     peb_m: np.ndarray | None = None
     achievable_m: np.ndarray | None = None
     error_median_epoch_m: np.ndarray | None = None
+    tracker_vues: str | None = None
+    drive_bound_known_rms_m: float | None = None
+    drive_bound_learned_rms_m: float | None = None
+    rmse_over_tracker_bound: float | None = None
     screen_m: float | None = field(default=None, repr=False)
     srnf_valid: np.ndarray | None = field(default=None, repr=False)
 
@@ -103,7 +109,8 @@ class DesignRow:
         """``array, n_elements, aperture_diagonal_m, status, reason, srnf_valid_share,
         srnf_valid_share_by_surface, peb_median_m, peb_p90_m, achievable_median_m,
         achievable_p90_m, met_share, error_median_m, error_p90_m, error_p90_ci95_m, rmse_m,
-        rmse_ci95_m, runs`` and ``per_epoch {x_m, peb_m, achievable_m, error_median_m}``
+        rmse_ci95_m, runs, tracker_vues, drive_bound_known_rms_m, drive_bound_learned_rms_m,
+        rmse_over_tracker_bound`` and ``per_epoch {x_m, peb_m, achievable_m, error_median_m}``
         (non-finite values and anything not computed are null)."""
         return {
             "array": self.array,
@@ -126,6 +133,10 @@ class DesignRow:
             "rmse_m": _fin(self.rmse_m),
             "rmse_ci95_m": _fins(self.rmse_ci95_m),
             "runs": int(self.runs),
+            "tracker_vues": self.tracker_vues,
+            "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
+            "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
+            "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
             "per_epoch": {
                 "x_m": _fins(self.x_m),
                 "peb_m": _fins(self.peb_m),
@@ -422,6 +433,7 @@ def _score(row, res, criterion, target, share, seed, n_boot) -> None:
     idx = rng.integers(0, runs, size=(n_boot, runs))
     boot = np.sqrt(sq.mean(axis=1)[idx].mean(axis=1))
     row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
+    _drive_bounds(row, res, k)
     row.status, row.reason = judge(
         target,
         row.screen_m,
@@ -430,6 +442,17 @@ def _score(row, res, criterion, target, share, seed, n_boot) -> None:
         ci=row.error_p90_ci95_m,
         share=share,
     )
+
+
+def _drive_bounds(row, res, k) -> None:
+    """RMS over the counted epochs ``k`` of ``res.drive`` (surfaces known) and ``res.learned``
+    (VUEs learnt); the tracker's RMSE over the bound of the VUEs it ran with."""
+    known, learned = getattr(res, "drive", None), getattr(res, "learned", None)
+    if known is not None and learned is not None:
+        rms = [float(np.sqrt(np.mean(np.asarray(b)[k] ** 2))) for b in (known, learned)]
+        row.drive_bound_known_rms_m, row.drive_bound_learned_rms_m = rms
+        row.tracker_vues, bound = res.vues, rms[0] if res.vues == "known" else rms[1]
+        row.rmse_over_tracker_bound = row.rmse_m / bound if bound > 0 else None
 
 
 def design_sweep(
