@@ -29,6 +29,10 @@ KEYS = {
     "rmse_m",
     "rmse_ci95_m",
     "runs",
+    "tracker_vues",
+    "drive_bound_known_rms_m",
+    "drive_bound_learned_rms_m",
+    "rmse_over_tracker_bound",
     "per_epoch",
 }
 INPUTS = {"scenario", "arrays", "fc", "bandwidth", "target", "share", "criterion", "impairments"}
@@ -46,7 +50,9 @@ def test_json_answers_the_28ghz_question(capsys):
     for a in out["arrays"]:
         assert set(a) == KEYS
         assert a["runs"] == 0 and a["status"] in ("bound only", "hopeless")
-        assert all(a[k] is None for k in KEYS if k.startswith(("error", "rmse")))
+        assert all(
+            a[k] is None for k in KEYS if k.startswith(("error", "rmse", "drive", "tracker"))
+        )
         ep = a["per_epoch"]
         assert len(ep["x_m"]) == len(ep["peb_m"]) == len(ep["achievable_m"]) == 40
         assert ep["error_median_m"] is None
@@ -193,3 +199,13 @@ def test_monte_carlo_identical_on_two_workers():
     serial = design.javelin_rmse(setup, "4x4", 2, 7, n_epochs=3)
     dask = design.javelin_rmse(setup, "4x4", 2, 7, n_epochs=3, workers=2)
     assert np.array_equal(serial["runs"], dask["runs"])
+
+
+def test_json_reports_both_bounds_over_the_drive(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "8x8", "--runs", "2"]
+    assert main([*argv, "--n-epochs", "12", "--format", "json", "--no-progress"]) == 0
+    a = json.loads(capsys.readouterr().out)["arrays"][0]
+    assert a["tracker_vues"] == "known"
+    known, learned = a["drive_bound_known_rms_m"], a["drive_bound_learned_rms_m"]
+    assert 0 < known < learned  # learning the surfaces costs information
+    assert a["rmse_over_tracker_bound"] == pytest.approx(a["rmse_m"] / known)
