@@ -14,12 +14,20 @@ is identical serially and on any number of workers. Two measurement routes:
 
 JAVELIN there takes each path's covariance as the extraction reports it (the CRLB at the
 estimate, which the ML route attains), so the tracker is tuned by the design itself at any
-carrier and size (:func:`javelin_config`); its settled error (after the first :data:`SETTLE_S`)
+carrier and size (:func:`javelin_config`). It starts from an open-sky fix drawn with the
+uncertainty it is told (:data:`STARTS`; 1 m across, 5 cm in height), first fixes itself on the
+path the known surfaces say is the LoS, and takes its VUEs from the tunnel's known surfaces
+(:data:`VUES`, :class:`tunnelkit.tracking.javelin.surfaces.GeometricBirth`): a design knows
+its tunnel, and a tracker that learns every VUE afresh cannot use the reflections' information
+until it has learnt the surfaces (under a calibration error, whose bias repeats, it never
+does). Its settled error (after the first :data:`SETTLE_S`)
 is set beside the PEB, the posterior CRLB over the drive (:func:`drive_pcrlb`, Tichavsky et
 al. 1998 with JAVELIN's motion model and the position information of the model's reported bound)
 and the bound over the drive under the impairments (:func:`drive_bound`: the posterior CRLB with
 the position bias of the array's one calibration draw and of the wideband term added, which no
-number of epochs averages down). :func:`javelin_rmse` is the one-array summary on top of it.
+number of epochs averages down) and beside the same bound for a tracker that learns its VUEs
+(:mod:`tunnelkit.design.learnedbound`); ``MonteCarloResult.tracker_bound`` is the one of the
+tracker run. :func:`javelin_rmse` is the one-array summary on top of it.
 
 Cost: the per-array work (error model, the bound route's shared part
 :func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
