@@ -32,7 +32,7 @@ def _case():
 
 
 def _short(K):
-    setup, spec, m, g = _case()
+    setup, spec, m, _ = _case()
     return setup, _head(m, K), design.route_geometry(setup, spec, epochs=np.arange(K))
 
 
@@ -71,8 +71,8 @@ def test_filter_bias_of_one_epoch_is_the_snapshot_bias():
 
 def test_learning_the_vues_costs_information():
     setup, _, m, g = _case()
-    pk, bk = learned_pcrlb(m, g, setup, vues="known")
-    pl, bl = learned_pcrlb(m, g, setup)
+    pk, _ = learned_pcrlb(m, g, setup, vues="known")
+    pl, _ = learned_pcrlb(m, g, setup)
     assert np.all(pl >= pk * (1 - 1e-9))
     assert np.mean(pl) > 1.05 * np.mean(pk)
 
