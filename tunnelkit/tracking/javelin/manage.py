@@ -238,7 +238,10 @@ def manage_tracks(
     for j in free:
         placed = None
         if callable(getattr(initiator, "place", None)):  # VUEs from known surfaces
-            placed = initiator.place(state, meas, j, config, noise)
+            placed = initiator.place(state, meas, j, config, noise, ref=los_path)
+            if placed is not None and placed[0] is None:  # two surfaces explain it: wait
+                unborn.append(j)
+                continue
         yz = intersection(meas.phi[j], meas.psi[j], state.x[0], config.bs)
         if placed is not None:
             yz = placed[0]

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import finite_array, instance, probability
+from ..._validate import finite_array, instance, positive, probability
 from ...geometry import spherical_jacobian
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
@@ -28,7 +28,10 @@ from .manage import MeasuredBirth
 from .measurement import PathMeasurements
 from .state import JavelinState
 
-__all__ = ["GeometricBirth", "mirror_vue"]
+__all__ = ["AMBIGUOUS", "GeometricBirth", "mirror_vue"]
+
+#: :meth:`GeometricBirth.match` when two planes explain a path about equally well
+AMBIGUOUS = -1
 
 
 def mirror_vue(state: JavelinState, normal, offset: float) -> tuple[np.ndarray, np.ndarray]:
@@ -53,7 +56,9 @@ class GeometricBirth(MeasuredBirth):
     (S, 3) unit normals across the tunnel and ``offsets`` (S,) [m] of the planes
     ``n . p + o = 0`` in the tracker's coordinates; ``probability``: the angle gate that decides
     whether a plane explains a path (2 degrees of freedom). ``update_at_birth`` defaults to
-    True: the VUE was not placed by its path, so the path's information is new. ``acquire``:
+    True: the VUE was not placed by its path, so the path's information is new. ``margin``:
+    a path two planes explain within this difference of ``d2`` is not born until one wins
+    (a small array's angles do not tell a wall from a road marking a few degrees away). ``acquire``:
     the tracker's first epoch starts with an iterated fix on the shortest path
     (:meth:`~.tracker.Javelin._acquire`), so the VUEs are placed from a UE on the LoS ray."""
 
@@ -62,6 +67,7 @@ class GeometricBirth(MeasuredBirth):
     probability: float = 0.9999
     update_at_birth: bool = True
     acquire: bool = True
+    margin: float = 9.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -74,6 +80,7 @@ class GeometricBirth(MeasuredBirth):
         ):
             raise ValueError("normals: expected unit normals across the tunnel (n_x = 0)")
         probability("probability", self.probability)
+        positive("margin", self.margin)
         if not isinstance(self.acquire, bool):
             raise TypeError(f"acquire: expected True or False, got {self.acquire!r}")
         object.__setattr__(self, "normals", tuple(map(tuple, n.tolist())))
@@ -91,10 +98,10 @@ class GeometricBirth(MeasuredBirth):
             **kw,
         )
 
-    def match(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
-        """The plane index whose mirror of the UE explains path ``j``'s angles best within the
-        gate, or ``None``."""
-        return self.match_distance(state, meas, j, config, noise)[0]
+    def match(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise, ref=None):
+        """The plane index whose mirror of the UE explains path ``j`` best within the gate, or
+        ``None`` (:meth:`match_distance`)."""
+        return self.match_distance(state, meas, j, config, noise, ref)[0]
 
     def inside(self, p, bs) -> bool:
         """Whether ``p`` (3,) lies on the base station's side of every known plane."""
@@ -102,45 +109,72 @@ class GeometricBirth(MeasuredBirth):
         o = np.asarray(self.offsets, float)
         return bool(np.all((n @ np.asarray(p, float) + o) * (n @ np.asarray(bs, float) + o) > 0))
 
-    def match_distance(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
-        """``(plane, d2)``: :meth:`match` and its squared normalised angle innovation
-        (``(None, inf)`` when no plane explains the path)."""
+    def match_distance(
+        self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise, ref=None
+    ):
+        """``(plane, d2)``: the plane whose mirror image of the UE explains path ``j`` best and
+        the squared normalised innovation of its angles and, with a LoS path ``ref``, of its
+        delay difference ``d_j - d_ref`` (the UE's uncertainty mapped through the mirror), gated
+        at ``probability``; ``(None, inf)`` when no plane explains the path, ``(AMBIGUOUS,
+        d2)`` when a second plane's ``d2`` is within ``margin`` of the best. The delay tells a
+        wall from a road marking a few degrees away, which a small array's angles cannot."""
         if not self.normals:
             return None, np.inf
         R = noise.covariances(meas, config)[j, :2, :2]
-        z = np.array([meas.phi[j], meas.psi[j]])
-        gate = ChiSquareGate(self.probability).threshold(2)
-        Puu = state.P[1:3, 1:3]
-        best = None
+        z = [meas.phi[j], meas.psi[j]]
+        use_d = ref is not None and ref != j and np.isfinite(meas.d[j]) and np.isfinite(meas.d[ref])
+        if use_d:
+            Rd = float(noise.tdoa_covariance(meas, [j], ref, config)[0, 0])
+            R = np.block([[R, np.zeros((2, 1))], [np.zeros((1, 2)), np.array([[Rd]])]])
+            z.append(meas.d[j] - meas.d[ref])
+        z = np.asarray(z, float)
+        gate = ChiSquareGate(self.probability).threshold(z.size)
+        u = state.x[:3]
+        qu = u - config.bs
+        Puu = state.P[:3, :3]
+        cands = []
         for s, (n, o) in enumerate(zip(self.normals, self.offsets, strict=True)):
             yz, A = mirror_vue(state, n, o)
-            q = np.array([state.x[0], yz[0], yz[1]]) - config.bs
+            q = np.array([u[0], yz[0], yz[1]]) - config.bs
+            D = np.eye(3)
+            D[1:, 1:] = A[:, 1:3]  # d VUE / d UE
             try:
-                Js = spherical_jacobian(q)[:2, 1:]  # d(phi, psi) / d(y_v, z_v)
+                Js = spherical_jacobian(q) @ D  # d(phi, psi, r) / d UE
             except ValueError:
                 continue
-            h = np.array([np.arctan2(q[1], q[0]), np.arctan2(q[2], np.hypot(q[0], q[1]))])
-            y = z - h
+            h = [np.arctan2(q[1], q[0]), np.arctan2(q[2], np.hypot(q[0], q[1]))]
+            H = Js[:2]
+            if use_d:
+                h.append(np.linalg.norm(q) - np.linalg.norm(qu))
+                H = np.vstack([H, Js[2] - qu / np.linalg.norm(qu)])
+            y = z - np.asarray(h)
             y[0] = (y[0] + np.pi) % (2 * np.pi) - np.pi
-            M = A[:, 1:3]
-            S = Js @ M @ Puu @ M.T @ Js.T + R
+            S = H @ Puu @ H.T + R
             try:
                 d2 = float(y @ np.linalg.solve(0.5 * (S + S.T), y))
             except np.linalg.LinAlgError:
                 continue
-            if d2 <= gate and (best is None or d2 < best[0]):
-                best = (d2, s)
-        return (None, np.inf) if best is None else (best[1], best[0])
+            if d2 <= gate:
+                cands.append((d2, s))
+        if not cands:
+            return None, np.inf
+        cands.sort()
+        if len(cands) > 1 and cands[1][0] - cands[0][0] < self.margin:
+            return AMBIGUOUS, cands[0][0]
+        return cands[0][1], cands[0][0]
 
-    def place(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise):
+    def place(self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise, ref=None):
         """``(yz, cov, cross, bias_cross)`` of the VUE born from path ``j`` at the mirror of the
         UE in the matched plane, or ``None`` when no known plane explains the path (the caller
         then births it from its angles). ``bias_cross`` (2, 4 L_hat + 4) with a consider
         cross-covariance ``C``: the UE's bias cross-covariance mirrored, zero for the new
-        track's own bias (it did not place the VUE)."""
-        s = self.match(state, meas, j, config, noise)
+        track's own bias (it did not place the VUE). ``ref``: the epoch's LoS path (its delay
+        helps the match)."""
+        s = self.match(state, meas, j, config, noise, ref)
         if s is None:
             return None
+        if s == AMBIGUOUS:  # not born this epoch: the UE's next estimate decides
+            return None, None, None, None
         yz, A = mirror_vue(state, self.normals[s], self.offsets[s])
         cross = A @ state.P
         cov = cross @ A.T

@@ -229,10 +229,10 @@ class Javelin:
             dx = x - x0
             score = float(dx @ np.linalg.solve(P0, dx))
             trial = JavelinState(x, P)
-            gate = ChiSquareGate(init.probability).threshold(2)
+            gate = ChiSquareGate(init.probability).threshold(3)
             for k in range(len(meas)):
                 if k != j:
-                    d2 = init.match_distance(trial, meas, k, cfg, self.design.noise)[1]
+                    d2 = init.match_distance(trial, meas, k, cfg, self.design.noise, j)[1]
                     score += min(d2, gate)
             if best is None or score < best[0]:
                 best = (score, j, x, P, C)
