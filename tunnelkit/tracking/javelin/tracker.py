@@ -282,6 +282,8 @@ class Javelin:
             # Associate (Algorithm 2)
             R3 = noise.covariances(meas, cfg)
             costs, assoc = roles.associator(pred, J, st.P, meas, R3, self.gate)
+            if used is not None:  # the first fix chose the UE's path (no VUE exists yet)
+                assoc = [(0, used)]
             # ManageTracks (Algorithm 3)
             v_u = ue_velocity(nu, theta) if sig_nu is None else None
             mres = manage_tracks(st, meas, assoc, cfg, v_u, initiator=roles.initiator, noise=noise)
