@@ -259,8 +259,8 @@ size_figure(
 # %% [markdown]
 # Read the three tables top to bottom. With an ideal array every candidate's tracker error sits
 # within a small factor of its PEB and the smallest array passes; with half a degree of phase
-# error the achievable bound and the tracker's median error rise by more than an order of
-# magnitude over the PEB, the tracker staying within a small factor of the achievable bound;
+# error the achievable bound and the tracker's median error rise by about an order of magnitude
+# over the PEB, the tracker staying within a small factor of the achievable bound;
 # with 2° the smaller arrays are hopeless before any Monte-Carlo. The recommendation (printed
 # above, `recs`) follows the calibration, not the PEB. (In quick mode, with few drives, read the
 # verdicts "undecided" as exactly that.)
@@ -445,13 +445,13 @@ if not tk.quick_mode():
 else:  # few runs: no interval is presented as an answer
     assert all(r.status in ("undecided", "hopeless", "error") for r in answers["0.5°"].rows)
     assert any("runs" in w for w in answers["0.5°"].warnings)
-# section 6's reading: ideal, the tracker within a small factor of the PEB; at 0.5 deg far above
-# the PEB and within a small factor of the achievable bound
+# section 6's reading: ideal, the tracker within a small factor of the PEB; at 0.5 deg about an
+# order of magnitude above the PEB and within a small factor of the achievable bound
 for r in answers["ideal"].rows:
     assert r.error_median_m < 5 * r.peb_median_m, r.array
 for r in answers["0.5°"].rows:
     if r.error_median_m is not None:
-        assert r.error_median_m > 10 * r.peb_median_m, r.array
+        assert r.error_median_m > 5 * r.peb_median_m, r.array
         assert r.error_median_m < 4 * r.achievable_median_m, r.array
 # 2 deg: the small arrays are hopeless before any Monte-Carlo
 assert {r.array: r.status for r in answers["2°"].rows}["4x4"] == "hopeless"
