@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import nonnegative, positive
+from .._validate import finite_array, nonnegative, positive
+from ..budget import check_elements
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
 
@@ -117,6 +118,10 @@ def learned_model(
         raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    from .geometry import RouteGeometry
+
+    if not isinstance(geometry, RouteGeometry):
+        raise TypeError(f"geometry: expected a design.RouteGeometry, got {type(geometry).__name__}")
     if geometry.exists.shape != model.exists.shape:
         raise ValueError("geometry: expected the model's epochs and path slots")
     if vues not in ("learned", "known"):
@@ -216,8 +221,13 @@ def batch_information(info: np.ndarray, Q: np.ndarray, P0: np.ndarray) -> np.nda
     ``x_k = x_{k-1} + w_k`` with ``w_k ~ N(0, Q_k)`` and the per-epoch measurement information
     ``info`` (T, n, n) (no births in between): its inverse's last block is what the recursion of
     :func:`learned_pcrlb` gives at the last epoch."""
-    info = np.asarray(info, float)
+    info = finite_array("info", info, ndim=3)
     T, n = info.shape[:2]
+    if info.shape[2] != n:
+        raise ValueError(f"info: expected (T, n, n), got shape {info.shape}")
+    Q = finite_array("Q", Q, shape=info.shape)
+    P0 = finite_array("P0", P0, shape=(n, n))
+    check_elements("info", (T * n) ** 2)
     J = np.zeros((T * n, T * n))
     J[:n, :n] += np.linalg.inv(P0)
     for k in range(T):

@@ -112,6 +112,8 @@ def design_planes(setup: DesignSetup) -> list:
     """The planes of the surfaces a design traces (:data:`tunnelkit.design.geometry.KINDS`)."""
     from .geometry import KINDS
 
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     return [s.plane for s in setup.tunnel.surfaces if s.kind in KINDS]
 
 

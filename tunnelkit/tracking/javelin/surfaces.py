@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import finite_array, instance, positive, probability
+from ..._validate import finite_array, instance, integer, positive, probability, vector
 from ...geometry import spherical_jacobian
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
@@ -42,6 +42,7 @@ def mirror_vue(state: JavelinState, normal, offset: float) -> tuple[np.ndarray, 
     n = finite_array("normal", normal, shape=(3,))
     if abs(np.linalg.norm(n) - 1.0) > 1e-9 or abs(n[0]) > 1e-9:
         raise ValueError(f"normal: expected a unit normal across the tunnel (n_x = 0), got {n}")
+    offset = finite_array("offset", offset, ndim=0)
     m = n[1:]
     M = np.eye(2) - 2.0 * np.outer(m, m)
     yz = M @ state.x[1:3] - 2.0 * float(offset) * m
@@ -105,9 +106,10 @@ class GeometricBirth(MeasuredBirth):
 
     def inside(self, p, bs) -> bool:
         """Whether ``p`` (3,) lies on the base station's side of every known plane."""
+        p, bs = vector("p", p, 3), vector("bs", bs, 3)
         n = np.asarray(self.normals, float).reshape(-1, 3)
         o = np.asarray(self.offsets, float)
-        return bool(np.all((n @ np.asarray(p, float) + o) * (n @ np.asarray(bs, float) + o) > 0))
+        return bool(np.all((n @ p + o) * (n @ bs + o) > 0))
 
     def match_distance(
         self, state, meas: PathMeasurements, j: int, config: JavelinConfig, noise, ref=None
@@ -118,6 +120,14 @@ class GeometricBirth(MeasuredBirth):
         at ``probability``; ``(None, inf)`` when no plane explains the path, ``(AMBIGUOUS,
         d2)`` when a second plane's ``d2`` is within ``margin`` of the best. The delay tells a
         wall from a road marking a few degrees away, which a small array's angles cannot."""
+        instance("state", state, JavelinState)
+        instance("meas", meas, PathMeasurements)
+        instance("config", config, JavelinConfig)
+        j = integer("j", j, minimum=0, maximum=len(meas) - 1)
+        if ref is not None:
+            ref = integer("ref", ref, minimum=0, maximum=len(meas) - 1)
+        if not callable(getattr(noise, "covariances", None)):
+            raise TypeError(f"noise: expected a measurement-noise role, got {type(noise).__name__}")
         if not self.normals:
             return None, np.inf
         R = noise.covariances(meas, config)[j, :2, :2]
