@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -188,9 +188,14 @@ class Javelin:
         return meas, n_clutter
 
     def _fix(self, meas: PathMeasurements, j: int):
-        """The UE's prior updated with path ``j`` as its LoS by an iterated EKF (relinearised at
-        its own estimate until it settles): ``(x, P, C)``."""
+        """The UE's prior updated with path ``j``'s angles as its LoS by an iterated EKF
+        (relinearised at its own estimate until it settles): ``(x, P, C)``. The curvature is
+        left out: an extraction near its threshold reports it metres off with a sigma that
+        does not say so, and the height prior and the angles place the UE on the ray."""
         st, cfg, roles = self.state, self.config, self.design
+        kap = meas.kappa.copy()
+        kap[j] = np.nan
+        meas = replace(meas, kappa=kap)
         x0, P0, C0 = st.x.copy(), st.P.copy(), None if st.C is None else st.C.copy()
         xi = x0.copy()
         for _ in range(ACQUIRE_ITERATIONS):
