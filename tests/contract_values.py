@@ -339,15 +339,13 @@ def _baselines_tracking():
 
 
 def _known_surfaces():
-    """The design's tracker pieces: an honest start, VUEs from known planes, the first fix, and
-    the bound over the drive of a tracker that learns its VUEs."""
+    """The design's tracker pieces: an honest start, VUEs from known planes and the batch form
+    of the bound over the drive."""
     from tunnelkit import design
-    from tunnelkit.design.achievable import path_error_model
-    from tunnelkit.design.learnedbound import batch_information, learned_model, learned_pcrlb
+    from tunnelkit.design.learnedbound import batch_information
     from tunnelkit.design.montecarlo import design_planes
-    from tunnelkit.tracking.javelin import Javelin, draw_start
+    from tunnelkit.tracking.javelin import JavelinState, draw_start
     from tunnelkit.tracking.javelin.config import JavelinConfig
-    from tunnelkit.tracking.javelin.designs import array_design
     from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
     from tunnelkit.tracking.javelin.noise import ReportedNoise
     from tunnelkit.tracking.javelin.surfaces import GeometricBirth, mirror_vue
@@ -367,25 +365,18 @@ def _known_surfaces():
         cov=np.repeat(np.diag([1e-6, 1e-6, 0.01])[None], n, 0),
         sigma_d=np.full(n, 0.01),
     )
-    start = draw_start(truth, 1.0, rng, 0.05)
-    d = array_design({"d": 0.01, "direction": 1e-3, "kappa": 0.1}, planes=planes)
-    trk = Javelin(start, d.with_(base_station=bs, sigma_p0_ue=1.0, sigma_p0_height=0.05))
-    trk.step(meas, 0.0, 0.0, 0.0)
+    st = JavelinState.initial(draw_start(truth, 0.1, rng, 0.05), 0.1, 0.05)
     birth = GeometricBirth.from_planes(planes)
     cfg = JavelinConfig(base_station=bs)
-    st = trk.state
     birth.match(st, meas, 1, cfg, ReportedNoise(), 0)
     birth.match_distance(st, meas, 1, cfg, ReportedNoise(), 0)
     birth.place(st, meas, 1, cfg, ReportedNoise(), 0)
     birth.inside(truth, bs)
     mirror_vue(st, planes[0].normal, planes[0].offset)
-    setup = design.DesignSetup.from_scenario("italiano2026-straight")
-    design_planes(setup)
-    m = path_error_model(setup, "4x4")
-    g = design.route_geometry(setup, "4x4", epochs=np.arange(m.exists.shape[0]))
-    info, Q, _, _ = learned_model(m, g, setup)
-    learned_pcrlb(m, g, setup)
-    batch_information(info[:3], Q[:3], np.eye(info.shape[1]))
+    design_planes(design.DesignSetup.from_scenario("italiano2026-straight"))
+    A = rng.standard_normal((3, 2, 2))
+    info = A @ np.swapaxes(A, 1, 2)
+    batch_information(info, info + np.eye(2), np.eye(2))
 
 
 DRIVERS = (

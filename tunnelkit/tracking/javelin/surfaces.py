@@ -72,10 +72,15 @@ class GeometricBirth(MeasuredBirth):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        n = finite_array("normals", np.asarray(self.normals, float).reshape(-1, 3), ndim=2)
-        o = finite_array("offsets", np.asarray(self.offsets, float).reshape(-1), ndim=1)
+        n = finite_array("normals", self.normals, ndim=2) if len(self.normals) else np.zeros((0, 3))
+        if n.shape[1] != 3:
+            raise ValueError(f"normals: expected (S, 3) unit normals, got shape {n.shape}")
+        o = finite_array("offsets", self.offsets, ndim=1) if len(self.offsets) else np.zeros(0)
         if n.shape[0] != o.size:
-            raise ValueError(f"offsets: expected one per normal ({n.shape[0]}), got {o.size}")
+            raise ValueError(
+                f"normals, offsets: expected one offset per normal, got {n.shape[0]} normals "
+                f"and {o.size} offsets"
+            )
         if n.size and (
             np.any(np.abs(np.linalg.norm(n, axis=1) - 1.0) > 1e-9) or np.any(np.abs(n[:, 0]) > 1e-9)
         ):
@@ -92,6 +97,11 @@ class GeometricBirth(MeasuredBirth):
         """From :class:`tunnelkit.geometry.Plane` objects (or anything with ``normal`` (3,) and
         ``offset``); planes with a component of their normal along the tunnel are left out (a
         VUE of JAVELIN shares the UE's ``x``)."""
+        if isinstance(planes, str | bytes) or not hasattr(planes, "__iter__"):
+            raise TypeError(f"planes: expected a list of planes, got {type(planes).__name__}")
+        planes = list(planes)
+        if not planes or not all(hasattr(p, "normal") and hasattr(p, "offset") for p in planes):
+            raise ValueError("planes: expected at least one plane with a normal and an offset")
         keep = [p for p in planes if abs(float(np.asarray(p.normal, float)[0])) <= 1e-9]
         return cls(
             normals=tuple(tuple(float(v) for v in p.normal) for p in keep),
