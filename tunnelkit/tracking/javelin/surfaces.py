@@ -51,6 +51,10 @@ def mirror_vue(state: JavelinState, normal, offset: float) -> tuple[np.ndarray, 
     return yz, A
 
 
+def _empty(v) -> bool:
+    return isinstance(v, tuple | list) and not len(v)
+
+
 @dataclass(frozen=True)
 class GeometricBirth(MeasuredBirth):
     """Births at the mirror image of the UE in a known plane (module docstring). ``normals``
@@ -72,10 +76,14 @@ class GeometricBirth(MeasuredBirth):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        n = finite_array("normals", self.normals, ndim=2) if len(self.normals) else np.zeros((0, 3))
+        n = (
+            np.zeros((0, 3))
+            if _empty(self.normals)
+            else finite_array("normals", self.normals, ndim=2)
+        )
         if n.shape[1] != 3:
             raise ValueError(f"normals: expected (S, 3) unit normals, got shape {n.shape}")
-        o = finite_array("offsets", self.offsets, ndim=1) if len(self.offsets) else np.zeros(0)
+        o = np.zeros(0) if _empty(self.offsets) else finite_array("offsets", self.offsets, ndim=1)
         if n.shape[0] != o.size:
             raise ValueError(
                 f"normals, offsets: expected one offset per normal, got {n.shape[0]} normals "
