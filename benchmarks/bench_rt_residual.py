@@ -48,66 +48,48 @@ sys.path.insert(0, str(ROOT))
 
 from tunnelkit.channel import channel_tensor
 from tunnelkit.extraction.ml.residual import calibrated_threshold, residual_peak
-from tunnelkit.rt import ElementPaths, element_tensor
+from tunnelkit.rt import element_tensor, first_order_groups, tensor_components
 from tunnelkit.signal_route import SignalRoute
 
 COMPONENTS = ("diffuse", "specular2+", "wideband", "element_gain", "visibility")
-
-
-def _with(ep: ElementPaths, **kw) -> ElementPaths:
-    f = {k: getattr(ep, k) for k in ElementPaths.__dataclass_fields__}
-    f.update(kw)
-    return ElementPaths(**f)
-
-
-def first_order_reference(ep: ElementPaths) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per (element, slot) of the LoS and first-order specular paths: the reference element's
-    delay and gain of the same path (matched by order and first object; a path the reference
-    element does not see keeps its own), and the mask of those paths."""
-    first = ep.mask("los") | ep.mask("specular1")
-    tau0, g0 = ep.tau.copy(), ep.gain.copy()
-    for j in np.flatnonzero(first[0]):
-        same = first & (ep.order == ep.order[0, j]) & (ep.first_object == ep.first_object[0, j])
-        tau0[same], g0[same] = ep.tau[0, j], ep.gain[0, j]
-    return tau0, g0, first
 
 
 def components(route: SignalRoute, k: int) -> dict:
     """The noiseless tensors of epoch ``k`` (module docstring), transmit power included."""
     cfg = route.config
     arr, ep, trace_s = route.raytraced.trace(k)
-    args = (cfg.tone_spacing, cfg.n_tones, cfg.symbol_period, cfg.n_symbols)
-    amp = np.sqrt(cfg.tx_power)
-
-    def synth(e, sel):
-        return amp * element_tensor(e, *args, select=sel)
-
-    tau0, g0, first = first_order_reference(ep)
-    H = {
-        "full": synth(ep, None),
-        "diffuse": synth(ep, ep.mask("diffuse")),
-        "specular2+": synth(ep, ep.mask("specular2+")),
-    }
-    H1 = synth(ep, first)
-    H1_nb = synth(_with(ep, tau=tau0), first)
-    model = _with(ep, tau=tau0, gain=g0 * np.exp(-2j * np.pi * cfg.fc * (ep.tau - tau0)))
-    H1_model = synth(model, first)
-    H["wideband"] = H1 - H1_nb
-    H["element_gain"] = H1_nb - H1_model
+    H = tensor_components(
+        ep,
+        cfg.fc,
+        cfg.tone_spacing,
+        cfg.n_tones,
+        cfg.symbol_period,
+        cfg.n_symbols,
+        amplitude=np.sqrt(cfg.tx_power),
+    )
     _, paths = route.paths(k)
     atoms = np.stack([channel_tensor([p], cfg).ravel() for p in paths], axis=1)
-    H["visibility"] = (H1_model.ravel() - _project(atoms, H1_model.ravel())).reshape(H1.shape)
+    model = H["first_order_model"].ravel()
+    H["visibility"] = (model - _project(atoms, model)).reshape(H["full"].shape)
+    eng = route.raytraced.engine()
     groups = []
-    for j in np.flatnonzero(first[0]):
-        same = first & (ep.order == ep.order[0, j]) & (ep.first_object == ep.first_object[0, j])
-        h = synth(model, same).ravel()
+    for g in first_order_groups(ep):
+        h = (
+            np.sqrt(cfg.tx_power)
+            * element_tensor(
+                ep,
+                cfg.tone_spacing,
+                cfg.n_tones,
+                cfg.symbol_period,
+                cfg.n_symbols,
+                select=g["select"],
+            ).ravel()
+        )
         cor = np.abs(atoms.conj().T @ h) / np.linalg.norm(atoms, axis=0) / np.linalg.norm(h)
         groups.append(
             {
-                "surface": route.raytraced.engine().surface_of(int(ep.first_object[0, j]))[0]
-                if ep.order[0, j]
-                else "los",
-                "elements": int(same.sum()),
+                "surface": eng.surface_of(g["first_object"])[0] if g["order"] else "los",
+                "elements": g["count"],
                 "corr": float(cor.max()),
                 "power_N0": float(np.mean(np.abs(h) ** 2) / cfg.noise_power),
             }
