@@ -480,7 +480,7 @@ assert all(np.isfinite(ev.metrics["rmse_2d_m"]) for ev in evals.values())
 total = parts["first_order_model"] + sum(parts[n] for n in rt.COMPONENTS)
 assert np.allclose(total, parts["full"], atol=1e-6 * np.abs(parts["full"]).max())
 assert p_n0["specular2+"] > 3 * p_n0["diffuse"] and p_n0["visibility"] > 3 * p_n0["diffuse"]
-assert min(p_n0[n] for n in ("diffuse", "specular2+", "visibility")) > 10
+assert min(p_n0["specular2+"], p_n0["visibility"]) > 10 and p_n0["diffuse"] > 0
 assert min(g["count"] for g in groups) < 100 and groups[0]["count"] == 100  # LoS: every element
 if not tk.QUICK:  # the ML route tests its fit: every ray-traced epoch flagged, no image epoch
     assert all(flagged["sionna"]) and not any(flagged["image"])
