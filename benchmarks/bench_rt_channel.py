@@ -19,8 +19,11 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    ``image``, ``sionna`` (first-order model), ``sionna_floor`` (the same, its fit tested against
    noise + diffuse power, ``SignalRoute(diffuse_floor=True)``), ``sionna_2nd`` (the model also
    carries the ``--second-order`` strongest second-order images, ``SignalRoute(second_order=N)``;
-   the bound is then the whole model's CRLB) and ``sionna_2nd_floor`` (both). Also the number of
-   draws each route's extraction flags (``fit_ok`` False).
+   the bound is then the whole model's CRLB), ``sionna_2nd_floor`` (both) and
+   ``sionna_glrt_floor`` (the model order by a detection test per added path from the
+   first-order paths up to ``--max-paths``, ``SignalRoute(model_order="glrt")``, with the
+   diffuse floor). Also the draws each route's extraction flags (``fit_ok`` False), per epoch,
+   the number of paths each route extracted and its seconds per epoch.
 3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
    direct path-by-path sum against the non-uniform FFT (``method="nufft"``, ``eps=1e-9``), on
    ``--synthesis-epochs`` epochs traced afresh per drive (not from the cache, which keeps only the
