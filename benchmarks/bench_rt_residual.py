@@ -4,34 +4,30 @@ The extraction's residual test flags every ray-traced epoch. This benchmark meas
 carry that residual. Per epoch it traces the paths afresh (:meth:`tunnelkit.rt.RayTracedChannel.trace`)
 and splits the noiseless tensor (transmit power included, noise power ``N0`` of the radio) into
 
-* ``diffuse``: every path with a diffuse interaction;
-* ``specular2+``: specular paths of two or more bounces;
-* ``wideband``: the spatial-wideband term of the LoS and first-order specular paths: their
-  tensor with each element's own delay across the band minus the same with the reference
-  element's delay (the carrier phase per element kept);
-* ``element_gain``: what eq. 1's constant complex gain per path leaves out across the array
-  (the 1/distance amplitude per element, the reflection coefficient's change with the incidence
-  angle, the polarisation projection): the first-order tensor without the wideband term minus
-  the one with every element's gain replaced by the reference element's gain times the traced
-  carrier phase difference ``exp(-j 2 pi fc (tau_m - tau_0))``;
-* ``visibility``: that last tensor (constant gains, traced delays) minus its least-squares fit by
-  the image method's eq. 1 atoms of the same paths (:func:`tunnelkit.channel.channel_tensor`,
-  a free complex gain per path). A sign or reference mismatch between the two conventions would
-  show here; so does a first-order path that only part of the array sees (the specular point
-  leaves a finite facet or road marking across the aperture; no diffraction is traced, so the
-  field is cut at the shadow boundary), and a facet's path that the image method does not list
-  at the reference element. Per first-order path the benchmark prints how many elements see it
-  and the normalised correlation of its tensor with the best image-method atom (1 for a path
-  every element sees, when the conventions agree).
+* the parts of :func:`tunnelkit.rt.tensor_components`: ``diffuse``, ``specular2+``, the
+  spatial-wideband term of the first-order paths (``wideband``), the change of a path's gain
+  across the array (``element_gain``: 1/distance, the reflection coefficient's change with the
+  incidence angle, the polarisation projection) and of its Doppler shift (``element_doppler``),
+  beside ``first_order_model`` (each first-order path with the reference element's gain, delay
+  and Doppler);
+* ``visibility``: ``first_order_model`` minus its least-squares fit by the image method's eq. 1
+  atoms of the same paths (:func:`tunnelkit.channel.channel_tensor`, a free complex gain per
+  path). A sign or reference mismatch between the two conventions would show here; so does a
+  first-order path that only part of the array sees (the specular point leaves a finite facet
+  or road marking across the aperture; no diffraction is traced, so the field is cut at the
+  shadow boundary), a facet's path the image method does not list at the reference element, and
+  any other difference between the traced paths and the image method's. Per first-order path
+  the benchmark prints how many elements see it and the normalised correlation of its tensor
+  (as traced) with the best image-method atom.
 
 For each: its power per sample over ``N0``, and the largest peak of its single-path periodogram
 in noise units (:func:`tunnelkit.extraction.ml.residual.residual_peak`, the statistic of the
 extraction's residual test; the threshold at its false-alarm rate is printed). Then the residual
 the first-order model leaves at the **true** parameters (the full tensor minus its least-squares
-fit by the image method's first-order atoms) and the same residual with each component removed
-from the tensor, one at a time, and all of them.
+fit by the image method's first-order atoms) and the same residual with each part of
+:func:`tunnelkit.rt.tensor_components` removed from the tensor, one at a time, and all of them.
 
-    python benchmarks/bench_rt_residual.py --epochs 0 12 24 36
+    python benchmarks/bench_rt_residual.py --epochs 0 12 24 28
 """
 
 from __future__ import annotations
@@ -48,10 +44,11 @@ sys.path.insert(0, str(ROOT))
 
 from tunnelkit.channel import channel_tensor
 from tunnelkit.extraction.ml.residual import calibrated_threshold, residual_peak
+from tunnelkit.rt import COMPONENTS as RT_COMPONENTS
 from tunnelkit.rt import element_tensor, first_order_groups, tensor_components
 from tunnelkit.signal_route import SignalRoute
 
-COMPONENTS = ("diffuse", "specular2+", "wideband", "element_gain", "visibility")
+COMPONENTS = (*RT_COMPONENTS, "visibility")
 
 
 def components(route: SignalRoute, k: int) -> dict:
@@ -128,10 +125,10 @@ def study(route: SignalRoute, k: int) -> dict:
         return float(np.mean(np.abs(r) ** 2) / n0), residual_peak(r, pos, cfg.fc, n0)[0]
 
     out["residual"] = {"none removed": resid(full)}
-    for name in COMPONENTS[:4]:
+    for name in RT_COMPONENTS:
         out["residual"][f"-{name}"] = resid(full - H[name].ravel())
-    allr = full - sum(H[n].ravel() for n in COMPONENTS[:4])
-    out["residual"]["-all four"] = resid(allr)
+    allr = full - sum(H[n].ravel() for n in RT_COMPONENTS)
+    out["residual"]["-all five"] = resid(allr)
     out["threshold"] = calibrated_threshold(pos, cfg.fc, H["full"].shape)
     out["signal"] = float(np.mean(np.abs(full) ** 2) / n0)
     return out
@@ -140,7 +137,7 @@ def study(route: SignalRoute, k: int) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="italiano2026-straight")
-    ap.add_argument("--epochs", type=int, nargs="+", default=[0, 12, 24, 36])
+    ap.add_argument("--epochs", type=int, nargs="+", default=[0, 12, 24, 28])
     a = ap.parse_args(argv)
     route = SignalRoute.from_scenario(a.scenario, channel="sionna")
     for k in a.epochs:

@@ -51,18 +51,25 @@ def test_parts_sum_to_the_tensor_and_match_their_paths():
     assert np.allclose(total, h["full"], rtol=0, atol=1e-9 * np.abs(h["full"]).max())
     direct = 2.0 * rt.element_tensor(ep, DF, NF, T0, NT, select=ep.mask("diffuse"))
     assert np.allclose(h["diffuse"], direct, atol=1e-12)
-    assert np.abs(h["wideband"]).max() > 0 and np.abs(h["element_gain"]).max() > 0
+    for n in ("wideband", "element_gain", "element_doppler"):
+        assert np.abs(h[n]).max() > 0, n
     groups = rt.first_order_groups(ep)
     assert [(g["order"], g["first_object"], g["count"]) for g in groups] == [(0, -1, 9), (1, 7, 8)]
 
 
 def test_constant_gain_spherical_paths_leave_no_element_gain_and_equal_delays_no_wideband():
+    """And equal Doppler shifts across the array leave no element_doppler part."""
     rng = np.random.default_rng(2)
     h = _parts(_paths(rng, constant_gain=True))
     scale = np.abs(h["full"]).max()
     assert np.abs(h["element_gain"]).max() < 1e-12 * scale
     h = _parts(_paths(rng, same_delay=True))
     assert np.abs(h["wideband"]).max() < 1e-12 * scale
+    ep = _paths(rng)
+    f = ep.doppler.copy()
+    f[:, :2] = f[0, :2]
+    h = _parts(rt.ElementPaths(ep.tau, ep.gain, f, ep.valid, ep.order, ep.diffuse, ep.first_object))
+    assert np.abs(h["element_doppler"]).max() < 1e-12 * np.abs(h["full"]).max()
 
 
 @pytest.mark.parametrize(

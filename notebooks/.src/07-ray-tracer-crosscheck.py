@@ -346,7 +346,7 @@ print(
 # splits one traced epoch's noiseless tensor into the parts that model has (each first-order
 # path with the reference element's gain and delay) and the parts it lacks: the diffuse paths,
 # the higher-order specular bounces, the spatial-wideband term and the change of each path's
-# gain across the array; what is left of the modelled part after its least-squares fit by the
+# gain and Doppler shift across the array; what is left of the modelled part after its least-squares fit by the
 # image method's eq. 1 atoms is the *visibility* part. Powers per tensor sample, in units of the
 # noise power $N_0$ (the ML fit's residual test flags a residual whose periodogram peaks above
 # about 17 $N_0$ per cell, over some $5\times10^5$ samples).

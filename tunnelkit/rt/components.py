@@ -4,7 +4,7 @@
 (:class:`~tunnelkit.rt.elements.ElementPaths`, :func:`~tunnelkit.rt.elements.element_tensor`)
 into parts that sum back to it exactly::
 
-    full = first_order_model + element_gain + wideband + specular2+ + diffuse
+    full = first_order_model + element_doppler + element_gain + wideband + specular2+ + diffuse
 
 * ``diffuse``: every path with a diffuse interaction;
 * ``specular2+``: the specular paths of two or more bounces;
@@ -14,10 +14,14 @@ into parts that sum back to it exactly::
 * ``element_gain``: what a constant complex gain per path leaves out across the array (the
   1/distance amplitude per element, the reflection coefficient's change with the incidence
   angle, the polarisation projection): the first-order tensor without the wideband term minus
-  ``first_order_model``;
-* ``first_order_model``: the LoS and first-order specular paths with the reference element's gain
-  and delay and the traced carrier phase difference ``exp(-j 2 pi fc (tau_m - tau_0))`` per
-  element: eq. 1's atom of each path, as far as the ray tracer's paths are whole.
+  the same with the reference element's gain (below);
+* ``element_doppler``: each element's own Doppler shift of a first-order path (in the near field
+  the direction of arrival, hence ``v . u / lambda``, changes across the aperture) against the
+  reference element's;
+* ``first_order_model``: the LoS and first-order specular paths with the reference element's
+  gain, delay and Doppler and the traced carrier phase difference
+  ``exp(-j 2 pi fc (tau_m - tau_0))`` per element: eq. 1's atom of each path, as far as the ray
+  tracer's paths are whole.
 
 A path is followed across the array by its order and the object of its first bounce; the
 reference element is element 0 (the array's reference antenna). A first-order path the reference
@@ -38,7 +42,7 @@ from .elements import ElementPaths, element_tensor
 __all__ = ["COMPONENTS", "first_order_groups", "tensor_components"]
 
 #: the parts of :func:`tensor_components` besides ``first_order_model``
-COMPONENTS = ("diffuse", "specular2+", "wideband", "element_gain")
+COMPONENTS = ("diffuse", "specular2+", "wideband", "element_gain", "element_doppler")
 
 
 def _check(paths) -> ElementPaths:
@@ -99,19 +103,22 @@ def tensor_components(
         return amp * element_tensor(e, *args, select=sel)
 
     first = ep.mask("los") | ep.mask("specular1")
-    tau0, g0 = ep.tau.copy(), ep.gain.copy()
+    tau0, g0, f0 = ep.tau.copy(), ep.gain.copy(), ep.doppler.copy()
     for g in first_order_groups(ep):
         tau0[g["select"]] = ep.tau[0, g["slot"]]
         g0[g["select"]] = ep.gain[0, g["slot"]]
+        f0[g["select"]] = ep.doppler[0, g["slot"]]
     model = _with(ep, tau=tau0, gain=g0 * np.exp(-2j * np.pi * fc * (ep.tau - tau0)))
     h1 = synth(ep, first)
     h1_nb = synth(_with(ep, tau=tau0), first)
+    h1_gain = synth(model, first)
     out = {
         "full": synth(ep, None),
-        "first_order_model": synth(model, first),
+        "first_order_model": synth(_with(model, doppler=f0), first),
         "diffuse": synth(ep, ep.mask("diffuse")),
         "specular2+": synth(ep, ep.mask("specular2+")),
         "wideband": h1 - h1_nb,
     }
-    out["element_gain"] = h1_nb - out["first_order_model"]
+    out["element_gain"] = h1_nb - h1_gain
+    out["element_doppler"] = h1_gain - out["first_order_model"]
     return out
