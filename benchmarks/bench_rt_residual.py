@@ -18,7 +18,8 @@ and splits the noiseless tensor (transmit power included, noise power ``N0`` of 
   shadow boundary), a facet's path the image method does not list at the reference element, and
   any other difference between the traced paths and the image method's. Per first-order path
   the benchmark prints how many elements see it and the normalised correlation of its tensor
-  (as traced) with the best image-method atom.
+  (as traced) with the best image-method atom, and the first-order paths the reference element
+  does not see (the image method does not list them).
 
 For each: its power per sample over ``N0``, and the largest peak of its single-path periodogram
 in noise units (:func:`tunnelkit.extraction.ml.residual.residual_peak`, the statistic of the
