@@ -19,8 +19,11 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    ``image``, ``sionna`` (first-order model), ``sionna_floor`` (the same, its fit tested against
    noise + diffuse power, ``SignalRoute(diffuse_floor=True)``), ``sionna_2nd`` (the model also
    carries the ``--second-order`` strongest second-order images, ``SignalRoute(second_order=N)``;
-   the bound is then the whole model's CRLB) and ``sionna_2nd_floor`` (both). Also the number of
-   draws each route's extraction flags (``fit_ok`` False).
+   the bound is then the whole model's CRLB), ``sionna_2nd_floor`` (both) and
+   ``sionna_glrt_floor`` (the model order by a detection test per added path from the
+   first-order paths up to ``--max-paths``, ``SignalRoute(model_order="glrt")``, with the
+   diffuse floor). Also the draws each route's extraction flags (``fit_ok`` False), per epoch,
+   the number of paths each route extracted and its seconds per epoch.
 3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
    direct path-by-path sum against the non-uniform FFT (``method="nufft"``, ``eps=1e-9``), on
    ``--synthesis-epochs`` epochs traced afresh per drive (not from the cache, which keeps only the
@@ -103,11 +106,25 @@ def _errors(ep, config, snr_offset_db=0.0) -> np.ndarray:
     return e[[p.kind != SECOND_ORDER for p in ep.paths]]
 
 
-ROUTES = ("image", "sionna", "sionna_floor", "sionna_2nd", "sionna_2nd_floor")
+ROUTES = (
+    "image",
+    "sionna",
+    "sionna_floor",
+    "sionna_2nd",
+    "sionna_2nd_floor",
+    "sionna_glrt_floor",
+)
 
 
 def extraction_study(
-    name: str, every: int, draws: int, seed: int, second_order: int, which=ROUTES
+    name: str,
+    every: int,
+    draws: int,
+    seed: int,
+    second_order: int,
+    which=ROUTES,
+    max_paths: int = 16,
+    epochs=None,
 ) -> dict:
     """Normalised errors of the first-order paths on both channels (same rng per draw), and on
     the ray-traced channel with ``second_order`` second-order paths in the model; the share of
@@ -124,12 +141,18 @@ def extraction_study(
         "sionna_2nd_floor": SignalRoute.from_scenario(
             name, channel="sionna", second_order=second_order, diffuse_floor=True
         ),
+        "sionna_glrt_floor": SignalRoute.from_scenario(
+            name, channel="sionna", diffuse_floor=True, model_order="glrt", max_paths=max_paths
+        ),
     }
     routes = {key: r for key, r in routes.items() if key in which}
-    ks = list(range(0, len(img.trajectory), every))
+    ks = list(range(0, len(img.trajectory), every)) if epochs is None else list(epochs)
     cfg = img.config
     out: dict[str, list] = {}
     flagged = dict.fromkeys(routes, 0)
+    per_epoch = {key: dict.fromkeys(ks, 0) for key in routes}
+    n_paths = {key: [] for key in routes}
+    seconds = {key: [] for key in routes}
     n_second = []
     kinds: list[str] = []
     for i, rng in enumerate(spawn_rngs(seed, len(ks) * draws)):
@@ -140,8 +163,13 @@ def extraction_study(
             warnings.simplefilter("ignore")
             for key, route in routes.items():
                 rng.bit_generator.state = state
+                t0 = time.perf_counter()
                 eps[key] = route.epoch(k, rng)
-                flagged[key] += eps[key].estimates.fit_ok is False
+                seconds[key].append(time.perf_counter() - t0)
+                bad = eps[key].estimates.fit_ok is False
+                flagged[key] += bad
+                per_epoch[key][k] += bad
+                n_paths[key].append(len(eps[key].estimates))
         two = [e for key, e in eps.items() if "2nd" in key]
         n_second.append(sum(p.kind == SECOND_ORDER for p in two[0].paths) if two else 0)
         pw = srt.raytraced.epoch(k)["power"]
@@ -168,6 +196,9 @@ def extraction_study(
         "epochs": ks,
         "draws": draws,
         "flagged": flagged,
+        "flagged_per_epoch": per_epoch,
+        "paths_extracted": n_paths,
+        "seconds": seconds,
         "n": len(ks) * draws,
         "second_order_paths": n_second,
     }
@@ -219,6 +250,16 @@ def report(costs: dict, studies: dict, synth: dict | None = None) -> str:
             + f"; second-order paths in the model per epoch: median "
             f"{np.median(st['second_order_paths']):.0f}"
         )
+        for key in st["flagged"]:
+            lines.append(
+                f"  {key}: flagged share per epoch "
+                + " ".join(
+                    f"{k}:{v / st['draws']:.2f}" for k, v in st["flagged_per_epoch"][key].items()
+                )
+                + f"; paths extracted median {np.median(st['paths_extracted'][key]):.0f} "
+                f"[{min(st['paths_extracted'][key])}, {max(st['paths_extracted'][key])}]; "
+                f"seconds per epoch median {np.median(st['seconds'][key]):.1f}"
+            )
         lines.append(f"{name}: |error| / CRLB of the first-order paths (median / RMS, missed)")
         for col, label in ((0, "d"), (2, "direction")):
             for key, e in st["errors"].items():
@@ -249,6 +290,8 @@ def main(argv=None) -> int:
     )
     ap.add_argument("--drives", nargs="+", default=list(DRIVES), choices=DRIVES)
     ap.add_argument("--routes", nargs="+", default=list(ROUTES), choices=ROUTES)
+    ap.add_argument("--max-paths", type=int, default=16, help="L_max of the glrt route")
+    ap.add_argument("--epochs", type=int, nargs="+", default=None, help="these epochs only")
     ap.add_argument("--json", type=Path, default=None)
     a = ap.parse_args(argv)
     synth = {
@@ -262,7 +305,16 @@ def main(argv=None) -> int:
         costs = {n: trace_costs(SignalRoute.from_scenario(n, channel="sionna")) for n in a.drives}
     if a.only in ("all", "extraction"):
         studies = {
-            n: extraction_study(n, a.epochs_every, a.draws, a.seed, a.second_order, a.routes)
+            n: extraction_study(
+                n,
+                a.epochs_every,
+                a.draws,
+                a.seed,
+                a.second_order,
+                a.routes,
+                a.max_paths,
+                a.epochs,
+            )
             for n in a.drives
         }
     print(report(costs, studies, synth))

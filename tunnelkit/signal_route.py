@@ -20,6 +20,7 @@ or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a singl
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -33,9 +34,11 @@ from .evaluation import match_paths
 __all__ = [
     "CHANNELS",
     "MAX_SECOND_ORDER",
+    "MODEL_ORDERS",
     "Epoch",
     "RouteMeasurements",
     "SignalRoute",
+    "glrt_paths",
     "measurements_from_estimates",
     "simulate_epoch",
 ]
@@ -46,6 +49,8 @@ __all__ = [
 CHANNELS = ("image", "sionna")
 #: the most second-order paths a route models (:attr:`SignalRoute.second_order`)
 MAX_SECOND_ORDER = 32
+#: how a route chooses the number of paths it extracts (:attr:`SignalRoute.model_order`)
+MODEL_ORDERS = ("known", "glrt")
 
 
 def _check_arrays(arrays) -> None:
@@ -264,6 +269,12 @@ class SignalRoute:
     diffuse interaction, times the transmit power; :meth:`ml_noise_power`) instead of the noise
     alone: the diffuse paths as a known noise-like nuisance. The fitted parameters are the
     same least-squares fit; only the tests and the re-seeding they trigger change.
+    ``model_order`` (:data:`MODEL_ORDERS`): ``"known"`` (default) extracts ``L`` = the number of
+    true paths; ``"glrt"`` starts there and adds paths one at a time while the fit's residual
+    holds one more (:func:`glrt_paths`: the residual test's periodogram peak above its threshold,
+    against the noise, or noise + diffuse power with ``diffuse_floor``), up to ``max_paths``.
+    The paths found beyond the true ones (higher-order bounces, clutter) stay in the
+    measurements unless matched to a modelled second-order path.
     """
 
     tunnel: object
@@ -282,6 +293,8 @@ class SignalRoute:
     wideband_model: bool = False
     second_order: int = 0
     diffuse_floor: bool = False
+    model_order: str = "known"
+    max_paths: int = 24
 
     def __post_init__(self) -> None:
         from .propagation import PATH_KINDS, Tunnel3D
@@ -306,6 +319,8 @@ class SignalRoute:
         boolean("bias_aware_delay_check", self.bias_aware_delay_check)
         boolean("wideband_model", self.wideband_model)
         integer("second_order", self.second_order, minimum=0, maximum=MAX_SECOND_ORDER)
+        choice("model_order", self.model_order, MODEL_ORDERS)
+        integer("max_paths", self.max_paths, minimum=1)
         if boolean("diffuse_floor", self.diffuse_floor) and self.channel != "sionna":
             raise ValueError(
                 "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
@@ -483,7 +498,11 @@ class SignalRoute:
             extract_kw.setdefault("wideband", True)
         if self.diffuse_floor and extract_kw.get("refine", "ml") == "ml":
             extract_kw.setdefault("noise_power", self.ml_noise_power(k, snap, tunnel))
-        est = self.extract(snap.H, arr, L, **extract_kw)
+        if self.model_order == "glrt" and extract_kw.get("refine", "ml") == "ml":
+            kw = {k: v for k, v in extract_kw.items() if k not in ("refine", "search")}
+            est = glrt_paths(snap.H, arr, self.config, L, max(L, self.max_paths), **kw)
+        else:
+            est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None
         meas, truth = _measure(est, arr, paths, snap, cfg, self.min_d)
         return Epoch(
@@ -498,6 +517,71 @@ class SignalRoute:
             meas,
             truth,
         )
+
+
+def glrt_paths(
+    H,
+    array: ArrayGeometry,
+    config: SRSConfig,
+    n_start: int,
+    max_paths: int,
+    *,
+    noise_power: float | None = None,
+    wideband: bool = False,
+):
+    """The model order by a detection test per added path, from ``n_start`` paths up: the ML fit
+    (:func:`tunnelkit.extraction.ml.ml_paths`) of ``n_start`` paths, then while its residual's
+    single-path periodogram peak (the GLRT statistic of one path more, the fit's ``peak``)
+    exceeds its threshold (``peak_max``) and fewer than ``max_paths`` (at most ``M - 1``) paths
+    are fitted, one path more started at that peak (its far-field direction, delay and Doppler,
+    :func:`tunnelkit.extraction.ml.residual.residual_peak`) and every path refitted from the
+    previous fit (no re-seeding). A fit whose newest path fails its own detection test
+    (``fit.detected``) ends the count one path earlier. ``noise_power`` is the floor of every
+    test (estimated from ``H`` when None). Returns the estimates at the chosen order."""
+    from .extraction.ml import ml_paths
+    from .extraction.ml.residual import residual_peak
+
+    instance("array", array, ArrayGeometry)
+    instance("config", config, SRSConfig)
+    H = np.asarray(H)
+    if H.ndim != 3 or H.shape[0] != array.M:
+        raise ValueError(f"H: expected an ({array.M}, Nf, Nt) tensor, got shape {H.shape}")
+    n0 = integer("n_start", n_start, minimum=1, maximum=array.M - 1)
+    cap = min(integer("max_paths", max_paths, minimum=n0), array.M - 1)
+
+    def fit(n, start=None):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            e = ml_paths(
+                H,
+                n,
+                array,
+                config,
+                start=start,
+                noise_power=noise_power,
+                n_reseed=None if start is None else 0,
+                wideband=wideband,
+            )
+        return e, caught
+
+    est, caught = fit(n0)
+    while len(est) < cap and est.fit.peak > est.fit.peak_max:
+        f = est.fit
+        model = np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
+        floor = f.noise_power if noise_power is None else noise_power
+        _, (ux, uy, mu_f, mu_t), _ = residual_peak(H - model, array.local, config.fc, floor)
+        start = (
+            np.vstack([f.theta, [ux, uy, 0]]),
+            np.append(f.mu_f, mu_f),
+            np.append(f.mu_t, mu_t),
+        )
+        nxt, nxt_caught = fit(len(est) + 1, start)
+        if not nxt.fit.detected.all():
+            break
+        est, caught = nxt, nxt_caught
+    for w in caught:  # the chosen fit's own warnings (the smaller orders' are expected)
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return est
 
 
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:

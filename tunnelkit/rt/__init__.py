@@ -231,10 +231,12 @@ from .compare import (  # noqa: E402
     time_engines,
     worst_errors,
 )
+from .components import COMPONENTS, first_order_groups, tensor_components  # noqa: E402
 from .elements import ElementPaths, element_tensor  # noqa: E402
 from .settings import RTSettings  # noqa: E402
 
 __all__ += [
+    "COMPONENTS",
     "ElementPaths",
     "MitsubaScene",
     "RTSettings",
@@ -243,8 +245,10 @@ __all__ += [
     "compare_paths",
     "default_cache_dir",
     "element_tensor",
+    "first_order_groups",
     "lower_into_tunnel",
     "plate_occluders",
+    "tensor_components",
     "time_engines",
     "worst_errors",
 ]

@@ -1,0 +1,100 @@
+"""JAVELIN-L (Italiano 2026 Tables 1-2, condition L) on both channel sources, seed 0 and held out.
+
+For each drive (straight = Table 1, slalom = Table 2), channel (``image``: eq. 1 from the image
+method; ``sionna``: the cached ray-traced tensor, diffuse scattering on, the ML fit tested against
+noise + diffuse power) and seed (0 and :data:`tunnelkit.studies.HELD_OUT_SEED`), ``--runs``
+drives through the ML route (:func:`tunnelkit.reproduce.javelin_tables.javelin_table`,
+condition L): the table's JAVELIN-L and TeNFiLoc-L rows, the epochs the extraction flagged, the
+wall time.
+
+On the ray-traced channel every epoch fails the extraction's residual test
+(``benchmarks/bench_rt_residual.py`` says why), and a flagged epoch carries no measurement
+(:func:`tunnelkit.studies.drives.path_measurements`): the table then scores the tracker's
+prediction from its start alone. ``--keep-flagged`` is the experiment beside it: in this process
+only, the adapter passes the flagged epochs' measurements on (the same estimates; only the
+``fit_ok`` verdict is ignored), so the tracker sees what the extraction measured.
+
+    python benchmarks/bench_rt_tables.py --runs 2 --drives straight --channels image sionna
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tunnelkit.reproduce.javelin_tables import javelin_table
+from tunnelkit.studies import HELD_OUT_SEED, drives
+
+TABLES = {
+    "straight": ("italiano2026-straight", "italiano2026_table1"),
+    "slalom": ("italiano2026-slalom", "italiano2026_table2"),
+}
+
+
+def keep_flagged() -> None:
+    """Let flagged epochs' measurements through :func:`drives.path_measurements` (this process)."""
+    original = drives.path_measurements
+
+    def adapter(ep, route):
+        pm, reason = original(ep, route)
+        if reason == drives.FLAGGED:
+            m = ep.measurements
+            pm = drives.PathMeasurements.from_arrays(
+                m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d
+            )
+            return pm, None
+        return pm, reason
+
+    drives.path_measurements = adapter
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=2)
+    ap.add_argument("--drives", nargs="+", default=list(TABLES), choices=list(TABLES))
+    ap.add_argument("--channels", nargs="+", default=["image", "sionna"])
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, HELD_OUT_SEED])
+    ap.add_argument("--keep-flagged", action="store_true")
+    a = ap.parse_args(argv)
+    if a.keep_flagged:
+        keep_flagged()
+    for name in a.drives:
+        scenario, ref = TABLES[name]
+        for chan in a.channels:
+            for seed in a.seeds:
+                t0 = time.perf_counter()
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    rep = javelin_table(
+                        scenario,
+                        ref,
+                        ("L",),
+                        a.runs,
+                        seed,
+                        False,
+                        extractions=("ml",),
+                        channel=chan,
+                        nuisance={"diffuse_floor": True} if chan == "sionna" else None,
+                    )
+                wall = time.perf_counter() - t0
+                fl, ep = rep.meta["flagged_epochs"]["ml"], rep.meta["epochs"]["ml"]
+                print(
+                    f"{name} channel={chan} seed={seed} runs={a.runs} keep_flagged={a.keep_flagged}: "
+                    f"wall {wall:.0f} s ({wall / a.runs:.0f} s/run), flagged {fl} of {ep} epochs"
+                )
+                for row in rep.rows:
+                    vals = ", ".join(
+                        f"{c}: {v:.3f}" for c, v in zip(rep.columns[2:], row[2:]) if v is not None
+                    )
+                    print(f"  {row[0]:11s} {row[1]:10s} {vals}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
