@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from .._validate import boolean, positive
+from .._validate import boolean, integer, positive, record
 from ..report import Report
 from .bounds import (
     mmax_2d,
@@ -47,6 +47,14 @@ class MmaxSummary:
     fraunhofer: float  #: mmax_fraunhofer(R)
     exact_capped: bool = False  #: the ULA search hit its limit: ``exact`` is a lower bound only
     exact_ura_capped: bool = False  #: the URA search hit its limit: ``exact_ura`` is a lower bound
+
+    def __post_init__(self) -> None:
+        record(
+            self,
+            positive=("R", "W", "fc", "eps_phi", "exact"),
+            nonnegative=("paraxial_ratio", "eq25", "eq37", "nonparaxial", "fraunhofer"),
+        )
+        integer("exact_ura", self.exact_ura, minimum=-1)  # -1: the URA search was skipped
 
     @property
     def ratio(self) -> float | None:

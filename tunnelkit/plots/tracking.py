@@ -8,6 +8,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .._validate import finite_array, nonnegative_array
 from .common import COLORS, line_figure, reveal_overlaps
 from .tables import TableFigure, table
 from .topview import tunnel_topview
@@ -120,7 +121,11 @@ def rmse_bound_figure(
     t, rmse: Mapping[str, np.ndarray], bound, *, title: str = "", log_y: bool = True
 ) -> go.Figure:
     """RMSE per epoch of each estimator with sqrt(posterior CRLB) dashed underneath."""
-    series = {**rmse, "PCRLB": np.asarray(bound)}
+    t = finite_array("t", t, ndim=1)
+    if not isinstance(rmse, Mapping):
+        raise TypeError(f"rmse: expected a mapping name -> values, got {type(rmse).__name__}")
+    bound = nonnegative_array("bound", bound, shape=(len(t),))
+    series = {**rmse, "PCRLB": bound}
     fig = line_figure(
         t,
         series,

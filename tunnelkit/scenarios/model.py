@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import record
 from ..schema import ScenarioError
 from .registry import ARRAYS, TRAJECTORIES, TUNNELS, Trajectory, getter
 
@@ -32,6 +33,9 @@ class Scenario:
     sections: dict[str, Any] = field(repr=False)
     family: str = ""
     raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        record(self, may_be_empty=("paper", "description"))
 
     def section(self, key: str) -> dict[str, Any]:
         """A raw TOML table (``ScenarioError`` naming it if absent)."""

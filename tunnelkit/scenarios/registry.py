@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import callable_
+from .._validate import callable_, record
 from ..schema import ScenarioError
 
 __all__ = [
@@ -55,6 +55,9 @@ class Trajectory:
     t: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"t": ("T",), "position": ("T", "D"), "velocity": ("T", "D")})
 
     def __len__(self) -> int:
         return self.t.shape[0]

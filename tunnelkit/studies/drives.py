@@ -24,7 +24,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import choice, instance, integer, nonnegative, rng_or_error
+from .._validate import (
+    choice,
+    instance,
+    integer,
+    nonnegative,
+    probability,
+    record,
+    rng_or_error,
+)
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..signal_route import CHANNELS, Epoch, SignalRoute
@@ -60,6 +68,10 @@ class Condition:
     los_probability: float
     rrms: bool = True
 
+    def __post_init__(self) -> None:
+        record(self)
+        probability("los_probability", self.los_probability, open_interval=False)
+
 
 CONDITIONS: dict[str, Condition] = {
     c.name: c
@@ -70,6 +82,16 @@ CONDITIONS: dict[str, Condition] = {
         Condition("NoRRMs", 0.0, rrms=False),
         Condition("NoRRMs-L", 1.0, rrms=False),
     )
+}
+
+
+#: the shapes of a drive's fields: T epochs, positions and velocities in 3-D
+_DRIVE_SHAPES = {
+    **dict.fromkeys(("t", "speed", "heading", "los", "n_true"), ("T",)),
+    **dict.fromkeys(("epochs", "truth_index", "kinds", "sources"), ("T",)),
+    "truth": ("T", 3),
+    "velocity": ("T", 3),
+    "base_station": (3,),
 }
 
 
@@ -107,6 +129,15 @@ class DriveData:
     extraction: str = "paper"
     clock_bias_limit: float = 100e-9
     reports_covariance: bool = False
+
+    def __post_init__(self) -> None:
+        record(
+            self,
+            shapes=_DRIVE_SHAPES,
+            positive=("clock_bias_limit",),
+            may_be_empty=("truth_index", "kinds", "faults", "sources"),
+        )
+        choice("extraction", self.extraction, (*EXTRACTIONS, *_ALIASES))
 
     @property
     def dt(self) -> float:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import instance, positive
+from ..._validate import instance, positive, record
 from ...drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
 from ..registry import family, register
 from .filters import (
@@ -51,6 +51,9 @@ class Track:
     t: np.ndarray
     position: np.ndarray
     speed: np.ndarray
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"t": ("T",), "position": ("T", 2), "speed": ("T",)})
 
 
 # --- the three approaches, registered -------------------------------------------------------------

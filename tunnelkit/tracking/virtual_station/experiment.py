@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import finite_array, instance, integer, rng_or_error
+from ..._validate import finite_array, instance, integer, record, rng_or_error
 from ...montecarlo import spawn_rngs
 from ...scenarios import Scenario, load_scenario
 from ..registry import family
@@ -30,6 +30,9 @@ class VsExperiment:
     truth: np.ndarray
     P0: np.ndarray
     scenario: str = ""
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"truth": (None, 4), "P0": (4, 4)}, may_be_empty=("scenario",))
 
     @property
     def times(self) -> np.ndarray:

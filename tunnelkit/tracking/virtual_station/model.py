@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import positioning
-from ..._validate import boolean, finite_array, integer, positive, rng_or_error
+from ..._validate import boolean, finite_array, integer, positive, rng_or_error, text
 from ...crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from ...scenarios import load_scenario
 from ..cv import STATE_DIM, cv_process_noise, cv_transition
@@ -46,9 +46,12 @@ def regularized_cholesky(P, *, name: str = "P", rel_floor: float = 1e-10) -> np.
     particle, a bad prior) its eigenvalues are clipped to ``rel_floor * max(|eig|)`` (at least
     ``1e-12``) and a ``RuntimeWarning`` says so; the factor is never NaN.
     """
+    name = text("name", name)
     P = np.asarray(P, dtype=float)
     if not np.all(np.isfinite(P)):
         raise ValueError(f"{name}: covariance contains NaN or infinite values")
+    if P.ndim < 2 or P.shape[-1] != P.shape[-2]:
+        raise ValueError(f"{name}: expected square matrices (..., n, n), got shape {P.shape}")
     P = 0.5 * (P + np.swapaxes(P, -1, -2))
     try:
         return np.linalg.cholesky(P)
@@ -258,6 +261,8 @@ def measurement_ok(z, dim_z: int, *, who: str = "update") -> np.ndarray | None:
 
     ``None`` means "missed epoch": the caller predicts only.
     """
+    dim_z = integer("dim_z", dim_z, minimum=1)
+    who = text("who", who)
     if z is None:
         return None
     try:
