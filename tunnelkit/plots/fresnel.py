@@ -11,7 +11,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import fresnel
-from .._validate import integer, positive_array, text
+from .._validate import finite_array, instance, integer, positive, positive_array, text
 from ..constants import wavelength
 from ..fresnel.bounds import carrier_tolerance, wall_geometry
 from .common import COLORS
@@ -44,6 +44,14 @@ FRESNEL_COLORS = {
 }
 
 _MARGIN = {"l": 60, "r": 20, "t": 60, "b": 50}
+
+
+def _real(name: str, value):
+    """Real numbers (NaN allowed), text and complex refused."""
+    a = np.asarray(value) if not isinstance(value, str | bytes) else None
+    if a is None or a.dtype.kind not in "iuf":
+        raise TypeError(f"{name}: expected real numbers, got {type(value).__name__}")
+    return a
 
 
 def _point(R, W, y_u, fc, eps_phi=1.0, z_u=0.0, **axes) -> tuple[float, ...]:
@@ -439,6 +447,8 @@ def mmax_range_figure(
 
 def derivation_figure(profile: fresnel.ApertureProfile, *, lam: float) -> go.Figure:
     """Error of each approximation of the proof (eq. 28, 31, 33) in phase [rad] across the ULA."""
+    instance("profile", profile, fresnel.ApertureProfile)
+    lam = positive("lam", lam)
     k = 2 * np.pi / lam
     y_cm = profile.y * 100
     series = {
@@ -470,7 +480,19 @@ def ratio_map_figure(
     colorbar_title: str | None = None,
 ) -> go.Figure:
     """Heat map of a ratio (e.g. bound / exact Mmax) over (R, y_u), 1 = tight, log colour scale."""
-    r = np.asarray(ratio, dtype=float)
+    R_grid = positive_array("R_grid", R_grid, ndim=1)
+    y_grid = finite_array("y_grid", y_grid, ndim=1)
+    # NaN: no ratio there (e.g. a capped exact search), shown blank
+    r = np.asarray(_real("ratio", ratio), dtype=float)
+    if r.shape != (len(y_grid), len(R_grid)):
+        raise ValueError(f"ratio: expected shape ({len(y_grid)}, {len(R_grid)}), got {r.shape}")
+    if np.any(r <= 0) or np.any(np.isinf(r)):
+        raise ValueError("ratio: must be > 0 and finite (NaN for no value)")
+    title = text("title", title)
+    if W is not None:
+        W = positive("W", W)
+    if colorbar_title is not None:
+        colorbar_title = text("colorbar_title", colorbar_title)
     # the colour bar names the ratio it shows (the title's, unless told), not just "ratio"
     colorbar_title = title if colorbar_title is None else colorbar_title
     ticks = np.array([0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0])

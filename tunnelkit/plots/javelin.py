@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import plotly.graph_objects as go
 
+from .._validate import finite_array, integer, nonnegative_array, text
 from .common import COLORS
 from .tables import TableFigure, table
 
@@ -257,6 +258,15 @@ def tracks_count_figure(
     t, n_tracks, los=None, *, title: str = "tracked states per epoch"
 ) -> go.Figure:
     """Number of tracks (UE + VUEs) over time, with the epochs whose LoS existed shaded."""
+    t = finite_array("t", t, ndim=1)
+    n_tracks = nonnegative_array("n_tracks", n_tracks, shape=(len(t),))
+    if los is not None:
+        los = np.asarray(los)
+        if los.dtype.kind not in "bi" or los.shape != t.shape:
+            raise TypeError(
+                f"los: expected {len(t)} booleans, got {los.dtype} of shape {los.shape}"
+            )
+    title = text("title", title, empty=True)
     fig = go.Figure()
     fig.add_scatter(
         x=np.asarray(t),
@@ -287,6 +297,7 @@ def javelin_table_figure(
     columns: Sequence[str], rows: Sequence[Sequence], *, title: str = "", digits: int = 2
 ) -> TableFigure:
     """A table (numbers rounded to ``digits``, ``None`` or NaN as a dash), shown as HTML."""
+    digits = integer("digits", digits, minimum=0, maximum=15)
 
     def fmt(v):
         if v is None:

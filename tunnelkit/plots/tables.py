@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-from .._validate import callable_, sequence, text
+from .._validate import callable_, instance, sequence, text
+from ..report import Report
 
 __all__ = ["TableFigure", "report_table", "table"]
 
@@ -50,7 +51,10 @@ class TableFigure(go.Figure):
         notes: Sequence[str] = (),
     ):
         columns = [str(c) for c in sequence("columns", columns)]
-        cells = [[str(v) for v in sequence("cells", col, empty=True)] for col in cells]
+        cells = [
+            [str(v) for v in sequence("cells", col, empty=True)]
+            for col in sequence("cells", cells, empty=True)
+        ]
         if len(cells) != len(columns):
             raise ValueError(f"cells: expected {len(columns)} columns of cells, got {len(cells)}")
         title = text("title", title, empty=True)
@@ -157,6 +161,7 @@ def table(
 def report_table(report) -> TableFigure:
     """A :class:`tunnelkit.reproduce.Report` (what ``tunnelkit reproduce`` prints as text) as a
     table: its title with its settings, its rows, its notes."""
+    instance("report", report, Report)
     meta = ", ".join(f"{k}: {v}" for k, v in report.meta.items())
     title = f"{report.title} ({meta})" if meta else report.title
     return table(report.columns, report.rows, title=title, notes=report.notes)

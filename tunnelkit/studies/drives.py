@@ -224,10 +224,10 @@ def scenario_route(
                 f"channel: the route given runs on the {route.channel!r} channel, not {channel!r}"
             )
         return replace(route, **nuisance) if nuisance else route
-    if not isinstance(route, str):
-        raise TypeError(
-            f"route: expected a SignalRoute or a scenario name, got {type(route).__name__}"
-        )
+    if not isinstance(route, str) or not route:
+        raise TypeError(f"route: expected a SignalRoute or a scenario name, got {route!r}")
+    if channel is not None:
+        choice("channel", channel, CHANNELS)
     key = (route, model, channel or "image", tuple(sorted(nuisance.items())))
     if key not in _ROUTES:
         _ROUTES[key] = SignalRoute.from_scenario(
@@ -350,8 +350,10 @@ def simulate_routes(
         choice("channel", channel, CHANNELS)
     if n_epochs is not None:
         integer("n_epochs", n_epochs, minimum=1)
-    if not tuple(extractions):
-        raise ValueError(f"extraction: expected one of {EXTRACTIONS}, got {extractions!r}")
+    if isinstance(extractions, str) or not isinstance(extractions, tuple | list):
+        raise TypeError(f"extractions: expected a tuple of routes, got {extractions!r}")
+    if not extractions:
+        raise ValueError(f"extractions: expected one or more of {EXTRACTIONS}, got none")
     extractions = tuple(dict.fromkeys(route_name(e) for e in extractions))
     if "route" in extractions and len(extractions) > 1:
         raise ValueError(

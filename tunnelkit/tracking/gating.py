@@ -202,6 +202,8 @@ class InnovationGate:
             raise ValueError(f"S: expected square matrices (..., m, m), got shape {S.shape}")
         R = finite_array("R", R, shape=S.shape[-2:])
         d2 = _d2(d2)
+        if not np.isfinite(d2).all():
+            raise ValueError("d2: a reopened measurement has a finite distance, got NaN or inf")
         dof = integer("dof", dof, minimum=1)
         trS = np.trace(S, axis1=-2, axis2=-1)
         trR = float(np.trace(R))

@@ -135,7 +135,8 @@ class EkfDS(_Base):
         self._p0 = np.array(fix.position, dtype=float)
 
     def step(self, doppler, toa=None) -> np.ndarray:
-        return self.ekf.step(doppler)
+        scalar_measurement("toa", toa)  # not used by the Doppler-only EKF, still checked
+        return self.ekf.step(scalar_measurement("doppler", doppler))
 
     def speed(self) -> float:
         return float(np.linalg.norm(self.ekf.velocity))
@@ -281,6 +282,8 @@ def run_approaches(
     fam = family("halili2022")
     if isinstance(approaches, str) or not isinstance(approaches, list | tuple):
         raise TypeError(f"approaches: expected a tuple of names, got {approaches!r:.60}")
+    if not approaches:
+        raise ValueError("approaches: expected at least one approach")
     for name in approaches:
         if name not in fam:
             raise ValueError(

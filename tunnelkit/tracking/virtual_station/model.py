@@ -134,6 +134,8 @@ class VsModel:
             raise ValueError(
                 f"x: expected real state(s) (..., {STATE_DIM}), got {x.dtype} of shape {x.shape}"
             )
+        if not np.isfinite(x).all():
+            raise ValueError("x: contains NaN or infinite values")
         d, th = toa_doa(x[..., :2], self.stations)
         return np.concatenate([d, th], axis=-1)
 
@@ -162,6 +164,8 @@ class VsModel:
         """``d f_2 / d X`` (..., 2N, 4): the position block of eq. A2-A9 (sign-corrected), zeros
         for the velocities."""
         x = np.asarray(x, dtype=float)
+        if x.ndim == 0 or x.shape[-1] != STATE_DIM or not np.isfinite(x).all():
+            raise ValueError(f"x: expected finite state(s) (..., {STATE_DIM}), got {x.shape}")
         J = toa_doa_jacobian(x[..., :2], self.stations)
         return np.concatenate([J, np.zeros_like(J)], axis=-1)
 
