@@ -391,6 +391,16 @@ def _baselines_checks():
     pool.gather(pool.prepare(abs, [1, -2]))
     pool.map(abs, [1, -2])
     mc.run_trials(_trial, 2, 0)
+    from tunnelkit.plots import doppler as pd
+    from tunnelkit.plots import tunnel3d as t3
+
+    drv = dv.make_drive(duration=2.0, pass_time=1.0)
+    pd.doppler_delay_figure(drv)
+    pd.drive_topview(drv)
+    truth = np.column_stack([np.linspace(0.0, 10.0, 5), np.zeros(5), np.zeros(5)])
+    pj.trajectories_figure(truth, {"JAVELIN": truth + 0.1})
+    t3.paths_table_figure([{"a": 1, "b": 2.0}])
+    t3.wave_origins_figure({"x": np.array([[1.0, 2.0, 3.0]])})
 
 
 def _trial(rng):

@@ -250,6 +250,15 @@ DOCUMENTED: tuple[Documented, ...] = (
         "states (..., 4): leading axes vectorise (the docstring's contract)",
     ),
     _doc(
+        r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|geometry\.spherical\w*"
+        r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
+        r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation",
+        r"p|q|u|a|F|errors|estimate|truth|d_hat|jacobians|bounds|S",
+        "shape",
+        "vectorised over leading axes (..., dim) (each docstring's contract): an extra leading "
+        "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
+    ),
+    _doc(
         r"fresnel\.bounds\.aperture",
         r"M",
         "type",
@@ -512,6 +521,36 @@ def test_bad_arguments_are_refused_with_the_parameter_named(suite):
     if FULL:
         fixed = sorted(n for n, w in listed.items() if w.split()[0].isdigit() and n not in counts)
         assert not fixed, f"meet their contract now, remove from {OPEN_FILE.name}: {fixed}"
+
+
+def test_extra_leading_axes_vectorise():
+    """The documented "shape" results above: functions of points (..., dim) give, for an extra
+    leading axis, the same numbers with that axis (not a silently wrong broadcast)."""
+    import numpy as np
+
+    from tunnelkit import crlb, geometry, metrics, positioning
+    from tunnelkit.arrays import make_array
+
+    st = np.array([[0.0, 5.0], [0.0, -5.0], [10.0, 0.0]])
+    p = np.array([[30.0, 1.0], [20.0, -1.0]])
+    q = np.array([[1.0, 2.0, 3.0], [3.0, -1.0, 2.0]])
+    arr = make_array(2, 2, fc=28e9, azimuth=0.3, elevation=0.1)
+    F = crlb.fim_toa_doa(p, st, 0.01, 0.5)
+    cases = [
+        (lambda x: crlb.toa_doa(x, st)[0], p),
+        (lambda x: crlb.crlb_rmse(x, st, 0.01, 0.5), p),
+        (lambda x: crlb.toa_doa_jacobian(x, st), p),
+        (crlb.crlb_trace, F),
+        (lambda x: metrics.position_errors(x, x + 1.0), p),
+        (geometry.spherical, q),
+        (geometry.spherical_jacobian, q),
+        (arr.to_local, q),
+        (arr.dir_to_world, q),
+        (lambda x: positioning.toa_only_candidates(st, x), np.array([30.0, 31.0, 25.0])),
+        (crlb.wrap_angle, np.array([4.0, -4.0])),
+    ]
+    for f, x in cases:
+        np.testing.assert_allclose(f(x[None, None]), f(x)[None, None], rtol=1e-12)
 
 
 def main(argv) -> None:  # pragma: no cover - the measurement behind the report

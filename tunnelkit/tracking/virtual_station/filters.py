@@ -82,7 +82,10 @@ class EstimatorBase:
         is a missed epoch.
         """
         Z = _measurements(Z, check_model(model).dim_z)
-        x0 = np.asarray(x0, dtype=float)
+        x0 = finite_array("x0", x0, shape=(Z.shape[0], STATE_DIM))
+        if len(x0):
+            check_prior(x0[0], P0)
+        _rng(rng)
         out = np.empty((*Z.shape[:2], STATE_DIM))
         for r in range(Z.shape[0]):
             est = cls(model, x0[r], P0, rng=rng, **options)
