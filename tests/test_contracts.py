@@ -132,8 +132,9 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN in a measurement marks a missed epoch: the filter predicts only (with a warning)",
     ),
     _doc(
-        r"report\.Report|plots\.(tables\.table|javelin\.javelin_table_figure|tracking\.table_figure)",
-        r"rows|notes",
+        r"report\.Report|plots\.(tables\.(table|TableFigure)|javelin\.javelin_table_figure"
+        r"|tracking\.table_figure|tunnel3d\.paths_table_figure)",
+        r"rows|notes|columns|cells",
         "empty",
         "a table with no rows (its header alone)",
     ),

@@ -8,7 +8,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import plotly.graph_objects as go
 
-from .._validate import finite_array, integer, nonnegative_array, text
+from .._validate import finite_array, integer, nonnegative_array, text, vector
 from .common import COLORS
 from .tables import TableFigure, table
 
@@ -50,7 +50,14 @@ def trajectories_figure(
     truth, estimates: Mapping[str, np.ndarray], *, base_station=None, title: str = ""
 ) -> go.Figure:
     """Top view (x, y) of the true trajectory and each method's estimates (the paper's Fig. 6)."""
-    truth = np.asarray(truth, float)
+    truth = finite_array("truth", truth, ndim=2)
+    if truth.shape[1] < 2:
+        raise ValueError(f"truth: expected positions (T, 2 or 3), got shape {truth.shape}")
+    if not isinstance(estimates, Mapping):
+        raise TypeError(f"estimates: expected a mapping name -> positions, got {estimates!r:.40}")
+    if base_station is not None:
+        base_station = vector("base_station", base_station, (2, 3))
+    title = text("title", title, empty=True)
     fig = go.Figure()
     fig.add_scatter(
         x=truth[:, 0],

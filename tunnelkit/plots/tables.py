@@ -50,7 +50,7 @@ class TableFigure(go.Figure):
         title: str = "",
         notes: Sequence[str] = (),
     ):
-        columns = [str(c) for c in sequence("columns", columns)]
+        columns = [str(c) for c in sequence("columns", columns, empty=True)]
         cells = [
             [str(v) for v in sequence("cells", col, empty=True)]
             for col in sequence("cells", cells, empty=True)
@@ -144,7 +144,7 @@ def table(
 ) -> TableFigure:
     """A :class:`TableFigure` from row sequences, each value formatted by ``fmt``; ``notes`` are
     listed under the HTML table."""
-    columns = sequence("columns", columns)
+    columns = sequence("columns", columns, empty=True)
     rows = sequence("rows", rows, empty=True)
     title = text("title", title, empty=True)
     fmt = callable_("fmt", fmt)

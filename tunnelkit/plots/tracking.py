@@ -246,7 +246,7 @@ def table_figure(
     rows: Sequence[Mapping], columns: Sequence[str], *, title: str = ""
 ) -> TableFigure:
     """A table of dict rows (floats shown with 4 significant digits), shown as HTML."""
-    columns = sequence("columns", columns)
+    columns = sequence("columns", columns, empty=True)
     rows = sequence("rows", rows, empty=True)
     for i, r in enumerate(rows):
         if not isinstance(r, Mapping):
