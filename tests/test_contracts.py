@@ -253,8 +253,9 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(
         r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|geometry\.spherical\w*"
         r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
-        r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation",
-        r"p|q|u|a|F|errors|estimate|truth|d_hat|jacobians|bounds|S",
+        r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation"
+        r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim)",
+        r"p|q|u|a|x|F|errors|estimate|truth|d_hat|jacobians|bounds|S",
         "shape",
         "vectorised over leading axes (..., dim) (each docstring's contract): an extra leading "
         "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
@@ -531,12 +532,15 @@ def test_extra_leading_axes_vectorise():
 
     from tunnelkit import crlb, geometry, metrics, positioning
     from tunnelkit.arrays import make_array
+    from tunnelkit.tracking.virtual_station import experiment
 
     st = np.array([[0.0, 5.0], [0.0, -5.0], [10.0, 0.0]])
     p = np.array([[30.0, 1.0], [20.0, -1.0]])
     q = np.array([[1.0, 2.0, 3.0], [3.0, -1.0, 2.0]])
     arr = make_array(2, 2, fc=28e9, azimuth=0.3, elevation=0.1)
     F = crlb.fim_toa_doa(p, st, 0.01, 0.5)
+    model = experiment("jiang2023-straight").model
+    x4 = np.array([[30.0, 1.0, 5.0, 0.1], [20.0, -1.0, 4.0, 0.0]])
     cases = [
         (lambda x: crlb.toa_doa(x, st)[0], p),
         (lambda x: crlb.crlb_rmse(x, st, 0.01, 0.5), p),
@@ -549,6 +553,9 @@ def test_extra_leading_axes_vectorise():
         (arr.dir_to_world, q),
         (lambda x: positioning.toa_only_candidates(st, x), np.array([30.0, 31.0, 25.0])),
         (crlb.wrap_angle, np.array([4.0, -4.0])),
+        (model.hx, x4),
+        (model.jacobian, x4),
+        (model.position_fim, p),
     ]
     for f, x in cases:
         np.testing.assert_allclose(f(x[None, None]), f(x)[None, None], rtol=1e-12)

@@ -198,9 +198,9 @@ class VsModel:
 
     def simulate(self, positions, rng: np.random.Generator, size: int | None = None) -> np.ndarray:
         """Noisy measurements ``Z`` (eq. 44) at true positions (T, 2): shape (T, 2N) or (size, T, 2N)."""
-        positions = finite_array("positions", positions, ndim=2)
-        if positions.shape[1] != 2:
-            raise ValueError(f"positions: expected shape (T, 2), got {positions.shape}")
+        positions = finite_array("positions", positions)
+        if positions.ndim == 0 or positions.shape[-1] != 2:
+            raise ValueError(f"positions: expected positions (..., T, 2), got {positions.shape}")
         d_hat, th_hat = positioning.simulate_toa_doa(
             positions, self.stations, self.sigma_theta, self.sigma_d, rng, size=size
         )
