@@ -254,8 +254,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|geometry\.spherical\w*"
         r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
         r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation"
-        r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim)",
-        r"p|q|u|a|x|F|errors|estimate|truth|d_hat|jacobians|bounds|S",
+        r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim|simulate)",
+        r"p|q|u|a|x|F|errors|estimate|truth|d_hat|jacobians|bounds|S|positions",
         "shape",
         "vectorised over leading axes (..., dim) (each docstring's contract): an extra leading "
         "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
@@ -556,6 +556,7 @@ def test_extra_leading_axes_vectorise():
         (model.hx, x4),
         (model.jacobian, x4),
         (model.position_fim, p),
+        (lambda x: model.simulate(x, np.random.default_rng(0)), p),
     ]
     for f, x in cases:
         np.testing.assert_allclose(f(x[None, None]), f(x)[None, None], rtol=1e-12)

@@ -137,7 +137,6 @@ class DriveData:
             positive=("clock_bias_limit",),
             may_be_empty=("truth_index", "kinds", "faults", "sources"),
         )
-        choice("extraction", self.extraction, (*EXTRACTIONS, *_ALIASES))
 
     @property
     def dt(self) -> float:
