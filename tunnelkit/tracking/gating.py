@@ -55,6 +55,10 @@ def _quantile(p: float, dof: int) -> float:
 
 def _d2(d2) -> np.ndarray:
     """Squared Mahalanobis distances: real, ``>= 0`` or NaN/inf (a non-finite one is rejected)."""
+    if type(d2) is float or type(d2) is np.float64:  # one filter's distance: the inner loop's case
+        if d2 < 0:
+            raise ValueError(f"d2: must be >= 0 (a squared distance), got {d2}")
+        return np.asarray(d2)
     if isinstance(d2, np.ndarray) and d2.dtype == float:
         arr = d2
     else:
@@ -173,7 +177,8 @@ class InnovationGate:
         when None). A non-finite ``d2`` is rejected.
         """
         d2 = _d2(d2)
-        dof = integer("dof", dof, minimum=1)
+        if type(dof) is not int or dof < 1:  # plain ints pass without the general check
+            dof = integer("dof", dof, minimum=1)
         if rows is not None and (
             isinstance(rows, str | bytes) or np.asarray(rows).dtype.kind not in "iub"
         ):

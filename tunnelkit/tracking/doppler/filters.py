@@ -87,11 +87,11 @@ class DopplerSetup:
 def scalar_measurement(name: str, z) -> float | None:
     """One epoch's measurement ``z`` (parameter ``name``): ``None`` for a dropped epoch (``None``
     or NaN), else a float; infinities and non-numbers are refused."""
-    if not isinstance(name, str) or not name:
+    if type(name) is not str or not name:
         raise TypeError(f"name: expected the parameter's name, got {name!r}")
     if z is None:
         return None
-    if isinstance(z, str | bytes | bool | np.bool_):
+    if type(z) is not float and isinstance(z, (str, bytes, bool, np.bool_)):
         raise TypeError(f"{name}: expected a number or None, got {type(z).__name__}")
     try:
         x = float(z)
