@@ -382,6 +382,76 @@ def _known_surfaces():
     batch_information(info, info + np.eye(2), np.eye(2))
 
 
+def _baselines_checks():
+    """Valid calls of callables that had none: the Fresnel figures at a real design point (the
+    filled defaults put the UE on the wall), widgets' controls, tables, schema keys."""
+    from tunnelkit import fresnel, schema
+    from tunnelkit.arrays import make_array
+    from tunnelkit.plots import fresnel as pf
+    from tunnelkit.plots import javelin as pj
+    from tunnelkit.plots import tables, tracking
+    from tunnelkit.report import Report
+    from tunnelkit.scenarios.registry import Registry
+    from tunnelkit.studies.drives import Condition
+    from tunnelkit.widgets import base
+
+    point = dict(R=10.0, W=5.0, y_u=2.0, fc=5.9e9)
+    fresnel.phase_mismatch_ura(4, **point)
+    pf.mismatch_figure(8, **point, eps_phi=0.15)
+    pf.mmax_range_figure(**point, eps_phi=0.15, M=8, R_grid=np.array([5.0, 10.0, 20.0]))
+    prof = fresnel.aperture_profile(8, **point)
+    pf.derivation_figure(prof, lam=0.05)
+    pf.ratio_map_figure(np.array([5.0, 10.0]), np.array([1.0, 2.0]), np.ones((2, 2)))
+    Condition("L", 1.0)
+    make_array(2, 2, fc=28e9, azimuth=0.0, elevation=0.0, name="a").to_world(np.zeros((2, 3)))
+    base.checkbox("wideband", True)
+    base.float_slider("x", 0.5, 0.0, 1.0, 0.1)
+    base.int_slider("n", 2, 1, 4)
+    base.slider_value("x", 0.5, 0.0, 1.0)
+    tables.report_table(Report("t", ["a", "b"], [[1, 2.5]]))
+    t = np.arange(4) * 0.1
+    tracking.bound_ratio_figure(t, {"a": ({"EKF": np.ones(4)}, np.ones(4))})
+    tracking.table_figure([{"a": 1, "b": 2.0}], ["a", "b"])
+    pj.tracks_count_figure(t, np.array([1, 2, 2, 3]))
+    pj.javelin_table_figure(["a", "b"], [[1, 2.5]])
+    key = schema.Key("fc", "float", "carrier [Hz]")
+    schema.Table((key,))
+    Registry("tunnel", "a tunnel builder")
+    pf.fresnel_topview(8, **point)
+    from tunnelkit import drive as dv
+    from tunnelkit import montecarlo as mc
+    from tunnelkit.tracking import doppler as dp
+    from tunnelkit.tracking import virtual_station as vs
+    from tunnelkit.tracking.doppler import bounds as dpb
+
+    setup = dp.DopplerSetup(np.array([0.0, 0.0]), 5.0, 5.9e9, 0.1)
+    s = np.array([-20.0, 1.5, 10.0, 0.0])
+    dp.doppler_model(s, setup)
+    dp.doppler_jacobian(s, setup)
+    dpb.snapshot_fim(s[:2], s[2:], setup, sigma_hz=30.0)
+    dpb.posterior_crlb(dv.make_drive(duration=2.0, pass_time=1.0))
+    vs.experiment("jiang2023-straight").model.position_fim(np.array([30.0, 2.0]))
+    pool = mc.TrialPool(None)
+    pool.gather(pool.prepare(abs, [1, -2]))
+    pool.map(abs, [1, -2])
+    mc.run_trials(_trial, 2, 0)
+    from tunnelkit.plots import doppler as pd
+    from tunnelkit.plots import tunnel3d as t3
+
+    drv = dv.make_drive(duration=2.0, pass_time=1.0)
+    pd.doppler_delay_figure(drv)
+    pd.drive_topview(drv)
+    truth = np.column_stack([np.linspace(0.0, 10.0, 5), np.zeros(5), np.zeros(5)])
+    pj.trajectories_figure(truth, {"JAVELIN": truth + 0.1})
+    t3.paths_table_figure([{"a": 1, "b": 2.0}])
+    t3.wave_origins_figure({"x": np.array([[1.0, 2.0, 3.0]])})
+
+
+def _trial(rng):
+    """A Monte-Carlo trial for the runner's contract (module level: picklable)."""
+    return float(rng.random())
+
+
 DRIVERS = (
     _jiang,
     _javelin,
@@ -394,6 +464,7 @@ DRIVERS = (
     _baselines,
     _baselines_tracking,
     _known_surfaces,
+    _baselines_checks,
 )
 
 

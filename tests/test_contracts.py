@@ -82,6 +82,190 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(r".*\.ConsiderNoise\.decay", r"dt", "zero huge", "no time passed, or a long gap"),
     _doc(r".*\.bias_slice", r"i", "zero huge", "track 0 is the UE; any track index"),
+    _doc(
+        r"plots\.(common|tables|tracking|javelin|design|doppler|efficiency|tunnel3d)\..*",
+        r"title|xaxis|yaxis",
+        "empty",
+        "an empty title or axis label shows none (the default)",
+    ),
+    _doc(
+        r"geometry\.(Plane|line)|arrays\.(ArrayGeometry|make_array)",
+        r"name",
+        "empty",
+        "a label only; unnamed is the default",
+    ),
+    _doc(r"budget\.check_(bytes|elements)", r"what", "empty", "no description: the count is shown"),
+    _doc(
+        r"geometry\.(Plane|Tunnel2D)\.\w+|geometry\.(mirror|reflector_point|specular_point)",
+        r"p|point|target|q|p_u|p_v",
+        "shape",
+        "points (..., dim): leading axes vectorise (the docstring's contract)",
+    ),
+    _doc(
+        r"fresnel\.(bounds|exact)\.\w+",
+        r"R|W|y_u|z_u|lam|eps|p_v|pv|ps|pos|positions",
+        "shape",
+        "elementwise in the geometry, points (..., 3): any leading shape broadcasts",
+    ),
+    _doc(
+        r"tracking\.gating\.mahalanobis2|tracking\.gating\.ChiSquareGate\.accepts",
+        r"y|S|d2",
+        "shape",
+        "vectorised over leading axes (the docstring's contract)",
+    ),
+    _doc(
+        r"tracking\.virtual_station\.model\.regularized_cholesky",
+        r"P",
+        "shape",
+        "a stack (..., n, n) of covariances is factored matrix by matrix",
+    ),
+    _doc(
+        r"tracking\.gating\.(ChiSquareGate\.accepts|InnovationGate\.judge)",
+        r"d2",
+        "nan",
+        "a non-finite d2 is rejected by the gate (the docstring's contract)",
+    ),
+    _doc(
+        r"tracking\.virtual_station\..*",
+        r"z|Z",
+        "nan",
+        "NaN in a measurement marks a missed epoch: the filter predicts only (with a warning)",
+    ),
+    _doc(
+        r"report\.Report|plots\.(tables\.(table|TableFigure)|javelin\.javelin_table_figure"
+        r"|tracking\.table_figure|tunnel3d\.paths_table_figure)",
+        r"rows|notes|columns|cells",
+        "empty",
+        "a table with no rows (its header alone)",
+    ),
+    _doc(
+        r"plots\.fresnel\.ratio_map_figure",
+        r"ratio",
+        "nan",
+        "NaN: no ratio at that point (a capped exact search), shown blank",
+    ),
+    _doc(
+        r"schema\.(Key|Table|render_template)",
+        r"unit|doc|header",
+        "empty",
+        "optional text: a unitless key, an undocumented table, no header",
+    ),
+    _doc(
+        r"schema\.Key",
+        r"default",
+        "type",
+        "any default value: the key's type is checked where a file is read",
+    ),
+    _doc(
+        r"widgets\.base\.slider_value",
+        r"value",
+        "type nan negative",
+        "name=None: the explorer's own constant, passed through unchecked (tested)",
+    ),
+    _doc(
+        r"widgets\.base\.(float_slider|int_slider)",
+        r"value",
+        "negative",
+        "name=None: the explorer's own constant; the range is not applied to it (tested)",
+    ),
+    _doc(
+        r"studies\.drives\.DriveData",
+        r"truth_index|kinds|faults|sources",
+        "empty",
+        "not recorded (the default): the drive's truth association is optional",
+    ),
+    _doc(
+        r"tracking\.virtual_station\.experiment\.VsExperiment",
+        r"scenario",
+        "empty",
+        "a label only; empty for an experiment built by hand (the default)",
+    ),
+    _doc(r"evaluation\.match_paths", r"paths", "empty", "no true path: every estimate unmatched"),
+    _doc(r"evaluation\.match_paths", r"clock_bias", "negative", "a clock bias takes any sign"),
+    _doc(r"geometry\.line", r"A|B|C", "negative", "a line's coefficients take any sign"),
+    _doc(
+        r"geometry\.Tunnel2D\.contains",
+        r"margin",
+        "negative",
+        "a negative margin also counts points just outside the walls",
+    ),
+    _doc(
+        r"tracking\.doppler\..*",
+        r"z|doppler|toa",
+        "nan",
+        "NaN (or None) is a dropped epoch: the filter predicts only (the docstring's contract)",
+    ),
+    _doc(
+        r"tracking\.doppler\..*",
+        r"doppler|u|u0|dr|dz",
+        "negative",
+        "a signed quantity: Doppler shift, approach speed, a step back, a height offset",
+    ),
+    _doc(
+        r"channel\..*",
+        r"clock_bias|tx_power_dbm",
+        "negative",
+        "a clock bias takes any sign; a transmit power in dBm may be below 1 mW",
+    ),
+    _doc(
+        r"fresnel\.summary\.MmaxSummary",
+        r"exact_ura",
+        "negative",
+        "-1 records a skipped URA search (mmax_summary(ura=False))",
+    ),
+    _doc(
+        r"tracking\.virtual_station\.filters\.VsUKF",
+        r"kappa",
+        "negative",
+        "kappa = 3 - n < 0 is the classic choice; n + kappa > 0 is what is required",
+    ),
+    _doc(
+        r"scenarios\.(registry\.(Registry\.lookup|require|getter)|model\.Scenario)",
+        r"where|prefix|paper|description",
+        "empty",
+        "optional text: no file name, the top-level table, a user file (no paper), no description",
+    ),
+    _doc(
+        r"widgets\.base\.(checkbox|float_slider|int_slider)",
+        r"description",
+        "empty",
+        "a control without a label (the explorer's own text beside it)",
+    ),
+    _doc(
+        r"widgets\.base\.(slider_value|float_slider|int_slider)",
+        r"lo",
+        "negative",
+        "a slider's range may reach below zero",
+    ),
+    _doc(r"schema\.Key", r"gt|ge|lt|le", "negative", "a range bound takes any sign"),
+    _doc(
+        r"montecarlo\.TrialPool\.(map|prepare|gather)",
+        r"items|handles",
+        "empty",
+        "no items: no tasks, an empty list back",
+    ),
+    _doc(
+        r"tracking\.doppler\.filters\.doppler_(model|jacobian)",
+        r"s",
+        "shape",
+        "states (..., 4): leading axes vectorise (the docstring's contract)",
+    ),
+    _doc(
+        r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|geometry\.spherical\w*"
+        r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
+        r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation"
+        r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim|simulate)",
+        r"p|q|u|a|x|F|errors|estimate|truth|d_hat|jacobians|bounds|S|positions",
+        "shape",
+        "vectorised over leading axes (..., dim) (each docstring's contract): an extra leading "
+        "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
+    ),
+    _doc(
+        r"fresnel\.bounds\.aperture",
+        r"M",
+        "type",
+        "M may be a bound's real value (mmax_fraunhofer): the aperture (M - 1) lambda / 2",
+    ),
 )
 
 
@@ -339,6 +523,43 @@ def test_bad_arguments_are_refused_with_the_parameter_named(suite):
     if FULL:
         fixed = sorted(n for n, w in listed.items() if w.split()[0].isdigit() and n not in counts)
         assert not fixed, f"meet their contract now, remove from {OPEN_FILE.name}: {fixed}"
+
+
+def test_extra_leading_axes_vectorise():
+    """The documented "shape" results above: functions of points (..., dim) give, for an extra
+    leading axis, the same numbers with that axis (not a silently wrong broadcast)."""
+    import numpy as np
+
+    from tunnelkit import crlb, geometry, metrics, positioning
+    from tunnelkit.arrays import make_array
+    from tunnelkit.tracking.virtual_station import experiment
+
+    st = np.array([[0.0, 5.0], [0.0, -5.0], [10.0, 0.0]])
+    p = np.array([[30.0, 1.0], [20.0, -1.0]])
+    q = np.array([[1.0, 2.0, 3.0], [3.0, -1.0, 2.0]])
+    arr = make_array(2, 2, fc=28e9, azimuth=0.3, elevation=0.1)
+    F = crlb.fim_toa_doa(p, st, 0.01, 0.5)
+    model = experiment("jiang2023-straight").model
+    x4 = np.array([[30.0, 1.0, 5.0, 0.1], [20.0, -1.0, 4.0, 0.0]])
+    cases = [
+        (lambda x: crlb.toa_doa(x, st)[0], p),
+        (lambda x: crlb.crlb_rmse(x, st, 0.01, 0.5), p),
+        (lambda x: crlb.toa_doa_jacobian(x, st), p),
+        (crlb.crlb_trace, F),
+        (lambda x: metrics.position_errors(x, x + 1.0), p),
+        (geometry.spherical, q),
+        (geometry.spherical_jacobian, q),
+        (arr.to_local, q),
+        (arr.dir_to_world, q),
+        (lambda x: positioning.toa_only_candidates(st, x), np.array([30.0, 31.0, 25.0])),
+        (crlb.wrap_angle, np.array([4.0, -4.0])),
+        (model.hx, x4),
+        (model.jacobian, x4),
+        (model.position_fim, p),
+        (lambda x: model.simulate(x, np.random.default_rng(0)), p),
+    ]
+    for f, x in cases:
+        np.testing.assert_allclose(f(x[None, None]), f(x)[None, None], rtol=1e-12)
 
 
 def main(argv) -> None:  # pragma: no cover - the measurement behind the report

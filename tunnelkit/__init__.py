@@ -58,9 +58,14 @@ def setup_notebook(*, renderer: str | None = None) -> None:
     (:mod:`tunnelkit.solutions`) and prints one line: the package version and whether quick mode
     is on. Returns None, so the call is not echoed as a cell result.
     """
+    # the type and emptiness first: the first look at plotly's renderer registry loads it (seconds)
+    if renderer is not None and not isinstance(renderer, str):
+        raise TypeError(f"renderer: expected a plotly renderer name, got {type(renderer).__name__}")
+    if renderer == "":
+        raise ValueError("renderer: must not be empty (None keeps the default renderer)")
     import plotly.io as pio
 
-    if renderer is not None and (not isinstance(renderer, str) or renderer not in pio.renderers):
+    if renderer is not None and renderer not in pio.renderers:
         raise ValueError(
             f"renderer: expected one of plotly's renderers ({', '.join(list(pio.renderers)[:6])}, "
             f"...), got {renderer!r}"

@@ -27,8 +27,11 @@ __all__ = [
     "positive_array",
     "probability",
     "real",
+    "record",
     "rng_or_error",
+    "sequence",
     "spd_matrix",
+    "text",
     "vector",
     "weights",
 ]
@@ -190,6 +193,25 @@ def integer(name: str, value, *, minimum: int | None = None, maximum: int | None
     return n
 
 
+def text(name: str, value, *, empty: bool = False) -> str:
+    """A string (a title, an axis or a label), non-empty unless ``empty``."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name}: expected text, got {type(value).__name__}")
+    if not value and not empty:
+        raise ValueError(f"{name}: must not be empty")
+    return value
+
+
+def sequence(name: str, value, *, empty: bool = False) -> list:
+    """A list or tuple (or another non-text sequence) as a list, non-empty unless ``empty``."""
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise TypeError(f"{name}: expected a list, got {type(value).__name__}")
+    out = list(value)
+    if not out and not empty:
+        raise ValueError(f"{name}: must not be empty")
+    return out
+
+
 def boolean(name: str, value) -> bool:
     """A real ``True``/``False`` (numpy bools accepted; ``"no"``, 0 and 1 refused)."""
     if not isinstance(value, bool | np.bool_):
@@ -310,3 +332,164 @@ def rng_or_error(name: str, rng) -> np.random.Generator:
             f"got {type(rng).__name__}"
         )
     return rng
+
+
+# --- records: every field of a dataclass checked by its annotation ------------------------------
+
+_FIELD_HINTS: dict[type, dict[str, object]] = {}
+
+
+def _field_hints(cls: type) -> dict[str, object]:
+    """``{field: annotation}`` of a dataclass, resolved once per class (a name that cannot be
+    resolved, e.g. one imported for type checking only, is left unchecked)."""
+    hints = _FIELD_HINTS.get(cls)
+    if hints is None:
+        import dataclasses
+        import sys
+        import typing
+
+        try:
+            hints = typing.get_type_hints(cls)
+        except Exception:
+            ns = vars(sys.modules[cls.__module__]) if cls.__module__ in sys.modules else {}
+            hints = {}
+            for f in dataclasses.fields(cls):
+                tp = f.type
+                if isinstance(tp, str):
+                    try:
+                        tp = eval(tp, ns)  # an annotation of the package's own code
+                    except Exception:
+                        continue
+                hints[f.name] = tp
+        _FIELD_HINTS[cls] = hints
+    return hints
+
+
+def _members(tp) -> tuple[tuple, bool]:
+    """(annotation's members without None, whether None is allowed)."""
+    import types
+    import typing
+
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        args = typing.get_args(tp)
+        return tuple(a for a in args if a is not type(None)), type(None) in args
+    return (tp,), tp is None or tp is type(None)
+
+
+def _bind(name: str, got: tuple[int, ...], spec: tuple, dims: dict) -> None:
+    """Check ``got`` (a shape) against ``spec`` (ints, symbol names shared across fields, None)."""
+    if len(got) != len(spec):
+        raise ValueError(f"{name}: expected {len(spec)}-D input, got shape {got}")
+    for g, s in zip(got, spec):
+        if s is None:
+            continue
+        if isinstance(s, str):
+            s = dims.setdefault(s, g)
+        if g != s:
+            want = "(" + ", ".join("n" if x is None else str(dims.get(x, x)) for x in spec) + ")"
+            raise ValueError(f"{name}: expected shape {want}, got {got}")
+
+
+def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims) -> None:
+    import typing
+    from collections.abc import Callable as _Callable
+    from collections.abc import Mapping as _Mapping
+    from collections.abc import Sequence as _Sequence
+
+    members, allows_none = _members(tp)
+    if value is None:
+        if allows_none:
+            return
+        raise TypeError(f"{name}: expected a value, got None")
+    plain = tuple(typing.get_origin(m) or m for m in members)
+    if np.ndarray in plain:
+        others = tuple(m for m in plain if m is not np.ndarray and isinstance(m, type))
+        if others and not isinstance(value, np.ndarray) and isinstance(value, others):
+            return
+        if isinstance(value, str | bytes):
+            raise TypeError(f"{name}: expected an array of numbers, got text {value!r}")
+        arr = value if isinstance(value, np.ndarray) else np.asarray(value)
+        if arr.dtype.kind not in "biufc":
+            raise TypeError(f"{name}: expected an array of numbers, got dtype {arr.dtype}")
+        if arr.dtype.kind in "fc" and not allow_nan and not np.isfinite(arr).all():
+            raise ValueError(f"{name}: contains NaN or infinite values")
+        if spec is not None:
+            _bind(name, arr.shape, spec, dims)
+        if sign and arr.size and arr.dtype.kind in "iuf":
+            low = float(arr.min())
+            if low < 0 or (sign == "positive" and low == 0):
+                raise ValueError(
+                    f"{name}: must be {'>' if sign == 'positive' else '>='} 0, got {low}"
+                )
+        return
+    if bool in plain:
+        boolean(name, value)
+    elif int in plain and float not in plain:
+        integer(name, value, minimum={"positive": 1, "nonnegative": 0}.get(sign))
+    elif float in plain:
+        if allow_nan and isinstance(value, float) and np.isnan(value):
+            return
+        {"positive": positive, "nonnegative": nonnegative}.get(sign, real)(name, value)
+    elif str in plain:
+        if not isinstance(value, str):
+            raise TypeError(f"{name}: expected text, got {type(value).__name__}")
+        if not value and not may_be_empty:
+            raise ValueError(f"{name}: must not be empty")
+    elif any(m in (list, tuple, _Sequence, typing.Sequence) for m in plain):
+        if isinstance(value, str | bytes) or not isinstance(value, list | tuple):
+            raise TypeError(f"{name}: expected a list, got {type(value).__name__}")
+        if not value:
+            if not may_be_empty:
+                raise ValueError(f"{name}: must not be empty")
+        elif spec is not None:
+            _bind(name, (len(value),), spec, dims)
+    elif any(m in (dict, _Mapping, typing.Mapping) for m in plain):
+        if not isinstance(value, _Mapping):
+            raise TypeError(f"{name}: expected a mapping, got {type(value).__name__}")
+    elif any(m in (_Callable, typing.Callable) for m in plain):
+        callable_(name, value)
+    else:
+        classes = tuple(m for m in plain if isinstance(m, type) and m is not object)
+        if classes and len(classes) == len(plain):
+            instance(name, value, classes)
+
+
+def record(
+    obj,
+    *,
+    shapes: dict[str, tuple] | None = None,
+    positive: Sequence[str] = (),
+    nonnegative: Sequence[str] = (),
+    allow_nan: Sequence[str] = (),
+    may_be_empty: Sequence[str] = (),
+    skip: Sequence[str] = (),
+) -> None:
+    """Check every field of the dataclass ``obj`` by its annotation (for ``__post_init__``).
+
+    ``float`` finite real, ``int`` integer, ``bool`` True/False, ``str`` non-empty text,
+    ``np.ndarray`` numbers (finite unless in ``allow_nan``), lists, mappings, callables and classes
+    by type, ``X | None`` also ``None``. ``shapes`` gives a field's shape (arrays) or ``(length,)``
+    (lists): ints, ``None`` for any length, or a symbol such as ``"T"`` that must take the same
+    value in every field it appears in. ``positive``/``nonnegative`` name fields with that sign;
+    ``may_be_empty`` text or lists that may be empty; ``skip`` fields left unchecked. Errors name
+    the field.
+    """
+    import dataclasses
+
+    hints = _field_hints(type(obj))
+    shapes = shapes or {}
+    dims: dict[str, int] = {}
+    for f in dataclasses.fields(obj):
+        if not f.init or f.name in skip or f.name not in hints:
+            continue
+        sign = "positive" if f.name in positive else "nonnegative" if f.name in nonnegative else ""
+        _field(
+            f.name,
+            getattr(obj, f.name),
+            hints[f.name],
+            spec=shapes.get(f.name),
+            sign=sign,
+            allow_nan=f.name in allow_nan,
+            may_be_empty=f.name in may_be_empty,
+            dims=dims,
+        )

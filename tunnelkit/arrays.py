@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ._validate import finite_array, integer, positive, real, vector
+from ._validate import finite_array, integer, nonnegative, positive, real, text, vector
 from .budget import check_elements
 from .constants import wavelength
 
@@ -88,8 +88,12 @@ def check_element_positions(
 
     Raises ``ValueError`` naming ``name`` if the elements are not in the local xy-plane (the frame
     eq. 17-19 need), if element 0 is not at the origin, if two elements coincide, or if the count
-    does not match ``m``.
+    does not match ``m``. ``name`` is the caller's parameter the errors about ``positions`` name.
     """
+    name = text("name", name)
+    if m is not None:
+        m = integer("m", m, minimum=2)
+    atol = nonnegative("atol", atol)
     p = finite_array(name, positions)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"{name}: expected shape (M, 3), got {p.shape}")
@@ -134,6 +138,7 @@ class ArrayGeometry:
         loc = check_element_positions("local", self.local)
         object.__setattr__(self, "local", loc)
         object.__setattr__(self, "origin", vector("origin", self.origin, 3))
+        text("name", self.name, empty=True)
         object.__setattr__(self, "R", rotation(self.azimuth, self.elevation))
         object.__setattr__(self, "azimuth", float(self.azimuth))
         object.__setattr__(self, "elevation", float(self.elevation))

@@ -23,6 +23,10 @@ import math
 import os
 import re
 
+import numpy as np
+
+from ._validate import integer, text
+
 __all__ = [
     "DEFAULT_BUDGET",
     "check_bytes",
@@ -91,6 +95,8 @@ def set_memory_budget(nbytes: int | str | None) -> int | None:
             finite = math.isfinite(nbytes)
         except OverflowError:  # an int beyond float range
             finite = False
+        if finite and isinstance(nbytes, float) and not nbytes.is_integer():
+            raise ValueError(f"nbytes: must be a whole number of bytes, got {nbytes}")
         if not finite or nbytes <= 0:
             big_int = isinstance(nbytes, int) and not finite
             shown = f"an integer of {len(str(nbytes))} digits" if big_int else f"{nbytes}"
@@ -120,9 +126,18 @@ def _count(n: int) -> str:
     return f"{n} elements"
 
 
+def _whole(name: str, value) -> int:
+    """A count ``>= 0``: an integer, or a float holding a whole number (a product of sizes)."""
+    if isinstance(value, float | np.floating) and math.isfinite(value) and value.is_integer():
+        value = int(value)
+    return integer(name, value, minimum=0)
+
+
 def check_bytes(name: str, nbytes, what: str = "") -> None:
     """Raise ``ValueError`` naming ``name`` if ``nbytes`` exceeds the budget."""
-    nbytes = int(nbytes)
+    text("name", name)
+    text("what", what, empty=True)
+    nbytes = _whole("nbytes", nbytes)
     limit = memory_budget()
     if nbytes > limit:
         detail = f" ({what})" if what else ""
@@ -135,6 +150,11 @@ def check_bytes(name: str, nbytes, what: str = "") -> None:
 
 def check_elements(name: str, count, itemsize: int = 8, what: str = "") -> None:
     """:func:`check_bytes` for ``count`` elements of ``itemsize`` bytes (exact integer product)."""
-    count = int(count)
+    text("name", name)
+    text("what", what, empty=True)
+    count = _whole("count", count)
+    itemsize = _whole("itemsize", itemsize)
+    if itemsize == 0:
+        raise ValueError("itemsize: must be > 0 bytes")
     desc = what or f"{_count(count)} of {itemsize} B"
     check_bytes(name, count * int(itemsize), desc)

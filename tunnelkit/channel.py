@@ -287,7 +287,7 @@ def diffuse_tensor(
     docstring), starting at delay ``tau0`` [s], with diffuse power ``spec.power(specular_power)``
     per element; drawn from ``rng``."""
     if not isinstance(spec, DiffuseSpec):
-        raise TypeError(f"dmc: expected a channel.DiffuseSpec, got {type(spec).__name__}")
+        raise TypeError(f"spec: expected a channel.DiffuseSpec, got {type(spec).__name__}")
     rng = rng_or_error("rng", rng)
     m, nf, nt = (integer("shape", v, minimum=1) for v in shape)
     tau0 = float(finite_array("tau0", tau0, ndim=0))
@@ -400,6 +400,8 @@ def channel_tensor(
             raise TypeError(f"dmc: expected a channel.DiffuseSpec, got {type(dmc).__name__}")
         if rng is None:
             raise ValueError("rng: diffuse multipath (dmc) is random; pass a numpy Generator")
+        rng = rng_or_error("rng", rng)
+    elif rng is not None:  # unused without dmc, but a wrong one is still an error
         rng = rng_or_error("rng", rng)
     nf = config.n_tones if n_tones is None else integer("n_tones", n_tones, minimum=2)
     nt = config.n_symbols if n_symbols is None else integer("n_symbols", n_symbols, minimum=2)

@@ -23,7 +23,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validate import callable_, finite_array, integer, positive, spd_matrix
+from ._validate import callable_, finite_array, integer, positive, spd_matrix, text
 
 __all__ = [
     "crlb_rmse",
@@ -107,6 +107,7 @@ def station_sigmas(name: str, sigma, n: int) -> np.ndarray | None:
     > 0; ``None`` leaves that measurement type out. Errors name the parameter ``name``.
     """
     n = integer("n", n, minimum=1)
+    name = text("name", name)
     if sigma is None:
         return None
     s = finite_array(name, sigma)
@@ -165,6 +166,10 @@ def numeric_jacobian(
     step = positive("step", step)
     if p.ndim == 0:
         raise ValueError("p: expected a point (..., n), got a scalar")
+    if angle_mask is not None:
+        mask = np.asarray(angle_mask)
+        if mask.dtype.kind != "b" or mask.ndim != 1:
+            raise TypeError(f"angle_mask: expected a 1-D array of booleans, got {angle_mask!r:.40}")
     n = p.shape[-1]
     cols = []
     for k in range(n):
@@ -177,7 +182,6 @@ def numeric_jacobian(
                 f"h: fails on p of shape {p.shape} ({type(exc).__name__}: {exc})"
             ) from None
         if angle_mask is not None:
-            mask = np.asarray(angle_mask, dtype=bool)
             diff = np.where(mask, _wrap(diff), diff)
         cols.append(diff / (2.0 * step))
     J = np.stack(cols, axis=-1)

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._validate import finite_array, positive, real
 from .arrays import ArrayGeometry
 from .constants import C
 
@@ -22,6 +23,17 @@ __all__ = [
 ]
 
 
+def _ranges_directions(d_name: str, d, u_name: str, u) -> tuple[np.ndarray, np.ndarray]:
+    """Distances (N,) and unit directions (N, 3), checked and named."""
+    d = np.atleast_1d(finite_array(d_name, d))
+    if d.ndim != 1:
+        raise ValueError(f"{d_name}: expected 1-D distances, got shape {d.shape}")
+    u = finite_array(u_name, u)
+    if not (u.size == 0 and d.size == 0) and u.shape != (d.shape[0], 3):
+        raise ValueError(f"{u_name}: expected shape ({d.shape[0]}, 3), got {u.shape}")
+    return d, u.reshape(d.shape[0], 3)
+
+
 def match_paths(
     d_est,
     dir_est,
@@ -36,7 +48,14 @@ def match_paths(
     Cost: ``|d_est - (length + c b)| / range_scale + ||u_est - u_true|| / direction_scale``;
     assignments costing more than 10 are refused.
     """
-    d_est = np.atleast_1d(np.asarray(d_est, float))
+    d_est, dir_est = _ranges_directions("d_est", d_est, "dir_est", dir_est)
+    if isinstance(paths, str | bytes) or not hasattr(paths, "__len__"):
+        raise TypeError(f"paths: expected a list of traced paths, got {type(paths).__name__}")
+    if any(not hasattr(p, "length") or not hasattr(p, "direction") for p in paths):
+        raise TypeError("paths: expected traced paths (with .length and .direction)")
+    clock_bias = real("clock_bias", clock_bias)
+    direction_scale = positive("direction_scale", direction_scale)
+    range_scale = positive("range_scale", range_scale)
     if not len(paths) or not d_est.size:
         return -np.ones(d_est.shape[0], dtype=int)
     d_true = np.array([p.length for p in paths]) + C * clock_bias
@@ -57,17 +76,16 @@ def match_points(
     """:func:`match_paths` on plain arrays (distances and unit directions in one frame)."""
     from scipy.optimize import linear_sum_assignment
 
-    d_est = np.atleast_1d(np.asarray(d_est, float))
+    d_est, dir_est = _ranges_directions("d_est", d_est, "dir_est", dir_est)
+    d_true, dir_true = _ranges_directions("d_true", d_true, "dir_true", dir_true)
+    direction_scale = positive("direction_scale", direction_scale)
+    range_scale = positive("range_scale", range_scale)
     out = -np.ones(d_est.shape[0], dtype=int)
-    d_true = np.atleast_1d(np.asarray(d_true, float))
     if not d_true.size or not d_est.size:
         return out
     cost = (
         np.abs(d_est[:, None] - d_true[None, :]) / range_scale
-        + np.linalg.norm(
-            np.asarray(dir_est, float)[:, None, :] - np.asarray(dir_true, float)[None], axis=-1
-        )
-        / direction_scale
+        + np.linalg.norm(dir_est[:, None, :] - dir_true[None], axis=-1) / direction_scale
     )
     r, c = linear_sum_assignment(cost)
     ok = cost[r, c] < 10.0
@@ -168,6 +186,20 @@ class Scene:
     v: np.ndarray
     element_positions: np.ndarray
     config: object
+
+    def __post_init__(self) -> None:
+        from ._validate import instance, record
+        from .channel import SRSConfig
+
+        shapes = {
+            "sources": ("L", 3),
+            "alpha": ("L",),
+            "d": ("L",),
+            "v": ("L",),
+            "element_positions": (None, 3),
+        }
+        record(self, shapes=shapes, positive=("d",))
+        instance("config", self.config, SRSConfig)
 
     @property
     def mu_f(self) -> np.ndarray:

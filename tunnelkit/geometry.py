@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import finite_array, real, vector
+from ._validate import finite_array, real, sequence, text, vector
 
 __all__ = [
     "Plane",
@@ -81,6 +81,7 @@ class Plane:
         if norm == 0.0:
             raise ValueError("normal: degenerate plane, all coefficients are zero (A = B = 0)")
         off = real("offset", self.offset)
+        text("name", self.name, empty=True)
         object.__setattr__(self, "normal", n / norm)
         object.__setattr__(self, "offset", off / norm)
 
@@ -128,12 +129,13 @@ def line(A: float, B: float, C: float, name: str = "") -> Plane:
 def mirror(point, plane: Plane) -> np.ndarray:
     """Mirror ``point`` in ``plane`` (functional form of :meth:`Plane.mirror`)."""
     _check_plane("plane", plane)
+    point = plane._points("point", point)
     return plane.mirror(point)
 
 
 def virtual_stations(base_station, walls) -> np.ndarray:
     """Virtual stations: the base station mirrored in each wall (Jiang eq. 3-4). Shape (N, dim)."""
-    walls = list(walls)
+    walls = sequence("walls", walls, empty=True)
     if not walls:
         raise ValueError("walls: need at least one wall")
     for i, w in enumerate(walls):
@@ -206,6 +208,7 @@ class Tunnel2D:
     walls: tuple[Plane, Plane]
 
     def __post_init__(self) -> None:
+        sequence("walls", self.walls, empty=True)
         if len(self.walls) != 2:
             raise ValueError(f"walls: a 2-D tunnel needs exactly two walls, got {len(self.walls)}")
         for i, w in enumerate(self.walls):
@@ -222,7 +225,9 @@ class Tunnel2D:
     @classmethod
     def from_lines(cls, line0, line1) -> Tunnel2D:
         """Build from two ``(A, B, C)`` triples, e.g. Jiang's ``(3, -3, 40)`` and ``(3, -3, -23.6396)``."""
-        return cls((line(*line0, name="wall 1"), line(*line1, name="wall 2")))
+        l0 = finite_array("line0", line0, shape=(3,))
+        l1 = finite_array("line1", line1, shape=(3,))
+        return cls((line(*l0, name="wall 1"), line(*l1, name="wall 2")))
 
     @property
     def _sign(self) -> float:
@@ -260,10 +265,13 @@ class Tunnel2D:
     def contains(self, p, margin: float = 0.0) -> np.ndarray:
         """True where ``p`` lies strictly between the walls (by more than ``margin``)."""
         depth = self._depth(self.walls[0]._points("p", p))
+        margin = real("margin", margin)
         return (depth > margin) & (depth < self.width - margin)
 
     def require_inside(self, name: str, p) -> np.ndarray:
-        """Return ``p`` as an array, raising if any point lies outside the tunnel."""
+        """Return ``p`` as an array, raising if any point lies outside the tunnel (the error names
+        ``name``, the caller's parameter)."""
+        name = text("name", name)
         p = self.walls[0]._points(name, p)
         inside = np.atleast_1d(self.contains(p))
         if not np.all(inside):

@@ -45,7 +45,7 @@ from urllib.parse import urlsplit
 
 import numpy as np
 
-from ._validate import callable_, integer, positive
+from ._validate import boolean, callable_, integer, positive, sequence, text
 from .budget import check_bytes
 
 __all__ = [
@@ -153,6 +153,7 @@ def run_trials(
     calls = _calls(rngs, inputs)
     workers, scheduler = parallel_options(workers, scheduler)
     retries = integer("retries", retries, minimum=0)
+    progress, desc = boolean("progress", progress), text("desc", desc)
     timeout = positive("timeout", timeout)
     if trial_timeout is not None:
         trial_timeout = positive("trial_timeout", trial_timeout)
@@ -209,8 +210,8 @@ class TrialPool:
         """:meth:`map` leaving each result on its worker (a future; serially the value). As
         :func:`run_trials` ``inputs``, a trial's task depends on its item's only (no barrier)
         and fetches it worker to worker. Submitted in order: put the longest item first."""
-        callable_("fn", fn)
-        items = _sequence("items", items)
+        fn, desc = callable_("fn", fn), text("desc", desc)
+        items = sequence("items", items, empty=True)
         if self.client is None:
             with _one_blas_thread():
                 return [fn(x) for x in items]
@@ -222,28 +223,25 @@ class TrialPool:
 
     def gather(self, handles: Sequence[Any]) -> list:
         """The values of :meth:`prepare`'s handles, in order."""
-        handles = _sequence("handles", handles)
+        handles = sequence("handles", handles, empty=True)
         return handles if self.client is None else self.client.gather(handles)
 
 
-def _sequence(name: str, x) -> list:
-    if isinstance(x, str | bytes) or not isinstance(x, Sequence | np.ndarray):
-        raise TypeError(f"{name}: expected a sequence, got {type(x).__name__}")
-    return list(x)
-
-
-@contextlib.contextmanager
 def trial_pool(
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float = CONNECT_TIMEOUT_S,
-) -> Iterator[TrialPool]:
-    """A :class:`TrialPool`: serial without ``workers`` / ``scheduler``, else one local cluster
-    of ``workers`` processes (capped to the cores, as :func:`run_trials`) or the cluster at
-    ``scheduler``, closed on exit."""
+) -> contextlib.AbstractContextManager[TrialPool]:
+    """A :class:`TrialPool` (a context manager, its arguments checked at the call): serial without
+    ``workers`` / ``scheduler``, else one local cluster of ``workers`` processes (capped to the
+    cores, as :func:`run_trials`) or the cluster at ``scheduler``, closed on exit."""
     workers, scheduler = parallel_options(workers, scheduler)
     timeout = positive("timeout", timeout)
-    workers = _capped(workers)
+    return _trial_pool(_capped(workers), scheduler, timeout)
+
+
+@contextlib.contextmanager
+def _trial_pool(workers, scheduler, timeout) -> Iterator[TrialPool]:
     if workers is None and scheduler is None:
         yield TrialPool(None)
         return

@@ -13,6 +13,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from ._validate import record
+
 __all__ = ["Report"]
 
 
@@ -25,6 +27,16 @@ class Report:
     rows: list[Sequence[Any]]
     notes: list[str] = field(default_factory=list)
     meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        record(self, may_be_empty=("rows", "notes"))
+        for name in ("columns", "notes"):
+            bad = [c for c in getattr(self, name) if not isinstance(c, str)]
+            if bad:
+                raise TypeError(f"{name}: expected text items, got {bad[0]!r}")
+        for i, row in enumerate(self.rows):
+            if isinstance(row, str) or not isinstance(row, Sequence):
+                raise TypeError(f"rows: row {i} is a {type(row).__name__}, expected a sequence")
 
     def records(self) -> list[dict[str, Any]]:
         """Rows as dicts keyed by column name."""

@@ -23,6 +23,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from ._validate import choice, instance, record, text
+
 __all__ = [
     "FAMILIES",
     "Key",
@@ -40,6 +42,10 @@ class ScenarioError(ValueError):
 
 
 _REQUIRED = object()
+
+
+#: the kinds of value a :class:`Key` describes
+KEY_TYPES = ("float", "int", "str", "floats", "ints", "strs", "table", "tables", "bool")
 
 
 @dataclass(frozen=True)
@@ -66,6 +72,10 @@ class Key:
     le: float | None = None
     choices: tuple | None = None
     table: Table | None = None
+
+    def __post_init__(self) -> None:
+        record(self, may_be_empty=("unit",), skip=("default",))
+        choice("type", self.type, KEY_TYPES)
 
     @property
     def required(self) -> bool:
@@ -96,7 +106,14 @@ class Table:
     doc: str = ""
     variants: dict[str, tuple[Key, ...]] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        record(self, may_be_empty=("doc",))
+        for k in self.keys:
+            instance("keys", k, Key)
+
     def allowed(self, kind: str | None) -> tuple[Key, ...]:
+        if kind is not None:
+            text("kind", kind)
         return self.keys + tuple(self.variants.get(kind, ()))
 
 
@@ -243,6 +260,7 @@ def family_of(raw: dict, where: str) -> str:
     """The family of a parsed file: its ``paper`` key, or ``"user"`` without one."""
     if not isinstance(raw, dict):
         raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
+    text("where", where)
     paper = raw.get("paper")
     if paper is None:
         return "user"
@@ -261,6 +279,7 @@ def family_of(raw: dict, where: str) -> str:
 
 def validate(raw: dict, where: str) -> tuple[str, dict]:
     """``(family, normalised copy)`` of a parsed scenario file (``ScenarioError`` if malformed)."""
+    text("where", where)
     fam = family_of(raw, where)
     return fam, validate_table(raw, FAMILIES[fam], where)
 

@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from .. import arrays
-from .._validate import finite_array, integer
+from .._validate import boolean, finite_array, integer, text
 from ..budget import check_elements
 from ..constants import C, wavelength
 
@@ -49,6 +49,8 @@ SECTION_4_1_TILT = math.radians(30.0)
 def real_input(name: str, value, *, pos: bool = False) -> np.ndarray:
     """``value`` as a finite real scalar or array (bools and text refused, errors naming
     ``name``); ``pos`` insists on > 0 everywhere. The input check of every function here."""
+    text("name", name)
+    pos = boolean("pos", pos)
     if isinstance(value, bool | np.bool_):
         raise TypeError(f"{name}: expected a real number, got {value!r}")
     if isinstance(value, str | bytes):

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, integer
+from .._validate import finite_array, integer, record
 from ..budget import check_elements
 from ..constants import C, wavelength
 from .bounds import (
@@ -315,6 +315,24 @@ def mmax_exact_ura(
 # the derivation, term by term, and summaries
 
 
+#: every per-antenna term of :class:`ApertureProfile` has one value per element
+_PROFILE_SHAPES = dict.fromkeys(
+    (
+        "y",
+        "d_v",
+        "d_p0",
+        "delta_star",
+        "delta_star_fresnel",
+        "delta_sr",
+        "delta_sr_fresnel",
+        "mismatch",
+        "mismatch_paraxial",
+        "mismatch_second_order",
+    ),
+    ("M",),
+)
+
+
 @dataclass(frozen=True)
 class ApertureProfile:
     """Every term of the proof of Theorem 3.1 across an ``M``-element ULA (2-D, ``z_u = 0``).
@@ -333,6 +351,9 @@ class ApertureProfile:
     mismatch: np.ndarray  #: exact 2 pi / lambda (delta* - delta^SR) (signed)
     mismatch_paraxial: np.ndarray  #: eq. 33 times 2 pi / lambda
     mismatch_second_order: np.ndarray  #: corrected eq. 41 (see mmax_nonparaxial), signed
+
+    def __post_init__(self) -> None:
+        record(self, shapes=_PROFILE_SHAPES, positive=("x_p0",))
 
 
 def aperture_profile(M: int, R: float, W: float, y_u: float, fc: float) -> ApertureProfile:

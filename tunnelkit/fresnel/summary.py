@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from .._validate import boolean, positive
+from .._validate import boolean, integer, positive, record, text
 from ..report import Report
 from .bounds import (
     mmax_2d,
@@ -47,6 +47,14 @@ class MmaxSummary:
     fraunhofer: float  #: mmax_fraunhofer(R)
     exact_capped: bool = False  #: the ULA search hit its limit: ``exact`` is a lower bound only
     exact_ura_capped: bool = False  #: the URA search hit its limit: ``exact_ura`` is a lower bound
+
+    def __post_init__(self) -> None:
+        record(
+            self,
+            positive=("R", "W", "fc", "eps_phi", "exact"),
+            nonnegative=("paraxial_ratio", "eq25", "eq37", "nonparaxial", "fraunhofer"),
+        )
+        integer("exact_ura", self.exact_ura, minimum=-1)  # -1: the URA search was skipped
 
     @property
     def ratio(self) -> float | None:
@@ -93,8 +101,16 @@ def design_report(points, *, title: str = "SR-NF validity: bounds vs exact Mmax"
     ``points`` is an iterable of dicts with keys ``R, W, y_u, fc, eps_phi`` (and optionally
     ``z_u``, ``label``).
     """
+    if isinstance(points, str | bytes) or not hasattr(points, "__iter__"):
+        raise TypeError(f"points: expected an iterable of dicts, got {type(points).__name__}")
+    title, ura = text("title", title), boolean("ura", ura)
+    points = list(points)
+    if not points:
+        raise ValueError("points: expected at least one design point")
     rows, recs = [], []
-    for p in points:
+    for i, p in enumerate(points):
+        if not isinstance(p, dict):
+            raise TypeError(f"points: item {i} is a {type(p).__name__}, expected a dict")
         p = dict(p)
         label = str(p.pop("label", ""))
         s = mmax_summary(**p, ura=ura)

@@ -7,6 +7,7 @@ from collections.abc import Mapping
 import numpy as np
 import plotly.graph_objects as go
 
+from .._validate import boolean, finite_array, text
 from ..metrics import ecdf
 
 __all__ = ["COLORS", "cdf_figure", "line_figure", "reveal_overlaps"]
@@ -83,7 +84,12 @@ def line_figure(
         raise TypeError(f"series: expected a mapping name -> values, got {type(series).__name__}")
     if dash is not None and not isinstance(dash, Mapping):
         raise TypeError(f"dash: expected a mapping name -> dash style, got {type(dash).__name__}")
-    n = len(np.atleast_1d(np.asarray(x)))
+    x = finite_array("x", np.atleast_1d(x), ndim=1)
+    title, xaxis, yaxis = (
+        text(k, v, empty=True) for k, v in (("title", title), ("xaxis", xaxis), ("yaxis", yaxis))
+    )
+    log_y = boolean("log_y", log_y)
+    n = len(x)
     for name, y in series.items():
         if len(np.atleast_1d(np.asarray(y))) != n:
             raise ValueError(f"series: {name!r} has {len(np.atleast_1d(y))} values, x has {n}")
@@ -114,6 +120,7 @@ def cdf_figure(
     """Empirical CDFs of error samples, one line each."""
     if not isinstance(errors, Mapping):
         raise TypeError(f"errors: expected a mapping name -> samples, got {type(errors).__name__}")
+    title, xaxis = text("title", title, empty=True), text("xaxis", xaxis, empty=True)
     fig = go.Figure()
     for name, e in errors.items():
         x, p = ecdf(e)

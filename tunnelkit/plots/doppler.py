@@ -8,7 +8,9 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .._validate import instance, text
 from ..constants import C
+from ..drive import DopplerToaMeasurements, Drive
 from ..metrics import ecdf
 from .common import reveal_overlaps
 
@@ -46,6 +48,12 @@ def drive_topview(
 
     The tube is 1.3 km long and 10 m wide, so the y axis is stretched.
     """
+    instance("drive", drive, Drive)
+    if tracks is not None and not isinstance(tracks, Mapping):
+        raise TypeError(
+            f"tracks: expected a mapping name -> positions, got {type(tracks).__name__}"
+        )
+    title = text("title", title, empty=True)
     cfg = drive.config
     x0, x1 = float(drive.position[:, 0].min()) - 20, float(drive.position[:, 0].max()) + 20
     fig = go.Figure()
@@ -104,6 +112,9 @@ def doppler_delay_figure(drive, meas=None) -> go.Figure:
     The right panel shows what the delay estimate adds to the geometric delay ``r / c``: the
     multipath pull of the impulse-response peak and, if ``meas`` is given, noise, NLOS and clock.
     """
+    instance("drive", drive, Drive)
+    if meas is not None:
+        instance("meas", meas, DopplerToaMeasurements)
     fig = make_subplots(
         rows=1, cols=2, subplot_titles=("Doppler shift [Hz]", "ToA minus line-of-sight delay [ns]")
     )

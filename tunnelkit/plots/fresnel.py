@@ -11,8 +11,9 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import fresnel
-from .._validate import integer
+from .._validate import finite_array, instance, integer, positive, positive_array, text
 from ..constants import wavelength
+from ..fresnel.bounds import carrier_tolerance, wall_geometry
 from .common import COLORS
 
 __all__ = [
@@ -45,6 +46,24 @@ FRESNEL_COLORS = {
 _MARGIN = {"l": 60, "r": 20, "t": 60, "b": 50}
 
 
+def _real(name: str, value):
+    """Real numbers (NaN allowed), text and complex refused."""
+    a = np.asarray(value) if not isinstance(value, str | bytes) else None
+    if a is None or a.dtype.kind not in "iuf":
+        raise TypeError(f"{name}: expected real numbers, got {type(value).__name__}")
+    return a
+
+
+def _point(R, W, y_u, fc, eps_phi=1.0, z_u=0.0, **axes) -> tuple[float, ...]:
+    """The design point (R, W, y_u, fc, eps_phi, z_u) as floats, validated with the theorem's
+    rules (errors name the parameter); ``axes`` (xaxis, yaxis, legend) checked as names."""
+    for k, v in axes.items():
+        text(k, v)
+    R, W, y_u, z_u = (float(v) for v in wall_geometry(R, W, y_u, z_u))
+    fc, eps_phi = (float(v) for v in carrier_tolerance(fc, eps_phi))
+    return R, W, y_u, fc, eps_phi, z_u
+
+
 def _polyline(points: list[np.ndarray]) -> tuple[list, list]:
     """Segments joined with ``None`` breaks: [[p0, p1], [q0, q1, q2], ...] -> x, y lists."""
     xs: list = []
@@ -70,6 +89,7 @@ def geometry_traces(
     SR-NF paths (dotted red) for the first and the last antenna. Eight traces, fixed order:
     wall, BS array, UE, VUE, true paths, VUE paths, SR-NF paths, reflector p0."""
     M = integer("M", M, minimum=2, maximum=100_000)
+    R, W, y_u, fc, _, _ = _point(R, W, y_u, fc, xaxis=xaxis, yaxis=yaxis, legend=legend)
     y = np.arange(M) * wavelength(fc) / 2.0
     a = 2.0 * W - y_u
     ue, pv = np.array([R, y_u]), np.array([R, a])
@@ -186,6 +206,9 @@ def mismatch_traces(
 ) -> list[dict]:
     """|phase mismatch| [rad] across the ULA: exact (with ``z_u``), eq. 33, corrected second order,
     and the tolerance ``eps_phi``. Four traces, fixed order."""
+    R, W, y_u, fc, eps_phi, z_u = _point(
+        R, W, y_u, fc, eps_phi, z_u, xaxis=xaxis, yaxis=yaxis, legend=legend
+    )
     prof = fresnel.aperture_profile(M, R, W, y_u, fc)
     exact = fresnel.mismatch_profile(
         np.column_stack([np.zeros(M), prof.y, np.zeros(M)]), R, W, y_u, fc, z_u=z_u
@@ -264,7 +287,15 @@ def mmax_range_traces(
     """Mmax vs R (log-log): exact ULA, eq. 25, eq. 37, corrected second order, the Fraunhofer
     ``1 + sqrt(2R/lambda)`` law (the ``sqrt(R/lambda)`` scaling), the chosen M and the design
     point. Seven traces, fixed order."""
-    Rg = np.geomspace(0.5, 500.0, 61) if R_grid is None else np.asarray(R_grid, dtype=float)
+    R, W, y_u, fc, eps_phi, z_u = _point(
+        R, W, y_u, fc, eps_phi, z_u, xaxis=xaxis, yaxis=yaxis, legend=legend
+    )
+    M = integer("M", M, minimum=1)
+    Rg = (
+        np.geomspace(0.5, 500.0, 61) if R_grid is None else positive_array("R_grid", R_grid, ndim=1)
+    )
+    if exact_here is not None:
+        exact_here = integer("exact_here", exact_here, minimum=1)
     a = 2.0 * W - y_u
     exact = fresnel.mmax_exact_grid(Rg, W, y_u, fc, eps_phi, z_u=z_u)
     eq25 = fresnel.mmax_2d(Rg, W, y_u, fc, eps_phi)
@@ -416,6 +447,8 @@ def mmax_range_figure(
 
 def derivation_figure(profile: fresnel.ApertureProfile, *, lam: float) -> go.Figure:
     """Error of each approximation of the proof (eq. 28, 31, 33) in phase [rad] across the ULA."""
+    instance("profile", profile, fresnel.ApertureProfile)
+    lam = positive("lam", lam)
     k = 2 * np.pi / lam
     y_cm = profile.y * 100
     series = {
@@ -447,7 +480,19 @@ def ratio_map_figure(
     colorbar_title: str | None = None,
 ) -> go.Figure:
     """Heat map of a ratio (e.g. bound / exact Mmax) over (R, y_u), 1 = tight, log colour scale."""
-    r = np.asarray(ratio, dtype=float)
+    R_grid = positive_array("R_grid", R_grid, ndim=1)
+    y_grid = finite_array("y_grid", y_grid, ndim=1)
+    # NaN: no ratio there (e.g. a capped exact search), shown blank
+    r = np.asarray(_real("ratio", ratio), dtype=float)
+    if r.shape != (len(y_grid), len(R_grid)):
+        raise ValueError(f"ratio: expected shape ({len(y_grid)}, {len(R_grid)}), got {r.shape}")
+    if np.any(r <= 0) or np.any(np.isinf(r)):
+        raise ValueError("ratio: must be > 0 and finite (NaN for no value)")
+    title = text("title", title)
+    if W is not None:
+        W = positive("W", W)
+    if colorbar_title is not None:
+        colorbar_title = text("colorbar_title", colorbar_title)
     # the colour bar names the ratio it shows (the title's, unless told), not just "ratio"
     colorbar_title = title if colorbar_title is None else colorbar_title
     ticks = np.array([0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0])

@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import plotly.graph_objects as go
 
+from .._validate import finite_array, integer, nonnegative_array, text, vector
 from .common import COLORS
 from .tables import TableFigure, table
 
@@ -49,7 +50,14 @@ def trajectories_figure(
     truth, estimates: Mapping[str, np.ndarray], *, base_station=None, title: str = ""
 ) -> go.Figure:
     """Top view (x, y) of the true trajectory and each method's estimates (the paper's Fig. 6)."""
-    truth = np.asarray(truth, float)
+    truth = finite_array("truth", truth, ndim=2)
+    if truth.shape[1] < 2:
+        raise ValueError(f"truth: expected positions (T, 2 or 3), got shape {truth.shape}")
+    if not isinstance(estimates, Mapping):
+        raise TypeError(f"estimates: expected a mapping name -> positions, got {estimates!r:.40}")
+    if base_station is not None:
+        base_station = vector("base_station", base_station, (2, 3))
+    title = text("title", title, empty=True)
     fig = go.Figure()
     fig.add_scatter(
         x=truth[:, 0],
@@ -257,6 +265,15 @@ def tracks_count_figure(
     t, n_tracks, los=None, *, title: str = "tracked states per epoch"
 ) -> go.Figure:
     """Number of tracks (UE + VUEs) over time, with the epochs whose LoS existed shaded."""
+    t = finite_array("t", t, ndim=1)
+    n_tracks = nonnegative_array("n_tracks", n_tracks, shape=(len(t),))
+    if los is not None:
+        los = np.asarray(los)
+        if los.dtype.kind not in "bi" or los.shape != t.shape:
+            raise TypeError(
+                f"los: expected {len(t)} booleans, got {los.dtype} of shape {los.shape}"
+            )
+    title = text("title", title, empty=True)
     fig = go.Figure()
     fig.add_scatter(
         x=np.asarray(t),
@@ -287,6 +304,7 @@ def javelin_table_figure(
     columns: Sequence[str], rows: Sequence[Sequence], *, title: str = "", digits: int = 2
 ) -> TableFigure:
     """A table (numbers rounded to ``digits``, ``None`` or NaN as a dash), shown as HTML."""
+    digits = integer("digits", digits, minimum=0, maximum=15)
 
     def fmt(v):
         if v is None:

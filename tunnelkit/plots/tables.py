@@ -16,6 +16,9 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
+from .._validate import callable_, instance, sequence, text
+from ..report import Report
+
 __all__ = ["TableFigure", "report_table", "table"]
 
 _ROW_PX, _HEADER_PX, _CHAR_PX, _TITLE_PX = 22, 26, 7.2, 36
@@ -47,8 +50,15 @@ class TableFigure(go.Figure):
         title: str = "",
         notes: Sequence[str] = (),
     ):
-        columns = [str(c) for c in columns]
-        cells = [[str(v) for v in col] for col in cells]
+        columns = [str(c) for c in sequence("columns", columns, empty=True)]
+        cells = [
+            [str(v) for v in sequence("cells", col, empty=True)]
+            for col in sequence("cells", cells, empty=True)
+        ]
+        if len(cells) != len(columns):
+            raise ValueError(f"cells: expected {len(columns)} columns of cells, got {len(cells)}")
+        title = text("title", title, empty=True)
+        notes = sequence("notes", notes, empty=True)
         n_rows = len(cells[0]) if cells else 0
         super().__init__(
             go.Table(
@@ -134,8 +144,14 @@ def table(
 ) -> TableFigure:
     """A :class:`TableFigure` from row sequences, each value formatted by ``fmt``; ``notes`` are
     listed under the HTML table."""
-    columns = list(columns)
+    columns = sequence("columns", columns, empty=True)
+    rows = sequence("rows", rows, empty=True)
+    title = text("title", title, empty=True)
+    fmt = callable_("fmt", fmt)
+    notes = sequence("notes", notes, empty=True)
     for i, r in enumerate(rows):
+        if isinstance(r, str | bytes) or not isinstance(r, Sequence | np.ndarray):
+            raise TypeError(f"rows: row {i} is a {type(r).__name__}, expected a sequence")
         if len(r) != len(columns):
             raise ValueError(f"rows: row {i} has {len(r)} values for {len(columns)} columns")
     cells = [[fmt(r[i]) for r in rows] for i in range(len(columns))]
@@ -145,6 +161,7 @@ def table(
 def report_table(report) -> TableFigure:
     """A :class:`tunnelkit.reproduce.Report` (what ``tunnelkit reproduce`` prints as text) as a
     table: its title with its settings, its rows, its notes."""
+    instance("report", report, Report)
     meta = ", ".join(f"{k}: {v}" for k, v in report.meta.items())
     title = f"{report.title} ({meta})" if meta else report.title
     return table(report.columns, report.rows, title=title, notes=report.notes)

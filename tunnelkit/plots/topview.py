@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
+from .._validate import finite_array, interval, text, vector
 from ..geometry import Tunnel2D, specular_point
 from .common import COLORS
 
@@ -29,10 +30,17 @@ def tunnel_topview(
     the two wall-reflected paths (solid) with their virtual-station equivalents (dotted)."""
     if not isinstance(tunnel, Tunnel2D):
         raise TypeError(f"tunnel: expected a geometry.Tunnel2D, got {type(tunnel).__name__}")
-    bs = np.asarray(base_station, dtype=float)
+    bs = vector("base_station", base_station, 2)
+    a = np.asarray(interval("along", along))
+    if vehicle is not None:
+        vehicle = vector("vehicle", vehicle, 2)
+    if trajectory is not None:
+        trajectory = finite_array("trajectory", trajectory, ndim=2)
+        if trajectory.shape[1] < 2:
+            raise ValueError(f"trajectory: expected shape (T, 2), got {trajectory.shape}")
+    title = text("title", title)
     vs = tunnel.virtual_stations(bs)
     fig = go.Figure()
-    a = np.asarray(along, dtype=float)
     for k in range(2):
         ends = tunnel.from_tunnel_frame(
             np.stack([a, np.full(2, tunnel.width if k == 0 else 0.0)], -1)

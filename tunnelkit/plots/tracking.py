@@ -8,6 +8,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .._validate import finite_array, nonnegative_array, sequence, text
 from .common import COLORS, line_figure, reveal_overlaps
 from .tables import TableFigure, table
 from .topview import tunnel_topview
@@ -120,7 +121,11 @@ def rmse_bound_figure(
     t, rmse: Mapping[str, np.ndarray], bound, *, title: str = "", log_y: bool = True
 ) -> go.Figure:
     """RMSE per epoch of each estimator with sqrt(posterior CRLB) dashed underneath."""
-    series = {**rmse, "PCRLB": np.asarray(bound)}
+    t = finite_array("t", t, ndim=1)
+    if not isinstance(rmse, Mapping):
+        raise TypeError(f"rmse: expected a mapping name -> values, got {type(rmse).__name__}")
+    bound = nonnegative_array("bound", bound, shape=(len(t),))
+    series = {**rmse, "PCRLB": bound}
     fig = line_figure(
         t,
         series,
@@ -142,6 +147,12 @@ def bound_ratio_figure(
 ) -> go.Figure:
     """One panel per truth: each filter's RMSE divided by sqrt(PCRLB), epoch by epoch, with the
     bound's level 1 dashed. ``panels`` maps a panel title to ``(rmse per filter (T,), bound (T,))``."""
+    t = finite_array("t", t, ndim=1)
+    if not isinstance(panels, Mapping) or not panels:
+        raise TypeError(
+            f"panels: expected a non-empty mapping title -> (rmse, bound), got {panels!r:.40}"
+        )
+    title = text("title", title, empty=True)
     fig = make_subplots(
         rows=1,
         cols=len(panels),
@@ -235,4 +246,9 @@ def table_figure(
     rows: Sequence[Mapping], columns: Sequence[str], *, title: str = ""
 ) -> TableFigure:
     """A table of dict rows (floats shown with 4 significant digits), shown as HTML."""
+    columns = sequence("columns", columns, empty=True)
+    rows = sequence("rows", rows, empty=True)
+    for i, r in enumerate(rows):
+        if not isinstance(r, Mapping):
+            raise TypeError(f"rows: row {i} is a {type(r).__name__}, expected a mapping")
     return table(columns, [[r[c] for c in columns] for r in rows], title=title)

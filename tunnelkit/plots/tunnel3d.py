@@ -9,6 +9,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .._validate import finite_array, interval, nonnegative, sequence, text
 from .tables import TableFigure, table
 
 __all__ = [
@@ -148,8 +149,11 @@ def tunnel3d_figure(
 
 def paths_table_figure(rows: Sequence[dict], *, title: str = "") -> TableFigure:
     """A table from a list of dicts (same keys; floats shown with 4 significant digits), as HTML."""
+    rows = sequence("rows", rows, empty=True)
     if not rows:
-        return table([], [], title=title)
+        return table([], [], title=text("title", title, empty=True))
+    if not all(isinstance(r, dict) for r in rows):
+        raise TypeError("rows: expected dicts (one per path)")
     keys = list(rows[0])
     return table(keys, [[r[k] for k in keys] for r in rows], title=title)
 
@@ -216,9 +220,14 @@ def wave_origins_figure(
     With a ``trajectory`` or ``bs``, the view spans their x extent plus ``margin_m`` on each side;
     origins beyond it (a wild estimate metres or kilometres away would squash the rest into a
     strip) are left out and counted in the title."""
+    if not isinstance(origins, dict):
+        raise TypeError(f"origins: expected a dict name -> points (n, 3), got {origins!r:.40}")
+    named = {"trajectory": trajectory, "bs": bs}
+    anchors = [finite_array(k, a).reshape(-1, 3)[:, 0] for k, a in named.items() if a is not None]
+    z_range = interval("z_range", z_range)
+    margin_m, title = nonnegative("margin_m", margin_m), text("title", title, empty=True)
     fig = go.Figure()
     symbols = ["circle", "x", "diamond", "square"]
-    anchors = [np.asarray(a, float).reshape(-1, 3)[:, 0] for a in (trajectory, bs) if a is not None]
     x_lim = None
     if anchors:
         xs = np.concatenate(anchors)

@@ -127,6 +127,8 @@ def scenario_from_dict(raw: dict, path: str | os.PathLike = "<dict>") -> Scenari
     """
     if not isinstance(raw, dict):
         raise TypeError(f"raw: expected a dict of TOML tables, got {type(raw).__name__}")
+    if not isinstance(path, str | os.PathLike):
+        raise TypeError(f"path: expected a file name or path, got {type(path).__name__}")
     path = Path(path)
     where = path.name
     _check_depth(raw, where)
@@ -249,6 +251,8 @@ def _derive_user(sec: dict, raw: dict, where: str) -> None:
 
 def check_all(paths=None) -> list[tuple[str, str | None]]:
     """``[(name, error or None), ...]`` for every preset (or the given names/paths)."""
+    if paths is not None and (isinstance(paths, str | bytes) or not hasattr(paths, "__iter__")):
+        raise TypeError(f"paths: expected a list of scenario names or paths, got {paths!r:.40}")
     out = []
     for n in list_scenarios() if paths is None else paths:
         try:

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import record, text
 from ..schema import ScenarioError
 from .registry import ARRAYS, TRAJECTORIES, TUNNELS, Trajectory, getter
 
@@ -33,9 +34,12 @@ class Scenario:
     family: str = ""
     raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
+    def __post_init__(self) -> None:
+        record(self, may_be_empty=("paper", "description"))
+
     def section(self, key: str) -> dict[str, Any]:
         """A raw TOML table (``ScenarioError`` naming it if absent)."""
-        sec = self.sections.get(key)
+        sec = self.sections.get(text("key", key))
         if not isinstance(sec, dict):
             raise ScenarioError(f"{self.path.name}: missing section [{key}]")
         return sec
@@ -44,6 +48,8 @@ class Scenario:
         """Read ``"section.key"`` with type/shape checks, e.g. ``sc.get("radio.fc")``."""
         if not isinstance(key, str) or not key:
             raise TypeError(f"key: expected a dotted key such as 'radio.fc', got {key!r}")
+        if kind not in (float, int, str):
+            raise TypeError(f"kind: expected float, int or str, got {kind!r}")
         sec_name, _, k = key.rpartition(".")
         sec = self.section(sec_name) if sec_name else self.sections
         return getter(self.path.name, sec, sec_name)(k, kind, **kw)

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import callable_
+from .._validate import callable_, record, text
 from ..schema import ScenarioError
 
 __all__ = [
@@ -55,6 +55,9 @@ class Trajectory:
     t: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"t": ("T",), "position": ("T", "D"), "velocity": ("T", "D")})
 
     def __len__(self) -> int:
         return self.t.shape[0]
@@ -154,6 +157,7 @@ def require(module: str, where: str = "") -> None:
     installed loader; without one, a :class:`ScenarioError` unless it is imported already."""
     if not isinstance(module, str) or not module:
         raise TypeError(f"module: expected a module name, got {module!r}")
+    text("where", where, empty=True)
     if module in sys.modules:
         return
     if not _loader:
@@ -165,8 +169,8 @@ class Registry:
     """Builders of one kind of object, by key, all called the same way (``protocol``)."""
 
     def __init__(self, name: str, protocol: str) -> None:
-        self.name = name
-        self.protocol = protocol
+        self.name = text("name", name)
+        self.protocol = text("protocol", protocol)
         self._builders: dict[str, Callable] = {}
 
     def __repr__(self) -> str:
@@ -191,6 +195,8 @@ class Registry:
 
     def lookup(self, key: str, where: str = "") -> Callable:
         """The builder of ``key``; a built-in one is imported through the loader on first use."""
+        text("key", key)
+        text("where", where, empty=True)
         if key not in self._builders:
             module = PROVIDERS.get(self.name, {}).get(key)
             if module is None:

@@ -28,6 +28,8 @@ def template(name: str, preset: str | os.PathLike) -> str:
             f"name: {len(name)} characters, longer than the {MAX_NAME_LENGTH} a scenario name may "
             "have (it becomes the file name NAME.toml)"
         )
+    if not isinstance(preset, str | os.PathLike) or not str(preset):
+        raise TypeError(f"preset: expected a scenario name or a path, got {preset!r}")
     sc = load_scenario(preset)
     vals = {k: v for k, v in sc.raw.items()}
     family = sc.family

@@ -24,7 +24,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import choice, instance, integer, nonnegative, rng_or_error
+from .._validate import (
+    choice,
+    instance,
+    integer,
+    nonnegative,
+    probability,
+    record,
+    rng_or_error,
+)
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..signal_route import CHANNELS, Epoch, SignalRoute
@@ -60,6 +68,10 @@ class Condition:
     los_probability: float
     rrms: bool = True
 
+    def __post_init__(self) -> None:
+        record(self)
+        probability("los_probability", self.los_probability, open_interval=False)
+
 
 CONDITIONS: dict[str, Condition] = {
     c.name: c
@@ -70,6 +82,16 @@ CONDITIONS: dict[str, Condition] = {
         Condition("NoRRMs", 0.0, rrms=False),
         Condition("NoRRMs-L", 1.0, rrms=False),
     )
+}
+
+
+#: the shapes of a drive's fields: T epochs, positions and velocities in 3-D
+_DRIVE_SHAPES = {
+    **dict.fromkeys(("t", "speed", "heading", "los", "n_true"), ("T",)),
+    **dict.fromkeys(("epochs", "truth_index", "kinds", "sources"), ("T",)),
+    "truth": ("T", 3),
+    "velocity": ("T", 3),
+    "base_station": (3,),
 }
 
 
@@ -107,6 +129,14 @@ class DriveData:
     extraction: str = "paper"
     clock_bias_limit: float = 100e-9
     reports_covariance: bool = False
+
+    def __post_init__(self) -> None:
+        record(
+            self,
+            shapes=_DRIVE_SHAPES,
+            positive=("clock_bias_limit",),
+            may_be_empty=("truth_index", "kinds", "faults", "sources"),
+        )
 
     @property
     def dt(self) -> float:
@@ -193,10 +223,10 @@ def scenario_route(
                 f"channel: the route given runs on the {route.channel!r} channel, not {channel!r}"
             )
         return replace(route, **nuisance) if nuisance else route
-    if not isinstance(route, str):
-        raise TypeError(
-            f"route: expected a SignalRoute or a scenario name, got {type(route).__name__}"
-        )
+    if not isinstance(route, str) or not route:
+        raise TypeError(f"route: expected a SignalRoute or a scenario name, got {route!r}")
+    if channel is not None:
+        choice("channel", channel, CHANNELS)
     key = (route, model, channel or "image", tuple(sorted(nuisance.items())))
     if key not in _ROUTES:
         _ROUTES[key] = SignalRoute.from_scenario(
@@ -319,8 +349,10 @@ def simulate_routes(
         choice("channel", channel, CHANNELS)
     if n_epochs is not None:
         integer("n_epochs", n_epochs, minimum=1)
-    if not tuple(extractions):
-        raise ValueError(f"extraction: expected one of {EXTRACTIONS}, got {extractions!r}")
+    if isinstance(extractions, str) or not isinstance(extractions, tuple | list):
+        raise TypeError(f"extractions: expected a tuple of routes, got {extractions!r}")
+    if not extractions:
+        raise ValueError(f"extractions: expected one or more of {EXTRACTIONS}, got none")
     extractions = tuple(dict.fromkeys(route_name(e) for e in extractions))
     if "route" in extractions and len(extractions) > 1:
         raise ValueError(

@@ -28,7 +28,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.stats import chi2
 
-from .._validate import finite_array, instance, integer
+from .._validate import finite_array, instance, integer, text
 from .._validate import probability as check_probability
 
 __all__ = [
@@ -51,6 +51,23 @@ ACCEPT, REJECT, REOPEN = 0, 1, 2
 @lru_cache(maxsize=64)
 def _quantile(p: float, dof: int) -> float:
     return float(chi2.ppf(p, dof))
+
+
+def _d2(d2) -> np.ndarray:
+    """Squared Mahalanobis distances: real, ``>= 0`` or NaN/inf (a non-finite one is rejected)."""
+    if type(d2) is float or type(d2) is np.float64:  # one filter's distance: the inner loop's case
+        if d2 < 0:
+            raise ValueError(f"d2: must be >= 0 (a squared distance), got {d2}")
+        return np.asarray(d2)
+    if isinstance(d2, np.ndarray) and d2.dtype == float:
+        arr = d2
+    else:
+        if isinstance(d2, str | bytes) or np.asarray(d2).dtype.kind not in "iuf":
+            raise TypeError(f"d2: expected real numbers, got {type(d2).__name__}")
+        arr = np.asarray(d2, dtype=float)
+    if np.any(arr < 0):
+        raise ValueError(f"d2: must be >= 0 (a squared distance), got {float(np.nanmin(arr))}")
+    return arr
 
 
 def mahalanobis2(y, S) -> np.ndarray:
@@ -91,12 +108,15 @@ class ChiSquareGate:
 
     def threshold(self, dof: int = 3) -> float:
         """The chi-square quantile ``chi2_dof(p)`` (11.34 for 3 dof at p = 0.99)."""
-        return _quantile(float(self.probability), integer("dof", int(dof), minimum=1))
+        return _quantile(float(self.probability), integer("dof", dof, minimum=1))
 
     def accepts(self, d2, dof) -> np.ndarray:
         """Elementwise ``d2 < chi2_dof(p)``; ``dof`` broadcasts against ``d2``."""
-        d2 = np.asarray(d2, dtype=float)
-        dof = np.broadcast_to(np.asarray(dof, dtype=int), d2.shape)
+        d2 = _d2(d2)
+        dof = np.asarray(dof)
+        if dof.dtype.kind not in "iu":
+            raise TypeError(f"dof: expected integers, got {dof.dtype}")
+        dof = np.broadcast_to(dof, d2.shape)
         thr = np.vectorize(self.threshold, otypes=[float])(dof) if dof.size else np.zeros(dof.shape)
         return np.isfinite(d2) & (d2 < thr)
 
@@ -117,7 +137,12 @@ class InnovationGate:
         batch: int | None = None,
         name: str = "gate",
     ) -> None:
-        self.probability = None if probability is None else check_probability(name, probability)
+        name = text("name", name)
+        self.probability = (
+            None
+            if probability is None
+            else check_probability(f"{name} (the gate probability)", probability)
+        )
         self.test = None if probability is None else ChiSquareGate(self.probability)
         self.reopen_after = integer("reopen_after", reopen_after, minimum=1)
         shape = () if batch is None else (integer("batch", batch, minimum=1),)
@@ -151,7 +176,9 @@ class InnovationGate:
         ``d2`` is a scalar for one filter, or (len(rows),) for the batch rows ``rows`` (all rows
         when None). A non-finite ``d2`` is rejected.
         """
-        d2 = np.asarray(d2, dtype=float)
+        d2 = _d2(d2)
+        if type(dof) is not int or dof < 1:  # plain ints pass without the general check
+            dof = integer("dof", dof, minimum=1)
         if rows is not None and (
             isinstance(rows, str | bytes) or np.asarray(rows).dtype.kind not in "iub"
         ):
@@ -175,10 +202,17 @@ class InnovationGate:
 
         ``S`` (..., m, m) is the innovation covariance, ``R`` (m, m) the measurement noise.
         """
-        trS = np.trace(np.asarray(S, dtype=float), axis1=-2, axis2=-1)
-        trR = float(np.trace(np.asarray(R, dtype=float)))
+        S = finite_array("S", S)
+        if S.ndim < 2 or S.shape[-1] != S.shape[-2]:
+            raise ValueError(f"S: expected square matrices (..., m, m), got shape {S.shape}")
+        R = finite_array("R", R, shape=S.shape[-2:])
+        d2 = _d2(d2)
+        if not np.isfinite(d2).all():
+            raise ValueError("d2: a reopened measurement has a finite distance, got NaN or inf")
+        dof = integer("dof", dof, minimum=1)
+        trS = np.trace(S, axis1=-2, axis2=-1)
+        trR = float(np.trace(R))
         trA = np.maximum(trS - trR, 1e-12 * np.maximum(trS, 1e-300))
-        d2 = np.asarray(d2, dtype=float)
         return np.maximum(1.0, (d2 * trS / self.threshold(dof) - trR) / trA)
 
 
@@ -192,6 +226,8 @@ def gated_filterpy_update(f, update, gate: InnovationGate, *, redraw=None) -> in
     e.g. a UKF's sigma points) and the update is made again.
     """
     instance("gate", gate, InnovationGate)
+    if redraw is not None and not callable(redraw):
+        raise TypeError(f"redraw: expected a callable or None, got {type(redraw).__name__}")
     if not (hasattr(f, "x") and hasattr(f, "P")):
         raise TypeError(f"f: expected a filterpy filter (with x and P), got {type(f).__name__}")
     if not callable(update):

@@ -8,7 +8,7 @@ from typing import Any
 import ipywidgets as widgets
 import plotly.graph_objects as go
 
-from .._validate import boolean, integer, real
+from .._validate import boolean, integer, positive, real, text
 
 __all__ = ["Explorer", "checkbox", "float_slider", "int_slider", "slider_value"]
 
@@ -16,12 +16,21 @@ __all__ = ["Explorer", "checkbox", "float_slider", "int_slider", "slider_value"]
 def slider_value(name: str | None, value, lo: float, hi: float, *, whole: bool = False):
     """``value`` checked against a slider's range before the slider exists (ipywidgets would
     clamp it silently, or fail with a ``TraitError`` naming no parameter): a real number (an
-    integer when ``whole``) in ``[lo, hi]``, errors naming ``name``. ``name=None``: unchecked (the
-    explorer's own constant)."""
+    integer when ``whole``) in ``[lo, hi]``, errors naming ``name``. ``name=None``: the value is
+    unchecked (the explorer's own constant), the range still is."""
+    if name is not None:
+        text("name", name)
+    whole = boolean("whole", whole)
+    if whole:
+        lo, hi = integer("lo", lo), integer("hi", hi)
+    else:
+        lo, hi = real("lo", lo), real("hi", hi)
+    if hi <= lo:
+        raise ValueError(f"hi: must be above lo = {lo:g}, got {hi:g}")
     if name is None:
         return value
     if whole:
-        return integer(name, value, minimum=int(lo), maximum=int(hi))
+        return integer(name, value, minimum=lo, maximum=hi)
     x = real(name, value)
     if not lo <= x <= hi:
         raise ValueError(f"{name}: must lie in [{lo:g}, {hi:g}] (the slider's range), got {x:g}")
@@ -41,7 +50,11 @@ def float_slider(
     """A FloatSlider that only reports on release (``continuous_update=False``); with ``name``
     (the explorer's parameter) ``value`` is checked against ``[lo, hi]`` first
     (:func:`slider_value`)."""
-    value = slider_value(name, value, lo, hi)
+    value = slider_value(name, value, lo, hi) if name is not None else real("value", value)
+    slider_value(None, value, lo, hi)  # the range, also for the explorer's own constant
+    description = text("description", description, empty=True)
+    step = positive("step", step)
+    readout_format = text("readout_format", readout_format)
     return widgets.FloatSlider(
         value=value,
         min=lo,
@@ -60,7 +73,14 @@ def int_slider(
 ) -> widgets.IntSlider:
     """An IntSlider that only reports on release (``continuous_update=False``); ``name`` as in
     :func:`float_slider`."""
-    value = slider_value(name, value, lo, hi, whole=True)
+    value = (
+        slider_value(name, value, lo, hi, whole=True)
+        if name is not None
+        else integer("value", value)
+    )
+    slider_value(None, value, lo, hi, whole=True)
+    description = text("description", description, empty=True)
+    step = integer("step", step, minimum=1)
     return widgets.IntSlider(
         value=value,
         min=lo,
@@ -74,10 +94,11 @@ def int_slider(
 
 
 def checkbox(description: str, value: bool, *, name: str | None = None) -> widgets.Checkbox:
-    """A Checkbox; with ``name`` the value must be a real ``True``/``False``."""
-    return widgets.Checkbox(
-        value=boolean(name, value) if name else bool(value), description=description
-    )
+    """A Checkbox; the value must be a real ``True``/``False`` (errors name ``name``, else
+    ``value``)."""
+    description = text("description", description, empty=True)
+    label = "value" if name is None else text("name", name)
+    return widgets.Checkbox(value=boolean(label, value), description=description)
 
 
 class Explorer:

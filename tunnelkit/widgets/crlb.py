@@ -7,7 +7,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import crlb
-from .._validate import finite_array, integer
+from .._validate import boolean, finite_array, integer, positive
 from ..budget import check_elements
 from ..geometry import Tunnel2D
 from ..scenarios import load_scenario
@@ -53,6 +53,11 @@ def crlb_figure(
 
     NLOS uses the two virtual stations; ``los=True`` adds the base station itself (the direct path).
     """
+    sigma_theta_deg, sigma_d = (
+        positive("sigma_theta_deg", sigma_theta_deg),
+        positive("sigma_d", sigma_d),
+    )
+    los, log_scale = boolean("los", los), boolean("log_scale", log_scale)
     sc = load_scenario(scenario)
     tunnel, bs = sc.tunnel(), sc.base_station()
     stations = tunnel.virtual_stations(bs)

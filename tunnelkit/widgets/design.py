@@ -71,6 +71,11 @@ def design_figure(
     tunnel at this mount) gives an empty figure whose title says so instead of raising.
     """
     wideband = checkbox("", wideband, name="wideband").value
+    # the arguments are checked here, before the "does not fit" figure below catches ValueError
+    fc_ghz, bandwidth_mhz = positive("fc_ghz", fc_ghz), positive("bandwidth_mhz", bandwidth_mhz)
+    n = integer("n", n, minimum=1)
+    tilt_deg, mount_height = real("tilt_deg", tilt_deg), positive("mount_height", mount_height)
+    eps_phi = positive("eps_phi", eps_phi)
     imp = design.DesignImpairments(
         phase_error_deg=phase_error_deg,
         gain_error_db=gain_error_db,

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import instance, positive
+from ..._validate import instance, positive, record
 from ...drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
 from ..registry import family, register
 from .filters import (
@@ -51,6 +51,9 @@ class Track:
     t: np.ndarray
     position: np.ndarray
     speed: np.ndarray
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"t": ("T",), "position": ("T", 2), "speed": ("T",)})
 
 
 # --- the three approaches, registered -------------------------------------------------------------
@@ -132,7 +135,8 @@ class EkfDS(_Base):
         self._p0 = np.array(fix.position, dtype=float)
 
     def step(self, doppler, toa=None) -> np.ndarray:
-        return self.ekf.step(doppler)
+        scalar_measurement("toa", toa)  # not used by the Doppler-only EKF, still checked
+        return self.ekf.step(scalar_measurement("doppler", doppler))
 
     def speed(self) -> float:
         return float(np.linalg.norm(self.ekf.velocity))
@@ -278,6 +282,8 @@ def run_approaches(
     fam = family("halili2022")
     if isinstance(approaches, str) or not isinstance(approaches, list | tuple):
         raise TypeError(f"approaches: expected a tuple of names, got {approaches!r:.60}")
+    if not approaches:
+        raise ValueError("approaches: expected at least one approach")
     for name in approaches:
         if name not in fam:
             raise ValueError(

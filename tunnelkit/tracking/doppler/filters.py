@@ -18,7 +18,16 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 
-from ..._validate import finite_array, instance, integer, nonnegative, positive, probability, real
+from ..._validate import (
+    boolean,
+    finite_array,
+    instance,
+    integer,
+    nonnegative,
+    positive,
+    probability,
+    real,
+)
 from ...constants import C
 from ...drive import Drive, GnssFix
 from ..cv import cv_process_noise, cv_transition
@@ -78,8 +87,12 @@ class DopplerSetup:
 def scalar_measurement(name: str, z) -> float | None:
     """One epoch's measurement ``z`` (parameter ``name``): ``None`` for a dropped epoch (``None``
     or NaN), else a float; infinities and non-numbers are refused."""
+    if type(name) is not str or not name:
+        raise TypeError(f"name: expected the parameter's name, got {name!r}")
     if z is None:
         return None
+    if type(z) is not float and isinstance(z, (str, bytes, bool, np.bool_)):
+        raise TypeError(f"{name}: expected a number or None, got {type(z).__name__}")
     try:
         x = float(z)
     except (TypeError, ValueError):
@@ -203,7 +216,11 @@ class DopplerEKF:
         q = nonnegative("q", q)
         self.a = probability("a", a, open_interval=False)
         _check_adaptive_form(adaptive_form)
-        self.setup, self.adaptive, self.adaptive_form = setup, bool(adaptive), adaptive_form
+        self.setup, self.adaptive, self.adaptive_form = (
+            setup,
+            boolean("adaptive", adaptive),
+            adaptive_form,
+        )
         kf = ExtendedKalmanFilter(dim_x=4, dim_z=1)
         kf.F, kf.Q = cv_model(setup.dt, q)
         kf.x = np.concatenate([fix.position, fix.velocity]).reshape(4, 1)
@@ -317,7 +334,7 @@ class SpeedKF:
         u0 = float(finite_array("u0", u0, ndim=0))
         self.a = probability("a", a, open_interval=False)
         _check_adaptive_form(adaptive_form)
-        self.adaptive, self.adaptive_form = bool(adaptive), adaptive_form
+        self.adaptive, self.adaptive_form = boolean("adaptive", adaptive), adaptive_form
         kf = KalmanFilter(dim_x=1, dim_z=1)
         kf.x = np.array([[u0]])
         kf.P = np.array([[positive("sigma_u0", sigma_u0) ** 2]])
@@ -399,7 +416,11 @@ class RangeKF:
         sigma_toa = positive("sigma_toa", sigma_toa)
         q = nonnegative("q", q)
         self.calibration_epochs = integer("calibration_epochs", calibration_epochs, minimum=1)
-        self.setup, self.calibrate, self.sigma_toa = setup, bool(calibrate), sigma_toa
+        self.setup, self.calibrate, self.sigma_toa = (
+            setup,
+            boolean("calibrate", calibrate),
+            sigma_toa,
+        )
         self.offset: float | None = None if calibrate else 0.0
         self.calibration_outliers = 0
         self._calib: list[float] = []  # ToA minus predicted distance / c

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import finite_array, instance, integer, rng_or_error
+from ..._validate import boolean, finite_array, instance, integer, record, rng_or_error
 from ...montecarlo import spawn_rngs
 from ...scenarios import Scenario, load_scenario
 from ..registry import family
@@ -30,6 +30,9 @@ class VsExperiment:
     truth: np.ndarray
     P0: np.ndarray
     scenario: str = ""
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"truth": (None, 4), "P0": (4, 4)}, may_be_empty=("scenario",))
 
     @property
     def times(self) -> np.ndarray:
@@ -97,6 +100,11 @@ def monte_carlo(
             f"options: expected a dict name -> keyword options, got {type(options).__name__}"
         )
     fam = family(FAMILY)
+    progress = boolean("progress", progress)
+    if names is not None and (isinstance(names, str) or not isinstance(names, list | tuple)):
+        raise TypeError(f"names: expected a list of estimator names, got {names!r}")
+    if names is not None and not names:
+        raise ValueError("names: expected at least one estimator (None: all of them)")
     names = list(fam) if names is None else list(names)
     rng_data, *rng_alg = spawn_rngs(seed, 1 + len(names))
     Z, x0 = exp.simulate(runs, rng_data)

@@ -13,11 +13,31 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, MerweScaledSigmaPoints, UnscentedKalmanFilter
 
 from ... import positioning
-from ..._validate import finite_array, positive, rng_or_error
+from ..._validate import finite_array, nonnegative, positive, real, rng_or_error
 from ..cv import STATE_DIM
 from ..gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, InnovationGate, gated_filterpy_update
 from ..registry import get, register
 from .model import FAMILY, VsModel, check_model, check_prior, measurement_ok, regularized_cholesky
+
+
+def _measurements(Z, dim_z: int, runs: bool = True) -> np.ndarray:
+    """Measurement runs ``Z`` (R, T, dim_z) (or one run (T, dim_z)): real numbers, NaN rows for
+    missed epochs (so not a finite check), the shape named."""
+    if isinstance(Z, str | bytes) or np.asarray(Z).dtype.kind not in "iuf":
+        raise TypeError(f"Z: expected real measurements, got {type(Z).__name__}")
+    Z = np.asarray(Z, dtype=float)
+    want = (None, None, dim_z) if runs else (None, dim_z)
+    if Z.ndim != len(want) or Z.shape[-1] != dim_z:
+        shape = "(runs, epochs, " if runs else "(epochs, "
+        raise ValueError(f"Z: expected shape {shape}{dim_z}), got {Z.shape}")
+    return Z
+
+
+def _rng(rng) -> None:
+    """Every estimator takes ``rng`` (a Generator or None), used or not."""
+    if rng is not None:
+        rng_or_error("rng", rng)
+
 
 __all__ = ["EstimatorBase", "VsEKF", "VsTSWLS", "VsUKF", "run_estimator", "track"]
 
@@ -45,6 +65,8 @@ class EstimatorBase:
 
     def step(self, z, *, first: bool = False) -> np.ndarray:
         """``predict()`` (unless ``first``) then ``update(z)``; returns the state estimate."""
+        if not isinstance(first, bool):
+            raise TypeError(f"first: expected True or False, got {first!r}")
         if not first:
             self.predict()
         self.update(z)
@@ -59,8 +81,11 @@ class EstimatorBase:
         The default loops over runs; vectorised estimators override it. A row of NaN in ``Z``
         is a missed epoch.
         """
-        Z = np.asarray(Z, dtype=float)
-        x0 = np.asarray(x0, dtype=float)
+        Z = _measurements(Z, check_model(model).dim_z)
+        x0 = finite_array("x0", x0, shape=(Z.shape[0], STATE_DIM))
+        if len(x0):
+            check_prior(x0[0], P0)
+        _rng(rng)
         out = np.empty((*Z.shape[:2], STATE_DIM))
         for r in range(Z.shape[0]):
             est = cls(model, x0[r], P0, rng=rng, **options)
@@ -84,6 +109,7 @@ class VsTSWLS(EstimatorBase):
     def __init__(self, model: VsModel, x0, P0, *, rng: np.random.Generator | None = None) -> None:
         self.model = check_model(model)
         self.x, self.P = check_prior(x0, P0)
+        _rng(rng)
         self._has_fix = False
         self._since = 0  # epochs (predict calls) since the last fix
 
@@ -107,12 +133,14 @@ class VsTSWLS(EstimatorBase):
     def run(cls, model, Z, x0, P0, *, rng=None, **options) -> np.ndarray:
         """Vectorised over runs and epochs in one :func:`tunnelkit.positioning.tswls` call."""
         model = check_model(model)
-        Z = np.asarray(Z, dtype=float)
+        Z = _measurements(Z, model.dim_z)
         x0 = finite_array("x0", x0)
         if x0.ndim != 2 or x0.shape[-1] != STATE_DIM:
             raise ValueError(
                 f"x0: expected one prior state per run (runs, {STATE_DIM}), got {x0.shape}"
             )
+        check_prior(x0[0], P0)
+        _rng(rng)
         n = model.n_stations
         ok = np.all(np.isfinite(Z), axis=-1)
         Zf = np.where(ok[..., None], Z, model.hx(np.asarray(x0)[:, None, :]))  # placeholder rows
@@ -190,6 +218,7 @@ class VsEKF(_FilterpyEstimator):
         self.model = check_model(model)
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
         x0, P0 = check_prior(x0, P0)
+        _rng(rng)
         f = ExtendedKalmanFilter(dim_x=STATE_DIM, dim_z=model.dim_z)
         f.x, f.P = x0, P0
         f.F, f.Q, f.R = model.F.copy(), model.Q.copy(), model.R.copy()
@@ -241,10 +270,14 @@ class VsUKF(_FilterpyEstimator):
         self.model = check_model(model)
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
         x0, P0 = check_prior(x0, P0)
+        _rng(rng)
+        kappa = real("kappa", kappa)
+        if STATE_DIM + kappa <= 0:  # eq. 47: lambda + n = alpha^2 (n + kappa) must be > 0
+            raise ValueError(f"kappa: must be > -{STATE_DIM} (n + kappa > 0), got {kappa:g}")
         pts = MerweScaledSigmaPoints(
             STATE_DIM,
             alpha=positive("alpha", alpha),
-            beta=beta,
+            beta=nonnegative("beta", beta),
             kappa=kappa,
             sqrt_method=_upper_sqrt,
         )
@@ -290,6 +323,11 @@ def track(estimator, Z) -> np.ndarray:
         raise TypeError(
             f"estimator: expected a filter with a step() method, got {type(estimator).__name__}"
         )
+    model = getattr(estimator, "model", None)
+    if isinstance(model, VsModel) and (
+        isinstance(Z, np.ndarray) or not isinstance(Z, list | tuple)
+    ):
+        Z = _measurements(Z, model.dim_z, runs=False)
     out = np.empty((len(Z), STATE_DIM))
     for k, z in enumerate(Z):
         z = None if z is None or not np.all(np.isfinite(np.asarray(z, dtype=float))) else z
@@ -303,9 +341,7 @@ def run_estimator(
     """Estimates (R, T, 4) of registry member ``name`` over measurement runs ``Z`` (R, T, 2N)."""
     cls = get(FAMILY, name)
     model = check_model(model)
-    Z = np.asarray(Z, dtype=float)
-    if Z.ndim != 3 or Z.shape[-1] != model.dim_z:
-        raise ValueError(f"Z: expected shape (runs, epochs, {model.dim_z}), got {Z.shape}")
+    Z = _measurements(Z, model.dim_z)
     x0 = finite_array("x0", x0, shape=(Z.shape[0], STATE_DIM))
     check_prior(x0[0], P0)
     if rng is not None:

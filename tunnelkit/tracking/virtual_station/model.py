@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import positioning
-from ..._validate import boolean, finite_array, integer, positive, rng_or_error
+from ..._validate import boolean, finite_array, integer, positive, rng_or_error, text
 from ...crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from ...scenarios import load_scenario
 from ..cv import STATE_DIM, cv_process_noise, cv_transition
@@ -46,9 +46,12 @@ def regularized_cholesky(P, *, name: str = "P", rel_floor: float = 1e-10) -> np.
     particle, a bad prior) its eigenvalues are clipped to ``rel_floor * max(|eig|)`` (at least
     ``1e-12``) and a ``RuntimeWarning`` says so; the factor is never NaN.
     """
+    name = text("name", name)
     P = np.asarray(P, dtype=float)
     if not np.all(np.isfinite(P)):
         raise ValueError(f"{name}: covariance contains NaN or infinite values")
+    if P.ndim < 2 or P.shape[-1] != P.shape[-2]:
+        raise ValueError(f"{name}: expected square matrices (..., n, n), got shape {P.shape}")
     P = 0.5 * (P + np.swapaxes(P, -1, -2))
     try:
         return np.linalg.cholesky(P)
@@ -131,6 +134,8 @@ class VsModel:
             raise ValueError(
                 f"x: expected real state(s) (..., {STATE_DIM}), got {x.dtype} of shape {x.shape}"
             )
+        if not np.isfinite(x).all():
+            raise ValueError("x: contains NaN or infinite values")
         d, th = toa_doa(x[..., :2], self.stations)
         return np.concatenate([d, th], axis=-1)
 
@@ -159,6 +164,8 @@ class VsModel:
         """``d f_2 / d X`` (..., 2N, 4): the position block of eq. A2-A9 (sign-corrected), zeros
         for the velocities."""
         x = np.asarray(x, dtype=float)
+        if x.ndim == 0 or x.shape[-1] != STATE_DIM or not np.isfinite(x).all():
+            raise ValueError(f"x: expected finite state(s) (..., {STATE_DIM}), got {x.shape}")
         J = toa_doa_jacobian(x[..., :2], self.stations)
         return np.concatenate([J, np.zeros_like(J)], axis=-1)
 
@@ -191,6 +198,9 @@ class VsModel:
 
     def simulate(self, positions, rng: np.random.Generator, size: int | None = None) -> np.ndarray:
         """Noisy measurements ``Z`` (eq. 44) at true positions (T, 2): shape (T, 2N) or (size, T, 2N)."""
+        positions = finite_array("positions", positions)
+        if positions.ndim == 0 or positions.shape[-1] != 2:
+            raise ValueError(f"positions: expected positions (..., T, 2), got {positions.shape}")
         d_hat, th_hat = positioning.simulate_toa_doa(
             positions, self.stations, self.sigma_theta, self.sigma_d, rng, size=size
         )
@@ -258,6 +268,8 @@ def measurement_ok(z, dim_z: int, *, who: str = "update") -> np.ndarray | None:
 
     ``None`` means "missed epoch": the caller predicts only.
     """
+    dim_z = integer("dim_z", dim_z, minimum=1)
+    who = text("who", who)
     if z is None:
         return None
     try:
