@@ -303,37 +303,68 @@ def cases() -> list[Case]:
     return out
 
 
-def cpu_times(repeat: int = 9) -> str:
-    """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction and of
-    the basic search (the route before issue 23: re-seeding on the residual energy only) on
-    bench_ml's L = 6 tensor and on two long-range tensors (UE at x = 110 m and 85 m)."""
+def _unscreened(fn):
+    """``fn()`` with the early screen of the search off (``SCREEN_ITER`` beyond ``max_iter``: the
+    first fit runs to ``max_iter`` before the residual test, the default route before it)."""
+    old = ml.fitting.SCREEN_ITER
+    try:
+        ml.fitting.SCREEN_ITER = 10**6
+        return fn()
+    finally:
+        ml.fitting.SCREEN_ITER = old
+
+
+def cpu_times(repeat: int = 9, far: bool = True) -> str:
+    """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction, of
+    the same without the early screen (the default before it) and of the basic search (the route
+    before issue 23: re-seeding on the residual energy only) on bench_ml's L = 6 tensor and on
+    long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m)."""
     from bench_ml import _tensor
 
     tensors = {"L=6 (bench_ml)": _tensor()}
-    for x in (110.0, 85.0):
+    for x in (120.0, 110.0, 100.0, 95.0, 85.0) if far else (110.0, 85.0):
         H, arr, cfg, L = _long_tensor(x=x)
         tensors[f"L={L} x={x:.0f} m"] = (H, arr, cfg, L)
-    lines = [f"CPU time per extraction, median of {repeat} (one BLAS thread)"]
+    lines = [
+        f"CPU time per extraction, median of {repeat} (one BLAS thread); ratios to the default "
+        "without the screen (the route before it) and to the basic search, same run"
+    ]
+    runs = {
+        "default": lambda H, arr, cfg, L: extraction.extract_paths(H, L, arr, cfg),
+        "unscreened": lambda H, arr, cfg, L: _unscreened(
+            lambda: extraction.extract_paths(H, L, arr, cfg)
+        ),
+        "basic": lambda H, arr, cfg, L: extraction.extract_paths(H, L, arr, cfg, search="basic"),
+    }
+    long_med = {k: [] for k in runs}
     with threadpool_limits(1), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for name, (H, arr, cfg, L) in tensors.items():
-            t = {"residual": [], "basic": []}
-            extraction.extract_paths(H, L, arr, cfg)  # warm-up
+        for name, args in tensors.items():
+            t = {k: [] for k in runs}
+            ok = {}
+            runs["default"](*args)  # warm-up (and the residual test's calibration)
             for _ in range(repeat):
-                for search in t:
+                for k, fn in runs.items():
                     t0 = time.process_time()
-                    est = extraction.extract_paths(H, L, arr, cfg, search=search)
-                    t[search].append(time.process_time() - t0)
-                    if search == "residual":
-                        ok = est.fit_ok
-                    else:
-                        ok_basic = est.fit_ok
+                    est = fn(*args)
+                    t[k].append(time.process_time() - t0)
+                    ok[k] = (est.fit_ok, round(est.fit.cost / est.fit.noise_power))
             med = {k: float(np.median(v)) for k, v in t.items()}
+            if name.startswith("L=") and " x=" in name:
+                for k in runs:
+                    long_med[k].append(med[k])
             lines.append(
-                f"  {name:18s} default {med['residual'] * 1e3:6.0f} ms (fit_ok {ok}), basic "
-                f"{med['basic'] * 1e3:6.0f} ms (fit_ok {ok_basic}), ratio "
-                f"{med['residual'] / med['basic']:.2f}"
+                f"  {name:18s} default {med['default'] * 1e3:5.0f} ms, unscreened "
+                f"{med['unscreened'] * 1e3:5.0f} ms (ratio {med['default'] / med['unscreened']:.2f}), "
+                f"basic {med['basic'] * 1e3:5.0f} ms (ratio {med['default'] / med['basic']:.2f}); "
+                f"(fit_ok, cost/sigma^2): " + ", ".join(f"{k} {ok[k]}" for k in runs)
             )
+    m = {k: float(np.median(v)) for k, v in long_med.items()}
+    lines.append(
+        f"  long range, median over the tensors: default {m['default'] * 1e3:.0f} ms, unscreened "
+        f"{m['unscreened'] * 1e3:.0f} ms (ratio {m['default'] / m['unscreened']:.2f}), basic "
+        f"{m['basic'] * 1e3:.0f} ms"
+    )
     return "\n".join(lines)
 
 

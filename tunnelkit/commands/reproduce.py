@@ -1,5 +1,5 @@
 """``tunnelkit reproduce TARGET [--runs N] [--seed S] [--channel image|sionna]
-[--second-order N] [--diffuse-floor] [--workers N | --scheduler ADDRESS] [--format table|json]``."""
+[--second-order N] [--diffuse-floor] [--length METRES] [--workers N | --scheduler ADDRESS] [--format table|json]``."""
 
 from __future__ import annotations
 
@@ -40,6 +40,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--diffuse-floor",
         action="store_true",
         help="with --channel sionna: the ML fit tested against noise + the epoch's diffuse power",
+    )
+    p.add_argument(
+        "--length",
+        type=float,
+        default=None,
+        metavar="METRES",
+        help="drive over this many metres, ending where the preset's drive ends (e.g. 120: UE "
+        "ranges 5-125 m in a lengthened tunnel; javelin-table1 only, image channel)",
     )
     add_parallel_arguments(p)
 
@@ -108,6 +116,13 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.length is not None and not targets()[args.target].lengths:
+        print(
+            f"tunnelkit reproduce: error: --length: {args.target} drives its preset only "
+            "(javelin-table1 only)",
+            file=sys.stderr,
+        )
+        return 2
     try:
         rep = run(
             args.target,
@@ -116,6 +131,7 @@ def main(args: argparse.Namespace) -> int:
             progress=(args.format == "table" and not args.no_progress),
             channel=args.channel,
             nuisance=nuisance or None,
+            length=args.length,
             **parallel_kwargs(args),
         )
     except (TrialLost, RTUnavailableError) as exc:

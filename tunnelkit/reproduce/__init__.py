@@ -38,6 +38,7 @@ class Target:
     fn: Callable[..., Report]
     bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
     channels: tuple[str, ...] = ("image",)  #: channel sources it runs on (``fn(channel=...)``)
+    lengths: bool = False  #: its drive can be lengthened (``fn(length=...)``)
 
 
 _REGISTRY: dict[str, Target] = {}
@@ -51,19 +52,23 @@ def register(
     default_runs: int,
     bytes_per_run: int = RUN_BYTES,
     channels: tuple[str, ...] = ("image",),
+    lengths: bool = False,
 ):
     """Decorator registering a reproduction target under ``name``.
 
     ``bytes_per_run`` is what one Monte-Carlo run keeps in memory until the report is built;
     ``runs * bytes_per_run`` is checked against :mod:`tunnelkit.budget` before anything runs.
     ``channels``: the channel sources the target runs on; with more than "image" its function
-    takes ``channel=``.
+    takes ``channel=``. ``lengths``: its drive can be lengthened (its function takes
+    ``length=``, metres).
     """
 
     def deco(fn):
         if name in _REGISTRY:
             raise ValueError(f"name: reproduce target {name!r} registered twice")
-        _REGISTRY[name] = Target(name, help, default_runs, fn, bytes_per_run, tuple(channels))
+        _REGISTRY[name] = Target(
+            name, help, default_runs, fn, bytes_per_run, tuple(channels), bool(lengths)
+        )
         return fn
 
     return deco
@@ -90,13 +95,16 @@ def run(
     timeout: float = CONNECT_TIMEOUT_S,
     channel: str = "image",
     nuisance: dict | None = None,
+    length: float | None = None,
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
     :func:`tunnelkit.montecarlo.run_trials`). The report is the same either way. ``channel``:
     "image" (default) or, for the targets that support it, "sionna" (the ray-traced channel).
     ``nuisance`` (those targets only): the route's ``second_order`` / ``diffuse_floor``
-    (:class:`tunnelkit.signal_route.SignalRoute`)."""
+    (:class:`tunnelkit.signal_route.SignalRoute`). ``length`` (the targets whose drive can be
+    lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
+    (:func:`tunnelkit.studies.drives.drive_variant`, e.g. 120)."""
     reg = targets()
     if name not in reg:
         raise ValueError(f"name: unknown reproduce target {name!r}; available: {', '.join(reg)}")
@@ -116,6 +124,12 @@ def run(
         if not isinstance(nuisance, dict):
             raise TypeError(f"nuisance: expected a dict, got {type(nuisance).__name__}")
         on["nuisance"] = nuisance
+    if length is not None:
+        if not tgt.lengths:
+            raise ValueError(
+                f"length: target {name!r} drives its preset only (javelin-table1 takes a length)"
+            )
+        on["length"] = positive("length", length)
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
     check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..reference import load as load_reference
 from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
-from ..studies.drives import FLAGGED
+from ..studies.drives import FLAGGED, drive_variant
 from ..studies.scoring import evaluate
 from ..tracking.javelin import designs
 from . import Report, register
@@ -170,13 +170,15 @@ NOTES = [
 
 
 def _simulate_and_score(
-    scenario, n_epochs, extractions, columns, cond, rng, channel="image", nuisance=None
+    scenario, n_epochs, extractions, columns, cond, rng, channel="image", nuisance=None, length=None
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.studies.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
-    count."""
+    count. ``length``: the drive of :func:`~tunnelkit.studies.drives.drive_variant` instead of
+    the preset's (built on the worker, once per process)."""
+    route = scenario if length is None else drive_variant(scenario, length)
     drives = simulate_condition(
-        scenario, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance
+        route, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance
     )
     faults = {
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
@@ -196,6 +198,7 @@ def javelin_table(
     n_epochs: int | None = None,
     channel: str = "image",
     nuisance: dict | None = None,
+    length: float | None = None,
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -210,7 +213,18 @@ def javelin_table(
     for NoRRMs, without the road markings) are traced here first, once, into the cache; the
     trials then read the cache and draw noise and clock bias per run. ``nuisance``: the route's
     ``second_order`` (second-order paths in the model) and ``diffuse_floor`` (the ML fit tested
-    against noise + diffuse power), :class:`~tunnelkit.signal_route.SignalRoute`."""
+    against noise + diffuse power), :class:`~tunnelkit.signal_route.SignalRoute`. ``length``
+    (image channel, straight lane): the drive lengthened to ``length`` metres ending where the
+    preset's ends (:func:`~tunnelkit.studies.drives.drive_variant`; 120 m: UE ranges 5-125 m);
+    ``None`` the preset's drive."""
+    if length is not None:
+        if channel != "image" or nuisance:
+            raise ValueError(
+                "length: a lengthened drive runs on the image channel without route nuisances "
+                "(the ray-traced cache holds the preset's tunnel)"
+            )
+        drive_variant(scenario, length)  # checked (and built) before any trial runs
+        length = float(length)
     rt_info = _prepare_channel(scenario, conditions, n_epochs, channel, progress)
     extractions, done = per_drive(
         scenario,
@@ -227,6 +241,7 @@ def javelin_table(
             table_columns(e),
             channel=channel,
             nuisance=nuisance,
+            length=length,
         ),
         **parallel,
     )
@@ -247,6 +262,9 @@ def javelin_table(
             epochs[e] += n_ep
     cols, rows = _rows(scores, reference, columns)
     on = "" if channel == "image" else ", ray-traced channel (Sionna RT)"
+    if length is not None:
+        traj = drive_variant(scenario, length).trajectory.position
+        on += f", {length:g} m drive (x = {traj[0, 0]:g} m to {traj[-1, 0]:g} m)"
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}{on}: JAVELIN vs "
         "TeNFiLoc",
@@ -257,6 +275,7 @@ def javelin_table(
             "extraction_failures": faults,
             "flagged_epochs": flagged,
             "epochs": epochs,
+            **({"drive_length_m": length} if length is not None else {}),
             **({"channel": channel, **rt_info} if channel != "image" else {}),
             **({"nuisance": dict(nuisance)} if nuisance else {}),
         },
@@ -331,6 +350,7 @@ def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     default_runs=20,
     bytes_per_run=1024 * 1024,
     channels=("image", "sionna"),
+    lengths=True,
 )
 def javelin_table1(
     runs: int,
@@ -338,9 +358,12 @@ def javelin_table1(
     progress: bool,
     channel: str = "image",
     nuisance: dict | None = None,
+    length: float | None = None,
     **parallel,
 ) -> Report:
-    """Table 1 (straight trajectory); ``nuisance`` as in :func:`javelin_table`."""
+    """Table 1 (straight trajectory); ``nuisance`` and ``length`` (the drive lengthened, e.g.
+    120 m: UE ranges 5-125 m; ``tunnelkit reproduce javelin-table1 --length 120``) as in
+    :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-straight",
         "italiano2026_table1",
@@ -350,6 +373,7 @@ def javelin_table1(
         progress,
         channel=channel,
         nuisance=nuisance,
+        length=length,
         **parallel,
     )
 

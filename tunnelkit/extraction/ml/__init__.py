@@ -106,7 +106,11 @@ of the weakest (halves an eighth of a beamwidth apart along each axis, and along
 the nearest path to the peak, full and half length: a merged pair leaves its missing energy on
 that side) — each given ``RANK_ITER`` iterations, ranked by the likelihood, the best fitted
 to convergence and kept if the likelihood rises (SAGE / RIMAX re-initialisation; the moves on
-``rho`` below follow when the energy test still fails). ``MLFit.fit_ok`` (and
+``rho`` below follow when the energy test still fails). The first fit is screened after
+``SCREEN_ITER`` iterations: one not converged by then whose residual fails the test (a fit
+crawling in a wrong basin, typically clustered long-range paths merging) is re-initialised at
+once, its own continuation one of the ranked starts; one that passes goes on to ``max_iter``
+exactly as without the screen (the iteration is resumable). ``MLFit.fit_ok`` (and
 ``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their
 thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
 further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical

@@ -23,6 +23,7 @@ __all__ = [
     "MAX_ITER",
     "RESOLVE_Z",
     "RHO_Z",
+    "SCREEN_ITER",
     "SEARCHES",
     "SPLIT_STEPS",
     "STEP_TOL",
@@ -98,11 +99,17 @@ class MLFit:
     reason: str = ""
 
 
-def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
-    """Levenberg-Marquardt on the concentrated cost; returns the best point and its evaluation."""
+def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):
+    """Levenberg-Marquardt on the concentrated cost; returns the best point and its evaluation.
+
+    ``state`` (a dict, optional) makes the iteration resumable: read at the start (``"lam"`` the
+    damping, ``"ev"`` the evaluation at the start point, if present) and written at the end
+    (the damping reached and the evaluation of the returned point), so ``m`` iterations and
+    then ``n`` more from the point returned run exactly the ``m + n`` iterations of one call."""
     L = theta.shape[0]
-    ev = prob.evaluate(theta, mu_f, mu_t)
-    lam, it, converged = 1e-3, 0, False
+    state = {} if state is None else state
+    ev = state.get("ev") or prob.evaluate(theta, mu_f, mu_t)
+    lam, it, converged = state.get("lam", 1e-3), 0, False
     for it in range(1, max_iter + 1):  # noqa: B007
         lower = np.zeros((L, 5), bool)
         lower[:, 2] = theta[:, 2] <= 0.0
@@ -129,6 +136,7 @@ def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int):
             if lam > 1e10:
                 converged = True  # no descent direction left at working precision
                 break
+    state["lam"], state["ev"] = lam, ev
     return theta, mu_f, mu_t, ev, it, converged
 
 
@@ -205,20 +213,26 @@ def _peak_of(prob: Problem, res, sigma2):
 #: Levenberg-Marquardt iterations each start of a re-initialisation gets before the starts are
 #: ranked by their likelihood (the best one is then fitted to convergence)
 RANK_ITER = 8
+#: iterations of the first fit before the residual test screens it: a fit not converged by then
+#: whose residual fails the test is re-initialised at once (the first fit goes on as one of the
+#: ranked starts); one that passes goes on to ``max_iter`` exactly as without the screen
+SCREEN_ITER = 16
 
 
-def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves):
+def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves, resume=None):
     """Re-initialisation on the residual (SAGE / RIMAX): while the residual's periodogram has a
     peak above ``peak_max``, a path is started there (its grid direction, delay and Doppler, a
     curvature scan and a single-source fit) and several starts are made from it: *birth and
     death* (all ``L + 1`` fitted, the least significant out) and *replace* (it takes the place
     of the path nearest to it in delay and Doppler, or of the least significant one). Each start
     gets ``RANK_ITER`` iterations; the most likely is fitted to convergence and kept if it beats
-    the current fit. Returns the fit, its peak, the iterations spent and the kept moves."""
+    the current fit. ``resume``: ``best`` is a fit stopped before convergence (its
+    :func:`_lm` state): it goes on as one more start of the first move, and if it wins, that
+    move is not counted. Returns the fit, its peak, the iterations spent and the kept moves."""
     n_it = kept = 0
     L = best[0].shape[0]
     short = min(RANK_ITER, max_iter)
-    for _ in range(n_moves):
+    for _ in range(n_moves + (resume is not None)):
         if peak[0] <= peak_max:
             break
         theta, mu_f, mu_t, ev = best[:4]
@@ -244,14 +258,19 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves)
                 th2[out, :2] -= du
                 starts.append((project_feasible(th2), mf2, mt2))
         cands = [_lm(prob, *st, sigma2, short) for st in starts]
+        if resume is not None:  # the first fit, stopped early, goes on as one more start
+            cands.append(_lm(prob, theta, mu_f, mu_t, sigma2, short, resume))
         n_it += sum(c[4] for c in cands)
-        cand = min(cands, key=lambda c: c[3]["cost"])
+        i_best = min(range(len(cands)), key=lambda i: cands[i][3]["cost"])
+        cand = cands[i_best]
+        went_on = resume is not None and i_best == len(cands) - 1
+        resume = None
         if not cand[5]:
             cand = _lm(prob, *cand[:3], sigma2, max_iter)
             n_it += cand[4]
         if not cand[3]["cost"] < ev["cost"]:
             break
-        best, kept = cand, kept + 1
+        best, kept = cand, kept + (not went_on)
         peak = _peak_of(prob, best, sigma2)
     return best, peak, n_it, kept
 
@@ -450,14 +469,31 @@ def fit_problem(
 
     ev0 = prob.evaluate(theta, mu_f, mu_t, derivatives=False)
     cost0 = ev0["cost"]
-    best = _lm(prob, theta, mu_f, mu_t, sigma2, max_iter)
-    n_it, kept = best[4], 0
-    history = [best[3]["cost"] / (dof * sigma2)]
     peak_max = calibrated_threshold(prob.pos, prob.k0 * C / (2 * np.pi), prob.H.shape, FALSE_ALARM)
-    peak = _peak_of(prob, best, sigma2)
+    screen = bool(n_reseed) and search == "residual" and max_iter > SCREEN_ITER
+    state: dict = {}
+    if screen:
+        best = _lm(prob, theta, mu_f, mu_t, sigma2, SCREEN_ITER, state)
+    else:
+        best = _lm(prob, theta, mu_f, mu_t, sigma2, max_iter)
+    n_it, kept = best[4], 0
+    resume = None
+    if screen and not best[5]:
+        # not converged after SCREEN_ITER iterations: a fit crawling in a wrong basin (clustered
+        # paths merging) is re-initialised now, one on its way to the right optimum goes on
+        peak = _peak_of(prob, best, sigma2)
+        if peak[0] <= peak_max:
+            more = _lm(prob, *best[:3], sigma2, max_iter - SCREEN_ITER, state)
+            best = (*more[:4], best[4] + more[4], more[5])
+            n_it = best[4]
+        else:
+            resume = state
+    history = [best[3]["cost"] / (dof * sigma2)]
+    if resume is None:
+        peak = _peak_of(prob, best, sigma2)
     if n_reseed and search == "residual":
         best, peak, its, n_kept = _peak_reseed(
-            prob, best, sigma2, max_iter, peak, peak_max, n_reseed
+            prob, best, sigma2, max_iter, peak, peak_max, n_reseed, resume
         )
         n_it, kept = n_it + its, kept + n_kept
         history.append(best[3]["cost"] / (dof * sigma2))
