@@ -158,6 +158,9 @@ def _studies():
         extractions=("paper",),
         n_epochs=3,
     )
+    from tunnelkit.studies.drives import drive_variant
+
+    drive_variant("italiano2026-straight", 120.0)
 
 
 def _doppler():
