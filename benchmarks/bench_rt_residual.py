@@ -46,7 +46,7 @@ sys.path.insert(0, str(ROOT))
 from tunnelkit.channel import channel_tensor
 from tunnelkit.extraction.ml.residual import calibrated_threshold, residual_peak
 from tunnelkit.rt import COMPONENTS as RT_COMPONENTS
-from tunnelkit.rt import element_tensor, first_order_groups, tensor_components
+from tunnelkit.rt import element_tensor, first_order_groups
 from tunnelkit.signal_route import SignalRoute
 
 COMPONENTS = (*RT_COMPONENTS, "visibility")
@@ -55,16 +55,7 @@ COMPONENTS = (*RT_COMPONENTS, "visibility")
 def components(route: SignalRoute, k: int) -> dict:
     """The noiseless tensors of epoch ``k`` (module docstring), transmit power included."""
     cfg = route.config
-    arr, ep, trace_s = route.raytraced.trace(k)
-    H = tensor_components(
-        ep,
-        cfg.fc,
-        cfg.tone_spacing,
-        cfg.n_tones,
-        cfg.symbol_period,
-        cfg.n_symbols,
-        amplitude=np.sqrt(cfg.tx_power),
-    )
+    arr, H, ep, trace_s = route.raytraced.components(k, amplitude=np.sqrt(cfg.tx_power))
     _, paths = route.paths(k)
     atoms = np.stack([channel_tensor([p], cfg).ravel() for p in paths], axis=1)
     model = H["first_order_model"].ravel()

@@ -379,7 +379,11 @@ def _known_surfaces():
     birth.place(st, meas, 1, cfg, ReportedNoise(), 0)
     birth.inside(truth, bs)
     mirror_vue(st, planes[0].normal, planes[0].offset)
-    design_planes(design.DesignSetup.from_scenario("italiano2026-straight"))
+    setup = design.DesignSetup.from_scenario("italiano2026-straight")
+    design_planes(setup)
+    from tunnelkit.design.drivebound import drive_motion
+
+    drive_motion(setup, 5, 0.2, 0.0175)
     A = rng.standard_normal((3, 2, 2))
     info = A @ np.swapaxes(A, 1, 2)
     batch_information(info, info + np.eye(2), np.eye(2))

@@ -354,16 +354,7 @@ print(
 # %%
 cfg = route_rt.config
 k0 = 0
-arr0, ep0, _ = route_rt.raytraced.trace(k0)
-parts = rt.tensor_components(
-    ep0,
-    cfg.fc,
-    cfg.tone_spacing,
-    cfg.n_tones,
-    cfg.symbol_period,
-    cfg.n_symbols,
-    amplitude=np.sqrt(cfg.tx_power),
-)
+arr0, parts, ep0, _ = route_rt.raytraced.components(k0, amplitude=np.sqrt(cfg.tx_power))
 atoms = np.stack([channel.channel_tensor([p], cfg).ravel() for p in route_img.paths(k0)[1]], 1)
 m = parts["first_order_model"].ravel()
 fit = atoms @ np.linalg.lstsq(atoms, m, rcond=None)[0]

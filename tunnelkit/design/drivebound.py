@@ -16,7 +16,13 @@ import numpy as np
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
 
-__all__ = ["drive_bound", "drive_pcrlb", "position_bias_rms", "position_information"]
+__all__ = [
+    "drive_bound",
+    "drive_motion",
+    "drive_pcrlb",
+    "position_bias_rms",
+    "position_information",
+]
 
 
 def _position_rows(model: PathErrorModel, geometry, k: int):
@@ -138,14 +144,31 @@ def drive_pcrlb(
     sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
     sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
     sigma_p0 = positive("sigma_p0", sigma_p0)
+    G, Qn, _ = drive_motion(setup, info.shape[0], sig_nu, sig_th)
+    Q = G @ Qn @ np.swapaxes(G, 1, 2)
+    Q += 1e-12 * np.eye(2)  # a standing vehicle: no motion noise, still a valid recursion
+    B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
+    return pcrlb_position_rmse(B)
+
+
+def drive_motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
+    """JAVELIN's motion model along ``setup``'s drive for its first ``T`` epochs: per epoch the
+    Jacobian ``G`` (T, 2, 2) of the 2-D position increment ``dt nu (cos theta, sin theta)`` with
+    respect to (speed, heading), the noise covariance of (speed, heading) from ``sig_nu`` [m/s]
+    and ``sig_th`` [rad], and ``dt`` (T,) [s]. The message of epoch ``k-1`` drives the
+    prediction into epoch ``k`` (Algorithm 4, line 7)."""
+    from .._validate import instance, integer, positive
+
+    setup = instance("setup", setup, DesignSetup)
     traj = setup.trajectory
-    T = info.shape[0]
+    T = integer("T", T, minimum=1, maximum=len(traj.t))
+    sig_nu = positive("sig_nu", sig_nu)
+    sig_th = positive("sig_th", sig_th)
     vel = traj.velocity[:T]
     nu = np.linalg.norm(vel[:, :2], axis=1)
     th = np.arctan2(vel[:, 1], vel[:, 0])
     dt = np.diff(traj.t[:T], prepend=traj.t[0])
     dt[0] = dt[1] if T > 1 else 0.1
-    # the message of epoch k-1 drives the prediction into epoch k (Algorithm 4, line 7)
     nu_p, th_p = np.roll(nu, 1), np.roll(th, 1)
     G = dt[:, None, None] * np.stack(
         [
@@ -154,7 +177,4 @@ def drive_pcrlb(
         ],
         axis=1,
     )
-    Q = G @ np.diag([sig_nu**2, sig_th**2]) @ np.swapaxes(G, 1, 2)
-    Q += 1e-12 * np.eye(2)  # a standing vehicle: no motion noise, still a valid recursion
-    B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
-    return pcrlb_position_rmse(B)
+    return G, np.diag([sig_nu**2, sig_th**2]), dt

@@ -30,6 +30,7 @@ import numpy as np
 
 from .._validate import finite_array, nonnegative, positive
 from ..budget import check_elements
+from .drivebound import drive_motion
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
 
@@ -38,26 +39,6 @@ __all__ = ["batch_information", "learned_model", "learned_pcrlb"]
 #: a VUE's prior standard deviation at birth [m] (JAVELIN's ``sigma_P``: 10 m, diffuse against
 #: what one epoch's angles say)
 SIGMA_BIRTH = 10.0
-
-
-def _motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
-    """Per epoch the UE's ``G`` (T, 2, 2) of the prediction into it (the message of epoch
-    ``k-1``, Algorithm 4 line 7), the noise covariance of (nu, theta) and ``dt`` (T,)."""
-    traj = setup.trajectory
-    vel = traj.velocity[:T]
-    nu = np.linalg.norm(vel[:, :2], axis=1)
-    th = np.arctan2(vel[:, 1], vel[:, 0])
-    dt = np.diff(traj.t[:T], prepend=traj.t[0])
-    dt[0] = dt[1] if T > 1 else 0.1
-    nu_p, th_p = np.roll(nu, 1), np.roll(th, 1)
-    G = dt[:, None, None] * np.stack(
-        [
-            np.stack([np.cos(th_p), -nu_p * np.sin(th_p)], axis=-1),
-            np.stack([np.sin(th_p), nu_p * np.cos(th_p)], axis=-1),
-        ],
-        axis=1,
-    )
-    return G, np.diag([sig_nu**2, sig_th**2]), dt
 
 
 def _epoch_rows(model, geometry, k: int, n: int, learned: bool):
@@ -134,7 +115,7 @@ def learned_model(
     S = P - 1 if learned else 0
     n = 2 + 2 * S
     ex = model.exists & geometry.exists
-    G, Qn, dt = _motion(setup, T, sig_nu, sig_th)
+    G, Qn, dt = drive_motion(setup, T, sig_nu, sig_th)
     # every state entry's sensitivity to (nu, theta): the UE's, and its yz part mirrored per VUE
     Gs = np.zeros((T, n, 2))
     Gs[:, :2] = G

@@ -192,6 +192,26 @@ class RayTracedChannel:
         ep = eng.trace_elements(arr, ue, vel)
         return arr, ep, time.perf_counter() - t0
 
+    def components(self, k: int, *, amplitude: float = 1.0, tunnel=None):
+        """Trace epoch ``k`` now (no cache) and split its noiseless tensor by what the
+        first-order model lacks (:func:`~tunnelkit.rt.components.tensor_components` at this
+        drive's SRS, times ``amplitude``): the array, the parts, the :class:`ElementPaths` and
+        the seconds the trace took."""
+        from .components import tensor_components
+
+        arr, ep, seconds = self.trace(k, tunnel)
+        c = self.config
+        parts = tensor_components(
+            ep,
+            c.fc,
+            c.tone_spacing,
+            c.n_tones,
+            c.symbol_period,
+            c.n_symbols,
+            amplitude=amplitude,
+        )
+        return arr, parts, ep, seconds
+
     def epoch(self, k: int, tunnel=None) -> dict:
         """Epoch ``k`` from the cache (traced and stored on a miss): ``array`` (name), ``H``
         (M, Nf, Nt) without the LoS, ``los_tau`` / ``los_gain`` / ``los_doppler`` / ``los_valid``
