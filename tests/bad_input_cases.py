@@ -211,7 +211,7 @@ def build_cases() -> list[Case]:
         Case(
             "Tunnel2D.from_lines[nan]",
             lambda: _mod("geometry").Tunnel2D.from_lines((0, 1, -5), (0, 1, NAN)),
-            ("C", "line coefficients (A, B, C)", "offset"),
+            ("line1", "C", "line coefficients (A, B, C)", "offset"),
         )
     )
     c.append(
