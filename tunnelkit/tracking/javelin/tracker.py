@@ -97,8 +97,9 @@ class Javelin:
         ``epochs``, ``speed``, ``heading``, ``dt``): it starts from ``start`` (3,) [m], default
         the true first position (the open-sky fix the paper assumes), with ``sigma_p0_ue`` [m]
         of uncertainty (``sigma_p0_height`` for the height when given), the base station at the
-        drive's reference antenna, the roles of ``design`` (default the paper's). An honest start (its error drawn with the covariance
-        the tracker is told, :func:`draw_start`) is the caller's to give."""
+        drive's reference antenna, the roles of ``design`` (default the paper's). An honest start
+        (its error drawn with the covariance the tracker is told, :func:`draw_start`) is the
+        caller's to give."""
         d = JavelinDesign() if design is None else design
         if not isinstance(d, JavelinDesign):
             raise TypeError(f"design: expected a JavelinDesign, got {type(d).__name__}")
@@ -223,6 +224,7 @@ class Javelin:
         if st.n_vue or not len(meas):
             return None
         x0, P0 = st.x.copy(), st.P.copy()
+        gate = ChiSquareGate(init.probability).threshold(3)
         best = None
         for j in range(len(meas)):
             try:
@@ -234,7 +236,6 @@ class Javelin:
             dx = x - x0
             score = float(dx @ np.linalg.solve(P0, dx))
             trial = JavelinState(x, P)
-            gate = ChiSquareGate(init.probability).threshold(3)
             for k in range(len(meas)):
                 if k != j:
                     d2 = init.match_distance(trial, meas, k, cfg, self.design.noise, j)[1]
