@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
-from .._validate import finite_array, positive, rng_or_error
+from .._validate import finite_array, positive, record, rng_or_error
 from ..constants import C
 from .route import Drive
 
@@ -30,6 +30,11 @@ class DopplerToaMeasurements:
     dropped: np.ndarray
     outlier: np.ndarray
     parts: dict[str, np.ndarray] = field(repr=False)
+
+    def __post_init__(self) -> None:  # dropped epochs are NaN in doppler and toa
+        T = ("T",)
+        record(self, shapes={"t": T, "doppler": T, "toa": T, "dropped": T, "outlier": T},
+               allow_nan=("doppler", "toa"))  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_array, instance, positive, real, vector
+from .._validate import finite_array, instance, positive, real, record, vector
 from ..constants import C
 from ..scenarios import Trajectory
 from .config import DriveConfig
@@ -42,6 +42,12 @@ class Drive:
     toa_los: np.ndarray  # (T,) [s]
     doppler_peak: np.ndarray = field(repr=False)
     toa_peak: np.ndarray = field(repr=False)
+
+    def __post_init__(self) -> None:
+        T = ("T",)
+        record(self, shapes={"tx": (3,), "range": T, "doppler_los": T, "toa_los": T,
+                             "doppler_peak": T, "toa_peak": T},
+               nonnegative=("range", "toa_los"))  # fmt: skip
 
     @property
     def t(self) -> np.ndarray:

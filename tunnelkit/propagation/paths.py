@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import boolean, integer, positive, vector
+from .._validate import boolean, choice, integer, positive, record, sequence, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from .surfaces import Tunnel3D
@@ -39,7 +39,8 @@ class Path:
     Attributes
     ----------
     kind : "los", "reflection" or "reflection2" (:data:`SECOND_ORDER`: two specular bounces)
-    surface, surface_kind : name and kind ("wall", "ceiling", "road", "rrm") of the reflector
+    surface, surface_kind : name and kind ("wall", "ceiling", "road", "rrm"; "surface" for an
+        object a ray tracer does not name) of the reflector
         ("" and "los" for the direct path; for a second-order path ``"first > second"`` and
         "reflection2")
     source : (3,) the VUE (the UE itself for LoS; the UE mirrored twice for a second-order
@@ -82,6 +83,16 @@ class Path:
     gain: complex
     ue: np.ndarray = field(default=None, repr=False)
 
+    def __post_init__(self) -> None:
+        v3, m = (3,), ("M",)
+        record(self, shapes={"source": v3, "point": v3, "direction": v3, "direction_local": v3,
+                             "ue": v3, "lengths": m, "lengths_srnf": m},
+               positive=("length", "lengths", "lengths_srnf", "kappa_srnf"),
+               may_be_empty=("surface",), skip=("ue",) if self.ue is None else ())  # fmt: skip
+        choice("kind", self.kind, ("los", "reflection", SECOND_ORDER))
+        choice("surface_kind", self.surface_kind, (*PATH_KINDS, SECOND_ORDER, "surface"))
+        _physical_motion(self.direction, self.range_rate, self.velocity)
+
     def delta(self, model: str = "exact") -> np.ndarray:
         """Path-length offsets ``delta_m = d_m - d_0`` (eq. 2) for ``model`` "exact" or "srnf"."""
         if model == "exact":
@@ -100,7 +111,18 @@ class Path:
 
     def wave_origin(self, model: str = "exact") -> np.ndarray:
         """Where the wavefront is centred: the VUE (exact) or the reflection point (SR-NF)."""
-        return self.source if model == "exact" else self.point
+        return self.source if choice("model", model, ("exact", "srnf")) == "exact" else self.point
+
+
+def _physical_motion(direction, range_rate, velocity) -> None:
+    """A path's physical sanity: a unit direction of arrival and a speed below light's."""
+    if abs(float(np.linalg.norm(direction)) - 1.0) > 1e-6:
+        raise ValueError(
+            f"direction: must be a unit vector, got norm {np.linalg.norm(direction):g}"
+        )
+    for name, x in (("range_rate", range_rate), ("velocity", velocity)):
+        if abs(x) >= C:
+            raise ValueError(f"{name}: |{x:g}| m/s is not below the speed of light")
 
 
 def arrival_angles(u) -> tuple[float, float]:
@@ -355,9 +377,12 @@ def _second_order(tunnel, array, ue, vel, fc, kinds, front_only) -> list[Path]:
 
 def select_array(arrays, ue) -> ArrayGeometry:
     """The array whose boresight points most towards ``ue`` (the one the vehicle drives into)."""
-    arrays = list(arrays)
-    if not arrays:
-        raise ValueError("arrays: need at least one array")
+    arrays = sequence("arrays", arrays)
     ue = vector("ue", ue, 3)
+    for i, a in enumerate(arrays):
+        if not isinstance(a, ArrayGeometry):
+            raise TypeError(
+                f"arrays[{i}]: expected an arrays.ArrayGeometry, got {type(a).__name__}"
+            )
     scores = [float(a.boresight @ (ue - a.origin)) for a in arrays]
     return arrays[int(np.argmax(scores))]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import integer, positive, real
+from .._validate import integer, nonnegative, positive, real
 from ..arrays import ArrayGeometry, make_array
 from ..budget import check_bytes
 from ..scenarios import (
@@ -29,7 +29,7 @@ def plate_from_table(i: int, tab: dict) -> Facet:
     i = integer("i", i, minimum=0)
     where = f"tunnel.plates[{i}]"
     if not isinstance(tab, dict):
-        raise ScenarioError(f"{where}: expected a table")
+        raise ScenarioError(f"{where}: expected a table (tab), got {type(tab).__name__}")
     try:
         return road_marking(
             x_range=tab["x_range"],
@@ -92,8 +92,8 @@ def lane_trajectory(
     speed, period = positive("speed", speed), positive("period", period)
     lam = positive("slalom_wavelength", slalom_wavelength)
     x_start, x_end = real("x_start", x_start), real("x_end", x_end)
-    y, height = real("y", y), real("height", height)
-    slalom_amplitude = real("slalom_amplitude", slalom_amplitude)
+    y, height = real("y", y), nonnegative("height", height)  # the antenna above the road
+    slalom_amplitude = nonnegative("slalom_amplitude", slalom_amplitude)
     span = x_end - x_start
     if span == 0:
         raise ValueError("x_end: must differ from x_start")

@@ -9,7 +9,19 @@ from functools import cached_property
 
 import numpy as np
 
-from .._validate import finite_array, integer, positive, real, vector
+from .._validate import (
+    choice,
+    finite_array,
+    instance,
+    integer,
+    nonnegative,
+    positive,
+    real,
+    record,
+    sequence,
+    text,
+    vector,
+)
 from ..budget import check_bytes
 from ..geometry import Plane
 from .materials import MATERIALS, reflection_coefficient
@@ -28,6 +40,8 @@ __all__ = [
 #: memory one facet takes while tracing: the facet (about 0.6 KiB measured), its plane and the
 #: candidate path with two per-antenna length arrays (1.6 KiB at M = 100)
 FACET_BYTES = 4096
+#: what a facet is (``Facet.kind``)
+FACET_KINDS = ("wall", "ceiling", "road", "rrm")
 
 
 @dataclass(frozen=True)
@@ -48,6 +62,8 @@ class Facet:
     material: str = "concrete"
 
     def __post_init__(self) -> None:
+        text("name", self.name, empty=True)
+        choice("kind", self.kind, FACET_KINDS)
         label = self.name or "facet"
         c = vector(f"{label}.corner", self.corner, 3)
         u = vector(f"{label}.edge_u", self.edge_u, 3)
@@ -87,8 +103,10 @@ class Facet:
         return Plane(self.normal, -float(self.normal @ self.corner), name=self.name)
 
     def contains(self, p, tol: float = 1e-9) -> np.ndarray:
-        """True where point(s) ``p`` on the plane fall inside the finite rectangle."""
-        rel = finite_array("p", p) - self.corner
+        """True where point(s) ``p`` (..., 3) on the plane fall inside the finite rectangle
+        (by ``tol`` in units of the edges; a negative ``tol`` keeps points strictly inside)."""
+        tol = real("tol", tol)
+        rel = _points("p", p) - self.corner
         a = rel @ self.edge_u / (self.edge_u @ self.edge_u)
         b = rel @ self.edge_v / (self.edge_v @ self.edge_v)
         return (a >= -tol) & (a <= 1 + tol) & (b >= -tol) & (b <= 1 + tol)
@@ -112,6 +130,7 @@ class Box:
     name: str = "box"
 
     def __post_init__(self) -> None:
+        text("name", self.name, empty=True)
         lo = vector(f"{self.name}.lo", self.lo, 3)
         hi = vector(f"{self.name}.hi", self.hi, 3)
         if np.any(hi <= lo):
@@ -121,8 +140,8 @@ class Box:
 
     def blocks(self, a, b) -> np.ndarray:
         """True where the segment ``a -> b`` (..., 3) crosses the box (slab test, vectorised)."""
-        a = np.asarray(a, dtype=float)
-        d = np.asarray(b, dtype=float) - a
+        a = _points("a", a)
+        d = _points("b", b) - a
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / d
             t1 = (self.lo - a) * inv
@@ -169,6 +188,16 @@ class Tunnel3D:
     width: float = 0.0
     height: float = 0.0
 
+    def __post_init__(self) -> None:
+        record(self, shapes={"x_range": (2,)}, nonnegative=("width", "height"),
+               may_be_empty=("plates", "blockers"))  # fmt: skip
+        for name, cls in (("facets", Facet), ("plates", Facet), ("blockers", Box)):
+            for i, f in enumerate(getattr(self, name)):
+                instance(f"{name}[{i}]", f, cls)
+        lo, hi = (real("x_range", x) for x in self.x_range)
+        if not lo < hi:
+            raise ValueError(f"x_range: must be increasing, got ({lo:g}, {hi:g})")
+
     @property
     def surfaces(self) -> tuple[Facet, ...]:
         """Every reflecting surface: facets then plates."""
@@ -176,7 +205,7 @@ class Tunnel3D:
 
     def contains(self, p, margin: float = 0.0) -> np.ndarray:
         """True where ``p`` (..., 3) lies inside the tunnel by more than ``margin`` [m]."""
-        p = finite_array("p", p)
+        p, margin = _points("p", p), real("margin", margin)
         ok = (p[..., 0] > self.x_range[0] + margin) & (p[..., 0] < self.x_range[1] - margin)
         for f in self.facets:
             ok &= f.plane.signed_distance(p) > margin
@@ -184,7 +213,7 @@ class Tunnel3D:
 
     def require_inside(self, name: str, p) -> np.ndarray:
         """``p`` as an array, raising ``ValueError`` naming ``name`` if a point is outside."""
-        p = finite_array(name, p)
+        p = finite_array(text("name", name), p)
         if p.ndim == 0 or p.shape[-1] != 3:
             raise ValueError(f"{name}: expected 3-D point(s), got shape {p.shape}")
         inside = np.atleast_1d(self.contains(p, margin=1e-6))
@@ -205,11 +234,20 @@ class Tunnel3D:
         return replace(self, plates=())
 
     def blocked(self, a, b) -> np.ndarray:
-        """True where segment ``a -> b`` crosses any blocker."""
+        """True where segment ``a -> b`` (..., 3) crosses any blocker."""
+        a, b = _points("a", a), _points("b", b)
         out = np.zeros(np.broadcast_shapes(np.shape(a), np.shape(b))[:-1], dtype=bool)
         for box in self.blockers:
             out |= box.blocks(a, b)
         return out
+
+
+def _points(name: str, p) -> np.ndarray:
+    """Finite point(s) (..., 3)."""
+    p = finite_array(name, p)
+    if p.ndim == 0 or p.shape[-1] != 3:
+        raise ValueError(f"{name}: expected 3-D point(s) (..., 3), got shape {p.shape}")
+    return p
 
 
 def semicircular_tunnel(
@@ -236,6 +274,12 @@ def semicircular_tunnel(
         positive("height", height),
     )
     n = integer("n_facets", n_facets, minimum=2)
+    choice("wall_material", wall_material, MATERIALS)
+    choice("road_material", road_material, MATERIALS)
+    plates, blockers = (
+        sequence("plates", plates, empty=True),
+        sequence("blockers", blockers, empty=True),
+    )
     check_bytes("n_facets", n * FACET_BYTES, f"{n} facets of about {FACET_BYTES} B while tracing")
     x0 = -length / 2 if x_start is None else real("x_start", x_start)
     ax = np.array([length, 0.0, 0.0])
@@ -271,6 +315,14 @@ def close_tunnel(
 ) -> Tunnel3D:
     """Add the road (``width`` across from ``y_right``, along x from ``x0``) to the wall/ceiling
     ``facets`` and check that every plate lies inside the tunnel and every blocker is a Box."""
+    facets = sequence("facets", facets)
+    x0, y_right, length = real("x0", x0), real("y_right", y_right), positive("length", length)
+    width, height = positive("width", width), positive("height", height)
+    choice("road_material", road_material, MATERIALS)
+    plates, blockers = (
+        sequence("plates", plates, empty=True),
+        sequence("blockers", blockers, empty=True),
+    )
     road = Facet(
         np.array([x0, y_right, 0.0]),
         np.array([length, 0.0, 0.0]),
