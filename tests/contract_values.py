@@ -17,6 +17,7 @@ import sys
 import warnings
 
 import numpy as np
+from contract_routes import DRIVERS as ROUTE_DRIVERS
 from contracts import Target, function_of, hints, parameters
 
 
@@ -472,6 +473,7 @@ DRIVERS = (
     _baselines_tracking,
     _known_surfaces,
     _baselines_checks,
+    *ROUTE_DRIVERS,
 )
 
 

@@ -56,7 +56,8 @@ ANY = r"(tunnelkit\.)?.*"
 DOCUMENTED: tuple[Documented, ...] = (
     _doc(
         ANY,
-        r"x|y|z|y_u|z_u|x_start|x_end|start|stop|lane|offset|x_center|y_center|origin",
+        r"x|y|z|y_u|z_u|x_start|x_end|start|stop|lane|offset|x_center|y_center|origin"
+        r"|x0|y_right|lane_y|tx_y",
         "negative zero",
         "a coordinate [m]: any sign, the origin included",
     ),
@@ -89,7 +90,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "an empty title or axis label shows none (the default)",
     ),
     _doc(
-        r"geometry\.(Plane|line)|arrays\.(ArrayGeometry|make_array)",
+        r"geometry\.(Plane|line)|arrays\.(ArrayGeometry|make_array)"
+        r"|propagation\.surfaces\.(Facet|Box|road_marking|truck_box)",
         r"name",
         "empty",
         "a label only; unnamed is the default",
@@ -184,7 +186,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(r"evaluation\.match_paths", r"clock_bias", "negative", "a clock bias takes any sign"),
     _doc(r"geometry\.line", r"A|B|C", "negative", "a line's coefficients take any sign"),
     _doc(
-        r"geometry\.Tunnel2D\.contains",
+        r"(geometry\.Tunnel2D|propagation\.surfaces\.Tunnel3D)\.contains",
         r"margin",
         "negative",
         "a negative margin also counts points just outside the walls",
@@ -196,7 +198,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN (or None) is a dropped epoch: the filter predicts only (the docstring's contract)",
     ),
     _doc(
-        r"tracking\.doppler\..*",
+        r"(tracking\.doppler|drive\.route)\..*",
         r"doppler|u|u0|dr|dz",
         "negative",
         "a signed quantity: Doppler shift, approach speed, a step back, a height offset",
@@ -259,6 +261,80 @@ DOCUMENTED: tuple[Documented, ...] = (
         "shape",
         "vectorised over leading axes (..., dim) (each docstring's contract): an extra leading "
         "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
+    ),
+    _doc(
+        r"extraction\.paper\.algorithm1|signal_route\.measurements_from_estimates",
+        r"min_d",
+        "negative",
+        "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
+    ),
+    _doc(
+        r"drive\.config\.DriveConfig",
+        r"clock_drift|cfo_hz",
+        "negative",
+        "a clock drift or a carrier frequency offset takes either sign",
+    ),
+    _doc(
+        r"propagation\.surfaces\.Facet\.contains",
+        r"tol",
+        "negative",
+        "a negative tol counts only points strictly inside the rectangle (the tracer's own use)",
+    ),
+    _doc(
+        r"propagation\.surfaces\.(Facet\.contains|Tunnel3D\.(contains|blocked|require_inside)"
+        r"|Box\.blocks)|drive\.route\.(slant_range|doppler_shift)",
+        r"p|a|b|v",
+        "shape",
+        "points or segments (..., 3) / (..., 2): leading axes vectorise "
+        "(test_extra_leading_axes_vectorise)",
+    ),
+    _doc(
+        r"propagation\.surfaces\.(close_tunnel|semicircular_tunnel)|tunnels\.\w+",
+        r"plates|blockers",
+        "empty",
+        "no road markings, no blockers (the default)",
+    ),
+    _doc(
+        r"propagation\.materials\.\w+",
+        r"cos_i",
+        "shape",
+        "elementwise in the incidence: any shape of cosines",
+    ),
+    _doc(
+        r"extraction\.ml\.fitting\.MLFit",
+        r"history|reason",
+        "empty",
+        "no iterations recorded (the default); no failed test (the fit passed)",
+    ),
+    _doc(
+        r"propagation\.paths\.Path",
+        r"surface",
+        "empty",
+        "the direct path reflects off no surface",
+    ),
+    _doc(
+        r"propagation\.paths\.Path",
+        r"range_rate|velocity|doppler",
+        "negative",
+        "signed: a receding source has a negative velocity and Doppler shift",
+    ),
+    _doc(
+        r"extraction\.estimates\.PathEstimates|signal_route\.RouteMeasurements",
+        r"kappa|kappa_nf",
+        "nan",
+        "NaN: a far-field path has no curvature (the docstring's contract)",
+    ),
+    _doc(
+        r"drive\.measurement\.DopplerToaMeasurements",
+        r"doppler|toa",
+        "nan",
+        "NaN marks a dropped epoch (the docstring's contract; ``dropped`` flags it too)",
+    ),
+    _doc(
+        r"signal_route\.RouteMeasurements",
+        r"array",
+        "empty",
+        "the name of an unnamed array (a label only)",
     ),
     _doc(
         r"fresnel\.bounds\.aperture",
@@ -557,6 +633,26 @@ def test_extra_leading_axes_vectorise():
         (model.jacobian, x4),
         (model.position_fim, p),
         (lambda x: model.simulate(x, np.random.default_rng(0)), p),
+    ]
+    import tunnelkit as tk
+    from tunnelkit.drive import doppler_shift, slant_range
+    from tunnelkit.propagation import truck_box
+
+    tun = tk.load_scenario("italiano2026-straight").tunnel()
+    box = truck_box(20.0, 0.0)
+    pts = np.array([[10.0, 0.5, 1.5], [30.0, -1.0, 2.0]])
+    far = pts + np.array([20.0, 0.0, 0.0])
+    xy, tx, v2 = p, np.array([0.0, 3.0]), np.array([[10.0, 0.5], [-9.0, 0.0]])
+    cases += [
+        (lambda x: tun.contains(x), pts),
+        (lambda x: tun.require_inside("p", x), pts),
+        (lambda x: tun.facets[0].contains(x), pts),
+        (lambda x: tun.with_blockers(box).blocked(x, far), pts),
+        (lambda x: tun.with_blockers(box).blocked(pts, x), far),
+        (lambda x: box.blocks(x, far), pts),
+        (lambda x: slant_range(x, tx, 2.0), xy),
+        (lambda x: doppler_shift(x, v2, tx, 5.9e9, 2.0), xy),
+        (lambda x: doppler_shift(xy, x, tx, 5.9e9, 2.0), v2),
     ]
     for f, x in cases:
         np.testing.assert_allclose(f(x[None, None]), f(x)[None, None], rtol=1e-12)

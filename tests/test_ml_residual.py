@@ -194,12 +194,19 @@ def test_a_physically_impossible_path_is_never_valid():
     )
     ok = ml.physical(est, sc.config)
     assert ok.all()
-    fast = replace(est, v=est.v + np.array([0.0, 2 * C]))
+    # marked valid, a path faster than light or from behind the array is refused outright
+    with pytest.raises(ValueError, match=r"^valid: path 1 is marked valid but is not physical"):
+        replace(est, v=est.v + np.array([0.0, 2 * C]))
+    fast = replace(est, v=est.v + np.array([0.0, 2 * C]), valid=np.array([True, False]))
     np.testing.assert_array_equal(ml.physical(fast, sc.config), [True, False])
+    np.testing.assert_array_equal(fast.physical(), [True, False])
     behind = est.direction.copy()
     behind[0, 2] = -behind[0, 2]
+    with pytest.raises(ValueError, match=r"^valid: path 0 "):
+        replace(est, direction=behind)
     np.testing.assert_array_equal(
-        ml.physical(replace(est, direction=behind), sc.config), [False, True]
+        ml.physical(replace(est, direction=behind, valid=np.array([False, True])), sc.config),
+        [False, True],
     )
     close = replace(est, kappa=np.array([0.1, est.kappa[1]]))
     assert not ml.physical(close, sc.config)[0]

@@ -390,7 +390,7 @@ def _bind(name: str, got: tuple[int, ...], spec: tuple, dims: dict) -> None:
             raise ValueError(f"{name}: expected shape {want}, got {got}")
 
 
-def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims) -> None:
+def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims, allow_inf=False) -> None:
     import typing
     from collections.abc import Callable as _Callable
     from collections.abc import Mapping as _Mapping
@@ -429,6 +429,8 @@ def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims) -> Non
     elif float in plain:
         if allow_nan and isinstance(value, float) and np.isnan(value):
             return
+        if allow_inf and isinstance(value, float) and value == np.inf:
+            return
         {"positive": positive, "nonnegative": nonnegative}.get(sign, real)(name, value)
     elif str in plain:
         if not isinstance(value, str):
@@ -463,6 +465,7 @@ def record(
     allow_nan: Sequence[str] = (),
     may_be_empty: Sequence[str] = (),
     skip: Sequence[str] = (),
+    allow_inf: Sequence[str] = (),
 ) -> None:
     """Check every field of the dataclass ``obj`` by its annotation (for ``__post_init__``).
 
@@ -471,8 +474,8 @@ def record(
     by type, ``X | None`` also ``None``. ``shapes`` gives a field's shape (arrays) or ``(length,)``
     (lists): ints, ``None`` for any length, or a symbol such as ``"T"`` that must take the same
     value in every field it appears in. ``positive``/``nonnegative`` name fields with that sign;
-    ``may_be_empty`` text or lists that may be empty; ``skip`` fields left unchecked. Errors name
-    the field.
+    ``may_be_empty`` text or lists that may be empty; ``skip`` fields left unchecked;
+    ``allow_inf`` floats that may be ``+inf`` (no bound, never). Errors name the field.
     """
     import dataclasses
 
@@ -492,4 +495,5 @@ def record(
             allow_nan=f.name in allow_nan,
             may_be_empty=f.name in may_be_empty,
             dims=dims,
+            allow_inf=f.name in allow_inf,
         )

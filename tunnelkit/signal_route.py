@@ -25,7 +25,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ._validate import boolean, choice, instance, integer, real, rng_or_error
+from ._validate import boolean, choice, instance, integer, real, record, rng_or_error, sequence
 from .arrays import ArrayGeometry
 from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from .constants import C
@@ -55,18 +55,19 @@ MODEL_ORDERS = ("known", "glrt")
 
 def _check_arrays(arrays) -> None:
     """A non-empty list of ArrayGeometry with distinct names (calibration is keyed by name)."""
-    if isinstance(arrays, str) or not isinstance(arrays, list | tuple) or not arrays:
-        raise TypeError(f"arrays: expected a non-empty list of ArrayGeometry, got {arrays!r:.80}")
     names = {}
-    for i, a in enumerate(arrays):
-        if not isinstance(a, ArrayGeometry):
-            raise TypeError(f"arrays[{i}]: expected an ArrayGeometry, got {type(a).__name__}")
-        if a.name in names:
+    for i, a in enumerate(sequence("arrays", arrays)):
+        if instance(f"arrays[{i}]", a, ArrayGeometry).name in names:
             raise ValueError(
                 f"arrays: arrays[{i}] and arrays[{names[a.name]}] are both named {a.name!r}; "
                 "names must be distinct (the calibration is keyed by name)"
             )
         names[a.name] = i
+
+
+_SHAPES = dict.fromkeys("phi psi kappa near_field d delta_d v alpha index sigma_d".split(), ("K",))
+_SHAPES.update(origin=(3,), direction=("K", 3), cov=("K", 3, 3))  # RouteMeasurements' fields
+_EPOCH_SHAPES = {"ue": (3,), "velocity": (3,), "truth_index": (None,)}  # Epoch's fields
 
 
 @dataclass(frozen=True)
@@ -98,6 +99,9 @@ class RouteMeasurements:
     cov: np.ndarray | None = None
     sigma_d: np.ndarray | None = None
 
+    def __post_init__(self) -> None:  # kappa is NaN for a far-field path
+        record(self, shapes=_SHAPES, allow_nan=("kappa",), may_be_empty=("array",))
+
     def __len__(self) -> int:
         return self.d.shape[0]
 
@@ -126,6 +130,9 @@ class Epoch:
     estimates: object = field(repr=False)
     measurements: RouteMeasurements
     truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
+
+    def __post_init__(self) -> None:
+        record(self, shapes=_EPOCH_SHAPES, nonnegative=("k", "t"))
 
     def with_estimates(self, est, config: SRSConfig | None = None, *, min_d: float = 0.0):
         """This epoch with other estimates of the same tensor (another extraction route):
@@ -306,11 +313,7 @@ class SignalRoute:
         instance("trajectory", self.trajectory, Trajectory)
         instance("config", self.config, SRSConfig)
         choice("model", self.model, ("exact", "srnf"))
-        if not isinstance(self.kinds, tuple | list) or not self.kinds:
-            raise TypeError(
-                f"kinds: expected a non-empty tuple of path kinds, got {self.kinds!r:.60}"
-            )
-        for k in self.kinds:
+        for k in sequence("kinds", self.kinds):
             choice("kinds", k, PATH_KINDS)
         real("snr_offset_db", self.snr_offset_db)
         instance("impairments", self.impairments, Impairments)
@@ -474,6 +477,7 @@ class SignalRoute:
         radio (``refine``, ... in ``extract_kw``)."""
         from .extraction import extract_paths
 
+        instance("arr", arr, ArrayGeometry)
         return extract_paths(H, n_paths, arr, self.config, **extract_kw)
 
     def epoch(

@@ -60,6 +60,8 @@ __all__ = [
 
 #: curvature bounds of a fitted source: 1 / kappa in [1 / KAPPA_MAX, 1 / KAPPA_MIN]
 KAPPA_MIN, KAPPA_MAX = 1.0, 1000.0
+#: the most Levenberg-Marquardt steps :func:`fit_sources` takes (``max_nfev``)
+MAX_NFEV = 10_000
 
 
 def source_points(theta) -> np.ndarray:
@@ -68,14 +70,27 @@ def source_points(theta) -> np.ndarray:
     ``(u_x, u_y)`` are the direction cosines in the array plane (the front half-space,
     ``u_z = sqrt(1 - u_x^2 - u_y^2)``) and ``w = 1 / kappa`` the wavefront curvature.
     """
-    th = np.asarray(theta, float).reshape(-1, 3)
+    th = _theta("theta", theta)
     uz = np.sqrt(np.clip(1.0 - th[:, 0] ** 2 - th[:, 1] ** 2, 1e-12, None))
     return np.column_stack([th[:, 0], th[:, 1], uz]) / th[:, 2:3]
+
+
+def _theta(name: str, theta) -> np.ndarray:
+    """Source parameters ``(u_x, u_y, w)`` flat or (n, 3), finite, ``w = 1 / kappa > 0``."""
+    th = finite_array(name, theta)
+    if th.ndim > 2 or th.size == 0 or th.size % 3 or (th.ndim == 2 and th.shape[1] != 3):
+        raise ValueError(f"{name}: expected (u_x, u_y, w) per source, (n, 3), got {th.shape}")
+    th = th.reshape(-1, 3)
+    if np.any(th[:, 2] <= 0):
+        raise ValueError(f"{name}: the curvature w = 1 / kappa must be > 0, got {th[:, 2].min()}")
+    return th
 
 
 def spherical_steering(sources, element_positions, fc: float) -> np.ndarray:
     """Steering matrix (M, n) of point sources: ``exp(j k0 (||q - p_m|| - ||q||))`` (eq. 1-2)."""
     q = np.atleast_2d(finite_array("sources", sources))
+    if q.ndim != 2 or q.shape[1] != 3:
+        raise ValueError(f"sources: expected points (n, 3), got shape {q.shape}")
     p = finite_array("element_positions", element_positions, ndim=2)
     k0 = 2 * np.pi * positive("fc", fc) / C
     dist = np.linalg.norm(q[None, :, :] - p[:, None, :], axis=-1)
@@ -118,8 +133,10 @@ def fit_sources(
     less than a relative ``1e-6``.
     Returns ``(theta (n, 3), g (n,), relative residual energy ||b - S g||^2 / ||b||^2)``.
     """
-    b = np.asarray(b, complex)
+    b = finite_array("b", b, ndim=1, dtype=complex)
+    theta0 = _theta("theta0", theta0)
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])
+    max_nfev = integer("max_nfev", max_nfev, minimum=0, maximum=MAX_NFEV)
     return _fit_sources(b, theta0, p, positive("fc", fc), max_nfev)
 
 
@@ -204,8 +221,11 @@ def split_component(
     """
     max_sources = integer("max_sources", max_sources, minimum=1)
     fc = positive("fc", fc)
-    b = np.asarray(b, complex)
-    p = np.asarray(element_positions, float)
+    b = finite_array("b", b, ndim=1, dtype=complex)
+    theta0 = _theta("theta0", theta0)
+    p = check_element_positions("element_positions", element_positions, m=b.shape[0])
+    tol, max_gain = positive("tol", tol), positive("max_gain", max_gain)
+    min_separation = nonnegative("min_separation", min_separation)
     th, g, rel = _fit_sources(b, theta0, p, fc)
     scale = float(np.sqrt(np.mean(np.abs(b) ** 2)))
     while rel > tol and th.shape[0] < max_sources:

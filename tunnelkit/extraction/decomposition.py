@@ -20,7 +20,8 @@ import tensorly as tl
 from tensorly.cp_tensor import CPTensor
 from tensorly.decomposition import parafac
 
-from .._validate import finite_array, integer, positive
+from .._validate import choice, finite_array, integer, positive, record, sequence
+from ..arrays import check_element_positions
 from .numerics import contract, grid_index
 
 __all__ = [
@@ -158,6 +159,11 @@ class CPDResult:
     converged: bool
     method: str
 
+    def __post_init__(self) -> None:
+        record(self, shapes={"factors": (3,)}, nonnegative=("rel_error", "n_iter"))
+        choice("method", self.method, ("fast", "plain"))
+        _check_factors(self.factors)
+
 
 def _range_basis(X: np.ndarray, r: int, rng: np.random.Generator) -> np.ndarray:
     """Orthonormal basis (rows, r) of the dominant column space of ``X`` (randomised, 1 power step)."""
@@ -293,6 +299,9 @@ def cpd(
     n_iter_max = integer("n_iter_max", n_iter_max, minimum=1, maximum=MAX_SWEEPS)
     tol = positive("tol", tol)
     polish = integer("polish", polish, minimum=0, maximum=MAX_SWEEPS)
+    integer("seed", seed, minimum=0)
+    if element_positions is not None:
+        check_element_positions("element_positions", element_positions, m=H.shape[0])
     if method == "plain":
         cp, errs = parafac(
             tl.tensor(H),
@@ -363,10 +372,22 @@ def _cpd_fast(
     return CPDResult(tuple(factors), rel, n_it, n_it < n_iter_max, "fast")
 
 
+def _check_factors(factors, name: str = "factors") -> list[np.ndarray]:
+    """Three finite factor matrices (rows, L) with the same number of columns ``L``, as arrays;
+    errors name ``name``."""
+    out = sequence(name, factors)
+    if len(out) != 3:
+        raise ValueError(f"{name}: expected the three factor matrices (A, F, T), got {len(out)}")
+    out = [finite_array(f"{name}[{i}]", B, ndim=2, dtype=complex) for i, B in enumerate(out)]
+    if len({B.shape[1] for B in out}) != 1:
+        raise ValueError(f"{name}: one column per component in each, got {[B.shape for B in out]}")
+    return out
+
+
 def normalize_factors(factors):
     """Scaling fix ``B <- B diag^-1(B[0, :])`` for each factor, and eq. 12 ``alpha = prod B[0, l]``."""
     out, alpha = [], 1.0
-    for B in factors:
+    for B in _check_factors(factors):
         first = B[0]
         if np.any(np.abs(first) < 1e-300):
             raise ValueError(
@@ -380,8 +401,9 @@ def normalize_factors(factors):
 def cp_rel_error(H: np.ndarray, factors, nh2: float | None = None) -> float:
     """``||H - [[A, B, C]]|| / ||H||`` without forming the model tensor: the cross term is one
     contraction of ``H``, the model's energy the Hadamard product of the factors' Gram matrices."""
-    A, B, Cm = factors
-    nh2 = float(np.vdot(H, H).real) if nh2 is None else nh2
+    H = check_tensor(H)
+    A, B, Cm = _check_factors(factors)
+    nh2 = float(np.vdot(H, H).real) if nh2 is None else positive("nh2", nh2)
     fit = contract(H, B.conj(), Cm.conj())  # <H, model> per component before summing
     gram = (A.conj().T @ A) * (B.conj().T @ B) * (Cm.conj().T @ Cm)
     err2 = nh2 - 2 * float(np.sum(np.real(A.conj() * fit))) + float(np.real(gram.sum()))

@@ -6,16 +6,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import boolean, integer, nonnegative
+from .._validate import boolean, integer, nonnegative, sequence
+from ..constants import C
 
 __all__ = ["PathEstimates", "path_estimates"]
 
 _KINDS = {"real": "iuf", "complex": "iufc", "bool": "b"}
 
 
+#: fields that may hold NaN or inf: a far-field path has no curvature
+_NOT_FINITE_OK = ("kappa", "kappa_nf")
+
+
 def _per_path(name: str, value, n: int, kind: str, *, ndim: int = 1, width: int | None = None):
-    """A per-path array of ``n`` rows: numbers of ``kind`` (NaN allowed: a far-field path has no
-    curvature), ``ndim`` axes and ``width`` columns when given; errors name ``name``."""
+    """A per-path array of ``n`` rows: numbers of ``kind`` (finite, but for the curvatures in
+    ``_NOT_FINITE_OK``), ``ndim`` axes and ``width`` columns when given; errors name ``name``."""
     if isinstance(value, str | bytes) or not isinstance(value, np.ndarray | list | tuple):
         raise TypeError(
             f"{name}: expected an array with one row per path, got {type(value).__name__}"
@@ -26,6 +31,16 @@ def _per_path(name: str, value, n: int, kind: str, *, ndim: int = 1, width: int 
     if arr.ndim != ndim or arr.shape[0] != n or (width is not None and arr.shape[1] != width):
         want = f"({n},)" if ndim == 1 else f"({n}, {width if width is not None else 'M'})"
         raise ValueError(f"{name}: expected shape {want} (one row per path), got {arr.shape}")
+    if name not in _NOT_FINITE_OK and arr.dtype.kind in "fc" and not np.isfinite(arr).all():
+        raise ValueError(f"{name}: contains NaN or infinite values")
+
+
+def _physical(d, v, direction) -> np.ndarray:
+    """Per path: physically possible — finite, ``|v| < c``, a unit direction of arrival in the
+    array's front half-space (local ``z >= 0``)."""
+    u = np.asarray(direction, float)
+    ok = np.isfinite(d) & np.isfinite(v) & np.all(np.isfinite(u), axis=1) & (np.abs(v) < C)
+    return ok & (u[:, 2] >= 0) & (np.abs(np.linalg.norm(u, axis=1) - 1.0) <= 1e-6)
 
 
 @dataclass(frozen=True)
@@ -89,9 +104,22 @@ class PathEstimates:
             _per_path("significance", self.significance, n, "real")
         if self.fit_ok is not None:
             boolean("fit_ok", self.fit_ok)
+        bad = np.flatnonzero(self.valid & ~_physical(d, self.v, self.direction))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"valid: path {i} is marked valid but is not physical (d = {d[i]:g} m, v = "
+                f"{self.v[i]:g} m/s, direction {np.asarray(self.direction)[i].tolist()}): a valid "
+                "path has |v| < c and a unit direction in the front half-space"
+            )
 
     def __len__(self) -> int:
         return self.d.shape[0]
+
+    def physical(self) -> np.ndarray:
+        """Per path: physically possible (finite, ``|v| < c``, a unit direction in the front
+        half-space), what every path marked ``valid`` is."""
+        return _physical(self.d, self.v, self.direction)
 
     def __getitem__(self, key: str):
         return getattr(self, key)
@@ -120,6 +148,10 @@ def path_estimates(
         if isinstance(a, str) or np.ndim(a) != nd or np.shape(a)[0] != L:
             want = "(L,)" if nd == 1 else "(L, M)"
             raise ValueError(f"{name}: expected shape {want} with L = len(d), got {np.shape(a)}")
+    if len(sequence("factors", factors)) != 3:
+        raise ValueError(
+            f"factors: expected the three factor matrices (A, F, T), got {len(factors)}"
+        )
     if not isinstance(ang, dict):
         raise TypeError(f"ang: expected the dict of angles_from_solution, got {type(ang).__name__}")
     direction = np.where(near[:, None], ang["dir_nf"], ang["dir_ff"])
@@ -136,7 +168,7 @@ def path_estimates(
         near[o],
         phi[o],
         psi[o],
-        d[o] >= 0,
+        (d >= 0)[o] & _physical(d, v, direction)[o],
         ang["kappa_nf"][o],
         delta[o],
         mu_f[o],

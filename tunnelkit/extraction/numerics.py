@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._validate import integer, positive
+from .._validate import finite_array, integer, positive
 from ..constants import C
 
 __all__ = [
@@ -38,13 +38,14 @@ MIN_SIGNIFICANCE = 25.0
 
 
 def _square(name: str, A) -> np.ndarray:
-    A = np.asarray(A)
+    A = finite_array(name, A, dtype=complex) if np.iscomplexobj(A) else finite_array(name, A)
     if A.ndim != 2 or A.shape[0] != A.shape[1]:
         raise ValueError(f"{name}: expected a square matrix, got shape {A.shape}")
     return A
 
 
 def _masks(g, *masks):
+    finite_array("g", g)
     if g.ndim != 1:
         raise ValueError(f"g: expected a vector, got shape {g.shape}")
     for name, m in masks:
@@ -56,7 +57,7 @@ def solve(G, B) -> np.ndarray:
     """``G^{-1} B`` for a square ``G`` (n, n) and ``B`` (n,) or (n, k); the least-squares
     solution when ``G`` is singular."""
     G = _square("G", G)
-    B = np.asarray(B)
+    B = finite_array("B", B, dtype=complex) if np.iscomplexobj(B) else finite_array("B", B)
     if B.ndim not in (1, 2) or B.shape[0] != G.shape[0]:
         raise ValueError(f"B: expected {G.shape[0]} rows, got shape {B.shape}")
     try:
@@ -121,15 +122,20 @@ def contract(H, F, T) -> np.ndarray:
         raise ValueError(f"F: expected ({nf}, L), got shape {F.shape}")
     if T.ndim != 2 or T.shape != (nt, F.shape[1]):
         raise ValueError(f"T: expected ({nt}, {F.shape[1]}), got shape {T.shape}")
+    finite_array("F", F, dtype=complex)
+    finite_array("T", T, dtype=complex)
     tmp = (H.reshape(M * nf, nt) @ T).reshape(M, nf, -1)
-    return np.einsum("msl,sl->ml", tmp, F)
+    out = np.einsum("msl,sl->ml", tmp, F)
+    if not np.isfinite(out).all():  # F and T are finite: H is not (checked here, not per sample)
+        raise ValueError("H: contains NaN or infinite values")
+    return out
 
 
 def grid_index(element_positions, tol: float = 1e-6):
     """``(rows, cols, n_rows, n_cols)`` integer grid coordinates of the elements if their xy
     positions (M, >= 2) form a full rectangular lattice (a URA, or a ULA along x or y), else
     ``None``. Positions closer than ``tol`` along an axis count as one level."""
-    p = np.asarray(element_positions, float)
+    p = finite_array("element_positions", element_positions)
     if p.ndim != 2 or p.shape[1] < 2:
         raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
     tol = positive("tol", tol)
@@ -166,10 +172,10 @@ def spatial_phase(theta, element_positions, k0: float):
         d psi / d u_x = k0 p_x (-2 / Q + N w / (Q^2 D))         (likewise u_y with p_y),
         d psi / d w   = k0 (|p|^2 / Q - N (w |p|^2 - u.p) / (Q^2 D)).
     """
-    th = np.atleast_2d(np.asarray(theta, float))
+    th = np.atleast_2d(finite_array("theta", theta))
     if th.ndim != 2 or th.shape[1] != 3:
         raise ValueError(f"theta: expected shape (L, 3), got {th.shape}")
-    p = np.asarray(element_positions, float)
+    p = finite_array("element_positions", element_positions)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
     k0 = positive("k0", k0)
@@ -206,7 +212,7 @@ def scan_grid(element_positions, fc: float, n_grid: int = 61):
     """The far-field beam-scan grid of an array over the whole visible region ``|u| <= 1`` (to
     end-fire): directions ``u`` (G, 2) on an ``n_grid x n_grid`` lattice and the steering matrix
     ``A`` (M, G), ``A[m, g] = exp(-j k0 u_g . p_m)`` (cached, read-only)."""
-    p = np.ascontiguousarray(element_positions, float)
+    p = np.ascontiguousarray(finite_array("element_positions", element_positions))
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
     n_grid = integer("n_grid", n_grid, minimum=2)
@@ -217,11 +223,12 @@ def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:
     """Direction cosines ``(u_x, u_y)`` of the strongest far-field beam of the spatial vector
     ``r`` (M,) on an ``n_grid x n_grid`` grid of the unit disc (the steering matrix of the last
     two arrays is cached)."""
-    p = np.ascontiguousarray(element_positions, float)
+    p = np.ascontiguousarray(finite_array("element_positions", element_positions))
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
     if np.shape(r) != (p.shape[0],):
         raise ValueError(f"r: expected shape ({p.shape[0]},), got {np.shape(r)}")
+    finite_array("r", r, dtype=complex)
     n_grid = integer("n_grid", n_grid, minimum=2)
     u, A = _scan_grid(p.tobytes(), p.shape[0], positive("fc", fc), n_grid)
     return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H

@@ -58,8 +58,8 @@ def vandermonde_roots(B) -> np.ndarray:
 
 def _numeric(name: str, value, ndim: tuple[int, ...], last: int | None = None) -> np.ndarray:
     """``value`` as a numeric (real or complex) array with ``ndim`` in ``ndim`` and, when given,
-    ``last`` entries in the last axis; NaN allowed (the inner stages pass noise-driven values
-    through). Errors name ``name``."""
+    ``last`` entries in the last axis, finite (NaN or inf is refused: a root, a factor or a
+    tensor entry that is not a number has no path behind it). Errors name ``name``."""
     if value is None or isinstance(value, str | bytes):
         raise TypeError(f"{name}: expected a numeric array, got {type(value).__name__}")
     arr = np.asarray(value)
@@ -68,6 +68,8 @@ def _numeric(name: str, value, ndim: tuple[int, ...], last: int | None = None) -
     if arr.ndim not in ndim or (last is not None and arr.shape[-1] != last):
         want = " or ".join(f"{d}-D" for d in ndim) + (f" with {last} columns" if last else "")
         raise ValueError(f"{name}: expected {want}, got shape {arr.shape}")
+    if arr.dtype.kind in "fc" and not np.isfinite(arr).all():
+        raise ValueError(f"{name}: contains NaN or infinite values")
     return arr
 
 
@@ -325,7 +327,8 @@ def algorithm1(est: PathEstimates, min_d: float = 0.0) -> np.ndarray:
     bias, up to ``b_max = 100`` ns either way in section 4.2, so a path nearer than
     ``c b_max = 30`` m can arrive with ``d < 0`` and still be good; ``min_d = -c b_max`` is the
     check that only drops what no bias explains. Paths the maximum-likelihood route finds
-    indistinguishable from noise stay dropped either way.
+    indistinguishable from noise stay dropped either way, and so do paths that are not physical
+    (:meth:`PathEstimates.physical`: ``|v| >= c``, a direction behind the array).
     """
     if not isinstance(est, PathEstimates):
         raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
@@ -339,7 +342,7 @@ def algorithm1(est: PathEstimates, min_d: float = 0.0) -> np.ndarray:
         if est.significance is None
         else np.asarray(est.significance) >= MIN_SIGNIFICANCE
     )
-    return np.flatnonzero(detected & (est.d >= min_d))
+    return np.flatnonzero(detected & (est.d >= min_d) & est.physical())
 
 
 #: the refinements of the paper's route (see :func:`paper_route`)

@@ -14,7 +14,6 @@ from .._validate import (
     finite_array,
     instance,
     integer,
-    nonnegative,
     positive,
     real,
     record,

@@ -7,6 +7,8 @@ import time
 
 import numpy as np
 
+from .._validate import instance, positive, sequence, vector
+from ..arrays import ArrayGeometry
 from ..constants import C
 from ..propagation import Path, Tunnel3D
 
@@ -34,7 +36,9 @@ def plate_occluders(tunnel: Tunnel3D, path: Path, ue, origin) -> list[str]:
     The image method treats plates as reflectors only; a ray tracer also sees them as obstacles,
     so such a path exists in the image method and not in Sionna.
     """
-    ue, origin = np.asarray(ue, float), np.asarray(origin, float)
+    instance("tunnel", tunnel, Tunnel3D)
+    instance("path", path, Path)
+    ue, origin = vector("ue", ue, 3), vector("origin", origin, 3)
     legs = [(ue, origin)] if path.kind == "los" else [(ue, path.point), (path.point, origin)]
     hit = []
     for f in tunnel.plates:
@@ -48,6 +52,14 @@ def plate_occluders(tunnel: Tunnel3D, path: Path, ue, origin) -> list[str]:
     return hit
 
 
+def _paths(name: str, paths) -> list[Path]:
+    """A list of :class:`Path` (an engine may find none)."""
+    out = sequence(name, paths, empty=True)
+    for i, p in enumerate(out):
+        instance(f"{name}[{i}]", p, Path)
+    return out
+
+
 def compare_paths(image: list[Path], other: list[Path]) -> list[dict]:
     """One row per path found by either engine, with both values and their differences.
 
@@ -55,8 +67,8 @@ def compare_paths(image: list[Path], other: list[Path]) -> list[dict]:
     |d az|, |d el| [deg], |d Doppler| [Hz], |d point| [m], max |d length| over the antennas
     [m], and |Gamma| of each engine.
     """
-    a = {_key(p): p for p in image}
-    b = {_key(p): p for p in other}
+    a = {_key(p): p for p in _paths("image", image)}
+    b = {_key(p): p for p in _paths("other", other)}
     rows = []
     for key in list(a) + [k for k in b if k not in a]:
         p, q = a.get(key), b.get(key)
@@ -86,6 +98,9 @@ def compare_paths(image: list[Path], other: list[Path]) -> list[dict]:
 
 def worst_errors(rows: list[dict]) -> dict[str, float]:
     """Largest difference per column over the rows found by both engines."""
+    for i, r in enumerate(sequence("rows", rows, empty=True)):
+        if not isinstance(r, dict) or "found" not in r:
+            raise TypeError(f"rows[{i}]: expected a row of compare_paths, got {type(r).__name__}")
     both = [r for r in rows if r["found"] == "both"]
     return {k: max(r[k] for r in both) for k in _DIFF_COLS} if both else {}
 
@@ -128,6 +143,9 @@ def lower_into_tunnel(tunnel: Tunnel3D, array, *, step: float = 0.05):
     up to 4.998 m, above the 12-facet ceiling (4.970 m at y = 0.229 m; even the circle is only 4.995 m there): a ray tracer sees those
     elements behind the concrete. Returns ``(array, shift)``.
     """
+    instance("tunnel", tunnel, Tunnel3D)
+    instance("array", array, ArrayGeometry)
+    step = positive("step", step)
     shift = 0.0
     while not np.all(tunnel.contains(array.world - [0.0, 0.0, shift])):
         shift += step

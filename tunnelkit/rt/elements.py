@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import choice, integer, positive
+from .._validate import choice, finite_array, integer, positive, record
 
 __all__ = ["NUFFT_MIN_PATHS", "SYNTHESIS_METHODS", "ElementPaths", "element_tensor"]
 
@@ -73,6 +73,10 @@ class ElementPaths:
                 raise ValueError(
                     f"{name}: expected shape {shape} like tau, got {np.shape(getattr(self, name))}"
                 )
+        record(self, allow_nan=("tau", "gain", "doppler"))  # numbers; unused slots hold anything
+        for name in ("tau", "gain", "doppler"):  # the paths themselves are finite
+            finite_array(name, np.asarray(getattr(self, name))[np.asarray(self.valid, bool)],
+                         dtype=complex if name == "gain" else float)  # fmt: skip
 
     @property
     def M(self) -> int:
@@ -157,6 +161,8 @@ def element_tensor(
     eps = positive("eps", eps)
     if not 1e-15 <= eps <= 1e-3:
         raise ValueError(f"eps: expected a relative tolerance in [1e-15, 1e-3], got {eps}")
+    if select is not None and np.asarray(select).dtype != bool:
+        raise TypeError(f"select: expected a boolean (M, P) mask, got {np.asarray(select).dtype}")
     sel = paths.valid if select is None else np.asarray(select, bool) & paths.valid
     if sel.shape != paths.valid.shape:
         raise ValueError(f"select: expected shape {paths.valid.shape}, got {sel.shape}")

@@ -18,10 +18,12 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
+from os import PathLike
 from pathlib import Path as FsPath
 
 import numpy as np
 
+from .._validate import instance, record
 from ..propagation import Box, Facet, Tunnel3D
 
 __all__ = ["MitsubaScene", "SceneError", "SurfaceInfo", "export_tunnel", "read_scene"]
@@ -50,6 +52,9 @@ class SurfaceInfo:
     kind: str
     material: str
 
+    def __post_init__(self) -> None:  # a user shape may name no material
+        record(self, may_be_empty=("material",))
+
 
 @dataclass(frozen=True)
 class MitsubaScene:
@@ -57,6 +62,11 @@ class MitsubaScene:
 
     xml: FsPath
     surfaces: dict[str, SurfaceInfo] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        instance("xml", self.xml, FsPath)
+        for k, v in dict(instance("surfaces", self.surfaces, dict)).items():
+            instance(f"surfaces[{k!r}]", v, SurfaceInfo)
 
     @property
     def n_surfaces(self) -> int:
@@ -131,7 +141,7 @@ def export_tunnel(tunnel: Tunnel3D, directory, *, name: str = "tunnel") -> Mitsu
         raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
         raise ValueError(f"name: expected a plain file stem (letters, digits, _.-), got {name!r}")
-    out = FsPath(directory)
+    out = FsPath(instance("directory", directory, (str, PathLike), "a directory name"))
     (out / "meshes").mkdir(parents=True, exist_ok=True)
     root = ET.Element("scene", version="2.1.0")
     used_mat: set[str] = set()
@@ -177,7 +187,7 @@ def read_scene(path) -> MitsubaScene:
     "ceiling", "road", "rrm", "blocker" (so ``rrm-left`` is an RRM), otherwise "surface". Mesh
     files are resolved by Mitsuba when the scene is loaded.
     """
-    p = FsPath(path)
+    p = FsPath(instance("path", path, (str, PathLike), "a file name"))
     if not p.is_file():
         raise SceneError(f"scene file {str(p)!r} does not exist")
     try:

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, integer, positive
+from ..._validate import finite_array, integer, positive, record
 from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
@@ -97,6 +97,15 @@ class MLFit:
     detected: np.ndarray | None = field(default=None, repr=False)
     separation: float = np.inf
     reason: str = ""
+
+    def __post_init__(self) -> None:  # theta inside the feasible set: the front half-space
+        L = ("L",)
+        record(self, shapes={"theta": (*L, 3), "mu_f": L, "mu_t": L, "alpha": L, "significance": L, "detected": L},
+               nonnegative=("cost", "noise_power", "rho", "rho_max", "n_iter", "n_reseed", "peak", "peak_max", "separation"),
+               allow_inf=("peak_max", "separation"), may_be_empty=("history", "reason"))  # fmt: skip
+        r, w = np.hypot(self.theta[:, 0], self.theta[:, 1]), self.theta[:, 2]
+        if np.any(r > 1) or np.any(w < 0) or np.any(w > W_MAX * (1 + 1e-9)):
+            raise ValueError("theta: outside the front half-space |u| <= 1, 0 <= w <= W_MAX")
 
 
 def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):

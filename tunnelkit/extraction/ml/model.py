@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import zherk
 
-from ..._validate import integer, positive
+from ..._validate import boolean, finite_array, integer, positive
 from ...arrays import check_element_positions
 from ...constants import C
 from ..decomposition import check_tensor
@@ -26,7 +26,7 @@ W_FAR = 1e-3
 
 
 def _check_theta(theta) -> np.ndarray:
-    th = np.asarray(theta)
+    th = finite_array("theta", theta)
     if th.ndim != 2 or th.shape[1] != 3:
         raise ValueError(f"theta: expected shape (L, 3), got {th.shape}")
     return th
@@ -50,6 +50,8 @@ def check_paths(theta, mu_f, mu_t) -> None:
         raise ValueError(
             f"mu_f, mu_t: expected shape ({L},) each, got {np.shape(mu_f)}, {np.shape(mu_t)}"
         )
+    finite_array("mu_f", mu_f)
+    finite_array("mu_t", mu_t)
 
 
 class Problem:
@@ -77,6 +79,7 @@ class Problem:
         matrix ``A = Re J^H J`` (5L, 5L), the descent direction ``g = Re D^H r`` (5L,) and the
         steering vectors ``a`` (M, L)."""
         check_paths(theta, mu_f, mu_t)
+        derivatives = boolean("derivatives", derivatives)
         L = theta.shape[0]
         psi, dx, dy, dw = spatial_phase(theta, self.pos, self.k0)
         a = np.exp(1j * psi)
@@ -139,6 +142,7 @@ class Problem:
         """The model tensor ``sum_l c_l X_l`` (M, Nf, Nt) of the paths ``theta``, ``mu_f``,
         ``mu_t`` with gains ``c`` (L,)."""
         check_paths(theta, mu_f, mu_t)
+        c = finite_array("c", c, shape=(len(theta),), dtype=complex)
         a = np.exp(1j * spatial_phase(theta, self.pos, self.k0)[0])
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.fft
 
-from ..._validate import integer, positive
+from ..._validate import finite_array, integer, positive
 from ..numerics import scan_grid
 
 __all__ = [
@@ -86,7 +86,8 @@ def residual_peak(R, element_positions, fc: float, noise_power: float, *, n_cell
     R = np.asarray(R)
     if R.ndim != 3 or not np.iscomplexobj(R):
         raise ValueError(f"R: expected a complex (M, Nf, Nt) tensor, got {R.dtype} {R.shape}")
-    p = np.ascontiguousarray(element_positions, float)
+    finite_array("R", R, dtype=complex)
+    p = np.ascontiguousarray(finite_array("element_positions", element_positions))
     if p.ndim != 2 or p.shape != (R.shape[0], 3):
         raise ValueError(f"element_positions: expected shape ({R.shape[0]}, 3), got {p.shape}")
     fc = positive("fc", fc)

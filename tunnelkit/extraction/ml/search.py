@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import zherk
 
-from ..._validate import integer
+from ..._validate import finite_array, integer
 from ...constants import C
 from ..coherent import fit_sources
 from ..estimates import PathEstimates
@@ -96,8 +96,8 @@ def path_from_peak(prob: Problem, loc, x) -> tuple[np.ndarray, float, float]:
     spatial vector of its delay-Doppler cell): the curvature by a 1-D scan and a single-source
     fit of ``x`` from the grid direction."""
     _check_problem(prob)
-    ux, uy, mf, mt = (float(v) for v in loc)
-    th = _spatial_search(np.asarray(x), prob, u=(ux, uy))
+    ux, uy, mf, mt = (float(v) for v in finite_array("loc", loc, shape=(4,)))
+    th = _spatial_search(finite_array("x", x, shape=(prob.M,), dtype=complex), prob, u=(ux, uy))
     return th, mf, mt
 
 

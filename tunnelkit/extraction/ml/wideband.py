@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import positive
+from ..._validate import boolean, finite_array, positive
 from ..numerics import solve, spatial_phase
 from .model import Problem, check_paths
 
@@ -61,6 +61,7 @@ class WidebandProblem(Problem):
     def evaluate(self, theta, mu_f, mu_t, *, derivatives: bool = True) -> dict:
         """As :meth:`Problem.evaluate`, on the wideband atoms."""
         check_paths(theta, mu_f, mu_t)
+        derivatives = boolean("derivatives", derivatives)
         L = theta.shape[0]
         MF = self.M * self.nf
         B, (psi, dx, dy, dw) = self._atoms(theta, mu_f)
@@ -113,6 +114,7 @@ class WidebandProblem(Problem):
     def model(self, theta, mu_f, mu_t, c) -> np.ndarray:
         """The model tensor ``sum_l c_l X_l`` (M, Nf, Nt) on the wideband atoms."""
         check_paths(theta, mu_f, mu_t)
+        c = finite_array("c", c, shape=(len(theta),), dtype=complex)
         B, _ = self._atoms(theta, mu_f)
         T = np.exp(1j * self.kk * mu_t[None, :])
         return np.einsum("msl,kl->msk", B * c[None, None, :], T, optimize=True)
