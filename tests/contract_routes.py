@@ -72,6 +72,13 @@ def route_rt():
     scene = rt.export_tunnel(tun, d)
     rt.read_scene(scene.xml)
     mitsuba.SurfaceInfo("wall-left", "wall", "concrete")
+    rt.time_engines(tun, arr, ue, route.trajectory.velocity[10], fc=route.config.fc, repeat=1,
+                    engines=("image",))  # fmt: skip
+    chan = rt.RayTracedChannel(tun, route.arrays, route.trajectory, route.config, settings,
+                               label="contract", cache_dir=d / "cache")  # fmt: skip
+    chan.key()
+    chan.directory()
+    rt.RayTracedChannel.variant(tun)
     rng = np.random.default_rng(0)
     pos = np.c_[np.stack(np.meshgrid(np.arange(3), np.arange(3)), -1).reshape(-1, 2) * 0.025,
                 np.zeros(9)]  # fmt: skip

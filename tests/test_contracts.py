@@ -204,7 +204,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a signed quantity: Doppler shift, approach speed, a step back, a height offset",
     ),
     _doc(
-        r"channel\..*",
+        r"(channel|signal_route)\..*",
         r"clock_bias|tx_power_dbm",
         "negative",
         "a clock bias takes any sign; a transmit power in dBm may be below 1 mW",
@@ -263,7 +263,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
     ),
     _doc(
-        r"extraction\.paper\.algorithm1|signal_route\.measurements_from_estimates",
+        r"extraction\.paper\.algorithm1|signal_route\.(measurements_from_estimates"
+        r"|Epoch\.with_estimates)",
         r"min_d",
         "negative",
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
@@ -335,6 +336,18 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"array",
         "empty",
         "the name of an unnamed array (a label only)",
+    ),
+    _doc(
+        r"rt\.compare\.(compare_paths|worst_errors)",
+        r"image|other|rows",
+        "empty",
+        "an engine may find no path: the rows of the other alone; no rows, no differences",
+    ),
+    _doc(
+        r"rt\.mitsuba\.SurfaceInfo",
+        r"material",
+        "empty",
+        "a user scene's shape that references no material",
     ),
     _doc(
         r"fresnel\.bounds\.aperture",

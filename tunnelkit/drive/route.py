@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_array, instance, positive, real, record, vector
+from .._validate import finite_array, instance, integer, positive, real, record, vector
 from ..constants import C
 from ..scenarios import Trajectory
 from .config import DriveConfig
@@ -260,8 +260,10 @@ def delay_doppler_profiles(
     Incoherent sums of the image-method paths smeared by the delay (1/B) and Doppler
     (window) resolutions, in dB relative to the strongest cell. Every ``every``-th epoch.
     """
-    cfg = drive.config
-    idx = np.arange(0, len(drive.t), int(every))
+    cfg = instance("drive", drive, Drive).config
+    every, n_bins = integer("every", every, minimum=1), integer("n_bins", n_bins, minimum=2)
+    doppler_span = positive("doppler_span", doppler_span)
+    idx = np.arange(0, len(drive.t), every)
     paths = channel_paths(cfg, drive.position[idx], drive.velocity[idx], drive.tx)
     pw = np.abs(paths["amplitude"]) ** 2
     delays = np.linspace(0, 1.1 * float(paths["delay"].max()), n_bins)

@@ -30,7 +30,7 @@ from pathlib import Path as FsPath
 
 import numpy as np
 
-from .._validate import integer
+from .._validate import boolean, instance, integer, positive, sequence
 from .elements import ElementPaths, element_tensor
 from .mitsuba import export_tunnel
 from .settings import RTSettings
@@ -100,6 +100,16 @@ class RayTracedChannel:
         label: str = "custom",
         cache_dir=None,
     ) -> None:
+        from ..arrays import ArrayGeometry
+        from ..propagation import Tunnel3D
+        from ..scenarios import Trajectory
+
+        instance("tunnel", tunnel, Tunnel3D)
+        for i, a in enumerate(sequence("arrays", arrays)):
+            instance(f"arrays[{i}]", a, ArrayGeometry)
+        instance("trajectory", trajectory, Trajectory)
+        if cache_dir is not None:
+            instance("cache_dir", cache_dir, (str, os.PathLike), "a directory name")
         need = ("fc", "tone_spacing", "n_tones", "symbol_period", "n_symbols")
         if not all(hasattr(config, a) for a in need):
             raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
@@ -118,7 +128,7 @@ class RayTracedChannel:
     # --- key and directory --------------------------------------------------------------------
     def key(self, tunnel=None) -> dict:
         """Everything the trace of ``tunnel`` (this drive's by default) depends on, hashed."""
-        tun = self.tunnel if tunnel is None else tunnel
+        tun = self._tunnel(tunnel)
         cfg = self.config
         return {
             "format": FORMAT,
@@ -132,6 +142,12 @@ class RayTracedChannel:
             "radio": [cfg.fc, cfg.tone_spacing, cfg.n_tones, cfg.symbol_period, cfg.n_symbols],
         }
 
+    def _tunnel(self, tunnel):
+        """``tunnel`` (this drive's when None), checked: a :class:`Tunnel3D`."""
+        from ..propagation import Tunnel3D
+
+        return self.tunnel if tunnel is None else instance("tunnel", tunnel, Tunnel3D)
+
     @staticmethod
     def variant(tunnel) -> str:
         """The cache subdirectory of ``tunnel``: "rrms" with road markings, else "no-rrms"."""
@@ -139,7 +155,7 @@ class RayTracedChannel:
 
     def directory(self, tunnel=None) -> FsPath:
         """The checked cache directory of ``tunnel`` (emptied first if written under another key)."""
-        tun = self.tunnel if tunnel is None else tunnel
+        tun = self._tunnel(tunnel)
         var = self.variant(tun)
         if var in self._checked:
             return self._checked[var]
@@ -171,7 +187,7 @@ class RayTracedChannel:
         """The Sionna engine of ``tunnel`` with this channel's settings (built on first use)."""
         from .sionna_engine import SionnaEngine
 
-        tun = self.tunnel if tunnel is None else tunnel
+        tun = self._tunnel(tunnel)
         var = self.variant(tun)
         if var not in self._engines:
             eng = SionnaEngine(tun, fc=self.config.fc)
@@ -185,6 +201,7 @@ class RayTracedChannel:
         from ..propagation import select_array
 
         k = integer("k", k, minimum=0, maximum=len(self.trajectory) - 1)
+        self._tunnel(tunnel)
         ue, vel = self.trajectory.position[k], self.trajectory.velocity[k]
         arr = select_array(self.arrays, ue)
         eng = self.engine(tunnel)
@@ -199,6 +216,7 @@ class RayTracedChannel:
         the seconds the trace took."""
         from .components import tensor_components
 
+        amplitude = positive("amplitude", amplitude)
         arr, ep, seconds = self.trace(k, tunnel)
         c = self.config
         parts = tensor_components(
@@ -217,7 +235,7 @@ class RayTracedChannel:
         (M, Nf, Nt) without the LoS, ``los_tau`` / ``los_gain`` / ``los_doppler`` / ``los_valid``
         (M,), ``power`` {kind: mean power per element}, ``count`` {kind: paths per element},
         ``trace_s`` / ``synth_s`` [s]."""
-        tun = self.tunnel if tunnel is None else tunnel
+        tun = self._tunnel(tunnel)
         k = integer("k", k, minimum=0, maximum=len(self.trajectory) - 1)
         memo = (self.variant(tun), k)
         if memo in self._memo:
@@ -271,6 +289,7 @@ class RayTracedChannel:
     def tensor(self, k: int, *, tunnel=None, los: bool = True) -> tuple[str, np.ndarray]:
         """``(array name, H)``: the noiseless tensor (M, Nf, Nt) of epoch ``k``, unit transmit
         power, no clock bias; ``los=False`` leaves the LoS path out (a blocked LoS)."""
+        los = boolean("los", los)
         e = self.epoch(k, tunnel)
         H = e["H"].astype(complex)
         if los:
@@ -295,8 +314,12 @@ class RayTracedChannel:
         ``{"traced": n newly traced, "trace_s": [...] per epoch, "bytes": cache size}``."""
         from tqdm.auto import tqdm
 
-        tun = self.tunnel if tunnel is None else tunnel
-        ks = range(len(self.trajectory)) if epochs is None else epochs
+        tun = self._tunnel(tunnel)
+        progress = boolean("progress", progress)
+        n = len(self.trajectory)
+        ks = range(n) if epochs is None else sequence("epochs", epochs)
+        for k in ks:
+            integer("epochs", k, minimum=0, maximum=n - 1)
         d = self.directory(tun)
         traced, times = 0, []
         for k in tqdm(

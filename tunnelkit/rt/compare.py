@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from .._validate import instance, positive, sequence, vector
+from .._validate import choice, instance, integer, positive, sequence, vector
 from ..arrays import ArrayGeometry
 from ..constants import C
 from ..propagation import Path, Tunnel3D
@@ -121,14 +121,19 @@ def time_engines(
     The Sionna engine is built (scene export + load) and warmed up (JIT compilation) before the
     timed runs, so the times are per epoch in steady state. ``options`` go to the Sionna engine.
     """
-    from . import compute_paths
+    from . import ENGINES, compute_paths
 
+    instance("tunnel", tunnel, Tunnel3D)
+    instance("array", array, ArrayGeometry)
+    repeat = integer("repeat", repeat, minimum=1, maximum=1000)
+    for e in sequence("engines", engines):
+        choice("engines", e, ENGINES)
     out = {}
     for eng in engines:
         opts = options if eng == "sionna" else {}
         compute_paths(tunnel, array, ue, ue_velocity, fc=fc, engine=eng, **opts)  # warm-up
         times = []
-        for _ in range(max(1, int(repeat))):
+        for _ in range(repeat):
             t0 = time.perf_counter()
             paths = compute_paths(tunnel, array, ue, ue_velocity, fc=fc, engine=eng, **opts)
             times.append(time.perf_counter() - t0)

@@ -28,7 +28,7 @@ import hashlib
 import json
 from dataclasses import asdict, dataclass
 
-from .._validate import choice, integer, nonnegative
+from .._validate import choice, instance, integer, nonnegative, text
 
 __all__ = [
     "ANTENNA_PATTERNS",
@@ -110,6 +110,7 @@ class RTSettings:
     def material_for(self, kind: str) -> tuple[str, str, float, float]:
         """``(tunnelkit material, ITU type, thickness [m], scattering coefficient)`` of a surface
         of ``kind`` ("wall", "ceiling", "road", "rrm", "blocker"; anything else is shell)."""
+        kind = text("kind", kind)
         if kind == "road":
             name = self.road_material
         elif kind in ("rrm", "blocker"):
@@ -127,6 +128,9 @@ class RTSettings:
     @classmethod
     def from_scenario(cls, scenario, **overrides) -> RTSettings:
         """The scenario's ``[raytracing]`` section (absent: every default), ``overrides`` on top."""
+        from ..scenarios import Scenario
+
+        instance("scenario", scenario, Scenario)
         kw = dict(scenario.sections.get("raytracing") or {})
         kw.update(overrides)
         unknown = sorted(set(kw) - set(cls.__dataclass_fields__))

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, integer, positive, record
+from ..._validate import finite_array, integer, positive, record, sequence
 from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
@@ -412,7 +412,7 @@ def fit_ml(
     H = check_tensor(H)
     pos = check_array(array, m=H.shape[0])
     srs = check_srs(srs)
-    L = np.atleast_2d(np.asarray(start[0])).shape[0]
+    L = np.atleast_2d(np.asarray(sequence("start", start)[0])).shape[0]
     start = check_start(start, L)
     return fit_problem(
         Problem(H, pos, srs.fc),

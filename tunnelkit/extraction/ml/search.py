@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import zherk
 
-from ..._validate import finite_array, integer
+from ..._validate import finite_array, integer, sequence
 from ...constants import C
 from ..coherent import fit_sources
 from ..estimates import PathEstimates
@@ -81,6 +81,7 @@ def search_path(R, prob: Problem) -> tuple[np.ndarray, float, float]:
     _check_problem(prob)
     if np.shape(R) != prob.H.shape:
         raise ValueError(f"R: expected shape {prob.H.shape}, got {np.shape(R)}")
+    finite_array("R", R, dtype=complex)
     x, y, z = _power_rank_one(R)
     mf0 = float(np.angle(np.sum(y[1:] * y[:-1].conj())))
     mt0 = float(np.angle(np.sum(z[1:] * z[:-1].conj())))
@@ -105,6 +106,8 @@ def complete_paths(prob: Problem, start, n_paths: int):
     """``start = (theta, mu_f, mu_t)`` with paths found in the residual added until there are
     ``n_paths`` (successive cancellation); returns the completed ``(theta, mu_f, mu_t)``."""
     _check_problem(prob)
+    if len(sequence("start", start)) != 3:
+        raise ValueError(f"start: expected a tuple (theta, mu_f, mu_t), got {len(start)} items")
     theta, mu_f, mu_t = start
     L = integer("n_paths", n_paths, minimum=theta.shape[0])
     H = prob.H
@@ -142,6 +145,8 @@ def check_start(start, n_paths: int):
     (finite, ``|u| < 1``, ``w >= 0``; ``ValueError`` naming ``start``) and projected onto the
     feasible set."""
     L = integer("n_paths", n_paths, minimum=1)
+    if len(sequence("start", start)) != 3:
+        raise ValueError(f"start: expected a tuple (theta, mu_f, mu_t), got {len(start)} items")
     try:
         th, mf, mt = (np.asarray(v, float) for v in start)
     except (TypeError, ValueError) as exc:
