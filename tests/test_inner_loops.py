@@ -77,3 +77,23 @@ def test_the_phase_median_is_numpy_s():
         for _ in range(50):
             v = list(rng.normal(size=n) * 100)
             assert approaches._median(v) == float(np.median(v))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_traced_paths_are_what_the_checked_path_record_accepts(order):
+    """The tracer builds its paths unchecked (several per epoch); each one, rebuilt through the
+    checked constructor, passes every field check and equals the traced one."""
+    import dataclasses
+
+    from tunnelkit import propagation, signal_route
+
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    for k in (0, 10, len(route.trajectory) - 1):
+        ue, vel = route.trajectory.position[k], route.trajectory.velocity[k]
+        arr = propagation.select_array(route.arrays, ue)
+        paths = propagation.trace_paths(route.tunnel, arr, ue, vel, fc=route.config.fc, order=order)
+        assert paths
+        for p in paths:
+            q = propagation.Path(*(getattr(p, f.name) for f in dataclasses.fields(p)))
+            for f in dataclasses.fields(p):
+                assert _same(getattr(p, f.name), getattr(q, f.name)), f.name

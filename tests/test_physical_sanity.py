@@ -79,3 +79,41 @@ def test_smallest_meeting_refuses_nan_targets(kw, match):
     setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
     with pytest.raises(ValueError, match=match):
         tk.design.smallest_meeting(setup, ["4x4"], **kw)
+
+
+def test_a_path_faster_than_light_or_with_a_bent_direction_is_refused():
+    import dataclasses
+
+    from tunnelkit import signal_route
+    from tunnelkit.constants import C
+    from tunnelkit.propagation import Path
+
+    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    p = route.paths(10)[1][0]
+    kw = {f.name: getattr(p, f.name) for f in dataclasses.fields(p)}
+    for name in ("velocity", "range_rate"):
+        with pytest.raises(ValueError, match=rf"^{name}: .* not below the speed of light"):
+            Path(**{**kw, name: 1.01 * C})
+    with pytest.raises(ValueError, match=r"^direction: must be a unit vector"):
+        Path(**{**kw, "direction": 2 * p.direction})
+    with pytest.raises(ValueError, match=r"^length: must be > 0"):
+        Path(**{**kw, "length": -1.0})
+    assert Path(**kw) == p  # the traced path itself passes
+
+
+def test_algorithm1_keeps_no_unphysical_path(epoch):
+    """The bias-aware delay check (min_d < 0) does not read ``valid``: it drops an estimate
+    faster than light or from behind the array itself."""
+    import dataclasses
+
+    from tunnelkit.constants import C
+    from tunnelkit.extraction import algorithm1
+
+    H, L, array, srs = epoch
+    est = extract_paths(H, L, array, srs, refine="joint")
+    kept = algorithm1(est, -30.0)
+    i = int(kept[0])
+    v = est.v.copy()
+    v[i] = 2 * C
+    fast = dataclasses.replace(est, v=v, valid=est.valid & (np.arange(L) != i))
+    np.testing.assert_array_equal(algorithm1(fast, -30.0), kept[1:])

@@ -328,14 +328,11 @@ class SignalRoute:
             raise ValueError(
                 "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
             )
-        if self.channel == "sionna":
-            from .rt.cache import RayTracedChannel
+        from .rt.cache import RayTracedChannel
 
-            if not isinstance(self.raytraced, RayTracedChannel):
-                raise TypeError(
-                    "raytraced: channel='sionna' needs an rt.cache.RayTracedChannel, got "
-                    f"{type(self.raytraced).__name__}"
-                )
+        if self.channel == "sionna" or self.raytraced is not None:  # channel='sionna' needs one
+            instance("raytraced", self.raytraced, RayTracedChannel)
+        if self.channel == "sionna":
             if self.impairments.dmc is not None:
                 raise ValueError(
                     "impairments: dmc (synthetic diffuse multipath) cannot be added to the "
@@ -376,7 +373,9 @@ class SignalRoute:
             raise TypeError(
                 f"scenario: expected a name or a Scenario, got {type(scenario).__name__}"
             )
-        choice("channel", channel, CHANNELS)
+        rt_kw = (rt_settings, cache_dir)
+        if choice("channel", channel, CHANNELS) != "sionna" and rt_kw != (None, None):
+            raise ValueError("rt_settings, cache_dir: only used with channel='sionna'")
         tun = sc.tunnel()
         arrays = propagation.scenario_arrays(sc)
         traj = sc.trajectory(tun)

@@ -6,6 +6,7 @@ wall, ...), each bounce checked inside its finite surface."""
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -135,6 +136,16 @@ def _angles(u: np.ndarray) -> tuple[float, float]:
     return float(np.arctan2(u[1], u[0])), float(np.arctan2(u[2], np.hypot(u[0], u[1])))
 
 
+def _traced_path(*values) -> Path:
+    """A :class:`Path` of the tracer's own values (finite, a unit direction, a speed below c by
+    construction), its fields not checked again: the unchecked twin of ``Path(...)`` for the
+    tracer, which makes several per epoch (the checks at the public boundary only)."""
+    path = object.__new__(Path)
+    for f, v in zip(dataclasses.fields(Path), values, strict=True):
+        object.__setattr__(path, f.name, v)
+    return path
+
+
 def _make_path(
     kind, surface, skind, source, point, ue, src_vel, array, fc, gamma, leg=None
 ) -> Path:
@@ -151,7 +162,7 @@ def _make_path(
     vel = -rr
     az, el = _angles(u)
     g = complex(gamma) * lam / (4 * np.pi * d0) * np.exp(-2j * np.pi * d0 / lam)
-    return Path(
+    return _traced_path(
         kind,
         surface,
         skind,

@@ -151,6 +151,9 @@ class RayTracedChannel:
     @staticmethod
     def variant(tunnel) -> str:
         """The cache subdirectory of ``tunnel``: "rrms" with road markings, else "no-rrms"."""
+        from ..propagation import Tunnel3D
+
+        instance("tunnel", tunnel, Tunnel3D)
         return "rrms" if getattr(tunnel, "plates", ()) else "no-rrms"
 
     def directory(self, tunnel=None) -> FsPath:
