@@ -321,3 +321,28 @@ def test_slider_values_are_checked_against_the_slider_range():
     with pytest.raises(ValueError, match=r"^seed"):
         int_slider("seed", -1, 0, 20, name="seed")
     assert int_slider("seed", 3, 0, 20, name="seed").value == 3
+
+
+def test_record_allow_inf_takes_plus_infinity_only():
+    """``record(allow_inf=...)``: a float field that may be +inf (no bound) still refuses NaN,
+    -inf, a negative value where it must be >= 0 and text, naming the field."""
+    from dataclasses import dataclass
+
+    from tunnelkit._validate import record
+
+    @dataclass
+    class Bound:
+        limit: float = np.inf
+
+        def __post_init__(self):
+            record(self, nonnegative=("limit",), allow_inf=("limit",))
+
+    assert Bound().limit == np.inf and Bound(2.0).limit == 2.0
+    for bad, exc in (
+        (np.nan, ValueError),
+        (-np.inf, ValueError),
+        (-1.0, ValueError),
+        ("x", TypeError),
+    ):
+        with pytest.raises(exc, match=r"^limit: "):
+            Bound(bad)
