@@ -7,7 +7,7 @@ must never start Dr.Jit)."""
 from __future__ import annotations
 
 import tempfile
-from pathlib import Path
+from pathlib import Path as FsPath
 
 import numpy as np
 
@@ -63,12 +63,20 @@ def route_rt():
     ue = route.trajectory.position[10]
     image = rt.compute_paths(tun, arr, ue, route.trajectory.velocity[10], fc=route.config.fc)
     rows = rt.compare_paths(image, paths)
+    import dataclasses
+
+    from tunnelkit import propagation
+
+    path = propagation.Path(
+        **{f.name: getattr(paths[1], f.name) for f in dataclasses.fields(paths[1])}
+    )
+    path.kappa("srnf"), path.wave_origin("srnf"), path.delta("srnf")  # the tracer builds unchecked
     rt.worst_errors(rows)
     rt.plate_occluders(tun, paths[-1], ue, arr.origin)
     rt.lower_into_tunnel(tun, arr)
     settings = rt.RTSettings.from_scenario(sc)
     settings.material_for("wall")
-    d = Path(tempfile.gettempdir()) / "tunnelkit-contract-scene"  # reused by every case
+    d = FsPath(tempfile.gettempdir()) / "tunnelkit-contract-scene"  # reused by every case
     scene = rt.export_tunnel(tun, d)
     rt.read_scene(scene.xml)
     mitsuba.SurfaceInfo("wall-left", "wall", "concrete")

@@ -97,3 +97,20 @@ def test_traced_paths_are_what_the_checked_path_record_accepts(order):
             q = propagation.Path(*(getattr(p, f.name) for f in dataclasses.fields(p)))
             for f in dataclasses.fields(p):
                 assert _same(getattr(p, f.name), getattr(q, f.name)), f.name
+
+
+def test_the_tracer_s_unchecked_surface_tests_equal_the_checked_ones():
+    from tunnelkit import signal_route
+    from tunnelkit.propagation import truck_box
+
+    tun = signal_route.SignalRoute.from_scenario("italiano2026-straight").tunnel
+    tun = tun.with_blockers(truck_box(20.0, 0.0), truck_box(60.0, -2.0))
+    rng = np.random.default_rng(6)
+    a = rng.uniform([-10.0, -5.0, 0.0], [110.0, 5.0, 5.0], (200, 3))
+    b = rng.uniform([-10.0, -5.0, 0.0], [110.0, 5.0, 5.0], (200, 3))
+    assert _same(tun._blocked(a, b), tun.blocked(a, b))
+    for box in tun.blockers:
+        assert _same(box._blocks(a, b), box.blocks(a, b))
+    for f in tun.surfaces:
+        for tol in (1e-9, 0.0, -1e-4):
+            assert _same(f._contains(a, tol), f.contains(a, tol=tol))

@@ -212,7 +212,7 @@ def trace_paths(
     )
     a0 = array.origin
     out: list[Path] = []
-    if "los" in kinds and not tunnel.blocked(ue, a0) and (not front_only or array.in_front(ue)):
+    if "los" in kinds and not tunnel._blocked(ue, a0) and (not front_only or array.in_front(ue)):
         out.append(_make_path("los", "", "los", ue, ue, ue, vel, array, fc, 1.0))
     refl = []
     for s in tunnel.surfaces:
@@ -224,9 +224,9 @@ def trace_paths(
             continue
         vue = pl.mirror(ue)
         point = a0 + da / (da + du) * (vue - a0)  # where reference-antenna -> VUE crosses S
-        if not s.contains(point, tol=1e-9):
+        if not s._contains(point, 1e-9):
             continue
-        if tunnel.blocked(ue, point) or tunnel.blocked(point, a0):
+        if tunnel._blocked(ue, point) or tunnel._blocked(point, a0):
             continue
         if front_only and not array.in_front(point):
             continue
@@ -351,15 +351,15 @@ def _second_order(tunnel, array, ue, vel, fc, kinds, front_only) -> list[Path]:
                 continue
             v2 = p2.mirror(v1)
             q2 = a0 + da / (da + dv) * (v2 - a0)  # the reference antenna -> V2 crosses S2
-            if not s2.contains(q2, tol=1e-9):
+            if not s2._contains(q2, 1e-9):
                 continue
             e2 = float(p1.signed_distance(q2))
             if e2 <= 0:
                 continue
             q1 = q2 + e2 / (e2 + du) * (v1 - q2)  # P2 -> V1 crosses S1
-            if not s1.contains(q1, tol=1e-9) or float(p2.signed_distance(q1)) <= 0:
+            if not s1._contains(q1, 1e-9) or float(p2.signed_distance(q1)) <= 0:
                 continue
-            if tunnel.blocked(ue, q1) or tunnel.blocked(q1, q2) or tunnel.blocked(q2, a0):
+            if tunnel._blocked(ue, q1) or tunnel._blocked(q1, q2) or tunnel._blocked(q2, a0):
                 continue
             if front_only and not array.in_front(q2):
                 continue

@@ -104,8 +104,11 @@ class Facet:
     def contains(self, p, tol: float = 1e-9) -> np.ndarray:
         """True where point(s) ``p`` (..., 3) on the plane fall inside the finite rectangle
         (by ``tol`` in units of the edges; a negative ``tol`` keeps points strictly inside)."""
-        tol = real("tol", tol)
-        rel = _points("p", p) - self.corner
+        return self._contains(_points("p", p), real("tol", tol))
+
+    def _contains(self, p: np.ndarray, tol: float) -> np.ndarray:
+        """:meth:`contains` on checked arguments (the tracer's unchecked twin)."""
+        rel = p - self.corner
         a = rel @ self.edge_u / (self.edge_u @ self.edge_u)
         b = rel @ self.edge_v / (self.edge_v @ self.edge_v)
         return (a >= -tol) & (a <= 1 + tol) & (b >= -tol) & (b <= 1 + tol)
@@ -139,8 +142,11 @@ class Box:
 
     def blocks(self, a, b) -> np.ndarray:
         """True where the segment ``a -> b`` (..., 3) crosses the box (slab test, vectorised)."""
-        a = _points("a", a)
-        d = _points("b", b) - a
+        return self._blocks(_points("a", a), _points("b", b))
+
+    def _blocks(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """:meth:`blocks` on checked arguments (the tracer's unchecked twin)."""
+        d = b - a
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / d
             t1 = (self.lo - a) * inv
@@ -234,10 +240,13 @@ class Tunnel3D:
 
     def blocked(self, a, b) -> np.ndarray:
         """True where segment ``a -> b`` (..., 3) crosses any blocker."""
-        a, b = _points("a", a), _points("b", b)
+        return self._blocked(_points("a", a), _points("b", b))
+
+    def _blocked(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """:meth:`blocked` on checked arguments (the tracer's unchecked twin)."""
         out = np.zeros(np.broadcast_shapes(np.shape(a), np.shape(b))[:-1], dtype=bool)
         for box in self.blockers:
-            out |= box.blocks(a, b)
+            out |= box._blocks(a, b)
         return out
 
 
