@@ -37,15 +37,26 @@ __all__ = [
 MIN_SIGNIFICANCE = 25.0
 
 
+def _finite(name: str, A) -> np.ndarray:
+    """``A`` as an array of finite numbers (real or complex, not converted: these helpers run
+    inside the fits' iterations, so the check is the cheapest that names ``name``)."""
+    A = np.asarray(A)
+    if A.dtype.kind not in "biufc":
+        raise TypeError(f"{name}: expected numbers, got dtype {A.dtype}")
+    if not np.isfinite(A).all():
+        raise ValueError(f"{name}: contains NaN or infinite values")
+    return A
+
+
 def _square(name: str, A) -> np.ndarray:
-    A = finite_array(name, A, dtype=complex) if np.iscomplexobj(A) else finite_array(name, A)
+    A = _finite(name, A)
     if A.ndim != 2 or A.shape[0] != A.shape[1]:
         raise ValueError(f"{name}: expected a square matrix, got shape {A.shape}")
     return A
 
 
 def _masks(g, *masks):
-    finite_array("g", g)
+    _finite("g", g)
     if g.ndim != 1:
         raise ValueError(f"g: expected a vector, got shape {g.shape}")
     for name, m in masks:
@@ -57,7 +68,7 @@ def solve(G, B) -> np.ndarray:
     """``G^{-1} B`` for a square ``G`` (n, n) and ``B`` (n,) or (n, k); the least-squares
     solution when ``G`` is singular."""
     G = _square("G", G)
-    B = finite_array("B", B, dtype=complex) if np.iscomplexobj(B) else finite_array("B", B)
+    B = _finite("B", B)
     if B.ndim not in (1, 2) or B.shape[0] != G.shape[0]:
         raise ValueError(f"B: expected {G.shape[0]} rows, got shape {B.shape}")
     try:
