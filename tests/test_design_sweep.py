@@ -367,3 +367,49 @@ def test_the_bound_over_the_drive_is_the_error_of_the_tracker_run_under_calibrat
     ratio = r.rmse_settled / r.settled_rms(r.drive)
     assert 0.6 < ratio < 1.7, ratio
     assert r.settled_rms(r.drive) > 5 * r.settled_rms(r.pcrlb)  # the bias dominates
+
+
+def test_position_error_parts_diffuse_is_the_weighted_fix_of_the_excess_covariance(setup):
+    """Brute force: errors drawn with the excess covariance ``cov - crlb`` (correlated across
+    the paths), the fix weighted by the tracker's blocks, RMS of the position over the draws."""
+    from dataclasses import replace
+
+    from tunnelkit.design.drivebound import position_error_parts
+
+    spec = "4x4"
+    m0 = _diag_model(setup, spec)
+    g = route_geometry(setup, spec)
+    rng = np.random.default_rng(5)
+    T, P = m0.exists.shape
+    scale = np.tile([1e-3, 1e-3, 0.1, 0.01], P)
+    A = rng.standard_normal((T, 4 * P, 4 * P)) * scale[:, None] / np.sqrt(4 * P)
+    E = A @ np.swapaxes(A, 1, 2)
+    mask = np.repeat(m0.exists, 4, axis=1)
+    E = np.where(mask[:, :, None] & mask[:, None, :], E, 0.0)
+    m = replace(m0, cov=m0.crlb + E)
+    blocks = np.moveaxis(
+        m.cov.reshape(T, P, 4, P, 4)[:, np.arange(P), :, np.arange(P), :], 0, 1
+    ).copy()
+    parts = position_error_parts(m, g, blocks)
+    assert np.allclose(parts[:, :2], 0.0) and np.all(parts[m0.exists.any(axis=1), 2] > 0)
+    for k in (3, 20):
+        j = np.flatnonzero(m.exists[k])
+        rows = (4 * j[:, None] + np.arange(4)).ravel()
+        Hk = np.zeros((j.size, 4, 3))
+        for i in range(2):
+            dp = np.zeros(3)
+            dp[i] = 1e-6
+            za = model_truth(_moved(g, k, dp), setup.fc)[0][0, j]
+            zb = model_truth(_moved(g, k, -dp), setup.fc)[0][0, j]
+            Hk[:, :, i] = (za - zb) / 2e-6
+        Hk[:, 3, 2] = 1.0
+        L = np.linalg.cholesky(E[k][np.ix_(rows, rows)] + 1e-30 * np.eye(rows.size))
+        e = (L @ rng.standard_normal((rows.size, 4000))).reshape(j.size, 4, -1)
+        Hs, es = [], []
+        for i, p in enumerate(j):
+            Lw = np.linalg.cholesky(np.linalg.inv(blocks[k, p]))
+            es.append(Lw.T @ e[i])
+            Hs.append(Lw.T @ Hk[i])
+        sol = np.linalg.lstsq(np.vstack(Hs), np.vstack(es), rcond=None)[0]
+        rms = np.sqrt(np.mean(np.sum(sol[:2] ** 2, axis=0)))
+        assert abs(rms - parts[k, 2]) < 0.05 * parts[k, 2]
