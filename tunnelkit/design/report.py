@@ -44,6 +44,7 @@ from .verdict import (
     implied_quantile,
     judge,
     recommend,
+    screen_bound,
     share_quantile,
 )
 
@@ -350,8 +351,7 @@ def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
 
 
 def _error_models(impairments: DesignImpairments, mode: str):
-    """The bound route's error model per array under ``impairments`` (``None``: the ideal
-    default of :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`)."""
+    """The bound route's error model per array under ``impairments`` (``None``: the ideal)."""
     if mode != "bound" or impairments.ideal:
         return None
     return partial(path_error_model, impairments=impairments)
@@ -407,7 +407,8 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
     row.achievable_median_m = float(np.median(ach[k]))
     row.achievable_p90_m = share_quantile(ach[k], share)
     row.met_share = float(np.mean(gated <= target))
-    row.screen_m = implied_quantile(gated, share)  # the pre-screen under the criterion
+    scr = gate(screen_bound(peb, ach), sr.srnf_valid, criterion)[k]  # the pre-screen's bound
+    row.screen_m = implied_quantile(scr, share)
     row.srnf_valid = sr.srnf_valid
     row.status, row.reason = judge(target, row.screen_m, share=share)
     return row
@@ -483,12 +484,11 @@ def design_sweep(
     ``target`` [m] on ``share`` of the settled route; ``criterion`` ``"achievable"`` (default,
     the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a gate);
     ``impairments``: a ``design.DesignImpairments`` or a dict of its fields (``None``: ideal);
-    ``runs`` Monte-Carlo drives per array (0: bounds only) on the ``mode`` route (``"bound"``:
-    measurements drawn from the error model; ``"channel"``: synthesis and extraction), seeded
-    by ``seed``; ``workers`` / ``scheduler`` / ``timeout`` go to the one task set;
-    ``n_epochs`` truncates the route; ``n_boot`` bootstrap resamples. An array that does not
-    fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
-    reason; the sweep goes on.
+    ``runs`` drives per array (0: bounds only) on the ``mode`` route (``"bound"``: drawn from
+    the error model; ``"channel"``: synthesis and extraction), seeded by ``seed``; ``workers``
+    / ``scheduler`` / ``timeout`` go to the one task set; ``n_epochs`` truncates the route;
+    ``n_boot`` bootstrap resamples. An array that does not fit, or whose bound or Monte-Carlo
+    is undefined, is a row with status ``"error"`` and the reason; the sweep goes on.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -554,8 +554,8 @@ def design_sweep(
                 _score(r, results[r.array], criterion, target, share, seed, n_boot)
     if runs == 0:
         warnings.append(
-            "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a necessary "
-            "condition, not an answer"
+            "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a "
+            "necessary condition, not an answer"
         )
     elif runs == 1:
         warnings.append(
