@@ -29,10 +29,11 @@ number of epochs averages down) and beside the same bound for a tracker that lea
 (:mod:`tunnelkit.design.learnedbound`); ``MonteCarloResult.tracker_bound`` is the one of the
 tracker run. :func:`javelin_rmse` is the one-array summary on top of it.
 
-Cost: the per-array work (error model, the bound route's shared part
-:func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
-is one task per array (:meth:`tunnelkit.montecarlo.TrialPool.prepare`, the largest array first)
-and the drives go in a few tasks per worker, each depending on its array's task only: one task
+Cost: what the drives need (error model, the bound route's shared part
+:func:`~tunnelkit.design.fastroute.bound_route` and the tracker) is one task per array
+(:meth:`tunnelkit.montecarlo.TrialPool.prepare`, the largest array first); the bounds reported
+beside them (PEB, the bounds over the drive) a second task per array that the drives do not
+wait for; the drives go in a few tasks per worker, each depending on its array's task only: one task
 set on one cluster (:func:`tunnelkit.montecarlo.trial_pool`, started once, or ``pool`` shared by
 several sweeps), no barrier between models and drives, the array's state fetched worker to
 worker once per worker and only the bounds brought back. A drive on the bound route then costs
