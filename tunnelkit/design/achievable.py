@@ -392,6 +392,9 @@ class AchievableBound:
     diffuse: np.ndarray
     weights: str = "tracker"
 
+    def __post_init__(self) -> None:
+        choice("weights", self.weights, WEIGHTS)
+
 
 #: whose error :func:`achievable_bound` maps to the position: ``"tracker"`` the design's tracker
 #: (each path weighted by the error budget it is told, block by block, a curvature it is not

@@ -169,14 +169,26 @@ def bootstrap_quantile_ci(
 SCREEN_IMPAIRMENT_SCALE = 0.5
 
 
+def _bounds(name: str, v) -> np.ndarray:
+    """A 1-D array of bounds [m]: real, >= 0, ``inf`` allowed, NaN refused."""
+    try:
+        a = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}: expected real numbers, got {type(v).__name__}") from None
+    if a.ndim != 1 or a.size == 0:
+        raise ValueError(f"{name}: expected a non-empty 1-D array, got shape {a.shape}")
+    if np.isnan(a).any() or (a < 0).any():
+        raise ValueError(f"{name}: expected bounds >= 0 (inf allowed), got NaN or a negative")
+    return a
+
+
 def screen_bound(peb, achievable) -> np.ndarray:
     """The per-epoch bound the pre-screen takes (module docstring):
     ``sqrt(peb^2 + s^2 (achievable^2 - peb^2))`` with ``s`` :data:`SCREEN_IMPAIRMENT_SCALE`
     (the PEB where the two are equal; ``inf`` where the achievable bound is)."""
-    p = np.asarray(peb, float)
-    a = np.asarray(achievable, float)
-    if p.shape != a.shape or p.ndim != 1:
-        raise ValueError(f"achievable: expected shape {p.shape} like peb (1-D), got {a.shape}")
+    p, a = _bounds("peb", peb), _bounds("achievable", achievable)
+    if p.shape != a.shape:
+        raise ValueError(f"achievable: expected shape {p.shape} like peb, got {a.shape}")
     with np.errstate(invalid="ignore"):
         extra = np.clip(a**2 - p**2, 0.0, None)
         out = np.sqrt(p**2 + SCREEN_IMPAIRMENT_SCALE**2 * extra)
