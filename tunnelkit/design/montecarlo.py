@@ -29,11 +29,10 @@ number of epochs averages down) and beside the same bound for a tracker that lea
 (:mod:`tunnelkit.design.learnedbound`); ``MonteCarloResult.tracker_bound`` is the one of the
 tracker run. :func:`javelin_rmse` is the one-array summary on top of it.
 
-Cost: what the drives need (error model, the bound route's shared part
-:func:`~tunnelkit.design.fastroute.bound_route` and the tracker) is one task per array
-(:meth:`tunnelkit.montecarlo.TrialPool.prepare`, the largest array first); the bounds reported
-beside them (PEB, the bounds over the drive) a second task per array that the drives do not
-wait for; the drives go in a few tasks per worker, each depending on its array's task only: one task
+Cost: the per-array work (error model, the bound route's shared part
+:func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
+is one task per array (:meth:`tunnelkit.montecarlo.TrialPool.prepare`, the largest array first)
+and the drives go in a few tasks per worker, each depending on its array's task only: one task
 set on one cluster (:func:`tunnelkit.montecarlo.trial_pool`, started once, or ``pool`` shared by
 several sweeps), no barrier between models and drives, the array's state fetched worker to
 worker once per worker and only the bounds brought back. A drive on the bound route then costs
@@ -248,24 +247,26 @@ def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
 @dataclass(frozen=True)
 class _Prepared:
     """What the drives of one array share (:class:`_ArrayJob`): the bound route's shared part
-    (``route``, bound mode), the tracker (``design``) and, on the channel route with a model,
-    the ``model`` its bounds take (:class:`_ArrayBounds`; on the bound route ``route.model``)."""
+    (``route``, bound mode), the tracker (``design``) and the bounds reported beside them."""
 
     spec: ArraySpec
     route: object  # fastroute.BoundRoute (bound mode) or None
     design: object  # tracking.javelin.JavelinDesign
-    model: PathErrorModel | None = None
+    peb: np.ndarray
+    pcrlb: np.ndarray | None
+    drive: np.ndarray | None
+    learned: np.ndarray | None = None
 
-    def error_model(self) -> PathErrorModel | None:
-        return self.route.model if self.route is not None else self.model
+    def summary(self) -> tuple:
+        """What the sweep's result keeps (not the model and route the drives need)."""
+        return self.peb, self.pcrlb, self.drive, self.design.config, self.learned
 
 
 @dataclass(frozen=True)
 class _ArrayJob:
-    """What the drives of one array need, built once per array before them (one task per array,
-    on the sweep's cluster when it has one): the error model, the bound route's shared part and
-    the tracker (:class:`_Prepared`). The bounds reported beside the drives are a task of their
-    own (:class:`_ArrayBounds`), so the drives do not wait for them."""
+    """Everything a sweep computes once per array, before its drives (one task per array, on
+    the sweep's cluster when it has one): the error model, the bound route's shared part, the
+    PEB, the bounds over the drive and the tracker (:class:`_Prepared`)."""
 
     setup: DesignSetup
     error_models: object
@@ -277,13 +278,29 @@ class _ArrayJob:
     vues: str = "known"
 
     def __call__(self, spec: ArraySpec) -> _Prepared:
-        m = route = None
+        ep = np.arange(self.T)
+        peb = route_bounds(self.setup, spec, epochs=ep).peb
+        m = route = pc = drive = learned = None
         if self.with_model:
             m = _model(self.setup, spec, self.error_models, self.impairments)
             if self.mode == "bound":
                 from .fastroute import bound_route
 
                 route = bound_route(m, self.setup, spec)
+            g = route_geometry(self.setup, spec, epochs=ep)
+            head = _head(m, self.T)
+            pc = drive_pcrlb(self.setup, position_information(head, g))
+            # the bias of a fix weighted as the tracker weighs (its reported budget, bound mode;
+            # on the channel route the extraction reports its CRLB)
+            w = None
+            if route is not None:
+                from .fastroute import tracker_weights
+
+                w = tracker_weights(route)[: self.T]
+            drive = drive_bound(pc, position_bias_rms(head, g, w))
+            from .learnedbound import learned_pcrlb
+
+            learned = drive_bound(*learned_pcrlb(head, g, self.setup))
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
             crlb = _median_sigmas(m)
@@ -292,39 +309,11 @@ class _ArrayJob:
             crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
         planes = design_planes(self.setup) if self.vues == "known" else None
         design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
-        return _Prepared(spec, route, design, m if route is None else None)
+        return _Prepared(spec, route, design, peb, pc, drive, learned)
 
 
-@dataclass(frozen=True)
-class _ArrayBounds:
-    """The bounds one array's result reports (a task per array, after its :class:`_ArrayJob`,
-    beside its drives): PEB, the posterior CRLB over the drive, the bound over the drive of the
-    tracker run (the bias of a fix weighted as it weighs: its reported budget on the bound
-    route, the extraction's CRLB on the channel route) and of one that learns its VUEs; with
-    the tracker's configuration, what :func:`sweep_montecarlo` keeps."""
-
-    setup: DesignSetup
-    T: int
-
-    def __call__(self, prep: _Prepared) -> tuple:
-        ep = np.arange(self.T)
-        peb = route_bounds(self.setup, prep.spec, epochs=ep).peb
-        pc = drive = learned = None
-        m = prep.error_model()
-        if m is not None:
-            g = route_geometry(self.setup, prep.spec, epochs=ep)
-            head = _head(m, self.T)
-            pc = drive_pcrlb(self.setup, position_information(head, g))
-            w = None
-            if prep.route is not None:
-                from .fastroute import tracker_weights
-
-                w = tracker_weights(prep.route)[: self.T]
-            drive = drive_bound(pc, position_bias_rms(head, g, w))
-            from .learnedbound import learned_pcrlb
-
-            learned = drive_bound(*learned_pcrlb(head, g, self.setup))
-        return peb, pc, drive, prep.design.config, learned
+def _summary(prep: _Prepared) -> tuple:
+    return prep.summary()
 
 
 def sweep_montecarlo(
@@ -422,8 +411,6 @@ def sweep_montecarlo(
         # depending on its array's task only (no barrier; the state goes worker to worker)
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
-        # the bounds: a task per array beside its drives (the drives do not wait for them)
-        bounds = pool.prepare(_ArrayBounds(setup, T), handles, desc="design bounds")
         res = run_trials(
             _SweepTrial(setup, mode, n_epochs, impairments, start),
             A * runs,
@@ -435,7 +422,7 @@ def sweep_montecarlo(
             trial_timeout=trial_timeout,
             pool=pool,
         )
-        built = pool.gather([bounds[order.index(a)] for a in range(A)])
+        built = pool.map(_summary, prepared, desc="design summaries")
     t = traj.t[:T].copy()
     idx = settled(t)
     use = idx if idx.size else np.arange(T)
