@@ -312,6 +312,14 @@ class _ArrayJob:
         return _Prepared(spec, route, design, peb, pc, drive, learned)
 
 
+def _load_tracker() -> None:
+    """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
+    a worker that imports them in a task while another thread unpickles a tracker sent from
+    another worker deadlocks on the package's import locks)."""
+    from .. import studies  # noqa: F401
+    from ..tracking import javelin  # noqa: F401
+
+
 def _summary(prep: _Prepared) -> tuple:
     return prep.summary()
 
@@ -409,6 +417,8 @@ def sweep_montecarlo(
     with nullcontext(pool) if pool is not None else trial_pool(**kw) as pool:
         # one task set: the per-array work (models, bounds, tracker) and every drive, each drive
         # depending on its array's task only (no barrier; the state goes worker to worker)
+        if pool.parallel:
+            pool.client.run(_load_tracker)
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(
