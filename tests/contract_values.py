@@ -305,6 +305,7 @@ def _baselines():
     verdict.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
     verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
     verdict.gate(e, np.ones(50, bool), "achievable")
+    verdict.screen_bound(e, 2 * e)
     report.over_target(np.arange(5.0), np.array([0.1, 0.3, 0.25, 0.1, 0.4]), 0.2)
     drive_bound(np.full(5, 0.1), np.full(5, 0.02))
     javelin_config({"d": 0.05, "direction": 0.01, "kappa": 2.0})

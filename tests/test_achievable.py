@@ -515,5 +515,8 @@ def test_undefined_per_path_bound_is_a_clear_error_and_the_position_bound_says_i
     setup = design.DesignSetup.from_scenario(SCEN)
     with pytest.raises(ValueError, match=r"spec: .*2x2"):
         path_error_model(setup, "2x2", epochs=EPOCHS)
-    b = achievable_bound(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS)
+    b = achievable_bound(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS, weights="ideal")
     assert np.all((b.achievable >= b.peb) | ~np.isfinite(b.peb))
+    # the tracker's weighting needs the per-path model: no tracker bound, inf everywhere
+    t = achievable_bound(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS)
+    assert np.all(np.isinf(t.achievable)) and t.weights == "tracker"

@@ -33,6 +33,7 @@ KEYS = {
     "drive_bound_known_rms_m",
     "drive_bound_learned_rms_m",
     "rmse_over_tracker_bound",
+    "rmse_over_achievable",
     "per_epoch",
 }
 INPUTS = {"scenario", "arrays", "fc", "bandwidth", "target", "share", "criterion", "impairments"}
@@ -85,7 +86,7 @@ def test_wideband_model_drops_the_wideband_bias_and_is_an_input(capsys):
     assert out["--wideband"]["inputs"]["impairments"]["wideband_model"] is False
     ach = {k: v["arrays"][0]["achievable_p90_m"] for k, v in out.items()}
     peb = out[""]["arrays"][0]["peb_p90_m"]
-    assert ach["--wideband"] > 2 * peb  # the plain fit's wideband bias
+    assert ach["--wideband"] > 1.2 * peb  # the plain fit's wideband bias, as the tracker weighs
     assert ach["--wideband --wideband-model"] == ach[""] == peb
 
 

@@ -347,3 +347,14 @@ def test_implied_quantile_matches_sampled_circular_gaussians():
 def test_share_quantile_agrees_with_the_met_share():
     x = np.r_[np.full(90, 0.05), np.full(10, 0.5)]
     assert v.share_quantile(x, 0.9) == 0.05 and np.mean(x <= 0.05) == 0.9
+
+
+def test_screen_bound_halves_the_impairments_part_only():
+    peb = np.array([0.01, 0.02, 0.03, 0.04])
+    ach = np.array([0.01, 0.1, np.inf, 0.05])
+    got = v.screen_bound(peb, ach)
+    assert got[0] == 0.01 and np.isinf(got[2])
+    np.testing.assert_allclose(got[1], np.sqrt(0.02**2 + 0.25 * (0.1**2 - 0.02**2)))
+    assert np.all(peb <= got) and np.all(got[[0, 1, 3]] <= ach[[0, 1, 3]])
+    with pytest.raises(ValueError, match="achievable"):
+        v.screen_bound(peb, ach[:2])

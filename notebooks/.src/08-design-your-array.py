@@ -142,11 +142,17 @@ print(
 #   \mathbf A = \tfrac{2}{N_0}\Re\,\mathbf D^H\mathbf D,\quad
 #   \mathbf B = \tfrac{2}{N_0^2}\Re\,\mathbf D^H\mathbf C\mathbf D .$$
 #
-# Mapped to the position like the PEB, the **achievable bound** is
-# $\sqrt{\mathrm E\|\mathbf b_p\|^2 + \mathrm{tr}\,\mathrm{MCRB}_p}$, the calibration bias
-# averaged over the calibration draw in closed form (`design.achievable_bound`; its closed forms are
-# tested against finite differences and an exact nonlinear fit in `tests/test_achievable.py`, and
-# against Monte-Carlo of the ML extraction in `benchmarks/bench_achievable.py`). With no
+# Per path this gives the extraction's bias and covariance in the tracker's measurement space
+# (`design.path_error_model`; its closed forms are tested against finite differences and an
+# exact nonlinear fit in `tests/test_achievable.py`, and against Monte-Carlo of the ML extraction
+# in `benchmarks/bench_achievable.py`). The **achievable bound** maps them to the position *as the
+# design's tracker weighs its paths* (each path by the error budget it is told, section 6):
+# $\sqrt{\mathrm{PEB}^2 + \mathrm E\|\mathbf G\mathbf b\|^2 + \mathrm{tr}\,\mathbf G
+# (\mathrm{MCRB} - \mathrm{CRLB})\mathbf G^T}$ with $\mathbf G$ that weighted fix, the calibration
+# bias averaged over the calibration draw in closed form. Weighing by the ideal information
+# instead (`weights="ideal"`, the direct-position estimator that trusts eq. 1) lets a large
+# array's micrometre curvatures carry their centimetres of calibration and wideband bias into the
+# position: a bound several times above what the tracker achieves is not a bound of it. With no
 # impairment it is the PEB. Below, the 8 × 8 array at three calibration qualities (phase error
 # per element, with 0.2 dB of gain error); the spatial wideband term and diffuse power are left to
 # exercise 3, so that what moves here is the calibration alone:

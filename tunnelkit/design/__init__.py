@@ -69,6 +69,7 @@ from .verdict import (
     implied_quantile,
     judge,
     recommend,
+    screen_bound,
     share_quantile,
 )
 
@@ -118,6 +119,7 @@ __all__ = [
     "recommend",
     "route_bounds",
     "route_geometry",
+    "screen_bound",
     "share_quantile",
     "smallest_meeting",
     "sweep_montecarlo",

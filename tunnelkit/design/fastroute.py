@@ -61,6 +61,7 @@ __all__ = [
     "bound_drive",
     "bound_route",
     "model_truth",
+    "tracker_weights",
 ]
 
 #: a curvature is reported only where its reported standard deviation is below this share of the
@@ -155,6 +156,29 @@ def bound_route(
         float(setup.signal_route(spec).min_d),
         repeating,
     )
+
+
+def tracker_weights(route) -> np.ndarray:
+    """The per-path covariances (T, P, 4, 4) the tracker is told on the bound route: ``route``
+    a :class:`BoundRoute` (its ``blocks``) or a :class:`PathErrorModel` (its ``"auto"`` report:
+    the CRLB for an ideal model, the error budget otherwise), with the variance of a curvature
+    :func:`bound_drive` does not hand on (reported standard deviation above
+    :data:`KAPPA_RESOLVED` of the range) infinite and its covariances zero: the weights of
+    :func:`tunnelkit.design.drivebound.position_error_parts` for the tracker that is run."""
+    if isinstance(route, PathErrorModel):
+        model, blocks = route, _reported_blocks(route, "auto")[0]
+    elif isinstance(route, BoundRoute):
+        model, blocks = route.model, route.blocks
+    else:
+        raise TypeError(
+            f"route: expected a design.BoundRoute or PathErrorModel, got {type(route).__name__}"
+        )
+    b = np.array(blocks, float)
+    drop = np.sqrt(b[..., 2, 2]) > KAPPA_RESOLVED * np.abs(model.truth[..., 3])
+    b[..., 2, :] = np.where(drop[..., None], 0.0, b[..., 2, :])
+    b[..., :, 2] = np.where(drop[..., None], 0.0, b[..., :, 2])
+    b[..., 2, 2] = np.where(drop, np.inf, b[..., 2, 2])
+    return b
 
 
 def bound_drive(

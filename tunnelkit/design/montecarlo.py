@@ -290,7 +290,14 @@ class _ArrayJob:
             g = route_geometry(self.setup, spec, epochs=ep)
             head = _head(m, self.T)
             pc = drive_pcrlb(self.setup, position_information(head, g))
-            drive = drive_bound(pc, position_bias_rms(head, g))
+            # the bias of a fix weighted as the tracker weighs (its reported budget, bound mode;
+            # on the channel route the extraction reports its CRLB)
+            w = None
+            if route is not None:
+                from .fastroute import tracker_weights
+
+                w = tracker_weights(route)[: self.T]
+            drive = drive_bound(pc, position_bias_rms(head, g, w))
             from .learnedbound import learned_pcrlb
 
             learned = drive_bound(*learned_pcrlb(head, g, self.setup))
@@ -303,6 +310,14 @@ class _ArrayJob:
         planes = design_planes(self.setup) if self.vues == "known" else None
         design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
         return _Prepared(spec, route, design, peb, pc, drive, learned)
+
+
+def _load_tracker() -> None:
+    """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
+    a worker that imports them in a task while another thread unpickles a tracker sent from
+    another worker deadlocks on the package's import locks)."""
+    from .. import studies  # noqa: F401
+    from ..tracking import javelin  # noqa: F401
 
 
 def _summary(prep: _Prepared) -> tuple:
@@ -402,6 +417,8 @@ def sweep_montecarlo(
     with nullcontext(pool) if pool is not None else trial_pool(**kw) as pool:
         # one task set: the per-array work (models, bounds, tracker) and every drive, each drive
         # depending on its array's task only (no barrier; the state goes worker to worker)
+        if pool.parallel:
+            pool.client.run(_load_tracker)
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(

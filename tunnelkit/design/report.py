@@ -5,10 +5,10 @@ tracker achieves.
 
 1. it is placed on the mount (an array with an element outside the cross-section is refused,
    per array, with the reason: :meth:`DesignSetup.arrays`);
-2. the **ideal PEB** and the **achievable bound** of the estimator under the stated impairments
-   (:func:`tunnelkit.design.achievable.achievable_bound`; with no impairments the two coincide,
-   the misspecified bound of a well-specified model being the CRLB), and SR-NF validity per
-   surface (information under ``criterion="achievable"``, a gate under ``"srnf"``);
+2. the **ideal PEB** and the **achievable bound** of the design's tracker under the stated
+   impairments (:func:`tunnelkit.design.achievable.achievable_bound`: each path's error mapped
+   to the position as the tracker weighs it; with no impairments the two coincide), and SR-NF
+   validity per surface (information under ``criterion="achievable"``, a gate under ``"srnf"``);
 3. the **pre-screen**: a candidate on which even an estimator at the achievable bound would miss
    the target on ``share`` of the counted epochs is hopeless and gets no Monte-Carlo;
 4. the **Monte-Carlo** of the design's tracker on the others, all arrays x runs as one task set
@@ -44,6 +44,7 @@ from .verdict import (
     implied_quantile,
     judge,
     recommend,
+    screen_bound,
     share_quantile,
 )
 
@@ -97,6 +98,7 @@ class DesignRow:
     drive_bound_known_rms_m: float | None = None
     drive_bound_learned_rms_m: float | None = None
     rmse_over_tracker_bound: float | None = None
+    rmse_over_achievable: float | None = None
     screen_m: float | None = field(default=None, repr=False)
     srnf_valid: np.ndarray | None = field(default=None, repr=False)
 
@@ -110,8 +112,9 @@ class DesignRow:
         srnf_valid_share_by_surface, peb_median_m, peb_p90_m, achievable_median_m,
         achievable_p90_m, met_share, error_median_m, error_p90_m, error_p90_ci95_m, rmse_m,
         rmse_ci95_m, runs, tracker_vues, drive_bound_known_rms_m, drive_bound_learned_rms_m,
-        rmse_over_tracker_bound`` and ``per_epoch {x_m, peb_m, achievable_m, error_median_m}``
-        (non-finite values and anything not computed are null)."""
+        rmse_over_tracker_bound, rmse_over_achievable`` (the RMSE over the RMS of
+        ``achievable_m`` on the same epochs) and ``per_epoch {x_m, peb_m, achievable_m,
+        error_median_m}`` (non-finite values and anything not computed are null)."""
         return {
             "array": self.array,
             "n_elements": int(self.n_elements),
@@ -137,6 +140,7 @@ class DesignRow:
             "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
             "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
             "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
+            "rmse_over_achievable": _fin(self.rmse_over_achievable),
             "per_epoch": {
                 "x_m": _fins(self.x_m),
                 "peb_m": _fins(self.peb_m),
@@ -283,12 +287,11 @@ def smallest_meeting(
     """The first array of ``arrays`` (in the order given) whose **bound** meets ``target`` on
     ``share`` of the route, and its met share; ``(None, best share)`` if none.
 
-    A bound-only pre-screen for the explorer, a necessary condition, not an answer (the answer
-    is :func:`design_sweep` with Monte-Carlo runs): with ``criterion="achievable"`` (default) the
-    achievable bound under ``impairments`` (``None``: ideal, the PEB), SR-NF only information;
-    with ``"srnf"`` (an eq. 51 estimator) an epoch where SR-NF fails counts as missed. Arrays
-    that do not fit in the tunnel are skipped; ``epochs`` subsamples the route.
-    """
+    A bound-only pre-screen for the explorer (the answer is :func:`design_sweep` with runs):
+    with ``criterion="achievable"`` (default) the achievable bound under ``impairments``
+    (``None``: the PEB), SR-NF only information; with ``"srnf"`` (an eq. 51 estimator) an epoch
+    where SR-NF fails counts as missed. Arrays that do not fit are skipped; ``epochs``
+    subsamples the route."""
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
     if share == 0:
@@ -348,8 +351,7 @@ def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
 
 
 def _error_models(impairments: DesignImpairments, mode: str):
-    """The bound route's error model per array under ``impairments`` (``None``: the ideal
-    default of :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`)."""
+    """The bound route's error model per array under ``impairments`` (``None``: the ideal)."""
     if mode != "bound" or impairments.ideal:
         return None
     return partial(path_error_model, impairments=impairments)
@@ -387,11 +389,11 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
     except (ValueError, ArithmeticError) as exc:
         row.reason = str(exc)
         return row
-    bad = np.isnan(peb) | np.isnan(ach)
+    bad = np.isnan(peb) | np.isnan(ach) | (np.isinf(ach) & np.isfinite(peb))
     if bad.any():
         row.reason = (
-            f"bound undefined (NaN) at {int(bad.sum())} of {bad.size} epochs: the array cannot "
-            "be evaluated on this route"
+            f"bound undefined (NaN, or a per-path bound the tracker needs) at {int(bad.sum())} "
+            f"of {bad.size} epochs: the array cannot be evaluated on this route"
         )
         return row
     t = setup.trajectory.t[: len(x)]
@@ -405,7 +407,8 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
     row.achievable_median_m = float(np.median(ach[k]))
     row.achievable_p90_m = share_quantile(ach[k], share)
     row.met_share = float(np.mean(gated <= target))
-    row.screen_m = implied_quantile(gated, share)  # the pre-screen under the criterion
+    scr = gate(screen_bound(peb, ach), sr.srnf_valid, criterion)[k]  # the pre-screen's bound
+    row.screen_m = implied_quantile(scr, share)
     row.srnf_valid = sr.srnf_valid
     row.status, row.reason = judge(target, row.screen_m, share=share)
     return row
@@ -433,6 +436,8 @@ def _score(row, res, criterion, target, share, seed, n_boot) -> None:
     idx = rng.integers(0, runs, size=(n_boot, runs))
     boot = np.sqrt(sq.mean(axis=1)[idx].mean(axis=1))
     row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
+    ach = np.sqrt(np.mean(np.asarray(row.achievable_m)[k] ** 2))
+    row.rmse_over_achievable = row.rmse_m / ach if ach > 0 else None
     _drive_bounds(row, res, k)
     row.status, row.reason = judge(
         target,
@@ -479,12 +484,11 @@ def design_sweep(
     ``target`` [m] on ``share`` of the settled route; ``criterion`` ``"achievable"`` (default,
     the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a gate);
     ``impairments``: a ``design.DesignImpairments`` or a dict of its fields (``None``: ideal);
-    ``runs`` Monte-Carlo drives per array (0: bounds only) on the ``mode`` route (``"bound"``:
-    measurements drawn from the error model; ``"channel"``: synthesis and extraction), seeded
-    by ``seed``; ``workers`` / ``scheduler`` / ``timeout`` go to the one task set;
-    ``n_epochs`` truncates the route; ``n_boot`` bootstrap resamples. An array that does not
-    fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
-    reason; the sweep goes on.
+    ``runs`` drives per array (0: bounds only) on the ``mode`` route (``"bound"``: drawn from
+    the error model; ``"channel"``: synthesis and extraction), seeded by ``seed``; ``workers``
+    / ``scheduler`` / ``timeout`` go to the one task set; ``n_epochs`` truncates the route;
+    ``n_boot`` bootstrap resamples. An array that does not fit, or whose bound or Monte-Carlo
+    is undefined, is a row with status ``"error"`` and the reason; the sweep goes on.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -550,8 +554,8 @@ def design_sweep(
                 _score(r, results[r.array], criterion, target, share, seed, n_boot)
     if runs == 0:
         warnings.append(
-            "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a necessary "
-            "condition, not an answer"
+            "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a "
+            "necessary condition, not an answer"
         )
     elif runs == 1:
         warnings.append(
