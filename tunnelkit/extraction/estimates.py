@@ -43,7 +43,11 @@ class PathEstimates:
     log-likelihood ratio against noise on that route (sorted like the rest), ``None`` elsewhere;
     ``fit_ok`` the ML stage's verdict on its own fit (``MLFit.fit_ok``: no structured residual
     left, every path above the noise, every two paths resolved; ``fit.reason`` names a failed
-    test), ``None`` on the routes that do not test themselves.
+    test), ``None`` on the routes that do not test themselves; ``resolution`` each path's
+    smallest distance to another path in standard deviations of their difference (Fisher
+    information at the fit, :func:`~tunnelkit.extraction.ml.separations`): below
+    ``ml.RESOLVE_Z`` (5) the path is in the threshold region of resolution (its errors are not
+    described by the bound, ``fit_ok`` is False), ``None`` on the routes without the ML fit.
     """
 
     alpha: np.ndarray
@@ -66,6 +70,7 @@ class PathEstimates:
     fit: object = field(default=None, repr=False)
     significance: np.ndarray | None = field(default=None, repr=False)
     fit_ok: bool | None = None
+    resolution: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         d = self.d
@@ -89,6 +94,8 @@ class PathEstimates:
             _per_path("significance", self.significance, n, "real")
         if self.fit_ok is not None:
             boolean("fit_ok", self.fit_ok)
+        if self.resolution is not None:
+            _per_path("resolution", self.resolution, n, "real")
 
     def __len__(self) -> int:
         return self.d.shape[0]

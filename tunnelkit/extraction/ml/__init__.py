@@ -141,6 +141,8 @@ Modules, each importing only from the ones above it:
 - :mod:`.search` — the starts: one path from a (residual) tensor, successive cancellation,
   starts from estimates;
 - :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
+- :mod:`.resolution` — the statistical resolution limit: per-path separations in standard
+  deviations, significance, the per-path verdict :func:`resolvable` (the threshold region);
 - :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
   re-seedings: :func:`fit_ml`, :class:`MLFit`;
 - :mod:`.wideband` — :class:`WidebandProblem`, the model with the spatial-wideband term (each
@@ -166,6 +168,7 @@ from .fitting import (
 from .model import Problem, noise_floor, project_feasible
 from .paths import estimates_from_fit, ml_order, ml_paths, physical
 from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
+from .resolution import RESOLVE_Z, resolvable, separations
 from .search import (
     check_start,
     complete_paths,
@@ -178,6 +181,7 @@ from .wideband import WidebandProblem
 __all__ = [
     "FALSE_ALARM",
     "MAX_ITER",
+    "RESOLVE_Z",
     "SEARCHES",
     "MLConvergenceWarning",
     "MLDetectionWarning",
@@ -200,7 +204,9 @@ __all__ = [
     "physical",
     "project_feasible",
     "residual_peak",
+    "resolvable",
     "search_path",
+    "separations",
     "spatial_phase",
     "start_from_estimates",
 ]

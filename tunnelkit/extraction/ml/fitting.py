@@ -10,13 +10,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, integer, positive
+from ..._validate import integer, positive
 from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
 from ..radio import check_array, check_srs
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
+from .resolution import RESOLVE_Z, pair_separation, separations
+from .resolution import significance as _significance
 from .search import check_start, path_from_peak, search_path
 
 __all__ = [
@@ -37,10 +39,6 @@ __all__ = [
 
 STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
-#: resolution test: two paths closer than this many standard deviations of their difference
-#: (:func:`pair_separation`) are in the threshold region of resolution: the likelihood cannot
-#: place them, and the local bound does not describe their errors
-RESOLVE_Z = 5.0
 #: cap on ``max_iter`` (Levenberg-Marquardt iterations per fit) and on ``n_reseed``: an iteration
 #: is one pass over the tensor (~5-10 ms at M = 100, Nf = 410, Nt = 12); a fit that has not
 #: converged in 1,000 is not converging, and more would take hours over a drive
@@ -71,7 +69,9 @@ class MLFit:
     path more); ``detected`` (L,) each path's GLRT against that threshold (``significance >=
     peak_max``: the path would have been added from the noise with probability below
     ``FALSE_ALARM``); ``separation`` the smallest distance of two paths in standard deviations
-    of their difference (:func:`pair_separation`); ``fit_ok`` the fit passed every test: the
+    of their difference (:func:`pair_separation`), ``resolution`` (L,) each path's smallest
+    distance to another (:func:`~.resolution.separations`; below ``RESOLVE_Z`` the path is in
+    the threshold region of resolution); ``fit_ok`` the fit passed every test: the
     residual peak and ``rho`` below their thresholds, all ``L`` paths above the noise and every
     two paths resolved (``separation >= RESOLVE_Z``); ``reason`` the tests it failed
     (``"residual peak"``: a path missed or a wrong basin; ``"residual energy"``; ``"path below
@@ -97,6 +97,7 @@ class MLFit:
     detected: np.ndarray | None = field(default=None, repr=False)
     separation: float = np.inf
     reason: str = ""
+    resolution: np.ndarray | None = field(default=None, repr=False)
 
 
 def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):
@@ -347,39 +348,6 @@ def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, histor
     return best, n_it, kept
 
 
-def pair_separation(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> float:
-    """The smallest distance between two paths in standard deviations of their difference: for
-    each pair ``(i, j)`` the Mahalanobis length of ``Delta = (u_x, u_y, w, mu_f, mu_t)_i - (...)_j``
-    under the covariance of that difference, ``Sigma_ii + Sigma_jj - Sigma_ij - Sigma_ji``,
-    ``Sigma = (sigma^2 / 2) (Re J^H J)^+`` (the inverse Fisher information of the concentrated
-    model at the fit). ``inf`` for one path. A pair a few standard deviations apart is below the
-    statistical resolution limit: the likelihood has no single peak for it to sit on."""
-    if not isinstance(prob, Problem):
-        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
-    sigma2 = positive("noise_power", noise_power)
-    theta = finite_array("theta", theta, shape=(None, 3))
-    L = theta.shape[0]
-    mu_f = finite_array("mu_f", mu_f, shape=(L,))
-    mu_t = finite_array("mu_t", mu_t, shape=(L,))
-    if L < 2:
-        return float("inf")
-    ev = prob.evaluate(theta, mu_f, mu_t)
-    cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
-    C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)  # (L, L, 5, 5) blocks
-    x = np.column_stack([theta, mu_f, mu_t])
-    i, j = np.triu_indices(L, 1)
-    S = C5[i, i] + C5[j, j] - C5[i, j] - C5[j, i]  # (P, 5, 5)
-    D = x[i] - x[j]
-    q = np.einsum("pa,pa->p", D, np.linalg.solve(S + 1e-300 * np.eye(5), D[..., None])[..., 0])
-    return float(np.sqrt(max(float(np.min(q)), 0.0)))
-
-
-def _significance(ev, sigma2) -> np.ndarray:
-    """Per path: the cost increase if it were removed (gains re-projected), over ``sigma2``."""
-    Gi = np.linalg.pinv(ev["G"])
-    return np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(Gi)), 1e-300) / sigma2
-
-
 def fit_ml(
     H,
     start,
@@ -517,7 +485,8 @@ def fit_problem(
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
     significance = _significance(ev, sigma2)
-    separation = pair_separation(prob, theta, mu_f, mu_t, sigma2)
+    resolution = separations(prob, theta, mu_f, mu_t, sigma2)
+    separation = float(np.min(resolution)) if resolution.size else float("inf")
     failed = {
         "residual peak": peak[0] > peak_max,
         "residual energy": rho > rho_max,
@@ -561,4 +530,5 @@ def fit_problem(
         significance >= peak_max,
         float(separation),
         reason,
+        resolution,
     )
