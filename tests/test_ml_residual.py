@@ -462,3 +462,32 @@ def test_separations_per_path_against_a_finite_difference_fisher_information_and
         ml.resolvable(prob, th, mf, mt, sigma2, detect=0.0)
     with pytest.raises(TypeError, match="prob"):
         ml.separations(H, th, mf, mt, sigma2)
+
+
+def test_split_weak_recovers_a_merged_pair_from_a_path_below_the_noise():
+    """Two sources 0.03 apart in direction cosine (a seventh of a beamwidth) fitted as one
+    strong path plus a path on nothing (below the noise): the split move drops the weak path, splits the strong one and
+    finds both sources (cost down by more than the detection threshold); a fit with every path
+    above the noise is left alone."""
+    sc = _scene(47, n_paths=2, snr_db=(20.0, 25.0))
+    src = sc.sources.copy()
+    r0 = np.linalg.norm(src[0])
+    u = src[0, :2] / r0 + [0.03, 0.0]
+    src[1] = r0 * np.append(u, np.sqrt(1 - u @ u))
+    pair = replace(sc, sources=src, d=np.array([sc.d[0], sc.d[0] + 0.05]), v=sc.v[[0, 0]])
+    H = pair.tensor(np.random.default_rng(5))
+    prob = ml.Problem(H, pair.element_positions, pair.config.fc)
+    th, mf, mt = _truth(pair)
+    sigma2 = prob.noise_floor(2)
+    # the pair merged into one path at its centre, the other path far from both
+    th0 = np.vstack([np.append(th[:, :2].mean(0), th[0, 2]), [-0.5, -0.5, 0.1]])
+    start = (th0, np.array([mf.mean(), -2.0]), np.array([mt.mean(), -0.5]))
+    best = ml.fitting._lm(prob, *start, sigma2, 60)
+    assert ml.resolution.significance(best[3], sigma2).min() < ml.fitting.MIN_SIGNIFICANCE
+    gain = 30.0 * sigma2
+    out, n_it, kept = ml.fitting._split_weak(prob, best, sigma2, 60, gain)
+    assert kept and n_it > 0 and out[3]["cost"] < best[3]["cost"] - gain
+    err = np.abs(np.sort(out[0][:, 0]) - np.sort(th[:, 0]))
+    assert err.max() < 0.003
+    again, n2, kept2 = ml.fitting._split_weak(prob, out, sigma2, 60, gain)
+    assert not kept2 and n2 == 0 and again is out

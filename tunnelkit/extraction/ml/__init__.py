@@ -110,7 +110,11 @@ to convergence and kept if the likelihood rises (SAGE / RIMAX re-initialisation;
 ``SCREEN_ITER`` iterations: one not converged by then whose residual fails the test (a fit
 crawling in a wrong basin, typically clustered long-range paths merging) is re-initialised at
 once, its own continuation one of the ranked starts; one that passes goes on to ``max_iter``
-exactly as without the screen (the iteration is resumable). ``MLFit.fit_ok`` (and
+exactly as without the screen (the iteration is resumable). When a path is still below the noise after that (the fit counts one path too few elsewhere:
+at long range two images merged into one strong path), the weak path is dropped and each other
+path in turn split in two (``WEAK_SPLITS``: an eighth of a beamwidth and 2.5 times that, along
+each axis), the starts ranked after ``RANK_ITER`` iterations, the best fitted and kept if the
+cost falls by more than the detection threshold of one path. ``MLFit.fit_ok`` (and
 ``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their
 thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
 further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical

@@ -214,6 +214,8 @@ def _peak_of(prob: Problem, res, sigma2):
 #: Levenberg-Marquardt iterations each start of a re-initialisation gets before the starts are
 #: ranked by their likelihood (the best one is then fitted to convergence)
 RANK_ITER = 8
+#: after the re-initialisation, a path below the noise starts the split move (:func:`_split_weak`)
+SPLIT_WEAK = True
 #: iterations of the first fit before the residual test screens it: a fit not converged by then
 #: whose residual fails the test is re-initialised at once (the first fit goes on as one of the
 #: ranked starts); one that passes goes on to ``max_iter`` exactly as without the screen
@@ -274,6 +276,47 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
         best, kept = cand, kept + (not went_on)
         peak = _peak_of(prob, best, sigma2)
     return best, peak, n_it, kept
+
+
+#: split steps of :func:`_split_weak`: ``SPLIT_STEPS`` and the same 2.5 times longer (long-range
+#: images lie 1-5 deg, 0.02-0.09 in direction cosine, from the path they merge with)
+WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS))
+
+
+def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
+    """A path below the noise (``MIN_SIGNIFICANCE``) after the search: the fit counts one path
+    too few elsewhere, typically two sources merged into one strong path. The weak path is
+    dropped and each other path in turn split in two (halves ``u -+ WEAK_SPLITS``, same delay
+    and Doppler); each start gets ``RANK_ITER`` iterations, the most likely is fitted to
+    convergence and kept if the cost falls by more than ``gain_min`` (the detection threshold
+    of one path, in cost units: the split must explain a path's worth of structure, not fit
+    noise). Returns the fit, the iterations spent and whether it was kept."""
+    theta, mu_f, mu_t, ev = best[:4]
+    L = theta.shape[0]
+    sig = _significance(ev, sigma2)
+    if L < 2 or sig.min() >= MIN_SIGNIFICANCE:
+        return best, 0, False
+    weak = int(np.argmin(sig))
+    starts = []
+    for l_ in np.argsort(-np.abs(ev["c"])):
+        if l_ == weak:
+            continue
+        for du in WEAK_SPLITS:
+            th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
+            th2[weak], mf2[weak], mt2[weak] = theta[l_], mu_f[l_], mu_t[l_]
+            th2[l_, :2] += du
+            th2[weak, :2] -= du
+            starts.append((project_feasible(th2), mf2, mt2))
+    short = min(RANK_ITER, max_iter)
+    cands = [_lm(prob, *st, sigma2, short) for st in starts]
+    n_it = sum(c[4] for c in cands)
+    cand = min(cands, key=lambda c: c[3]["cost"])
+    if not cand[5]:
+        cand = _lm(prob, *cand[:3], sigma2, max_iter)
+        n_it += cand[4]
+    if cand[3]["cost"] < ev["cost"] - gain_min:
+        return cand, n_it, True
+    return best, n_it, False
 
 
 def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
@@ -465,6 +508,11 @@ def fit_problem(
         )
         n_it, kept = n_it + its, kept + n_kept
         history.append(best[3]["cost"] / (dof * sigma2))
+    if n_reseed and search == "residual" and SPLIT_WEAK:
+        best, its, split = _split_weak(prob, best, sigma2, max_iter, peak_max * sigma2)
+        n_it, kept = n_it + its, kept + split
+        if split:
+            peak = _peak_of(prob, best, sigma2)
     if best[3]["cost"] / (dof * sigma2) > rho_max:
         best, its, n_kept = _rho_reseed(
             prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof
