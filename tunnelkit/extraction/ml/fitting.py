@@ -99,6 +99,19 @@ class MLFit:
     reason: str = ""
     resolution: np.ndarray | None = field(default=None, repr=False)
 
+    def __post_init__(self) -> None:
+        if self.resolution is not None:  # (L,) separations >= 0, inf for a path alone
+            r = self.resolution
+            if isinstance(r, str | bytes) or not isinstance(r, np.ndarray | list | tuple):
+                raise TypeError(f"resolution: expected an array (L,), got {type(r).__name__}")
+            r = np.asarray(r)
+            th = np.shape(self.theta) if isinstance(self.theta, np.ndarray) else ()
+            L = th[0] if len(th) == 2 else r.shape[0] if r.ndim == 1 else -1
+            if r.dtype.kind not in "iuf" or r.shape != (L,):
+                raise ValueError(f"resolution: expected (L,) real values, got {r.dtype} {r.shape}")
+            if np.any(np.isnan(r)) or np.any(r < 0):
+                raise ValueError("resolution: expected separations >= 0 (inf for a path alone)")
+
 
 def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):
     """Levenberg-Marquardt on the concentrated cost; returns the best point and its evaluation.
