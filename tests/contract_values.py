@@ -147,6 +147,16 @@ def _signal_route():
     from tunnelkit.extraction.ml.residual import peak_null
 
     peak_null(arr.local, route.config.fc, (arr.M, 8, 4), rng, n_draws=10)
+    # the resolution limit at a fit (fit_problem calls only separations)
+    from tunnelkit.extraction import ml
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extract_paths(snap.H[:, :8, :4], 2, arr, route.config)
+    prob = ml.Problem(snap.H[:, :8, :4], arr.local, route.config.fc)
+    f = est.fit
+    ml.pair_separation(prob, f.theta, f.mu_f, f.mu_t, f.noise_power)
+    ml.resolvable(prob, f.theta, f.mu_f, f.mu_t, f.noise_power, f.peak_max)
     del ep
 
 

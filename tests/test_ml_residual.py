@@ -415,3 +415,86 @@ def test_ml_order_adds_paths_while_the_residual_holds_one():
         ml.ml_order(noise, pos, srs, max_paths=0)
     with pytest.raises(TypeError, match="n_paths"):
         ml.ml_order(noise, pos, srs, n_paths=2)
+
+
+def test_separations_per_path_against_a_finite_difference_fisher_information_and_resolvable():
+    """Brute force: each path's smallest Mahalanobis distance to another from the inverse Fisher
+    information of a finite-difference Jacobian (three paths, 15 parameters); ``resolvable``
+    drops a path whose gain is scaled to the noise and a path moved onto another; the
+    estimates carry the fit's per-path ``resolution`` sorted like their delays."""
+    sc = _scene(43, n_paths=3, snr_db=(5.0, 10.0))
+    H = sc.tensor(np.random.default_rng(4))
+    pos, srs = sc.element_positions, sc.config
+    prob = ml.Problem(H, pos, srs.fc)
+    th, mf, mt = _truth(sc)
+    sigma2 = prob.noise_floor(3)
+    z = ml.separations(prob, th, mf, mt, sigma2)
+    x0 = np.column_stack([th, mf, mt]).ravel()
+
+    def resid(x):
+        x = x.reshape(3, 5)
+        ev = prob.evaluate(x[:, :3], x[:, 3], x[:, 4], derivatives=False)
+        return (H - prob.model(x[:, :3], x[:, 3], x[:, 4], ev["c"])).ravel()
+
+    h = 1e-7
+    J = np.stack([(resid(x0 + h * e) - resid(x0 - h * e)) / (2 * h) for e in np.eye(15)], 1)
+    cov = np.linalg.inv(2 * np.real(J.conj().T @ J) / sigma2)
+    want = np.full(3, np.inf)
+    for i in range(3):
+        for j in range(3):
+            if i != j:
+                a, b = slice(5 * i, 5 * i + 5), slice(5 * j, 5 * j + 5)
+                D = x0[a] - x0[b]
+                S = cov[a, a] + cov[b, b] - cov[a, b] - cov[b, a]
+                want[i] = min(want[i], np.sqrt(D @ np.linalg.solve(S, D)))
+    np.testing.assert_allclose(z, want, rtol=1e-3)
+    assert ml.pair_separation(prob, th, mf, mt, sigma2) == pytest.approx(want.min(), rel=1e-3)
+    sig = ml.resolution.significance(prob.evaluate(th, mf, mt), sigma2)
+    assert ml.resolvable(prob, th, mf, mt, sigma2, detect=20.0).all() and sig.min() > 20.0
+    # a detection threshold above the weakest path's log-likelihood ratio: that path only
+    weak = ml.resolvable(prob, th, mf, mt, sigma2, detect=float(np.sort(sig)[1]) - 1e-9)
+    assert list(weak) == list(sig >= np.sort(sig)[1] - 1e-9) and weak.sum() == 2
+    th2, mf2, mt2 = th.copy(), mf.copy(), mt.copy()
+    th2[1, :2] = th[0, :2] + [0.002, 0.0]
+    th2[1, 2], mf2[1], mt2[1] = th[0, 2], mf[0], mt[0]
+    near = ml.resolvable(prob, th2, mf2, mt2, sigma2, detect=1e-9)
+    assert not near[0] and not near[1] and near[2]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = extraction.extract_paths(H, 3, pos, srs)
+    o = np.argsort(-est.fit.mu_f)  # the estimates are sorted by d = -c mu_f / (2 pi Df)
+    np.testing.assert_array_equal(est.resolution, est.fit.resolution[o])
+    assert est.resolution.min() == est.fit.separation
+    with pytest.raises(ValueError, match="detect"):
+        ml.resolvable(prob, th, mf, mt, sigma2, detect=0.0)
+    with pytest.raises(TypeError, match="prob"):
+        ml.separations(H, th, mf, mt, sigma2)
+
+
+def test_split_weak_recovers_a_merged_pair_from_a_path_below_the_noise():
+    """Two sources 0.03 apart in direction cosine (a seventh of a beamwidth) fitted as one
+    strong path plus a path on nothing (below the noise): the split move drops the weak path, splits the strong one and
+    finds both sources (cost down by more than the detection threshold); a fit with every path
+    above the noise is left alone."""
+    sc = _scene(47, n_paths=2, snr_db=(20.0, 25.0))
+    src = sc.sources.copy()
+    r0 = np.linalg.norm(src[0])
+    u = src[0, :2] / r0 + [0.03, 0.0]
+    src[1] = r0 * np.append(u, np.sqrt(1 - u @ u))
+    pair = replace(sc, sources=src, d=np.array([sc.d[0], sc.d[0] + 0.05]), v=sc.v[[0, 0]])
+    H = pair.tensor(np.random.default_rng(5))
+    prob = ml.Problem(H, pair.element_positions, pair.config.fc)
+    th, mf, mt = _truth(pair)
+    sigma2 = prob.noise_floor(2)
+    # the pair merged into one path at its centre, the other path far from both
+    th0 = np.vstack([np.append(th[:, :2].mean(0), th[0, 2]), [-0.5, -0.5, 0.1]])
+    start = (th0, np.array([mf.mean(), -2.0]), np.array([mt.mean(), -0.5]))
+    best = ml.fitting._lm(prob, *start, sigma2, 60)
+    assert ml.resolution.significance(best[3], sigma2).min() < ml.fitting.MIN_SIGNIFICANCE
+    gain = 30.0 * sigma2
+    out, n_it, kept = ml.fitting._split_weak(prob, best, sigma2, 60, gain)
+    assert kept and n_it > 0 and out[3]["cost"] < best[3]["cost"] - gain
+    err = np.abs(np.sort(out[0][:, 0]) - np.sort(th[:, 0]))
+    assert err.max() < 0.003
+    again, n2, kept2 = ml.fitting._split_weak(prob, out, sigma2, 60, gain)
+    assert not kept2 and n2 == 0 and again is out

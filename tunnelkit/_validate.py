@@ -411,8 +411,10 @@ def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims, allow_
         arr = value if isinstance(value, np.ndarray) else np.asarray(value)
         if arr.dtype.kind not in "biufc":
             raise TypeError(f"{name}: expected an array of numbers, got dtype {arr.dtype}")
-        if arr.dtype.kind in "fc" and not allow_nan and not np.isfinite(arr).all():
-            raise ValueError(f"{name}: contains NaN or infinite values")
+        if arr.dtype.kind in "fc" and not allow_nan:
+            bad = np.isnan(arr) | (np.isinf(arr) & ~(allow_inf & (arr.real == np.inf)))
+            if bad.any():
+                raise ValueError(f"{name}: contains NaN or infinite values")
         if spec is not None:
             _bind(name, arr.shape, spec, dims)
         if sign and arr.size and arr.dtype.kind in "iuf":
@@ -475,7 +477,7 @@ def record(
     (lists): ints, ``None`` for any length, or a symbol such as ``"T"`` that must take the same
     value in every field it appears in. ``positive``/``nonnegative`` name fields with that sign;
     ``may_be_empty`` text or lists that may be empty; ``skip`` fields left unchecked;
-    ``allow_inf`` floats that may be ``+inf`` (no bound, never). Errors name the field.
+    ``allow_inf`` floats or float arrays whose entries may be ``+inf`` (no bound, never). Errors name the field.
     """
     import dataclasses
 

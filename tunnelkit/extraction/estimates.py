@@ -16,6 +16,8 @@ _KINDS = {"real": "iuf", "complex": "iufc", "bool": "b"}
 
 #: fields that may hold NaN or inf: a far-field path has no curvature
 _NOT_FINITE_OK = ("kappa", "kappa_nf")
+#: fields that may hold +inf: a path with no other path near it has an infinite separation
+_INF_OK = ("resolution",)
 
 
 def _per_path(name: str, value, n: int, kind: str, *, ndim: int = 1, width: int | None = None):
@@ -31,7 +33,9 @@ def _per_path(name: str, value, n: int, kind: str, *, ndim: int = 1, width: int 
     if arr.ndim != ndim or arr.shape[0] != n or (width is not None and arr.shape[1] != width):
         want = f"({n},)" if ndim == 1 else f"({n}, {width if width is not None else 'M'})"
         raise ValueError(f"{name}: expected shape {want} (one row per path), got {arr.shape}")
-    if name not in _NOT_FINITE_OK and arr.dtype.kind in "fc" and not np.isfinite(arr).all():
+    inf_ok = name in _INF_OK and arr.dtype.kind == "f"
+    bad = ~np.isfinite(arr) & ~(inf_ok & (arr == np.inf)) if arr.dtype.kind in "fc" else None
+    if name not in _NOT_FINITE_OK and bad is not None and bad.any():
         raise ValueError(f"{name}: contains NaN or infinite values")
 
 
@@ -58,7 +62,11 @@ class PathEstimates:
     log-likelihood ratio against noise on that route (sorted like the rest), ``None`` elsewhere;
     ``fit_ok`` the ML stage's verdict on its own fit (``MLFit.fit_ok``: no structured residual
     left, every path above the noise, every two paths resolved; ``fit.reason`` names a failed
-    test), ``None`` on the routes that do not test themselves.
+    test), ``None`` on the routes that do not test themselves; ``resolution`` each path's
+    smallest distance to another path in standard deviations of their difference (Fisher
+    information at the fit, :func:`~tunnelkit.extraction.ml.separations`): below
+    ``ml.RESOLVE_Z`` (5) the path is in the threshold region of resolution (its errors are not
+    described by the bound, ``fit_ok`` is False), ``None`` on the routes without the ML fit.
     """
 
     alpha: np.ndarray
@@ -81,6 +89,7 @@ class PathEstimates:
     fit: object = field(default=None, repr=False)
     significance: np.ndarray | None = field(default=None, repr=False)
     fit_ok: bool | None = None
+    resolution: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         d = self.d
@@ -112,6 +121,8 @@ class PathEstimates:
                 f"{self.v[i]:g} m/s, direction {np.asarray(self.direction)[i].tolist()}): a valid "
                 "path has |v| < c and a unit direction in the front half-space"
             )
+        if self.resolution is not None:
+            _per_path("resolution", self.resolution, n, "real")
 
     def __len__(self) -> int:
         return self.d.shape[0]

@@ -245,6 +245,14 @@ def javelin_table(
         ),
         **parallel,
     )
+    return _report(
+        scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info
+    )
+
+
+def _report(scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info):
+    """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
+    (scores, faults)), ...]`` in drive order (also from a subset of whole runs)."""
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
     faults = dict.fromkeys(extractions, 0)

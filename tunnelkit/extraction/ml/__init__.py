@@ -110,7 +110,11 @@ to convergence and kept if the likelihood rises (SAGE / RIMAX re-initialisation;
 ``SCREEN_ITER`` iterations: one not converged by then whose residual fails the test (a fit
 crawling in a wrong basin, typically clustered long-range paths merging) is re-initialised at
 once, its own continuation one of the ranked starts; one that passes goes on to ``max_iter``
-exactly as without the screen (the iteration is resumable). ``MLFit.fit_ok`` (and
+exactly as without the screen (the iteration is resumable). When a path is still below the noise after that (the fit counts one path too few elsewhere:
+at long range two images merged into one strong path), the weak path is dropped and each other
+path in turn split in two (``WEAK_SPLITS``: an eighth of a beamwidth and 2.5 times that, along
+each axis), the starts ranked after ``RANK_ITER`` iterations, the best fitted and kept if the
+cost falls by more than the detection threshold of one path. ``MLFit.fit_ok`` (and
 ``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their
 thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
 further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical
@@ -141,6 +145,8 @@ Modules, each importing only from the ones above it:
 - :mod:`.search` — the starts: one path from a (residual) tensor, successive cancellation,
   starts from estimates;
 - :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
+- :mod:`.resolution` — the statistical resolution limit: per-path separations in standard
+  deviations, significance, the per-path verdict :func:`resolvable` (the threshold region);
 - :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
   re-seedings: :func:`fit_ml`, :class:`MLFit`;
 - :mod:`.wideband` — :class:`WidebandProblem`, the model with the spatial-wideband term (each
@@ -166,6 +172,7 @@ from .fitting import (
 from .model import Problem, noise_floor, project_feasible
 from .paths import estimates_from_fit, ml_order, ml_paths, physical
 from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
+from .resolution import RESOLVE_Z, resolvable, separations
 from .search import (
     check_start,
     complete_paths,
@@ -178,6 +185,7 @@ from .wideband import WidebandProblem
 __all__ = [
     "FALSE_ALARM",
     "MAX_ITER",
+    "RESOLVE_Z",
     "SEARCHES",
     "MLConvergenceWarning",
     "MLDetectionWarning",
@@ -200,7 +208,9 @@ __all__ = [
     "physical",
     "project_feasible",
     "residual_peak",
+    "resolvable",
     "search_path",
+    "separations",
     "spatial_phase",
     "start_from_estimates",
 ]

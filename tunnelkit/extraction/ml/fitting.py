@@ -17,6 +17,8 @@ from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
 from ..radio import check_array, check_srs
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
+from .resolution import RESOLVE_Z, pair_separation, separations
+from .resolution import significance as _significance
 from .search import check_start, path_from_peak, search_path
 
 __all__ = [
@@ -37,10 +39,6 @@ __all__ = [
 
 STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
-#: resolution test: two paths closer than this many standard deviations of their difference
-#: (:func:`pair_separation`) are in the threshold region of resolution: the likelihood cannot
-#: place them, and the local bound does not describe their errors
-RESOLVE_Z = 5.0
 #: cap on ``max_iter`` (Levenberg-Marquardt iterations per fit) and on ``n_reseed``: an iteration
 #: is one pass over the tensor (~5-10 ms at M = 100, Nf = 410, Nt = 12); a fit that has not
 #: converged in 1,000 is not converging, and more would take hours over a drive
@@ -71,7 +69,9 @@ class MLFit:
     path more); ``detected`` (L,) each path's GLRT against that threshold (``significance >=
     peak_max``: the path would have been added from the noise with probability below
     ``FALSE_ALARM``); ``separation`` the smallest distance of two paths in standard deviations
-    of their difference (:func:`pair_separation`); ``fit_ok`` the fit passed every test: the
+    of their difference (:func:`pair_separation`), ``resolution`` (L,) each path's smallest
+    distance to another (:func:`~.resolution.separations`; below ``RESOLVE_Z`` the path is in
+    the threshold region of resolution); ``fit_ok`` the fit passed every test: the
     residual peak and ``rho`` below their thresholds, all ``L`` paths above the noise and every
     two paths resolved (``separation >= RESOLVE_Z``); ``reason`` the tests it failed
     (``"residual peak"``: a path missed or a wrong basin; ``"residual energy"``; ``"path below
@@ -97,12 +97,13 @@ class MLFit:
     detected: np.ndarray | None = field(default=None, repr=False)
     separation: float = np.inf
     reason: str = ""
+    resolution: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:  # theta inside the feasible set: the front half-space
         L = ("L",)
-        record(self, shapes={"theta": (*L, 3), "mu_f": L, "mu_t": L, "alpha": L, "significance": L, "detected": L},
-               nonnegative=("cost", "noise_power", "rho", "rho_max", "n_iter", "n_reseed", "peak", "peak_max", "separation"),
-               allow_inf=("peak_max", "separation"), may_be_empty=("history", "reason"))  # fmt: skip
+        record(self, shapes={"theta": (*L, 3), "mu_f": L, "mu_t": L, "alpha": L, "significance": L, "detected": L, "resolution": L},
+               nonnegative=("cost", "noise_power", "rho", "rho_max", "n_iter", "n_reseed", "peak", "peak_max", "separation", "resolution"),
+               allow_inf=("peak_max", "separation", "resolution"), may_be_empty=("history", "reason"))  # fmt: skip
         r, w = np.hypot(self.theta[:, 0], self.theta[:, 1]), self.theta[:, 2]
         if np.any(r > 1) or np.any(w < 0) or np.any(w > W_MAX * (1 + 1e-9)):
             raise ValueError("theta: outside the front half-space |u| <= 1, 0 <= w <= W_MAX")
@@ -222,6 +223,8 @@ def _peak_of(prob: Problem, res, sigma2):
 #: Levenberg-Marquardt iterations each start of a re-initialisation gets before the starts are
 #: ranked by their likelihood (the best one is then fitted to convergence)
 RANK_ITER = 8
+#: after the re-initialisation, a path below the noise starts the split move (:func:`_split_weak`)
+SPLIT_WEAK = True
 #: iterations of the first fit before the residual test screens it: a fit not converged by then
 #: whose residual fails the test is re-initialised at once (the first fit goes on as one of the
 #: ranked starts); one that passes goes on to ``max_iter`` exactly as without the screen
@@ -282,6 +285,47 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
         best, kept = cand, kept + (not went_on)
         peak = _peak_of(prob, best, sigma2)
     return best, peak, n_it, kept
+
+
+#: split steps of :func:`_split_weak`: ``SPLIT_STEPS`` and the same 2.5 times longer (long-range
+#: images lie 1-5 deg, 0.02-0.09 in direction cosine, from the path they merge with)
+WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS))
+
+
+def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
+    """A path below the noise (``MIN_SIGNIFICANCE``) after the search: the fit counts one path
+    too few elsewhere, typically two sources merged into one strong path. The weak path is
+    dropped and each other path in turn split in two (halves ``u -+ WEAK_SPLITS``, same delay
+    and Doppler); each start gets ``RANK_ITER`` iterations, the most likely is fitted to
+    convergence and kept if the cost falls by more than ``gain_min`` (the detection threshold
+    of one path, in cost units: the split must explain a path's worth of structure, not fit
+    noise). Returns the fit, the iterations spent and whether it was kept."""
+    theta, mu_f, mu_t, ev = best[:4]
+    L = theta.shape[0]
+    sig = _significance(ev, sigma2)
+    if L < 2 or sig.min() >= MIN_SIGNIFICANCE:
+        return best, 0, False
+    weak = int(np.argmin(sig))
+    starts = []
+    for l_ in np.argsort(-np.abs(ev["c"])):
+        if l_ == weak:
+            continue
+        for du in WEAK_SPLITS:
+            th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
+            th2[weak], mf2[weak], mt2[weak] = theta[l_], mu_f[l_], mu_t[l_]
+            th2[l_, :2] += du
+            th2[weak, :2] -= du
+            starts.append((project_feasible(th2), mf2, mt2))
+    short = min(RANK_ITER, max_iter)
+    cands = [_lm(prob, *st, sigma2, short) for st in starts]
+    n_it = sum(c[4] for c in cands)
+    cand = min(cands, key=lambda c: c[3]["cost"])
+    if not cand[5]:
+        cand = _lm(prob, *cand[:3], sigma2, max_iter)
+        n_it += cand[4]
+    if cand[3]["cost"] < ev["cost"] - gain_min:
+        return cand, n_it, True
+    return best, n_it, False
 
 
 def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
@@ -354,39 +398,6 @@ def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, histor
             best, kept = cand, kept + 1
             tried = set()
     return best, n_it, kept
-
-
-def pair_separation(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> float:
-    """The smallest distance between two paths in standard deviations of their difference: for
-    each pair ``(i, j)`` the Mahalanobis length of ``Delta = (u_x, u_y, w, mu_f, mu_t)_i - (...)_j``
-    under the covariance of that difference, ``Sigma_ii + Sigma_jj - Sigma_ij - Sigma_ji``,
-    ``Sigma = (sigma^2 / 2) (Re J^H J)^+`` (the inverse Fisher information of the concentrated
-    model at the fit). ``inf`` for one path. A pair a few standard deviations apart is below the
-    statistical resolution limit: the likelihood has no single peak for it to sit on."""
-    if not isinstance(prob, Problem):
-        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
-    sigma2 = positive("noise_power", noise_power)
-    theta = finite_array("theta", theta, shape=(None, 3))
-    L = theta.shape[0]
-    mu_f = finite_array("mu_f", mu_f, shape=(L,))
-    mu_t = finite_array("mu_t", mu_t, shape=(L,))
-    if L < 2:
-        return float("inf")
-    ev = prob.evaluate(theta, mu_f, mu_t)
-    cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
-    C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)  # (L, L, 5, 5) blocks
-    x = np.column_stack([theta, mu_f, mu_t])
-    i, j = np.triu_indices(L, 1)
-    S = C5[i, i] + C5[j, j] - C5[i, j] - C5[j, i]  # (P, 5, 5)
-    D = x[i] - x[j]
-    q = np.einsum("pa,pa->p", D, np.linalg.solve(S + 1e-300 * np.eye(5), D[..., None])[..., 0])
-    return float(np.sqrt(max(float(np.min(q)), 0.0)))
-
-
-def _significance(ev, sigma2) -> np.ndarray:
-    """Per path: the cost increase if it were removed (gains re-projected), over ``sigma2``."""
-    Gi = np.linalg.pinv(ev["G"])
-    return np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(Gi)), 1e-300) / sigma2
 
 
 def fit_ml(
@@ -506,6 +517,11 @@ def fit_problem(
         )
         n_it, kept = n_it + its, kept + n_kept
         history.append(best[3]["cost"] / (dof * sigma2))
+    if n_reseed and search == "residual" and SPLIT_WEAK:
+        best, its, split = _split_weak(prob, best, sigma2, max_iter, peak_max * sigma2)
+        n_it, kept = n_it + its, kept + split
+        if split:
+            peak = _peak_of(prob, best, sigma2)
     if best[3]["cost"] / (dof * sigma2) > rho_max:
         best, its, n_kept = _rho_reseed(
             prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof
@@ -526,7 +542,8 @@ def fit_problem(
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
     significance = _significance(ev, sigma2)
-    separation = pair_separation(prob, theta, mu_f, mu_t, sigma2)
+    resolution = separations(prob, theta, mu_f, mu_t, sigma2)
+    separation = float(np.min(resolution)) if resolution.size else float("inf")
     failed = {
         "residual peak": peak[0] > peak_max,
         "residual energy": rho > rho_max,
@@ -570,4 +587,5 @@ def fit_problem(
         significance >= peak_max,
         float(separation),
         reason,
+        resolution,
     )

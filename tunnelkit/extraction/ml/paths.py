@@ -69,13 +69,15 @@ def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: floa
         fit.n_iter,
         fit.converged,
     )
-    signif = fit.significance[np.argsort(d)]
+    o = np.argsort(d)
+    signif = fit.significance[o]
     return replace(
         est,
         valid=est.valid & (signif >= MIN_SIGNIFICANCE) & physical(est, srs),
         fit=fit,
         significance=signif,
         fit_ok=bool(fit.fit_ok),
+        resolution=None if fit.resolution is None else np.asarray(fit.resolution, float)[o],
     )
 
 
