@@ -137,6 +137,27 @@ def _signal_route():
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
     ml_truth(paths, arr, route.config)
+    from tunnelkit.extraction.misspecified import misspecified_bound, parameter_vector, pseudo_true
+
+    small = snap.H[:, :8, :4]
+    pt = pseudo_true(
+        small,
+        arr.local,
+        route.config.fc,
+        ml_truth(paths, arr, route.config),
+        noise_power=route.config.noise_power,
+    )
+    misspecified_bound(
+        small,
+        arr.local,
+        route.config.fc,
+        pt["theta"],
+        pt["mu_f"],
+        pt["mu_t"],
+        pt["c"],
+        route.config.noise_power,
+    )
+    parameter_vector(pt["theta"], pt["mu_f"], pt["mu_t"], pt["c"])
     from tunnelkit.propagation import second_order_paths
 
     traj = route.trajectory
