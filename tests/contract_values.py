@@ -158,6 +158,18 @@ def _signal_route():
         route.config.noise_power,
     )
     parameter_vector(pt["theta"], pt["mu_f"], pt["mu_t"], pt["c"])
+    from tunnelkit.extraction.misspecified import model_error_test
+
+    n0 = route.config.noise_power
+    model_error_test(
+        pt["residual"],
+        len(paths),
+        float(np.vdot(small, small).real),
+        arr.local,
+        route.config.fc,
+        n0,
+        0.1,
+    )
     from tunnelkit.propagation import second_order_paths
 
     traj = route.trajectory

@@ -176,3 +176,38 @@ def test_bound_bad_input():
         misspecified_bound(H, _pos(), FC, THETA, MU_F, MU_T, GAIN * np.nan, SIGMA2)
     with pytest.raises(ValueError, match="noise_power"):
         misspecified_bound(H, _pos(), FC, THETA, MU_F, MU_T, GAIN, 0.0)
+
+
+def test_model_error_test_allows_the_stated_share():
+    """A residual of noise plus one unmodelled path carrying a share s0 of the received energy:
+    the peak test needs about s0 (the path's energy over the received energy), the test passes
+    at s0 (1 + 5 %) and fails at s0 / 2; pure noise passes at share 0 (false-alarm rate 1 %)."""
+    from tunnelkit.extraction.misspecified import model_error_test
+
+    pos = _pos()
+    rng = np.random.default_rng(3)
+    shape = (16, NF, NT)
+    noise = np.sqrt(SIGMA2 / 2) * (rng.standard_normal(shape) + 1j * rng.standard_normal(shape))
+    h, _ = _tensors(0.0)
+    e_rx = float(np.vdot(h, h).real)
+    y2 = e_rx + noise.size * SIGMA2
+    plain = model_error_test(noise, 2, y2, pos, FC, SIGMA2, 0.0)
+    assert plain["passed"] and plain["needed"] == 0.0
+    prob = Problem(np.ones(shape, complex), pos, FC)
+    # a far-field path on the FFT grid of the test (its periodogram sees all of its energy)
+    extra = prob.model(
+        np.array([[0.0, 0.0, 0.0]]), np.array([np.pi / 6]), np.array([0.0]), np.ones(1)
+    )
+    s0 = 0.02
+    extra *= np.sqrt(s0 * e_rx / np.vdot(extra, extra).real)
+    r = model_error_test(noise + extra, 2, y2, pos, FC, SIGMA2, 0.0)
+    assert not r["passed"]
+    assert abs(r["share_peak"] - s0) < 0.15 * s0
+    assert model_error_test(noise + extra, 2, y2, pos, FC, SIGMA2, 1.05 * r["needed"])["passed"]
+    assert not model_error_test(noise + extra, 2, y2, pos, FC, SIGMA2, 0.5 * s0)["passed"]
+    for kw, name in (({"share": -0.1}, "share"), ({"n_paths": -1}, "n_paths")):
+        args = {"n_paths": 2, "share": 0.0, **kw}
+        with pytest.raises(ValueError, match=name):
+            model_error_test(noise, args["n_paths"], y2, pos, FC, SIGMA2, args["share"])
+    with pytest.raises(ValueError, match="residual"):
+        model_error_test(noise.real, 2, y2, pos, FC, SIGMA2, 0.0)
