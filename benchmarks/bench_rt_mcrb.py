@@ -45,7 +45,7 @@ from tunnelkit.evaluation import match_paths
 from tunnelkit.extraction import ml_truth
 from tunnelkit.extraction.misspecified import misspecified_bound, model_error_test, pseudo_true
 from tunnelkit.extraction.ml import Problem, fit_problem
-from tunnelkit.signal_route import SignalRoute
+from tunnelkit.signal_route import SignalRoute, measurements_from_estimates
 
 
 def needed_share(resid, n_paths, y2, pos, fc, n0) -> dict:
@@ -119,15 +119,14 @@ def study(route: SignalRoute, k: int, draws: int, full_draws: int, rng) -> dict:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             est = route.extract(snap.H, arr, L)
-        idx = match_paths(est.d, est.direction, paths)
+        meas = measurements_from_estimates(est, arr)  # world frame, as the paths
+        idx = match_paths(meas.d, meas.direction, paths)
         err = np.full(L, np.nan)
         z = np.full(L, np.nan)
         for i, j in enumerate(idx):
             if j >= 0:
-                err[j] = est.d[i] - paths[j].length
-                z[j] = (est.d[i] - (paths[j].length + out["bias_d_m"][j])) / max(
-                    out["mcrb_sd_d_m"][j], 1e-300
-                )
+                err[j] = meas.d[i] - paths[j].length
+                z[j] = (err[j] - out["bias_d_m"][j]) / max(out["mcrb_sd_d_m"][j], 1e-300)
         model = np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
         r = snap.H - model
         y2 = float(np.vdot(snap.H, snap.H).real)
