@@ -35,14 +35,18 @@ def choose(drive: dict, margin: float) -> float:
     return margin * max(need)
 
 
-def _beyond(fit: dict, z: float) -> bool:
+def _beyond(fit: dict, z: float) -> bool | None:
+    """Any first-order delay beyond ``z`` MCRB sd of the pseudo-true one; None when a path's
+    ``z`` is unknown (an unmatched estimate)."""
     v = np.abs(np.asarray(fit["z_mcrb"], float))
-    return bool(np.any(~np.isfinite(v)) or np.any(v > z))
+    if not np.all(np.isfinite(v)):
+        return None
+    return bool(np.any(v > z))
 
 
 def report(drive: dict, share: float, z: float) -> dict:
     rows = []
-    tot = {"beyond": 0, "beyond_flagged": 0, "within": 0, "within_flagged": 0}
+    tot = {"beyond": 0, "beyond_flagged": 0, "within": 0, "within_flagged": 0, "unknown": 0}
     for e in drive["epochs"]:
         fits = [("local", d) for d in e["local"]] + [("full", d) for d in e["full"]]
         row = {"k": e["k"], "residual_share": e["residual_share"], "definite": e["definite"]}
@@ -52,6 +56,9 @@ def report(drive: dict, share: float, z: float) -> dict:
             row[kind] = (int(sum(flagged)), len(f))
         for _, d in fits:
             b, fl = _beyond(d, z), _needed(d["test"]) > share
+            if b is None:
+                tot["unknown"] += 1
+                continue
             tot["beyond" if b else "within"] += 1
             tot[("beyond" if b else "within") + "_flagged"] += int(fl)
         rows.append(row)
@@ -83,7 +90,7 @@ def main(argv=None) -> int:
         print(
             f"  fits beyond {a.z:g} MCRB sd of the pseudo-true delays: {t['beyond']}, flagged "
             f"{t['beyond_flagged']}; within: {t['within']}, flagged (false flags) "
-            f"{t['within_flagged']}"
+            f"{t['within_flagged']}; z unknown (unmatched): {t['unknown']}"
         )
     return 0
 
