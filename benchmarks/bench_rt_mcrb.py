@@ -80,6 +80,9 @@ def study(route: SignalRoute, k: int, draws: int, full_draws: int, rng) -> dict:
         "L": L,
         "kinds": [p.kind for p in paths],
         "pseudo_true_s": t_pt,
+        "converged": pt["converged"],
+        "lm_iterations": pt["lm_iterations"],
+        "newton_iterations": pt["newton_iterations"],
         "residual_N0": pt["residual_power"] / n0,
         "residual_share": pt["residual_power"] / p_rx,
         "held": pt["held"].tolist(),
@@ -147,6 +150,8 @@ def study(route: SignalRoute, k: int, draws: int, full_draws: int, rng) -> dict:
 def _summary(s: dict) -> None:
     print(
         f"epoch {s['k']} ({s['array']}, L = {s['L']}): pseudo-true fit {s['pseudo_true_s']:.1f} s, "
+        f"(LM {s.get('lm_iterations')} + Newton {s.get('newton_iterations')} iterations, "
+        f"minimum reached {s.get('converged')}), "
         f"residual {s['residual_N0']:.3g} N0/sample = {s['residual_share']:.3g} of P_rx, "
         f"held w {sum(s['held'])}, separation {s['separation']:.3g} sd, A definite {s['definite']}, "
         f"cond B {s['condition']:.2g}"
