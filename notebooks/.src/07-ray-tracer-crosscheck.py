@@ -490,8 +490,9 @@ print("section 7 checks passed")
 # (`tunnelkit.extraction.misspecified`). Its error is then bias $\theta_0-\theta$ plus a
 # spread the MCRB bounds. Here for one epoch's first-order paths: $\theta_0$ from the
 # extraction's own fit of the noiseless tensor started at the true paths, finished by Newton
-# steps with the exact Hessian (on the traced tensor the Gauss-Newton fit crawls: at this epoch
-# it was still lowering the cost after its 1,000 iterations), on both channels.
+# steps with the exact Hessian (on the traced tensor the Gauss-Newton fit can crawl: at the
+# slalom drive's first epoch, full tensor, it was still lowering the cost after its 1,000
+# iterations), on both channels.
 # Quick mode uses the first 64 tones and 4 symbols of the tensor (a smaller problem).
 
 # %%
