@@ -135,7 +135,8 @@ def main(argv=None) -> int:
                     print(
                         f"  model-error share {a.model_error_share:.4g}: of the flagged epochs "
                         f"{tally['passed']} pass, {tally['flagged']} stay flagged; share needed "
-                        f"median {np.median(nd) if nd.size else float('nan'):.3g}"
+                        f"median {np.median(nd) if nd.size else float('nan'):.3g}, "
+                        f"max {np.max(nd) if nd.size else float('nan'):.3g}"
                     )
                     tally.update(passed=0, flagged=0)
                 for row in rep.rows:
