@@ -138,6 +138,39 @@ def _signal_route():
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
     ml_truth(paths, arr, route.config)
+    from tunnelkit.extraction.misspecified import misspecified_bound, parameter_vector, pseudo_true
+
+    small = snap.H[:, :8, :4]
+    pt = pseudo_true(
+        small,
+        arr.local,
+        route.config.fc,
+        ml_truth(paths, arr, route.config),
+        noise_power=route.config.noise_power,
+    )
+    misspecified_bound(
+        small,
+        arr.local,
+        route.config.fc,
+        pt["theta"],
+        pt["mu_f"],
+        pt["mu_t"],
+        pt["c"],
+        route.config.noise_power,
+    )
+    parameter_vector(pt["theta"], pt["mu_f"], pt["mu_t"], pt["c"])
+    from tunnelkit.extraction.misspecified import model_error_test
+
+    n0 = route.config.noise_power
+    model_error_test(
+        pt["residual"],
+        len(paths),
+        float(np.vdot(small, small).real),
+        arr.local,
+        route.config.fc,
+        n0,
+        0.1,
+    )
     from tunnelkit.propagation import second_order_paths
 
     traj = route.trajectory

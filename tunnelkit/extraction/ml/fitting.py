@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, integer, positive, record, sequence
+from ..._validate import integer, positive, record, sequence
 from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
