@@ -264,6 +264,20 @@ def test_position_bias_rms_is_the_rms_of_the_least_squares_fix_over_calibration_
         drive_bound(pc, got[:-1])
 
 
+def _fd_jacobian(g, k, j, fc):
+    """Central-difference Jacobian of paths ``j``'s measurements at epoch ``k`` in the UE's
+    x and y (step 1 um), and the height column a known offset: (n, 4, 3)."""
+    Hk = np.zeros((j.size, 4, 3))
+    for i in range(2):
+        dp = np.zeros(3)
+        dp[i] = 1e-6
+        za = model_truth(_moved(g, k, dp), fc)[0][0, j]
+        zb = model_truth(_moved(g, k, -dp), fc)[0][0, j]
+        Hk[:, :, i] = (za - zb) / 2e-6
+    Hk[:, 3, 2] = 1.0
+    return Hk
+
+
 def _moved(g, k, dp):
     """Geometry of epoch ``k`` alone with the UE moved by ``dp``: every wave origin moves
     through its mirror (the known surface)."""
@@ -308,14 +322,7 @@ def test_position_bias_rms_with_the_trackers_weights_is_the_weighted_fix_over_dr
     for k in (3, 20):
         j = np.flatnonzero(m.exists[k])
         rows, H = [], []
-        Hk = np.zeros((j.size, 4, 3))
-        for i in range(2):
-            dp = np.zeros(3)
-            dp[i] = 1e-6
-            za = model_truth(_moved(g, k, dp), setup.fc)[0][0, j]
-            zb = model_truth(_moved(g, k, -dp), setup.fc)[0][0, j]
-            Hk[:, :, i] = (za - zb) / 2e-6
-        Hk[:, 3, 2] = 1.0
+        Hk = _fd_jacobian(g, k, j, setup.fc)
         phis = 0.3 * rng.standard_normal((M, 4000))
         e = b[k, j][..., None] + np.einsum("pim,mn->pin", K[k, j], phis)  # (n, 4, draws)
         for i, p in enumerate(j):
@@ -395,14 +402,7 @@ def test_position_error_parts_diffuse_is_the_weighted_fix_of_the_excess_covarian
     for k in (3, 20):
         j = np.flatnonzero(m.exists[k])
         rows = (4 * j[:, None] + np.arange(4)).ravel()
-        Hk = np.zeros((j.size, 4, 3))
-        for i in range(2):
-            dp = np.zeros(3)
-            dp[i] = 1e-6
-            za = model_truth(_moved(g, k, dp), setup.fc)[0][0, j]
-            zb = model_truth(_moved(g, k, -dp), setup.fc)[0][0, j]
-            Hk[:, :, i] = (za - zb) / 2e-6
-        Hk[:, 3, 2] = 1.0
+        Hk = _fd_jacobian(g, k, j, setup.fc)
         L = np.linalg.cholesky(E[k][np.ix_(rows, rows)] + 1e-30 * np.eye(rows.size))
         e = (L @ rng.standard_normal((rows.size, 4000))).reshape(j.size, 4, -1)
         Hs, es = [], []
