@@ -18,7 +18,7 @@ from ..radio import check_array, check_srs
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .resolution import RESOLVE_Z, pair_separation, separations
-from .resolution import significance as _significance
+from .resolution import significance as path_significance
 from .search import check_start, path_from_peak, search_path
 
 __all__ = [
@@ -169,7 +169,7 @@ def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
     twice, or two paths merged, leave a structured residual that this move picks up)."""
     r = prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
     big = _lm_with(prob, theta, mu_f, mu_t, search_path(r, prob), sigma2, max_iter)
-    keep = np.arange(theta.shape[0] + 1) != int(np.argmin(_significance(big[3], sigma2)))
+    keep = np.arange(theta.shape[0] + 1) != int(np.argmin(path_significance(big[3], sigma2)))
     res = _lm(prob, big[0][keep], big[1][keep], big[2][keep], sigma2, max_iter)
     return res, big[4] + res[4]
 
@@ -251,7 +251,7 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
         th_n, mf_n, mt_n = path_from_peak(prob, peak[1], peak[2])
         big = _lm_with(prob, theta, mu_f, mu_t, (th_n, mf_n, mt_n), sigma2, short)
         n_it += big[4]
-        keep = np.arange(L + 1) != int(np.argmin(_significance(big[3], sigma2)))
+        keep = np.arange(L + 1) != int(np.argmin(path_significance(big[3], sigma2)))
         starts = [(big[0][keep], big[1][keep], big[2][keep])]
         near = _nearest_atom(prob, theta, mu_f, mu_t, th_n, mf_n, mt_n)
         out = _weakest(ev, sigma2)
@@ -302,7 +302,7 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
     noise). Returns the fit, the iterations spent and whether it was kept."""
     theta, mu_f, mu_t, ev = best[:4]
     L = theta.shape[0]
-    sig = _significance(ev, sigma2)
+    sig = path_significance(ev, sigma2)
     if L < 2 or sig.min() >= MIN_SIGNIFICANCE:
         return best, 0, False
     weak = int(np.argmin(sig))
@@ -354,7 +354,7 @@ def _weakest(ev, sigma2) -> int:
     i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
     if coh[i, j] > 0.9:
         return int(j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i)
-    return int(np.argmin(_significance(ev, sigma2)))
+    return int(np.argmin(path_significance(ev, sigma2)))
 
 
 def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
@@ -379,7 +379,7 @@ def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, histor
         elif attempt % 2 == 0:  # birth and death: a path from the residual, the weakest out
             cand, its = _birth_death(prob, theta, mu_f, mu_t, ev, sigma2, max_iter)
         else:  # the weakest path re-sought in the residual plus its own contribution
-            sig = _significance(ev, sigma2)
+            sig = path_significance(ev, sigma2)
             order = [int(i) for i in np.argsort(sig) if int(i) not in tried]
             if not order:
                 continue
@@ -541,7 +541,7 @@ def fit_problem(
     if not np.all(np.isfinite(ev["c"])):
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
-    significance = _significance(ev, sigma2)
+    significance = path_significance(ev, sigma2)
     resolution = separations(prob, theta, mu_f, mu_t, sigma2)
     separation = float(np.min(resolution)) if resolution.size else float("inf")
     failed = {
