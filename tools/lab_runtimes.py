@@ -45,14 +45,20 @@ from _lecture import (
     serving,
 )
 
-STAMP = """import json as _json, resource as _resource, time as _time
+# The stamp cell also says whether any earlier cell raised: IPython keeps the last exception it
+# showed in sys.last_value. Run All does not always stop at a failing cell: the kernel aborts only
+# the requests already queued when the error is raised (ipykernel's stop_on_error_timeout is 0 s),
+# and on a loaded machine JupyterLab's requests for the later cells can arrive after that, so the
+# stamp alone cannot tell a notebook that failed from one that ran.
+STAMP = """import json as _json, resource as _resource, sys as _sys, time as _time
 _s, _c = _resource.getrusage(_resource.RUSAGE_SELF), _resource.getrusage(_resource.RUSAGE_CHILDREN)
-open({path!r}, "w").write(_json.dumps({{"t": _time.time(), "cpu": _s.ru_utime + _s.ru_stime + _c.ru_utime + _c.ru_stime}}))
+_e = getattr(_sys, "last_value", None)
+open({path!r}, "w").write(_json.dumps({{"t": _time.time(), "cpu": _s.ru_utime + _s.ru_stime + _c.ru_utime + _c.ru_stime, "error": None if _e is None else f"{{type(_e).__name__}}: {{_e}}"}}))
 """
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-sync"]
 
 
-def _stamped_copy(src: Path, work: Path) -> tuple[Path, Path]:
+def stamped_copy(src: Path, work: Path) -> tuple[Path, Path]:
     """A copy of ``src`` in ``work`` with the time-stamp cell appended; the stamp file's path."""
     import nbformat
 
@@ -94,7 +100,7 @@ def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout
             f"{nb_path.name}: Run All did not reach its last cell within {timeout:.0f} s "
             "(a failing cell stops Run All)"
         )
-    done = json.loads(stamp.read_text())
+    done = read_stamp(stamp, nb_path.name)
     return {
         "notebook": nb_path.stem,
         "wall_s": done["t"] - t0,
@@ -102,6 +108,18 @@ def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout
         "load_before": load0,
         "load_after": os.getloadavg()[0],
     }
+
+
+def read_stamp(stamp: Path, name: str) -> dict:
+    """The stamp cell's record; a ``LectureError`` when a cell before it raised (Run All went on
+    past a failing cell: see ``STAMP``), so a failed notebook is never timed as if it ran."""
+    done = json.loads(stamp.read_text())
+    if done.get("error") is not None:
+        raise LectureError(
+            f"{name}: a cell failed during Run All ({done['error']}); "
+            "the later cells ran because the kernel did not abort them"
+        )
+    return done
 
 
 def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict]:
@@ -121,7 +139,7 @@ def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict
                 own.close()
     tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-"))
     try:
-        copies = [_stamped_copy(b, tmp) for b in books]
+        copies = [stamped_copy(b, tmp) for b in books]
         env = kernel_env(quick=True)
         env["PYTHONPATH"] = str(ROOT)
         rows = []

@@ -2,7 +2,9 @@
 
 Notebook 02 (the shortest) is run through the tool: one row, a positive wall time not shorter
 than a tenth of the kernel's CPU time (the stamp cell ran after every other cell), and a notebook
-whose second cell fails is reported as failed (Run All stops there, the stamp never comes).
+whose second cell fails is reported as failed: either Run All stops there and the stamp never
+comes, or (when the kernel did not abort the later requests in time) the stamp cell records the
+exception. Both must raise; which one happens depends on timing, not on the tool.
 Both run in the session's browser (a second Playwright cannot start beside it in one thread).
 """
 
@@ -36,5 +38,5 @@ def test_a_failing_cell_is_reported(tmp_path, browser):
     }
     path = tmp_path / "failing.ipynb"
     nbformat.write(nb, path)
-    with pytest.raises(LectureError, match="did not reach its last cell"):
+    with pytest.raises(LectureError, match=r"did not reach its last cell|a cell failed"):
         measure_all([path], timeout=20, browser=browser)
