@@ -171,6 +171,12 @@ def _signal_route():
         n0,
         0.1,
     )
+    from tunnelkit.rt.consistency import consistent_paths, geometry_consistency, tunnel_planes
+
+    m = ep.measurements
+    planes = tunnel_planes(route.tunnel)
+    geometry_consistency(m.direction, m.d, m.origin, planes, 1e-3, 1e-3, 0.05)
+    consistent_paths(m, route.tunnel, sigma_phi=1e-3, sigma_psi=1e-3, sigma_d=0.05)
     from tunnelkit.propagation import second_order_paths
 
     traj = route.trajectory
