@@ -32,21 +32,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
-from tunnelkit.extraction import algorithm1, estimate_crlb
-from tunnelkit.geometry import spherical_jacobian
-from tunnelkit.rt.consistency import geometry_consistency, tunnel_planes
+from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
 from tunnelkit.signal_route import SignalRoute
-
-
-def bound_sigmas(est, array, config) -> np.ndarray:
-    """(K, 3) CRLB standard deviations of the kept paths' world azimuth, elevation and range."""
-    keep = algorithm1(est, 0.0)
-    b = estimate_crlb(est, array, config, paths=keep)
-    rot = array.R
-    cov = rot @ b["source_cov"] @ rot.T
-    G = spherical_jacobian(array.dir_to_world(b["source"]))
-    cov = G @ cov @ np.swapaxes(G, 1, 2)
-    return np.stack([np.sqrt(cov[:, 0, 0]), np.sqrt(cov[:, 1, 1]), np.asarray(b["d"])], -1)
 
 
 def truth_errors(ep, sig) -> np.ndarray:
@@ -69,7 +56,6 @@ def truth_errors(ep, sig) -> np.ndarray:
 
 
 def study(route: SignalRoute, draws: int, pfa: float, floors, rng) -> dict:
-    planes = tunnel_planes(route.tunnel)
     acc = {"flag": [], "fit_ok": [], "worst": [], "drop_true": [], "drop_spur": []}
     for k in range(len(route.trajectory)):
         for _ in range(draws):
@@ -83,18 +69,14 @@ def study(route: SignalRoute, draws: int, pfa: float, floors, rng) -> dict:
                 sig = bound_sigmas(ep.estimates, ep.array, route.config)
             except np.linalg.LinAlgError:
                 continue
-            res = geometry_consistency(
-                m.direction, m.d, m.origin, planes, sig[:, 0], sig[:, 1], sig[:, 2], pfa=pfa,
-                inside=route.tunnel.contains,
-            )  # fmt: skip
+            res = epoch_consistency(ep, route, pfa=pfa)
             acc["flag"].append(not res["consistent"])
             acc["fit_ok"].append(bool(getattr(ep.estimates, "fit_ok", True)))
             te = truth_errors(ep, sig)
             acc["worst"].append(te.max() if te.size else np.nan)
-            fl = geometry_consistency(
-                m.direction, m.d, m.origin, planes, 0.0, 0.0, 0.0, pfa=pfa,
-                floor_angle=floors[0], floor_range=floors[1], inside=route.tunnel.contains,
-            )  # fmt: skip
+            fl = epoch_consistency(
+                ep, route, bound=False, pfa=pfa, floor_angle=floors[0], floor_range=floors[1]
+            )
             ti = np.asarray(ep.truth_index)
             acc["drop_true"].extend((~fl["keep"][ti >= 0]).tolist())
             acc["drop_spur"].extend((~fl["keep"][ti < 0]).tolist())

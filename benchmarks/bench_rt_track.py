@@ -12,7 +12,7 @@ flagged epochs pass there) are measured once; the same measurements are then sco
 * ``true LoS first``: the measurement matched to the LoS moved to row 0 (what Algorithm 1's
   earliest-arrival order and the tracker's first fix take for the LoS);
 * ``geometry test``: the paths the per-snapshot geometry-consistency test rejects dropped
-  (:func:`tunnelkit.rt.consistency.consistent_paths`, no oracle);
+  (:func:`tunnelkit.path_consistency.epoch_consistency` with model-error floors, no oracle);
 * ``sigmas x S``: the design's measurement sigmas scaled by ``S`` (``--scale``).
 
 Per epoch of the ``measured`` variant it prints the 2-D error, the number of measurements, how
@@ -25,6 +25,7 @@ the tracker's association (which measurement the UE track took and whether it is
 from __future__ import annotations
 
 import argparse
+import pickle
 import sys
 import time
 import warnings
@@ -38,7 +39,7 @@ sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
 from tunnelkit.montecarlo import run_trials
-from tunnelkit.rt.consistency import consistent_paths
+from tunnelkit.path_consistency import epoch_consistency
 from tunnelkit.studies import drives, evaluate
 from tunnelkit.studies.analysis import extraction_errors
 from tunnelkit.studies.collect import simulate_condition
@@ -71,6 +72,10 @@ def traced_drive(scenario: str, seed: int, runs: int) -> list[tuple]:
                 reason = None
             return pm, reason
 
+        def light(ep):  # the tensor dropped (kept: truth, estimates, measurements, clock bias)
+            snap = replace(ep.snapshot, H=ep.snapshot.H[:, :1, :1].copy())
+            return replace(ep, snapshot=snap)
+
         drives.path_measurements = adapter
         try:
             with warnings.catch_warnings():
@@ -80,7 +85,7 @@ def traced_drive(scenario: str, seed: int, runs: int) -> list[tuple]:
                 )["ml"]
         finally:
             drives.path_measurements = original
-        return d, eps
+        return d, [light(ep) for ep in eps]
 
     res = run_trials(trial, runs, seed, inputs=["L"] * runs)
     out.extend(res)
@@ -112,12 +117,11 @@ def los_row(ep) -> int | None:
 
 def geometry_keep(ep, route, floors) -> np.ndarray:
     """Rows the geometry-consistency test keeps (the bound's sigmas taken as zero: the model-error
-    floors ``floors = (angle [rad], range [m])`` alone, :func:`consistent_paths`)."""
+    floors ``floors = (angle [rad], range [m])`` alone, :func:`epoch_consistency`)."""
     m = ep.measurements
     if len(m) < 2:
         return np.arange(len(m))
-    res = consistent_paths(m, route.tunnel, sigma_phi=0.0, sigma_psi=0.0, sigma_d=0.0,
-                           floor_angle=floors[0], floor_range=floors[1])  # fmt: skip
+    res = epoch_consistency(ep, route, bound=False, floor_angle=floors[0], floor_range=floors[1])
     return np.flatnonzero(res["keep"])
 
 
@@ -137,12 +141,23 @@ def variants(drive, eps, route, floors) -> dict:
         return rows if j is None else np.r_[j, np.delete(rows, j)]
 
     out["true LoS first"] = subset_drive(drive, eps, los_first)
+    out["no curvature"] = no_curvature(drive)
     out["geometry test"] = subset_drive(
         drive,
         eps,
         lambda ep, pm: geometry_keep(ep, route, floors),
     )
     return out
+
+
+def no_curvature(drive):
+    """``drive`` with every path's curvature removed (far-field: the tracker uses its angles and
+    delay only)."""
+    eps = [
+        None if pm is None else replace(pm, kappa=np.full_like(pm.kappa, np.nan))
+        for pm in drive.epochs
+    ]
+    return replace(drive, epochs=eps)
 
 
 def epoch_table(drive, eps, ev) -> list[str]:
@@ -181,48 +196,69 @@ def main(argv=None) -> int:
         help="phi_deg psi_deg kappa_m delta_d_m: a design with these sigmas (else the rows "
         "measured on these drives, in-sample)",
     )  # fmt: skip
+    ap.add_argument("--sigmas-kept", type=float, nargs=4, default=None,
+                    help="as --sigmas, for the design fed the geometry-kept paths")  # fmt: skip
+    ap.add_argument(
+        "--store", default=None, help="a pickle of the drives: read if present, else written"
+    )
     ap.add_argument("--floor-angle-deg", type=float, default=0.5)
     ap.add_argument("--floor-range", type=float, default=0.3)
     a = ap.parse_args(argv)
     route = drives.scenario_route(a.scenario, "exact", "sionna", NUISANCE)
     floors = (np.radians(a.floor_angle_deg), a.floor_range)
     t0 = time.perf_counter()
-    data = traced_drive(a.scenario, a.seed, a.runs)
+    store = Path(a.store) if a.store else None
+    if store is not None and store.is_file():
+        with store.open("rb") as f:
+            data = pickle.load(f)
+        print(f"drives read from {store}")
+    else:
+        data = traced_drive(a.scenario, a.seed, a.runs)
+        if store is not None:
+            with store.open("wb") as f:
+                pickle.dump(data, f)
     print(
         f"{a.scenario} seed {a.seed}: {a.runs} traced drive(s) in {time.perf_counter() - t0:.0f} s"
     )
     base = designs.ours_ml()
     cfg = base.config
     scores: dict[str, list] = {}
-    _, rows = extraction_errors([d for d, _ in data])
-    for row in rows:
-        print(
-            "  extraction error "
-            + ", ".join(f"{x:.4g}" if isinstance(x, float) else str(x) for x in row)
-        )
-    if a.sigmas is None:
-        matched = design_from_errors(rows, base=base)
-        label = "traced sigmas (in-sample)"
-    else:
-        matched = design_from_errors([["all", 0, *a.sigmas]], base=base)
-        label = "traced sigmas (given)"
-    print(f"  {label}: " + ", ".join(f"{k} {getattr(matched.config, k):.4g}" for k in SIGMAS))
+    geo = [variants(d, e, route, floors)["geometry test"] for d, e in data]
+
+    def sigma_design(rows, given, what):
+        for row in rows:
+            print(f"  extraction error, {what}: " + ", ".join(
+                f"{x:.4g}" if isinstance(x, float) else str(x) for x in row))  # fmt: skip
+        if given is None:
+            return design_from_errors(rows, base=base), "in-sample"
+        return design_from_errors([["all", 0, *given]], base=base), "given"
+
+    all_d, how_all = sigma_design(extraction_errors([d for d, _ in data])[1], a.sigmas, "all paths")
+    kept_d, how_kept = sigma_design(extraction_errors(geo)[1], a.sigmas_kept, "kept paths")
+    for lab, d in (
+        (f"all-path sigmas ({how_all})", all_d),
+        (f"kept-path sigmas ({how_kept})", kept_d),
+    ):
+        print(f"  {lab}: " + ", ".join(f"{k} {getattr(d.config, k):.4g}" for k in SIGMAS))
     for r, (drive, eps) in enumerate(data):
         for name, dv in variants(drive, eps, route, floors).items():
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ev = evaluate(dv, base, keep_reports=True)
-            scores.setdefault(name, []).append(ev.metrics["rmse_2d_m"])
+            scores.setdefault(name, []).append(ev.metrics)
             if name == "measured" and a.epochs:
                 print(f"run {r}, measured, per epoch:")
                 print("\n".join(epoch_table(drive, eps, ev)))
-        for name, dv in (
-            (label, drive),
-            (label + " + geometry test", variants(drive, eps, route, floors)["geometry test"]),
+        for name, dv, des in (
+            ("no curvature + geometry test", no_curvature(geo[r]), base),
+            ("all-path sigmas", drive, all_d),
+            ("all-path sigmas + geometry test", geo[r], all_d),
+            ("kept-path sigmas + geometry test", geo[r], kept_d),
+            ("kept-path sigmas, no curvature + geometry test", no_curvature(geo[r]), kept_d),
         ):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                scores.setdefault(name, []).append(evaluate(dv, matched).metrics["rmse_2d_m"])
+                scores.setdefault(name, []).append(evaluate(dv, des).metrics)
         for s in a.scale:
             d = base.with_(
                 sigma_phi=s * cfg.sigma_phi,
@@ -232,9 +268,9 @@ def main(argv=None) -> int:
             )
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                scores.setdefault(f"sigmas x {s:g}", []).append(
-                    evaluate(drive, d).metrics["rmse_2d_m"]
-                )
+                scores.setdefault(f"sigmas x {s:g}", []).append(evaluate(drive, d).metrics)
+        kept = sum(0 if pm is None else len(pm.phi) for pm in geo[r].epochs)
+        print(f"run {r}: the geometry test keeps {kept} measurements")
         n_meas = sum(len(np.asarray(ep.truth_index)) for ep in eps)
         n_spur = sum(int(np.sum(np.asarray(ep.truth_index) < 0)) for ep in eps)
         n_row0 = sum(los_row(ep) == 0 for ep in eps)
@@ -243,7 +279,11 @@ def main(argv=None) -> int:
             f"row 0 is the LoS in {n_row0} epochs"
         )
     for name, v in scores.items():
-        print(f"  {name:16s} 2-D RMSE mean {np.mean(v):.3f} m  runs {np.round(v, 3).tolist()}")
+        rm = [m["rmse_2d_m"] for m in v]
+        ma = np.mean([m["mae_2d_m"] for m in v])
+        print(
+            f"  {name:46s} 2-D RMSE {np.mean(rm):.3f} m, MAE {ma:.3f} m  runs {np.round(rm, 3).tolist()}"
+        )
     return 0
 
 

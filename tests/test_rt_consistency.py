@@ -132,3 +132,29 @@ def test_bad_input_names_the_parameter(scene, kw, match):
     args.update(kw)
     with pytest.raises((ValueError, TypeError), match=match):
         geometry_consistency(**args)
+
+
+def test_bound_sigmas_match_the_reported_covariance(scene):
+    """Where the fit passes its own test, the bound at the estimate is the route's reported one."""
+    from dataclasses import replace
+
+    from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
+
+    route = replace(scene[0], report_covariance=True)
+    ep = route.epoch(10, np.random.default_rng(5), refine="ml")
+    m = ep.measurements
+    assert m.cov is not None
+    sig = bound_sigmas(ep.estimates, ep.array, route.config)
+    np.testing.assert_allclose(sig[:, 0], np.sqrt(m.cov[:, 0, 0]), rtol=1e-9)
+    np.testing.assert_allclose(sig[:, 1], np.sqrt(m.cov[:, 1, 1]), rtol=1e-9)
+    np.testing.assert_allclose(sig[:, 2], m.sigma_d, rtol=1e-9)
+    res = epoch_consistency(ep, route, pfa=1e-3)
+    assert res["r2"].shape == (len(m),) and np.linalg.norm(res["ue"] - ep.ue) < 0.05
+    floors = epoch_consistency(ep, route, bound=False, floor_angle=1e-3, floor_range=0.05)
+    assert floors["consistent"]
+    with pytest.raises(ValueError, match="floor"):
+        epoch_consistency(ep, route, bound=False)
+    with pytest.raises(TypeError, match="ep"):
+        epoch_consistency(m, route)
+    with pytest.raises(TypeError, match="est"):
+        bound_sigmas(m, ep.array, route.config)
