@@ -67,9 +67,10 @@ def study(route: SignalRoute, draws: int, pfa: float, floors, rng) -> dict:
                 continue
             try:
                 sig = bound_sigmas(ep.estimates, ep.array, route.config)
-            except np.linalg.LinAlgError:
+                res = epoch_consistency(ep, route, pfa=pfa)
+            except (np.linalg.LinAlgError, ValueError):  # Fisher information singular there
+                acc["skipped"] = acc.get("skipped", 0) + 1
                 continue
-            res = epoch_consistency(ep, route, pfa=pfa)
             acc["flag"].append(not res["consistent"])
             acc["fit_ok"].append(bool(getattr(ep.estimates, "fit_ok", True)))
             te = truth_errors(ep, sig)
@@ -80,7 +81,8 @@ def study(route: SignalRoute, draws: int, pfa: float, floors, rng) -> dict:
             ti = np.asarray(ep.truth_index)
             acc["drop_true"].extend((~fl["keep"][ti >= 0]).tolist())
             acc["drop_spur"].extend((~fl["keep"][ti < 0]).tolist())
-    return {k: np.array(v) for k, v in acc.items()}
+    skipped = acc.pop("skipped", 0)
+    return {**{k: np.array(v) for k, v in acc.items()}, "skipped": skipped}
 
 
 def main(argv=None) -> int:
@@ -103,7 +105,10 @@ def main(argv=None) -> int:
         n = r["flag"].size
         ok = r["fit_ok"]
         beyond = r["worst"] > 6
-        print(f"{a.scenario} channel={chan}: {n} snapshots in {wall:.0f} s, pfa {a.pfa:g}")
+        print(
+            f"{a.scenario} channel={chan}: {n} snapshots in {wall:.0f} s, pfa {a.pfa:g} "
+            f"({r['skipped']} skipped: the bound at the estimate undefined)"
+        )
         print(
             f"  snapshot test flags {r['flag'].mean():.3f} of all, "
             f"{r['flag'][ok].mean() if ok.any() else np.nan:.3f} of the {ok.sum()} fits passing "

@@ -177,6 +177,10 @@ def _signal_route():
     planes = tunnel_planes(route.tunnel)
     geometry_consistency(m.direction, m.d, m.origin, planes, 1e-3, 1e-3, 0.05)
     consistent_paths(m, route.tunnel, sigma_phi=1e-3, sigma_psi=1e-3, sigma_d=0.05)
+    from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
+
+    bound_sigmas(ep.estimates, ep.array, route.config)
+    epoch_consistency(ep, route, bound=False, floor_angle=1e-2, floor_range=0.3)
     from tunnelkit.propagation import second_order_paths
 
     traj = route.trajectory

@@ -98,7 +98,7 @@ def test_a_floor_absorbs_a_model_error_within_it(scene):
 
 def test_route_measurements_and_one_path(scene):
     route = scene[0]
-    ep = route.epoch(10, np.random.default_rng(0), refine="ml")
+    ep = route.epoch(10, np.random.default_rng(0), refine="joint")
     res = consistent_paths(ep.measurements, route.tunnel, sigma_phi=1e-3, sigma_psi=1e-3,
                            sigma_d=0.05)  # fmt: skip
     assert res["keep"].shape == (len(ep.measurements),)
