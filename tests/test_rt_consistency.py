@@ -158,3 +158,9 @@ def test_bound_sigmas_match_the_reported_covariance(scene):
         epoch_consistency(m, route)
     with pytest.raises(TypeError, match="est"):
         bound_sigmas(m, ep.array, route.config)
+    np.testing.assert_array_equal(bound_sigmas(ep.estimates, ep.array, route.config, m.index), sig)
+    for bad in ([0, 0], [-1], [99], [[0]], [0.5]):
+        with pytest.raises(ValueError, match="keep"):
+            bound_sigmas(ep.estimates, ep.array, route.config, bad)
+    with pytest.raises(TypeError, match="bound"):
+        epoch_consistency(ep, route, bound="yes")

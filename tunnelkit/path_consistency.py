@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import instance
+from ._validate import boolean, instance
 from .arrays import ArrayGeometry
 from .channel import SRSConfig
 from .rt.consistency import geometry_consistency, tunnel_planes
@@ -24,11 +24,12 @@ from .signal_route import Epoch, SignalRoute
 __all__ = ["bound_sigmas", "epoch_consistency"]
 
 
-def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, min_d: float = 0.0) -> np.ndarray:
+def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.ndarray:
     """(K, 3) CRLB standard deviations at the estimate ``est`` (a
     :class:`tunnelkit.extraction.PathEstimates`) of the world azimuth, elevation [rad] and range
-    [m] of the paths Algorithm 1 keeps (``min_d`` its delay check), in their order; the Fisher
-    information of the kept paths jointly (:func:`tunnelkit.extraction.estimate_crlb`), the
+    [m] of the paths ``keep`` (indices into ``est``, in their order; default the paths Algorithm 1
+    keeps with its printed check ``d >= 0``, as ``RouteMeasurements.index``); the Fisher
+    information of those paths jointly (:func:`tunnelkit.extraction.estimate_crlb`), the
     wave origin's covariance rotated to the world frame and mapped through d(phi, psi, r)/dq.
     Raises ``numpy.linalg.LinAlgError`` where that information is singular."""
     from .extraction import PathEstimates, algorithm1, estimate_crlb
@@ -37,7 +38,15 @@ def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, min_d: float = 0.
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
     instance("config", config, SRSConfig)
-    keep = algorithm1(est, min_d)
+    if keep is None:
+        keep = algorithm1(est, 0.0)
+    else:
+        raw = np.asarray(keep)
+        if raw.ndim != 1 or (raw.size and raw.dtype.kind not in "iu"):
+            raise ValueError(f"keep: expected a 1-D array of path indices, got {keep!r}")
+        if raw.size and (raw.min() < 0 or raw.max() >= len(est) or np.unique(raw).size < raw.size):
+            raise ValueError(f"keep: indices must be distinct and in [0, {len(est)}), got {raw}")
+        keep = raw.astype(int)
     if not keep.size:
         return np.zeros((0, 3))
     b = estimate_crlb(est, array, config, paths=keep)
@@ -57,8 +66,8 @@ def epoch_consistency(ep: Epoch, route: SignalRoute, *, bound: bool = True, **kw
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)
     m = ep.measurements
-    if bound:
-        sig = bound_sigmas(ep.estimates, ep.array, route.config, route.min_d)
+    if boolean("bound", bound):
+        sig = bound_sigmas(ep.estimates, ep.array, route.config, m.index)
         if sig.shape[0] != len(m):
             raise RuntimeError("bound_sigmas: rows differ from the epoch's measurements")
     else:

@@ -32,7 +32,15 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
-from .._validate import finite_array, instance, integer, nonnegative, probability, vector
+from .._validate import (
+    finite_array,
+    instance,
+    integer,
+    nonnegative,
+    probability,
+    sequence,
+    vector,
+)
 from ..geometry import Plane
 
 __all__ = ["consistent_paths", "geometry_consistency", "tunnel_planes"]
@@ -128,7 +136,7 @@ def geometry_consistency(
     if d.shape != (K,):
         raise ValueError(f"d: expected {K} values (one per path), got shape {d.shape}")
     o = vector("origin", origin, 3)
-    pl = [instance(f"planes[{i}]", p, Plane) for i, p in enumerate(planes)]
+    pl = [instance(f"planes[{i}]", p, Plane) for i, p in enumerate(sequence("planes", planes))]
     if not pl or any(p.dim != 3 for p in pl):
         raise ValueError("planes: expected one or more 3-D planes")
     pfa = probability("pfa", pfa)
@@ -158,7 +166,7 @@ def geometry_consistency(
     offsets = np.array([p.offset for p in pl])
     phi, psi, _ = _angles(u)
     order = np.argsort(d)
-    ca, cr = (nonnegative("coarse", c) for c in coarse)
+    ca, cr = (nonnegative("coarse", c) for c in vector("coarse", coarse, 2))
     sig_c = np.maximum(sig, [ca, ca, cr])
     if inside is not None and not callable(inside):
         raise TypeError(f"inside: expected a callable p -> bool, got {type(inside).__name__}")
@@ -228,11 +236,14 @@ def consistent_paths(measurements, tunnel, origin=None, **kw) -> dict:
     ``direction``, ``origin`` and, when the route reports them, ``cov`` / ``sigma_d``: the bound
     the residuals are normalised by; without them ``kw`` must give ``sigma_phi``, ``sigma_psi``,
     ``sigma_d``) through ``tunnel``'s planes; ``kw`` the test's options."""
+    from ..propagation import Tunnel3D
+
     m = measurements
     for name in ("phi", "psi", "d", "direction", "origin"):
         if not hasattr(m, name):
             raise TypeError(f"measurements: expected a RouteMeasurements, got {type(m).__name__}")
-    o = m.origin if origin is None else origin
+    instance("tunnel", tunnel, Tunnel3D)
+    o = m.origin if origin is None else vector("origin", origin, 3)
     if getattr(m, "cov", None) is not None and "sigma_phi" not in kw:
         kw.setdefault("sigma_phi", np.sqrt(m.cov[:, 0, 0]))
         kw.setdefault("sigma_psi", np.sqrt(m.cov[:, 1, 1]))
