@@ -13,13 +13,23 @@ flagged epochs pass there) are measured once; the same measurements are then sco
   earliest-arrival order and the tracker's first fix take for the LoS);
 * ``geometry test``: the paths the per-snapshot geometry-consistency test rejects dropped
   (:func:`tunnelkit.path_consistency.epoch_consistency` with model-error floors, no oracle);
+* ``no curvature``: every path's curvature removed (far-field: angles and delay only);
+* ``all-path sigmas`` / ``kept-path sigmas``: the design's measurement noise set to the RMS
+  extraction error on these traced drives (:func:`tunnelkit.studies.analysis.extraction_errors`,
+  :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`) of every matched path, or of
+  the paths the geometry test keeps; in-sample unless ``--sigmas`` / ``--sigmas-kept`` give them
+  (measured on another drive or seed), alone and with the geometry test;
 * ``sigmas x S``: the design's measurement sigmas scaled by ``S`` (``--scale``).
 
-Per epoch of the ``measured`` variant it prints the 2-D error, the number of measurements, how
-many were spurious, whether row 0 is the LoS, the delay error of the earliest measurement, and
-the tracker's association (which measurement the UE track took and whether it is the LoS).
+Per epoch of the ``measured`` variant (``--epochs``) it prints the 2-D error, the number of
+measurements, how many were spurious, whether row 0 is the LoS, the delay error of the earliest
+measurement, and which measurement the UE took as its LoS (by association or eq. 61's test).
+``--store FILE`` keeps the simulated drives (tensors dropped) for a re-scoring without tracing.
 
-    python benchmarks/bench_rt_track.py --scenario italiano2026-straight --runs 1 --seed 0
+    python benchmarks/bench_rt_track.py --scenario italiano2026-straight --runs 3 --seed 0 \
+        --scale 10 --store /tmp/straight-0.pkl
+    python benchmarks/bench_rt_track.py --scenario italiano2026-slalom --runs 3 --seed 0 \
+        --sigmas 9.328 8.583 33.71 1.078 --sigmas-kept 5.216 6.896 36.27 0.6224 --scale 10
 """
 
 from __future__ import annotations
