@@ -499,6 +499,23 @@ def _baselines_checks():
     t3.wave_origins_figure({"x": np.array([[1.0, 2.0, 3.0]])})
 
 
+def _consistency():
+    """The geometry-consistency test (after the route drivers: their first calls of the
+    extraction's bounds stay the recorded ones)."""
+    from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
+    from tunnelkit.rt.consistency import consistent_paths, geometry_consistency, tunnel_planes
+    from tunnelkit.signal_route import SignalRoute
+
+    route = SignalRoute.from_scenario("italiano2026-straight")
+    ep = route.epoch(10, np.random.default_rng(0))
+    m = ep.measurements
+    planes = tunnel_planes(route.tunnel)
+    geometry_consistency(m.direction, m.d, m.origin, planes, 1e-3, 1e-3, 0.05)
+    consistent_paths(m, route.tunnel, sigma_phi=1e-3, sigma_psi=1e-3, sigma_d=0.05)
+    bound_sigmas(ep.estimates, ep.array, route.config, ep.measurements.index)
+    epoch_consistency(ep, route, bound=False, floor_angle=1e-2, floor_range=0.3)
+
+
 def _trial(rng):
     """A Monte-Carlo trial for the runner's contract (module level: picklable)."""
     return float(rng.random())
@@ -518,6 +535,7 @@ DRIVERS = (
     _known_surfaces,
     _baselines_checks,
     *ROUTE_DRIVERS,
+    _consistency,
 )
 
 

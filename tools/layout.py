@@ -51,6 +51,7 @@ RANKS = {
     "evaluation": 6,
     "signal_route": 7,
     "efficiency": 7,
+    "path_consistency": 7.5,  # the geometry-consistency test on a signal route's epoch
     "studies": 8,
     "design": 9,
     "plots": 10,
