@@ -17,6 +17,7 @@ import sys
 import warnings
 
 import numpy as np
+from contract_design import DRIVERS as DESIGN_DRIVERS
 from contract_routes import DRIVERS as ROUTE_DRIVERS
 from contracts import Target, function_of, hints, parameters
 
@@ -518,6 +519,7 @@ DRIVERS = (
     _known_surfaces,
     _baselines_checks,
     *ROUTE_DRIVERS,
+    *DESIGN_DRIVERS,
 )
 
 
