@@ -515,6 +515,12 @@ DOCUMENTED: tuple[Documented, ...] = (
         "all, the docstring's contract)",
     ),
     _doc(
+        r"design\.montecarlo\.MonteCarloResult",
+        r"errors|rmse_runs",
+        "nan",
+        "NaN: a run without an estimate there (counted as infinite by the verdict)",
+    ),
+    _doc(
         r"design\.fastroute\.BoundRoute",
         r"min_d",
         "negative",

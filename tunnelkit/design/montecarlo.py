@@ -154,7 +154,8 @@ class MonteCarloResult:
 
     def __post_init__(self) -> None:
         b = ("peb", "pcrlb", "drive", "learned")
-        record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), "errors": (None, "T")},
+        record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), "errors": ("R", "T"),
+                             "rmse_runs": ("R",), "settled": (None,)},
                allow_nan=("errors", "rmse_runs"), nonnegative=("errors", "rmse_runs", "settled", *b),
                allow_inf=b, skip=("spec",))  # fmt: skip
         instance("spec", self.spec, ArraySpec), choice("mode", self.mode, MODES)

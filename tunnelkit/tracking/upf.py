@@ -114,7 +114,8 @@ def ukf_proposal(
     finite_array("P_pred", P_pred, ndim=None)
     if np.shape(P_pred)[-2:] != (STATE_DIM, STATE_DIM):
         raise ValueError(f"P_pred: expected covariances (..., 4, 4), got {np.shape(P_pred)}")
-    real_array("z", z)
+    if np.broadcast_shapes(real_array("z", z).shape[:-1], m.shape[:-1]) != m.shape[:-1]:
+        raise ValueError(f"z: expected measurements (..., 2N) like m_pred, got {np.shape(z)}")
     return _ukf_update(model, m_pred, P_pred, z, alpha, beta, kappa)[:2]
 
 

@@ -57,7 +57,7 @@ class StepReport:
     clutter: int = 0
 
     def __post_init__(self) -> None:
-        lists = ("prior_ids", "prior_cov", "associated", "ids", "faults")
+        lists = ("prior_ids", "associated", "ids", "faults")
         record(self, shapes={"prior_positions": (None, 3), "estimate": (3,), "cov": (3, 3),
                              "positions": (None, 3)},
                nonnegative=("k", "n_paths", "n_rows", "nis", "clutter"), may_be_empty=lists)  # fmt: skip
