@@ -527,22 +527,49 @@ def record(
     ``may_be_empty`` text or lists that may be empty; ``skip`` fields left unchecked;
     ``allow_inf`` floats or float arrays whose entries may be ``+inf`` (no bound, never). Errors name the field.
     """
-    shapes = shapes or {}
-    dims: dict[str, int] = {}
-    for name, kind, classes, allows_none in _plan(type(obj)):
-        if name in skip:
-            continue
-        sign = "positive" if name in positive else "nonnegative" if name in nonnegative else ""
-        _field(
-            name,
-            getattr(obj, name),
-            kind,
-            classes,
-            allows_none,
-            spec=shapes.get(name),
-            sign=sign,
-            allow_nan=name in allow_nan,
-            may_be_empty=name in may_be_empty,
-            dims=dims,
-            allow_inf=name in allow_inf,
+    key = (type(obj), positive, nonnegative, allow_nan, may_be_empty, skip, allow_inf,
+           tuple(shapes.items()) if shapes else ())  # fmt: skip
+    try:
+        steps = _COMPILED[key]
+    except (KeyError, TypeError):  # first call (or options given as lists: not cached)
+        shapes = shapes or {}
+        steps = tuple(
+            (
+                name,
+                kind,
+                classes,
+                allows_none,
+                shapes.get(name),
+                "positive" if name in positive else "nonnegative" if name in nonnegative else "",
+                name in allow_nan,
+                name in may_be_empty,
+                name in allow_inf,
+            )
+            for name, kind, classes, allows_none in _plan(type(obj))
+            if name not in skip
         )
+        try:
+            _COMPILED[key] = steps
+        except TypeError:
+            pass
+    dims: dict[str, int] = {}
+    for name, kind, classes, allows_none, spec, sign, nan_ok, empty_ok, inf_ok in steps:
+        value = getattr(obj, name)
+        if kind == "array" and type(value) is np.ndarray and value.dtype.kind == "f" and value.size:
+            # the common case, float arrays: min (and max) catch NaN, infinities and the sign
+            lo = value.min()
+            if not nan_ok and not (lo > -np.inf and (inf_ok or value.max() < np.inf)):
+                raise ValueError(f"{name}: contains NaN or infinite values")
+            if spec is not None:
+                _bind(name, value.shape, spec, dims)
+            if sign and (lo < 0 or (sign == "positive" and lo == 0)):
+                raise ValueError(
+                    f"{name}: must be {'>' if sign == 'positive' else '>='} 0, got {float(lo)}"
+                )
+            continue
+        _field(name, value, kind, classes, allows_none, spec=spec, sign=sign, allow_nan=nan_ok,
+               may_be_empty=empty_ok, dims=dims, allow_inf=inf_ok)  # fmt: skip
+
+
+#: record()'s checks per (class, options), built on the first call
+_COMPILED: dict[tuple, tuple] = {}
