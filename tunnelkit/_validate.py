@@ -567,6 +567,23 @@ def record(
                     f"{name}: must be {'>' if sign == 'positive' else '>='} 0, got {float(lo)}"
                 )
             continue
+        # the other common cases inline (what _field would accept), the rest through _field
+        tv = type(value)
+        if (
+            (kind == "int" and tv is int and (not sign or value >= (sign == "positive")))
+            or (kind == "bool" and tv is bool)
+            or (kind == "class" and isinstance(value, classes))
+            or (kind == "str" and tv is str and (value or empty_ok))
+            or (kind == "map" and tv is dict)
+            or (
+                kind == "seq"
+                and (tv is list or tv is tuple)
+                and spec is None
+                and (value or empty_ok)
+            )
+            or (value is None and allows_none)
+        ):
+            continue
         _field(name, value, kind, classes, allows_none, spec=spec, sign=sign, allow_nan=nan_ok,
                may_be_empty=empty_ok, dims=dims, allow_inf=inf_ok)  # fmt: skip
 

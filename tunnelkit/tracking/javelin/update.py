@@ -339,9 +339,9 @@ class JosephUpdater:
     def update(self, x, P, m: StackedMeasurement, C=None):
         """``(x, P, nis)`` after the update (:func:`~.update.joseph_update`); with a consider
         cross-covariance ``C`` and ``m.B``, ``(x, P, nis, C)`` (:func:`consider_update`)."""
-        instance("m", m, StackedMeasurement)
-        state_arguments(x, P, m.H.shape[1] if m.z.size else None)
+        instance("m", m, StackedMeasurement)  # x and P: checked by the update that runs
         if C is not None:
+            state_arguments(x, P, m.H.shape[1] if m.z.size else None)
             C = finite_array("C", C, ndim=2)
         if C is not None and m.B is not None and (np.any(m.B) or np.any(C)):
             x, P, C, nis = consider_update(x, P, C, m)
