@@ -17,6 +17,7 @@ import sys
 import warnings
 
 import numpy as np
+from contract_design import DRIVERS as DESIGN_DRIVERS
 from contract_routes import DRIVERS as ROUTE_DRIVERS
 from contracts import Target, function_of, hints, parameters
 
@@ -536,6 +537,7 @@ DRIVERS = (
     _baselines_checks,
     *ROUTE_DRIVERS,
     _consistency,
+    *DESIGN_DRIVERS,
 )
 
 

@@ -350,6 +350,202 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a user scene's shape that references no material",
     ),
     _doc(
+        r"tracking\.javelin\.(measurement\.(DelayCheck|PathMeasurements\.(from_arrays|sanitised))"
+        r"|designs\.array_design)|design\.montecarlo\.javelin_config",
+        r"min_d",
+        "negative",
+        "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
+    ),
+    _doc(
+        r"tracking\.javelin\.(manage\.(FixedBirth|MeasuredBirth|static_doppler)"
+        r"|surfaces\.GeometricBirth|geometric\.geometric_paths)",
+        r"doppler_sign|sign",
+        "negative",
+        "-1 is one of the two signs (the channel's convention, the default); 0, 2, NaN refused",
+    ),
+    _doc(
+        r"tracking\.javelin\.geometric\.geometric_paths",
+        r"clock_bias",
+        "negative",
+        "a clock bias takes any sign",
+    ),
+    _doc(
+        r"tracking\.javelin\.manage\.intersection", r"x_u", "negative", "a coordinate [m]: any sign"
+    ),
+    _doc(
+        r"tracking\.javelin\.state\.JavelinState",
+        r"ids|misses|transient",
+        "empty",
+        "a state without VUE tracks (the default: the UE alone)",
+    ),
+    _doc(
+        r"tracking\.javelin\.(manage\.(ManageResult|manage_tracks)"
+        r"|update\.(stack_measurement|JosephUpdater\.stack))",
+        r"pairs|born|dead|dynamic|unborn",
+        "empty",
+        "no associated pair, no birth or death this epoch: the tracker predicts only",
+    ),
+    _doc(
+        r"tracking\.javelin\.tracker\.(Javelin\.(step|run)|run_javelin)",
+        r"speed|heading",
+        "nan",
+        "NaN (or None) is a missing V2X message: the last one is reused with inflated noise "
+        "(the docstring's contract, a fault in the report)",
+    ),
+    _doc(
+        r"tracking\.javelin\.(tracker\.Javelin\.step|motion\.(ue_velocity|motion_increment|predict"
+        r"|RandomWalk\.increment))",
+        r"speed",
+        "negative",
+        "a measured (V2X) speed carries noise: it dips below zero near a standstill",
+    ),
+    _doc(
+        r"tracking\.javelin\.measurement\.PathMeasurements(\.from_arrays)?",
+        r"phi|psi|kappa|d|v",
+        "nan",
+        "NaN kappa: far field; NaN d, v: unknown; a NaN angle is dropped by Algorithm 1 "
+        "(from_arrays, with a JavelinWarning; the tracker sanitises a hand-built one, "
+        "test_directly_built_paths_never_stop_a_run)",
+    ),
+    _doc(
+        r"tracking\.javelin\.update\.StackedMeasurement",
+        r"labels",
+        "empty",
+        "row labels are for reports only: a hand-built measurement may carry none",
+    ),
+    _doc(
+        r"tracking\.javelin\.manage\.los_test",
+        r"d|kappa",
+        "nan",
+        "a path without a curvature or a delay cannot be tested (the docstring's contract)",
+    ),
+    _doc(
+        r"tracking\.javelin\.tenfiloc\.TeNFiLoc\.plausible_kappa",
+        r"kappa|d",
+        "nan negative",
+        "a plausibility test: NaN, negative or far curvatures answer False; an unknown (NaN) "
+        "delay is not compared",
+    ),
+    _doc(
+        r"design\.verdict\.(share_quantile|gate|bootstrap_quantile_ci)",
+        r"values|errors",
+        "nan",
+        "a non-finite error (no estimate) counts as infinite (the module's contract)",
+    ),
+    _doc(
+        r"design\.verdict\.(share_quantile|gate)",
+        r"values",
+        "shape",
+        "values of any shape pooled / (..., T) gated epoch by epoch (each docstring's contract)",
+    ),
+    _doc(
+        r"design\.report\.over_target",
+        r"y",
+        "nan",
+        "a non-finite value counts as over the target (the docstring's contract)",
+    ),
+    _doc(
+        r"design\.errormodel\.psd_sqrt|tracking\.upf\.systematic_resample",
+        r"S|weights",
+        "shape",
+        "a stack (..., n, n) / a batch (..., N): leading axes vectorise (the docstring's contract)",
+    ),
+    _doc(
+        r"tracking\.upf\.UnscentedParticleFilter(\.run|\.update)?",
+        r"z|Z",
+        "nan",
+        "NaN in a measurement marks a missed epoch: the filter predicts only",
+    ),
+    _doc(
+        r"tracking\.upf\.(UnscentedParticleFilter|merwe_weights)",
+        r"kappa",
+        "negative",
+        "kappa = 3 - n < 0 is the classic choice; n + lambda > 0 is what is required (checked)",
+    ),
+    _doc(
+        r"tracking\.virtual_station\.model\.VsModel\.(residual_z|log_likelihood|z_mean)",
+        r"a|b|z|x|sigmas",
+        "shape",
+        "vectorised over leading axes (..., 2N) / (..., 4) / (..., S, 2N) (the docstring's "
+        "contract, test_extra_leading_axes_vectorise)",
+    ),
+    _doc(
+        r"tracking\.virtual_station\.model\.VsModel\.residual_z",
+        r"a|b",
+        "nan",
+        "a NaN component (a missed measurement) stays NaN in the residual: the filters mask it",
+    ),
+    _doc(
+        r"tracking\.doppler\.approaches\.EkfDS\.step",
+        r"toa",
+        "negative",
+        "EKF DS uses no ToA; a ToA <= 0 is no time of flight, which the ToA filters drop with a "
+        "warning",
+    ),
+    _doc(
+        r"channel\.(DiffuseSpec\.tone_covariance|diffuse_tensor)",
+        r"tau0",
+        "negative",
+        "a delay with the clock bias in it (channel_tensor passes min(tau + b)): any sign",
+    ),
+    _doc(
+        r"tracking\.javelin\.geometric\.(geometric_paths|geometric_stream)",
+        r"planes",
+        "empty",
+        "no reflector: the LoS path alone",
+    ),
+    _doc(
+        r"tracking\.javelin\.tracker\.(JavelinRun|StepReport)|tracking\.javelin\.tenfiloc"
+        r"\.TeNFiLocFix",
+        r"reports|associated|ids|paths",
+        "empty",
+        "reports not kept (the default), no pair associated, no VUE track, a fix from no path",
+    ),
+    _doc(
+        r"tracking\.javelin\.update\.(JointTestUpdater\.stack|exclude_inconsistent)",
+        r"pairs",
+        "empty",
+        "no associated pair: nothing to test, the tracker predicts only",
+    ),
+    _doc(
+        r"design\.montecarlo\.MonteCarloResult",
+        r"settled",
+        "empty",
+        "a drive shorter than the settling time has no settled epoch (the RMSE then covers it "
+        "all, the docstring's contract)",
+    ),
+    _doc(
+        r"design\.montecarlo\.MonteCarloResult",
+        r"errors|rmse_runs",
+        "nan",
+        "NaN: a run without an estimate there (counted as infinite by the verdict)",
+    ),
+    _doc(
+        r"design\.fastroute\.BoundRoute",
+        r"min_d",
+        "negative",
+        "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
+    ),
+    _doc(
+        r"tracking\.upf\.(effective_sample_size|ukf_proposal)",
+        r"weights|m_pred|P_pred",
+        "shape",
+        "a batch (..., N) of weights, means (..., 4) and covariances (..., 4, 4): leading axes "
+        "vectorise (the docstring's contract)",
+    ),
+    _doc(
+        r"tracking\.upf\.(ukf_proposal|one_epoch_ess)",
+        r"z|Z",
+        "nan",
+        "NaN in a measurement marks a missed epoch (the filters predict only)",
+    ),
+    _doc(
+        r"tracking\.upf\.ukf_proposal",
+        r"kappa",
+        "negative",
+        "kappa = 3 - n < 0 is the classic choice",
+    ),
+    _doc(
         r"fresnel\.bounds\.aperture",
         r"M",
         "type",
@@ -646,6 +842,9 @@ def test_extra_leading_axes_vectorise():
         (model.jacobian, x4),
         (model.position_fim, p),
         (lambda x: model.simulate(x, np.random.default_rng(0)), p),
+        (lambda x: model.residual_z(x, model.hx(x4)), model.hx(x4 + 0.5)),
+        (lambda x: model.log_likelihood(model.hx(x4), x), x4 + 0.5),
+        (lambda x: model.z_mean(x, np.full(3, 1 / 3)), np.stack([model.hx(x4)] * 3, axis=1)),
     ]
     import tunnelkit as tk
     from tunnelkit.drive import doppler_shift, slant_range

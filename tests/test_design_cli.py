@@ -115,7 +115,7 @@ def test_table_and_overrides(capsys):
     [
         (["--arrays", "8y8"], "arrays: cannot read '8y8'"),
         (["--arrays", "64x64"], "arrays: the 64x64 array"),
-        (["--mount-height", "9"], "mount:"),
+        (["--mount-height", "9"], "mount_height: 9 m puts the base-station mount"),
         (["--share", "1.5"], "share"),
         (["--wideband-model"], "wideband_model: the estimator models the spatial-wideband"),
     ],

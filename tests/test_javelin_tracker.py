@@ -163,7 +163,7 @@ def test_constructor_checks():
         Javelin([0.0, 1.0])
     with pytest.raises(TypeError, match=r"^design"):
         Javelin([0.0, 1.0, 1.0], design={"max_misses": 1})
-    with pytest.raises(ValueError, match=r"^speed, heading"):
+    with pytest.raises(ValueError, match=r"^epochs, speed, heading"):
         run_javelin([None, None], [1.0], [0.0, 0.0], 0.1, [0, 1, 1])
 
 

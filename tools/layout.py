@@ -27,6 +27,7 @@ SIZE_EXEMPT = {"tunnelkit.schema"}
 #: rank of each top-level module or subpackage of tunnelkit (lower = nearer the ground)
 RANKS = {
     "_validate": 0,
+    "_checks": 0.25,  # more checks of the validation layer, built on _validate
     "constants": 0.5,
     "solutions": 0.5,  # the notebooks' solution cells (IPython hooks), imports nothing of ours
     "budget": 0.5,

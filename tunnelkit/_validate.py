@@ -390,56 +390,85 @@ def _bind(name: str, got: tuple[int, ...], spec: tuple, dims: dict) -> None:
             raise ValueError(f"{name}: expected shape {want}, got {got}")
 
 
-def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims, allow_inf=False) -> None:
+def _classify(tp) -> tuple[str, tuple, bool]:
+    """(kind, classes, None allowed) of a field annotation, the dispatch of :func:`_field`:
+    kind one of array, bool, int, float, str, seq, map, callable, class, any."""
     import typing
     from collections.abc import Callable as _Callable
     from collections.abc import Mapping as _Mapping
     from collections.abc import Sequence as _Sequence
 
     members, allows_none = _members(tp)
+    plain = tuple(typing.get_origin(m) or m for m in members)
+    if np.ndarray in plain:
+        others = tuple(m for m in plain if m is not np.ndarray and isinstance(m, type))
+        return "array", others, allows_none
+    if bool in plain:
+        return "bool", (), allows_none
+    if int in plain and float not in plain:
+        return "int", (), allows_none
+    if float in plain:
+        return "float", (), allows_none
+    if str in plain:
+        return "str", (), allows_none
+    if any(m in (list, tuple, _Sequence, typing.Sequence) for m in plain):
+        return "seq", (), allows_none
+    if any(m in (dict, _Mapping, typing.Mapping) for m in plain):
+        return "map", (), allows_none
+    if any(m in (_Callable, typing.Callable) for m in plain):
+        return "callable", (), allows_none
+    classes = tuple(m for m in plain if isinstance(m, type) and m is not object)
+    if classes and len(classes) == len(plain):
+        return "class", classes, allows_none
+    return "any", (), allows_none
+
+
+_SIGNED = {"positive": positive, "nonnegative": nonnegative}
+
+
+def _field(name, value, kind, classes, allows_none, *, spec, sign, allow_nan, may_be_empty,
+           dims, allow_inf=False) -> None:  # fmt: skip
     if value is None:
         if allows_none:
             return
         raise TypeError(f"{name}: expected a value, got None")
-    plain = tuple(typing.get_origin(m) or m for m in members)
-    if np.ndarray in plain:
-        others = tuple(m for m in plain if m is not np.ndarray and isinstance(m, type))
-        if others and not isinstance(value, np.ndarray) and isinstance(value, others):
+    if kind == "array":
+        if classes and not isinstance(value, np.ndarray) and isinstance(value, classes):
             return
         if isinstance(value, str | bytes):
             raise TypeError(f"{name}: expected an array of numbers, got text {value!r}")
         arr = value if isinstance(value, np.ndarray) else np.asarray(value)
-        if arr.dtype.kind not in "biufc":
+        dk = arr.dtype.kind
+        if dk not in "biufc":
             raise TypeError(f"{name}: expected an array of numbers, got dtype {arr.dtype}")
-        if arr.dtype.kind in "fc" and not allow_nan:
+        if dk in "fc" and not allow_nan and not np.isfinite(arr).all():
             bad = np.isnan(arr) | (np.isinf(arr) & ~(allow_inf & (arr.real == np.inf)))
             if bad.any():
                 raise ValueError(f"{name}: contains NaN or infinite values")
         if spec is not None:
             _bind(name, arr.shape, spec, dims)
-        if sign and arr.size and arr.dtype.kind in "iuf":
+        if sign and arr.size and dk in "iuf":
             low = float(arr.min())
             if low < 0 or (sign == "positive" and low == 0):
                 raise ValueError(
                     f"{name}: must be {'>' if sign == 'positive' else '>='} 0, got {low}"
                 )
-        return
-    if bool in plain:
+    elif kind == "bool":
         boolean(name, value)
-    elif int in plain and float not in plain:
+    elif kind == "int":
         integer(name, value, minimum={"positive": 1, "nonnegative": 0}.get(sign))
-    elif float in plain:
+    elif kind == "float":
         if allow_nan and isinstance(value, float) and np.isnan(value):
             return
         if allow_inf and isinstance(value, float) and value == np.inf:
             return
-        {"positive": positive, "nonnegative": nonnegative}.get(sign, real)(name, value)
-    elif str in plain:
+        _SIGNED.get(sign, real)(name, value)
+    elif kind == "str":
         if not isinstance(value, str):
             raise TypeError(f"{name}: expected text, got {type(value).__name__}")
         if not value and not may_be_empty:
             raise ValueError(f"{name}: must not be empty")
-    elif any(m in (list, tuple, _Sequence, typing.Sequence) for m in plain):
+    elif kind == "seq":
         if isinstance(value, str | bytes) or not isinstance(value, list | tuple):
             raise TypeError(f"{name}: expected a list, got {type(value).__name__}")
         if not value:
@@ -447,15 +476,34 @@ def _field(name, value, tp, *, spec, sign, allow_nan, may_be_empty, dims, allow_
                 raise ValueError(f"{name}: must not be empty")
         elif spec is not None:
             _bind(name, (len(value),), spec, dims)
-    elif any(m in (dict, _Mapping, typing.Mapping) for m in plain):
+    elif kind == "map":
+        from collections.abc import Mapping as _Mapping
+
         if not isinstance(value, _Mapping):
             raise TypeError(f"{name}: expected a mapping, got {type(value).__name__}")
-    elif any(m in (_Callable, typing.Callable) for m in plain):
+    elif kind == "callable":
         callable_(name, value)
-    else:
-        classes = tuple(m for m in plain if isinstance(m, type) and m is not object)
-        if classes and len(classes) == len(plain):
-            instance(name, value, classes)
+    elif kind == "class":
+        instance(name, value, classes)
+
+
+_PLANS: dict[type, list] = {}
+
+
+def _plan(cls: type) -> list:
+    """[(field, kind, classes, None allowed)] of a dataclass's init fields, once per class."""
+    plan = _PLANS.get(cls)
+    if plan is None:
+        import dataclasses
+
+        hints = _field_hints(cls)
+        plan = [
+            (f.name, *_classify(hints[f.name]))
+            for f in dataclasses.fields(cls)
+            if f.init and f.name in hints
+        ]
+        _PLANS[cls] = plan
+    return plan
 
 
 def record(
@@ -479,23 +527,66 @@ def record(
     ``may_be_empty`` text or lists that may be empty; ``skip`` fields left unchecked;
     ``allow_inf`` floats or float arrays whose entries may be ``+inf`` (no bound, never). Errors name the field.
     """
-    import dataclasses
-
-    hints = _field_hints(type(obj))
-    shapes = shapes or {}
-    dims: dict[str, int] = {}
-    for f in dataclasses.fields(obj):
-        if not f.init or f.name in skip or f.name not in hints:
-            continue
-        sign = "positive" if f.name in positive else "nonnegative" if f.name in nonnegative else ""
-        _field(
-            f.name,
-            getattr(obj, f.name),
-            hints[f.name],
-            spec=shapes.get(f.name),
-            sign=sign,
-            allow_nan=f.name in allow_nan,
-            may_be_empty=f.name in may_be_empty,
-            dims=dims,
-            allow_inf=f.name in allow_inf,
+    key = (type(obj), positive, nonnegative, allow_nan, may_be_empty, skip, allow_inf,
+           tuple(shapes.items()) if shapes else ())  # fmt: skip
+    try:
+        steps = _COMPILED[key]
+    except (KeyError, TypeError):  # first call (or options given as lists: not cached)
+        shapes = shapes or {}
+        steps = tuple(
+            (
+                name,
+                kind,
+                classes,
+                allows_none,
+                shapes.get(name),
+                "positive" if name in positive else "nonnegative" if name in nonnegative else "",
+                name in allow_nan,
+                name in may_be_empty,
+                name in allow_inf,
+            )
+            for name, kind, classes, allows_none in _plan(type(obj))
+            if name not in skip
         )
+        try:
+            _COMPILED[key] = steps
+        except TypeError:
+            pass
+    dims: dict[str, int] = {}
+    for name, kind, classes, allows_none, spec, sign, nan_ok, empty_ok, inf_ok in steps:
+        value = getattr(obj, name)
+        if kind == "array" and type(value) is np.ndarray and value.dtype.kind == "f" and value.size:
+            # the common case, float arrays: min (and max) catch NaN, infinities and the sign
+            lo = value.min()
+            if not nan_ok and not (lo > -np.inf and (inf_ok or value.max() < np.inf)):
+                raise ValueError(f"{name}: contains NaN or infinite values")
+            if spec is not None:
+                _bind(name, value.shape, spec, dims)
+            if sign and (lo < 0 or (sign == "positive" and lo == 0)):
+                raise ValueError(
+                    f"{name}: must be {'>' if sign == 'positive' else '>='} 0, got {float(lo)}"
+                )
+            continue
+        # the other common cases inline (what _field would accept), the rest through _field
+        tv = type(value)
+        if (
+            (kind == "int" and tv is int and (not sign or value >= (sign == "positive")))
+            or (kind == "bool" and tv is bool)
+            or (kind == "class" and isinstance(value, classes))
+            or (kind == "str" and tv is str and (value or empty_ok))
+            or (kind == "map" and tv is dict)
+            or (
+                kind == "seq"
+                and (tv is list or tv is tuple)
+                and spec is None
+                and (value or empty_ok)
+            )
+            or (value is None and allows_none)
+        ):
+            continue
+        _field(name, value, kind, classes, allows_none, spec=spec, sign=sign, allow_nan=nan_ok,
+               may_be_empty=empty_ok, dims=dims, allow_inf=inf_ok)  # fmt: skip
+
+
+#: record()'s checks per (class, options), built on the first call
+_COMPILED: dict[tuple, tuple] = {}

@@ -45,6 +45,7 @@ from urllib.parse import urlsplit
 
 import numpy as np
 
+from ._checks import attributes
 from ._validate import boolean, callable_, integer, positive, sequence, text
 from .budget import check_bytes
 
@@ -195,6 +196,8 @@ class TrialPool:
     same cluster, started once."""
 
     def __init__(self, client=None) -> None:
+        if client is not None:
+            attributes("client", client, ("submit",), "a dask.distributed Client")
         self.client = client
 
     @property

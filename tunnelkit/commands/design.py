@@ -191,7 +191,10 @@ def main(args: argparse.Namespace) -> int:
     from ..montecarlo import TrialLost
     from .reproduce import parallel_kwargs
 
-    specs = [design.parse_array(a, args.spacing) for a in args.arrays]
+    try:
+        specs = [design.parse_array(a, args.spacing) for a in args.arrays]
+    except ValueError as exc:  # the option's name, not the function's parameter
+        raise ValueError(f"arrays: {str(exc).removeprefix('spec: ')}") from None
     if args.channel != "image" and (args.mode != "channel" or args.runs == 0):
         print(
             "tunnelkit design: error: --channel sionna needs --mode channel and --runs > 0 "

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import boolean, choice, instance, nonnegative, positive
+from .._validate import boolean, choice, instance, nonnegative, positive, record
 from ..channel import DiffuseSpec, Impairments
 from ..constants import C
 from ..geometry import spherical_jacobian
@@ -58,7 +58,7 @@ from .bounds import compress_slots, route_bounds, route_geometry, theta_fim, the
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .mcrb import EtaModes, scaled_inverse
-from .setup import DesignSetup, parse_array
+from .setup import ArraySpec, DesignSetup, parse_array
 
 __all__ = [
     "WEIGHTS",
@@ -393,6 +393,10 @@ class AchievableBound:
     weights: str = "tracker"
 
     def __post_init__(self) -> None:
+        instance("spec", self.spec, ArraySpec)
+        bounds = ("peb", "achievable", "calibration", "wideband", "diffuse")
+        record(self, shapes=dict.fromkeys(("x", *bounds), ("T",)), nonnegative=bounds,
+               allow_inf=bounds)  # fmt: skip
         choice("weights", self.weights, WEIGHTS)
 
 

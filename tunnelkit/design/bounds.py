@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import finite_array, instance, positive
+from .._validate import boolean, finite_array, instance, positive, record
 from ..constants import C, wavelength
 from ..fresnel import signed_mismatch
 from .geometry import RouteGeometry, trace_route
@@ -58,13 +58,20 @@ class RouteBounds:
 
     spec: ArraySpec
     x: np.ndarray
-    peb: np.ndarray
+    peb: np.ndarray | None
     mismatch: np.ndarray
     used: np.ndarray
     srnf_valid: np.ndarray
     kinds: tuple[str, ...]
     eps_phi: float
     n_paths: np.ndarray = field(repr=False)
+
+    def __post_init__(self) -> None:
+        tp = ("T", "P")
+        record(self, shapes={"x": ("T",), "peb": ("T",), "mismatch": tp, "used": tp,
+                             "srnf_valid": ("T",), "kinds": ("P",), "n_paths": ("T",)},
+               positive=("eps_phi",), nonnegative=("peb", "mismatch", "n_paths"),
+               allow_inf=("peb",))  # fmt: skip
 
     def surface_validity(self) -> dict[str, float]:
         """Per surface kind: share of epochs where every used path off that kind is valid."""
@@ -271,6 +278,9 @@ def route_bounds(
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     spec = parse_array(spec)
+    for name, flag in (("markings", markings), ("curvature", curvature),
+                       ("height_known", height_known), ("peb", peb)):  # fmt: skip
+        boolean(name, flag)
     if clock_bias not in _CLOCK:
         raise ValueError(f"clock_bias: expected one of {_CLOCK}, got {clock_bias!r}")
     eps_phi = positive("eps_phi", eps_phi)

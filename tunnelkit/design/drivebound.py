@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import bound_array, real_array
+from .._validate import finite_array, instance
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
 
@@ -45,6 +47,9 @@ def _position_rows(model: PathErrorModel, geometry, k: int):
 
 
 def _check_geometry(model, geometry) -> None:
+    from .geometry import RouteGeometry
+
+    instance("geometry", geometry, RouteGeometry)
     if not isinstance(model, PathErrorModel):
         raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
     if geometry.exists.shape != model.exists.shape:
@@ -111,6 +116,8 @@ def position_error_parts(model: PathErrorModel, geometry, weights=None) -> np.nd
     model."""
     _check_geometry(model, geometry)
     T, P = model.exists.shape
+    if weights is not None and np.isnan(real_array("weights", weights)).any():
+        raise ValueError("weights: contains NaN (an infinite variance is allowed)")
     if weights is not None:
         weights = np.asarray(weights, float)
         if weights.shape != (T, P, 4, 4):
@@ -163,8 +170,8 @@ def drive_bound(pcrlb: np.ndarray, bias_rms: np.ndarray) -> np.ndarray:
     part is that of a snapshot fix weighted as the tracker weighs its paths (the design's
     sweep passes :func:`tunnelkit.design.fastroute.tracker_weights`), not minimised over the
     drive: the error of the tracker that is run, not a strict lower bound."""
-    p = np.asarray(pcrlb, float)
-    b = np.asarray(bias_rms, float)
+    p = bound_array("pcrlb", pcrlb)
+    b = bound_array("bias_rms", bias_rms)
     if p.shape != b.shape:
         raise ValueError(f"bias_rms: expected shape {p.shape} like pcrlb, got {b.shape}")
     return np.sqrt(p**2 + b**2)
@@ -191,6 +198,7 @@ def drive_pcrlb(
     sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
     sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
     sigma_p0 = positive("sigma_p0", sigma_p0)
+    info = finite_array("info", info, shape=(None, 2, 2))
     G, Qn, _ = drive_motion(setup, info.shape[0], sig_nu, sig_th)
     Q = G @ Qn @ np.swapaxes(G, 1, 2)
     Q += 1e-12 * np.eye(2)  # a standing vehicle: no motion noise, still a valid recursion

@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, nonnegative, rng_or_error
+from .._checks import real_array, square_matrices
+from .._validate import finite_array, nonnegative, rng_or_error, sequence
 
 __all__ = ["Z_NAMES", "PathErrorModel", "psd_sqrt"]
 
@@ -40,6 +41,7 @@ Z_NAMES = ("phi", "psi", "kappa", "d")
 def psd_sqrt(S: np.ndarray) -> np.ndarray:
     """A square root ``L`` with ``L L^T = S`` of a stack of symmetric positive semi-definite
     matrices (..., n, n), through the eigendecomposition (round-off negatives set to 0)."""
+    S = square_matrices("S", S)
     S = 0.5 * (S + np.swapaxes(S, -1, -2))
     w, V = np.linalg.eigh(S)
     return V * np.sqrt(np.clip(w, 0.0, None))[..., None, :]
@@ -91,6 +93,9 @@ class PathErrorModel:
     gain_sigma_db: float = 0.0
 
     def __post_init__(self) -> None:
+        sequence("kinds", self.kinds)
+        for name in ("truth", "v", "crlb", "cov", "bias"):  # NaN allowed where no path exists
+            real_array(name, getattr(self, name))
         ex = np.asarray(self.exists)
         if ex.ndim != 2 or ex.dtype != bool:
             raise ValueError(f"exists: expected a (T, P) bool array, got {ex.dtype} {ex.shape}")
@@ -128,6 +133,9 @@ class PathErrorModel:
                 raise ValueError(f"{name}: a calibration error needs its sensitivity {k}")
             if getattr(self, k) is not None and not np.all(np.isfinite(getattr(self, k))):
                 raise ValueError(f"{k}: every entry must be finite")
+        for name in ("crlb", "cov"):  # a covariance's variances are >= 0
+            if np.any(np.diagonal(np.asarray(getattr(self, name)), axis1=1, axis2=2) < 0):
+                raise ValueError(f"{name}: a variance is negative (not a covariance)")
 
     @property
     def n_elements(self) -> int | None:

@@ -48,9 +48,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import choice, nonnegative, rng_or_error
+from .._validate import choice, instance, nonnegative, positive, record, rng_or_error
 from ..constants import C
 from .errormodel import PathErrorModel
+from .geometry import RouteGeometry
 from .setup import DesignSetup, parse_array
 
 __all__ = [
@@ -78,6 +79,7 @@ SIGMA_V = 0.05
 def model_truth(g, fc: float) -> tuple[np.ndarray, np.ndarray]:
     """True ``z = [phi, psi, kappa, d]`` (T, P, 4) and radial speed ``v`` (T, P) [m/s] of every
     slot of a :class:`~tunnelkit.design.geometry.RouteGeometry` (NaN where a path is absent)."""
+    instance("g", g, RouteGeometry), positive("fc", fc)
     rel = g.source - g.origin[:, None, :]
     r = np.linalg.norm(rel, axis=-1)
     phi = np.arctan2(rel[..., 1], rel[..., 0])
@@ -107,6 +109,12 @@ class BoundRoute:
     origin: np.ndarray
     min_d: float
     repeating: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        blocks = ("T", "P", 4, 4)
+        record(self, shapes={"blocks": blocks, "noise_sqrt": ("T", None, None),
+                             "origin": ("T", 3), "repeating": blocks})  # fmt: skip
+        choice("report", self.report, REPORTS)
 
 
 def _reported_blocks(model: PathErrorModel, report: str) -> tuple[np.ndarray, np.ndarray | None]:
@@ -201,6 +209,7 @@ def bound_drive(
     from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
     from ..tracking.javelin.measurement import PathMeasurements
 
+    choice("report", report, REPORTS)
     if isinstance(model, BoundRoute):
         prepared = model
         if parse_array(spec).label != prepared.label:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, positive
+from .._validate import choice, finite_array, positive, record, sequence
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from ..propagation import Tunnel3D
@@ -49,6 +49,13 @@ class RouteGeometry:
     origin: np.ndarray
     rotation: np.ndarray
 
+    def __post_init__(self) -> None:
+        tp, t3 = ("T", "P"), ("T", "P", 3)
+        record(self, shapes={"ue": ("T", 3), "exists": tp, "source": t3, "point": t3, "gain": tp,
+                             "doppler": tp, "mirror": ("P", 3, 3), "kinds": ("P",),
+                             "names": ("P",), "array_index": ("T",), "origin": ("T", 3),
+                             "rotation": ("T", 3, 3)})  # fmt: skip
+
     @property
     def length(self) -> np.ndarray:
         """Path length to the reference antenna (T, P) [m]."""
@@ -71,7 +78,8 @@ def trace_route(
     """
     if not isinstance(tunnel, Tunnel3D):
         raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
-    arrays = list(arrays)
+    arrays = sequence("arrays", arrays)
+    kinds = tuple(choice("kinds", k, KINDS) for k in sequence("kinds", kinds))
     if not arrays or not all(isinstance(a, ArrayGeometry) for a in arrays):
         raise TypeError("arrays: expected a non-empty list of arrays.ArrayGeometry")
     fc = positive("fc", fc)

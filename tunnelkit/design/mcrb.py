@@ -40,6 +40,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import square_matrices
+from .._validate import finite_array, instance, integer, positive, probability
 from ..channel import DiffuseSpec
 from ..constants import C
 
@@ -76,6 +78,8 @@ def _gram(X: np.ndarray, Y: np.ndarray | None = None) -> np.ndarray:
 def scaled_inverse(G: np.ndarray, rcond: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
     """Inverse of a stack of symmetric positive (semi-)definite matrices (T, n, n) with Jacobi
     scaling, and a (T,) flag of the singular ones (their inverse is NaN)."""
+    G = square_matrices("G", G, ndim=3)
+    rcond = probability("rcond", rcond, open_interval=False)
     d = np.diagonal(G, axis1=1, axis2=2)
     sc = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
     Gs = sc[:, :, None] * G * sc[:, None, :]
@@ -88,6 +92,18 @@ def scaled_inverse(G: np.ndarray, rcond: float = 1e-12) -> tuple[np.ndarray, np.
     return inv, sing
 
 
+def _check_modes(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols) -> None:
+    """The arguments of :class:`EtaModes`: shapes (T, L, 3), (M, 3), (T, L) each."""
+    T, L, _ = finite_array("s_loc", s_loc, shape=(None, None, 3)).shape
+    finite_array("pos", pos, shape=(None, 3))
+    finite_array("alpha", alpha, dtype=complex, shape=(T, L))
+    finite_array("mu_f", mu_f, shape=(T, L)), finite_array("mu_t", mu_t, shape=(T, L))
+    if np.shape(mask) != (T, L) or np.asarray(mask).dtype != bool:
+        raise ValueError(f"mask: expected a ({T}, {L}) bool array, got {np.shape(mask)}")
+    positive("fc", fc), integer("n_tones", n_tones, minimum=1)
+    integer("n_symbols", n_symbols, minimum=1)
+
+
 class EtaModes:
     """The mode vectors of ``J`` for a stack of epochs (module docstring).
 
@@ -98,6 +114,7 @@ class EtaModes:
     """
 
     def __init__(self, s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols):
+        _check_modes(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols)
         T, L, _ = s_loc.shape
         self.k0 = 2 * np.pi * fc / C
         self.n_tones, self.n_symbols = int(n_tones), int(n_symbols)
@@ -132,6 +149,8 @@ class EtaModes:
 
     def assemble(self, Gs, Gf, Gt) -> np.ndarray:
         """``J_i^H (S (x) F (x) T) J_j`` (T, 7L, 7L) from the modes' matrices (complex)."""
+        for name, G, own in zip(("Gs", "Gf", "Gt"), (Gs, Gf, Gt), (self.X, self.F2, self.T2)):
+            finite_array(name, G, dtype=complex, shape=(own.shape[0], own.shape[2], own.shape[2]))
         si, fi, ti = self.si, self.fi, self.ti
         return (
             np.conj(self.coef)[:, :, None]
@@ -143,6 +162,7 @@ class EtaModes:
 
     def fim(self, noise_power: float) -> np.ndarray:
         """``A = (2 / sigma^2) Re J^H J`` (T, 7L, 7L)."""
+        positive("noise_power", noise_power)
         return 2.0 / noise_power * self.assemble(*self.grams).real
 
     def calibration_scores(self) -> np.ndarray:
@@ -159,6 +179,7 @@ class EtaModes:
 
     def wideband_terms(self, tone_spacing: float) -> int:
         """Number of series terms the spatial-wideband ``delta`` needs (``WB_TOL``)."""
+        positive("tone_spacing", tone_spacing)
         eps = 2 * np.pi * tone_spacing * np.abs(self.offset).max() / C
         x = 0.5 * (self.n_tones - 1) * eps
         n, term = 0, 1.0
@@ -170,6 +191,9 @@ class EtaModes:
     def wideband_score(self, tone_spacing: float, n_terms: int | None = None) -> np.ndarray:
         """``J^H delta`` (T, 7L) complex of the spatial-wideband term (series in the tone's
         offset from the band centre, ``n_terms`` terms, :meth:`wideband_terms` by default)."""
+        positive("tone_spacing", tone_spacing)
+        if n_terms is not None:
+            integer("n_terms", n_terms, minimum=1, maximum=200)
         N = self.wideband_terms(tone_spacing) if n_terms is None else int(n_terms)
         sc = 0.5 * (self.n_tones - 1)
         eps = 2 * np.pi * tone_spacing * self.offset / C  # (T, M, L)
@@ -199,6 +223,8 @@ class EtaModes:
     def diffuse_gram(self, spec: DiffuseSpec, tone_spacing: float, tau0) -> np.ndarray:
         """``J^H C_D J / P_D`` (T, 7L, 7L) complex for unit diffuse power starting at delay
         ``tau0`` (T,) [s] (module docstring)."""
+        instance("spec", spec, DiffuseSpec), positive("tone_spacing", tone_spacing)
+        finite_array("tau0", tau0, shape=(self.X.shape[0],))
         _, w = spec.taps(tone_spacing, self.n_tones)
         n_fft = spec.oversample * self.n_tones
         ph = np.exp(-2j * np.pi * tone_spacing * np.arange(self.n_tones)[None, :] * tau0[:, None])

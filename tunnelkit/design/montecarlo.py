@@ -47,7 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import integer
+from .._checks import bound_array
+from .._validate import choice, instance, integer, record
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import TrialPool, run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
@@ -151,6 +152,15 @@ class MonteCarloResult:
     learned: np.ndarray | None = None
     vues: str = "known"
 
+    def __post_init__(self) -> None:
+        b = ("peb", "pcrlb", "drive", "learned")
+        record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), "errors": ("R", "T"),
+                             "rmse_runs": ("R",), "settled": (None,)},
+               allow_nan=("errors", "rmse_runs"), nonnegative=("errors", "rmse_runs", "settled", *b),
+               allow_inf=b, skip=("spec",))  # fmt: skip
+        instance("spec", self.spec, ArraySpec), choice("mode", self.mode, MODES)
+        choice("vues", self.vues, VUES)
+
     @property
     def tracker_bound(self) -> np.ndarray | None:
         """The achievable bound over the drive of the tracker that was run (T,) [m]:
@@ -173,6 +183,8 @@ class MonteCarloResult:
 
     def settled_rms(self, bound: np.ndarray) -> float:
         """RMS of a per-epoch bound (T,) over the settled epochs [m]."""
+        if bound_array("bound", bound, ndim=1).shape != self.t.shape:
+            raise ValueError(f"bound: expected one value per epoch {self.t.shape}")
         return float(np.sqrt(np.mean(np.asarray(bound)[self.settled] ** 2)))
 
 
@@ -372,6 +384,8 @@ def sweep_montecarlo(
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    if not isinstance(specs, str | ArraySpec | Sequence):
+        raise TypeError(f"specs: expected arrays such as ['8x8'], got {type(specs).__name__}")
     if isinstance(specs, str | ArraySpec) or not isinstance(specs, Sequence | tuple):
         specs = [specs]
     specs = tuple(parse_array(s) for s in specs)

@@ -28,7 +28,7 @@ from functools import partial
 
 import numpy as np
 
-from .._validate import choice, finite_array, integer, positive, probability
+from .._validate import choice, finite_array, integer, positive, probability, sequence
 from ..budget import check_elements
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
@@ -292,6 +292,7 @@ def smallest_meeting(
     (``None``: the PEB), SR-NF only information; with ``"srnf"`` (an eq. 51 estimator) an epoch
     where SR-NF fails counts as missed. Arrays that do not fit are skipped; ``epochs``
     subsamples the route."""
+    sequence("arrays", arrays), epochs is None or finite_array("epochs", epochs, ndim=1)
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
     if share == 0:
@@ -488,8 +489,7 @@ def design_sweep(
     the error model; ``"channel"``: synthesis and extraction), seeded by ``seed``; ``workers``
     / ``scheduler`` / ``timeout`` go to the one task set; ``n_epochs`` truncates the route;
     ``n_boot`` bootstrap resamples. An array that does not fit, or whose bound or Monte-Carlo
-    is undefined, is a row with status ``"error"`` and the reason; the sweep goes on.
-    """
+    is undefined, is a row with status ``"error"`` and the reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     if isinstance(arrays, (str, ArraySpec)):

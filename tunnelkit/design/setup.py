@@ -19,7 +19,7 @@ from functools import lru_cache
 import numpy as np
 
 from .. import propagation
-from .._validate import choice, finite_array, integer, positive
+from .._validate import choice, finite_array, instance, integer, positive, record
 from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
 from ..constants import wavelength
@@ -71,23 +71,25 @@ class ArraySpec:
 _SPEC = re.compile(r"\s*(\d+)\s*(?:[xX×]\s*(\d+))?\s*")
 
 
-def parse_array(text, spacing_wl: float = 0.5) -> ArraySpec:
+def parse_array(spec, spacing_wl: float = 0.5) -> ArraySpec:
     """``"8x8"`` -> 8 x 8 URA, ``"16"`` -> 16-element ULA, an :class:`ArraySpec` passes through.
 
-    Anything else raises ``ValueError`` naming ``arrays``.
+    Anything else raises ``ValueError`` naming ``spec`` (the parameter every design function
+    passes it on from).
     """
-    if isinstance(text, ArraySpec):
-        return text
+    if isinstance(spec, ArraySpec):
+        return spec
+    text = spec
     if not isinstance(text, str):
-        raise TypeError(f"arrays: expected a string such as '8x8', got {type(text).__name__}")
+        raise TypeError(f"spec: expected a string such as '8x8', got {type(text).__name__}")
     m = _SPEC.fullmatch(text)
     if not m:
         raise ValueError(
-            f"arrays: cannot read {text!r}; expected N (a ULA) or NxM (a URA), e.g. 16 or 8x8"
+            f"spec: cannot read {text!r}; expected N (a ULA) or NxM (a URA), e.g. 16 or 8x8"
         )
     rows, cols = (1, int(m.group(1))) if m.group(2) is None else (int(m.group(1)), int(m.group(2)))
     if rows < 1 or cols < 1 or rows * cols < 2:
-        raise ValueError(f"arrays: {text!r} has fewer than 2 elements")
+        raise ValueError(f"spec: {text!r} has fewer than 2 elements")
     return ArraySpec(rows, cols, spacing_wl)
 
 
@@ -102,6 +104,9 @@ class Mount:
     centre: np.ndarray
     azimuth: float
     elevation: float
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"centre": (3,)})
 
 
 @dataclass(frozen=True)
@@ -150,6 +155,10 @@ class DesignSetup:
         for k in kinds:
             choice("kinds", k, propagation.PATH_KINDS)
         choice("channel", self.channel, CHANNELS)
+        if self.rt_settings is not None:
+            from ..rt import RTSettings  # the ray tracer loads only for a "sionna" channel
+
+            instance("rt_settings", self.rt_settings, RTSettings)
 
     @classmethod
     def from_scenario(
@@ -215,6 +224,8 @@ class DesignSetup:
     ) -> DesignSetup:
         """A copy with another carrier, bandwidth, down-tilt or mount height (``None`` keeps)."""
         choice("channel", channel, CHANNELS)
+        if mount_height is not None:
+            _mount_height_inside(self, float(finite_array("mount_height", mount_height, ndim=0)))
         cfg = self.config
         if fc is not None:
             cfg = replace(cfg, fc=positive("fc", fc))
@@ -300,6 +311,17 @@ class DesignSetup:
                 _placed(spec, self.fc, tuple(origin.tolist()), m.azimuth, m.elevation, m.name)
             )
         return out
+
+
+def _mount_height_inside(setup: DesignSetup, h: float) -> None:
+    """Refuse a mount height that puts a mount's centre outside the tunnel (``mount_height``)."""
+    for m in setup.mounts:
+        centre = np.array([m.centre[0], m.centre[1], h])
+        if not np.all(setup.tunnel.contains(centre, margin=0.0)):
+            raise ValueError(
+                f"mount_height: {h:g} m puts the base-station mount of array {m.name!r} at "
+                f"{centre.round(3).tolist()}, outside the tunnel"
+            )
 
 
 @lru_cache(maxsize=64)

@@ -45,7 +45,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, integer, positive, probability, rng_or_error
+from .._checks import bound, bound_array, real_array
+from .._validate import finite_array, integer, positive, probability, rng_or_error, sequence
 
 __all__ = [
     "CRITERIA",
@@ -83,6 +84,7 @@ def gate(values, srnf_valid, criterion: str) -> np.ndarray:
     not hold (``srnf_valid`` (T,) False) becomes ``inf``; ``"achievable"`` leaves them."""
     if criterion not in CRITERIA:
         raise ValueError(f"criterion: expected one of {CRITERIA}, got {criterion!r}")
+    real_array("values", values)
     v = np.asarray(values, float)
     ok = np.asarray(srnf_valid, bool)
     if ok.shape != v.shape[-1:]:
@@ -95,6 +97,7 @@ def share_quantile(values, share: float) -> float:
     ``method="inverted_cdf"``: the smallest observed ``q`` with at least ``share`` of the values
     <= ``q`` (so ``inf`` once fewer than ``share`` are finite)."""
     share = probability("share", share, open_interval=False)
+    real_array("values", values)
     v = np.asarray(values, float).ravel()
     if not v.size:
         raise ValueError("values: expected at least one value")
@@ -110,6 +113,7 @@ def implied_quantile(bounds, share: float) -> float:
     ``P(|e| <= x) = 1 - exp(-x^2 / bound^2)``, pooled over the epochs (a non-finite bound is an
     epoch never met). Solved by bisection on the pooled distribution function."""
     share = probability("share", share, open_interval=False)
+    bound_array("bounds", bounds, ndim=1)
     b = np.asarray(bounds, float).ravel()
     if not b.size:
         raise ValueError("bounds: expected at least one value")
@@ -144,6 +148,7 @@ def bootstrap_quantile_ci(
     share = probability("share", share, open_interval=False)
     level = probability("level", level)
     n_boot = integer("n_boot", n_boot, minimum=1)
+    real_array("errors", errors)
     e = np.asarray(errors, float)
     if e.ndim != 2 or not e.size:
         raise ValueError(f"errors: expected (runs, T) with runs, T >= 1, got shape {e.shape}")
@@ -211,6 +216,13 @@ def judge(
     target = positive("target", target)
     runs = integer("runs", runs, minimum=0)
     share = probability("share", share, open_interval=False)
+    bound("bound_q", bound_q)
+    if error_q is not None:
+        bound("error_q", error_q)
+    if ci is not None and len(sequence("ci", ci)) != 2:
+        raise ValueError(f"ci: expected a [lo, hi] interval, got {ci!r}")
+    if ci is not None:
+        bound("ci", ci[0]), bound("ci", ci[1])
     if np.isnan(bound_q) or bound_q < 0:
         raise ValueError(f"bound_q: expected a quantile >= 0 (inf allowed), got {bound_q!r}")
     pct = f"{100 * share:g} %"

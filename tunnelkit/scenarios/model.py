@@ -71,6 +71,11 @@ class Scenario:
 
     def trajectory(self, tunnel=None) -> Trajectory:
         """Ground-truth trajectory built from ``[trajectory]`` by the builder of its ``kind``."""
+        if tunnel is not None and not callable(getattr(tunnel, "contains", None)):
+            raise TypeError(
+                f"tunnel: expected a tunnel (geometry.Tunnel2D or propagation.Tunnel3D), got "
+                f"{type(tunnel).__name__}"
+            )
         sec = self.section("trajectory")
         get = getter(self.path.name, sec, "trajectory")
         kind = get("kind", str)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._validate import finite_array, record
 from ..metrics import SETTLE_S, settled
 from ..tracking import registry
 from ..tracking.javelin.designs import paper
@@ -47,6 +48,11 @@ def tenfiloc_track(
 
 def error_metrics(estimates, truth) -> dict[str, float]:
     """2-D RMSE, 2-D MAE (mean Euclidean error in the road plane) and Y-MAE (lateral) [m]."""
+    a, b = finite_array("estimates", estimates), finite_array("truth", truth)
+    if a.shape != b.shape or a.ndim == 0 or a.shape[-1] < 2:
+        raise ValueError(
+            f"estimates, truth: expected positions of one shape, got {a.shape}, {b.shape}"
+        )
     e = np.asarray(estimates, float)[..., :2] - np.asarray(truth, float)[..., :2]
     e2 = np.linalg.norm(e, axis=-1)
     return {
@@ -63,6 +69,9 @@ class Evaluation:
     estimates: np.ndarray
     metrics: dict[str, float]
     run: JavelinRun | None = None
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"estimates": (None, 3)})
 
 
 def evaluate(

@@ -38,7 +38,16 @@ import warnings
 import numpy as np
 from filterpy.kalman import MerweScaledSigmaPoints
 
-from .._validate import finite_array, integer, positive, probability, real, rng_or_error
+from .._checks import real_array
+from .._validate import (
+    finite_array,
+    integer,
+    nonnegative,
+    positive,
+    probability,
+    real,
+    rng_or_error,
+)
 from .._validate import weights as check_weights
 from ..budget import check_elements
 from .cv import STATE_DIM
@@ -86,7 +95,7 @@ def _merwe_weights(n, alpha, beta, kappa) -> tuple[np.ndarray, np.ndarray, float
 
 def _check_merwe(n, alpha, beta, kappa):
     n = integer("n", n, minimum=1)
-    alpha, beta, kappa = positive("alpha", alpha), real("beta", beta), real("kappa", kappa)
+    alpha, beta, kappa = positive("alpha", alpha), nonnegative("beta", beta), real("kappa", kappa)
     return n, alpha, beta, kappa
 
 
@@ -98,6 +107,15 @@ def ukf_proposal(
     ``m_pred`` (..., 4) and ``P_pred`` (..., 4, 4) are the predicted means and covariances,
     ``z`` (..., 2N) broadcasts against them.
     """
+    check_model(model)
+    m = finite_array("m_pred", m_pred)
+    if m.ndim == 0 or m.shape[-1] != STATE_DIM:
+        raise ValueError(f"m_pred: expected means (..., {STATE_DIM}), got shape {m.shape}")
+    finite_array("P_pred", P_pred, ndim=None)
+    if np.shape(P_pred)[-2:] != (STATE_DIM, STATE_DIM):
+        raise ValueError(f"P_pred: expected covariances (..., 4, 4), got {np.shape(P_pred)}")
+    if np.broadcast_shapes(real_array("z", z).shape[:-1], m.shape[:-1]) != m.shape[:-1]:
+        raise ValueError(f"z: expected measurements (..., 2N) like m_pred, got {np.shape(z)}")
     return _ukf_update(model, m_pred, P_pred, z, alpha, beta, kappa)[:2]
 
 
@@ -242,6 +260,7 @@ class UnscentedParticleFilter(EstimatorBase):
         if self.resample_threshold == 0:
             raise ValueError("resample_threshold: must be > 0")
         self.alpha, self.beta, self.kappa = positive("alpha", alpha), float(beta), float(kappa)
+        nonnegative("beta", beta), real("kappa", kappa)
         merwe_weights(STATE_DIM, self.alpha, self.beta, self.kappa)
         x0 = finite_array("x0", x0)
         self._batched = x0.ndim == 2
@@ -462,6 +481,7 @@ class UnscentedParticleFilter(EstimatorBase):
         """All runs filtered together (batch axis), epochs in a loop: estimates (R, T, 4)."""
         if rng is None:
             raise TypeError("rng: the UPF needs an explicit numpy.random.Generator")
+        real_array("Z", Z, ndim=3), finite_array("x0", x0)
         Z = np.asarray(Z, dtype=float)
         f = cls(model, np.asarray(x0, dtype=float), P0, rng=rng, **options)
         out = np.empty((*Z.shape[:2], STATE_DIM))
@@ -490,6 +510,7 @@ def one_epoch_ess(
     epoch k measures how well the proposal of that epoch alone matches the posterior (the
     diagnostic of the eq. 52 trap in notebook 05). Returns (epochs,).
     """
+    real_array("Z", Z, ndim=2)
     Z = np.asarray(Z, dtype=float)
     T = Z.shape[0] if epochs is None else integer("epochs", epochs, minimum=1)
     f = UnscentedParticleFilter(

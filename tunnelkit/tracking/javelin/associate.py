@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from ..._validate import instance
+from ..._validate import finite_array, instance, record
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate, mahalanobis2
 from .measurement import PathMeasurements, check_track_model
@@ -44,6 +44,10 @@ class AssociationCosts:
     def __post_init__(self) -> None:
         if self.cost is None:
             self.cost = self.eta2
+        ln = ("L", "n")
+        record(self, shapes={"eta2": ln, "dof": ("n",), "gated": ln, "threshold": ("n",),
+                             "cost": ln},
+               nonnegative=("eta2", "dof", "threshold"), allow_inf=("eta2", "cost"))  # fmt: skip
 
 
 def association_costs(
@@ -76,6 +80,9 @@ def association_costs(
         raise ValueError(
             f"P: expected the ({J.shape[-1]}, {J.shape[-1]}) state covariance, got shape {np.shape(P)}"
         )
+    finite_array("P", P)
+    if finite_array("R3", R3).shape not in ((3, 3), (len(meas), 3, 3)):
+        raise ValueError(f"R3: expected shape (3, 3) or ({len(meas)}, 3, 3), got {np.shape(R3)}")
     L, n = pred.shape[0], len(meas)
     if n == 0 or L == 0:
         e = np.zeros((L, n))
@@ -129,6 +136,7 @@ def global_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:
     Ungated pairs get a cost above any gated total, so they are chosen only when nothing else
     fits and are then dropped; the result is the maximum-cardinality, minimum-cost matching.
     """
+    instance("costs", costs, AssociationCosts)
     if costs.eta2.size == 0 or not costs.gated.any():
         return []
     # shift to non-negative costs (a log-likelihood cost can be negative), then price every

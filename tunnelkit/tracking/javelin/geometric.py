@@ -10,7 +10,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import finite_array, integer, nonnegative, positive, rng_or_error, vector
+from ..._checks import items, sign
+from ..._validate import (
+    boolean,
+    finite_array,
+    integer,
+    nonnegative,
+    positive,
+    probability,
+    real,
+    rng_or_error,
+    vector,
+)
 from ...budget import check_elements
 from ...geometry import Plane, reflector_point
 from .measurement import PathMeasurements
@@ -21,7 +32,7 @@ __all__ = ["GeometricTruth", "geometric_paths", "geometric_stream", "toy_drive",
 def toy_reflectors(half_width: float = 4.5) -> list[Plane]:
     """Two side walls (``y = +-half_width``) and two road-marking plates at the wall/sidewalk
     junction tilted by 55 deg (a toy version of the paper's section 4.1 tunnel)."""
-    w = float(half_width)
+    w = positive("half_width", half_width)
     a = np.radians(55.0)
     return [
         Plane(np.array([0.0, -1.0, 0.0]), w, name="left wall"),
@@ -73,6 +84,8 @@ def geometric_paths(
     vu = vector("v_u", v_u, 3)
     b = vector("bs", bs, 3)
     finite_array("clock_bias", clock_bias, ndim=0)
+    items("planes", planes, Plane, empty=True)
+    boolean("los", los), boolean("shuffle", shuffle), sign("doppler_sign", doppler_sign)
     for name, s in (
         ("sigma_phi", sigma_phi),
         ("sigma_psi", sigma_psi),
@@ -145,6 +158,12 @@ def toy_drive(
     with a lateral sine of ``amplitude`` around ``lane`` (``amplitude = 0``: straight lane)."""
     n = integer("n", n, minimum=1)
     dt = positive("dt", dt)
+    for name, value in (("start", start), ("stop", stop), ("lane", lane)):
+        real(name, value)
+    if stop == start:
+        raise ValueError(f"stop: must differ from start ({start}), got {stop}")
+    positive("speed", speed), nonnegative("amplitude", amplitude), positive("period", period)
+    positive("height", height)
     check_elements("n", 6 * n)
     t = np.arange(n) * dt
     mid, half = 0.5 * (start + stop), 0.5 * abs(stop - start)
@@ -168,6 +187,10 @@ def geometric_stream(
     number) go to :func:`geometric_paths`. For unit tests only.
     """
     rng = rng_or_error("rng", rng)
+    P = finite_array("P", P, shape=(None, 3))
+    V = finite_array("V", V, shape=(len(P), 3))
+    items("planes", planes, Plane, empty=True)
+    probability("los_probability", los_probability, open_interval=False)
     bias = kw.pop("clock_bias", 0.0)
     out = []
     for p, v in zip(np.asarray(P, float), np.asarray(V, float)):

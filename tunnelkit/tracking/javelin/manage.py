@@ -7,7 +7,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import instance
+from ..._checks import series
+from ..._checks import sign as check_sign
+from ..._validate import instance, integer, positive, real, record, sequence, vector
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 from .noise import FixedNoise
@@ -31,6 +33,10 @@ def los_test(d, kappa, gamma: float, candidates=None) -> int | None:
     ``candidates`` restricts the search (we search only paths no VUE track claimed); paths
     without a curvature or a delay cannot be tested.
     """
+    series("d", d), series("kappa", kappa), positive("gamma", gamma)
+    if candidates is not None:
+        for i in sequence("candidates", candidates, empty=True):
+            integer("candidates", i, minimum=0, maximum=np.size(d) - 1)
     d = np.asarray(d, dtype=float)
     kappa = np.asarray(kappa, dtype=float)
     ok = np.isfinite(d) & np.isfinite(kappa) & (kappa > 0)
@@ -50,7 +56,8 @@ def intersection(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.n
     """``Intersection`` of Algorithm 3: the arrival ray from the base station meets the plane
     ``x = x_u`` (the VUE shares the UE's x). Returns the VUE ``(y, z)`` or ``None`` if the ray
     runs parallel to that plane or points away from it."""
-    b = np.asarray(bs, dtype=float)
+    real("phi", phi), real("psi", psi), real("x_u", x_u)
+    b = vector("bs", bs, 3)
     u = np.array([np.cos(psi) * np.cos(phi), np.cos(psi) * np.sin(phi), np.sin(psi)])
     if abs(u[0]) < 1e-6:
         return None
@@ -112,6 +119,9 @@ def static_doppler(p_u, p_v, v_u, bs=(0.0, 0.0, 0.0), sign: float = -1.0) -> flo
     in the reflecting plane (normal along ``p_v - p_u``); ``p_v = p_u`` means the LoS path.
 
     Returns ``sign * d||p_v - b||/dt`` (``sign = -1``: positive when approaching)."""
+    for name, value in (("p_u", p_u), ("p_v", p_v), ("v_u", v_u), ("bs", bs)):
+        vector(name, value, 3)
+    sign = check_sign("sign", sign)
     pu, pv, vu = (np.asarray(a, dtype=float) for a in (p_u, p_v, v_u))
     b = np.asarray(bs, dtype=float)
     w = pv - pu
@@ -142,6 +152,7 @@ class FixedBirth:
 
     def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
         """Covariance (2, 2) of the VUE born from path ``j`` and its cross-covariance (or None)."""
+        _birth_arguments(state, meas, j, noise)
         instance("config", config, JavelinConfig)
         return np.eye(2) * config.sigma_p0**2, None
 
@@ -153,6 +164,8 @@ class MeasuredBirth(FixedBirth):
     :func:`~tunnelkit.tracking.javelin.manage.birth_covariance`)."""
 
     def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
+        _birth_arguments(state, meas, j, noise)
+        instance("config", config, JavelinConfig)
         return birth_covariance(state, meas, j, config, noise)
 
 
@@ -167,6 +180,27 @@ class ManageResult:
     dead: list[int] = field(default_factory=list)
     dynamic: list[int] = field(default_factory=list)
     unborn: list[int] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        lists = ("pairs", "born", "dead", "dynamic", "unborn")
+        record(self, may_be_empty=lists, nonnegative=("los_path",))
+        if self.los != (self.los_path is not None):
+            raise ValueError(f"los: {self.los} disagrees with los_path = {self.los_path}")
+
+
+def _birth_arguments(state, meas, j, noise) -> None:
+    """The arguments every initiator's ``covariance`` takes (a path index into ``meas``)."""
+    instance("state", state, JavelinState)
+    instance("meas", meas, PathMeasurements)
+    integer("j", j, minimum=0, maximum=len(meas) - 1)
+    noise_role("noise", noise)
+
+
+def noise_role(name: str, noise):
+    """``None`` (the paper's fixed sigmas) or a measurement-noise role (``covariances``)."""
+    if noise is not None and not callable(getattr(noise, "covariances", None)):
+        raise TypeError(f"{name}: expected a measurement-noise role, got {type(noise).__name__}")
+    return noise
 
 
 def manage_tracks(
@@ -200,6 +234,9 @@ def manage_tracks(
     instance("state", state, JavelinState)
     instance("meas", meas, PathMeasurements)
     instance("config", config, JavelinConfig)
+    sequence("pairs", pairs, empty=True), noise_role("noise", noise)
+    if v_u is not None:
+        vector("v_u", v_u, 3)
     initiator = FixedBirth() if initiator is None else instance("initiator", initiator, FixedBirth)
     pairs = [(int(i), int(j)) for i, j in pairs]
     assoc_tracks = {i for i, _ in pairs}

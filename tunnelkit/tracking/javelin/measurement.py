@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, nonnegative, real, vector
+from ..._checks import series
+from ..._validate import boolean, finite_array, nonnegative, real, vector
 from ...geometry import spherical_jacobian
 from .state import vue_positions
 
@@ -131,7 +132,9 @@ class PathMeasurements:
 
     def __post_init__(self) -> None:
         # built directly (not through from_arrays): 1-D float arrays of one length, and a
-        # default ``source`` so that ``subset`` works
+        # default ``source`` so that ``subset`` works (NaN angles: the tracker sanitises them)
+        for name in ("phi", "psi", "kappa", "d", "v", "source"):
+            series(name, getattr(self, name), finite=name == "source")
         for name in ("phi", "psi", "kappa", "d", "v"):
             setattr(self, name, np.asarray(getattr(self, name), dtype=float).reshape(-1))
         n = self.phi.size
@@ -158,6 +161,7 @@ class PathMeasurements:
         """These paths through the checks of Algorithm 1 (idempotent), and how many were dropped.
 
         ``source`` keeps pointing into the original input."""
+        real("min_d", min_d)
         clean = PathMeasurements.from_arrays(
             self.phi, self.psi, self.kappa, self.d, self.v, warn=False, min_d=min_d
         )
@@ -191,6 +195,10 @@ class PathMeasurements:
         :class:`JavelinWarning`. ``cov`` / ``sigma_d`` / ``bias_cov``: the reported uncertainty
         of every input path and its repeating share (see the class).
         """
+        for name, value in (("phi", phi), ("psi", psi), ("kappa", kappa), ("d", d), ("v", v)):
+            if value is not None:
+                series(name, value)
+        boolean("warn", warn), real("min_d", min_d)
         phi = np.asarray(phi, dtype=float).reshape(-1)
         n = phi.size
         psi = _opt("psi", psi, n)
@@ -325,6 +333,8 @@ def check_track_model(pred, J) -> tuple[np.ndarray, np.ndarray]:
         if arr.ndim != nd or arr.shape[1:2] != (4,):
             want = "(L, 4)" if nd == 2 else "(L, 4, D)"
             raise ValueError(f"{name}: expected shape {want} (track_model), got {arr.shape}")
+        if not np.isfinite(arr[:, [PHI, PSI, RANGE]]).all():  # only a curvature may be undefined
+            raise ValueError(f"{name}: the angle and delay rows must be finite")
         out.append(arr)
     if out[0].shape[0] != out[1].shape[0]:
         raise ValueError(f"J: {out[1].shape[0]} tracks, pred has {out[0].shape[0]}")

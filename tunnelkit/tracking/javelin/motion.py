@@ -18,15 +18,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import instance, nonnegative
+from ..._validate import choice, instance, nonnegative, positive, real
 from .config import JavelinConfig
 from .state import JavelinState
 
 __all__ = ["motion_increment", "predict", "ue_velocity"]
 
+#: the VUE motion models (:class:`RandomWalk`, :class:`MirrorMotion`)
+VUE_MOTIONS = ("random_walk", "mirror")
+
 
 def ue_velocity(speed: float, heading: float) -> np.ndarray:
     """UE velocity (3,) from speed [m/s] and heading [rad] (angle from +x in the road plane)."""
+    real("speed", speed), real("heading", heading)
     return float(speed) * np.array([np.cos(heading), np.sin(heading), 0.0])
 
 
@@ -35,6 +39,8 @@ def motion_increment(
 ) -> tuple[np.ndarray, np.ndarray]:
     """State increment ``f(s) - s`` (D,) and its sensitivity ``G`` (D, 2) to ``(nu, theta)``."""
     instance("state", state, JavelinState)
+    real("speed", speed), real("heading", heading), nonnegative("dt", dt)
+    choice("vue_motion", vue_motion, VUE_MOTIONS)
     D = state.dim
     du = dt * ue_velocity(speed, heading)
     Gu = dt * np.array(
@@ -80,6 +86,8 @@ def predict(
     dt = nonnegative("dt", dt)
     instance("state", state, JavelinState)
     instance("config", config, JavelinConfig)
+    if sigma_speed is not None:
+        positive("sigma_speed", sigma_speed)
     inc, G = motion_increment(state, speed, heading, dt, vue_motion)
     s_nu = config.sigma_speed if sigma_speed is None else sigma_speed
     Q = G @ np.diag([s_nu**2, config.sigma_heading**2]) @ G.T

@@ -61,7 +61,7 @@ class FixedNoise:
         self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
     ) -> np.ndarray:
         """Covariance of the TDoA rows ``d_j - d_ref`` for the paths ``others``."""
-        instance("config", config, JavelinConfig)
+        others, reference = _tdoa_rows(meas, others, reference, config)
         nd = len(others)
         s2 = config.sigma_delta_d**2
         if self.correlated_delta_d:

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
 
+from ..._validate import instance
 from .associate import Associator
 from .config import JavelinConfig
 from .manage import FixedBirth, MeasuredBirth
@@ -125,6 +126,7 @@ class JavelinDesign:
 
     def with_prefilter(self, pre) -> JavelinDesign:
         """A copy with ``pre`` replacing the pre-filter of its type (or appended)."""
+        instance("pre", pre, (DelayCheck, DopplerClutter))
         kind = type(pre)
         kept = [p for p in self.prefilters if type(p) is not kind]
         new = [pre, *kept] if kind is DelayCheck else [*kept, pre]

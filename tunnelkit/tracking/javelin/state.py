@@ -19,13 +19,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import finite_array, integer, positive, vector
+from ..._validate import boolean, finite_array, integer, positive, record, sequence, vector
 
 __all__ = ["JavelinState", "bias_slice", "track_slice"]
 
 
 def track_slice(i: int) -> slice:
     """State indices of track ``i``: ``0:3`` for the UE, ``3 + 2(i-1) : 5 + 2(i-1)`` for VUE i."""
+    if type(i) is not int or i < 0:
+        i = integer("i", i, minimum=0)
     if i == 0:
         return slice(0, 3)
     return slice(3 + 2 * (i - 1), 5 + 2 * (i - 1))
@@ -66,6 +68,8 @@ class JavelinState:
         return cls(x=p.copy(), P=np.diag([s * s, s * s, sh * sh]))
 
     def __post_init__(self) -> None:
+        record(self, skip=("x", "P", "C"), may_be_empty=("ids", "misses", "transient"),
+               nonnegative=("ue_misses",), positive=("next_id",))  # fmt: skip
         self.x = finite_array("x", self.x, ndim=1)
         self.P = finite_array("P", self.P, shape=(self.x.size, self.x.size))
         if self.x.size < 3 or (self.x.size - 3) % 2:
@@ -130,7 +134,9 @@ class JavelinState:
         Marginalising a Gaussian is dropping rows and columns (section 3.5); the UE cannot be
         removed.
         """
-        tracks = sorted({int(i) for i in tracks})
+        tracks = sorted(
+            {integer("tracks", i, minimum=1) for i in sequence("tracks", tracks, empty=True)}
+        )
         if not tracks:
             return []
         if tracks[0] < 1 or tracks[-1] > self.n_vue:
@@ -162,6 +168,7 @@ class JavelinState:
         """
         yz = vector("yz", yz, 2)
         cov = finite_array("cov", cov, shape=(2, 2))
+        boolean("transient", transient)
         d = self.dim
         P = np.zeros((d + 2, d + 2))
         P[:d, :d] = self.P

@@ -28,12 +28,17 @@ from typing import ClassVar
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..._validate import positive, vector
+from ..._checks import attributes, real_array
+from ..._validate import choice, instance, integer, positive, record, vector
 from ...constants import C
 from .manage import los_test
 from .measurement import PathMeasurements
 
 __all__ = ["TeNFiLoc", "TeNFiLocFix"]
+
+
+#: what :meth:`TeNFiLoc.for_drive` reads of a drive
+_DRIVE = ("condition", "base_station", "clock_bias_limit")
 
 
 @dataclass
@@ -43,6 +48,10 @@ class TeNFiLocFix:
     position: np.ndarray | None
     mode: str  # "los-kappa" | "los-d" | "nlos" | "none"
     paths: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"position": (3,)}, may_be_empty=("paths",))
+        choice("mode", self.mode, ("los-kappa", "los-d", "nlos", "none"))
 
 
 @dataclass
@@ -67,6 +76,7 @@ class TeNFiLoc:
     bias_limit: float = C * 100e-9
 
     def __post_init__(self) -> None:
+        record(self, skip=("base_station",))
         positive("max_range", self.max_range)
         positive("bias_limit", self.bias_limit)
         g = positive("los_gamma", self.los_gamma)
@@ -82,6 +92,7 @@ class TeNFiLoc:
         route. ``design`` must be ``None`` (TeNFiLoc has no tracker design)."""
         if design is not None:
             raise ValueError(f"design: TeNFiLoc takes no tracker design, got {design!r}")
+        attributes("drive", drive, _DRIVE, "a simulated drive (studies.DriveData)")
         cond = drive.condition
         return cls(
             base_station=tuple(float(v) for v in drive.base_station),
@@ -92,6 +103,7 @@ class TeNFiLoc:
     def track(self, drive) -> tuple[np.ndarray, np.ndarray]:
         """Fixes per epoch (T, 3) and which epochs had a fix; without a fix the previous one is
         held (the true start position before the first), so every epoch has an estimate."""
+        attributes("drive", drive, ("truth", "epochs"), "a simulated drive (studies.DriveData)")
         out = np.empty_like(np.asarray(drive.truth, dtype=float))
         ok = np.zeros(len(drive.epochs), bool)
         last = np.asarray(drive.truth[0], dtype=float).copy()
@@ -107,6 +119,12 @@ class TeNFiLoc:
         self, paths: PathMeasurements | None, *, los_path: int | None = None, initial=None
     ) -> TeNFiLocFix:
         """Fix from ``paths``; ``los_path`` forces the LoS path (else eq. 60-61 decides)."""
+        if paths is not None:
+            instance("paths", paths, PathMeasurements)
+        if los_path is not None:
+            integer("los_path", los_path, minimum=0)
+        if initial is not None:
+            vector("initial", initial, 3)
         if paths is None or len(paths) == 0:
             return TeNFiLocFix(None, "none")
         b = np.asarray(self.base_station)
@@ -126,6 +144,7 @@ class TeNFiLoc:
     def plausible_kappa(self, kappa: float, d: float) -> bool:
         """Whether a LoS curvature can be a range: positive, within ``max_range``, and (when the
         delay is known) within the clock-bias support of it, ``|d - kappa| <= bias_limit``."""
+        real_array("kappa", kappa, ndim=0), real_array("d", d, ndim=0)
         if not (np.isfinite(kappa) and 0.0 < kappa <= self.max_range):
             return False
         return not np.isfinite(d) or abs(d - kappa) <= self.bias_limit

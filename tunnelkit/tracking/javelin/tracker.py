@@ -17,7 +17,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..._validate import boolean, finite_array, nonnegative, positive, rng_or_error, vector
+from ..._checks import attributes, optional_real
+from ..._validate import boolean, finite_array, nonnegative, positive, record, rng_or_error, vector
 from ..gating import ChiSquareGate
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
@@ -54,6 +55,12 @@ class StepReport:
     paths: PathMeasurements
     faults: list[str] = field(default_factory=list)
     clutter: int = 0
+
+    def __post_init__(self) -> None:
+        lists = ("prior_ids", "associated", "ids", "faults")
+        record(self, shapes={"prior_positions": (None, 3), "estimate": (3,), "cov": (3, 3),
+                             "positions": (None, 3)},
+               nonnegative=("k", "n_paths", "n_rows", "nis", "clutter"), may_be_empty=lists)  # fmt: skip
 
 
 class Javelin:
@@ -100,6 +107,9 @@ class Javelin:
         drive's reference antenna, the roles of ``design`` (default the paper's). An honest start
         (its error drawn with the covariance the tracker is told, :func:`draw_start`) is the
         caller's to give."""
+        attributes(
+            "drive", drive, ("truth", "base_station"), "a simulated drive (studies.DriveData)"
+        )
         d = JavelinDesign() if design is None else design
         if not isinstance(d, JavelinDesign):
             raise TypeError(f"design: expected a JavelinDesign, got {type(d).__name__}")
@@ -113,6 +123,7 @@ class Javelin:
 
     def track(self, drive, *, keep_reports: bool = False) -> tuple[np.ndarray, JavelinRun]:
         """UE estimates (T, 3) over ``drive``'s measurement stream and the :class:`JavelinRun`."""
+        attributes("drive", drive, _DRIVE, "a simulated drive (studies.DriveData)")
         run = self.run(
             drive.epochs, drive.speed, drive.heading, drive.dt, keep_reports=keep_reports
         )
@@ -129,7 +140,8 @@ class Javelin:
         spd, hdg = (_v2x(k, v) for k, v in (("speed", speed), ("heading", heading)))
         if spd.size != n or hdg.size != n:
             raise ValueError(
-                f"speed, heading: expected {n} values (one per epoch), got {spd.size} and {hdg.size}"
+                f"epochs, speed, heading: expected one speed and heading per epoch ({n}), got "
+                f"{spd.size} and {hdg.size}"
             )
         finite_array("dt", dt, ndim=0)
         est = np.empty((n, 3))
@@ -257,6 +269,7 @@ class Javelin:
         """One epoch: predict with (speed, heading) over ``dt``, associate, manage, update."""
         cfg, roles = self.config, self.design
         dt = nonnegative("dt", dt)
+        optional_real("speed", speed), optional_real("heading", heading)
         faults: list[str] = []
         meas = self._paths(paths, faults)
         nu, theta, sig_nu = self._motion(speed, heading, faults)
@@ -353,6 +366,15 @@ class JavelinRun:
     n_tracks: np.ndarray
     reports: list[StepReport]
     faults: int
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"estimates": ("T", 3), "covariances": ("T", 3, 3),
+                             "n_tracks": ("T",)},
+               nonnegative=("n_tracks", "faults"), may_be_empty=("reports",))  # fmt: skip
+
+
+#: what :meth:`Javelin.track` reads of a drive
+_DRIVE = ("epochs", "speed", "heading", "dt")
 
 
 def draw_start(

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from ..._validate import finite_array, instance, integer, probability
+from ..._validate import finite_array, instance, integer, probability, record, sequence
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
@@ -49,6 +49,14 @@ __all__ = [
     "schmidt_update",
     "stack_measurement",
 ]
+
+
+def state_arguments(x, P, D: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """A filter's state ``x`` (D,) and covariance ``P`` (D, D): finite, of matching sizes."""
+    x = finite_array("x", x, ndim=1)
+    if D is not None and x.size != D:
+        raise ValueError(f"x: expected {D} entries (the state's dimension), got {x.size}")
+    return x, finite_array("P", P, shape=(x.size, x.size))
 
 
 @dataclass
@@ -67,6 +75,10 @@ class StackedMeasurement:
     B: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        rows = ("K",)
+        record(self, shapes={"z": rows, "h": rows, "H": ("K", None), "R": ("K", "K"),
+                             "angle": rows, "labels": rows, "reference": (2,)},
+               may_be_empty=("labels",), skip=("B",))  # fmt: skip
         if self.B is not None:
             self.B = finite_array("B", self.B, ndim=2)
             if self.B.shape[0] != np.size(self.z):
@@ -95,6 +107,9 @@ def stack_measurement(
     (:class:`~.noise.ConsiderNoise`), ``R`` is the white share and ``B`` the rows' map of the
     tracks' normalised biases (a TDoA row ``L_j[d] u_i - L_ref[d] u_ref``)."""
     pred, J = check_track_model(pred, J)
+    sequence("pairs", pairs, empty=True)
+    if los_path is not None:
+        integer("los_path", los_path, minimum=0)
     instance("meas", meas, PathMeasurements)
     instance("config", config, JavelinConfig)
     noise = FixedNoise() if noise is None else noise
@@ -241,6 +256,7 @@ def joseph_update(
     semi-definite under rounding; we symmetrise once more against round-off.
     """
     instance("m", m, StackedMeasurement)
+    state_arguments(x, P, m.H.shape[1] if m.z.size else None)
     if m.z.size == 0:
         return x.copy(), P.copy(), 0.0
     y = m.residual()
@@ -289,6 +305,10 @@ def exclude_inconsistent(
     of the kept pairs and the pairs left out (in order). Raises ``numpy.linalg.LinAlgError`` if
     an innovation covariance is not positive definite (the tracker then skips the update).
     ``C``: the consider cross-covariance (:func:`stack_measurement`)."""
+    (
+        state_arguments(x, P, np.shape(J)[-1] if np.ndim(J) else None),
+        sequence("pairs", pairs, empty=True),
+    )
     gate = ChiSquareGate(probability)
     pairs = list(pairs)
     out: list[tuple[int, int]] = []
@@ -313,12 +333,15 @@ class JosephUpdater:
 
     def stack(self, x, P, pred, J, meas, pairs, config, los_path, noise, C=None):
         """The stacked measurement of the pairs to update with and the pairs left out."""
+        state_arguments(x, P, np.shape(J)[-1] if np.ndim(J) else None)
         return stack_measurement(pred, J, meas, pairs, config, los_path, noise, C), []
 
     def update(self, x, P, m: StackedMeasurement, C=None):
         """``(x, P, nis)`` after the update (:func:`~.update.joseph_update`); with a consider
         cross-covariance ``C`` and ``m.B``, ``(x, P, nis, C)`` (:func:`consider_update`)."""
+        instance("m", m, StackedMeasurement)  # x and P: checked by the update that runs
         if C is not None:
+            state_arguments(x, P, m.H.shape[1] if m.z.size else None)
             C = finite_array("C", C, ndim=2)
         if C is not None and m.B is not None and (np.any(m.B) or np.any(C)):
             x, P, C, nis = consider_update(x, P, C, m)

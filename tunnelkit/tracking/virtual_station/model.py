@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import positioning
-from ..._validate import boolean, finite_array, integer, positive, rng_or_error, text
+from ..._checks import real_array
+from ..._validate import boolean, finite_array, integer, positive, probability, rng_or_error, text
 from ...crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from ...scenarios import load_scenario
 from ..cv import STATE_DIM, cv_process_noise, cv_transition
@@ -47,6 +48,8 @@ def regularized_cholesky(P, *, name: str = "P", rel_floor: float = 1e-10) -> np.
     ``1e-12``) and a ``RuntimeWarning`` says so; the factor is never NaN.
     """
     name = text("name", name)
+    probability("rel_floor", rel_floor)
+    real_array(name, P)
     P = np.asarray(P, dtype=float)
     if not np.all(np.isfinite(P)):
         raise ValueError(f"{name}: covariance contains NaN or infinite values")
@@ -171,7 +174,7 @@ class VsModel:
 
     def residual_z(self, a, b) -> np.ndarray:
         """``a - b`` with the bearing components wrapped to ``(-pi, pi]``."""
-        r = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+        r = real_array("a", a) - real_array("b", b)
         n = self.n_stations
         r[..., n:] = wrap_angle(r[..., n:])
         return r
@@ -182,7 +185,10 @@ class VsModel:
         Bearings are averaged as wrapped offsets from the first sigma point, so the mean of
         bearings straddling +-pi is right; the result's bearings are wrapped.
         """
-        sig = np.asarray(sigmas, dtype=float)
+        sig = finite_array("sigmas", sigmas)
+        if sig.ndim < 2:
+            raise ValueError(f"sigmas: expected sigma points (..., S, 2N), got shape {sig.shape}")
+        finite_array("Wm", Wm, shape=(sig.shape[-2],))
         ref = sig[..., :1, :]
         m = ref[..., 0, :] + np.einsum(
             "s,...sj->...j", np.asarray(Wm, float), self.residual_z(sig, ref)
@@ -193,6 +199,7 @@ class VsModel:
 
     def log_likelihood(self, z, x) -> np.ndarray:
         """``log p(Z | X)`` up to a constant, for state(s) ``x`` (..., 4) and ``z`` broadcasting."""
+        real_array("z", z)
         r = self.residual_z(z, self.hx(x))
         return -0.5 * np.sum(r * r / np.diag(self.R), axis=-1)
 

@@ -1,0 +1,128 @@
+"""More recorded valid calls for the contract suite (:mod:`contract_values`): the design's error
+model, bounds over the drive, fast route and sweep on a few epochs of a 4 x 4 array, and the
+tracking pieces no teaching workflow hands a valid argument to (a costs matrix, a drive, a UPF
+cloud). Kept short: every generated case repeats its callable's call."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+SCENARIO = "italiano2026-straight"
+
+
+def design_models():
+    """Path error model, bounds over the drive, the fast route and its drive, the learned bound,
+    the mode vectors of the misspecified bound."""
+    from tunnelkit import design
+    from tunnelkit.design import drivebound, errormodel, fastroute, learnedbound, mcrb
+
+    setup = design.DesignSetup.from_scenario(SCENARIO)
+    imp = design.DesignImpairments(phase_error_deg=0.5, gain_error_db=0.2)
+    design.path_error_model(setup, "4x4", imp, epochs=[5, 10])  # the recorded (short) call
+    g = design.route_geometry(setup, "4x4")
+    m = design.path_error_model(setup, "4x4", imp, geometry=g)
+    n = m.n_elements
+    m.calibration_bias(np.zeros(n), np.zeros(n))
+    m.draw(np.random.default_rng(0))
+    info = drivebound.position_information(m, g)
+    drivebound.position_error_parts(m, g)
+    drivebound.position_bias_rms(m, g)
+    drivebound.drive_pcrlb(setup, info)
+    fastroute.model_truth(g, setup.fc)
+    route = fastroute.bound_route(m, setup, "4x4")
+    fastroute.tracker_weights(route)
+    fastroute.bound_drive(route, setup, "4x4", np.random.default_rng(0), n_epochs=5)
+    learnedbound.learned_model(m, g, setup)
+    learnedbound.learned_pcrlb(m, g, setup)
+    del errormodel, mcrb
+
+
+def design_modes():
+    """:class:`~tunnelkit.design.mcrb.EtaModes` of two epochs (its assembly and scores)."""
+    from tunnelkit import design
+    from tunnelkit.channel import DiffuseSpec
+    from tunnelkit.constants import C
+    from tunnelkit.design.mcrb import EtaModes
+
+    setup = design.DesignSetup.from_scenario(SCENARIO)
+    cfg = setup.config
+    g = design.route_geometry(setup, "4x4", epochs=[5, 10])
+    spec = design.parse_array("4x4")
+    pos = spec.local(cfg.fc)
+    T = len(g.ue)
+    idx = np.argsort(~g.exists, axis=1, kind="stable")[:, :2]
+    mask = np.take_along_axis(g.exists, idx, axis=1)
+    src = np.take_along_axis(g.source, idx[..., None], axis=1)
+    s_loc = np.einsum("tlj,tjk->tlk", src - g.origin[:, None, :], g.rotation)
+    d0 = np.linalg.norm(s_loc, axis=-1)
+    alpha = np.sqrt(cfg.tx_power) * np.take_along_axis(g.gain, idx, axis=1)
+    mu_f = -2 * np.pi * cfg.tone_spacing * d0 / C
+    mu_t = 2 * np.pi * cfg.symbol_period * np.take_along_axis(g.doppler, idx, axis=1)
+    modes = EtaModes(s_loc, pos, alpha, mu_f, mu_t, mask, cfg.fc, 16, 4)
+    modes.fim(cfg.noise_power)
+    modes.assemble(*modes.grams)
+    modes.wideband_score(cfg.tone_spacing, modes.wideband_terms(cfg.tone_spacing))
+    modes.diffuse_gram(DiffuseSpec(0.1), cfg.tone_spacing, np.zeros(T))
+
+
+def design_sweep():
+    """The Monte-Carlo and the sweep on a few epochs, one run (``javelin_rmse``, a channel-route
+    Monte-Carlo of at least two drives, takes seconds; the sweep's report records are left out
+    too, ``design/report.py`` being at the module size limit: no room for their checks)."""
+    from tunnelkit import design
+    from tunnelkit.design import montecarlo, report
+
+    setup = design.DesignSetup.from_scenario(SCENARIO)
+    res = montecarlo.sweep_montecarlo(setup, ["4x4"], 1, 0, n_epochs=3)
+    r = next(iter(res.values()))
+    r.settled_rms(np.full(len(r.t), 0.1))
+    report.smallest_meeting(setup, ["4x4"], epochs=[5, 10])
+    setup.signal_route("4x4")
+
+
+def tracking_pieces():
+    """A costs matrix, a measured birth, TeNFiLoc and JAVELIN on a short simulated drive, the
+    UPF's pieces and the joint innovation test."""
+    from tunnelkit import studies
+    from tunnelkit.tracking import upf
+    from tunnelkit.tracking import virtual_station as vs
+    from tunnelkit.tracking.javelin import (
+        Javelin,
+        JavelinConfig,
+        JavelinState,
+        PathMeasurements,
+        TeNFiLoc,
+    )
+    from tunnelkit.tracking.javelin.associate import AssociationCosts, global_nearest_neighbour
+    from tunnelkit.tracking.javelin.manage import MeasuredBirth
+    from tunnelkit.tracking.javelin.measurement import track_model
+    from tunnelkit.tracking.javelin.update import JointTestUpdater
+
+    rng = np.random.default_rng(0)
+    eta2 = np.array([[1.0, 5.0], [4.0, 0.5]])
+    global_nearest_neighbour(AssociationCosts(eta2, np.array([2, 2]), eta2 < 4.0, np.full(2, 4.0)))
+    st = JavelinState(np.array([0.0, 1.0, 1.5, 2.0, 3.0]), np.eye(5), [1], [0], [False], next_id=2)
+    pm = PathMeasurements.from_arrays(
+        np.array([0.1, 0.5]), np.array([0.2, 0.3]), np.array([5.0, 6.0]), np.array([4.0, 6.0])
+    )
+    cfg = JavelinConfig(base_station=(0.0, 0.0, 4.8))
+    MeasuredBirth().covariance(st, pm, 1, cfg, None)
+    pred, J = track_model(st.x, cfg.bs)
+    JointTestUpdater().stack(st.x, st.P, pred, J, pm, [(0, 0), (1, 1)], cfg, 0, None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        drive = studies.simulate_drive("italiano2026-straight", rng, n_epochs=4)
+        TeNFiLoc.for_drive(drive).track(drive)
+        Javelin.for_drive(drive).track(drive)
+    exp = vs.experiment("jiang2023-straight")
+    Z = exp.model.simulate(exp.truth[:3, :2], rng, size=1)
+    x0, P0 = exp.truth[0], exp.P0
+    upf.one_epoch_ess(exp.model, Z[0], x0, P0, rng=rng, n_particles=20, epochs=2)
+    upf.effective_sample_size(np.full((2, 5), 0.2))
+    upf.ukf_proposal(exp.model, np.tile(x0, (3, 1)), np.tile(P0, (3, 1, 1)), Z[0, 0])
+    vs.VsTSWLS(exp.model, x0, P0).update(Z[0, 0])
+
+
+DRIVERS = (design_models, design_modes, design_sweep, tracking_pieces)

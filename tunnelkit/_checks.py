@@ -1,0 +1,118 @@
+"""More input checks of the validation layer (:mod:`tunnelkit._validate`): values where NaN
+or infinity mean something (a missed epoch, a bound never met), stacks of matrices, signs,
+lists of objects and duck-typed records. Each raises ``ValueError`` or ``TypeError`` whose
+message starts with the offending parameter's name."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ._validate import finite_array, instance, nonnegative, real, sequence
+
+__all__ = [
+    "attributes",
+    "bound",
+    "bound_array",
+    "items",
+    "optional_real",
+    "real_array",
+    "series",
+    "sign",
+    "square_matrices",
+]
+
+
+def real_array(name: str, value, *, ndim: int | None = None) -> np.ndarray:
+    """A real float array where NaN and +-inf are values (a missed epoch, no estimate): text,
+    booleans, complex numbers and ``None`` refused, a wrong ``ndim`` named."""
+    if value is None or isinstance(value, str | bytes | bool | np.bool_):
+        raise TypeError(f"{name}: expected real numbers, got {type(value).__name__}")
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):  # ragged nested lists
+        raise TypeError(
+            f"{name}: expected an array of numbers, got {type(value).__name__}"
+        ) from None
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name}: expected real numbers, got dtype {arr.dtype}")
+    arr = arr.astype(float, copy=False)
+    if ndim is not None and arr.ndim != ndim:
+        raise ValueError(f"{name}: expected {ndim}-D input, got shape {arr.shape}")
+    return arr
+
+
+def series(name: str, value, *, finite: bool = False) -> np.ndarray:
+    """A scalar or a 1-D series of real numbers as a flat float array (one value per path or
+    per epoch); NaN marks a missing value unless ``finite``; a second axis is refused."""
+    arr = real_array(name, value)
+    if arr.ndim > 1:
+        raise ValueError(f"{name}: expected one value per entry (1-D), got shape {arr.shape}")
+    if finite and not np.isfinite(arr).all():
+        raise ValueError(f"{name}: contains NaN or infinite values")
+    return arr.reshape(-1)
+
+
+def optional_real(name: str, value) -> float | None:
+    """A real scalar where ``None`` or NaN means "missing" (returned as ``None``); text,
+    booleans, complex numbers and infinities refused."""
+    if value is None:
+        return None
+    if isinstance(value, float | np.floating) and np.isnan(value):
+        return None
+    return real(name, value)
+
+
+def bound_array(name: str, value, *, ndim: int | None = None, empty: bool = True) -> np.ndarray:
+    """Bounds or errors [m] (a standard deviation, an RMSE, a quantile): real, ``>= 0``, ``+inf``
+    allowed (not identifiable, never met), NaN refused; non-empty unless ``empty``."""
+    arr = real_array(name, value, ndim=ndim)
+    if not empty and arr.size == 0:
+        raise ValueError(f"{name}: expected at least one value")
+    if np.isnan(arr).any() or (arr < 0).any():
+        raise ValueError(f"{name}: expected values >= 0 (inf allowed), got NaN or a negative")
+    return arr
+
+
+def square_matrices(name: str, value, *, ndim: int | None = None) -> np.ndarray:
+    """A finite real square matrix or stack (..., n, n) (``ndim`` fixes the stack's rank)."""
+    A = finite_array(name, value, ndim=ndim)
+    if A.ndim < 2 or A.shape[-1] != A.shape[-2] or A.shape[-1] == 0:
+        raise ValueError(f"{name}: expected square matrices (..., n, n), got shape {A.shape}")
+    return A
+
+
+def bound(name: str, value) -> float:
+    """A bound, an error or a quantile [m]: a real scalar ``>= 0``, ``+inf`` allowed (never
+    met, not identifiable), NaN and ``-inf`` refused."""
+    if isinstance(value, float | np.floating) and value == np.inf:
+        return float("inf")
+    return nonnegative(name, value)
+
+
+def sign(name: str, value) -> float:
+    """A sign convention: the real number ``-1`` or ``+1``."""
+    x = real(name, value)
+    if x not in (-1.0, 1.0):
+        raise ValueError(f"{name}: expected -1 or +1, got {x}")
+    return x
+
+
+def items(name: str, value, cls: type | tuple[type, ...], *, empty: bool = False) -> list:
+    """A list or tuple whose every item is an instance of ``cls`` (e.g. reflector planes)."""
+    out = sequence(name, value, empty=empty)
+    for i, v in enumerate(out):
+        instance(f"{name}[{i}]", v, cls)
+    return out
+
+
+def attributes(name: str, value, attrs: Sequence[str], what: str):
+    """``value`` if it has every attribute in ``attrs`` (a duck-typed record such as a simulated
+    drive), else ``TypeError`` naming ``name`` and ``what`` was expected."""
+    missing = [a for a in attrs if not hasattr(value, a)]
+    if missing:
+        raise TypeError(
+            f"{name}: expected {what} (with {', '.join(missing)}), got {type(value).__name__}"
+        )
+    return value
