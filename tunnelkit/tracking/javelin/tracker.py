@@ -30,16 +30,12 @@ from .update import stack_measurement
 #: iterations of the first fix's iterated EKF at most (:meth:`Javelin._acquire`)
 ACQUIRE_ITERATIONS = 20
 
-#: iterations of an epoch's iterated EKF update at most (:meth:`Javelin._iterate`)
-UPDATE_ITERATIONS = 10
-
 #: an epoch's iterated update stops when an iteration moves the UE by less than this share of
 #: its posterior standard deviation (the smallest axis): the linearisation point is then
 #: as good as the estimate can tell
 UPDATE_TOLERANCE = 0.01
 
 __all__ = [
-    "UPDATE_ITERATIONS",
     "UPDATE_TOLERANCE",
     "Javelin",
     "JavelinRun",
@@ -239,13 +235,13 @@ class Javelin:
         millimetres off while its covariance says tenths of a millimetre (italiano2026-straight,
         16 x 16, the first epoch: 3.4 mm RMS against a 0.35 mm bound); the inconsistent state
         then fails the joint innovation test with true pairs for many epochs. Stops after
-        :data:`UPDATE_ITERATIONS` or when an iteration moves the UE by less than
-        :data:`UPDATE_TOLERANCE` of its posterior standard deviation; the NIS stays the
-        prior's (what the tests and the report use)."""
+        ``update_iterations`` (:class:`~.config.JavelinConfig`; the array design's) or when an
+        iteration moves the UE by less than :data:`UPDATE_TOLERANCE` of its posterior
+        standard deviation; the NIS stays the prior's (what the tests and the report use)."""
         st, cfg, roles = self.state, self.config, self.design
         pairs = list(dict.fromkeys((i, j) for _, i, j in m.labels))
         x0, P0 = st.x, st.P
-        for _ in range(UPDATE_ITERATIONS):
+        for _ in range(cfg.update_iterations):
             xi = out[0]
             sd = np.sqrt(max(float(np.linalg.eigvalsh(out[1][:3, :3])[0]), 0.0))
             pred, J = roles.curvature.predict(xi, cfg.bs)
@@ -355,7 +351,7 @@ class Javelin:
                     faults.append(f"{len(left_out)} pair(s) failed the joint innovation test")
                 n_rows = m.z.size
                 out = roles.updater.update(st.x, st.P, m, st.C)
-                if n_rows:
+                if n_rows and cfg.update_iterations:
                     out = self._iterate(out, meas, m, mres.los_path, st.C)
                 x_new, P_new, nis = out[:3]
                 C_new = out[3] if len(out) == 4 else st.C
