@@ -70,7 +70,8 @@ def test_json_answers_the_28ghz_question(capsys):
     assert by["8x8"]["srnf_valid_share_by_surface"]["ceiling"] == 0.0
     assert by["8x8"]["status"] == "bound only"
     assert by["2x2"]["peb_median_m"] > by["8x8"]["peb_median_m"]
-    assert set(out["recommendation"]) == {"array", "reason", "basis"}
+    assert set(out["recommendation"]) == {"array", "reason", "basis", "route"}
+    assert out["recommendation"]["route"] is None  # no Monte-Carlo: no route decided
     assert out["recommendation"]["basis"] == "bounds"
     assert "necessary condition, not an answer" in out["recommendation"]["reason"]
     assert any("rests on bounds only" in w for w in out["warnings"])
