@@ -61,12 +61,25 @@ def test_truth_is_the_measurement_space_of_the_tracker(setup):
     np.testing.assert_allclose(m.t, setup.trajectory.t[EPOCHS])
 
 
-def test_no_impairment_achievable_equals_peb(setup):
+def test_no_impairment_achievable_is_the_block_weighted_fix_never_below_the_peb(setup):
+    """Without impairments the achievable bound is the noise of the fix the tracker makes,
+    told one covariance block per path (``position_noise_cov``), not below the PEB; the
+    direct-position weighting (``weights="ideal"``) is the PEB itself."""
+    from tunnelkit.design.bounds import route_geometry
+    from tunnelkit.design.drivebound import position_noise_cov
+    from tunnelkit.design.fastroute import tracker_weights
+
     b = achievable_bound(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
     peb = design.route_bounds(setup, "6x6", epochs=EPOCHS).peb
-    np.testing.assert_array_equal(b.achievable, peb)
     np.testing.assert_array_equal(b.peb, peb)
     assert not (b.calibration.any() or b.wideband.any() or b.diffuse.any())
+    g = route_geometry(setup, "6x6", epochs=EPOCHS)
+    m = path_error_model(setup, "6x6", geometry=g)
+    cov = position_noise_cov(m, g, tracker_weights(m))
+    np.testing.assert_allclose(b.achievable, np.sqrt(np.trace(cov, axis1=1, axis2=2)))
+    assert np.all(b.achievable >= peb) and np.any(b.achievable > 1.01 * peb)
+    ideal = achievable_bound(setup, "6x6", DesignImpairments(), epochs=EPOCHS, weights="ideal")
+    np.testing.assert_array_equal(ideal.achievable, peb)
 
 
 # --- the factorised misspecified bound against brute force (small case) ----------------------
@@ -435,10 +448,11 @@ def test_an_estimator_that_models_the_wideband_term_has_no_wideband_bias(setup):
     cal = path_error_model(setup, "6x6", DesignImpairments(phase_error_deg=0.5), epochs=EPOCHS)
     np.testing.assert_array_equal(m.k_phase, cal.k_phase)
     b = achievable_bound(
-        setup, "6x6", DesignImpairments(spatial_wideband=True, wideband_model=True)
+        setup, "6x6", DesignImpairments(spatial_wideband=True, wideband_model=True), epochs=EPOCHS
     )
     assert not b.wideband.any()
-    np.testing.assert_array_equal(b.achievable, b.peb)
+    ideal = achievable_bound(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
+    np.testing.assert_allclose(b.achievable, ideal.achievable, rtol=1e-12)
 
 
 def test_the_wideband_model_s_fisher_information_is_eq1_s_to_one_percent():

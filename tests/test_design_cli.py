@@ -57,8 +57,9 @@ def test_json_answers_the_28ghz_question(capsys):
         ep = a["per_epoch"]
         assert len(ep["x_m"]) == len(ep["peb_m"]) == len(ep["achievable_m"]) == 40
         assert ep["error_median_m"] is None
-        # no impairments: the achievable bound is the PEB
-        assert ep["achievable_m"] == ep["peb_m"]
+        # no impairments: the achievable bound is the noise of the tracker's block-weighted
+        # fix, never below the PEB
+        assert all(a >= p for a, p in zip(ep["achievable_m"], ep["peb_m"], strict=True))
     by = {a["array"]: a for a in out["arrays"]}
     assert by["8x8"]["n_elements"] == 64
     # lambda/2 at 28 GHz: 7 spacings along each side, diagonal 7 sqrt(2) lambda/2
@@ -69,7 +70,8 @@ def test_json_answers_the_28ghz_question(capsys):
     assert by["8x8"]["srnf_valid_share_by_surface"]["ceiling"] == 0.0
     assert by["8x8"]["status"] == "bound only"
     assert by["2x2"]["peb_median_m"] > by["8x8"]["peb_median_m"]
-    assert set(out["recommendation"]) == {"array", "reason", "basis"}
+    assert set(out["recommendation"]) == {"array", "reason", "basis", "route"}
+    assert out["recommendation"]["route"] is None  # no Monte-Carlo: no route decided
     assert out["recommendation"]["basis"] == "bounds"
     assert "necessary condition, not an answer" in out["recommendation"]["reason"]
     assert any("rests on bounds only" in w for w in out["warnings"])
@@ -87,7 +89,9 @@ def test_wideband_model_drops_the_wideband_bias_and_is_an_input(capsys):
     ach = {k: v["arrays"][0]["achievable_p90_m"] for k, v in out.items()}
     peb = out[""]["arrays"][0]["peb_p90_m"]
     assert ach["--wideband"] > 1.2 * peb  # the plain fit's wideband bias, as the tracker weighs
-    assert ach["--wideband --wideband-model"] == ach[""] == peb
+    # modelled, the term costs nothing: the ideal achievable bound (the tracker's block-weighted
+    # fix, not below the PEB)
+    assert ach["--wideband --wideband-model"] == ach[""] >= peb
 
 
 def test_srnf_criterion_keeps_the_gate(capsys):

@@ -413,3 +413,53 @@ def test_position_error_parts_diffuse_is_the_weighted_fix_of_the_excess_covarian
         sol = np.linalg.lstsq(np.vstack(Hs), np.vstack(es), rcond=None)[0]
         rms = np.sqrt(np.mean(np.sum(sol[:2] ** 2, axis=0)))
         assert abs(rms - parts[k, 2]) < 0.05 * parts[k, 2]
+
+
+def test_position_noise_cov_is_the_block_weighted_fix_under_the_joint_crlb(setup):
+    """Brute force: a joint CRLB correlating the paths (random, per epoch) and the tracker told
+    only its per-path blocks (one curvature not handed on): the covariance of the block-weighted
+    least-squares fix over many draws of the joint noise (finite-difference Jacobian, lstsq).
+    It is never below the PEB's covariance, equals it for a CRLB without cross-path terms, and
+    its inverse is the information ``position_information`` uses with the tracker's weights."""
+    from dataclasses import replace
+
+    from tunnelkit.design.drivebound import position_noise_cov
+
+    spec = "4x4"
+    m0 = _diag_model(setup, spec)
+    g = route_geometry(setup, spec)
+    rng = np.random.default_rng(11)
+    T, P = m0.exists.shape
+    scale = np.tile(np.array([1e-3, 1e-3, 0.1, 0.01]), P)
+    A = rng.standard_normal((T, 4 * P, 4 * P)) * scale[:, None]
+    crlb = A @ np.swapaxes(A, -1, -2) / (4 * P) + np.diag(scale**2) * 0.1
+    m = replace(m0, crlb=crlb, cov=crlb.copy())
+    blocks = np.stack([crlb[:, 4 * p : 4 * p + 4, 4 * p : 4 * p + 4] for p in range(P)], axis=1)
+    blocks[:, 1, 2, :] = blocks[:, 1, :, 2] = 0.0
+    blocks[:, 1, 2, 2] = np.inf
+    got = position_noise_cov(m, g, blocks)
+    info = position_information(m, g, blocks)
+    ideal = np.linalg.inv(position_information(m, g))
+    for k in (3, 20):
+        j = np.flatnonzero(m.exists[k])
+        rows4 = (4 * j[:, None] + np.arange(4)).ravel()
+        Hk = _fd_jacobian(g, k, j, setup.fc)
+        e = rng.multivariate_normal(np.zeros(rows4.size), crlb[k][np.ix_(rows4, rows4)], 20_000)
+        e = e.T.reshape(j.size, 4, -1)
+        rows, H = [], []
+        for i, p in enumerate(j):
+            on = np.isfinite(np.diag(blocks[k, p]))
+            Lw = np.linalg.cholesky(np.linalg.inv(blocks[k, p][np.ix_(on, on)]))
+            rows.append(Lw.T @ e[i][on])
+            H.append(Lw.T @ Hk[i][on])
+        sol = np.linalg.lstsq(np.vstack(H), np.vstack(rows), rcond=None)[0][:2]
+        emp = np.cov(sol)
+        assert np.allclose(got[k], emp, rtol=0.05, atol=0.05 * np.abs(emp).max())
+        assert np.trace(got[k]) > 1.05 * np.trace(ideal[k])  # the cross-path terms unused
+        assert np.allclose(np.linalg.inv(info[k]), got[k], rtol=1e-6)
+    w0 = np.stack([m0.crlb[:, 4 * p : 4 * p + 4, 4 * p : 4 * p + 4] for p in range(P)], axis=1)
+    same = position_noise_cov(m0, g, w0)
+    ref = np.linalg.inv(position_information(m0, g)[m0.exists.any(axis=1)])
+    assert np.allclose(same[m0.exists.any(axis=1)], ref, rtol=1e-6)
+    with pytest.raises(ValueError, match="weights"):
+        position_noise_cov(m, g, blocks[:-1])

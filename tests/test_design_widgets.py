@@ -17,7 +17,9 @@ def test_figure_meta_and_title():
     assert m["array"] == "8x8" and m["n_elements"] == 64 and m["fits"]
     assert m["srnf_valid_share"] == 0.0  # the ceiling, 20 cm above the array
     assert fig.layout.title.text.startswith(f"Recommended: {m['recommended']} ")
-    assert m["recommended"] == "3x3"
+    # 3x3's achievable bound (its paths weighed one block at a time) misses 0.15 m on part of
+    # the route; 4x4 meets it
+    assert m["recommended"] == "4x4"
     names = [t.name for t in fig.data]
     assert names[:2] == ["PEB 8x8", "SR-NF not valid"] and "mismatch, ceiling" in names
 
@@ -58,7 +60,8 @@ def test_size_figure_marks_the_papers_array():
 def test_impairment_sliders_move_the_achievable_bound_not_the_peb():
     ideal = design_figure(n=8, target=0.1).layout.meta
     cal = design_figure(n=8, target=0.1, phase_error_deg=2.0, gain_error_db=0.2).layout.meta
-    assert ideal["achievable_median_m"] == ideal["peb_median_m"]  # no impairment: the PEB
+    # no impairment: the tracker's block-weighted fix, never below the PEB
+    assert ideal["achievable_median_m"] >= ideal["peb_median_m"]
     assert cal["peb_median_m"] == ideal["peb_median_m"]
     assert cal["achievable_median_m"] > 10 * ideal["achievable_median_m"]
     assert cal["met_share"] < ideal["met_share"]

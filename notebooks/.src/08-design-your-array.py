@@ -147,15 +147,19 @@ print(
 # exact nonlinear fit in `tests/test_achievable.py`, and against Monte-Carlo of the ML extraction
 # in `benchmarks/bench_achievable.py`). The **achievable bound** maps them to the position *as the
 # design's tracker weighs its paths* (each path by the error budget it is told, section 6):
-# $\sqrt{\mathrm{PEB}^2 + \mathrm E\|\mathbf G\mathbf b\|^2 + \mathrm{tr}\,\mathbf G
-# (\mathrm{MCRB} - \mathrm{CRLB})\mathbf G^T}$ with $\mathbf G$ that weighted fix, the calibration
-# bias averaged over the calibration draw in closed form. Weighing by the ideal information
-# instead (`weights="ideal"`, the direct-position estimator that trusts eq. 1) lets a large
-# array's micrometre curvatures carry their centimetres of calibration and wideband bias into the
-# position: a bound several times above what the tracker achieves is not a bound of it. With no
-# impairment it is the PEB. Below, the 8 × 8 array at three calibration qualities (phase error
-# per element, with 0.2 dB of gain error); the spatial wideband term and diffuse power are left to
-# exercise 3, so that what moves here is the calibration alone:
+# $\sqrt{\mathrm{tr}\,\mathbf G\,\mathrm{CRLB}\,\mathbf G^T + \mathrm E\|\mathbf G\mathbf b\|^2
+# + \mathrm{tr}\,\mathbf G(\mathrm{MCRB} - \mathrm{CRLB})\mathbf G^T}$ with $\mathbf G$ that
+# weighted fix, the calibration bias averaged over the calibration draw in closed form. Weighing by
+# the ideal information instead (`weights="ideal"`, the direct-position estimator that trusts
+# eq. 1) lets a large array's micrometre curvatures carry their centimetres of calibration and
+# wideband bias into the position: a bound several times above what the tracker achieves is not a
+# bound of it. With no impairment the first term alone remains, and it is not quite the PEB: the
+# joint CRLB correlates the paths' errors (paths close in angle and delay share the same
+# samples), while the extraction reports, and the tracker weighs, one block per path, so the
+# ideal achievable bound sits above the PEB by the factor printed below (never below it: any
+# other weighting loses information). Below, the 8 × 8 array at three calibration qualities
+# (phase error per element, with 0.2 dB of gain error); the spatial wideband term and diffuse
+# power are left to exercise 3, so that what moves here is the calibration alone:
 
 # %%
 levels = {"ideal": 0.0, "0.5°": 0.5, "2°": 2.0}
@@ -171,6 +175,8 @@ for k, a in ach8.items():
         f" wideband {100 * np.median(a.wideband):.3g} cm)"
     )
 ratio_cal = np.median(ach8["0.5°"].achievable) / np.median(ach8["ideal"].peb)
+ratio_blocks = np.median(ach8["ideal"].achievable / ach8["ideal"].peb)
+print(f"ideal: one block per path puts the bound {ratio_blocks:.2g} times the PEB (median)")
 print(f"0.5° and 0.2 dB lift the median bound by a factor {ratio_cal:.2g}")
 
 # %%
@@ -431,8 +437,10 @@ print(f"factor: {sol4['crlb'] / sol4['budget']:.2g}")
 # ## Checks
 
 # %%
-# the ideal PEB is millimetres; the achievable bound equals it with no impairment
-assert np.allclose(ach8["ideal"].achievable, ach8["ideal"].peb, equal_nan=True)
+# the ideal PEB is millimetres; with no impairment the achievable bound is the tracker's
+# block-weighted fix, never below the PEB and within a small factor of it (ratio_blocks)
+assert np.all(ach8["ideal"].achievable >= ach8["ideal"].peb * (1 - 1e-9))
+assert 1.0 <= ratio_blocks < 2.0, ratio_blocks
 assert np.median(ach8["ideal"].peb) < 0.01
 # calibration lifts the bound several-fold (the printed ratio_cal)
 assert ratio_cal > 5, ratio_cal

@@ -2,14 +2,16 @@
 [--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--wideband-model]
 [--dmc-share S]
 [--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--format table|json]``.
+[--criterion achievable|srnf] [--confirm] [--format table|json]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
 the ideal position error bound, the achievable bound under the stated impairments, SR-NF validity
 per surface, and with ``--runs`` the Monte-Carlo error of the design's tracker (its
 ``share``-quantile over the settled route with a bootstrap 95 % interval); the smallest array
-whose interval lies below ``--target`` is recommended. Every input, the criterion and the
-warnings are in the JSON.
+whose interval lies below ``--target`` is recommended (``recommendation.route`` the route that
+decided; ``--confirm``: the bound route's answer re-run on the channel route, which then decides,
+:func:`tunnelkit.design.confirm_on_channel`). Every input, the criterion and the warnings are in
+the JSON.
 """
 
 from __future__ import annotations
@@ -169,6 +171,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "synthesised and extracted (channel)",
     )
     p.add_argument(
+        "--confirm",
+        action="store_true",
+        help="re-run the recommended array (and the smaller ones left undecided) on the channel "
+        "route with the same runs and seed, and take the recommendation from it (bound mode)",
+    )
+    p.add_argument(
         "--channel",
         choices=["image", "sionna"],
         default="image",
@@ -195,6 +203,13 @@ def main(args: argparse.Namespace) -> int:
         specs = [design.parse_array(a, args.spacing) for a in args.arrays]
     except ValueError as exc:  # the option's name, not the function's parameter
         raise ValueError(f"arrays: {str(exc).removeprefix('spec: ')}") from None
+    if args.confirm and (args.mode != "bound" or args.runs == 0):
+        print(
+            "tunnelkit design: error: --confirm re-runs a bound-route answer: it needs --mode "
+            "bound and --runs > 0",
+            file=sys.stderr,
+        )
+        return 2
     if args.channel != "image" and (args.mode != "channel" or args.runs == 0):
         print(
             "tunnelkit design: error: --channel sionna needs --mode channel and --runs > 0 "
@@ -242,6 +257,18 @@ def main(args: argparse.Namespace) -> int:
         mount_height_m=args.mount_height,
         **({"channel": args.channel} if args.channel != "image" else {}),
     )
+    rep.recommendation["route"] = args.mode if args.runs else None
+    if args.confirm and args.mode == "bound" and args.runs:
+        try:
+            rep = design.confirm_on_channel(
+                rep,
+                setup,
+                **parallel_kwargs(args),
+                progress=args.format == "table" and not args.no_progress,
+            )
+        except TrialLost as exc:
+            print(f"tunnelkit design: error: {exc}", file=sys.stderr)
+            return 1
     if all(r.status == "error" for r in rep.rows):
         for r in rep.rows:
             print(f"tunnelkit design: error: {r.reason}", file=sys.stderr)

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
+from .confirm import ConfirmedReport, confirm_on_channel, confirmation_candidates
 from .drivebound import drive_bound, drive_pcrlb, position_bias_rms, position_information
 from .errormodel import PathErrorModel
 from .fastroute import BoundRoute, bound_drive, bound_route
@@ -87,6 +88,7 @@ __all__ = [
     "AchievableBound",
     "ArraySpec",
     "BoundRoute",
+    "ConfirmedReport",
     "DesignImpairments",
     "DesignReport",
     "DesignRow",
@@ -100,6 +102,8 @@ __all__ = [
     "bootstrap_quantile_ci",
     "bound_drive",
     "bound_route",
+    "confirm_on_channel",
+    "confirmation_candidates",
     "counted_epochs",
     "design_planes",
     "design_sweep",

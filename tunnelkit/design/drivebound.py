@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import bound_array, real_array
+from .._checks import bound_array
 from .._validate import finite_array, instance
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
@@ -25,6 +25,7 @@ __all__ = [
     "position_bias_rms",
     "position_error_parts",
     "position_information",
+    "position_noise_cov",
 ]
 
 
@@ -59,15 +60,29 @@ def _check_geometry(model, geometry) -> None:
         )
 
 
-def position_information(model: PathErrorModel, geometry) -> np.ndarray:
+def position_information(model: PathErrorModel, geometry, weights=None) -> np.ndarray:
     """Fisher information (T, 2, 2) [1/m^2] of the UE's horizontal position (height known, as
     JAVELIN and the PEB) in what the extraction reports: ``H^T crlb^-1 H`` over the existing
     paths' ``z = [phi, psi, kappa, d]``, with the clock bias (common to every ``d``) a nuisance
     removed by the Schur complement. ``H`` maps the UE position through each path's wave origin
-    (the UE, or its mirror image in the known surface: ``geometry.mirror``)."""
+    (the UE, or its mirror image in the known surface: ``geometry.mirror``).
+
+    ``weights`` (T, P, 4, 4): the per-path covariances a tracker is told
+    (:func:`tunnelkit.design.fastroute.tracker_weights`); the information is then the inverse
+    of the covariance of the fix that weighs the paths by them (:func:`position_noise_cov`):
+    a tracker told one block per path cannot use the correlation of the joint CRLB between
+    paths (at 4 x 4 in the paper's tunnel up to 0.9 between the LoS and the ceiling path,
+    which the joint bound turns into half the position error)."""
     _check_geometry(model, geometry)
     T = model.exists.shape[0]
     out = np.zeros((T, 2, 2))
+    if weights is not None:
+        cov = position_noise_cov(model, geometry, weights)
+        for k in range(T):
+            if np.any(cov[k]):
+                out[k] = np.linalg.pinv(cov[k], rcond=1e-15, hermitian=True)
+                out[k] = 0.5 * (out[k] + out[k].T)
+        return out
     for k in range(T):
         rows, H, _ = _position_rows(model, geometry, k)
         if rows is None:
@@ -99,6 +114,61 @@ def _block_weights(blocks: np.ndarray) -> np.ndarray:
     return W
 
 
+def _check_weights(model: PathErrorModel, weights) -> np.ndarray:
+    """Per-path covariances (T, P, 4, 4): numbers, ``inf`` allowed (a quantity not handed on)."""
+    T, P = model.exists.shape
+    if isinstance(weights, str | bytes):
+        raise TypeError("weights: expected per-path covariances (T, P, 4, 4), got text")
+    try:
+        weights = np.asarray(weights, float)
+    except (TypeError, ValueError):
+        raise TypeError(f"weights: expected numbers, got {type(weights).__name__}") from None
+    if weights.shape != (T, P, 4, 4):
+        raise ValueError(f"weights: expected shape {(T, P, 4, 4)}, got {weights.shape}")
+    if np.isnan(weights).any():
+        raise ValueError("weights: NaN (an infinite variance marks a quantity not handed on)")
+    return weights
+
+
+def _weighted_gain(model, geometry, k: int, weights):
+    """Epoch ``k``: the rows, the position rows ``G`` (2, 4n) of the weighted least-squares
+    fix ``(H^T W H)^-1 H^T W`` (clock bias estimated; ``W`` the inverse of the ideal CRLB or
+    block-diagonal from ``weights``), or ``(None, None)`` without a path."""
+    rows, H, j = _position_rows(model, geometry, k)
+    if rows is None:
+        return None, None
+    if weights is None:
+        R = model.crlb[k][np.ix_(rows, rows)]
+        W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
+    else:
+        W = _block_weights(weights[k, j])
+    J = H.T @ W @ H
+    G = (np.linalg.pinv(0.5 * (J + J.T), rcond=1e-15, hermitian=True) @ H.T @ W)[:2]
+    return rows, G
+
+
+def position_noise_cov(model: PathErrorModel, geometry, weights) -> np.ndarray:
+    """Per epoch (T, 2, 2) [m^2] the covariance of the horizontal position of the weighted
+    least-squares snapshot fix (clock bias estimated) under the model's ideal noise, the joint
+    CRLB ``crlb`` of every path: ``G crlb G^T`` with ``G`` the position rows of ``(H^T W H)^-1
+    H^T W`` and ``W`` block-diagonal over the paths from ``weights`` (T, P, 4, 4), the
+    covariances the tracker is told (:func:`tunnelkit.design.fastroute.tracker_weights`; an
+    unresolved curvature as an infinite variance gets no weight). ``W = crlb^-1`` would give
+    the PEB's covariance; any other weight gives more (Gauss-Markov), and the tracker that is
+    run weighs its paths block by block. Zero at an epoch without a path."""
+    _check_geometry(model, geometry)
+    weights = _check_weights(model, weights)
+    T = model.exists.shape[0]
+    out = np.zeros((T, 2, 2))
+    for k in range(T):
+        rows, G = _weighted_gain(model, geometry, k, weights)
+        if rows is None:
+            continue
+        C = G @ model.crlb[k][np.ix_(rows, rows)] @ G.T
+        out[k] = 0.5 * (C + C.T)
+    return out
+
+
 def position_error_parts(model: PathErrorModel, geometry, weights=None) -> np.ndarray:
     """Per epoch (T, 3) [m] the horizontal position error a weighted least-squares snapshot fix
     (clock bias estimated) takes from the model's impairments: the RMS over the calibration
@@ -116,12 +186,8 @@ def position_error_parts(model: PathErrorModel, geometry, weights=None) -> np.nd
     model."""
     _check_geometry(model, geometry)
     T, P = model.exists.shape
-    if weights is not None and np.isnan(real_array("weights", weights)).any():
-        raise ValueError("weights: contains NaN (an infinite variance is allowed)")
     if weights is not None:
-        weights = np.asarray(weights, float)
-        if weights.shape != (T, P, 4, 4):
-            raise ValueError(f"weights: expected shape {(T, P, 4, 4)}, got {weights.shape}")
+        weights = _check_weights(model, weights)
     out = np.zeros((T, 3))
     b_all = np.asarray(model.bias).reshape(T, 4 * P)
     ks = [
@@ -132,16 +198,9 @@ def position_error_parts(model: PathErrorModel, geometry, weights=None) -> np.nd
     excess = np.asarray(model.cov) - np.asarray(model.crlb)
     diffuse = bool(np.any(excess))
     for k in range(T):
-        rows, H, j = _position_rows(model, geometry, k)
+        rows, G = _weighted_gain(model, geometry, k, weights)
         if rows is None:
             continue
-        if weights is None:
-            R = model.crlb[k][np.ix_(rows, rows)]
-            W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
-        else:
-            W = _block_weights(weights[k, j])
-        J = H.T @ W @ H
-        G = (np.linalg.pinv(0.5 * (J + J.T), rcond=1e-15, hermitian=True) @ H.T @ W)[:2]
         cal = sum(sig**2 * float(np.sum((G @ K[k, rows]) ** 2)) for K, sig in ks)
         out[k, 0] = np.sqrt(cal)
         out[k, 1] = np.linalg.norm(G @ b_all[k, rows])

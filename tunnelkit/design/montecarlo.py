@@ -302,17 +302,22 @@ class _ArrayJob:
             g = route_geometry(self.setup, spec, epochs=ep)
             head = _head(m, self.T)
             pc = drive_pcrlb(self.setup, position_information(head, g))
-            # the bias of a fix weighted as the tracker weighs (its reported budget, bound mode;
-            # on the channel route the extraction reports its CRLB)
-            w = None
+            # the noise and the bias of a fix weighted as the tracker weighs (its reported
+            # budget, one block per path, bound mode; on the channel route the extraction
+            # reports its CRLB): the information a tracker told one block per path can use
+            w, pc_w = None, pc
             if route is not None:
                 from .fastroute import tracker_weights
 
                 w = tracker_weights(route)[: self.T]
-            drive = drive_bound(pc, position_bias_rms(head, g, w))
+                pc_w = drive_pcrlb(self.setup, position_information(head, g, w))
+            drive = drive_bound(pc_w, position_bias_rms(head, g, w))
             from .learnedbound import learned_pcrlb
 
-            learned = drive_bound(*learned_pcrlb(head, g, self.setup))
+            # a tracker that learns its VUEs is told the same blocks: the paths taken one by one
+            learned = drive_bound(
+                *learned_pcrlb(_per_path(head) if w is not None else head, g, self.setup)
+            )
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
             crlb = _median_sigmas(m)
@@ -487,6 +492,16 @@ def _median_sigmas(m: PathErrorModel) -> dict[str, float]:
         "direction": float(np.median(np.sqrt(var[:, 0] * np.cos(psi) ** 2 + var[:, 1]))),
         "kappa": float(np.median(np.sqrt(var[:, 2]))),
     }
+
+
+def _per_path(m: PathErrorModel) -> PathErrorModel:
+    """A model whose ideal bound keeps only each path's own block (the correlation of the joint
+    CRLB between paths dropped): the information a tracker told one block per path uses."""
+    from dataclasses import replace
+
+    P = m.exists.shape[1]
+    keep = np.kron(np.eye(P, dtype=bool), np.ones((4, 4), dtype=bool))
+    return replace(m, crlb=np.where(keep, m.crlb, 0.0))
 
 
 def _head(m: PathErrorModel, T: int) -> PathErrorModel:

@@ -7,7 +7,7 @@ tracker achieves.
    per array, with the reason: :meth:`DesignSetup.arrays`);
 2. the **ideal PEB** and the **achievable bound** of the design's tracker under the stated
    impairments (:func:`tunnelkit.design.achievable.achievable_bound`: each path's error mapped
-   to the position as the tracker weighs it; with no impairments the two coincide), and SR-NF
+   to the position as the tracker weighs it, one block per path, never below the PEB), SR-NF
    validity per surface (information under ``criterion="achievable"``, a gate under ``"srnf"``);
 3. the **pre-screen**: a candidate on which even an estimator at the achievable bound would miss
    the target on ``share`` of the counted epochs is hopeless and gets no Monte-Carlo;
@@ -340,10 +340,10 @@ def _design_impairments(impairments) -> DesignImpairments:
 
 
 def _achievable_bound(setup, spec, impairments, geometry):
-    """Per-epoch ``x``, ``peb`` and ``achievable`` (T,) of ``spec`` along the traced route
-    ``geometry`` (:func:`tunnelkit.design.achievable.achievable_bound`)."""
-    res = achievable_bound(setup, spec, impairments, geometry=geometry)
-    return res.x, res.peb, res.achievable
+    r = achievable_bound(setup, spec, impairments, geometry=geometry)  # and PEB + impairments:
+    a, n = r.achievable, np.where(np.isfinite(r.noise), r.noise, 0.0)
+    imp = np.where(np.isfinite(a), a**2 - n**2, np.inf)
+    return r.x, r.peb, r.achievable, np.sqrt(np.clip(imp, 0.0, None) + r.peb**2)
 
 
 def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
@@ -386,7 +386,7 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
         setup.arrays(spec)
         g = route_geometry(setup, spec, epochs=epochs)
         sr = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
-        x, peb, ach = _achievable_bound(setup, spec, impairments, g)
+        x, peb, ach, imp_only = _achievable_bound(setup, spec, impairments, g)
     except (ValueError, ArithmeticError) as exc:
         row.reason = str(exc)
         return row
@@ -408,14 +408,14 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
     row.achievable_median_m = float(np.median(ach[k]))
     row.achievable_p90_m = share_quantile(ach[k], share)
     row.met_share = float(np.mean(gated <= target))
-    scr = gate(screen_bound(peb, ach), sr.srnf_valid, criterion)[k]  # the pre-screen's bound
+    scr = gate(screen_bound(peb, imp_only), sr.srnf_valid, criterion)[k]  # the pre-screen
     row.screen_m = implied_quantile(scr, share)
     row.srnf_valid = sr.srnf_valid
     row.status, row.reason = judge(target, row.screen_m, share=share)
     return row
 
 
-def _score(row, res, criterion, target, share, seed, n_boot) -> None:
+def score_row(row, res, criterion, target, share, seed, n_boot) -> None:
     """Fill ``row`` from one array's Monte-Carlo result (errors (runs, T)) and judge it."""
     errors = np.asarray(_field(res, "errors"), float)
     t = np.asarray(_field(res, "t"), float)
@@ -551,7 +551,7 @@ def design_sweep(
                 r.status, r.reason = "error", failed[r.array]
                 warnings.append(f"{r.array}: {r.reason}")
             elif r.array in results:
-                _score(r, results[r.array], criterion, target, share, seed, n_boot)
+                score_row(r, results[r.array], criterion, target, share, seed, n_boot)
     if runs == 0:
         warnings.append(
             "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a "

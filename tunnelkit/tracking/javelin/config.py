@@ -54,7 +54,10 @@ class JavelinConfig:
       ``sigma_height`` [m/sqrt(s)] drift of the (known) UE height, ``doppler_tolerance`` [m/s]
       for the static/dynamic test, ``sigma_speed_missing`` [m/s] extra speed noise while the
       speed/heading message is missing;
-    - ``base_station``: reference-antenna position [m] (the paper's origin).
+    - ``base_station``: reference-antenna position [m] (the paper's origin);
+    - ours: ``update_iterations`` the relinearisations of each epoch's update at most (an
+      iterated EKF, :meth:`~tunnelkit.tracking.javelin.tracker.Javelin._iterate`; default 0:
+      the paper's one EKF step).
     """
 
     gate_probability: float = 0.99
@@ -74,6 +77,7 @@ class JavelinConfig:
     sigma_speed_missing: float = 1.0
     sigma_p0_height: float | None = None
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    update_iterations: int = 0
 
     def __post_init__(self) -> None:
         probability("gate_probability", self.gate_probability)
@@ -87,6 +91,7 @@ class JavelinConfig:
             positive("sigma_p0_height", self.sigma_p0_height)
         bs = vector("base_station", self.base_station, 3)
         object.__setattr__(self, "base_station", tuple(float(v) for v in bs))
+        integer("update_iterations", self.update_iterations, minimum=0)
 
     @property
     def bs(self) -> np.ndarray:

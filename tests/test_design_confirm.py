@@ -1,0 +1,73 @@
+"""The recommendation confirmed on the channel route (design.confirm)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from tunnelkit import design
+from tunnelkit.cli import main
+from tunnelkit.design.confirm import confirmation_candidates
+
+
+def _report(statuses, rec):
+    rows = [
+        design.DesignRow(a, n, 0.01 * n, status=s)
+        for (a, n), s in zip((("4x4", 16), ("8x8", 64), ("16x16", 256)), statuses, strict=True)
+    ]
+    return design.DesignReport("x", rows, {"array": rec}, {"mode": "bound", "runs": 20})
+
+
+def test_candidates_are_the_recommendation_and_the_smaller_undecided():
+    assert confirmation_candidates(_report(["undecided", "met", "met"], "8x8")) == ["4x4", "8x8"]
+    assert confirmation_candidates(_report(["not met", "met", "met"], "8x8")) == ["8x8"]
+    assert confirmation_candidates(_report(["met", "met", "met"], "4x4")) == ["4x4"]
+    # nothing met: the smallest candidate still open
+    assert confirmation_candidates(_report(["hopeless", "undecided", "met"], None)) == ["8x8"]
+    assert confirmation_candidates(_report(["hopeless", "error", "hopeless"], None)) == []
+    with pytest.raises(TypeError, match="report"):
+        confirmation_candidates("x")
+
+
+def test_confirmation_reruns_on_the_channel_route_and_decides():
+    """A short ideal drive, 2 runs: the recommended array is re-run on the channel route with
+    the sweep's seed (its errors differ from the bound route's), the recommendation says which
+    route decided, and the bound route's answer stays beside it."""
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    kw = {"target": 1.0, "runs": 2, "n_epochs": 4, "seed": 3}
+    rep = design.design_sweep(setup, ["4x4"], **kw)
+    assert rep.recommendation["basis"] == "monte-carlo"
+    conf = design.confirm_on_channel(rep, setup)
+    assert isinstance(conf, design.ConfirmedReport)
+    assert conf.recommendation["route"] == "channel"
+    assert conf.bound_recommendation["route"] == "bound"
+    (row,) = conf.confirmation
+    assert row.array == "4x4" and row.runs == 2
+    assert row.error_p90_m != rep.rows[0].error_p90_m  # measured again, not copied
+    assert rep.rows[0].error_p90_m is not None  # the bound route's row unchanged
+    direct = design.sweep_montecarlo(setup, ["4x4"], 2, 3, mode="channel", n_epochs=4)["4x4"]
+    k = design.counted_epochs(direct.t)
+    assert row.error_p90_m == design.share_quantile(direct.errors[:, k], 0.9)
+    out = conf.to_json()
+    assert out["confirmation"]["route"] == "channel"
+    assert out["confirmation"]["arrays"][0]["array"] == "4x4"
+    assert out["inputs"]["confirm_route"] == "channel"
+    assert "confirmed on the channel route" in conf.to_table()
+    with pytest.raises(ValueError, match="report"):
+        design.confirm_on_channel(design.design_sweep(setup, ["4x4"], n_epochs=4), setup)
+    assert np.isfinite(out["arrays"][0]["error_p90_m"])
+
+
+def test_cli_confirm_needs_bound_runs(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "4x4", "--confirm"]
+    assert main(argv) == 2
+    assert "--confirm" in capsys.readouterr().err
+    assert main([*argv, "--runs", "2", "--mode", "channel"]) == 2
+
+
+def test_cli_json_says_which_route_decided(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "4x4", "--n-epochs", "4"]
+    assert main([*argv, "--runs", "2", "--format", "json", "--no-progress"]) == 0
+    assert json.loads(capsys.readouterr().out)["recommendation"]["route"] == "bound"
+    assert main([*argv, "--format", "json"]) == 0
+    assert json.loads(capsys.readouterr().out)["recommendation"]["route"] is None

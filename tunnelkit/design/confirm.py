@@ -1,0 +1,148 @@
+"""The recommendation confirmed on the channel route: what the system achieves decides.
+
+The bound route (:mod:`tunnelkit.design.fastroute`) draws each path's measurement from the
+extraction's error model; the channel route synthesises the tensor and runs the extraction. Near
+the target the two can disagree: the bound route cannot have the extraction's outliers (a path
+merged, a fit in its threshold region), and it reads the ideal channel 1.2-1.5 times
+optimistic in error p90 (README, the design answer). :func:`confirm_on_channel` re-runs the
+candidates the recommendation rests on, on the channel route with the same impairments, runs
+and seed:
+
+* the recommended array, and every smaller candidate the bound route left ``"undecided"``
+  (its 95 % interval straddling the target);
+* with no recommendation, the smallest candidate that is neither hopeless nor in error.
+
+Each is judged again from its channel-route error quantile and 95 % interval
+(:func:`tunnelkit.design.verdict.judge`, the same rule), and the recommendation is taken from
+those rows alone: the smallest candidate met on the channel route, ``route: "channel"`` in its
+JSON; the bound route's rows stay in the report beside them (``confirmation`` in the JSON).
+
+Under impairments the channel route's tracker is told what the extraction reports (its CRLB at
+the estimate), not the error budget the bound route hands it: the confirmation then judges that
+system (28 GHz example, 0.5 deg phase error, 2 runs, seed 0: settled median error 0.42 m on
+4 x 4 and 0.97 m on 8 x 8 on the channel route, 1.5 and 0.4 cm on the bound route), and a bound
+route answer it does not confirm is reported with a warning.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+
+from .._validate import instance, integer
+from .report import DesignReport, score_row
+from .setup import DesignSetup, parse_array
+from .verdict import MIN_RUNS_CI, recommend
+
+__all__ = ["ConfirmedReport", "confirm_on_channel", "confirmation_candidates"]
+
+
+@dataclass
+class ConfirmedReport(DesignReport):
+    """A :class:`~tunnelkit.design.report.DesignReport` whose recommendation the channel route
+    decided: ``confirmation`` the channel route's rows, ``bound_recommendation`` the bound
+    route's recommendation it replaces."""
+
+    confirmation: list = field(default_factory=list)
+    bound_recommendation: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        out = super().to_json()
+        out["confirmation"] = {
+            "route": "channel",
+            "arrays": [r.to_json() for r in self.confirmation],
+            "bound_recommendation": dict(self.bound_recommendation),
+        }
+        return out
+
+    def to_table(self) -> str:
+        lines = [super().to_table(), "confirmed on the channel route (synthesis and extraction):"]
+        for r in self.confirmation:
+            ci = r.error_p90_ci95_m
+            cis = f"[{100 * ci[0]:.2f}, {100 * ci[1]:.2f}] cm" if ci else "-"
+            p90 = "-" if r.error_p90_m is None else f"{100 * r.error_p90_m:.2f} cm"
+            lines.append(f"  {r.array:>7s}: error p90 {p90} {cis}, {r.status}")
+        b = self.bound_recommendation
+        lines.append(f"  the bound route recommended {b.get('array') or 'none'}")
+        return "\n".join(lines)
+
+
+def confirmation_candidates(report: DesignReport) -> list[str]:
+    """The arrays :func:`confirm_on_channel` re-runs (module docstring), smallest first."""
+    instance("report", report, DesignReport)
+    order = sorted(report.rows, key=lambda r: (r.n_elements, r.aperture_diagonal_m))
+    rec = report.recommendation.get("array")
+    if rec is None:
+        open_ = [r.array for r in order if r.status not in ("hopeless", "error")]
+        return open_[:1]
+    at = [r.array for r in order].index(rec)
+    return [r.array for r in order[:at] if r.status == "undecided"] + [rec]
+
+
+def confirm_on_channel(
+    report: DesignReport,
+    setup: DesignSetup,
+    *,
+    runs: int | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    timeout: float | None = None,
+    progress: bool = False,
+) -> ConfirmedReport:
+    """``report`` (a bound-route :func:`~tunnelkit.design.report.design_sweep` with runs) with
+    its recommendation re-decided on the channel route (module docstring): the candidates of
+    :func:`confirmation_candidates`, ``runs`` drives each (default the report's), its seed,
+    impairments, target, share, criterion and epochs; ``workers`` / ``scheduler`` /
+    ``timeout`` as :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`'s."""
+    from .achievable import DesignImpairments
+    from .montecarlo import sweep_montecarlo
+
+    instance("report", report, DesignReport)
+    instance("setup", setup, DesignSetup)
+    s = report.settings
+    if s.get("mode") != "bound" or not s.get("runs"):
+        raise ValueError("report: expected a bound-route sweep with runs (mode 'bound', runs > 0)")
+    runs = s["runs"] if runs is None else integer("runs", runs, minimum=1)
+    labels = confirmation_candidates(report)
+    by = {r.array: r for r in report.rows}
+    imp = DesignImpairments(**s["impairments"])
+    rows, warnings = [], list(report.warnings)
+    if labels:
+        sp = s["spacing_wl"]  # per array (the sweep's) or one value (the command line's)
+        sp = sp if isinstance(sp, list | tuple) else [sp] * len(s["arrays"])
+        specs = [parse_array(a, w) for a, w in zip(s["arrays"], sp, strict=True)]
+        specs = [x for x in specs if x.label in labels]
+        res = sweep_montecarlo(
+            setup,
+            specs,
+            runs,
+            s["seed"],
+            mode="channel",
+            impairments=None if imp.ideal else imp,
+            workers=workers,
+            scheduler=scheduler,
+            timeout=timeout,
+            progress=progress,
+            n_epochs=s["n_epochs"],
+        )
+        for a in labels:
+            row = copy.deepcopy(by[a])
+            # the channel route gives no bound over the drive (no error model): none reported
+            row.drive_bound_known_rms_m = row.drive_bound_learned_rms_m = None
+            row.rmse_over_tracker_bound = None
+            score_row(row, res[a], s["criterion"], s["target"], s["share"], s["seed"], s["n_boot"])
+            rows.append(row)
+    rec = recommend(rows, s["target"], s["share"], runs)
+    rec["route"] = "channel"
+    if not rows:
+        rec["reason"] = "no candidate left to confirm on the channel route"
+    bound_rec = dict(report.recommendation, route="bound")
+    if rec.get("array") != bound_rec.get("array"):
+        warnings.append(
+            f"the channel route does not confirm the bound route's recommendation "
+            f"({bound_rec.get('array') or 'none'} -> {rec.get('array') or 'none'})"
+        )
+    if runs < MIN_RUNS_CI:
+        warnings.append(f"confirmation with {runs} runs: every verdict is undecided")
+    settings = dict(s, confirm_route="channel", confirm_runs=runs)
+    return ConfirmedReport(report.scenario, report.rows, rec, settings, warnings, rows, bound_rec)
