@@ -7,7 +7,7 @@ import pytest
 
 from tunnelkit import design
 from tunnelkit.cli import main
-from tunnelkit.design.confirm import confirmation_candidates
+from tunnelkit.design.confirm import IMPAIRED_WARNING, confirmation_candidates
 
 
 def _report(statuses, rec):
@@ -56,6 +56,18 @@ def test_confirmation_reruns_on_the_channel_route_and_decides():
     with pytest.raises(ValueError, match="report"):
         design.confirm_on_channel(design.design_sweep(setup, ["4x4"], n_epochs=4), setup)
     assert np.isfinite(out["arrays"][0]["error_p90_m"])
+    assert IMPAIRED_WARNING not in conf.warnings  # the ideal channel: a confirmation
+
+
+def test_confirmation_under_calibration_error_says_what_it_judges():
+    """Under calibration error the extraction's fit test (white noise only) flags its fits and
+    the channel route predicts through them: the confirmation says so in its warnings."""
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    kw = {"target": 1.0, "runs": 2, "n_epochs": 2, "seed": 3}
+    rep = design.design_sweep(setup, ["4x4"], impairments={"phase_error_deg": 0.5}, **kw)
+    conf = design.confirm_on_channel(rep, setup)
+    assert IMPAIRED_WARNING in conf.warnings
+    assert IMPAIRED_WARNING not in rep.warnings  # the bound route's answer is not concerned
 
 
 def test_cli_confirm_needs_bound_runs(capsys):

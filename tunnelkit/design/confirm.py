@@ -17,11 +17,16 @@ Each is judged again from its channel-route error quantile and 95 % interval
 those rows alone: the smallest candidate met on the channel route, ``route: "channel"`` in its
 JSON; the bound route's rows stay in the report beside them (``confirmation`` in the JSON).
 
-Under impairments the channel route's tracker is told what the extraction reports (its CRLB at
-the estimate), not the error budget the bound route hands it: the confirmation then judges that
-system (28 GHz example, 0.5 deg phase error, 2 runs, seed 0: settled median error 0.42 m on
-4 x 4 and 0.97 m on 8 x 8 on the channel route, 1.5 and 0.4 cm on the bound route), and a bound
-route answer it does not confirm is reported with a warning.
+Under calibration error the confirmation is not yet an answer (:data:`IMPAIRED_WARNING`, added
+to the report's warnings). The ML extraction tests its own fit against white noise only, so the
+calibration error it does not model makes it flag its fit (``fit_ok = False``) and a flagged
+epoch carries no measurement: 28 GHz example, the first 10 epochs, one drive: 7 of 10 flagged on
+4 x 4 and 10 of 10 on 8 x 8 at 0.5 deg, 2 of 10 on both at 0.1 deg, 0 of 10 on the ideal
+channel. The tracker then predicts through the drive (2 runs, seed 0, 0.5 deg: settled median
+error 0.42 m on 4 x 4 and 0.97 m on 8 x 8 on the channel route, 1.5 and 0.4 cm on the bound
+route). It also hands the tracker the extraction's CRLB, not the error budget the bound route
+hands it. A test with a stated model-error floor
+(:func:`tunnelkit.extraction.misspecified.model_error_test`) is what the channel route needs.
 """
 
 from __future__ import annotations
@@ -34,7 +39,14 @@ from .report import DesignReport, score_row
 from .setup import DesignSetup, parse_array
 from .verdict import MIN_RUNS_CI, recommend
 
-__all__ = ["ConfirmedReport", "confirm_on_channel", "confirmation_candidates"]
+__all__ = ["IMPAIRED_WARNING", "ConfirmedReport", "confirm_on_channel", "confirmation_candidates"]
+
+#: the warning a confirmation under calibration error carries (module docstring)
+IMPAIRED_WARNING = (
+    "the channel route under calibration error: the extraction's fit test has no model-error "
+    "floor, so it flags most epochs and the tracker predicts through them; this confirmation "
+    "judges that test, not the array (valid for the ideal channel)"
+)
 
 
 @dataclass
@@ -144,5 +156,7 @@ def confirm_on_channel(
         )
     if runs < MIN_RUNS_CI:
         warnings.append(f"confirmation with {runs} runs: every verdict is undecided")
+    if labels and (imp.phase_error_deg or imp.gain_error_db):
+        warnings.append(IMPAIRED_WARNING)
     settings = dict(s, confirm_route="channel", confirm_runs=runs)
     return ConfirmedReport(report.scenario, report.rows, rec, settings, warnings, rows, bound_rec)
