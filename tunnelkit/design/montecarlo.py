@@ -43,7 +43,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from contextlib import nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -221,8 +221,6 @@ class _SweepTrial:
                 # this run's array: its calibration error drawn once, for the whole drive
                 route = route.with_impairments(imp.channel_impairments(), rng)
             if imp is not None and imp.wideband_model:
-                from dataclasses import replace
-
                 route = replace(route, wideband_model=True)
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
@@ -497,8 +495,6 @@ def _median_sigmas(m: PathErrorModel) -> dict[str, float]:
 def _per_path(m: PathErrorModel) -> PathErrorModel:
     """A model whose ideal bound keeps only each path's own block (the correlation of the joint
     CRLB between paths dropped): the information a tracker told one block per path uses."""
-    from dataclasses import replace
-
     P = m.exists.shape[1]
     keep = np.kron(np.eye(P, dtype=bool), np.ones((4, 4), dtype=bool))
     return replace(m, crlb=np.where(keep, m.crlb, 0.0))
@@ -508,8 +504,6 @@ def _head(m: PathErrorModel, T: int) -> PathErrorModel:
     """The first ``T`` epochs of a model."""
     if m.exists.shape[0] == T:
         return m
-    from dataclasses import replace
-
     cut = {k: getattr(m, k)[:T] for k in ("t", "exists", "truth", "v", "crlb", "cov", "bias")}
     for k in ("k_phase", "k_gain"):
         if getattr(m, k) is not None:
