@@ -174,22 +174,28 @@ def search_failed(est, truth) -> bool:
     return bool(lr > chi2.ppf(0.99, 5 * len(d)))
 
 
-def above_threshold(est, truth) -> tuple[bool, float]:
+def above_threshold(est, truth) -> tuple[bool, float, float]:
     """Whether the snapshot lies outside the estimator's threshold region, by the stated
-    criterion computed from the bound at the truth (:func:`tunnelkit.extraction.ml.resolvable`:
-    every true path at least ``RESOLVE_Z`` = 5 standard deviations of the difference from every
-    other, Fisher information of the concentrated model at the true parameters, and every true
-    path's log-likelihood ratio against noise above the detection threshold of one path at the
-    residual test's 1 % false-alarm rate), and the smallest separation at the truth."""
+    criterion computed from the bound at the truth (:func:`tunnelkit.extraction.ml.below_threshold`:
+    every true path's post-integration SNR, its log-likelihood ratio against noise at the true
+    parameters, at least the threshold SNR of the method of interval errors,
+    :func:`~tunnelkit.extraction.ml.snr_threshold` of the tensor's ``M Nf Nt`` cells at a 1 %
+    outlier rate, and every true path at least ``RESOLVE_Z`` = 5 standard deviations of the
+    difference from every other, Fisher information of the concentrated model at the true
+    parameters), the smallest separation and the smallest SNR at the truth."""
     H, pos, cfg, src, d, v = truth
     r = np.linalg.norm(src, axis=1)
     th = np.column_stack([src[:, :2] / r[:, None], 1 / r])
     mf = -2 * np.pi * cfg.tone_spacing * d / C
     mt = 2 * np.pi * cfg.fc * cfg.symbol_period * v / C
     prob = ml.Problem(H, pos, cfg.fc)
-    ok = ml.resolvable(prob, th, mf, mt, est.fit.noise_power, est.fit.peak_max)
-    z = ml.separations(prob, th, mf, mt, est.fit.noise_power)
-    return bool(ok.all()), float(z.min()) if z.size else float("inf")
+    sigma2 = est.fit.noise_power
+    ev = prob.evaluate(th, mf, mt)
+    sig = np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(np.linalg.pinv(ev["G"]))), 1e-300)
+    sig = sig / sigma2
+    z = ml.separations(prob, th, mf, mt, sigma2)
+    below = ml.below_threshold(sig, z, H.size)
+    return bool(not below.any()), float(z.min()) if z.size else float("inf"), float(sig.min())
 
 
 def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "residual") -> list:
@@ -199,6 +205,7 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
         name, kind, band, off = case
         ci = CASES.index(case)  # the seed of a case does not depend on the selection
         errs, flags, bad, secs, srch, reasons, above, zmin = [], [], [], [], [], [], [], []
+        snr_min, est_below = [], []
         for rng in spawn_rngs(seed * 1000 + ci, n):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -208,8 +215,10 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
                     e, est, dt, truth = _drive_snapshot(kind, band, off, rng, search)
                 b = bool(np.any(~(np.abs(e) <= 6.0)))
                 srch.append(b and search_failed(est, truth))
-                a, z = above_threshold(est, truth)
+                a, z, g = above_threshold(est, truth)
             above.append(a)
+            snr_min.append(g)
+            est_below.append(bool(np.any(est.below_threshold)))
             zmin.append(z)
             errs.append(e)
             flags.append(not est.fit_ok)
@@ -229,6 +238,8 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
                 "reasons": reasons,
                 "above": np.array(above),
                 "zmin": np.array(zmin),
+                "snr_min": np.array(snr_min),
+                "est_below": np.array(est_below),
                 "n_paths": np.array([len(e) for e in errs]),
             }
         )
@@ -332,6 +343,16 @@ def threshold_table(rows: list) -> str:
             + f" {f'{(up & ~bad & fl).sum()}/{(up & ~bad).sum()}':>13s}"
             + f" {f'{(lo & bad & fl).sum()}/{(lo & bad).sum()}':>13s}"
             + f" {f'{(lo & ~bad & fl).sum()}/{(lo & ~bad).sum()}':>7s}"
+        )
+    eb = [(r["above"], r["bad"], r["flagged"], r["est_below"]) for r in rows if "est_below" in r]
+    if eb:
+        up, bad, fl, said = (np.concatenate(x) for x in zip(*eb))
+        lines.append(
+            "the estimate's own verdict (PathEstimates.below_threshold, a path below the threshold "
+            f"at the fit): below at the truth {said[~up].sum()}/{(~up).sum()}, above at the truth "
+            f"{said[up].sum()}/{up.sum()}; bad snapshots told by fit_ok = False or a path below "
+            f"the threshold at the fit {(bad & (fl | said)).sum()}/{bad.sum()}, good ones "
+            f"{(~bad & (fl | said)).sum()}/{(~bad).sum()}"
         )
     pb = tot["bbf"] / max(tot["bb"], 1) * 100
     pg = tot["bgf"] / max(tot["bg"], 1) * 100
