@@ -190,6 +190,9 @@ def _signal_route():
     f = est.fit
     ml.pair_separation(prob, f.theta, f.mu_f, f.mu_t, f.noise_power)
     ml.resolvable(prob, f.theta, f.mu_f, f.mu_t, f.noise_power, f.peak_max)
+    ml.below_threshold(est.significance, est.resolution, prob.N)
+    ml.outlier_probability(est.significance, prob.N)
+    ml.snr_threshold(prob.N, 0.01)
     del ep
 
 

@@ -65,6 +65,8 @@ def test_below_threshold_per_path():
     np.testing.assert_array_equal(ml.below_threshold(sig, res, N), [True, False, True, False])
     with pytest.raises(ValueError, match="resolution"):
         ml.below_threshold(sig, res[:3], N)
+    with pytest.raises(ValueError, match="n_cells"):
+        ml.snr_threshold(10**12)
     with pytest.raises(ValueError, match="resolution"):
         ml.below_threshold(sig, np.array([np.nan, 1, 1, 1.0]), N)
     with pytest.raises(ValueError, match="significance"):

@@ -63,6 +63,8 @@ __all__ = [
 
 #: outlier (interval-error) probability of a path at the threshold SNR (module text)
 OUTLIER_RATE = 0.01
+#: cap on ``n_cells``: a tensor of 10^11 samples (1.6 TB) is beyond any snapshot's memory budget
+MAX_CELLS = 10**11
 
 #: resolution test: two paths closer than this many standard deviations of their difference are
 #: in the threshold region of resolution (module text: non-centrality 25 of the 5-parameter test)
@@ -163,7 +165,7 @@ def outlier_probability(snr, n_cells: int) -> np.ndarray:
     snr = finite_array("snr", snr)
     if np.any(snr < 0):
         raise ValueError("snr: expected non-negative signal-to-noise ratios (linear)")
-    n = integer("n_cells", n_cells, minimum=1)
+    n = integer("n_cells", n_cells, minimum=1, maximum=MAX_CELLS)
     return np.reshape([_outlier(float(g), n - 1) for g in snr.ravel()], snr.shape)
 
 
@@ -179,7 +181,7 @@ def snr_threshold(n_cells: int, outlier: float = OUTLIER_RATE) -> float:
     """The post-integration SNR (linear) at which :func:`outlier_probability` over ``n_cells``
     equals ``outlier`` (0 when ``n_cells = 1``: nothing to confuse the path with); close to the
     union bound's ``2 ln((n_cells - 1) / (2 outlier))`` when ``outlier`` is small."""
-    n = integer("n_cells", n_cells, minimum=1)
+    n = integer("n_cells", n_cells, minimum=1, maximum=MAX_CELLS)
     outlier = positive("outlier", outlier)
     if outlier >= 1:
         raise ValueError(f"outlier: expected a probability below 1, got {outlier}")
@@ -194,7 +196,10 @@ def below_threshold(significance, resolution, n_cells: int) -> np.ndarray:
     Nt``) or its ``resolution`` (L,, :func:`separations`; ``inf`` alone) below ``RESOLVE_Z``."""
     sig = finite_array("significance", significance, shape=(None,))
     if isinstance(resolution, str | bytes) or np.shape(resolution) != sig.shape:
-        raise ValueError(f"resolution: expected shape {sig.shape}, got {np.shape(resolution)}")
+        raise ValueError(
+            f"significance, resolution: expected one of each per path, got shapes {sig.shape} "
+            f"and {np.shape(resolution)}"
+        )
     res = np.asarray(resolution)
     if res.dtype.kind not in "iuf" or np.any(np.isnan(res)) or np.any(res < 0):
         raise ValueError("resolution: expected non-negative separations (inf for a path alone)")
