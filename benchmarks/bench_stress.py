@@ -424,11 +424,43 @@ def _unscreened(fn):
         ml.fitting.SCREEN_ITER = old
 
 
+#: the numerics' unchecked twins the fits call, per module (swapped back by :func:`_checked`)
+TWINS = {
+    "tunnelkit.extraction.ml.fitting": ("damped_step", "free_newton", "spatial_phase"),
+    "tunnelkit.extraction.ml.model": ("solve", "spatial_phase"),
+    "tunnelkit.extraction.ml.wideband": ("solve", "spatial_phase"),
+    "tunnelkit.extraction.coherent": ("damped_step", "free_newton", "solve", "spatial_phase"),
+    "tunnelkit.extraction.paper": ("contract",),
+}
+
+
+def _checked(fn):
+    """``fn()`` with the fits calling the checked public numerics instead of their unchecked
+    twins (the route before the twins: the same arithmetic, every call's finiteness checks)."""
+    import importlib
+
+    from tunnelkit.extraction import numerics
+
+    saved = []
+    try:
+        for mod, names in TWINS.items():
+            m = importlib.import_module(mod)
+            for n in names:
+                saved.append((m, f"{n}_unchecked", getattr(m, f"{n}_unchecked")))
+                setattr(m, f"{n}_unchecked", getattr(numerics, n))
+        return fn()
+    finally:
+        for m, n, f in saved:
+            setattr(m, n, f)
+
+
 def cpu_times(repeat: int = 9, far: bool = True) -> str:
     """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction, of
     the same without the early screen (the default before it) and of the basic search (the route
     before issue 23: re-seeding on the residual energy only) on bench_ml's L = 6 tensor and on
-    long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m)."""
+    long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m), and of
+    the default with the fits calling the checked numerics (:func:`_checked`: the route before
+    the unchecked twins, same results)."""
     from bench_ml import _tensor
 
     tensors = {"L=6 (bench_ml)": _tensor()}
@@ -445,6 +477,9 @@ def cpu_times(repeat: int = 9, far: bool = True) -> str:
             lambda: extraction.extract_paths(H, L, arr, cfg)
         ),
         "basic": lambda H, arr, cfg, L: extraction.extract_paths(H, L, arr, cfg, search="basic"),
+        "checked": lambda H, arr, cfg, L: _checked(
+            lambda: extraction.extract_paths(H, L, arr, cfg)
+        ),
     }
     long_med = {k: [] for k in runs}
     with threadpool_limits(1), warnings.catch_warnings():
@@ -466,14 +501,17 @@ def cpu_times(repeat: int = 9, far: bool = True) -> str:
             lines.append(
                 f"  {name:18s} default {med['default'] * 1e3:5.0f} ms, unscreened "
                 f"{med['unscreened'] * 1e3:5.0f} ms (ratio {med['default'] / med['unscreened']:.2f}), "
-                f"basic {med['basic'] * 1e3:5.0f} ms (ratio {med['default'] / med['basic']:.2f}); "
+                f"basic {med['basic'] * 1e3:5.0f} ms (ratio {med['default'] / med['basic']:.2f}), "
+                f"checked numerics {med['checked'] * 1e3:5.0f} ms (ratio "
+                f"{med['default'] / med['checked']:.3f}); "
                 f"(fit_ok, cost/sigma^2): " + ", ".join(f"{k} {ok[k]}" for k in runs)
             )
     m = {k: float(np.median(v)) for k, v in long_med.items()}
     lines.append(
         f"  long range, median over the tensors: default {m['default'] * 1e3:.0f} ms, unscreened "
         f"{m['unscreened'] * 1e3:.0f} ms (ratio {m['default'] / m['unscreened']:.2f}), basic "
-        f"{m['basic'] * 1e3:.0f} ms"
+        f"{m['basic'] * 1e3:.0f} ms, checked numerics {m['checked'] * 1e3:.0f} ms (ratio "
+        f"{m['default'] / m['checked']:.3f})"
     )
     return "\n".join(lines)
 
@@ -503,11 +541,12 @@ if __name__ == "__main__":
     ap.add_argument("-k", dest="pattern", default=None, help="only cases containing this")
     ap.add_argument("--cpu", action="store_true", help="only the CPU times of the extraction")
     ap.add_argument("--repeat", type=int, default=9, help="with --cpu: runs per route")
+    ap.add_argument("--near", action="store_true", help="with --cpu: two long-range tensors only")
     ap.add_argument("--save", default=None, help="directory: run case by case, save each")
     ap.add_argument("--report-only", action="store_true", help="with --save: print what is saved")
     a = ap.parse_args()
     if a.cpu:
-        print(cpu_times(a.repeat))
+        print(cpu_times(a.repeat, far=not a.near))
         sys.exit(0)
     sel = [c for c in CASES if a.pattern is None or a.pattern in c[0]]
     t0 = time.perf_counter()

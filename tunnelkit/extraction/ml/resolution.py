@@ -171,8 +171,8 @@ def outlier_probability(snr, n_cells: int) -> np.ndarray:
 
 @lru_cache(maxsize=32)
 def _threshold(n: int, outlier: float) -> float:
-    if n == 1:
-        return 0.0
+    if n == 1 or _outlier(0.0, n - 1) <= outlier:
+        return 0.0  # even a path at zero SNR is confused less often than that
     hi = 2.0 * np.log(0.5 * (n - 1) / outlier) + 40.0  # the union bound's root, and margin
     return float(brentq(lambda g: _outlier(g, n - 1) - outlier, 0.0, hi, xtol=1e-6))
 
@@ -185,8 +185,6 @@ def snr_threshold(n_cells: int, outlier: float = OUTLIER_RATE) -> float:
     outlier = positive("outlier", outlier)
     if outlier >= 1:
         raise ValueError(f"outlier: expected a probability below 1, got {outlier}")
-    if n > 1 and _outlier(0.0, n - 1) <= outlier:
-        return 0.0  # even a path at zero SNR is confused less often than that
     return _threshold(n, float(outlier))
 
 
