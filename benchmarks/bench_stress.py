@@ -30,12 +30,16 @@ tracker that skips flagged epochs still sees), and the threshold SNR: the lowest
 at which every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5).
 
 The threshold region is also stated per snapshot, from the bound at the truth
-(:func:`above_threshold`, :func:`tunnelkit.extraction.ml.resolvable`): a snapshot is below the
-threshold when a true path lies fewer than ``RESOLVE_Z`` = 5 standard deviations of the
-difference from another (the statistical resolution limit of the 5-parameter test; Smith 2005,
-Liu & Nehorai 2007) or its log-likelihood ratio against noise is below the detection threshold
-of one path (1 % false alarms). :func:`threshold_table` gives per case the snapshots above
-(beyond 6 sigma, RMS: goal <= 2 %, <= 1.5) and below (bad flagged >= 95 %, good flagged <= 5 %).
+(:func:`above_threshold`, :func:`tunnelkit.extraction.ml.below_threshold`): a snapshot is below the
+threshold when a true path's post-integration SNR (its log-likelihood ratio against noise at the
+true parameters) is below the threshold SNR of the method of interval errors (the SNR at which
+the search puts the path in a wrong one of the tensor's ``M Nf Nt`` cells with probability 1 %,
+:func:`tunnelkit.extraction.ml.snr_threshold`: 28.5, 14.5 dB, for the presets' tensor), or a true
+path lies fewer than ``RESOLVE_Z`` = 5 standard deviations of the difference from another (the
+statistical resolution limit of the 5-parameter test; Smith 2005, Liu & Nehorai 2007).
+:func:`threshold_table` gives per case the snapshots above (beyond 6 sigma, RMS: goal <= 2 %,
+<= 1.5) and below (bad flagged >= 95 %, good flagged <= 5 %), and how often the estimate's own
+verdict (``PathEstimates.below_threshold`` at the fit) agrees with the truth's.
 
 ``python benchmarks/bench_stress.py --seed S --snapshots 30`` prints the table; the
 settings were chosen on seed 23 (the design seed); ``HELD_OUT_SEED`` is a seed the settings
