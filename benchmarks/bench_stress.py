@@ -458,6 +458,53 @@ def _checked(fn):
             setattr(m, n, f)
 
 
+def check_share(x: float = 110.0) -> str:
+    """The share of one default extraction (UE at ``x`` on the long straight drive, one BLAS
+    thread, after a warm-up) spent in the numerics' argument checks, profiled, with the fits
+    calling the unchecked twins and calling the checked functions (:func:`_checked`); a
+    load-independent measure of what the twins save (profiling inflates the Python-level share)."""
+    import cProfile
+    import pstats
+
+    H, arr, cfg, L = _long_tensor(x=x)
+
+    def run():
+        return extraction.extract_paths(H, L, arr, cfg)
+
+    lines = [
+        f"argument checks of extraction.numerics in one extraction (UE x = {x:.0f} m, profiled)"
+    ]
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run()
+        for name, fn in (("twins", run), ("checked", lambda: _checked(run))):
+            pr = cProfile.Profile()
+            pr.enable()
+            fn()
+            pr.disable()
+            st = pstats.Stats(pr)
+            chk, calls = 0.0, 0
+            for (f, _, fname), (_, nc, tt, ct, callers) in st.stats.items():
+                if f.endswith("numerics.py") and fname in ("_finite", "_square"):
+                    chk += ct
+                if f.endswith("numerics.py") and fname == "_masks":
+                    chk += tt
+                if f.endswith("_validate.py") and any(
+                    c[0].endswith("numerics.py") for c in callers
+                ):
+                    chk += ct
+                if f.endswith("numerics.py") and fname in TWIN_NAMES:
+                    calls += nc
+            lines.append(
+                f"  {name:8s} {st.total_tt * 1e3:6.0f} ms profiled, checks {chk * 1e3:5.1f} ms "
+                f"({100 * chk / st.total_tt:.1f} %), calls of the checked numerics {calls}"
+            )
+    return "\n".join(lines)
+
+
+TWIN_NAMES = ("solve", "free_newton", "damped_step", "spatial_phase", "contract")
+
+
 def cpu_times(repeat: int = 9, far: bool = True) -> str:
     """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction, of
     the same without the early screen (the default before it) and of the basic search (the route
@@ -550,6 +597,7 @@ if __name__ == "__main__":
     ap.add_argument("--report-only", action="store_true", help="with --save: print what is saved")
     a = ap.parse_args()
     if a.cpu:
+        print(check_share())
         print(cpu_times(a.repeat, far=not a.near))
         sys.exit(0)
     sel = [c for c in CASES if a.pattern is None or a.pattern in c[0]]
