@@ -428,91 +428,14 @@ def _unscreened(fn):
         ml.fitting.SCREEN_ITER = old
 
 
-#: the numerics' unchecked twins the fits call, per module (swapped back by :func:`_checked`)
-TWINS = {
-    "tunnelkit.extraction.ml.fitting": ("damped_step", "free_newton", "spatial_phase"),
-    "tunnelkit.extraction.ml.model": ("solve", "spatial_phase"),
-    "tunnelkit.extraction.ml.wideband": ("solve", "spatial_phase"),
-    "tunnelkit.extraction.coherent": ("damped_step", "free_newton", "solve", "spatial_phase"),
-    "tunnelkit.extraction.paper": ("contract",),
-}
-
-
-def _checked(fn):
-    """``fn()`` with the fits calling the checked public numerics instead of their unchecked
-    twins (the route before the twins: the same arithmetic, every call's finiteness checks)."""
-    import importlib
-
-    from tunnelkit.extraction import numerics
-
-    saved = []
-    try:
-        for mod, names in TWINS.items():
-            m = importlib.import_module(mod)
-            for n in names:
-                saved.append((m, f"{n}_unchecked", getattr(m, f"{n}_unchecked")))
-                setattr(m, f"{n}_unchecked", getattr(numerics, n))
-        return fn()
-    finally:
-        for m, n, f in saved:
-            setattr(m, n, f)
-
-
-def check_share(x: float = 110.0) -> str:
-    """The share of one default extraction (UE at ``x`` on the long straight drive, one BLAS
-    thread, after a warm-up) spent in the numerics' argument checks, profiled, with the fits
-    calling the unchecked twins and calling the checked functions (:func:`_checked`); a
-    load-independent measure of what the twins save (profiling inflates the Python-level share)."""
-    import cProfile
-    import pstats
-
-    H, arr, cfg, L = _long_tensor(x=x)
-
-    def run():
-        return extraction.extract_paths(H, L, arr, cfg)
-
-    lines = [
-        f"argument checks of extraction.numerics in one extraction (UE x = {x:.0f} m, profiled)"
-    ]
-    with threadpool_limits(1), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        run()
-        for name, fn in (("twins", run), ("checked", lambda: _checked(run))):
-            pr = cProfile.Profile()
-            pr.enable()
-            fn()
-            pr.disable()
-            st = pstats.Stats(pr)
-            chk, calls = 0.0, 0
-            for (f, _, fname), (_, nc, tt, ct, callers) in st.stats.items():
-                if f.endswith("numerics.py") and fname in ("_finite", "_square"):
-                    chk += ct
-                if f.endswith("numerics.py") and fname == "_masks":
-                    chk += tt
-                if f.endswith("_validate.py") and any(
-                    c[0].endswith("numerics.py") for c in callers
-                ):
-                    chk += ct
-                if f.endswith("numerics.py") and fname in TWIN_NAMES:
-                    calls += nc
-            lines.append(
-                f"  {name:8s} {st.total_tt * 1e3:6.0f} ms profiled, checks {chk * 1e3:5.1f} ms "
-                f"({100 * chk / st.total_tt:.1f} %), calls of the checked numerics {calls}"
-            )
-    return "\n".join(lines)
-
-
-TWIN_NAMES = ("solve", "free_newton", "damped_step", "spatial_phase", "contract")
-
-
 def cpu_times(repeat: int = 9, far: bool = True) -> str:
     """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction, of
     the same without the early screen (the default before it) and of the basic search (the route
     before issue 23: re-seeding on the residual energy only) on bench_ml's L = 6 tensor and on
     long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m), and of
-    the default with the fits calling the checked numerics (:func:`_checked`: the route before
-    the unchecked twins, same results)."""
-    from bench_ml import _tensor
+    the default with the fits calling the checked numerics (``bench_ml.checked_numerics``: the
+    route before the unchecked twins, same results)."""
+    from bench_ml import _tensor, checked_numerics
 
     tensors = {"L=6 (bench_ml)": _tensor()}
     for x in (120.0, 110.0, 100.0, 95.0, 85.0) if far else (110.0, 85.0):
@@ -528,7 +451,7 @@ def cpu_times(repeat: int = 9, far: bool = True) -> str:
             lambda: extraction.extract_paths(H, L, arr, cfg)
         ),
         "basic": lambda H, arr, cfg, L: extraction.extract_paths(H, L, arr, cfg, search="basic"),
-        "checked": lambda H, arr, cfg, L: _checked(
+        "checked": lambda H, arr, cfg, L: checked_numerics(
             lambda: extraction.extract_paths(H, L, arr, cfg)
         ),
     }
@@ -597,7 +520,9 @@ if __name__ == "__main__":
     ap.add_argument("--report-only", action="store_true", help="with --save: print what is saved")
     a = ap.parse_args()
     if a.cpu:
-        print(check_share())
+        from bench_ml import check_share
+
+        print(check_share(_long_tensor(x=110.0), "UE x = 110 m"))
         print(cpu_times(a.repeat, far=not a.near))
         sys.exit(0)
     sel = [c for c in CASES if a.pattern is None or a.pattern in c[0]]
