@@ -156,6 +156,81 @@ def table(res: dict) -> str:
     return "\n".join(lines)
 
 
+#: the numerics' unchecked twins the fits call, per module (swapped back by :func:`checked_numerics`)
+TWINS = {
+    "tunnelkit.extraction.ml.fitting": ("damped_step", "free_newton", "spatial_phase"),
+    "tunnelkit.extraction.ml.model": ("solve", "spatial_phase"),
+    "tunnelkit.extraction.ml.wideband": ("solve", "spatial_phase"),
+    "tunnelkit.extraction.coherent": ("damped_step", "free_newton", "solve", "spatial_phase"),
+    "tunnelkit.extraction.paper": ("contract",),
+}
+
+
+def checked_numerics(fn):
+    """``fn()`` with the fits calling the checked public numerics instead of their unchecked
+    twins (the route before the twins: the same arithmetic, every call's finiteness checks)."""
+    import importlib
+
+    from tunnelkit.extraction import numerics
+
+    saved = []
+    try:
+        for mod, names in TWINS.items():
+            m = importlib.import_module(mod)
+            for n in names:
+                saved.append((m, f"{n}_unchecked", getattr(m, f"{n}_unchecked")))
+                setattr(m, f"{n}_unchecked", getattr(numerics, n))
+        return fn()
+    finally:
+        for m, n, f in saved:
+            setattr(m, n, f)
+
+
+def check_share(tensor, label: str) -> str:
+    """The share of one default extraction of ``tensor = (H, array, config, L)`` (one BLAS
+    thread, after a warm-up) spent in the numerics' argument checks, profiled, with the fits
+    calling the unchecked twins and calling the checked functions (:func:`checked_numerics`); a
+    load-independent measure of what the twins save (profiling inflates the Python-level share)."""
+    import cProfile
+    import pstats
+
+    H, arr, cfg, L = tensor
+
+    def run():
+        return extraction.extract_paths(H, L, arr, cfg)
+
+    lines = [f"argument checks of extraction.numerics in one extraction ({label}, profiled)"]
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run()
+        for name, fn in (("twins", run), ("checked", lambda: checked_numerics(run))):
+            pr = cProfile.Profile()
+            pr.enable()
+            fn()
+            pr.disable()
+            st = pstats.Stats(pr)
+            chk, calls = 0.0, 0
+            for (f, _, fname), (_, nc, tt, ct, callers) in st.stats.items():
+                if f.endswith("numerics.py") and fname in ("_finite", "_square"):
+                    chk += ct
+                if f.endswith("numerics.py") and fname == "_masks":
+                    chk += tt
+                if f.endswith("_validate.py") and any(
+                    c[0].endswith("numerics.py") for c in callers
+                ):
+                    chk += ct
+                if f.endswith("numerics.py") and fname in TWIN_NAMES:
+                    calls += nc
+            lines.append(
+                f"  {name:8s} {st.total_tt * 1e3:6.0f} ms profiled, checks {chk * 1e3:5.1f} ms "
+                f"({100 * chk / st.total_tt:.1f} %), calls of the checked numerics {calls}"
+            )
+    return "\n".join(lines)
+
+
+TWIN_NAMES = ("solve", "free_newton", "damped_step", "spatial_phase", "contract")
+
+
 def cpu_times(repeat: int = 15) -> str:
     """Median process (CPU) time of the default extraction and of the CPD + coherent route on
     bench_extraction's tensor, one BLAS thread, interleaved: on a shared machine the wall-clock

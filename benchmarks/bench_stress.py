@@ -30,12 +30,16 @@ tracker that skips flagged epochs still sees), and the threshold SNR: the lowest
 at which every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5).
 
 The threshold region is also stated per snapshot, from the bound at the truth
-(:func:`above_threshold`, :func:`tunnelkit.extraction.ml.resolvable`): a snapshot is below the
-threshold when a true path lies fewer than ``RESOLVE_Z`` = 5 standard deviations of the
-difference from another (the statistical resolution limit of the 5-parameter test; Smith 2005,
-Liu & Nehorai 2007) or its log-likelihood ratio against noise is below the detection threshold
-of one path (1 % false alarms). :func:`threshold_table` gives per case the snapshots above
-(beyond 6 sigma, RMS: goal <= 2 %, <= 1.5) and below (bad flagged >= 95 %, good flagged <= 5 %).
+(:func:`above_threshold`, :func:`tunnelkit.extraction.ml.below_threshold`): a snapshot is below the
+threshold when a true path's post-integration SNR (its log-likelihood ratio against noise at the
+true parameters) is below the threshold SNR of the method of interval errors (the SNR at which
+the search puts the path in a wrong one of the tensor's ``M Nf Nt`` cells with probability 1 %,
+:func:`tunnelkit.extraction.ml.snr_threshold`: 28.5, 14.5 dB, for the presets' tensor), or a true
+path lies fewer than ``RESOLVE_Z`` = 5 standard deviations of the difference from another (the
+statistical resolution limit of the 5-parameter test; Smith 2005, Liu & Nehorai 2007).
+:func:`threshold_table` gives per case the snapshots above (beyond 6 sigma, RMS: goal <= 2 %,
+<= 1.5) and below (bad flagged >= 95 %, good flagged <= 5 %), and how often the estimate's own
+verdict (``PathEstimates.below_threshold`` at the fit) agrees with the truth's.
 
 ``python benchmarks/bench_stress.py --seed S --snapshots 30`` prints the table; the
 settings were chosen on seed 23 (the design seed); ``HELD_OUT_SEED`` is a seed the settings
@@ -174,22 +178,28 @@ def search_failed(est, truth) -> bool:
     return bool(lr > chi2.ppf(0.99, 5 * len(d)))
 
 
-def above_threshold(est, truth) -> tuple[bool, float]:
+def above_threshold(est, truth) -> tuple[bool, float, float]:
     """Whether the snapshot lies outside the estimator's threshold region, by the stated
-    criterion computed from the bound at the truth (:func:`tunnelkit.extraction.ml.resolvable`:
-    every true path at least ``RESOLVE_Z`` = 5 standard deviations of the difference from every
-    other, Fisher information of the concentrated model at the true parameters, and every true
-    path's log-likelihood ratio against noise above the detection threshold of one path at the
-    residual test's 1 % false-alarm rate), and the smallest separation at the truth."""
+    criterion computed from the bound at the truth (:func:`tunnelkit.extraction.ml.below_threshold`:
+    every true path's post-integration SNR, its log-likelihood ratio against noise at the true
+    parameters, at least the threshold SNR of the method of interval errors,
+    :func:`~tunnelkit.extraction.ml.snr_threshold` of the tensor's ``M Nf Nt`` cells at a 1 %
+    outlier rate, and every true path at least ``RESOLVE_Z`` = 5 standard deviations of the
+    difference from every other, Fisher information of the concentrated model at the true
+    parameters), the smallest separation and the smallest SNR at the truth."""
     H, pos, cfg, src, d, v = truth
     r = np.linalg.norm(src, axis=1)
     th = np.column_stack([src[:, :2] / r[:, None], 1 / r])
     mf = -2 * np.pi * cfg.tone_spacing * d / C
     mt = 2 * np.pi * cfg.fc * cfg.symbol_period * v / C
     prob = ml.Problem(H, pos, cfg.fc)
-    ok = ml.resolvable(prob, th, mf, mt, est.fit.noise_power, est.fit.peak_max)
-    z = ml.separations(prob, th, mf, mt, est.fit.noise_power)
-    return bool(ok.all()), float(z.min()) if z.size else float("inf")
+    sigma2 = est.fit.noise_power
+    ev = prob.evaluate(th, mf, mt)
+    sig = np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(np.linalg.pinv(ev["G"]))), 1e-300)
+    sig = sig / sigma2
+    z = ml.separations(prob, th, mf, mt, sigma2)
+    below = ml.below_threshold(sig, z, H.size)
+    return bool(not below.any()), float(z.min()) if z.size else float("inf"), float(sig.min())
 
 
 def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "residual") -> list:
@@ -199,6 +209,7 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
         name, kind, band, off = case
         ci = CASES.index(case)  # the seed of a case does not depend on the selection
         errs, flags, bad, secs, srch, reasons, above, zmin = [], [], [], [], [], [], [], []
+        snr_min, est_below = [], []
         for rng in spawn_rngs(seed * 1000 + ci, n):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -208,8 +219,10 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
                     e, est, dt, truth = _drive_snapshot(kind, band, off, rng, search)
                 b = bool(np.any(~(np.abs(e) <= 6.0)))
                 srch.append(b and search_failed(est, truth))
-                a, z = above_threshold(est, truth)
+                a, z, g = above_threshold(est, truth)
             above.append(a)
+            snr_min.append(g)
+            est_below.append(bool(np.any(est.below_threshold)))
             zmin.append(z)
             errs.append(e)
             flags.append(not est.fit_ok)
@@ -229,6 +242,8 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
                 "reasons": reasons,
                 "above": np.array(above),
                 "zmin": np.array(zmin),
+                "snr_min": np.array(snr_min),
+                "est_below": np.array(est_below),
                 "n_paths": np.array([len(e) for e in errs]),
             }
         )
@@ -333,6 +348,16 @@ def threshold_table(rows: list) -> str:
             + f" {f'{(lo & bad & fl).sum()}/{(lo & bad).sum()}':>13s}"
             + f" {f'{(lo & ~bad & fl).sum()}/{(lo & ~bad).sum()}':>7s}"
         )
+    eb = [(r["above"], r["bad"], r["flagged"], r["est_below"]) for r in rows if "est_below" in r]
+    if eb:
+        up, bad, fl, said = (np.concatenate(x) for x in zip(*eb))
+        lines.append(
+            "the estimate's own verdict (PathEstimates.below_threshold, a path below the threshold "
+            f"at the fit): below at the truth {said[~up].sum()}/{(~up).sum()}, above at the truth "
+            f"{said[up].sum()}/{up.sum()}; bad snapshots told by fit_ok = False or a path below "
+            f"the threshold at the fit {(bad & (fl | said)).sum()}/{bad.sum()}, good ones "
+            f"{(~bad & (fl | said)).sum()}/{(~bad).sum()}"
+        )
     pb = tot["bbf"] / max(tot["bb"], 1) * 100
     pg = tot["bgf"] / max(tot["bg"], 1) * 100
     lines.append(
@@ -407,8 +432,10 @@ def cpu_times(repeat: int = 9, far: bool = True) -> str:
     """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction, of
     the same without the early screen (the default before it) and of the basic search (the route
     before issue 23: re-seeding on the residual energy only) on bench_ml's L = 6 tensor and on
-    long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m)."""
-    from bench_ml import _tensor
+    long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m), and of
+    the default with the fits calling the checked numerics (``bench_ml.checked_numerics``: the
+    route before the unchecked twins, same results)."""
+    from bench_ml import _tensor, checked_numerics
 
     tensors = {"L=6 (bench_ml)": _tensor()}
     for x in (120.0, 110.0, 100.0, 95.0, 85.0) if far else (110.0, 85.0):
@@ -424,6 +451,9 @@ def cpu_times(repeat: int = 9, far: bool = True) -> str:
             lambda: extraction.extract_paths(H, L, arr, cfg)
         ),
         "basic": lambda H, arr, cfg, L: extraction.extract_paths(H, L, arr, cfg, search="basic"),
+        "checked": lambda H, arr, cfg, L: checked_numerics(
+            lambda: extraction.extract_paths(H, L, arr, cfg)
+        ),
     }
     long_med = {k: [] for k in runs}
     with threadpool_limits(1), warnings.catch_warnings():
@@ -445,14 +475,17 @@ def cpu_times(repeat: int = 9, far: bool = True) -> str:
             lines.append(
                 f"  {name:18s} default {med['default'] * 1e3:5.0f} ms, unscreened "
                 f"{med['unscreened'] * 1e3:5.0f} ms (ratio {med['default'] / med['unscreened']:.2f}), "
-                f"basic {med['basic'] * 1e3:5.0f} ms (ratio {med['default'] / med['basic']:.2f}); "
+                f"basic {med['basic'] * 1e3:5.0f} ms (ratio {med['default'] / med['basic']:.2f}), "
+                f"checked numerics {med['checked'] * 1e3:5.0f} ms (ratio "
+                f"{med['default'] / med['checked']:.3f}); "
                 f"(fit_ok, cost/sigma^2): " + ", ".join(f"{k} {ok[k]}" for k in runs)
             )
     m = {k: float(np.median(v)) for k, v in long_med.items()}
     lines.append(
         f"  long range, median over the tensors: default {m['default'] * 1e3:.0f} ms, unscreened "
         f"{m['unscreened'] * 1e3:.0f} ms (ratio {m['default'] / m['unscreened']:.2f}), basic "
-        f"{m['basic'] * 1e3:.0f} ms"
+        f"{m['basic'] * 1e3:.0f} ms, checked numerics {m['checked'] * 1e3:.0f} ms (ratio "
+        f"{m['default'] / m['checked']:.3f})"
     )
     return "\n".join(lines)
 
@@ -482,11 +515,15 @@ if __name__ == "__main__":
     ap.add_argument("-k", dest="pattern", default=None, help="only cases containing this")
     ap.add_argument("--cpu", action="store_true", help="only the CPU times of the extraction")
     ap.add_argument("--repeat", type=int, default=9, help="with --cpu: runs per route")
+    ap.add_argument("--near", action="store_true", help="with --cpu: two long-range tensors only")
     ap.add_argument("--save", default=None, help="directory: run case by case, save each")
     ap.add_argument("--report-only", action="store_true", help="with --save: print what is saved")
     a = ap.parse_args()
     if a.cpu:
-        print(cpu_times(a.repeat))
+        from bench_ml import check_share
+
+        print(check_share(_long_tensor(x=110.0), "UE x = 110 m"))
+        print(cpu_times(a.repeat, far=not a.near))
         sys.exit(0)
     sel = [c for c in CASES if a.pattern is None or a.pattern in c[0]]
     t0 = time.perf_counter()

@@ -98,6 +98,18 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(r"budget\.check_(bytes|elements)", r"what", "empty", "no description: the count is shown"),
     _doc(
+        r"extraction\.ml\.resolution\.below_threshold",
+        r"resolution",
+        "inf",
+        "a path alone is infinitely far from any other (separations gives inf)",
+    ),
+    _doc(
+        r"extraction\.ml\.resolution\.outlier_probability",
+        r"snr",
+        "empty shape",
+        "elementwise: one probability per SNR, of the same shape (none for none)",
+    ),
+    _doc(
         r"geometry\.(Plane|Tunnel2D)\.\w+|geometry\.(mirror|reflector_point|specular_point)",
         r"p|point|target|q|p_u|p_v",
         "shape",

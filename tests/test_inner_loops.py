@@ -114,3 +114,40 @@ def test_the_tracer_s_unchecked_surface_tests_equal_the_checked_ones():
     for f in tun.surfaces:
         for tol in (1e-9, 0.0, -1e-4):
             assert _same(f._contains(a, tol), f.contains(a, tol=tol))
+
+
+def test_the_extraction_numerics_unchecked_twins_equal_the_checked_functions():
+    """The fits (ml.fitting, ml.model, coherent, paper.refine_joint) call the unchecked twins of
+    ``extraction.numerics``: same bytes as the checked public forms, including the singular
+    fall-back of ``solve``, the held coordinates of ``free_newton`` and ``damped_step``'s None."""
+    from tunnelkit.extraction import numerics as nm
+
+    rng = np.random.default_rng(6)
+    for n in (1, 4, 10):
+        J = rng.normal(size=(3 * n, n)) + 1j * rng.normal(size=(3 * n, n))
+        G = J.conj().T @ J
+        B = rng.normal(size=(n, 2)) + 1j * rng.normal(size=(n, 2))
+        assert _same(nm.solve_unchecked(G, B), nm.solve(G, B))
+        assert _same(nm.solve_unchecked(G, B[:, 0]), nm.solve(G, B[:, 0]))
+        S = np.outer(J[0], J[0].conj())  # rank one: the least-squares fall-back
+        assert _same(nm.solve_unchecked(S, B), nm.solve(S, B))
+        A = (J.conj().T @ J).real
+        g = rng.normal(size=n)
+        lower, upper = rng.random(n) < 0.3, rng.random(n) < 0.3
+        upper &= ~lower
+        f1, d1 = nm.free_newton_unchecked(A, g, lower, upper)
+        f2, d2 = nm.free_newton(A, g, lower, upper)
+        assert _same(f1, f2) and d1 == d2
+        for lam in (1e-9, 1e-3, 10.0):
+            assert _same(nm.damped_step_unchecked(A, g, f2, lam), nm.damped_step(A, g, f2, lam))
+    Z = np.zeros((3, 3))
+    assert nm.damped_step_unchecked(Z, np.ones(3), np.ones(3, bool), 0.0) is None
+    p = np.column_stack([rng.normal(size=(16, 2)) * 0.02, np.zeros(16)])
+    th = np.column_stack([rng.uniform(-0.7, 0.7, (5, 2)), rng.uniform(0, 0.5, 5)])
+    th[0] = (0.0, 0.0, 0.0)  # far field, broadside
+    for a, b in zip(nm.spatial_phase_unchecked(th, p, 587.0), nm.spatial_phase(th, p, 587.0)):
+        assert _same(a, b)
+    H = rng.normal(size=(4, 7, 3)) + 1j * rng.normal(size=(4, 7, 3))
+    F = np.exp(1j * rng.normal(size=(7, 2)))
+    T = np.exp(1j * rng.normal(size=(3, 2)))
+    assert _same(nm.contract_unchecked(H, F, T), nm.contract(H, F, T))

@@ -45,7 +45,13 @@ from ..arrays import check_element_positions
 from ..constants import C
 from .decomposition import check_tensor, cp_rel_error, normalize_factors
 from .estimates import PathEstimates, path_estimates
-from .numerics import damped_step, free_newton, scan_peak, solve, spatial_phase
+from .numerics import (
+    damped_step_unchecked,
+    free_newton_unchecked,
+    scan_peak,
+    solve_unchecked,
+    spatial_phase_unchecked,
+)
 from .paper import angles_from_solution, refine_roots, vandermonde_roots
 from .radio import check_array, check_srs
 
@@ -158,10 +164,10 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
         return t
 
     def evaluate(t):
-        psi, dx, dy, dw = spatial_phase(t, p, k0)
+        psi, dx, dy, dw = spatial_phase_unchecked(t, p, k0)
         S = np.exp(1j * psi)
         G = S.conj().T @ S
-        g = solve(G, S.conj().T @ b)
+        g = solve_unchecked(G, S.conj().T @ b)
         r = b - S @ g
         return S, np.stack([dx, dy, dw], axis=2), G, g, r, float(np.vdot(r, r).real)
 
@@ -172,16 +178,16 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
         S, dpsi, G, g, r, cost = cur
         D = (1j * dpsi * (S * g[None, :])[..., None]).reshape(m, 3 * n)
         DS = D.conj().T @ S
-        A = (D.conj().T @ D - DS @ solve(G, DS.conj().T)).real
+        A = (D.conj().T @ D - DS @ solve_unchecked(G, DS.conj().T)).real
         grad = (D.conj().T @ r).real
         lower = np.zeros((n, 3), bool)
         lower[:, 2] = th[:, 2] <= 1 / KAPPA_MAX
         upper = np.zeros((n, 3), bool)
         upper[:, 2] = th[:, 2] >= 1 / KAPPA_MIN
-        free, dec = free_newton(A, grad, lower.ravel(), upper.ravel())
+        free, dec = free_newton_unchecked(A, grad, lower.ravel(), upper.ravel())
         if dec <= 1e-6 * cost + 1e-14 * b2:
             break  # the full Gauss-Newton step would gain less than ftol = 1e-6
-        step = damped_step(A, grad, free, lam)
+        step = damped_step_unchecked(A, grad, free, lam)
         if step is None:
             lam *= 4.0
             continue

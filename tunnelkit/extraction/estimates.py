@@ -66,7 +66,11 @@ class PathEstimates:
     smallest distance to another path in standard deviations of their difference (Fisher
     information at the fit, :func:`~tunnelkit.extraction.ml.separations`): below
     ``ml.RESOLVE_Z`` (5) the path is in the threshold region of resolution (its errors are not
-    described by the bound, ``fit_ok`` is False), ``None`` on the routes without the ML fit.
+    described by the bound, ``fit_ok`` is False), ``None`` on the routes without the ML fit;
+    ``below_threshold`` per path, in the estimator's threshold region at the fit
+    (:func:`~tunnelkit.extraction.ml.below_threshold`: its SNR below the threshold of the method of
+    interval errors, :func:`~tunnelkit.extraction.ml.snr_threshold`, or unresolved): its errors
+    may leave the bound; ``fit_ok`` stays the fit's own tests (``None`` off the ML route).
     """
 
     alpha: np.ndarray
@@ -90,6 +94,7 @@ class PathEstimates:
     significance: np.ndarray | None = field(default=None, repr=False)
     fit_ok: bool | None = None
     resolution: np.ndarray | None = field(default=None, repr=False)
+    below_threshold: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         d = self.d
@@ -123,6 +128,8 @@ class PathEstimates:
             )
         if self.resolution is not None:
             _per_path("resolution", self.resolution, n, "real")
+        if self.below_threshold is not None:
+            _per_path("below_threshold", self.below_threshold, n, "bool")
 
     def __len__(self) -> int:
         return self.d.shape[0]

@@ -10,6 +10,13 @@
 - :func:`spatial_phase` — the exact spherical spatial phase of eq. 1 and its derivatives in
   ``(u_x, u_y, w = 1 / kappa)``;
 - :func:`scan_peak` — the far-field beam-scan peak of a spatial vector.
+
+The fits call :func:`solve`, :func:`free_newton`, :func:`damped_step`, :func:`spatial_phase` and
+:func:`contract` on every iteration with arrays they built themselves; there the finiteness
+checks cost ~2 % of an extraction. Each has an unchecked twin (``solve_unchecked``,
+``free_newton_unchecked``, ``damped_step_unchecked``, ``spatial_phase_unchecked``,
+``contract_unchecked``; not exported) that the fits call on their own arrays: the same
+arithmetic, bit for bit (``tests/test_inner_loops.py``); the checked forms are the public ones.
 """
 
 from __future__ import annotations
@@ -71,6 +78,11 @@ def solve(G, B) -> np.ndarray:
     B = _finite("B", B)
     if B.ndim not in (1, 2) or B.shape[0] != G.shape[0]:
         raise ValueError(f"B: expected {G.shape[0]} rows, got shape {B.shape}")
+    return solve_unchecked(G, B)
+
+
+def solve_unchecked(G, B) -> np.ndarray:
+    """:func:`solve` without the checks (the fits' inner loops, on their own finite arrays)."""
     try:
         return np.linalg.solve(G, B)
     except np.linalg.LinAlgError:
@@ -89,6 +101,11 @@ def free_newton(A, g, lower, upper) -> tuple[np.ndarray, float]:
     A = _square("A", A)
     g = np.asarray(g)
     _masks(g, ("A", A[0]), ("lower", lower), ("upper", upper))
+    return free_newton_unchecked(A, g, lower, upper)
+
+
+def free_newton_unchecked(A, g, lower, upper) -> tuple[np.ndarray, float]:
+    """:func:`free_newton` without the checks (the fits' inner loops, on their own arrays)."""
     free = np.ones(g.size, bool)
     for _ in range(3):
         sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
@@ -110,7 +127,11 @@ def damped_step(A, g, free, lam: float) -> np.ndarray | None:
     A = _square("A", A)
     g = np.asarray(g)
     _masks(g, ("A", A[0]), ("free", free))
-    lam = positive("lam", lam)
+    return damped_step_unchecked(A, g, free, positive("lam", lam))
+
+
+def damped_step_unchecked(A, g, free, lam: float) -> np.ndarray | None:
+    """:func:`damped_step` without the checks (the fits' inner loops, on their own arrays)."""
     sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
     As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
     try:
@@ -128,18 +149,25 @@ def contract(H, F, T) -> np.ndarray:
     H, F, T = np.asarray(H), np.asarray(F), np.asarray(T)
     if H.ndim != 3:
         raise ValueError(f"H: expected a 3-D tensor (M x Nf x Nt), got shape {H.shape}")
-    M, nf, nt = H.shape
+    _, nf, nt = H.shape
     if F.ndim != 2 or F.shape[0] != nf:
         raise ValueError(f"F: expected ({nf}, L), got shape {F.shape}")
     if T.ndim != 2 or T.shape != (nt, F.shape[1]):
         raise ValueError(f"T: expected ({nt}, {F.shape[1]}), got shape {T.shape}")
     finite_array("F", F, dtype=complex)
     finite_array("T", T, dtype=complex)
-    tmp = (H.reshape(M * nf, nt) @ T).reshape(M, nf, -1)
-    out = np.einsum("msl,sl->ml", tmp, F)
+    out = contract_unchecked(H, F, T)
     if not np.isfinite(out).all():  # F and T are finite: H is not (checked here, not per sample)
         raise ValueError("H: contains NaN or infinite values")
     return out
+
+
+def contract_unchecked(H, F, T) -> np.ndarray:
+    """:func:`contract` without the checks (arrays (M, Nf, Nt), (Nf, L), (Nt, L) the caller
+    built or checked)."""
+    M, nf, nt = H.shape
+    tmp = (H.reshape(M * nf, nt) @ T).reshape(M, nf, -1)
+    return np.einsum("msl,sl->ml", tmp, F)
 
 
 def grid_index(element_positions, tol: float = 1e-6):
@@ -189,7 +217,12 @@ def spatial_phase(theta, element_positions, k0: float):
     p = finite_array("element_positions", element_positions)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
-    k0 = positive("k0", k0)
+    return spatial_phase_unchecked(th, p, positive("k0", k0))
+
+
+def spatial_phase_unchecked(th, p, k0: float):
+    """:func:`spatial_phase` without the checks: ``th`` (L, 3) and ``p`` (M, 3) finite float
+    arrays, ``k0 > 0`` (the fits' inner loops, on their own arrays)."""
     p2 = np.sum(p**2, axis=1)[:, None]
     up = p[:, :2] @ th[:, :2].T
     w = th[None, :, 2]

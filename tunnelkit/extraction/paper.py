@@ -30,7 +30,7 @@ from .._validate import finite_array, integer
 from ..constants import C
 from .decomposition import check_rank, check_tensor, cpd, normalize_factors
 from .estimates import PathEstimates, path_estimates
-from .numerics import MIN_SIGNIFICANCE, contract, grid_index
+from .numerics import MIN_SIGNIFICANCE, contract_unchecked, grid_index
 from .radio import check_array, check_srs
 
 __all__ = [
@@ -142,7 +142,8 @@ def refine_joint(H, mu_f, mu_t, n_steps: int = 6):
         FF, TT = F.conj().T @ F, T.conj().T @ T
         WD = np.concatenate([1j * (F.conj().T @ Fs) * TT, 1j * FF * (T.conj().T @ Tk)], axis=1)
         XD = -1j * np.concatenate(
-            [np.einsum("msl,sl->ml", HT, Fs.conj()), contract(H, F.conj(), Tk.conj())], axis=1
+            [np.einsum("msl,sl->ml", HT, Fs.conj()), contract_unchecked(H, F.conj(), Tk.conj())],
+            axis=1,
         )
         RD = XD - A @ WD.conj()  # R conj(D)
         Aa = np.concatenate([A, A], axis=1)

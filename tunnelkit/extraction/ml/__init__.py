@@ -146,7 +146,9 @@ Modules, each importing only from the ones above it:
   starts from estimates;
 - :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
 - :mod:`.resolution` — the statistical resolution limit: per-path separations in standard
-  deviations, significance, the per-path verdict :func:`resolvable` (the threshold region);
+  deviations, significance, the per-path verdict :func:`resolvable`; the threshold in SNR by
+  the method of interval errors (:func:`snr_threshold`, :func:`outlier_probability`) and the
+  per-path threshold region :func:`below_threshold` (``PathEstimates.below_threshold``);
 - :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
   re-seedings: :func:`fit_ml`, :class:`MLFit`;
 - :mod:`.wideband` — :class:`WidebandProblem`, the model with the spatial-wideband term (each
@@ -172,7 +174,15 @@ from .fitting import (
 from .model import Problem, noise_floor, project_feasible
 from .paths import estimates_from_fit, ml_order, ml_paths, physical
 from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
-from .resolution import RESOLVE_Z, resolvable, separations
+from .resolution import (
+    OUTLIER_RATE,
+    RESOLVE_Z,
+    below_threshold,
+    outlier_probability,
+    resolvable,
+    separations,
+    snr_threshold,
+)
 from .search import (
     check_start,
     complete_paths,
@@ -185,6 +195,7 @@ from .wideband import WidebandProblem
 __all__ = [
     "FALSE_ALARM",
     "MAX_ITER",
+    "OUTLIER_RATE",
     "RESOLVE_Z",
     "SEARCHES",
     "MLConvergenceWarning",
@@ -192,6 +203,7 @@ __all__ = [
     "MLFit",
     "Problem",
     "WidebandProblem",
+    "below_threshold",
     "calibrated_threshold",
     "check_start",
     "complete_paths",
@@ -201,6 +213,7 @@ __all__ = [
     "ml_order",
     "ml_paths",
     "noise_floor",
+    "outlier_probability",
     "pair_separation",
     "path_from_peak",
     "peak_null",
@@ -211,6 +224,7 @@ __all__ = [
     "resolvable",
     "search_path",
     "separations",
+    "snr_threshold",
     "spatial_phase",
     "start_from_estimates",
 ]

@@ -13,7 +13,12 @@ import numpy as np
 from ..._validate import integer, positive, record, sequence
 from ...constants import C
 from ..decomposition import check_tensor
-from ..numerics import MIN_SIGNIFICANCE, damped_step, free_newton, spatial_phase
+from ..numerics import (
+    MIN_SIGNIFICANCE,
+    damped_step_unchecked,
+    free_newton_unchecked,
+    spatial_phase_unchecked,
+)
 from ..radio import check_array, check_srs
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
@@ -126,11 +131,11 @@ def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | N
         upper = np.zeros((L, 5), bool)
         upper[:, 2] = theta[:, 2] >= W_MAX
         # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
-        free, dec = free_newton(ev["A"], ev["g"], lower.ravel(), upper.ravel())
+        free, dec = free_newton_unchecked(ev["A"], ev["g"], lower.ravel(), upper.ravel())
         if dec < STEP_TOL * sigma2:
             converged = True
             break
-        step = damped_step(ev["A"], ev["g"], free, lam)
+        step = damped_step_unchecked(ev["A"], ev["g"], free, lam)
         if step is None:
             lam *= 4.0
             continue
@@ -331,7 +336,7 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
 def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
     """The path whose atom is most like the new one ``(th_n, mf_n, mt_n)`` (normalised inner
     product, a product over the three modes)."""
-    a = np.exp(1j * spatial_phase(np.vstack([theta, th_n]), prob.pos, prob.k0)[0])
+    a = np.exp(1j * spatial_phase_unchecked(np.vstack([theta, th_n]), prob.pos, prob.k0)[0])
     ca = np.abs(a[:, :-1].conj().T @ a[:, -1]) / prob.M
     cf = np.abs(_dirichlet(mu_f - mf_n, prob.nf))
     ct = np.abs(_dirichlet(mu_t - mt_n, prob.nt))

@@ -12,7 +12,7 @@ from ..._validate import boolean, finite_array, integer, positive
 from ...arrays import check_element_positions
 from ...constants import C
 from ..decomposition import check_tensor
-from ..numerics import solve, spatial_phase
+from ..numerics import solve_unchecked, spatial_phase_unchecked
 
 __all__ = ["U_MAX", "W_FAR", "W_MAX", "Problem", "noise_floor", "project_feasible"]
 
@@ -81,7 +81,7 @@ class Problem:
         check_paths(theta, mu_f, mu_t)
         derivatives = boolean("derivatives", derivatives)
         L = theta.shape[0]
-        psi, dx, dy, dw = spatial_phase(theta, self.pos, self.k0)
+        psi, dx, dy, dw = spatial_phase_unchecked(theta, self.pos, self.k0)
         a = np.exp(1j * psi)
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])
@@ -120,7 +120,7 @@ class Problem:
         Dr = cd.conj() * (P[L:] - Gram[L:, :L] @ c)  # <D_i, r>
         DB = cd.conj()[:, None] * Gram[L:, :L]
         DD = np.outer(cd.conj(), cd) * Gram[L:, L:]
-        JJ = DD - DB @ solve(G, DB.conj().T)
+        JJ = DD - DB @ solve_unchecked(G, DB.conj().T)
         return {"c": c, "cost": cost, "G": G, "b": b, "A": JJ.real, "g": Dr.real, "a": a}
 
     def _contract(self, T, F, sF=None, kT=None):
@@ -143,7 +143,7 @@ class Problem:
         ``mu_t`` with gains ``c`` (L,)."""
         check_paths(theta, mu_f, mu_t)
         c = finite_array("c", c, shape=(len(theta),), dtype=complex)
-        a = np.exp(1j * spatial_phase(theta, self.pos, self.k0)[0])
+        a = np.exp(1j * spatial_phase_unchecked(theta, self.pos, self.k0)[0])
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])
         return np.einsum("ml,sl,kl->msk", a * c[None, :], F, T, optimize=True)
@@ -158,7 +158,7 @@ class Problem:
 
 
 def _solve_gains(G, b, h2):
-    c = solve(G, b)
+    c = solve_unchecked(G, b)
     return c, max(h2 - float(np.real(np.vdot(b, c))), 0.0)
 
 

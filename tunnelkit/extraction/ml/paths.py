@@ -18,6 +18,7 @@ from ..paper import angles_from_solution, paper_route
 from ..radio import check_array, check_srs
 from .fitting import MAX_ITER, SEARCHES, MLDetectionWarning, MLFit, fit_problem
 from .model import W_FAR, W_MAX, Problem
+from .resolution import below_threshold
 from .search import check_start, complete_paths, start_from_estimates
 from .wideband import WidebandProblem
 
@@ -71,13 +72,18 @@ def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: floa
     )
     o = np.argsort(d)
     signif = fit.significance[o]
+    res = None if fit.resolution is None else np.asarray(fit.resolution, float)[o]
+    n_cells = element_positions.shape[0] * nf * nt
     return replace(
         est,
         valid=est.valid & (signif >= MIN_SIGNIFICANCE) & physical(est, srs),
         fit=fit,
         significance=signif,
         fit_ok=bool(fit.fit_ok),
-        resolution=None if fit.resolution is None else np.asarray(fit.resolution, float)[o],
+        resolution=res,
+        below_threshold=below_threshold(
+            signif, np.full(len(o), np.inf) if res is None else res, n_cells
+        ),
     )
 
 

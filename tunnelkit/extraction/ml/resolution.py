@@ -16,16 +16,55 @@ against noise passes the detection test of one path (the residual test's thresho
 false-alarm rate, :func:`~.residual.calibrated_threshold`). Evaluated at the truth this is a
 property of the snapshot (its geometry, gains and noise power), not of the search: the
 threshold region is the set of snapshots with a path not resolvable there.
+
+The threshold in SNR (:func:`snr_threshold`, :func:`outlier_probability`; the method of
+interval errors, Van Trees 2001 sec. 2.4, Richmond 2006): the concentrated likelihood of one
+path is its periodogram ``|x^H h|^2``. At the true cell it is ``|sqrt(gamma) + n_0|^2`` (in noise
+powers, ``gamma = E / sigma^2`` the path's post-integration SNR, its energy ``E`` over the noise
+power: :func:`significance`), at a cell orthogonal to it ``|n_1|^2``, ``n ~ CN(0, 1)``
+independent; the wrong cell wins with probability ``P(|n_1|^2 > |sqrt(gamma) + n_0|^2) = e^{-gamma
+/ 2} / 2`` (non-coherent orthogonal signalling). The ``N = M Nf Nt`` cells of the DFT grid in
+direction, delay and Doppler are orthogonal, so the union bound gives the outlier (interval
+error) probability ``P_out <= (N - 1) e^{-gamma / 2} / 2``; exactly, ``P_out = P(max of N - 1
+unit exponentials > |sqrt(gamma) + n_0|^2)``, one integral over the path cell's non-central
+chi-square density (:func:`outlier_probability`).
+The method of interval errors writes the mean-square error as ``(1 - P_out) CRLB + P_out
+sigma_prior^2``: an outlier lands anywhere in the search space, thousands of standard deviations
+away, so the estimate leaves the bound where ``P_out`` stops being negligible. The threshold
+SNR ``gamma_th`` is where ``P_out = OUTLIER_RATE`` (1 %): 28.5 (14.5 dB) for the paper's tensor
+(``M = 100``, ``Nf = 410``, ``Nt = 12``; the union bound's root ``2 ln((N - 1) / (2
+OUTLIER_RATE))`` is 34, loose because the events share the path cell). A path is in the
+threshold region (:func:`below_threshold`) when its SNR is below ``gamma_th`` or it lies fewer
+than ``RESOLVE_Z`` standard deviations from another path.
 """
 
 from __future__ import annotations
 
-import numpy as np
+from functools import lru_cache
 
-from ..._validate import finite_array, positive
+import numpy as np
+from scipy.integrate import quad
+from scipy.optimize import brentq
+from scipy.special import i0e
+
+from ..._validate import finite_array, integer, positive
 from .model import Problem
 
-__all__ = ["RESOLVE_Z", "pair_separation", "resolvable", "separations"]
+__all__ = [
+    "OUTLIER_RATE",
+    "RESOLVE_Z",
+    "below_threshold",
+    "outlier_probability",
+    "pair_separation",
+    "resolvable",
+    "separations",
+    "snr_threshold",
+]
+
+#: outlier (interval-error) probability of a path at the threshold SNR (module text)
+OUTLIER_RATE = 0.01
+#: cap on ``n_cells``: a tensor of 10^11 samples (1.6 TB) is beyond any snapshot's memory budget
+MAX_CELLS = 10**11
 
 #: resolution test: two paths closer than this many standard deviations of their difference are
 #: in the threshold region of resolution (module text: non-centrality 25 of the 5-parameter test)
@@ -97,3 +136,69 @@ def resolvable(prob: Problem, theta, mu_f, mu_t, noise_power: float, detect: flo
     ev = prob.evaluate(theta, mu_f, mu_t)
     z = _separations(prob, theta, mu_f, mu_t, sigma2, ev)
     return (z >= RESOLVE_Z) & (significance(ev, sigma2) >= detect)
+
+
+def _outlier(gamma: float, K: int) -> float:
+    """``P(max of K unit exponentials > |sqrt(gamma) + n_0|^2)`` by quadrature over the path
+    cell's non-central chi-square density ``e^{-(x + gamma)} I_0(2 sqrt(gamma x))``."""
+    if K == 0:
+        return 0.0
+    rg = np.sqrt(gamma)
+
+    def f(x):
+        s = np.sqrt(x)
+        with np.errstate(divide="ignore"):
+            beat = -np.expm1(K * np.log1p(-np.exp(-x)))  # 1 - (1 - e^{-x})^K
+        return i0e(2.0 * rg * s) * np.exp(-((s - rg) ** 2)) * beat
+
+    hi = (rg + 12.0) ** 2
+    pts = sorted({min(gamma, hi), min(np.log(K), hi)})
+    return float(min(max(quad(f, 0.0, hi, points=pts, limit=200, epsabs=1e-14)[0], 0.0), 1.0))
+
+
+def outlier_probability(snr, n_cells: int) -> np.ndarray:
+    """The probability that the maximum-likelihood search puts a path of post-integration SNR
+    ``snr`` (``E / sigma^2``, linear; array) in a wrong one of ``n_cells`` orthogonal cells
+    (module text): ``P(max of n_cells - 1 unit exponentials > |sqrt(snr) + n_0|^2)``, ``n_0 ~
+    CN(0, 1)``, by quadrature (the union bound ``(n_cells - 1) e^{-snr / 2} / 2`` is its first
+    term)."""
+    snr = finite_array("snr", snr)
+    if np.any(snr < 0):
+        raise ValueError("snr: expected non-negative signal-to-noise ratios (linear)")
+    n = integer("n_cells", n_cells, minimum=1, maximum=MAX_CELLS)
+    return np.reshape([_outlier(float(g), n - 1) for g in snr.ravel()], snr.shape)
+
+
+@lru_cache(maxsize=32)
+def _threshold(n: int, outlier: float) -> float:
+    if n == 1 or _outlier(0.0, n - 1) <= outlier:
+        return 0.0  # even a path at zero SNR is confused less often than that
+    hi = 2.0 * np.log(0.5 * (n - 1) / outlier) + 40.0  # the union bound's root, and margin
+    return float(brentq(lambda g: _outlier(g, n - 1) - outlier, 0.0, hi, xtol=1e-6))
+
+
+def snr_threshold(n_cells: int, outlier: float = OUTLIER_RATE) -> float:
+    """The post-integration SNR (linear) at which :func:`outlier_probability` over ``n_cells``
+    equals ``outlier`` (0 when ``n_cells = 1``: nothing to confuse the path with); close to the
+    union bound's ``2 ln((n_cells - 1) / (2 outlier))`` when ``outlier`` is small."""
+    n = integer("n_cells", n_cells, minimum=1, maximum=MAX_CELLS)
+    outlier = positive("outlier", outlier)
+    if outlier >= 1:
+        raise ValueError(f"outlier: expected a probability below 1, got {outlier}")
+    return _threshold(n, float(outlier))
+
+
+def below_threshold(significance, resolution, n_cells: int) -> np.ndarray:
+    """Per path (L,) bool: in the estimator's threshold region (module text), its SNR
+    ``significance`` (L,) below :func:`snr_threshold` of ``n_cells`` (the tensor's ``M Nf
+    Nt``) or its ``resolution`` (L,, :func:`separations`; ``inf`` alone) below ``RESOLVE_Z``."""
+    sig = finite_array("significance", significance, shape=(None,))
+    if isinstance(resolution, str | bytes) or np.shape(resolution) != sig.shape:
+        raise ValueError(
+            f"significance, resolution: expected one of each per path, got shapes {sig.shape} "
+            f"and {np.shape(resolution)}"
+        )
+    res = np.asarray(resolution)
+    if res.dtype.kind not in "iuf" or np.any(np.isnan(res)) or np.any(res < 0):
+        raise ValueError("resolution: expected non-negative separations (inf for a path alone)")
+    return (sig < snr_threshold(n_cells)) | (res < RESOLVE_Z)

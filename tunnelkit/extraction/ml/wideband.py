@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._validate import boolean, finite_array, positive
-from ..numerics import solve, spatial_phase
+from ..numerics import solve_unchecked, spatial_phase_unchecked
 from .model import Problem, check_paths
 
 __all__ = ["WidebandProblem"]
@@ -54,7 +54,7 @@ class WidebandProblem(Problem):
     def _atoms(self, theta, mu_f):
         """``B`` (M, Nf, L) the (element x tone) part of each atom, and the spatial phase and
         its derivatives (M, L) each."""
-        psi, dx, dy, dw = spatial_phase(theta, self.pos, self.k0)
+        psi, dx, dy, dw = spatial_phase_unchecked(theta, self.pos, self.k0)
         ph = psi[:, None, :] * self.g[None, :, None] + self.s[None, :, :] * mu_f[None, None, :]
         return np.exp(1j * ph), (psi, dx, dy, dw)
 
@@ -100,7 +100,7 @@ class WidebandProblem(Problem):
         Dr = cd.conj() * (P[L:] - Gram[L:, :L] @ c)
         DB = cd.conj()[:, None] * Gram[L:, :L]
         DD = np.outer(cd.conj(), cd) * Gram[L:, L:]
-        JJ = DD - DB @ solve(G, DB.conj().T)
+        JJ = DD - DB @ solve_unchecked(G, DB.conj().T)
         return {
             "c": c,
             "cost": cost,
