@@ -266,7 +266,7 @@ def path_error_model(
     """The joint ML extraction's per-path error along ``setup``'s route for array ``spec`` under
     ``impairments`` (module docstring; fields in :class:`PathErrorModel`).
 
-    Every existing path of the route geometry (``geometry``, or traced at ``epochs``) enters
+    Every existing path of the route geometry (``geometry``, or traced at ``epochs``: not both) enters
     the joint model. ``crlb`` is the ideal bound of all paths' ``z`` (gains and Dopplers
     eliminated), ``cov`` the sandwich covariance with diffuse multipath (``crlb`` without it),
     ``bias`` the spatial-wideband bias (zero when the estimator models the term,
@@ -280,6 +280,8 @@ def path_error_model(
     _check(setup, imp)
     spec = parse_array(spec)
     cfg = setup.config
+    if geometry is not None and epochs is not None:
+        raise ValueError("epochs: the geometry given was traced at its own epochs; give one")
     g = route_geometry(setup, spec, epochs=epochs) if geometry is None else geometry
     instance("geometry", g, RouteGeometry)
     fr = _frame(setup, spec, g)
