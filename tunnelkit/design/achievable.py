@@ -54,6 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._checks import bound_array
 from .._validate import boolean, choice, instance, nonnegative, positive, record
 from ..channel import DiffuseSpec, Impairments
 from ..constants import C
@@ -409,22 +410,7 @@ class AchievableBound:
                allow_inf=bounds)  # fmt: skip
         choice("weights", self.weights, WEIGHTS)
         if self.noise is not None:
-            object.__setattr__(self, "noise", _bound_array("noise", self.noise))
-
-
-def _bound_array(name: str, value) -> np.ndarray:
-    """A per-epoch bound (T,) [m]: numbers >= 0, ``inf`` allowed (not identifiable), no NaN."""
-    if isinstance(value, str | bytes):
-        raise TypeError(f"{name}: expected a bound per epoch (T,) [m], got text")
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name}: expected numbers, got {type(value).__name__}") from None
-    if arr.ndim != 1:
-        raise ValueError(f"{name}: expected one value per epoch (1-D), got shape {arr.shape}")
-    if np.isnan(arr).any() or (arr < 0).any():
-        raise ValueError(f"{name}: expected values >= 0 (inf allowed), got NaN or a negative")
-    return arr
+            object.__setattr__(self, "noise", bound_array("noise", self.noise, ndim=1))
 
 
 #: whose error :func:`achievable_bound` maps to the position: ``"tracker"`` the design's tracker
