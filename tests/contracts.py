@@ -319,11 +319,15 @@ def bad_values(p: inspect.Parameter, tp, valid) -> list[Bad]:
 
 @dataclass
 class Case:
+    """One generated call. ``aliases``: other names the error may give for ``param`` (a helper
+    whose ``name`` argument says which caller's parameter it checks names that one)."""
+
     id: str
     target: str
     param: str
     bad: Bad
     call: Callable[[], object]
+    aliases: tuple[str, ...] = ()
 
 
 def names_parameter(message: str, name: str) -> bool:
@@ -342,8 +346,9 @@ def _alarm(signum, frame):
     raise _TimeBox
 
 
-def classify(call: Callable[[], object], param: str) -> tuple[str, str]:
-    """(outcome, detail) of one call, time-boxed."""
+def classify(call: Callable[[], object], param: str, aliases=()) -> tuple[str, str]:
+    """(outcome, detail) of one call, time-boxed; an error naming ``param`` or one of
+    ``aliases`` is clear."""
     old = signal.signal(signal.SIGALRM, _alarm)
     signal.setitimer(signal.ITIMER_REAL, CALL_TIMEOUT_S)
     try:
@@ -355,7 +360,7 @@ def classify(call: Callable[[], object], param: str) -> tuple[str, str]:
         return "hang", f"still running after {CALL_TIMEOUT_S:g} s"
     except (ValueError, TypeError) as exc:
         msg = str(exc)
-        if names_parameter(msg, param):
+        if any(names_parameter(msg, n) for n in (param, *aliases)):
             return "clear", f"{type(exc).__name__}: {msg[:160]}"
         return "unclear", f"{type(exc).__name__}: {msg[:160]}"
     except Exception as exc:
@@ -420,7 +425,7 @@ def _child(cases, start, conn) -> None:
     for i in range(start, len(cases)):
         conn.send(("start", i))
         try:
-            outcome, detail = classify(cases[i].call, cases[i].param)
+            outcome, detail = classify(cases[i].call, cases[i].param, cases[i].aliases)
         except _TimeBox:  # the alarm went off while the call was being disarmed
             outcome, detail = "hang", f"still running after {CALL_TIMEOUT_S:g} s"
         conn.send(("done", i, outcome, detail))

@@ -639,6 +639,10 @@ def build_suite() -> Suite:
 
         baselines.append(Case(f"{t.name}()", t.name, "", None, call))
         h = hints(t)
+        # a checking helper (a function, not a record's constructor) names the parameter its
+        # caller passes as ``name``
+        helper = t.kind != "class" and isinstance(kw.get("name"), str) and kw["name"]
+        alias = (kw["name"],) if helper else ()
         for p in params:
             for bad in bad_values(p, h.get(p.name, p.empty), kw.get(p.name)):
                 cases.append(
@@ -648,6 +652,7 @@ def build_suite() -> Suite:
                         p.name,
                         bad,
                         lambda call=call, p=p.name, v=bad.value: call(p=p, bad=v),
+                        alias if p.name != "name" else (),
                     )
                 )
     return Suite(targets, cases, baselines, no_baseline, no_params)

@@ -132,12 +132,14 @@ class Epoch:
     truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
 
     def __post_init__(self) -> None:
+        from .extraction.estimates import PathEstimates
+
         record(self, shapes=_EPOCH_SHAPES, nonnegative=("k", "t"))
+        instance("estimates", self.estimates, PathEstimates)
 
     def with_estimates(self, est, config: SRSConfig | None = None, *, min_d: float = 0.0):
-        """This epoch with other estimates of the same tensor (another extraction route):
-        Algorithm 1, the world frame and the match to the true paths redone
-        (``config`` / ``min_d`` as in :func:`measurements_from_estimates`)."""
+        """This epoch with other estimates of the same tensor (another extraction route): Algorithm
+        1, the world frame and the match to the truth redone (:func:`measurements_from_estimates`)."""
         meas, truth = _measure(est, self.array, self.paths, self.snapshot, config, min_d)
         return replace(self, estimates=est, measurements=meas, truth_index=truth)
 
@@ -179,9 +181,9 @@ def _rows(m: RouteMeasurements, rows: np.ndarray) -> RouteMeasurements:
 
 def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
     """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
-    ``keep`` (the Fisher information of those paths jointly), as the covariance of the world-frame ``(phi, psi, kappa)`` (K, 3, 3) and the
-    standard deviation of ``d`` (K,). The wave origin's covariance is rotated to the world frame
-    and mapped through d(phi, psi, r)/dq (:func:`tunnelkit.geometry.spherical_jacobian`).
+    ``keep`` (their Fisher information jointly) as the covariance of the world-frame ``(phi,
+    psi, kappa)`` (K, 3, 3) and the standard deviation of ``d`` (K,): the wave origin's
+    covariance rotated to the world frame, mapped through d(phi, psi, r)/dq (``spherical_jacobian``).
     Returns ``(None, None)`` when the maximum-likelihood fit failed its own residual test
     (``fit.rho > fit.rho_max``: a wrong basin, where the bound at the estimate says nothing about
     the error) or the Fisher information is singular at the estimate."""

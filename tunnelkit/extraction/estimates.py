@@ -97,6 +97,10 @@ class PathEstimates:
     below_threshold: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
+        if self.fit is not None and not all(hasattr(self.fit, a) for a in ("rho", "rho_max")):
+            raise TypeError(
+                f"fit: expected the ML fit's record (MLFit) or None, got {type(self.fit).__name__}"
+            )
         d = self.d
         if isinstance(d, str | bytes) or np.ndim(d) != 1:
             raise ValueError(f"d: expected one distance per path (L,), got shape {np.shape(d)}")
