@@ -3,8 +3,8 @@
 :func:`tunnelkit.rt.consistency.geometry_consistency` asks whether one snapshot's paths agree with
 one UE position through the tunnel's planes, each residual in standard deviations of a bound.
 Here the bound is the CRLB at the estimate (:func:`bound_sigmas`: world azimuth, elevation and
-range of each kept path, computed whatever the fit's own residual verdict, unlike
-:func:`tunnelkit.signal_route.reported_covariance`), and :func:`epoch_consistency` runs the test
+range of each kept path, :func:`tunnelkit.signal_route.reported_covariance` computed whatever the
+fit's own residual verdict), and :func:`epoch_consistency` runs the test
 on a :class:`tunnelkit.signal_route.Epoch`::
 
     ep = route.epoch(12, rng, refine="ml")
@@ -19,7 +19,7 @@ from ._validate import boolean, instance
 from .arrays import ArrayGeometry
 from .channel import SRSConfig
 from .rt.consistency import geometry_consistency, tunnel_planes
-from .signal_route import Epoch, SignalRoute
+from .signal_route import Epoch, SignalRoute, reported_covariance
 
 __all__ = ["bound_sigmas", "epoch_consistency"]
 
@@ -28,12 +28,10 @@ def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.
     """(K, 3) CRLB standard deviations at the estimate ``est`` (a
     :class:`tunnelkit.extraction.PathEstimates`) of the world azimuth, elevation [rad] and range
     [m] of the paths ``keep`` (indices into ``est``, in their order; default the paths Algorithm 1
-    keeps with its printed check ``d >= 0``, as ``RouteMeasurements.index``); the Fisher
-    information of those paths jointly (:func:`tunnelkit.extraction.estimate_crlb`), the
-    wave origin's covariance rotated to the world frame and mapped through d(phi, psi, r)/dq.
-    Raises ``numpy.linalg.LinAlgError`` where that information is singular."""
-    from .extraction import PathEstimates, algorithm1, estimate_crlb
-    from .geometry import spherical_jacobian
+    keeps with its printed check ``d >= 0``, as ``RouteMeasurements.index``): the route's
+    reported covariance (:func:`tunnelkit.signal_route.reported_covariance`, ``judged=False``).
+    Raises ``numpy.linalg.LinAlgError`` where the Fisher information is singular."""
+    from .extraction import PathEstimates, algorithm1
 
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
@@ -49,12 +47,10 @@ def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.
         keep = raw.astype(int)
     if not keep.size:
         return np.zeros((0, 3))
-    b = estimate_crlb(est, array, config, paths=keep)
-    rot = array.R
-    cov = rot @ b["source_cov"] @ rot.T
-    G = spherical_jacobian(array.dir_to_world(b["source"]))
-    cov = G @ cov @ np.swapaxes(G, 1, 2)
-    return np.stack([np.sqrt(cov[:, 0, 0]), np.sqrt(cov[:, 1, 1]), np.asarray(b["d"])], -1)
+    cov, sigma_d = reported_covariance(est, keep, array, config, judged=False)
+    if cov is None:
+        raise np.linalg.LinAlgError("the Fisher information is singular at the estimate")
+    return np.stack([np.sqrt(cov[:, 0, 0]), np.sqrt(cov[:, 1, 1]), np.asarray(sigma_d)], -1)
 
 
 def epoch_consistency(ep: Epoch, route: SignalRoute, *, bound: bool = True, **kw) -> dict:

@@ -179,19 +179,18 @@ def _rows(m: RouteMeasurements, rows: np.ndarray) -> RouteMeasurements:
     )
 
 
-def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig):
+def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig, judged=True):
     """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
     ``keep`` (their Fisher information jointly) as the covariance of the world-frame ``(phi,
     psi, kappa)`` (K, 3, 3) and the standard deviation of ``d`` (K,): the wave origin's
     covariance rotated to the world frame, mapped through d(phi, psi, r)/dq (``spherical_jacobian``).
-    Returns ``(None, None)`` when the maximum-likelihood fit failed its own residual test
-    (``fit.rho > fit.rho_max``: a wrong basin, where the bound at the estimate says nothing about
-    the error) or the Fisher information is singular at the estimate."""
+    Returns ``(None, None)`` when the Fisher information is singular at the estimate or, if
+    ``judged``, the fit failed its own residual test (``fit.rho > fit.rho_max``: a wrong basin)."""
     from .extraction import estimate_crlb
     from .geometry import spherical_jacobian
 
     fit = getattr(est, "fit", None)
-    if fit is not None and not fit.rho <= fit.rho_max:
+    if boolean("judged", judged) and fit is not None and not fit.rho <= fit.rho_max:
         return None, None
     try:
         b = estimate_crlb(est, array, config, paths=keep)
