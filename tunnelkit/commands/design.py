@@ -2,7 +2,7 @@
 [--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--wideband-model]
 [--dmc-share S]
 [--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--confirm] [--format table|json]``.
+[--criterion achievable|srnf] [--confirm [--confirm-runs N]] [--format table|json]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
 the ideal position error bound, the achievable bound under the stated impairments, SR-NF validity
@@ -177,6 +177,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "route with the same runs and seed, and take the recommendation from it (bound mode)",
     )
     p.add_argument(
+        "--confirm-runs",
+        type=int,
+        default=None,
+        help="drives per array of the --confirm re-run (default: --runs); the channel route "
+        "costs minutes per drive, the bound route seconds",
+    )
+    p.add_argument(
         "--channel",
         choices=["image", "sionna"],
         default="image",
@@ -207,6 +214,12 @@ def main(args: argparse.Namespace) -> int:
         print(
             "tunnelkit design: error: --confirm re-runs a bound-route answer: it needs --mode "
             "bound and --runs > 0",
+            file=sys.stderr,
+        )
+        return 2
+    if args.confirm_runs is not None and (not args.confirm or args.confirm_runs < 1):
+        print(
+            "tunnelkit design: error: --confirm-runs needs --confirm and at least 1 run",
             file=sys.stderr,
         )
         return 2
@@ -263,6 +276,7 @@ def main(args: argparse.Namespace) -> int:
             rep = design.confirm_on_channel(
                 rep,
                 setup,
+                runs=args.confirm_runs,
                 **parallel_kwargs(args),
                 progress=args.format == "table" and not args.no_progress,
             )

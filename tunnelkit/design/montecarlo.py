@@ -52,12 +52,8 @@ from .._validate import choice, instance, integer, record
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import TrialPool, run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
-from .drivebound import (
-    drive_bound,
-    drive_pcrlb,
-    position_bias_rms,
-    position_information,
-)
+from .channelbudget import channel_route_budget
+from .drivebound import drive_bound, drive_pcrlb, position_bias_rms, position_information
 from .errormodel import PathErrorModel
 from .setup import ArraySpec, DesignSetup, parse_array
 
@@ -218,8 +214,9 @@ class _SweepTrial:
             route = self.setup.signal_route(spec)
             imp = self.impairments
             if imp is not None and not imp.ideal:
-                # this run's array: its calibration error drawn once, for the whole drive
+                # its calibration error drawn once per drive; fits judged against noise + it
                 route = route.with_impairments(imp.channel_impairments(), rng)
+                route = replace(route, model_error_floor=True, bias_budget=prep.budget)
             if imp is not None and imp.wideband_model:
                 route = replace(route, wideband_model=True)
             drive = simulate_drive(
@@ -266,6 +263,7 @@ class _Prepared:
     pcrlb: np.ndarray | None
     drive: np.ndarray | None
     learned: np.ndarray | None = None
+    budget: object = None  # signal_route.judging.BiasBudget: the channel route's, impaired
 
     def summary(self) -> tuple:
         """What the sweep's result keeps (not the model and route the drives need)."""
@@ -324,7 +322,9 @@ class _ArrayJob:
             crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
         planes = design_planes(self.setup) if self.vues == "known" else None
         design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
-        return _Prepared(spec, route, design, peb, pc, drive, learned)
+        imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired
+        budget = channel_route_budget(self.setup, spec, imp)
+        return _Prepared(spec, route, design, peb, pc, drive, learned, budget)
 
 
 def _load_tracker() -> None:

@@ -287,16 +287,27 @@ def path_measurements(ep, route: SignalRoute) -> tuple[PathMeasurements | None, 
     epoch carries no measurement (the tracker predicts only). An extraction that tests its own
     fit (the ML route: ``PathEstimates.fit_ok``) and flags it — a path missed, merged or in a wrong
     basin of the likelihood, or the snapshot in the threshold region — gives none either, with
-    the reason :data:`FLAGGED`."""
+    the reason :data:`FLAGGED`, unless the route re-judged the fit against noise plus its
+    impairment power and it passed (``Epoch.fit_ok``, ``SignalRoute.model_error_floor``). The
+    repeating share of the error a route with a bias budget reports goes on as ``bias_cov``."""
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)
     m = ep.measurements
-    if getattr(ep.estimates, "fit_ok", None) is False:
+    if ep.fit_ok is False:
         return None, FLAGGED
     if route.report_covariance and m.cov is None and len(m):
         return None, "extraction failed its residual test"
     pm = PathMeasurements.from_arrays(
-        m.phi, m.psi, m.kappa, m.d, m.v, warn=False, cov=m.cov, sigma_d=m.sigma_d, min_d=route.min_d
+        m.phi,
+        m.psi,
+        m.kappa,
+        m.d,
+        m.v,
+        warn=False,
+        cov=m.cov,
+        sigma_d=m.sigma_d,
+        min_d=route.min_d,
+        bias_cov=m.bias_cov,
     )
     return pm, None
 

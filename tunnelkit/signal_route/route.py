@@ -1,47 +1,20 @@
-"""The measurement route of notebooks 03-04: scenario -> propagation -> channel tensor -> extraction -> Algorithm 1.
-
-:class:`SignalRoute` builds the scenario's objects once; :meth:`SignalRoute.epoch` traces the paths
-of one SRS slot (:mod:`tunnelkit.propagation`), synthesises the tensor with noise and clock bias
-(:mod:`tunnelkit.channel`), extracts the path parameters (:mod:`tunnelkit.extraction`) and applies
-Algorithm 1's checks (:func:`measurements_from_estimates`). Matching estimates to the truth lives in
-:mod:`tunnelkit.evaluation`. In one line::
-
-    import numpy as np
-    from tunnelkit import signal_route
-    route = signal_route.SignalRoute.from_scenario("italiano2026-straight")   # build once
-    ep = route.epoch(k=10, rng=np.random.default_rng(0))                     # one SRS slot
-    ep.measurements.z            # eq. 54: [phi; psi; kappa; Delta d] of the kept paths
-    ep.measurements.origin       # world position of the array's reference antenna
-    ep.paths                     # ground truth (tunnelkit.propagation.Path list)
-
-or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a single call. Angles in
-``ep.measurements`` are world-frame azimuth/elevation (eq. 46-47, 49-50) seen from ``origin``.
-"""
+"""The route itself (:class:`SignalRoute`): scenario objects built once, then per epoch
+propagation -> channel tensor -> extraction -> Algorithm 1."""
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ._validate import boolean, choice, instance, integer, real, record, rng_or_error, sequence
-from .arrays import ArrayGeometry
-from .channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
-from .constants import C
-from .evaluation import match_paths
+from .._validate import boolean, choice, instance, integer, real, rng_or_error, sequence
+from ..arrays import ArrayGeometry
+from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
+from ..constants import C
+from .measurements import Epoch, measure_epoch
+from .order import glrt_paths
 
-__all__ = [
-    "CHANNELS",
-    "MAX_SECOND_ORDER",
-    "MODEL_ORDERS",
-    "Epoch",
-    "RouteMeasurements",
-    "SignalRoute",
-    "glrt_paths",
-    "measurements_from_estimates",
-    "simulate_epoch",
-]
+__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "MODEL_ORDERS", "SignalRoute", "simulate_epoch"]
 
 
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
@@ -53,7 +26,7 @@ MAX_SECOND_ORDER = 32
 MODEL_ORDERS = ("known", "glrt")
 
 
-def _check_arrays(arrays) -> None:
+def check_arrays(arrays) -> None:
     """A non-empty list of ArrayGeometry with distinct names (calibration is keyed by name)."""
     names = {}
     for i, a in enumerate(sequence("arrays", arrays)):
@@ -68,175 +41,6 @@ def _check_arrays(arrays) -> None:
 _SHAPES = dict.fromkeys("phi psi kappa near_field d delta_d v alpha index sigma_d".split(), ("K",))
 _SHAPES.update(origin=(3,), direction=("K", 3), cov=("K", 3, 3))  # RouteMeasurements' fields
 _EPOCH_SHAPES = {"ue": (3,), "velocity": (3,), "truth_index": (None,)}  # Epoch's fields
-
-
-@dataclass(frozen=True)
-class RouteMeasurements:
-    """Algorithm 1 output for one array, angles in the **world** frame, seen from ``origin``.
-
-    Per kept path (sorted by ``d``; path 0 is the earliest arrival): ``phi``/``psi`` azimuth and
-    elevation (eq. 46-47), ``kappa`` (NaN when far-field), ``near_field``, ``d`` (biased distance),
-    ``delta_d = d - d[0]`` (eq. 52, ``delta_d[0] = 0``), ``v`` (m/s), ``direction`` (K, 3) world unit
-    vectors, ``alpha``. ``z`` is eq. 54, ``[phi; psi; kappa; delta_d[1:]]``. ``index`` maps each
-    kept path to its row in the raw :class:`tunnelkit.extraction.PathEstimates`.
-    ``cov`` (K, 3, 3) / ``sigma_d`` (K,): the uncertainty the extraction reports for
-    ``(phi, psi, kappa)`` and ``d`` (:func:`reported_covariance`), ``None`` unless the route
-    was asked for it.
-    """
-
-    origin: np.ndarray
-    array: str
-    phi: np.ndarray
-    psi: np.ndarray
-    kappa: np.ndarray
-    near_field: np.ndarray
-    d: np.ndarray
-    delta_d: np.ndarray
-    v: np.ndarray
-    direction: np.ndarray
-    alpha: np.ndarray
-    index: np.ndarray
-    cov: np.ndarray | None = None
-    sigma_d: np.ndarray | None = None
-
-    def __post_init__(self) -> None:  # kappa is NaN for a far-field path
-        record(self, shapes=_SHAPES, allow_nan=("kappa",), may_be_empty=("array",))
-
-    def __len__(self) -> int:
-        return self.d.shape[0]
-
-    @property
-    def z(self) -> np.ndarray:
-        """Eq. 54 stacked vector ``[phi; psi; kappa; delta_d[1:]]`` (kappa NaN for far-field)."""
-        return np.concatenate([self.phi, self.psi, self.kappa, self.delta_d[1:]])
-
-    @property
-    def wave_origins(self) -> np.ndarray:
-        """``origin + kappa * direction`` (K, 3), NaN rows for far-field paths (Fig. 5)."""
-        return self.origin + self.kappa[:, None] * self.direction
-
-
-@dataclass(frozen=True)
-class Epoch:
-    """Everything about one simulated epoch (truth, tensor, raw estimates, measurements)."""
-
-    k: int
-    t: float
-    ue: np.ndarray
-    velocity: np.ndarray
-    array: ArrayGeometry = field(repr=False)
-    paths: list = field(repr=False)
-    snapshot: ChannelSnapshot = field(repr=False)
-    estimates: object = field(repr=False)
-    measurements: RouteMeasurements
-    truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
-
-    def __post_init__(self) -> None:
-        from .extraction.estimates import PathEstimates
-
-        record(self, shapes=_EPOCH_SHAPES, nonnegative=("k", "t"))
-        instance("estimates", self.estimates, PathEstimates)
-
-    def with_estimates(self, est, config: SRSConfig | None = None, *, min_d: float = 0.0):
-        """This epoch with other estimates of the same tensor (another extraction route): Algorithm
-        1, the world frame and the match to the truth redone (:func:`measurements_from_estimates`)."""
-        meas, truth = _measure(est, self.array, self.paths, self.snapshot, config, min_d)
-        return replace(self, estimates=est, measurements=meas, truth_index=truth)
-
-
-def _measure(est, array, paths, snap, config, min_d):
-    """Measurements of ``est`` (Algorithm 1, world frame) and their match to the true paths; the
-    estimates matched to a second-order path (a nuisance path the model carries,
-    :attr:`SignalRoute.second_order`) are left out of the measurements."""
-    from .propagation import SECOND_ORDER
-
-    meas = measurements_from_estimates(est, array, config, min_d=min_d)
-    truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
-    nuisance = [i for i, p in enumerate(paths) if p.kind == SECOND_ORDER]
-    if nuisance and len(meas):
-        rows = np.flatnonzero(~np.isin(truth, nuisance))
-        meas, truth = _rows(meas, rows), truth[rows]
-    return meas, truth
-
-
-def _rows(m: RouteMeasurements, rows: np.ndarray) -> RouteMeasurements:
-    """``m`` restricted to ``rows`` (``delta_d`` re-referenced to the first row kept)."""
-    d = m.d[rows]
-    return replace(
-        m,
-        phi=m.phi[rows],
-        psi=m.psi[rows],
-        kappa=m.kappa[rows],
-        near_field=m.near_field[rows],
-        d=d,
-        delta_d=d - d[0] if d.size else d,
-        v=m.v[rows],
-        direction=m.direction[rows],
-        alpha=m.alpha[rows],
-        index=m.index[rows],
-        cov=None if m.cov is None else m.cov[rows],
-        sigma_d=None if m.sigma_d is None else m.sigma_d[rows],
-    )
-
-
-def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig, judged=True):
-    """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
-    ``keep`` (their Fisher information jointly) as the covariance of the world-frame ``(phi,
-    psi, kappa)`` (K, 3, 3) and the standard deviation of ``d`` (K,): the wave origin's
-    covariance rotated to the world frame, mapped through d(phi, psi, r)/dq (``spherical_jacobian``).
-    Returns ``(None, None)`` when the Fisher information is singular at the estimate or, if
-    ``judged``, the fit failed its own residual test (``fit.rho > fit.rho_max``: a wrong basin)."""
-    from .extraction import estimate_crlb
-    from .geometry import spherical_jacobian
-
-    fit = getattr(est, "fit", None)
-    if boolean("judged", judged) and fit is not None and not fit.rho <= fit.rho_max:
-        return None, None
-    try:
-        b = estimate_crlb(est, array, config, paths=keep)
-    except np.linalg.LinAlgError:
-        return None, None
-    rot = array.R  # local -> world: u_world = R u_local
-    cov_w = rot @ b["source_cov"] @ rot.T
-    G = spherical_jacobian(array.dir_to_world(b["source"]))
-    return G @ cov_w @ np.swapaxes(G, 1, 2), b["d"]
-
-
-def measurements_from_estimates(
-    est, array: ArrayGeometry, config: SRSConfig | None = None, *, min_d: float = 0.0
-) -> RouteMeasurements:
-    """Apply Algorithm 1's checks to raw estimates (``min_d``: see
-    :func:`tunnelkit.extraction.algorithm1`) and express them in the world frame; with
-    ``config``, also the covariance the extraction reports (:func:`reported_covariance`)."""
-    from .extraction import algorithm1
-
-    instance("array", array, ArrayGeometry)
-    if config is not None:
-        instance("config", config, SRSConfig)
-    keep = algorithm1(est, min_d)
-    u = array.dir_to_world(est.direction[keep]) if keep.size else np.zeros((0, 3))
-    phi = np.arctan2(u[:, 1], u[:, 0])
-    psi = np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1]))
-    d = est.d[keep]
-    cov = sigma_d = None
-    if config is not None and keep.size:
-        cov, sigma_d = reported_covariance(est, keep, array, config)
-    return RouteMeasurements(
-        array.origin.copy(),
-        array.name,
-        phi,
-        psi,
-        est.kappa[keep],
-        est.near_field[keep],
-        d,
-        d - d[0] if d.size else d,
-        est.v[keep],
-        u,
-        est.alpha[keep],
-        keep,
-        cov,
-        sigma_d,
-    )
 
 
 @dataclass
@@ -283,6 +87,17 @@ class SignalRoute:
     against the noise, or noise + diffuse power with ``diffuse_floor``), up to ``max_paths``.
     The paths found beyond the true ones (higher-order bounces, clutter) stay in the
     measurements unless matched to a modelled second-order path.
+    ``model_error_floor`` (off by default): an ML fit that fails its white-noise test
+    (``fit_ok = False``) is judged again against noise plus the impairment power this route
+    was told about (:func:`~tunnelkit.signal_route.judging.impairment_share` of
+    ``impairments``: the calibration levels and the diffuse share; nothing to re-judge when it
+    is zero, nor when the extraction models the wideband term), ``Epoch.rejudged`` the test
+    and ``Epoch.fit_ok`` its verdict; a fit that passes it reports the CRLB at its estimate
+    (:func:`~tunnelkit.signal_route.measurements.reported_covariance` with ``judged=False``).
+    ``bias_budget`` (a :class:`~tunnelkit.signal_route.judging.BiasBudget` over this route's
+    epochs, None by default): every epoch's reported covariances get the budget of the slot
+    each estimate matches (:func:`~tunnelkit.signal_route.judging.apply_budget`; by direction
+    and delay) and its repeating share as ``bias_cov``.
     """
 
     tunnel: object
@@ -303,14 +118,16 @@ class SignalRoute:
     diffuse_floor: bool = False
     model_order: str = "known"
     max_paths: int = 24
+    model_error_floor: bool = False
+    bias_budget: object = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        from .propagation import PATH_KINDS, Tunnel3D
-        from .scenarios import Trajectory
+        from ..propagation import PATH_KINDS, Tunnel3D
+        from ..scenarios import Trajectory
 
         choice("channel", self.channel, CHANNELS)
         instance("tunnel", self.tunnel, Tunnel3D)
-        _check_arrays(self.arrays)
+        check_arrays(self.arrays)
         instance("trajectory", self.trajectory, Trajectory)
         instance("config", self.config, SRSConfig)
         choice("model", self.model, ("exact", "srnf"))
@@ -325,11 +142,21 @@ class SignalRoute:
         integer("second_order", self.second_order, minimum=0, maximum=MAX_SECOND_ORDER)
         choice("model_order", self.model_order, MODEL_ORDERS)
         integer("max_paths", self.max_paths, minimum=1)
+        boolean("model_error_floor", self.model_error_floor)
+        if self.bias_budget is not None:
+            from .judging import BiasBudget
+
+            budget = instance("bias_budget", self.bias_budget, BiasBudget)
+            if budget.exists.shape[0] != len(self.trajectory):
+                raise ValueError(
+                    f"bias_budget: {budget.exists.shape[0]} epochs, the trajectory has "
+                    f"{len(self.trajectory)}"
+                )
         if boolean("diffuse_floor", self.diffuse_floor) and self.channel != "sionna":
             raise ValueError(
                 "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
             )
-        from .rt.cache import RayTracedChannel
+        from ..rt.cache import RayTracedChannel
 
         if self.channel == "sionna" or self.raytraced is not None:  # channel='sionna' needs one
             instance("raytraced", self.raytraced, RayTracedChannel)
@@ -366,8 +193,8 @@ class SignalRoute:
         ``channel="sionna"`` attaches the scenario's ray-traced channel (settings from its
         ``[raytracing]`` section unless ``rt_settings`` is given, cache under ``cache_dir``,
         :mod:`tunnelkit.rt.cache`)."""
-        from . import propagation
-        from .scenarios import Scenario, load_scenario
+        from .. import propagation
+        from ..scenarios import Scenario, load_scenario
 
         sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
         if not isinstance(sc, Scenario):
@@ -382,7 +209,7 @@ class SignalRoute:
         traj = sc.trajectory(tun)
         config = SRSConfig.from_scenario(sc)
         if channel == "sionna":
-            from .rt import RayTracedChannel, RTSettings
+            from ..rt import RayTracedChannel, RTSettings
 
             settings = RTSettings.from_scenario(sc) if rt_settings is None else rt_settings
             kw["raytraced"] = RayTracedChannel(
@@ -393,7 +220,7 @@ class SignalRoute:
     def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
         """The array facing the vehicle and the true paths at epoch ``k`` (first order, then the
         strongest ``second_order`` second-order paths)."""
-        from . import propagation
+        from .. import propagation
 
         k = integer("k", k, minimum=0)
         if k >= len(self.trajectory):
@@ -475,7 +302,7 @@ class SignalRoute:
     def extract(self, H, arr: ArrayGeometry, n_paths: int, **extract_kw):
         """:func:`tunnelkit.extraction.extract_paths` of ``H`` at ``arr`` with this route's
         radio (``refine``, ... in ``extract_kw``)."""
-        from .extraction import extract_paths
+        from ..extraction import extract_paths
 
         instance("arr", arr, ArrayGeometry)
         return extract_paths(H, n_paths, arr, self.config, **extract_kw)
@@ -508,7 +335,13 @@ class SignalRoute:
         else:
             est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None
-        meas, truth = _measure(est, arr, paths, snap, cfg, self.min_d)
+        rejudged = self.rejudge(est, snap, arr, extract_kw)
+        judged = rejudged is None or not rejudged["passed"]
+        meas, truth = measure_epoch(est, arr, paths, snap, cfg, self.min_d, judged)
+        if self.bias_budget is not None:
+            from .judging import apply_budget
+
+            meas = apply_budget(meas, self.bias_budget, k)
         return Epoch(
             k,
             float(self.trajectory.t[k]),
@@ -520,72 +353,23 @@ class SignalRoute:
             est,
             meas,
             truth,
+            rejudged,
         )
 
+    def rejudge(self, est, snap: ChannelSnapshot, arr: ArrayGeometry, extract_kw: dict):
+        """The model-error test of a flagged ML fit (``model_error_floor``; None when there is
+        nothing to re-judge: the floor off or zero, the fit passed or is not an ML fit, the
+        extraction modelled the wideband term)."""
+        if not self.model_error_floor or getattr(est, "fit_ok", None) is not False:
+            return None
+        if getattr(est, "fit", None) is None or extract_kw.get("wideband", False):
+            return None
+        from .judging import impairment_share, rejudge
 
-def glrt_paths(
-    H,
-    array: ArrayGeometry,
-    config: SRSConfig,
-    n_start: int,
-    max_paths: int,
-    *,
-    noise_power: float | None = None,
-    wideband: bool = False,
-):
-    """The model order by a detection test per added path, from ``n_start`` paths up: the ML fit
-    (:func:`tunnelkit.extraction.ml.ml_paths`) of ``n_start`` paths, then while its residual's
-    single-path periodogram peak (the GLRT statistic of one path more, the fit's ``peak``)
-    exceeds its threshold (``peak_max``) and fewer than ``max_paths`` (at most ``M - 1``) paths
-    are fitted, one path more started at that peak (its far-field direction, delay and Doppler,
-    :func:`tunnelkit.extraction.ml.residual.residual_peak`) and every path refitted from the
-    previous fit (no re-seeding). A fit whose newest path fails its own detection test
-    (``fit.detected``) ends the count one path earlier. ``noise_power`` is the floor of every
-    test (estimated from ``H`` when None). Returns the estimates at the chosen order."""
-    from .extraction.ml import ml_paths
-    from .extraction.ml.residual import residual_peak
-
-    instance("array", array, ArrayGeometry)
-    instance("config", config, SRSConfig)
-    H = np.asarray(H)
-    if H.ndim != 3 or H.shape[0] != array.M:
-        raise ValueError(f"H: expected an ({array.M}, Nf, Nt) tensor, got shape {H.shape}")
-    n0 = integer("n_start", n_start, minimum=1, maximum=array.M - 1)
-    cap = min(integer("max_paths", max_paths, minimum=n0), array.M - 1)
-
-    def fit(n, start=None):
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            e = ml_paths(
-                H,
-                n,
-                array,
-                config,
-                start=start,
-                noise_power=noise_power,
-                n_reseed=None if start is None else 0,
-                wideband=wideband,
-            )
-        return e, caught
-
-    est, caught = fit(n0)
-    while len(est) < cap and est.fit.peak > est.fit.peak_max:
-        f = est.fit
-        model = np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
-        floor = f.noise_power if noise_power is None else noise_power
-        _, (ux, uy, mu_f, mu_t), _ = residual_peak(H - model, array.local, config.fc, floor)
-        start = (
-            np.vstack([f.theta, [ux, uy, 0]]),
-            np.append(f.mu_f, mu_f),
-            np.append(f.mu_t, mu_t),
-        )
-        nxt, nxt_caught = fit(len(est) + 1, start)
-        if not nxt.fit.detected.all():
-            break
-        est, caught = nxt, nxt_caught
-    for w in caught:  # the chosen fit's own warnings (the smaller orders' are expected)
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return est
+        share = impairment_share(self.impairments)
+        if share <= 0:
+            return None
+        return rejudge(est, snap.H, arr.local, self.config.fc, share)
 
 
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:

@@ -1,0 +1,163 @@
+"""A fit judged against noise plus the impairment power (tunnelkit.signal_route.judging): the
+closed-form calibration share against brute-force draws, the re-judged fit on a tensor with
+calibration error, the budget's slots matched by direction and delay (not by kind)."""
+
+import numpy as np
+import pytest
+
+from tunnelkit.channel import DiffuseSpec, Impairments, draw_calibration
+from tunnelkit.constants import C
+from tunnelkit.extraction.ml import Problem, fit_problem
+from tunnelkit.extraction.numerics import spatial_phase
+from tunnelkit.signal_route import RouteMeasurements
+from tunnelkit.signal_route.judging import (
+    BiasBudget,
+    apply_budget,
+    calibration_share,
+    impairment_share,
+    rejudge,
+)
+from tunnelkit.tracking.javelin.measurement import PathMeasurements
+
+FC = 5.9e9
+
+
+@pytest.mark.parametrize("phase_deg, gain_db", [(0.5, 0.0), (2.0, 0.2), (10.0, 1.0), (0.0, 3.0)])
+def test_calibration_share_against_draws(phase_deg, gain_db):
+    """``1 - exp(-sigma_phi^2 - s^2)`` is ``1 - |E g|^2 / E |g|^2`` of the drawn gains (200 000
+    elements), and the share a fitted common gain leaves (``1 - |sum g|^2 / (M sum |g|^2)`` of
+    one M-element array, averaged over arrays) is below it: the closed form is an upper bound."""
+    rng = np.random.default_rng(7)
+    g = draw_calibration(rng, 200_000, phase_deg, gain_db)
+    brute = 1.0 - abs(g.mean()) ** 2 / np.mean(abs(g) ** 2)
+    share = calibration_share(phase_deg, gain_db)
+    assert share == pytest.approx(brute, rel=0.03, abs=1e-6)
+    arrays = g.reshape(-1, 16)
+    left = 1.0 - abs(arrays.sum(1)) ** 2 / (16 * np.sum(abs(arrays) ** 2, 1))
+    assert left.mean() <= share
+    assert left.mean() == pytest.approx(share * 15 / 16, rel=0.05)
+
+
+def test_impairment_share_adds_the_diffuse_share_and_checks_its_input():
+    imp = Impairments(phase_sigma_deg=2.0, dmc=DiffuseSpec(0.1))
+    assert impairment_share(imp) == pytest.approx(calibration_share(2.0, 0.0) + 0.1)
+    assert impairment_share(Impairments()) == 0.0
+    for kw, name in (
+        ({"phase_sigma_deg": -1}, "phase_sigma_deg"),
+        ({"gain_sigma_db": np.nan}, "gain_sigma_db"),
+    ):
+        args = {"phase_sigma_deg": 0.0, "gain_sigma_db": 0.0, **kw}
+        with pytest.raises(ValueError, match=name):
+            calibration_share(**args)
+    with pytest.raises(TypeError, match="impairments"):
+        impairment_share(0.5)
+
+
+class _Est:
+    """The parts of PathEstimates :func:`rejudge` reads (fit, eq. 1 factors, gains)."""
+
+    def __init__(self, prob, fit):
+        self.fit = fit
+        self.alpha = fit.alpha
+        a = np.exp(1j * spatial_phase(fit.theta, prob.pos, prob.k0)[0])
+        self.factors = (
+            a,
+            np.exp(1j * prob.s * fit.mu_f[None, :]),
+            np.exp(1j * prob.kk * fit.mu_t[None, :]),
+        )
+
+    def __len__(self):
+        return len(self.alpha)
+
+
+def _pos():
+    g = np.arange(4) * C / FC / 2
+    return np.array([[x, y, 0.0] for x in g for y in g])
+
+
+def test_rejudge_passes_a_calibration_error_fit_at_the_closed_form_share():
+    """Two paths seen through 6 deg of phase error at high SNR: the white-noise test flags the
+    fit (its residual carries the calibration error), the test with the closed-form share
+    passes it, with no floor it fails, and the share it needs is below the closed form."""
+    theta = np.array([[0.2, -0.1, 0.2], [-0.3, 0.25, 0.1]])
+    mu_f, mu_t = np.array([-0.5, -0.9]), np.array([0.1, -0.2])
+    gain = np.array([1 + 0.5j, 0.6 - 0.3j])
+    pos, sigma2 = _pos(), 1e-3
+    rng = np.random.default_rng(11)
+    prob0 = Problem(np.ones((16, 24, 4), complex), pos, FC)
+    h = prob0.model(theta, mu_f, mu_t, gain) * draw_calibration(rng, 16, 6.0)[:, None, None]
+    noise = np.sqrt(sigma2 / 2) * (rng.standard_normal(h.shape) + 1j * rng.standard_normal(h.shape))
+    prob = Problem(h + noise, pos, FC)
+    with pytest.warns(RuntimeWarning):
+        fit = fit_problem(prob, (theta, mu_f, mu_t), noise_power=sigma2, n_reseed=0)
+    assert not fit.fit_ok
+    est = _Est(prob, fit)
+    share = calibration_share(6.0, 0.0)
+    r = rejudge(est, prob.H, pos, FC, share)
+    assert r["residual_only"] and r["passed"] and 0 < r["needed"] <= share
+    assert not rejudge(est, prob.H, pos, FC, 0.0)["passed"]
+    with pytest.raises(ValueError, match="share"):
+        rejudge(est, prob.H, pos, FC, -0.1)
+    with pytest.raises(ValueError, match="H"):
+        rejudge(est, prob.H[:8], pos, FC, share)
+
+
+def _budget():
+    """Two epochs, four slots: the LoS and two walls mirrored about the array's axis (same
+    kind, same delay), the road; epoch 1 without the second wall."""
+    origin = np.array([[0.0, 0.0, 6.0]] * 2)
+    ue = np.array([30.0, 0.0, 1.5])
+    wall = np.array([0.0, 8.0, 0.0])
+    src = np.array([ue, ue + wall, ue - wall, ue * np.array([1.0, 1.0, -1.0])])
+    source = np.stack([src, src])
+    exists = np.array([[True] * 4, [True, True, False, True]])
+    extra = np.zeros((2, 4, 4, 4))
+    rep = np.zeros((2, 4, 4, 4))
+    for p in range(4):
+        extra[:, p] = np.diag([1e-6, 2e-6, 1e-2, 1e-4]) * (p + 1)
+        rep[:, p] = 0.5 * extra[:, p]
+    return BiasBudget(source, exists, origin, extra, rep), src, origin[0]
+
+
+def test_budget_slots_matched_by_direction_and_delay_with_an_unknown_clock_offset():
+    b, src, origin = _budget()
+    rel = src - origin
+    r = np.linalg.norm(rel, axis=1)
+    order = np.array([2, 0, 3, 1])  # any order; both walls have the same delay
+    u = rel[order] / r[order, None]
+    d = r[order] + 12.3  # the clock offset
+    assert b.match(0, d, u).tolist() == order.tolist()
+    # the second wall's slot absent at epoch 1: its estimate stays unmatched
+    assert b.match(1, d, u).tolist() == [-1, 0, 3, 1]
+    # an estimate far from every slot (clutter) is unmatched
+    far = np.vstack([u, [[0.0, 0.0, 1.0]]])
+    assert b.match(0, np.append(d, 90.0), far)[-1] == -1
+    with pytest.raises(ValueError, match="k"):
+        b.match(2, d, u)
+    with pytest.raises(ValueError, match="direction"):
+        b.match(0, d, u[:2])
+
+
+def test_apply_budget_adds_the_matched_slots_budget_and_the_tracker_takes_it():
+    b, src, origin = _budget()
+    rel = src[[1, 0]] - origin
+    r = np.linalg.norm(rel, axis=1)
+    u = rel / r[:, None]
+    phi, psi = np.arctan2(u[:, 1], u[:, 0]), np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1]))
+    d = r + 3.0
+    cov = np.stack([np.eye(3) * 1e-8] * 2)
+    m = RouteMeasurements(origin, "a", phi, psi, r, np.ones(2, bool), d, d - d[0], np.zeros(2),
+                          u, np.ones(2, complex), np.arange(2), cov, np.full(2, 1e-3))  # fmt: skip
+    out = apply_budget(m, b, 0)
+    assert np.allclose(out.cov[0], cov[0] + b.extra[0, 1, :3, :3])
+    assert np.allclose(out.cov[1], cov[1] + b.extra[0, 0, :3, :3])
+    assert np.allclose(out.sigma_d**2, 1e-6 + b.extra[0, [1, 0], 3, 3])
+    assert np.allclose(out.bias_cov, b.repeating[0, [1, 0]])
+    pm = PathMeasurements.from_arrays(out.phi, out.psi, out.kappa, out.d, out.v, warn=False,
+                                      cov=out.cov, sigma_d=out.sigma_d, bias_cov=out.bias_cov)  # fmt: skip
+    assert pm.bias_cov.shape == (2, 4, 4)
+    # without reported covariances there is nothing to add to
+    assert (
+        apply_budget(RouteMeasurements(**{**m.__dict__, "cov": None, "sigma_d": None}), b, 0).cov
+        is None
+    )
