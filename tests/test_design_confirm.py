@@ -7,7 +7,8 @@ import pytest
 
 from tunnelkit import design
 from tunnelkit.cli import main
-from tunnelkit.design.confirm import IMPAIRED_WARNING, confirmation_candidates
+from tunnelkit.design.confirm import confirmation_candidates
+from tunnelkit.signal_route.judging import calibration_share
 
 
 def _report(statuses, rec):
@@ -56,18 +57,19 @@ def test_confirmation_reruns_on_the_channel_route_and_decides():
     with pytest.raises(ValueError, match="report"):
         design.confirm_on_channel(design.design_sweep(setup, ["4x4"], n_epochs=4), setup)
     assert np.isfinite(out["arrays"][0]["error_p90_m"])
-    assert IMPAIRED_WARNING not in conf.warnings  # the ideal channel: a confirmation
+    assert out["inputs"]["model_error_share"] == 0.0  # the ideal channel: the white-noise test
 
 
 def test_confirmation_under_calibration_error_says_what_it_judges():
-    """Under calibration error the extraction's fit test (white noise only) flags its fits and
-    the channel route predicts through them: the confirmation says so in its warnings."""
+    """Under calibration error the channel route judges its fits against noise plus the
+    closed-form calibration share: the confirmation states that share in its inputs."""
     setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
     kw = {"target": 1.0, "runs": 2, "n_epochs": 2, "seed": 3}
     rep = design.design_sweep(setup, ["4x4"], impairments={"phase_error_deg": 0.5}, **kw)
     conf = design.confirm_on_channel(rep, setup)
-    assert IMPAIRED_WARNING in conf.warnings
-    assert IMPAIRED_WARNING not in rep.warnings  # the bound route's answer is not concerned
+    share = conf.to_json()["inputs"]["model_error_share"]
+    assert share == pytest.approx(calibration_share(0.5, 0.0)) and share > 0
+    assert "model_error_share" not in rep.to_json()["inputs"]  # the bound route has no fit test
 
 
 def test_cli_confirm_needs_bound_runs(capsys):
@@ -75,6 +77,11 @@ def test_cli_confirm_needs_bound_runs(capsys):
     assert main(argv) == 2
     assert "--confirm" in capsys.readouterr().err
     assert main([*argv, "--runs", "2", "--mode", "channel"]) == 2
+    # --confirm-runs: only with --confirm, at least one run
+    assert main([*argv[:-1], "--runs", "2", "--confirm-runs", "2"]) == 2
+    assert "--confirm-runs" in capsys.readouterr().err
+    assert main([*argv, "--runs", "2", "--confirm-runs", "0"]) == 2
+    assert "--confirm-runs" in capsys.readouterr().err
 
 
 def test_cli_json_says_which_route_decided(capsys):
