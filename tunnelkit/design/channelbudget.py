@@ -49,7 +49,10 @@ def channel_budget(model: PathErrorModel, setup: DesignSetup, spec) -> BiasBudge
 
 def channel_route_budget(setup: DesignSetup, spec, impairments) -> BiasBudget | None:
     """:func:`channel_budget` of the error model under ``impairments`` (a
-    :class:`~tunnelkit.design.achievable.DesignImpairments`), None for none or ideal ones."""
+    :class:`~tunnelkit.design.achievable.DesignImpairments`), None for none or ideal ones, and
+    None where the model is undefined (a Fisher information singular at some epoch, e.g. the
+    curvature of a 2 x 2 array: the route then reports the CRLB at the estimate alone, and the
+    design reports that array's bound as undefined)."""
     from .achievable import DesignImpairments, path_error_model
 
     if impairments is None:
@@ -57,4 +60,8 @@ def channel_route_budget(setup: DesignSetup, spec, impairments) -> BiasBudget | 
     instance("impairments", impairments, DesignImpairments)
     if impairments.ideal:
         return None
-    return channel_budget(path_error_model(setup, spec, impairments), setup, spec)
+    try:
+        model = path_error_model(setup, spec, impairments)
+    except ValueError:
+        return None
+    return channel_budget(model, setup, spec)
