@@ -27,7 +27,8 @@ fits and a flagged epoch carried no measurement: 28 GHz example, 0.5 deg, the fi
 one drive (seed 0): 6 of 10 flagged on 4 x 4 and 10 of 10 on 8 x 8, after the re-judge 1 and 0
 (the 4 x 4 one an unresolved pair, which stays flagged); the fits needed 0.01-0.07 of the closed
 form. The settled median error on the channel route went from 0.42 / 0.97 m (4 x 4 / 8 x 8, 2
-runs) to 0.9 / 0.5 cm (3 runs), the bound route's 1.1 / 0.4 cm (README, the design answer).
+runs) to 1.8 / 0.49 cm (20 runs; p90 10.3 / 3.6 cm), the bound route's 1.1 / 0.42 cm (p90 8.3 /
+2.6 cm): both recommend 8 x 8 (README, the design answer).
 """
 
 from __future__ import annotations
