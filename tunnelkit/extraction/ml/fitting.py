@@ -284,8 +284,7 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
 #: split steps of :func:`_split_weak`: ``SPLIT_STEPS`` and the same 2.5 times longer (long-range
 #: images lie 1-5 deg, 0.02-0.09 in direction cosine, from the path they merge with)
 WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS))
-#: :func:`_split_weak` on an unresolved pair keeps a split that lowers the cost by this many noise
-#: powers (a likelihood ratio of e); it is tried at most ``SPLIT_ROUNDS`` times per fit
+#: :func:`_split_weak` on a pair: kept at a cost fall of PAIR_GAIN sigma^2; SPLIT_ROUNDS tries
 PAIR_GAIN, SPLIT_ROUNDS = 1.0, 2
 
 
@@ -304,7 +303,7 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
     sig = path_significance(ev, sigma2)
     weak = int(np.argmin(sig))
     if sig.min() >= MIN_SIGNIFICANCE:
-        res = separations(prob, theta, mu_f, mu_t, sigma2)
+        res = ev["resolution"] = separations(prob, theta, mu_f, mu_t, sigma2)  # kept with ev
         if res.min() >= RESOLVE_Z:
             return best, 0, False
         pair = np.argsort(res)[:2]
@@ -551,7 +550,8 @@ def fit_problem(
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
     significance = path_significance(ev, sigma2)
-    resolution = separations(prob, theta, mu_f, mu_t, sigma2)
+    resolution = ev.get("resolution", None)  # at theta: ev is the evaluation there
+    resolution = separations(prob, theta, mu_f, mu_t, sigma2) if resolution is None else resolution
     separation = float(np.min(resolution)) if resolution.size else float("inf")
     failed = {
         "residual peak": peak[0] > peak_max,
