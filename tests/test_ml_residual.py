@@ -498,3 +498,37 @@ def test_split_weak_recovers_a_merged_pair_from_a_path_below_the_noise():
     assert err.max() < 0.003
     again, n2, kept2 = ml.fitting._split_weak(prob, out, sigma2, 60, gain)
     assert not kept2 and n2 == 0 and again is out
+
+
+def test_split_weak_recovers_a_merged_pair_from_a_path_counted_twice():
+    """The same pair merged into one path while a third source is fitted twice (two atoms 0.004
+    apart in direction cosine, both far above the noise, 0.2 standard deviations of their
+    difference apart: unresolved). The move drops the weaker of the unresolved pair, splits the
+    merged path and reaches the likelihood of the fit started at the truth, every source within
+    0.003 in direction cosine and the pair resolved; the fit it returns is left alone."""
+    sc = _scene(47, n_paths=3, snr_db=(20.0, 25.0))
+    src = sc.sources.copy()
+    r0 = np.linalg.norm(src[0])
+    u = src[0, :2] / r0 + [0.03, 0.0]
+    src[1] = r0 * np.append(u, np.sqrt(1 - u @ u))
+    d, v = sc.d.copy(), sc.v.copy()
+    d[1], v[1] = d[0] + 0.05, v[0]
+    pair = replace(sc, sources=src, d=d, v=v)
+    prob = ml.Problem(pair.tensor(np.random.default_rng(5)), pair.element_positions, pair.config.fc)
+    th, mf, mt = _truth(pair)
+    sigma2 = prob.noise_floor(3)
+    dx = np.array([0.002, 0.0, 0.0])
+    th0 = np.vstack([np.append(th[:2, :2].mean(0), th[0, 2]), th[2] - dx, th[2] + dx])
+    mf0, mt0 = np.array([mf[:2].mean(), mf[2], mf[2]]), np.array([mt[:2].mean(), mt[2], mt[2]])
+    best = (th0, mf0, mt0, prob.evaluate(th0, mf0, mt0))
+    assert ml.resolution.significance(best[3], sigma2).min() > 10 * ml.fitting.MIN_SIGNIFICANCE
+    assert ml.separations(prob, th0, mf0, mt0, sigma2).min() < 1.0
+    out, n_it, kept = ml.fitting._split_weak(prob, best, sigma2, 60, 30.0 * sigma2)
+    at_truth = ml.fitting._lm(prob, th, mf, mt, sigma2, 60)
+    assert kept and n_it > 0
+    assert out[3]["cost"] == pytest.approx(at_truth[3]["cost"], rel=1e-9)
+    for row in th[:, :2]:
+        assert np.min(np.linalg.norm(out[0][:, :2] - row, axis=1)) < 0.003
+    assert ml.separations(prob, *out[:3], sigma2).min() > ml.RESOLVE_Z
+    again, n2, kept2 = ml.fitting._split_weak(prob, out, sigma2, 60, 30.0 * sigma2)
+    assert not kept2 and n2 == 0 and again is out

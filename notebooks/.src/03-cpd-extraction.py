@@ -628,7 +628,14 @@ fig_thr.update_layout(
 # 1 % false-alarm rate —, a path below the noise, or two paths closer than their bound can
 # resolve: the same threshold effect for a pair), and the trackers skip it
 # (`studies.path_measurements`). `benchmarks/bench_stress.py` stresses the same over the whole
-# drive, far below the presets' SNR, with many paths and close pairs.
+# drive, far below the presets' SNR, with many paths and close pairs. Before it gives up, the
+# search re-splits around such a pair (a cluster merged while a path is counted twice: the
+# weaker of the pair out, each other path split in two, kept only if the likelihood rises), and
+# the benchmark tells every failure left above the threshold apart: a *search miss* (the fit
+# restarted at the truth finds a significantly more likely basin) or *not attainable* (the
+# estimate is at least as likely as the truth's basin, so no search can do better and the CRLB
+# of the resolved model is not a bound it can reach; the separation at the estimate, from its
+# Fisher information, says why).
 
 # %%
 above_thr = [r for r in snr_rows if r["integrated SNR [dB]"] >= eta_th + 7.0]

@@ -114,7 +114,13 @@ exactly as without the screen (the iteration is resumable). When a path is still
 at long range two images merged into one strong path), the weak path is dropped and each other
 path in turn split in two (``WEAK_SPLITS``: an eighth of a beamwidth and 2.5 times that, along
 each axis), the starts ranked after ``RANK_ITER`` iterations, the best fitted and kept if the
-cost falls by more than the detection threshold of one path. ``MLFit.fit_ok`` (and
+cost falls by more than the detection threshold of one path. The same move runs (up to
+``SPLIT_ROUNDS`` times) when two paths are closer than ``RESOLVE_Z`` standard deviations of
+their difference: at long range and at low SNR the search also ends with a cluster merged and a
+path counted twice (two atoms side by side with large opposite gains, each far above the
+noise); the less significant of the pair is the path dropped, and a split is kept when it lowers
+the cost by more than ``PAIR_GAIN`` noise powers (the model order is the same, so the more
+likely basin is the estimate). ``MLFit.fit_ok`` (and
 ``PathEstimates.fit_ok``) is the verdict: the periodogram peak and ``rho`` below their
 thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
 further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical

@@ -157,15 +157,8 @@ def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | N
 
 def _lm_with(prob: Problem, theta, mu_f, mu_t, new, sigma2, max_iter):
     """:func:`_lm` on the ``L`` paths plus one more, ``new = (theta, mu_f, mu_t)`` of it."""
-    th_n, mf_n, mt_n = new
-    return _lm(
-        prob,
-        np.vstack([theta, th_n]),
-        np.append(mu_f, mf_n),
-        np.append(mu_t, mt_n),
-        sigma2,
-        max_iter,
-    )
+    th, mf, mt = np.vstack([theta, new[0]]), np.append(mu_f, new[1]), np.append(mu_t, new[2])
+    return _lm(prob, th, mf, mt, sigma2, max_iter)
 
 
 def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
@@ -189,12 +182,8 @@ def _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coh
     ``u -+ SPLIT_STEPS`` (two sources closer than a beamwidth fitted as one) and fit all ``L``;
     the first split whose cost is below ``cost_ok`` (the basin test), else the best. ``None``
     when no two atoms are that alike."""
-    G = ev["G"]
-    dg = np.sqrt(np.maximum(np.real(np.diag(G)), 1e-300))
-    coh = np.abs(G) / np.outer(dg, dg)
-    np.fill_diagonal(coh, 0.0)
-    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
-    if coh[i, j] < coherence:
+    i, j, coh = _coherent_pair(ev)
+    if coh < coherence:
         return None
     drop = j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i
     keep = np.arange(theta.shape[0]) != drop
@@ -295,22 +284,30 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
 #: split steps of :func:`_split_weak`: ``SPLIT_STEPS`` and the same 2.5 times longer (long-range
 #: images lie 1-5 deg, 0.02-0.09 in direction cosine, from the path they merge with)
 WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS))
+#: :func:`_split_weak` on a pair: kept at a cost fall of PAIR_GAIN sigma^2; SPLIT_ROUNDS tries
+PAIR_GAIN, SPLIT_ROUNDS = 1.0, 2
 
 
 def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
-    """A path below the noise (``MIN_SIGNIFICANCE``) after the search: the fit counts one path
-    too few elsewhere, typically two sources merged into one strong path. The weak path is
-    dropped and each other path in turn split in two (halves ``u -+ WEAK_SPLITS``, same delay
-    and Doppler); each start gets ``RANK_ITER`` iterations, the most likely is fitted to
-    convergence and kept if the cost falls by more than ``gain_min`` (the detection threshold
-    of one path, in cost units: the split must explain a path's worth of structure, not fit
-    noise). Returns the fit, the iterations spent and whether it was kept."""
+    """A path below the noise (``MIN_SIGNIFICANCE``) or two closer than ``RESOLVE_Z``: one path
+    too few elsewhere (two sources merged) while the weak path, or the less significant of the
+    pair (a path counted twice), sits on nothing. It is dropped and each other path in turn split
+    in two (halves ``u -+ WEAK_SPLITS``, same delay and Doppler); each start gets ``RANK_ITER``
+    iterations, the most likely is fitted to convergence and kept if the cost falls by more than
+    ``gain_min`` (a path's detection threshold: structure, not noise) or, for a pair (same model
+    order), ``PAIR_GAIN`` noise powers. Returns the fit, the iterations and whether it was kept."""
     theta, mu_f, mu_t, ev = best[:4]
     L = theta.shape[0]
-    sig = path_significance(ev, sigma2)
-    if L < 2 or sig.min() >= MIN_SIGNIFICANCE:
+    if L < 2:
         return best, 0, False
+    sig = path_significance(ev, sigma2)
     weak = int(np.argmin(sig))
+    if sig.min() >= MIN_SIGNIFICANCE:
+        res = ev["resolution"] = separations(prob, theta, mu_f, mu_t, sigma2)  # kept with ev
+        if res.min() >= RESOLVE_Z:
+            return best, 0, False
+        pair = np.argsort(res)[:2]
+        weak, gain_min = int(pair[np.argmin(sig[pair])]), PAIR_GAIN * sigma2
     starts = []
     for l_ in np.argsort(-np.abs(ev["c"])):
         if l_ == weak:
@@ -352,14 +349,19 @@ def _dirichlet(dmu, n: int) -> np.ndarray:
 def _weakest(ev, sigma2) -> int:
     """The weaker of the two most collinear atoms when two are nearly one (``|G_ij| / sqrt(G_ii
     G_jj) > 0.9``: a path counted twice), else the least significant path."""
-    G = ev["G"]
-    dg = np.sqrt(np.maximum(np.real(np.diag(G)), 1e-300))
-    coh = np.abs(G) / np.outer(dg, dg)
-    np.fill_diagonal(coh, 0.0)
-    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
-    if coh[i, j] > 0.9:
+    i, j, coh = _coherent_pair(ev)
+    if coh > 0.9:
         return int(j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i)
     return int(np.argmin(path_significance(ev, sigma2)))
+
+
+def _coherent_pair(ev):
+    """The two most collinear atoms ``i, j`` and their coherence ``|G_ij| / sqrt(G_ii G_jj)``."""
+    dg = np.sqrt(np.maximum(np.real(np.diag(ev["G"])), 1e-300))
+    coh = np.abs(ev["G"]) / np.outer(dg, dg)
+    np.fill_diagonal(coh, 0.0)
+    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
+    return i, j, coh[i, j]
 
 
 def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
@@ -522,11 +524,12 @@ def fit_problem(
         )
         n_it, kept = n_it + its, kept + n_kept
         history.append(best[3]["cost"] / (dof * sigma2))
-    if n_reseed and search == "residual" and SPLIT_WEAK:
+    for _ in range(SPLIT_ROUNDS if n_reseed and search == "residual" and SPLIT_WEAK else 0):
         best, its, split = _split_weak(prob, best, sigma2, max_iter, peak_max * sigma2)
         n_it, kept = n_it + its, kept + split
-        if split:
-            peak = _peak_of(prob, best, sigma2)
+        if not split:
+            break
+        peak = _peak_of(prob, best, sigma2)
     if best[3]["cost"] / (dof * sigma2) > rho_max:
         best, its, n_kept = _rho_reseed(
             prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof
@@ -547,7 +550,8 @@ def fit_problem(
         raise FloatingPointError("fit_ml: non-finite gains (degenerate paths)")
     rho = float(ev["cost"] / (dof * sigma2))
     significance = path_significance(ev, sigma2)
-    resolution = separations(prob, theta, mu_f, mu_t, sigma2)
+    resolution = ev.get("resolution", None)  # at theta: ev is the evaluation there
+    resolution = separations(prob, theta, mu_f, mu_t, sigma2) if resolution is None else resolution
     separation = float(np.min(resolution)) if resolution.size else float("inf")
     failed = {
         "residual peak": peak[0] > peak_max,
