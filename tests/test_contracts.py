@@ -620,6 +620,8 @@ def build_suite() -> Suite:
             no_baseline[t.name] = f"no valid value for {', '.join(missing)}"
             continue
         this = None
+        if t.kind == "classmethod":  # the class it was called through (None: its owner)
+            this = rec[0] if rec else None
         if t.kind == "method":
             this = rec[0] if rec else None
             if this is None:
