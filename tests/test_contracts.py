@@ -234,7 +234,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "kappa = 3 - n < 0 is the classic choice; n + kappa > 0 is what is required",
     ),
     _doc(
-        r"scenarios\.(registry\.(Registry\.lookup|require|getter)|model\.Scenario)",
+        r"scenarios\.(registry\.(Registry\.(lookup|build)|require|getter)|model\.Scenario)",
         r"where|prefix|paper|description",
         "empty",
         "optional text: no file name, the top-level table, a user file (no paper), no description",
@@ -546,13 +546,13 @@ DOCUMENTED: tuple[Documented, ...] = (
         "vectorise (the docstring's contract)",
     ),
     _doc(
-        r"tracking\.upf\.(ukf_proposal|one_epoch_ess)",
+        r"tracking\.upf\.(ukf_proposal(_reference)?|one_epoch_ess)",
         r"z|Z",
         "nan",
         "NaN in a measurement marks a missed epoch (the filters predict only)",
     ),
     _doc(
-        r"tracking\.upf\.ukf_proposal",
+        r"tracking\.upf\.ukf_proposal(_reference)?",
         r"kappa",
         "negative",
         "kappa = 3 - n < 0 is the classic choice",
