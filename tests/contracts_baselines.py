@@ -279,6 +279,34 @@ def ray_tracer():
     eng.surface_of(0)
 
 
+def javelin_records():
+    """The records one JAVELIN step builds unchecked (its inner loop), built here through their
+    checked constructors from a short run's report."""
+    import dataclasses as dc
+
+    from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
+    from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
+    from tunnelkit.tracking.javelin.measurement import track_model
+    from tunnelkit.tracking.javelin.update import stack_measurement
+
+    bs = (0.0, 0.0, 4.8)
+    P, V = toy_drive(6, 0.1, amplitude=0.5, speed=4.0)
+    eps = geometric_stream(P, V, toy_reflectors(), np.random.default_rng(0), bs=bs)
+    spd, hdg = np.linalg.norm(V, axis=1), np.arctan2(V[:, 1], V[:, 0])
+    design = JavelinDesign(JavelinConfig(base_station=bs, sigma_p0_ue=1.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_javelin(eps, spd, hdg, 0.1, P[0], design, keep_reports=True)
+    rep = next(r for r in run.reports[1:] if r.manage is not None and r.manage.pairs)
+    for r in (rep.manage, rep):
+        type(r)(*(getattr(r, f.name) for f in dc.fields(r) if f.init))
+    x = np.concatenate([rep.estimate, rep.positions[1:, 1:].ravel()])
+    pred, J = track_model(x, bs)
+    pairs = [(i, j) for i, j in rep.manage.pairs if i < len(pred)]
+    m = stack_measurement(pred, J, rep.paths, pairs, design.config)
+    type(m)(*(getattr(m, f.name) for f in dc.fields(m) if f.init))
+
+
 DRIVERS = (
     design_confirm,
     route_studies,
@@ -288,4 +316,5 @@ DRIVERS = (
     tracking_figures,
     tunnels_registries,
     ray_tracer,
+    javelin_records,
 )
