@@ -509,9 +509,10 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(
         r"tracking\.javelin\.tracker\.(JavelinRun|StepReport)|tracking\.javelin\.tenfiloc"
         r"\.TeNFiLocFix",
-        r"reports|associated|ids|paths",
+        r"reports|associated|(prior_)?ids|paths",
         "empty",
-        "reports not kept (the default), no pair associated, no VUE track, a fix from no path",
+        "reports not kept (the default), no pair associated, no VUE track (before or after the "
+        "step), a fix from no path",
     ),
     _doc(
         r"tracking\.javelin\.update\.(JointTestUpdater\.stack|exclude_inconsistent)",
