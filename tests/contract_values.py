@@ -20,6 +20,7 @@ import numpy as np
 from contract_design import DRIVERS as DESIGN_DRIVERS
 from contract_routes import DRIVERS as ROUTE_DRIVERS
 from contracts import Target, function_of, hints, parameters
+from contracts_baselines import DRIVERS as BASELINE_DRIVERS
 
 
 def _code_of(target: Target):
@@ -48,6 +49,16 @@ def _keep(value):
         return value
 
 
+def _star_parameters(target: Target) -> list[tuple[str, str]]:
+    """[("*", name) / ("**", name)] of the variadic parameters of ``target``'s signature."""
+    try:
+        sig = inspect.signature(function_of(target))
+    except (TypeError, ValueError):
+        return []
+    kinds = {inspect.Parameter.VAR_POSITIONAL: "*", inspect.Parameter.VAR_KEYWORD: "**"}
+    return [(kinds[p.kind], p.name) for p in sig.parameters.values() if p.kind in kinds]
+
+
 def capture(targets: list[Target], drivers) -> dict[str, tuple[object, dict]]:
     """{target name: (self or None, {parameter: value})} of the first call each driver makes."""
     by_code = {}
@@ -74,10 +85,20 @@ def capture(targets: list[Target], drivers) -> dict[str, tuple[object, dict]]:
                 if not owner_ok:
                     continue
             kw = {p.name: _keep(loc[p.name]) for p in params if p.name in loc}
+            for star, name in _star_parameters(t):  # *args / **kwargs as called
+                if loc.get(name):
+                    kw[star + name] = _keep(loc[name])
             this = None
-            if t.kind == "method":
+            if t.kind in ("method", "classmethod"):
+                # a method on its instance; a classmethod on the class it was called through
+                # (a base's classmethod reached from a concrete subclass)
                 this = loc.get(next(iter(frame.f_code.co_varnames), "self"))
-                if not isinstance(this, t.owner):
+                ok = (
+                    isinstance(this, t.owner)
+                    if t.kind == "method"
+                    else isinstance(this, type) and issubclass(this, t.owner)
+                )
+                if not ok:
                     continue
                 this = _keep(this)
             got[t.name] = (this, kw)
@@ -553,6 +574,7 @@ DRIVERS = (
     *ROUTE_DRIVERS,
     _consistency,
     *DESIGN_DRIVERS,
+    *BASELINE_DRIVERS,
 )
 
 
@@ -621,6 +643,8 @@ def fill_arguments(target: Target, recorded: dict | None) -> tuple[dict, list[st
             out[p.name] = neutral(p, h.get(p.name, inspect.Parameter.empty))
         except NoValue:
             missing.append(p.name)
+    if recorded is not None:  # the recorded *args / **kwargs, as called
+        out.update({k: v for k, v in recorded.items() if k.startswith("*")})
     return out, missing
 
 
@@ -637,15 +661,20 @@ def fresh(value):
 def invoke(target: Target, this, kwargs: dict):
     """Call ``target`` with ``kwargs`` (positional-only parameters passed by position)."""
     params = parameters(target)
-    pos = [kwargs[p.name] for p in params if p.kind is p.POSITIONAL_ONLY and p.name in kwargs]
-    kw = {
-        k: v
-        for k, v in kwargs.items()
-        if not any(p.name == k and p.kind is p.POSITIONAL_ONLY for p in params)
-    }
+    kw = {k: v for k, v in kwargs.items() if not k.startswith("*")}
+    var_pos = next((v for k, v in kwargs.items() if k[:1] == "*" and k[:2] != "**"), ())
+    var_kw = next((v for k, v in kwargs.items() if k[:2] == "**"), {})
+    # positional-only parameters by position; with recorded *args, every parameter before them
+    P = inspect.Parameter
+    by_position = (P.POSITIONAL_ONLY, P.POSITIONAL_OR_KEYWORD) if var_pos else (P.POSITIONAL_ONLY,)
+    pos = [kw.pop(p.name) for p in params if p.kind in by_position and p.name in kw]
+    pos += list(var_pos)
+    kw = {**var_kw, **kw}
     short = target.name.rsplit(".", 1)[1]
     if target.kind == "class":
         return target.obj(*pos, **kw)
+    if target.kind == "classmethod" and this is not None:
+        return getattr(this, short)(*pos, **kw)
     if target.kind in ("classmethod", "staticmethod"):
         return getattr(target.owner, short)(*pos, **kw)
     if target.kind == "method":

@@ -234,7 +234,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "kappa = 3 - n < 0 is the classic choice; n + kappa > 0 is what is required",
     ),
     _doc(
-        r"scenarios\.(registry\.(Registry\.lookup|require|getter)|model\.Scenario)",
+        r"scenarios\.(registry\.(Registry\.(lookup|build)|require|getter)|model\.Scenario)",
         r"where|prefix|paper|description",
         "empty",
         "optional text: no file name, the top-level table, a user file (no paper), no description",
@@ -509,9 +509,10 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(
         r"tracking\.javelin\.tracker\.(JavelinRun|StepReport)|tracking\.javelin\.tenfiloc"
         r"\.TeNFiLocFix",
-        r"reports|associated|ids|paths",
+        r"reports|associated|(prior_)?ids|paths",
         "empty",
-        "reports not kept (the default), no pair associated, no VUE track, a fix from no path",
+        "reports not kept (the default), no pair associated, no VUE track (before or after the "
+        "step), a fix from no path",
     ),
     _doc(
         r"tracking\.javelin\.update\.(JointTestUpdater\.stack|exclude_inconsistent)",
@@ -546,13 +547,13 @@ DOCUMENTED: tuple[Documented, ...] = (
         "vectorise (the docstring's contract)",
     ),
     _doc(
-        r"tracking\.upf\.(ukf_proposal|one_epoch_ess)",
+        r"tracking\.upf\.(ukf_proposal(_reference)?|one_epoch_ess)",
         r"z|Z",
         "nan",
         "NaN in a measurement marks a missed epoch (the filters predict only)",
     ),
     _doc(
-        r"tracking\.upf\.ukf_proposal",
+        r"tracking\.upf\.ukf_proposal(_reference)?",
         r"kappa",
         "negative",
         "kappa = 3 - n < 0 is the classic choice",
@@ -620,6 +621,8 @@ def build_suite() -> Suite:
             no_baseline[t.name] = f"no valid value for {', '.join(missing)}"
             continue
         this = None
+        if t.kind == "classmethod":  # the class it was called through (None: its owner)
+            this = rec[0] if rec else None
         if t.kind == "method":
             this = rec[0] if rec else None
             if this is None:

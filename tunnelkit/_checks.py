@@ -6,6 +6,8 @@ message starts with the offending parameter's name."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import MISSING as _MISSING
+from dataclasses import fields
 
 import numpy as np
 
@@ -21,6 +23,7 @@ __all__ = [
     "series",
     "sign",
     "square_matrices",
+    "unchecked",
 ]
 
 
@@ -116,3 +119,36 @@ def attributes(name: str, value, attrs: Sequence[str], what: str):
             f"{name}: expected {what} (with {', '.join(missing)}), got {type(value).__name__}"
         )
     return value
+
+
+_UNCHECKED: dict[type, tuple] = {}
+
+
+def unchecked(cls: type, *args, **kwargs):
+    """``cls(*args, **kwargs)`` for a dataclass record, without its ``__post_init__``: the
+    unchecked twin for a caller that builds the record from values it has checked or computed
+    itself (an inner loop, e.g. one JAVELIN step), the public constructor keeping its checks.
+    Fields take the arguments, then their defaults; nothing is converted, so the values must be
+    what the checked constructor keeps (tests/test_inner_loops.py rebuilds each such record
+    through it)."""
+    plan = _UNCHECKED.get(cls)
+    if plan is None:
+        plan = tuple((f.name, f.init, f.default, f.default_factory) for f in fields(cls))
+        _UNCHECKED[cls] = plan
+    obj = object.__new__(cls)
+    n = len(args)
+    i = 0
+    for name, init, default, factory in plan:
+        if init and i < n:
+            value = args[i]
+            i += 1
+        elif init and name in kwargs:
+            value = kwargs[name]
+        elif factory is not _MISSING:
+            value = factory()
+        elif default is not _MISSING:
+            value = default
+        else:
+            raise TypeError(f"{cls.__name__}: missing field {name}")
+        object.__setattr__(obj, name, value)
+    return obj

@@ -27,7 +27,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._validate import finite_array, integer, positive, real
+from ._validate import finite_array, integer, positive, real, text
 from .propagation import (
     Box,
     Facet,
@@ -69,6 +69,7 @@ def extruded_tunnel(
     ``names[i]``, extruded over ``[x_start, x_start + length]`` (centred on x = 0 by default). The
     road closes the section. Normals point into the tunnel; plates must lie inside.
     """
+    text("wall_material", wall_material), text("road_material", road_material)
     prof = finite_array("profile", profile)
     if prof.ndim != 2 or prof.shape[1] != 2 or prof.shape[0] < 3:
         raise ValueError(f"profile: expected (K >= 3, 2) vertices, got shape {prof.shape}")

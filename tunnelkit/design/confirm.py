@@ -36,7 +36,7 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 
-from .._validate import instance, integer
+from .._validate import instance, integer, record
 from .report import DesignReport, score_row
 from .setup import DesignSetup, parse_array
 from .verdict import MIN_RUNS_CI, recommend
@@ -52,6 +52,9 @@ class ConfirmedReport(DesignReport):
 
     confirmation: list = field(default_factory=list)
     bound_recommendation: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        record(self, may_be_empty=("warnings", "confirmation"))
 
     def to_json(self) -> dict:
         out = super().to_json()

@@ -20,7 +20,8 @@ import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from .._validate import integer, positive
+from .._checks import items
+from .._validate import boolean, integer, positive, record, text
 from ..budget import check_bytes
 from ..montecarlo import CONNECT_TIMEOUT_S, RUN_BYTES, parallel_options
 from ..report import Report
@@ -39,6 +40,9 @@ class Target:
     bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
     channels: tuple[str, ...] = ("image",)  #: channel sources it runs on (``fn(channel=...)``)
     lengths: bool = False  #: its drive can be lengthened (``fn(length=...)``)
+
+    def __post_init__(self) -> None:
+        record(self, positive=("default_runs", "bytes_per_run"))
 
 
 _REGISTRY: dict[str, Target] = {}
@@ -62,6 +66,10 @@ def register(
     takes ``channel=``. ``lengths``: its drive can be lengthened (its function takes
     ``length=``, metres).
     """
+    text("name", name), text("help", help), boolean("lengths", lengths)
+    integer("default_runs", default_runs, minimum=1)
+    integer("bytes_per_run", bytes_per_run, minimum=1)
+    [text(f"channels[{i}]", c) for i, c in enumerate(items("channels", channels, str))]
 
     def deco(fn):
         if name in _REGISTRY:

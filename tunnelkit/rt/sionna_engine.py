@@ -44,7 +44,7 @@ from pathlib import Path as FsPath
 
 import numpy as np
 
-from .._validate import integer, positive, vector
+from .._validate import boolean, choice, integer, positive, sequence, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from ..propagation import Path, Tunnel3D, arrival_angles
@@ -263,6 +263,7 @@ class SionnaEngine:
         """``(surface name, kind)`` of a Sionna object id (``("", "los")`` for none)."""
         from sionna.rt.constants import INVALID_SHAPE
 
+        object_id = integer("object_id", object_id)
         if int(object_id) == int(INVALID_SHAPE):
             return "", "los"
         return self._surface_by_id.get(int(object_id), (str(object_id), "surface"))
@@ -349,6 +350,8 @@ class SionnaEngine:
         first, then reflections by length). Paths off blocker boxes are dropped (the image method
         treats boxes as blockers only).
         """
+        [choice(f"kinds[{i}]", k, _ALL_KINDS) for i, k in enumerate(sequence("kinds", kinds))]
+        boolean("front_only", front_only)
         if not isinstance(array, ArrayGeometry):
             raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
         ue = vector("ue", ue, 3)

@@ -230,11 +230,13 @@ CHECKS = Registry("placement check", "check(scenario) -> None")
 
 def register_tunnel(kind: str):
     """Decorator: ``builder(section, get)`` building a tunnel of ``[tunnel] kind = ...``."""
+    text("kind", kind)
     return TUNNELS.register(kind)
 
 
 def register_trajectory(kind: str):
     """Decorator: ``builder(section, get, tunnel) -> Trajectory`` for ``[trajectory] kind = ...``."""
+    text("kind", kind)
     return TRAJECTORIES.register(kind)
 
 

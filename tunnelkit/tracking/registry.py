@@ -44,6 +44,8 @@ import importlib
 from collections.abc import Callable
 from typing import Any
 
+from .._validate import text
+
 __all__ = ["families", "family", "get", "provide", "register"]
 
 _REG: dict[str, dict[str, Callable[..., Any]]] = {}
@@ -53,6 +55,7 @@ _PROVIDERS: dict[str, list[str]] = {}
 
 def provide(family_name: str, module: str) -> None:
     """Declare that importing ``module`` registers members of ``family_name``."""
+    text("family_name", family_name), text("module", module)
     _PROVIDERS.setdefault(family_name, [])
     if module not in _PROVIDERS[family_name]:
         _PROVIDERS[family_name].append(module)
@@ -60,6 +63,7 @@ def provide(family_name: str, module: str) -> None:
 
 def register(family_name: str, name: str):
     """Decorator registering ``obj`` as ``name`` in ``family_name``."""
+    text("family_name", family_name), text("name", name)
 
     def deco(obj):
         fam = _REG.setdefault(family_name, {})

@@ -163,6 +163,10 @@ def ukf_proposal_reference(
     A slow loop kept as the reference the vectorised :func:`ukf_proposal` is tested and
     benchmarked against. ``particles`` (N, 4) are the previous samples, ``covs`` (N, 4, 4) theirs.
     """
+    particles = finite_array("particles", particles, ndim=2)
+    covs = finite_array("covs", covs, shape=(len(particles), STATE_DIM, STATE_DIM))
+    if particles.shape[1] != STATE_DIM:
+        raise ValueError(f"particles: expected shape (N, {STATE_DIM}), got {particles.shape}")
     out_m = np.empty_like(particles)
     out_P = np.empty_like(covs)
     for i in range(particles.shape[0]):

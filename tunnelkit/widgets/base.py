@@ -8,7 +8,7 @@ from typing import Any
 import ipywidgets as widgets
 import plotly.graph_objects as go
 
-from .._validate import boolean, integer, positive, real, text
+from .._validate import boolean, callable_, integer, positive, real, text
 
 __all__ = ["Explorer", "checkbox", "float_slider", "int_slider", "slider_value"]
 
@@ -116,7 +116,10 @@ class Explorer:
         *,
         columns: int = 3,
     ) -> None:
-        self.callback = callback
+        self.callback = callable_("callback", callback)
+        if not isinstance(controls, Mapping):
+            raise TypeError(f"controls: expected a mapping name -> widget, got {controls!r:.40}")
+        integer("columns", columns, minimum=1)
         self.controls = dict(controls)
         self.figure = go.FigureWidget(callback(**self.values))
         for w in self.controls.values():

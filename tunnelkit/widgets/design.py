@@ -25,7 +25,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import design
-from .._validate import integer, positive, probability, real
+from .._validate import integer, positive, probability, real, text
 from ..plots.design import route_figure
 from .base import Explorer, checkbox, float_slider, int_slider
 
@@ -163,6 +163,9 @@ class DesignExplorer(Explorer):
         target: float = 0.2,
         share: float = 0.9,
     ) -> None:
+        text("scenario", scenario), integer("runs", runs, minimum=1)
+        integer("seed", seed, minimum=0), positive("target", target)
+        probability("share", share, open_interval=False)
         super().__init__(callback, controls, columns=3)
         self.scenario, self.runs, self.seed = scenario, runs, seed
         self.target, self.share = target, share

@@ -6,14 +6,23 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
+from .._checks import attributes
+from .._validate import choice, integer
 from ..plots.javelin import epoch_figure
 from .base import Explorer, int_slider
 
 __all__ = ["epoch_explorer", "epoch_view"]
 
 
+def _drive_and_evaluation(drive, evaluation) -> None:
+    attributes("drive", drive, ("truth", "sources", "base_station"), "a studies.DriveData")
+    attributes("evaluation", evaluation, ("run",), "a studies.Evaluation")
+
+
 def epoch_view(drive, evaluation, k: int, plane: str = "yz") -> go.Figure:
     """Pure callback: the figure of epoch ``k`` of ``evaluation`` (with reports) on ``drive``."""
+    _drive_and_evaluation(drive, evaluation)
+    integer("k", k, minimum=0), choice("plane", plane, ("yz", "xy"))
     reps = evaluation.run.reports if evaluation.run is not None else []
     if not reps:
         raise ValueError("evaluation: run the tracker with keep_reports=True to explore epochs")
@@ -26,6 +35,8 @@ def epoch_view(drive, evaluation, k: int, plane: str = "yz") -> go.Figure:
 
 def epoch_explorer(drive, evaluation, *, k: int = 0) -> Explorer:
     """A slider over epochs and a cross-section / top-view switch around :func:`epoch_view`."""
+    _drive_and_evaluation(drive, evaluation)
+    integer("k", k, minimum=0)
     import ipywidgets as widgets
 
     n = len(evaluation.run.reports) if evaluation.run is not None else 1

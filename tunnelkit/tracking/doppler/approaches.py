@@ -11,11 +11,12 @@ averaged over seeded drives.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import instance, positive, record
+from ..._validate import instance, integer, positive, record, sequence, text
 from ...drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
 from ..registry import family, register
 from .filters import (
@@ -317,6 +318,8 @@ def error_study(
 
     Keys ``(approach, sigma label)``; all settings see the same measurements and GNSS fix.
     """
+    if sigmas is not None and not isinstance(sigmas, Mapping):
+        raise TypeError(f"sigmas: expected a mapping label -> sigma [Hz], got {sigmas!r:.40}")
     sigmas = SIGMAS if sigmas is None else dict(sigmas)
     meas = measure(drive, rng)
     fix = gnss_fix(drive, rng)
@@ -342,7 +345,8 @@ def mean_errors(
     Each seed gives one noise realisation and GNSS fix (``numpy.random.default_rng(seed)``) shared
     by all approaches; extra keywords (``gate``, ``adaptive_form``, ...) go to the trackers.
     """
-    seeds = [int(s) for s in seeds]
+    seeds = [integer(f"seeds[{i}]", s, minimum=0) for i, s in enumerate(sequence("seeds", seeds))]
+    [text(f"approaches[{i}]", a) for i, a in enumerate(sequence("approaches", approaches))]
     if not seeds:
         raise ValueError("seeds: give at least one seed")
     acc: dict[str, list[float]] = {name: [] for name in approaches}

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from ..._checks import unchecked
 from ..._validate import finite_array, instance, record
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate, mahalanobis2
@@ -86,7 +87,7 @@ def association_costs(
     L, n = pred.shape[0], len(meas)
     if n == 0 or L == 0:
         e = np.zeros((L, n))
-        return AssociationCosts(e, np.zeros(n, int), e.astype(bool), np.zeros(n))
+        return unchecked(AssociationCosts, e, np.zeros(n, int), e.astype(bool), np.zeros(n), e)
     H3 = J[:, :3, :]
     R3 = np.asarray(R3, dtype=float)
     per_path = R3.ndim == 3  # (n, 3, 3): each path's reported covariance
@@ -106,13 +107,14 @@ def association_costs(
     thr = np.array([gate.threshold(int(k)) for k in dof])
     gated = np.isfinite(eta2) & (eta2 < thr)  # ChiSquareGate.accepts with the quantiles at hand
     if cost == "mahalanobis":
-        return AssociationCosts(eta2, dof, gated, thr)
+        return unchecked(AssociationCosts, eta2, dof, gated, thr, eta2)
     if cost != "likelihood":
         raise ValueError(f"cost: expected 'mahalanobis' or 'likelihood', got {cost!r}")
     # ln det over the components every pair carries (the angles): a far-field path has no
     # curvature row, and ln det of the full S would hand it a bonus of -ln S_kappa (about -11 at
     # a curvature sigma of 300 m), enough to take a track's path from the LoS it predicts
-    return AssociationCosts(eta2, dof, gated, thr, eta2 + np.linalg.slogdet(S[..., :2, :2])[1])
+    lndet = np.linalg.slogdet(S[..., :2, :2])[1]
+    return unchecked(AssociationCosts, eta2, dof, gated, thr, eta2 + lndet)
 
 
 def greedy_nearest_neighbour(costs: AssociationCosts) -> list[tuple[int, int]]:

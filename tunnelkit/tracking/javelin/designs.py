@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._validate import sequence
 from .associate import Associator
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, VueCurvature
@@ -226,7 +227,7 @@ def design_from_errors(rows: list[list], base: JavelinDesign | None = None) -> J
     base = ours_coherent() if base is None else base
     if not isinstance(base, JavelinDesign):
         raise TypeError(f"base: expected a JavelinDesign, got {type(base).__name__}")
-    pooled = {r[0]: r for r in rows}.get("all")
+    pooled = {r[0]: r for r in sequence("rows", rows)}.get("all")
     if pooled is None:
         raise ValueError("rows: expected the table of extraction_errors (an 'all' row)")
     return base.with_(

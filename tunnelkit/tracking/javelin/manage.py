@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._checks import series
+from ..._checks import series, unchecked
 from ..._checks import sign as check_sign
 from ..._validate import instance, integer, positive, real, record, sequence, vector
 from .config import JavelinConfig
@@ -305,4 +305,6 @@ def manage_tracks(
             dynamic.append(tid)
         if initiator.update_at_birth:
             pairs.append((state.n_vue, j))
-    return ManageResult(sorted(pairs), los_path is not None, los_path, born, dead, dynamic, unborn)
+    return unchecked(
+        ManageResult, sorted(pairs), los_path is not None, los_path, born, dead, dynamic, unborn
+    )

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._checks import series
+from ..._checks import series, unchecked
 from ..._validate import boolean, finite_array, nonnegative, real, vector
 from ...geometry import spherical_jacobian
 from .state import vue_positions
@@ -162,14 +162,19 @@ class PathMeasurements:
 
         ``source`` keeps pointing into the original input."""
         real("min_d", min_d)
-        clean = PathMeasurements.from_arrays(
-            self.phi, self.psi, self.kappa, self.d, self.v, warn=False, min_d=min_d
-        )
-        if self.reported:
-            clean.cov, clean.sigma_d = self.cov[clean.source], self.sigma_d[clean.source]
-            if self.bias_cov is not None:
-                clean.bias_cov = self.bias_cov[clean.source]
-        clean.source = self.source[clean.source]
+        # this record's fields were checked when it was built: Algorithm 1's tests alone (what
+        # from_arrays does after its checks), the kept paths a record built unchecked (the
+        # tracker sanitises every epoch's paths)
+        keep = np.isfinite(self.phi) & np.isfinite(self.psi) & ~(self.d < min_d)
+        idx = np.flatnonzero(keep)
+        kappa = np.where(np.isfinite(self.kappa) & (self.kappa > 0), self.kappa, np.nan)
+        d = np.where(np.isfinite(self.d), self.d, np.nan)
+        v = np.where(np.isfinite(self.v), self.v, np.nan)
+        sub = [None if a is None else a[idx] for a in (self.cov, self.sigma_d, self.bias_cov)]
+        clean = unchecked(
+            PathMeasurements, self.phi[idx], self.psi[idx], kappa[idx], d[idx], v[idx],
+            self.source[idx], *sub,
+        )  # fmt: skip
         return clean, len(self) - len(clean)
 
     @classmethod

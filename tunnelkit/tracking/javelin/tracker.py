@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..._checks import attributes, optional_real
+from ..._checks import attributes, optional_real, unchecked
 from ..._validate import boolean, finite_array, nonnegative, positive, record, rng_or_error, vector
 from ..gating import ChiSquareGate
 from .associate import AssociationCosts
@@ -382,7 +382,9 @@ class Javelin:
             mres = manage_tracks(st, meas, [], cfg, initiator=roles.initiator, noise=roles.noise)
         for f in faults:
             warnings.warn(f"epoch {self.k}: {f}", JavelinWarning, stacklevel=2)
-        rep = StepReport(
+        # the report holds what the step computed (checked at its boundary): built unchecked
+        rep = unchecked(
+            StepReport,
             self.k,
             prior_pos,
             prior_ids,

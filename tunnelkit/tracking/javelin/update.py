@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
+from ..._checks import unchecked
 from ..._validate import finite_array, instance, integer, probability, record, sequence
 from ...crlb import wrap_angle
 from ..gating import ChiSquareGate
@@ -172,7 +173,9 @@ def stack_measurement(
         for r, terms in enumerate(brow):
             for i, j, c, sign in terms:
                 B[r, 4 * i : 4 * i + 4] += sign * Lf[j, c]
-    return StackedMeasurement(
+    # rows computed here from checked arguments: the record built unchecked (the step's loop)
+    return unchecked(
+        StackedMeasurement,
         np.asarray(z, float),
         np.asarray(h, float),
         np.asarray(H, float).reshape(K, D),
