@@ -1,7 +1,9 @@
 """Benchmark runner: ``make bench`` (or ``python benchmarks/run.py [-k PATTERN] [--json FILE]``).
 
-Every ``benchmarks/bench_*.py`` defines ``cases() -> list[Case]`` (and may define
-``report() -> str``, an accuracy table printed after the timings). Each case is timed with
+Every timed ``benchmarks/bench_*.py`` defines ``cases() -> list[Case]`` (and may define
+``report() -> str``, an accuracy table printed after the timings). A ``bench_*.py`` without
+``cases()`` is a study script run on its own (``python benchmarks/bench_rt_track.py --help``): the
+runner lists it and does not import it. Each case is timed with
 ``timeit`` (repeats after a warm-up); we report the median and the interquartile range, and within
 a ``group`` the ratio of every case to the group's ``baseline`` case, all measured in the same run.
 Benchmarks are not tests: nothing here asserts a time.
@@ -10,6 +12,7 @@ Benchmarks are not tests: nothing here asserts a time.
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib.util
 import json
 import statistics
@@ -37,9 +40,17 @@ class Case:
     warmup: bool = True
 
 
-def _load_cases(pattern: str | None) -> list[Case]:
+def is_timed(path: Path) -> bool:
+    """True when the module at ``path`` defines a top-level ``cases()`` (a study script does not)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    return any(isinstance(n, ast.FunctionDef) and n.name == "cases" for n in tree.body)
+
+
+def _load_cases(pattern: str | None, where: Path = HERE) -> list[Case]:
     cases: list[Case] = []
-    for path in sorted(HERE.glob("bench_*.py")):
+    for path in sorted(where.glob("bench_*.py")):
+        if not is_timed(path):
+            continue
         spec = importlib.util.spec_from_file_location(path.stem, path)
         mod = importlib.util.module_from_spec(spec)
         sys.modules[path.stem] = mod
@@ -49,6 +60,11 @@ def _load_cases(pattern: str | None) -> list[Case]:
             if pattern is None or pattern in c.name or pattern in c.group:
                 cases.append(c)
     return cases
+
+
+def study_scripts(where: Path = HERE) -> list[str]:
+    """The ``bench_*.py`` study scripts (no ``cases()``), run on their own."""
+    return [p.name for p in sorted(where.glob("bench_*.py")) if not is_timed(p)]
 
 
 def main(argv=None) -> int:
@@ -97,6 +113,9 @@ def main(argv=None) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(results, indent=2))
     print(f"\nwritten {out}")
+    studies = study_scripts()
+    if studies:
+        print(f"study scripts, not timed here (run each on its own): {', '.join(studies)}")
     return 0
 
 
