@@ -346,3 +346,14 @@ def test_record_allow_inf_takes_plus_infinity_only():
     ):
         with pytest.raises(exc, match=r"^limit: "):
             Bound(bad)
+
+
+def test_indices_are_integers_in_range_and_name_the_parameter():
+    from tunnelkit._checks import indices
+
+    np.testing.assert_array_equal(indices("keep", [2, 0], 3), [2, 0])
+    assert indices("keep", [], 3).shape == (0,)
+    for bad, exc in [("01", TypeError), (np.array([np.nan]), TypeError), (5, TypeError),
+                     ([3], ValueError), ([-1], ValueError), ([[0, 1]], ValueError)]:  # fmt: skip
+        with pytest.raises(exc, match=r"^keep: "):
+            indices("keep", bad, 3)

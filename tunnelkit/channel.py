@@ -62,7 +62,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import choice, finite_array, integer, nonnegative, positive, real, rng_or_error
+from ._validate import (
+    choice,
+    finite_array,
+    integer,
+    nonnegative,
+    positive,
+    real,
+    rng_or_error,
+    sequence,
+)
 from .budget import check_elements
 from .constants import K_B, C, db2lin, dbm2watt
 
@@ -545,6 +554,7 @@ def tensor_snapshot(
     if H0.ndim != 3 or not np.all(np.isfinite(H0)):
         raise ValueError(f"H0: expected a finite 3-D tensor, got shape {H0.shape}")
     rng = rng_or_error("rng", rng)
+    paths = sequence("paths", paths, empty=True)  # empty: no true path recorded (the default)
     off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
     cal = _check_calibration(calibration, H0.shape[0])
     if clock_bias is None:

@@ -55,6 +55,8 @@ def channel_route_budget(setup: DesignSetup, spec, impairments) -> BiasBudget | 
     design reports that array's bound as undefined)."""
     from .achievable import DesignImpairments, path_error_model
 
+    instance("setup", setup, DesignSetup)
+    spec = parse_array(spec)
     if impairments is None:
         return None
     instance("impairments", impairments, DesignImpairments)

@@ -40,6 +40,7 @@ tensor.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from os import PathLike
 from pathlib import Path as FsPath
 
 import numpy as np
@@ -126,6 +127,8 @@ class SionnaEngine:
         max_num_paths_per_src: int | None = None,
         workdir=None,
     ) -> None:
+        if workdir is not None and not isinstance(workdir, str | PathLike):
+            raise TypeError(f"workdir: expected a directory name, got {type(workdir).__name__}")
         require_sionna()
         import sionna.rt as srt
 
@@ -146,8 +149,11 @@ class SionnaEngine:
             self.mitsuba = export_tunnel(tunnel, workdir)
         elif isinstance(tunnel, MitsubaScene):
             self.mitsuba = tunnel
-        elif isinstance(tunnel, (str, FsPath)):
-            self.mitsuba = read_scene(tunnel)
+        elif isinstance(tunnel, str | PathLike):
+            try:
+                self.mitsuba = read_scene(tunnel)
+            except SceneError as exc:  # name the parameter the file came in
+                raise SceneError(f"tunnel: {exc}") from None
         else:
             raise TypeError(
                 "tunnel: expected a propagation.Tunnel3D, a MitsubaScene or a path to "
@@ -263,7 +269,7 @@ class SionnaEngine:
         """``(surface name, kind)`` of a Sionna object id (``("", "los")`` for none)."""
         from sionna.rt.constants import INVALID_SHAPE
 
-        object_id = integer("object_id", object_id)
+        object_id = integer("object_id", object_id, minimum=0)
         if int(object_id) == int(INVALID_SHAPE):
             return "", "los"
         return self._surface_by_id.get(int(object_id), (str(object_id), "surface"))

@@ -8,7 +8,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import boolean, instance, record
+from .._checks import indices
+from .._validate import boolean, instance, nonnegative, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
 from ..evaluation import match_paths
@@ -127,6 +128,8 @@ def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
     :func:`reported_covariance`."""
     from ..propagation import SECOND_ORDER
 
+    paths = sequence("paths", paths, empty=True)  # empty: no true path recorded
+    instance("snap", snap, ChannelSnapshot)
     meas = measurements_from_estimates(est, array, config, min_d=min_d, judged=judged)
     truth = match_paths(meas.d, meas.direction, paths, clock_bias=snap.clock_bias)
     nuisance = [i for i, p in enumerate(paths) if p.kind == SECOND_ORDER]
@@ -165,8 +168,13 @@ def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig, judg
     Returns ``(None, None)`` when the Fisher information is singular at the estimate or, if
     ``judged``, the fit failed its own residual test (``fit.rho > fit.rho_max``: a wrong basin)."""
     from ..extraction import estimate_crlb
+    from ..extraction.estimates import PathEstimates
     from ..geometry import spherical_jacobian
 
+    instance("est", est, PathEstimates)
+    instance("array", array, ArrayGeometry)
+    instance("config", config, SRSConfig)
+    keep = indices("keep", keep, len(est.d))
     fit = getattr(est, "fit", None)
     if boolean("judged", judged) and fit is not None and not fit.rho <= fit.rho_max:
         return None, None
@@ -193,10 +201,14 @@ def measurements_from_estimates(
     ``config``, also the covariance the extraction reports (:func:`reported_covariance`, with
     ``judged``: False for a fit the route re-judged and passed)."""
     from ..extraction import algorithm1
+    from ..extraction.estimates import PathEstimates
 
+    instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
     if config is not None:
         instance("config", config, SRSConfig)
+    min_d = nonnegative("min_d", min_d)
+    judged = boolean("judged", judged)
     keep = algorithm1(est, min_d)
     u = array.dir_to_world(est.direction[keep]) if keep.size else np.zeros((0, 3))
     phi = np.arctan2(u[:, 1], u[:, 0])

@@ -263,6 +263,8 @@ class SignalRoute:
         cached noiseless tensor (LoS left out unless "los" is in ``kinds``), clock bias, this
         route's calibration and SNR offset, noise (:func:`tunnelkit.channel.tensor_snapshot`);
         ``paths`` (the true paths) are recorded in the snapshot."""
+        instance("arr", arr, ArrayGeometry)
+        paths = sequence("paths", paths, empty=True)  # empty: no true path recorded
         if self.raytraced is None:
             raise ValueError("channel: this route has no ray-traced channel (channel='image')")
         name, H0 = self.raytraced.tensor(
@@ -360,6 +362,12 @@ class SignalRoute:
         """The model-error test of a flagged ML fit (``model_error_floor``; None when there is
         nothing to re-judge: the floor off or zero, the fit passed or is not an ML fit, the
         extraction modelled the wideband term)."""
+        from ..extraction.estimates import PathEstimates
+
+        instance("est", est, PathEstimates)
+        instance("snap", snap, ChannelSnapshot)
+        instance("arr", arr, ArrayGeometry)
+        instance("extract_kw", extract_kw, dict)
         if not self.model_error_floor or getattr(est, "fit_ok", None) is not False:
             return None
         if getattr(est, "fit", None) is None or extract_kw.get("wideband", False):
