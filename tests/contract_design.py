@@ -69,8 +69,7 @@ def design_modes():
 
 def design_sweep():
     """The Monte-Carlo and the sweep on a few epochs, one run (``javelin_rmse``, a channel-route
-    Monte-Carlo of at least two drives, takes seconds; the sweep's report records are left out
-    too, ``design/report.py`` being at the module size limit: no room for their checks)."""
+    Monte-Carlo of at least two drives, takes seconds)."""
     from tunnelkit import design
     from tunnelkit.design import montecarlo, report
 

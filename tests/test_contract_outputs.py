@@ -140,3 +140,21 @@ def test_parse_array_names_spec_and_the_design_functions_pass_it_on(setup):
         design.path_bounds(setup, 8)
     with pytest.raises(ValueError, match=r"^mount_height: "):
         setup.variant(mount_height=-1.0)
+
+
+def test_a_design_row_refuses_impossible_statistics_and_keeps_never_met():
+    row = design.DesignRow("4x4", 16, 0.02, peb_median_m=np.inf, x_m=np.arange(3.0),
+                           peb_m=np.array([0.1, np.inf, np.nan]), error_p90_ci95_m=[0.1, np.inf])  # fmt: skip
+    assert np.isinf(row.peb_median_m) and row.to_json()["peb_median_m"] is None
+    for field, bad in [("runs", -1), ("rmse_m", -0.1), ("met_share", np.nan), ("n_elements", 0),
+                       ("error_p90_ci95_m", [0.1]), ("status", ""), ("array", 3)]:  # fmt: skip
+        with pytest.raises((TypeError, ValueError), match=rf"^{field}: "):
+            design.DesignRow(**{"array": "4x4", "n_elements": 16, "aperture_diagonal_m": 0.02,
+                                field: bad})  # fmt: skip
+    with pytest.raises(ValueError, match=r"^peb_m: "):  # one value per x
+        design.DesignRow("4x4", 16, 0.02, x_m=np.arange(3.0), peb_m=np.ones(2))
+    assert design.DesignReport("x", [row], {}, {}).warnings == []
+    for rows in ([], [row, "8x8"]):
+        with pytest.raises((TypeError, ValueError), match=r"^rows(\[1\])?: "):
+            design.DesignReport("x", rows, {}, {})
+    assert design.report.DesignRow is design.records.DesignRow  # the same record, re-exported

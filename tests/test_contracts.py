@@ -451,7 +451,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "values of any shape pooled / (..., T) gated epoch by epoch (each docstring's contract)",
     ),
     _doc(
-        r"design\.report\.over_target",
+        r"design\.(report|records)\.over_target",
         r"y",
         "nan",
         "a non-finite value counts as over the target (the docstring's contract)",
@@ -557,6 +557,49 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"kappa",
         "negative",
         "kappa = 3 - n < 0 is the classic choice",
+    ),
+    _doc(
+        r"channel\.tensor_snapshot|signal_route\.measurements\.measure_epoch"
+        r"|signal_route\.route\.SignalRoute\.raytraced_snapshot",
+        r"paths",
+        "empty",
+        "no true path recorded in the snapshot (tensor_snapshot's default)",
+    ),
+    _doc(
+        r"signal_route\.measurements\.RouteMeasurements",
+        r"kappa",
+        "nan",
+        "NaN is the curvature of a far-field path (no wave origin to report)",
+    ),
+    _doc(
+        r"signal_route\.measurements\.RouteMeasurements",
+        r"array",
+        "empty",
+        "the array's label: an unnamed ArrayGeometry (its default name) is measured too",
+    ),
+    _doc(
+        r"design\.(report|records|confirm)\.(DesignReport|ConfirmedReport)",
+        r"warnings",
+        "empty",
+        "no warning to report",
+    ),
+    _doc(
+        r"design\.records\.DesignRow",
+        r"reason",
+        "empty",
+        "no reason to give (the default: a row with a verdict says why only when it has to)",
+    ),
+    _doc(
+        r"design\.verdict\.recommend",
+        r"rows",
+        "empty",
+        "no candidate left (every array failed, or none to confirm): none is recommended, with why",
+    ),
+    _doc(
+        r"design\.confirm\.ConfirmedReport",
+        r"confirmation",
+        "empty",
+        "no candidate left to confirm on the channel route (confirm_report's own case)",
     ),
     _doc(
         r"fresnel\.bounds\.aperture",
