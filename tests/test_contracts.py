@@ -85,7 +85,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(r".*\.bias_slice", r"i", "zero huge", "track 0 is the UE; any track index"),
     _doc(
         r"plots\.(common|tables|tracking|javelin|design|doppler|efficiency|tunnel3d)\..*",
-        r"title|xaxis|yaxis",
+        r"title|subtitle|xaxis|yaxis",
         "empty",
         "an empty title or axis label shows none (the default)",
     ),
@@ -582,6 +582,12 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"warnings",
         "empty",
         "no warning to report",
+    ),
+    _doc(
+        r"plots\.tunnel3d\.tunnel3d_figure",
+        r"arrays|paths",
+        "empty",
+        "the tunnel alone: no array or no path to draw (the defaults)",
     ),
     _doc(
         r"design\.records\.DesignRow",

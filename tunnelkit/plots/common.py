@@ -7,7 +7,7 @@ from collections.abc import Mapping
 import numpy as np
 import plotly.graph_objects as go
 
-from .._validate import boolean, finite_array, text
+from .._validate import boolean, finite_array, instance, text
 from ..metrics import ecdf
 
 __all__ = ["COLORS", "cdf_figure", "line_figure", "reveal_overlaps"]
@@ -45,6 +45,18 @@ def _close(u, v) -> bool:
     both = both[np.isfinite(both)]
     span = float(np.ptp(both)) if both.size else 0.0
     return bool(np.allclose(u, v, rtol=0, atol=3e-3 * span + 1e-300, equal_nan=True))
+
+
+def figure_inputs(*, texts: Mapping | None = None, mappings: Mapping | None = None) -> None:
+    """The checks at the top of a figure function, by parameter name: ``texts`` titles and labels
+    (text; empty shows none; ``None`` the default), ``mappings`` name -> series tables (a dict;
+    ``None`` for none). Errors name the parameter."""
+    for name, value in (texts or {}).items():
+        if value is not None:
+            text(name, value, empty=True)
+    for name, value in (mappings or {}).items():
+        if value is not None:
+            instance(name, value, Mapping, "a mapping (a dict)")
 
 
 def reveal_overlaps(fig: go.Figure) -> go.Figure:

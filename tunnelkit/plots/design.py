@@ -9,7 +9,9 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
-from .common import COLORS
+from .._checks import attributes
+from .._validate import positive, sequence, text
+from .common import COLORS, figure_inputs
 
 __all__ = ["route_figure", "route_traces", "size_figure"]
 
@@ -49,6 +51,10 @@ def route_traces(
     (``{"0.5° phase error": design.AchievableBound, ...}``), then the target line (if given), then
     one mismatch trace per surface kind and the ``eps_phi`` line on (x, y2).
     """
+    attributes("bounds", bounds, ("x", "peb", "srnf_valid", "spec"), "a design.RouteBounds")
+    figure_inputs(mappings={"variants": variants, "achievable": achievable})
+    if target is not None:
+        positive("target", target)
     x = bounds.x
     peb_cm = 100 * bounds.peb
     bad = ~bounds.srnf_valid
@@ -151,6 +157,7 @@ def route_figure(
 
     ``layout.meta`` carries ``meta`` (for tests and lecture scripts).
     """
+    figure_inputs(texts={"title": title, "subtitle": subtitle}, mappings={"meta": meta})
     layout = {
         "title": {"text": title, "subtitle": {"text": subtitle}, "x": 0.01, "xanchor": "left"},
         "height": 620,
@@ -191,6 +198,12 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
     ``rows``: :class:`tunnelkit.design.DesignRow` list (one sweep). ``mark`` highlights one
     array label (the paper's 10 x 10) when present.
     """
+    rows = sequence("rows", rows)
+    for i, r in enumerate(rows):
+        attributes(f"rows[{i}]", r, ("array", "n_elements", "peb_median_m"), "a design.DesignRow")
+    if mark is not None:
+        text("mark", mark)
+    figure_inputs(texts={"title": title})
     n = np.array([r.n_elements for r in rows])
     labels = [r.array for r in rows]
     med = 100 * np.array([r.peb_median_m for r in rows])

@@ -8,11 +8,11 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from .._validate import instance, text
+from .._validate import instance, sequence, text
 from ..constants import C
 from ..drive import DopplerToaMeasurements, Drive
 from ..metrics import ecdf
-from .common import reveal_overlaps
+from .common import figure_inputs, reveal_overlaps
 
 __all__ = [
     "APPROACH_COLORS",
@@ -178,6 +178,7 @@ def doppler_delay_figure(drive, meas=None) -> go.Figure:
 
 def profiles_figure(profiles: Mapping[str, np.ndarray]) -> go.Figure:
     """Synthetic power-delay and Doppler power profiles over time (the paper's Fig. 2)."""
+    figure_inputs(mappings={"profiles": profiles})
     fig = make_subplots(
         rows=1, cols=2, subplot_titles=("(a) power-delay profile", "(b) Doppler power profile")
     )
@@ -212,6 +213,8 @@ def profiles_figure(profiles: Mapping[str, np.ndarray]) -> go.Figure:
 
 def error_time_figure(drive, tracks: Mapping[str, np.ndarray], *, title: str = "") -> go.Figure:
     """Fig. 3 in synthetic form: (a) along-track and (b) lateral error, (c) position error over time."""
+    instance("drive", drive, Drive)
+    figure_inputs(texts={"title": title}, mappings={"tracks": tracks})
     fig = make_subplots(
         rows=3,
         cols=1,
@@ -266,6 +269,8 @@ def approach_cdfs(
     The panels (one per approach) share their x range; a line's colour and dash name its sigma,
     the same in every panel, so the legend (one entry per sigma) reads for all three.
     """
+    figure_inputs(mappings={"errors": errors, "paper_p90": paper_p90})
+    approaches = sequence("approaches", approaches)
     fig = make_subplots(
         rows=1,
         cols=len(approaches),
@@ -323,6 +328,8 @@ def approach_cdfs(
 
 def pcrlb_figure(drive, bounds: Mapping[str, np.ndarray], *, title: str = "") -> go.Figure:
     """sqrt of the posterior CRLB of x (along) and y (across) over time, one line per setting."""
+    instance("drive", drive, Drive)
+    figure_inputs(texts={"title": title}, mappings={"bounds": bounds})
     fig = make_subplots(
         rows=1,
         cols=2,
@@ -364,6 +371,7 @@ def information_figure(
     drive, setup, *, sigma_hz: float = 32.79, sigma_range: float = 1.0
 ) -> go.Figure:
     """Fisher information of one epoch on x and y (velocity known) along the drive: Doppler vs ToA."""
+    instance("drive", drive, Drive)
     from ..tracking.doppler import snapshot_fim
 
     idx = np.arange(0, len(drive.t), 4)
@@ -405,6 +413,8 @@ def information_figure(
 
 def regime_figure(settings, means: Mapping[str, np.ndarray], *, title: str = "") -> go.Figure:
     """Grouped bars: mean error of each approach (``means[name]``, one per setting) per setting."""
+    settings = sequence("settings", settings)
+    figure_inputs(texts={"title": title}, mappings={"means": means})
     fig = go.Figure()
     for name, vals in means.items():
         fig.add_bar(

@@ -5,6 +5,9 @@ from __future__ import annotations
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from .._validate import sequence, text
+from .common import figure_inputs
+
 __all__ = ["efficiency_figure"]
 
 #: one colour and a readable name per extraction route
@@ -20,6 +23,9 @@ ROUTE_STYLE = {
 def efficiency_figure(rows: list[dict], path: str = "los", *, title: str = "") -> go.Figure:
     """Direction (left) and curvature (right) RMSE against range, one line per route, the CRLB
     dashed; ``rows`` from :func:`tunnelkit.efficiency.drive_efficiency`, ``path`` a surface kind."""
+    rows = sequence("rows", rows)
+    path = text("path", path)
+    figure_inputs(texts={"title": title})
     from ..efficiency import efficiency_rows
 
     data = efficiency_rows(rows, path)

@@ -8,8 +8,17 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import plotly.graph_objects as go
 
-from .._validate import finite_array, integer, nonnegative_array, text, vector
-from .common import COLORS
+from .._checks import attributes
+from .._validate import (
+    choice,
+    finite_array,
+    integer,
+    nonnegative_array,
+    sequence,
+    text,
+    vector,
+)
+from .common import COLORS, figure_inputs
 from .tables import TableFigure, table
 
 __all__ = ["epoch_figure", "javelin_table_figure", "tracks_count_figure", "trajectories_figure"]
@@ -116,6 +125,14 @@ def epoch_figure(
     ``Intersection``), association lines, births (green) and deaths (red crosses), and the
     posterior positions. ``plane="xy"`` gives the top view of the same.
     """
+    attributes("report", report, ("prior_positions", "prior_cov"), "a javelin StepReport")
+    if truth is not None:
+        truth = vector("truth", truth, 3)
+    base_station = vector("base_station", base_station, 3)
+    if true_vues is not None:
+        true_vues = sequence("true_vues", true_vues, empty=True)
+    plane = choice("plane", plane, ("yz", "xy"))
+    figure_inputs(texts={"title": title})
     from ..tracking.javelin.manage import intersection
 
     ax = (1, 2) if plane == "yz" else (0, 1)

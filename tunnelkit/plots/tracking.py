@@ -8,8 +8,9 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from .._validate import finite_array, nonnegative_array, sequence, text
-from .common import COLORS, line_figure, reveal_overlaps
+from .._checks import attributes
+from .._validate import finite_array, integer, nonnegative_array, positive, sequence, text
+from .common import COLORS, figure_inputs, line_figure, reveal_overlaps
 from .tables import TableFigure, table
 from .topview import tunnel_topview
 
@@ -34,6 +35,11 @@ def tracks_figure(
 ) -> go.Figure:
     """Top view with the true track and each estimator's track; a slider (and play button) moves
     one marker per estimator along time. ``truth`` (T, >=2), ``estimates`` name -> (T, >=2)."""
+    attributes("tunnel", tunnel, ("to_tunnel_frame",), "a tunnel (geometry.Tunnel2D)")
+    truth = finite_array("truth", truth, ndim=2)
+    figure_inputs(texts={"title": title}, mappings={"estimates": estimates})
+    period = positive("period", period)
+    every = integer("every", every, minimum=1)
     truth = np.asarray(truth)[:, :2]
     lo, hi = tunnel.to_tunnel_frame(truth)[:, 0][[0, -1]]
     fig = tunnel_topview(tunnel, base_station, along=(min(lo, -5.0) - 10, hi + 15), title=title)
@@ -191,6 +197,9 @@ def particle_cloud_figure(
 ) -> go.Figure:
     """One panel per snapshot ``{"k", "t", "particles" (N, >=2), "weights" (N,), "truth" (2,),
     "estimate" (2,)}``; marker area follows the weight. Axes span ``half_width`` around the truth."""
+    snapshots = sequence("snapshots", snapshots)
+    figure_inputs(texts={"title": title})
+    half_width = positive("half_width", half_width)
     fig = make_subplots(
         rows=1,
         cols=len(snapshots),

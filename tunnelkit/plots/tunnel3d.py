@@ -9,7 +9,9 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from .._validate import finite_array, interval, nonnegative, sequence, text
+from .._checks import attributes
+from .._validate import finite_array, integer, interval, nonnegative, sequence, text, vector
+from .common import figure_inputs
 from .tables import TableFigure, table
 
 __all__ = [
@@ -62,6 +64,14 @@ def tunnel3d_figure(
     Each path is drawn UE -> reflection point -> array reference antenna, coloured by family.
     ``x_range`` crops the drawn tunnel along x (facets are clipped to it).
     """
+    attributes("tunnel", tunnel, ("facets", "x_range"), "a propagation.Tunnel3D")
+    arrays = sequence("arrays", arrays, empty=True)  # empty: the tunnel alone
+    paths = sequence("paths", paths, empty=True)
+    if ue is not None:
+        ue = vector("ue", ue, 3)
+    if x_range is not None:
+        x_range = interval("x_range", x_range)
+    figure_inputs(texts={"title": title})
     fig = go.Figure()
     xr = tunnel.x_range if x_range is None else x_range
     for i, f in enumerate(tunnel.facets):
@@ -166,6 +176,14 @@ def factors_figure(
     title: str = "Phase [rad] of the CPD factor matrices (normalised, eq. 12-13)",
 ) -> go.Figure:
     """Phase of the three factor matrices: spatial (unwrapped, per path), frequency, time."""
+    factors = sequence("factors", factors)
+    if len(factors) != 3:
+        raise ValueError(f"factors: expected the three factor matrices, got {len(factors)}")
+    if shape is not None:
+        shape = tuple(integer("shape", n, minimum=1) for n in sequence("shape", shape))
+    if unwrapped is not None:
+        unwrapped = finite_array("unwrapped", unwrapped, ndim=2)
+    figure_inputs(texts={"title": title})
     bs, bf, bt = factors
     fig = make_subplots(
         rows=1,
