@@ -584,6 +584,13 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no warning to report",
     ),
     _doc(
+        r"evaluation\.(path_rows|comparison_rows)",
+        r"paths",
+        "empty",
+        "no true path: an empty table, or every estimate unmatched",
+    ),
+    _doc(r"evaluation\.comparison_rows", r"clock_bias", "negative", "a clock offset: either sign"),
+    _doc(
         r"plots\.tunnel3d\.tunnel3d_figure",
         r"arrays|paths",
         "empty",

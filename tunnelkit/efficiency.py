@@ -16,7 +16,8 @@ import warnings
 
 import numpy as np
 
-from ._validate import integer
+from ._checks import attributes
+from ._validate import boolean, finite_array, integer, sequence, text
 
 __all__ = ["drive_efficiency", "efficiency_rows", "mie_threshold_db", "threshold_study"]
 
@@ -62,11 +63,13 @@ def drive_efficiency(
     from .extraction import path_crlb
     from .montecarlo import spawn_rngs
 
+    attributes("route", route, ("paths", "config"), "a signal_route.SignalRoute")
+    progress = boolean("progress", progress)
     epochs = [integer("epochs", k, minimum=0) for k in np.atleast_1d(epochs).tolist()]
     if not epochs:
         raise ValueError("epochs: need at least one epoch")
     n = integer("n_snapshots", n_snapshots, minimum=1)
-    refines = tuple(refines)
+    refines = tuple(sequence("refines", refines, empty=True))
     if not refines:
         raise ValueError("refines: need at least one route")
     it = list(zip(epochs, spawn_rngs(seed, len(epochs))))
@@ -106,6 +109,8 @@ def efficiency_rows(rows: list[dict], path: str = "los") -> dict[str, dict[str, 
     """:func:`drive_efficiency` rows of one path kind regrouped per route for plotting:
     ``{route: {"range", "dir", "kappa", "crlb_dir", "crlb_kappa"}}`` sorted by range (the first
     path of that kind in each epoch)."""
+    rows = sequence("rows", rows)
+    path = text("path", path)
     out: dict[str, dict[str, list]] = {}
     seen = set()
     for r in rows:
@@ -152,8 +157,13 @@ def threshold_study(
     from .extraction import path_crlb
     from .montecarlo import spawn_rngs
 
+    attributes("route", route, ("paths", "config"), "a signal_route.SignalRoute")
+    progress = boolean("progress", progress)
     epochs = [integer("epochs", k, minimum=0) for k in np.atleast_1d(epochs).tolist()]
-    offsets = [float(o) for o in np.atleast_1d(np.asarray(snr_offsets_db, float))]
+    offsets = np.atleast_1d(finite_array("snr_offsets_db", snr_offsets_db))
+    if offsets.ndim != 1:
+        raise ValueError(f"snr_offsets_db: expected a list of offsets, got shape {offsets.shape}")
+    offsets = offsets.tolist()
     if not epochs or not offsets:
         raise ValueError("epochs, snr_offsets_db: need at least one of each")
     if not np.all(np.isfinite(offsets)):

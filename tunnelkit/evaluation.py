@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validate import finite_array, positive, real
+from ._checks import attributes
+from ._validate import boolean, finite_array, instance, integer, positive, real, sequence
 from .arrays import ArrayGeometry
 from .constants import C
 
@@ -93,6 +94,25 @@ def match_points(
     return out
 
 
+def _truth_and_bound(est, d_true, v_true, sources, bound):
+    """The checked inputs of :func:`normalized_errors` / :func:`bound_errors`: ``sources``
+    (L, 3) finite, ``d_true`` and ``v_true`` (L,) finite, ``bound`` a dict of (L,) arrays."""
+    from .extraction.estimates import PathEstimates
+
+    instance("est", est, PathEstimates)
+    src = np.atleast_2d(finite_array("sources", sources))
+    if src.ndim != 2 or src.shape[1] != 3:
+        raise ValueError(f"sources: expected wave origins (L, 3), got shape {src.shape}")
+    n = src.shape[0]
+    d_true = finite_array("d_true", d_true, ndim=1)
+    v_true = finite_array("v_true", v_true, ndim=1)
+    for name, x in (("d_true", d_true), ("v_true", v_true)):
+        if x.shape != (n,):
+            raise ValueError(f"{name}: expected one value per source ({n}), got shape {x.shape}")
+    instance("bound", bound, dict, "a dict of standard deviations")
+    return src, d_true, v_true
+
+
 def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     """Errors over the CRLB standard deviation, (L_true, 4) for ``d, v, direction, kappa``.
 
@@ -104,7 +124,7 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     of a near-field path gets ``inf`` in the kappa column. The direction error is the angle
     between the unit vectors (non-negative).
     """
-    src = np.atleast_2d(np.asarray(sources, float))
+    src, d_true, v_true = _truth_and_bound(est, d_true, v_true, sources, bound)
     rng_ = np.linalg.norm(src, axis=1)
     u = src / rng_[:, None]
     out = np.full((src.shape[0], 4), np.inf)
@@ -141,7 +161,7 @@ def bound_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     """
     from scipy.optimize import linear_sum_assignment
 
-    src = np.atleast_2d(np.asarray(sources, float))
+    src, d_true, v_true = _truth_and_bound(est, d_true, v_true, sources, bound)
     rng_ = np.linalg.norm(src, axis=1)
     u = src / rng_[:, None]
     out = np.full((src.shape[0], 4), np.inf)
@@ -289,6 +309,7 @@ def random_scene(
 
 def path_rows(paths) -> list[dict]:
     """One table row per true path: family, surface, length, angles [deg], Doppler, gain, kappa."""
+    paths = sequence("paths", paths, empty=True)  # no path: an empty table
     return [
         {
             "kind": p.surface_kind,
@@ -307,6 +328,12 @@ def path_rows(paths) -> list[dict]:
 
 def comparison_rows(est, paths, array: ArrayGeometry, clock_bias: float) -> list[dict]:
     """Extracted vs true parameters, one row per estimate matched to a true path."""
+    from .extraction.estimates import PathEstimates
+
+    instance("est", est, PathEstimates)
+    paths = sequence("paths", paths, empty=True)  # no true path: every estimate unmatched
+    instance("array", array, ArrayGeometry)
+    clock_bias = real("clock_bias", clock_bias)  # a clock offset [s]: either sign
     match = match_paths(est.d, array.dir_to_world(est.direction), paths, clock_bias=clock_bias)
     rows = []
     for i, j in enumerate(match):
@@ -350,6 +377,9 @@ def rmse_study(
     bound (:func:`~tunnelkit.extraction.path_crlb`): by default "free" for the paper's routes
     ("joint", "column", "none": what a CPD can reach) and "structured" for "ml" and "coherent".
     """
+    attributes("route", route, ("paths", "config"), "a signal_route.SignalRoute")
+    n_snapshots = integer("n_snapshots", n_snapshots, minimum=1)
+    progress = boolean("progress", progress)
     if spatial is None:
         spatial = "free" if refine in ("joint", "column", "none") else "structured"
     from .extraction import path_crlb
