@@ -17,6 +17,7 @@ import functools
 
 import numpy as np
 
+from .._validate import boolean, instance, integer, sequence, text
 from ..reference import load as load_reference
 from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
 from ..studies.drives import FLAGGED, drive_variant
@@ -63,6 +64,9 @@ def table_columns(
     """The columns a table of ``routes`` (names of measured routes) has: ``columns`` (default
     :data:`COLUMNS`, plus :data:`COHERENT_COLUMN` when that route is present) without those whose
     route is missing."""
+    instance("routes", routes, (dict, list, tuple), "route names")
+    if columns is not None:
+        sequence("columns", columns)
     routes = tuple(routes)
     if columns is None:
         columns = COLUMNS + ((COHERENT_COLUMN,) if "coherent" in routes else ())
@@ -79,6 +83,9 @@ def score_drive(
     scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
     column's design; TeNFiLoc (no design of its own) on LoS drives, in the paper design's
     columns. Each (route, method, design) is evaluated once. Draws no random numbers."""
+    instance("drives", drives, dict, "drives per route (a dict)")
+    text("cond", cond)
+    sequence("columns", columns)
     table_designs = _designs()
     cache: dict[tuple[str, str, str], dict[str, float]] = {}
     out = {}
@@ -127,6 +134,9 @@ def table_rows(
     as :func:`table_columns`; each drive is scored by :func:`score_drive`. ``progress``: a tqdm
     bar over the drives scored (nothing here draws random numbers).
     """
+    instance("routes", routes, dict, "drives per route (a dict)")
+    text("reference", reference)
+    boolean("progress", progress)
     from tqdm.auto import tqdm
 
     columns = table_columns(routes, columns)
@@ -217,6 +227,9 @@ def javelin_table(
     (image channel, straight lane): the drive lengthened to ``length`` metres ending where the
     preset's ends (:func:`~tunnelkit.studies.drives.drive_variant`; 120 m: UE ranges 5-125 m);
     ``None`` the preset's drive."""
+    sequence("conditions", conditions)
+    integer("runs", runs, minimum=1)
+    sequence("extractions", extractions)
     if length is not None:
         if channel != "image" or nuisance:
             raise ValueError(

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 from tqdm.auto import tqdm
 
+from .._validate import boolean, instance, sequence
 from ..tracking.javelin import designs
 from ..tracking.javelin.motion import motion_increment
 from ..tracking.javelin.roles import JavelinDesign
@@ -34,6 +35,11 @@ def ablation(
     :func:`~tunnelkit.tracking.javelin.designs.ours_ml`.
     ``progress``: a tqdm bar over the (variant, drive) evaluations; nothing here is random.
     """
+    instance("drives", drives, dict, "drives per condition (a dict)")
+    for name, value in (("variants", variants), ("separated", separated), ("ml", ml)):
+        if value is not None:
+            instance(name, value, dict, "a dict")
+    boolean("progress", progress)
     variants = designs.ablation_path() if variants is None else variants
     conds = list(drives)
     steps = [(name, cfg, drives) for name, cfg in variants.items()]
@@ -69,6 +75,7 @@ def path_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     (matched to an estimate), RMS and median angle error between the measured and the true
     arrival direction [deg]; a last row counts the estimates matched to no true path.
     """
+    drives = sequence("drives", drives)
     err: dict[str, list[float]] = {}
     n_true: dict[str, int] = {}
     spurious = 0
@@ -113,6 +120,7 @@ def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     Rows per kind and a last row ``"all"`` pooling every path; columns: kind, matched
     measurements, RMS of phi, psi, kappa, Delta d, and how many matched paths had no curvature.
     """
+    drives = sequence("drives", drives)
     acc: dict[str, dict[str, list]] = {}
     for drive in drives:
         for k, m in enumerate(drive.epochs):
@@ -178,6 +186,7 @@ def vue_prediction_errors(drive: DriveData, vue_motion: str) -> np.ndarray:
     ``vue_motion`` ("random_walk": stay; "mirror": mirrored UE displacement) and compare each
     prediction with the nearest true VUE of epoch ``k + 1`` in (y, z).
     """
+    instance("drive", drive, DriveData)
     out = []
     for k in range(len(drive.sources) - 1):
         a, b = drive.sources[k], drive.sources[k + 1]

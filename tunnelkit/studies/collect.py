@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 
+from .._validate import boolean, callable_, integer, sequence, text
 from ..montecarlo import run_trials
 from .drives import route_name, simulate_routes
 
@@ -32,6 +33,8 @@ def simulate_condition(
     (:func:`~tunnelkit.studies.drives.simulate_routes`); the argument order suits
     ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``; ``nuisance`` the route's
     ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.studies.drives.scenario_route`)."""
+    if cond is not None:
+        text("cond", cond)
     return simulate_routes(
         scenario,
         rng,
@@ -48,6 +51,12 @@ def per_drive(scenario, conditions, runs, seed, progress, extractions, make_tria
     ``i // n``, condition ``i % n``) draws from the ``i``-th child of ``seed``. ``make_trial``
     gets the route names (``extractions``, normalised) and returns the trial ``(cond, rng)``.
     Returns the route names and ``[(condition, result), ...]`` in drive order."""
+    text("scenario", scenario)
+    sequence("conditions", conditions)
+    integer("runs", runs, minimum=1)
+    boolean("progress", progress)
+    sequence("extractions", extractions)
+    callable_("make_trial", make_trial)
     extractions = tuple(dict.fromkeys(route_name(e) for e in extractions))
     jobs = [c for _ in range(runs) for c in tuple(conditions)]
     results = run_trials(
@@ -81,6 +90,11 @@ def collect_routes(
     the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode); ``channel``
     the channel source (:data:`tunnelkit.signal_route.CHANNELS`). Returns
     ``{extraction: {condition: [DriveData, ...]}}``."""
+    text("scenario", scenario)
+    sequence("conditions", conditions)
+    integer("runs", runs, minimum=1)
+    boolean("progress", progress)
+    sequence("extractions", extractions)
     extractions, done = per_drive(
         scenario,
         conditions,
@@ -109,5 +123,9 @@ def collect_drives(
     **parallel,
 ) -> dict[str, list]:
     """:func:`collect_routes` through one route: ``{condition: [DriveData, ...]}``."""
+    text("scenario", scenario)
+    sequence("conditions", conditions)
+    integer("runs", runs, minimum=1)
+    boolean("progress", progress)
     e = route_name(extraction)
     return collect_routes(scenario, conditions, runs, seed, progress, n_epochs, (e,), **parallel)[e]

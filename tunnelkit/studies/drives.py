@@ -34,6 +34,7 @@ from .._validate import (
     record,
     rng_or_error,
 )
+from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..signal_route import CHANNELS, Epoch, SignalRoute
@@ -178,6 +179,8 @@ def ml_epoch(ep, config, noise_power: float | None = None):
     """``ep`` with its estimates and measurements redone by the maximum-likelihood route
     (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor (``noise_power``:
     what its fit is tested against, estimated from the tensor by default)."""
+    instance("ep", ep, Epoch)
+    instance("config", config, SRSConfig)
     return ep.with_estimates(
         ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config, noise_power=noise_power)
     )
@@ -185,6 +188,8 @@ def ml_epoch(ep, config, noise_power: float | None = None):
 
 def separate_epoch(ep, config):
     """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
+    instance("ep", ep, Epoch)
+    instance("config", config, SRSConfig)
     return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, record
+from .._checks import attributes
+from .._validate import finite_array, instance, record
 from ..metrics import SETTLE_S, settled
 from ..tracking import registry
 from ..tracking.javelin.designs import paper
@@ -121,6 +122,8 @@ def evaluate(
 def settled_errors(ev: Evaluation, drive: DriveData) -> tuple[float, float, float]:
     """The 2-D RMSE over the whole drive, and the RMSE and median of the 2-D error over the
     settled epochs (NaN when the drive is shorter than the start-up)."""
+    attributes("ev", ev, ("estimates", "metrics"), "a studies.scoring.Evaluation")
+    instance("drive", drive, DriveData)
     idx = settled(drive.t)
     e = np.linalg.norm(ev.estimates[idx, :2] - drive.truth[idx, :2], axis=1)
     rmse, med = (np.sqrt(np.mean(e**2)), np.median(e)) if idx.size else (np.nan, np.nan)
