@@ -76,6 +76,8 @@ def design_figure(
     n = integer("n", n, minimum=1)
     tilt_deg, mount_height = real("tilt_deg", tilt_deg), positive("mount_height", mount_height)
     eps_phi = positive("eps_phi", eps_phi)
+    target = positive("target", target)  # before the bounds: a bad value costs no computation
+    share = probability("share", share, open_interval=False)
     imp = design.DesignImpairments(
         phase_error_deg=phase_error_deg,
         gain_error_db=gain_error_db,
