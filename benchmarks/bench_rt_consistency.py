@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
-from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
+from tunnelkit.path_consistency import bound_sigmas, epoch_consistency, rate_interval
 from tunnelkit.signal_route import SignalRoute
 
 
@@ -124,16 +124,6 @@ def false_alarms(scenarios, seeds, draws: int, pfa: float) -> dict:
     return out
 
 
-def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    """Exact binomial confidence interval of a rate ``k / n``."""
-    from scipy.stats import beta
-
-    a = 1.0 - level
-    lo = 0.0 if k == 0 else float(beta.ppf(a / 2, k, n - k + 1))
-    hi = 1.0 if k == n else float(beta.ppf(1 - a / 2, k + 1, n - k))
-    return lo, hi
-
-
 def report_false_alarms(res: dict, pfa: float) -> None:
     tot = {"joint": [0, 0], "diag": [0, 0]}
     for (sc, seed), r in res.items():
@@ -142,11 +132,11 @@ def report_false_alarms(res: dict, pfa: float) -> None:
             k, n = int(r[v].sum()), r[v].size
             tot[v][0] += k
             tot[v][1] += n
-            lo, hi = clopper_pearson(k, n)
+            lo, hi = rate_interval(k, n)
             line += f"; {v} {k}/{n} = {k / n:.4f} [95 % CI {lo:.4f}, {hi:.4f}]"
         print(line)
     for v, (k, n) in tot.items():
-        lo, hi = clopper_pearson(k, n)
+        lo, hi = rate_interval(k, n)
         pv = np.concatenate([r[f"p_{v}"] for r in res.values()])
         q = np.quantile(pv, [0.01, 0.05, 0.1, 0.5])
         print(

@@ -269,3 +269,20 @@ def test_gls_statistic_with_a_diagonal_cov_is_the_plain_one(scene):
         geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, cov=np.eye(3))
     with pytest.raises(ValueError, match="cov"):
         geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, cov=-np.eye(3 * K))
+
+
+def test_rate_interval_is_the_exact_binomial_interval():
+    """At each end the binomial tail equals (1 - level) / 2 (brute force: scipy's binomial)."""
+    from tunnelkit.path_consistency import rate_interval
+
+    for k, n in ((0, 50), (3, 50), (20, 500), (50, 50)):
+        lo, hi = rate_interval(k, n, 0.95)
+        assert 0 <= lo <= k / n <= hi <= 1
+        if k > 0:
+            assert binom.sf(k - 1, n, lo) == pytest.approx(0.025, rel=1e-6)
+        if k < n:
+            assert binom.cdf(k, n, hi) == pytest.approx(0.025, rel=1e-6)
+    with pytest.raises(ValueError, match="k"):
+        rate_interval(5, 4)
+    with pytest.raises(ValueError, match="level"):
+        rate_interval(1, 4, 1.5)

@@ -22,7 +22,23 @@ from .constants import C
 from .rt.consistency import geometry_consistency, tunnel_planes
 from .signal_route import Epoch, SignalRoute, reported_covariance
 
-__all__ = ["bound_sigmas", "epoch_consistency", "joint_bound", "joint_fisher"]
+__all__ = ["bound_sigmas", "epoch_consistency", "joint_bound", "joint_fisher", "rate_interval"]
+
+
+def rate_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """The exact (Clopper-Pearson) confidence interval at ``level`` of a rate observed as ``k``
+    events in ``n`` trials (e.g. a test's false alarms in ``n`` snapshots): the rates ``p`` for
+    which ``P(X >= k | p)`` and ``P(X <= k | p)`` both exceed ``(1 - level) / 2``."""
+    from scipy.stats import beta
+
+    from ._validate import probability
+
+    n = integer("n", n, minimum=1)
+    k = integer("k", k, minimum=0, maximum=n)
+    a = 1.0 - probability("level", level)
+    lo = 0.0 if k == 0 else float(beta.ppf(a / 2, k, n - k + 1))
+    hi = 1.0 if k == n else float(beta.ppf(1 - a / 2, k + 1, n - k))
+    return lo, hi
 
 
 def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.ndarray:

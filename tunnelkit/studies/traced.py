@@ -34,7 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, rng_or_error
+from .._validate import boolean, finite_array, instance, integer, rng_or_error
 from ..path_consistency import epoch_consistency
 from ..scenarios import data_dir
 from ..signal_route import Epoch, SignalRoute
@@ -79,6 +79,15 @@ NUISANCE = {"diffuse_floor": True}
 
 def _errors_path():
     return data_dir() / "rt" / "traced_errors.json"
+
+
+def _path(path):
+    import os
+    from pathlib import Path
+
+    if not isinstance(path, str | os.PathLike) or not str(path):
+        raise TypeError(f"path: expected a file path, got {path!r}")
+    return Path(path)
 
 
 def _floors(floors) -> tuple[float, float]:
@@ -251,6 +260,7 @@ def measure_traced_errors(
 
     runs = integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
+    boolean("progress", progress)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     drives = run_trials(
@@ -276,11 +286,9 @@ def measure_traced_errors(
 def write_traced_errors(record: dict, path=None) -> str:
     """Store ``record`` (:func:`measure_traced_errors`) as JSON at ``path`` (default
     ``data/rt/traced_errors.json``, what :func:`traced_errors` reads); returns the path."""
-    from pathlib import Path
-
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of measure_traced_errors")
-    p = _errors_path() if path is None else Path(path)
+    p = _errors_path() if path is None else _path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     p.write_text(json.dumps(record, indent=1, default=str) + "\n")
     return str(p)
@@ -289,9 +297,7 @@ def write_traced_errors(record: dict, path=None) -> str:
 def traced_errors(path=None) -> dict:
     """The stored record of :func:`measure_traced_errors` (``path`` default
     ``data/rt/traced_errors.json``)."""
-    from pathlib import Path
-
-    p = _errors_path() if path is None else Path(path)
+    p = _errors_path() if path is None else _path(path)
     if not p.is_file():
         raise FileNotFoundError(
             f"path: no traced errors at {p}; measure them with benchmarks/bench_rt_sigmas.py --write"
