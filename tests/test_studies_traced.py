@@ -4,6 +4,7 @@ stored sigmas and the design read from them."""
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import replace
 
 import numpy as np
@@ -101,3 +102,27 @@ def test_the_stored_record_states_its_procedure():
     assert rec["seed"] == 0 and rec["scenario"] == "italiano2026-straight"
     assert rec["condition"] == "L" and rec["nuisance"] == {"diffuse_floor": True}
     assert FLOORS[1] > 0
+
+
+@pytest.mark.skipif(os.environ.get("TUNNELKIT_SKIP_RT") == "1", reason="TUNNELKIT_SKIP_RT=1")
+def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive():
+    """``javelin_table(channel="sionna")`` (two epochs, one run) adds the traced column; its
+    JAVELIN-L score is the traced design's on simulate_traced's ``ml-traced`` drive of the same
+    child seed; the image channel's table has no such column."""
+    from tunnelkit.montecarlo import spawn_rngs
+    from tunnelkit.reproduce.javelin_tables import TRACED_COLUMN, javelin_table
+    from tunnelkit.studies import evaluate
+
+    nuis = {"diffuse_floor": True}
+    rep = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
+                        extractions=("ml",), n_epochs=2, channel="sionna", nuisance=nuis)  # fmt: skip
+    assert TRACED_COLUMN[0] in rep.columns
+    col = rep.columns.index(TRACED_COLUMN[0])
+    row = next(r for r in rep.rows if r[0] == "JAVELIN-L" and r[1] == "rmse_2d_m")
+    d = simulate_traced("italiano2026-slalom", spawn_rngs(0, 1)[0], n_epochs=2, channel="sionna",
+                        nuisance=nuis)["ml-traced"]  # fmt: skip
+    assert row[col] == pytest.approx(evaluate(d, traced_design()).metrics["rmse_2d_m"], rel=1e-12)
+    assert any("traced design" in n for n in rep.notes)
+    img = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
+                        extractions=("ml",), n_epochs=2)  # fmt: skip
+    assert TRACED_COLUMN[0] not in img.columns
