@@ -4,8 +4,11 @@
 one UE position through the tunnel's planes, each residual in standard deviations of a bound.
 Here the bound is the CRLB at the estimate (:func:`bound_sigmas`: world azimuth, elevation and
 range of each kept path, :func:`tunnelkit.signal_route.reported_covariance` computed whatever the
-fit's own residual verdict), and :func:`epoch_consistency` runs the test
-on a :class:`tunnelkit.signal_route.Epoch`::
+fit's own residual verdict) and, for the snapshot's statistic, its joint covariance over all
+paths (:func:`joint_bound`, from :func:`joint_fisher`: the ML fit's paths are estimated together,
+so their errors correlate within a path and between paths, up to 0.9 at the presets' epochs;
+without it the test over-rejects on eq. 1's own channel). :func:`epoch_consistency` runs the
+test on a :class:`tunnelkit.signal_route.Epoch`::
 
     ep = route.epoch(12, rng, refine="ml")
     res = epoch_consistency(ep, route)        # res["consistent"], res["keep"], res["r2"], ...
