@@ -314,7 +314,7 @@ def _report(scenario, reference, conditions, extractions, done, channel, nuisanc
         notes=[
             *NOTES,
             *(_RT_NOTES if channel == "sionna" else []),
-            *([_traced_note()] if TRACED_COLUMN[1] in extractions else []),
+            *([_traced_note(nuisance)] if TRACED_COLUMN[1] in extractions else []),
             *([_nuisance_note(nuisance)] if nuisance else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
@@ -335,22 +335,32 @@ _RT_NOTES = [
 ]
 
 
-def _traced_note() -> str:
-    """The traced column's note, its numbers read from the stored record."""
+def _traced_note(nuisance: dict | None) -> str:
+    """The traced column's note, its numbers read from the stored record (and whether the
+    table's route is the one they were measured on)."""
     from ..studies.traced import FLOORS, traced_errors
 
     rec = traced_errors()
     a = {r[0]: r for r in rec["rows"]}["all"]
+    same = dict(nuisance or {}) == rec["nuisance"]
     return (
         f"Column '{TRACED_COLUMN[0]}': designs.ours_ml with its measurement noise set to the ML "
         f"route's RMS error on the ray-traced channel ({a[2]:.3g} deg, {a[3]:.3g} deg, "
         f"{a[4]:.3g} m, {a[5]:.3g} m over {a[1]} matched paths; {rec['scenario']}, condition "
         f"{rec['condition']}, seed {rec['seed']}, {rec['runs']} runs: "
-        "studies.traced.measure_traced_errors, stored in data/rt/traced_errors.json; in-sample "
-        "for the straight drive's first runs at seed 0), fed every epoch's ML measurements "
+        "studies.traced.measure_traced_errors on children 0.."
+        f"{rec['runs'] - 1} of seed {rec['seed']}, stored in data/rt/traced_errors.json; Table 1's "
+        "JAVELIN-L run 0 at that seed is child 0, one of those drives), fed every epoch's ML "
+        "measurements "
         "(the fit's own test ignored) that the geometry-consistency test keeps "
         f"(path_consistency.epoch_consistency, floors {np.degrees(FLOORS[0]):.2g} deg and "
         f"{FLOORS[1]:.2g} m, chosen on the straight drive at seed 0)."
+        + (
+            ""
+            if same
+            else f" The sigmas were measured on the route with {rec['nuisance']}, this table "
+            f"runs {dict(nuisance or {})} (pass --diffuse-floor for the route they belong to)."
+        )
     )
 
 
