@@ -16,6 +16,11 @@ verdict) and no model-error floor, at the false-alarm rate ``--pfa``:
   first-order path and of spurious paths (matched to none) that the per-path test drops.
 
     python benchmarks/bench_rt_consistency.py --scenario italiano2026-straight --draws 1
+    python benchmarks/bench_rt_consistency.py --false-alarm --draws 5 --seeds 0 1
+
+``--false-alarm``: on the image channel only, the snapshot test's false-alarm rate with the
+bound's joint covariance (correlations within and between paths) beside the per-component sigmas
+alone, on the same snapshots, with exact (Clopper-Pearson) 95 % intervals.
 """
 
 from __future__ import annotations
@@ -27,12 +32,13 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import chi2, kstest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
-from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
+from tunnelkit.path_consistency import bound_sigmas, epoch_consistency, rate_interval
 from tunnelkit.signal_route import SignalRoute
 
 
@@ -85,6 +91,61 @@ def study(route: SignalRoute, draws: int, pfa: float, floors, rng) -> dict:
     return {**{k: np.array(v) for k, v in acc.items()}, "skipped": skipped}
 
 
+def false_alarms(scenarios, seeds, draws: int, pfa: float) -> dict:
+    """Image channel (eq. 1 is the truth): per scenario and seed, ``draws`` snapshots per epoch
+    (noise and clock bias drawn, LoS kept, ML route), the snapshot test's verdict with the
+    bound's joint covariance (:func:`epoch_consistency`, ``joint=True``) and with the
+    per-component sigmas alone (``joint=False``) on the same snapshots."""
+    out = {}
+    for sc in scenarios:
+        route = SignalRoute.from_scenario(sc)
+        for seed in seeds:
+            rng = np.random.default_rng(seed)
+            acc = {"joint": [], "diag": [], "fit_ok": [], "skipped": 0}
+            for k in range(len(route.trajectory)):
+                for _ in range(draws):
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        ep = route.epoch(k, rng, refine="ml")
+                    if len(ep.measurements) < 2:
+                        continue
+                    try:
+                        rj = epoch_consistency(ep, route, pfa=pfa)
+                        rd = epoch_consistency(ep, route, pfa=pfa, joint=False)
+                    except (np.linalg.LinAlgError, ValueError):
+                        acc["skipped"] += 1
+                        continue
+                    acc["joint"].append(not rj["consistent"])
+                    acc["diag"].append(not rd["consistent"])
+                    acc.setdefault("p_joint", []).append(chi2.sf(rj["statistic"], rj["dof"]))
+                    acc.setdefault("p_diag", []).append(chi2.sf(rd["statistic"], rd["dof"]))
+                    acc["fit_ok"].append(bool(getattr(ep.estimates, "fit_ok", True)))
+            out[(sc, seed)] = {k: np.array(v) if isinstance(v, list) else v for k, v in acc.items()}
+    return out
+
+
+def report_false_alarms(res: dict, pfa: float) -> None:
+    tot = {"joint": [0, 0], "diag": [0, 0]}
+    for (sc, seed), r in res.items():
+        line = f"{sc} seed {seed}: {r['joint'].size} snapshots ({r['skipped']} skipped)"
+        for v in ("joint", "diag"):
+            k, n = int(r[v].sum()), r[v].size
+            tot[v][0] += k
+            tot[v][1] += n
+            lo, hi = rate_interval(k, n)
+            line += f"; {v} {k}/{n} = {k / n:.4f} [95 % CI {lo:.4f}, {hi:.4f}]"
+        print(line)
+    for v, (k, n) in tot.items():
+        lo, hi = rate_interval(k, n)
+        pv = np.concatenate([r[f"p_{v}"] for r in res.values()])
+        q = np.quantile(pv, [0.01, 0.05, 0.1, 0.5])
+        print(
+            f"  all, {v}: {k}/{n} = {k / n:.4f} [95 % CI {lo:.4f}, {hi:.4f}] against {pfa:g}; "
+            f"p-values (uniform if the statistic is chi-square): quantiles 1/5/10/50 % "
+            f"{np.round(q, 4).tolist()}, KS p {kstest(pv, 'uniform').pvalue:.3g}"
+        )
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="italiano2026-straight")
@@ -94,7 +155,20 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--floor-angle-deg", type=float, default=0.5)
     ap.add_argument("--floor-range", type=float, default=0.3)
+    ap.add_argument("--false-alarm", action="store_true",
+                    help="image channel only: the snapshot test's false-alarm rate, joint "
+                    "covariance against per-component sigmas, on --scenarios x --seeds")  # fmt: skip
+    ap.add_argument("--scenarios", nargs="+",
+                    default=["italiano2026-straight", "italiano2026-slalom"])  # fmt: skip
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     a = ap.parse_args(argv)
+    if a.false_alarm:
+        t0 = time.perf_counter()
+        res = false_alarms(a.scenarios, a.seeds, a.draws, a.pfa)
+        print(f"false alarms, image channel, pfa {a.pfa:g}, {a.draws} draw(s) per epoch: "
+              f"{time.perf_counter() - t0:.0f} s")  # fmt: skip
+        report_false_alarms(res, a.pfa)
+        return 0
     floors = (np.radians(a.floor_angle_deg), a.floor_range)
     for chan in a.channels:
         kw = {"diffuse_floor": True} if chan == "sionna" else {}

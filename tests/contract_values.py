@@ -553,6 +553,29 @@ def _consistency():
     epoch_consistency(ep, route, bound=False, floor_angle=1e-2, floor_range=0.3)
 
 
+def _traced():
+    """The traced design's pieces and the joint bound of the geometry test (image channel, one
+    epoch; the stored traced errors)."""
+    import tempfile
+
+    from tunnelkit.path_consistency import joint_bound, joint_fisher, rate_interval
+    from tunnelkit.studies import traced as tr
+    from tunnelkit.studies.drives import scenario_route
+
+    route = scenario_route("italiano2026-straight")
+    ep = route.epoch(10, np.random.default_rng(0), refine="ml")
+    joint_bound(ep.estimates, ep.array, route.config, ep.measurements.index)
+    pos = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
+    src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
+    joint_fisher([1.0 + 0.5j, 0.5j], src, pos, [-0.7, -1.1], [0.05, -0.02], 4, 3, 0.3, 3.5e9)
+    rate_interval(3, 50)
+    tr.geometry_keep(ep, route)
+    tr.traced_measurements(ep, route)
+    tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
+    tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
+    tr.traced_design()
+
+
 def _trial(rng):
     """A Monte-Carlo trial for the runner's contract (module level: picklable)."""
     return float(rng.random())
@@ -573,6 +596,7 @@ DRIVERS = (
     _baselines_checks,
     *ROUTE_DRIVERS,
     _consistency,
+    _traced,
     *DESIGN_DRIVERS,
     *BASELINE_DRIVERS,
 )

@@ -70,6 +70,12 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(ANY, r".*_db|snr_db", "negative zero", "a level or offset in dB: any sign"),
     _doc(ANY, r"seed", "zero", "0 is a seed like any other"),
     _doc(
+        r"design\.verdict\.recommend",
+        r"rows",
+        "empty",
+        "no candidate left (every array failed, reported per array): no recommendation",
+    ),
+    _doc(
         ANY,
         r"(phase|gain)_sigma_(deg|db)|amplitude|clock_bias|margin|min_d|.*_prob|.*_bias_hz",
         "zero",
@@ -601,12 +607,6 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"reason",
         "empty",
         "no reason to give (the default: a row with a verdict says why only when it has to)",
-    ),
-    _doc(
-        r"design\.verdict\.recommend",
-        r"rows",
-        "empty",
-        "no candidate left (every array failed, or none to confirm): none is recommended, with why",
     ),
     _doc(
         r"design\.confirm\.ConfirmedReport",

@@ -360,3 +360,11 @@ def test_screen_bound_halves_the_impairments_part_only():
     assert np.all(peb <= got) and np.all(got[[0, 1, 3]] <= ach[[0, 1, 3]])
     with pytest.raises(ValueError, match="achievable"):
         v.screen_bound(peb, ach[:2])
+
+
+def test_no_candidate_left_is_no_recommendation_not_an_error():
+    from tunnelkit.design.verdict import recommend
+
+    for runs in (0, 20):
+        rec = recommend([], 0.1, 0.9, runs)
+        assert rec["array"] is None and "no candidate" in rec["reason"]

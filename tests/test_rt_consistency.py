@@ -164,3 +164,125 @@ def test_bound_sigmas_match_the_reported_covariance(scene):
             bound_sigmas(ep.estimates, ep.array, route.config, bad)
     with pytest.raises(TypeError, match="bound"):
         epoch_consistency(ep, route, bound="yes")
+
+
+def test_joint_fisher_against_finite_differences():
+    """The joint Fisher information of two paths against 2/N0 Re(J^H J) with J the central
+    finite differences of the eq.-1 tensor (small array, few tones), cross terms included."""
+    from tunnelkit.path_consistency import joint_fisher
+
+    rng = np.random.default_rng(2)
+    pos = np.c_[rng.uniform(-0.02, 0.02, (4, 2)), np.zeros(4)]
+    pos[0] = 0.0
+    fc, nf, nt, n0 = 3.5e9, 6, 3, 0.3
+    alpha = np.array([1.0 + 0.5j, -0.4 + 0.8j])
+    src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
+    mu_f, mu_t = np.array([-0.7, -1.1]), np.array([0.05, -0.02])
+    k0 = 2 * np.pi * fc / 299792458.0
+
+    def tensor(theta):
+        H = np.zeros((4, nf, nt), complex)
+        for j in range(2):
+            q = theta[7 * j : 7 * j + 7]
+            r = np.linalg.norm(q[4:][None] - pos, axis=1)
+            a = np.exp(1j * k0 * (r - r[0]))
+            f = np.exp(1j * np.arange(nf) * q[2])
+            t = np.exp(1j * np.arange(nt) * q[3])
+            H += (q[0] + 1j * q[1]) * a[:, None, None] * f[None, :, None] * t[None, None, :]
+        return H.ravel()
+
+    theta = np.concatenate([[alpha[j].real, alpha[j].imag, mu_f[j], mu_t[j], *src[j]]
+                            for j in range(2)])  # fmt: skip
+    J = np.zeros((4 * nf * nt, 14), complex)
+    for i in range(14):
+        h = 1e-6 * max(1.0, abs(theta[i]))
+        e = np.zeros(14)
+        e[i] = h
+        J[:, i] = (tensor(theta + e) - tensor(theta - e)) / (2 * h)
+    want = 2.0 / n0 * (J.conj().T @ J).real
+    got = joint_fisher(alpha, src, pos, mu_f, mu_t, nf, nt, n0, fc)
+    np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6 * np.abs(want).max())
+    assert np.abs(got[:7, 7:]).max() > 1e-3 * np.abs(got).max()  # the paths do interact
+    with pytest.raises(ValueError, match="sources"):
+        joint_fisher(alpha, src[:1], pos, mu_f, mu_t, nf, nt, n0, fc)
+    with pytest.raises(ValueError, match="noise_power"):
+        joint_fisher(alpha, src, pos, mu_f, mu_t, nf, nt, -1.0, fc)
+
+
+def test_joint_bound_blocks_are_the_per_path_bound(scene):
+    """The joint covariance's diagonal is bound_sigmas squared; its off-diagonal correlations
+    are there (the statistic needs them)."""
+    from tunnelkit.path_consistency import bound_sigmas, joint_bound
+
+    route = scene[0]
+    ep = route.epoch(10, np.random.default_rng(5), refine="ml")
+    m = ep.measurements
+    cov = joint_bound(ep.estimates, ep.array, route.config, m.index)
+    sig = bound_sigmas(ep.estimates, ep.array, route.config, m.index)
+    np.testing.assert_allclose(np.sqrt(np.diag(cov)).reshape(-1, 3), sig, rtol=1e-8)
+    corr = cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))
+    assert np.abs(corr - np.eye(len(cov))).max() > 0.3
+    assert joint_bound(ep.estimates, ep.array, route.config, np.zeros(0, int)).shape == (0, 0)
+    with pytest.raises(ValueError, match="keep"):
+        joint_bound(ep.estimates, ep.array, route.config, [0, 0])
+
+
+def test_gls_statistic_with_a_diagonal_cov_is_the_plain_one(scene):
+    """cov = diag(sigma^2): the generalised least-squares statistic equals the per-component one;
+    a correlated cov whitens correlated errors (false-alarm rate at pfa over the draws)."""
+    route, arr, paths = scene
+    u0, d0 = _exact(paths, 0.0)
+    K = len(paths)
+    planes = tunnel_planes(route.tunnel)
+    sa, sd = 2e-4, 2e-3
+    rng = np.random.default_rng(4)
+    sig = np.tile([sa, sa, sd], K)
+
+    def draw(cov):
+        e = np.linalg.cholesky(cov) @ rng.standard_normal(3 * K)
+        e = e.reshape(K, 3)
+        az = np.arctan2(u0[:, 1], u0[:, 0]) + e[:, 0]
+        el = np.arcsin(u0[:, 2]) + e[:, 1]
+        return np.c_[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], d0 + e[:, 2]
+
+    u, d = draw(np.diag(sig**2))
+    kw = {"inside": route.tunnel.contains}
+    a = geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, **kw)
+    b = geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, cov=np.diag(sig**2), **kw)
+    assert b["statistic"] == pytest.approx(a["statistic"], rel=1e-6)
+    np.testing.assert_allclose(b["r2"], a["r2"], rtol=1e-6)
+    # strongly correlated errors (0.8 between every pair of paths' ranges and within each path's
+    # angles): with the joint cov the rate is pfa
+    corr = np.eye(3 * K)
+    idx = np.arange(K) * 3
+    corr[np.ix_(idx + 2, idx + 2)] = 0.8 + 0.2 * np.eye(K)
+    corr[idx, idx + 1] = corr[idx + 1, idx] = 0.8
+    cov = corr * np.outer(sig, sig)
+    n, pfa, flags = 150, 0.1, 0
+    for _ in range(n):
+        u, d = draw(cov)
+        res = geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, pfa=pfa, cov=cov, **kw)
+        flags += not res["consistent"]
+    lo, hi = binom.ppf([0.0005, 0.9995], n, pfa)
+    assert lo <= flags <= hi
+    with pytest.raises(ValueError, match="cov"):
+        geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, cov=np.eye(3))
+    with pytest.raises(ValueError, match="cov"):
+        geometry_consistency(u, d, arr.origin, planes, sa, sa, sd, cov=-np.eye(3 * K))
+
+
+def test_rate_interval_is_the_exact_binomial_interval():
+    """At each end the binomial tail equals (1 - level) / 2 (brute force: scipy's binomial)."""
+    from tunnelkit.path_consistency import rate_interval
+
+    for k, n in ((0, 50), (3, 50), (20, 500), (50, 50)):
+        lo, hi = rate_interval(k, n, 0.95)
+        assert 0 <= lo <= k / n <= hi <= 1
+        if k > 0:
+            assert binom.sf(k - 1, n, lo) == pytest.approx(0.025, rel=1e-6)
+        if k < n:
+            assert binom.cdf(k, n, hi) == pytest.approx(0.025, rel=1e-6)
+    with pytest.raises(ValueError, match="k"):
+        rate_interval(5, 4)
+    with pytest.raises(ValueError, match="level"):
+        rate_interval(1, 4, 1.5)

@@ -578,54 +578,104 @@ print("section 8 checks passed")
 # $(p, \beta)$ the paths agree on best (each earliest path tried as the LoS, the UE triangulated
 # with a second path's ray through each plane, then a least-squares fit), and tests
 #
-# $$T = \sum_j r_j^2,\qquad r_j^2 = \Big(\tfrac{\Delta\phi_j}{\sigma_{\phi,j}}\Big)^2 +
-# \Big(\tfrac{\Delta\psi_j}{\sigma_{\psi,j}}\Big)^2 + \Big(\tfrac{\Delta d_j}{\sigma_{d,j}}\Big)^2
-# \;\gtrless\; \chi^2_{3K-4}(1-P_\mathrm{fa}),$$
+# $$T = \min_{p,\beta}\; z^\mathsf{T}\,\Sigma^{-1} z \;\gtrless\;
+# \chi^2_{3K-4}(1-P_\mathrm{fa}),\qquad z_j = (\Delta\phi_j,\ \Delta\psi_j,\ \Delta d_j),$$
 #
-# each residual in standard deviations of the bound (here the CRLB at the estimate,
-# `path_consistency.bound_sigmas`), $K$ paths, 4 unknowns. Per path, $r_j^2$ against
-# $\chi^2_3(1-P_\mathrm{fa})$ says which path disagrees. The same epochs on both channels, the
-# ML route, $P_\mathrm{fa} = 1\,\%$:
+# $z$ the $3K$ residuals of the $K$ paths' azimuth, elevation and delay distance against the
+# hypothesis (4 unknowns) and $\Sigma$ their **joint** covariance: the CRLB at the estimate of all
+# paths together (`path_consistency.joint_bound`: the Fisher information of every path inverted
+# whole, then mapped to the world angles and $d$). The ML fit estimates the paths jointly, so
+# their errors are correlated, within a path (azimuth with elevation) and between paths; a
+# statistic that divides each residual by its own standard deviation alone
+# (`joint=False`) leaves that out and its false-alarm rate is no longer the stated one. Per
+# path, $r_j^2 = z_j^\mathsf{T}\Sigma_{jj}^{-1} z_j$ against $\chi^2_3(1-P_\mathrm{fa})$ says which
+# path disagrees. The same epochs on both channels, the ML route, $P_\mathrm{fa} = 1\,\%$; on
+# the image channel (eq. 1 is the truth, so every flag is a false alarm) `n_draw` noise draws per
+# epoch and both statistics on the same snapshots:
 
 # %%
-from tunnelkit.path_consistency import epoch_consistency
+from tunnelkit.path_consistency import epoch_consistency, rate_interval
 
-geo = {"image": [], "sionna": []}
-err_rt = {"phi": [], "psi": [], "kappa": []}
+PFA = 0.01
+n_draw = tk.mc_count(4, 2)
+geo = {"image": [], "image, per-component": [], "sionna": []}
+err_rt = {"phi": [], "psi": [], "kappa": [], "d": []}
+eps_geo = {"image": [], "sionna": []}
 for k in range(n_ep):
-    for label, route in (("image", route_img), ("sionna", route_rt)):
-        ep = route.epoch(k, np.random.default_rng(900 + k), refine="ml")
-        try:
-            res = epoch_consistency(ep, route, pfa=0.01)
-        except (ValueError, np.linalg.LinAlgError):  # the bound at the estimate undefined
-            continue
-        geo[label].append((res["statistic"], res["threshold"], res["consistent"]))
-        if label == "sionna":  # each matched path's error against the truth
-            m = ep.measurements
-            for j, t in enumerate(ep.truth_index):
-                p = ep.paths[t]
-                err_rt["phi"].append(np.angle(np.exp(1j * (m.phi[j] - p.azimuth))))
-                err_rt["psi"].append(m.psi[j] - p.elevation)
-                err_rt["kappa"].append(m.kappa[j] - p.length if np.isfinite(m.kappa[j]) else np.nan)
+    for label, route, draws in (("image", route_img, n_draw), ("sionna", route_rt, 1)):
+        for i in range(draws):
+            ep = route.epoch(k, np.random.default_rng(900 + 50 * i + k), refine="ml")
+            try:
+                res = epoch_consistency(ep, route, pfa=PFA)
+                diag = epoch_consistency(ep, route, pfa=PFA, joint=False)
+            except (ValueError, np.linalg.LinAlgError):  # the bound at the estimate undefined
+                continue
+            geo[label].append((res["statistic"], res["threshold"], res["consistent"]))
+            if label == "image":
+                geo["image, per-component"].append((diag["statistic"], diag["threshold"],
+                                                    diag["consistent"]))  # fmt: skip
+            eps_geo[label].append(ep)
+            if label == "sionna":  # each matched path's error against the truth
+                m = ep.measurements
+                for j, t in enumerate(ep.truth_index):
+                    p = ep.paths[t]
+                    err_rt["phi"].append(np.angle(np.exp(1j * (m.phi[j] - p.azimuth))))
+                    err_rt["psi"].append(m.psi[j] - p.elevation)
+                    kap = m.kappa[j] - p.length if np.isfinite(m.kappa[j]) else np.nan
+                    err_rt["kappa"].append(kap)
+                    err_rt["d"].append(m.d[j] - p.length - C * ep.snapshot.clock_bias)
+fa = {}
 for label, rows in geo.items():
     flagged = sum(not r[2] for r in rows)
-    print(f"{label:7s} flagged {flagged} of {len(rows)} snapshots; T / threshold: "
-          + " ".join(f"{r[0] / r[1]:.3g}" for r in rows))  # fmt: skip
+    fa[label] = (flagged, len(rows), *rate_interval(flagged, len(rows), 0.99))
+    print(f"{label:22s} flagged {flagged} of {len(rows)} snapshots (99 % interval of the rate "
+          f"{fa[label][2]:.3f}-{fa[label][3]:.3f}); median T / threshold "
+          f"{np.median([r[0] / r[1] for r in rows]):.3g}")  # fmt: skip
 geo_flag = {label: np.mean([not r[2] for r in rows]) for label, rows in geo.items()}
 
 # %% [markdown]
-# On the image channel the paths agree with one UE to their CRLB; on the traced one every
-# snapshot fails, typically by orders of magnitude (the ratios printed), the wrong basin included: its
-# paths fit the tensor but not one UE. For a tracker the test must not drop everything, so its
-# pre-filter form states a model-error floor instead of the bound (`bound=False`,
-# `floor_angle`, `floor_range`: $0.5°$ and $0.3$ m in `benchmarks/bench_rt_track.py`) and drops
-# the paths beyond it.
+# On the image channel the test with the joint covariance flags a share of the snapshots whose
+# 99 % binomial interval (printed) contains the stated 1 %: there the paths agree with one UE to
+# their bound (the checks assert the interval; `benchmarks/bench_rt_consistency.py
+# --false-alarm` measures both statistics on several hundred snapshots). On the traced one every
+# snapshot fails, typically by orders of magnitude (the median ratio printed), the wrong basin
+# included: its paths fit the tensor but not one UE.
+#
+# For a tracker the test must not drop everything, so its pre-filter form states a model-error
+# floor instead of the bound (`bound=False`, `floor_angle`, `floor_range`): the traced design of
+# the tables (`studies.traced`, the `--channel sionna` column of `tunnelkit reproduce
+# javelin-table1|2`) uses `studies.traced.FLOORS`. Where they sit, computed on these epochs: the
+# share of paths the pre-filter keeps on each channel, and the traced matched paths' errors
+# against them.
+
+# %%
+from tunnelkit.studies.traced import FLOORS, geometry_keep, traced_errors
+
+floor_deg, floor_m = float(np.degrees(FLOORS[0])), float(FLOORS[1])
+kept = {}
+for label, route in (("image", route_img), ("sionna", route_rt)):
+    n_kept = [(len(geometry_keep(ep, route)), len(ep.measurements)) for ep in eps_geo[label]]
+    kept[label] = sum(a for a, _ in n_kept) / max(1, sum(b for _, b in n_kept))
+ang_rt = np.degrees(np.hypot(err_rt["phi"], err_rt["psi"]))
+d_rt = np.abs(err_rt["d"])  # delay distance against the true length plus the true clock bias
+within = float(np.mean((ang_rt <= floor_deg) & (d_rt <= floor_m)))
+print(f"floors {floor_deg:.3g} deg, {floor_m:.3g} m: the pre-filter keeps {kept['image']:.3f} "
+      f"of the image channel's paths and {kept['sionna']:.3f} of the traced ones")  # fmt: skip
+print(f"traced matched paths: median angle error {np.median(ang_rt):.3g} deg, median range "
+      f"error {np.median(d_rt):.3g} m; {within:.3f} of them within both floors")  # fmt: skip
+
+# %% [markdown]
+# The floors are far above the image channel's bound (the pre-filter keeps its paths) and
+# below the traced channel's typical error (it drops a share of them, the wrong-basin and cut-off
+# paths first): a path kept agrees with one UE to a fraction of a degree and decimetres.
 #
 # **What makes the traced track metres off.** The measurement noise of our design for the ML
 # route is the RMS error that route makes on the *image* channel. On the traced channel its
 # errors are far larger than those sigmas, the curvature worst of all: the ray tracer's
 # wavefronts are cut off across the aperture (section 7's visibility part) and bent by the
-# spatial-wideband term, and the ML fit's curvature absorbs it.
+# spatial-wideband term, and the ML fit's curvature absorbs it. The traced design's sigmas are
+# that error, measured once on the straight drive (seed 0, `studies.traced.measure_traced_errors`,
+# stored in `data/rt/traced_errors.json`); below, beside the same RMS on this notebook's epochs.
 
 # %%
 cfg_ml = designs.ours_ml().config
@@ -642,6 +692,9 @@ print(
     f"{np.degrees(cfg_ml.sigma_psi):.3g} deg, {cfg_ml.sigma_kappa:.3g} m"
 )
 print("error / sigma: " + ", ".join(f"{n} {r:.3g}" for n, r in ratio_rt.items()))
+stored = {r[0]: r for r in traced_errors()["rows"]}["all"]
+print(f"traced design's sigmas (stored): {stored[2]:.3g} deg, {stored[3]:.3g} deg, "
+      f"{stored[4]:.3g} m over {stored[1]} matched paths")  # fmt: skip
 
 # %% [markdown]
 # A tracker that trusts a curvature tens of metres off at the sigma of a few metres pulls the UE
@@ -657,8 +710,14 @@ print("error / sigma: " + ", ".join(f"{n} {r:.3g}" for n, r in ratio_rt.items())
 
 # %%
 assert geo_flag["sionna"] == 1.0  # every traced snapshot is geometry-inconsistent at its CRLB
-assert geo_flag["image"] <= (0.34 if tk.QUICK else 0.15)  # false alarms: a few % (1 % stated)
+assert fa["image"][2] <= PFA <= fa["image"][3]  # the stated 1 % within the 99 % interval
 assert np.median([r[0] / r[1] for r in geo["sionna"]]) > 10  # ... by over 10 times the threshold
-assert min(len(geo["sionna"]), len(geo["image"])) >= max(1, n_ep // 2)  # bound mostly defined
+assert len(geo["sionna"]) >= max(1, n_ep // 2)  # bound mostly defined
+assert len(geo["image"]) >= max(1, n_draw * n_ep // 2)
 assert ratio_rt["kappa"] > 3 and max(ratio_rt["phi"], ratio_rt["psi"]) > 1
+# the floors: above the image channel's errors, below the traced channel's typical ones
+assert kept["image"] >= 0.95 and kept["sionna"] < 1.0
+assert np.median(ang_rt) > floor_deg and within < 0.5
+# the stored traced sigmas and this notebook's RMS errors: the same order of magnitude
+assert 0.1 < np.degrees(rms_rt["phi"]) / stored[2] < 10 and 0.1 < rms_rt["kappa"] / stored[4] < 10
 print("section 9 checks passed")

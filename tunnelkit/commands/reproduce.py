@@ -26,7 +26,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         choices=["image", "sionna"],
         default="image",
         help="channel source: the image method's eq. 1 (default) or the ray-traced channel "
-        "(Sionna RT, every path per element, traced once and cached; javelin-table1|2 only)",
+        "(Sionna RT, every path per element, traced once and cached; javelin-table1|2 only; "
+        "adds the traced design's column: sigmas measured on that channel, geometry pre-filter; "
+        "its sigmas belong to the route with --diffuse-floor)",
     )
     p.add_argument(
         "--second-order",

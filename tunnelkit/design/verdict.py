@@ -269,8 +269,8 @@ def recommend(rows, target: float, share: float, runs: int) -> dict:
     """The recommendation from candidates with ``.array``, ``.n_elements``,
     ``.aperture_diagonal_m``, ``.status``, ``.reason``: ``{array, reason, basis}``; ``basis``
     is ``"monte-carlo"`` or ``"bounds"`` (no runs: a necessary condition, not an answer)."""
-    rows = sequence("rows", rows, empty=True)  # empty: no candidate left, none recommended
-    target = positive("target", target)
+    # no rows: every candidate failed (reported per array): "no candidate", not an error
+    rows, target = sequence("rows", rows, empty=True), positive("target", target)
     share = probability("share", share, open_interval=False)
     runs = integer("runs", runs, minimum=0)
     pct = f"{100 * share:g} %"

@@ -22,6 +22,7 @@ from ..reference import load as load_reference
 from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
 from ..studies.drives import FLAGGED, drive_variant
 from ..studies.scoring import evaluate
+from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from . import Report, register
 
@@ -47,15 +48,22 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
 )
 #: the column added when the coherent route was measured too
 COHERENT_COLUMN = ("our design, coherent route", "coherent", "ours-coherent")
+#: the column added on the ray-traced channel: the traced design (measurement noise measured on
+#: that channel, :func:`~tunnelkit.studies.traced.traced_design`) fed the ML route's measurements
+#: of every epoch that the geometry pre-filter keeps (:func:`~tunnelkit.studies.traced.simulate_traced`)
+TRACED_COLUMN = ("traced design + geometry test, ML route", "ml-traced", "traced")
 
 
-def _designs() -> dict:
-    return {
+def _designs(traced: bool = False) -> dict:
+    out = {
         "paper": designs.paper(),
         "paper-vue": designs.paper_vue(),
         "ours": designs.ours_ml(),
         "ours-coherent": designs.ours_coherent(),
     }
+    if traced:
+        out["traced"] = traced_design()
+    return out
 
 
 def table_columns(
@@ -70,6 +78,7 @@ def table_columns(
     routes = tuple(routes)
     if columns is None:
         columns = COLUMNS + ((COHERENT_COLUMN,) if "coherent" in routes else ())
+        columns += (TRACED_COLUMN,) if TRACED_COLUMN[1] in routes else ()
     columns = tuple(c for c in columns if c[1] in routes)
     if not columns:
         raise ValueError(f"routes: none of the table's routes present, got {list(routes)}")
@@ -86,7 +95,7 @@ def score_drive(
     instance("drives", drives, dict, "drives per route (a dict)")
     text("cond", cond)
     sequence("columns", columns)
-    table_designs = _designs()
+    table_designs = _designs(traced=any(c[2] == "traced" for c in columns))
     cache: dict[tuple[str, str, str], dict[str, float]] = {}
     out = {}
     for label, route, design in columns:
@@ -187,9 +196,15 @@ def _simulate_and_score(
     count. ``length``: the drive of :func:`~tunnelkit.studies.drives.drive_variant` instead of
     the preset's (built on the worker, once per process)."""
     route = scenario if length is None else drive_variant(scenario, length)
-    drives = simulate_condition(
-        route, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance
-    )
+    if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced column: one more adapter
+        drives = simulate_traced(
+            route, rng, condition=cond, n_epochs=n_epochs, channel=channel, nuisance=nuisance
+        )
+        drives = {e: drives[e] for e in (*extractions, TRACED_COLUMN[1])}
+    else:
+        drives = simulate_condition(
+            route, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance
+        )
     faults = {
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
@@ -251,7 +266,7 @@ def javelin_table(
             scenario,
             n_epochs,
             e,
-            table_columns(e),
+            table_columns(_traced_routes(e, channel)),
             channel=channel,
             nuisance=nuisance,
             length=length,
@@ -263,9 +278,18 @@ def javelin_table(
     )
 
 
+def _traced_routes(extractions: tuple[str, ...], channel: str) -> tuple[str, ...]:
+    """``extractions`` plus the traced column's route on the ray-traced channel (when the ML
+    route is measured: the traced column's drives are its measurements)."""
+    if channel == "sionna" and "ml" in extractions and set(extractions) <= {"paper", "ml"}:
+        return (*extractions, TRACED_COLUMN[1])
+    return tuple(extractions)
+
+
 def _report(scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
     (scores, faults)), ...]`` in drive order (also from a subset of whole runs)."""
+    extractions = _traced_routes(extractions, channel)
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
     faults = dict.fromkeys(extractions, 0)
@@ -303,6 +327,7 @@ def _report(scenario, reference, conditions, extractions, done, channel, nuisanc
         notes=[
             *NOTES,
             *(_RT_NOTES if channel == "sionna" else []),
+            *([_traced_note(nuisance)] if TRACED_COLUMN[1] in extractions else []),
             *([_nuisance_note(nuisance)] if nuisance else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
@@ -319,8 +344,37 @@ _RT_NOTES = [
     "shell, asphalt road as ITU very_dry_ground, metal RRMs; tunnelkit.rt.settings), in eq. 1's "
     "sign convention (tunnelkit.rt.elements); noise and clock bias drawn per run. The number of "
     "paths to extract and the truth are the image method's first-order specular paths; "
-    "the trackers' designs are unchanged (chosen on the image channel).",
+    "the image channel's designs are unchanged (chosen on the image channel).",
 ]
+
+
+def _traced_note(nuisance: dict | None) -> str:
+    """The traced column's note, its numbers read from the stored record (and whether the
+    table's route is the one they were measured on)."""
+    from ..studies.traced import FLOORS, traced_errors
+
+    rec = traced_errors()
+    a = {r[0]: r for r in rec["rows"]}["all"]
+    same = dict(nuisance or {}) == rec["nuisance"]
+    return (
+        f"Column '{TRACED_COLUMN[0]}': designs.ours_ml with its measurement noise set to the ML "
+        f"route's RMS error on the ray-traced channel ({a[2]:.3g} deg, {a[3]:.3g} deg, "
+        f"{a[4]:.3g} m, {a[5]:.3g} m over {a[1]} matched paths; {rec['scenario']}, condition "
+        f"{rec['condition']}, seed {rec['seed']}, {rec['runs']} runs: "
+        "studies.traced.measure_traced_errors on children 0.."
+        f"{rec['runs'] - 1} of seed {rec['seed']}, stored in data/rt/traced_errors.json; Table 1's "
+        "JAVELIN-L run 0 at that seed is child 0, one of those drives), fed every epoch's ML "
+        "measurements "
+        "(the fit's own test ignored) that the geometry-consistency test keeps "
+        f"(path_consistency.epoch_consistency, floors {np.degrees(FLOORS[0]):.2g} deg and "
+        f"{FLOORS[1]:.2g} m, chosen on the straight drive at seed 0)."
+        + (
+            ""
+            if same
+            else f" The sigmas were measured on the route with {rec['nuisance']}, this table "
+            f"runs {dict(nuisance or {})} (pass --diffuse-floor for the route they belong to)."
+        )
+    )
 
 
 def _nuisance_note(nuisance: dict) -> str:

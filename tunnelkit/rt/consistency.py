@@ -22,13 +22,17 @@ planes, whatever their individual fit to the tensor. :func:`geometry_consistency
 The residuals are normalised by ``sigma^2 = sigma_bound^2 + floor^2`` per component: the bound's
 standard deviations (e.g. the CRLB the extraction reports) and a stated model-error floor
 (``floor_angle`` [rad], ``floor_range`` [m]; zero by default, the test of eq. 1 itself).
-Correlations between a path's components are left out. :func:`consistent_paths` runs it on a
+Without ``cov`` the correlations within a path and between paths are left out (the statistic
+then over-rejects: the ML fit's paths are correlated up to 0.9 at the presets' geometry); with
+the joint covariance ``cov`` of all paths the statistic is the generalised least-squares
+chi-square. :func:`consistent_paths` runs it on a
 route's measurements (the rows of :class:`tunnelkit.signal_route.RouteMeasurements`).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import solve_triangular
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
@@ -113,6 +117,7 @@ def geometry_consistency(
     n_los: int = 3,
     coarse: tuple[float, float] = (1e-3, 0.05),
     inside=None,
+    cov=None,
 ) -> dict:
     """The geometry-consistency test of one snapshot's paths (module docstring).
 
@@ -124,7 +129,12 @@ def geometry_consistency(
     paths are tried as the LoS, ``coarse`` the (angle [rad], range [m]) floor under which the
     hypotheses are ranked (the plane assignment is chosen there, then refined at ``sigma``),
     ``inside`` (optional) a callable ``p -> bool`` that a hypothesised UE must pass (e.g.
-    ``tunnel.contains``). Returns a dict: ``r2`` (K,), ``plane`` (K,) (-1 LoS),
+    ``tunnel.contains``), ``cov`` (optional) the bound's joint (3 K, 3 K) covariance of every
+    path's ``(phi, psi, d)`` (row ``3 j + i``; e.g.
+    :func:`tunnelkit.path_consistency.joint_bound`): then the snapshot's statistic is the
+    generalised least-squares fit ``min z^T (cov + F)^-1 z`` (``F`` the floors squared on the
+    diagonal; correlations within and between paths included) and each path's ``r2`` uses its
+    3 x 3 block (the ``sigma_*`` still rank the hypotheses and assign the planes). Returns a dict: ``r2`` (K,), ``plane`` (K,) (-1 LoS),
     ``keep`` (K,) bool, ``statistic``, ``dof``, ``threshold``, ``consistent``, ``ue`` (3,),
     ``beta`` [m]; with fewer than two paths nothing is testable (``consistent`` True, all kept,
     ``dof`` 0)."""
@@ -156,6 +166,16 @@ def geometry_consistency(
             raise ValueError(f"{name}: zero with a zero floor leaves the test undefined")
         sig.append(s)
     sig = np.stack(sig, axis=-1)  # (K, 3)
+    chol = None
+    if cov is not None:
+        cv = finite_array("cov", cov)
+        if cv.shape != (3 * K, 3 * K) or not np.allclose(cv, cv.T, rtol=1e-9, atol=0.0):
+            raise ValueError(f"cov: expected a symmetric ({3 * K}, {3 * K}) matrix, got {cv.shape}")
+        cv = cv + np.diag(np.tile([fa**2, fa**2, fr**2], K))
+        try:
+            chol = np.linalg.cholesky(cv)
+        except np.linalg.LinAlgError as exc:
+            raise ValueError("cov: not positive definite") from exc
     g = float(chi2.ppf(1.0 - pfa, 3))
     if K < 2:
         return {"r2": np.zeros(K), "plane": -np.ones(K, int), "keep": np.ones(K, bool),
@@ -212,9 +232,29 @@ def geometry_consistency(
         res = _residuals(z[:3], z[3], o, phi, psi, d, normals, offsets, sig)
         return res[rows, plane].ravel()
 
-    x_all = least_squares(f_all, x, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15).x
-    r2_all = (f_all(x_all).reshape(K, 3) ** 2).sum(-1)
-    stat = float(r2_all.sum())
+    if chol is None:
+        x_all = least_squares(f_all, x, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15).x
+        r2_all = (f_all(x_all).reshape(K, 3) ** 2).sum(-1)
+        stat = float(r2_all.sum())
+    else:  # generalised least squares: the residuals whitened by the joint covariance
+        one = np.ones_like(sig)
+
+        def raw(z):
+            return _residuals(z[:3], z[3], o, phi, psi, d, normals, offsets, one)[rows, plane]
+
+        def f_gls(z):
+            return solve_triangular(chol, raw(z).ravel(), lower=True)
+
+        x_all = least_squares(f_gls, x, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15).x
+        stat = float(np.sum(f_gls(x_all) ** 2))
+        blocks = np.stack([cv[3 * j : 3 * j + 3, 3 * j : 3 * j + 3] for j in range(K)])
+
+        def block_r2(z):
+            e = raw(z)
+            return np.einsum("ki,ki->k", e, np.linalg.solve(blocks, e[..., None])[..., 0])
+
+        r2_all = block_r2(x_all)
+        r2 = block_r2(x)
     ok = stat <= thr
     if ok:  # consistent: every path judged against the fit of all
         x, r2 = x_all, r2_all

@@ -1,0 +1,133 @@
+"""``tunnelkit reproduce javelin-table1|2 --channel sionna --diffuse-floor`` drive by drive, resumable.
+
+A traced drive takes minutes on a loaded machine, so a 20-run table on the ray-traced channel may
+not finish in one sitting. Here each drive (table ``T``, seed ``S``, run ``r``, condition ``c``:
+drive ``i = n r + c`` of the table's ``n`` conditions, drawn from the ``i``-th child of the seed
+exactly as :func:`tunnelkit.montecarlo.run_trials` draws it, with one BLAS thread as there) is
+simulated (:func:`tunnelkit.studies.traced.simulate_traced`: the paper's route, the ML route and
+the traced column's measurements from the same tensors) and scored in every column
+(:func:`tunnelkit.reproduce.javelin_tables.score_drive`), as the reproduce target's trial
+(``javelin_tables._simulate_and_score``) does; the result and the drives (tensors are not kept)
+go to ``DIR/<table>-seed<S>/drive<i>.pkl``. ``--conditions L`` runs only the drives of those
+conditions (their rows equal the full table's: same drive indices); ``--report`` assembles the
+table from the whole runs saved so far. Runs are interleaved over the tables and seeds given
+(run 0 of each, then run 1, ...), so a cut-off leaves them with equal counts.
+
+    nice python benchmarks/bench_rt_javelin.py --tables 1 2 --seeds 0 20261202 --conditions L \
+        --runs 20 --dir /tmp/rtj
+    python benchmarks/bench_rt_javelin.py --tables 1 2 --seeds 0 20261202 --conditions L --report \
+        --dir /tmp/rtj
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pickle
+import sys
+import time
+import warnings
+from pathlib import Path
+
+from threadpoolctl import threadpool_limits
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tunnelkit.montecarlo import spawn_rngs
+from tunnelkit.reproduce import javelin_tables as jt
+from tunnelkit.studies.drives import FLAGGED
+from tunnelkit.studies.traced import simulate_traced
+
+TABLES = {
+    "1": ("italiano2026-straight", "italiano2026_table1", ("L", "N@0.5", "N", "NoRRMs")),
+    "2": ("italiano2026-slalom", "italiano2026_table2", ("L", "N@0.5", "N")),
+}
+EXTRACTIONS = ("paper", "ml")
+NUISANCE = {"diffuse_floor": True}
+
+
+def drive(table: str, seed: int, i: int, n_epochs: int | None = None):
+    """Drive ``i`` of ``table`` at ``seed``: ``((cond, (scores, faults)), drives)``."""
+    scenario, _, conds = TABLES[table]
+    rng = spawn_rngs(seed, i + 1)[i]
+    cond = conds[i % len(conds)]
+    routes = jt._traced_routes(EXTRACTIONS, "sionna")
+    cols = jt.table_columns(routes)
+    with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        drives = simulate_traced(
+            scenario, rng, condition=cond, n_epochs=n_epochs, channel="sionna", nuisance=NUISANCE
+        )
+        scores = jt.score_drive({e: drives[e] for e in routes}, cond, cols)
+    faults = {
+        e: (len(drives[e].faults), sum(f.endswith(FLAGGED) for f in drives[e].faults),
+            len(drives[e].t))
+        for e in routes
+    }  # fmt: skip
+    return (cond, (scores, faults)), drives
+
+
+def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None) -> None:
+    for r in range(runs):
+        for t in tables:
+            conds = TABLES[t][2]
+            for s in seeds:
+                d = out / f"table{t}-seed{s}"
+                d.mkdir(parents=True, exist_ok=True)
+                for c, cond in enumerate(conds):
+                    if cond not in conditions:
+                        continue
+                    i = len(conds) * r + c
+                    f = d / f"drive{i}.pkl"
+                    if f.exists():
+                        continue
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    res, drives = drive(t, s, i, n_epochs)
+                    tmp = f.with_suffix(".tmp")
+                    tmp.write_bytes(pickle.dumps({"result": res, "drives": drives}))
+                    tmp.rename(f)
+                    print(
+                        f"table {t} seed {s} drive {i} ({cond}): {time.perf_counter() - t0:.0f} s "
+                        f"wall, {time.process_time() - c0:.0f} s CPU, faults {res[1][1]}",
+                        flush=True,
+                    )
+
+
+def report(table: str, seed: int, conditions, out: Path, fmt: str = "text") -> str:
+    scenario, ref, conds = TABLES[table]
+    conds = tuple(c for c in conds if c in conditions)
+    n = len(TABLES[table][2])
+    d = out / f"table{table}-seed{seed}"
+    done, r = [], 0
+    while True:
+        idx = [n * r + TABLES[table][2].index(c) for c in conds]
+        if not all((d / f"drive{i}.pkl").exists() for i in idx):
+            break
+        done += [pickle.loads((d / f"drive{i}.pkl").read_bytes())["result"] for i in idx]
+        r += 1
+    if not done:
+        return f"table {table} seed {seed}: no whole run saved yet in {d}"
+    rep = jt._report(scenario, ref, conds, EXTRACTIONS, done, "sionna", NUISANCE, None, {})
+    rep.meta = {"target": f"javelin-table{table}", "runs": r, "seed": seed, **rep.meta}
+    return rep.to_json() if fmt == "json" else rep.to_table() + "\n" + json.dumps(rep.meta)
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--tables", nargs="+", default=["1", "2"], choices=list(TABLES))
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0])
+    ap.add_argument("--runs", type=int, default=20)
+    ap.add_argument("--conditions", nargs="+", default=["L", "N@0.5", "N", "NoRRMs"])
+    ap.add_argument("--n-epochs", type=int, default=None)
+    ap.add_argument("--dir", default="rt_javelin")
+    ap.add_argument("--report", action="store_true")
+    ap.add_argument("--format", default="text", choices=("text", "json"))
+    a = ap.parse_args()
+    out = Path(a.dir)
+    if a.report:
+        for t in a.tables:
+            for s in a.seeds:
+                print(report(t, s, a.conditions, out, a.format))
+    else:
+        simulate(a.tables, a.seeds, a.runs, a.conditions, out, a.n_epochs)

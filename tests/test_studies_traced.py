@@ -1,0 +1,128 @@
+"""The traced design's pieces: the drive loop equals the one drive simulator, the adapter, the
+stored sigmas and the design read from them."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tunnelkit.studies import simulate_routes
+from tunnelkit.studies.drives import path_measurements, scenario_route
+from tunnelkit.studies.traced import (
+    FLOORS,
+    geometry_keep,
+    simulate_traced,
+    traced_design,
+    traced_errors,
+    traced_measurements,
+    write_traced_errors,
+)
+from tunnelkit.tracking.javelin import designs
+
+
+def _same_drive(a, b):
+    assert a.faults == b.faults
+    np.testing.assert_array_equal(a.los, b.los)
+    np.testing.assert_array_equal(a.n_true, b.n_true)
+    np.testing.assert_array_equal(a.speed, b.speed)
+    np.testing.assert_array_equal(a.heading, b.heading)
+    for pa, pb, ta, tb in zip(a.epochs, b.epochs, a.truth_index, b.truth_index, strict=True):
+        assert (pa is None) == (pb is None)
+        np.testing.assert_array_equal(ta, tb)
+        if pa is not None:
+            for f in ("phi", "psi", "kappa", "d", "source"):
+                np.testing.assert_array_equal(getattr(pa, f), getattr(pb, f))
+
+
+@pytest.mark.parametrize("cond", ["L", "N@0.5"])
+def test_the_loop_draws_and_measures_as_the_drive_simulator(cond):
+    """Same seed: the paper's and the ML route's drives equal simulate_routes' (image channel)."""
+    ref = simulate_routes(
+        "italiano2026-straight", np.random.default_rng(3), condition=cond,
+        extractions=("paper", "ml"), n_epochs=3,
+    )  # fmt: skip
+    got = simulate_traced("italiano2026-straight", np.random.default_rng(3), condition=cond,
+                          n_epochs=3)  # fmt: skip
+    for e in ("paper", "ml"):
+        _same_drive(got[e], ref[e])
+    # the traced adapter keeps a subset of every epoch's ML measurements, in their order
+    for pa, pt in zip(got["ml-all"].epochs, got["ml-traced"].epochs, strict=True):
+        if pt is not None:
+            assert set(pt.source) <= set(pa.source)
+            assert np.all(np.diff(pt.source) > 0)
+
+
+def test_the_adapter_passes_a_flagged_fit_and_drops_an_inconsistent_path():
+    route = scenario_route("italiano2026-straight")
+    ep = route.epoch(5, np.random.default_rng(1), refine="ml")
+    keep = geometry_keep(ep, route)
+    assert keep.tolist() == list(range(len(ep.measurements)))  # eq.-1 channel: all agree
+    flagged = replace(ep, estimates=replace(ep.estimates, fit_ok=False))
+    assert path_measurements(flagged, route)[0] is None  # the ordinary adapter drops it
+    pm, why = traced_measurements(flagged, route)
+    assert why is None and len(pm) == len(ep.measurements)
+    # one path's range moved by 5 m (far beyond the 0.3 m floor): dropped, the others kept
+    m = ep.measurements
+    d = m.d.copy()
+    d[1] += 5.0
+    bad = replace(ep, measurements=replace(m, d=d))
+    kept = geometry_keep(bad, route)
+    assert 1 not in kept and len(kept) == len(m) - 1
+    with pytest.raises(ValueError, match="floors"):
+        geometry_keep(ep, route, floors=(0.0, 0.3))
+
+
+def test_the_stored_errors_set_the_design(tmp_path):
+    rec = {"scenario": "italiano2026-straight", "condition": "L", "seed": 0, "runs": 1,
+           "rows": [["los", 3, 1.0, 2.0, 30.0, 0.5, 0], ["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]}  # fmt: skip
+    p = write_traced_errors(rec, tmp_path / "e.json")
+    assert json.loads(open(p).read())["rows"][1][0] == "all"
+    d = traced_design(p)
+    assert d.config.sigma_phi == pytest.approx(np.radians(9.0))
+    assert d.config.sigma_psi == pytest.approx(np.radians(8.0))
+    assert d.config.sigma_kappa == 33.0 and d.config.sigma_delta_d == 1.1
+    base = designs.ours_ml()
+    assert replace(d.config, sigma_phi=1, sigma_psi=1, sigma_kappa=1, sigma_delta_d=1) == replace(
+        base.config, sigma_phi=1, sigma_psi=1, sigma_kappa=1, sigma_delta_d=1
+    )  # every other number from ours_ml
+    with pytest.raises(FileNotFoundError, match="path"):
+        traced_errors(tmp_path / "missing.json")
+    (tmp_path / "bad.json").write_text(json.dumps({"rows": [["los", 1, 1, 1, 1, 1, 0]]}))
+    with pytest.raises(ValueError, match="path"):
+        traced_errors(tmp_path / "bad.json")
+
+
+def test_the_stored_record_states_its_procedure():
+    rec = traced_errors()
+    assert rec["procedure"] == "tunnelkit.studies.traced.measure_traced_errors"
+    assert rec["seed"] == 0 and rec["scenario"] == "italiano2026-straight"
+    assert rec["condition"] == "L" and rec["nuisance"] == {"diffuse_floor": True}
+    assert FLOORS[1] > 0
+
+
+@pytest.mark.skipif(os.environ.get("TUNNELKIT_SKIP_RT") == "1", reason="TUNNELKIT_SKIP_RT=1")
+def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive():
+    """``javelin_table(channel="sionna")`` (two epochs, one run) adds the traced column; its
+    JAVELIN-L score is the traced design's on simulate_traced's ``ml-traced`` drive of the same
+    child seed; the image channel's table has no such column."""
+    from tunnelkit.montecarlo import spawn_rngs
+    from tunnelkit.reproduce.javelin_tables import TRACED_COLUMN, javelin_table
+    from tunnelkit.studies import evaluate
+
+    nuis = {"diffuse_floor": True}
+    rep = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
+                        extractions=("ml",), n_epochs=2, channel="sionna", nuisance=nuis)  # fmt: skip
+    assert TRACED_COLUMN[0] in rep.columns
+    col = rep.columns.index(TRACED_COLUMN[0])
+    row = next(r for r in rep.rows if r[0] == "JAVELIN-L" and r[1] == "rmse_2d_m")
+    d = simulate_traced("italiano2026-slalom", spawn_rngs(0, 1)[0], n_epochs=2, channel="sionna",
+                        nuisance=nuis)["ml-traced"]  # fmt: skip
+    assert row[col] == pytest.approx(evaluate(d, traced_design()).metrics["rmse_2d_m"], rel=1e-12)
+    assert any("traced design" in n for n in rep.notes)
+    img = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
+                        extractions=("ml",), n_epochs=2)  # fmt: skip
+    assert TRACED_COLUMN[0] not in img.columns

@@ -1,0 +1,316 @@
+"""The traced design: JAVELIN on the ray-traced channel, told the channel's own errors.
+
+On the ray-traced channel (Sionna RT: diffuse scattering, higher-order bounces, cut-off
+wavefronts; ``tunnelkit reproduce javelin-table1|2 --channel sionna``) the ML route's first-order
+estimates are 25-40 times further off than on the image channel, and every fit fails its own
+residual test. The design of the image channel (:func:`~tunnelkit.tracking.javelin.designs.ours_ml`:
+sigmas of 0.23 deg, 0.31 deg, 3.6 m, 3.2 cm) then trusts them far too much. The traced design
+changes two things, nothing else:
+
+* **measurement noise**: the RMS extraction error of the ML route on the traced channel
+  (:func:`~tunnelkit.studies.analysis.extraction_errors`, all matched paths pooled), measured by
+  :func:`measure_traced_errors` on the straight drive, seed 0, condition L, :data:`SIGMA_RUNS`
+  runs (drive ``i`` from the ``i``-th child of seed 0), and stored with its provenance in
+  ``data/rt/traced_errors.json`` (:func:`write_traced_errors`; ``benchmarks/bench_rt_sigmas.py
+  --write`` re-measures it); :func:`traced_design` reads it;
+* **a geometry pre-filter**: an epoch's paths that do not agree with one UE through the tunnel's
+  planes are dropped (:func:`geometry_keep`: :func:`tunnelkit.path_consistency.epoch_consistency`
+  with the model-error floors :data:`FLOORS` alone), and an epoch whose fit failed its residual
+  test still carries its measurements (on this channel every fit fails it: the test judges eq. 1,
+  not the paths the tracker needs).
+
+:func:`simulate_traced` is the drive simulator's loop with that adapter beside the ordinary one
+(:func:`tunnelkit.studies.drives.path_measurements`, which drops a flagged epoch inside
+:func:`~tunnelkit.studies.drives.simulate_routes`' loop): one drive, the same random draws as
+``simulate_routes(extractions=("paper", "ml"))``, returned as ``{"paper", "ml", "ml-all",
+"ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from dataclasses import replace
+
+import numpy as np
+
+from .._validate import boolean, finite_array, instance, integer, rng_or_error
+from ..path_consistency import epoch_consistency
+from ..scenarios import data_dir
+from ..signal_route import Epoch, SignalRoute
+from ..tracking.javelin import designs
+from ..tracking.javelin.measurement import PathMeasurements
+from .drives import (
+    CONDITIONS,
+    SIGMA_HEADING,
+    SIGMA_SPEED,
+    DriveData,
+    ml_epoch,
+    path_measurements,
+    scenario_route,
+)
+
+__all__ = [
+    "FLOORS",
+    "SIGMA_RUNS",
+    "SIGMA_SCENARIO",
+    "TRACED_ROUTES",
+    "geometry_keep",
+    "measure_traced_errors",
+    "simulate_traced",
+    "traced_design",
+    "traced_errors",
+    "traced_measurements",
+    "write_traced_errors",
+]
+
+#: model-error floors of the geometry pre-filter: (angle [rad], range [m]), chosen on the straight
+#: drive, seed 0 (``benchmarks/bench_rt_track.py``); the bound's own sigmas are left out (the
+#: traced fits lie thousands of CRLB standard deviations off)
+FLOORS = (float(np.radians(0.5)), 0.3)
+#: the drive and number of condition-L runs (seed 0) the traced sigmas are measured on
+SIGMA_SCENARIO, SIGMA_RUNS = "italiano2026-straight", 3
+#: the routes :func:`simulate_traced` returns
+TRACED_ROUTES = ("paper", "ml", "ml-all", "ml-traced")
+#: the ray-traced route the traced sigmas are measured on (the ML fit judged against noise +
+#: diffuse power)
+NUISANCE = {"diffuse_floor": True}
+
+
+def _errors_path():
+    return data_dir() / "rt" / "traced_errors.json"
+
+
+def _path(path):
+    import os
+    from pathlib import Path
+
+    if not isinstance(path, str | os.PathLike) or not str(path):
+        raise TypeError(f"path: expected a file path, got {path!r}")
+    return Path(path)
+
+
+def _floors(floors) -> tuple[float, float]:
+    f = finite_array("floors", floors)
+    if f.shape != (2,) or np.any(f <= 0):
+        raise ValueError(f"floors: expected (angle [rad], range [m]), both > 0, got {floors!r}")
+    return float(f[0]), float(f[1])
+
+
+def geometry_keep(ep: Epoch, route: SignalRoute, floors=FLOORS) -> np.ndarray:
+    """Rows of ``ep.measurements`` the geometry-consistency test keeps (residuals in units of the
+    model-error ``floors`` = (angle [rad], range [m]) alone, per-path chi-square(3) at 1 %); an
+    epoch of fewer than two paths keeps them all (nothing to test)."""
+    instance("ep", ep, Epoch)
+    instance("route", route, SignalRoute)
+    fa, fr = _floors(floors)
+    m = ep.measurements
+    if len(m) < 2:
+        return np.arange(len(m))
+    res = epoch_consistency(ep, route, bound=False, floor_angle=fa, floor_range=fr)
+    return np.flatnonzero(res["keep"])
+
+
+def traced_measurements(
+    ep: Epoch, route: SignalRoute, floors=FLOORS, *, prefilter: bool = True
+) -> tuple[PathMeasurements | None, str | None]:
+    """The traced design's adapter: ``ep``'s measurements whatever its fit's own verdict
+    (``fit_ok``), reduced to the rows :func:`geometry_keep` keeps (``prefilter=False``: all);
+    ``(None, reason)`` when no row is left."""
+    instance("ep", ep, Epoch)
+    instance("route", route, SignalRoute)
+    m = ep.measurements
+    pm = PathMeasurements.from_arrays(
+        m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d
+    )
+    if not prefilter:
+        return pm, None
+    keep = geometry_keep(ep, route, floors)
+    rows = np.flatnonzero(np.isin(pm.source, keep))
+    if not rows.size:
+        return None, "the geometry test kept no path"
+    return pm.subset(rows), None
+
+
+def _acc() -> dict:
+    return {"epochs": [], "tidx": [], "kinds": [], "faults": [], "sources": [], "los": [], "n": []}
+
+
+def _add(a: dict, k: int, ep, pm, reason) -> None:
+    if ep is None or pm is None:
+        a["faults"].append(f"epoch {k}: {reason}")
+        a["epochs"].append(None)
+        a["tidx"].append(np.zeros(0, int))
+        a["kinds"].append([])
+        a["sources"].append(np.zeros((0, 3)))
+        a["los"].append(False)
+        a["n"].append(0 if ep is None else len(ep.paths))
+        return
+    a["epochs"].append(pm)
+    a["tidx"].append(np.asarray(ep.truth_index)[pm.source])
+    a["kinds"].append([p.surface_kind for p in ep.paths])
+    a["sources"].append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
+    a["los"].append(any(p.kind == "los" for p in ep.paths))
+    a["n"].append(len(ep.paths))
+
+
+def simulate_traced(
+    route,
+    rng: np.random.Generator,
+    *,
+    condition: str = "L",
+    n_epochs: int | None = None,
+    channel: str | None = None,
+    nuisance: dict | None = None,
+    floors=FLOORS,
+) -> dict[str, DriveData]:
+    """One drive of ``route`` (a :class:`SignalRoute` or a scenario name, :func:`scenario_route`
+    with ``channel`` / ``nuisance``) under ``condition`` (a name of :data:`CONDITIONS`), measured
+    through the paper's and the ML route as :func:`~tunnelkit.studies.drives.simulate_routes`
+    measures them (same draws, same ``"paper"`` and ``"ml"`` drives), plus ``"ml-all"`` (the ML
+    route's measurements of every epoch, its fit test ignored) and ``"ml-traced"`` (those the
+    geometry pre-filter keeps, :func:`traced_measurements` with ``floors``)."""
+    rng = rng_or_error("rng", rng)
+    if condition not in CONDITIONS:
+        raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
+    cond = CONDITIONS[condition]
+    floors = _floors(floors)
+    label = route if isinstance(route, str) else "route"
+    route = scenario_route(route, "exact", channel, nuisance)
+    no_los = replace(route, kinds=tuple(k for k in route.kinds if k != "los"))
+    tunnel = route.tunnel if cond.rrms else route.tunnel.without_plates()
+    traj = route.trajectory
+    T = len(traj) if n_epochs is None else min(integer("n_epochs", n_epochs, minimum=1), len(traj))
+    acc = {e: _acc() for e in TRACED_ROUTES}
+    bs = None
+    for k in range(T):
+        r = route if rng.random() < cond.los_probability else no_los
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                ep0, why = None, f"extraction failed ({exc})"
+            ep = None
+            if ep0 is not None:
+                try:
+                    ep = ml_epoch(ep0, r.config, r.ml_noise_power(ep0.k, ep0.snapshot, tunnel))
+                except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
+                    why_ml = f"extraction failed ({exc})"
+            for e, src in (("paper", ep0), ("ml", ep), ("ml-all", ep), ("ml-traced", ep)):
+                reason = why if ep0 is None else (why_ml if src is None else None)
+                pm = None
+                if src is not None:
+                    bs = src.measurements.origin.copy()
+                    if e in ("paper", "ml"):
+                        pm, reason = path_measurements(src, route)
+                    else:
+                        pm, reason = traced_measurements(
+                            src, route, floors, prefilter=e != "ml-all"
+                        )
+                _add(acc[e], k, src, pm, reason)
+    if bs is None:
+        bs = route.arrays[0].origin.copy()
+    vel = traj.velocity[:T]
+    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
+    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
+    return {
+        e: DriveData(
+            label,
+            cond,
+            traj.t[:T].copy(),
+            traj.position[:T].copy(),
+            vel.copy(),
+            speed.copy(),
+            heading.copy(),
+            a["epochs"],
+            np.array(a["los"], bool),
+            np.array(a["n"], int),
+            bs.copy(),
+            a["tidx"],
+            a["kinds"],
+            a["faults"],
+            a["sources"],
+            "ml" if e != "paper" else "paper",
+            route.config.clock_bias_limit,
+            bool(route.report_covariance),
+        )
+        for e, a in acc.items()
+    }
+
+
+def _sigma_trial(n_epochs, cond, rng):
+    return simulate_traced(
+        SIGMA_SCENARIO, rng, condition=cond, n_epochs=n_epochs, channel="sionna", nuisance=NUISANCE
+    )["ml-all"]
+
+
+def measure_traced_errors(
+    runs: int = SIGMA_RUNS, seed: int = 0, progress: bool = False, n_epochs: int | None = None
+) -> dict:
+    """The traced design's measurement noise, measured: ``runs`` condition-L drives of
+    :data:`SIGMA_SCENARIO` on the ray-traced channel (diffuse power as the ML fit's floor; drive
+    ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.montecarlo.run_trials`), every
+    epoch's ML measurements (``"ml-all"`` of :func:`simulate_traced`), their RMS errors per kind
+    of path (:func:`~tunnelkit.studies.analysis.extraction_errors`). Returns the record
+    :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the sigmas) and
+    the procedure's provenance."""
+    from ..montecarlo import run_trials
+    from .analysis import extraction_errors
+
+    runs = integer("runs", runs, minimum=1)
+    seed = integer("seed", seed, minimum=0)
+    boolean("progress", progress)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    drives = run_trials(
+        lambda c, rng: _sigma_trial(n_epochs, c, rng), runs, seed, inputs=["L"] * runs,
+        progress=progress, desc="traced drives",
+    )  # fmt: skip
+    cols, rows = extraction_errors(drives)
+    route = scenario_route(SIGMA_SCENARIO, "exact", "sionna", NUISANCE)
+    return {
+        "procedure": "tunnelkit.studies.traced.measure_traced_errors",
+        "scenario": SIGMA_SCENARIO,
+        "condition": "L",
+        "seed": seed,
+        "runs": runs,
+        "n_epochs": n_epochs,
+        "nuisance": dict(NUISANCE),
+        "rt_settings": {k: v for k, v in vars(route.raytraced.settings).items()},
+        "columns": list(cols),
+        "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
+    }
+
+
+def write_traced_errors(record: dict, path=None) -> str:
+    """Store ``record`` (:func:`measure_traced_errors`) as JSON at ``path`` (default
+    ``data/rt/traced_errors.json``, what :func:`traced_errors` reads); returns the path."""
+    if not isinstance(record, dict) or "rows" not in record:
+        raise TypeError("record: expected the dict of measure_traced_errors")
+    p = _errors_path() if path is None else _path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    p.write_text(json.dumps(record, indent=1, default=str) + "\n")
+    return str(p)
+
+
+def traced_errors(path=None) -> dict:
+    """The stored record of :func:`measure_traced_errors` (``path`` default
+    ``data/rt/traced_errors.json``)."""
+    p = _errors_path() if path is None else _path(path)
+    if not p.is_file():
+        raise FileNotFoundError(
+            f"path: no traced errors at {p}; measure them with benchmarks/bench_rt_sigmas.py --write"
+        )
+    rec = json.loads(p.read_text())
+    if not any(r[0] == "all" for r in rec.get("rows", [])):
+        raise ValueError(f"path: {p} holds no 'all' row of extraction_errors")
+    return rec
+
+
+def traced_design(path=None):
+    """:func:`~tunnelkit.tracking.javelin.designs.ours_ml` with its measurement noise set to the
+    stored traced errors (:func:`traced_errors`, the ``"all"`` row;
+    :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`); to be fed the
+    ``"ml-traced"`` drives of :func:`simulate_traced`."""
+    return designs.design_from_errors(traced_errors(path)["rows"], base=designs.ours_ml())
