@@ -172,6 +172,7 @@ def epoch_consistency(
     least-squares chi-square), else the per-component sigmas alone. Other ``kw``: the test's options (``pfa``, ``n_los``, ...)."""
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)
+    joint = boolean("joint", joint)  # checked whether or not the bound is asked for
     m = ep.measurements
     if boolean("bound", bound):
         sig = bound_sigmas(ep.estimates, ep.array, route.config, m.index)

@@ -119,6 +119,7 @@ def traced_measurements(
     ``(None, reason)`` when no row is left."""
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)
+    prefilter = boolean("prefilter", prefilter)
     m = ep.measurements
     pm = PathMeasurements.from_arrays(
         m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d
