@@ -281,8 +281,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "axis gives the same numbers with that axis (test_extra_leading_axes_vectorise)",
     ),
     _doc(
-        r"extraction\.paper\.algorithm1|signal_route\.(measurements_from_estimates"
-        r"|Epoch\.with_estimates)",
+        r"extraction\.paper\.algorithm1|signal_route\.(measurements\.)?"
+        r"(measurements_from_estimates|measure_epoch|Epoch\.with_estimates)",
         r"min_d",
         "negative",
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",

@@ -7,6 +7,8 @@ a finite-difference Jacobian, the CRLB at the estimate against the CRLB at the t
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.linalg import block_diag
@@ -169,7 +171,6 @@ def _epoch(array="10x10", k=3, seed=2026):
 
 
 def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles():
-    from types import SimpleNamespace
 
     from tunnelkit.extraction import estimate_crlb, path_crlb
     from tunnelkit.signal_route import reported_covariance
@@ -197,9 +198,7 @@ def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles
     kap = np.sqrt(m.cov[ok, 2, 2])
     np.testing.assert_allclose(kap, truth["kappa"][ti[ok]], rtol=0.5)
     # a fit that failed its residual test reports nothing
-    bad = SimpleNamespace(**{f: getattr(est, f) for f in ("alpha", "d", "direction", "kappa")})
-    bad.mu_f, bad.mu_t = est.mu_f, est.mu_t
-    bad.fit = SimpleNamespace(rho=2.0, rho_max=1.05, noise_power=est.fit.noise_power)
+    bad = dataclasses.replace(est, fit=dataclasses.replace(est.fit, rho=2.0, rho_max=1.05))
     assert reported_covariance(bad, m.index, arr, route.config) == (None, None)
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .._checks import indices
-from .._validate import boolean, instance, nonnegative, record, sequence
+from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
 from ..evaluation import match_paths
@@ -207,7 +207,7 @@ def measurements_from_estimates(
     instance("array", array, ArrayGeometry)
     if config is not None:
         instance("config", config, SRSConfig)
-    min_d = nonnegative("min_d", min_d)
+    min_d = real("min_d", min_d)  # -c b_max on a route with a clock-bias support
     judged = boolean("judged", judged)
     keep = algorithm1(est, min_d)
     u = array.dir_to_world(est.direction[keep]) if keep.size else np.zeros((0, 3))
