@@ -13,6 +13,10 @@ KERNEL_DISPLAY := Python (tunnelkit)
 # JupyterLab refuses to start as root unless told; pass --allow-root only then.
 LAB_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
+# Two `make test` side by side on one machine both reach apt-get: ours wait for each other on one
+# lock file (flock), and for any other apt client on dpkg's own lock, instead of failing at once.
+APT_LOCK_FILE ?= /var/lock/tunnelkit-apt.lock
+APT_LOCKED = flock -w 1800 $(APT_LOCK_FILE) apt-get -o DPkg::Lock::Timeout=600
 # pip --quiet still relays setuptools' build warnings and a site-wide config's "is ignored" notes
 PIP_FILTER := sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$\|Please be careful\|name as your package\|take precedence during\|with strategy, WheelFile\|warnings.warn(/d'
 

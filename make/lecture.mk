@@ -45,8 +45,8 @@ chromium:
 	    echo "chromium: cannot install: apt-get not found (not Debian/Ubuntu)." \
 	         "Install Chromium so that $(CHROMIUM) exists." >&2; exit 1; fi; \
 	  export DEBIAN_FRONTEND=noninteractive; \
-	  timeout 600 $$SUDO apt-get update -qq \
-	    && timeout 1200 $$SUDO apt-get install -y -qq chromium >/dev/null \
+	  timeout 600 $$SUDO $(APT_LOCKED) update -qq \
+	    && timeout 1200 $$SUDO $(APT_LOCKED) install -y -qq chromium >/dev/null \
 	    || { echo "chromium: apt-get could not install Debian's chromium (see above)" >&2; exit 1; }; \
 	  test -x $(CHROMIUM) || { echo "chromium: installed, but $(CHROMIUM) is still missing" >&2; exit 1; }; \
 	  echo "chromium: installed $$($(CHROMIUM) --version 2>/dev/null)"; \

@@ -19,7 +19,7 @@ rt-llvm:
 	@if ls /usr/lib/*-linux-gnu/libLLVM.so.19.1 >/dev/null 2>&1; then :; \
 	elif command -v apt-get >/dev/null 2>&1; then \
 		echo "installing Debian's libllvm19 (Dr.Jit CPU backend for Sionna RT)"; \
-		$(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq libllvm19 >/dev/null; \
+		$(SUDO) $(APT_LOCKED) update -qq && $(SUDO) $(APT_LOCKED) install -y -qq libllvm19 >/dev/null; \
 	else \
 		echo "rt-llvm: no apt-get here; install LLVM >= 17 and set DRJIT_LIBLLVM_PATH to its libLLVM.so" >&2; \
 	fi
