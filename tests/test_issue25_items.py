@@ -395,3 +395,91 @@ def test_scenarios_new_with_a_300_character_name(tmp_path, capsys):
     assert re.search(r"name: 300 characters", capsys.readouterr().err)
     assert not list(tmp_path.iterdir())
     _raises(tk.scenarios.ScenarioError, r"^name: 300", tk.load_scenario, "a" * 300)
+
+
+# --- the callables that had no valid call in the generated suite --------------------------------
+
+
+def _joint_fisher_args():
+    pos = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
+    src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
+    return [np.array([1.0 + 0.5j, 0.5j]), src, pos, [-0.7, -1.1], [0.05, -0.02], 4, 3, 0.3, 3.5e9]
+
+
+def test_joint_fisher_refuses_gains_with_an_extra_axis():
+    from tunnelkit.path_consistency import joint_fisher
+
+    args = _joint_fisher_args()
+    F = joint_fisher(*args)
+    assert F.shape == (14, 14) and np.allclose(F, F.T)
+    args[0] = args[0][None, None]
+    _raises(ValueError, r"^alpha: expected one complex gain per path", joint_fisher, *args)
+
+
+@pytest.mark.parametrize(
+    "i, value, match",
+    [(5, 10**12, r"^n_tones: .*memory budget"), (6, 10**12, r"^n_symbols: .*memory budget"),
+     (8, 28.0, r"^fc: .*1 MHz"), (8, 1e300, r"^fc: .*1 THz")],
+)  # fmt: skip
+def test_joint_fisher_bounded_work_and_carrier(i, value, match):
+    from tunnelkit.path_consistency import joint_fisher
+
+    args = _joint_fisher_args()
+    args[i] = value
+    _raises(ValueError, match, joint_fisher, *args)
+
+
+@pytest.fixture(scope="module")
+def ml_epoch():
+    import dataclasses
+
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight", kinds=("los",))
+    cfg = dataclasses.replace(route.config, bandwidth=10e6, n_rb=27, n_symbols=2)
+    route = dataclasses.replace(route, config=cfg)
+    return route, route.epoch(5, np.random.default_rng(3), refine="ml")
+
+
+def test_rejudge_refuses_real_tensors_bad_carriers_and_shares(ml_epoch):
+    from tunnelkit.signal_route.judging import rejudge
+
+    route, ep = ml_epoch
+    H, pos, fc = ep.snapshot.H, ep.array.local, route.config.fc
+    assert rejudge(ep.estimates, H, pos, fc, 0.01)["share"] == 0.01
+    _raises(TypeError, r"^H: expected a complex", rejudge, ep.estimates, np.abs(H), pos, fc, 0.01)
+    _raises(ValueError, r"^fc: .*1 MHz", rejudge, ep.estimates, H, pos, 28.0, 0.01)
+    _raises(ValueError, r"^share: .*at most 1", rejudge, ep.estimates, H, pos, fc, 2.0)
+    _raises(ValueError, r"^element_positions", rejudge, ep.estimates, H, pos[None], fc, 0.01)
+    _raises(ValueError, r"^element_positions", rejudge, ep.estimates, H, pos[:, :2], fc, 0.01)
+
+
+def test_restrict_rows_and_apply_budget_check_their_arguments(ml_epoch):
+    from tunnelkit.signal_route.judging import apply_budget
+    from tunnelkit.signal_route.measurements import restrict_rows
+
+    _, ep = ml_epoch
+    m = ep.measurements
+    assert len(restrict_rows(m, np.arange(len(m)))) == len(m)
+    assert len(restrict_rows(m, [])) == 0
+    _raises(TypeError, r"^rows", restrict_rows, m, np.array([0.5]))
+    _raises(ValueError, r"^rows", restrict_rows, m, [len(m)])
+    _raises(TypeError, r"^m: expected", restrict_rows, "m", [0])
+    _raises(TypeError, r"^meas: expected", apply_budget, None, None, 0)
+
+
+def test_bias_budget_refuses_complex_blocks_and_a_real_mask():
+    from tunnelkit.signal_route.judging import BiasBudget
+
+    T, P = 2, 3
+    ok = dict(
+        source=np.ones((T, P, 3)),
+        exists=np.ones((T, P), bool),
+        origin=np.zeros((T, 3)),
+        extra=np.zeros((T, P, 4, 4)),
+        repeating=np.zeros((T, P, 4, 4)),
+    )
+    b = BiasBudget(**ok)
+    assert (b.match(0, np.zeros(0), np.zeros((0, 3))) == -1).all()
+    _raises(ValueError, r"d, direction", b.match, 0, np.zeros(0), np.zeros((1, 3)))
+    for name in ("source", "origin", "extra", "repeating"):
+        _raises(TypeError, rf"^{name}", BiasBudget, **{**ok, name: ok[name] + 0j})
+    _raises((TypeError, ValueError), r"^exists", BiasBudget, **{**ok, "exists": np.ones((T, P))})
