@@ -257,14 +257,21 @@ def test_huge_toml_is_a_clear_error(tmp_path):
 
 def test_crlb_paths_arguments_checked_at_the_boundary():
     p = np.zeros((4, 3)) + np.arange(4)[:, None] * [0.025, 0, 0]
+    square = np.array([[0.0, 0.0, 0.0], [0.025, 0.0, 0.0], [0.0, 0.025, 0.0], [0.025, 0.025, 0.0]])
     kw = dict(mu_f=np.array([0.1]), mu_t=np.array([0.0]), fc=5.9e9, n_symbols=2, noise_power=1.0)
     src, alpha = np.array([[0.1, 0.1, 0.2]]), np.array([1.0 + 0j])
     # sources and alpha swapped: the gains' shape is named, not a broadcast error
     _raises(ValueError, r"^alpha", tk.extraction.crlb_paths, src, alpha, p, n_tones=4, **kw)
     # one tone: the delay is unidentifiable (the bound would be NaN)
     _raises(ValueError, r"^n_tones", tk.extraction.crlb_paths, alpha, src, p, n_tones=1, **kw)
-    out = tk.extraction.crlb_paths(alpha, src, p, n_tones=4, **kw)
+    # a line array cannot place a wave origin in 3-D, a zero gain carries no information: the
+    # bound is infinite (it was a LinAlgError and NaN)
+    for pos, a in ((p, alpha), (square, 0.0 * alpha)):
+        out = tk.extraction.crlb_paths(a, src, pos, n_tones=4, **kw)
+        assert np.all(np.isinf(out["mu_f"])) and np.all(np.isinf(out["source_cov"]))
+    out = tk.extraction.crlb_paths(alpha, src, square, n_tones=4, **kw)
     assert np.all(np.isfinite(out["mu_f"])) and np.all(out["mu_f"] > 0)
+    assert np.all(np.linalg.eigvalsh(out["source_cov"]) > 0)
 
 
 # --- the items without a test in round two ------------------------------------------------------
@@ -483,3 +490,55 @@ def test_bias_budget_refuses_complex_blocks_and_a_real_mask():
     for name in ("source", "origin", "extra", "repeating"):
         _raises(TypeError, rf"^{name}", BiasBudget, **{**ok, name: ok[name] + 0j})
     _raises((TypeError, ValueError), r"^exists", BiasBudget, **{**ok, "exists": np.ones((T, P))})
+
+
+# --- the items that still passed through at the start of round three ----------------------------
+
+
+@pytest.mark.parametrize("across", [-3.0, 25.0])
+def test_geometry_virtual_stations_with_the_base_station_outside(jiang, across):
+    tunnel = jiang["tunnel"]
+    inside = tunnel.from_tunnel_frame(np.array([10.0, 0.5 * tunnel.width]))
+    vs = tk.geometry.virtual_stations(inside, list(tunnel.walls))
+    np.testing.assert_allclose(vs, tunnel.virtual_stations(inside))
+    outside = tunnel.from_tunnel_frame(np.array([10.0, across]))
+    _raises(ValueError, r"^base_station: .* outside", tk.geometry.virtual_stations, outside,
+            list(tunnel.walls))  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "gains, match",
+    [(1e20, r"dB"), (INF, r"NaN or infinite"), (0.0, r"dB"), ("short", r"shape"),
+     ("unknown", r"not one of the arrays")],
+)  # fmt: skip
+def test_signal_route_calibration_gains_out_of_range(gains, match):
+    import dataclasses
+
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight", kinds=("los",))
+    a = route.arrays[0]
+    if gains == "short":
+        cal = {a.name: np.ones(a.M - 1, complex)}
+    elif gains == "unknown":
+        cal = {"not-an-array": np.ones(a.M, complex)}
+    else:
+        cal = {a.name: np.full(a.M, gains, complex)}
+    _raises(ValueError, rf"^calibration.*{match}", dataclasses.replace, route, calibration=cal)
+    drawn = route.with_impairments(tk.channel.Impairments(1.0, 3.0), np.random.default_rng(0))
+    assert set(drawn.calibration) == {x.name for x in route.arrays}
+
+
+def test_javelin_with_a_vanishing_gate_probability_runs_finite():
+    # reported as JavelinConfig(update_gate=1e-300) -> ZeroDivisionError later: the field is
+    # gate_probability (eq. 59's p); a gate that small admits almost nothing, and the tracker
+    # predicts through it with finite estimates
+    from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
+    from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
+
+    bs = (0.0, 0.0, 4.8)
+    P, V = toy_drive(12, 0.1, amplitude=0.5, speed=4.0)
+    eps = geometric_stream(P, V, toy_reflectors(), np.random.default_rng(0), bs=bs)
+    spd, hdg = np.linalg.norm(V, axis=1), np.arctan2(V[:, 1], V[:, 0])
+    cfg = JavelinConfig(base_station=bs, sigma_p0_ue=1.0, gate_probability=1e-300)
+    run = run_javelin(eps, spd, hdg, 0.1, P[0], JavelinDesign(cfg))
+    assert np.all(np.isfinite(run.estimates))
+    _raises(ValueError, r"^gate_probability", JavelinConfig, gate_probability=0.0)
