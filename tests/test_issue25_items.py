@@ -542,3 +542,45 @@ def test_javelin_with_a_vanishing_gate_probability_runs_finite():
     run = run_javelin(eps, spd, hdg, 0.1, P[0], JavelinDesign(cfg))
     assert np.all(np.isfinite(run.estimates))
     _raises(ValueError, r"^gate_probability", JavelinConfig, gate_probability=0.0)
+
+
+def test_path_crlb_with_one_tone():
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight", kinds=("los",))
+    arr, paths = route.paths(10)
+    _raises(ValueError, r"^n_tones", tk.extraction.path_crlb, paths, arr, route.config, n_tones=1)
+    out = tk.extraction.path_crlb(paths, arr, route.config, n_tones=2)
+    assert np.all(np.isfinite(out["d"])) and np.all(out["d"] > 0)
+
+
+def test_design_cli_with_a_scheduler_that_accepts_and_never_answers(capsys):
+    import socket
+    import threading
+    import time
+
+    from tunnelkit import cli
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    held = []
+
+    def accept():
+        while True:
+            try:
+                held.append(srv.accept()[0])
+            except OSError:
+                return
+
+    threading.Thread(target=accept, daemon=True).start()
+    addr = f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    argv = ["design", "italiano2026-straight", "--arrays", "4x4", "--runs", "2"]
+    t0 = time.perf_counter()
+    try:
+        rc = cli.main([*argv, "--scheduler", addr, "--connect-timeout", "2"])
+    finally:
+        srv.close()
+        for c in held:
+            c.close()
+    assert rc != 0 and time.perf_counter() - t0 < 60.0  # it hung past 120 s before
+    assert held  # the connection was accepted: the handshake, not the connect, timed out
+    assert re.search(r"no Dask scheduler answered .* within 2 s", capsys.readouterr().err)
