@@ -307,7 +307,44 @@ def javelin_records():
     type(m)(*(getattr(m, f.name) for f in dc.fields(m) if f.init))
 
 
+def short_setup():
+    """:func:`tiny_setup` on three epochs of its route (a model over the whole route is cheap)."""
+    from tunnelkit.scenarios import Trajectory
+
+    setup = tiny_setup()
+    tr, keep = setup.trajectory, slice(5, 8)
+    short = Trajectory(tr.t[keep], tr.position[keep], tr.velocity[keep])
+    return dataclasses.replace(setup, trajectory=short)
+
+
+def channel_budgets():
+    """The design's impairment budget on a three-epoch route at 1 deg of phase error, matched
+    to an epoch's estimates and added to their covariances, the re-judged fit, a row subset."""
+    from tunnelkit.channel import Impairments
+    from tunnelkit.design.achievable import DesignImpairments, path_error_model
+    from tunnelkit.design.channelbudget import channel_budget
+    from tunnelkit.signal_route import judging
+    from tunnelkit.signal_route.measurements import restrict_rows
+
+    setup = short_setup()
+    model = path_error_model(setup, "4x4", DesignImpairments(phase_error_deg=1.0))
+    budget = channel_budget(model, setup, "4x4")
+    imp = Impairments(phase_sigma_deg=1.0)
+    route = dataclasses.replace(setup.signal_route("4x4"), impairments=imp)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ep = route.epoch(1, np.random.default_rng(0), refine="ml")
+    m = ep.measurements
+    budget.match(1, m.d, m.direction)
+    judging.apply_budget(m, budget, 1)
+    judging.rejudge(
+        ep.estimates, ep.snapshot.H, ep.array.local, route.config.fc, judging.impairment_share(imp)
+    )
+    restrict_rows(m, np.arange(len(m)))
+
+
 DRIVERS = (
+    channel_budgets,
     design_confirm,
     route_studies,
     evaluation_tables,

@@ -620,6 +620,42 @@ DOCUMENTED: tuple[Documented, ...] = (
         "type",
         "M may be a bound's real value (mmax_fraunhofer): the aperture (M - 1) lambda / 2",
     ),
+    _doc(
+        r"signal_route\.judging\.(BiasBudget\.match|apply_budget)",
+        r"k",
+        "zero",
+        "epoch 0 is the budget's first epoch",
+    ),
+    _doc(
+        r"signal_route\.judging\.rejudge",
+        r"share",
+        "zero",
+        "no impairment floor: the fit is judged against the noise alone",
+    ),
+    _doc(
+        r"signal_route\.judging\.calibration_share",
+        r"phase_sigma_deg|gain_sigma_db",
+        "huge",
+        "share 1: a calibration error that large leaves no received power to the model",
+    ),
+    _doc(
+        r"signal_route\.measurements\.restrict_rows",
+        r"rows",
+        "empty",
+        "no row kept: measurements of no path (the route's own case of an empty epoch)",
+    ),
+    _doc(
+        r"path_consistency\.joint_fisher",
+        r"alpha",
+        "dtype",
+        "a real gain is a complex gain of zero phase",
+    ),
+    _doc(
+        r"path_consistency\.joint_fisher",
+        r"noise_power",
+        "huge",
+        "the information scales as 1 / N0: any positive noise power gives a (small) finite one",
+    ),
 )
 
 

@@ -134,13 +134,28 @@ def mirror(point, plane: Plane) -> np.ndarray:
 
 
 def virtual_stations(base_station, walls) -> np.ndarray:
-    """Virtual stations: the base station mirrored in each wall (Jiang eq. 3-4). Shape (N, dim)."""
+    """Virtual stations: the base station mirrored in each wall (Jiang eq. 3-4). Shape (N, dim).
+
+    The base station must lie off every wall and between every pair of parallel walls (the
+    tunnel's inside): ``ValueError`` naming ``base_station`` otherwise."""
     walls = sequence("walls", walls, empty=True)
     if not walls:
         raise ValueError("walls: need at least one wall")
     for i, w in enumerate(walls):
         _check_plane(f"walls[{i}]", w)
     bs = vector("base_station", base_station, walls[0].dim)
+    side = [float(w.signed_distance(bs)) for w in walls]
+    for i, wi in enumerate(walls):
+        if side[i] == 0.0:
+            raise ValueError(f"base_station: {bs} lies on walls[{i}] (no mirror image)")
+        for j, wj in enumerate(walls):
+            on_j = -wj.offset * wj.normal  # a point of wall j
+            parallel = wi.dim == wj.dim and abs(abs(float(wi.normal @ wj.normal)) - 1) < 1e-12
+            if j != i and parallel and side[i] * float(wi.signed_distance(on_j)) < 0:
+                raise ValueError(
+                    f"base_station: {bs} lies outside the tunnel (beyond walls[{i}], away "
+                    f"from walls[{j}])"
+                )
     return np.stack([w.mirror(bs) for w in walls])
 
 

@@ -20,8 +20,10 @@ import numpy as np
 
 from ._validate import boolean, finite_array, instance, integer, positive
 from .arrays import ArrayGeometry
+from .budget import check_elements
 from .channel import SRSConfig
 from .constants import C
+from .extraction.radio import MAX_CARRIER
 from .rt.consistency import geometry_consistency, tunnel_planes
 from .signal_route import Epoch, SignalRoute, reported_covariance
 
@@ -74,6 +76,8 @@ def joint_fisher(
     N0 Re(J^H J)``, factorised over the three modes); that function keeps only each path's own
     block of the inverse, the geometry test needs the whole."""
     alpha = np.atleast_1d(finite_array("alpha", alpha, dtype=complex))
+    if alpha.ndim != 1:
+        raise ValueError(f"alpha: expected one complex gain per path (L,), got shape {alpha.shape}")
     L = alpha.size
     src = finite_array("sources", sources, ndim=2)
     if src.shape != (L, 3):
@@ -84,10 +88,15 @@ def joint_fisher(
     mu_f, mu_t = finite_array("mu_f", mu_f), finite_array("mu_t", mu_t)
     if mu_f.shape != (L,) or mu_t.shape != (L,):
         raise ValueError(f"mu_f, mu_t: expected shape ({L},) each, got {mu_f.shape}, {mu_t.shape}")
-    s = np.arange(integer("n_tones", n_tones, minimum=2))[:, None]
-    kk = np.arange(integer("n_symbols", n_symbols, minimum=2))[:, None]
+    n_tones = integer("n_tones", n_tones, minimum=2)
+    n_symbols = integer("n_symbols", n_symbols, minimum=2)
+    check_elements("n_tones", 7 * L * n_tones, 16, "the Fisher information's tone factors")
+    check_elements("n_symbols", 7 * L * n_symbols, 16, "the Fisher information's symbol factors")
+    s, kk = np.arange(n_tones)[:, None], np.arange(n_symbols)[:, None]
     n0 = positive("noise_power", noise_power)
-    k0 = 2 * np.pi * positive("fc", fc) / C
+    if not 1e6 <= positive("fc", fc) <= MAX_CARRIER:
+        raise ValueError(f"fc: {fc:g} Hz is outside [1 MHz, 1 THz] (fc is in Hz)")
+    k0 = 2 * np.pi * fc / C
     rng_m = np.linalg.norm(src[None] - p[:, None], axis=-1)  # (M, L)
     if np.any(rng_m == 0):
         raise ValueError("sources: a wave origin coincides with an element")

@@ -43,7 +43,8 @@ def crlb_paths(
     part, ``a_0 = 1``): the model a CPD actually fits. ``alpha`` includes ``sqrt(P_t)``. The FIM
     ``2/N0 Re(J^H J)`` is assembled from the rank-1 structure (inner products factorise over the
     three modes). Returns the bound's standard deviations for ``mu_f``, ``mu_t`` (rad) and, when
-    structured, the (L, 3, 3) covariance of each wave origin.
+    structured, the (L, 3, 3) covariance of each wave origin; all infinite where the Fisher
+    information is singular (a path of zero gain, a wave origin the array cannot resolve).
     """
     if spatial not in ("structured", "free"):
         raise ValueError(f"spatial: expected 'structured' or 'free', got {spatial!r}")
@@ -107,9 +108,18 @@ def crlb_paths(
     X, Y, Z = (np.stack(v, axis=1) for v in (X, Y, Z))
     gram = (X.conj().T @ X) * (Y.conj().T @ Y) * (Z.conj().T @ Z)
     fim = 2.0 / noise_power * gram.real
-    # Jacobi scaling before the inverse: the parameters differ by many orders of magnitude
-    dsc = 1.0 / np.sqrt(np.diag(fim))
-    cov = dsc[:, None] * np.linalg.inv(dsc[:, None] * fim * dsc[None, :]) * dsc[None, :]
+    # Jacobi scaling before the inverse: the parameters differ by many orders of magnitude.
+    # A singular information (a zero gain, an origin the array cannot resolve) bounds nothing:
+    # every variance is infinite rather than NaN or an error from the inverse.
+    cov = np.full_like(fim, np.inf)
+    if np.all(np.diag(fim) > 0):
+        dsc = 1.0 / np.sqrt(np.diag(fim))
+        try:
+            inv = np.linalg.inv(dsc[:, None] * fim * dsc[None, :])
+        except np.linalg.LinAlgError:
+            inv = None
+        if inv is not None and np.all(np.isfinite(inv)) and np.all(np.diag(inv) > 0):
+            cov = dsc[:, None] * inv * dsc[None, :]
     n_per = fim.shape[0] // L
     idx = np.arange(L) * n_per
     out = {"mu_f": np.sqrt(cov[idx + 2, idx + 2]), "mu_t": np.sqrt(cov[idx + 3, idx + 3])}

@@ -42,7 +42,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, nonnegative, record
+from .._validate import finite_array, instance, integer, nonnegative, positive, record
 from ..channel import Impairments
 from ..evaluation import match_points
 
@@ -98,14 +98,25 @@ def rejudge(est, H, element_positions, fc: float, share: float):
     ``passed``, ``needed`` (the larger of the two shares, at least 0), ``share``,
     ``share_energy_fit``, ``residual_only``."""
     from ..extraction.misspecified import model_error_test
+    from ..extraction.radio import MAX_CARRIER
 
     fit = getattr(est, "fit", None)
     if fit is None:
         raise ValueError("est: expected estimates of the ML route (with a fit), got none")
-    share = nonnegative("share", share)
-    H = np.asarray(H)
-    if H.ndim != 3 or H.shape[0] != np.shape(element_positions)[0]:
+    pos = finite_array("element_positions", element_positions, ndim=2)
+    if pos.shape[0] < 1 or pos.shape[1] != 3:
+        raise ValueError(f"element_positions: expected shape (M, 3), got {pos.shape}")
+    if not np.iscomplexobj(H):
+        raise TypeError(f"H: expected a complex channel tensor, got dtype {np.asarray(H).dtype}")
+    H = finite_array("H", H, ndim=3, dtype=complex)
+    if H.shape[0] != pos.shape[0]:
         raise ValueError(f"H: expected an (M, Nf, Nt) tensor of the array's M, got {H.shape}")
+    if not 1e6 <= positive("fc", fc) <= MAX_CARRIER:
+        raise ValueError(f"fc: {fc:g} Hz is outside [1 MHz, 1 THz] (fc is in Hz)")
+    share = nonnegative("share", share)
+    if share > 1.0:
+        raise ValueError(f"share: a share of the received power, at most 1, got {share:g}")
+    element_positions = pos
     model = np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
     e_y, n0, L = float(np.vdot(H, H).real), float(fit.noise_power), len(est)
     out = model_error_test(H - model, L, e_y, element_positions, fc, n0, share)
@@ -144,6 +155,10 @@ class BiasBudget:
         blocks = ("T", "P", 4, 4)
         record(self, shapes={"source": ("T", "P", 3), "exists": ("T", "P"), "origin": ("T", 3),
                              "extra": blocks, "repeating": blocks})  # fmt: skip
+        for name in ("source", "origin", "extra", "repeating"):
+            finite_array(name, getattr(self, name))
+        if np.asarray(self.exists).dtype != bool:
+            raise TypeError(f"exists: expected a boolean (T, P) mask, got {self.exists.dtype}")
 
     def match(self, k: int, d, direction) -> np.ndarray:
         """The slot (index into P, -1 if none) of each estimate at epoch ``k``: ``d`` (K,) its
@@ -152,7 +167,11 @@ class BiasBudget:
         over the matched pairs)."""
         k = integer("k", k, minimum=0, maximum=self.exists.shape[0] - 1)
         d = finite_array("d", d, ndim=1)
-        u = finite_array("direction", direction, shape=(d.size, 3))
+        u = finite_array("direction", direction, ndim=2)
+        if u.shape != (d.size, 3):
+            raise ValueError(
+                f"d, direction: expected one (3,) direction per d ({d.size}), got {u.shape}"
+            )
         slots = np.flatnonzero(self.exists[k])
         out = -np.ones(d.size, int)
         if not d.size or not slots.size:
@@ -177,7 +196,11 @@ def apply_budget(meas, budget: BiasBudget, k: int):
     reported covariances) with the budget of its matched slots added: ``cov`` + the ``(phi, psi,
     kappa)`` block of ``extra``, ``sigma_d`` in quadrature with its ``d`` variance, ``bias_cov``
     the slots' ``repeating`` (zero for an estimate matched to no slot)."""
+    from .measurements import RouteMeasurements
+
+    instance("meas", meas, RouteMeasurements)
     instance("budget", budget, BiasBudget)
+    integer("k", k, minimum=0, maximum=budget.exists.shape[0] - 1)
     if meas.cov is None or not len(meas):
         return meas
     slot = budget.match(k, meas.d, meas.direction)

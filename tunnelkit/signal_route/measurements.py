@@ -141,6 +141,8 @@ def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
 
 def restrict_rows(m: RouteMeasurements, rows: np.ndarray) -> RouteMeasurements:
     """``m`` restricted to ``rows`` (``delta_d`` re-referenced to the first row kept)."""
+    instance("m", m, RouteMeasurements)
+    rows = indices("rows", rows, len(m))
     d = m.d[rows]
     return replace(
         m,

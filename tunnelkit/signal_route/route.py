@@ -7,7 +7,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import boolean, choice, instance, integer, real, rng_or_error, sequence
+from .._validate import (
+    boolean,
+    choice,
+    finite_array,
+    instance,
+    integer,
+    real,
+    rng_or_error,
+    sequence,
+)
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from ..constants import C
@@ -22,6 +31,10 @@ __all__ = ["CHANNELS", "MAX_SECOND_ORDER", "MODEL_ORDERS", "SignalRoute", "simul
 CHANNELS = ("image", "sionna")
 #: the most second-order paths a route models (:attr:`SignalRoute.second_order`)
 MAX_SECOND_ORDER = 32
+#: the largest element gain error [dB] a route's calibration may hold (far beyond any drawn one:
+#: :func:`tunnelkit.channel.draw_calibration` allows a spread of at most 40 dB)
+MAX_CALIBRATION_DB = 300.0
+
 #: how a route chooses the number of paths it extracts (:attr:`SignalRoute.model_order`)
 MODEL_ORDERS = ("known", "glrt")
 
@@ -136,6 +149,19 @@ class SignalRoute:
         real("snr_offset_db", self.snr_offset_db)
         instance("impairments", self.impairments, Impairments)
         instance("calibration", self.calibration, dict)
+        sizes = {a.name: a.M for a in self.arrays}
+        for name, g in self.calibration.items():
+            if name not in sizes:
+                raise ValueError(f"calibration: {name!r} is not one of the arrays {list(sizes)}")
+            g = finite_array(f"calibration[{name!r}]", g, shape=(sizes[name],), dtype=complex)
+            with np.errstate(divide="ignore"):
+                db = 20 * np.log10(np.abs(g))
+            if not np.all(np.abs(db) <= MAX_CALIBRATION_DB):
+                raise ValueError(
+                    f"calibration[{name!r}]: element gains of {db.min():.3g} to {db.max():.3g} dB; "
+                    f"a calibration error lies within +-{MAX_CALIBRATION_DB:g} dB (a dead element "
+                    "or a unit mistake is not one)"
+                )
         boolean("report_covariance", self.report_covariance)
         boolean("bias_aware_delay_check", self.bias_aware_delay_check)
         boolean("wideband_model", self.wideband_model)
