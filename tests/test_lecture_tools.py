@@ -257,6 +257,42 @@ def test_wait_http_reports_a_server_that_died():
         lec.wait_http(f"http://{lec.HOST}:{lec.free_port()}/", proc, timeout=20)
 
 
+def test_serving_on_free_port_tries_again_when_the_port_was_taken(monkeypatch):
+    """Another process takes the port between free_port() and the server's bind: the server exits
+    with 'Address already in use' and the next attempt runs on a new port; a port held on every
+    attempt ends in the error after ``attempts`` tries."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as held:
+        held.bind((lec.HOST, 0))
+        held.listen()
+        taken = held.getsockname()[1]
+        real = lec.free_port
+        handed = iter([taken])
+        monkeypatch.setattr(lec, "free_port", lambda: next(handed, None) or real())
+        seen = []
+
+        def http_server(port):
+            seen.append(port)
+            return [sys.executable, "-m", "http.server", str(port), "--bind", lec.HOST]
+
+        with lec.serving_on_free_port(http_server, "", timeout=30) as (proc, base):
+            assert proc.poll() is None
+            assert base == f"http://{lec.HOST}:{seen[-1]}/"
+        assert seen[0] == taken and len(seen) == 2 and seen[1] != taken
+        assert proc.poll() is not None, "the server outlived its context"
+
+        monkeypatch.setattr(lec, "free_port", lambda: taken)
+        with (
+            pytest.raises(lec.LectureError, match="exited with code"),
+            lec.serving_on_free_port(http_server, "", attempts=2, timeout=30),
+        ):
+            pass
+
+
+def test_lab_command_puts_kernels_on_ipc_and_never_moves_the_port():
+    cmd = lec.lab_command(8888, Path("/tmp"))
+    assert lec.IPC_TRANSPORT_FLAG in cmd and "--ServerApp.port_retries=0" in cmd
+
+
 def _saved_widget_notebook(fw: go.FigureWidget, holder, source: str):
     """An 'executed' notebook whose one cell displays ``holder`` (a widget containing fw)."""
     from ipywidgets.embed import embed_data

@@ -270,9 +270,46 @@ def serving(
         stop_server(proc)
 
 
+@contextlib.contextmanager
+def serving_on_free_port(
+    make_cmd,
+    path: str = "api",
+    *,
+    attempts: int = 3,
+    env: dict[str, str] | None = None,
+    log: Path | None = None,
+    timeout: float = 90.0,
+) -> Iterator[tuple[subprocess.Popen, str]]:
+    """``serving`` on a port found free: yields ``(process, base URL)``.
+
+    ``free_port`` binds and releases, so another process may take the port before the server binds
+    it; the server then exits before answering. That case is tried again on a new port, up to
+    ``attempts`` times (a server that runs but does not answer is not retried: that is a real
+    failure). ``make_cmd(port)`` builds the command; ``path`` is polled under the base URL.
+    """
+    for attempt in range(1, attempts + 1):
+        port = free_port()
+        base = f"http://{HOST}:{port}/"
+        proc = start_server(make_cmd(port), env=env, log=log)
+        try:
+            wait_http(base + path, proc, timeout)
+        except LectureError:
+            exited = proc.poll() is not None
+            stop_server(proc)
+            if exited and attempt < attempts:
+                continue
+            raise
+        try:
+            yield proc, base
+        finally:
+            stop_server(proc)
+        return
+
+
 def lab_command(port: int, root: Path, *extra: str) -> list[str]:
     """JupyterLab serving ``root`` on ``HOST:port``: no browser, no token or password, no news
-    feed (every request stays on the loopback), as root where need be; ``extra`` switches after."""
+    feed (every request stays on the loopback), kernels over IPC, no silent move to another port,
+    as root where need be; ``extra`` switches after."""
     return [
         sys.executable,
         "-m",
@@ -284,6 +321,8 @@ def lab_command(port: int, root: Path, *extra: str) -> list[str]:
         "--ServerApp.password=",
         f"--ServerApp.root_dir={root}",
         "--LabApp.news_url=",
+        "--ServerApp.port_retries=0",  # a port taken meanwhile ends the server: the caller retries
+        IPC_TRANSPORT_FLAG,  # kernels on Unix sockets: no TCP port race between kernels
         *extra,
         "--allow-root",
     ]

@@ -32,17 +32,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _lecture import (
     CHROMIUM,
-    HOST,
     ROOT,
     LectureError,
     die,
-    free_port,
     kernel_env,
     lab_command,
     list_notebooks,
     render_table,
     resolve_notebook,
-    serving,
+    serving_on_free_port,
 )
 
 # The stamp cell also says whether any earlier cell raised: IPython keeps the last exception it
@@ -72,15 +70,16 @@ def stamped_copy(src: Path, work: Path) -> tuple[Path, Path]:
 
 def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout: float) -> dict:
     """Serve ``root`` with JupyterLab, open ``nb_path``, click Run All, wait for ``stamp``."""
-    port = free_port()
-    base = f"http://{HOST}:{port}/"
-    cmd = lab_command(
-        port,
-        root,
-        f"--LabApp.workspaces_dir={root / ('workspaces-' + nb_path.stem)}",  # no restored tabs
+    workspaces = (
+        f"--LabApp.workspaces_dir={root / ('workspaces-' + nb_path.stem)}"  # no restored tabs
     )
     env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{nb_path.stem}")}  # no user settings
-    with serving(cmd, base + "api", env=env, log=root / f"{nb_path.stem}.log", timeout=180):
+    with serving_on_free_port(
+        lambda port: lab_command(port, root, workspaces),
+        env=env,
+        log=root / f"{nb_path.stem}.log",
+        timeout=180,
+    ) as (_, base):
         page = browser.new_page(viewport={"width": 1400, "height": 900})
         try:
             page.goto(base + f"lab/tree/{nb_path.name}", timeout=180_000)

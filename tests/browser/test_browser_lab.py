@@ -15,7 +15,7 @@ from __future__ import annotations
 import shutil
 
 import nbformat
-from _lecture import HOST, ROOT, free_port, kernel_env, lab_command, resolve_notebook, serving
+from _lecture import ROOT, kernel_env, lab_command, resolve_notebook, serving_on_free_port
 
 from tunnelkit.solutions import SUMMARY
 
@@ -45,13 +45,12 @@ def test_run_all_keeps_solutions_collapsed(tmp_path, watched, artifacts):
     sols = [i for i, c in enumerate(nb.cells) if "solution" in c.metadata.get("tags", [])]
     assert sols, f"{src.name} has no solution cell"
 
-    port = free_port()
-    url = f"http://{HOST}:{port}/"
     env = kernel_env(quick=True)
     env["PYTHONPATH"] = str(ROOT)
     env["JUPYTER_CONFIG_DIR"] = str(tmp_path / "config")  # no user settings, no news prompt
-    cmd = lab_command(port, work)
-    with serving(cmd, url + "api", env=env, log=artifacts / "lab-01.log", timeout=180):
+    with serving_on_free_port(
+        lambda port: lab_command(port, work), env=env, log=artifacts / "lab-01.log", timeout=180
+    ) as (_, url):
         page = watched.page
         page.goto(url + f"lab/tree/{src.name}", timeout=180_000)
         page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)

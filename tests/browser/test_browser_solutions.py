@@ -17,7 +17,7 @@ import sys
 
 import nbformat
 import pytest
-from _lecture import BUILD, HOST, ROOT, free_port, list_notebooks, resolve_notebook, serving
+from _lecture import BUILD, ROOT, list_notebooks, resolve_notebook, serving_on_free_port
 
 SOLUTION = "solution"
 
@@ -84,12 +84,13 @@ def test_site_solutions_are_collapsed(site_url, watched, artifacts):
 @pytest.fixture(scope="module")
 def voila_02():
     nb = resolve_notebook("02")
-    port = free_port()
-    url = f"http://{HOST}:{port}/"
     log = BUILD / "artifacts" / "voila-solutions-02.log"
     log.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick", f"--port={port}"]
-    with serving(cmd, url + "api", log=log, timeout=120):
+    present = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick"]
+    with serving_on_free_port(lambda port: [*present, f"--port={port}"], log=log, timeout=120) as (
+        _,
+        url,
+    ):
         yield nb, url
 
 
