@@ -87,7 +87,7 @@ def rejudge(est, H, element_positions, fc: float, share: float):
     ``fc`` judged against noise plus ``share`` of the received power.
 
     :func:`tunnelkit.extraction.misspecified.model_error_test` of its residual ``H - mu`` (eq. 1
-    of the estimates' factors and gains),
+    of the estimates' model tensor, :meth:`~tunnelkit.extraction.PathEstimates.model_tensor`),
     the received energy ``||H||^2`` and the noise power the fit tested against gives each
     test's share, the residual energy's at the fit's own threshold ``fit.rho_max``, not at the
     test's default ``1 + z / sqrt(N)``: the fit's also allows for a noise power estimated from
@@ -107,7 +107,7 @@ def rejudge(est, H, element_positions, fc: float, share: float):
     if H.ndim != 3 or H.shape[0] != np.shape(element_positions)[0]:
         raise ValueError(f"H: expected an (M, Nf, Nt) tensor of the array's M, got {H.shape}")
     e_y, n0, L = float(np.vdot(H, H).real), float(fit.noise_power), len(est)
-    residual = H - np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
+    residual = H - est.model_tensor()
     out = model_error_test(
         residual, L, e_y, element_positions, fc, n0, share, rho_max=float(fit.rho_max)
     )
