@@ -211,3 +211,33 @@ def test_model_error_test_allows_the_stated_share():
             model_error_test(noise, args["n_paths"], y2, pos, FC, SIGMA2, args["share"])
     with pytest.raises(ValueError, match="residual"):
         model_error_test(noise.real, 2, y2, pos, FC, SIGMA2, 0.0)
+
+
+def test_model_error_test_energy_threshold_rho_max():
+    """``rho_max`` sets the energy test's threshold: the default is ``1 + z / sqrt(N)``, a looser
+    one lowers the energy share by ``(rho_max' - rho_max) (N - 2.5 L) sigma^2 / E_rx`` and
+    leaves the peak test alone; a non-positive or NaN ``rho_max`` is refused by name."""
+    from tunnelkit.extraction.misspecified import RHO_Z, model_error_test
+
+    pos = _pos()
+    rng = np.random.default_rng(4)
+    shape = (16, NF, NT)
+    noise = np.sqrt(SIGMA2 / 2) * (rng.standard_normal(shape) + 1j * rng.standard_normal(shape))
+    h, _ = _tensors(0.0)
+    y2 = float(np.vdot(h, h).real) + noise.size * SIGMA2
+    resid = 1.2 * noise  # 44 % above the noise's energy: flagged by the energy test
+    N, L = noise.size, 2
+    strict = 1.0 + RHO_Z / np.sqrt(N)
+    base = model_error_test(resid, L, y2, pos, FC, SIGMA2, 0.0)
+    same = model_error_test(resid, L, y2, pos, FC, SIGMA2, 0.0, rho_max=strict)
+    assert base == same
+    assert base["share_energy"] > 0 and not base["passed"]
+    loose = model_error_test(resid, L, y2, pos, FC, SIGMA2, 0.0, rho_max=1.6)
+    e_rx = y2 - N * SIGMA2
+    drop = (1.6 - strict) * (N - 2.5 * L) * SIGMA2 / e_rx
+    assert loose["share_energy"] == pytest.approx(base["share_energy"] - drop, rel=1e-9)
+    assert loose["share_peak"] == base["share_peak"] and loose["rho"] == base["rho"]
+    assert loose["passed"] and loose["needed"] == max(loose["share_peak"], 0.0)
+    for bad in (0.0, -1.0, np.nan, np.inf):
+        with pytest.raises(ValueError, match="rho_max"):
+            model_error_test(resid, L, y2, pos, FC, SIGMA2, 0.0, rho_max=bad)

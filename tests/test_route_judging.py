@@ -2,11 +2,14 @@
 closed-form calibration share against brute-force draws, the re-judged fit on a tensor with
 calibration error, the budget's slots matched by direction and delay (not by kind)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from tunnelkit.channel import DiffuseSpec, Impairments, draw_calibration
 from tunnelkit.constants import C
+from tunnelkit.extraction import PathEstimates
 from tunnelkit.extraction.ml import Problem, fit_problem
 from tunnelkit.extraction.numerics import spatial_phase
 from tunnelkit.signal_route import RouteMeasurements
@@ -69,6 +72,8 @@ class _Est:
     def __len__(self):
         return len(self.alpha)
 
+    model_tensor = PathEstimates.model_tensor
+
 
 def _pos():
     g = np.arange(4) * C / FC / 2
@@ -96,6 +101,12 @@ def test_rejudge_passes_a_calibration_error_fit_at_the_closed_form_share():
     r = rejudge(est, prob.H, pos, FC, share)
     assert r["residual_only"] and r["passed"] and 0 < r["needed"] <= share
     assert not rejudge(est, prob.H, pos, FC, 0.0)["passed"]
+    # the energy test at the fit's own threshold, not at the stricter default 1 + z / sqrt(N)
+    resid = prob.H - np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
+    N, L, n0 = prob.H.size, len(est), fit.noise_power
+    e_rx = float(np.vdot(prob.H, prob.H).real) - N * n0
+    want = (float(np.vdot(resid, resid).real) - fit.rho_max * (N - 2.5 * L) * n0) / e_rx
+    assert r["share_energy"] == pytest.approx(want, rel=1e-9, abs=1e-15)
     with pytest.raises(ValueError, match="share"):
         rejudge(est, prob.H, pos, FC, -0.1)
     with pytest.raises(ValueError, match="H"):
@@ -161,3 +172,44 @@ def test_apply_budget_adds_the_matched_slots_budget_and_the_tracker_takes_it():
         apply_budget(RouteMeasurements(**{**m.__dict__, "cov": None, "sigma_d": None}), b, 0).cov
         is None
     )
+
+
+def test_model_tensor_is_eq1_of_the_factors_and_gains():
+    """``PathEstimates.model_tensor`` against the einsum over a random estimate's factors and
+    gains; factors without one column per path are refused naming ``factors``."""
+    rng = np.random.default_rng(5)
+    L, M, Nf, Nt = 3, 6, 7, 4
+
+    def cplx(*shape):
+        return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+
+    u = rng.standard_normal((L, 3))
+    u[:, 2] = np.abs(u[:, 2])
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    real = {k: rng.standard_normal(L) for k in ("v", "kappa", "phi", "psi", "kappa_nf")}
+    factors = (cplx(M, L), cplx(Nf, L), cplx(Nt, L))
+    est = PathEstimates(
+        alpha=cplx(L),
+        d=np.sort(rng.uniform(10, 50, L)),
+        direction=u,
+        near_field=np.ones(L, bool),
+        valid=np.ones(L, bool),
+        delta=rng.standard_normal((L, M)),
+        mu_f=rng.standard_normal(L),
+        mu_t=rng.standard_normal(L),
+        factors=factors,
+        **real,
+    )
+    want = np.einsum("ml,sl,kl,l->msk", *factors, est.alpha)
+    got = est.model_tensor()
+    assert got.shape == (M, Nf, Nt)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+    brute = sum(
+        est.alpha[i] * factors[0][:, i, None, None] * factors[1][None, :, i, None]
+        * factors[2][None, None, :, i]
+        for i in range(L)
+    )  # fmt: skip
+    np.testing.assert_allclose(got, brute, rtol=1e-12, atol=1e-12)
+    bad = replace(est, factors=(factors[0][:, :2], factors[1], factors[2]))
+    with pytest.raises(ValueError, match="factors"):
+        bad.model_tensor()

@@ -29,6 +29,14 @@ one drive (seed 0): 6 of 10 flagged on 4 x 4 and 10 of 10 on 8 x 8, after the re
 form. The settled median error on the channel route went from 0.42 / 0.97 m (4 x 4 / 8 x 8, 2
 runs) to 1.8 / 0.49 cm (20 runs; p90 10.3 / 3.6 cm), the bound route's 1.1 / 0.42 cm (p90 8.3 /
 2.6 cm): both recommend 8 x 8 (README, the design answer).
+
+At 2 deg the channel route's 8 x 8 had a tail (p90 65 cm, 4 runs) the bound route did not
+(8.3 cm): on the drives that carried it the calibration error's quadratic phase drove every
+path's unresolved curvature to 3-7 m the same way every epoch, and seen from the reference
+antenna (the URA's corner) that moved every direction by 5-8 mrad (``SignalRoute.
+centroid_unresolved``: such paths are reported far-field from the array's centroid). After
+it, 10 runs: error p90 8.9 cm [4.3, 15.5] (seed 0, undecided; bound route 9.2 cm) and 5.9 cm
+[4.1, 8.5] (seed 8675309, met; bound route 5.7 cm).
 """
 
 from __future__ import annotations

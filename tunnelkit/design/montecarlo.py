@@ -216,7 +216,9 @@ class _SweepTrial:
             if imp is not None and not imp.ideal:
                 # its calibration error drawn once per drive; fits judged against noise + it
                 route = route.with_impairments(imp.channel_impairments(), rng)
-                route = replace(route, model_error_floor=True, bias_budget=prep.budget)
+                route = replace(
+                    route, model_error_floor=True, bias_budget=prep.budget, centroid_unresolved=True
+                )
             if imp is not None and imp.wideband_model:
                 route = replace(route, wideband_model=True)
             drive = simulate_drive(

@@ -146,6 +146,18 @@ class PathEstimates:
     def __getitem__(self, key: str):
         return getattr(self, key)
 
+    def model_tensor(self) -> np.ndarray:
+        """The (M, Nf, Nt) tensor of eq. 1 the estimates describe: ``sum_l alpha_l a_l (x) f_l
+        (x) t_l`` of the ``factors`` (A, F, T) (one column per path) and gains ``alpha``."""
+        a, f, t = (np.asarray(x) for x in self.factors)
+        n = len(self)
+        if any(x.ndim != 2 or x.shape[1] != n for x in (a, f, t)):
+            raise ValueError(
+                f"factors: expected three matrices with one column per path ({n}), got shapes "
+                f"{[x.shape for x in (a, f, t)]}"
+            )
+        return np.einsum("ml,sl,kl,l->msk", a, f, t, self.alpha)
+
     def wave_origins(self) -> np.ndarray:
         """``kappa * direction`` (L, 3) in the local frame (NaN rows for far-field paths)."""
         return self.kappa[:, None] * self.direction

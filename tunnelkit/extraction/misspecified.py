@@ -354,6 +354,7 @@ def model_error_test(
     fc: float,
     noise_power: float,
     share: float,
+    rho_max: float | None = None,
 ) -> dict:
     """The extraction's residual tests with a stated model-error floor.
 
@@ -366,7 +367,10 @@ def model_error_test(
     N noise_power`` (``received_energy`` = ``||Y||^2`` of the snapshot): the model error the
     deployed system allows, stated as a share of the received power (like a DMC share; the
     residual a fit leaves at the pseudo-true paths, :func:`pseudo_true`, is what it stands for
-    and what no deployed system knows). ``share = 0`` is the plain test.
+    and what no deployed system knows). ``share = 0`` is the plain test. ``rho_max`` (> 0) is
+    the energy test's threshold; ``None`` takes ``1 + z / sqrt(N)`` (:data:`RHO_Z`); a fit's own
+    ``fit.rho_max``, which also allows for a noise power estimated from the tensor, is the
+    looser one its extraction applied.
 
     Returns ``passed``, ``needed`` the smallest share that passes, ``share_peak`` /
     ``share_energy`` each test's, ``peak`` (noise powers) and ``rho``."""
@@ -380,11 +384,11 @@ def model_error_test(
     e_y = positive("received_energy", received_energy)
     share = nonnegative("share", share)
     N = R.size
+    rho_max = 1.0 + RHO_Z / np.sqrt(N) if rho_max is None else positive("rho_max", rho_max)
     e_rx = max(e_y - N * n0, 1e-300 * e_y)
     peak = residual_peak(R, pos, fc, n0)[0]
     thr = calibrated_threshold(pos, fc, R.shape)
     energy = float(np.vdot(R, R).real)
-    rho_max = 1.0 + RHO_Z / np.sqrt(N)
     s_peak = (peak - thr) * n0 / e_rx
     s_energy = (energy - rho_max * (N - 2.5 * L) * n0) / e_rx
     needed = max(s_peak, s_energy, 0.0)

@@ -87,16 +87,16 @@ def rejudge(est, H, element_positions, fc: float, share: float):
     ``fc`` judged against noise plus ``share`` of the received power.
 
     :func:`tunnelkit.extraction.misspecified.model_error_test` of its residual ``H - mu`` (eq. 1
-    of the estimates' factors and gains), the received energy ``||H||^2`` and the noise power
-    the fit tested against gives each test's share: the residual peak's as it is; the residual
-    energy's is taken at the fit's own threshold ``fit.rho_max`` (``share_energy_fit``), not at
-    the test's ``1 + z / sqrt(N)``: the fit's also allows for a noise power estimated from the
-    tensor, and the stricter one flags fits the extraction itself passes (28 GHz example, 4 x 4,
-    0.5 deg, epoch 0: ``rho`` 1.021 below the fit's 1.036, share 4.2e-4 needed by the other).
-    Only a fit flagged by its residual tests alone is re-judged; a path below the noise or an
-    unresolved pair stays flagged (``residual_only`` False). Returns the test's dict with
+    of the estimates' model tensor, :meth:`~tunnelkit.extraction.PathEstimates.model_tensor`),
+    the received energy ``||H||^2`` and the noise power the fit tested against gives each
+    test's share, the residual energy's at the fit's own threshold ``fit.rho_max``, not at the
+    test's default ``1 + z / sqrt(N)``: the fit's also allows for a noise power estimated from
+    the tensor, and the stricter one flags fits the extraction itself passes (28 GHz example,
+    4 x 4, 0.5 deg, epoch 0: ``rho`` 1.021 below the fit's 1.036, share 4.2e-4 needed by the
+    other). Only a fit flagged by its residual tests alone is re-judged; a path below the noise
+    or an unresolved pair stays flagged (``residual_only`` False). Returns the test's dict with
     ``passed``, ``needed`` (the larger of the two shares, at least 0), ``share``,
-    ``share_energy_fit``, ``residual_only``."""
+    ``residual_only``."""
     from ..extraction.misspecified import model_error_test
     from ..extraction.radio import MAX_CARRIER
 
@@ -117,19 +117,16 @@ def rejudge(est, H, element_positions, fc: float, share: float):
     if share > 1.0:
         raise ValueError(f"share: a share of the received power, at most 1, got {share:g}")
     element_positions = pos
-    model = np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
     e_y, n0, L = float(np.vdot(H, H).real), float(fit.noise_power), len(est)
-    out = model_error_test(H - model, L, e_y, element_positions, fc, n0, share)
-    e_rx = max(e_y - H.size * n0, 1e-300 * e_y)
-    s_energy = (out["rho"] - fit.rho_max) * (H.size - 2.5 * L) * n0 / e_rx
+    residual = H - est.model_tensor()
+    out = model_error_test(
+        residual, L, e_y, element_positions, fc, n0, share, rho_max=float(fit.rho_max)
+    )
     reasons = {r.strip() for r in str(fit.reason).split(",") if r.strip()}
     residual_only = reasons <= {"residual peak", "residual energy"}
-    needed = max(out["share_peak"], s_energy, 0.0)
     out.update(
-        passed=bool(residual_only and needed <= share),
-        needed=float(needed),
+        passed=bool(residual_only and out["passed"]),
         share=float(share),
-        share_energy_fit=float(s_energy),
         residual_only=bool(residual_only),
     )
     return out

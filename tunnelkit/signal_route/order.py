@@ -61,7 +61,7 @@ def glrt_paths(
     est, caught = fit(n0)
     while len(est) < cap and est.fit.peak > est.fit.peak_max:
         f = est.fit
-        model = np.einsum("ml,sl,kl,l->msk", *est.factors, est.alpha)
+        model = est.model_tensor()
         floor = f.noise_power if noise_power is None else noise_power
         _, (ux, uy, mu_f, mu_t), _ = residual_peak(H - model, array.local, config.fc, floor)
         start = (
