@@ -48,14 +48,19 @@ from scipy.optimize import brentq
 from scipy.special import i0e
 
 from ..._validate import finite_array, integer, positive
-from .model import Problem
+from .lm import lm_fit
+from .model import Problem, project_feasible
 
 __all__ = [
     "OUTLIER_RATE",
+    "PAIR_FALSE_ALARM",
+    "PAIR_LLR",
+    "PAIR_TEST_Z",
     "RESOLVE_Z",
     "below_threshold",
     "outlier_probability",
     "pair_separation",
+    "pair_test",
     "resolvable",
     "separations",
     "snr_threshold",
@@ -94,14 +99,8 @@ def _separations(prob: Problem, theta, mu_f, mu_t, sigma2, ev=None) -> np.ndarra
     if L < 2:
         return np.full(L, np.inf)
     ev = prob.evaluate(theta, mu_f, mu_t) if ev is None else ev
-    cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
-    C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)  # (L, L, 5, 5) blocks
-    x = np.column_stack([theta, mu_f, mu_t])
+    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, ev)
     i, j = np.triu_indices(L, 1)
-    S = C5[i, i] + C5[j, j] - C5[i, j] - C5[j, i]  # (P, 5, 5)
-    D = x[i] - x[j]
-    q = np.einsum("pa,pa->p", D, np.linalg.solve(S + 1e-300 * np.eye(5), D[..., None])[..., 0])
-    z = np.sqrt(np.maximum(q, 0.0))
     out = np.full(L, np.inf)
     np.minimum.at(out, i, z)
     np.minimum.at(out, j, z)
@@ -136,6 +135,123 @@ def resolvable(prob: Problem, theta, mu_f, mu_t, noise_power: float, detect: flo
     ev = prob.evaluate(theta, mu_f, mu_t)
     z = _separations(prob, theta, mu_f, mu_t, sigma2, ev)
     return (z >= RESOLVE_Z) & (significance(ev, sigma2) >= detect)
+
+
+#: the pair test (module text): rate at which one path is reported as two resolved ones
+PAIR_FALSE_ALARM = 0.01
+#: pairs fewer than this many standard deviations of their difference apart are tested; further
+#: apart the log-likelihood ratio of the two against one, about ``z^2 / 2`` (50 here), is far
+#: above ``PAIR_LLR``
+PAIR_TEST_Z = 10.0
+#: the pair test's threshold on ``(cost_merged - cost) / sigma^2``: the ``1 - PAIR_FALSE_ALARM``
+#: quantile of its null distribution (one path fitted as a close pair; module text)
+PAIR_LLR = 13.0
+#: Levenberg-Marquardt iterations each start of the merged fit gets before they are ranked
+_MERGE_RANK_ITER = 8
+
+
+def _merged_fit(prob: Problem, theta, mu_f, mu_t, c, sigma2, i: int, j: int, max_iter: int):
+    """The ``L - 1`` paths with ``i`` and ``j`` replaced by one: started at their centroid
+    (weights ``|c|^2``, circular means of ``mu``) and at each of the two, every start given a few
+    iterations, the most likely fitted to convergence; returns the fit and the iterations."""
+    L = theta.shape[0]
+    w = np.abs(c[[i, j]]) ** 2
+    w = w / max(w.sum(), 1e-300)
+    keep = np.arange(L) != j
+    starts = []
+    for wi in (w[0], 1.0, 0.0):
+        th, mf, mt = theta.copy(), mu_f.copy(), mu_t.copy()
+        th[i] = wi * theta[i] + (1 - wi) * theta[j]
+        mf[i] = np.angle(wi * np.exp(1j * mu_f[i]) + (1 - wi) * np.exp(1j * mu_f[j]))
+        mt[i] = np.angle(wi * np.exp(1j * mu_t[i]) + (1 - wi) * np.exp(1j * mu_t[j]))
+        starts.append((project_feasible(th[keep]), mf[keep], mt[keep]))
+    short = min(_MERGE_RANK_ITER, max_iter)
+    cands = [lm_fit(prob, *st, sigma2, short) for st in starts]
+    n_it = sum(c_[4] for c_ in cands)
+    best = min(cands, key=lambda c_: c_[3]["cost"])
+    if not best[5]:
+        best = lm_fit(prob, *best[:3], sigma2, max_iter)
+        n_it += best[4]
+    return best, n_it
+
+
+def _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max=PAIR_TEST_Z):
+    """(P, 4) rows ``(i, j, z_ij, llr_ij)`` for the pairs closer than ``PAIR_TEST_Z``, and the
+    iterations spent."""
+    L = theta.shape[0]
+    rows, n_it = [], 0
+    if L < 2:
+        return np.zeros((0, 4)), 0
+    i, j = np.triu_indices(L, 1)
+    for a, b, zab in zip(i, j, z, strict=True):
+        if not zab < z_max:
+            continue
+        merged, its = _merged_fit(prob, theta, mu_f, mu_t, ev["c"], sigma2, a, b, max_iter)
+        n_it += its
+        rows.append((a, b, zab, (merged[3]["cost"] - ev["cost"]) / sigma2))
+    return np.array(rows, float).reshape(-1, 4), n_it
+
+
+def pair_tests_at(prob: Problem, theta, mu_f, mu_t, sigma2: float, ev: dict, max_iter: int):
+    """:func:`pair_test` at a fit whose evaluation ``ev`` (with derivatives) is at hand, inputs
+    unchecked (the fit's own call); returns the rows and the iterations spent."""
+    if theta.shape[0] < 2:
+        return np.zeros((0, 4)), 0
+    ev = ev if "A" in ev else prob.evaluate(theta, mu_f, mu_t)
+    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, ev)
+    return _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter)
+
+
+def _pair_z(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> np.ndarray:
+    """Per pair ``(i < j)`` in ``np.triu_indices`` order: their distance in standard deviations
+    of their difference (module text)."""
+    L = theta.shape[0]
+    cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
+    C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)
+    x = np.column_stack([theta, mu_f, mu_t])
+    i, j = np.triu_indices(L, 1)
+    S = C5[i, i] + C5[j, j] - C5[i, j] - C5[j, i]
+    D = x[i] - x[j]
+    q = np.einsum("pa,pa->p", D, np.linalg.solve(S + 1e-300 * np.eye(5), D[..., None])[..., 0])
+    return np.sqrt(np.maximum(q, 0.0))
+
+
+def pair_test(
+    prob: Problem,
+    theta,
+    mu_f,
+    mu_t,
+    noise_power: float,
+    *,
+    max_iter: int = 60,
+    z_max: float = PAIR_TEST_Z,
+) -> np.ndarray:
+    """The resolution test of each close pair of a fit (module text): for every two paths fewer
+    than ``z_max`` (default ``PAIR_TEST_Z``) standard deviations of their difference apart, the generalised
+    likelihood-ratio test of one path (the two merged, all ``L - 1`` fitted again) against two:
+    rows ``(i, j, z_ij, llr_ij)``, ``llr = (cost_merged - cost) / sigma^2``; the pair is resolved
+    when ``llr >= PAIR_LLR`` (false-alarm rate ``PAIR_FALSE_ALARM``). ``theta, mu_f, mu_t``
+    should be a converged fit (the statistic compares two maxima of the likelihood)."""
+    theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
+    max_iter = integer("max_iter", max_iter, minimum=1, maximum=1000)
+    if not (isinstance(z_max, float) and z_max == np.inf):  # inf: every pair tested
+        z_max = positive("z_max", z_max)
+    ev = prob.evaluate(theta, mu_f, mu_t)
+    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, ev) if theta.shape[0] > 1 else np.zeros(0)
+    return _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max)[0]
+
+
+def unresolved_partners(tests: np.ndarray, L: int) -> np.ndarray:
+    """Per path (L,): the path it is not resolved from (the pair test's ``llr`` below
+    ``PAIR_LLR``; of several, the one with the lowest ``llr``), ``-1`` when resolved from all."""
+    out = np.full(L, -1, int)
+    best = np.full(L, np.inf)
+    for a, b, _, llr in np.asarray(tests, float).reshape(-1, 4):
+        if llr < PAIR_LLR:
+            for p, q in ((int(a), int(b)), (int(b), int(a))):
+                if llr < best[p]:
+                    out[p], best[p] = q, llr
+    return out
 
 
 def _outlier(gamma: float, K: int) -> float:
