@@ -125,7 +125,11 @@ likely basin is the estimate). ``MLFit.fit_ok`` (and
 thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
 further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical
 resolution limit, :func:`~.fitting.pair_separation`: below it the likelihood has no separate
-peak for each and the errors leave the local bound however well the search does);
+peak for each and the errors leave the local bound however well the search does) and
+every close pair resolved by the pair test (:func:`~.resolution.pair_test`: the GLRT of one path,
+the two merged and every path fitted again, against two, at a 1 % false-alarm rate from its
+null distribution by Monte-Carlo; ``MLFit.unresolved`` and ``PathEstimates.unresolved`` name
+each path's partner in a pair it fails);
 ``MLFit.reason`` names the tests a fit failed. ``search="basic"`` skips the
 re-initialisation (the route before it, for comparison).
 
@@ -148,15 +152,16 @@ Modules, each importing only from the ones above it:
 
 - :mod:`.model` — :class:`Problem` (the concentrated cost and its Gauss-Newton model), the
   feasible set, the noise floor;
+- :mod:`.lm` — Levenberg-Marquardt and its stopping rule (:func:`~.lm.lm_fit`);
 - :mod:`.search` — the starts: one path from a (residual) tensor, successive cancellation,
   starts from estimates;
 - :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
 - :mod:`.resolution` — the statistical resolution limit: per-path separations in standard
   deviations, significance, the per-path verdict :func:`resolvable`; the threshold in SNR by
   the method of interval errors (:func:`snr_threshold`, :func:`outlier_probability`) and the
-  per-path threshold region :func:`below_threshold` (``PathEstimates.below_threshold``);
-- :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
-  re-seedings: :func:`fit_ml`, :class:`MLFit`;
+  per-path threshold region :func:`below_threshold` (``PathEstimates.below_threshold``); the
+  pair test :func:`pair_test` (``PathEstimates.unresolved``);
+- :mod:`.fitting` — the basin test and the re-seedings: :func:`fit_ml`, :class:`MLFit`;
 - :mod:`.wideband` — :class:`WidebandProblem`, the model with the spatial-wideband term (each
   element its own delay across the band), a :class:`Problem` the fit runs on unchanged;
 - :mod:`.paths` — :func:`ml_paths` (``wideband=True``: the eq. 1 fit refined on that model) and

@@ -85,7 +85,10 @@ class MLFit:
     two paths resolved (``separation >= RESOLVE_Z``); ``reason`` the tests it failed
     (``"residual peak"``: a path missed or a wrong basin; ``"residual energy"``; ``"path below
     the noise"``; ``"unresolved pair"``: the threshold region of two paths closer than their
-    bound can tell), ``""`` when it passed."""
+    bound can tell; ``"pair not resolved"``: the pair test), ``""`` when it passed; ``pairs``
+    (P, 4) the pair test of each pair closer than ``PAIR_TEST_Z`` (rows ``(i, j, z, llr)``,
+    :func:`~.resolution.pair_test`) and ``unresolved`` (L,) each path's partner in a pair whose
+    ``llr`` is below ``PAIR_LLR`` (one path explains the two as well), ``-1`` when resolved."""
 
     theta: np.ndarray
     mu_f: np.ndarray
