@@ -87,15 +87,20 @@ def test_resolvable_pair_is_resolved_and_far_pairs_not_tested():
     assert rows.shape == (1, 4) and rows[0, 3] > ml.PAIR_LLR
     z = ml.separations(prob, *fit[:3], 1.0)[0]
     assert (ml.pair_test(prob, *fit[:3], 1.0).shape[0] == 1) == (z < ml.PAIR_TEST_Z)
-    np.testing.assert_array_equal(ml.resolution.unresolved_partners(rows, 2), [-1, -1])
-    low = rows.copy()
+    far = rows.copy()
+    far[0, 2] = ml.RESOLVE_Z
+    np.testing.assert_array_equal(ml.resolution.unresolved_partners(far, 2), [-1, -1])
+    low = far.copy()
     low[0, 3] = ml.PAIR_LLR - 1e-9
     np.testing.assert_array_equal(ml.resolution.unresolved_partners(low, 2), [1, 0])
+    close = far.copy()
+    close[0, 2] = ml.RESOLVE_Z * (1 - 1e-9)  # two paths, closer than the bound can tell
+    np.testing.assert_array_equal(ml.resolution.unresolved_partners(close, 2), [1, 0])
 
 
 def test_unresolved_partners_takes_the_least_resolved():
-    rows = np.array([[0, 1, 2.0, 3.0], [1, 2, 2.0, 1.0], [0, 3, 2.0, 50.0]])
-    np.testing.assert_array_equal(ml.resolution.unresolved_partners(rows, 4), [1, 2, 1, -1])
+    rows = np.array([[0, 1, 9.0, 3.0], [1, 2, 9.0, 1.0], [0, 3, 9.0, 50.0], [3, 4, 2.0, 99.0]])
+    np.testing.assert_array_equal(ml.resolution.unresolved_partners(rows, 6), [1, 2, 1, 4, 3, -1])
 
 
 def test_verdict_reported_on_the_fit_and_the_estimates():
@@ -119,7 +124,11 @@ def test_verdict_reported_on_the_fit_and_the_estimates():
         assert (p < 0) == (q < 0)
         if p >= 0:
             assert o[p] == q
-    assert ("pair not resolved" in fit.reason) == bool(np.any(fit.unresolved >= 0))
+    llr, z = fit.pairs[:, 3], fit.pairs[:, 2]
+    assert ("pair not resolved" in fit.reason) == bool(np.any(llr < ml.PAIR_LLR))
+    assert bool(np.any(fit.unresolved >= 0)) == bool(
+        np.any((llr < ml.PAIR_LLR) | (z < ml.RESOLVE_Z))
+    )
     if np.any(fit.unresolved >= 0):
         assert not est.fit_ok
     with pytest.raises(ValueError, match="unresolved"):

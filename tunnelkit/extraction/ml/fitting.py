@@ -19,6 +19,7 @@ from .lm import STEP_TOL, lm_fit
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .resolution import (
+    PAIR_LLR,
     RESOLVE_Z,
     pair_separation,
     pair_tests_at,
@@ -88,7 +89,9 @@ class MLFit:
     bound can tell; ``"pair not resolved"``: the pair test), ``""`` when it passed; ``pairs``
     (P, 4) the pair test of each pair closer than ``PAIR_TEST_Z`` (rows ``(i, j, z, llr)``,
     :func:`~.resolution.pair_test`) and ``unresolved`` (L,) each path's partner in a pair whose
-    ``llr`` is below ``PAIR_LLR`` (one path explains the two as well), ``-1`` when resolved."""
+    ``llr`` is below ``PAIR_LLR`` (one path explains the two as well) or closer than
+    ``RESOLVE_Z`` (:func:`~.resolution.unresolved_partners`: the CRLB of the two is not a bound
+    the estimate can reach), ``-1`` when resolved."""
 
     theta: np.ndarray
     mu_f: np.ndarray
@@ -529,7 +532,7 @@ def fit_problem(
         "residual energy": rho > rho_max,
         "path below the noise": not np.all(significance >= MIN_SIGNIFICANCE),
         "unresolved pair": not separation >= RESOLVE_Z,
-        "pair not resolved": bool(np.any(unresolved >= 0)),
+        "pair not resolved": bool(np.any(pairs[:, 3] < PAIR_LLR)),
     }
     reason = ", ".join(k for k, v in failed.items() if v)
     fit_ok = not reason
