@@ -79,8 +79,9 @@ def null_draw(rng, snr, pos, shape):
 
 def resolvable_draw(rng, snr, z_target, pos, shape):
     """Two paths of equal SNR ``snr`` about ``z_target`` standard deviations apart (the second
-    offset from the first along a random direction of the five parameters, scaled by the
-    Fisher information at the truth); the fit started at the truth; (llr, z at the fit)."""
+    offset from the first along a random direction of ``(u_x, u_y, mu_f, mu_t)``, scaled by
+    bisection to the first separation ``z_target`` along it, Fisher information of the
+    noise-free tensor at the truth); the fit started at the truth; (llr, z at the fit)."""
     th, mf, mt = _path(rng, shape[1], shape[2])
     N = np.prod(shape)
     c = np.sqrt(snr / N) * np.exp(2j * np.pi * rng.uniform(0, 1, 2))
@@ -88,15 +89,24 @@ def resolvable_draw(rng, snr, z_target, pos, shape):
     d = rng.standard_normal(5)
     d[2] = 0.0  # same curvature
     scale = np.array([0.01, 0.01, 0.0, 2 * np.pi / shape[1], 2 * np.pi / shape[2]])
-    d = d * scale
-    for _ in range(3):  # scale the offset to z_target at the truth (noise-free Fisher)
-        th2 = np.vstack([th, th + d[:3]])
-        f2, m2 = np.append(mf, mf + d[3]), np.append(mt, mt + d[4])
+    d = 0.05 * d * scale
+
+    def pair(t):
+        th2 = np.vstack([th, th + t * d[:3]])
+        return th2, np.append(mf, mf + t * d[3]), np.append(mt, mt + t * d[4])
+
+    def z_at(t):  # noise-free Fisher information at the truth
+        th2, f2, m2 = pair(t)
         clean = ml.Problem(prob0.model(th2, f2, m2, c), pos, FC)
-        z = ml.separations(clean, th2, f2, m2, 1.0)[0]
-        d = d * z_target / z
-    th2 = np.vstack([th, th + d[:3]])
-    f2, m2 = np.append(mf, mf + d[3]), np.append(mt, mt + d[4])
+        return ml.separations(clean, th2, f2, m2, 1.0)[0]
+
+    lo, hi = 0.0, 1.0
+    while z_at(hi) < z_target and hi < 2**20:  # first crossing (z is not monotone further out)
+        lo, hi = hi, 2 * hi
+    for _ in range(12):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if z_at(mid) < z_target else (lo, mid)
+    th2, f2, m2 = pair(hi)
     prob = _tensor(rng, th2, f2, m2, c, pos, shape)
     fit = lm_fit(prob, ml.project_feasible(th2), f2, m2, 1.0, 100)
     rows = ml.pair_test(prob, fit[0], fit[1], fit[2], 1.0)
