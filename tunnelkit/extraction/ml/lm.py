@@ -6,12 +6,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._validate import finite_array, integer, positive
 from ..numerics import damped_step_unchecked, free_newton_unchecked
 from .model import W_MAX, Problem, project_feasible
 
 __all__ = ["STEP_TOL", "lm_fit"]
 
 STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
+#: cap on ``max_iter`` (``fitting.MAX_ITER``: a fit not converged in 1,000 is not converging)
+MAX_LM_ITER = 1000
 
 
 def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):
@@ -21,7 +24,16 @@ def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict 
     damping, ``"ev"`` the evaluation at the start point, if present) and written at the end
     (the damping reached and the evaluation of the returned point), so ``m`` iterations and
     then ``n`` more from the point returned run exactly the ``m + n`` iterations of one call."""
+    if not isinstance(prob, Problem):
+        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
+    theta = finite_array("theta", theta, shape=(None, 3))
     L = theta.shape[0]
+    mu_f = finite_array("mu_f", mu_f, shape=(L,))
+    mu_t = finite_array("mu_t", mu_t, shape=(L,))
+    sigma2 = positive("sigma2", sigma2)
+    max_iter = integer("max_iter", max_iter, minimum=1, maximum=MAX_LM_ITER)
+    if state is not None and not isinstance(state, dict):
+        raise TypeError(f"state: expected a dict or None, got {type(state).__name__}")
     state = {} if state is None else state
     ev = state.get("ev") or prob.evaluate(theta, mu_f, mu_t)
     lam, it, converged = state.get("lam", 1e-3), 0, False
