@@ -147,3 +147,19 @@ def test_pair_test_checks_its_arguments():
     with pytest.raises(ValueError, match="mu_f"):
         ml.pair_test(prob, two[0], two[1][:1], two[2], 1.0)
     assert ml.pair_test(prob, th, mf, mt, 1.0).shape == (0, 4)  # one path: no pair
+
+
+def test_lm_fit_checks_its_arguments():
+    prob, th, mf, mt = _one_source(np.random.default_rng(1))
+    for args, kw, name in (
+        (("x", th, mf, mt, 1.0, 5), {}, "prob"),
+        ((prob, "x", mf, mt, 1.0, 5), {}, "theta"),
+        ((prob, th, mf[:0], mt, 1.0, 5), {}, "mu_f"),
+        ((prob, th, mf, mt, np.nan, 5), {}, "sigma2"),
+        ((prob, th, mf, mt, -1.0, 5), {}, "sigma2"),
+        ((prob, th, mf, mt, 1.0, -1), {}, "max_iter"),
+        ((prob, th, mf, mt, 1.0, 10**7), {}, "max_iter"),
+        ((prob, th, mf, mt, 1.0, 5), {"state": 3}, "state"),
+    ):
+        with pytest.raises((TypeError, ValueError), match=name):
+            lm_fit(*args, **kw)
