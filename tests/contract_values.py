@@ -215,6 +215,7 @@ def _signal_route():
     ml.below_threshold(est.significance, est.resolution, prob.N)
     ml.outlier_probability(est.significance, prob.N)
     ml.snr_threshold(prob.N, 0.01)
+    ml.pair_test(prob, f.theta, f.mu_f, f.mu_t, f.noise_power, z_max=float("inf"))
     # the fits call the numerics' unchecked twins: the checked public forms called directly
     from tunnelkit.extraction import numerics as nm
 

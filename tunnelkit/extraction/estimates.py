@@ -70,7 +70,11 @@ class PathEstimates:
     ``below_threshold`` per path, in the estimator's threshold region at the fit
     (:func:`~tunnelkit.extraction.ml.below_threshold`: its SNR below the threshold of the method of
     interval errors, :func:`~tunnelkit.extraction.ml.snr_threshold`, or unresolved): its errors
-    may leave the bound; ``fit_ok`` stays the fit's own tests (``None`` off the ML route).
+    may leave the bound; ``fit_ok`` stays the fit's own tests (``None`` off the ML route);
+    ``unresolved`` per path, the index (in this order) of the path it is not resolved from by the
+    pair test (:func:`~tunnelkit.extraction.ml.pair_test`: one path explains the two as well),
+    ``-1`` when resolved from every other; the two are one path's worth of information and are
+    judged against the bound of one (``None`` off the ML route).
     """
 
     alpha: np.ndarray
@@ -95,6 +99,7 @@ class PathEstimates:
     fit_ok: bool | None = None
     resolution: np.ndarray | None = field(default=None, repr=False)
     below_threshold: np.ndarray | None = field(default=None, repr=False)
+    unresolved: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         if self.fit is not None and not all(hasattr(self.fit, a) for a in ("rho", "rho_max")):
@@ -134,6 +139,11 @@ class PathEstimates:
             _per_path("resolution", self.resolution, n, "real")
         if self.below_threshold is not None:
             _per_path("below_threshold", self.below_threshold, n, "bool")
+        if self.unresolved is not None:
+            _per_path("unresolved", self.unresolved, n, "real")
+            u = np.asarray(self.unresolved)
+            if u.dtype.kind not in "iu" or np.any((u < -1) | (u >= n)) or np.any(u == np.arange(n)):
+                raise ValueError("unresolved: expected per path another path's index or -1")
 
     def __len__(self) -> int:
         return self.d.shape[0]

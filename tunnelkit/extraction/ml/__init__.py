@@ -125,7 +125,11 @@ likely basin is the estimate). ``MLFit.fit_ok`` (and
 thresholds, every path above the noise (``MIN_SIGNIFICANCE``) and every two paths resolved:
 further apart than ``RESOLVE_Z`` standard deviations of their difference (the statistical
 resolution limit, :func:`~.fitting.pair_separation`: below it the likelihood has no separate
-peak for each and the errors leave the local bound however well the search does);
+peak for each and the errors leave the local bound however well the search does) and
+every close pair resolved by the pair test (:func:`~.resolution.pair_test`: the GLRT of one path,
+the two merged and every path fitted again, against two, at a 1 % false-alarm rate from its
+null distribution by Monte-Carlo; ``MLFit.unresolved`` and ``PathEstimates.unresolved`` name
+each path's partner in a pair it fails);
 ``MLFit.reason`` names the tests a fit failed. ``search="basic"`` skips the
 re-initialisation (the route before it, for comparison).
 
@@ -148,15 +152,16 @@ Modules, each importing only from the ones above it:
 
 - :mod:`.model` — :class:`Problem` (the concentrated cost and its Gauss-Newton model), the
   feasible set, the noise floor;
+- :mod:`.lm` — Levenberg-Marquardt and its stopping rule (:func:`~.lm.lm_fit`);
 - :mod:`.search` — the starts: one path from a (residual) tensor, successive cancellation,
   starts from estimates;
 - :mod:`.residual` — the residual test (periodogram peak against its noise-only distribution);
 - :mod:`.resolution` — the statistical resolution limit: per-path separations in standard
   deviations, significance, the per-path verdict :func:`resolvable`; the threshold in SNR by
   the method of interval errors (:func:`snr_threshold`, :func:`outlier_probability`) and the
-  per-path threshold region :func:`below_threshold` (``PathEstimates.below_threshold``);
-- :mod:`.fitting` — Levenberg-Marquardt, the stopping rule, the basin test and the
-  re-seedings: :func:`fit_ml`, :class:`MLFit`;
+  per-path threshold region :func:`below_threshold` (``PathEstimates.below_threshold``); the
+  pair test :func:`pair_test` (``PathEstimates.unresolved``);
+- :mod:`.fitting` — the basin test and the re-seedings: :func:`fit_ml`, :class:`MLFit`;
 - :mod:`.wideband` — :class:`WidebandProblem`, the model with the spatial-wideband term (each
   element its own delay across the band), a :class:`Problem` the fit runs on unchanged;
 - :mod:`.paths` — :func:`ml_paths` (``wideband=True``: the eq. 1 fit refined on that model) and
@@ -182,9 +187,13 @@ from .paths import estimates_from_fit, ml_order, ml_paths, physical
 from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
 from .resolution import (
     OUTLIER_RATE,
+    PAIR_FALSE_ALARM,
+    PAIR_LLR,
+    PAIR_TEST_Z,
     RESOLVE_Z,
     below_threshold,
     outlier_probability,
+    pair_test,
     resolvable,
     separations,
     snr_threshold,
@@ -202,6 +211,9 @@ __all__ = [
     "FALSE_ALARM",
     "MAX_ITER",
     "OUTLIER_RATE",
+    "PAIR_FALSE_ALARM",
+    "PAIR_LLR",
+    "PAIR_TEST_Z",
     "RESOLVE_Z",
     "SEARCHES",
     "MLConvergenceWarning",
@@ -221,6 +233,7 @@ __all__ = [
     "noise_floor",
     "outlier_probability",
     "pair_separation",
+    "pair_test",
     "path_from_peak",
     "peak_null",
     "peak_threshold",

@@ -13,16 +13,19 @@ import numpy as np
 from ..._validate import integer, positive, record, sequence
 from ...constants import C
 from ..decomposition import check_tensor
-from ..numerics import (
-    MIN_SIGNIFICANCE,
-    damped_step_unchecked,
-    free_newton_unchecked,
-    spatial_phase_unchecked,
-)
+from ..numerics import MIN_SIGNIFICANCE, spatial_phase_unchecked
 from ..radio import check_array, check_srs
+from .lm import STEP_TOL, lm_fit
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
-from .resolution import RESOLVE_Z, pair_separation, separations
+from .resolution import (
+    PAIR_LLR,
+    RESOLVE_Z,
+    pair_separation,
+    pair_tests_at,
+    separations,
+    unresolved_partners,
+)
 from .resolution import significance as path_significance
 from .search import check_start, path_from_peak, search_path
 
@@ -42,7 +45,6 @@ __all__ = [
     "pair_separation",
 ]
 
-STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
 #: cap on ``max_iter`` (Levenberg-Marquardt iterations per fit) and on ``n_reseed``: an iteration
 #: is one pass over the tensor (~5-10 ms at M = 100, Nf = 410, Nt = 12); a fit that has not
@@ -50,6 +52,9 @@ RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
 MAX_ITER = 1000
 #: the searches of :func:`fit_problem`
 SEARCHES = ("residual", "basic")
+
+
+_lm = lm_fit  # the fit's name for it
 
 
 class MLConvergenceWarning(RuntimeWarning):
@@ -81,7 +86,12 @@ class MLFit:
     two paths resolved (``separation >= RESOLVE_Z``); ``reason`` the tests it failed
     (``"residual peak"``: a path missed or a wrong basin; ``"residual energy"``; ``"path below
     the noise"``; ``"unresolved pair"``: the threshold region of two paths closer than their
-    bound can tell), ``""`` when it passed."""
+    bound can tell; ``"pair not resolved"``: the pair test), ``""`` when it passed; ``pairs``
+    (P, 4) the pair test of each pair closer than ``PAIR_TEST_Z`` (rows ``(i, j, z, llr)``,
+    :func:`~.resolution.pair_test`) and ``unresolved`` (L,) each path's partner in a pair whose
+    ``llr`` is below ``PAIR_LLR`` (one path explains the two as well) or closer than
+    ``RESOLVE_Z`` (:func:`~.resolution.unresolved_partners`: the CRLB of the two is not a bound
+    the estimate can reach), ``-1`` when resolved."""
 
     theta: np.ndarray
     mu_f: np.ndarray
@@ -103,56 +113,17 @@ class MLFit:
     separation: float = np.inf
     reason: str = ""
     resolution: np.ndarray | None = field(default=None, repr=False)
+    pairs: np.ndarray | None = field(default=None, repr=False)
+    unresolved: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:  # theta inside the feasible set: the front half-space
         L = ("L",)
-        record(self, shapes={"theta": (*L, 3), "mu_f": L, "mu_t": L, "alpha": L, "significance": L, "detected": L, "resolution": L},
+        record(self, shapes={"theta": (*L, 3), "mu_f": L, "mu_t": L, "alpha": L, "significance": L, "detected": L, "resolution": L, "pairs": (None, 4), "unresolved": L},
                nonnegative=("cost", "noise_power", "rho", "rho_max", "n_iter", "n_reseed", "peak", "peak_max", "separation", "resolution"),
                allow_inf=("peak_max", "separation", "resolution"), may_be_empty=("history", "reason"))  # fmt: skip
         r, w = np.hypot(self.theta[:, 0], self.theta[:, 1]), self.theta[:, 2]
         if np.any(r > 1) or np.any(w < 0) or np.any(w > W_MAX * (1 + 1e-9)):
             raise ValueError("theta: outside the front half-space |u| <= 1, 0 <= w <= W_MAX")
-
-
-def _lm(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):
-    """Levenberg-Marquardt on the concentrated cost; returns the best point and its evaluation.
-
-    ``state`` (a dict, optional) makes the iteration resumable: read at the start (``"lam"`` the
-    damping, ``"ev"`` the evaluation at the start point, if present) and written at the end
-    (the damping reached and the evaluation of the returned point), so ``m`` iterations and
-    then ``n`` more from the point returned run exactly the ``m + n`` iterations of one call."""
-    L = theta.shape[0]
-    state = {} if state is None else state
-    ev = state.get("ev") or prob.evaluate(theta, mu_f, mu_t)
-    lam, it, converged = state.get("lam", 1e-3), 0, False
-    for it in range(1, max_iter + 1):  # noqa: B007
-        lower = np.zeros((L, 5), bool)
-        lower[:, 2] = theta[:, 2] <= 0.0
-        upper = np.zeros((L, 5), bool)
-        upper[:, 2] = theta[:, 2] >= W_MAX
-        # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
-        free, dec = free_newton_unchecked(ev["A"], ev["g"], lower.ravel(), upper.ravel())
-        if dec < STEP_TOL * sigma2:
-            converged = True
-            break
-        step = damped_step_unchecked(ev["A"], ev["g"], free, lam)
-        if step is None:
-            lam *= 4.0
-            continue
-        st = step.reshape(L, 5)
-        th_new = project_feasible(theta + st[:, :3])
-        mf_new, mt_new = mu_f + st[:, 3], mu_t + st[:, 4]
-        ev_new = prob.evaluate(th_new, mf_new, mt_new)
-        if ev_new["cost"] < ev["cost"]:
-            theta, mu_f, mu_t, ev = th_new, mf_new, mt_new, ev_new
-            lam = max(lam / 3.0, 1e-9)
-        else:
-            lam *= 4.0
-            if lam > 1e10:
-                converged = True  # no descent direction left at working precision
-                break
-    state["lam"], state["ev"] = lam, ev
-    return theta, mu_f, mu_t, ev, it, converged
 
 
 def _lm_with(prob: Problem, theta, mu_f, mu_t, new, sigma2, max_iter):
@@ -553,11 +524,15 @@ def fit_problem(
     resolution = ev.get("resolution", None)  # at theta: ev is the evaluation there
     resolution = separations(prob, theta, mu_f, mu_t, sigma2) if resolution is None else resolution
     separation = float(np.min(resolution)) if resolution.size else float("inf")
+    pairs, its = pair_tests_at(prob, theta, mu_f, mu_t, sigma2, ev, max_iter)
+    n_it += its
+    unresolved = unresolved_partners(pairs, L)
     failed = {
         "residual peak": peak[0] > peak_max,
         "residual energy": rho > rho_max,
         "path below the noise": not np.all(significance >= MIN_SIGNIFICANCE),
         "unresolved pair": not separation >= RESOLVE_Z,
+        "pair not resolved": bool(np.any(pairs[:, 3] < PAIR_LLR)),
     }
     reason = ", ".join(k for k, v in failed.items() if v)
     fit_ok = not reason
@@ -597,4 +572,6 @@ def fit_problem(
         float(separation),
         reason,
         resolution,
+        pairs,
+        unresolved,
     )

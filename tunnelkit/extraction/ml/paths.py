@@ -74,6 +74,12 @@ def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: floa
     signif = fit.significance[o]
     res = None if fit.resolution is None else np.asarray(fit.resolution, float)[o]
     n_cells = element_positions.shape[0] * nf * nt
+    unres = None
+    if fit.unresolved is not None:  # partners in the sorted order
+        rank = np.empty(len(o), int)
+        rank[o] = np.arange(len(o))
+        part = np.asarray(fit.unresolved, int)[o]
+        unres = np.where(part >= 0, rank[np.maximum(part, 0)], -1)
     return replace(
         est,
         valid=est.valid & (signif >= MIN_SIGNIFICANCE) & physical(est, srs),
@@ -84,6 +90,7 @@ def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: floa
         below_threshold=below_threshold(
             signif, np.full(len(o), np.inf) if res is None else res, n_cells
         ),
+        unresolved=unres,
     )
 
 

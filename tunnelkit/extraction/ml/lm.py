@@ -1,0 +1,67 @@
+"""Levenberg-Marquardt on the concentrated cost of a :class:`~.model.Problem` (package text of
+:mod:`tunnelkit.extraction.ml`: the damped Gauss-Newton step, the stopping rule on the Newton
+decrement), shared by the fit (:mod:`.fitting`) and the resolution test (:mod:`.resolution`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._validate import finite_array, integer, positive
+from ..numerics import damped_step_unchecked, free_newton_unchecked
+from .model import W_MAX, Problem, project_feasible
+
+__all__ = ["STEP_TOL", "lm_fit"]
+
+STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
+#: cap on ``max_iter`` (``fitting.MAX_ITER``: a fit not converged in 1,000 is not converging)
+MAX_LM_ITER = 1000
+
+
+def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict | None = None):
+    """Levenberg-Marquardt on the concentrated cost; returns the best point and its evaluation.
+
+    ``state`` (a dict, optional) makes the iteration resumable: read at the start (``"lam"`` the
+    damping, ``"ev"`` the evaluation at the start point, if present) and written at the end
+    (the damping reached and the evaluation of the returned point), so ``m`` iterations and
+    then ``n`` more from the point returned run exactly the ``m + n`` iterations of one call."""
+    if not isinstance(prob, Problem):
+        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
+    theta = finite_array("theta", theta, shape=(None, 3))
+    L = theta.shape[0]
+    mu_f = finite_array("mu_f", mu_f, shape=(L,))
+    mu_t = finite_array("mu_t", mu_t, shape=(L,))
+    sigma2 = positive("sigma2", sigma2)
+    max_iter = integer("max_iter", max_iter, minimum=1, maximum=MAX_LM_ITER)
+    if state is not None and not isinstance(state, dict):
+        raise TypeError(f"state: expected a dict or None, got {type(state).__name__}")
+    state = {} if state is None else state
+    ev = state.get("ev") or prob.evaluate(theta, mu_f, mu_t)
+    lam, it, converged = state.get("lam", 1e-3), 0, False
+    for it in range(1, max_iter + 1):  # noqa: B007
+        lower = np.zeros((L, 5), bool)
+        lower[:, 2] = theta[:, 2] <= 0.0
+        upper = np.zeros((L, 5), bool)
+        upper[:, 2] = theta[:, 2] >= W_MAX
+        # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
+        free, dec = free_newton_unchecked(ev["A"], ev["g"], lower.ravel(), upper.ravel())
+        if dec < STEP_TOL * sigma2:
+            converged = True
+            break
+        step = damped_step_unchecked(ev["A"], ev["g"], free, lam)
+        if step is None:
+            lam *= 4.0
+            continue
+        st = step.reshape(L, 5)
+        th_new = project_feasible(theta + st[:, :3])
+        mf_new, mt_new = mu_f + st[:, 3], mu_t + st[:, 4]
+        ev_new = prob.evaluate(th_new, mf_new, mt_new)
+        if ev_new["cost"] < ev["cost"]:
+            theta, mu_f, mu_t, ev = th_new, mf_new, mt_new, ev_new
+            lam = max(lam / 3.0, 1e-9)
+        else:
+            lam *= 4.0
+            if lam > 1e10:
+                converged = True  # no descent direction left at working precision
+                break
+    state["lam"], state["ev"] = lam, ev
+    return theta, mu_f, mu_t, ev, it, converged
