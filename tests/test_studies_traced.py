@@ -56,6 +56,47 @@ def test_the_loop_draws_and_measures_as_the_drive_simulator(cond):
             assert np.all(np.diff(pt.source) > 0)
 
 
+def test_an_adapter_measures_its_extractions_epochs_without_a_draw():
+    """simulate_routes' adapters: an extra route fed the same epochs; with the ordinary adapter it
+    equals its extraction's drive, and the other routes and draws are those without it."""
+    kw = dict(condition="N@0.5", extractions=("paper", "ml"), n_epochs=3)
+    ref = simulate_routes("italiano2026-straight", np.random.default_rng(4), **kw)
+    calls = []
+
+    def spy(ep, route):
+        calls.append(ep.k)
+        return path_measurements(ep, route)
+
+    got = simulate_routes(
+        "italiano2026-straight", np.random.default_rng(4), adapters={"copy": ("ml", spy)}, **kw
+    )
+    assert list(got) == ["paper", "ml", "copy"]
+    for e in ("paper", "ml"):
+        _same_drive(got[e], ref[e])
+    _same_drive(got["copy"], ref["ml"])
+    assert got["copy"].extraction == "ml"
+    failed = {int(f.split(":")[0].split()[1]) for f in ref["ml"].faults if "failed (" in f}
+    assert calls == [k for k in range(3) if k not in failed]  # once per measured epoch
+
+
+@pytest.mark.parametrize(
+    "adapters, exc, match",
+    [
+        ([("x", ("ml", path_measurements))], TypeError, "adapters: expected a dict"),
+        ({"ml": ("ml", path_measurements)}, ValueError, "adapters: expected new route names"),
+        ({"x": ("coherent", path_measurements)}, ValueError, "not one of the extractions"),
+        ({"x": ("ml", None)}, TypeError, "must map to"),
+        ({"x": ("nope", path_measurements)}, ValueError, "extraction: expected one of"),
+    ],
+)
+def test_bad_adapters_are_named(adapters, exc, match):
+    with pytest.raises(exc, match=match):
+        simulate_routes(
+            "italiano2026-straight", np.random.default_rng(0), extractions=("paper", "ml"),
+            n_epochs=1, adapters=adapters,
+        )  # fmt: skip
+
+
 def test_the_adapter_passes_a_flagged_fit_and_drops_an_inconsistent_path():
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(5, np.random.default_rng(1), refine="ml")

@@ -19,18 +19,17 @@ changes two things, nothing else:
   test still carries its measurements (on this channel every fit fails it: the test judges eq. 1,
   not the paths the tracker needs).
 
-:func:`simulate_traced` is the drive simulator's loop with that adapter beside the ordinary one
-(:func:`tunnelkit.studies.drives.path_measurements`, which drops a flagged epoch inside
-:func:`~tunnelkit.studies.drives.simulate_routes`' loop): one drive, the same random draws as
-``simulate_routes(extractions=("paper", "ml"))``, returned as ``{"paper", "ml", "ml-all",
-"ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
+:func:`simulate_traced` is the drive simulator (:func:`tunnelkit.studies.drives.simulate_routes`)
+with that adapter beside the ordinary one (:func:`tunnelkit.studies.drives.path_measurements`,
+which drops a flagged epoch), both measuring the ML route's epochs (its ``adapters``): one drive,
+the same random draws as ``simulate_routes(extractions=("paper", "ml"))``, returned as
+``{"paper", "ml", "ml-all", "ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
 """
 
 from __future__ import annotations
 
 import json
-import warnings
-from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -40,15 +39,7 @@ from ..scenarios import data_dir
 from ..signal_route import Epoch, SignalRoute
 from ..tracking.javelin import designs
 from ..tracking.javelin.measurement import PathMeasurements
-from .drives import (
-    CONDITIONS,
-    SIGMA_HEADING,
-    SIGMA_SPEED,
-    DriveData,
-    ml_epoch,
-    path_measurements,
-    scenario_route,
-)
+from .drives import CONDITIONS, DriveData, scenario_route, simulate_routes
 
 __all__ = [
     "FLOORS",
@@ -133,28 +124,6 @@ def traced_measurements(
     return pm.subset(rows), None
 
 
-def _acc() -> dict:
-    return {"epochs": [], "tidx": [], "kinds": [], "faults": [], "sources": [], "los": [], "n": []}
-
-
-def _add(a: dict, k: int, ep, pm, reason) -> None:
-    if ep is None or pm is None:
-        a["faults"].append(f"epoch {k}: {reason}")
-        a["epochs"].append(None)
-        a["tidx"].append(np.zeros(0, int))
-        a["kinds"].append([])
-        a["sources"].append(np.zeros((0, 3)))
-        a["los"].append(False)
-        a["n"].append(0 if ep is None else len(ep.paths))
-        return
-    a["epochs"].append(pm)
-    a["tidx"].append(np.asarray(ep.truth_index)[pm.source])
-    a["kinds"].append([p.surface_kind for p in ep.paths])
-    a["sources"].append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
-    a["los"].append(any(p.kind == "los" for p in ep.paths))
-    a["n"].append(len(ep.paths))
-
-
 def simulate_traced(
     route,
     rng: np.random.Generator,
@@ -175,69 +144,22 @@ def simulate_traced(
     if condition not in CONDITIONS:
         raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
     cond = CONDITIONS[condition]
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
     floors = _floors(floors)
-    label = route if isinstance(route, str) else "route"
-    route = scenario_route(route, "exact", channel, nuisance)
-    no_los = replace(route, kinds=tuple(k for k in route.kinds if k != "los"))
-    tunnel = route.tunnel if cond.rrms else route.tunnel.without_plates()
-    traj = route.trajectory
-    T = len(traj) if n_epochs is None else min(integer("n_epochs", n_epochs, minimum=1), len(traj))
-    acc = {e: _acc() for e in TRACED_ROUTES}
-    bs = None
-    for k in range(T):
-        r = route if rng.random() < cond.los_probability else no_los
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                ep0, why = None, f"extraction failed ({exc})"
-            ep = None
-            if ep0 is not None:
-                try:
-                    ep = ml_epoch(ep0, r.config, r.ml_noise_power(ep0.k, ep0.snapshot, tunnel))
-                except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
-                    why_ml = f"extraction failed ({exc})"
-            for e, src in (("paper", ep0), ("ml", ep), ("ml-all", ep), ("ml-traced", ep)):
-                reason = why if ep0 is None else (why_ml if src is None else None)
-                pm = None
-                if src is not None:
-                    bs = src.measurements.origin.copy()
-                    if e in ("paper", "ml"):
-                        pm, reason = path_measurements(src, route)
-                    else:
-                        pm, reason = traced_measurements(
-                            src, route, floors, prefilter=e != "ml-all"
-                        )
-                _add(acc[e], k, src, pm, reason)
-    if bs is None:
-        bs = route.arrays[0].origin.copy()
-    vel = traj.velocity[:T]
-    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
-    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
-    return {
-        e: DriveData(
-            label,
-            cond,
-            traj.t[:T].copy(),
-            traj.position[:T].copy(),
-            vel.copy(),
-            speed.copy(),
-            heading.copy(),
-            a["epochs"],
-            np.array(a["los"], bool),
-            np.array(a["n"], int),
-            bs.copy(),
-            a["tidx"],
-            a["kinds"],
-            a["faults"],
-            a["sources"],
-            "ml" if e != "paper" else "paper",
-            route.config.clock_bias_limit,
-            bool(route.report_covariance),
-        )
-        for e, a in acc.items()
-    }
+    return simulate_routes(
+        route,
+        rng,
+        condition=cond,
+        extractions=("paper", "ml"),
+        n_epochs=n_epochs,
+        channel=channel,
+        nuisance=nuisance,
+        adapters={
+            "ml-all": ("ml", partial(traced_measurements, floors=floors, prefilter=False)),
+            "ml-traced": ("ml", partial(traced_measurements, floors=floors)),
+        },
+    )
 
 
 def _sigma_trial(n_epochs, cond, rng):
