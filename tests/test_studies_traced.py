@@ -14,7 +14,9 @@ from tunnelkit.studies import simulate_routes
 from tunnelkit.studies.drives import path_measurements, scenario_route
 from tunnelkit.studies.traced import (
     FLOORS,
+    check_provenance,
     geometry_keep,
+    scene_provenance,
     simulate_traced,
     traced_design,
     traced_errors,
@@ -120,6 +122,7 @@ def test_the_adapter_passes_a_flagged_fit_and_drops_an_inconsistent_path():
 def test_the_stored_errors_set_the_design(tmp_path):
     rec = {"scenario": "italiano2026-straight", "condition": "L", "seed": 0, "runs": 1,
            "rows": [["los", 3, 1.0, 2.0, 30.0, 0.5, 0], ["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]}  # fmt: skip
+    rec.update(scene_provenance())
     p = write_traced_errors(rec, tmp_path / "e.json")
     assert json.loads(open(p).read())["rows"][1][0] == "all"
     d = traced_design(p)
@@ -135,6 +138,53 @@ def test_the_stored_errors_set_the_design(tmp_path):
     (tmp_path / "bad.json").write_text(json.dumps({"rows": [["los", 1, 1, 1, 1, 1, 0]]}))
     with pytest.raises(ValueError, match="path"):
         traced_errors(tmp_path / "bad.json")
+
+
+def test_stored_sigmas_of_another_scene_are_refused_never_reused(tmp_path):
+    """The record's ray-tracer settings and scene key are checked against the current ones: any
+    difference is refused (naming it), a record without them is used with a warning."""
+    import warnings
+
+    cur = scene_provenance()
+    assert cur["rt_key"]["scene"] and cur["rt_settings"]["max_depth"] >= 1
+    rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
+    ok = write_traced_errors({"rows": rows, **cur}, tmp_path / "ok.json")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert traced_errors(ok)["rows"] == rows  # same scene: no warning
+    for part, name, value in [
+        ("rt_settings", "scattering_coefficient", 0.5),
+        ("rt_key", "scene", "0" * 64),
+        ("rt_key", "sionna_rt", "0.0.1"),
+    ]:
+        other = json.loads(json.dumps(cur))
+        other[part][name] = value
+        p = write_traced_errors({"rows": rows, **other}, tmp_path / f"{name}.json")
+        with pytest.raises(ValueError, match=rf"path: .*{part}\.{name}: stored"):
+            traced_errors(p)
+        with pytest.raises(ValueError, match=rf"{part}\.{name}"):
+            traced_design(p)
+        assert traced_errors(p, check=False)["rows"] == rows  # read as it is, on request
+        with pytest.raises(ValueError, match="another scene"):
+            check_provenance(json.loads(open(p).read()), cur)
+    legacy = write_traced_errors(
+        {"rows": rows, "rt_settings": cur["rt_settings"]}, tmp_path / "legacy.json"
+    )
+    with pytest.warns(UserWarning, match="carries no rt_key"):
+        traced_errors(legacy)
+    assert check_provenance({"rows": rows}, cur) == ["rt_settings", "rt_key"]
+    with pytest.raises(TypeError, match="check"):
+        traced_errors(ok, check="yes")
+
+
+def test_the_traced_note_says_when_the_tables_ray_tracer_differs():
+    from tunnelkit.reproduce.javelin_tables import _traced_note
+
+    cur = dict(traced_errors(check=False)["rt_settings"])
+    assert "ray tracer differs" not in _traced_note({"diffuse_floor": True}, {"rt_settings": cur})
+    cur["scattering_coefficient"] = 0.5
+    note = _traced_note({"diffuse_floor": True}, {"rt_settings": cur})
+    assert "ray tracer differs" in note and "scattering_coefficient: 0.3 there, 0.5 here" in note
 
 
 def test_the_stored_record_states_its_procedure():

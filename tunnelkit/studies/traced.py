@@ -29,6 +29,7 @@ the same random draws as ``simulate_routes(extractions=("paper", "ml"))``, retur
 from __future__ import annotations
 
 import json
+import warnings
 from functools import partial
 
 import numpy as np
@@ -46,8 +47,10 @@ __all__ = [
     "SIGMA_RUNS",
     "SIGMA_SCENARIO",
     "TRACED_ROUTES",
+    "check_provenance",
     "geometry_keep",
     "measure_traced_errors",
+    "scene_provenance",
     "simulate_traced",
     "traced_design",
     "traced_errors",
@@ -200,7 +203,7 @@ def measure_traced_errors(
         "runs": runs,
         "n_epochs": n_epochs,
         "nuisance": dict(NUISANCE),
-        "rt_settings": {k: v for k, v in vars(route.raytraced.settings).items()},
+        **scene_provenance(route),
         "columns": list(cols),
         "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
     }
@@ -217,10 +220,64 @@ def write_traced_errors(record: dict, path=None) -> str:
     return str(p)
 
 
-def traced_errors(path=None) -> dict:
+def scene_provenance(route=None) -> dict:
+    """What the traced sigmas depend on besides the procedure: ``rt_settings`` (the ray tracer's
+    :class:`~tunnelkit.rt.settings.RTSettings`) and ``rt_key`` (the ray-tracing cache's key of the
+    drive: scene export hash, settings, arrays, trajectory, radio, cache format, sionna-rt
+    version; :meth:`~tunnelkit.rt.cache.RayTracedChannel.key`) of ``route`` (default: the route
+    the sigmas are measured on, :data:`SIGMA_SCENARIO` on the ray-traced channel)."""
+    if route is None:
+        route = scenario_route(SIGMA_SCENARIO, "exact", "sionna", NUISANCE)
+    instance("route", route, SignalRoute)
+    if route.raytraced is None:
+        raise ValueError("route: expected a route on the ray-traced channel (channel='sionna')")
+    return {
+        "rt_settings": dict(vars(route.raytraced.settings)),
+        "rt_key": route.raytraced.key(),
+    }
+
+
+def check_provenance(record: dict, current: dict | None = None) -> list[str]:
+    """Compare a stored record's ``rt_settings`` / ``rt_key`` with ``current``
+    (:func:`scene_provenance` by default). Returns the entries it cannot check (absent from the
+    record); raises ``ValueError`` naming every entry that differs (the record belongs to another
+    scene or ray tracer and must not be reused)."""
+    if not isinstance(record, dict):
+        raise TypeError(f"record: expected the dict of measure_traced_errors, got {record!r}")
+    cur = scene_provenance() if current is None else current
+    if not isinstance(cur, dict) or not {"rt_settings", "rt_key"} <= set(cur):
+        raise TypeError("current: expected the dict of scene_provenance")
+    unchecked, differ = [], []
+    for part in ("rt_settings", "rt_key"):
+        old = record.get(part)
+        if not isinstance(old, dict):
+            unchecked.append(part)
+            continue
+        for name in sorted(set(old) | set(cur[part])):
+            a, b = old.get(name), cur[part].get(name)
+            if json.dumps(a, default=str) != json.dumps(b, default=str):
+                differ.append(f"{part}.{name}: stored {a!r}, now {b!r}")
+    if differ:
+        raise ValueError(
+            "record: measured on another scene or ray tracer than the current one ("
+            + "; ".join(differ)
+            + "); re-measure with benchmarks/bench_rt_sigmas.py --write"
+        )
+    return unchecked
+
+
+_CHECKED: dict[tuple, list[str]] = {}
+
+
+def traced_errors(path=None, *, check: bool = True) -> dict:
     """The stored record of :func:`measure_traced_errors` (``path`` default
-    ``data/rt/traced_errors.json``)."""
+    ``data/rt/traced_errors.json``). ``check``: its provenance is compared with the current scene
+    and ray tracer (:func:`check_provenance`): a record of another scene, settings, trajectory,
+    array, radio or sionna-rt version is refused (``ValueError``), one that does not carry its
+    scene key is used with a warning (its scene cannot be checked); ``check=False`` reads it
+    as it is."""
     p = _errors_path() if path is None else _path(path)
+    check = boolean("check", check)
     if not p.is_file():
         raise FileNotFoundError(
             f"path: no traced errors at {p}; measure them with benchmarks/bench_rt_sigmas.py --write"
@@ -228,12 +285,28 @@ def traced_errors(path=None) -> dict:
     rec = json.loads(p.read_text())
     if not any(r[0] == "all" for r in rec.get("rows", [])):
         raise ValueError(f"path: {p} holds no 'all' row of extraction_errors")
+    if check:
+        st = p.stat()
+        memo = (str(p.resolve()), st.st_mtime_ns, st.st_size)
+        if memo not in _CHECKED:
+            try:
+                _CHECKED[memo] = check_provenance(rec)
+            except ValueError as exc:
+                raise ValueError(f"path: {p}: {exc}") from None
+        if _CHECKED[memo]:
+            warnings.warn(
+                f"{p} carries no {' / '.join(_CHECKED[memo])}: the scene and ray tracer its "
+                "sigmas were measured on cannot be checked against the current ones; re-measure "
+                "with benchmarks/bench_rt_sigmas.py --write",
+                stacklevel=2,
+            )
     return rec
 
 
 def traced_design(path=None):
     """:func:`~tunnelkit.tracking.javelin.designs.ours_ml` with its measurement noise set to the
-    stored traced errors (:func:`traced_errors`, the ``"all"`` row;
+    stored traced errors (:func:`traced_errors`, checked against the current scene; the ``"all"``
+    row;
     :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`); to be fed the
     ``"ml-traced"`` drives of :func:`simulate_traced`."""
     return designs.design_from_errors(traced_errors(path)["rows"], base=designs.ours_ml())
