@@ -576,6 +576,7 @@ def _traced():
     tr.traced_design()
     cur = tr.scene_provenance()
     tr.check_provenance({"rows": [], **cur}, cur)
+    tr.traced_pcrlb("italiano2026-straight")
 
 
 def _trial(rng):

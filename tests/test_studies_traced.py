@@ -217,3 +217,47 @@ def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive():
     img = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
                         extractions=("ml",), n_epochs=2)  # fmt: skip
     assert TRACED_COLUMN[0] not in img.columns
+
+
+def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypatch):
+    """traced_pcrlb: the covariance recursion of the linear model (F = I) it states, written out
+    (P_k = ((P_{k-1} + Q_k)^-1 + I_k)^-1), gives the same bound; tighter sigmas a tighter bound;
+    sigmas so large the paths carry nothing: the dead reckoning's bound; bad rows named."""
+    import tunnelkit.design as design
+    from tunnelkit.design import DesignSetup, drive_pcrlb
+    from tunnelkit.design.drivebound import drive_motion
+    from tunnelkit.studies.drives import SIGMA_HEADING, SIGMA_SPEED
+    from tunnelkit.studies.traced import traced_pcrlb
+
+    rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
+    seen = {}
+    real = design.position_information
+
+    def spy(model, geometry, weights=None):
+        seen["info"] = real(model, geometry, weights)
+        return seen["info"]
+
+    monkeypatch.setattr(design, "position_information", spy)
+    b = traced_pcrlb(rows=rows, sigma_p0=0.5)
+    info = seen["info"]
+    assert info.shape == (len(b), 2, 2) and np.all(np.linalg.eigvalsh(info) > 0)
+    setup = DesignSetup.from_scenario("italiano2026-straight")
+    G, Qn, _ = drive_motion(setup, len(b), SIGMA_SPEED, SIGMA_HEADING)
+    P = np.linalg.inv(np.eye(2) / 0.25 + info[0])
+    want = [np.sqrt(np.trace(P))]
+    for k in range(1, len(b)):
+        Q = G[k] @ Qn @ G[k].T + 1e-12 * np.eye(2)
+        P = np.linalg.inv(np.linalg.inv(P + Q) + info[k])
+        want.append(np.sqrt(np.trace(P)))
+    np.testing.assert_allclose(b, want, rtol=1e-9)
+    tight = traced_pcrlb(rows=[["all", 9, 0.9, 0.8, 3.3, 0.11, 1]], sigma_p0=0.5)
+    assert np.all(tight <= b + 1e-12) and tight.mean() < b.mean()
+    huge = traced_pcrlb(rows=[["all", 9, 1e6, 1e6, 1e9, 1e9, 1]], sigma_p0=0.5)
+    dr = drive_pcrlb(setup, np.zeros((len(b), 2, 2)), sigma_p0=0.5)
+    np.testing.assert_allclose(huge, dr, rtol=1e-6)
+    with pytest.raises(ValueError, match="rows"):
+        traced_pcrlb(rows=[["los", 9, 9.0, 8.0, 33.0, 1.1, 1]])
+    with pytest.raises(ValueError, match="rows"):
+        traced_pcrlb(rows=[["all", 9, 0.0, 8.0, 33.0, 1.1, 1]])
+    with pytest.raises(TypeError, match="scenario"):
+        traced_pcrlb(3)
