@@ -576,7 +576,9 @@ def _traced():
     tr.traced_design()
     cur = tr.scene_provenance()
     tr.check_provenance({"rows": [], **cur}, cur)
-    tr.traced_pcrlb("italiano2026-straight")
+    from tunnelkit.reproduce.traced_bound import traced_pcrlb
+
+    traced_pcrlb("italiano2026-straight")
 
 
 def _trial(rng):
