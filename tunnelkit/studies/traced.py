@@ -12,7 +12,9 @@ changes two things, nothing else:
   :func:`measure_traced_errors` on the straight drive, seed 0, condition L, :data:`SIGMA_RUNS`
   runs (drive ``i`` from the ``i``-th child of seed 0), and stored with its provenance in
   ``data/rt/traced_errors.json`` (:func:`write_traced_errors`; ``benchmarks/bench_rt_sigmas.py
-  --write`` re-measures it); :func:`traced_design` reads it;
+  --write`` re-measures it); :func:`traced_design` reads it, its scene checked against the
+  current one (:func:`check_provenance`: the ray tracer's settings and the trace cache's key;
+  a record of another scene is refused, never reused);
 * **a geometry pre-filter**: an epoch's paths that do not agree with one UE through the tunnel's
   planes are dropped (:func:`geometry_keep`: :func:`tunnelkit.path_consistency.epoch_consistency`
   with the model-error floors :data:`FLOORS` alone), and an epoch whose fit failed its residual
