@@ -261,3 +261,7 @@ def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypat
         traced_pcrlb(rows=[["all", 9, 0.0, 8.0, 33.0, 1.1, 1]])
     with pytest.raises(TypeError, match="scenario"):
         traced_pcrlb(3)
+    with pytest.raises(TypeError, match="array"):
+        traced_pcrlb(array=4)
+    with pytest.raises(ValueError, match="array"):
+        traced_pcrlb(array="4y4")

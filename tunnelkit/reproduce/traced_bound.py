@@ -39,9 +39,12 @@ def traced_pcrlb(
     alone allow, not a bound on what the channel allows."""
     from ..design import DesignSetup, drive_pcrlb, position_information, route_geometry
     from ..design.errormodel import PathErrorModel
+    from ..design.setup import parse_array
 
     if not isinstance(scenario, str) or not scenario:
         raise TypeError(f"scenario: expected a preset name, got {scenario!r}")
+    if not isinstance(array, str) or not array:
+        raise TypeError(f"array: expected a candidate such as '10x10', got {array!r}")
     if rows is None:
         rows = traced_errors()["rows"]
     if not isinstance(rows, list | tuple) or not all(isinstance(r, list | tuple) for r in rows):
@@ -53,8 +56,12 @@ def traced_pcrlb(
     sig = finite_array("rows", [np.radians(a[2]), np.radians(a[3]), a[4], a[5]])
     if np.any(sig <= 0):
         raise ValueError(f"rows: the 'all' row's sigmas must be > 0, got {a[2:6]}")
+    try:
+        spec = parse_array(array)
+    except ValueError as exc:
+        raise ValueError(f"array: {exc}") from None
     setup = DesignSetup.from_scenario(scenario)
-    g = route_geometry(setup, array)
+    g = route_geometry(setup, spec)
     T, P = g.exists.shape
     ex4 = np.repeat(g.exists, 4, axis=1)
     cov = np.where(ex4[:, :, None] & ex4[:, None, :], np.kron(np.eye(P), np.diag(sig**2)), np.nan)
