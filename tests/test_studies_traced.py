@@ -188,7 +188,12 @@ def test_the_traced_note_says_when_the_tables_ray_tracer_differs():
 
 
 def test_the_stored_record_states_its_procedure():
-    rec = traced_errors()
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # it carries its scene, and the scene is the current one
+        rec = traced_errors()
+    assert set(rec["rt_key"]) >= {"scene", "settings", "sionna_rt", "trajectory", "arrays"}
     assert rec["procedure"] == "tunnelkit.studies.traced.measure_traced_errors"
     assert rec["seed"] == 0 and rec["scenario"] == "italiano2026-straight"
     assert rec["condition"] == "L" and rec["nuisance"] == {"diffuse_floor": True}
