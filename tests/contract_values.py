@@ -575,6 +575,11 @@ def _traced():
     tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()
+    cur = tr.scene_provenance()
+    tr.check_provenance({"rows": [], **cur}, cur)
+    from tunnelkit.reproduce.traced_bound import traced_pcrlb
+
+    traced_pcrlb("italiano2026-straight")
 
 
 def _trial(rng):

@@ -14,7 +14,9 @@ from tunnelkit.studies import simulate_routes
 from tunnelkit.studies.drives import path_measurements, scenario_route
 from tunnelkit.studies.traced import (
     FLOORS,
+    check_provenance,
     geometry_keep,
+    scene_provenance,
     simulate_traced,
     traced_design,
     traced_errors,
@@ -56,6 +58,47 @@ def test_the_loop_draws_and_measures_as_the_drive_simulator(cond):
             assert np.all(np.diff(pt.source) > 0)
 
 
+def test_an_adapter_measures_its_extractions_epochs_without_a_draw():
+    """simulate_routes' adapters: an extra route fed the same epochs; with the ordinary adapter it
+    equals its extraction's drive, and the other routes and draws are those without it."""
+    kw = dict(condition="N@0.5", extractions=("paper", "ml"), n_epochs=3)
+    ref = simulate_routes("italiano2026-straight", np.random.default_rng(4), **kw)
+    calls = []
+
+    def spy(ep, route):
+        calls.append(ep.k)
+        return path_measurements(ep, route)
+
+    got = simulate_routes(
+        "italiano2026-straight", np.random.default_rng(4), adapters={"copy": ("ml", spy)}, **kw
+    )
+    assert list(got) == ["paper", "ml", "copy"]
+    for e in ("paper", "ml"):
+        _same_drive(got[e], ref[e])
+    _same_drive(got["copy"], ref["ml"])
+    assert got["copy"].extraction == "ml"
+    failed = {int(f.split(":")[0].split()[1]) for f in ref["ml"].faults if "failed (" in f}
+    assert calls == [k for k in range(3) if k not in failed]  # once per measured epoch
+
+
+@pytest.mark.parametrize(
+    "adapters, exc, match",
+    [
+        ([("x", ("ml", path_measurements))], TypeError, "adapters: expected a dict"),
+        ({"ml": ("ml", path_measurements)}, ValueError, "adapters: expected new route names"),
+        ({"x": ("coherent", path_measurements)}, ValueError, "not one of the extractions"),
+        ({"x": ("ml", None)}, TypeError, "must map to"),
+        ({"x": ("nope", path_measurements)}, ValueError, "extraction: expected one of"),
+    ],
+)
+def test_bad_adapters_are_named(adapters, exc, match):
+    with pytest.raises(exc, match=match):
+        simulate_routes(
+            "italiano2026-straight", np.random.default_rng(0), extractions=("paper", "ml"),
+            n_epochs=1, adapters=adapters,
+        )  # fmt: skip
+
+
 def test_the_adapter_passes_a_flagged_fit_and_drops_an_inconsistent_path():
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(5, np.random.default_rng(1), refine="ml")
@@ -79,6 +122,7 @@ def test_the_adapter_passes_a_flagged_fit_and_drops_an_inconsistent_path():
 def test_the_stored_errors_set_the_design(tmp_path):
     rec = {"scenario": "italiano2026-straight", "condition": "L", "seed": 0, "runs": 1,
            "rows": [["los", 3, 1.0, 2.0, 30.0, 0.5, 0], ["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]}  # fmt: skip
+    rec.update(scene_provenance())
     p = write_traced_errors(rec, tmp_path / "e.json")
     assert json.loads(open(p).read())["rows"][1][0] == "all"
     d = traced_design(p)
@@ -96,8 +140,60 @@ def test_the_stored_errors_set_the_design(tmp_path):
         traced_errors(tmp_path / "bad.json")
 
 
+def test_stored_sigmas_of_another_scene_are_refused_never_reused(tmp_path):
+    """The record's ray-tracer settings and scene key are checked against the current ones: any
+    difference is refused (naming it), a record without them is used with a warning."""
+    import warnings
+
+    cur = scene_provenance()
+    assert cur["rt_key"]["scene"] and cur["rt_settings"]["max_depth"] >= 1
+    rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
+    ok = write_traced_errors({"rows": rows, **cur}, tmp_path / "ok.json")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert traced_errors(ok)["rows"] == rows  # same scene: no warning
+    for part, name, value in [
+        ("rt_settings", "scattering_coefficient", 0.5),
+        ("rt_key", "scene", "0" * 64),
+        ("rt_key", "sionna_rt", "0.0.1"),
+    ]:
+        other = json.loads(json.dumps(cur))
+        other[part][name] = value
+        p = write_traced_errors({"rows": rows, **other}, tmp_path / f"{name}.json")
+        with pytest.raises(ValueError, match=rf"path: .*{part}\.{name}: stored"):
+            traced_errors(p)
+        with pytest.raises(ValueError, match=rf"{part}\.{name}"):
+            traced_design(p)
+        assert traced_errors(p, check=False)["rows"] == rows  # read as it is, on request
+        with pytest.raises(ValueError, match="another scene"):
+            check_provenance(json.loads(open(p).read()), cur)
+    legacy = write_traced_errors(
+        {"rows": rows, "rt_settings": cur["rt_settings"]}, tmp_path / "legacy.json"
+    )
+    with pytest.warns(UserWarning, match="carries no rt_key"):
+        traced_errors(legacy)
+    assert check_provenance({"rows": rows}, cur) == ["rt_settings", "rt_key"]
+    with pytest.raises(TypeError, match="check"):
+        traced_errors(ok, check="yes")
+
+
+def test_the_traced_note_says_when_the_tables_ray_tracer_differs():
+    from tunnelkit.reproduce.javelin_tables import _traced_note
+
+    cur = dict(traced_errors(check=False)["rt_settings"])
+    assert "ray tracer differs" not in _traced_note({"diffuse_floor": True}, {"rt_settings": cur})
+    cur["scattering_coefficient"] = 0.5
+    note = _traced_note({"diffuse_floor": True}, {"rt_settings": cur})
+    assert "ray tracer differs" in note and "scattering_coefficient: 0.3 there, 0.5 here" in note
+
+
 def test_the_stored_record_states_its_procedure():
-    rec = traced_errors()
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # it carries its scene, and the scene is the current one
+        rec = traced_errors()
+    assert set(rec["rt_key"]) >= {"scene", "settings", "sionna_rt", "trajectory", "arrays"}
     assert rec["procedure"] == "tunnelkit.studies.traced.measure_traced_errors"
     assert rec["seed"] == 0 and rec["scenario"] == "italiano2026-straight"
     assert rec["condition"] == "L" and rec["nuisance"] == {"diffuse_floor": True}
@@ -126,3 +222,51 @@ def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive():
     img = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
                         extractions=("ml",), n_epochs=2)  # fmt: skip
     assert TRACED_COLUMN[0] not in img.columns
+
+
+def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypatch):
+    """traced_pcrlb: the covariance recursion of the linear model (F = I) it states, written out
+    (P_k = ((P_{k-1} + Q_k)^-1 + I_k)^-1), gives the same bound; tighter sigmas a tighter bound;
+    sigmas so large the paths carry nothing: the dead reckoning's bound; bad rows named."""
+    import tunnelkit.design as design
+    from tunnelkit.design import DesignSetup, drive_pcrlb
+    from tunnelkit.design.drivebound import drive_motion
+    from tunnelkit.reproduce.traced_bound import traced_pcrlb
+    from tunnelkit.studies.drives import SIGMA_HEADING, SIGMA_SPEED
+
+    rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
+    seen = {}
+    real = design.position_information
+
+    def spy(model, geometry, weights=None):
+        seen["info"] = real(model, geometry, weights)
+        return seen["info"]
+
+    monkeypatch.setattr(design, "position_information", spy)
+    b = traced_pcrlb(rows=rows, sigma_p0=0.5)
+    info = seen["info"]
+    assert info.shape == (len(b), 2, 2) and np.all(np.linalg.eigvalsh(info) > 0)
+    setup = DesignSetup.from_scenario("italiano2026-straight")
+    G, Qn, _ = drive_motion(setup, len(b), SIGMA_SPEED, SIGMA_HEADING)
+    P = np.linalg.inv(np.eye(2) / 0.25 + info[0])
+    want = [np.sqrt(np.trace(P))]
+    for k in range(1, len(b)):
+        Q = G[k] @ Qn @ G[k].T + 1e-12 * np.eye(2)
+        P = np.linalg.inv(np.linalg.inv(P + Q) + info[k])
+        want.append(np.sqrt(np.trace(P)))
+    np.testing.assert_allclose(b, want, rtol=1e-9)
+    tight = traced_pcrlb(rows=[["all", 9, 0.9, 0.8, 3.3, 0.11, 1]], sigma_p0=0.5)
+    assert np.all(tight <= b + 1e-12) and tight.mean() < b.mean()
+    huge = traced_pcrlb(rows=[["all", 9, 1e6, 1e6, 1e9, 1e9, 1]], sigma_p0=0.5)
+    dr = drive_pcrlb(setup, np.zeros((len(b), 2, 2)), sigma_p0=0.5)
+    np.testing.assert_allclose(huge, dr, rtol=1e-6)
+    with pytest.raises(ValueError, match="rows"):
+        traced_pcrlb(rows=[["los", 9, 9.0, 8.0, 33.0, 1.1, 1]])
+    with pytest.raises(ValueError, match="rows"):
+        traced_pcrlb(rows=[["all", 9, 0.0, 8.0, 33.0, 1.1, 1]])
+    with pytest.raises(TypeError, match="scenario"):
+        traced_pcrlb(3)
+    with pytest.raises(TypeError, match="array"):
+        traced_pcrlb(array=4)
+    with pytest.raises(ValueError, match="array"):
+        traced_pcrlb(array="4y4")

@@ -327,7 +327,7 @@ def _report(scenario, reference, conditions, extractions, done, channel, nuisanc
         notes=[
             *NOTES,
             *(_RT_NOTES if channel == "sionna" else []),
-            *([_traced_note(nuisance)] if TRACED_COLUMN[1] in extractions else []),
+            *([_traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
             *([_nuisance_note(nuisance)] if nuisance else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
@@ -348,14 +348,18 @@ _RT_NOTES = [
 ]
 
 
-def _traced_note(nuisance: dict | None) -> str:
-    """The traced column's note, its numbers read from the stored record (and whether the
-    table's route is the one they were measured on)."""
+def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
+    """The traced column's note, its numbers read from the stored record (checked against the
+    current scene, :func:`~tunnelkit.studies.traced.traced_errors`), and whether the table's
+    route (its nuisance, its ray-tracer settings ``rt_info["rt_settings"]``) is the one they
+    were measured on."""
     from ..studies.traced import FLOORS, traced_errors
 
     rec = traced_errors()
     a = {r[0]: r for r in rec["rows"]}["all"]
     same = dict(nuisance or {}) == rec["nuisance"]
+    mine, theirs = (rt_info or {}).get("rt_settings"), rec.get("rt_settings") or {}
+    other = sorted(k for k in mine or {} if mine[k] != theirs.get(k))
     return (
         f"Column '{TRACED_COLUMN[0]}': designs.ours_ml with its measurement noise set to the ML "
         f"route's RMS error on the ray-traced channel ({a[2]:.3g} deg, {a[3]:.3g} deg, "
@@ -373,6 +377,13 @@ def _traced_note(nuisance: dict | None) -> str:
             if same
             else f" The sigmas were measured on the route with {rec['nuisance']}, this table "
             f"runs {dict(nuisance or {})} (pass --diffuse-floor for the route they belong to)."
+        )
+        + (
+            " This table's ray tracer differs from the one the sigmas were measured with ("
+            + ", ".join(f"{k}: {theirs.get(k)!r} there, {mine[k]!r} here" for k in other)
+            + "): they are applied as they are, not re-measured."
+            if other
+            else ""
         )
     )
 

@@ -376,6 +376,65 @@ def _redo(ep0, e: str, route: SignalRoute, tunnel):
     return ep0
 
 
+def _accumulator(T: int) -> dict:
+    """One route's per-epoch record of a drive (filled by :func:`_record`)."""
+    return {
+        "epochs": [],
+        "los": np.zeros(T, bool),
+        "n_true": np.zeros(T, int),
+        "tidx": [],
+        "kinds": [],
+        "faults": [],
+        "sources": [],
+    }
+
+
+def _record(a: dict, k: int, ep, pm, reason: str | None) -> None:
+    """Epoch ``k`` of one route into its accumulator ``a``: the measurements ``pm`` of ``ep``, or
+    a fault with ``reason`` when either is ``None``."""
+    if ep is not None:
+        a["n_true"][k] = len(ep.paths)
+    if ep is None or pm is None:
+        a["faults"].append(f"epoch {k}: {reason}")
+        a["epochs"].append(None)
+        a["tidx"].append(np.zeros(0, int))
+        a["kinds"].append([])
+        a["sources"].append(np.zeros((0, 3)))
+        return
+    a["los"][k] = any(p.kind == "los" for p in ep.paths)
+    a["epochs"].append(pm)
+    a["tidx"].append(np.asarray(ep.truth_index)[pm.source])
+    a["kinds"].append([p.surface_kind for p in ep.paths])
+    a["sources"].append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
+
+
+def _adapters(adapters, extractions: tuple[str, ...]) -> dict:
+    """``adapters`` checked: ``{name: (extraction, callable)}``, each extraction one of
+    ``extractions``, each name new."""
+    if adapters is None:
+        return {}
+    if not isinstance(adapters, dict):
+        raise TypeError(
+            f"adapters: expected a dict of name: (extraction, adapter), got {type(adapters).__name__}"
+        )
+    out = {}
+    for name, spec in adapters.items():
+        if not isinstance(name, str) or not name or name in extractions or name in EXTRACTIONS:
+            raise ValueError(
+                f"adapters: expected new route names (not one of {EXTRACTIONS}), got {name!r}"
+            )
+        if not isinstance(spec, tuple) or len(spec) != 2 or not callable(spec[1]):
+            raise TypeError(f"adapters: {name!r} must map to (extraction, callable), got {spec!r}")
+        base = route_name(spec[0])
+        if base not in extractions or base == "route":
+            raise ValueError(
+                f"adapters: {name!r} measures the epochs of {base!r}, which is not one of the "
+                f"extractions {list(extractions)}"
+            )
+        out[name] = (base, spec[1])
+    return out
+
+
 def simulate_routes(
     route,
     rng: np.random.Generator,
@@ -388,6 +447,7 @@ def simulate_routes(
     n_epochs: int | None = None,
     channel: str | None = None,
     nuisance: dict | None = None,
+    adapters: dict | None = None,
 ) -> dict[str, DriveData]:
     """One drive (:func:`simulate_drive`) measured through every route in ``extractions``.
 
@@ -395,7 +455,12 @@ def simulate_routes(
     refinement) runs on it and the coherent route starts from those estimates, the ML route runs
     its own start on the same tensor; ``"route"`` is the route's own extraction and cannot be
     combined with the others (it draws the tensor itself). ``channel`` and ``nuisance`` as in
-    :func:`scenario_route`. Returns ``{extraction: DriveData}``.
+    :func:`scenario_route`. ``adapters``: extra routes measured from the same epochs, ``{name:
+    (extraction, adapter)}``: ``adapter(ep, route) -> (PathMeasurements | None, reason)`` turns
+    the epoch of ``extraction`` (one of ``extractions``) into the tracker's measurements instead
+    of :func:`path_measurements` (no extra draw, the other routes unchanged); the drive's
+    ``extraction`` field is that extraction. Returns ``{extraction: DriveData}``, the adapters'
+    names after the extractions.
     """
     rng = rng_or_error("rng", rng)
     cond = _condition(condition)
@@ -415,27 +480,16 @@ def simulate_routes(
             f"extractions: 'route' (the route's own extraction) cannot be combined with "
             f"{[e for e in extractions if e != 'route']}"
         )
+    adapters = _adapters(adapters, extractions)
     label = route if isinstance(route, str) else "route"
     route = scenario_route(route, model, channel, nuisance)
-    if n_epochs is not None:
-        integer("n_epochs", n_epochs, minimum=1)
     kinds_all = tuple(route.kinds)
     no_los = replace(route, kinds=tuple(k for k in kinds_all if k != "los"))
     tunnel = route.tunnel if cond is None or cond.rrms else route.tunnel.without_plates()
     traj = route.trajectory
     T = len(traj) if n_epochs is None else min(int(n_epochs), len(traj))
-    acc = {
-        e: {
-            "epochs": [],
-            "los": np.zeros(T, bool),
-            "n_true": np.zeros(T, int),
-            "tidx": [],
-            "kinds": [],
-            "faults": [],
-            "sources": [],
-        }
-        for e in extractions
-    }
+    measure = {e: (e, path_measurements) for e in extractions} | adapters
+    acc = {e: _accumulator(T) for e in measure}
     bs = None
     own = extractions == ("route",)
     for k in range(T):
@@ -447,37 +501,29 @@ def simulate_routes(
                 ep0 = r.epoch(k, rng) if own else r.epoch(k, rng, tunnel=tunnel, refine="joint")
             except (ValueError, np.linalg.LinAlgError) as exc:
                 ep0, failure = None, exc
-            for e, a in acc.items():
-                ep, reason = ep0, None
+            eps = {}
+            for e in extractions:
+                ep = ep0
                 if ep is not None and e not in ("paper", "route"):
                     try:
                         ep = _redo(ep0, e, r, tunnel)
                     except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
                         ep, failure = None, exc
+                eps[e] = (ep, None if ep is not None else f"extraction failed ({failure})")
+            for name, (e, adapt) in measure.items():
+                ep, reason = eps[e]
+                pm = None
                 if ep is not None:
                     bs = ep.measurements.origin.copy()
-                    pm, reason = path_measurements(ep, route)
-                    a["n_true"][k] = len(ep.paths)
-                if ep is None or pm is None:
-                    why = reason or f"extraction failed ({failure})"
-                    a["faults"].append(f"epoch {k}: {why}")
-                    a["epochs"].append(None)
-                    a["tidx"].append(np.zeros(0, int))
-                    a["kinds"].append([])
-                    a["sources"].append(np.zeros((0, 3)))
-                    continue
-                a["los"][k] = any(p.kind == "los" for p in ep.paths)
-                a["epochs"].append(pm)
-                a["tidx"].append(np.asarray(ep.truth_index)[pm.source])
-                a["kinds"].append([p.surface_kind for p in ep.paths])
-                a["sources"].append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
+                    pm, reason = adapt(ep, route)
+                _record(acc[name], k, ep, pm, reason)
     if bs is None:
         bs = route.arrays[0].origin.copy()
     vel = traj.velocity[:T]
     speed = np.linalg.norm(vel[:, :2], axis=1) + sigma_speed * rng.standard_normal(T)
     heading = np.arctan2(vel[:, 1], vel[:, 0]) + sigma_heading * rng.standard_normal(T)
     return {
-        e: DriveData(
+        name: DriveData(
             label,
             cond,
             traj.t[:T].copy(),
@@ -493,9 +539,9 @@ def simulate_routes(
             a["kinds"],
             a["faults"],
             a["sources"],
-            e,
+            measure[name][0],
             route.config.clock_bias_limit,
             bool(route.report_covariance),
         )
-        for e, a in acc.items()
+        for name, a in acc.items()
     }

@@ -12,25 +12,27 @@ changes two things, nothing else:
   :func:`measure_traced_errors` on the straight drive, seed 0, condition L, :data:`SIGMA_RUNS`
   runs (drive ``i`` from the ``i``-th child of seed 0), and stored with its provenance in
   ``data/rt/traced_errors.json`` (:func:`write_traced_errors`; ``benchmarks/bench_rt_sigmas.py
-  --write`` re-measures it); :func:`traced_design` reads it;
+  --write`` re-measures it); :func:`traced_design` reads it, its scene checked against the
+  current one (:func:`check_provenance`: the ray tracer's settings and the trace cache's key;
+  a record of another scene is refused, never reused);
 * **a geometry pre-filter**: an epoch's paths that do not agree with one UE through the tunnel's
   planes are dropped (:func:`geometry_keep`: :func:`tunnelkit.path_consistency.epoch_consistency`
   with the model-error floors :data:`FLOORS` alone), and an epoch whose fit failed its residual
   test still carries its measurements (on this channel every fit fails it: the test judges eq. 1,
   not the paths the tracker needs).
 
-:func:`simulate_traced` is the drive simulator's loop with that adapter beside the ordinary one
-(:func:`tunnelkit.studies.drives.path_measurements`, which drops a flagged epoch inside
-:func:`~tunnelkit.studies.drives.simulate_routes`' loop): one drive, the same random draws as
-``simulate_routes(extractions=("paper", "ml"))``, returned as ``{"paper", "ml", "ml-all",
-"ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
+:func:`simulate_traced` is the drive simulator (:func:`tunnelkit.studies.drives.simulate_routes`)
+with that adapter beside the ordinary one (:func:`tunnelkit.studies.drives.path_measurements`,
+which drops a flagged epoch), both measuring the ML route's epochs (its ``adapters``): one drive,
+the same random draws as ``simulate_routes(extractions=("paper", "ml"))``, returned as
+``{"paper", "ml", "ml-all", "ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
 """
 
 from __future__ import annotations
 
 import json
 import warnings
-from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -40,23 +42,17 @@ from ..scenarios import data_dir
 from ..signal_route import Epoch, SignalRoute
 from ..tracking.javelin import designs
 from ..tracking.javelin.measurement import PathMeasurements
-from .drives import (
-    CONDITIONS,
-    SIGMA_HEADING,
-    SIGMA_SPEED,
-    DriveData,
-    ml_epoch,
-    path_measurements,
-    scenario_route,
-)
+from .drives import CONDITIONS, DriveData, scenario_route, simulate_routes
 
 __all__ = [
     "FLOORS",
     "SIGMA_RUNS",
     "SIGMA_SCENARIO",
     "TRACED_ROUTES",
+    "check_provenance",
     "geometry_keep",
     "measure_traced_errors",
+    "scene_provenance",
     "simulate_traced",
     "traced_design",
     "traced_errors",
@@ -133,28 +129,6 @@ def traced_measurements(
     return pm.subset(rows), None
 
 
-def _acc() -> dict:
-    return {"epochs": [], "tidx": [], "kinds": [], "faults": [], "sources": [], "los": [], "n": []}
-
-
-def _add(a: dict, k: int, ep, pm, reason) -> None:
-    if ep is None or pm is None:
-        a["faults"].append(f"epoch {k}: {reason}")
-        a["epochs"].append(None)
-        a["tidx"].append(np.zeros(0, int))
-        a["kinds"].append([])
-        a["sources"].append(np.zeros((0, 3)))
-        a["los"].append(False)
-        a["n"].append(0 if ep is None else len(ep.paths))
-        return
-    a["epochs"].append(pm)
-    a["tidx"].append(np.asarray(ep.truth_index)[pm.source])
-    a["kinds"].append([p.surface_kind for p in ep.paths])
-    a["sources"].append(np.array([p.source for p in ep.paths]).reshape(-1, 3))
-    a["los"].append(any(p.kind == "los" for p in ep.paths))
-    a["n"].append(len(ep.paths))
-
-
 def simulate_traced(
     route,
     rng: np.random.Generator,
@@ -175,69 +149,22 @@ def simulate_traced(
     if condition not in CONDITIONS:
         raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
     cond = CONDITIONS[condition]
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
     floors = _floors(floors)
-    label = route if isinstance(route, str) else "route"
-    route = scenario_route(route, "exact", channel, nuisance)
-    no_los = replace(route, kinds=tuple(k for k in route.kinds if k != "los"))
-    tunnel = route.tunnel if cond.rrms else route.tunnel.without_plates()
-    traj = route.trajectory
-    T = len(traj) if n_epochs is None else min(integer("n_epochs", n_epochs, minimum=1), len(traj))
-    acc = {e: _acc() for e in TRACED_ROUTES}
-    bs = None
-    for k in range(T):
-        r = route if rng.random() < cond.los_probability else no_los
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                ep0, why = None, f"extraction failed ({exc})"
-            ep = None
-            if ep0 is not None:
-                try:
-                    ep = ml_epoch(ep0, r.config, r.ml_noise_power(ep0.k, ep0.snapshot, tunnel))
-                except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
-                    why_ml = f"extraction failed ({exc})"
-            for e, src in (("paper", ep0), ("ml", ep), ("ml-all", ep), ("ml-traced", ep)):
-                reason = why if ep0 is None else (why_ml if src is None else None)
-                pm = None
-                if src is not None:
-                    bs = src.measurements.origin.copy()
-                    if e in ("paper", "ml"):
-                        pm, reason = path_measurements(src, route)
-                    else:
-                        pm, reason = traced_measurements(
-                            src, route, floors, prefilter=e != "ml-all"
-                        )
-                _add(acc[e], k, src, pm, reason)
-    if bs is None:
-        bs = route.arrays[0].origin.copy()
-    vel = traj.velocity[:T]
-    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
-    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
-    return {
-        e: DriveData(
-            label,
-            cond,
-            traj.t[:T].copy(),
-            traj.position[:T].copy(),
-            vel.copy(),
-            speed.copy(),
-            heading.copy(),
-            a["epochs"],
-            np.array(a["los"], bool),
-            np.array(a["n"], int),
-            bs.copy(),
-            a["tidx"],
-            a["kinds"],
-            a["faults"],
-            a["sources"],
-            "ml" if e != "paper" else "paper",
-            route.config.clock_bias_limit,
-            bool(route.report_covariance),
-        )
-        for e, a in acc.items()
-    }
+    return simulate_routes(
+        route,
+        rng,
+        condition=cond,
+        extractions=("paper", "ml"),
+        n_epochs=n_epochs,
+        channel=channel,
+        nuisance=nuisance,
+        adapters={
+            "ml-all": ("ml", partial(traced_measurements, floors=floors, prefilter=False)),
+            "ml-traced": ("ml", partial(traced_measurements, floors=floors)),
+        },
+    )
 
 
 def _sigma_trial(n_epochs, cond, rng):
@@ -278,7 +205,7 @@ def measure_traced_errors(
         "runs": runs,
         "n_epochs": n_epochs,
         "nuisance": dict(NUISANCE),
-        "rt_settings": {k: v for k, v in vars(route.raytraced.settings).items()},
+        **scene_provenance(route),
         "columns": list(cols),
         "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
     }
@@ -295,10 +222,64 @@ def write_traced_errors(record: dict, path=None) -> str:
     return str(p)
 
 
-def traced_errors(path=None) -> dict:
+def scene_provenance(route=None) -> dict:
+    """What the traced sigmas depend on besides the procedure: ``rt_settings`` (the ray tracer's
+    :class:`~tunnelkit.rt.settings.RTSettings`) and ``rt_key`` (the ray-tracing cache's key of the
+    drive: scene export hash, settings, arrays, trajectory, radio, cache format, sionna-rt
+    version; :meth:`~tunnelkit.rt.cache.RayTracedChannel.key`) of ``route`` (default: the route
+    the sigmas are measured on, :data:`SIGMA_SCENARIO` on the ray-traced channel)."""
+    if route is None:
+        route = scenario_route(SIGMA_SCENARIO, "exact", "sionna", NUISANCE)
+    instance("route", route, SignalRoute)
+    if route.raytraced is None:
+        raise ValueError("route: expected a route on the ray-traced channel (channel='sionna')")
+    return {
+        "rt_settings": dict(vars(route.raytraced.settings)),
+        "rt_key": route.raytraced.key(),
+    }
+
+
+def check_provenance(record: dict, current: dict | None = None) -> list[str]:
+    """Compare a stored record's ``rt_settings`` / ``rt_key`` with ``current``
+    (:func:`scene_provenance` by default). Returns the entries it cannot check (absent from the
+    record); raises ``ValueError`` naming every entry that differs (the record belongs to another
+    scene or ray tracer and must not be reused)."""
+    if not isinstance(record, dict):
+        raise TypeError(f"record: expected the dict of measure_traced_errors, got {record!r}")
+    cur = scene_provenance() if current is None else current
+    if not isinstance(cur, dict) or not {"rt_settings", "rt_key"} <= set(cur):
+        raise TypeError("current: expected the dict of scene_provenance")
+    unchecked, differ = [], []
+    for part in ("rt_settings", "rt_key"):
+        old = record.get(part)
+        if not isinstance(old, dict):
+            unchecked.append(part)
+            continue
+        for name in sorted(set(old) | set(cur[part])):
+            a, b = old.get(name), cur[part].get(name)
+            if json.dumps(a, default=str) != json.dumps(b, default=str):
+                differ.append(f"{part}.{name}: stored {a!r}, now {b!r}")
+    if differ:
+        raise ValueError(
+            "record: measured on another scene or ray tracer than the current one ("
+            + "; ".join(differ)
+            + "); re-measure with benchmarks/bench_rt_sigmas.py --write"
+        )
+    return unchecked
+
+
+_CHECKED: dict[tuple, list[str]] = {}
+
+
+def traced_errors(path=None, *, check: bool = True) -> dict:
     """The stored record of :func:`measure_traced_errors` (``path`` default
-    ``data/rt/traced_errors.json``)."""
+    ``data/rt/traced_errors.json``). ``check``: its provenance is compared with the current scene
+    and ray tracer (:func:`check_provenance`): a record of another scene, settings, trajectory,
+    array, radio or sionna-rt version is refused (``ValueError``), one that does not carry its
+    scene key is used with a warning (its scene cannot be checked); ``check=False`` reads it
+    as it is."""
     p = _errors_path() if path is None else _path(path)
+    check = boolean("check", check)
     if not p.is_file():
         raise FileNotFoundError(
             f"path: no traced errors at {p}; measure them with benchmarks/bench_rt_sigmas.py --write"
@@ -306,12 +287,29 @@ def traced_errors(path=None) -> dict:
     rec = json.loads(p.read_text())
     if not any(r[0] == "all" for r in rec.get("rows", [])):
         raise ValueError(f"path: {p} holds no 'all' row of extraction_errors")
+    if check:
+        st = p.stat()
+        memo = (str(p.resolve()), st.st_mtime_ns, st.st_size)
+        if memo not in _CHECKED:
+            try:
+                _CHECKED[memo] = check_provenance(rec)
+            except ValueError as exc:
+                raise ValueError(f"path: {p}: {exc}") from None
+        if _CHECKED[memo]:
+            warnings.warn(
+                f"{p} carries no {' / '.join(_CHECKED[memo])}: the scene and ray tracer its "
+                "sigmas were measured on cannot be checked against the current ones; re-measure "
+                "with benchmarks/bench_rt_sigmas.py --write",
+                stacklevel=2,
+            )
     return rec
 
 
 def traced_design(path=None):
     """:func:`~tunnelkit.tracking.javelin.designs.ours_ml` with its measurement noise set to the
-    stored traced errors (:func:`traced_errors`, the ``"all"`` row;
+    stored traced errors (:func:`traced_errors`, checked against the current scene; the ``"all"``
+    row;
     :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`); to be fed the
     ``"ml-traced"`` drives of :func:`simulate_traced`."""
     return designs.design_from_errors(traced_errors(path)["rows"], base=designs.ours_ml())
+

@@ -1,0 +1,73 @@
+"""A track bound beside the traced JAVELIN RMSEs: the posterior CRLB of the drive at the traced
+sigmas (:func:`traced_pcrlb`).
+
+The traced design (:mod:`tunnelkit.studies.traced`) tells JAVELIN the ML route's RMS extraction
+error on the ray-traced channel. Fed those sigmas as independent Gaussian errors of every
+first-order path, the design's drive bound (:func:`tunnelkit.design.position_information`,
+:func:`tunnelkit.design.drive_pcrlb`: JAVELIN's motion model on the V2X speed and heading,
+Tichavsky et al. 1998) says what such measurements allow a tracker told the reflectors.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import finite_array
+from ..studies.traced import SIGMA_SCENARIO, traced_errors
+
+__all__ = ["traced_pcrlb"]
+
+
+def traced_pcrlb(
+    scenario: str = SIGMA_SCENARIO,
+    *,
+    rows=None,
+    array: str = "10x10",
+    sigma_p0: float = 1.0,
+) -> np.ndarray:
+    """The posterior CRLB (T,) [m] of the 2-D position along ``scenario``'s drive when every
+    first-order path (LoS, walls, ceiling, road, RRMs; the image method's, known reflectors) is
+    measured at every epoch with independent zero-mean Gaussian errors of the traced sigmas
+    (``rows``: an :func:`~tunnelkit.studies.analysis.extraction_errors` table, its ``"all"`` row;
+    default the stored record, :func:`~tunnelkit.studies.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
+    clock bias removed (:func:`tunnelkit.design.position_information`), JAVELIN's motion model
+    on the V2X messages and a start of ``sigma_p0`` [m] (:func:`tunnelkit.design.drive_pcrlb`).
+    ``array`` is the candidate mounted as the design mounts it (the paper's 10 x 10 by default).
+
+    A bound for a tracker told the reflectors; the traced errors are neither Gaussian nor
+    independent between epochs (repeating biases of the bounces), so it is what the sigmas
+    alone allow, not a bound on what the channel allows."""
+    from ..design import DesignSetup, drive_pcrlb, position_information, route_geometry
+    from ..design.errormodel import PathErrorModel
+    from ..design.setup import parse_array
+
+    if not isinstance(scenario, str) or not scenario:
+        raise TypeError(f"scenario: expected a preset name, got {scenario!r}")
+    if not isinstance(array, str) or not array:
+        raise TypeError(f"array: expected a candidate such as '10x10', got {array!r}")
+    if rows is None:
+        rows = traced_errors()["rows"]
+    if not isinstance(rows, list | tuple) or not all(isinstance(r, list | tuple) for r in rows):
+        raise TypeError(f"rows: expected the rows of extraction_errors, got {rows!r}")
+    allrow = [r for r in rows if len(r) >= 6 and r[0] == "all"]
+    if not allrow:
+        raise ValueError("rows: no 'all' row of extraction_errors")
+    a = allrow[0]
+    sig = finite_array("rows", [np.radians(a[2]), np.radians(a[3]), a[4], a[5]])
+    if np.any(sig <= 0):
+        raise ValueError(f"rows: the 'all' row's sigmas must be > 0, got {a[2:6]}")
+    try:
+        spec = parse_array(array)
+    except ValueError as exc:
+        raise ValueError(f"array: {exc}") from None
+    setup = DesignSetup.from_scenario(scenario)
+    g = route_geometry(setup, spec)
+    T, P = g.exists.shape
+    ex4 = np.repeat(g.exists, 4, axis=1)
+    cov = np.where(ex4[:, :, None] & ex4[:, None, :], np.kron(np.eye(P), np.diag(sig**2)), np.nan)
+    zero = np.where(g.exists[..., None], 0.0, np.nan) * np.ones((T, P, 4))
+    model = PathErrorModel(
+        t=setup.trajectory.t[:T], exists=g.exists, kinds=g.kinds, truth=zero,
+        v=np.where(g.exists, 0.0, np.nan), crlb=cov, cov=cov, bias=zero,
+    )  # fmt: skip
+    return drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
