@@ -46,11 +46,15 @@ def test_lm_resumed_from_its_state_runs_the_iterations_of_one_call():
     prob = ml.Problem(H, sc.element_positions, SMALL.fc)
     sigma2 = prob.noise_floor(3)
     one = fitting._lm(prob, th, mf, mt, sigma2, 60)
-    assert 30 < one[4] < 60 and one[5]  # converged after the split below
+    n = one[4]
+    # converged within the cap, late enough to split: how many iterations it takes depends on the
+    # machine's BLAS (16 on one CPU, 30-60 on another), the identity below does not
+    assert 4 <= n < 60 and one[5], n
+    m = n // 2
     state: dict = {}
-    a = fitting._lm(prob, th, mf, mt, sigma2, 20, state)
-    assert a[4] == 20 and not a[5]
-    b = fitting._lm(prob, *a[:3], sigma2, 40, state)
+    a = fitting._lm(prob, th, mf, mt, sigma2, m, state)
+    assert a[4] == m and not a[5]
+    b = fitting._lm(prob, *a[:3], sigma2, 60 - m, state)
     for x, y in zip(b[:3], one[:3]):
         np.testing.assert_array_equal(x, y)
     assert b[3]["cost"] == one[3]["cost"] and a[4] + b[4] == one[4] and b[5]
