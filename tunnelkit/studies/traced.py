@@ -312,4 +312,3 @@ def traced_design(path=None):
     :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`); to be fed the
     ``"ml-traced"`` drives of :func:`simulate_traced`."""
     return designs.design_from_errors(traced_errors(path)["rows"], base=designs.ours_ml())
-
