@@ -15,7 +15,7 @@ from ...constants import C
 from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, spatial_phase_unchecked
 from ..radio import check_array, check_srs
-from .lm import STEP_TOL, lm_fit
+from .lm import STEP_TOL, best_of_starts, lm_fit
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .resolution import (
@@ -289,13 +289,7 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
             th2[l_, :2] += du
             th2[weak, :2] -= du
             starts.append((project_feasible(th2), mf2, mt2))
-    short = min(RANK_ITER, max_iter)
-    cands = [_lm(prob, *st, sigma2, short) for st in starts]
-    n_it = sum(c[4] for c in cands)
-    cand = min(cands, key=lambda c: c[3]["cost"])
-    if not cand[5]:
-        cand = _lm(prob, *cand[:3], sigma2, max_iter)
-        n_it += cand[4]
+    cand, n_it = best_of_starts(_lm, prob, starts, sigma2, min(RANK_ITER, max_iter), max_iter)
     if cand[3]["cost"] < ev["cost"] - gain_min:
         return cand, n_it, True
     return best, n_it, False

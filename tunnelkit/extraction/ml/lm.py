@@ -10,7 +10,7 @@ from ..._validate import finite_array, integer, positive
 from ..numerics import damped_step_unchecked, free_newton_unchecked
 from .model import W_MAX, Problem, project_feasible
 
-__all__ = ["STEP_TOL", "lm_fit"]
+__all__ = ["STEP_TOL", "best_of_starts", "lm_fit"]
 
 STEP_TOL = 1e-4  # Newton decrement in units of sigma^2 (0.01 standard deviations)
 #: cap on ``max_iter`` (``fitting.MAX_ITER``: a fit not converged in 1,000 is not converging)
@@ -65,3 +65,27 @@ def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict 
                 break
     state["lam"], state["ev"] = lam, ev
     return theta, mu_f, mu_t, ev, it, converged
+
+
+def best_of_starts(fit, prob: Problem, starts, sigma2, short: int, max_iter: int):
+    """Several starts ranked by their likelihood: each ``(theta, mu_f, mu_t)`` of ``starts`` gets
+    ``short`` iterations of ``fit`` (:func:`lm_fit`'s signature), the lowest cost is run on to
+    ``max_iter`` unless already converged. Returns that fit and the iterations spent in all."""
+    if not callable(fit):
+        raise TypeError(f"fit: expected a function like lm_fit, got {type(fit).__name__}")
+    if not isinstance(prob, Problem):
+        raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
+    if not isinstance(starts, (list, tuple)) or not starts:
+        raise ValueError("starts: expected a non-empty list of (theta, mu_f, mu_t)")
+    if any(not isinstance(st, (list, tuple)) or len(st) != 3 for st in starts):
+        raise ValueError("starts: every start must be a (theta, mu_f, mu_t) triple")
+    sigma2 = positive("sigma2", sigma2)
+    max_iter = integer("max_iter", max_iter, minimum=1, maximum=MAX_LM_ITER)
+    short = integer("short", short, minimum=1, maximum=max_iter)
+    cands = [fit(prob, *st, sigma2, short) for st in starts]
+    n_it = sum(c[4] for c in cands)
+    best = min(cands, key=lambda c: c[3]["cost"])
+    if not best[5]:
+        best = fit(prob, *best[:3], sigma2, max_iter)
+        n_it += best[4]
+    return best, n_it

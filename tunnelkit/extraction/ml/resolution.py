@@ -76,7 +76,7 @@ from scipy.optimize import brentq
 from scipy.special import i0e
 
 from ..._validate import finite_array, integer, positive
-from .lm import lm_fit
+from .lm import best_of_starts, lm_fit
 from .model import Problem, project_feasible
 
 __all__ = [
@@ -193,14 +193,7 @@ def _merged_fit(prob: Problem, theta, mu_f, mu_t, c, sigma2, i: int, j: int, max
         mf[i] = np.angle(wi * np.exp(1j * mu_f[i]) + (1 - wi) * np.exp(1j * mu_f[j]))
         mt[i] = np.angle(wi * np.exp(1j * mu_t[i]) + (1 - wi) * np.exp(1j * mu_t[j]))
         starts.append((project_feasible(th[keep]), mf[keep], mt[keep]))
-    short = min(_MERGE_RANK_ITER, max_iter)
-    cands = [lm_fit(prob, *st, sigma2, short) for st in starts]
-    n_it = sum(c_[4] for c_ in cands)
-    best = min(cands, key=lambda c_: c_[3]["cost"])
-    if not best[5]:
-        best = lm_fit(prob, *best[:3], sigma2, max_iter)
-        n_it += best[4]
-    return best, n_it
+    return best_of_starts(lm_fit, prob, starts, sigma2, min(_MERGE_RANK_ITER, max_iter), max_iter)
 
 
 def _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max=PAIR_TEST_Z):
