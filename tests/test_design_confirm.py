@@ -7,7 +7,7 @@ import pytest
 
 from tunnelkit import design
 from tunnelkit.cli import main
-from tunnelkit.design.confirm import confirmation_candidates
+from tunnelkit.design.confirm import confirmation_candidates, next_candidate
 from tunnelkit.signal_route.judging import calibration_share
 
 
@@ -28,6 +28,56 @@ def test_candidates_are_the_recommendation_and_the_smaller_undecided():
     assert confirmation_candidates(_report(["hopeless", "error", "hopeless"], None)) == []
     with pytest.raises(TypeError, match="report"):
         confirmation_candidates("x")
+
+
+def test_next_candidate_is_the_next_larger_not_ruled_out():
+    rep = _report(["undecided", "hopeless", "met"], "4x4")
+    assert next_candidate(rep, ["4x4"]) == "16x16"  # 8x8 ruled out by the bound route
+    assert next_candidate(rep, ["16x16"]) is None
+    assert next_candidate(_report(["met", "met", "met"], "4x4"), []) == "4x4"
+    with pytest.raises(ValueError, match="confirmed"):
+        next_candidate(rep, ["2x2"])
+    with pytest.raises(TypeError, match="report"):
+        next_candidate("x", [])
+
+
+@pytest.mark.parametrize(
+    ("channel", "runs_of", "array"),
+    [
+        # the recommended 4x4 straddles the target on the channel route: 8x8 is run next, met
+        ({"4x4": "undecided", "8x8": "met", "16x16": "met"}, [["4x4"], ["8x8"]], "8x8"),
+        # met at once: nothing else is run
+        ({"4x4": "met", "8x8": "met", "16x16": "met"}, [["4x4"]], "4x4"),
+        # nothing meets: every candidate run once, in order, and no recommendation
+        ({"4x4": "not met", "8x8": "undecided", "16x16": "not met"},
+         [["4x4"], ["8x8"], ["16x16"]], None),
+    ],
+)  # fmt: skip
+def test_confirmation_escalates_while_none_is_met(monkeypatch, channel, runs_of, array):
+    """The escalation's order and stopping rule, the channel route's verdicts given."""
+    from tunnelkit.design import confirm, montecarlo
+
+    calls = []
+
+    def fake_sweep(setup, specs, runs, seed, **kw):
+        calls.append([x.label for x in specs])
+        return {x.label: x.label for x in specs}
+
+    def fake_score(row, res, *args):
+        row.status, row.reason = channel[res], f"channel {channel[res]}"
+
+    monkeypatch.setattr(montecarlo, "sweep_montecarlo", fake_sweep)
+    monkeypatch.setattr(confirm, "score_row", fake_score)
+    rep = _report(["met", "met", "met"], "4x4")
+    rep.settings.update(
+        arrays=["4x4", "8x8", "16x16"], spacing_wl=0.5, impairments={}, seed=0, n_epochs=None,
+        criterion="achievable", target=0.1, share=0.9, n_boot=10,
+    )  # fmt: skip
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    conf = design.confirm_on_channel(rep, setup)
+    assert calls == runs_of
+    assert conf.recommendation["array"] == array
+    assert [r.array for r in conf.confirmation] == [c[0] for c in runs_of]
 
 
 def test_confirmation_reruns_on_the_channel_route_and_decides():

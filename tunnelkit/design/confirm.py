@@ -10,7 +10,11 @@ and seed:
 
 * the recommended array, and every smaller candidate the bound route left ``"undecided"``
   (its 95 % interval straddling the target);
-* with no recommendation, the smallest candidate that is neither hopeless nor in error.
+* with no recommendation, the smallest candidate that is neither hopeless nor in error;
+* while none of those is met on the channel route, the next larger candidate the bound route did
+  not rule out (hopeless or in error), one at a time (:func:`next_candidate`): a marginal array
+  (its channel-route interval straddling the target) then comes with the larger one that meets
+  it, not with "none" (28 GHz example at 2 deg: 8 x 8 undecided on the channel route, 20 runs).
 
 Each is judged again from its channel-route error quantile and 95 % interval
 (:func:`tunnelkit.design.verdict.judge`, the same rule), and the recommendation is taken from
@@ -44,12 +48,12 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 
-from .._validate import instance, integer, record
+from .._validate import instance, integer, record, sequence
 from .report import DesignReport, score_row
 from .setup import DesignSetup, parse_array
 from .verdict import MIN_RUNS_CI, recommend
 
-__all__ = ["ConfirmedReport", "confirm_on_channel", "confirmation_candidates"]
+__all__ = ["ConfirmedReport", "confirm_on_channel", "confirmation_candidates", "next_candidate"]
 
 
 @dataclass
@@ -97,6 +101,23 @@ def confirmation_candidates(report: DesignReport) -> list[str]:
     return [r.array for r in order[:at] if r.status == "undecided"] + [rec]
 
 
+def next_candidate(report: DesignReport, confirmed) -> str | None:
+    """The array :func:`confirm_on_channel` runs next when none of ``confirmed`` (the labels
+    already re-run) is met on the channel route: the smallest candidate of ``report`` larger than
+    all of them that the bound route did not call hopeless or in error; ``None`` when none is
+    left."""
+    instance("report", report, DesignReport)
+    done = sequence("confirmed", confirmed, empty=True)
+    order = sorted(report.rows, key=lambda r: (r.n_elements, r.aperture_diagonal_m))
+    labels = [r.array for r in order]
+    unknown = [a for a in done if a not in labels]
+    if unknown:
+        raise ValueError(f"confirmed: {unknown[0]!r} is not a candidate of the report")
+    start = max((labels.index(a) for a in done), default=-1) + 1
+    rest = [r.array for r in order[start:] if r.status not in ("hopeless", "error")]
+    return rest[0] if rest else None
+
+
 def confirm_on_channel(
     report: DesignReport,
     setup: DesignSetup,
@@ -126,14 +147,14 @@ def confirm_on_channel(
     by = {r.array: r for r in report.rows}
     imp = DesignImpairments(**s["impairments"])
     rows, warnings = [], list(report.warnings)
-    if labels:
-        sp = s["spacing_wl"]  # per array (the sweep's) or one value (the command line's)
-        sp = sp if isinstance(sp, list | tuple) else [sp] * len(s["arrays"])
-        specs = [parse_array(a, w) for a, w in zip(s["arrays"], sp, strict=True)]
-        specs = [x for x in specs if x.label in labels]
+    sp = s["spacing_wl"]  # per array (the sweep's) or one value (the command line's)
+    sp = sp if isinstance(sp, list | tuple) else [sp] * len(s["arrays"])
+    all_specs = [parse_array(a, w) for a, w in zip(s["arrays"], sp, strict=True)]
+
+    def run(labels):
         res = sweep_montecarlo(
             setup,
-            specs,
+            [x for x in all_specs if x.label in labels],
             runs,
             s["seed"],
             mode="channel",
@@ -151,7 +172,17 @@ def confirm_on_channel(
             row.rmse_over_tracker_bound = None
             score_row(row, res[a], s["criterion"], s["target"], s["share"], s["seed"], s["n_boot"])
             rows.append(row)
+
+    if labels:
+        run(labels)
     rec = recommend(rows, s["target"], s["share"], runs)
+    # none met: the next larger candidate, one at a time (module docstring)
+    while rows and rec.get("array") is None and runs >= MIN_RUNS_CI:
+        nxt = next_candidate(report, [r.array for r in rows])
+        if nxt is None:
+            break
+        run([nxt])
+        rec = recommend(rows, s["target"], s["share"], runs)
     rec["route"] = "channel"
     if not rows:
         rec["reason"] = "no candidate left to confirm on the channel route"
