@@ -55,9 +55,9 @@ from .montecarlo import (
     MonteCarloResult,
     design_planes,
     javelin_config,
-    javelin_rmse,
     sweep_montecarlo,
 )
+from .onearray import javelin_rmse
 from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 from .verdict import (
