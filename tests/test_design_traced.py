@@ -146,3 +146,18 @@ def test_bad_input(setup):
     imp = design.DesignImpairments(phase_error_deg=0.5)
     with pytest.raises(ValueError, match="impairments"):
         design.sweep_montecarlo(setup, ["4x4"], 1, 0, mode="channel", impairments=imp, n_epochs=1)
+
+
+def test_the_paper_tunnels_records_ship_and_others_go_to_the_cache(tmp_path, monkeypatch):
+    """The shipped records (data/rt/design) match the current scene; a record the repository
+    does not ship lives in the ray-tracing cache."""
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    for label in ("4x4", "8x8", "16x16"):
+        p = traced.design_errors_path(setup, label)
+        assert p.parent.name == "design" and p.is_file()
+        rec = traced.design_errors(setup, label, measure=False)  # provenance checked
+        assert rec["array"] == label and rec["seed"] == traced.ERROR_SEED
+    assert traced.design_errors_path(setup, "4x4", 3) == tmp_path / "design-errors" / (
+        f"{SCENARIO}-4x4-T3.json"
+    )

@@ -18,7 +18,7 @@ only. The traced route changes the same two things the traced JAVELIN tables cha
   first :data:`ERROR_RUNS` drives of seed :data:`ERROR_SEED` (the choice; report the sweep on
   another seed) by :func:`measure_design_errors` and cached as JSON with its provenance
   (:func:`design_errors`: scenario, array, epochs, the ray tracer's settings and the trace
-  cache's key; a record of another scene, settings, array or sionna-rt version is refused, never
+  cache's key; the paper tunnel's in ``data/rt/design/``; a record of another scene, settings, array or sionna-rt version is refused, never
   reused). The tracker (:func:`traced_javelin`) is the design's
   (:func:`~tunnelkit.design.montecarlo.javelin_config`: VUEs from the known surfaces, likelihood
   association, joint innovation test) with fixed per-quantity sigmas set to those errors.
@@ -176,8 +176,10 @@ def measure_design_errors(
 
 
 def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) -> Path:
-    """Where :func:`design_errors` keeps ``spec``'s record: ``data/rt/design/<scenario>-<array>
-    [-T<n_epochs>].json`` (``TUNNELKIT_DATA`` moves ``data/``)."""
+    """Where :func:`design_errors` keeps ``spec``'s record, ``<scenario>-<array>[-T<n_epochs>].json``:
+    in ``data/rt/design/`` when the repository ships it (the paper tunnel's arrays), else in the
+    ray-tracing cache's ``design-errors/`` (:func:`tunnelkit.rt.cache.default_cache_dir`)."""
+    from ..rt.cache import default_cache_dir
     from ..scenarios import data_dir
 
     setup = _setup(setup)
@@ -187,7 +189,9 @@ def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) ->
     T = len(setup.trajectory)
     tail = "" if n_epochs is None or n_epochs >= T else f"-T{n_epochs}"
     name = "".join(c if c.isalnum() or c in "-_." else "_" for c in setup.name)
-    return data_dir() / "rt" / "design" / f"{name}-{spec.label}{tail}.json"
+    fname = f"{name}-{spec.label}{tail}.json"
+    shipped = data_dir() / "rt" / "design" / fname
+    return shipped if shipped.is_file() else default_cache_dir() / "design-errors" / fname
 
 
 def _mismatch(stored: dict, current: dict) -> list[str]:
