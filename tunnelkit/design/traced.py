@@ -228,6 +228,7 @@ def design_errors(
     setup = _setup(setup)
     spec = parse_array(spec)
     measure = boolean("measure", measure)
+    progress = boolean("progress", progress)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     if path is None:
