@@ -9,7 +9,7 @@ beside it (p90, eq.-1 model), the traced route's measurement noise, and the ray 
 (trace time per epoch, median and max, and the cache size of the array's drive).
 
     python benchmarks/bench_rt_design.py --runs 5 --seed 20261202 --workers 2
-    python benchmarks/bench_rt_design.py --from-json build/sweep-image.json build/sweep-sionna.json
+    python benchmarks/bench_rt_design.py --from-json build/sweep-image.json build/sweep-sionna-*.json
 
 Choose on seed 0 (the traced errors are measured there), report on a seed never looked at
 (:data:`tunnelkit.studies.HELD_OUT_SEED` by default).
@@ -111,11 +111,18 @@ def main() -> None:
     ap.add_argument("--out", default=str(ROOT / "build"))
     ap.add_argument("--from-json", nargs="+", default=None, help="tabulate CLI outputs instead")
     args = ap.parse_args()
-    if args.from_json:
+    if args.from_json:  # one file per channel, or per channel and array (merged in order)
         reps = {}
         for f in args.from_json:
             rep = json.loads(Path(f).read_text())
-            reps[rep["inputs"].get("channel", "image")] = rep
+            ch = rep["inputs"].get("channel", "image")
+            if ch in reps:
+                reps[ch]["arrays"] += rep["arrays"]
+                reps[ch]["warnings"] += rep["warnings"]
+                reps[ch]["recommendation"] = {"array": "(per-array files: see each)"}
+                reps[ch]["wall_s"] = reps[ch].get("wall_s", 0.0) + rep.get("wall_s", 0.0)
+            else:
+                reps[ch] = rep
     else:
         Path(args.out).mkdir(parents=True, exist_ok=True)
         reps = {
