@@ -81,6 +81,25 @@ def design_sweep():
     setup.signal_route("4x4")
 
 
+def design_traced():
+    """The design's traced route on one epoch of a 4 x 4 array: its drive, the errors measured on
+    one run into a temporary record, the tracker told them, the summary the JSON carries."""
+    import tempfile
+
+    from tunnelkit import design
+    from tunnelkit.design import traced
+
+    setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    route = traced.traced_route(setup, "4x4")
+    traced.traced_drive(route, np.random.default_rng(0), n_epochs=1)
+    traced.design_errors_path(setup, "4x4", n_epochs=1)
+    rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=1)
+    path = tempfile.mkdtemp() + "/errors.json"
+    rec = traced.design_errors(setup, "4x4", n_epochs=1, path=path)
+    traced.traced_javelin(setup, "4x4", rec)
+    traced.error_model_summary(rec)
+
+
 def tracking_pieces():
     """A costs matrix, a measured birth, TeNFiLoc and JAVELIN on a short simulated drive, the
     UPF's pieces and the joint innovation test."""
@@ -124,4 +143,4 @@ def tracking_pieces():
     vs.VsTSWLS(exp.model, x0, P0).update(Z[0, 0])
 
 
-DRIVERS = (design_models, design_modes, design_sweep, tracking_pieces)
+DRIVERS = (design_models, design_modes, design_sweep, design_traced, tracking_pieces)

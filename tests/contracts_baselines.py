@@ -61,7 +61,7 @@ def design_confirm():
     """A bound-route sweep with two one-epoch runs, its confirmation on the channel, the
     channel-route Monte-Carlo, the design's figures and its explorer."""
     from tunnelkit import design
-    from tunnelkit.design import confirm, montecarlo, report, verdict
+    from tunnelkit.design import confirm, report, verdict
     from tunnelkit.plots import design as pdz
     from tunnelkit.widgets import design as wd
 
@@ -70,7 +70,7 @@ def design_confirm():
     verdict.recommend(rep.rows, 0.2, 0.9, 2)
     confirm.confirmation_candidates(rep)
     confirm.confirm_on_channel(rep, setup, runs=2)
-    montecarlo.javelin_rmse(setup, "4x4", 2, 0, n_epochs=1, crlb=CRLB)
+    design.javelin_rmse(setup, "4x4", 2, 0, n_epochs=1, crlb=CRLB)
     pdz.size_figure(rep.rows)
     full = design.DesignSetup.from_scenario(SCENARIO)
     b = design.route_bounds(full, "4x4", epochs=[5, 10])

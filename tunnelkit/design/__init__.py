@@ -22,9 +22,11 @@ quantile lies below the target. One job per module:
 * :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design, every array x run as one task
   set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
   :class:`MonteCarloResult` with the posterior CRLB and the bound over the drive with the bias
-  that does not average down, :func:`drive_bound`; :func:`javelin_rmse` for one array);
-  :mod:`~tunnelkit.design.fastroute`: the bound-driven drive (:func:`bound_drive`, its
-  per-array share computed once by :func:`bound_route`);
+  that does not average down, :func:`drive_bound`; :func:`javelin_rmse` for one array,
+  :mod:`~tunnelkit.design.onearray`); :mod:`~tunnelkit.design.fastroute`: the bound-driven
+  drive (:func:`bound_drive`, its per-array share computed once by :func:`bound_route`);
+  :mod:`~tunnelkit.design.traced`: the channel route on the ray-traced channel (the geometry
+  pre-filter and each array's own traced errors, cached with their provenance);
 * :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile with its bootstrap
   interval, the verdict per array and the recommendation (:func:`judge`, :func:`recommend`);
 * :mod:`~tunnelkit.design.report`: the sweep and its table (:func:`design_sweep`,
@@ -55,9 +57,9 @@ from .montecarlo import (
     MonteCarloResult,
     design_planes,
     javelin_config,
-    javelin_rmse,
     sweep_montecarlo,
 )
+from .onearray import javelin_rmse
 from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 from .verdict import (

@@ -7,7 +7,10 @@ random numbers). Each trial returns the per-epoch 2-D position error of its driv
 is identical serially and on any number of workers. Two measurement routes:
 
 * ``mode="channel"``: the route's own signal chain (:func:`tunnelkit.studies.simulate_drive`,
-  ``extraction="route"``: the ``M x Nf x Nt`` tensor and the ML extraction every epoch);
+  ``extraction="route"``: the ``M x Nf x Nt`` tensor and the ML extraction every epoch); on the
+  ray-traced channel (``setup.channel == "sionna"``) the traced treatment of the tables
+  (:mod:`tunnelkit.design.traced`): every epoch's ML measurements through the geometry
+  pre-filter, the tracker told the array's own errors measured on that channel;
 * ``mode="bound"``: each epoch's path measurements drawn from a
   :class:`~tunnelkit.design.errormodel.PathErrorModel` and reported with its CRLB
   (:func:`tunnelkit.design.fastroute.bound_drive`): the cost no longer grows with the array.
@@ -27,7 +30,7 @@ and the bound over the drive under the impairments (:func:`drive_bound`: the pos
 the position bias of the array's one calibration draw and of the wideband term added, which no
 number of epochs averages down) and beside the same bound for a tracker that learns its VUEs
 (:mod:`tunnelkit.design.learnedbound`); ``MonteCarloResult.tracker_bound`` is the one of the
-tracker run. :func:`javelin_rmse` is the one-array summary on top of it.
+tracker run. :func:`~tunnelkit.design.onearray.javelin_rmse` is the one-array summary on top of it.
 
 Cost: the per-array work (error model, the bound route's shared part
 :func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
@@ -66,7 +69,6 @@ __all__ = [
     "VUES",
     "MonteCarloResult",
     "javelin_config",
-    "javelin_rmse",
     "sweep_montecarlo",
 ]
 
@@ -131,7 +133,9 @@ class MonteCarloResult:
     surfaces known; ``learned`` (T,) [m] the same for a tracker that learns its VUEs
     (:func:`~tunnelkit.design.learnedbound.learned_pcrlb`: the posterior CRLB of UE + VUEs and
     the bias of the filter attaining it, in quadrature); ``vues`` how the tracker run got its
-    VUEs (:data:`VUES`), and :attr:`tracker_bound` the bound of that tracker.
+    VUEs (:data:`VUES`), and :attr:`tracker_bound` the bound of that tracker; ``error_model``
+    the traced route's measurement-noise model (:func:`tunnelkit.design.traced.error_model_summary`;
+    ``None`` on the image channel, where each path carries its reported CRLB).
     """
 
     spec: ArraySpec
@@ -147,15 +151,18 @@ class MonteCarloResult:
     drive: np.ndarray | None = None
     learned: np.ndarray | None = None
     vues: str = "known"
+    error_model: dict | None = None
 
     def __post_init__(self) -> None:
         b = ("peb", "pcrlb", "drive", "learned")
         record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), "errors": ("R", "T"),
                              "rmse_runs": ("R",), "settled": (None,)},
                allow_nan=("errors", "rmse_runs"), nonnegative=("errors", "rmse_runs", "settled", *b),
-               allow_inf=b, skip=("spec",))  # fmt: skip
+               allow_inf=b, skip=("spec", "error_model"))  # fmt: skip
         instance("spec", self.spec, ArraySpec), choice("mode", self.mode, MODES)
         choice("vues", self.vues, VUES)
+        if self.error_model is not None:
+            instance("error_model", self.error_model, dict)
 
     @property
     def tracker_bound(self) -> np.ndarray | None:
@@ -210,6 +217,13 @@ class _SweepTrial:
             from .fastroute import bound_drive
 
             drive = bound_drive(prep.route, self.setup, spec, rng, n_epochs=self.n_epochs)
+        elif self.setup.channel == "sionna":
+            from .traced import traced_drive, traced_route
+
+            # the traced treatment (tunnelkit.design.traced): every epoch's ML measurements,
+            # the geometry pre-filter; the tracker told this array's measured errors
+            route = traced_route(self.setup, spec)
+            drive = traced_drive(route, rng, n_epochs=self.n_epochs)["ml-traced"]
         else:
             route = self.setup.signal_route(spec)
             imp = self.impairments
@@ -266,10 +280,11 @@ class _Prepared:
     drive: np.ndarray | None
     learned: np.ndarray | None = None
     budget: object = None  # signal_route.judging.BiasBudget: the channel route's, impaired
+    error_model: dict | None = None  # traced.error_model_summary: the traced route's
 
     def summary(self) -> tuple:
         """What the sweep's result keeps (not the model and route the drives need)."""
-        return self.peb, self.pcrlb, self.drive, self.design.config, self.learned
+        return self.peb, self.pcrlb, self.drive, self.design.config, self.learned, self.error_model
 
 
 @dataclass(frozen=True)
@@ -326,7 +341,14 @@ class _ArrayJob:
         design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
         imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired
         budget = channel_route_budget(self.setup, spec, imp)
-        return _Prepared(spec, route, design, peb, pc, drive, learned, budget)
+        error_model = None
+        if self.mode == "channel" and self.setup.channel == "sionna":
+            from .traced import design_errors, error_model_summary, traced_javelin
+
+            # this array's errors on the traced channel (cached with their provenance)
+            rec = design_errors(self.setup, spec, n_epochs=self.T)
+            design, error_model = traced_javelin(self.setup, spec, rec), error_model_summary(rec)
+        return _Prepared(spec, route, design, peb, pc, drive, learned, budget, error_model)
 
 
 def _load_tracker() -> None:
@@ -413,6 +435,16 @@ def sweep_montecarlo(
                 "impairments: expected a design.DesignImpairments or None, got "
                 f"{type(impairments).__name__}"
             )
+    if mode == "channel" and setup.channel == "sionna":
+        if impairments is not None and not impairments.ideal:
+            raise ValueError(
+                "impairments: the traced route's measurement noise is measured on the ray-traced "
+                "channel as it is (tunnelkit.design.traced); give none with channel 'sionna'"
+            )
+        if vues != "known":
+            raise ValueError(
+                "vues: the traced route's tracker takes its VUEs from the known surfaces"
+            )
     if not isinstance(seed, np.random.Generator):
         seed = integer("seed", seed, minimum=0)
     if n_epochs is not None:
@@ -458,7 +490,7 @@ def sweep_montecarlo(
     out = {}
     for a, spec in enumerate(specs):
         err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
-        peb, pc, drive, cfg, learned = built[a]
+        peb, pc, drive, cfg, learned, error_model = built[a]
         out[spec.label] = MonteCarloResult(
             spec,
             mode,
@@ -477,6 +509,7 @@ def sweep_montecarlo(
             drive,
             learned,
             vues,
+            error_model,
         )
     return out
 
@@ -511,90 +544,3 @@ def _head(m: PathErrorModel, T: int) -> PathErrorModel:
         if getattr(m, k) is not None:
             cut[k] = getattr(m, k)[:T]
     return replace(m, **cut)
-
-
-def _t_interval(x: np.ndarray) -> tuple[float, list[float]]:
-    """Mean and 95 % t-interval (clipped at 0: an RMSE is not negative)."""
-    from scipy import stats
-
-    mean = float(x.mean())
-    half = float(stats.t.ppf(0.975, x.size - 1) * x.std(ddof=1) / np.sqrt(x.size))
-    return mean, [max(mean - half, 0.0), mean + half]
-
-
-def javelin_rmse(
-    setup: DesignSetup,
-    spec,
-    runs: int,
-    seed: int | np.random.Generator,
-    *,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    progress: bool = False,
-    n_epochs: int | None = None,
-    crlb: dict | None = None,
-    timeout: float | None = None,
-) -> dict:
-    """Monte-Carlo 2-D RMSE of JAVELIN on ``spec`` with a 95 % t-interval over ``runs`` drives
-    (LoS condition, the scenario's route; the interval is clipped at 0).
-
-    Each path's measurement covariance is the one the extraction reports (:func:`javelin_config`),
-    and an epoch whose fit fails its own residual test is predict-only. ``crlb`` (default: the
-    route-median per-path bounds) only sets the fixed fallback sigmas. Besides the whole-drive
-    RMSE (``rmse_m``, as the paper's tables), the settled RMSE leaves out the first
-    :data:`SETTLE_S` of every drive (``rmse_settled_m``, ``None`` for a shorter drive) and is set
-    beside the RMS of the PEB over the same epochs (``peb_rms_settled_m``); ``median_settled_m``
-    is the median over runs of each run's median settled error (the typical epoch, where the
-    RMSE also counts the epochs the tracker coasts through without a measurement). Runs go through
-    :func:`tunnelkit.montecarlo.run_trials` (``workers`` / ``scheduler`` / ``timeout`` passed on
-    when given); ``seed`` is an int or a Generator.
-    """
-    spec = parse_array(spec)
-    runs = integer("runs", runs, minimum=2)
-    if not isinstance(seed, np.random.Generator):
-        seed = integer("seed", seed, minimum=0)
-    if n_epochs is not None:
-        n_epochs = integer("n_epochs", n_epochs, minimum=1)
-    if crlb is None:
-        pb = path_bounds(setup, spec)
-        crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
-    r = sweep_montecarlo(
-        setup,
-        [spec],
-        runs,
-        seed,
-        mode="channel",
-        workers=workers,
-        scheduler=scheduler,
-        timeout=timeout,
-        progress=progress,
-        n_epochs=n_epochs,
-        crlbs={spec.label: crlb},
-    )[spec.label]
-    e = r.errors
-    whole = np.sqrt(np.mean(e**2, axis=1))
-    if r.settled.size:
-        es = e[:, r.settled]
-        res = np.stack([whole, np.sqrt(np.mean(es**2, axis=1)), np.median(es, axis=1)], axis=1)
-    else:
-        res = np.stack([whole, np.full(runs, np.nan), np.full(runs, np.nan)], axis=1)
-    mean, ci = _t_interval(res[:, 0])
-    out = {
-        "rmse_m": mean,
-        "ci95_m": ci,
-        "runs": res[:, 0],
-        "rmse_settled_m": None,
-        "settled_ci95_m": None,
-        "peb_rms_settled_m": None,
-        "median_settled_m": None,
-        "runs_settled": res[:, 1],
-        "sigmas": r.sigmas,
-    }
-    T = len(setup.trajectory) if n_epochs is None else min(int(n_epochs), len(setup.trajectory))
-    idx = settled(setup.trajectory.t[:T])
-    if idx.size:
-        out["rmse_settled_m"], out["settled_ci95_m"] = _t_interval(res[:, 1])
-        out["median_settled_m"] = float(np.median(res[:, 2]))
-        peb = route_bounds(setup, spec, epochs=idx).peb
-        out["peb_rms_settled_m"] = float(np.sqrt(np.mean(peb**2)))
-    return out

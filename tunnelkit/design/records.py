@@ -76,6 +76,7 @@ class DesignRow:
     drive_bound_learned_rms_m: float | None = None
     rmse_over_tracker_bound: float | None = None
     rmse_over_achievable: float | None = None
+    error_model: dict | None = None
     screen_m: float | None = field(default=None, repr=False)
     srnf_valid: np.ndarray | None = field(default=None, repr=False)
 
@@ -97,7 +98,9 @@ class DesignRow:
         rmse_ci95_m, runs, tracker_vues, drive_bound_known_rms_m, drive_bound_learned_rms_m,
         rmse_over_tracker_bound, rmse_over_achievable`` (the RMSE over the RMS of
         ``achievable_m`` on the same epochs) and ``per_epoch {x_m, peb_m, achievable_m,
-        error_median_m}`` (non-finite values and anything not computed are null)."""
+        error_median_m}`` (non-finite values and anything not computed are null); on the
+        ray-traced channel's route also ``error_model`` (the tracker's measurement-noise model,
+        :func:`tunnelkit.design.traced.error_model_summary`)."""
         return {
             "array": self.array,
             "n_elements": int(self.n_elements),
@@ -130,7 +133,7 @@ class DesignRow:
                 "achievable_m": _fins(self.achievable_m),
                 "error_median_m": _fins(self.error_median_epoch_m),
             },
-        }
+        } | ({} if self.error_model is None else {"error_model": dict(self.error_model)})
 
 
 @dataclass
@@ -216,6 +219,14 @@ class DesignReport:
                     spans = over_target(r.x_m[: len(y)], y, s["target"])
                     if spans:
                         lines.append(f"  {r.array}: {what} above the target at x = {spans}")
+            em = r.error_model
+            if em and em.get("kind") == "traced-measured":
+                sg = em["sigmas"]
+                lines.append(
+                    f"  {r.array}: traced route, noise measured on seed {em['seed']} "
+                    f"({em['runs']} drives): {sg['phi_deg']:.3g} / {sg['psi_deg']:.3g} deg, "
+                    f"{sg['kappa_m']:.3g} m, {sg['delta_d_m']:.3g} m; geometry pre-filter"
+                )
         lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 

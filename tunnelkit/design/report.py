@@ -216,6 +216,7 @@ def score_row(row, res, criterion, target, share, seed, n_boot) -> None:
     idx = rng.integers(0, runs, size=(n_boot, runs))
     boot = np.sqrt(sq.mean(axis=1)[idx].mean(axis=1))
     row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
+    row.error_model = getattr(res, "error_model", None)
     ach = np.sqrt(np.mean(np.asarray(row.achievable_m)[k] ** 2))
     row.rmse_over_achievable = row.rmse_m / ach if ach > 0 else None
     _drive_bounds(row, res, k)
@@ -351,6 +352,16 @@ def design_sweep(
     straddle = [r.array for r in rows if r.status == "undecided" and r.runs >= MIN_RUNS_CI]
     if straddle:
         warnings.append(f"{', '.join(straddle)}: the 95 % interval straddles the target; add runs")
+    reused = sorted(
+        r.array
+        for r in rows
+        if r.error_model and r.error_model.get("seed") == seed and mode == "channel"
+    )
+    if runs and reused:
+        warnings.append(
+            f"{', '.join(reused)}: the traced route's measurement noise was measured on this "
+            f"seed's first drives (seed {seed}); report the sweep on another seed"
+        )
     if criterion == "srnf" and runs:
         warnings.append(
             "criterion srnf: the Monte-Carlo tracker models the VUE curvature; the SR-NF gate "
@@ -377,5 +388,7 @@ def design_sweep(
         "scheduler": scheduler,
         "timeout_s": timeout,
     }
+    if setup.channel != "image":  # (the image channel's JSON as before)
+        settings["channel"] = setup.channel
     rec = recommend([r for r in rows if r.status != "error"], target, share, runs)
     return DesignReport(setup.name, rows, rec, settings, warnings)

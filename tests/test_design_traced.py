@@ -1,0 +1,163 @@
+"""The design's channel route on the ray-traced channel: the traced adapter, the per-array
+errors cached with their provenance (refused when they do not match), the tracker told them,
+and the sweep and report that say which error model they used.
+
+Marked like the other ray-traced tests: they need the ``rt`` extra and fail without it unless
+``TUNNELKIT_SKIP_RT=1``. A 4x4 array and two or three epochs, traced into a temporary cache.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+from tunnelkit import design
+from tunnelkit.design import traced
+from tunnelkit.rt.cache import CACHE_ENV
+from tunnelkit.studies import simulate_routes
+from tunnelkit.studies.traced import geometry_keep
+from tunnelkit.tracking.javelin.noise import FixedNoise
+
+SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
+pytestmark = pytest.mark.skipif(SKIP_RT, reason="TUNNELKIT_SKIP_RT=1")
+
+SCENARIO = "italiano2026-straight"
+
+
+@pytest.fixture
+def setup(tmp_path, monkeypatch):
+    """The paper tunnel on the ray-traced channel; traces and error records in ``tmp_path``."""
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
+    monkeypatch.setattr(
+        traced,
+        "design_errors_path",
+        lambda setup, spec, n_epochs=None: tmp_path / f"{parse(spec)}-{n_epochs}.json",
+    )
+    return design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+
+
+def parse(spec):
+    return design.parse_array(spec).label
+
+
+def test_the_traced_drive_is_the_drive_simulator_with_the_traced_adapters(setup):
+    """Same seed: its "ml" drive is simulate_routes' (ML route, no condition); "ml-all" keeps
+    every epoch's ML rows whatever the fit's verdict, "ml-traced" the rows geometry_keep keeps."""
+    route = traced.traced_route(setup, "4x4")
+    assert route.diffuse_floor and route.raytraced is not None
+    got = traced.traced_drive(route, np.random.default_rng(3), n_epochs=2)
+    ref = simulate_routes(
+        route, np.random.default_rng(3), condition=None, extractions=("ml",), n_epochs=2
+    )["ml"]
+    assert list(got) == ["ml", "ml-all", "ml-traced"]
+    np.testing.assert_array_equal(got["ml"].speed, ref.speed)
+    assert got["ml"].faults == ref.faults
+    for pa, pt in zip(got["ml-all"].epochs, got["ml-traced"].epochs, strict=True):
+        assert pa is not None  # the fit's own test ignored
+        assert pt is None or (set(pt.source) <= set(pa.source) and len(pt) <= len(pa))
+    # the pre-filter is geometry_keep on the same epoch: redo epoch 0 and compare the rows kept
+    from tunnelkit.studies.drives import ml_epoch
+
+    with warnings.catch_warnings():  # every traced fit fails its own residual test
+        warnings.simplefilter("ignore")
+        ep0 = route.epoch(0, np.random.default_rng(3), tunnel=route.tunnel, refine="joint")
+        ep = ml_epoch(ep0, route.config, route.ml_noise_power(0, ep0.snapshot, route.tunnel))
+    kept = geometry_keep(ep, route)
+    pt = got["ml-traced"].epochs[0]
+    assert pt is not None and set(np.unique(pt.source)) == set(kept)
+
+
+def test_errors_are_measured_once_cached_and_refused_for_another_scene(setup, tmp_path):
+    rec = traced.design_errors(setup, "4x4", n_epochs=2)
+    p = rec["path"]
+    assert rec["array"] == "4x4" and rec["scenario"] == SCENARIO and rec["n_epochs"] == 2
+    assert rec["seed"] == traced.ERROR_SEED and rec["runs"] == traced.ERROR_RUNS
+    assert rec["rt_key"]["sionna_rt"] and rec["rt_settings"]["max_depth"] >= 1
+    # the record is what measure_design_errors gives on the same seed (the drives are seeded)
+    again = traced.measure_design_errors(setup, "4x4", n_epochs=2)
+    assert again["rows"] == rec["rows"]
+    stored = json.loads(open(p).read())
+    # read back, not re-measured
+    assert traced.design_errors(setup, "4x4", n_epochs=2, measure=False)["rows"] == stored["rows"]
+    # another scene key, array or epoch count: refused, naming what differs
+    for field, value in (("rt_key", {**stored["rt_key"], "scene": "0" * 64}), ("array", "8x8"),
+                         ("n_epochs", 5)):  # fmt: skip
+        bad = tmp_path / "bad.json"
+        bad.write_text(json.dumps({**stored, field: value}))
+        with pytest.raises(ValueError, match=f"path: .*{field}"):
+            traced.design_errors(setup, "4x4", n_epochs=2, path=bad)
+    with pytest.raises(FileNotFoundError, match="path"):
+        traced.design_errors(setup, "4x4", n_epochs=1, measure=False)
+
+
+def test_the_tracker_is_told_the_measured_errors(setup):
+    rec = traced.design_errors(setup, "4x4", n_epochs=2)
+    d = traced.traced_javelin(setup, "4x4", rec)
+    row = {r[0]: r for r in rec["rows"]}["all"]
+    assert isinstance(d.noise, FixedNoise)
+    assert d.config.sigma_phi == pytest.approx(np.radians(row[2]))
+    assert d.config.sigma_psi == pytest.approx(np.radians(row[3]))
+    assert d.config.sigma_kappa == pytest.approx(row[4])
+    assert d.config.sigma_delta_d == pytest.approx(row[5])
+    s = traced.error_model_summary(rec)
+    assert s["kind"] == "traced-measured" and s["sigmas"]["kappa_m"] == pytest.approx(row[4])
+    assert traced.error_model_summary(None) == {"kind": "reported-crlb"}
+    # the errors the traced channel gives are far above the reported CRLB of the image design
+    assert s["sigmas"]["phi_deg"] > 0.1
+
+
+def test_the_sweep_and_report_name_the_error_model(setup):
+    rep = design.design_sweep(setup, ["4x4"], runs=2, seed=0, mode="channel", n_epochs=3)
+    row = rep.rows[0]
+    assert row.runs == 2 and row.error_p90_m is not None and np.isfinite(row.error_p90_m)
+    j = rep.to_json()
+    assert j["inputs"]["channel"] == "sionna"
+    em = j["arrays"][0]["error_model"]
+    assert em["kind"] == "traced-measured" and em["seed"] == traced.ERROR_SEED
+    # seed 0 is the one the noise was chosen on: the report says so
+    assert any("measured on this seed" in w for w in rep.warnings)
+    assert "traced route, noise measured on seed 0" in rep.to_table()
+    # the image channel's JSON carries neither
+    img = design.design_sweep(
+        design.DesignSetup.from_scenario(SCENARIO), ["4x4"], runs=2, seed=1, mode="channel",
+        n_epochs=2,
+    ).to_json()  # fmt: skip
+    assert "channel" not in img["inputs"] and "error_model" not in img["arrays"][0]
+
+
+def test_bad_input(setup):
+    image = design.DesignSetup.from_scenario(SCENARIO)
+    with pytest.raises(ValueError, match="setup"):
+        traced.traced_route(image, "4x4")
+    with pytest.raises(TypeError, match="setup"):
+        traced.design_errors("italiano2026-straight", "4x4")
+    with pytest.raises(TypeError, match="record"):
+        traced.traced_javelin(setup, "4x4", {"no": "rows"})
+    with pytest.raises(ValueError, match="record"):
+        traced.traced_javelin(setup, "4x4", {"rows": [["all", 1, 0.0, 1.0, 1.0, 1.0, 0]]})
+    with pytest.raises(TypeError, match="rng"):
+        traced.traced_drive(traced.traced_route(setup, "4x4"), 3)
+    with pytest.raises(ValueError, match="route"):
+        traced.traced_drive(image.signal_route("4x4"), np.random.default_rng(0))
+    imp = design.DesignImpairments(phase_error_deg=0.5)
+    with pytest.raises(ValueError, match="impairments"):
+        design.sweep_montecarlo(setup, ["4x4"], 1, 0, mode="channel", impairments=imp, n_epochs=1)
+
+
+def test_the_paper_tunnels_records_ship_and_others_go_to_the_cache(tmp_path, monkeypatch):
+    """The shipped records (data/rt/design) match the current scene; a record the repository
+    does not ship lives in the ray-tracing cache."""
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    for label in ("4x4", "8x8", "16x16"):
+        p = traced.design_errors_path(setup, label)
+        assert p.parent.name == "design" and p.is_file()
+        rec = traced.design_errors(setup, label, measure=False)  # provenance checked
+        assert rec["array"] == label and rec["seed"] == traced.ERROR_SEED
+    assert traced.design_errors_path(setup, "4x4", 3) == tmp_path / "design-errors" / (
+        f"{SCENARIO}-4x4-T3.json"
+    )

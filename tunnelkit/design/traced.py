@@ -1,0 +1,317 @@
+"""The design's channel route on the ray-traced channel: the traced treatment of the tables.
+
+On the ray-traced channel (``tunnelkit design --mode channel --channel sionna``) the ML route's
+first-order estimates lie thousands of CRLB standard deviations off (diffuse scattering,
+higher-order bounces, the spatial-wideband term), and every fit fails its own residual test. The
+image channel's design tracker takes each path's reported CRLB as its covariance and drops a
+flagged epoch: on this channel it is told micrometres about measurements metres off, or predicts
+only. The traced route changes the same two things the traced JAVELIN tables change
+(:mod:`tunnelkit.studies.traced`), for each candidate array:
+
+* **measurements**: every epoch's ML measurements (fits judged against noise + the epoch's
+  diffuse power, ``diffuse_floor``), reduced to the paths that agree with one UE through the
+  tunnel's planes (:func:`tunnelkit.studies.traced.geometry_keep` with
+  :data:`~tunnelkit.studies.traced.FLOORS`), whatever the fit's own verdict
+  (:func:`traced_drive`);
+* **measurement noise**: the RMS extraction error of THIS array on this channel (the stored
+  traced record is the paper array's; a 4x4 and a 16x16 have other errors), measured on the
+  first :data:`ERROR_RUNS` drives of seed :data:`ERROR_SEED` (the choice; report the sweep on
+  another seed) by :func:`measure_design_errors` and cached as JSON with its provenance
+  (:func:`design_errors`: scenario, array, epochs, the ray tracer's settings and the trace
+  cache's key; the paper tunnel's in ``data/rt/design/``; a record of another scene, settings, array or sionna-rt version is refused, never
+  reused). The tracker (:func:`traced_javelin`) is the design's
+  (:func:`~tunnelkit.design.montecarlo.javelin_config`: VUEs from the known surfaces, likelihood
+  association, joint innovation test) with fixed per-quantity sigmas set to those errors.
+
+The report's JSON names the error model each array's traced route used
+(:func:`error_model_summary`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+from .._validate import boolean, instance, integer, rng_or_error
+from .setup import DesignSetup, parse_array
+
+__all__ = [
+    "ERROR_RUNS",
+    "ERROR_SEED",
+    "TRACED_NUISANCE",
+    "design_errors",
+    "design_errors_path",
+    "error_model_summary",
+    "measure_design_errors",
+    "traced_drive",
+    "traced_javelin",
+    "traced_route",
+]
+
+#: the seed whose first :data:`ERROR_RUNS` drives measure each array's traced errors (the
+#: choice; a sweep reported on it reuses those drives, :func:`design_errors` says so)
+ERROR_SEED = 0
+#: drives per array the traced errors are measured on (every epoch, every matched path pooled)
+ERROR_RUNS = 3
+#: the traced route's nuisance: the ML fit judged against noise + the epoch's diffuse power
+TRACED_NUISANCE = {"diffuse_floor": True}
+#: the record's procedure (part of what a stored record must match)
+PROCEDURE = "tunnelkit.design.traced.measure_design_errors"
+
+
+def _setup(setup) -> DesignSetup:
+    instance("setup", setup, DesignSetup)
+    if setup.channel != "sionna":
+        raise ValueError(
+            f"setup: the traced route needs the ray-traced channel (channel='sionna'), got "
+            f"{setup.channel!r}"
+        )
+    return setup
+
+
+def traced_route(setup: DesignSetup, spec):
+    """The design's signal route of ``spec`` (:meth:`DesignSetup.signal_route`) on the
+    ray-traced channel with :data:`TRACED_NUISANCE` (``setup.channel`` must be ``"sionna"``)."""
+    setup = _setup(setup)
+    return replace(setup.signal_route(parse_array(spec)), **TRACED_NUISANCE)
+
+
+def traced_drive(route, rng: np.random.Generator, *, n_epochs: int | None = None) -> dict:
+    """One drive of the design route ``route`` (:func:`traced_route`; LoS and road markings as
+    the image channel's design drive: no condition) measured by the ML route, through
+    :func:`tunnelkit.studies.drives.simulate_routes` with the traced adapters: ``{"ml",
+    "ml-all", "ml-traced"}`` (``"ml-all"`` every epoch's ML measurements, its fit test ignored;
+    ``"ml-traced"`` those :func:`~tunnelkit.studies.traced.geometry_keep` keeps)."""
+    from ..signal_route import SignalRoute
+    from ..studies.drives import simulate_routes
+    from ..studies.traced import FLOORS, traced_measurements
+
+    instance("route", route, SignalRoute)
+    if route.raytraced is None:
+        raise ValueError("route: expected a route on the ray-traced channel (traced_route)")
+    rng = rng_or_error("rng", rng)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    return simulate_routes(
+        route,
+        rng,
+        condition=None,
+        extractions=("ml",),
+        n_epochs=n_epochs,
+        adapters={
+            "ml-all": ("ml", partial(traced_measurements, floors=FLOORS, prefilter=False)),
+            "ml-traced": ("ml", partial(traced_measurements, floors=FLOORS)),
+        },
+    )
+
+
+def _error_trial(route, n_epochs, _input, rng):
+    return traced_drive(route, rng, n_epochs=n_epochs)["ml-all"]
+
+
+def _provenance(setup: DesignSetup, spec, n_epochs: int | None) -> dict:
+    """What a stored record must match: scenario, array, epochs, procedure, nuisance and the
+    scene (:func:`tunnelkit.studies.traced.scene_provenance` of the array's traced route)."""
+    from ..studies.traced import scene_provenance
+
+    route = traced_route(setup, spec)
+    T = len(setup.trajectory)
+    return {
+        "procedure": PROCEDURE,
+        "scenario": setup.name,
+        "array": parse_array(spec).label,
+        "n_epochs": None if n_epochs is None or n_epochs >= T else int(n_epochs),
+        "nuisance": dict(TRACED_NUISANCE),
+        **scene_provenance(route),
+    }
+
+
+def measure_design_errors(
+    setup: DesignSetup,
+    spec,
+    runs: int = ERROR_RUNS,
+    seed: int = ERROR_SEED,
+    *,
+    n_epochs: int | None = None,
+    progress: bool = False,
+) -> dict:
+    """``spec``'s traced measurement noise, measured: ``runs`` design drives on the ray-traced
+    channel (drive ``i`` from the ``i``-th child of ``seed``, as run ``i`` of a sweep on
+    ``seed``: :func:`~tunnelkit.montecarlo.run_trials`), every epoch's ML measurements
+    (``"ml-all"`` of :func:`traced_drive`), their RMS errors per kind of path
+    (:func:`~tunnelkit.studies.analysis.extraction_errors`, the ``"all"`` row the sigmas).
+    Returns the record (provenance, ``seed``, ``runs``, ``columns``, ``rows``, the wall time)
+    :func:`design_errors` stores."""
+    import time
+
+    from ..montecarlo import run_trials
+    from ..studies.analysis import extraction_errors
+
+    setup = _setup(setup)
+    spec = parse_array(spec)
+    runs = integer("runs", runs, minimum=1)
+    seed = integer("seed", seed, minimum=0)
+    progress = boolean("progress", progress)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    route = traced_route(setup, spec)
+    t0 = time.perf_counter()
+    drives = run_trials(
+        partial(_error_trial, route, n_epochs), runs, seed, inputs=[None] * runs,
+        progress=progress, desc=f"traced errors {spec.label}",
+    )  # fmt: skip
+    cols, rows = extraction_errors(drives)
+    return {
+        **_provenance(setup, spec, n_epochs),
+        "seed": seed,
+        "runs": runs,
+        "wall_s": round(time.perf_counter() - t0, 1),
+        "columns": list(cols),
+        "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
+    }
+
+
+def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) -> Path:
+    """Where :func:`design_errors` keeps ``spec``'s record, ``<scenario>-<array>[-T<n_epochs>].json``:
+    in ``data/rt/design/`` when the repository ships it (the paper tunnel's arrays), else in the
+    ray-tracing cache's ``design-errors/`` (:func:`tunnelkit.rt.cache.default_cache_dir`)."""
+    from ..rt.cache import default_cache_dir
+    from ..scenarios import data_dir
+
+    setup = _setup(setup)
+    spec = parse_array(spec)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    T = len(setup.trajectory)
+    tail = "" if n_epochs is None or n_epochs >= T else f"-T{n_epochs}"
+    name = "".join(c if c.isalnum() or c in "-_." else "_" for c in setup.name)
+    fname = f"{name}-{spec.label}{tail}.json"
+    shipped = data_dir() / "rt" / "design" / fname
+    return shipped if shipped.is_file() else default_cache_dir() / "design-errors" / fname
+
+
+def _mismatch(stored: dict, current: dict) -> list[str]:
+    from ..studies.traced import check_provenance
+
+    out = []
+    for k in ("procedure", "scenario", "array", "n_epochs", "nuisance"):
+        if json.dumps(stored.get(k), default=str) != json.dumps(current[k], default=str):
+            out.append(f"{k}: stored {stored.get(k)!r}, now {current[k]!r}")
+    try:
+        unchecked = check_provenance(stored, current)
+    except ValueError as exc:
+        out.append(str(exc).removeprefix("record: "))
+    else:
+        out += [f"{u}: absent from the record" for u in unchecked]
+    return out
+
+
+def design_errors(
+    setup: DesignSetup,
+    spec,
+    *,
+    n_epochs: int | None = None,
+    path=None,
+    measure: bool = True,
+    progress: bool = False,
+) -> dict:
+    """``spec``'s traced-error record (:func:`measure_design_errors`), read from ``path``
+    (default :func:`design_errors_path`) when its provenance matches the current scene, array,
+    epochs and ray tracer; a record that does not match is refused (``ValueError`` naming what
+    differs: delete it to re-measure), never reused. A missing record is measured on
+    :data:`ERROR_RUNS` drives of seed :data:`ERROR_SEED` and stored (``measure=False``:
+    ``FileNotFoundError`` instead). The record gains ``path``."""
+    setup = _setup(setup)
+    spec = parse_array(spec)
+    measure = boolean("measure", measure)
+    progress = boolean("progress", progress)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    if path is None:
+        p = design_errors_path(setup, spec, n_epochs)
+    else:
+        import os
+
+        if not isinstance(path, str | os.PathLike) or not str(path):
+            raise TypeError(f"path: expected a file path, got {path!r}")
+        p = Path(path)
+    current = _provenance(setup, spec, n_epochs)
+    if p.is_file():
+        rec = json.loads(p.read_text())
+        differ = _mismatch(rec, current)
+        if differ:
+            raise ValueError(
+                f"path: {p} holds traced errors of another scene, array or ray tracer ("
+                + "; ".join(differ)
+                + "); delete it to re-measure"
+            )
+    else:
+        if not measure:
+            raise FileNotFoundError(f"path: no traced errors at {p}")
+        rec = measure_design_errors(setup, spec, n_epochs=n_epochs, progress=progress)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp = p.with_name(f".{p.name}.tmp")
+        tmp.write_text(json.dumps(rec, indent=1, default=str) + "\n")
+        tmp.replace(p)
+    if not any(r[0] == "all" for r in rec.get("rows", [])):
+        raise ValueError(f"path: {p} holds no 'all' row of extraction_errors")
+    return {**rec, "path": str(p)}
+
+
+def _sigmas(record: dict) -> dict:
+    row = {r[0]: r for r in record["rows"]}["all"]
+    names = ("phi_deg", "psi_deg", "kappa_m", "delta_d_m")
+    vals = [float(v) for v in row[2:6]]
+    if not all(np.isfinite(v) and v > 0 for v in vals):
+        raise ValueError(f"record: the 'all' row's sigmas must be finite and > 0, got {vals}")
+    return dict(zip(names, vals, strict=True))
+
+
+def traced_javelin(setup: DesignSetup, spec, record: dict):
+    """The design's tracker (:func:`~tunnelkit.design.montecarlo.javelin_config`: VUEs from the
+    known surfaces, likelihood association, joint innovation test) with the measurement noise of
+    ``record`` (:func:`design_errors`): fixed sigmas (the ``"all"`` row:
+    :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`) in place of each path's
+    reported CRLB, which on this channel is thousands of times too small."""
+    from ..tracking.javelin.designs import array_design, design_from_errors
+    from .geometry import KINDS
+
+    setup = _setup(setup)
+    spec = parse_array(spec)
+    if not isinstance(record, dict) or "rows" not in record:
+        raise TypeError("record: expected the dict of design_errors")
+    s = _sigmas(record)
+    crlb = {
+        "d": s["delta_d_m"],
+        "direction": float(np.radians(s["phi_deg"])),
+        "kappa": s["kappa_m"],
+    }
+    # the design's tracker (montecarlo.javelin_config) with the tunnel's known planes
+    planes = [f.plane for f in setup.tunnel.surfaces if f.kind in KINDS]
+    base = array_design(crlb, setup.signal_route(spec).min_d, planes)
+    base = base.with_(noise=base.noise.fallback)
+    return design_from_errors(record["rows"], base=base)
+
+
+def error_model_summary(record: dict | None) -> dict:
+    """What the report's JSON says about an array's measurement-noise model: ``{"kind":
+    "reported-crlb"}`` (``record`` None: each path's reported CRLB, the image channel's), or the
+    traced record's ``kind`` "traced-measured", sigmas, seed, runs, file and scene key."""
+    if record is None:
+        return {"kind": "reported-crlb"}
+    if not isinstance(record, dict) or "rows" not in record:
+        raise TypeError("record: expected the dict of design_errors or None")
+    return {
+        "kind": "traced-measured",
+        "sigmas": _sigmas(record),
+        "seed": record.get("seed"),
+        "runs": record.get("runs"),
+        "n_epochs": record.get("n_epochs"),
+        "prefilter": "geometry_keep",
+        "path": record.get("path"),
+        "rt_key": record.get("rt_key"),
+    }
