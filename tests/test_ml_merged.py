@@ -5,6 +5,7 @@ CRLB of one path at the pair's power-weighted centroid)."""
 import warnings
 
 import numpy as np
+import pytest
 
 from tunnelkit import arrays, channel
 from tunnelkit.constants import C
@@ -61,3 +62,76 @@ def test_a_pair_fitted_with_the_wrong_curvature_is_left_by_the_split_of_the_clos
     assert not kept and n_it == 0 and same is best
     out, n_it, kept = ml.fitting._split_weak(prob, best, 1.0, 60, 17.0, flagged=True)
     assert kept and n_it > 0 and abs(out[3]["cost"] - at_truth[3]["cost"]) < 1.0
+
+
+def _model(params, pos, k0, nf, nt):
+    """Eq. 1 tensor of paths given as rows ``(Re alpha, Im alpha, mu_f, mu_t, x, y, z)``."""
+    s, k = np.arange(nf), np.arange(nt)
+    out = 0
+    for re, im, mf, mt, *q in params.reshape(-1, 7):
+        rng_m = np.linalg.norm(np.asarray(q)[None] - pos, axis=1)
+        a = np.exp(1j * k0 * (rng_m - rng_m[0]))
+        out = out + (re + 1j * im) * np.einsum(
+            "m,s,k->msk", a, np.exp(1j * s * mf), np.exp(1j * k * mt)
+        )
+    return out
+
+
+def test_merged_crlb_against_a_finite_difference_fisher_information():
+    """The merged path of a pair (power-weighted centroid, gain of the summed power) and its
+    bound jointly with a third path: the closed form against the inverse of ``2 / sigma^2
+    Re(J^H J)`` with ``J`` by central differences of the eq. 1 tensor of the two paths left; the
+    centroid by hand: equal powers -> the midpoint in direction, curvature, delay and Doppler,
+    one gain zero -> the other path."""
+    from tunnelkit.extraction.bounds import merged_crlb, merged_path
+
+    fc, nf, nt, sigma2 = 5.9e9, 8, 4, 0.3
+    k0 = 2 * np.pi * fc / C
+    pos = arrays.ura(4, 4, C / fc / 2)
+    src = np.array([[0.4, 0.3, 3.0], [0.5, 0.25, 3.1], [-1.0, 0.6, 4.0]])
+    alpha = np.array([1.0 + 0.5j, 0.6 - 0.8j, 0.9j])
+    mf, mt = np.array([0.3, 0.35, -1.0]), np.array([0.1, 0.12, 0.6])
+    b = merged_crlb(alpha, src, pos, mf, mt, fc, nf, nt, sigma2, (0, 1))
+    p = np.abs(alpha[:2]) ** 2 / np.sum(np.abs(alpha[:2]) ** 2)
+    assert b["mu_f"] == pytest.approx(p @ mf[:2]) and b["mu_t"] == pytest.approx(p @ mt[:2])
+    r = np.linalg.norm(src[:2], axis=1)
+    assert b["w"] == pytest.approx(p @ (1 / r))
+    assert abs(b["alpha"]) == pytest.approx(np.sqrt(np.sum(np.abs(alpha[:2]) ** 2)))
+    # finite-difference Fisher information of the merged path and the third one
+    x0 = np.concatenate(
+        [
+            [b["alpha"].real, b["alpha"].imag, b["mu_f"], b["mu_t"], *b["source"]],
+            [alpha[2].real, alpha[2].imag, mf[2], mt[2], *src[2]],
+        ]
+    )
+    J = []
+    for n in range(x0.size):
+        h = 1e-6 * max(1.0, abs(x0[n]))
+        e = np.zeros_like(x0)
+        e[n] = h
+        J.append(
+            ((_model(x0 + e, pos, k0, nf, nt) - _model(x0 - e, pos, k0, nf, nt)) / (2 * h)).ravel()
+        )
+    J = np.stack(J, axis=1)
+    cov = np.linalg.inv(2 / sigma2 * np.real(J.conj().T @ J))
+    assert b["sd_mu_f"] == pytest.approx(np.sqrt(cov[2, 2]), rel=1e-5)
+    assert b["sd_mu_t"] == pytest.approx(np.sqrt(cov[3, 3]), rel=1e-5)
+    q = b["source"]
+    u = q / np.linalg.norm(q)
+    cq = cov[4:7, 4:7]
+    proj = np.eye(3) - np.outer(u, u)
+    ang = np.sqrt(np.trace(proj @ cq @ proj)) / np.linalg.norm(q)
+    assert b["sd_direction"] == pytest.approx(ang, rel=1e-5)
+    assert b["sd_kappa"] == pytest.approx(np.sqrt(u @ cq @ u), rel=1e-5)
+    # the centroid by hand
+    eq = merged_path(np.array([1.0, 1.0j]), src[:2], mf[:2], mt[:2], (0, 1))
+    mid = (src[0] / r[0] + src[1] / r[1]) / 2
+    assert np.allclose(eq["direction"], mid / np.linalg.norm(mid))
+    assert eq["w"] == pytest.approx(np.mean(1 / r)) and eq["mu_f"] == pytest.approx(mf[:2].mean())
+    one = merged_path(np.array([2.0, 0.0]), src[:2], mf[:2], mt[:2], (0, 1))
+    assert np.allclose(one["source"], src[0]) and one["alpha"] == pytest.approx(2.0)
+    for bad in ((0, 0), (0, 5), "ab", 3):
+        with pytest.raises(ValueError, match="pair"):
+            merged_path(alpha, src, mf, mt, bad)
+    with pytest.raises(ValueError, match="alpha"):
+        merged_path(np.zeros(3), src, mf, mt, (0, 1))
