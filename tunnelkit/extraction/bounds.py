@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, positive
+from .._validate import finite_array, instance, integer, positive, sequence
 from ..arrays import ArrayGeometry
 from ..budget import check_elements
 from ..channel import SRSConfig
@@ -332,7 +332,7 @@ def merged_path(alpha, sources, mu_f, mu_t, pair) -> dict:
     ``alpha`` (L,) complex gains, ``sources`` (L, 3) wave origins (local frame), ``mu_f``,
     ``mu_t`` (L,) [rad], ``pair`` two distinct indices. Returns ``alpha`` (complex), ``source``
     (3,), ``mu_f``, ``mu_t``, ``direction`` (3,) unit and ``w`` [1/m]."""
-    alpha = np.atleast_1d(finite_array("alpha", alpha, dtype=complex))
+    alpha = _gains(alpha)
     L = alpha.size
     src = finite_array("sources", sources, shape=(L, 3))
     mu_f = finite_array("mu_f", mu_f, shape=(L,))
@@ -364,13 +364,20 @@ def merged_path(alpha, sources, mu_f, mu_t, pair) -> dict:
 
 
 def _pair_indices(pair, L: int) -> tuple[int, int]:
-    try:
-        i, j = (int(k) for k in pair)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"pair: expected two path indices, got {pair!r}") from exc
-    if not (0 <= i < L and 0 <= j < L) or i == j:
-        raise ValueError(f"pair: expected two distinct indices in [0, {L}), got {pair!r}")
+    pair = sequence("pair", pair)
+    if len(pair) != 2:
+        raise ValueError(f"pair: expected two path indices, got {len(pair)}")
+    i, j = (integer("pair", k, minimum=0, maximum=L - 1) for k in pair)
+    if i == j:
+        raise ValueError(f"pair: expected two distinct indices, got {i} twice")
     return i, j
+
+
+def _gains(alpha) -> np.ndarray:
+    alpha = finite_array("alpha", alpha, dtype=complex)
+    if alpha.ndim != 1 or alpha.size < 2:
+        raise ValueError(f"alpha: expected one complex gain per path (L >= 2,), got {alpha.shape}")
+    return alpha
 
 
 def merged_crlb(
@@ -396,7 +403,7 @@ def merged_crlb(
     ``source``, ``mu_f``, ``mu_t``, ``direction``, ``w``) and the merged path's standard
     deviations ``sd_mu_f``, ``sd_mu_t`` [rad], ``sd_direction`` [rad], ``sd_kappa`` [m] (range
     of the wave origin; ``sd_kappa * w^2`` bounds ``w``)."""
-    alpha = np.atleast_1d(finite_array("alpha", alpha, dtype=complex))
+    alpha = _gains(alpha)
     L = alpha.size
     src = finite_array("sources", sources, shape=(L, 3))
     mu_f = finite_array("mu_f", mu_f, shape=(L,))
