@@ -34,7 +34,11 @@ paths above the threshold into their own column of :func:`threshold_table` ("unr
 counted, with how many lie beyond 6 sigma of the resolved model's bound, never dropped): the
 goal is stated on the others. :func:`attainability` gives each not-attainable snapshot's
 smallest pair ``llr`` and whether it was reported.
-The table also gives the share of unflagged snapshots with a path beyond 6 sigma (what a
+:func:`merged_table` judges each pair the estimate reports unresolved against the bound it can
+reach instead: the CRLB of ONE path at the true pair's power-weighted centroid, jointly with the
+other paths (:func:`tunnelkit.extraction.bounds.merged_crlb`), the estimate's two paths taken
+at their own power-weighted centroid (:func:`merged_errors`): share beyond 6 sigma, RMS(error /
+bound) per parameter. The table also gives the share of unflagged snapshots with a path beyond 6 sigma (what a
 tracker that skips flagged epochs still sees), and the threshold SNR: the lowest SNR offset
 at which every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5).
 
@@ -56,7 +60,10 @@ were never tried on before the final run (the seed 2026 of the session before wa
 choosing these; the split of an unresolved pair, ``ml.fitting.PAIR_GAIN``, was chosen on seed 23
 alone and then run once on 8191 and on 4242, a seed never run before; the resolution verdict,
 ``PathEstimates.unresolved`` with ``ml.PAIR_LLR`` from its Monte-Carlo null, was decided on seed
-23 and then run once on 8191, 4242 and 30011, a seed never run before). ``make bench``
+23 and then run once on 8191, 4242 and 30011, a seed never run before; the split of the closest
+pair while the residual test fails, ``ml.fitting._split_weak(flagged=)``, was found on a 30011
+search miss, tested on a synthetic cluster and run once on 61417, a seed never run before).
+``make bench``
 runs ``report()`` (both seeds, ``TUNNELKIT_BENCH_STRESS`` snapshots per case, default 30).
 """
 
