@@ -135,6 +135,11 @@ def evaluation_tables():
     b = sc.crlb()
     evaluation.bound_errors(est, sc.d, sc.v, sc.sources, b)
     evaluation.normalized_errors(est, sc.d, sc.v, sc.sources, b)
+    from tunnelkit.extraction.bounds import merged_crlb, merged_path
+
+    merged_path(sc.alpha, sc.sources, sc.mu_f, sc.mu_t, (0, 1))
+    args = (sc.alpha, sc.sources, sc.element_positions, sc.mu_f, sc.mu_t, cfg.fc)
+    merged_crlb(*args, cfg.n_tones, cfg.n_symbols, cfg.noise_power, (0, 1))
 
 
 def javelin_studies():

@@ -645,6 +645,18 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no row kept: measurements of no path (the route's own case of an empty epoch)",
     ),
     _doc(
+        r"extraction\.bounds\.merged_(path|crlb)",
+        r"alpha",
+        "dtype",
+        "a real gain is a complex gain of zero phase",
+    ),
+    _doc(
+        r"extraction\.bounds\.merged_crlb",
+        r"noise_power|fc",
+        "huge",
+        "the information scales as 1 / N0 and k0^2: any positive value gives a finite bound",
+    ),
+    _doc(
         r"path_consistency\.joint_fisher",
         r"alpha",
         "dtype",

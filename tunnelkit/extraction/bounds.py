@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, positive
+from .._validate import finite_array, instance, integer, positive, sequence
 from ..arrays import ArrayGeometry
 from ..budget import check_elements
 from ..channel import SRSConfig
@@ -16,6 +16,8 @@ __all__ = [
     "crlb_paths",
     "estimate_crlb",
     "in_path_units",
+    "merged_crlb",
+    "merged_path",
     "ml_truth",
     "path_crlb",
     "source_crlb",
@@ -317,3 +319,107 @@ def estimate_crlb(est, array, srs, *, noise_power: float | None = None, paths=No
     if not ok:
         raise np.linalg.LinAlgError("estimate_crlb: Fisher information singular at the estimate")
     return {"source": src, "source_cov": cov, "d": d}
+
+
+def merged_path(alpha, sources, mu_f, mu_t, pair) -> dict:
+    """The path one fitted path becomes when it explains two (an unresolved pair): the pair's
+    power-weighted centroid. With weights ``p_k = |alpha_k|^2 / (|alpha_i|^2 + |alpha_j|^2)``
+    over the pair ``(i, j)``: the direction ``sum p_k u_k`` normalised, the curvature ``w = sum
+    p_k / r_k`` (the wave origin at ``u / w``), ``mu_f`` and ``mu_t`` the weighted means (delay
+    and Doppler), and the gain of the summed power, ``sqrt(|alpha_i|^2 + |alpha_j|^2)``, with the
+    phase of ``alpha_i + alpha_j`` (of the stronger when they cancel).
+
+    ``alpha`` (L,) complex gains, ``sources`` (L, 3) wave origins (local frame), ``mu_f``,
+    ``mu_t`` (L,) [rad], ``pair`` two distinct indices. Returns ``alpha`` (complex), ``source``
+    (3,), ``mu_f``, ``mu_t``, ``direction`` (3,) unit and ``w`` [1/m]."""
+    alpha = _gains(alpha)
+    L = alpha.size
+    src = finite_array("sources", sources, shape=(L, 3))
+    mu_f = finite_array("mu_f", mu_f, shape=(L,))
+    mu_t = finite_array("mu_t", mu_t, shape=(L,))
+    i, j = _pair_indices(pair, L)
+    pw = np.abs(alpha[[i, j]]) ** 2
+    if not pw.sum() > 0:
+        raise ValueError("alpha: the pair has no power (both gains zero)")
+    p = pw / pw.sum()
+    r = np.linalg.norm(src[[i, j]], axis=1)
+    if np.any(r == 0):
+        raise ValueError("sources: a wave origin of the pair sits at the reference antenna")
+    u = p @ (src[[i, j]] / r[:, None])
+    if not np.linalg.norm(u) > 0:
+        raise ValueError("sources: the pair's directions are opposite (no centroid direction)")
+    u = u / np.linalg.norm(u)
+    w = float(p @ (1.0 / r))
+    s = alpha[i] + alpha[j]
+    ph = s / abs(s) if abs(s) > 1e-12 * np.sqrt(pw.sum()) else alpha[[i, j]][np.argmax(pw)]
+    ph = ph / abs(ph)
+    return {
+        "alpha": complex(np.sqrt(pw.sum()) * ph),
+        "source": u / w,
+        "mu_f": float(p @ mu_f[[i, j]]),
+        "mu_t": float(p @ mu_t[[i, j]]),
+        "direction": u,
+        "w": w,
+    }
+
+
+def _pair_indices(pair, L: int) -> tuple[int, int]:
+    pair = sequence("pair", pair)
+    if len(pair) != 2:
+        raise ValueError(f"pair: expected two path indices, got {len(pair)}")
+    i, j = (integer("pair", k, minimum=0, maximum=L - 1) for k in pair)
+    if i == j:
+        raise ValueError(f"pair: expected two distinct indices, got {i} twice")
+    return i, j
+
+
+def _gains(alpha) -> np.ndarray:
+    alpha = finite_array("alpha", alpha, dtype=complex)
+    if alpha.ndim != 1 or alpha.size < 2:
+        raise ValueError(f"alpha: expected one complex gain per path (L >= 2,), got {alpha.shape}")
+    return alpha
+
+
+def merged_crlb(
+    alpha,
+    sources,
+    element_positions,
+    mu_f,
+    mu_t,
+    fc: float,
+    n_tones: int,
+    n_symbols: int,
+    noise_power: float,
+    pair,
+) -> dict:
+    """The bound an unresolved pair is judged against: where two paths are closer than the data
+    resolve (``ml.pair_test``), the two-path CRLB is not attainable; one fitted path at the
+    pair's power-weighted centroid (:func:`merged_path`) is what the estimate can reach. The
+    structured CRLB (:func:`source_crlb`) of the model with the pair ``(i, j)`` replaced by that
+    one path, jointly with the other ``L - 2`` paths, read out for the merged path.
+
+    Arguments as :func:`source_crlb` (``alpha`` (L,), ``sources`` (L, 3) local frame, ...) plus
+    ``pair`` (two distinct indices). Returns :func:`merged_path`'s centroid (``alpha``,
+    ``source``, ``mu_f``, ``mu_t``, ``direction``, ``w``) and the merged path's standard
+    deviations ``sd_mu_f``, ``sd_mu_t`` [rad], ``sd_direction`` [rad], ``sd_kappa`` [m] (range
+    of the wave origin; ``sd_kappa * w^2`` bounds ``w``)."""
+    alpha = _gains(alpha)
+    L = alpha.size
+    src = finite_array("sources", sources, shape=(L, 3))
+    mu_f = finite_array("mu_f", mu_f, shape=(L,))
+    mu_t = finite_array("mu_t", mu_t, shape=(L,))
+    i, j = _pair_indices(pair, L)
+    m = merged_path(alpha, src, mu_f, mu_t, (i, j))
+    rest = np.array([k for k in range(L) if k not in (i, j)], int)
+    b = source_crlb(
+        np.append(m["alpha"], alpha[rest]),
+        np.vstack([m["source"], src[rest]]),
+        element_positions,
+        np.append(m["mu_f"], mu_f[rest]),
+        np.append(m["mu_t"], mu_t[rest]),
+        fc,
+        n_tones,
+        n_symbols,
+        noise_power,
+    )
+    return {**m, **{f"sd_{k}": float(b[k][0]) for k in ("mu_f", "mu_t", "direction", "kappa")}}

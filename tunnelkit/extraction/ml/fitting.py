@@ -259,14 +259,19 @@ WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS)
 PAIR_GAIN, SPLIT_ROUNDS = 1.0, 2
 
 
-def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
+def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool = False):
     """A path below the noise (``MIN_SIGNIFICANCE``) or two closer than ``RESOLVE_Z``: one path
     too few elsewhere (two sources merged) while the weak path, or the less significant of the
     pair (a path counted twice), sits on nothing. It is dropped and each other path in turn split
     in two (halves ``u -+ WEAK_SPLITS``, same delay and Doppler); each start gets ``RANK_ITER``
     iterations, the most likely is fitted to convergence and kept if the cost falls by more than
     ``gain_min`` (a path's detection threshold: structure, not noise) or, for a pair (same model
-    order), ``PAIR_GAIN`` noise powers. Returns the fit, the iterations and whether it was kept."""
+    order), ``PAIR_GAIN`` noise powers. Returns the fit, the iterations and whether it was kept.
+
+    ``flagged``: the residual test still fails after the re-initialisation on its peak (a wrong
+    basin the far-field periodogram cannot locate: two paths of a cluster fitted with the wrong
+    curvature, each on a mixture of two sources, leave near-field structure whose grid peak lies
+    nowhere near them). The closest pair is then tried as above whatever its separation."""
     theta, mu_f, mu_t, ev = best[:4]
     L = theta.shape[0]
     if L < 2:
@@ -275,7 +280,7 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min):
     weak = int(np.argmin(sig))
     if sig.min() >= MIN_SIGNIFICANCE:
         res = ev["resolution"] = separations(prob, theta, mu_f, mu_t, sigma2)  # kept with ev
-        if res.min() >= RESOLVE_Z:
+        if res.min() >= RESOLVE_Z and not flagged:
             return best, 0, False
         pair = np.argsort(res)[:2]
         weak, gain_min = int(pair[np.argmin(sig[pair])]), PAIR_GAIN * sigma2
@@ -490,7 +495,9 @@ def fit_problem(
         n_it, kept = n_it + its, kept + n_kept
         history.append(best[3]["cost"] / (dof * sigma2))
     for _ in range(SPLIT_ROUNDS if n_reseed and search == "residual" and SPLIT_WEAK else 0):
-        best, its, split = _split_weak(prob, best, sigma2, max_iter, peak_max * sigma2)
+        best, its, split = _split_weak(
+            prob, best, sigma2, max_iter, peak_max * sigma2, flagged=peak[0] > peak_max
+        )
         n_it, kept = n_it + its, kept + split
         if not split:
             break
