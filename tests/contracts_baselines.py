@@ -69,6 +69,7 @@ def design_confirm():
     rep = report.design_sweep(setup, ["4x4"], runs=2, n_epochs=1, n_boot=100)
     verdict.recommend(rep.rows, 0.2, 0.9, 2)
     confirm.confirmation_candidates(rep)
+    confirm.next_candidate(rep, [])
     confirm.confirm_on_channel(rep, setup, runs=2)
     design.javelin_rmse(setup, "4x4", 2, 0, n_epochs=1, crlb=CRLB)
     pdz.size_figure(rep.rows)
