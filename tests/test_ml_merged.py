@@ -81,8 +81,8 @@ def test_merged_crlb_against_a_finite_difference_fisher_information():
     """The merged path of a pair (power-weighted centroid, gain of the summed power) and its
     bound jointly with a third path: the closed form against the inverse of ``2 / sigma^2
     Re(J^H J)`` with ``J`` by central differences of the eq. 1 tensor of the two paths left; the
-    centroid by hand: equal powers -> the midpoint in direction, curvature, delay and Doppler,
-    one gain zero -> the other path."""
+    centroid by hand: equal powers -> the midpoint in direction, curvature, delay and Doppler
+    (phases on the circle, also across +-pi), one gain zero -> the other path."""
     from tunnelkit.extraction.bounds import merged_crlb, merged_path
 
     fc, nf, nt, sigma2 = 5.9e9, 8, 4, 0.3
@@ -93,7 +93,8 @@ def test_merged_crlb_against_a_finite_difference_fisher_information():
     mf, mt = np.array([0.3, 0.35, -1.0]), np.array([0.1, 0.12, 0.6])
     b = merged_crlb(alpha, src, pos, mf, mt, fc, nf, nt, sigma2, (0, 1))
     p = np.abs(alpha[:2]) ** 2 / np.sum(np.abs(alpha[:2]) ** 2)
-    assert b["mu_f"] == pytest.approx(p @ mf[:2]) and b["mu_t"] == pytest.approx(p @ mt[:2])
+    assert b["mu_f"] == pytest.approx(np.angle(p @ np.exp(1j * mf[:2])))
+    assert b["mu_t"] == pytest.approx(np.angle(p @ np.exp(1j * mt[:2])))
     r = np.linalg.norm(src[:2], axis=1)
     assert b["w"] == pytest.approx(p @ (1 / r))
     assert abs(b["alpha"]) == pytest.approx(np.sqrt(np.sum(np.abs(alpha[:2]) ** 2)))
@@ -127,7 +128,11 @@ def test_merged_crlb_against_a_finite_difference_fisher_information():
     eq = merged_path(np.array([1.0, 1.0j]), src[:2], mf[:2], mt[:2], (0, 1))
     mid = (src[0] / r[0] + src[1] / r[1]) / 2
     assert np.allclose(eq["direction"], mid / np.linalg.norm(mid))
-    assert eq["w"] == pytest.approx(np.mean(1 / r)) and eq["mu_f"] == pytest.approx(mf[:2].mean())
+    assert eq["w"] == pytest.approx(np.mean(1 / r))
+    assert eq["mu_f"] == pytest.approx(np.angle(np.exp(1j * mf[:2]).mean()))
+    # phases either side of +-pi: the centroid sits at pi, not at the arithmetic mean 0
+    wrap = merged_path(np.array([1.0, 1.0]), src[:2], [3.1, -3.1], [-3.0, 3.0], (0, 1))
+    assert abs(np.exp(1j * wrap["mu_f"]) + 1) < 1e-12 and abs(np.exp(1j * wrap["mu_t"]) + 1) < 1e-12
     one = merged_path(np.array([2.0, 0.0]), src[:2], mf[:2], mt[:2], (0, 1))
     assert np.allclose(one["source"], src[0]) and one["alpha"] == pytest.approx(2.0)
     for bad in ((0, 0), (0, 5), "ab", 3):
@@ -135,3 +140,31 @@ def test_merged_crlb_against_a_finite_difference_fisher_information():
             merged_path(alpha, src, mf, mt, bad)
     with pytest.raises(ValueError, match="alpha"):
         merged_path(np.zeros(3), src, mf, mt, (0, 1))
+
+
+def test_circular_mean_against_the_phasor_sum_and_its_contract():
+    """``circular_mean``: the angle of the weighted phasor sum (random draws against the sum by
+    hand, shifts by 2 pi change nothing), the heaviest angle when the phasors cancel, and the
+    weights and angles refused by name."""
+    from tunnelkit.extraction.numerics import circular_mean
+
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        k = int(rng.integers(1, 5))
+        w, a = rng.uniform(0, 1, k), rng.uniform(-np.pi, np.pi, k)
+        want = np.angle(w @ np.exp(1j * a))
+        assert circular_mean(w, a) == pytest.approx(want, abs=1e-12)
+        assert circular_mean(w, a + 2 * np.pi * rng.integers(-3, 4, k)) == pytest.approx(
+            want, abs=1e-9
+        )
+    assert circular_mean([1.0, 1.0], [0.0, np.pi]) == pytest.approx(0.0)
+    assert circular_mean([1.0, 2.0], [0.2, 0.2 + np.pi]) == pytest.approx(0.2 + np.pi - 2 * np.pi)
+    for w, a, name in (
+        ([1.0], [np.nan], "angles"),
+        ([-1.0, 2.0], [0.0, 1.0], "weights"),
+        ([0.0, 0.0], [0.0, 1.0], "weights"),
+        ([1.0], [0.0, 1.0], "weights"),
+        ([], [], "angles"),
+    ):
+        with pytest.raises(ValueError, match=f"^{name}"):
+            circular_mean(w, a)

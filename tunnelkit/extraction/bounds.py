@@ -10,6 +10,7 @@ from ..budget import check_elements
 from ..channel import SRSConfig
 from ..constants import C, db2lin
 from .estimates import PathEstimates
+from .numerics import circular_mean
 from .radio import check_array, check_srs
 
 __all__ = [
@@ -325,9 +326,10 @@ def merged_path(alpha, sources, mu_f, mu_t, pair) -> dict:
     """The path one fitted path becomes when it explains two (an unresolved pair): the pair's
     power-weighted centroid. With weights ``p_k = |alpha_k|^2 / (|alpha_i|^2 + |alpha_j|^2)``
     over the pair ``(i, j)``: the direction ``sum p_k u_k`` normalised, the curvature ``w = sum
-    p_k / r_k`` (the wave origin at ``u / w``), ``mu_f`` and ``mu_t`` the weighted means (delay
-    and Doppler), and the gain of the summed power, ``sqrt(|alpha_i|^2 + |alpha_j|^2)``, with the
-    phase of ``alpha_i + alpha_j`` (of the stronger when they cancel).
+    p_k / r_k`` (the wave origin at ``u / w``), ``mu_f`` and ``mu_t`` the weighted means on the
+    circle (delay and Doppler phases, :func:`~tunnelkit.extraction.numerics.circular_mean`, as
+    the ML fit's merged start), and the gain of the summed power, ``sqrt(|alpha_i|^2 +
+    |alpha_j|^2)``, with the phase of ``alpha_i + alpha_j`` (of the stronger when they cancel).
 
     ``alpha`` (L,) complex gains, ``sources`` (L, 3) wave origins (local frame), ``mu_f``,
     ``mu_t`` (L,) [rad], ``pair`` two distinct indices. Returns ``alpha`` (complex), ``source``
@@ -356,8 +358,8 @@ def merged_path(alpha, sources, mu_f, mu_t, pair) -> dict:
     return {
         "alpha": complex(np.sqrt(pw.sum()) * ph),
         "source": u / w,
-        "mu_f": float(p @ mu_f[[i, j]]),
-        "mu_t": float(p @ mu_t[[i, j]]),
+        "mu_f": circular_mean(p, mu_f[[i, j]]),
+        "mu_t": circular_mean(p, mu_t[[i, j]]),
         "direction": u,
         "w": w,
     }

@@ -9,7 +9,8 @@
 - :func:`grid_index` — the rectangular-lattice coordinates of a URA (or ULA) layout;
 - :func:`spatial_phase` — the exact spherical spatial phase of eq. 1 and its derivatives in
   ``(u_x, u_y, w = 1 / kappa)``;
-- :func:`scan_peak` — the far-field beam-scan peak of a spatial vector.
+- :func:`scan_peak` — the far-field beam-scan peak of a spatial vector;
+- :func:`circular_mean` — the weighted mean of phases on the circle (a merged pair's ``mu``).
 
 The fits call :func:`solve`, :func:`free_newton`, :func:`damped_step`, :func:`spatial_phase` and
 :func:`contract` on every iteration with arrays they built themselves; there the finiteness
@@ -30,6 +31,7 @@ from ..constants import C
 
 __all__ = [
     "MIN_SIGNIFICANCE",
+    "circular_mean",
     "contract",
     "damped_step",
     "free_newton",
@@ -276,3 +278,21 @@ def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:
     n_grid = integer("n_grid", n_grid, minimum=2)
     u, A = _scan_grid(p.tobytes(), p.shape[0], positive("fc", fc), n_grid)
     return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H
+
+
+def circular_mean(weights, angles) -> float:
+    """The weighted mean of phases on the circle, ``angle(sum_k w_k exp(j a_k))`` [rad], in
+    ``(-pi, pi]``: the ``mu_f`` / ``mu_t`` of a pair of paths merged into one (an arithmetic mean
+    of ``3.1`` and ``-3.1`` gives ``0``, the opposite side of the circle; this gives ``pi``).
+    ``weights`` (K,) non-negative, not all zero; ``angles`` (K,) [rad]. When the weighted
+    phasors cancel the result is the angle of the heaviest one."""
+    a = finite_array("angles", angles, ndim=1)
+    w = finite_array("weights", weights, shape=(a.size,))
+    if a.size == 0:
+        raise ValueError("angles: expected at least one angle")
+    if np.any(w < 0) or not w.sum() > 0:
+        raise ValueError("weights: expected non-negative weights, not all zero")
+    z = w @ np.exp(1j * a)
+    if not abs(z) > 1e-12 * w.sum():
+        return float(np.angle(np.exp(1j * a[int(np.argmax(w))])))
+    return float(np.angle(z))

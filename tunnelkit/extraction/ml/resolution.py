@@ -76,6 +76,7 @@ from scipy.optimize import brentq
 from scipy.special import i0e
 
 from ..._validate import finite_array, integer, positive
+from ..numerics import circular_mean
 from .lm import best_of_starts, lm_fit
 from .model import Problem, project_feasible
 
@@ -190,8 +191,8 @@ def _merged_fit(prob: Problem, theta, mu_f, mu_t, c, sigma2, i: int, j: int, max
     for wi in (w[0], 1.0, 0.0):
         th, mf, mt = theta.copy(), mu_f.copy(), mu_t.copy()
         th[i] = wi * theta[i] + (1 - wi) * theta[j]
-        mf[i] = np.angle(wi * np.exp(1j * mu_f[i]) + (1 - wi) * np.exp(1j * mu_f[j]))
-        mt[i] = np.angle(wi * np.exp(1j * mu_t[i]) + (1 - wi) * np.exp(1j * mu_t[j]))
+        mf[i] = circular_mean([wi, 1 - wi], mu_f[[i, j]])
+        mt[i] = circular_mean([wi, 1 - wi], mu_t[[i, j]])
         starts.append((project_feasible(th[keep]), mf[keep], mt[keep]))
     return best_of_starts(lm_fit, prob, starts, sigma2, min(_MERGE_RANK_ITER, max_iter), max_iter)
 
