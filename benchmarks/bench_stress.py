@@ -40,7 +40,9 @@ other paths (:func:`tunnelkit.extraction.bounds.merged_crlb`), the estimate's tw
 at their own power-weighted centroid (:func:`merged_errors`): share beyond 6 sigma, RMS(error /
 bound) per parameter. The table also gives the share of unflagged snapshots with a path beyond 6 sigma (what a
 tracker that skips flagged epochs still sees), and the threshold SNR: the lowest SNR offset
-at which every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5).
+at which every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5) on all its
+snapshots, the paths the estimate itself reports unresolved judged apart (:func:`merged_table`):
+a statement that needs no truth, beside the per-snapshot one below.
 
 The threshold region is also stated per snapshot, from the bound at the truth
 (:func:`above_threshold`, :func:`tunnelkit.extraction.ml.below_threshold`): a snapshot is below the
@@ -370,6 +372,18 @@ def study(n: int = 30, seed: int = HELD_OUT_SEED, cases=None, search: str = "res
     return out
 
 
+def _meets_goal(e: np.ndarray) -> bool:
+    """The goal on rows of ``error / CRLB`` (n, 4): at most 2 % of the paths beyond 6 sigma in
+    any parameter (a missed path, NaN, counts as beyond) and RMS <= 1.5 per parameter over the
+    finite rows; no rows meets it."""
+    if not len(e):
+        return True
+    beyond = np.mean(np.any(~(np.abs(e) <= 6.0), axis=1)) * 100
+    fin = np.all(np.isfinite(e), axis=1)
+    rms = np.sqrt(np.mean(e[fin] ** 2, axis=0)) if fin.any() else np.zeros(e.shape[1])
+    return bool(beyond <= 2.0 and np.all(rms <= 1.5))
+
+
 def table(rows: list) -> str:
     head = (
         f"{'case':26s} {'paths':>5s} "
@@ -396,8 +410,10 @@ def table(rows: list) -> str:
             + f" {uf:>14s} {np.median(r['seconds']):8.3f}"
         )
         if r.get("drive"):
-            ok = beyond <= 2.0 and bool(np.all(rms <= 1.5))
-            meets[r["offset"]] = meets.get(r["offset"], True) and ok
+            # the estimate's own verdict only (no truth): the paths it reports unresolved are
+            # judged in merged_table, every other path of every snapshot here
+            keep = ~r.get("pair", np.zeros(len(e), bool))
+            meets[r["offset"]] = meets.get(r["offset"], True) and _meets_goal(e[keep])
     allbad = np.concatenate([r["bad"] for r in rows])
     allfl = np.concatenate([r["flagged"] for r in rows])
     lines.append(
@@ -420,6 +436,7 @@ def table(rows: list) -> str:
         passing = [o for o in sorted(meets) if all(meets[p] for p in meets if p >= o)]
         lines.append(
             "threshold SNR: every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5) "
+            "on every path but those the estimate reports unresolved (no truth used) "
             + (f"at offsets >= {passing[0]:+.0f} dB" if passing else "at no offset tried")
             + " ("
             + ", ".join(f"{o:+.0f} dB {'met' if meets[o] else 'not met'}" for o in sorted(meets))
@@ -466,7 +483,7 @@ def threshold_table(rows: list) -> str:
         tot["abf"] += (up & bad & fl).sum()
         tot["ag"] += (up & ~bad).sum()
         tot["agf"] += (up & ~bad & fl).sum()
-        if up.any() and not (beyond <= 2.0 and bool(np.all(rms[np.isfinite(rms)] <= 1.5))):
+        if up.any() and not _meets_goal(e):
             fails.append(r["case"])
         lines.append(
             f"{r['case']:26s} {up.sum():5d} {lo.sum():5d} {beyond:10.1f}% "
