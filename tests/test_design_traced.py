@@ -161,3 +161,22 @@ def test_the_paper_tunnels_records_ship_and_others_go_to_the_cache(tmp_path, mon
     assert traced.design_errors_path(setup, "4x4", 3) == tmp_path / "design-errors" / (
         f"{SCENARIO}-4x4-T3.json"
     )
+
+
+def test_variant_switches_the_channel_source_and_keeps_it_otherwise():
+    """``DesignSetup.variant(channel=)`` used to validate the channel and drop it: a copy always
+    came back with the original source. Now ``None`` keeps, ``"sionna"`` takes the scenario's
+    ray-tracing settings, ``"image"`` goes back, and an unknown source is refused by name."""
+    from tunnelkit import design
+
+    base = design.DesignSetup.from_scenario("italiano2026-straight")
+    assert base.channel == "image" and base.rt_settings is None
+    rt = base.variant(channel="sionna")
+    assert rt.channel == "sionna" and rt.rt_settings is not None
+    want = design.DesignSetup.from_scenario("italiano2026-straight", channel="sionna")
+    assert rt.rt_settings == want.rt_settings
+    kept = rt.variant(bandwidth=50e6)
+    assert kept.channel == "sionna" and kept.rt_settings == rt.rt_settings
+    assert rt.variant(channel="image").channel == "image"
+    with pytest.raises(ValueError, match=r"^channel"):
+        base.variant(channel="raytrace")

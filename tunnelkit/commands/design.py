@@ -188,7 +188,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         choices=["image", "sionna"],
         default="image",
         help="channel source of --mode channel: eq. 1 from the image method (default) or the "
-        "ray-traced channel (Sionna RT, traced once per array and cached)",
+        "ray-traced channel (Sionna RT, traced once per array and cached; there every epoch's ML "
+        "measurements pass a geometry pre-filter and the tracker is told the array's errors "
+        "measured on that channel, not the reported CRLB; no impairments)",
     )
     p.add_argument(
         "--n-epochs", type=_count("n_epochs", 1), default=None, help="first N epochs of the route"

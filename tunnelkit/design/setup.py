@@ -220,10 +220,27 @@ class DesignSetup:
         bandwidth: float | None = None,
         tilt_deg: float | None = None,
         mount_height: float | None = None,
-        channel: str = "image",
+        channel: str | None = None,
     ) -> DesignSetup:
-        """A copy with another carrier, bandwidth, down-tilt or mount height (``None`` keeps)."""
-        choice("channel", channel, CHANNELS)
+        """A copy with another carrier, bandwidth, down-tilt, mount height or channel source
+        (``None`` keeps). ``channel="sionna"`` on a setup without ray-tracing settings takes
+        them from the scenario of the setup's name (its ``[raytracing]``)."""
+        rts = self.rt_settings
+        if channel is not None:
+            choice("channel", channel, CHANNELS)
+            if channel == "sionna" and rts is None:
+                from ..rt import RTSettings
+
+                try:
+                    sc = load_scenario(self.name)
+                except (FileNotFoundError, KeyError, ValueError) as exc:
+                    raise ValueError(
+                        f"channel: 'sionna' needs the ray-tracing settings of scenario "
+                        f"{self.name!r}, which does not load ({exc})"
+                    ) from None
+                rts = RTSettings.from_scenario(sc)
+        else:
+            channel = self.channel
         if mount_height is not None:
             _mount_height_inside(self, float(finite_array("mount_height", mount_height, ndim=0)))
         cfg = self.config
@@ -252,7 +269,7 @@ class DesignSetup:
                     f"{m.name!r} lies outside the tunnel"
                 )
             mounts.append(Mount(m.name, centre, m.azimuth, float(el)))
-        return replace(self, mounts=tuple(mounts), config=cfg)
+        return replace(self, mounts=tuple(mounts), config=cfg, channel=channel, rt_settings=rts)
 
     @property
     def fc(self) -> float:
