@@ -107,9 +107,11 @@ class SignalRoute:
     measurements unless matched to a modelled second-order path.
     ``model_error_floor`` (off by default): an ML fit that fails its white-noise test
     (``fit_ok = False``) is judged again against noise plus the impairment power this route
-    was told about (:func:`~tunnelkit.signal_route.judging.impairment_share` of
-    ``impairments``: the calibration levels and the diffuse share; nothing to re-judge when it
-    is zero, nor when the extraction models the wideband term), ``Epoch.rejudged`` the test
+    was told about (``impairments``: the diffuse share and the calibration levels'
+    :func:`~tunnelkit.signal_route.judging.calibration_floor`, the share one drawn array leaves
+    at a 1 % false-alarm rate over the draw; nothing to re-judge when
+    :func:`~tunnelkit.signal_route.judging.impairment_share` is zero, nor when the extraction
+    models the wideband term), ``Epoch.rejudged`` the test
     and ``Epoch.fit_ok`` its verdict; a fit that passes it reports the CRLB at its estimate
     (:func:`~tunnelkit.signal_route.measurements.reported_covariance` with ``judged=False``).
     ``bias_budget`` (a :class:`~tunnelkit.signal_route.judging.BiasBudget` over this route's
@@ -414,10 +416,13 @@ class SignalRoute:
             return None
         from .judging import impairment_share, rejudge
 
-        share = impairment_share(self.impairments)
-        if share <= 0:
+        imp = self.impairments
+        if impairment_share(imp) <= 0:
             return None
-        return rejudge(est, snap.H, arr.local, self.config.fc, share)
+        # the diffuse share as it is, the calibration at the draw's false-alarm floor
+        dmc = 0.0 if imp.dmc is None else float(imp.dmc.share)
+        cal = (imp.phase_sigma_deg, imp.gain_sigma_db)
+        return rejudge(est, snap.H, arr.local, self.config.fc, dmc, calibration=cal)
 
 
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
