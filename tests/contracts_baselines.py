@@ -346,6 +346,10 @@ def channel_budgets():
     judging.rejudge(
         ep.estimates, ep.snapshot.H, ep.array.local, route.config.fc, judging.impairment_share(imp)
     )
+    judging.rejudge(
+        ep.estimates, ep.snapshot.H, ep.array.local, route.config.fc, 0.0, calibration=(1.0, 0.0)
+    )
+    judging.calibration_floor(1.0, 0.2, np.abs(ep.snapshot.H).sum(axis=(1, 2)))
     restrict_rows(m, np.arange(len(m)))
 
 
