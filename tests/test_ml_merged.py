@@ -168,3 +168,15 @@ def test_circular_mean_against_the_phasor_sum_and_its_contract():
     ):
         with pytest.raises(ValueError, match=f"^{name}"):
             circular_mean(w, a)
+
+
+def test_circular_mean_scales_huge_weights_exactly():
+    """Weights near the float maximum: no overflow (the weights are scaled by a power of two,
+    which leaves the result bit for bit); a -pi and a pi give the same point."""
+    from tunnelkit.extraction.numerics import circular_mean
+
+    a = np.array([0.1, 0.5])
+    assert circular_mean([1e308, 1e308], a) == pytest.approx(0.3)
+    tiny = np.ldexp(np.array([3.0, 9.0]), -1000)
+    assert circular_mean(tiny, a) == circular_mean([3.0, 9.0], a)
+    assert abs(np.exp(1j * circular_mean([1.0], [-np.pi])) + 1) < 1e-15

@@ -23,9 +23,10 @@ JSON; the bound route's rows stay in the report beside them (``confirmation`` in
 
 Under calibration error the channel route judges the extraction's fits against noise plus the
 impairment power it was told about (``SignalRoute.model_error_floor``,
-:mod:`tunnelkit.signal_route.judging`: the closed-form calibration share of the received power,
-an upper bound of what a fit needs, plus the diffuse share; ``model_error_share`` in the
-inputs) and hands the tracker the design's per-path impairment budget beside the CRLB at the
+:mod:`tunnelkit.signal_route.judging`: the calibration share of the received power at a 1 %
+false-alarm quantile of the array's draw, :func:`~tunnelkit.signal_route.judging.
+calibration_floor`, plus the diffuse share; ``model_error_share`` (the expectation) and
+``model_error_false_alarm`` in the inputs) and hands the tracker the design's per-path impairment budget beside the CRLB at the
 estimate (:mod:`tunnelkit.design.channelbudget`). Before, the white-noise test alone flagged the
 fits and a flagged epoch carried no measurement: 28 GHz example, 0.5 deg, the first 10 epochs of
 one drive (seed 0): 6 of 10 flagged on 4 x 4 and 10 of 10 on 8 x 8, after the re-judge 1 and 0
@@ -133,7 +134,7 @@ def confirm_on_channel(
     :func:`confirmation_candidates`, ``runs`` drives each (default the report's), its seed,
     impairments, target, share, criterion and epochs; ``workers`` / ``scheduler`` /
     ``timeout`` as :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`'s."""
-    from ..signal_route.judging import impairment_share
+    from ..signal_route.judging import FLOOR_FALSE_ALARM, impairment_share
     from .achievable import DesignImpairments
     from .montecarlo import sweep_montecarlo
 
@@ -194,7 +195,14 @@ def confirm_on_channel(
         )
     if runs < MIN_RUNS_CI:
         warnings.append(f"confirmation with {runs} runs: every verdict is undecided")
-    # the floor the channel route's fit test allows for (0: the white-noise test alone)
+    # the expectation of the floor the channel route's fit test allows for (0: the white-noise
+    # test alone); the test takes the calibration part at its draw's false-alarm quantile
     share = 0.0 if imp.ideal else impairment_share(imp.channel_impairments())
-    settings = dict(s, confirm_route="channel", confirm_runs=runs, model_error_share=share)
+    settings = dict(
+        s,
+        confirm_route="channel",
+        confirm_runs=runs,
+        model_error_share=share,
+        model_error_false_alarm=FLOOR_FALSE_ALARM,
+    )
     return ConfirmedReport(report.scenario, report.rows, rec, settings, warnings, rows, bound_rec)

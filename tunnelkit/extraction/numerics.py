@@ -282,7 +282,7 @@ def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:
 
 def circular_mean(weights, angles) -> float:
     """The weighted mean of phases on the circle, ``angle(sum_k w_k exp(j a_k))`` [rad], in
-    ``(-pi, pi]``: the ``mu_f`` / ``mu_t`` of a pair of paths merged into one (an arithmetic mean
+    ``[-pi, pi]``: the ``mu_f`` / ``mu_t`` of a pair of paths merged into one (an arithmetic mean
     of ``3.1`` and ``-3.1`` gives ``0``, the opposite side of the circle; this gives ``pi``).
     ``weights`` (K,) non-negative, not all zero; ``angles`` (K,) [rad]. When the weighted
     phasors cancel the result is the angle of the heaviest one."""
@@ -290,8 +290,9 @@ def circular_mean(weights, angles) -> float:
     w = finite_array("weights", weights, shape=(a.size,))
     if a.size == 0:
         raise ValueError("angles: expected at least one angle")
-    if np.any(w < 0) or not w.sum() > 0:
+    if np.any(w < 0) or not w.max() > 0:
         raise ValueError("weights: expected non-negative weights, not all zero")
+    w = np.ldexp(w, -int(np.frexp(w.max())[1]))  # by a power of 2: exact, no overflow
     z = w @ np.exp(1j * a)
     if not abs(z) > 1e-12 * w.sum():
         return float(np.angle(np.exp(1j * a[int(np.argmax(w))])))
