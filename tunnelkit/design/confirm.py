@@ -26,14 +26,15 @@ impairment power it was told about (``SignalRoute.model_error_floor``,
 :mod:`tunnelkit.signal_route.judging`: the calibration share of the received power at a 1 %
 false-alarm quantile of the array's draw, :func:`~tunnelkit.signal_route.judging.
 calibration_floor`, plus the diffuse share; ``model_error_share`` (the expectation) and
-``model_error_false_alarm`` in the inputs) and hands the tracker the design's per-path impairment budget beside the CRLB at the
-estimate (:mod:`tunnelkit.design.channelbudget`). Before, the white-noise test alone flagged the
-fits and a flagged epoch carried no measurement: 28 GHz example, 0.5 deg, the first 10 epochs of
-one drive (seed 0): 6 of 10 flagged on 4 x 4 and 10 of 10 on 8 x 8, after the re-judge 1 and 0
-(the 4 x 4 one an unresolved pair, which stays flagged); the fits needed 0.01-0.07 of the closed
-form. The settled median error on the channel route went from 0.42 / 0.97 m (4 x 4 / 8 x 8, 2
-runs) to 1.8 / 0.49 cm (20 runs; p90 10.3 / 3.6 cm), the bound route's 1.1 / 0.42 cm (p90 8.3 /
-2.6 cm): both recommend 8 x 8 (README, the design answer).
+``model_error_false_alarm`` in the inputs) and hands the tracker the design's per-path
+impairment budget beside the CRLB at the estimate (:mod:`tunnelkit.design.channelbudget`).
+Before, the white-noise test alone flagged the fits and a flagged epoch carried no measurement:
+28 GHz example, 0.5 deg, the first 10 epochs of one drive (seed 0): 6 of 10 flagged on 4 x 4 and
+10 of 10 on 8 x 8, after the re-judge 1 and 0 (the 4 x 4 one an unresolved pair, which stays
+flagged); the fits needed 0.01-0.07 of the closed form. The settled median error on the channel
+route went from 0.42 / 0.97 m (4 x 4 / 8 x 8, 2 runs) to 1.8 / 0.49 cm (20 runs; p90 10.3 / 3.6
+cm), the bound route's 1.1 / 0.42 cm (p90 8.3 / 2.6 cm): both recommend 8 x 8 (README, the
+design answer).
 
 At 2 deg the channel route's 8 x 8 had a tail (p90 65 cm, 4 runs) the bound route did not
 (8.3 cm): on the drives that carried it the calibration error's quadratic phase drove every

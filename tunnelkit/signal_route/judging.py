@@ -133,7 +133,7 @@ def calibration_floor(
     w = p / p.max()
     w = w / w.sum()
     K1, K2, K3 = k1, k2 * float(np.sum(w**2)), k3 * float(np.sum(w**3))
-    if not K3 > 0:  # a symmetric term (cannot happen for |.|^2): the normal quantile
+    if not K3 > 0:  # the third cumulant underflows at vanishing levels: the normal quantile
         from scipy.stats import norm
 
         return float(min(K1 + np.sqrt(K2) * norm.ppf(1.0 - a), 1.0))

@@ -421,8 +421,7 @@ class SignalRoute:
             return None
         # the diffuse share as it is, the calibration at the draw's false-alarm floor
         dmc = 0.0 if imp.dmc is None else float(imp.dmc.share)
-        cal = (imp.phase_sigma_deg, imp.gain_sigma_db)
-        cal = None if cal == (0.0, 0.0) else cal
+        cal = None if imp.calibrated else (imp.phase_sigma_deg, imp.gain_sigma_db)
         return rejudge(est, snap.H, arr.local, self.config.fc, dmc, calibration=cal)
 
 
