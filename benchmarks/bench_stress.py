@@ -393,6 +393,7 @@ def table(rows: list) -> str:
     )
     lines = [head]
     meets: dict = {}
+    missed: dict = {}
     for r in rows:
         e = r["errors"]
         fin = np.all(np.isfinite(e), axis=1)
@@ -413,7 +414,10 @@ def table(rows: list) -> str:
             # the estimate's own verdict only (no truth): the paths it reports unresolved are
             # judged in merged_table, every other path of every snapshot here
             keep = ~r.get("pair", np.zeros(len(e), bool))
-            meets[r["offset"]] = meets.get(r["offset"], True) and _meets_goal(e[keep])
+            ok = _meets_goal(e[keep])
+            meets[r["offset"]] = meets.get(r["offset"], True) and ok
+            if not ok:
+                missed.setdefault(r["offset"], []).append(r["case"])
     allbad = np.concatenate([r["bad"] for r in rows])
     allfl = np.concatenate([r["flagged"] for r in rows])
     lines.append(
@@ -439,9 +443,17 @@ def table(rows: list) -> str:
             "on every path but those the estimate reports unresolved (no truth used) "
             + (f"at offsets >= {passing[0]:+.0f} dB" if passing else "at no offset tried")
             + " ("
-            + ", ".join(f"{o:+.0f} dB {'met' if meets[o] else 'not met'}" for o in sorted(meets))
+            + "; ".join(
+                f"{o:+.0f} dB " + ("met" if meets[o] else "not met: " + ", ".join(missed[o]))
+                for o in sorted(meets)
+            )
             + ")"
         )
+        if not passing:
+            lines.append(
+                "  (a case that misses the goal at every offset leaves it by range, not SNR: the "
+                "per-snapshot threshold table below is the statement to use)"
+            )
     return "\n".join(lines)
 
 

@@ -211,6 +211,7 @@ def _signal_route():
     prob = ml.Problem(snap.H[:, :8, :4], arr.local, route.config.fc)
     f = est.fit
     ml.pair_separation(prob, f.theta, f.mu_f, f.mu_t, f.noise_power)
+    ml.closest_pair(prob, f.theta, f.mu_f, f.mu_t, f.noise_power)
     ml.resolvable(prob, f.theta, f.mu_f, f.mu_t, f.noise_power, f.peak_max)
     ml.below_threshold(est.significance, est.resolution, prob.N)
     ml.outlier_probability(est.significance, prob.N)

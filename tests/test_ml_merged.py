@@ -180,3 +180,61 @@ def test_circular_mean_scales_huge_weights_exactly():
     tiny = np.ldexp(np.array([3.0, 9.0]), -1000)
     assert circular_mean(tiny, a) == circular_mean([3.0, 9.0], a)
     assert abs(np.exp(1j * circular_mean([1.0], [-np.pi])) + 1) < 1e-15
+
+
+def test_a_path_counted_twice_is_split_off_even_when_the_separations_tie():
+    """A held-out stress snapshot (``bench_stress.py --seed 4242``, slalom 15-45 m at -10 dB,
+    snapshot 26): five images within 35 cm and a few degrees. The search ended with one path
+    counted twice (two atoms of coherence 0.99996 with large, cancelling gains) and its neighbour
+    missing, 1,085 noise powers above the fit started at the truth. The duplicate left the
+    Fisher information so ill-conditioned that an unrelated pair also read 0 sd apart, and the
+    split move took that pair (the two smallest per-path separations). Now the pair closest in
+    its own distance and the most coherent pair are both split, ranked by the likelihood: the
+    fit reaches the truth's basin and passes every test."""
+    from tunnelkit import scenarios
+    from tunnelkit.montecarlo import spawn_rngs
+    from tunnelkit.signal_route import SignalRoute
+
+    sc = scenarios.with_values(
+        scenarios.load_scenario("italiano2026-slalom"),
+        {"tunnel.length": 300.0, "trajectory.x_start": 122.0, "trajectory.x_end": 0.5},
+    )
+    route = SignalRoute.from_scenario(sc, snr_offset_db=-10.0)
+    rng = spawn_rngs(4242 * 1000 + 11, 30)[26]
+    dist = np.linalg.norm(route.trajectory.position - route.arrays[0].origin, axis=1)
+    k = int(rng.choice(np.flatnonzero((dist >= 15.0) & (dist <= 45.0))))
+    arr, paths = route.paths(k)
+    snap = route.snapshot(paths, arr, rng)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = route.extract(snap.H, arr, len(paths), search="residual")
+    cfg = route.config
+    src = np.stack([arr.to_local(p.source) for p in paths])
+    r = np.linalg.norm(src, axis=1)
+    th = np.column_stack([src[:, :2] / r[:, None], 1 / r])
+    d = np.array([p.length for p in paths]) + C * snap.clock_bias
+    mf = -2 * np.pi * cfg.tone_spacing * d / C
+    mt = 2 * np.pi * cfg.fc * cfg.symbol_period * np.array([p.velocity for p in paths]) / C
+    prob = ml.Problem(snap.H, arr.local, cfg.fc)
+    sigma2 = est.fit.noise_power
+    at_truth = ml.fitting._lm(prob, th, mf, mt, sigma2, 60)
+    assert est.fit_ok and est.fit.reason == ""
+    assert abs(est.fit.cost - at_truth[3]["cost"]) / sigma2 < 1.0
+    for row in th[:, :2]:  # every true direction has its estimate (none missing, none twice)
+        assert np.min(np.linalg.norm(est.fit.theta[:, :2] - row, axis=1)) < 0.005
+
+
+def test_closest_pair_is_the_pair_whose_members_hold_the_smallest_separation():
+    prob, th, mf, mt = _cluster(2)
+    i, j, z = ml.closest_pair(prob, th, mf, mt, 1.0)
+    res = ml.separations(prob, th, mf, mt, 1.0)
+    assert i < j and z == pytest.approx(res.min(), rel=1e-12)
+    assert res[i] == pytest.approx(z, rel=1e-12) and res[j] == pytest.approx(z, rel=1e-12)
+    # the other paths moved many delay cells from everything: the pair stays the closest
+    far = mf.copy()
+    others = [k for k in range(len(th)) if k not in (i, j)]
+    far[others] += 0.6 * (1 + np.arange(len(others)))
+    assert ml.closest_pair(prob, th, far, mt, 1.0)[:2] == (i, j)
+    assert ml.closest_pair(prob, th[:1], mf[:1], mt[:1], 1.0) == (-1, -1, float("inf"))
+    with pytest.raises(ValueError, match="noise_power"):
+        ml.closest_pair(prob, th, mf, mt, -1.0)

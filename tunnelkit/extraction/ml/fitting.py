@@ -21,6 +21,7 @@ from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .resolution import (
     PAIR_LLR,
     RESOLVE_Z,
+    closest_pair,
     pair_separation,
     pair_tests_at,
     separations,
@@ -143,11 +144,15 @@ def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
     return res, big[4] + res[4]
 
 
+#: coherence ``|G_ij| / sqrt(G_ii G_jj)`` above which two atoms are one path counted twice
+COUNTED_TWICE = 0.9
 #: offsets in (u_x, u_y) of the two halves of a split path (an eighth of a 10 x 10 beamwidth)
 SPLIT_STEPS = ((0.012, 0.0), (0.0, 0.012))
 
 
-def _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coherence=0.9):
+def _merge_and_split(
+    prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coherence=COUNTED_TWICE
+):
     """If two atoms are nearly collinear (one path counted twice, ``|G_ij| / sqrt(G_ii G_jj) >
     coherence``): drop the weaker, fit the ``L - 1``, then split one of them into two halves
     ``u -+ SPLIT_STEPS`` (two sources closer than a beamwidth fitted as one) and fit all ``L``;
@@ -277,27 +282,44 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool =
     if L < 2:
         return best, 0, False
     sig = path_significance(ev, sigma2)
-    weak = int(np.argmin(sig))
+    weaks = [int(np.argmin(sig))]
     if sig.min() >= MIN_SIGNIFICANCE:
         res = ev["resolution"] = separations(prob, theta, mu_f, mu_t, sigma2)  # kept with ev
         if res.min() >= RESOLVE_Z and not flagged:
             return best, 0, False
-        pair = np.argsort(res)[:2]
-        weak, gain_min = int(pair[np.argmin(sig[pair])]), PAIR_GAIN * sigma2
+        pairs = _split_pairs(prob, theta, mu_f, mu_t, sigma2, ev)
+        weaks, gain_min = [int(p[np.argmin(sig[p])]) for p in pairs], PAIR_GAIN * sigma2
     starts = []
-    for l_ in np.argsort(-np.abs(ev["c"])):
-        if l_ == weak:
-            continue
-        for du in WEAK_SPLITS:
-            th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
-            th2[weak], mf2[weak], mt2[weak] = theta[l_], mu_f[l_], mu_t[l_]
-            th2[l_, :2] += du
-            th2[weak, :2] -= du
-            starts.append((project_feasible(th2), mf2, mt2))
+    for weak in weaks:
+        for l_ in np.argsort(-np.abs(ev["c"])):
+            if l_ == weak:
+                continue
+            for du in WEAK_SPLITS:
+                th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
+                th2[weak], mf2[weak], mt2[weak] = theta[l_], mu_f[l_], mu_t[l_]
+                th2[l_, :2] += du
+                th2[weak, :2] -= du
+                starts.append((project_feasible(th2), mf2, mt2))
     cand, n_it = best_of_starts(_lm, prob, starts, sigma2, min(RANK_ITER, max_iter), max_iter)
     if cand[3]["cost"] < ev["cost"] - gain_min:
         return cand, n_it, True
     return best, n_it, False
+
+
+def _split_pairs(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> list[np.ndarray]:
+    """The pairs :func:`_split_weak` takes apart, their starts ranked together by the likelihood:
+    the pair fewest standard deviations of its difference apart (the argmin of
+    :func:`~.resolution.separations`' pairwise distances), and the two most collinear atoms when
+    their coherence exceeds :data:`COUNTED_TWICE` and they are another pair. A path counted twice
+    (two atoms with large, cancelling gains) leaves the Fisher information so ill-conditioned
+    that an unrelated pair can read 0 sd apart too; the coherence still names the duplicate. Real
+    resolvable paths can be that coherent as well, so neither criterion alone decides."""
+    a, b, _ = closest_pair(prob, theta, mu_f, mu_t, sigma2)
+    out = [np.array([a, b])]
+    i, j, coh = _coherent_pair(ev)
+    if coh > COUNTED_TWICE and {int(i), int(j)} != {a, b}:
+        out.append(np.array([i, j]))
+    return out
 
 
 def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
@@ -318,9 +340,9 @@ def _dirichlet(dmu, n: int) -> np.ndarray:
 
 def _weakest(ev, sigma2) -> int:
     """The weaker of the two most collinear atoms when two are nearly one (``|G_ij| / sqrt(G_ii
-    G_jj) > 0.9``: a path counted twice), else the least significant path."""
+    G_jj) > COUNTED_TWICE``: a path counted twice), else the least significant path."""
     i, j, coh = _coherent_pair(ev)
-    if coh > 0.9:
+    if coh > COUNTED_TWICE:
         return int(j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i)
     return int(np.argmin(path_significance(ev, sigma2)))
 

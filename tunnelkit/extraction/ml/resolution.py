@@ -87,6 +87,7 @@ __all__ = [
     "PAIR_TEST_Z",
     "RESOLVE_Z",
     "below_threshold",
+    "closest_pair",
     "outlier_probability",
     "pair_separation",
     "pair_test",
@@ -141,6 +142,20 @@ def separations(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> np.ndar
     difference (module text; ``inf`` for a single path)."""
     theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
     return _separations(prob, theta, mu_f, mu_t, sigma2)
+
+
+def closest_pair(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> tuple[int, int, float]:
+    """The two paths fewest standard deviations of their difference apart (the pairwise distances
+    of :func:`separations`): ``(i, j, z)`` with ``i < j``; ``(-1, -1, inf)`` for one path. The two
+    smallest per-path minima of :func:`separations` need not be one pair when minima tie."""
+    theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
+    L = theta.shape[0]
+    if L < 2:
+        return -1, -1, float("inf")
+    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, prob.evaluate(theta, mu_f, mu_t))
+    a, b = np.triu_indices(L, 1)
+    k = int(np.argmin(z))
+    return int(a[k]), int(b[k]), float(z[k])
 
 
 def pair_separation(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> float:
