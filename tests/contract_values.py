@@ -571,8 +571,17 @@ def _traced():
     src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
     joint_fisher([1.0 + 0.5j, 0.5j], src, pos, [-0.7, -1.1], [0.05, -0.02], 4, 3, 0.3, 3.5e9)
     rate_interval(3, 50)
+    tr.geometry_labels(ep, route)
     tr.geometry_keep(ep, route)
-    tr.traced_measurements(ep, route)
+    pm, _ = tr.traced_measurements(ep, route)
+    from tunnelkit.rt.consistency import plane_kinds
+    from tunnelkit.tracking.javelin import JavelinConfig, KindNoise
+
+    plane_kinds(route.tunnel)
+    pm.with_kinds(list(pm.kind))
+    kn = KindNoise((("los", 0.01, 0.02, 30.0, 0.2),))
+    kn.covariances(pm, JavelinConfig())
+    kn.tdoa_covariance(pm, list(range(1, len(pm))), 0, JavelinConfig())
     tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()

@@ -47,12 +47,11 @@ from .._validate import (
 )
 from ..geometry import Plane
 
-__all__ = ["consistent_paths", "geometry_consistency", "tunnel_planes"]
+__all__ = ["consistent_paths", "geometry_consistency", "plane_kinds", "tunnel_planes"]
 
 
-def tunnel_planes(tunnel) -> list[Plane]:
-    """The distinct planes of ``tunnel``'s reflecting surfaces (facets and road markings; one
-    plane per ``(normal, offset)`` to 1e-9)."""
+def _distinct_planes(tunnel) -> list:
+    """The first surface of ``tunnel`` on each distinct plane (``(normal, offset)`` to 1e-9)."""
     from ..propagation import Tunnel3D
 
     instance("tunnel", tunnel, Tunnel3D)
@@ -62,8 +61,21 @@ def tunnel_planes(tunnel) -> list[Plane]:
         key = tuple(np.round(np.append(pl.normal, pl.offset), 9))
         if key not in seen:
             seen.add(key)
-            out.append(pl)
+            out.append(f)
     return out
+
+
+def tunnel_planes(tunnel) -> list[Plane]:
+    """The distinct planes of ``tunnel``'s reflecting surfaces (facets and road markings; one
+    plane per ``(normal, offset)`` to 1e-9)."""
+    return [f.plane for f in _distinct_planes(tunnel)]
+
+
+def plane_kinds(tunnel) -> tuple[str, ...]:
+    """The surface kind of each plane of :func:`tunnel_planes` (``"wall"``, ``"ceiling"``,
+    ``"road"``, ``"rrm"``), in its order: ``plane_kinds(t)[i]`` is the kind of the paths
+    :func:`geometry_consistency` assigns to plane ``i``."""
+    return tuple(f.kind for f in _distinct_planes(tunnel))
 
 
 def _mirror_all(points: np.ndarray, normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:

@@ -24,12 +24,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import sequence
+from ..._validate import boolean, sequence
 from .associate import Associator
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, VueCurvature
 from .motion import MirrorMotion
-from .noise import ConsiderNoise
+from .noise import ConsiderNoise, KindNoise
 from .roles import JavelinDesign
 from .surfaces import GeometricBirth
 from .update import JointTestUpdater
@@ -39,6 +39,7 @@ __all__ = [
     "ARRAY_DESIGN_KNOWN_VUE_WALK",
     "ARRAY_DESIGN_UPDATE_ITERATIONS",
     "ARRAY_DESIGN_VUE_WALK",
+    "MIN_KIND_MATCHED",
     "ML_ERRORS_SEED0",
     "ablation_path",
     "array_design",
@@ -219,23 +220,43 @@ def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> Ja
     )
 
 
-def design_from_errors(rows: list[list], base: JavelinDesign | None = None) -> JavelinDesign:
+#: matched measurements a kind of path needs before :func:`design_from_errors` gives it its own
+#: sigmas (fewer: the pooled row's)
+MIN_KIND_MATCHED = 30
+
+
+def design_from_errors(
+    rows: list[list], base: JavelinDesign | None = None, *, per_kind: bool = False
+) -> JavelinDesign:
     """A design whose measurement noise is the measured extraction error: ``sigma_phi``,
     ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d`` from the ``"all"`` row of
     :func:`tunnelkit.studies.extraction_errors`; every role and other number from ``base``
-    (default :func:`ours_coherent`)."""
+    (default :func:`ours_coherent`). ``per_kind``: the noise role becomes
+    :class:`~.noise.KindNoise` with each kind's own row (a kind of fewer than
+    :data:`MIN_KIND_MATCHED` matched measurements, and a quantity a row leaves empty, keep the
+    pooled sigma; no kind with enough: the pooled design); a path the route did not label keeps
+    the pooled sigmas."""
     base = ours_coherent() if base is None else base
     if not isinstance(base, JavelinDesign):
         raise TypeError(f"base: expected a JavelinDesign, got {type(base).__name__}")
-    pooled = {r[0]: r for r in sequence("rows", rows)}.get("all")
+    per_kind = boolean("per_kind", per_kind)
+    table = {r[0]: r for r in sequence("rows", rows)}
+    pooled = table.get("all")
     if pooled is None:
         raise ValueError("rows: expected the table of extraction_errors (an 'all' row)")
-    return base.with_(
-        sigma_phi=float(np.radians(pooled[2])),
-        sigma_psi=float(np.radians(pooled[3])),
-        sigma_kappa=float(pooled[4]),
-        sigma_delta_d=float(pooled[5]),
-    )
+    sig = [float(np.radians(pooled[2])), float(np.radians(pooled[3])), *map(float, pooled[4:6])]
+    out = base.with_(sigma_phi=sig[0], sigma_psi=sig[1], sigma_kappa=sig[2], sigma_delta_d=sig[3])
+    if not per_kind:
+        return out
+    kinds = []
+    for kind, r in table.items():
+        if kind == "all" or not isinstance(r[1], int | np.integer) or r[1] < MIN_KIND_MATCHED:
+            continue
+        own = [np.radians(r[2]), np.radians(r[3]), r[4], r[5]]
+        own = [float(v) if v is not None and np.isfinite(v) and v > 0 else p
+               for v, p in zip(own, sig, strict=True)]  # fmt: skip
+        kinds.append((kind, *own))
+    return out.with_(noise=KindNoise(tuple(kinds))) if kinds else out
 
 
 def ablation_path() -> dict[str, JavelinDesign]:

@@ -8,8 +8,11 @@ role                  the paper (section 4.2)                   ours
 ====================  ========================================  =================================
 measurement noise     :class:`FixedNoise` (one sigma per        :class:`FixedNoise` with
                       quantity, diagonal TDoAs)                 ``correlated_delta_d``;
-                                                                :class:`ReportedNoise` (each
-                                                                path's reported covariance)
+                                                                :class:`KindNoise` (one sigma
+                                                                per quantity for each kind of
+                                                                path); :class:`ReportedNoise`
+                                                                (each path's reported
+                                                                covariance)
 associator            :class:`Associator` (greedy, ``eta^2``)   global nearest neighbour,
                                                                 ``eta^2 + ln det S``
 initiator             :class:`FixedBirth` (``sigma_P^2 I``,     :class:`MeasuredBirth` (the
@@ -38,7 +41,7 @@ from .config import JavelinConfig
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, ReflectorCurvature, VueCurvature
 from .motion import MirrorMotion, RandomWalk
-from .noise import ConsiderNoise, FixedNoise, ReportedNoise
+from .noise import ConsiderNoise, FixedNoise, KindNoise, ReportedNoise
 from .update import JointTestUpdater, JosephUpdater
 
 __all__ = [
@@ -51,6 +54,7 @@ __all__ = [
     "JavelinDesign",
     "JointTestUpdater",
     "JosephUpdater",
+    "KindNoise",
     "MeasuredBirth",
     "MirrorMotion",
     "RandomWalk",
@@ -62,7 +66,7 @@ __all__ = [
 
 # -- the design -----------------------------------------------------------------------------------
 _ROLE_TYPES = {
-    "noise": (FixedNoise, ReportedNoise),
+    "noise": (FixedNoise, KindNoise, ReportedNoise),
     "associator": (Associator,),
     "initiator": (FixedBirth,),
     "vue_motion": (RandomWalk,),
@@ -80,7 +84,7 @@ class JavelinDesign:
     """
 
     config: JavelinConfig = field(default_factory=JavelinConfig)
-    noise: FixedNoise | ReportedNoise = field(default_factory=FixedNoise)
+    noise: FixedNoise | KindNoise | ReportedNoise = field(default_factory=FixedNoise)
     associator: Associator = field(default_factory=Associator)
     initiator: FixedBirth = field(default_factory=FixedBirth)
     vue_motion: RandomWalk = field(default_factory=RandomWalk)
