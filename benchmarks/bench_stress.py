@@ -449,10 +449,14 @@ def table(rows: list) -> str:
             )
             + ")"
         )
-        if not passing:
+        # drive and range band (the case name without its offset) missing at every offset
+        bands = [{c.rsplit(" ", 2)[0] for c in missed.get(o, [])} for o in sorted(meets)]
+        always = sorted(set.intersection(*bands)) if bands else []
+        if always:
             lines.append(
-                "  (a case that misses the goal at every offset leaves it by range, not SNR: the "
-                "per-snapshot threshold table below is the statement to use)"
+                f"  ({', '.join(always)}: the goal missed at every offset tried, a range threshold "
+                "rather than an SNR one: the per-snapshot threshold table below is the statement "
+                "to use)"
             )
     return "\n".join(lines)
 

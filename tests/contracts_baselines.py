@@ -171,6 +171,7 @@ def javelin_studies():
     studies.vue_prediction_errors(drive, "mirror")
     studies.path_errors([drive])
     studies.extraction_errors([routes["ml"]])
+    studies.error_correlations([routes["ml"]])
     studies.ablation({"L": [drive]}, separated={"L": [routes["coherent"]]})
     pjv.epoch_figure(ev.run.reports[0], truth=drive.truth[0])
     wj.epoch_view(drive, ev, 0)

@@ -64,6 +64,9 @@ def test_each_path_gets_its_kinds_sigmas_and_every_other_path_the_configs():
         ((("los", 1.0, 1.0, 1.0, np.nan),), ValueError, "sigmas"),
         ((("los", 1, 1, 1, 1), ("los", 2, 2, 2, 2)), ValueError, "distinct"),
         ((("", 1, 1, 1, 1),), ValueError, "non-empty"),
+        ((("los", "a", 1, 1, 1),), TypeError, r"sigmas\['los'\]"),
+        ((("los", None, 1, 1, 1),), TypeError, r"sigmas\['los'\]"),
+        ((("los", True, 1, 1, 1),), TypeError, r"sigmas\['los'\]"),
     ],
 )
 def test_bad_kind_rows_are_named(rows, exc, match):
@@ -91,6 +94,10 @@ def test_the_kinds_ride_along_the_checks_and_subsets():
         m.with_kinds("los")
     with pytest.raises(TypeError, match="kind"):
         m.with_kinds([1, 2, 3])
+    with pytest.raises(TypeError, match="kind"):
+        m.with_kinds({"los", "road", "rrm"})  # no order
+    # one dtype whatever the strings: a record rebuilt with its checks equals the unchecked one
+    assert m.kind.dtype == object and clean.kind.dtype == object
 
 
 def test_plane_kinds_follow_tunnel_planes():
@@ -143,6 +150,17 @@ def test_design_from_errors_per_kind():
     assert designs.design_from_errors(few, base=base, per_kind=True) == pooled
     with pytest.raises(TypeError, match="per_kind"):
         designs.design_from_errors(rows, base=base, per_kind="yes")
+    with pytest.raises(ValueError, match="per_kind"):  # would drop the reported covariances
+        designs.design_from_errors(
+            rows,
+            base=designs.array_design({"d": 0.05, "direction": 0.01, "kappa": 2.0}),
+            per_kind=True,
+        )
+    bad = [["los", 80, -2.0, 2.5, 40.0, 0.2, 3], rows[-1]]
+    with pytest.raises(ValueError, match=r"rows\['los'\]"):
+        designs.design_from_errors(bad, base=base, per_kind=True)
+    with pytest.raises(ValueError, match="rows"):
+        designs.design_from_errors([["los", 80, 2.0], rows[-1]], base=base, per_kind=True)
 
 
 def test_a_kind_row_equal_to_the_pooled_sigmas_tracks_exactly_as_the_fixed_noise():

@@ -182,15 +182,15 @@ def test_circular_mean_scales_huge_weights_exactly():
     assert abs(np.exp(1j * circular_mean([1.0], [-np.pi])) + 1) < 1e-15
 
 
-def test_a_path_counted_twice_is_split_off_even_when_the_separations_tie():
+def test_a_path_counted_twice_is_split_off_when_an_unrelated_pair_reads_0_sd_apart():
     """A held-out stress snapshot (``bench_stress.py --seed 4242``, slalom 15-45 m at -10 dB,
     snapshot 26): five images within 35 cm and a few degrees. The search ended with one path
     counted twice (two atoms of coherence 0.99996 with large, cancelling gains) and its neighbour
     missing, 1,085 noise powers above the fit started at the truth. The duplicate left the
-    Fisher information so ill-conditioned that an unrelated pair also read 0 sd apart, and the
-    split move took that pair (the two smallest per-path separations). Now the pair closest in
-    its own distance and the most coherent pair are both split, ranked by the likelihood: the
-    fit reaches the truth's basin and passes every test."""
+    Fisher information so ill-conditioned that an unrelated pair read 0 sd apart, closer than
+    the duplicate, and the split move took that pair. Now the most coherent pair is split too,
+    the starts of both ranked by the likelihood: the fit reaches the truth's basin and passes
+    every test."""
     from tunnelkit import scenarios
     from tunnelkit.montecarlo import spawn_rngs
     from tunnelkit.signal_route import SignalRoute

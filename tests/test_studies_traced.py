@@ -133,6 +133,11 @@ def test_the_stored_errors_set_the_design(tmp_path):
     assert replace(d.config, sigma_phi=1, sigma_psi=1, sigma_kappa=1, sigma_delta_d=1) == replace(
         base.config, sigma_phi=1, sigma_psi=1, sigma_kappa=1, sigma_delta_d=1
     )  # every other number from ours_ml
+    # with the record's lag-1 error correlation: each sigma its long-run value
+    rec["correlation"] = {"phi": {"r": 0.6, "pairs": 9}, "psi": {"r": 0.0, "pairs": 9}}
+    d2 = traced_design(write_traced_errors(rec, tmp_path / "c.json"))
+    assert d2.config.sigma_phi == pytest.approx(np.radians(9.0) * 2.0)
+    assert d2.config.sigma_psi == pytest.approx(np.radians(8.0))
     with pytest.raises(FileNotFoundError, match="path"):
         traced_errors(tmp_path / "missing.json")
     (tmp_path / "bad.json").write_text(json.dumps({"rows": [["los", 1, 1, 1, 1, 1, 0]]}))

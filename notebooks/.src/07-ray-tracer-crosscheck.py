@@ -649,7 +649,7 @@ geo_flag = {label: np.mean([not r[2] for r in rows]) for label, rows in geo.item
 # against them.
 
 # %%
-from tunnelkit.studies.traced import FLOORS, geometry_keep, traced_errors
+from tunnelkit.studies.traced import FLOORS, geometry_keep, traced_design, traced_errors
 
 floor_deg, floor_m = float(np.degrees(FLOORS[0])), float(FLOORS[1])
 kept = {}
@@ -676,6 +676,10 @@ print(f"traced matched paths: median angle error {np.median(ang_rt):.3g} deg, me
 # spatial-wideband term, and the ML fit's curvature absorbs it. The traced design's sigmas are
 # that error, measured once on the straight drive (seed 0, `studies.traced.measure_traced_errors`,
 # stored in `data/rt/traced_errors.json`); below, beside the same RMS on this notebook's epochs.
+# The errors of one path also repeat from epoch to epoch (the record's lag-1 correlation $r$,
+# `studies.error_correlations`), and a tracker that takes them as white averages them down too
+# far: each sigma is told its long-run value, $\sigma\sqrt{(1+r)/(1-r)}$ (an AR(1) error's
+# variance summed over all lags).
 
 # %%
 cfg_ml = designs.ours_ml().config
@@ -695,6 +699,18 @@ print("error / sigma: " + ", ".join(f"{n} {r:.3g}" for n, r in ratio_rt.items())
 stored = {r[0]: r for r in traced_errors()["rows"]}["all"]
 print(f"traced design's sigmas (stored): {stored[2]:.3g} deg, {stored[3]:.3g} deg, "
       f"{stored[4]:.3g} m over {stored[1]} matched paths")  # fmt: skip
+
+corr = traced_errors().get("correlation", {})
+cfg_tr = traced_design().config
+inflation = {
+    "phi": np.degrees(cfg_tr.sigma_phi) / stored[2],
+    "psi": np.degrees(cfg_tr.sigma_psi) / stored[3],
+}
+print("lag-1 error correlation: " + ", ".join(f"{q} {v['r']:.2f}" for q, v in corr.items()))
+print(
+    "the traced design's sigmas / the RMS: "
+    + ", ".join(f"{q} {v:.2f}" for q, v in inflation.items())
+)
 
 # %% [markdown]
 # A tracker that trusts a curvature tens of metres off at the sigma of a few metres pulls the UE
@@ -720,4 +736,8 @@ assert kept["image"] >= 0.95 and kept["sionna"] < 1.0
 assert np.median(ang_rt) > floor_deg and within < 0.5
 # the stored traced sigmas and this notebook's RMS errors: the same order of magnitude
 assert 0.1 < np.degrees(rms_rt["phi"]) / stored[2] < 10 and 0.1 < rms_rt["kappa"] / stored[4] < 10
+# the long-run inflation of the traced design's angle sigmas, from the record's correlation
+for q in ("phi", "psi"):
+    r_q = min(max(corr[q]["r"], 0.0), 0.9)
+    assert abs(inflation[q] - np.sqrt((1 + r_q) / (1 - r_q))) < 1e-9 and inflation[q] > 1
 print("section 9 checks passed")

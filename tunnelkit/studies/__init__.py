@@ -9,7 +9,13 @@ javelin-table1|2`` and the array design (``tunnelkit design``) use them.
 
 from __future__ import annotations
 
-from .analysis import ablation, extraction_errors, path_errors, vue_prediction_errors
+from .analysis import (
+    ablation,
+    error_correlations,
+    extraction_errors,
+    path_errors,
+    vue_prediction_errors,
+)
 from .collect import collect_drives, collect_routes, per_drive, simulate_condition
 from .drives import (
     CONDITIONS,
@@ -50,6 +56,7 @@ __all__ = [
     "ablation",
     "collect_drives",
     "collect_routes",
+    "error_correlations",
     "error_metrics",
     "evaluate",
     "extraction_errors",

@@ -15,7 +15,14 @@ from ..tracking.javelin.state import JavelinState
 from .drives import DriveData
 from .scoring import evaluate
 
-__all__ = ["ablation", "extraction_errors", "path_errors", "vue_prediction_errors"]
+__all__ = [
+    "ERROR_QUANTITIES",
+    "ablation",
+    "error_correlations",
+    "extraction_errors",
+    "path_errors",
+    "vue_prediction_errors",
+]
 
 
 def ablation(
@@ -109,6 +116,47 @@ def path_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     return ["path", "true", "found", "rms angle error [deg]", "median [deg]"], rows
 
 
+def _matched_errors(drive: DriveData, k: int):
+    """Epoch ``k``'s measurements matched to a true path: ``(kind, key, dphi [deg], dpsi [deg],
+    dkappa [m], Delta d error [m] or None for the epoch's reference)`` per measurement (the
+    quantities of :func:`extraction_errors`); ``key`` names the true path across epochs (the LoS,
+    or the plane a reflection's wave source mirrors the UE in: its normal and offset, rounded)."""
+    m = drive.epochs[k]
+    if m is None or not len(m):
+        return []
+    tidx = np.asarray(drive.truth_index[k])
+    hit = np.flatnonzero(tidx >= 0)
+    if not hit.size:
+        return []
+    src = drive.sources[k][tidx[hit]]
+    q = src - drive.base_station
+    rng_true = np.linalg.norm(q, axis=1)
+    phi_t = np.arctan2(q[:, 1], q[:, 0])
+    psi_t = np.arctan2(q[:, 2], np.hypot(q[:, 0], q[:, 1]))
+    dphi = np.degrees(np.angle(np.exp(1j * (m.phi[hit] - phi_t))))
+    dpsi = np.degrees(m.psi[hit] - psi_t)
+    dkap = m.kappa[hit] - rng_true
+    e_d = m.d[hit] - rng_true  # common clock bias per epoch
+    ref = int(np.argmin(m.d[hit]))
+    ddd = e_d - e_d[ref]
+    out = []
+    for i, j in enumerate(hit):
+        kind = drive.kinds[k][tidx[j]]
+        w = src[i] - drive.truth[k]
+        nw = float(np.linalg.norm(w))
+        if nw < 1e-6:
+            key = (kind,)
+        else:  # the mirror plane: normal along w, through the midpoint
+            n = w / nw
+            key = (
+                kind,
+                *np.round(n, 2).tolist(),
+                round(float(n @ (src[i] + drive.truth[k])) / 2, 1),
+            )
+        out.append((kind, key, dphi[i], dpsi[i], dkap[i], None if i == ref else ddd[i]))
+    return out
+
+
 def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     """RMS error of what the tracker is fed, per kind of path, over ``drives``.
 
@@ -123,34 +171,17 @@ def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     drives = sequence("drives", drives)
     acc: dict[str, dict[str, list]] = {}
     for drive in drives:
-        for k, m in enumerate(drive.epochs):
-            if m is None or not len(m):
-                continue
-            tidx = np.asarray(drive.truth_index[k])
-            hit = np.flatnonzero(tidx >= 0)
-            if not hit.size:
-                continue
-            q = drive.sources[k][tidx[hit]] - drive.base_station
-            rng_true = np.linalg.norm(q, axis=1)
-            phi_t = np.arctan2(q[:, 1], q[:, 0])
-            psi_t = np.arctan2(q[:, 2], np.hypot(q[:, 0], q[:, 1]))
-            dphi = np.degrees(np.angle(np.exp(1j * (m.phi[hit] - phi_t))))
-            dpsi = np.degrees(m.psi[hit] - psi_t)
-            dkap = m.kappa[hit] - rng_true
-            e_d = m.d[hit] - rng_true  # common clock bias per epoch
-            ref = int(np.argmin(m.d[hit]))
-            ddd = e_d - e_d[ref]
-            for i, j in enumerate(hit):
-                kind = drive.kinds[k][tidx[j]]
+        for k in range(len(drive.epochs)):
+            for kind, _, dphi, dpsi, dkap, ddd in _matched_errors(drive, k):
                 a = acc.setdefault(kind, {"phi": [], "psi": [], "kappa": [], "dd": [], "far": 0})
-                a["phi"].append(dphi[i])
-                a["psi"].append(dpsi[i])
-                if np.isfinite(dkap[i]):
-                    a["kappa"].append(dkap[i])
+                a["phi"].append(dphi)
+                a["psi"].append(dpsi)
+                if np.isfinite(dkap):
+                    a["kappa"].append(dkap)
                 else:
                     a["far"] += 1
-                if i != ref:
-                    a["dd"].append(ddd[i])
+                if ddd is not None:
+                    a["dd"].append(ddd)
     if not acc:
         raise ValueError("drives: no measurement matched to a true path")
 
@@ -177,6 +208,40 @@ def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     )
     cols = ["path", "matched", "phi [deg]", "psi [deg]", "kappa [m]", "Delta d [m]", "no kappa"]
     return cols, rows
+
+
+#: the quantities of :func:`error_correlations` (the columns of :func:`extraction_errors`)
+ERROR_QUANTITIES = ("phi", "psi", "kappa", "delta_d")
+
+
+def error_correlations(drives: list[DriveData]) -> dict[str, dict[str, float]]:
+    """How much of what the tracker is fed repeats from one epoch to the next: for each quantity
+    of :func:`extraction_errors` (``phi``, ``psi``, ``kappa``, ``delta_d``), the lag-1
+    correlation ``r = sum e_k e_{k+1} / sqrt(sum e_k^2 sum e_{k+1}^2)`` of the errors of the same
+    true path (the LoS, or the reflection off one plane) at consecutive epochs, pooled over
+    ``drives``. Uncentred, so an error that persists along the drive (a bias) counts as repeating.
+    Returns ``{quantity: {"r": r, "pairs": n}}`` (``r`` NaN without pairs). An AR(1) error with
+    this ``r`` averages over epochs as white noise of ``(1 + r) / (1 - r)`` times its variance
+    (the long-run variance), which is what a tracker that takes the errors as white should be
+    told (:func:`~tunnelkit.tracking.javelin.designs.design_from_errors` ``correlation=``)."""
+    drives = sequence("drives", drives)
+    sums = {q: np.zeros(4) for q in ERROR_QUANTITIES}  # sum xy, sum xx, sum yy, pairs
+    for drive in drives:
+        instance("drives[i]", drive, DriveData)
+        prev = None
+        for k in range(len(drive.epochs)):
+            cur = {e[1]: e[2:] for e in _matched_errors(drive, k)}
+            if prev:
+                for key in cur.keys() & prev.keys():
+                    for q, a, b in zip(ERROR_QUANTITIES, prev[key], cur[key], strict=True):
+                        if a is not None and b is not None and np.isfinite(a) and np.isfinite(b):
+                            sums[q] += (a * b, a * a, b * b, 1.0)
+            prev = cur
+    out = {}
+    for q, (xy, xx, yy, n) in sums.items():
+        r = float(xy / np.sqrt(xx * yy)) if xx > 0 and yy > 0 else float("nan")
+        out[q] = {"r": r, "pairs": int(n)}
+    return out
 
 
 def vue_prediction_errors(drive: DriveData, vue_motion: str) -> np.ndarray:

@@ -8,7 +8,11 @@ sigmas of 0.23 deg, 0.31 deg, 3.6 m, 3.2 cm) then trusts them far too much. The 
 changes two things, nothing else:
 
 * **measurement noise**: the RMS extraction error of the ML route on the traced channel
-  (:func:`~tunnelkit.studies.analysis.extraction_errors`, all matched paths pooled), measured by
+  (:func:`~tunnelkit.studies.analysis.extraction_errors`, all matched paths pooled), each sigma
+  times ``sqrt((1 + r) / (1 - r))`` with ``r`` its lag-1 correlation from epoch to epoch
+  (:func:`~tunnelkit.studies.analysis.error_correlations`: the errors of one path repeat, 0.44
+  in azimuth and 0.66 in elevation, and a tracker that takes them as white averages them down
+  too far), measured by
   :func:`measure_traced_errors` on the straight drive, seed 0, condition L, :data:`SIGMA_RUNS`
   runs (drive ``i`` from the ``i``-th child of seed 0), and stored with its provenance in
   ``data/rt/traced_errors.json`` (:func:`write_traced_errors`; ``benchmarks/bench_rt_sigmas.py
@@ -203,11 +207,12 @@ def measure_traced_errors(
     :data:`SIGMA_SCENARIO` on the ray-traced channel (diffuse power as the ML fit's floor; drive
     ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.montecarlo.run_trials`), every
     epoch's ML measurements (``"ml-all"`` of :func:`simulate_traced`), their RMS errors per kind
-    of path (:func:`~tunnelkit.studies.analysis.extraction_errors`). Returns the record
-    :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the sigmas) and
-    the procedure's provenance."""
+    of path (:func:`~tunnelkit.studies.analysis.extraction_errors`) and their lag-1 correlation
+    from epoch to epoch (:func:`~tunnelkit.studies.analysis.error_correlations`). Returns the
+    record :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the
+    sigmas), ``correlation`` (each sigma's inflation) and the procedure's provenance."""
     from ..montecarlo import run_trials
-    from .analysis import extraction_errors
+    from .analysis import error_correlations, extraction_errors
 
     runs = integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
@@ -219,6 +224,7 @@ def measure_traced_errors(
         progress=progress, desc="traced drives",
     )  # fmt: skip
     cols, rows = extraction_errors(drives)
+    corr = error_correlations(drives)
     route = scenario_route(SIGMA_SCENARIO, "exact", "sionna", NUISANCE)
     return {
         "procedure": "tunnelkit.studies.traced.measure_traced_errors",
@@ -231,6 +237,7 @@ def measure_traced_errors(
         **scene_provenance(route),
         "columns": list(cols),
         "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
+        "correlation": corr,
     }
 
 
@@ -331,7 +338,11 @@ def traced_errors(path=None, *, check: bool = True) -> dict:
 def traced_design(path=None):
     """:func:`~tunnelkit.tracking.javelin.designs.ours_ml` with its measurement noise set to the
     stored traced errors (:func:`traced_errors`, checked against the current scene; the ``"all"``
-    row;
+    row, each sigma inflated by the record's lag-1 error correlation when it has one, the
+    long-run standard deviation of an error that repeats from epoch to epoch;
     :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`); to be fed the
     ``"ml-traced"`` drives of :func:`simulate_traced`."""
-    return designs.design_from_errors(traced_errors(path)["rows"], base=designs.ours_ml())
+    rec = traced_errors(path)
+    return designs.design_from_errors(
+        rec["rows"], base=designs.ours_ml(), correlation=rec.get("correlation")
+    )

@@ -276,7 +276,8 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool =
     ``flagged``: the residual test still fails after the re-initialisation on its peak (a wrong
     basin the far-field periodogram cannot locate: two paths of a cluster fitted with the wrong
     curvature, each on a mixture of two sources, leave near-field structure whose grid peak lies
-    nowhere near them). The closest pair is then tried as above whatever its separation."""
+    nowhere near them). The closest pair is then tried as above whatever its separation; with
+    the most coherent pair's starts ranked beside it (:func:`_split_pairs`)."""
     theta, mu_f, mu_t, ev = best[:4]
     L = theta.shape[0]
     if L < 2:
@@ -288,7 +289,8 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool =
         if res.min() >= RESOLVE_Z and not flagged:
             return best, 0, False
         pairs = _split_pairs(prob, theta, mu_f, mu_t, sigma2, ev)
-        weaks, gain_min = [int(p[np.argmin(sig[p])]) for p in pairs], PAIR_GAIN * sigma2
+        weaks = list(dict.fromkeys(int(p[np.argmin(sig[p])]) for p in pairs))
+        gain_min = PAIR_GAIN * sigma2
     starts = []
     for weak in weaks:
         for l_ in np.argsort(-np.abs(ev["c"])):
@@ -307,13 +309,10 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool =
 
 
 def _split_pairs(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> list[np.ndarray]:
-    """The pairs :func:`_split_weak` takes apart, their starts ranked together by the likelihood:
-    the pair fewest standard deviations of its difference apart (the argmin of
-    :func:`~.resolution.separations`' pairwise distances), and the two most collinear atoms when
-    their coherence exceeds :data:`COUNTED_TWICE` and they are another pair. A path counted twice
-    (two atoms with large, cancelling gains) leaves the Fisher information so ill-conditioned
-    that an unrelated pair can read 0 sd apart too; the coherence still names the duplicate. Real
-    resolvable paths can be that coherent as well, so neither criterion alone decides."""
+    """The pairs :func:`_split_weak` takes apart: the closest in standard deviations of its
+    difference (:func:`~.resolution.closest_pair`) and, when another pair, the two atoms more
+    coherent than :data:`COUNTED_TWICE` (one path counted twice: its large, cancelling gains can
+    leave an unrelated pair 0 sd apart, and real paths can be that coherent too)."""
     a, b, _ = closest_pair(prob, theta, mu_f, mu_t, sigma2)
     out = [np.array([a, b])]
     i, j, coh = _coherent_pair(ev)

@@ -146,8 +146,7 @@ def separations(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> np.ndar
 
 def closest_pair(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> tuple[int, int, float]:
     """The two paths fewest standard deviations of their difference apart (the pairwise distances
-    of :func:`separations`): ``(i, j, z)`` with ``i < j``; ``(-1, -1, inf)`` for one path. The two
-    smallest per-path minima of :func:`separations` need not be one pair when minima tie."""
+    of :func:`separations`): ``(i, j, z)`` with ``i < j``; ``(-1, -1, inf)`` for one path."""
     theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
     L = theta.shape[0]
     if L < 2:

@@ -24,12 +24,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import boolean, sequence
+from ..._validate import boolean, integer, positive, real, sequence
 from .associate import Associator
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, VueCurvature
 from .motion import MirrorMotion
-from .noise import ConsiderNoise, KindNoise
+from .noise import ConsiderNoise, FixedNoise, KindNoise
 from .roles import JavelinDesign
 from .surfaces import GeometricBirth
 from .update import JointTestUpdater
@@ -39,6 +39,8 @@ __all__ = [
     "ARRAY_DESIGN_KNOWN_VUE_WALK",
     "ARRAY_DESIGN_UPDATE_ITERATIONS",
     "ARRAY_DESIGN_VUE_WALK",
+    "CORRELATED",
+    "MAX_CORRELATION",
     "MIN_KIND_MATCHED",
     "ML_ERRORS_SEED0",
     "ablation_path",
@@ -225,8 +227,43 @@ def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> Ja
 MIN_KIND_MATCHED = 30
 
 
+#: the largest lag-1 correlation :func:`design_from_errors` inflates by (a larger one is an
+#: error that hardly changes along the drive: a bias, which no white noise describes)
+MAX_CORRELATION = 0.9
+#: the quantities a ``correlation`` may name, in the order of the sigmas
+CORRELATED = ("phi", "psi", "kappa", "delta_d")
+
+
+def _inflation(correlation) -> np.ndarray:
+    """``sqrt((1 + r) / (1 - r))`` per quantity of :data:`CORRELATED` (1 where not given), ``r``
+    clipped to ``[0, MAX_CORRELATION]``."""
+    f = np.ones(len(CORRELATED))
+    if correlation is None:
+        return f
+    if not isinstance(correlation, dict):
+        raise TypeError(f"correlation: expected a dict quantity -> r, got {correlation!r:.60}")
+    unknown = set(correlation) - set(CORRELATED)
+    if unknown:
+        raise ValueError(f"correlation: unknown quantities {sorted(unknown)}; known {CORRELATED}")
+    for i, q in enumerate(CORRELATED):
+        r = correlation.get(q)
+        r = r.get("r") if isinstance(r, dict) else r
+        if r is None or (isinstance(r, float) and np.isnan(r)):
+            continue
+        r = float(real(f"correlation[{q!r}]", r))
+        if not -1.0 < r < 1.0:
+            raise ValueError(f"correlation[{q!r}]: a correlation lies in (-1, 1), got {r}")
+        r = min(max(r, 0.0), MAX_CORRELATION)
+        f[i] = np.sqrt((1.0 + r) / (1.0 - r))
+    return f
+
+
 def design_from_errors(
-    rows: list[list], base: JavelinDesign | None = None, *, per_kind: bool = False
+    rows: list[list],
+    base: JavelinDesign | None = None,
+    *,
+    per_kind: bool = False,
+    correlation: dict | None = None,
 ) -> JavelinDesign:
     """A design whose measurement noise is the measured extraction error: ``sigma_phi``,
     ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d`` from the ``"all"`` row of
@@ -235,7 +272,12 @@ def design_from_errors(
     :class:`~.noise.KindNoise` with each kind's own row (a kind of fewer than
     :data:`MIN_KIND_MATCHED` matched measurements, and a quantity a row leaves empty, keep the
     pooled sigma; no kind with enough: the pooled design); a path the route did not label keeps
-    the pooled sigmas."""
+    the pooled sigmas; ``base`` must have the paper's noise role (``FixedNoise()``), which this
+    replaces. ``correlation``: each quantity's lag-1 error correlation ``r``
+    (:func:`tunnelkit.studies.error_correlations`, ``{"phi", "psi", "kappa", "delta_d"}`` to
+    ``r`` or to ``{"r": r, ...}``): its sigma times ``sqrt((1 + r) / (1 - r))``, the long-run
+    standard deviation of an AR(1) error (what averaging over epochs leaves of it; ``r`` clipped
+    to ``[0, MAX_CORRELATION]``: a white model for a negative one, and a bias is not AR(1))."""
     base = ours_coherent() if base is None else base
     if not isinstance(base, JavelinDesign):
         raise TypeError(f"base: expected a JavelinDesign, got {type(base).__name__}")
@@ -244,17 +286,29 @@ def design_from_errors(
     pooled = table.get("all")
     if pooled is None:
         raise ValueError("rows: expected the table of extraction_errors (an 'all' row)")
+    f = _inflation(correlation)
     sig = [float(np.radians(pooled[2])), float(np.radians(pooled[3])), *map(float, pooled[4:6])]
+    sig = [float(v * fi) for v, fi in zip(sig, f, strict=True)]
     out = base.with_(sigma_phi=sig[0], sigma_psi=sig[1], sigma_kappa=sig[2], sigma_delta_d=sig[3])
     if not per_kind:
         return out
+    if base.noise != FixedNoise():
+        raise ValueError(
+            f"per_kind: replaces the noise role, and base's is {base.noise!r} (only the paper's "
+            "FixedNoise() has no more to it than its sigmas)"
+        )
     kinds = []
     for kind, r in table.items():
-        if kind == "all" or not isinstance(r[1], int | np.integer) or r[1] < MIN_KIND_MATCHED:
+        if kind == "all":
             continue
-        own = [np.radians(r[2]), np.radians(r[3]), r[4], r[5]]
-        own = [float(v) if v is not None and np.isfinite(v) and v > 0 else p
-               for v, p in zip(own, sig, strict=True)]  # fmt: skip
+        if not isinstance(kind, str) or not kind or len(r) < 6:
+            raise ValueError(f"rows: expected [kind, matched, phi, psi, kappa, dd, ...], got {r!r}")
+        n = integer(f"rows[{kind!r}] matched", r[1], minimum=0)
+        if n < MIN_KIND_MATCHED:
+            continue
+        own = [None if v is None else positive(f"rows[{kind!r}]", v) for v in r[2:6]]
+        own = [np.radians(own[0]), np.radians(own[1]), *own[2:]]  # None stays None
+        own = [float(v * fi) if v is not None else p for v, p, fi in zip(own, sig, f, strict=True)]
         kinds.append((kind, *own))
     return out.with_(noise=KindNoise(tuple(kinds))) if kinds else out
 

@@ -81,13 +81,15 @@ def _kinds(kind, n: int):
     """Checked ``kind``: ``None`` or one string per path, as an (n,) str array."""
     if kind is None:
         return None
-    if isinstance(kind, str | bytes) or not hasattr(kind, "__len__"):
-        raise TypeError(f"kind: expected one string per path, got {kind!r:.60}")
+    if not (isinstance(kind, list | tuple) or (isinstance(kind, np.ndarray) and kind.ndim == 1)):
+        raise TypeError(f"kind: expected a list of one string per path, got {kind!r:.60}")
     if len(kind) != n:
         raise ValueError(f"kind: expected {n} values (one per path), got {len(kind)}")
     if not all(isinstance(k, str | np.str_) for k in kind):
         raise TypeError(f"kind: expected one string per path, got {list(kind)!r:.80}")
-    return np.array([str(k) for k in kind], dtype=object).astype(str) if n else np.zeros(0, str)
+    out = np.empty(n, dtype=object)  # one dtype whatever the strings' lengths
+    out[:] = [str(k) for k in kind]
+    return out
 
 
 def _bias(bias_cov, cov, sigma_d, n: int):

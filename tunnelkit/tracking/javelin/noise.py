@@ -97,7 +97,7 @@ class KindNoise:
             if not r[0] or r[0] in seen:
                 raise ValueError(f"sigmas: kinds must be non-empty and distinct, got {r[0]!r}")
             seen.add(r[0])
-            out.append((r[0], *(positive(f"sigmas[{r[0]!r}]", float(v)) for v in r[1:])))
+            out.append((r[0], *(float(positive(f"sigmas[{r[0]!r}]", v)) for v in r[1:])))
         object.__setattr__(self, "sigmas", tuple(out))
 
     def _per_path(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
