@@ -10,7 +10,8 @@ the traced column's measurements from the same tensors) and scored in every colu
 (``javelin_tables._simulate_and_score``) does; the result and the drives (tensors are not kept)
 go to ``DIR/<table>-seed<S>/drive<i>.pkl``. ``--conditions L`` runs only the drives of those
 conditions (their rows equal the full table's: same drive indices); ``--report`` assembles the
-table from the whole runs saved so far. Runs are interleaved over the tables and seeds given
+table from the whole runs saved so far; ``--rescore OUT`` scores the saved drives again with the
+current designs (e.g. after the traced record changed) into ``OUT``. Runs are interleaved over the tables and seeds given
 (run 0 of each, then run 1, ...), so a cut-off leaves them with equal counts.
 
     nice python benchmarks/bench_rt_javelin.py --tables 1 2 --seeds 0 20261202 --conditions L \
@@ -94,6 +95,32 @@ def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None) -> None:
                     )
 
 
+def rescore(tables, seeds, conditions, src: Path, out: Path) -> None:
+    """Every drive saved in ``src`` scored again with the current designs (the traced design
+    reads the stored record now), no drive simulated again; written to ``out`` in the same
+    layout, so ``--report --dir OUT`` tables them."""
+    routes = jt._traced_routes(EXTRACTIONS, "sionna")
+    cols = jt.table_columns(routes)
+    for t in tables:
+        conds = TABLES[t][2]
+        for s in seeds:
+            d_in, d_out = src / f"table{t}-seed{s}", out / f"table{t}-seed{s}"
+            d_out.mkdir(parents=True, exist_ok=True)
+            for f in sorted(d_in.glob("drive*.pkl")):
+                i = int(f.stem.removeprefix("drive"))
+                cond = conds[i % len(conds)]
+                if cond not in conditions:
+                    continue
+                saved = pickle.loads(f.read_bytes())
+                drives = saved["drives"]
+                with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    scores = jt.score_drive({e: drives[e] for e in routes}, cond, cols)
+                res = (cond, (scores, saved["result"][1][1]))
+                (d_out / f.name).write_bytes(pickle.dumps({"result": res, "drives": drives}))
+                print(f"table {t} seed {s} drive {i} ({cond}) rescored", flush=True)
+
+
 def report(table: str, seed: int, conditions, out: Path, fmt: str = "text") -> str:
     scenario, ref, conds = TABLES[table]
     conds = tuple(c for c in conds if c in conditions)
@@ -122,10 +149,14 @@ if __name__ == "__main__":
     ap.add_argument("--n-epochs", type=int, default=None)
     ap.add_argument("--dir", default="rt_javelin")
     ap.add_argument("--report", action="store_true")
+    ap.add_argument("--rescore", metavar="OUT", default=None,
+                    help="score the drives saved in --dir again with the current designs, into OUT")  # fmt: skip
     ap.add_argument("--format", default="text", choices=("text", "json"))
     a = ap.parse_args()
     out = Path(a.dir)
-    if a.report:
+    if a.rescore:
+        rescore(a.tables, a.seeds, a.conditions, out, Path(a.rescore))
+    elif a.report:
         for t in a.tables:
             for s in a.seeds:
                 print(report(t, s, a.conditions, out, a.format))

@@ -99,10 +99,20 @@ def test_the_tracker_is_told_the_measured_errors(setup):
     d = traced.traced_javelin(setup, "4x4", rec)
     row = {r[0]: r for r in rec["rows"]}["all"]
     assert isinstance(d.noise, FixedNoise)
-    assert d.config.sigma_phi == pytest.approx(np.radians(row[2]))
-    assert d.config.sigma_psi == pytest.approx(np.radians(row[3]))
-    assert d.config.sigma_kappa == pytest.approx(row[4])
-    assert d.config.sigma_delta_d == pytest.approx(row[5])
+
+    def f(q):  # the long-run inflation of the record's lag-1 correlation (1 without one)
+        r = rec.get("correlation", {}).get(q, {}).get("r", np.nan)
+        r = 0.0 if not np.isfinite(r) else min(max(r, 0.0), 0.9)
+        return np.sqrt((1 + r) / (1 - r))
+
+    assert set(rec["correlation"]) == {"phi", "psi", "kappa", "delta_d"}
+    assert d.config.sigma_phi == pytest.approx(np.radians(row[2]) * f("phi"))
+    assert d.config.sigma_psi == pytest.approx(np.radians(row[3]) * f("psi"))
+    assert d.config.sigma_kappa == pytest.approx(row[4] * f("kappa"))
+    assert d.config.sigma_delta_d == pytest.approx(row[5] * f("delta_d"))
+    # a record without the correlation (the shipped ones): the RMS as it is
+    bare = traced.traced_javelin(setup, "4x4", {k: v for k, v in rec.items() if k != "correlation"})
+    assert bare.config.sigma_phi == pytest.approx(np.radians(row[2]))
     s = traced.error_model_summary(rec)
     assert s["kind"] == "traced-measured" and s["sigmas"]["kappa_m"] == pytest.approx(row[4])
     assert traced.error_model_summary(None) == {"kind": "reported-crlb"}

@@ -149,7 +149,7 @@ def measure_design_errors(
     import time
 
     from ..montecarlo import run_trials
-    from ..studies.analysis import extraction_errors
+    from ..studies.analysis import error_correlations, extraction_errors
 
     setup = _setup(setup)
     spec = parse_array(spec)
@@ -165,6 +165,7 @@ def measure_design_errors(
         progress=progress, desc=f"traced errors {spec.label}",
     )  # fmt: skip
     cols, rows = extraction_errors(drives)
+    corr = error_correlations(drives)
     return {
         **_provenance(setup, spec, n_epochs),
         "seed": seed,
@@ -172,6 +173,7 @@ def measure_design_errors(
         "wall_s": round(time.perf_counter() - t0, 1),
         "columns": list(cols),
         "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
+        "correlation": corr,
     }
 
 
@@ -275,8 +277,10 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     """The design's tracker (:func:`~tunnelkit.design.montecarlo.javelin_config`: VUEs from the
     known surfaces, likelihood association, joint innovation test) with the measurement noise of
     ``record`` (:func:`design_errors`): fixed sigmas (the ``"all"`` row:
-    :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`) in place of each path's
-    reported CRLB, which on this channel is thousands of times too small."""
+    :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`, at their long-run value when
+    the record carries the errors' lag-1 correlation; the shipped records predate it and do
+    not) in place of each path's reported CRLB, which on this channel is thousands of times too
+    small."""
     from ..tracking.javelin.designs import array_design, design_from_errors
     from .geometry import KINDS
 
@@ -294,13 +298,15 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     planes = [f.plane for f in setup.tunnel.surfaces if f.kind in KINDS]
     base = array_design(crlb, setup.signal_route(spec).min_d, planes)
     base = base.with_(noise=base.noise.fallback)
-    return design_from_errors(record["rows"], base=base)
+    return design_from_errors(record["rows"], base=base, correlation=record.get("correlation"))
 
 
 def error_model_summary(record: dict | None) -> dict:
     """What the report's JSON says about an array's measurement-noise model: ``{"kind":
     "reported-crlb"}`` (``record`` None: each path's reported CRLB, the image channel's), or the
-    traced record's ``kind`` "traced-measured", sigmas, seed, runs, file and scene key."""
+    traced record's ``kind`` "traced-measured", sigmas (the RMS errors), the errors' lag-1
+    correlation (the tracker's sigmas are the RMS times ``sqrt((1 + r) / (1 - r))``; None for a
+    record without it), seed, runs, file and scene key."""
     if record is None:
         return {"kind": "reported-crlb"}
     if not isinstance(record, dict) or "rows" not in record:
@@ -308,6 +314,7 @@ def error_model_summary(record: dict | None) -> dict:
     return {
         "kind": "traced-measured",
         "sigmas": _sigmas(record),
+        "correlation": record.get("correlation"),
         "seed": record.get("seed"),
         "runs": record.get("runs"),
         "n_epochs": record.get("n_epochs"),

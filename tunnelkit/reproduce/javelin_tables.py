@@ -357,6 +357,8 @@ def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
 
     rec = traced_errors()
     a = {r[0]: r for r in rec["rows"]}["all"]
+    corr = rec.get("correlation") or {}
+    r_txt = ", ".join(f"{q} {v['r']:.2f}" for q, v in corr.items() if np.isfinite(v["r"]))
     same = dict(nuisance or {}) == rec["nuisance"]
     mine, theirs = (rt_info or {}).get("rt_settings"), rec.get("rt_settings") or {}
     other = sorted(k for k in mine or {} if mine[k] != theirs.get(k))
@@ -367,7 +369,14 @@ def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
         f"{rec['condition']}, seed {rec['seed']}, {rec['runs']} runs: "
         "studies.traced.measure_traced_errors on children 0.."
         f"{rec['runs'] - 1} of seed {rec['seed']}, stored in data/rt/traced_errors.json; Table 1's "
-        "JAVELIN-L run 0 at that seed is child 0, one of those drives), fed every epoch's ML "
+        "JAVELIN-L run 0 at that seed is child 0, one of those drives)"
+        + (
+            f", each sigma times sqrt((1 + r) / (1 - r)) for the lag-1 correlation r of one "
+            f"path's errors from epoch to epoch ({r_txt}; studies.error_correlations)"
+            if r_txt
+            else ""
+        )
+        + ", fed every epoch's ML "
         "measurements "
         "(the fit's own test ignored) that the geometry-consistency test keeps "
         f"(path_consistency.epoch_consistency, floors {np.degrees(FLOORS[0]):.2g} deg and "
