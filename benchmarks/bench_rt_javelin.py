@@ -48,19 +48,26 @@ EXTRACTIONS = ("paper", "ml")
 NUISANCE = {"diffuse_floor": True}
 
 
+def _score(drives: dict, cond: str) -> dict:
+    """One drive's routes scored in every column of the traced table (one BLAS thread)."""
+    routes = jt._traced_routes(EXTRACTIONS, "sionna")
+    with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return jt.score_drive({e: drives[e] for e in routes}, cond, jt.table_columns(routes))
+
+
 def drive(table: str, seed: int, i: int, n_epochs: int | None = None):
     """Drive ``i`` of ``table`` at ``seed``: ``((cond, (scores, faults)), drives)``."""
     scenario, _, conds = TABLES[table]
     rng = spawn_rngs(seed, i + 1)[i]
     cond = conds[i % len(conds)]
     routes = jt._traced_routes(EXTRACTIONS, "sionna")
-    cols = jt.table_columns(routes)
     with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         drives = simulate_traced(
             scenario, rng, condition=cond, n_epochs=n_epochs, channel="sionna", nuisance=NUISANCE
         )
-        scores = jt.score_drive({e: drives[e] for e in routes}, cond, cols)
+    scores = _score(drives, cond)
     faults = {
         e: (len(drives[e].faults), sum(f.endswith(FLAGGED) for f in drives[e].faults),
             len(drives[e].t))
@@ -99,8 +106,6 @@ def rescore(tables, seeds, conditions, src: Path, out: Path) -> None:
     """Every drive saved in ``src`` scored again with the current designs (the traced design
     reads the stored record now), no drive simulated again; written to ``out`` in the same
     layout, so ``--report --dir OUT`` tables them."""
-    routes = jt._traced_routes(EXTRACTIONS, "sionna")
-    cols = jt.table_columns(routes)
     for t in tables:
         conds = TABLES[t][2]
         for s in seeds:
@@ -112,12 +117,9 @@ def rescore(tables, seeds, conditions, src: Path, out: Path) -> None:
                 if cond not in conditions:
                     continue
                 saved = pickle.loads(f.read_bytes())
-                drives = saved["drives"]
-                with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    scores = jt.score_drive({e: drives[e] for e in routes}, cond, cols)
-                res = (cond, (scores, saved["result"][1][1]))
-                (d_out / f.name).write_bytes(pickle.dumps({"result": res, "drives": drives}))
+                res = (cond, (_score(saved["drives"], cond), saved["result"][1][1]))
+                saved = {"result": res, "drives": saved["drives"]}
+                (d_out / f.name).write_bytes(pickle.dumps(saved))
                 print(f"table {t} seed {s} drive {i} ({cond}) rescored", flush=True)
 
 

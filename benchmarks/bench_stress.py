@@ -392,8 +392,7 @@ def table(rows: list) -> str:
         + f" {'good flagged':>12s} {'unflagged>6sig':>14s} {'median s':>8s}"
     )
     lines = [head]
-    meets: dict = {}
-    missed: dict = {}
+    missed: dict = {}  # per SNR offset, the drive cases missing the goal
     for r in rows:
         e = r["errors"]
         fin = np.all(np.isfinite(e), axis=1)
@@ -414,10 +413,9 @@ def table(rows: list) -> str:
             # the estimate's own verdict only (no truth): the paths it reports unresolved are
             # judged in merged_table, every other path of every snapshot here
             keep = ~r.get("pair", np.zeros(len(e), bool))
-            ok = _meets_goal(e[keep])
-            meets[r["offset"]] = meets.get(r["offset"], True) and ok
-            if not ok:
-                missed.setdefault(r["offset"], []).append(r["case"])
+            missed.setdefault(r["offset"], [])
+            if not _meets_goal(e[keep]):
+                missed[r["offset"]].append(r["case"])
     allbad = np.concatenate([r["bad"] for r in rows])
     allfl = np.concatenate([r["flagged"] for r in rows])
     lines.append(
@@ -436,7 +434,8 @@ def table(rows: list) -> str:
             for k in why.split(", ") if f else ():
                 reasons[k] = reasons.get(k, 0) + 1
     lines.append("flag reasons: " + (", ".join(f"{k} {v}" for k, v in reasons.items()) or "none"))
-    if meets:
+    if missed:
+        meets = {o: not c for o, c in missed.items()}
         passing = [o for o in sorted(meets) if all(meets[p] for p in meets if p >= o)]
         lines.append(
             "threshold SNR: every drive case meets the goal (<= 2 % beyond 6 sigma, RMS <= 1.5) "
@@ -450,8 +449,9 @@ def table(rows: list) -> str:
             + ")"
         )
         # drive and range band (the case name without its offset) missing at every offset
-        bands = [{c.rsplit(" ", 2)[0] for c in missed.get(o, [])} for o in sorted(meets)]
-        always = sorted(set.intersection(*bands)) if bands else []
+        always = sorted(
+            set.intersection(*({c.rsplit(" ", 2)[0] for c in v} for v in missed.values()))
+        )
         if always:
             lines.append(
                 f"  ({', '.join(always)}: the goal missed at every offset tried, a range threshold "

@@ -146,6 +146,12 @@ def test_design_from_errors_per_kind():
     assert got["los"] == pytest.approx((np.radians(2.0), np.radians(2.5), 40.0, 0.2))
     # no curvature measured on the road: the pooled sigma
     assert got["road"] == pytest.approx((np.radians(13.0), np.radians(16.0), 33.0, 1.6))
+    no_psi = [["los", 80, 2.0, None, 40.0, 0.2, 3], rows[-1]]  # an empty angle: the pooled one
+    got = {
+        r[0]: r[1:]
+        for r in designs.design_from_errors(no_psi, base=base, per_kind=True).noise.sigmas
+    }
+    assert got["los"] == pytest.approx((np.radians(2.0), np.radians(8.0), 40.0, 0.2))
     few = [r if r[0] != "los" else [*r[:1], 5, *r[2:]] for r in rows if r[0] != "road"]
     assert designs.design_from_errors(few, base=base, per_kind=True) == pooled
     with pytest.raises(TypeError, match="per_kind"):

@@ -210,8 +210,9 @@ def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
     return cols, rows
 
 
-#: the quantities of :func:`error_correlations` (the columns of :func:`extraction_errors`)
-ERROR_QUANTITIES = ("phi", "psi", "kappa", "delta_d")
+#: the quantities of :func:`error_correlations` (the columns of :func:`extraction_errors`; the
+#: names ``design_from_errors(correlation=)`` reads)
+ERROR_QUANTITIES = designs.CORRELATED
 
 
 def error_correlations(drives: list[DriveData]) -> dict[str, dict[str, float]]:

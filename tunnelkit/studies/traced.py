@@ -151,9 +151,9 @@ def traced_measurements(
     rows = np.flatnonzero(np.isin(pm.source, keep))
     if not rows.size:
         return None, "the geometry test kept no path"
-    label = dict(zip(keep.tolist(), kinds.tolist(), strict=True))
-    sub = pm.subset(rows)
-    return sub.with_kinds([label[int(i)] for i in sub.source]), None
+    label = np.full(len(m), "", dtype=object)
+    label[keep] = kinds
+    return pm.with_kinds(list(label[pm.source])).subset(rows), None
 
 
 def simulate_traced(

@@ -306,9 +306,9 @@ def design_from_errors(
         n = integer(f"rows[{kind!r}] matched", r[1], minimum=0)
         if n < MIN_KIND_MATCHED:
             continue
-        own = [None if v is None else positive(f"rows[{kind!r}]", v) for v in r[2:6]]
-        own = [np.radians(own[0]), np.radians(own[1]), *own[2:]]  # None stays None
-        own = [float(v * fi) if v is not None else p for v, p, fi in zip(own, sig, f, strict=True)]
+        unit = (np.radians(1.0), np.radians(1.0), 1.0, 1.0)  # the rows' angles are in degrees
+        own = [p if v is None else float(positive(f"rows[{kind!r}]", v) * u * fi)
+               for v, u, p, fi in zip(r[2:6], unit, sig, f, strict=True)]  # fmt: skip
         kinds.append((kind, *own))
     return out.with_(noise=KindNoise(tuple(kinds))) if kinds else out
 
