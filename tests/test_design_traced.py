@@ -139,6 +139,51 @@ def test_the_sweep_and_report_name_the_error_model(setup):
     assert "channel" not in img["inputs"] and "error_model" not in img["arrays"][0]
 
 
+def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
+    """traced_bounds: the model has one diagonal block of the sigmas per existing path and no
+    bias; the bound grows with the sigmas, tends to dead reckoning's (no radio) for huge ones,
+    and learning the VUEs can only lose information."""
+    from tunnelkit.design import drive_pcrlb
+    from tunnelkit.tracking.javelin.designs import ours_coherent
+
+    sig = {"phi": 0.05, "psi": 0.04, "kappa": 20.0, "d": 0.5}
+    m, g = traced.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6))
+    k, p = np.argwhere(m.exists)[0]
+    block = m.cov[k, 4 * p : 4 * p + 4, 4 * p : 4 * p + 4]
+    np.testing.assert_allclose(block, np.diag([0.05**2, 0.04**2, 400.0, 0.25]))
+    ex4 = np.repeat(m.exists, 4, axis=1)
+    assert np.all(np.isnan(m.cov[~(ex4[:, :, None] & ex4[:, None, :])]))
+    assert np.all(m.bias[m.exists] == 0)
+
+    def cfg(scale):
+        return ours_coherent().with_(
+            sigma_phi=0.05 * scale, sigma_psi=0.04 * scale, sigma_kappa=20.0 * scale,
+            sigma_delta_d=0.5 * scale,
+        ).config  # fmt: skip
+
+    T = 6
+    pc1, dr1, le1 = traced.traced_bounds(setup, "4x4", cfg(1.0), T)
+    pc3, _, _ = traced.traced_bounds(setup, "4x4", cfg(3.0), T)
+    pch, _, _ = traced.traced_bounds(setup, "4x4", cfg(1e6), T)
+    assert pc1.shape == (T,) and np.all(pc3 > pc1)
+    np.testing.assert_allclose(dr1, pc1)  # no bias: the drive bound is the PCRLB
+    assert np.all(le1 >= pc1 * (1 - 1e-9))
+    none = drive_pcrlb(setup, np.zeros((T, 2, 2)))
+    np.testing.assert_allclose(pch, none, rtol=1e-6)
+    assert np.all(pc1 < none)
+
+
+def test_the_sweep_reports_the_bound_of_the_told_sigmas(setup):
+    rep = design.design_sweep(setup, ["4x4"], runs=2, seed=0, mode="channel", n_epochs=3)
+    row, rec = rep.rows[0], traced.design_errors(setup, "4x4", n_epochs=3)
+    d = traced.traced_javelin(setup, "4x4", rec)
+    _, drive, learned = traced.traced_bounds(setup, "4x4", d.config, 3)
+    k = design.counted_epochs(setup.trajectory.t[:3])
+    assert row.drive_bound_known_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
+    assert row.drive_bound_learned_rms_m == pytest.approx(np.sqrt(np.mean(learned[k] ** 2)))
+    assert row.rmse_over_tracker_bound == pytest.approx(row.rmse_m / row.drive_bound_known_rms_m)
+
+
 def test_bad_input(setup):
     image = design.DesignSetup.from_scenario(SCENARIO)
     with pytest.raises(ValueError, match="setup"):
@@ -153,6 +198,15 @@ def test_bad_input(setup):
         traced.traced_drive(traced.traced_route(setup, "4x4"), 3)
     with pytest.raises(ValueError, match="route"):
         traced.traced_drive(image.signal_route("4x4"), np.random.default_rng(0))
+    cfg = traced.traced_javelin(setup, "4x4", {"rows": [["all", 1, 9.0, 8.0, 30.0, 1.0, 0]]}).config
+    with pytest.raises(ValueError, match="sigmas"):
+        traced.sigma_error_model(setup, "4x4", {"phi": 0.1, "psi": 0.1, "kappa": 1.0})
+    with pytest.raises(ValueError, match="sigmas"):
+        traced.sigma_error_model(setup, "4x4", {"phi": 0.0, "psi": 0.1, "kappa": 1.0, "d": 1.0})
+    with pytest.raises(TypeError, match="config"):
+        traced.traced_bounds(setup, "4x4", {"sigma_phi": 0.1}, 2)
+    with pytest.raises(ValueError, match="T"):
+        traced.traced_bounds(setup, "4x4", cfg, 0)
     imp = design.DesignImpairments(phase_error_deg=0.5)
     with pytest.raises(ValueError, match="impairments"):
         design.sweep_montecarlo(setup, ["4x4"], 1, 0, mode="channel", impairments=imp, n_epochs=1)

@@ -127,7 +127,9 @@ class MonteCarloResult:
     (:func:`tunnelkit.metrics.settled`); ``mode`` the measurement route; ``peb`` (T,) [m] the
     snapshot PEB; ``pcrlb`` (T,) [m] the posterior CRLB of the 2-D position over the drive,
     from the ideal per-path CRLB (under impairments the ideal posterior bound, not an achievable one)
-    (``None`` on the channel route without a model); ``sigmas`` the tracker's fallback sigmas;
+    (``None`` on the channel route without a model; on the ray-traced channel's route ``pcrlb``,
+    ``drive`` and ``learned`` are those of the sigmas the tracker is told,
+    :func:`tunnelkit.design.traced.traced_bounds`); ``sigmas`` the tracker's fallback sigmas;
     ``drive`` (T,) [m] the achievable bound over the drive (:func:`drive_bound`: the posterior
     CRLB with the bias that does not average down; equal to ``pcrlb`` for an ideal model), the
     surfaces known; ``learned`` (T,) [m] the same for a tracker that learns its VUEs
@@ -343,11 +345,13 @@ class _ArrayJob:
         budget = channel_route_budget(self.setup, spec, imp)
         error_model = None
         if self.mode == "channel" and self.setup.channel == "sionna":
-            from .traced import design_errors, error_model_summary, traced_javelin
+            from .traced import design_errors, error_model_summary, traced_bounds, traced_javelin
 
             # this array's errors on the traced channel (cached with their provenance)
             rec = design_errors(self.setup, spec, n_epochs=self.T)
             design, error_model = traced_javelin(self.setup, spec, rec), error_model_summary(rec)
+            # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
+            pc, drive, learned = traced_bounds(self.setup, spec, design.config, self.T)
         return _Prepared(spec, route, design, peb, pc, drive, learned, budget, error_model)
 
 

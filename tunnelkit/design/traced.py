@@ -24,7 +24,10 @@ only. The traced route changes the same two things the traced JAVELIN tables cha
   association, joint innovation test) with fixed per-quantity sigmas set to those errors.
 
 The report's JSON names the error model each array's traced route used
-(:func:`error_model_summary`).
+(:func:`error_model_summary`). Its bounds over the drive are those of the sigmas the tracker is
+told (:func:`traced_bounds`: every first-order path measured at every epoch with independent
+Gaussian errors of those sigmas), not the image channel's micrometre CRLBs: what such
+measurements allow a tracker, beside what it achieves.
 """
 
 from __future__ import annotations
@@ -47,6 +50,8 @@ __all__ = [
     "design_errors_path",
     "error_model_summary",
     "measure_design_errors",
+    "sigma_error_model",
+    "traced_bounds",
     "traced_drive",
     "traced_javelin",
     "traced_route",
@@ -322,3 +327,63 @@ def error_model_summary(record: dict | None) -> dict:
         "path": record.get("path"),
         "rt_key": record.get("rt_key"),
     }
+
+
+def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
+    """A :class:`~tunnelkit.design.errormodel.PathErrorModel` of ``spec``'s route (``epochs``:
+    indices that subsample it, as :func:`~tunnelkit.design.bounds.route_geometry`) in which every
+    first-order path the image method traces is measured at every epoch with independent
+    zero-mean Gaussian errors of ``sigmas`` (``{"phi", "psi"}`` [rad], ``{"kappa", "d"}`` [m],
+    each > 0): no bias, no calibration term, the truth and radial speed zero (the bounds over the
+    drive use only the geometry's Jacobians and the covariance). Any channel: the geometry is
+    the image method's. Returns ``(model, geometry)``."""
+    from .bounds import route_geometry
+    from .errormodel import PathErrorModel
+
+    instance("setup", setup, DesignSetup)
+    spec = parse_array(spec)
+    if not isinstance(sigmas, dict) or set(sigmas) != {"phi", "psi", "kappa", "d"}:
+        raise ValueError(f"sigmas: expected {{'phi', 'psi', 'kappa', 'd'}} to a sigma, got {sigmas!r}")
+    sig = np.array([sigmas[k] for k in ("phi", "psi", "kappa", "d")], dtype=float)
+    if not np.all(np.isfinite(sig) & (sig > 0)):
+        raise ValueError(f"sigmas: each must be finite and > 0, got {sigmas!r}")
+    g = route_geometry(setup, spec, epochs=epochs)
+    T, P = g.exists.shape
+    ex4 = np.repeat(g.exists, 4, axis=1)
+    cov = np.where(ex4[:, :, None] & ex4[:, None, :], np.kron(np.eye(P), np.diag(sig**2)), np.nan)
+    zero = np.where(g.exists[..., None], 0.0, np.nan) * np.ones((T, P, 4))
+    t = setup.trajectory.t if epochs is None else setup.trajectory.t[np.asarray(epochs)]
+    model = PathErrorModel(
+        t=np.asarray(t, float)[:T], exists=g.exists, kinds=g.kinds, truth=zero,
+        v=np.where(g.exists, 0.0, np.nan), crlb=cov, cov=cov, bias=zero,
+    )  # fmt: skip
+    return model, g
+
+
+def traced_bounds(setup: DesignSetup, spec, config, T: int | None = None) -> tuple:
+    """The bounds over the first ``T`` epochs of ``spec``'s drive (default all) of a tracker
+    told the sigmas of ``config`` (a :class:`~tunnelkit.tracking.javelin.JavelinConfig`:
+    ``sigma_phi``, ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d``; the traced design's,
+    :func:`traced_javelin`), every first-order path measured with independent Gaussian errors of
+    those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive, learned)`` (T,) [m] as the design's
+    Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` with the design's
+    1 m start, ``drive`` the same with no bias, ``learned`` for a tracker that learns its VUEs,
+    :func:`~tunnelkit.design.learnedbound.learned_pcrlb`). What the told sigmas allow: the traced
+    errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
+    from .drivebound import drive_bound, drive_pcrlb, position_information
+    from .learnedbound import learned_pcrlb
+
+    instance("setup", setup, DesignSetup)
+    spec = parse_array(spec)
+    n = len(setup.trajectory)
+    T = n if T is None else min(integer("T", T, minimum=1), n)
+    try:
+        sig = {k: float(getattr(config, a)) for k, a in (("phi", "sigma_phi"), ("psi", "sigma_psi"),
+               ("kappa", "sigma_kappa"), ("d", "sigma_delta_d"))}  # fmt: skip
+    except (AttributeError, TypeError, ValueError):
+        raise TypeError(f"config: expected a JavelinConfig, got {type(config).__name__}") from None
+    model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
+    pc = drive_pcrlb(setup, position_information(model, g))
+    drive = drive_bound(pc, np.zeros_like(pc))
+    learned = drive_bound(*learned_pcrlb(model, g, setup))
+    return pc, drive, learned

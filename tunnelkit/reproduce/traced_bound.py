@@ -37,9 +37,9 @@ def traced_pcrlb(
     A bound for a tracker told the reflectors; the traced errors are neither Gaussian nor
     independent between epochs (repeating biases of the bounces), so it is what the sigmas
     alone allow, not a bound on what the channel allows."""
-    from ..design import DesignSetup, drive_pcrlb, position_information, route_geometry
-    from ..design.errormodel import PathErrorModel
+    from ..design import DesignSetup, drive_pcrlb, position_information
     from ..design.setup import parse_array
+    from ..design.traced import sigma_error_model
 
     if not isinstance(scenario, str) or not scenario:
         raise TypeError(f"scenario: expected a preset name, got {scenario!r}")
@@ -61,13 +61,5 @@ def traced_pcrlb(
     except ValueError as exc:
         raise ValueError(f"array: {exc}") from None
     setup = DesignSetup.from_scenario(scenario)
-    g = route_geometry(setup, spec)
-    T, P = g.exists.shape
-    ex4 = np.repeat(g.exists, 4, axis=1)
-    cov = np.where(ex4[:, :, None] & ex4[:, None, :], np.kron(np.eye(P), np.diag(sig**2)), np.nan)
-    zero = np.where(g.exists[..., None], 0.0, np.nan) * np.ones((T, P, 4))
-    model = PathErrorModel(
-        t=setup.trajectory.t[:T], exists=g.exists, kinds=g.kinds, truth=zero,
-        v=np.where(g.exists, 0.0, np.nan), crlb=cov, cov=cov, bias=zero,
-    )  # fmt: skip
+    model, g = sigma_error_model(setup, spec, dict(zip(("phi", "psi", "kappa", "d"), sig)))
     return drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
