@@ -192,6 +192,34 @@ def test_sweep_bad_input_is_refused_by_name(setup):
         sweep_montecarlo(setup, ["4x4"], 0, 0)
     with pytest.raises(TypeError, match="setup"):
         sweep_montecarlo("x", ["4x4"], 2, 0)
+    for bad in (0.0, -1.0, np.inf, np.nan):
+        with pytest.raises(ValueError, match="start_sigma"):
+            sweep_montecarlo(setup, ["4x4"], 2, 0, start_sigma=bad)
+
+
+def test_the_entry_fix_sets_the_trackers_start_and_the_bounds_prior(setup):
+    """start_sigma: the drawn start's spread and the prior of the bounds over the drive; the
+    report's inputs carry it only when it is not the default (the default's JSON as before)."""
+    from tunnelkit.design import design_sweep
+    from tunnelkit.design.montecarlo import START_SIGMA_M
+
+    kw = {"mode": "bound", "n_epochs": 8}
+    wide = sweep_montecarlo(setup, ["4x4"], 6, 11, **kw)["4x4"]
+    fine = sweep_montecarlo(setup, ["4x4"], 6, 11, start_sigma=0.01, **kw)["4x4"]
+    assert START_SIGMA_M == 1.0
+    # at the first epoch the bound and the tracker's error still carry the start: both shrink
+    # with the entry fix (here by about 10x), and the bound never grows with a better one
+    assert fine.drive[0] < wide.drive[0] / 5
+    assert np.median(fine.errors[:, 0]) < np.median(wide.errors[:, 0]) / 5
+    assert np.all(fine.pcrlb <= wide.pcrlb * (1 + 1e-9))
+    rep = design_sweep(setup, ["4x4"], runs=2, n_epochs=8, start_sigma=0.01)
+    assert rep.to_json()["inputs"]["start_sigma_m"] == 0.01
+    assert "entry fix 0.01 m per axis" in rep.to_table()
+    assert (
+        "start_sigma_m" not in design_sweep(setup, ["4x4"], runs=2, n_epochs=8).to_json()["inputs"]
+    )
+    with pytest.raises(ValueError, match="start_sigma"):
+        design_sweep(setup, ["4x4"], runs=2, n_epochs=8, start_sigma=0.0)
 
 
 def test_a_prepared_route_gives_the_same_drive_and_is_checked(setup):

@@ -147,7 +147,7 @@ def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
     from tunnelkit.tracking.javelin.designs import ours_coherent
 
     sig = {"phi": 0.05, "psi": 0.04, "kappa": 20.0, "d": 0.5}
-    m, g = traced.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6))
+    m, _ = traced.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6))
     k, p = np.argwhere(m.exists)[0]
     block = m.cov[k, 4 * p : 4 * p + 4, 4 * p : 4 * p + 4]
     np.testing.assert_allclose(block, np.diag([0.05**2, 0.04**2, 400.0, 0.25]))

@@ -2,7 +2,8 @@
 [--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--wideband-model]
 [--dmc-share S]
 [--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--confirm [--confirm-runs N]] [--format table|json]``.
+[--criterion achievable|srnf] [--confirm [--confirm-runs N]] [--channel image|sionna]
+[--start-sigma S] [--format table|json]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
 the ideal position error bound, the achievable bound under the stated impairments, SR-NF validity
@@ -42,8 +43,8 @@ def _frequency(param: str):
             raise argparse.ArgumentTypeError(
                 f"{param}: cannot read {text!r} (e.g. 28GHz, 400MHz, 5.9e9)"
             ) from None
-        if not value > 0:
-            raise argparse.ArgumentTypeError(f"{param}: must be > 0, got {text!r}")
+        if not 0 < value < float("inf"):
+            raise argparse.ArgumentTypeError(f"{param}: must be > 0 and finite, got {text!r}")
         return value
 
     return parse
@@ -55,8 +56,8 @@ def _positive(param: str):
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{param}: expected a number, got {text!r}") from None
-        if not value > 0:
-            raise argparse.ArgumentTypeError(f"{param}: must be > 0, got {text!r}")
+        if not 0 < value < float("inf"):
+            raise argparse.ArgumentTypeError(f"{param}: must be > 0 and finite, got {text!r}")
         return value
 
     return parse
@@ -196,6 +197,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--n-epochs", type=_count("n_epochs", 1), default=None, help="first N epochs of the route"
     )
     p.add_argument("--seed", type=_count("seed", 0), default=0, help="Monte-Carlo seed (0)")
+    p.add_argument(
+        "--start-sigma",
+        type=_positive("start_sigma"),
+        default=None,
+        help="the entry fix's standard deviation per axis [m]: the tracker's start and the prior "
+        "of the bounds over the drive (default 1, an open-sky fix)",
+    )
     from .reproduce import add_parallel_arguments
 
     add_parallel_arguments(p)
@@ -260,6 +268,7 @@ def main(args: argparse.Namespace) -> int:
             seed=args.seed,
             mode=args.mode,
             n_epochs=args.n_epochs,
+            **({} if args.start_sigma is None else {"start_sigma": args.start_sigma}),
             **parallel_kwargs(args),
             progress=args.runs > 0 and args.format == "table" and not args.no_progress,
         )

@@ -166,6 +166,7 @@ def confirm_on_channel(
             timeout=timeout,
             progress=progress,
             n_epochs=s["n_epochs"],
+            **({"start_sigma": s["start_sigma_m"]} if "start_sigma_m" in s else {}),
         )
         for a in labels:
             row = copy.deepcopy(by[a])

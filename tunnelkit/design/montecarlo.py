@@ -51,7 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._checks import bound_array
-from .._validate import choice, instance, integer, record
+from .._validate import choice, instance, integer, positive, record
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import TrialPool, run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
@@ -209,6 +209,7 @@ class _SweepTrial:
     n_epochs: int | None
     impairments: object = None  # achievable.DesignImpairments: the channel mode's
     start: str = "drawn"
+    start_sigma: float = START_SIGMA_M
 
     def __call__(self, prep: _Prepared, rng: np.random.Generator) -> np.ndarray:
         from ..studies import evaluate, simulate_drive
@@ -240,7 +241,7 @@ class _SweepTrial:
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
             )
-        sigma = START_SIGMA_M
+        sigma = self.start_sigma
         # the open-sky fix: drawn after the drive (the drive's draws do not depend on it)
         sh = START_HEIGHT_SIGMA_M
         p0 = draw_start(drive.truth[0], sigma, rng, sh) if self.start == "drawn" else None
@@ -303,6 +304,7 @@ class _ArrayJob:
     crlbs: dict | None
     impairments: object = None
     vues: str = "known"
+    start_sigma: float = START_SIGMA_M
 
     def __call__(self, spec: ArraySpec) -> _Prepared:
         ep = np.arange(self.T)
@@ -316,7 +318,8 @@ class _ArrayJob:
                 route = bound_route(m, self.setup, spec)
             g = route_geometry(self.setup, spec, epochs=ep)
             head = _head(m, self.T)
-            pc = drive_pcrlb(self.setup, position_information(head, g))
+            sp0 = self.start_sigma
+            pc = drive_pcrlb(self.setup, position_information(head, g), sigma_p0=sp0)
             # the noise and the bias of a fix weighted as the tracker weighs (its reported
             # budget, one block per path, bound mode; on the channel route the extraction
             # reports its CRLB): the information a tracker told one block per path can use
@@ -325,13 +328,15 @@ class _ArrayJob:
                 from .fastroute import tracker_weights
 
                 w = tracker_weights(route)[: self.T]
-                pc_w = drive_pcrlb(self.setup, position_information(head, g, w))
+                pc_w = drive_pcrlb(self.setup, position_information(head, g, w), sigma_p0=sp0)
             drive = drive_bound(pc_w, position_bias_rms(head, g, w))
             from .learnedbound import learned_pcrlb
 
             # a tracker that learns its VUEs is told the same blocks: the paths taken one by one
             learned = drive_bound(
-                *learned_pcrlb(_per_path(head) if w is not None else head, g, self.setup)
+                *learned_pcrlb(
+                    _per_path(head) if w is not None else head, g, self.setup, sigma_p0=sp0
+                )
             )
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
@@ -351,7 +356,9 @@ class _ArrayJob:
             rec = design_errors(self.setup, spec, n_epochs=self.T)
             design, error_model = traced_javelin(self.setup, spec, rec), error_model_summary(rec)
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
-            pc, drive, learned = traced_bounds(self.setup, spec, design.config, self.T)
+            pc, drive, learned = traced_bounds(
+                self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma
+            )
         return _Prepared(spec, route, design, peb, pc, drive, learned, budget, error_model)
 
 
@@ -386,6 +393,7 @@ def sweep_montecarlo(
     impairments=None,
     start: str = "drawn",
     vues: str = "known",
+    start_sigma: float = START_SIGMA_M,
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -409,7 +417,9 @@ def sweep_montecarlo(
     wideband term with ``wideband_model``); the default error model carries them too.
     ``start`` (:data:`STARTS`): each drive's tracker starts from an open-sky fix drawn with the
     run's generator after the drive (``"drawn"``, default) or from the true first position
-    (``"truth"``), with :data:`START_SIGMA_M` of uncertainty either way. ``vues``
+    (``"truth"``), with ``start_sigma`` [m] per axis of uncertainty either way (default
+    :data:`START_SIGMA_M`; the entry fix's quality, also the prior of the bounds over the
+    drive). ``vues``
     (:data:`VUES`): the tracker's VUEs from the tunnel's known surfaces (``"known"``, default)
     or learnt from the paths' angles (``"learned"``).
     """
@@ -431,6 +441,7 @@ def sweep_montecarlo(
     if vues not in VUES:
         raise ValueError(f"vues: expected one of {VUES}, got {vues!r}")
     runs = integer("runs", runs, minimum=1)
+    start_sigma = positive("start_sigma", start_sigma)
     if impairments is not None:
         from .achievable import DesignImpairments
 
@@ -459,7 +470,7 @@ def sweep_montecarlo(
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
     A = len(specs)
     with_model = mode == "bound" or error_models is not None
-    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, vues)
+    job = _ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, vues, start_sigma)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
     kw = {k: v for k, v in kw.items() if v is not None}
     if pool is not None:
@@ -477,7 +488,7 @@ def sweep_montecarlo(
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(
-            _SweepTrial(setup, mode, n_epochs, impairments, start),
+            _SweepTrial(setup, mode, n_epochs, impairments, start, start_sigma),
             A * runs,
             seed,
             inputs=[prepared[a] for a in range(A) for _ in range(runs)],

@@ -176,7 +176,8 @@ class DesignReport:
             f"impairments: phase {imp['phase_error_deg']:g} deg, gain {imp['gain_error_db']:g} "
             f"dB, spatial wideband {'on' if imp['spatial_wideband'] else 'off'}, diffuse share "
             f"{imp['dmc_share']:g}; Monte-Carlo: {s['runs']} runs ({s['mode']} route), seed "
-            f"{s['seed']}",
+            f"{s['seed']}"
+            + (f", entry fix {s['start_sigma_m']:g} m per axis" if "start_sigma_m" in s else ""),
             f"criterion: {_CRITERION_TEXT[s['criterion']]}",
             f"{'array':>7s} {'M':>5s} {'diagonal':>9s} {'SR-NF ok':>9s} {'PEB med':>9s} "
             f"{'PEB ' + q:>9s} {'ach. med':>9s} {'ach. ' + q:>9s} {'err med':>9s} "
@@ -227,6 +228,13 @@ class DesignReport:
                     f"({em['runs']} drives): {sg['phi_deg']:.3g} / {sg['psi_deg']:.3g} deg, "
                     f"{sg['kappa_m']:.3g} m, {sg['delta_d_m']:.3g} m; geometry pre-filter"
                 )
+                if r.drive_bound_known_rms_m is not None:
+                    ratio = r.rmse_over_tracker_bound
+                    lines.append(
+                        f"  {r.array}: bound of the sigmas the tracker is told (settled RMS) "
+                        f"{r.drive_bound_known_rms_m:.3g} m"
+                        + ("" if ratio is None else f", tracker RMSE / bound {ratio:.3g}")
+                    )
         lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 

@@ -33,7 +33,7 @@ from ..budget import check_elements
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
 from .bounds import route_bounds, route_geometry
-from .montecarlo import MODES, sweep_montecarlo
+from .montecarlo import MODES, START_SIGMA_M, sweep_montecarlo
 from .records import DesignReport, DesignRow, over_target
 from .setup import ArraySpec, DesignSetup, parse_array
 from .verdict import (
@@ -259,6 +259,7 @@ def design_sweep(
     n_epochs: int | None = None,
     timeout: float | None = None,
     n_boot: int = 2000,
+    start_sigma: float = START_SIGMA_M,
 ) -> DesignReport:
     """Every candidate of ``arrays`` evaluated and judged (module docstring).
 
@@ -268,7 +269,9 @@ def design_sweep(
     ``runs`` drives per array (0: bounds only) on the ``mode`` route (``"bound"``: drawn from
     the error model; ``"channel"``: synthesis and extraction), seeded by ``seed``; ``workers``
     / ``scheduler`` / ``timeout`` go to the one task set; ``n_epochs`` truncates the route;
-    ``n_boot`` bootstrap resamples. An array that does not fit, or whose bound or Monte-Carlo
+    ``n_boot`` bootstrap resamples; ``start_sigma`` [m] the entry fix's standard deviation per
+    axis (the tracker's start and the prior of the bounds over the drive; default
+    :data:`~tunnelkit.design.montecarlo.START_SIGMA_M`, the open-sky fix). An array that does not fit, or whose bound or Monte-Carlo
     is undefined, is a row with status ``"error"`` and the reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -289,6 +292,7 @@ def design_sweep(
     runs = integer("runs", runs, minimum=0)
     seed = integer("seed", seed, minimum=0)
     n_boot = integer("n_boot", n_boot, minimum=100)
+    start_sigma = positive("start_sigma", start_sigma)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     workers, scheduler = parallel_options(workers, scheduler)
@@ -326,6 +330,7 @@ def design_sweep(
             "timeout": timeout,
             "progress": progress,
             "n_epochs": n_epochs,
+            "start_sigma": start_sigma,
         }
         results, failed = _run_montecarlo(setup, todo, runs, seed, kw)
         for r in rows:
@@ -390,5 +395,7 @@ def design_sweep(
     }
     if setup.channel != "image":  # (the image channel's JSON as before)
         settings["channel"] = setup.channel
+    if start_sigma != START_SIGMA_M:  # (the default's JSON as before)
+        settings["start_sigma_m"] = start_sigma
     rec = recommend([r for r in rows if r.status != "error"], target, share, runs)
     return DesignReport(setup.name, rows, rec, settings, warnings)

@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validate import boolean, instance, integer, rng_or_error
+from .._validate import boolean, instance, integer, positive, rng_or_error
 from .setup import DesignSetup, parse_array
 
 __all__ = [
@@ -343,7 +343,9 @@ def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
     instance("setup", setup, DesignSetup)
     spec = parse_array(spec)
     if not isinstance(sigmas, dict) or set(sigmas) != {"phi", "psi", "kappa", "d"}:
-        raise ValueError(f"sigmas: expected {{'phi', 'psi', 'kappa', 'd'}} to a sigma, got {sigmas!r}")
+        raise ValueError(
+            f"sigmas: expected {{'phi', 'psi', 'kappa', 'd'}} to a sigma, got {sigmas!r}"
+        )
     sig = np.array([sigmas[k] for k in ("phi", "psi", "kappa", "d")], dtype=float)
     if not np.all(np.isfinite(sig) & (sig > 0)):
         raise ValueError(f"sigmas: each must be finite and > 0, got {sigmas!r}")
@@ -360,14 +362,16 @@ def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
     return model, g
 
 
-def traced_bounds(setup: DesignSetup, spec, config, T: int | None = None) -> tuple:
+def traced_bounds(
+    setup: DesignSetup, spec, config, T: int | None = None, *, sigma_p0: float = 1.0
+) -> tuple:
     """The bounds over the first ``T`` epochs of ``spec``'s drive (default all) of a tracker
     told the sigmas of ``config`` (a :class:`~tunnelkit.tracking.javelin.JavelinConfig`:
     ``sigma_phi``, ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d``; the traced design's,
     :func:`traced_javelin`), every first-order path measured with independent Gaussian errors of
     those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive, learned)`` (T,) [m] as the design's
-    Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` with the design's
-    1 m start, ``drive`` the same with no bias, ``learned`` for a tracker that learns its VUEs,
+    Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` from a start of
+    ``sigma_p0`` [m] per axis, the design's 1 m by default; ``drive`` the same with no bias, ``learned`` for a tracker that learns its VUEs,
     :func:`~tunnelkit.design.learnedbound.learned_pcrlb`). What the told sigmas allow: the traced
     errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
     from .drivebound import drive_bound, drive_pcrlb, position_information
@@ -382,8 +386,9 @@ def traced_bounds(setup: DesignSetup, spec, config, T: int | None = None) -> tup
                ("kappa", "sigma_kappa"), ("d", "sigma_delta_d"))}  # fmt: skip
     except (AttributeError, TypeError, ValueError):
         raise TypeError(f"config: expected a JavelinConfig, got {type(config).__name__}") from None
+    sigma_p0 = positive("sigma_p0", sigma_p0)
     model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
-    pc = drive_pcrlb(setup, position_information(model, g))
+    pc = drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
     drive = drive_bound(pc, np.zeros_like(pc))
-    learned = drive_bound(*learned_pcrlb(model, g, setup))
+    learned = drive_bound(*learned_pcrlb(model, g, setup, sigma_p0=sigma_p0))
     return pc, drive, learned
