@@ -5,10 +5,13 @@
 :mod:`tunnelkit.design.traced`: geometry pre-filter, the array's own errors measured on the first
 drives of seed 0 and cached in ``data/rt/design/``), then per array and channel: median and p90
 of the settled error with its bootstrap 95 % interval, the verdict, the PEB and achievable bound
-beside it (p90, eq.-1 model), the traced route's measurement noise, and the ray tracer's cost
-(trace time per epoch, median and max, and the cache size of the array's drive).
+beside it (p90, eq.-1 model), on the traced route the bound of the sigmas its tracker is told
+(settled RMS, :func:`tunnelkit.design.traced.traced_bounds`), the traced route's measurement
+noise, and the ray tracer's cost (trace time per epoch, median and max, and the cache size of the
+array's drive). ``--start-sigma`` sets the entry fix (the CLI's ``--start-sigma``).
 
     python benchmarks/bench_rt_design.py --runs 5 --seed 20261202 --workers 2
+    python benchmarks/bench_rt_design.py --runs 10 --channels sionna --start-sigma 0.1
     python benchmarks/bench_rt_design.py --from-json build/sweep-image.json build/sweep-sionna-*.json
 
 Choose on seed 0 (the traced errors are measured there), report on a seed never looked at
@@ -33,13 +36,15 @@ from tunnelkit import design
 from tunnelkit.studies import HELD_OUT_SEED
 
 
-def run_sweep(scenario, arrays, channel, runs, seed, workers, out: Path) -> dict:
+def run_sweep(scenario, arrays, channel, runs, seed, workers, out: Path, start_sigma=None) -> dict:
     """The CLI's sweep on ``channel``; its JSON (written to ``out``) with the wall time."""
     cmd = [sys.executable, "-m", "tunnelkit", "design", scenario, "--arrays", *arrays,
            "--mode", "channel", "--channel", channel, "--runs", str(runs), "--seed", str(seed),
            "--no-progress", "--format", "json"]  # fmt: skip
     if workers:
         cmd += ["--workers", str(workers)]
+    if start_sigma is not None:
+        cmd += ["--start-sigma", str(start_sigma)]
     t0 = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if res.returncode not in (0, 1):
@@ -69,8 +74,10 @@ def _m(v) -> str:
 
 def table(reps: dict, costs: dict) -> str:
     lines = [
-        f"{'channel':8s} {'array':6s} {'runs':>4s} {'median':>9s} {'p90':>9s} {'95% CI of p90':>22s} "
-        f"{'PEB p90':>9s} {'ach. p90':>9s} {'verdict':10s} noise model / trace cost"
+        "bound: on the traced route the posterior CRLB of the sigmas its tracker is told (settled "
+        "RMS); none on the image channel's channel route",
+        f"{'channel':12s} {'array':6s} {'runs':>4s} {'median':>9s} {'p90':>9s} {'95% CI of p90':>22s} "
+        f"{'PEB p90':>9s} {'ach. p90':>9s} {'bound':>9s} {'verdict':10s} noise model / trace cost",
     ]
     for ch, rep in reps.items():
         for a in rep["arrays"]:
@@ -84,17 +91,19 @@ def table(reps: dict, costs: dict) -> str:
             else:
                 note = "reported CRLB"
             c = costs.get(a["array"])
-            if ch == "sionna" and c:
+            if ch.startswith("sionna") and c:
                 note += (f"; trace {c['median_s']:.2f} s/epoch (max {c['max_s']:.2f}), cache "
                          f"{c['bytes'] / 1e6:.0f} MB")  # fmt: skip
             lines.append(
-                f"{ch:8s} {a['array']:6s} {a['runs']:4d} {_m(a['error_median_m']):>9s} "
+                f"{ch:12s} {a['array']:6s} {a['runs']:4d} {_m(a['error_median_m']):>9s} "
                 f"{_m(a['error_p90_m']):>9s} {cis:>22s} {_m(a['peb_p90_m']):>9s} "
-                f"{_m(a['achievable_p90_m']):>9s} {a['status']:10s} {note}"
+                f"{_m(a['achievable_p90_m']):>9s} {_m(a.get('drive_bound_known_rms_m')):>9s} "
+                f"{a['status']:10s} {note}"
             )
         lines.append(
             f"{ch}: recommendation {rep['recommendation'].get('array')}, seed "
-            f"{rep['inputs']['seed']}, wall {rep.get('wall_s', float('nan')):.0f} s"
+            f"{rep['inputs']['seed']}, entry fix {rep['inputs'].get('start_sigma_m', 1.0):g} m, "
+            f"wall {rep.get('wall_s', float('nan')):.0f} s"
         )
         lines += [f"  warning: {w}" for w in rep["warnings"]]
     return "\n".join(lines)
@@ -108,6 +117,7 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--seed", type=int, default=HELD_OUT_SEED)
     ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--start-sigma", type=float, default=None, help="entry fix [m] per axis")
     ap.add_argument("--out", default=str(ROOT / "build"))
     ap.add_argument("--from-json", nargs="+", default=None, help="tabulate CLI outputs instead")
     args = ap.parse_args()
@@ -116,6 +126,8 @@ def main() -> None:
         for f in args.from_json:
             rep = json.loads(Path(f).read_text())
             ch = rep["inputs"].get("channel", "image")
+            if "start_sigma_m" in rep["inputs"]:
+                ch += f"@{rep['inputs']['start_sigma_m']:g}m"
             if ch in reps:
                 reps[ch]["arrays"] += rep["arrays"]
                 reps[ch]["warnings"] += rep["warnings"]
@@ -134,13 +146,14 @@ def main() -> None:
                 args.seed,
                 args.workers,
                 Path(args.out) / f"design-{ch}-{args.seed}.json",
+                args.start_sigma,
             )
             for ch in args.channels
         }
     labels = [a["array"] for rep in reps.values() for a in rep["arrays"]]
     costs = (
         {lb: trace_cost(args.scenario, lb) for lb in dict.fromkeys(labels)}
-        if "sionna" in reps
+        if any(ch.startswith("sionna") for ch in reps)
         else {}
     )
     print(table(reps, costs))

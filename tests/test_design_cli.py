@@ -218,3 +218,18 @@ def test_json_reports_both_bounds_over_the_drive(capsys):
     known, learned = a["drive_bound_known_rms_m"], a["drive_bound_learned_rms_m"]
     assert 0 < known < learned  # learning the surfaces costs information
     assert a["rmse_over_tracker_bound"] == pytest.approx(a["rmse_m"] / known)
+
+
+def test_start_sigma_reaches_the_json_and_the_table(capsys):
+    argv = ["design", "example-rectangular-28ghz", "--arrays", "4x4", "--runs", "2",
+            "--n-epochs", "6", "--no-progress"]  # fmt: skip
+    assert main([*argv, "--start-sigma", "0.05", "--format", "json"]) == 0
+    fine = json.loads(capsys.readouterr().out)
+    assert fine["inputs"]["start_sigma_m"] == 0.05
+    assert main([*argv, "--format", "json"]) == 0
+    wide = json.loads(capsys.readouterr().out)
+    assert "start_sigma_m" not in wide["inputs"]
+    b = [r["arrays"][0]["drive_bound_known_rms_m"] for r in (fine, wide)]
+    assert b[0] < b[1]  # the bounds' prior follows the entry fix
+    assert main([*argv, "--start-sigma", "0.05"]) == 0
+    assert "entry fix 0.05 m per axis" in capsys.readouterr().out

@@ -80,6 +80,31 @@ def test_confirmation_escalates_while_none_is_met(monkeypatch, channel, runs_of,
     assert [r.array for r in conf.confirmation] == [c[0] for c in runs_of]
 
 
+def test_confirmation_keeps_the_sweeps_entry_fix(monkeypatch):
+    from tunnelkit.design import confirm, montecarlo
+
+    seen = []
+
+    def fake_sweep(setup, specs, runs, seed, **kw):
+        seen.append(kw.get("start_sigma"))
+        return {x.label: x.label for x in specs}
+
+    def fake_score(row, res, *args):
+        row.status, row.reason = "met", "channel met"
+
+    monkeypatch.setattr(montecarlo, "sweep_montecarlo", fake_sweep)
+    monkeypatch.setattr(confirm, "score_row", fake_score)
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    for extra, want in (({"start_sigma_m": 0.2}, 0.2), ({}, None)):
+        rep = _report(["met", "met", "met"], "4x4")
+        rep.settings.update(
+            arrays=["4x4", "8x8", "16x16"], spacing_wl=0.5, impairments={}, seed=0, n_epochs=None,
+            criterion="achievable", target=0.1, share=0.9, n_boot=10, **extra,
+        )  # fmt: skip
+        design.confirm_on_channel(rep, setup)
+        assert seen[-1] == want
+
+
 def test_confirmation_reruns_on_the_channel_route_and_decides():
     """A short ideal drive, 2 runs: the recommended array is re-run on the channel route with
     the sweep's seed (its errors differ from the bound route's), the recommendation says which

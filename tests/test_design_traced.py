@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -162,26 +163,47 @@ def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
         ).config  # fmt: skip
 
     T = 6
-    pc1, dr1, le1 = traced.traced_bounds(setup, "4x4", cfg(1.0), T)
+    pc1, _, le1 = traced.traced_bounds(setup, "4x4", cfg(1.0), T)
     pc3, _, _ = traced.traced_bounds(setup, "4x4", cfg(3.0), T)
     pch, _, _ = traced.traced_bounds(setup, "4x4", cfg(1e6), T)
     assert pc1.shape == (T,) and np.all(pc3 > pc1)
-    np.testing.assert_allclose(dr1, pc1)  # no bias: the drive bound is the PCRLB
     assert np.all(le1 >= pc1 * (1 - 1e-9))
+    # the start's prior: a better entry fix, a lower bound; the default is the design's start
+    pc_fine, _, _ = traced.traced_bounds(setup, "4x4", cfg(1.0), T, sigma_p0=0.1)
+    assert np.all(pc_fine < pc1) and pc_fine[0] < 0.2 < pc1[0]
+    np.testing.assert_allclose(
+        traced.traced_bounds(setup, "4x4", cfg(1.0), T, sigma_p0=design.START_SIGMA_M)[0], pc1
+    )
+    # float epochs (whole numbers, as route_geometry takes them) give the same model
+    mf, _ = traced.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6.0))
+    np.testing.assert_array_equal(mf.t, m.t)
     none = drive_pcrlb(setup, np.zeros((T, 2, 2)))
     np.testing.assert_allclose(pch, none, rtol=1e-6)
     assert np.all(pc1 < none)
 
 
 def test_the_sweep_reports_the_bound_of_the_told_sigmas(setup):
-    rep = design.design_sweep(setup, ["4x4"], runs=2, seed=0, mode="channel", n_epochs=3)
-    row, rec = rep.rows[0], traced.design_errors(setup, "4x4", n_epochs=3)
+    rec = traced.design_errors(setup, "4x4", n_epochs=3)
     d = traced.traced_javelin(setup, "4x4", rec)
-    _, drive, learned = traced.traced_bounds(setup, "4x4", d.config, 3)
     k = design.counted_epochs(setup.trajectory.t[:3])
-    assert row.drive_bound_known_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
-    assert row.drive_bound_learned_rms_m == pytest.approx(np.sqrt(np.mean(learned[k] ** 2)))
-    assert row.rmse_over_tracker_bound == pytest.approx(row.rmse_m / row.drive_bound_known_rms_m)
+    for fix in (None, 0.1):  # the default entry fix and a better one: the bounds' prior follows
+        kw = {} if fix is None else {"start_sigma": fix}
+        rep = design.design_sweep(setup, ["4x4"], runs=2, seed=0, mode="channel", n_epochs=3, **kw)
+        row = rep.rows[0]
+        _, drive, learned = traced.traced_bounds(setup, "4x4", d.config, 3, sigma_p0=fix)
+        assert row.drive_bound_known_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
+        assert row.drive_bound_learned_rms_m == pytest.approx(np.sqrt(np.mean(learned[k] ** 2)))
+        assert row.rmse_over_tracker_bound == pytest.approx(
+            row.rmse_m / row.drive_bound_known_rms_m
+        )
+        told = row.error_model["told_sigmas"]
+        assert told["phi_deg"] == pytest.approx(np.degrees(d.config.sigma_phi))
+        table = rep.to_table()
+        assert "the tracker is told their long-run value" in table
+        assert (
+            f"bound of the sigmas the tracker is told (settled RMS) {row.drive_bound_known_rms_m:.3g} m"
+            in table
+        )
 
 
 def test_bad_input(setup):
@@ -205,8 +227,20 @@ def test_bad_input(setup):
         traced.sigma_error_model(setup, "4x4", {"phi": 0.0, "psi": 0.1, "kappa": 1.0, "d": 1.0})
     with pytest.raises(TypeError, match="config"):
         traced.traced_bounds(setup, "4x4", {"sigma_phi": 0.1}, 2)
-    with pytest.raises(ValueError, match="T"):
+    with pytest.raises(ValueError, match=r"^T:"):
         traced.traced_bounds(setup, "4x4", cfg, 0)
+    with pytest.raises(ValueError, match="sigma_p0"):
+        traced.traced_bounds(setup, "4x4", cfg, 2, sigma_p0=0.0)
+    names = ("sigma_phi", "sigma_psi", "sigma_kappa", "sigma_delta_d")
+    told = {k: getattr(cfg, k) for k in names}
+    with pytest.raises(ValueError, match=r"^config:"):
+        traced.traced_bounds(setup, "4x4", SimpleNamespace(**{**told, "sigma_phi": 0.0}), 2)
+    for bad in ("a", True, -1.0, np.nan):
+        with pytest.raises((TypeError, ValueError), match=r"sigmas\['phi'\]"):
+            traced.sigma_error_model(setup, "4x4", {"phi": bad, "psi": 0.1, "kappa": 1.0, "d": 1.0})
+    with pytest.raises(ValueError, match="error_models"):
+        design.sweep_montecarlo(setup, ["4x4"], 1, 0, mode="channel", n_epochs=1,
+                                error_models=lambda st, sp: None)  # fmt: skip
     imp = design.DesignImpairments(phase_error_deg=0.5)
     with pytest.raises(ValueError, match="impairments"):
         design.sweep_montecarlo(setup, ["4x4"], 1, 0, mode="channel", impairments=imp, n_epochs=1)

@@ -25,6 +25,7 @@
 
 # %%
 import os
+from itertools import pairwise
 
 import numpy as np
 
@@ -400,7 +401,8 @@ print("image channel, snapshot PEB median:", {a: f"{1e3 * peb_img[a]:.3g} mm" fo
 # %% [markdown]
 # Now the tracker itself, on both channels, on a seed the traced errors were not measured on
 # (quick mode: the 4 × 4 array and one drive, its verdict "undecided"; full mode: the three
-# arrays and 10 drives, about half an hour, the ray tracer's traces cached under `build/`). The
+# arrays and 10 drives, on both channels and once more from a better entry fix below; the ray
+# tracer's traces are cached under `build/`). The
 # same from a shell:
 #
 #     tunnelkit design italiano2026-straight --arrays 4x4 8x8 16x16 --mode channel \
@@ -437,9 +439,9 @@ print(f"the told sigmas' bound: largest / smallest array {bound_ratio:.3g}")
 #
 # - **A design from eq. 1 alone is optimistic by orders of magnitude.** Every array passes on the
 #   image channel; on the traced one none does.
-# - **The lever is the model, not the array size.** An extraction that models the diffuse power
-#   and the higher-order bounces, a better start, or a second base station would move the traced
-#   bound. More elements hardly do.
+# - **The lever is the model, not the array size.** More elements hardly move the traced bound.
+#   What could: an extraction that models the diffuse power and the higher-order bounces, a
+#   better entry fix (below), a second base station (none of these is built here).
 #
 # This bound is what the told sigmas allow, not what the channel allows. The traced errors are
 # neither Gaussian nor independent, and no misspecified track bound is computed here.
@@ -459,6 +461,10 @@ for sp in fixes:
     by_fix[sp] = (radio, alone)
     print(f"entry fix {sp:5.2f} m: bound {radio:.3g} m with the radio, {alone:.3g} m without "
           f"(the radio's gain {100 * (1 - radio / alone):.2g} %)")  # fmt: skip
+# the floor: dead reckoning from the best fix with a V2X heading ten times better
+calm = settled_rms(design.drive_pcrlb(paper_rt, np.zeros((T_rt, 2, 2)), sigma_p0=fixes[-1],
+                                      sigma_heading=tk.studies.SIGMA_HEADING / 10))  # fmt: skip
+print(f"dead reckoning from {fixes[-1]} m with a heading 10x better: {calm:.3g} m")
 fine_fix = design.design_sweep(paper_rt, rt_arrays, target=0.2, runs=rt_runs, mode="channel",
                                seed=20261202, start_sigma=0.1, progress=True)  # fmt: skip
 print(fine_fix.to_table())
@@ -467,7 +473,7 @@ p90_fine = {r.array: r.error_p90_m for r in fine_fix.rows}
 # %% [markdown]
 # The radio's gain over dead reckoning shrinks with the entry fix, to about one per cent at
 # 0.1 m. The bound's floor is the V2X heading's drift over the drive. A better fix brings the
-# tracker down with its bound (the table's last line: its RMSE over the bound). On this channel
+# tracker down with its bound (the line under the array's noise model: its RMSE over the bound). On this channel
 # the single base station's first-order extraction corrects a poor entry fix a little; it does not
 # position the vehicle.
 # The design question becomes *which entry fix and which odometry*, or an extraction that models
@@ -633,15 +639,19 @@ assert round(28e9 / 5.9e9, 1) == 4.7 and 400e6 / 100e6 == 4
 # inflation), their bound misses 0.2 m for every array and hardly moves with the array, and it
 # lies below dead reckoning's; the tracker meets 0.2 m on the image channel and not on the traced
 for a in rt_sizes:
-    assert np.degrees(told[a].sigma_phi) >= {r[0]: r for r in traced.design_errors(
-        paper_rt, a, measure=False)["rows"]}["all"][2] * (1 - 1e-9)  # fmt: skip
+    rec = traced.design_errors(paper_rt, a, measure=False)
+    assert rec["runs"] == 3 and rec["seed"] == 0, (a, rec["runs"], rec["seed"])
+    rms_phi = {r[0]: r for r in rec["rows"]}["all"][2]
+    assert np.degrees(told[a].sigma_phi) >= rms_phi * (1 - 1e-9)
 assert min(bound_rt.values()) > 0.2, bound_rt
 # the entry-fix table: the bound falls with the fix, stays at or below dead reckoning's, and the
 # radio's gain shrinks to a few per cent for a fix of 0.1 m or better; the tracker's p90 falls too
 gains = {sp: 1 - r / a for sp, (r, a) in by_fix.items()}
 assert all(r <= a * (1 + 1e-9) for r, a in by_fix.values()), by_fix
-assert all(by_fix[x][0] > by_fix[y][0] for x, y in zip(fixes, fixes[1:])), by_fix
+assert all(by_fix[x][0] > by_fix[y][0] for x, y in pairwise(fixes)), by_fix
 assert gains[1.0] > 0.1 and all(gains[sp] < 0.02 for sp in fixes if sp <= 0.1), gains
+assert all(gains[x] > gains[y] for x, y in pairwise(fixes)), gains
+assert calm < 0.5 * by_fix[fixes[-1]][1], (calm, by_fix)  # the floor is the heading's drift
 for a in rt_arrays:
     assert p90_fine[a] < p90["sionna"][a], (p90_fine, p90)
 assert bound_ratio < 1.25, bound_rt
@@ -649,9 +659,10 @@ assert max(bound_rt.values()) < no_radio, (bound_rt, no_radio)
 assert all(peb_img[a] < 0.01 for a in rt_sizes), peb_img
 for a in rt_arrays:
     assert p90["image"][a] < 0.01 and 0.2 < p90["sionna"][a], (a, p90)
+    assert p90["sionna"][a] > 100 * p90["image"][a], (a, p90)  # orders of magnitude
 assert all(r.status != "met" for r in on["sionna"].rows)
 if not tk.quick_mode():
-    assert {r.array: r.status for r in on["image"].rows}["4x4"] == "met"
+    assert all(r.status == "met" for r in on["image"].rows), on["image"].to_table()
     assert all(r.status == "not met" for r in on["sionna"].rows), on["sionna"].to_table()
 assert explorer.figure.layout.title.text.startswith("Recommended: ")
 assert design_figure(n=4, target=0.1).layout.meta["achievable_median_m"] > 0

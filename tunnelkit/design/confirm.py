@@ -170,7 +170,8 @@ def confirm_on_channel(
         )
         for a in labels:
             row = copy.deepcopy(by[a])
-            # the channel route gives no bound over the drive (no error model): none reported
+            # the image channel's channel route gives no bound over the drive (no error model;
+            # score_row fills the traced route's, the bound of its told sigmas)
             row.drive_bound_known_rms_m = row.drive_bound_learned_rms_m = None
             row.rmse_over_tracker_bound = None
             score_row(row, res[a], s["criterion"], s["target"], s["share"], s["seed"], s["n_boot"])

@@ -19,6 +19,7 @@ from .errormodel import PathErrorModel
 from .setup import DesignSetup
 
 __all__ = [
+    "START_SIGMA_M",
     "drive_bound",
     "drive_motion",
     "drive_pcrlb",
@@ -27,6 +28,11 @@ __all__ = [
     "position_information",
     "position_noise_cov",
 ]
+
+#: the open-sky fix's standard deviation per axis [m], the design's default entry fix
+#: (``start_sigma`` of :func:`tunnelkit.design.montecarlo.sweep_montecarlo`): the tracker's
+#: ``sigma_p0_ue`` and the prior of the bounds over the drive (:func:`drive_pcrlb`)
+START_SIGMA_M = 1.0
 
 
 def _position_rows(model: PathErrorModel, geometry, k: int):
@@ -240,7 +246,7 @@ def drive_pcrlb(
     setup: DesignSetup,
     info: np.ndarray,
     *,
-    sigma_p0: float = 1.0,
+    sigma_p0: float = START_SIGMA_M,
     sigma_speed: float | None = None,
     sigma_heading: float | None = None,
 ) -> np.ndarray:

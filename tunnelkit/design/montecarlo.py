@@ -18,8 +18,8 @@ is identical serially and on any number of workers. Two measurement routes:
 JAVELIN there takes each path's covariance as the extraction reports it (the CRLB at the
 estimate, which the ML route attains), so the tracker is tuned by the design itself at any
 carrier and size (:func:`javelin_config`). It starts from an open-sky fix drawn with the
-uncertainty it is told (:data:`STARTS`; 1 m across, 5 cm in height), first fixes itself on the
-path the known surfaces say is the LoS, and takes its VUEs from the tunnel's known surfaces
+uncertainty it is told (:data:`STARTS`; ``start_sigma`` per axis, default 1 m, 5 cm in
+height), first fixes itself on the path the known surfaces say is the LoS, and takes its VUEs from the tunnel's known surfaces
 (:data:`VUES`, :class:`tunnelkit.tracking.javelin.surfaces.GeometricBirth`): a design knows
 its tunnel, and a tracker that learns every VUE afresh cannot use the reflections' information
 until it has learnt the surfaces (under a calibration error, whose bias repeats, it never
@@ -56,7 +56,13 @@ from ..metrics import SETTLE_S, settled
 from ..montecarlo import TrialPool, run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
 from .channelbudget import channel_route_budget
-from .drivebound import drive_bound, drive_pcrlb, position_bias_rms, position_information
+from .drivebound import (
+    START_SIGMA_M,
+    drive_bound,
+    drive_pcrlb,
+    position_bias_rms,
+    position_information,
+)
 from .errormodel import PathErrorModel
 from .setup import ArraySpec, DesignSetup, parse_array
 
@@ -76,7 +82,8 @@ __all__ = [
 MODES = ("bound", "channel")
 
 #: where a drive's tracker starts (:func:`sweep_montecarlo`): ``"drawn"`` an open-sky fix drawn
-#: from ``N(truth, diag(s^2, s^2, s_h^2))`` (``s`` :data:`START_SIGMA_M`, ``s_h``
+#: from ``N(truth, diag(s^2, s^2, s_h^2))`` (``s`` the sweep's ``start_sigma``, default
+#: :data:`START_SIGMA_M`; ``s_h``
 #: :data:`START_HEIGHT_SIGMA_M`) with the run's generator, so the tracker's ``P_0`` is its true
 #: error; ``"truth"`` the true first position with the same ``P_0`` (the paper tables' start,
 #: which rewards a tracker that trusts its measurements too little)
@@ -86,10 +93,6 @@ STARTS = ("drawn", "truth")
 #: mirror image in the tunnel's known surfaces (the design knows its tunnel), ``"learned"`` from
 #: each path's angles and learnt over the drive (Algorithm 3)
 VUES = ("known", "learned")
-
-#: the open-sky fix's standard deviation per axis [m]: the tracker's ``sigma_p0_ue`` and the
-#: prior of the bounds over the drive (:func:`drive_pcrlb`)
-START_SIGMA_M = 1.0
 
 #: the open-sky fix's height standard deviation [m]: a vehicle's antenna height is known (the
 #: PEB and the bounds over the drive take it as known); the start's and the tracker's ``P_0``
@@ -355,6 +358,13 @@ class _ArrayJob:
             # this array's errors on the traced channel (cached with their provenance)
             rec = design_errors(self.setup, spec, n_epochs=self.T)
             design, error_model = traced_javelin(self.setup, spec, rec), error_model_summary(rec)
+            c = design.config
+            error_model["told_sigmas"] = {
+                "phi_deg": float(np.degrees(c.sigma_phi)),
+                "psi_deg": float(np.degrees(c.sigma_psi)),
+                "kappa_m": float(c.sigma_kappa),
+                "delta_d_m": float(c.sigma_delta_d),
+            }
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
             pc, drive, learned = traced_bounds(
                 self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma
@@ -404,8 +414,10 @@ def sweep_montecarlo(
     ``(setup, spec) -> model``, e.g. :func:`tunnelkit.design.achievable.path_error_model` with
     impairments); default the ideal model (``path_error_model(setup, spec)``: an efficient
     extraction without impairments). The bound mode draws from it, and
-    both modes take the posterior CRLB from its reported bound (on the channel route only when
-    models are given). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
+    both modes take the posterior CRLB from its reported bound (on the image channel's channel
+    route only when models are given; the ray-traced channel's route takes the bounds of the
+    sigmas its tracker is told, :func:`tunnelkit.design.traced.traced_bounds`, and refuses
+    models). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
     route-median per-path bounds, from the model when there is one). ``workers`` /
     ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
     sweep), or ``pool`` (a :func:`tunnelkit.montecarlo.trial_pool` already open, so several
@@ -459,6 +471,11 @@ def sweep_montecarlo(
         if vues != "known":
             raise ValueError(
                 "vues: the traced route's tracker takes its VUEs from the known surfaces"
+            )
+        if error_models is not None:
+            raise ValueError(
+                "error_models: the traced route's noise is measured on the ray-traced channel "
+                "(tunnelkit.design.traced); give none with channel 'sionna'"
             )
     if not isinstance(seed, np.random.Generator):
         seed = integer("seed", seed, minimum=0)

@@ -44,7 +44,8 @@ class DesignRow:
     ``share``-quantile (the 90th percentile at the default share). ``status`` is a verdict of
     :func:`tunnelkit.design.verdict.judge` or ``"error"`` (``reason`` says why). Per-epoch
     arrays cover the whole route: ``x_m``, ``peb_m``, ``achievable_m`` and, with runs,
-    ``error_median_epoch_m`` (median over runs). With runs on the bound route, the bounds over
+    ``error_median_epoch_m`` (median over runs). With runs on the bound route (and on the
+    ray-traced channel's route, there of the sigmas its tracker is told), the bounds over
     the drive (RMS, counted epochs) of a tracker that knows the surfaces and of one that learns
     its VUEs (``drive_bound_known_rms_m``, ``drive_bound_learned_rms_m``, :func:`_drive_bounds`).
     """
@@ -100,7 +101,8 @@ class DesignRow:
         ``achievable_m`` on the same epochs) and ``per_epoch {x_m, peb_m, achievable_m,
         error_median_m}`` (non-finite values and anything not computed are null); on the
         ray-traced channel's route also ``error_model`` (the tracker's measurement-noise model,
-        :func:`tunnelkit.design.traced.error_model_summary`)."""
+        :func:`tunnelkit.design.traced.error_model_summary`, with ``told_sigmas`` the long-run
+        sigmas its tracker is told)."""
         return {
             "array": self.array,
             "n_elements": int(self.n_elements),
@@ -228,6 +230,13 @@ class DesignReport:
                     f"({em['runs']} drives): {sg['phi_deg']:.3g} / {sg['psi_deg']:.3g} deg, "
                     f"{sg['kappa_m']:.3g} m, {sg['delta_d_m']:.3g} m; geometry pre-filter"
                 )
+                tg = em.get("told_sigmas")
+                if tg:
+                    lines.append(
+                        f"  {r.array}: the tracker is told their long-run value "
+                        f"{tg['phi_deg']:.3g} / {tg['psi_deg']:.3g} deg, {tg['kappa_m']:.3g} m, "
+                        f"{tg['delta_d_m']:.3g} m"
+                    )
                 if r.drive_bound_known_rms_m is not None:
                     ratio = r.rmse_over_tracker_bound
                     lines.append(

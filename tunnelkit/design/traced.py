@@ -21,7 +21,9 @@ only. The traced route changes the same two things the traced JAVELIN tables cha
   cache's key; the paper tunnel's in ``data/rt/design/``; a record of another scene, settings, array or sionna-rt version is refused, never
   reused). The tracker (:func:`traced_javelin`) is the design's
   (:func:`~tunnelkit.design.montecarlo.javelin_config`: VUEs from the known surfaces, likelihood
-  association, joint innovation test) with fixed per-quantity sigmas set to those errors.
+  association, joint innovation test) with fixed per-quantity sigmas set to those errors at
+  their long-run value (each RMS times ``sqrt((1 + r) / (1 - r))``, ``r`` the record's lag-1
+  error correlation).
 
 The report's JSON names the error model each array's traced route used
 (:func:`error_model_summary`). Its bounds over the drive are those of the sigmas the tracker is
@@ -283,8 +285,8 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     known surfaces, likelihood association, joint innovation test) with the measurement noise of
     ``record`` (:func:`design_errors`): fixed sigmas (the ``"all"`` row:
     :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`, at their long-run value when
-    the record carries the errors' lag-1 correlation; the shipped records predate it and do
-    not) in place of each path's reported CRLB, which on this channel is thousands of times too
+    the record carries the errors' lag-1 correlation, as the shipped records do; the RMS as it
+    is for a record without it) in place of each path's reported CRLB, which on this channel is thousands of times too
     small."""
     from ..tracking.javelin.designs import array_design, design_from_errors
     from .geometry import KINDS
@@ -337,6 +339,7 @@ def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
     each > 0): no bias, no calibration term, the truth and radial speed zero (the bounds over the
     drive use only the geometry's Jacobians and the covariance). Any channel: the geometry is
     the image method's. Returns ``(model, geometry)``."""
+    from .._validate import finite_array
     from .bounds import route_geometry
     from .errormodel import PathErrorModel
 
@@ -346,35 +349,38 @@ def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
         raise ValueError(
             f"sigmas: expected {{'phi', 'psi', 'kappa', 'd'}} to a sigma, got {sigmas!r}"
         )
-    sig = np.array([sigmas[k] for k in ("phi", "psi", "kappa", "d")], dtype=float)
-    if not np.all(np.isfinite(sig) & (sig > 0)):
-        raise ValueError(f"sigmas: each must be finite and > 0, got {sigmas!r}")
+    names = ("phi", "psi", "kappa", "d")
+    sig = np.array([positive(f"sigmas['{k}']", sigmas[k]) for k in names], dtype=float)
     g = route_geometry(setup, spec, epochs=epochs)
+    t = setup.trajectory.t
+    if epochs is not None:  # route_geometry checked them: whole numbers inside the route
+        t = t[finite_array("epochs", epochs, ndim=1).astype(int)]
     T, P = g.exists.shape
     ex4 = np.repeat(g.exists, 4, axis=1)
     cov = np.where(ex4[:, :, None] & ex4[:, None, :], np.kron(np.eye(P), np.diag(sig**2)), np.nan)
     zero = np.where(g.exists[..., None], 0.0, np.nan) * np.ones((T, P, 4))
-    t = setup.trajectory.t if epochs is None else setup.trajectory.t[np.asarray(epochs)]
     model = PathErrorModel(
-        t=np.asarray(t, float)[:T], exists=g.exists, kinds=g.kinds, truth=zero,
+        t=np.asarray(t, float), exists=g.exists, kinds=g.kinds, truth=zero,
         v=np.where(g.exists, 0.0, np.nan), crlb=cov, cov=cov, bias=zero,
     )  # fmt: skip
     return model, g
 
 
 def traced_bounds(
-    setup: DesignSetup, spec, config, T: int | None = None, *, sigma_p0: float = 1.0
+    setup: DesignSetup, spec, config, T: int | None = None, *, sigma_p0: float | None = None
 ) -> tuple:
-    """The bounds over the first ``T`` epochs of ``spec``'s drive (default all) of a tracker
+    """The bounds over the first ``T`` epochs of ``spec``'s drive (default all; a ``T`` beyond
+    the route is the whole route, as the sweep's ``n_epochs``) of a tracker
     told the sigmas of ``config`` (a :class:`~tunnelkit.tracking.javelin.JavelinConfig`:
     ``sigma_phi``, ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d``; the traced design's,
     :func:`traced_javelin`), every first-order path measured with independent Gaussian errors of
     those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive, learned)`` (T,) [m] as the design's
     Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` from a start of
-    ``sigma_p0`` [m] per axis, the design's 1 m by default; ``drive`` the same with no bias, ``learned`` for a tracker that learns its VUEs,
+    ``sigma_p0`` [m] per axis, default :data:`~tunnelkit.design.drivebound.START_SIGMA_M`;
+    ``drive`` the same with no bias, ``learned`` for a tracker that learns its VUEs,
     :func:`~tunnelkit.design.learnedbound.learned_pcrlb`). What the told sigmas allow: the traced
     errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
-    from .drivebound import drive_bound, drive_pcrlb, position_information
+    from .drivebound import START_SIGMA_M, drive_bound, drive_pcrlb, position_information
     from .learnedbound import learned_pcrlb
 
     instance("setup", setup, DesignSetup)
@@ -386,8 +392,11 @@ def traced_bounds(
                ("kappa", "sigma_kappa"), ("d", "sigma_delta_d"))}  # fmt: skip
     except (AttributeError, TypeError, ValueError):
         raise TypeError(f"config: expected a JavelinConfig, got {type(config).__name__}") from None
-    sigma_p0 = positive("sigma_p0", sigma_p0)
-    model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
+    sigma_p0 = START_SIGMA_M if sigma_p0 is None else positive("sigma_p0", sigma_p0)
+    try:
+        model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
+    except ValueError as exc:  # a sigma of the config that is not > 0
+        raise ValueError(f"config: {exc}") from None
     pc = drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
     drive = drive_bound(pc, np.zeros_like(pc))
     learned = drive_bound(*learned_pcrlb(model, g, setup, sigma_p0=sigma_p0))
