@@ -36,7 +36,7 @@ help:
 	@echo "make site    execute every notebook into a static HTML site in build/site/ (QUICK=1 for quick mode)"
 	@echo "make figures headline figures as PNG and SVG in build/figures/ (QUICK=1 for quick mode)"
 	@echo "make browser Playwright + Chromium tests of the dashboard and the site (part of make test)"
-	@echo "make rt-deps Sionna RT extra and Debian's libllvm19, needed by notebook 07 (part of make test)"
+	@echo "make rt-deps Sionna RT extra and Debian's libllvm19, needed by notebooks 07 and 08 (part of make test)"
 	@echo "make bench   benchmarks (medians and ratios measured in one run)"
 	@echo "make format  ruff formatting; rebuild notebooks/*.ipynb from notebooks/.src/*.py without outputs"
 	@echo "make clean   remove .venv and caches"
