@@ -461,10 +461,12 @@ for sp in fixes:
     by_fix[sp] = (radio, alone)
     print(f"entry fix {sp:5.2f} m: bound {radio:.3g} m with the radio, {alone:.3g} m without "
           f"(the radio's gain {100 * (1 - radio / alone):.2g} %)")  # fmt: skip
-# the floor: dead reckoning from the best fix with a V2X heading ten times better
-calm = settled_rms(design.drive_pcrlb(paper_rt, np.zeros((T_rt, 2, 2)), sigma_p0=fixes[-1],
-                                      sigma_heading=tk.studies.SIGMA_HEADING / 10))  # fmt: skip
-print(f"dead reckoning from {fixes[-1]} m with a heading 10x better: {calm:.3g} m")
+# the floor: dead reckoning from the best fix with the V2X speed and heading ten times better
+calm = settled_rms(design.drive_pcrlb(
+    paper_rt, np.zeros((T_rt, 2, 2)), sigma_p0=fixes[-1],
+    sigma_speed=tk.studies.SIGMA_SPEED / 10, sigma_heading=tk.studies.SIGMA_HEADING / 10,
+))  # fmt: skip
+print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {calm:.3g} m")
 fine_fix = design.design_sweep(paper_rt, rt_arrays, target=0.2, runs=rt_runs, mode="channel",
                                seed=20261202, start_sigma=0.1, progress=True)  # fmt: skip
 print(fine_fix.to_table())
@@ -472,7 +474,8 @@ p90_fine = {r.array: r.error_p90_m for r in fine_fix.rows}
 
 # %% [markdown]
 # The radio's gain over dead reckoning shrinks with the entry fix, to about one per cent at
-# 0.1 m. The bound's floor is the V2X heading's drift over the drive. A better fix brings the
+# 0.1 m. The bound's floor is the drift of the V2X odometry (speed and heading) over the drive:
+# ten times better messages lower it about threefold (printed above). A better fix brings the
 # tracker down with its bound (the line under the array's noise model: its RMSE over the bound). On this channel
 # the single base station's first-order extraction corrects a poor entry fix a little; it does not
 # position the vehicle.
@@ -651,7 +654,7 @@ assert all(r <= a * (1 + 1e-9) for r, a in by_fix.values()), by_fix
 assert all(by_fix[x][0] > by_fix[y][0] for x, y in pairwise(fixes)), by_fix
 assert gains[1.0] > 0.1 and all(gains[sp] < 0.02 for sp in fixes if sp <= 0.1), gains
 assert all(gains[x] > gains[y] for x, y in pairwise(fixes)), gains
-assert calm < 0.5 * by_fix[fixes[-1]][1], (calm, by_fix)  # the floor is the heading's drift
+assert 2.5 < by_fix[fixes[-1]][1] / calm < 4, (calm, by_fix)  # the odometry's drift: ~threefold
 for a in rt_arrays:
     assert p90_fine[a] < p90["sionna"][a], (p90_fine, p90)
 assert bound_ratio < 1.25, bound_rt
