@@ -6,7 +6,8 @@
 drives of seed 0 and cached in ``data/rt/design/``), then per array and channel: median and p90
 of the settled error with its bootstrap 95 % interval, the verdict, the PEB and achievable bound
 beside it (p90, eq.-1 model), on the traced route the bound of the sigmas its tracker is told
-(settled RMS, :func:`tunnelkit.design.traced.traced_bounds`), the traced route's measurement
+(settled RMS, :func:`tunnelkit.design.traced.traced_bounds`), with ``--dead-reckoning`` the
+same drives' error p90 with every measurement dropped ("DR p90"), the traced route's measurement
 noise, and the ray tracer's cost (trace time per epoch, median and max, and the cache size of the
 array's drive). ``--start-sigma`` sets the entry fix (the CLI's ``--start-sigma``).
 
@@ -36,7 +37,17 @@ from tunnelkit import design
 from tunnelkit.studies import HELD_OUT_SEED
 
 
-def run_sweep(scenario, arrays, channel, runs, seed, workers, out: Path, start_sigma=None) -> dict:
+def run_sweep(
+    scenario,
+    arrays,
+    channel,
+    runs,
+    seed,
+    workers,
+    out: Path,
+    start_sigma=None,
+    dead_reckoning=False,
+) -> dict:
     """The CLI's sweep on ``channel``; its JSON (written to ``out``) with the wall time."""
     cmd = [sys.executable, "-m", "tunnelkit", "design", scenario, "--arrays", *arrays,
            "--mode", "channel", "--channel", channel, "--runs", str(runs), "--seed", str(seed),
@@ -45,6 +56,8 @@ def run_sweep(scenario, arrays, channel, runs, seed, workers, out: Path, start_s
         cmd += ["--workers", str(workers)]
     if start_sigma is not None:
         cmd += ["--start-sigma", str(start_sigma)]
+    if dead_reckoning:
+        cmd += ["--dead-reckoning"]
     t0 = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if res.returncode not in (0, 1):
@@ -75,9 +88,11 @@ def _m(v) -> str:
 def table(reps: dict, costs: dict) -> str:
     lines = [
         "bound: on the traced route the posterior CRLB of the sigmas its tracker is told (settled "
-        "RMS); none on the image channel's channel route",
+        "RMS); none on the image channel's channel route; DR p90: the same drives with every "
+        "measurement dropped (--dead-reckoning)",
         f"{'channel':12s} {'array':6s} {'runs':>4s} {'median':>9s} {'p90':>9s} {'95% CI of p90':>22s} "
-        f"{'PEB p90':>9s} {'ach. p90':>9s} {'bound':>9s} {'verdict':10s} noise model / trace cost",
+        f"{'PEB p90':>9s} {'ach. p90':>9s} {'bound':>9s} {'DR p90':>9s} {'verdict':10s} "
+        "noise model / trace cost",
     ]
     for ch, rep in reps.items():
         for a in rep["arrays"]:
@@ -98,6 +113,7 @@ def table(reps: dict, costs: dict) -> str:
                 f"{ch:12s} {a['array']:6s} {a['runs']:4d} {_m(a['error_median_m']):>9s} "
                 f"{_m(a['error_p90_m']):>9s} {cis:>22s} {_m(a['peb_p90_m']):>9s} "
                 f"{_m(a['achievable_p90_m']):>9s} {_m(a.get('drive_bound_known_rms_m')):>9s} "
+                f"{_m(a.get('dead_reckoning_p90_m')):>9s} "
                 f"{a['status']:10s} {note}"
             )
         lines.append(
@@ -118,6 +134,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=HELD_OUT_SEED)
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--start-sigma", type=float, default=None, help="entry fix [m] per axis")
+    ap.add_argument("--dead-reckoning", action="store_true", help="also each drive without radio")
     ap.add_argument("--out", default=str(ROOT / "build"))
     ap.add_argument("--from-json", nargs="+", default=None, help="tabulate CLI outputs instead")
     args = ap.parse_args()
@@ -147,6 +164,7 @@ def main() -> None:
                 args.workers,
                 Path(args.out) / f"design-{ch}-{args.seed}.json",
                 args.start_sigma,
+                args.dead_reckoning,
             )
             for ch in args.channels
         }

@@ -74,7 +74,9 @@ def design_sweep():
     from tunnelkit.design import montecarlo, report
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
-    res = montecarlo.sweep_montecarlo(setup, ["4x4"], 1, 0, n_epochs=3, start_sigma=0.5)
+    res = montecarlo.sweep_montecarlo(
+        setup, ["4x4"], 1, 0, n_epochs=3, start_sigma=0.5, dead_reckoning=True
+    )
     r = next(iter(res.values()))
     r.settled_rms(np.full(len(r.t), 0.1))
     report.smallest_meeting(setup, ["4x4"], epochs=[5, 10])

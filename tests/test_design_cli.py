@@ -233,3 +233,6 @@ def test_start_sigma_reaches_the_json_and_the_table(capsys):
     assert b[0] < b[1]  # the bounds' prior follows the entry fix
     assert main([*argv, "--start-sigma", "0.05"]) == 0
     assert "entry fix 0.05 m per axis" in capsys.readouterr().out
+    assert main([*argv, "--dead-reckoning", "--format", "json"]) == 0
+    dr = json.loads(capsys.readouterr().out)
+    assert dr["inputs"]["dead_reckoning"] is True and dr["arrays"][0]["dead_reckoning_p90_m"] > 0

@@ -491,3 +491,35 @@ def test_position_noise_cov_is_the_block_weighted_fix_under_the_joint_crlb(setup
     assert np.allclose(same[m0.exists.any(axis=1)], ref, rtol=1e-6)
     with pytest.raises(ValueError, match="weights"):
         position_noise_cov(m, g, blocks[:-1])
+
+
+def test_dead_reckoning_drops_the_radio_and_leaves_the_tracker_run_unchanged(setup):
+    """dead_reckoning: each drive run again with every measurement dropped. It does not depend
+    on the measurements (the same drives with 1000x the noise give the same dead reckoning),
+    it does not change the tracker's run (same errors as without it), and a tracker told
+    measurements 1000x worse is dead reckoning to within a small fraction."""
+    from tunnelkit.design import design_sweep
+
+    kw = {"mode": "bound", "n_epochs": 8}
+    models = {s: {"4x4": _diag_model(setup, "4x4", scale=s)} for s in (1.0, 1000.0)}
+    r1 = sweep_montecarlo(setup, ["4x4"], 3, 5, error_models=models[1.0], dead_reckoning=True, **kw)
+    rk = sweep_montecarlo(setup, ["4x4"], 3, 5, error_models=models[1000.0], dead_reckoning=True,
+                          **kw)["4x4"]  # fmt: skip
+    plain = sweep_montecarlo(setup, ["4x4"], 3, 5, error_models=models[1.0], **kw)["4x4"]
+    r1 = r1["4x4"]
+    assert plain.dead_reckoning is None and r1.dead_reckoning.shape == r1.errors.shape
+    np.testing.assert_array_equal(r1.errors, plain.errors)
+    np.testing.assert_allclose(r1.dead_reckoning, rk.dead_reckoning, rtol=1e-12)
+    assert not np.allclose(r1.errors, r1.dead_reckoning)
+    assert np.all(np.abs(rk.errors - rk.dead_reckoning) < 0.05 * rk.dead_reckoning + 1e-3)
+    rep = design_sweep(setup, ["4x4"], runs=2, n_epochs=8, dead_reckoning=True)
+    row = rep.to_json()["arrays"][0]
+    assert rep.to_json()["inputs"]["dead_reckoning"] is True
+    assert row["dead_reckoning_p90_m"] > 0 and row["dead_reckoning_rmse_m"] > 0
+    assert "dead reckoning on the same drives" in rep.to_table()
+    bare = design_sweep(setup, ["4x4"], runs=2, n_epochs=8).to_json()
+    assert (
+        "dead_reckoning" not in bare["inputs"] and "dead_reckoning_p90_m" not in bare["arrays"][0]
+    )
+    with pytest.raises(TypeError, match="dead_reckoning"):
+        sweep_montecarlo(setup, ["4x4"], 2, 0, dead_reckoning="yes", **kw)

@@ -3,7 +3,7 @@
 [--dmc-share S]
 [--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
 [--criterion achievable|srnf] [--confirm [--confirm-runs N]] [--channel image|sionna]
-[--start-sigma S] [--format table|json]``.
+[--start-sigma S] [--dead-reckoning] [--format table|json]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
 the ideal position error bound, the achievable bound under the stated impairments, SR-NF validity
@@ -204,6 +204,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="the entry fix's standard deviation per axis [m]: the tracker's start and the prior "
         "of the bounds over the drive (default 1, an open-sky fix)",
     )
+    p.add_argument(
+        "--dead-reckoning",
+        action="store_true",
+        help="run each drive also with every measurement dropped (the same tracker, start and "
+        "V2X messages) and report its error beside the tracker's: what the radio adds",
+    )
     from .reproduce import add_parallel_arguments
 
     add_parallel_arguments(p)
@@ -269,6 +275,7 @@ def main(args: argparse.Namespace) -> int:
             mode=args.mode,
             n_epochs=args.n_epochs,
             **({} if args.start_sigma is None else {"start_sigma": args.start_sigma}),
+            **({"dead_reckoning": True} if args.dead_reckoning else {}),
             **parallel_kwargs(args),
             progress=args.runs > 0 and args.format == "table" and not args.no_progress,
         )

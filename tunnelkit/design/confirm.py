@@ -167,6 +167,7 @@ def confirm_on_channel(
             progress=progress,
             n_epochs=s["n_epochs"],
             **({"start_sigma": s["start_sigma_m"]} if "start_sigma_m" in s else {}),
+            dead_reckoning=bool(s.get("dead_reckoning", False)),
         )
         for a in labels:
             row = copy.deepcopy(by[a])

@@ -51,7 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._checks import bound_array
-from .._validate import choice, instance, integer, positive, record
+from .._validate import boolean, choice, instance, integer, positive, record
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import TrialPool, run_trials, trial_pool
 from .bounds import path_bounds, route_bounds, route_geometry
@@ -140,7 +140,9 @@ class MonteCarloResult:
     the bias of the filter attaining it, in quadrature); ``vues`` how the tracker run got its
     VUEs (:data:`VUES`), and :attr:`tracker_bound` the bound of that tracker; ``error_model``
     the traced route's measurement-noise model (:func:`tunnelkit.design.traced.error_model_summary`;
-    ``None`` on the image channel, where each path carries its reported CRLB).
+    ``None`` on the image channel, where each path carries its reported CRLB);
+    ``dead_reckoning`` (runs, T) [m] the same drives' errors with every measurement dropped
+    (``sweep_montecarlo(dead_reckoning=True)``; else ``None``).
     """
 
     spec: ArraySpec
@@ -157,12 +159,14 @@ class MonteCarloResult:
     learned: np.ndarray | None = None
     vues: str = "known"
     error_model: dict | None = None
+    dead_reckoning: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         b = ("peb", "pcrlb", "drive", "learned")
-        record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), "errors": ("R", "T"),
+        e = ("errors", "dead_reckoning")
+        record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), **dict.fromkeys(e, ("R", "T")),
                              "rmse_runs": ("R",), "settled": (None,)},
-               allow_nan=("errors", "rmse_runs"), nonnegative=("errors", "rmse_runs", "settled", *b),
+               allow_nan=("errors", "rmse_runs"), nonnegative=(*e, "rmse_runs", "settled", *b),
                allow_inf=b, skip=("spec", "error_model"))  # fmt: skip
         instance("spec", self.spec, ArraySpec), choice("mode", self.mode, MODES)
         choice("vues", self.vues, VUES)
@@ -213,6 +217,7 @@ class _SweepTrial:
     impairments: object = None  # achievable.DesignImpairments: the channel mode's
     start: str = "drawn"
     start_sigma: float = START_SIGMA_M
+    dead_reckoning: bool = False
 
     def __call__(self, prep: _Prepared, rng: np.random.Generator) -> np.ndarray:
         from ..studies import evaluate, simulate_drive
@@ -249,7 +254,13 @@ class _SweepTrial:
         sh = START_HEIGHT_SIGMA_M
         p0 = draw_start(drive.truth[0], sigma, rng, sh) if self.start == "drawn" else None
         ev = evaluate(drive, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
-        return _trial_errors(ev.estimates, drive.truth)
+        err = _trial_errors(ev.estimates, drive.truth)
+        if not self.dead_reckoning:
+            return err
+        # the same tracker, start and V2X messages with every measurement dropped
+        alone = replace(drive, epochs=[None] * len(drive.epochs))
+        ev = evaluate(alone, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
+        return np.stack([err, _trial_errors(ev.estimates, drive.truth)])
 
 
 def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
@@ -404,6 +415,7 @@ def sweep_montecarlo(
     start: str = "drawn",
     vues: str = "known",
     start_sigma: float = START_SIGMA_M,
+    dead_reckoning: bool = False,
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -431,7 +443,9 @@ def sweep_montecarlo(
     run's generator after the drive (``"drawn"``, default) or from the true first position
     (``"truth"``), with ``start_sigma`` [m] per axis of uncertainty either way (default
     :data:`START_SIGMA_M`; the entry fix's quality, also the prior of the bounds over the
-    drive). ``vues``
+    drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
+    tracker, start and V2X messages: what the radio adds), its errors the result's
+    ``dead_reckoning``. ``vues``
     (:data:`VUES`): the tracker's VUEs from the tunnel's known surfaces (``"known"``, default)
     or learnt from the paths' angles (``"learned"``).
     """
@@ -454,6 +468,7 @@ def sweep_montecarlo(
         raise ValueError(f"vues: expected one of {VUES}, got {vues!r}")
     runs = integer("runs", runs, minimum=1)
     start_sigma = positive("start_sigma", start_sigma)
+    dead_reckoning = boolean("dead_reckoning", dead_reckoning)
     if impairments is not None:
         from .achievable import DesignImpairments
 
@@ -505,7 +520,7 @@ def sweep_montecarlo(
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         res = run_trials(
-            _SweepTrial(setup, mode, n_epochs, impairments, start, start_sigma),
+            _SweepTrial(setup, mode, n_epochs, impairments, start, start_sigma, dead_reckoning),
             A * runs,
             seed,
             inputs=[prepared[a] for a in range(A) for _ in range(runs)],
@@ -522,6 +537,9 @@ def sweep_montecarlo(
     out = {}
     for a, spec in enumerate(specs):
         err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
+        dr = None
+        if dead_reckoning:  # each run (2, T): the tracker's errors, then dead reckoning's
+            err, dr = err[:, 0], err[:, 1]
         peb, pc, drive, cfg, learned, error_model = built[a]
         out[spec.label] = MonteCarloResult(
             spec,
@@ -542,6 +560,7 @@ def sweep_montecarlo(
             learned,
             vues,
             error_model,
+            dr,
         )
     return out
 

@@ -29,7 +29,8 @@ _ROW_INF = (
     "peb_median_m", "peb_p90_m", "achievable_median_m", "achievable_p90_m", "error_median_m",
     "error_p90_m", "error_p90_ci95_m", "rmse_m", "rmse_ci95_m", "peb_m", "achievable_m",
     "error_median_epoch_m", "drive_bound_known_rms_m", "drive_bound_learned_rms_m",
-    "rmse_over_tracker_bound", "rmse_over_achievable", "screen_m",
+    "rmse_over_tracker_bound", "rmse_over_achievable", "screen_m", "dead_reckoning_p90_m",
+    "dead_reckoning_rmse_m",
 )  # fmt: skip
 _ROW_NONNEGATIVE = ("srnf_valid_share", "met_share", "runs", *_ROW_INF)
 _ROW_SHAPES = {"error_p90_ci95_m": (2,), "rmse_ci95_m": (2,), "x_m": ("T",), "peb_m": ("T",),
@@ -78,6 +79,8 @@ class DesignRow:
     rmse_over_tracker_bound: float | None = None
     rmse_over_achievable: float | None = None
     error_model: dict | None = None
+    dead_reckoning_p90_m: float | None = None
+    dead_reckoning_rmse_m: float | None = None
     screen_m: float | None = field(default=None, repr=False)
     srnf_valid: np.ndarray | None = field(default=None, repr=False)
 
@@ -102,40 +105,52 @@ class DesignRow:
         error_median_m}`` (non-finite values and anything not computed are null); on the
         ray-traced channel's route also ``error_model`` (the tracker's measurement-noise model,
         :func:`tunnelkit.design.traced.error_model_summary`, with ``told_sigmas`` the long-run
-        sigmas its tracker is told)."""
-        return {
-            "array": self.array,
-            "n_elements": int(self.n_elements),
-            "aperture_diagonal_m": _fin(self.aperture_diagonal_m),
-            "status": self.status,
-            "reason": self.reason,
-            "srnf_valid_share": _fin(self.srnf_valid_share),
-            "srnf_valid_share_by_surface": {
-                k: _fin(v) for k, v in self.srnf_valid_share_by_surface.items()
-            },
-            "peb_median_m": _fin(self.peb_median_m),
-            "peb_p90_m": _fin(self.peb_p90_m),
-            "achievable_median_m": _fin(self.achievable_median_m),
-            "achievable_p90_m": _fin(self.achievable_p90_m),
-            "met_share": _fin(self.met_share),
-            "error_median_m": _fin(self.error_median_m),
-            "error_p90_m": _fin(self.error_p90_m),
-            "error_p90_ci95_m": _fins(self.error_p90_ci95_m),
-            "rmse_m": _fin(self.rmse_m),
-            "rmse_ci95_m": _fins(self.rmse_ci95_m),
-            "runs": int(self.runs),
-            "tracker_vues": self.tracker_vues,
-            "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
-            "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
-            "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
-            "rmse_over_achievable": _fin(self.rmse_over_achievable),
-            "per_epoch": {
-                "x_m": _fins(self.x_m),
-                "peb_m": _fins(self.peb_m),
-                "achievable_m": _fins(self.achievable_m),
-                "error_median_m": _fins(self.error_median_epoch_m),
-            },
-        } | ({} if self.error_model is None else {"error_model": dict(self.error_model)})
+        sigmas its tracker is told); with dead reckoning measured, ``dead_reckoning_p90_m`` and
+        ``dead_reckoning_rmse_m`` (the same drives, every measurement dropped)."""
+        return (
+            {
+                "array": self.array,
+                "n_elements": int(self.n_elements),
+                "aperture_diagonal_m": _fin(self.aperture_diagonal_m),
+                "status": self.status,
+                "reason": self.reason,
+                "srnf_valid_share": _fin(self.srnf_valid_share),
+                "srnf_valid_share_by_surface": {
+                    k: _fin(v) for k, v in self.srnf_valid_share_by_surface.items()
+                },
+                "peb_median_m": _fin(self.peb_median_m),
+                "peb_p90_m": _fin(self.peb_p90_m),
+                "achievable_median_m": _fin(self.achievable_median_m),
+                "achievable_p90_m": _fin(self.achievable_p90_m),
+                "met_share": _fin(self.met_share),
+                "error_median_m": _fin(self.error_median_m),
+                "error_p90_m": _fin(self.error_p90_m),
+                "error_p90_ci95_m": _fins(self.error_p90_ci95_m),
+                "rmse_m": _fin(self.rmse_m),
+                "rmse_ci95_m": _fins(self.rmse_ci95_m),
+                "runs": int(self.runs),
+                "tracker_vues": self.tracker_vues,
+                "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
+                "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
+                "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
+                "rmse_over_achievable": _fin(self.rmse_over_achievable),
+                "per_epoch": {
+                    "x_m": _fins(self.x_m),
+                    "peb_m": _fins(self.peb_m),
+                    "achievable_m": _fins(self.achievable_m),
+                    "error_median_m": _fins(self.error_median_epoch_m),
+                },
+            }
+            | ({} if self.error_model is None else {"error_model": dict(self.error_model)})
+            | (
+                {}
+                if self.dead_reckoning_p90_m is None
+                else {
+                    "dead_reckoning_p90_m": _fin(self.dead_reckoning_p90_m),
+                    "dead_reckoning_rmse_m": _fin(self.dead_reckoning_rmse_m),
+                }
+            )
+        )
 
 
 @dataclass
@@ -244,6 +259,15 @@ class DesignReport:
                         f"{r.drive_bound_known_rms_m:.3g} m"
                         + ("" if ratio is None else f", tracker RMSE / bound {ratio:.3g}")
                     )
+            if r.dead_reckoning_p90_m is not None:
+                gain = None
+                if r.rmse_m is not None and r.dead_reckoning_rmse_m:
+                    gain = 1 - r.rmse_m / r.dead_reckoning_rmse_m
+                lines.append(
+                    f"  {r.array}: dead reckoning on the same drives (every measurement dropped): "
+                    f"{q} {r.dead_reckoning_p90_m:.3g} m, RMSE {r.dead_reckoning_rmse_m:.3g} m"
+                    + ("" if gain is None else f"; the radio's gain in RMSE {100 * gain:.2g} %")
+                )
         lines.extend(f"warning: {w}" for w in self.warnings)
         return "\n".join(lines)
 

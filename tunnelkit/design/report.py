@@ -28,7 +28,7 @@ from functools import partial
 
 import numpy as np
 
-from .._validate import choice, finite_array, integer, positive, probability, sequence
+from .._validate import boolean, choice, finite_array, integer, positive, probability, sequence
 from ..budget import check_elements
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
@@ -217,6 +217,13 @@ def score_row(row, res, criterion, target, share, seed, n_boot) -> None:
     boot = np.sqrt(sq.mean(axis=1)[idx].mean(axis=1))
     row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
     row.error_model = getattr(res, "error_model", None)
+    dr = getattr(res, "dead_reckoning", None)
+    if dr is not None:  # the same drives, every measurement dropped: what the radio adds
+        dr = np.asarray(dr, float)
+        row.dead_reckoning_p90_m = share_quantile(
+            np.where(np.isfinite(dr), dr, np.inf)[:, k], share
+        )
+        row.dead_reckoning_rmse_m = float(np.sqrt(np.mean(dr[:, k] ** 2)))
     ach = np.sqrt(np.mean(np.asarray(row.achievable_m)[k] ** 2))
     row.rmse_over_achievable = row.rmse_m / ach if ach > 0 else None
     _drive_bounds(row, res, k)
@@ -260,6 +267,7 @@ def design_sweep(
     timeout: float | None = None,
     n_boot: int = 2000,
     start_sigma: float = START_SIGMA_M,
+    dead_reckoning: bool = False,
 ) -> DesignReport:
     """Every candidate of ``arrays`` evaluated and judged (module docstring).
 
@@ -271,7 +279,9 @@ def design_sweep(
     / ``scheduler`` / ``timeout`` go to the one task set; ``n_epochs`` truncates the route;
     ``n_boot`` bootstrap resamples; ``start_sigma`` [m] the entry fix's standard deviation per
     axis (the tracker's start and the prior of the bounds over the drive; default
-    :data:`~tunnelkit.design.montecarlo.START_SIGMA_M`, the open-sky fix). An array that does not fit, or whose bound or Monte-Carlo
+    :data:`~tunnelkit.design.montecarlo.START_SIGMA_M`, the open-sky fix); ``dead_reckoning``:
+    each drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what
+    the radio adds). An array that does not fit, or whose bound or Monte-Carlo
     is undefined, is a row with status ``"error"`` and the reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -293,6 +303,7 @@ def design_sweep(
     seed = integer("seed", seed, minimum=0)
     n_boot = integer("n_boot", n_boot, minimum=100)
     start_sigma = positive("start_sigma", start_sigma)
+    dead_reckoning = boolean("dead_reckoning", dead_reckoning)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     workers, scheduler = parallel_options(workers, scheduler)
@@ -331,6 +342,7 @@ def design_sweep(
             "progress": progress,
             "n_epochs": n_epochs,
             "start_sigma": start_sigma,
+            "dead_reckoning": dead_reckoning,
         }
         results, failed = _run_montecarlo(setup, todo, runs, seed, kw)
         for r in rows:
@@ -397,5 +409,7 @@ def design_sweep(
         settings["channel"] = setup.channel
     if start_sigma != START_SIGMA_M:  # (the default's JSON as before)
         settings["start_sigma_m"] = start_sigma
+    if dead_reckoning:
+        settings["dead_reckoning"] = True
     rec = recommend([r for r in rows if r.status != "error"], target, share, runs)
     return DesignReport(setup.name, rows, rec, settings, warnings)
