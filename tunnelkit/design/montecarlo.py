@@ -19,8 +19,8 @@ JAVELIN there takes each path's covariance as the extraction reports it (the CRL
 estimate, which the ML route attains), so the tracker is tuned by the design itself at any
 carrier and size (:func:`javelin_config`). It starts from an open-sky fix drawn with the
 uncertainty it is told (:data:`STARTS`; ``start_sigma`` per axis, default 1 m, 5 cm in
-height), first fixes itself on the path the known surfaces say is the LoS, and takes its VUEs from the tunnel's known surfaces
-(:data:`VUES`, :class:`tunnelkit.tracking.javelin.surfaces.GeometricBirth`): a design knows
+height), first fixes itself on the path the known surfaces say is the LoS, and takes its VUEs
+from the tunnel's known surfaces (:data:`VUES`, :class:`tunnelkit.tracking.javelin.surfaces.GeometricBirth`): a design knows
 its tunnel, and a tracker that learns every VUE afresh cannot use the reflections' information
 until it has learnt the surfaces (under a calibration error, whose bias repeats, it never
 does). Its settled error (after the first :data:`SETTLE_S`)

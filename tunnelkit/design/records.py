@@ -107,50 +107,45 @@ class DesignRow:
         :func:`tunnelkit.design.traced.error_model_summary`, with ``told_sigmas`` the long-run
         sigmas its tracker is told); with dead reckoning measured, ``dead_reckoning_p90_m`` and
         ``dead_reckoning_rmse_m`` (the same drives, every measurement dropped)."""
-        return (
-            {
-                "array": self.array,
-                "n_elements": int(self.n_elements),
-                "aperture_diagonal_m": _fin(self.aperture_diagonal_m),
-                "status": self.status,
-                "reason": self.reason,
-                "srnf_valid_share": _fin(self.srnf_valid_share),
-                "srnf_valid_share_by_surface": {
-                    k: _fin(v) for k, v in self.srnf_valid_share_by_surface.items()
-                },
-                "peb_median_m": _fin(self.peb_median_m),
-                "peb_p90_m": _fin(self.peb_p90_m),
-                "achievable_median_m": _fin(self.achievable_median_m),
-                "achievable_p90_m": _fin(self.achievable_p90_m),
-                "met_share": _fin(self.met_share),
-                "error_median_m": _fin(self.error_median_m),
-                "error_p90_m": _fin(self.error_p90_m),
-                "error_p90_ci95_m": _fins(self.error_p90_ci95_m),
-                "rmse_m": _fin(self.rmse_m),
-                "rmse_ci95_m": _fins(self.rmse_ci95_m),
-                "runs": int(self.runs),
-                "tracker_vues": self.tracker_vues,
-                "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
-                "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
-                "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
-                "rmse_over_achievable": _fin(self.rmse_over_achievable),
-                "per_epoch": {
-                    "x_m": _fins(self.x_m),
-                    "peb_m": _fins(self.peb_m),
-                    "achievable_m": _fins(self.achievable_m),
-                    "error_median_m": _fins(self.error_median_epoch_m),
-                },
-            }
-            | ({} if self.error_model is None else {"error_model": dict(self.error_model)})
-            | (
-                {}
-                if self.dead_reckoning_p90_m is None
-                else {
-                    "dead_reckoning_p90_m": _fin(self.dead_reckoning_p90_m),
-                    "dead_reckoning_rmse_m": _fin(self.dead_reckoning_rmse_m),
-                }
-            )
-        )
+        out = {
+            "array": self.array,
+            "n_elements": int(self.n_elements),
+            "aperture_diagonal_m": _fin(self.aperture_diagonal_m),
+            "status": self.status,
+            "reason": self.reason,
+            "srnf_valid_share": _fin(self.srnf_valid_share),
+            "srnf_valid_share_by_surface": {
+                k: _fin(v) for k, v in self.srnf_valid_share_by_surface.items()
+            },
+            "peb_median_m": _fin(self.peb_median_m),
+            "peb_p90_m": _fin(self.peb_p90_m),
+            "achievable_median_m": _fin(self.achievable_median_m),
+            "achievable_p90_m": _fin(self.achievable_p90_m),
+            "met_share": _fin(self.met_share),
+            "error_median_m": _fin(self.error_median_m),
+            "error_p90_m": _fin(self.error_p90_m),
+            "error_p90_ci95_m": _fins(self.error_p90_ci95_m),
+            "rmse_m": _fin(self.rmse_m),
+            "rmse_ci95_m": _fins(self.rmse_ci95_m),
+            "runs": int(self.runs),
+            "tracker_vues": self.tracker_vues,
+            "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
+            "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
+            "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
+            "rmse_over_achievable": _fin(self.rmse_over_achievable),
+            "per_epoch": {
+                "x_m": _fins(self.x_m),
+                "peb_m": _fins(self.peb_m),
+                "achievable_m": _fins(self.achievable_m),
+                "error_median_m": _fins(self.error_median_epoch_m),
+            },
+        }
+        if self.error_model is not None:
+            out["error_model"] = dict(self.error_model)
+        if self.dead_reckoning_p90_m is not None:
+            out["dead_reckoning_p90_m"] = _fin(self.dead_reckoning_p90_m)
+            out["dead_reckoning_rmse_m"] = _fin(self.dead_reckoning_rmse_m)
+        return out
 
 
 @dataclass
