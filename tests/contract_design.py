@@ -99,7 +99,7 @@ def design_traced():
     path = tempfile.mkdtemp() + "/errors.json"
     rec = traced.design_errors(setup, "4x4", n_epochs=1, path=path)
     d = traced.traced_javelin(setup, "4x4", rec)
-    traced.error_model_summary(rec)
+    traced.error_model_summary(rec, d.config)
     sig = {"phi": 0.1, "psi": 0.1, "kappa": 30.0, "d": 1.0}
     traced.sigma_error_model(setup, "4x4", sig, epochs=[0, 1])
     traced.traced_bounds(setup, "4x4", d.config, 2)

@@ -117,6 +117,11 @@ def test_the_tracker_is_told_the_measured_errors(setup):
     s = traced.error_model_summary(rec)
     assert s["kind"] == "traced-measured" and s["sigmas"]["kappa_m"] == pytest.approx(row[4])
     assert traced.error_model_summary(None) == {"kind": "reported-crlb"}
+    told = traced.error_model_summary(rec, d.config)["told_sigmas"]
+    assert "told_sigmas" not in s and told["kappa_m"] == pytest.approx(d.config.sigma_kappa)
+    assert told["psi_deg"] == pytest.approx(np.degrees(d.config.sigma_psi))
+    with pytest.raises(TypeError, match="config"):
+        traced.error_model_summary(rec, {"sigma_phi": 0.1})
     # the errors the traced channel gives are far above the reported CRLB of the image design
     assert s["sigmas"]["phi_deg"] > 0.1
 

@@ -368,14 +368,8 @@ class _ArrayJob:
 
             # this array's errors on the traced channel (cached with their provenance)
             rec = design_errors(self.setup, spec, n_epochs=self.T)
-            design, error_model = traced_javelin(self.setup, spec, rec), error_model_summary(rec)
-            c = design.config
-            error_model["told_sigmas"] = {
-                "phi_deg": float(np.degrees(c.sigma_phi)),
-                "psi_deg": float(np.degrees(c.sigma_psi)),
-                "kappa_m": float(c.sigma_kappa),
-                "delta_d_m": float(c.sigma_delta_d),
-            }
+            design = traced_javelin(self.setup, spec, rec)
+            error_model = error_model_summary(rec, design.config)
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
             pc, drive, learned = traced_bounds(
                 self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma

@@ -308,16 +308,34 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     return design_from_errors(record["rows"], base=base, correlation=record.get("correlation"))
 
 
-def error_model_summary(record: dict | None) -> dict:
+def _config_sigmas(config) -> dict:
+    """``config``'s four sigmas (a JavelinConfig's ``sigma_phi``, ``sigma_psi`` [rad],
+    ``sigma_kappa``, ``sigma_delta_d`` [m]) as ``{"phi", "psi", "kappa", "d"}``."""
+    names = (("phi", "sigma_phi"), ("psi", "sigma_psi"), ("kappa", "sigma_kappa"),
+             ("d", "sigma_delta_d"))  # fmt: skip
+    try:
+        return {k: float(getattr(config, a)) for k, a in names}
+    except (AttributeError, TypeError, ValueError):
+        raise TypeError(f"config: expected a JavelinConfig, got {type(config).__name__}") from None
+
+
+def error_model_summary(record: dict | None, config=None) -> dict:
     """What the report's JSON says about an array's measurement-noise model: ``{"kind":
     "reported-crlb"}`` (``record`` None: each path's reported CRLB, the image channel's), or the
     traced record's ``kind`` "traced-measured", sigmas (the RMS errors), the errors' lag-1
     correlation (the tracker's sigmas are the RMS times ``sqrt((1 + r) / (1 - r))``; None for a
-    record without it), seed, runs, file and scene key."""
+    record without it), seed, runs, file and scene key; with ``config`` (the tracker's
+    JavelinConfig, :func:`traced_javelin`) also ``told_sigmas``, the sigmas it is told."""
     if record is None:
         return {"kind": "reported-crlb"}
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of design_errors or None")
+    told = {}
+    if config is not None:
+        c = _config_sigmas(config)
+        told = {"told_sigmas": {"phi_deg": float(np.degrees(c["phi"])),
+                                "psi_deg": float(np.degrees(c["psi"])),
+                                "kappa_m": c["kappa"], "delta_d_m": c["d"]}}  # fmt: skip
     return {
         "kind": "traced-measured",
         "sigmas": _sigmas(record),
@@ -328,6 +346,7 @@ def error_model_summary(record: dict | None) -> dict:
         "prefilter": "geometry_keep",
         "path": record.get("path"),
         "rt_key": record.get("rt_key"),
+        **told,
     }
 
 
@@ -387,11 +406,7 @@ def traced_bounds(
     spec = parse_array(spec)
     n = len(setup.trajectory)
     T = n if T is None else min(integer("T", T, minimum=1), n)
-    try:
-        sig = {k: float(getattr(config, a)) for k, a in (("phi", "sigma_phi"), ("psi", "sigma_psi"),
-               ("kappa", "sigma_kappa"), ("d", "sigma_delta_d"))}  # fmt: skip
-    except (AttributeError, TypeError, ValueError):
-        raise TypeError(f"config: expected a JavelinConfig, got {type(config).__name__}") from None
+    sig = _config_sigmas(config)
     sigma_p0 = START_SIGMA_M if sigma_p0 is None else positive("sigma_p0", sigma_p0)
     try:
         model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
