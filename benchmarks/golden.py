@@ -1,5 +1,5 @@
 """Golden regression of the command line: every ``tunnelkit reproduce`` target and
-``tunnelkit design --runs 2``, on two seeds, written as JSON and compared byte for byte.
+``tunnelkit design --units 2`` (two units of two drives), on two seeds, written as JSON and compared byte for byte.
 
 A refactor that must not change a number is checked like this::
 
@@ -32,6 +32,9 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 SEEDS = (0, 20261202)
 
+#: the design cases' Monte-Carlo: two units of two drives, one batch (no sequential rule)
+DESIGN_UNITS = ["--units", "2", "--drives-per-unit", "2", "--max-units", "2"]
+
 # (name, arguments after `tunnelkit`); seed appended per case
 CASES = [
     ("jiang-crlb", ["reproduce", "jiang-crlb", "--runs", "300"]),
@@ -42,11 +45,11 @@ CASES = [
     ("javelin-table2", ["reproduce", "javelin-table2", "--runs", "2"]),
     (
         "design-28ghz",
-        ["design", "example-rectangular-28ghz", "--arrays", "4x4", "8x8", "--runs", "2"],
+        ["design", "example-rectangular-28ghz", "--arrays", "4x4", "8x8", *DESIGN_UNITS],
     ),
     (
         "design-paper",
-        ["design", "italiano2026-straight", "--arrays", "4x4", "10x10", "--runs", "2"],
+        ["design", "italiano2026-straight", "--arrays", "4x4", "10x10", *DESIGN_UNITS],
     ),
 ]
 

@@ -344,8 +344,8 @@ def _baselines():
     from tunnelkit import budget, crlb, geometry, metrics, propagation
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
     from tunnelkit.design import errormodel, mcrb, report, verdict
+    from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.design.drivebound import drive_bound
-    from tunnelkit.design.montecarlo import javelin_config
     from tunnelkit.extraction.decomposition import kruskal_rank
     from tunnelkit.fresnel.bounds import fraunhofer_distance
     from tunnelkit.plots import common, tables, topview
@@ -387,7 +387,15 @@ def _baselines():
     verdict.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
     verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
     verdict.gate(e, np.ones(50, bool), "achievable")
-    verdict.screen_bound(e, 2 * e)
+    verdict.judge(0.1, units=20, yield_=0.9, ci=[0.7, 0.97], cap=200)
+    verdict.recommend([], 0.1, 0.9, 20)
+    from tunnelkit.design import units
+
+    units.wilson_interval(3, 20)
+    units.unit_quantiles(np.abs(rng.standard_normal((4, 30))), 2, np.arange(10, 30), 0.9)
+    units.unit_yield(np.array([0.05, 0.2, 0.08]), 0.1)
+    units.unit_rngs(3, 2, 2)
+    units.drive_streams(2, 3, 2)
     report.over_target(np.arange(5.0), np.array([0.1, 0.3, 0.25, 0.1, 0.4]), 0.2)
     drive_bound(np.full(5, 0.1), np.full(5, 0.02))
     javelin_config({"d": 0.05, "direction": 0.01, "kappa": 2.0})
@@ -432,8 +440,8 @@ def _known_surfaces():
     """The design's tracker pieces: an honest start, VUEs from known planes and the batch form
     of the bound over the drive."""
     from tunnelkit import design
+    from tunnelkit.design.arrayjob import design_planes
     from tunnelkit.design.learnedbound import batch_information
-    from tunnelkit.design.montecarlo import design_planes
     from tunnelkit.tracking.javelin import JavelinState, draw_start
     from tunnelkit.tracking.javelin.config import JavelinConfig
     from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors

@@ -66,13 +66,15 @@ def design_confirm():
     from tunnelkit.widgets import design as wd
 
     setup = tiny_setup()
-    rep = report.design_sweep(setup, ["4x4"], runs=2, n_epochs=1, n_boot=100)
+    few = {"units": 2, "max_units": 2, "drives_per_unit": 1, "settle": 0.0}
+    rep = report.design_sweep(setup, ["4x4"], n_epochs=1, n_boot=100, **few)
     verdict.recommend(rep.rows, 0.2, 0.9, 2)
     confirm.confirmation_candidates(rep)
     confirm.next_candidate(rep, [])
-    confirm.confirm_on_channel(rep, setup, runs=2)
+    confirm.confirm_on_channel(rep, setup, units=2)
     design.javelin_rmse(setup, "4x4", 2, 0, n_epochs=1, crlb=CRLB)
     pdz.size_figure(rep.rows)
+    pdz.design_answer_figure(rep)
     full = design.DesignSetup.from_scenario(SCENARIO)
     b = design.route_bounds(full, "4x4", epochs=[5, 10])
     pdz.route_traces(b, target=0.2)
@@ -81,7 +83,7 @@ def design_confirm():
         lambda x: pdz.route_figure(b, target=x),
         {"x": _slider()},
         scenario=SCENARIO,
-        runs=2,
+        units=2,
         seed=0,
     )
 

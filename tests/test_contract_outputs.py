@@ -74,10 +74,12 @@ def test_the_quantiles_of_the_verdict_stay_in_zero_to_infinity():
         verdict.implied_quantile(np.array([0.1, np.nan]), 0.9)
     with pytest.raises(TypeError, match=r"^values: "):
         verdict.share_quantile("x", 0.9)
-    with pytest.raises(ValueError, match=r"^error_q: "):
-        verdict.judge(0.2, 0.1, runs=20, error_q=float("nan"), ci=[0.1, 0.2])
+    with pytest.raises(ValueError, match=r"^yield_: "):
+        verdict.judge(0.2, units=20, yield_=float("nan"), ci=[0.1, 0.2])
     with pytest.raises(ValueError, match=r"^ci: "):
-        verdict.judge(0.2, 0.1, runs=20, error_q=0.1, ci=[])
+        verdict.judge(0.2, units=20, yield_=0.1, ci=[])
+    with pytest.raises(ValueError, match=r"^ci: "):
+        verdict.judge(0.2, units=20, yield_=0.5, ci=[0.6, 1.2])
 
 
 @pytest.fixture(scope="module")

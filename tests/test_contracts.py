@@ -604,9 +604,28 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(
         r"design\.records\.DesignRow",
+        r"reason|gaps",
+        "empty",
+        "no reason to give (the default: a row with a verdict says why only when it has to); "
+        "no gap on the route",
+    ),
+    _doc(
+        r"design\.units\.unit_quantiles",
+        r"errors",
+        "nan",
+        "no estimate at that epoch (a lost track): counted as an infinite error",
+    ),
+    _doc(
+        r"design\.arrayjob\.javelin_config",
+        r"min_d",
+        "negative",
+        "Algorithm 1's delay-check threshold: negative where the route's clock bias allows it",
+    ),
+    _doc(
+        r"design\.achievable\.AchievableBound",
         r"reason",
         "empty",
-        "no reason to give (the default: a row with a verdict says why only when it has to)",
+        "no gap on the route: nothing to name",
     ),
     _doc(
         r"design\.confirm\.ConfirmedReport",

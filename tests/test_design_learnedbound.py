@@ -7,6 +7,7 @@ import pytest
 
 from tunnelkit import design
 from tunnelkit.design.achievable import DesignImpairments, path_error_model
+from tunnelkit.design.arrayjob import model_head
 from tunnelkit.design.drivebound import (
     drive_pcrlb,
     position_bias_rms,
@@ -18,7 +19,6 @@ from tunnelkit.design.learnedbound import (
     learned_model,
     learned_pcrlb,
 )
-from tunnelkit.design.montecarlo import _head
 
 
 @lru_cache(maxsize=1)
@@ -33,7 +33,7 @@ def _case():
 
 def _short(K):
     setup, spec, m, _ = _case()
-    return setup, _head(m, K), design.route_geometry(setup, spec, epochs=np.arange(K))
+    return setup, model_head(m, K), design.route_geometry(setup, spec, epochs=np.arange(K))
 
 
 def test_recursion_matches_the_batch_information_on_a_short_drive():

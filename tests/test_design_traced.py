@@ -126,8 +126,12 @@ def test_the_tracker_is_told_the_measured_errors(setup):
     assert s["sigmas"]["phi_deg"] > 0.1
 
 
+#: a two-unit sweep of one drive each on a short route: every epoch counted
+FEW = {"units": 2, "max_units": 2, "drives_per_unit": 1, "settle": 0.0}
+
+
 def test_the_sweep_and_report_name_the_error_model(setup):
-    rep = design.design_sweep(setup, ["4x4"], runs=2, seed=0, mode="channel", n_epochs=3)
+    rep = design.design_sweep(setup, ["4x4"], seed=0, mode="channel", n_epochs=3, **FEW)
     row = rep.rows[0]
     assert row.runs == 2 and row.error_p90_m is not None and np.isfinite(row.error_p90_m)
     j = rep.to_json()
@@ -139,8 +143,8 @@ def test_the_sweep_and_report_name_the_error_model(setup):
     assert "traced route, noise measured on seed 0" in rep.to_table()
     # the image channel's JSON carries neither
     img = design.design_sweep(
-        design.DesignSetup.from_scenario(SCENARIO), ["4x4"], runs=2, seed=1, mode="channel",
-        n_epochs=2,
+        design.DesignSetup.from_scenario(SCENARIO), ["4x4"], seed=1, mode="channel",
+        n_epochs=2, **FEW,
     ).to_json()  # fmt: skip
     assert "channel" not in img["inputs"] and "error_model" not in img["arrays"][0]
 
@@ -190,25 +194,25 @@ def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
 def test_the_sweep_reports_the_bound_of_the_told_sigmas(setup):
     rec = traced.design_errors(setup, "4x4", n_epochs=3)
     d = traced.traced_javelin(setup, "4x4", rec)
-    k = design.counted_epochs(setup.trajectory.t[:3])
+    k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
     for fix in (None, 0.1):  # the default entry fix and a better one: the bounds' prior follows
         kw = {} if fix is None else {"start_sigma": fix}
-        rep = design.design_sweep(setup, ["4x4"], runs=2, seed=0, mode="channel", n_epochs=3, **kw)
+        rep = design.design_sweep(setup, ["4x4"], seed=0, mode="channel", n_epochs=3, **FEW, **kw)
         row = rep.rows[0]
         _, drive, learned = traced.traced_bounds(setup, "4x4", d.config, 3, sigma_p0=fix)
-        assert row.drive_bound_known_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
-        assert row.drive_bound_learned_rms_m == pytest.approx(np.sqrt(np.mean(learned[k] ** 2)))
-        assert row.rmse_over_tracker_bound == pytest.approx(
-            row.rmse_m / row.drive_bound_known_rms_m
+        # the told sigmas' posterior CRLB: a prediction of the traced tracker, not its bound
+        assert row.pcrlb_rms_m is None and row.hybrid_bound_rms_m is None
+        assert row.predicted_drive_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
+        assert row.predicted_drive_learned_rms_m == pytest.approx(np.sqrt(np.mean(learned[k] ** 2)))
+        assert row.rmse_over_predicted_drive == pytest.approx(
+            row.rmse_m / row.predicted_drive_rms_m
         )
         told = row.error_model["told_sigmas"]
         assert told["phi_deg"] == pytest.approx(np.degrees(d.config.sigma_phi))
         table = rep.to_table()
         assert "the tracker is told their long-run value" in table
-        assert (
-            f"bound of the sigmas the tracker is told (settled RMS) {row.drive_bound_known_rms_m:.3g} m"
-            in table
-        )
+        assert "posterior CRLB of the sigmas the tracker is told" in table
+        assert f"{row.predicted_drive_rms_m:.3g} m, tracker RMSE / it" in table
 
 
 def test_bad_input(setup):

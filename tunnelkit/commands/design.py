@@ -1,18 +1,24 @@
 """``tunnelkit design SCENARIO --arrays 4x4 8x8 16x16 [--fc 28GHz] [--bandwidth 400MHz]
 [--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--wideband-model]
 [--dmc-share S]
-[--target T] [--share Q] [--runs N] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--confirm [--confirm-runs N]] [--channel image|sionna]
-[--start-sigma S] [--dead-reckoning] [--format table|json]``.
+[--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
+[--settle S] [--workers N | --scheduler A] [--mode bound|channel]
+[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna]
+[--start-sigma S] [--dead-reckoning] [--format table|json] [--plot FILE.html]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
-the ideal position error bound, the achievable bound under the stated impairments, SR-NF validity
-per surface, and with ``--runs`` the Monte-Carlo error of the design's tracker (its
-``share``-quantile over the settled route with a bootstrap 95 % interval); the smallest array
-whose interval lies below ``--target`` is recommended (``recommendation.route`` the route that
-decided; ``--confirm``: the bound route's answer re-run on the channel route, which then decides,
-:func:`tunnelkit.design.confirm_on_channel`). Every input, the criterion and the warnings are in
-the JSON.
+the ideal position error bound, the predicted error under the stated impairments (a first-order
+prediction, not a bound), SR-NF validity per surface, and with ``--units`` the Monte-Carlo of the
+design's tracker over manufactured units (one calibration draw each, ``--drives-per-unit``
+drives): the unit yield (the share of units whose own ``share``-quantile over the settled route
+meets ``--target``, Wilson 95 % interval), the pooled quantile with a bootstrap over units, and the
+bounds over the drive beside the tracker's RMSE. Undecided arrays get more units until decided or
+``--max-units``; the smallest array whose yield interval reaches ``--yield`` is recommended
+(``recommendation.route`` the route that decided; ``--confirm``: the bound route's answer re-run
+on the channel route, which then decides, :func:`tunnelkit.design.confirm_on_channel`). Every
+input, the criterion and the warnings are in the JSON. ``--plot FILE.html`` also writes the answer
+as a figure (:func:`tunnelkit.plots.design.design_answer_figure`, plotly.js included, so it opens
+offline) and says so on stderr, so the JSON on stdout stays valid.
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ import argparse
 import json
 import re
 import sys
+from pathlib import Path
 
 NAME = "design"
 HELP = (
@@ -79,6 +86,18 @@ def _level(param: str, upper: float | None = None):
     return parse
 
 
+def _share(param: str):
+    """argparse type: a share in (0, 1); errors name ``param``."""
+
+    def parse(text: str) -> float:
+        value = _level(param, 1.0)(text)
+        if value == 0:
+            raise argparse.ArgumentTypeError(f"{param}: must be in (0, 1), got {text!r}")
+        return value
+
+    return parse
+
+
 def _count(param: str, minimum: int):
     def parse(text: str) -> int:
         try:
@@ -90,6 +109,23 @@ def _count(param: str, minimum: int):
         if value < minimum:
             raise argparse.ArgumentTypeError(f"{param}: must be >= {minimum}, got {text!r}")
         return value
+
+    return parse
+
+
+def _html_path(param: str):
+    """argparse type: a file path whose directory exists (checked before the sweep runs, not
+    after it); errors name ``param``."""
+
+    def parse(text: str) -> Path:
+        path = Path(text).expanduser()
+        if not text.strip() or path.is_dir():
+            raise argparse.ArgumentTypeError(f"{param}: expected a file path, got {text!r}")
+        if not path.parent.is_dir():
+            raise argparse.ArgumentTypeError(
+                f"{param}: the directory {str(path.parent)!r} of {text!r} does not exist"
+            )
+        return path
 
     return parse
 
@@ -118,7 +154,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=0.9,
         help="share of the settled route on which the error must meet the target (0.9)",
     )
-    imp = p.add_argument_group("impairments (the achievable bound and the Monte-Carlo)")
+    imp = p.add_argument_group(
+        "impairments (the predicted error and the Monte-Carlo; default none: the ideal, optimistic array)"
+    )
     imp.add_argument(
         "--phase-error-deg",
         type=_level("phase_error_deg"),
@@ -158,11 +196,44 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "srnf: an eq. 51 estimator, SR-NF validity a gate",
     )
     p.add_argument("--eps", type=_positive("eps"), default=0.15, help="eps_phi [rad] (0.15)")
-    p.add_argument(
+    mc = p.add_argument_group(
+        "Monte-Carlo by manufactured units (each unit one calibration draw, several drives)"
+    )
+    mc.add_argument(
+        "--units",
         "--runs",
-        type=_count("runs", 0),
+        dest="units",
+        type=_count("units", 0),
         default=0,
-        help="Monte-Carlo drives per array (0: bounds only; 20 for a decision)",
+        help="units of the first batch (0: bounds and predictions only, no recommendation; 20 "
+        "to decide); undecided arrays then get as many again until decided or --max-units",
+    )
+    mc.add_argument(
+        "--drives-per-unit",
+        type=_count("drives_per_unit", 1),
+        default=2,
+        help="drives per unit (2): a unit's own quantile pools its drives",
+    )
+    mc.add_argument(
+        "--yield",
+        dest="required_yield",
+        type=_share("yield"),
+        default=0.95,
+        help="required share of units that meet the target on their own (0.95); the "
+        "recommendation is the smallest array whose yield's 95 %% interval reaches it",
+    )
+    mc.add_argument(
+        "--max-units",
+        type=_count("max_units", 1),
+        default=200,
+        help="cap of the sequential rule: units per array at most (200)",
+    )
+    mc.add_argument(
+        "--settle",
+        type=_level("settle"),
+        default=1.0,
+        help="settle window [s]: the epochs this long after the start (the tracker's start-up "
+        "from the entry fix) are left out of the settled route (1)",
     )
     p.add_argument(
         "--mode",
@@ -175,13 +246,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--confirm",
         action="store_true",
         help="re-run the recommended array (and the smaller ones left undecided) on the channel "
-        "route with the same runs and seed, and take the recommendation from it (bound mode)",
+        "route with the same units and seed, and take the recommendation from it (bound mode)",
     )
     p.add_argument(
+        "--confirm-units",
         "--confirm-runs",
+        dest="confirm_units",
         type=int,
         default=None,
-        help="drives per array of the --confirm re-run (default: --runs); the channel route "
+        help="units per array of the --confirm re-run (default: --units); the channel route "
         "costs minutes per drive, the bound route seconds",
     )
     p.add_argument(
@@ -215,6 +288,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_parallel_arguments(p)
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--format", choices=["table", "json"], default="table")
+    p.add_argument(
+        "--plot",
+        type=_html_path("plot"),
+        default=None,
+        metavar="FILE.html",
+        help="also write the answer as an interactive figure (HTML): the error along the route "
+        "beside the PEB and the prediction, the unit yield per array",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -226,22 +307,22 @@ def main(args: argparse.Namespace) -> int:
         specs = [design.parse_array(a, args.spacing) for a in args.arrays]
     except ValueError as exc:  # the option's name, not the function's parameter
         raise ValueError(f"arrays: {str(exc).removeprefix('spec: ')}") from None
-    if args.confirm and (args.mode != "bound" or args.runs == 0):
+    if args.confirm and (args.mode != "bound" or args.units == 0):
         print(
             "tunnelkit design: error: --confirm re-runs a bound-route answer: it needs --mode "
-            "bound and --runs > 0",
+            "bound and --units > 0",
             file=sys.stderr,
         )
         return 2
-    if args.confirm_runs is not None and (not args.confirm or args.confirm_runs < 1):
+    if args.confirm_units is not None and (not args.confirm or args.confirm_units < 1):
         print(
-            "tunnelkit design: error: --confirm-runs needs --confirm and at least 1 run",
+            "tunnelkit design: error: --confirm-units needs --confirm and at least 1 unit",
             file=sys.stderr,
         )
         return 2
-    if args.channel != "image" and (args.mode != "channel" or args.runs == 0):
+    if args.channel != "image" and (args.mode != "channel" or args.units == 0):
         print(
-            "tunnelkit design: error: --channel sionna needs --mode channel and --runs > 0 "
+            "tunnelkit design: error: --channel sionna needs --mode channel and --units > 0 "
             "(the bounds and the bound mode use the eq. 1 model)",
             file=sys.stderr,
         )
@@ -270,14 +351,18 @@ def main(args: argparse.Namespace) -> int:
             criterion=args.criterion,
             impairments=impairments,
             eps_phi=args.eps,
-            runs=args.runs,
+            units=args.units,
+            drives_per_unit=args.drives_per_unit,
+            required_yield=args.required_yield,
+            max_units=args.max_units,
+            settle=args.settle,
             seed=args.seed,
             mode=args.mode,
             n_epochs=args.n_epochs,
             **({} if args.start_sigma is None else {"start_sigma": args.start_sigma}),
             **({"dead_reckoning": True} if args.dead_reckoning else {}),
             **parallel_kwargs(args),
-            progress=args.runs > 0 and args.format == "table" and not args.no_progress,
+            progress=args.units > 0 and args.format == "table" and not args.no_progress,
         )
     except TrialLost as exc:
         print(f"tunnelkit design: error: {exc}", file=sys.stderr)
@@ -288,13 +373,13 @@ def main(args: argparse.Namespace) -> int:
         mount_height_m=args.mount_height,
         **({"channel": args.channel} if args.channel != "image" else {}),
     )
-    rep.recommendation["route"] = args.mode if args.runs else None
-    if args.confirm and args.mode == "bound" and args.runs:
+    rep.recommendation["route"] = args.mode if args.units else None
+    if args.confirm and args.mode == "bound" and args.units:
         try:
             rep = design.confirm_on_channel(
                 rep,
                 setup,
-                runs=args.confirm_runs,
+                units=args.confirm_units,
                 **parallel_kwargs(args),
                 progress=args.format == "table" and not args.no_progress,
             )
@@ -305,6 +390,15 @@ def main(args: argparse.Namespace) -> int:
         for r in rep.rows:
             print(f"tunnelkit design: error: {r.reason}", file=sys.stderr)
         return 2
+    if args.plot is not None:
+        from ..plots.design import design_answer_figure
+
+        try:
+            design_answer_figure(rep).write_html(args.plot, include_plotlyjs=True)
+        except OSError as exc:
+            print(f"tunnelkit design: error: plot: cannot write {exc}", file=sys.stderr)
+            return 2
+        print(f"figure written to {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps(rep.to_json(), indent=2))
     else:

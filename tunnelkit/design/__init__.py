@@ -41,9 +41,16 @@ quantile lies below the target. One job per module:
 from __future__ import annotations
 
 from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
+from .arrayjob import design_planes
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .confirm import ConfirmedReport, confirm_on_channel, confirmation_candidates
-from .drivebound import drive_bound, drive_pcrlb, position_bias_rms, position_information
+from .drivebound import (
+    drive_bound,
+    drive_pcrlb,
+    position_bias_rms,
+    position_information,
+    unit_pcrlb,
+)
 from .errormodel import PathErrorModel
 from .fastroute import BoundRoute, bound_drive, bound_route
 from .geometry import KINDS, RouteGeometry, trace_route
@@ -55,13 +62,13 @@ from .montecarlo import (
     STARTS,
     VUES,
     MonteCarloResult,
-    design_planes,
     javelin_config,
     sweep_montecarlo,
 )
 from .onearray import javelin_rmse
 from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
+from .units import unit_quantiles, unit_yield, wilson_interval
 from .verdict import (
     CRITERIA,
     MIN_RUNS_CI,
@@ -72,7 +79,6 @@ from .verdict import (
     implied_quantile,
     judge,
     recommend,
-    screen_bound,
     share_quantile,
 )
 
@@ -125,9 +131,12 @@ __all__ = [
     "recommend",
     "route_bounds",
     "route_geometry",
-    "screen_bound",
     "share_quantile",
     "smallest_meeting",
     "sweep_montecarlo",
     "trace_route",
+    "unit_pcrlb",
+    "unit_quantiles",
+    "unit_yield",
+    "wilson_interval",
 ]

@@ -55,13 +55,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import bound_array
-from .._validate import boolean, choice, instance, nonnegative, positive, record
-from ..channel import DiffuseSpec, Impairments
+from .._validate import choice, instance, record, text
 from ..constants import C
 from ..geometry import spherical_jacobian
 from .bounds import compress_slots, route_bounds, route_geometry, theta_fim, theta_jacobian
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
+from .impairments import DesignImpairments
 from .mcrb import EtaModes, scaled_inverse
 from .setup import ArraySpec, DesignSetup, parse_array
 
@@ -71,81 +71,12 @@ __all__ = [
     "DesignImpairments",
     "achievable_bound",
     "path_error_model",
+    "unresolved_reason",
 ]
 
-_DMC_SPATIAL = ("white", "per-surface")
 LN10_20 = np.log(10.0) / 20.0
 #: epochs evaluated together (bounds the memory of the mode vectors)
 _CHUNK_BYTES = 64e6
-
-
-@dataclass(frozen=True)
-class DesignImpairments:
-    """The impairments a design carries (module docstring).
-
-    ``phase_error_deg`` / ``gain_error_db``: standard deviations of the per-element calibration
-    error; ``spatial_wideband``: the per-element delay across the aperture, in the channel;
-    ``wideband_model``: the estimator models that term too (the ML extraction with
-    ``wideband=True``, :mod:`tunnelkit.extraction.ml.wideband`), so it leaves no bias (needs
-    ``spatial_wideband``: a model term the channel lacks is refused); ``dmc_share`` in
-    [0, 1): the diffuse share of the received power, with time constant ``dmc_decay_s`` (20 ns
-    by default, a short concrete tunnel); ``dmc_spatial``: ``"white"`` (independent over the
-    elements). ``"per-surface"`` (diffuse power spread in angle around each specular path) is
-    not implemented and refused.
-    """
-
-    phase_error_deg: float = 0.0
-    gain_error_db: float = 0.0
-    spatial_wideband: bool = False
-    dmc_share: float = 0.0
-    dmc_decay_s: float = 20e-9
-    dmc_spatial: str = "white"
-    wideband_model: bool = False
-
-    def __post_init__(self) -> None:
-        nonnegative("phase_error_deg", self.phase_error_deg)
-        nonnegative("gain_error_db", self.gain_error_db)
-        boolean("spatial_wideband", self.spatial_wideband)
-        if boolean("wideband_model", self.wideband_model) and not self.spatial_wideband:
-            raise ValueError(
-                "wideband_model: the estimator models the spatial-wideband term of the channel; "
-                "set spatial_wideband=True too (a model term the channel lacks is not an option)"
-            )
-        share = nonnegative("dmc_share", self.dmc_share)
-        if share >= 1.0:
-            raise ValueError(f"dmc_share: the diffuse share must lie in [0, 1), got {share}")
-        positive("dmc_decay_s", self.dmc_decay_s)
-        if self.dmc_spatial not in _DMC_SPATIAL:
-            raise ValueError(f"dmc_spatial: expected 'white', got {self.dmc_spatial!r}")
-        if self.dmc_spatial == "per-surface":
-            raise ValueError(
-                "dmc_spatial: 'per-surface' (diffuse power spread around each specular path) is "
-                "not implemented; use 'white'"
-            )
-
-    @property
-    def ideal(self) -> bool:
-        """True when the channel is eq. 1 exactly (no impairment)."""
-        return (
-            self.phase_error_deg == 0
-            and self.gain_error_db == 0
-            and not self.spatial_wideband
-            and self.dmc_share == 0
-        )
-
-    @property
-    def dmc(self) -> DiffuseSpec | None:
-        """The :class:`~tunnelkit.channel.DiffuseSpec` of the diffuse multipath (None if off)."""
-        return DiffuseSpec(self.dmc_share, self.dmc_decay_s) if self.dmc_share > 0 else None
-
-    def channel_impairments(self) -> Impairments:
-        """The :class:`~tunnelkit.channel.Impairments` that synthesise this channel."""
-        return Impairments(
-            phase_sigma_deg=float(self.phase_error_deg),
-            gain_sigma_db=float(self.gain_error_db),
-            spatial_wideband=bool(self.spatial_wideband),
-            dmc=self.dmc,
-        )
 
 
 def _check(setup, impairments):
@@ -194,10 +125,12 @@ def _frame(setup, spec, g) -> _Frame:
     )
 
 
-def _chunks(setup, fr: _Frame, imp: DesignImpairments):
+def _chunks(setup, fr: _Frame, imp: DesignImpairments, frame: str = "cartesian"):
     """Per chunk of epochs: the slice, the FIM ``A``, the diffuse excess ``E`` (or None), the
-    wideband score ``s`` (or None) and the calibration scores per unit phase [rad] and gain
-    [dB] (or None): all in eta space (module :mod:`~tunnelkit.design.mcrb`)."""
+    wideband score ``s`` (or None), the calibration scores per unit phase [rad] and gain
+    [dB] (or None) and the wave-origin ``basis`` of ``frame``: all in eta space (module
+    :mod:`~tunnelkit.design.mcrb`; ``frame="radial"``: each wave origin in its own azimuth,
+    elevation and range directions, :func:`~tunnelkit.design.mcrb.radial_basis`)."""
     cfg = setup.config
     T, L = fr.idx.shape
     M = fr.pos.shape[0]
@@ -217,8 +150,10 @@ def _chunks(setup, fr: _Frame, imp: DesignImpairments):
             cfg.fc,
             cfg.n_tones,
             cfg.n_symbols,
+            frame=frame,
         )
         out = {"slice": sl, "A": md.fim(s2), "E": None, "s_wb": None, "S_ph": None, "S_g": None}
+        out["basis"] = md.basis
         if imp.dmc_share > 0:
             spec = imp.dmc
             tau0 = np.where(mk, fr.d0[sl], np.inf).min(axis=1) / C
@@ -256,6 +191,76 @@ def _block_diag(Jz: np.ndarray) -> np.ndarray:
     return out.reshape(T, 4 * L, 7 * L)
 
 
+def _vertical(fr: _Frame, g: RouteGeometry) -> np.ndarray:
+    """(T, L) the used paths whose wave origin lies on the vertical through the reference
+    antenna: their world azimuth (``z``'s ``phi``) is undefined."""
+    rel = fr.src - g.origin[:, None, :]
+    rho2 = rel[..., 0] ** 2 + rel[..., 1] ** 2
+    return fr.mask & (rho2 < 1e-18)
+
+
+def _subframe(fr: _Frame, rows: np.ndarray, mask: np.ndarray) -> _Frame:
+    """The epochs ``rows`` of ``fr`` with the used paths ``mask`` (len(rows), L)."""
+    return _Frame(
+        fr.g, fr.idx[rows], mask, fr.src[rows], fr.s_loc[rows], fr.d0[rows], fr.alpha[rows],
+        fr.mu_f[rows], fr.mu_t[rows], fr.pos,
+    )  # fmt: skip
+
+
+def _weakest_path(A: np.ndarray, mask: np.ndarray, alpha: np.ndarray) -> int:
+    """The path (index into ``mask``) a singular ``A`` (7L, 7L) cannot resolve: the one that
+    carries most of the Jacobi-scaled eigenvector of the smallest eigenvalue (of two paths that
+    share it, the weaker)."""
+    d = np.diagonal(A)
+    sc = 1.0 / np.sqrt(np.where(d > 0, d, 1.0))
+    _, V = np.linalg.eigh(sc[:, None] * A * sc[None, :])
+    share = np.where(mask, np.sum(V[:, 0].reshape(-1, 7) ** 2, axis=1), 0.0)
+    share[np.flatnonzero(mask)[np.any(d.reshape(-1, 7)[mask] <= 0, axis=1)]] = np.inf
+    cand = np.flatnonzero(share >= 0.5 * share.max())
+    return int(cand[np.argmin(np.abs(alpha[cand]))])
+
+
+def _solve(setup, fr: _Frame, imp: DesignImpairments, Jz: np.ndarray, cal: bool) -> dict:
+    """The compressed per-path error model of the epochs of ``fr`` (``Jz`` (T, L, 4, 7): d z /
+    d eta, Cartesian wave origin), and per epoch whether the Fisher information is singular
+    (``bad``) with the path it cannot resolve (``weakest``, -1 where regular)."""
+    T, L = fr.idx.shape
+    M = fr.pos.shape[0]
+    out = {
+        "crlb": np.zeros((T, 4 * L, 4 * L)),
+        "cov": np.zeros((T, 4 * L, 4 * L)),
+        "bias": np.zeros((T, 4 * L)),
+        "kph": np.zeros((T, 4 * L, M)) if cal else None,
+        "kg": np.zeros((T, 4 * L, M)) if cal else None,
+        "bad": np.zeros(T, bool),
+        "weakest": np.full(T, -1),
+    }
+    for ch in _chunks(setup, fr, imp, frame="radial"):
+        sl = ch["slice"]
+        mk = np.repeat(fr.mask[sl], 7, axis=1)
+        A = ch["A"] + np.eye(7 * L)[None] * ~mk[:, :, None]  # padding decoupled
+        Ainv, sing = scaled_inverse(A)
+        sing &= fr.mask[sl].any(axis=1)
+        out["bad"][sl] = sing
+        for i in np.flatnonzero(sing):
+            out["weakest"][sl.start + i] = _weakest_path(A[i], fr.mask[sl][i], fr.alpha[sl][i])
+        Ainv = np.where(mk[:, :, None] & mk[:, None, :] & ~sing[:, None, None], Ainv, 0.0)
+        Jr = Jz[sl].copy()  # the wave origin in its radial frame: d z / d s @ basis
+        Jr[..., 4:] = Jr[..., 4:] @ ch["basis"]
+        J = _block_diag(Jr)
+        JA = J @ Ainv
+        out["crlb"][sl] = JA @ J.transpose(0, 2, 1)
+        out["cov"][sl] = out["crlb"][sl]
+        if ch["E"] is not None:
+            out["cov"][sl] += JA @ ch["E"] @ JA.transpose(0, 2, 1)
+        if ch["s_wb"] is not None:
+            out["bias"][sl] = (JA @ ch["s_wb"][..., None])[..., 0]
+        if cal:
+            out["kph"][sl] = JA @ ch["S_ph"]
+            out["kg"][sl] = JA @ ch["S_g"]
+    return out
+
+
 def path_error_model(
     setup: DesignSetup,
     spec,
@@ -273,9 +278,18 @@ def path_error_model(
     ``bias`` the spatial-wideband bias (zero when the estimator models the term,
     ``impairments.wideband_model``: its Fisher information is eq. 1's to within 1 %, module
     docstring), ``k_phase`` [per rad] and ``k_gain`` [per dB] the
-    calibration sensitivities (None when the calibration is perfect). Raises ``ValueError``
-    naming ``spec`` where the Fisher information of an epoch is singular (a parameter the
-    array cannot resolve, e.g. curvature with 2 x 2 elements).
+    calibration sensitivities (None when the calibration is perfect).
+
+    Each epoch stands alone: the Fisher information is inverted with every wave origin in its
+    own azimuth, elevation and range directions (:func:`~tunnelkit.design.mcrb.radial_basis`),
+    in which a far path's unresolved curvature is a large but finite variance at any range.
+    Where it is still singular at an epoch (a path the array cannot tell from another, or a
+    parameter it cannot resolve), the path that carries the singular direction is left out of
+    that epoch's joint model, one at a time until the rest is regular; a path whose wave
+    origin lies on the vertical through the reference antenna (no azimuth) is left out too.
+    Those paths are absent from ``exists`` at that epoch and flagged in ``unresolved``
+    (:func:`unresolved_reason` says which and where); the other epochs and paths keep their
+    values, whatever the rest of the route holds.
     """
     imp = DesignImpairments() if impairments is None else impairments
     _check(setup, imp)
@@ -289,41 +303,26 @@ def path_error_model(
     T, L = fr.idx.shape
     P = g.exists.shape[1]
     M = fr.pos.shape[0]
-    Jz = _block_diag(_z_jacobian(fr, g, cfg))  # (T, 4L, 7L)
-    crlb_c = np.zeros((T, 4 * L, 4 * L))
-    cov_c = np.zeros((T, 4 * L, 4 * L))
-    bias_c = np.zeros((T, 4 * L))
     cal = imp.phase_error_deg > 0 or imp.gain_error_db > 0
-    kph_c = np.zeros((T, 4 * L, M)) if cal else None
-    kg_c = np.zeros((T, 4 * L, M)) if cal else None
-    bad = np.zeros(T, bool)
-    for ch in _chunks(setup, fr, imp):
-        sl = ch["slice"]
-        mk = np.repeat(fr.mask[sl], 7, axis=1)
-        A = ch["A"] + np.eye(7 * L)[None] * ~mk[:, :, None]  # padding decoupled
-        Ainv, sing = scaled_inverse(A)
-        bad[sl] = sing & fr.mask[sl].any(axis=1)
-        Ainv = np.where(mk[:, :, None] & mk[:, None, :], Ainv, 0.0)
-        J = Jz[sl]
-        JA = J @ Ainv
-        crlb_c[sl] = JA @ J.transpose(0, 2, 1)
-        cov_c[sl] = crlb_c[sl]
-        if ch["E"] is not None:
-            cov_c[sl] += JA @ ch["E"] @ JA.transpose(0, 2, 1)
-        if ch["s_wb"] is not None:
-            bias_c[sl] = (JA @ ch["s_wb"][..., None])[..., 0]
-        if cal:
-            kph_c[sl] = JA @ ch["S_ph"]
-            kg_c[sl] = JA @ ch["S_g"]
-    if bad.any():
-        raise ValueError(
-            f"spec: the per-path bound of the {spec.label} array is undefined (singular Fisher "
-            f"information) at {int(bad.sum())} of {T} epochs; a parameter of some path "
-            "(e.g. its curvature) is not resolvable by this array"
-        )
+    vertical = _vertical(fr, g)
+    mask = fr.mask & ~vertical
+    fr = _subframe(fr, np.arange(T), mask)
+    Jz = _z_jacobian(fr, g, cfg)  # (T, L, 4, 7)
+    res = _solve(setup, fr, imp, Jz, cal)
+    todo = np.flatnonzero(res["bad"])
+    weak = res["weakest"][todo]
+    while todo.size:  # leave out, epoch by epoch, the path the array cannot resolve
+        mask[todo, weak] = False
+        res_t = _solve(setup, _subframe(fr, todo, mask[todo]), imp, Jz[todo], cal)
+        for key in ("crlb", "cov", "bias", "kph", "kg"):
+            if res[key] is not None:
+                res[key][todo] = res_t[key]
+        still = res_t["bad"]
+        todo, weak = todo[still], res_t["weakest"][still]
+    crlb_c, cov_c, bias_c, kph_c, kg_c = (res[k] for k in ("crlb", "cov", "bias", "kph", "kg"))
     # scatter the compressed paths into the route's slots
     rows = (4 * fr.idx[:, :, None] + np.arange(4)).reshape(T, 4 * L)
-    keep = np.repeat(fr.mask, 4, axis=1)
+    keep = np.repeat(mask, 4, axis=1)
     tt = np.arange(T)[:, None]
 
     def scatter_mat(Xc):
@@ -351,14 +350,16 @@ def path_error_model(
         ],
         axis=-1,
     )
-    ex = g.exists
+    ex = np.zeros((T, P), bool)
+    np.put_along_axis(ex, fr.idx, mask, axis=1)
+    ex &= g.exists
     k_ph = k_g = None
     if cal:
         k_ph = scatter_vec(kph_c).reshape(T, P, 4, M)
         k_g = scatter_vec(kg_c).reshape(T, P, 4, M)
     return PathErrorModel(
         t=_epoch_times(setup, g),
-        exists=ex.copy(),
+        exists=ex,
         kinds=tuple(g.kinds),
         truth=np.where(ex[..., None], truth, 0.0),
         v=np.where(ex, C * g.doppler / cfg.fc, 0.0),
@@ -369,7 +370,40 @@ def path_error_model(
         k_gain=k_g,
         phase_sigma_rad=float(np.radians(imp.phase_error_deg)),
         gain_sigma_db=float(imp.gain_error_db),
+        unresolved=g.exists & ~ex,
     )
+
+
+def _ranges(x: np.ndarray, hit: np.ndarray) -> str:
+    """``"x = 80.3..100.2 m, 120.0 m"``: the runs of consecutive epochs where ``hit``."""
+    k = np.flatnonzero(hit)
+    runs = np.split(k, np.flatnonzero(np.diff(k) > 1) + 1) if k.size else []
+    parts = [
+        f"{x[r[0]]:.1f} m" if r.size == 1 else f"{x[r[0]]:.1f}..{x[r[-1]]:.1f} m" for r in runs
+    ]
+    return "x = " + ", ".join(parts)
+
+
+def unresolved_reason(model: PathErrorModel, geometry: RouteGeometry, label: str) -> str:
+    """Which paths ``model`` leaves out because the array cannot resolve them, and where:
+    ``"the 4x4 cannot resolve the ceiling path at x = 80.3..100.2 m (12 epochs)"`` per path
+    kind, joined by ``"; "`` (``""`` when it leaves out none)."""
+    instance("model", model, PathErrorModel), instance("geometry", geometry, RouteGeometry)
+    text("label", label)
+    if model.unresolved is None or not model.unresolved.any():
+        return ""
+    x = geometry.ue[:, 0]
+    out = []
+    for kind in dict.fromkeys(model.kinds):
+        cols = np.array(model.kinds) == kind
+        hit = model.unresolved[:, cols].any(axis=1)
+        if hit.any():
+            name = "direct" if kind == "los" else kind
+            out.append(
+                f"the {label} cannot resolve the {name} path at {_ranges(x, hit)} "
+                f"({int(hit.sum())} epochs)"
+            )
+    return "; ".join(out)
 
 
 def _epoch_times(setup, g: RouteGeometry) -> np.ndarray:
@@ -390,7 +424,12 @@ class AchievableBound:
     (:data:`WEIGHTS`). ``inf`` where the position is not identifiable. ``noise`` (T,) [m] the
     noise part of ``achievable`` (the impairments' parts left out): the PEB for the ideal
     weights, the noise of the fix weighted block by block as the tracker is told for the
-    tracker's (``None``: the PEB)."""
+    tracker's (``None``: the PEB). ``valid`` (T,) bool: the epochs where ``achievable`` is
+    defined (finite); elsewhere it is ``inf``, a gap at that epoch only, and ``reason`` says
+    why and where (no path, a position the paths do not determine, paths the array cannot
+    resolve: :func:`unresolved_reason`); ``""`` when nothing is missing. A path the array
+    cannot resolve at an epoch is left out of that epoch only (its information is absent),
+    which is named in ``reason`` even where the other paths still fix the position."""
 
     spec: object
     impairments: DesignImpairments
@@ -402,12 +441,19 @@ class AchievableBound:
     diffuse: np.ndarray
     weights: str = "tracker"
     noise: np.ndarray | None = None
+    valid: np.ndarray | None = None
+    reason: str = ""
 
     def __post_init__(self) -> None:
         instance("spec", self.spec, ArraySpec)
+        if self.valid is None:
+            object.__setattr__(self, "valid", np.isfinite(np.asarray(self.achievable, float)))
         bounds = ("peb", "achievable", "calibration", "wideband", "diffuse")
-        record(self, shapes=dict.fromkeys(("x", *bounds), ("T",)), nonnegative=bounds,
-               allow_inf=bounds)  # fmt: skip
+        record(self, shapes={**dict.fromkeys(("x", *bounds, "valid"), ("T",))},
+               nonnegative=bounds, allow_inf=(*bounds, "noise"),
+               may_be_empty=("reason",))  # fmt: skip
+        if np.asarray(self.valid).dtype != bool:
+            raise TypeError(f"valid: expected a bool array, got {np.asarray(self.valid).dtype}")
         choice("weights", self.weights, WEIGHTS)
         if self.noise is not None:
             object.__setattr__(self, "noise", bound_array("noise", self.noise, ndim=1))
@@ -441,9 +487,10 @@ def achievable_bound(
     weighting trusts a large array's micrometre curvatures, whose calibration and wideband
     biases are centimetres: on the 28 GHz example with the wideband term and 0.2 dB of gain
     error it puts 32 x 32 at several times the error its tracker has. The tracker weighting
-    needs the per-path model: where that is undefined (e.g. 2 x 2, which cannot resolve a
-    curvature) the bound is ``inf`` at every epoch (no tracker bound; ``"ideal"`` still maps
-    the channel's score; an ideal channel keeps the PEB). With the tracker's weights the noise
+    needs the per-path model: a path the array cannot resolve at an epoch is left out of that
+    epoch (:func:`path_error_model`), and an epoch whose resolved paths do not fix the position
+    is a gap (``inf`` there, ``valid`` False, ``reason`` naming the cause and where); every
+    epoch is evaluated on its own, whatever the rest of the route holds. With the tracker's weights the noise
     part is the covariance of the fix weighted block by block as the tracker is told
     (:func:`tunnelkit.design.drivebound.position_noise_cov`), not the PEB: never below it, and
     above it where the joint CRLB correlates paths (small arrays, paths close in angle and
@@ -480,7 +527,9 @@ def achievable_bound(
         for ch in _chunks(setup, fr, imp):
             sl = ch["slice"]
             Tc = Tm[sl]
-            Ginv, _ = scaled_inverse(theta_fim(ch["A"], Tc, fr.mask[sl], n_nui, base))
+            Ginv, sing = scaled_inverse(theta_fim(ch["A"], Tc, fr.mask[sl], n_nui, base))
+            Ginv = np.where(sing[:, None, None], 0.0, Ginv)
+            peb[sl] = np.where(sing, np.inf, peb[sl])
             Pm = Ginv[:, :n_pos, :] @ Tc.transpose(0, 2, 1)  # d position / d score (n_pos, 7L)
             if ch["E"] is not None:
                 dif2[sl] = np.trace(Pm @ ch["E"] @ Pm.transpose(0, 2, 1), axis1=1, axis2=2)
@@ -495,34 +544,56 @@ def achievable_bound(
     dif = np.where(fin, np.sqrt(np.clip(dif2, 0, None)), np.inf)
     with np.errstate(invalid="ignore"):
         ach = np.where(fin, np.sqrt(peb**2 + cal**2 + wb**2 + dif**2), np.inf)
-    return AchievableBound(spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif, "ideal", peb)
+    reason = _gap_reason(spec, g, peb, None, None)
+    return AchievableBound(
+        spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif, "ideal", peb, fin, reason
+    )
 
 
 def _tracker_bound(setup, spec, imp, g, peb) -> AchievableBound:
     """:func:`achievable_bound` with the tracker's weights."""
-    from .drivebound import position_error_parts, position_noise_cov
+    from .drivebound import fix_identifiable, position_error_parts, position_noise_cov
     from .fastroute import tracker_weights
 
     T = peb.shape[0]
-    parts = np.zeros((T, 3))
-    noise = peb
-    try:
-        m = path_error_model(setup, spec, imp, geometry=g)
-    except ValueError:  # a per-path bound undefined: no tracker bound (ideal: the PEB)
-        if not imp.ideal:
-            parts[:] = np.inf
-    else:
-        w = tracker_weights(m)
-        # the noise of the fix weighted as the tracker weighs: one block per path, so the
-        # correlation of the joint CRLB between paths is not used (never below the PEB)
-        cov = position_noise_cov(m, g, w)
-        noise = np.where(m.exists.any(axis=1), np.sqrt(np.trace(cov, axis1=1, axis2=2)), peb)
-        noise = np.maximum(noise, peb)
-        if not imp.ideal:
-            parts = position_error_parts(m, g, w)
-    fin = np.isfinite(peb)
+    m = path_error_model(setup, spec, imp, geometry=g)
+    w = tracker_weights(m)
+    ok = fix_identifiable(m, g, w)
+    # the noise of the fix weighted as the tracker weighs: one block per path, so the
+    # correlation of the joint CRLB between paths is not used (never below the PEB)
+    cov = position_noise_cov(m, g, w)
+    noise = np.maximum(np.sqrt(np.clip(np.trace(cov, axis1=1, axis2=2), 0, None)), peb)
+    parts = np.zeros((T, 3)) if imp.ideal else position_error_parts(m, g, w)
+    fin = np.isfinite(peb) & ok
     cal, wb, dif = (np.where(fin, parts[:, i], np.inf) for i in range(3))
     with np.errstate(invalid="ignore"):
         ach = np.where(fin, np.sqrt(noise**2 + cal**2 + wb**2 + dif**2), np.inf)
     noise = np.where(fin, noise, np.inf)
-    return AchievableBound(spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif, "tracker", noise)
+    reason = _gap_reason(spec, g, peb, m, ok)
+    return AchievableBound(
+        spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif, "tracker", noise, fin, reason
+    )
+
+
+def _gap_reason(spec, g: RouteGeometry, peb, model: PathErrorModel | None, ok) -> str:
+    """Why and where the bound has gaps: epochs without a path, without an identifiable
+    position (PEB), whose resolved paths do not fix the position, and the paths the array
+    cannot resolve (:func:`unresolved_reason`); ``""`` without a gap."""
+    x = g.ue[:, 0]
+    out = []
+    none = ~g.exists.any(axis=1)
+    if none.any():
+        out.append(f"no path reaches the {spec.label} at {_ranges(x, none)}")
+    unid = ~none & ~np.isfinite(peb)
+    if unid.any():
+        out.append(f"the paths do not determine the position at {_ranges(x, unid)}")
+    if model is not None:
+        lost = ~none & np.isfinite(peb) & ~ok
+        if lost.any():
+            out.append(
+                f"the paths the {spec.label} resolves do not fix the position at {_ranges(x, lost)}"
+            )
+        un = unresolved_reason(model, g, spec.label)
+        if un:
+            out.append(un)
+    return "; ".join(out)

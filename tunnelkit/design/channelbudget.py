@@ -37,7 +37,8 @@ def channel_budget(model: PathErrorModel, setup: DesignSetup, spec) -> BiasBudge
     if T != len(setup.trajectory):
         raise ValueError(f"model: expected {len(setup.trajectory)} epochs (the route's), got {T}")
     g = route_geometry(setup, spec, epochs=np.arange(T))
-    if g.exists.shape != (T, P) or not np.array_equal(g.exists, model.exists):
+    traced = model.exists if model.unresolved is None else model.exists | model.unresolved
+    if g.exists.shape != (T, P) or not np.array_equal(g.exists, traced):
         raise ValueError(f"model: not built on {spec.label}'s route geometry (slots differ)")
     white, rep = model.split()
     idx = np.arange(P)

@@ -10,9 +10,9 @@ and seed:
 
 * the recommended array, and every smaller candidate the bound route left ``"undecided"``
   (its 95 % interval straddling the target);
-* with no recommendation, the smallest candidate that is neither hopeless nor in error;
+* with no recommendation, the smallest candidate that is neither not met (on the bound route) nor in error;
 * while none of those is met on the channel route, the next larger candidate the bound route did
-  not rule out (hopeless or in error), one at a time (:func:`next_candidate`): a marginal array
+  not rule out (not met or in error), one at a time (:func:`next_candidate`): a marginal array
   (its channel-route interval straddling the target) then comes with the larger one that meets
   it, not with "none" (28 GHz example at 2 deg: 8 x 8 undecided on the channel route, 20 runs).
 
@@ -97,7 +97,7 @@ def confirmation_candidates(report: DesignReport) -> list[str]:
     order = sorted(report.rows, key=lambda r: (r.n_elements, r.aperture_diagonal_m))
     rec = report.recommendation.get("array")
     if rec is None:
-        open_ = [r.array for r in order if r.status not in ("hopeless", "error")]
+        open_ = [r.array for r in order if r.status not in ("not met", "error")]
         return open_[:1]
     at = [r.array for r in order].index(rec)
     return [r.array for r in order[:at] if r.status == "undecided"] + [rec]
@@ -106,7 +106,7 @@ def confirmation_candidates(report: DesignReport) -> list[str]:
 def next_candidate(report: DesignReport, confirmed) -> str | None:
     """The array :func:`confirm_on_channel` runs next when none of ``confirmed`` (the labels
     already re-run) is met on the channel route: the smallest candidate of ``report`` larger than
-    all of them that the bound route did not call hopeless or in error; ``None`` when none is
+    all of them that the bound route did not call not met or in error; ``None`` when none is
     left."""
     instance("report", report, DesignReport)
     done = sequence("confirmed", confirmed, empty=True)
@@ -116,7 +116,7 @@ def next_candidate(report: DesignReport, confirmed) -> str | None:
     if unknown:
         raise ValueError(f"confirmed: {unknown[0]!r} is not a candidate of the report")
     start = max((labels.index(a) for a in done), default=-1) + 1
-    rest = [r.array for r in order[start:] if r.status not in ("hopeless", "error")]
+    rest = [r.array for r in order[start:] if r.status not in ("not met", "error")]
     return rest[0] if rest else None
 
 
@@ -124,15 +124,15 @@ def confirm_on_channel(
     report: DesignReport,
     setup: DesignSetup,
     *,
-    runs: int | None = None,
+    units: int | None = None,
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float | None = None,
     progress: bool = False,
 ) -> ConfirmedReport:
-    """``report`` (a bound-route :func:`~tunnelkit.design.report.design_sweep` with runs) with
+    """``report`` (a bound-route :func:`~tunnelkit.design.report.design_sweep` with units) with
     its recommendation re-decided on the channel route (module docstring): the candidates of
-    :func:`confirmation_candidates`, ``runs`` drives each (default the report's), its seed,
+    :func:`confirmation_candidates`, ``units`` units each (default the report's), its seed,
     impairments, target, share, criterion and epochs; ``workers`` / ``scheduler`` /
     ``timeout`` as :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`'s."""
     from ..signal_route.judging import FLOOR_FALSE_ALARM, impairment_share
@@ -142,9 +142,12 @@ def confirm_on_channel(
     instance("report", report, DesignReport)
     instance("setup", setup, DesignSetup)
     s = report.settings
-    if s.get("mode") != "bound" or not s.get("runs"):
-        raise ValueError("report: expected a bound-route sweep with runs (mode 'bound', runs > 0)")
-    runs = s["runs"] if runs is None else integer("runs", runs, minimum=1)
+    if s.get("mode") != "bound" or not s.get("units"):
+        raise ValueError(
+            "report: expected a bound-route sweep with units (mode 'bound', units > 0)"
+        )
+    units = s["units"] if units is None else integer("units", units, minimum=1)
+    d = s["drives_per_unit"]
     labels = confirmation_candidates(report)
     by = {r.array: r for r in report.rows}
     imp = DesignImpairments(**s["impairments"])
@@ -157,7 +160,7 @@ def confirm_on_channel(
         res = sweep_montecarlo(
             setup,
             [x for x in all_specs if x.label in labels],
-            runs,
+            units * d,
             s["seed"],
             mode="channel",
             impairments=None if imp.ideal else imp,
@@ -168,26 +171,39 @@ def confirm_on_channel(
             n_epochs=s["n_epochs"],
             **({"start_sigma": s["start_sigma_m"]} if "start_sigma_m" in s else {}),
             dead_reckoning=bool(s.get("dead_reckoning", False)),
+            drives_per_unit=d,
         )
         for a in labels:
             row = copy.deepcopy(by[a])
-            # the image channel's channel route gives no bound over the drive (no error model;
-            # score_row fills the traced route's, the bound of its told sigmas)
-            row.drive_bound_known_rms_m = row.drive_bound_learned_rms_m = None
-            row.rmse_over_tracker_bound = None
-            score_row(row, res[a], s["criterion"], s["target"], s["share"], s["seed"], s["n_boot"])
+            # the image channel's channel route gives no bound or prediction over the drive
+            # (no error model; score_row fills the traced route's prediction)
+            row.pcrlb_rms_m = row.hybrid_bound_rms_m = row.rmse_over_pcrlb = None
+            row.rmse_over_hybrid_bound = row.unit_rmse_over_pcrlb_min = None
+            row.predicted_drive_rms_m = row.predicted_drive_learned_rms_m = None
+            row.rmse_over_predicted_drive = None
+            score_row(
+                row,
+                res[a],
+                s["criterion"],
+                s["target"],
+                s["share"],
+                s["seed"],
+                s["n_boot"],
+                settle=s["settle_s"],
+                required=s["required_yield"],
+            )
             rows.append(row)
 
     if labels:
         run(labels)
-    rec = recommend(rows, s["target"], s["share"], runs)
+    rec = recommend(rows, s["target"], s["share"], units, s["required_yield"])
     # none met: the next larger candidate, one at a time (module docstring)
-    while rows and rec.get("array") is None and runs >= MIN_RUNS_CI:
+    while rows and rec.get("array") is None and units >= MIN_RUNS_CI:
         nxt = next_candidate(report, [r.array for r in rows])
         if nxt is None:
             break
         run([nxt])
-        rec = recommend(rows, s["target"], s["share"], runs)
+        rec = recommend(rows, s["target"], s["share"], units, s["required_yield"])
     rec["route"] = "channel"
     if not rows:
         rec["reason"] = "no candidate left to confirm on the channel route"
@@ -197,15 +213,15 @@ def confirm_on_channel(
             f"the channel route does not confirm the bound route's recommendation "
             f"({bound_rec.get('array') or 'none'} -> {rec.get('array') or 'none'})"
         )
-    if runs < MIN_RUNS_CI:
-        warnings.append(f"confirmation with {runs} runs: every verdict is undecided")
+    if units < MIN_RUNS_CI:
+        warnings.append(f"confirmation with {units} units: every verdict is undecided")
     # the expectation of the floor the channel route's fit test allows for (0: the white-noise
     # test alone); the test takes the calibration part at its draw's false-alarm quantile
     share = 0.0 if imp.ideal else impairment_share(imp.channel_impairments())
     settings = dict(
         s,
         confirm_route="channel",
-        confirm_runs=runs,
+        confirm_units=units,
         model_error_share=share,
         model_error_false_alarm=FLOOR_FALSE_ALARM,
     )

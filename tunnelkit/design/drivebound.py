@@ -5,8 +5,11 @@ reported per-path bound into the UE's horizontal position (the clock bias ``c b`
 the PEB does); :func:`drive_pcrlb` runs the posterior CRLB of JAVELIN's motion model over the
 drive with it (Tichavsky et al. 1998); :func:`position_bias_rms` is the position bias of the
 array's one calibration draw and of the wideband term, which no number of epochs averages down,
-and :func:`drive_bound` sets the two together. The Monte-Carlo of
-:mod:`tunnelkit.design.montecarlo` is judged against them.
+and :func:`drive_bound` sets the two together: a first-order **prediction** of the tracker's
+error, not a bound (the tracker beats it). The **bounds** over the drive are
+:func:`unit_pcrlb`'s: every unit's posterior CRLB, and the one pooled over units with the
+calibration draw a fixed unknown of the drive (a hybrid bound). The Monte-Carlo of
+:mod:`tunnelkit.design.montecarlo` is set beside both.
 """
 
 from __future__ import annotations
@@ -23,10 +26,12 @@ __all__ = [
     "drive_bound",
     "drive_motion",
     "drive_pcrlb",
+    "fix_identifiable",
     "position_bias_rms",
     "position_error_parts",
     "position_information",
     "position_noise_cov",
+    "unit_pcrlb",
 ]
 
 #: the open-sky fix's standard deviation per axis [m], the design's default entry fix
@@ -153,6 +158,39 @@ def _weighted_gain(model, geometry, k: int, weights):
     return rows, G
 
 
+def fix_identifiable(model: PathErrorModel, geometry, weights=None, rcond: float = 1e-12):
+    """Per epoch (T,) bool: the weighted least-squares fix of :func:`position_noise_cov`
+    (``weights`` as there) determines the horizontal position and the clock bias, i.e.
+    ``H^T W H`` is regular (Jacobi-scaled smallest eigenvalue above ``rcond`` times the
+    largest). False at an epoch without a path, or where the paths left (e.g. one path whose
+    curvature is not handed on) fix a direction but not a range: there the pseudo-inverse the
+    fix is computed with would report a finite, meaningless covariance."""
+    from .._validate import positive
+
+    _check_geometry(model, geometry)
+    rcond = positive("rcond", rcond)
+    if weights is not None:
+        weights = _check_weights(model, weights)
+    T = model.exists.shape[0]
+    out = np.zeros(T, bool)
+    for k in range(T):
+        rows, H, j = _position_rows(model, geometry, k)
+        if rows is None:
+            continue
+        if weights is None:
+            R = model.crlb[k][np.ix_(rows, rows)]
+            W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
+        else:
+            W = _block_weights(weights[k, j])
+        J = H.T @ W @ H
+        d = np.diag(J)
+        if np.any(d <= 0) or not np.all(np.isfinite(J)):
+            continue
+        w = np.linalg.eigvalsh(J / np.sqrt(np.outer(d, d)))
+        out[k] = w[0] > rcond * w[-1]
+    return out
+
+
 def position_noise_cov(model: PathErrorModel, geometry, weights) -> np.ndarray:
     """Per epoch (T, 2, 2) [m^2] the covariance of the horizontal position of the weighted
     least-squares snapshot fix (clock bias estimated) under the model's ideal noise, the joint
@@ -228,7 +266,7 @@ def position_bias_rms(model: PathErrorModel, geometry, weights=None) -> np.ndarr
 
 
 def drive_bound(pcrlb: np.ndarray, bias_rms: np.ndarray) -> np.ndarray:
-    """The achievable bound over the drive (T,) [m]: the posterior CRLB of the noise
+    """The predicted error over the drive (T,) [m] (a prediction, not a bound): the posterior CRLB of the noise
     (:func:`drive_pcrlb`, which averages down along the drive) and the position bias that does
     not average down (:func:`position_bias_rms`, the array's one calibration draw and the
     deterministic wideband bias) added in quadrature, ``sqrt(pcrlb^2 + bias_rms^2)``. The bias
@@ -298,3 +336,78 @@ def drive_motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
         axis=1,
     )
     return G, np.diag([sig_nu**2, sig_th**2]), dt
+
+
+def unit_pcrlb(
+    setup: DesignSetup,
+    model: PathErrorModel,
+    geometry,
+    *,
+    sigma_p0: float = START_SIGMA_M,
+    calibration: bool = True,
+) -> np.ndarray:
+    """Posterior CRLB (T,) [m] of the 2-D position along the drive for the measurements the
+    model draws, ``z_k = h(x_k) + b_k + K_k e + n_k`` with ``n_k ~ N(0, cov_k)`` and ``e`` the
+    array's calibration error (phase [rad] and gain [dB] per element):
+
+    * ``calibration=True``: ``e`` a **fixed unknown of the drive** with its prior ``N(0,
+      diag(sigma_phase^2 I, sigma_gain^2 I))`` (one draw per manufactured unit), carried as a
+      static state beside the position (a hybrid / consider bound, Van Trees over the drive and
+      the unit): a lower bound of the MSE **pooled over units** of any tracker;
+    * ``calibration=False``: ``e`` known to the bound (conditioned on the unit's draw, whose
+      bias ``K e`` then carries no information and only shifts the mean): the bound of **every
+      unit**, the same for every draw (the model is linear in ``e``).
+
+    The noise is the model's ``cov`` (what is drawn, diffuse power included), not the reported
+    ``crlb``; the clock bias is eliminated per epoch with a flat prior (as the PEB), the
+    motion is JAVELIN's driven by the V2X messages (:func:`drive_pcrlb`, which this equals for
+    ``calibration=False``), the start an open-sky fix of ``sigma_p0`` [m]. Computed in
+    covariance form, each epoch a low-rank update (Woodbury), so the cost grows as ``M^2`` per
+    epoch, not ``M^3``."""
+    from .._validate import boolean, positive
+    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED
+
+    _check_geometry(model, geometry)
+    sigma_p0 = positive("sigma_p0", sigma_p0)
+    calibration = boolean("calibration", calibration)
+    T, P = model.exists.shape
+    ks = []
+    if calibration:
+        ks = [
+            (np.asarray(K).reshape(T, 4 * P, -1), sig)
+            for K, sig in (
+                (model.k_phase, model.phase_sigma_rad),
+                (model.k_gain, model.gain_sigma_db),
+            )
+            if K is not None and sig > 0
+        ]
+    m = sum(K.shape[-1] for K, _ in ks)
+    G, Qn, _ = drive_motion(setup, T, SIGMA_SPEED, SIGMA_HEADING)
+    Q = G @ Qn @ np.swapaxes(G, 1, 2) + 1e-12 * np.eye(2)
+    Pm = np.zeros((2 + m, 2 + m))
+    Pm[:2, :2] = sigma_p0**2 * np.eye(2)
+    if m:
+        Pm[2:, 2:] = np.diag(np.concatenate([np.full(K.shape[-1], s**2) for K, s in ks]))
+    out = np.empty(T)
+    for k in range(T):
+        if k:
+            Pm[:2, :2] += Q[k]
+        rows, H, _ = _position_rows(model, geometry, k)
+        if rows is not None:
+            R = np.asarray(model.cov[k])[np.ix_(rows, rows)]
+            A = np.concatenate([H[:, :2], *(K[k, rows] for K, _ in ks)], axis=1)
+            # whiten, then remove the clock bias' direction (flat prior): unit-noise rows
+            w, V = np.linalg.eigh(0.5 * (R + R.T))
+            on = w > w.max() * 1e-15
+            L = (V[:, on] / np.sqrt(w[on])).T
+            Lh = L @ H[:, 2]
+            if Lh @ Lh > 0:
+                u = Lh / np.linalg.norm(Lh)
+                L = L - np.outer(u, u @ L)
+            B = L @ A
+            S = np.eye(B.shape[0]) + B @ Pm @ B.T
+            PB = Pm @ B.T
+            Pm = Pm - PB @ np.linalg.solve(S, PB.T)
+            Pm = 0.5 * (Pm + Pm.T)
+        out[k] = np.sqrt(max(Pm[0, 0] + Pm[1, 1], 0.0))
+    return out

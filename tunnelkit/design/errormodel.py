@@ -76,7 +76,10 @@ class PathErrorModel:
     ``v`` (T, P) [m/s]; ``crlb`` and ``cov`` (T, 4P, 4P) ordered path-major
     (``[phi_0, psi_0, kappa_0, d_0, phi_1, ...]``); ``bias`` (T, P, 4); ``k_phase`` and
     ``k_gain`` (T, P, 4, M) or ``None`` (no calibration sensitivity computed);
-    ``phase_sigma_rad`` and ``gain_sigma_db`` the calibration error's standard deviations.
+    ``phase_sigma_rad`` and ``gain_sigma_db`` the calibration error's standard deviations;
+    ``unresolved`` (T, P) bool or ``None``: paths of the route geometry the model leaves out
+    at an epoch because the array cannot resolve them there (absent from ``exists``: a gap in
+    that path's information, not in the epoch's).
     """
 
     t: np.ndarray
@@ -91,6 +94,7 @@ class PathErrorModel:
     k_gain: np.ndarray | None = None
     phase_sigma_rad: float = 0.0
     gain_sigma_db: float = 0.0
+    unresolved: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         sequence("kinds", self.kinds)
@@ -133,6 +137,12 @@ class PathErrorModel:
                 raise ValueError(f"{name}: a calibration error needs its sensitivity {k}")
             if getattr(self, k) is not None and not np.all(np.isfinite(getattr(self, k))):
                 raise ValueError(f"{k}: every entry must be finite")
+        if self.unresolved is not None:
+            un = np.asarray(self.unresolved)
+            if un.shape != (T, P) or un.dtype != bool:
+                raise ValueError(f"unresolved: expected a ({T}, {P}) bool array, got {un.shape}")
+            if np.any(un & ex):
+                raise ValueError("unresolved: a path the model leaves out cannot also exist")
         for name in ("crlb", "cov"):  # a covariance's variances are >= 0
             if np.any(np.diagonal(np.asarray(getattr(self, name)), axis1=1, axis2=2) < 0):
                 raise ValueError(f"{name}: a variance is negative (not a covariance)")
@@ -221,14 +231,33 @@ class PathErrorModel:
         m = np.repeat(self.exists, 4, axis=1)
         return psd_sqrt(np.where(m[:, :, None] & m[:, None, :], self.cov, 0.0))
 
-    def draw(self, rng: np.random.Generator, *, noise_sqrt: np.ndarray | None = None) -> np.ndarray:
+    def draw_calibration(self, rng: np.random.Generator) -> tuple:
+        """One manufactured array's calibration error ``(phase_rad, gain_db)``, each (M,) or
+        ``None`` where the model has none: drawn once per unit, shared by all its drives."""
+        rng = rng_or_error("rng", rng)
+        M = self.n_elements
+        phase = gain = None
+        if M is not None and self.phase_sigma_rad > 0:
+            phase = self.phase_sigma_rad * rng.standard_normal(M)
+        if M is not None and self.gain_sigma_db > 0:
+            gain = self.gain_sigma_db * rng.standard_normal(M)
+        return phase, gain
+
+    def draw(
+        self,
+        rng: np.random.Generator,
+        *,
+        noise_sqrt: np.ndarray | None = None,
+        calibration: tuple | None = None,
+    ) -> np.ndarray:
         """One drive's measured ``z`` (T, P, 4): the truth plus the deterministic bias, one
-        array's calibration bias (phase and gain errors drawn once from ``rng``) and a Gaussian
-        error with covariance ``cov`` per epoch; NaN where a path does not exist.
-        ``noise_sqrt``: :meth:`noise_sqrt` computed once (the same draw, without its cost)."""
+        array's calibration bias and a Gaussian error with covariance ``cov`` per epoch; NaN
+        where a path does not exist. ``calibration``: the unit's ``(phase_rad, gain_db)``
+        (:meth:`draw_calibration`, shared by every drive of one unit); ``None`` draws it from
+        ``rng`` first (a unit of its own). ``noise_sqrt``: :meth:`noise_sqrt` computed once
+        (the same draw, without its cost)."""
         rng = rng_or_error("rng", rng)
         T, P = self.exists.shape
-        M = self.n_elements
         if noise_sqrt is None:
             noise_sqrt = self.noise_sqrt()
         elif np.shape(noise_sqrt) != (T, 4 * P, 4 * P):
@@ -236,11 +265,12 @@ class PathErrorModel:
                 f"noise_sqrt: expected shape {(T, 4 * P, 4 * P)} (the model's noise_sqrt()), "
                 f"got {np.shape(noise_sqrt)}"
             )
-        phase = gain = None
-        if M is not None and self.phase_sigma_rad > 0:
-            phase = self.phase_sigma_rad * rng.standard_normal(M)
-        if M is not None and self.gain_sigma_db > 0:
-            gain = self.gain_sigma_db * rng.standard_normal(M)
+        if calibration is None:
+            phase, gain = self.draw_calibration(rng)
+        elif not isinstance(calibration, tuple) or len(calibration) != 2:
+            raise TypeError("calibration: expected (phase_rad, gain_db) from draw_calibration()")
+        else:
+            phase, gain = calibration
         noise = (noise_sqrt @ rng.standard_normal((T, 4 * P, 1)))[..., 0].reshape(T, P, 4)
         z = self.truth + self.bias + self.calibration_bias(phase, gain) + noise
         return np.where(self.exists[..., None], z, np.nan)

@@ -128,6 +128,17 @@ def _reported_blocks(model: PathErrorModel, report: str) -> tuple[np.ndarray, np
     return white + repeating, repeating
 
 
+def _snapshot_blocks(model: PathErrorModel) -> np.ndarray:
+    """The per-path blocks (T, P, 4, 4) of each epoch on its own: the CRLB for an ideal model,
+    the error budget (:meth:`PathErrorModel.budget`) otherwise."""
+    T, P = model.exists.shape
+    ideal = model.phase_sigma_rad == 0 and model.gain_sigma_db == 0
+    if ideal and not np.any(model.bias) and np.array_equal(model.cov, model.crlb):
+        idx = np.arange(P)
+        return np.moveaxis(model.crlb.reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1)
+    return model.budget()
+
+
 def bound_route(
     model: PathErrorModel,
     setup: DesignSetup,
@@ -168,13 +179,17 @@ def bound_route(
 
 def tracker_weights(route) -> np.ndarray:
     """The per-path covariances (T, P, 4, 4) the tracker is told on the bound route: ``route``
-    a :class:`BoundRoute` (its ``blocks``) or a :class:`PathErrorModel` (its ``"auto"`` report:
-    the CRLB for an ideal model, the error budget otherwise), with the variance of a curvature
+    a :class:`BoundRoute` (its ``blocks``) or a :class:`PathErrorModel` (each epoch on its own:
+    the CRLB for an ideal model, the error budget :meth:`PathErrorModel.budget` otherwise, not
+    the drive's split, whose repeating share is a correlation over the whole route), with the variance of a curvature
     :func:`bound_drive` does not hand on (reported standard deviation above
     :data:`KAPPA_RESOLVED` of the range) infinite and its covariances zero: the weights of
     :func:`tunnelkit.design.drivebound.position_error_parts` for the tracker that is run."""
     if isinstance(route, PathErrorModel):
-        model, blocks = route, _reported_blocks(route, "auto")[0]
+        # the budget of each epoch alone: the report of a drive (its split into white and
+        # repeating shares) weighs every epoch by correlations over the whole route, so a
+        # snapshot fix at one position would depend on the rest of the route
+        model, blocks = route, _snapshot_blocks(route)
     elif isinstance(route, BoundRoute):
         model, blocks = route.model, route.blocks
     else:
@@ -198,13 +213,15 @@ def bound_drive(
     n_epochs: int | None = None,
     sigma_v: float = SIGMA_V,
     report: str = "auto",
+    calibration: tuple | None = None,
 ):
     """One drive of ``setup``'s route for ``spec`` measured through ``model`` (module docstring):
     a :class:`tunnelkit.studies.DriveData` the tracker runs on exactly as on the channel route
     (``extraction="bound"``, reported covariances). ``n_epochs`` keeps the first epochs only.
     ``model`` may be a :class:`BoundRoute` of ``spec`` (:func:`bound_route`, computed once per
     array; its own ``report`` then applies): the same drive, without recomputing the array's
-    share of it."""
+    share of it. ``calibration``: the unit's calibration draw
+    (:meth:`PathErrorModel.draw_calibration`; ``None``: drawn from ``rng``, a unit per drive)."""
     from ..channel import sample_clock_bias
     from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
     from ..tracking.javelin.measurement import PathMeasurements
@@ -232,7 +249,7 @@ def bound_drive(
 
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
     min_d = prepared.min_d
-    z = model.draw(rng, noise_sqrt=prepared.noise_sqrt)[:T]
+    z = model.draw(rng, noise_sqrt=prepared.noise_sqrt, calibration=calibration)[:T]
     ex = model.exists[:T]
     P = ex.shape[1]
     bias = sample_clock_bias(rng, cfg.clock_bias_sigma, cfg.clock_bias_limit, size=T)

@@ -45,7 +45,12 @@ from .._validate import finite_array, instance, integer, positive, probability
 from ..channel import DiffuseSpec
 from ..constants import C
 
-__all__ = ["WB_TOL", "EtaModes", "scaled_inverse"]
+__all__ = ["FRAMES", "WB_TOL", "EtaModes", "radial_basis", "scaled_inverse"]
+
+#: the coordinates of each path's wave origin in ``eta`` (:class:`EtaModes`): ``"cartesian"``
+#: the local frame's ``s_x, s_y, s_z``; ``"radial"`` displacements along the path's own
+#: azimuth, elevation and range directions (:func:`radial_basis`)
+FRAMES = ("cartesian", "radial")
 
 #: truncation of the spatial-wideband series (relative size of the first term left out)
 WB_TOL = 1e-13
@@ -92,6 +97,32 @@ def scaled_inverse(G: np.ndarray, rcond: float = 1e-12) -> tuple[np.ndarray, np.
     return inv, sing
 
 
+def radial_basis(s_loc) -> np.ndarray:
+    """Per wave origin ``s_loc`` (..., 3) an orthonormal basis (..., 3, 3) whose columns are the
+    directions of increasing azimuth, elevation and range seen from the origin (the reference
+    antenna): ``[e_phi, e_psi, u]``, ``u = s / |s|``. On the vertical axis ``e_phi`` is the
+    local ``y`` axis; at ``s = 0`` the identity.
+
+    In these coordinates the Fisher information of a distant path is well conditioned after
+    Jacobi scaling at any range: the range column is small (the wavefront's curvature) but
+    not nearly collinear with the others, whereas in Cartesian coordinates the three columns of
+    the wave origin become collinear as the range grows (their combination along ``u`` is
+    second order in aperture / range), so the scaled matrix' condition number grows like
+    ``(range / aperture)^2`` and the inverse is lost (4 x 4 at 28 GHz beyond about 100 m)."""
+    s = finite_array("s_loc", s_loc)
+    if s.ndim not in (1, 2, 3) or s.shape[-1] != 3:
+        raise ValueError(f"s_loc: expected points (3,), (n, 3) or (T, n, 3), got {s.shape}")
+    r = np.linalg.norm(s, axis=-1)
+    u = np.where(r[..., None] > 0, s / np.where(r > 0, r, 1.0)[..., None], [1.0, 0.0, 0.0])
+    phi = np.arctan2(u[..., 1], u[..., 0])
+    psi = np.arctan2(u[..., 2], np.hypot(u[..., 0], u[..., 1]))
+    e_phi = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)], axis=-1)
+    e_psi = np.stack([-np.sin(psi) * np.cos(phi), -np.sin(psi) * np.sin(phi), np.cos(psi)], axis=-1)
+    u = np.stack([np.cos(psi) * np.cos(phi), np.cos(psi) * np.sin(phi), np.sin(psi)], axis=-1)
+    B = np.stack([e_phi, e_psi, u], axis=-1)
+    return np.where((r > 0)[..., None, None], B, np.eye(3))
+
+
 def _check_modes(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols) -> None:
     """The arguments of :class:`EtaModes`: shapes (T, L, 3), (M, 3), (T, L) each."""
     T, L, _ = finite_array("s_loc", s_loc, shape=(None, None, 3)).shape
@@ -110,11 +141,20 @@ class EtaModes:
     ``s_loc`` (T, L, 3) wave origins (local frame), ``pos`` (M, 3) elements, ``alpha`` (T, L)
     gains with ``sqrt(P_t)``, ``mu_f`` / ``mu_t`` (T, L), ``mask`` (T, L) the real paths (the
     others are padding and contribute nothing). Columns of ``J`` per path: ``Re a, Im a, mu_f,
-    mu_t, s_x, s_y, s_z``.
+    mu_t`` and three of the wave origin: ``s_x, s_y, s_z`` (``frame="cartesian"``) or, with
+    ``frame="radial"``, displacements along ``basis[t, l]`` (T, L, 3, 3) (:func:`radial_basis`:
+    azimuth, elevation, range), ``s = s_0 + basis @ eta_s``; a Jacobian ``d z / d s`` maps to
+    these as ``d z / d s @ basis``. The range column is evaluated without cancellation
+    (``(u_m - u_0) . u_0 = -|u_m - u_0|^2 / 2``), so a far path's curvature information is
+    exact to rounding.
     """
 
-    def __init__(self, s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols):
+    def __init__(
+        self, s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols, frame="cartesian"
+    ):
         _check_modes(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols)
+        if frame not in FRAMES:
+            raise ValueError(f"frame: expected one of {FRAMES}, got {frame!r}")
         T, L, _ = s_loc.shape
         self.k0 = 2 * np.pi * fc / C
         self.n_tones, self.n_symbols = int(n_tones), int(n_symbols)
@@ -125,7 +165,16 @@ class EtaModes:
         u = diff / rng_m[..., None]
         A = np.empty((T, pos.shape[0], L, 4), complex)
         A[..., 0] = a
-        A[..., 1:] = 1j * self.k0 * a[..., None] * (u - u[:, :1])
+        du = u - u[:, :1]  # (T, M, L, 3)
+        if frame == "radial":
+            self.basis = radial_basis(s_loc)
+            g = np.einsum("tmli,tlij->tmlj", du, self.basis)
+            g[..., 2] = -0.5 * np.sum(du * du, axis=-1)  # (u_m - u_0) . u_0, cancellation-free
+        else:
+            self.basis = np.broadcast_to(np.eye(3), (T, L, 3, 3))
+            g = du
+        A[..., 1:] = 1j * self.k0 * a[..., None] * g
+        self.frame = frame
         self.a = a
         self.X = A.reshape(T, pos.shape[0], 4 * L)
         self.F2 = _pair(mu_f, self.n_tones)

@@ -26,29 +26,42 @@ def _fins(v):
 
 
 _ROW_INF = (
-    "peb_median_m", "peb_p90_m", "achievable_median_m", "achievable_p90_m", "error_median_m",
-    "error_p90_m", "error_p90_ci95_m", "rmse_m", "rmse_ci95_m", "peb_m", "achievable_m",
-    "error_median_epoch_m", "drive_bound_known_rms_m", "drive_bound_learned_rms_m",
-    "rmse_over_tracker_bound", "rmse_over_achievable", "screen_m", "dead_reckoning_p90_m",
-    "dead_reckoning_rmse_m",
+    "peb_median_m", "peb_p90_m", "predicted_median_m", "predicted_p90_m", "error_median_m",
+    "error_p90_m", "error_p90_route_m", "error_p90_ci95_m", "rmse_m", "rmse_ci95_m", "peb_m",
+    "predicted_m", "error_median_epoch_m", "unit_p90_m", "pcrlb_rms_m", "hybrid_bound_rms_m",
+    "rmse_over_pcrlb", "rmse_over_hybrid_bound", "unit_rmse_over_pcrlb_min",
+    "predicted_drive_rms_m", "predicted_drive_learned_rms_m", "rmse_over_predicted_drive",
+    "rmse_over_predicted", "dead_reckoning_p90_m", "dead_reckoning_rmse_m",
 )  # fmt: skip
-_ROW_NONNEGATIVE = ("srnf_valid_share", "met_share", "runs", *_ROW_INF)
-_ROW_SHAPES = {"error_p90_ci95_m": (2,), "rmse_ci95_m": (2,), "x_m": ("T",), "peb_m": ("T",),
-               "achievable_m": ("T",), "srnf_valid": ("T",)}  # fmt: skip
+_ROW_NONNEGATIVE = ("srnf_valid_share", "met_share", "runs", "units", "drives_per_unit",
+                    "unit_yield", "unit_yield_ci95", *_ROW_INF)  # fmt: skip
+_ROW_SHAPES = {"error_p90_ci95_m": (2,), "rmse_ci95_m": (2,), "unit_yield_ci95": (2,),
+               "unit_p90_m": (3,), "x_m": ("T",), "peb_m": ("T",), "predicted_m": ("T",),
+               "srnf_valid": ("T",)}  # fmt: skip
 
 
 @dataclass
 class DesignRow:
     """One candidate array (the JSON entry of ``tunnelkit design``, :meth:`to_json`).
 
-    Bound and error statistics are over the counted (settled) epochs; ``*_p90_m`` is the
-    ``share``-quantile (the 90th percentile at the default share). ``status`` is a verdict of
-    :func:`tunnelkit.design.verdict.judge` or ``"error"`` (``reason`` says why). Per-epoch
-    arrays cover the whole route: ``x_m``, ``peb_m``, ``achievable_m`` and, with runs,
-    ``error_median_epoch_m`` (median over runs). With runs on the bound route (and on the
-    ray-traced channel's route, there of the sigmas its tracker is told), the bounds over
-    the drive (RMS, counted epochs) of a tracker that knows the surfaces and of one that learns
-    its VUEs (``drive_bound_known_rms_m``, ``drive_bound_learned_rms_m``, :func:`_drive_bounds`).
+    Statistics are over the counted (settled) epochs unless named ``*_route_*`` (the whole
+    route); ``*_p90_m`` is the ``share``-quantile (the 90th percentile at the default share).
+    ``status`` is a verdict of :func:`tunnelkit.design.verdict.judge` (by the unit yield) or
+    ``"error"`` (``reason`` says why). The Monte-Carlo ran ``units`` manufactured units (one
+    calibration draw each) of ``drives_per_unit`` drives (``runs`` in all): ``unit_yield`` the
+    share of units whose own error quantile meets the target, ``unit_yield_ci95`` its Wilson
+    interval, ``unit_p90_m`` the units' quantiles' [min, median, max]; ``error_p90_m`` the
+    quantile pooled over units with ``error_p90_ci95_m`` a bootstrap over units.
+
+    **Bounds** (lower bounds of what they are set beside, :mod:`tunnelkit.design.drivebound`):
+    ``peb_*`` the snapshot PEB (ideal model, one epoch); ``pcrlb_rms_m`` every unit's posterior
+    CRLB over the drive, with ``unit_rmse_over_pcrlb_min`` the smallest unit RMSE over it;
+    ``hybrid_bound_rms_m`` the posterior CRLB pooled over units (the calibration draw a fixed
+    unknown of the drive). **Predictions** (first-order, not bounds: the tracker may beat
+    them): ``predicted_*`` the snapshot fix's RMS error under the impairments, weighted as the
+    tracker weighs; ``predicted_drive_rms_m`` / ``predicted_drive_learned_rms_m`` the same over
+    the drive, surfaces known / VUEs learnt. Per-epoch arrays cover the whole route: ``x_m``,
+    ``peb_m``, ``predicted_m`` and, with units, ``error_median_epoch_m`` (median over runs).
     """
 
     array: str
@@ -60,83 +73,95 @@ class DesignRow:
     srnf_valid_share_by_surface: dict = field(default_factory=dict)
     peb_median_m: float | None = None
     peb_p90_m: float | None = None
-    achievable_median_m: float | None = None
-    achievable_p90_m: float | None = None
+    predicted_median_m: float | None = None
+    predicted_p90_m: float | None = None
     met_share: float | None = None
     error_median_m: float | None = None
     error_p90_m: float | None = None
     error_p90_ci95_m: list | None = None
+    error_p90_route_m: float | None = None
     rmse_m: float | None = None
     rmse_ci95_m: list | None = None
     runs: int = 0
+    units: int = 0
+    drives_per_unit: int = 0
+    unit_yield: float | None = None
+    unit_yield_ci95: list | None = None
+    unit_p90_m: list | None = None
     x_m: np.ndarray | None = None
     peb_m: np.ndarray | None = None
-    achievable_m: np.ndarray | None = None
+    predicted_m: np.ndarray | None = None
     error_median_epoch_m: np.ndarray | None = None
+    pcrlb_rms_m: float | None = None
+    hybrid_bound_rms_m: float | None = None
+    rmse_over_pcrlb: float | None = None
+    rmse_over_hybrid_bound: float | None = None
+    unit_rmse_over_pcrlb_min: float | None = None
     tracker_vues: str | None = None
-    drive_bound_known_rms_m: float | None = None
-    drive_bound_learned_rms_m: float | None = None
-    rmse_over_tracker_bound: float | None = None
-    rmse_over_achievable: float | None = None
+    predicted_drive_rms_m: float | None = None
+    predicted_drive_learned_rms_m: float | None = None
+    rmse_over_predicted_drive: float | None = None
+    rmse_over_predicted: float | None = None
     error_model: dict | None = None
     dead_reckoning_p90_m: float | None = None
     dead_reckoning_rmse_m: float | None = None
-    screen_m: float | None = field(default=None, repr=False)
+    gaps: str = ""
     srnf_valid: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:  # a bound or an error may be +inf (never met)
         record(self, shapes=_ROW_SHAPES, positive=("n_elements", "aperture_diagonal_m"),
                nonnegative=_ROW_NONNEGATIVE, allow_inf=_ROW_INF,
-               allow_nan=("peb_m", "achievable_m", "error_median_epoch_m"),
-               may_be_empty=("reason",))  # fmt: skip
+               allow_nan=("peb_m", "predicted_m", "error_median_epoch_m"),
+               may_be_empty=("reason", "gaps"))  # fmt: skip
 
     @property
     def aperture_m(self) -> float:
         """The aperture's diagonal [m] (largest distance between two elements)."""
         return self.aperture_diagonal_m
 
+    #: the JSON's scalar keys, in order (besides the fields handled apart in :meth:`to_json`)
+    _SCALARS = (
+        "srnf_valid_share", "peb_median_m", "peb_p90_m", "predicted_median_m", "predicted_p90_m",
+        "met_share", "error_median_m", "error_p90_m", "error_p90_route_m", "rmse_m",
+        "unit_yield", "pcrlb_rms_m", "hybrid_bound_rms_m", "rmse_over_pcrlb",
+        "rmse_over_hybrid_bound", "unit_rmse_over_pcrlb_min", "predicted_drive_rms_m",
+        "predicted_drive_learned_rms_m", "rmse_over_predicted_drive", "rmse_over_predicted",
+    )  # fmt: skip
+
     def to_json(self) -> dict:
-        """``array, n_elements, aperture_diagonal_m, status, reason, srnf_valid_share,
-        srnf_valid_share_by_surface, peb_median_m, peb_p90_m, achievable_median_m,
-        achievable_p90_m, met_share, error_median_m, error_p90_m, error_p90_ci95_m, rmse_m,
-        rmse_ci95_m, runs, tracker_vues, drive_bound_known_rms_m, drive_bound_learned_rms_m,
-        rmse_over_tracker_bound, rmse_over_achievable`` (the RMSE over the RMS of
-        ``achievable_m`` on the same epochs) and ``per_epoch {x_m, peb_m, achievable_m,
-        error_median_m}`` (non-finite values and anything not computed are null); on the
-        ray-traced channel's route also ``error_model`` (the tracker's measurement-noise model,
-        :func:`tunnelkit.design.traced.error_model_summary`, with ``told_sigmas`` the long-run
-        sigmas its tracker is told); with dead reckoning measured, ``dead_reckoning_p90_m`` and
-        ``dead_reckoning_rmse_m`` (the same drives, every measurement dropped)."""
+        """The row as JSON: ``array, n_elements, aperture_diagonal_m, status, reason, gaps`` (the
+        epochs where the array cannot fix the position, named; empty when none), the
+        scalars of the class docstring (``null`` when not computed or not finite),
+        ``error_p90_ci95_m, rmse_ci95_m, unit_yield_ci95, unit_p90_m``, the counts ``runs,
+        units, drives_per_unit``, ``tracker_vues`` and ``per_epoch {x_m, peb_m, predicted_m,
+        error_median_m}``; on the ray-traced channel's route also ``error_model`` (the
+        tracker's measurement-noise model, :func:`tunnelkit.design.traced.error_model_summary`,
+        with ``told_sigmas`` the long-run sigmas its tracker is told); with dead reckoning
+        measured, ``dead_reckoning_p90_m`` and ``dead_reckoning_rmse_m`` (the same drives,
+        every measurement dropped)."""
         out = {
             "array": self.array,
             "n_elements": int(self.n_elements),
             "aperture_diagonal_m": _fin(self.aperture_diagonal_m),
             "status": self.status,
             "reason": self.reason,
-            "srnf_valid_share": _fin(self.srnf_valid_share),
+            "gaps": self.gaps,
             "srnf_valid_share_by_surface": {
                 k: _fin(v) for k, v in self.srnf_valid_share_by_surface.items()
             },
-            "peb_median_m": _fin(self.peb_median_m),
-            "peb_p90_m": _fin(self.peb_p90_m),
-            "achievable_median_m": _fin(self.achievable_median_m),
-            "achievable_p90_m": _fin(self.achievable_p90_m),
-            "met_share": _fin(self.met_share),
-            "error_median_m": _fin(self.error_median_m),
-            "error_p90_m": _fin(self.error_p90_m),
+            **{k: _fin(getattr(self, k)) for k in self._SCALARS},
             "error_p90_ci95_m": _fins(self.error_p90_ci95_m),
-            "rmse_m": _fin(self.rmse_m),
             "rmse_ci95_m": _fins(self.rmse_ci95_m),
+            "unit_yield_ci95": _fins(self.unit_yield_ci95),
+            "unit_p90_m": _fins(self.unit_p90_m),
             "runs": int(self.runs),
+            "units": int(self.units),
+            "drives_per_unit": int(self.drives_per_unit),
             "tracker_vues": self.tracker_vues,
-            "drive_bound_known_rms_m": _fin(self.drive_bound_known_rms_m),
-            "drive_bound_learned_rms_m": _fin(self.drive_bound_learned_rms_m),
-            "rmse_over_tracker_bound": _fin(self.rmse_over_tracker_bound),
-            "rmse_over_achievable": _fin(self.rmse_over_achievable),
             "per_epoch": {
                 "x_m": _fins(self.x_m),
                 "peb_m": _fins(self.peb_m),
-                "achievable_m": _fins(self.achievable_m),
+                "predicted_m": _fins(self.predicted_m),
                 "error_median_m": _fins(self.error_median_epoch_m),
             },
         }
@@ -181,43 +206,50 @@ class DesignReport:
         s = self.settings
         imp = s["impairments"]
         q = f"p{100 * s['share']:g}"
+        st = s["settle_s"]
         lines = [
             f"Array design for {self.scenario}: fc {s['fc'] / 1e9:g} GHz, bandwidth "
-            f"{s['bandwidth'] / 1e6:g} MHz; target {s['target']:g} m on {100 * s['share']:g} % "
-            "of the settled route",
+            f"{s['bandwidth'] / 1e6:g} MHz ({s['n_rb']} RB at {s['scs'] / 1e3:g} kHz); target {s['target']:g} m on {100 * s['share']:g} % "
+            f"of the settled route (the epochs {st:g} s after the start, --settle), required "
+            f"unit yield {100 * s['required_yield']:g} %",
             f"impairments: phase {imp['phase_error_deg']:g} deg, gain {imp['gain_error_db']:g} "
             f"dB, spatial wideband {'on' if imp['spatial_wideband'] else 'off'}, diffuse share "
-            f"{imp['dmc_share']:g}; Monte-Carlo: {s['runs']} runs ({s['mode']} route), seed "
+            f"{imp['dmc_share']:g}; Monte-Carlo: units of {s['drives_per_unit']} drives "
+            f"({s['mode']} route, {s['units']} units first, up to {s['max_units']}), seed "
             f"{s['seed']}"
             + (f", entry fix {s['start_sigma_m']:g} m per axis" if "start_sigma_m" in s else ""),
             f"criterion: {_CRITERION_TEXT[s['criterion']]}",
-            f"{'array':>7s} {'M':>5s} {'diagonal':>9s} {'SR-NF ok':>9s} {'PEB med':>9s} "
-            f"{'PEB ' + q:>9s} {'ach. med':>9s} {'ach. ' + q:>9s} {'err med':>9s} "
-            f"{'err ' + q:>9s} {'95% CI':>21s} {'RMSE':>9s}  status",
+            f"{'array':>7s} {'M':>5s} {'SR-NF ok':>9s} {'PEB ' + q:>9s} {'pred ' + q:>9s} "
+            f"{'units':>5s} {'unit yield [95% CI]':>20s} {'err ' + q:>9s} {'95% CI':>21s} "
+            f"{'route ' + q:>9s} {'RMSE':>9s} {'PCRLB':>9s} {'hybrid':>9s}  status",
         ]
         for r in self.rows:
             if r.peb_median_m is None:  # nothing computed: the reason only
-                lines.append(
-                    f"{r.array:>7s} {r.n_elements:5d} {_cm(r.aperture_diagonal_m)}  {r.reason}"
-                )
+                lines.append(f"{r.array:>7s} {r.n_elements:5d}  {r.reason}")
                 continue
             ci = r.error_p90_ci95_m
             cis = f"[{_cm(ci[0]).strip()}, {_cm(ci[1]).strip()}]" if ci else "-"
+            yc = r.unit_yield_ci95
+            ys = f"{100 * r.unit_yield:.0f}% [{100 * yc[0]:.0f}, {100 * yc[1]:.0f}]" if yc else "-"
             lines.append(
-                f"{r.array:>7s} {r.n_elements:5d} {_cm(r.aperture_diagonal_m)} "
-                f"{100 * r.srnf_valid_share:8.1f}% {_cm(r.peb_median_m)} {_cm(r.peb_p90_m)} "
-                f"{_cm(r.achievable_median_m)} {_cm(r.achievable_p90_m)} "
-                f"{_cm(r.error_median_m)} {_cm(r.error_p90_m)} {cis:>21s} {_cm(r.rmse_m)}  "
-                f"{r.status}"
+                f"{r.array:>7s} {r.n_elements:5d} {100 * r.srnf_valid_share:8.1f}% "
+                f"{_cm(r.peb_p90_m)} {_cm(r.predicted_p90_m)} {r.units:5d} {ys:>20s} "
+                f"{_cm(r.error_p90_m)} {cis:>21s} {_cm(r.error_p90_route_m)} {_cm(r.rmse_m)} "
+                f"{_cm(r.pcrlb_rms_m)} {_cm(r.hybrid_bound_rms_m)}  {r.status}"
             )
         rec = self.recommendation
         lines.append(f"recommendation ({rec['basis']}): {rec['array'] or 'none'} — {rec['reason']}")
         lines.append(
-            f"diagonal: the aperture's diagonal; PEB: ideal position error bound; ach.: the "
-            f"achievable bound under the impairments; err: Monte-Carlo 2-D error; {q}: the "
-            f"{s['share']:g}-quantile over the settled epochs (pooled over runs), CI: bootstrap "
-            "over runs; SR-NF ok: share of the route where SR-NF holds on every surface."
+            f"Bounds (lower bounds, checked by Monte-Carlo): PEB the ideal snapshot position "
+            f"error bound; PCRLB every unit's posterior CRLB over the drive (settled RMS, beside "
+            f"each unit's RMSE); hybrid the same pooled over units, the calibration a fixed "
+            f"unknown per unit (beside RMSE). Prediction (not a bound, decides nothing): pred, "
+            f"the first-order RMS error of the tracker's fix under the impairments. err: "
+            f"Monte-Carlo 2-D error, {q} its {s['share']:g}-quantile pooled over units on the "
+            f"settled route (CI: bootstrap over units), route {q} on the whole route; unit "
+            f"yield: the share of units whose own {q} meets the target (Wilson interval)."
         )
+        lines.append(_CHANNEL_TEXT[s.get("channel", "image")])
         for r in self.rows:
             if r.srnf_valid_share_by_surface:
                 per = ", ".join(
@@ -225,7 +257,7 @@ class DesignReport:
                 )
                 lines.append(f"  SR-NF valid, {r.array}: {per}")
             for what, y in (
-                ("achievable bound", r.achievable_m),
+                ("predicted error", r.predicted_m),
                 ("median error", r.error_median_epoch_m),
             ):
                 if y is not None and r.x_m is not None:
@@ -247,12 +279,13 @@ class DesignReport:
                         f"{tg['phi_deg']:.3g} / {tg['psi_deg']:.3g} deg, {tg['kappa_m']:.3g} m, "
                         f"{tg['delta_d_m']:.3g} m"
                     )
-                if r.drive_bound_known_rms_m is not None:
-                    ratio = r.rmse_over_tracker_bound
+                if r.predicted_drive_rms_m is not None:
+                    ratio = r.rmse_over_predicted_drive
                     lines.append(
-                        f"  {r.array}: bound of the sigmas the tracker is told (settled RMS) "
-                        f"{r.drive_bound_known_rms_m:.3g} m"
-                        + ("" if ratio is None else f", tracker RMSE / bound {ratio:.3g}")
+                        f"  {r.array}: posterior CRLB of the sigmas the tracker is told (settled "
+                        f"RMS; a prediction, the traced errors are not Gaussian) "
+                        f"{r.predicted_drive_rms_m:.3g} m"
+                        + ("" if ratio is None else f", tracker RMSE / it {ratio:.3g}")
                     )
             if r.dead_reckoning_p90_m is not None:
                 gain = None
@@ -291,6 +324,15 @@ def over_target(x, y, target: float) -> str:
         i = j + 1
     return ", ".join(out)
 
+
+_CHANNEL_TEXT = {
+    "image": (
+        "channel: the image method's eq. 1 decided (specular paths only). On the paper tunnel "
+        "the ray-traced channel (diffuse and second-order paths) gave errors of metres where "
+        "this one gives millimetres (notebook 08, section 9): read the table as optimistic."
+    ),
+    "sionna": "channel: the ray-traced channel decided (Sionna RT, the array's measured errors).",
+}
 
 _CRITERION_TEXT = {
     "achievable": (

@@ -1,51 +1,64 @@
-"""A design sweep and its recommendation: one row per candidate array, decided from what the
-tracker achieves.
+"""A design sweep and its recommendation: one row per candidate array, decided by the share of
+manufactured units that meet the target.
 
 :func:`design_sweep` evaluates every candidate along the route:
 
 1. it is placed on the mount (an array with an element outside the cross-section is refused,
    per array, with the reason: :meth:`DesignSetup.arrays`);
-2. the **ideal PEB** and the **achievable bound** of the design's tracker under the stated
-   impairments (:func:`tunnelkit.design.achievable.achievable_bound`: each path's error mapped
-   to the position as the tracker weighs it, one block per path, never below the PEB), SR-NF
-   validity per surface (information under ``criterion="achievable"``, a gate under ``"srnf"``);
-3. the **pre-screen**: a candidate on which even an estimator at the achievable bound would miss
-   the target on ``share`` of the counted epochs is hopeless and gets no Monte-Carlo;
-4. the **Monte-Carlo** of the design's tracker on the others, all arrays x runs as one task set
-   (:func:`tunnelkit.design.montecarlo.sweep_montecarlo`), and the verdict of
-   :mod:`tunnelkit.design.verdict` (error quantile with a bootstrap 95 % interval).
+2. the **ideal PEB** (a bound) and the **predicted error** of the design's tracker under the
+   stated impairments (:func:`tunnelkit.design.achievable.achievable_bound`: each path's error
+   mapped to the position as the tracker weighs it, one block per path; a first-order
+   prediction, not a bound), SR-NF validity per surface (information under
+   ``criterion="achievable"``, a gate under ``"srnf"``); an epoch where the array cannot fix
+   the position is a gap of that epoch (the row's ``gaps``);
+3. the **Monte-Carlo** of the design's tracker over manufactured units, one calibration draw
+   each (:mod:`tunnelkit.design.units`), all arrays x drives of a batch as one task set
+   (:func:`tunnelkit.design.montecarlo.sweep_montecarlo`), more units for the arrays still
+   undecided (:func:`_sequential`), and the verdict of :mod:`tunnelkit.design.verdict` (the unit
+   yield with its Wilson interval against the required yield), the bounds over the drive set
+   beside the tracker's RMSE. Nothing is skipped on a bound or a prediction.
 
-:class:`DesignReport` holds the rows, the recommendation, every input and the warnings, as JSON
+:class:`DesignReport` holds the rows, the recommendation, every input and the warnings (an
+implausible input, an ideal array, a radio numerology that is not NR's), as JSON
 (:meth:`DesignReport.to_json`) or a text table (:meth:`DesignReport.to_table`).
-:func:`smallest_meeting` is the explorer's bound-only pre-screen (achievable bound, or PEB and SR-NF
-under ``criterion="srnf"``).
+:func:`smallest_meeting` is the explorer's quick look: the smallest array *predicted* to meet
+the target (or, under ``criterion="srnf"``, with the PEB and SR-NF), a prediction, not an answer.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from functools import partial
 
 import numpy as np
 
-from .._validate import boolean, choice, finite_array, integer, positive, probability, sequence
-from ..budget import check_elements
+from .._validate import (
+    boolean,
+    choice,
+    finite_array,
+    integer,
+    nonnegative,
+    positive,
+    probability,
+    sequence,
+)
+from ..budget import check_bytes, check_elements
+from ..metrics import SETTLE_S
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
 from .bounds import route_bounds, route_geometry
 from .montecarlo import MODES, START_SIGMA_M, sweep_montecarlo
 from .records import DesignReport, DesignRow, over_target
 from .setup import ArraySpec, DesignSetup, parse_array
+from .units import DRIVES_PER_UNIT, MAX_UNITS, REQUIRED_YIELD, unit_quantiles, unit_yield
 from .verdict import (
     CRITERIA,
     MIN_RUNS_CI,
     bootstrap_quantile_ci,
     counted_epochs,
     gate,
-    implied_quantile,
     judge,
     recommend,
-    screen_bound,
     share_quantile,
 )
 
@@ -63,11 +76,11 @@ def smallest_meeting(
     eps_phi: float = 0.15,
     epochs=None,
 ) -> tuple[ArraySpec | None, float]:
-    """The first array of ``arrays`` (in the order given) whose **bound** meets ``target`` on
-    ``share`` of the route, and its met share; ``(None, best share)`` if none.
+    """The first array of ``arrays`` (in the order given) whose **predicted error** meets
+    ``target`` on ``share`` of the route, and its met share; ``(None, best share)`` if none.
 
-    A bound-only pre-screen for the explorer (the answer is :func:`design_sweep` with runs):
-    with ``criterion="achievable"`` (default) the achievable bound under ``impairments``
+    A prediction for the explorer, not an answer (the answer is :func:`design_sweep` with
+    units): with ``criterion="achievable"`` (default) the predicted error under ``impairments``
     (``None``: the PEB), SR-NF only information; with ``"srnf"`` (an eq. 51 estimator) an epoch
     where SR-NF fails counts as missed. Arrays that do not fit are skipped; ``epochs``
     subsamples the route."""
@@ -105,7 +118,7 @@ def _impairment_fields(imp: DesignImpairments) -> dict:
 
 def _design_impairments(impairments) -> DesignImpairments:
     """``impairments`` (None, a dict of fields or a ``DesignImpairments``) as the object the
-    achievable bound and the error model take."""
+    prediction and the error model take."""
     if impairments is None:
         return DesignImpairments()
     if isinstance(impairments, dict):
@@ -116,13 +129,6 @@ def _design_impairments(impairments) -> DesignImpairments:
             f"{type(impairments).__name__}"
         )
     return impairments
-
-
-def _achievable_bound(setup, spec, impairments, geometry):
-    r = achievable_bound(setup, spec, impairments, geometry=geometry)  # and PEB + impairments:
-    a, n = r.achievable, np.where(np.isfinite(r.noise), r.noise, 0.0)
-    imp = np.where(np.isfinite(a), a**2 - n**2, np.inf)
-    return r.x, r.peb, r.achievable, np.sqrt(np.clip(imp, 0.0, None) + r.peb**2)
 
 
 def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
@@ -158,92 +164,125 @@ def _field(res, name):
     return res[name] if isinstance(res, dict) else getattr(res, name)
 
 
-def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epochs) -> DesignRow:
+def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epochs, settle):
     """The bound part of one candidate's row (placement checked first)."""
     row = DesignRow(spec.label, spec.n_elements, spec.aperture(setup.fc))
     try:
         setup.arrays(spec)
         g = route_geometry(setup, spec, epochs=epochs)
         sr = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
-        x, peb, ach, imp_only = _achievable_bound(setup, spec, impairments, g)
+        r = achievable_bound(setup, spec, impairments, geometry=g)
     except (ValueError, ArithmeticError) as exc:
         row.reason = str(exc)
         return row
-    bad = np.isnan(peb) | np.isnan(ach) | (np.isinf(ach) & np.isfinite(peb))
-    if bad.any():
-        row.reason = (
-            f"bound undefined (NaN, or a per-path bound the tracker needs) at {int(bad.sum())} "
-            f"of {bad.size} epochs: the array cannot be evaluated on this route"
-        )
+    x, peb, pred = r.x, r.peb, r.achievable
+    if not np.any(r.valid):
+        row.reason = f"no epoch of the route has a defined prediction: {r.reason}"
         return row
+    # an epoch where the array cannot fix the position is a gap of that epoch (infinite:
+    # counted as missed), named in ``gaps``; the other epochs stand
+    row.gaps = r.reason if not np.all(r.valid) else ""
     t = setup.trajectory.t[: len(x)]
-    k = counted_epochs(t)
-    row.x_m, row.peb_m, row.achievable_m = x, peb, ach
+    k = counted_epochs(t, settle)
+    row.x_m, row.peb_m, row.predicted_m = x, peb, pred
     row.srnf_valid_share = float(sr.srnf_valid.mean())
     row.srnf_valid_share_by_surface = sr.surface_validity()
-    gated = gate(ach, sr.srnf_valid, criterion)[k]
+    gated = gate(pred, sr.srnf_valid, criterion)[k]
     row.peb_median_m = float(np.median(peb[k]))
     row.peb_p90_m = share_quantile(peb[k], share)
-    row.achievable_median_m = float(np.median(ach[k]))
-    row.achievable_p90_m = share_quantile(ach[k], share)
+    row.predicted_median_m = float(np.median(pred[k]))
+    row.predicted_p90_m = share_quantile(pred[k], share)
     row.met_share = float(np.mean(gated <= target))
-    scr = gate(screen_bound(peb, imp_only), sr.srnf_valid, criterion)[k]  # the pre-screen
-    row.screen_m = implied_quantile(scr, share)
     row.srnf_valid = sr.srnf_valid
-    row.status, row.reason = judge(target, row.screen_m, share=share)
+    row.status, row.reason = judge(target, share=share)
     return row
 
 
-def score_row(row, res, criterion, target, share, seed, n_boot) -> None:
-    """Fill ``row`` from one array's Monte-Carlo result (errors (runs, T)) and judge it."""
+def _rms(v, k) -> float | None:
+    return None if v is None else float(np.sqrt(np.mean(np.asarray(v, float)[k] ** 2)))
+
+
+def score_row(
+    row,
+    res,
+    criterion,
+    target,
+    share,
+    seed,
+    n_boot,
+    *,
+    settle: float = SETTLE_S,
+    required: float = REQUIRED_YIELD,
+    cap: int | None = None,
+) -> None:
+    """Fill ``row`` from one array's Monte-Carlo result (errors (units x drives, T), the drives
+    of one unit after each other) and judge it by the unit yield."""
     errors = np.asarray(_field(res, "errors"), float)
     t = np.asarray(_field(res, "t"), float)
     if errors.ndim != 2 or errors.shape[1] != t.size:
         raise ValueError(f"errors: expected (runs, {t.size}), got shape {errors.shape}")
-    runs = errors.shape[0]
-    k = counted_epochs(t)
+    d = int(getattr(res, "drives_per_unit", 1))
+    runs, units = errors.shape[0], errors.shape[0] // d
+    k = counted_epochs(t, settle)
     valid = row.srnf_valid[: t.size]
     lost = np.where(np.isfinite(errors), errors, np.inf)  # no estimate: an infinite error
-    e = gate(lost, valid, criterion)[:, k]
+    gated = gate(lost, valid, criterion)
+    e = gated[:, k]
     rng = np.random.default_rng([0xB007, int(seed), *row.array.encode()])
-    row.runs = runs
+    row.runs, row.units, row.drives_per_unit = runs, units, d
     row.error_median_epoch_m = np.median(lost, axis=0)
     row.error_median_m = float(np.median(e))
     row.error_p90_m = share_quantile(e, share)
-    row.error_p90_ci95_m = bootstrap_quantile_ci(e, share, rng, n_boot=n_boot)
+    row.error_p90_route_m = share_quantile(gated, share)
+    # the interval over units (whole units resampled: a unit's drives share its calibration)
+    by_unit = e.reshape(units, -1)
+    row.error_p90_ci95_m = bootstrap_quantile_ci(by_unit, share, rng, n_boot=n_boot)
     sq = np.where(np.isfinite(errors[:, k]), errors[:, k], np.inf) ** 2
     row.rmse_m = float(np.sqrt(sq.mean()))
-    idx = rng.integers(0, runs, size=(n_boot, runs))
-    boot = np.sqrt(sq.mean(axis=1)[idx].mean(axis=1))
+    unit_ms = sq.reshape(units, -1).mean(axis=1)
+    idx = rng.integers(0, units, size=(n_boot, units))
+    boot = np.sqrt(unit_ms[idx].mean(axis=1))
     row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
+    uq = unit_quantiles(gated, d, k, share)
+    row.unit_p90_m = [float(v) for v in np.quantile(uq, [0.0, 0.5, 1.0], method="inverted_cdf")]
+    row.unit_yield, row.unit_yield_ci95 = unit_yield(uq, target)
     row.error_model = getattr(res, "error_model", None)
     dr = getattr(res, "dead_reckoning", None)
     if dr is not None:  # the same drives, every measurement dropped: what the radio adds
         dr = np.asarray(dr, float)
         row.dead_reckoning_p90_m = share_quantile(dr[:, k], share)  # never lost: no NaN
         row.dead_reckoning_rmse_m = float(np.sqrt(np.mean(dr[:, k] ** 2)))
-    ach = np.sqrt(np.mean(np.asarray(row.achievable_m)[k] ** 2))
-    row.rmse_over_achievable = row.rmse_m / ach if ach > 0 else None
-    _drive_bounds(row, res, k)
+    pred = _rms(row.predicted_m, k)
+    row.rmse_over_predicted = row.rmse_m / pred if pred else None
+    _drive_bounds(row, res, k, np.sqrt(unit_ms))
     row.status, row.reason = judge(
         target,
-        row.screen_m,
-        runs=runs,
-        error_q=row.error_p90_m,
-        ci=row.error_p90_ci95_m,
+        units=units,
+        yield_=row.unit_yield,
+        ci=row.unit_yield_ci95,
+        required=required,
         share=share,
+        cap=cap,
     )
 
 
-def _drive_bounds(row, res, k) -> None:
-    """RMS over the counted epochs ``k`` of ``res.drive`` (surfaces known) and ``res.learned``
-    (VUEs learnt); the tracker's RMSE over the bound of the VUEs it ran with."""
-    known, learned = getattr(res, "drive", None), getattr(res, "learned", None)
+def _drive_bounds(row, res, k, unit_rmse) -> None:
+    """The bounds over the drive (RMS over the counted epochs ``k``) and the tracker's RMSE
+    over them: ``pcrlb`` every unit's (so each unit's RMSE ``unit_rmse`` is set beside it),
+    ``hybrid`` the one pooled over units; and the predictions ``predicted`` (surfaces known)
+    and ``predicted_learned`` (VUEs learnt), the tracker's over the one of the VUEs it ran."""
+    pc, hy = _rms(getattr(res, "pcrlb", None), k), _rms(getattr(res, "hybrid", None), k)
+    if pc:
+        row.pcrlb_rms_m, row.rmse_over_pcrlb = pc, row.rmse_m / pc
+        row.unit_rmse_over_pcrlb_min = float(np.min(unit_rmse)) / pc
+    if hy:
+        row.hybrid_bound_rms_m, row.rmse_over_hybrid_bound = hy, row.rmse_m / hy
+    known = _rms(getattr(res, "predicted", None), k)
+    learned = _rms(getattr(res, "predicted_learned", None), k)
     if known is not None and learned is not None:
-        rms = [float(np.sqrt(np.mean(np.asarray(b)[k] ** 2))) for b in (known, learned)]
-        row.drive_bound_known_rms_m, row.drive_bound_learned_rms_m = rms
-        row.tracker_vues, bound = res.vues, rms[0] if res.vues == "known" else rms[1]
-        row.rmse_over_tracker_bound = row.rmse_m / bound if bound > 0 else None
+        row.predicted_drive_rms_m, row.predicted_drive_learned_rms_m = known, learned
+        row.tracker_vues, pred = res.vues, known if res.vues == "known" else learned
+        row.rmse_over_predicted_drive = row.rmse_m / pred if pred > 0 else None
 
 
 def design_sweep(
@@ -255,7 +294,11 @@ def design_sweep(
     criterion: str = "achievable",
     impairments=None,
     eps_phi: float = 0.15,
-    runs: int = 0,
+    units: int = 0,
+    drives_per_unit: int = DRIVES_PER_UNIT,
+    required_yield: float = REQUIRED_YIELD,
+    max_units: int = MAX_UNITS,
+    settle: float = SETTLE_S,
     seed: int = 0,
     mode: str = "bound",
     workers: int | None = None,
@@ -269,18 +312,22 @@ def design_sweep(
 ) -> DesignReport:
     """Every candidate of ``arrays`` evaluated and judged (module docstring).
 
-    ``target`` [m] on ``share`` of the settled route; ``criterion`` ``"achievable"`` (default,
-    the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a gate);
-    ``impairments``: a ``design.DesignImpairments`` or a dict of its fields (``None``: ideal);
-    ``runs`` drives per array (0: bounds only) on the ``mode`` route (``"bound"``: drawn from
-    the error model; ``"channel"``: synthesis and extraction), seeded by ``seed``; ``workers``
-    / ``scheduler`` / ``timeout`` go to the one task set; ``n_epochs`` truncates the route;
-    ``n_boot`` bootstrap resamples; ``start_sigma`` [m] the entry fix's standard deviation per
-    axis (the tracker's start and the prior of the bounds over the drive; default
-    :data:`~tunnelkit.design.montecarlo.START_SIGMA_M`, the open-sky fix); ``dead_reckoning``:
-    each drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what
-    the radio adds). An array that does not fit, or whose bound or Monte-Carlo
-    is undefined, is a row with status ``"error"`` and the reason; the sweep goes on."""
+    ``target`` [m] on ``share`` of the settled route (the epochs at least ``settle`` [s] after
+    the start, default :data:`~tunnelkit.metrics.SETTLE_S`); ``criterion`` ``"achievable"``
+    (default, the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a
+    gate); ``impairments``: a ``design.DesignImpairments`` or a dict of its fields (``None``:
+    ideal). The Monte-Carlo runs manufactured units (one calibration draw each) of
+    ``drives_per_unit`` drives on the ``mode`` route (``"bound"``: drawn from the error model;
+    ``"channel"``: synthesis and extraction), seeded by ``seed``: ``units`` in the first batch
+    (0: bounds and predictions only), then, for every array still undecided, as many again
+    until its unit yield's 95 % interval lies on one side of ``required_yield`` or
+    ``max_units`` is reached (the sequential rule). ``workers`` / ``scheduler`` / ``timeout``
+    go to each batch's task set; ``n_epochs`` truncates the route; ``n_boot`` bootstrap
+    resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
+    (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
+    drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
+    radio adds). An array that does not fit, or whose bound or Monte-Carlo is undefined, is a
+    row with status ``"error"`` and the reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     if isinstance(arrays, (str, ArraySpec)):
@@ -297,7 +344,11 @@ def design_sweep(
     criterion = choice("criterion", criterion, CRITERIA)
     mode = choice("mode", mode, MODES)
     eps_phi = positive("eps_phi", eps_phi)
-    runs = integer("runs", runs, minimum=0)
+    units = integer("units", units, minimum=0)
+    drives_per_unit = integer("drives_per_unit", drives_per_unit, minimum=1, maximum=100)
+    required_yield = probability("required_yield", required_yield)
+    max_units = integer("max_units", max_units, minimum=max(units, 1))
+    settle = nonnegative("settle", settle)
     seed = integer("seed", seed, minimum=0)
     n_boot = integer("n_boot", n_boot, minimum=100)
     start_sigma = positive("start_sigma", start_sigma)
@@ -307,7 +358,19 @@ def design_sweep(
     workers, scheduler = parallel_options(workers, scheduler)
     imp = _design_impairments(impairments)
     fields = _impairment_fields(imp)
-    if mode == "channel" and runs:
+    T = len(setup.trajectory)
+    if n_epochs is not None and n_epochs < T:
+        T = n_epochs
+    counted_epochs(setup.trajectory.t[:T], settle)  # a settle window that leaves an epoch
+    if units:
+        # the largest array's drives at the cap: what one batch's results may hold at most
+        check_bytes(
+            "max_units",
+            8 * (2 if dead_reckoning else 1) * len(specs) * max_units * drives_per_unit * T,
+            f"{len(specs)} arrays x {max_units} units x {drives_per_unit} drives x {T} epochs "
+            "of errors",
+        )
+    if mode == "channel" and units:
         # each drive synthesises the largest candidate's tensor and a noise draw of its size:
         # the band's tone count is refused here, before any bound is computed
         cfg, big = setup.config, max(s.n_elements for s in specs)
@@ -318,18 +381,14 @@ def design_sweep(
             f"a {big} x {cfg.n_tones} tones x {cfg.n_symbols} symbols channel tensor and its noise "
             f"at bandwidth = {cfg.bandwidth:g} Hz",
         )
-    T = len(setup.trajectory)
-    epochs = None if n_epochs is None or n_epochs >= T else np.arange(n_epochs)
-    rows = [_bound_row(setup, s, imp, criterion, target, share, eps_phi, epochs) for s in specs]
+    epochs = None if n_epochs is None or n_epochs >= len(setup.trajectory) else np.arange(n_epochs)
+    rows = [
+        _bound_row(setup, s, imp, criterion, target, share, eps_phi, epochs, settle) for s in specs
+    ]
     warnings = [f"{r.array}: {r.reason}" for r in rows if r.status == "error"]
+    warnings += [f"{r.array}: {r.gaps}" for r in rows if r.gaps]
     todo = [s for s, r in zip(specs, rows) if r.status == "bound only"]
-    hopeless = [r.array for r in rows if r.status == "hopeless"]
-    if runs and hopeless:
-        warnings.append(
-            f"{', '.join(hopeless)}: even an estimator at the achievable bound would miss "
-            f"{target:g} m on {100 * share:g} % of the route; Monte-Carlo skipped"
-        )
-    if runs and todo:
+    if units and todo:
         kw = {
             "mode": mode,
             "error_models": _error_models(imp, mode),
@@ -341,43 +400,36 @@ def design_sweep(
             "n_epochs": n_epochs,
             "start_sigma": start_sigma,
             "dead_reckoning": dead_reckoning,
+            "drives_per_unit": drives_per_unit,
         }
-        results, failed = _run_montecarlo(setup, todo, runs, seed, kw)
-        for r in rows:
-            if r.array in failed:
-                r.status, r.reason = "error", failed[r.array]
-                warnings.append(f"{r.array}: {r.reason}")
-            elif r.array in results:
-                score_row(r, results[r.array], criterion, target, share, seed, n_boot)
-    if runs == 0:
+        judged = {"settle": settle, "required": required_yield, "cap": max_units}
+        _sequential(setup, rows, todo, units, max_units, seed, kw, warnings,
+                    (criterion, target, share, seed, n_boot), judged)  # fmt: skip
+    if units == 0:
+        warnings.append("no Monte-Carlo (units 0): bounds and predictions only, no recommendation")
+    elif units < MIN_RUNS_CI:
         warnings.append(
-            "no Monte-Carlo (runs 0): the recommendation rests on bounds only, a "
-            "necessary condition, not an answer"
+            f"units {units}: fewer than {MIN_RUNS_CI} units in the first batch; every array "
+            "gets more units until its yield is decided or the cap is reached"
         )
-    elif runs == 1:
+    capped = [r.array for r in rows if r.status == "undecided" and r.units >= max_units]
+    if capped:
         warnings.append(
-            "runs 1: one drive gives no confidence interval; every verdict is undecided "
-            f"(use --runs {2 * MIN_RUNS_CI})"
+            f"{', '.join(capped)}: the unit yield's interval still straddles the required "
+            f"{100 * required_yield:g} % at the cap of {max_units} units (--max-units)"
         )
-    elif runs < MIN_RUNS_CI:
-        warnings.append(
-            f"runs {runs}: too few for a 95 % interval to decide (at least {MIN_RUNS_CI}); the "
-            "intervals are shown, every verdict is undecided"
-        )
-    straddle = [r.array for r in rows if r.status == "undecided" and r.runs >= MIN_RUNS_CI]
-    if straddle:
-        warnings.append(f"{', '.join(straddle)}: the 95 % interval straddles the target; add runs")
     reused = sorted(
         r.array
         for r in rows
         if r.error_model and r.error_model.get("seed") == seed and mode == "channel"
     )
-    if runs and reused:
+    if units and reused:
         warnings.append(
             f"{', '.join(reused)}: the traced route's measurement noise was measured on this "
             f"seed's first drives (seed {seed}); report the sweep on another seed"
         )
-    if criterion == "srnf" and runs:
+    warnings += _plausibility(setup, target, imp)
+    if criterion == "srnf" and units:
         warnings.append(
             "criterion srnf: the Monte-Carlo tracker models the VUE curvature; the SR-NF gate "
             "stands for an eq. 51 estimator"
@@ -388,17 +440,23 @@ def design_sweep(
         "spacing_wl": [s.spacing_wl for s in specs],
         "fc": setup.fc,
         "bandwidth": float(setup.config.bandwidth),
+        "scs": float(setup.config.scs),
+        "n_rb": int(setup.config.n_rb),
         "target": target,
         "share": share,
+        "settle_s": settle,
         "criterion": criterion,
         "impairments": fields,
         "eps_phi": eps_phi,
-        "runs": runs,
+        "units": units,
+        "drives_per_unit": drives_per_unit,
+        "required_yield": required_yield,
+        "max_units": max_units,
         "seed": seed,
         "mode": mode,
         "n_epochs": n_epochs,
         "n_boot": n_boot,
-        "min_runs_ci": MIN_RUNS_CI,
+        "min_units_ci": MIN_RUNS_CI,
         "workers": workers,
         "scheduler": scheduler,
         "timeout_s": timeout,
@@ -409,5 +467,82 @@ def design_sweep(
         settings["start_sigma_m"] = start_sigma
     if dead_reckoning:
         settings["dead_reckoning"] = True
-    rec = recommend([r for r in rows if r.status != "error"], target, share, runs)
+    usable = [r for r in rows if r.status != "error"]
+    rec = recommend(usable, target, share, units, required_yield)
     return DesignReport(setup.name, rows, rec, settings, warnings)
+
+
+#: road-tunnel cross-sections beyond these are valid inputs but not road tunnels (a value in cm
+#: for m, say): the report warns
+PLAUSIBLE_WIDTH_M, PLAUSIBLE_HEIGHT_M = 40.0, 15.0
+#: the diffuse share of the received power measured in a road tunnel at 5.9 GHz (mean, with LoS;
+#: "Measurement and diffuse multipath analysis of V2V propagation channel at 5.9 GHz in tunnel
+#: area", REFERENCES.md) against about 1.1 % from the project's ray tracer on concrete
+MEASURED_DIFFUSE_SHARE = 0.056
+#: NR FR1 (up to 7.125 GHz) and its SRS subcarrier spacings [Hz] (TS 38.211, numerologies 0-2)
+FR1_MAX_HZ, FR1_SCS_HZ = 7.125e9, (15e3, 30e3, 60e3)
+
+
+def _plausibility(setup, target: float, imp) -> list[str]:
+    """Warnings for valid but implausible inputs: a cross-section no road tunnel has, a target
+    no narrower than the tunnel, and the ideal array (the optimistic case) said as such."""
+    out = []
+    w, h = float(setup.tunnel.width), float(setup.tunnel.height)
+    if w > PLAUSIBLE_WIDTH_M or h > PLAUSIBLE_HEIGHT_M:
+        out.append(
+            f"tunnel: {w:g} m x {h:g} m is wider or higher than a road tunnel "
+            f"({PLAUSIBLE_WIDTH_M:g} x {PLAUSIBLE_HEIGHT_M:g} m at most); a length in cm?"
+        )
+    if target >= w / 2:
+        out.append(
+            f"target: {target:g} m is half the tunnel's width ({w:g} m) or more: a lane-level "
+            "answer asks for less (a value in cm?)"
+        )
+    cfg = setup.config
+    if setup.fc < FR1_MAX_HZ and cfg.scs > max(FR1_SCS_HZ):
+        out.append(
+            f"radio: a {cfg.scs / 1e3:g} kHz subcarrier spacing at {setup.fc / 1e9:g} GHz is "
+            f"not an NR FR1 numerology ({', '.join(f'{v / 1e3:g}' for v in FR1_SCS_HZ)} kHz); "
+            f"the {cfg.bandwidth / 1e6:g} MHz band holds {cfg.n_rb} resource blocks of it "
+            "(set the scenario's radio.scs and radio.n_rb for another numerology)"
+        )
+    if imp.ideal:
+        out.append(
+            "impairments: none (an ideal array and eq. 1's channel), the optimistic case; a "
+            f"road-tunnel campaign at 5.9 GHz measured {100 * MEASURED_DIFFUSE_SHARE:g} % of the "
+            "received power diffuse (--dmc-share), and real arrays carry calibration errors "
+            "(--phase-error-deg, --gain-error-db)"
+        )
+    return out
+
+
+def _sequential(setup, rows, todo, units, cap, seed, kw, warnings, scoring, judged) -> None:
+    """The Monte-Carlo by units: ``units`` units of every array in ``todo``, then as many again
+    (doubling) for the arrays still undecided, up to ``cap`` units; each batch's units follow
+    the last (a unit's generators do not depend on the batch), each array scored on all its
+    units after every batch (:func:`score_row`)."""
+    by = {r.array: r for r in rows}
+    done, batch, open_ = 0, units, list(todo)
+    acc: dict = {}
+    while open_ and batch > 0:
+        d = kw["drives_per_unit"]
+        results, failed = _run_montecarlo(setup, open_, batch * d, seed, dict(kw, first_unit=done))
+        done += batch
+        for label, why in failed.items():
+            by[label].status, by[label].reason = "error", why
+            warnings.append(f"{label}: {why}")
+        for label, res in results.items():
+            acc[label] = res if label not in acc else _joined(acc[label], res)
+            score_row(by[label], acc[label], *scoring, **judged)
+        open_ = [s for s in open_ if s.label in results and by[s.label].status == "undecided"]
+        batch = min(done, cap - done)
+
+
+def _joined(a, b):
+    """Two Monte-Carlo results of one array, ``b``'s units after ``a``'s."""
+    cat = {
+        k: np.concatenate([getattr(a, k), getattr(b, k)])
+        for k in ("errors", "rmse_runs", "dead_reckoning")
+        if getattr(a, k) is not None
+    }
+    return replace(a, **cat)

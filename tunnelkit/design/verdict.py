@@ -1,12 +1,14 @@
 """Deciding a candidate array from what the system achieves: the criterion, the error quantile
-with its bootstrap interval, the verdict per array and the recommendation.
+with its interval, the verdict per array by the unit yield, and the recommendation.
 
 Everything here works on plain arrays, so it is the same whether the errors come from the
 bound-driven or the channel Monte-Carlo.
 
-* **Counted epochs**: the settled epochs of the drive (:func:`tunnelkit.metrics.settled`, the
-  first :data:`~tunnelkit.metrics.SETTLE_S` left out: the tracker's start-up from a coarse fix
-  is not the array's accuracy); the whole route if it is shorter than that.
+* **Counted epochs** (:func:`counted_epochs`): the epochs at least ``settle`` seconds after the
+  start (default :data:`~tunnelkit.metrics.SETTLE_S`: the tracker's start-up from the entry fix
+  is not the array's accuracy), a design input stated in the report; a window that leaves no
+  epoch is refused, never silently replaced by the whole route. The report shows the
+  whole-route quantile beside the settled one.
 * **The criterion** says which epochs can count as met. ``"achievable"`` (the design's
   tracker, which models a reflection's wavefront on its virtual UE) scores every counted epoch;
   SR-NF validity is reported as information. ``"srnf"`` (a route that uses eq. 51, the
@@ -17,42 +19,38 @@ bound-driven or the channel Monte-Carlo.
   values <= the target is >= ``share``) of the per-epoch 2-D error, pooled over runs and over the
   counted epochs. A non-finite error (no estimate) counts as infinite. This is the ``*_p90_m`` of
   the report at the default ``share = 0.9``.
-* **Its 95 % interval** (:func:`bootstrap_quantile_ci`): percentile bootstrap over runs (whole
-  drives resampled with replacement, an explicit :class:`numpy.random.Generator`), since the
-  epochs of one drive are correlated.
-* **The pre-screen** (:func:`implied_quantile`): the error quantile an estimator *at* the
-  achievable bound would have, each counted epoch's 2-D error a circular Gaussian whose RMS is
-  the bound there. A bound's own quantile is not a lower bound of the error's quantile (a
-  1-cm bound on 89 % of the route and 20 cm elsewhere still lets 90 % of the errors lie under
-  5 cm); this one is the quantile of an estimator that attains the bound everywhere.
-  Under impairments the screen takes the PEB with the achievable bound's impairments' part
-  halved (:func:`screen_bound`): the tracker averages over the drive the share of a
-  snapshot's calibration bias that does not repeat, so the implied quantile of the full bound
-  would skip a candidate the tracker meets. Why one half, measured (28 GHz example, 4 x 4 ...
-  32 x 32, 20 runs, seed 0, 0.5 and 2 deg phase error; ``q``: the implied 90 % quantile of the
-  PEB with the impairments' part): the tracker's error p90 is 0.78-1.08 ``q`` and the lower
-  end of its 95 % interval 0.58-0.91 ``q`` (the smallest, 0.58, 4 x 4 at 0.5 deg: p90 82.6 mm,
-  interval [61.5, 112] mm, ``q`` 105.7 mm); the halved part puts the screen at 0.50-0.54 ``q``,
-  below every interval's lower end, so no candidate whose interval can reach below the target
-  is skipped (the full part would have skipped that 4 x 4, whose interval straddles 0.1 m).
-  With no impairment the screen is the PEB (unchanged; the tracker's interval starts at 0.91
-  ``q`` or above there).
-* **The verdict** (:func:`judge`): ``"hopeless"`` when that implied quantile misses the target
-  (its Monte-Carlo is skipped); ``"bound only"`` with no Monte-Carlo;
-  ``"met"`` only when the interval's upper end is below the target; ``"not met"`` when its lower
-  end is at or above it; ``"undecided"`` when it straddles the target or when fewer than
-  :data:`MIN_RUNS_CI` runs stand behind it (a 2-run interval is not an answer).
+* **Its 95 % interval** (:func:`bootstrap_quantile_ci`): percentile bootstrap over the rows it
+  is given, resampled whole with replacement (an explicit :class:`numpy.random.Generator`); the
+  sweep gives it one row per manufactured unit (all its drives), since a unit's drives share
+  its calibration draw and the epochs of one drive are correlated.
+* **The verdict** (:func:`judge`) is by the **unit yield** (:mod:`tunnelkit.design.units`): the
+  share of units whose own quantile meets the target, with its Wilson 95 % interval.
+  ``"met"`` when the interval's lower end reaches the required yield, ``"not met"`` when its
+  upper end is below it, ``"undecided"`` between, or with fewer than :data:`MIN_RUNS_CI`
+  units; ``"bound only"`` with no Monte-Carlo. Bounds and predictions never decide and never
+  skip a Monte-Carlo: a bound of the RMSE is not a bound of a quantile, and a prediction can be
+  beaten by the tracker (:func:`implied_quantile` remains, as the quantile an estimator that
+  attains a given RMS at every epoch would have).
 * **The recommendation** (:func:`recommend`): the smallest candidate (fewest elements, then
-  aperture) that is met; with bounds only, the smallest that passes the pre-screen, said to be
-  a necessary condition, not an answer.
+  aperture) that is met; with bounds only, none.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._checks import bound, bound_array, real_array
-from .._validate import finite_array, integer, positive, probability, rng_or_error, sequence
+from .._checks import bound_array, real_array
+from .._validate import (
+    finite_array,
+    integer,
+    nonnegative,
+    positive,
+    probability,
+    rng_or_error,
+    sequence,
+)
+from ..metrics import SETTLE_S
+from .units import REQUIRED_YIELD
 
 __all__ = [
     "CRITERIA",
@@ -64,25 +62,31 @@ __all__ = [
     "implied_quantile",
     "judge",
     "recommend",
-    "screen_bound",
     "share_quantile",
 ]
 
 #: the pass/fail criteria: the design's VUE-curvature tracker, or a route using eq. 51
 CRITERIA = ("achievable", "srnf")
-#: fewer runs than this: the interval is reported but never decides (a warning says so)
+#: fewer units than this: the interval is reported but never decides (a warning says so)
 MIN_RUNS_CI = 10
 #: verdicts of :func:`judge`, and ``"error"`` for a candidate that could not be evaluated
-STATUSES = ("met", "undecided", "not met", "hopeless", "bound only", "error")
+STATUSES = ("met", "undecided", "not met", "bound only", "error")
 
 
-def counted_epochs(t) -> np.ndarray:
-    """Indices of the epochs that count: the settled ones of ``t`` [s], all if none settle."""
-    from ..metrics import settled
-
+def counted_epochs(t, settle: float = SETTLE_S) -> np.ndarray:
+    """Indices of the epochs that count: those of ``t`` [s] at least ``settle`` [s] after its
+    start (the tracker's start-up from the entry fix left out); refused when none is left."""
     t = finite_array("t", t, ndim=1)
-    idx = settled(t)
-    return idx if idx.size else np.arange(t.size)
+    settle = nonnegative("settle", settle)
+    if not t.size:
+        raise ValueError("t: expected at least one epoch time")
+    idx = np.flatnonzero(t - t[0] >= settle - 1e-9)
+    if not idx.size:
+        raise ValueError(
+            f"settle: {settle:g} s leaves no epoch of a {t[-1] - t[0]:.3g} s drive to count; "
+            "give a shorter settle window or a longer route"
+        )
+    return idx
 
 
 def gate(values, srnf_valid, criterion: str) -> np.ndarray:
@@ -176,121 +180,78 @@ def bootstrap_quantile_ci(
     return [float(lo), float(hi)]
 
 
-#: the share of the achievable bound's impairment part the pre-screen keeps (module docstring:
-#: measured, the screen then lies below the lower end of every tracker interval, 0.58 of the
-#: PEB-with-impairments quantile at the smallest)
-SCREEN_IMPAIRMENT_SCALE = 0.5
-
-
-def _bounds(name: str, v) -> np.ndarray:
-    """A 1-D array of bounds [m]: real, >= 0, ``inf`` allowed, NaN refused."""
-    try:
-        a = np.asarray(v, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name}: expected real numbers, got {type(v).__name__}") from None
-    if a.ndim != 1 or a.size == 0:
-        raise ValueError(f"{name}: expected a non-empty 1-D array, got shape {a.shape}")
-    if np.isnan(a).any() or (a < 0).any():
-        raise ValueError(f"{name}: expected bounds >= 0 (inf allowed), got NaN or a negative")
-    return a
-
-
-def screen_bound(peb, achievable) -> np.ndarray:
-    """The per-epoch bound the pre-screen takes (module docstring):
-    ``sqrt(peb^2 + s^2 (achievable^2 - peb^2))`` with ``s`` :data:`SCREEN_IMPAIRMENT_SCALE`
-    (the PEB where the two are equal; ``inf`` where the achievable bound is). The design sweep
-    passes as ``achievable`` the PEB with the achievable bound's impairments' part only (its
-    noise part, the tracker's block-weighted fix, is not an impairment)."""
-    p, a = _bounds("peb", peb), _bounds("achievable", achievable)
-    if p.shape != a.shape:
-        raise ValueError(f"achievable: expected shape {p.shape} like peb, got {a.shape}")
-    with np.errstate(invalid="ignore"):
-        extra = np.clip(a**2 - p**2, 0.0, None)
-        out = np.sqrt(p**2 + SCREEN_IMPAIRMENT_SCALE**2 * extra)
-    return np.where(np.isinf(a), np.inf, out)
-
-
 def judge(
     target: float,
-    bound_q: float,
     *,
-    runs: int = 0,
-    error_q: float | None = None,
+    units: int = 0,
+    yield_: float | None = None,
     ci: list | None = None,
+    required: float = REQUIRED_YIELD,
     share: float = 0.9,
+    cap: int | None = None,
 ) -> tuple[str, str]:
-    """``(status, reason)`` of one candidate (module docstring): ``bound_q`` the error quantile
-    implied by the achievable bound (:func:`implied_quantile`) over the counted epochs,
-    ``error_q`` and ``ci`` the Monte-Carlo error's quantile and interval from ``runs`` drives
-    (``runs = 0``: none)."""
+    """``(status, reason)`` of one candidate (module docstring) from its unit yield ``yield_``
+    and the yield's 95 % interval ``ci`` over ``units`` units (``units = 0``: no Monte-Carlo,
+    ``"bound only"``); ``cap`` the sequential rule's cap (``None``: no cap stated)."""
     target = positive("target", target)
-    runs = integer("runs", runs, minimum=0)
+    units = integer("units", units, minimum=0)
     share = probability("share", share, open_interval=False)
-    bound("bound_q", bound_q)
-    if error_q is not None:
-        bound("error_q", error_q)
-    if ci is not None and len(sequence("ci", ci)) != 2:
-        raise ValueError(f"ci: expected a [lo, hi] interval, got {ci!r}")
+    required = probability("required", required)
+    if cap is not None:
+        cap = integer("cap", cap, minimum=1)
+    if yield_ is not None:
+        yield_ = probability("yield_", yield_, open_interval=False)
     if ci is not None:
-        bound("ci", ci[0]), bound("ci", ci[1])
-    if np.isnan(bound_q) or bound_q < 0:
-        raise ValueError(f"bound_q: expected a quantile >= 0 (inf allowed), got {bound_q!r}")
+        if len(sequence("ci", ci)) != 2:
+            raise ValueError(f"ci: expected a [lo, hi] interval, got {ci!r}")
+        lo = probability("ci", ci[0], open_interval=False)
+        hi = probability("ci", ci[1], open_interval=False)
+        if yield_ is not None and not lo <= yield_ <= hi:
+            raise ValueError(f"ci: expected [lo, hi] around yield_ = {yield_!r}, got {ci!r}")
     pct = f"{100 * share:g} %"
-    if not bound_q <= target:
-        return "hopeless", (
-            f"even an estimator at the achievable bound would err by more than {target:g} m on "
-            f"{100 - 100 * share:g} % of the route or more (its {pct} quantile {_m(bound_q)}): "
-            "Monte-Carlo skipped"
-        )
-    if runs == 0:
+    if units == 0:
         return "bound only", (
-            f"an estimator at the achievable bound would stay within {_m(bound_q)} <= {target:g} m"
-            f" on {pct} of the route: a necessary condition only (no Monte-Carlo)"
+            "no Monte-Carlo: bounds and predictions only, which decide nothing (give --units)"
         )
-    if error_q is None or ci is None:
-        raise ValueError("error_q: give the Monte-Carlo quantile and its interval when runs > 0")
-    lo, hi = ci
-    if not lo <= error_q <= hi:
-        raise ValueError(f"ci: expected [lo, hi] around error_q = {error_q!r}, got {ci!r}")
-    head = f"error on {pct} of the settled route {_m(error_q)}, 95 % CI [{_m(lo)}, {_m(hi)}]"
-    if runs < MIN_RUNS_CI:
-        return "undecided", (
-            f"{head} from {runs} run{'s' * (runs != 1)}: too few for the interval to decide "
-            f"(use >= {MIN_RUNS_CI})"
-        )
-    if hi < target:
-        return "met", f"{head} below {target:g} m"
-    if lo >= target:
-        return "not met", f"{head} at or above {target:g} m"
-    return "undecided", f"{head} straddles {target:g} m: add runs"
+    if yield_ is None or ci is None:
+        raise ValueError("ci: give the unit yield and its [lo, hi] interval when units > 0")
+    head = (
+        f"{100 * yield_:.3g} % of {units} units meet {target:g} m on {pct} of the settled "
+        f"route, 95 % CI [{100 * lo:.3g}, {100 * hi:.3g}] %"
+    )
+    need = f"the required {100 * required:g} %"
+    if units < MIN_RUNS_CI:
+        return "undecided", f"{head}: too few units for the interval to decide (>= {MIN_RUNS_CI})"
+    if lo >= required:
+        return "met", f"{head}: at least {need}"
+    if hi < required:
+        return "not met", f"{head}: below {need}"
+    tail = f"the cap of {cap} units reached" if cap is not None and units >= cap else "add units"
+    return "undecided", f"{head} straddles {need}: {tail}"
 
 
-def recommend(rows, target: float, share: float, runs: int) -> dict:
+def recommend(
+    rows, target: float, share: float, units: int, required: float = REQUIRED_YIELD
+) -> dict:
     """The recommendation from candidates with ``.array``, ``.n_elements``,
     ``.aperture_diagonal_m``, ``.status``, ``.reason``: ``{array, reason, basis}``; ``basis``
-    is ``"monte-carlo"`` or ``"bounds"`` (no runs: a necessary condition, not an answer)."""
+    is ``"unit-yield"`` (the smallest candidate whose unit yield's interval reaches
+    ``required``) or ``"none"`` (no Monte-Carlo: no recommendation)."""
     # no rows: every candidate failed (reported per array): "no candidate", not an error
     rows, target = sequence("rows", rows, empty=True), positive("target", target)
     share = probability("share", share, open_interval=False)
-    runs = integer("runs", runs, minimum=0)
+    units = integer("units", units, minimum=0)
+    required = probability("required", required)
     pct = f"{100 * share:g} %"
     order = sorted(rows, key=lambda r: (r.n_elements, r.aperture_diagonal_m))
-    if runs == 0:
-        ok = [r for r in order if r.status == "bound only"]
-        if ok:
-            return {
-                "array": ok[0].array,
-                "basis": "bounds",
-                "reason": (
-                    f"rests on bounds only: {ok[0].array} is the smallest candidate whose "
-                    f"achievable bound meets {target:g} m on {pct} of the route, a necessary "
-                    "condition, not an answer; run the Monte-Carlo (--runs 20) to decide"
-                ),
-            }
+    if units == 0:
         return {
             "array": None,
-            "basis": "bounds",
-            "reason": f"no candidate's achievable bound meets {target:g} m on {pct} of the route",
+            "basis": "none",
+            "reason": (
+                "no Monte-Carlo (units 0): the bounds and predictions decide nothing; give "
+                "--units to decide by the unit yield"
+            ),
         }
     met = [r for r in order if r.status == "met"]
     smaller_open = [
@@ -298,17 +259,18 @@ def recommend(rows, target: float, share: float, runs: int) -> dict:
         for r in order
         if r.status == "undecided" and (not met or order.index(r) < order.index(met[0]))
     ]
+    goal = f"{100 * required:g} % of units within {target:g} m on {pct} of the settled route"
     if met:
         best = met[0]
-        why = f"smallest candidate met: {best.reason}"
+        why = f"the smallest candidate whose unit yield reaches {goal}: {best.reason}"
         if smaller_open:
-            why += f"; smaller {', '.join(smaller_open)} undecided (add runs)"
-        return {"array": best.array, "basis": "monte-carlo", "reason": why}
+            why += f"; smaller {', '.join(smaller_open)} undecided"
+        return {"array": best.array, "basis": "unit-yield", "reason": why}
     if smaller_open:
-        why = f"none met yet; undecided: {', '.join(smaller_open)} (add runs)"
+        why = f"none met yet; undecided: {', '.join(smaller_open)}"
     else:
-        why = f"no candidate meets {target:g} m on {pct} of the settled route"
-    return {"array": None, "basis": "monte-carlo", "reason": why}
+        why = f"no candidate's unit yield reaches {goal}"
+    return {"array": None, "basis": "unit-yield", "reason": why}
 
 
 def _m(v: float) -> str:

@@ -114,11 +114,15 @@ def crlb_paths(
     # Jacobi scaling before the inverse: the parameters differ by many orders of magnitude.
     # A singular information (a zero gain, an origin the array cannot resolve) bounds nothing:
     # every variance is infinite rather than NaN or an error from the inverse.
+    # The scaled matrix is symmetrised before the inverse: an exactly singular information
+    # (a line array's 3-D origin) then fails the factorisation on every BLAS build, where its
+    # round-off asymmetry let some builds return 1e12-sized garbage instead.
     cov = np.full_like(fim, np.inf)
     if np.all(np.diag(fim) > 0):
         dsc = 1.0 / np.sqrt(np.diag(fim))
+        S = dsc[:, None] * fim * dsc[None, :]
         try:
-            inv = np.linalg.inv(dsc[:, None] * fim * dsc[None, :])
+            inv = np.linalg.inv(0.5 * (S + S.T))
         except np.linalg.LinAlgError:
             inv = None
         if inv is not None and np.all(np.isfinite(inv)) and np.all(np.diag(inv) > 0):

@@ -10,6 +10,7 @@ from .common import (
     line_figure,
 )
 from .design import (
+    design_answer_figure,
     route_figure,
     size_figure,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "bound_ratio_figure",
     "cdf_figure",
     "derivation_figure",
+    "design_answer_figure",
     "doppler_delay_figure",
     "drive_topview",
     "efficiency_figure",

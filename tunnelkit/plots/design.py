@@ -1,5 +1,6 @@
-"""Notebook 08 figures: the position error bound along the route with the SR-NF overlay, and the
-PEB / SR-NF share against array size.
+"""Notebook 08 figures: the position error bound along the route with the SR-NF overlay, the
+PEB / SR-NF share against array size, and the answer of a design sweep (the tracker's error along
+the route beside its bound and prediction, the unit yield per array).
 
 Builders are pure (data -> figure) and take the results of :mod:`tunnelkit.design`.
 """
@@ -8,12 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 import plotly.graph_objects as go
+from plotly.subplots import make_subplots
 
 from .._checks import attributes
-from .._validate import positive, sequence, text
+from .._validate import instance, positive, sequence, text
 from .common import COLORS, figure_inputs
 
-__all__ = ["route_figure", "route_traces", "size_figure"]
+__all__ = ["design_answer_figure", "route_figure", "route_traces", "size_figure"]
 
 _KIND_COLORS = {
     "wall": "#1f77b4",
@@ -23,7 +25,7 @@ _KIND_COLORS = {
 }
 
 
-#: colours of the achievable-bound lines, one per impairment level
+#: colours of the predicted-error lines, one per impairment level
 _ACHIEVABLE_COLORS = ("#ff7f0e", "#9467bd", "#17becf", "#e377c2")
 
 
@@ -42,17 +44,17 @@ def route_traces(
     *,
     variants: dict | None = None,
     target: float | None = None,
-    achievable: dict | None = None,
+    predicted: dict | None = None,
 ) -> list:
     """Trace dicts on axes (x, y) PEB [cm] along the tunnel and (x, y2) SR-NF mismatch per surface.
 
     Order: 0 PEB, 1 SR-NF not valid (markers on the PEB), 2.. one dashed trace per variant
-    (``{"no curvature": RouteBounds, ...}``), then one solid trace per achievable bound
+    (``{"no curvature": RouteBounds, ...}``), then one solid trace per predicted error (a prediction, not a bound)
     (``{"0.5° phase error": design.AchievableBound, ...}``), then the target line (if given), then
     one mismatch trace per surface kind and the ``eps_phi`` line on (x, y2).
     """
     attributes("bounds", bounds, ("x", "peb", "srnf_valid", "spec"), "a design.RouteBounds")
-    figure_inputs(mappings={"variants": variants, "achievable": achievable})
+    figure_inputs(mappings={"variants": variants, "predicted": predicted})
     if target is not None:
         positive("target", target)
     x = bounds.x
@@ -85,13 +87,13 @@ def route_traces(
                 line={"dash": ["dash", "dot", "dashdot"][i % 3], "width": 1.5},
             )
         )
-    for i, (name, a) in enumerate((achievable or {}).items()):
+    for i, (name, a) in enumerate((predicted or {}).items()):
         traces.append(
             _scatter(
                 x=a.x,
                 y=_finite(100 * a.achievable),
                 mode="lines",
-                name=f"achievable, {name}",
+                name=f"predicted, {name}",
                 line={"color": _ACHIEVABLE_COLORS[i % len(_ACHIEVABLE_COLORS)], "width": 2},
             )
         )
@@ -147,12 +149,12 @@ def route_figure(
     *,
     variants: dict | None = None,
     target: float | None = None,
-    achievable: dict | None = None,
+    predicted: dict | None = None,
     title: str = "",
     subtitle: str = "",
     meta: dict | None = None,
 ) -> go.Figure:
-    """PEB along the tunnel (top, log) with SR-NF failures marked and the achievable bound under
+    """PEB along the tunnel (top, log) with SR-NF failures marked and the predicted error under
     impairments beside it; per-surface mismatch (bottom).
 
     ``layout.meta`` carries ``meta`` (for tests and lecture scripts).
@@ -186,7 +188,7 @@ def route_figure(
     }
     return go.Figure(
         {
-            "data": route_traces(bounds, variants=variants, target=target, achievable=achievable),
+            "data": route_traces(bounds, variants=variants, target=target, predicted=predicted),
             "layout": layout,
         }
     )
@@ -290,3 +292,202 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
         ),
     }
     return go.Figure({"data": traces, "layout": layout})
+
+
+#: one colour per candidate array of :func:`design_answer_figure`, in the report's order
+_ARRAY_COLORS = (
+    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+)  # fmt: skip
+
+
+def _pct(v) -> str:
+    return "-" if v is None else f"{100 * v:.0f} %"
+
+
+def _cm_text(v) -> str:
+    return "-" if v is None else (f"{100 * v:.3g} cm" if np.isfinite(v) else "inf")
+
+
+def design_answer_figure(report) -> go.Figure:
+    """The answer of a design sweep (:func:`tunnelkit.design.design_sweep`, ``tunnelkit design``).
+
+    Top, per array along the route (log, cm): the tracker's median 2-D error per epoch over the
+    Monte-Carlo drives (solid; its legend entry states the pooled ``share``-quantile over the
+    settled route with its bootstrap 95 % interval), the ideal snapshot PEB (dotted, a lower
+    bound) and the first-order predicted error under the impairments (dashed, a prediction, not a
+    bound), and the target. Rows without Monte-Carlo (``--units 0``) show the PEB and the
+    prediction only. Bottom: the unit yield per array (the share of manufactured units that meet
+    the target on their own) with its Wilson 95 % interval, and the required yield; the verdict
+    is in the hover.
+
+    ``layout.meta``: ``{"arrays", "unit_yield" (None without Monte-Carlo), "required_yield",
+    "target"}``.
+    """
+    from ..design.records import DesignReport  # the records, loaded on first use
+
+    instance("report", report, DesignReport, "a tunnelkit.design.DesignReport")
+    s = report.settings
+    target = float(s["target"])
+    share = float(s.get("share", 0.9))
+    required = float(s["required_yield"])
+    q = f"p{100 * share:g}"
+    fig = make_subplots(
+        rows=2,
+        cols=1,
+        row_heights=[0.64, 0.36],
+        vertical_spacing=0.14,
+        subplot_titles=(
+            "error along the route: tracker (median over drives), PEB (bound), prediction",
+            "unit yield: share of units meeting the target on their own (Wilson 95 % interval)",
+        ),
+    )
+    xs = [r.x_m for r in report.rows if r.x_m is not None and np.size(r.x_m)]
+    for i, r in enumerate(report.rows):
+        if r.x_m is None:
+            continue
+        color = _ARRAY_COLORS[i % len(_ARRAY_COLORS)]
+        x = np.asarray(r.x_m, float)
+        group = {"legendgroup": r.array, "legendgrouptitle": {"text": r.array}}
+        hover = (
+            f"{r.array} ({r.status})<br>x %{{x:.1f}} m: %{{y:.3g}} cm"
+            "<extra>%{fullData.name}</extra>"
+        )
+        if r.error_median_epoch_m is not None:
+            med = np.asarray(r.error_median_epoch_m, float)
+            ci = r.error_p90_ci95_m
+            pooled = f"{q} {_cm_text(r.error_p90_m)}" + (
+                f" [{_cm_text(ci[0])}, {_cm_text(ci[1])}]" if ci else ""
+            )
+            fig.add_scatter(
+                x=x[: med.size],
+                y=_finite(100 * med),
+                mode="lines",
+                name=f"tracker median error ({pooled})",
+                line={"color": color, "width": 2.5},
+                hovertemplate=(
+                    f"{r.array} ({r.status}): median over {r.runs} drives<br>"
+                    "x %{x:.1f} m: %{y:.3g} cm<br>"
+                    f"pooled {pooled} (settled route, 95 % CI)<br>"
+                    f"RMSE {_cm_text(r.rmse_m)}; PCRLB {_cm_text(r.pcrlb_rms_m)}, hybrid bound "
+                    f"{_cm_text(r.hybrid_bound_rms_m)} (lower bounds of the RMSE)<extra></extra>"
+                ),
+                **group,
+                row=1,
+                col=1,
+            )
+        if r.peb_m is not None:
+            fig.add_scatter(
+                x=x,
+                y=_finite(100 * np.asarray(r.peb_m, float)),
+                mode="lines",
+                name="PEB (bound)",
+                line={"color": color, "width": 1.5, "dash": "dot"},
+                hovertemplate=hover,
+                **group,
+                row=1,
+                col=1,
+            )
+        if r.predicted_m is not None:
+            fig.add_scatter(
+                x=x,
+                y=_finite(100 * np.asarray(r.predicted_m, float)),
+                mode="lines",
+                name="predicted (not a bound)",
+                line={"color": color, "width": 1.5, "dash": "dash"},
+                hovertemplate=hover,
+                **group,
+                row=1,
+                col=1,
+            )
+    if xs:
+        x0 = float(min(np.nanmin(v) for v in xs))
+        x1 = float(max(np.nanmax(v) for v in xs))
+        fig.add_scatter(
+            x=[x0, x1],
+            y=[100 * target, 100 * target],
+            mode="lines",
+            name=f"target {_cm_text(target)}",
+            line={"color": "black", "width": 1.5, "dash": "longdashdot"},
+            hoverinfo="name",
+            legendgroup="targets",
+            row=1,
+            col=1,
+        )
+    labels = [r.array for r in report.rows]
+    yields = [None if r.unit_yield is None else float(r.unit_yield) for r in report.rows]
+    up, down, hovers = [], [], []
+    for r, y in zip(report.rows, yields):
+        ci = r.unit_yield_ci95
+        up.append(None if y is None or not ci else 100 * (ci[1] - y))
+        down.append(None if y is None or not ci else 100 * (y - ci[0]))
+        ci_text = f" [{_pct(ci[0])}, {_pct(ci[1])}]" if ci else ""
+        hovers.append(
+            f"{r.array}: {r.status}<br>unit yield {_pct(y)}{ci_text}<br>"
+            f"{r.units} units x {r.drives_per_unit} drives"
+            + (f"<br>{r.reason}" if r.reason else "")
+        )
+    fig.add_scatter(
+        x=labels,
+        y=[None if y is None else 100 * y for y in yields],
+        mode="markers",
+        name="unit yield (95 % interval)",
+        marker={
+            "size": 11,
+            "symbol": "diamond",
+            "color": [_ARRAY_COLORS[i % len(_ARRAY_COLORS)] for i in range(len(labels))],
+        },
+        error_y={"type": "data", "symmetric": False, "array": up, "arrayminus": down},
+        text=hovers,
+        hovertemplate="%{text}<extra></extra>",
+        legendgroup="yield",
+        row=2,
+        col=1,
+    )
+    fig.add_hline(
+        y=100 * required,
+        line={"color": "black", "width": 1.5, "dash": "longdashdot"},
+        name=f"required yield {_pct(required)}",
+        showlegend=True,
+        legendgroup="targets",
+        row=2,
+        col=1,
+    )
+    if all(y is None for y in yields):
+        fig.add_annotation(
+            text="no Monte-Carlo (units 0): no unit yield, bounds and predictions only",
+            x=0.5,
+            y=50,
+            xref="x2 domain",
+            yref="y2",
+            showarrow=False,
+        )
+    fig.update_yaxes(type="log", title_text="position error [cm]", row=1, col=1)
+    fig.update_yaxes(range=[-3, 103], title_text="unit yield [%]", row=2, col=1)
+    fig.update_xaxes(title_text="vehicle position x along the tunnel [m]", row=1, col=1)
+    fig.update_xaxes(type="category", title_text="array", row=2, col=1)
+    title = (
+        f"Design answer for {report.scenario}: target {_cm_text(target)} on "
+        f"{100 * share:g} % of the settled route, required unit yield {_pct(required)}"
+    )
+    fig.update_layout(
+        title={
+            "text": title,
+            "subtitle": {
+                "text": "solid: tracker's median error (Monte-Carlo); dotted: PEB, a lower bound; "
+                "dashed: first-order prediction, not a bound"
+            },
+            "x": 0.01,
+            "xanchor": "left",
+        },
+        height=760,
+        autosize=True,
+        margin={"l": 70, "r": 20, "t": 110, "b": 50},
+        legend={"font": {"size": 10}, "groupclick": "toggleitem"},
+        meta={
+            "arrays": labels,
+            "unit_yield": yields,
+            "required_yield": required,
+            "target": target,
+        },
+    )
+    return fig

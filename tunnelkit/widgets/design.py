@@ -1,17 +1,17 @@
 """Notebook 08 explorer: carrier, bandwidth, array size, tilt, mount height and the impairments
 (per-element phase and gain calibration error, diffuse multipath share, spatial wideband) -> the
-ideal position error bound and the achievable bound along the tunnel, the SR-NF overlay and the
-smallest square array whose achievable bound meets the target.
+ideal position error bound and the predicted error along the tunnel, the SR-NF overlay and the
+smallest square array predicted to meet the target.
 
-:func:`design_figure` is the pure callback (bounds only, vectorised: no Monte-Carlo); its
-recommendation is a bound-based pre-screen (:func:`tunnelkit.design.smallest_meeting`), a
-necessary condition: the explorer adds a button that runs the design's Monte-Carlo (the tracker on
-the bound-driven route under the same impairments) for the current design with a progress bar.
+:func:`design_figure` is the pure callback (bound and prediction only, vectorised: no
+Monte-Carlo); its smallest array is a prediction (:func:`tunnelkit.design.smallest_meeting`), not
+a decision: the explorer adds a button that runs the design's Monte-Carlo over manufactured units
+(the tracker on the bound-driven route under the same impairments) for the current design.
 
 Figure layout (stable, for tests and lecture scripts): ``layout.title.text`` starts with
-``"Recommended: "`` followed by the array label or ``"none"``; ``layout.meta`` holds ``array``,
-``n_elements``, ``peb_median_m``, ``achievable_median_m``, ``srnf_valid_share``, ``met_share``
-(share of the route where the achievable bound meets the target), ``recommended``, ``fits``
+``"Predicted to meet: "`` followed by the array label or ``"none"``; ``layout.meta`` holds
+``array``, ``n_elements``, ``peb_median_m``, ``predicted_median_m``, ``srnf_valid_share``,
+``met_share`` (share of the route where the prediction meets the target), ``predicted``, ``fits``
 (False when the array does not fit at this mount); traces as in
 :func:`tunnelkit.plots.design.route_traces`.
 """
@@ -63,9 +63,9 @@ def design_figure(
     share: float = 0.9,
     eps_phi: float = 0.15,
 ) -> go.Figure:
-    """PEB and achievable bound of an ``n x n`` URA along the route under the impairments, SR-NF
-    failures marked (information: the design's tracker does not need it), and the bound-based
-    recommendation.
+    """PEB and predicted error of an ``n x n`` URA along the route under the impairments, SR-NF
+    failures marked (information: the design's tracker does not need it), and the smallest
+    square array predicted to meet the target (a prediction, not a decision).
 
     Pure: the same arguments give the same figure. A design that does not fit (array outside the
     tunnel at this mount) gives an empty figure whose title says so instead of raising.
@@ -100,10 +100,10 @@ def design_figure(
     except ValueError as exc:
         return go.Figure(
             layout={
-                "title": {"text": f"Recommended: none — {exc}", "font": {"size": 12}},
+                "title": {"text": f"Predicted to meet: none — {exc}", "font": {"size": 12}},
                 "height": 620,
                 "autosize": True,
-                "meta": {"fits": False, "recommended": None},
+                "meta": {"fits": False, "predicted": None},
             }
         )
     rec, _ = design.smallest_meeting(
@@ -120,33 +120,33 @@ def design_figure(
     med_a = float(np.median(a.achievable))
     if rec is None:
         title = (
-            f"Recommended: none — no square URA up to {SIZES[-1]}x{SIZES[-1]} has an achievable "
-            f"bound ≤ {100 * target:g} cm on {100 * share:.0f} %"
+            f"Predicted to meet: none — no square URA up to {SIZES[-1]}x{SIZES[-1]} has a "
+            f"predicted error ≤ {100 * target:g} cm on {100 * share:.0f} %"
         )
     else:
         title = (
-            f"Recommended: {rec.label} — smallest square URA with achievable bound ≤ "
-            f"{100 * target:g} cm on {100 * share:.0f} % (a bound)"
+            f"Predicted to meet: {rec.label} — smallest square URA with predicted error ≤ "
+            f"{100 * target:g} cm on {100 * share:.0f} % (a prediction: the button decides)"
         )
     sub = (
         f"{spec.label}, {fc_ghz:g} GHz, {bandwidth_mhz:g} MHz, {phase_error_deg:g}°/"
         f"{gain_error_db:g} dB, diffuse {100 * dmc_share:g} %: median PEB {100 * med:.3g} cm, "
-        f"achievable {100 * med_a:.3g} cm · met {100 * met:.0f} % · SR-NF (eq. 51) "
+        f"predicted {100 * med_a:.3g} cm · met {100 * met:.0f} % · SR-NF (eq. 51) "
         f"{100 * b.srnf_valid.mean():.0f} %"
     )
     meta = {
         "array": spec.label,
         "n_elements": spec.n_elements,
         "peb_median_m": med,
-        "achievable_median_m": med_a,
+        "predicted_median_m": med_a,
         "srnf_valid_share": float(b.srnf_valid.mean()),
         "met_share": met,
-        "recommended": None if rec is None else rec.label,
+        "predicted": None if rec is None else rec.label,
         "fits": True,
     }
     label = "ideal" if imp.ideal else "impaired"
     return route_figure(
-        b, target=target, achievable={label: a}, title=title, subtitle=sub, meta=meta
+        b, target=target, predicted={label: a}, title=title, subtitle=sub, meta=meta
     )
 
 
@@ -160,19 +160,19 @@ class DesignExplorer(Explorer):
         controls,
         *,
         scenario: str,
-        runs: int,
+        units: int,
         seed: int,
         target: float = 0.2,
         share: float = 0.9,
     ) -> None:
-        text("scenario", scenario), integer("runs", runs, minimum=1)
+        text("scenario", scenario), integer("units", units, minimum=1)
         integer("seed", seed, minimum=0), positive("target", target)
         probability("share", share, open_interval=False)
         super().__init__(callback, controls, columns=3)
-        self.scenario, self.runs, self.seed = scenario, runs, seed
+        self.scenario, self.units, self.seed = scenario, units, seed
         self.target, self.share = target, share
         self.button = widgets.Button(
-            description=f"Monte-Carlo ({runs} drives)", icon="play", layout={"width": "220px"}
+            description=f"Monte-Carlo ({units} units)", icon="play", layout={"width": "220px"}
         )
         self.output = widgets.Output()
         self.button.on_click(self._run)
@@ -181,8 +181,9 @@ class DesignExplorer(Explorer):
     def run_monte_carlo(self):
         """The design's Monte-Carlo of the current design under the current impairments (the
         tracker on the bound-driven route, :func:`tunnelkit.design.design_sweep` on this one
-        array): its :class:`~tunnelkit.design.DesignRow`, verdict and error quantile with its
-        interval; what the button runs."""
+        array, ``units`` manufactured units of two drives, one batch): its
+        :class:`~tunnelkit.design.DesignRow`, unit yield and error quantile with their
+        intervals; what the button runs."""
         v = self.values
         setup = _base(self.scenario).variant(
             fc=v["fc_ghz"] * 1e9,
@@ -202,7 +203,8 @@ class DesignExplorer(Explorer):
             target=self.target,
             share=self.share,
             impairments=imp,
-            runs=self.runs,
+            units=self.units,
+            max_units=self.units,
             seed=self.seed,
             progress=True,
         )
@@ -216,21 +218,25 @@ class DesignExplorer(Explorer):
             except ValueError as exc:
                 print(f"Monte-Carlo not run: {exc}")
                 return
-            print(monte_carlo_summary(res, self.runs))
+            print(monte_carlo_summary(res))
 
 
-def monte_carlo_summary(row, runs: int) -> str:
-    """One line for a :class:`tunnelkit.design.DesignRow` with Monte-Carlo runs: its verdict, the
-    error quantile with its 95 % interval and the achievable bound beside it."""
+def monte_carlo_summary(row) -> str:
+    """One line for a :class:`tunnelkit.design.DesignRow` with Monte-Carlo units: its verdict,
+    the unit yield and the pooled error quantile with their 95 % intervals, the prediction and
+    the PEB beside them."""
     if row.status == "error":
         return f"Monte-Carlo not run: {row.reason}"
     if row.error_p90_m is None:
         return f"{row.array}: {row.status} — {row.reason}"
     lo, hi = row.error_p90_ci95_m
+    ylo, yhi = row.unit_yield_ci95
     return (
-        f"{row.array}: {row.status} — tracker error quantile {100 * row.error_p90_m:.3g} cm, "
-        f"95 % CI [{100 * lo:.3g}, {100 * hi:.3g}] cm over {runs} drives; achievable bound "
-        f"{100 * row.achievable_p90_m:.3g} cm, ideal PEB {100 * row.peb_p90_m:.3g} cm"
+        f"{row.array}: {row.status} — {100 * row.unit_yield:.3g} % of {row.units} units meet "
+        f"the target (95 % CI [{100 * ylo:.3g}, {100 * yhi:.3g}] %); tracker error quantile "
+        f"{100 * row.error_p90_m:.3g} cm, 95 % CI [{100 * lo:.3g}, {100 * hi:.3g}] cm over "
+        f"{row.runs} drives; predicted {100 * row.predicted_p90_m:.3g} cm (not a bound), ideal "
+        f"PEB {100 * row.peb_p90_m:.3g} cm"
     )
 
 
@@ -248,19 +254,19 @@ def design_explorer(
     wideband: bool = False,
     target: float = 0.2,
     share: float = 0.9,
-    runs: int = 10,
+    units: int = 10,
     seed: int = 0,
 ) -> DesignExplorer:
     """Sliders for carrier, bandwidth, array size, tilt, mount height and the impairments
-    redrawing :func:`design_figure`; a button runs ``runs`` Monte-Carlo drives of the design's
-    tracker on the current design."""
+    redrawing :func:`design_figure`; a button runs ``units`` manufactured units (two drives each)
+    of the design's tracker on the current design."""
     from functools import partial
 
     if not isinstance(scenario, str) or not scenario:
         raise TypeError(f"scenario: expected a scenario name, got {scenario!r}")
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
-    runs = integer("runs", runs, minimum=0)
+    units = integer("units", units, minimum=1)
     seed = integer("seed", seed, minimum=0)
     if bandwidth_mhz not in BANDWIDTHS_MHZ:
         raise ValueError(
@@ -295,5 +301,5 @@ def design_explorer(
     }
     cb = partial(design_figure, scenario=scenario, target=target, share=share)
     return DesignExplorer(
-        cb, controls, scenario=scenario, runs=runs, seed=seed, target=target, share=share
+        cb, controls, scenario=scenario, units=units, seed=seed, target=target, share=share
     )

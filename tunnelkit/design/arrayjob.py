@@ -1,0 +1,297 @@
+"""What the drives of one array share, and one drive: the per-array job of a design sweep.
+
+:class:`ArrayJob` computes once per array (on the sweep's cluster, one task): the error model,
+the bound route's shared part, the PEB, the bounds over the drive (every unit's and the one
+pooled over units, :func:`~tunnelkit.design.drivebound.unit_pcrlb`), the predictions over the
+drive and the tracker (:class:`Prepared`). :class:`SweepTrial` is one drive of one unit on
+it: the unit's calibration draw, the drive's measurements, JAVELIN from the open-sky fix and
+the 2-D error per epoch (:mod:`tunnelkit.design.montecarlo` runs them as one task set).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .bounds import path_bounds, route_bounds, route_geometry
+from .channelbudget import channel_route_budget
+from .drivebound import (
+    START_SIGMA_M,
+    drive_bound,
+    drive_pcrlb,
+    position_bias_rms,
+    position_information,
+    unit_pcrlb,
+)
+from .errormodel import PathErrorModel
+from .setup import ArraySpec, DesignSetup
+
+__all__ = ["START_HEIGHT_SIGMA_M", "design_planes", "javelin_config"]
+
+#: the open-sky fix's height standard deviation [m]: a vehicle's antenna height is known (the
+#: PEB and the bounds over the drive take it as known); the start's and the tracker's ``P_0``
+START_HEIGHT_SIGMA_M = 0.05
+
+
+def javelin_config(crlb: dict, min_d: float = 0.0, planes=None):
+    """The design's JAVELIN: :func:`tunnelkit.tracking.javelin.designs.array_design` (reported
+    covariances, likelihood cost, measured births, the joint innovation test; ``crlb`` sets
+    only the fixed fallback sigmas, ``min_d`` Algorithm 1's delay check; ``planes`` the
+    tunnel's surfaces when the VUEs come from the known geometry)."""
+    # the tracker and the drive simulator load on the first Monte-Carlo, not with the bounds
+    from ..tracking.javelin.designs import array_design
+
+    return array_design(crlb, min_d, planes)
+
+
+def design_planes(setup: DesignSetup) -> list:
+    """The planes of the surfaces a design traces (:data:`tunnelkit.design.geometry.KINDS`)."""
+    from .geometry import KINDS
+
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    return [s.plane for s in setup.tunnel.surfaces if s.kind in KINDS]
+
+
+def _trial_errors(estimates: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(estimates[:, :2] - truth[:, :2], axis=1)
+
+
+@dataclass(frozen=True)
+class SweepTrial:
+    """One Monte-Carlo run of one array (picklable for Dask workers; sent to each worker once):
+    a drive of the design's route through the chosen measurement route, JAVELIN, the 2-D error
+    per epoch (T,). ``prep`` is the array's :class:`Prepared` (built once per array on the
+    sweep's cluster, fetched once by each worker that runs its drives)."""
+
+    setup: DesignSetup
+    mode: str
+    n_epochs: int | None
+    impairments: object = None  # achievable.DesignImpairments: the channel mode's
+    start: str = "drawn"
+    start_sigma: float = START_SIGMA_M
+    dead_reckoning: bool = False
+
+    def __call__(self, item: tuple, rng: np.random.Generator) -> np.ndarray:
+        from ..studies import evaluate, simulate_drive
+        from ..tracking.javelin import draw_start
+
+        prep, unit = item  # the array's shared part, the unit's calibration generator
+        spec = prep.spec
+        if self.mode == "bound":
+            from .fastroute import bound_drive
+
+            cal = prep.route.model.draw_calibration(unit)  # the unit's, every drive the same
+            drive = bound_drive(
+                prep.route, self.setup, spec, rng, n_epochs=self.n_epochs, calibration=cal
+            )
+        elif self.setup.channel == "sionna":
+            from .traced import traced_drive, traced_route
+
+            # the traced treatment (tunnelkit.design.traced): every epoch's ML measurements,
+            # the geometry pre-filter; the tracker told this array's measured errors
+            route = traced_route(self.setup, spec)
+            drive = traced_drive(route, rng, n_epochs=self.n_epochs)["ml-traced"]
+        else:
+            route = self.setup.signal_route(spec)
+            imp = self.impairments
+            if imp is not None and not imp.ideal:
+                # the unit's calibration error (every drive of the unit the same); fits judged
+                # against noise + it
+                route = route.with_impairments(imp.channel_impairments(), unit)
+                route = replace(
+                    route, model_error_floor=True, bias_budget=prep.budget, centroid_unresolved=True
+                )
+            if imp is not None and imp.wideband_model:
+                route = replace(route, wideband_model=True)
+            drive = simulate_drive(
+                route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
+            )
+        sigma = self.start_sigma
+        # the open-sky fix: drawn after the drive (the drive's draws do not depend on it)
+        sh = START_HEIGHT_SIGMA_M
+        p0 = draw_start(drive.truth[0], sigma, rng, sh) if self.start == "drawn" else None
+        ev = evaluate(drive, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
+        err = _trial_errors(ev.estimates, drive.truth)
+        if not self.dead_reckoning:
+            return err
+        # the same tracker, start and V2X messages with every measurement dropped
+        alone = replace(drive, epochs=[None] * len(drive.epochs))
+        ev = evaluate(alone, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
+        return np.stack([err, _trial_errors(ev.estimates, drive.truth)])
+
+
+def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
+    from .achievable import path_error_model
+
+    if error_models is None:
+        m = path_error_model(setup, spec, impairments=impairments)
+    elif callable(error_models):
+        m = error_models(setup, spec)
+    elif isinstance(error_models, dict) and spec.label in error_models:
+        m = error_models[spec.label]
+    else:
+        raise ValueError(
+            f"error_models: expected None, a callable (setup, spec) -> PathErrorModel or a "
+            f"dict by array label holding {spec.label!r}"
+        )
+    if not isinstance(m, PathErrorModel):
+        raise TypeError(
+            f"error_models: expected PathErrorModel for {spec.label}, got {type(m).__name__}"
+        )
+    return m
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """What the drives of one array share (:class:`ArrayJob`): the bound route's shared part
+    (``route``, bound mode), the tracker (``design``) and the bounds reported beside them."""
+
+    spec: ArraySpec
+    route: object  # fastroute.BoundRoute (bound mode) or None
+    design: object  # tracking.javelin.JavelinDesign
+    peb: np.ndarray
+    pcrlb: np.ndarray | None
+    drive: np.ndarray | None
+    learned: np.ndarray | None = None
+    budget: object = None  # signal_route.judging.BiasBudget: the channel route's, impaired
+    error_model: dict | None = None  # traced.error_model_summary: the traced route's
+    hybrid: np.ndarray | None = None  # the bound pooled over units (drivebound.unit_pcrlb)
+
+    def summary(self) -> tuple:
+        """What the sweep's result keeps (not the model and route the drives need)."""
+        return (
+            self.peb,
+            self.pcrlb,
+            self.drive,
+            self.design.config,
+            self.learned,
+            self.error_model,
+            self.hybrid,
+        )
+
+
+@dataclass(frozen=True)
+class ArrayJob:
+    """Everything a sweep computes once per array, before its drives (one task per array, on
+    the sweep's cluster when it has one): the error model, the bound route's shared part, the
+    PEB, the bounds over the drive and the tracker (:class:`Prepared`)."""
+
+    setup: DesignSetup
+    error_models: object
+    mode: str
+    T: int
+    with_model: bool
+    crlbs: dict | None
+    impairments: object = None
+    vues: str = "known"
+    start_sigma: float = START_SIGMA_M
+
+    def __call__(self, spec: ArraySpec) -> Prepared:
+        ep = np.arange(self.T)
+        peb = route_bounds(self.setup, spec, epochs=ep).peb
+        m = route = pc = hybrid = drive = learned = None
+        if self.with_model:
+            m = _model(self.setup, spec, self.error_models, self.impairments)
+            if self.mode == "bound":
+                from .fastroute import bound_route
+
+                route = bound_route(m, self.setup, spec)
+            g = route_geometry(self.setup, spec, epochs=ep)
+            head = model_head(m, self.T)
+            sp0 = self.start_sigma
+            # the bounds: every unit's (its calibration draw known to the bound) and the one
+            # pooled over units (the draw a fixed unknown of the drive, with its prior)
+            pc = unit_pcrlb(self.setup, head, g, sigma_p0=sp0, calibration=False)
+            hybrid = unit_pcrlb(self.setup, head, g, sigma_p0=sp0, calibration=True)
+            # the prediction (not a bound): the noise and the bias of a fix weighted as the
+            # tracker weighs (its reported budget, one block per path, bound mode; on the
+            # channel route the extraction reports its CRLB)
+            w, pc_w = None, drive_pcrlb(self.setup, position_information(head, g), sigma_p0=sp0)
+            if route is not None:
+                from .fastroute import tracker_weights
+
+                w = tracker_weights(route)[: self.T]
+                pc_w = drive_pcrlb(self.setup, position_information(head, g, w), sigma_p0=sp0)
+            drive = drive_bound(pc_w, position_bias_rms(head, g, w))
+            from .learnedbound import learned_pcrlb
+
+            # a tracker that learns its VUEs is told the same blocks: the paths taken one by one
+            learned = drive_bound(
+                *learned_pcrlb(
+                    _per_path(head) if w is not None else head, g, self.setup, sigma_p0=sp0
+                )
+            )
+        crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
+        if crlb is None and m is not None:
+            crlb = _median_sigmas(m)
+        if crlb is None:
+            pb = path_bounds(self.setup, spec)
+            crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
+        planes = design_planes(self.setup) if self.vues == "known" else None
+        design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
+        imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired
+        budget = channel_route_budget(self.setup, spec, imp)
+        error_model = None
+        if self.mode == "channel" and self.setup.channel == "sionna":
+            from .traced import design_errors, error_model_summary, traced_bounds, traced_javelin
+
+            # this array's errors on the traced channel (cached with their provenance)
+            rec = design_errors(self.setup, spec, n_epochs=self.T)
+            design = traced_javelin(self.setup, spec, rec)
+            error_model = error_model_summary(rec, design.config)
+            # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
+            # (a model's posterior CRLB, not a bound of the tracker on the traced channel,
+            # whose errors are neither Gaussian nor independent: a prediction)
+            pc, drive, learned = (
+                None,
+                *traced_bounds(self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma)[
+                    1:
+                ],
+            )
+        return Prepared(spec, route, design, peb, pc, drive, learned, budget, error_model, hybrid)
+
+
+def load_tracker() -> None:
+    """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
+    a worker that imports them in a task while another thread unpickles a tracker sent from
+    another worker deadlocks on the package's import locks)."""
+    from .. import studies  # noqa: F401
+    from ..tracking import javelin  # noqa: F401
+
+
+def prepared_summary(prep: Prepared) -> tuple:
+    return prep.summary()
+
+
+def _median_sigmas(m: PathErrorModel) -> dict[str, float]:
+    """Route-median standard deviations of ``d`` [m], direction [rad] and ``kappa`` [m] in a
+    model's reported bound (what :func:`path_bounds` gives, without evaluating it again)."""
+    T, P = m.exists.shape
+    var = np.diagonal(m.crlb, axis1=1, axis2=2).reshape(T, P, 4)[m.exists]
+    psi = m.truth[..., 1][m.exists]
+    return {
+        "d": float(np.median(np.sqrt(var[:, 3]))),
+        "direction": float(np.median(np.sqrt(var[:, 0] * np.cos(psi) ** 2 + var[:, 1]))),
+        "kappa": float(np.median(np.sqrt(var[:, 2]))),
+    }
+
+
+def _per_path(m: PathErrorModel) -> PathErrorModel:
+    """A model whose ideal bound keeps only each path's own block (the correlation of the joint
+    CRLB between paths dropped): the information a tracker told one block per path uses."""
+    P = m.exists.shape[1]
+    keep = np.kron(np.eye(P, dtype=bool), np.ones((4, 4), dtype=bool))
+    return replace(m, crlb=np.where(keep, m.crlb, 0.0))
+
+
+def model_head(m: PathErrorModel, T: int) -> PathErrorModel:
+    """The first ``T`` epochs of a model."""
+    if m.exists.shape[0] == T:
+        return m
+    cut = {k: getattr(m, k)[:T] for k in ("t", "exists", "truth", "v", "crlb", "cov", "bias")}
+    for k in ("k_phase", "k_gain", "unresolved"):
+        if getattr(m, k) is not None:
+            cut[k] = getattr(m, k)[:T]
+    return replace(m, **cut)
