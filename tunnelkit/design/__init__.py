@@ -1,12 +1,14 @@
-"""Size an antenna array for a tunnel: bounds, achievable accuracy, the tracker's Monte-Carlo and
-a recommendation from what the system achieves.
+"""Size an antenna array for a tunnel: bounds, predicted error, the tracker's Monte-Carlo over
+manufactured units and a recommendation by unit yield.
 
 For every candidate array (ULA ``n``, URA ``n x m``, spacing in wavelengths) placed at the
 scenario's base-station mount (refused if an element lies outside the cross-section), along the
 scenario's route, the design computes the exact SR-NF validity of every path, the ideal position
-error bound (PEB), the achievable (misspecified) bound under the stated impairments, and the
-Monte-Carlo error of the design's tracker; a candidate is met when the 95 % interval of its error
-quantile lies below the target. One job per module:
+error bound (PEB, a bound), the predicted error under the stated impairments (a first-order
+misspecified-model prediction, not a bound), and the Monte-Carlo of the design's tracker over
+manufactured units, one calibration draw each, with the bounds over the drive beside it; a
+candidate is met when the share of units that meet the target on their own (the unit yield)
+reaches the required yield with 95 % confidence. One job per module:
 
 * :mod:`~tunnelkit.design.setup`: candidate arrays (:class:`ArraySpec`, :func:`parse_array`)
   and the scenario reduced to tunnel, mounts, route and radio (:class:`DesignSetup`);
@@ -14,23 +16,24 @@ quantile lies below the target. One job per module:
   (:func:`trace_route`, :class:`RouteGeometry`);
 * :mod:`~tunnelkit.design.bounds`: exact SR-NF validity, the PEB from the joint Fisher
   information of eq. 1 and the per-path CRLBs (:func:`route_bounds`, :func:`path_bounds`);
-* :mod:`~tunnelkit.design.achievable`: impairments as design inputs
-  (:class:`DesignImpairments`), the extraction's per-path error model along the route
-  (:func:`path_error_model`, :class:`PathErrorModel`) and the achievable (misspecified) position
-  bound beside the PEB (:func:`achievable_bound`); the misspecified bound itself is
-  :mod:`~tunnelkit.design.mcrb`;
-* :mod:`~tunnelkit.design.montecarlo`: JAVELIN on the design, every array x run as one task
-  set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
-  :class:`MonteCarloResult` with the posterior CRLB and the bound over the drive with the bias
-  that does not average down, :func:`drive_bound`; :func:`javelin_rmse` for one array,
-  :mod:`~tunnelkit.design.onearray`); :mod:`~tunnelkit.design.fastroute`: the bound-driven
-  drive (:func:`bound_drive`, its per-array share computed once by :func:`bound_route`);
-  :mod:`~tunnelkit.design.traced`: the channel route on the ray-traced channel (the geometry
-  pre-filter and each array's own traced errors, cached with their provenance);
-* :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile with its bootstrap
-  interval, the verdict per array and the recommendation (:func:`judge`, :func:`recommend`);
-* :mod:`~tunnelkit.design.report`: the sweep and its table (:func:`design_sweep`,
-  :func:`smallest_meeting`).
+* :mod:`~tunnelkit.design.impairments` and :mod:`~tunnelkit.design.achievable`: impairments as
+  design inputs (:class:`DesignImpairments`), the extraction's per-path error model along the
+  route (:func:`path_error_model`, :class:`PathErrorModel`) and the predicted position error
+  beside the PEB (:func:`achievable_bound`; its misspecified part is :mod:`~tunnelkit.design.mcrb`);
+* :mod:`~tunnelkit.design.drivebound`: over the drive, every unit's posterior CRLB and the one
+  pooled over units (:func:`unit_pcrlb`, bounds) and the tracker's predicted error
+  (:func:`drive_bound`, a prediction);
+* :mod:`~tunnelkit.design.montecarlo` (with :mod:`~tunnelkit.design.arrayjob`, what one array's
+  drives share and one drive): JAVELIN on the design, every array x drive of a batch as one
+  task set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
+  :class:`MonteCarloResult`); :mod:`~tunnelkit.design.fastroute`: the bound-driven drive;
+  :mod:`~tunnelkit.design.traced`: the channel route on the ray-traced channel;
+* :mod:`~tunnelkit.design.units`: manufactured units (their generators) and the unit yield
+  with its Wilson interval; :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile
+  with its interval, the verdict by the yield and the recommendation (:func:`judge`,
+  :func:`recommend`);
+* :mod:`~tunnelkit.design.report` and :mod:`~tunnelkit.design.records`: the sweep with its
+  sequential rule and its table (:func:`design_sweep`, :class:`DesignReport`).
 
     >>> import tunnelkit as tk
     >>> setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")

@@ -141,18 +141,26 @@ def _check_weights(model: PathErrorModel, weights) -> np.ndarray:
     return weights
 
 
+def _fix_weights(model, geometry, k: int, weights):
+    """Epoch ``k``: the rows, ``H`` (4n, 3) and the weight ``W`` of the weighted least-squares
+    fix (the inverse of the ideal CRLB, or block-diagonal from ``weights``); ``(None, None,
+    None)`` without a path."""
+    rows, H, j = _position_rows(model, geometry, k)
+    if rows is None:
+        return None, None, None
+    if weights is None:
+        R = model.crlb[k][np.ix_(rows, rows)]
+        return rows, H, np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
+    return rows, H, _block_weights(weights[k, j])
+
+
 def _weighted_gain(model, geometry, k: int, weights):
     """Epoch ``k``: the rows, the position rows ``G`` (2, 4n) of the weighted least-squares
     fix ``(H^T W H)^-1 H^T W`` (clock bias estimated; ``W`` the inverse of the ideal CRLB or
     block-diagonal from ``weights``), or ``(None, None)`` without a path."""
-    rows, H, j = _position_rows(model, geometry, k)
+    rows, H, W = _fix_weights(model, geometry, k, weights)
     if rows is None:
         return None, None
-    if weights is None:
-        R = model.crlb[k][np.ix_(rows, rows)]
-        W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
-    else:
-        W = _block_weights(weights[k, j])
     J = H.T @ W @ H
     G = (np.linalg.pinv(0.5 * (J + J.T), rcond=1e-15, hermitian=True) @ H.T @ W)[:2]
     return rows, G
@@ -174,14 +182,9 @@ def fix_identifiable(model: PathErrorModel, geometry, weights=None, rcond: float
     T = model.exists.shape[0]
     out = np.zeros(T, bool)
     for k in range(T):
-        rows, H, j = _position_rows(model, geometry, k)
+        rows, H, W = _fix_weights(model, geometry, k, weights)
         if rows is None:
             continue
-        if weights is None:
-            R = model.crlb[k][np.ix_(rows, rows)]
-            W = np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
-        else:
-            W = _block_weights(weights[k, j])
         J = H.T @ W @ H
         d = np.diag(J)
         if np.any(d <= 0) or not np.all(np.isfinite(J)):

@@ -375,30 +375,22 @@ def design_answer_figure(report) -> go.Figure:
                 row=1,
                 col=1,
             )
-        if r.peb_m is not None:
-            fig.add_scatter(
-                x=x,
-                y=_finite(100 * np.asarray(r.peb_m, float)),
-                mode="lines",
-                name="PEB (bound)",
-                line={"color": color, "width": 1.5, "dash": "dot"},
-                hovertemplate=hover,
-                **group,
-                row=1,
-                col=1,
-            )
-        if r.predicted_m is not None:
-            fig.add_scatter(
-                x=x,
-                y=_finite(100 * np.asarray(r.predicted_m, float)),
-                mode="lines",
-                name="predicted (not a bound)",
-                line={"color": color, "width": 1.5, "dash": "dash"},
-                hovertemplate=hover,
-                **group,
-                row=1,
-                col=1,
-            )
+        for name, y, dash in (
+            ("PEB (bound)", r.peb_m, "dot"),
+            ("predicted (not a bound)", r.predicted_m, "dash"),
+        ):
+            if y is not None:
+                fig.add_scatter(
+                    x=x,
+                    y=_finite(100 * np.asarray(y, float)),
+                    mode="lines",
+                    name=name,
+                    line={"color": color, "width": 1.5, "dash": dash},
+                    hovertemplate=hover,
+                    **group,
+                    row=1,
+                    col=1,
+                )
     if xs:
         x0 = float(min(np.nanmin(v) for v in xs))
         x1 = float(max(np.nanmax(v) for v in xs))

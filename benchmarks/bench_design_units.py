@@ -1,0 +1,401 @@
+"""The design's Monte-Carlo by manufactured units: are the bounds below the tracker, and do the
+reported intervals cover?
+
+Two studies on the bound route of ``example-rectangular-28ghz`` (8 x 6 m tunnel, 28 GHz), each
+unit one calibration draw shared by its drives (:mod:`tunnelkit.design.units`):
+
+1. **Bounds vs the tracker** (:func:`bound_matrix`): arrays 4x4, 8x8, 16x16 x phase error
+   {0.5, 2} deg x gain error {0, 0.2} dB, on seeds the design was never tuned on (101, 202),
+   ``--units`` units x ``--drives`` drives each in one batch (``design_sweep`` with
+   ``max_units = units``: no sequential rule), optionally on moved mounts too (``--tunnels``,
+   e.g. ``mount_height=5.0`` or ``tilt_deg=10``). Per cell the tracker's pooled settled RMSE,
+   RMSE / hybrid bound (posterior CRLB pooled over units, the bound of the pooled RMSE) with the
+   95 % interval of the RMSE bootstrapped over units, the smallest unit RMSE / PCRLB (every
+   unit's posterior CRLB, the bound of each unit's RMSE), the pooled RMSE / PCRLB and RMSE /
+   predicted drive error (a first-order prediction, not a bound: either side of 1 is allowed).
+   A bound is beaten where its ratio's interval lies below 1 (the minimum over units is a point:
+   below 1 at all). The failures are listed after the table.
+2. **Coverage of the reported intervals** (:func:`coverage`): for 8x8 and 16x16 x phase error
+   {0.5, 2} deg at target 0.1 m, a long reference run (``--ref-units`` units x 2 drives, seed
+   ``--ref-seed``) gives the reference pooled p90 and unit yield; ``--blocks`` short runs of
+   ``--block-units`` units x 2 drives (disjoint blocks of one ``sweep_montecarlo`` call on
+   seed ``--seed``: different units, so independent runs) count how often the bootstrap-over-
+   units 95 % interval of the pooled p90 holds the reference p90 and the Wilson interval of the
+   unit yield the reference yield. Beside them the old interval: drives with a calibration draw
+   each (``drives_per_unit=1``, ``--block-units`` drives per block), bootstrapped over drives,
+   against the reference p90 of that setting (its own long run); and, as a check of why the
+   resampling unit matters, the D=2 blocks bootstrapped over drives (ignoring the unit). Each
+   measured coverage with its Wilson 95 % interval (the blocks are Bernoulli trials), and how
+   many intervals missed low (below the reference) or high.
+
+The tables are printed and written to ``--out`` (``units_bounds[_TAG].md``,
+``units_coverage[_TAG].md``); ``--quick`` is a smoke test (one impairment, 10 units, 5 blocks),
+not a measurement. Serial, a drive costs about 0.1 s of one core (40 epochs): part 1 is about
+1,440 drives per tunnel, part 2 about ``4 * ref_units + 60 * blocks`` drives per array and phase
+error (two serial processes, one per ``--phases``, use both cores without a cluster):
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --quick
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --part 1 --tunnels base \
+        mount_height=5.0
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --part 2 --phases 2 \
+        --ref-units 250 --blocks 25 --seed 1 --tag ph2
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import time
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+SCENARIO = "example-rectangular-28ghz"
+ARRAYS = ("4x4", "8x8", "16x16")
+PHASES_DEG = (0.5, 2.0)
+GAINS_DB = (0.0, 0.2)
+SEEDS = (101, 202)
+COVERAGE_ARRAYS = ("8x8", "16x16")
+TARGET_M = 0.1
+SHARE = 0.9
+
+
+def _setup(tunnel: str):
+    """The design setup of ``tunnel``: ``"base"`` or ``"key=value"`` of ``from_scenario``."""
+    from tunnelkit.design import DesignSetup
+
+    if tunnel == "base":
+        return DesignSetup.from_scenario(SCENARIO)
+    key, value = tunnel.split("=")
+    return DesignSetup.from_scenario(SCENARIO, **{key: float(value)})
+
+
+def bound_matrix(
+    tunnels=("base",),
+    arrays=ARRAYS,
+    phases=PHASES_DEG,
+    gains=GAINS_DB,
+    seeds=SEEDS,
+    units: int = 30,
+    drives: int = 2,
+    workers: int | None = None,
+) -> list[dict]:
+    """Part 1: one ``design_sweep`` per tunnel x impairment x seed (every array in it)."""
+    from tunnelkit.design import design_sweep
+
+    out = []
+    for tunnel, ph, g, seed in itertools.product(tunnels, phases, gains, seeds):
+        t0 = time.perf_counter()
+        rep = design_sweep(
+            _setup(tunnel),
+            list(arrays),
+            target=TARGET_M,
+            impairments={"phase_error_deg": ph, "gain_error_db": g},
+            units=units,
+            drives_per_unit=drives,
+            max_units=units,
+            seed=seed,
+            mode="bound",
+            workers=workers,
+        )
+        dt = time.perf_counter() - t0
+        for r in rep.rows:
+            hy, lo_hi = r.hybrid_bound_rms_m, r.rmse_ci95_m
+            out.append(
+                {
+                    "tunnel": tunnel,
+                    "array": r.array,
+                    "phase": ph,
+                    "gain": g,
+                    "seed": seed,
+                    "units": r.units,
+                    "drives": r.drives_per_unit,
+                    "rmse": r.rmse_m,
+                    "rmse_ci": lo_hi,
+                    "hybrid": hy,
+                    "r_hy": r.rmse_over_hybrid_bound,
+                    "r_hy_ci": None if hy is None else [v / hy for v in lo_hi],
+                    "pcrlb": r.pcrlb_rms_m,
+                    "r_pc": r.rmse_over_pcrlb,
+                    "r_pc_unit_min": r.unit_rmse_over_pcrlb_min,
+                    "r_pred": r.rmse_over_predicted_drive,
+                    "p90": r.error_p90_m,
+                    "p90_ci": r.error_p90_ci95_m,
+                    "yield": r.unit_yield,
+                    "yield_ci": r.unit_yield_ci95,
+                    "status": r.status,
+                    "reason": r.reason,
+                    "seconds": dt / len(rep.rows),
+                }
+            )
+    return out
+
+
+def bound_failures(rows) -> list[str]:
+    """Every cell where a figure called a bound is above the tracker's error."""
+    bad = []
+    for r in rows:
+        cell = f"{r['tunnel']} {r['array']} {r['phase']:g} deg {r['gain']:g} dB seed {r['seed']}"
+        if r["r_hy_ci"] is None or r["r_pc_unit_min"] is None:
+            bad.append(f"{cell}: a bound is missing ({r['status']}: {r['reason']})")
+            continue
+        if r["r_hy_ci"][1] < 1:
+            bad.append(f"{cell}: RMSE / hybrid bound interval {_ci(r['r_hy_ci'])} below 1")
+        if r["r_pc_unit_min"] < 1:
+            bad.append(f"{cell}: min unit RMSE / PCRLB {r['r_pc_unit_min']:.3g} below 1")
+    return bad
+
+
+def _ci(ci, fmt=".3g") -> str:
+    return "-" if ci is None else f"[{ci[0]:{fmt}}, {ci[1]:{fmt}}]"
+
+
+def _num(v, fmt=".3g") -> str:
+    return "-" if v is None else f"{v:{fmt}}"
+
+
+def bound_table(rows) -> str:
+    head = (
+        "| tunnel | array | phase deg | gain dB | seed | units x D | RMSE m | RMSE / hybrid "
+        "[95 % CI] | min unit RMSE / PCRLB | RMSE / PCRLB | RMSE / pred. drive | p90 m [CI] | "
+        "unit yield @0.1 m [Wilson] |\n|" + "---|" * 13
+    )
+    lines = [head]
+    for r in rows:
+        if r["rmse"] is None:  # no Monte-Carlo: the row's reason
+            lines.append(
+                f"| {r['tunnel']} | {r['array']} | {r['phase']:g} | {r['gain']:g} | {r['seed']} | "
+                f"{r['status']}: {r['reason']} |" + " |" * 7
+            )
+            continue
+        lines.append(
+            f"| {r['tunnel']} | {r['array']} | {r['phase']:g} | {r['gain']:g} | {r['seed']} | "
+            f"{r['units']} x {r['drives']} | {r['rmse']:.4f} | {_num(r['r_hy'])} "
+            f"{_ci(r['r_hy_ci'])} | {_num(r['r_pc_unit_min'])} | {_num(r['r_pc'])} | "
+            f"{_num(r['r_pred'])} | {r['p90']:.4f} {_ci(r['p90_ci'], '.4f')} | "
+            f"{r['yield']:.2f} {_ci(r['yield_ci'], '.2f')} |"
+        )
+    bad = bound_failures(rows)
+    lines.append("")
+    lines.append(
+        f"Cells: {len(rows)}; a bound above the tracker's error: "
+        + ("none" if not bad else f"{len(bad)}")
+    )
+    lines += [f"- {b}" for b in bad]
+    return "\n".join(lines)
+
+
+def _finite(e):
+    return np.where(np.isfinite(e), e, np.inf)
+
+
+def _boot_ci(by, rng, n_boot):
+    from tunnelkit.design import bootstrap_quantile_ci
+
+    return bootstrap_quantile_ci(by, SHARE, rng, n_boot=n_boot)
+
+
+def coverage(
+    arrays=COVERAGE_ARRAYS,
+    phases=PHASES_DEG,
+    ref_units: int = 400,
+    blocks: int = 40,
+    block_units: int = 20,
+    drives: int = 2,
+    ref_seed: int = 9001,
+    seed: int = 1,
+    workers: int | None = None,
+    n_boot: int = 2000,
+) -> list[dict]:
+    """Part 2: per array x phase error, the reference and the coverage over ``blocks`` blocks."""
+    from tunnelkit.design import (
+        DesignImpairments,
+        path_error_model,
+        share_quantile,
+        sweep_montecarlo,
+    )
+    from tunnelkit.design.units import unit_quantiles, unit_yield, wilson_interval
+    from tunnelkit.montecarlo import trial_pool
+
+    setup = _setup("base")
+    out = []
+    with trial_pool(workers) as pool:
+        for ph in phases:
+            imp = DesignImpairments(phase_error_deg=ph)
+            kw = {
+                "impairments": imp,
+                "error_models": partial(path_error_model, impairments=imp),
+                "mode": "bound",
+                "pool": pool,
+            }
+            t0 = time.perf_counter()
+            ref2 = sweep_montecarlo(setup, arrays, ref_units * drives, ref_seed,
+                                    drives_per_unit=drives, **kw)  # fmt: skip
+            ref1 = sweep_montecarlo(setup, arrays, ref_units * drives, ref_seed + 1, **kw)
+            run2 = sweep_montecarlo(setup, arrays, blocks * block_units * drives, seed,
+                                    drives_per_unit=drives, **kw)  # fmt: skip
+            run1 = sweep_montecarlo(setup, arrays, blocks * block_units, seed + 1, **kw)
+            dt = time.perf_counter() - t0
+            for a in arrays:
+                k = ref2[a].settled
+                rng = np.random.default_rng([0xC0FE, int(10 * ph), *a.encode()])
+                e_ref2 = _finite(ref2[a].errors[:, k])
+                e_ref1 = _finite(ref1[a].errors[:, k])
+                p90_ref = share_quantile(e_ref2, SHARE)
+                p90_ref1 = share_quantile(e_ref1, SHARE)
+                uq = unit_quantiles(ref2[a].errors, drives, k, SHARE)
+                y_ref, y_ref_ci = unit_yield(uq, TARGET_M)
+                ref_ci = _boot_ci(e_ref2.reshape(ref_units, -1), rng, n_boot)
+                ref1_ci = _boot_ci(e_ref1, rng, n_boot)
+                hits = {"units": [], "yield": [], "drives1": [], "drives2": []}
+                widths = {key: [] for key in hits}
+                for b in range(blocks):
+                    rows2 = slice(b * block_units * drives, (b + 1) * block_units * drives)
+                    e2 = _finite(run2[a].errors[rows2][:, k])
+                    ci = _boot_ci(e2.reshape(block_units, -1), rng, n_boot)
+                    hits["units"].append(_where(p90_ref, ci))
+                    widths["units"].append(ci[1] - ci[0])
+                    ci = _boot_ci(e2, rng, n_boot)  # drives resampled, the unit ignored
+                    hits["drives2"].append(_where(p90_ref, ci))
+                    widths["drives2"].append(ci[1] - ci[0])
+                    q = unit_quantiles(run2[a].errors[rows2], drives, k, SHARE)
+                    _, ci = unit_yield(q, TARGET_M)
+                    hits["yield"].append(_where(y_ref, ci))
+                    widths["yield"].append(ci[1] - ci[0])
+                    e1 = _finite(run1[a].errors[b * block_units : (b + 1) * block_units][:, k])
+                    ci = _boot_ci(e1, rng, n_boot)
+                    hits["drives1"].append(_where(p90_ref1, ci))
+                    widths["drives1"].append(ci[1] - ci[0])
+                cov = {}
+                for key, h in hits.items():
+                    h = np.asarray(h)
+                    n_in = int(np.sum(h == 0))
+                    cov[key] = {
+                        "in": n_in,
+                        "low": int(np.sum(h < 0)),
+                        "high": int(np.sum(h > 0)),
+                        "share": n_in / blocks,
+                        "ci": wilson_interval(n_in, blocks),
+                        "width": float(np.mean(widths[key])),
+                    }
+                out.append(
+                    {
+                        "array": a,
+                        "phase": ph,
+                        "ref_units": ref_units,
+                        "p90_ref": p90_ref,
+                        "p90_ref_ci": ref_ci,
+                        "p90_ref1": p90_ref1,
+                        "p90_ref1_ci": ref1_ci,
+                        "yield_ref": y_ref,
+                        "yield_ref_ci": y_ref_ci,
+                        "blocks": blocks,
+                        "block_units": block_units,
+                        "drives": drives,
+                        "coverage": cov,
+                        "seconds": dt / len(arrays),
+                    }
+                )
+    return out
+
+
+def _where(ref: float, ci) -> int:
+    """-1: the interval lies below the reference, 0: holds it, 1: lies above it."""
+    return -1 if ci[1] < ref else (1 if ci[0] > ref else 0)
+
+
+def coverage_table(rows) -> str:
+    lines = [
+        "| array | phase deg | reference (units x D) | ref p90 m [CI] | ref unit yield [Wilson] | "
+        "D=1 ref p90 m [CI] |\n|" + "---|" * 6
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['array']} | {r['phase']:g} | {r['ref_units']} x {r['drives']} | "
+            f"{r['p90_ref']:.4f} {_ci(r['p90_ref_ci'], '.4f')} | {r['yield_ref']:.3f} "
+            f"{_ci(r['yield_ref_ci'], '.3f')} | {r['p90_ref1']:.4f} {_ci(r['p90_ref1_ci'], '.4f')} |"
+        )
+    names = {
+        "units": "p90, bootstrap over units (D=2, new)",
+        "yield": "unit yield @0.1 m, Wilson (D=2, new)",
+        "drives1": "p90, bootstrap over drives (D=1, old)",
+        "drives2": "p90, bootstrap over drives (D=2, unit ignored)",
+    }
+    lines += [
+        "",
+        "| array | phase deg | interval | blocks x units | nominal | measured coverage "
+        "[Wilson 95 %] | missed low / high | mean width |\n|" + "---|" * 8,
+    ]
+    for r in rows:
+        for key, name in names.items():
+            c = r["coverage"][key]
+            n_units = r["block_units"] if key != "drives1" else f"{r['block_units']} drives"
+            lines.append(
+                f"| {r['array']} | {r['phase']:g} | {name} | {r['blocks']} x {n_units} | 0.95 | "
+                f"{c['share']:.3f} {_ci(c['ci'], '.3f')} | {c['low']} / {c['high']} | "
+                f"{c['width']:.4g} |"
+            )
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="a smoke test: small and few")
+    ap.add_argument("--part", choices=("1", "2", "both"), default="both")
+    ap.add_argument("--tunnels", nargs="+", default=["base"],
+                    help="'base' and/or from_scenario overrides such as mount_height=5.0")  # fmt: skip
+    ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
+    ap.add_argument("--phases", type=float, nargs="+", default=list(PHASES_DEG))
+    ap.add_argument("--tag", default="", help="a suffix of the written files' names")
+    ap.add_argument("--units", type=int, default=30, help="part 1: units per cell")
+    ap.add_argument("--drives", type=int, default=2, help="drives per unit")
+    ap.add_argument("--ref-units", type=int, default=400)
+    ap.add_argument("--ref-seed", type=int, default=9001)
+    ap.add_argument("--blocks", type=int, default=40, help="part 2: short runs per cell")
+    ap.add_argument("--block-units", type=int, default=20)
+    ap.add_argument("--seed", type=int, default=1, help="part 2: the short runs' seed")
+    ap.add_argument("--n-boot", type=int, default=2000)
+    ap.add_argument("--workers", type=int, default=None, choices=(1, 2))
+    ap.add_argument("--out", type=Path, default=Path("/tmp/bench_units"))
+    args = ap.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    tag = ("_quick" if args.quick else "") + (f"_{args.tag}" if args.tag else "")
+    if args.part in ("1", "both"):
+        kw = {"units": args.units, "drives": args.drives, "workers": args.workers}
+        kw["phases"] = tuple(args.phases)
+        if args.quick:
+            kw.update(phases=(2.0,), gains=(0.2,), seeds=args.seeds[:1], units=10)
+        else:
+            kw["seeds"] = args.seeds
+        t0 = time.perf_counter()
+        rows = bound_matrix(tuple(args.tunnels), **kw)
+        dt = time.perf_counter() - t0
+        text = f"## Bounds vs the tracker ({dt:.0f} s)\n\n{bound_table(rows)}\n"
+        print(text)
+        (args.out / f"units_bounds{tag}.md").write_text(text, encoding="utf-8")
+    if args.part in ("2", "both"):
+        kw = {
+            "ref_units": args.ref_units,
+            "blocks": args.blocks,
+            "block_units": args.block_units,
+            "drives": args.drives,
+            "ref_seed": args.ref_seed,
+            "seed": args.seed,
+            "workers": args.workers,
+            "n_boot": args.n_boot,
+            "phases": tuple(args.phases),
+        }
+        if args.quick:
+            kw.update(phases=(2.0,), ref_units=60, blocks=5)
+        t0 = time.perf_counter()
+        rows = coverage(**kw)
+        dt = time.perf_counter() - t0
+        text = f"## Coverage of the reported intervals ({dt:.0f} s)\n\n{coverage_table(rows)}\n"
+        print(text)
+        (args.out / f"units_coverage{tag}.md").write_text(text, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
