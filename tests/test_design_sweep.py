@@ -424,6 +424,27 @@ def test_a_units_drives_share_its_calibration_and_later_units_extend_the_sweep(s
     np.testing.assert_array_equal(whole.errors, np.concatenate([head.errors, tail.errors]))
     with pytest.raises(ValueError, match="runs"):
         sweep_montecarlo(setup, ["4x4"], 3, 7, **kw)
+    # serially too, every drive of a unit draws the same calibration error, and the sweep is the
+    # same on two workers (each drive makes its own generator from its unit's seed)
+    from tunnelkit.design.errormodel import PathErrorModel
+
+    seen = []
+    real = PathErrorModel.draw_calibration
+
+    def spy(self, rng):
+        cal = real(self, rng)
+        seen.append(cal[0])
+        return cal
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(PathErrorModel, "draw_calibration", spy)
+        serial = sweep_montecarlo(setup, ["4x4"], 6, 7, **kw)["4x4"]
+    assert len(seen) == 6 and not np.array_equal(seen[0], seen[2])
+    for u in range(3):
+        np.testing.assert_array_equal(seen[2 * u], seen[2 * u + 1])
+    np.testing.assert_array_equal(serial.errors, whole.errors[:6])
+    two = sweep_montecarlo(setup, ["4x4"], 6, 7, workers=2, **kw)["4x4"]
+    np.testing.assert_array_equal(two.errors, serial.errors)
     m = path_error_model(setup, "4x4", impairments=imp)
     from tunnelkit.design.units import unit_rngs
 

@@ -414,3 +414,30 @@ def test_no_candidate_left_is_no_recommendation_not_an_error():
     rec = recommend([], 0.1, 0.9, 20)
     assert rec["array"] is None and "no candidate" in rec["reason"]
     assert recommend([], 0.1, 0.9, 0)["array"] is None
+
+
+def test_the_report_warns_of_valid_but_implausible_inputs(setup):
+    """A target of half the tunnel's width, the ideal array, the spatial-wideband term off where
+    the band calls for it and a non-NR numerology are said, not silently accepted."""
+    rep = design.design_sweep(setup, ["4x4", "32x32"], target=4.0)
+    text = " ".join(rep.warnings)
+    assert "target: 4 m is half the tunnel's width" in text
+    assert "impairments: none" in text and "5.6 %" in text
+    assert "the band calls for it" in text  # 32x32 spans 0.31 cycles of 400 MHz
+    calm = design.design_sweep(
+        setup, ["4x4"], target=0.1, impairments={"phase_error_deg": 0.5, "dmc_share": 0.05}
+    )
+    assert not calm.warnings[:-1] and "no Monte-Carlo" in calm.warnings[-1]
+    fr1 = design.design_sweep(setup.variant(fc=3.5e9, bandwidth=100e6), ["4x4"], target=0.1)
+    assert any("not an NR FR1 numerology" in w for w in fr1.warnings)
+    j = fr1.to_json()["inputs"]
+    assert j["scs"] == 120e3 and j["n_rb"] == 69
+
+
+def test_run_counts_beyond_the_memory_budget_are_refused_before_any_work(setup):
+    with pytest.raises(ValueError, match=r"^runs: would need"):
+        design.sweep_montecarlo(setup, ["4x4"], 10**9, 0)
+    with pytest.raises(ValueError, match=r"^max_units: would need"):
+        design.design_sweep(setup, ["4x4"], units=20, max_units=10**9)
+    with pytest.raises(ValueError, match=r"^units: the first batch"):
+        design.design_sweep(setup, ["4x4"], units=10**10)

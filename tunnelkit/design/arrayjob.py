@@ -77,7 +77,8 @@ class SweepTrial:
         from ..studies import evaluate, simulate_drive
         from ..tracking.javelin import draw_start
 
-        prep, unit = item  # the array's shared part, the unit's calibration generator
+        prep, unit_seed = item  # the array's shared part, the unit's calibration seed
+        unit = np.random.default_rng(unit_seed)  # this drive's own copy: the unit's draw
         spec = prep.spec
         if self.mode == "bound":
             from .fastroute import bound_drive

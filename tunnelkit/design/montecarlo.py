@@ -52,8 +52,9 @@ import numpy as np
 
 from .._checks import bound_array
 from .._validate import boolean, choice, instance, integer, positive, record
+from ..budget import check_bytes
 from ..metrics import SETTLE_S, settled
-from ..montecarlo import TrialPool, run_trials, trial_pool
+from ..montecarlo import RUN_BYTES, TrialPool, run_trials, trial_pool
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,
@@ -64,7 +65,7 @@ from .arrayjob import (
 )
 from .drivebound import START_SIGMA_M
 from .setup import ArraySpec, DesignSetup, parse_array
-from .units import drive_streams, unit_rngs
+from .units import drive_streams, unit_seeds
 
 __all__ = [
     "MODES",
@@ -305,6 +306,12 @@ def sweep_montecarlo(
     traj = setup.trajectory
     T = len(traj) if n_epochs is None else min(n_epochs, len(traj))
     A = len(specs)
+    # refused before any per-array work: every drive's errors, its generator and its unit's
+    check_bytes(
+        "runs",
+        A * runs * (8 * T * (2 if dead_reckoning else 1) + 2 * RUN_BYTES),
+        f"{A} arrays x {runs} drives x {T} epochs of errors and their generators",
+    )
     with_model = mode == "bound" or error_models is not None
     job = ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, vues, start_sigma)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
@@ -324,7 +331,8 @@ def sweep_montecarlo(
         handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
         prepared = [handles[order.index(a)] for a in range(A)]
         n_units = runs // drives_per_unit
-        units = [u for u in unit_rngs(seed, first_unit, n_units) for _ in range(drives_per_unit)]
+        # each drive gets its unit's seed and makes its own generator: the same calibration
+        units = [u for u in unit_seeds(seed, first_unit, n_units) for _ in range(drives_per_unit)]
         streams = drive_streams(first_unit, n_units, drives_per_unit)
         res = run_trials(
             SweepTrial(setup, mode, n_epochs, impairments, start, start_sigma, dead_reckoning),

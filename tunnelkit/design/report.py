@@ -43,6 +43,7 @@ from .._validate import (
     sequence,
 )
 from ..budget import check_bytes, check_elements
+from ..constants import C
 from ..metrics import SETTLE_S
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
@@ -347,7 +348,12 @@ def design_sweep(
     units = integer("units", units, minimum=0)
     drives_per_unit = integer("drives_per_unit", drives_per_unit, minimum=1, maximum=100)
     required_yield = probability("required_yield", required_yield)
-    max_units = integer("max_units", max_units, minimum=max(units, 1))
+    max_units = integer("max_units", max_units, minimum=1)
+    if units > max_units:
+        raise ValueError(
+            f"units: the first batch ({units} units) is larger than max_units ({max_units}); "
+            "raise max_units (--max-units) or give fewer units"
+        )
     settle = nonnegative("settle", settle)
     seed = integer("seed", seed, minimum=0)
     n_boot = integer("n_boot", n_boot, minimum=100)
@@ -428,7 +434,7 @@ def design_sweep(
             f"{', '.join(reused)}: the traced route's measurement noise was measured on this "
             f"seed's first drives (seed {seed}); report the sweep on another seed"
         )
-    warnings += _plausibility(setup, target, imp)
+    warnings += _plausibility(setup, specs, target, imp)
     if criterion == "srnf" and units:
         warnings.append(
             "criterion srnf: the Monte-Carlo tracker models the VUE curvature; the SR-NF gate "
@@ -481,9 +487,13 @@ PLAUSIBLE_WIDTH_M, PLAUSIBLE_HEIGHT_M = 40.0, 15.0
 MEASURED_DIFFUSE_SHARE = 0.056
 #: NR FR1 (up to 7.125 GHz) and its SRS subcarrier spacings [Hz] (TS 38.211, numerologies 0-2)
 FR1_MAX_HZ, FR1_SCS_HZ = 7.125e9, (15e3, 30e3, 60e3)
+#: the band's delay across the largest aperture [cycles of the bandwidth] above which the report
+#: says the spatial-wideband term matters (bandwidth x aperture / c; the term's phase error
+#: across the band reaches about this share of a cycle)
+WIDEBAND_CYCLES = 0.1
 
 
-def _plausibility(setup, target: float, imp) -> list[str]:
+def _plausibility(setup, specs, target: float, imp) -> list[str]:
     """Warnings for valid but implausible inputs: a cross-section no road tunnel has, a target
     no narrower than the tunnel, and the ideal array (the optimistic case) said as such."""
     out = []
@@ -505,6 +515,13 @@ def _plausibility(setup, target: float, imp) -> list[str]:
             f"not an NR FR1 numerology ({', '.join(f'{v / 1e3:g}' for v in FR1_SCS_HZ)} kHz); "
             f"the {cfg.bandwidth / 1e6:g} MHz band holds {cfg.n_rb} resource blocks of it "
             "(set the scenario's radio.scs and radio.n_rb for another numerology)"
+        )
+    wide = max(s.aperture(setup.fc) for s in specs) * cfg.bandwidth / C
+    if not imp.spatial_wideband and wide > WIDEBAND_CYCLES:
+        out.append(
+            f"impairments: the spatial-wideband term is off, yet the largest aperture spans "
+            f"{wide:.2g} cycles of the {cfg.bandwidth / 1e6:g} MHz band (above "
+            f"{WIDEBAND_CYCLES:g}): the band calls for it (--wideband, --wideband-model)"
         )
     if imp.ideal:
         out.append(

@@ -33,6 +33,7 @@ __all__ = [
     "drive_streams",
     "unit_quantiles",
     "unit_rngs",
+    "unit_seeds",
     "unit_yield",
     "wilson_interval",
 ]
@@ -47,9 +48,12 @@ DRIVES_PER_UNIT = 2
 _UNIT_TAG = 0x0417CA1
 
 
-def unit_rngs(seed, first: int, n: int) -> list[np.random.Generator]:
-    """The calibration generators of units ``first .. first + n - 1`` of ``seed`` (an int or a
-    Generator, not advanced): unit ``u``'s generator is the same whatever batch it runs in."""
+def unit_seeds(seed, first: int, n: int) -> list[np.random.SeedSequence]:
+    """The calibration seeds of units ``first .. first + n - 1`` of ``seed`` (an int or a
+    Generator, not advanced): unit ``u``'s seed is the same whatever batch it runs in. A seed,
+    not a generator, is what a unit's drives share: each drive makes its own generator from it
+    and draws the same calibration error (a generator shared in one process would hand its
+    second drive the next draw)."""
     first = integer("first", first, minimum=0)
     n = integer("n", n, minimum=1)
     if isinstance(seed, np.random.Generator):
@@ -58,9 +62,14 @@ def unit_rngs(seed, first: int, n: int) -> list[np.random.Generator]:
     else:
         entropy, key = integer("seed", seed, minimum=0), ()
     return [
-        np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(*key, _UNIT_TAG, u)))
+        np.random.SeedSequence(entropy, spawn_key=(*key, _UNIT_TAG, u))
         for u in range(first, first + n)
     ]
+
+
+def unit_rngs(seed, first: int, n: int) -> list[np.random.Generator]:
+    """The calibration generators of units ``first .. first + n - 1`` (:func:`unit_seeds`)."""
+    return [np.random.default_rng(s) for s in unit_seeds(seed, first, n)]
 
 
 def drive_streams(first: int, units: int, drives_per_unit: int) -> list[int]:
