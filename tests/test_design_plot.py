@@ -77,8 +77,8 @@ def test_figure_of_a_monte_carlo_sweep(report):
         assert med.legendgroup == peb.legendgroup == pred.legendgroup == r.array
         assert med.line.dash is None and "median" in med.name
         assert f"{100 * r.error_p90_m:.3g} cm" in med.name  # the pooled p90 in the legend
-        assert peb.line.dash == "dot" and peb.name == "PEB (bound)"
-        assert pred.line.dash == "dash" and pred.name == "predicted (not a bound)"
+        assert peb.line.dash == "dot" and peb.name == f"{r.array} PEB (bound)"
+        assert pred.line.dash == "dash" and pred.name == f"{r.array} predicted (not a bound)"
         np.testing.assert_allclose(_cm(med.y), r.error_median_epoch_m, rtol=1e-12)
         np.testing.assert_allclose(_cm(peb.y), r.peb_m, rtol=1e-12)
         np.testing.assert_allclose(_cm(pred.y), r.predicted_m, rtol=1e-12)
@@ -102,9 +102,10 @@ def test_figure_of_a_monte_carlo_sweep(report):
 def test_bounds_only_report_shows_bounds_and_predictions(bounds_only):
     fig = design_answer_figure(bounds_only)
     top = _top(fig)
-    assert [t.name for t in top] == ["PEB (bound)", "predicted (not a bound)"] * 2 + [
-        "target 10 cm"
-    ]
+    assert [t.name for t in top] == [
+        f"{a} {k}" for a in ARRAYS for k in ("PEB (bound)", "predicted (not a bound)")
+    ] + ["target 10 cm"]
+    assert len({t.name for t in top}) == len(top)  # no legend entry repeated
     assert not any("median" in (t.name or "") for t in fig.data)
     assert fig.layout.meta["unit_yield"] == [None, None]
     assert any("no Monte-Carlo" in a.text for a in fig.layout.annotations)
@@ -126,7 +127,7 @@ def test_cli_writes_the_figure(tmp_path, capsys):
     assert json.loads(cap.out)["arrays"][0]["array"] == "4x4"  # stdout stays valid JSON
     assert cap.err.strip().endswith(f"figure written to {out}")
     html = out.read_text()
-    assert "plotly" in html.lower() and "Design answer for" in html and "unit yield" in html
+    assert "plotly" in html.lower() and f"{SCENARIO}: 10 cm" in html and "unit yield" in html
 
 
 def test_cli_writes_the_figure_without_monte_carlo(tmp_path, capsys):

@@ -17,7 +17,7 @@ def test_figure_meta_and_title():
     assert m["array"] == "8x8" and m["n_elements"] == 64 and m["fits"]
     assert m["srnf_valid_share"] == 0.0  # the ceiling, 20 cm above the array
     assert fig.layout.title.text.startswith(f"Predicted to meet: {m['predicted']} ")
-    assert "a prediction" in fig.layout.title.text
+    assert "(a prediction)" in fig.layout.title.text
     # 3x3's predicted error (its paths weighed one block at a time) misses 0.15 m on part of
     # the route; 4x4 meets it
     assert m["predicted"] == "4x4"

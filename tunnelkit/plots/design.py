@@ -362,7 +362,7 @@ def design_answer_figure(report) -> go.Figure:
                 x=x[: med.size],
                 y=_finite(100 * med),
                 mode="lines",
-                name=f"tracker median error ({pooled})",
+                name=f"{r.array} tracker median ({pooled})",
                 line={"color": color, "width": 2.5},
                 hovertemplate=(
                     f"{r.array} ({r.status}): median over {r.runs} drives<br>"
@@ -376,8 +376,8 @@ def design_answer_figure(report) -> go.Figure:
                 col=1,
             )
         for name, y, dash in (
-            ("PEB (bound)", r.peb_m, "dot"),
-            ("predicted (not a bound)", r.predicted_m, "dash"),
+            (f"{r.array} PEB (bound)", r.peb_m, "dot"),
+            (f"{r.array} predicted (not a bound)", r.predicted_m, "dash"),
         ):
             if y is not None:
                 fig.add_scatter(
@@ -458,15 +458,15 @@ def design_answer_figure(report) -> go.Figure:
     fig.update_xaxes(title_text="vehicle position x along the tunnel [m]", row=1, col=1)
     fig.update_xaxes(type="category", title_text="array", row=2, col=1)
     title = (
-        f"Design answer for {report.scenario}: target {_cm_text(target)} on "
-        f"{100 * share:g} % of the settled route, required unit yield {_pct(required)}"
+        f"{report.scenario}: {_cm_text(target)} on {100 * share:g} % of the route, "
+        f"yield {_pct(required)}"
     )
     fig.update_layout(
         title={
             "text": title,
             "subtitle": {
-                "text": "solid: tracker's median error (Monte-Carlo); dotted: PEB, a lower bound; "
-                "dashed: first-order prediction, not a bound"
+                "text": f"target on the settled route, required unit yield {_pct(required)}; "
+                "solid: tracker's median error; dotted: PEB (a bound); dashed: prediction"
             },
             "x": 0.01,
             "xanchor": "left",

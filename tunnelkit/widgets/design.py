@@ -125,8 +125,8 @@ def design_figure(
         )
     else:
         title = (
-            f"Predicted to meet: {rec.label} — smallest square URA with predicted error ≤ "
-            f"{100 * target:g} cm on {100 * share:.0f} % (a prediction: the button decides)"
+            f"Predicted to meet: {rec.label} — smallest square URA predicted ≤ "
+            f"{100 * target:g} cm on {100 * share:.0f} % (a prediction)"
         )
     sub = (
         f"{spec.label}, {fc_ghz:g} GHz, {bandwidth_mhz:g} MHz, {phase_error_deg:g}°/"
