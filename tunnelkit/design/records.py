@@ -250,7 +250,8 @@ class DesignReport:
             f"unknown per unit (beside RMSE). Prediction (not a bound, decides nothing): pred, "
             f"the first-order RMS error of the tracker's fix under the impairments. err: "
             f"Monte-Carlo 2-D error, {q} its {s['share']:g}-quantile pooled over units on the "
-            f"settled route (CI: bootstrap over units), route {q} on the whole route; unit "
+            f"settled route (CI: bootstrap over units, information only: it covers about 86 % "
+            f"at 20 units, docs/results/design-units.md), route {q} on the whole route; unit "
             f"yield: the share of units whose own {q} meets the target (Wilson interval)."
         )
         lines.append(_CHANNEL_TEXT[s.get("channel", "image")])
