@@ -77,7 +77,7 @@ def test_figure_of_a_monte_carlo_sweep(report):
         assert med.legendgroup == peb.legendgroup == pred.legendgroup == r.array
         assert med.line.dash is None and "median" in med.name
         assert f"{100 * r.error_p90_m:.3g} cm" in med.name  # the pooled p90 in the legend
-        assert peb.line.dash == "dot" and peb.name == f"{r.array} PEB (bound)"
+        assert peb.line.dash == "dot" and peb.name == f"{r.array} PEB (snapshot bound)"
         assert pred.line.dash == "dash" and pred.name == f"{r.array} predicted (not a bound)"
         np.testing.assert_allclose(_cm(med.y), r.error_median_epoch_m, rtol=1e-12)
         np.testing.assert_allclose(_cm(peb.y), r.peb_m, rtol=1e-12)
@@ -103,7 +103,7 @@ def test_bounds_only_report_shows_bounds_and_predictions(bounds_only):
     fig = design_answer_figure(bounds_only)
     top = _top(fig)
     assert [t.name for t in top] == [
-        f"{a} {k}" for a in ARRAYS for k in ("PEB (bound)", "predicted (not a bound)")
+        f"{a} {k}" for a in ARRAYS for k in ("PEB (snapshot bound)", "predicted (not a bound)")
     ] + ["target 10 cm"]
     assert len({t.name for t in top}) == len(top)  # no legend entry repeated
     assert not any("median" in (t.name or "") for t in fig.data)
@@ -136,7 +136,7 @@ def test_cli_writes_the_figure_without_monte_carlo(tmp_path, capsys):
     argv += ["--settle", "0.5"]
     assert main([*argv, "--plot", str(out)]) == 0
     assert "figure written to" in capsys.readouterr().err
-    assert "PEB (bound)" in out.read_text()
+    assert "PEB (snapshot bound)" in out.read_text()
 
 
 def test_cli_missing_directory_names_plot(tmp_path, capsys):

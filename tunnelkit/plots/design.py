@@ -314,7 +314,7 @@ def design_answer_figure(report) -> go.Figure:
     Top, per array along the route (log, cm): the tracker's median 2-D error per epoch over the
     Monte-Carlo drives (solid; its legend entry states the pooled ``share``-quantile over the
     settled route with its bootstrap 95 % interval), the ideal snapshot PEB (dotted, a lower
-    bound) and the first-order predicted error under the impairments (dashed, a prediction, not a
+    bound of one epoch's fix, which the tracker, fusing epochs, may go below) and the first-order predicted error under the impairments (dashed, a prediction, not a
     bound), and the target. Rows without Monte-Carlo (``--units 0``) show the PEB and the
     prediction only. Bottom: the unit yield per array (the share of manufactured units that meet
     the target on their own) with its Wilson 95 % interval, and the required yield; the verdict
@@ -337,7 +337,7 @@ def design_answer_figure(report) -> go.Figure:
         row_heights=[0.64, 0.36],
         vertical_spacing=0.14,
         subplot_titles=(
-            "error along the route: tracker (median over drives), PEB (bound), prediction",
+            "error along the route: tracker (median over drives), snapshot PEB, prediction",
             "unit yield: share of units meeting the target on their own (Wilson 95 % interval)",
         ),
     )
@@ -376,7 +376,7 @@ def design_answer_figure(report) -> go.Figure:
                 col=1,
             )
         for name, y, dash in (
-            (f"{r.array} PEB (bound)", r.peb_m, "dot"),
+            (f"{r.array} PEB (snapshot bound)", r.peb_m, "dot"),
             (f"{r.array} predicted (not a bound)", r.predicted_m, "dash"),
         ):
             if y is not None:
@@ -466,7 +466,7 @@ def design_answer_figure(report) -> go.Figure:
             "text": title,
             "subtitle": {
                 "text": f"target on the settled route, required unit yield {_pct(required)}; "
-                "solid: tracker's median error; dotted: PEB (a bound); dashed: prediction"
+                "solid: tracker's median error; dotted: PEB (one epoch's bound); dashed: prediction"
             },
             "x": 0.01,
             "xanchor": "left",
