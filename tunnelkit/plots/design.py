@@ -465,8 +465,8 @@ def design_answer_figure(report) -> go.Figure:
         title={
             "text": title,
             "subtitle": {
-                "text": f"target on the settled route, required unit yield {_pct(required)}; "
-                "solid: tracker's median error; dotted: PEB (one epoch's bound); dashed: prediction"
+                "text": "solid: tracker's median; dotted: PEB (one epoch's bound); dashed: "
+                "prediction (not a bound)"
             },
             "x": 0.01,
             "xanchor": "left",
