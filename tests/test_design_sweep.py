@@ -590,3 +590,32 @@ def test_dead_reckoning_drops_the_radio_and_leaves_the_tracker_run_unchanged(set
     )
     with pytest.raises(TypeError, match="dead_reckoning"):
         sweep_montecarlo(setup, ["4x4"], 2, 0, dead_reckoning="yes", **kw)
+
+
+def test_unit_pcrlb_is_the_drive_pcrlb_without_calibration_and_grows_with_it(setup):
+    """Brute force: with the calibration known (or absent) the covariance recursion of
+    ``unit_pcrlb`` is Tichavsky's recursion of ``drive_pcrlb`` on the same position
+    information (an ideal model: ``cov`` is the reported ``crlb``); carrying the calibration as
+    an unknown with its prior never lowers it, more prior spread never lowers it, and a tiny
+    spread gives the known-calibration bound back."""
+    from dataclasses import replace
+
+    from tunnelkit.design.achievable import DesignImpairments, path_error_model
+    from tunnelkit.design.drivebound import unit_pcrlb
+
+    spec = "4x4"
+    g = route_geometry(setup, spec)
+    m = path_error_model(setup, spec, impairments=DesignImpairments(phase_error_deg=2.0))
+    ref = drive_pcrlb(setup, position_information(m, g))
+    known = unit_pcrlb(setup, m, g, calibration=False)
+    np.testing.assert_allclose(known, ref, rtol=1e-9)
+    pooled = unit_pcrlb(setup, m, g)
+    assert np.all(pooled >= known * (1 - 1e-12)) and np.any(pooled > known * 1.01)
+    wider = unit_pcrlb(setup, replace(m, phase_sigma_rad=2 * m.phase_sigma_rad), g)
+    assert np.all(wider >= pooled * (1 - 1e-12))
+    tiny = unit_pcrlb(setup, replace(m, phase_sigma_rad=1e-9), g)
+    np.testing.assert_allclose(tiny, known, rtol=1e-9)
+    fine = unit_pcrlb(setup, m, g, sigma_p0=0.1)
+    assert fine[0] < pooled[0]  # the entry fix is the bound's prior
+    with pytest.raises(TypeError, match="calibration"):
+        unit_pcrlb(setup, m, g, calibration="yes")
