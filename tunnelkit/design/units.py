@@ -2,8 +2,9 @@
 
 A phase or gain calibration error is one fixed draw per manufactured array, not noise: every
 drive of one unit sees the same draw. The design's Monte-Carlo therefore runs ``units`` units
-of ``drives_per_unit`` drives each: unit ``u`` draws its calibration error from its own
-generator (:func:`unit_rngs`, a stream apart from the drives'), its drives ``d`` take the
+of ``drives_per_unit`` drives each: unit ``u`` draws its calibration error from its own seed
+(:func:`unit_seeds`, a stream apart from the drives'; every drive of the unit makes its own
+generator from it, so all draw the same error), its drives ``d`` take the
 drive streams ``u * drives_per_unit + d`` (:func:`drive_streams`), so a sweep extended by more
 units reproduces the units it already ran.
 
