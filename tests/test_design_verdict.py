@@ -393,16 +393,6 @@ def test_bad_impairments_name_the_field(setup, kw, match):
         design.design_sweep(setup, ["4x4"], **kw)
 
 
-def test_implied_quantile_matches_sampled_circular_gaussians():
-    rng = np.random.default_rng(5)
-    b = np.r_[np.full(895, 0.01), np.full(105, 0.2)]  # the bound's own p90 is 0.2 m
-    e = b * np.sqrt(rng.exponential(size=(400, b.size)))  # |e|^2 ~ b^2 Exp(1): circular Gaussian
-    q = v.implied_quantile(b, 0.9)
-    assert abs(np.mean(e <= q) - 0.9) < 0.005
-    assert q < 0.1 < v.share_quantile(b, 0.9)  # a bound's own quantile is not the error's
-    assert v.implied_quantile(np.r_[b[:-200], np.full(200, np.inf)], 0.9) == np.inf
-
-
 def test_share_quantile_agrees_with_the_met_share():
     x = np.r_[np.full(90, 0.05), np.full(10, 0.5)]
     assert v.share_quantile(x, 0.9) == 0.05 and np.mean(x <= 0.05) == 0.9

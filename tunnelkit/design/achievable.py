@@ -375,13 +375,11 @@ def path_error_model(
 
 
 def _ranges(x: np.ndarray, hit: np.ndarray) -> str:
-    """``"x = 80.3..100.2 m, 120.0 m"``: the runs of consecutive epochs where ``hit``."""
-    k = np.flatnonzero(hit)
-    runs = np.split(k, np.flatnonzero(np.diff(k) > 1) + 1) if k.size else []
-    parts = [
-        f"{x[r[0]]:.1f} m" if r.size == 1 else f"{x[r[0]]:.1f}..{x[r[-1]]:.1f} m" for r in runs
-    ]
-    return "x = " + ", ".join(parts)
+    """``"x = 80.3..100.2 m, 120.0 m"``: the runs of consecutive epochs where ``hit``, worded
+    as the report words the stretches above a target (:func:`~tunnelkit.design.records.over_target`)."""
+    from .records import over_target
+
+    return "x = " + over_target(x, np.asarray(hit, float), 0.5)
 
 
 def unresolved_reason(model: PathErrorModel, geometry: RouteGeometry, label: str) -> str:

@@ -205,16 +205,17 @@ class ArrayJob:
             # the bounds: every unit's (its calibration draw known to the bound) and the one
             # pooled over units (the draw a fixed unknown of the drive, with its prior)
             pc = unit_pcrlb(self.setup, head, g, sigma_p0=sp0, calibration=False)
-            hybrid = unit_pcrlb(self.setup, head, g, sigma_p0=sp0, calibration=True)
+            calibrated = head.phase_sigma_rad > 0 or head.gain_sigma_db > 0
+            hybrid = unit_pcrlb(self.setup, head, g, sigma_p0=sp0) if calibrated else pc
             # the prediction (not a bound): the noise and the bias of a fix weighted as the
             # tracker weighs (its reported budget, one block per path, bound mode; on the
             # channel route the extraction reports its CRLB)
-            w, pc_w = None, drive_pcrlb(self.setup, position_information(head, g), sigma_p0=sp0)
+            w = None
             if route is not None:
                 from .fastroute import tracker_weights
 
                 w = tracker_weights(route)[: self.T]
-                pc_w = drive_pcrlb(self.setup, position_information(head, g, w), sigma_p0=sp0)
+            pc_w = drive_pcrlb(self.setup, position_information(head, g, w), sigma_p0=sp0)
             drive = drive_bound(pc_w, position_bias_rms(head, g, w))
             from .learnedbound import learned_pcrlb
 

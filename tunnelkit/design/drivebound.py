@@ -305,11 +305,16 @@ def drive_pcrlb(
     sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
     sigma_p0 = positive("sigma_p0", sigma_p0)
     info = finite_array("info", info, shape=(None, 2, 2))
-    G, Qn, _ = drive_motion(setup, info.shape[0], sig_nu, sig_th)
-    Q = G @ Qn @ np.swapaxes(G, 1, 2)
-    Q += 1e-12 * np.eye(2)  # a standing vehicle: no motion noise, still a valid recursion
+    Q = _motion_noise(setup, info.shape[0], sig_nu, sig_th)
     B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
     return pcrlb_position_rmse(B)
+
+
+def _motion_noise(setup: DesignSetup, T: int, sig_nu: float, sig_th: float) -> np.ndarray:
+    """The position's process noise (T, 2, 2) of JAVELIN's motion model (:func:`drive_motion`);
+    a standing vehicle has none, kept a valid recursion by 1e-12 m^2."""
+    G, Qn, _ = drive_motion(setup, T, sig_nu, sig_th)
+    return G @ Qn @ np.swapaxes(G, 1, 2) + 1e-12 * np.eye(2)
 
 
 def drive_motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
@@ -385,8 +390,7 @@ def unit_pcrlb(
             if K is not None and sig > 0
         ]
     m = sum(K.shape[-1] for K, _ in ks)
-    G, Qn, _ = drive_motion(setup, T, SIGMA_SPEED, SIGMA_HEADING)
-    Q = G @ Qn @ np.swapaxes(G, 1, 2) + 1e-12 * np.eye(2)
+    Q = _motion_noise(setup, T, SIGMA_SPEED, SIGMA_HEADING)
     Pm = np.zeros((2 + m, 2 + m))
     Pm[:2, :2] = sigma_p0**2 * np.eye(2)
     if m:

@@ -33,7 +33,6 @@ __all__ = [
     "REQUIRED_YIELD",
     "drive_streams",
     "unit_quantiles",
-    "unit_rngs",
     "unit_seeds",
     "unit_yield",
     "wilson_interval",
@@ -66,11 +65,6 @@ def unit_seeds(seed, first: int, n: int) -> list[np.random.SeedSequence]:
         np.random.SeedSequence(entropy, spawn_key=(*key, _UNIT_TAG, u))
         for u in range(first, first + n)
     ]
-
-
-def unit_rngs(seed, first: int, n: int) -> list[np.random.Generator]:
-    """The calibration generators of units ``first .. first + n - 1`` (:func:`unit_seeds`)."""
-    return [np.random.default_rng(s) for s in unit_seeds(seed, first, n)]
 
 
 def drive_streams(first: int, units: int, drives_per_unit: int) -> list[int]:

@@ -29,8 +29,7 @@ bound-driven or the channel Monte-Carlo.
   upper end is below it, ``"undecided"`` between, or with fewer than :data:`MIN_RUNS_CI`
   units; ``"bound only"`` with no Monte-Carlo. Bounds and predictions never decide and never
   skip a Monte-Carlo: a bound of the RMSE is not a bound of a quantile, and a prediction can be
-  beaten by the tracker (:func:`implied_quantile` remains, as the quantile an estimator that
-  attains a given RMS at every epoch would have).
+  beaten by the tracker.
 * **The recommendation** (:func:`recommend`): the smallest candidate (fewest elements, then
   aperture) that is met; with bounds only, none.
 """
@@ -39,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import bound_array, real_array
+from .._checks import real_array
 from .._validate import (
     finite_array,
     integer,
@@ -59,7 +58,6 @@ __all__ = [
     "bootstrap_quantile_ci",
     "counted_epochs",
     "gate",
-    "implied_quantile",
     "judge",
     "recommend",
     "share_quantile",
@@ -115,36 +113,6 @@ def share_quantile(values, share: float) -> float:
         raise ValueError("values: errors and bounds are not negative")
     v = np.where(np.isfinite(v), v, np.inf)
     return float(np.quantile(v, share, method="inverted_cdf"))
-
-
-def implied_quantile(bounds, share: float) -> float:
-    """The ``share``-quantile of the 2-D error of an estimator that attains ``bounds`` (T,) [m]
-    at every epoch: each epoch's error a circular Gaussian with ``E|e|^2 = bound^2``, so
-    ``P(|e| <= x) = 1 - exp(-x^2 / bound^2)``, pooled over the epochs (a non-finite bound is an
-    epoch never met). Solved by bisection on the pooled distribution function."""
-    share = probability("share", share, open_interval=False)
-    bound_array("bounds", bounds, ndim=1)
-    b = np.asarray(bounds, float).ravel()
-    if not b.size:
-        raise ValueError("bounds: expected at least one value")
-    if np.any(b < 0):
-        raise ValueError("bounds: a bound is not negative")
-    fin = np.isfinite(b)
-    if fin.mean() < share:
-        return float("inf")
-    bf = b[fin]
-
-    def cdf(x: float) -> float:
-        with np.errstate(divide="ignore"):
-            return float(np.sum(1.0 - np.exp(-(x**2) / np.where(bf > 0, bf**2, 1e-300)))) / b.size
-
-    lo, hi = 0.0, max(float(bf.max()), 1e-12)
-    while cdf(hi) < share:
-        hi *= 2.0
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if cdf(mid) < share else (lo, mid)
-    return hi
 
 
 def bootstrap_quantile_ci(
