@@ -128,7 +128,7 @@ def table(reps: dict, costs: dict) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="italiano2026-straight")
-    ap.add_argument("--arrays", nargs="+", default=["4x4", "8x8", "16x16"])
+    ap.add_argument("--arrays", nargs="+", default=["4x4", "8x8", "10x10"])
     ap.add_argument("--channels", nargs="+", default=["image", "sionna"])
     ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--seed", type=int, default=HELD_OUT_SEED)

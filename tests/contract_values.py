@@ -384,6 +384,7 @@ def _baselines():
     e = np.abs(rng.standard_normal(50))
     verdict.share_quantile(e, 0.9)
     verdict.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
+    verdict.cluster_quantile_ci(e[None, :].repeat(3, 0), 0.9)
     verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
     verdict.gate(e, np.ones(50, bool), "achievable")
     verdict.judge(0.1, units=20, yield_=0.9, ci=[0.7, 0.97], cap=200)

@@ -57,7 +57,8 @@ INPUTS = {"scenario", "arrays", "fc", "bandwidth", "target", "share", "criterion
 
 
 def test_json_answers_the_28ghz_question(capsys):
-    argv = ["design", "example-rectangular-28ghz", "--arrays", "2x2", "3x3", "4x4", "8x8"]
+    argv = ["design", "example-rectangular-28ghz", "--ideal", "--arrays", "2x2", "3x3", "4x4"]
+    argv += ["8x8"]
     assert main([*argv, "--target", "0.15", "--format", "json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert set(out) == {"scenario", "inputs", "criterion", "arrays", "recommendation", "warnings"}
@@ -65,6 +66,7 @@ def test_json_answers_the_28ghz_question(capsys):
     assert INPUTS | {"seed", "units", "mode", "eps_phi", "spacing_wl"} <= set(out["inputs"])
     assert {"drives_per_unit", "required_yield", "max_units", "settle_s"} <= set(out["inputs"])
     assert out["inputs"]["impairments"]["phase_error_deg"] == 0.0
+    assert out["inputs"]["impairments_preset"] == "ideal"
     assert [a["array"] for a in out["arrays"]] == ["2x2", "3x3", "4x4", "8x8"]
     for a in out["arrays"]:
         assert set(a) == KEYS
@@ -93,13 +95,16 @@ def test_json_answers_the_28ghz_question(capsys):
 
 
 def test_wideband_model_drops_the_wideband_bias_and_is_an_input(capsys):
-    argv = ["design", "example-rectangular-28ghz", "--arrays", "8x8", "--format", "json"]
+    argv = ["design", "example-rectangular-28ghz", "--ideal", "--arrays", "8x8"]
+    argv += ["--format", "json"]
     out = {}
-    for extra in ([], ["--wideband"], ["--wideband", "--wideband-model"]):
+    for extra in ([], ["--wideband", "--no-wideband-model"], ["--wideband"]):
         assert main([*argv, *extra]) == 0
         out[" ".join(extra)] = json.loads(capsys.readouterr().out)
+    out["--wideband --wideband-model"] = out.pop("--wideband")  # the model follows the channel
     imp = out["--wideband --wideband-model"]["inputs"]["impairments"]
     assert imp["spatial_wideband"] is True and imp["wideband_model"] is True
+    out["--wideband"] = out.pop("--wideband --no-wideband-model")
     assert out["--wideband"]["inputs"]["impairments"]["wideband_model"] is False
     ach = {k: v["arrays"][0]["predicted_p90_m"] for k, v in out.items()}
     peb = out[""]["arrays"][0]["peb_p90_m"]
@@ -110,8 +115,9 @@ def test_wideband_model_drops_the_wideband_bias_and_is_an_input(capsys):
 
 
 def test_srnf_criterion_keeps_the_gate(capsys):
-    argv = ["design", "example-rectangular-28ghz", "--arrays", "2x2", "3x3", "4x4", "8x8"]
-    assert main([*argv, "--target", "0.15", "--criterion", "srnf", "--format", "json"]) == 0
+    argv = ["design", "example-rectangular-28ghz", "--ideal", "--arrays", "2x2", "3x3", "4x4"]
+    argv += ["8x8", "--target", "0.15", "--criterion", "srnf", "--format", "json"]
+    assert main(argv) == 0
     out = json.loads(capsys.readouterr().out)
     by = {a["array"]: a for a in out["arrays"]}
     # SR-NF breaks on the ceiling path from 4x4 on: the gate fails those epochs
@@ -136,7 +142,7 @@ def test_table_and_overrides(capsys):
         (["--arrays", "64x64"], "arrays: the 64x64 array"),
         (["--mount-height", "9"], "mount_height: 9 m puts the base-station mount"),
         (["--share", "1.5"], "share"),
-        (["--wideband-model"], "wideband_model: the estimator models the spatial-wideband"),
+        (["--ideal", "--wideband-model"], "wideband_model: the estimator models the spatial-"),
     ],
 )
 def test_bad_input_names_the_parameter(capsys, extra, message):

@@ -122,7 +122,7 @@ def test_confirmation_reruns_on_the_channel_route_and_decides():
     route decided, and the bound route's answer stays beside it."""
     setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
     kw = {"target": 1.0, "units": 2, "max_units": 2, "drives_per_unit": 1, "settle": 0.0}
-    rep = design.design_sweep(setup, ["4x4"], n_epochs=4, seed=3, **kw)
+    rep = design.design_sweep(setup, ["4x4"], n_epochs=4, seed=3, impairments="ideal", **kw)
     assert rep.recommendation["basis"] == "unit-yield"
     conf = design.confirm_on_channel(rep, setup)
     assert isinstance(conf, design.ConfirmedReport)

@@ -260,7 +260,7 @@ def test_the_paper_tunnels_records_ship_and_others_go_to_the_cache(tmp_path, mon
     does not ship lives in the ray-tracing cache."""
     monkeypatch.setenv(CACHE_ENV, str(tmp_path))
     setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
-    for label in ("4x4", "8x8", "16x16"):
+    for label in ("4x4", "8x8", "10x10"):
         p = traced.design_errors_path(setup, label)
         assert p.parent.name == "design" and p.is_file()
         rec = traced.design_errors(setup, label, measure=False)  # provenance checked

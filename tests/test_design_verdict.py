@@ -409,7 +409,7 @@ def test_no_candidate_left_is_no_recommendation_not_an_error():
 def test_the_report_warns_of_valid_but_implausible_inputs(setup):
     """A target of half the tunnel's width, the ideal array, the spatial-wideband term off where
     the band calls for it and a non-NR numerology are said, not silently accepted."""
-    rep = design.design_sweep(setup, ["4x4", "32x32"], target=4.0)
+    rep = design.design_sweep(setup, ["4x4", "32x32"], target=4.0, impairments="ideal")
     text = " ".join(rep.warnings)
     assert "target: 4 m is half the tunnel's width" in text
     assert "impairments: none" in text and "5.6 %" in text
@@ -418,6 +418,9 @@ def test_the_report_warns_of_valid_but_implausible_inputs(setup):
         setup, ["4x4"], target=0.1, impairments={"phase_error_deg": 0.5, "dmc_share": 0.05}
     )
     assert not calm.warnings[:-1] and "no Monte-Carlo" in calm.warnings[-1]
+    # the default (calibrated) set turns the wideband term on where the band calls for it
+    dflt = design.design_sweep(setup, ["4x4", "32x32"], target=0.1)
+    assert not any("the band calls for it" in w or "impairments: none" in w for w in dflt.warnings)
     fr1 = design.design_sweep(setup.variant(fc=3.5e9, bandwidth=100e6), ["4x4"], target=0.1)
     assert any("not an NR FR1 numerology" in w for w in fr1.warnings)
     j = fr1.to_json()["inputs"]

@@ -34,7 +34,7 @@ from itertools import pairwise
 import numpy as np
 
 import tunnelkit as tk
-from tunnelkit import design
+from tunnelkit import design, propagation
 from tunnelkit.design import traced
 from tunnelkit.plots.design import route_figure, size_figure
 from tunnelkit.rt.cache import CACHE_ENV
@@ -310,6 +310,11 @@ print(f"a pass at {required:.0%} needs every unit of at least {n_prove} meeting;
 #     tunnelkit design example-rectangular-28ghz --arrays 4x4 8x8 16x16 32x32 --target 0.1 \
 #         --units 20 --max-units 200 --yield 0.95 --phase-error-deg 0.5 --gain-error-db 0.2
 #
+# Without impairment options the command (and `design.design_sweep`) assumes a calibrated
+# array: 1.5° and 0.25 dB per element, what a 28 GHz array kept after calibration, and 5.6 % of
+# the power diffuse, as measured in a road tunnel (`design.preset_impairments("calibrated",
+# ...)`, sources in REFERENCES.md); `--ideal` (`impairments="ideal"`) is the optimistic case.
+#
 # Quick mode runs 4 units first, capped at 8: below 10 units every verdict is "undecided" and
 # says so. Below, the three calibration qualities of section 4:
 
@@ -361,8 +366,8 @@ design_answer_figure(answers["0.5°"]).show()
 # %% [markdown]
 # Read the yields across the three calibrations. With an ideal array every unit of every
 # candidate meets 10 cm, and the tracker's error sits within a small factor of the PEB; with
-# half a degree of phase error the errors rise by about an order of magnitude over the PEB and
-# the smallest array's yield drops; with 2° it drops further, and an array that every unit
+# half a degree of phase error (and 0.2 dB of gain error) the median error rises to several
+# times the PEB (3 to 10 times, by array) and the smallest array's yield drops; with 2° it drops further, and an array that every unit
 # passed at 0.5° loses units: **0.5° against 2° of calibration changes the yield**, and with it
 # the recommendation (printed above each table; with the full counts it is a larger array at 2°
 # than for an ideal array), never the PEB. The whole-route p90 lies above the settled one: the
@@ -446,11 +451,14 @@ print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g}")
 # unknown, where the bound knows the surfaces.
 
 # %% [markdown]
-# ## 8. The paper's tunnel, 4 × 4 to 16 × 16, and the SR-NF criterion
+# ## 8. The paper's tunnel, 4 × 4 to 10 × 10, and the SR-NF criterion
 #
 # The JAVELIN tunnel (semicircular, 10 m × 5 m, 5.9 GHz, 100 MHz), its arrays hung inside the
-# faceted ceiling. A 32 × 32 URA at 5.9 GHz is 0.8 m on a side and does not fit
-# (`setup.arrays` refuses it, naming the elements outside). Below, the bounds at 0.5° of
+# faceted ceiling. The scenario file places each array by its reference antenna (element 0, a
+# corner); the design centres every candidate on the centre of the file's array, so the paper's
+# 10 × 10 sits exactly where the file puts it. It is also the largest square array that fits
+# there: a 12 × 12 reaches through the ceiling, and a 32 × 32 (0.8 m on a side) by far
+# (`setup.arrays` refuses both, naming the elements outside). Below, the bounds at 0.5° of
 # calibration error under the SR-NF criterion (`criterion="srnf"`, an eq. 51 route): SR-NF gates,
 # the ceiling breaks it on every epoch, and no epoch of any array is left where the gated
 # prediction meets the target ("met share" 0) — the estimator's criterion, not the array's
@@ -459,7 +467,7 @@ print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g}")
 
 # %%
 paper = design.DesignSetup.from_scenario("italiano2026-straight")
-sizes = ["4x4", "8x8", "10x10", "16x16"]
+sizes = ["4x4", "8x8", "10x10"]
 sweep = design.design_sweep(
     paper, sizes, target=0.2, criterion="srnf", impairments=imps["0.5°"], units=0
 )
@@ -502,7 +510,7 @@ print(sweep.to_table())
 # %%
 os.environ.setdefault(CACHE_ENV, str(tk.build_dir("rt", "cache")))  # traces under build/
 paper_rt = design.DesignSetup.from_scenario("italiano2026-straight", channel="sionna")
-rt_sizes = ["4x4", "8x8", "16x16"]
+rt_sizes = ["4x4", "8x8", "10x10"]
 records, told = {}, {}
 for a in rt_sizes:
     records[a] = traced.design_errors(paper_rt, a, measure=False)  # shipped, provenance checked
@@ -545,7 +553,8 @@ print(
 )
 
 # %% [markdown]
-# Now the tracker itself, on both channels, on a seed the traced errors were not measured on.
+# Now the tracker itself, on both channels, on a seed the traced errors were not measured on,
+# with an ideal array on both (`impairments="ideal"`: the traced errors were measured on one).
 # The route carries no calibration draw, so a unit is one drive (`drives_per_unit=1`). Quick
 # mode runs the 4 × 4 array and one unit (its verdicts "undecided"); full mode the three arrays
 # and 10 units, the cap too: ten units that all miss decide "not met" (the upper end of 0 of 10
@@ -555,7 +564,7 @@ print(
 # same tracker, entry fix and V2X messages, so the table's "dead reckoning" line says what the
 # radio adds. The same from a shell:
 #
-#     tunnelkit design italiano2026-straight --arrays 4x4 8x8 16x16 --mode channel \
+#     tunnelkit design italiano2026-straight --arrays 4x4 8x8 10x10 --mode channel \
 #         --channel sionna --units 10 --max-units 10 --drives-per-unit 1 --seed 20261202 \
 #         --dead-reckoning
 
@@ -565,7 +574,7 @@ rt_units = tk.mc_count(10, 1)
 rt_mc = {"units": rt_units, "max_units": rt_units, "drives_per_unit": 1, "mode": "channel"}
 on = {
     ch: design.design_sweep(st, rt_arrays, target=0.2, **rt_mc, seed=20261202,
-                            dead_reckoning=ch == "sionna", progress=True)
+                            impairments="ideal", dead_reckoning=ch == "sionna", progress=True)
     for ch, st in (("image", paper), ("sionna", paper_rt))
 }  # fmt: skip
 for ch, rep in on.items():
@@ -576,11 +585,14 @@ p90 = {ch: {r.array: r.error_p90_m for r in rep.rows} for ch, rep in on.items()}
 # %% [markdown]
 # Read the two tables against the bounds printed above.
 #
-# - **Image channel**: the error is millimetres, far below 0.2 m, within a small factor of the
-#   predicted error's p90 in the same row ("pred p90"); every unit meets the target.
+# - **Image channel**: the error is millimetres (a centimetre or two on quick mode's single
+#   drive), far below 0.2 m, within a small factor of the predicted error's p90 in the same row
+#   ("pred p90"); every unit meets the target.
 # - **Ray-traced channel**: no unit of any array meets 0.2 m. The bound of the told sigmas is
-#   above the target for every array. The told sigmas fall with the array (printed above), yet
-#   the bound barely moves: the largest over the smallest is the printed factor. At these sigmas
+#   above the target for every array. The RMS errors fall with the array (printed above); the
+#   told sigmas need not, since an array whose errors repeat more from epoch to epoch is told
+#   more (the 8 × 8's azimuth errors have the largest lag-1 correlation). The bound follows the
+#   told sigmas and barely moves: the largest over the smallest is the printed factor. At these sigmas
 #   the radio adds little to the odometry, whatever the array. The bound lies below dead
 #   reckoning's: the radio adds information, too little to correct a 1 m entry fix to 0.2 m.
 #
@@ -626,7 +638,8 @@ print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {ca
 
 # %%
 fine_fix = design.design_sweep(paper_rt, rt_arrays, target=0.2, **rt_mc, seed=20261202,
-                               start_sigma=0.1, dead_reckoning=True, progress=True)  # fmt: skip
+                               impairments="ideal", start_sigma=0.1, dead_reckoning=True,
+                               progress=True)  # fmt: skip
 print(fine_fix.to_table())
 p90_fine = {r.array: r.error_p90_m for r in fine_fix.rows}
 
@@ -790,12 +803,12 @@ assert all(y == 1.0 for y in yields["ideal"].values()), yields
 assert all(yields["0.5°"][a] >= yields["2°"][a] for a in candidates), yields
 assert yields["0.5°"]["4x4"] < 1.0 and yields["2°"]["4x4"] < yields["0.5°"]["4x4"], yields
 assert any(yields["0.5°"][a] == 1.0 > yields["2°"][a] for a in candidates), yields
-# section 6's reading: ideal, the tracker within a small factor of the PEB; at 0.5 deg about an
-# order of magnitude above the PEB and within a small factor of the predicted error
+# section 6's reading: ideal, the tracker within a small factor of the PEB; at 0.5 deg several
+# times the PEB (3 to 10) and within a small factor of the predicted error
 for r in answers["ideal"].rows:
     assert r.error_median_m < 5 * r.peb_median_m, r.array
 for r in answers["0.5°"].rows:
-    assert r.error_median_m > 5 * r.peb_median_m, r.array
+    assert 3 * r.peb_median_m < r.error_median_m < 10 * r.peb_median_m, r.array
     assert r.error_median_m < 4 * r.predicted_median_m, r.array
 # bounds below the tracker (every unit's PCRLB, the hybrid bound pooled over units, the hybrid
 # never below the PCRLB); the prediction beaten on some row; with calibration error the tracker
@@ -818,20 +831,31 @@ assert all(r.srnf_valid_share_by_surface["ceiling"] == 0.0 for r in sweep.rows)
 peb_paper = [r.peb_median_m for r in sweep.rows]
 assert np.all(np.diff(peb_paper) < 0)  # PEB falls with size
 assert sweep.rows[0].srnf_valid_share >= sweep.rows[-1].srnf_valid_share
-# numbers the prose quotes: the radio (792 tones x 12 symbols), the ceiling 20 cm above the
-# mount, a 32 x 32 URA 0.8 m on a side at 5.9 GHz that does not fit, exercise 2's 4.7 and 4
+# numbers the prose quotes: the radio (792 tones x 12 symbols), the base station 20 cm under
+# the ceiling, a 32 x 32 URA 0.8 m on a side at 5.9 GHz that does not fit, exercise 2's 4.7 and 4
 assert cfg.n_tones == 792 and cfg.n_symbols == 12
-assert abs(setup.tunnel.height - setup.mounts[0].centre[2] - 0.2) < 1e-9
+file_arr = propagation.scenario_arrays(tk.scenarios.load_scenario(setup.name))[0]
+assert abs(setup.tunnel.height - file_arr.origin[2] - 0.2) < 1e-9  # the base station's point
+assert 0 < setup.mounts[0].centre[2] - file_arr.origin[2] < 0.03  # the 8x8's centre, 2 cm up
 assert abs(31 * design.parse_array("32x32").spacing(5.9e9) - 0.8) < 0.02
-try:
-    paper.arrays("32x32")
-    fits32 = True
-except ValueError:
-    fits32 = False
-assert not fits32
+fits = {}
+for a in ("10x10", "12x12", "32x32"):
+    try:
+        paper.arrays(a)
+        fits[a] = True
+    except ValueError:
+        fits[a] = False
+assert fits == {"10x10": True, "12x12": False, "32x32": False}, fits
+# the file's own 10 x 10, placed by the design, is where the scenario (and the channel) put it
+assert np.allclose(
+    paper.arrays("10x10")[0].world,
+    propagation.scenario_arrays(tk.scenarios.load_scenario("italiano2026-straight"))[0].world,
+    atol=1e-9,
+)
 assert round(28e9 / 5.9e9, 1) == 4.7 and 400e6 / 100e6 == 4
 # section 9: the told sigmas are the RMS errors at their long-run value (all four quantities,
-# records of 3 drives of seed 0); the azimuth sigma falls with the array
+# records of 3 drives of seed 0); the azimuth RMS falls with the array, the told sigma follows
+# the correlation (the array told the most has the largest lag-1 r)
 for a in rt_sizes:
     rec = records[a]
     assert rec["runs"] == 3 and rec["seed"] == 0, (a, rec["runs"], rec["seed"])
@@ -843,19 +867,22 @@ for a in rt_sizes:
                          ("delta_d", told[a].sigma_delta_d, rms[5])):  # fmt: skip
         r = min(max(corr[q]["r"], 0.0), 0.9)
         assert np.isclose(got, want * np.sqrt((1 + r) / (1 - r)), rtol=1e-9), (a, q)
-sig_phi = [told[a].sigma_phi for a in rt_sizes]
-assert all(x > y for x, y in pairwise(sig_phi)), sig_phi
-# the bound of the told sigmas: above 0.2 m for every array, barely moving with the array
-# (falling with it), below dead reckoning's; the default entry fix is 1 m
+rms_phi = [{r[0]: r for r in records[a]["rows"]}["all"][2] for a in rt_sizes]
+assert all(x > y for x, y in pairwise(rms_phi)), rms_phi
+most = max(rt_sizes, key=lambda a: told[a].sigma_phi)
+assert most == max(rt_sizes, key=lambda a: records[a]["correlation"]["phi"]["r"]), most
+# the bound of the told sigmas: above 0.2 m for every array, barely moving with the array (the
+# largest where the most is told), below dead reckoning's; the default entry fix is 1 m
 assert design.START_SIGMA_M == 1.0
 assert min(bound_rt.values()) > 0.2, bound_rt
-assert bound_ratio < 1.25 and all(x > y for x, y in pairwise(bound_rt.values())), bound_rt
+assert bound_ratio < 1.25 and max(bound_rt, key=bound_rt.get) == most, bound_rt
 assert max(bound_rt.values()) < no_radio, (bound_rt, no_radio)
 # the trackers: millimetres on the image channel, within a small factor of the predicted p90,
 # every unit meeting; above the target on the traced one, by orders of magnitude, no unit
 # meeting; there no bound, the told sigmas' posterior CRLB filed as a prediction
 for r in on["image"].rows:
-    assert r.error_p90_m < 0.01 and r.error_p90_m < 3 * r.predicted_p90_m, r.array
+    small = 0.02 if tk.quick_mode() else 0.01  # quick mode: one drive
+    assert r.error_p90_m < small and r.error_p90_m < 4 * r.predicted_p90_m, r.array
     assert r.unit_yield == 1.0 and r.drives_per_unit == 1, r.array
 for a in rt_arrays:
     assert 0.2 < p90["sionna"][a] and p90["sionna"][a] > 100 * p90["image"][a], (a, p90)

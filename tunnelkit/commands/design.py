@@ -1,6 +1,6 @@
 """``tunnelkit design SCENARIO --arrays 4x4 8x8 16x16 [--fc 28GHz] [--bandwidth 400MHz]
-[--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband] [--wideband-model]
-[--dmc-share S]
+[--ideal] [--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband]
+[--wideband-model/--no-wideband-model] [--dmc-share S]
 [--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
 [--settle S] [--workers N | --scheduler A] [--mode bound|channel]
 [--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna]
@@ -11,7 +11,7 @@ the ideal position error bound, the predicted error under the stated impairments
 prediction, not a bound), SR-NF validity per surface, and with ``--units`` the Monte-Carlo of the
 design's tracker over manufactured units (one calibration draw each, ``--drives-per-unit``
 drives): the unit yield (the share of units whose own ``share``-quantile over the settled route
-meets ``--target``, Wilson 95 % interval), the pooled quantile with a bootstrap over units, and the
+meets ``--target``, Wilson 95 % interval), the pooled quantile with its interval over units, and the
 bounds over the drive beside the tracker's RMSE. Undecided arrays get more units until decided or
 ``--max-units``; the smallest array whose yield interval reaches ``--yield`` is recommended
 (``recommendation.route`` the route that decided; ``--confirm``: the bound route's answer re-run
@@ -27,6 +27,7 @@ import argparse
 import json
 import re
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 NAME = "design"
@@ -130,7 +131,45 @@ def _html_path(param: str):
     return parse
 
 
+def _impairments(args: argparse.Namespace, setup, specs):
+    """The impairments the options ask for and their name: the calibrated set (or the ideal one,
+    ``--ideal``) with each impairment option given replacing its field."""
+    from .. import design
+
+    base = "ideal" if args.ideal else "calibrated"
+    given = {
+        k: v
+        for k, v in (
+            ("phase_error_deg", args.phase_error_deg),
+            ("gain_error_db", args.gain_error_db),
+            ("spatial_wideband", args.wideband),
+            ("wideband_model", args.wideband_model),
+            ("dmc_share", args.dmc_share),
+        )
+        if v is not None
+    }
+    if not given:
+        return base, base
+    if args.wideband is not None and args.wideband_model is None:
+        given["wideband_model"] = args.wideband  # the estimator follows the channel
+    imp = replace(design.preset_impairments(base, setup, specs), **given)
+    return imp, f"{base}, changed: {', '.join(sorted(given))}"
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    # the main options (at most 15): the question an engineer asks; the rest in advanced groups
+    geo = p.add_argument_group("advanced: array, mount and geometry")
+    imp = p.add_argument_group(
+        "advanced: impairments (the default, a calibrated array: phase 1.5 deg and gain 0.25 "
+        "dB per element, 5.6 %% of the power diffuse, the spatial-wideband term where the band "
+        "calls for it; sources in REFERENCES.md)"
+    )
+    mc = p.add_argument_group(
+        "advanced: Monte-Carlo by manufactured units (each unit one calibration draw, several "
+        "drives)"
+    )
+    rt = p.add_argument_group("advanced: routes, criterion and channel")
+    out = p.add_argument_group("advanced: progress and parallel runs")
     p.add_argument("scenario", help="preset name (tunnelkit scenarios) or a .toml path")
     p.add_argument(
         "--arrays",
@@ -138,11 +177,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=["4x4", "8x8", "16x16"],
         help="candidate arrays: N (a ULA) or NxM (a URA), e.g. 4x4 8x8 16x16",
     )
-    p.add_argument("--spacing", type=_positive("spacing"), default=0.5, help="[wavelengths] (0.5)")
+    geo.add_argument(
+        "--spacing", type=_positive("spacing"), default=0.5, help="[wavelengths] (0.5)"
+    )
     p.add_argument("--fc", type=_frequency("fc"), default=None, help="carrier, e.g. 28GHz")
     p.add_argument("--bandwidth", type=_frequency("bandwidth"), default=None, help="e.g. 400MHz")
-    p.add_argument("--tilt", type=float, default=None, help="down-tilt of every array [deg]")
-    p.add_argument(
+    geo.add_argument("--tilt", type=float, default=None, help="down-tilt of every array [deg]")
+    geo.add_argument(
         "--mount-height", type=float, default=None, help="height of the arrays' centre [m]"
     )
     p.add_argument(
@@ -154,52 +195,54 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=0.9,
         help="share of the settled route on which the error must meet the target (0.9)",
     )
-    imp = p.add_argument_group(
-        "impairments (the predicted error and the Monte-Carlo; default none: the ideal, optimistic array)"
+    p.add_argument(
+        "--ideal",
+        action="store_true",
+        help="start from the ideal array and eq. 1's channel (no impairment: the optimistic "
+        "case) instead of the calibrated one",
     )
-    imp.add_argument(
+    p.add_argument(
         "--phase-error-deg",
         type=_level("phase_error_deg"),
-        default=0.0,
-        help="per-element phase calibration error, standard deviation [deg] (0)",
+        default=None,
+        help="per-element phase calibration error, standard deviation [deg] (1.5; --ideal 0)",
     )
-    imp.add_argument(
+    p.add_argument(
         "--gain-error-db",
         type=_level("gain_error_db"),
-        default=0.0,
-        help="per-element gain calibration error, standard deviation [dB] (0)",
+        default=None,
+        help="per-element gain calibration error, standard deviation [dB] (0.25; --ideal 0)",
     )
     imp.add_argument(
         "--wideband",
         action=argparse.BooleanOptionalAction,
-        default=False,
-        help="the spatial-wideband term (delay across the aperture) in the channel (off)",
+        default=None,
+        help="the spatial-wideband term (delay across the aperture) in the channel (on where "
+        "the band's delay across the largest array exceeds 0.1 cycle; --ideal off)",
     )
     imp.add_argument(
         "--wideband-model",
         action=argparse.BooleanOptionalAction,
-        default=False,
+        default=None,
         help="the estimator models the spatial-wideband term (ML with the per-element delay), so "
-        "it leaves no bias; needs --wideband (off: the estimator fits eq. 1)",
-    )
-    imp.add_argument(
-        "--dmc-share",
-        type=_level("dmc_share", 1.0),
-        default=0.0,
-        help="dense diffuse multipath: share of the received power, in [0, 1) (0)",
+        "it leaves no bias; needs --wideband (default: as --wideband; --no-wideband-model: the "
+        "estimator fits eq. 1 and carries the term's bias)",
     )
     p.add_argument(
+        "--dmc-share",
+        type=_level("dmc_share", 1.0),
+        default=None,
+        help="dense diffuse multipath: share of the received power, in [0, 1) (0.056; --ideal 0)",
+    )
+    rt.add_argument(
         "--criterion",
         choices=["achievable", "srnf"],
         default="achievable",
         help="achievable: the design's VUE-curvature tracker, SR-NF as information (default); "
         "srnf: an eq. 51 estimator, SR-NF validity a gate",
     )
-    p.add_argument("--eps", type=_positive("eps"), default=0.15, help="eps_phi [rad] (0.15)")
-    mc = p.add_argument_group(
-        "Monte-Carlo by manufactured units (each unit one calibration draw, several drives)"
-    )
-    mc.add_argument(
+    rt.add_argument("--eps", type=_positive("eps"), default=0.15, help="eps_phi [rad] (0.15)")
+    p.add_argument(
         "--units",
         "--runs",
         dest="units",
@@ -214,7 +257,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=2,
         help="drives per unit (2): a unit's own quantile pools its drives",
     )
-    mc.add_argument(
+    p.add_argument(
         "--yield",
         dest="required_yield",
         type=_share("yield"),
@@ -235,20 +278,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="settle window [s]: the epochs this long after the start (the tracker's start-up "
         "from the entry fix) are left out of the settled route (1)",
     )
-    p.add_argument(
+    rt.add_argument(
         "--mode",
         choices=["bound", "channel"],
         default="bound",
         help="Monte-Carlo measurements: drawn from the error model (bound, fast) or "
         "synthesised and extracted (channel)",
     )
-    p.add_argument(
+    rt.add_argument(
         "--confirm",
         action="store_true",
         help="re-run the recommended array (and the smaller ones left undecided) on the channel "
         "route with the same units and seed, and take the recommendation from it (bound mode)",
     )
-    p.add_argument(
+    rt.add_argument(
         "--confirm-units",
         "--confirm-runs",
         dest="confirm_units",
@@ -257,7 +300,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="units per array of the --confirm re-run (default: --units); the channel route "
         "costs minutes per drive, the bound route seconds",
     )
-    p.add_argument(
+    rt.add_argument(
         "--channel",
         choices=["image", "sionna"],
         default="image",
@@ -266,18 +309,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "measurements pass a geometry pre-filter and the tracker is told the array's errors "
         "measured on that channel, not the reported CRLB; no impairments)",
     )
-    p.add_argument(
+    mc.add_argument(
         "--n-epochs", type=_count("n_epochs", 1), default=None, help="first N epochs of the route"
     )
     p.add_argument("--seed", type=_count("seed", 0), default=0, help="Monte-Carlo seed (0)")
-    p.add_argument(
+    mc.add_argument(
         "--start-sigma",
         type=_positive("start_sigma"),
         default=None,
         help="the entry fix's standard deviation per axis [m]: the tracker's start and the prior "
         "of the bounds over the drive (default 1, an open-sky fix)",
     )
-    p.add_argument(
+    mc.add_argument(
         "--dead-reckoning",
         action="store_true",
         help="run each drive also with every measurement dropped (the same tracker, start and "
@@ -285,8 +328,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     from .reproduce import add_parallel_arguments
 
-    add_parallel_arguments(p)
-    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_parallel_arguments(out)
+    out.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--format", choices=["table", "json"], default="table")
     p.add_argument(
         "--plot",
@@ -335,13 +378,7 @@ def main(args: argparse.Namespace) -> int:
         mount_height=args.mount_height,
         channel=args.channel,
     )
-    impairments = {
-        "phase_error_deg": args.phase_error_deg,
-        "gain_error_db": args.gain_error_db,
-        "spatial_wideband": args.wideband,
-        "wideband_model": args.wideband_model,
-        "dmc_share": args.dmc_share,
-    }
+    impairments, preset = _impairments(args, setup, specs)
     try:
         rep = design.design_sweep(
             setup,
@@ -368,6 +405,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"tunnelkit design: error: {exc}", file=sys.stderr)
         return 1
     rep.settings.update(
+        impairments_preset=preset,
         spacing_wl=args.spacing,
         tilt_deg=args.tilt,
         mount_height_m=args.mount_height,

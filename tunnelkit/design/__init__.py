@@ -57,6 +57,8 @@ from .drivebound import (
 from .errormodel import PathErrorModel
 from .fastroute import BoundRoute, bound_drive, bound_route
 from .geometry import KINDS, RouteGeometry, trace_route
+from .impairments import PRESETS as IMPAIRMENT_PRESETS
+from .impairments import preset_impairments
 from .montecarlo import (
     MODES,
     SETTLE_S,
@@ -77,6 +79,7 @@ from .verdict import (
     MIN_RUNS_CI,
     STATUSES,
     bootstrap_quantile_ci,
+    cluster_quantile_ci,
     counted_epochs,
     gate,
     judge,
@@ -86,6 +89,7 @@ from .verdict import (
 
 __all__ = [
     "CRITERIA",
+    "IMPAIRMENT_PRESETS",
     "KINDS",
     "MIN_RUNS_CI",
     "MODES",
@@ -112,6 +116,7 @@ __all__ = [
     "bootstrap_quantile_ci",
     "bound_drive",
     "bound_route",
+    "cluster_quantile_ci",
     "confirm_on_channel",
     "confirmation_candidates",
     "counted_epochs",
@@ -129,6 +134,7 @@ __all__ = [
     "path_error_model",
     "position_bias_rms",
     "position_information",
+    "preset_impairments",
     "recommend",
     "route_bounds",
     "route_geometry",

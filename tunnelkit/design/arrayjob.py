@@ -228,9 +228,15 @@ class ArrayJob:
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
             crlb = _median_sigmas(m)
-        if crlb is None:
+        if crlb is None:  # the paths the array resolves (an unresolved one is a gap)
             pb = path_bounds(self.setup, spec)
-            crlb = {k: float(np.median(pb[k])) for k in ("d", "direction", "kappa")}
+            ok = np.all([np.isfinite(pb[k]) for k in ("d", "direction", "kappa")], axis=0)
+            if not ok.any():
+                raise ValueError(
+                    f"arrays: the {spec.label} array resolves no path anywhere on the route (its "
+                    "per-path CRLB is infinite at every epoch); choose a larger array"
+                )
+            crlb = {k: float(np.median(pb[k][ok])) for k in ("d", "direction", "kappa")}
         planes = design_planes(self.setup) if self.vues == "known" else None
         design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
         imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired

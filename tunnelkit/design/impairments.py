@@ -1,21 +1,66 @@
 """The impairments a design carries: :class:`DesignImpairments` (per-element calibration error,
 the spatial-wideband term, dense diffuse multipath), as the design's error model
-(:func:`tunnelkit.design.achievable.path_error_model`) and the channel route take them."""
+(:func:`tunnelkit.design.achievable.path_error_model`) and the channel route take them, and the
+two named sets a design starts from (:func:`preset_impairments`):
+
+* ``"calibrated"`` (the default of :func:`tunnelkit.design.design_sweep` and of
+  ``tunnelkit design``): a manufactured array after calibration and a tunnel's measured diffuse
+  power. Per-element phase and gain errors of 1.5 deg and 0.25 dB RMS, what a 28 GHz, 64-element
+  phased-array receiver kept after calibration by code-modulated embedded test, checked against a
+  network analyser over its 64 elements and 64 phase settings
+  (:data:`CALIBRATED_PHASE_ERROR_DEG`, :data:`CALIBRATED_GAIN_ERROR_DB`); 5.6 % of the received
+  power diffuse, the mean a 5.9 GHz V2V campaign measured in a road tunnel with LoS
+  (:data:`MEASURED_DIFFUSE_SHARE`; the project's ray tracer gives about 1.1 % on concrete); the
+  spatial-wideband term in the channel, and modelled by the estimator, where the band's delay
+  across the largest candidate spans more than :data:`WIDEBAND_CYCLES` of a cycle (sources in
+  REFERENCES.md).
+* ``"ideal"``: eq. 1's channel and a perfect array, the optimistic case.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .._validate import boolean, nonnegative, positive
+from .._validate import boolean, nonnegative, positive, sequence
 from ..channel import DiffuseSpec, Impairments
+from ..constants import C
+from .setup import ArraySpec, DesignSetup, parse_array
 
-__all__ = ["MAX_GAIN_ERROR_DB", "MAX_PHASE_ERROR_DEG", "DesignImpairments"]
+__all__ = [
+    "CALIBRATED_GAIN_ERROR_DB",
+    "CALIBRATED_PHASE_ERROR_DEG",
+    "MAX_GAIN_ERROR_DB",
+    "MAX_PHASE_ERROR_DEG",
+    "MEASURED_DIFFUSE_SHARE",
+    "PRESETS",
+    "WIDEBAND_CYCLES",
+    "DesignImpairments",
+    "preset_impairments",
+    "wideband_cycles",
+]
 
 _DMC_SPATIAL = ("white", "per-surface")
 #: the largest per-element phase error [deg, standard deviation] a calibrated array has
 MAX_PHASE_ERROR_DEG = 45.0
 #: the largest per-element gain error [dB, standard deviation] a calibrated array has
 MAX_GAIN_ERROR_DB = 6.0
+#: per-element phase error [deg RMS] left after calibration: a 28 GHz, 64-element phased-array
+#: receiver calibrated by hierarchical code-modulated embedded test, against a network analyser
+#: over 64 elements and 64 phase settings (REFERENCES.md)
+CALIBRATED_PHASE_ERROR_DEG = 1.5
+#: per-element gain error [dB RMS] left after calibration, the same array
+CALIBRATED_GAIN_ERROR_DB = 0.25
+#: the diffuse share of the received power measured in a road tunnel at 5.9 GHz (mean, with LoS;
+#: "Measurement and diffuse multipath analysis of V2V propagation channel at 5.9 GHz in tunnel
+#: area", REFERENCES.md) against about 1.1 % from the project's ray tracer on concrete
+MEASURED_DIFFUSE_SHARE = 0.056
+#: the band's delay across the largest aperture [cycles of the bandwidth] above which the
+#: spatial-wideband term matters (bandwidth x aperture / c; the term's phase error across the
+#: band reaches about this share of a cycle): the calibrated set turns it on, the report warns
+#: when it is off
+WIDEBAND_CYCLES = 0.1
+#: the named impairment sets (module docstring)
+PRESETS = ("calibrated", "ideal")
 
 
 @dataclass(frozen=True)
@@ -95,3 +140,33 @@ class DesignImpairments:
             spatial_wideband=bool(self.spatial_wideband),
             dmc=self.dmc,
         )
+
+
+def wideband_cycles(setup: DesignSetup, specs) -> float:
+    """The band's delay across the largest of ``specs`` (candidate arrays, as
+    :func:`~tunnelkit.design.setup.parse_array` reads them) on ``setup``, in cycles of the
+    bandwidth: ``bandwidth x aperture / c``."""
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
+    if isinstance(specs, str | ArraySpec):
+        specs = [specs]
+    specs = [parse_array(s) for s in sequence("specs", specs)]
+    return max(s.aperture(setup.fc) for s in specs) * setup.config.bandwidth / C
+
+
+def preset_impairments(name: str, setup, specs) -> DesignImpairments:
+    """The named impairment set ``name`` (:data:`PRESETS`, module docstring) for the candidates
+    ``specs`` on ``setup``: the spatial-wideband term of ``"calibrated"`` depends on the band and
+    the largest aperture (:func:`wideband_cycles`)."""
+    if not isinstance(name, str) or name not in PRESETS:
+        raise ValueError(f"name: expected one of {', '.join(PRESETS)}, got {name!r}")
+    wide = wideband_cycles(setup, specs) > WIDEBAND_CYCLES
+    if name == "ideal":
+        return DesignImpairments()
+    return DesignImpairments(
+        phase_error_deg=CALIBRATED_PHASE_ERROR_DEG,
+        gain_error_db=CALIBRATED_GAIN_ERROR_DB,
+        spatial_wideband=wide,
+        dmc_share=MEASURED_DIFFUSE_SHARE,
+        wideband_model=wide,
+    )

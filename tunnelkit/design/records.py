@@ -51,7 +51,7 @@ class DesignRow:
     calibration draw each) of ``drives_per_unit`` drives (``runs`` in all): ``unit_yield`` the
     share of units whose own error quantile meets the target, ``unit_yield_ci95`` its Wilson
     interval, ``unit_p90_m`` the units' quantiles' [min, median, max]; ``error_p90_m`` the
-    quantile pooled over units with ``error_p90_ci95_m`` a bootstrap over units.
+    quantile pooled over units with ``error_p90_ci95_m`` Woodruff's interval over units.
 
     **Bounds** (lower bounds of what they are set beside, :mod:`tunnelkit.design.drivebound`):
     ``peb_*`` the snapshot PEB (ideal model, one epoch); ``pcrlb_rms_m`` every unit's posterior
@@ -216,7 +216,8 @@ class DesignReport:
             f"{s['bandwidth'] / 1e6:g} MHz ({s['n_rb']} RB at {s['scs'] / 1e3:g} kHz); target {s['target']:g} m on {100 * s['share']:g} % "
             f"of the settled route (the epochs {st:g} s after the start, --settle), required "
             f"unit yield {100 * s['required_yield']:g} %",
-            f"impairments: phase {imp['phase_error_deg']:g} deg, gain {imp['gain_error_db']:g} "
+            f"impairments ({s.get('impairments_preset', 'custom')}): phase "
+            f"{imp['phase_error_deg']:g} deg, gain {imp['gain_error_db']:g} "
             f"dB, spatial wideband {'on' if imp['spatial_wideband'] else 'off'}, diffuse share "
             f"{imp['dmc_share']:g}; Monte-Carlo: units of {s['drives_per_unit']} drives "
             f"({s['mode']} route, {s['units']} units first, up to {s['max_units']}), seed "
@@ -251,8 +252,8 @@ class DesignReport:
             f"calibration a fixed unknown per unit (both beside RMSE). Prediction (not a bound, decides nothing): pred, "
             f"the first-order RMS error of the tracker's fix under the impairments. err: "
             f"Monte-Carlo 2-D error, {q} its {s['share']:g}-quantile pooled over units on the "
-            f"settled route (CI: bootstrap over units, information only: it covers about 86 % "
-            f"at 20 units, docs/results/design-units.md), route {q} on the whole route; unit "
+            f"settled route (CI: Woodruff's interval over units, a unit's drives one cluster; "
+            f"its coverage: docs/results/design-units.md), route {q} on the whole route; unit "
             f"yield: the share of units whose own {q} meets the target (Wilson interval)."
         )
         lines.append(_CHANNEL_TEXT[s.get("channel", "image")])

@@ -43,11 +43,19 @@ from .._validate import (
     sequence,
 )
 from ..budget import check_bytes, check_elements
-from ..constants import C
 from ..metrics import SETTLE_S
 from ..montecarlo import parallel_options
 from .achievable import DesignImpairments, achievable_bound, path_error_model
 from .bounds import route_bounds, route_geometry
+from .impairments import (
+    CALIBRATED_GAIN_ERROR_DB,
+    CALIBRATED_PHASE_ERROR_DEG,
+    MEASURED_DIFFUSE_SHARE,
+    WIDEBAND_CYCLES,
+    preset_impairments,
+    wideband_cycles,
+)
+from .impairments import PRESETS as IMPAIRMENT_PRESETS
 from .montecarlo import MODES, START_SIGMA_M, sweep_montecarlo
 from .records import DesignReport, DesignRow, over_target
 from .setup import ArraySpec, DesignSetup, parse_array
@@ -55,7 +63,7 @@ from .units import DRIVES_PER_UNIT, MAX_UNITS, REQUIRED_YIELD, unit_quantiles, u
 from .verdict import (
     CRITERIA,
     MIN_RUNS_CI,
-    bootstrap_quantile_ci,
+    cluster_quantile_ci,
     counted_epochs,
     gate,
     judge,
@@ -73,7 +81,7 @@ def smallest_meeting(
     target: float = 0.2,
     share: float = 0.9,
     criterion: str = "achievable",
-    impairments=None,
+    impairments="calibrated",
     eps_phi: float = 0.15,
     epochs=None,
 ) -> tuple[ArraySpec | None, float]:
@@ -82,7 +90,7 @@ def smallest_meeting(
 
     A prediction for the explorer, not an answer (the answer is :func:`design_sweep` with
     units): with ``criterion="achievable"`` (default) the predicted error under ``impairments``
-    (``None``: the PEB), SR-NF only information; with ``"srnf"`` (an eq. 51 estimator) an epoch
+    (as :func:`design_sweep`'s; ``"ideal"``: the PEB), SR-NF only information; with ``"srnf"`` (an eq. 51 estimator) an epoch
     where SR-NF fails counts as missed. Arrays that do not fit are skipped; ``epochs``
     subsamples the route."""
     sequence("arrays", arrays), epochs is None or finite_array("epochs", epochs, ndim=1)
@@ -90,10 +98,13 @@ def smallest_meeting(
     share = probability("share", share, open_interval=False)
     if share == 0:
         raise ValueError("share: expected a share in (0, 1], got 0")
+    if not isinstance(setup, DesignSetup):
+        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     criterion = choice("criterion", criterion, CRITERIA)
-    imp = _design_impairments(impairments)
+    specs = [parse_array(a) for a in arrays]
+    imp = _design_impairments(impairments, setup, specs) if specs else None
     best = 0.0
-    for spec in (parse_array(a) for a in arrays):
+    for spec in specs:
         try:
             g = route_geometry(setup, spec, epochs=epochs)
         except ValueError:
@@ -117,16 +128,23 @@ def _impairment_fields(imp: DesignImpairments) -> dict:
     return {k: (v if isinstance(v, (bool, str)) else float(v)) for k, v in asdict(imp).items()}
 
 
-def _design_impairments(impairments) -> DesignImpairments:
-    """``impairments`` (None, a dict of fields or a ``DesignImpairments``) as the object the
-    prediction and the error model take."""
-    if impairments is None:
-        return DesignImpairments()
+def _design_impairments(impairments, setup, specs) -> DesignImpairments:
+    """``impairments`` (a preset's name, :data:`~tunnelkit.design.impairments.PRESETS`, a dict
+    of fields or a ``DesignImpairments``) as the object the prediction and the error model
+    take."""
+    if isinstance(impairments, str):
+        if impairments not in IMPAIRMENT_PRESETS:
+            raise ValueError(
+                f"impairments: expected one of {', '.join(IMPAIRMENT_PRESETS)}, a "
+                f"design.DesignImpairments or a dict of its fields, got {impairments!r}"
+            )
+        return preset_impairments(impairments, setup, specs)
     if isinstance(impairments, dict):
         return DesignImpairments(**impairments)
     if not isinstance(impairments, DesignImpairments):
         raise TypeError(
-            f"impairments: expected a design.DesignImpairments or a dict of its fields, got "
+            f"impairments: expected 'calibrated', 'ideal', a design.DesignImpairments or a dict "
+            f"of its fields, got "
             f"{type(impairments).__name__}"
         )
     return impairments
@@ -235,9 +253,8 @@ def score_row(
     row.error_median_m = float(np.median(e))
     row.error_p90_m = share_quantile(e, share)
     row.error_p90_route_m = share_quantile(gated, share)
-    # the interval over units (whole units resampled: a unit's drives share its calibration)
-    by_unit = e.reshape(units, -1)
-    row.error_p90_ci95_m = bootstrap_quantile_ci(by_unit, share, rng, n_boot=n_boot)
+    # the interval over units (one cluster per unit: its drives share its calibration)
+    row.error_p90_ci95_m = cluster_quantile_ci(e.reshape(units, -1), share)
     sq = np.where(np.isfinite(errors[:, k]), errors[:, k], np.inf) ** 2
     row.rmse_m = float(np.sqrt(sq.mean()))
     unit_ms = sq.reshape(units, -1).mean(axis=1)
@@ -293,7 +310,7 @@ def design_sweep(
     target: float = 0.2,
     share: float = 0.9,
     criterion: str = "achievable",
-    impairments=None,
+    impairments="calibrated",
     eps_phi: float = 0.15,
     units: int = 0,
     drives_per_unit: int = DRIVES_PER_UNIT,
@@ -316,8 +333,9 @@ def design_sweep(
     ``target`` [m] on ``share`` of the settled route (the epochs at least ``settle`` [s] after
     the start, default :data:`~tunnelkit.metrics.SETTLE_S`); ``criterion`` ``"achievable"``
     (default, the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a
-    gate); ``impairments``: a ``design.DesignImpairments`` or a dict of its fields (``None``:
-    ideal). The Monte-Carlo runs manufactured units (one calibration draw each) of
+    gate); ``impairments``: ``"calibrated"`` (default: a calibrated manufactured array in a
+    tunnel's measured diffuse power, :mod:`tunnelkit.design.impairments`), ``"ideal"``, a
+    ``design.DesignImpairments`` or a dict of its fields. The Monte-Carlo runs manufactured units (one calibration draw each) of
     ``drives_per_unit`` drives on the ``mode`` route (``"bound"``: drawn from the error model;
     ``"channel"``: synthesis and extraction), seeded by ``seed``: ``units`` in the first batch
     (0: bounds and predictions only), then, for every array still undecided, as many again
@@ -362,7 +380,10 @@ def design_sweep(
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     workers, scheduler = parallel_options(workers, scheduler)
-    imp = _design_impairments(impairments)
+    traced_array = setup.channel != "image" and impairments == "calibrated"
+    if traced_array:  # the traced route's tracker is told errors measured on an ideal array
+        impairments = "ideal"
+    imp = _design_impairments(impairments, setup, specs)
     fields = _impairment_fields(imp)
     T = len(setup.trajectory)
     if n_epochs is not None and n_epochs < T:
@@ -434,6 +455,12 @@ def design_sweep(
             f"{', '.join(reused)}: the traced route's measurement noise was measured on this "
             f"seed's first drives (seed {seed}); report the sweep on another seed"
         )
+    if traced_array:
+        warnings.append(
+            "impairments: the ray-traced channel carries its own diffuse and second-order "
+            "power; the array on it is ideal (no calibration error: the traced route's tracker "
+            "is told errors measured on an ideal array)"
+        )
     warnings += _plausibility(setup, specs, target, imp)
     if criterion == "srnf" and units:
         warnings.append(
@@ -453,6 +480,7 @@ def design_sweep(
         "settle_s": settle,
         "criterion": criterion,
         "impairments": fields,
+        "impairments_preset": impairments if isinstance(impairments, str) else "custom",
         "eps_phi": eps_phi,
         "units": units,
         "drives_per_unit": drives_per_unit,
@@ -481,16 +509,8 @@ def design_sweep(
 #: road-tunnel cross-sections beyond these are valid inputs but not road tunnels (a value in cm
 #: for m, say): the report warns
 PLAUSIBLE_WIDTH_M, PLAUSIBLE_HEIGHT_M = 40.0, 15.0
-#: the diffuse share of the received power measured in a road tunnel at 5.9 GHz (mean, with LoS;
-#: "Measurement and diffuse multipath analysis of V2V propagation channel at 5.9 GHz in tunnel
-#: area", REFERENCES.md) against about 1.1 % from the project's ray tracer on concrete
-MEASURED_DIFFUSE_SHARE = 0.056
 #: NR FR1 (up to 7.125 GHz) and its SRS subcarrier spacings [Hz] (TS 38.211, numerologies 0-2)
 FR1_MAX_HZ, FR1_SCS_HZ = 7.125e9, (15e3, 30e3, 60e3)
-#: the band's delay across the largest aperture [cycles of the bandwidth] above which the report
-#: says the spatial-wideband term matters (bandwidth x aperture / c; the term's phase error
-#: across the band reaches about this share of a cycle)
-WIDEBAND_CYCLES = 0.1
 
 
 def _plausibility(setup, specs, target: float, imp) -> list[str]:
@@ -516,19 +536,20 @@ def _plausibility(setup, specs, target: float, imp) -> list[str]:
             f"the {cfg.bandwidth / 1e6:g} MHz band holds {cfg.n_rb} resource blocks of it "
             "(set the scenario's radio.scs and radio.n_rb for another numerology)"
         )
-    wide = max(s.aperture(setup.fc) for s in specs) * cfg.bandwidth / C
-    if not imp.spatial_wideband and wide > WIDEBAND_CYCLES:
+    wide = wideband_cycles(setup, specs)
+    if not imp.spatial_wideband and wide > WIDEBAND_CYCLES and setup.channel == "image":
         out.append(
             f"impairments: the spatial-wideband term is off, yet the largest aperture spans "
             f"{wide:.2g} cycles of the {cfg.bandwidth / 1e6:g} MHz band (above "
             f"{WIDEBAND_CYCLES:g}): the band calls for it (--wideband, --wideband-model)"
         )
-    if imp.ideal:
+    if imp.ideal and setup.channel == "image":
         out.append(
             "impairments: none (an ideal array and eq. 1's channel), the optimistic case; a "
             f"road-tunnel campaign at 5.9 GHz measured {100 * MEASURED_DIFFUSE_SHARE:g} % of the "
-            "received power diffuse (--dmc-share), and real arrays carry calibration errors "
-            "(--phase-error-deg, --gain-error-db)"
+            "received power diffuse, and a calibrated 28 GHz array kept "
+            f"{CALIBRATED_PHASE_ERROR_DEG:g} deg and {CALIBRATED_GAIN_ERROR_DB:g} dB per element "
+            "(the default set, without --ideal)"
         )
     return out
 

@@ -5,9 +5,12 @@ and radio.
 :class:`DesignSetup` holds the tunnel, the base-station :class:`Mount` points, the route and the
 SRS configuration, and places a candidate array on every mount.
 
-Conventions (ours): the mount point of ``[base_station]`` (plus each array's ``offset``) is the
-array's **centre**; the reference antenna ``p_0`` (element 0, a corner) sits where that puts it.
-Every element must lie inside the tunnel.
+Conventions: a scenario file's ``base_station.position`` plus an array's ``offset`` is that
+array's reference antenna ``p_0`` (element 0, a corner), everywhere (the scenario checker, the
+channel, the lessons, the design). A design's :class:`Mount` is the **centre** of the scenario's
+array, so the scenario's own array sits in the design exactly where the file puts it, and every
+candidate array is centred on that point, its reference antenna where that puts it
+(``mount_height`` moves the centre). Every element must lie inside the tunnel.
 """
 
 from __future__ import annotations
@@ -190,8 +193,8 @@ class DesignSetup:
                 f"scenario: {sc.name!r} has a 2-D tunnel; the design needs a 3-D tunnel "
                 "(semicircular, rectangular or horseshoe)"
             )
-        mounts = tuple(
-            Mount(a.name, a.origin.copy(), a.azimuth, a.elevation)
+        mounts = tuple(  # the centre of the scenario's array (module docstring)
+            Mount(a.name, a.world.mean(axis=0), a.azimuth, a.elevation)
             for a in propagation.scenario_arrays(sc)
         )
         choice("channel", channel, CHANNELS)

@@ -196,9 +196,9 @@ class SignalRoute:
             raise ValueError(
                 "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
             )
-        from ..rt.cache import RayTracedChannel
-
         if self.channel == "sionna" or self.raytraced is not None:  # channel='sionna' needs one
+            from ..rt.cache import RayTracedChannel  # the ray tracer loads only when asked for
+
             instance("raytraced", self.raytraced, RayTracedChannel)
         if self.channel == "sionna":
             if self.impairments.dmc is not None:
