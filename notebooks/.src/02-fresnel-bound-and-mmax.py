@@ -1,5 +1,5 @@
 # %% [markdown]
-# # 02 · How many antennas before a reflected path stops looking like one point? SR-NF validity and $M_{\max}$
+# # 02 · When does a reflection stop looking like one point? SR-NF validity and $M_{\max}$
 #
 # *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
 # and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
@@ -280,7 +280,7 @@ print(f"facets within 10 deg of the vertical reach {top_vertical:.2f} m above th
 #
 # For the ULA, $\|\mathbf P^\perp_{\mathbf U}\mathbf p_m\|^2 = y_m^2 (R^2 + z_u^2)/\rho^2$, so
 #
-# $$M_{\max} \le 1 + 2\sqrt{\frac{\varepsilon_\Phi\,\rho^3\, W}{\lambda\,\pi\,|W - y_u|\,(R^2 + z_u^2)}}
+# $$M_{\max} \approx 1 + 2\sqrt{\frac{\varepsilon_\Phi\,\rho^3\, W}{\lambda\,\pi\,|W - y_u|\,(R^2 + z_u^2)}}
 #   \quad\xrightarrow{\ \rho \to R\ }\quad \text{eq. 25.}$$
 #
 # (`fresnel.mmax_nonparaxial`). Compare eq. 41 as printed, $|\Delta\delta_m| \approx
