@@ -68,11 +68,11 @@ plots.paths_table_figure(evaluation.path_rows(paths), title="True paths (world f
 # $$h_{m,s}[k]=\sum_{\ell=0}^{L-1}\alpha_{\ell}\,e^{j2\pi\frac{f_c}{c}\delta_{\ell,m}}
 #   \,e^{-j2\pi s\Delta f\tau_{\ell}}\,e^{j2\pi k f^{d}_{\ell}T_{0}} \qquad (1)$$
 #
-# Section 4.2's SRS: $f_c = 5.9$ GHz, 100 MHz, comb 8, hence $N_f = 410$ tones spaced
-# $\Delta f = 240$ kHz; $N_t = 12$ symbols of $T_0 = 35.7\,\mu$s; noise $\mathcal{CN}(0, N_0)$ per
-# element. The delay $\tau_\ell = d_\ell/c + b$ carries the UE clock bias $b$ (the paper writes
-# $d = \tau/c$ for $d = c\,\tau$). Eq. 3 is a CPD: $\mathcal{H}=\sum_\ell \alpha_\ell\,
-# b^s_\ell\circ b^f_\ell \circ b^t_\ell$.
+# Section 4.2's SRS: $f_c = 5.9$ GHz, 100 MHz, comb 8, hence $N_f = 410$ tones spaced $\Delta f
+# = 240$ kHz; $N_t = 12$ symbols of $T_0 = 35.7\,\mu$s; noise $\mathcal{CN}(0, N_0)$ per element.
+# The delay $\tau_\ell = d_\ell/c + b$ carries the UE clock bias $b$ (the paper writes $d =
+# \tau/c$ for $d = c\,\tau$). Eq. 3 is a CPD: $\mathcal{H}=\sum_\ell \alpha_\ell\, b^s_\ell\circ
+# b^f_\ell \circ b^t_\ell$.
 #
 # **The clock bias, read.** The paper draws $b$ from a Gaussian "with variance 50 ns" truncated to
 # $[-100, 100]$ ns. We read a 50 ns **standard deviation**: a variance would be in ns², and 50 ns
@@ -165,9 +165,9 @@ plots.paths_table_figure(both, title=f"Paper's route, all paths and LoS + road (
 
 # %% [markdown]
 # **LoS + road**: $d$ and $v$ close to their bound, direction and $\kappa$ above theirs. **All
-# paths** (within a metre of each other): direction and $\kappa$ orders of magnitude above the
-# bound of eq. 1; in $d$, though, the LoS and the ceiling bounce sit *below* their free-factor
-# bound, which is huge (metres, printed above).
+# paths** (lengths within 1.5 m): direction and $\kappa$ orders of magnitude above the bound of
+# eq. 1; in $d$, though, the LoS and the ceiling bounce sit *below* their free-factor bound, which
+# is huge (metres, printed above).
 #
 # No bound is broken. With a free spatial factor those two paths are almost unidentifiable, so an
 # *unbiased* estimate of each delay would scatter by metres. The paper's route returns instead one
@@ -226,9 +226,8 @@ plots.efficiency_figure(eff, "los", title=f"LoS along the drive, {n_eff} snapsho
 #
 # ## 8. Estimated wave origins along the trajectory (cf. Fig. 5)
 #
-# Each near-field estimate of the paper's route at $\text{origin} + \hat\kappa\,\hat u$: with the
-# SR-NF channel, the reflection points (markings low, ceiling high); with the exact physics, the
-# VUEs, mirrored *outside* the tunnel.
+# The paper's near-field estimates at $\text{origin} + \hat\kappa\,\hat u$: with the SR-NF channel,
+# the reflection points (markings low, ceiling high); with the exact physics, the VUEs, outside.
 
 # %%
 origins, ks = {}, range(0, len(route.trajectory), 7 if tk.quick_mode() else 1)
@@ -246,9 +245,9 @@ plots.wave_origins_figure(origins, route.trajectory.position, route.arrays[0].or
 # only the VUE explains it. The explorer resizes the URA, synthesises the *exact* channel, and
 # shows the strongest road marking's TLS $\hat\kappa$ between the two candidates and its largest
 # SR-NF phase mismatch against $\varepsilon_\Phi = 0.15$ rad. At the paper's 10 × 10 *this
-# path's* channel is SR-NF within tolerance (geometry), yet the TLS estimates scatter over metres
-# and match neither (the estimator). SR-NF belongs to one path: at the same epoch the other
-# marking and the ceiling bounce break it, the ceiling at every epoch (notebook 02; printed).
+# path's* channel is SR-NF within tolerance (geometry), yet the TLS estimates match neither
+# candidate (the estimator). SR-NF belongs to one path: at the same epoch the other marking and
+# the ceiling bounce break it, the ceiling at every epoch (notebook 02; printed).
 
 # %% tags=["explorer"]
 explorer = cpd_explorer()
@@ -513,7 +512,8 @@ print("warnings:", sorted({type(w.message).__name__ for w in caught}))
 los = paths[0]
 # sections 1-2: the paths, section 4.2's SRS, the clock bias read as a 50 ns sd
 assert los.kind == "los" and abs(los.length - np.linalg.norm(ue - array.origin)) < 1e-12
-assert {p.surface_kind for p in paths} >= {"los", "ceiling", "road", "rrm"}
+assert {p.surface_kind for p in paths} >= {"los", "ceiling", "road", "rrm"} and cfg.comb == 8
+assert np.ptp([p.length for p in paths]) < 1.5 and cfg.bandwidth == 100e6
 assert 0 < ceil.length - los.length < 0.1 and abs(ceil.doppler - los.doppler) < 0.01 * doppler_res
 assert ceil.kappa_srnf < 0.25 * ceil.length and 0 < ceil_gap < ceil.kappa_srnf
 assert snap.H.shape == (100, 410, 12) and cfg.tone_spacing == 240e3 and cfg.fc == 5.9e9
