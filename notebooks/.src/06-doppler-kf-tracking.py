@@ -480,10 +480,8 @@ lat_rms = {
     k: float(np.sqrt(np.mean((v.position[:, 1] - drive.position[:, 1]) ** 2)))
     for k, v in tracks.items()
 }
-print(
-    f"lateral RMS error on the drive of section 2: { ({k: round(v, 1) for k, v in lat_rms.items()}) }; "
-    f"RMS of the lateral bound along it {np.sqrt(np.mean(sy_dop**2)):.1f} m"
-)
+print("lateral RMS error on the drive of section 2:", {k: round(v, 1) for k, v in lat_rms.items()})
+print(f"RMS of the lateral bound along that drive: {np.sqrt(np.mean(sy_dop**2)):.1f} m")
 
 # %% [markdown]
 # With Doppler alone the along-track bound grows from the entrance (the GNSS fix) until the
@@ -491,17 +489,16 @@ print(
 # transmitter). A 1 m ToA holds it below 1 m far from the transmitter; on the last stretch of
 # the approach (from the time printed) it rises to a few metres, peaking seconds before the pass,
 # because the range there also depends on the lateral position, and that one is poorly known.
-# The **lateral** bound is another story: far from the
-# transmitter neither Doppler nor ToA sees $y$, so it grows with the motion model's lateral
-# random walk ($q = 0.5$ on both axes) to tens of metres — several times the 10 m tube (the
-# printout) — and only tightens around the pass. One transmitter cannot tell the lanes apart;
-# the tunnel walls (a map) can.
+# The **lateral** bound is another story: far from the transmitter neither Doppler nor ToA sees
+# $y$, so it grows with the motion model's lateral random walk ($q = 0.5$ on both axes) to tens
+# of metres — several times the 10 m tube (the printout) — and only tightens around the pass.
+# One transmitter cannot tell the lanes apart; the tunnel walls (a map) can.
 #
 # The same numbers show what the bound is *not*. The drive of section 2 keeps its lane; the
 # truths the bound averages over wander across it as $q = 0.5$ lets them. On that one drive the
 # two ToA approaches keep a lateral RMS error of a few metres, far below the lateral bound's
-# tens of metres (the last printed line): not a violation, a drive the bound is not about. A
-# road that constrains the lateral motion is a different motion model, with a smaller lateral
+# tens of metres (the last two printed lines): not a violation, a drive the bound is not about.
+# A road that constrains the lateral motion is a different motion model, with a smaller lateral
 # $q$ and a smaller bound (exercise 4).
 #
 # And **the initial GNSS fix matters**: before the pass, nothing but the fix and the motion model
