@@ -670,11 +670,15 @@ print(f"largest RMSE/CRLB (direction) 7 dB or more above the threshold: {rms_abo
 #    `fit.rho_max` (the basin test) and `fit.significance`. What went wrong, and how does the
 #    fit tell you?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and once you have
-# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
-# what it printed. What to read in them follows.
+# The solutions are the collapsed cells below, and Run All does not run them. Once you have
+# tried an exercise, click the "Run solution" button under its solution (or run
+# `tk.solution("03.2")` in a cell, for exercise 2): the solution runs on a copy of the
+# notebook's variables, so it changes none of yours, and shows what it prints. A cell's blue
+# bar shows its code. On the static site the solutions have already run: open one, then its
+# "Show the solution's output". What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.1
 # Solution 1: a truck between the vehicle and the BS, epoch 12
 from tunnelkit import propagation
 
@@ -690,9 +694,12 @@ print(
     f"path 0 of the extraction: d = {est_t1.d[0]:.3f} m "
     f"(= length + clock bias {C * snap_t1.clock_bias:.3f} m)"
 )
+assert "los" not in {p.kind for p in ps_t1} and first_t1.surface_kind == "rrm"
+assert abs(est_t1.d[0] - first_t1.length - C * snap_t1.clock_bias) < 0.1
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.2
 # Solution 2: the LoS estimate with and without the ceiling bounce (the paper's route, section 6)
 no_ceil = signal_route.SignalRoute(
     route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "wall", "road", "rrm")
@@ -704,9 +711,12 @@ for name, r in sol2.items():
         f"{name:11s} LoS d RMSE {r['RMSE d [m]']:.4f} m, free-factor CRLB {r['CRLB d [m]']:.4f} m, "
         f"direction RMSE {r['RMSE dir [deg]']:.3f} deg"
     )
+d_rmse = [sol2[n]["RMSE d [m]"] for n in ("all paths", "no ceiling", "LoS + road")]
+assert d_rmse[0] > 5 * d_rmse[1] > 5 * d_rmse[2], d_rmse
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.3
 # Solution 3: the SNR lowered on the paper's route: how often is each path missed?
 n_sol3 = tk.mc_count(10, 2)
 sol3 = {}
@@ -724,9 +734,12 @@ print(
         for r, v in zip(rows3, snap.snr_db.round(1))
     },
 )
+assert sol3[0]["road"] == 0 and sol3[-30]["RRM bottom right"] > 0, sol3
+assert sum(sol3[-30].values()) >= sum(sol3[0].values()), sol3
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.4a
 # Exercise 4, solution (a): starts in the wrong basin, on the tensor of sections 2-4
 def truth_start(paths, array, clock_bias):
     """(theta, mu_f, mu_t) of the true paths: (u_x, u_y, 1/kappa) in the array frame, roots."""
@@ -748,8 +761,12 @@ fits = {
 }
 for name, f in fits.items():
     print(f"{name:30s} rho = {f.rho:9.3f} (basin test passes below {f.rho_max:.4f})")
+assert fits["truth"].rho < fits["truth"].rho_max
+assert fits["paper's route, no re-seeding"].rho > 10 * fits["truth"].rho
+assert fits["paper's route, re-seeding"].rho < fits["paper's route, re-seeding"].rho_max
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.4b
 # Exercise 4, solution (b): the wrong number of paths, on a LoS + road tensor
 arr2, paths2 = two.paths(k_demo)
 snap2 = channel.synthesize(paths2, cfg, np.random.default_rng(4))
@@ -763,6 +780,8 @@ for L, e in wrong_L.items():
         f"valid = {e.valid}"
     )
 print("warnings:", sorted({type(w.message).__name__ for w in caught}))
+assert wrong_L[1].fit.rho > wrong_L[1].fit.rho_max and wrong_L[2].fit.rho < wrong_L[2].fit.rho_max
+assert not wrong_L[3].valid.all()
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
@@ -856,12 +875,7 @@ assert 0.5 < ceil.kappa_srnf  # inside the ML search's kappa >= 0.5 m
 assert np.allclose(snr_eff - snap.snr_db, 10 * np.log10(410 * 12 * 100))
 # the sampling interval of section 7 contains 1 and widens with fewer snapshots
 assert chi_lo < 1 < chi_hi
-# exercise 4: the basin test
-assert fits["truth"].rho < fits["truth"].rho_max
-assert fits["paper's route, no re-seeding"].rho > 10 * fits["truth"].rho
-assert fits["paper's route, re-seeding"].rho < fits["paper's route, re-seeding"].rho_max
-assert wrong_L[1].fit.rho > wrong_L[1].fit.rho_max and wrong_L[2].fit.rho < wrong_L[2].fit.rho_max
-assert not wrong_L[3].valid.all()
+# exercise 4 (the basin test) and exercises 1-3: asserted in their solutions (run in CI)
 z_srnf = origins["srnf channel"][:, 2]
 assert np.nanmax(z_srnf) > 4.0 and np.nanmin(z_srnf) < 1.0  # ceiling high, road/RRMs low
 title = explorer.figure.layout.title.text
@@ -879,11 +893,4 @@ assert 14.0 < eta_th_full < 15.0  # 14.5 dB for the paper's 100 x 410 x 12 tenso
 assert all(r["RMS/CRLB direction"] < 3.0 and r["beyond 6 sigma"] == 0.0 for r in above), above
 assert all(r["beyond 6 sigma"] >= 0.5 and r["flagged"] >= 0.5 for r in below), below
 assert margin_120 > 10.0 and rms_above < 3.0
-# exercises 1-3: the solutions' readings
-assert "los" not in {p.kind for p in ps_t1} and first_t1.surface_kind == "rrm"
-assert abs(est_t1.d[0] - first_t1.length - C * snap_t1.clock_bias) < 0.1
-d_rmse = [sol2[n]["RMSE d [m]"] for n in ("all paths", "no ceiling", "LoS + road")]
-assert d_rmse[0] > 5 * d_rmse[1] > 5 * d_rmse[2], d_rmse
-assert sol3[0]["road"] == 0 and sol3[-30]["RRM bottom right"] > 0, sol3
-assert sum(sol3[-30].values()) >= sum(sol3[0].values()), sol3
 print("all checks passed")
