@@ -45,6 +45,7 @@ def test_exercise_of_and_title():
     assert solutions.title("\n# Solution 2: the opposite lane\nx") == "the opposite lane"
     assert solutions.title("# Exercise 4, solution (a): the basin\nx") == "the basin"
     assert solutions.title("# Solution 1\nx") == ""
+    assert solutions.title("# Solution 3: one (long\n# line)\nx = 1  # no") == "one (long line)"
     assert solutions.title("# a note: this\nx") == "a note: this"
     assert solutions.title("x = 1") == ""
     with pytest.raises(TypeError, match="source"):

@@ -69,12 +69,15 @@ def exercise_of(sid: str) -> tuple[str, int]:
 
 
 def title(body: str) -> str:
-    """What a solution answers: its first line when that is a comment, without the exercise's
-    number (``# Solution 2: the opposite lane`` -> ``the opposite lane``)."""
-    first = _first_line(body)
-    if not first.startswith("#"):
-        return ""
-    text = first.lstrip("#").strip()
+    """What a solution answers: the comment it starts with (its lines joined), without the
+    exercise's number (``# Solution 2: the opposite lane`` -> ``the opposite lane``)."""
+    lines = body.strip().splitlines() if isinstance(body, str) else []
+    comment = []
+    for line in lines:
+        if not line.strip().startswith("#"):
+            break
+        comment.append(line.strip().lstrip("#").strip())
+    text = " ".join(comment)
     return re.sub(r"(?i)^(?:exercise\s+\d+\s*,\s*)?solution\b[^:]*:?\s*", "", text)
 
 
