@@ -114,8 +114,8 @@ def collapsed_html(stdout: str, stderr: str, outputs: list[dict[str, Any]]) -> s
 def ask_line(sid: str, body: str, button: bool = True) -> str:
     """The line an un-run solution shows (``button``: whether a button is shown below it)."""
     what = title(body)
-    how = f'{"click the button, or " if button else ""}run tk.solution("{sid}") in a cell'
-    return f"Solution {sid}{f' ({what})' if what else ''}: {ASK}. To run it, {how}."
+    how = f'{"the button or " if button else ""}tk.solution("{sid}") in a cell'
+    return f"Solution {sid}{f' ({what})' if what else ''}: {ASK}, with {how}."
 
 
 class Solutions:
@@ -174,7 +174,12 @@ class Solutions:
             print(ask_line(sid, body, button=False))
             return None
         text = ask_line(sid, body)
-        button = w.Button(description=f"Run solution {sid}", icon="play", button_style="info")
+        button = w.Button(
+            description=f"Run solution {sid}",
+            icon="play",
+            button_style="info",
+            layout=w.Layout(width="auto"),
+        )
         out = w.Output()
 
         def run(_button) -> None:

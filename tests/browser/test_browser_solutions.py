@@ -127,6 +127,13 @@ def test_voila_solutions_are_collapsed(voila_02, watched, artifacts):
         arg=sels,
         timeout=300_000,
     )
+    # the widgets (a solution's line and button) render once the page's kernel is connected
+    page.wait_for_function(
+        "([sels, ask]) => sels.every(s => (document.querySelector(s)?.textContent || '')"
+        ".includes(ask))",
+        arg=[sels, ASK],
+        timeout=120_000,
+    )
     states = page.evaluate(STATE, sels)
     _assert_hidden(states, f"Voila {nb.stem}")
     for s in states:  # a live kernel: no solution ran, each offers itself
