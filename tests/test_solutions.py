@@ -3,6 +3,8 @@ asked for, or at once under TUNNELKIT_SOLUTIONS=1, always in a copy of the noteb
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 from IPython.core.interactiveshell import InteractiveShell
 from IPython.utils.capture import capture_output
@@ -182,3 +184,12 @@ def test_outside_a_notebook():
         tk.solution("01.1")
     with pytest.raises(TypeError, match="shell"):
         solutions.install(object())
+
+
+def test_without_ipywidgets_the_line_alone(shell, monkeypatch):
+    monkeypatch.delenv(solutions.ENV, raising=False)
+    monkeypatch.setitem(sys.modules, "ipywidgets", None)  # import fails
+    with capture_output() as cap:
+        assert solutions._INSTALLED[id(shell)]._offer("01.1", "# Solution 1: it\nx = 1") is None
+    assert cap.stdout.strip() == solutions.ask_line("01.1", "# Solution 1: it", button=False)
+    assert "button" not in cap.stdout and 'tk.solution("01.1")' in cap.stdout
