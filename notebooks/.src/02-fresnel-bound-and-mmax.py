@@ -448,32 +448,43 @@ explorer
 # 3. An engineer wants a $16 \times 16$ URA at 28 GHz in the tunnel of section 5 (far lane). From
 #    which distance on does the SR-NF model hold for it?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and once you have
-# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
-# what it printed. What to read in them follows.
+# The solutions are the collapsed cells below, and Run All does not run them. Once you have
+# tried an exercise, click the "Run solution" button under its solution (or run
+# `tk.solution("02.2")` in a cell, for exercise 2): the solution runs on a copy of the
+# notebook's variables, so it changes none of yours, and shows what it prints. A cell's blue
+# bar shows its code. On the static site the solutions have already run: open one, then its
+# "Show the solution's output". What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 02.1
 # Solution 1: from which distance on is eq. 25 within 5 % of the exact Mmax?
 Rs = np.geomspace(1, 300, 400)
 r_ex = fresnel.mmax_2d(Rs, 3, 2.5, 5.9e9, 0.15) / fresnel.mmax_exact_grid(Rs, 3, 2.5, 5.9e9, 0.15)
 off = np.abs(r_ex - 1) >= 0.05
 r_from = Rs[np.flatnonzero(off)[-1] + 1]
 print(f"eq. 25 within 5 % for every R >= {r_from:.1f} m, where (2W - y_u)/R = {3.5 / r_from:.2f}")
+assert 0.2 < 3.5 / r_from < 0.5
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 02.2
 # Solution 2: the opposite lane at 28 GHz
 summ = fresnel.mmax_summary(30, 3, -2, 28e9, 0.15)
 for name in ("exact", "eq25", "eq37", "nonparaxial"):
     v = getattr(summ, name)
     print(f"{name:12s} {v:6.2f}  {'unsafe' if v > summ.exact + 0.5 else 'safe'}")
+assert summ.eq37 > summ.exact + 0.5 > summ.eq25
+assert summ.exact < summ.nonparaxial < summ.exact + 1  # unsafe, by less than one antenna
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 02.3
 # Solution 3: a 16 x 16 URA at 28 GHz in the far lane of section 5's tunnel
 R_try = np.arange(5.0, 60.0, 0.5)
 mis16 = np.array([fresnel.phase_mismatch_ura(16, R, 5, -1.75, 28e9, z_u=-3.3) for R in R_try])
 r16 = R_try[np.flatnonzero(mis16 > 0.15)[-1] + 1]
 print(f"mismatch {mis16[R_try == 15][0]:.3f} rad at 15 m; within 0.15 rad from R = {r16:.1f} m on")
-print("exact URA Mmax there:", fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15, z_u=-3.3))
+m16 = fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15, z_u=-3.3)
+print("exact URA Mmax there:", m16)
+assert m16 >= 16
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
@@ -515,10 +526,7 @@ assert "wall" not in mism and top_vertical < 1.5
 assert len(wall_hits) > 0 and hit_tilt.min() > 30 and hit_z.min() > 3
 # ... but not for the ceiling of the section 4.1 tunnel, at any epoch of the drive
 assert min(mism["ceiling"]) > eps, mism["ceiling"]
-# exercises: the solutions' readings
-assert 0.2 < 3.5 / r_from < 0.5 and summ.eq37 > summ.exact + 0.5 > summ.eq25
-assert summ.exact < summ.nonparaxial < summ.exact + 1  # unsafe, by less than one antenna
-assert fresnel.mmax_exact_ura(r16, 5, -1.75, 28e9, 0.15, z_u=-3.3) >= 16
+# the exercises' readings are asserted in their solutions (run in CI with TUNNELKIT_SOLUTIONS=1)
 assert fresnel.phase_mismatch_ura(10, R, W, y_u, fc) <= eps
 assert np.abs(floor_gap).max() <= 1 and abs(ratio25[:, far] - 1).max() < 0.08  # tight far away
 assert ratio25.min() < 0.5  # ... and loose close to the anchor
