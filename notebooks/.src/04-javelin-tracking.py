@@ -155,13 +155,14 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 # %% [markdown]
 # Two things stand out. (i) The LoS path and the ceiling reflection arrive almost together (the
 # array hangs just under the ceiling): the CPD mixes them, so their angles are off by degrees and
-# their curvature belongs to neither. (ii) The paper's route reads $\hat\kappa$ tens of metres
+# their curvature belongs to neither. (ii) The paper's route reads $\hat\kappa$ more than ten metres
 # away from the true curvature (over the whole drive: the median printed below) — not because
 # the array cannot measure it (notebook 03: along this drive its Cramér–Rao bound runs from
 # centimetres near the BS to decimetres at the far end), but because a CPD with free spatial
 # factors followed by a TLS is far from efficient. The paper assumes $\sigma_\kappa = 1.5$ m
-# (section 4.2). The Doppler column, on the other hand, stays close to the vehicle's speed, and a
-# spurious CPD component shows itself by a radial speed no static reflector can produce.
+# (section 4.2). The Doppler of the matched paths, on the other hand, stays close to the
+# vehicle's speed, and a spurious CPD component (a "clutter" row, when there is one) shows itself
+# by a radial speed no static reflector can produce.
 
 
 # %%
@@ -280,9 +281,9 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 # along the drive, which is what notebook 03's Cramér–Rao bound allows a 10 × 10 array there
 # (centimetres near the BS, decimetres at the far end) and what its ML fit reaches. So the
 # paper's 1.5 m is a generous assumption on this route — and far too tight on the paper's own
-# route, whose curvatures are tens of metres off (section 2). Where the ML fit's own test flags
-# an epoch (a path missed or merged), the epoch carries no measurement: the "found" column of
-# the ML table falls short of "true" by those epochs' paths.
+# route, whose curvatures are more than ten metres off (section 2). Where the ML fit's own test
+# flags an epoch (a path missed or merged), the epoch carries no measurement and the tracker
+# only predicts: one reason why "found" can fall short of "true" in the ML route's table.
 #
 # The curvature the ML route measures for a reflection is the distance to its **VUE** (the exact
 # wavefront's radius), not eq. 51's distance to the reflection point (the SR-NF model) — for the
@@ -392,7 +393,7 @@ tracks_count_figure(
 )
 
 # %% [markdown]
-# On the paper's route the paper's design churns: with curvatures tens of metres off and
+# On the paper's route the paper's design churns: with curvatures more than ten metres off and
 # $\sigma_\kappa = 1.5$ m the true pairs fail the gate, so more tracks die over the drive than
 # it has epochs — on average every epoch kills a track and gives birth to a new one — and the UE
 # is pulled by whatever passes. On the ML route the same design (with the VUE curvature) keeps
@@ -629,7 +630,8 @@ assert array_shapes == [[10, 10], [10, 10]]
 assert (srs.fc, srs.bandwidth, srs.n_symbols) == (5.9e9, 100e6, 12), srs
 assert abs(speed_kmh - 50.0) < 0.1 and (traj["x_start"], traj["x_end"]) == (45.0, 5.0), traj
 assert traj["period"] == 0.1 and abs(drive.dt - traj["period"]) < 1e-9, drive.dt
-# section 2: the paper's route reads the curvature tens of metres off, its LoS direction degrees
+# section 2: the paper's route reads the curvature more than ten metres off (its LoS direction
+# degrees off: section 3)
 assert np.median(kappa_err_paper) > 10.0, np.median(kappa_err_paper)
 assert jac_err < 1e-5, jac_err
 # section 3: every path less than 2 m behind the LoS (c/B = 3 m), the ceiling bounce
