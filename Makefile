@@ -78,7 +78,7 @@ unit: install rt-deps
 	$(PY) -m pytest -q -n 2 tests
 
 notebooks: install rt-deps
-	TUNNELKIT_QUICK=1 $(PY) -m pytest -q -n 2 --nbmake --nbmake-timeout=900 notebooks
+	TUNNELKIT_QUICK=1 TUNNELKIT_SOLUTIONS=1 $(PY) -m pytest -q -n 2 --nbmake --nbmake-timeout=900 notebooks
 
 test: lint unit notebooks browser
 

@@ -41,8 +41,8 @@ HIDDEN = {"jupyter": {"source_hidden": True, "outputs_hidden": True}, "tags": ["
 def test_the_one_exercise_format_passes():
     cells = [
         _md("## Exercises\n1. Do it.\n2. And this."),
-        _code("# Solution 1: it\nprint(1)", **HIDDEN),
-        _code("# Exercise 2, solution (a): this\nprint(2)", **HIDDEN),
+        _code("%%solution 09.1\n# Solution 1: it\nprint(1)", **HIDDEN),
+        _code("%%solution 09.2a\n# Exercise 2, solution (a): this\nprint(2)", **HIDDEN),
         _md("<details><summary>What to read</summary>\n\n1. One.\n3. A reading, not an exercise."),
         _md("## Checks"),
     ]
@@ -54,12 +54,16 @@ def test_the_one_exercise_format_passes():
     [
         ([_md("## Exercises"), _code("print(1)"), _md("## Checks")], "not tagged 'solution'"),
         ([_md("## Exercises"), _code("x", tags=["solution"])], "does not hide its source"),
+        ([_md("## Exercises"), _code("# Solution 1: it\nx", **HIDDEN)], "start with the magic"),
+        ([_code("%%solution 09.1\nx")], "not tagged 'solution'"),
+        ([_code("%%solution 08.1\nx", **HIDDEN)], "not of notebook 09"),
+        ([_code("%%solution 09.1\nx", **HIDDEN)] * 2, "solution 09.1 again"),
         ([_md("## Exercises\n<details>\n```python\nx\n```"), _md("## Checks")], "markdown code"),
         ([_md("## Exercises\n<details>answer</details>"), _md("## Checks")], "without a solution"),
         (
             [
                 _md("## Exercises\n1. Do it.\n2. And this.\n<details>\n2. answer in prose"),
-                _code("# Solution 1: it\nprint(1)", **HIDDEN),
+                _code("%%solution 09.1\n# Solution 2: the comment does not count\nx", **HIDDEN),
                 _md("## Checks"),
             ],
             "exercise 2 has no solution cell",
@@ -69,6 +73,48 @@ def test_the_one_exercise_format_passes():
 def test_other_formats_are_refused(cells, message):
     found = cn.exercise_problems(Path("09-x.ipynb"), cells)
     assert any(message in p for p in found), found
+
+
+def test_names_a_cell_assigns_and_reads_before_assigning():
+    assigned, free = cn.cell_names(
+        "%%solution 09.1\nimport numpy as np\nfrom a.b import c as d\ny = np.sin(x)\n"
+        "def f(t):\n    return t + z\nfor k in range(3):\n    w = [j for j in y] + d\n"
+        "try:\n    pass\nexcept ValueError as err:\n    print(err)\n"
+    )
+    assert {"np", "d", "y", "f", "k", "w", "err"} <= assigned
+    assert free == {"x", "z", "range", "ValueError", "print"}
+    assert cn.cell_names("%timeit x = 1\ny = v")[1] >= {"v"}  # IPython syntax parses
+
+
+@pytest.mark.parametrize(
+    ("cells", "message"),
+    [
+        (  # the Checks read a solution's result
+            [_code("x = 1"), _code("%%solution 09.1\nans = x + 1", **HIDDEN), _code("assert ans")],
+            "cell 2 reads 'ans', which only solution cells assign",
+        ),
+        (  # a solution reads another solution's result
+            [
+                _code("%%solution 09.1\nZp = 1", **HIDDEN),
+                _code("%%solution 09.2\nZ = Zp", **HIDDEN),
+            ],
+            "cell 1 reads 'Zp', which only another solution assigns",
+        ),
+    ],
+)
+def test_the_lesson_does_not_depend_on_its_solutions(cells, message):
+    found = cn.namespace_problems(Path("09-x.ipynb"), cells)
+    assert len(found) == 1 and message in found[0], found
+
+
+def test_a_solution_may_rebind_a_lesson_name_and_use_its_own():
+    cells = [
+        _code("route = 1\ncfg = 2"),
+        _code("%%solution 09.1\nroute = 3\nans = route + cfg\nassert ans", **HIDDEN),
+        _code("%%solution 09.2\nans = 4\nprint(ans)", **HIDDEN),
+        _code("assert route == 1"),
+    ]
+    assert cn.namespace_problems(Path("09-x.ipynb"), cells) == []
 
 
 def test_clean_drops_outputs_counts_and_lab_metadata_and_keeps_the_solution_metadata():

@@ -8,7 +8,13 @@ from tunnelkit.plots.javelin import (
     tracks_count_figure,
     trajectories_figure,
 )
-from tunnelkit.reproduce.javelin_tables import COLUMNS, collect_routes, javelin_table, table_rows
+from tunnelkit.reproduce.javelin_tables import (
+    COLUMNS,
+    collect_routes,
+    javelin_table,
+    seed_note,
+    table_rows,
+)
 from tunnelkit.tracking.javelin import designs
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
@@ -272,5 +278,18 @@ def test_table_scored_on_the_workers_equals_table_rows_on_the_drives():
         "italiano2026-straight", "italiano2026_table1", ("L", "N"), 2, 11, False, ("paper", "ml"), 2
     )
     assert rep.columns == cols and rep.rows == rows
+    assert rep.meta["seed"] == 11 and seed_note(11) in rep.notes
     faults = {e: sum(len(d.faults) for lst in r.values() for d in lst) for e, r in routes.items()}
     assert rep.meta["extraction_failures"] == faults
+
+
+def test_a_table_says_whether_its_seed_was_held_out():
+    """The report names its seed's kind: our design scored on a tuning seed is not held out."""
+    assert ex.HELD_OUT_SEED not in ex.TUNING_SEEDS
+    assert "the held-out seed: no design choice" in seed_note(ex.HELD_OUT_SEED)
+    for s in ex.TUNING_SEEDS:
+        note = seed_note(s)
+        assert "a tuning seed" in note and f"--seed {ex.HELD_OUT_SEED}" in note
+    assert "neither a tuning seed" in seed_note(11)
+    with pytest.raises(TypeError):
+        seed_note("0")

@@ -222,14 +222,22 @@ def test_methods_get_distinct_markers():
 
 
 def test_execute_keeps_the_callers_environment(tmp_path, monkeypatch):
-    """The kernel sees the caller's environment (PATH, PYTHONPATH, ...) plus quick mode."""
+    """The kernel sees the caller's environment (PATH, PYTHONPATH, ...) plus quick mode and the
+    solutions run at once (the static site); a live kernel's solutions wait to be asked for."""
     monkeypatch.setattr(lec, "EXECUTED", tmp_path / "executed")
     monkeypatch.setenv("TK_ENV_MARK", "kept")
+    monkeypatch.setenv("TUNNELKIT_SOLUTIONS", "0")
     path = tmp_path / "09-env.ipynb"
-    code = "import os\nprint(os.environ.get('TK_ENV_MARK'), os.environ.get('TUNNELKIT_QUICK'))"
+    code = (
+        "import os\nprint(*(os.environ.get(v) for v in "
+        "('TK_ENV_MARK', 'TUNNELKIT_QUICK', 'TUNNELKIT_SOLUTIONS')))"
+    )
     nbformat.write(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)]), path)
     nb = lec.execute(path, quick=True, use_cache=False, timeout=120)
-    assert nb.cells[0].outputs[0]["text"].strip() == "kept 1"
+    assert nb.cells[0].outputs[0]["text"].strip() == "kept 1 1"
+    assert os.environ["TUNNELKIT_SOLUTIONS"] == "0"
+    live = lec.kernel_env(quick=False)
+    assert "TUNNELKIT_SOLUTIONS" not in live and "TUNNELKIT_QUICK" not in live
     assert os.environ["TK_ENV_MARK"] == "kept" and "PATH" in os.environ  # restored afterwards
 
 

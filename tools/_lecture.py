@@ -378,14 +378,17 @@ def notebook_client(nb, **kwargs):
     return client
 
 
-def kernel_env(quick: bool) -> dict[str, str]:
-    """Environment of an executing kernel: quick mode or not, plotly figures as JSON."""
+def kernel_env(quick: bool, solutions: bool = False) -> dict[str, str]:
+    """Environment of an executing kernel: quick mode or not, plotly figures as JSON, and the
+    exercises' solutions run at once (``TUNNELKIT_SOLUTIONS=1``, tunnelkit.solutions: the static
+    site) or, by default, only when the reader asks for them (JupyterLab, Voila)."""
     env = dict(os.environ)
     env["PLOTLY_RENDERER"] = "plotly_mimetype"
-    if quick:
-        env["TUNNELKIT_QUICK"] = "1"
-    else:
-        env.pop("TUNNELKIT_QUICK", None)
+    for var, on in (("TUNNELKIT_QUICK", quick), ("TUNNELKIT_SOLUTIONS", solutions)):
+        if on:
+            env[var] = "1"
+        else:
+            env.pop(var, None)
     return env
 
 
@@ -420,7 +423,8 @@ print("{_DUMP_MARK}" + _json.dumps(_figs))
 
 
 def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = True):
-    """Execute a notebook headless (widget state kept) and return it as a NotebookNode.
+    """Execute a notebook headless (widget state kept), every exercise's solution included, and
+    return it as a NotebookNode.
 
     The result is cached in ``build/executed/`` keyed on the notebook, the package sources, the
     data files and the mode, so ``make figures`` after ``make site`` does not run it again.
@@ -437,7 +441,7 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
             return nb
     nb = nbformat.read(path, as_version=4)
     saved = dict(os.environ)
-    env = kernel_env(quick)  # computed before the clear below, or it would start from nothing
+    env = kernel_env(quick, solutions=True)  # before the clear below, or it would start empty
     os.environ.clear()
     os.environ.update(env)  # the kernel inherits this process's environment
     try:

@@ -8,10 +8,14 @@
 * a markdown cell headed "Checks" followed by code that asserts;
 * one exercise format: every code cell between the "Exercises" heading and "Checks" is a
   solution (tag ``solution``, cell metadata ``jupyter.source_hidden`` and
-  ``jupyter.outputs_hidden`` true), so it runs with Run All and in CI while the student sees
-  neither its code nor its output until they expand it; a solution is code, not a markdown code
-  block, and every numbered exercise has one (its first line names it: ``# Solution 2: ...``;
-  by that line ``tunnelkit.solutions`` collapses the cell's output when it runs in JupyterLab).
+  ``jupyter.outputs_hidden`` true) whose first line is the magic ``%%solution NN.E`` (the
+  notebook's number and the exercise's; ``tunnelkit.solutions``): Run All does not run it, the
+  student asks for it, CI runs it with ``TUNNELKIT_SOLUTIONS=1``. A solution is code, not a
+  markdown code block, every numbered exercise has one, and no other cell starts with the magic;
+* the lesson does not depend on its solutions: a solution runs in a copy of the notebook's
+  namespace, and perhaps never, so no other cell (the Checks included) reads a name that only
+  solution cells assign, and no solution reads a name that only another solution assigns
+  (names found by ``ast``; a solution asserts on its own results).
 
 The committed notebook is what is checked. In a clone where ``make lab`` installed the output
 filter (``git config filter.nbstrip.clean``), that is the notebook as the filter cleans it, so
@@ -39,9 +43,6 @@ SOURCES = ".src"
 SOLUTION_TAG = "solution"
 #: a numbered exercise in the Exercises section's markdown ("1. ..." at the start of a line)
 EXERCISE = re.compile(r"^(\d+)\. ", re.MULTILINE)
-#: the exercise a solution cell answers, from its first line ("# Solution 2: ...",
-#: "# Exercise 4, solution (a): ...")
-SOLVES = re.compile(r"(?i)(?:solution|exercise)s?\s+(\d+)")
 FILTER = "nbstrip"
 KERNELSPEC = {"display_name": "Python (tunnelkit)", "language": "python", "name": "python3"}
 
@@ -188,23 +189,39 @@ def _heading_index(cells: list[dict], word: str) -> int | None:
     return None
 
 
+def _source(cell: dict) -> str:
+    return "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+
+
+def _tagged(cell: dict) -> bool:
+    return SOLUTION_TAG in cell.get("metadata", {}).get("tags", [])
+
+
 def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
     """The one exercise format (see the module docstring)."""
-    from tunnelkit.solutions import is_solution
+    from tunnelkit.solutions import exercise_of, solution_id
 
     out = []
+    number = path.stem.split("-", 1)[0]
+    seen: dict[str, int] = {}
     for i, c in enumerate(cells):
         meta = c.get("metadata", {})
         hidden = meta.get("jupyter", {})
-        src = "".join(c["source"]) if isinstance(c["source"], list) else c["source"]
-        if SOLUTION_TAG in meta.get("tags", []) and not is_solution(src):
+        sid = solution_id(_source(c)) if c.get("cell_type") == "code" else None
+        if _tagged(c) and sid is None:
             out.append(
-                f"{path}: cell {i} is a solution but its first line does not say so "
-                "('# Solution N: ...'), so the kernel would not collapse its output"
+                f"{path}: cell {i} is a solution but does not start with the magic "
+                f"'%%solution {number}.N' (N: its exercise), so Run All would run it"
             )
-        if SOLUTION_TAG in meta.get("tags", []) and not (
-            hidden.get("source_hidden") and hidden.get("outputs_hidden")
-        ):
+        if sid is not None and not _tagged(c):
+            out.append(f"{path}: cell {i} starts with %%solution but is not tagged 'solution'")
+        if sid is not None and exercise_of(sid)[0] != number:
+            out.append(f"{path}: cell {i}: solution {sid} is not of notebook {number}")
+        if sid is not None and sid in seen:
+            out.append(f"{path}: cell {i}: solution {sid} again (first in cell {seen[sid]})")
+        if sid is not None:
+            seen.setdefault(sid, i)
+        if _tagged(c) and not (hidden.get("source_hidden") and hidden.get("outputs_hidden")):
             out.append(
                 f"{path}: cell {i} is a solution but does not hide its source and outputs "
                 "(jupyter.source_hidden and jupyter.outputs_hidden)"
@@ -233,13 +250,77 @@ def exercise_problems(path: Path, cells: list[dict]) -> list[str]:
         if c.get("cell_type") == "markdown":
             text = src.split("<details", 1)[0]  # what follows is a reading, not an exercise
             asked |= {int(m) for m in EXERCISE.findall(text)}
-        elif SOLUTION_TAG in c.get("metadata", {}).get("tags", []):
-            first = src.strip().splitlines()[0] if src.strip() else ""
-            answered |= {int(m) for m in SOLVES.findall(first)}
+        elif c.get("cell_type") == "code" and solution_id(src) is not None:
+            answered.add(exercise_of(solution_id(src))[1])
     for n in sorted(asked - answered):
         out.append(
-            f"{path}: exercise {n} has no solution cell (its first line: '# Solution {n}: ...')"
+            f"{path}: exercise {n} has no solution cell (its first line: '%%solution {number}.{n}')"
         )
+    return out
+
+
+def _names(tree) -> tuple[set[str], set[str]]:
+    """(names a statement binds, names it reads that it does not bind itself)."""
+    import ast
+
+    bound, read = set(), set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            (read if isinstance(node.ctx, ast.Load) else bound).add(node.id)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            bound.add(node.name)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            bound |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        elif isinstance(node, ast.arg):
+            bound.add(node.arg)
+        elif isinstance(node, ast.ExceptHandler) and node.name:
+            bound.add(node.name)
+    return bound, read - bound
+
+
+def cell_names(source: str) -> tuple[set[str], set[str]]:
+    """(names a cell assigns, names it reads before assigning them), statement by statement; a
+    solution cell without its magic line, IPython syntax turned into Python first."""
+    import ast
+
+    from IPython.core.inputtransformer2 import TransformerManager
+
+    from tunnelkit.solutions import is_solution
+
+    if is_solution(source):
+        source = source.lstrip().split("\n", 1)[1] if "\n" in source.lstrip() else ""
+    tree = ast.parse(TransformerManager().transform_cell(source))
+    assigned, free = set(), set()
+    for stmt in tree.body:
+        bound, read = _names(stmt)
+        free |= read - assigned
+        assigned |= bound
+    return assigned, free
+
+
+def namespace_problems(path: Path, cells: list[dict]) -> list[str]:
+    """No cell depends on a name only solutions assign (see the module docstring)."""
+    from tunnelkit.solutions import solution_id
+
+    code = [(i, c) for i, c in enumerate(cells) if c.get("cell_type") == "code"]
+    names = {}
+    for i, c in code:
+        try:
+            names[i] = cell_names(_source(c))
+        except SyntaxError as exc:
+            return [f"{path}: cell {i} does not parse: {exc}"]
+    sol = {i for i, c in code if solution_id(_source(c)) is not None}
+    lesson = set().union(*(names[i][0] for i, _ in code if i not in sol))
+    out = []
+    for i, _ in code:
+        others = set().union(*(names[j][0] for j in sol if j != i)) - lesson
+        for name in sorted(names[i][1] & others):
+            whose = "another solution assigns" if i in sol else "solution cells assign"
+            out.append(
+                f"{path}: cell {i} reads {name!r}, which only {whose}; a solution runs "
+                "alone, in a copy of the namespace, and not on Run All (assert on a solution's "
+                "result in its own cell)"
+            )
     return out
 
 
@@ -287,6 +368,7 @@ def problems(path: Path, strip: bool) -> list[str]:
         )
     ]
     out += exercise_problems(path, cells)
+    out += namespace_problems(path, cells)
     if not heads:
         out.append(f"{path}: no markdown cell headed 'Checks'")
     elif not any(

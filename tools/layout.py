@@ -29,7 +29,7 @@ RANKS = {
     "_validate": 0,
     "_checks": 0.25,  # more checks of the validation layer, built on _validate
     "constants": 0.5,
-    "solutions": 0.5,  # the notebooks' solution cells (IPython hooks), imports nothing of ours
+    "solutions": 0.5,  # the notebooks' solution cells (an IPython magic), imports nothing of ours
     "budget": 0.5,
     "report": 0.5,
     "schema": 0.5,

@@ -33,6 +33,7 @@ __all__ = [
     "mc_count",
     "quick_mode",
     "setup_notebook",
+    "solution",
 ]
 
 
@@ -54,8 +55,9 @@ def setup_notebook(*, renderer: str | None = None) -> None:
     """The one setup call every notebook makes after ``import tunnelkit as tk``.
 
     Sets a plotly renderer that works both in JupyterLab and when the notebook is executed
-    headless (CI, static site), collapses the output of exercise solution cells
-    (:mod:`tunnelkit.solutions`) and prints one line: the package version and whether quick mode
+    headless (CI, static site), registers the ``%%solution`` magic of exercise solution cells
+    (:mod:`tunnelkit.solutions`: run on demand, or at once with ``TUNNELKIT_SOLUTIONS=1``) and
+    prints one line: the package version and whether quick mode
     is on. Returns None, so the call is not echoed as a cell result.
     """
     # the type and emptiness first: the first look at plotly's renderer registry loads it (seconds)
@@ -77,9 +79,17 @@ def setup_notebook(*, renderer: str | None = None) -> None:
     pio.templates.default = "plotly_white"
     from .solutions import install
 
-    install()  # exercise solutions: output collapsed until asked for (tunnelkit.solutions)
+    install()  # exercise solutions: run when asked for (tunnelkit.solutions)
     mode = "quick (TUNNELKIT_QUICK=1: Monte-Carlo counts shrunk for CI)" if quick_mode() else "full"
     print(f"tunnelkit {__version__} · mode: {mode}")
+
+
+def solution(sid: str) -> None:
+    """Run an exercise's solution in this notebook once you have tried: ``tk.solution("03.2")``
+    (notebook 03, exercise 2), as the button under its cell does (:mod:`tunnelkit.solutions`)."""
+    from .solutions import run
+
+    run(sid)
 
 
 def build_dir(*parts: str) -> Path:

@@ -3,101 +3,64 @@
 #
 # *Italiano, Brambilla & Nicoli (2026), "In-Tunnel Single-Anchor Localization Exploiting Near-Field
 # and Radio-Reflective Road Markings", [arXiv:2604.04217](https://arxiv.org/abs/2604.04217v1),
-# sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2.
-# All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
-# [glossary](GLOSSARY.md).*
+# sections 2 (eq. 1–24), 3.2 (Algorithm 1) and 4.1–4.2. References: `REFERENCES.md`; terms and
+# the words for bounds: the [glossary](GLOSSARY.md) and its [Bounds](GLOSSARY.md#bounds) section.
+# How the extraction is computed and reports its own failures is told in
+# [docs/extraction-notes.md](../docs/extraction-notes.md).*
 #
 # **What you will learn**
 #
-# - how the image method turns a tunnel (semicircular facets, road, metallic road markings)
-#   into a handful of paths, each with a virtual UE (VUE), a reflection point, a delay, an
-#   angle, a Doppler shift and an exact length to *every* antenna;
-# - how those paths build the uplink [SRS](GLOSSARY.md#srs) (sounding reference signal) channel tensor $\mathcal{H}$ (eq. 1, 3) and why its
-#   canonical polyadic decomposition (CPD) hands the paths back one rank-1 term each;
-# - the paper's extraction chain: scaling fix and Vandermonde roots (eq. 12–15), 2-D phase
-#   unwrapping (eq. 16), TLS near-field / LS far-field solutions (eq. 17–24), Algorithm 1;
-# - where it is fragile: paths that share delay *and* Doppler (the ceiling bounce right above
-#   the base station), eq. 13's inefficiency, and what the curvature $\kappa$ really measures;
-# - how far the estimates are from the Cramér–Rao bound, why a CPD's free spatial factors cannot
-#   reach it, and how a joint maximum-likelihood fit of eq. 1 (the package's default route) does:
-#   *if the array is perfectly calibrated*, a 23 cm array measures direction to about a
-#   thousandth of a degree and $\kappa$ to centimetres;
-# - why no real array does: calibration error and the delay across the aperture (spatial
-#   wideband), both left out of eq. 1, move the same estimates by metres (section 10).
+# - how the image method turns a tunnel into paths, each from a virtual UE (VUE), and how they
+#   build the uplink [SRS](GLOSSARY.md#srs) channel tensor (eq. 1, 3), whose canonical polyadic
+#   decomposition (CPD) hands them back one rank-1 term each (eq. 12–24, Algorithm 1);
+# - how far that is from the Cramér–Rao bound (CRLB), and how a maximum-likelihood (ML) fit of
+#   eq. 1 attains it — on a calibrated array (section 10), above a threshold SNR (section 11).
 
 # %%
 import warnings
+from dataclasses import replace
 
 import numpy as np
 from scipy.stats import chi2
 from tqdm.auto import tqdm
 
 import tunnelkit as tk
-from tunnelkit import channel, evaluation, extraction, signal_route
+from tunnelkit import channel, efficiency, evaluation, extraction, plots, signal_route
 from tunnelkit.constants import C
-from tunnelkit.efficiency import drive_efficiency
 from tunnelkit.extraction import ml
-from tunnelkit.plots import (
-    efficiency_figure,
-    factors_figure,
-    paths_table_figure,
-    tunnel3d_figure,
-    wave_origins_figure,
-)
 from tunnelkit.widgets import cpd_explorer, curvature_study
+from tunnelkit.widgets.cpd import mismatch
 
 tk.setup_notebook()
 
 # %% [markdown]
 # ## 1. The JAVELIN tunnel and its paths
 #
-# Section 4.1: a straight tunnel, 100 m long, with a semicircular cross-section 10 m wide and
-# 5 m high; one base station (BS) at the centre, 4.8 m high, with two $10\times10$ URAs looking
-# along the tunnel and tilted 30° down; four metallic radio-reflective road markings (RRMs), two
-# at the sidewalk–wall junction (55°) and two on the walls at 3.3 m (90°). The preset
-# `italiano2026-straight` holds all of it (`tunnelkit.propagation` registers its tunnel and
-# trajectory kinds). The semicircle is built from 12 planar facets plus the road.
+# Section 4.1: a straight tunnel, 100 m long, semicircular, 10 m wide and 5 m high; a base
+# station (BS) 4.8 m high with two $10\times10$ URAs along the tunnel; four metallic road
+# markings (RRMs): the preset `italiano2026-straight`. **Image method**: a surface with unit normal
+# $n$ and offset $c$ mirrors the UE into the VUE $p_v = p_u - 2(n\cdot p_u + c)\,n$; the path
+# exists when the line from the array to the VUE crosses the finite facet, unblocked. Its length
+# to antenna $m$ is $d_{\ell,m} = \lVert p_v - p_m\rVert$ (eq. 2, 38): a spherical wavefront.
 #
-# **Image method.** A surface with unit normal $n$ and offset $c$ mirrors the UE into the VUE
-# $p_v = p_u - 2(n\cdot p_u + c)\,n$. The reflected path exists when the straight line from the
-# array's reference antenna to the VUE crosses the surface *inside* the finite facet (the
-# specular point) and no box (a truck) blocks either leg. Its exact length to antenna $m$ is
-# $d_{\ell,m} = \lVert p_v - p_m\rVert$ (eq. 2, 38): a spherical wavefront centred on the VUE.
+# The ceiling bounce is only centimetres longer than the LoS, with the same Doppler: the array
+# hangs just under the crown, so the ceiling's VUE sits almost on the LoS ray. And the SR-NF
+# model's curvature of a reflected path (the distance to the reflection point, eq. 51, "kappa
+# SR-NF") is much shorter than the distance to the VUE ("length").
 
 # %%
 route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
 k_demo = 12
 array, paths = route.paths(k_demo)
 ue = route.trajectory.position[k_demo]
-print(f"epoch {k_demo}: UE at {ue.round(2)}, array '{array.name}', {len(paths)} paths")
-tunnel3d_figure(
-    route.tunnel,
-    [array],
-    paths,
-    ue,
-    x_range=(-5, 40),
-    title=f"Paths at epoch {k_demo} (LoS green, ceiling red, road grey, RRM purple)",
-)
-
-# %%
-paths_table_figure(evaluation.path_rows(paths), title="True paths (world-frame angles, eq. 46-50)")
-
-# %% [markdown]
-# Two things to notice (the numbers are printed below). The ceiling bounce is only centimetres
-# longer than the LoS and has the same Doppler: the array hangs just under the crown, so the
-# ceiling's VUE sits almost on the LoS ray, mirrored upwards. And the curvature the SR-NF model
-# assigns to a reflected path (the distance to the reflection point, eq. 51, column "kappa
-# SR-NF") is much shorter than the distance to the VUE (column "length").
+plots.tunnel3d_figure(route.tunnel, [array], paths, ue, x_range=(-5, 40), title=f"epoch {k_demo}")
 
 # %%
 ceil = next(p for p in paths if p.surface_kind == "ceiling")
 ceil_gap = float(ceil.point[2] - array.origin[2])
-print(
-    f"ceiling bounce: reflection point {ceil_gap:.2f} m above the array's reference antenna, "
-    f"{100 * (ceil.length - paths[0].length):.1f} cm longer than the LoS, Doppler "
-    f"{ceil.doppler - paths[0].doppler:+.1f} Hz from it; kappa SR-NF (eq. 51) "
-    f"{ceil.kappa_srnf:.2f} m against |VUE| = {ceil.length:.2f} m"
-)
+print(f"ceiling: reflection point {ceil_gap:.2f} m above the array,", end=" ")
+print(f"{100 * (ceil.length - paths[0].length):.1f} cm longer than the LoS")
+plots.paths_table_figure(evaluation.path_rows(paths), title="True paths (world frame, eq. 46-50)")
 
 # %% [markdown]
 # ## 2. The channel tensor (eq. 1, 3)
@@ -105,550 +68,286 @@ print(
 # $$h_{m,s}[k]=\sum_{\ell=0}^{L-1}\alpha_{\ell}\,e^{j2\pi\frac{f_c}{c}\delta_{\ell,m}}
 #   \,e^{-j2\pi s\Delta f\tau_{\ell}}\,e^{j2\pi k f^{d}_{\ell}T_{0}} \qquad (1)$$
 #
-# with section 4.2's SRS: $f_c = 5.9$ GHz, 100 MHz (273 resource blocks of 12 subcarriers at
-# 30 kHz), comb 8, hence $N_f = 410$ tones spaced $\Delta f = 240$ kHz; $N_t = 12$ symbols of
-# $T_0 = 35.7\,\mu$s; 23 dBm; noise $\mathcal{CN}(0, N_0)$ per element with
-# $N_0 = k_B\,BW\,T_e$, $T_e = T_\text{ant} + 290(N_F - 1)$, $T_\text{ant} = 298$ K,
-# $N_F = 5$ dB. The delay $\tau_\ell = d_\ell/c + b$ carries the UE clock bias $b$, a Gaussian of
-# 50 ns standard deviation truncated to ±100 ns. (The paper writes $d = \tau/c$; it means
-# $d = c\,\tau$.) Eq. 3 is a CPD: $\mathcal{H}=\sum_\ell \alpha_\ell\, b^s_\ell\circ b^f_\ell
-# \circ b^t_\ell$.
+# Section 4.2's SRS: $f_c = 5.9$ GHz, 100 MHz, comb 8, hence $N_f = 410$ tones spaced $\Delta f
+# = 240$ kHz; $N_t = 12$ symbols of $T_0 = 35.7\,\mu$s; noise $\mathcal{CN}(0, N_0)$ per element.
+# The delay $\tau_\ell = d_\ell/c + b$ carries the UE clock bias $b$ (the paper writes $d =
+# \tau/c$ for $d = c\,\tau$). Eq. 3 is a CPD: $\mathcal{H}=\sum_\ell \alpha_\ell\, b^s_\ell\circ
+# b^f_\ell \circ b^t_\ell$.
+#
+# **The clock bias, read.** The paper draws $b$ from a Gaussian "with variance 50 ns" truncated to
+# $[-100, 100]$ ns. We read a 50 ns **standard deviation**: a variance would be in ns², and 50 ns
+# puts the truncation at two standard deviations, where it acts; as 50 ns², the deviation would be
+# about 7 ns and the support fourteen of them each side, a truncation that never acts (printed).
 
 # %%
 cfg = route.config
 snap = channel.synthesize(paths, cfg, np.random.default_rng(1))
-print("H shape (M, Nf, Nt):", snap.H.shape)
-print(
-    f"N0 = {cfg.noise_power:.3e} W, T_e = {cfg.noise_temperature:.0f} K, "
-    f"clock bias = {snap.clock_bias * 1e9:.1f} ns = {snap.clock_bias * 3e8:.2f} m"
-)
-print("per-element SNR of each path [dB]:", snap.snr_db.round(1))
+sd_ns2 = np.sqrt(50.0) * 1e-9  # the literal reading: a variance of 50 ns^2
+print(f"support ±{cfg.clock_bias_limit / cfg.clock_bias_sigma:.0f} sd of 50 ns", end="; ")
+print(f"as 50 ns²: sd {1e9 * sd_ns2:.1f} ns, support ±{cfg.clock_bias_limit / sd_ns2:.0f} sd")
 doppler_res = 1 / (cfg.n_symbols * cfg.symbol_period)  # 1/(N_t T_0) [Hz]
-print(
-    f"Doppler resolution 1/(N_t T_0) = {doppler_res / 1e3:.2f} kHz "
-    f"= {doppler_res * C / cfg.fc:.0f} m/s in radial speed"
-)
-gain_ft = 10 * np.log10(cfg.n_tones * cfg.n_symbols)  # integration over tones and symbols
-gain_m = 10 * np.log10(array.M)  # and over the array's elements
-snr_eff = snap.snr_db + gain_ft + gain_m
-print(
-    f"effective SNR per path [dB]: per element + {gain_ft:.1f} dB (N_f N_t) "
-    f"= {np.round(snap.snr_db + gain_ft, 0)}; + {gain_m:.0f} dB (M) = {np.round(snr_eff, 0)}"
-)
+print(f"Doppler resolution {doppler_res / 1e3:.2f} kHz = {doppler_res * C / cfg.fc:.0f} m/s")
+snr_eff = snap.snr_db + 10 * np.log10(snap.H.size)  # integrated over N_f N_t M
+print(f"SNR per element {snap.snr_db.round(1)} dB, integrated {snr_eff.round(0)} dB")
 
 # %% [markdown]
 # ## 3. CPD and the three factor matrices (eq. 11–16)
 #
-# `extraction.extract_paths(..., refine="joint")` runs the paper's chain (its default,
-# `refine="ml"`, is the maximum-likelihood route of section 7). The CPD (tensorly `parafac`) returns
-# $\hat B^s, \hat B^f, \hat B^t$ up to scale; dividing each column by its first entry fixes the
-# scale, and the gain is the product of the first rows (eq. 12). The frequency and time factors
-# are Vandermonde, so their roots follow from shift invariance (eq. 13):
-# $\hat\mu = \angle\,\mathrm{diag}(\hat B_-^H \hat B_+)$, giving
-# $\hat d = -\frac{c}{2\pi\Delta f}\hat\mu^f$ (eq. 14) and $\hat v = \frac{c}{2\pi f_c T_0}\hat\mu^t$
-# (eq. 15). The spatial factor's phase, unwrapped in 2-D over the URA grid (eq. 16, scikit-image's
-# Herráez et al. 2002 algorithm, the paper's ref. 25), gives the path-length offsets $\hat\delta_m$.
+# `extraction.extract_paths(..., refine="joint")` runs the paper's chain. The CPD (fitted to a
+# [HOSVD](GLOSSARY.md#hosvd)-compressed core: extraction notes, part 1) returns the factors up to
+# scale; dividing each column by its first entry fixes it (eq. 12). The frequency and time
+# factors are Vandermonde: by shift invariance $\hat\mu = \angle\,\mathrm{diag}(\hat B_-^H \hat
+# B_+)$ (eq. 13), so $\hat d = -\frac{c}{2\pi\Delta f}\hat\mu^f$ (eq. 14), $\hat v = \frac{c}{2\pi
+# f_c T_0}\hat\mu^t$ (eq. 15). The spatial factor's phase, unwrapped in 2-D (eq. 16, [Herráez
+# 2002]), gives the path-length offsets $\hat\delta_m$.
 
 # %%
 est = extraction.extract_paths(snap.H, len(paths), array, cfg, refine="joint")
-print(f"CPD relative error {est.rel_error:.4f} (the noise floor), core iterations {est.n_iter}")
-factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
-
-# %% [markdown]
-# **How the CPD is computed here.** A plain `parafac(H, L, init="svd")` on the full
-# $100\times410\times12$ tensor is about ten times slower (see `benchmarks/bench_extraction.py`)
-# and, even on a noiseless tensor, stops in a wrong decomposition: the time factor hardly varies
-# between paths over 12 symbols (Doppler resolution $1/(N_tT_0) \approx 2.3$ kHz, i.e. 119 m/s,
-# printed in section 2),
-# and the frequency factor barely separates paths closer than $c/BW = 3$ m. So
-# `extract_paths` (1) compresses $\mathcal{H}$ to an $L\times L\times L$ core (truncated [HOSVD](GLOSSARY.md#hosvd), the higher-order SVD),
-# (2) initialises the core's CPD algebraically from a *shift invariance* — of the URA rows
-# (angles differ by degrees) and of the Vandermonde frequency factor — (3) refines with
-# tensorly's `parafac(init=..., linesearch=True)` on the core, (4) lifts back and polishes with
-# two ALS sweeps on the full tensor. Below, the plain call on a smaller tensor for comparison.
-
-# %%
-small = channel.channel_tensor(paths, cfg, n_tones=64, clock_bias=snap.clock_bias)
-plain = extraction.extract_paths(
-    small, len(paths), array, cfg, method="plain", n_iter_max=60, refine="joint"
-)  # may warn
-fast = extraction.extract_paths(small, len(paths), array, cfg, refine="joint")
-d_true = np.sort([p.length for p in paths]) + C * snap.clock_bias
-print("true d      ", d_true.round(3))
-print("plain parafac", plain.d.round(3), "| converged:", plain.converged)
-print("fast          ", fast.d.round(3))
+print(f"CPD relative error {est.rel_error:.4f} (the noise floor)")
+plots.factors_figure(est.factors, unwrapped=est.delta.T * 2 * np.pi * cfg.fc / C)
 
 # %% [markdown]
 # ## 4. Directions and curvature (eq. 17–24)
 #
-# With the reference antenna at the origin of the array's local frame and the array in its
-# $xy$-plane, $\hat\delta_{\ell,m}+\kappa_\ell = \lVert p_m - p_\ell\rVert$ (eq. 17) becomes the
-# linear system $2[x_m\; y_m\; \hat\delta_{\ell,m}]\,x_\ell = r_m^2-\hat\delta_{\ell,m}^2$
-# (eq. 18), solved by total least squares; in the far field $[x_m\; y_m]\,u = -\hat\delta_m$
-# by LS. **Convention**: eq. 19 writes
-# $x_\ell = \kappa(\cos\phi\sin\psi,\ \sin\phi\sin\psi)$, so $\psi$ is the polar angle from the
-# array normal, while eq. 22/24's $\cos^{-1}(\rho/\kappa)$ returns its complement (the angle
-# above the array plane). We follow eq. 19 and also return the unit direction, checked against
-# exact geometry in `tests/test_extraction.py`. Algorithm 1 then drops $\hat d<0$ and falls back
-# on the far-field angles when $\hat\kappa<0$.
+# In the array's frame, $\hat\delta_{\ell,m}+\kappa_\ell = \lVert p_m - p_\ell\rVert$ (eq. 17)
+# becomes $2[x_m\; y_m\; \hat\delta_{\ell,m}]\,x_\ell = r_m^2-\hat\delta_{\ell,m}^2$ (eq. 18),
+# solved by total least squares (TLS); far field: $[x_m\; y_m]\,u = -\hat\delta_m$ by LS. (Eq.
+# 19's $\psi$ is the polar angle from the array normal; eq. 22/24 return its complement.)
+# Algorithm 1 drops $\hat d<0$ and falls back on the far field when $\hat\kappa<0$. The LoS and the
+# ceiling share delay and Doppler: [Kruskal's](GLOSSARY.md#kruskal-rank) condition
+# $\mathrm{kr}(B^s)+\mathrm{kr}(B^f)+\mathrm{kr}(B^t)\ge 2L+2$ holds exactly, but numerically
+# the time factor has Kruskal rank 1 (printed), and only the spatial factor tells them apart.
 
 # %%
 rows = evaluation.comparison_rows(est, paths, array, snap.clock_bias)
-paths_table_figure(rows, title="Extracted vs true (kappa: NaN = far-field fallback of Algorithm 1)")
-
-# %% [markdown]
-# The ceiling path and the LoS share delay and Doppler within a fraction of the resolution, so
-# only the spatial factor tells them apart, and a CPD with a free spatial factor struggles:
-# [Kruskal's](GLOSSARY.md#kruskal-rank) condition $\mathrm{kr}(B^s)+\mathrm{kr}(B^f)+\mathrm{kr}(B^t)\ge 2L+2$ holds in exact
-# arithmetic but, numerically, the time factor has Kruskal rank 1.
-
-# %%
 Bt = np.exp(2j * np.pi * cfg.symbol_period * np.outer(np.arange(12), [p.doppler for p in paths]))
-Bf = np.exp(
-    -2j * np.pi * cfg.tone_spacing * np.outer(np.arange(cfg.n_tones), [p.length / C for p in paths])
-)
-kr = {
-    tol: (extraction.kruskal_rank(Bf, tol), extraction.kruskal_rank(Bt, tol))
-    for tol in (1e-6, 1e-2)
-}
-print("Kruskal rank (frequency, time) at tolerance 1e-6 and 1e-2:", kr)
+kr_t = {tol: extraction.kruskal_rank(Bt, tol) for tol in (1e-6, 1e-2)}
+print("Kruskal rank of the time factor at tolerance 1e-6 and 1e-2:", kr_t)
+plots.paths_table_figure(rows, title="Extracted vs true (kappa NaN: far-field fallback)")
 
 # %% [markdown]
 # ## 5. Eq. 13 is unbiased but not efficient
 #
 # Eq. 13 sums $\bar b_n b_{n+1}$: its phase error telescopes to the two end samples, so its
-# variance falls as $1/N^2$ instead of the $1/N^3$ of the maximum-likelihood (periodogram) root.
-# `extract_paths(refine=...)` offers the paper's `"none"`, a per-column periodogram `"column"`
-# and `"joint"`: all roots refined together with free spatial factors ([variable projection](GLOSSARY.md#variable-projection)), the
-# ML estimate of exactly the model a CPD fits plus the Vandermonde structure; and `"ml"`, the
-# fit of eq. 1 itself (section 7). We compare them on LoS + road (no ceiling, so the comparison
-# is not dominated by it).
+# variance falls as $1/N^2$, not the $1/N^3$ of the ML (periodogram) root. `refine=`: the paper's
+# `"none"`, a per-column periodogram `"column"`, `"joint"` (all roots with free spatial factors,
+# [variable projection](GLOSSARY.md#variable-projection)), `"ml"` (section 7). LoS, on LoS + road:
 
 # %%
-two = signal_route.SignalRoute(
-    route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "road")
-)
+two = replace(route, kinds=("los", "road"))  # the same route, two path families
 n_cmp = tk.mc_count(40, 4)
-cmp = {
-    m: evaluation.rmse_study(two, k_demo, n_cmp, seed=7, refine=m, progress=True)[0]
-    for m in ("none", "column", "joint", "ml")
-}
-paths_table_figure(
-    [
-        {
-            "refine": m,
-            "RMSE d [mm]": 1e3 * r["RMSE d [m]"],
-            "CRLB d [mm]": 1e3 * r["CRLB d [m]"],
-            "RMSE v [m/s]": r["RMSE v [m/s]"],
-            "CRLB v [m/s]": r["CRLB v [m/s]"],
-        }
-        for m, r in cmp.items()
-    ],
-    title=f"LoS errors over {n_cmp} snapshots",
-)
+refines = ("none", "column", "joint", "ml")
+cmp = {m: evaluation.rmse_study(two, k_demo, n_cmp, seed=7, refine=m)[0] for m in refines}
+plots.paths_table_figure([{"refine": m, **r} for m, r in cmp.items()])
 
 # %% [markdown]
 # ## 6. RMSE against the Cramér–Rao bound
 #
-# `extraction.path_crlb` assembles the Fisher information of eq. 1 for all paths jointly from
-# the rank-1 structure (inner products factorise over the three modes; checked against a
-# finite-difference FIM in the tests). Per path the unknowns are the complex gain, the two
-# Vandermonde frequencies ($d$, $v$) and the wave origin (3 numbers: direction and $\kappa$).
-# Seeded snapshots at the paper's SNR, $L$ known, clock bias drawn per snapshot (and part of the
-# truth for $d$), the paper's route first. Full mode: 200 snapshots.
+# `extraction.path_crlb` assembles the Fisher information $J$ of eq. 1, all paths jointly (per
+# path: gain, $d$, $v$, wave origin). The CRLB, $J^{-1}$, bounds the *variance* of an *unbiased*
+# estimator. The table's $d$ and $v$ bounds are those of the model the paper's route fits (free
+# spatial factor, section 7), direction and $\kappa$ those of eq. 1. Full mode: 200 snapshots.
 
 # %%
 n_mc = tk.mc_count(200, 6)
 study_all = evaluation.rmse_study(route, k_demo, n_mc, seed=11, refine="joint", progress=True)
-study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11, refine="joint", progress=True)
-paths_table_figure(study_all, title=f"Paper's route, all paths at epoch {k_demo}, {n_mc} snapshots")
-
-# %%
-paths_table_figure(study_noceil, title=f"Paper's route, LoS + road only, {n_mc} snapshots")
-
-# %% [markdown]
-# Read the two tables column by column; two different bounds stand in them. The bounds of $d$
-# and $v$ are those of the model the paper's route fits (a free spatial factor, section 7);
-# direction and $\kappa$ are bounded by eq. 1 itself.
-#
-# - **LoS + road** (two well-separated paths): the paper's route gets $d$ and $v$ close to their
-#   bound, while direction and $\kappa$ stay above theirs.
-# - **The whole cluster** (LoS, ceiling, road and road markings within a metre of each other,
-#   with the same Doppler): direction and $\kappa$ are orders of magnitude above the bound of
-#   eq. 1. In $d$ and $v$, though, the errors sit *below* the free-factor bound printed beside
-#   them. No estimator beats a Cramér–Rao bound here: that bound holds for an *unbiased*
-#   estimator of every path separately, and with a free spatial factor the LoS and the ceiling
-#   bounce are almost unidentifiable, so their bound is huge (metres). The paper's route does not
-#   estimate them separately: it returns one merged component between the two (a biased
-#   estimate, whose variance no CRLB limits) and often misses the ceiling bounce (column
-#   `missed`). Against the bound of eq. 1 (section 7, a fraction of a millimetre) the same $d$
-#   errors are orders of magnitude above it. The ratios, computed:
-
-# %%
+study_noceil = evaluation.rmse_study(two, k_demo, n_mc, seed=11, refine="joint")
+both = [{"paths": "all", **r} for r in study_all] + [{"paths": "2", **r} for r in study_noceil]
 b_eq1 = extraction.path_crlb(paths, array, cfg)
-ratio_rows = [
-    {
-        "path": r["path"],
-        "surface": r["surface"],
-        "RMSE d / CRLB d (free factor)": r["RMSE d [m]"] / r["CRLB d [m]"],
-        "RMSE d / CRLB d (eq. 1)": r["RMSE d [m]"] / b_eq1["d"][i],
-        "RMSE dir / CRLB dir (eq. 1)": r["RMSE dir [deg]"] / r["CRLB dir [deg]"],
-        "RMSE kappa / CRLB kappa (eq. 1)": r["RMSE kappa [m]"] / r["CRLB kappa [m]"],
-    }
-    for i, r in enumerate(study_all)
-]
-paths_table_figure(ratio_rows, title="Paper's route, all paths: RMSE over each bound")
-
-# %%
-print(
-    f"the bound of eq. 1 at {np.linalg.norm(ue - array.origin):.1f} m: LoS direction "
-    f"{study_all[0]['CRLB dir [deg]']:.4f} deg, kappa "
-    f"{100 * study_all[0]['CRLB kappa [m]']:.1f} cm "
-    f"(all paths: {100 * min(r['CRLB kappa [m]'] for r in study_all):.0f}-"
-    f"{100 * max(r['CRLB kappa [m]'] for r in study_all):.0f} cm)"
-)
+b_free = extraction.path_crlb(paths, array, cfg, spatial="free")
+pair = [r for r in study_all if r["path"] in ("los", "ceiling")]  # the merged pair
+print("LoS, ceiling: d RMSE [m]", [round(r["RMSE d [m]"], 2) for r in pair], end=" ")
+print("under their free-factor CRLB [m]", [round(r["CRLB d [m]"], 2) for r in pair])
+d_mm = {"free factor": (1e3 * b_free["d"]).round(1), "eq. 1": (1e3 * b_eq1["d"]).round(3)}
+print("CRLB d [mm]:", d_mm, "\neq. 1, kappa [m]:", b_eq1["kappa"].round(3), end="; ")
+print(f"LoS direction {study_all[0]['CRLB dir [deg]']:.4f} deg")
+plots.paths_table_figure(both, title=f"Paper's route, all paths and LoS + road (2), {n_mc} draws")
 
 # %% [markdown]
-# That gap is the estimator, not the physics: the bound of eq. 1 (printed above) says that a
-# 23 cm array at this range and SNR pins the direction to about a thousandth of a degree and
-# $\kappa$ to centimetres — for an array that is perfectly calibrated (section 10 shows how far
-# from that a real one is).
+# **LoS + road**: $d$ and $v$ close to their bound, direction and $\kappa$ above theirs. **All
+# paths** (lengths within 1.5 m): direction and $\kappa$ orders of magnitude above the bound of
+# eq. 1; in $d$, though, the LoS and the ceiling bounce sit *below* their free-factor bound, which
+# is huge (metres, printed above).
+#
+# No bound is broken. With a free spatial factor those two paths are almost unidentifiable, so an
+# *unbiased* estimate of each delay would scatter by metres. The paper's route returns instead one
+# merged component (section 7), whose mean follows neither delay one for one, and often misses a
+# path (column `missed`; the RMSE counts matched snapshots only). A biased estimator obeys the
+# *biased* CRB, $\mathrm{var} \ge (1+\partial b/\partial\theta)^2/J$ for a bias $b(\theta)$
+# ($g^\mathsf{T}J^{-1}g$ for several parameters, $g$ the gradient of the estimate's mean), small
+# when the mean hardly moves with $\theta$; and an RMSE holds the bias, $\text{RMSE}^2 = b^2 +
+# \mathrm{var}$, so it is compared with $\sqrt{b^2 + (1+\partial b/\partial\theta)^2/J}$. An RMSE
+# under the unbiased bound marks a biased estimator, not a bound beaten. The bound of eq. 1
+# (printed: a fraction of a millimetre in $d$, about a thousandth of a degree, centimetres in
+# $\kappa$, for a calibrated array) lies far below the same errors: the gap is the estimator's.
 #
 # ## 7. Why a CPD is not efficient, and what is
 #
-# A CPD fits, per path, a **free** spatial factor: $M$ complex numbers ($2(M-1)$ real unknowns
-# after the scaling of eq. 12) where the physics has **three** (the wave origin). Two things
-# follow.
+# A CPD fits, per path, a **free** spatial factor, $2(M-1)$ real unknowns where the physics has
+# **three** (the wave origin). (1) *Noise enters every free entry*: the curvature's small quadratic
+# phase, $k_0\lVert p_m\rVert^2/(2\kappa)$, is buried in $2(M-1)$ noisy directions and read back by
+# a TLS weighting every antenna alike. (2) *Paths sharing delay and Doppler are one rank-one
+# term*, $(\alpha_1 s_1 + \alpha_2 s_2)\circ b_f\circ b_t$: the LoS and the ceiling come out as one
+# biased path. (The free-factor bound on $d$ is looser too: printed above.)
 #
-# 1. *Noise enters every free entry.* The curvature lives in a tiny quadratic phase across the
-#    aperture, $k_0\lVert p_m\rVert^2/(2\kappa)$ (a few hundredths of a radian at 30 m), and
-#    the free factor carries it buried in $2(M-1)$ noisy directions; eq. 16–18 then read it back
-#    by unwrapping and a TLS that weights every antenna alike and ignores how the noise entered.
-#    Nothing in that chain uses the tensor's other two modes to pin the spatial phase.
-# 2. *Paths that share delay and Doppler are one rank-one term.* Their frequency and time factors
-#    are the same vectors, so $\alpha_1 s_1\circ b_f\circ b_t + \alpha_2 s_2\circ b_f\circ b_t$
-#    is a single CPD component with a mixed spatial factor: the LoS and the ceiling bounce (same
-#    delay within centimetres, same Doppler) come out as one biased path. The coherent split
-#    (`refine="coherent"`) fits one to three point sources to such a factor — better directions,
-#    but still from the free factor.
-#
-# A **structured** fit estimates the five numbers per path (direction, $\kappa$, $d$, $v$) plus
-# the gain directly from the whole tensor with the exact model of eq. 1: maximum likelihood,
-# which at this SNR is efficient — it reaches the CRLB. `extraction.ml` does it by variable
-# projection (gains by linear least squares), [Levenberg–Marquardt](GLOSSARY.md#levenberg-marquardt) with analytic derivatives built
-# from the rank-one structure (never an $MN_fN_t \times 5L$ matrix), started from the CPD and the
-# coherent split, with [SAGE](GLOSSARY.md#sage)-like re-seeding of a path when the residual stands above the noise
-# floor (the *basin test*: at the right optimum $\rho = \lVert r\rVert^2/(\text{dof}\,\sigma^2) \approx 1$).
-# It is `extract_paths`' default. The bounds of the two models differ too: the free-factor model
-# has more unknowns, so even its own bound on $d$ is looser.
+# A **structured** fit of eq. 1 to the whole tensor — maximum likelihood — attains the CRLB at
+# this SNR (far above section 11's threshold). `extraction.ml`: variable projection and
+# [Levenberg–Marquardt](GLOSSARY.md#levenberg-marquardt) from the CPD, re-seeding a path in the
+# manner of [SAGE](GLOSSARY.md#sage) while the residual stands above the noise floor (the *basin
+# test*: at the right optimum $\rho = \lVert r\rVert^2/(\text{dof}\,\sigma^2) \approx 1$).
 
 # %%
-b_free = extraction.path_crlb(paths, array, cfg, spatial="free")
-b_struct = extraction.path_crlb(paths, array, cfg)
-print("CRLB d [mm], free spatial factor:", np.round(1e3 * b_free["d"], 2))
-print("CRLB d [mm], structured (eq. 1): ", np.round(1e3 * b_struct["d"], 2))
 study_ml = evaluation.rmse_study(route, k_demo, tk.mc_count(40, 2), seed=11, refine="ml")
-paths_table_figure(study_ml, title=f"ML route, all paths at epoch {k_demo}")
+plots.paths_table_figure(study_ml, title=f"ML route, all paths at epoch {k_demo}")
 
 # %% [markdown]
-# ### Along the drive
-#
-# The same comparison at several epochs of the drive, for the LoS path: the paper's route, the
-# coherent split and the ML stage against the bound, direction and $\kappa$ against the UE's
-# range (`tunnelkit.efficiency.drive_efficiency`, plotted by `tunnelkit.plots.efficiency_figure`).
-# Quick mode: two epochs, one snapshot each; full mode: every third epoch, 10 snapshots.
-#
-# **Reading an RMSE from few snapshots.** An RMSE over $n$ draws is itself random. For an
-# efficient estimator of one parameter, $n\,\text{RMSE}^2/\text{CRLB}^2$ follows a $\chi^2_n$
-# law, so the ratio RMSE/CRLB falls between $\sqrt{\chi^2_{n;0.05}/n}$ and
-# $\sqrt{\chi^2_{n;0.95}/n}$ nine times out of ten (printed below the figure). From one
-# snapshot that is anything from a few hundredths to about two: a point *below* the bound in
-# quick mode is one lucky draw, not an estimator beating the bound.
+# **Along the drive**, the LoS: the paper's route, the coherent split (`refine="coherent"`, point
+# sources fitted to a free factor) and ML (quick: two epochs, one snapshot; full: every third, 10).
+# An RMSE over $n$ draws is random: for an efficient estimator $n\,\text{RMSE}^2/\text{CRLB}^2 \sim
+# \chi^2_n$, so RMSE/CRLB lies in $[\sqrt{\chi^2_{n;0.05}/n}, \sqrt{\chi^2_{n;0.95}/n}]$ nine times
+# in ten: from one snapshot, anything from a few hundredths to about two (printed).
 
 # %%
 drive_epochs = [4, 24] if tk.quick_mode() else list(range(0, len(route.trajectory), 3))
 n_eff = tk.mc_count(10, 1)
-eff = drive_efficiency(route, drive_epochs, n_eff, seed=5)
-efficiency_figure(eff, "los", title=f"LoS path along the drive, {n_eff} snapshot(s) per epoch")
-
-# %%
-chi_lo, chi_hi = (float(np.sqrt(chi2.ppf(q, n_eff) / n_eff)) for q in (0.05, 0.95))
+eff = efficiency.drive_efficiency(route, drive_epochs, n_eff, seed=5)
+chi_band = {n: [float(np.sqrt(chi2.ppf(q, n) / n)) for q in (0.05, 0.95)] for n in (1, n_eff)}
 eff_ml = [r for r in eff if r["route"] == "ml" and r["path"] == "los"]
-eff_paper = [r for r in eff if r["route"] == "joint" and r["path"] == "los"]
-print(
-    f"{n_eff} snapshot(s): an efficient estimator's RMSE/CRLB lies in [{chi_lo:.2f}, {chi_hi:.2f}]"
-)
-for name, rs in (("ML stage", eff_ml), ("paper's route", eff_paper)):
-    print(
-        f"{name:14s} RMSE/CRLB, kappa: "
-        + ", ".join(
-            f"{r['RMSE kappa [m]'] / r['CRLB kappa [m]']:.2g} at {r['range [m]']:.0f} m" for r in rs
-        )
-    )
-print(
-    "ML stage kappa RMSE [m]: "
-    + ", ".join(f"{r['RMSE kappa [m]']:.3f} at {r['range [m]']:.0f} m" for r in eff_ml)
-)
+ratio_ml = [r["RMSE kappa [m]"] / r["CRLB kappa [m]"] for r in eff_ml]
+crlb_k = [r["CRLB kappa [m]"] for r in eff_ml]
+print("90 % band of RMSE/CRLB, by number of snapshots:", chi_band)
+print("ML kappa, RMSE/CRLB:", np.round(ratio_ml, 2), "CRLB [m]:", np.round(crlb_k, 3))
+plots.efficiency_figure(eff, "los", title=f"LoS along the drive, {n_eff} snapshot(s) per epoch")
 
 # %% [markdown]
-# The paper's route sits orders of magnitude above the bound, the coherent split in between; the
-# ML stage lies on it at every range (within the sampling spread printed above), with $\kappa$
-# from centimetres near the BS to decimetres at the far end. A 10 × 10 URA of 23 cm **does**
-# measure the curvature of the wavefront along the whole drive — if it is calibrated (section 10)
-# and the estimator uses the model.
-
-# %% [markdown]
+# The paper's route sits far above the bound, ML on it (mostly inside the band); $\kappa$'s bound
+# grows from millimetres near the BS to decimetres at the far end. The paper's URA **does**
+# measure the wavefront's curvature, if calibrated and if the estimator uses the model.
+#
 # ## 8. Estimated wave origins along the trajectory (cf. Fig. 5)
 #
-# For every epoch we place each near-field estimate of the paper's route at
-# $p = \text{origin} + \hat\kappa\,\hat u$ and colour it by altitude. With the SR-NF channel
-# the origins are the reflection points (road markings low, the ceiling high); with the exact
-# physics they are the VUEs, mirrored *outside* the tunnel. (The ML route of section 7 places
-# them to centimetres; it fits point sources at any $\kappa \ge 0.5$ m, so the nearest SR-NF
-# origin, the ceiling's reflection point, is within its reach: its $\kappa$ is printed in
-# section 1, its height above the array below the figure.)
+# The paper's near-field estimates at $\text{origin} + \hat\kappa\,\hat u$: with the SR-NF channel,
+# the reflection points (markings low, ceiling high); with the exact physics, the VUEs, outside.
 
 # %%
-step = 7 if tk.quick_mode() else 1
-origins = {}
+origins, ks = {}, range(0, len(route.trajectory), 7 if tk.quick_mode() else 1)
 for model in ("srnf", "exact"):
-    r_m = signal_route.SignalRoute(route.tunnel, route.arrays, route.trajectory, cfg, model=model)
-    ks = range(0, len(route.trajectory), step)
-    eps = [
-        r_m.epoch(k, np.random.default_rng(100 + k), refine="joint")
-        for k in tqdm(ks, desc=model, leave=False)
-    ]
+    r_m = replace(route, model=model)
+    eps = [r_m.epoch(k, np.random.default_rng(100 + k), refine="joint") for k in tqdm(ks)]
     origins[f"{model} channel"] = np.concatenate([e.measurements.wave_origins for e in eps])
-wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
-
-# %%
-print(
-    f"epoch {k_demo}: the ceiling's reflection point is {ceil_gap:.2f} m above the array "
-    f"(vertical gap) and kappa = {ceil.kappa_srnf:.2f} m from it (eq. 51)"
-)
+plots.wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)
 
 # %% [markdown] tags=["explorer"]
 # ## 9. What does the curvature measure? (M and SNR sliders)
 #
-# Theorem 3.1/3.4 (notebook 02): up to $M_{\max}$ antennas the exact channel of a reflected path
-# is indistinguishable, within a phase error $\varepsilon_\Phi$, from the SR-NF model whose
-# wavefront is centred on the reflection point. Past $M_{\max}$ only the VUE explains it. The
-# explorer resizes the URA ($n\times n$), synthesises the *exact* channel and shows the paper's
-# TLS $\hat\kappa$ (eq. 17–18) of the strongest road-marking path between the two candidates; on
-# the right, the largest SR-NF phase mismatch over the aperture against
-# $\varepsilon_\Phi = 0.15$ rad. The title says two separate things: whether the *channel* is
-# SR-NF within $\varepsilon_\Phi$ (a property of the geometry), and whether the *estimates*
-# resolve either candidate (a property of the estimator: the TLS spread against the gap between
-# the two). At the paper's 10 × 10 the channel is SR-NF within tolerance, yet the TLS estimates
-# scatter over metres and match neither.
+# Theorem 3.1/3.4 (notebook 02): up to $M_{\max}$ antennas a reflected path's exact channel is,
+# within a phase error $\varepsilon_\Phi$, the SR-NF one centred on the reflection point; past it
+# only the VUE explains it. The explorer resizes the URA, synthesises the *exact* channel, and
+# shows the strongest road marking's TLS $\hat\kappa$ between the two candidates and its largest
+# SR-NF phase mismatch against $\varepsilon_\Phi = 0.15$ rad. At the paper's 10 × 10 *this
+# path's* channel is SR-NF within tolerance (geometry), yet the TLS estimates match neither
+# candidate (the estimator). SR-NF belongs to one path: at the same epoch the other marking and
+# the ceiling bounce break it, the ceiling at every epoch (notebook 02; printed).
 
 # %% tags=["explorer"]
 explorer = cpd_explorer()
 explorer
 
 # %%
-big = curvature_study(16, 30.0, k_demo)
-small_arr = curvature_study(3, 30.0, k_demo)
-print(
-    f"M = 256: kappa = {np.round(big['kappa'], 2)} (VUE {big['kappa_vue']:.2f} m, reflection "
-    f"point {big['kappa_reflection']:.2f} m), mismatch {big['mismatch']:.3f} rad"
-)
-print(
-    f"M = 9:   kappa = {np.round(small_arr['kappa'], 2)}, mismatch {small_arr['mismatch']:.4f} rad"
-)
+big, small_arr = curvature_study(16, 30.0, k_demo), curvature_study(3, 30.0, k_demo)
+for s in (big, small_arr):
+    print(f"M = {s['M']}: kappa {s['kappa'].round(2)}, mismatch {s['mismatch']:.4f} rad")
+print(f"candidates: VUE {big['kappa_vue']:.2f} m, reflection {big['kappa_reflection']:.2f} m")
+mis = {p.surface: round(mismatch(p, cfg.fc), 3) for p in paths[1:]}  # 10 x 10, epoch 12
+drive_paths = [route.paths(k)[1] for k in range(len(route.trajectory))]
+ceil_mis = [mismatch(p, cfg.fc) for ps in drive_paths for p in ps if p.surface_kind == "ceiling"]
+print(f"10 x 10 mismatch [rad] {mis}; the ceiling's, whole drive: >= {min(ceil_mis):.2f}")
 
 # %% [markdown]
-# With a 3 × 3 array (5 cm) the SR-NF and the exact model are the same channel within
-# $\varepsilon_\Phi$, and the paper's TLS often returns no curvature at all (Algorithm 1's
-# far-field fallback): the quadratic phase is a few thousandths of a radian and the TLS does not
-# dig it out. The bound of such an array is metres, not centimetres — compare
-# `extraction.path_crlb` for `small_arr` below. With a large array the estimate sits on the VUE
-# distance, never on eq. 51's reflection-point distance; at 10 × 10 the ML route of section 7
-# already does (centimetres). The tracker of notebook 04 has to know which one it is fed.
-
-# %% [markdown]
+# With a 3 × 3 array SR-NF and exact differ by a few thousandths of a radian, and the TLS mostly
+# returns no curvature ($\hat\kappa < 0$: the fallback). With a large array it sits on the VUE's
+# distance, never on eq. 51's; at 10 × 10 the ML route already does, to its bound.
+#
 # ## 10. Where the bound stops being reachable: impairments eq. 1 leaves out
 #
-# The bound above assumes eq. 1 is the truth. Two things a real array adds
-# (`channel.Impairments`, off by default):
-#
-# - **calibration error**: each element multiplies what it receives by
-#   $10^{e_m/20}e^{j\varphi_m}$, $e_m\sim\mathcal N(0,\sigma_\text{dB}^2)$,
-#   $\varphi_m\sim\mathcal N(0,\sigma_\varphi^2)$, drawn once per array (a well-calibrated array
-#   keeps a degree or two and a few tenths of a dB; below we try a quarter of that, 0.5° and
-#   0.05 dB);
-# - **spatial wideband**: eq. 1 gives every element the reference antenna's delay; the wave
-#   reaches element $m$ $\delta_{\ell m}/c$ later, so tone $s$, at $f_s = f_c + (s - s_c)\Delta f$
-#   around the band centre, carries the extra phase
-#   $e^{-j2\pi (s - s_c)\Delta f\,\delta_{\ell m}/c}$ — up to about 0.2 rad at the band edges
-#   across 23 cm.
-#
-# `SignalRoute.with_impairments` builds an impaired route; the ML stage (which still fits eq. 1)
-# and the bound of eq. 1, LoS + road at epoch 12:
+# A real array adds (`channel.Impairments`) a **calibration error**, element $m$ multiplying what
+# it receives by $10^{e_m/20}e^{j\varphi_m}$, $e_m\sim\mathcal N(0,\sigma_\text{dB}^2)$,
+# $\varphi_m\sim\mathcal N(0,\sigma_\varphi^2)$, drawn once (a small one below), and **spatial
+# wideband**: the wave reaches element $m$ $\delta_{\ell m}/c$ later, so tone $s$ carries
+# $e^{-j2\pi (s - s_c)\Delta f\,\delta_{\ell m}/c}$ (over a tenth of a radian at the band edges,
+# printed). ML still fits eq. 1; LoS + road at epoch 12:
 
 # %%
-n_imp = tk.mc_count(10, 1)
 impairments = {
     "none": channel.Impairments(),
     "calibration 0.5 deg, 0.05 dB": channel.Impairments(phase_sigma_deg=0.5, gain_sigma_db=0.05),
     "spatial wideband": channel.Impairments(spatial_wideband=True),
 }
-imp_rows = []
+imp_los = {}
 for name, imp in impairments.items():
     r_imp = two.with_impairments(imp, np.random.default_rng(3))
-    for row in drive_efficiency(r_imp, [k_demo], n_imp, seed=21, refines=("ml",)):
-        imp_rows.append({"impairment": name, **row})
-paths_table_figure(imp_rows, title="ML route with and without impairments (LoS + road, epoch 12)")
-
-# %%
-imp_los = {r["impairment"]: r for r in imp_rows if r["path"] == "los"}
-cal_name = "calibration 0.5 deg, 0.05 dB"
-for name, r in imp_los.items():
-    print(
-        f"{name:30s} LoS kappa error {r['RMSE kappa [m]']:8.3f} m "
-        f"= {r['RMSE kappa [m]'] / r['CRLB kappa [m]']:7.2g} x its bound, at {r['range [m]']:.0f} m"
-    )
+    rows_ = efficiency.drive_efficiency(r_imp, [k_demo], tk.mc_count(10, 1), 21, refines=("ml",))
+    r = imp_los[name] = next(x for x in rows_ if x["path"] == "los")
+    print(f"{name}: LoS kappa RMSE {r['RMSE kappa [m]']:.3f} m, CRLB {r['CRLB kappa [m]']:.3f} m")
+delta_max = max(np.abs(p.delta("exact")).max() for p in paths)  # largest offset [m]
+sw_edge = 2 * np.pi * (cfg.n_tones / 2) * cfg.tone_spacing * delta_max / C
+print(f"spatial wideband phase at the band edges: up to {sw_edge:.2f} rad")
 
 # %% [markdown]
-# Each impairment lifts the estimate far off the bound (the ratios above): at the effective SNR of
-# section 2 even a fraction of a degree of phase error per element is a bias far larger than the
-# noise, and the estimator, fitting the wrong model, converts it into a wrong direction and
-# curvature. The two are not alike, though. The spatial-wideband term is deterministic and follows
-# from the geometry the fit estimates anyway: it can be put in the model (the ML stage here does
-# not), and then it costs nothing. The calibration error is not known; even 0.5° and 0.05 dB leave
-# the LoS curvature off by about a metre or more (printed above; one array draw in quick mode). It
-# is what limits a real array, and what a designer must budget for — the bound of a real array is
-# set by its calibration, not by its noise.
-
-# %% [markdown]
+# Each impairment lifts the estimate far off the bound: at section 2's integrated SNR a fraction
+# of a degree of phase error is a bias far above the noise, which the fit of the wrong model turns
+# into a wrong direction and curvature. Spatial wideband is deterministic and can be modelled (ML
+# here does not); the unknown calibration error, even this small, puts $\kappa$ off by metres.
+#
 # ## 11. The threshold region: where maximum likelihood leaves the bound
 #
-# The CRLB is a *local* bound: it measures the curvature of the likelihood at its peak, and it
-# holds for the ML estimate only while that peak is the highest one. The ML search scans about
-# $K = M N_f N_t$ orthogonal cells (beams × delays × Dopplers). On the normalised periodogram a
-# noise-only cell is $|n_1|^2$, exponential with mean 1, and the path's cell is
-# $|\sqrt{\eta} + n_0|^2$ with $\eta = P_t|\alpha|^2 M N_f N_t / N_0$ the integrated SNR (the
-# path's energy over the noise power; `PathEstimates.significance` at the fit). One noise cell
-# beats the path with probability $e^{-\eta/2}/2$; the probability that *some* cell does — an
-# outlier, or interval error — is exactly
-# $P_\text{out}(\eta) = \Pr\big(\max_{K-1} |n_k|^2 > |\sqrt{\eta} + n_0|^2\big)$, one integral
-# over the path cell's non-central $\chi^2$ density (`ml.outlier_probability`; the tests check it
-# against brute force). The method of interval errors (MIE; Van Trees, Richmond 2006) writes the
-# mean-square error as $(1 - P_\text{out})\,\text{CRLB} + P_\text{out}\,\sigma^2_\text{prior}$:
-# an outlier lands anywhere in the search space, thousands of standard deviations away, so the
-# estimate leaves the bound as soon as $P_\text{out}$ is no longer negligible — the Ziv–Zakai
-# bound, tighter than the CRLB, leaves it at the same place. The threshold SNR the extraction
-# states is where $P_\text{out} = 1\,\%$ (`ml.snr_threshold`): a path below it, or closer to
-# another than `ml.RESOLVE_Z` standard deviations of their difference, is in the threshold region,
-# and the extraction says so per path (`PathEstimates.below_threshold`, computed at its own fit).
-# The paper's array with a thinner SRS (its size printed below, to keep this fast) and the LoS
-# alone at epoch 12, the SNR lowered step by step (`efficiency.threshold_study`: errors over the
-# CRLB *at that SNR*; a path the fit cannot tell from noise counts as missed):
+# The CRLB is *local* (the likelihood's curvature at the truth) and bounds every unbiased
+# estimator at every SNR; at low SNR it still holds, but ML stops attaining it. ML scans about
+# $K = M N_f N_t$ orthogonal cells; on the normalised periodogram a noise cell is $|n_1|^2$
+# (exponential, mean 1), the path's $|\sqrt{\eta} + n_0|^2$ ($\eta = P_t|\alpha|^2 M N_f N_t /
+# N_0$, the integrated SNR). A noise cell beats the path — an *outlier*, far from the truth — with
+# probability $P_\text{out}(\eta) = \Pr(\max_{K-1} |n_k|^2 > |\sqrt{\eta} + n_0|^2)$.
+#
+# - The **method of interval errors (MIE)** is an *approximation*, not a bound: ML's mean-square
+#   error $\approx (1 - P_\text{out})\,\text{CRLB} + P_\text{out}\,\sigma^2_\text{prior}$ (near
+#   the truth, or with probability $P_\text{out}$ a guess anywhere in the search space).
+# - The **Ziv–Zakai bound** is a *bound* on the mean-square error of any estimator of a parameter
+#   drawn from a prior (an average over it), valid at every SNR: near the CRLB far above the
+#   threshold, rising towards the prior's variance below. It is not computed here.
+#
+# The threshold is the $\eta$ where $P_\text{out} = 1\,\%$ (`ml.snr_threshold`); a path below it,
+# or closer to another than `ml.RESOLVE_Z` standard deviations, is flagged. The fit is also tested
+# by a **generalised likelihood-ratio test (GLRT)**: the likelihood with one path more against the
+# fitted model, each maximised over its unknowns, against a threshold set for 1 % false alarms
+# (failed: `fit_ok = False`). The LoS alone, a thinner SRS, the SNR lowered step by step:
 
 # %%
-from dataclasses import replace
-
-import plotly.graph_objects as go
-
-from tunnelkit import efficiency
-
-thin_cfg = replace(cfg, n_rb=20, comb=4)
-los_only = signal_route.SignalRoute(
-    route.tunnel, route.arrays, route.trajectory, thin_cfg, kinds=("los",)
-)
-n_cells = array.M * thin_cfg.n_tones * thin_cfg.n_symbols
+thin = replace(cfg, n_rb=20, comb=4)
+los_only = replace(route, config=thin, kinds=("los",))
+n_cells = array.M * thin.n_tones * thin.n_symbols
 eta_th = 10 * np.log10(ml.snr_threshold(n_cells))  # P_out = 1 %
-eta_half = 10 * np.log10(ml.snr_threshold(n_cells, 0.5))  # an outlier half the time
-arr_t, paths_t = los_only.paths(k_demo)
-eta0 = 10 * np.log10(abs(paths_t[0].gain) ** 2 * thin_cfg.tx_power * n_cells / thin_cfg.noise_power)
-eta_grid = eta_th + np.array([15.0, 8.0, 0.0, -5.0])  # integrated SNR [dB] around the threshold
-n_thr = tk.mc_count(20, 2)
-snr_rows = efficiency.threshold_study(los_only, [k_demo], eta_grid - eta0, n_thr, seed=23)
-p_out = {
-    round(r["integrated SNR [dB]"] - eta_th): float(
-        ml.outlier_probability(10 ** (r["integrated SNR [dB]"] / 10), n_cells)
-    )
-    for r in snr_rows
-}
-print(
-    f"{array.M} antennas x {thin_cfg.n_tones} tones x {thin_cfg.n_symbols} symbols; "
-    f"MIE threshold (1 % outliers): eta = {eta_th:.1f} dB for K = {n_cells} cells "
-    f"(outliers half the time at {eta_half:.1f} dB)"
-)
+power = abs(los_only.paths(k_demo)[1][0].gain) ** 2 * thin.tx_power  # the LoS's power
+eta0 = 10 * np.log10(power * n_cells / thin.noise_power)  # its integrated SNR
+offsets = eta_th + np.array([15.0, 8.0, 0.0, -5.0]) - eta0  # to eta_th +15, +8, 0, -5 dB
+snr_rows = efficiency.threshold_study(los_only, [k_demo], offsets, tk.mc_count(20, 2), seed=23)
+print(f"K = {n_cells} cells: threshold (P_out = 1 %) at an integrated SNR of {eta_th:.1f} dB")
+p_out = {}
 for r in snr_rows:
     dx = round(r["integrated SNR [dB]"] - eta_th)
-    print(
-        f"  eta_th {dx:+d} dB: MIE outlier probability {p_out[dx]:.2g}, "
-        f"measured beyond 6 sigma {r['beyond 6 sigma']:.2f}, flagged {r['flagged']:.2f}"
-    )
-paths_table_figure(snr_rows, title="ML route against the CRLB as the SNR falls (LoS, epoch 12)")
+    p_out[dx] = float(ml.outlier_probability(10 ** (r["integrated SNR [dB]"] / 10), n_cells))
+    print(f"{dx:+3d} dB: MIE P_out {p_out[dx]:.2g}, lost {r['beyond 6 sigma']:.2f}", end=", ")
+    print(f"flagged {r['flagged']:.2f}, RMSE/CRLB direction {r['RMS/CRLB direction']:.2f}")
+eta_120 = snr_eff[0] - 20 * np.log10(120.0 / paths[0].length)  # the LoS at 120 m, full SRS
+margin_120 = eta_120 - 10 * np.log10(ml.snr_threshold(snap.H.size))
+print(f"presets' SNR, full SRS: the LoS at 120 m stands {margin_120:.0f} dB above the threshold")
 
 # %% [markdown]
-# Against range at one SNR: the LoS power falls as $1/r^2$, so a drive crosses the threshold
-# where $\eta$ drops below $\eta_\text{th}$. Here the SNR is set to put $\eta_\text{th} + 5$ dB at
-# 7 m. At the presets' own SNR and full SRS the LoS stays far above the threshold over the whole
-# drive: the margin at 120 m (the $1/r^2$ law from epoch 12) is printed below. The figure puts
-# both sweeps on one axis, $\eta$; a lost path is drawn at 100.
-
-# %%
-d_ue = np.linalg.norm(los_only.trajectory.position - arr_t.origin, axis=1)
-k_rng = [int(np.argmin(np.abs(d_ue - r))) for r in (7.0, 15.0, 45.0)]
-off_rng = eta_th + 5.0 - eta0 + 20 * np.log10(d_ue[k_demo] / 7.0)
-rng_rows = efficiency.threshold_study(los_only, k_rng, [off_rng], n_thr, seed=24)
-n_full = array.M * cfg.n_tones * cfg.n_symbols
-eta_full = 10 * np.log10(abs(paths_t[0].gain) ** 2 * cfg.tx_power * n_full / cfg.noise_power)
-eta_th_full = 10 * np.log10(ml.snr_threshold(n_full))
-margin_120 = eta_full - 20 * np.log10(120.0 / d_ue[k_demo]) - eta_th_full
-print(
-    f"presets' SNR, full SRS ({n_full} cells, threshold {eta_th_full:.1f} dB): the LoS at 120 m "
-    f"stands {margin_120:.0f} dB above the threshold"
-)
-fig_thr = go.Figure()
-for rows_, name in ((snr_rows, "SNR lowered, 29 m"), (rng_rows, "range 7-45 m")):
-    lost = [r["beyond 6 sigma"] >= 0.5 for r in rows_]
-    y = [100.0 if b else max(r["RMS/CRLB direction"], 0.1) for r, b in zip(rows_, lost)]
-    x = [r["integrated SNR [dB]"] for r in rows_]
-    fig_thr.add_scatter(x=x, y=y, mode="markers+lines", name=name)
-fig_thr.add_vline(x=eta_th, line_dash="dash", annotation_text="MIE threshold (1 % outliers)")
-fig_thr.add_vline(x=eta_half, line_dash="dot", annotation_text="outliers half the time")
-fig_thr.update_layout(
-    xaxis_title="integrated SNR [dB]", yaxis_title="RMSE / CRLB, direction", yaxis_type="log"
-)
-
-# %% [markdown]
-# Above the threshold the ML route sits on the bound (the largest RMSE/CRLB there is printed
-# below) and the MIE outlier probability printed above is negligible; a few dB below it the path
-# is lost in the noise or an outlier wins, and the error jumps by orders of magnitude: the CRLB
-# says nothing there, the MIE / Ziv–Zakai bound does. The SNR threshold is not the only one: at
-# long range the images lie a few standard deviations of their difference from the LoS (the
-# resolution threshold, `ml.separations`), and there the search can miss a path whose own SNR is
-# thousands of noise powers (`benchmarks/bench_stress.py` counts both, per case). The
-# extraction reports it: such a snapshot has `fit_ok = False` and `fit.reason` says why (its
-# residual test — the GLRT of one path more, its threshold calibrated on noise-only tensors at a
-# 1 % false-alarm rate —, a path below the noise, or two paths closer than their bound can
-# resolve: the same threshold effect for a pair), and the trackers skip it
-# (`studies.path_measurements`). `benchmarks/bench_stress.py` stresses the same over the whole
-# drive, far below the presets' SNR, with many paths and close pairs. Before it gives up, the
-# search re-splits around such a pair (a cluster merged while a path is counted twice: the
-# weaker of the pair out, each other path split in two, kept only if the likelihood rises), and
-# the benchmark tells every failure left above the threshold apart: a *search miss* (the fit
-# restarted at the truth finds a significantly more likely basin) or *not attainable* (the
-# estimate is at least as likely as the truth's basin, so no search can do better and the CRLB
-# of the resolved model is not a bound it can reach; the separation at the estimate, from its
-# Fisher information, says why). For such a pair the extraction gives its own verdict, the test
-# channel sounding uses: for each pair closer than `ml.PAIR_TEST_Z` standard deviations, the
-# generalised likelihood-ratio test of one path (the two merged, every path fitted again)
-# against two (`ml.pair_test`: the cost drop in noise powers against `ml.PAIR_LLR`, the 99 %
-# quantile of its null distribution, one path fitted as a close pair, by Monte-Carlo in
-# `benchmarks/bench_stress_pairs.py`). A pair that fails it holds one path's worth of
-# information: `PathEstimates.unresolved` names each path's partner, `fit_ok` is False
-# (`"pair not resolved"`), and the benchmark counts such paths in their own column instead of
-# judging them against the bound of two resolved paths.
-
-# %%
-above_thr = [r for r in snr_rows if r["integrated SNR [dB]"] >= eta_th + 7.0]
-rms_above = max(r["RMS/CRLB direction"] for r in above_thr)
-print(f"largest RMSE/CRLB (direction) 7 dB or more above the threshold: {rms_above:.2f}")
+# From 7 dB above the threshold on, ML sits on the bound and $P_\text{out}$ is negligible; 5 dB
+# below, the path is lost (beyond 6 standard deviations, or missed) in most snapshots, and flagged.
+# The CRLB still holds there: ML has stopped attaining it. At the threshold itself the share lost
+# is well above the MIE's 1 %: an approximation, of the search's outliers only. At the presets'
+# SNR the LoS stays far above the threshold over the drive (margin at 120 m printed; the
+# resolution threshold and the failures past both: extraction notes, part 3).
 
 # %% [markdown]
 # ## Exercises
@@ -670,11 +369,12 @@ print(f"largest RMSE/CRLB (direction) 7 dB or more above the threshold: {rms_abo
 #    `fit.rho_max` (the basin test) and `fit.significance`. What went wrong, and how does the
 #    fit tell you?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and once you have
-# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
-# what it printed. What to read in them follows.
+# Run All does not run the solutions below: once you have tried, click "Run solution" under
+# one (or run `tk.solution("03.2")`); it runs on a copy of your variables. On the static site
+# they have run: open one, then "Show the solution's output". What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.1
 # Solution 1: a truck between the vehicle and the BS, epoch 12
 from tunnelkit import propagation
 
@@ -690,9 +390,11 @@ print(
     f"path 0 of the extraction: d = {est_t1.d[0]:.3f} m "
     f"(= length + clock bias {C * snap_t1.clock_bias:.3f} m)"
 )
-
+assert "los" not in {p.kind for p in ps_t1} and first_t1.surface_kind == "rrm"
+assert abs(est_t1.d[0] - first_t1.length - C * snap_t1.clock_bias) < 0.1
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.2
 # Solution 2: the LoS estimate with and without the ceiling bounce (the paper's route, section 6)
 no_ceil = signal_route.SignalRoute(
     route.tunnel, route.arrays, route.trajectory, cfg, kinds=("los", "wall", "road", "rrm")
@@ -704,9 +406,11 @@ for name, r in sol2.items():
         f"{name:11s} LoS d RMSE {r['RMSE d [m]']:.4f} m, free-factor CRLB {r['CRLB d [m]']:.4f} m, "
         f"direction RMSE {r['RMSE dir [deg]']:.3f} deg"
     )
-
+d_rmse = [sol2[n]["RMSE d [m]"] for n in ("all paths", "no ceiling", "LoS + road")]
+assert d_rmse[0] > 5 * d_rmse[1] > 5 * d_rmse[2], d_rmse
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.3
 # Solution 3: the SNR lowered on the paper's route: how often is each path missed?
 n_sol3 = tk.mc_count(10, 2)
 sol3 = {}
@@ -724,9 +428,15 @@ print(
         for r, v in zip(rows3, snap.snr_db.round(1))
     },
 )
+assert sol3[0]["los"] + sol3[0]["ceiling"] > 0, sol3  # the merged pair, missed at 0 dB
+low = [o for o in sol3 if o <= -10]  # from 10 dB below on: the marking worse, the road less so
+assert all(sol3[o]["RRM bottom right"] > sol3[0]["RRM bottom right"] for o in low), sol3
+assert 2 * sum(sol3[o]["road"] for o in low) < sum(sol3[o]["RRM bottom right"] for o in low)
+assert sum(sol3[-30].values()) >= sum(sol3[0].values()), sol3
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.4a
 # Exercise 4, solution (a): starts in the wrong basin, on the tensor of sections 2-4
 def truth_start(paths, array, clock_bias):
     """(theta, mu_f, mu_t) of the true paths: (u_x, u_y, 1/kappa) in the array frame, roots."""
@@ -748,8 +458,13 @@ fits = {
 }
 for name, f in fits.items():
     print(f"{name:30s} rho = {f.rho:9.3f} (basin test passes below {f.rho_max:.4f})")
+assert fits["truth"].rho < fits["truth"].rho_max
+assert fits["paper's route, no re-seeding"].rho > 10 * fits["truth"].rho
+assert fits["paper's route, re-seeding"].rho < fits["paper's route, re-seeding"].rho_max
+assert 10 < fits["paper's route, no re-seeding"].rho < 100  # tens of times the noise floor
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 03.4b
 # Exercise 4, solution (b): the wrong number of paths, on a LoS + road tensor
 arr2, paths2 = two.paths(k_demo)
 snap2 = channel.synthesize(paths2, cfg, np.random.default_rng(4))
@@ -763,6 +478,9 @@ for L, e in wrong_L.items():
         f"valid = {e.valid}"
     )
 print("warnings:", sorted({type(w.message).__name__ for w in caught}))
+assert wrong_L[1].fit.rho > wrong_L[1].fit.rho_max and wrong_L[2].fit.rho < wrong_L[2].fit.rho_max
+assert 100 < wrong_L[1].fit.rho < 1000  # one path too few: hundreds of times
+assert not wrong_L[3].valid.all()
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
@@ -777,9 +495,10 @@ print("warnings:", sorted({type(w.message).__name__ for w in caught}))
 #    split their sum with the spatial factor alone, and a free spatial factor can rotate between
 #    them (Kruskal rank 1 in time, section 4); the free-factor CRLB grows accordingly.
 # 3. The CPD loses paths long before the noise hides them, and not the weakest first: already at
-#    the presets' SNR the LoS and the ceiling bounce are often merged (one of them missed), the
-#    bottom-right road marking goes from about 10 dB below on, while the road bounce, the
-#    weakest per element, is found throughout. What a free spatial factor cannot separate goes
+#    the presets' SNR the LoS and the ceiling bounce are often merged (one of them missed); from
+#    about 10 dB below on, the bottom-right road marking is missed more often than at the
+#    presets' SNR, while the road bounce, the weakest per element, is missed less than half as
+#    often as that marking over the same levels. What a free spatial factor cannot separate goes
 #    first. (Quick mode: two snapshots per level, so the counts are coarse.) Try the same with
 #    `refine="ml"` (slower): its `MLDetectionWarning` says when a path no longer stands above
 #    the noise.
@@ -791,7 +510,7 @@ print("warnings:", sorted({type(w.message).__name__ for w in caught}))
 # (a) From the truth the fit stays there and $\rho \approx 1$: the residual is the noise. The
 # paper's route merged the LoS and the ceiling bounce into one component and left a spare one
 # on noise: started there, Levenberg–Marquardt improves what it has and stops in a local
-# minimum whose residual is about a thousand times the noise floor — one wave is explained by
+# minimum whose residual is tens of times the noise floor — one wave is explained by
 # two starts, another by none, and no small step fixes that. The basin test sees it
 # ($\rho \gg \rho_{\max}$). With re-seeding on, the fit drops the least significant path,
 # searches the residual for it (SAGE-like: power iterations, periodogram, beam scan, curvature
@@ -809,81 +528,73 @@ print("warnings:", sorted({type(w.message).__name__ for w in caught}))
 
 # %%
 los = paths[0]
+# sections 1-2: the paths, section 4.2's SRS, the clock bias read as a 50 ns sd
 assert los.kind == "los" and abs(los.length - np.linalg.norm(ue - array.origin)) < 1e-12
-assert {p.surface_kind for p in paths} >= {"los", "ceiling", "road", "rrm"}
-assert cfg.n_tones == 410 and snap.H.shape == (100, 410, 12)
-assert abs(snap.clock_bias) <= 100e-9
-assert est.rel_error < 0.05 and np.all(np.isfinite(est.d))
-assert np.max(np.abs(fast.d - d_true)) < 0.05  # noiseless small tensor: fast CPD exact-ish
-assert kr[1e-2][1] == 1  # the time factor is numerically rank one
-assert cmp["joint"]["RMSE d [m]"] < cmp["none"]["RMSE d [m]"]  # eq. 13 is not efficient
-assert cmp["ml"]["RMSE d [m]"] < 3 * cmp["ml"]["CRLB d [m]"]
-# the paper's route on two separated paths: d and v within 2x the bound of the model it fits
-arr_two, paths_two = two.paths(k_demo)
-free_two = extraction.path_crlb(paths_two, arr_two, cfg, spatial="free")
-assert study_noceil[0]["RMSE d [m]"] < 2 * free_two["d"][0]
-assert study_noceil[0]["RMSE v [m/s]"] < 2 * free_two["v"][0]
-assert study_noceil[0]["RMSE dir [deg]"] < 2.0
-# the ML stage at the bound (loose in quick mode: RMS over few snapshots), the paper's route not
-ml_rows = {r["path"]: r for r in study_ml}
-assert ml_rows["los"]["matched"] >= 2 and ml_rows["los"]["missed"] == 0
-for kind in ("los", "road", "ceiling"):
-    lim = 4.0 if tk.quick_mode() else 1.5
-    assert ml_rows[kind]["RMSE kappa [m]"] < lim * ml_rows[kind]["CRLB kappa [m]"], kind
-    assert ml_rows[kind]["RMSE dir [deg]"] < lim * ml_rows[kind]["CRLB dir [deg]"], kind
-assert study_all[0]["RMSE dir [deg]"] > 100 * study_all[0]["CRLB dir [deg]"]
-for r in eff:
-    if r["route"] == "ml" and r["path"] == "los":
-        assert r["RMSE kappa [m]"] < (5.0 if tk.quick_mode() else 2.0) * r["CRLB kappa [m]"], r
-# impairments lift the estimate off the bound; 0.5 deg / 0.05 dB: the LoS kappa off by metres
-assert imp_los["none"]["RMSE kappa [m]"] < 5 * imp_los["none"]["CRLB kappa [m]"]
-for name in (cal_name, "spatial wideband"):
-    r = imp_los[name]
-    lost = r["no kappa"] == r["matched"]  # the curvature lost altogether: a plane-wave fit
-    assert lost or r["RMSE kappa [m]"] > 10 * r["CRLB kappa [m]"], name
-r = imp_los[cal_name]
-assert r["no kappa"] == r["matched"] or r["RMSE kappa [m]"] > 0.5, r
-# section 6: the CRLB column of the tables is the structured one for direction and kappa
-assert np.allclose([r["CRLB kappa [m]"] for r in study_all], b_eq1["kappa"], rtol=1e-9)
-# ... and the free-factor d bound exceeds the eq. 1 bound by orders of magnitude (merged pair)
-assert study_all[0]["CRLB d [m]"] > 1e3 * b_eq1["d"][0]
-assert study_all[0]["RMSE d [m]"] > 100 * b_eq1["d"][0]  # the paper's route far above eq. 1
-assert all(r["RMSE kappa [m]"] > 10 * r["CRLB kappa [m]"] for r in study_all)
-# section 1 / 8: the ceiling's reflection point is a short kappa, much shorter than its VUE
+assert {p.surface_kind for p in paths} >= {"los", "ceiling", "road", "rrm"} and cfg.comb == 8
+assert np.ptp([p.length for p in paths]) < 1.5 and cfg.bandwidth == 100e6
+assert 0 < ceil.length - los.length < 0.1 and abs(ceil.doppler - los.doppler) < 0.01 * doppler_res
 assert ceil.kappa_srnf < 0.25 * ceil.length and 0 < ceil_gap < ceil.kappa_srnf
-assert 0.5 < ceil.kappa_srnf  # inside the ML search's kappa >= 0.5 m
-# section 2: effective SNR = per element + 10 log10(N_f N_t) + 10 log10(M)
-assert np.allclose(snr_eff - snap.snr_db, 10 * np.log10(410 * 12 * 100))
-# the sampling interval of section 7 contains 1 and widens with fewer snapshots
-assert chi_lo < 1 < chi_hi
-# exercise 4: the basin test
-assert fits["truth"].rho < fits["truth"].rho_max
-assert fits["paper's route, no re-seeding"].rho > 10 * fits["truth"].rho
-assert fits["paper's route, re-seeding"].rho < fits["paper's route, re-seeding"].rho_max
-assert wrong_L[1].fit.rho > wrong_L[1].fit.rho_max and wrong_L[2].fit.rho < wrong_L[2].fit.rho_max
-assert not wrong_L[3].valid.all()
+assert snap.H.shape == (100, 410, 12) and cfg.tone_spacing == 240e3 and cfg.fc == 5.9e9
+assert abs(cfg.symbol_period - 35.7e-6) < 0.05e-6 and abs(snap.clock_bias) <= cfg.clock_bias_limit
+assert np.isclose(cfg.clock_bias_sigma, 50e-9) and np.isclose(cfg.clock_bias_limit, 100e-9)
+assert 7.0e-9 < sd_ns2 < 7.1e-9 and 14.0 < cfg.clock_bias_limit / sd_ns2 < 14.2
+assert 2.3e3 < doppler_res < 2.4e3 and 118.5 < doppler_res * C / cfg.fc < 119.5
+# sections 3-5: the CPD, the numerically rank-one time factor, eq. 13 not efficient
+assert est.rel_error < 0.05 and np.all(np.isfinite(est.d)) and kr_t[1e-2] == 1
+assert cmp["joint"]["RMSE d [m]"] < cmp["none"]["RMSE d [m]"]
+assert cmp["ml"]["RMSE d [m]"] < 3 * cmp["ml"]["CRLB d [m]"]
+# section 6, LoS + road: d and v within 2x the bound of the model the route fits, dir/kappa above
+arr_two, paths_two = two.paths(k_demo)
+free_two, nc = extraction.path_crlb(paths_two, arr_two, cfg, spatial="free"), study_noceil[0]
+assert nc["RMSE d [m]"] < 2 * free_two["d"][0] and nc["RMSE v [m/s]"] < 2 * free_two["v"][0]
+assert 2 * nc["CRLB dir [deg]"] < nc["RMSE dir [deg]"] < 2.0
+assert nc["RMSE kappa [m]"] > 2 * nc["CRLB kappa [m]"]
+# ... all paths: the merged pair under its huge (metres) free-factor bound in d; eq. 1 far below
+assert [r["path"] for r in pair] == ["los", "ceiling"]
+assert all(r["CRLB d [m]"] > 1.0 and r["RMSE d [m]"] < r["CRLB d [m]"] for r in pair), pair
+assert np.allclose([r["CRLB kappa [m]"] for r in study_all], b_eq1["kappa"], rtol=1e-9)
+for r in study_all:
+    assert r["RMSE dir [deg]"] > 100 * r["CRLB dir [deg]"], r
+    assert r["RMSE kappa [m]"] > 100 * r["CRLB kappa [m]"], r
+assert b_eq1["d"].max() < 1e-3 and study_all[0]["RMSE d [m]"] > 100 * b_eq1["d"][0]
+assert 5e-4 < study_all[0]["CRLB dir [deg]"] < 5e-3 and 0.01 < b_eq1["kappa"].min()
+assert b_eq1["kappa"].max() < 0.1 and np.all(b_free["d"] > b_eq1["d"])
+# section 7: the ML stage at the bound (loose in quick mode: RMS over few snapshots)
+ml_rows, lim = {r["path"]: r for r in study_ml}, (4.0 if tk.quick_mode() else 1.5)
+assert ml_rows["los"]["matched"] >= 2 and ml_rows["los"]["missed"] == 0
+for r in (ml_rows[kind] for kind in ("los", "road", "ceiling")):
+    assert r["RMSE kappa [m]"] < lim * r["CRLB kappa [m]"], r
+    assert r["RMSE dir [deg]"] < lim * r["CRLB dir [deg]"], r
+# ... along the drive: ML mostly inside the 90 % band, kappa's bound mm to dm, the paper far above
+(lo1, hi1), (lo_n, hi_n) = chi_band[1], chi_band[n_eff]
+assert 0.01 < lo1 < 0.1 and 1.5 < hi1 < 2.5 and lo_n < 1 < hi_n
+assert np.mean([lo_n <= x <= hi_n for x in ratio_ml]) > 0.5 and max(ratio_ml) < 5.0, ratio_ml
+assert min(crlb_k) < 0.01 and max(crlb_k) > 0.1, crlb_k
+paper = [r for r in eff if r["route"] == "joint" and r["path"] == "los"]
+assert np.nanmin([r["RMSE kappa [m]"] / r["CRLB kappa [m]"] for r in paper]) > 10
+# section 8: ceiling high, road and RRMs low; the ceiling's kappa inside the ML search's 0.5 m
 z_srnf = origins["srnf channel"][:, 2]
-assert np.nanmax(z_srnf) > 4.0 and np.nanmin(z_srnf) < 1.0  # ceiling high, road/RRMs low
+assert np.nanmax(z_srnf) > 4.0 and np.nanmin(z_srnf) < 1.0 and 0.5 < ceil.kappa_srnf
+# section 9: SR-NF holds for the marking shown, not the other one nor the ceiling (any epoch)
 title = explorer.figure.layout.title.text
-assert title.startswith(f"epoch {k_demo}")
-# section 9: at the paper's 10 x 10 the channel is SR-NF within eps_Phi, the TLS resolves neither
-assert "channel SR-NF within" in title and "neither" in title, title
+assert title.startswith(f"epoch {k_demo}") and "SR-NF within" in title and "neither" in title
+assert big["surface"] == small_arr["surface"] == "RRM bottom right"
+assert mis["RRM bottom right"] < 0.15 < min(mis["RRM top left"], mis[ceil.surface], *ceil_mis)
 assert abs(np.median(big["kappa"]) - big["kappa_vue"]) < 0.1 * big["kappa_vue"]  # VUE, not eq. 51
-assert big["mismatch"] > 0.15 > small_arr["mismatch"]
-above = [r for r in snr_rows if r["integrated SNR [dB]"] >= eta_th + 7.0]
-below = [r for r in snr_rows + rng_rows if r["integrated SNR [dB]"] <= eta_th - 4.0]
-assert above and below and 12.0 < eta_th < 16.0 and eta_half < eta_th
+assert big["mismatch"] > 0.15 and 1e-3 < small_arr["mismatch"] < 1e-2
+assert np.sum(small_arr["kappa"] < 0) > len(small_arr["kappa"]) / 2  # mostly the fallback
+# section 10: impairments lift the estimate off the bound; the small calibration error by metres
+assert imp_los["none"]["RMSE kappa [m]"] < 5 * imp_los["none"]["CRLB kappa [m]"]
+for r in list(imp_los.values())[1:]:  # lost: the curvature gone altogether, a plane-wave fit
+    assert r["no kappa"] == r["matched"] or r["RMSE kappa [m]"] > max(10 * r["CRLB kappa [m]"], 1)
+assert 0.1 < sw_edge < 0.3
+# section 11: on the bound from 7 dB above the threshold, lost and flagged 5 dB below it
+at = {round(r["integrated SNR [dB]"] - eta_th): r for r in snr_rows}
+assert sorted(at) == [-5, 0, 8, 15] and 12.0 < eta_th < 16.0
 assert abs(float(ml.outlier_probability(10 ** (eta_th / 10), n_cells)) - 0.01) < 1e-4
 assert p_out[15] < 1e-6 and p_out[8] < 1e-3 and p_out[-5] > 0.5, p_out
-assert 14.0 < eta_th_full < 15.0  # 14.5 dB for the paper's 100 x 410 x 12 tensor
-assert all(r["RMS/CRLB direction"] < 3.0 and r["beyond 6 sigma"] == 0.0 for r in above), above
-assert all(r["beyond 6 sigma"] >= 0.5 and r["flagged"] >= 0.5 for r in below), below
-assert margin_120 > 10.0 and rms_above < 3.0
-# exercises 1-3: the solutions' readings
-assert "los" not in {p.kind for p in ps_t1} and first_t1.surface_kind == "rrm"
-assert abs(est_t1.d[0] - first_t1.length - C * snap_t1.clock_bias) < 0.1
-d_rmse = [sol2[n]["RMSE d [m]"] for n in ("all paths", "no ceiling", "LoS + road")]
-assert d_rmse[0] > 5 * d_rmse[1] > 5 * d_rmse[2], d_rmse
-assert sol3[0]["road"] == 0 and sol3[-30]["RRM bottom right"] > 0, sol3
-assert sum(sol3[-30].values()) >= sum(sol3[0].values()), sol3
+assert all(at[x]["RMS/CRLB direction"] < 3.0 and at[x]["beyond 6 sigma"] == 0 for x in (8, 15))
+assert at[-5]["beyond 6 sigma"] > 0.5 and at[-5]["flagged"] > 0.5, at[-5]
+assert at[0]["beyond 6 sigma"] > 0.05 and margin_120 > 10.0, at[0]  # well above the MIE's 1 %
+# exercises 1-4: asserted in their solutions (run in CI)
 print("all checks passed")

@@ -14,13 +14,17 @@
 # - how filterpy's EKF and UKF are wired to it, with bearing residuals wrapped to $(-\pi, \pi]$;
 # - the unscented particle filter (UPF, eq. 46–63), vectorised over particles, and why the
 #   algorithm *as printed* collapses its weights when the process noise is small;
-# - the posterior Cramér–Rao bound (PCRLB): the best RMSE *any* filter can reach, which the paper
-#   never shows — and how close each filter gets;
+# - the posterior Cramér–Rao bound (PCRLB), which the paper never shows: a lower bound on the
+#   mean-square error of *any* filter **averaged over random truths** (the prior's initial state
+#   and the process noise), not an error any filter is promised to reach, and not a floor under
+#   the error on one fixed trajectory (see [bounds](GLOSSARY.md#bounds)) — and how close each
+#   filter gets;
 # - Tables 2 and 3 of the paper beside ours, and which assumption produces the paper's UPF errors
 #   of about 1 cm.
 
 # %%
 import numpy as np
+from scipy.stats import chi2
 from tqdm.auto import tqdm
 
 import tunnelkit as tk
@@ -97,10 +101,11 @@ print("LOS stations:\n", vs.model_from_scenario("jiang2023-straight", los=True).
 # innovation $y = Z - \hat Z$ (bearings wrapped) and its covariance $S$ from the filter, a vector
 # with $y^T S^{-1} y > \chi^2_{2N}(0.999)$ (18.5 for two stations) is a gross outlier — a range
 # 100 m off, a bearing 90° off — and the epoch is treated as missed; `n_rejected` counts them.
-# A consistent filter loses one good epoch in a thousand, which leaves Tables 2–3 unchanged to
-# within a per cent; after five rejections in a row the gate takes the next measurement with an
-# inflated covariance, so a real change is never locked out (`tunnelkit.tracking.gating`).
-# `gate=None` gives the paper's filters.
+# A consistent filter rejects a good vector once in a thousand epochs (that is what the 0.999
+# quantile means): on clean runs the gate changes the EKF's RMSE by less than a per cent (printed
+# below). After five rejections in a row the gate takes the next measurement with an inflated
+# covariance, so a real change is never locked out (`tunnelkit.tracking.gating`). `gate=None`
+# gives the paper's filters.
 #
 # One run, all four on the same measurements; drag the slider (or press play) to follow them.
 
@@ -114,6 +119,15 @@ for opts in ({"gate": None}, {}):
     est = vs.run_estimator("EKF", m, Zg, x0g, exp.P0, **opts)[0, :, :2]
     jump[opts.get("gate", 0.999)] = float(np.linalg.norm(est[50] - exp.truth[50, :2]))
 print(f"EKF error at the outlier epoch: no gate {jump[None]:.2f} m, gated {jump[0.999]:.2f} m")
+Zc, x0c = exp.simulate(RUNS, np.random.default_rng(9))  # clean runs: what the gate costs
+gate_rmse = {}
+for g in (None, 0.999):
+    ec = vs.run_estimator("EKF", m, Zc, x0c, exp.P0, gate=g)[..., :2] - exp.truth[:, :2]
+    gate_rmse[g] = float(np.sqrt(np.mean(np.sum(ec**2, axis=-1))))
+print(
+    f"EKF RMSE on {RUNS} clean runs: no gate {gate_rmse[None]:.4f} m, gated {gate_rmse[0.999]:.4f} m"
+)
+print(f"gate threshold chi2_{2 * m.n_stations}(0.999) = {chi2.ppf(0.999, 2 * m.n_stations):.1f}")
 sc = tk.load_scenario("jiang2023-straight")
 tracks_figure(sc.tunnel(), sc.base_station(), exp.truth, {n: e[0] for n, e in one.items()})
 
@@ -163,11 +177,20 @@ print("wrapped mean bearing:", round(float(m1.z_mean(sig, w)[1]), 4), "rad")
 
 # %%
 Z1, x01 = exp.simulate(1, np.random.default_rng(4))
+N_ESS, ess_med = 200, {}
 for prop in ("carried", "conditional"):
     ess = upf.one_epoch_ess(
-        m, Z1[0], x01[0], exp.P0, rng=np.random.default_rng(1), proposal=prop, epochs=30
+        m,
+        Z1[0],
+        x01[0],
+        exp.P0,
+        rng=np.random.default_rng(1),
+        n_particles=N_ESS,
+        proposal=prop,
+        epochs=30,
     )
-    print(f"{prop:11s}: median ESS of one epoch's weights = {np.median(ess[5:]):6.1f} of 200")
+    ess_med[prop] = float(np.median(ess[5:]))
+    print(f"{prop:11s}: median ESS of one epoch's weights = {ess_med[prop]:6.1f} of {N_ESS}")
 
 # %% [markdown]
 # ### The particle cloud
@@ -206,12 +229,18 @@ particle_cloud_figure(snaps)
 # $$D^{11} = \Phi^T Q^{-1}\Phi,\quad D^{12} = (D^{21})^T = -\Phi^T Q^{-1},\quad
 # D^{22}_k = Q^{-1} + E[H_k^T R^{-1} H_k],$$
 #
-# where $H_k$ is the Jacobian of eq. 45 at the true state. Every filter's position MSE is at least
-# $\mathrm{tr}$ of the position block of $J_k^{-1}$. Tests check the recursion against filterpy's
-# Kalman filter (linear case, equal to $10^{-8}$) and against the snapshot CRLB of notebook 01
-# (huge $Q$).
+# where $H_k$ is the Jacobian of eq. 45 at the true state and $E[\cdot]$ averages over the random
+# truth. It is a [Bayesian bound](GLOSSARY.md#bounds): **averaged over random truths** — the
+# initial state drawn from the prior, the process noise $U$ of every epoch — and over the
+# measurement noise, every filter's position MSE is at least $\mathrm{tr}$ of the position block
+# of $J_k^{-1}$. It says nothing about one fixed trajectory: there a filter can do better (the
+# next subsection shows it). Tests check the recursion against filterpy's Kalman filter (linear
+# case, equal to $10^{-8}$) and against the snapshot CRLB of notebook 01 (huge $Q$).
 #
-# Below: 2 deg / 2 m, straight, NLOS, the same simulated runs for all four.
+# Below: 2 deg / 2 m, straight, NLOS, the same simulated runs for all four. Every run drives the
+# **same** path, the straight preset, which has no process noise; the bound is evaluated along it
+# ($H_k$ at its true states), and the filters' RMSE is over the runs' measurement noise and prior
+# means only.
 
 # %%
 bound = pcrlb.vs_pcrlb(m, exp.truth, exp.P0)
@@ -224,7 +253,8 @@ print("RMSE / sqrt(PCRLB) over the run:", {n: round(r, 3) for n, r in ratio.item
 rmse_bound_figure(exp.times, rmse_t, bound, title=f"Straight NLOS, 2 deg / 2 m, {RUNS} runs")
 
 # %% [markdown]
-# EKF, UKF and UPF sit on the bound, and late in the run even slightly *below* it. TSWLS uses one
+# On this one fixed path the EKF, UKF and UPF end up *below* the bound: their ratios, printed
+# above, are all under 1. That does not break it — the next subsection shows why. TSWLS uses one
 # epoch at a time and stays 3–4× above it. The CDFs of the per-epoch error (the paper's Figs. 5,
 # 7, 9 in spirit):
 
@@ -246,8 +276,8 @@ cdf_figure(err, title="CDF of the position error, straight NLOS, 2 deg / 2 m")
 # measurements are about the *same* velocity, the accumulated information is larger than the
 # bound allows for a random truth, and the RMSE can end up below it. Draw the truths from the
 # motion model instead — the start of the straight preset, then $X_k = \Phi X_{k-1} + U_{k-1}$
-# with the same $Q$ — and the bound is the exact yardstick: the ratio comes back to 1 (the UPF a
-# little above, from its Monte-Carlo sampling). The bound is then the average over the sampled
+# with the same $Q$ — and the bound is the yardstick it was derived for: the ratio comes back to
+# about 1 (the UPF a little above, from its Monte-Carlo sampling). The bound is then the average over the sampled
 # truths of $E[H_k^\mathsf{T}R^{-1}H_k]$, as `vs_pcrlb` does for a stack of trajectories.
 
 # %%
@@ -287,9 +317,15 @@ bound_ratio_figure(
 #
 # The curved preset (a lane change with $\pm 0.24\ \mathrm{m/s^2}$ lateral acceleration) is not a
 # constant-velocity path: the filters absorb the manoeuvre through $Q$. In LOS the direct path
-# adds a third station. (The PCRLB is evaluated along the true path in both cases.)
+# adds a third station. (The PCRLB is evaluated along the one true path in both cases, as for
+# the straight preset above.)
 
 # %%
+cur = vs.experiment("jiang2023-curved", level=2).truth
+acc = np.diff(cur[:, 2:], axis=0) / m.period
+v_c = cur[1:, 2:]
+a_lat = (v_c[:, 0] * acc[:, 1] - v_c[:, 1] * acc[:, 0]) / np.linalg.norm(v_c, axis=1)
+print(f"curved preset: lateral acceleration from {a_lat.min():+.3f} to {a_lat.max():+.3f} m/s^2")
 curves, rmse_c = {}, {}
 for name, los in tqdm((("curved NLOS", False), ("straight LOS", True)), leave=False):
     scen = "jiang2023-curved" if name.startswith("curved") else "jiang2023-straight"
@@ -331,33 +367,66 @@ table_figure(t2, cols, title=f"Table 2 (NLOS), {RUNS} runs")
 t3 = table_rows(
     "jiang2023_table3", los=True, runs=RUNS, seed=0, n_particles=PARTICLES, progress=True
 )
+# the comparisons the reading below makes, over both tables and every noise level
+ours = {
+    (t, r["sigma_d_m"], r["algorithm"]): r for t, tab in (("NLOS", t2), ("LOS", t3)) for r in tab
+}
+levels_d = sorted({k[1] for k in ours})
+cases = [(t, lv) for t in ("NLOS", "LOS") for lv in levels_d]
+mean_of = {k: r["ours_mean_m"] for k, r in ours.items()}
+filt = ("EKF", "UKF", "UPF")
+tswls_factor = {
+    (t, lv, a): mean_of[t, lv, "TSWLS"] / mean_of[t, lv, a] for t, lv in cases for a in filt
+}
+ekf_ukf = [mean_of[t, lv, "EKF"] / mean_of[t, lv, "UKF"] - 1 for t, lv in cases]
+upf_ukf = [mean_of[t, lv, "UPF"] / mean_of[t, lv, "UKF"] - 1 for t, lv in cases]
+kf_bound = [ours[t, lv, a]["rmse_over_pcrlb"] for t, lv in cases for a in ("EKF", "UKF")]
+print(
+    f"TSWLS mean / filter mean: {min(tswls_factor.values()):.2f} to {max(tswls_factor.values()):.2f}"
+)
+print(f"EKF mean / UKF mean - 1: {min(ekf_ukf):+.1%} to {max(ekf_ukf):+.1%}")
+print(
+    f"UPF mean / UKF mean - 1 ({PARTICLES} particles): {min(upf_ukf):+.1%} to {max(upf_ukf):+.1%}"
+)
+print(
+    f"EKF and UKF, RMSE / sqrt(PCRLB) on the fixed path: {min(kf_bound):.2f} to {max(kf_bound):.2f}"
+)
 table_figure(t3, cols, title=f"Table 3 (LOS), {RUNS} runs")
 
 # %% [markdown]
-# **What agrees.** Filtering beats snapshot TSWLS by a factor of 2.5–3.5 in mean error, errors
-# grow with the noise, and LOS (three stations) is better than NLOS.
+# **What agrees** (the ranges printed above Table 3). Filtering beats snapshot TSWLS by a factor
+# of 2 to 4 in mean error, the more the noisier the measurements; errors grow with the noise; LOS
+# (three stations) is better than NLOS.
 #
-# **What does not.** EKF, UKF and UPF are within a few per cent of each other and of the bound:
-# for this nearly linear, Gaussian problem the UKF posterior is already almost exact, so a particle
-# filter has nothing left to gain; its Monte-Carlo sampling costs it a little. No ordering
-# UPF < UKF < EKF beyond noise is to be had here.
+# **What does not.** EKF and UKF are within a few per cent of each other, and the UPF does not
+# beat them: with 500 particles its mean is a few per cent above the UKF's, with fewer (quick
+# mode's 200) it can lose track on a run and end further above. On this one fixed path the EKF's
+# and UKF's RMSE lies between 0.75 and 1.05 times $\sqrt{\mathrm{PCRLB}}$ at every level: close to
+# the bound, and below it where the fixed path lets them (section 5). For this nearly linear,
+# Gaussian problem the UKF posterior is already almost exact, so a particle filter has nothing
+# left to gain; its Monte-Carlo sampling costs it a little. No ordering UPF < UKF < EKF beyond
+# noise is to be had here.
 #
 # **How many particles?** Under a small $Q$ the velocity is almost a constant parameter, and
-# each resampling leaves fewer distinct velocities (sample impoverishment). With too few
-# particles a run now and then locks onto a wrong velocity and drifts for seconds. Measured on
-# 100 runs at 2 deg / 2 m (straight, NLOS): runs with an error above 3 m at some epoch were
-# 3 / 1 / 0 / 0 for 150 / 300 / 500 / 1000 particles, with mean errors 0.73 / 0.70 / 0.68 /
-# 0.66 m against the UKF's 0.66 m. The UPF approaches the UKF from above as $N$ grows.
+# each resampling leaves fewer distinct velocities (sample impoverishment): with too few
+# particles a run can lock onto a wrong velocity and drift. How often, against the particle
+# count, takes a hundred runs per count; the measurement is in
+# [docs/results/upf-particles.md](../docs/results/upf-particles.md), and
+# `python benchmarks/upf_particles.py` repeats it (a few minutes).
 #
 # **The paper's UPF means (0.011 m at $\sigma_d = 0.1$ m, 0.074 m at 2 m)** are far below what the
-# measurements allow: with ranges good to 2 m and bearings to 2°, the bound itself (the
-# $\sqrt{\mathrm{PCRLB}}$ of section 5, printed below: its smallest value over the run and its
-# value at the end) is many times their 0.074 m at every epoch, and no filter can be that far
-# below it. Two assumptions reproduce numbers of that size: (a) the filter starts at
-# the *true* state with a tiny prior covariance and (almost) no process noise, on a path that is
-# exactly constant-velocity: it then reports its prior and hardly listens to the measurements;
-# (b) "mean error" is the mean of *signed* errors, which cancel. The same goes for the paper's
-# TSWLS (0.333 m at 2 m range noise is impossible for a per-epoch fix). Both effects, measured:
+# measurements allow. With ranges good to 2 m and bearings to 2°, the $\sqrt{\mathrm{PCRLB}}$ of
+# section 5 (printed below: its smallest value over the run and its value at the end) is many
+# times their 0.074 m at every epoch. The bound averages over random truths, so on one fixed path
+# an honest filter can dip below it — by less than 20 % in section 5 — but not by that factor.
+# Two assumptions reproduce numbers of that size: (a) the filter starts at the *true* state with
+# a tiny prior covariance and (almost) no process noise, on a path that is exactly
+# constant-velocity: it then reports its prior and hardly listens to the measurements;
+# (b) "mean error" is the mean of *signed* errors, which cancel. The paper's TSWLS mean (0.333 m
+# at 2 m range noise) is as implausible for a per-epoch fix: the snapshot CRLB (the same
+# recursion with a huge $Q$, so that no epoch remembers another), the variance bound of an
+# unbiased per-epoch fix, stays several times above 0.333 m along the run, and so does our
+# TSWLS's mean (both printed below). Both effects, and the snapshot bound, measured:
 
 # %%
 oracle = vs.experiment("jiang2023-straight", level=2, q=1e-6, p0_sigma=[0.01, 0.01])
@@ -376,6 +445,15 @@ print(f"    honest UPF, mean Euclidean error : {np.linalg.norm(signed, axis=-1).
 print(
     f"sqrt(PCRLB) of section 5 (2 deg / 2 m): {bound[-1]:.2f} m at the last epoch "
     f"(t = {exp.times[-1]:.1f} s, epoch {len(bound)}), smallest over the run {bound.min():.2f} m"
+)
+snap = vs.experiment("jiang2023-straight", level=2, q=1e6)  # no memory from epoch to epoch
+snap_bound = pcrlb.vs_pcrlb(snap.model, exp.truth, snap.P0)[1:]  # epoch 0 still has the prior
+paper_t2 = {
+    (r["algorithm"], r["sigma_d_m"]): r["mean_m"] for r in tk.reference.load("jiang2023_table2")
+}
+print(
+    f"snapshot sqrt(CRLB), one epoch at 2 deg / 2 m: at least {snap_bound.min():.2f} m; "
+    f"our TSWLS mean {mean_of['NLOS', 2.0, 'TSWLS']:.2f} m; the paper's {paper_t2['TSWLS', 2.0]} m"
 )
 
 # %% [markdown] tags=["explorer"]
@@ -399,11 +477,15 @@ upf_explorer(n_particles=min(PARTICLES, 200))
 # 3. Drop every third epoch (`Z[:, ::3] = np.nan`) and rerun. How much does each filter lose? What
 #    does TSWLS do on a missed epoch?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and once you have
-# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
-# what it printed. What to read in them follows.
+# The solutions are the collapsed cells below, and Run All does not run them. Once you have
+# tried an exercise, click the "Run solution" button under its solution (or run
+# `tk.solution("05.2")` in a cell, for exercise 2): the solution runs on a copy of the
+# notebook's variables, so it changes none of yours, and shows what it prints. A cell's blue
+# bar shows its code. On the static site the solutions have already run: open one, then its
+# "Show the solution's output". What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 05.1
 # Solution 1: q ten times larger and smaller, straight and curved (UKF; EKF alike here)
 q0, n_x = exp.model.q, tk.mc_count(20, 6)
 sol1 = {}
@@ -418,8 +500,11 @@ for scen in ("jiang2023-straight", "jiang2023-curved"):
             f"{scen:20s} q x {fq:4}: RMSE {sol1[scen, fq][0]:.2f} m, RMSE/sqrt(PCRLB) "
             f"{sol1[scen, fq][1]:.2f}"
         )
+st, cu = "jiang2023-straight", "jiang2023-curved"
+assert sol1[st, 0.1][0] < sol1[st, 10.0][0] and sol1[cu, 0.1][1] > 1.0 > sol1[st, 10.0][1], sol1
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 05.2
 # Solution 2: the proposal as printed (eq. 52) against the default
 Zp, x0p = exp.simulate(tk.mc_count(20, 4), np.random.default_rng(0))
 sol2 = {}
@@ -439,9 +524,15 @@ for prop in ("carried", "conditional"):
         f"{prop:12s} resampling events per run {sol2[prop][0]:5.1f} of {Zp.shape[1]}, "
         f"RMSE {rmse_p:.2f} m"
     )
+assert (
+    sol2["carried"][0] > 2 * sol2["conditional"][0]
+    and sol2["carried"][1] > 2 * sol2["conditional"][1]
+), sol2
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
-# Solution 3: every third epoch missed
+# %%solution 05.3
+# Solution 3: every third epoch missed (on solution 2's drives)
+Zp, x0p = exp.simulate(tk.mc_count(20, 4), np.random.default_rng(0))
 Zm = Zp.copy()
 Zm[:, ::3] = np.nan
 sol3 = {}
@@ -454,6 +545,7 @@ for name in ("EKF", "UKF", "TSWLS"):
     print(
         f"{name:6s} RMSE all epochs {sol3[name][0]:.2f} m, every third missed {sol3[name][1]:.2f} m"
     )
+assert all(sol3[n][1] > sol3[n][0] for n in sol3) and sol3["TSWLS"][1] > sol3["UKF"][1], sol3
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
@@ -477,18 +569,48 @@ for name in ("EKF", "UKF", "TSWLS"):
 
 # %%
 assert list(registry.family("jiang2023")) == ["TSWLS", "EKF", "UKF", "UPF"]
-assert ratio["UPF"] <= 1.2 and ratio["EKF"] <= 1.3 and ratio["UKF"] <= 1.3, ratio
-assert ratio["TSWLS"] > 2.0, ratio
-for tab in (t2, t3):
-    for lv in sorted({r["sigma_d_m"] for r in tab}):
-        mean = {r["algorithm"]: r["ours_mean_m"] for r in tab if r["sigma_d_m"] == lv}
-        assert max(mean["EKF"], mean["UKF"], mean["UPF"]) < mean["TSWLS"], (lv, mean)
-        # the UPF is within a few per cent of the UKF with 500 particles (looser with fewer, quick mode)
-        assert abs(mean["UPF"] / mean["UKF"] - 1) < (0.3 if tk.quick_mode() else 0.1), (lv, mean)
+# section 1: T1 = 0.1 s and q = 0.1 m^2/s^3, as the prose says
+assert m.period == 0.1 and m.q == 0.1
+# section 2: the gate's threshold (18.5 for two stations), a 100 m range outlier skipped, and on
+# clean runs the gate changes the EKF's RMSE by less than a per cent
+assert m.n_stations == 2 and abs(chi2.ppf(0.999, 4) - 18.5) < 0.05
+assert jump[None] > 3.0 and jump[0.999] < 1.5
+assert abs(gate_rmse[0.999] / gate_rmse[None] - 1) < 0.01, gate_rmse
+# section 4: eq. 52 as printed gives one particle all the weight; the conditional proposal does not
+assert ess_med["carried"] < 2.0 and ess_med["conditional"] > 0.1 * N_ESS, ess_med
+# section 5, one fixed path: EKF, UKF and UPF below the bound (by less than 20 %), TSWLS 3-4x above
+assert all(0.8 < ratio[n] < 1.0 for n in ("EKF", "UKF", "UPF")), ratio
+assert 3.0 < ratio["TSWLS"] < 4.0, ratio
+# the curved preset's lane change: +-0.24 m/s^2 lateral acceleration
+assert abs(a_lat.max() - 0.24) < 0.01 and abs(a_lat.min() + 0.24) < 0.01, (a_lat.min(), a_lat.max())
+# section 6, both tables, every level: filtering beats TSWLS by 2 to 4 times in mean error, the
+# more the noisier the measurements; errors grow with the noise; LOS beats NLOS
+assert 2.0 < min(tswls_factor.values()) and max(tswls_factor.values()) < 4.0, tswls_factor
+for t in ("NLOS", "LOS"):
+    for a in filt:
+        assert tswls_factor[t, levels_d[-1], a] > tswls_factor[t, levels_d[0], a], (t, a)
+for a in ("TSWLS", *filt):
+    for t in ("NLOS", "LOS"):
+        assert all(np.diff([mean_of[t, lv, a] for lv in levels_d]) > 0), (t, a)
+    assert all(mean_of["LOS", lv, a] < mean_of["NLOS", lv, a] for lv in levels_d), a
+# EKF and UKF within a few (5) per cent of each other; the UPF no better than the UKF beyond noise,
+# a few (6) per cent above it with 500 particles or more, further with fewer (a lost run)
+assert max(abs(d) for d in ekf_ukf) < 0.05, ekf_ukf
+assert min(upf_ukf) > -0.03 and max(upf_ukf) < (0.06 if PARTICLES >= 500 else 0.5), upf_ukf
+# EKF and UKF, on the fixed path: between 0.75 and 1.05 times sqrt(PCRLB) at every level
+assert 0.75 < min(kf_bound) and max(kf_bound) < 1.05, kf_bound
 assert all(v < 1.3 for v in curves["straight LOS"].values() if v != curves["straight LOS"]["TSWLS"])
-assert oracle_mean < 0.05  # the oracle assumption yields centimetre "errors" like the paper's
-assert bound.min() > 5 * 0.0742  # no honest filter reaches the paper's UPF mean at 2 deg / 2 m
-assert jump[None] > 3.0 and jump[0.999] < 1.5  # the gate skips a 100 m range outlier
+# the paper's UPF means and TSWLS mean, and why they cannot be honest errors
+assert (
+    paper_t2["UPF", 0.1] == 0.011
+    and paper_t2["UPF", 2.0] == 0.0742
+    and paper_t2["TSWLS", 2.0] == 0.333
+)
+assert bound.min() > 5 * paper_t2["UPF", 2.0]  # many times the paper's UPF mean at every epoch
+assert oracle_mean < 0.05  # (a) the oracle assumption yields centimetre "errors" like the paper's
+assert np.abs(signed.mean(axis=(0, 1))).max() < 0.1  # (b) signed errors cancel to centimetres
+# the paper's TSWLS mean is several (> 3) times below the snapshot bound and our TSWLS mean
+assert snap_bound.min() > 3 * paper_t2["TSWLS", 2.0] and mean_of["NLOS", 2.0, "TSWLS"] > 3 * 0.333
 # the bound is the yardstick for truths drawn from its own motion model: ratio 1 within 10 %
 # (EKF, UKF; 15 % with quick mode's 12 runs), the UPF within 15 % (20 %) for its sampling; on the
 # noise-free straight truth the same filters end below that ratio
@@ -496,14 +618,7 @@ tol = 0.15 if tk.quick_mode() else 0.10
 assert all(abs(ratio_mm[n] - 1) < tol for n in ("EKF", "UKF")), ratio_mm
 assert 0.9 < ratio_mm["UPF"] < 1 + tol + 0.05, ratio_mm
 assert all(ratio[n] < ratio_mm[n] for n in ("EKF", "UKF", "UPF")), (ratio, ratio_mm)
-# exercises: the solutions' readings
-st, cu = "jiang2023-straight", "jiang2023-curved"
-assert sol1[st, 0.1][0] < sol1[st, 10.0][0] and sol1[cu, 0.1][1] > 1.0 > sol1[st, 10.0][1], sol1
-assert (
-    sol2["carried"][0] > 2 * sol2["conditional"][0]
-    and sol2["carried"][1] > 2 * sol2["conditional"][1]
-), sol2
-assert all(sol3[n][1] > sol3[n][0] for n in sol3) and sol3["TSWLS"][1] > sol3["UKF"][1], sol3
+# the exercises' readings are asserted in their solutions (run in CI with TUNNELKIT_SOLUTIONS=1)
 
 # %% [markdown]
 # The check on the curve is left out on purpose: the manoeuvre is outside the constant-velocity

@@ -29,6 +29,7 @@
 
 # %%
 import numpy as np
+from scipy.stats import chi2
 from tqdm.auto import tqdm
 
 import tunnelkit as tk
@@ -237,12 +238,21 @@ print({k: round(v, 1) for k, v in r_est.items()}, "(true R = 400)")
 # would average the dead-reckoning drift of the window into the offset). The position then
 # follows eq. 16 with the heading $\phi$ from past estimates:
 #
-# $$x_k = x_{k-1} + \Delta r\sin\phi_{k-1},\qquad y_k = y_{k-1} + \Delta r\cos\phi_{k-1},
-#   \qquad \Delta r = \pm(d_{k-1} - d_k).$$
+# $$x_k = x_{k-1} + \Delta r\sin\phi_{k-1},\qquad y_k = y_{k-1} + \Delta r\cos\phi_{k-1}.$$
 #
-# The paper takes $\Delta r = |d_k - d_{k-1}|$; we keep the sign ($+$ approaching, $-$ receding,
-# from the median of the last five Doppler samples), so a range correction that is later undone
-# cancels instead of counting twice as forward motion.
+# The paper defines $\Delta r$ in words only: "The geometric range Δr is equal to the difference
+# between two successive distances ($d_{k-1}$ and $d_k$) obtained from ToA measurements", and
+# calls it "the traveled distance or range Δr". It prints neither the order of the difference
+# nor a sign rule. Read as a distance travelled forward, one fixed order cannot serve both legs:
+# $d_{k-1} - d_k$ is positive while approaching and negative after the pass, $d_k - d_{k-1}$ the
+# other way round. We take
+#
+# $$\Delta r = \pm(d_{k-1} - d_k),$$
+#
+# $+$ approaching, $-$ receding (from the median of the last five Doppler samples), so that
+# $\Delta r$ is positive for forward motion on both legs and a range correction that is later
+# undone cancels. (Taking the magnitude $|d_k - d_{k-1}|$ instead would also be positive on both
+# legs, but would count such a correction twice as forward motion.)
 #
 # $\Delta r$ is a *range* change, equal to the distance travelled only when the vehicle moves
 # radially. Passing a transmitter at closest distance $h$ from $x=-L_1$ to $x=L_2$ adds up
@@ -290,6 +300,19 @@ error_time_figure(drive, {k: v.position for k, v in tracks.items()}).show()
 runs = tk.mc_count(20, 3)
 errs = pooled_errors(runs, seed=0, progress=True)
 report = halili_report(errs)
+mean = {k: float(v.mean()) for k, v in errs.items()}
+ekf_over_best = {
+    s: mean["EKF DS", s] / mean["EKF DS", "103.70 Hz"] for s in ("10.37 Hz", "dynamic")
+}
+print(
+    "EKF DS mean error / its mean error at 103.70 Hz:",
+    {s: round(v, 2) for s, v in ekf_over_best.items()},
+)
+per_drive = {
+    a: errs[a, "103.70 Hz"].reshape(runs, -1).mean(axis=1) for a in ("EKF DS", "KF DS and ToA")
+}
+ekf_wins = int(np.sum(per_drive["EKF DS"] < per_drive["KF DS and ToA"]))
+print(f"103.70 Hz: EKF DS has the smaller mean error on {ekf_wins} of {runs} drives")
 report_table(report)
 
 # %%
@@ -301,8 +324,13 @@ approach_cdfs(errs, p90_paper).show()
 # **Reading the table.** The paper's qualitative claims, tested on our drive:
 #
 # - *A too-small $R$ hurts when the measurements carry bias* — yes, clearly for EKF DS
-#   (10.37 Hz gives a much larger mean error than 103.70 Hz); the adaptive $R$ does not rescue it.
-# - *EKF DS beats KF DS and ToA in mean error* — **not on our default drive**. The ToA route
+#   (10.37 Hz gives a much larger mean error than 103.70 Hz); the adaptive $R$ does not rescue it
+#   (its mean error stays more than 1.5 times the 103.70 Hz one: the ratios printed above the
+#   table).
+# - *EKF DS beats KF DS and ToA in mean error* — **not on our default drive** at 32.79 Hz,
+#   10.37 Hz or with the adaptive $R$. At 103.70 Hz, EKF DS's best setting, it has the smaller
+#   mean error on some of the drives (the count printed above the table): the spread from drive
+#   to drive is large. The ToA route
 #   shrugs off slowly varying Doppler errors (it only uses range *differences* and is re-anchored by
 #   every ToA), while the EKF integrates every Doppler error into position. Which one wins depends
 #   on how the Doppler errors are made, and the measured drive does not tell us that. Below we add
@@ -336,9 +364,16 @@ print({label: {n: round(v, 2) for n, v in r.items()} for label, r in regime.item
 # i.e. 10.8) and treat the epoch as missed (predict only). **Every tunnelkit tracker does this by
 # default** (`gate=0.999`; `gate=None` is the paper's filter; `n_rejected` counts what was
 # skipped). With $\sigma = 103.70$ Hz the gate hardly fires ($S$ is too wide to call anything an
-# outlier); at the headline 32.79 Hz:
+# outlier: the count on the drive of section 2 is printed first); at the headline 32.79 Hz it
+# catches a good part of them:
 
 # %%
+n_rej = {}
+for sig in (103.70, 32.79):
+    ekf_gated = fam["EKF DS"](setup, fix, sigma_hz=sig)  # the default gate
+    ekf_gated.run(meas)
+    n_rej[sig] = ekf_gated.n_rejected
+print(f"Doppler outliers on the drive of section 2: {meas.outlier.sum()}; rejected: {n_rej}")
 plain = dp.mean_errors(drive, seeds, sigma_hz=32.79, approaches=("EKF DS",), **PAPER)["EKF DS"]
 gated = dp.mean_errors(drive, seeds, sigma_hz=32.79, approaches=("EKF DS",))["EKF DS"]
 print(f"EKF DS at 32.79 Hz on the default drive: plain {plain:.2f} m, gated {gated:.2f} m")
@@ -399,10 +434,17 @@ information_figure(drive, setup, sigma_hz=32.79, sigma_range=1.0).show()
 
 # %% [markdown]
 # Over time the posterior CRLB (Tichavský et al. 1998) adds the motion model: for the linear
-# constant-velocity dynamics $J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + H_k^T R^{-1} H_k$, started from
-# the GNSS fix, $J_0 = P_0^{-1}$. It bounds the mean-square error of *any* tracker under that
-# model and prior, biased or not: a Bayesian bound averages over the prior and the
-# noise together and needs no unbiasedness (notebook 05 says the same of its filters).
+# constant-velocity dynamics $J_k = (Q + F J_{k-1}^{-1} F^T)^{-1} + E[H_k^T R^{-1} H_k]$, started
+# from the GNSS fix, $J_0 = P_0^{-1}$. It is a [Bayesian bound](GLOSSARY.md#bounds): it bounds the
+# mean-square error of *any* tracker, biased or not, **averaged over random truths** — a truth
+# that starts where the GNSS fix's error puts it and then wanders as the motion model's process
+# noise lets it ($q = 0.5$ on both axes) — and over white measurement noise of the stated
+# $\sigma$. It is not a floor under the error on one given drive: a drive that keeps its lane
+# uses none of the freedom the bound allows for, and a tracker on it can lie below the bound
+# (notebook 05, section 5, shows it for its filters). Below, the expectation is replaced by its
+# value along this one drive ($H_k$ at its true states): read the curves as what the model and
+# one transmitter can tell about a vehicle near this path, not as a floor under the errors of
+# section 6, whose drives also carry the biases and outliers the bound's model leaves out.
 
 # %%
 bounds = {
@@ -418,14 +460,46 @@ for name, P in bounds.items():
         f"{name:32s} sqrt PCRLB at t = 20 s: x {np.sqrt(P[625, 0, 0]):6.2f} m, y {np.sqrt(P[625, 1, 1]):6.2f} m; "
         f"end: x {np.sqrt(P[-1, 0, 0]):6.2f} m, y {np.sqrt(P[-1, 1, 1]):6.2f} m"
     )
+sx_dop, sy_dop = (np.sqrt(bounds["Doppler 32.79 Hz"][:, i, i]) for i in (0, 1))
+sx_toa = np.sqrt(bounds["ToA 1 m"][:, 0, 0])
+toa_worst = int(np.argmax(sx_toa))
+print(
+    f"Doppler, along-track: {sx_dop[0]:.1f} m at the entrance, largest before the pass "
+    f"{sx_dop[:k_pass].max():.1f} m, one second after it {sx_dop[k_pass + 30]:.1f} m"
+)
+print(
+    f"ToA, along-track: below 1 m until t = {drive.t[np.argmax(sx_toa > 1.0)]:.1f} s, "
+    f"largest {sx_toa.max():.1f} m at t = {drive.t[toa_worst]:.1f} s (pass at {drive.t[k_pass]:.1f} s)"
+)
+print(
+    f"Doppler, lateral: largest {sy_dop.max():.1f} m = {sy_dop.max() / cfg.width:.1f} times the "
+    f"{cfg.width:g} m tube, {sy_dop[k_pass]:.1f} m at the pass"
+)
+# one drive against the bound: the lateral errors of section 2's tracks
+lat_rms = {
+    k: float(np.sqrt(np.mean((v.position[:, 1] - drive.position[:, 1]) ** 2)))
+    for k, v in tracks.items()
+}
+print("lateral RMS error on the drive of section 2:", {k: round(v, 1) for k, v in lat_rms.items()})
+print(f"RMS of the lateral bound along that drive: {np.sqrt(np.mean(sy_dop**2)):.1f} m")
 
 # %% [markdown]
-# With Doppler alone the along-track bound grows from the entrance until the pass, where it
-# collapses (the zero crossing of the Doppler marks *when* the van is abeam of the transmitter);
-# a ToA pins it everywhere. The **lateral** bound is another story: far from the transmitter
-# neither Doppler nor ToA sees $y$, so it grows with the motion model's lateral random walk
-# ($q = 0.5$ on both axes) to tens of metres — several times the 10 m tube — and only tightens
-# around the pass. One transmitter cannot tell the lanes apart; the tunnel walls (a map) can.
+# With Doppler alone the along-track bound grows from the entrance (the GNSS fix) until the
+# pass, where it collapses (the zero crossing of the Doppler marks *when* the van is abeam of the
+# transmitter). A 1 m ToA holds it below 1 m far from the transmitter; on the last stretch of
+# the approach (from the time printed) it rises to a few metres, peaking seconds before the pass,
+# because the range there also depends on the lateral position, and that one is poorly known.
+# The **lateral** bound is another story: far from the transmitter neither Doppler nor ToA sees
+# $y$, so it grows with the motion model's lateral random walk ($q = 0.5$ on both axes) to tens
+# of metres — several times the 10 m tube (the printout) — and only tightens around the pass.
+# One transmitter cannot tell the lanes apart; the tunnel walls (a map) can.
+#
+# The same numbers show what the bound is *not*. The drive of section 2 keeps its lane; the
+# truths the bound averages over wander across it as $q = 0.5$ lets them. On that one drive the
+# two ToA approaches keep a lateral RMS error of a few metres, far below the lateral bound's
+# tens of metres (the last two printed lines): not a violation, a drive the bound is not about.
+# A road that constrains the lateral motion is a different motion model, with a smaller lateral
+# $q$ and a smaller bound (exercise 4).
 #
 # And **the initial GNSS fix matters**: before the pass, nothing but the fix and the motion model
 # holds the along-track position. A worse fix raises the whole approach leg:
@@ -465,17 +539,22 @@ explorer
 # 4. **Lateral drift.** Why does the EKF DS lateral error grow far from the transmitter? Compute
 #    $\sqrt{\mathrm{PCRLB}_{yy}}$ with `sigma_hz=32.79` and `q=0.05` and compare.
 #
-# The solutions are the collapsed cells below: they run with the notebook, and once you have
-# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
-# what it printed. What to read in them follows.
+# The solutions are the collapsed cells below, and Run All does not run them. Once you have
+# tried an exercise, click the "Run solution" button under its solution (or run
+# `tk.solution("06.2")` in a cell, for exercise 2): the solution runs on a copy of the
+# notebook's variables, so it changes none of yours, and shows what it prints. A cell's blue
+# bar shows its code. On the static site the solutions have already run: open one, then its
+# "Show the solution's output". What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 06.1
 # Solution 1: the CFO of the preset's clock drift, and 5 Hz (mean error of EKF DS over seeds)
 cfo_drift = cfg.clock_drift * cfg.fc
 print(
     f"drift {cfg.clock_drift:.1e} s/s -> CFO {cfo_drift:.2f} Hz "
     f"= {cfo_drift * tk.constants.C / cfg.fc:.3f} m/s of apparent approach speed"
 )
+assert 0.1 < cfo_drift < 1.0 and 0.5 < 5.0 * tk.constants.C / cfg.fc < 2.0
 seeds_x = range(tk.mc_count(8, 4))
 sol1 = {
     c: dp.mean_errors(
@@ -491,14 +570,18 @@ for c, v in sol1.items():
     print(f"cfo_hz = {c:4.2f} Hz ({c * tk.constants.C / cfg.fc:5.2f} m/s): mean error {v:5.1f} m")
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 06.2
 # Solution 2: the radial loss 2h at the pass, h the closest distance, for a ceiling mount
 h_side = drive.range.min()
 h_ceil = dv.make_drive(cfg.replace(tx_y=0.0, tx_z=4.9)).range.min()
 print(f"preset: h = {h_side:.2f} m, loss about {2 * h_side:.1f} m")
 print(f"ceiling mount: h = {h_ceil:.2f} m, loss about {2 * h_ceil:.1f} m")
+assert 0.4 < h_ceil / h_side < 0.65
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 06.3
 # Solution 3: adaptive R with the posterior (ours) and the prior (as printed) covariance
+seeds_x = range(tk.mc_count(8, 4))
 sol3 = {
     form: dp.mean_errors(
         drive, seeds_x, sigma_hz=None, approaches=("EKF DS",), adaptive_form=form, **PAPER
@@ -508,10 +591,13 @@ sol3 = {
 print({form: round(v, 1) for form, v in sol3.items()}, "m mean error, EKF DS dynamic R")
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 06.4
 # Solution 4: the lateral bound for q = 0.5 (the filters') and q = 0.05
 lat = {q: np.sqrt(dp.posterior_crlb(drive, sigma_hz=32.79, q=q)[:, 1, 1]) for q in (0.5, 0.05)}
 for q, b in lat.items():
     print(f"q = {q}: sqrt(PCRLB_yy) largest {b.max():5.1f} m, at the end {b[-1]:5.1f} m")
+ratio_q = lat[0.5].max() / lat[0.05].max()
+assert 2.5 < ratio_q < 3.6, ratio_q  # about sqrt(10)
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
@@ -538,6 +624,11 @@ for q, b in lat.items():
 # ## Checks
 
 # %%
+# the campaign of section 1: the tube, the pass near second 37, the two resolutions
+assert (cfg.width, cfg.height) == (10.0, 5.0) and abs(drive.t[k_pass] - 37.0) < 0.5
+assert np.isclose(cfg.delay_resolution, 12.5e-9) and np.isclose(
+    cfg.doppler_resolution, 32.0, rtol=0.01
+)
 assert sign_err < 1e-3  # the pinned Doppler sign is -(fc/c) dr/dt
 assert (
     drive.doppler_los[0] > 100
@@ -548,24 +639,40 @@ assert paper_eq5[0] < 0  # the printed eq. 5 has the opposite sign
 assert jac_err < 1e-6
 assert abs(r_est["posterior"] - 400) < 0.08 * 400 and r_est["paper"] > 1.3 * 400
 assert abs(lost - radial_loss) < 0.5 and abs(radial_loss - 2 * clean.range.min()) < 0.2  # ~2 h lost
-mean = {k: float(v.mean()) for k, v in errs.items()}
-assert mean[("EKF DS", "10.37 Hz")] > 1.5 * mean[("EKF DS", "103.70 Hz")]  # too-small R hurts
-# default drive, headline sigma: the ToA route wins on average (drive-to-drive spread is large)
-assert mean[("KF DS and ToA", "32.79 Hz")] < mean[("EKF DS", "32.79 Hz")]
+# too-small R hurts EKF DS, and the adaptive R does not rescue it (both > 1.5 x its 103.70 Hz error)
+assert ekf_over_best["10.37 Hz"] > 1.5 and ekf_over_best["dynamic"] > 1.5, ekf_over_best
+# default drive: the ToA route wins on average at 32.79 Hz, 10.37 Hz and with the adaptive R;
+# at 103.70 Hz EKF DS wins on some drives
+for s_ in ("32.79 Hz", "10.37 Hz", "dynamic"):
+    assert mean["KF DS and ToA", s_] < mean["EKF DS", s_], (s_, mean)
+assert ekf_wins >= 1, per_drive
 white, default = regime["white noise only"], regime["+ 2 % outliers (default)"]
 assert white["EKF DS"] < white["KF DS and ToA"]  # white Doppler errors: the paper's ranking
 assert default["EKF DS"] > 1.2 * default["KF DS and ToA"]  # correlated errors + outliers: reversed
+# the outliers are the error term that hurts EKF DS most
+steps = np.diff([regime[label]["EKF DS"] for label in settings])
+assert steps[-1] == steps.max(), steps
+# the gate: at 103.70 Hz it hardly fires, at 32.79 Hz it catches a good part of the outliers
+assert n_rej[103.70] <= 0.1 * meas.outlier.sum() and n_rej[32.79] >= 0.25 * meas.outlier.sum()
+assert abs(chi2.ppf(0.999, 1) - 10.8) < 0.05
 assert gated < 0.8 * plain  # the gate removes most of the outliers' damage
-assert deviation["paper (no gate)"].max() > 10 and deviation["gate = 0.999"].max() < 1.0
+# one glitch: the paper's EKF is thrown off for good, the gated one hardly moves
+assert deviation["paper (no gate)"].max() > 10 and deviation["paper (no gate)"][-1] > 10
+assert deviation["gate = 0.999"].max() < 1.0
 assert np.allclose(fim_closed, fim_num, rtol=1e-5, atol=1e-12)
-sx = np.sqrt(bounds["Doppler 32.79 Hz"][:, 0, 0])
-assert sx[k_pass + 30] < 0.5 * sx[k_pass - 30]  # the pass pins the along-track position
-assert np.sqrt(bounds["ToA 1 m"][625, 0, 0]) < 1.0 < np.sqrt(bounds["Doppler 32.79 Hz"][625, 0, 0])
+# Doppler only: the along-track bound grows from the fix to just before the pass, then collapses
+assert np.argmax(sx_dop[:k_pass]) > 0.9 * k_pass and sx_dop[:k_pass].max() > 2 * sx_dop[0]
+assert sx_dop[k_pass + 30] < 0.5 * sx_dop[k_pass - 30]  # the pass pins the along-track position
+assert sx_toa[625] < 1.0 < sx_dop[625]
+# a 1 m ToA: below 1 m far from the transmitter, a few metres just before the pass
+assert sx_toa[: k_pass // 2].max() < 1.0 and 2.0 < sx_toa.max() < 10.0 and toa_worst < k_pass
+# the lateral bound: tens of metres, several (>= 3) times the 10 m tube, tight at the pass
+assert 20.0 < sy_dop.max() < 100.0 and sy_dop.max() > 3 * cfg.width, sy_dop.max()
+assert sy_dop[k_pass] < 0.1 * sy_dop.max()
+# one drive that keeps its lane: the ToA routes' lateral RMS error, a few metres, far below it
+for a_ in ("KF DS and ToA", "EKF DS and KF ToA"):
+    assert 1.0 < lat_rms[a_] < 10.0 and lat_rms[a_] < 0.25 * np.sqrt(np.mean(sy_dop**2)), lat_rms
 assert before["Doppler, GNSS sigma 20 m"] > 3 * before["Doppler, GNSS sigma 1 m"]
 assert len(explorer.figure.data) == 9
-# exercises: the solutions' readings
-assert 0.1 < cfo_drift < 1.0 and 0.5 < 5.0 * tk.constants.C / cfg.fc < 2.0
-assert 0.4 < h_ceil / h_side < 0.65
-ratio_q = lat[0.5].max() / lat[0.05].max()
-assert 2.5 < ratio_q < 3.6, ratio_q
+# the exercises' readings are asserted in their solutions (run in CI with TUNNELKIT_SOLUTIONS=1)
 print("all checks passed")

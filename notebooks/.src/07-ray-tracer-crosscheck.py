@@ -189,11 +189,15 @@ print(f"H: {H_img.shape}, {len(alike(p_img))} paths, max relative difference {re
 # 3. Would a finer ceiling (`n_facets` = 24, 48, 96 in `propagation.semicircular_tunnel`) let the
 #    preset's array fit under it?
 #
-# The solutions are the collapsed cells below: they run with the notebook, and once you have
-# tried, clicking one (or its blue bar) shows its code and its "Show the solution's output" line
-# what it printed. What to read in them follows.
+# The solutions are the collapsed cells below, and Run All does not run them. Once you have
+# tried an exercise, click the "Run solution" button under its solution (or run
+# `tk.solution("07.2")` in a cell, for exercise 2): the solution runs on a copy of the
+# notebook's variables, so it changes none of yours, and shows what it prints. A cell's blue
+# bar shows its code. On the static site the solutions have already run: open one, then its
+# "Show the solution's output". What to read in them follows.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 07.1
 # Solution 1: the slalom epochs of section 4 in the tunnel without RRMs, both engines
 bare = tun.without_plates()
 sol1 = {}
@@ -209,8 +213,10 @@ for kk in epochs:
     print(f"epoch {kk:3d}: " + ", ".join(f"{n} ({f})" for n, f in found.items()))
 sol1_image_only = [(kk, n) for kk, f in sol1.items() for n, w in f.items() if w != "both"]
 print("paths not found by both engines:", sol1_image_only)
+assert sol1 and not sol1_image_only, sol1_image_only
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 07.2
 # Solution 2: fewer rays from the UE at epoch 9 (section 3); one Sionna engine per value
 sol2 = {}
 for n_rays in (300, 100, 30):
@@ -227,8 +233,10 @@ for n_rays in (300, 100, 30):
     lost = [r["path"] for r in rt.compare_paths(p_img, ps) if r["found"] == "image only"]
     sol2[n_rays] = lost
     print(f"{n_rays:4d} rays per source: {len(ps)} paths found, lost: {lost or 'none'}")
+assert sol2[300] == [] and {"RRM top left", "RRM bottom right"} <= set(sol2[100]), sol2
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 07.3
 # Solution 3: finer ceilings, the array at the paper's 4.8 m
 sol3 = {
     n: int((~propagation.semicircular_tunnel(n_facets=n).contains(arrays[0].world + up)).sum())
@@ -241,6 +249,7 @@ print(
     f"top element z = {top[:, 2].max():.4f} m at |y| = {y_top:.3f} m; "
     f"the exact circle there: {np.sqrt(5.0**2 - y_top**2):.4f} m"
 )
+assert all(sol3[a] > sol3[b] > 0 for a, b in zip((12, 24, 48), (24, 48, 96))), sol3
 
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
@@ -275,10 +284,7 @@ assert worst["|d az| [deg]"] < 0.01 and worst["|d el| [deg]"] < 0.01
 assert not unexplained and not any(r["found"] == "sionna only" for r in rows_all)
 assert t_img < t_srt  # the image method is the fast default
 assert rel_h < 2e-3
-# exercises: the solutions' readings
-assert sol1 and not sol1_image_only, sol1_image_only
-assert sol2[300] == [] and {"RRM top left", "RRM bottom right"} <= set(sol2[100]), sol2
-assert all(sol3[a] > sol3[b] > 0 for a, b in zip((12, 24, 48), (24, 48, 96))), sol3
+# the exercises' readings are asserted in their solutions (run in CI with TUNNELKIT_SOLUTIONS=1)
 print("all checks passed")
 
 # %% [markdown]

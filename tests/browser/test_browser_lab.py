@@ -1,13 +1,16 @@
-"""Test 5: in JupyterLab, Run All leaves every exercise's solution collapsed.
+"""Test 5: in JupyterLab, Run All leaves every exercise's solution un-run, until asked for.
 
 A copy of notebook 01 (as committed: no outputs) is opened in JupyterLab, served on a free loopback
-port from a temporary directory, and run with Run > Run All Cells in quick mode. When the Checks
-cell has printed, each solution cell (tag ``solution``, metadata ``jupyter.source_hidden`` and
-``jupyter.outputs_hidden``) must show only its collapsed first line and, below it, the one-line
-summary of its collapsed output (tunnelkit.solutions: JupyterLab itself shows the outputs of a
-cell again once it runs): it ran, but nothing it printed is on screen until the student opens it.
+port from a temporary directory, and run with Run > Run All Cells in quick mode (the kernel
+without ``TUNNELKIT_SOLUTIONS``, as a student's). When the Checks cell has printed (so the Checks
+pass without the solutions), each solution cell (tag ``solution``, magic ``%%solution 01.N``,
+metadata ``jupyter.source_hidden``) must show its collapsed source and, below it, only the line
+"Solution 01.N ...: run it when you have tried" and its "Run solution 01.N" button
+(tunnelkit.solutions): nothing the solution prints, nor its collapsed output of a run at once.
+One click on the first solution's button then runs it and shows what it prints.
 
-Artefacts in build/artifacts/: lab-01-solutions.png (the exercises after Run All) and lab-01.log.
+Artefacts in build/artifacts/: lab-01-solutions.png (the exercises after Run All),
+lab-01-solution-run.png (after the click) and lab-01.log.
 """
 
 from __future__ import annotations
@@ -17,9 +20,11 @@ import shutil
 import nbformat
 from _lecture import ROOT, kernel_env, lab_command, resolve_notebook, serving_on_free_port
 
-from tunnelkit.solutions import SUMMARY
+from tunnelkit.solutions import ASK, SUMMARY, solution_id
 
 NOTEBOOK = "01"
+#: what the solutions of 01 print (their first words), none of which Run All may show
+PRINTED = ("smallest bound", "median bound at", "TOA-only bound above")
 
 # What a cell shows: whether its source is collapsed, all the text of its outputs, and the text of
 # its outputs that is on screen (innerText leaves out what a closed <details> hides)
@@ -36,7 +41,7 @@ CELL = """idx => {
 }"""
 
 
-def test_run_all_keeps_solutions_collapsed(tmp_path, watched, artifacts):
+def test_run_all_leaves_solutions_unrun_until_asked(tmp_path, watched, artifacts):
     src = resolve_notebook(NOTEBOOK)
     work = tmp_path / "lab"
     work.mkdir()
@@ -44,8 +49,10 @@ def test_run_all_keeps_solutions_collapsed(tmp_path, watched, artifacts):
     nb = nbformat.read(src, as_version=4)
     sols = [i for i, c in enumerate(nb.cells) if "solution" in c.metadata.get("tags", [])]
     assert sols, f"{src.name} has no solution cell"
+    sids = {i: solution_id(nb.cells[i].source) for i in sols}
+    assert all(sids.values()), sids
 
-    env = kernel_env(quick=True)
+    env = kernel_env(quick=True)  # no TUNNELKIT_SOLUTIONS: solutions wait to be asked for
     env["PYTHONPATH"] = str(ROOT)
     env["JUPYTER_CONFIG_DIR"] = str(tmp_path / "config")  # no user settings, no news prompt
     with serving_on_free_port(
@@ -80,11 +87,27 @@ def test_run_all_keeps_solutions_collapsed(tmp_path, watched, artifacts):
         for idx in sols:
             page.locator(f'.jp-Cell[data-windowed-list-index="{idx}"]').scroll_into_view_if_needed()
             states[idx] = page.evaluate(CELL, idx)
-        page.locator(f'.jp-Cell[data-windowed-list-index="{sols[0]}"]').scroll_into_view_if_needed()
+        first = page.locator(f'.jp-Cell[data-windowed-list-index="{sols[0]}"]')
+        first.scroll_into_view_if_needed()
         page.screenshot(path=str(artifacts / "lab-01-solutions.png"))
+        # asked for: the button runs the solution and its output appears under it
+        first.get_by_role("button", name=f"Run solution {sids[sols[0]]}").click()
+        page.wait_for_function(
+            "([idx, text]) => (document.querySelector("
+            '`.jp-Cell[data-windowed-list-index="${idx}"] .jp-OutputArea`'
+            ")?.innerText || '').includes(text)",
+            arg=[sols[0], PRINTED[0]],
+            timeout=120_000,
+        )
+        after = page.evaluate(CELL, sols[0])
+        page.screenshot(path=str(artifacts / "lab-01-solution-run.png"))
     for idx, s in states.items():
         assert s is not None, f"cell {idx} was not rendered"
         assert s["input_collapsed"], f"cell {idx}: its source is not collapsed"
-        assert s["output_text"], f"cell {idx}: no output after Run All (did it run?)"
-        assert all(t == SUMMARY for t in s["shown"]), f"cell {idx} shows unasked: {s['shown']}"
-        assert len(s["output_text"]) > len(SUMMARY), f"cell {idx}: the collapsed output is empty"
+        assert s["output_text"], f"cell {idx}: no output after Run All (did its cell run?)"
+        text = " ".join(s["shown"])
+        assert ASK in text and f"Run solution {sids[idx]}" in text, f"cell {idx} shows: {text}"
+        assert SUMMARY not in s["output_text"], f"cell {idx}: the solution ran on Run All"
+        for words in PRINTED:
+            assert words not in s["output_text"], f"cell {idx} shows its answer unasked: {words}"
+    assert any(PRINTED[0] in t for t in after["shown"]), after["shown"]

@@ -1,14 +1,18 @@
 """Test 4: an exercise's solution shows nothing until the student asks for it.
 
-Every cell tagged ``solution`` runs with the notebook (so its output exists), but on the static
-site (tools/site.py) and in Voila (tools/present.py) its output must not be on screen when the
-page opens: it sits in a closed ``<details>``, and one click on its summary shows it. Solution
-cells are found from the notebook itself (their cell ids on the site, their position in Voila,
-which numbers its cells from 1), so a template that forgets to collapse them fails here.
+On the static site (tools/site.py) every solution ran when the site was built
+(``TUNNELKIT_SOLUTIONS=1``, tunnelkit.solutions), but its output must not be on screen when the
+page opens: the cell sits in a closed ``<details>``, one click on its summary shows its code and
+the summary of its collapsed output ("Show the solution's output"), which holds what it printed.
+In Voila (tools/present.py), a live kernel, a solution does not run at all until asked for: its
+closed ``<details>`` holds the line "run it when you have tried" and a button, and only the
+button's click runs it and shows its output. Solution cells are found from the notebook itself
+(their cell ids on the site, their position in Voila, which numbers its cells from 1), so a
+template that forgets to collapse them, or a solution that runs unasked, fails here.
 
 Artefacts in build/artifacts/: solutions-site-NN.png (each chapter with solutions, as it opens),
-solutions-site-NN-open.png (its first solution opened), solutions-voila-02.png and
-solutions-voila-02-open.png.
+solutions-site-NN-open.png (its first solution opened), solutions-voila-02.png,
+solutions-voila-02-open.png and solutions-voila-02-run.png (after the button's click).
 """
 
 from __future__ import annotations
@@ -19,22 +23,26 @@ import nbformat
 import pytest
 from _lecture import BUILD, ROOT, list_notebooks, resolve_notebook, serving_on_free_port
 
+from tunnelkit.solutions import ASK, CSS_CLASS, SUMMARY, solution_id
+
 SOLUTION = "solution"
+#: words solution 02.1 prints (not in its title, which the line before its button shows)
+PRINTED_02_1 = "for every R >="
 
 
-def solution_cells(path) -> list[tuple[int, str]]:
-    """(position, cell id) of every solution cell of a notebook."""
+def solution_cells(path) -> list[tuple[int, str, str]]:
+    """(position, cell id, solution id) of every solution cell of a notebook."""
     nb = nbformat.read(path, as_version=4)
     return [
-        (i, c.get("id", ""))
+        (i, c.get("id", ""), solution_id(c.source))
         for i, c in enumerate(nb.cells)
         if SOLUTION in c.get("metadata", {}).get("tags", [])
     ]
 
 
 # For each selector: how many elements match, how many of the outputs inside them are on screen
-# (a box with a size and not inside a closed <details>), and whether each sits in a closed
-# <details class="tk-solution">.
+# (a box with a size and not inside a closed <details>), whether each sits in a closed
+# <details class="tk-solution">, how many hold a solution's collapsed output (it ran) and their text.
 STATE = """sels => sels.map(sel => {
   const cells = [...document.querySelectorAll(sel)];
   const outs = cells.flatMap(c => [...c.querySelectorAll('.jp-OutputArea-output')]);
@@ -44,8 +52,10 @@ STATE = """sels => sels.map(sel => {
   });
   return {sel, cells: cells.length, outputs: outs.length, shown: shown.length,
           closed: cells.filter(c => { const d = c.closest('details.tk-solution');
-                                      return d && !d.open; }).length};
-})"""
+                                      return d && !d.open; }).length,
+          ran: cells.filter(c => c.querySelector('details.OUTPUT_CLASS')).length,
+          text: cells.map(c => c.textContent).join(' ')};
+})""".replace("OUTPUT_CLASS", CSS_CLASS)
 
 
 def _assert_hidden(states: list[dict], where: str) -> None:
@@ -64,6 +74,10 @@ def _open_first(page, selector: str) -> int:
     return page.evaluate(STATE, [selector])[0]["shown"]
 
 
+def _visible_text(page, selector: str) -> str:
+    return page.locator(selector).locator(".jp-OutputArea").first.inner_text()
+
+
 def test_site_solutions_are_collapsed(site_url, watched, artifacts):
     page = watched.page
     books = [(b, solution_cells(b)) for b in list_notebooks()]
@@ -72,12 +86,17 @@ def test_site_solutions_are_collapsed(site_url, watched, artifacts):
     for book, cells in books:
         page.goto(site_url + f"{book.stem}.html", wait_until="load")
         page.wait_for_load_state("networkidle")
-        sels = [f'[id="cell-id={cid}"]' for _, cid in cells]
-        _assert_hidden(page.evaluate(STATE, sels), book.stem)
+        sels = [f'[id="cell-id={cid}"]' for _, cid, _ in cells]
+        states = page.evaluate(STATE, sels)
+        _assert_hidden(states, book.stem)
+        for s in states:  # built with the flag: every solution ran, its output collapsed
+            assert s["ran"] == 1, f"{book.stem}: {s['sel']} did not run for the site"
+            assert ASK not in s["text"], f"{book.stem}: {s['sel']} offers instead of showing"
         tag = book.stem.split("-", 1)[0]
         page.locator(sels[0]).locator("xpath=ancestor::details[1]").scroll_into_view_if_needed()
         page.screenshot(path=str(artifacts / f"solutions-site-{tag}.png"))
         assert _open_first(page, sels[0]) > 0, f"{book.stem}: the opened solution shows nothing"
+        assert SUMMARY in _visible_text(page, sels[0]), f"{book.stem}: no collapsed output shown"
         page.screenshot(path=str(artifacts / f"solutions-site-{tag}-open.png"))
 
 
@@ -101,15 +120,34 @@ def test_voila_solutions_are_collapsed(voila_02, watched, artifacts):
     page = watched.page
     page.goto(url, timeout=300_000)
     # Voila numbers its cells from 1 and shows the page once the last cell has run
-    sels = [f'[cell-index="{i + 1}"] .jp-CodeCell' for i, _ in cells]
+    sels = [f'[cell-index="{i + 1}"] .jp-CodeCell' for i, _, _ in cells]
     page.wait_for_selector("#rendered_cells", state="visible", timeout=300_000)
     page.wait_for_function(
         "sels => sels.every(s => document.querySelector(s + ' .jp-OutputArea-output'))",
         arg=sels,
         timeout=300_000,
     )
-    _assert_hidden(page.evaluate(STATE, sels), f"Voila {nb.stem}")
+    # the widgets (a solution's line and button) render once the page's kernel is connected
+    page.wait_for_function(
+        "([sels, ask]) => sels.every(s => (document.querySelector(s)?.textContent || '')"
+        ".includes(ask))",
+        arg=[sels, ASK],
+        timeout=120_000,
+    )
+    states = page.evaluate(STATE, sels)
+    _assert_hidden(states, f"Voila {nb.stem}")
+    for s in states:  # a live kernel: no solution ran, each offers itself
+        assert s["ran"] == 0 and ASK in s["text"], f"Voila: {s['sel']} ran unasked: {s['text']}"
+        assert PRINTED_02_1 not in s["text"], f"Voila: {s['sel']} shows an answer unasked"
     page.locator(sels[0]).locator("xpath=ancestor::details[1]").scroll_into_view_if_needed()
     page.screenshot(path=str(artifacts / "solutions-voila-02.png"))
     assert _open_first(page, sels[0]) > 0, "the opened solution shows nothing"
+    assert PRINTED_02_1 not in _visible_text(page, sels[0]), "opened, it ran without the click"
     page.screenshot(path=str(artifacts / "solutions-voila-02-open.png"))
+    page.locator(sels[0]).get_by_role("button", name=f"Run solution {cells[0][2]}").click()
+    page.wait_for_function(
+        "([sel, text]) => (document.querySelector(sel)?.innerText || '').includes(text)",
+        arg=[sels[0], PRINTED_02_1],
+        timeout=120_000,
+    )
+    page.screenshot(path=str(artifacts / "solutions-voila-02-run.png"))

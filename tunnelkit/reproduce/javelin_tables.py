@@ -20,7 +20,7 @@ import numpy as np
 from .._validate import boolean, instance, integer, sequence, text
 from ..reference import load as load_reference
 from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
-from ..studies.drives import FLAGGED, drive_variant
+from ..studies.drives import FLAGGED, HELD_OUT_SEED, TUNING_SEEDS, drive_variant
 from ..studies.scoring import evaluate
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
@@ -33,6 +33,7 @@ __all__ = [
     "collect_routes",
     "javelin_table",
     "score_drive",
+    "seed_note",
     "table_columns",
     "table_rows",
 ]
@@ -183,9 +184,27 @@ NOTES = [
     "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails, uses its curvature only when "
     "plausible (|d - kappa| within the clock-bias support, range within 200 m), else its delay "
     "distance, and holds its last fix on epochs without one.",
-    "Seeds: designs were chosen on seed 0 (and seed 7); studies.HELD_OUT_SEED (20261202) was "
-    "never looked at while choosing anything.",
+    f"Seeds: designs were chosen on the tuning seeds {TUNING_SEEDS} (studies.TUNING_SEEDS); "
+    f"studies.HELD_OUT_SEED ({HELD_OUT_SEED}) was never looked at while choosing anything.",
 ]
+
+
+def seed_note(seed: int) -> str:
+    """Which kind of seed a table ran on: the held-out seed, a tuning seed (our design's column
+    is then scored on drives its choices were made on), or another seed."""
+    seed = integer("seed", seed)
+    if seed == HELD_OUT_SEED:
+        return f"This table: seed {seed}, the held-out seed: no design choice saw its drives."
+    if seed in TUNING_SEEDS:
+        return (
+            f"This table: seed {seed}, a tuning seed: choices of our design were made on its "
+            "drives, so the 'our design' column is not a held-out result (the held-out seed: "
+            f"--seed {HELD_OUT_SEED})."
+        )
+    return (
+        f"This table: seed {seed}, neither a tuning seed {TUNING_SEEDS} nor the held-out seed "
+        f"({HELD_OUT_SEED}): no design choice saw its drives."
+    )
 
 
 def _simulate_and_score(
@@ -274,7 +293,16 @@ def javelin_table(
         **parallel,
     )
     return _report(
-        scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info
+        scenario,
+        reference,
+        conditions,
+        extractions,
+        done,
+        channel,
+        nuisance,
+        length,
+        rt_info,
+        seed=seed,
     )
 
 
@@ -286,9 +314,12 @@ def _traced_routes(extractions: tuple[str, ...], channel: str) -> tuple[str, ...
     return tuple(extractions)
 
 
-def _report(scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info):
+def _report(
+    scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info, seed
+):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
-    (scores, faults)), ...]`` in drive order (also from a subset of whole runs)."""
+    (scores, faults)), ...]`` in drive order (also from a subset of whole runs); ``seed`` the
+    seed they were drawn from (:func:`seed_note`)."""
     extractions = _traced_routes(extractions, channel)
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
@@ -317,6 +348,7 @@ def _report(scenario, reference, conditions, extractions, done, channel, nuisanc
         rows=rows,
         meta={
             "scenario": scenario,
+            "seed": seed,
             "extraction_failures": faults,
             "flagged_epochs": flagged,
             "epochs": epochs,
@@ -326,6 +358,7 @@ def _report(scenario, reference, conditions, extractions, done, channel, nuisanc
         },
         notes=[
             *NOTES,
+            seed_note(seed),
             *(_RT_NOTES if channel == "sionna" else []),
             *([_traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
             *([_nuisance_note(nuisance)] if nuisance else []),

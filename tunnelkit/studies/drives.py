@@ -48,6 +48,7 @@ __all__ = [
     "MAX_DRIVE_LENGTH",
     "SIGMA_HEADING",
     "SIGMA_SPEED",
+    "TUNING_SEEDS",
     "Condition",
     "DriveData",
     "drive_variant",
@@ -159,8 +160,13 @@ EXTRACTIONS = ("paper", "coherent", "ml", "route")
 #: older name of a route
 _ALIASES = {"separated": "coherent"}
 
+#: the tuning seeds of the JAVELIN designs: seed 0 (the ML route's measurement noise of
+#: :func:`~tunnelkit.tracking.javelin.designs.ours_ml` and its joint innovation test) and seed 7
+#: (the CPD-route settings of :func:`~tunnelkit.tracking.javelin.designs.ours`)
+TUNING_SEEDS = (0, 7)
+
 #: the held-out seed of the JAVELIN tables: never looked at while choosing anything (designs,
-#: sigmas, settings); every choice was made on seed 0 (and seed 7 for :data:`OURS`)
+#: sigmas, settings); every choice was made on :data:`TUNING_SEEDS`
 HELD_OUT_SEED = 20261202
 
 

@@ -490,9 +490,11 @@ class HeadingDeadReckoning:
     ``phi`` is the heading from the y axis, taken from the past estimated positions (the last
     displacement longer than ``min_step``, oriented forward), starting from the GNSS velocity.
     ``dr`` is the signed change of the filtered distance along the direction of travel (positive
-    forward): the paper takes ``|d_k - d_{k-1}|``, which turns a range correction that is later
-    undone into two forward steps. Near the transmitter (where the distance barely changes) the
-    position stalls: the paper's radial-motion approximation.
+    forward). The paper defines it in words, "the difference between two successive distances
+    (d_{k-1} and d_k)", with no order or sign rule: one fixed order moves the vehicle backwards on
+    one of the two legs, and the magnitude ``|d_k - d_{k-1}|`` would turn a range correction that
+    is later undone into two forward steps. Near the transmitter (where the distance barely
+    changes) the position stalls: the paper's radial-motion approximation.
     """
 
     def __init__(self, p0, v0, *, min_step: float = 1e-3) -> None:
