@@ -3,7 +3,7 @@
     python tools/runtimes.py                 # quick mode (TUNNELKIT_QUICK=1), every notebook
     python tools/runtimes.py 03 07           # only these chapters
     python tools/runtimes.py --full          # full mode (the papers' counts: long)
-    python tools/runtimes.py --markdown      # the table in the README's markdown
+    python tools/runtimes.py --markdown      # the table of docs/runtimes.md, in markdown
 
 Each notebook runs alone, top to bottom, with nbclient and the ``python3`` kernel (what Run All in
 JupyterLab does), one after the other. One extra cell after the last reads the kernel's CPU time

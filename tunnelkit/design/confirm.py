@@ -4,7 +4,7 @@ The bound route (:mod:`tunnelkit.design.fastroute`) draws each path's measuremen
 extraction's error model; the channel route synthesises the tensor and runs the extraction. Near
 the target the two can disagree: the bound route cannot have the extraction's outliers (a path
 merged, a fit in its threshold region), and it reads the ideal channel 1.2-1.5 times
-optimistic in error p90 (README, the design answer). :func:`confirm_on_channel` re-runs the
+optimistic in error p90 (docs/results/design-answer.md). :func:`confirm_on_channel` re-runs the
 candidates the recommendation rests on, on the channel route with the same impairments, runs
 and seed:
 
@@ -33,8 +33,8 @@ Before, the white-noise test alone flagged the fits and a flagged epoch carried 
 10 of 10 on 8 x 8, after the re-judge 1 and 0 (the 4 x 4 one an unresolved pair, which stays
 flagged); the fits needed 0.01-0.07 of the closed form. The settled median error on the channel
 route went from 0.42 / 0.97 m (4 x 4 / 8 x 8, 2 runs) to 1.8 / 0.49 cm (20 runs; p90 10.3 / 3.6
-cm), the bound route's 1.1 / 0.42 cm (p90 8.3 / 2.6 cm): both recommend 8 x 8 (README, the
-design answer).
+cm), the bound route's 1.1 / 0.42 cm (p90 8.3 / 2.6 cm): both recommend 8 x 8 (docs/results/
+design-answer.md).
 
 At 2 deg the channel route's 8 x 8 had a tail (p90 65 cm, 4 runs) the bound route did not
 (8.3 cm): on the drives that carried it the calibration error's quadratic phase drove every
