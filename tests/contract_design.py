@@ -13,10 +13,10 @@ SCENARIO = "italiano2026-straight"
 
 
 def design_models():
-    """Path error model, bounds over the drive, the fast route and its drive, the learned bound,
-    the mode vectors of the misspecified bound."""
+    """Path error model, bounds over the drive, the fast route and its drive, the mode vectors of
+    the misspecified bound."""
     from tunnelkit import design
-    from tunnelkit.design import drivebound, errormodel, fastroute, learnedbound, mcrb
+    from tunnelkit.design import drivebound, errormodel, fastroute, mcrb
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
     imp = design.DesignImpairments(phase_error_deg=0.5, gain_error_db=0.2)
@@ -34,8 +34,6 @@ def design_models():
     route = fastroute.bound_route(m, setup, "4x4")
     fastroute.tracker_weights(route)
     fastroute.bound_drive(route, setup, "4x4", np.random.default_rng(0), n_epochs=5)
-    learnedbound.learned_model(m, g, setup)
-    learnedbound.learned_pcrlb(m, g, setup)
     del errormodel, mcrb
 
 
@@ -68,7 +66,7 @@ def design_modes():
 
 
 def design_sweep():
-    """The Monte-Carlo and the sweep on a few epochs, one run (``javelin_rmse``, a channel-route
+    """The Monte-Carlo and the sweep on a few epochs, one run (a channel-route
     Monte-Carlo of at least two drives, takes seconds)."""
     from tunnelkit import design
     from tunnelkit.design import montecarlo, report

@@ -441,7 +441,6 @@ def _known_surfaces():
     of the bound over the drive."""
     from tunnelkit import design
     from tunnelkit.design.arrayjob import design_planes
-    from tunnelkit.design.learnedbound import batch_information
     from tunnelkit.tracking.javelin import JavelinState, draw_start
     from tunnelkit.tracking.javelin.config import JavelinConfig
     from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
@@ -476,9 +475,6 @@ def _known_surfaces():
     from tunnelkit.design.drivebound import drive_motion
 
     drive_motion(setup, 5, 0.2, 0.0175)
-    A = rng.standard_normal((3, 2, 2))
-    info = A @ np.swapaxes(A, 1, 2)
-    batch_information(info, info + np.eye(2), np.eye(2))
 
 
 def _baselines_checks():

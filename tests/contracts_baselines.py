@@ -72,7 +72,6 @@ def design_confirm():
     confirm.confirmation_candidates(rep)
     confirm.next_candidate(rep, [])
     confirm.confirm_on_channel(rep, setup, units=2)
-    design.javelin_rmse(setup, "4x4", 2, 0, n_epochs=1, crlb=CRLB)
     pdz.size_figure(rep.rows)
     pdz.design_answer_figure(rep)
     full = design.DesignSetup.from_scenario(SCENARIO)

@@ -210,12 +210,10 @@ def test_kruskal_rank_of_40_columns_is_bounded():
     assert kruskal_rank(B) == 40  # generic columns: full k-rank, found without 2^40 subsets
 
 
-def test_javelin_rmse_with_no_epochs():
+def test_design_monte_carlo_with_no_epochs():
     setup = tk.design.DesignSetup.from_scenario("italiano2026-straight")
-    # runs=1 is refused on its own (runs >= 2 for an interval); with valid runs, n_epochs=0 is
-    # refused at the boundary, before any bound or drive is computed
-    _raises(ValueError, r"^runs", tk.design.javelin_rmse, setup, "4x4", 1, 0, n_epochs=0)
-    _raises(ValueError, r"^n_epochs", tk.design.javelin_rmse, setup, "4x4", 2, 0, n_epochs=0)
+    # n_epochs=0 is refused at the boundary, before any bound or drive is computed
+    _raises(ValueError, r"^n_epochs", tk.design.sweep_montecarlo, setup, "4x4", 2, 0, n_epochs=0)
 
 
 def test_route_bounds_with_an_epoch_past_the_route():

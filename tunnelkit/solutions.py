@@ -233,6 +233,7 @@ def install(shell=None) -> bool:
 
 def run(sid: str) -> None:
     """Run solution ``sid`` (``"03.2"``) of this notebook, as its button does."""
+    exercise_of(sid)  # a solution id, refused by name before anything runs
     from IPython import get_ipython
 
     shell = get_ipython()

@@ -65,12 +65,10 @@ from .montecarlo import (
     START_HEIGHT_SIGMA_M,
     START_SIGMA_M,
     STARTS,
-    VUES,
     MonteCarloResult,
     javelin_config,
     sweep_montecarlo,
 )
-from .onearray import javelin_rmse
 from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
 from .setup import ArraySpec, DesignSetup, Mount, parse_array
 from .units import unit_quantiles, unit_yield, wilson_interval
@@ -98,7 +96,6 @@ __all__ = [
     "START_HEIGHT_SIGMA_M",
     "START_SIGMA_M",
     "STATUSES",
-    "VUES",
     "AchievableBound",
     "ArraySpec",
     "BoundRoute",
@@ -126,7 +123,6 @@ __all__ = [
     "drive_pcrlb",
     "gate",
     "javelin_config",
-    "javelin_rmse",
     "judge",
     "over_target",
     "parse_array",

@@ -155,7 +155,6 @@ class Prepared:
     peb: np.ndarray
     pcrlb: np.ndarray | None
     drive: np.ndarray | None
-    learned: np.ndarray | None = None
     budget: object = None  # signal_route.judging.BiasBudget: the channel route's, impaired
     error_model: dict | None = None  # traced.error_model_summary: the traced route's
     hybrid: np.ndarray | None = None  # the bound pooled over units (drivebound.unit_pcrlb)
@@ -167,7 +166,6 @@ class Prepared:
             self.pcrlb,
             self.drive,
             self.design.config,
-            self.learned,
             self.error_model,
             self.hybrid,
         )
@@ -186,13 +184,12 @@ class ArrayJob:
     with_model: bool
     crlbs: dict | None
     impairments: object = None
-    vues: str = "known"
     start_sigma: float = START_SIGMA_M
 
     def __call__(self, spec: ArraySpec) -> Prepared:
         ep = np.arange(self.T)
         peb = route_bounds(self.setup, spec, epochs=ep).peb
-        m = route = pc = hybrid = drive = learned = None
+        m = route = pc = hybrid = drive = None
         if self.with_model:
             m = _model(self.setup, spec, self.error_models, self.impairments)
             if self.mode == "bound":
@@ -217,14 +214,6 @@ class ArrayJob:
                 w = tracker_weights(route)[: self.T]
             pc_w = drive_pcrlb(self.setup, position_information(head, g, w), sigma_p0=sp0)
             drive = drive_bound(pc_w, position_bias_rms(head, g, w))
-            from .learnedbound import learned_pcrlb
-
-            # a tracker that learns its VUEs is told the same blocks: the paths taken one by one
-            learned = drive_bound(
-                *learned_pcrlb(
-                    _per_path(head) if w is not None else head, g, self.setup, sigma_p0=sp0
-                )
-            )
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
             crlb = _median_sigmas(m)
@@ -237,8 +226,9 @@ class ArrayJob:
                     "per-path CRLB is infinite at every epoch); choose a larger array"
                 )
             crlb = {k: float(np.median(pb[k][ok])) for k in ("d", "direction", "kappa")}
-        planes = design_planes(self.setup) if self.vues == "known" else None
-        design = javelin_config(crlb, self.setup.signal_route(spec).min_d, planes)
+        design = javelin_config(
+            crlb, self.setup.signal_route(spec).min_d, design_planes(self.setup)
+        )
         imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired
         budget = channel_route_budget(self.setup, spec, imp)
         error_model = None
@@ -252,13 +242,11 @@ class ArrayJob:
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
             # (a model's posterior CRLB, not a bound of the tracker on the traced channel,
             # whose errors are neither Gaussian nor independent: a prediction)
-            pc, drive, learned = (
-                None,
-                *traced_bounds(self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma)[
-                    1:
-                ],
-            )
-        return Prepared(spec, route, design, peb, pc, drive, learned, budget, error_model, hybrid)
+            pc = None
+            drive = traced_bounds(
+                self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma
+            )[1]
+        return Prepared(spec, route, design, peb, pc, drive, budget, error_model, hybrid)
 
 
 def load_tracker() -> None:
@@ -284,14 +272,6 @@ def _median_sigmas(m: PathErrorModel) -> dict[str, float]:
         "direction": float(np.median(np.sqrt(var[:, 0] * np.cos(psi) ** 2 + var[:, 1]))),
         "kappa": float(np.median(np.sqrt(var[:, 2]))),
     }
-
-
-def _per_path(m: PathErrorModel) -> PathErrorModel:
-    """A model whose ideal bound keeps only each path's own block (the correlation of the joint
-    CRLB between paths dropped): the information a tracker told one block per path uses."""
-    P = m.exists.shape[1]
-    keep = np.kron(np.eye(P, dtype=bool), np.ones((4, 4), dtype=bool))
-    return replace(m, crlb=np.where(keep, m.crlb, 0.0))
 
 
 def model_head(m: PathErrorModel, T: int) -> PathErrorModel:

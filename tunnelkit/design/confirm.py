@@ -179,7 +179,7 @@ def confirm_on_channel(
             # (no error model; score_row fills the traced route's prediction)
             row.pcrlb_rms_m = row.hybrid_bound_rms_m = row.rmse_over_pcrlb = None
             row.rmse_over_hybrid_bound = row.unit_rmse_over_pcrlb_min = None
-            row.predicted_drive_rms_m = row.predicted_drive_learned_rms_m = None
+            row.predicted_drive_rms_m = None
             row.rmse_over_predicted_drive = None
             score_row(
                 row,

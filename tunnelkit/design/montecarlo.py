@@ -20,7 +20,7 @@ estimate, which the ML route attains), so the tracker is tuned by the design its
 carrier and size (:func:`javelin_config`). It starts from an open-sky fix drawn with the
 uncertainty it is told (:data:`STARTS`; ``start_sigma`` per axis, default 1 m, 5 cm in
 height), first fixes itself on the path the known surfaces say is the LoS, and takes its VUEs
-from the tunnel's known surfaces (:data:`VUES`, :class:`tunnelkit.tracking.javelin.surfaces.GeometricBirth`): a design knows
+from the tunnel's known surfaces (:class:`tunnelkit.tracking.javelin.surfaces.GeometricBirth`): a design knows
 its tunnel, and a tracker that learns every VUE afresh cannot use the reflections' information
 until it has learnt the surfaces (under a calibration error, whose bias repeats, it never
 does). Its settled error (after the first :data:`SETTLE_S`)
@@ -28,9 +28,7 @@ is set beside the PEB, the posterior CRLB over the drive (:func:`drive_pcrlb`, T
 al. 1998 with JAVELIN's motion model and the position information of the model's reported bound)
 and the bound over the drive under the impairments (:func:`drive_bound`: the posterior CRLB with
 the position bias of the array's one calibration draw and of the wideband term added, which no
-number of epochs averages down) and beside the same bound for a tracker that learns its VUEs
-(:mod:`tunnelkit.design.learnedbound`); ``MonteCarloResult.tracker_bound`` is the one of the
-tracker run. :func:`~tunnelkit.design.onearray.javelin_rmse` is the one-array summary on top of it.
+number of epochs averages down).
 
 Cost: the per-array work (error model, the bound route's shared part
 :func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
@@ -73,7 +71,6 @@ __all__ = [
     "STARTS",
     "START_HEIGHT_SIGMA_M",
     "START_SIGMA_M",
-    "VUES",
     "MonteCarloResult",
     "javelin_config",
     "sweep_montecarlo",
@@ -89,11 +86,6 @@ MODES = ("bound", "channel")
 #: error; ``"truth"`` the true first position with the same ``P_0`` (the paper tables' start,
 #: which rewards a tracker that trusts its measurements too little)
 STARTS = ("drawn", "truth")
-
-#: how the design's tracker gets its VUEs (:func:`sweep_montecarlo`): ``"known"`` at the UE's
-#: mirror image in the tunnel's known surfaces (the design knows its tunnel), ``"learned"`` from
-#: each path's angles and learnt over the drive (Algorithm 3)
-VUES = ("known", "learned")
 
 
 @dataclass(frozen=True)
@@ -114,11 +106,8 @@ class MonteCarloResult:
     prior). Two **predictions** (first-order, not bounds: a tracker may beat them):
     ``predicted`` (T,) [m] the posterior CRLB of the tracker's weighting with the position bias
     of the calibration draw and the wideband term added (:func:`drive_bound`), the surfaces
-    known; ``predicted_learned`` (T,) [m] the same for a tracker that learns its VUEs
-    (:func:`~tunnelkit.design.learnedbound.learned_pcrlb`); on the ray-traced channel's route
-    both are those of the sigmas the tracker is told (:func:`tunnelkit.design.traced.traced_bounds`)
-    and ``pcrlb`` is ``None``. ``vues`` how the tracker run got its VUEs (:data:`VUES`),
-    :attr:`tracker_prediction` the prediction of that tracker; ``error_model`` the traced
+    known; on the ray-traced channel's route that of the sigmas the tracker is told
+    (:func:`tunnelkit.design.traced.traced_bounds`) and ``pcrlb`` is ``None``. ``error_model`` the traced
     route's measurement-noise model (:func:`tunnelkit.design.traced.error_model_summary`;
     ``None`` on the image channel, where each path carries its reported CRLB);
     ``dead_reckoning`` (runs, T) [m] the same drives' errors with every measurement dropped
@@ -136,15 +125,13 @@ class MonteCarloResult:
     pcrlb: np.ndarray | None
     sigmas: dict
     predicted: np.ndarray | None = None
-    predicted_learned: np.ndarray | None = None
-    vues: str = "known"
     error_model: dict | None = None
     dead_reckoning: np.ndarray | None = None
     hybrid: np.ndarray | None = None
     drives_per_unit: int = 1
 
     def __post_init__(self) -> None:
-        b = ("peb", "pcrlb", "predicted", "predicted_learned", "hybrid")
+        b = ("peb", "pcrlb", "predicted", "hybrid")
         e = ("errors", "dead_reckoning")
         record(self, shapes={**dict.fromkeys(("t", "x", *b), ("T",)), **dict.fromkeys(e, ("R", "T")),
                              "rmse_runs": ("R",), "settled": (None,)},
@@ -154,16 +141,8 @@ class MonteCarloResult:
         d = integer("drives_per_unit", self.drives_per_unit, minimum=1)
         if self.errors.shape[0] % d:
             raise ValueError(f"drives_per_unit: {self.errors.shape[0]} runs are not units of {d}")
-        choice("vues", self.vues, VUES)
         if self.error_model is not None:
             instance("error_model", self.error_model, dict)
-
-    @property
-    def tracker_prediction(self) -> np.ndarray | None:
-        """The predicted error over the drive of the tracker that was run (T,) [m] (a
-        first-order prediction, not a bound): ``predicted`` for VUEs from the known surfaces,
-        ``predicted_learned`` for learnt VUEs."""
-        return self.predicted if self.vues == "known" else self.predicted_learned
 
     @property
     def runs(self) -> int:
@@ -204,7 +183,6 @@ def sweep_montecarlo(
     pool: TrialPool | None = None,
     impairments=None,
     start: str = "drawn",
-    vues: str = "known",
     start_sigma: float = START_SIGMA_M,
     dead_reckoning: bool = False,
     drives_per_unit: int = 1,
@@ -244,9 +222,7 @@ def sweep_montecarlo(
     :data:`START_SIGMA_M`; the entry fix's quality, also the prior of the bounds over the
     drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
     tracker, start and V2X messages: what the radio adds), its errors the result's
-    ``dead_reckoning``. ``vues``
-    (:data:`VUES`): the tracker's VUEs from the tunnel's known surfaces (``"known"``, default)
-    or learnt from the paths' angles (``"learned"``).
+    ``dead_reckoning``.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -263,8 +239,6 @@ def sweep_montecarlo(
         raise ValueError(f"mode: expected one of {MODES}, got {mode!r}")
     if start not in STARTS:
         raise ValueError(f"start: expected one of {STARTS}, got {start!r}")
-    if vues not in VUES:
-        raise ValueError(f"vues: expected one of {VUES}, got {vues!r}")
     runs = integer("runs", runs, minimum=1)
     drives_per_unit = integer("drives_per_unit", drives_per_unit, minimum=1)
     first_unit = integer("first_unit", first_unit, minimum=0)
@@ -288,10 +262,6 @@ def sweep_montecarlo(
                 "impairments: the traced route's measurement noise is measured on the ray-traced "
                 "channel as it is (tunnelkit.design.traced); give none with channel 'sionna'"
             )
-        if vues != "known":
-            raise ValueError(
-                "vues: the traced route's tracker takes its VUEs from the known surfaces"
-            )
         if error_models is not None:
             raise ValueError(
                 "error_models: the traced route's noise is measured on the ray-traced channel "
@@ -313,7 +283,7 @@ def sweep_montecarlo(
         f"{A} arrays x {runs} drives x {T} epochs of errors and their generators",
     )
     with_model = mode == "bound" or error_models is not None
-    job = ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, vues, start_sigma)
+    job = ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, start_sigma)
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
     kw = {k: v for k, v in kw.items() if v is not None}
     if pool is not None:
@@ -355,7 +325,7 @@ def sweep_montecarlo(
         dr = None
         if dead_reckoning:  # each run (2, T): the tracker's errors, then dead reckoning's
             err, dr = err[:, 0], err[:, 1]
-        peb, pc, drive, cfg, learned, error_model, hybrid = built[a]
+        peb, pc, drive, cfg, error_model, hybrid = built[a]
         out[spec.label] = MonteCarloResult(
             spec,
             mode,
@@ -372,8 +342,6 @@ def sweep_montecarlo(
                 "delta_d_m": cfg.sigma_delta_d,
             },
             drive,
-            learned,
-            vues,
             error_model,
             dr,
             hybrid,

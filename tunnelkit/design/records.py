@@ -30,7 +30,7 @@ _ROW_INF = (
     "error_p90_m", "error_p90_route_m", "error_p90_ci95_m", "rmse_m", "rmse_ci95_m", "peb_m",
     "predicted_m", "error_median_epoch_m", "unit_p90_m", "pcrlb_rms_m", "hybrid_bound_rms_m",
     "rmse_over_pcrlb", "rmse_over_hybrid_bound", "unit_rmse_over_pcrlb_min",
-    "predicted_drive_rms_m", "predicted_drive_learned_rms_m", "rmse_over_predicted_drive",
+    "predicted_drive_rms_m", "rmse_over_predicted_drive",
     "rmse_over_predicted", "dead_reckoning_p90_m", "dead_reckoning_rmse_m",
 )  # fmt: skip
 _ROW_NONNEGATIVE = ("srnf_valid_share", "met_share", "runs", "units", "drives_per_unit",
@@ -63,8 +63,7 @@ class DesignRow:
     ``hybrid_bound_rms_m`` the posterior CRLB pooled over units (the calibration draw a fixed
     unknown of the drive). **Predictions** (first-order, not bounds: the tracker may beat
     them): ``predicted_*`` the snapshot fix's RMS error under the impairments, weighted as the
-    tracker weighs; ``predicted_drive_rms_m`` / ``predicted_drive_learned_rms_m`` the same over
-    the drive, surfaces known / VUEs learnt. Per-epoch arrays cover the whole route: ``x_m``,
+    tracker weighs; ``predicted_drive_rms_m`` the same over the drive. Per-epoch arrays cover the whole route: ``x_m``,
     ``peb_m``, ``predicted_m`` and, with units, ``error_median_epoch_m`` (median over runs).
     """
 
@@ -101,9 +100,7 @@ class DesignRow:
     rmse_over_pcrlb: float | None = None
     rmse_over_hybrid_bound: float | None = None
     unit_rmse_over_pcrlb_min: float | None = None
-    tracker_vues: str | None = None
     predicted_drive_rms_m: float | None = None
-    predicted_drive_learned_rms_m: float | None = None
     rmse_over_predicted_drive: float | None = None
     rmse_over_predicted: float | None = None
     error_model: dict | None = None
@@ -129,7 +126,7 @@ class DesignRow:
         "met_share", "error_median_m", "error_p90_m", "error_p90_route_m", "rmse_m",
         "unit_yield", "pcrlb_rms_m", "hybrid_bound_rms_m", "rmse_over_pcrlb",
         "rmse_over_hybrid_bound", "unit_rmse_over_pcrlb_min", "predicted_drive_rms_m",
-        "predicted_drive_learned_rms_m", "rmse_over_predicted_drive", "rmse_over_predicted",
+        "rmse_over_predicted_drive", "rmse_over_predicted",
     )  # fmt: skip
 
     def to_json(self) -> dict:
@@ -137,7 +134,7 @@ class DesignRow:
         epochs where the array cannot fix the position, named; empty when none), the
         scalars of the class docstring (``null`` when not computed or not finite),
         ``error_p90_ci95_m, rmse_ci95_m, unit_yield_ci95, unit_p90_m``, the counts ``runs,
-        units, drives_per_unit``, ``tracker_vues`` and ``per_epoch {x_m, peb_m, predicted_m,
+        units, drives_per_unit`` and ``per_epoch {x_m, peb_m, predicted_m,
         error_median_m}``; on the ray-traced channel's route also ``error_model`` (the
         tracker's measurement-noise model, :func:`tunnelkit.design.traced.error_model_summary`,
         with ``told_sigmas`` the long-run sigmas its tracker is told); with dead reckoning
@@ -161,7 +158,6 @@ class DesignRow:
             "runs": int(self.runs),
             "units": int(self.units),
             "drives_per_unit": int(self.drives_per_unit),
-            "tracker_vues": self.tracker_vues,
             "per_epoch": {
                 "x_m": _fins(self.x_m),
                 "peb_m": _fins(self.peb_m),

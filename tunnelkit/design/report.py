@@ -287,19 +287,16 @@ def score_row(
 def _drive_bounds(row, res, k, unit_rmse) -> None:
     """The bounds over the drive (RMS over the counted epochs ``k``) and the tracker's RMSE
     over them: ``pcrlb`` every unit's (so each unit's RMSE ``unit_rmse`` is set beside it),
-    ``hybrid`` the one pooled over units; and the predictions ``predicted`` (surfaces known)
-    and ``predicted_learned`` (VUEs learnt), the tracker's over the one of the VUEs it ran."""
+    ``hybrid`` the one pooled over units; and the prediction ``predicted`` over the drive."""
     pc, hy = _rms(getattr(res, "pcrlb", None), k), _rms(getattr(res, "hybrid", None), k)
     if pc:
         row.pcrlb_rms_m, row.rmse_over_pcrlb = pc, row.rmse_m / pc
         row.unit_rmse_over_pcrlb_min = float(np.min(unit_rmse)) / pc
     if hy:
         row.hybrid_bound_rms_m, row.rmse_over_hybrid_bound = hy, row.rmse_m / hy
-    known = _rms(getattr(res, "predicted", None), k)
-    learned = _rms(getattr(res, "predicted_learned", None), k)
-    if known is not None and learned is not None:
-        row.predicted_drive_rms_m, row.predicted_drive_learned_rms_m = known, learned
-        row.tracker_vues, pred = res.vues, known if res.vues == "known" else learned
+    pred = _rms(getattr(res, "predicted", None), k)
+    if pred is not None:
+        row.predicted_drive_rms_m = pred
         row.rmse_over_predicted_drive = row.rmse_m / pred if pred > 0 else None
 
 

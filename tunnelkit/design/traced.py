@@ -393,14 +393,12 @@ def traced_bounds(
     told the sigmas of ``config`` (a :class:`~tunnelkit.tracking.javelin.JavelinConfig`:
     ``sigma_phi``, ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d``; the traced design's,
     :func:`traced_javelin`), every first-order path measured with independent Gaussian errors of
-    those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive, learned)`` (T,) [m] as the design's
+    those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive)`` (T,) [m] as the design's
     Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` from a start of
     ``sigma_p0`` [m] per axis, default :data:`~tunnelkit.design.drivebound.START_SIGMA_M`;
-    ``drive`` the same with no bias, ``learned`` for a tracker that learns its VUEs,
-    :func:`~tunnelkit.design.learnedbound.learned_pcrlb`). What the told sigmas allow: the traced
+    ``drive`` the same with no bias). What the told sigmas allow: the traced
     errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
     from .drivebound import START_SIGMA_M, drive_bound, drive_pcrlb, position_information
-    from .learnedbound import learned_pcrlb
 
     instance("setup", setup, DesignSetup)
     spec = parse_array(spec)
@@ -413,6 +411,4 @@ def traced_bounds(
     except ValueError as exc:  # a sigma of the config that is not > 0
         raise ValueError(f"config: {exc}") from None
     pc = drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
-    drive = drive_bound(pc, np.zeros_like(pc))
-    learned = drive_bound(*learned_pcrlb(model, g, setup, sigma_p0=sigma_p0))
-    return pc, drive, learned
+    return pc, drive_bound(pc, np.zeros_like(pc))

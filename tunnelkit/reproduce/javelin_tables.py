@@ -192,7 +192,7 @@ NOTES = [
 def seed_note(seed: int) -> str:
     """Which kind of seed a table ran on: the held-out seed, a tuning seed (our design's column
     is then scored on drives its choices were made on), or another seed."""
-    seed = integer("seed", seed)
+    seed = integer("seed", seed, minimum=0)
     if seed == HELD_OUT_SEED:
         return f"This table: seed {seed}, the held-out seed: no design choice saw its drives."
     if seed in TUNING_SEEDS:
