@@ -58,14 +58,7 @@ scene = rt.export_tunnel(tun, tk.build_dir("rt", "javelin"), name="javelin")
 shell = [f for f in tun.facets if f.kind != "road"]
 plate_w = {p.name: float(np.linalg.norm(p.edge_v)) for p in tun.plates}
 print(
-    scene.xml,
-    "-",
-    scene.n_surfaces,
-    "surfaces:",
-    len(shell),
-    "facets, road,",
-    len(plate_w),
-    "plates",
+    f"{scene.xml} - {scene.n_surfaces} surfaces: {len(shell)} facets, the road, {len(plate_w)} plates"
 )
 print(f"tube {np.ptp(tun.x_range):g} m x {tun.width:g} m x {tun.height:g} m; plates [m]:", plate_w)
 for sid in ("facet-0", "road", "rrm-top-left"):
@@ -76,7 +69,7 @@ for sid in ("facet-0", "road", "rrm-top-left"):
 #
 # The paper puts the anchor "at the center of the tunnel at a height of 4.8 m" and does not say
 # which point of its arrays sits there. tunnelkit places an array by its *reference antenna*,
-# element 0, a corner (notebook 03's model). With that antenna at 4.8 m, the 10 × 10 array at
+# element 0, a corner (`tunnelkit.arrays`: element 0 sits at the array's origin). With that antenna at 4.8 m, the 10 × 10 array at
 # half-wavelength spacing, tilted 30° down, rises to
 # $4.8 + 9\,\tfrac{\lambda}{2}\cos 30° = 4.998$ m. Its top corner, $|y| = 0.229$ m off the
 # tunnel's axis, is then above the 12-facet ceiling there (4.970 m), and even above the exact
@@ -387,13 +380,14 @@ for g in rt.first_order_groups(ep0):
     )
 
 # %% [markdown]
-# The path part of the array misses correlates far less. It is the ceiling reflection: its
-# specular point, a few metres from the array, lies a few decimetres from the ridge between two
-# ceiling facets (printed below), so across the array's aperture it crosses onto the next facet
-# and that facet's path reaches part of the array only. Road-marking paths do the same when
-# their specular points leave the 0.3 m and 0.8 m wide plates across the aperture. Without
-# diffraction the ray tracer's field stops at each shadow boundary; no point-source atom fits a
-# wavefront cut off across the array.
+# A path part of the array misses correlates far less (below 0.95). One is the ceiling
+# reflection: its specular point, a few metres from the array, lies a few decimetres from the
+# ridge between two ceiling facets (printed below), so across the array's aperture it crosses
+# onto the next facet, and that facet's path reaches part of the array only. Road-marking paths
+# do the same where their specular points leave the 0.3 m and 0.8 m wide plates across the
+# aperture (full mode, whose ten times more rays find the wall marking at this epoch, lists one).
+# Without diffraction the ray tracer's field stops at each shadow boundary; no point-source atom
+# fits a wavefront cut off across the array.
 
 # %%
 ceil = next(p for p in route_img.paths(k0)[1] if p.surface_kind == "ceiling")
@@ -561,8 +555,9 @@ print(f"traced channel: |bias| / MCRB sd from {ratio8.min():.3g} to {ratio8.max(
 # %% [markdown]
 # On the image channel the tensor *is* eq. 1: $\theta_0$ is the truth, there is no bias, and the
 # MCRB is the CRLB (asserted in the Checks). On the traced one the residual at $\theta_0$ is a
-# few per cent of the received power; the fit's limit is centimetres to metres off in delay
-# (the bias printed above), while the spread about it stays at millimetres or less: the bias is
+# few per cent of the received power; the fit's limit is off in delay by centimetres at least,
+# by decimetres or more for some paths (the bias printed above), while the spread about it stays
+# at millimetres or less: the bias is
 # over ten standard deviations for every path (the ratio printed above). More SNR or a larger
 # array only shrinks the spread, never the bias: what limits the chain on the traced channel is
 # the model, not the noise. Where $A$ is not positive definite there is no minimum near the
@@ -633,17 +628,20 @@ for k in range(n_ep):
 # %%
 fa, t_over = {}, {}
 for label, snaps in geo.items():
-    flagged_n = sum(not s[2] for s in snaps)
-    fa[label] = (flagged_n, len(snaps), *rate_interval(flagged_n, len(snaps), 0.99))
-    t_over[label] = float(np.median([s[0] / s[1] for s in snaps]))
-    print(f"{label:22s} flagged {flagged_n} of {len(snaps)} snapshots (99 % interval of the rate "
-          f"{fa[label][2]:.3f}-{fa[label][3]:.3f}); median T / threshold {t_over[label]:.3g}")  # fmt: skip
+    tested = [s for s in snaps if np.isfinite(s[1])]  # fewer than 2 paths: nothing to test
+    flagged_n = sum(not s[2] for s in tested)
+    fa[label] = (flagged_n, len(tested), *rate_interval(flagged_n, len(tested), 0.99))
+    t_over[label] = float(np.median([s[0] / s[1] for s in tested]))
+    print(f"{label:22s} flagged {flagged_n} of {len(tested)} snapshots ({len(snaps) - len(tested)}"
+          f" with too few paths to test; 99 % interval of the rate {fa[label][2]:.3f}-"
+          f"{fa[label][3]:.3f}); median T / threshold {t_over[label]:.3g}")  # fmt: skip
 
 # %% [markdown]
-# On the image channel the test with the joint covariance flags a share of the snapshots whose
-# 99 % interval contains the stated 1 %: there the paths agree with one UE to their bound. On the
-# traced one every snapshot fails, the median by over ten times the threshold (printed), the
-# wrong basin included: its paths fit the tensor but not one UE.
+# A snapshot with fewer than two paths has nothing to test and is left out. On the image channel
+# the test with the joint covariance flags a share of the snapshots whose 99 % interval contains
+# the stated 1 %: there the paths agree with one UE to their bound. On the traced one nearly every
+# snapshot fails (at least 90 % of them), the median by over ten times the threshold (printed),
+# the wrong basin included: its paths fit the tensor but not one UE.
 #
 # For a tracker the test must not drop everything, so its pre-filter form states a model-error
 # floor instead of the bound (`bound=False`, `floor_angle`, `floor_range`): a path is kept when
@@ -861,7 +859,8 @@ assert p_n0["specular2+"] > 3 * p_n0["diffuse"] and p_n0["visibility"] > 3 * p_n
 assert min(p_n0["specular2+"], p_n0["visibility"]) > 10 and p_n0["diffuse"] > 0
 assert 15 < test_n0 < 20 and 4e5 < parts["full"].size < 6e5
 assert seen[0][:2] == ("LoS", arr0.M) and all(rho > 0.99 for _, c, rho in seen if c == arr0.M)
-assert all(rho < 0.99 for _, c, rho in seen if c < arr0.M)
+assert all(rho < 0.95 for _, c, rho in seen if c < arr0.M)
+assert tk.QUICK or any(n.startswith("RRM") and c < arr0.M for n, c, _ in seen)
 assert any(n == ceil.surface and c < arr0.M and rho < 0.95 for n, c, rho in seen)
 assert 1 < d_ceil < 10 and 0.1 < y_ridge < 1 and abs(ceiling(0.0) - tun.height) < 1e-9
 for kind in ("los", "road"):  # the model, not the noise
@@ -877,13 +876,13 @@ assert tensors8["image"].shape[1:] == ((64, 4) if tk.QUICK else (cfg.n_tones, cf
 assert np.all(np.abs(im["bias"]) < 1e-6) and im["share"] < 1e-12  # eq. 1: theta_0 = theta
 np.testing.assert_allclose(im["mcrb"], im["crlb"], rtol=1e-6)  # ... and the MCRB is the CRLB
 assert 0.005 < si["share"] < 0.2  # a few per cent of the received power
-assert 0.005 < np.min(np.abs(si["bias"])) and 0.05 < np.max(np.abs(si["bias"])) < 10
+assert 0.005 < np.min(np.abs(si["bias"])) and 0.1 < np.max(np.abs(si["bias"])) < 10
 assert np.max(si["mcrb"]) < 0.01 and np.min(ratio8) > 10  # millimetres or less; > 10 sd
 # 9. geometry consistency, the pre-filter's floors, the traced sigmas
 assert fa["image"][2] <= PFA <= fa["image"][3]  # the stated 1 % within the 99 % interval
-assert all(not s[2] for s in geo["sionna"]) and t_over["sionna"] > 10
-assert len(geo["sionna"]) >= max(1, n_ep // 2)  # the bound mostly defined
-assert len(geo["image"]) >= max(1, n_draw * n_ep // 2)
+assert fa["sionna"][0] >= 0.9 * fa["sionna"][1] and t_over["sionna"] > 10
+assert fa["sionna"][1] >= max(1, n_ep // 2)  # the bound mostly defined, the test mostly possible
+assert fa["image"][1] >= max(1, n_draw * n_ep // 2)
 assert floor_deg < 1 and 0.1 <= floor_m < 1  # a fraction of a degree, decimetres
 assert kept["image"] >= 0.95 and np.median(ang_rt) > floor_deg and within < 0.5
 assert ratio_rt["kappa"] > 3 and min(ratio_rt["phi"], ratio_rt["psi"]) > 1
