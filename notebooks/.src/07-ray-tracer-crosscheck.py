@@ -450,6 +450,8 @@ drives = {
 }
 design = designs.paper() if tk.QUICK else designs.ours_ml()
 evals = {ch: studies.evaluate(d, design) for ch, d in drives.items()}
+
+# %%
 fig = go.Figure(
     [go.Scatter(x=traj.position[:n_ep, 0], y=traj.position[:n_ep, 1], name="truth", mode="lines")]
     + [
@@ -599,7 +601,6 @@ from tunnelkit.path_consistency import epoch_consistency, rate_interval
 PFA = 0.01
 n_draw = tk.mc_count(4, 2)
 geo = {"image": [], "image, per-component": [], "sionna": []}
-err_rt = {"phi": [], "psi": [], "kappa": [], "d": []}
 eps_geo = {"image": [], "sionna": []}
 for k in range(n_ep):
     for label, route, draws in (("image", route_img, n_draw), ("sionna", route_rt, 1)):
@@ -615,15 +616,6 @@ for k in range(n_ep):
                 geo["image, per-component"].append((diag["statistic"], diag["threshold"],
                                                     diag["consistent"]))  # fmt: skip
             eps_geo[label].append(ep)
-            if label == "sionna":  # each matched path's error against the truth
-                m = ep.measurements
-                for j, t in enumerate(ep.truth_index):
-                    p = ep.paths[t]
-                    err_rt["phi"].append(np.angle(np.exp(1j * (m.phi[j] - p.azimuth))))
-                    err_rt["psi"].append(m.psi[j] - p.elevation)
-                    kap = m.kappa[j] - p.length if np.isfinite(m.kappa[j]) else np.nan
-                    err_rt["kappa"].append(kap)
-                    err_rt["d"].append(m.d[j] - p.length - C * ep.snapshot.clock_bias)
 
 # %%
 fa, t_over = {}, {}
@@ -653,6 +645,17 @@ for label, snaps in geo.items():
 # %%
 from tunnelkit.studies.traced import FLOORS, geometry_keep, traced_design, traced_errors
 
+err_rt = {"phi": [], "psi": [], "kappa": [], "d": []}  # each traced matched path's error
+for ep in eps_geo["sionna"]:
+    m = ep.measurements
+    for j, t in ((j, t) for j, t in enumerate(ep.truth_index) if t >= 0):  # -1: matched to none
+        p = ep.paths[t]
+        err_rt["phi"].append(np.angle(np.exp(1j * (m.phi[j] - p.azimuth))))
+        err_rt["psi"].append(m.psi[j] - p.elevation)
+        err_rt["kappa"].append(m.kappa[j] - p.length if np.isfinite(m.kappa[j]) else np.nan)
+        err_rt["d"].append(m.d[j] - p.length - C * ep.snapshot.clock_bias)
+
+# %%
 floor_deg, floor_m = float(np.degrees(FLOORS[0])), float(FLOORS[1])
 kept = {}
 for label, route in (("image", route_img), ("sionna", route_rt)):
