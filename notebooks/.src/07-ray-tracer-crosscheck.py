@@ -8,8 +8,8 @@
 # tracer, built on the Mitsuba 3 renderer and its Dr.Jit just-in-time compiler), an independent
 # ray tracer that loads Blender-exported scenes.
 # All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
-# [glossary](GLOSSARY.md), whose [Bounds](GLOSSARY.md#bounds) part defines the CRLB and the
-# misspecified bound this notebook uses. The benchmarks behind sections 7–9 and what they
+# [glossary](GLOSSARY.md), whose entries [CRLB](GLOSSARY.md#crlb) and [MCRB](GLOSSARY.md#mcrb)
+# define the two bounds this notebook uses. The benchmarks behind sections 7–9 and what they
 # measured: [`docs/raytraced-notes.md`](../docs/raytraced-notes.md).*
 #
 # **What you will learn**
