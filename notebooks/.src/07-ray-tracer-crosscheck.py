@@ -359,7 +359,8 @@ print(f"the residual test's threshold: {test_n0:.1f} N0 over {parts['full'].size
 # visibility part is not a sign or reference mismatch between the two engines' conventions:
 # below, each first-order path as traced (all its elements) against its eq. 1 atom, by their
 # normalised correlation $|\langle a, h\rangle| / \lVert a\rVert \lVert h\rVert$. Every path all
-# 100 elements see correlates above 0.99 (what is left is the wideband and gain terms).
+# 100 elements see correlates above 0.99; what keeps it from 1 are the terms eq. 1 lacks even for
+# such a path (the spatial-wideband term and the gain's change across the array, printed above).
 
 # %%
 import dataclasses
@@ -859,7 +860,7 @@ assert np.all(power[:, 2] > 0) and 0.1 < second_first < 1  # a few tenths
 total = parts["first_order_model"] + sum(parts[n] for n in rt.COMPONENTS)
 assert np.allclose(total, parts["full"], atol=1e-6 * np.abs(parts["full"]).max())
 assert p_n0["specular2+"] > 3 * p_n0["diffuse"] and p_n0["visibility"] > 3 * p_n0["diffuse"]
-assert min(p_n0["specular2+"], p_n0["visibility"]) > 10 and p_n0["diffuse"] > 0
+assert min(p_n0["specular2+"], p_n0["visibility"]) > test_n0 and p_n0["diffuse"] > 0
 assert 15 < test_n0 < 20 and 4e5 < parts["full"].size < 6e5
 assert seen[0][:2] == ("LoS", arr0.M) and all(rho > 0.99 for _, c, rho in seen if c == arr0.M)
 assert all(rho < 0.95 for _, c, rho in seen if c < arr0.M)
