@@ -144,9 +144,11 @@ def time_engines(
 def lower_into_tunnel(tunnel: Tunnel3D, array, *, step: float = 0.05):
     """``array`` moved down in steps of ``step`` [m] until every element is inside ``tunnel``.
 
-    The JAVELIN preset's reference antenna sits at 4.8 m and the 10 x 10 array tilts its top row
-    up to 4.998 m, above the 12-facet ceiling (4.970 m at y = 0.229 m; even the circle is only 4.995 m there): a ray tracer sees those
-    elements behind the concrete. Returns ``(array, shift)``.
+    With its reference antenna at the paper's 4.8 m, the JAVELIN 10 x 10 array tilts its top row
+    up to 4.998 m, above the 12-facet ceiling (4.970 m at y = 0.229 m; even the circle is only
+    4.995 m there): a ray tracer sees those elements behind the concrete. One step of 5 cm
+    brings every element inside, which is why the preset hangs the arrays' reference antennas
+    at 4.75 m (notebook 07, section 2). Returns ``(array, shift)``.
     """
     instance("tunnel", tunnel, Tunnel3D)
     instance("array", array, ArrayGeometry)
