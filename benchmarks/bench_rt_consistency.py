@@ -2,7 +2,7 @@
 
 Per epoch of a drive and per draw (noise and clock bias drawn, LoS kept), the ML route's
 estimates (``refine="ml"``, ``L`` known; on the ray-traced channel tested against noise + diffuse
-power) go through :func:`tunnelkit.rt.consistency.geometry_consistency` with the CRLB at the
+power) go through :func:`tunnelkit.consistency.geometry_consistency` with the CRLB at the
 estimate as the bound (world-frame azimuth, elevation, range; computed whatever the fit's own
 verdict) and no model-error floor, at the false-alarm rate ``--pfa``:
 

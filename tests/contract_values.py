@@ -545,8 +545,8 @@ def _baselines_checks():
 def _consistency():
     """The geometry-consistency test (after the route drivers: their first calls of the
     extraction's bounds stay the recorded ones)."""
+    from tunnelkit.consistency import consistent_paths, geometry_consistency, tunnel_planes
     from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
-    from tunnelkit.rt.consistency import consistent_paths, geometry_consistency, tunnel_planes
     from tunnelkit.signal_route import SignalRoute
 
     route = SignalRoute.from_scenario("italiano2026-straight")
@@ -578,7 +578,7 @@ def _traced():
     tr.geometry_labels(ep, route)
     tr.geometry_keep(ep, route)
     pm, _ = tr.traced_measurements(ep, route)
-    from tunnelkit.rt.consistency import plane_kinds
+    from tunnelkit.consistency import plane_kinds
     from tunnelkit.tracking.javelin import JavelinConfig, KindNoise
 
     plane_kinds(route.tunnel)

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tunnelkit.rt.consistency import plane_kinds, tunnel_planes
+from tunnelkit.consistency import plane_kinds, tunnel_planes
 from tunnelkit.studies.drives import scenario_route
 from tunnelkit.studies.traced import geometry_keep, geometry_labels, traced_measurements
 from tunnelkit.tracking.javelin import (

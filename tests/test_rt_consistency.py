@@ -1,4 +1,4 @@
-"""The geometry-consistency test of one snapshot's paths (rt.consistency)."""
+"""The geometry-consistency test of one snapshot's paths (tunnelkit.consistency)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.stats import binom
 
-from tunnelkit.rt.consistency import consistent_paths, geometry_consistency, tunnel_planes
+from tunnelkit.consistency import consistent_paths, geometry_consistency, tunnel_planes
 from tunnelkit.signal_route import SignalRoute
 
 

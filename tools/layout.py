@@ -52,6 +52,7 @@ RANKS = {
     "evaluation": 6,
     "signal_route": 7,
     "efficiency": 7,
+    "consistency": 3.6,  # the geometry-consistency test of one snapshot's paths (planes only)
     "path_consistency": 7.5,  # the geometry-consistency test on a signal route's epoch
     "studies": 8,
     "design": 9,

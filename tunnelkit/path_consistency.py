@@ -1,6 +1,6 @@
 """The geometry-consistency test on a signal route's epoch, with the bound at the estimate.
 
-:func:`tunnelkit.rt.consistency.geometry_consistency` asks whether one snapshot's paths agree with
+:func:`tunnelkit.consistency.geometry_consistency` asks whether one snapshot's paths agree with
 one UE position through the tunnel's planes, each residual in standard deviations of a bound.
 Here the bound is the CRLB at the estimate (:func:`bound_sigmas`: world azimuth, elevation and
 range of each kept path, :func:`tunnelkit.signal_route.reported_covariance` computed whatever the
@@ -22,9 +22,9 @@ from ._validate import boolean, finite_array, instance, integer, positive
 from .arrays import ArrayGeometry
 from .budget import check_elements
 from .channel import SRSConfig
+from .consistency import geometry_consistency, tunnel_planes
 from .constants import C
 from .extraction.radio import MAX_CARRIER
-from .rt.consistency import geometry_consistency, tunnel_planes
 from .signal_route import Epoch, SignalRoute, reported_covariance
 
 __all__ = ["bound_sigmas", "epoch_consistency", "joint_bound", "joint_fisher", "rate_interval"]
@@ -172,7 +172,7 @@ def _keep(keep, n: int) -> np.ndarray:
 def epoch_consistency(
     ep: Epoch, route: SignalRoute, *, bound: bool = True, joint: bool = True, **kw
 ) -> dict:
-    """:func:`tunnelkit.rt.consistency.geometry_consistency` of ``ep``'s measurements through
+    """:func:`tunnelkit.consistency.geometry_consistency` of ``ep``'s measurements through
     ``route``'s tunnel planes (the UE hypotheses kept inside the tunnel). ``bound=True``: the
     residuals in CRLB standard deviations at the estimate (:func:`bound_sigmas`) plus any
     ``floor_angle`` / ``floor_range`` in ``kw``; ``bound=False``: the floors alone (``kw`` must

@@ -575,7 +575,7 @@ print(f"traced channel: |bias| / MCRB sd from {ratio8.min():.3g} to {ratio8.max(
 # the geometry can: the first-order paths of one snapshot come from one UE through the tunnel's
 # known planes. A path off plane $P$ arrives from the UE's mirror image $\mathrm{mirror}_P(p)$
 # (its [VUE](GLOSSARY.md#vue)), along its direction and at its distance plus the common
-# clock-bias range $\beta$ (the UE's clock offset times $c$). `rt.consistency` finds the
+# clock-bias range $\beta$ (the UE's clock offset times $c$). `tunnelkit.consistency` finds the
 # $(p, \beta)$ the paths agree on best (each earliest path tried as the LoS, the UE triangulated
 # with a second path's ray through each plane, then a least-squares fit), and tests
 #

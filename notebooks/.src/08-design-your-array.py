@@ -22,7 +22,9 @@
 #   Monte-Carlo units x drives (one calibration draw per unit), the **unit yield** with its
 #   Wilson interval against a required yield, and how the answer changes with calibration
 #   quality; beside it the true bounds over the drive (posterior CRLB per unit, and the hybrid
-#   bound pooled over units), which the tracker never beats;
+#   bound pooled over units): lower bounds of the tracker's mean-square error over random drives
+#   (on one drive a tracker may fall below a posterior bound; averaged over the units' drives
+#   here it never does, GLOSSARY.md#pcrlb);
 # - what the same question gets on a ray-traced channel (Sionna RT, diffuse scattering on), where
 #   eq. 1 is no longer the channel;
 # - an explorer whose impairment sliders move the predicted-error curve.
@@ -141,8 +143,8 @@ print(
 # receives by its calibration error $(1 + \epsilon_m)e^{j\varphi_m}$ (phase and gain errors drawn
 # once per array), the wave reaches element $m$ later than the reference antenna by
 # $\delta_{\ell m}/c$, which eq. 1 ignores across the band (the **spatial wideband** term), and
-# rough walls add **dense diffuse multipath** (DMC: many weak paths, an exponential power-delay
-# profile holding a share of the received power). The estimator still fits eq. 1, $\mathbf f
+# rough walls add **dense multipath** (DMC, diffuse multipath components: many weak paths, an
+# exponential power-delay profile holding a share of the received power). The estimator still fits eq. 1, $\mathbf f
 # (\boldsymbol\eta)$, to data whose mean is $\mathbf f(\boldsymbol\eta) + \boldsymbol\delta$ and whose
 # covariance is $\mathbf C = N_0\mathbf I + \mathbf C_D$. To first order (Richmond & Horowitz 2015;
 # Fortunati et al. 2017) it converges to a *pseudo-true* parameter, biased by one Gauss–Newton
@@ -152,6 +154,12 @@ print(
 #   \boldsymbol\delta, \qquad \mathrm{MCRB} = \mathbf A^{-1}\mathbf B\mathbf A^{-1},\quad
 #   \mathbf A = \tfrac{2}{N_0}\Re\,\mathbf D^H\mathbf D,\quad
 #   \mathbf B = \tfrac{2}{N_0^2}\Re\,\mathbf D^H\mathbf C\mathbf D .$$
+#
+# These are the glossary's $\mathbf A$ and $\mathbf B$ ([MCRB](GLOSSARY.md#mcrb)), the same as
+# notebook 07 section 8's: $\mathbf A$ minus the expected Hessian of the assumed model's
+# log-likelihood at the pseudo-true parameter (here to first order: the residual term notebook
+# 07 keeps is dropped, since $\boldsymbol\delta$ is small), $\mathbf B$ the covariance of its
+# score under the true distribution (here carrying the diffuse covariance $\mathbf C_D$).
 #
 # Per path this gives the extraction's bias and covariance in the tracker's measurement space
 # (`design.path_error_model`; its closed forms are tested against finite differences and an
@@ -164,9 +172,10 @@ print(
 #   \mathrm{CRLB})\mathbf G^T}$$
 #
 # with $\mathbf G$ that weighted snapshot fix, the calibration bias averaged over the calibration
-# draw in closed form. **It is a prediction, not a bound.** The MCRB bounds a misspecified
-# *snapshot* estimator around its pseudo-true parameter; this is a first-order approximation of
-# it, for one weighted fix of one epoch. The tracker fuses epochs and carries a prior, so it can
+# draw in closed form. **It is a prediction, not a bound.** The MCRB bounds the covariance of a
+# misspecified-unbiased *snapshot* estimator around its pseudo-true parameter (not its error
+# around the true one); this is a first-order approximation of it, for one weighted fix of one
+# epoch. The tracker fuses epochs and carries a prior, so it can
 # do better, and it does (section 6 shows it beaten). It decides nothing in the design; it
 # says *where to look*. (The function keeps its historical name, `design.achievable_bound`, and
 # its curve `.achievable`; read both as "predicted error".) Weighing by the ideal information
@@ -256,8 +265,9 @@ print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.i
 # stated impairments (the CRLB plus the covariance of the calibration tolerance and the bias of
 # the terms the model leaves out: `PathErrorModel.budget`) and the share of it one unit repeats
 # (`PathErrorModel.split`: what one calibration draw keeps from epoch to epoch, the bias that
-# keeps its sign), which the tracker carries as a consider parameter of the path's track (a
-# Schmidt–Kalman update: `tracking.javelin.ConsiderNoise`) instead of averaging it down as if it
+# keeps its sign), which the tracker carries as a *consider parameter* of the path's track (a
+# bias it keeps in its covariance without estimating it: a Schmidt–Kalman update,
+# `tracking.javelin.ConsiderNoise`) instead of averaging it down as if it
 # were drawn afresh every epoch; a curvature the array cannot resolve (its budget above a tenth
 # of the range) is handed on as far field, as a plane-wave fit would report it. An extraction
 # that reported only its CRLB (sub-millimetre in delay) would hand the tracker centimetres of
@@ -484,7 +494,9 @@ print(sweep.to_table())
 # diffuse power. An estimator tested on its own model meets its bound by construction. Notebook
 # 07 (sections 7–9) runs the same chain on Sionna RT's channel, with diffuse scattering and
 # second-order bounces. There the ML route's estimates of the first-order paths lie far beyond
-# their CRLB (notebook 07, section 8), because the model is wrong, not because of the noise.
+# their CRLB (notebook 07, section 7), because the model is wrong, not because of the noise: the
+# noise-free fit converges to pseudo-true paths centimetres to decimetres from the truth, more
+# than ten MCRB standard deviations away (notebook 07, section 8).
 #
 # Each path reports four quantities: $\phi$ and $\psi$ its azimuth and elevation at the array,
 # $\kappa$ its wavefront's curvature radius, $\Delta d$ its delay distance beyond the LoS's. On

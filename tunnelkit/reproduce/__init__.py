@@ -47,6 +47,16 @@ class Target:
 
 _REGISTRY: dict[str, Target] = {}
 _DISCOVERED = False
+#: the module of each target: :func:`run` imports only that one (notebook 01's ``jiang-crlb``
+#: loads no tracker or drive simulator); :func:`targets` imports them all
+TARGET_MODULES = {
+    "halili": "halili",
+    "javelin-table1": "javelin_tables",
+    "javelin-table2": "javelin_tables",
+    "jiang-crlb": "jiang_crlb",
+    "jiang-table2": "jiang_tables",
+    "jiang-table3": "jiang_tables",
+}
 
 
 def register(
@@ -113,7 +123,9 @@ def run(
     (:class:`tunnelkit.signal_route.SignalRoute`). ``length`` (the targets whose drive can be
     lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
     (:func:`tunnelkit.studies.drives.drive_variant`, e.g. 120)."""
-    reg = targets()
+    if isinstance(name, str) and name in TARGET_MODULES:
+        importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
+    reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()
     if name not in reg:
         raise ValueError(f"name: unknown reproduce target {name!r}; available: {', '.join(reg)}")
     tgt = reg[name]

@@ -49,8 +49,8 @@ from functools import partial
 import numpy as np
 
 from .._validate import boolean, finite_array, instance, integer, rng_or_error
+from ..consistency import plane_kinds
 from ..path_consistency import epoch_consistency
-from ..rt.consistency import plane_kinds
 from ..scenarios import data_dir
 from ..signal_route import Epoch, SignalRoute
 from ..tracking.javelin import designs
@@ -111,7 +111,7 @@ def geometry_labels(ep: Epoch, route: SignalRoute, floors=FLOORS) -> tuple[np.nd
     """The geometry-consistency test of ``ep.measurements`` (residuals in units of the
     model-error ``floors`` = (angle [rad], range [m]) alone, per-path chi-square(3) at 1 %):
     the rows it keeps, and the kind of surface it assigns to each kept row (``"los"`` or
-    :func:`~tunnelkit.rt.consistency.plane_kinds` of its plane). An epoch of fewer than two
+    :func:`~tunnelkit.consistency.plane_kinds` of its plane). An epoch of fewer than two
     paths keeps them all, unassigned (``""``: nothing to test)."""
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)

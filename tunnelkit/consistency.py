@@ -36,7 +36,7 @@ from scipy.linalg import solve_triangular
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
-from .._validate import (
+from ._validate import (
     finite_array,
     instance,
     integer,
@@ -45,14 +45,14 @@ from .._validate import (
     sequence,
     vector,
 )
-from ..geometry import Plane
+from .geometry import Plane
 
 __all__ = ["consistent_paths", "geometry_consistency", "plane_kinds", "tunnel_planes"]
 
 
 def _distinct_planes(tunnel) -> list:
     """The first surface of ``tunnel`` on each distinct plane (``(normal, offset)`` to 1e-9)."""
-    from ..propagation import Tunnel3D
+    from .propagation import Tunnel3D
 
     instance("tunnel", tunnel, Tunnel3D)
     seen, out = set(), []
@@ -288,7 +288,7 @@ def consistent_paths(measurements, tunnel, origin=None, **kw) -> dict:
     ``direction``, ``origin`` and, when the route reports them, ``cov`` / ``sigma_d``: the bound
     the residuals are normalised by; without them ``kw`` must give ``sigma_phi``, ``sigma_psi``,
     ``sigma_d``) through ``tunnel``'s planes; ``kw`` the test's options."""
-    from ..propagation import Tunnel3D
+    from .propagation import Tunnel3D
 
     m = measurements
     for name in ("phi", "psi", "d", "direction", "origin"):
