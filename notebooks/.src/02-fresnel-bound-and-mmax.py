@@ -444,7 +444,7 @@ explorer
 # 1. At 5.9 GHz with $W = 3$ m and $y_u = 2.5$ m, from which distance $R$ on is eq. 25 within 5 %
 #    of the exact $M_{\max}$?
 # 2. Put the UE in the opposite lane, $y_u = -2$ m, at $R = 30$ m, 28 GHz. Which of eq. 25,
-#    eq. 37 and the second-order bound is unsafe (larger than the exact value)?
+#    eq. 37 and the second-order expression is unsafe (larger than the exact value)?
 # 3. An engineer wants a $16 \times 16$ URA at 28 GHz in the tunnel of section 5 (far lane). From
 #    which distance on does the SR-NF model hold for it?
 #
@@ -491,7 +491,7 @@ assert m16 >= 16
 #
 # 1. "$\ll 1$" need not be very small: eq. 25 is within 5 % once $(2W - y_u)/R$ is about a third.
 # 2. Eq. 37 is unsafe by several antennas: it drops the factor $W/(W - y_u)$. Eq. 25 is close
-#    and just safe (its paraxial ratio $(2W - y_u)/R$ is small). The second-order bound is
+#    and just safe (its paraxial ratio $(2W - y_u)/R$ is small). The second-order expression is
 #    unsafe too, but by less than one antenna: it is an expansion to second order, not a
 #    rigorous bound, and here the third-order terms tip it just above the exact value.
 # 3. The mismatch falls with distance; from the printed distance on the SR-NF model holds for the

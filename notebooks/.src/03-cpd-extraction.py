@@ -342,7 +342,7 @@ margin_120 = eta_120 - 10 * np.log10(ml.snr_threshold(snap.H.size))
 print(f"presets' SNR, full SRS: the LoS at 120 m stands {margin_120:.0f} dB above the threshold")
 
 # %% [markdown]
-# From 7 dB above the threshold on, ML sits on the bound and $P_\text{out}$ is negligible; 5 dB
+# From 8 dB above the threshold on, ML sits on the bound and $P_\text{out}$ is negligible; 5 dB
 # below, the path is lost (beyond 6 standard deviations, or missed) in most snapshots, and flagged.
 # The CRLB still holds there: ML has stopped attaining it. At the threshold itself the share lost
 # is well above the MIE's 1 %: an approximation, of the search's outliers only. At the presets'
@@ -588,7 +588,7 @@ assert imp_los["none"]["RMSE kappa [m]"] < 5 * imp_los["none"]["CRLB kappa [m]"]
 for r in list(imp_los.values())[1:]:  # lost: the curvature gone altogether, a plane-wave fit
     assert r["no kappa"] == r["matched"] or r["RMSE kappa [m]"] > max(10 * r["CRLB kappa [m]"], 1)
 assert 0.1 < sw_edge < 0.3
-# section 11: on the bound from 7 dB above the threshold, lost and flagged 5 dB below it
+# section 11: on the bound from 8 dB above the threshold, lost and flagged 5 dB below it
 at = {round(r["integrated SNR [dB]"] - eta_th): r for r in snr_rows}
 assert sorted(at) == [-5, 0, 8, 15] and 12.0 < eta_th < 16.0
 assert abs(float(ml.outlier_probability(10 ** (eta_th / 10), n_cells)) - 0.01) < 1e-4

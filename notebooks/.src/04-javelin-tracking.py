@@ -158,7 +158,7 @@ javelin_table_figure(cols, model_rows(drive, k), title=f"epoch {k}: extracted vs
 # their curvature belongs to neither. (ii) The paper's route reads $\hat\kappa$ more than ten metres
 # away from the true curvature (over the whole drive: the median printed below) — not because
 # the array cannot measure it (notebook 03: along this drive its Cramér–Rao bound runs from
-# centimetres near the BS to decimetres at the far end), but because a CPD with free spatial
+# millimetres near the BS to decimetres at the far end), but because a CPD with free spatial
 # factors followed by a TLS is far from efficient. The paper assumes $\sigma_\kappa = 1.5$ m
 # (section 4.2). The Doppler of the matched paths, on the other hand, stays close to the
 # vehicle's speed, and a spurious CPD component (a "clutter" row, when there is one) shows itself
@@ -179,7 +179,8 @@ def curvature_errors(d):
 
 kappa_err_paper = curvature_errors(drive)
 print(f"paper route, this drive: median curvature error {np.median(kappa_err_paper):.1f} m")
-#
+
+# %% [markdown]
 # ## 3. Paths the CPD merges, and what a structured fit measures (ours)
 #
 # In this tunnel every path of an epoch arrives less than 2 m behind the LoS, where the 100 MHz
@@ -279,7 +280,7 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 # printed below). In the angles and the TDoA the ML route's RMS errors are two to four orders of
 # magnitude smaller. In the curvature they are smaller by a factor of several: decimetres
 # along the drive, which is what notebook 03's Cramér–Rao bound allows a 10 × 10 array there
-# (centimetres near the BS, decimetres at the far end) and what its ML fit reaches. So the
+# (millimetres near the BS, decimetres at the far end) and what its ML fit reaches. So the
 # paper's 1.5 m is a generous assumption on this route — and far too tight on the paper's own
 # route, whose curvatures are more than ten metres off (section 2). Where the ML fit's own test
 # flags an epoch (a path missed or merged), the epoch carries no measurement and the tracker
@@ -323,8 +324,9 @@ print("ours / measured:   ", np.round(sig["our ML design assumes"] / sig["measur
 #
 # The UE moves by the V2X speed $\nu$ and heading $\theta$:
 # $\mathbf p_{u,k} = \mathbf p_{u,k-1} + T\nu[\cos\theta, \sin\theta, 0]^\mathsf T$, with
-# $\mathbf Q_u = T^2\mathbf G\,\mathrm{diag}(\sigma_\nu^2, \sigma_\theta^2)\mathbf G^\mathsf T$ and
-# $\mathbf G = \partial\Delta\mathbf p/\partial(\nu, \theta)$. The paper lets every VUE follow a
+# $\mathbf Q_u = \mathbf G\,\mathrm{diag}(\sigma_\nu^2, \sigma_\theta^2)\mathbf G^\mathsf T$ and
+# $\mathbf G = \partial\Delta\mathbf p/\partial(\nu, \theta)$ (proportional to $T$, since
+# $\Delta\mathbf p$ is). The paper lets every VUE follow a
 # random walk. But a VUE of a surface along the tunnel *is* the UE mirrored in it, so it moves by
 # the mirrored displacement $\Delta_v = \Delta_u - 2(\mathbf n\cdot\Delta_u)\mathbf n$. How far off is each
 # prediction from the true VUEs one epoch later, on the slalom?
@@ -400,9 +402,9 @@ tracks_count_figure(
 # its tracks: after the births of the first epoch, fewer than one track dies in three epochs,
 # since its measurements are well inside the noise the design assumes (section 3); an epoch the
 # ML fit flags carries no measurement, and the tracker predicts through it. The LoS test of
-# eq. 61 compares $\hat d$ with $\hat\kappa$; $\hat d$ carries the clock bias (tens of
-# nanoseconds in section 4.2 of the paper, metres of distance), so it fires only when the bias
-# is small — but with the LoS tracked the tracker no longer needs it.
+# eq. 61 compares $\hat d$ with $\hat\kappa$; $\hat d$ carries the clock bias (a 50 ns
+# standard deviation, read from section 4.2 of the paper as in notebook 03: 15 m of distance),
+# so it fires only when the bias is small — but with the LoS tracked the tracker no longer needs it.
 
 # %% [markdown] tags=["explorer"]
 # ## 7. Epoch by epoch

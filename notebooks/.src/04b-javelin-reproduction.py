@@ -82,8 +82,9 @@ print({sc: {c: len(d) for c, d in r["ml"].items()} for sc, r in routes.items()})
 # %% [markdown]
 # ## 2. Tables 1–2 beside the paper
 #
-# The paper scores each configuration by three numbers over the epochs $k = 1..K$ of a run
-# (section 4.3), averaged over runs: the 2-D RMSE
+# The paper names three scores (section 4.3) but gives neither their formulas nor a run count;
+# we score each configuration by these three numbers over the epochs $k = 1..K$ of a run,
+# averaged over runs: the 2-D RMSE
 # $\sqrt{\tfrac1K\sum_k\|\hat{\mathbf p}_{xy,k} - \mathbf p_{xy,k}\|^2}$, the 2-D MAE
 # $\tfrac1K\sum_k\|\hat{\mathbf p}_{xy,k} - \mathbf p_{xy,k}\|$ and the lateral Y-MAE
 # $\tfrac1K\sum_k|\hat y_k - y_k|$ (lane detection). Its JAVELIN-L reaches 0.20 m 2-D RMSE on the

@@ -561,9 +561,10 @@ print(f"traced channel: |bias| / MCRB sd from {ratio8.min():.3g} to {ratio8.max(
 # few per cent of the received power; the fit's limit is off in delay by centimetres at least,
 # by decimetres or more for some paths (the bias printed above), while the spread about it stays
 # at millimetres or less: the bias is
-# over ten standard deviations for every path (the ratio printed above). More SNR or a larger
-# array only shrinks the spread, never the bias: what limits the chain on the traced channel is
-# the model, not the noise. Where $A$ is not positive definite there is no minimum near the
+# over ten standard deviations for every path (the ratio printed above). More SNR only shrinks
+# the spread, never the bias; a larger array changes the bias too, since the model error itself
+# (the spatial-wideband term, the visibility cut-offs) grows with the aperture: what limits the
+# chain on the traced channel is the model, not the noise. Where $A$ is not positive definite there is no minimum near the
 # truth at all: two atoms with large opposite gains stand in for a term eq. 1 lacks (a path's
 # change across the array), and the bound about $\theta_0$ means little.
 

@@ -1,7 +1,7 @@
 # %% [markdown]
 # # 08 · Design your array: how many antennas for *your* tunnel?
 #
-# *Italiano et al. (2026), eq. 1 (the channel tensor), section 3.1 (the SR-NF validity bound) and
+# *Italiano et al. (2026), eq. 1 (the channel tensor), section 3.1 (the SR-NF validity condition) and
 # section 4 (JAVELIN); the position error bound is ours, built from the same model.*
 #
 # **What you will learn**
@@ -491,7 +491,7 @@ print(sweep.to_table())
 # ## 9. The paper's tunnel on a ray-traced channel: when the model is not the channel
 #
 # Every number above comes from eq. 1 itself: first-order specular paths, isotropic elements, no
-# diffuse power. An estimator tested on its own model meets its bound by construction. Notebook
+# diffuse power: every number above assumes the channel is eq. 1. Notebook
 # 07 (sections 7–9) runs the same chain on Sionna RT's channel, with diffuse scattering and
 # second-order bounces. There the ML route's estimates of the first-order paths lie far beyond
 # their CRLB (notebook 07, section 7), because the model is wrong, not because of the noise: the
@@ -534,8 +534,8 @@ for a in rt_sizes:
     )
 
 # %% [markdown]
-# Beside the tracker stands the bound of those sigmas (`design.traced.traced_bounds`). It is the
-# posterior CRLB over the drive (Tichavský et al. 1998): every first-order path measured at every
+# Beside the tracker stands the posterior CRLB of those sigmas, the *told-sigma PCRLB*
+# (`design.traced.traced_bounds`): the posterior CRLB over the drive (Tichavský et al. 1998): every first-order path measured at every
 # epoch with independent Gaussian errors of $\sigma_q$, and JAVELIN's motion model. That model
 # is the car's **odometry**: each epoch the car broadcasts its speed and heading over V2X, with
 # noise `tk.studies.SIGMA_SPEED` and `SIGMA_HEADING`, and the tracker integrates them. The
@@ -559,7 +559,10 @@ def settled_rms(bound):
 bound_rt = {a: settled_rms(traced.traced_bounds(paper_rt, a, told[a])[0]) for a in rt_sizes}
 no_radio = settled_rms(design.drive_pcrlb(paper_rt, np.zeros((T_rt, 2, 2))))
 bound_ratio = max(bound_rt.values()) / min(bound_rt.values())
-print("bound of the told sigmas, settled RMS:", {a: f"{b:.3g} m" for a, b in bound_rt.items()})
+print(
+    "told-sigma PCRLB (a prediction here), settled RMS:",
+    {a: f"{b:.3g} m" for a, b in bound_rt.items()},
+)
 print(
     f"dead reckoning's bound (no radio): {no_radio:.3g} m; largest bound / smallest {bound_ratio:.3g}"
 )
@@ -600,15 +603,16 @@ p90 = {ch: {r.array: r.error_p90_m for r in rep.rows} for ch, rep in on.items()}
 # - **Image channel**: the error is millimetres (a centimetre or two on quick mode's single
 #   drive), far below 0.2 m, within a small factor of the predicted error's p90 in the same row
 #   ("pred p90"); every unit meets the target.
-# - **Ray-traced channel**: no unit of any array meets 0.2 m. The bound of the told sigmas is
+# - **Ray-traced channel**: no unit of any array meets 0.2 m. The told-sigma PCRLB is
 #   above the target for every array. The RMS errors fall with the array (printed above); the
 #   told sigmas need not, since an array whose errors repeat more from epoch to epoch is told
-#   more (the 8 × 8's azimuth errors have the largest lag-1 correlation). The bound follows the
+#   more (the 8 × 8's azimuth errors have the largest lag-1 correlation). It follows the
 #   told sigmas and barely moves: the largest over the smallest is the printed factor. At these sigmas
-#   the radio adds little to the odometry, whatever the array. The bound lies below dead
-#   reckoning's: the radio adds information, too little to correct a 1 m entry fix to 0.2 m.
+#   the radio adds little to the odometry, whatever the array. It lies below dead
+#   reckoning's: under the told-sigma model the radio adds information, too little to correct
+#   a 1 m entry fix to 0.2 m.
 #
-# This bound is what the told sigmas allow as independent Gaussian errors, not what the channel
+# This PCRLB is what the told sigmas allow as independent Gaussian errors, not what the channel
 # allows. The traced errors are neither, so a tracker can even beat it where the true errors are
 # smaller than the told ones; no misspecified track bound is computed here.
 
@@ -617,13 +621,13 @@ p90 = {ch: {r.array: r.error_p90_m for r in rep.rows} for ch, rep in on.items()}
 #
 # - **A design from eq. 1 alone is optimistic by orders of magnitude.** Every array passes on the
 #   image channel (full mode); on the traced one none does.
-# - **The lever is not the array size.** More elements hardly move the traced bound. What could:
+# - **The lever is not the array size.** More elements hardly move the told-sigma PCRLB (a prediction here). What could:
 #   a better entry fix (explored next), better odometry, an extraction that models the diffuse
 #   power and the higher-order bounces, or a second base station (the last two are not built
 #   here).
 #
 # **The entry fix.** `start_sigma` (`--start-sigma` on the command line) sets it, for the tracker
-# and the bound alike. First the bound of the 8 × 8 array's told sigmas against dead reckoning's,
+# and the PCRLB alike. First the 8 × 8 array's told-sigma PCRLB against dead reckoning's,
 # for better entry fixes, and the floor they leave.
 
 # %%
@@ -633,7 +637,7 @@ for sp in fixes:
     radio = settled_rms(traced.traced_bounds(paper_rt, "8x8", told["8x8"], sigma_p0=sp)[0])
     alone = settled_rms(design.drive_pcrlb(paper_rt, np.zeros((T_rt, 2, 2)), sigma_p0=sp))
     by_fix[sp] = (radio, alone)
-    print(f"entry fix {sp:5.2f} m: bound {radio:.3g} m with the radio, {alone:.3g} m without "
+    print(f"entry fix {sp:5.2f} m: PCRLB {radio:.3g} m with the radio, {alone:.3g} m without "
           f"(the radio's gain {100 * (1 - radio / alone):.2g} %)")  # fmt: skip
 # the floor: dead reckoning from the best fix with the V2X speed and heading ten times better
 calm = settled_rms(design.drive_pcrlb(
@@ -644,7 +648,7 @@ print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {ca
 
 # %% [markdown]
 # The radio's gain over dead reckoning shrinks with the entry fix, to about one per cent at
-# 0.1 m. The bound's floor is the drift of the odometry over the drive: ten times better
+# 0.1 m. The PCRLB's floor is the drift of the odometry over the drive: ten times better
 # messages lower it about threefold (the last line). Now the tracker once more on the traced
 # channel, from a 0.1 m entry fix (quick mode: 4 × 4, one drive, as above).
 
@@ -656,7 +660,7 @@ print(fine_fix.to_table())
 p90_fine = {r.array: r.error_p90_m for r in fine_fix.rows}
 
 # %% [markdown]
-# A better fix brings the tracker and its bound down together: compare the line "posterior CRLB
+# A better fix brings the tracker and its told-sigma PCRLB (its prediction) down together: compare the line "posterior CRLB
 # of the sigmas the tracker is told" under each array with the table above. Compare also the "dead
 # reckoning" lines: the radio's gain is small from 1 m and vanishes from 0.1 m, where dead
 # reckoning alone misses 0.2 m too (in full mode). On this channel the single base station's
@@ -892,7 +896,7 @@ rms_phi = [{r[0]: r for r in records[a]["rows"]}["all"][2] for a in rt_sizes]
 assert all(x > y for x, y in pairwise(rms_phi)), rms_phi
 most = max(rt_sizes, key=lambda a: told[a].sigma_phi)
 assert most == max(rt_sizes, key=lambda a: records[a]["correlation"]["phi"]["r"]), most
-# the bound of the told sigmas: above 0.2 m for every array, barely moving with the array (the
+# the told-sigma PCRLB: above 0.2 m for every array, barely moving with the array (the
 # largest where the most is told), below dead reckoning's; the default entry fix is 1 m
 assert design.START_SIGMA_M == 1.0
 assert min(bound_rt.values()) > 0.2, bound_rt
@@ -910,7 +914,7 @@ for a in rt_arrays:
 for r in on["sionna"].rows:
     assert r.status != "met" and r.unit_yield == 0.0, r.array
     assert r.pcrlb_rms_m is None and r.hybrid_bound_rms_m is None, r.array
-    assert r.predicted_drive_rms_m > 0.2, r.array  # the bound of the told sigmas, above 0.2 m
+    assert r.predicted_drive_rms_m > 0.2, r.array  # the told-sigma PCRLB, above 0.2 m
 if not tk.quick_mode():  # ten passing units cannot show 95 % (73 needed); ten failing ones can
     assert all(r.status == "undecided" and r.units == 10 for r in on["image"].rows)
     assert all(r.status == "not met" for r in on["sionna"].rows), on["sionna"].to_table()
@@ -930,7 +934,7 @@ assert all(by_fix[x][0] > by_fix[y][0] for x, y in pairwise(fixes)), by_fix
 assert all(gains[x] > gains[y] for x, y in pairwise(fixes)), gains
 assert gains[1.0] > 0.1 and 0.005 < gains[0.1] < 0.02, gains
 assert 2.5 < by_fix[fixes[-1]][1] / calm < 4, (calm, by_fix)
-# from the 0.1 m fix the tracker and its bound come down together
+# from the 0.1 m fix the tracker and its told-sigma PCRLB come down together
 for rf, rc in zip(fine_fix.rows, on["sionna"].rows, strict=True):
     assert rf.error_p90_m < rc.error_p90_m, rf.array
     assert rf.predicted_drive_rms_m < rc.predicted_drive_rms_m, rf.array

@@ -119,6 +119,18 @@ def share_quantile(values, share: float) -> float:
     return float(np.quantile(v, share, method="inverted_cdf"))
 
 
+def _error_rows(errors, expected: str) -> np.ndarray:
+    """``errors`` as a 2-D float array of rows (``expected`` names its shape in the error), no
+    value negative, a non-finite error (no estimate) counted as infinite."""
+    real_array("errors", errors)
+    e = np.asarray(errors, float)
+    if e.ndim != 2 or not e.size:
+        raise ValueError(f"errors: expected {expected}, got shape {e.shape}")
+    if np.any(e < 0):
+        raise ValueError("errors: a position error is not negative")
+    return np.where(np.isfinite(e), e, np.inf)
+
+
 def cluster_quantile_ci(errors, share: float, *, level: float = 0.95) -> list[float]:
     """Woodruff's ``level`` interval of :func:`share_quantile` of ``errors`` (units, n), one row
     per cluster (a manufactured unit: its drives share the calibration draw, and one drive's
@@ -136,13 +148,7 @@ def cluster_quantile_ci(errors, share: float, *, level: float = 0.95) -> list[fl
     not a decision. One unit gives the degenerate interval ``[q, q]``."""
     share = probability("share", share, open_interval=False)
     level = probability("level", level)
-    real_array("errors", errors)
-    e = np.asarray(errors, float)
-    if e.ndim != 2 or not e.size:
-        raise ValueError(f"errors: expected (units, n) with units, n >= 1, got shape {e.shape}")
-    if np.any(e < 0):
-        raise ValueError("errors: a position error is not negative")
-    e = np.where(np.isfinite(e), e, np.inf)
+    e = _error_rows(errors, "(units, n) with units, n >= 1")
     units = e.shape[0]
     q = float(np.quantile(e, share, method="inverted_cdf"))
     if units < 2:
@@ -167,13 +173,7 @@ def bootstrap_quantile_ci(
     share = probability("share", share, open_interval=False)
     level = probability("level", level)
     n_boot = integer("n_boot", n_boot, minimum=1)
-    real_array("errors", errors)
-    e = np.asarray(errors, float)
-    if e.ndim != 2 or not e.size:
-        raise ValueError(f"errors: expected (runs, T) with runs, T >= 1, got shape {e.shape}")
-    if np.any(e < 0):
-        raise ValueError("errors: a position error is not negative")
-    e = np.where(np.isfinite(e), e, np.inf)
+    e = _error_rows(errors, "(runs, T) with runs, T >= 1")
     runs, T = e.shape
     draws = rng.integers(0, runs, size=(n_boot, runs))
     qs = np.empty(n_boot)
