@@ -68,11 +68,11 @@ plots.paths_table_figure(evaluation.path_rows(paths), title="True paths (world f
 # $$h_{m,s}[k]=\sum_{\ell=0}^{L-1}\alpha_{\ell}\,e^{j2\pi\frac{f_c}{c}\delta_{\ell,m}}
 #   \,e^{-j2\pi s\Delta f\tau_{\ell}}\,e^{j2\pi k f^{d}_{\ell}T_{0}} \qquad (1)$$
 #
-# Section 4.2's SRS: $f_c = 5.9$ GHz, 100 MHz, comb 8, hence $N_f = 410$ tones spaced $\Delta f
-# = 240$ kHz; $N_t = 12$ symbols of $T_0 = 35.7\,\mu$s; noise $\mathcal{CN}(0, N_0)$ per element.
-# The delay $\tau_\ell = d_\ell/c + b$ carries the UE clock bias $b$ (the paper writes $d =
-# \tau/c$ for $d = c\,\tau$). Eq. 3 is a CPD: $\mathcal{H}=\sum_\ell \alpha_\ell\, b^s_\ell\circ
-# b^f_\ell \circ b^t_\ell$.
+# Section 4.2's SRS: $f_c = 5.9$ GHz, 100 MHz, comb 8; at our assumed 30 kHz spacing (273 RB;
+# the paper gives neither) $N_f = 410$ tones spaced $\Delta f = 240$ kHz; $N_t = 12$ symbols of
+# $T_0 = 35.7\,\mu$s; noise $\mathcal{CN}(0, N_0)$ per element. The delay $\tau_\ell = d_\ell/c
+# + b$ carries the UE clock bias $b$ (the paper writes $d = \tau/c$ for $d = c\,\tau$). Eq. 3 is
+# a CPD: $\mathcal{H}=\sum_\ell \alpha_\ell\, b^s_\ell\circ b^f_\ell \circ b^t_\ell$.
 #
 # **The clock bias, read.** The paper draws $b$ from a Gaussian "with variance 50 ns" truncated to
 # $[-100, 100]$ ns. We read a 50 ns **standard deviation**: a variance would be in ns², and 50 ns

@@ -110,8 +110,9 @@ javelin_table_figure(cols2, rows2, title=f"Table 2 (slalom), {runs} run(s) per c
 # for $\sigma_\kappa = 1.5$ m. On the ML route the same design with eq. 51 still does worse than
 # with the curvature centred on the VUE, because the exact channel's wavefront is centred there;
 # with the VUE curvature, nothing else changed, it tracks to within the paper's own JAVELIN-L on
-# the straight drive (full mode), and to below a metre on the slalom. The JAVELIN-L rows of this
-# run, side by side:
+# the straight drive (full mode), and to below a metre on the slalom. Our tracker starts from
+# the true position with 1 m of uncertainty (section 6), the paper's design from $\sigma_P$ =
+# 10 m; the comparison holds for that start. The JAVELIN-L rows of this run, side by side:
 
 # %%
 sl = {r[0]: dict(zip(cols2[2:], r[2:])) for r in rows2 if r[1] == "rmse_2d_m"}["JAVELIN-L"]

@@ -393,9 +393,10 @@ design_answer_figure(answers["0.5°"]).show()
 #   every unit, and each unit's expected mean-square error lies above it (one unit's RMSE from
 #   two drives is itself a noisy estimate of that expectation, so the check here is on the
 #   pooled RMSE; `benchmarks/bench_design_units.py` checks units one by one with many drives);
-# - `hybrid_bound_rms_m`: the calibration a **fixed unknown** of the drive with its prior, a
-#   static state beside the position (a hybrid bound): the bound of the RMSE **pooled over
-#   units**, never below the first.
+# - `hybrid_bound_rms_m`: the calibration a **random static state** of the drive (drawn once
+#   per unit, with its prior) beside the position, every parameter random: the posterior CRLB of
+#   the augmented state ([Bayesian bound](GLOSSARY.md#pcrlb); the key keeps the name "hybrid"),
+#   the bound of the RMSE **pooled over units**, never below the first.
 #
 # Against them stands the **prediction** `predicted_drive_rms_m`: the posterior CRLB of the
 # tracker's weighting with the calibration's position bias added, to first order. It is no
