@@ -29,7 +29,7 @@ from bench_achievable import extraction_errors
 
 from tunnelkit import propagation
 from tunnelkit.channel import synthesize
-from tunnelkit.design import DesignImpairments, DesignSetup, achievable_bound
+from tunnelkit.design import DesignImpairments, DesignSetup, predicted_error
 from tunnelkit.extraction import ml_truth
 from tunnelkit.extraction.ml import ml_paths
 
@@ -56,11 +56,11 @@ def part_route(arrays=ARRAYS) -> None:
     )
     for spec in arrays:
         for name, imp in levels.items():
-            b = achievable_bound(setup, spec, imp)
+            b = predicted_error(setup, spec, imp)
             print(
                 f"{spec:6s} {name:20s} {_cm(np.median(b.peb))} {_cm(np.percentile(b.peb, 90))} "
                 f"{_cm(np.median(b.wideband))} {_cm(np.percentile(b.wideband, 90))} "
-                f"{_cm(np.median(b.achievable))} {_cm(np.percentile(b.achievable, 90))}"
+                f"{_cm(np.median(b.predicted))} {_cm(np.percentile(b.predicted, 90))}"
             )
 
 

@@ -268,7 +268,7 @@ def _design():
 
     setup = design.DesignSetup.from_scenario("italiano2026-straight")
     design.route_bounds(setup, "4x4", epochs=[5, 10])
-    design.achievable_bound(setup, "4x4", design.DesignImpairments(), epochs=[5, 10])
+    design.predicted_error(setup, "4x4", design.DesignImpairments(), epochs=[5, 10])
 
 
 def _javelin():

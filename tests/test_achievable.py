@@ -14,8 +14,8 @@ from tunnelkit.channel import DiffuseSpec, diffuse_tensor
 from tunnelkit.constants import C
 from tunnelkit.design.achievable import (
     DesignImpairments,
-    achievable_bound,
     path_error_model,
+    predicted_error,
 )
 from tunnelkit.design.mcrb import EtaModes
 
@@ -69,17 +69,17 @@ def test_no_impairment_achievable_is_the_block_weighted_fix_never_below_the_peb(
     from tunnelkit.design.drivebound import position_noise_cov
     from tunnelkit.design.fastroute import tracker_weights
 
-    b = achievable_bound(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
+    b = predicted_error(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
     peb = design.route_bounds(setup, "6x6", epochs=EPOCHS).peb
     np.testing.assert_array_equal(b.peb, peb)
     assert not (b.calibration.any() or b.wideband.any() or b.diffuse.any())
     g = route_geometry(setup, "6x6", epochs=EPOCHS)
     m = path_error_model(setup, "6x6", geometry=g)
     cov = position_noise_cov(m, g, tracker_weights(m))
-    np.testing.assert_allclose(b.achievable, np.sqrt(np.trace(cov, axis1=1, axis2=2)))
-    assert np.all(b.achievable >= peb) and np.any(b.achievable > 1.01 * peb)
-    ideal = achievable_bound(setup, "6x6", DesignImpairments(), epochs=EPOCHS, weights="ideal")
-    np.testing.assert_array_equal(ideal.achievable, peb)
+    np.testing.assert_allclose(b.predicted, np.sqrt(np.trace(cov, axis1=1, axis2=2)))
+    assert np.all(b.predicted >= peb) and np.any(b.predicted > 1.01 * peb)
+    ideal = predicted_error(setup, "6x6", DesignImpairments(), epochs=EPOCHS, weights="ideal")
+    np.testing.assert_array_equal(ideal.predicted, peb)
 
 
 # --- the factorised misspecified bound against brute force (small case) ----------------------
@@ -447,12 +447,12 @@ def test_an_estimator_that_models_the_wideband_term_has_no_wideband_bias(setup):
     np.testing.assert_array_equal(m.crlb, plain.crlb)
     cal = path_error_model(setup, "6x6", DesignImpairments(phase_error_deg=0.5), epochs=EPOCHS)
     np.testing.assert_array_equal(m.k_phase, cal.k_phase)
-    b = achievable_bound(
+    b = predicted_error(
         setup, "6x6", DesignImpairments(spatial_wideband=True, wideband_model=True), epochs=EPOCHS
     )
     assert not b.wideband.any()
-    ideal = achievable_bound(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
-    np.testing.assert_allclose(b.achievable, ideal.achievable, rtol=1e-12)
+    ideal = predicted_error(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
+    np.testing.assert_allclose(b.predicted, ideal.predicted, rtol=1e-12)
 
 
 def test_the_wideband_model_s_fisher_information_is_eq1_s_to_one_percent():
@@ -518,7 +518,7 @@ def test_bad_arguments_are_named(setup):
     with pytest.raises(TypeError, match="setup"):
         path_error_model("italiano2026-straight", "4x4")
     with pytest.raises(TypeError, match="impairments"):
-        achievable_bound(setup, "4x4", {"phase_error_deg": 1.0})
+        predicted_error(setup, "4x4", {"phase_error_deg": 1.0})
     with pytest.raises(ValueError, match=r"^spec: "):
         path_error_model(setup, "4y4")
 
@@ -535,9 +535,9 @@ def test_an_unresolved_curvature_is_a_large_variance_and_the_tracker_bound_stays
     assert m.unresolved.mean() < 0.05 and m.exists.any(axis=1).all()
     sd_kappa = np.sqrt(np.diagonal(m.crlb, axis1=1, axis2=2)[:, 2::4])[m.exists]
     assert np.median(sd_kappa / m.truth[..., 3][m.exists]) > 10
-    b = achievable_bound(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS, weights="ideal")
-    assert np.all((b.achievable >= b.peb) | ~np.isfinite(b.peb))
-    t = achievable_bound(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS)
+    b = predicted_error(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS, weights="ideal")
+    assert np.all((b.predicted >= b.peb) | ~np.isfinite(b.peb))
+    t = predicted_error(setup, "2x2", DesignImpairments(0.5), epochs=EPOCHS)
     assert t.weights == "tracker" and t.valid.all()
     assert "the 2x2 cannot resolve the ceiling path" in t.reason, t.reason  # a gap, named
-    assert np.all(np.isfinite(t.achievable)) and np.all(t.achievable >= t.peb)
+    assert np.all(np.isfinite(t.predicted)) and np.all(t.predicted >= t.peb)

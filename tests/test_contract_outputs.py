@@ -37,12 +37,12 @@ def test_a_negative_or_nan_position_bound_is_refused(bounds):
         dataclasses.replace(bounds, used=bounds.used[:-1])
 
 
-def test_an_achievable_bound_is_a_length(setup):
-    a = design.achievable_bound(
+def test_a_predicted_error_is_a_length(setup):
+    a = design.predicted_error(
         setup, "4x4", design.DesignImpairments(phase_error_deg=0.5), epochs=[5, 10]
     )
-    assert np.all(a.achievable >= a.peb)
-    for name in ("achievable", "calibration", "wideband", "diffuse"):
+    assert np.all(a.predicted >= a.peb)
+    for name in ("predicted", "calibration", "wideband", "diffuse"):
         with pytest.raises(ValueError, match=rf"^{name}: "):
             dataclasses.replace(a, **{name: np.full(2, np.nan)})
         with pytest.raises(ValueError, match=rf"^{name}: "):

@@ -622,7 +622,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "Algorithm 1's delay-check threshold: negative where the route's clock bias allows it",
     ),
     _doc(
-        r"design\.achievable\.AchievableBound",
+        r"design\.achievable\.PredictedError",
         r"reason",
         "empty",
         "no gap on the route: nothing to name",

@@ -3,7 +3,7 @@ is finite or a per-epoch gap with a named cause, never NaN; one epoch's value do
 the rest of the route; invalid inputs are refused up front with the parameter named.
 
 Built on :class:`tunnelkit.design.DesignSetup`, :func:`~tunnelkit.design.route_bounds`,
-:func:`~tunnelkit.design.path_error_model` and :func:`~tunnelkit.design.achievable_bound` only
+:func:`~tunnelkit.design.path_error_model` and :func:`~tunnelkit.design.predicted_error` only
 (not on the report). Each generated tunnel is one ceiling mount with one array looking along
 the lane (azimuth 0 or 180), tilted down, the vehicle driving towards it from up to 1.5 km
 away; the long routes are evaluated at a few epochs (the first, the last, one in between), which
@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tunnelkit import design
-from tunnelkit.design import DesignImpairments, achievable_bound, path_error_model, route_bounds
+from tunnelkit.design import DesignImpairments, path_error_model, predicted_error, route_bounds
 from tunnelkit.scenarios import ScenarioError, scenario_from_dict, scenario_path
 
 ARRAYS = ("4x4", "8x8", "16x16")
@@ -89,11 +89,11 @@ def impairment_sets(draw):
 
 def _check_bound(b, geometry, tag: str) -> None:
     """Finite where valid; a gap (inf, never NaN) elsewhere, with a reason naming it."""
-    for name in ("peb", "achievable", "calibration", "wideband", "diffuse", "noise"):
+    for name in ("peb", "predicted", "calibration", "wideband", "diffuse", "noise"):
         assert not np.isnan(getattr(b, name)).any(), f"{tag}: NaN in {name}"
-    assert np.array_equal(b.valid, np.isfinite(b.achievable)), tag
+    assert np.array_equal(b.valid, np.isfinite(b.predicted)), tag
     ok = b.valid
-    assert np.all(b.achievable[ok] >= b.peb[ok] * (1 - 1e-9)), tag
+    assert np.all(b.predicted[ok] >= b.peb[ok] * (1 - 1e-9)), tag
     if not ok.all():
         assert b.reason and "x = " in b.reason, f"{tag}: a gap without a cause: {b.reason!r}"
         COUNTS["gap epochs"] += int((~ok).sum())
@@ -137,13 +137,13 @@ def test_every_epoch_is_finite_or_a_named_gap(p, imps, pick):
             assert not np.any(m.exists & m.unresolved)
             assert np.array_equal(m.exists | m.unresolved, g.exists)
             COUNTS["paths left out (unresolved)"] += int(m.unresolved.sum())
-            b = achievable_bound(setup, spec, imp, geometry=g)
+            b = predicted_error(setup, spec, imp, geometry=g)
             assert np.array_equal(b.peb, rb.peb, equal_nan=True)
             _check_bound(b, g, tag)
             if not local_done and imp.phase_error_deg > 0:
                 # one epoch alone gives the value it has among the others
-                alone = achievable_bound(setup, spec, imp, epochs=epochs[-1:])
-                a, c = alone.achievable[0], b.achievable[-1]
+                alone = predicted_error(setup, spec, imp, epochs=epochs[-1:])
+                a, c = alone.predicted[0], b.predicted[-1]
                 assert (np.isinf(a) and np.isinf(c)) or np.isclose(a, c, rtol=1e-7), tag
                 local_done = True
                 COUNTS["locality checks"] += 1
@@ -178,7 +178,7 @@ def test_invalid_tunnels_are_refused_naming_the_parameter(change, name):
         (lambda s: s.variant(mount_height=6.5), "mount_height"),
         (lambda s: s.variant(tilt_deg=95.0), "tilt_deg"),
         (lambda s: s.arrays("128x128"), "arrays"),
-        (lambda s: achievable_bound(s, "4x4", epochs=[10**6]), "epochs"),
+        (lambda s: predicted_error(s, "4x4", epochs=[10**6]), "epochs"),
     ],
 )
 def test_invalid_design_inputs_are_refused_naming_the_parameter(call, name):

@@ -261,7 +261,7 @@ def test_srnf_criterion_gates_and_achievable_informs(setup):
 
 
 def test_an_undefined_bound_is_reported_per_array(setup, monkeypatch):
-    real = rep_mod.achievable_bound
+    real = rep_mod.predicted_error
 
     def nan_for_2x2(setup, spec, impairments, geometry):
         r = real(setup, spec, impairments, geometry=geometry)
@@ -269,13 +269,13 @@ def test_an_undefined_bound_is_reported_per_array(setup, monkeypatch):
             return SimpleNamespace(
                 x=r.x,
                 peb=r.peb,
-                achievable=np.full_like(r.peb, np.inf),
+                predicted=np.full_like(r.peb, np.inf),
                 valid=np.zeros(r.peb.shape, bool),
                 reason="the paths do not determine the position at x = 5.0..60.0 m",
             )
         return r
 
-    monkeypatch.setattr(rep_mod, "achievable_bound", nan_for_2x2)
+    monkeypatch.setattr(rep_mod, "predicted_error", nan_for_2x2)
     rep = design.design_sweep(setup, ["2x2", "200x200", "4x4"])
     by = {r.array: r for r in rep.rows}
     assert by["2x2"].status == "error" and "no epoch of the route" in by["2x2"].reason

@@ -177,8 +177,8 @@ print(
 # around the true one); this is a first-order approximation of it, for one weighted fix of one
 # epoch. The tracker fuses epochs and carries a prior, so it can
 # do better, and it does (section 6 shows it beaten). It decides nothing in the design; it
-# says *where to look*. (The function keeps its historical name, `design.achievable_bound`, and
-# its curve `.achievable`; read both as "predicted error".) Weighing by the ideal information
+# says *where to look* (`design.predicted_error`, its curve `.predicted`). Weighing by the
+# ideal information
 # instead (`weights="ideal"`, the direct-position estimator that trusts eq. 1) lets a large
 # array's micrometre curvatures carry their centimetres of calibration and wideband bias into
 # the position: a prediction several times above what the tracker achieves predicts another
@@ -197,15 +197,15 @@ imps = {
     k: design.DesignImpairments(phase_error_deg=v, gain_error_db=0.2 if v else 0.0)
     for k, v in levels.items()
 }
-pred8 = {k: design.achievable_bound(setup, "8x8", imp) for k, imp in imps.items()}  # predictions
+pred8 = {k: design.predicted_error(setup, "8x8", imp) for k, imp in imps.items()}  # predictions
 for k, a in pred8.items():
     print(
         f"8x8 {k:6s}: median PEB {100 * np.median(a.peb):.3g} cm, predicted error "
-        f"{100 * np.median(a.achievable):.3g} cm (calibration {100 * np.median(a.calibration):.3g},"
+        f"{100 * np.median(a.predicted):.3g} cm (calibration {100 * np.median(a.calibration):.3g},"
         f" wideband {100 * np.median(a.wideband):.3g} cm)"
     )
-ratio_cal = np.median(pred8["0.5°"].achievable) / np.median(pred8["ideal"].peb)
-ratio_blocks = np.median(pred8["ideal"].achievable / pred8["ideal"].peb)
+ratio_cal = np.median(pred8["0.5°"].predicted) / np.median(pred8["ideal"].peb)
+ratio_blocks = np.median(pred8["ideal"].predicted / pred8["ideal"].peb)
 print(f"ideal: one block per path puts the prediction {ratio_blocks:.2g} times the PEB (median)")
 print(f"0.5° and 0.2 dB lift the median predicted error {ratio_cal:.2g}-fold over the PEB")
 
@@ -694,7 +694,7 @@ explorer
 #    10 cm by the predicted error (`design.smallest_meeting`)? Is that an answer?
 # 3. Which impairment costs the 16 × 16 array most at 28 GHz: 0.5° of phase error, the spatial
 #    wideband term, or 5 % of diffuse power? Compare the medians of the predicted error
-#    (`design.achievable_bound(...).achievable`).
+#    (`design.predicted_error(...).predicted`).
 # 4. Run the 8 × 8 array at 0.5° on the bound route twice, once reporting the error budget and
 #    once only the CRLB (`design.bound_drive(..., report="crlb")`): what happens to the tracker?
 #
@@ -711,10 +711,10 @@ explorer
 low = setup.variant(mount_height=5.0)
 for name, st in (("5.8 m", setup), ("5.0 m", low)):
     bs = design.route_bounds(st, "8x8", peb=False).surface_validity()
-    ab = design.achievable_bound(st, "8x8", imps["0.5°"])
+    ab = design.predicted_error(st, "8x8", imps["0.5°"])
     print(
         f"{name}: ceiling SR-NF share {bs['ceiling']:.2f}, predicted error median "
-        f"{100 * np.median(ab.achievable):.3g} cm"
+        f"{100 * np.median(ab.predicted):.3g} cm"
     )
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
@@ -731,7 +731,7 @@ print("smallest square array by the predicted error:", sol2.label if sol2 else N
 # Solution 3
 sol3 = {
     name: np.median(
-        design.achievable_bound(setup, "16x16", design.DesignImpairments(**kw)).achievable
+        design.predicted_error(setup, "16x16", design.DesignImpairments(**kw)).predicted
     )
     for name, kw in (
         ("0.5 deg phase", {"phase_error_deg": 0.5}),
@@ -784,12 +784,12 @@ assert sol4["crlb"] > sol4["budget"], sol4  # what the extraction reports matter
 # %%
 # the ideal PEB is millimetres; with no impairment the predicted error is the tracker's
 # block-weighted fix, never below the PEB and within a small factor of it (ratio_blocks)
-assert np.all(pred8["ideal"].achievable >= pred8["ideal"].peb * (1 - 1e-9))
+assert np.all(pred8["ideal"].predicted >= pred8["ideal"].peb * (1 - 1e-9))
 assert 1.0 <= ratio_blocks < 2.0, ratio_blocks
 assert np.median(pred8["ideal"].peb) < 0.01
 # calibration lifts the predicted error several-fold (the printed ratio_cal)
 assert ratio_cal > 5, ratio_cal
-assert np.all(pred8["2°"].achievable >= pred8["ideal"].peb * (1 - 1e-9))
+assert np.all(pred8["2°"].predicted >= pred8["ideal"].peb * (1 - 1e-9))
 # SR-NF: the ceiling binds for 8x8 under the ceiling, and the default criterion does not gate on it
 assert srnf8["ceiling"] == 0.0
 assert all(rep.criterion == "achievable" for rep in answers.values())

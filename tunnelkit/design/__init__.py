@@ -19,7 +19,7 @@ reaches the required yield with 95 % confidence. One job per module:
 * :mod:`~tunnelkit.design.impairments` and :mod:`~tunnelkit.design.achievable`: impairments as
   design inputs (:class:`DesignImpairments`), the extraction's per-path error model along the
   route (:func:`path_error_model`, :class:`PathErrorModel`) and the predicted position error
-  beside the PEB (:func:`achievable_bound`; its misspecified part is :mod:`~tunnelkit.design.mcrb`);
+  beside the PEB (:func:`predicted_error`; its misspecified part is :mod:`~tunnelkit.design.mcrb`);
 * :mod:`~tunnelkit.design.drivebound`: over the drive, every unit's posterior CRLB and the one
   pooled over units (:func:`unit_pcrlb`, bounds) and the tracker's predicted error
   (:func:`drive_bound`, a prediction);
@@ -43,7 +43,7 @@ reaches the required yield with 95 % confidence. One job per module:
 
 from __future__ import annotations
 
-from .achievable import AchievableBound, DesignImpairments, achievable_bound, path_error_model
+from .achievable import DesignImpairments, PredictedError, path_error_model, predicted_error
 from .arrayjob import design_planes
 from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
 from .confirm import ConfirmedReport, confirm_on_channel, confirmation_candidates
@@ -96,7 +96,6 @@ __all__ = [
     "START_HEIGHT_SIGMA_M",
     "START_SIGMA_M",
     "STATUSES",
-    "AchievableBound",
     "ArraySpec",
     "BoundRoute",
     "ConfirmedReport",
@@ -107,9 +106,9 @@ __all__ = [
     "MonteCarloResult",
     "Mount",
     "PathErrorModel",
+    "PredictedError",
     "RouteBounds",
     "RouteGeometry",
-    "achievable_bound",
     "bootstrap_quantile_ci",
     "bound_drive",
     "bound_route",
@@ -130,6 +129,7 @@ __all__ = [
     "path_error_model",
     "position_bias_rms",
     "position_information",
+    "predicted_error",
     "preset_impairments",
     "recommend",
     "route_bounds",

@@ -1,5 +1,6 @@
 """What an array achieves, not only what it could: impairments as design inputs, the per-path
-error model of the extraction and the achievable (misspecified) position bound.
+error model of the extraction and the predicted error of the position (a first-order
+prediction from the misspecified model, not a bound).
 
 * :class:`DesignImpairments`: per-element calibration error (phase [deg], gain [dB]), the
   spatial-wideband term and dense diffuse multipath (share of the received power, exponential
@@ -8,7 +9,7 @@ error model of the extraction and the achievable (misspecified) position bound.
   tracker's measurement space ``z = [phi, psi, kappa, d]`` and the error of the joint ML
   extraction under the impairments (:class:`~tunnelkit.design.errormodel.PathErrorModel`:
   ideal CRLB, misspecified covariance, bias, calibration sensitivities);
-* :func:`achievable_bound`: the ideal PEB of :func:`~tunnelkit.design.bounds.route_bounds`
+* :func:`predicted_error`: the ideal PEB of :func:`~tunnelkit.design.bounds.route_bounds`
   beside ``sqrt(E ||position bias||^2 + trace(position MCRB))``, mapped to the position exactly
   as the PEB (horizontal position, antenna height known, clock bias and per-path gains and
   Dopplers nuisances). With the tracker's weights (the default) the noise part too is that of
@@ -67,10 +68,10 @@ from .setup import ArraySpec, DesignSetup, parse_array
 
 __all__ = [
     "WEIGHTS",
-    "AchievableBound",
     "DesignImpairments",
-    "achievable_bound",
+    "PredictedError",
     "path_error_model",
+    "predicted_error",
     "unresolved_reason",
 ]
 
@@ -412,17 +413,17 @@ def _epoch_times(setup, g: RouteGeometry) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class AchievableBound:
-    """Per-epoch results of :func:`achievable_bound` [m]: ``x`` position along the tunnel,
-    ``peb`` the ideal PEB (as :func:`~tunnelkit.design.bounds.route_bounds`), ``achievable``
+class PredictedError:
+    """Per-epoch results of :func:`predicted_error` [m]: ``x`` position along the tunnel,
+    ``peb`` the ideal PEB (as :func:`~tunnelkit.design.bounds.route_bounds`), ``predicted``
     ``sqrt(peb^2 + calibration^2 + wideband^2 + diffuse^2)`` and its parts: ``calibration`` the
     RMS position bias over the calibration draw, ``wideband`` the spatial-wideband position
     bias (zero when the estimator models the term), ``diffuse`` the excess standard deviation
     the diffuse multipath adds (root of the trace); ``weights`` the estimator they belong to
     (:data:`WEIGHTS`). ``inf`` where the position is not identifiable. ``noise`` (T,) [m] the
-    noise part of ``achievable`` (the impairments' parts left out): the PEB for the ideal
+    noise part of ``predicted`` (the impairments' parts left out): the PEB for the ideal
     weights, the noise of the fix weighted block by block as the tracker is told for the
-    tracker's (``None``: the PEB). ``valid`` (T,) bool: the epochs where ``achievable`` is
+    tracker's (``None``: the PEB). ``valid`` (T,) bool: the epochs where ``predicted`` is
     defined (finite); elsewhere it is ``inf``, a gap at that epoch only, and ``reason`` says
     why and where (no path, a position the paths do not determine, paths the array cannot
     resolve: :func:`unresolved_reason`); ``""`` when nothing is missing. A path the array
@@ -433,7 +434,7 @@ class AchievableBound:
     impairments: DesignImpairments
     x: np.ndarray
     peb: np.ndarray
-    achievable: np.ndarray
+    predicted: np.ndarray
     calibration: np.ndarray
     wideband: np.ndarray
     diffuse: np.ndarray
@@ -445,8 +446,8 @@ class AchievableBound:
     def __post_init__(self) -> None:
         instance("spec", self.spec, ArraySpec)
         if self.valid is None:
-            object.__setattr__(self, "valid", np.isfinite(np.asarray(self.achievable, float)))
-        bounds = ("peb", "achievable", "calibration", "wideband", "diffuse")
+            object.__setattr__(self, "valid", np.isfinite(np.asarray(self.predicted, float)))
+        bounds = ("peb", "predicted", "calibration", "wideband", "diffuse")
         record(self, shapes={**dict.fromkeys(("x", *bounds, "valid"), ("T",))},
                nonnegative=bounds, allow_inf=(*bounds, "noise"),
                may_be_empty=("reason",))  # fmt: skip
@@ -457,7 +458,7 @@ class AchievableBound:
             object.__setattr__(self, "noise", bound_array("noise", self.noise, ndim=1))
 
 
-#: whose error :func:`achievable_bound` maps to the position: ``"tracker"`` the design's tracker
+#: whose error :func:`predicted_error` maps to the position: ``"tracker"`` the design's tracker
 #: (each path weighted by the error budget it is told, block by block, a curvature it is not
 #: handed left out: :func:`tunnelkit.design.fastroute.tracker_weights`), ``"ideal"`` the
 #: direct-position ML estimator that assumes eq. 1 (the misspecified bound of the whole
@@ -465,7 +466,7 @@ class AchievableBound:
 WEIGHTS = ("tracker", "ideal")
 
 
-def achievable_bound(
+def predicted_error(
     setup: DesignSetup,
     spec,
     impairments: DesignImpairments | None = None,
@@ -473,8 +474,8 @@ def achievable_bound(
     geometry: RouteGeometry | None = None,
     epochs=None,
     weights: str = "tracker",
-) -> AchievableBound:
-    """The ideal PEB and the achievable (misspecified) position bound of ``spec`` along
+) -> PredictedError:
+    """The ideal PEB and the predicted error (a first-order prediction, not a bound) of ``spec`` along
     ``setup``'s route under ``impairments`` (module docstring); ``geometry`` reuses a traced
     route, ``epochs`` (indices) subsamples it.
 
@@ -543,13 +544,13 @@ def achievable_bound(
     with np.errstate(invalid="ignore"):
         ach = np.where(fin, np.sqrt(peb**2 + cal**2 + wb**2 + dif**2), np.inf)
     reason = _gap_reason(spec, g, peb, None, None)
-    return AchievableBound(
+    return PredictedError(
         spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif, "ideal", peb, fin, reason
     )
 
 
-def _tracker_bound(setup, spec, imp, g, peb) -> AchievableBound:
-    """:func:`achievable_bound` with the tracker's weights."""
+def _tracker_bound(setup, spec, imp, g, peb) -> PredictedError:
+    """:func:`predicted_error` with the tracker's weights."""
     from .drivebound import fix_identifiable, position_error_parts, position_noise_cov
     from .fastroute import tracker_weights
 
@@ -568,7 +569,7 @@ def _tracker_bound(setup, spec, imp, g, peb) -> AchievableBound:
         ach = np.where(fin, np.sqrt(noise**2 + cal**2 + wb**2 + dif**2), np.inf)
     noise = np.where(fin, noise, np.inf)
     reason = _gap_reason(spec, g, peb, m, ok)
-    return AchievableBound(
+    return PredictedError(
         spec, imp, g.ue[:, 0].copy(), peb, ach, cal, wb, dif, "tracker", noise, fin, reason
     )
 

@@ -6,7 +6,7 @@ manufactured units that meet the target.
 1. it is placed on the mount (an array with an element outside the cross-section is refused,
    per array, with the reason: :meth:`DesignSetup.arrays`);
 2. the **ideal PEB** (a bound) and the **predicted error** of the design's tracker under the
-   stated impairments (:func:`tunnelkit.design.achievable.achievable_bound`: each path's error
+   stated impairments (:func:`tunnelkit.design.achievable.predicted_error`: each path's error
    mapped to the position as the tracker weighs it, one block per path; a first-order
    prediction, not a bound), SR-NF validity per surface (information under
    ``criterion="achievable"``, a gate under ``"srnf"``); an epoch where the array cannot fix
@@ -45,7 +45,7 @@ from .._validate import (
 from ..budget import check_bytes, check_elements
 from ..metrics import SETTLE_S
 from ..montecarlo import parallel_options
-from .achievable import DesignImpairments, achievable_bound, path_error_model
+from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
 from .impairments import (
     CALIBRATED_GAIN_ERROR_DB,
@@ -112,8 +112,8 @@ def smallest_meeting(
         b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
         if criterion == "srnf" and b.srnf_valid.mean() < share:
             continue
-        a = achievable_bound(setup, spec, imp, geometry=g)
-        met = float(np.mean(gate(a.achievable, b.srnf_valid, criterion) <= target))
+        a = predicted_error(setup, spec, imp, geometry=g)
+        met = float(np.mean(gate(a.predicted, b.srnf_valid, criterion) <= target))
         if met >= share:
             return spec, met
         best = max(best, met)
@@ -190,11 +190,11 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
         setup.arrays(spec)
         g = route_geometry(setup, spec, epochs=epochs)
         sr = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
-        r = achievable_bound(setup, spec, impairments, geometry=g)
+        r = predicted_error(setup, spec, impairments, geometry=g)
     except (ValueError, ArithmeticError) as exc:
         row.reason = str(exc)
         return row
-    x, peb, pred = r.x, r.peb, r.achievable
+    x, peb, pred = r.x, r.peb, r.predicted
     if not np.any(r.valid):
         row.reason = f"no epoch of the route has a defined prediction: {r.reason}"
         return row

@@ -50,7 +50,7 @@ def route_traces(
 
     Order: 0 PEB, 1 SR-NF not valid (markers on the PEB), 2.. one dashed trace per variant
     (``{"no curvature": RouteBounds, ...}``), then one solid trace per predicted error (a prediction, not a bound)
-    (``{"0.5° phase error": design.AchievableBound, ...}``), then the target line (if given), then
+    (``{"0.5° phase error": design.PredictedError, ...}``), then the target line (if given), then
     one mismatch trace per surface kind and the ``eps_phi`` line on (x, y2).
     """
     attributes("bounds", bounds, ("x", "peb", "srnf_valid", "spec"), "a design.RouteBounds")
@@ -91,7 +91,7 @@ def route_traces(
         traces.append(
             _scatter(
                 x=a.x,
-                y=_finite(100 * a.achievable),
+                y=_finite(100 * a.predicted),
                 mode="lines",
                 name=f"predicted, {name}",
                 line={"color": _ACHIEVABLE_COLORS[i % len(_ACHIEVABLE_COLORS)], "width": 2},

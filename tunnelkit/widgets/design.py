@@ -96,7 +96,7 @@ def design_figure(
         ep = np.unique(np.linspace(0, T - 1, min(T, MAX_POINTS)).round().astype(int))
         g = design.route_geometry(setup, spec, epochs=ep)
         b = design.route_bounds(setup, spec, eps_phi=eps_phi, geometry=g)
-        a = design.achievable_bound(setup, spec, imp, geometry=g)
+        a = design.predicted_error(setup, spec, imp, geometry=g)
     except ValueError as exc:
         return go.Figure(
             layout={
@@ -115,9 +115,9 @@ def design_figure(
         eps_phi=eps_phi,
         epochs=ep,
     )
-    met = float(np.mean(a.achievable <= target))
+    met = float(np.mean(a.predicted <= target))
     med = float(np.median(b.peb))
-    med_a = float(np.median(a.achievable))
+    med_a = float(np.median(a.predicted))
     if rec is None:
         title = (
             f"Predicted to meet: none — no square URA up to {SIZES[-1]}x{SIZES[-1]} has a "
