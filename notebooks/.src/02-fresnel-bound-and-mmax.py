@@ -180,6 +180,7 @@ edge34 = k * abs(W - y_u) / (2 * R * W) * ((m25 - 1) * lam / 2) ** 2  # eq. 34 a
 m_exact = fresnel.mmax_exact(R, W, y_u, fc, eps)
 m_ura = fresnel.mmax_exact_ura(R, W, y_u, fc, eps)
 print(f"eq. 25: Mmax = {m25:.2f} (eq. 34 there: {edge34:.4f} rad), M = {round(m25) ** 2}")
+print(f"eq. 25 / exact ULA Mmax: {m25 / m_exact:.2f}")
 print(
     f"exact ULA: Mmax = {m_exact}   (mismatch {fresnel.phase_mismatch(m_exact, R, W, y_u, fc):.4f}"
     f" rad; with {m_exact + 1}: {fresnel.phase_mismatch(m_exact + 1, R, W, y_u, fc):.4f} rad)"

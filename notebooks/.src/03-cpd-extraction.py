@@ -268,7 +268,7 @@ print(f"10 x 10 mismatch [rad] {mis}; the ceiling's, whole drive: >= {min(ceil_m
 # returns no curvature ($\hat\kappa < 0$: the fallback). With a large array it sits on the VUE's
 # distance, never on eq. 51's; at 10 × 10 the ML route already does, to its bound.
 #
-# ## 10. Where the bound stops being reachable: impairments eq. 1 leaves out
+# ## 10. When the model is wrong: impairments eq. 1 leaves out
 #
 # A real array adds (`channel.Impairments`) a **calibration error**, element $m$ multiplying what
 # it receives by $10^{e_m/20}e^{j\varphi_m}$, $e_m\sim\mathcal N(0,\sigma_\text{dB}^2)$,
@@ -294,10 +294,10 @@ sw_edge = 2 * np.pi * (cfg.n_tones / 2) * cfg.tone_spacing * delta_max / C
 print(f"spatial wideband phase at the band edges: up to {sw_edge:.2f} rad")
 
 # %% [markdown]
-# Each impairment lifts the estimate far off the bound: at section 2's integrated SNR a fraction
-# of a degree of phase error is a bias far above the noise, which the fit of the wrong model turns
-# into a wrong direction and curvature. Spatial wideband is deterministic and can be modelled (ML
-# here does not); the unknown calibration error, even this small, puts $\kappa$ off by metres.
+# The printed CRLB is eq. 1's, no bound for data of another model: ML converges to a pseudo-true
+# value (the MCRB, notebooks 07-08). A fraction of a degree of phase error is a bias far above the
+# noise, which the wrong model's fit turns into a wrong direction and curvature. Spatial wideband
+# can be modelled (ML here does not); the calibration error puts $\kappa$ off by metres.
 #
 # ## 11. The threshold region: where maximum likelihood leaves the bound
 #

@@ -459,7 +459,8 @@ print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g}")
 # Where it is not — a 4 × 4 array 60 m away — the channel route loses epochs that the bound route
 # cannot lose, so the fast route is trusted only above the threshold. The tracker's settled RMSE
 # against the posterior bound is the printed ratio: JAVELIN estimates each reflection's VUE as an
-# unknown, where the bound knows the surfaces.
+# unknown, where the bound knows the surfaces. (A ratio a little below 1 on a few drives would be
+# Monte-Carlo scatter: the bound is an average over random drives.)
 
 # %% [markdown]
 # ## 8. The paper's tunnel, 4 × 4 to 10 × 10, and the SR-NF criterion
