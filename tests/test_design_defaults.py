@@ -123,3 +123,21 @@ def test_the_help_leads_with_at_most_15_options(capsys):
     assert text.count("\nadvanced: ") >= 4
     for hidden in ("--mount-height", "--wideband", "--max-units", "--channel", "--workers"):
         assert hidden in text[text.index("\nadvanced: ") :]
+
+
+def test_unusual_impairments_warn_and_usual_ones_do_not(setup):
+    """A diffuse share beyond three standard deviations of the tunnel campaign, or phase and
+    gain errors no calibrated array keeps, warn; the calibrated set and its neighbours do not."""
+    specs = [design.parse_array("8x8")]
+    assert di.implausible_impairments(design.preset_impairments("calibrated", setup, specs)) == []
+    assert di.implausible_impairments(design.DesignImpairments(dmc_share=0.2)) == []
+    (w,) = di.implausible_impairments(design.DesignImpairments(dmc_share=0.999999999))
+    assert "more than three standard deviations" in w and "1e-07 % of the power" in w
+    (w,) = di.implausible_impairments(design.DesignImpairments(phase_error_deg=20))
+    assert "20 deg per element" in w and "uncalibrated" in w
+    (w,) = di.implausible_impairments(design.DesignImpairments(gain_error_db=3))
+    assert "3 dB per element" in w
+    assert (
+        di.implausible_impairments(design.DesignImpairments(phase_error_deg=5, gain_error_db=1))
+        == []
+    )

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .._validate import boolean, nonnegative, positive, sequence
+from .._validate import boolean, instance, nonnegative, positive, sequence
 from ..channel import DiffuseSpec, Impairments
 from ..constants import C
 from .setup import ArraySpec, DesignSetup, parse_array
@@ -31,10 +31,12 @@ __all__ = [
     "CALIBRATED_PHASE_ERROR_DEG",
     "MAX_GAIN_ERROR_DB",
     "MAX_PHASE_ERROR_DEG",
+    "MEASURED_DIFFUSE_SD",
     "MEASURED_DIFFUSE_SHARE",
     "PRESETS",
     "WIDEBAND_CYCLES",
     "DesignImpairments",
+    "implausible_impairments",
     "preset_impairments",
     "wideband_cycles",
 ]
@@ -54,6 +56,8 @@ CALIBRATED_GAIN_ERROR_DB = 0.25
 #: "Measurement and diffuse multipath analysis of V2V propagation channel at 5.9 GHz in tunnel
 #: area", REFERENCES.md) against about 1.1 % from the project's ray tracer on concrete
 MEASURED_DIFFUSE_SHARE = 0.056
+#: its standard deviation over the campaign's snapshots (the same source)
+MEASURED_DIFFUSE_SD = 0.063
 #: the band's delay across the largest aperture [cycles of the bandwidth] above which the
 #: spatial-wideband term matters (bandwidth x aperture / c; the term's phase error across the
 #: band reaches about this share of a cycle): the calibrated set turns it on, the report warns
@@ -170,3 +174,35 @@ def preset_impairments(name: str, setup, specs) -> DesignImpairments:
         dmc_share=MEASURED_DIFFUSE_SHARE,
         wideband_model=wide,
     )
+
+
+def implausible_impairments(imp: DesignImpairments) -> list[str]:
+    """Warnings for valid but unusual impairments (``imp`` a checked
+    :class:`DesignImpairments`): a diffuse share more than three standard deviations above the
+    tunnel campaign's mean, phase or gain errors above a quarter of the hard limits
+    (:data:`MAX_PHASE_ERROR_DEG`, :data:`MAX_GAIN_ERROR_DB`): an uncalibrated array, or a value
+    in the wrong unit."""
+    imp = instance("imp", imp, DesignImpairments)
+    out = []
+    top = MEASURED_DIFFUSE_SHARE + 3 * MEASURED_DIFFUSE_SD
+    if imp.dmc_share > top:
+        out.append(
+            f"impairments: a diffuse share of {100 * imp.dmc_share:.4g} % is more than three "
+            f"standard deviations above the {100 * MEASURED_DIFFUSE_SHARE:g} % "
+            f"(sd {100 * MEASURED_DIFFUSE_SD:g} %) a road-tunnel campaign measured at 5.9 GHz "
+            f"(above {100 * top:.3g} %): the specular paths the design locates on carry "
+            f"{100 * (1 - imp.dmc_share):.3g} % of the power"
+        )
+    if imp.phase_error_deg > MAX_PHASE_ERROR_DEG / 4:
+        out.append(
+            f"impairments: {imp.phase_error_deg:g} deg per element is more than a calibrated "
+            f"array keeps ({CALIBRATED_PHASE_ERROR_DEG:g} deg after calibration): an "
+            "uncalibrated array?"
+        )
+    if imp.gain_error_db > MAX_GAIN_ERROR_DB / 4:
+        out.append(
+            f"impairments: {imp.gain_error_db:g} dB per element is more than a calibrated "
+            f"array keeps ({CALIBRATED_GAIN_ERROR_DB:g} dB after calibration): an uncalibrated "
+            "array?"
+        )
+    return out

@@ -215,7 +215,7 @@ class DesignReport:
             f"impairments ({s.get('impairments_preset', 'custom')}): phase "
             f"{imp['phase_error_deg']:g} deg, gain {imp['gain_error_db']:g} "
             f"dB, spatial wideband {'on' if imp['spatial_wideband'] else 'off'}, diffuse share "
-            f"{imp['dmc_share']:g}; Monte-Carlo: units of {s['drives_per_unit']} drives "
+            f"{imp['dmc_share']:.10g}; Monte-Carlo: units of {s['drives_per_unit']} drives "
             f"({s['mode']} route, {s['units']} units first, up to {s['max_units']}), seed "
             f"{s['seed']}"
             + (f", entry fix {s['start_sigma_m']:g} m per axis" if "start_sigma_m" in s else ""),

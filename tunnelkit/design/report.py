@@ -52,6 +52,7 @@ from .impairments import (
     CALIBRATED_PHASE_ERROR_DEG,
     MEASURED_DIFFUSE_SHARE,
     WIDEBAND_CYCLES,
+    implausible_impairments,
     preset_impairments,
     wideband_cycles,
 )
@@ -540,6 +541,7 @@ def _plausibility(setup, specs, target: float, imp) -> list[str]:
             f"{wide:.2g} cycles of the {cfg.bandwidth / 1e6:g} MHz band (above "
             f"{WIDEBAND_CYCLES:g}): the band calls for it (--wideband, --wideband-model)"
         )
+    out += implausible_impairments(imp)
     if imp.ideal and setup.channel == "image":
         out.append(
             "impairments: none (an ideal array and eq. 1's channel), the optimistic case; a "
