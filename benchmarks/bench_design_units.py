@@ -17,19 +17,18 @@ unit one calibration draw shared by its drives (:mod:`tunnelkit.design.units`):
    chance, part 3 measures units on many drives) and RMSE / predicted drive error (a
    first-order prediction, not a bound: either side of 1 is allowed). A bound is beaten where
    its ratio's interval lies below 1. The failures are listed after the table.
-2. **Coverage of the reported intervals** (:func:`coverage`): for 8x8 and 16x16 x phase error
-   {0.5, 2} deg at target 0.1 m, a long reference run (``--ref-units`` units x 2 drives, seed
-   ``--ref-seed``) gives the reference pooled p90 and unit yield; ``--blocks`` short runs of
-   ``--block-units`` units x 2 drives (disjoint blocks of one ``sweep_montecarlo`` call on
-   seed ``--seed``: different units, so independent runs) count how often the reported 95 %
-   interval of the pooled p90 (Woodruff's over units, ``design.cluster_quantile_ci``) and the
-   bootstrap over units it replaced hold the reference p90, and the Wilson interval of the
-   unit yield the reference yield. Beside them the old interval: drives with a calibration draw
-   each (``drives_per_unit=1``, ``--block-units`` drives per block), bootstrapped over drives,
-   against the reference p90 of that setting (its own long run); and, as a check of why the
-   resampling unit matters, the D=2 blocks bootstrapped over drives (ignoring the unit). Each
-   measured coverage with its Wilson 95 % interval (the blocks are Bernoulli trials), and how
-   many intervals missed low (below the reference) or high.
+2. **Coverage of the reported intervals** (:func:`coverage`): for 8x8 and 16x16 x impairment
+   level (``--levels``: a phase error alone in deg, or the design's default ``calibrated``) at
+   target 0.1 m, a long reference run (``--ref-units`` units x 2 drives, seed ``--ref-seed``)
+   gives the reference pooled p90 and unit yield; ``--blocks`` short runs of ``--block-units``
+   units x 2 drives (disjoint blocks of one ``sweep_montecarlo`` call on seed ``--seed``:
+   different units, so independent runs) count how often the reported 95 % interval of the
+   pooled p90 (Woodruff's over units, ``design.cluster_quantile_ci``), the percentile bootstrap
+   over units, and the Wilson interval of the unit yield hold the reference. With ``--old`` also
+   the intervals reported before: drives with a calibration draw each, bootstrapped over drives
+   (against that setting's own long run), and the D=2 blocks bootstrapped over drives (ignoring
+   the unit). Each measured coverage with its Wilson 95 % interval (the blocks are Bernoulli
+   trials), and how many intervals missed low (below the reference) or high.
 
 3. **Each unit against the PCRLB** (:func:`unit_bounds`): 12 units x 25 drives of the 8x8 under
    the calibrated default: each unit's RMSE over its own drives / PCRLB, beside the two-drive
@@ -38,14 +37,14 @@ unit one calibration draw shared by its drives (:mod:`tunnelkit.design.units`):
 The tables are printed and written to ``--out`` (``units_bounds[_TAG].md``,
 ``units_coverage[_TAG].md``); ``--quick`` is a smoke test (one impairment, 10 units, 5 blocks),
 not a measurement. Serial, a drive costs about 0.1 s of one core (40 epochs): part 1 is about
-1,440 drives per tunnel, part 2 about ``4 * ref_units + 60 * blocks`` drives per array and phase
-error (two serial processes, one per ``--phases``, use both cores without a cluster):
+1,800 drives per tunnel, part 2 about ``2 * ref_units + 40 * blocks`` drives per array and level
+(twice with ``--old``); two serial processes, one per ``--levels``, use both cores:
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --quick
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --part 1 --tunnels base \
         mount_height=5.0
-    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --part 2 --phases 2 \
-        --ref-units 250 --blocks 25 --seed 1 --tag ph2
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_units.py --part 2 --levels 2 \
+        --ref-units 1000 --blocks 60 --seed 1 --tag ph2
 """
 
 from __future__ import annotations
@@ -262,9 +261,21 @@ def unit_bounds_text(r) -> str:
     )
 
 
+def _level(level):
+    """An impairment level of part 2: a phase error in degrees (nothing else), or the
+    design's default ``"calibrated"``; returns ``(label, impairments)``."""
+    from tunnelkit.design import DesignImpairments, preset_impairments
+    from tunnelkit.design.setup import parse_array
+
+    if level == "calibrated":
+        specs = [parse_array(a) for a in COVERAGE_ARRAYS]
+        return "cal", preset_impairments("calibrated", _setup("base"), specs)
+    return f"{float(level):g}", DesignImpairments(phase_error_deg=float(level))
+
+
 def coverage(
     arrays=COVERAGE_ARRAYS,
-    phases=PHASES_DEG,
+    levels=PHASES_DEG,
     ref_units: int = 400,
     blocks: int = 40,
     block_units: int = 20,
@@ -273,10 +284,12 @@ def coverage(
     seed: int = 1,
     workers: int | None = None,
     n_boot: int = 2000,
+    old: bool = False,
 ) -> list[dict]:
-    """Part 2: per array x phase error, the reference and the coverage over ``blocks`` blocks."""
+    """Part 2: per array x impairment level (:func:`_level`), the reference and the coverage
+    over ``blocks`` blocks; with ``old`` also the intervals the design reported before (one
+    calibration draw per drive, and drives resampled ignoring the unit)."""
     from tunnelkit.design import (
-        DesignImpairments,
         cluster_quantile_ci,
         path_error_model,
         share_quantile,
@@ -288,8 +301,8 @@ def coverage(
     setup = _setup("base")
     out = []
     with trial_pool(workers) as pool:
-        for ph in phases:
-            imp = DesignImpairments(phase_error_deg=ph)
+        for level in levels:
+            label, imp = _level(level)
             kw = {
                 "impairments": imp,
                 "error_models": partial(path_error_model, impairments=imp),
@@ -299,44 +312,40 @@ def coverage(
             t0 = time.perf_counter()
             ref2 = sweep_montecarlo(setup, arrays, ref_units * drives, ref_seed,
                                     drives_per_unit=drives, **kw)  # fmt: skip
-            ref1 = sweep_montecarlo(setup, arrays, ref_units * drives, ref_seed + 1, **kw)
             run2 = sweep_montecarlo(setup, arrays, blocks * block_units * drives, seed,
                                     drives_per_unit=drives, **kw)  # fmt: skip
-            run1 = sweep_montecarlo(setup, arrays, blocks * block_units, seed + 1, **kw)
+            if old:
+                ref1 = sweep_montecarlo(setup, arrays, ref_units * drives, ref_seed + 1, **kw)
+                run1 = sweep_montecarlo(setup, arrays, blocks * block_units, seed + 1, **kw)
             dt = time.perf_counter() - t0
             for a in arrays:
                 k = ref2[a].settled
-                rng = np.random.default_rng([0xC0FE, int(10 * ph), *a.encode()])
+                rng = np.random.default_rng([0xC0FE, *label.encode(), *a.encode()])
                 e_ref2 = _finite(ref2[a].errors[:, k])
-                e_ref1 = _finite(ref1[a].errors[:, k])
                 p90_ref = share_quantile(e_ref2, SHARE)
-                p90_ref1 = share_quantile(e_ref1, SHARE)
                 uq = unit_quantiles(ref2[a].errors, drives, k, SHARE)
                 y_ref, y_ref_ci = unit_yield(uq, TARGET_M)
-                ref_ci = _boot_ci(e_ref2.reshape(ref_units, -1), rng, n_boot)
-                ref1_ci = _boot_ci(e_ref1, rng, n_boot)
-                hits = {"cluster": [], "units": [], "yield": [], "drives1": [], "drives2": []}
-                widths = {key: [] for key in hits}
+                ref_ci = cluster_quantile_ci(e_ref2.reshape(ref_units, -1), SHARE)
+                keys = ["cluster", "units", "yield"] + (["drives1", "drives2"] if old else [])
+                hits = {key: [] for key in keys}
+                widths = {key: [] for key in keys}
+
+                def hit(key, ref, ci, hits=hits, widths=widths):
+                    hits[key].append(_where(ref, ci))
+                    widths[key].append(ci[1] - ci[0])
+
                 for b in range(blocks):
                     rows2 = slice(b * block_units * drives, (b + 1) * block_units * drives)
                     e2 = _finite(run2[a].errors[rows2][:, k])
-                    ci = cluster_quantile_ci(e2.reshape(block_units, -1), SHARE)
-                    hits["cluster"].append(_where(p90_ref, ci))
-                    widths["cluster"].append(ci[1] - ci[0])
-                    ci = _boot_ci(e2.reshape(block_units, -1), rng, n_boot)
-                    hits["units"].append(_where(p90_ref, ci))
-                    widths["units"].append(ci[1] - ci[0])
-                    ci = _boot_ci(e2, rng, n_boot)  # drives resampled, the unit ignored
-                    hits["drives2"].append(_where(p90_ref, ci))
-                    widths["drives2"].append(ci[1] - ci[0])
+                    hit("cluster", p90_ref, cluster_quantile_ci(e2.reshape(block_units, -1), SHARE))
+                    hit("units", p90_ref, _boot_ci(e2.reshape(block_units, -1), rng, n_boot))
                     q = unit_quantiles(run2[a].errors[rows2], drives, k, SHARE)
-                    _, ci = unit_yield(q, TARGET_M)
-                    hits["yield"].append(_where(y_ref, ci))
-                    widths["yield"].append(ci[1] - ci[0])
-                    e1 = _finite(run1[a].errors[b * block_units : (b + 1) * block_units][:, k])
-                    ci = _boot_ci(e1, rng, n_boot)
-                    hits["drives1"].append(_where(p90_ref1, ci))
-                    widths["drives1"].append(ci[1] - ci[0])
+                    hit("yield", y_ref, unit_yield(q, TARGET_M)[1])
+                    if old:  # drives resampled, the unit ignored; one draw per drive
+                        hit("drives2", p90_ref, _boot_ci(e2, rng, n_boot))
+                        e1 = _finite(run1[a].errors[b * block_units : (b + 1) * block_units][:, k])
+                        p90_ref1 = share_quantile(_finite(ref1[a].errors[:, k]), SHARE)
+                        hit("drives1", p90_ref1, _boot_ci(e1, rng, n_boot))
                 cov = {}
                 for key, h in hits.items():
                     h = np.asarray(h)
@@ -352,12 +361,10 @@ def coverage(
                 out.append(
                     {
                         "array": a,
-                        "phase": ph,
+                        "level": label,
                         "ref_units": ref_units,
                         "p90_ref": p90_ref,
                         "p90_ref_ci": ref_ci,
-                        "p90_ref1": p90_ref1,
-                        "p90_ref1_ci": ref1_ci,
                         "yield_ref": y_ref,
                         "yield_ref_ci": y_ref_ci,
                         "blocks": blocks,
@@ -377,33 +384,35 @@ def _where(ref: float, ci) -> int:
 
 def coverage_table(rows) -> str:
     lines = [
-        "| array | phase deg | reference (units x D) | ref p90 m [CI] | ref unit yield [Wilson] | "
-        "D=1 ref p90 m [CI] |\n|" + "---|" * 6
+        "| array | impairments | reference (units x D) | ref p90 m [Woodruff 95 %] | "
+        "ref unit yield [Wilson] |\n|" + "---|" * 5
     ]
     for r in rows:
         lines.append(
-            f"| {r['array']} | {r['phase']:g} | {r['ref_units']} x {r['drives']} | "
+            f"| {r['array']} | {r['level']} | {r['ref_units']} x {r['drives']} | "
             f"{r['p90_ref']:.4f} {_ci(r['p90_ref_ci'], '.4f')} | {r['yield_ref']:.3f} "
-            f"{_ci(r['yield_ref_ci'], '.3f')} | {r['p90_ref1']:.4f} {_ci(r['p90_ref1_ci'], '.4f')} |"
+            f"{_ci(r['yield_ref_ci'], '.3f')} |"
         )
     names = {
-        "cluster": "p90, Woodruff over units (D=2, reported)",
-        "units": "p90, bootstrap over units (D=2, before)",
-        "yield": "unit yield @0.1 m, Wilson (D=2, new)",
-        "drives1": "p90, bootstrap over drives (D=1, old)",
+        "cluster": "p90, Woodruff over units (reported)",
+        "units": "p90, percentile bootstrap over units",
+        "yield": "unit yield @0.1 m, Wilson (reported)",
+        "drives1": "p90, bootstrap over drives (D=1, one draw per drive)",
         "drives2": "p90, bootstrap over drives (D=2, unit ignored)",
     }
     lines += [
         "",
-        "| array | phase deg | interval | blocks x units | nominal | measured coverage "
+        "| array | impairments | interval | blocks x units | nominal | measured coverage "
         "[Wilson 95 %] | missed low / high | mean width |\n|" + "---|" * 8,
     ]
     for r in rows:
         for key, name in names.items():
+            if key not in r["coverage"]:
+                continue
             c = r["coverage"][key]
             n_units = r["block_units"] if key != "drives1" else f"{r['block_units']} drives"
             lines.append(
-                f"| {r['array']} | {r['phase']:g} | {name} | {r['blocks']} x {n_units} | 0.95 | "
+                f"| {r['array']} | {r['level']} | {name} | {r['blocks']} x {n_units} | 0.95 | "
                 f"{c['share']:.3f} {_ci(c['ci'], '.3f')} | {c['low']} / {c['high']} | "
                 f"{c['width']:.4g} |"
             )
@@ -418,6 +427,10 @@ def main(argv=None) -> int:
                     help="'base' and/or from_scenario overrides such as mount_height=5.0")  # fmt: skip
     ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
     ap.add_argument("--phases", type=float, nargs="+", default=list(PHASES_DEG))
+    ap.add_argument("--levels", nargs="+", default=["2", "calibrated"],
+                    help="part 2: impairment levels, a phase error in deg or 'calibrated'")  # fmt: skip
+    ap.add_argument("--old", action="store_true",
+                    help="part 2: also the intervals reported before (drives resampled)")  # fmt: skip
     ap.add_argument("--tag", default="", help="a suffix of the written files' names")
     ap.add_argument("--units", type=int, default=30, help="part 1: units per cell")
     ap.add_argument("--drives", type=int, default=2, help="drives per unit")
@@ -459,10 +472,11 @@ def main(argv=None) -> int:
             "seed": args.seed,
             "workers": args.workers,
             "n_boot": args.n_boot,
-            "phases": tuple(args.phases),
+            "levels": tuple(args.levels),
+            "old": args.old,
         }
         if args.quick:
-            kw.update(phases=(2.0,), ref_units=60, blocks=5)
+            kw.update(levels=("calibrated",), ref_units=60, blocks=5)
         t0 = time.perf_counter()
         rows = coverage(**kw)
         dt = time.perf_counter() - t0
