@@ -14,7 +14,12 @@ holds the key: a hash of everything that changes the trace (the exported scene's
 meshes, the :class:`~tunnelkit.rt.settings.RTSettings`, the arrays' element positions, the
 trajectory, the tensor's tones and symbols, the cache format and the sionna-rt version). A
 directory written under another key (another version of the scene) is detected, emptied and
-rebuilt, never reused.
+rebuilt, never reused: only the cache's own files in that directory are removed.
+
+Nothing read is trusted: every epoch file is checked on load (its keys, shapes against the
+radio and the array, finite values, the kinds of path); a truncated, foreign or non-finite file
+is traced again with a warning naming it, or refused naming it when it cannot be. A label is a
+plain name, and a directory that resolves outside ``cache_dir`` (a symbolic link) is refused.
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import shutil
+import re
 import tempfile
 import time
 import warnings
@@ -41,6 +46,14 @@ __all__ = ["CACHE_ENV", "FORMAT", "RayTracedChannel", "default_cache_dir"]
 CACHE_ENV = "TUNNELKIT_RT_CACHE"
 #: version of the cache's file format (part of the key)
 FORMAT = 1
+#: a cache label: a plain name (no separator, no leading dot, so no ``..``)
+_LABEL = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}")
+#: the files the cache writes in a directory (all it ever removes)
+_OWN = re.compile(r"(meta\.json|\.meta-\d+\.json|epoch-\d{3,}\.npz|\.epoch-\d{3,}-\d+\.npz)")
+#: the kinds of path whose power and count an epoch file stores
+_KINDS = ("los", "specular1", "specular2+", "diffuse")
+_FIELDS = ("array", "H", "los_tau", "los_gain", "los_doppler", "los_valid", "power_json",
+           "count_json", "trace_s", "synth_s")  # fmt: skip
 
 
 def default_cache_dir() -> FsPath:
@@ -116,8 +129,11 @@ class RayTracedChannel:
         settings = RTSettings() if settings is None else settings
         if not isinstance(settings, RTSettings):
             raise TypeError(f"settings: expected an RTSettings, got {type(settings).__name__}")
-        if not isinstance(label, str) or not label or "/" in label:
-            raise ValueError(f"label: expected a non-empty name without '/', got {label!r}")
+        if not isinstance(label, str) or not _LABEL.fullmatch(label):
+            raise ValueError(
+                "label: expected a plain name (letters, digits, '_', '.', '+', '-', not starting "
+                f"with '.', at most 100 characters), got {label!r}"
+            )
         self.tunnel, self.arrays, self.trajectory = tunnel, list(arrays), trajectory
         self.config, self.settings, self.label = config, settings, label
         self.cache_dir = default_cache_dir() if cache_dir is None else FsPath(cache_dir)
@@ -156,19 +172,30 @@ class RayTracedChannel:
         instance("tunnel", tunnel, Tunnel3D)
         return "rrms" if getattr(tunnel, "plates", ()) else "no-rrms"
 
+    def _inside(self, d: FsPath) -> FsPath:
+        """``d`` if it resolves inside the cache directory, else ``ValueError`` naming both (a
+        symbolic link out of the cache is never followed to write or delete)."""
+        root = self.cache_dir.resolve()
+        if not d.resolve().is_relative_to(root):
+            raise ValueError(
+                f"label: the cache directory {d} resolves to {d.resolve()}, outside the cache "
+                f"{root} (a symbolic link?)"
+            )
+        return d
+
     def directory(self, tunnel=None) -> FsPath:
         """The checked cache directory of ``tunnel`` (emptied first if written under another key)."""
         tun = self._tunnel(tunnel)
         var = self.variant(tun)
         if var in self._checked:
             return self._checked[var]
-        d = self.cache_dir / self.label / var
+        d = self._inside(self.cache_dir / self.label / var)
         key = self.key(tun)
         meta = d / "meta.json"
         if meta.is_file():
             try:
                 old = json.loads(meta.read_text())
-            except ValueError:
+            except (ValueError, OSError):
                 old = None
             if old != key:
                 warnings.warn(
@@ -176,7 +203,9 @@ class RayTracedChannel:
                     "rebuilding it",
                     stacklevel=2,
                 )
-                shutil.rmtree(d)
+                for f in d.iterdir():  # the cache's own files only, never a link's target
+                    if _OWN.fullmatch(f.name) and (f.is_symlink() or f.is_file()):
+                        f.unlink()
         if not meta.is_file():
             d.mkdir(parents=True, exist_ok=True)
             tmp = d / f".meta-{os.getpid()}.json"
@@ -246,15 +275,69 @@ class RayTracedChannel:
         f = self.directory(tun) / f"epoch-{k:03d}.npz"
         if not f.is_file():
             self._store(k, tun, f)
-        with np.load(f) as z:
-            out = {name: z[name] for name in z.files}
-        out["array"] = str(out["array"])
-        out["power"] = json.loads(str(out.pop("power_json")))
-        out["count"] = json.loads(str(out.pop("count_json")))
-        out["trace_s"], out["synth_s"] = float(out["trace_s"]), float(out["synth_s"])
+        try:
+            out = self._read(f)
+        except ValueError as why:
+            warnings.warn(
+                f"ray-tracing cache: {f} is unreadable ({why}); tracing epoch {k} again",
+                stacklevel=2,
+            )
+            f.unlink()
+            self._store(k, tun, f)
+            try:
+                out = self._read(f)
+            except ValueError as again:
+                raise ValueError(
+                    f"ray-tracing cache: {f} traced again is still bad ({again})"
+                ) from None
         if len(self._memo) > 4:  # a few epochs in memory (one drive reads each epoch per run)
             self._memo.clear()
         self._memo[memo] = out
+        return out
+
+    def _read(self, f: FsPath) -> dict:
+        """Epoch file ``f``, checked: ``ValueError`` saying what is wrong with it otherwise."""
+        import zipfile
+
+        try:
+            with np.load(f, allow_pickle=False) as z:
+                missing = [name for name in _FIELDS if name not in z.files]
+                if missing:
+                    raise ValueError(f"missing {', '.join(missing)}")
+                out = {name: z[name] for name in _FIELDS}
+            power = json.loads(str(out.pop("power_json")))
+            count = json.loads(str(out.pop("count_json")))
+        except (OSError, EOFError, zipfile.BadZipFile, KeyError, json.JSONDecodeError) as e:
+            raise ValueError(f"{type(e).__name__}: {e}") from None
+        names = {a.name: a for a in self.arrays}
+        name, H = str(out["array"]), out["H"]
+        cfg = self.config
+        if name not in names:
+            raise ValueError(f"array {name!r} is none of this drive's ({', '.join(names)})")
+        M = len(names[name].world)
+        if H.shape != (M, cfg.n_tones, cfg.n_symbols) or not np.iscomplexobj(H):
+            raise ValueError(
+                f"H: expected complex ({M}, {cfg.n_tones}, {cfg.n_symbols}), got {H.dtype} "
+                f"{H.shape}"
+            )
+        if not np.all(np.isfinite(H)):
+            raise ValueError("H: not finite")
+        valid = out["los_valid"]
+        if valid.shape != (M,) or valid.dtype != bool:
+            raise ValueError(f"los_valid: expected ({M},) bool, got {valid.dtype} {valid.shape}")
+        for key in ("los_tau", "los_gain", "los_doppler"):
+            v = out[key]
+            if v.shape != (M,) or not np.all(np.isfinite(v[valid])):
+                raise ValueError(f"{key}: expected ({M},) finite where the LoS is, got {v.shape}")
+        for key, d in (("power", power), ("count", count)):
+            if not isinstance(d, dict) or set(d) != set(_KINDS):
+                raise ValueError(f"{key}: expected the kinds {', '.join(_KINDS)}")
+            if not all(
+                isinstance(x, (int, float)) and np.isfinite(x) and x >= 0 for x in d.values()
+            ):
+                raise ValueError(f"{key}: expected finite non-negative numbers")
+        out["array"], out["power"], out["count"] = name, power, count
+        out["trace_s"], out["synth_s"] = float(out["trace_s"]), float(out["synth_s"])
         return out
 
     def _store(self, k: int, tunnel, f: FsPath) -> None:
@@ -272,7 +355,7 @@ class RayTracedChannel:
         los = ep.mask("los")
         j = np.argmax(los, axis=1)
         rows = np.arange(ep.M)
-        kinds = ("los", "specular1", "specular2+", "diffuse")
+        kinds = _KINDS
         tmp = f.with_name(f".{f.stem}-{os.getpid()}.npz")
         np.savez(
             tmp,
