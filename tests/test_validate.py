@@ -235,6 +235,16 @@ def test_sizes_are_checked_before_allocating(budget):
         fresnel.phase_mismatch_ura(100_000, 3.5, 3.0, 2.5, 5.9e9)
     with pytest.raises(ValueError, match="m_limit: would need"):
         fresnel.mmax_exact(3.5, 3.0, 2.5, 5.9e9, 0.15, m_limit=10**12)
+    from tunnelkit import design, drive, rt
+
+    with pytest.raises(ValueError, match=r"n_boot: would need 156 GiB \(1000000000 resamples"):
+        design.bootstrap_quantile_ci(np.ones((20, 30)), 0.9, np.random.default_rng(0), n_boot=10**9)
+    paths = rt.ElementPaths(*(np.zeros((4, 1)),) * 3, np.ones((4, 1), bool),
+                            np.zeros((4, 1), int), np.zeros((4, 1), bool), np.zeros((4, 1), int))  # fmt: skip
+    with pytest.raises(ValueError, match=r"n_tones: would need .* \(4 x 1000000000 x 12 complex"):
+        rt.element_tensor(paths, 120e3, 10**9, 1e-5, 12)
+    with pytest.raises(ValueError, match=r"n_bins: would need 2 TiB \(211 epochs x 100000000 bins"):
+        drive.delay_doppler_profiles(drive.make_drive(), n_bins=10**8)
     budget.set_memory_budget(10**4)  # a small budget turns an ordinary array into an error
     with pytest.raises(ValueError, match="n_rows, n_cols: would need 100 KiB"):
         arrays.make_array(40, 40, fc=5.9e9, azimuth=0.0, elevation=0.0)

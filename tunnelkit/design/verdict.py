@@ -51,6 +51,7 @@ from .._validate import (
     rng_or_error,
     sequence,
 )
+from ..budget import check_elements
 from ..metrics import SETTLE_S
 from .units import REQUIRED_YIELD
 
@@ -175,6 +176,7 @@ def bootstrap_quantile_ci(
     n_boot = integer("n_boot", n_boot, minimum=1)
     e = _error_rows(errors, "(runs, T) with runs, T >= 1")
     runs, T = e.shape
+    check_elements("n_boot", n_boot * (runs + 1), what=f"{n_boot} resamples of {runs} runs")
     draws = rng.integers(0, runs, size=(n_boot, runs))
     qs = np.empty(n_boot)
     step = max(1, 2_000_000 // (runs * T))  # bounded memory per chunk

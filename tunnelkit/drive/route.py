@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._validate import finite_array, instance, integer, positive, real, record, vector
+from ..budget import check_elements
 from ..constants import C
 from ..scenarios import Trajectory
 from .config import DriveConfig
@@ -265,6 +266,12 @@ def delay_doppler_profiles(
     doppler_span = positive("doppler_span", doppler_span)
     idx = np.arange(0, len(drive.t), every)
     paths = channel_paths(cfg, drive.position[idx], drive.velocity[idx], drive.tx)
+    n_paths = paths["delay"].shape[-1]
+    check_elements(
+        "n_bins",
+        idx.size * n_bins * n_paths,
+        what=f"{idx.size} epochs x {n_bins} bins x {n_paths} paths",
+    )
     pw = np.abs(paths["amplitude"]) ** 2
     delays = np.linspace(0, 1.1 * float(paths["delay"].max()), n_bins)
     dops = np.linspace(-doppler_span, doppler_span, n_bins)

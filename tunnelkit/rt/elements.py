@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import choice, finite_array, integer, positive, record
+from ..budget import check_elements
 
 __all__ = ["NUFFT_MIN_PATHS", "SYNTHESIS_METHODS", "ElementPaths", "element_tensor"]
 
@@ -157,6 +158,7 @@ def element_tensor(
     T0 = positive("symbol_period", symbol_period)
     nf = integer("n_tones", n_tones, minimum=1)
     nt = integer("n_symbols", n_symbols, minimum=1)
+    check_elements("n_tones", paths.M * nf * nt, 16, f"{paths.M} x {nf} x {nt} complex tensor")
     choice("method", method, SYNTHESIS_METHODS)
     eps = positive("eps", eps)
     if not 1e-15 <= eps <= 1e-3:
