@@ -33,6 +33,7 @@ from scipy.spatial import cKDTree
 from ._validate import finite_array, integer, nonnegative, positive, real, text, vector
 from .budget import check_elements
 from .constants import wavelength
+from .physical import element_spacing
 
 __all__ = [
     "ArrayGeometry",
@@ -52,7 +53,7 @@ def ura(n_rows: int, n_cols: int, spacing: float) -> np.ndarray:
     """
     n_rows = integer("n_rows", n_rows, minimum=1)
     n_cols = integer("n_cols", n_cols, minimum=1)
-    spacing = positive("spacing", spacing)
+    spacing = element_spacing("spacing", spacing)
     # positions (M, 3) plus the index grids and the world copy every array makes
     check_elements("n_rows, n_cols", n_rows * n_cols * 8, what=f"a {n_rows} x {n_cols} array")
     r, c = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")

@@ -74,6 +74,7 @@ from ._validate import (
 )
 from .budget import check_elements
 from .constants import K_B, C, db2lin, dbm2watt
+from .physical import carrier, power_dbm, subcarrier
 
 __all__ = [
     "ChannelSnapshot",
@@ -115,12 +116,10 @@ class SRSConfig:
     clock_bias_limit: float = 100e-9
 
     def __post_init__(self) -> None:
-        for k in ("fc", "bandwidth", "scs", "t_ant"):
+        carrier("fc", self.fc)
+        subcarrier("scs", self.scs)
+        for k in ("bandwidth", "t_ant"):
             positive(k, getattr(self, k))
-        if self.fc < 1e6:
-            raise ValueError(
-                f"fc: {self.fc:g} Hz is below 1 MHz; fc is in Hz (did you mean {self.fc:g}e9?)"
-            )
         if self.bandwidth >= 2 * self.fc:
             raise ValueError(
                 f"bandwidth: {self.bandwidth:g} Hz around fc = {self.fc:g} Hz reaches 0 Hz (the band "
@@ -128,10 +127,15 @@ class SRSConfig:
             )
         for k in ("clock_bias_sigma", "clock_bias_limit", "noise_figure_db"):
             nonnegative(k, getattr(self, k))
-        real("tx_power_dbm", self.tx_power_dbm)
+        power_dbm("tx_power_dbm", self.tx_power_dbm)
         integer("comb", self.comb, minimum=1)
         integer("n_symbols", self.n_symbols, minimum=2)
         integer("n_rb", self.n_rb, minimum=1)
+        if self.n_tones < 2:
+            raise ValueError(
+                f"n_rb, comb: {self.n_rb} resource blocks of 12 subcarriers, one in {self.comb}, "
+                f"give {self.n_tones} tone; a delay needs at least 2"
+            )
         if 12 * self.n_rb * self.scs > self.bandwidth * 1.0001:
             raise ValueError(
                 f"n_rb: {self.n_rb} RBs at {self.scs:g} Hz exceed the bandwidth {self.bandwidth:g} Hz"

@@ -24,6 +24,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ._validate import callable_, finite_array, integer, positive, spd_matrix, text
+from .physical import MIN_SIGMA
 
 __all__ = [
     "crlb_rmse",
@@ -117,6 +118,11 @@ def station_sigmas(name: str, sigma, n: int) -> np.ndarray | None:
         )
     if np.any(s <= 0):
         raise ValueError(f"{name}: must be > 0 (use None to leave this measurement out), got {s}")
+    if np.any(s < MIN_SIGMA):
+        raise ValueError(
+            f"{name}: {float(s.min()):g} is below {MIN_SIGMA:g} (no measurement is that precise; "
+            "its information would overflow)"
+        )
     return np.broadcast_to(s, (n,)).astype(float)
 
 

@@ -77,13 +77,14 @@ class Plane:
         n = finite_array("normal", self.normal, ndim=1)
         if n.shape[0] not in (2, 3):
             raise ValueError(f"normal: expected 2 or 3 components, got {n.shape[0]}")
-        norm = float(np.linalg.norm(n))
-        if norm == 0.0:
+        big = float(np.max(np.abs(n)))  # scaled first: no overflow of the norm
+        if big == 0.0:
             raise ValueError("normal: degenerate plane, all coefficients are zero (A = B = 0)")
+        norm = float(np.linalg.norm(n / big))
         off = real("offset", self.offset)
         text("name", self.name, empty=True)
-        object.__setattr__(self, "normal", n / norm)
-        object.__setattr__(self, "offset", off / norm)
+        object.__setattr__(self, "normal", n / big / norm)
+        object.__setattr__(self, "offset", off / big / norm)
 
     @property
     def dim(self) -> int:

@@ -19,6 +19,7 @@ import numpy as np
 from ._validate import distinct_points, finite_array, integer, rng_or_error
 from .budget import check_elements
 from .crlb import station_sigmas, toa_doa
+from .physical import MAX_RANGE_M
 
 __all__ = ["ls_toa_doa", "simulate_toa_doa", "toa_only_candidates", "tswls"]
 
@@ -43,6 +44,8 @@ def _inputs(stations, d_hat, theta_hat):
         raise ValueError(f"theta_hat: shape {th.shape} does not match d_hat {d.shape}")
     if np.any(d <= 0):
         raise ValueError("d_hat: ranges must be > 0")
+    if np.any(d > MAX_RANGE_M):
+        raise ValueError(f"d_hat: ranges up to {MAX_RANGE_M:g} m, got {float(d.max()):g}")
     return st, d, th
 
 

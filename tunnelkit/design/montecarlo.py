@@ -49,10 +49,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import bound_array
-from .._validate import boolean, choice, instance, integer, positive, record
+from .._validate import boolean, choice, instance, integer, record
 from ..budget import check_bytes
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import RUN_BYTES, TrialPool, run_trials, trial_pool
+from ..physical import start_spread
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,
@@ -246,7 +247,7 @@ def sweep_montecarlo(
         raise ValueError(
             f"runs: expected whole units of drives_per_unit = {drives_per_unit} drives, got {runs}"
         )
-    start_sigma = positive("start_sigma", start_sigma)
+    start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
     if impairments is not None:
         from .achievable import DesignImpairments

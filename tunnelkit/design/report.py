@@ -45,6 +45,7 @@ from .._validate import (
 from ..budget import check_bytes, check_elements
 from ..metrics import SETTLE_S
 from ..montecarlo import parallel_options
+from ..physical import start_spread
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
 from .impairments import (
@@ -373,7 +374,7 @@ def design_sweep(
     settle = nonnegative("settle", settle)
     seed = integer("seed", seed, minimum=0)
     n_boot = integer("n_boot", n_boot, minimum=100)
-    start_sigma = positive("start_sigma", start_sigma)
+    start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)

@@ -7,6 +7,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from .._validate import finite_array, nonnegative, positive, probability
+from ..physical import carrier, speeds
 from ..scenarios import MAX_SAMPLES, Scenario, ScenarioError, load_scenario, register_check
 
 __all__ = ["IDEAL", "DriveConfig", "load_drive_config"]
@@ -108,6 +109,8 @@ class DriveConfig:
             or not 0 <= self.max_order <= 6
         ):
             raise ValueError(f"max_order: must be an integer in [0, 6], got {self.max_order!r}")
+        carrier("fc", self.fc)
+        speeds("speed", self.speed + self.speed_amplitude)
         if self.speed_amplitude >= self.speed:
             raise ValueError(
                 f"speed_amplitude: must be below speed ({self.speed}) so the vehicle keeps moving, "

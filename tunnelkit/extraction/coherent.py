@@ -142,7 +142,7 @@ def fit_sources(
     b = finite_array("b", b, ndim=1, dtype=complex)
     theta0 = _theta("theta0", theta0)
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])
-    max_nfev = integer("max_nfev", max_nfev, minimum=0, maximum=MAX_NFEV)
+    max_nfev = integer("max_nfev", max_nfev, minimum=1, maximum=MAX_NFEV)
     return _fit_sources(b, theta0, p, positive("fc", fc), max_nfev)
 
 
@@ -232,8 +232,10 @@ def split_component(
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])
     tol, max_gain = positive("tol", tol), positive("max_gain", max_gain)
     min_separation = nonnegative("min_separation", min_separation)
-    th, g, rel = _fit_sources(b, theta0, p, fc)
     scale = float(np.sqrt(np.mean(np.abs(b) ** 2)))
+    if scale == 0.0:
+        raise ValueError("b: an all-zero spatial factor has no source to split")
+    th, g, rel = _fit_sources(b, theta0, p, fc)
     while rel > tol and th.shape[0] < max_sources:
         S = spherical_steering(source_points(th), p, fc)
         u = scan_peak(b - S @ g, p, fc)

@@ -105,6 +105,8 @@ def max_identifiable_rank(shape) -> int:
 def check_rank(shape, n_paths) -> int:
     """``n_paths`` as an int, or ``ValueError`` if Kruskal's condition cannot identify it."""
     n = integer("n_paths", n_paths, minimum=1)
+    if isinstance(shape, str | bytes) or not hasattr(shape, "__len__") or len(shape) != 3:
+        raise ValueError(f"shape: expected a 3-way tensor shape (M, Nf, Nt), got {shape!r}")
     top = max_identifiable_rank(shape)
     if n > top:
         raise ValueError(

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from .._validate import callable_, record, text
+from ..physical import speeds
 from ..schema import ScenarioError
 
 __all__ = [
@@ -58,6 +59,7 @@ class Trajectory:
 
     def __post_init__(self) -> None:
         record(self, shapes={"t": ("T",), "position": ("T", "D"), "velocity": ("T", "D")})
+        speeds("velocity", self.velocity)
 
     def __len__(self) -> int:
         return self.t.shape[0]

@@ -18,7 +18,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..._checks import attributes, optional_real, unchecked
-from ..._validate import boolean, finite_array, nonnegative, positive, record, rng_or_error, vector
+from ..._validate import boolean, finite_array, positive, record, rng_or_error, vector
+from ...physical import speeds, step_seconds
 from ..gating import ChiSquareGate
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
@@ -314,7 +315,9 @@ class Javelin:
     ) -> StepReport:
         """One epoch: predict with (speed, heading) over ``dt``, associate, manage, update."""
         cfg, roles = self.config, self.design
-        dt = nonnegative("dt", dt)
+        dt = step_seconds("dt", dt)
+        if speed is not None:
+            speeds("speed", speed)
         optional_real("speed", speed), optional_real("heading", heading)
         faults: list[str] = []
         meas = self._paths(paths, faults)

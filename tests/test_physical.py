@@ -1,0 +1,117 @@
+"""Physically impossible inputs are refused where they enter, naming the parameter and the unit:
+a car faster than any road vehicle, a carrier in GHz or a subcarrier spacing in kHz where Hz are
+meant, a radio with one tone, a transmit power of a megawatt of dBm, an array spacing of 1e308
+m, a measurement more precise than a picometre, a range of 1e200 m; and the leftovers of the
+first round of bad input fixed at their cause (an overflowing plane normal, a 2-way tensor shape,
+a fit of no steps, an all-zero spatial factor)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tunnelkit as tk
+from tunnelkit import arrays, channel, crlb, drive, geometry, physical, positioning
+from tunnelkit.extraction import coherent, decomposition
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (
+            lambda: drive.make_drive(fc=1.35),
+            r"fc: expected 1e\+08 to 3e\+11 Hz, got 1.35 \(in Hz: 1.35 GHz",
+        ),
+        (lambda: channel.SRSConfig(fc=3.5), r"fc: .*3.5 GHz is 3.5e9"),
+        (lambda: channel.SRSConfig(fc=1e12), r"fc: expected 1e\+08 to 3e\+11 Hz, got 1e\+12"),
+        (lambda: channel.SRSConfig(scs=120), r"scs: .*120 kHz is 120e3"),
+        (lambda: channel.SRSConfig(n_rb=1, comb=64), r"n_rb, comb: .* give 1 tone"),
+        (lambda: channel.SRSConfig(tx_power_dbm=1e6), r"tx_power_dbm: expected -150 to 100 dBm"),
+        (lambda: drive.make_drive(speed=400.0), r"speed: a speed of 40\d m/s, above 150 m/s"),
+        (lambda: arrays.ura(4, 4, 1e308), r"spacing: expected 0 to 10 m"),
+        (
+            lambda: crlb.fim_toa_doa([1.0, 2.0], [[0, 0], [10, 0]], 1e-200, 1.0),
+            r"sigma_theta: 1e-200 is below 1e-12",
+        ),
+        (
+            lambda: positioning.ls_toa_doa([[0, 0], [10, 0]], [1e200, 1e200], [0.1, 0.2]),
+            r"d_hat: ranges up to 1e\+06 m",
+        ),
+        (lambda: decomposition.check_rank((4, 4), 1), r"shape: expected a 3-way tensor shape"),
+        (
+            lambda: coherent.fit_sources(
+                np.ones(16, complex), [[0, 0, 0.01]], arrays.ura(4, 4, 0.025), 5.9e9, max_nfev=0
+            ),
+            r"max_nfev: ",
+        ),
+        (
+            lambda: coherent.split_component(
+                np.zeros(16, complex), [[0, 0, 0.01]], arrays.ura(4, 4, 0.025), 5.9e9
+            ),
+            r"b: an all-zero spatial factor",
+        ),
+    ],
+)
+def test_impossible_inputs_are_refused_by_name(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+def test_a_trajectory_faster_than_a_vehicle_is_refused():
+    t = np.arange(3.0)
+    ok = tk.scenarios.Trajectory(t, np.zeros((3, 2)), np.full((3, 2), [40.0, 0.0]))
+    assert len(ok) == 3
+    with pytest.raises(ValueError, match=r"velocity: a speed of 8.7e\+10 m/s, above 150 m/s"):
+        tk.scenarios.Trajectory(t, np.zeros((3, 2)), np.full((3, 2), [8.7e10, 0.0]))
+
+
+def test_a_slalom_scenario_at_light_speed_is_refused(tmp_path):
+    """A slalom of wavelength 1e-9 m at 14 m/s swings sideways at ~1e11 m/s."""
+    text = tk.scenarios.scenario_path("italiano2026-slalom").read_text()
+    text = text.replace("slalom_wavelength = 25.0", "slalom_wavelength = 1e-9", 1)
+    text = text.replace('name = "italiano2026-slalom"', 'name = "fast-slalom"', 1)
+    f = tmp_path / "fast-slalom.toml"
+    f.write_text(text)
+    with pytest.raises(Exception, match=r"trajectory: velocity: a speed of .* above 150 m/s"):
+        tk.load_scenario(f).trajectory(tk.load_scenario(f).tunnel())
+
+
+def test_the_ranges_admit_every_preset():
+    for name in tk.list_scenarios():
+        sc = tk.load_scenario(name)
+        if sc.family == "halili2022":  # its drive has no tunnel section: make_drive
+            drive.make_drive(drive.load_drive_config(name))
+            continue
+        sc.trajectory(sc.tunnel())
+        if "radio" in sc.sections:
+            channel.SRSConfig.from_scenario(sc)
+    assert physical.speeds("v", [[25.0, 3.0]]).shape == (1, 2)
+    assert physical.carrier("fc", 28e9) == 28e9 and physical.subcarrier("scs", 120e3) == 120e3
+
+
+def test_a_plane_with_huge_coefficients_keeps_its_normal():
+    p = geometry.Plane(normal=[1e200, 1e200], offset=1e200)
+    np.testing.assert_allclose(p.normal, [2**-0.5, 2**-0.5])
+    assert p.offset == pytest.approx(2**-0.5)
+    np.testing.assert_allclose(geometry.Plane(normal=[3.0, 4.0], offset=10.0).normal, [0.6, 0.8])
+
+
+def test_a_tracker_step_at_light_speed_or_of_a_lifetime_is_refused():
+    from tunnelkit.tracking.javelin import Javelin
+    from tunnelkit.tracking.javelin.designs import array_design
+
+    design = array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.05})
+    trk = Javelin(np.array([-30.0, -3.0, 1.2]), design)
+    with pytest.raises(ValueError, match=r"speed: a speed of 4e\+08 m/s, above 150 m/s"):
+        trk.step(None, 4e8, 0.0, 0.1)
+    with pytest.raises(ValueError, match=r"dt: expected 0 to 60 s, got 1e\+09"):
+        trk.step(None, 10.0, 0.0, 1e9)
+    trk.step(None, 10.0, 0.0, 0.1)  # a car at 36 km/h for 0.1 s
+
+
+def test_a_design_start_spread_of_100_km_is_refused():
+    from tunnelkit import design
+
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    with pytest.raises(ValueError, match=r"start_sigma: expected 0 to 1000 m, got 100000"):
+        design.design_sweep(setup, ["4x4"], start_sigma=1e5)
