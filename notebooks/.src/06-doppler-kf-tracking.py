@@ -454,8 +454,8 @@ bounds = {
     "Doppler + ToA": dp.posterior_crlb(drive, sigma_hz=32.79, sigma_range=1.0),
 }
 # headline: pcrlb-one-transmitter
-BOUND_OF = "the RMSE bound over random drives, not one drive's error"
-pcrlb_figure(drive, bounds, title=f"sqrt(PCRLB) of one transmitter: {BOUND_OF}").show()
+BOUND_OF = "RMSE bound over random drives, not one drive's"
+pcrlb_figure(drive, bounds, title=f"One transmitter, sqrt(PCRLB): {BOUND_OF}").show()
 for name, P in bounds.items():
     print(
         f"{name:32s} sqrt PCRLB at t = 20 s: x {np.sqrt(P[625, 0, 0]):6.2f} m, y {np.sqrt(P[625, 1, 1]):6.2f} m; "
@@ -510,7 +510,7 @@ fix_bounds = {
     f"Doppler, GNSS sigma {s:g} m": dp.posterior_crlb(drive, sigma_hz=32.79, sigma_p0=s)
     for s in (1.0, 5.0, 20.0)
 }
-pcrlb_figure(drive, fix_bounds, title=f"Doppler only, by entry fix: {BOUND_OF}").show()
+pcrlb_figure(drive, fix_bounds, title=f"Doppler only, by entry fix, sqrt(PCRLB): {BOUND_OF}").show()
 before = {
     k: float(np.sqrt(P[k_pass // 2, 0, 0])) for k, P in fix_bounds.items()
 }  # half-way to the pass
