@@ -626,11 +626,11 @@ assert 2.5 < ratio_q < 3.6, ratio_q  # about sqrt(10)
 
 # %%
 # the campaign of section 1: the tube, 1.35 GHz and 80 MHz, 90 km/h for 54 s, the pass near
-# second 37, the two resolutions; the assumed mounts: transmitter at (x_T, 4.5, 4.5) m, the van's
-# antenna at y = -2.5 m, z = 2 m
+# second 37, channel parameters every 0.8 m, the two resolutions; the assumed mounts:
+# transmitter at (x_T, 4.5, 4.5) m, the van's antenna at y = -2.5 m, z = 2 m
 assert (cfg.width, cfg.height) == (10.0, 5.0) and abs(drive.t[k_pass] - 37.0) < 0.5
 assert (cfg.fc, cfg.bandwidth, cfg.duration) == (1.35e9, 80e6, 54.0) and cfg.speed * 3.6 == 90
-assert (cfg.tx_y, cfg.tx_z, cfg.lane_y, cfg.rx_height) == (4.5, 4.5, -2.5, 2.0)
+assert (cfg.tx_y, cfg.tx_z, cfg.lane_y, cfg.rx_height, cfg.spacing) == (4.5, 4.5, -2.5, 2.0, 0.8)
 assert np.allclose(drive.tx[1:], 4.5) and np.allclose(drive.position[:, 1], -2.5)
 assert np.isclose(cfg.delay_resolution, 12.5e-9) and np.isclose(
     cfg.doppler_resolution, 32.0, rtol=0.01
