@@ -245,11 +245,10 @@ print(
 # path (curvature against the distance of the true wave source, the UE or its VUE; $\Delta d$
 # against the true TDoA). The drives of section 1 are the first of these.
 #
-# **Which seed.** These drives are the first runs of seed 0 of the random generator, a *tuning*
-# seed: our own design for the ML route (notebook 04b) took its measurement noise from drives of
-# this seed. They show what the extraction does; they are not a fair test of a design chosen on
-# them. Notebook 04b reports its tables on a *held-out* seed, one never looked at while choosing
-# anything.
+# **Which seed.** These drives are the first runs of seed 0, on which our ML-route design
+# (notebook 04b) took its measurement noise: they show what the extraction does, not a fair test
+# of a design chosen on them. Notebook 04b scores its tables on a held-out seed; which choice saw
+# which drives is in [docs/javelin-seeds.md](../docs/javelin-seeds.md).
 
 # %%
 runs = tk.mc_count(3, 1)

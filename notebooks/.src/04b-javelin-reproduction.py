@@ -53,13 +53,11 @@ tk.setup_notebook()
 # first 6 epochs, fewer conditions.
 #
 # **Tuning seeds and the held-out seed.** A design chosen on some drives and scored on the same
-# drives is scored too kindly. Every choice of our design was made on *tuning* seeds of the random
-# generator: its settings for the paper's route on seed 7; its measurement noise for the ML route
-# on the first three LoS drives per trajectory of seed 0 (the drives notebook 04 shows), and its
-# last step, the joint innovation test of section 5, on seed 0's slalom drives. The paper's design
-# takes the published numbers and has nothing tuned. Every drive of this notebook comes from the
-# **held-out** seed `ex.HELD_OUT_SEED` (printed below), which was not run while anything was being
-# chosen: every table and figure here is a report on drives no choice has seen.
+# drives is scored too kindly. Every choice of our design was made on drives of the *tuning*
+# seeds (`ex.TUNING_SEEDS`); the paper's design takes the published numbers and has nothing
+# tuned. Every drive of this notebook comes from the **held-out** seed `ex.HELD_OUT_SEED`
+# (printed below), not run while anything was chosen; which choice saw which drives is in
+# [docs/javelin-seeds.md](../docs/javelin-seeds.md).
 
 # %%
 seed = ex.HELD_OUT_SEED  # the held-out seed (the tuning seeds: ex.TUNING_SEEDS)
@@ -94,7 +92,7 @@ print({sc: {c: len(d) for c, d in r["ml"].items()} for sc, r in routes.items()})
 # route, as printed (eq. 51) and with the curvature centred on the VUE; our design on the ML
 # route; the paper's numbers. The same computation runs from the command line:
 # `tunnelkit reproduce javelin-table1` / `javelin-table2` with `--seed` set to the held-out seed
-# printed in section 1 (without it the command runs the tuning seed 0).
+# printed in section 1.
 
 # %%
 cols1, rows1 = table_rows(routes["italiano2026-straight"], "italiano2026_table1", progress=True)
@@ -242,10 +240,10 @@ for cond in ("N", "NoRRMs"):
 # Algorithm 2; (4) VUEs moved with the mirrored UE displacement instead of eq. 63's random walk
 # (notebook 04, section 4); (5) a newborn track is not used to update in its birth epoch (its
 # position came from the very angles it would update with). Settings (1)–(5) were tuned on the
-# paper's extraction, on the tuning seed 7. The last rows change the measurement route: the
+# paper's extraction of tuning drives. The last rows change the measurement route: the
 # paper's design on the ML route (eq. 51 as printed, then the curvature centred on the VUE, the
 # radius of the exact wavefront that the ML route measures), and our design on it: (1)–(5), the
-# VUE curvature, a measurement noise set from the extraction error measured on the tuning seed 0,
+# VUE curvature, a measurement noise set from the extraction error measured on tuning drives,
 # and (6) a joint innovation test: a pair that makes the stacked innovation of the epoch
 # inconsistent is left out of the update. (6) is there because when the LoS is blocked, eq. 61
 # accepts any free path whose delay is within $\gamma$ of its curvature, and a road-marking
@@ -266,8 +264,8 @@ javelin_table_figure(abl_cols, abl_rows, title="ablation on the straight drives:
 # matters far less than what the tracker is fed.
 #
 # Our ML-route design does not set its four measurement sigmas to the RMS error the ML route
-# delivers on these drives: they are wider (the last row below, measured on the tuning seed 0,
-# against the held-out rows above it), so that one gross error — two nearly coincident paths
+# delivers on these drives: they are wider (the last row below, set on tuning drives, against
+# the held-out rows above it), so that one gross error — two nearly coincident paths
 # swapped or merged — does not make the gate reject the next good measurement (exercise 2 tries
 # the narrower choice). The RMS measurement error over all the LoS drives here:
 
@@ -280,7 +278,7 @@ assumed = [
     c_ml.sigma_kappa,
     c_ml.sigma_delta_d,
 ]
-display_rows = [*erows, ["our ML design assumes (seed 0)", None, *assumed, None]]
+display_rows = [*erows, ["our ML design assumes", None, *assumed, None]]
 javelin_table_figure(
     ecols, display_rows, title=f"ML route: RMS measurement error, {runs} run(s)", digits=4
 )
@@ -338,8 +336,8 @@ print(
 #
 # 1. Run the ablation of section 5 on the slalom drives (`ex.ablation(slalom, ml=slalom_ml)`).
 #    Does every step of our design help there too?
-# 2. Our ML-route design (`designs.ours_ml()`) took its measurement noise from three LoS drives
-#    per trajectory of the tuning seed 0. Set it instead from all the LoS drives of section 1
+# 2. Our ML-route design (`designs.ours_ml()`) took its measurement noise from a few LoS drives
+#    of a tuning seed. Set it instead from all the LoS drives of section 1
 #    (`designs.design_from_errors` on the table of section 5) and score JAVELIN-L on both
 #    trajectories with both designs. Does more calibration data change the result? Mind what
 #    the comparison is: the refit is fitted on the very held-out drives it is scored on, which
