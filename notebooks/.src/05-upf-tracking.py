@@ -245,12 +245,7 @@ particle_cloud_figure(snaps)
 
 
 # %%
-def bound_named(fig, what="random drives, q = 0.1"):
-    """Name the dashed sqrt(PCRLB) for what it bounds: the RMSE over random drives."""
-    fig.data[-1].name = f"sqrt(PCRLB): RMSE bound over {what}"
-    return fig
-
-
+Q01 = "sqrt(PCRLB): RMSE bound over random drives, q = 0.1"  # the dashed curve's name
 bound = pcrlb.vs_pcrlb(m, exp.truth, exp.P0)
 # the same simulated runs for every estimator; a progress bar over the estimators
 mc = vs.monte_carlo(exp, RUNS, seed=0, options={"UPF": {"n_particles": PARTICLES}}, progress=True)
@@ -258,8 +253,8 @@ err = {n: np.linalg.norm(e[..., :2] - exp.truth[:, :2], axis=-1) for n, e in mc.
 rmse_t = {n: np.sqrt(np.mean(e**2, axis=0)) for n, e in err.items()}
 ratio = {n: float(np.sqrt(np.mean(e**2) / np.mean(bound**2))) for n, e in err.items()}
 print("RMSE / sqrt(PCRLB) over the run:", {n: round(r, 3) for n, r in ratio.items()})
-bound_named(
-    rmse_bound_figure(exp.times, rmse_t, bound, title=f"Straight NLOS, 2 deg / 2 m, {RUNS} runs")
+rmse_bound_figure(
+    exp.times, rmse_t, bound, title=f"Straight NLOS, 2 deg / 2 m, {RUNS} runs", bound_name=Q01
 )
 
 # %% [markdown]
@@ -367,10 +362,11 @@ for name, los in tqdm((("curved NLOS", False), ("straight LOS", True)), leave=Fa
     curves[name] = {n: float(np.sqrt(np.mean(v) / np.mean(b2**2))) for n, v in mse.items()}
     rmse_c[name] = ({n: np.sqrt(v) for n, v in mse.items()}, b2)
     print(f"{name:13s} RMSE / sqrt(PCRLB):", {n: round(v, 3) for n, v in curves[name].items()})
-bound_named(
-    rmse_bound_figure(
-        exp.times, *rmse_c["curved NLOS"], title=f"Curved NLOS, 2 deg / 2 m, {RUNS} runs"
-    )
+rmse_bound_figure(
+    exp.times,
+    *rmse_c["curved NLOS"],
+    title=f"Curved NLOS, 2 deg / 2 m, {RUNS} runs",
+    bound_name=Q01,
 )
 
 # %% [markdown]
@@ -522,8 +518,6 @@ print(
 
 # %% tags=["explorer"]
 explorer = upf_explorer(n_particles=min(PARTICLES, 200))
-explorer.callback = lambda cb=explorer.callback, **v: bound_named(cb(**v))  # its bound, named
-bound_named(explorer.figure)
 explorer
 
 # %% [markdown]

@@ -123,11 +123,24 @@ def tracks_figure(
     return reveal_overlaps(fig)
 
 
+#: the dashed curve's name: what a posterior CRLB bounds
+BOUND_NAME = "sqrt(PCRLB): RMSE bound over random drives"
+
+
 def rmse_bound_figure(
-    t, rmse: Mapping[str, np.ndarray], bound, *, title: str = "", log_y: bool = True
+    t,
+    rmse: Mapping[str, np.ndarray],
+    bound,
+    *,
+    title: str = "",
+    log_y: bool = True,
+    bound_name: str = BOUND_NAME,
 ) -> go.Figure:
-    """RMSE per epoch of each estimator with sqrt(posterior CRLB) dashed underneath."""
+    """RMSE per epoch of each estimator with sqrt(posterior CRLB) dashed underneath, named
+    ``bound_name`` (default: what it bounds, the RMSE over random drives, not one drive's
+    error)."""
     t = finite_array("t", t, ndim=1)
+    bound_name = text("bound_name", bound_name)
     if not isinstance(rmse, Mapping):
         raise TypeError(f"rmse: expected a mapping name -> values, got {type(rmse).__name__}")
     bound = nonnegative_array("bound", bound, shape=(len(t),))
@@ -141,7 +154,7 @@ def rmse_bound_figure(
         dash={"PCRLB": "dash"},
         log_y=log_y,
     )
-    fig.data[-1].name = "sqrt(PCRLB)"
+    fig.data[-1].name = bound_name
     return fig
 
 
