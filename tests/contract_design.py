@@ -73,7 +73,7 @@ def design_sweep():
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
     res = montecarlo.sweep_montecarlo(
-        setup, ["4x4"], 1, 0, n_epochs=3, start_sigma=0.5, dead_reckoning=True
+        setup, ["4x4"], 1, 0, n_epochs=12, start_sigma=0.5, dead_reckoning=True
     )
     r = next(iter(res.values()))
     r.settled_rms(np.full(len(r.t), 0.1))

@@ -115,3 +115,24 @@ def test_a_design_start_spread_of_100_km_is_refused():
     setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
     with pytest.raises(ValueError, match=r"start_sigma: expected 0 to 1000 m, got 100000"):
         design.design_sweep(setup, ["4x4"], start_sigma=1e5)
+
+
+def test_a_route_shorter_than_the_start_up_scores_nothing():
+    """Three epochs (0.2 s) leave nothing after the 1 s start-up: the per-run RMSE is missing
+    and the settled statistics refuse, never the whole route instead."""
+    from tunnelkit import design
+
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    r = design.sweep_montecarlo(setup, ["4x4"], 1, 0, n_epochs=3)["4x4"]
+    assert r.settled.size == 0 and np.isnan(r.rmse_runs).all()
+    with pytest.raises(ValueError, match=r"settled: a 0\.2 s route has no epoch after"):
+        _ = r.rmse_settled
+    with pytest.raises(ValueError, match="nothing settled to score"):
+        r.settled_rms(np.ones(3))
+
+
+def test_a_drive_of_a_nanometre_is_refused_not_scored_zero():
+    from tunnelkit.studies.drives import drive_variant
+
+    with pytest.raises(ValueError, match=r"length: a 1e-09 m drive ends within the tracker.s 1 s"):
+        drive_variant("italiano2026-straight", 1e-9)

@@ -97,7 +97,8 @@ class MonteCarloResult:
     ``errors`` (runs, T) [m] the 2-D position error of every run and epoch, the runs in unit
     order (``drives_per_unit`` drives of one manufactured unit, one calibration draw, after
     each other: :mod:`tunnelkit.design.units`); ``rmse_runs`` (runs,) each run's RMSE over the
-    settled epochs (the whole drive when it is shorter than :data:`SETTLE_S`); ``settled`` the
+    settled epochs (NaN when the drive is shorter than :data:`SETTLE_S`: nothing settled, and
+    the settled statistics refuse); ``settled`` the
     indices of the settled epochs (:func:`tunnelkit.metrics.settled`); ``mode`` the
     measurement route; ``peb`` (T,) [m] the snapshot PEB; ``sigmas`` the tracker's fallback
     sigmas. Two **bounds** over the drive (with a model: the bound route, or given models),
@@ -149,21 +150,30 @@ class MonteCarloResult:
     def runs(self) -> int:
         return int(self.errors.shape[0])
 
+    def _settled(self) -> np.ndarray:
+        """The settled epochs, refused when there are none (never the whole route instead)."""
+        if not self.settled.size:
+            raise ValueError(
+                f"settled: a {self.t[-1] - self.t[0]:.3g} s route has no epoch after the tracker's "
+                f"{SETTLE_S:g} s start-up (metrics.SETTLE_S): nothing settled to score"
+            )
+        return self.settled
+
     @property
     def rmse_settled(self) -> float:
         """RMSE over every run and settled epoch [m]."""
-        return float(np.sqrt(np.mean(self.errors[:, self.settled] ** 2)))
+        return float(np.sqrt(np.mean(self.errors[:, self._settled()] ** 2)))
 
     @property
     def median_settled(self) -> float:
         """Median 2-D error over every run and settled epoch [m]."""
-        return float(np.median(self.errors[:, self.settled]))
+        return float(np.median(self.errors[:, self._settled()]))
 
     def settled_rms(self, bound: np.ndarray) -> float:
         """RMS of a per-epoch bound (T,) over the settled epochs [m]."""
         if bound_array("bound", bound, ndim=1).shape != self.t.shape:
             raise ValueError(f"bound: expected one value per epoch {self.t.shape}")
-        return float(np.sqrt(np.mean(np.asarray(bound)[self.settled] ** 2)))
+        return float(np.sqrt(np.mean(np.asarray(bound)[self._settled()] ** 2)))
 
 
 def sweep_montecarlo(
@@ -318,8 +328,7 @@ def sweep_montecarlo(
         )
         built = pool.map(prepared_summary, prepared, desc="design summaries")
     t = traj.t[:T].copy()
-    idx = settled(t)
-    use = idx if idx.size else np.arange(T)
+    idx = settled(t)  # empty on a route shorter than the start-up: nothing settled to score
     out = {}
     for a, spec in enumerate(specs):
         err = np.stack([np.asarray(e, float) for e in res[a * runs : (a + 1) * runs]])
@@ -333,7 +342,7 @@ def sweep_montecarlo(
             t,
             traj.position[:T, 0].copy(),
             err,
-            np.sqrt(np.mean(err[:, use] ** 2, axis=1)),
+            np.sqrt(np.mean(err[:, idx] ** 2, axis=1)) if idx.size else np.full(runs, np.nan),
             idx,
             peb,
             pc,

@@ -37,6 +37,7 @@ from .._validate import (
 from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
+from ..metrics import SETTLE_S, settled
 from ..signal_route import CHANNELS, Epoch, SignalRoute
 from ..tracking.javelin.measurement import PathMeasurements
 
@@ -282,7 +283,13 @@ def drive_variant(scenario: str, length: float) -> SignalRoute:
         x_start = x_end + length
         tunnel = max(float(sc.raw["tunnel"]["length"]), 2.0 * (x_start + 25.0))
         sc = with_values(sc, {"trajectory.x_start": x_start, "tunnel.length": tunnel})
-        _VARIANTS[key] = SignalRoute.from_scenario(sc)
+        route = SignalRoute.from_scenario(sc)
+        if not settled(route.trajectory.t).size:  # nothing to score, never an RMSE of 0
+            raise ValueError(
+                f"length: a {length:g} m drive ends within the tracker's {SETTLE_S:g} s start-up "
+                "(metrics.SETTLE_S): nothing settled to score; give a longer drive"
+            )
+        _VARIANTS[key] = route
     return _VARIANTS[key]
 
 
