@@ -29,10 +29,13 @@ def test_a_complex64_tensor_still_works(epoch):
 @pytest.mark.parametrize(
     ("kw", "match"),
     [
-        ({"fc": 28.0}, r"^fc: 28 Hz is below 1 MHz; fc is in Hz \(did you mean 28e9\?\)"),
+        (
+            {"fc": 28.0},
+            r"^fc: expected 1e\+08 to 3e\+11 Hz, got 28 \(fc is in Hz: did you mean 28e9\?\)",
+        ),
         ({"fc": 5.9e3}, r"^fc: "),
         ({"fc": 100e6, "bandwidth": 200e6, "n_rb": 1}, r"^bandwidth: .* reaches 0 Hz"),
-        ({"fc": 50e6, "bandwidth": 100e6, "n_rb": 1}, r"^bandwidth: "),
+        ({"fc": 120e6, "bandwidth": 250e6, "n_rb": 1}, r"^bandwidth: "),
     ],
 )
 def test_radio_units_and_band(kw, match):

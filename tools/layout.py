@@ -28,7 +28,7 @@ SIZE_EXEMPT = {"tunnelkit.schema"}
 RANKS = {
     "_validate": 0,
     "_checks": 0.25,  # more checks of the validation layer, built on _validate
-    "physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
+    "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
     "constants": 0.5,
     "solutions": 0.5,  # the notebooks' solution cells (an IPython magic), imports nothing of ours
     "budget": 0.5,

@@ -30,10 +30,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ._physical import element_spacing
 from ._validate import finite_array, integer, nonnegative, positive, real, text, vector
 from .budget import check_elements
 from .constants import wavelength
-from .physical import element_spacing
 
 __all__ = [
     "ArrayGeometry",

@@ -62,6 +62,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._physical import carrier, power_dbm, subcarrier
 from ._validate import (
     choice,
     finite_array,
@@ -74,7 +75,6 @@ from ._validate import (
 )
 from .budget import check_elements
 from .constants import K_B, C, db2lin, dbm2watt
-from .physical import carrier, power_dbm, subcarrier
 
 __all__ = [
     "ChannelSnapshot",

@@ -23,8 +23,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ._physical import MIN_SIGMA
 from ._validate import callable_, finite_array, integer, positive, spd_matrix, text
-from .physical import MIN_SIGMA
 
 __all__ = [
     "crlb_rmse",

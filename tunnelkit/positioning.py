@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._physical import MAX_RANGE_M
 from ._validate import distinct_points, finite_array, integer, rng_or_error
 from .budget import check_elements
 from .crlb import station_sigmas, toa_doa
-from .physical import MAX_RANGE_M
 
 __all__ = ["ls_toa_doa", "simulate_toa_doa", "toa_only_candidates", "tswls"]
 

@@ -49,11 +49,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import bound_array
+from .._physical import start_spread
 from .._validate import boolean, choice, instance, integer, record
 from ..budget import check_bytes
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import RUN_BYTES, TrialPool, run_trials, trial_pool
-from ..physical import start_spread
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,

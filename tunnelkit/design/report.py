@@ -32,6 +32,7 @@ from functools import partial
 
 import numpy as np
 
+from .._physical import start_spread
 from .._validate import (
     boolean,
     choice,
@@ -45,7 +46,6 @@ from .._validate import (
 from ..budget import check_bytes, check_elements
 from ..metrics import SETTLE_S
 from ..montecarlo import parallel_options
-from ..physical import start_spread
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
 from .impairments import (

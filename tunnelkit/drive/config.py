@@ -6,8 +6,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+from .._physical import carrier, speeds
 from .._validate import finite_array, nonnegative, positive, probability
-from ..physical import carrier, speeds
 from ..scenarios import MAX_SAMPLES, Scenario, ScenarioError, load_scenario, register_check
 
 __all__ = ["IDEAL", "DriveConfig", "load_drive_config"]

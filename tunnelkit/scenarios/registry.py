@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from .._physical import speeds
 from .._validate import callable_, record, text
-from ..physical import speeds
 from ..schema import ScenarioError
 
 __all__ = [

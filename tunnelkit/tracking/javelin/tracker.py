@@ -18,8 +18,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..._checks import attributes, optional_real, unchecked
+from ..._physical import speeds, step_seconds
 from ..._validate import boolean, finite_array, positive, record, rng_or_error, vector
-from ...physical import speeds, step_seconds
 from ..gating import ChiSquareGate
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
@@ -316,9 +316,9 @@ class Javelin:
         """One epoch: predict with (speed, heading) over ``dt``, associate, manage, update."""
         cfg, roles = self.config, self.design
         dt = step_seconds("dt", dt)
-        if speed is not None:
-            speeds("speed", speed)
         optional_real("speed", speed), optional_real("heading", heading)
+        if speed is not None and np.isfinite(speed):  # NaN: the message is missing
+            speeds("speed", speed)
         faults: list[str] = []
         meas = self._paths(paths, faults)
         nu, theta, sig_nu = self._motion(speed, heading, faults)

@@ -72,14 +72,14 @@ def _within(name: str, value: float, lo: float, hi: float, unit: str, hint: str)
 def carrier(name: str, value) -> float:
     """``value`` [Hz] if a radio carrier (:data:`CARRIER_HZ`); a value in GHz is named as such."""
     v = real(name, value)
-    hint = f"in Hz: {v:g} GHz is {v:g}e9" if 0 < v < 1e3 else ""
+    hint = f"{name} is in Hz: did you mean {v:g}e9?" if 0 < v < 1e3 else ""
     return _within(name, v, *CARRIER_HZ, "Hz", hint)
 
 
 def subcarrier(name: str, value) -> float:
     """``value`` [Hz] if a subcarrier spacing (:data:`SUBCARRIER_HZ`); kHz named as such."""
     v = real(name, value)
-    hint = f"in Hz: {v:g} kHz is {v:g}e3" if 0 < v < 1e3 else ""
+    hint = f"{name} is in Hz: did you mean {v:g}e3?" if 0 < v < 1e3 else ""
     return _within(name, v, *SUBCARRIER_HZ, "Hz", hint)
 
 
