@@ -24,7 +24,7 @@ from threadpoolctl import threadpool_limits
 
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce import javelin_tables as jt
-from tunnelkit.studies.drives import route_name
+from tunnelkit.simulation.drives import route_name
 
 SCENARIO, REFERENCE = "italiano2026-straight", "italiano2026_table1"
 CONDITIONS = ("L", "N@0.5", "N", "NoRRMs")

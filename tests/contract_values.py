@@ -233,21 +233,21 @@ def _signal_route():
 
 
 def _studies():
-    from tunnelkit import studies
+    from tunnelkit import simulation
 
-    studies.simulate_routes(
+    simulation.simulate_routes(
         "italiano2026-straight",
         np.random.default_rng(0),
         extractions=("paper",),
         n_epochs=3,
     )
-    from tunnelkit.studies.drives import drive_variant
+    from tunnelkit.simulation.drives import drive_variant
 
     drive_variant("italiano2026-straight", 120.0)
 
 
 def _doppler():
-    from tunnelkit import drive as dv
+    from tunnelkit import doppler_drive as dv
     from tunnelkit.tracking import doppler as dp
 
     d = dv.make_drive(duration=8.0, pass_time=4.0)
@@ -487,7 +487,7 @@ def _baselines_checks():
     from tunnelkit.plots import tables, tracking
     from tunnelkit.report import Report
     from tunnelkit.scenarios.registry import Registry
-    from tunnelkit.studies.drives import Condition
+    from tunnelkit.simulation.drives import Condition
     from tunnelkit.widgets import base
 
     point = dict(R=10.0, W=5.0, y_u=2.0, fc=5.9e9)
@@ -513,7 +513,7 @@ def _baselines_checks():
     schema.Table((key,))
     Registry("tunnel", "a tunnel builder")
     pf.fresnel_topview(8, **point)
-    from tunnelkit import drive as dv
+    from tunnelkit import doppler_drive as dv
     from tunnelkit import montecarlo as mc
     from tunnelkit.tracking import doppler as dp
     from tunnelkit.tracking import virtual_station as vs
@@ -565,8 +565,8 @@ def _traced():
     import tempfile
 
     from tunnelkit.path_consistency import joint_bound, joint_fisher, rate_interval
-    from tunnelkit.studies import traced as tr
-    from tunnelkit.studies.drives import scenario_route
+    from tunnelkit.simulation import traced as tr
+    from tunnelkit.simulation.drives import scenario_route
 
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(10, np.random.default_rng(0), refine="ml")

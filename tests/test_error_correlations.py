@@ -1,4 +1,4 @@
-"""The lag-1 correlation of the errors the tracker is fed (``studies.error_correlations``) and
+"""The lag-1 correlation of the errors the tracker is fed (``simulation.error_correlations``) and
 the long-run inflation of the sigmas it sets (``design_from_errors(correlation=)``), each checked
 on drives whose errors are drawn as AR(1) processes of a known coefficient."""
 
@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tunnelkit.studies.analysis import error_correlations, extraction_errors
-from tunnelkit.studies.drives import DriveData
+from tunnelkit.simulation.analysis import error_correlations, extraction_errors
+from tunnelkit.simulation.drives import DriveData
 from tunnelkit.tracking.javelin import PathMeasurements, designs
 
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tunnelkit.consistency import plane_kinds, tunnel_planes
-from tunnelkit.studies.drives import scenario_route
-from tunnelkit.studies.traced import geometry_keep, geometry_labels, traced_measurements
+from tunnelkit.simulation.drives import scenario_route
+from tunnelkit.simulation.traced import geometry_keep, geometry_labels, traced_measurements
 from tunnelkit.tracking.javelin import (
     FixedNoise,
     JavelinConfig,
@@ -172,8 +172,8 @@ def test_design_from_errors_per_kind():
 def test_a_kind_row_equal_to_the_pooled_sigmas_tracks_exactly_as_the_fixed_noise():
     """Brute force: every path labelled with a kind whose row is the config's own sigmas gives
     the fixed-noise tracker's estimates bit for bit; another row for that kind moves them."""
-    from tunnelkit.studies import simulate_routes
-    from tunnelkit.studies.scoring import evaluate
+    from tunnelkit.simulation import simulate_routes
+    from tunnelkit.simulation.scoring import evaluate
 
     route = scenario_route("italiano2026-straight")
     drive = simulate_routes(route, np.random.default_rng(5), extractions=("ml",), n_epochs=6)["ml"]

@@ -23,7 +23,7 @@ pytest.importorskip("distributed")
 from distributed import LocalCluster
 
 from tunnelkit.cli import main
-from tunnelkit.drive import load_drive_config
+from tunnelkit.doppler_drive import load_drive_config
 from tunnelkit.montecarlo import SchedulerUnreachable, TrialLost, parallel_options, run_trials
 from tunnelkit.reproduce.halili import pooled_errors
 from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows

@@ -44,7 +44,7 @@ RANKS = {
     "reference": 3,
     "propagation": 3,
     "tunnels": 3.5,
-    "drive": 3,
+    "doppler_drive": 3,
     "channel": 4,
     "rt": 4,
     "extraction": 5,
@@ -54,7 +54,7 @@ RANKS = {
     "efficiency": 7,
     "consistency": 3.6,  # the geometry-consistency test of one snapshot's paths (planes only)
     "path_consistency": 7.5,  # the geometry-consistency test on a signal route's epoch
-    "studies": 8,
+    "simulation": 8,
     "design": 9,
     "plots": 10,
     "widgets": 11,

@@ -122,7 +122,7 @@ def run(
     ``nuisance`` (those targets only): the route's ``second_order`` / ``diffuse_floor``
     (:class:`tunnelkit.signal_route.SignalRoute`). ``length`` (the targets whose drive can be
     lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
-    (:func:`tunnelkit.studies.drives.drive_variant`, e.g. 120)."""
+    (:func:`tunnelkit.simulation.drives.drive_variant`, e.g. 120)."""
     if isinstance(name, str) and name in TARGET_MODULES:
         importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
     reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()

@@ -1,7 +1,7 @@
 """A track bound beside the traced JAVELIN RMSEs: the posterior CRLB of the drive at the traced
 sigmas (:func:`traced_pcrlb`).
 
-The traced design (:mod:`tunnelkit.studies.traced`) tells JAVELIN the ML route's RMS extraction
+The traced design (:mod:`tunnelkit.simulation.traced`) tells JAVELIN the ML route's RMS extraction
 error on the ray-traced channel. Fed those sigmas as independent Gaussian errors of every
 first-order path, the design's drive bound (:func:`tunnelkit.design.position_information`,
 :func:`tunnelkit.design.drive_pcrlb`: JAVELIN's motion model on the V2X speed and heading,
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import finite_array
-from ..studies.traced import SIGMA_SCENARIO, traced_errors
+from ..simulation.traced import SIGMA_SCENARIO, traced_errors
 
 __all__ = ["traced_pcrlb"]
 
@@ -28,8 +28,8 @@ def traced_pcrlb(
     """The posterior CRLB (T,) [m] of the 2-D position along ``scenario``'s drive when every
     first-order path (LoS, walls, ceiling, road, RRMs; the image method's, known reflectors) is
     measured at every epoch with independent zero-mean Gaussian errors of the traced sigmas
-    (``rows``: an :func:`~tunnelkit.studies.analysis.extraction_errors` table, its ``"all"`` row;
-    default the stored record, :func:`~tunnelkit.studies.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
+    (``rows``: an :func:`~tunnelkit.simulation.analysis.extraction_errors` table, its ``"all"`` row;
+    default the stored record, :func:`~tunnelkit.simulation.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
     clock bias removed (:func:`tunnelkit.design.position_information`), JAVELIN's motion model
     on the V2X messages and a start of ``sigma_p0`` [m] (:func:`tunnelkit.design.drive_pcrlb`).
     ``array`` is the candidate mounted as the design mounts it (the paper's 10 x 10 by default).

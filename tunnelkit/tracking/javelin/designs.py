@@ -55,7 +55,7 @@ __all__ = [
 
 #: RMS extraction error of the ML route over every matched path (663) of the first three seed-0
 #: LoS drives of each trajectory (``collect_routes(..., seed=0)``, runs 0-2;
-#: :func:`tunnelkit.studies.extraction_errors`, row "all"): what :func:`ours_ml` assumes. Per kind
+#: :func:`tunnelkit.simulation.extraction_errors`, row "all"): what :func:`ours_ml` assumes. Per kind
 #: (phi / psi [deg], kappa / Delta d [m]): LoS 0.34 / 0.33 / 3.0 / -, ceiling 0.054 / 0.16 / 3.2 /
 #: 0.0022, road 0.26 / 0.035 / 5.7 / 0.019, RRM 0.00065 / 0.00048 / 0.11 / 0.0001, wall 0.43 / 1.3
 #: / 0.21 / 0.058. The RMS is set by a few gross errors on the slalom (paths swapped or merged in
@@ -267,14 +267,14 @@ def design_from_errors(
 ) -> JavelinDesign:
     """A design whose measurement noise is the measured extraction error: ``sigma_phi``,
     ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d`` from the ``"all"`` row of
-    :func:`tunnelkit.studies.extraction_errors`; every role and other number from ``base``
+    :func:`tunnelkit.simulation.extraction_errors`; every role and other number from ``base``
     (default :func:`ours_coherent`). ``per_kind``: the noise role becomes
     :class:`~.noise.KindNoise` with each kind's own row (a kind of fewer than
     :data:`MIN_KIND_MATCHED` matched measurements, and a quantity a row leaves empty, keep the
     pooled sigma; no kind with enough: the pooled design); a path the route did not label keeps
     the pooled sigmas; ``base`` must have the paper's noise role (``FixedNoise()``), which this
     replaces. ``correlation``: each quantity's lag-1 error correlation ``r``
-    (:func:`tunnelkit.studies.error_correlations`, ``{"phi", "psi", "kappa", "delta_d"}`` to
+    (:func:`tunnelkit.simulation.error_correlations`, ``{"phi", "psi", "kappa", "delta_d"}`` to
     ``r`` or to ``{"r": r, ...}``): its sigma times ``sqrt((1 + r) / (1 - r))``, the long-run
     standard deviation of an AR(1) error (what averaging over epochs leaves of it; ``r`` clipped
     to ``[0, MAX_CORRELATION]``: a white model for a negative one, and a bias is not AR(1))."""

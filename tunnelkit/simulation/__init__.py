@@ -1,4 +1,4 @@
-"""Studies: the chain run along whole drives, above the trackers and below the design.
+"""The drive simulator: the chain run along whole drives, above the trackers and below the design.
 
 ``drives`` (the one drive simulator and the adapter from extracted paths to tracker
 measurements) · ``scoring`` (JAVELIN / TeNFiLoc on a drive, error metrics, settled errors) ·

@@ -8,9 +8,9 @@ sigmas of 0.23 deg, 0.31 deg, 3.6 m, 3.2 cm) then trusts them far too much. The 
 changes two things, nothing else:
 
 * **measurement noise**: the RMS extraction error of the ML route on the traced channel
-  (:func:`~tunnelkit.studies.analysis.extraction_errors`, all matched paths pooled), each sigma
+  (:func:`~tunnelkit.simulation.analysis.extraction_errors`, all matched paths pooled), each sigma
   times ``sqrt((1 + r) / (1 - r))`` with ``r`` its lag-1 correlation from epoch to epoch
-  (:func:`~tunnelkit.studies.analysis.error_correlations`: the errors of one path repeat, 0.44
+  (:func:`~tunnelkit.simulation.analysis.error_correlations`: the errors of one path repeat, 0.44
   in azimuth and 0.66 in elevation, and a tracker that takes them as white averages them down
   too far), measured by
   :func:`measure_traced_errors` on the straight drive, seed 0, condition L, :data:`SIGMA_RUNS`
@@ -33,8 +33,8 @@ the kind of surface the pre-filter assigns it (:func:`geometry_labels`, ``PathMe
 matched paths (the road bounce for 4 of 38, mostly taken for a wall or the LoS), and a road
 bounce taken for the LoS is given the LoS's 2 deg where it errs by 13.
 
-:func:`simulate_traced` is the drive simulator (:func:`tunnelkit.studies.drives.simulate_routes`)
-with that adapter beside the ordinary one (:func:`tunnelkit.studies.drives.path_measurements`,
+:func:`simulate_traced` is the drive simulator (:func:`tunnelkit.simulation.drives.simulate_routes`)
+with that adapter beside the ordinary one (:func:`tunnelkit.simulation.drives.path_measurements`,
 which drops a flagged epoch), both measuring the ML route's epochs (its ``adapters``): one drive,
 the same random draws as ``simulate_routes(extractions=("paper", "ml"))``, returned as
 ``{"paper", "ml", "ml-all", "ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
@@ -168,7 +168,7 @@ def simulate_traced(
 ) -> dict[str, DriveData]:
     """One drive of ``route`` (a :class:`SignalRoute` or a scenario name, :func:`scenario_route`
     with ``channel`` / ``nuisance``) under ``condition`` (a name of :data:`CONDITIONS`), measured
-    through the paper's and the ML route as :func:`~tunnelkit.studies.drives.simulate_routes`
+    through the paper's and the ML route as :func:`~tunnelkit.simulation.drives.simulate_routes`
     measures them (same draws, same ``"paper"`` and ``"ml"`` drives), plus ``"ml-all"`` (the ML
     route's measurements of every epoch, its fit test ignored) and ``"ml-traced"`` (those the
     geometry pre-filter keeps, :func:`traced_measurements` with ``floors``)."""
@@ -207,8 +207,8 @@ def measure_traced_errors(
     :data:`SIGMA_SCENARIO` on the ray-traced channel (diffuse power as the ML fit's floor; drive
     ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.montecarlo.run_trials`), every
     epoch's ML measurements (``"ml-all"`` of :func:`simulate_traced`), their RMS errors per kind
-    of path (:func:`~tunnelkit.studies.analysis.extraction_errors`) and their lag-1 correlation
-    from epoch to epoch (:func:`~tunnelkit.studies.analysis.error_correlations`). Returns the
+    of path (:func:`~tunnelkit.simulation.analysis.extraction_errors`) and their lag-1 correlation
+    from epoch to epoch (:func:`~tunnelkit.simulation.analysis.error_correlations`). Returns the
     record :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the
     sigmas), ``correlation`` (each sigma's inflation) and the procedure's provenance."""
     from ..montecarlo import run_trials
@@ -227,7 +227,7 @@ def measure_traced_errors(
     corr = error_correlations(drives)
     route = scenario_route(SIGMA_SCENARIO, "exact", "sionna", NUISANCE)
     return {
-        "procedure": "tunnelkit.studies.traced.measure_traced_errors",
+        "procedure": "tunnelkit.simulation.traced.measure_traced_errors",
         "scenario": SIGMA_SCENARIO,
         "condition": "L",
         "seed": seed,

@@ -30,9 +30,9 @@ def simulate_condition(
 ):
     """One drive of condition ``cond`` of ``scenario`` through the signal route on ``channel``
     ("image" or "sionna"), measured through every route in ``extractions``
-    (:func:`~tunnelkit.studies.drives.simulate_routes`); the argument order suits
+    (:func:`~tunnelkit.simulation.drives.simulate_routes`); the argument order suits
     ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``; ``nuisance`` the route's
-    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.studies.drives.scenario_route`)."""
+    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.simulation.drives.scenario_route`)."""
     if cond is not None:
         text("cond", cond)
     return simulate_routes(
@@ -84,7 +84,7 @@ def collect_routes(
 ) -> dict[str, dict[str, list]]:
     """``runs`` seeded drives per condition through the signal route (the expensive part), each
     measured through every route in ``extractions`` from the same tensors
-    (:func:`~tunnelkit.studies.drives.simulate_routes`). One trial of
+    (:func:`~tunnelkit.simulation.drives.simulate_routes`). One trial of
     :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its ``workers`` /
     ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
     the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode); ``channel``
