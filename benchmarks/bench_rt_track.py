@@ -48,8 +48,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
-from tunnelkit.montecarlo import run_trials
 from tunnelkit.path_consistency import epoch_consistency
+from tunnelkit.runner import run_trials
 from tunnelkit.simulation import drives, evaluate
 from tunnelkit.simulation.analysis import extraction_errors
 from tunnelkit.simulation.collect import simulate_condition

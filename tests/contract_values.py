@@ -514,7 +514,7 @@ def _baselines_checks():
     Registry("tunnel", "a tunnel builder")
     pf.fresnel_topview(8, **point)
     from tunnelkit import doppler_drive as dv
-    from tunnelkit import montecarlo as mc
+    from tunnelkit import runner as mc
     from tunnelkit.tracking import doppler as dp
     from tunnelkit.tracking import virtual_station as vs
     from tunnelkit.tracking.doppler import bounds as dpb

@@ -37,6 +37,7 @@ RANKS = {
     "crlb": 1,
     "metrics": 1,
     "montecarlo": 1,
+    "runner": 1.1,  # the Monte-Carlo runner (serial or Dask) over montecarlo's seeds
     "arrays": 1,
     "scenarios": 2,
     "positioning": 2,

@@ -52,7 +52,8 @@ from .._checks import bound_array
 from .._validate import boolean, choice, instance, integer, positive, record
 from ..budget import check_bytes
 from ..metrics import SETTLE_S, settled
-from ..montecarlo import RUN_BYTES, TrialPool, run_trials, trial_pool
+from ..montecarlo import RUN_BYTES
+from ..runner import TrialPool, run_trials, trial_pool
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,

@@ -148,14 +148,14 @@ def measure_design_errors(
 ) -> dict:
     """``spec``'s traced measurement noise, measured: ``runs`` design drives on the ray-traced
     channel (drive ``i`` from the ``i``-th child of ``seed``, as run ``i`` of a sweep on
-    ``seed``: :func:`~tunnelkit.montecarlo.run_trials`), every epoch's ML measurements
+    ``seed``: :func:`~tunnelkit.runner.run_trials`), every epoch's ML measurements
     (``"ml-all"`` of :func:`traced_drive`), their RMS errors per kind of path
     (:func:`~tunnelkit.simulation.analysis.extraction_errors`, the ``"all"`` row the sigmas).
     Returns the record (provenance, ``seed``, ``runs``, ``columns``, ``rows``, the wall time)
     :func:`design_errors` stores."""
     import time
 
-    from ..montecarlo import run_trials
+    from ..runner import run_trials
     from ..simulation.analysis import error_correlations, extraction_errors
 
     setup = _setup(setup)

@@ -13,8 +13,8 @@ import numpy as np
 
 from ..doppler_drive import load_drive_config, make_drive
 from ..metrics import error_stats
-from ..montecarlo import run_trials
 from ..reference import load as load_reference
+from ..runner import run_trials
 from . import Report, register
 
 PAPER = "paper: measured (Beveren)"
@@ -30,7 +30,7 @@ def pooled_errors(
 ) -> dict[tuple[str, str], np.ndarray]:
     """Errors of every (approach, sigma) over ``runs`` synthetic drives, pooled: (runs * T,) each.
 
-    One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its
+    One trial of :func:`~tunnelkit.runner.run_trials` per drive (``parallel``: its
     ``workers`` / ``scheduler`` / ``timeout``). The trackers run as in the paper (no gate) unless
     ``tracker_kw`` says otherwise.
     """

@@ -247,7 +247,7 @@ def javelin_table(
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
     paper's number beside (``n_epochs`` truncates the drives, for quick checks; ``parallel``
-    goes to :func:`~tunnelkit.montecarlo.run_trials`). Each trial simulates one drive and scores
+    goes to :func:`~tunnelkit.runner.run_trials`). Each trial simulates one drive and scores
     it where it ran, so scoring runs in parallel too; the drives are the same as
     :func:`collect_routes`' (drive ``i`` draws from the ``i``-th child of ``seed``) and the table
     equals :func:`table_rows` on them.

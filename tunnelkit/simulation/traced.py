@@ -205,13 +205,13 @@ def measure_traced_errors(
 ) -> dict:
     """The traced design's measurement noise, measured: ``runs`` condition-L drives of
     :data:`SIGMA_SCENARIO` on the ray-traced channel (diffuse power as the ML fit's floor; drive
-    ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.montecarlo.run_trials`), every
+    ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.runner.run_trials`), every
     epoch's ML measurements (``"ml-all"`` of :func:`simulate_traced`), their RMS errors per kind
     of path (:func:`~tunnelkit.simulation.analysis.extraction_errors`) and their lag-1 correlation
     from epoch to epoch (:func:`~tunnelkit.simulation.analysis.error_correlations`). Returns the
     record :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the
     sigmas), ``correlation`` (each sigma's inflation) and the procedure's provenance."""
-    from ..montecarlo import run_trials
+    from ..runner import run_trials
     from .analysis import error_correlations, extraction_errors
 
     runs = integer("runs", runs, minimum=1)
