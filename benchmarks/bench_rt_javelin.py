@@ -4,7 +4,7 @@ A traced drive takes minutes on a loaded machine, so a 20-run table on the ray-t
 not finish in one sitting. Here each drive (table ``T``, seed ``S``, run ``r``, condition ``c``:
 drive ``i = n r + c`` of the table's ``n`` conditions, drawn from the ``i``-th child of the seed
 exactly as :func:`tunnelkit.runner.run_trials` draws it, with one BLAS thread as there) is
-simulated (:func:`tunnelkit.simulation.traced.simulate_traced`: the paper's route, the ML route and
+simulated (:func:`tunnelkit.studies.traced.simulate_traced`: the paper's route, the ML route and
 the traced column's measurements from the same tensors) and scored in every column
 (:func:`tunnelkit.reproduce.javelin_tables.score_drive`), as the reproduce target's trial
 (``javelin_tables._simulate_and_score``) does; the result and the drives (tensors are not kept)
@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce import javelin_tables as jt
 from tunnelkit.simulation.drives import FLAGGED
-from tunnelkit.simulation.traced import simulate_traced
+from tunnelkit.studies.traced import simulate_traced
 
 TABLES = {
     "1": ("italiano2026-straight", "italiano2026_table1", ("L", "N@0.5", "N", "NoRRMs")),

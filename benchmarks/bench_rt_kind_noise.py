@@ -5,7 +5,7 @@ On the ray-traced channel the ML route's errors differ by kind of path: the stor
 and 0.20 m of TDoA, the road bounce at 12.8 / 16.0 deg and 1.6 m, pooled 9.4 / 8.5 deg and 1.09 m.
 The traced design uses the pooled row. Here the tracker instead takes each path's row from the
 kind of surface the geometry pre-filter assigned it
-(:func:`tunnelkit.simulation.traced.geometry_labels`, ``PathMeasurements.kind``,
+(:func:`tunnelkit.simulation.prefilter.geometry_labels`, ``PathMeasurements.kind``,
 :class:`tunnelkit.tracking.javelin.KindNoise`, ``design_from_errors(per_kind=True)``), with the
 rows measured on every epoch (the record) or on the epochs the pre-filter passes.
 
@@ -34,8 +34,9 @@ sys.path.insert(0, str(ROOT))
 
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.simulation.analysis import extraction_errors
+from tunnelkit.simulation.prefilter import NUISANCE
 from tunnelkit.simulation.scoring import evaluate
-from tunnelkit.simulation.traced import NUISANCE, simulate_traced, traced_design, traced_errors
+from tunnelkit.studies.traced import simulate_traced, traced_design, traced_errors
 from tunnelkit.tracking.javelin import designs
 
 TABLES = {"1": ("italiano2026-straight", 4), "2": ("italiano2026-slalom", 3)}  # conditions

@@ -1,10 +1,10 @@
 """The traced design's measurement noise: measure it (and store it with ``--write``).
 
-:func:`tunnelkit.simulation.traced.measure_traced_errors`: the ML route's RMS extraction error on
+:func:`tunnelkit.studies.traced.measure_traced_errors`: the ML route's RMS extraction error on
 the ray-traced channel, condition-L drives of the straight preset, seed 0 (``--runs``, default
-:data:`~tunnelkit.simulation.traced.SIGMA_RUNS`), every epoch's measurements whatever the fit's own
+:data:`~tunnelkit.studies.traced.SIGMA_RUNS`), every epoch's measurements whatever the fit's own
 verdict. ``--write`` stores the record in ``data/rt/traced_errors.json``, which
-:func:`~tunnelkit.simulation.traced.traced_design` (the ``--channel sionna`` tables' traced column)
+:func:`~tunnelkit.studies.traced.traced_design` (the ``--channel sionna`` tables' traced column)
 reads. Deterministic: the same cache and seed give the same numbers.
 
     python benchmarks/bench_rt_sigmas.py --write
@@ -21,7 +21,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from tunnelkit.simulation.traced import SIGMA_RUNS, measure_traced_errors, write_traced_errors
+from tunnelkit.studies.traced import SIGMA_RUNS, measure_traced_errors, write_traced_errors
 
 
 def main(argv=None) -> int:

@@ -565,8 +565,9 @@ def _traced():
     import tempfile
 
     from tunnelkit.path_consistency import joint_bound, joint_fisher, rate_interval
-    from tunnelkit.simulation import traced as tr
+    from tunnelkit.simulation import prefilter as pre
     from tunnelkit.simulation.drives import scenario_route
+    from tunnelkit.studies import traced as tr
 
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(10, np.random.default_rng(0), refine="ml")
@@ -575,9 +576,9 @@ def _traced():
     src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
     joint_fisher([1.0 + 0.5j, 0.5j], src, pos, [-0.7, -1.1], [0.05, -0.02], 4, 3, 0.3, 3.5e9)
     rate_interval(3, 50)
-    tr.geometry_labels(ep, route)
-    tr.geometry_keep(ep, route)
-    pm, _ = tr.traced_measurements(ep, route)
+    pre.geometry_labels(ep, route)
+    pre.geometry_keep(ep, route)
+    pm, _ = pre.traced_measurements(ep, route)
     from tunnelkit.consistency import plane_kinds
     from tunnelkit.tracking.javelin import JavelinConfig, KindNoise
 
@@ -589,8 +590,8 @@ def _traced():
     tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()
-    cur = tr.scene_provenance()
-    tr.check_provenance({"rows": [], **cur}, cur)
+    cur = pre.scene_provenance()
+    pre.check_provenance({"rows": [], **cur}, cur)
     from tunnelkit.reproduce.traced_bound import traced_pcrlb
 
     traced_pcrlb("italiano2026-straight")

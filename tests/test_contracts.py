@@ -259,7 +259,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(r"schema\.Key", r"gt|ge|lt|le", "negative", "a range bound takes any sign"),
     _doc(
-        r"montecarlo\.TrialPool\.(map|prepare|gather)",
+        r"runner\.TrialPool\.(map|prepare|gather)",
         r"items|handles",
         "empty",
         "no items: no tasks, an empty list back",

@@ -20,7 +20,7 @@ from tunnelkit import design
 from tunnelkit.design import traced
 from tunnelkit.rt.cache import CACHE_ENV
 from tunnelkit.simulation import simulate_routes
-from tunnelkit.simulation.traced import geometry_keep
+from tunnelkit.simulation.prefilter import geometry_keep
 from tunnelkit.tracking.javelin.noise import FixedNoise
 
 SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"

@@ -11,7 +11,7 @@ import pytest
 
 from tunnelkit.consistency import plane_kinds, tunnel_planes
 from tunnelkit.simulation.drives import scenario_route
-from tunnelkit.simulation.traced import geometry_keep, geometry_labels, traced_measurements
+from tunnelkit.simulation.prefilter import geometry_keep, geometry_labels, traced_measurements
 from tunnelkit.tracking.javelin import (
     FixedNoise,
     JavelinConfig,

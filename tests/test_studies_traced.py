@@ -12,15 +12,17 @@ import pytest
 
 from tunnelkit.simulation import simulate_routes
 from tunnelkit.simulation.drives import path_measurements, scenario_route
-from tunnelkit.simulation.traced import (
+from tunnelkit.simulation.prefilter import (
     FLOORS,
     check_provenance,
     geometry_keep,
     scene_provenance,
+    traced_measurements,
+)
+from tunnelkit.studies.traced import (
     simulate_traced,
     traced_design,
     traced_errors,
-    traced_measurements,
     write_traced_errors,
 )
 from tunnelkit.tracking.javelin import designs

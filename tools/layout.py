@@ -59,7 +59,8 @@ RANKS = {
     "design": 9,
     "plots": 10,
     "widgets": 11,
-    "reproduce": 12,
+    "studies": 11.5,  # the studies layer: research beside the course, over the core
+    "reproduce": 12,  # the studies layer: the papers' tables (tunnelkit reproduce)
     "commands": 12.5,
     "cli": 13,
     "__main__": 14,

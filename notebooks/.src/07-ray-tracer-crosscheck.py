@@ -640,12 +640,13 @@ for label, snaps in geo.items():
 # For a tracker the test must not drop everything, so its pre-filter form states a model-error
 # floor instead of the bound (`bound=False`, `floor_angle`, `floor_range`): a path is kept when
 # it agrees with the UE hypothesis to within those floors. The traced JAVELIN design
-# (`simulation.traced`) uses `simulation.traced.FLOORS`. Where they sit, computed on these epochs: the
+# (`studies.traced`) uses `simulation.prefilter.FLOORS`. Where they sit, computed on these epochs: the
 # share of paths the pre-filter keeps on each channel, and the traced matched paths' errors
 # against them.
 
 # %%
-from tunnelkit.simulation.traced import FLOORS, geometry_keep, traced_design, traced_errors
+from tunnelkit.simulation.prefilter import FLOORS, geometry_keep
+from tunnelkit.studies.traced import traced_design, traced_errors
 
 err_rt = {"phi": [], "psi": [], "kappa": [], "d": []}  # each traced matched path's error
 for ep in eps_geo["sionna"]:

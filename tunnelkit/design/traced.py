@@ -6,12 +6,12 @@ higher-order bounces, the spatial-wideband term), and every fit fails its own re
 image channel's design tracker takes each path's reported CRLB as its covariance and drops a
 flagged epoch: on this channel it is told micrometres about measurements metres off, or predicts
 only. The traced route changes the same two things the traced JAVELIN tables change
-(:mod:`tunnelkit.simulation.traced`), for each candidate array:
+(:mod:`tunnelkit.studies.traced`), for each candidate array:
 
 * **measurements**: every epoch's ML measurements (fits judged against noise + the epoch's
   diffuse power, ``diffuse_floor``), reduced to the paths that agree with one UE through the
-  tunnel's planes (:func:`tunnelkit.simulation.traced.geometry_keep` with
-  :data:`~tunnelkit.simulation.traced.FLOORS`), whatever the fit's own verdict
+  tunnel's planes (:func:`tunnelkit.simulation.prefilter.geometry_keep` with
+  :data:`~tunnelkit.simulation.prefilter.FLOORS`), whatever the fit's own verdict
   (:func:`traced_drive`);
 * **measurement noise**: the RMS extraction error of THIS array on this channel (the stored
   traced record is the paper array's; a 4x4 and a 16x16 have other errors), measured on the
@@ -92,10 +92,10 @@ def traced_drive(route, rng: np.random.Generator, *, n_epochs: int | None = None
     the image channel's design drive: no condition) measured by the ML route, through
     :func:`tunnelkit.simulation.drives.simulate_routes` with the traced adapters: ``{"ml",
     "ml-all", "ml-traced"}`` (``"ml-all"`` every epoch's ML measurements, its fit test ignored;
-    ``"ml-traced"`` those :func:`~tunnelkit.simulation.traced.geometry_keep` keeps)."""
+    ``"ml-traced"`` those :func:`~tunnelkit.simulation.prefilter.geometry_keep` keeps)."""
     from ..signal_route import SignalRoute
     from ..simulation.drives import simulate_routes
-    from ..simulation.traced import FLOORS, traced_measurements
+    from ..simulation.prefilter import FLOORS, traced_measurements
 
     instance("route", route, SignalRoute)
     if route.raytraced is None:
@@ -122,8 +122,8 @@ def _error_trial(route, n_epochs, _input, rng):
 
 def _provenance(setup: DesignSetup, spec, n_epochs: int | None) -> dict:
     """What a stored record must match: scenario, array, epochs, procedure, nuisance and the
-    scene (:func:`tunnelkit.simulation.traced.scene_provenance` of the array's traced route)."""
-    from ..simulation.traced import scene_provenance
+    scene (:func:`tunnelkit.simulation.prefilter.scene_provenance` of the array's traced route)."""
+    from ..simulation.prefilter import scene_provenance
 
     route = traced_route(setup, spec)
     T = len(setup.trajectory)
@@ -204,7 +204,7 @@ def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) ->
 
 
 def _mismatch(stored: dict, current: dict) -> list[str]:
-    from ..simulation.traced import check_provenance
+    from ..simulation.prefilter import check_provenance
 
     out = []
     for k in ("procedure", "scenario", "array", "n_epochs", "nuisance"):

@@ -22,7 +22,7 @@ from ..reference import load as load_reference
 from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
 from ..simulation.drives import FLAGGED, HELD_OUT_SEED, TUNING_SEEDS, drive_variant
 from ..simulation.scoring import evaluate
-from ..simulation.traced import simulate_traced, traced_design
+from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from . import Report, register
 
@@ -50,8 +50,8 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
 #: the column added when the coherent route was measured too
 COHERENT_COLUMN = ("our design, coherent route", "coherent", "ours-coherent")
 #: the column added on the ray-traced channel: the traced design (measurement noise measured on
-#: that channel, :func:`~tunnelkit.simulation.traced.traced_design`) fed the ML route's measurements
-#: of every epoch that the geometry pre-filter keeps (:func:`~tunnelkit.simulation.traced.simulate_traced`)
+#: that channel, :func:`~tunnelkit.studies.traced.traced_design`) fed the ML route's measurements
+#: of every epoch that the geometry pre-filter keeps (:func:`~tunnelkit.studies.traced.simulate_traced`)
 TRACED_COLUMN = ("traced design + geometry test, ML route", "ml-traced", "traced")
 
 
@@ -383,10 +383,11 @@ _RT_NOTES = [
 
 def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
     """The traced column's note, its numbers read from the stored record (checked against the
-    current scene, :func:`~tunnelkit.simulation.traced.traced_errors`), and whether the table's
+    current scene, :func:`~tunnelkit.studies.traced.traced_errors`), and whether the table's
     route (its nuisance, its ray-tracer settings ``rt_info["rt_settings"]``) is the one they
     were measured on."""
-    from ..simulation.traced import FLOORS, traced_errors
+    from ..simulation.prefilter import FLOORS
+    from ..studies.traced import traced_errors
 
     rec = traced_errors()
     a = {r[0]: r for r in rec["rows"]}["all"]

@@ -1,7 +1,7 @@
 """A track bound beside the traced JAVELIN RMSEs: the posterior CRLB of the drive at the traced
 sigmas (:func:`traced_pcrlb`).
 
-The traced design (:mod:`tunnelkit.simulation.traced`) tells JAVELIN the ML route's RMS extraction
+The traced design (:mod:`tunnelkit.studies.traced`) tells JAVELIN the ML route's RMS extraction
 error on the ray-traced channel. Fed those sigmas as independent Gaussian errors of every
 first-order path, the design's drive bound (:func:`tunnelkit.design.position_information`,
 :func:`tunnelkit.design.drive_pcrlb`: JAVELIN's motion model on the V2X speed and heading,
@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import finite_array
-from ..simulation.traced import SIGMA_SCENARIO, traced_errors
+from ..simulation.prefilter import SIGMA_SCENARIO
+from ..studies.traced import traced_errors
 
 __all__ = ["traced_pcrlb"]
 
@@ -29,7 +30,7 @@ def traced_pcrlb(
     first-order path (LoS, walls, ceiling, road, RRMs; the image method's, known reflectors) is
     measured at every epoch with independent zero-mean Gaussian errors of the traced sigmas
     (``rows``: an :func:`~tunnelkit.simulation.analysis.extraction_errors` table, its ``"all"`` row;
-    default the stored record, :func:`~tunnelkit.simulation.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
+    default the stored record, :func:`~tunnelkit.studies.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
     clock bias removed (:func:`tunnelkit.design.position_information`), JAVELIN's motion model
     on the V2X messages and a start of ``sigma_p0`` [m] (:func:`tunnelkit.design.drive_pcrlb`).
     ``array`` is the candidate mounted as the design mounts it (the paper's 10 x 10 by default).

@@ -1,0 +1,14 @@
+"""Studies: the research beside the course, above the core and below the command line.
+
+What was measured to choose or to check the core, kept so that it can be measured again; the
+core never imports it (``tests/test_layout.py``):
+
+- :mod:`.traced` — the traced error record: the ML route's errors per kind of path on the
+  ray-traced channel, measured, stored with its provenance and read back as the traced design
+  of ``tunnelkit reproduce javelin-table1|2 --channel sionna`` (notebook 07);
+- :mod:`.misspecified` — the misspecified-model bound: the pseudo-true paths of a channel that
+  eq. 1 does not describe and the sandwich bound around them (notebook 07).
+
+The papers' tables (``tunnelkit reproduce``) are :mod:`tunnelkit.reproduce`, the other package of
+this layer.
+"""
