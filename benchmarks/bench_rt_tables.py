@@ -14,7 +14,7 @@ prediction from its start alone. ``--keep-flagged`` is the experiment beside it:
 only, the adapter passes the flagged epochs' measurements on (the same estimates; only the
 ``fit_ok`` verdict is ignored), so the tracker sees what the extraction measured. ``--model-error-share S`` keeps only the
 flagged epochs whose residual passes the test with a stated model-error share ``S`` of the
-received power (:func:`tunnelkit.extraction.misspecified.model_error_test`; the share chosen on
+received power (:func:`tunnelkit.signal_route.judging.model_error_test`; the share chosen on
 the straight drive by ``benchmarks/bench_rt_flags.py``).
 
     python benchmarks/bench_rt_tables.py --runs 2 --drives straight --channels image sionna
@@ -62,10 +62,10 @@ def keep_flagged() -> None:
 def model_error_share(share: float, tally: dict) -> None:
     """Judge the flagged epochs again with a stated model-error share (this process): an epoch
     the extraction flagged carries its measurements when its fit's residual passes
-    :func:`tunnelkit.extraction.misspecified.model_error_test` at ``share`` (against the
+    :func:`tunnelkit.signal_route.judging.model_error_test` at ``share`` (against the
     snapshot's noise power and received energy); ``tally`` counts the epochs passed and kept
     flagged."""
-    from tunnelkit.extraction.misspecified import model_error_test
+    from tunnelkit.signal_route.judging import model_error_test
 
     original = drives.path_measurements
 

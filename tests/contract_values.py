@@ -160,7 +160,7 @@ def _signal_route():
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
     ml_truth(paths, arr, route.config)
-    from tunnelkit.extraction.misspecified import misspecified_bound, parameter_vector, pseudo_true
+    from tunnelkit.studies.misspecified import misspecified_bound, parameter_vector, pseudo_true
 
     small = snap.H[:, :8, :4]
     pt = pseudo_true(
@@ -181,7 +181,7 @@ def _signal_route():
         route.config.noise_power,
     )
     parameter_vector(pt["theta"], pt["mu_f"], pt["mu_t"], pt["c"])
-    from tunnelkit.extraction.misspecified import model_error_test
+    from tunnelkit.signal_route.judging import model_error_test
 
     n0 = route.config.noise_power
     model_error_test(

@@ -497,7 +497,7 @@ for ch, ev in evals.items():
 # changed: its curvature), $B$ the covariance of that log-likelihood's score (its gradient)
 # under the *true* distribution (its mean is zero at $\theta_0$). With the residual
 # $r = H - \mu(\theta_0)$ and $J = \partial\mu/\partial\theta$ at $\theta_0$
-# (`tunnelkit.extraction.misspecified`),
+# (`tunnelkit.studies.misspecified`),
 #
 # $$A = \tfrac{2}{\sigma^2}\Big(\Re\, J^H J - \Re\,\big\langle \tfrac{\partial^2\mu}{\partial
 #   \theta_i \partial\theta_j}, r\big\rangle\Big),\qquad B = \tfrac{2}{\sigma^2}\Re\, J^H J .$$
@@ -519,7 +519,7 @@ for ch, ev in evals.items():
 
 # %%
 from tunnelkit.extraction import ml_truth
-from tunnelkit.extraction.misspecified import misspecified_bound, pseudo_true
+from tunnelkit.studies.misspecified import misspecified_bound, pseudo_true
 
 k8 = 0
 arr8, paths8 = route_rt.paths(k8)
