@@ -154,9 +154,6 @@ def _signal_route():
     arr, paths = route.paths(10)
     snap = route.snapshot(paths, arr, rng)
     route.ml_noise_power(10, snap)
-    with warnings.catch_warnings():  # two paths of five: the fit's own test fails, as it should
-        warnings.simplefilter("ignore")
-        signal_route.glrt_paths(snap.H[:, :8, :4], arr, route.config, 1, 2)
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
     ml_truth(paths, arr, route.config)
