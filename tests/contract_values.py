@@ -575,15 +575,10 @@ def _traced():
     rate_interval(3, 50)
     pre.geometry_labels(ep, route)
     pre.geometry_keep(ep, route)
-    pm, _ = pre.traced_measurements(ep, route)
+    pre.traced_measurements(ep, route)
     from tunnelkit.consistency import plane_kinds
-    from tunnelkit.tracking.javelin import JavelinConfig, KindNoise
 
     plane_kinds(route.tunnel)
-    pm.with_kinds(list(pm.kind))
-    kn = KindNoise((("los", 0.01, 0.02, 30.0, 0.2),))
-    kn.covariances(pm, JavelinConfig())
-    kn.tdoa_covariance(pm, list(range(1, len(pm))), 0, JavelinConfig())
     tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()

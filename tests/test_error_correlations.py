@@ -93,9 +93,6 @@ def test_the_sigmas_take_the_long_run_inflation():
     assert got.sigma_psi == pytest.approx(white.sigma_psi)  # negative: white
     assert got.sigma_kappa == pytest.approx(white.sigma_kappa * np.sqrt(1.9 / 0.1))  # clipped
     assert got.sigma_delta_d == pytest.approx(white.sigma_delta_d)  # NaN: not measured
-    kinds = designs.design_from_errors(ROWS, base=base, per_kind=True, correlation={"phi": 0.6})
-    los = {r[0]: r[1:] for r in kinds.noise.sigmas}["los"]
-    assert los[0] == pytest.approx(np.radians(2.0) * 2.0)
 
 
 @pytest.mark.parametrize(

@@ -86,9 +86,8 @@ def traced_measurements(
     ep: Epoch, route: SignalRoute, floors=FLOORS, *, prefilter: bool = True
 ) -> tuple[PathMeasurements | None, str | None]:
     """The traced design's adapter: ``ep``'s measurements whatever its fit's own verdict
-    (``fit_ok``), reduced to the rows :func:`geometry_labels` keeps, each labelled with the kind
-    of surface the test assigned it (``PathMeasurements.kind``, what a per-kind noise model
-    reads); ``prefilter=False``: all rows, unlabelled. ``(None, reason)`` when no row is left."""
+    (``fit_ok``), reduced to the rows :func:`geometry_keep` keeps; ``prefilter=False``: all rows.
+    ``(None, reason)`` when no row is left."""
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)
     prefilter = boolean("prefilter", prefilter)
@@ -98,13 +97,10 @@ def traced_measurements(
     )
     if not prefilter:
         return pm, None
-    keep, kinds = geometry_labels(ep, route, floors)
-    rows = np.flatnonzero(np.isin(pm.source, keep))
+    rows = np.flatnonzero(np.isin(pm.source, geometry_keep(ep, route, floors)))
     if not rows.size:
         return None, "the geometry test kept no path"
-    label = np.full(len(m), "", dtype=object)
-    label[keep] = kinds
-    return pm.with_kinds(list(label[pm.source])).subset(rows), None
+    return pm.subset(rows), None
 
 
 def scene_provenance(route=None) -> dict:

@@ -25,13 +25,12 @@ changes two things, nothing else:
   test still carries its measurements (on this channel every fit fails it: the test judges eq. 1,
   not the paths the tracker needs).
 
-The noise stays pooled over the kinds of path. One sigma set per kind, each path's taken from
-the kind of surface the pre-filter assigns it (:func:`~tunnelkit.simulation.prefilter.geometry_labels`, ``PathMeasurements.kind``,
-:class:`~tunnelkit.tracking.javelin.KindNoise`), was measured and is worse
-(``benchmarks/bench_rt_kind_noise.py``, held-out seed, 4 drives per table: JAVELIN-L 0.556 /
-0.563 m against 0.167 / 0.309 m pooled): the assigned kind is the true one for 58 % of the
-matched paths (the road bounce for 4 of 38, mostly taken for a wall or the LoS), and a road
-bounce taken for the LoS is given the LoS's 2 deg where it errs by 13.
+The noise stays pooled over the kinds of path. One sigma set per kind of path, each path's
+taken from the kind of surface the pre-filter assigns it, was measured and is worse (held-out
+seed, 4 drives per table: JAVELIN-L 0.556 / 0.563 m against 0.167 / 0.309 m pooled): the
+assigned kind is the true one for 58 % of the matched paths (the road bounce for 4 of 38, mostly
+taken for a wall or the LoS), and a road bounce taken for the LoS is given the LoS's 2 deg where
+it errs by 13. That per-kind noise model was removed with its benchmark.
 
 :func:`simulate_traced` is the drive simulator (:func:`tunnelkit.simulation.drives.simulate_routes`)
 with that adapter beside the ordinary one (:func:`tunnelkit.simulation.drives.path_measurements`,
