@@ -831,7 +831,7 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "run_trials[runs=1e12]",
-            lambda: _mod("montecarlo").run_trials(lambda r: 0, 10**12, 0),
+            lambda: _mod("runner").run_trials(lambda r: 0, 10**12, 0),
             ("runs", "n"),
             heavy=True,
         )
@@ -839,13 +839,13 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "run_trials[runs=True]",
-            lambda: _mod("montecarlo").run_trials(lambda r: 0, True, 0),
+            lambda: _mod("runner").run_trials(lambda r: 0, True, 0),
             ("runs", "n"),
         )
     )
     c.append(
         Case(
-            "run_trials[trial=None]", lambda: _mod("montecarlo").run_trials(None, 2, 0), ("trial",)
+            "run_trials[trial=None]", lambda: _mod("runner").run_trials(None, 2, 0), ("trial",)
         )
     )
     c.append(Case("mc_count[full=1.5]", lambda: _mod("montecarlo").mc_count(1.5, 1), ("full",)))
