@@ -844,9 +844,7 @@ def build_cases() -> list[Case]:
         )
     )
     c.append(
-        Case(
-            "run_trials[trial=None]", lambda: _mod("runner").run_trials(None, 2, 0), ("trial",)
-        )
+        Case("run_trials[trial=None]", lambda: _mod("runner").run_trials(None, 2, 0), ("trial",))
     )
     c.append(Case("mc_count[full=1.5]", lambda: _mod("montecarlo").mc_count(1.5, 1), ("full",)))
 
