@@ -584,7 +584,7 @@ def _traced():
     tr.traced_design()
     cur = pre.scene_provenance()
     pre.check_provenance({"rows": [], **cur}, cur)
-    from tunnelkit.reproduce.traced_bound import traced_pcrlb
+    from tunnelkit.studies.traced_bound import traced_pcrlb
 
     traced_pcrlb("italiano2026-straight")
 

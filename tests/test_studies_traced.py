@@ -238,8 +238,8 @@ def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypat
     import tunnelkit.design as design
     from tunnelkit.design import DesignSetup, drive_pcrlb
     from tunnelkit.design.drivebound import drive_motion
-    from tunnelkit.reproduce.traced_bound import traced_pcrlb
     from tunnelkit.simulation.drives import SIGMA_HEADING, SIGMA_SPEED
+    from tunnelkit.studies.traced_bound import traced_pcrlb
 
     rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
     seen = {}

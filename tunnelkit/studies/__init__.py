@@ -6,6 +6,8 @@ core never imports it (``tests/test_layout.py``):
 - :mod:`.traced` — the traced error record: the ML route's errors per kind of path on the
   ray-traced channel, measured, stored with its provenance and read back as the traced design
   of ``tunnelkit reproduce javelin-table1|2 --channel sionna`` (notebook 07);
+- :mod:`.traced_bound` — the posterior CRLB of a drive at the traced sigmas, beside the traced
+  JAVELIN RMSEs;
 - :mod:`.misspecified` — the misspecified-model bound: the pseudo-true paths of a channel that
   eq. 1 does not describe and the sandwich bound around them (notebook 07).
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._validate import finite_array
 from ..simulation.prefilter import SIGMA_SCENARIO
-from ..studies.traced import traced_errors
+from .traced import traced_errors
 
 __all__ = ["traced_pcrlb"]
 
