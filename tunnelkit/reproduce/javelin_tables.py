@@ -406,7 +406,7 @@ def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
         "JAVELIN-L run 0 at that seed is child 0, one of those drives)"
         + (
             f", each sigma times sqrt((1 + r) / (1 - r)) for the lag-1 correlation r of one "
-            f"path's errors from epoch to epoch ({r_txt}; studies.error_correlations)"
+            f"path's errors from epoch to epoch ({r_txt}; simulation.error_correlations)"
             if r_txt
             else ""
         )
