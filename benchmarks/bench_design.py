@@ -274,7 +274,7 @@ def _timed(workers, mode, arrays, runs, n_epochs, warm: bool, schedulers=None) -
 
     from tunnelkit.design import DesignSetup
     from tunnelkit.design.montecarlo import sweep_montecarlo
-    from tunnelkit.montecarlo import trial_pool
+    from tunnelkit.runner import trial_pool
 
     setup = DesignSetup.from_scenario("example-rectangular-28ghz")
     kw = dict(mode=mode, n_epochs=n_epochs)

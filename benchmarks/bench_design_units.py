@@ -296,7 +296,7 @@ def coverage(
         sweep_montecarlo,
     )
     from tunnelkit.design.units import unit_quantiles, unit_yield, wilson_interval
-    from tunnelkit.montecarlo import trial_pool
+    from tunnelkit.runner import trial_pool
 
     setup = _setup("base")
     out = []

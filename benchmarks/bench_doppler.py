@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from run import Case
 
-from tunnelkit import drive as dv
-from tunnelkit.drive import route
+from tunnelkit import doppler_drive as dv
+from tunnelkit.doppler_drive import drive as drive_model
 from tunnelkit.tracking import doppler as dp
 
 
@@ -15,7 +15,7 @@ def cases() -> list[Case]:
     rng = np.random.default_rng(0)
     meas = dv.measure(d, rng)
     fix = dv.gnss_fix(d, rng)
-    key = route._config_key(d.config)
+    key = drive_model._config_key(d.config)
 
     def three():
         return dp.run_approaches(d, meas, fix, sigma_hz=32.79)
@@ -35,7 +35,7 @@ def cases() -> list[Case]:
         ),
         Case(
             "channel: image method + CIR/Doppler peaks",
-            lambda: route._make_drive_cached.__wrapped__(key),
+            lambda: drive_model._make_drive_cached.__wrapped__(key),
             group="doppler_parts",
             baseline=True,
             repeat=5,

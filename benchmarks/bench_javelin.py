@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from run import Case
 
-from tunnelkit import studies as ex
+from tunnelkit import simulation as ex
 from tunnelkit.tracking.javelin import Javelin, JavelinWarning, PathMeasurements, designs
 from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 

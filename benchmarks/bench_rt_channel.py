@@ -19,10 +19,7 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    ``image``, ``sionna`` (first-order model), ``sionna_floor`` (the same, its fit tested against
    noise + diffuse power, ``SignalRoute(diffuse_floor=True)``), ``sionna_2nd`` (the model also
    carries the ``--second-order`` strongest second-order images, ``SignalRoute(second_order=N)``;
-   the bound is then the whole model's CRLB), ``sionna_2nd_floor`` (both) and
-   ``sionna_glrt_floor`` (the model order by a detection test per added path from the
-   first-order paths up to ``--max-paths``, ``SignalRoute(model_order="glrt")``, with the
-   diffuse floor). Also the draws each route's extraction flags (``fit_ok`` False), per epoch,
+   the bound is then the whole model's CRLB) and ``sionna_2nd_floor`` (both). Also the draws each route's extraction flags (``fit_ok`` False), per epoch,
    the number of paths each route extracted and its seconds per epoch.
 3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
    direct path-by-path sum against the non-uniform FFT (``method="nufft"``, ``eps=1e-9``), on
@@ -112,7 +109,6 @@ ROUTES = (
     "sionna_floor",
     "sionna_2nd",
     "sionna_2nd_floor",
-    "sionna_glrt_floor",
 )
 
 
@@ -123,7 +119,6 @@ def extraction_study(
     seed: int,
     second_order: int,
     which=ROUTES,
-    max_paths: int = 16,
     epochs=None,
 ) -> dict:
     """Normalised errors of the first-order paths on both channels (same rng per draw), and on
@@ -140,9 +135,6 @@ def extraction_study(
         "sionna_2nd": srt2,
         "sionna_2nd_floor": SignalRoute.from_scenario(
             name, channel="sionna", second_order=second_order, diffuse_floor=True
-        ),
-        "sionna_glrt_floor": SignalRoute.from_scenario(
-            name, channel="sionna", diffuse_floor=True, model_order="glrt", max_paths=max_paths
         ),
     }
     routes = {key: r for key, r in routes.items() if key in which}
@@ -290,7 +282,6 @@ def main(argv=None) -> int:
     )
     ap.add_argument("--drives", nargs="+", default=list(DRIVES), choices=DRIVES)
     ap.add_argument("--routes", nargs="+", default=list(ROUTES), choices=ROUTES)
-    ap.add_argument("--max-paths", type=int, default=16, help="L_max of the glrt route")
     ap.add_argument("--epochs", type=int, nargs="+", default=None, help="these epochs only")
     ap.add_argument("--json", type=Path, default=None)
     a = ap.parse_args(argv)
@@ -312,7 +303,6 @@ def main(argv=None) -> int:
                 a.seed,
                 a.second_order,
                 a.routes,
-                a.max_paths,
                 a.epochs,
             )
             for n in a.drives

@@ -16,7 +16,7 @@ array's drive). ``--start-sigma`` sets the entry fix (the CLI's ``--start-sigma`
     python benchmarks/bench_rt_design.py --from-json build/sweep-image.json build/sweep-sionna-*.json
 
 Choose on seed 0 (the traced errors are measured there), report on a seed never looked at
-(:data:`tunnelkit.studies.HELD_OUT_SEED` by default).
+(:data:`tunnelkit.simulation.HELD_OUT_SEED` by default).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit import design
-from tunnelkit.studies import HELD_OUT_SEED
+from tunnelkit.simulation import HELD_OUT_SEED
 
 
 def run_sweep(

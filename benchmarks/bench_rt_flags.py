@@ -3,7 +3,7 @@
 Reads the JSON of ``benchmarks/bench_rt_mcrb.py`` for a drive to choose on (the straight drive)
 and a held-out drive (the slalom). The share is chosen as the smallest that lets every fit of the
 choosing drive whose noise-free limit is the pseudo-true point pass: the residual at the
-pseudo-true paths and the local fits about them (:func:`tunnelkit.extraction.misspecified.model_error_test`;
+pseudo-true paths and the local fits about them (:func:`tunnelkit.signal_route.judging.model_error_test`;
 ``--margin`` multiplies it). On the held-out drive, per epoch: the share of fits the test flags
 (local fits about the pseudo-true point and the route's full extraction), and, over the fits whose
 first-order delays lie beyond ``--z`` MCRB standard deviations of the pseudo-true ones, how many

@@ -3,7 +3,7 @@
 A traced drive takes minutes on a loaded machine, so a 20-run table on the ray-traced channel may
 not finish in one sitting. Here each drive (table ``T``, seed ``S``, run ``r``, condition ``c``:
 drive ``i = n r + c`` of the table's ``n`` conditions, drawn from the ``i``-th child of the seed
-exactly as :func:`tunnelkit.montecarlo.run_trials` draws it, with one BLAS thread as there) is
+exactly as :func:`tunnelkit.runner.run_trials` draws it, with one BLAS thread as there) is
 simulated (:func:`tunnelkit.studies.traced.simulate_traced`: the paper's route, the ML route and
 the traced column's measurements from the same tensors) and scored in every column
 (:func:`tunnelkit.reproduce.javelin_tables.score_drive`), as the reproduce target's trial
@@ -37,7 +37,7 @@ sys.path.insert(0, str(ROOT))
 
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce import javelin_tables as jt
-from tunnelkit.studies.drives import FLAGGED
+from tunnelkit.simulation.drives import FLAGGED
 from tunnelkit.studies.traced import simulate_traced
 
 TABLES = {

@@ -3,9 +3,9 @@
 Per epoch of a drive (``channel="sionna"``, cached traces, transmit power included):
 
 1. the pseudo-true first-order paths ``phi_0`` of the noiseless traced tensor: the ML fit of eq. 1
-   started at the true first-order paths (:func:`tunnelkit.extraction.misspecified.pseudo_true`),
+   started at the true first-order paths (:func:`tunnelkit.studies.misspecified.pseudo_true`),
    the bias ``phi_0 - phi`` and the sandwich bound at ``phi_0``
-   (:func:`~tunnelkit.extraction.misspecified.misspecified_bound`) beside eq. 1's CRLB there;
+   (:func:`~tunnelkit.studies.misspecified.misspecified_bound`) beside eq. 1's CRLB there;
    ``residual`` ``||H - mu(phi_0)||^2`` per sample over ``N0`` and as a share of the received
    power (the model-error share the residual test below is given);
 2. ``--draws`` noisy snapshots (noise drawn on the cached tensor, no clock bias): the ML fit started
@@ -43,9 +43,10 @@ sys.path.insert(0, str(ROOT))
 from tunnelkit.constants import C
 from tunnelkit.evaluation import match_paths
 from tunnelkit.extraction import ml_truth
-from tunnelkit.extraction.misspecified import misspecified_bound, model_error_test, pseudo_true
 from tunnelkit.extraction.ml import Problem, fit_problem
 from tunnelkit.signal_route import SignalRoute, measurements_from_estimates
+from tunnelkit.signal_route.judging import model_error_test
+from tunnelkit.studies.misspecified import misspecified_bound, pseudo_true
 
 
 def needed_share(resid, n_paths, y2, pos, fc, n0) -> dict:

@@ -2,19 +2,19 @@
 
 For each drive (straight = Table 1, slalom = Table 2), channel (``image``: eq. 1 from the image
 method; ``sionna``: the cached ray-traced tensor, diffuse scattering on, the ML fit tested against
-noise + diffuse power) and seed (0 and :data:`tunnelkit.studies.HELD_OUT_SEED`), ``--runs``
+noise + diffuse power) and seed (0 and :data:`tunnelkit.simulation.HELD_OUT_SEED`), ``--runs``
 drives through the ML route (:func:`tunnelkit.reproduce.javelin_tables.javelin_table`,
 condition L): the table's JAVELIN-L and TeNFiLoc-L rows, the epochs the extraction flagged, the
 wall time.
 
 On the ray-traced channel every epoch fails the extraction's residual test
 (``benchmarks/bench_rt_residual.py`` says why), and a flagged epoch carries no measurement
-(:func:`tunnelkit.studies.drives.path_measurements`): the table then scores the tracker's
+(:func:`tunnelkit.simulation.drives.path_measurements`): the table then scores the tracker's
 prediction from its start alone. ``--keep-flagged`` is the experiment beside it: in this process
 only, the adapter passes the flagged epochs' measurements on (the same estimates; only the
 ``fit_ok`` verdict is ignored), so the tracker sees what the extraction measured. ``--model-error-share S`` keeps only the
 flagged epochs whose residual passes the test with a stated model-error share ``S`` of the
-received power (:func:`tunnelkit.extraction.misspecified.model_error_test`; the share chosen on
+received power (:func:`tunnelkit.signal_route.judging.model_error_test`; the share chosen on
 the straight drive by ``benchmarks/bench_rt_flags.py``).
 
     python benchmarks/bench_rt_tables.py --runs 2 --drives straight --channels image sionna
@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.reproduce.javelin_tables import javelin_table
-from tunnelkit.studies import HELD_OUT_SEED, drives
+from tunnelkit.simulation import HELD_OUT_SEED, drives
 
 TABLES = {
     "straight": ("italiano2026-straight", "italiano2026_table1"),
@@ -62,10 +62,10 @@ def keep_flagged() -> None:
 def model_error_share(share: float, tally: dict) -> None:
     """Judge the flagged epochs again with a stated model-error share (this process): an epoch
     the extraction flagged carries its measurements when its fit's residual passes
-    :func:`tunnelkit.extraction.misspecified.model_error_test` at ``share`` (against the
+    :func:`tunnelkit.signal_route.judging.model_error_test` at ``share`` (against the
     snapshot's noise power and received energy); ``tally`` counts the epochs passed and kept
     flagged."""
-    from tunnelkit.extraction.misspecified import model_error_test
+    from tunnelkit.signal_route.judging import model_error_test
 
     original = drives.path_measurements
 

@@ -15,7 +15,7 @@ flagged epochs pass there) are measured once; the same measurements are then sco
   (:func:`tunnelkit.path_consistency.epoch_consistency` with model-error floors, no oracle);
 * ``no curvature``: every path's curvature removed (far-field: angles and delay only);
 * ``all-path sigmas`` / ``kept-path sigmas``: the design's measurement noise set to the RMS
-  extraction error on these traced drives (:func:`tunnelkit.studies.analysis.extraction_errors`,
+  extraction error on these traced drives (:func:`tunnelkit.simulation.analysis.extraction_errors`,
   :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`) of every matched path, or of
   the paths the geometry test keeps; in-sample unless ``--sigmas`` / ``--sigmas-kept`` give them
   (measured on another drive or seed), alone and with the geometry test;
@@ -48,11 +48,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
-from tunnelkit.montecarlo import run_trials
 from tunnelkit.path_consistency import epoch_consistency
-from tunnelkit.studies import drives, evaluate
-from tunnelkit.studies.analysis import extraction_errors
-from tunnelkit.studies.collect import simulate_condition
+from tunnelkit.runner import run_trials
+from tunnelkit.simulation import drives, evaluate
+from tunnelkit.simulation.analysis import extraction_errors
+from tunnelkit.simulation.collect import simulate_condition
 from tunnelkit.tracking.javelin import designs
 from tunnelkit.tracking.javelin.designs import design_from_errors
 

@@ -11,7 +11,7 @@ first-order paths (no re-seeding, converged far below the noise):
 * ``+ wideband``: that plus the spatial-wideband term (the term alone);
 * ``full``: the whole traced tensor (second-order and diffuse paths, per-element gains too);
 
-each by the eq. 1 model (:func:`tunnelkit.extraction.misspecified.pseudo_true`: its pseudo-true
+each by the eq. 1 model (:func:`tunnelkit.studies.misspecified.pseudo_true`: its pseudo-true
 paths) and by the model with the spatial-wideband term (the ML option ``wideband=True``,
 :class:`tunnelkit.extraction.ml.WidebandProblem`, fitted by
 :func:`tunnelkit.extraction.ml.fit_problem` from the same start). Printed: per path the delay
@@ -36,9 +36,9 @@ sys.path.insert(0, str(ROOT))
 from tunnelkit.channel import channel_tensor
 from tunnelkit.constants import C
 from tunnelkit.extraction import ml_truth
-from tunnelkit.extraction.misspecified import pseudo_true
 from tunnelkit.extraction.ml import WidebandProblem, fit_problem
 from tunnelkit.signal_route import SignalRoute
+from tunnelkit.studies.misspecified import pseudo_true
 
 
 def wideband_pseudo_true(H, pos, cfg, start, n0):

@@ -3,7 +3,7 @@
 The reproduce target runs all ``runs x 4`` drives in one call and reports at the end; a 120 m
 drive takes minutes on a loaded machine, so 20 runs may not finish in one sitting. Here each drive
 (run ``r``, condition ``c``: drive ``i = 4 r + c``, drawn from the ``i``-th child of the seed,
-exactly as :func:`tunnelkit.montecarlo.run_trials` draws it, with one BLAS thread as there) is simulated and scored alone and its
+exactly as :func:`tunnelkit.runner.run_trials` draws it, with one BLAS thread as there) is simulated and scored alone and its
 result saved to ``DIR/seed<S>/drive<i>.pkl``; ``--report`` assembles the table from the whole runs
 saved so far. The table of ``k`` whole runs is the one ``tunnelkit reproduce javelin-table1
 --length L --runs k --seed S`` prints (same drives, same aggregation).
@@ -24,7 +24,7 @@ from threadpoolctl import threadpool_limits
 
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce import javelin_tables as jt
-from tunnelkit.studies.drives import route_name
+from tunnelkit.simulation.drives import route_name
 
 SCENARIO, REFERENCE = "italiano2026-straight", "italiano2026_table1"
 CONDITIONS = ("L", "N@0.5", "N", "NoRRMs")

@@ -26,7 +26,7 @@ import warnings
 
 import numpy as np
 
-from tunnelkit import drive as dv
+from tunnelkit import doppler_drive as dv
 from tunnelkit.constants import C
 from tunnelkit.tracking import registry
 from tunnelkit.tracking import virtual_station as vs

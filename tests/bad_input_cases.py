@@ -831,7 +831,7 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "run_trials[runs=1e12]",
-            lambda: _mod("montecarlo").run_trials(lambda r: 0, 10**12, 0),
+            lambda: _mod("runner").run_trials(lambda r: 0, 10**12, 0),
             ("runs", "n"),
             heavy=True,
         )
@@ -839,14 +839,12 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "run_trials[runs=True]",
-            lambda: _mod("montecarlo").run_trials(lambda r: 0, True, 0),
+            lambda: _mod("runner").run_trials(lambda r: 0, True, 0),
             ("runs", "n"),
         )
     )
     c.append(
-        Case(
-            "run_trials[trial=None]", lambda: _mod("montecarlo").run_trials(None, 2, 0), ("trial",)
-        )
+        Case("run_trials[trial=None]", lambda: _mod("runner").run_trials(None, 2, 0), ("trial",))
     )
     c.append(Case("mc_count[full=1.5]", lambda: _mod("montecarlo").mc_count(1.5, 1), ("full",)))
 
@@ -855,39 +853,45 @@ def build_cases() -> list[Case]:
     _array_cases(
         c,
         "slant_range",
-        lambda: _mod("drive").slant_range,
+        lambda: _mod("doppler_drive").slant_range,
         {"p": [[10.0, -2.5]], "tx": tx},
         ["p", "tx"],
     )
     _scalar_cases(
         c,
         "slant_range",
-        lambda: _mod("drive").slant_range,
+        lambda: _mod("doppler_drive").slant_range,
         {"p": [[10.0, -2.5]], "tx": tx, "dz": 2.5},
         ["dz"],
         {k: v for k, v in SCALAR_BAD.items() if k != "none"},
     )
     dsg = {"p": [[10.0, -2.5]], "v": [[25.0, 0.0]], "tx": tx, "fc": 1.35e9, "dz": 2.5}
-    _array_cases(c, "doppler_shift", lambda: _mod("drive").doppler_shift, dsg, ["p", "v", "tx"])
-    _scalar_cases(c, "doppler_shift", lambda: _mod("drive").doppler_shift, dsg, ["fc", "dz"])
+    _array_cases(
+        c, "doppler_shift", lambda: _mod("doppler_drive").doppler_shift, dsg, ["p", "v", "tx"]
+    )
+    _scalar_cases(
+        c, "doppler_shift", lambda: _mod("doppler_drive").doppler_shift, dsg, ["fc", "dz"]
+    )
     c.append(
         Case(
             "doppler_shift[fc=-1e9]",
-            lambda: _mod("drive").doppler_shift(**{**dsg, "fc": -1e9}),
+            lambda: _mod("doppler_drive").doppler_shift(**{**dsg, "fc": -1e9}),
             ("fc",),
         )
     )
     c.append(
         Case(
             "doppler_shift[fc=0]",
-            lambda: _mod("drive").doppler_shift(**{**dsg, "fc": 0.0}),
+            lambda: _mod("doppler_drive").doppler_shift(**{**dsg, "fc": 0.0}),
             ("fc",),
         )
     )
     c.append(
         Case(
             "doppler_shift[at tx, dz=0]",
-            lambda: _mod("drive").doppler_shift([[0.0, 4.5]], [[1.0, 0.0]], tx, 1.35e9, 0.0),
+            lambda: _mod("doppler_drive").doppler_shift(
+                [[0.0, 4.5]], [[1.0, 0.0]], tx, 1.35e9, 0.0
+            ),
             ("p", "tx", "dz"),
         )
     )

@@ -106,7 +106,7 @@ def design_traced():
 def tracking_pieces():
     """A costs matrix, a measured birth, TeNFiLoc and JAVELIN on a short simulated drive, the
     UPF's pieces and the joint innovation test."""
-    from tunnelkit import studies
+    from tunnelkit import simulation
     from tunnelkit.tracking import upf
     from tunnelkit.tracking import virtual_station as vs
     from tunnelkit.tracking.javelin import (
@@ -134,7 +134,7 @@ def tracking_pieces():
     JointTestUpdater().stack(st.x, st.P, pred, J, pm, [(0, 0), (1, 1)], cfg, 0, None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        drive = studies.simulate_drive("italiano2026-straight", rng, n_epochs=4)
+        drive = simulation.simulate_drive("italiano2026-straight", rng, n_epochs=4)
         TeNFiLoc.for_drive(drive).track(drive)
         Javelin.for_drive(drive).track(drive)
     exp = vs.experiment("jiang2023-straight")

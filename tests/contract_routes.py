@@ -54,7 +54,7 @@ def route_rt():
     import tunnelkit as tk
     from tunnelkit import rt
     from tunnelkit.constants import C
-    from tunnelkit.drive import delay_doppler_profiles, make_drive
+    from tunnelkit.doppler_drive import delay_doppler_profiles, make_drive
     from tunnelkit.rt import mitsuba
 
     sc = tk.load_scenario("italiano2026-straight")

@@ -154,13 +154,10 @@ def _signal_route():
     arr, paths = route.paths(10)
     snap = route.snapshot(paths, arr, rng)
     route.ml_noise_power(10, snap)
-    with warnings.catch_warnings():  # two paths of five: the fit's own test fails, as it should
-        warnings.simplefilter("ignore")
-        signal_route.glrt_paths(snap.H[:, :8, :4], arr, route.config, 1, 2)
     extract_paths(snap.H, len(paths), arr, route.config, refine="joint")
     path_crlb(paths, arr, route.config)
     ml_truth(paths, arr, route.config)
-    from tunnelkit.extraction.misspecified import misspecified_bound, parameter_vector, pseudo_true
+    from tunnelkit.studies.misspecified import misspecified_bound, parameter_vector, pseudo_true
 
     small = snap.H[:, :8, :4]
     pt = pseudo_true(
@@ -181,7 +178,7 @@ def _signal_route():
         route.config.noise_power,
     )
     parameter_vector(pt["theta"], pt["mu_f"], pt["mu_t"], pt["c"])
-    from tunnelkit.extraction.misspecified import model_error_test
+    from tunnelkit.signal_route.judging import model_error_test
 
     n0 = route.config.noise_power
     model_error_test(
@@ -233,21 +230,21 @@ def _signal_route():
 
 
 def _studies():
-    from tunnelkit import studies
+    from tunnelkit import simulation
 
-    studies.simulate_routes(
+    simulation.simulate_routes(
         "italiano2026-straight",
         np.random.default_rng(0),
         extractions=("paper",),
         n_epochs=3,
     )
-    from tunnelkit.studies.drives import drive_variant
+    from tunnelkit.simulation.drives import drive_variant
 
     drive_variant("italiano2026-straight", 120.0)
 
 
 def _doppler():
-    from tunnelkit import drive as dv
+    from tunnelkit import doppler_drive as dv
     from tunnelkit.tracking import doppler as dp
 
     d = dv.make_drive(duration=8.0, pass_time=4.0)
@@ -487,7 +484,7 @@ def _baselines_checks():
     from tunnelkit.plots import tables, tracking
     from tunnelkit.report import Report
     from tunnelkit.scenarios.registry import Registry
-    from tunnelkit.studies.drives import Condition
+    from tunnelkit.simulation.drives import Condition
     from tunnelkit.widgets import base
 
     point = dict(R=10.0, W=5.0, y_u=2.0, fc=5.9e9)
@@ -513,8 +510,8 @@ def _baselines_checks():
     schema.Table((key,))
     Registry("tunnel", "a tunnel builder")
     pf.fresnel_topview(8, **point)
-    from tunnelkit import drive as dv
-    from tunnelkit import montecarlo as mc
+    from tunnelkit import doppler_drive as dv
+    from tunnelkit import runner as mc
     from tunnelkit.tracking import doppler as dp
     from tunnelkit.tracking import virtual_station as vs
     from tunnelkit.tracking.doppler import bounds as dpb
@@ -565,8 +562,9 @@ def _traced():
     import tempfile
 
     from tunnelkit.path_consistency import joint_bound, joint_fisher, rate_interval
+    from tunnelkit.simulation import prefilter as pre
+    from tunnelkit.simulation.drives import scenario_route
     from tunnelkit.studies import traced as tr
-    from tunnelkit.studies.drives import scenario_route
 
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(10, np.random.default_rng(0), refine="ml")
@@ -575,23 +573,18 @@ def _traced():
     src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
     joint_fisher([1.0 + 0.5j, 0.5j], src, pos, [-0.7, -1.1], [0.05, -0.02], 4, 3, 0.3, 3.5e9)
     rate_interval(3, 50)
-    tr.geometry_labels(ep, route)
-    tr.geometry_keep(ep, route)
-    pm, _ = tr.traced_measurements(ep, route)
+    pre.geometry_labels(ep, route)
+    pre.geometry_keep(ep, route)
+    pre.traced_measurements(ep, route)
     from tunnelkit.consistency import plane_kinds
-    from tunnelkit.tracking.javelin import JavelinConfig, KindNoise
 
     plane_kinds(route.tunnel)
-    pm.with_kinds(list(pm.kind))
-    kn = KindNoise((("los", 0.01, 0.02, 30.0, 0.2),))
-    kn.covariances(pm, JavelinConfig())
-    kn.tdoa_covariance(pm, list(range(1, len(pm))), 0, JavelinConfig())
     tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()
-    cur = tr.scene_provenance()
-    tr.check_provenance({"rows": [], **cur}, cur)
-    from tunnelkit.reproduce.traced_bound import traced_pcrlb
+    cur = pre.scene_provenance()
+    pre.check_provenance({"rows": [], **cur}, cur)
+    from tunnelkit.studies.traced_bound import traced_pcrlb
 
     traced_pcrlb("italiano2026-straight")
 

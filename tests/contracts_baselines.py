@@ -147,7 +147,7 @@ def evaluation_tables():
 def javelin_studies():
     """The studies on one-epoch drives: collection through the runner, the JAVELIN tables and
     their reproduction target, the ablation and error tables, the epoch figure and explorer."""
-    from tunnelkit import reproduce, studies
+    from tunnelkit import reproduce, simulation
     from tunnelkit.plots import javelin as pjv
     from tunnelkit.reproduce import javelin_tables as jt
     from tunnelkit.signal_route import SignalRoute
@@ -157,33 +157,33 @@ def javelin_studies():
     rng = np.random.default_rng(0)
     route = SignalRoute.from_scenario(tiny_scenario())
     ep = dataclasses.replace(route, kinds=("los", "road")).epoch(6, rng)
-    studies.ml_epoch(ep, route.config)
-    studies.separate_epoch(ep, route.config)
+    simulation.ml_epoch(ep, route.config)
+    simulation.separate_epoch(ep, route.config)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        studies.simulate_condition(route, 1, ("paper",), "L", rng)
-        routes = studies.simulate_routes(
+        simulation.simulate_condition(route, 1, ("paper",), "L", rng)
+        routes = simulation.simulate_routes(
             route, rng, extractions=("paper", "coherent", "ml"), n_epochs=2
         )
     drive = routes["paper"]
-    ev = studies.evaluate(drive, designs.ours(), keep_reports=True)
-    studies.settled_errors(ev, drive)
-    studies.tenfiloc_track(drive)
-    studies.vue_prediction_errors(drive, "mirror")
-    studies.path_errors([drive])
-    studies.extraction_errors([routes["ml"]])
-    studies.error_correlations([routes["ml"]])
-    studies.ablation({"L": [drive]}, separated={"L": [routes["coherent"]]})
+    ev = simulation.evaluate(drive, designs.ours(), keep_reports=True)
+    simulation.settled_errors(ev, drive)
+    simulation.tenfiloc_track(drive)
+    simulation.vue_prediction_errors(drive, "mirror")
+    simulation.path_errors([drive])
+    simulation.extraction_errors([routes["ml"]])
+    simulation.error_correlations([routes["ml"]])
+    simulation.ablation({"L": [drive]}, separated={"L": [routes["coherent"]]})
     pjv.epoch_figure(ev.run.reports[0], truth=drive.truth[0])
     wj.epoch_view(drive, ev, 0)
     wj.epoch_explorer(drive, ev)
-    _, erows = studies.extraction_errors([routes["ml"]])
+    _, erows = simulation.extraction_errors([routes["ml"]])
     designs.design_from_errors(erows)
     by_route = {"paper": {"L": [drive]}}
     jt.table_columns(by_route)
     jt.table_rows(by_route, "italiano2026_table1")
-    studies.collect_drives(SCENARIO, ("L",), 1, 0, n_epochs=1)
-    studies.collect_routes(SCENARIO, ("L",), 1, 0, n_epochs=1, extractions=("paper",))
+    simulation.collect_drives(SCENARIO, ("L",), 1, 0, n_epochs=1)
+    simulation.collect_routes(SCENARIO, ("L",), 1, 0, n_epochs=1, extractions=("paper",))
     jt.javelin_table(SCENARIO, "italiano2026_table1", ("L",), 1, 0, False, ("paper",), 1)
     reproduce.Target("contract-target", "a target", 1, lambda **kw: None)
     reproduce.register("contract-target", help="a target", default_runs=1)
@@ -192,7 +192,7 @@ def javelin_studies():
 
 def doppler_figures():
     """Halili's error study and its regimes on a two-second drive, the Doppler figures."""
-    from tunnelkit import drive as dv
+    from tunnelkit import doppler_drive as dv
     from tunnelkit.plots import doppler as pd
     from tunnelkit.tracking import doppler as dp
 

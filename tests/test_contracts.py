@@ -189,7 +189,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "name=None: the explorer's own constant; the range is not applied to it (tested)",
     ),
     _doc(
-        r"studies\.drives\.DriveData",
+        r"simulation\.drives\.DriveData",
         r"truth_index|kinds|faults|sources",
         "empty",
         "not recorded (the default): the drive's truth association is optional",
@@ -216,7 +216,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN (or None) is a dropped epoch: the filter predicts only (the docstring's contract)",
     ),
     _doc(
-        r"(tracking\.doppler|drive\.route)\..*",
+        r"(tracking\.doppler|doppler_drive\.drive)\..*",
         r"doppler|u|u0|dr|dz",
         "negative",
         "a signed quantity: Doppler shift, approach speed, a step back, a height offset",
@@ -259,7 +259,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(r"schema\.Key", r"gt|ge|lt|le", "negative", "a range bound takes any sign"),
     _doc(
-        r"montecarlo\.TrialPool\.(map|prepare|gather)",
+        r"runner\.TrialPool\.(map|prepare|gather)",
         r"items|handles",
         "empty",
         "no items: no tasks, an empty list back",
@@ -288,7 +288,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
     ),
     _doc(
-        r"drive\.config\.DriveConfig",
+        r"doppler_drive\.config\.DriveConfig",
         r"clock_drift|cfo_hz",
         "negative",
         "a clock drift or a carrier frequency offset takes either sign",
@@ -301,7 +301,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(
         r"propagation\.surfaces\.(Facet\.contains|Tunnel3D\.(contains|blocked|require_inside)"
-        r"|Box\.blocks)|drive\.route\.(slant_range|doppler_shift)",
+        r"|Box\.blocks)|doppler_drive\.drive\.(slant_range|doppler_shift)",
         r"p|a|b|v",
         "shape",
         "points or segments (..., 3) / (..., 2): leading axes vectorise "
@@ -344,7 +344,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN: a far-field path has no curvature (the docstring's contract)",
     ),
     _doc(
-        r"drive\.measurement\.DopplerToaMeasurements",
+        r"doppler_drive\.measurement\.DopplerToaMeasurements",
         r"doppler|toa",
         "nan",
         "NaN marks a dropped epoch (the docstring's contract; ``dropped`` flags it too)",
@@ -990,7 +990,7 @@ def test_extra_leading_axes_vectorise():
         (lambda x: model.z_mean(x, np.full(3, 1 / 3)), np.stack([model.hx(x4)] * 3, axis=1)),
     ]
     import tunnelkit as tk
-    from tunnelkit.drive import doppler_shift, slant_range
+    from tunnelkit.doppler_drive import doppler_shift, slant_range
     from tunnelkit.propagation import truck_box
 
     tun = tk.load_scenario("italiano2026-straight").tunnel()

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import tunnelkit.extraction
-import tunnelkit.studies
+import tunnelkit.simulation
 from tunnelkit.design import DesignImpairments, DesignSetup, sweep_montecarlo
 
 
@@ -29,7 +29,7 @@ def _first_drive_route(setup, monkeypatch, **kw):
         seen.append(route)
         raise _Stop
 
-    monkeypatch.setattr(tunnelkit.studies, "simulate_drive", fake_drive)
+    monkeypatch.setattr(tunnelkit.simulation, "simulate_drive", fake_drive)
     with pytest.raises(_Stop):
         sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", n_epochs=1, **kw)
     (route,) = seen

@@ -160,7 +160,7 @@ def test_sweep_is_one_task_set_with_the_same_numbers_serially_and_on_two_workers
 
 
 def test_sweeps_sharing_one_cluster_give_the_serial_numbers(setup):
-    from tunnelkit.montecarlo import trial_pool
+    from tunnelkit.runner import trial_pool
 
     specs = ["8x8", "4x4"]
     models = {s: _diag_model(setup, s) for s in specs}

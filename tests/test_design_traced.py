@@ -19,8 +19,8 @@ import pytest
 from tunnelkit import design
 from tunnelkit.design import traced
 from tunnelkit.rt.cache import CACHE_ENV
-from tunnelkit.studies import simulate_routes
-from tunnelkit.studies.traced import geometry_keep
+from tunnelkit.simulation import simulate_routes
+from tunnelkit.simulation.prefilter import geometry_keep
 from tunnelkit.tracking.javelin.noise import FixedNoise
 
 SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
@@ -61,7 +61,7 @@ def test_the_traced_drive_is_the_drive_simulator_with_the_traced_adapters(setup)
         assert pa is not None  # the fit's own test ignored
         assert pt is None or (set(pt.source) <= set(pa.source) and len(pt) <= len(pa))
     # the pre-filter is geometry_keep on the same epoch: redo epoch 0 and compare the rows kept
-    from tunnelkit.studies.drives import ml_epoch
+    from tunnelkit.simulation.drives import ml_epoch
 
     with warnings.catch_warnings():  # every traced fit fails its own residual test
         warnings.simplefilter("ignore")

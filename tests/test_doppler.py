@@ -9,7 +9,7 @@ import pytest
 from filterpy.kalman import KalmanFilter
 
 from tunnelkit import crlb
-from tunnelkit import drive as dv
+from tunnelkit import doppler_drive as dv
 from tunnelkit.constants import C
 from tunnelkit.tracking import doppler as dp
 from tunnelkit.tracking import registry

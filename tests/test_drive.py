@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tunnelkit import drive as dv
+from tunnelkit import doppler_drive as dv
 from tunnelkit.constants import C
-from tunnelkit.drive import measurement, route
+from tunnelkit.doppler_drive import drive as drive_model
+from tunnelkit.doppler_drive import measurement
 from tunnelkit.geometry import Plane, mirror, specular_point
 from tunnelkit.scenarios import ScenarioError
 
@@ -215,7 +216,7 @@ def test_speed_profile_distance_is_the_integral_of_the_speed():
     """Brute force for the closed-form distance: trapezoidal integral of v(t) on a fine grid."""
     cfg = dv.DriveConfig(speed_amplitude=3.0, speed_period=11.0)
     t = np.linspace(0.0, cfg.duration, 200_001)
-    s, v = route._speed_profile(cfg, t)
+    s, v = drive_model._speed_profile(cfg, t)
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
     assert np.allclose(s, integral, atol=1e-6)
 
@@ -224,4 +225,4 @@ def test_parabolic_peak_is_exact_on_a_parabola():
     grid = np.tile(np.linspace(-2.0, 2.0, 41), (3, 1))
     true = np.array([-0.537, 0.0, 1.234])
     mag = 5.0 - (grid - true[:, None]) ** 2
-    assert np.allclose(route._peak(grid, mag), true, atol=1e-12)
+    assert np.allclose(drive_model._peak(grid, mag), true, atol=1e-12)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from tunnelkit import crlb
-from tunnelkit import drive as dv
+from tunnelkit import doppler_drive as dv
 from tunnelkit.tracking import doppler as dp
 from tunnelkit.tracking import virtual_station as vs
 from tunnelkit.tracking.doppler import approaches

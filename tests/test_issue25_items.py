@@ -174,7 +174,9 @@ def test_draw_calibration_beyond_the_memory_budget():
 
 
 def test_drive_config_beyond_the_memory_budget():
-    _raises(ValueError, r"duration|spacing", tk.drive.DriveConfig, duration=1e6, spacing=1e-3)
+    _raises(
+        ValueError, r"duration|spacing", tk.doppler_drive.DriveConfig, duration=1e6, spacing=1e-3
+    )
 
 
 def test_crlb_map_beyond_the_memory_budget(jiang):

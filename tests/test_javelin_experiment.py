@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from tunnelkit import studies as ex
+from tunnelkit import simulation as ex
 from tunnelkit.plots.javelin import (
     epoch_figure,
     javelin_table_figure,

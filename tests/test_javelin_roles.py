@@ -199,12 +199,12 @@ def test_named_designs():
 
 
 def test_reported_noise_on_a_route_without_covariances_is_refused():
-    from tunnelkit import studies
+    from tunnelkit import simulation
 
-    drive = studies.simulate_drive(
+    drive = simulation.simulate_drive(
         "italiano2026-straight", np.random.default_rng(0), condition="L", n_epochs=1
     )
     assert not drive.reports_covariance
     d = designs.paper(noise=ReportedNoise())
     with pytest.raises(ValueError, match=r"^design, drive: the noise role ReportedNoise"):
-        studies.evaluate(drive, d)
+        simulation.evaluate(drive, d)

@@ -37,3 +37,61 @@ def test_the_analysis_sees_what_it_must(tmp_path):
     assert r["cycles"] == [["tunnelkit.design", "tunnelkit.geometry"]]
     assert "tunnelkit.geometry -> tunnelkit.design" in r["upward"]
     assert r["private_imports"] == ["tunnelkit.design imports _h from tunnelkit.crlb"]
+
+
+def test_no_core_module_imports_the_studies_layer():
+    lay = _layout()
+    r = lay.analyse(ROOT)
+    assert r["core_to_studies"] == []
+    floor = min(lay.RANKS[s] for s in lay.STUDIES)
+    # the layer sits above every core package and below the command line
+    assert floor > max(v for k, v in lay.RANKS.items() if k not in lay.STUDIES and v < floor)
+    assert max(lay.RANKS[s] for s in lay.STUDIES) < lay.RANKS["commands"]
+
+
+def test_the_check_sees_a_core_module_importing_a_study(tmp_path):
+    pkg = tmp_path / "tunnelkit"
+    (pkg / "studies").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "studies" / "__init__.py").write_text("")
+    (pkg / "studies" / "traced.py").write_text("from ..geometry import f\n")
+    (pkg / "geometry.py").write_text("def f():\n    from .studies.traced import g\n")
+    r = _layout().analyse(tmp_path)
+    assert r["core_to_studies"] == ["tunnelkit.geometry -> tunnelkit.studies.traced"]
+
+
+def _lesson_imports(names) -> list[str]:
+    """Every import statement of the notebooks' sources whose names start with ``names``."""
+    import ast
+
+    out = []
+    for src in sorted((ROOT / "notebooks" / ".src").glob("*.py")):
+        if not src.name.startswith(names):
+            continue
+        for node in ast.walk(ast.parse(src.read_text())):
+            if isinstance(node, ast.Import | ast.ImportFrom):
+                out.append(ast.unparse(node))
+    return out
+
+
+def test_the_lessons_imports_do_not_load_the_ray_tracer():
+    """Lessons 01-06 import what they use and nothing loads ``tunnelkit.rt`` (the ray tracer is
+    an optional channel backend, loaded only when a route asks for ``channel="sionna"``)."""
+    import json
+    import subprocess
+
+    lines = _lesson_imports(("01-", "02-", "03-", "04-", "04b-", "05-", "06-"))
+    assert any("tunnelkit" in s for s in lines)
+    code = "\n".join(
+        [
+            *lines,
+            "import json, sys",
+            "print(json.dumps(sorted(m for m in sys.modules if 'tunnelkit' in m)))",
+        ]
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True
+    ).stdout
+    loaded = json.loads(out)
+    assert "tunnelkit.signal_route" in loaded  # the lessons' imports did run
+    assert not [m for m in loaded if m == "tunnelkit.rt" or m.startswith("tunnelkit.rt.")]

@@ -1,4 +1,4 @@
-"""The misspecified bound (tunnelkit.extraction.misspecified) against brute force: the pseudo-true
+"""The misspecified bound (tunnelkit.studies.misspecified) against brute force: the pseudo-true
 point against an independent least-squares refit, ``A`` against the finite-difference Hessian of
 the cost, the sandwich against Monte-Carlo of the extraction's fit, and the CRLB when the model
 holds."""
@@ -11,12 +11,12 @@ from scipy.optimize import least_squares
 
 from tunnelkit.constants import C
 from tunnelkit.extraction.bounds import crlb_paths
-from tunnelkit.extraction.misspecified import (
+from tunnelkit.extraction.ml import Problem, fit_problem
+from tunnelkit.studies.misspecified import (
     misspecified_bound,
     parameter_vector,
     pseudo_true,
 )
-from tunnelkit.extraction.ml import Problem, fit_problem
 
 FC = 5.9e9
 NF, NT = 24, 4
@@ -182,7 +182,7 @@ def test_model_error_test_allows_the_stated_share():
     """A residual of noise plus one unmodelled path carrying a share s0 of the received energy:
     the peak test needs about s0 (the path's energy over the received energy), the test passes
     at s0 (1 + 5 %) and fails at s0 / 2; pure noise passes at share 0 (false-alarm rate 1 %)."""
-    from tunnelkit.extraction.misspecified import model_error_test
+    from tunnelkit.signal_route.judging import model_error_test
 
     pos = _pos()
     rng = np.random.default_rng(3)
@@ -217,7 +217,8 @@ def test_model_error_test_energy_threshold_rho_max():
     """``rho_max`` sets the energy test's threshold: the default is ``1 + z / sqrt(N)``, a looser
     one lowers the energy share by ``(rho_max' - rho_max) (N - 2.5 L) sigma^2 / E_rx`` and
     leaves the peak test alone; a non-positive or NaN ``rho_max`` is refused by name."""
-    from tunnelkit.extraction.misspecified import RHO_Z, model_error_test
+    from tunnelkit.extraction.ml.fitting import RHO_Z
+    from tunnelkit.signal_route.judging import model_error_test
 
     pos = _pos()
     rng = np.random.default_rng(4)

@@ -214,18 +214,18 @@ def test_a_physically_impossible_path_is_never_valid():
 
 
 def test_the_drive_adapter_drops_a_flagged_epoch():
-    from tunnelkit import studies
+    from tunnelkit import simulation
 
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ep = route.epoch(10, np.random.default_rng(0))
     assert ep.estimates.fit_ok is True
-    pm, why = studies.path_measurements(ep, route)
+    pm, why = simulation.path_measurements(ep, route)
     assert pm is not None and why is None
     flagged = replace(ep, estimates=replace(ep.estimates, fit_ok=False))
-    pm, why = studies.path_measurements(flagged, route)
-    assert pm is None and why == studies.drives.FLAGGED
+    pm, why = simulation.path_measurements(flagged, route)
+    assert pm is None and why == simulation.drives.FLAGGED
 
 
 def test_mie_threshold_is_where_a_noise_cell_beats_the_path_half_the_time():

@@ -5,7 +5,7 @@ resumable), and the lengthened drive of ``tunnelkit reproduce javelin-table1 --l
 import numpy as np
 import pytest
 
-from tunnelkit import channel, evaluation, studies
+from tunnelkit import channel, evaluation, simulation
 from tunnelkit.cli import main
 from tunnelkit.extraction import ml
 from tunnelkit.extraction.ml import fitting
@@ -93,21 +93,21 @@ def test_the_screen_reinitialises_a_crawling_wrong_basin_early():
 
 
 def test_drive_variant_lengthens_the_straight_drive_and_checks_its_arguments():
-    route = studies.drives.drive_variant("italiano2026-straight", 120.0)
+    route = simulation.drives.drive_variant("italiano2026-straight", 120.0)
     pos = route.trajectory.position
-    preset = studies.scenario_route("italiano2026-straight").trajectory.position
+    preset = simulation.scenario_route("italiano2026-straight").trajectory.position
     assert pos[0, 0] == pytest.approx(preset[-1, 0] + 120.0, abs=1.5)
     assert pos[-1, 0] == pytest.approx(preset[-1, 0], abs=1.5)
     np.testing.assert_allclose(pos[:, 1:], preset[:1, 1:].repeat(len(pos), 0))  # same lane
     step = np.diff(pos[:, 0])
     np.testing.assert_allclose(step, np.diff(preset[:, 0])[0], rtol=1e-9)  # same speed x period
-    assert studies.drives.drive_variant("italiano2026-straight", 120) is route  # kept
+    assert simulation.drives.drive_variant("italiano2026-straight", 120) is route  # kept
     with pytest.raises(ValueError, match="length"):
-        studies.drives.drive_variant("italiano2026-straight", 500.0)
+        simulation.drives.drive_variant("italiano2026-straight", 500.0)
     with pytest.raises(ValueError, match="length"):
-        studies.drives.drive_variant("italiano2026-straight", -1.0)
+        simulation.drives.drive_variant("italiano2026-straight", -1.0)
     with pytest.raises(TypeError, match="scenario"):
-        studies.drives.drive_variant(route, 120.0)
+        simulation.drives.drive_variant(route, 120.0)
 
 
 def test_length_is_refused_where_it_does_not_apply(capsys):

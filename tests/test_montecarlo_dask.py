@@ -23,10 +23,10 @@ pytest.importorskip("distributed")
 from distributed import LocalCluster
 
 from tunnelkit.cli import main
-from tunnelkit.drive import load_drive_config
-from tunnelkit.montecarlo import SchedulerUnreachable, TrialLost, parallel_options, run_trials
+from tunnelkit.doppler_drive import load_drive_config
 from tunnelkit.reproduce.halili import pooled_errors
 from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows
+from tunnelkit.runner import SchedulerUnreachable, TrialLost, parallel_options, run_trials
 
 
 @pytest.fixture(scope="module")
@@ -247,7 +247,7 @@ def test_silent_scheduler_fails_within_the_timeout():
 
 
 def test_a_trial_past_its_timeout_stops_the_run_serially_and_on_dask(cluster):
-    from tunnelkit.montecarlo import TrialTimeout
+    from tunnelkit.runner import TrialTimeout
 
     t0 = time.perf_counter()
     with pytest.raises(TrialTimeout, match="trial 1 of 2"):
@@ -273,7 +273,7 @@ def test_a_trial_past_its_timeout_stops_the_run_serially_and_on_dask(cluster):
 
 
 def test_workers_beyond_the_cores_are_capped_with_a_warning(monkeypatch):
-    import tunnelkit.montecarlo as mc
+    import tunnelkit.runner as mc
 
     monkeypatch.setattr(mc, "available_cores", lambda: 1)
     with pytest.warns(RuntimeWarning, match="workers: 64 processes on 1 core"):
@@ -294,7 +294,7 @@ def test_trials_sharing_a_stream_see_the_same_numbers():
 
 
 def test_a_pool_shares_one_cluster_between_steps_with_the_serial_numbers():
-    from tunnelkit.montecarlo import TrialPool, trial_pool
+    from tunnelkit.runner import TrialPool, trial_pool
 
     serial = run_trials(_draw, 6, seed=4)
     with trial_pool() as pool:
@@ -323,7 +323,7 @@ def _dot(v: np.ndarray, rng: np.random.Generator) -> float:
 def test_prepared_inputs_and_chunked_trials_give_the_serial_numbers(cluster):
     # per-item state built on the cluster feeds the trials without a round trip through the
     # client; trials go in several per task (20 trials on 2 threads: 2 per task)
-    from tunnelkit.montecarlo import trial_pool
+    from tunnelkit.runner import trial_pool
 
     sizes = [3, 5, 4, 6]
     inputs = [s for s in sizes for _ in range(5)]
@@ -345,7 +345,7 @@ def test_prepared_inputs_and_chunked_trials_give_the_serial_numbers(cluster):
 
 def test_a_cluster_without_workers_stops_the_run_instead_of_hanging(monkeypatch):
     # workers killed and never restarted (seen on a loaded machine) left a run waiting for ever
-    import tunnelkit.montecarlo as mc
+    import tunnelkit.runner as mc
 
     monkeypatch.setattr(mc, "NO_WORKER_WAIT_S", 2.0)
     with LocalCluster(

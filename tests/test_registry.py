@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from tunnelkit import drive as dv
+from tunnelkit import doppler_drive as dv
 from tunnelkit.tracking import registry
 from tunnelkit.tracking import virtual_station as vs
 from tunnelkit.tracking.doppler import DopplerSetup, Track
@@ -54,16 +54,16 @@ def _halili2022(name, cls):
 
 
 def _italiano2026(name, cls):
-    from tunnelkit import studies
+    from tunnelkit import simulation
 
-    drive = studies.simulate_drive(
+    drive = simulation.simulate_drive(
         "italiano2026-straight", np.random.default_rng(0), condition="L", n_epochs=3
     )
     trk = cls.for_drive(drive)
     est, details = trk.track(drive)
     assert est.shape == (3, 3) and np.all(np.isfinite(est))
     assert len(details.estimates if hasattr(details, "estimates") else details) == 3
-    np.testing.assert_array_equal(est, studies.evaluate(drive, method=name).estimates)
+    np.testing.assert_array_equal(est, simulation.evaluate(drive, method=name).estimates)
 
 
 #: family -> how one member is built and run (the protocol of ``registry``'s docstring)

@@ -20,7 +20,7 @@ def test_jiang_crlb_loads_no_drive_simulator_or_ray_tracer():
     code = (
         "import sys, tunnelkit as tk\n"
         "tk.reproduce.run('jiang-crlb', runs=20, seed=0)\n"
-        "print(sorted(m for m in ('tunnelkit.studies', 'tunnelkit.rt', 'tunnelkit.design')"
+        "print(sorted(m for m in ('tunnelkit.simulation', 'tunnelkit.rt', 'tunnelkit.design')"
         " if m in sys.modules))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)

@@ -9,7 +9,7 @@ import pytest
 
 from tunnelkit import channel, propagation, rt
 from tunnelkit.signal_route import SignalRoute
-from tunnelkit.studies import drives
+from tunnelkit.simulation import drives
 
 
 def test_second_order_paths_in_the_model():

@@ -121,7 +121,8 @@ def test_reference_tables_load():
 
 from pathlib import Path  # noqa: E402
 
-from tunnelkit import cli, drive, schema  # noqa: E402
+from tunnelkit import cli, schema  # noqa: E402
+from tunnelkit import doppler_drive as drive  # noqa: E402
 from tunnelkit import scenarios as S  # noqa: E402
 
 PRESETS = Path(__file__).resolve().parent.parent / "data" / "scenarios"

@@ -10,17 +10,19 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tunnelkit.studies import simulate_routes
-from tunnelkit.studies.drives import path_measurements, scenario_route
-from tunnelkit.studies.traced import (
+from tunnelkit.simulation import simulate_routes
+from tunnelkit.simulation.drives import path_measurements, scenario_route
+from tunnelkit.simulation.prefilter import (
     FLOORS,
     check_provenance,
     geometry_keep,
     scene_provenance,
+    traced_measurements,
+)
+from tunnelkit.studies.traced import (
     simulate_traced,
     traced_design,
     traced_errors,
-    traced_measurements,
     write_traced_errors,
 )
 from tunnelkit.tracking.javelin import designs
@@ -212,7 +214,7 @@ def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive():
     child seed; the image channel's table has no such column."""
     from tunnelkit.montecarlo import spawn_rngs
     from tunnelkit.reproduce.javelin_tables import TRACED_COLUMN, javelin_table
-    from tunnelkit.studies import evaluate
+    from tunnelkit.simulation import evaluate
 
     nuis = {"diffuse_floor": True}
     rep = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
@@ -236,8 +238,8 @@ def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypat
     import tunnelkit.design as design
     from tunnelkit.design import DesignSetup, drive_pcrlb
     from tunnelkit.design.drivebound import drive_motion
-    from tunnelkit.reproduce.traced_bound import traced_pcrlb
-    from tunnelkit.studies.drives import SIGMA_HEADING, SIGMA_SPEED
+    from tunnelkit.simulation.drives import SIGMA_HEADING, SIGMA_SPEED
+    from tunnelkit.studies.traced_bound import traced_pcrlb
 
     rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
     seen = {}

@@ -36,8 +36,8 @@ def test_spawned_streams_are_reproducible_and_independent():
     a = [r.standard_normal() for r in tk.montecarlo.spawn_rngs(5, 3)]
     b = [r.standard_normal() for r in tk.montecarlo.spawn_rngs(5, 3)]
     assert a == b and len(set(a)) == 3
-    out = tk.montecarlo.run_trials(lambda r: r.integers(100), 4, seed=1)
-    assert out == tk.montecarlo.run_trials(lambda r: r.integers(100), 4, seed=1)
+    out = tk.runner.run_trials(lambda r: r.integers(100), 4, seed=1)
+    assert out == tk.runner.run_trials(lambda r: r.integers(100), 4, seed=1)
 
 
 def test_lazy_submodules():
@@ -128,7 +128,8 @@ def test_domain_checks():
 
 
 def test_findings_of_the_issue_raise_naming_the_parameter():
-    from tunnelkit import crlb, drive, metrics, positioning, propagation
+    from tunnelkit import crlb, metrics, positioning, propagation
+    from tunnelkit import doppler_drive as drive
     from tunnelkit.channel import SRSConfig
     from tunnelkit.tracking import pcrlb, upf
     from tunnelkit.tracking.gating import mahalanobis2
@@ -221,21 +222,22 @@ def test_budget_error_names_parameter_and_size(budget):
 
 
 def test_sizes_are_checked_before_allocating(budget):
-    from tunnelkit import arrays, fresnel, montecarlo, propagation, reproduce
+    from tunnelkit import arrays, fresnel, propagation, reproduce, runner
 
     with pytest.raises(ValueError, match="n_rows, n_cols: would need 596 GiB"):
         arrays.make_array(10**5, 10**5, fc=5.9e9, azimuth=0.0, elevation=0.0)
     with pytest.raises(ValueError, match=r"n_facets: would need 3\.81 GiB"):
         propagation.semicircular_tunnel(n_facets=10**6)
     with pytest.raises(ValueError, match="runs: would need 931 TiB"):
-        montecarlo.run_trials(lambda r: 0, 10**12, 0)
+        runner.run_trials(lambda r: 0, 10**12, 0)
     with pytest.raises(ValueError, match="runs: would need"):
         reproduce.run("halili", runs=10**18)
     with pytest.raises(ValueError, match="M: would need"):
         fresnel.phase_mismatch_ura(100_000, 3.5, 3.0, 2.5, 5.9e9)
     with pytest.raises(ValueError, match="m_limit: would need"):
         fresnel.mmax_exact(3.5, 3.0, 2.5, 5.9e9, 0.15, m_limit=10**12)
-    from tunnelkit import design, drive, rt
+    from tunnelkit import design, rt
+    from tunnelkit import doppler_drive as drive
 
     with pytest.raises(ValueError, match=r"n_boot: would need 156 GiB \(1000000000 resamples"):
         design.bootstrap_quantile_ci(np.ones((20, 30)), 0.9, np.random.default_rng(0), n_boot=10**9)

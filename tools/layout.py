@@ -3,10 +3,12 @@ across modules, function-local imports and module sizes (``python tools/layout.p
 
 Every import counts, the ones inside functions included (a cycle hidden in a function is still a
 cycle). A name imported from a package's ``__init__`` is followed to the submodule that defines
-it. ``RANKS`` is the intended direction of the signal route (synthesis -> extraction -> studies ->
-tracking -> design): a module may import only from a lower rank or from its own top-level
+it. ``RANKS`` is the intended direction of the signal route (synthesis -> extraction -> tracking
+-> simulation -> design): a module may import only from a lower rank or from its own top-level
 package; two packages of the same rank (``extraction`` and ``tracking``) may not import each
-other. ``tests/test_layout.py`` asserts the result.
+other. Above the core stands the studies layer (:data:`STUDIES`: research beside the course, the
+papers' tables), below the command line: it imports the core, and no core module imports it.
+``tests/test_layout.py`` asserts the result.
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ RANKS = {
     "crlb": 1,
     "metrics": 1,
     "montecarlo": 1,
+    "runner": 1.1,  # the Monte-Carlo runner (serial or Dask) over montecarlo's seeds
     "arrays": 1,
     "scenarios": 2,
     "positioning": 2,
@@ -45,7 +48,7 @@ RANKS = {
     "reference": 3,
     "propagation": 3,
     "tunnels": 3.5,
-    "drive": 3,
+    "doppler_drive": 3,
     "channel": 4,
     "rt": 4,
     "extraction": 5,
@@ -55,16 +58,22 @@ RANKS = {
     "efficiency": 7,
     "consistency": 3.6,  # the geometry-consistency test of one snapshot's paths (planes only)
     "path_consistency": 7.5,  # the geometry-consistency test on a signal route's epoch
-    "studies": 8,
+    "simulation": 8,
     "design": 9,
     "plots": 10,
     "widgets": 11,
-    "reproduce": 12,
+    "studies": 11.5,  # the studies layer: research beside the course, over the core
+    "reproduce": 12,  # the studies layer: the papers' tables (tunnelkit reproduce)
     "commands": 12.5,
     "cli": 13,
     "__main__": 14,
     "": 2.5,  # tunnelkit/__init__.py: quick mode and scenarios, the rest lazily
 }
+
+
+#: the studies layer: every package here ranks above the core (all that ranks lower) and below the
+#: command line (which may import it for ``tunnelkit reproduce``)
+STUDIES = ("studies", "reproduce")
 
 
 def _modules(root: Path) -> dict[str, Path]:
@@ -161,11 +170,19 @@ def analyse(root: Path = ROOT) -> dict:
                 continue
             if RANKS[tb] >= RANKS[ta]:
                 upward.append(f"{a} -> {b}")
+    floor = min(RANKS[s] for s in STUDIES)
+    core_to_studies = sorted(
+        f"{a} -> {b}"
+        for a, bs in graph.items()
+        for b in bs
+        if top(b) in STUDIES and top(a) in RANKS and RANKS[top(a)] < floor
+    )
     sizes = {n: len(p.read_text().splitlines()) for n, p in mods.items()}
     big = {n: s for n, s in sizes.items() if s > MAX_LINES and n not in SIZE_EXEMPT}
     return {
         "cycles": cycles,
         "upward": sorted(upward),
+        "core_to_studies": core_to_studies,
         "unranked": unranked,
         "private_imports": sorted(private),
         "function_local_imports": len(local_imports),
@@ -231,6 +248,9 @@ def main(argv=None) -> int:
         print("   ", " <-> ".join(c))
     print(f"arrows that run back up: {len(r['upward'])}")
     for u in r["upward"]:
+        print("   ", u)
+    print(f"core modules importing the studies layer: {len(r['core_to_studies'])}")
+    for u in r["core_to_studies"]:
         print("   ", u)
     print(f"private names imported across modules: {len(r['private_imports'])}")
     for p in r["private_imports"]:

@@ -31,7 +31,7 @@ import numpy as np
 from IPython.display import display
 
 import tunnelkit as tk
-from tunnelkit import studies as ex
+from tunnelkit import simulation as ex
 from tunnelkit.crlb import numeric_jacobian
 from tunnelkit.evaluation import match_paths
 from tunnelkit.extraction.coherent import resolve_coherent
@@ -43,7 +43,7 @@ from tunnelkit.plots import (
     trajectories_figure,
 )
 from tunnelkit.signal_route import SignalRoute, measurements_from_estimates
-from tunnelkit.studies import collect_routes
+from tunnelkit.simulation import collect_routes
 from tunnelkit.tracking.javelin import TeNFiLoc, designs, measurement_model
 from tunnelkit.widgets import epoch_explorer
 

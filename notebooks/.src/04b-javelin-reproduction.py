@@ -26,13 +26,13 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import tunnelkit as tk
-from tunnelkit import studies as ex
+from tunnelkit import simulation as ex
 from tunnelkit.constants import C
 from tunnelkit.metrics import position_errors
 from tunnelkit.plots import cdf_figure, javelin_table_figure
 from tunnelkit.reproduce.javelin_tables import table_rows
 from tunnelkit.signal_route import SignalRoute
-from tunnelkit.studies import collect_routes
+from tunnelkit.simulation import collect_routes
 from tunnelkit.tracking.javelin import designs
 
 tk.setup_notebook()

@@ -25,7 +25,7 @@
 #
 # The paper's numbers come from **one measured drive through the Beveren tunnel** (Antwerp); those
 # data are not public. Everything below runs on a synthetic drive whose model is written out in
-# `tunnelkit.drive`; where we put the paper's numbers beside ours, they are labelled "measured".
+# `tunnelkit.doppler_drive`; where we put the paper's numbers beside ours, they are labelled "measured".
 
 # %%
 import numpy as np
@@ -34,7 +34,7 @@ from tqdm.auto import tqdm
 
 import tunnelkit as tk
 from tunnelkit import crlb
-from tunnelkit import drive as dv
+from tunnelkit import doppler_drive as dv
 from tunnelkit.plots import (
     approach_cdfs,
     doppler_delay_figure,
@@ -113,7 +113,7 @@ print(f"paper eq. 5: start {paper_eq5[0]:+.1f} Hz (approaching, yet negative)")
 # %% [markdown]
 # ### Multipath, noise and clocks: the measurement model
 #
-# `tunnelkit.drive` builds the channel with the image method in the rectangular cross-section
+# `tunnelkit.doppler_drive` builds the channel with the image method in the rectangular cross-section
 # (line of sight plus wall/ceiling/floor bounces up to second order). The **measured delay** is
 # the peak of the band-limited impulse response (a $\mathrm{sinc}$ of width $1/B = 12.5$ ns), the
 # **measured Doppler** the peak of the Doppler spectrum of a 32-snapshot window (resolution 32 Hz):

@@ -284,7 +284,7 @@ print(f"H: {H_img.shape}, {len(alike(p_img))} paths, max relative difference {re
 # %%
 import plotly.graph_objects as go
 
-from tunnelkit import studies
+from tunnelkit import simulation
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.tracking.javelin import designs
 
@@ -439,7 +439,7 @@ print("epochs flagged: " + ", ".join(f"{ch} {sum(f)} of {len(f)}" for ch, f in f
 
 # %%
 drives = {
-    ch: studies.simulate_drive(
+    ch: simulation.simulate_drive(
         "italiano2026-straight",
         np.random.default_rng(7),
         condition="L",
@@ -450,7 +450,7 @@ drives = {
     for ch in ("image", "sionna")
 }
 design = designs.paper() if tk.QUICK else designs.ours_ml()
-evals = {ch: studies.evaluate(d, design) for ch, d in drives.items()}
+evals = {ch: simulation.evaluate(d, design) for ch, d in drives.items()}
 
 # %%
 fig = go.Figure(
@@ -497,7 +497,7 @@ for ch, ev in evals.items():
 # changed: its curvature), $B$ the covariance of that log-likelihood's score (its gradient)
 # under the *true* distribution (its mean is zero at $\theta_0$). With the residual
 # $r = H - \mu(\theta_0)$ and $J = \partial\mu/\partial\theta$ at $\theta_0$
-# (`tunnelkit.extraction.misspecified`),
+# (`tunnelkit.studies.misspecified`),
 #
 # $$A = \tfrac{2}{\sigma^2}\Big(\Re\, J^H J - \Re\,\big\langle \tfrac{\partial^2\mu}{\partial
 #   \theta_i \partial\theta_j}, r\big\rangle\Big),\qquad B = \tfrac{2}{\sigma^2}\Re\, J^H J .$$
@@ -519,7 +519,7 @@ for ch, ev in evals.items():
 
 # %%
 from tunnelkit.extraction import ml_truth
-from tunnelkit.extraction.misspecified import misspecified_bound, pseudo_true
+from tunnelkit.studies.misspecified import misspecified_bound, pseudo_true
 
 k8 = 0
 arr8, paths8 = route_rt.paths(k8)
@@ -640,12 +640,13 @@ for label, snaps in geo.items():
 # For a tracker the test must not drop everything, so its pre-filter form states a model-error
 # floor instead of the bound (`bound=False`, `floor_angle`, `floor_range`): a path is kept when
 # it agrees with the UE hypothesis to within those floors. The traced JAVELIN design
-# (`studies.traced`) uses `studies.traced.FLOORS`. Where they sit, computed on these epochs: the
+# (`studies.traced`) uses `simulation.prefilter.FLOORS`. Where they sit, computed on these epochs: the
 # share of paths the pre-filter keeps on each channel, and the traced matched paths' errors
 # against them.
 
 # %%
-from tunnelkit.studies.traced import FLOORS, geometry_keep, traced_design, traced_errors
+from tunnelkit.simulation.prefilter import FLOORS, geometry_keep
+from tunnelkit.studies.traced import traced_design, traced_errors
 
 err_rt = {"phi": [], "psi": [], "kappa": [], "d": []}  # each traced matched path's error
 for ep in eps_geo["sionna"]:

@@ -551,7 +551,7 @@ for a in rt_sizes:
 # (`design.traced.traced_bounds`): the posterior CRLB over the drive (Tichavský et al. 1998): every first-order path measured at every
 # epoch with independent Gaussian errors of $\sigma_q$, and JAVELIN's motion model. That model
 # is the car's **odometry**: each epoch the car broadcasts its speed and heading over V2X, with
-# noise `tk.studies.SIGMA_SPEED` and `SIGMA_HEADING`, and the tracker integrates them. The
+# noise `tk.simulation.SIGMA_SPEED` and `SIGMA_HEADING`, and the tracker integrates them. The
 # tracker starts from an entry fix of `design.START_SIGMA_M` per axis (1 m, an open-sky GNSS fix at
 # the portal). With no radio at all the same recursion is the bound of dead reckoning.
 #
@@ -656,7 +656,7 @@ for sp in fixes:
 # the floor: dead reckoning from the best fix with the V2X speed and heading ten times better
 calm = settled_rms(design.drive_pcrlb(
     paper_rt, np.zeros((T_rt, 2, 2)), sigma_p0=fixes[-1],
-    sigma_speed=tk.studies.SIGMA_SPEED / 10, sigma_heading=tk.studies.SIGMA_HEADING / 10,
+    sigma_speed=tk.simulation.SIGMA_SPEED / 10, sigma_heading=tk.simulation.SIGMA_HEADING / 10,
 ))  # fmt: skip
 print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {calm:.3g} m")
 
@@ -768,7 +768,7 @@ for report in ("budget", "crlb"):
     errs = []
     for seed in range(2):
         drive = design.bound_drive(model8, setup, "8x8", np.random.default_rng(seed), report=report)
-        errs.append(tk.studies.settled_errors(tk.studies.evaluate(drive, ours8), drive)[1])
+        errs.append(tk.simulation.settled_errors(tk.simulation.evaluate(drive, ours8), drive)[1])
     sol4[report] = float(np.median(errs))
     print(f"reported {report:6s}: median settled RMSE {100 * sol4[report]:.3g} cm over 2 drives")
 print(f"factor: {sol4['crlb'] / sol4['budget']:.2g}")

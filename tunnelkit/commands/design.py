@@ -343,7 +343,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     from .. import design
-    from ..montecarlo import TrialLost
+    from ..runner import TrialLost
     from .reproduce import parallel_kwargs
 
     try:

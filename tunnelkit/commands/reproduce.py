@@ -56,8 +56,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
     """``--workers N | --scheduler ADDRESS`` and ``--connect-timeout`` (any command whose trials
-    go through :func:`tunnelkit.montecarlo.run_trials`; pass them on with :func:`parallel_kwargs`)."""
-    from ..montecarlo import CONNECT_TIMEOUT_S
+    go through :func:`tunnelkit.runner.run_trials`; pass them on with :func:`parallel_kwargs`)."""
+    from ..runner import CONNECT_TIMEOUT_S
 
     par = p.add_mutually_exclusive_group()
     par.add_argument(
@@ -88,9 +88,9 @@ def parallel_kwargs(args: argparse.Namespace) -> dict:
 
 
 def main(args: argparse.Namespace) -> int:
-    from ..montecarlo import TrialLost
     from ..reproduce import run, targets
     from ..rt import RTUnavailableError
+    from ..runner import TrialLost
 
     chans = targets()[args.target].channels
     if args.channel not in chans:

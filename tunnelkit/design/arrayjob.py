@@ -74,7 +74,7 @@ class SweepTrial:
     dead_reckoning: bool = False
 
     def __call__(self, item: tuple, rng: np.random.Generator) -> np.ndarray:
-        from ..studies import evaluate, simulate_drive
+        from ..simulation import evaluate, simulate_drive
         from ..tracking.javelin import draw_start
 
         prep, unit_seed = item  # the array's shared part, the unit's calibration seed
@@ -253,7 +253,7 @@ def load_tracker() -> None:
     """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
     a worker that imports them in a task while another thread unpickles a tracker sent from
     another worker deadlocks on the package's import locks)."""
-    from .. import studies  # noqa: F401
+    from .. import simulation  # noqa: F401
     from ..tracking import javelin  # noqa: F401
 
 

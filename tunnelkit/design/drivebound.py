@@ -298,7 +298,7 @@ def drive_pcrlb(
     start from an open-sky fix of ``sigma_p0`` [m] (as the studies start JAVELIN), and ``info``
     (T, 2, 2) the position information per epoch (:func:`position_information`)."""
     from .._validate import positive
-    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED
+    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
     from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
 
     sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
@@ -373,7 +373,7 @@ def unit_pcrlb(
     covariance form, each epoch a low-rank update (Woodbury), so the cost grows as ``M^2`` per
     epoch, not ``M^3``."""
     from .._validate import boolean, positive
-    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED
+    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
 
     _check_geometry(model, geometry)
     sigma_p0 = positive("sigma_p0", sigma_p0)

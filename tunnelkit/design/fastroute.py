@@ -1,7 +1,7 @@
 """The design's fast measurement route: a drive whose path measurements are drawn from a
 :class:`~tunnelkit.design.errormodel.PathErrorModel` instead of synthesised and extracted.
 
-The channel route (:func:`tunnelkit.studies.simulate_drive` with ``extraction="route"``) builds
+The channel route (:func:`tunnelkit.simulation.simulate_drive` with ``extraction="route"``) builds
 the ``M x Nf x Nt`` tensor of every epoch and runs the maximum-likelihood extraction on it; its
 cost grows with the array (580 s for two 32 x 32 drives). An efficient extraction above its
 threshold delivers the true path parameters plus an error the model describes, and *reports*
@@ -35,7 +35,7 @@ the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
   fit), instead of a draw that would be negative or a kilometre off;
 * the paths ordered by measured ``d`` (an extraction does not know which path is the LoS) and
   Algorithm 1's ``d >= min_d`` applied as the route does (``SignalRoute.min_d``);
-* the V2X speed and heading messages as :func:`tunnelkit.studies.simulate_drive` draws them.
+* the V2X speed and heading messages as :func:`tunnelkit.simulation.simulate_drive` draws them.
 
 The model comes from :func:`tunnelkit.design.achievable.path_error_model` (the joint ideal CRLB
 and, under impairments, the misspecified covariance, bias and calibration sensitivities);
@@ -216,14 +216,14 @@ def bound_drive(
     calibration: tuple | None = None,
 ):
     """One drive of ``setup``'s route for ``spec`` measured through ``model`` (module docstring):
-    a :class:`tunnelkit.studies.DriveData` the tracker runs on exactly as on the channel route
+    a :class:`tunnelkit.simulation.DriveData` the tracker runs on exactly as on the channel route
     (``extraction="bound"``, reported covariances). ``n_epochs`` keeps the first epochs only.
     ``model`` may be a :class:`BoundRoute` of ``spec`` (:func:`bound_route`, computed once per
     array; its own ``report`` then applies): the same drive, without recomputing the array's
     share of it. ``calibration``: the unit's calibration draw
     (:meth:`PathErrorModel.draw_calibration`; ``None``: drawn from ``rng``, a unit per drive)."""
     from ..channel import sample_clock_bias
-    from ..studies.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
+    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
     from ..tracking.javelin.measurement import PathMeasurements
 
     choice("report", report, REPORTS)

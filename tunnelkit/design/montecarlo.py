@@ -1,12 +1,12 @@
 """JAVELIN on a design: Monte-Carlo drives of every candidate array as one task set.
 
 :func:`sweep_montecarlo` runs the tracker over drives of the scenario's route for every array
-and run through ONE :func:`tunnelkit.montecarlo.run_trials` call (one Dask cluster for the whole
+and run through ONE :func:`tunnelkit.runner.run_trials` call (one Dask cluster for the whole
 sweep; run ``r`` of every array shares child generator ``r``, so arrays are compared on the same
 random numbers). Each trial returns the per-epoch 2-D position error of its drive, so the result
 is identical serially and on any number of workers. Two measurement routes:
 
-* ``mode="channel"``: the route's own signal chain (:func:`tunnelkit.studies.simulate_drive`,
+* ``mode="channel"``: the route's own signal chain (:func:`tunnelkit.simulation.simulate_drive`,
   ``extraction="route"``: the ``M x Nf x Nt`` tensor and the ML extraction every epoch); on the
   ray-traced channel (``setup.channel == "sionna"``) the traced treatment of the tables
   (:mod:`tunnelkit.design.traced`): every epoch's ML measurements through the geometry
@@ -32,9 +32,9 @@ number of epochs averages down).
 
 Cost: the per-array work (error model, the bound route's shared part
 :func:`~tunnelkit.design.fastroute.bound_route`, PEB, the bounds over the drive and the tracker)
-is one task per array (:meth:`tunnelkit.montecarlo.TrialPool.prepare`, the largest array first)
+is one task per array (:meth:`tunnelkit.runner.TrialPool.prepare`, the largest array first)
 and the drives go in a few tasks per worker, each depending on its array's task only: one task
-set on one cluster (:func:`tunnelkit.montecarlo.trial_pool`, started once, or ``pool`` shared by
+set on one cluster (:func:`tunnelkit.runner.trial_pool`, started once, or ``pool`` shared by
 several sweeps), no barrier between models and drives, the array's state fetched worker to
 worker once per worker and only the bounds brought back. A drive on the bound route then costs
 its random draws and the tracker.
@@ -53,7 +53,8 @@ from .._physical import start_spread
 from .._validate import boolean, choice, instance, integer, record
 from ..budget import check_bytes
 from ..metrics import SETTLE_S, settled
-from ..montecarlo import RUN_BYTES, TrialPool, run_trials, trial_pool
+from ..montecarlo import RUN_BYTES
+from ..runner import TrialPool, run_trials, trial_pool
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,
@@ -219,8 +220,8 @@ def sweep_montecarlo(
     sigmas its tracker is told, :func:`tunnelkit.design.traced.traced_bounds`, and refuses
     models). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
     route-median per-path bounds, from the model when there is one). ``workers`` /
-    ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.montecarlo.run_trials` (one cluster for the
-    sweep), or ``pool`` (a :func:`tunnelkit.montecarlo.trial_pool` already open, so several
+    ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.runner.run_trials` (one cluster for the
+    sweep), or ``pool`` (a :func:`tunnelkit.runner.trial_pool` already open, so several
     sweeps share one cluster, started once); ``seed`` an int or a Generator: run ``r`` of every
     array uses child generator ``r``.
     ``impairments`` (a :class:`~tunnelkit.design.achievable.DesignImpairments`, default none):
@@ -299,7 +300,7 @@ def sweep_montecarlo(
     kw = {k: v for k, v in kw.items() if v is not None}
     if pool is not None:
         if not isinstance(pool, TrialPool):
-            raise TypeError(f"pool: expected a montecarlo.TrialPool, got {type(pool).__name__}")
+            raise TypeError(f"pool: expected a runner.TrialPool, got {type(pool).__name__}")
         if kw:
             raise ValueError(f"pool, {', '.join(kw)}: give a pool or where to start one, not both")
     # the largest array's model first (the longest task); its drives wait only for it

@@ -45,7 +45,7 @@ from .._validate import (
 )
 from ..budget import check_bytes, check_elements
 from ..metrics import SETTLE_S
-from ..montecarlo import parallel_options
+from ..runner import parallel_options
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
 from .impairments import (

@@ -10,8 +10,8 @@ only. The traced route changes the same two things the traced JAVELIN tables cha
 
 * **measurements**: every epoch's ML measurements (fits judged against noise + the epoch's
   diffuse power, ``diffuse_floor``), reduced to the paths that agree with one UE through the
-  tunnel's planes (:func:`tunnelkit.studies.traced.geometry_keep` with
-  :data:`~tunnelkit.studies.traced.FLOORS`), whatever the fit's own verdict
+  tunnel's planes (:func:`tunnelkit.simulation.prefilter.geometry_keep` with
+  :data:`~tunnelkit.simulation.prefilter.FLOORS`), whatever the fit's own verdict
   (:func:`traced_drive`);
 * **measurement noise**: the RMS extraction error of THIS array on this channel (the stored
   traced record is the paper array's; a 4x4 and a 16x16 have other errors), measured on the
@@ -90,12 +90,12 @@ def traced_route(setup: DesignSetup, spec):
 def traced_drive(route, rng: np.random.Generator, *, n_epochs: int | None = None) -> dict:
     """One drive of the design route ``route`` (:func:`traced_route`; LoS and road markings as
     the image channel's design drive: no condition) measured by the ML route, through
-    :func:`tunnelkit.studies.drives.simulate_routes` with the traced adapters: ``{"ml",
+    :func:`tunnelkit.simulation.drives.simulate_routes` with the traced adapters: ``{"ml",
     "ml-all", "ml-traced"}`` (``"ml-all"`` every epoch's ML measurements, its fit test ignored;
-    ``"ml-traced"`` those :func:`~tunnelkit.studies.traced.geometry_keep` keeps)."""
+    ``"ml-traced"`` those :func:`~tunnelkit.simulation.prefilter.geometry_keep` keeps)."""
     from ..signal_route import SignalRoute
-    from ..studies.drives import simulate_routes
-    from ..studies.traced import FLOORS, traced_measurements
+    from ..simulation.drives import simulate_routes
+    from ..simulation.prefilter import FLOORS, traced_measurements
 
     instance("route", route, SignalRoute)
     if route.raytraced is None:
@@ -122,8 +122,8 @@ def _error_trial(route, n_epochs, _input, rng):
 
 def _provenance(setup: DesignSetup, spec, n_epochs: int | None) -> dict:
     """What a stored record must match: scenario, array, epochs, procedure, nuisance and the
-    scene (:func:`tunnelkit.studies.traced.scene_provenance` of the array's traced route)."""
-    from ..studies.traced import scene_provenance
+    scene (:func:`tunnelkit.simulation.prefilter.scene_provenance` of the array's traced route)."""
+    from ..simulation.prefilter import scene_provenance
 
     route = traced_route(setup, spec)
     T = len(setup.trajectory)
@@ -148,15 +148,15 @@ def measure_design_errors(
 ) -> dict:
     """``spec``'s traced measurement noise, measured: ``runs`` design drives on the ray-traced
     channel (drive ``i`` from the ``i``-th child of ``seed``, as run ``i`` of a sweep on
-    ``seed``: :func:`~tunnelkit.montecarlo.run_trials`), every epoch's ML measurements
+    ``seed``: :func:`~tunnelkit.runner.run_trials`), every epoch's ML measurements
     (``"ml-all"`` of :func:`traced_drive`), their RMS errors per kind of path
-    (:func:`~tunnelkit.studies.analysis.extraction_errors`, the ``"all"`` row the sigmas).
+    (:func:`~tunnelkit.simulation.analysis.extraction_errors`, the ``"all"`` row the sigmas).
     Returns the record (provenance, ``seed``, ``runs``, ``columns``, ``rows``, the wall time)
     :func:`design_errors` stores."""
     import time
 
-    from ..montecarlo import run_trials
-    from ..studies.analysis import error_correlations, extraction_errors
+    from ..runner import run_trials
+    from ..simulation.analysis import error_correlations, extraction_errors
 
     setup = _setup(setup)
     spec = parse_array(spec)
@@ -204,7 +204,7 @@ def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) ->
 
 
 def _mismatch(stored: dict, current: dict) -> list[str]:
-    from ..studies.traced import check_provenance
+    from ..simulation.prefilter import check_provenance
 
     out = []
     for k in ("procedure", "scenario", "array", "n_epochs", "nuisance"):

@@ -1,6 +1,6 @@
 """Channel-parameter extraction from the SRS tensor (Italiano et al. 2026, eq. 11-24, Algorithm 1).
 
-One module per stage, :func:`extract_paths` (:mod:`.route`) in front:
+One module per stage, :func:`extract_paths` (:mod:`.extract`) in front:
 
 - :mod:`.decomposition` — the CP decomposition of ``H`` (eq. 3, 11, 12) with tensorly, rank checks;
 - :mod:`.paper` — the paper's route from CPD factors to path parameters (eq. 13-24, Algorithm 1);
@@ -38,6 +38,7 @@ from .decomposition import (
     normalize_factors,
 )
 from .estimates import PathEstimates, path_estimates
+from .extract import ROUTES, extract_paths
 from .numerics import MIN_SIGNIFICANCE
 from .paper import (
     algorithm1,
@@ -50,7 +51,6 @@ from .paper import (
     unwrap_spatial,
     vandermonde_roots,
 )
-from .route import ROUTES, extract_paths
 
 __all__ = [
     "MIN_SIGNIFICANCE",

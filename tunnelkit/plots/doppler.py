@@ -10,7 +10,7 @@ from plotly.subplots import make_subplots
 
 from .._validate import instance, sequence, text
 from ..constants import C
-from ..drive import DopplerToaMeasurements, Drive
+from ..doppler_drive import DopplerToaMeasurements, Drive
 from ..metrics import ecdf
 from .common import figure_inputs, reveal_overlaps
 

@@ -6,7 +6,7 @@ Adding a target is one module in this package with one decorated function::
     def jiang_crlb(runs: int, seed: int, progress: bool, **parallel) -> Report: ...
 
 ``parallel`` holds ``workers``, ``scheduler`` and ``timeout``; the target passes them on to
-:func:`tunnelkit.montecarlo.run_trials`, through which all its random trials go (module-level
+:func:`tunnelkit.runner.run_trials`, through which all its random trials go (module-level
 trial functions bound with ``functools.partial``, so Dask can ship them to other processes). The
 report must not depend on them: the same seed gives the same numbers serially or on N workers.
 
@@ -23,8 +23,9 @@ from dataclasses import dataclass
 from .._checks import items
 from .._validate import boolean, integer, positive, record, text
 from ..budget import check_bytes
-from ..montecarlo import CONNECT_TIMEOUT_S, RUN_BYTES, parallel_options
+from ..montecarlo import RUN_BYTES
 from ..report import Report
+from ..runner import CONNECT_TIMEOUT_S, parallel_options
 
 __all__ = ["Report", "Target", "register", "run", "targets"]
 
@@ -117,12 +118,12 @@ def run(
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
-    :func:`tunnelkit.montecarlo.run_trials`). The report is the same either way. ``channel``:
+    :func:`tunnelkit.runner.run_trials`). The report is the same either way. ``channel``:
     "image" (default) or, for the targets that support it, "sionna" (the ray-traced channel).
     ``nuisance`` (those targets only): the route's ``second_order`` / ``diffuse_floor``
     (:class:`tunnelkit.signal_route.SignalRoute`). ``length`` (the targets whose drive can be
     lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
-    (:func:`tunnelkit.studies.drives.drive_variant`, e.g. 120)."""
+    (:func:`tunnelkit.simulation.drives.drive_variant`, e.g. 120)."""
     if isinstance(name, str) and name in TARGET_MODULES:
         importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
     reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()

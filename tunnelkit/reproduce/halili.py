@@ -1,7 +1,7 @@
 """Halili et al. 2022, section 6: error statistics and 90 % error points of the three approaches.
 
 The paper's numbers come from one measured drive through the Beveren tunnel (data not public);
-ours from synthetic drives (:mod:`tunnelkit.drive`) with fresh noise per run. The rows say which
+ours from synthetic drives (:mod:`tunnelkit.doppler_drive`) with fresh noise per run. The rows say which
 is which; the comparison is qualitative, nothing is fitted to the paper's figures.
 """
 
@@ -11,10 +11,10 @@ import functools
 
 import numpy as np
 
-from ..drive import load_drive_config, make_drive
+from ..doppler_drive import load_drive_config, make_drive
 from ..metrics import error_stats
-from ..montecarlo import run_trials
 from ..reference import load as load_reference
+from ..runner import run_trials
 from . import Report, register
 
 PAPER = "paper: measured (Beveren)"
@@ -30,7 +30,7 @@ def pooled_errors(
 ) -> dict[tuple[str, str], np.ndarray]:
     """Errors of every (approach, sigma) over ``runs`` synthetic drives, pooled: (runs * T,) each.
 
-    One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its
+    One trial of :func:`~tunnelkit.runner.run_trials` per drive (``parallel``: its
     ``workers`` / ``scheduler`` / ``timeout``). The trackers run as in the paper (no gate) unless
     ``tracker_kw`` says otherwise.
     """
@@ -129,6 +129,6 @@ def halili_report(errs: dict[tuple[str, str], np.ndarray]) -> Report:
             "(the first one that is not an outlier among them) and eq. 16 keeps the sign of the range "
             "change.",
             "Our first epoch carries the GNSS error of the entrance fix (the paper starts from the true position).",
-            "Synthetic errors follow our documented assumptions (tunnelkit.drive), not fitted to the paper.",
+            "Synthetic errors follow our documented assumptions (tunnelkit.doppler_drive), not fitted to the paper.",
         ],
     )

@@ -2,7 +2,7 @@
 
 Every run simulates a drive through the signal route (image method -> SRS tensor with noise and
 clock bias) once per condition and measures each epoch's tensor through several extraction
-routes (:data:`tunnelkit.studies.EXTRACTIONS`): the paper's (CPD, eq. 11-24)
+routes (:data:`tunnelkit.simulation.EXTRACTIONS`): the paper's (CPD, eq. 11-24)
 and the joint maximum-likelihood fit of eq. 1 (``ml``); the tensors are identical, only the
 extraction differs. The table has five columns per configuration and metric: the paper's design
 (section 4.2) on the paper's route, the paper's design on the ML route, the same with the
@@ -19,9 +19,9 @@ import numpy as np
 
 from .._validate import boolean, instance, integer, sequence, text
 from ..reference import load as load_reference
-from ..studies.collect import collect_drives, collect_routes, per_drive, simulate_condition
-from ..studies.drives import FLAGGED, HELD_OUT_SEED, TUNING_SEEDS, drive_variant
-from ..studies.scoring import evaluate
+from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
+from ..simulation.drives import FLAGGED, HELD_OUT_SEED, TUNING_SEEDS, drive_variant
+from ..simulation.scoring import evaluate
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from . import Report, register
@@ -184,8 +184,8 @@ NOTES = [
     "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails, uses its curvature only when "
     "plausible (|d - kappa| within the clock-bias support, range within 200 m), else its delay "
     "distance, and holds its last fix on epochs without one.",
-    f"Seeds: designs were chosen on the tuning seeds {TUNING_SEEDS} (studies.TUNING_SEEDS); "
-    f"studies.HELD_OUT_SEED ({HELD_OUT_SEED}) was never looked at while choosing anything.",
+    f"Seeds: designs were chosen on the tuning seeds {TUNING_SEEDS} (simulation.TUNING_SEEDS); "
+    f"simulation.HELD_OUT_SEED ({HELD_OUT_SEED}) was never looked at while choosing anything.",
 ]
 
 
@@ -210,9 +210,9 @@ def seed_note(seed: int) -> str:
 def _simulate_and_score(
     scenario, n_epochs, extractions, columns, cond, rng, channel="image", nuisance=None, length=None
 ):
-    """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.studies.collect.simulate_condition`) scored in every column on
+    """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
-    count. ``length``: the drive of :func:`~tunnelkit.studies.drives.drive_variant` instead of
+    count. ``length``: the drive of :func:`~tunnelkit.simulation.drives.drive_variant` instead of
     the preset's (built on the worker, once per process)."""
     route = scenario if length is None else drive_variant(scenario, length)
     if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced column: one more adapter
@@ -247,7 +247,7 @@ def javelin_table(
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
     paper's number beside (``n_epochs`` truncates the drives, for quick checks; ``parallel``
-    goes to :func:`~tunnelkit.montecarlo.run_trials`). Each trial simulates one drive and scores
+    goes to :func:`~tunnelkit.runner.run_trials`). Each trial simulates one drive and scores
     it where it ran, so scoring runs in parallel too; the drives are the same as
     :func:`collect_routes`' (drive ``i`` draws from the ``i``-th child of ``seed``) and the table
     equals :func:`table_rows` on them.
@@ -259,7 +259,7 @@ def javelin_table(
     ``second_order`` (second-order paths in the model) and ``diffuse_floor`` (the ML fit tested
     against noise + diffuse power), :class:`~tunnelkit.signal_route.SignalRoute`. ``length``
     (image channel, straight lane): the drive lengthened to ``length`` metres ending where the
-    preset's ends (:func:`~tunnelkit.studies.drives.drive_variant`; 120 m: UE ranges 5-125 m);
+    preset's ends (:func:`~tunnelkit.simulation.drives.drive_variant`; 120 m: UE ranges 5-125 m);
     ``None`` the preset's drive."""
     sequence("conditions", conditions)
     integer("runs", runs, minimum=1)
@@ -386,7 +386,8 @@ def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
     current scene, :func:`~tunnelkit.studies.traced.traced_errors`), and whether the table's
     route (its nuisance, its ray-tracer settings ``rt_info["rt_settings"]``) is the one they
     were measured on."""
-    from ..studies.traced import FLOORS, traced_errors
+    from ..simulation.prefilter import FLOORS
+    from ..studies.traced import traced_errors
 
     rec = traced_errors()
     a = {r[0]: r for r in rec["rows"]}["all"]
@@ -405,7 +406,7 @@ def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
         "JAVELIN-L run 0 at that seed is child 0, one of those drives)"
         + (
             f", each sigma times sqrt((1 + r) / (1 - r)) for the lag-1 correlation r of one "
-            f"path's errors from epoch to epoch ({r_txt}; studies.error_correlations)"
+            f"path's errors from epoch to epoch ({r_txt}; simulation.error_correlations)"
             if r_txt
             else ""
         )
@@ -447,7 +448,7 @@ def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     """Trace the epochs a ray-traced table needs into the cache (nothing for the image channel);
     returns the cache's numbers for the report's meta."""
     from ..signal_route import CHANNELS
-    from ..studies.drives import CONDITIONS, scenario_route
+    from ..simulation.drives import CONDITIONS, scenario_route
 
     if channel not in CHANNELS:
         raise ValueError(f"channel: expected one of {CHANNELS}, got {channel!r}")

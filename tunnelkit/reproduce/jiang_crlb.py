@@ -7,7 +7,7 @@ import functools
 import numpy as np
 
 from .. import crlb, positioning
-from ..montecarlo import run_trials
+from ..runner import run_trials
 from ..scenarios import load_scenario
 from . import Report, register
 

@@ -11,8 +11,9 @@ import functools
 
 import numpy as np
 
-from ..montecarlo import run_trials, spawn_rngs
+from ..montecarlo import spawn_rngs
 from ..reference import load as load_reference
+from ..runner import run_trials
 from ..scenarios import load_scenario
 from . import Report, register
 
@@ -34,7 +35,7 @@ def table_rows(
 ) -> list[dict]:
     """One dict per (level, algorithm): paper and our mean/variance, RMSE, RMSE / sqrt(PCRLB).
 
-    One trial of :func:`~tunnelkit.montecarlo.run_trials` per noise level (``parallel``: its
+    One trial of :func:`~tunnelkit.runner.run_trials` per noise level (``parallel``: its
     ``workers`` / ``scheduler`` / ``timeout``): its ``runs`` drives, every algorithm on them."""
     from ..tracking import registry
     from ..tracking.virtual_station import FAMILY

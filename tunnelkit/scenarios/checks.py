@@ -1,7 +1,7 @@
 """What a scenario must satisfy beyond its schema, checked once on load: sizes that fit in
 memory, and a base station, arrays and route inside the tunnel (one placement check per family,
 registered in :data:`tunnelkit.scenarios.registry.CHECKS`; Halili's drive registers its own in
-:mod:`tunnelkit.drive`)."""
+:mod:`tunnelkit.doppler_drive`)."""
 
 from __future__ import annotations
 

@@ -138,7 +138,7 @@ PROVIDERS: dict[str, dict[str, str]] = {
         "jiang2023": "tunnelkit.scenarios.checks",
         "italiano2026": "tunnelkit.scenarios.checks",
         "user": "tunnelkit.scenarios.checks",
-        "halili2022": "tunnelkit.drive",
+        "halili2022": "tunnelkit.doppler_drive",
     },
 }
 

@@ -20,25 +20,21 @@ or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a singl
 The package's modules follow its jobs: :mod:`~tunnelkit.signal_route.measurements` (Algorithm 1's
 world-frame measurements of one epoch and the covariance the extraction reports),
 :mod:`~tunnelkit.signal_route.route` (:class:`SignalRoute`: propagation -> channel ->
-extraction), :mod:`~tunnelkit.signal_route.order` (the model order by a detection test per path)
-and :mod:`~tunnelkit.signal_route.judging` (a fit judged against noise plus the impairment power
+extraction) and :mod:`~tunnelkit.signal_route.judging` (a fit judged against noise plus the impairment power
 the route was told about).
 """
 
 from __future__ import annotations
 
 from .measurements import Epoch, RouteMeasurements, measurements_from_estimates, reported_covariance
-from .order import glrt_paths
-from .route import CHANNELS, MAX_SECOND_ORDER, MODEL_ORDERS, SignalRoute, simulate_epoch
+from .route import CHANNELS, MAX_SECOND_ORDER, SignalRoute, simulate_epoch
 
 __all__ = [
     "CHANNELS",
     "MAX_SECOND_ORDER",
-    "MODEL_ORDERS",
     "Epoch",
     "RouteMeasurements",
     "SignalRoute",
-    "glrt_paths",
     "measurements_from_estimates",
     "reported_covariance",
     "simulate_epoch",

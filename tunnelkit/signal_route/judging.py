@@ -6,7 +6,7 @@ calibration error and the diffuse multipath out, so on an impaired channel the r
 carries model error and the test flags fits that found every path: on the 28 GHz example at
 0.5 deg of phase error, 7 of 10 epochs on 4 x 4 and 10 of 10 on 8 x 8, none on the ideal
 channel. A route told its impairment levels (:attr:`SignalRoute.model_error_floor`) re-judges
-such a fit with :func:`tunnelkit.extraction.misspecified.model_error_test`, the same two tests
+such a fit with :func:`model_error_test`, the same two tests
 with a floor of the impairments' share of the received power added (:func:`rejudge`: the
 diffuse share and :func:`calibration_floor`; :func:`impairment_share` their expectation).
 
@@ -82,6 +82,7 @@ __all__ = [
     "calibration_floor",
     "calibration_share",
     "impairment_share",
+    "model_error_test",
     "rejudge",
 ]
 
@@ -177,7 +178,7 @@ def rejudge(est, H, element_positions, fc: float, share: float, calibration=None
     those levels with the fit's model tensor's power per element (``share`` then holds the
     rest: the diffuse share).
 
-    :func:`tunnelkit.extraction.misspecified.model_error_test` of its residual ``H - mu`` (eq. 1
+    :func:`model_error_test` of its residual ``H - mu`` (eq. 1
     of the estimates' model tensor, :meth:`~tunnelkit.extraction.PathEstimates.model_tensor`),
     the received energy ``||H||^2`` and the noise power the fit tested against gives each
     test's share, the residual energy's at the fit's own threshold ``fit.rho_max``, not at the
@@ -188,7 +189,6 @@ def rejudge(est, H, element_positions, fc: float, share: float, calibration=None
     or an unresolved pair stays flagged (``residual_only`` False). Returns the test's dict with
     ``passed``, ``needed`` (the larger of the two shares, at least 0), ``share`` (the floor
     applied, calibration included), ``calibration_floor`` (0 without), ``residual_only``."""
-    from ..extraction.misspecified import model_error_test
     from ..extraction.radio import MAX_CARRIER
 
     fit = getattr(est, "fit", None)
@@ -314,3 +314,63 @@ def apply_budget(meas, budget: BiasBudget, k: int):
         sigma_d=np.sqrt(meas.sigma_d**2 + extra[:, 3, 3]),
         bias_cov=rep,
     )
+
+
+def model_error_test(
+    residual,
+    n_paths: int,
+    received_energy: float,
+    element_positions,
+    fc: float,
+    noise_power: float,
+    share: float,
+    rho_max: float | None = None,
+) -> dict:
+    """The extraction's residual tests with a stated model-error floor.
+
+    A fit's residual ``residual`` (M, Nf, Nt) of ``n_paths`` paths passes when its strongest
+    single-path component (the periodogram peak of
+    :func:`~tunnelkit.extraction.ml.residual_peak`, times ``noise_power``) is at most the
+    noise-only threshold (:func:`~tunnelkit.extraction.ml.calibrated_threshold`) times
+    ``noise_power`` plus ``share * E_rx``, and its energy at most the basin test's
+    ``rho_max (N - 2.5 L) noise_power`` plus ``share * E_rx``; ``E_rx = received_energy -
+    N noise_power`` (``received_energy`` = ``||Y||^2`` of the snapshot): the model error the
+    deployed system allows, stated as a share of the received power (like a DMC share; the
+    residual a fit leaves at the pseudo-true paths, :func:`pseudo_true`, is what it stands for
+    and what no deployed system knows). ``share = 0`` is the plain test. ``rho_max`` (> 0) is
+    the energy test's threshold; ``None`` takes ``1 + z / sqrt(N)`` (:data:`RHO_Z`); a fit's own
+    ``fit.rho_max``, which also allows for a noise power estimated from the tensor, is the
+    looser one its extraction applied.
+
+    Returns ``passed``, ``needed`` the smallest share that passes, ``share_peak`` /
+    ``share_energy`` each test's, ``peak`` (noise powers) and ``rho``."""
+    from ..arrays import check_element_positions
+    from ..extraction.ml import calibrated_threshold, residual_peak
+    from ..extraction.ml.fitting import RHO_Z
+
+    R = np.asarray(residual)
+    if R.ndim != 3 or not np.iscomplexobj(R) or not np.all(np.isfinite(R)):
+        raise ValueError(f"residual: expected a finite complex (M, Nf, Nt) tensor, got {R.shape}")
+    pos = check_element_positions("element_positions", element_positions, m=R.shape[0])
+    fc = positive("fc", fc)
+    n0 = positive("noise_power", noise_power)
+    L = integer("n_paths", n_paths, minimum=0)
+    e_y = positive("received_energy", received_energy)
+    share = nonnegative("share", share)
+    N = R.size
+    rho_max = 1.0 + RHO_Z / np.sqrt(N) if rho_max is None else positive("rho_max", rho_max)
+    e_rx = max(e_y - N * n0, 1e-300 * e_y)
+    peak = residual_peak(R, pos, fc, n0)[0]
+    thr = calibrated_threshold(pos, fc, R.shape)
+    energy = float(np.vdot(R, R).real)
+    s_peak = (peak - thr) * n0 / e_rx
+    s_energy = (energy - rho_max * (N - 2.5 * L) * n0) / e_rx
+    needed = max(s_peak, s_energy, 0.0)
+    return {
+        "passed": bool(needed <= share),
+        "needed": float(needed),
+        "share_peak": float(s_peak),
+        "share_energy": float(s_energy),
+        "peak": float(peak),
+        "rho": energy / ((N - 2.5 * L) * n0),
+    }

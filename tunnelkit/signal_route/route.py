@@ -22,9 +22,8 @@ from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from ..constants import C
 from .measurements import Epoch, RouteMeasurements, measure_epoch
-from .order import glrt_paths
 
-__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "MODEL_ORDERS", "SignalRoute", "simulate_epoch"]
+__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "SignalRoute", "simulate_epoch"]
 
 #: a near-field path whose curvature estimate is below ``UNRESOLVED_Z`` reported standard
 #: deviations (``kappa < z sigma_kappa``) has an unresolved curvature (:func:`_centroid_far_field`)
@@ -39,9 +38,6 @@ MAX_SECOND_ORDER = 32
 #: the largest element gain error [dB] a route's calibration may hold (far beyond any drawn one:
 #: :func:`tunnelkit.channel.draw_calibration` allows a spread of at most 40 dB)
 MAX_CALIBRATION_DB = 300.0
-
-#: how a route chooses the number of paths it extracts (:attr:`SignalRoute.model_order`)
-MODEL_ORDERS = ("known", "glrt")
 
 
 def check_arrays(arrays) -> None:
@@ -99,12 +95,6 @@ class SignalRoute:
     diffuse interaction, times the transmit power; :meth:`ml_noise_power`) instead of the noise
     alone: the diffuse paths as a known noise-like nuisance. The fitted parameters are the
     same least-squares fit; only the tests and the re-seeding they trigger change.
-    ``model_order`` (:data:`MODEL_ORDERS`): ``"known"`` (default) extracts ``L`` = the number of
-    true paths; ``"glrt"`` starts there and adds paths one at a time while the fit's residual
-    holds one more (:func:`glrt_paths`: the residual test's periodogram peak above its threshold,
-    against the noise, or noise + diffuse power with ``diffuse_floor``), up to ``max_paths``.
-    The paths found beyond the true ones (higher-order bounces, clutter) stay in the
-    measurements unless matched to a modelled second-order path.
     ``model_error_floor`` (off by default): an ML fit that fails its white-noise test
     (``fit_ok = False``) is judged again against noise plus the impairment power this route
     was told about (``impairments``: the diffuse share and the calibration levels'
@@ -141,8 +131,6 @@ class SignalRoute:
     wideband_model: bool = False
     second_order: int = 0
     diffuse_floor: bool = False
-    model_order: str = "known"
-    max_paths: int = 24
     model_error_floor: bool = False
     bias_budget: object = field(default=None, repr=False)
     centroid_unresolved: bool = False
@@ -179,8 +167,6 @@ class SignalRoute:
         boolean("bias_aware_delay_check", self.bias_aware_delay_check)
         boolean("wideband_model", self.wideband_model)
         integer("second_order", self.second_order, minimum=0, maximum=MAX_SECOND_ORDER)
-        choice("model_order", self.model_order, MODEL_ORDERS)
-        integer("max_paths", self.max_paths, minimum=1)
         boolean("model_error_floor", self.model_error_floor)
         boolean("centroid_unresolved", self.centroid_unresolved)
         if self.bias_budget is not None:
@@ -371,11 +357,7 @@ class SignalRoute:
             extract_kw.setdefault("wideband", True)
         if self.diffuse_floor and extract_kw.get("refine", "ml") == "ml":
             extract_kw.setdefault("noise_power", self.ml_noise_power(k, snap, tunnel))
-        if self.model_order == "glrt" and extract_kw.get("refine", "ml") == "ml":
-            kw = {k: v for k, v in extract_kw.items() if k not in ("refine", "search")}
-            est = glrt_paths(snap.H, arr, self.config, L, max(L, self.max_paths), **kw)
-        else:
-            est = self.extract(snap.H, arr, L, **extract_kw)
+        est = self.extract(snap.H, arr, L, **extract_kw)
         cfg = self.config if self.report_covariance else None
         rejudged = self.rejudge(est, snap, arr, extract_kw)
         judged = rejudged is None or not rejudged["passed"]

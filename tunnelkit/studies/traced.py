@@ -8,33 +8,32 @@ sigmas of 0.23 deg, 0.31 deg, 3.6 m, 3.2 cm) then trusts them far too much. The 
 changes two things, nothing else:
 
 * **measurement noise**: the RMS extraction error of the ML route on the traced channel
-  (:func:`~tunnelkit.studies.analysis.extraction_errors`, all matched paths pooled), each sigma
+  (:func:`~tunnelkit.simulation.analysis.extraction_errors`, all matched paths pooled), each sigma
   times ``sqrt((1 + r) / (1 - r))`` with ``r`` its lag-1 correlation from epoch to epoch
-  (:func:`~tunnelkit.studies.analysis.error_correlations`: the errors of one path repeat, 0.44
+  (:func:`~tunnelkit.simulation.analysis.error_correlations`: the errors of one path repeat, 0.44
   in azimuth and 0.66 in elevation, and a tracker that takes them as white averages them down
   too far), measured by
   :func:`measure_traced_errors` on the straight drive, seed 0, condition L, :data:`SIGMA_RUNS`
   runs (drive ``i`` from the ``i``-th child of seed 0), and stored with its provenance in
   ``data/rt/traced_errors.json`` (:func:`write_traced_errors`; ``benchmarks/bench_rt_sigmas.py
   --write`` re-measures it); :func:`traced_design` reads it, its scene checked against the
-  current one (:func:`check_provenance`: the ray tracer's settings and the trace cache's key;
+  current one (:func:`~tunnelkit.simulation.prefilter.check_provenance`: the ray tracer's settings and the trace cache's key;
   a record of another scene is refused, never reused);
-* **a geometry pre-filter**: an epoch's paths that do not agree with one UE through the tunnel's
-  planes are dropped (:func:`geometry_keep`: :func:`tunnelkit.path_consistency.epoch_consistency`
-  with the model-error floors :data:`FLOORS` alone), and an epoch whose fit failed its residual
+* **a geometry pre-filter** (:mod:`tunnelkit.simulation.prefilter`): an epoch's paths that do not agree with one UE through the tunnel's
+  planes are dropped (:func:`~tunnelkit.simulation.prefilter.geometry_keep`: :func:`tunnelkit.path_consistency.epoch_consistency`
+  with the model-error floors :data:`~tunnelkit.simulation.prefilter.FLOORS` alone), and an epoch whose fit failed its residual
   test still carries its measurements (on this channel every fit fails it: the test judges eq. 1,
   not the paths the tracker needs).
 
-The noise stays pooled over the kinds of path. One sigma set per kind, each path's taken from
-the kind of surface the pre-filter assigns it (:func:`geometry_labels`, ``PathMeasurements.kind``,
-:class:`~tunnelkit.tracking.javelin.KindNoise`), was measured and is worse
-(``benchmarks/bench_rt_kind_noise.py``, held-out seed, 4 drives per table: JAVELIN-L 0.556 /
-0.563 m against 0.167 / 0.309 m pooled): the assigned kind is the true one for 58 % of the
-matched paths (the road bounce for 4 of 38, mostly taken for a wall or the LoS), and a road
-bounce taken for the LoS is given the LoS's 2 deg where it errs by 13.
+The noise stays pooled over the kinds of path. One sigma set per kind of path, each path's
+taken from the kind of surface the pre-filter assigns it, was measured and is worse (held-out
+seed, 4 drives per table: JAVELIN-L 0.556 / 0.563 m against 0.167 / 0.309 m pooled): the
+assigned kind is the true one for 58 % of the matched paths (the road bounce for 4 of 38, mostly
+taken for a wall or the LoS), and a road bounce taken for the LoS is given the LoS's 2 deg where
+it errs by 13. That per-kind noise model was removed with its benchmark.
 
-:func:`simulate_traced` is the drive simulator (:func:`tunnelkit.studies.drives.simulate_routes`)
-with that adapter beside the ordinary one (:func:`tunnelkit.studies.drives.path_measurements`,
+:func:`simulate_traced` is the drive simulator (:func:`tunnelkit.simulation.drives.simulate_routes`)
+with that adapter beside the ordinary one (:func:`tunnelkit.simulation.drives.path_measurements`,
 which drops a flagged epoch), both measuring the ML route's epochs (its ``adapters``): one drive,
 the same random draws as ``simulate_routes(extractions=("paper", "ml"))``, returned as
 ``{"paper", "ml", "ml-all", "ml-traced"}`` (``ml-all``: every epoch's ML measurements, flagged or not, unfiltered).
@@ -48,43 +47,36 @@ from functools import partial
 
 import numpy as np
 
-from .._validate import boolean, finite_array, instance, integer, rng_or_error
-from ..consistency import plane_kinds
-from ..path_consistency import epoch_consistency
+from .._validate import boolean, integer, rng_or_error
 from ..scenarios import data_dir
-from ..signal_route import Epoch, SignalRoute
+from ..simulation.drives import CONDITIONS, DriveData, scenario_route, simulate_routes
+from ..simulation.prefilter import (
+    FLOORS,
+    NUISANCE,
+    SIGMA_SCENARIO,
+    check_floors,
+    check_provenance,
+    scene_provenance,
+    traced_measurements,
+)
 from ..tracking.javelin import designs
-from ..tracking.javelin.measurement import PathMeasurements
-from .drives import CONDITIONS, DriveData, scenario_route, simulate_routes
 
 __all__ = [
-    "FLOORS",
     "SIGMA_RUNS",
-    "SIGMA_SCENARIO",
     "TRACED_ROUTES",
-    "check_provenance",
-    "geometry_keep",
-    "geometry_labels",
     "measure_traced_errors",
-    "scene_provenance",
     "simulate_traced",
     "traced_design",
     "traced_errors",
-    "traced_measurements",
     "write_traced_errors",
 ]
 
-#: model-error floors of the geometry pre-filter: (angle [rad], range [m]), chosen on the straight
-#: drive, seed 0 (``benchmarks/bench_rt_track.py``); the bound's own sigmas are left out (the
-#: traced fits lie thousands of CRLB standard deviations off)
-FLOORS = (float(np.radians(0.5)), 0.3)
-#: the drive and number of condition-L runs (seed 0) the traced sigmas are measured on
-SIGMA_SCENARIO, SIGMA_RUNS = "italiano2026-straight", 3
+#: the number of condition-L runs (seed 0) the traced sigmas are measured on
+SIGMA_RUNS = 3
+
+
 #: the routes :func:`simulate_traced` returns
 TRACED_ROUTES = ("paper", "ml", "ml-all", "ml-traced")
-#: the ray-traced route the traced sigmas are measured on (the ML fit judged against noise +
-#: diffuse power)
-NUISANCE = {"diffuse_floor": True}
 
 
 def _errors_path():
@@ -100,62 +92,6 @@ def _path(path):
     return Path(path)
 
 
-def _floors(floors) -> tuple[float, float]:
-    f = finite_array("floors", floors)
-    if f.shape != (2,) or np.any(f <= 0):
-        raise ValueError(f"floors: expected (angle [rad], range [m]), both > 0, got {floors!r}")
-    return float(f[0]), float(f[1])
-
-
-def geometry_labels(ep: Epoch, route: SignalRoute, floors=FLOORS) -> tuple[np.ndarray, np.ndarray]:
-    """The geometry-consistency test of ``ep.measurements`` (residuals in units of the
-    model-error ``floors`` = (angle [rad], range [m]) alone, per-path chi-square(3) at 1 %):
-    the rows it keeps, and the kind of surface it assigns to each kept row (``"los"`` or
-    :func:`~tunnelkit.consistency.plane_kinds` of its plane). An epoch of fewer than two
-    paths keeps them all, unassigned (``""``: nothing to test)."""
-    instance("ep", ep, Epoch)
-    instance("route", route, SignalRoute)
-    fa, fr = _floors(floors)
-    m = ep.measurements
-    if len(m) < 2:
-        return np.arange(len(m)), np.full(len(m), "", dtype="<U7")
-    res = epoch_consistency(ep, route, bound=False, floor_angle=fa, floor_range=fr)
-    keep = np.flatnonzero(res["keep"])
-    names = np.array(("los", *plane_kinds(route.tunnel)))
-    return keep, names[res["plane"][keep] + 1]
-
-
-def geometry_keep(ep: Epoch, route: SignalRoute, floors=FLOORS) -> np.ndarray:
-    """Rows of ``ep.measurements`` the geometry-consistency test keeps
-    (:func:`geometry_labels`)."""
-    return geometry_labels(ep, route, floors)[0]
-
-
-def traced_measurements(
-    ep: Epoch, route: SignalRoute, floors=FLOORS, *, prefilter: bool = True
-) -> tuple[PathMeasurements | None, str | None]:
-    """The traced design's adapter: ``ep``'s measurements whatever its fit's own verdict
-    (``fit_ok``), reduced to the rows :func:`geometry_labels` keeps, each labelled with the kind
-    of surface the test assigned it (``PathMeasurements.kind``, what a per-kind noise model
-    reads); ``prefilter=False``: all rows, unlabelled. ``(None, reason)`` when no row is left."""
-    instance("ep", ep, Epoch)
-    instance("route", route, SignalRoute)
-    prefilter = boolean("prefilter", prefilter)
-    m = ep.measurements
-    pm = PathMeasurements.from_arrays(
-        m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d
-    )
-    if not prefilter:
-        return pm, None
-    keep, kinds = geometry_labels(ep, route, floors)
-    rows = np.flatnonzero(np.isin(pm.source, keep))
-    if not rows.size:
-        return None, "the geometry test kept no path"
-    label = np.full(len(m), "", dtype=object)
-    label[keep] = kinds
-    return pm.with_kinds(list(label[pm.source])).subset(rows), None
-
-
 def simulate_traced(
     route,
     rng: np.random.Generator,
@@ -168,7 +104,7 @@ def simulate_traced(
 ) -> dict[str, DriveData]:
     """One drive of ``route`` (a :class:`SignalRoute` or a scenario name, :func:`scenario_route`
     with ``channel`` / ``nuisance``) under ``condition`` (a name of :data:`CONDITIONS`), measured
-    through the paper's and the ML route as :func:`~tunnelkit.studies.drives.simulate_routes`
+    through the paper's and the ML route as :func:`~tunnelkit.simulation.drives.simulate_routes`
     measures them (same draws, same ``"paper"`` and ``"ml"`` drives), plus ``"ml-all"`` (the ML
     route's measurements of every epoch, its fit test ignored) and ``"ml-traced"`` (those the
     geometry pre-filter keeps, :func:`traced_measurements` with ``floors``)."""
@@ -178,7 +114,7 @@ def simulate_traced(
     cond = CONDITIONS[condition]
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
-    floors = _floors(floors)
+    floors = check_floors(floors)
     return simulate_routes(
         route,
         rng,
@@ -205,14 +141,14 @@ def measure_traced_errors(
 ) -> dict:
     """The traced design's measurement noise, measured: ``runs`` condition-L drives of
     :data:`SIGMA_SCENARIO` on the ray-traced channel (diffuse power as the ML fit's floor; drive
-    ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.montecarlo.run_trials`), every
+    ``i`` from the ``i``-th child of ``seed``, :func:`~tunnelkit.runner.run_trials`), every
     epoch's ML measurements (``"ml-all"`` of :func:`simulate_traced`), their RMS errors per kind
-    of path (:func:`~tunnelkit.studies.analysis.extraction_errors`) and their lag-1 correlation
-    from epoch to epoch (:func:`~tunnelkit.studies.analysis.error_correlations`). Returns the
+    of path (:func:`~tunnelkit.simulation.analysis.extraction_errors`) and their lag-1 correlation
+    from epoch to epoch (:func:`~tunnelkit.simulation.analysis.error_correlations`). Returns the
     record :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the
     sigmas), ``correlation`` (each sigma's inflation) and the procedure's provenance."""
-    from ..montecarlo import run_trials
-    from .analysis import error_correlations, extraction_errors
+    from ..runner import run_trials
+    from ..simulation.analysis import error_correlations, extraction_errors
 
     runs = integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
@@ -250,52 +186,6 @@ def write_traced_errors(record: dict, path=None) -> str:
     p.parent.mkdir(parents=True, exist_ok=True)
     p.write_text(json.dumps(record, indent=1, default=str) + "\n")
     return str(p)
-
-
-def scene_provenance(route=None) -> dict:
-    """What the traced sigmas depend on besides the procedure: ``rt_settings`` (the ray tracer's
-    :class:`~tunnelkit.rt.settings.RTSettings`) and ``rt_key`` (the ray-tracing cache's key of the
-    drive: scene export hash, settings, arrays, trajectory, radio, cache format, sionna-rt
-    version; :meth:`~tunnelkit.rt.cache.RayTracedChannel.key`) of ``route`` (default: the route
-    the sigmas are measured on, :data:`SIGMA_SCENARIO` on the ray-traced channel)."""
-    if route is None:
-        route = scenario_route(SIGMA_SCENARIO, "exact", "sionna", NUISANCE)
-    instance("route", route, SignalRoute)
-    if route.raytraced is None:
-        raise ValueError("route: expected a route on the ray-traced channel (channel='sionna')")
-    return {
-        "rt_settings": dict(vars(route.raytraced.settings)),
-        "rt_key": route.raytraced.key(),
-    }
-
-
-def check_provenance(record: dict, current: dict | None = None) -> list[str]:
-    """Compare a stored record's ``rt_settings`` / ``rt_key`` with ``current``
-    (:func:`scene_provenance` by default). Returns the entries it cannot check (absent from the
-    record); raises ``ValueError`` naming every entry that differs (the record belongs to another
-    scene or ray tracer and must not be reused)."""
-    if not isinstance(record, dict):
-        raise TypeError(f"record: expected the dict of measure_traced_errors, got {record!r}")
-    cur = scene_provenance() if current is None else current
-    if not isinstance(cur, dict) or not {"rt_settings", "rt_key"} <= set(cur):
-        raise TypeError("current: expected the dict of scene_provenance")
-    unchecked, differ = [], []
-    for part in ("rt_settings", "rt_key"):
-        old = record.get(part)
-        if not isinstance(old, dict):
-            unchecked.append(part)
-            continue
-        for name in sorted(set(old) | set(cur[part])):
-            a, b = old.get(name), cur[part].get(name)
-            if json.dumps(a, default=str) != json.dumps(b, default=str):
-                differ.append(f"{part}.{name}: stored {a!r}, now {b!r}")
-    if differ:
-        raise ValueError(
-            "record: measured on another scene or ray tracer than the current one ("
-            + "; ".join(differ)
-            + "); re-measure with benchmarks/bench_rt_sigmas.py --write"
-        )
-    return unchecked
 
 
 _CHECKED: dict[tuple, list[str]] = {}

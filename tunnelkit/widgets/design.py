@@ -24,7 +24,6 @@ import ipywidgets as widgets
 import numpy as np
 import plotly.graph_objects as go
 
-from .. import design
 from .._validate import integer, positive, probability, real, text
 from ..plots.design import route_figure
 from .base import Explorer, checkbox, float_slider, int_slider
@@ -43,7 +42,10 @@ BANDWIDTHS_MHZ = (20.0, 50.0, 100.0, 200.0, 400.0, 800.0)
 
 
 @lru_cache(maxsize=8)
-def _base(scenario: str) -> design.DesignSetup:
+def _base(scenario: str):
+    """The scenario's :class:`~tunnelkit.design.DesignSetup` (the design loaded on first use)."""
+    from .. import design
+
     return design.DesignSetup.from_scenario(scenario)
 
 
@@ -70,6 +72,8 @@ def design_figure(
     Pure: the same arguments give the same figure. A design that does not fit (array outside the
     tunnel at this mount) gives an empty figure whose title says so instead of raising.
     """
+    from .. import design
+
     wideband = checkbox("", wideband, name="wideband").value
     # the arguments are checked here, before the "does not fit" figure below catches ValueError
     fc_ghz, bandwidth_mhz = positive("fc_ghz", fc_ghz), positive("bandwidth_mhz", bandwidth_mhz)
@@ -184,6 +188,8 @@ class DesignExplorer(Explorer):
         array, ``units`` manufactured units of two drives, one batch): its
         :class:`~tunnelkit.design.DesignRow`, unit yield and error quantile with their
         intervals; what the button runs."""
+        from .. import design
+
         v = self.values
         setup = _base(self.scenario).variant(
             fc=v["fc_ghz"] * 1e9,

@@ -19,7 +19,7 @@ def doppler_figure(
     ``sigma_hz`` is the filters' assumed Doppler noise (R = sigma^2), ``q`` the process-noise
     density of eq. 3, ``doppler_bias_hz`` the drive's traffic bias on the Doppler (the truth).
     """
-    from ..drive import gnss_fix, make_drive, measure
+    from ..doppler_drive import gnss_fix, make_drive, measure
     from ..plots.doppler import error_time_figure
     from ..tracking.doppler import run_approaches
 

@@ -15,8 +15,8 @@ __all__ = ["epoch_explorer", "epoch_view"]
 
 
 def _drive_and_evaluation(drive, evaluation) -> None:
-    attributes("drive", drive, ("truth", "sources", "base_station"), "a studies.DriveData")
-    attributes("evaluation", evaluation, ("run",), "a studies.Evaluation")
+    attributes("drive", drive, ("truth", "sources", "base_station"), "a simulation.DriveData")
+    attributes("evaluation", evaluation, ("run",), "a simulation.Evaluation")
 
 
 def epoch_view(drive, evaluation, k: int, plane: str = "yz") -> go.Figure:

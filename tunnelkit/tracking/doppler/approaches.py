@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._validate import instance, integer, positive, record, sequence, text
-from ...drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
+from ...doppler_drive import DopplerToaMeasurements, Drive, GnssFix, gnss_fix, measure, slant_range
 from ..registry import family, register
 from .filters import (
     DopplerEKF,

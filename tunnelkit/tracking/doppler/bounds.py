@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._validate import finite_array, nonnegative, positive
-from ...drive import Drive, slant_range
+from ...doppler_drive import Drive, slant_range
 from .filters import DopplerSetup, cv_model, doppler_jacobian
 
 __all__ = ["posterior_crlb", "snapshot_fim"]

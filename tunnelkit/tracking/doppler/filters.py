@@ -29,7 +29,7 @@ from ..._validate import (
     real,
 )
 from ...constants import C
-from ...drive import Drive, GnssFix
+from ...doppler_drive import Drive, GnssFix
 from ..cv import cv_process_noise, cv_transition
 from ..gating import (
     DEFAULT_GATE,

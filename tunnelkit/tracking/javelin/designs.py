@@ -24,12 +24,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import boolean, integer, positive, real, sequence
+from ..._validate import real, sequence
 from .associate import Associator
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, VueCurvature
 from .motion import MirrorMotion
-from .noise import ConsiderNoise, FixedNoise, KindNoise
+from .noise import ConsiderNoise
 from .roles import JavelinDesign
 from .surfaces import GeometricBirth
 from .update import JointTestUpdater
@@ -41,7 +41,6 @@ __all__ = [
     "ARRAY_DESIGN_VUE_WALK",
     "CORRELATED",
     "MAX_CORRELATION",
-    "MIN_KIND_MATCHED",
     "ML_ERRORS_SEED0",
     "ablation_path",
     "array_design",
@@ -55,7 +54,7 @@ __all__ = [
 
 #: RMS extraction error of the ML route over every matched path (663) of the first three seed-0
 #: LoS drives of each trajectory (``collect_routes(..., seed=0)``, runs 0-2;
-#: :func:`tunnelkit.studies.extraction_errors`, row "all"): what :func:`ours_ml` assumes. Per kind
+#: :func:`tunnelkit.simulation.extraction_errors`, row "all"): what :func:`ours_ml` assumes. Per kind
 #: (phi / psi [deg], kappa / Delta d [m]): LoS 0.34 / 0.33 / 3.0 / -, ceiling 0.054 / 0.16 / 3.2 /
 #: 0.0022, road 0.26 / 0.035 / 5.7 / 0.019, RRM 0.00065 / 0.00048 / 0.11 / 0.0001, wall 0.43 / 1.3
 #: / 0.21 / 0.058. The RMS is set by a few gross errors on the slalom (paths swapped or merged in
@@ -222,11 +221,6 @@ def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> Ja
     )
 
 
-#: matched measurements a kind of path needs before :func:`design_from_errors` gives it its own
-#: sigmas (fewer: the pooled row's)
-MIN_KIND_MATCHED = 30
-
-
 #: the largest lag-1 correlation :func:`design_from_errors` inflates by (a larger one is an
 #: error that hardly changes along the drive: a bias, which no white noise describes)
 MAX_CORRELATION = 0.9
@@ -262,26 +256,19 @@ def design_from_errors(
     rows: list[list],
     base: JavelinDesign | None = None,
     *,
-    per_kind: bool = False,
     correlation: dict | None = None,
 ) -> JavelinDesign:
     """A design whose measurement noise is the measured extraction error: ``sigma_phi``,
     ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d`` from the ``"all"`` row of
-    :func:`tunnelkit.studies.extraction_errors`; every role and other number from ``base``
-    (default :func:`ours_coherent`). ``per_kind``: the noise role becomes
-    :class:`~.noise.KindNoise` with each kind's own row (a kind of fewer than
-    :data:`MIN_KIND_MATCHED` matched measurements, and a quantity a row leaves empty, keep the
-    pooled sigma; no kind with enough: the pooled design); a path the route did not label keeps
-    the pooled sigmas; ``base`` must have the paper's noise role (``FixedNoise()``), which this
-    replaces. ``correlation``: each quantity's lag-1 error correlation ``r``
-    (:func:`tunnelkit.studies.error_correlations`, ``{"phi", "psi", "kappa", "delta_d"}`` to
+    :func:`tunnelkit.simulation.extraction_errors`; every role and other number from ``base``
+    (default :func:`ours_coherent`). ``correlation``: each quantity's lag-1 error correlation ``r``
+    (:func:`tunnelkit.simulation.error_correlations`, ``{"phi", "psi", "kappa", "delta_d"}`` to
     ``r`` or to ``{"r": r, ...}``): its sigma times ``sqrt((1 + r) / (1 - r))``, the long-run
     standard deviation of an AR(1) error (what averaging over epochs leaves of it; ``r`` clipped
     to ``[0, MAX_CORRELATION]``: a white model for a negative one, and a bias is not AR(1))."""
     base = ours_coherent() if base is None else base
     if not isinstance(base, JavelinDesign):
         raise TypeError(f"base: expected a JavelinDesign, got {type(base).__name__}")
-    per_kind = boolean("per_kind", per_kind)
     table = {r[0]: r for r in sequence("rows", rows)}
     pooled = table.get("all")
     if pooled is None:
@@ -290,27 +277,7 @@ def design_from_errors(
     sig = [float(np.radians(pooled[2])), float(np.radians(pooled[3])), *map(float, pooled[4:6])]
     sig = [float(v * fi) for v, fi in zip(sig, f, strict=True)]
     out = base.with_(sigma_phi=sig[0], sigma_psi=sig[1], sigma_kappa=sig[2], sigma_delta_d=sig[3])
-    if not per_kind:
-        return out
-    if base.noise != FixedNoise():
-        raise ValueError(
-            f"per_kind: replaces the noise role, and base's is {base.noise!r} (only the paper's "
-            "FixedNoise() has no more to it than its sigmas)"
-        )
-    kinds = []
-    for kind, r in table.items():
-        if kind == "all":
-            continue
-        if not isinstance(kind, str) or not kind or len(r) < 6:
-            raise ValueError(f"rows: expected [kind, matched, phi, psi, kappa, dd, ...], got {r!r}")
-        n = integer(f"rows[{kind!r}] matched", r[1], minimum=0)
-        if n < MIN_KIND_MATCHED:
-            continue
-        unit = (np.radians(1.0), np.radians(1.0), 1.0, 1.0)  # the rows' angles are in degrees
-        own = [p if v is None else float(positive(f"rows[{kind!r}]", v) * u * fi)
-               for v, u, p, fi in zip(r[2:6], unit, sig, f, strict=True)]  # fmt: skip
-        kinds.append((kind, *own))
-    return out.with_(noise=KindNoise(tuple(kinds))) if kinds else out
+    return out
 
 
 def ablation_path() -> dict[str, JavelinDesign]:

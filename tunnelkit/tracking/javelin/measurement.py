@@ -18,7 +18,7 @@ paper's ``tan^-1(y/x)`` so a UE behind the array (``x < 0``) keeps its true bear
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -77,21 +77,6 @@ def _reported(cov, sigma_d, n: int):
     return cov, sd
 
 
-def _kinds(kind, n: int):
-    """Checked ``kind``: ``None`` or one string per path, as an (n,) str array."""
-    if kind is None:
-        return None
-    if not (isinstance(kind, list | tuple) or (isinstance(kind, np.ndarray) and kind.ndim == 1)):
-        raise TypeError(f"kind: expected a list of one string per path, got {kind!r:.60}")
-    if len(kind) != n:
-        raise ValueError(f"kind: expected {n} values (one per path), got {len(kind)}")
-    if not all(isinstance(k, str | np.str_) for k in kind):
-        raise TypeError(f"kind: expected one string per path, got {list(kind)!r:.80}")
-    out = np.empty(n, dtype=object)  # one dtype whatever the strings' lengths
-    out[:] = [str(k) for k in kind]
-    return out
-
-
 def _bias(bias_cov, cov, sigma_d, n: int):
     """Checked ``bias_cov`` (n, 4, 4): symmetric, positive semi-definite, and no larger than the
     reported covariance it is a share of (``cov`` / ``sigma_d``) in any direction."""
@@ -132,10 +117,7 @@ class PathMeasurements:
     (n, 4, 4), with a reported covariance only: the share of it over ``(phi, psi, kappa, d)``
     that repeats from one epoch to the next (a calibration error drawn once per array, a bias of
     the estimator's model), which a bias-aware tracker (:class:`~.noise.ConsiderNoise`) keeps
-    apart from the white share ``cov - bias_cov``. ``kind`` (n,) str, optional: the kind of
-    surface each path was assigned to by a test outside the tracker (``"los"``, ``"wall"``,
-    ``"ceiling"``, ``"road"``, ``"rrm"``; ``""`` unassigned), which a per-kind noise model
-    (:class:`~.noise.KindNoise`) reads; no other role does.
+    apart from the white share ``cov - bias_cov``.
     """
 
     phi: np.ndarray
@@ -147,7 +129,6 @@ class PathMeasurements:
     cov: np.ndarray | None = None
     sigma_d: np.ndarray | None = None
     bias_cov: np.ndarray | None = None
-    kind: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # built directly (not through from_arrays): 1-D float arrays of one length, and a
@@ -170,7 +151,6 @@ class PathMeasurements:
         self.source = src
         self.cov, self.sigma_d = _reported(self.cov, self.sigma_d, n)
         self.bias_cov = _bias(self.bias_cov, self.cov, self.sigma_d, n)
-        self.kind = _kinds(self.kind, n)
 
     @property
     def reported(self) -> bool:
@@ -190,10 +170,7 @@ class PathMeasurements:
         kappa = np.where(np.isfinite(self.kappa) & (self.kappa > 0), self.kappa, np.nan)
         d = np.where(np.isfinite(self.d), self.d, np.nan)
         v = np.where(np.isfinite(self.v), self.v, np.nan)
-        sub = [
-            None if a is None else a[idx]
-            for a in (self.cov, self.sigma_d, self.bias_cov, self.kind)
-        ]
+        sub = [None if a is None else a[idx] for a in (self.cov, self.sigma_d, self.bias_cov)]
         clean = unchecked(
             PathMeasurements, self.phi[idx], self.psi[idx], kappa[idx], d[idx], v[idx],
             self.source[idx], *sub,
@@ -280,12 +257,7 @@ class PathMeasurements:
             None if self.cov is None else self.cov[idx],
             None if self.sigma_d is None else self.sigma_d[idx],
             None if self.bias_cov is None else self.bias_cov[idx],
-            None if self.kind is None else self.kind[idx],
         )
-
-    def with_kinds(self, kind) -> PathMeasurements:
-        """A copy with every path's surface ``kind`` (n,) str set (``None``: cleared)."""
-        return replace(self, kind=kind)
 
     def triples(self) -> np.ndarray:
         """``(phi, psi, kappa)`` per path, shape (n, 3) (NaN kappa where far field)."""

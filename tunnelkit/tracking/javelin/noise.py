@@ -1,7 +1,6 @@
 """The measurement-noise role of JAVELIN: the covariance of every measured row.
 
-:class:`FixedNoise` is the paper's (one sigma per quantity, section 4.2); :class:`KindNoise`
-(ours) one sigma per quantity for each kind of path; :class:`ReportedNoise`
+:class:`FixedNoise` is the paper's (one sigma per quantity, section 4.2); :class:`ReportedNoise`
 takes each path's covariance as the extraction reports it (ours). Both answer the same two
 questions: the (n, 3, 3) covariance of each path's ``(phi, psi, kappa)``
 (:meth:`~FixedNoise.covariances`) and the covariance of the TDoA rows ``d_j - d_ref``
@@ -21,7 +20,7 @@ from ..._validate import finite_array, instance, integer, nonnegative, positive
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 
-__all__ = ["ConsiderNoise", "FixedNoise", "KindNoise", "ReportedNoise", "bias_factors"]
+__all__ = ["ConsiderNoise", "FixedNoise", "ReportedNoise", "bias_factors"]
 
 
 def _tdoa_rows(meas, others, reference: int, config) -> tuple[list[int], int]:
@@ -68,62 +67,6 @@ class FixedNoise:
         if self.correlated_delta_d:
             return 0.5 * s2 * (np.eye(nd) + np.ones((nd, nd)))
         return s2 * np.eye(nd)
-
-
-@dataclass(frozen=True)
-class KindNoise:
-    """One sigma per quantity for each KIND of path (ours): a path whose ``PathMeasurements.kind``
-    is a row of ``sigmas`` gets that row's ``diag(sigma_phi^2, sigma_psi^2, sigma_kappa^2)`` and
-    TDoA variance ``sigma_dd^2``; any other path (no kind, an unassigned ``""``, a kind without a
-    row) the config's sigmas, as :class:`FixedNoise`. TDoA rows are independent, as
-    :class:`FixedNoise`'s default. ``sigmas``: rows ``(kind, sigma_phi [rad], sigma_psi [rad],
-    sigma_kappa [m], sigma_dd [m])``, e.g. measured per kind of path on a channel the estimator's
-    model does not describe (:func:`~tunnelkit.tracking.javelin.designs.design_from_errors` with
-    ``per_kind=True``), where the line of sight is several times better than the road's bounce."""
-
-    sigmas: tuple
-    needs_reported: ClassVar[bool] = False
-
-    def __post_init__(self) -> None:
-        rows = self.sigmas
-        if isinstance(rows, str) or not isinstance(rows, tuple | list):
-            raise TypeError(f"sigmas: expected rows (kind, phi, psi, kappa, dd), got {rows!r:.60}")
-        if not rows:
-            raise ValueError("sigmas: expected at least one row (kind, phi, psi, kappa, dd)")
-        out, seen = [], set()
-        for r in rows:
-            if not isinstance(r, tuple | list) or len(r) != 5 or not isinstance(r[0], str):
-                raise TypeError(f"sigmas: expected rows (kind, phi, psi, kappa, dd), got {r!r:.60}")
-            if not r[0] or r[0] in seen:
-                raise ValueError(f"sigmas: kinds must be non-empty and distinct, got {r[0]!r}")
-            seen.add(r[0])
-            out.append((r[0], *(float(positive(f"sigmas[{r[0]!r}]", v)) for v in r[1:])))
-        object.__setattr__(self, "sigmas", tuple(out))
-
-    def _per_path(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
-        """(n, 4) sigmas ``(phi, psi, kappa, dd)`` of each path of ``meas``."""
-        base = [config.sigma_phi, config.sigma_psi, config.sigma_kappa, config.sigma_delta_d]
-        out = np.tile(np.asarray(base, float), (len(meas), 1))
-        if meas.kind is not None:
-            for kind, *sig in self.sigmas:
-                out[meas.kind == kind] = sig
-        return out
-
-    def covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
-        """The (n, 3, 3) covariance of each path's ``(phi, psi, kappa)``, from its kind."""
-        instance("meas", meas, PathMeasurements)
-        instance("config", config, JavelinConfig)
-        s = self._per_path(meas, config)[:, :3]
-        out = np.zeros((len(meas), 3, 3))
-        out[:, [0, 1, 2], [0, 1, 2]] = s**2
-        return out
-
-    def tdoa_covariance(
-        self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
-    ) -> np.ndarray:
-        """Covariance of the TDoA rows ``d_j - d_ref``: ``diag(sigma_dd(kind_j)^2)``."""
-        others, reference = _tdoa_rows(meas, others, reference, config)
-        return np.diag(self._per_path(meas, config)[others, 3] ** 2)
 
 
 @dataclass(frozen=True)

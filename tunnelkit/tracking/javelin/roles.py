@@ -8,9 +8,7 @@ role                  the paper (section 4.2)                   ours
 ====================  ========================================  =================================
 measurement noise     :class:`FixedNoise` (one sigma per        :class:`FixedNoise` with
                       quantity, diagonal TDoAs)                 ``correlated_delta_d``;
-                                                                :class:`KindNoise` (one sigma
-                                                                per quantity for each kind of
-                                                                path); :class:`ReportedNoise`
+                                                                :class:`ReportedNoise`
                                                                 (each path's reported
                                                                 covariance)
 associator            :class:`Associator` (greedy, ``eta^2``)   global nearest neighbour,
@@ -41,7 +39,7 @@ from .config import JavelinConfig
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, ReflectorCurvature, VueCurvature
 from .motion import MirrorMotion, RandomWalk
-from .noise import ConsiderNoise, FixedNoise, KindNoise, ReportedNoise
+from .noise import ConsiderNoise, FixedNoise, ReportedNoise
 from .update import JointTestUpdater, JosephUpdater
 
 __all__ = [
@@ -54,7 +52,6 @@ __all__ = [
     "JavelinDesign",
     "JointTestUpdater",
     "JosephUpdater",
-    "KindNoise",
     "MeasuredBirth",
     "MirrorMotion",
     "RandomWalk",
@@ -66,7 +63,7 @@ __all__ = [
 
 # -- the design -----------------------------------------------------------------------------------
 _ROLE_TYPES = {
-    "noise": (FixedNoise, KindNoise, ReportedNoise),
+    "noise": (FixedNoise, ReportedNoise),
     "associator": (Associator,),
     "initiator": (FixedBirth,),
     "vue_motion": (RandomWalk,),
@@ -84,7 +81,7 @@ class JavelinDesign:
     """
 
     config: JavelinConfig = field(default_factory=JavelinConfig)
-    noise: FixedNoise | KindNoise | ReportedNoise = field(default_factory=FixedNoise)
+    noise: FixedNoise | ReportedNoise = field(default_factory=FixedNoise)
     associator: Associator = field(default_factory=Associator)
     initiator: FixedBirth = field(default_factory=FixedBirth)
     vue_motion: RandomWalk = field(default_factory=RandomWalk)

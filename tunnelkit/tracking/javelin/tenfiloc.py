@@ -92,7 +92,7 @@ class TeNFiLoc:
         route. ``design`` must be ``None`` (TeNFiLoc has no tracker design)."""
         if design is not None:
             raise ValueError(f"design: TeNFiLoc takes no tracker design, got {design!r}")
-        attributes("drive", drive, _DRIVE, "a simulated drive (studies.DriveData)")
+        attributes("drive", drive, _DRIVE, "a simulated drive (simulation.DriveData)")
         cond = drive.condition
         return cls(
             base_station=tuple(float(v) for v in drive.base_station),
@@ -103,7 +103,7 @@ class TeNFiLoc:
     def track(self, drive) -> tuple[np.ndarray, np.ndarray]:
         """Fixes per epoch (T, 3) and which epochs had a fix; without a fix the previous one is
         held (the true start position before the first), so every epoch has an estimate."""
-        attributes("drive", drive, ("truth", "epochs"), "a simulated drive (studies.DriveData)")
+        attributes("drive", drive, ("truth", "epochs"), "a simulated drive (simulation.DriveData)")
         out = np.empty_like(np.asarray(drive.truth, dtype=float))
         ok = np.zeros(len(drive.epochs), bool)
         last = np.asarray(drive.truth[0], dtype=float).copy()

@@ -121,7 +121,7 @@ class Javelin:
         (its error drawn with the covariance the tracker is told, :func:`draw_start`) is the
         caller's to give."""
         attributes(
-            "drive", drive, ("truth", "base_station"), "a simulated drive (studies.DriveData)"
+            "drive", drive, ("truth", "base_station"), "a simulated drive (simulation.DriveData)"
         )
         d = JavelinDesign() if design is None else design
         if not isinstance(d, JavelinDesign):
@@ -136,7 +136,7 @@ class Javelin:
 
     def track(self, drive, *, keep_reports: bool = False) -> tuple[np.ndarray, JavelinRun]:
         """UE estimates (T, 3) over ``drive``'s measurement stream and the :class:`JavelinRun`."""
-        attributes("drive", drive, _DRIVE, "a simulated drive (studies.DriveData)")
+        attributes("drive", drive, _DRIVE, "a simulated drive (simulation.DriveData)")
         run = self.run(
             drive.epochs, drive.speed, drive.heading, drive.dt, keep_reports=keep_reports
         )

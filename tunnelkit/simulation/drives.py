@@ -4,7 +4,7 @@ Section 4 of Italiano et al. (2026) in two steps, so the expensive part is done 
 runs the signal route of notebook 03 (:class:`tunnelkit.signal_route.SignalRoute`: image method,
 eq. 1 tensor with noise and clock bias, :func:`tunnelkit.extraction.extract_paths`, Algorithm 1)
 for every epoch under a propagation *condition*, plus the V2X speed and heading messages
-(``sigma_nu``, ``sigma_theta`` of section 4.2); :mod:`tunnelkit.studies.scoring` then runs a
+(``sigma_nu``, ``sigma_theta`` of section 4.2); :mod:`tunnelkit.simulation.scoring` then runs a
 tracker on the stored measurements. The tables (notebook 04b, ``tunnelkit reproduce``), the
 ablation, notebook 04 and the array design (``tunnelkit design``) all drive through
 :func:`simulate_drive` / :func:`simulate_routes`, and one adapter,

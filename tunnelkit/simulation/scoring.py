@@ -1,7 +1,7 @@
 """Scoring a tracker on simulated drives: error metrics, settled errors, TeNFiLoc fixes.
 
 :func:`evaluate` runs JAVELIN (any :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign`) or
-the TeNFiLoc snapshot baseline on a :class:`~tunnelkit.studies.drives.DriveData` and scores it:
+the TeNFiLoc snapshot baseline on a :class:`~tunnelkit.simulation.drives.DriveData` and scores it:
 :func:`error_metrics` gives the 2-D RMSE, 2-D MAE and Y-MAE of Tables 1-2. The first
 :data:`SETTLE_S` of a drive is the tracker's start-up (an open-sky fix with 1 m of uncertainty,
 the VUE tracks born over the first epochs); :func:`settled` selects the epochs after it.
@@ -122,7 +122,7 @@ def evaluate(
 def settled_errors(ev: Evaluation, drive: DriveData) -> tuple[float, float, float]:
     """The 2-D RMSE over the whole drive, and the RMSE and median of the 2-D error over the
     settled epochs (NaN when the drive is shorter than the start-up)."""
-    attributes("ev", ev, ("estimates", "metrics"), "a studies.scoring.Evaluation")
+    attributes("ev", ev, ("estimates", "metrics"), "a simulation.scoring.Evaluation")
     instance("drive", drive, DriveData)
     idx = settled(drive.t)
     e = np.linalg.norm(ev.estimates[idx, :2] - drive.truth[idx, :2], axis=1)

@@ -36,21 +36,19 @@ import warnings
 
 import numpy as np
 
-from .._validate import finite_array, integer, nonnegative, positive
+from .._validate import finite_array, integer, positive
 from ..arrays import check_element_positions
 from ..constants import C
-from .decomposition import check_tensor
-from .ml import MAX_ITER, Problem, calibrated_threshold, fit_problem, pair_separation, residual_peak
-from .ml.fitting import RHO_Z
-from .ml.model import W_MAX, project_feasible
-from .ml.search import check_start
-from .numerics import spatial_phase
+from ..extraction.decomposition import check_tensor
+from ..extraction.ml import MAX_ITER, Problem, fit_problem, pair_separation
+from ..extraction.ml.model import W_MAX, project_feasible
+from ..extraction.ml.search import check_start
+from ..extraction.numerics import spatial_phase
 
 __all__ = [
     "FD_STEP",
     "PARAMS",
     "misspecified_bound",
-    "model_error_test",
     "parameter_vector",
     "pseudo_true",
 ]
@@ -344,59 +342,3 @@ def parameter_vector(theta, mu_f, mu_t, c) -> np.ndarray:
             finite_array("mu_t", mu_t, shape=(L,)),
         ]
     )
-
-
-def model_error_test(
-    residual,
-    n_paths: int,
-    received_energy: float,
-    element_positions,
-    fc: float,
-    noise_power: float,
-    share: float,
-    rho_max: float | None = None,
-) -> dict:
-    """The extraction's residual tests with a stated model-error floor.
-
-    A fit's residual ``residual`` (M, Nf, Nt) of ``n_paths`` paths passes when its strongest
-    single-path component (the periodogram peak of
-    :func:`~tunnelkit.extraction.ml.residual_peak`, times ``noise_power``) is at most the
-    noise-only threshold (:func:`~tunnelkit.extraction.ml.calibrated_threshold`) times
-    ``noise_power`` plus ``share * E_rx``, and its energy at most the basin test's
-    ``rho_max (N - 2.5 L) noise_power`` plus ``share * E_rx``; ``E_rx = received_energy -
-    N noise_power`` (``received_energy`` = ``||Y||^2`` of the snapshot): the model error the
-    deployed system allows, stated as a share of the received power (like a DMC share; the
-    residual a fit leaves at the pseudo-true paths, :func:`pseudo_true`, is what it stands for
-    and what no deployed system knows). ``share = 0`` is the plain test. ``rho_max`` (> 0) is
-    the energy test's threshold; ``None`` takes ``1 + z / sqrt(N)`` (:data:`RHO_Z`); a fit's own
-    ``fit.rho_max``, which also allows for a noise power estimated from the tensor, is the
-    looser one its extraction applied.
-
-    Returns ``passed``, ``needed`` the smallest share that passes, ``share_peak`` /
-    ``share_energy`` each test's, ``peak`` (noise powers) and ``rho``."""
-    R = np.asarray(residual)
-    if R.ndim != 3 or not np.iscomplexobj(R) or not np.all(np.isfinite(R)):
-        raise ValueError(f"residual: expected a finite complex (M, Nf, Nt) tensor, got {R.shape}")
-    pos = check_element_positions("element_positions", element_positions, m=R.shape[0])
-    fc = positive("fc", fc)
-    n0 = positive("noise_power", noise_power)
-    L = integer("n_paths", n_paths, minimum=0)
-    e_y = positive("received_energy", received_energy)
-    share = nonnegative("share", share)
-    N = R.size
-    rho_max = 1.0 + RHO_Z / np.sqrt(N) if rho_max is None else positive("rho_max", rho_max)
-    e_rx = max(e_y - N * n0, 1e-300 * e_y)
-    peak = residual_peak(R, pos, fc, n0)[0]
-    thr = calibrated_threshold(pos, fc, R.shape)
-    energy = float(np.vdot(R, R).real)
-    s_peak = (peak - thr) * n0 / e_rx
-    s_energy = (energy - rho_max * (N - 2.5 * L) * n0) / e_rx
-    needed = max(s_peak, s_energy, 0.0)
-    return {
-        "passed": bool(needed <= share),
-        "needed": float(needed),
-        "share_peak": float(s_peak),
-        "share_energy": float(s_energy),
-        "peak": float(peak),
-        "rho": energy / ((N - 2.5 * L) * n0),
-    }

@@ -11,7 +11,7 @@ from scipy.signal import lfilter
 
 from .._validate import finite_array, positive, record, rng_or_error
 from ..constants import C
-from .route import Drive
+from .drive import Drive
 
 __all__ = ["DopplerToaMeasurements", "GnssFix", "gnss_fix", "measure"]
 
@@ -77,7 +77,7 @@ def measure(drive: Drive, rng: np.random.Generator) -> DopplerToaMeasurements:
     """One noisy realisation of the Doppler and ToA streams (model in the module docstring)."""
     if not isinstance(drive, Drive):
         raise TypeError(
-            f"drive: expected a Drive (tunnelkit.drive.make_drive()), got {type(drive).__name__}"
+            f"drive: expected a Drive (tunnelkit.doppler_drive.make_drive()), got {type(drive).__name__}"
         )
     rng = rng_or_error("rng", rng)
     cfg = drive.config

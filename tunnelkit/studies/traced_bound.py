@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import finite_array
-from ..studies.traced import SIGMA_SCENARIO, traced_errors
+from ..simulation.prefilter import SIGMA_SCENARIO
+from .traced import traced_errors
 
 __all__ = ["traced_pcrlb"]
 
@@ -28,7 +29,7 @@ def traced_pcrlb(
     """The posterior CRLB (T,) [m] of the 2-D position along ``scenario``'s drive when every
     first-order path (LoS, walls, ceiling, road, RRMs; the image method's, known reflectors) is
     measured at every epoch with independent zero-mean Gaussian errors of the traced sigmas
-    (``rows``: an :func:`~tunnelkit.studies.analysis.extraction_errors` table, its ``"all"`` row;
+    (``rows``: an :func:`~tunnelkit.simulation.analysis.extraction_errors` table, its ``"all"`` row;
     default the stored record, :func:`~tunnelkit.studies.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
     clock bias removed (:func:`tunnelkit.design.position_information`), JAVELIN's motion model
     on the V2X messages and a start of ``sigma_p0`` [m] (:func:`tunnelkit.design.drive_pcrlb`).

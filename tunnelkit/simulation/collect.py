@@ -2,7 +2,7 @@
 
 :func:`collect_routes` runs ``runs`` drives per condition through the signal route (the expensive
 part), each measured through several extraction routes from the same tensors, on
-:func:`tunnelkit.montecarlo.run_trials` (serial, a local Dask cluster or a running one; drive
+:func:`tunnelkit.runner.run_trials` (serial, a local Dask cluster or a running one; drive
 ``i`` draws from the ``i``-th child of the seed, so the result does not depend on where it ran).
 :func:`per_drive` is the runner under it, for studies that score each drive where it ran.
 """
@@ -12,7 +12,7 @@ from __future__ import annotations
 import functools
 
 from .._validate import boolean, callable_, integer, sequence, text
-from ..montecarlo import run_trials
+from ..runner import run_trials
 from .drives import route_name, simulate_routes
 
 __all__ = ["collect_drives", "collect_routes", "per_drive", "simulate_condition"]
@@ -30,9 +30,9 @@ def simulate_condition(
 ):
     """One drive of condition ``cond`` of ``scenario`` through the signal route on ``channel``
     ("image" or "sionna"), measured through every route in ``extractions``
-    (:func:`~tunnelkit.studies.drives.simulate_routes`); the argument order suits
+    (:func:`~tunnelkit.simulation.drives.simulate_routes`); the argument order suits
     ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``; ``nuisance`` the route's
-    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.studies.drives.scenario_route`)."""
+    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.simulation.drives.scenario_route`)."""
     if cond is not None:
         text("cond", cond)
     return simulate_routes(
@@ -47,7 +47,7 @@ def simulate_condition(
 
 
 def per_drive(scenario, conditions, runs, seed, progress, extractions, make_trial, **parallel):
-    """One trial of :func:`~tunnelkit.montecarlo.run_trials` per drive: drive ``i`` (run
+    """One trial of :func:`~tunnelkit.runner.run_trials` per drive: drive ``i`` (run
     ``i // n``, condition ``i % n``) draws from the ``i``-th child of ``seed``. ``make_trial``
     gets the route names (``extractions``, normalised) and returns the trial ``(cond, rng)``.
     Returns the route names and ``[(condition, result), ...]`` in drive order."""
@@ -84,8 +84,8 @@ def collect_routes(
 ) -> dict[str, dict[str, list]]:
     """``runs`` seeded drives per condition through the signal route (the expensive part), each
     measured through every route in ``extractions`` from the same tensors
-    (:func:`~tunnelkit.studies.drives.simulate_routes`). One trial of
-    :func:`~tunnelkit.montecarlo.run_trials` per drive (``parallel``: its ``workers`` /
+    (:func:`~tunnelkit.simulation.drives.simulate_routes`). One trial of
+    :func:`~tunnelkit.runner.run_trials` per drive (``parallel``: its ``workers`` /
     ``scheduler`` / ``timeout``): drive ``i`` (run ``i // n``, condition ``i % n``) draws from
     the ``i``-th child of ``seed``. ``n_epochs`` truncates each drive (quick mode); ``channel``
     the channel source (:data:`tunnelkit.signal_route.CHANNELS`). Returns

@@ -35,7 +35,7 @@ The channel part is deterministic for a given configuration and is cached; each 
 One module per job, re-exported here:
 
 - :mod:`.config` — :class:`DriveConfig`, :data:`IDEAL` and :func:`load_drive_config`;
-- :mod:`.route` — the noise-free :class:`Drive` (:func:`make_drive`): route, line-of-sight and
+- :mod:`.drive` — the noise-free :class:`Drive` (:func:`make_drive`): route, line-of-sight and
   multipath-peak observables, :func:`delay_doppler_profiles`;
 - :mod:`.measurement` — the noisy streams (:func:`measure`) and the GNSS fix (:func:`gnss_fix`).
 """
@@ -43,8 +43,7 @@ One module per job, re-exported here:
 from __future__ import annotations
 
 from .config import IDEAL, DriveConfig, load_drive_config
-from .measurement import DopplerToaMeasurements, GnssFix, gnss_fix, measure
-from .route import (
+from .drive import (
     Drive,
     channel_paths,
     delay_doppler_profiles,
@@ -53,6 +52,7 @@ from .route import (
     make_drive,
     slant_range,
 )
+from .measurement import DopplerToaMeasurements, GnssFix, gnss_fix, measure
 
 __all__ = [
     "IDEAL",
