@@ -205,10 +205,11 @@ def test_unknown_scenario_and_2d_tunnel(capsys):
 
 def test_monte_carlo_is_seeded_and_reported():
     setup = design.DesignSetup.from_scenario("italiano2026-straight")
-    a = design.sweep_montecarlo(setup, "4x4", 2, 5, n_epochs=3)["4x4"]
-    b = design.sweep_montecarlo(setup, "4x4", 2, 5, n_epochs=3)["4x4"]
+    a = design.sweep_montecarlo(setup, "4x4", 2, 5, n_epochs=13)["4x4"]
+    b = design.sweep_montecarlo(setup, "4x4", 2, 5, n_epochs=13)["4x4"]
     assert np.array_equal(a.errors, b.errors) and np.all(np.isfinite(a.errors))
-    assert a.rmse_runs == pytest.approx(np.sqrt(np.mean(a.errors**2, axis=1)))
+    assert a.settled.tolist() == [10, 11, 12]  # the epochs 1 s after the start
+    assert a.rmse_runs == pytest.approx(np.sqrt(np.mean(a.errors[:, a.settled] ** 2, axis=1)))
     # sigmas from this design, not 5.9 GHz constants: at least the CRLB, finite, positive
     pb = design.path_bounds(setup, "4x4")
     ok = np.all([np.isfinite(pb[k]) for k in ("d", "direction", "kappa")], axis=0)  # resolved

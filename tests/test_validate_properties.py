@@ -20,13 +20,13 @@ from tunnelkit import (
     budget,
     constants,
     crlb,
-    drive,
     fresnel,
     geometry,
     metrics,
     positioning,
     propagation,
 )
+from tunnelkit import doppler_drive as drive
 from tunnelkit.tracking import pcrlb, upf
 from tunnelkit.tracking.gating import mahalanobis2
 
