@@ -282,7 +282,11 @@ def test_workers_beyond_the_cores_are_capped_with_a_warning(monkeypatch):
 
 
 def test_trials_sharing_a_stream_see_the_same_numbers():
-    out = run_trials(_draw, 4, seed=9, streams=[0, 1, 0, 1])
+    with pytest.raises(
+        ValueError, match=r"streams: stream 0 is given 2 times.*shared_streams=True"
+    ):
+        run_trials(_draw, 4, seed=9, streams=[0, 1, 0, 1])
+    out = run_trials(_draw, 4, seed=9, streams=[0, 1, 0, 1], shared_streams=True)
     assert out[0] == out[2] and out[1] == out[3] and out[0] != out[1]
     assert out[:2] == run_trials(_draw, 2, seed=9)
     with pytest.raises(ValueError, match="streams: expected 4 values"):
@@ -328,12 +332,13 @@ def test_prepared_inputs_and_chunked_trials_give_the_serial_numbers(cluster):
     sizes = [3, 5, 4, 6]
     inputs = [s for s in sizes for _ in range(5)]
     streams = [r for _ in sizes for r in range(5)]
-    serial = run_trials(_dot, 20, 7, inputs=[_scaled(n) for n in inputs], streams=streams)
+    kw = {"streams": streams, "shared_streams": True}
+    serial = run_trials(_dot, 20, 7, inputs=[_scaled(n) for n in inputs], **kw)
     for pool_kw in ({}, {"scheduler": cluster.scheduler_address}):
         with trial_pool(**pool_kw) as pool:
             handles = pool.prepare(_scaled, sizes)
             ins = [handles[sizes.index(n)] for n in inputs]
-            assert run_trials(_dot, 20, 7, inputs=ins, streams=streams, pool=pool) == serial
+            assert run_trials(_dot, 20, 7, inputs=ins, pool=pool, **kw) == serial
             assert [len(v) for v in pool.gather(handles)] == sizes
     # a trial that raises inside a task of several is still named
     with pytest.raises(ArithmeticError, match="bad draw") as info:

@@ -100,19 +100,21 @@ def run_trials(
     timeout: float = CONNECT_TIMEOUT_S,
     trial_timeout: float | None = None,
     streams: Sequence[int] | None = None,
+    shared_streams: bool = False,
     pool: TrialPool | None = None,
 ) -> list[Any]:
     """Call ``trial(rng)`` ``runs`` times with independent seeded generators, optionally with tqdm.
 
     ``streams`` (one non-negative integer per trial): trial ``i`` gets a fresh copy of child
     generator ``streams[i]`` of ``seed`` (trials with the same stream see the same random
-    numbers); default: trial ``i`` gets child ``i``. ``trial_timeout`` [s]: see the module
+    numbers: a stream given twice is refused unless ``shared_streams``, common random numbers
+    meant); default: trial ``i`` gets child ``i``. ``trial_timeout`` [s]: see the module
     docstring. ``pool``: a :func:`trial_pool` already open (instead of ``workers`` /
     ``scheduler``), so several steps share one cluster. Other options: module docstring."""
     callable_("trial", trial)
     runs = integer("runs", runs, minimum=1)
     check_bytes("runs", runs * RUN_BYTES, f"{runs} runs of at least {RUN_BYTES} B each")
-    rngs = _stream_rngs(seed, runs, streams)
+    rngs = _stream_rngs(seed, runs, streams, boolean("shared_streams", shared_streams))
     # ``trial(inputs[i], rng_i)`` when ``inputs`` is given; parallel options: module docstring
     calls = _calls(rngs, inputs)
     workers, scheduler = parallel_options(workers, scheduler)
@@ -221,9 +223,9 @@ def _one_call(fn, x):
         return fn(x)
 
 
-def _stream_rngs(seed, runs: int, streams) -> list[np.random.Generator]:
+def _stream_rngs(seed, runs: int, streams, shared: bool = False) -> list[np.random.Generator]:
     """One generator per trial: child ``i`` of ``seed``, or child ``streams[i]`` (copied, so
-    trials sharing a stream start from the same state)."""
+    trials sharing a stream start from the same state: refused unless ``shared``)."""
     if streams is None:
         return spawn_rngs(seed, runs)
     if isinstance(streams, str | bytes) or not isinstance(streams, Sequence | np.ndarray):
@@ -233,6 +235,13 @@ def _stream_rngs(seed, runs: int, streams) -> list[np.random.Generator]:
     idx = [integer("streams", s, minimum=0) for s in streams]
     if len(idx) != runs:
         raise ValueError(f"streams: expected {runs} values (runs), got {len(idx)}")
+    if not shared and len(set(idx)) < len(idx):
+        twice = next(i for i in idx if idx.count(i) > 1)
+        raise ValueError(
+            f"streams: stream {twice} is given {idx.count(twice)} times, and trials of one stream "
+            "see the same random numbers; pass shared_streams=True where that is meant (common "
+            "random numbers)"
+        )
     children = spawn_rngs(seed, max(idx) + 1)
     return [pickle.loads(pickle.dumps(children[i])) for i in idx]
 

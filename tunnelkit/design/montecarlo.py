@@ -322,6 +322,7 @@ def sweep_montecarlo(
             seed,
             inputs=[(prepared[a], units[r]) for a in range(A) for r in range(runs)],
             streams=[r for _ in range(A) for r in streams],
+            shared_streams=True,  # the same unit of every array: common random numbers
             progress=progress,
             desc=f"JAVELIN {mode} " + " ".join(s.label for s in specs),
             trial_timeout=trial_timeout,
