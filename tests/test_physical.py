@@ -138,3 +138,17 @@ def test_a_drive_of_a_nanometre_is_refused_not_scored_zero():
 
     with pytest.raises(ValueError, match=r"length: a 1e-09 m drive ends within the tracker.s 1 s"):
         drive_variant("italiano2026-straight", 1e-9)
+
+
+def test_a_clock_bias_beyond_the_radio_limit_is_refused():
+    """A 1 s bias wraps the phase ramp (240 kHz tones: whole cycles), so the tensor would carry
+    none while the snapshot records 1 s; refused where it is given."""
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    with pytest.raises(ValueError, match=r"clock_bias: 1 s is beyond 1e-07 s"):
+        route.epoch(0, np.random.default_rng(0), clock_bias=1.0)
+    array, paths = route.paths(0)
+    cfg = channel.SRSConfig(clock_bias_sigma=0.0, clock_bias_limit=0.0)
+    with pytest.raises(ValueError, match=r"clock_bias: 1e-05 s is beyond 2.08333e-06 s"):
+        channel.channel_tensor(paths, cfg, clock_bias=1e-5)
+    snap = channel.synthesize(paths, route.config, np.random.default_rng(0), clock_bias=80e-9)
+    assert snap.clock_bias == 80e-9

@@ -204,6 +204,20 @@ class SRSConfig:
         return cls(**kw)
 
 
+def _clock_bias(value, config: SRSConfig) -> float:
+    """A clock bias [s] the tensor can carry: within the radio's ``clock_bias_limit`` (or, with
+    no limit, half the unambiguous delay ``1 / tone_spacing``: beyond it the phase ramp wraps and
+    the tensor shows another bias than the one recorded)."""
+    bias = float(finite_array("clock_bias", value, ndim=0))
+    top = config.clock_bias_limit if config.clock_bias_limit > 0 else 0.5 / config.tone_spacing
+    if abs(bias) > top * (1 + 1e-12):
+        raise ValueError(
+            f"clock_bias: {bias:g} s is beyond {top:g} s (the radio's clock_bias_limit, or half its "
+            "unambiguous delay 1 / tone_spacing); a clock bias is given in seconds"
+        )
+    return bias
+
+
 def sample_clock_bias(
     rng: np.random.Generator, sigma: float = 50e-9, limit: float = 100e-9, size: int | None = None
 ):
@@ -404,7 +418,7 @@ def channel_tensor(
     if model not in _MODELS:
         raise ValueError(f"model: expected one of {_MODELS}, got {model!r}")
     paths = _check_paths(paths)
-    bias = float(finite_array("clock_bias", clock_bias, ndim=0))
+    bias = _clock_bias(clock_bias, config)
     if not isinstance(spatial_wideband, bool):
         raise TypeError(f"spatial_wideband: expected True or False, got {spatial_wideband!r}")
     cal = _check_calibration(calibration, paths[0].lengths.shape[0])
@@ -563,7 +577,7 @@ def tensor_snapshot(
     cal = _check_calibration(calibration, H0.shape[0])
     if clock_bias is None:
         clock_bias = sample_clock_bias(rng, config.clock_bias_sigma, config.clock_bias_limit)
-    bias = float(finite_array("clock_bias", clock_bias, ndim=0))
+    bias = _clock_bias(clock_bias, config)
     ramp = np.exp(-2j * np.pi * config.tone_spacing * np.arange(H0.shape[1]) * bias)
     H = np.sqrt(config.tx_power) * H0 * ramp[None, :, None]
     if cal is not None:
