@@ -146,9 +146,26 @@ def test_a_clock_bias_beyond_the_radio_limit_is_refused():
     route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
     with pytest.raises(ValueError, match=r"clock_bias: 1 s is beyond 1e-07 s"):
         route.epoch(0, np.random.default_rng(0), clock_bias=1.0)
-    array, paths = route.paths(0)
+    _, paths = route.paths(0)
     cfg = channel.SRSConfig(clock_bias_sigma=0.0, clock_bias_limit=0.0)
     with pytest.raises(ValueError, match=r"clock_bias: 1e-05 s is beyond 2.08333e-06 s"):
         channel.channel_tensor(paths, cfg, clock_bias=1e-5)
     snap = channel.synthesize(paths, route.config, np.random.default_rng(0), clock_bias=80e-9)
     assert snap.clock_bias == 80e-9
+
+
+def test_containers_refuse_speeds_no_vehicle_has():
+    from tunnelkit.tracking.javelin.measurement import PathMeasurements
+
+    with pytest.raises(ValueError, match=r"v: a measured radial speed of 4e\+08 m/s, faster than"):
+        PathMeasurements.from_arrays([0.1], [0.0], [10.0], [10.0], [4e8])
+    # an extraction's outlier (a wrong path's Doppler) is carried for the tracker to gate
+    assert PathMeasurements.from_arrays([0.1], [0.0], [10.0], [10.0], [550.0]).v[0] == 550.0
+    assert PathMeasurements.from_arrays([0.1], [0.0], [10.0], [10.0], [np.nan]).v.size == 1
+    d = tk.simulation.simulate_drive(
+        "italiano2026-straight", np.random.default_rng(0), extraction="paper", n_epochs=2
+    )
+    import dataclasses
+
+    with pytest.raises(ValueError, match=r"velocity: a speed of 3e\+08 m/s"):
+        dataclasses.replace(d, velocity=np.full_like(d.velocity, 3e8 / np.sqrt(3)))

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .._physical import speeds
 from .._validate import (
     choice,
     instance,
@@ -143,6 +144,8 @@ class DriveData:
             positive=("clock_bias_limit",),
             may_be_empty=("truth_index", "kinds", "faults", "sources"),
         )
+        speeds("velocity", self.velocity)
+        speeds("speed", self.speed[np.isfinite(self.speed)])
 
     @property
     def dt(self) -> float:

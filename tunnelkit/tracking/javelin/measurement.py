@@ -24,6 +24,7 @@ import numpy as np
 
 from ..._checks import series, unchecked
 from ..._validate import boolean, finite_array, nonnegative, real, vector
+from ...constants import C
 from ...geometry import spherical_jacobian
 from .state import vue_positions
 
@@ -137,6 +138,13 @@ class PathMeasurements:
             series(name, getattr(self, name), finite=name == "source")
         for name in ("phi", "psi", "kappa", "d", "v"):
             setattr(self, name, np.asarray(getattr(self, name), dtype=float).reshape(-1))
+        # a measured radial speed may be an extraction's outlier (the tracker gates it), never
+        # faster than light
+        fast = np.abs(self.v[np.isfinite(self.v)])
+        if fast.size and fast.max() >= C:
+            raise ValueError(
+                f"v: a measured radial speed of {fast.max():.4g} m/s, faster than light"
+            )
         n = self.phi.size
         for name in ("psi", "kappa", "d", "v"):
             if getattr(self, name).size != n:
