@@ -169,3 +169,11 @@ def test_containers_refuse_speeds_no_vehicle_has():
 
     with pytest.raises(ValueError, match=r"velocity: a speed of 3e\+08 m/s"):
         dataclasses.replace(d, velocity=np.full_like(d.velocity, 3e8 / np.sqrt(3)))
+
+
+def test_an_information_so_small_its_bound_overflows_is_refused():
+    with pytest.raises(ValueError, match="F: numerically singular"):
+        crlb.crlb_trace(np.array([[2.22507386e-309, 0.0], [0.0, 1.0]]))
+    with pytest.raises(ValueError, match="F: numerically singular"):
+        crlb.crlb_trace(np.diag([1e-320, 1.0, 1.0]))
+    assert crlb.crlb_trace(np.diag([4.0, 2.0])) == pytest.approx(0.75)

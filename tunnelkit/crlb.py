@@ -229,11 +229,17 @@ def crlb_trace(F) -> np.ndarray:
         det = F[..., 0, 0] * F[..., 1, 1] - F[..., 0, 1] * F[..., 1, 0]
         if np.any(det <= 0) or np.any(F[..., 0, 0] <= 0):
             raise ValueError(bad)
-        return (F[..., 0, 0] + F[..., 1, 1]) / det
-    ev = np.linalg.eigvalsh(F)
-    if np.any(ev <= 0):
-        raise ValueError(bad)
-    return np.sum(1.0 / ev, axis=-1)
+        with np.errstate(over="ignore"):
+            out = (F[..., 0, 0] + F[..., 1, 1]) / det
+    else:
+        ev = np.linalg.eigvalsh(F)
+        if np.any(ev <= 0):
+            raise ValueError(bad)
+        with np.errstate(over="ignore", divide="ignore"):
+            out = np.sum(1.0 / ev, axis=-1)
+    if not np.all(np.isfinite(out)):  # an information so small its inverse overflows
+        raise ValueError(bad.replace("singular", "numerically singular (the bound overflows)"))
+    return out
 
 
 def crlb_rmse(p, stations, sigma_theta, sigma_d) -> np.ndarray:
