@@ -63,12 +63,12 @@ tk.setup_notebook()
 # epoch (one SRS slot) every 0.1 s; the preset also places the RRMs and hangs each array just
 # below the anchor, so that the tilted array fits under the curved ceiling.
 #
-# Every epoch goes through the signal route of notebook 03: image-method paths → the tensor of
-# eq. 1 with noise and a clock bias → extraction → Algorithm 1. The drive is measured twice from
-# the *same* tensors: with the paper's extraction (CPD, eq. 11–24) and with the joint
-# maximum-likelihood fit of eq. 1 (`extract_paths(refine="ml")`, notebook 03 section 7), whose
-# errors come close to the Cramér–Rao bound at this SNR (notebook 03 checks how close; the CRLB:
-# the smallest variance an unbiased estimator can have; see [bounds](GLOSSARY.md#bounds)). One drive in LoS on the straight
+# Every epoch goes through the signal route of notebook 03: image-method paths → the tensor of eq. 1
+# with noise and a clock bias → extraction → Algorithm 1. The drive is measured twice from the
+# *same* tensors: with the paper's extraction (CPD, eq. 11–24) and with the joint maximum-likelihood
+# fit of eq. 1 (`extract_paths(refine="ml")`, notebook 03 section 7), whose errors come close to the
+# Cramér–Rao bound at this SNR (notebook 03 checks how close; the CRLB: the smallest variance an
+# unbiased estimator can have; see [bounds](GLOSSARY.md#bounds)). One drive in LoS on the straight
 # trajectory and one on the slalom (quick mode: their first 6 epochs).
 
 # %%

@@ -161,13 +161,13 @@ fig7b.update_xaxes(type="log", range=[-2, 2])
 # %% [markdown]
 # ## 4. The road-marking ablation
 #
-# The paper mounts two RRM plates on the side walls, 3.3 m high, "midway between the vehicle and
-# the anchor", and two at the junction of sidewalk and wall, inclined at 55°, without saying
-# where along the tunnel. The preset puts all four along $10 \le x \le 30$ m (printed below), but
-# the vehicle sees their reflections from further away: a plate reflects towards the BS whenever the specular point falls on it, which
-# happens for a UE well beyond the plate's end. Where along each drive does an RRM path exist
-# (the true paths of the scenario, every epoch)? The same count for the wall facets serves
-# section 6.
+# The paper mounts two RRM plates on the side walls, 3.3 m high, "midway between the vehicle and the
+# anchor", and two at the junction of sidewalk and wall, inclined at 55°, without saying where along
+# the tunnel. The preset puts all four along $10 \le x \le 30$ m (printed below), but the vehicle
+# sees their reflections from further away: a plate reflects towards the BS whenever the specular
+# point falls on it, which happens for a UE well beyond the plate's end. Where along each drive does
+# an RRM path exist (the true paths of the scenario, every epoch)? The same count for the wall
+# facets serves section 6.
 
 # %%
 preset = tk.load_scenario("italiano2026-straight")

@@ -454,19 +454,19 @@ table_figure(t3, cols, title=f"Table 3 (LOS), {RUNS} runs")
 # the run bounds the RMSE over runs and epochs. It rests on our reading of what the paper leaves
 # open ($T_1 = 0.1$ s, the preset's 100 epochs, the prior $P_0$ of section 1).
 #
-# Printed below, per noise level: at 0.5° / 0.1 m the paper's RMSEs lie at or above the bound,
-# the UPF's within a few per cent of it; at 1° / 1 m and 2° / 2 m every filter's, EKF and UKF
-# as well as the UPF, lies at 0.3 to 0.6 times it — below what any filter with an honest prior
-# can reach on average over starts, under the assumptions just named — while ours lie above it. Two assumptions reproduce numbers of that size: (a) the
-# filter starts at the *true* state with a tiny prior covariance and (almost) no process noise,
-# on a path that is exactly constant-velocity: it then reports its prior and hardly listens to
-# the measurements (it starts from what no filter knows, the true state, so no bound built on
-# our prior $P_0$ holds it);
-# (b) "mean error" is the mean of *signed* errors, which cancel. The paper's TSWLS fails the same
-# test against the snapshot CRLB (the same recursion with a huge $Q$, so that no epoch remembers
-# another), the bound of an unbiased per-epoch fix: its RMSE at 2° / 2 m (0.35 m, from its mean
-# 0.333 m and its variance) is several times below that bound's RMS, where our TSWLS's RMSE
-# lies (within 10 %; it is unbiased to first order). Both effects, and both bounds, measured:
+# Printed below, per noise level: at 0.5° / 0.1 m the paper's RMSEs lie at or above the bound, the
+# UPF's within a few per cent of it; at 1° / 1 m and 2° / 2 m every filter's, EKF and UKF as well as
+# the UPF, lies at 0.3 to 0.6 times it — below what any filter with an honest prior can reach on
+# average over starts, under the assumptions just named — while ours lie above it. Two assumptions
+# reproduce numbers of that size: (a) the filter starts at the *true* state with a tiny prior
+# covariance and (almost) no process noise, on a path that is exactly constant-velocity: it then
+# reports its prior and hardly listens to the measurements (it starts from what no filter knows, the
+# true state, so no bound built on our prior $P_0$ holds it); (b) "mean error" is the mean of
+# *signed* errors, which cancel. The paper's TSWLS fails the same test against the snapshot CRLB
+# (the same recursion with a huge $Q$, so that no epoch remembers another), the bound of an unbiased
+# per-epoch fix: its RMSE at 2° / 2 m (0.35 m, from its mean 0.333 m and its variance) is several
+# times below that bound's RMS, where our TSWLS's RMSE lies (within 10 %; it is unbiased to first
+# order). Both effects, and both bounds, measured:
 
 # %%
 oracle = vs.experiment("jiang2023-straight", level=2, q=1e-6, p0_sigma=[0.01, 0.01])

@@ -680,13 +680,13 @@ print(f"traced matched paths: median angle error {np.median(ang_rt):.3g} deg, me
 #
 # **The errors a tracker must be told.** The measurement noise of the JAVELIN design for the ML
 # route is set from, and wider than, the RMS error that route makes on the *image* channel
-# (notebooks 04 and 04b). On the traced channel its errors are far larger than those sigmas (every error over its sigma, printed below, above 1; the
-# curvature's above 3): the ray tracer's wavefronts are cut off across the aperture
-# (section 7's visibility part) and bent by the spatial-wideband term, and the ML fit's
-# curvature absorbs both. The traced design's sigmas are set from that error: its RMS, measured
-# once on the straight drive (seed 0) and stored with the package, widened below for the errors'
-# correlation; first the stored RMS beside the same RMS on this notebook's epochs (the same order
-# of magnitude).
+# (notebooks 04 and 04b). On the traced channel its errors are far larger than those sigmas (every
+# error over its sigma, printed below, above 1; the curvature's above 3): the ray tracer's
+# wavefronts are cut off across the aperture (section 7's visibility part) and bent by the
+# spatial-wideband term, and the ML fit's curvature absorbs both. The traced design's sigmas are set
+# from that error: its RMS, measured once on the straight drive (seed 0) and stored with the
+# package, widened below for the errors' correlation; first the stored RMS beside the same RMS on
+# this notebook's epochs (the same order of magnitude).
 
 # %%
 cfg_ml = designs.ours_ml().config

@@ -168,8 +168,9 @@ print(
 #
 # Per path this gives the extraction's bias and covariance in the tracker's measurement space
 # (`design.path_error_model`; its closed forms agree with finite differences, with an exact
-# nonlinear fit and with Monte-Carlo of the ML extraction). The **predicted error** maps them to the position *as the
-# design's tracker weighs its paths* (each path by the error budget it is told, section 6):
+# nonlinear fit and with Monte-Carlo of the ML extraction). The **predicted error** maps them to
+# the position *as the design's tracker weighs its paths* (each path by the error budget it is
+# told, section 6):
 #
 # $$e_{\mathrm{pred}} = \sqrt{\mathrm{tr}\,\mathbf G\,\mathrm{CRLB}\,\mathbf G^T
 #   + \mathrm E\|\mathbf G\mathbf b\|^2 + \mathrm{tr}\,\mathbf G(\mathrm{MCRB} -
@@ -429,16 +430,15 @@ print(f"RMSE over a bound: at least {bound_min:.3g}; over the prediction: down t
 print(f"with calibration error, RMSE over the augmented-state bound: at least {cal_gap:.2g}")
 
 # %% [markdown]
-# The tracker's RMSE lies above both bounds on every row (`bound_min` ≥ 1), while the prediction
-# is beaten on some (`pred_min` below 1): the prediction is a first-order guess of where the
-# tracker lands, the bounds are what no tracker can beat on average over drives. They hold here
-# because their $\mathbf Q$ is the V2X odometry noise (`tk.studies.SIGMA_SPEED`,
-# `SIGMA_HEADING`), drawn afresh in every drive: they bound this fixed route driven with random
-# odometry, which is what every simulated drive is. (Notebook 05's $\mathbf Q$ modelled
-# randomness of the truth itself, which its straight preset lacked, and its filters went below.)
-# Under calibration error the tracker sits several times above the augmented-state bound
-# (`cal_gap`): the bound learns each unit's draw from
-# the whole drive, JAVELIN only tolerates it. That gap is the most a tracker that estimated its
+# The tracker's RMSE lies above both bounds on every row (`bound_min` ≥ 1), while the prediction is
+# beaten on some (`pred_min` below 1): the prediction is a first-order guess of where the tracker
+# lands, the bounds are what no tracker can beat on average over drives. They hold here because
+# their $\mathbf Q$ is the V2X odometry noise (`tk.studies.SIGMA_SPEED`, `SIGMA_HEADING`), drawn
+# afresh in every drive: they bound this fixed route driven with random odometry, which is what
+# every simulated drive is. (Notebook 05's $\mathbf Q$ modelled randomness of the truth itself,
+# which its straight preset lacked, and its filters went below.) Under calibration error the tracker
+# sits several times above the augmented-state bound (`cal_gap`): the bound learns each unit's draw
+# from the whole drive, JAVELIN only tolerates it. That gap is the most a tracker that estimated its
 # array's calibration on the road could recover.
 
 # %% [markdown]
@@ -488,14 +488,14 @@ print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g}")
 # The JAVELIN tunnel (semicircular, 10 m × 5 m, 5.9 GHz, 100 MHz), its arrays hung inside the
 # faceted ceiling. The scenario file places each array by its reference antenna (element 0, a
 # corner); the design centres every candidate on the centre of the file's array, so the paper's
-# 10 × 10 sits exactly where the file puts it. It is not the largest square array that fits
-# there: an 11 × 11 still does, a 12 × 12 reaches through the ceiling, and a 32 × 32 (0.8 m on a
-# side) by far (`setup.arrays` refuses both, naming the elements outside). Below, the PEB and the prediction
-# at 0.5° of calibration error under the SR-NF criterion (`criterion="srnf"`, an eq. 51 route): SR-NF gates,
-# the ceiling breaks it on every epoch, and no epoch of any array is left where the gated
-# prediction meets the target ("met share" 0) — the estimator's criterion, not the array's
-# accuracy, rules the eq. 51 route out. With `units=0` (no Monte-Carlo) the sweep recommends
-# nothing in any case: bounds and predictions decide nothing.
+# 10 × 10 sits exactly where the file puts it. It is not the largest square array that fits there:
+# an 11 × 11 still does, a 12 × 12 reaches through the ceiling, and a 32 × 32 (0.8 m on a side) by
+# far (`setup.arrays` refuses both, naming the elements outside). Below, the PEB and the prediction
+# at 0.5° of calibration error under the SR-NF criterion (`criterion="srnf"`, an eq. 51 route):
+# SR-NF gates, the ceiling breaks it on every epoch, and no epoch of any array is left where the
+# gated prediction meets the target ("met share" 0) — the estimator's criterion, not the array's
+# accuracy, rules the eq. 51 route out. With `units=0` (no Monte-Carlo) the sweep recommends nothing
+# in any case: bounds and predictions decide nothing.
 
 # %%
 paper = design.DesignSetup.from_scenario("italiano2026-straight")
@@ -812,10 +812,10 @@ assert 0.5 < sol5["channel"] / sol5["bound"] < 2.0, sol5  # within the drives' s
 # 1. A lower mount moves the ceiling's reflection point away from the array, so SR-NF holds on
 #    more of the route — which matters to an eq. 51 estimator only; the predicted error of the
 #    design's tracker hardly depends on it.
-# 2. The printed array and the share of the route it meets (at least the 90 % asked); at 5.9 GHz an array of the same
-#    element count is 4.7 times larger, so curvature and direction improve, the band is four
-#    times narrower and the delays worse. It is not an answer: a prediction, first order, which
-#    the tracker may beat or miss; only `design.design_sweep` with units decides.
+# 2. The printed array and the share of the route it meets (at least the 90 % asked); at 5.9 GHz an
+#    array of the same element count is 4.7 times larger, so curvature and direction improve, the
+#    band is four times narrower and the delays worse. It is not an answer: a prediction, first
+#    order, which the tracker may beat or miss; only `design.design_sweep` with units decides.
 # 3. The three medians printed, each above the ideal array's PEB (printed below them); whichever
 #    is largest is what the 16 × 16 array must be protected against first.
 # 4. Told only its CRLB the tracker trusts micrometres and weighs centimetres of calibration bias
