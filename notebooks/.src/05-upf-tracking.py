@@ -528,8 +528,8 @@ explorer
 #    and the curved preset. Which filter suffers on which trajectory, and does the ratio to the
 #    PCRLB tell you?
 # 2. Run the UPF with `proposal="carried"` (eq. 52 as printed) in a small Monte-Carlo at
-#    2 deg / 2 m. Compare its RMSE and the number of resampling events (`f.resampled`; they
-#    exist because we resample only below $N/2$, section 4) with the default.
+#    2 deg / 2 m. Compare its RMSE and the number of resampling events (`f.resampled`: under the
+#    paper's rule every epoch resamples, ours only below $N/2$, section 4) with the default.
 # 3. Drop every third epoch (`Z[:, ::3] = np.nan`) and rerun. How much does each filter lose? What
 #    does TSWLS do on a missed epoch?
 #
