@@ -233,7 +233,7 @@ def test_figures_and_explorer_callback(exp_hi):
     fig = tracks_figure(sc.tunnel(), sc.base_station(), exp_hi.truth, est, every=10)
     assert len(fig.frames) == 11 and len(fig.frames[0].data) == 2
     fig = rmse_bound_figure(exp_hi.times, {"EKF": np.ones(100)}, np.ones(100) * 0.5)
-    assert fig.data[-1].name == "sqrt(PCRLB): RMSE bound over random drives"
+    assert fig.data[-1].name == "sqrt(PCRLB), H along the nominal path (approx.)"
     snap = {
         "t": 0.0,
         "particles": np.zeros((5, 4)),

@@ -52,15 +52,12 @@ tk.setup_notebook()
 # average), 140 drives, minutes (the progress bar shows the estimate); quick mode: one run of the
 # first 6 epochs, fewer conditions.
 #
-# **Tuning seeds and the held-out seed.** A design chosen on some drives and scored on the same
-# drives is scored too kindly. Every choice of our design was made on drives of the *tuning*
-# seeds (`ex.TUNING_SEEDS`); the paper's design takes the published numbers and has nothing
-# tuned. Every drive of this notebook comes from the **held-out** seed `ex.HELD_OUT_SEED`
-# (printed below), not run while anything was chosen; which choice saw which drives is in
-# [docs/javelin-seeds.md](../docs/javelin-seeds.md).
+# **A held-out seed.** A design scored on the drives it was chosen on is scored too kindly, so
+# every drive here comes from a seed that no choice of our design saw (the paper's design has
+# nothing tuned; which choice saw which drives: [docs/javelin-seeds.md](../docs/javelin-seeds.md)).
 
 # %%
-seed = ex.HELD_OUT_SEED  # the held-out seed (the tuning seeds: ex.TUNING_SEEDS)
+seed = ex.HELD_OUT_SEED
 runs = tk.mc_count(20, 1)
 n_epochs = 6 if tk.quick_mode() else None
 straight_conditions = ("L", "N", "NoRRMs") if tk.quick_mode() else ("L", "N@0.5", "N", "NoRRMs")
@@ -74,7 +71,7 @@ routes = {
 }
 straight, straight_ml = (routes["italiano2026-straight"][e] for e in ("paper", "ml"))
 slalom, slalom_ml = (routes["italiano2026-slalom"][e] for e in ("paper", "ml"))
-print(f"held-out seed {seed} (tuning seeds {ex.TUNING_SEEDS}); drives per condition:")
+print(f"held-out seed {seed}; drives per condition:")
 print({sc: {c: len(d) for c, d in r["ml"].items()} for sc, r in routes.items()})
 
 # %% [markdown]
@@ -107,10 +104,12 @@ javelin_table_figure(cols2, rows2, title=f"Table 2 (slalom), {runs} run(s) per c
 # together (notebook 04, section 3), and curvatures more than ten metres off fail a gate built
 # for $\sigma_\kappa = 1.5$ m. On the ML route the same design with eq. 51 still does worse than
 # with the curvature centred on the VUE, because the exact channel's wavefront is centred there;
-# with the VUE curvature, nothing else changed, it tracks to within the paper's own JAVELIN-L on
-# the straight drive (full mode), and to below a metre on the slalom. Our tracker starts from
-# the true position with 1 m of uncertainty (section 6), the paper's design from $\sigma_P$ =
-# 10 m; the comparison holds for that start. The JAVELIN-L rows of this run, side by side:
+# with the VUE curvature, nothing else changed, its error is at or below the paper's own
+# JAVELIN-L on the straight drive (full mode), and below a metre on the slalom. Mind the start:
+# every column here, the paper's design included, starts JAVELIN at the true position with 1 m
+# of uncertainty (`ex.evaluate`'s default, section 6), while the paper's runs start from its
+# $\sigma_P$ = 10 m; the paper's column is a different start, and a tracker told 1 m has less to
+# settle. The JAVELIN-L rows of this run, side by side:
 
 # %%
 sl = {r[0]: dict(zip(cols2[2:], r[2:])) for r in rows2 if r[1] == "rmse_2d_m"}["JAVELIN-L"]
@@ -162,12 +161,13 @@ fig7b.update_xaxes(type="log", range=[-2, 2])
 # %% [markdown]
 # ## 4. The road-marking ablation
 #
-# The four RRM plates lie along $10 \le x \le 30$ m (the preset's placement of the paper's
-# "midway between the vehicle and the anchor"), but the vehicle sees their reflections from
-# further away: a plate reflects towards the BS whenever the specular point falls on it, which
-# happens for a UE well beyond the plate's end. Where along each drive does an RRM path exist
-# (the true paths of the scenario, every epoch)? The same count for the wall facets serves
-# section 6.
+# The paper mounts two RRM plates on the side walls, 3.3 m high, "midway between the vehicle and the
+# anchor", and two at the junction of sidewalk and wall, inclined at 55°, without saying where along
+# the tunnel. The preset puts all four along $10 \le x \le 30$ m (printed below), but the vehicle
+# sees their reflections from further away: a plate reflects towards the BS whenever the specular
+# point falls on it, which happens for a UE well beyond the plate's end. Where along each drive does
+# an RRM path exist (the true paths of the scenario, every epoch)? The same count for the wall
+# facets serves section 6.
 
 # %%
 preset = tk.load_scenario("italiano2026-straight")
@@ -307,8 +307,8 @@ javelin_table_figure(
 # - **Clock bias.** Section 4.2 gives "variance 50 ns"; we read it as a 50 ns standard deviation
 #   (15 m of distance). TDoAs cancel it, but the LoS test of eq. 61 and TeNFiLoc's $\hat d$
 #   fallback suffer.
-# - **Start.** The paper assumes the open-sky position is known; we start at the truth with 1 m
-#   uncertainty rather than its $\sigma_P = 10$ m.
+# - **Start.** The paper assumes the open-sky position is known; in every column, the paper's
+#   design included, we start at the truth with 1 m uncertainty rather than its $\sigma_P = 10$ m.
 # - **Drive length.** The presets' drives are short (printed below: 29 epochs, about 40 m),
 #   so start-up transients weigh in the averages.
 # - **Side-wall paths.** Our cross-section is 12 flat facets, the lower ones (steeper than 45°)
@@ -368,12 +368,21 @@ assert sl_rows[2][1] < 0.5 * sl_rows[0][1], sl_rows
 # %%solution 04b.2
 # Solution 2
 refit = designs.design_from_errors(erows)
+sol2 = {}
 for name, by_cond in (("straight", straight_ml), ("slalom", slalom_ml)):
-    scores = {
+    scores = sol2[name] = {
         label: np.mean([ex.evaluate(d, cfg).metrics["rmse_2d_m"] for d in by_cond["L"]])
         for label, cfg in (("OURS_ML (3 drives)", designs.ours_ml()), ("refit (all drives)", refit))
     }
     print(name, {k: round(float(v), 3) for k, v in scores.items()})
+c_refit = refit.config
+refit_sig = [np.degrees(c_refit.sigma_phi), np.degrees(c_refit.sigma_psi), c_refit.sigma_kappa]
+ratio_sig = np.array(assumed) / np.array([*refit_sig, c_refit.sigma_delta_d])
+print("our ML design's sigmas / the refit's:", ratio_sig.round(1))
+# the refit's sigmas many times narrower; both trajectories lose with them, the slalom by far
+assert np.all(ratio_sig > 5), ratio_sig
+assert all(v["refit (all drives)"] > v["OURS_ML (3 drives)"] for v in sol2.values()), sol2
+assert sol2["slalom"]["refit (all drives)"] > 2 * sol2["slalom"]["OURS_ML (3 drives)"], sol2
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
@@ -394,6 +403,20 @@ for cond in ("N", "NoRRMs"):
     share, births = np.mean([rrm_share_and_births(d) for d in straight_ml[cond]], axis=0)
     print(f"JAVELIN-{cond:7s} epochs with an RRM path {share:5.1%}, births per drive {births:4.1f}")
 
+
+def rrm_appearances(d):
+    """How often an RRM path appears: more matched RRM paths than the epoch before."""
+    n = [
+        sum(d.kinds[k][t] == "rrm" for t in d.truth_index[k] if t >= 0) if m is not None else 0
+        for k, m in enumerate(d.epochs)
+    ]
+    return int(np.sum(np.maximum(np.diff(n, prepend=0), 0)))
+
+
+appear = [(rrm_appearances(d), rrm_share_and_births(d)[1]) for d in straight_ml["N"]]
+print("JAVELIN-N, per drive (RRM path appearances, births):", appear)
+assert all(births >= n for n, births in appear), appear  # every appearance a birth
+
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
 #
@@ -402,8 +425,8 @@ for cond in ("N", "NoRRMs"):
 #    whose error is above the one before it). The ablation of section 5 was one trajectory; a
 #    design choice has to be checked on the other as well.
 # 2. More data is not automatically a better design. The pooled RMS over all the LoS drives has
-#    sigmas many times smaller than our ML design's (section 5); with them a trajectory can lose,
-#    the slalom by far once a run loses the track (the output: compare the two numbers per
+#    sigmas many times smaller than our ML design's (section 5); with them both trajectories
+#    lose, the slalom by far once a run loses the track (the output: compare the two numbers per
 #    trajectory; with one short run in quick mode they are one draw) — although the refit is
 #    scored on the very drives it was fitted on. The extraction error is heavy-tailed — near
 #    the bound in most epochs, off by metres in the few where nearly coincident paths are
@@ -425,7 +448,7 @@ for cond in ("N", "NoRRMs"):
 
 # %%
 # section 1: the held-out seed (not a tuning seed), 20 runs of 7 conditions in full mode
-assert seed == ex.HELD_OUT_SEED and seed not in ex.TUNING_SEEDS and ex.TUNING_SEEDS == (0, 7)
+assert seed == ex.HELD_OUT_SEED and seed not in ex.TUNING_SEEDS
 n_drives = sum(len(d) for r in routes.values() for d in r["ml"].values())
 assert tk.quick_mode() or (runs == 20 and n_drives == 140), (runs, n_drives)
 assert ex.CONDITIONS["N@0.5"].los_probability == 0.5
@@ -452,6 +475,9 @@ assert abs(abl_rows[-2][1] - ml_vue) < 1e-12
 # section 4: the plates span x = 10-30 m; RRM paths exist beyond the plates' far end and not
 # over the whole drive; the paper's JAVELIN-N and -NoRRMs as quoted
 assert plate_x == (10.0, 30.0), plate_x
+wall_plates = [p for p in plates if p["inclination_deg"] == 90.0]
+assert len(wall_plates) == 2 and all(p["z"] == 3.3 for p in wall_plates), plates
+assert sorted(p["inclination_deg"] for p in plates) == [55.0, 55.0, 90.0, 90.0], plates
 straight_x = rrm_x["italiano2026-straight"]
 assert straight_x.max() > plate_x[1] and straight_x.min() > plate_x[0], straight_x
 assert (paper_ref[1]["JAVELIN-N"], paper_ref[1]["JAVELIN-NoRRMs"]) == (0.88, 2.26), paper_ref

@@ -9,8 +9,8 @@
 # ray tracer that loads Blender-exported scenes.
 # All references: `REFERENCES.md` at the top of the repository; terms and abbreviations: the
 # [glossary](GLOSSARY.md), whose entries [CRLB](GLOSSARY.md#crlb) and [MCRB](GLOSSARY.md#mcrb)
-# define the two bounds this notebook uses. The benchmarks behind sections 7–9 and what they
-# measured: [`docs/raytraced-notes.md`](../docs/raytraced-notes.md).*
+# define the two bounds this notebook uses. Further reading: the longer runs behind sections 7–9
+# in [`docs/raytraced-notes.md`](../docs/raytraced-notes.md).*
 #
 # **What you will learn**
 #
@@ -166,8 +166,7 @@ tunnel3d_figure(
 # %% [markdown]
 # ## 4. Along both trajectories
 #
-# The acceptance test (`tests/test_rt_crossval.py`) runs positions along each trajectory. Here a
-# few epochs (more in full mode) of the slalom, which swings the vehicle towards the right wall.
+# A few epochs (more in full mode) of the slalom, which swings the vehicle towards the right wall.
 # Paths the image method finds but Sionna does not are checked against one explanation: a leg of
 # the path crosses an RRM plate (`rt.plate_occluders`). The image method treats plates as
 # reflectors only; physically the 0.8 m wall plate, standing off the curved wall, shadows the
@@ -206,7 +205,9 @@ print("image-only paths behind a plate at epochs", occluded, "; unexplained:", u
 # parallel to the surface, perpendicular to the plane of incidence) or TM (the field in the plane
 # of incidence). The image method uses a scalar coefficient: the TE Fresnel coefficient for
 # concrete (ITU-R P.2040), $-1$ for metal. Sionna traces polarised fields through an ITU slab,
-# with vertically polarised isotropic antennas at both ends, and reports the co-polar part (the
+# with Sionna's idealised `"iso"` pattern, vertically polarised, at both ends (the same gain in
+# every direction: no physical antenna can radiate one polarisation equally everywhere, but it
+# keeps the pattern out of the comparison), and reports the co-polar part (the
 # part of the reflected field in the vertical polarisation the receiving antenna picks up). For
 # the vertical RRMs the field is parallel to the plate (pure TE) and both give $|\Gamma| = 1$;
 # for the 55° RRMs the plate rotates the polarisation and the co-polar $|\Gamma|$ drops well
@@ -679,13 +680,14 @@ print(f"traced matched paths: median angle error {np.median(ang_rt):.3g} deg, me
 # with one UE to a fraction of a degree and decimetres.
 #
 # **The errors a tracker must be told.** The measurement noise of the JAVELIN design for the ML
-# route is the RMS error that route makes on the *image* channel. On the traced channel its
-# errors are far larger than those sigmas (every error over its sigma, printed below, above 1; the
-# curvature's above 3): the ray tracer's wavefronts are cut off across the aperture
-# (section 7's visibility part) and bent by the spatial-wideband term, and the ML fit's
-# curvature absorbs both. The traced design's sigmas are that error, measured once on the
-# straight drive (seed 0) and stored in `data/rt/traced_errors.json`; below, beside the same RMS
-# on this notebook's epochs (the same order of magnitude).
+# route is set from, and wider than, the RMS error that route makes on the *image* channel
+# (notebooks 04 and 04b). On the traced channel its errors are far larger than those sigmas (every
+# error over its sigma, printed below, above 1; the curvature's above 3): the ray tracer's
+# wavefronts are cut off across the aperture (section 7's visibility part) and bent by the
+# spatial-wideband term, and the ML fit's curvature absorbs both. The traced design's sigmas are set
+# from that error: its RMS, measured once on the straight drive (seed 0) and stored with the
+# package, widened below for the errors' correlation; first the stored RMS beside the same RMS on
+# this notebook's epochs (the same order of magnitude).
 
 # %%
 cfg_ml = designs.ours_ml().config
@@ -702,7 +704,7 @@ print(
     f"{np.degrees(cfg_ml.sigma_psi):.3g} deg, {cfg_ml.sigma_kappa:.3g} m"
 )
 print("error / sigma: " + ", ".join(f"{n} {r:.3g}" for n, r in ratio_rt.items()))
-rec = traced_errors()  # data/rt/traced_errors.json, with its provenance
+rec = traced_errors()  # the stored record, with its provenance
 stored = {r[0]: r for r in rec["rows"]}["all"]
 print(f"traced design's sigmas (stored, {rec['scenario']}, seed {rec['seed']}): {stored[2]:.3g} "
       f"deg, {stored[3]:.3g} deg, {stored[4]:.3g} m over {stored[1]} matched paths")  # fmt: skip

@@ -123,8 +123,9 @@ def tracks_figure(
     return reveal_overlaps(fig)
 
 
-#: the dashed curve's name: what a posterior CRLB bounds
-BOUND_NAME = "sqrt(PCRLB): RMSE bound over random drives"
+#: the dashed curve's name: the posterior CRLB with the measurement information evaluated along
+#: the one nominal path, an approximation of the bound over random drives about that path
+BOUND_NAME = "sqrt(PCRLB), H along the nominal path (approx.)"
 
 
 def rmse_bound_figure(
@@ -137,8 +138,8 @@ def rmse_bound_figure(
     bound_name: str = BOUND_NAME,
 ) -> go.Figure:
     """RMSE per epoch of each estimator with sqrt(posterior CRLB) dashed underneath, named
-    ``bound_name`` (default: what it bounds, the RMSE over random drives, not one drive's
-    error)."""
+    ``bound_name`` (default: what it is, the bound of random drives with ``H`` evaluated along
+    the nominal path, an approximation; in no case a bound on one drive's error)."""
     t = finite_array("t", t, ndim=1)
     bound_name = text("bound_name", bound_name)
     if not isinstance(rmse, Mapping):
