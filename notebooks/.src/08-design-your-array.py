@@ -433,7 +433,7 @@ print(f"with calibration error, RMSE over the augmented-state bound: at least {c
 # The tracker's RMSE lies above both bounds on every row (`bound_min` ≥ 1), while the prediction is
 # beaten on some (`pred_min` below 1): the prediction is a first-order guess of where the tracker
 # lands, the bounds are what no tracker can beat on average over drives. They hold here because
-# their $\mathbf Q$ is the V2X odometry noise (`tk.studies.SIGMA_SPEED`, `SIGMA_HEADING`), drawn
+# their $\mathbf Q$ is the V2X odometry noise (`tk.simulation.SIGMA_SPEED`, `SIGMA_HEADING`), drawn
 # afresh in every drive: they bound this fixed route driven with random odometry, which is what
 # every simulated drive is. (Notebook 05's $\mathbf Q$ modelled randomness of the truth itself,
 # which its straight preset lacked, and its filters went below.) Under calibration error the tracker

@@ -10,8 +10,10 @@ Per epoch, without memory:
   the paper does without a curvature. The paper does not say what TeNFiLoc does with a curvature
   of kilometres on a 45 m path; taken as is it puts the fix kilometres away;
 - NLoS: minimise eq. 69 over ``p_u``. The paper prints a plain sum of residuals
-  ``sum_l w_l (||p_u - p_s,l|| - d_l + kappa_l)``, which is unbounded below; we minimise the sum of
-  *squared* residuals (least squares, the form the paper's "LS algorithm" needs) and, ours,
+  ``sum_l w_l (||p_u - p_s,l|| - d_l + kappa_l)``: with positive weights it is convex, its
+  minimum the weighted geometric median of the reflectors, where ``d_l`` and ``kappa_l`` enter
+  as constants and play no role (the paper leaves eq. 69 out of its results, section 4.3); we
+  minimise the sum of *squared* residuals (least squares, the form the paper's "LS algorithm" needs) and, ours,
   optionally solve for the clock bias as a fourth unknown (``d_l = kappa_l + ||p_u - p_s,l|| + beta``)
   instead of assuming perfect synchronisation. ``p_s,l = b + kappa_l u_l`` is the reflector of
   eq. 19. A fitted bias outside the support (``|beta| > bias_limit``) refuses the fix.
