@@ -177,3 +177,24 @@ def test_an_information_so_small_its_bound_overflows_is_refused():
     with pytest.raises(ValueError, match="F: numerically singular"):
         crlb.crlb_trace(np.diag([1e-320, 1.0, 1.0]))
     assert crlb.crlb_trace(np.diag([4.0, 2.0])) == pytest.approx(0.75)
+
+
+def test_a_predicted_error_larger_than_the_tunnel_is_no_fix():
+    """A diffuse share of 1 - 1e-9 predicted errors of hundreds of kilometres in an 8 m tunnel:
+    each such epoch is a gap (no fix), and a candidate with no other epoch is refused by name."""
+    from tunnelkit import design
+
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    rep = design.design_sweep(setup, ["4x4"], impairments={"dmc_share": 0.999999999})
+    (row,) = rep.rows
+    assert row.status == "error" and "beyond the tunnel's extent (200.2 m)" in row.reason
+    ok = design.design_sweep(setup, ["8x8"], impairments={"dmc_share": 0.5}).rows[0]
+    assert ok.status == "bound only" and np.isfinite(ok.predicted_p90_m)
+
+
+def test_a_series_of_speeds_is_judged_speed_by_speed():
+    assert physical.speeds("speed", np.full(1500, 10.0), vectors=False).shape == (1500,)
+    with pytest.raises(ValueError, match=r"speed: a speed of 200 m/s"):
+        physical.speeds("speed", [10.0, 200.0], vectors=False)
+    with pytest.raises(ValueError, match=r"v: a speed of 387.3 m/s"):
+        physical.speeds("v", np.full(1500, 10.0))  # one 1500-D velocity vector

@@ -88,11 +88,11 @@ def power_dbm(name: str, value) -> float:
     return _within(name, real(name, value), *TX_POWER_DBM, "dBm", "")
 
 
-def speeds(name: str, velocity) -> np.ndarray:
-    """``velocity`` (..., D) [m/s], finite, each speed at most :data:`MAX_SPEED`; a scalar is one
-    speed (its magnitude)."""
+def speeds(name: str, velocity, *, vectors: bool = True) -> np.ndarray:
+    """``velocity`` (..., D) [m/s], finite, each speed at most :data:`MAX_SPEED`; a scalar, or
+    with ``vectors=False`` every entry, is one speed (its magnitude)."""
     v = finite_array(name, velocity)
-    s = np.abs(v) if v.ndim == 0 else np.linalg.norm(v, axis=-1)
+    s = np.abs(v) if v.ndim == 0 or not vectors else np.linalg.norm(v, axis=-1)
     top = float(np.max(s)) if s.size else 0.0
     if top > MAX_SPEED:
         raise ValueError(

@@ -197,12 +197,24 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
         row.reason = str(exc)
         return row
     x, peb, pred = r.x, r.peb, r.predicted
-    if not np.any(r.valid):
-        row.reason = f"no epoch of the route has a defined prediction: {r.reason}"
+    # an error larger than the tunnel is no fix: that epoch's prediction is a gap (infinite)
+    lo, hi = setup.tunnel.x_range
+    extent = float(np.linalg.norm([hi - lo, setup.tunnel.width, setup.tunnel.height]))
+    beyond = np.isfinite(pred) & (pred > extent)
+    pred = np.where(beyond, np.inf, pred)
+    valid = r.valid & ~beyond
+    why = "; ".join(
+        w for w in (r.reason if not np.all(r.valid) else "",
+                    f"predicted error beyond the tunnel's extent ({extent:.4g} m) at "
+                    f"{int(beyond.sum())} of {beyond.size} epochs: no fix there"
+                    if beyond.any() else "") if w
+    )  # fmt: skip
+    if not np.any(valid):
+        row.reason = f"no epoch of the route has a defined prediction: {why}"
         return row
     # an epoch where the array cannot fix the position is a gap of that epoch (infinite:
     # counted as missed), named in ``gaps``; the other epochs stand
-    row.gaps = r.reason if not np.all(r.valid) else ""
+    row.gaps = why
     t = setup.trajectory.t[: len(x)]
     k = counted_epochs(t, settle)
     row.x_m, row.peb_m, row.predicted_m = x, peb, pred

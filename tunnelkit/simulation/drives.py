@@ -145,7 +145,7 @@ class DriveData:
             may_be_empty=("truth_index", "kinds", "faults", "sources"),
         )
         speeds("velocity", self.velocity)
-        speeds("speed", self.speed[np.isfinite(self.speed)])
+        speeds("speed", self.speed[np.isfinite(self.speed)], vectors=False)
 
     @property
     def dt(self) -> float:
