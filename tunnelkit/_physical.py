@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import finite_array, real
+from ._validate import finite_array, positive, real
 
 __all__ = [
     "CARRIER_HZ",
@@ -107,17 +107,17 @@ def step_seconds(name: str, value) -> float:
     return _within(name, real(name, value), 0.0, MAX_STEP_S, "s", "")
 
 
+def _length(name: str, value, top: float) -> float:
+    """``value`` [m] above 0 and at most ``top``."""
+    v = positive(name, value)
+    return _within(name, v, 0.0, top, "m", "")
+
+
 def element_spacing(name: str, value) -> float:
     """``value`` [m], an element spacing: above 0, at most :data:`MAX_SPACING_M`."""
-    v = real(name, value)
-    if v <= 0:
-        raise ValueError(f"{name}: must be > 0, got {v:g}")
-    return _within(name, v, 0.0, MAX_SPACING_M, "m", "")
+    return _length(name, value, MAX_SPACING_M)
 
 
 def start_spread(name: str, value) -> float:
     """``value`` [m per axis], an entry fix's spread: above 0, at most :data:`MAX_START_SPREAD_M`."""
-    v = real(name, value)
-    if v <= 0:
-        raise ValueError(f"{name}: must be > 0, got {v:g}")
-    return _within(name, v, 0.0, MAX_START_SPREAD_M, "m", "")
+    return _length(name, value, MAX_START_SPREAD_M)

@@ -203,12 +203,11 @@ def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epoc
     beyond = np.isfinite(pred) & (pred > extent)
     pred = np.where(beyond, np.inf, pred)
     valid = r.valid & ~beyond
-    why = "; ".join(
-        w for w in (r.reason if not np.all(r.valid) else "",
-                    f"predicted error beyond the tunnel's extent ({extent:.4g} m) at "
-                    f"{int(beyond.sum())} of {beyond.size} epochs: no fix there"
-                    if beyond.any() else "") if w
-    )  # fmt: skip
+    reasons = [r.reason] if not np.all(r.valid) else []
+    if beyond.any():
+        reasons.append(f"predicted error beyond the tunnel's extent ({extent:.4g} m) at "
+                       f"{int(beyond.sum())} of {beyond.size} epochs: no fix there")  # fmt: skip
+    why = "; ".join(reasons)
     if not np.any(valid):
         row.reason = f"no epoch of the route has a defined prediction: {why}"
         return row
