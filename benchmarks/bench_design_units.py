@@ -460,6 +460,8 @@ def main(argv=None) -> int:
     ap.add_argument("--phases", type=float, nargs="+", default=list(PHASES_DEG))
     ap.add_argument("--levels", nargs="+", default=["2", "calibrated"],
                     help="part 2: impairment levels, a phase error in deg or 'calibrated'")  # fmt: skip
+    ap.add_argument("--arrays", nargs="+", default=list(COVERAGE_ARRAYS),
+                    help="part 2: the arrays measured")  # fmt: skip
     ap.add_argument("--old", action="store_true",
                     help="part 2: also the intervals reported before (drives resampled)")  # fmt: skip
     ap.add_argument("--tag", default="", help="a suffix of the written files' names")
@@ -504,6 +506,7 @@ def main(argv=None) -> int:
             "workers": args.workers,
             "n_boot": args.n_boot,
             "levels": tuple(args.levels),
+            "arrays": tuple(args.arrays),
             "old": args.old,
         }
         if args.quick:
