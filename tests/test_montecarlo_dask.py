@@ -365,3 +365,22 @@ def test_a_cluster_without_workers_stops_the_run_instead_of_hanging(monkeypatch)
         with pytest.raises(TrialLost, match=r"no worker for 2 s"):
             run_trials(_draw, 3, seed=0, scheduler=empty.scheduler_address)
         assert time.perf_counter() - t0 < 60.0
+
+
+def test_trials_have_a_default_time_limit_and_nested_runs_keep_the_outer_one():
+    import inspect
+
+    from tunnelkit.runner import TRIAL_TIMEOUT_S, TrialTimeout
+
+    assert inspect.signature(run_trials).parameters["trial_timeout"].default == TRIAL_TIMEOUT_S
+    assert 60.0 <= TRIAL_TIMEOUT_S <= 3600.0
+    # an inner run (its own, longer limit) inside an outer trial: the outer limit still fires
+    t0 = time.perf_counter()
+    with pytest.raises(TrialTimeout, match="trial 0 of 1 \\(outer\\)"):
+        run_trials(_nested_sleep, 1, seed=0, trial_timeout=1.0, desc="outer")
+    assert time.perf_counter() - t0 < 10.0
+
+
+def _nested_sleep(rng):
+    run_trials(_sleep, 1, seed=0, inputs=[0.0], trial_timeout=600.0, desc="inner")
+    time.sleep(30.0)

@@ -22,9 +22,10 @@ Bad input and stalls: ``workers`` beyond the cores this process may use is cappe
 :class:`RuntimeWarning`: more single-threaded processes than cores only add overhead); a
 scheduler address that accepts the connection but never answers fails with
 :class:`SchedulerUnreachable` after ``timeout`` seconds (the address is probed with Dask's
-``identity`` call under a hard deadline before a client is built); ``trial_timeout`` stops a run
-with :class:`TrialTimeout` when a trial runs longer than that serially, or when no trial has
-finished for that long on Dask. ``streams`` lets several trials share one child generator
+``identity`` call under a hard deadline before a client is built); ``trial_timeout`` (default
+:data:`TRIAL_TIMEOUT_S`, half an hour) stops a run with :class:`TrialTimeout` when a trial runs
+longer than that serially, or on Dask when no task has finished for that long times the trials
+per task (one task holds a few trials, :data:`CHUNKS_PER_THREAD`). ``streams`` lets several trials share one child generator
 (common random numbers: e.g. the same drive noise for every candidate array).
 
 
@@ -64,6 +65,11 @@ __all__ = [
 #: seconds to wait for a scheduler given by address before :class:`SchedulerUnreachable`
 CONNECT_TIMEOUT_S = 10.0
 
+#: the default per-trial time limit [s]: a trial that runs this long is taken as stuck (the
+#: longest trial in the project, a full-mode drive of the channel route with a 16 x 16 array,
+#: takes a few minutes); ``trial_timeout=None`` lifts the limit
+TRIAL_TIMEOUT_S = 1800.0
+
 
 class SchedulerUnreachable(ConnectionError, ValueError):
     """No Dask scheduler answered at the address given as ``scheduler`` within the timeout."""
@@ -98,7 +104,7 @@ def run_trials(
     scheduler: str | None = None,
     retries: int = 0,
     timeout: float = CONNECT_TIMEOUT_S,
-    trial_timeout: float | None = None,
+    trial_timeout: float | None = TRIAL_TIMEOUT_S,
     streams: Sequence[int] | None = None,
     shared_streams: bool = False,
     pool: TrialPool | None = None,
@@ -108,8 +114,8 @@ def run_trials(
     ``streams`` (one non-negative integer per trial): trial ``i`` gets a fresh copy of child
     generator ``streams[i]`` of ``seed`` (trials with the same stream see the same random
     numbers: a stream given twice is refused unless ``shared_streams``, common random numbers
-    meant); default: trial ``i`` gets child ``i``. ``trial_timeout`` [s]: see the module
-    docstring. ``pool``: a :func:`trial_pool` already open (instead of ``workers`` /
+    meant); default: trial ``i`` gets child ``i``. ``trial_timeout`` [s] (default
+    :data:`TRIAL_TIMEOUT_S`, ``None`` no limit): see the module docstring. ``pool``: a :func:`trial_pool` already open (instead of ``workers`` /
     ``scheduler``), so several steps share one cluster. Other options: module docstring."""
     callable_("trial", trial)
     runs = integer("runs", runs, minimum=1)
@@ -291,13 +297,20 @@ def _alarm(seconds: float | None, what: str) -> Iterator[None]:
     def _fire(signum, frame):
         raise TrialTimeout(f"{what} ran longer than trial_timeout = {seconds:g} s")
 
+    import time
+
+    # a run inside a trial (nested limits): the outer limit's time keeps running and is restored
+    outer, _ = signal.getitimer(signal.ITIMER_REAL)
+    t0 = time.monotonic()
     old = signal.signal(signal.SIGALRM, _fire)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    signal.setitimer(signal.ITIMER_REAL, min(seconds, outer) if outer > 0 else seconds)
     try:
         yield
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         signal.signal(signal.SIGALRM, old)
+        if outer > 0:
+            signal.setitimer(signal.ITIMER_REAL, max(outer - (time.monotonic() - t0), 1e-3))
 
 
 def _run_serial(
@@ -462,13 +475,13 @@ def _trial_chunk(trial, chunk: list, n: int, desc: str) -> list:
 
 
 #: trials go in about this many tasks per worker thread (a task costs the scheduler and the
-#: worker a few ms; several per thread keep the end of the run balanced); one trial per task
-#: with a ``trial_timeout`` (it counts from the last finished task)
+#: worker a few ms; several per thread keep the end of the run balanced); the time limit counts
+#: from the last finished task, ``trial_timeout`` per trial it holds
 CHUNKS_PER_THREAD = 8
 
 
-def _chunk_size(n: int, threads: int, trial_timeout: float | None) -> int:
-    return 1 if trial_timeout is not None else -(-n // (CHUNKS_PER_THREAD * max(threads, 1)))
+def _chunk_size(n: int, threads: int) -> int:
+    return -(-n // (CHUNKS_PER_THREAD * max(threads, 1)))
 
 
 def _run_dask(
@@ -482,7 +495,9 @@ def _run_dask(
     # the trial (it may carry a large model) is one task's result, fetched once per worker, not
     # sent with every task; unlike scattered data it is recomputed if a worker holding it dies
     shared = client.submit(_hold, trial, key=f"{desc}-trial-{tag}", pure=False)
-    size = _chunk_size(n, sum(client.nthreads().values()), trial_timeout)
+    size = _chunk_size(n, sum(client.nthreads().values()))
+    # no task finished for this long: a task of ``size`` trials may take ``size`` trial times
+    stall = None if trial_timeout is None else trial_timeout * size
     chunks = [list(range(i, min(i + size, n))) for i in range(0, n, size)]
     futures = [
         client.submit(
@@ -500,7 +515,7 @@ def _run_dask(
     index = {f.key: c for c, f in enumerate(futures)}
     out: list[Any] = [None] * n
     with _bar(n, progress, desc) as bar:
-        for fut in _as_completed(as_completed, futures, client, trial_timeout, chunks, index, desc):
+        for fut in _as_completed(as_completed, futures, client, stall, chunks, index, desc):
             idx = chunks[index[fut.key]]
             try:
                 out[idx[0] : idx[-1] + 1] = fut.result()
@@ -564,7 +579,7 @@ def _as_completed(as_completed, futures, client, trial_timeout, chunks, index, d
             if trial_timeout is not None and now - last > trial_timeout:
                 raise TrialTimeout(
                     f"{_cancel_late(futures, chunks, index)} ({desc}): none finished within "
-                    f"trial_timeout = {trial_timeout:g} s"
+                    f"{trial_timeout:g} s (trial_timeout times the trials per task)"
                 )
             continue
         last = now

@@ -54,7 +54,7 @@ from .._validate import boolean, choice, instance, integer, record
 from ..budget import check_bytes
 from ..metrics import SETTLE_S, settled
 from ..montecarlo import RUN_BYTES
-from ..runner import TrialPool, run_trials, trial_pool
+from ..runner import TRIAL_TIMEOUT_S, TrialPool, run_trials, trial_pool
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,
@@ -188,7 +188,7 @@ def sweep_montecarlo(
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float | None = None,
-    trial_timeout: float | None = None,
+    trial_timeout: float | None = TRIAL_TIMEOUT_S,
     progress: bool = False,
     n_epochs: int | None = None,
     crlbs: dict | None = None,
