@@ -1,4 +1,4 @@
-"""Issue 14: the default extraction (CPD, coherent split, joint ML) against the structured CRLB.
+"""The default extraction (CPD, coherent split, joint ML) against the structured CRLB.
 
 Timing (``cases``): the whole default extraction at M = 100, Nf = 410, Nt = 12, L = 6 on one
 BLAS thread, with today's CPD + coherent route as the baseline of the group.

@@ -1,4 +1,4 @@
-"""Issue 23: the default extraction stressed over its whole operating range, and its failure test.
+"""The default extraction stressed over its whole operating range, and its failure test.
 
 Cases (``CASES``): both drives (``italiano2026-straight`` and ``-slalom``) on a 300 m variant of
 the tunnel whose trajectory runs from x = 122 m to x = 0.5 m (``long_route``: the ranges the
@@ -653,7 +653,7 @@ def _long_tensor(drive="italiano2026-straight", x=110.0, seed=0):
 
 def cases() -> list[Case]:
     """The default extraction at long range (UE ~110 m and ~85 m on the straight drive), and the
-    basic search (the route before issue 23) on the same tensors as the baseline."""
+    basic search (the route before the pair search and the residual test) on the same tensors as the baseline."""
     out = []
     for x in (110.0, 85.0):
         H, arr, cfg, L = _long_tensor(x=x)
@@ -699,7 +699,7 @@ def _unscreened(fn):
 def cpu_times(repeat: int = 9, far: bool = True) -> str:
     """Median process (CPU) time, one BLAS thread, interleaved, of the default extraction, of
     the same without the early screen (the default before it) and of the basic search (the route
-    before issue 23: re-seeding on the residual energy only) on bench_ml's L = 6 tensor and on
+    before the pair search: re-seeding on the residual energy only) on bench_ml's L = 6 tensor and on
     long-range tensors (UE at x = 110 m and 85 m; with ``far`` also 120, 100 and 95 m), and of
     the default with the fits calling the checked numerics (``bench_ml.checked_numerics``: the
     route before the unchecked twins, same results)."""

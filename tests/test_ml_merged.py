@@ -1,4 +1,4 @@
-"""Issue 23: a pair of a cluster fitted with the wrong curvature (the search leaves it by the split
+"""A pair of a cluster fitted with the wrong curvature (the search leaves it by the split
 move on the closest pair while the residual test fails), and the bound of a merged pair (the
 CRLB of one path at the pair's power-weighted centroid)."""
 

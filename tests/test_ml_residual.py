@@ -1,4 +1,4 @@
-"""Issue 23: the residual test of the ML stage (fit_ok), the re-initialisation on the residual,
+"""The residual test of the ML stage (fit_ok), the re-initialisation on the residual,
 the bounds at the SNR used, the feasible set to end-fire, caps and physically possible paths."""
 
 import warnings

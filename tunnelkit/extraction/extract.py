@@ -59,7 +59,7 @@ def extract_paths(
     noise_power : noise power per sample for the "ml" route (default: estimated from ``H``).
     search : the "ml" route's search: "residual" (default: re-initialisation on the residual's
         periodogram peak until the residual test passes) or "basic" (re-seeding on the residual
-        energy alone, the route before issue 23, kept for comparison); see
+        energy alone, the route before the pair search and the residual test, kept for comparison); see
         :func:`.ml.fitting.fit_problem`.
     wideband : the "ml" route's model carries the spatial-wideband term (each element its own
         delay across the band, :mod:`.ml.wideband`); off by default (eq. 1).

@@ -1,5 +1,6 @@
-"""Each bad input named in issue 25's "Why", exactly as reported: refused with the parameter
-named (or a documented, physically right result: an infinite bound, a capped count)."""
+"""Each bad input of the fifth round of outside probes, exactly as reported: refused with the
+parameter named (or a documented, physically right result: an infinite bound, a capped
+count)."""
 
 from __future__ import annotations
 
