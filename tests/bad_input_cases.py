@@ -460,7 +460,7 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "mmax_exact_ura[m_limit=1e6]",
-            lambda: _mod("fresnel").mmax_exact_ura(3.5, 3.0, 2.5, 5.9e9, 1e6, m_limit=10**6),
+            lambda: _mod("fresnel").mmax_exact_ura(3.5, 3.0, 2.5, 5.9e9, 3.0, m_limit=10**6),
             ("m_limit",),
             heavy=True,
         )
@@ -468,7 +468,7 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "mmax_exact_grid[m_limit=1e12]",
-            lambda: _mod("fresnel").mmax_exact_grid(3.5, 3.0, 2.5, 5.9e9, 1e6, m_limit=10**12),
+            lambda: _mod("fresnel").mmax_exact_grid(3.5, 3.0, 2.5, 5.9e9, 3.0, m_limit=10**12),
             ("m_limit",),
             heavy=True,
         )

@@ -160,6 +160,7 @@ NAN, INF = float("nan"), float("inf")
 @dataclass(frozen=True)
 class Bad:
     kind: str  # type | nan | inf | zero | negative | huge | empty | shape | dtype | complex
+    # | physical (outside a declared physical range or budget)
     label: str
     value: object = field(compare=False)
 
@@ -311,7 +312,75 @@ def bad_values(p: inspect.Parameter, tp, valid) -> list[Bad]:
         out = [Bad("type", "object", object())]
     if not allows_none and kind != "any":
         out.append(Bad("type", "None", None))
-    return out[:MAX_CASES_PER_PARAMETER]
+    out = out[:MAX_CASES_PER_PARAMETER]
+    if kind in ("float", "int", "array"):
+        out += physical_bads(p.name, kind, valid)
+    return out
+
+
+# --- physical probes: generated from the package's declared ranges ----------------------------
+
+
+def _quantities() -> tuple:
+    """(parameter-name pattern, [(label, value)]) per physical quantity: values outside the range
+    :mod:`tunnelkit._physical` declares for it (a car faster than any vehicle, a carrier in GHz,
+    a subcarrier spacing in kHz, a time step or an entry-fix spread no motion model holds), and a
+    size no memory budget allows for a count a user controls."""
+    from tunnelkit import _physical as ph
+
+    return (
+        (
+            r"fc|fc_hz|f_c|carrier|carrier_hz|carrier_frequency|frequency_hz",
+            [("GHz-for-Hz", 28.0), ("above-range", ph.CARRIER_HZ[1] * 10)],
+        ),
+        (
+            r"scs|scs_hz|subcarrier|subcarrier_hz|subcarrier_spacing|delta_f",
+            [("kHz-for-Hz", 120.0), ("above-range", ph.SUBCARRIER_HZ[1] * 10)],
+        ),
+        (
+            r"tone_spacing",
+            [("kHz-for-Hz", 120.0), ("above-range", ph.TONE_SPACING_HZ[1] * 10)],
+        ),
+        (
+            r"speed|speeds|speed_mps|velocity|v0|v_max|max_speed",
+            [("faster-than-a-vehicle", 2 * ph.MAX_SPEED), ("light", 3e8)],
+        ),
+        (r"dt|step_s|epoch_s|period_s|interval_s", [("step-too-long", 100 * ph.MAX_STEP_S)]),
+        (
+            r"start_sigma|sigma_p0|sigma_p0_ue|start_sigma_m",
+            [("spread-too-wide", 100 * ph.MAX_START_SPREAD_M)],
+        ),
+        (r"tx_power_dbm|power_dbm", [("above-range", 10 * ph.TX_POWER_DBM[1])]),
+        (r"spacing|element_spacing|spacing_m", [("above-range", 10 * ph.MAX_SPACING_M)]),
+        (
+            r"runs|n_runs|units|n_units|n_boot|n_tones|n_bins|n_epochs|reps|n_particles"
+            r"|particles|drives|drives_per_unit|n_draws|n_samples|trials",
+            [("beyond-budget", 10**10)],
+        ),
+    )
+
+
+def physical_bads(name: str, kind: str, valid) -> list[Bad]:
+    """The physical probes of parameter ``name`` (:func:`_quantities`), shaped like ``valid``
+    (an array parameter gets the value in every element); none for other names."""
+    out = []
+    for pattern, values in _quantities():
+        if not re.fullmatch(pattern, name):
+            continue
+        for label, value in values:
+            if kind == "int" and not float(value).is_integer():
+                continue
+            if label == "beyond-budget" and kind != "int":
+                continue  # a count only (an array named "particles" holds the samples)
+            if kind == "array":
+                a = np.asarray(valid) if valid is not None else None
+                if a is None or a.dtype.kind not in "iuf" or not a.size:
+                    continue
+                value = np.full(a.shape, value, dtype=float)
+            elif kind == "int":
+                value = int(value)
+            out.append(Bad("physical", label, value))
+    return out
 
 
 # --- one case ---------------------------------------------------------------------------------

@@ -70,6 +70,36 @@ DOCUMENTED: tuple[Documented, ...] = (
     _doc(ANY, r".*_db|snr_db", "negative zero", "a level or offset in dB: any sign"),
     _doc(ANY, r"seed", "zero", "0 is a seed like any other"),
     _doc(
+        ANY,
+        r"n_epochs",
+        "physical",
+        "at most the route's epochs: a larger count drives the whole route (a hang is that drive)",
+    ),
+    _doc(
+        r"(tunnelkit\.)?design\.(records\.DesignRow|verdict\.(judge|recommend))",
+        r"runs|units|drives_per_unit",
+        "physical",
+        "a count reported or judged, nothing allocated from it",
+    ),
+    _doc(
+        r"(tunnelkit\.)?extraction\.ml\.residual\.peak_threshold",
+        r"n_samples",
+        "physical",
+        "a count in a closed form (the threshold of n cells), nothing allocated",
+    ),
+    _doc(
+        r"(tunnelkit\.)?tracking\.doppler\.approaches\.Track",
+        r"speed",
+        "physical",
+        "a tracker's speed estimates: a diverged filter's output is reported, not refused",
+    ),
+    _doc(
+        r"(tunnelkit\.)?doppler_drive\.config\.DriveConfig",
+        r"spacing",
+        "physical",
+        "the drive's sample spacing [m] (not an element spacing), checked against its length",
+    ),
+    _doc(
         r"design\.verdict\.recommend",
         r"rows",
         "empty",
@@ -835,6 +865,7 @@ FULL = os.environ.get("TUNNELKIT_CONTRACTS", "") == "full"
 # the unit run takes these bad-value kinds of every parameter (each present kind, in this
 # order, at most UNIT_PER_PARAMETER); TUNNELKIT_CONTRACTS=full (or the script) runs them all
 UNIT_KINDS = (
+    "physical",
     "type",
     "nan",
     "negative",
@@ -1047,3 +1078,20 @@ def main(argv) -> None:  # pragma: no cover - the measurement behind the report
 
 if __name__ == "__main__":  # pragma: no cover
     main(sys.argv[1:])
+
+
+def test_physical_probes_come_from_the_declared_ranges(suite):
+    """The physical class is generated, not listed: every parameter named like a carrier, a
+    speed, a time step, an entry-fix spread or a count gets its probes from
+    :mod:`tunnelkit._physical`'s ranges (and the budget), and the unit run takes them first."""
+    from tunnelkit import _physical as ph
+
+    phys = [c for c in suite.cases if c.bad.kind == "physical"]
+    assert len(phys) > 200
+    fcs = {c.target for c in phys if c.param == "fc" and c.bad.label == "GHz-for-Hz"}
+    assert len(fcs) > 30
+    assert all(c.bad.value > ph.CARRIER_HZ[1] for c in phys if c.bad.label == "above-range"
+               and c.param == "fc")  # fmt: skip
+    assert {c.id for c in phys} <= {c.id for c in unit_sample(suite.cases)} | {
+        c.id for c in phys if c.bad.label not in ("GHz-for-Hz", "faster-than-a-vehicle")
+    }

@@ -158,7 +158,7 @@ def test_findings_of_the_issue_raise_naming_the_parameter():
         (lambda: propagation.fresnel_te(5.24, 5.0), r"cos_i: must lie in \[0, 1\]"),
         (
             lambda: drive.doppler_shift([[1.0, 0.0]], [[1.0, 0.0]], [0.0, 4.5], -1e9),
-            "fc: must be > 0",
+            r"fc: expected 1e\+08 to 3e\+11 Hz",
         ),
         (lambda: crlb.wrap_angle([0.1, np.nan]), "a: contains NaN"),
         (lambda: drive.slant_range([[np.nan, 0.0]], [0.0, 4.5]), "p: contains NaN"),
@@ -275,15 +275,24 @@ def test_duplicate_elements_match_brute_force():
         assert brute == bool(trial % 2)
 
 
-def test_mmax_json_marks_a_capped_search(capsys):
+def test_mmax_json_marks_a_capped_search(capsys, monkeypatch):
+    """A search that hits its cap is marked as a lower bound (the caps lowered here: at the
+    package's caps of 2^20 and 1024 antennas no tolerance up to pi rad reaches them)."""
+    import functools
     import json
 
     from tunnelkit import cli
+    from tunnelkit.fresnel import summary
 
+    for name, cap in (("mmax_exact", 8), ("mmax_exact_ura", 4)):
+        monkeypatch.setattr(summary, name, functools.partial(getattr(summary, name), m_limit=cap))
+    monkeypatch.setattr(summary, "M_LIMIT", 8)
+    monkeypatch.setattr(summary, "M_LIMIT_URA", 4)
     with pytest.warns(RuntimeWarning, match="returned as a lower bound"):
-        assert cli.main(["mmax", "--eps", "1000", "--format", "json"]) == 0
+        assert cli.main(["mmax", "--format", "json"]) == 0
     row = json.loads(capsys.readouterr().out)["rows"][0]
-    assert row["exact ULA"] == ">= 1048576" and row["exact URA MxM"] == ">= 1024"
+    assert row["exact ULA"] == ">= 8" and row["exact URA MxM"] == ">= 4"
+    monkeypatch.undo()  # the package's caps
     assert row["eq.25/exact"] is None
     assert cli.main(["mmax", "--format", "json"]) == 0
     row = json.loads(capsys.readouterr().out)["rows"][0]

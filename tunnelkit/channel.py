@@ -62,7 +62,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._physical import carrier, power_dbm, subcarrier
+from ._physical import carrier, power_dbm, subcarrier, tone_step
 from ._validate import (
     choice,
     finite_array,
@@ -285,9 +285,10 @@ class DiffuseSpec:
     def taps(self, tone_spacing: float, n_tones: int) -> tuple[float, np.ndarray]:
         """The delay step ``dtau`` [s] and the tap weights ``w`` (P,) (sum 1) for a band of
         ``n_tones`` tones ``tone_spacing`` apart."""
-        df = positive("tone_spacing", tone_spacing)
+        df = tone_step("tone_spacing", tone_spacing)
         nf = integer("n_tones", n_tones, minimum=1)
         n_fft = self.oversample * nf
+        check_elements("n_tones", n_fft, what=f"the diffuse taps of {nf} tones")
         dtau = 1.0 / (n_fft * df)
         n_taps = int(min(max(np.ceil(self.span * self.decay_s / dtau), 1), n_fft))
         w = np.exp(-np.arange(n_taps) * dtau / self.decay_s)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import finite_array, positive
+from ._physical import carrier
+from ._validate import finite_array
 
 #: speed of light in vacuum [m/s]
 C = 299_792_458.0
@@ -14,7 +15,7 @@ K_B = 1.380649e-23
 
 def wavelength(fc: float) -> float:
     """Carrier wavelength ``lambda = c / fc`` [m] for a carrier ``fc`` [Hz]."""
-    return C / positive("fc", fc)
+    return C / carrier("fc", fc)
 
 
 def db2lin(x_db):

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._checks import attributes
+from ._physical import speeds as check_speeds
 from ._validate import boolean, finite_array, instance, integer, positive, real, sequence
 from .arrays import ArrayGeometry
 from .constants import C
@@ -291,7 +292,7 @@ def random_scene(
         raise ValueError(f"max_sine: must lie in (0, 1], got {max_sine}")
     snr_db = interval("snr_db", snr_db)
     spread_d = nonnegative("spread_d", spread_d)
-    speeds = interval("speeds", speeds)
+    speeds = tuple(check_speeds("speeds", interval("speeds", speeds), vectors=False))
     pos = ura(10, 10, wavelength(cfg.fc) / 2) if element_positions is None else element_positions
     if element_positions is not None:
         pos = check_element_positions("element_positions", element_positions)

@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._physical import carrier
 from ._validate import boolean, finite_array, instance, integer, positive
 from .arrays import ArrayGeometry
 from .budget import check_elements
 from .channel import SRSConfig
 from .consistency import geometry_consistency, tunnel_planes
 from .constants import C
-from .extraction.radio import MAX_CARRIER
 from .signal_route import Epoch, SignalRoute, reported_covariance
 
 __all__ = ["bound_sigmas", "epoch_consistency", "joint_bound", "joint_fisher", "rate_interval"]
@@ -94,8 +94,7 @@ def joint_fisher(
     check_elements("n_symbols", 7 * L * n_symbols, 16, "the Fisher information's symbol factors")
     s, kk = np.arange(n_tones)[:, None], np.arange(n_symbols)[:, None]
     n0 = positive("noise_power", noise_power)
-    if not 1e6 <= positive("fc", fc) <= MAX_CARRIER:
-        raise ValueError(f"fc: {fc:g} Hz is outside [1 MHz, 1 THz] (fc is in Hz)")
+    fc = carrier("fc", fc)
     k0 = 2 * np.pi * fc / C
     rng_m = np.linalg.norm(src[None] - p[:, None], axis=-1)  # (M, L)
     if np.any(rng_m == 0):

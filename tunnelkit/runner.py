@@ -294,14 +294,17 @@ def _alarm(seconds: float | None, what: str) -> Iterator[None]:
         yield
         return
 
-    def _fire(signum, frame):
-        raise TrialTimeout(f"{what} ran longer than trial_timeout = {seconds:g} s")
-
     import time
 
     # a run inside a trial (nested limits): the outer limit's time keeps running and is restored
     outer, _ = signal.getitimer(signal.ITIMER_REAL)
     t0 = time.monotonic()
+
+    def _fire(signum, frame):
+        if 0 < outer <= seconds and callable(old):  # the outer deadline came first: its handler
+            return old(signum, frame)
+        raise TrialTimeout(f"{what} ran longer than trial_timeout = {seconds:g} s")
+
     old = signal.signal(signal.SIGALRM, _fire)
     signal.setitimer(signal.ITIMER_REAL, min(seconds, outer) if outer > 0 else seconds)
     try:

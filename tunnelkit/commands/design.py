@@ -25,10 +25,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import sys
 from dataclasses import replace
 from pathlib import Path
+
+from .._physical import MAX_RANGE_M
 
 NAME = "design"
 HELP = (
@@ -58,7 +61,9 @@ def _frequency(param: str):
     return parse
 
 
-def _positive(param: str):
+def _positive(param: str, upper: float = float("inf")):
+    """argparse type: a number > 0 and finite (at most ``upper``); errors name ``param``."""
+
     def parse(text: str) -> float:
         try:
             value = float(text)
@@ -66,6 +71,23 @@ def _positive(param: str):
             raise argparse.ArgumentTypeError(f"{param}: expected a number, got {text!r}") from None
         if not 0 < value < float("inf"):
             raise argparse.ArgumentTypeError(f"{param}: must be > 0 and finite, got {text!r}")
+        if value > upper:
+            raise argparse.ArgumentTypeError(f"{param}: at most {upper:g}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _bounded(param: str, lo: float, hi: float):
+    """argparse type: a finite number in ``[lo, hi]``; errors name ``param``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{param}: expected a number, got {text!r}") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{param}: must be in [{lo:g}, {hi:g}], got {text!r}")
         return value
 
     return parse
@@ -182,12 +204,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--fc", type=_frequency("fc"), default=None, help="carrier, e.g. 28GHz")
     p.add_argument("--bandwidth", type=_frequency("bandwidth"), default=None, help="e.g. 400MHz")
-    geo.add_argument("--tilt", type=float, default=None, help="down-tilt of every array [deg]")
+    geo.add_argument(
+        "--tilt",
+        type=_bounded("tilt", -90.0, 90.0),
+        default=None,
+        help="down-tilt of every array [deg]",
+    )
     geo.add_argument(
         "--mount-height", type=float, default=None, help="height of the arrays' centre [m]"
     )
     p.add_argument(
-        "--target", type=_positive("target"), default=0.2, help="position error target [m] (0.2)"
+        "--target",
+        type=_positive("target", MAX_RANGE_M),
+        default=0.2,
+        help="position error target [m] (0.2)",
     )
     p.add_argument(
         "--share",
@@ -241,7 +271,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="achievable: the design's VUE-curvature tracker, SR-NF as information (default); "
         "srnf: an eq. 51 estimator, SR-NF validity a gate",
     )
-    rt.add_argument("--eps", type=_positive("eps"), default=0.15, help="eps_phi [rad] (0.15)")
+    rt.add_argument(
+        "--eps", type=_positive("eps", math.pi), default=0.15, help="eps_phi [rad] (0.15)"
+    )
     p.add_argument(
         "--units",
         "--runs",

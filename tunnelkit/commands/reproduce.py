@@ -54,6 +54,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_parallel_arguments(p)
 
 
+def _seconds(param: str):
+    """argparse type: a time in seconds, > 0 and at most a day; errors name ``param``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{param}: expected seconds, got {text!r}") from None
+        if not 0 < value <= 86400:
+            raise argparse.ArgumentTypeError(f"{param}: must be in (0, 86400] s, got {text!r}")
+        return value
+
+    return parse
+
+
 def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
     """``--workers N | --scheduler ADDRESS`` and ``--connect-timeout`` (any command whose trials
     go through :func:`tunnelkit.runner.run_trials`; pass them on with :func:`parallel_kwargs`)."""
@@ -75,7 +90,7 @@ def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--connect-timeout",
-        type=float,
+        type=_seconds("connect_timeout"),
         default=CONNECT_TIMEOUT_S,
         metavar="SECONDS",
         help=f"give up on --scheduler after this long (default {CONNECT_TIMEOUT_S:g})",

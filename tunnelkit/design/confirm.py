@@ -51,6 +51,8 @@ import copy
 from dataclasses import dataclass, field
 
 from .._validate import instance, integer, record, sequence
+from ..budget import check_bytes
+from ..montecarlo import RUN_BYTES
 from .report import DesignReport, score_row
 from .setup import DesignSetup, parse_array
 from .verdict import MIN_RUNS_CI, recommend
@@ -147,6 +149,7 @@ def confirm_on_channel(
             "report: expected a bound-route sweep with units (mode 'bound', units > 0)"
         )
     units = s["units"] if units is None else integer("units", units, minimum=1)
+    check_bytes("units", units * RUN_BYTES, f"{units} units' calibration draws")
     d = s["drives_per_unit"]
     labels = confirmation_candidates(report)
     by = {r.array: r for r in report.rows}

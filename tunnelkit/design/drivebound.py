@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import bound_array
+from .._physical import start_spread
 from .._validate import finite_array, instance
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
@@ -303,7 +304,7 @@ def drive_pcrlb(
 
     sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
     sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
-    sigma_p0 = positive("sigma_p0", sigma_p0)
+    sigma_p0 = start_spread("sigma_p0", sigma_p0)
     info = finite_array("info", info, shape=(None, 2, 2))
     Q = _motion_noise(setup, info.shape[0], sig_nu, sig_th)
     B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
@@ -372,11 +373,11 @@ def unit_pcrlb(
     ``calibration=False``), the start an open-sky fix of ``sigma_p0`` [m]. Computed in
     covariance form, each epoch a low-rank update (Woodbury), so the cost grows as ``M^2`` per
     epoch, not ``M^3``."""
-    from .._validate import boolean, positive
+    from .._validate import boolean
     from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
 
     _check_geometry(model, geometry)
-    sigma_p0 = positive("sigma_p0", sigma_p0)
+    sigma_p0 = start_spread("sigma_p0", sigma_p0)
     calibration = boolean("calibration", calibration)
     T, P = model.exists.shape
     ks = []

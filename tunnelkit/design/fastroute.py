@@ -48,7 +48,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import choice, instance, nonnegative, positive, record, rng_or_error
+from .._physical import carrier
+from .._validate import choice, instance, nonnegative, record, rng_or_error
 from ..constants import C
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
@@ -79,7 +80,7 @@ SIGMA_V = 0.05
 def model_truth(g, fc: float) -> tuple[np.ndarray, np.ndarray]:
     """True ``z = [phi, psi, kappa, d]`` (T, P, 4) and radial speed ``v`` (T, P) [m/s] of every
     slot of a :class:`~tunnelkit.design.geometry.RouteGeometry` (NaN where a path is absent)."""
-    instance("g", g, RouteGeometry), positive("fc", fc)
+    instance("g", g, RouteGeometry), carrier("fc", fc)
     rel = g.source - g.origin[:, None, :]
     r = np.linalg.norm(rel, axis=-1)
     phi = np.arctan2(rel[..., 1], rel[..., 0])

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import choice, finite_array, positive, record, sequence
+from .._physical import carrier, speeds
+from .._validate import choice, finite_array, record, sequence
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from ..propagation import Tunnel3D
@@ -82,9 +83,13 @@ def trace_route(
     kinds = tuple(choice("kinds", k, KINDS) for k in sequence("kinds", kinds))
     if not arrays or not all(isinstance(a, ArrayGeometry) for a in arrays):
         raise TypeError("arrays: expected a non-empty list of arrays.ArrayGeometry")
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     ue = tunnel.require_inside("ue", finite_array("ue", ue, shape=(None, 3)))
-    vel = np.zeros_like(ue) if velocity is None else finite_array("velocity", velocity)
+    vel = (
+        np.zeros_like(ue)
+        if velocity is None
+        else speeds("velocity", finite_array("velocity", velocity))
+    )
     if vel.shape != ue.shape:
         raise ValueError(f"velocity: expected shape {ue.shape}, got {vel.shape}")
     origins = np.stack([a.origin for a in arrays])

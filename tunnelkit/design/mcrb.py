@@ -41,7 +41,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import square_matrices
+from .._physical import carrier, tone_step
 from .._validate import finite_array, instance, integer, positive, probability
+from ..budget import check_elements
 from ..channel import DiffuseSpec
 from ..constants import C
 
@@ -131,8 +133,10 @@ def _check_modes(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols) ->
     finite_array("mu_f", mu_f, shape=(T, L)), finite_array("mu_t", mu_t, shape=(T, L))
     if np.shape(mask) != (T, L) or np.asarray(mask).dtype != bool:
         raise ValueError(f"mask: expected a ({T}, {L}) bool array, got {np.shape(mask)}")
-    positive("fc", fc), integer("n_tones", n_tones, minimum=1)
+    carrier("fc", fc), integer("n_tones", n_tones, minimum=1)
     integer("n_symbols", n_symbols, minimum=1)
+    check_elements("n_tones", T * L * n_tones, 16, f"{T} x {L} paths' tone factors")
+    check_elements("n_symbols", T * L * n_symbols, 16, f"{T} x {L} paths' symbol factors")
 
 
 class EtaModes:
@@ -228,7 +232,7 @@ class EtaModes:
 
     def wideband_terms(self, tone_spacing: float) -> int:
         """Number of series terms the spatial-wideband ``delta`` needs (``WB_TOL``)."""
-        positive("tone_spacing", tone_spacing)
+        tone_step("tone_spacing", tone_spacing)
         eps = 2 * np.pi * tone_spacing * np.abs(self.offset).max() / C
         x = 0.5 * (self.n_tones - 1) * eps
         n, term = 0, 1.0
@@ -240,7 +244,7 @@ class EtaModes:
     def wideband_score(self, tone_spacing: float, n_terms: int | None = None) -> np.ndarray:
         """``J^H delta`` (T, 7L) complex of the spatial-wideband term (series in the tone's
         offset from the band centre, ``n_terms`` terms, :meth:`wideband_terms` by default)."""
-        positive("tone_spacing", tone_spacing)
+        tone_step("tone_spacing", tone_spacing)
         if n_terms is not None:
             integer("n_terms", n_terms, minimum=1, maximum=200)
         N = self.wideband_terms(tone_spacing) if n_terms is None else int(n_terms)
@@ -272,7 +276,7 @@ class EtaModes:
     def diffuse_gram(self, spec: DiffuseSpec, tone_spacing: float, tau0) -> np.ndarray:
         """``J^H C_D J / P_D`` (T, 7L, 7L) complex for unit diffuse power starting at delay
         ``tau0`` (T,) [s] (module docstring)."""
-        instance("spec", spec, DiffuseSpec), positive("tone_spacing", tone_spacing)
+        instance("spec", spec, DiffuseSpec), tone_step("tone_spacing", tone_spacing)
         finite_array("tau0", tau0, shape=(self.X.shape[0],))
         _, w = spec.taps(tone_spacing, self.n_tones)
         n_fft = spec.oversample * self.n_tones

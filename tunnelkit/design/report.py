@@ -388,7 +388,7 @@ def design_sweep(
     start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
     if n_epochs is not None:
-        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+        n_epochs = integer("n_epochs", n_epochs, minimum=1, maximum=len(setup.trajectory))
     workers, scheduler = parallel_options(workers, scheduler)
     traced_array = setup.channel != "image" and impairments == "calibrated"
     if traced_array:  # the traced route's tracker is told errors measured on an ideal array
@@ -396,8 +396,7 @@ def design_sweep(
     imp = _design_impairments(impairments, setup, specs)
     fields = _impairment_fields(imp)
     T = len(setup.trajectory)
-    if n_epochs is not None and n_epochs < T:
-        T = n_epochs
+    T = T if n_epochs is None else n_epochs
     counted_epochs(setup.trajectory.t[:T], settle)  # a settle window that leaves an epoch
     if units:
         # the largest array's drives at the cap: what one batch's results may hold at most
@@ -406,6 +405,9 @@ def design_sweep(
             8 * (2 if dead_reckoning else 1) * len(specs) * max_units * drives_per_unit * T,
             f"{len(specs)} arrays x {max_units} units x {drives_per_unit} drives x {T} epochs "
             "of errors",
+        )
+        check_elements(
+            "n_boot", n_boot * max_units, what=f"{n_boot} resamples of {max_units} units"
         )
     if mode == "channel" and units:
         # each drive synthesises the largest candidate's tensor and a noise draw of its size:

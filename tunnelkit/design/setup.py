@@ -22,6 +22,7 @@ from functools import lru_cache
 import numpy as np
 
 from .. import propagation
+from .._physical import carrier
 from .._validate import choice, finite_array, instance, integer, positive, record
 from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
@@ -248,7 +249,7 @@ class DesignSetup:
             _mount_height_inside(self, float(finite_array("mount_height", mount_height, ndim=0)))
         cfg = self.config
         if fc is not None:
-            cfg = replace(cfg, fc=positive("fc", fc))
+            cfg = replace(cfg, fc=carrier("fc", fc))
         if bandwidth is not None:
             bw = positive("bandwidth", bandwidth)
             n_rb = int(np.floor(bw / (12 * cfg.scs) * (1 + 1e-9)))

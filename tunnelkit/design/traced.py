@@ -41,7 +41,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .._physical import start_spread
 from .._validate import boolean, instance, integer, positive, rng_or_error
+from ..budget import check_bytes
+from ..montecarlo import RUN_BYTES
 from .setup import DesignSetup, parse_array
 
 __all__ = [
@@ -161,6 +164,7 @@ def measure_design_errors(
     setup = _setup(setup)
     spec = parse_array(spec)
     runs = integer("runs", runs, minimum=1)
+    check_bytes("runs", runs * RUN_BYTES, f"{runs} traced drives")
     seed = integer("seed", seed, minimum=0)
     progress = boolean("progress", progress)
     if n_epochs is not None:
@@ -405,7 +409,7 @@ def traced_bounds(
     n = len(setup.trajectory)
     T = n if T is None else min(integer("T", T, minimum=1), n)
     sig = _config_sigmas(config)
-    sigma_p0 = START_SIGMA_M if sigma_p0 is None else positive("sigma_p0", sigma_p0)
+    sigma_p0 = START_SIGMA_M if sigma_p0 is None else start_spread("sigma_p0", sigma_p0)
     try:
         model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
     except ValueError as exc:  # a sigma of the config that is not > 0

@@ -26,6 +26,7 @@ import numpy as np
 
 from .._checks import bound_array, real_array
 from .._validate import finite_array, integer, positive, probability
+from ..budget import check_elements
 
 __all__ = [
     "DRIVES_PER_UNIT",
@@ -73,6 +74,7 @@ def drive_streams(first: int, units: int, drives_per_unit: int) -> list[int]:
     first = integer("first", first, minimum=0)
     units = integer("units", units, minimum=1)
     d = integer("drives_per_unit", drives_per_unit, minimum=1)
+    check_elements("units, drives_per_unit", units * d, 64, f"{units} units x {d} drives' streams")
     return [u * d + i for u in range(first, first + units) for i in range(d)]
 
 
@@ -104,7 +106,9 @@ def unit_quantiles(errors, drives_per_unit: int, counted, share: float) -> np.nd
     share = probability("share", share, open_interval=False)
     e = real_array("errors", errors, ndim=2)
     if e.shape[0] % d or not e.size:
-        raise ValueError(f"errors: expected (units x {d} drives, T), got shape {e.shape}")
+        raise ValueError(
+            f"errors, drives_per_unit: expected (units x {d} drives, T), got shape {e.shape}"
+        )
     if np.any(e < 0):
         raise ValueError("errors: a position error is not negative")
     k = finite_array("counted", counted, ndim=1)

@@ -23,7 +23,7 @@ bound-driven or the channel Monte-Carlo.
   manufactured unit (all its drives), since a unit's drives share its calibration draw and the
   epochs of one drive are correlated: deterministic; on synthetic clustered errors it covers
   where the percentile bootstrap over units (:func:`bootstrap_quantile_ci`, kept for the
-  comparison) under-covers, and on the design's Monte-Carlo 88-96 % (its docstring): the yield
+  comparison) under-covers, and on the design's Monte-Carlo 90-98 % (its docstring): the yield
   decides, the interval informs.
 * **The verdict** (:func:`judge`) is by the **unit yield** (:mod:`tunnelkit.design.units`): the
   share of units whose own quantile meets the target, with its Wilson 95 % interval.
@@ -145,8 +145,8 @@ def cluster_quantile_ci(errors, share: float, *, level: float = 0.95) -> list[fl
     interval of a quantile under cluster sampling). On 20 units of synthetic clustered errors it
     covers 94-95 % where the percentile bootstrap over units covers 80-91 %; on the design's
     Monte-Carlo (8x8 and 16x16, the calibrated default and 2 deg of phase error, 20 units) it
-    covered 88-93 % on disjoint blocks, 93-96 % on blocks of 20-80 units drawn from one long
-    reference (``benchmarks/bench_design_units.py``, part 2: docs/results/design-units.md).
+    covered 90-93 % on disjoint blocks (60 to 180 per cell), 93-98 % on blocks of 20-80 units
+    drawn from one long reference (``benchmarks/bench_design_units.py``, part 2: docs/results/design-units.md).
     Information beside the verdict (the unit yield's Wilson interval decides). One unit gives the
     degenerate interval ``[q, q]``."""
     share = probability("share", share, open_interval=False)

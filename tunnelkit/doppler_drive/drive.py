@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._physical import carrier, speeds
 from .._validate import finite_array, instance, integer, positive, real, record, vector
 from ..budget import check_elements
 from ..constants import C
@@ -102,7 +103,7 @@ def doppler_shift(p, v, tx, fc: float, dz: float = 0.0) -> np.ndarray:
     position at the transmitter with ``dz = 0`` (range zero) raises.
     """
     p, v = _planar("p", p), _planar("v", v)
-    fc, dz, tx = positive("fc", fc), real("dz", dz), finite_array("tx", tx, shape=(2,))
+    fc, dz, tx = carrier("fc", fc), real("dz", dz), finite_array("tx", tx, shape=(2,))
     return _doppler_shift(p, v, tx, fc, dz)
 
 
@@ -155,7 +156,7 @@ def channel_paths(cfg: DriveConfig, position, velocity, tx) -> dict[str, np.ndar
     instance("cfg", cfg, DriveConfig)
     tx = vector("tx", tx, 3)
     position = finite_array("position", position, shape=(None, 2))
-    velocity = finite_array("velocity", velocity, shape=(len(position), 2))
+    velocity = speeds("velocity", finite_array("velocity", velocity, shape=(len(position), 2)))
     src, order = image_sources(cfg, tx)
     p3 = np.concatenate([position, np.full((len(position), 1), cfg.rx_height)], -1)
     v3 = np.concatenate([velocity, np.zeros((len(velocity), 1))], -1)

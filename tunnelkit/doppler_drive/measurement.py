@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
+from .._physical import speeds
 from .._validate import finite_array, positive, record, rng_or_error
 from ..constants import C
 from .drive import Drive
@@ -48,7 +49,7 @@ class GnssFix:
 
     def __post_init__(self) -> None:
         finite_array("position", self.position, shape=(2,))
-        v = finite_array("velocity", self.velocity, shape=(2,))
+        v = speeds("velocity", finite_array("velocity", self.velocity, shape=(2,)))
         positive("sigma_p", self.sigma_p)
         positive("sigma_v", self.sigma_v)
         if np.linalg.norm(v) < 1e-6:

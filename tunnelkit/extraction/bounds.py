@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._physical import carrier
 from .._validate import finite_array, instance, integer, positive, sequence
 from ..arrays import ArrayGeometry
 from ..budget import check_elements
@@ -68,7 +69,7 @@ def crlb_paths(
     for name, v in (("mu_f", mu_f), ("mu_t", mu_t)):
         if v.shape != (L,):
             raise ValueError(f"{name}: expected shape ({L},) (one per alpha), got {v.shape}")
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     n_tones = integer("n_tones", n_tones, minimum=2)
     n_symbols = integer("n_symbols", n_symbols, minimum=2)
     noise_power = positive("noise_power", noise_power)

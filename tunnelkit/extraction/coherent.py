@@ -40,6 +40,7 @@ import warnings
 
 import numpy as np
 
+from .._physical import carrier
 from .._validate import finite_array, integer, nonnegative, positive, probability
 from ..arrays import check_element_positions
 from ..constants import C
@@ -98,7 +99,7 @@ def spherical_steering(sources, element_positions, fc: float) -> np.ndarray:
     if q.ndim != 2 or q.shape[1] != 3:
         raise ValueError(f"sources: expected points (n, 3), got shape {q.shape}")
     p = finite_array("element_positions", element_positions, ndim=2)
-    k0 = 2 * np.pi * positive("fc", fc) / C
+    k0 = 2 * np.pi * carrier("fc", fc) / C
     dist = np.linalg.norm(q[None, :, :] - p[:, None, :], axis=-1)
     return np.exp(1j * k0 * (dist - np.linalg.norm(q, axis=1)[None, :]))
 
@@ -143,7 +144,7 @@ def fit_sources(
     theta0 = _theta("theta0", theta0)
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])
     max_nfev = integer("max_nfev", max_nfev, minimum=1, maximum=MAX_NFEV)
-    return _fit_sources(b, theta0, p, positive("fc", fc), max_nfev)
+    return _fit_sources(b, theta0, p, carrier("fc", fc), max_nfev)
 
 
 def _fit_sources(b, theta0, p, fc, max_nfev=40):
@@ -226,7 +227,7 @@ def split_component(
     Returns ``(theta (n, 3), g (n,), relative residual)``.
     """
     max_sources = integer("max_sources", max_sources, minimum=1)
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     b = finite_array("b", b, ndim=1, dtype=complex)
     theta0 = _theta("theta0", theta0)
     p = check_element_positions("element_positions", element_positions, m=b.shape[0])

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from .. import arrays
+from .._physical import carrier, distances, phase_tolerance
 from .._validate import boolean, finite_array, integer, text
 from ..budget import check_elements
 from ..constants import C, wavelength
@@ -64,10 +65,10 @@ def real_input(name: str, value, *, pos: bool = False) -> np.ndarray:
 def wall_geometry(R, W, y_u, z_u=0.0) -> tuple[np.ndarray, ...]:
     """The theorem's geometry, validated: ``R > 0``, ``W > 0``, ``y_u < W`` and finite ``z_u``
     as arrays broadcast against each other (errors name the parameter)."""
-    R = real_input("R", R, pos=True)
-    W = real_input("W", W, pos=True)
-    y_u = real_input("y_u", y_u)
-    z_u = real_input("z_u", z_u)
+    R = real_input("R", distances("R", R), pos=True)
+    W = real_input("W", distances("W", W), pos=True)
+    y_u = real_input("y_u", distances("y_u", y_u))
+    z_u = real_input("z_u", distances("z_u", z_u))
     try:
         R, W, y_u, z_u = np.broadcast_arrays(R, W, y_u, z_u)
     except ValueError as exc:
@@ -87,7 +88,8 @@ def wall_geometry(R, W, y_u, z_u=0.0) -> tuple[np.ndarray, ...]:
 
 def carrier_tolerance(fc, eps_phi) -> tuple[np.ndarray, np.ndarray]:
     """The carrier ``fc > 0`` [Hz] and the phase tolerance ``eps_phi > 0`` [rad], validated."""
-    return real_input("fc", fc, pos=True), real_input("eps_phi", eps_phi, pos=True)
+    eps_phi = phase_tolerance("eps_phi", real_input("eps_phi", eps_phi, pos=True))
+    return real_input("fc", carrier("fc", fc)), eps_phi
 
 
 def _out(x: np.ndarray):
@@ -233,7 +235,7 @@ def aperture(M, fc):
     M = real_input("M", M)
     if np.any(M < 1):
         raise ValueError(f"M: must be >= 1, got {float(np.min(M))}")
-    fc = real_input("fc", fc, pos=True)
+    fc = real_input("fc", carrier("fc", fc))
     return _out((M - 1.0) * (C / fc) / 2.0)
 
 
@@ -242,7 +244,7 @@ def fraunhofer_distance(D, fc):
     D = real_input("D", D)
     if np.any(D < 0):
         raise ValueError(f"D: must be >= 0, got {float(np.min(D))}")
-    fc = real_input("fc", fc, pos=True)
+    fc = real_input("fc", carrier("fc", fc))
     return _out(2.0 * D**2 / (C / fc))
 
 
@@ -252,5 +254,5 @@ def mmax_fraunhofer(R, fc):
     The classical far-field scaling ``O(sqrt(R / lambda))`` of Remark 3.3, for comparison.
     """
     R = real_input("R", R, pos=True)
-    fc = real_input("fc", fc, pos=True)
+    fc = real_input("fc", carrier("fc", fc))
     return _out(1.0 + np.sqrt(2.0 * R / (C / fc)))

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._physical import carrier
 from .._validate import finite_array, integer, record
 from ..budget import check_elements
 from ..constants import C, wavelength
@@ -141,7 +142,7 @@ def phase_mismatch(M: int, R: float, W: float, y_u: float, fc: float, *, z_u: fl
     """
     M = integer("M", M, minimum=2)
     wall_geometry(R, W, y_u, z_u)
-    fc = real_input("fc", fc, pos=True)
+    fc = real_input("fc", carrier("fc", fc))
     return float(
         np.max(np.abs(mismatch_profile(ula_positions(M, float(fc)), R, W, y_u, fc, z_u=z_u)))
     )
@@ -165,7 +166,7 @@ def phase_mismatch_ura(
     """
     M = integer("M", M, minimum=2)
     wall_geometry(R, W, y_u, z_u)
-    fc = real_input("fc", fc, pos=True)
+    fc = real_input("fc", carrier("fc", fc))
     pos = ura_positions(M, float(fc), N=N, tilt=tilt)
     return float(np.max(np.abs(mismatch_profile(pos, R, W, y_u, fc, z_u=z_u))))
 

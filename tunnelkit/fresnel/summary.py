@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from .._physical import carrier
 from .._validate import boolean, integer, positive, record, text
 from ..report import Report
 from .bounds import (
@@ -54,6 +55,7 @@ class MmaxSummary:
             positive=("R", "W", "fc", "eps_phi", "exact"),
             nonnegative=("paraxial_ratio", "eq25", "eq37", "nonparaxial", "fraunhofer"),
         )
+        carrier("fc", self.fc)
         integer("exact_ura", self.exact_ura, minimum=-1)  # -1: the URA search was skipped
 
     @property
@@ -69,7 +71,7 @@ def mmax_summary(
     R: float, W: float, y_u: float, fc: float, eps_phi: float, *, z_u: float = 0.0, ura: bool = True
 ) -> MmaxSummary:
     """All bounds and exact values for one design point (``ura=False`` skips the URA search)."""
-    fc, eps_phi = positive("fc", fc), positive("eps_phi", eps_phi)
+    fc, eps_phi = carrier("fc", fc), positive("eps_phi", eps_phi)
     ura = boolean("ura", ura)
     s = dict(R=R, W=W, y_u=y_u, fc=fc, eps_phi=eps_phi)
     R_, W_, y_, z_ = (float(v) for v in wall_geometry(R, W, y_u, z_u))

@@ -7,7 +7,8 @@ import numbers
 
 import numpy as np
 
-from .._validate import choice, cosine, positive
+from .._physical import carrier
+from .._validate import choice, cosine
 
 __all__ = ["MATERIALS", "concrete_permittivity", "fresnel_te", "reflection_coefficient"]
 
@@ -21,7 +22,7 @@ def concrete_permittivity(fc: float) -> complex:
 
     ``eps' = 5.24``, ``sigma = 0.0462 f_GHz^0.7822`` S/m, ``eps = eps' - j sigma / (2 pi f eps0)``.
     """
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     sigma = 0.0462 * (fc / 1e9) ** 0.7822
     return complex(5.24, -sigma / (2 * np.pi * fc * _EPS0))
 
@@ -64,7 +65,7 @@ def reflection_coefficient(material: str, fc: float, cos_i) -> np.ndarray:
     """``-1`` for ``"metal"``, the TE Fresnel coefficient of concrete at ``fc`` [Hz] for
     ``"concrete"``; ``cos_i`` is the cosine of the incidence angle from the surface normal."""
     ci = cosine("cos_i", cos_i)
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     if choice("material", material, MATERIALS) == "metal":
         return -np.ones_like(ci) + 0j
     return _fresnel_te(concrete_permittivity(fc), ci)

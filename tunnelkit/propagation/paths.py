@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import boolean, choice, integer, positive, record, sequence, vector
+from .._physical import carrier, speeds
+from .._validate import boolean, choice, integer, record, sequence, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from .surfaces import Tunnel3D
@@ -124,6 +125,8 @@ def _physical_motion(direction, range_rate, velocity) -> None:
     for name, x in (("range_rate", range_rate), ("velocity", velocity)):
         if abs(x) >= C:
             raise ValueError(f"{name}: |{x:g}| m/s is not below the speed of light")
+        # a path's length changes no faster than the vehicle moves (static base station)
+        speeds(name, x)
 
 
 def arrival_angles(u) -> tuple[float, float]:
@@ -250,7 +253,7 @@ def _trace_arguments(tunnel, array, ue, ue_velocity, fc, kinds, front_only):
         raise TypeError(f"tunnel: expected a propagation.Tunnel3D, got {type(tunnel).__name__}")
     if not isinstance(array, ArrayGeometry):
         raise TypeError(f"array: expected an arrays.ArrayGeometry, got {type(array).__name__}")
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     if isinstance(kinds, str) or not isinstance(kinds, tuple | list | set | frozenset):
         raise TypeError(f"kinds: expected a tuple of path kinds from {PATH_KINDS}, got {kinds!r}")
     unknown = [k for k in kinds if k not in PATH_KINDS]

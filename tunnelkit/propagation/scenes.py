@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._physical import speeds
 from .._validate import integer, nonnegative, positive, real
 from ..arrays import ArrayGeometry, make_array
 from ..budget import check_bytes
@@ -89,7 +90,7 @@ def lane_trajectory(
     With ``slalom_amplitude > 0`` the lateral position is ``y + A sin(2 pi (x - x_start) / Lambda)``
     (velocity includes the lateral component; the speed along x stays ``speed``).
     """
-    speed, period = positive("speed", speed), positive("period", period)
+    speed, period = float(speeds("speed", positive("speed", speed))), positive("period", period)
     lam = positive("slalom_wavelength", slalom_wavelength)
     x_start, x_end = real("x_start", x_start), real("x_end", x_end)
     y, height = real("y", y), nonnegative("height", height)  # the antenna above the road

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._physical import carrier
 from .._validate import positive
 from .elements import ElementPaths, element_tensor
 
@@ -95,7 +96,7 @@ def tensor_components(
     ``amplitude`` (``sqrt(P_t)`` for a received tensor): ``full``, ``first_order_model`` and
     :data:`COMPONENTS`; they sum to ``full`` up to rounding."""
     ep = _check(paths)
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     amp = positive("amplitude", amplitude)
     args = (tone_spacing, n_tones, symbol_period, n_symbols)
 

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._physical import tone_step
 from .._validate import choice, finite_array, integer, positive, record
 from ..budget import check_elements
 
@@ -154,7 +155,7 @@ def element_tensor(
     "direct" (the sum path by path) or "auto" (module docstring)."""
     if not isinstance(paths, ElementPaths):
         raise TypeError(f"paths: expected an ElementPaths, got {type(paths).__name__}")
-    df = positive("tone_spacing", tone_spacing)
+    df = tone_step("tone_spacing", tone_spacing)
     T0 = positive("symbol_period", symbol_period)
     nf = integer("n_tones", n_tones, minimum=1)
     nt = integer("n_symbols", n_symbols, minimum=1)

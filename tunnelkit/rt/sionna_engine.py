@@ -45,7 +45,8 @@ from pathlib import Path as FsPath
 
 import numpy as np
 
-from .._validate import boolean, choice, integer, positive, sequence, vector
+from .._physical import carrier
+from .._validate import boolean, choice, integer, sequence, vector
 from ..arrays import ArrayGeometry
 from ..constants import C, wavelength
 from ..propagation import Path, Tunnel3D, arrival_angles
@@ -80,7 +81,7 @@ def load_sionna_scene(scene: MitsubaScene | str | FsPath, *, fc: float):
         ) from None
     if not sc.objects:
         raise SceneError(f"scene file {str(ms.xml)!r} has no surfaces Sionna can trace")
-    sc.frequency = positive("fc", fc)
+    sc.frequency = carrier("fc", fc)
     return sc
 
 
@@ -132,7 +133,7 @@ class SionnaEngine:
         require_sionna()
         import sionna.rt as srt
 
-        self.fc = positive("fc", fc)
+        self.fc = carrier("fc", fc)
         self.samples_per_src = integer("samples_per_src", samples_per_src, minimum=1)
         self.max_num_paths_per_src = (
             None

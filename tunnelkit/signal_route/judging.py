@@ -69,6 +69,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from .._physical import carrier
 from .._validate import finite_array, instance, integer, nonnegative, positive, record, sequence
 from ..channel import Impairments
 from ..evaluation import match_points
@@ -189,7 +190,6 @@ def rejudge(est, H, element_positions, fc: float, share: float, calibration=None
     or an unresolved pair stays flagged (``residual_only`` False). Returns the test's dict with
     ``passed``, ``needed`` (the larger of the two shares, at least 0), ``share`` (the floor
     applied, calibration included), ``calibration_floor`` (0 without), ``residual_only``."""
-    from ..extraction.radio import MAX_CARRIER
 
     fit = getattr(est, "fit", None)
     if fit is None:
@@ -202,8 +202,7 @@ def rejudge(est, H, element_positions, fc: float, share: float, calibration=None
     H = finite_array("H", H, ndim=3, dtype=complex)
     if H.shape[0] != pos.shape[0]:
         raise ValueError(f"H: expected an (M, Nf, Nt) tensor of the array's M, got {H.shape}")
-    if not 1e6 <= positive("fc", fc) <= MAX_CARRIER:
-        raise ValueError(f"fc: {fc:g} Hz is outside [1 MHz, 1 THz] (fc is in Hz)")
+    fc = carrier("fc", fc)
     share = nonnegative("share", share)
     if share > 1.0:
         raise ValueError(f"share: a share of the received power, at most 1, got {share:g}")
@@ -352,7 +351,7 @@ def model_error_test(
     if R.ndim != 3 or not np.iscomplexobj(R) or not np.all(np.isfinite(R)):
         raise ValueError(f"residual: expected a finite complex (M, Nf, Nt) tensor, got {R.shape}")
     pos = check_element_positions("element_positions", element_positions, m=R.shape[0])
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     n0 = positive("noise_power", noise_power)
     L = integer("n_paths", n_paths, minimum=0)
     e_y = positive("received_energy", received_energy)

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .._checks import indices
+from .._physical import speeds
 from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
@@ -101,6 +102,7 @@ class Epoch:
         from ..extraction.estimates import PathEstimates
 
         record(self, shapes=_EPOCH_SHAPES, nonnegative=("k", "t"), skip=("rejudged",))
+        speeds("velocity", self.velocity)
         instance("estimates", self.estimates, PathEstimates)
         if self.rejudged is not None:
             instance("rejudged", self.rejudged, dict)

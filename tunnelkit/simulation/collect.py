@@ -12,6 +12,8 @@ from __future__ import annotations
 import functools
 
 from .._validate import boolean, callable_, integer, sequence, text
+from ..budget import check_bytes
+from ..montecarlo import RUN_BYTES
 from ..runner import run_trials
 from .drives import route_name, simulate_routes
 
@@ -54,6 +56,8 @@ def per_drive(scenario, conditions, runs, seed, progress, extractions, make_tria
     text("scenario", scenario)
     sequence("conditions", conditions)
     integer("runs", runs, minimum=1)
+    n = max(len(conditions), 1)
+    check_bytes("runs", runs * n * RUN_BYTES, f"{runs} runs x {n} conditions, before any is made")
     boolean("progress", progress)
     sequence("extractions", extractions)
     callable_("make_trial", make_trial)

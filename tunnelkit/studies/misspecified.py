@@ -36,6 +36,7 @@ import warnings
 
 import numpy as np
 
+from .._physical import carrier
 from .._validate import finite_array, integer, positive
 from ..arrays import check_element_positions
 from ..constants import C
@@ -67,7 +68,7 @@ _TI = np.array([0, 0, 0, 0, 0, 0, 1])
 def _check(H, element_positions, fc):
     H = check_tensor(H)
     pos = check_element_positions("element_positions", element_positions, m=H.shape[0])
-    return Problem(H, pos, positive("fc", fc))
+    return Problem(H, pos, carrier("fc", fc))
 
 
 def pseudo_true(

@@ -48,6 +48,8 @@ from functools import partial
 import numpy as np
 
 from .._validate import boolean, integer, rng_or_error
+from ..budget import check_bytes
+from ..montecarlo import RUN_BYTES
 from ..scenarios import data_dir
 from ..simulation.drives import CONDITIONS, DriveData, scenario_route, simulate_routes
 from ..simulation.prefilter import (
@@ -151,6 +153,7 @@ def measure_traced_errors(
     from ..simulation.analysis import error_correlations, extraction_errors
 
     runs = integer("runs", runs, minimum=1)
+    check_bytes("runs", runs * RUN_BYTES, f"{runs} traced drives")
     seed = integer("seed", seed, minimum=0)
     boolean("progress", progress)
     if n_epochs is not None:

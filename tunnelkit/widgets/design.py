@@ -25,6 +25,8 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .._validate import integer, positive, probability, real, text
+from ..budget import check_bytes
+from ..montecarlo import RUN_BYTES
 from ..plots.design import route_figure
 from .base import Explorer, checkbox, float_slider, int_slider
 
@@ -170,6 +172,7 @@ class DesignExplorer(Explorer):
         share: float = 0.9,
     ) -> None:
         text("scenario", scenario), integer("units", units, minimum=1)
+        check_bytes("units", 2 * units * RUN_BYTES, f"{units} units x 2 drives")
         integer("seed", seed, minimum=0), positive("target", target)
         probability("share", share, open_interval=False)
         super().__init__(callback, controls, columns=3)

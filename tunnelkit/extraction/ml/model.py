@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.blas import zherk
 
-from ..._validate import boolean, finite_array, integer, positive
+from ..._physical import carrier
+from ..._validate import boolean, finite_array, integer
 from ...arrays import check_element_positions
 from ...constants import C
 from ..decomposition import check_tensor
@@ -67,7 +68,7 @@ class Problem:
         self.M, self.nf, self.nt = H.shape
         self.Hp = np.ascontiguousarray(H.transpose(0, 2, 1)).reshape(self.M * self.nt, self.nf)
         self.pos = check_element_positions("element_positions", element_positions, m=self.M)
-        self.k0 = 2 * np.pi * positive("fc", fc) / C
+        self.k0 = 2 * np.pi * carrier("fc", fc) / C
         self.s = np.arange(self.nf, dtype=float)[:, None]
         self.kk = np.arange(self.nt, dtype=float)[:, None]
         self.h2 = float(np.vdot(H, H).real)

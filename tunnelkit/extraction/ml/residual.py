@@ -40,7 +40,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.fft
 
+from ..._physical import carrier
 from ..._validate import finite_array, integer, positive
+from ...budget import check_elements
 from ..numerics import scan_grid
 
 __all__ = [
@@ -90,7 +92,7 @@ def residual_peak(R, element_positions, fc: float, noise_power: float, *, n_cell
     p = np.ascontiguousarray(finite_array("element_positions", element_positions))
     if p.ndim != 2 or p.shape != (R.shape[0], 3):
         raise ValueError(f"element_positions: expected shape ({R.shape[0]}, 3), got {p.shape}")
-    fc = positive("fc", fc)
+    fc = carrier("fc", fc)
     sigma2 = positive("noise_power", noise_power)
     n_cells = integer("n_cells", n_cells, minimum=1)
     M, nf, nt = R.shape
@@ -131,7 +133,7 @@ def _check_null_args(element_positions, fc, shape):
         raise ValueError("element_positions: expected a real (M, 3) array") from exc
     if p.ndim != 2 or p.shape != (M, 3) or not np.all(np.isfinite(p)):
         raise ValueError(f"element_positions: expected finite ({M}, 3), got {p.shape}")
-    return p, positive("fc", fc), (M, nf, nt)
+    return p, carrier("fc", fc), (M, nf, nt)
 
 
 def peak_null(
@@ -148,6 +150,7 @@ def peak_null(
     if not isinstance(rng, np.random.Generator):
         raise TypeError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
     n_draws = integer("n_draws", n_draws, minimum=10)
+    check_elements("n_draws", n_draws, what=f"{n_draws} noise-only peaks")
     n_cells = integer("n_cells", n_cells, minimum=1)
     pk = np.empty(n_draws)
     for i in range(n_draws):

@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import boolean, finite_array, positive
+from ..._physical import carrier, tone_step
+from ..._validate import boolean, finite_array
 from ..numerics import solve_unchecked, spatial_phase_unchecked
 from .model import Problem, check_paths
 
@@ -45,7 +46,7 @@ class WidebandProblem(Problem):
 
     def __init__(self, H, element_positions, fc: float, tone_spacing: float):
         super().__init__(H, element_positions, fc)
-        rho = positive("tone_spacing", tone_spacing) / positive("fc", fc)
+        rho = tone_step("tone_spacing", tone_spacing) / carrier("fc", fc)
         self.tone_spacing = float(tone_spacing)
         #: the per-tone scale of the spatial phase, g_s = f_s / fc
         self.g = 1.0 - rho * (np.arange(self.nf) - 0.5 * (self.nf - 1))

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._physical import start_spread
 from ..._validate import finite_array, nonnegative, positive
 from ...doppler_drive import Drive, slant_range
 from .filters import DopplerSetup, cv_model, doppler_jacobian
@@ -58,7 +59,7 @@ def posterior_crlb(
     cfg = drive.config
     setup = DopplerSetup.from_drive(drive)
     q = nonnegative("q", q)
-    sp = positive("sigma_p0", cfg.gnss_sigma_m if sigma_p0 is None else sigma_p0)
+    sp = start_spread("sigma_p0", cfg.gnss_sigma_m if sigma_p0 is None else sigma_p0)
     sv = positive("sigma_v0", cfg.gnss_sigma_v if sigma_v0 is None else sigma_v0)
     F, Q = cv_model(setup.dt, q)
     s = np.concatenate([drive.position, drive.velocity], -1)

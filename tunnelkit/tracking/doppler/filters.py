@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter
 
+from ..._physical import carrier, speeds, step_seconds
 from ..._validate import (
     boolean,
     finite_array,
@@ -69,8 +70,8 @@ class DopplerSetup:
     def __post_init__(self) -> None:
         finite_array("tx", self.tx, shape=(2,))
         finite_array("dz", self.dz, ndim=0)
-        positive("fc", self.fc)
-        positive("dt", self.dt)
+        carrier("fc", self.fc)
+        step_seconds("dt", positive("dt", self.dt))
 
     @classmethod
     def from_drive(cls, drive: Drive) -> DopplerSetup:
@@ -133,7 +134,7 @@ def _state(name: str, s) -> np.ndarray:
 
 def cv_model(dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
     """``F`` (eq. 2) and ``Q`` (eq. 3) of the constant-velocity model, state ``[x, y, v_x, v_y]``."""
-    dt = positive("dt", dt)
+    dt = step_seconds("dt", positive("dt", dt))
     q = nonnegative("q", q)
     return cv_transition(dt), cv_process_noise(dt, q)  # the same model as Jiang eq. 40-41
 
@@ -499,7 +500,7 @@ class HeadingDeadReckoning:
 
     def __init__(self, p0, v0, *, min_step: float = 1e-3) -> None:
         self.p = finite_array("p0", p0, shape=(2,)).copy()
-        v0 = finite_array("v0", v0, shape=(2,))
+        v0 = speeds("v0", finite_array("v0", v0, shape=(2,)))
         if np.linalg.norm(v0) < 1e-6:
             raise ValueError("v0: speed of zero, the initial heading is undefined")
         self.phi = float(np.arctan2(v0[0], v0[1]))

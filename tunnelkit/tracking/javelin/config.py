@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..._physical import start_spread
 from ..._validate import integer, positive, probability, vector
 
 __all__ = ["JavelinConfig"]
@@ -87,6 +88,7 @@ class JavelinConfig:
             raise ValueError(f"los_gamma: must lie in (0, 1], got {g}")
         for name in _SIGMAS:
             positive(name, getattr(self, name))
+        start_spread("sigma_p0", self.sigma_p0), start_spread("sigma_p0_ue", self.sigma_p0_ue)
         if self.sigma_p0_height is not None:
             positive("sigma_p0_height", self.sigma_p0_height)
         bs = vector("base_station", self.base_station, 3)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._checks import items, sign
+from ..._physical import speeds, step_seconds
 from ..._validate import (
     boolean,
     finite_array,
@@ -157,12 +158,16 @@ def toy_drive(
     and ``stop`` along x (peak speed ``speed``, a cosine in time so it turns round without a jump)
     with a lateral sine of ``amplitude`` around ``lane`` (``amplitude = 0``: straight lane)."""
     n = integer("n", n, minimum=1)
-    dt = positive("dt", dt)
+    dt = step_seconds("dt", positive("dt", dt))
     for name, value in (("start", start), ("stop", stop), ("lane", lane)):
         real(name, value)
     if stop == start:
         raise ValueError(f"stop: must differ from start ({start}), got {stop}")
-    positive("speed", speed), nonnegative("amplitude", amplitude), positive("period", period)
+    (
+        speeds("speed", positive("speed", speed)),
+        nonnegative("amplitude", amplitude),
+        positive("period", period),
+    )
     positive("height", height)
     check_elements("n", 6 * n)
     t = np.arange(n) * dt

@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import choice, instance, nonnegative, positive, real
+from ..._physical import speeds, step_seconds
+from ..._validate import choice, instance, positive, real
 from .config import JavelinConfig
 from .state import JavelinState
 
@@ -30,7 +31,7 @@ VUE_MOTIONS = ("random_walk", "mirror")
 
 def ue_velocity(speed: float, heading: float) -> np.ndarray:
     """UE velocity (3,) from speed [m/s] and heading [rad] (angle from +x in the road plane)."""
-    real("speed", speed), real("heading", heading)
+    speeds("speed", speed), real("heading", heading)
     return float(speed) * np.array([np.cos(heading), np.sin(heading), 0.0])
 
 
@@ -39,7 +40,7 @@ def motion_increment(
 ) -> tuple[np.ndarray, np.ndarray]:
     """State increment ``f(s) - s`` (D,) and its sensitivity ``G`` (D, 2) to ``(nu, theta)``."""
     instance("state", state, JavelinState)
-    real("speed", speed), real("heading", heading), nonnegative("dt", dt)
+    speeds("speed", speed), real("heading", heading), step_seconds("dt", dt)
     choice("vue_motion", vue_motion, VUE_MOTIONS)
     D = state.dim
     du = dt * ue_velocity(speed, heading)
@@ -83,7 +84,7 @@ def predict(
     ``vue_motion`` as in :func:`motion_increment`; ``sigma_speed`` overrides the configured speed
     noise (used while the V2X message is missing and the last one is reused).
     """
-    dt = nonnegative("dt", dt)
+    dt = step_seconds("dt", dt)
     instance("state", state, JavelinState)
     instance("config", config, JavelinConfig)
     if sigma_speed is not None:

@@ -16,7 +16,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..._validate import finite_array, instance, integer, nonnegative, positive
+from ..._physical import step_seconds
+from ..._validate import finite_array, instance, integer, positive
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 
@@ -148,7 +149,7 @@ class ConsiderNoise(ReportedNoise):
 
     def decay(self, dt: float) -> float:
         """``exp(-dt / tau_s)``: how much of the normalised bias survives ``dt`` [s]."""
-        return float(np.exp(-nonnegative("dt", dt) / self.tau_s))
+        return float(np.exp(-step_seconds("dt", dt) / self.tau_s))
 
     def white_covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
         """The white share (n, 3, 3) of each path's reported ``(phi, psi, kappa)`` covariance."""

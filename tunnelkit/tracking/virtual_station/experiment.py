@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._validate import boolean, finite_array, instance, integer, record, rng_or_error
+from ...budget import check_elements
 from ...montecarlo import spawn_rngs
 from ...scenarios import Scenario, load_scenario
 from ..registry import family
@@ -41,6 +42,8 @@ class VsExperiment:
     def simulate(self, runs: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """``(Z, x0)``: measurements (runs, T, 2N) and prior means (runs, 4) drawn with ``rng``."""
         runs = integer("runs", runs, minimum=1)
+        n = 4 * runs * self.truth.shape[0] * max(self.model.n_stations, 1)
+        check_elements("runs", n, what=f"{runs} runs' ranges and bearings")
         rng = rng_or_error("rng", rng)
         Z = self.model.simulate(self.truth[:, :2], rng, size=runs)
         x0 = initial_states(self.truth[0], self.P0, rng, size=runs)
