@@ -75,7 +75,7 @@ _EXPORTS = {
     "DesignImpairments": "impairments",
     "preset_impairments": "impairments",
     "IMPAIRMENT_PRESETS": "impairments:PRESETS",
-    "MODES": "montecarlo",
+    "MODES": "fastroute",
     "MonteCarloResult": "montecarlo",
     "SETTLE_S": "montecarlo",
     "STARTS": "montecarlo",
