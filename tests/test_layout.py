@@ -147,8 +147,11 @@ def test_every_lazy_table_holds():
         assert set(pkg.__all__) <= set(star), name
 
 
-#: what the README's four verbs (``tests/test_readme.py``) may load of the package, in lines
-README_MAX_LINES = 21_600
+#: what the README's four verbs (``tests/test_readme.py``) may load of the package, in lines:
+#: 21,526 measured, of which the modules whose functions the verbs call hold about 19,700 (the
+#: rest: package ``__init__`` modules and what a called module imports at its top); an eager
+#: package namespace or a Monte-Carlo loaded by a sweep without units adds over 1,000
+README_MAX_LINES = 22_000
 
 
 def test_the_readme_verbs_load_a_lean_package():
