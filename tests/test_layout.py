@@ -95,3 +95,80 @@ def test_the_lessons_imports_do_not_load_the_ray_tracer():
     loaded = json.loads(out)
     assert "tunnelkit.signal_route" in loaded  # the lessons' imports did run
     assert not [m for m in loaded if m == "tunnelkit.rt" or m.startswith("tunnelkit.rt.")]
+
+
+def test_the_analysis_follows_a_name_reexported_lazily(tmp_path):
+    """A name a package re-exports through its ``_EXPORTS`` table (tunnelkit._lazy) is followed to
+    its submodule: a cycle through it is found."""
+    pkg = tmp_path / "tunnelkit"
+    (pkg / "design").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "design" / "__init__.py").write_text('_EXPORTS = {"g": "inner"}\n__all__ = ["g"]\n')
+    (pkg / "design" / "inner.py").write_text("from ..geometry import f\n\n\ndef g():\n    pass\n")
+    (pkg / "geometry.py").write_text("from .design import g\n\n\ndef f():\n    pass\n")
+    r = _layout().analyse(tmp_path)
+    assert r["cycles"] == [["tunnelkit.design.inner", "tunnelkit.geometry"]]
+
+
+def _lazy_packages() -> dict[str, dict[str, str]]:
+    """Every package ``__init__`` with an ``_EXPORTS`` table: package name -> its table."""
+    import ast
+
+    lay = _layout()
+    out = {}
+    for init in sorted((ROOT / "tunnelkit").rglob("__init__.py")):
+        name = ".".join(init.parent.relative_to(ROOT).parts)
+        for node in ast.parse(init.read_text()).body:
+            if table := lay._lazy_table(node):
+                out[name] = table
+    return out
+
+
+def test_every_lazy_table_holds():
+    """Each lazily re-exported name resolves to its submodule's object, no name shadows a
+    submodule (importing it would replace the name on the package), and ``__all__``, ``dir()``
+    and ``import *`` still give every name."""
+    import importlib
+
+    packages = _lazy_packages()
+    assert "tunnelkit.design" in packages
+    for name, table in packages.items():
+        pkg = importlib.import_module(name)
+        folder = ROOT.joinpath(*name.split("."))
+        for key, where in table.items():
+            module, _, attr = where.partition(":")
+            assert not (folder / f"{key}.py").exists() and not (folder / key).is_dir(), key
+            sub = importlib.import_module(f"{name}.{module}")
+            assert getattr(pkg, key) is getattr(sub, attr or key), f"{name}.{key}"
+        assert set(pkg.__all__) <= set(table) | set(vars(pkg)), name
+        assert set(pkg.__all__) <= set(dir(pkg)), name
+        star = {}
+        exec(f"from {name} import *", star)
+        assert set(pkg.__all__) <= set(star), name
+
+
+#: what the README's four verbs (``tests/test_readme.py``) may load of the package, in lines:
+#: 21,526 measured, of which the modules whose functions the verbs call hold about 19,700 (the
+#: rest: package ``__init__`` modules and what a called module imports at its top); an eager
+#: package namespace or a Monte-Carlo loaded by a sweep without units adds over 1,000
+README_MAX_LINES = 22_000
+
+
+def test_the_readme_verbs_load_a_lean_package():
+    """The README's examples, in a fresh process, load at most README_MAX_LINES lines of tunnelkit
+    (``tools/loaded_lines.py readme``): a package namespace imports its submodules on first use."""
+    import json
+    import subprocess
+
+    out = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "loaded_lines.py"), "readme", "--json"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    r = json.loads(out)
+    assert r["attempted"] >= 15 and r["failed"] == 0, r  # the verbs did run
+    assert "tunnelkit.design.report" in r["sizes"]
+    top = list(r["sizes"].items())[:15]
+    assert r["lines"] <= README_MAX_LINES, f"{r['lines']} lines in {r['modules']} modules: {top}"

@@ -25,10 +25,13 @@ PACKAGE = "tunnelkit"
 MAX_LINES = 600
 #: declarative tables, exempt from the size limit
 SIZE_EXEMPT = {"tunnelkit.schema"}
+#: the table of names a package ``__init__`` re-exports lazily, name -> submodule
+LAZY_TABLE = "_EXPORTS"
 
 #: rank of each top-level module or subpackage of tunnelkit (lower = nearer the ground)
 RANKS = {
     "_validate": 0,
+    "_lazy": 0,  # a package's names loaded on first use (PEP 562)
     "_checks": 0.25,  # more checks of the validation layer, built on _validate
     "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
     "constants": 0.5,
@@ -98,6 +101,19 @@ def _base(mods, name: str, level: int, module: str | None) -> str:
     return module or ""
 
 
+def _lazy_table(node: ast.stmt) -> dict[str, str]:
+    """A package's ``_EXPORTS = {name: "submodule", ...}`` (:mod:`tunnelkit._lazy`), else {}."""
+    if not (
+        isinstance(node, ast.Assign)
+        and [getattr(t, "id", None) for t in node.targets] == [LAZY_TABLE]
+        and isinstance(node.value, ast.Dict)
+    ):
+        return {}
+    return {
+        ast.literal_eval(k): ast.literal_eval(v) for k, v in zip(node.value.keys, node.value.values)
+    }
+
+
 def analyse(root: Path = ROOT) -> dict:
     mods = _modules(root)
     trees = {n: ast.parse(p.read_text()) for n, p in mods.items()}
@@ -112,6 +128,8 @@ def analyse(root: Path = ROOT) -> dict:
                 if b in mods:
                     for a in node.names:
                         reexport[n][a.asname or a.name] = b
+            for name, sub in _lazy_table(node).items():  # loaded on first use (tunnelkit._lazy)
+                reexport[n][name] = f"{n}.{sub.partition(':')[0]}"
 
     def target(b: str, name: str) -> str | None:
         if f"{b}.{name}" in mods:

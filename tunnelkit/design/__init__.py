@@ -43,47 +43,67 @@ reaches the required yield with 95 % confidence. One job per module:
 
 from __future__ import annotations
 
-from .achievable import DesignImpairments, PredictedError, path_error_model, predicted_error
-from .arrayjob import design_planes
-from .bounds import RouteBounds, path_bounds, route_bounds, route_geometry
-from .confirm import ConfirmedReport, confirm_on_channel, confirmation_candidates
-from .drivebound import (
-    drive_bound,
-    drive_pcrlb,
-    position_bias_rms,
-    position_information,
-    unit_pcrlb,
-)
-from .errormodel import PathErrorModel
-from .fastroute import BoundRoute, bound_drive, bound_route
-from .geometry import KINDS, RouteGeometry, trace_route
-from .impairments import PRESETS as IMPAIRMENT_PRESETS
-from .impairments import preset_impairments
-from .montecarlo import (
-    MODES,
-    SETTLE_S,
-    START_HEIGHT_SIGMA_M,
-    START_SIGMA_M,
-    STARTS,
-    MonteCarloResult,
-    javelin_config,
-    sweep_montecarlo,
-)
-from .report import DesignReport, DesignRow, design_sweep, over_target, smallest_meeting
-from .setup import ArraySpec, DesignSetup, Mount, parse_array
-from .units import unit_quantiles, unit_yield, wilson_interval
-from .verdict import (
-    CRITERIA,
-    MIN_RUNS_CI,
-    STATUSES,
-    bootstrap_quantile_ci,
-    cluster_quantile_ci,
-    counted_epochs,
-    gate,
-    judge,
-    recommend,
-    share_quantile,
-)
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "PredictedError": "achievable",
+    "path_error_model": "achievable",
+    "predicted_error": "achievable",
+    "START_HEIGHT_SIGMA_M": "arrayjob",
+    "design_planes": "arrayjob",
+    "javelin_config": "arrayjob",
+    "RouteBounds": "bounds",
+    "path_bounds": "bounds",
+    "route_bounds": "bounds",
+    "route_geometry": "bounds",
+    "ConfirmedReport": "confirm",
+    "confirm_on_channel": "confirm",
+    "confirmation_candidates": "confirm",
+    "START_SIGMA_M": "drivebound",
+    "drive_bound": "drivebound",
+    "drive_pcrlb": "drivebound",
+    "position_bias_rms": "drivebound",
+    "position_information": "drivebound",
+    "unit_pcrlb": "drivebound",
+    "PathErrorModel": "errormodel",
+    "BoundRoute": "fastroute",
+    "bound_drive": "fastroute",
+    "bound_route": "fastroute",
+    "KINDS": "geometry",
+    "RouteGeometry": "geometry",
+    "trace_route": "geometry",
+    "DesignImpairments": "impairments",
+    "preset_impairments": "impairments",
+    "IMPAIRMENT_PRESETS": "impairments:PRESETS",
+    "MODES": "fastroute",
+    "MonteCarloResult": "montecarlo",
+    "SETTLE_S": "montecarlo",
+    "STARTS": "montecarlo",
+    "sweep_montecarlo": "montecarlo",
+    "DesignReport": "records",
+    "DesignRow": "records",
+    "over_target": "records",
+    "design_sweep": "report",
+    "smallest_meeting": "report",
+    "ArraySpec": "setup",
+    "DesignSetup": "setup",
+    "Mount": "setup",
+    "parse_array": "setup",
+    "unit_quantiles": "units",
+    "unit_yield": "units",
+    "wilson_interval": "units",
+    "CRITERIA": "verdict",
+    "MIN_RUNS_CI": "verdict",
+    "STATUSES": "verdict",
+    "bootstrap_quantile_ci": "verdict",
+    "cluster_quantile_ci": "verdict",
+    "counted_epochs": "verdict",
+    "gate": "verdict",
+    "judge": "verdict",
+    "recommend": "verdict",
+    "share_quantile": "verdict",
+}
+
 
 __all__ = [
     "CRITERIA",
@@ -143,3 +163,4 @@ __all__ = [
     "unit_yield",
     "wilson_interval",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -57,6 +57,7 @@ from .setup import DesignSetup, parse_array
 
 __all__ = [
     "KAPPA_RESOLVED",
+    "MODES",
     "REPORTS",
     "SIGMA_V",
     "BoundRoute",
@@ -65,6 +66,10 @@ __all__ = [
     "model_truth",
     "tracker_weights",
 ]
+
+#: the design's measurement routes: this one (``"bound"``) and the channel route (``"channel"``),
+#: what :func:`tunnelkit.design.montecarlo.sweep_montecarlo` runs the tracker on
+MODES = ("bound", "channel")
 
 #: a curvature is reported only where its reported standard deviation is below this share of the
 #: path's range (otherwise the path goes on as far field, as a plane-wave fit would report it)

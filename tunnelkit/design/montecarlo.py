@@ -64,6 +64,7 @@ from .arrayjob import (
     prepared_summary,
 )
 from .drivebound import START_SIGMA_M
+from .fastroute import MODES
 from .setup import ArraySpec, DesignSetup, parse_array
 from .units import drive_streams, unit_seeds
 
@@ -77,9 +78,6 @@ __all__ = [
     "javelin_config",
     "sweep_montecarlo",
 ]
-
-#: the measurement routes of :func:`sweep_montecarlo`
-MODES = ("bound", "channel")
 
 #: where a drive's tracker starts (:func:`sweep_montecarlo`): ``"drawn"`` an open-sky fix drawn
 #: from ``N(truth, diag(s^2, s^2, s_h^2))`` (``s`` the sweep's ``start_sigma``, default

@@ -48,6 +48,8 @@ from ..metrics import SETTLE_S
 from ..runner import parallel_options
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
+from .drivebound import START_SIGMA_M
+from .fastroute import MODES
 from .impairments import (
     CALIBRATED_GAIN_ERROR_DB,
     CALIBRATED_PHASE_ERROR_DEG,
@@ -58,7 +60,6 @@ from .impairments import (
     wideband_cycles,
 )
 from .impairments import PRESETS as IMPAIRMENT_PRESETS
-from .montecarlo import MODES, START_SIGMA_M, sweep_montecarlo
 from .records import DesignReport, DesignRow, over_target
 from .setup import ArraySpec, DesignSetup, parse_array
 from .units import DRIVES_PER_UNIT, MAX_UNITS, REQUIRED_YIELD, unit_quantiles, unit_yield
@@ -153,7 +154,9 @@ def _design_impairments(impairments, setup, specs) -> DesignImpairments:
 
 
 def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:
-    """:func:`tunnelkit.design.montecarlo.sweep_montecarlo` (one task set for every array)."""
+    """:func:`tunnelkit.design.montecarlo.sweep_montecarlo`, loaded when a sweep asks for units."""
+    from .montecarlo import sweep_montecarlo
+
     return sweep_montecarlo(setup, specs, runs, seed, **kw)
 
 

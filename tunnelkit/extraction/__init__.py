@@ -25,32 +25,38 @@ a :class:`tunnelkit.arrays.ArrayGeometry` (or (M, 3) local element positions), `
 
 from __future__ import annotations
 
-from .bounds import crlb_paths, estimate_crlb, ml_truth, path_crlb
-from .decomposition import (
-    CPDConvergenceWarning,
-    CPDResult,
-    check_rank,
-    check_tensor,
-    cp_rel_error,
-    cpd,
-    kruskal_rank,
-    max_identifiable_rank,
-    normalize_factors,
-)
-from .estimates import PathEstimates, path_estimates
-from .extract import ROUTES, extract_paths
-from .numerics import MIN_SIGNIFICANCE
-from .paper import (
-    algorithm1,
-    angles_from_solution,
-    paper_route,
-    refine_joint,
-    refine_roots,
-    solve_far_field,
-    solve_near_field,
-    unwrap_spatial,
-    vandermonde_roots,
-)
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "crlb_paths": "bounds",
+    "estimate_crlb": "bounds",
+    "ml_truth": "bounds",
+    "path_crlb": "bounds",
+    "CPDConvergenceWarning": "decomposition",
+    "CPDResult": "decomposition",
+    "check_rank": "decomposition",
+    "check_tensor": "decomposition",
+    "cp_rel_error": "decomposition",
+    "cpd": "decomposition",
+    "kruskal_rank": "decomposition",
+    "max_identifiable_rank": "decomposition",
+    "normalize_factors": "decomposition",
+    "PathEstimates": "estimates",
+    "path_estimates": "estimates",
+    "ROUTES": "extract",
+    "extract_paths": "extract",
+    "MIN_SIGNIFICANCE": "numerics",
+    "algorithm1": "paper",
+    "angles_from_solution": "paper",
+    "paper_route": "paper",
+    "refine_joint": "paper",
+    "refine_roots": "paper",
+    "solve_far_field": "paper",
+    "solve_near_field": "paper",
+    "unwrap_spatial": "paper",
+    "vandermonde_roots": "paper",
+}
+
 
 __all__ = [
     "MIN_SIGNIFICANCE",
@@ -81,3 +87,4 @@ __all__ = [
     "unwrap_spatial",
     "vandermonde_roots",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

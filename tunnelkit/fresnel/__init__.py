@@ -31,34 +31,38 @@ All functions take SI units (metres, hertz, radians).
 
 from __future__ import annotations
 
-from .bounds import (
-    SECTION_4_1_TILT,
-    aperture,
-    fraunhofer_distance,
-    mmax_2d,
-    mmax_3d,
-    mmax_fraunhofer,
-    mmax_nonparaxial,
-    paraxial_ratio,
-    reference_specular_point,
-    ula_positions,
-    ura_positions,
-    vue,
-)
-from .exact import (
-    M_LIMIT,
-    M_LIMIT_URA,
-    ApertureProfile,
-    aperture_profile,
-    mismatch_profile,
-    mmax_exact,
-    mmax_exact_grid,
-    mmax_exact_ura,
-    phase_mismatch,
-    phase_mismatch_ura,
-    signed_mismatch,
-)
-from .summary import FC_PRESETS, MmaxSummary, design_report, mmax_summary
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "SECTION_4_1_TILT": "bounds",
+    "aperture": "bounds",
+    "fraunhofer_distance": "bounds",
+    "mmax_2d": "bounds",
+    "mmax_3d": "bounds",
+    "mmax_fraunhofer": "bounds",
+    "mmax_nonparaxial": "bounds",
+    "paraxial_ratio": "bounds",
+    "reference_specular_point": "bounds",
+    "ula_positions": "bounds",
+    "ura_positions": "bounds",
+    "vue": "bounds",
+    "ApertureProfile": "exact",
+    "M_LIMIT": "exact",
+    "M_LIMIT_URA": "exact",
+    "aperture_profile": "exact",
+    "mismatch_profile": "exact",
+    "mmax_exact": "exact",
+    "mmax_exact_grid": "exact",
+    "mmax_exact_ura": "exact",
+    "phase_mismatch": "exact",
+    "phase_mismatch_ura": "exact",
+    "signed_mismatch": "exact",
+    "FC_PRESETS": "summary",
+    "MmaxSummary": "summary",
+    "design_report": "summary",
+    "mmax_summary": "summary",
+}
+
 
 __all__ = [
     "FC_PRESETS",
@@ -89,3 +93,4 @@ __all__ = [
     "ura_positions",
     "vue",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -4,63 +4,48 @@ Notebooks call these instead of carrying plotting boilerplate; each builder is a
 ``data -> go.Figure`` function so it can be tested without a kernel.
 """
 
-from .common import (
-    COLORS,
-    cdf_figure,
-    line_figure,
-)
-from .design import (
-    design_answer_figure,
-    route_figure,
-    size_figure,
-)
-from .doppler import (
-    approach_cdfs,
-    doppler_delay_figure,
-    drive_topview,
-    error_time_figure,
-    information_figure,
-    pcrlb_figure,
-    profiles_figure,
-    regime_figure,
-)
-from .efficiency import (
-    efficiency_figure,
-)
-from .fresnel import (
-    derivation_figure,
-    fresnel_topview,
-    mismatch_figure,
-    mmax_range_figure,
-    ratio_map_figure,
-)
-from .javelin import (
-    epoch_figure,
-    javelin_table_figure,
-    tracks_count_figure,
-    trajectories_figure,
-)
-from .tables import (
-    TableFigure,
-    report_table,
-    table,
-)
-from .topview import (
-    tunnel_topview,
-)
-from .tracking import (
-    bound_ratio_figure,
-    particle_cloud_figure,
-    rmse_bound_figure,
-    table_figure,
-    tracks_figure,
-)
-from .tunnel3d import (
-    factors_figure,
-    paths_table_figure,
-    tunnel3d_figure,
-    wave_origins_figure,
-)
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "COLORS": "common",
+    "cdf_figure": "common",
+    "line_figure": "common",
+    "design_answer_figure": "design",
+    "route_figure": "design",
+    "size_figure": "design",
+    "approach_cdfs": "doppler",
+    "doppler_delay_figure": "doppler",
+    "drive_topview": "doppler",
+    "error_time_figure": "doppler",
+    "information_figure": "doppler",
+    "pcrlb_figure": "doppler",
+    "profiles_figure": "doppler",
+    "regime_figure": "doppler",
+    "efficiency_figure": "efficiency",
+    "derivation_figure": "fresnel",
+    "fresnel_topview": "fresnel",
+    "mismatch_figure": "fresnel",
+    "mmax_range_figure": "fresnel",
+    "ratio_map_figure": "fresnel",
+    "epoch_figure": "javelin",
+    "javelin_table_figure": "javelin",
+    "tracks_count_figure": "javelin",
+    "trajectories_figure": "javelin",
+    "TableFigure": "tables",
+    "report_table": "tables",
+    "table": "tables",
+    "tunnel_topview": "topview",
+    "bound_ratio_figure": "tracking",
+    "particle_cloud_figure": "tracking",
+    "rmse_bound_figure": "tracking",
+    "table_figure": "tracking",
+    "tracks_figure": "tracking",
+    "factors_figure": "tunnel3d",
+    "paths_table_figure": "tunnel3d",
+    "tunnel3d_figure": "tunnel3d",
+    "wave_origins_figure": "tunnel3d",
+}
+
 
 __all__ = [
     "COLORS",
@@ -101,3 +86,4 @@ __all__ = [
     "tunnel_topview",
     "wave_origins_figure",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -9,40 +9,42 @@ javelin-table1|2`` and the array design (``tunnelkit design``) use them.
 
 from __future__ import annotations
 
-from .analysis import (
-    ablation,
-    error_correlations,
-    extraction_errors,
-    path_errors,
-    vue_prediction_errors,
-)
-from .collect import collect_drives, collect_routes, per_drive, simulate_condition
-from .drives import (
-    CONDITIONS,
-    EXTRACTIONS,
-    HELD_OUT_SEED,
-    SIGMA_HEADING,
-    SIGMA_SPEED,
-    TUNING_SEEDS,
-    Condition,
-    DriveData,
-    ml_epoch,
-    path_measurements,
-    route_name,
-    scenario_route,
-    separate_epoch,
-    simulate_drive,
-    simulate_routes,
-)
-from .scoring import (
-    SETTLE_S,
-    Evaluation,
-    error_metrics,
-    evaluate,
-    settled,
-    settled_errors,
-    tenfiloc_track,
-)
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "ablation": "analysis",
+    "error_correlations": "analysis",
+    "extraction_errors": "analysis",
+    "path_errors": "analysis",
+    "vue_prediction_errors": "analysis",
+    "collect_drives": "collect",
+    "collect_routes": "collect",
+    "per_drive": "collect",
+    "simulate_condition": "collect",
+    "CONDITIONS": "drives",
+    "Condition": "drives",
+    "DriveData": "drives",
+    "EXTRACTIONS": "drives",
+    "HELD_OUT_SEED": "drives",
+    "SIGMA_HEADING": "drives",
+    "SIGMA_SPEED": "drives",
+    "TUNING_SEEDS": "drives",
+    "ml_epoch": "drives",
+    "path_measurements": "drives",
+    "route_name": "drives",
+    "scenario_route": "drives",
+    "separate_epoch": "drives",
+    "simulate_drive": "drives",
+    "simulate_routes": "drives",
+    "Evaluation": "scoring",
+    "SETTLE_S": "scoring",
+    "error_metrics": "scoring",
+    "evaluate": "scoring",
+    "settled": "scoring",
+    "settled_errors": "scoring",
+    "tenfiloc_track": "scoring",
+}
+
 
 __all__ = [
     "CONDITIONS",
@@ -77,3 +79,4 @@ __all__ = [
     "tenfiloc_track",
     "vue_prediction_errors",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -6,38 +6,27 @@ is built with its initial state before it is displayed (a FigureWidget changed b
 connects shows stale in Voila).
 """
 
-from .base import (
-    Explorer,
-)
-from .cpd import (
-    cpd_explorer,
-    curvature_figure,
-    curvature_study,
-)
-from .crlb import (
-    crlb_explorer,
-    crlb_figure,
-)
-from .design import (
-    design_explorer,
-    design_figure,
-)
-from .doppler import (
-    doppler_explorer,
-    doppler_figure,
-)
-from .javelin import (
-    epoch_explorer,
-    epoch_view,
-)
-from .mmax import (
-    mmax_explorer,
-    mmax_figure,
-)
-from .tracking import (
-    upf_explorer,
-    upf_figure,
-)
+from .._lazy import lazy_exports
+
+_EXPORTS = {
+    "Explorer": "base",
+    "cpd_explorer": "cpd",
+    "curvature_figure": "cpd",
+    "curvature_study": "cpd",
+    "crlb_explorer": "crlb",
+    "crlb_figure": "crlb",
+    "design_explorer": "design",
+    "design_figure": "design",
+    "doppler_explorer": "doppler",
+    "doppler_figure": "doppler",
+    "epoch_explorer": "javelin",
+    "epoch_view": "javelin",
+    "mmax_explorer": "mmax",
+    "mmax_figure": "mmax",
+    "upf_explorer": "tracking",
+    "upf_figure": "tracking",
+}
+
 
 __all__ = [
     "Explorer",
@@ -57,3 +46,4 @@ __all__ = [
     "upf_explorer",
     "upf_figure",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
