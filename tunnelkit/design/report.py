@@ -409,9 +409,7 @@ def design_sweep(
             f"{len(specs)} arrays x {max_units} units x {drives_per_unit} drives x {T} epochs "
             "of errors",
         )
-        check_elements(
-            "n_boot", n_boot * max_units, what=f"{n_boot} resamples of {max_units} units"
-        )
+        check_elements("n_boot", n_boot * max_units, what=f"{n_boot} resamples, {max_units} units")
     if mode == "channel" and units:
         # each drive synthesises the largest candidate's tensor and a noise draw of its size:
         # the band's tone count is refused here, before any bound is computed
