@@ -672,7 +672,9 @@ print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {ca
 # The radio's gain over dead reckoning shrinks with the entry fix, to about one per cent at
 # 0.1 m. The PCRLB's floor is the drift of the odometry over the drive: ten times better
 # messages lower it about threefold (the last line). Now the tracker once more on the traced
-# channel, from a 0.1 m entry fix (quick mode: 4 × 4, one drive, as above).
+# channel, from a 0.1 m entry fix (quick mode: 4 × 4, one drive, as above). Same seed, same
+# drives: the entry fix is drawn after the drive, so each drive's measurements are those above,
+# kept from the first sweep (`design.traced.design_drive`), and only the tracker runs again.
 
 # %%
 fine_fix = design.design_sweep(paper_rt, rt_arrays, target=0.2, **rt_mc, seed=20261202,
