@@ -92,6 +92,7 @@ def design_traced():
     setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
     route = traced.traced_route(setup, "4x4")
     traced.traced_drive(route, np.random.default_rng(0), n_epochs=1)
+    traced.design_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1)
     traced.design_errors_path(setup, "4x4", n_epochs=1)
     rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=1)
     path = tempfile.mkdtemp() + "/errors.json"

@@ -151,6 +151,7 @@ def _signal_route():
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     rng = np.random.default_rng(0)
     ep = route.epoch(10, rng)
+    route.draw(10, np.random.default_rng(1))
     arr, paths = route.paths(10)
     snap = route.snapshot(paths, arr, rng)
     route.ml_noise_power(10, snap)

@@ -72,6 +72,58 @@ def test_the_traced_drive_is_the_drive_simulator_with_the_traced_adapters(setup)
     assert pt is not None and set(np.unique(pt.source)) == set(kept)
 
 
+def _same_drive(a, b):
+    for f in ("t", "truth", "speed", "heading", "base_station", "los", "n_true"):
+        np.testing.assert_array_equal(getattr(a, f), getattr(b, f))
+    assert a.faults == b.faults and len(a.epochs) == len(b.epochs)
+    for pa, pb in zip(a.epochs, b.epochs, strict=True):
+        assert (pa is None) == (pb is None)
+        if pa is not None:
+            for f in ("source", "phi", "psi", "kappa", "d", "v", "cov"):
+                np.testing.assert_array_equal(getattr(pa, f), getattr(pb, f))
+
+
+def test_a_design_drive_is_kept_and_driven_again_only_when_something_differs(setup, monkeypatch):
+    """design_drive: the sweep's traced drive, the "ml-traced" drive of traced_drive; asked for
+    again with the same setup, array, epochs and generator state it is a copy of the kept
+    drive and the generator ends where driving again leaves it; anything else drives again."""
+    g_ref, g1 = np.random.default_rng(11), np.random.default_rng(11)
+    ref = traced.traced_drive(traced.traced_route(setup, "4x4"), g_ref, n_epochs=1)["ml-traced"]
+    first = traced.design_drive(setup, "4x4", g1, n_epochs=1)
+    _same_drive(first, ref)
+    assert g1.bit_generator.state == g_ref.bit_generator.state
+    driven = []
+
+    def count(route, rng, *, n_epochs=None):
+        driven.append(n_epochs)
+        rng.random()  # a drive draws from the generator
+        return {"ml-traced": ref}
+
+    monkeypatch.setattr(traced, "traced_drive", count)
+    g2 = np.random.default_rng(11)
+    again = traced.design_drive(setup, "4x4", g2, n_epochs=1)
+    assert driven == [] and again is not first
+    _same_drive(again, ref)
+    assert g2.bit_generator.state == g_ref.bit_generator.state
+    assert g2.random() == g_ref.random()  # the entry fix drawn after it: the same draw
+    # another seed, array, number of epochs or setup object (equal or not): driven again
+    twin = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    for st, spec, rng, n in ((setup, "4x4", 12, 1), (setup, "8x8", 11, 1), (setup, "4x4", 11, 2),
+                             (twin, "4x4", 11, 1)):  # fmt: skip
+        traced.design_drive(st, spec, np.random.default_rng(rng), n_epochs=n)
+    assert driven == [1, 1, 2, 1]
+    # the oldest drives are dropped beyond DRIVES_KEPT
+    monkeypatch.setattr(traced, "DRIVES_KEPT", 2)
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())
+    for seed in (1, 2, 3, 1):
+        traced.design_drive(setup, "4x4", np.random.default_rng(seed), n_epochs=1)
+    assert len(traced._DRIVES) == 2 and driven[4:] == [1, 1, 1, 1]
+    with pytest.raises(TypeError, match="rng"):
+        traced.design_drive(setup, "4x4", 3)
+    with pytest.raises(ValueError, match="setup"):
+        traced.design_drive(design.DesignSetup.from_scenario(SCENARIO), "4x4", g1)
+
+
 def test_errors_are_measured_once_cached_and_refused_for_another_scene(setup, tmp_path):
     rec = traced.design_errors(setup, "4x4", n_epochs=2)
     p = rec["path"]

@@ -153,6 +153,26 @@ def test_stacked_consider_rows_split_the_reported_covariance():
     )
 
 
+def test_bias_factors_block_by_block():
+    """Every block factorised on its own terms, whatever its neighbours: full blocks, blocks
+    with some components that do not repeat (their rows and columns stay zero), zero blocks and
+    a singular one; the same factor as the block alone, lower-triangular, L L^T = the block."""
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((6, 4, 4)) * np.array([1e-4, 1.0, 3.0, 1e-2, 1.0, 0.5])[:, None, None]
+    b = A @ np.swapaxes(A, 1, 2)
+    b[1] = 0.0  # nothing repeats
+    b[2][[0, 2], :] = b[2][:, [0, 2]] = 0.0  # psi and d repeat only
+    v = rng.standard_normal(4)
+    b[4] = np.outer(v, v)  # rank one: the ridge keeps it factorisable
+    L = bias_factors(b)
+    for k in range(len(b)):
+        np.testing.assert_array_equal(L[k], bias_factors(b[k : k + 1])[0])
+        assert np.all(np.triu(L[k], 1) == 0)
+        np.testing.assert_allclose(L[k] @ L[k].T, b[k], rtol=1e-5, atol=1e-12 * np.abs(b[k]).max())
+    assert np.all(L[1] == 0) and np.all(L[2][[0, 2]] == 0) and np.all(L[2][:, [0, 2]] == 0)
+    assert bias_factors(np.zeros((0, 4, 4))).shape == (0, 4, 4)
+
+
 def test_consider_update_through_the_stack_equals_the_augmented_schmidt_update():
     meas = _meas(0.5)
     cfg = JavelinConfig()

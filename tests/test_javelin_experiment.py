@@ -196,6 +196,18 @@ def test_separated_drive_uses_the_same_tensors():
     # within a metre at 44 m), the LoS direction sharper than the coherent split's
     ml = both["ml"]
     np.testing.assert_array_equal(ml.speed, a.speed)
+    # the ML route alone (the paper route not run: the ML fit starts from its own CPD): the
+    # same draws, tensors and measurements
+    alone = ex.simulate_routes(
+        "italiano2026-straight", np.random.default_rng(5), condition="L", extractions=("ml",), **kw
+    )["ml"]
+    for f in ("speed", "heading", "los", "n_true"):
+        np.testing.assert_array_equal(getattr(alone, f), getattr(ml, f))
+    assert alone.faults == ml.faults and len(alone.epochs) == len(ml.epochs)
+    for m1, m2 in zip(alone.epochs, ml.epochs, strict=True):
+        for f in ("phi", "psi", "kappa", "d", "v", "source"):
+            np.testing.assert_array_equal(getattr(m1, f), getattr(m2, f))
+    assert [t.tolist() for t in alone.truth_index] == [t.tolist() for t in ml.truth_index]
     assert [int(np.sum(t >= 0)) for t in ml.truth_index] == [len(s) for s in ml.sources]
     ecols, erows = ex.extraction_errors([ml])
     err = {r[0]: dict(zip(ecols, r)) for r in erows}

@@ -308,7 +308,7 @@ for k, n in ((10, 10), (20, 20), (19, 20), (17, 20)):
     print(f"{k:2d} of {n} units meet: yield {k / n:.0%}, 95 % interval [{lo:.1%}, {hi:.1%}]")
 n_prove = next(n for n in range(1, 1000) if design.wilson_interval(n, n)[0] >= required)
 n_fail = next(f for f in range(21) if design.wilson_interval(20 - f, 20)[1] < required)
-units, max_units = tk.mc_count(20, 4), tk.mc_count(200, 8)
+units, max_units = tk.mc_count(20, 2), tk.mc_count(200, 4)
 batches = [units]  # the units an undecided array has after each batch
 while batches[-1] < max_units:
     batches.append(min(2 * batches[-1], max_units))
@@ -331,7 +331,7 @@ print(f"a pass at {required:.0%} needs every unit of at least {n_prove} meeting;
 # the power diffuse, as measured in a road tunnel (`design.preset_impairments("calibrated",
 # ...)`, sources in REFERENCES.md); `--ideal` (`impairments="ideal"`) is the optimistic case.
 #
-# Quick mode runs 4 units first, capped at 8: below 10 units every verdict is "undecided" and
+# Quick mode runs 2 units first, capped at 4: below 10 units every verdict is "undecided" and
 # says so. Below, the three calibration qualities of section 4:
 
 # %%
@@ -672,7 +672,9 @@ print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {ca
 # The radio's gain over dead reckoning shrinks with the entry fix, to about one per cent at
 # 0.1 m. The PCRLB's floor is the drift of the odometry over the drive: ten times better
 # messages lower it about threefold (the last line). Now the tracker once more on the traced
-# channel, from a 0.1 m entry fix (quick mode: 4 × 4, one drive, as above).
+# channel, from a 0.1 m entry fix (quick mode: 4 × 4, one drive, as above). Same seed, same
+# drives: the entry fix is drawn after the drive, so each drive's measurements are those above,
+# kept from the first sweep (`design.traced.design_drive`), and only the tracker runs again.
 
 # %%
 fine_fix = design.design_sweep(paper_rt, rt_arrays, target=0.2, **rt_mc, seed=20261202,
@@ -878,7 +880,9 @@ if not tk.quick_mode():
     assert recs["ideal"] == "4x4" and rank[2] > rank[0], recs
     rows_ideal = {r.array: r for r in answers["ideal"].rows}
     assert rows_ideal["4x4"].status == "met" and rows_ideal["4x4"].units == 80
-else:  # a cap of 8 units: below 10 no interval decides, and the sweep says so
+else:  # a cap of 4 units: below 10 no interval decides, and the sweep says so
+    assert (units, max_units) == (2, 4) and batches == [2, 4], batches
+    assert all(r.units == max_units for rep in answers.values() for r in rep.rows)
     assert n_decide is None and all(r.status == "undecided" for r in answers["0.5°"].rows)
     assert any("units" in w for w in answers["0.5°"].warnings)
 # the yields: every unit meets with an ideal array; calibration lowers the yield, 2 deg below

@@ -88,12 +88,12 @@ class SweepTrial:
                 prep.route, self.setup, spec, rng, n_epochs=self.n_epochs, calibration=cal
             )
         elif self.setup.channel == "sionna":
-            from .traced import traced_drive, traced_route
+            from .traced import design_drive
 
             # the traced treatment (tunnelkit.design.traced): every epoch's ML measurements,
-            # the geometry pre-filter; the tracker told this array's measured errors
-            route = traced_route(self.setup, spec)
-            drive = traced_drive(route, rng, n_epochs=self.n_epochs)["ml-traced"]
+            # the geometry pre-filter; the tracker told this array's measured errors (a drive
+            # of the same setup and seed, driven before in this process, is reused)
+            drive = design_drive(self.setup, spec, rng, n_epochs=self.n_epochs)
         else:
             route = self.setup.signal_route(spec)
             imp = self.impairments

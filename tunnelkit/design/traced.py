@@ -34,7 +34,9 @@ measurements allow a tracker, beside what it achieves.
 
 from __future__ import annotations
 
+import copy
 import json
+from collections import OrderedDict
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
@@ -51,6 +53,7 @@ __all__ = [
     "ERROR_RUNS",
     "ERROR_SEED",
     "TRACED_NUISANCE",
+    "design_drive",
     "design_errors",
     "design_errors_path",
     "error_model_summary",
@@ -71,6 +74,9 @@ ERROR_RUNS = 3
 TRACED_NUISANCE = {"diffuse_floor": True}
 #: the record's procedure (part of what a stored record must match)
 PROCEDURE = "tunnelkit.design.traced.measure_design_errors"
+#: design drives :func:`design_drive` keeps for the process (the oldest dropped first)
+DRIVES_KEPT = 64
+_DRIVES: OrderedDict = OrderedDict()
 
 
 def _setup(setup) -> DesignSetup:
@@ -117,6 +123,37 @@ def traced_drive(route, rng: np.random.Generator, *, n_epochs: int | None = None
             "ml-traced": ("ml", partial(traced_measurements, floors=FLOORS)),
         },
     )
+
+
+def design_drive(
+    setup: DesignSetup, spec, rng: np.random.Generator, *, n_epochs: int | None = None
+):
+    """The design sweep's drive of ``spec`` on the ray-traced channel: the ``"ml-traced"`` drive
+    of :func:`traced_drive` on :func:`traced_route`, kept for the process. Its key is ``setup``
+    itself (the object: a frozen setup builds the same route every time), the array,
+    ``n_epochs`` and the state of ``rng`` at the start; a drive asked for again (the same setup
+    and seed in another sweep: another entry fix, dead reckoning) is a copy of the kept one, and
+    ``rng`` is moved to the state the drive left it in: bit for bit what driving again gives
+    (the ML extraction draws nothing from ``rng``, the entry fix is drawn after the drive),
+    without the extraction's cost. At most :data:`DRIVES_KEPT` drives are kept, the oldest
+    dropped first; an equal setup built anew, or one sent to another process, drives again."""
+    setup = _setup(setup)
+    spec = parse_array(spec)
+    rng = rng_or_error("rng", rng)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    start = json.dumps(rng.bit_generator.state, sort_keys=True, default=str)
+    key = (id(setup), spec.label, n_epochs, start)
+    kept = _DRIVES.get(key)
+    if kept is not None and kept[0] is setup:  # the entry holds the setup: its id is not reused
+        _DRIVES.move_to_end(key)
+        rng.bit_generator.state = copy.deepcopy(kept[2])
+        return copy.deepcopy(kept[1])
+    drive = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)["ml-traced"]
+    _DRIVES[key] = (setup, copy.deepcopy(drive), copy.deepcopy(rng.bit_generator.state))
+    while len(_DRIVES) > DRIVES_KEPT:
+        _DRIVES.popitem(last=False)
+    return drive
 
 
 def _error_trial(route, n_epochs, _input, rng):

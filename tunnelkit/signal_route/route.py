@@ -335,6 +335,18 @@ class SignalRoute:
         instance("arr", arr, ArrayGeometry)
         return extract_paths(H, n_paths, arr, self.config, **extract_kw)
 
+    def draw(self, k: int, rng: np.random.Generator, *, tunnel=None, clock_bias=None) -> tuple:
+        """SRS slot ``k`` before any extraction, what :meth:`epoch` extracts from: the array, the
+        true paths and the snapshot (traced, synthesised with noise and clock bias; every draw
+        from ``rng`` the slot makes), ``(array, paths, snapshot)``."""
+        rng = rng_or_error("rng", rng)
+        arr, paths = self.paths(k, tunnel)
+        if self.channel == "sionna":
+            snap = self.raytraced_snapshot(k, arr, paths, rng, tunnel, clock_bias=clock_bias)
+        else:
+            snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
+        return arr, paths, snap
+
     def epoch(
         self,
         k: int,
@@ -346,12 +358,7 @@ class SignalRoute:
         **extract_kw,
     ) -> Epoch:
         """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1."""
-        rng = rng_or_error("rng", rng)
-        arr, paths = self.paths(k, tunnel)
-        if self.channel == "sionna":
-            snap = self.raytraced_snapshot(k, arr, paths, rng, tunnel, clock_bias=clock_bias)
-        else:
-            snap = self.snapshot(paths, arr, rng, clock_bias=clock_bias)
+        arr, paths, snap = self.draw(k, rng, tunnel=tunnel, clock_bias=clock_bias)
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
         if self.wideband_model:
             extract_kw.setdefault("wideband", True)

@@ -40,6 +40,7 @@ from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..metrics import SETTLE_S, settled
 from ..signal_route import CHANNELS, Epoch, SignalRoute
+from ..signal_route.measurements import measure_epoch
 from ..tracking.javelin.measurement import PathMeasurements
 
 __all__ = [
@@ -384,6 +385,23 @@ def simulate_drive(
     )[route_name(extraction)]
 
 
+def _ml_only_epoch(route: SignalRoute, k: int, rng: np.random.Generator, tunnel):
+    """Epoch ``k`` of a drive measured by the ML route alone: the slot drawn as
+    :meth:`SignalRoute.epoch` draws it, then :func:`ml_epoch`'s extraction and measurements,
+    without the paper route's extraction, which the ML route does not use (it starts from its
+    own CPD): the same epoch as ``ml_epoch(route.epoch(...), ...)``, the same draws."""
+    arr, paths, snap = route.draw(k, rng, tunnel=tunnel)
+    est = ml_paths(
+        snap.H, len(paths), arr, route.config, noise_power=route.ml_noise_power(k, snap, tunnel)
+    )
+    meas, truth = measure_epoch(est, arr, paths, snap, None, 0.0)
+    traj = route.trajectory
+    return Epoch(
+        k, float(traj.t[k]), traj.position[k].copy(), traj.velocity[k].copy(), arr, paths, snap,
+        est, meas, truth,
+    )  # fmt: skip
+
+
 def _redo(ep0, e: str, route: SignalRoute, tunnel):
     if e == "coherent":
         return separate_epoch(ep0, route.config)
@@ -508,19 +526,29 @@ def simulate_routes(
     acc = {e: _accumulator(T) for e in measure}
     bs = None
     own = extractions == ("route",)
+    ml_only = extractions == ("ml",)
     for k in range(T):
         has_los = True if cond is None else bool(rng.random() < cond.los_probability)
         r = route if has_los else no_los
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
-                ep0 = r.epoch(k, rng) if own else r.epoch(k, rng, tunnel=tunnel, refine="joint")
+                if ml_only:  # the ML route starts from its own CPD: no paper route to run
+                    ep0 = _ml_only_epoch(r, k, rng, tunnel)
+                elif own:
+                    ep0 = r.epoch(k, rng)
+                else:
+                    ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
             except (ValueError, np.linalg.LinAlgError) as exc:
+                ep0, failure = None, exc
+            except FloatingPointError as exc:  # the ML route's failures, as in _redo
+                if not ml_only:
+                    raise
                 ep0, failure = None, exc
             eps = {}
             for e in extractions:
                 ep = ep0
-                if ep is not None and e not in ("paper", "route"):
+                if ep is not None and e not in ("paper", "route") and not ml_only:
                     try:
                         ep = _redo(ep0, e, r, tunnel)
                     except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:

@@ -113,11 +113,15 @@ def bias_factors(bias_cov: np.ndarray) -> np.ndarray:
         raise ValueError(f"bias_cov: expected shape (n, 4, 4), got {b.shape}")
     n = b.shape[0]
     out = np.zeros((n, 4, 4))
-    for k in range(n):
-        s = np.sqrt(np.clip(np.diag(b[k]), 0.0, None))
-        on = s > 0
-        if not on.any():
-            continue
+    sd = np.sqrt(np.clip(np.diagonal(b, axis1=1, axis2=2), 0.0, None))  # (n, 4)
+    ons = sd > 0
+    full = ons.all(axis=1)
+    if full.any():  # every component repeats: the blocks factorised together
+        s = sd[full]
+        Lc = np.linalg.cholesky(b[full] / (s[:, :, None] * s[:, None, :]) + 1e-12 * np.eye(4))
+        out[full] = s[:, :, None] * Lc
+    for k in np.flatnonzero(ons.any(axis=1) & ~full):  # some components only
+        s, on = sd[k], ons[k]
         c = b[k][np.ix_(on, on)] / np.outer(s[on], s[on])
         Lc = np.linalg.cholesky(c + 1e-12 * np.eye(int(on.sum())))
         out[k][np.ix_(on, on)] = s[on][:, None] * Lc

@@ -139,7 +139,7 @@ def stack_measurement(
             ang.append(c == PHI)
             labels.append((("phi", "psi", "kappa")[c], i, j))
             brow.append([(i, j, c, 1.0)])
-        blocks.append(cov[j][np.ix_(comps, comps)])
+        blocks.append(cov[j][: len(comps), : len(comps)])  # comps: (PHI, PSI[, KAPPA]) = 0, 1[, 2]
     n_direct = len(z)
     with_d = [(i, j) for i, j in pairs if np.isfinite(meas.d[j])]
     ref = None
