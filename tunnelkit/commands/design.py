@@ -183,7 +183,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     geo = p.add_argument_group("advanced: array, mount and geometry")
     imp = p.add_argument_group(
         "advanced: impairments (the default, a calibrated array: phase 1.5 deg and gain 0.25 "
-        "dB per element, 5.6 %% of the power diffuse, the spatial-wideband term where the band "
+        "dB per element, 5.6 % of the power diffuse, the spatial-wideband term where the band "
         "calls for it; sources in REFERENCES.md)"
     )
     mc = p.add_argument_group(
