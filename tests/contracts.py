@@ -354,7 +354,8 @@ def _quantities() -> tuple:
         (r"spacing|element_spacing|spacing_m", [("above-range", 10 * ph.MAX_SPACING_M)]),
         (
             r"runs|n_runs|units|n_units|n_boot|n_tones|n_bins|n_epochs|reps|n_particles"
-            r"|particles|drives|drives_per_unit|n_draws|n_samples|trials",
+            r"|particles|drives|drives_per_unit|n_draws|n_samples|trials|n_paths|n_grid|nf|nt"
+            r"|batch|epochs|size|n_symbols",
             [("beyond-budget", 10**10)],
         ),
     )

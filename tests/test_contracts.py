@@ -76,8 +76,9 @@ DOCUMENTED: tuple[Documented, ...] = (
         "at most the route's epochs: a larger count drives the whole route (a hang is that drive)",
     ),
     _doc(
-        r"(tunnelkit\.)?design\.(records\.DesignRow|verdict\.(judge|recommend))",
-        r"runs|units|drives_per_unit",
+        r"(tunnelkit\.)?(design\.(records\.DesignRow|verdict\.(judge|recommend))"
+        r"|tracking\.javelin\.tracker\.StepReport)",
+        r"runs|units|drives_per_unit|n_paths",
         "physical",
         "a count reported or judged, nothing allocated from it",
     ),

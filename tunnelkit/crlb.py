@@ -25,6 +25,7 @@ import numpy as np
 
 from ._physical import MIN_SIGMA
 from ._validate import callable_, finite_array, integer, positive, spd_matrix, text
+from .budget import check_elements
 
 __all__ = [
     "crlb_rmse",
@@ -108,6 +109,7 @@ def station_sigmas(name: str, sigma, n: int) -> np.ndarray | None:
     > 0; ``None`` leaves that measurement type out. Errors name the parameter ``name``.
     """
     n = integer("n", n, minimum=1)
+    check_elements("n", n, what=f"{n} stations' sigmas")
     name = text("name", name)
     if sigma is None:
         return None

@@ -10,6 +10,7 @@ from ._checks import attributes
 from ._physical import speeds as check_speeds
 from ._validate import boolean, finite_array, instance, integer, positive, real, sequence
 from .arrays import ArrayGeometry
+from .budget import check_elements
 from .constants import C
 
 __all__ = [
@@ -285,6 +286,7 @@ def random_scene(
 
     rng = rng_or_error("rng", rng)
     L = integer("n_paths", n_paths, minimum=1)
+    check_elements("n_paths", 16 * L, what=f"{L} paths' parameters")
     cfg = SRSConfig() if config is None else instance("config", config, SRSConfig)
     ranges = interval("ranges", ranges, lower=1e-3)
     max_sine = real("max_sine", max_sine)

@@ -28,6 +28,7 @@ import numpy as np
 
 from .._physical import carrier
 from .._validate import finite_array, integer, positive
+from ..budget import check_elements
 from ..constants import C
 
 __all__ = [
@@ -263,6 +264,7 @@ def scan_grid(element_positions, fc: float, n_grid: int = 61):
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"element_positions: expected shape (M, 3), got {p.shape}")
     n_grid = integer("n_grid", n_grid, minimum=2)
+    check_elements("n_grid", n_grid * n_grid * (p.shape[0] + 2), 16, f"a {n_grid} x {n_grid} scan")
     return _scan_grid(p.tobytes(), p.shape[0], carrier("fc", fc), n_grid, 1.0 + 1e-12)
 
 
@@ -277,6 +279,7 @@ def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:
         raise ValueError(f"r: expected shape ({p.shape[0]},), got {np.shape(r)}")
     finite_array("r", r, dtype=complex)
     n_grid = integer("n_grid", n_grid, minimum=2)
+    check_elements("n_grid", n_grid * n_grid * (p.shape[0] + 2), 16, f"a {n_grid} x {n_grid} scan")
     u, A = _scan_grid(p.tobytes(), p.shape[0], carrier("fc", fc), n_grid)
     return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H
 

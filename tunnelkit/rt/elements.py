@@ -159,7 +159,9 @@ def element_tensor(
     T0 = positive("symbol_period", symbol_period)
     nf = integer("n_tones", n_tones, minimum=1)
     nt = integer("n_symbols", n_symbols, minimum=1)
-    check_elements("n_tones", paths.M * nf * nt, 16, f"{paths.M} x {nf} x {nt} complex tensor")
+    check_elements(
+        "n_tones, n_symbols", paths.M * nf * nt, 16, f"{paths.M} x {nf} x {nt} complex tensor"
+    )
     choice("method", method, SYNTHESIS_METHODS)
     eps = positive("eps", eps)
     if not 1e-15 <= eps <= 1e-3:

@@ -353,7 +353,7 @@ def model_error_test(
     pos = check_element_positions("element_positions", element_positions, m=R.shape[0])
     fc = carrier("fc", fc)
     n0 = positive("noise_power", noise_power)
-    L = integer("n_paths", n_paths, minimum=0)
+    L = integer("n_paths", n_paths, minimum=0, maximum=R.size)
     e_y = positive("received_energy", received_energy)
     share = nonnegative("share", share)
     N = R.size

@@ -58,7 +58,7 @@ def simulate_cv(
     F, Q = cv_transition(period), cv_process_noise(period, positive("q", q))
     lead = () if size is None else (integer("size", size, minimum=1),)
     check_elements(
-        "steps", 2 * (lead[0] if lead else 1) * steps * STATE_DIM, what="states and noise"
+        "steps, size", 2 * (lead[0] if lead else 1) * steps * STATE_DIM, what="states and noise"
     )
     L = np.linalg.cholesky(Q)
     noise = rng.standard_normal((*lead, steps - 1, STATE_DIM)) @ L.T

@@ -30,6 +30,7 @@ from scipy.stats import chi2
 
 from .._validate import finite_array, instance, integer, text
 from .._validate import probability as check_probability
+from ..budget import check_elements
 
 __all__ = [
     "DEFAULT_GATE",
@@ -146,6 +147,7 @@ class InnovationGate:
         self.test = None if probability is None else ChiSquareGate(self.probability)
         self.reopen_after = integer("reopen_after", reopen_after, minimum=1)
         shape = () if batch is None else (integer("batch", batch, minimum=1),)
+        check_elements("batch", 8 * int(np.prod(shape)), what="the gate's batch")
         self._rejected = np.zeros(shape, dtype=int)
         self._reopened = np.zeros(shape, dtype=int)
         self._streak = np.zeros(shape, dtype=int)

@@ -95,6 +95,7 @@ def _merwe_weights(n, alpha, beta, kappa) -> tuple[np.ndarray, np.ndarray, float
 
 def _check_merwe(n, alpha, beta, kappa):
     n = integer("n", n, minimum=1)
+    check_elements("n", 2 * n + 1, what=f"{2 * n + 1} sigma points' weights")
     alpha, beta, kappa = positive("alpha", alpha), nonnegative("beta", beta), real("kappa", kappa)
     return n, alpha, beta, kappa
 
@@ -516,7 +517,7 @@ def one_epoch_ess(
     """
     real_array("Z", Z, ndim=2)
     Z = np.asarray(Z, dtype=float)
-    T = Z.shape[0] if epochs is None else integer("epochs", epochs, minimum=1)
+    T = Z.shape[0] if epochs is None else integer("epochs", epochs, minimum=1, maximum=Z.shape[0])
     f = UnscentedParticleFilter(
         model,
         x0,

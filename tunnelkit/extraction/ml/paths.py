@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..._validate import boolean, integer, nonnegative, positive
+from ...budget import check_elements
 from ...constants import C
 from ..coherent import resolve_coherent
 from ..decomposition import check_rank, check_tensor
@@ -37,6 +38,7 @@ def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: floa
     fc, subcarrier_spacing, symbol_period = srs.fc, srs.tone_spacing, srs.symbol_period
     nf = integer("nf", nf, minimum=1)
     nt = integer("nt", nt, minimum=1)
+    check_elements("nf", nf), check_elements("nt", nt)
     rel_error = nonnegative("rel_error", rel_error)
     th = fit.theta
     w = th[:, 2]

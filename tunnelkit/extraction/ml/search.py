@@ -15,6 +15,7 @@ import numpy as np
 from scipy.linalg.blas import zherk
 
 from ..._validate import finite_array, integer, sequence
+from ...budget import check_elements
 from ...constants import C
 from ..coherent import fit_sources
 from ..estimates import PathEstimates
@@ -110,6 +111,7 @@ def complete_paths(prob: Problem, start, n_paths: int):
         raise ValueError(f"start: expected a tuple (theta, mu_f, mu_t), got {len(start)} items")
     theta, mu_f, mu_t = start
     L = integer("n_paths", n_paths, minimum=theta.shape[0])
+    check_elements("n_paths", 5 * L, what=f"{L} paths' parameters")
     H = prob.H
     while theta.shape[0] < L:
         if theta.shape[0]:
@@ -154,7 +156,7 @@ def check_start(start, n_paths: int):
     th = np.atleast_2d(th)
     if th.shape != (L, 3) or mf.shape != (L,) or mt.shape != (L,):
         raise ValueError(
-            f"start: expected theta ({L}, 3), mu_f ({L},), mu_t ({L},); got "
+            f"start, n_paths: expected theta ({L}, 3), mu_f ({L},), mu_t ({L},); got "
             f"{th.shape}, {mf.shape}, {mt.shape}"
         )
     if not (np.all(np.isfinite(th)) and np.all(np.isfinite(mf)) and np.all(np.isfinite(mt))):

@@ -18,6 +18,7 @@ import numpy as np
 from ... import positioning
 from ..._checks import real_array
 from ..._validate import boolean, finite_array, integer, positive, probability, rng_or_error, text
+from ...budget import check_elements
 from ...crlb import fim_toa_doa, toa_doa, toa_doa_jacobian, wrap_angle
 from ...scenarios import load_scenario
 from ..cv import STATE_DIM, cv_process_noise, cv_transition
@@ -267,6 +268,7 @@ def initial_states(truth_x0, P0, rng: np.random.Generator, size: int | None = No
     L = regularized_cholesky(finite_array("P0", P0, shape=(STATE_DIM, STATE_DIM)), name="P0")
     rng = rng_or_error("rng", rng)
     shape = (STATE_DIM,) if size is None else (integer("size", size, minimum=1), STATE_DIM)
+    check_elements("size", int(np.prod(shape)), what="the prior means")
     return x0 + rng.standard_normal(shape) @ L.T
 
 
