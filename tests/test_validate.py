@@ -243,7 +243,9 @@ def test_sizes_are_checked_before_allocating(budget):
         design.bootstrap_quantile_ci(np.ones((20, 30)), 0.9, np.random.default_rng(0), n_boot=10**9)
     paths = rt.ElementPaths(*(np.zeros((4, 1)),) * 3, np.ones((4, 1), bool),
                             np.zeros((4, 1), int), np.zeros((4, 1), bool), np.zeros((4, 1), int))  # fmt: skip
-    with pytest.raises(ValueError, match=r"n_tones: would need .* \(4 x 1000000000 x 12 complex"):
+    with pytest.raises(
+        ValueError, match=r"n_tones, n_symbols: would need .* \(4 x 1000000000 x 12 complex"
+    ):
         rt.element_tensor(paths, 120e3, 10**9, 1e-5, 12)
     with pytest.raises(ValueError, match=r"n_bins: would need 2 TiB \(211 epochs x 100000000 bins"):
         drive.delay_doppler_profiles(drive.make_drive(), n_bins=10**8)
