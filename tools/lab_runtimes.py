@@ -20,6 +20,7 @@ before and after is printed beside each time.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -68,32 +69,36 @@ def stamped_copy(src: Path, work: Path) -> tuple[Path, Path]:
     return dest, stamp
 
 
-def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout: float) -> dict:
-    """Serve ``root`` with JupyterLab, open ``nb_path``, click Run All, wait for ``stamp``."""
-    workspaces = (
-        f"--LabApp.workspaces_dir={root / ('workspaces-' + nb_path.stem)}"  # no restored tabs
-    )
-    env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{nb_path.stem}")}  # no user settings
+@contextlib.contextmanager
+def _own_lab(root: Path, stem: str, env: dict):
+    """A JupyterLab of its own for one notebook (no restored tabs, no user settings): its URL."""
+    workspaces = f"--LabApp.workspaces_dir={root / ('workspaces-' + stem)}"
+    env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{stem}")}
     with serving_on_free_port(
         lambda port: lab_command(port, root, workspaces),
         env=env,
-        log=root / f"{nb_path.stem}.log",
+        log=root / f"{stem}.log",
         timeout=180,
     ) as (_, base):
-        page = browser.new_page(viewport={"width": 1400, "height": 900})
-        try:
-            page.goto(base + f"lab/tree/{nb_path.name}", timeout=180_000)
-            page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
-            page.wait_for_function("document.body.innerText.includes('| Idle')", timeout=180_000)
-            load0 = os.getloadavg()[0]
-            page.get_by_role("menuitem", name="Run", exact=True).click()
-            t0 = time.time()
-            page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
-            while not stamp.exists() and time.time() - t0 < timeout:
-                page.wait_for_timeout(200)
-            page.wait_for_timeout(300)  # the stamp file is being written: let it close
-        finally:
-            page.close()
+        yield base
+
+
+def _run_all(browser, url: str, nb_path: Path, stamp: Path, timeout: float) -> dict:
+    """Open ``url`` (``nb_path`` in a running JupyterLab), click Run All, wait for ``stamp``."""
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    try:
+        page.goto(url, timeout=180_000)
+        page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
+        page.wait_for_function("document.body.innerText.includes('| Idle')", timeout=180_000)
+        load0 = os.getloadavg()[0]
+        page.get_by_role("menuitem", name="Run", exact=True).click()
+        t0 = time.time()
+        page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
+        while not stamp.exists() and time.time() - t0 < timeout:
+            page.wait_for_timeout(200)
+        page.wait_for_timeout(300)  # the stamp file is being written: let it close
+    finally:
+        page.close()
     if not stamp.exists():
         raise LectureError(
             f"{nb_path.name}: Run All did not reach its last cell within {timeout:.0f} s "
@@ -121,10 +126,14 @@ def read_stamp(stamp: Path, name: str) -> dict:
     return done
 
 
-def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict]:
+def measure_all(
+    books: list[Path], *, timeout: float, browser=None, lab: tuple[Path, str] | None = None
+) -> list[dict]:
     """Run All of every notebook in ``books``, one after the other (a row each). ``browser``: a
     Playwright browser already running in this thread (a second ``sync_playwright`` cannot
-    start beside it); default: Chromium started here and closed at the end."""
+    start beside it); default: Chromium started here and closed at the end. ``lab``: the root
+    directory and URL of a JupyterLab already running with ``kernel_env(quick=True)`` and this
+    checkout on PYTHONPATH (the browser tests'); default: a fresh one per notebook."""
     if browser is None:
         from playwright.sync_api import sync_playwright
 
@@ -133,17 +142,25 @@ def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict
         with sync_playwright() as pw:
             own = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
             try:
-                return measure_all(books, timeout=timeout, browser=own)
+                return measure_all(books, timeout=timeout, browser=own, lab=lab)
             finally:
                 own.close()
-    tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-"))
+    root, base = lab if lab is not None else (None, None)
+    tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-", dir=root))
     try:
         copies = [stamped_copy(b, tmp) for b in books]
         env = kernel_env(quick=True)
         env["PYTHONPATH"] = str(ROOT)
         rows = []
-        for nb_path, stamp in copies:  # a fresh server per notebook: nothing carried over
-            rows.append(_run_all(browser, nb_path, stamp, tmp, env, timeout))
+        for nb_path, stamp in copies:
+            if lab is None:  # a fresh server per notebook: nothing carried over
+                with _own_lab(tmp, nb_path.stem, env) as own:
+                    url = own + f"lab/tree/{nb_path.name}"
+                    rows.append(_run_all(browser, url, nb_path, stamp, timeout))
+            else:  # a workspace of its own in the given server: no tab restored
+                rel = nb_path.relative_to(root).as_posix()
+                url = base + f"lab/workspaces/{tmp.name}-{nb_path.stem}/tree/{rel}"
+                rows.append(_run_all(browser, url, nb_path, stamp, timeout))
             r = rows[-1]
             print(
                 f"  {r['notebook']}: Run All {r['wall_s']:.1f} s, kernel CPU "
