@@ -12,9 +12,10 @@ in headless Chromium (``make chromium``). A copy of each notebook gets one extra
 writes the wall-clock time and the kernel's CPU time to a file; the clock starts when "Run All
 Cells" is clicked, after the kernel has reported Idle (the kernel's start-up is not included; the
 page's rendering of outputs is). A cell that fails stops Run All, so a notebook whose last cell
-never runs within ``--timeout`` is reported as failed. Each notebook gets its own JupyterLab server,
-stopped before the next one starts, so they run one after the other on an otherwise idle machine; the load average
-before and after is printed beside each time.
+never runs within ``--timeout`` is reported as failed (at once, when JupyterLab shows every cell
+and Run All stopped before the last). Each notebook gets its own JupyterLab server, stopped before
+the next one starts, so they run one after the other on an otherwise idle machine; the load
+average before and after is printed beside each time.
 """
 
 from __future__ import annotations
@@ -83,9 +84,27 @@ def _own_lab(root: Path, stem: str, env: dict):
         yield base
 
 
+# True when Run All has ended without running the last cell: every cell is rendered (a short
+# notebook: a long one renders the cells near the viewport only), none is queued or running ("[*]"),
+# one has run ("[3]") and the last one has not ("[ ]"): its request was aborted after a failure
+STOPPED = """n => {
+  const prompts = [...document.querySelectorAll('.jp-Notebook .jp-Cell')].map(
+    c => (c.querySelector('.jp-InputPrompt')?.innerText || '').replace(/\\s/g, ''));
+  return prompts.length === n && prompts[n - 1] === '[]:' && !prompts.includes('[*]:')
+    && prompts.some(p => /^\\[\\d+\\]:$/.test(p));
+}"""
+
+
 def _run_all(browser, url: str, nb_path: Path, stamp: Path, timeout: float) -> dict:
-    """Open ``url`` (``nb_path`` in a running JupyterLab), click Run All, wait for ``stamp``."""
+    """Open ``url`` (``nb_path`` in a running JupyterLab), click Run All, wait for ``stamp``.
+
+    The wait ends early when Run All has visibly stopped before the stamp cell (``STOPPED``):
+    its request was aborted because a cell before it failed."""
+    import nbformat
+
+    n_cells = len(nbformat.read(nb_path, as_version=4).cells)
     page = browser.new_page(viewport={"width": 1400, "height": 900})
+    stopped = False
     try:
         page.goto(url, timeout=180_000)
         page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
@@ -95,15 +114,20 @@ def _run_all(browser, url: str, nb_path: Path, stamp: Path, timeout: float) -> d
         t0 = time.time()
         page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
         while not stamp.exists() and time.time() - t0 < timeout:
+            if page.evaluate(STOPPED, n_cells) and not stamp.exists():
+                stopped = True
+                break
             page.wait_for_timeout(200)
-        page.wait_for_timeout(300)  # the stamp file is being written: let it close
+        _wait_written(stamp)
     finally:
         page.close()
     if not stamp.exists():
-        raise LectureError(
-            f"{nb_path.name}: Run All did not reach its last cell within {timeout:.0f} s "
-            "(a failing cell stops Run All)"
+        why = (
+            "a cell before it failed and Run All stopped there"
+            if stopped
+            else f"within {timeout:.0f} s (a failing cell stops Run All)"
         )
+        raise LectureError(f"{nb_path.name}: Run All did not reach its last cell: {why}")
     done = read_stamp(stamp, nb_path.name)
     return {
         "notebook": nb_path.stem,
@@ -112,6 +136,18 @@ def _run_all(browser, url: str, nb_path: Path, stamp: Path, timeout: float) -> d
         "load_before": load0,
         "load_after": os.getloadavg()[0],
     }
+
+
+def _wait_written(stamp: Path, timeout: float = 10.0) -> None:
+    """Until the stamp file, if there is one, holds its whole record (the kernel may still be
+    writing it)."""
+    end = time.monotonic() + timeout
+    while stamp.exists() and time.monotonic() < end:
+        try:
+            json.loads(stamp.read_text())
+            return
+        except ValueError:
+            time.sleep(0.05)
 
 
 def read_stamp(stamp: Path, name: str) -> dict:
