@@ -34,6 +34,7 @@ from _lecture import (  # noqa: E402
     free_port,
     kernel_env,
     lab_command,
+    list_notebooks,
     resolve_notebook,
     serving,
     serving_on_free_port,
@@ -199,4 +200,8 @@ def chapter_pages(browser, site_url, artifacts):
     """Every chapter page of the site, opened once per width and recorded (pages.py)."""
     from .pages import ChapterPages
 
-    return ChapterPages(browser, site_url, artifacts)
+    pages = ChapterPages(browser, site_url, artifacts, list_notebooks())
+    try:
+        yield pages
+    finally:
+        pages.close()

@@ -168,17 +168,25 @@ def visible_text(page, selector: str) -> str:
 
 class ChapterPages:
     """Each chapter page of the site at each width, opened on first use and recorded; a page that
-    could not be opened fails every test that asks for it, with the same error."""
+    could not be opened fails every test that asks for it, with the same error.
 
-    def __init__(self, browser, site_url: str, artifacts: Path) -> None:
+    The tests ask for the pages in ``order`` (chapter by chapter, wide then narrow): while one page
+    is read, the next one already loads in a page of its own (Chromium renders it in another
+    process, so the two cores of a CI machine both work)."""
+
+    def __init__(self, browser, site_url: str, artifacts: Path, books: list[Path]) -> None:
         self.browser, self.site_url, self.artifacts = browser, site_url, artifacts
+        self.order = [(b, w) for b in books for w in (WIDE, NARROW)]
         self._seen: dict[tuple[str, int], dict | BaseException] = {}
+        self._loading: dict[tuple[str, int], tuple] = {}
 
     def get(self, notebook: Path, width: int = WIDE) -> dict:
         key = (notebook.stem, width)
         if key not in self._seen:
             try:
-                self._seen[key] = self._visit(notebook, width)
+                started = self._loading.pop(key, None) or self._open(notebook, width)
+                self._open_next(key)
+                self._seen[key] = self._read(notebook, width, started)
             except Exception as exc:  # kept, and raised to every test that asks
                 self._seen[key] = exc
         seen = self._seen[key]
@@ -186,12 +194,39 @@ class ChapterPages:
             raise seen
         return seen
 
-    def _visit(self, notebook: Path, width: int) -> dict:
+    def close(self) -> None:
+        """Close the pages opened ahead and not asked for."""
+        for cm, _ in self._loading.values():
+            cm.__exit__(None, None, None)
+        self._loading.clear()
+
+    def _open_next(self, key: tuple[str, int]) -> None:
+        keys = [(b.stem, w) for b, w in self.order]
+        if key not in keys or keys.index(key) + 1 == len(keys):
+            return
+        book, width = self.order[keys.index(key) + 1]
+        nxt = (book.stem, width)
+        if nxt not in self._seen and nxt not in self._loading:
+            self._loading[nxt] = self._open(book, width)
+
+    def _open(self, notebook: Path, width: int) -> tuple:
+        """A watched page of its own, its navigation to the chapter begun: (its context, page)."""
+        cm = watched_page(self.browser)
+        w = cm.__enter__()
+        try:
+            w.page.set_viewport_size({"width": width, "height": 1000})
+            w.page.goto(self.site_url + f"{notebook.stem}.html", wait_until="commit")
+        except BaseException:
+            cm.__exit__(None, None, None)
+            raise
+        return cm, w
+
+    def _read(self, notebook: Path, width: int, started: tuple) -> dict:
         stem, art = notebook.stem, self.artifacts
-        with watched_page(self.browser) as w:
+        cm, w = started
+        try:
             page = w.page
-            page.set_viewport_size({"width": width, "height": 1000})
-            page.goto(self.site_url + f"{stem}.html", wait_until="load")
+            page.wait_for_load_state("load")
             page.wait_for_selector(".js-plotly-plot .main-svg", timeout=30_000)
             page.wait_for_load_state("networkidle")
             page.wait_for_timeout(300)  # plotly's responsive relayout after the first paint
@@ -212,6 +247,8 @@ class ChapterPages:
             rec["solutions"] = self._solutions(page, stem, cells) if cells else None
             rec["errors"], rec["blocked"] = list(w.errors), list(w.blocked)
             return rec
+        finally:
+            cm.__exit__(None, None, None)
 
     def _solutions(self, page, stem: str, cells) -> dict:
         """The solutions as the page opens, then the first one opened by a click on its summary."""
