@@ -77,8 +77,11 @@ lint: install
 unit: install rt-deps
 	$(PY) -m pytest -q -n 2 tests
 
+# tools/nbmake_cache.py keeps each passing run in build/executed/, where the browser tests' site
+# build finds it: `make test` executes every notebook once
 notebooks: install rt-deps
-	TUNNELKIT_QUICK=1 TUNNELKIT_SOLUTIONS=1 $(PY) -m pytest -q -n 2 --nbmake --nbmake-timeout=900 notebooks
+	TUNNELKIT_QUICK=1 TUNNELKIT_SOLUTIONS=1 $(PY) -m pytest -q -n 2 -p tools.nbmake_cache \
+	  --nbmake --nbmake-timeout=900 notebooks
 
 test: lint unit notebooks browser
 

@@ -8,6 +8,10 @@ timeout and is classified as
 * ``silent``  -- returned a value (a wrong number, NaN or an empty result) without an error;
 * ``crash``   -- any other exception, a hang (timeout) or a memory blow-up.
 
+A command line runs as ``python -m tunnelkit`` would, in a child forked from the test process
+after every command's module has been imported once (its exit status and standard error are the
+interpreter's: ``test_a_forked_command_line_is_the_interpreters`` compares the two).
+
 The test asserts zero ``silent``, zero ``crash`` and zero ``unclear``. Run this file as a script
 for the table of counts (``python tests/test_bad_input_probe.py``; put the tree to probe first on
 ``PYTHONPATH``).
@@ -129,26 +133,105 @@ def run_case(case) -> tuple[str, str]:
     return _classify(kind, exc, msg, case.names)
 
 
+CLI_ENV = {"TUNNELKIT_QUICK": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+
+
 def run_cli_case(case) -> tuple[str, str]:
-    env = dict(os.environ, TUNNELKIT_QUICK="1", OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    """(outcome, detail) of one command line run as ``python -m tunnelkit`` in a new interpreter."""
     try:
         res = subprocess.run(
             [sys.executable, "-m", "tunnelkit", *case.argv],
             capture_output=True,
             text=True,
             timeout=CLI_TIMEOUT_S,
-            env=env,
+            env={**os.environ, **CLI_ENV},
         )
     except subprocess.TimeoutExpired:
         return "crash", f"no answer within {CLI_TIMEOUT_S:g} s (hang)"
-    err = res.stderr.strip()
-    if res.returncode == 0:
+    return _classify_cli(res.returncode, res.stderr, case.names)
+
+
+def _classify_cli(code: int, stderr: str, names) -> tuple[str, str]:
+    err = stderr.strip()
+    if code == 0:
         return "silent", "exit status 0"
-    if "Traceback" in err or res.returncode not in (1, 2):
-        return "crash", f"exit {res.returncode}: {err.splitlines()[-1][:200] if err else ''}"
-    if names_parameter(err, case.names):
+    if "Traceback" in err or code not in (1, 2):
+        return "crash", f"exit {code}: {err.splitlines()[-1][:200] if err else ''}"
+    if names_parameter(err, names):
         return "clear", err.splitlines()[-1][:200]
-    return "unclear", err.splitlines()[-1][:200] if err else f"exit {res.returncode}"
+    return "unclear", err.splitlines()[-1][:200] if err else f"exit {code}"
+
+
+def _cli_child(argv, err_fd: int) -> None:
+    """In a forked child: what ``python -m tunnelkit ARGV`` does (tunnelkit/__main__.py), its
+    standard error to ``err_fd``, its exit status as the interpreter would set it."""
+    import traceback as tb
+
+    code = 70
+    try:
+        os.environ.update(CLI_ENV)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(err_fd, 2)
+        # new streams on the descriptors (a test run's capture may have replaced sys.stdout/err)
+        sys.stdout = open(1, "w", closefd=False)
+        sys.stderr = open(2, "w", closefd=False, errors="backslashreplace")
+        sys.argv = ["tunnelkit", *argv]
+        from tunnelkit.cli import main
+
+        try:
+            status = main(list(argv))
+        except SystemExit as exc:
+            status = exc.code
+        except BaseException:
+            tb.print_exc()
+            status = 1
+        if status is None or isinstance(status, int):
+            code = status or 0
+        else:  # sys.exit("message"): printed, status 1
+            print(status, file=sys.stderr)
+            code = 1
+        sys.stdout.flush()
+        sys.stderr.flush()
+    finally:
+        os._exit(code)
+
+
+def run_cli_case_forked(case) -> tuple[str, str]:
+    """``run_cli_case`` in a child forked from this process, where the command line's modules are
+    already imported: the same exit status and standard error without a new interpreter per case
+    (``test_a_forked_command_line_is_the_interpreters`` compares the two)."""
+    import select
+    import signal
+    import time
+
+    from tunnelkit.cli import build_parser
+
+    build_parser()  # every command's module imported once here, inherited by every child
+
+    read, write = os.pipe()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        os.close(read)
+        _cli_child(case.argv, write)
+    os.close(write)
+    chunks, deadline = [], time.monotonic() + CLI_TIMEOUT_S
+    with os.fdopen(read, "rb") as err:
+        while time.monotonic() < deadline:
+            if select.select([err], [], [], 0.5)[0]:
+                chunk = os.read(err.fileno(), 65536)
+                if not chunk:
+                    break
+                chunks.append(chunk)
+        else:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return "crash", f"no answer within {CLI_TIMEOUT_S:g} s (hang)"
+    _, status = os.waitpid(pid, 0)
+    code = os.waitstatus_to_exitcode(status)
+    return _classify_cli(code, b"".join(chunks).decode(errors="replace"), case.names)
 
 
 CASES = build_cases()
@@ -156,11 +239,8 @@ CLI_CASES = build_cli_cases()
 
 
 def run_cli_cases(cases) -> dict[str, tuple[str, str]]:
-    """All command lines, two at a time."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(2) as pool:
-        return dict(zip((c.id for c in cases), pool.map(run_cli_case, cases)))
+    """All command lines, one after the other, each in a child forked from this process."""
+    return {c.id: run_cli_case_forked(c) for c in cases}
 
 
 def probe() -> dict[str, list[tuple[str, str, str]]]:
@@ -203,6 +283,16 @@ def test_names_parameter():
 def test_bad_input_gets_a_clear_error(case):
     outcome, detail = run_case(case)
     assert outcome == "clear", f"{case.id}: {outcome} ({detail})"
+
+
+def test_a_forked_command_line_is_the_interpreters():
+    """The forked run of a command line gives what a new interpreter gives: a clear error, and a
+    case that runs without error (``mmax --help``: exit 0) is still seen as silent."""
+    from bad_input_cases import CliCase
+
+    for case in (CLI_CASES[0], CliCase("mmax --help", ("mmax", "--help"), ("M",))):
+        assert run_cli_case_forked(case) == run_cli_case(case), case.id
+    assert run_cli_case_forked(CLI_CASES[0])[0] == "clear"
 
 
 @pytest.fixture(scope="module")

@@ -3,7 +3,7 @@ errors cached with their provenance (refused when they do not match), the tracke
 and the sweep and report that say which error model they used.
 
 Marked like the other ray-traced tests: they need the ``rt`` extra and fail without it unless
-``TUNNELKIT_SKIP_RT=1``. A 4x4 array and two or three epochs, traced into a temporary cache.
+``TUNNELKIT_SKIP_RT=1``. A 4x4 array and two or three epochs, traced once into a temporary cache.
 """
 
 from __future__ import annotations
@@ -29,10 +29,17 @@ pytestmark = pytest.mark.skipif(SKIP_RT, reason="TUNNELKIT_SKIP_RT=1")
 SCENARIO = "italiano2026-straight"
 
 
+@pytest.fixture(scope="module")
+def traces(tmp_path_factory):
+    """One ray-tracing cache for the module: a scene is traced once, as a user's cache keeps it."""
+    return tmp_path_factory.mktemp("rt-cache")
+
+
 @pytest.fixture
-def setup(tmp_path, monkeypatch):
-    """The paper tunnel on the ray-traced channel; traces and error records in ``tmp_path``."""
-    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
+def setup(tmp_path, monkeypatch, traces):
+    """The paper tunnel on the ray-traced channel; traces in the module's cache, error records in
+    ``tmp_path`` (each test measures its own)."""
+    monkeypatch.setenv(CACHE_ENV, str(traces))
     monkeypatch.setattr(
         traced,
         "design_errors_path",

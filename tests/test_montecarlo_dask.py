@@ -257,19 +257,31 @@ def test_a_trial_past_its_timeout_stops_the_run_serially_and_on_dask(cluster):
     # imported this module before the clock starts)
     ok = run_trials(_draw, 4, seed=3, scheduler=cluster.scheduler_address, trial_timeout=30.0)
     assert ok == run_trials(_draw, 4, seed=3)
-    t0 = time.perf_counter()
-    # the hung trial is named (on a loaded machine the quick ones may be named with it: the limit
-    # runs from the last finished trial, and their start may be late)
-    with pytest.raises(TrialTimeout, match=r"trials \[(0, )?1(, 2)?\] of 3"):
-        run_trials(
-            _sleep,
-            3,
-            seed=0,
-            inputs=[0.0, 60.0, 0.0],
-            scheduler=cluster.scheduler_address,
-            trial_timeout=3.0,
-        )
-    assert time.perf_counter() - t0 < 30.0  # the 60 s trial was not waited for
+    # the hung trial keeps its worker asleep after the run has stopped: it runs on a cluster of
+    # its own, closed here, so that it does not hold up the next tests' trials on the module's
+    with LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",
+        scheduler_kwargs={"dashboard": False},
+        silence_logs=40,
+    ) as own:
+        run_trials(_draw, 4, seed=3, scheduler=own.scheduler_address)  # workers import this module
+        t0 = time.perf_counter()
+        # the hung trial is named (on a loaded machine the quick ones may be named with it: the
+        # limit runs from the last finished trial, and their start may be late)
+        with pytest.raises(TrialTimeout, match=r"trials \[(0, )?1(, 2)?\] of 3"):
+            run_trials(
+                _sleep,
+                3,
+                seed=0,
+                inputs=[0.0, 60.0, 0.0],
+                scheduler=own.scheduler_address,
+                trial_timeout=3.0,
+            )
+        assert time.perf_counter() - t0 < 30.0  # the 60 s trial was not waited for
 
 
 def test_workers_beyond_the_cores_are_capped_with_a_warning(monkeypatch):

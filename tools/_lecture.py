@@ -36,6 +36,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from _widget_dump import add_widget_dump, take_widget_dump
+
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 BUILD = ROOT / "build"
@@ -392,10 +394,12 @@ def kernel_env(quick: bool, solutions: bool = False) -> dict[str, str]:
     return env
 
 
-def _inputs_digest(path: Path, quick: bool) -> str:
+def inputs_digest(path: Path, quick: bool) -> str:
+    """What an executed copy depends on: the notebook, this module, the package, the data."""
     h = hashlib.sha256(path.read_bytes())
     h.update(b"quick" if quick else b"full")
-    h.update(Path(__file__).read_bytes())  # this module decides how notebooks are executed
+    for rule in (Path(__file__), Path(__file__).with_name("_widget_dump.py")):
+        h.update(rule.read_bytes())  # these modules decide how notebooks are executed
     for base in (ROOT / "tunnelkit", ROOT / "data"):
         for f in sorted(base.rglob("*")):
             if f.is_file() and "__pycache__" not in f.parts:
@@ -404,37 +408,19 @@ def _inputs_digest(path: Path, quick: bool) -> str:
     return h.hexdigest()
 
 
-_DUMP_MARK = "@@tunnelkit-figure-widgets@@"
-# Run after the last cell: the final figure of every live FigureWidget, by model id. The saved widget
-# state alone can be stale: a FigureWidget sends later changes as deltas, not in its state.
-_DUMP_FIGURE_WIDGETS = f"""
-import json as _json
-import sys as _sys
-_figs = {{}}
-if "plotly.basewidget" in _sys.modules:
-    import plotly.io as _pio
-    from ipywidgets.widgets import widget as _w
-    _inst = getattr(_w, "_instances", None) or getattr(_w.Widget, "widgets", {{}})
-    _base = _sys.modules["plotly.basewidget"].BaseFigureWidget
-    _figs = {{k: _json.loads(_pio.to_json(v, validate=False))
-             for k, v in list(_inst.items()) if isinstance(v, _base)}}
-print("{_DUMP_MARK}" + _json.dumps(_figs))
-"""
-
-
 def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = True):
     """Execute a notebook headless (widget state kept), every exercise's solution included, and
     return it as a NotebookNode.
 
     The result is cached in ``build/executed/`` keyed on the notebook, the package sources, the
-    data files and the mode, so ``make figures`` after ``make site`` does not run it again.
+    data files and the mode, so ``make figures`` after ``make site`` does not run it again (nor
+    the browser tests' site build after ``make notebooks``: tools/nbmake_cache.py).
     """
     import nbformat
     from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
-    EXECUTED.mkdir(parents=True, exist_ok=True)
-    digest = _inputs_digest(path, quick)
-    cached = EXECUTED / f"{path.stem}.{'quick' if quick else 'full'}.ipynb"
+    digest = inputs_digest(path, quick)
+    cached = executed_path(path, quick)
     if use_cache and cached.exists():
         nb = nbformat.read(cached, as_version=4)
         if nb.metadata.get("tunnelkit_lecture", {}).get("digest") == digest:
@@ -445,7 +431,7 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
     os.environ.clear()
     os.environ.update(env)  # the kernel inherits this process's environment
     try:
-        nb.cells.append(nbformat.v4.new_code_cell(_DUMP_FIGURE_WIDGETS))
+        add_widget_dump(nb)
         client = notebook_client(
             nb,
             timeout=timeout,
@@ -454,17 +440,32 @@ def execute(path: Path, *, quick: bool, timeout: int = 1800, use_cache: bool = T
             resources={"metadata": {"path": str(path.parent)}},
         )
         client.execute()
-        dump = nb.cells.pop()
     except (CellExecutionError, CellTimeoutError, DeadKernelError) as exc:
         plain = re.sub(r"\x1b\[[0-9;]*m", "", str(exc))  # the traceback comes with ANSI colours
         raise LectureError(f"{path.name} failed to execute:\n{plain}") from None
     finally:
         os.environ.clear()
         os.environ.update(saved)
-    text = "".join(o.get("text", "") for o in dump.get("outputs", []) if o.get("name") == "stdout")
-    live = json.loads(text.split(_DUMP_MARK, 1)[1]) if _DUMP_MARK in text else {}
+    return store_executed(nb, path, quick, digest)
+
+
+def executed_path(path: Path, quick: bool) -> Path:
+    """Where ``execute`` keeps a notebook's executed copy."""
+    return EXECUTED / f"{path.stem}.{'quick' if quick else 'full'}.ipynb"
+
+
+def store_executed(nb, path: Path, quick: bool, digest: str):
+    """Take the dump cell off a notebook run by ``execute``'s rules, keep the figures it printed and
+    the inputs' digest in its metadata, and write it to the cache (whole, or not at all)."""
+    import nbformat
+
+    live = take_widget_dump(nb)
     nb.metadata["tunnelkit_lecture"] = {"digest": digest, "quick": quick, "figure_widgets": live}
-    nbformat.write(nb, cached)
+    cached = executed_path(path, quick)
+    cached.parent.mkdir(parents=True, exist_ok=True)
+    tmp = cached.with_name(f".{cached.name}.{os.getpid()}.tmp")
+    nbformat.write(nb, tmp)
+    tmp.replace(cached)
     return nb
 
 

@@ -12,14 +12,16 @@ in headless Chromium (``make chromium``). A copy of each notebook gets one extra
 writes the wall-clock time and the kernel's CPU time to a file; the clock starts when "Run All
 Cells" is clicked, after the kernel has reported Idle (the kernel's start-up is not included; the
 page's rendering of outputs is). A cell that fails stops Run All, so a notebook whose last cell
-never runs within ``--timeout`` is reported as failed. Each notebook gets its own JupyterLab server,
-stopped before the next one starts, so they run one after the other on an otherwise idle machine; the load average
-before and after is printed beside each time.
+never runs within ``--timeout`` is reported as failed (at once, when JupyterLab shows every cell
+and Run All stopped before the last). Each notebook gets its own JupyterLab server, stopped before
+the next one starts, so they run one after the other on an otherwise idle machine; the load
+average before and after is printed beside each time.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -68,37 +70,64 @@ def stamped_copy(src: Path, work: Path) -> tuple[Path, Path]:
     return dest, stamp
 
 
-def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout: float) -> dict:
-    """Serve ``root`` with JupyterLab, open ``nb_path``, click Run All, wait for ``stamp``."""
-    workspaces = (
-        f"--LabApp.workspaces_dir={root / ('workspaces-' + nb_path.stem)}"  # no restored tabs
-    )
-    env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{nb_path.stem}")}  # no user settings
+@contextlib.contextmanager
+def _own_lab(root: Path, stem: str, env: dict):
+    """A JupyterLab of its own for one notebook (no restored tabs, no user settings): its URL."""
+    workspaces = f"--LabApp.workspaces_dir={root / ('workspaces-' + stem)}"
+    env = {**env, "JUPYTER_CONFIG_DIR": str(root / f"config-{stem}")}
     with serving_on_free_port(
         lambda port: lab_command(port, root, workspaces),
         env=env,
-        log=root / f"{nb_path.stem}.log",
+        log=root / f"{stem}.log",
         timeout=180,
     ) as (_, base):
-        page = browser.new_page(viewport={"width": 1400, "height": 900})
-        try:
-            page.goto(base + f"lab/tree/{nb_path.name}", timeout=180_000)
-            page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
-            page.wait_for_function("document.body.innerText.includes('| Idle')", timeout=180_000)
-            load0 = os.getloadavg()[0]
-            page.get_by_role("menuitem", name="Run", exact=True).click()
-            t0 = time.time()
-            page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
-            while not stamp.exists() and time.time() - t0 < timeout:
-                page.wait_for_timeout(200)
-            page.wait_for_timeout(300)  # the stamp file is being written: let it close
-        finally:
-            page.close()
+        yield base
+
+
+# True when Run All has ended without running the last cell: every cell is rendered (a short
+# notebook: a long one renders the cells near the viewport only), none is queued or running ("[*]"),
+# one has run ("[3]") and the last one has not ("[ ]"): its request was aborted after a failure
+STOPPED = """n => {
+  const prompts = [...document.querySelectorAll('.jp-Notebook .jp-Cell')].map(
+    c => (c.querySelector('.jp-InputPrompt')?.innerText || '').replace(/\\s/g, ''));
+  return prompts.length === n && prompts[n - 1] === '[]:' && !prompts.includes('[*]:')
+    && prompts.some(p => /^\\[\\d+\\]:$/.test(p));
+}"""
+
+
+def _run_all(browser, url: str, nb_path: Path, stamp: Path, timeout: float) -> dict:
+    """Open ``url`` (``nb_path`` in a running JupyterLab), click Run All, wait for ``stamp``.
+
+    The wait ends early when Run All has visibly stopped before the stamp cell (``STOPPED``):
+    its request was aborted because a cell before it failed."""
+    import nbformat
+
+    n_cells = len(nbformat.read(nb_path, as_version=4).cells)
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    stopped = False
+    try:
+        page.goto(url, timeout=180_000)
+        page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
+        page.wait_for_function("document.body.innerText.includes('| Idle')", timeout=180_000)
+        load0 = os.getloadavg()[0]
+        page.get_by_role("menuitem", name="Run", exact=True).click()
+        t0 = time.time()
+        page.get_by_role("menuitem", name="Run All Cells", exact=True).click()
+        while not stamp.exists() and time.time() - t0 < timeout:
+            if page.evaluate(STOPPED, n_cells) and not stamp.exists():
+                stopped = True
+                break
+            page.wait_for_timeout(200)
+        _wait_written(stamp)
+    finally:
+        page.close()
     if not stamp.exists():
-        raise LectureError(
-            f"{nb_path.name}: Run All did not reach its last cell within {timeout:.0f} s "
-            "(a failing cell stops Run All)"
+        why = (
+            "a cell before it failed and Run All stopped there"
+            if stopped
+            else f"within {timeout:.0f} s (a failing cell stops Run All)"
         )
+        raise LectureError(f"{nb_path.name}: Run All did not reach its last cell: {why}")
     done = read_stamp(stamp, nb_path.name)
     return {
         "notebook": nb_path.stem,
@@ -107,6 +136,18 @@ def _run_all(browser, nb_path: Path, stamp: Path, root: Path, env: dict, timeout
         "load_before": load0,
         "load_after": os.getloadavg()[0],
     }
+
+
+def _wait_written(stamp: Path, timeout: float = 10.0) -> None:
+    """Until the stamp file, if there is one, holds its whole record (the kernel may still be
+    writing it)."""
+    end = time.monotonic() + timeout
+    while stamp.exists() and time.monotonic() < end:
+        try:
+            json.loads(stamp.read_text())
+            return
+        except ValueError:
+            time.sleep(0.05)
 
 
 def read_stamp(stamp: Path, name: str) -> dict:
@@ -121,10 +162,14 @@ def read_stamp(stamp: Path, name: str) -> dict:
     return done
 
 
-def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict]:
+def measure_all(
+    books: list[Path], *, timeout: float, browser=None, lab: tuple[Path, str] | None = None
+) -> list[dict]:
     """Run All of every notebook in ``books``, one after the other (a row each). ``browser``: a
     Playwright browser already running in this thread (a second ``sync_playwright`` cannot
-    start beside it); default: Chromium started here and closed at the end."""
+    start beside it); default: Chromium started here and closed at the end. ``lab``: the root
+    directory and URL of a JupyterLab already running with ``kernel_env(quick=True)`` and this
+    checkout on PYTHONPATH (the browser tests'); default: a fresh one per notebook."""
     if browser is None:
         from playwright.sync_api import sync_playwright
 
@@ -133,17 +178,25 @@ def measure_all(books: list[Path], *, timeout: float, browser=None) -> list[dict
         with sync_playwright() as pw:
             own = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
             try:
-                return measure_all(books, timeout=timeout, browser=own)
+                return measure_all(books, timeout=timeout, browser=own, lab=lab)
             finally:
                 own.close()
-    tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-"))
+    root, base = lab if lab is not None else (None, None)
+    tmp = Path(tempfile.mkdtemp(prefix="tunnelkit-lab-runtimes-", dir=root))
     try:
         copies = [stamped_copy(b, tmp) for b in books]
         env = kernel_env(quick=True)
         env["PYTHONPATH"] = str(ROOT)
         rows = []
-        for nb_path, stamp in copies:  # a fresh server per notebook: nothing carried over
-            rows.append(_run_all(browser, nb_path, stamp, tmp, env, timeout))
+        for nb_path, stamp in copies:
+            if lab is None:  # a fresh server per notebook: nothing carried over
+                with _own_lab(tmp, nb_path.stem, env) as own:
+                    url = own + f"lab/tree/{nb_path.name}"
+                    rows.append(_run_all(browser, url, nb_path, stamp, timeout))
+            else:  # a workspace of its own in the given server: no tab restored
+                rel = nb_path.relative_to(root).as_posix()
+                url = base + f"lab/workspaces/{tmp.name}-{nb_path.stem}/tree/{rel}"
+                rows.append(_run_all(browser, url, nb_path, stamp, timeout))
             r = rows[-1]
             print(
                 f"  {r['notebook']}: Run All {r['wall_s']:.1f} s, kernel CPU "

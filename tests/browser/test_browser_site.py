@@ -2,33 +2,34 @@
 
 The site is built in quick mode into build/browser-site/ by tools/site.py (the same code as
 ``make site``) and served by ``python -m http.server`` on a free loopback port (conftest.py).
+Each chapter is read as it opened (pages.py: one visit per chapter serves every site test).
 """
 
 from __future__ import annotations
 
+import contextlib
+
 from _lecture import list_notebooks
+from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 
-def test_index_links_every_chapter_and_each_renders(site_url, watched, artifacts):
+def test_index_links_every_chapter_and_each_renders(site_url, watched, chapter_pages):
     page = watched.page
     page.goto(site_url + "index.html")
     links = page.eval_on_selector_all(
         "ol.chapters a", "els => els.map(e => e.getAttribute('href'))"
     )
-    expected = [f"{nb.stem}.html" for nb in list_notebooks()]
-    assert links == expected
-    for href in links:
-        page.goto(site_url + href, wait_until="load")
-        page.wait_for_selector(".js-plotly-plot .main-svg", timeout=30_000)
-        page.wait_for_load_state("networkidle")
-        n = page.evaluate("document.querySelectorAll('.js-plotly-plot .main-svg').length")
-        assert n >= 1, f"{href}: no rendered plotly figure"
-        assert page.evaluate("typeof window.Plotly") == "object", f"{href}: plotly.js not loaded"
-        shot = artifacts / f"site-{href.removesuffix('.html')}"
-        page.screenshot(path=f"{shot}.png")
-        page.locator(".js-plotly-plot").first.screenshot(path=f"{shot}-figure.png")
-    assert watched.blocked == [], f"the site asked for off-machine resources: {watched.blocked}"
-    assert watched.errors == [], f"console errors: {watched.errors}"
+    books = list_notebooks()
+    assert links == [f"{nb.stem}.html" for nb in books]
+    blocked, errors = list(watched.blocked), list(watched.errors)
+    for href, book in zip(links, books, strict=True):  # each chapter as it opened (pages.py)
+        seen = chapter_pages.get(book)
+        assert seen["figures"] >= 1, f"{href}: no rendered plotly figure"
+        assert seen["plotly"], f"{href}: plotly.js not loaded"
+        blocked += seen["blocked"]
+        errors += [f"{href}: {e}" for e in seen["errors"]]
+    assert blocked == [], f"the site asked for off-machine resources: {blocked}"
+    assert errors == [], f"console errors: {errors}"
 
 
 # Page coordinates of the middle point of the first visible scatter trace of the first figure.
@@ -63,7 +64,12 @@ def test_figures_hover_and_zoom_without_a_kernel(site_url, watched):
     page.mouse.down()
     page.mouse.move(x0 + 0.3 * box["width"], y0 + 0.3 * box["height"], steps=8)
     page.mouse.up()
-    page.wait_for_timeout(500)
+    with contextlib.suppress(PlaywrightTimeout):  # the assert below says what did not happen
+        page.wait_for_function(
+            f"w => {plot}._fullLayout.xaxis.range[1] - {plot}._fullLayout.xaxis.range[0] < w",
+            arg=0.6 * (before[1] - before[0]),
+            timeout=5_000,
+        )
     after = page.evaluate(f"{plot}._fullLayout.xaxis.range.slice()")
     assert after[1] - after[0] < 0.6 * (before[1] - before[0]), (before, after)
     assert watched.errors == []

@@ -17,45 +17,14 @@ solutions-voila-02-open.png and solutions-voila-02-run.png (after the button's c
 
 from __future__ import annotations
 
-import sys
+from _lecture import list_notebooks
 
-import nbformat
-import pytest
-from _lecture import BUILD, ROOT, list_notebooks, resolve_notebook, serving_on_free_port
+from tunnelkit.solutions import ASK, SUMMARY
 
-from tunnelkit.solutions import ASK, CSS_CLASS, SUMMARY, solution_id
+from .pages import STATE, open_first, solution_cells, visible_text
 
-SOLUTION = "solution"
 #: words solution 02.1 prints (not in its title, which the line before its button shows)
 PRINTED_02_1 = "for every R >="
-
-
-def solution_cells(path) -> list[tuple[int, str, str]]:
-    """(position, cell id, solution id) of every solution cell of a notebook."""
-    nb = nbformat.read(path, as_version=4)
-    return [
-        (i, c.get("id", ""), solution_id(c.source))
-        for i, c in enumerate(nb.cells)
-        if SOLUTION in c.get("metadata", {}).get("tags", [])
-    ]
-
-
-# For each selector: how many elements match, how many of the outputs inside them are on screen
-# (a box with a size and not inside a closed <details>), whether each sits in a closed
-# <details class="tk-solution">, how many hold a solution's collapsed output (it ran) and their text.
-STATE = """sels => sels.map(sel => {
-  const cells = [...document.querySelectorAll(sel)];
-  const outs = cells.flatMap(c => [...c.querySelectorAll('.jp-OutputArea-output')]);
-  const shown = outs.filter(o => {
-    const r = o.getBoundingClientRect();
-    return r.width > 0 && r.height > 0 && o.checkVisibility();
-  });
-  return {sel, cells: cells.length, outputs: outs.length, shown: shown.length,
-          closed: cells.filter(c => { const d = c.closest('details.tk-solution');
-                                      return d && !d.open; }).length,
-          ran: cells.filter(c => c.querySelector('details.OUTPUT_CLASS')).length,
-          text: cells.map(c => c.textContent).join(' ')};
-})""".replace("OUTPUT_CLASS", CSS_CLASS)
 
 
 def _assert_hidden(states: list[dict], where: str) -> None:
@@ -66,59 +35,27 @@ def _assert_hidden(states: list[dict], where: str) -> None:
     assert sum(s["outputs"] for s in states) > 0, f"{where}: the solutions have no output at all"
 
 
-def _open_first(page, selector: str) -> int:
-    """Click the first solution's summary; the number of its outputs now on screen."""
-    page.locator(selector).locator("xpath=ancestor::details[1]/summary").click()
-    page.wait_for_timeout(300)
-    page.locator(selector).locator(".jp-OutputArea-output").first.scroll_into_view_if_needed()
-    return page.evaluate(STATE, [selector])[0]["shown"]
-
-
-def _visible_text(page, selector: str) -> str:
-    return page.locator(selector).locator(".jp-OutputArea").first.inner_text()
-
-
-def test_site_solutions_are_collapsed(site_url, watched, artifacts):
-    page = watched.page
+def test_site_solutions_are_collapsed(chapter_pages):
     books = [(b, solution_cells(b)) for b in list_notebooks()]
     books = [(b, cells) for b, cells in books if cells]
     assert len(books) >= 7, "fewer notebooks with solution cells than expected"
     for book, cells in books:
-        page.goto(site_url + f"{book.stem}.html", wait_until="load")
-        page.wait_for_load_state("networkidle")
-        sels = [f'[id="cell-id={cid}"]' for _, cid, _ in cells]
-        states = page.evaluate(STATE, sels)
+        seen = chapter_pages.get(book)["solutions"]  # as the page opened, then one click
+        states = seen["states"]
+        assert len(states) == len(cells), f"{book.stem}: {len(states)} of {len(cells)} read"
         _assert_hidden(states, book.stem)
         for s in states:  # built with the flag: every solution ran, its output collapsed
             assert s["ran"] == 1, f"{book.stem}: {s['sel']} did not run for the site"
             assert ASK not in s["text"], f"{book.stem}: {s['sel']} offers instead of showing"
-        tag = book.stem.split("-", 1)[0]
-        page.locator(sels[0]).locator("xpath=ancestor::details[1]").scroll_into_view_if_needed()
-        page.screenshot(path=str(artifacts / f"solutions-site-{tag}.png"))
-        assert _open_first(page, sels[0]) > 0, f"{book.stem}: the opened solution shows nothing"
-        assert SUMMARY in _visible_text(page, sels[0]), f"{book.stem}: no collapsed output shown"
-        page.screenshot(path=str(artifacts / f"solutions-site-{tag}-open.png"))
+        assert seen["opened_shown"] > 0, f"{book.stem}: the opened solution shows nothing"
+        assert SUMMARY in seen["opened_text"], f"{book.stem}: no collapsed output shown"
 
 
-@pytest.fixture(scope="module")
-def voila_02():
-    nb = resolve_notebook("02")
-    log = BUILD / "artifacts" / "voila-solutions-02.log"
-    log.parent.mkdir(parents=True, exist_ok=True)
-    present = [sys.executable, str(ROOT / "tools" / "present.py"), str(nb), "--quick"]
-    with serving_on_free_port(lambda port: [*present, f"--port={port}"], log=log, timeout=120) as (
-        _,
-        url,
-    ):
-        yield nb, url
-
-
-def test_voila_solutions_are_collapsed(voila_02, watched, artifacts):
-    nb, url = voila_02
+def test_voila_solutions_are_collapsed(voila_all, artifacts):
+    nb, _, watched = voila_all
     cells = solution_cells(nb)
     assert cells, f"{nb.name} has no solution cell"
     page = watched.page
-    page.goto(url, timeout=300_000)
     # Voila numbers its cells from 1 and shows the page once the last cell has run
     sels = [f'[cell-index="{i + 1}"] .jp-CodeCell' for i, _, _ in cells]
     page.wait_for_selector("#rendered_cells", state="visible", timeout=300_000)
@@ -141,8 +78,8 @@ def test_voila_solutions_are_collapsed(voila_02, watched, artifacts):
         assert PRINTED_02_1 not in s["text"], f"Voila: {s['sel']} shows an answer unasked"
     page.locator(sels[0]).locator("xpath=ancestor::details[1]").scroll_into_view_if_needed()
     page.screenshot(path=str(artifacts / "solutions-voila-02.png"))
-    assert _open_first(page, sels[0]) > 0, "the opened solution shows nothing"
-    assert PRINTED_02_1 not in _visible_text(page, sels[0]), "opened, it ran without the click"
+    assert open_first(page, sels[0]) > 0, "the opened solution shows nothing"
+    assert PRINTED_02_1 not in visible_text(page, sels[0]), "opened, it ran without the click"
     page.screenshot(path=str(artifacts / "solutions-voila-02-open.png"))
     page.locator(sels[0]).get_by_role("button", name=f"Run solution {cells[0][2]}").click()
     page.wait_for_function(

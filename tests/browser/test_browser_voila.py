@@ -12,13 +12,17 @@ from __future__ import annotations
 
 import json
 import re
-import sys
 
 import pytest
-from _lecture import BUILD, HOST, ROOT, alive, child_pids, free_port, resolve_notebook, serving
+
+from .conftest import VOILA_NOTEBOOK, presenting, watched_page
 
 #: the explorer under test: notebook, slider label, how to read the verdict from the figure
-TARGET = {"notebook": "02", "slider": "M", "verdict": re.compile(r"SR-NF (?:not )?valid\b[^<\n]*")}
+TARGET = {
+    "notebook": VOILA_NOTEBOOK,
+    "slider": "M",
+    "verdict": re.compile(r"SR-NF (?:not )?valid\b[^<\n]*"),
+}
 
 # Mark the slider labelled `label` and its explorer (the slider's nearest ancestor, inside its own
 # output cell, that holds a rendered plotly figure) so Playwright locators can reach them. Until the
@@ -58,35 +62,21 @@ def verdict_of(text: str) -> str:
 
 
 @pytest.fixture(scope="module", params=["all", "explorers"])
-def voila_url(request):
-    nb = resolve_notebook(TARGET["notebook"])
-    port = free_port()
-    url = f"http://{HOST}:{port}/"
-    log = BUILD / "artifacts" / f"voila-{nb.stem[:2]}-{request.param}.log"
-    log.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [
-        sys.executable,
-        str(ROOT / "tools" / "present.py"),
-        str(nb),
-        "--quick",
-        f"--port={port}",
-        f"--view={request.param}",
-    ]
-    with serving(cmd, url + "api", log=log, timeout=120) as proc:
-        assert child_pids(proc.pid), "present.py started no Voila"
-        yield url, request.param
-        spawned = [*child_pids(proc.pid)]  # Voila (its own process group) and its kernels
-        for pid in spawned:
-            spawned += child_pids(pid)
-    assert proc.poll() is not None, "present.py still runs"
-    left = [pid for pid in spawned if alive(pid, wait=15.0)]
-    assert not left, f"left running after the test: pids {left}"
+def voila_view(request, browser):
+    """The dashboard's page, opened: ``(view, Watched page)``. The whole notebook is the session's
+    page (conftest.py); the explorers view gets a server and a page of its own."""
+    if request.param == "all":
+        _, _, w = request.getfixturevalue("voila_all")
+        yield request.param, w
+        return
+    with presenting(request.param) as (_, url), watched_page(browser) as w:
+        w.page.goto(url, timeout=300_000)
+        yield request.param, w
 
 
-def test_keyboard_moves_m_and_the_verdict_changes(voila_url, watched, artifacts):
-    url, view = voila_url
+def test_keyboard_moves_m_and_the_verdict_changes(voila_view, artifacts):
+    view, watched = voila_view
     page = watched.page
-    page.goto(url, timeout=300_000)
     page.wait_for_function(MARK, arg=TARGET["slider"], timeout=300_000)
     tag = f"{TARGET['notebook']}-{view}"
     if view == "explorers":  # the lecturer's view: no long scroll to reach the slider
