@@ -22,7 +22,7 @@ from .scenarios import list_scenarios, load_scenario
 # objects and register themselves on import; the first lookup of a built-in kind imports its module
 scenarios.registry.set_loader(importlib.import_module)
 
-__version__ = "0.14.0"
+__version__ = "0.15.0"
 
 __all__ = [
     "QUICK",
