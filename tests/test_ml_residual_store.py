@@ -68,8 +68,8 @@ def test_a_stored_calibration_is_used_only_where_its_first_draw_reproduces(fresh
 
 
 def test_the_shipped_store_is_what_a_fresh_calibration_gives(monkeypatch):
-    """The paper tunnel's 4 x 4 (one of the tool's two cases; ``tools/residual_null.py --check``
-    re-measures both) calibrated afresh gives its stored entry bit for bit, and is read back."""
+    """The paper tunnel's 4 x 4 (one of the tool's cases; ``tools/residual_null.py --check``
+    re-measures them all) calibrated afresh gives its stored entry bit for bit, and is read back."""
     stored = json.loads((data_dir() / residual.STORE).read_text())
     spec = importlib.util.spec_from_file_location(
         "residual_null", ROOT / "tools" / "residual_null.py"
@@ -81,7 +81,7 @@ def test_the_shipped_store_is_what_a_fresh_calibration_gives(monkeypatch):
     rec = tool.measure([("italiano2026-straight", "4x4")])
     (entry,) = rec["entries"]
     assert entry in stored["entries"] and stored["settings"] == rec["settings"]
-    assert {e["M"] for e in stored["entries"]} == {16, 36}  # the tool's two cases
+    assert {e["M"] for e in stored["entries"]} == {16, 36, 100}  # the tool's three cases
     # the 4 x 4's entry is read back (checked against its first draw) without calibrating
     x_q, s, pos, fc, shape = next(iter(residual._NULL_CACHE.values()))
     monkeypatch.setattr(residual, "_NULL_CACHE", {})

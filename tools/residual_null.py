@@ -23,8 +23,13 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 #: (scenario, array) design routes whose calibrations are stored: notebook 08's section 7 (the
-#: 6 x 6 at 28 GHz) and section 9 (the paper tunnel's 4 x 4, image and ray-traced channel alike)
-CASES = (("example-rectangular-28ghz", "6x6"), ("italiano2026-straight", "4x4"))
+#: 6 x 6 at 28 GHz) and section 9 (the paper tunnel's 4 x 4, image and ray-traced channel alike),
+#: and the paper's 10 x 10 of notebooks 03, 04, 04b and 07
+CASES = (
+    ("example-rectangular-28ghz", "6x6"),
+    ("italiano2026-straight", "4x4"),
+    ("italiano2026-straight", "10x10"),
+)
 
 
 def measure(cases=CASES) -> dict:
