@@ -39,3 +39,31 @@ def epoch():
     array, paths = route.paths(10)
     snap = tk.channel.synthesize(paths, route.config, np.random.default_rng(0))
     return snap.H, len(paths), array, route.config
+
+
+@pytest.fixture
+def silent_server():
+    """A TCP server on 127.0.0.1 that accepts every connection and never answers (a scheduler
+    that hangs): yields ``(address "127.0.0.1:PORT", the accepted connections)``; closed after."""
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    held = []
+
+    def accept():
+        while True:
+            try:
+                held.append(srv.accept()[0])
+            except OSError:
+                return
+
+    threading.Thread(target=accept, daemon=True).start()
+    try:
+        yield f"127.0.0.1:{srv.getsockname()[1]}", held
+    finally:
+        srv.close()
+        for c in held:
+            c.close()

@@ -21,6 +21,7 @@ the others.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import inspect
 import math
@@ -321,6 +322,7 @@ def bad_values(p: inspect.Parameter, tp, valid) -> list[Bad]:
 # --- physical probes: generated from the package's declared ranges ----------------------------
 
 
+@functools.cache
 def _quantities() -> tuple:
     """(parameter-name pattern, [(label, value)]) per physical quantity: values outside the range
     :mod:`tunnelkit._physical` declares for it (a car faster than any vehicle, a carrier in GHz,

@@ -216,32 +216,12 @@ def _sleep(seconds: float, rng: np.random.Generator) -> float:
     return float(rng.random())
 
 
-def test_silent_scheduler_fails_within_the_timeout():
+def test_silent_scheduler_fails_within_the_timeout(silent_server):
     """A server that accepts the TCP connection and never answers: a clear error, no hang."""
-    import threading
-
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen(8)
-    held = []
-
-    def accept():
-        while True:
-            try:
-                held.append(srv.accept()[0])
-            except OSError:
-                return
-
-    threading.Thread(target=accept, daemon=True).start()
-    addr = f"127.0.0.1:{srv.getsockname()[1]}"
+    addr, held = silent_server
     t0 = time.perf_counter()
-    try:
-        with pytest.raises(SchedulerUnreachable, match=r"no Dask scheduler answered .* within 1 s"):
-            run_trials(_draw, 3, seed=0, scheduler=addr, timeout=1.0)
-    finally:
-        srv.close()
-        for c in held:
-            c.close()
+    with pytest.raises(SchedulerUnreachable, match=r"no Dask scheduler answered .* within 1 s"):
+        run_trials(_draw, 3, seed=0, scheduler=addr, timeout=1.0)
     assert time.perf_counter() - t0 < 10.0  # not the 120 s it hung before (loaded CI: margin)
     assert held  # the connection was accepted: the probe, not the connect, timed out
 

@@ -94,9 +94,12 @@ def test_a_path_faster_than_light_or_with_a_bent_direction_is_refused():
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     p = route.paths(10)[1][0]
     kw = {f.name: getattr(p, f.name) for f in dataclasses.fields(p)}
+    from tunnelkit._physical import MAX_SPEED
+
     for name in ("velocity", "range_rate"):
-        with pytest.raises(ValueError, match=rf"^{name}: .* not below the speed of light"):
-            Path(**{**kw, name: 1.01 * C})
+        for v in (1.01 * C, -2 * MAX_SPEED):  # light, and a car faster than any vehicle
+            with pytest.raises(ValueError, match=rf"^{name}: .* faster than any road vehicle"):
+                Path(**{**kw, name: v})
     with pytest.raises(ValueError, match=r"^direction: must be a unit vector"):
         Path(**{**kw, "direction": 2 * p.direction})
     with pytest.raises(ValueError, match=r"^length: must be > 0"):

@@ -553,35 +553,15 @@ def test_path_crlb_with_one_tone():
     assert np.all(np.isfinite(out["d"])) and np.all(out["d"] > 0)
 
 
-def test_design_cli_with_a_scheduler_that_accepts_and_never_answers(capsys):
-    import socket
-    import threading
+def test_design_cli_with_a_scheduler_that_accepts_and_never_answers(capsys, silent_server):
     import time
 
     from tunnelkit import cli
 
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen(8)
-    held = []
-
-    def accept():
-        while True:
-            try:
-                held.append(srv.accept()[0])
-            except OSError:
-                return
-
-    threading.Thread(target=accept, daemon=True).start()
-    addr = f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    addr, held = silent_server
     argv = ["design", "italiano2026-straight", "--arrays", "4x4", "--runs", "2"]
     t0 = time.perf_counter()
-    try:
-        rc = cli.main([*argv, "--scheduler", addr, "--connect-timeout", "2"])
-    finally:
-        srv.close()
-        for c in held:
-            c.close()
+    rc = cli.main([*argv, "--scheduler", f"tcp://{addr}", "--connect-timeout", "2"])
     assert rc != 0 and time.perf_counter() - t0 < 60.0  # it hung past 120 s before
     assert held  # the connection was accepted: the handshake, not the connect, timed out
     assert re.search(r"no Dask scheduler answered .* within 2 s", capsys.readouterr().err)
