@@ -17,8 +17,8 @@ Lambertian on the concrete shell and the asphalt road, smooth metal RRMs):
    (white across tones and elements for the diffuse part; the higher-order specular paths are
    not white, so the second bound is optimistic about what they cost). Routes (``--routes``):
    ``image``, ``sionna`` (first-order model), ``sionna_floor`` (the same, its fit tested against
-   noise + diffuse power, ``SignalRoute(diffuse_floor=True)``), ``sionna_2nd`` (the model also
-   carries the ``--second-order`` strongest second-order images, ``SignalRoute(second_order=N)``;
+   noise + diffuse power, ``RouteOptions(diffuse_floor=True)``), ``sionna_2nd`` (the model also
+   carries the ``--second-order`` strongest second-order images, ``RouteOptions(second_order=N)``;
    the bound is then the whole model's CRLB) and ``sionna_2nd_floor`` (both). Also the draws each route's extraction flags (``fit_ok`` False), per epoch,
    the number of paths each route extracted and its seconds per epoch.
 3. the tensor synthesis from the traced paths (:func:`tunnelkit.rt.element_tensor`): the
@@ -127,15 +127,13 @@ def extraction_study(
     noise + diffuse power (``diffuse_floor``)."""
     img = SignalRoute.from_scenario(name)
     srt = SignalRoute.from_scenario(name, channel="sionna")
-    srt2 = SignalRoute.from_scenario(name, channel="sionna", second_order=second_order)
+    srt2 = srt.with_options(second_order=second_order)
     routes = {
         "image": img,
         "sionna": srt,
-        "sionna_floor": SignalRoute.from_scenario(name, channel="sionna", diffuse_floor=True),
+        "sionna_floor": srt.with_options(diffuse_floor=True),
         "sionna_2nd": srt2,
-        "sionna_2nd_floor": SignalRoute.from_scenario(
-            name, channel="sionna", second_order=second_order, diffuse_floor=True
-        ),
+        "sionna_2nd_floor": srt2.with_options(diffuse_floor=True),
     }
     routes = {key: r for key, r in routes.items() if key in which}
     ks = list(range(0, len(img.trajectory), every)) if epochs is None else list(epochs)
@@ -301,7 +299,7 @@ def main(argv=None) -> int:
                 a.epochs_every,
                 a.draws,
                 a.seed,
-                a.second_order,
+                a.options.second_order,
                 a.routes,
                 a.epochs,
             )

@@ -171,8 +171,9 @@ def main(argv=None) -> int:
         return 0
     floors = (np.radians(a.floor_angle_deg), a.floor_range)
     for chan in a.channels:
-        kw = {"diffuse_floor": True} if chan == "sionna" else {}
-        route = SignalRoute.from_scenario(a.scenario, channel=chan, **kw)
+        route = SignalRoute.from_scenario(a.scenario, channel=chan)
+        if chan == "sionna":
+            route = route.with_options(diffuse_floor=True)
         t0 = time.perf_counter()
         r = study(route, a.draws, a.pfa, floors, np.random.default_rng(a.seed))
         wall = time.perf_counter() - t0

@@ -250,7 +250,16 @@ def _doppler():
 
     d = dv.make_drive(duration=8.0, pass_time=4.0)
     meas = dv.measure(d, np.random.default_rng(0))
-    dp.run_approaches(d, meas, dv.gnss_fix(d, np.random.default_rng(1)))
+    fix = dv.gnss_fix(d, np.random.default_rng(1))
+    dp.run_approaches(d, meas, fix)
+    # the filters' own protocol (tracking.protocol): predict, then update
+    setup = dp.DopplerSetup.from_drive(d)
+    for f in (dp.DopplerEKF(setup, fix), dp.SpeedKF(setup, 5.0)):
+        f.predict()
+        f.update(meas.doppler[1])
+    rkf = dp.RangeKF(setup, 30.0)
+    rkf.predict(5.0)
+    rkf.update(meas.toa[1])
 
 
 def _fresnel():
@@ -301,6 +310,12 @@ def _javelin():
         JavelinDesign(JavelinConfig(base_station=bs, sigma_p0_ue=1.0)),
         keep_reports=True,
     )
+    # the filter protocol (tracking.protocol): predict with the V2X message, update with paths
+    from tunnelkit.tracking.javelin import Javelin
+
+    trk = Javelin(P[0], JavelinDesign(JavelinConfig(base_station=bs, sigma_p0_ue=1.0)))
+    trk.predict(float(spd[0]), float(hdg[0]), 0.1)
+    trk.update(eps[1])
     # the bias-aware design: reported covariances with a repeating share (consider parameters)
     from tunnelkit.tracking.javelin import ConsiderNoise, PathMeasurements
 

@@ -89,6 +89,9 @@ def public_callables() -> list[Target]:
                 if issubclass(obj, _SKIP_BASES):
                     seen[id(obj)] = Target(qual, modname, obj, kind="exception")
                     continue
+                if getattr(obj, "_is_protocol", False):  # an interface: its members are stubs
+                    seen[id(obj)] = Target(qual, modname, obj, kind="protocol")
+                    continue
                 seen[id(obj)] = Target(qual, modname, obj, kind="class")
                 for attr, raw in vars(obj).items():
                     if attr.startswith("_"):
@@ -120,7 +123,7 @@ def function_of(target: Target):
 
 def parameters(target: Target) -> list[inspect.Parameter]:
     """The parameters a caller chooses (no self/cls, no *args/**kwargs)."""
-    if target.kind in ("exception", "property"):
+    if target.kind in ("exception", "property", "protocol"):
         return []
     fn = function_of(target)
     try:

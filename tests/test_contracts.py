@@ -435,14 +435,14 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no associated pair, no birth or death this epoch: the tracker predicts only",
     ),
     _doc(
-        r"tracking\.javelin\.tracker\.(Javelin\.(step|run)|run_javelin)",
+        r"tracking\.javelin\.tracker\.(Javelin\.(step|run|predict)|run_javelin)",
         r"speed|heading",
         "nan",
         "NaN (or None) is a missing V2X message: the last one is reused with inflated noise "
         "(the docstring's contract, a fault in the report)",
     ),
     _doc(
-        r"tracking\.javelin\.(tracker\.Javelin\.step|motion\.(ue_velocity|motion_increment|predict"
+        r"tracking\.javelin\.(tracker\.Javelin\.(step|predict)|motion\.(ue_velocity|motion_increment|predict"
         r"|RandomWalk\.increment))",
         r"speed",
         "negative",

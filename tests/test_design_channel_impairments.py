@@ -47,9 +47,9 @@ def test_channel_mode_synthesises_the_impairments_and_models_the_wideband_term(s
     assert set(route.calibration) == {a.name for a in route.arrays}
     for cal in route.calibration.values():
         assert cal.shape == (4,) and not np.allclose(cal, 1.0)
-    assert route.wideband_model
+    assert route.options.wideband_model
     # its fits judged against noise + the impairment power it was told about
-    assert route.model_error_floor
+    assert route.options.model_error_floor
 
     # and the epoch's extraction is asked to model the wideband term
     asked = {}
@@ -66,9 +66,9 @@ def test_channel_mode_synthesises_the_impairments_and_models_the_wideband_term(s
 
 def test_ideal_channel_mode_stays_the_ideal_route(setup, monkeypatch):
     route = _first_drive_route(setup, monkeypatch)
-    assert not route.calibration and not route.wideband_model
-    assert not route.model_error_floor and route.bias_budget is None
+    assert not route.calibration and not route.options.wideband_model
+    assert not route.options.model_error_floor and route.options.bias_budget is None
     with pytest.raises(TypeError, match="impairments"):
         sweep_montecarlo(setup, ["2x2"], 1, 0, mode="channel", impairments={"phase": 1.0})
     with pytest.raises(TypeError, match="wideband_model"):
-        type(route)(**{**route.__dict__, "wideband_model": "yes"})
+        route.with_options(wideband_model="yes")

@@ -1,7 +1,5 @@
 """The design's impairment budget handed to the channel route (tunnelkit.design.channelbudget)
-and the route's switches for it (SignalRoute.model_error_floor / bias_budget)."""
-
-from dataclasses import replace
+and the route's switches for it (RouteOptions.model_error_floor / bias_budget)."""
 
 import numpy as np
 import pytest
@@ -46,11 +44,11 @@ def test_route_switches_checked(setup):
     spec = parse_array("4x4")
     route = setup.signal_route(spec)
     with pytest.raises(TypeError, match="model_error_floor"):
-        replace(route, model_error_floor="yes")
+        route.with_options(model_error_floor="yes")
     with pytest.raises(TypeError, match="bias_budget"):
-        replace(route, bias_budget=np.zeros(3))
+        route.with_options(bias_budget=np.zeros(3))
     b = channel_route_budget(setup, spec, DesignImpairments(phase_error_deg=0.5))
     short = BiasBudget(b.source[:3], b.exists[:3], b.origin[:3], b.extra[:3], b.repeating[:3])
     with pytest.raises(ValueError, match="bias_budget"):
-        replace(route, bias_budget=short)
-    assert replace(route, model_error_floor=True, bias_budget=b).bias_budget is b
+        route.with_options(bias_budget=short)
+    assert route.with_options(model_error_floor=True, bias_budget=b).options.bias_budget is b

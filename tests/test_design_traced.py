@@ -56,7 +56,7 @@ def test_the_traced_drive_is_the_drive_simulator_with_the_traced_adapters(setup)
     """Same seed: its "ml" drive is simulate_routes' (ML route, no condition); "ml-all" keeps
     every epoch's ML rows whatever the fit's verdict, "ml-traced" the rows geometry_keep keeps."""
     route = traced.traced_route(setup, "4x4")
-    assert route.diffuse_floor and route.raytraced is not None
+    assert route.options.diffuse_floor and route.raytraced is not None
     got = traced.traced_drive(route, np.random.default_rng(3), n_epochs=2)
     ref = simulate_routes(
         route, np.random.default_rng(3), condition=None, extractions=("ml",), n_epochs=2

@@ -341,22 +341,23 @@ def test_bias_aware_delay_check_keeps_paths_a_negative_clock_bias_pushed_below_z
     """Algorithm 1 as printed drops d < 0; with a -60 ns bias every path of an epoch 9 m from
     the array has d < 0 and the epoch is lost. The bias-aware check keeps them all, and the
     TDoAs (bias-free) are unchanged."""
-    from dataclasses import replace
 
     from tunnelkit.constants import C
     from tunnelkit.extraction import algorithm1
     from tunnelkit.montecarlo import spawn_rngs
 
     route, _ = _epoch(k=0)
-    assert route.bias_aware_delay_check  # the design's route
-    route = replace(route, bias_aware_delay_check=False)
+    assert route.options.bias_aware_delay_check  # the design's route
+    route = route.with_options(bias_aware_delay_check=False)
     printed = route.epoch(26, spawn_rngs(3, 1)[0], clock_bias=-60e-9)
-    aware = replace(route, bias_aware_delay_check=True).epoch(
+    aware = route.with_options(bias_aware_delay_check=True).epoch(
         26, spawn_rngs(3, 1)[0], clock_bias=-60e-9
     )
     assert np.all(printed.estimates.d < 0) and len(printed.measurements) == 0
     assert len(aware.measurements) == len(aware.paths) and aware.measurements.cov is not None
-    assert replace(route, bias_aware_delay_check=True).min_d == -C * route.config.clock_bias_limit
+    assert (
+        route.with_options(bias_aware_delay_check=True).min_d == -C * route.config.clock_bias_limit
+    )
     lengths = np.sort([p.length for p in aware.paths])
     np.testing.assert_allclose(
         np.sort(aware.measurements.d) - aware.measurements.d.min(), lengths - lengths[0], atol=1e-3

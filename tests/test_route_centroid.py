@@ -100,10 +100,10 @@ def test_centroid_far_field_without_covariance_and_bad_input():
 
 
 def test_route_flag_is_checked():
-    """``SignalRoute.centroid_unresolved`` is a boolean."""
+    """``RouteOptions.centroid_unresolved`` is a boolean."""
     from tunnelkit.signal_route import SignalRoute
 
     route = SignalRoute.from_scenario("italiano2026-straight")
-    assert route.centroid_unresolved is False
+    assert route.options.centroid_unresolved is False
     with pytest.raises((TypeError, ValueError), match="centroid_unresolved"):
-        replace(route, centroid_unresolved="yes")
+        route.with_options(centroid_unresolved="yes")

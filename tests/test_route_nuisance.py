@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
 from tunnelkit import channel, propagation, rt
-from tunnelkit.signal_route import SignalRoute
+from tunnelkit.signal_route import RouteOptions, SignalRoute
 from tunnelkit.simulation import drives
 
 
@@ -25,7 +23,7 @@ def test_second_order_paths_in_the_model():
     )
     assert len(every) >= 3
     for n in (1, 2, 30):
-        _, ps = dataclasses.replace(base, second_order=n).paths(k)
+        _, ps = base.with_options(second_order=n).paths(k)
         assert [p.length for p in ps[: len(first)]] == [p.length for p in first]
         extra = ps[len(first) :]
         assert len(extra) == min(n, len(every))
@@ -38,7 +36,7 @@ def test_image_channel_with_second_order_paths_is_fitted_and_they_are_dropped():
     """On the image channel with the second-order paths synthesised (option (a)), the ML route
     with them in its model passes its own fit test; the first-order-only model on the same
     tensor does not. The estimates of the second-order paths never reach the measurements."""
-    route = SignalRoute.from_scenario("italiano2026-straight", second_order=3)
+    route = SignalRoute.from_scenario("italiano2026-straight", options=RouteOptions(second_order=3))
     k = 24
     ep = route.epoch(k, np.random.default_rng(3))
     n1 = sum(p.kind != propagation.SECOND_ORDER for p in ep.paths)
@@ -55,22 +53,27 @@ def test_image_channel_with_second_order_paths_is_fitted_and_they_are_dropped():
 
 def test_route_nuisance_options_validate(tmp_path):
     with pytest.raises(ValueError, match="second_order"):
-        SignalRoute.from_scenario("italiano2026-straight", second_order=-1)
+        RouteOptions(second_order=-1)
     with pytest.raises(ValueError, match="second_order"):
-        SignalRoute.from_scenario("italiano2026-straight", second_order=1000)
+        SignalRoute.from_scenario("italiano2026-straight").with_options(second_order=1000)
     with pytest.raises(ValueError, match="diffuse_floor"):
-        SignalRoute.from_scenario("italiano2026-straight", diffuse_floor=True)
+        SignalRoute.from_scenario("italiano2026-straight", options=RouteOptions(diffuse_floor=True))
     with pytest.raises((TypeError, ValueError), match="diffuse_floor"):
         SignalRoute.from_scenario(
-            "italiano2026-straight", channel="sionna", diffuse_floor="yes", cache_dir=tmp_path
-        )
+            "italiano2026-straight", channel="sionna", cache_dir=tmp_path
+        ).with_options(diffuse_floor="yes")
+    with pytest.raises(TypeError, match="options"):
+        SignalRoute.from_scenario("italiano2026-straight", options={"second_order": 1})
     with pytest.raises(ValueError, match="nuisance"):
         drives.scenario_route("italiano2026-straight", nuisance={"third_order": 1})
 
 
 def test_diffuse_floor_is_noise_plus_diffuse_power(tmp_path, monkeypatch):
     route = SignalRoute.from_scenario(
-        "italiano2026-straight", channel="sionna", diffuse_floor=True, cache_dir=tmp_path
+        "italiano2026-straight",
+        channel="sionna",
+        cache_dir=tmp_path,
+        options=RouteOptions(diffuse_floor=True),
     )
     assert isinstance(route.raytraced, rt.RayTracedChannel)
     monkeypatch.setattr(
@@ -81,13 +84,13 @@ def test_diffuse_floor_is_noise_plus_diffuse_power(tmp_path, monkeypatch):
     )
     got = route.ml_noise_power(4, snap)
     assert got == pytest.approx(1e-12 + route.config.tx_power * 1e-8)
-    assert dataclasses.replace(route, diffuse_floor=False).ml_noise_power(4, snap) is None
+    assert route.with_options(diffuse_floor=False).ml_noise_power(4, snap) is None
     # the routes built by name are kept per nuisance setting
     a = drives.scenario_route("italiano2026-straight", nuisance={"second_order": 2})
-    assert a.second_order == 2 and a is drives.scenario_route(
+    assert a.options.second_order == 2 and a is drives.scenario_route(
         "italiano2026-straight", nuisance={"second_order": 2}
     )
-    assert drives.scenario_route("italiano2026-straight").second_order == 0
+    assert drives.scenario_route("italiano2026-straight").options.second_order == 0
 
 
 def test_reproduce_nuisance_options_are_refused_where_they_do_not_apply(capsys):

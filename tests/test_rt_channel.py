@@ -217,10 +217,8 @@ def test_tensor_snapshot_equals_synthesize():
 def test_route_channel_switch_validates():
     route = SignalRoute.from_scenario("italiano2026-straight")
     assert route.channel == "image" and route.raytraced is None
-    with pytest.raises(ValueError, match="channel"):
-        dataclasses.replace(route, channel="raytraced")
     with pytest.raises(TypeError, match="raytraced"):
-        dataclasses.replace(route, channel="sionna")
+        dataclasses.replace(route, raytraced="sionna")
     with pytest.raises(ValueError, match="channel"):
         SignalRoute.from_scenario("italiano2026-straight", channel="ray")
     rs = SignalRoute.from_scenario("italiano2026-straight", channel="sionna")

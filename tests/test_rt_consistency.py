@@ -136,11 +136,10 @@ def test_bad_input_names_the_parameter(scene, kw, match):
 
 def test_bound_sigmas_match_the_reported_covariance(scene):
     """Where the fit passes its own test, the bound at the estimate is the route's reported one."""
-    from dataclasses import replace
 
     from tunnelkit.path_consistency import bound_sigmas, epoch_consistency
 
-    route = replace(scene[0], report_covariance=True)
+    route = scene[0].with_options(report_covariance=True)
     ep = route.epoch(10, np.random.default_rng(5), refine="ml")
     m = ep.measurements
     assert m.cov is not None

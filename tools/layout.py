@@ -34,6 +34,7 @@ RANKS = {
     "_lazy": 0,  # a package's names loaded on first use (PEP 562)
     "_checks": 0.25,  # more checks of the validation layer, built on _validate
     "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
+    "_parallel": 0.3,  # where trials run (workers or a scheduler address), checked once
     "constants": 0.5,
     "solutions": 0.5,  # the notebooks' solution cells (an IPython magic), imports nothing of ours
     "budget": 0.5,

@@ -40,11 +40,11 @@ import pickle
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
-from urllib.parse import urlsplit
 
 import numpy as np
 
 from ._checks import attributes
+from ._parallel import parallel_options
 from ._validate import boolean, callable_, integer, positive, sequence, text
 from .budget import check_bytes
 from .montecarlo import RUN_BYTES, spawn_rngs
@@ -326,56 +326,6 @@ def _run_serial(
                 out.append(trial(*args, rng))
             bar.update()
     return out
-
-
-def parallel_options(
-    workers: int | None = None, scheduler: str | None = None
-) -> tuple[int | None, str | None]:
-    """Check ``workers`` (an integer >= 1) and ``scheduler`` (``[tcp://]HOST:PORT``), at most one
-    given; returns them with the address normalised (``tcp://`` added when no scheme is given)."""
-    if workers is not None and scheduler is not None:
-        raise ValueError(
-            "workers, scheduler: give one or the other (a local cluster of N processes, or the "
-            f"address of a running one), got workers={workers!r} and scheduler={scheduler!r}"
-        )
-    if workers is not None:
-        workers = integer("workers", workers, minimum=1)
-    if scheduler is not None:
-        scheduler = _scheduler_address(scheduler)
-    return workers, scheduler
-
-
-_SCHEMES = ("tcp", "tls", "ws", "wss")
-
-
-def _scheduler_address(address) -> str:
-    if not isinstance(address, str):
-        raise TypeError(
-            f"scheduler: expected an address such as 'tcp://HOST:8786', got {address!r}"
-        )
-    text = address.strip()
-    full = text if "://" in text else f"tcp://{text}"
-    bad = ValueError(
-        f"scheduler: expected an address such as 'tcp://HOST:8786' "
-        f"(scheme one of {', '.join(_SCHEMES)}), got {address!r}"
-    )
-    try:
-        parts = urlsplit(full)
-        port = parts.port
-    except ValueError as exc:
-        raise bad from exc
-    if (
-        parts.scheme not in _SCHEMES
-        or not parts.hostname
-        or port is None
-        or port == 0
-        or parts.path not in ("", "/")
-        or parts.query
-        or parts.fragment
-        or parts.username
-    ):
-        raise bad
-    return full.rstrip("/")
 
 
 @contextlib.contextmanager

@@ -242,7 +242,7 @@ plots.efficiency_figure(eff, "los", title=f"LoS along the drive, {n_eff} snapsho
 # %%
 origins, ks = {}, range(0, len(route.trajectory), 7 if tk.quick_mode() else 1)
 for model in ("srnf", "exact"):
-    r_m = replace(route, model=model)
+    r_m = route.with_options(model=model)
     eps = [r_m.epoch(k, np.random.default_rng(100 + k), refine="joint") for k in tqdm(ks)]
     origins[f"{model} channel"] = np.concatenate([e.measurements.wave_origins for e in eps])
 plots.wave_origins_figure(origins, route.trajectory.position, route.arrays[0].origin)

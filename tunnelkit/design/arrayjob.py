@@ -101,11 +101,11 @@ class SweepTrial:
                 # the unit's calibration error (every drive of the unit the same); fits judged
                 # against noise + it
                 route = route.with_impairments(imp.channel_impairments(), unit)
-                route = replace(
-                    route, model_error_floor=True, bias_budget=prep.budget, centroid_unresolved=True
+                route = route.with_options(
+                    model_error_floor=True, bias_budget=prep.budget, centroid_unresolved=True
                 )
             if imp is not None and imp.wideband_model:
-                route = replace(route, wideband_model=True)
+                route = route.with_options(wideband_model=True)
             drive = simulate_drive(
                 route, rng, condition=None, extraction="route", n_epochs=self.n_epochs
             )

@@ -8,7 +8,7 @@ its estimate); :func:`channel_budget` gives the rest, per candidate slot of the 
 (one slot per surface: the LoS, each wall, the ceiling, the road, each road-marking column), as a
 :class:`tunnelkit.signal_route.judging.BiasBudget` the route matches to its estimates by
 direction and delay. Under calibration error the route also re-judges a fit its white-noise
-test flags (``SignalRoute.model_error_floor``, :mod:`tunnelkit.signal_route.judging`).
+test flags (``RouteOptions.model_error_floor``, :mod:`tunnelkit.signal_route.judging`).
 """
 
 from __future__ import annotations

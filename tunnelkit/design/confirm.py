@@ -22,7 +22,7 @@ those rows alone: the smallest candidate met on the channel route, ``route: "cha
 JSON; the bound route's rows stay in the report beside them (``confirmation`` in the JSON).
 
 Under calibration error the channel route judges the extraction's fits against noise plus the
-impairment power it was told about (``SignalRoute.model_error_floor``,
+impairment power it was told about (``RouteOptions.model_error_floor``,
 :mod:`tunnelkit.signal_route.judging`: the calibration share of the received power at a 1 %
 false-alarm quantile of the array's draw, :func:`~tunnelkit.signal_route.judging.
 calibration_floor`, plus the diffuse share; ``model_error_share`` (the expectation) and
@@ -39,7 +39,7 @@ design-answer.md).
 At 2 deg the channel route's 8 x 8 had a tail (p90 65 cm, 4 runs) the bound route did not
 (8.3 cm): on the drives that carried it the calibration error's quadratic phase drove every
 path's unresolved curvature to 3-7 m the same way every epoch, and seen from the reference
-antenna (the URA's corner) that moved every direction by 5-8 mrad (``SignalRoute.
+antenna (the URA's corner) that moved every direction by 5-8 mrad (``RouteOptions.
 centroid_unresolved``: such paths are reported far-field from the array's centroid). After
 it, 10 runs: error p90 8.9 cm [4.3, 15.5] (seed 0, undecided; bound route 9.2 cm) and 5.9 cm
 [4.1, 8.5] (seed 8675309, met; bound route 5.7 cm).

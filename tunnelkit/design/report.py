@@ -32,6 +32,7 @@ from functools import partial
 
 import numpy as np
 
+from .._parallel import parallel_options
 from .._physical import start_spread
 from .._validate import (
     boolean,
@@ -45,7 +46,6 @@ from .._validate import (
 )
 from ..budget import check_bytes, check_elements
 from ..metrics import SETTLE_S
-from ..runner import parallel_options
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
 from .drivebound import START_SIGMA_M

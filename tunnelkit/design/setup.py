@@ -28,7 +28,7 @@ from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
 from ..constants import wavelength
 from ..scenarios import Scenario, Trajectory, load_scenario
-from ..signal_route import CHANNELS, SignalRoute
+from ..signal_route import CHANNELS, RouteOptions, SignalRoute
 from .geometry import KINDS
 
 __all__ = ["ArraySpec", "DesignSetup", "Mount", "parse_array"]
@@ -303,10 +303,8 @@ class DesignSetup:
             self.trajectory,
             self.config,
             kinds=self.kinds,
-            report_covariance=True,
-            bias_aware_delay_check=True,
-            channel=self.channel,
             raytraced=raytraced,
+            options=RouteOptions(report_covariance=True, bias_aware_delay_check=True),
         )
 
     def arrays(self, spec) -> list[ArrayGeometry]:

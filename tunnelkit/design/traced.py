@@ -37,7 +37,6 @@ from __future__ import annotations
 import copy
 import json
 from collections import OrderedDict
-from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
@@ -93,7 +92,7 @@ def traced_route(setup: DesignSetup, spec):
     """The design's signal route of ``spec`` (:meth:`DesignSetup.signal_route`) on the
     ray-traced channel with :data:`TRACED_NUISANCE` (``setup.channel`` must be ``"sionna"``)."""
     setup = _setup(setup)
-    return replace(setup.signal_route(parse_array(spec)), **TRACED_NUISANCE)
+    return setup.signal_route(parse_array(spec)).with_options(**TRACED_NUISANCE)
 
 
 def traced_drive(route, rng: np.random.Generator, *, n_epochs: int | None = None) -> dict:

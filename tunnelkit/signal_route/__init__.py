@@ -20,13 +20,14 @@ or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a singl
 The package's modules follow its jobs: :mod:`~tunnelkit.signal_route.measurements` (Algorithm 1's
 world-frame measurements of one epoch and the covariance the extraction reports),
 :mod:`~tunnelkit.signal_route.route` (:class:`SignalRoute`: propagation -> channel ->
-extraction) and :mod:`~tunnelkit.signal_route.judging` (a fit judged against noise plus the impairment power
+extraction), :mod:`~tunnelkit.signal_route.options` (:class:`RouteOptions`, the route's switches) and :mod:`~tunnelkit.signal_route.judging` (a fit judged against noise plus the impairment power
 the route was told about).
 """
 
 from __future__ import annotations
 
 from .measurements import Epoch, RouteMeasurements, measurements_from_estimates, reported_covariance
+from .options import RouteOptions
 from .route import CHANNELS, MAX_SECOND_ORDER, SignalRoute, simulate_epoch
 
 __all__ = [
@@ -34,6 +35,7 @@ __all__ = [
     "MAX_SECOND_ORDER",
     "Epoch",
     "RouteMeasurements",
+    "RouteOptions",
     "SignalRoute",
     "measurements_from_estimates",
     "reported_covariance",

@@ -5,7 +5,7 @@ its strongest single-path component, :mod:`tunnelkit.extraction.ml`). Eq. 1 leav
 calibration error and the diffuse multipath out, so on an impaired channel the residual also
 carries model error and the test flags fits that found every path: on the 28 GHz example at
 0.5 deg of phase error, 7 of 10 epochs on 4 x 4 and 10 of 10 on 8 x 8, none on the ideal
-channel. A route told its impairment levels (:attr:`SignalRoute.model_error_floor`) re-judges
+channel. A route told its impairment levels (:attr:`RouteOptions.model_error_floor`) re-judges
 such a fit with :func:`model_error_test`, the same two tests
 with a floor of the impairments' share of the received power added (:func:`rejudge`: the
 diffuse share and :func:`calibration_floor`; :func:`impairment_share` their expectation).

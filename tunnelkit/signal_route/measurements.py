@@ -126,7 +126,7 @@ class Epoch:
 def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
     """Measurements of ``est`` (Algorithm 1, world frame) and their match to the true paths; the
     estimates matched to a second-order path (a nuisance path the model carries,
-    :attr:`SignalRoute.second_order`) are left out of the measurements. ``judged`` as in
+    :attr:`RouteOptions.second_order`) are left out of the measurements. ``judged`` as in
     :func:`reported_covariance`."""
     from ..propagation import SECOND_ORDER
 

@@ -9,7 +9,6 @@ import numpy as np
 
 from .._checks import indices
 from .._validate import (
-    boolean,
     choice,
     finite_array,
     instance,
@@ -22,8 +21,9 @@ from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from ..constants import C
 from .measurements import Epoch, RouteMeasurements, measure_epoch
+from .options import MAX_SECOND_ORDER, RouteOptions
 
-__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "SignalRoute", "simulate_epoch"]
+__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute", "simulate_epoch"]
 
 #: a near-field path whose curvature estimate is below ``UNRESOLVED_Z`` reported standard
 #: deviations (``kappa < z sigma_kappa``) has an unresolved curvature (:func:`_centroid_far_field`)
@@ -33,8 +33,6 @@ UNRESOLVED_Z = 3.0
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
 #: ``"sionna"`` (the tensor of every path Sionna RT traces per element, :mod:`tunnelkit.rt.cache`)
 CHANNELS = ("image", "sionna")
-#: the most second-order paths a route models (:attr:`SignalRoute.second_order`)
-MAX_SECOND_ORDER = 32
 #: the largest element gain error [dB] a route's calibration may hold (far beyond any drawn one:
 #: :func:`tunnelkit.channel.draw_calibration` allows a spread of at most 40 dB)
 MAX_CALIBRATION_DB = 300.0
@@ -63,88 +61,42 @@ class SignalRoute:
 
     ``kinds`` selects path families (see :func:`tunnelkit.propagation.trace_paths`);
     ``n_paths=None`` means L known (the number of traced paths, as in the paper).
-    ``report_covariance``: each epoch's measurements carry the CRLB at the estimate
-    (:func:`reported_covariance`), what the ML route's error follows; off by default.
-    ``bias_aware_delay_check``: Algorithm 1 drops only ``d < -c b_max`` (the clock bias's
-    support) instead of the printed ``d < 0`` (:func:`tunnelkit.extraction.algorithm1`).
     ``impairments`` (off by default) adds what eq. 1 leaves out (:class:`tunnelkit.channel.Impairments`);
     build an impaired route with :meth:`with_impairments`, which draws each array's calibration
     error once (``calibration``: array name -> (M,) complex gains).
-    ``channel`` (:data:`CHANNELS`): ``"image"`` (default) synthesises eq. 1 from the image
-    method's paths; ``"sionna"`` takes each epoch's noiseless tensor from ``raytraced`` (a
-    :class:`tunnelkit.rt.cache.RayTracedChannel`: every path Sionna RT returns per element,
-    specular of any order and diffuse, traced once and cached) and draws the clock bias and
-    the noise on it per run. The true paths (``Epoch.paths``, the number of paths to extract,
-    the matching) stay the image method's first-order specular paths; the LoS filter of
-    ``kinds`` and the epoch's ``tunnel`` (road markings removed) apply to the ray tracer too,
-    the other ``kinds`` filters do not. With ``"sionna"`` the spatial-wideband term is in the
+    ``raytraced`` (None by default: the image channel, eq. 1 from the image method's paths): a
+    :class:`tunnelkit.rt.cache.RayTracedChannel` makes this a ray-traced route (:attr:`channel`
+    ``"sionna"``, :data:`CHANNELS`): each epoch's noiseless tensor is every path Sionna RT
+    returns per element, specular of any order and diffuse, traced once and cached, with the
+    clock bias and the noise drawn on it per run. The true paths (``Epoch.paths``, the number of
+    paths to extract, the matching) stay the image method's first-order specular paths; the LoS
+    filter of ``kinds`` and the epoch's ``tunnel`` (road markings removed) apply to the ray
+    tracer too, the other ``kinds`` filters do not. On it the spatial-wideband term is in the
     tensor by construction and ``impairments.dmc`` is refused (the ray tracer has its own
-    diffuse power). ``wideband_model``: the extraction models the spatial-wideband term (the ML
-    route's ``wideband=True``, :func:`tunnelkit.extraction.extract_paths`) in every epoch.
-    ``second_order`` (0 by default: the first-order model): the route's model also carries the
-    ``second_order`` strongest second-order specular paths the image method predicts at each
-    epoch (:func:`tunnelkit.propagation.second_order_paths`, by ``|gain|`` at the reference
-    antenna; fewer when fewer exist). They are in ``Epoch.paths`` after the first-order ones, so
-    the extraction fits them (``L`` = first-order + second-order paths) and, on the image
-    channel, they are synthesised too; they are nuisance paths for the tracker: the estimates
-    matched to them (by range and direction, :func:`tunnelkit.evaluation.match_paths`, against
-    the geometry's prediction, as ``L`` itself is) are left out of the measurements.
-    ``diffuse_floor`` (``channel="sionna"`` only, off by default): the ML extraction judges its
-    own fit (``fit_ok``: residual, periodogram peak, significance) against the noise power plus
-    the epoch's diffuse power (the ray tracer's mean power per element of the paths with a
-    diffuse interaction, times the transmit power; :meth:`ml_noise_power`) instead of the noise
-    alone: the diffuse paths as a known noise-like nuisance. The fitted parameters are the
-    same least-squares fit; only the tests and the re-seeding they trigger change.
-    ``model_error_floor`` (off by default): an ML fit that fails its white-noise test
-    (``fit_ok = False``) is judged again against noise plus the impairment power this route
-    was told about (``impairments``: the diffuse share and the calibration levels'
-    :func:`~tunnelkit.signal_route.judging.calibration_floor`, the share one drawn array leaves
-    at a 1 % false-alarm rate over the draw; nothing to re-judge when
-    :func:`~tunnelkit.signal_route.judging.impairment_share` is zero, nor when the extraction
-    models the wideband term), ``Epoch.rejudged`` the test
-    and ``Epoch.fit_ok`` its verdict; a fit that passes it reports the CRLB at its estimate
-    (:func:`~tunnelkit.signal_route.measurements.reported_covariance` with ``judged=False``).
-    ``bias_budget`` (a :class:`~tunnelkit.signal_route.judging.BiasBudget` over this route's
-    epochs, None by default): every epoch's reported covariances get the budget of the slot
-    each estimate matches (:func:`~tunnelkit.signal_route.judging.apply_budget`; by direction
-    and delay) and its repeating share as ``bias_cov``. ``centroid_unresolved`` (False by
-    default; with ``report_covariance``): a path whose curvature its reported covariance (the
-    budget included) leaves unresolved is reported as a far-field path seen from the array's
-    centroid (:func:`_centroid_far_field`: under a
-    calibration error an unresolved curvature is biased the same way every epoch and, seen
-    from the reference antenna at the array's corner, moves every direction with it).
+    diffuse power). ``options`` (:class:`~tunnelkit.signal_route.options.RouteOptions`, all off
+    by default): the synthesis model, second-order nuisance paths, reported covariances and the
+    fit's judging; change them with :meth:`with_options`.
     """
 
     tunnel: object
     arrays: list
     trajectory: object
     config: SRSConfig
-    model: str = "exact"
     kinds: tuple[str, ...] = ("los", "wall", "ceiling", "road", "rrm")
     snr_offset_db: float = 0.0
     impairments: Impairments = field(default_factory=Impairments)
     calibration: dict = field(default_factory=dict)
-    report_covariance: bool = False
-    bias_aware_delay_check: bool = False
-    channel: str = "image"
     raytraced: object = field(default=None, repr=False)
-    wideband_model: bool = False
-    second_order: int = 0
-    diffuse_floor: bool = False
-    model_error_floor: bool = False
-    bias_budget: object = field(default=None, repr=False)
-    centroid_unresolved: bool = False
+    options: RouteOptions = field(default_factory=RouteOptions)
 
     def __post_init__(self) -> None:
         from ..propagation import PATH_KINDS, Tunnel3D
         from ..scenarios import Trajectory
 
-        choice("channel", self.channel, CHANNELS)
         instance("tunnel", self.tunnel, Tunnel3D)
         check_arrays(self.arrays)
         instance("trajectory", self.trajectory, Trajectory)
         instance("config", self.config, SRSConfig)
-        choice("model", self.model, ("exact", "srnf"))
         for k in sequence("kinds", self.kinds):
             choice("kinds", k, PATH_KINDS)
         real("snr_offset_db", self.snr_offset_db)
@@ -163,41 +115,43 @@ class SignalRoute:
                     f"a calibration error lies within +-{MAX_CALIBRATION_DB:g} dB (a dead element "
                     "or a unit mistake is not one)"
                 )
-        boolean("report_covariance", self.report_covariance)
-        boolean("bias_aware_delay_check", self.bias_aware_delay_check)
-        boolean("wideband_model", self.wideband_model)
-        integer("second_order", self.second_order, minimum=0, maximum=MAX_SECOND_ORDER)
-        boolean("model_error_floor", self.model_error_floor)
-        boolean("centroid_unresolved", self.centroid_unresolved)
-        if self.bias_budget is not None:
-            from .judging import BiasBudget
-
-            budget = instance("bias_budget", self.bias_budget, BiasBudget)
-            if budget.exists.shape[0] != len(self.trajectory):
-                raise ValueError(
-                    f"bias_budget: {budget.exists.shape[0]} epochs, the trajectory has "
-                    f"{len(self.trajectory)}"
-                )
-        if boolean("diffuse_floor", self.diffuse_floor) and self.channel != "sionna":
+        opts = instance("options", self.options, RouteOptions)
+        budget = opts.bias_budget
+        if budget is not None and budget.exists.shape[0] != len(self.trajectory):
             raise ValueError(
-                "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
+                f"bias_budget: {budget.exists.shape[0]} epochs, the trajectory has "
+                f"{len(self.trajectory)}"
             )
-        if self.channel == "sionna" or self.raytraced is not None:  # channel='sionna' needs one
+        if self.raytraced is not None:
             from ..rt.cache import RayTracedChannel  # the ray tracer loads only when asked for
 
             instance("raytraced", self.raytraced, RayTracedChannel)
-        if self.channel == "sionna":
             if self.impairments.dmc is not None:
                 raise ValueError(
                     "impairments: dmc (synthetic diffuse multipath) cannot be added to the "
                     "ray-traced channel, which has its own diffuse power"
                 )
+        elif opts.diffuse_floor:
+            raise ValueError(
+                "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
+            )
+
+    @property
+    def channel(self) -> str:
+        """The route's channel source (:data:`CHANNELS`): ``"sionna"`` with a ray-traced channel
+        attached (:attr:`raytraced`), else ``"image"``."""
+        return "image" if self.raytraced is None else "sionna"
+
+    def with_options(self, **changes) -> SignalRoute:
+        """A copy of this route with ``changes`` to its :class:`RouteOptions`
+        (``route.with_options(second_order=2)``); checked as a new route is."""
+        return replace(self, options=replace(self.options, **changes))
 
     @property
     def min_d(self) -> float:
         """Algorithm 1's delay check ``d >= min_d`` on this route: 0 as printed, ``-c b_max`` with
         ``bias_aware_delay_check``."""
-        return -C * self.config.clock_bias_limit if self.bias_aware_delay_check else 0.0
+        return -C * self.config.clock_bias_limit if self.options.bias_aware_delay_check else 0.0
 
     def with_impairments(self, impairments: Impairments, rng: np.random.Generator) -> SignalRoute:
         """A copy of this route whose arrays carry ``impairments``: each array's calibration error
@@ -241,7 +195,7 @@ class SignalRoute:
             kw["raytraced"] = RayTracedChannel(
                 tun, arrays, traj, config, settings, label=sc.name, cache_dir=cache_dir
             )
-        return cls(tun, arrays, traj, config, channel=channel, **kw)
+        return cls(tun, arrays, traj, config, **kw)
 
     def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
         """The array facing the vehicle and the true paths at epoch ``k`` (first order, then the
@@ -254,7 +208,7 @@ class SignalRoute:
         ue, vel = self.trajectory.position[k], self.trajectory.velocity[k]
         arr = propagation.select_array(self.arrays, ue)
         tun = self.tunnel if tunnel is None else tunnel
-        if not self.second_order:
+        if not self.options.second_order:
             return arr, propagation.trace_paths(
                 tun, arr, ue, vel, fc=self.config.fc, kinds=self.kinds
             )
@@ -264,7 +218,7 @@ class SignalRoute:
         first = [p for p in every if p.kind != propagation.SECOND_ORDER]
         second = [p for p in every if p.kind == propagation.SECOND_ORDER]
         second.sort(key=lambda p: -abs(p.gain))
-        return arr, first + sorted(second[: self.second_order], key=lambda p: p.length)
+        return arr, first + sorted(second[: self.options.second_order], key=lambda p: p.length)
 
     def snapshot(self, paths, arr: ArrayGeometry, rng: np.random.Generator, **kw):
         """The SRS tensor of ``paths`` at ``arr`` (:func:`tunnelkit.channel.synthesize`) with
@@ -274,7 +228,7 @@ class SignalRoute:
             paths,
             self.config,
             rng,
-            model=self.model,
+            model=self.options.model,
             snr_offset_db=self.snr_offset_db,
             calibration=self.calibration.get(arr.name),
             spatial_wideband=self.impairments.spatial_wideband,
@@ -321,7 +275,7 @@ class SignalRoute:
             raise TypeError(
                 f"tunnel: expected a {type(self.tunnel).__name__}, got {type(tunnel).__name__}"
             )
-        if not self.diffuse_floor:
+        if not self.options.diffuse_floor:
             return None
         tun = self.tunnel if tunnel is None else tunnel
         p_diffuse = self.raytraced.epoch(k, tun)["power"]["diffuse"]
@@ -360,20 +314,20 @@ class SignalRoute:
         """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1."""
         arr, paths, snap = self.draw(k, rng, tunnel=tunnel, clock_bias=clock_bias)
         L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
-        if self.wideband_model:
+        if self.options.wideband_model:
             extract_kw.setdefault("wideband", True)
-        if self.diffuse_floor and extract_kw.get("refine", "ml") == "ml":
+        if self.options.diffuse_floor and extract_kw.get("refine", "ml") == "ml":
             extract_kw.setdefault("noise_power", self.ml_noise_power(k, snap, tunnel))
         est = self.extract(snap.H, arr, L, **extract_kw)
-        cfg = self.config if self.report_covariance else None
+        cfg = self.config if self.options.report_covariance else None
         rejudged = self.rejudge(est, snap, arr, extract_kw)
         judged = rejudged is None or not rejudged["passed"]
         meas, truth = measure_epoch(est, arr, paths, snap, cfg, self.min_d, judged)
-        if self.bias_budget is not None:
+        if self.options.bias_budget is not None:
             from .judging import apply_budget
 
-            meas = apply_budget(meas, self.bias_budget, k)
-        if self.centroid_unresolved:
+            meas = apply_budget(meas, self.options.bias_budget, k)
+        if self.options.centroid_unresolved:
             meas = _centroid_far_field(meas, est, arr)
         return Epoch(
             k,
@@ -399,7 +353,7 @@ class SignalRoute:
         instance("snap", snap, ChannelSnapshot)
         instance("arr", arr, ArrayGeometry)
         instance("extract_kw", extract_kw, dict)
-        if not self.model_error_floor or getattr(est, "fit_ok", None) is not False:
+        if not self.options.model_error_floor or getattr(est, "fit_ok", None) is not False:
             return None
         if getattr(est, "fit", None) is None or extract_kw.get("wideband", False):
             return None
@@ -417,11 +371,11 @@ class SignalRoute:
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
     """One-call signal route: ``simulate_epoch("italiano2026-straight", 10, rng).measurements``.
 
-    Keyword arguments go to :class:`SignalRoute` (``model``, ``kinds``, ``snr_offset_db``) or to
-    :meth:`SignalRoute.epoch` (``n_paths``, ``tunnel``, ``clock_bias``, extraction options).
+    Keyword arguments go to :class:`SignalRoute` (``kinds``, ``snr_offset_db``, ``options``) or
+    to :meth:`SignalRoute.epoch` (``n_paths``, ``tunnel``, ``clock_bias``, extraction options).
     For loops over epochs build a :class:`SignalRoute` once instead.
     """
-    route_kw = {key: kw.pop(key) for key in ("model", "kinds", "snr_offset_db") if key in kw}
+    route_kw = {key: kw.pop(key) for key in ("kinds", "snr_offset_db", "options") if key in kw}
     return SignalRoute.from_scenario(scenario, **route_kw).epoch(k, rng, **kw)
 
 

@@ -39,7 +39,7 @@ from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..metrics import SETTLE_S, settled
-from ..signal_route import CHANNELS, Epoch, SignalRoute
+from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.javelin.measurement import PathMeasurements
 
@@ -116,7 +116,7 @@ class DriveData:
     measurement route (:data:`EXTRACTIONS`), ``clock_bias_limit`` [s] the support of the clock
     bias (TeNFiLoc's consistency check of a LoS curvature against the delay). ``condition`` is
     ``None`` for a drive without a visibility draw; ``reports_covariance``: the route reported
-    each path's covariance (``SignalRoute(report_covariance=True)``).
+    each path's covariance (``RouteOptions(report_covariance=True)``).
     """
 
     scenario: str
@@ -234,14 +234,14 @@ def scenario_route(
     """``route`` itself (a :class:`SignalRoute`; ``channel``, if given, must be its own), or the
     route of a scenario name built once per ``(name, model, channel, nuisance)`` and kept
     (``channel`` :data:`~tunnelkit.signal_route.CHANNELS`, "image" by default; ``nuisance`` the
-    route's ``second_order`` / ``diffuse_floor`` fields, none by default)."""
+    route's ``second_order`` / ``diffuse_floor`` options, none by default)."""
     nuisance = _nuisance(nuisance)
     if isinstance(route, SignalRoute):
         if channel is not None and channel != route.channel:
             raise ValueError(
                 f"channel: the route given runs on the {route.channel!r} channel, not {channel!r}"
             )
-        return replace(route, **nuisance) if nuisance else route
+        return route.with_options(**nuisance) if nuisance else route
     if not isinstance(route, str) or not route:
         raise TypeError(f"route: expected a SignalRoute or a scenario name, got {route!r}")
     if channel is not None:
@@ -249,7 +249,7 @@ def scenario_route(
     key = (route, model, channel or "image", tuple(sorted(nuisance.items())))
     if key not in _ROUTES:
         _ROUTES[key] = SignalRoute.from_scenario(
-            route, model=model, channel=channel or "image", **nuisance
+            route, channel=channel or "image", options=RouteOptions(model=model, **nuisance)
         )
     return _ROUTES[key]
 
@@ -310,14 +310,14 @@ def path_measurements(ep, route: SignalRoute) -> tuple[PathMeasurements | None, 
     fit (the ML route: ``PathEstimates.fit_ok``) and flags it — a path missed, merged or in a wrong
     basin of the likelihood, or the snapshot in the threshold region — gives none either, with
     the reason :data:`FLAGGED`, unless the route re-judged the fit against noise plus its
-    impairment power and it passed (``Epoch.fit_ok``, ``SignalRoute.model_error_floor``). The
+    impairment power and it passed (``Epoch.fit_ok``, ``RouteOptions.model_error_floor``). The
     repeating share of the error a route with a bias budget reports goes on as ``bias_cov``."""
     instance("ep", ep, Epoch)
     instance("route", route, SignalRoute)
     m = ep.measurements
     if ep.fit_ok is False:
         return None, FLAGGED
-    if route.report_covariance and m.cov is None and len(m):
+    if route.options.report_covariance and m.cov is None and len(m):
         return None, "extraction failed its residual test"
     pm = PathMeasurements.from_arrays(
         m.phi,
@@ -585,7 +585,7 @@ def simulate_routes(
             a["sources"],
             measure[name][0],
             route.config.clock_bias_limit,
-            bool(route.report_covariance),
+            bool(route.options.report_covariance),
         )
         for name, a in acc.items()
     }

@@ -111,7 +111,7 @@ def evaluate(
         raise ValueError(
             f"design, drive: the noise role {d.noise!r} needs a measurement route that reports "
             f"each path's covariance, but the drive's route ({drive.extraction!r}) reports none "
-            "(SignalRoute(report_covariance=True))"
+            "(RouteOptions(report_covariance=True))"
         )
     est, run = cls.for_drive(
         drive, d, sigma_p0_ue=sigma_p0_ue, start=start, sigma_p0_height=sigma_p0_height

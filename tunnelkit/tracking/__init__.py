@@ -5,9 +5,13 @@ setting they solve), so notebooks, tests and the command line loop over them::
 
     from tunnelkit.tracking import registry
     for name, make in registry.family("jiang2023").items(): ...
+
+Every filter follows one protocol (:mod:`tunnelkit.tracking.protocol`): ``predict(*inputs)``,
+``update(z)``, ``step`` (both), and an inspectable ``x`` and ``P``.
 """
 
 from . import registry
+from .protocol import Filter
 
 # families -> modules that register them; imported on first lookup so `import tunnelkit` stays light
 registry.provide("jiang2023", "tunnelkit.tracking.virtual_station")  # TSWLS, EKF, UKF
@@ -15,4 +19,4 @@ registry.provide("jiang2023", "tunnelkit.tracking.upf")  # UPF
 registry.provide("halili2022", "tunnelkit.tracking.doppler")  # KF/EKF on Doppler and ToA
 registry.provide("italiano2026", "tunnelkit.tracking.javelin")  # JAVELIN, TeNFiLoc
 
-__all__ = ["registry"]
+__all__ = ["Filter", "registry"]

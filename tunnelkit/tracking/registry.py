@@ -34,8 +34,12 @@ every member through it). Each member's ``name`` attribute is its registered nam
     Build for a simulated drive with ``cls.for_drive(drive, design=None)`` (JAVELIN takes a
     :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign`, TeNFiLoc none), run with
     ``trk.track(drive)`` -> ``(estimates (T, 3), details)`` (the ``JavelinRun``, or which epochs
-    had a fix). ``Javelin.step(paths, speed, heading, dt)`` and ``TeNFiLoc.locate(paths)`` are
-    the per-epoch calls under it.
+    had a fix). ``Javelin.step(paths, speed, heading, dt)`` (``predict(speed, heading, dt)``
+    then ``update(paths)``) and ``TeNFiLoc.locate(paths)`` are the per-epoch calls under it.
+
+Under the families, every filter (Jiang's, Halili's Doppler and range filters, JAVELIN) follows
+the one filter protocol of :mod:`tunnelkit.tracking.protocol`: ``predict(*inputs)``,
+``update(z)``, ``step`` (both), ``x`` and ``P``.
 """
 
 from __future__ import annotations

@@ -233,6 +233,16 @@ class DopplerEKF:
         self._k, self._dz2 = setup.k, setup.dz**2
 
     @property
+    def x(self) -> np.ndarray:
+        """The state (filterpy's column ``kf.x`` as a vector)."""
+        return self.kf.x[:, 0]
+
+    @property
+    def P(self) -> np.ndarray:
+        """The state's covariance."""
+        return self.kf.P
+
+    @property
     def n_rejected(self) -> int:
         """Doppler samples the gate rejected (predicted only)."""
         return self.gate.n_rejected
@@ -259,12 +269,24 @@ class DopplerEKF:
             [[mk * (v0 / r - vw * w0 / r3), mk * (v1 / r - vw * w1 / r3), mk * w0 / r, mk * w1 / r]]
         )
 
-    def step(self, z) -> np.ndarray:
-        """Predict (eq. 8-9) and, unless ``z`` is None/NaN, update with Doppler ``z`` [Hz] (eq. 10-12)."""
-        z = scalar_measurement("z", z)
+    def predict(self) -> None:
+        """Predict (eq. 8-9)."""
         kf = self.kf
         kf.predict()
         kf.P = 0.5 * (kf.P + kf.P.T)  # F P F^T and the Joseph form leave rounding asymmetry
+
+    def update(self, z) -> np.ndarray:
+        """Update with Doppler ``z`` [Hz] (eq. 10-12) unless ``z`` is None/NaN; the position."""
+        return self._update(scalar_measurement("z", z))
+
+    def step(self, z) -> np.ndarray:
+        """:meth:`predict`, then :meth:`update` with Doppler ``z`` [Hz]; the position."""
+        z = scalar_measurement("z", z)
+        self.predict()
+        return self._update(z)
+
+    def _update(self, z: float | None) -> np.ndarray:
+        kf = self.kf
         if z is None:
             _warn("Doppler: dropped epoch (None/NaN); EKF predicted only")
             kf.update(None, self._H, self._h)
@@ -347,15 +369,36 @@ class SpeedKF:
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
 
     @property
+    def x(self) -> np.ndarray:
+        """The state (filterpy's column ``kf.x`` as a vector)."""
+        return self.kf.x[:, 0]
+
+    @property
+    def P(self) -> np.ndarray:
+        """The state's covariance."""
+        return self.kf.P
+
+    @property
     def n_rejected(self) -> int:
         """Doppler samples the gate rejected (predicted only)."""
         return self.gate.n_rejected
 
+    def predict(self) -> None:
+        """Predict (random walk)."""
+        self.kf.predict()
+
+    def update(self, z) -> float:
+        """Update with Doppler ``z`` [Hz] unless dropped (None/NaN); the speed."""
+        return self._update(scalar_measurement("z", z))
+
     def step(self, z) -> float:
-        """Predict, then update with Doppler ``z`` [Hz] unless dropped."""
+        """:meth:`predict`, then :meth:`update` with Doppler ``z`` [Hz]; the speed."""
         z = scalar_measurement("z", z)
+        self.predict()
+        return self._update(z)
+
+    def _update(self, z: float | None) -> float:
         kf = self.kf
-        kf.predict()
         if z is None:
             _warn("Doppler: dropped epoch (None/NaN); speed KF predicted only")
             kf.update(None)
@@ -439,6 +482,16 @@ class RangeKF:
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
 
     @property
+    def x(self) -> np.ndarray:
+        """The state (filterpy's column ``kf.x`` as a vector)."""
+        return self.kf.x[:, 0]
+
+    @property
+    def P(self) -> np.ndarray:
+        """The state's covariance."""
+        return self.kf.P
+
+    @property
     def n_rejected(self) -> int:
         """ToAs rejected by the gate or left out of the calibration."""
         return self.gate.n_rejected + self.calibration_outliers
@@ -456,12 +509,27 @@ class RangeKF:
         self.calibration_outliers = int(np.sum(~keep))
         return True
 
+    def predict(self, u: float) -> None:
+        """Predict with approach speed ``u`` [m/s] (eq. 17)."""
+        self._predict(float(finite_array("u", u, ndim=0)))
+
+    def update(self, z) -> float:
+        """Update with ToA ``z`` [s] (eq. 19-21) unless dropped or impossible; the distance."""
+        return self._update(scalar_measurement("z", z))
+
     def step(self, u: float, z) -> float:
-        """Predict with approach speed ``u`` [m/s], update with ToA ``z`` [s] unless dropped/impossible."""
+        """:meth:`predict` with approach speed ``u`` [m/s], then :meth:`update` with ToA ``z``
+        [s]; the distance."""
         u = float(finite_array("u", u, ndim=0))
         z = scalar_measurement("z", z)
+        self._predict(u)
+        return self._update(z)
+
+    def _predict(self, u: float) -> None:
+        self.kf.predict(u=np.array([[-u]]))
+
+    def _update(self, z: float | None) -> float:
         kf = self.kf
-        kf.predict(u=np.array([[-u]]))
         if z is not None and z <= 0:
             _warn(f"ToA: {z:.3e} s is not a time of flight; KF ToA predicted only")
             z = None

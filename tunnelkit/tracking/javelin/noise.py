@@ -75,7 +75,7 @@ class ReportedNoise:
     """Each path's own covariance as the extraction reports it (ours; ``PathMeasurements.cov``
     and ``sigma_d``): TDoA rows ``diag(s_j^2) + s_ref^2 1 1^T``. An epoch without a reported
     covariance falls back to ``fallback`` (reported as a fault by the tracker). Needs a
-    measurement route that reports covariances (``SignalRoute(report_covariance=True)``)."""
+    measurement route that reports covariances (``RouteOptions(report_covariance=True)``)."""
 
     fallback: FixedNoise = field(default_factory=FixedNoise)
     needs_reported: ClassVar[bool] = True

@@ -101,6 +101,7 @@ class Javelin:
         self.gate = ChiSquareGate(self.config.gate_probability)
         self.k = 0
         self._last_motion: tuple[float, float] | None = None
+        self._predicted: tuple | None = None  # what the last predict left for the update
 
     # -- the family protocol (tunnelkit.tracking.registry, "italiano2026") ----------------------
     @classmethod
@@ -306,33 +307,64 @@ class Javelin:
                 "first fix failed (no path gives a UE inside the tunnel): open-sky fix kept"
             )
             return None
-        _, j, st.x, st.P, st.C = best
+        _, j, st.x, P, st.C = best
+        st.P = 0.5 * (P + P.T)
         return j
 
-    # -- Algorithm 4 --------------------------------------------------------------------------
-    def step(
-        self, paths: PathMeasurements | None, speed: float | None, heading: float | None, dt: float
-    ) -> StepReport:
-        """One epoch: predict with (speed, heading) over ``dt``, associate, manage, update."""
-        cfg, roles = self.config, self.design
+    # -- Algorithm 4: the tracking protocol (predict, update; step does both) ----------------
+    @property
+    def x(self) -> np.ndarray:
+        """The state: the UE's position, then every virtual UE's (3 each) [m]."""
+        return self.state.x
+
+    @property
+    def P(self) -> np.ndarray:
+        """The state's covariance [m^2]."""
+        return self.state.P
+
+    def predict(self, speed: float | None, heading: float | None, dt: float) -> None:
+        """Predict (eq. 62-63) with the V2X message (``speed`` [m/s], ``heading`` [rad]; None
+        or NaN: missing, the last one reused with a larger speed noise) over ``dt`` [s]."""
         dt = step_seconds("dt", dt)
         optional_real("speed", speed), optional_real("heading", heading)
         if speed is not None and np.isfinite(speed):  # NaN: the message is missing
             speeds("speed", speed)
         faults: list[str] = []
-        meas = self._paths(paths, faults)
         nu, theta, sig_nu = self._motion(speed, heading, faults)
-        meas, n_clutter = self._prefilter(meas, nu if sig_nu is None else None)
-        used = None
-        if self.k == 0 and getattr(roles.initiator, "acquire", False) and len(meas):
-            used = self._acquire(meas, faults)
-        # Predict (eq. 62-63)
-        st = self.state
+        st, roles = self.state, self.design
         st.x, st.P = predict(
-            st, nu, theta, dt, cfg, vue_motion=roles.vue_motion.name, sigma_speed=sig_nu
+            st, nu, theta, dt, self.config, vue_motion=roles.vue_motion.name, sigma_speed=sig_nu
         )
         if st.C is not None:  # F = I: the cross-covariance only decays with the biases
             st.C = st.C * roles.noise.decay(dt)
+        self._predicted = (nu, theta, sig_nu, faults)
+
+    def step(
+        self, paths: PathMeasurements | None, speed: float | None, heading: float | None, dt: float
+    ) -> StepReport:
+        """One epoch: :meth:`predict` with (speed, heading) over ``dt``, then :meth:`update`."""
+        self.predict(speed, heading, dt)
+        return self._update(paths)
+
+    def update(self, paths: PathMeasurements | None) -> StepReport:
+        """Associate (Algorithm 2), manage tracks (Algorithm 3) and update (eq. 64-68) with the
+        epoch's paths (None: predict only). The first epoch of a design whose initiator
+        acquires starts with the first fix (:meth:`_acquire`). Without a :meth:`predict` since
+        the last update, the motion is unknown (the Doppler pre-filter and the VUE births then
+        go without the UE's velocity)."""
+        return self._update(paths)
+
+    def _update(self, paths) -> StepReport:  # warnings point at the caller of update or step
+        cfg, roles = self.config, self.design
+        nu, theta, sig_nu, faults = self._predicted or (None, None, None, [])
+        self._predicted = None
+        meas = self._paths(paths, faults)
+        known = nu is not None and sig_nu is None
+        meas, n_clutter = self._prefilter(meas, nu if known else None)
+        used = None
+        if self.k == 0 and getattr(roles.initiator, "acquire", False) and len(meas):
+            used = self._acquire(meas, faults)
+        st = self.state
         prior_pos, prior_ids = st.positions(), list(st.ids)
         prior_cov = [st.P[track_slice(i), track_slice(i)].copy() for i in range(st.n_tracks)]
         costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
@@ -353,7 +385,7 @@ class Javelin:
             if used is not None:  # the first fix chose the UE's path (no VUE exists yet)
                 assoc = [(0, used)]
             # ManageTracks (Algorithm 3)
-            v_u = ue_velocity(nu, theta) if sig_nu is None else None
+            v_u = ue_velocity(nu, theta) if known else None
             mres = manage_tracks(st, meas, assoc, cfg, v_u, initiator=roles.initiator, noise=noise)
             # Update (eq. 64-68); the first fix's path has been used (counted once)
             if used is not None:
@@ -384,7 +416,7 @@ class Javelin:
             # every VUE missed this epoch
             mres = manage_tracks(st, meas, [], cfg, initiator=roles.initiator, noise=roles.noise)
         for f in faults:
-            warnings.warn(f"epoch {self.k}: {f}", JavelinWarning, stacklevel=2)
+            warnings.warn(f"epoch {self.k}: {f}", JavelinWarning, stacklevel=3)
         # the report holds what the step computed (checked at its boundary): built unchecked
         rep = unchecked(
             StepReport,

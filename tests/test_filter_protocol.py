@@ -1,0 +1,110 @@
+"""Every filter follows one protocol (tunnelkit.tracking.protocol): ``predict(*inputs)``,
+``update(z)``, ``step`` = both, an inspectable ``x`` and ``P``. Checked by running twins: one
+steps, the other predicts then updates; their states agree bit for bit at every epoch."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from tunnelkit import doppler_drive as dv
+from tunnelkit.tracking import Filter, registry
+from tunnelkit.tracking import virtual_station as vs
+from tunnelkit.tracking.doppler import DopplerEKF, DopplerSetup, RangeKF, SpeedKF
+
+EPOCHS = 8
+
+
+def _same(a, b):
+    np.testing.assert_array_equal(np.asarray(a.x), np.asarray(b.x))
+    np.testing.assert_array_equal(np.asarray(a.P), np.asarray(b.P))
+
+
+@pytest.mark.parametrize("name", list(registry.family("jiang2023")))
+def test_jiang_filters(name):
+    exp = vs.experiment("jiang2023-straight", level=2)
+    Z = exp.model.simulate(exp.truth[:EPOCHS, :2], np.random.default_rng(0), size=1)[0]
+    make = registry.get("jiang2023", name)
+    a, b = (make(exp.model, exp.truth[0], exp.P0, rng=np.random.default_rng(5)) for _ in "ab")
+    assert isinstance(a, Filter)
+    for k in range(1, EPOCHS):
+        a.step(Z[k])
+        b.predict()
+        b.update(Z[k])
+        _same(a, b)
+
+
+def _halili():
+    drive = dv.make_drive()
+    rng = np.random.default_rng(0)
+    return dv.measure(drive, rng), dv.gnss_fix(drive, rng), DopplerSetup.from_drive(drive)
+
+
+def test_halili_doppler_filters():
+    meas, fix, setup = _halili()
+    u0 = 10.0
+    for make in (
+        lambda: DopplerEKF(setup, fix, adaptive=True),
+        lambda: SpeedKF(setup, u0, adaptive=True),
+    ):
+        a, b = make(), make()
+        assert isinstance(a, Filter)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for k in range(1, 40):
+                z = None if k == 5 else meas.doppler[k]
+                a.step(z)
+                b.predict()
+                b.update(z)
+                _same(a, b)
+
+
+def test_halili_range_kf():
+    meas, fix, setup = _halili()
+    d0 = float(np.hypot(*(fix.position - setup.tx)))
+    a, b = (RangeKF(setup, d0, calibration_epochs=3) for _ in "ab")
+    assert isinstance(a, Filter) and a.x.shape == (1,) and a.P.shape == (1, 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for k in range(1, 40):
+            a.step(8.0, meas.toa[k])
+            b.predict(8.0)
+            b.update(meas.toa[k])
+            _same(a, b)
+    # the step checks its inputs before the state moves
+    x = a.x.copy()
+    with pytest.raises(ValueError, match="u"):
+        a.step(np.nan, meas.toa[1])
+    np.testing.assert_array_equal(a.x, x)
+
+
+def test_javelin():
+    from tunnelkit import simulation
+    from tunnelkit.tracking.javelin import Javelin, designs
+
+    drive = simulation.simulate_drive(
+        "italiano2026-straight", np.random.default_rng(0), condition="L", n_epochs=5
+    )
+    design = designs.ours_ml()
+    a, b = (Javelin.for_drive(drive, design) for _ in "ab")
+    assert isinstance(a, Filter)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for k, paths in enumerate(drive.epochs):
+            speed, heading = drive.speed[max(k - 1, 0)], drive.heading[max(k - 1, 0)]
+            dt = drive.dt if k else 0.0
+            ra = a.step(paths, speed, heading, dt)
+            b.predict(speed, heading, dt)
+            rb = b.update(paths)
+            _same(a, b)
+            np.testing.assert_array_equal(ra.estimate, rb.estimate)
+    # the run over the drive is these steps (the family's track)
+    np.testing.assert_array_equal(a.x[:3], Javelin.for_drive(drive, design).track(drive)[0][-1])
+    # an update without a prediction: the motion is unknown, the state did not move before it
+    c = Javelin.for_drive(drive, design)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = c.update(drive.epochs[0])
+    assert rep.k == 0 and np.all(np.isfinite(c.x))
