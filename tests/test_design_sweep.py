@@ -407,6 +407,36 @@ def test_the_bounds_lie_below_the_tracker_and_the_prediction_near_it_under_calib
     assert np.all(unit_rmse > r.settled_rms(r.pcrlb)), unit_rmse
 
 
+def test_a_serial_sweep_prepares_an_array_once_for_the_same_job(setup, monkeypatch):
+    """The sequential rule's next batch prepares the same arrays again: serially the first
+    preparation is reused (the same setup and error-model objects), and the drives come out as
+    from a fresh preparation; another setup object or other epochs prepare anew."""
+    from tunnelkit.design import montecarlo
+    from tunnelkit.design.arrayjob import ArrayJob
+
+    calls = []
+    real = ArrayJob.__call__
+
+    def counted(self, spec):
+        calls.append((spec.label, self.T))
+        return real(self, spec)
+
+    monkeypatch.setattr(ArrayJob, "__call__", counted)
+    monkeypatch.setattr(montecarlo, "_PREPARED", montecarlo.OrderedDict())
+    first = sweep_montecarlo(setup, ["4x4"], 2, 7, n_epochs=12)["4x4"]
+    again = sweep_montecarlo(setup, ["4x4"], 2, 7, n_epochs=12, first_unit=2)["4x4"]
+    assert calls == [("4x4", 12)]
+    montecarlo._PREPARED.clear()
+    fresh = sweep_montecarlo(setup, ["4x4"], 2, 7, n_epochs=12, first_unit=2)["4x4"]
+    assert calls == [("4x4", 12)] * 2
+    np.testing.assert_array_equal(again.errors, fresh.errors)
+    np.testing.assert_array_equal(again.pcrlb, first.pcrlb)
+    sweep_montecarlo(setup, ["4x4"], 2, 7, n_epochs=11)
+    other = DesignSetup.from_scenario(SCENARIO)
+    sweep_montecarlo(other, ["4x4"], 2, 7, n_epochs=12)
+    assert calls == [("4x4", 12), ("4x4", 12), ("4x4", 11), ("4x4", 12)]
+
+
 def test_a_units_drives_share_its_calibration_and_later_units_extend_the_sweep(setup):
     """Drives of one unit see one calibration draw; a sweep of 4 units is the sweep of units
     0-1 followed by the sweep of units 2-3 (``first_unit``), and a unit's first drive does not

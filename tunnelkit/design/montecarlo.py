@@ -42,6 +42,8 @@ its random draws and the tracker.
 
 from __future__ import annotations
 
+import json
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from contextlib import nullcontext
 from dataclasses import dataclass
@@ -173,6 +175,39 @@ class MonteCarloResult:
         if bound_array("bound", bound, ndim=1).shape != self.t.shape:
             raise ValueError(f"bound: expected one value per epoch {self.t.shape}")
         return float(np.sqrt(np.mean(np.asarray(bound)[self._settled()] ** 2)))
+
+
+#: arrays prepared by serial sweeps, kept for the process (the oldest dropped first)
+PREPARED_KEPT = 32
+_PREPARED: OrderedDict = OrderedDict()
+
+
+def _prepare(pool: TrialPool, job: ArrayJob, specs: list) -> list:
+    """``pool.prepare(job, specs)``; serially, an array prepared before in this process by an
+    equal job (the same setup and error-model objects, mode, epochs, fallback sigmas,
+    impairments and entry fix) is that preparation again: a sweep's next batch of units
+    (:func:`tunnelkit.design.report.design_sweep`'s sequential rule) prepares the same arrays,
+    and the preparation draws nothing at random (the drives only read it). At most
+    :data:`PREPARED_KEPT` are kept; on a cluster every sweep prepares its arrays."""
+    if pool.parallel:
+        return pool.prepare(job, specs, desc="design arrays")
+    head = (id(job.setup), id(job.error_models), job.mode, job.T, job.with_model,
+            json.dumps(job.crlbs, sort_keys=True, default=repr), repr(job.impairments),
+            job.start_sigma)  # fmt: skip
+    out, todo = {}, []
+    for spec in specs:
+        kept = _PREPARED.get((head, spec.label))
+        if kept is not None and kept[0] is job.setup and kept[1] is job.error_models:
+            _PREPARED.move_to_end((head, spec.label))
+            out[spec.label] = kept[2]
+        else:
+            todo.append(spec)
+    for spec, prep in zip(todo, pool.prepare(job, todo, desc="design arrays"), strict=True):
+        _PREPARED[(head, spec.label)] = (job.setup, job.error_models, prep)
+        out[spec.label] = prep
+    while len(_PREPARED) > PREPARED_KEPT:
+        _PREPARED.popitem(last=False)
+    return [out[spec.label] for spec in specs]
 
 
 def sweep_montecarlo(
@@ -308,7 +343,7 @@ def sweep_montecarlo(
         # depending on its array's task only (no barrier; the state goes worker to worker)
         if pool.parallel:
             pool.client.run(load_tracker)
-        handles = pool.prepare(job, [specs[a] for a in order], desc="design arrays")
+        handles = _prepare(pool, job, [specs[a] for a in order])
         prepared = [handles[order.index(a)] for a in range(A)]
         n_units = runs // drives_per_unit
         # each drive gets its unit's seed and makes its own generator: the same calibration

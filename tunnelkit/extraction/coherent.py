@@ -47,7 +47,8 @@ from ..constants import C
 from .decomposition import check_tensor, cp_rel_error, normalize_factors
 from .estimates import PathEstimates, path_estimates
 from .numerics import (
-    damped_step_unchecked,
+    damped_solve_unchecked,
+    damped_system_unchecked,
     free_newton_unchecked,
     scan_peak,
     solve_unchecked,
@@ -175,27 +176,30 @@ def _fit_sources(b, theta0, p, fc, max_nfev=40):
     th = project(th)
     cur = evaluate(th)
     lam = 1e-3
+    system = None  # the damped system at the current point, kept while a step is rejected
     for _ in range(max_nfev):
         S, dpsi, G, g, r, cost = cur
-        D = (1j * dpsi * (S * g[None, :])[..., None]).reshape(m, 3 * n)
-        DS = D.conj().T @ S
-        A = (D.conj().T @ D - DS @ solve_unchecked(G, DS.conj().T)).real
-        grad = (D.conj().T @ r).real
-        lower = np.zeros((n, 3), bool)
-        lower[:, 2] = th[:, 2] <= 1 / KAPPA_MAX
-        upper = np.zeros((n, 3), bool)
-        upper[:, 2] = th[:, 2] >= 1 / KAPPA_MIN
-        free, dec = free_newton_unchecked(A, grad, lower.ravel(), upper.ravel())
-        if dec <= 1e-6 * cost + 1e-14 * b2:
-            break  # the full Gauss-Newton step would gain less than ftol = 1e-6
-        step = damped_step_unchecked(A, grad, free, lam)
+        if system is None:
+            D = (1j * dpsi * (S * g[None, :])[..., None]).reshape(m, 3 * n)
+            DS = D.conj().T @ S
+            A = (D.conj().T @ D - DS @ solve_unchecked(G, DS.conj().T)).real
+            grad = (D.conj().T @ r).real
+            lower = np.zeros((n, 3), bool)
+            lower[:, 2] = th[:, 2] <= 1 / KAPPA_MAX
+            upper = np.zeros((n, 3), bool)
+            upper[:, 2] = th[:, 2] >= 1 / KAPPA_MIN
+            free, dec = free_newton_unchecked(A, grad, lower.ravel(), upper.ravel())
+            if dec <= 1e-6 * cost + 1e-14 * b2:
+                break  # the full Gauss-Newton step would gain less than ftol = 1e-6
+            system = damped_system_unchecked(A, grad, free)
+        step = damped_solve_unchecked(system, lam)
         if step is None:
             lam *= 4.0
             continue
         th_new = project(th + step.reshape(n, 3))
         new = evaluate(th_new)
         if new[-1] < cost:
-            th, cur, lam = th_new, new, max(lam / 3.0, 1e-9)
+            th, cur, lam, system = th_new, new, max(lam / 3.0, 1e-9), None
         else:
             lam *= 4.0
             if lam > 1e10:

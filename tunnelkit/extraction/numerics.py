@@ -108,12 +108,17 @@ def free_newton(A, g, lower, upper) -> tuple[np.ndarray, float]:
     return free_newton_unchecked(A, g, lower, upper)
 
 
+def _free_block(A, free, every: bool):
+    """``A`` on the ``free`` coordinates (``A`` itself when ``every`` one is free)."""
+    return A if every else A[np.ix_(free, free)]
+
+
 def free_newton_unchecked(A, g, lower, upper) -> tuple[np.ndarray, float]:
     """:func:`free_newton` without the checks (the fits' inner loops, on their own arrays)."""
     free = np.ones(g.size, bool)
-    for _ in range(3):
+    for i in range(3):
         sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
-        As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+        As = sc[:, None] * _free_block(A, free, i == 0) * sc[None, :]
         gs = sc * g[free]
         newton = np.zeros(g.size)
         newton[free] = sc * np.linalg.lstsq(As, gs, rcond=1e-12)[0]
@@ -136,13 +141,25 @@ def damped_step(A, g, free, lam: float) -> np.ndarray | None:
 
 def damped_step_unchecked(A, g, free, lam: float) -> np.ndarray | None:
     """:func:`damped_step` without the checks (the fits' inner loops, on their own arrays)."""
+    return damped_solve_unchecked(damped_system_unchecked(A, g, free), lam)
+
+
+def damped_system_unchecked(A, g, free) -> tuple:
+    """The scaled system of :func:`damped_step` on the ``free`` coordinates, for
+    :func:`damped_solve_unchecked` (a fit that raises ``lam`` at the same point builds it once)."""
     sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
-    As = sc[:, None] * A[np.ix_(free, free)] * sc[None, :]
+    As = sc[:, None] * _free_block(A, free, bool(free.all())) * sc[None, :]
+    return sc, As, np.eye(As.shape[0]), sc * g[free], free
+
+
+def damped_solve_unchecked(system, lam: float) -> np.ndarray | None:
+    """:func:`damped_step` of a system of :func:`damped_system_unchecked` at damping ``lam``."""
+    sc, As, eye, gs, free = system
     try:
-        sub = sc * np.linalg.solve(As + lam * np.eye(As.shape[0]), sc * g[free])
+        sub = sc * np.linalg.solve(As + lam * eye, gs)
     except np.linalg.LinAlgError:
         return None
-    step = np.zeros(g.size)
+    step = np.zeros(free.size)
     step[free] = sub
     return step
 

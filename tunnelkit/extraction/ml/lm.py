@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._validate import finite_array, integer, positive
-from ..numerics import damped_step_unchecked, free_newton_unchecked
+from ..numerics import damped_solve_unchecked, damped_system_unchecked, free_newton_unchecked
 from .model import W_MAX, Problem, project_feasible
 
 __all__ = ["STEP_TOL", "best_of_starts", "lm_fit"]
@@ -37,17 +37,22 @@ def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict 
     state = {} if state is None else state
     ev = state.get("ev") or prob.evaluate(theta, mu_f, mu_t)
     lam, it, converged = state.get("lam", 1e-3), 0, False
+    # the damped system at the current point (free set and decrement passed), kept while a
+    # rejected step leaves the point where it is (the same arrays give the same numbers)
+    newton = None
     for it in range(1, max_iter + 1):  # noqa: B007
-        lower = np.zeros((L, 5), bool)
-        lower[:, 2] = theta[:, 2] <= 0.0
-        upper = np.zeros((L, 5), bool)
-        upper[:, 2] = theta[:, 2] >= W_MAX
-        # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
-        free, dec = free_newton_unchecked(ev["A"], ev["g"], lower.ravel(), upper.ravel())
-        if dec < STEP_TOL * sigma2:
-            converged = True
-            break
-        step = damped_step_unchecked(ev["A"], ev["g"], free, lam)
+        if newton is None:
+            lower = np.zeros((L, 5), bool)
+            lower[:, 2] = theta[:, 2] <= 0.0
+            upper = np.zeros((L, 5), bool)
+            upper[:, 2] = theta[:, 2] >= W_MAX
+            # Newton decrement: the cost decrease a full Gauss-Newton step promises, in sigma^2
+            free, dec = free_newton_unchecked(ev["A"], ev["g"], lower.ravel(), upper.ravel())
+            if dec < STEP_TOL * sigma2:
+                converged = True
+                break
+            newton = damped_system_unchecked(ev["A"], ev["g"], free)
+        step = damped_solve_unchecked(newton, lam)
         if step is None:
             lam *= 4.0
             continue
@@ -58,6 +63,7 @@ def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict 
         if ev_new["cost"] < ev["cost"]:
             theta, mu_f, mu_t, ev = th_new, mf_new, mt_new, ev_new
             lam = max(lam / 3.0, 1e-9)
+            newton = None
         else:
             lam *= 4.0
             if lam > 1e10:

@@ -66,7 +66,8 @@ class Problem:
         H = check_tensor(H)
         self.H = H
         self.M, self.nf, self.nt = H.shape
-        self.Hp = np.ascontiguousarray(H.transpose(0, 2, 1)).reshape(self.M * self.nt, self.nf)
+        # H as (M Nt) x Nf, conjugated: the contraction's BLAS product (:meth:`_contract`)
+        self.Hpc = np.conj(H.transpose(0, 2, 1)).reshape(self.M * self.nt, self.nf)
         self.pos = check_element_positions("element_positions", element_positions, m=self.M)
         self.k0 = 2 * np.pi * carrier("fc", fc) / C
         self.s = np.arange(self.nf, dtype=float)[:, None]
@@ -83,9 +84,9 @@ class Problem:
         derivatives = boolean("derivatives", derivatives)
         L = theta.shape[0]
         psi, dx, dy, dw = spatial_phase_unchecked(theta, self.pos, self.k0)
-        a = np.exp(1j * psi)
-        F = np.exp(1j * self.s * mu_f[None, :])
-        T = np.exp(1j * self.kk * mu_t[None, :])
+        a = unit_phasors(psi)
+        F = unit_phasors(self.s * mu_f[None, :])
+        T = unit_phasors(self.kk * mu_t[None, :])
         if not derivatives:
             b = np.einsum("ml,ml->l", a.conj(), self._contract(T, F))
             G = (a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T)
@@ -99,22 +100,23 @@ class Problem:
         X = np.concatenate([a, np.stack([ax, ay, aw, a, a], axis=2).reshape(self.M, 5 * L)], 1)
         Y = np.concatenate([F, np.stack([F, F, F, sF, F], axis=2).reshape(self.nf, 5 * L)], 1)
         Z = np.concatenate([T, np.stack([T, T, T, T, kT], axis=2).reshape(self.nt, 5 * L)], 1)
+        Gram = (X.conj().T @ X) * (Y.conj().T @ Y) * (Z.conj().T @ Z)
+        ac = a.conj()
         P = np.concatenate(
             [
-                np.sum(a.conj() * W_ft, 0),
+                np.sum(ac * W_ft, 0),
                 np.stack(
                     [
                         np.sum(ax.conj() * W_ft, 0),
                         np.sum(ay.conj() * W_ft, 0),
                         np.sum(aw.conj() * W_ft, 0),
-                        np.sum(a.conj() * W_sft, 0),
-                        np.sum(a.conj() * W_fkt, 0),
+                        np.sum(ac * W_sft, 0),
+                        np.sum(ac * W_fkt, 0),
                     ],
                     axis=1,
                 ).ravel(),
             ]
         )
-        Gram = (X.conj().T @ X) * (Y.conj().T @ Y) * (Z.conj().T @ Z)
         G, b = Gram[:L, :L], P[:L]
         c, cost = self._gains(G, b)
         cd = np.repeat(c, 5)  # the gain of each derivative atom's path
@@ -126,17 +128,17 @@ class Problem:
 
     def _contract(self, T, F, sF=None, kT=None):
         """``W[m, l] = sum_{s,k} H[m, s, k] conj(F[s, l] T[k, l])`` (M, L); with ``sF`` and ``kT``
-        also the same with ``sF`` for ``F`` and with ``kT`` for ``T``. ``H``, stored once as
-        (M Nt) x Nf, meets the frequency vectors first (one BLAS product with a long inner
-        dimension), then each path its time vectors (small)."""
+        also the same with ``sF`` for ``F`` and with ``kT`` for ``T``. ``H``, stored once
+        conjugated as (M Nt) x Nf, meets the frequency vectors first (one BLAS product with a
+        long inner dimension, ``conj(W)`` exactly), then each path its time vectors (small)."""
         L = T.shape[1]
         if kT is None:
-            Hf = (self.Hp @ F.conj()).reshape(self.M, self.nt, L)
-            return np.einsum("mkl,kl->ml", Hf, T.conj())
-        Hf = (self.Hp @ np.concatenate([F, sF], axis=1).conj()).reshape(self.M, self.nt, 2 * L)
-        W_ft = np.einsum("mkl,kl->ml", Hf[:, :, :L], T.conj())
-        W_sft = np.einsum("mkl,kl->ml", Hf[:, :, L:], T.conj())
-        W_fkt = np.einsum("mkl,kl->ml", Hf[:, :, :L], kT.conj())
+            Hf = (self.Hpc @ F).reshape(self.M, self.nt, L)
+            return np.einsum("mkl,kl->ml", Hf, T).conj()
+        Hf = (self.Hpc @ np.concatenate([F, sF], axis=1)).reshape(self.M, self.nt, 2 * L)
+        W_ft = np.einsum("mkl,kl->ml", Hf[:, :, :L], T).conj()
+        W_sft = np.einsum("mkl,kl->ml", Hf[:, :, L:], T).conj()
+        W_fkt = np.einsum("mkl,kl->ml", Hf[:, :, :L], kT).conj()
         return W_ft, W_sft, W_fkt
 
     def model(self, theta, mu_f, mu_t, c) -> np.ndarray:
@@ -156,6 +158,16 @@ class Problem:
     def noise_floor(self, n_paths: int) -> float:
         """:func:`noise_floor` of this problem's tensor."""
         return _noise_floor(self.H, integer("n_paths", n_paths, minimum=0))
+
+
+def unit_phasors(phase) -> np.ndarray:
+    """``exp(1j * phase)`` for a real array ``phase``, from its cosine and sine (what the complex
+    exponential of a purely imaginary argument computes, bit for bit, without its exponential)."""
+    out = np.empty(phase.shape, complex)
+    parts = out.view(float).reshape(*phase.shape, 2)
+    np.cos(phase, out=parts[..., 0])
+    np.sin(phase, out=parts[..., 1])
+    return out
 
 
 def _solve_gains(G, b, h2):
