@@ -1,7 +1,7 @@
 """The attribution study: the tracer's switches, the one-epoch fix, and a tiny traced case.
 
 The traced case needs the ``rt`` extra (``make test`` installs it) and fails without it unless
-``TUNNELKIT_SKIP_RT=1``: a 3 x 3 array, two epochs, 2,000 rays, no noisy draws.
+``TUNNELKIT_SKIP_RT=1``: a 4 x 4 array, two epochs, 2,000 rays, no noisy draws.
 """
 
 from __future__ import annotations
@@ -84,7 +84,7 @@ def test_the_fix_of_the_true_paths_is_the_truth_and_a_bias_moves_it():
 @needs_sionna
 def test_a_clean_traced_channel_is_eq1_and_diffuse_power_is_a_residual(tmp_path):
     res = attribution(
-        arrays=[(3, 3)],
+        arrays=[(4, 4)],
         configs=["first-order-centre", "diffuse-alone", "all-off"],
         epochs=[10, 20],
         draws=0,
@@ -95,13 +95,15 @@ def test_a_clean_traced_channel_is_eq1_and_diffuse_power_is_a_residual(tmp_path)
     rows = {(r.config, r.kind): r for r in res.rows}
     assert summ["eq1"].residual_share < 1e-12
     assert rows["eq1", "all"].bias_d_m < 1e-6
-    # all mechanisms off: the traced tensor is eq. 1 with the spatial-wideband term, and eq. 1's
-    # fit of it lands where its fit of the image method's wideband tensor lands
+    # all mechanisms off: at this small aperture the traced tensor is eq. 1 with the
+    # spatial-wideband term (at 8 x 8 the centroid also sees the second ceiling facet's path,
+    # which the image method does not list), and eq. 1's fit of it lands where its fit of the
+    # image method's wideband tensor lands
     assert summ["all-off"].residual_share < 1e-3
     for kind in ("los", "ceiling", "road"):
         off, wb = rows["all-off", kind], rows["eq1+wideband", kind]
-        assert abs(off.bias_d_m - wb.bias_d_m) < 0.03, kind
-        assert off.bias_phi_deg < 1.0, kind
+        assert abs(off.bias_d_m - wb.bias_d_m) < 0.05, kind
+        assert off.bias_phi_deg < 0.5 and off.bias_d_m < 0.1, kind
     # diffuse scattering switched on (and nothing else): more residual, by orders of magnitude
     assert summ["diffuse-alone"].diffuse_share > 1e-3
     assert summ["diffuse-alone"].residual_share > 10 * summ["first-order-centre"].residual_share
@@ -112,5 +114,5 @@ def test_a_clean_traced_channel_is_eq1_and_diffuse_power_is_a_residual(tmp_path)
         "diffuse-alone",
         "all-off",
     }
-    assert "| all-off | 3x3 | los |" in res.markdown()
+    assert "| all-off | 4x4 | los |" in res.markdown()
     assert dataclasses.asdict(res.summary[0])["config"] == "eq1"
