@@ -563,6 +563,12 @@ _RAYTRACING = Table(
         ),
         _s("rrm_material", "material of the road markings", choices=_RT_MATERIALS, default="metal"),
         _s("antenna_pattern", "element pattern", choices=("iso", "tr38901"), default="iso"),
+        _s(
+            "array_tracing",
+            "how the array is traced: one receiver per element, or one ray set at the centroid",
+            choices=("element", "centre", "synthetic"),
+            default="element",
+        ),
     ),
     "the ray-traced channel (Sionna RT, `--channel sionna`): materials, diffuse scattering, depth",
 )

@@ -459,7 +459,7 @@ def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     tunnels = [route.tunnel] if any(CONDITIONS[c].rrms for c in conditions) else []
     if not all(CONDITIONS[c].rrms for c in conditions):
         tunnels.append(route.tunnel.without_plates())
-    info = {"rt_settings": dict(vars(route.raytraced.settings))}
+    info = {"rt_settings": route.raytraced.settings.record()}
     for tun in tunnels:
         st = route.raytraced.prepare(tun, range(T), progress=progress)
         var = route.raytraced.variant(tun)

@@ -20,6 +20,17 @@ plates and blockers. ``max_depth`` is the number of bounces traced (2: second-or
 paths and diffuse paths of up to two interactions). ``samples_per_src`` is the number of rays
 shot from the vehicle (Fibonacci directions); the diffuse power is a Monte-Carlo estimate over
 them.
+
+``array_tracing`` says how the array is traced: ``"element"`` (the default) traces every element
+as its own receiver, so each element gets its own ray set (its own delays, and its own cut-offs
+where a specular point leaves a plate or a facet across the aperture); ``"centre"`` traces one
+receiver at the array's centroid and carries each of its paths to every element as a spherical
+wave from the path's unfolded source (centroid + path length along the arrival direction): every
+element sees the same paths, with the spherical wavefront and the per-element delay (the
+spatial-wideband term) kept; ``"synthetic"`` is Sionna's synthetic array (one ray set at the
+centroid, a plane-wave phase per element, the same delay at every element): no curvature and no
+spatial-wideband term either. The last two are study switches (what per-element tracing costs
+eq. 1's fit), not a better channel.
 """
 
 from __future__ import annotations
@@ -32,6 +43,7 @@ from .._validate import choice, instance, integer, nonnegative, text
 
 __all__ = [
     "ANTENNA_PATTERNS",
+    "ARRAY_TRACING",
     "MATERIALS",
     "SCATTERING_PATTERNS",
     "RTSettings",
@@ -53,6 +65,13 @@ SCATTERING_PATTERNS = ("lambertian", "directive")
 #: element patterns (one receiver per element, oriented along the array's boresight):
 #: ``"iso"`` (isotropic, as the image method) or Sionna's ``"tr38901"`` (3GPP TR 38.901 element)
 ANTENNA_PATTERNS = ("iso", "tr38901")
+#: how the array is traced (module docstring): one receiver per element, or one ray set at the
+#: centroid carried to the elements as spherical or (Sionna's synthetic array) plane waves
+ARRAY_TRACING = ("element", "centre", "synthetic")
+#: settings added after traces and records were stored, with the value they had before: left out
+#: of :meth:`RTSettings.record` (and so of the cache key) at that value, so a cache or a record
+#: of the unchanged channel stays valid
+_LATER = {"array_tracing": "element"}
 
 
 def _material(name: str, value) -> str:
@@ -90,6 +109,7 @@ class RTSettings:
     road_material: str = "asphalt"
     rrm_material: str = "metal"
     antenna_pattern: str = "iso"
+    array_tracing: str = "element"
 
     def __post_init__(self) -> None:
         _coefficient("scattering_coefficient", self.scattering_coefficient)
@@ -101,6 +121,7 @@ class RTSettings:
         for key in ("wall_material", "road_material", "rrm_material"):
             _material(key, getattr(self, key))
         choice("antenna_pattern", self.antenna_pattern, ANTENNA_PATTERNS)
+        choice("array_tracing", self.array_tracing, ARRAY_TRACING)
 
     @property
     def diffuse(self) -> bool:
@@ -121,9 +142,18 @@ class RTSettings:
         s = self.metal_scattering_coefficient if name == "metal" else self.scattering_coefficient
         return name, itu, thickness, s
 
+    def record(self) -> dict:
+        """Every setting as a dict, less those added later that hold their earlier value
+        (``_LATER``): what a stored record's provenance and :meth:`fingerprint` compare."""
+        out = asdict(self)
+        for key, old in _LATER.items():
+            if out[key] == old:
+                del out[key]
+        return out
+
     def fingerprint(self) -> str:
-        """A stable hash of every setting (part of the ray-tracing cache key)."""
-        return hashlib.sha256(json.dumps(asdict(self), sort_keys=True).encode()).hexdigest()
+        """A stable hash of every setting (:meth:`record`; part of the ray-tracing cache key)."""
+        return hashlib.sha256(json.dumps(self.record(), sort_keys=True).encode()).hexdigest()
 
     @classmethod
     def from_scenario(cls, scenario, **overrides) -> RTSettings:

@@ -34,7 +34,9 @@ shapes the materials, scattering coefficients and lobe of a
 along the array's boresight); :meth:`SionnaEngine.trace_elements` then returns everything Sionna
 traces up to ``max_depth`` (LoS, specular of any order, diffuse) as an
 :class:`~tunnelkit.rt.elements.ElementPaths`, which :mod:`tunnelkit.rt.cache` turns into eq. 1's
-tensor.
+tensor. With the settings' ``array_tracing`` other than ``"element"`` it traces one receiver at the
+array's centroid instead and carries that ray set to every element (:func:`_carry`: spherical
+waves from each path's unfolded source, or Sionna's synthetic array's plane-wave phases).
 """
 
 from __future__ import annotations
@@ -102,6 +104,22 @@ class _RawPaths:
 
 def _p3(kind, v):
     return kind(*(float(x) for x in v))
+
+
+def _carry(tau, a, u, offsets, fc: float, how: str) -> tuple[np.ndarray, np.ndarray]:
+    """One ray set traced at the array's centroid (delays ``tau`` (P,), coefficients ``a`` (P,)
+    without the carrier phase, arrival directions ``u`` (P, 3)) carried to the elements at
+    ``offsets`` (M, 3) from the centroid: ``(tau (M, P), a (M, P))``. ``"centre"``: a spherical
+    wave from each path's unfolded source ``c tau u`` (the element's own distance to it as its
+    delay, the coefficient unchanged); ``"synthetic"``: Sionna's synthetic array, the same delay
+    at every element and the plane-wave phase ``exp(+j k0 u . offset)`` (the element nearer the
+    source by ``u . offset`` sees the carrier earlier)."""
+    src = C * tau[:, None] * u  # (P, 3) unfolded sources, from the centroid
+    if how == "centre":
+        tau_m = np.linalg.norm(src[None] - offsets[:, None], axis=-1) / C
+        return tau_m, np.broadcast_to(a, tau_m.shape).copy()
+    phase = np.exp(2j * np.pi * fc / C * (offsets @ u.T))  # (M, P)
+    return np.broadcast_to(tau, phase.shape).copy(), a[None] * phase
 
 
 class SionnaEngine:
@@ -231,10 +249,12 @@ class SionnaEngine:
         vel = vector("ue_velocity", ue_velocity, 3)
         if self.tunnel is not None:
             ue = self.tunnel.require_inside("ue", ue)
-        self._place(array, ue, vel)
+        per_element = st.array_tracing == "element"
+        centre = array.world.mean(axis=0)
+        self._place(array, ue, vel, None if per_element else centre[None])
         b = array.boresight
         yaw, pitch = float(np.arctan2(b[1], b[0])), float(-np.arcsin(np.clip(b[2], -1, 1)))
-        for m in range(array.M):
+        for m in range(self._n_rx):
             self.scene.get(f"ant-{m}").orientation = mi.Point3f(yaw, pitch, 0.0)
         p = self._solver(
             self.scene,
@@ -256,14 +276,27 @@ class SionnaEngine:
         tau = sq(p.tau).astype(float)
         inter = np.asarray(p.interactions.numpy())[:, :, 0, 0, 0]  # (depth, M, P)
         valid = sq(p.valid).astype(bool)
+        a = sq(ar) + 1j * sq(ai)
+        doppler = sq(p.doppler).astype(float)
+        order = np.sum(inter != InteractionType.NONE, axis=0)
+        diffuse = np.any(inter == InteractionType.DIFFUSE, axis=0)
+        first = np.asarray(p.objects.numpy())[0, :, 0, 0, 0].astype(np.int64)
+        if not per_element:  # one ray set at the centroid, carried to every element
+            th, ph = sq(p.theta_r).astype(float)[0], sq(p.phi_r).astype(float)[0]
+            u = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1)
+            tau, a = _carry(tau[0], a[0], u, array.world - centre, self.fc, st.array_tracing)
+            M = array.M
+            valid, doppler, order, diffuse, first = (
+                np.repeat(x[:1], M, axis=0) for x in (valid, doppler, order, diffuse, first)
+            )
         return ElementPaths(
             tau=tau,
-            gain=(sq(ar) + 1j * sq(ai)) * np.exp(-2j * np.pi * self.fc * tau),
-            doppler=sq(p.doppler).astype(float),
+            gain=a * np.exp(-2j * np.pi * self.fc * tau),
+            doppler=doppler,
             valid=valid,
-            order=np.sum(inter != InteractionType.NONE, axis=0),
-            diffuse=np.any(inter == InteractionType.DIFFUSE, axis=0),
-            first_object=np.asarray(p.objects.numpy())[0, :, 0, 0, 0].astype(np.int64),
+            order=order,
+            diffuse=diffuse,
+            first_object=first,
         )
 
     def surface_of(self, object_id: int) -> tuple[str, str]:
@@ -276,7 +309,9 @@ class SionnaEngine:
         return self._surface_by_id.get(int(object_id), (str(object_id), "surface"))
 
     # --- devices ------------------------------------------------------------------------------
-    def _place(self, array: ArrayGeometry, ue: np.ndarray, vel: np.ndarray) -> None:
+    def _place(self, array: ArrayGeometry, ue: np.ndarray, vel: np.ndarray, points=None) -> None:
+        """The UE as the transmitter and one receiver per element of ``array`` (or per row of
+        ``points`` (n, 3), world positions)."""
         import mitsuba as mi
         import sionna.rt as srt
 
@@ -288,16 +323,17 @@ class SionnaEngine:
         tx = sc.get("ue")
         tx.position = _p3(mi.Point3f, ue)
         tx.velocity = _p3(mi.Vector3f, vel)
-        world = array.world
-        while self._n_rx > array.M:
+        world = array.world if points is None else np.atleast_2d(points)
+        n = world.shape[0]
+        while self._n_rx > n:
             self._n_rx -= 1
             sc.remove(f"ant-{self._n_rx}")
-        for m in range(array.M):
+        for m in range(n):
             if m >= self._n_rx:
                 sc.add(srt.Receiver(f"ant-{m}", position=_p3(mi.Point3f, world[m])))
             else:
                 sc.get(f"ant-{m}").position = _p3(mi.Point3f, world[m])
-        self._n_rx = array.M
+        self._n_rx = n
 
     def _solve(self) -> _RawPaths:
         from sionna.rt.constants import InteractionType

@@ -115,7 +115,7 @@ def scene_provenance(route=None) -> dict:
     if route.raytraced is None:
         raise ValueError("route: expected a route on the ray-traced channel (channel='sionna')")
     return {
-        "rt_settings": dict(vars(route.raytraced.settings)),
+        "rt_settings": route.raytraced.settings.record(),
         "rt_key": route.raytraced.key(),
     }
 

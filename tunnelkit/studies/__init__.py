@@ -9,7 +9,10 @@ core never imports it (``tests/test_layout.py``):
 - :mod:`.traced_bound` — the posterior CRLB of a drive at the traced sigmas, beside the traced
   JAVELIN RMSEs;
 - :mod:`.misspecified` — the misspecified-model bound: the pseudo-true paths of a channel that
-  eq. 1 does not describe and the sandwich bound around them (notebook 07).
+  eq. 1 does not describe and the sandwich bound around them (notebook 07);
+- :mod:`.attribution` — what eq. 1 misses on the traced channel: each mechanism of the ray
+  tracer switched off in turn, its pseudo-true bias, extraction error and position cost
+  (``docs/results/traced-attribution.md``).
 
 The papers' tables (``tunnelkit reproduce``) are :mod:`tunnelkit.reproduce`, the other package of
 this layer.
