@@ -255,13 +255,18 @@ def test_start_sigma_reaches_the_json_and_the_table(capsys):
     assert main([*argv, "--start-sigma", "0.05", "--format", "json"]) == 0
     fine = json.loads(capsys.readouterr().out)
     assert fine["inputs"]["start_sigma_m"] == 0.05
-    assert main([*argv, "--format", "json"]) == 0
+    assert main([*argv, "--no-dead-reckoning", "--format", "json"]) == 0
     wide = json.loads(capsys.readouterr().out)
-    assert "start_sigma_m" not in wide["inputs"]
+    assert "start_sigma_m" not in wide["inputs"] and "dead_reckoning" not in wide["inputs"]
+    assert "dead_reckoning_p90_m" not in wide["arrays"][0]
     b = [r["arrays"][0]["pcrlb_rms_m"] for r in (fine, wide)]
     assert b[0] < b[1]  # the bounds' prior follows the entry fix
     assert main([*argv, "--start-sigma", "0.05"]) == 0
     assert "entry fix 0.05 m per axis" in capsys.readouterr().out
-    assert main([*argv, "--dead-reckoning", "--format", "json"]) == 0
+    assert main([*argv, "--format", "json"]) == 0  # dead reckoning on by default
     dr = json.loads(capsys.readouterr().out)
     assert dr["inputs"]["dead_reckoning"] is True and dr["arrays"][0]["dead_reckoning_p90_m"] > 0
+    assert dr["arrays"][0]["pcrlb_rms_m"] == wide["arrays"][0]["pcrlb_rms_m"]
+    # without the Monte-Carlo (no --units) there is no drive to reckon: nothing recorded
+    assert main([*argv[:4], "--format", "json"]) == 0
+    assert "dead_reckoning" not in json.loads(capsys.readouterr().out)["inputs"]

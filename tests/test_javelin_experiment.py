@@ -77,7 +77,9 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     cols, rows = table_rows(routes, "italiano2026_table1")
     assert cols == ["configuration", "metric", *(c[0] for c in COLUMNS), "paper"]
     at = {(r[0], r[1]): r for r in rows}
-    assert [r[0] for r in rows[::3]] == ["JAVELIN-L", "JAVELIN-N", "TeNFiLoc-L"]  # paper's order
+    assert [r[0] for r in rows[::3]] == [
+        "JAVELIN-L", "JAVELIN-N", "TeNFiLoc-L", "dead reckoning-L", "dead reckoning-N"
+    ]  # the paper's order, then the baselines  # fmt: skip
     row = at[("JAVELIN-L", "rmse_2d_m")]
     assert row[-1] == pytest.approx(0.20)
     assert row[2] == pytest.approx(
@@ -110,6 +112,34 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     assert [r[1] for r in arows2[-3:]] == pytest.approx(row[3:6])
     with pytest.raises(ValueError, match=r"^method"):
         ex.evaluate(drives["L"][0], method="UKF")
+
+
+def test_dead_reckoning_rows_drop_every_measurement_and_give_the_radio_s_gain():
+    """Each condition's baseline row: the column's JAVELIN on the same drive, start and V2X
+    messages with every measurement dropped; it does not depend on what the radio measured,
+    and the report's gain is its RMSE over JAVELIN's."""
+    from dataclasses import replace
+
+    from tunnelkit.reproduce.javelin_tables import DEAD_RECKONING, radio_gains
+
+    drive = _fake_drive("L")
+    routes = {"paper": {"L": [drive]}, "ml": {"L": [drive]}}
+    cols, rows = table_rows(routes, "italiano2026_table1")
+    at = {(r[0], r[1]): r for r in rows}
+    dr = at[(f"{DEAD_RECKONING}-L", "rmse_2d_m")]
+    alone = replace(drive, epochs=[None] * len(drive.epochs))
+    assert dr[2] == pytest.approx(ex.evaluate(alone, designs.paper()).metrics["rmse_2d_m"])
+    assert dr[-1] is None  # the paper shows no dead reckoning
+    # the radio's measurements do not reach it: other measurements, the same baseline
+    other = replace(drive, epochs=_fake_drive("L", seed=9).epochs)
+    _, rows2 = table_rows({"paper": {"L": [other]}}, "italiano2026_table1")
+    assert {(r[0], r[1]): r for r in rows2}[(f"{DEAD_RECKONING}-L", "rmse_2d_m")][2] == dr[2]
+    gains = radio_gains(cols, rows)
+    jav = at[("JAVELIN-L", "rmse_2d_m")]
+    assert set(gains) == {"JAVELIN-L"}
+    for label, v, b in zip(cols[2:-1], jav[2:-1], dr[2:-1], strict=True):
+        assert gains["JAVELIN-L"][label] == pytest.approx(b / v)
+    assert all(np.isfinite(g) and g > 0 for g in gains["JAVELIN-L"].values())
 
 
 def test_mirror_prediction_is_exact_for_planar_vues():
@@ -241,7 +271,9 @@ def test_collect_routes_runs_through_run_trials_with_the_condition_per_child():
         "italiano2026-straight", "italiano2026_table1", ("L",), 1, 3, False, ("paper",), 1
     )
     assert rep.columns == ["configuration", "metric", "paper design, paper route", "paper"]
-    assert [r[0] for r in rep.rows] == ["JAVELIN-L"] * 3 + ["TeNFiLoc-L"] * 3
+    assert [r[0] for r in rep.rows] == ["JAVELIN-L"] * 3 + ["TeNFiLoc-L"] * 3 + [
+        "dead reckoning-L"
+    ] * 3
     assert rep.meta["extraction_failures"] == {"paper": 0} and rep.notes
 
 

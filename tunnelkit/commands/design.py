@@ -4,7 +4,7 @@
 [--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
 [--settle S] [--workers N | --scheduler A] [--mode bound|channel]
 [--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna]
-[--start-sigma S] [--dead-reckoning] [--format table|json] [--plot FILE.html]``.
+[--start-sigma S] [--no-dead-reckoning] [--format table|json] [--plot FILE.html]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
 the ideal position error bound, the predicted error under the stated impairments (a first-order
@@ -354,9 +354,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     mc.add_argument(
         "--dead-reckoning",
-        action="store_true",
-        help="run each drive also with every measurement dropped (the same tracker, start and "
-        "V2X messages) and report its error beside the tracker's: what the radio adds",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="with --units: run each drive also with every measurement dropped (the same "
+        "tracker, start and V2X messages) and report its error beside the tracker's, what the "
+        "radio adds (on by default; --no-dead-reckoning leaves it out)",
     )
     from .reproduce import add_parallel_arguments
 
@@ -429,7 +431,7 @@ def main(args: argparse.Namespace) -> int:
             mode=args.mode,
             n_epochs=args.n_epochs,
             **({} if args.start_sigma is None else {"start_sigma": args.start_sigma}),
-            **({"dead_reckoning": True} if args.dead_reckoning else {}),
+            **({"dead_reckoning": True} if args.dead_reckoning and args.units else {}),
             **parallel_kwargs(args),
             progress=args.units > 0 and args.format == "table" and not args.no_progress,
         )

@@ -14,6 +14,7 @@ extraction error), and the paper's published number.
 from __future__ import annotations
 
 import functools
+from dataclasses import replace
 
 import numpy as np
 
@@ -28,10 +29,12 @@ from . import Report, register
 
 __all__ = [
     "COLUMNS",
+    "DEAD_RECKONING",
     "NOTES",
     "collect_drives",
     "collect_routes",
     "javelin_table",
+    "radio_gains",
     "score_drive",
     "seed_note",
     "table_columns",
@@ -39,6 +42,10 @@ __all__ = [
 ]
 
 _METRICS = ("rmse_2d_m", "mae_2d_m", "y_mae_m")
+
+#: the baseline row of every condition: the column's tracker on the same V2X speed and heading
+#: messages, from the same start, with every radio measurement dropped (predict only)
+DEAD_RECKONING = "dead reckoning"
 
 #: the table's columns: (label, measurement route, design); a design is a name of :func:`_designs`
 COLUMNS: tuple[tuple[str, str, str], ...] = (
@@ -92,7 +99,9 @@ def score_drive(
     """One drive of condition ``cond``, measured through each route (``{route: DriveData}``),
     scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
     column's design; TeNFiLoc (no design of its own) on LoS drives, in the paper design's
-    columns. Each (route, method, design) is evaluated once. Draws no random numbers."""
+    columns; dead reckoning (:data:`DEAD_RECKONING`: the column's JAVELIN, start and V2X
+    messages with every measurement dropped) in every column, the baseline the radio must beat.
+    Each (route, method, design) is evaluated once. Draws no random numbers."""
     instance("drives", drives, dict, "drives per route (a dict)")
     text("cond", cond)
     sequence("columns", columns)
@@ -103,12 +112,14 @@ def score_drive(
         entries = [(f"JAVELIN-{cond}", "JAVELIN", design)]
         if cond == "L" and design == "paper":  # once per route
             entries.append(("TeNFiLoc-L", "TeNFiLoc", "none"))
+        entries.append((f"{DEAD_RECKONING}-{cond}", DEAD_RECKONING, design))
         for name, method, dname in entries:
             key = (route, method, dname)
             if key not in cache:
-                cache[key] = evaluate(
-                    drives[route], table_designs.get(dname), method=method
-                ).metrics
+                drive = drives[route]
+                if method == DEAD_RECKONING:
+                    drive, method = replace(drive, epochs=[None] * len(drive.epochs)), "JAVELIN"
+                cache[key] = evaluate(drive, table_designs.get(dname), method=method).metrics
             out[(name, label)] = cache[key]
     return out
 
@@ -337,6 +348,7 @@ def _report(
             flagged[e] += n_flag
             epochs[e] += n_ep
     cols, rows = _rows(scores, reference, columns)
+    gains = radio_gains(cols, rows)
     on = "" if channel == "image" else ", ray-traced channel (Sionna RT)"
     if length is not None:
         traj = drive_variant(scenario, length).trajectory.position
@@ -355,10 +367,12 @@ def _report(
             **({"drive_length_m": length} if length is not None else {}),
             **({"channel": channel, **rt_info} if channel != "image" else {}),
             **({"nuisance": dict(nuisance)} if nuisance else {}),
+            "radio_gain": gains,
         },
         notes=[
             *NOTES,
             seed_note(seed),
+            _gain_note(gains),
             *(_RT_NOTES if channel == "sionna" else []),
             *([_traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
             *([_nuisance_note(nuisance)] if nuisance else []),
@@ -368,6 +382,39 @@ def _report(
             + ", ".join(f"{e} {flagged[e]} of {epochs[e]}" for e in extractions)
             + ".",
         ],
+    )
+
+
+def radio_gains(columns: list[str], rows: list[list]) -> dict[str, dict[str, float | None]]:
+    """The radio's gain per JAVELIN row and column of a table (``columns``, ``rows`` as
+    :func:`table_rows` returns them): dead reckoning's 2-D RMSE over JAVELIN's on the same
+    drives (above 1 the radio helps; None where either is missing)."""
+    sequence("columns", columns), sequence("rows", rows)
+    rmse = {r[0]: r[2:-1] for r in rows if r[1] == "rmse_2d_m"}
+    out: dict[str, dict[str, float | None]] = {}
+    for name, values in rmse.items():
+        cond = name.rpartition("-")[2]
+        base = rmse.get(f"{DEAD_RECKONING}-{cond}")
+        if not name.startswith("JAVELIN-") or base is None:
+            continue
+        out[name] = {
+            label: (b / v if v and b is not None and v is not None else None)
+            for label, v, b in zip(columns[2:-1], values, base, strict=True)
+        }
+    return out
+
+
+def _gain_note(gains: dict) -> str:
+    parts = [
+        f"{name}: " + ", ".join("-" if g is None else f"{g:.2f}x" for g in by_col.values())
+        for name, by_col in gains.items()
+    ]
+    return (
+        "Dead reckoning: the column's JAVELIN on the same drives, start and V2X speed/heading "
+        "messages with every radio measurement dropped. The radio's gain (dead reckoning's "
+        "2-D RMSE / JAVELIN's, above 1 the radio helps), columns in order: "
+        + ("; ".join(parts) if parts else "none measured")
+        + "."
     )
 
 
