@@ -30,7 +30,7 @@ from tunnelkit import simulation as ex
 from tunnelkit.constants import C
 from tunnelkit.metrics import position_errors
 from tunnelkit.plots import cdf_figure, javelin_table_figure
-from tunnelkit.reproduce.javelin_tables import table_rows
+from tunnelkit.reproduce.javelin_tables import DEAD_RECKONING, radio_gains, table_rows
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.simulation import collect_routes
 from tunnelkit.tracking.javelin import designs
@@ -116,6 +116,20 @@ sl = {r[0]: dict(zip(cols2[2:], r[2:])) for r in rows2 if r[1] == "rmse_2d_m"}["
 st = {r[0]: dict(zip(cols1[2:], r[2:])) for r in rows1 if r[1] == "rmse_2d_m"}["JAVELIN-L"]
 for name, row in (("straight", st), ("slalom", sl)):
     print(f"JAVELIN-L {name:8s} 2-D RMSE [m]: " + ", ".join(f"{c} {v:.3f}" for c, v in row.items()))
+
+# %% [markdown]
+# **The baseline: dead reckoning.** A tracker has to beat what it would do without the radio. Each
+# table's `dead reckoning` rows run the column's JAVELIN on the same drives, from the same start,
+# with the same V2X speed and heading messages and every radio measurement dropped (predict only).
+# They are the same in every column: nothing a route or a design does with the radio reaches
+# them. The radio's gain is dead reckoning's 2-D RMSE over the tracker's (above 1 the radio
+# helps), per condition, in our design's column:
+
+# %%
+ours = cols1[5]  # "our design, ML route"
+gains = {t: radio_gains(c, r) for t, c, r in (("straight", cols1, rows1), ("slalom", cols2, rows2))}
+for t, by_row in gains.items():
+    print(f"{t:8s} " + ", ".join(f"{n}: {g[ours]:.2f}x" for n, g in by_row.items()))
 
 # %% [markdown]
 # ## 3. Error CDFs (Fig. 7)
@@ -470,6 +484,14 @@ assert ml_vue < ml_51  # eq. 51 does not describe the exact channel's wavefront
 assert sl[col_om] < 1.0 and sl[col_om] < sl[col_pp], sl
 assert sl[col_pv] < 1.0 and sl[col_pv] < sl[col_pp], sl
 assert abl_rows[-2][1] < abl_rows[0][1]  # the ML route with the paper's design beats the paper's
+# section 2's baseline: dead reckoning is one number per condition, the same in every column, and
+# each gain is its RMSE over the tracker's
+for c, rows in ((cols1, rows1), (cols2, rows2)):
+    base = {r[0]: r[2:-1] for r in rows if r[0].startswith(DEAD_RECKONING) and r[1] == "rmse_2d_m"}
+    assert base and all(len(set(v)) == 1 and v[0] > 0 for v in base.values()), base
+    g = radio_gains(c, rows)["JAVELIN-L"][col_om]
+    jl = {r[0]: r for r in rows if r[1] == "rmse_2d_m"}
+    assert abs(g - jl[f"{DEAD_RECKONING}-L"][5] / jl["JAVELIN-L"][5]) < 1e-12, g
 # the ablation row and the table column of the paper design + VUE on the ML route: one computation
 assert abs(abl_rows[-2][1] - ml_vue) < 1e-12
 # section 4: the plates span x = 10-30 m; RRM paths exist beyond the plates' far end and not
