@@ -159,10 +159,16 @@ def table(res: dict) -> str:
 #: the numerics' unchecked twins the fits call, per module (swapped back by :func:`checked_numerics`)
 TWINS = {
     "tunnelkit.extraction.ml.fitting": ("spatial_phase",),
-    "tunnelkit.extraction.ml.lm": ("damped_step", "free_newton"),
+    "tunnelkit.extraction.ml.lm": ("damped_solve", "damped_system", "free_newton"),
     "tunnelkit.extraction.ml.model": ("solve", "spatial_phase"),
     "tunnelkit.extraction.ml.wideband": ("solve", "spatial_phase"),
-    "tunnelkit.extraction.coherent": ("damped_step", "free_newton", "solve", "spatial_phase"),
+    "tunnelkit.extraction.coherent": (
+        "damped_solve",
+        "damped_system",
+        "free_newton",
+        "solve",
+        "spatial_phase",
+    ),
     "tunnelkit.extraction.paper": ("contract",),
 }
 

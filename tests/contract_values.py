@@ -242,6 +242,26 @@ def _studies():
     from tunnelkit.simulation.drives import drive_variant
 
     drive_variant("italiano2026-straight", 120.0)
+    # the attribution study's record (its measurement traces the scene: tests/test_attribution.py)
+    from tunnelkit.studies.attribution import Attribution, AttributionRow, ConfigSummary
+
+    row = AttributionRow("scenario", "4x4", "los", 2, *[0.1] * 8, 0, 4, *[0.2] * 8)
+    summ = ConfigSummary("scenario", "4x4", 0.04, "2 of 2", *[0.5] * 6, 1.0)
+    Attribution([row], [summ], "italiano2026-straight", ("4x4",), (0, 5), 2, 0).markdown()
+    from tunnelkit.rt import RTSettings
+    from tunnelkit.studies.attribution import config_settings, scenario_with_array
+
+    config_settings(RTSettings(), "depth-1")
+    scenario_with_array("italiano2026-straight", (4, 4))
+    from tunnelkit.signal_route import SignalRoute
+    from tunnelkit.studies.attribution import one_epoch_fix
+
+    route = SignalRoute.from_scenario("italiano2026-straight")
+    arr, paths = route.paths(10)
+    rel = np.array([p.source for p in paths]) - arr.origin
+    rng_ = np.linalg.norm(rel, axis=1)
+    phi, psi = np.arctan2(rel[:, 1], rel[:, 0]), np.arcsin(rel[:, 2] / rng_)
+    one_epoch_fix(phi, psi, rng_, paths, route.trajectory.position[10], arr.origin)
 
 
 def _doppler():

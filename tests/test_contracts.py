@@ -55,6 +55,12 @@ def _doc(target, param, kinds, reason):
 ANY = r"(tunnelkit\.)?.*"
 DOCUMENTED: tuple[Documented, ...] = (
     _doc(
+        r"studies\.attribution\.(AttributionRow|ConfigSummary)",
+        r".*_(deg|m|share|s)",
+        "nan",
+        "NaN is 'nothing measured' (no path of that kind, no noisy draw): the record's docstring",
+    ),
+    _doc(
         ANY,
         r"x|y|z|y_u|z_u|x_start|x_end|start|stop|lane|offset|x_center|y_center|origin"
         r"|x0|y_right|lane_y|tx_y",

@@ -243,3 +243,23 @@ def test_javelin_step_records_built_unchecked_are_what_the_checked_records_accep
             del Pk
     assert {"StepReport", "AssociationCosts", "ManageResult", "PathMeasurements"} <= seen
     assert "StackedMeasurement" in seen
+
+
+def test_damped_system_and_solve_are_damped_step_in_two_parts():
+    """A fit that raises the damping at the same point builds the scaled system once
+    (numerics.damped_system) and solves it per damping (damped_solve): bit for bit the step."""
+    from tunnelkit.extraction import numerics as nm
+
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(9, 5))
+    A, g = J.T @ J, rng.normal(size=5)
+    for free in (np.ones(5, bool), np.array([True, False, True, True, False])):
+        system = nm.damped_system(A, g, free)
+        for lam in (1e-3, 0.1, 10.0):
+            np.testing.assert_array_equal(
+                nm.damped_solve(system, lam), nm.damped_step(A, g, free, lam)
+            )
+    with pytest.raises(ValueError, match="lam"):
+        nm.damped_solve(system, -1.0)
+    with pytest.raises(TypeError, match="system"):
+        nm.damped_solve((A, g), 0.1)

@@ -144,6 +144,22 @@ def damped_step_unchecked(A, g, free, lam: float) -> np.ndarray | None:
     return damped_solve_unchecked(damped_system_unchecked(A, g, free), lam)
 
 
+def damped_system(A, g, free) -> tuple:
+    """The scaled system of :func:`damped_step` on the ``free`` coordinates (n,) bool, for
+    :func:`damped_solve` (checked; the fits call :func:`damped_system_unchecked`)."""
+    A = _square("A", A)
+    g = np.asarray(g)
+    _masks(g, ("A", A[0]), ("free", free))
+    return damped_system_unchecked(A, g, free)
+
+
+def damped_solve(system, lam: float) -> np.ndarray | None:
+    """:func:`damped_step` of a system of :func:`damped_system` at damping ``lam`` (checked)."""
+    if not (isinstance(system, tuple) and len(system) == 5):
+        raise TypeError("system: expected the tuple damped_system returns")
+    return damped_solve_unchecked(system, positive("lam", lam))
+
+
 def damped_system_unchecked(A, g, free) -> tuple:
     """The scaled system of :func:`damped_step` on the ``free`` coordinates, for
     :func:`damped_solve_unchecked` (a fit that raises ``lam`` at the same point builds it once)."""

@@ -19,6 +19,9 @@ from . import Report, register
 
 #: particles of the UPF in the tables (the paper does not say how many it used)
 N_PARTICLES = 500
+#: the baseline row of every noise level: the filters' constant-velocity model run from the same
+#: prior with every measurement dropped (what a filter does without the radio)
+PREDICTION_ONLY = "prediction only"
 
 
 def table_rows(
@@ -80,9 +83,15 @@ def _level_rows(
     Z, x0 = exp.simulate(runs, rng_data)
     sth_deg, sd = round(float(np.degrees(exp.model.sigma_theta)), 6), exp.model.sigma_d
     rows = []
+    runs_of = {}
     for name, r in zip(names, rng_alg):
         opts = {"n_particles": n_particles} if name == "UPF" else {}
-        est = registry.get(FAMILY, name).run(exp.model, Z, x0, exp.P0, rng=r, **opts)
+        runs_of[name] = registry.get(FAMILY, name).run(exp.model, Z, x0, exp.P0, rng=r, **opts)
+    # the baseline: the EKF's motion model from the same prior with every measurement dropped
+    runs_of[PREDICTION_ONLY] = registry.get(FAMILY, "EKF").run(
+        exp.model, np.full_like(Z, np.nan), x0, exp.P0
+    )
+    for name, est in runs_of.items():
         err = np.linalg.norm(est[..., :2] - exp.truth[:, :2], axis=-1)
         ref = paper.get((name, sth_deg, sd), {})
         rows.append(
@@ -109,6 +118,8 @@ _NOTES = [
     f"UPF: {N_PARTICLES} particles, UKF proposal conditioned on each particle, systematic resampling at "
     "ESS < N/2.",
     "rmse_over_pcrlb = sqrt(mean MSE / mean PCRLB) along the run (Tichavský 1998 recursion at the true states).",
+    f"'{PREDICTION_ONLY}': the baseline, the filters' CV model from the same prior with every "
+    "measurement dropped (the EKF predicting only); the radio's gain is its RMSE over a filter's.",
     "The paper's UPF means (0.011 m at sigma_d = 0.1 m) lie far below the measurement noise: they need a filter "
     "started at the true state with (almost) no process noise, or a mean of signed errors; see notebook 05.",
 ]

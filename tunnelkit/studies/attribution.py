@@ -37,13 +37,24 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import boolean, instance, integer, sequence
+from .._validate import (
+    boolean,
+    choice,
+    finite_array,
+    instance,
+    integer,
+    nonnegative,
+    record,
+    sequence,
+    text,
+)
 from ..constants import C
 
 __all__ = [
@@ -149,6 +160,10 @@ class AttributionRow:
     rms_kappa_m: float
     med_kappa_m: float
 
+    def __post_init__(self) -> None:  # NaN: nothing measured
+        floats = tuple(f.name for f in dataclasses.fields(self) if f.type == "float")
+        record(self, allow_nan=floats, nonnegative=(*floats, "n_bias", "far_field", "n_err"))
+
 
 @dataclass(frozen=True)
 class ConfigSummary:
@@ -170,6 +185,10 @@ class ConfigSummary:
     higher_share: float
     trace_s: float
 
+    def __post_init__(self) -> None:  # NaN: nothing measured
+        floats = tuple(f.name for f in dataclasses.fields(self) if f.type == "float")
+        record(self, allow_nan=floats, nonnegative=floats)
+
 
 @dataclass
 class Attribution:
@@ -186,6 +205,21 @@ class Attribution:
     seed: int
     settings: dict = field(default_factory=dict)
     wall_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        for i, r in enumerate(sequence("rows", self.rows)):
+            instance(f"rows[{i}]", r, AttributionRow)
+        for i, r in enumerate(sequence("summary", self.summary)):
+            instance(f"summary[{i}]", r, ConfigSummary)
+        text("scenario", self.scenario)
+        for a in sequence("arrays", self.arrays):
+            text("arrays", a)
+        for k in sequence("epochs", self.epochs):
+            integer("epochs", k, minimum=0)
+        integer("draws", self.draws, minimum=0)
+        integer("seed", self.seed, minimum=0)
+        instance("settings", self.settings, dict)
+        nonnegative("wall_s", self.wall_s)
 
     def markdown(self) -> str:
         """The two tables (summary, then per kind) as markdown."""
@@ -256,8 +290,7 @@ def config_settings(base, name: str):
     from ..rt import RTSettings
 
     instance("base", base, RTSettings)
-    if name not in CONFIGURATIONS:
-        raise ValueError(f"config: expected one of {list(CONFIGURATIONS)}, got {name!r}")
+    choice("name", name, tuple(CONFIGURATIONS))
     return dataclasses.replace(base, **CONFIGURATIONS[name][1])
 
 
@@ -300,6 +333,13 @@ def _differences(est: dict, tru: dict, rows, cols, d_offset: float = 0.0) -> np.
     )
 
 
+def _check_sigmas(sigmas) -> np.ndarray:
+    sig = finite_array("sigmas", sigmas, shape=(3,))
+    if np.any(sig <= 0):
+        raise ValueError(f"sigmas: expected three positive numbers, got {sig.tolist()}")
+    return sig
+
+
 def one_epoch_fix(phi, psi, d, paths, ue, origin, sigmas=FIX_SIGMAS) -> np.ndarray:
     """Horizontal position error (2,) [m] of the one-epoch fix (module docstring) from path
     ``j``'s world azimuth ``phi[j]``, elevation ``psi[j]`` [rad] and delay distance ``d[j]``
@@ -309,16 +349,14 @@ def one_epoch_fix(phi, psi, d, paths, ue, origin, sigmas=FIX_SIGMAS) -> np.ndarr
     ``sigmas``: (azimuth, elevation [rad], ``d`` [m]) weights. NaN with fewer than two paths."""
     from scipy.optimize import least_squares
 
-    phi, psi, d = (np.atleast_1d(np.asarray(x, float)) for x in (phi, psi, d))
+    phi, psi, d = (finite_array(k, v, ndim=1) for k, v in (("phi", phi), ("psi", psi), ("d", d)))
     paths = sequence("paths", paths, empty=True)
     if not (len(paths) == phi.size == psi.size == d.size):
         raise ValueError("phi, psi, d, paths: expected one value per path")
-    sig = np.asarray(sigmas, float)
-    if sig.shape != (3,) or np.any(sig <= 0) or not np.all(np.isfinite(sig)):
-        raise ValueError(f"sigmas: expected three positive numbers, got {sigmas!r}")
+    sig = _check_sigmas(sigmas)
     if len(paths) < 2:
         return np.full(2, np.nan)
-    ue, o = np.asarray(ue, float), np.asarray(origin, float)
+    ue, o = finite_array("ue", ue, shape=(3,)), finite_array("origin", origin, shape=(3,))
     mirror = []  # (normal, point on the plane) per path, None for the LoS
     for p in paths:
         w = p.source - p.ue
@@ -479,6 +517,9 @@ def attribution(
     draws = integer("draws", draws, minimum=0, maximum=100)
     seed = integer("seed", seed, minimum=0)
     boolean("progress", progress)
+    _check_sigmas(sigmas)
+    if cache_dir is not None and not isinstance(cache_dir, str | os.PathLike):
+        raise TypeError(f"cache_dir: expected a directory path, got {type(cache_dir).__name__}")
     shapes = [tuple(sequence("arrays", a)) for a in sequence("arrays", arrays)]
     root = Path(default_cache_dir() if cache_dir is None else cache_dir) / "attribution"
     base = RTSettings.from_scenario(sc)

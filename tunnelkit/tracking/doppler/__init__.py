@@ -40,11 +40,13 @@ The package holds three parts: :mod:`.filters` (setup, measurement model, the Ka
 
 from .approaches import (
     APPROACHES,
+    DEAD_RECKONING,
     SIGMAS,
     EkfDS,
     EkfDSKfToA,
     KfDSToA,
     Track,
+    dead_reckoning,
     error_study,
     mean_errors,
     run_approaches,
@@ -65,6 +67,7 @@ from .filters import (
 
 __all__ = [
     "APPROACHES",
+    "DEAD_RECKONING",
     "SIGMAS",
     "DopplerEKF",
     "DopplerSetup",
@@ -77,6 +80,7 @@ __all__ = [
     "SpeedKF",
     "Track",
     "cv_model",
+    "dead_reckoning",
     "doppler_jacobian",
     "doppler_model",
     "error_study",

@@ -31,11 +31,13 @@ from .filters import (
 
 __all__ = [
     "APPROACHES",
+    "DEAD_RECKONING",
     "SIGMAS",
     "EkfDS",
     "EkfDSKfToA",
     "KfDSToA",
     "Track",
+    "dead_reckoning",
     "error_study",
     "mean_errors",
     "run_approaches",
@@ -43,6 +45,8 @@ __all__ = [
 
 #: the paper's three approaches, in the order of its tables
 APPROACHES = ("EKF DS", "KF DS and ToA", "EKF DS and KF ToA")
+#: the baseline beside them (:func:`dead_reckoning`): the GNSS fix carried on at its velocity
+DEAD_RECKONING = "dead reckoning"
 
 
 @dataclass(frozen=True)
@@ -305,6 +309,21 @@ def run_approaches(
     return out
 
 
+def dead_reckoning(drive: Drive, fix: GnssFix) -> np.ndarray:
+    """Positions (T, 2) without the radio: the EKF's constant-velocity model from the GNSS fix
+    (position and velocity at the tunnel entrance), predicting only; epoch 0 is the fix itself,
+    as for the approaches. What every approach must beat on the same drive and fix."""
+    instance("drive", drive, Drive)
+    instance("fix", fix, GnssFix)
+    ekf = DopplerEKF(DopplerSetup.from_drive(drive), fix)
+    out = np.empty((len(drive.t), 2))
+    out[0] = fix.position
+    for k in range(1, len(drive.t)):
+        ekf.predict()
+        out[k] = ekf.position
+    return out
+
+
 def error_study(
     drive: Drive,
     rng: np.random.Generator,
@@ -316,7 +335,8 @@ def error_study(
 ) -> dict[tuple[str, str], np.ndarray]:
     """One noisy realisation of ``drive``, every approach at every sigma: position errors (T,) each.
 
-    Keys ``(approach, sigma label)``; all settings see the same measurements and GNSS fix.
+    Keys ``(approach, sigma label)``; all settings see the same measurements and GNSS fix. The
+    baseline, :func:`dead_reckoning` from the same fix, under ``(DEAD_RECKONING, "-")``.
     """
     if sigmas is not None and not isinstance(sigmas, Mapping):
         raise TypeError(f"sigmas: expected a mapping label -> sigma [Hz], got {sigmas!r:.40}")
@@ -328,6 +348,9 @@ def error_study(
         tracks = run_approaches(drive, meas, fix, sigma_hz=sig, q=q, approaches=approaches, **kw)
         for name, tr in tracks.items():
             out[(name, label)] = np.linalg.norm(tr.position - drive.position, axis=-1)
+    out[(DEAD_RECKONING, "-")] = np.linalg.norm(
+        dead_reckoning(drive, fix) - drive.position, axis=-1
+    )
     return out
 
 
