@@ -74,8 +74,9 @@ lint: install
 	$(VENV)/bin/ruff format --check $(LINTED)
 	$(PY) tools/check_notebooks.py notebooks
 
+# --dist loadfile: whole test files to each worker, the longest first (tests/conftest.py)
 unit: install rt-deps
-	$(PY) -m pytest -q -n 2 tests
+	$(PY) -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder tests
 
 # tools/nbmake_cache.py keeps each passing run in build/executed/, where the browser tests' site
 # build finds it: `make test` executes every notebook once

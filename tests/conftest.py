@@ -8,6 +8,31 @@ import pytest
 
 import tunnelkit as tk
 
+#: the test files that take longest (seconds of CPU, or of wall time where a test waits on a
+#: timeout, one worker, 2026-12-05): collected first, longest first, the rest after them in name
+#: order. `make unit` hands whole files to its two workers in collection order (``--dist
+#: loadfile``: a module's fixtures are built once), so no worker starts a long file while the
+#: other is finishing.
+SLOW_FIRST = (
+    "test_montecarlo_dask.py",  # 45 s: local Dask clusters, trials past their time limit
+    "test_design_traced.py",  # 35 s: the traced design, ML fits on the ray-traced channel
+    "test_contracts.py",  # 33 s: the generated contracts (suite built once, 7,000 cases)
+    "test_javelin_experiment.py",  # 17 s
+    "test_design_sweep.py",  # 17 s
+    "test_rt_crossval.py",  # 12 s: Sionna RT against the image method, 20 positions
+    "test_ml_pairs.py",  # 11 s
+    "test_tracking_vs.py",  # 10 s
+    "test_layout.py",  # 10 s
+    "test_design_tunnels.py",  # 9 s
+    "test_achievable.py",  # 9 s
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    """:data:`SLOW_FIRST` first (a stable sort: each file's tests keep their order)."""
+    rank = {name: i for i, name in enumerate(SLOW_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
+
 
 @pytest.fixture(scope="session")
 def jiang():

@@ -82,20 +82,24 @@ def design_sweep():
 
 
 def design_traced():
-    """The design's traced route on one epoch of a 4 x 4 array: its drive, the errors measured on
-    one run into a temporary record, the tracker told them, the summary the JSON carries."""
+    """The design's traced route on one epoch of a 4 x 4 array: its drive (design_drive drives
+    it through traced_route and traced_drive), the errors measured on one run into a temporary
+    record (read back by design_errors, which checks it), the tracker told them, the summary the
+    JSON carries. Two drives of one epoch in all."""
+    import json
     import tempfile
 
     from tunnelkit import design
     from tunnelkit.design import traced
 
     setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
-    route = traced.traced_route(setup, "4x4")
-    traced.traced_drive(route, np.random.default_rng(0), n_epochs=1)
+    traced.traced_route(setup, "4x4")
     traced.design_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1)
     traced.design_errors_path(setup, "4x4", n_epochs=1)
     rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=1)
     path = tempfile.mkdtemp() + "/errors.json"
+    with open(path, "w") as fh:
+        json.dump(rec, fh, default=str)
     rec = traced.design_errors(setup, "4x4", n_epochs=1, path=path)
     d = traced.traced_javelin(setup, "4x4", rec)
     traced.error_model_summary(rec, d.config)

@@ -3,7 +3,10 @@ errors cached with their provenance (refused when they do not match), the tracke
 and the sweep and report that say which error model they used.
 
 Marked like the other ray-traced tests: they need the ``rt`` extra and fail without it unless
-``TUNNELKIT_SKIP_RT=1``. A 4x4 array and two or three epochs, traced once into a temporary cache.
+``TUNNELKIT_SKIP_RT=1``. A 4x4 array and two or three epochs, traced once into a temporary cache;
+one setup object and one directory of error records for the module, so a record or a sweep's
+drive another test has already measured is read back (its provenance checked) or reused, as in
+one session of a user's.
 """
 
 from __future__ import annotations
@@ -35,17 +38,31 @@ def traces(tmp_path_factory):
     return tmp_path_factory.mktemp("rt-cache")
 
 
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    """One directory of error records for the module: a record (array, epochs) is measured by the
+    first test that asks for it and read back, its provenance checked, by the others."""
+    return tmp_path_factory.mktemp("records")
+
+
+@pytest.fixture(scope="module")
+def module_setup():
+    """One setup object for the module: design_drive keeps a drive per setup object, so a sweep
+    on a seed another test swept already reuses its drives, as a second sweep in a session does."""
+    return design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+
+
 @pytest.fixture
-def setup(tmp_path, monkeypatch, traces):
+def setup(monkeypatch, traces, records, module_setup):
     """The paper tunnel on the ray-traced channel; traces in the module's cache, error records in
-    ``tmp_path`` (each test measures its own)."""
+    the module's directory."""
     monkeypatch.setenv(CACHE_ENV, str(traces))
     monkeypatch.setattr(
         traced,
         "design_errors_path",
-        lambda setup, spec, n_epochs=None: tmp_path / f"{parse(spec)}-{n_epochs}.json",
+        lambda setup, spec, n_epochs=None: records / f"{parse(spec)}-{n_epochs}.json",
     )
-    return design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    return module_setup
 
 
 def parse(spec):
