@@ -299,7 +299,7 @@ def main(argv=None) -> int:
                 a.epochs_every,
                 a.draws,
                 a.seed,
-                a.options.second_order,
+                a.second_order,
                 a.routes,
                 a.epochs,
             )

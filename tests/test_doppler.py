@@ -301,7 +301,7 @@ def test_reproduce_target_labels_paper_and_ours():
 
     rep = run("halili", runs=1, seed=0)
     recs = rep.records()
-    assert len(recs) == 15
+    assert len(recs) == 16  # 3 approaches x (the paper + 4 sigmas), then dead reckoning
     paper = [r for r in recs if r["source"].startswith("paper")]
     assert [r["mean_m"] for r in paper] == [20.30, 30.46, 21.04]  # data/reference, measured drive
     ours = [r for r in recs if r["source"].startswith("ours")]

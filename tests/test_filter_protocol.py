@@ -108,3 +108,35 @@ def test_javelin():
         warnings.simplefilter("ignore")
         rep = c.update(drive.epochs[0])
     assert rep.k == 0 and np.all(np.isfinite(c.x))
+
+
+def test_a_step_checks_its_arguments_before_the_state_moves():
+    from tunnelkit.tracking.javelin import Javelin
+
+    exp = vs.experiment("jiang2023-straight", level=2)
+    f = registry.get("jiang2023", "EKF")(exp.model, exp.truth[0], exp.P0)
+    x = np.array(f.x, copy=True)
+    with pytest.raises(ValueError, match="z"):
+        f.step(np.zeros(3))
+    np.testing.assert_array_equal(f.x, x)
+    trk = Javelin(initial_position=[-40.0, 1.5, -3.3])
+    x, P = trk.x.copy(), trk.P.copy()
+    with pytest.raises(TypeError, match="paths"):
+        trk.step("bad", 10.0, 0.0, 0.1)
+    np.testing.assert_array_equal(trk.x, x)
+    np.testing.assert_array_equal(trk.P, P)
+    # a missing message and a missing measurement: the paths' fault first, as one step reports
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = trk.step(None, None, None, 0.1)
+    assert rep.faults[0].startswith("no measurement") and "speed/heading" in rep.faults[1]
+
+
+def test_route_options_are_named_when_misplaced():
+    from tunnelkit.signal_route import SignalRoute, simulate_epoch
+
+    route = SignalRoute.from_scenario("italiano2026-straight")
+    with pytest.raises(TypeError, match="third_order: not a route option"):
+        route.with_options(third_order=1)
+    with pytest.raises(TypeError, match="options=RouteOptions"):
+        simulate_epoch("italiano2026-straight", 3, np.random.default_rng(0), model="srnf")

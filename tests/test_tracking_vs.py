@@ -216,7 +216,7 @@ def test_reproduce_targets_and_rows_carry_the_paper_numbers():
 
     assert {"jiang-table2", "jiang-table3"} <= set(targets())
     rows = table_rows("jiang2023_table3", los=True, runs=2, seed=0, n_particles=20, levels=[0])
-    assert [r["algorithm"] for r in rows] == ["TSWLS", "EKF", "UKF", "UPF"]
+    assert [r["algorithm"] for r in rows] == ["TSWLS", "EKF", "UKF", "UPF", "prediction only"]
     assert rows[3]["paper_mean_m"] == pytest.approx(0.0101) and rows[0][
         "paper_var_m2"
     ] == pytest.approx(0.0043)

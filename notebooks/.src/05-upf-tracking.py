@@ -647,6 +647,7 @@ assert jump[None] > 3.0 and jump[0.999] < 1.5
 assert abs(gate_rmse[0.999] / gate_rmse[None] - 1) < 0.01, gate_rmse
 # section 6's baseline: every filter beats prediction alone by more than 5x in RMSE
 assert min(radio_gain) > 5, radio_gain
+assert all(ours[t, lv, PREDICTION_ONLY]["ours_rmse_m"] > 1 for t, lv in cases)  # metres off
 # section 4: eq. 52 as printed gives one particle all the weight; the conditional proposal does not
 assert ess_med["carried"] < 2.0 and ess_med["conditional"] > 0.1 * N_ESS, ess_med
 # section 5, one fixed path: EKF, UKF and UPF below the bound (by less than 20 %), TSWLS 3-4x above

@@ -98,6 +98,11 @@ def halili_report(errs: dict[tuple[str, str], np.ndarray]) -> Report:
                     p90_ref.get((name, label)),
                 ]
             )
+    if (DEAD_RECKONING, "-") not in errs:
+        raise ValueError(
+            f"errs: no ({DEAD_RECKONING!r}, '-') entry, the baseline the table shows "
+            "(tracking.doppler.error_study returns it)"
+        )
     st = error_stats(errs[(DEAD_RECKONING, "-")])
     dr = [st[k] for k in ("min", "max", "mean", "std", "rmse", "p90")]
     rows.append([DEAD_RECKONING, "-", OURS, *dr, None])

@@ -8,7 +8,7 @@ report_covariance=True))`` or, on an existing route, ``route.with_options(second
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 from .._validate import boolean, choice, instance, integer
 
@@ -77,7 +77,7 @@ class RouteOptions:
     wideband_model: bool = False
     diffuse_floor: bool = False
     model_error_floor: bool = False
-    bias_budget: object = None
+    bias_budget: object = field(default=None, repr=False, compare=False)
     centroid_unresolved: bool = False
 
     def __post_init__(self) -> None:

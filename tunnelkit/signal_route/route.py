@@ -3,7 +3,7 @@ propagation -> channel tensor -> extraction -> Algorithm 1."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -145,6 +145,12 @@ class SignalRoute:
     def with_options(self, **changes) -> SignalRoute:
         """A copy of this route with ``changes`` to its :class:`RouteOptions`
         (``route.with_options(second_order=2)``); checked as a new route is."""
+        unknown = sorted(set(changes) - {f.name for f in fields(RouteOptions)})
+        if unknown:
+            raise TypeError(
+                f"{', '.join(unknown)}: not a route option; the options are "
+                f"{', '.join(f.name for f in fields(RouteOptions))}"
+            )
         return replace(self, options=replace(self.options, **changes))
 
     @property
@@ -375,6 +381,11 @@ def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
     to :meth:`SignalRoute.epoch` (``n_paths``, ``tunnel``, ``clock_bias``, extraction options).
     For loops over epochs build a :class:`SignalRoute` once instead.
     """
+    moved = sorted(set(kw) & {f.name for f in fields(RouteOptions)})
+    if moved:
+        raise TypeError(
+            f"{', '.join(moved)}: a route option, pass options=RouteOptions({moved[0]}=...)"
+        )
     route_kw = {key: kw.pop(key) for key in ("kinds", "snr_offset_db", "options") if key in kw}
     return SignalRoute.from_scenario(scenario, **route_kw).epoch(k, rng, **kw)
 

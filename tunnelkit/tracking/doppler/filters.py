@@ -105,8 +105,8 @@ def scalar_measurement(name: str, z) -> float | None:
     return x
 
 
-def _warn(msg: str) -> None:
-    warnings.warn(msg, MeasurementWarning, stacklevel=3)
+def _warn(msg: str) -> None:  # from a filter's _update: the warning names the caller's line
+    warnings.warn(msg, MeasurementWarning, stacklevel=4)
 
 
 def _check_setup(setup) -> DopplerSetup:

@@ -324,12 +324,13 @@ class Javelin:
 
     def predict(self, speed: float | None, heading: float | None, dt: float) -> None:
         """Predict (eq. 62-63) with the V2X message (``speed`` [m/s], ``heading`` [rad]; None
-        or NaN: missing, the last one reused with a larger speed noise) over ``dt`` [s]."""
+        or NaN: missing, the last one reused with a larger speed noise) over ``dt`` [s]. Two
+        predictions before an update: the update sees the last message and both one's faults."""
         dt = step_seconds("dt", dt)
         optional_real("speed", speed), optional_real("heading", heading)
         if speed is not None and np.isfinite(speed):  # NaN: the message is missing
             speeds("speed", speed)
-        faults: list[str] = []
+        faults: list[str] = [] if self._predicted is None else self._predicted[3]
         nu, theta, sig_nu = self._motion(speed, heading, faults)
         st, roles = self.state, self.design
         st.x, st.P = predict(
@@ -342,7 +343,10 @@ class Javelin:
     def step(
         self, paths: PathMeasurements | None, speed: float | None, heading: float | None, dt: float
     ) -> StepReport:
-        """One epoch: :meth:`predict` with (speed, heading) over ``dt``, then :meth:`update`."""
+        """One epoch: :meth:`predict` with (speed, heading) over ``dt``, then :meth:`update`
+        (``paths`` checked before the state moves)."""
+        if paths is not None and not isinstance(paths, PathMeasurements):
+            raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
         self.predict(speed, heading, dt)
         return self._update(paths)
 
@@ -356,9 +360,11 @@ class Javelin:
 
     def _update(self, paths) -> StepReport:  # warnings point at the caller of update or step
         cfg, roles = self.config, self.design
-        nu, theta, sig_nu, faults = self._predicted or (None, None, None, [])
+        nu, theta, sig_nu, motion_faults = self._predicted or (None, None, None, [])
         self._predicted = None
+        faults: list[str] = []
         meas = self._paths(paths, faults)
+        faults += motion_faults  # the path faults first, then the motion's (as one step reports)
         known = nu is not None and sig_nu is None
         meas, n_clutter = self._prefilter(meas, nu if known else None)
         used = None

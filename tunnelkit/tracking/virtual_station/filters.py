@@ -9,6 +9,8 @@ runs); :class:`VsTSWLS`, :class:`VsEKF` and :class:`VsUKF` are registered here, 
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter, MerweScaledSigmaPoints, UnscentedKalmanFilter
 
@@ -67,6 +69,10 @@ class EstimatorBase:
         """``predict()`` (unless ``first``) then ``update(z)``; returns the state estimate."""
         if not isinstance(first, bool):
             raise TypeError(f"first: expected True or False, got {first!r}")
+        if z is not None:  # checked before the state moves (update warns of a NaN epoch)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                measurement_ok(z, self.model.dim_z, who=self.name)
         if not first:
             self.predict()
         self.update(z)
