@@ -84,6 +84,7 @@ def design_sweep():
 def design_traced():
     """The design's traced route on one epoch of a 4 x 4 array: its drive, the errors measured on
     one run into a temporary record, the tracker told them, the summary the JSON carries."""
+    import json
     import tempfile
 
     from tunnelkit import design
@@ -93,6 +94,12 @@ def design_traced():
     route = traced.traced_route(setup, "4x4")
     traced.traced_drive(route, np.random.default_rng(0), n_epochs=1)
     traced.design_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1)
+    traced.stored_drive_path(setup, "4x4", n_epochs=1)
+    traced.drive_key(setup, "4x4", np.random.default_rng(0), n_epochs=1)
+    stored = tempfile.mkdtemp() + "/drive.json"
+    with open(stored, "w") as f:
+        json.dump(traced.drive_record(setup, "4x4", np.random.default_rng(0), n_epochs=1), f)
+    traced.stored_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1, path=stored)
     traced.design_errors_path(setup, "4x4", n_epochs=1)
     rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=1)
     path = tempfile.mkdtemp() + "/errors.json"

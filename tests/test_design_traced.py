@@ -241,7 +241,7 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
         "an end state out of range": lambda r: r["rng_end"]["state"].update(state=-1),
     }
     for what, change in bad.items():
-        with pytest.raises(ValueError, match=f"^{re.escape(str(p))}"):
+        with pytest.raises(ValueError, match=f"^path: {re.escape(str(p))}"):
             load(tampered(change))
             pytest.fail(what)
     with pytest.raises(ValueError, match=f"path: {re.escape(str(p))} is not a stored drive"):

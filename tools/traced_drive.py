@@ -56,7 +56,7 @@ def read_back(case, path: Path) -> None:
 
     from tunnelkit import design
     from tunnelkit.design import traced
-    from tunnelkit.design.drivestore import drive_to_record
+    from tunnelkit.design._drivestore import drive_to_record
 
     scenario, array, n_epochs, seed, stream = case
     setup = design.DesignSetup.from_scenario(scenario, channel="sionna")

@@ -185,9 +185,12 @@ def drive_key(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None)
     ``rng`` at the start, ``n_epochs``): the record format, the procedure, scenario, array,
     epochs (None: the whole route), nuisance, the ray tracer's settings and the trace cache's
     key (scene, arrays, trajectory, radio, sionna-rt version) and the generator's state."""
-    from .drivestore import FORMAT
+    from ._drivestore import FORMAT
 
+    setup = _setup(setup)
     rng = rng_or_error("rng", rng)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
     return {
         "format": FORMAT,
         **_provenance(setup, spec, n_epochs),
@@ -199,8 +202,8 @@ def drive_key(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None)
 def drive_record(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None) -> dict:
     """:func:`design_drive`'s drive of ``spec`` from ``rng``, driven now (never read from a
     store), as the record :func:`stored_drive` reads: ``{"key": drive_key(...), "drive": ...}``
-    (:func:`~tunnelkit.design.drivestore.drive_to_record`). ``rng`` ends where the drive leaves it."""
-    from .drivestore import drive_to_record
+    (:func:`~tunnelkit.design._drivestore.drive_to_record`). ``rng`` ends where the drive leaves it."""
+    from ._drivestore import drive_to_record
 
     setup = _setup(setup)
     if n_epochs is not None:
@@ -215,19 +218,25 @@ def stored_drive(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=No
     None: no file, or a file of another key (:func:`drive_key`): another generator state (another
     seed or run) silently, anything else (another scene, ray tracer, format) with a warning
     naming what differs; the caller then drives. A file of this key is checked field by field
-    (:func:`~tunnelkit.design.drivestore.drive_from_record`: fields, shapes, types, finite
+    (:func:`~tunnelkit.design._drivestore.drive_from_record`: fields, shapes, types, finite
     values, the generator's end state) and refused (``ValueError`` naming it) when anything is
     off, never half-used. On success ``rng`` is moved to the state the drive left it in."""
+    import os
     import warnings
 
-    from .drivestore import drive_from_record
+    from ._drivestore import drive_from_record
 
     setup = _setup(setup)
     spec = parse_array(spec)
     rng = rng_or_error("rng", rng)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
-    p = stored_drive_path(setup, spec, n_epochs) if path is None else Path(path)
+    if path is None:
+        p = stored_drive_path(setup, spec, n_epochs)
+    elif not isinstance(path, str | os.PathLike) or not str(path):
+        raise TypeError(f"path: expected a file path, got {path!r}")
+    else:
+        p = Path(path)
     if not p.is_file():
         return None
     try:
@@ -255,7 +264,7 @@ def stored_drive(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=No
         )
         return None
     drive, end = drive_from_record(
-        rec["drive"], traced_route(setup, spec), str(p), now["rng_start"]["bit_generator"]
+        rec["drive"], traced_route(setup, spec), f"path: {p}", now["rng_start"]["bit_generator"]
     )
     rng.bit_generator.state = end
     return drive
