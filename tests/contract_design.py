@@ -83,9 +83,9 @@ def design_sweep():
 
 def design_traced():
     """The design's traced route on one epoch of a 4 x 4 array: its drive (design_drive drives
-    it through traced_route and traced_drive), the errors measured on one run into a temporary
-    record (read back by design_errors, which checks it), the tracker told them, the summary the
-    JSON carries. Two drives of one epoch in all."""
+    it through traced_route and traced_drive; drive_record records one to a temporary file that
+    stored_drive reads back), the errors measured on one run into a temporary record (read back
+    by design_errors, which checks it), the tracker told them, the summary the JSON carries."""
     import json
     import tempfile
 
@@ -95,6 +95,12 @@ def design_traced():
     setup = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
     traced.traced_route(setup, "4x4")
     traced.design_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1)
+    traced.stored_drive_path(setup, "4x4", n_epochs=1)
+    traced.drive_key(setup, "4x4", np.random.default_rng(0), n_epochs=1)
+    stored = tempfile.mkdtemp() + "/drive.json"
+    with open(stored, "w") as f:
+        json.dump(traced.drive_record(setup, "4x4", np.random.default_rng(0), n_epochs=1), f)
+    traced.stored_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1, path=stored)
     traced.design_errors_path(setup, "4x4", n_epochs=1)
     rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=1)
     path = tempfile.mkdtemp() + "/errors.json"

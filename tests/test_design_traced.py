@@ -11,9 +11,12 @@ one session of a user's.
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
+import re
 import warnings
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -22,7 +25,7 @@ import pytest
 from tunnelkit import design
 from tunnelkit.design import traced
 from tunnelkit.rt.cache import CACHE_ENV
-from tunnelkit.simulation import simulate_routes
+from tunnelkit.simulation import drives, simulate_routes
 from tunnelkit.simulation.prefilter import geometry_keep
 from tunnelkit.tracking.javelin.noise import FixedNoise
 
@@ -30,6 +33,7 @@ SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
 pytestmark = pytest.mark.skipif(SKIP_RT, reason="TUNNELKIT_SKIP_RT=1")
 
 SCENARIO = "italiano2026-straight"
+ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(scope="module")
@@ -146,6 +150,153 @@ def test_a_design_drive_is_kept_and_driven_again_only_when_something_differs(set
         traced.design_drive(setup, "4x4", 3)
     with pytest.raises(ValueError, match="setup"):
         traced.design_drive(design.DesignSetup.from_scenario(SCENARIO), "4x4", g1)
+
+
+def _drive_tool():
+    spec = importlib.util.spec_from_file_location(
+        "traced_drive", ROOT / "tools" / "traced_drive.py"
+    )
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    return tool
+
+
+def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
+    """The shipped drive (tools/traced_drive.py; ``--check`` drives all of it again) is read for
+    notebook 08's quick traced drive (its key is the current one). Driven again here from the
+    same generator, its first epoch through the ML extraction and the others only drawn (their
+    extraction draws nothing): the first epoch's measurements within floating-point noise (bit
+    for bit on the machine that wrote it), the V2X messages and the generator's end state bit
+    for bit."""
+    tool = _drive_tool()
+    ((scenario, array, n_epochs, seed, stream),) = tool.CASES
+    assert scenario == SCENARIO and seed == drives.HELD_OUT_SEED and n_epochs == 12
+    path = traced.stored_drive_path(setup, array, n_epochs)
+    stored = json.loads(path.read_text())
+    assert stored["made_by"] == {"tool": "tools/traced_drive.py", "seed": seed, "stream": stream}
+    rng = tool.case_rng(seed, stream)
+    key = json.loads(json.dumps(traced.drive_key(setup, array, rng, n_epochs)))
+    assert stored["key"] == key and key["n_epochs"] == 12 and key["rt_key"]["sionna_rt"]
+    got = traced.stored_drive(setup, array, rng, n_epochs)
+    assert got is not None and len(got.epochs) == 12
+    extracted, real = [], drives.ml_paths
+
+    def first_only(*args, **kwargs):  # epoch 0 extracted, the others fail after their draws
+        extracted.append(1)
+        if len(extracted) > 1:
+            raise ValueError("not extracted here")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(drives, "ml_paths", first_only)
+    g = tool.case_rng(seed, stream)
+    fresh = traced.traced_drive(traced.traced_route(setup, array), g, n_epochs=n_epochs)
+    fresh = fresh["ml-traced"]
+    assert len(extracted) == 12 and g.bit_generator.state == rng.bit_generator.state
+    for f in ("speed", "heading", "t", "truth", "velocity", "base_station"):
+        np.testing.assert_array_equal(getattr(fresh, f), getattr(got, f), err_msg=f)
+    for f in ("extraction", "clock_bias_limit", "reports_covariance", "scenario", "condition"):
+        assert getattr(fresh, f) == getattr(got, f), f
+    pa, pb = fresh.epochs[0], got.epochs[0]
+    assert pa is not None and pb is not None
+    np.testing.assert_array_equal(pa.source, pb.source)
+    for f in ("phi", "psi", "kappa", "d", "v"):
+        np.testing.assert_allclose(getattr(pa, f), getattr(pb, f), rtol=1e-9, atol=0, err_msg=f)
+    assert pa.cov is None and pb.cov is None
+    np.testing.assert_array_equal(fresh.truth_index[0], got.truth_index[0])
+    np.testing.assert_allclose(fresh.sources[0], got.sources[0], rtol=1e-12, atol=0)
+    assert (fresh.kinds[0], fresh.los[0], fresh.n_true[0]) == (got.kinds[0], got.los[0],
+                                                              got.n_true[0])  # fmt: skip
+
+
+def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign(
+    setup, tmp_path, monkeypatch
+):
+    """A stored drive is read only for its own key and only when every field is what an encoded
+    drive holds: a tampered file of the key is refused naming it; a file of another generator
+    state is passed over, one of another scene or format with a warning; design_drive then
+    drives."""
+    tool = _drive_tool()
+    ((_, array, n_epochs, seed, stream),) = tool.CASES
+    stored = json.loads(traced.stored_drive_path(setup, array, n_epochs).read_text())
+    p = tmp_path / "drive.json"
+
+    def load(rec):
+        p.write_text(json.dumps(rec) if isinstance(rec, dict) else rec)
+        return traced.stored_drive(setup, array, tool.case_rng(seed, stream), n_epochs, path=p)
+
+    assert load(stored) is not None
+
+    def tampered(change):
+        rec = json.loads(json.dumps(stored))
+        change(rec["drive"])
+        return rec
+
+    ep = next(k for k, e in enumerate(stored["drive"]["epochs"]) if e["measurements"])
+
+    def meas(rec):
+        return rec["epochs"][ep]["measurements"]
+
+    bad = {
+        "a float written as an integer": lambda r: meas(r)["phi"].__setitem__(0, 1),
+        "a NaN angle": lambda r: meas(r)["psi"].__setitem__(0, None),
+        "an infinite speed": lambda r: r["speed"].__setitem__(3, float("inf")),
+        "a speed missing": lambda r: r["speed"].pop(),
+        "a path dropped from one field": lambda r: meas(r)["d"].pop(),
+        "a negative curvature": lambda r: meas(r)["kappa"].__setitem__(0, -1.0),
+        "a field missing": lambda r: r.pop("heading"),
+        "a field added": lambda r: r["epochs"][ep].__setitem__("extra", 1),
+        "an epoch dropped": lambda r: r["epochs"].pop(),
+        "an unmeasured epoch without its fault": lambda r: r["epochs"][ep].update(
+            measurements=None, truth_index=[]
+        ),
+        "a truth index beyond the true paths": lambda r: r["epochs"][ep]["truth_index"].__setitem__(
+            0, 99
+        ),
+        "a boolean for a count": lambda r: r["n_true"].__setitem__(0, True),
+        "another base station": lambda r: r["base_station"].__setitem__(2, 9.0),
+        "another generator's end state": lambda r: r["rng_end"].update(bit_generator="MT19937"),
+        "an end state out of range": lambda r: r["rng_end"]["state"].update(state=-1),
+    }
+    for what, change in bad.items():
+        with pytest.raises(ValueError, match=f"^path: {re.escape(str(p))}"):
+            load(tampered(change))
+            pytest.fail(what)
+    with pytest.raises(ValueError, match=f"path: {re.escape(str(p))} is not a stored drive"):
+        load("{not json")
+    # another generator state (another seed): passed over silently
+    other = {**stored, "key": {**stored["key"], "rng_start": tool.case_rng(seed + 1, 0)
+                               .bit_generator.state}}  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert load(other) is None
+    # another scene or record format: passed over, saying what differs
+    for field, value in (("rt_key", {**stored["key"]["rt_key"], "scene": "0" * 64}),
+                         ("format", 2), ("n_epochs", 11)):  # fmt: skip
+        with pytest.warns(
+            RuntimeWarning, match=f"{re.escape(str(p))} holds this drive made with other {field}"
+        ):
+            assert load({**stored, "key": {**stored["key"], field: value}}) is None
+    # design_drive: the stored drive of its key read (no driving, the generator moved to the
+    # drive's end), a foreign one driven
+    driven = []
+
+    def count(route, rng, *, n_epochs=None):
+        driven.append(n_epochs)
+        return {"ml-traced": "driven"}
+
+    monkeypatch.setattr(traced, "traced_drive", count)
+    monkeypatch.setattr(traced, "stored_drive_path", lambda *a: p)
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())
+    p.write_text(json.dumps(stored))
+    g = tool.case_rng(seed, stream)
+    d = traced.design_drive(setup, array, g, n_epochs=n_epochs)
+    assert driven == [] and len(d.epochs) == n_epochs
+    assert g.bit_generator.state == stored["drive"]["rng_end"]
+    p.write_text(json.dumps(other))
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())  # none kept in the process
+    g = tool.case_rng(seed, stream)
+    assert traced.design_drive(setup, array, g, n_epochs=n_epochs) == "driven"
+    assert driven == [n_epochs]
 
 
 def test_errors_are_measured_once_cached_and_refused_for_another_scene(setup, tmp_path):

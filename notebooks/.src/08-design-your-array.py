@@ -332,10 +332,12 @@ print(f"a pass at {required:.0%} needs every unit of at least {n_prove} meeting;
 # ...)`, sources in REFERENCES.md); `--ideal` (`impairments="ideal"`) is the optimistic case.
 #
 # Quick mode runs 2 units first, capped at 4: below 10 units every verdict is "undecided" and
-# says so. Below, the three calibration qualities of section 4:
+# says so. It also compares fewer arrays, the 4 × 4 and the 8 × 8 (full mode all four; an
+# array's rows do not depend on which others are compared). Below, the three calibration
+# qualities of section 4:
 
 # %%
-candidates = ["4x4", "8x8", "16x16"] if tk.quick_mode() else ["4x4", "8x8", "16x16", "32x32"]
+candidates = ["4x4", "8x8"] if tk.quick_mode() else ["4x4", "8x8", "16x16", "32x32"]
 answers = {
     k: design.design_sweep(setup, candidates, target=0.1, share=0.9, impairments=imp,
                            units=units, max_units=max_units, required_yield=required)
@@ -598,7 +600,13 @@ print(
 # the first 12 epochs of the route only (`n_epochs`: 1.1 s, so its verdict counts the two epochs
 # after the first second); its tracker is then told the errors measured the same way on the
 # first 12 epochs of the same three drives of seed 0 (a record of its own, shipped beside the
-# others: a record is used only on drives of the epochs it was measured on). Full mode runs the
+# others: a record is used only on drives of the epochs it was measured on). Quick mode's traced
+# drive itself, whose every epoch's ML extraction is what costs (about a second of CPU per
+# epoch), is stored too: its 12 epochs' measurements after the pre-filter, the tracker's input
+# (`data/rt/design/italiano2026-straight-4x4-T12-drive.json`, written by `tools/traced_drive.py`
+# from the package with the same settings and seed). It is read only for the drive its key
+# names (scene, ray tracer, array, epochs, the generator's state), every field checked, and the
+# tracker runs on it here; any other drive, full mode's included, is driven. Full mode runs the
 # three arrays, the whole route and 10 units, the cap too: ten units that all miss decide "not met" (the upper end of 0 of 10
 # is 28 %), while ten that all pass stay "undecided" (section 6: a pass at 95 % takes 73). The
 # ray tracer's traces are cached under `build/`. On the traced channel

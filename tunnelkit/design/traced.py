@@ -30,6 +30,12 @@ The report's JSON names the error model each array's traced route used
 told (:func:`traced_bounds`: every first-order path measured at every epoch with independent
 Gaussian errors of those sigmas), not the image channel's micrometre CRLBs: what such
 measurements allow a tracker, beside what it achieves.
+
+A drive costs about a second of CPU per epoch (its tracker milliseconds): :func:`design_drive`
+keeps it for the process, and reads the drives the repository ships (``data/rt/design/*-drive.json``,
+written by ``tools/traced_drive.py``: notebook 08's quick-mode 4 x 4 drive) from their record
+(:func:`stored_drive`) when its key is the drive asked for (scene, ray tracer, array, epochs, the
+generator's state: :func:`drive_key`), every field checked; any other drive is driven.
 """
 
 from __future__ import annotations
@@ -55,9 +61,13 @@ __all__ = [
     "design_drive",
     "design_errors",
     "design_errors_path",
+    "drive_key",
+    "drive_record",
     "error_model_summary",
     "measure_design_errors",
     "sigma_error_model",
+    "stored_drive",
+    "stored_drive_path",
     "traced_bounds",
     "traced_drive",
     "traced_javelin",
@@ -73,6 +83,8 @@ ERROR_RUNS = 3
 TRACED_NUISANCE = {"diffuse_floor": True}
 #: the record's procedure (part of what a stored record must match)
 PROCEDURE = "tunnelkit.design.traced.measure_design_errors"
+#: a stored drive's procedure (part of its key, :func:`drive_key`)
+DRIVE_PROCEDURE = "tunnelkit.design.traced.design_drive"
 #: design drives :func:`design_drive` keeps for the process (the oldest dropped first)
 DRIVES_KEPT = 64
 _DRIVES: OrderedDict = OrderedDict()
@@ -135,7 +147,9 @@ def design_drive(
     ``rng`` is moved to the state the drive left it in: bit for bit what driving again gives
     (the ML extraction draws nothing from ``rng``, the entry fix is drawn after the drive),
     without the extraction's cost. At most :data:`DRIVES_KEPT` drives are kept, the oldest
-    dropped first; an equal setup built anew, or one sent to another process, drives again."""
+    dropped first; an equal setup built anew, or one sent to another process, drives again. A
+    drive not kept is read from its stored record when the repository ships one of this key
+    (:func:`stored_drive`: the same numbers, checked on load) and driven otherwise."""
     setup = _setup(setup)
     spec = parse_array(spec)
     rng = rng_or_error("rng", rng)
@@ -148,10 +162,111 @@ def design_drive(
         _DRIVES.move_to_end(key)
         rng.bit_generator.state = copy.deepcopy(kept[2])
         return copy.deepcopy(kept[1])
-    drive = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)["ml-traced"]
+    drive = stored_drive(setup, spec, rng, n_epochs)
+    if drive is None:
+        drive = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)["ml-traced"]
     _DRIVES[key] = (setup, copy.deepcopy(drive), copy.deepcopy(rng.bit_generator.state))
     while len(_DRIVES) > DRIVES_KEPT:
         _DRIVES.popitem(last=False)
+    return drive
+
+
+def stored_drive_path(setup: DesignSetup, spec, n_epochs: int | None = None) -> Path:
+    """Where the repository stores :func:`design_drive`'s drive of ``spec`` (``n_epochs``: its
+    first epochs, all by default): ``data/rt/design/<scenario>-<array>[-T<n_epochs>]-drive.json``
+    (written by ``tools/traced_drive.py``); which drive it holds is its key (:func:`drive_key`)."""
+    from ..scenarios import data_dir
+
+    return data_dir() / "rt" / "design" / f"{_record_stem(setup, spec, n_epochs)}-drive.json"
+
+
+def drive_key(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None) -> dict:
+    """What a stored drive must match to be read for :func:`design_drive` (``setup``, ``spec``,
+    ``rng`` at the start, ``n_epochs``): the record format, the procedure, scenario, array,
+    epochs (None: the whole route), nuisance, the ray tracer's settings and the trace cache's
+    key (scene, arrays, trajectory, radio, sionna-rt version) and the generator's state."""
+    from ._drivestore import FORMAT
+
+    setup = _setup(setup)
+    rng = rng_or_error("rng", rng)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    return {
+        "format": FORMAT,
+        **_provenance(setup, spec, n_epochs),
+        "procedure": DRIVE_PROCEDURE,
+        "rng_start": copy.deepcopy(rng.bit_generator.state),
+    }
+
+
+def drive_record(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None) -> dict:
+    """:func:`design_drive`'s drive of ``spec`` from ``rng``, driven now (never read from a
+    store), as the record :func:`stored_drive` reads: ``{"key": drive_key(...), "drive": ...}``
+    (:func:`~tunnelkit.design._drivestore.drive_to_record`). ``rng`` ends where the drive leaves it."""
+    from ._drivestore import drive_to_record
+
+    setup = _setup(setup)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    key = drive_key(setup, spec, rng, n_epochs)
+    drive = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)["ml-traced"]
+    return {"key": key, "drive": drive_to_record(drive, rng.bit_generator.state)}
+
+
+def stored_drive(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None, *, path=None):
+    """:func:`design_drive`'s drive read from ``path`` (default :func:`stored_drive_path`), or
+    None: no file, or a file of another key (:func:`drive_key`): another generator state (another
+    seed or run) silently, anything else (another scene, ray tracer, format) with a warning
+    naming what differs; the caller then drives. A file of this key is checked field by field
+    (:func:`~tunnelkit.design._drivestore.drive_from_record`: fields, shapes, types, finite
+    values, the generator's end state) and refused (``ValueError`` naming it) when anything is
+    off, never half-used. On success ``rng`` is moved to the state the drive left it in."""
+    import os
+    import warnings
+
+    from ._drivestore import drive_from_record
+
+    setup = _setup(setup)
+    spec = parse_array(spec)
+    rng = rng_or_error("rng", rng)
+    if n_epochs is not None:
+        n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    if path is None:
+        p = stored_drive_path(setup, spec, n_epochs)
+    elif not isinstance(path, str | os.PathLike) or not str(path):
+        raise TypeError(f"path: expected a file path, got {path!r}")
+    else:
+        p = Path(path)
+    if not p.is_file():
+        return None
+    try:
+        rec = json.loads(p.read_text())
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ValueError(f"path: {p} is not a stored drive ({exc})") from None
+    if not isinstance(rec, dict) or not {"key", "drive"} <= set(rec) <= {"key", "drive", "made_by"}:
+        raise ValueError(f"path: {p} is not a stored drive (expected its key and drive)")
+    key, now = rec["key"], drive_key(setup, spec, rng, n_epochs)
+
+    def same(a, b):
+        return json.dumps(a, sort_keys=True, default=str) == json.dumps(
+            b, sort_keys=True, default=str
+        )
+
+    if not isinstance(key, dict) or not same(key.get("rng_start"), now["rng_start"]):
+        return None  # another drive of this array and route
+    differ = [k for k in now if not same(key.get(k), now[k])] + sorted(set(key) - set(now))
+    if differ:
+        warnings.warn(
+            f"{p} holds this drive made with other {', '.join(differ)} than now: driven again "
+            "(tools/traced_drive.py rewrites it)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        return None
+    drive, end = drive_from_record(
+        rec["drive"], traced_route(setup, spec), f"path: {p}", now["rng_start"]["bit_generator"]
+    )
+    rng.bit_generator.state = end
     return drive
 
 
@@ -231,6 +346,13 @@ def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) ->
     from ..rt.cache import default_cache_dir
     from ..scenarios import data_dir
 
+    fname = f"{_record_stem(setup, spec, n_epochs)}.json"
+    shipped = data_dir() / "rt" / "design" / fname
+    return shipped if shipped.is_file() else default_cache_dir() / "design-errors" / fname
+
+
+def _record_stem(setup: DesignSetup, spec, n_epochs: int | None) -> str:
+    """``<scenario>-<array>[-T<n_epochs>]`` (no tail for the whole route)."""
     setup = _setup(setup)
     spec = parse_array(spec)
     if n_epochs is not None:
@@ -238,9 +360,7 @@ def design_errors_path(setup: DesignSetup, spec, n_epochs: int | None = None) ->
     T = len(setup.trajectory)
     tail = "" if n_epochs is None or n_epochs >= T else f"-T{n_epochs}"
     name = "".join(c if c.isalnum() or c in "-_." else "_" for c in setup.name)
-    fname = f"{name}-{spec.label}{tail}.json"
-    shipped = data_dir() / "rt" / "design" / fname
-    return shipped if shipped.is_file() else default_cache_dir() / "design-errors" / fname
+    return f"{name}-{spec.label}{tail}"
 
 
 def _mismatch(stored: dict, current: dict) -> list[str]:
