@@ -140,3 +140,19 @@ def test_route_options_are_named_when_misplaced():
         route.with_options(third_order=1)
     with pytest.raises(TypeError, match="options=RouteOptions"):
         simulate_epoch("italiano2026-straight", 3, np.random.default_rng(0), model="srnf")
+
+
+def test_the_batched_upf_steps_many_runs_and_checks_their_shape():
+    from tunnelkit.tracking import upf
+
+    exp = vs.experiment("jiang2023-straight", level=2)
+    Z, x0 = exp.simulate(3, np.random.default_rng(0))
+    f = upf.UnscentedParticleFilter(
+        exp.model, x0, exp.P0, rng=np.random.default_rng(1), n_particles=50
+    )
+    assert f.step(Z[:, 0], first=True).shape == (3, 4)
+    x = np.array(f.x, copy=True)
+    with pytest.raises(ValueError, match="z"):
+        f.step(Z[0, 1])  # one run's measurement for a batch of three
+    np.testing.assert_array_equal(f.x, x)
+    assert f.step(Z[:, 1]).shape == (3, 4)

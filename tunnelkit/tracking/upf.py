@@ -348,6 +348,9 @@ class UnscentedParticleFilter(EstimatorBase):
         self._trans_chol = self._LQ
         self._pending = True
 
+    def _check_z(self, z) -> None:  # one row per run when the filter runs a batch
+        self._z_rows(z)
+
     def _z_rows(self, z) -> tuple[np.ndarray, np.ndarray]:
         m = self.model.dim_z
         if z is None:

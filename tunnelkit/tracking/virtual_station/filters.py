@@ -72,11 +72,15 @@ class EstimatorBase:
         if z is not None:  # checked before the state moves (update warns of a NaN epoch)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
-                measurement_ok(z, self.model.dim_z, who=self.name)
+                self._check_z(z)
         if not first:
             self.predict()
         self.update(z)
         return np.asarray(self.x, dtype=float).copy()
+
+    def _check_z(self, z) -> None:
+        """Refuse a measurement ``update`` would refuse (before ``step`` predicts)."""
+        measurement_ok(z, self.model.dim_z, who=self.name)
 
     @classmethod
     def run(
