@@ -183,7 +183,24 @@ def _adaptive_r(R_prev: float, e: float, H: np.ndarray, P: np.ndarray, a: float)
     return float(a * R_prev + (1 - a) * (e * e + (H @ P @ H.T).item()))
 
 
-class DopplerEKF:
+class _KalmanState:
+    """``x`` and ``P`` of a filter kept in a filterpy filter ``self.kf`` (the filter protocol,
+    :mod:`tunnelkit.tracking.protocol`)."""
+
+    kf: object
+
+    @property
+    def x(self) -> np.ndarray:
+        """The state (filterpy's column ``kf.x`` as a vector)."""
+        return self.kf.x[:, 0]
+
+    @property
+    def P(self) -> np.ndarray:
+        """The state's covariance."""
+        return self.kf.P
+
+
+class DopplerEKF(_KalmanState):
     """EKF DS: the EKF on Doppler shift, eq. 1-12, optionally with the adaptive R of eq. 13-15.
 
     ``sigma_hz`` sets the constant ``R = sigma^2`` (the starting value when ``adaptive``); ``q`` is
@@ -231,16 +248,6 @@ class DopplerEKF:
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
         self._tx = tuple(float(t) for t in setup.tx)
         self._k, self._dz2 = setup.k, setup.dz**2
-
-    @property
-    def x(self) -> np.ndarray:
-        """The state (filterpy's column ``kf.x`` as a vector)."""
-        return self.kf.x[:, 0]
-
-    @property
-    def P(self) -> np.ndarray:
-        """The state's covariance."""
-        return self.kf.P
 
     @property
     def n_rejected(self) -> int:
@@ -327,7 +334,7 @@ class DopplerEKF:
 # --- the KFs on Doppler and ToA (section 5) -------------------------------------------------------
 
 
-class SpeedKF:
+class SpeedKF(_KalmanState):
     """KF DS: scalar KF on Doppler for the approach speed ``u`` (sec. 5), ``H = f_c / c``.
 
     The state is the speed towards the transmitter (positive approaching, negative receding), so
@@ -369,16 +376,6 @@ class SpeedKF:
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
 
     @property
-    def x(self) -> np.ndarray:
-        """The state (filterpy's column ``kf.x`` as a vector)."""
-        return self.kf.x[:, 0]
-
-    @property
-    def P(self) -> np.ndarray:
-        """The state's covariance."""
-        return self.kf.P
-
-    @property
     def n_rejected(self) -> int:
         """Doppler samples the gate rejected (predicted only)."""
         return self.gate.n_rejected
@@ -418,7 +415,7 @@ class SpeedKF:
         return float(self.kf.x[0, 0])
 
 
-class RangeKF:
+class RangeKF(_KalmanState):
     """KF ToA: scalar KF on the transmitter-receiver distance (eq. 17-21).
 
     Prediction ``d_k = d_{k-1} - dt u_k`` with ``u`` the approach speed from the Doppler (eq. 17,
@@ -480,16 +477,6 @@ class RangeKF:
         kf.R = np.array([[sigma_toa**2]])
         self.kf = kf
         self.gate = InnovationGate(gate, reopen_after=reopen_after)
-
-    @property
-    def x(self) -> np.ndarray:
-        """The state (filterpy's column ``kf.x`` as a vector)."""
-        return self.kf.x[:, 0]
-
-    @property
-    def P(self) -> np.ndarray:
-        """The state's covariance."""
-        return self.kf.P
 
     @property
     def n_rejected(self) -> int:
