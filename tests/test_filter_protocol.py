@@ -130,6 +130,14 @@ def test_a_step_checks_its_arguments_before_the_state_moves():
         warnings.simplefilter("ignore")
         rep = trk.step(None, None, None, 0.1)
     assert rep.faults[0].startswith("no measurement") and "speed/heading" in rep.faults[1]
+    # a refused update keeps what the prediction left for the next one
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        trk.predict(None, None, 0.1)
+        with pytest.raises(TypeError, match="paths"):
+            trk.update("bad")
+        rep = trk.update(None)
+    assert any("speed/heading" in f for f in rep.faults), rep.faults
 
 
 def test_route_options_are_named_when_misplaced():

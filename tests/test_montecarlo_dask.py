@@ -29,18 +29,24 @@ from tunnelkit.reproduce.javelin_tables import collect_routes, table_rows
 from tunnelkit.runner import SchedulerUnreachable, TrialLost, parallel_options, run_trials
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    """Two single-threaded worker processes; a trial may kill its worker once (not twice)."""
-    with LocalCluster(
-        n_workers=2,
+def _local_cluster(n_workers: int, **scheduler):
+    """A local cluster of ``n_workers`` single-threaded processes on 127.0.0.1 (free ports, no
+    dashboard); ``scheduler``: more scheduler settings (``allowed_failures``)."""
+    return LocalCluster(
+        n_workers=n_workers,
         threads_per_worker=1,
         processes=True,
         host="127.0.0.1",
         dashboard_address="127.0.0.1:0",
-        scheduler_kwargs={"allowed_failures": 1, "dashboard": False},
+        scheduler_kwargs={"dashboard": False, **scheduler},
         silence_logs=40,
-    ) as c:
+    )
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """Two single-threaded worker processes; a trial may kill its worker once (not twice)."""
+    with _local_cluster(2, allowed_failures=1) as c:
         yield c
 
 
@@ -239,15 +245,7 @@ def test_a_trial_past_its_timeout_stops_the_run_serially_and_on_dask(cluster):
     assert ok == run_trials(_draw, 4, seed=3)
     # the hung trial keeps its worker asleep after the run has stopped: it runs on a cluster of
     # its own, closed here, so that it does not hold up the next tests' trials on the module's
-    with LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address="127.0.0.1:0",
-        scheduler_kwargs={"dashboard": False},
-        silence_logs=40,
-    ) as own:
+    with _local_cluster(2) as own:
         run_trials(_draw, 4, seed=3, scheduler=own.scheduler_address)  # workers import this module
         t0 = time.perf_counter()
         # the hung trial is named (on a loaded machine the quick ones may be named with it: the
@@ -345,14 +343,7 @@ def test_a_cluster_without_workers_stops_the_run_instead_of_hanging(monkeypatch)
     import tunnelkit.runner as mc
 
     monkeypatch.setattr(mc, "NO_WORKER_WAIT_S", 2.0)
-    with LocalCluster(
-        n_workers=0,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address="127.0.0.1:0",
-        scheduler_kwargs={"dashboard": False},
-        silence_logs=40,
-    ) as empty:
+    with _local_cluster(0) as empty:
         t0 = time.perf_counter()
         with pytest.raises(TrialLost, match=r"no worker for 2 s"):
             run_trials(_draw, 3, seed=0, scheduler=empty.scheduler_address)

@@ -130,6 +130,13 @@ KINDS = ("los", "ceiling", "road", "rrm", "wall")
 FIX_SIGMAS = (math.radians(10.0), math.radians(10.0), 1.0)
 
 
+def _measured(rec, counts: tuple[str, ...] = ()) -> None:
+    """A record of RMS / median / share values: each >= 0 or NaN (nothing measured); ``counts``
+    integers >= 0."""
+    floats = tuple(f.name for f in dataclasses.fields(rec) if f.type == "float")
+    record(rec, allow_nan=floats, nonnegative=(*floats, *counts))
+
+
 @dataclass(frozen=True)
 class AttributionRow:
     """One configuration, array and kind of path (``"all"``: every kind pooled). Bias: the
@@ -160,9 +167,8 @@ class AttributionRow:
     rms_kappa_m: float
     med_kappa_m: float
 
-    def __post_init__(self) -> None:  # NaN: nothing measured
-        floats = tuple(f.name for f in dataclasses.fields(self) if f.type == "float")
-        record(self, allow_nan=floats, nonnegative=(*floats, "n_bias", "far_field", "n_err"))
+    def __post_init__(self) -> None:
+        _measured(self, counts=("n_bias", "far_field", "n_err"))
 
 
 @dataclass(frozen=True)
@@ -185,9 +191,8 @@ class ConfigSummary:
     higher_share: float
     trace_s: float
 
-    def __post_init__(self) -> None:  # NaN: nothing measured
-        floats = tuple(f.name for f in dataclasses.fields(self) if f.type == "float")
-        record(self, allow_nan=floats, nonnegative=floats)
+    def __post_init__(self) -> None:
+        _measured(self)
 
 
 @dataclass

@@ -194,8 +194,6 @@ class Javelin:
         if paths is None:
             faults.append("no measurement this epoch: predict only")
             return PathMeasurements.empty()
-        if not isinstance(paths, PathMeasurements):
-            raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
         # a PathMeasurements built directly may still hold NaN angles or d < 0 (Algorithm 1)
         clean, dropped = self.design.prefilters[0](paths, None)
         if dropped:
@@ -345,8 +343,7 @@ class Javelin:
     ) -> StepReport:
         """One epoch: :meth:`predict` with (speed, heading) over ``dt``, then :meth:`update`
         (``paths`` checked before the state moves)."""
-        if paths is not None and not isinstance(paths, PathMeasurements):
-            raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
+        _check_paths(paths)
         self.predict(speed, heading, dt)
         return self._update(paths)
 
@@ -356,6 +353,7 @@ class Javelin:
         acquires starts with the first fix (:meth:`_acquire`). Without a :meth:`predict` since
         the last update, the motion is unknown (the Doppler pre-filter and the VUE births then
         go without the UE's velocity)."""
+        _check_paths(paths)
         return self._update(paths)
 
     def _update(self, paths) -> StepReport:  # warnings point at the caller of update or step
@@ -466,6 +464,12 @@ class JavelinRun:
 
 #: what :meth:`Javelin.track` reads of a drive
 _DRIVE = ("epochs", "speed", "heading", "dt")
+
+
+def _check_paths(paths) -> None:
+    """``paths`` of one epoch: PathMeasurements or None (checked before the state moves)."""
+    if paths is not None and not isinstance(paths, PathMeasurements):
+        raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
 
 
 def draw_start(
