@@ -39,3 +39,5 @@ def test_jiang_prediction_only_is_the_cv_model_from_the_prior():
     # the radio pays: every filter well ahead of the baseline on the same runs
     for name in ("EKF", "UKF", "UPF"):
         assert base[name]["ours_rmse_m"] < 0.5 * base[PREDICTION_ONLY]["ours_rmse_m"]
+    # the table's bound is the drive's own (no process noise): every row lies above it
+    assert all(r["rmse_over_pcrlb"] > 1.0 for r in rows), rows

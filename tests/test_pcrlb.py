@@ -67,10 +67,56 @@ def test_bound_shrinks_with_noise_and_filter_respects_it():
     assert 0.85 < np.mean(mse) / np.mean(b**2) < 1.25
 
 
+def test_noise_free_truth_is_the_batch_information_about_the_start():
+    """Q = 0: J_k = F^-kT [P0^-1 + sum_j F^jT I_j F^j] F^-k (brute force), the limit of Q -> 0."""
+    F = cv_transition(0.1)
+    rng = np.random.default_rng(3)
+    T = 12
+    A = rng.standard_normal((T, 3, 4))
+    info = A.transpose(0, 2, 1) @ A
+    P0 = np.diag([2.0, 3.0, 1.0, 0.5])
+    B = pcrlb.pcrlb(F, np.zeros((4, 4)), P0, info)
+    J0 = np.linalg.inv(P0)
+    for k in range(T):
+        Fk = [np.linalg.matrix_power(F, j) for j in range(k + 1)]
+        Jx0 = J0 + sum(Fk[j].T @ info[j] @ Fk[j] for j in range(k + 1))
+        Fik = np.linalg.inv(Fk[k])
+        assert np.allclose(B[k], np.linalg.inv(Fik.T @ Jx0 @ Fik), rtol=1e-8, atol=1e-12)
+
+    def gap(q):  # relative to each epoch's largest entry
+        near = pcrlb.pcrlb(F, cv_process_noise(0.1, q), P0, info)
+        return np.max(np.abs(near - B) / np.abs(B).max(axis=(1, 2), keepdims=True))
+
+    # the limit q -> 0, approached linearly in q (below 1e-6 the inverse of Q costs digits)
+    assert 8 < gap(1e-4) / gap(1e-5) < 12 and gap(1e-6) < 2e-5
+    assert np.all(
+        np.diagonal(pcrlb.pcrlb(F, cv_process_noise(0.1, 0.1), P0, info)[1:], 0, 1, 2)
+        > np.diagonal(B[1:], 0, 1, 2)
+    )
+
+
+def test_noise_free_bound_holds_for_filters_on_a_fixed_drive():
+    """The presets' drive is one straight path without process noise and random prior means: the
+    Q = 0 bound lies under the filters' RMSE (the model's q = 0.1 bound does not, see notebook 05)."""
+    exp = vs.experiment("jiang2023-straight", level=2)
+    rng = np.random.default_rng(20261205)
+    Z, x0 = exp.simulate(40, rng)
+    est = vs.VsEKF.run(exp.model, Z, x0, exp.P0)
+    mse = np.mean(np.sum((est[..., :2] - exp.truth[:, :2]) ** 2, -1))
+    free = pcrlb.vs_pcrlb(exp.model, exp.truth, exp.P0, process_noise=False)
+    noisy = pcrlb.vs_pcrlb(exp.model, exp.truth, exp.P0)
+    assert np.all(free[1:] < noisy[1:])
+    assert np.sqrt(mse / np.mean(free**2)) > 1.0
+    with pytest.raises(TypeError, match="process_noise"):
+        pcrlb.vs_pcrlb(exp.model, exp.truth, exp.P0, process_noise="no")
+
+
 def test_bad_input():
     F, Q = cv_transition(0.1), cv_process_noise(0.1, 0.3)
     with pytest.raises(ValueError, match="Q"):
-        pcrlb.pcrlb(F, np.zeros((4, 4)), np.eye(4), np.zeros((3, 4, 4)))
+        pcrlb.pcrlb(F, -Q, np.eye(4), np.zeros((3, 4, 4)))
+    with pytest.raises(ValueError, match=r"F: .*invertible"):
+        pcrlb.pcrlb(np.zeros((4, 4)), np.zeros((4, 4)), np.eye(4), np.zeros((3, 4, 4)))
     with pytest.raises(ValueError, match="info"):
         pcrlb.pcrlb(F, Q, np.eye(4), np.zeros((3, 2, 2)))
     with pytest.raises(ValueError, match="states"):

@@ -82,16 +82,17 @@ def test_tswls_run_equals_per_epoch_tswls(exp_hi):
     assert np.allclose(one[:, :2], est[0, :, :2])
 
 
-def test_filters_reach_the_pcrlb_and_beat_tswls(exp_hi):
-    """20 runs at (2 deg, 2 m): RMSE / sqrt(PCRLB) in [0.7, 1.3] for EKF/UKF, TSWLS far above."""
+def test_filters_lie_near_the_drives_bound_and_beat_tswls(exp_hi):
+    """20 runs at (2 deg, 2 m) of the noise-free straight drive: RMSE / sqrt(PCRLB of that drive)
+    in (1, 1.6] for EKF/UKF (a bound, and near it), TSWLS far above."""
     res = vs.monte_carlo(exp_hi, 20, 7, names=["TSWLS", "EKF", "UKF"])
-    bound = vs_pcrlb(exp_hi.model, exp_hi.truth, exp_hi.P0)
+    bound = vs_pcrlb(exp_hi.model, exp_hi.truth, exp_hi.P0, process_noise=False)
     ratio = {
         n: np.sqrt(np.mean(np.sum((e[..., :2] - exp_hi.truth[:, :2]) ** 2, -1)) / np.mean(bound**2))
         for n, e in res.items()
     }
-    assert 0.7 < ratio["EKF"] < 1.3 and 0.7 < ratio["UKF"] < 1.3
-    assert ratio["TSWLS"] > 2.0
+    assert 1.0 < ratio["EKF"] < 1.6 and 1.0 < ratio["UKF"] < 1.6, ratio
+    assert ratio["TSWLS"] > 3.0
 
 
 @pytest.mark.parametrize("name", ["EKF", "UKF", "TSWLS"])

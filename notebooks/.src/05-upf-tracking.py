@@ -287,9 +287,10 @@ cdf_figure(err, title="CDF of the position error, straight NLOS, 2 deg / 2 m")
 # truths of $E[H_k^\mathsf{T}R^{-1}H_k]$, as `vs_pcrlb` does for a stack of trajectories.
 #
 # The bound that matches the preset itself is the same recursion for truths **without** process
-# noise, $q \to 0$ ($q = 10^{-6}$ below; $10^{-9}$ changes it by less than 0.1 %), the initial
-# state still drawn from the prior: a bound for exactly straight drives from random starts around
-# this one. A bound depends on how the truth is random, never on what a filter assumes: the
+# noise, its limit $q \to 0$: $J_k = \Phi^{-T} J_{k-1} \Phi^{-1} + E[H_k^T R^{-1} H_k]$, the
+# information about the start carried forward (`vs_pcrlb(..., process_noise=False)`; $q = 10^{-6}$
+# gives the same to 0.1 %), the initial state still drawn from the prior: a bound for exactly
+# straight drives from random starts around this one. A bound depends on how the truth is random, never on what a filter assumes: the
 # filters are told $q = 0.1$, and this bound holds for them too. It lies below the $q = 0.1$
 # curve, and the same runs sit above it (the middle panel, ratios printed).
 
@@ -312,12 +313,9 @@ for name in tqdm(("EKF", "UKF", "UPF"), desc=f"filters on {RUNS_MM} random truth
     mse = np.sum((est[..., :2] - truth_mm[..., :2]) ** 2, axis=-1)  # (runs, T)
     rmse_mm[name] = np.sqrt(mse.mean(axis=0))
     ratio_mm[name] = float(np.sqrt(mse.mean() / np.mean(bound_mm**2)))
-Q_TO_0 = 1e-6  # the process noise of the bound for a straight, noise-free truth
-bound0 = pcrlb.vs_pcrlb(
-    vs.experiment("jiang2023-straight", level=2, q=Q_TO_0).model, exp.truth, exp.P0
-)
-bound0_9 = pcrlb.vs_pcrlb(
-    vs.experiment("jiang2023-straight", level=2, q=1e-9).model, exp.truth, exp.P0
+bound0 = pcrlb.vs_pcrlb(m, exp.truth, exp.P0, process_noise=False)  # q -> 0, the limit
+bound0_6 = pcrlb.vs_pcrlb(  # the recursion with a tiny q approaches it
+    vs.experiment("jiang2023-straight", level=2, q=1e-6).model, exp.truth, exp.P0
 )
 ratio0 = {n: float(np.sqrt(np.mean(err[n] ** 2) / np.mean(bound0**2))) for n in rmse_mm}
 print("RMSE / sqrt(PCRLB), noise-free truth, q = 0.1 :", {n: round(ratio[n], 3) for n in rmse_mm})
@@ -424,7 +422,8 @@ print(
     f"UPF mean / UKF mean - 1 ({PARTICLES} particles): {min(upf_ukf):+.1%} to {max(upf_ukf):+.1%}"
 )
 print(
-    f"EKF and UKF, RMSE / sqrt(PCRLB) on the fixed path: {min(kf_bound):.2f} to {max(kf_bound):.2f}"
+    "EKF and UKF, RMSE / sqrt(PCRLB of the drive as simulated, q -> 0): "
+    f"{min(kf_bound):.2f} to {max(kf_bound):.2f}"
 )
 print(f"prediction only RMSE / filter RMSE: {min(radio_gain):.0f} to {max(radio_gain):.0f}")
 table_figure(t3, cols, title=f"Table 3 (LOS), {RUNS} runs")
@@ -439,10 +438,12 @@ table_figure(t3, cols, title=f"Table 3 (LOS), {RUNS} runs")
 #
 # **What does not.** EKF and UKF are within a few per cent of each other, and the UPF does not
 # beat them: with 500 particles its mean is a few per cent above the UKF's, with fewer (quick
-# mode's 200) it can lose track on a run and end further above. On this one fixed path the EKF's
-# and UKF's RMSE lies between 0.75 and 1.05 times the $q = 0.1$ bound (along the path) at every
-# level, below it where the fixed path lets them (section 5), and above the $q \to 0$ bound of
-# the fixed path itself (printed below). For this nearly linear,
+# mode's 200) it can lose track on a run and end further above. The tables' `rmse_over_pcrlb`
+# is the RMSE over the bound of the drive as simulated, the $q \to 0$ bound of section 5 (not
+# the filters' $q = 0.1$ one, which they beat on this path): the EKF's and UKF's RMSE lies
+# between about 1.2 and 2.2 times it (printed above Table 3), above it at every level as a bound
+# requires, and furthest above at the lowest noise, where the velocity the filters let wander
+# ($q = 0.1$) costs most against a truth that never turns. For this nearly linear,
 # Gaussian problem the UKF posterior is already almost exact, so a particle filter has nothing
 # left to gain; its Monte-Carlo sampling costs it a little. No ordering UPF < UKF < EKF beyond
 # noise is to be had here.
@@ -496,8 +497,9 @@ paper_t2 = {(r["algorithm"], r["sigma_d_m"]): r for r in tk.reference.load("jian
 paper_rmse = {k: float(np.sqrt(r["mean_m"] ** 2 + r["variance_m2"])) for k, r in paper_t2.items()}
 bound0_rms, paper_over0, ours_over0 = {}, {}, {}
 for lv, sd in enumerate(levels_d):
-    e0 = vs.experiment("jiang2023-straight", level=lv, q=Q_TO_0)
-    bound0_rms[sd] = float(np.sqrt(np.mean(pcrlb.vs_pcrlb(e0.model, e0.truth, e0.P0) ** 2)))
+    e0 = vs.experiment("jiang2023-straight", level=lv)
+    b0 = pcrlb.vs_pcrlb(e0.model, e0.truth, e0.P0, process_noise=False)
+    bound0_rms[sd] = float(np.sqrt(np.mean(b0**2)))
     for a in filt:
         paper_over0[sd, a] = paper_rmse[a, sd] / bound0_rms[sd]
         ours_over0[sd, a] = ours["NLOS", sd, a]["ours_rmse_m"] / bound0_rms[sd]
@@ -521,8 +523,9 @@ print(
 # ## 7. Explore
 #
 # One run of all four estimators: each curve is one drive's error, epoch by epoch, and the dashed
-# sqrt(PCRLB), evaluated along the path, approximates the bound of random drives, not of that
-# error (section 5). Move the noise
+# sqrt(PCRLB) is the bound of the drive as simulated (no process noise, the start from the
+# prior): it bounds the RMSE over many such runs, not one run's error, which can dip under it
+# (section 5). Move the noise
 # sliders and the particle count (try 1 particle: the UPF becomes a UKF that samples its own
 # posterior, and pays for it).
 
@@ -669,8 +672,16 @@ for a in ("TSWLS", *filt):
 # a few (6) per cent above it with 500 particles or more, further with fewer (a lost run)
 assert max(abs(d) for d in ekf_ukf) < 0.05, ekf_ukf
 assert min(upf_ukf) > -0.03 and max(upf_ukf) < (0.06 if PARTICLES >= 500 else 0.5), upf_ukf
-# EKF and UKF, on the fixed path: between 0.75 and 1.05 times sqrt(PCRLB) at every level
-assert 0.75 < min(kf_bound) and max(kf_bound) < 1.05, kf_bound
+# EKF and UKF: about 1.2 to 2.2 times sqrt(PCRLB) of the drive as simulated, above it at every
+# level, furthest at the lowest noise
+assert 1.1 < min(kf_bound) and max(kf_bound) < 2.5, kf_bound
+kf_low = [
+    ours[t, levels_d[0], a]["rmse_over_pcrlb"] for t in ("NLOS", "LOS") for a in ("EKF", "UKF")
+]
+kf_high = [
+    ours[t, levels_d[-1], a]["rmse_over_pcrlb"] for t in ("NLOS", "LOS") for a in ("EKF", "UKF")
+]
+assert min(kf_low) > max(kf_high), (kf_low, kf_high)
 assert all(v < 1.3 for v in curves["straight LOS"].values() if v != curves["straight LOS"]["TSWLS"])
 # the paper's UPF means and TSWLS mean, as quoted, and the paper's RMSEs from its means and
 # variances against the q -> 0 bound (at 0.1 m at or above it, the UPF's within a few (5) per
@@ -692,7 +703,7 @@ assert abs(paper_rmse["TSWLS", 2.0] - 0.35) < 0.005 and snap_rms > 3 * paper_rms
 assert abs(tswls_over_snap - 1) < 0.1, tswls_over_snap
 # section 5: the bound for the noise-free preset (q -> 0) lies below the q = 0.1 one, and the
 # same runs sit above it
-assert np.allclose(bound0_9, bound0, rtol=1e-3)  # q = 1e-6 is q -> 0 to 0.1 %
+assert np.allclose(bound0_6, bound0, rtol=1e-3)  # q = 1e-6 is q -> 0 to 0.1 %
 assert np.all(bound0[1:] < bound[1:]) and all(ratio0[n] > 1.0 for n in ratio0), ratio0
 # the bound is the yardstick for truths drawn from its own motion model: ratio 1 within 10 %
 # (EKF, UKF; 15 % with quick mode's 12 runs), the UPF within 15 % (20 %) for its sampling; on the

@@ -8,7 +8,10 @@ information matrix of the state obeys the recursion (Tichavský et al. 1998, eq.
     D11     = Phi^T Q^-1 Phi,   D12 = D21^T = -Phi^T Q^-1,
     D22     = Q^-1 + E[H_k^T R^-1 H_k],                 H_k = d h / d X at X_k
 
-and ``E[(X_hat_k - X_k)(X_hat_k - X_k)^T] >= J_k^-1`` for any estimator. The expectation over the
+and ``E[(X_hat_k - X_k)(X_hat_k - X_k)^T] >= J_k^-1`` for any estimator. A truth without process
+noise (``Q = 0``: a deterministic path from a random start) has the limit of that recursion,
+``J_k = Phi^-T J_{k-1} Phi^-1 + E[H_k^T R^-1 H_k]`` (the information about the start carried
+forward; ``Phi`` invertible). The expectation over the
 true states is taken over the sample of states passed in (one trajectory: the bound along it; many
 trajectories drawn from the model: the full Bayesian bound). No paper in this workbook gives it;
 notebook 05 puts it under every RMSE curve.
@@ -18,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, spd_matrix
+from .._validate import boolean, finite_array, spd_matrix
 
 __all__ = ["measurement_information", "pcrlb", "pcrlb_position_rmse", "vs_pcrlb"]
 
@@ -39,7 +42,8 @@ def measurement_information(jacobians, R) -> np.ndarray:
 def pcrlb(F, Q, P0, info) -> np.ndarray:
     """Bound matrices ``J_k^-1`` (T, n, n) from the recursion above; ``info`` (T, n, n) holds
     ``E[H_k^T R^-1 H_k]`` per epoch. ``Q`` is one (n, n) matrix or one per epoch (T, n, n),
-    ``Q[k]`` the process noise of the step into epoch ``k`` (``Q[0]`` unused)."""
+    ``Q[k]`` the process noise of the step into epoch ``k`` (``Q[0]`` unused): positive definite,
+    or all zero for a truth without process noise (the module docstring's limit)."""
     F = finite_array("F", F, ndim=2)
     n = F.shape[0]
     info = finite_array("info", info, ndim=3)
@@ -50,18 +54,27 @@ def pcrlb(F, Q, P0, info) -> np.ndarray:
         raise ValueError(f"Q: expected shape ({n}, {n}) or {(info.shape[0], n, n)}, got {Q.shape}")
     P0 = finite_array("P0", P0, shape=(n, n))
     Qs = np.broadcast_to(Q, info.shape)
-    for k in range(1 if Q.ndim == 3 else 0, Qs.shape[0] if Q.ndim == 3 else 1):
-        spd_matrix("Q", Qs[k])
+    deterministic = not np.any(Q[1:] if Q.ndim == 3 else Q)
+    if deterministic:
+        if np.linalg.cond(F) > 1e12:
+            raise ValueError("F: a truth without process noise (Q = 0) needs an invertible F")
+        Fi = np.linalg.inv(F)
+    else:
+        for k in range(1 if Q.ndim == 3 else 0, Qs.shape[0] if Q.ndim == 3 else 1):
+            spd_matrix("Q", Qs[k])
     spd_matrix("P0", P0)
     _psd("info", info)
     J = np.linalg.inv(P0) + info[0]
     out = np.empty_like(info)
     out[0] = np.linalg.inv(J)
     for k in range(1, info.shape[0]):
-        Qi = np.linalg.inv(Qs[k])
-        D11 = F.T @ Qi @ F
-        D12 = -F.T @ Qi
-        J = Qi + info[k] - D12.T @ np.linalg.solve(J + D11, D12)
+        if deterministic:
+            J = Fi.T @ J @ Fi + info[k]
+        else:
+            Qi = np.linalg.inv(Qs[k])
+            D11 = F.T @ Qi @ F
+            D12 = -F.T @ Qi
+            J = Qi + info[k] - D12.T @ np.linalg.solve(J + D11, D12)
         J = 0.5 * (J + J.T)
         out[k] = np.linalg.inv(J)
     return out
@@ -91,12 +104,16 @@ def pcrlb_position_rmse(bounds) -> np.ndarray:
     return np.sqrt(B[..., 0, 0] + B[..., 1, 1])
 
 
-def vs_pcrlb(model, states, P0) -> np.ndarray:
+def vs_pcrlb(model, states, P0, *, process_noise: bool = True) -> np.ndarray:
     """Position RMSE bound (T,) [m] for the virtual-station model along ``states``.
 
     ``states`` is one true trajectory (T, 4) or a sample of them (S, T, 4) (the expectation of
-    the measurement information is the average over the sample).
+    the measurement information is the average over the sample). ``process_noise``: the truth
+    moves with the model's ``Q`` (True) or on a deterministic path from a start drawn from the
+    prior (False, ``Q = 0``: the bound for the presets' noise-free drives, whatever ``q`` a filter
+    is told).
     """
+    process_noise = boolean("process_noise", process_noise)
     if not all(hasattr(model, a) for a in ("jacobian", "R", "F", "Q")):
         raise TypeError(
             f"model: expected a virtual-station model (jacobian, R, F, Q), got {type(model).__name__}"
@@ -105,4 +122,5 @@ def vs_pcrlb(model, states, P0) -> np.ndarray:
     if X.ndim not in (2, 3) or X.shape[-1] != 4:
         raise ValueError(f"states: expected shape (T, 4) or (S, T, 4), got {X.shape}")
     info = measurement_information(model.jacobian(X), model.R)
-    return pcrlb_position_rmse(pcrlb(model.F, model.Q, P0, info))
+    Q = model.Q if process_noise else np.zeros_like(model.Q)
+    return pcrlb_position_rmse(pcrlb(model.F, Q, P0, info))

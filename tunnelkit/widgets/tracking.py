@@ -10,6 +10,9 @@ from .base import Explorer, checkbox, float_slider, int_slider
 
 __all__ = ["upf_explorer", "upf_figure"]
 
+#: the dashed curve's name: what it bounds (the RMSE over runs of this drive), not one run
+NOISE_FREE_BOUND_NAME = "sqrt(PCRLB), this path without process noise (bounds the RMSE over runs)"
+
 
 def upf_figure(
     sigma_theta_deg: float = 2.0,
@@ -20,7 +23,9 @@ def upf_figure(
     seed: int = 0,
 ) -> go.Figure:
     """Position error per epoch of the four ``jiang2023`` estimators on one simulated run, with
-    sqrt(posterior CRLB); the legend gives each one's RMSE over the run."""
+    sqrt(posterior CRLB) of the drive as simulated (its path without process noise, the start
+    from the prior: a bound on the RMSE over many such runs, not on one run's error); the legend
+    gives each one's RMSE over the run."""
     from ..plots.tracking import rmse_bound_figure
     from ..tracking.pcrlb import vs_pcrlb
     from ..tracking.virtual_station import experiment, monte_carlo
@@ -34,13 +39,15 @@ def upf_figure(
     exp = experiment(scenario, level=(float(np.radians(sigma_theta_deg)), float(sigma_d)), los=los)
     res = monte_carlo(exp, 1, int(seed), options={"UPF": {"n_particles": int(n_particles)}})
     err = {n: np.linalg.norm(e[0, :, :2] - exp.truth[:, :2], axis=-1) for n, e in res.items()}
-    bound = vs_pcrlb(exp.model, exp.truth, exp.P0)
+    bound = vs_pcrlb(exp.model, exp.truth, exp.P0, process_noise=False)
     labels = {f"{n} (RMSE {np.sqrt(np.mean(e**2)):.2f} m)": e for n, e in err.items()}
     title = (
         f"{'curved' if curved else 'straight'}, {'LOS' if los else 'NLOS'}: "
         f"sigma_theta = {sigma_theta_deg:g} deg, sigma_d = {sigma_d:g} m, {n_particles} particles"
     )
-    return rmse_bound_figure(exp.times, labels, bound, title=title)
+    return rmse_bound_figure(
+        exp.times, labels, bound, title=title, bound_name=NOISE_FREE_BOUND_NAME
+    )
 
 
 def upf_explorer(**initial) -> Explorer:
