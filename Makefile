@@ -74,9 +74,10 @@ lint: install
 	$(VENV)/bin/ruff format --check $(LINTED)
 	$(PY) tools/check_notebooks.py notebooks
 
-# --dist loadfile: whole test files to each worker, the longest first (tests/conftest.py)
+# --dist loadfile: whole test files to each worker, the longest first (tests/conftest.py); the
+# ten slowest tests are listed at the end
 unit: install rt-deps
-	$(PY) -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder tests
+	$(PY) -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder --durations=10 tests
 
 # tools/nbmake_cache.py keeps each passing run in build/executed/, where the browser tests' site
 # build finds it: `make test` executes every notebook once

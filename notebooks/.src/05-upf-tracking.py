@@ -17,10 +17,11 @@
 # - the posterior Cramér–Rao bound (PCRLB), which the paper never shows: a lower bound on the
 #   mean-square error of *any* filter **averaged over random truths** (the prior's initial state
 #   and the process noise), not an error any filter is promised to reach, and not a floor under
-#   the error on one fixed trajectory (see [bounds](GLOSSARY.md#bounds)) — and how close each
-#   filter gets;
-# - Tables 2 and 3 of the paper beside ours, and which assumption produces the paper's UPF errors
-#   of about 1 cm at its lowest noise level (7 cm at 2° / 2 m).
+#   the error on one fixed trajectory (see [bounds](GLOSSARY.md#bounds)) — and the same recursion
+#   without process noise, which for one fixed path is the classical CRLB of unbiased filters and
+#   does bound the runs of the paper's drive; how close each filter gets;
+# - Tables 2 and 3 of the paper beside ours, and which assumptions reproduce UPF errors of the
+#   size the paper reports (about 1 cm at its lowest noise level, 7 cm at 2° / 2 m).
 
 # %%
 import numpy as np
@@ -70,6 +71,9 @@ print(f"{RUNS} runs, {PARTICLES} particles")
 #
 # with $V_k \sim N(0, R)$, $R = \mathrm{diag}(\sigma_d^2 \dots, \sigma_\theta^2 \dots)$. In NLOS the
 # stations are the two virtual stations; in LOS the base station comes first (the direct path).
+# The paper writes the bearing as $\arctan$ of the ratio, which cannot tell opposite quadrants
+# apart; we use the four-quadrant $\operatorname{atan2}$ (the same where the paper's geometry
+# puts the vehicle, and defined everywhere).
 
 # %%
 exp = vs.experiment("jiang2023-straight", level=2)  # (2 deg, 2 m), NLOS
@@ -94,7 +98,7 @@ print("LOS stations:\n", vs.model_from_scenario("jiang2023-straight", los=True).
 # | --- | --- |
 # | TSWLS | snapshot two-stage weighted least squares (eq. 29–39), one epoch at a time |
 # | EKF | filterpy `ExtendedKalmanFilter`, analytic Jacobian of eq. 45 (sign-corrected eq. A2) |
-# | UKF | filterpy `UnscentedKalmanFilter`, `MerweScaledSigmaPoints` ($\alpha=1, \beta=2, \kappa=0$) |
+# | UKF | filterpy `UnscentedKalmanFilter`, `MerweScaledSigmaPoints` ($\alpha=1, \beta=2, \kappa=0$; the paper, after eq. 50, asks for a small $\alpha$ without a value: ours spreads the sigma points to $\pm\sqrt{n}$ standard deviations) |
 # | UPF | unscented particle filter (eq. 46–63), vectorised over particles |
 #
 # Not in the paper: EKF, UKF and UPF **gate** every measurement vector by default. With the
@@ -246,7 +250,7 @@ particle_cloud_figure(snaps)
 
 
 # %%
-Q01 = "sqrt(PCRLB), H along the nominal path (approx.), q = 0.1"  # the dashed curve's name
+Q01 = "sqrt(PCRLB) of wandering truths (q = 0.1): not a bound on this path"  # the dashed curve
 bound = pcrlb.vs_pcrlb(m, exp.truth, exp.P0)
 # the same simulated runs for every estimator; a progress bar over the estimators
 mc = vs.monte_carlo(exp, RUNS, seed=0, options={"UPF": {"n_particles": PARTICLES}}, progress=True)
@@ -283,16 +287,23 @@ cdf_figure(err, title="CDF of the position error, straight NLOS, 2 deg / 2 m")
 # bound allows for a random truth, and the RMSE can end up below it. Draw the truths from the
 # motion model instead — the start of the straight preset, then $X_k = \Phi X_{k-1} + U_{k-1}$
 # with the same $Q$ — and the bound is the yardstick it was derived for: the ratio comes back to
-# about 1 (the UPF a little above, from its Monte-Carlo sampling). The bound is then the average over the sampled
-# truths of $E[H_k^\mathsf{T}R^{-1}H_k]$, as `vs_pcrlb` does for a stack of trajectories.
+# about 1, within 10 % (15 % in quick mode's few runs), and never below 1 by more than two of its
+# Monte-Carlo standard errors (printed with it: a ratio a little under 1 on a finite sample is
+# sampling, not a broken bound). The bound is then the average over the sampled truths of
+# $E[H_k^\mathsf{T}R^{-1}H_k]$, as `vs_pcrlb` does for a stack of trajectories.
 #
-# The bound that matches the preset itself is the same recursion for truths **without** process
-# noise, its limit $q \to 0$: $J_k = \Phi^{-T} J_{k-1} \Phi^{-1} + E[H_k^T R^{-1} H_k]$, the
-# information about the start carried forward (`vs_pcrlb(..., process_noise=False)`; $q = 10^{-6}$
-# gives the same to 0.1 %), the initial state still drawn from the prior: a bound for exactly
-# straight drives from random starts around this one. A bound depends on how the truth is random, never on what a filter assumes: the
-# filters are told $q = 0.1$, and this bound holds for them too. It lies below the $q = 0.1$
-# curve, and the same runs sit above it (the middle panel, ratios printed).
+# The bound that matches the preset itself is the same recursion **without** process noise, its
+# limit $q \to 0$: $J_k = \Phi^{-T} J_{k-1} \Phi^{-1} + E[H_k^T R^{-1} H_k]$, the information
+# about the start carried forward (`vs_pcrlb(..., process_noise=False)`; $q = 10^{-6}$ gives the
+# same to 0.1 %). Why it bounds *these* runs, where the start is fixed and only the data vary:
+# the path is known up to its start $X_0$, and a run's data are the prior mean, drawn from
+# $N(X_0, P_0)$ — a measurement of $X_0$ with covariance $P_0$ — and the $Z_k$. For that
+# deterministic unknown the recursion is the **classical CRLB**: it bounds the covariance of
+# any unbiased estimator of $X_k$ (the filters are close to unbiased here), whatever $q$ the
+# filter is told. (Averaged over random starts it is also the Bayesian bound of straight drives
+# around this one.) An estimator that knew the path could beat it, as it could beat any bound of
+# a fixed truth; a filter that does not know it cannot. It lies below the $q = 0.1$ curve, and
+# the same runs sit above it (the middle panel, ratios printed).
 
 # %%
 RUNS_MM = tk.mc_count(100, 12)  # truths drawn from the motion model
@@ -306,14 +317,18 @@ for k in range(1, n_t):
 Z_mm = m.simulate(truth_mm[..., :2], rng_mm)
 x0_mm = vs.initial_states(exp.truth[0], exp.P0, rng_mm, size=RUNS_MM)
 bound_mm = pcrlb.vs_pcrlb(m, truth_mm, exp.P0)
-rmse_mm, ratio_mm = {}, {}
+rmse_mm, ratio_mm, se_mm = {}, {}, {}
 for name in tqdm(("EKF", "UKF", "UPF"), desc=f"filters on {RUNS_MM} random truths", leave=False):
     opts = {"n_particles": PARTICLES} if name == "UPF" else {}
     est = vs.run_estimator(name, m, Z_mm, x0_mm, exp.P0, rng=np.random.default_rng(22), **opts)
     mse = np.sum((est[..., :2] - truth_mm[..., :2]) ** 2, axis=-1)  # (runs, T)
     rmse_mm[name] = np.sqrt(mse.mean(axis=0))
     ratio_mm[name] = float(np.sqrt(mse.mean() / np.mean(bound_mm**2)))
+    # its Monte-Carlo standard error, from the spread of the runs' mean squared errors
+    per_run = mse.mean(axis=1)
+    se_mm[name] = ratio_mm[name] * float(per_run.std(ddof=1) / per_run.mean()) / (2 * RUNS_MM**0.5)
 bound0 = pcrlb.vs_pcrlb(m, exp.truth, exp.P0, process_noise=False)  # q -> 0, the limit
+DRIVE_BOUND = "sqrt(PCRLB) of this drive (q -> 0): a bound on the RMSE over runs"
 bound0_6 = pcrlb.vs_pcrlb(  # the recursion with a tiny q approaches it
     vs.experiment("jiang2023-straight", level=2, q=1e-6).model, exp.truth, exp.P0
 )
@@ -323,16 +338,17 @@ print(
     "RMSE / sqrt(PCRLB), noise-free truth, q -> 0  :", {n: round(r, 3) for n, r in ratio0.items()}
 )
 print(
-    "RMSE / sqrt(PCRLB), truths from the model    :", {n: round(r, 3) for n, r in ratio_mm.items()}
+    "RMSE / sqrt(PCRLB), truths from the model    :",
+    {n: f"{r:.3f} +- {se_mm[n]:.3f}" for n, r in ratio_mm.items()},
 )
 bound_ratio_figure(
     exp.times,
     {
-        "the preset, bound q = 0.1": ({n: rmse_t[n] for n in rmse_mm}, bound),
-        "the preset, bound q -> 0": ({n: rmse_t[n] for n in rmse_mm}, bound0),
+        "the preset, q = 0.1 figure (no bound here)": ({n: rmse_t[n] for n in rmse_mm}, bound),
+        "the preset, its bound (q -> 0)": ({n: rmse_t[n] for n in rmse_mm}, bound0),
         f"truths from the model ({RUNS_MM}), q = 0.1": (rmse_mm, bound_mm),
     },
-    title="RMSE / sqrt(PCRLB) per epoch: the bound assumes process noise in the truth",
+    title="RMSE / sqrt(PCRLB) per epoch: the q = 0.1 figure assumes a truth that wanders",
 )
 
 # %% [markdown]
@@ -340,8 +356,9 @@ bound_ratio_figure(
 #
 # The curved preset (a lane change with $\pm 0.24\ \mathrm{m/s^2}$ lateral acceleration) is not a
 # constant-velocity path: the filters absorb the manoeuvre through $Q$. In LOS the direct path
-# adds a third station. (The PCRLB is evaluated along the one true path in both cases, as for
-# the straight preset above.)
+# adds a third station. The dashed curve is each drive's own bound, $q \to 0$ along its true
+# path, as for the straight preset above; on the curved path the manoeuvre enters it as a known
+# input, which the filters do not have, so it stays a bound for them.
 
 # %%
 cur = vs.experiment("jiang2023-curved", level=2).truth
@@ -354,7 +371,7 @@ for name, los in tqdm((("curved NLOS", False), ("straight LOS", True)), leave=Fa
     scen = "jiang2023-curved" if name.startswith("curved") else "jiang2023-straight"
     e2 = vs.experiment(scen, level=2, los=los)
     r2 = vs.monte_carlo(e2, RUNS, seed=1, options={"UPF": {"n_particles": PARTICLES}})
-    b2 = pcrlb.vs_pcrlb(e2.model, e2.truth, e2.P0)
+    b2 = pcrlb.vs_pcrlb(e2.model, e2.truth, e2.P0, process_noise=False)
     mse = {
         n: np.mean(np.sum((e[..., :2] - e2.truth[:, :2]) ** 2, -1), axis=0) for n, e in r2.items()
     }
@@ -365,8 +382,14 @@ rmse_bound_figure(
     exp.times,
     *rmse_c["curved NLOS"],
     title=f"Curved NLOS, 2 deg / 2 m, {RUNS} runs",
-    bound_name=Q01,
+    bound_name=DRIVE_BOUND,
 )
+
+# %% [markdown]
+# Against each drive's own bound the three filters lie above it on both drives, at 1.1 to 1.5
+# times it (ratios printed above), and TSWLS at 4 to 5 times: the lane change costs the filters
+# little, since their $q = 0.1$ lets the velocity follow it, and the third station of LOS lowers
+# the bound and the errors alike.
 
 # %% [markdown]
 # ## 6. Tables 2 and 3: the paper beside ours
@@ -437,8 +460,9 @@ table_figure(t3, cols, title=f"Table 3 (LOS), {RUNS} runs")
 # radio's gain, is printed above Table 3, more than 5 everywhere).
 #
 # **What does not.** EKF and UKF are within a few per cent of each other, and the UPF does not
-# beat them: with 500 particles its mean is a few per cent above the UKF's, with fewer (quick
-# mode's 200) it can lose track on a run and end further above. The tables' `rmse_over_pcrlb`
+# beat them: with 500 particles its mean lies between 3 % below and 6 % above the UKF's (the
+# range printed above Table 3), with fewer (quick mode's 200) it can lose track on a run and end
+# further above. The tables' `rmse_over_pcrlb`
 # is the RMSE over the bound of the drive as simulated, the $q \to 0$ bound of section 5 (not
 # the filters' $q = 0.1$ one, which they beat on this path): the EKF's and UKF's RMSE lies
 # between about 1.2 and 2.2 times it (printed above Table 3), above it at every level as a bound
@@ -464,10 +488,11 @@ table_figure(t3, cols, title=f"Table 3 (LOS), {RUNS} runs")
 # the run bounds the RMSE over runs and epochs. It rests on our reading of what the paper leaves
 # open ($T_1 = 0.1$ s, the preset's 100 epochs, the prior $P_0$ of section 1).
 #
-# Printed below, per noise level: at 0.5° / 0.1 m the paper's RMSEs lie at or above the bound, the
-# UPF's within a few per cent of it; at 1° / 1 m and 2° / 2 m every filter's, EKF and UKF as well as
-# the UPF, lies at 0.3 to 0.6 times it — below what any filter with an honest prior can reach on
-# average over starts, under the assumptions just named — while ours lie above it. Two assumptions
+# Printed below, per noise level: at 0.5° / 0.1 m the paper's EKF and UKF RMSEs lie above the
+# bound (about 2 and 1.75 times), its UPF's about 3 % *below* it; at 1° / 1 m and 2° / 2 m every
+# filter's, EKF and UKF as well as the UPF, lies at 0.3 to 0.6 times it — below what any unbiased
+# filter with this prior can reach on this drive (section 5), under the assumptions just
+# named — while ours lie above it. Two assumptions
 # reproduce numbers of that size: (a) the filter starts at the *true* state with a tiny prior
 # covariance and (almost) no process noise, on a path that is exactly constant-velocity: it then
 # reports its prior and hardly listens to the measurements (it starts from what no filter knows, the
@@ -542,8 +567,8 @@ explorer
 # 2. Run the UPF with `proposal="carried"` (eq. 52 as printed) in a small Monte-Carlo at
 #    2 deg / 2 m. Compare its RMSE and the number of resampling events (`f.resampled`: under the
 #    paper's rule every epoch resamples, ours only below $N/2$, section 4) with the default.
-# 3. Drop every third epoch (`Z[:, ::3] = np.nan`) and rerun. How much does each filter lose? What
-#    does TSWLS do on a missed epoch?
+# 3. Drop every third epoch after the first two (`Z[:, 2::3] = np.nan`) and rerun. How much does
+#    each filter lose? What does TSWLS do on a missed epoch?
 #
 # The solutions are the collapsed cells below, and Run All does not run them. Once you have
 # tried an exercise, click the "Run solution" button under its solution (or run
@@ -554,23 +579,26 @@ explorer
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # %%solution 05.1
-# Solution 1: q ten times larger and smaller, straight and curved (UKF; EKF alike here)
+# Solution 1: q ten times larger and smaller, straight and curved, EKF and UKF
 q0, n_x = exp.model.q, tk.mc_count(20, 6)
-sol1 = {}
+sol1, sol1_ekf = {}, {}
 for scen in ("jiang2023-straight", "jiang2023-curved"):
     for fq in (10.0, 1.0, 0.1):
         e_q = vs.experiment(scen, level=2, q=q0 * fq)
         r_q = vs.monte_carlo(e_q, n_x, seed=2, names=["EKF", "UKF"])
         b_q = pcrlb.vs_pcrlb(e_q.model, e_q.truth, e_q.P0)
-        e2_q = np.sum((r_q["UKF"][..., :2] - e_q.truth[:, :2]) ** 2, axis=-1)
-        sol1[scen, fq] = (np.sqrt(e2_q.mean()), np.sqrt(e2_q.mean() / np.mean(b_q**2)))
+        for name_q, out_q in (("UKF", sol1), ("EKF", sol1_ekf)):
+            e2_q = np.sum((r_q[name_q][..., :2] - e_q.truth[:, :2]) ** 2, axis=-1)
+            out_q[scen, fq] = (np.sqrt(e2_q.mean()), np.sqrt(e2_q.mean() / np.mean(b_q**2)))
         print(
-            f"{scen:20s} q x {fq:4}: RMSE {sol1[scen, fq][0]:.2f} m, RMSE/sqrt(PCRLB) "
-            f"{sol1[scen, fq][1]:.2f}"
+            f"{scen:20s} q x {fq:4}: RMSE EKF {sol1_ekf[scen, fq][0]:.2f} m, UKF "
+            f"{sol1[scen, fq][0]:.2f} m; UKF RMSE/sqrt(PCRLB of the model) {sol1[scen, fq][1]:.2f}"
         )
 st, cu = "jiang2023-straight", "jiang2023-curved"
 assert sol1[st, 0.1][0] < sol1[st, 10.0][0] and sol1[cu, 0.1][1] > 1.0, sol1
 assert max(sol1[st, fq][1] for fq in (10.0, 1.0, 0.1)) < 1.0, sol1  # straight: below the bound
+# EKF and UKF alike (within 5 %) in every case: neither suffers more than the other
+assert all(abs(sol1_ekf[k][0] / sol1[k][0] - 1) < 0.05 for k in sol1), (sol1, sol1_ekf)
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # %%solution 05.2
@@ -603,10 +631,12 @@ assert (
 # Solution 3: every third epoch missed (on solution 2's drives)
 Zp, x0p = exp.simulate(tk.mc_count(20, 4), np.random.default_rng(0))
 Zm = Zp.copy()
-Zm[:, ::3] = np.nan
+Zm[:, 2::3] = np.nan
 sol3 = {}
 for name in ("EKF", "UKF", "TSWLS"):
     full, gaps = (vs.run_estimator(name, m, Z_, x0p, exp.P0) for Z_ in (Zp, Zm))
+    if name == "TSWLS":  # on a missed epoch it repeats the previous epoch's fix
+        assert np.allclose(gaps[:, 2::3, :2], gaps[:, 1::3, :2][:, : gaps[:, 2::3].shape[1]])
     sol3[name] = [
         float(np.sqrt(np.mean(np.sum((e_[..., :2] - exp.truth[:, :2]) ** 2, -1))))
         for e_ in (full, gaps)
@@ -619,9 +649,10 @@ assert all(sol3[n][1] > sol3[n][0] for n in sol3) and sol3["TSWLS"][1] > sol3["U
 # %% [markdown]
 # <details><summary>What to read in the solutions</summary>
 #
-# 1. On the straight path a smaller `q` lowers the RMSE (the filter averages longer) and the
-#    bound with it, and the ratio stays below 1 (section 5: the fixed, noise-free path lets the
-#    filters beat the bound of random drives). On the curve a too small `q` makes the filters lag
+# 1. EKF and UKF behave alike (within 5 %) in every case. On the straight path a smaller `q`
+#    lowers the RMSE (the filter averages longer) and the model's bound with it, and the ratio
+#    stays below 1 (section 5: the fixed, noise-free path lets the filters beat the bound of
+#    random drives; the drive's own bound, $q \to 0$, stays under them). On the curve a too small `q` makes the filters lag
 #    the lane change: the RMSE no longer falls with `q`, and the ratio to the PCRLB (computed for
 #    the model, which does not know about the manoeuvre) rises above 1. A ratio above 1 is also
 #    what any inefficient estimator shows (TSWLS, section 5); here, where EKF and UKF are
@@ -630,8 +661,8 @@ assert all(sol3[n][1] > sol3[n][0] for n in sol3) and sol3["TSWLS"][1] > sol3["U
 #    particle carries most of the weight, so the estimate is close to a single random draw that
 #    drifts.
 # 3. The filters predict through the gaps (with a warning) and lose only a little, since velocity
-#    is well known; TSWLS holds its last fix, so it loses on every missed epoch by the distance
-#    driven meanwhile.
+#    is well known; TSWLS repeats its last fix (the solution checks it), so on every missed epoch
+#    it is off by the distance driven meanwhile, 1.4 m at 14 m/s.
 #
 # </details>
 
@@ -669,12 +700,12 @@ for a in ("TSWLS", *filt):
         assert all(np.diff([mean_of[t, lv, a] for lv in levels_d]) > 0), (t, a)
     assert all(mean_of["LOS", lv, a] < mean_of["NLOS", lv, a] for lv in levels_d), a
 # EKF and UKF within a few (5) per cent of each other; the UPF no better than the UKF beyond noise,
-# a few (6) per cent above it with 500 particles or more, further with fewer (a lost run)
+# between 3 % below and 6 % above it with 500 particles or more, further with fewer (a lost run)
 assert max(abs(d) for d in ekf_ukf) < 0.05, ekf_ukf
 assert min(upf_ukf) > -0.03 and max(upf_ukf) < (0.06 if PARTICLES >= 500 else 0.5), upf_ukf
 # EKF and UKF: about 1.2 to 2.2 times sqrt(PCRLB) of the drive as simulated, above it at every
 # level, furthest at the lowest noise
-assert 1.1 < min(kf_bound) and max(kf_bound) < 2.5, kf_bound
+assert 1.15 < min(kf_bound) and max(kf_bound) < 2.3, kf_bound
 kf_low = [
     ours[t, levels_d[0], a]["rmse_over_pcrlb"] for t in ("NLOS", "LOS") for a in ("EKF", "UKF")
 ]
@@ -682,17 +713,21 @@ kf_high = [
     ours[t, levels_d[-1], a]["rmse_over_pcrlb"] for t in ("NLOS", "LOS") for a in ("EKF", "UKF")
 ]
 assert min(kf_low) > max(kf_high), (kf_low, kf_high)
-assert all(v < 1.3 for v in curves["straight LOS"].values() if v != curves["straight LOS"]["TSWLS"])
+# the curved and the LOS drive: the filters at 1.1 to 1.5 times their drive's bound, TSWLS 4-5x
+for name in curves:
+    assert all(1.1 < curves[name][n] < 1.5 for n in ("EKF", "UKF", "UPF")), curves
+    assert 4.0 < curves[name]["TSWLS"] < 5.0, curves
 # the paper's UPF means and TSWLS mean, as quoted, and the paper's RMSEs from its means and
-# variances against the q -> 0 bound (at 0.1 m at or above it, the UPF's within a few (5) per
-# cent; at 1 m and 2 m every filter's at 0.3 to 0.6 times it) while ours lie above it
+# variances against the q -> 0 bound (at 0.1 m EKF and UKF above it, the UPF's a few per cent
+# below; at 1 m and 2 m every filter's at 0.3 to 0.6 times it) while ours lie above it
 assert (
     paper_t2["UPF", 0.1]["mean_m"] == 0.011
     and paper_t2["UPF", 2.0]["mean_m"] == 0.0742
     and paper_t2["TSWLS", 2.0]["mean_m"] == 0.333
 )
 assert set(bound0_rms) == {0.1, 1.0, 2.0} and len(exp.truth) == 100, bound0_rms
-assert all(paper_over0[0.1, a] > 0.95 for a in filt) and paper_over0[0.1, "UPF"] < 1.05, paper_over0
+assert paper_over0[0.1, "EKF"] > 1.5 and paper_over0[0.1, "UKF"] > 1.5, paper_over0
+assert 0.95 < paper_over0[0.1, "UPF"] < 1.0, paper_over0  # about 3 % below the bound
 assert all(0.3 < paper_over0[sd, a] < 0.6 for sd in (1.0, 2.0) for a in filt), paper_over0
 assert all(ours_over0[sd, a] > 1.0 for sd in levels_d for a in ("EKF", "UKF")), ours_over0
 assert oracle_mean < 0.05  # (a) the oracle assumption yields centimetre "errors" like the paper's
@@ -710,7 +745,9 @@ assert np.all(bound0[1:] < bound[1:]) and all(ratio0[n] > 1.0 for n in ratio0), 
 # noise-free straight truth the same filters end below that ratio
 tol = 0.15 if tk.quick_mode() else 0.10
 assert all(abs(ratio_mm[n] - 1) < tol for n in ("EKF", "UKF")), ratio_mm
-assert 0.9 < ratio_mm["UPF"] < 1 + tol + 0.05, ratio_mm
+assert ratio_mm["UPF"] < 1 + tol + 0.05, ratio_mm
+# a bound: no ratio below 1 by more than two Monte-Carlo standard errors
+assert all(ratio_mm[n] > 1 - 2 * se_mm[n] for n in ratio_mm), (ratio_mm, se_mm)
 assert all(ratio[n] < ratio_mm[n] for n in ("EKF", "UKF", "UPF")), (ratio, ratio_mm)
 # the exercises' readings are asserted in their solutions (run in CI with TUNNELKIT_SOLUTIONS=1)
 

@@ -3,7 +3,8 @@
 Straight trajectory, 100 Monte-Carlo runs of 100 epochs, the four registry members of family
 ``"jiang2023"`` on the same simulated measurements, one row per (noise level, algorithm), the
 paper's numbers beside ours, plus our RMSE and its ratio to the posterior CRLB of the drive as
-simulated (a straight path without process noise from a start drawn from the prior).
+simulated (a straight path without process noise, its start known through the filters' prior
+mean: the classical CRLB of unbiased estimators on that path).
 """
 
 from __future__ import annotations
@@ -79,7 +80,8 @@ def _level_rows(
     from ..tracking.virtual_station import FAMILY, experiment
 
     exp = experiment(scenario, level=lv, los=los)
-    # the bound of the truth as simulated: one path, no process noise, the start from the prior
+    # the bound of the truth as simulated: one path, no process noise, the start known through
+    # the prior mean (the classical CRLB of unbiased estimators on that path)
     # (the filters' q = 0.1 bound assumes a truth that wanders, and on this path they beat it)
     bound = vs_pcrlb(exp.model, exp.truth, exp.P0, process_noise=False)
     rng_data, *rng_alg = spawn_rngs(rng, 1 + len(names))
@@ -121,9 +123,9 @@ _NOTES = [
     f"UPF: {N_PARTICLES} particles, UKF proposal conditioned on each particle, systematic resampling at "
     "ESS < N/2.",
     "rmse_over_pcrlb = sqrt(mean MSE / mean PCRLB) along the run: the PCRLB (Tichavský 1998 recursion at the "
-    "true states) of the drive as simulated, a straight path without process noise from a start drawn from "
-    "the prior, which every estimator's RMSE lies above; the filters' own q = 0.1 bound does not bound a "
-    "noise-free path (notebook 05, section 5).",
+    "true states) of the drive as simulated: a straight path without process noise, its start known "
+    "through the prior mean, so the classical CRLB of unbiased estimators on that path; the filters' own "
+    "q = 0.1 bound does not bound a noise-free path (notebook 05, section 5).",
     f"'{PREDICTION_ONLY}': the baseline, the filters' CV model from the same prior with every "
     "measurement dropped (the EKF predicting only); the radio's gain is its RMSE over a filter's.",
     "The paper's UPF means (0.011 m at sigma_d = 0.1 m) lie far below the measurement noise: they need a filter "

@@ -109,9 +109,11 @@ def vs_pcrlb(model, states, P0, *, process_noise: bool = True) -> np.ndarray:
 
     ``states`` is one true trajectory (T, 4) or a sample of them (S, T, 4) (the expectation of
     the measurement information is the average over the sample). ``process_noise``: the truth
-    moves with the model's ``Q`` (True) or on a deterministic path from a start drawn from the
-    prior (False, ``Q = 0``: the bound for the presets' noise-free drives, whatever ``q`` a filter
-    is told).
+    moves with the model's ``Q`` (True) or on a deterministic path known up to its start (False,
+    ``Q = 0``): for one fixed path, whose start the data know through the prior mean (drawn from
+    ``N(X_0, P0)``), the classical CRLB of any unbiased estimator; over random starts, the
+    Bayesian bound. It is the bound for the presets' noise-free drives, whatever ``q`` a filter
+    is told.
     """
     process_noise = boolean("process_noise", process_noise)
     if not all(hasattr(model, a) for a in ("jacobian", "R", "F", "Q")):

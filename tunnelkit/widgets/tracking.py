@@ -24,7 +24,8 @@ def upf_figure(
 ) -> go.Figure:
     """Position error per epoch of the four ``jiang2023`` estimators on one simulated run, with
     sqrt(posterior CRLB) of the drive as simulated (its path without process noise, the start
-    from the prior: a bound on the RMSE over many such runs, not on one run's error); the legend
+    known through the prior mean: a bound on the RMSE of unbiased estimators over many such runs,
+    not on one run's error); the legend
     gives each one's RMSE over the run."""
     from ..plots.tracking import rmse_bound_figure
     from ..tracking.pcrlb import vs_pcrlb
