@@ -6,14 +6,18 @@ the maximum-likelihood route (``extract_paths(refine="ml")``)."""
 from __future__ import annotations
 
 import itertools
+import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 from run import Case
 
 from tunnelkit import simulation as ex
 from tunnelkit.tracking.javelin import Javelin, JavelinWarning, PathMeasurements, designs
-from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
 
 
 def cases() -> list[Case]:

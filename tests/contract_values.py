@@ -299,8 +299,9 @@ def _design():
 
 
 def _javelin():
+    from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
+
     from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
-    from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 
     rng = np.random.default_rng(0)
     bs = (0.0, 0.0, 4.8)
@@ -472,11 +473,12 @@ def _baselines_tracking():
 def _known_surfaces():
     """The design's tracker pieces: an honest start, VUEs from known planes and the batch form
     of the bound over the drive."""
+    from javelin_geometric import geometric_paths, toy_reflectors
+
     from tunnelkit import design
     from tunnelkit.design.arrayjob import design_planes
     from tunnelkit.tracking.javelin import JavelinState, draw_start
     from tunnelkit.tracking.javelin.config import JavelinConfig
-    from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
     from tunnelkit.tracking.javelin.noise import ReportedNoise
     from tunnelkit.tracking.javelin.surfaces import GeometricBirth, mirror_vue
 
@@ -588,7 +590,7 @@ def _consistency():
     planes = tunnel_planes(route.tunnel)
     geometry_consistency(m.direction, m.d, m.origin, planes, 1e-3, 1e-3, 0.05)
     consistent_paths(m, route.tunnel, sigma_phi=1e-3, sigma_psi=1e-3, sigma_d=0.05)
-    bound_sigmas(ep.estimates, ep.array, route.config, ep.measurements.index)
+    bound_sigmas(ep.estimates, ep.array, route.config, ep.measurements.source)
     epoch_consistency(ep, route, bound=False, floor_angle=1e-2, floor_range=0.3)
 
 
@@ -604,7 +606,7 @@ def _traced():
 
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(10, np.random.default_rng(0), refine="ml")
-    joint_bound(ep.estimates, ep.array, route.config, ep.measurements.index)
+    joint_bound(ep.estimates, ep.array, route.config, ep.measurements.source)
     pos = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
     src = np.array([[0.3, 0.2, 4.0], [-0.5, 0.4, 6.0]])
     joint_fisher([1.0 + 0.5j, 0.5j], src, pos, [-0.7, -1.1], [0.05, -0.02], 4, 3, 0.3, 3.5e9)

@@ -292,8 +292,9 @@ def javelin_records():
     checked constructors from a short run's report."""
     import dataclasses as dc
 
+    from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
+
     from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
-    from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
     from tunnelkit.tracking.javelin.measurement import track_model
     from tunnelkit.tracking.javelin.update import stack_measurement
 
@@ -332,7 +333,6 @@ def channel_budgets():
     from tunnelkit.design.achievable import DesignImpairments, path_error_model
     from tunnelkit.design.channelbudget import channel_budget
     from tunnelkit.signal_route import judging
-    from tunnelkit.signal_route.measurements import restrict_rows
 
     setup = short_setup()
     model = path_error_model(setup, "4x4", DesignImpairments(phase_error_deg=1.0))
@@ -352,7 +352,7 @@ def channel_budgets():
         ep.estimates, ep.snapshot.H, ep.array.local, route.config.fc, 0.0, calibration=(1.0, 0.0)
     )
     judging.calibration_floor(1.0, 0.2, np.abs(ep.snapshot.H).sum(axis=(1, 2)))
-    restrict_rows(m, np.arange(len(m)))
+    m.subset(np.arange(len(m)))
 
 
 DRIVERS = (

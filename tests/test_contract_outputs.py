@@ -7,12 +7,12 @@ import dataclasses
 
 import numpy as np
 import pytest
+from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
 
 from tunnelkit import _checks, design
 from tunnelkit.design import verdict
 from tunnelkit.design.errormodel import psd_sqrt
 from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
-from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 
 
 @pytest.fixture(scope="module")

@@ -375,7 +375,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "signed: a receding source has a negative velocity and Doppler shift",
     ),
     _doc(
-        r"extraction\.estimates\.PathEstimates|signal_route\.RouteMeasurements",
+        r"extraction\.estimates\.PathEstimates",
         r"kappa|kappa_nf",
         "nan",
         "NaN: a far-field path has no curvature (the docstring's contract)",
@@ -385,12 +385,6 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"doppler|toa",
         "nan",
         "NaN marks a dropped epoch (the docstring's contract; ``dropped`` flags it too)",
-    ),
-    _doc(
-        r"signal_route\.RouteMeasurements",
-        r"array",
-        "empty",
-        "the name of an unnamed array (a label only)",
     ),
     _doc(
         r"rt\.compare\.(compare_paths|worst_errors)",
@@ -413,16 +407,10 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(
         r"tracking\.javelin\.(manage\.(FixedBirth|MeasuredBirth|static_doppler)"
-        r"|surfaces\.GeometricBirth|geometric\.geometric_paths)",
+        r"|surfaces\.GeometricBirth)",
         r"doppler_sign|sign",
         "negative",
         "-1 is one of the two signs (the channel's convention, the default); 0, 2, NaN refused",
-    ),
-    _doc(
-        r"tracking\.javelin\.geometric\.geometric_paths",
-        r"clock_bias",
-        "negative",
-        "a clock bias takes any sign",
     ),
     _doc(
         r"tracking\.javelin\.manage\.intersection", r"x_u", "negative", "a coordinate [m]: any sign"
@@ -544,12 +532,6 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a delay with the clock bias in it (channel_tensor passes min(tau + b)): any sign",
     ),
     _doc(
-        r"tracking\.javelin\.geometric\.(geometric_paths|geometric_stream)",
-        r"planes",
-        "empty",
-        "no reflector: the LoS path alone",
-    ),
-    _doc(
         r"tracking\.javelin\.tracker\.(JavelinRun|StepReport)|tracking\.javelin\.tenfiloc"
         r"\.TeNFiLocFix",
         r"reports|associated|(prior_)?ids|paths",
@@ -607,18 +589,6 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"paths",
         "empty",
         "no true path recorded in the snapshot (tensor_snapshot's default)",
-    ),
-    _doc(
-        r"signal_route\.measurements\.RouteMeasurements",
-        r"kappa",
-        "nan",
-        "NaN is the curvature of a far-field path (no wave origin to report)",
-    ),
-    _doc(
-        r"signal_route\.measurements\.RouteMeasurements",
-        r"array",
-        "empty",
-        "the array's label: an unnamed ArrayGeometry (its default name) is measured too",
     ),
     _doc(
         r"design\.(report|records|confirm)\.(DesignReport|ConfirmedReport)",
@@ -695,8 +665,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "share 1: a calibration error that large leaves no received power to the model",
     ),
     _doc(
-        r"signal_route\.measurements\.restrict_rows",
-        r"rows",
+        r"tracking\.javelin\.measurement\.PathMeasurements\.subset",
+        r"idx",
         "empty",
         "no row kept: measurements of no path (the route's own case of an empty epoch)",
     ),

@@ -177,6 +177,8 @@ def test_javelin_step_records_built_unchecked_are_what_the_checked_records_accep
     constructor, passes every field check and equals the unchecked one, byte for byte."""
     import warnings
 
+    from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
+
     from tunnelkit.tracking.javelin import (
         ConsiderNoise,
         Javelin,
@@ -185,7 +187,6 @@ def test_javelin_step_records_built_unchecked_are_what_the_checked_records_accep
         PathMeasurements,
         designs,
     )
-    from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
     from tunnelkit.tracking.javelin.measurement import track_model
     from tunnelkit.tracking.javelin.update import stack_measurement
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from javelin_geometric import toy_reflectors
 
 from tunnelkit.crlb import numeric_jacobian, wrap_angle
 from tunnelkit.geometry import reflector_point
@@ -13,7 +14,6 @@ from tunnelkit.tracking.javelin import (
     measurement_model,
     track_model,
 )
-from tunnelkit.tracking.javelin.geometric import toy_reflectors
 from tunnelkit.tracking.javelin.manage import manage_tracks, static_doppler
 from tunnelkit.tracking.javelin.motion import motion_increment, predict
 from tunnelkit.tracking.javelin.update import stack_measurement

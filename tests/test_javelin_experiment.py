@@ -1,5 +1,6 @@
 import numpy as np
 import pytest
+from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
 
 from tunnelkit import simulation as ex
 from tunnelkit.plots.javelin import (
@@ -16,7 +17,6 @@ from tunnelkit.reproduce.javelin_tables import (
     table_rows,
 )
 from tunnelkit.tracking.javelin import designs
-from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
 
 BS = np.array([0.0, 0.0, 4.8])

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
+from javelin_geometric import geometric_paths, toy_reflectors
 
 from tunnelkit.tracking.javelin import FixedBirth, JavelinConfig, JavelinState, PathMeasurements
-from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
 from tunnelkit.tracking.javelin.manage import intersection, los_test, manage_tracks, static_doppler
 
 BS = np.array([0.0, 0.0, 4.8])

@@ -1,5 +1,6 @@
 import numpy as np
 import pytest
+from javelin_geometric import geometric_paths, toy_reflectors
 
 from tunnelkit.crlb import numeric_jacobian
 from tunnelkit.geometry import reflector_point
@@ -9,7 +10,6 @@ from tunnelkit.tracking.javelin import (
     measurement_model,
     track_model,
 )
-from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
 
 BS = np.array([0.0, 0.0, 4.8])
 
@@ -84,3 +84,37 @@ def test_bad_state_rejected():
         track_model(np.zeros(4))
     with pytest.raises(ValueError, match=r"^x"):
         track_model(np.array([0.0, 0.0, 1.0]))  # on the base station's axis
+
+
+def test_derived_fields_follow_the_stored_ones():
+    """The container's derived fields: ``near_field`` where a curvature is given, ``delta_d``
+    (eq. 52) re-referenced to the first row of a subset, ``z`` (eq. 54), unit ``direction``
+    from the angles, ``wave_origins`` from ``origin`` (kept by ``subset`` and ``sanitised``,
+    needed by ``wave_origins``, three finite coordinates)."""
+    pm = PathMeasurements(
+        [0.1, -0.2, 0.3], [0.05, 0.0, -0.1], [12.0, np.nan, 30.0], [10.0, 13.5, 20.0],
+        [1.0, -2.0, 0.5], origin=[1.0, 2.0, 3.0],
+    )  # fmt: skip
+    np.testing.assert_array_equal(pm.near_field, [True, False, True])
+    np.testing.assert_array_equal(pm.delta_d, [0.0, 3.5, 10.0])
+    np.testing.assert_array_equal(pm.z, np.r_[pm.phi, pm.psi, pm.kappa, 3.5, 10.0])
+    u = pm.direction
+    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, atol=1e-15)
+    np.testing.assert_allclose(np.arctan2(u[:, 1], u[:, 0]), pm.phi, atol=1e-15)
+    np.testing.assert_allclose(np.arcsin(u[:, 2]), pm.psi, atol=1e-15)
+    w = pm.wave_origins
+    np.testing.assert_allclose(w[0], [1.0, 2.0, 3.0] + 12.0 * u[0], atol=1e-12)
+    assert np.isnan(w[1]).all()
+    tail = pm.subset(np.array([1, 2]))
+    np.testing.assert_array_equal(tail.delta_d, [0.0, 6.5])
+    np.testing.assert_array_equal(tail.origin, pm.origin)
+    np.testing.assert_array_equal(tail.source, [1, 2])
+    np.testing.assert_array_equal(pm.sanitised(0.0)[0].origin, pm.origin)
+    bare = PathMeasurements.from_arrays([0.1], [0.0], [5.0], [5.0], [0.0])
+    assert bare.origin is None
+    with pytest.raises(ValueError, match=r"^origin"):
+        _ = bare.wave_origins
+    with pytest.raises(ValueError, match=r"^origin"):
+        PathMeasurements([0.1], [0.0], [5.0], [5.0], [0.0], origin=[0.0, 1.0])
+    with pytest.raises(ValueError, match=r"^origin"):
+        PathMeasurements([0.1], [0.0], [5.0], [5.0], [0.0], origin=[0.0, np.nan, 1.0])

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from javelin_geometric import toy_reflectors
 
 from tunnelkit.crlb import numeric_jacobian
 from tunnelkit.tracking.javelin import JavelinConfig, JavelinState
-from tunnelkit.tracking.javelin.geometric import toy_reflectors
 from tunnelkit.tracking.javelin.motion import motion_increment, predict
 
 

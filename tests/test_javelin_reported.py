@@ -180,7 +180,7 @@ def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles
     assert m.cov is not None and m.cov.shape == (len(m), 3, 3)
     # brute force: push the local wave-origin covariance through finite differences of
     # (phi, psi, r) of the world point origin + R src
-    b = estimate_crlb(est, arr, route.config, paths=m.index)
+    b = estimate_crlb(est, arr, route.config, paths=m.source)
     h = 1e-5
     for jj in range(len(m)):
         src = b["source"][jj]
@@ -189,7 +189,7 @@ def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles
         np.testing.assert_allclose(m.cov[jj], G @ b["source_cov"][jj] @ G.T, rtol=1e-5)
     # with every path kept (as here), the subset is the whole joint bound
     full = estimate_crlb(est, arr, route.config)
-    np.testing.assert_allclose(full["source_cov"][m.index], b["source_cov"], rtol=1e-10)
+    np.testing.assert_allclose(full["source_cov"][m.source], b["source_cov"], rtol=1e-10)
     # at the estimate vs at the truth: the same bound to within the estimate's own scatter
     truth = path_crlb(ep.paths, arr, route.config)
     ti = np.asarray(ep.truth_index)
@@ -199,7 +199,7 @@ def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles
     np.testing.assert_allclose(kap, truth["kappa"][ti[ok]], rtol=0.5)
     # a fit that failed its residual test reports nothing
     bad = dataclasses.replace(est, fit=dataclasses.replace(est.fit, rho=2.0, rho_max=1.05))
-    assert reported_covariance(bad, m.index, arr, route.config) == (None, None)
+    assert reported_covariance(bad, m.source, arr, route.config) == (None, None)
 
 
 def test_design_monte_carlo_settles_near_the_bound():

@@ -6,6 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
 
 from tunnelkit.tracking.javelin import (
     Associator,
@@ -27,7 +28,6 @@ from tunnelkit.tracking.javelin import (
     designs,
     run_javelin,
 )
-from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 
 BS = (0.0, 0.0, 4.8)
 SIG = {"phi": np.radians(1.0), "psi": np.radians(1.0), "kappa": 1.0, "d": 0.3}

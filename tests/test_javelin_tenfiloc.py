@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
+from javelin_geometric import geometric_paths, toy_reflectors
 
 from tunnelkit.tracking.javelin import PathMeasurements, TeNFiLoc
-from tunnelkit.tracking.javelin.geometric import geometric_paths, toy_reflectors
 
 BS = (0.0, 0.0, 4.8)
 PU = np.array([-22.0, 1.4, 1.0])

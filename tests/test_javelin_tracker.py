@@ -1,5 +1,11 @@
 import numpy as np
 import pytest
+from javelin_geometric import (
+    geometric_paths,
+    geometric_stream,
+    toy_drive,
+    toy_reflectors,
+)
 
 from tunnelkit.tracking.javelin import (
     Associator,
@@ -13,12 +19,6 @@ from tunnelkit.tracking.javelin import (
     MirrorMotion,
     PathMeasurements,
     run_javelin,
-)
-from tunnelkit.tracking.javelin.geometric import (
-    geometric_paths,
-    geometric_stream,
-    toy_drive,
-    toy_reflectors,
 )
 
 BS = (0.0, 0.0, 4.8)

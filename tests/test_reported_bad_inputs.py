@@ -71,7 +71,7 @@ def test_vsmodel_los_not_a_bool():
 
 
 def test_toy_drive_negative_count():
-    from tunnelkit.tracking.javelin.geometric import toy_drive
+    from javelin_geometric import toy_drive
 
     _raises(ValueError, r"^n", toy_drive, -5, 0.1)
 
@@ -460,17 +460,23 @@ def test_rejudge_refuses_real_tensors_bad_carriers_and_shares(ml_epoch):
     _raises(ValueError, r"^element_positions", rejudge, ep.estimates, H, pos[:, :2], fc, 0.01)
 
 
-def test_restrict_rows_and_apply_budget_check_their_arguments(ml_epoch):
+def test_subset_of_route_measurements_and_apply_budget_check_their_arguments():
+    """A row subset of an epoch's measurements keeps the array's position and re-references the
+    delay differences to its first row (eq. 52); bad rows are refused naming ``idx``."""
     from tunnelkit.signal_route.judging import apply_budget
-    from tunnelkit.signal_route.measurements import restrict_rows
 
-    _, ep = ml_epoch
-    m = ep.measurements
-    assert len(restrict_rows(m, np.arange(len(m)))) == len(m)
-    assert len(restrict_rows(m, [])) == 0
-    _raises(TypeError, r"^rows", restrict_rows, m, np.array([0.5]))
-    _raises(ValueError, r"^rows", restrict_rows, m, [len(m)])
-    _raises(TypeError, r"^m: expected", restrict_rows, "m", [0])
+    m = tk.signal_route.simulate_epoch("italiano2026-straight", 10, np.random.default_rng(0))
+    m = m.measurements
+    assert len(m) >= 3
+    assert len(m.subset(np.arange(len(m)))) == len(m)
+    assert len(m.subset([])) == 0
+    tail = m.subset(np.arange(1, len(m)))
+    np.testing.assert_array_equal(tail.origin, m.origin)
+    np.testing.assert_array_equal(tail.source, m.source[1:])
+    assert tail.delta_d[0] == 0.0
+    np.testing.assert_allclose(tail.delta_d, m.delta_d[1:] - m.delta_d[1], rtol=0, atol=1e-9)
+    _raises(TypeError, r"^idx", m.subset, np.array([0.5]))
+    _raises(ValueError, r"^idx", m.subset, [len(m)])
     _raises(TypeError, r"^meas: expected", apply_budget, None, None, 0)
 
 
@@ -532,8 +538,9 @@ def test_javelin_with_a_vanishing_gate_probability_runs_finite():
     # reported as JavelinConfig(update_gate=1e-300) -> ZeroDivisionError later: the field is
     # gate_probability (eq. 59's p); a gate that small admits almost nothing, and the tracker
     # predicts through it with finite estimates
+    from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
+
     from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
-    from tunnelkit.tracking.javelin.geometric import geometric_stream, toy_drive, toy_reflectors
 
     bs = (0.0, 0.0, 4.8)
     P, V = toy_drive(12, 0.1, amplitude=0.5, speed=4.0)

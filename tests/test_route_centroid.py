@@ -81,9 +81,13 @@ def test_unresolved_curvature_is_reported_from_the_centroid():
     # the threshold: unresolved below z sigma_kappa
     at = 4.0 / UNRESOLVED_Z
     cov[0, 2, 2] = (at * 1.001) ** 2
-    assert np.isnan(_centroid_far_field(replace(meas, cov=cov), est, arr).kappa[0])
+    assert np.isnan(
+        _centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr).kappa[0]
+    )
     cov[0, 2, 2] = (at * 0.999) ** 2
-    assert not np.isnan(_centroid_far_field(replace(meas, cov=cov), est, arr).kappa[0])
+    assert not np.isnan(
+        _centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr).kappa[0]
+    )
 
 
 def test_centroid_far_field_without_covariance_and_bad_input():

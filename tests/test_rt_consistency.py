@@ -157,7 +157,7 @@ def test_bound_sigmas_match_the_reported_covariance(scene):
         epoch_consistency(m, route)
     with pytest.raises(TypeError, match="est"):
         bound_sigmas(m, ep.array, route.config)
-    np.testing.assert_array_equal(bound_sigmas(ep.estimates, ep.array, route.config, m.index), sig)
+    np.testing.assert_array_equal(bound_sigmas(ep.estimates, ep.array, route.config, m.source), sig)
     for bad in ([0, 0], [-1], [99], [[0]], [0.5]):
         with pytest.raises(ValueError, match="keep"):
             bound_sigmas(ep.estimates, ep.array, route.config, bad)
@@ -216,8 +216,8 @@ def test_joint_bound_blocks_are_the_per_path_bound(scene):
     route = scene[0]
     ep = route.epoch(10, np.random.default_rng(5), refine="ml")
     m = ep.measurements
-    cov = joint_bound(ep.estimates, ep.array, route.config, m.index)
-    sig = bound_sigmas(ep.estimates, ep.array, route.config, m.index)
+    cov = joint_bound(ep.estimates, ep.array, route.config, m.source)
+    sig = bound_sigmas(ep.estimates, ep.array, route.config, m.source)
     np.testing.assert_allclose(np.sqrt(np.diag(cov)).reshape(-1, 3), sig, rtol=1e-8)
     corr = cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))
     assert np.abs(corr - np.eye(len(cov))).max() > 0.3

@@ -26,7 +26,7 @@ Without ``cov`` the correlations within a path and between paths are left out (t
 then over-rejects: the ML fit's paths are correlated up to 0.9 at the presets' geometry); with
 the joint covariance ``cov`` of all paths the statistic is the generalised least-squares
 chi-square. :func:`consistent_paths` runs it on a
-route's measurements (the rows of :class:`tunnelkit.signal_route.RouteMeasurements`).
+route's measurements (the rows of a :class:`tunnelkit.tracking.javelin.PathMeasurements`).
 """
 
 from __future__ import annotations
@@ -293,9 +293,11 @@ def consistent_paths(measurements, tunnel, origin=None, **kw) -> dict:
     m = measurements
     for name in ("phi", "psi", "d", "direction", "origin"):
         if not hasattr(m, name):
-            raise TypeError(f"measurements: expected a RouteMeasurements, got {type(m).__name__}")
+            raise TypeError(f"measurements: expected a PathMeasurements, got {type(m).__name__}")
     instance("tunnel", tunnel, Tunnel3D)
     o = m.origin if origin is None else vector("origin", origin, 3)
+    if o is None:
+        raise ValueError("origin: the measurements carry no origin; give the array's position")
     if getattr(m, "cov", None) is not None and "sigma_phi" not in kw:
         kw.setdefault("sigma_phi", np.sqrt(m.cov[:, 0, 0]))
         kw.setdefault("sigma_psi", np.sqrt(m.cov[:, 1, 1]))

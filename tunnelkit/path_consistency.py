@@ -50,7 +50,7 @@ def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.
     """(K, 3) CRLB standard deviations at the estimate ``est`` (a
     :class:`tunnelkit.extraction.PathEstimates`) of the world azimuth, elevation [rad] and range
     [m] of the paths ``keep`` (indices into ``est``, in their order; default the paths Algorithm 1
-    keeps with its printed check ``d >= 0``, as ``RouteMeasurements.index``): the route's
+    keeps with its printed check ``d >= 0``, as ``PathMeasurements.source``): the route's
     reported covariance (:func:`tunnelkit.signal_route.reported_covariance`, ``judged=False``).
     Raises ``numpy.linalg.LinAlgError`` where the Fisher information is singular."""
     from .extraction import PathEstimates, algorithm1
@@ -183,11 +183,11 @@ def epoch_consistency(
     joint = boolean("joint", joint)  # checked whether or not the bound is asked for
     m = ep.measurements
     if boolean("bound", bound):
-        sig = bound_sigmas(ep.estimates, ep.array, route.config, m.index)
+        sig = bound_sigmas(ep.estimates, ep.array, route.config, m.source)
         if sig.shape[0] != len(m):
             raise RuntimeError("bound_sigmas: rows differ from the epoch's measurements")
         if boolean("joint", joint) and len(m) >= 2:
-            kw.setdefault("cov", joint_bound(ep.estimates, ep.array, route.config, m.index))
+            kw.setdefault("cov", joint_bound(ep.estimates, ep.array, route.config, m.source))
     else:
         if not (kw.get("floor_angle") and kw.get("floor_range")):
             raise ValueError("bound: without the bound, give floor_angle and floor_range")

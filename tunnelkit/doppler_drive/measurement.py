@@ -19,7 +19,9 @@ __all__ = ["DopplerToaMeasurements", "GnssFix", "gnss_fix", "measure"]
 
 @dataclass(frozen=True)
 class DopplerToaMeasurements:
-    """One noisy realisation: Doppler [Hz] and ToA [s] per epoch; dropped epochs are NaN in both.
+    """One noisy realisation: Doppler [Hz] and ToA [s] per epoch; dropped epochs are NaN in both
+    (Halili's one-path scalar series over a whole drive, not JAVELIN's per-epoch paths,
+    :class:`tunnelkit.tracking.javelin.PathMeasurements`).
 
     ``dropped`` marks them explicitly; ``outlier`` marks Doppler samples that locked on a moving
     scatterer; ``parts`` holds each error term for teaching plots.

@@ -15,7 +15,8 @@ Algorithm 1's checks (:func:`measurements_from_estimates`). Matching estimates t
     ep.paths                     # ground truth (tunnelkit.propagation.Path list)
 
 or ``signal_route.simulate_epoch("italiano2026-straight", 10, rng)`` for a single call. Angles in
-``ep.measurements`` are world-frame azimuth/elevation (eq. 46-47, 49-50) seen from ``origin``.
+``ep.measurements`` (a :class:`tunnelkit.tracking.javelin.PathMeasurements`, what the trackers
+take) are world-frame azimuth/elevation (eq. 46-47, 49-50) seen from ``origin``.
 
 The package's modules follow its jobs: :mod:`~tunnelkit.signal_route.measurements` (Algorithm 1's
 world-frame measurements of one epoch and the covariance the extraction reports),
@@ -26,7 +27,7 @@ the route was told about).
 
 from __future__ import annotations
 
-from .measurements import Epoch, RouteMeasurements, measurements_from_estimates, reported_covariance
+from .measurements import Epoch, measurements_from_estimates, reported_covariance
 from .options import RouteOptions
 from .route import CHANNELS, MAX_SECOND_ORDER, SignalRoute, simulate_epoch
 
@@ -34,7 +35,6 @@ __all__ = [
     "CHANNELS",
     "MAX_SECOND_ORDER",
     "Epoch",
-    "RouteMeasurements",
     "RouteOptions",
     "SignalRoute",
     "measurements_from_estimates",

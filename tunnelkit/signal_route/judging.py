@@ -73,6 +73,7 @@ from .._physical import carrier
 from .._validate import finite_array, instance, integer, nonnegative, positive, record, sequence
 from ..channel import Impairments
 from ..evaluation import match_points
+from ..tracking.javelin.measurement import PathMeasurements
 
 __all__ = [
     "FLOOR_FALSE_ALARM",
@@ -290,13 +291,11 @@ class BiasBudget:
 
 
 def apply_budget(meas, budget: BiasBudget, k: int):
-    """``meas`` (a :class:`~tunnelkit.signal_route.measurements.RouteMeasurements` with
+    """``meas`` (a :class:`~tunnelkit.tracking.javelin.PathMeasurements` with
     reported covariances) with the budget of its matched slots added: ``cov`` + the ``(phi, psi,
     kappa)`` block of ``extra``, ``sigma_d`` in quadrature with its ``d`` variance, ``bias_cov``
     the slots' ``repeating`` (zero for an estimate matched to no slot)."""
-    from .measurements import RouteMeasurements
-
-    instance("meas", meas, RouteMeasurements)
+    instance("meas", meas, PathMeasurements)
     instance("budget", budget, BiasBudget)
     integer("k", k, minimum=0, maximum=budget.exists.shape[0] - 1)
     if meas.cov is None or not len(meas):

@@ -1,6 +1,6 @@
-"""Algorithm 1's measurements of one epoch in the world frame (:class:`RouteMeasurements`), the
-epoch record (:class:`Epoch`) and the covariance the extraction reports
-(:func:`reported_covariance`)."""
+"""Algorithm 1's measurements of one epoch in the world frame (:func:`measurements_from_estimates`,
+a :class:`~tunnelkit.tracking.javelin.PathMeasurements`), the epoch record (:class:`Epoch`) and
+the covariance the extraction reports (:func:`reported_covariance`)."""
 
 from __future__ import annotations
 
@@ -14,76 +14,28 @@ from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
 from ..evaluation import match_paths
+from ..tracking.javelin.measurement import PathMeasurements
 
 __all__ = [
     "Epoch",
-    "RouteMeasurements",
     "measure_epoch",
     "measurements_from_estimates",
     "reported_covariance",
-    "restrict_rows",
 ]
 
 
-_SHAPES = dict.fromkeys("phi psi kappa near_field d delta_d v alpha index sigma_d".split(), ("K",))
-_SHAPES.update(
-    origin=(3,), direction=("K", 3), cov=("K", 3, 3), bias_cov=("K", 4, 4)
-)  # RouteMeasurements' fields
 _EPOCH_SHAPES = {"ue": (3,), "velocity": (3,), "truth_index": (None,)}  # Epoch's fields
 
 
 @dataclass(frozen=True)
-class RouteMeasurements:
-    """Algorithm 1 output for one array, angles in the **world** frame, seen from ``origin``.
-
-    Per kept path (sorted by ``d``; path 0 is the earliest arrival): ``phi``/``psi`` azimuth and
-    elevation (eq. 46-47), ``kappa`` (NaN when far-field), ``near_field``, ``d`` (biased distance),
-    ``delta_d = d - d[0]`` (eq. 52, ``delta_d[0] = 0``), ``v`` (m/s), ``direction`` (K, 3) world unit
-    vectors, ``alpha``. ``z`` is eq. 54, ``[phi; psi; kappa; delta_d[1:]]``. ``index`` maps each
-    kept path to its row in the raw :class:`tunnelkit.extraction.PathEstimates`.
-    ``cov`` (K, 3, 3) / ``sigma_d`` (K,): the uncertainty the extraction reports for
-    ``(phi, psi, kappa)`` and ``d`` (:func:`reported_covariance`), ``None`` unless the route
-    was asked for it. ``bias_cov`` (K, 4, 4): the share of the error of ``(phi, psi, kappa, d)``
-    that repeats every epoch (a route with a bias budget,
-    :func:`~tunnelkit.signal_route.judging.apply_budget`), ``None`` otherwise.
-    """
-
-    origin: np.ndarray
-    array: str
-    phi: np.ndarray
-    psi: np.ndarray
-    kappa: np.ndarray
-    near_field: np.ndarray
-    d: np.ndarray
-    delta_d: np.ndarray
-    v: np.ndarray
-    direction: np.ndarray
-    alpha: np.ndarray
-    index: np.ndarray
-    cov: np.ndarray | None = None
-    sigma_d: np.ndarray | None = None
-    bias_cov: np.ndarray | None = None
-
-    def __post_init__(self) -> None:  # kappa is NaN for a far-field path
-        record(self, shapes=_SHAPES, allow_nan=("kappa",), may_be_empty=("array",))
-
-    def __len__(self) -> int:
-        return self.d.shape[0]
-
-    @property
-    def z(self) -> np.ndarray:
-        """Eq. 54 stacked vector ``[phi; psi; kappa; delta_d[1:]]`` (kappa NaN for far-field)."""
-        return np.concatenate([self.phi, self.psi, self.kappa, self.delta_d[1:]])
-
-    @property
-    def wave_origins(self) -> np.ndarray:
-        """``origin + kappa * direction`` (K, 3), NaN rows for far-field paths (Fig. 5)."""
-        return self.origin + self.kappa[:, None] * self.direction
-
-
-@dataclass(frozen=True)
 class Epoch:
-    """Everything about one simulated epoch (truth, tensor, raw estimates, measurements)."""
+    """Everything about one simulated epoch: the truth (``ue``, ``velocity``, ``paths``), the
+    channel tensor (``snapshot``), the raw extraction output (``estimates``, a
+    :class:`tunnelkit.extraction.PathEstimates`: every path found, in the array's frame, before
+    Algorithm 1) and the measurements (a :class:`~tunnelkit.tracking.javelin.PathMeasurements`:
+    the kept paths in the world frame, what a tracker takes) with ``truth_index`` matching them
+    to the truth. One epoch of one array; a whole drive's measurements are a
+    :class:`tunnelkit.simulation.DriveData`."""
 
     k: int
     t: float
@@ -93,7 +45,7 @@ class Epoch:
     paths: list = field(repr=False)
     snapshot: ChannelSnapshot = field(repr=False)
     estimates: object = field(repr=False)
-    measurements: RouteMeasurements
+    measurements: PathMeasurements
     truth_index: np.ndarray  # for each kept measurement, the index of the true path (-1 if none)
     #: the re-judged fit test (:func:`tunnelkit.signal_route.judging.rejudge`), None if not re-judged
     rejudged: dict | None = field(default=None, repr=False)
@@ -137,31 +89,8 @@ def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
     nuisance = [i for i, p in enumerate(paths) if p.kind == SECOND_ORDER]
     if nuisance and len(meas):
         rows = np.flatnonzero(~np.isin(truth, nuisance))
-        meas, truth = restrict_rows(meas, rows), truth[rows]
+        meas, truth = meas.subset(rows), truth[rows]
     return meas, truth
-
-
-def restrict_rows(m: RouteMeasurements, rows: np.ndarray) -> RouteMeasurements:
-    """``m`` restricted to ``rows`` (``delta_d`` re-referenced to the first row kept)."""
-    instance("m", m, RouteMeasurements)
-    rows = indices("rows", rows, len(m))
-    d = m.d[rows]
-    return replace(
-        m,
-        phi=m.phi[rows],
-        psi=m.psi[rows],
-        kappa=m.kappa[rows],
-        near_field=m.near_field[rows],
-        d=d,
-        delta_d=d - d[0] if d.size else d,
-        v=m.v[rows],
-        direction=m.direction[rows],
-        alpha=m.alpha[rows],
-        index=m.index[rows],
-        cov=None if m.cov is None else m.cov[rows],
-        sigma_d=None if m.sigma_d is None else m.sigma_d[rows],
-        bias_cov=None if m.bias_cov is None else m.bias_cov[rows],
-    )
 
 
 def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig, judged=True):
@@ -199,9 +128,10 @@ def measurements_from_estimates(
     *,
     min_d: float = 0.0,
     judged: bool = True,
-) -> RouteMeasurements:
+) -> PathMeasurements:
     """Apply Algorithm 1's checks to raw estimates (``min_d``: see
-    :func:`tunnelkit.extraction.algorithm1`) and express them in the world frame; with
+    :func:`tunnelkit.extraction.algorithm1`) and express them in the world frame, seen from the
+    array's reference antenna (``origin``; ``source`` the kept rows of ``est``); with
     ``config``, also the covariance the extraction reports (:func:`reported_covariance`, with
     ``judged``: False for a fit the route re-judged and passed)."""
     from ..extraction import algorithm1
@@ -221,19 +151,6 @@ def measurements_from_estimates(
     cov = sigma_d = None
     if config is not None and keep.size:
         cov, sigma_d = reported_covariance(est, keep, array, config, judged=judged)
-    return RouteMeasurements(
-        array.origin.copy(),
-        array.name,
-        phi,
-        psi,
-        est.kappa[keep],
-        est.near_field[keep],
-        d,
-        d - d[0] if d.size else d,
-        est.v[keep],
-        u,
-        est.alpha[keep],
-        keep,
-        cov,
-        sigma_d,
+    return PathMeasurements(
+        phi, psi, est.kappa[keep], d, est.v[keep], keep, cov, sigma_d, origin=array.origin.copy()
     )

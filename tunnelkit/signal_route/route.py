@@ -20,7 +20,8 @@ from .._validate import (
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from ..constants import C
-from .measurements import Epoch, RouteMeasurements, measure_epoch
+from ..tracking.javelin.measurement import PathMeasurements
+from .measurements import Epoch, measure_epoch
 from .options import MAX_SECOND_ORDER, RouteOptions
 
 __all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute", "simulate_epoch"]
@@ -48,11 +49,6 @@ def check_arrays(arrays) -> None:
                 "names must be distinct (the calibration is keyed by name)"
             )
         names[a.name] = i
-
-
-_SHAPES = dict.fromkeys("phi psi kappa near_field d delta_d v alpha index sigma_d".split(), ("K",))
-_SHAPES.update(origin=(3,), direction=("K", 3), cov=("K", 3, 3))  # RouteMeasurements' fields
-_EPOCH_SHAPES = {"ue": (3,), "velocity": (3,), "truth_index": (None,)}  # Epoch's fields
 
 
 @dataclass
@@ -390,12 +386,10 @@ def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
     return SignalRoute.from_scenario(scenario, **route_kw).epoch(k, rng, **kw)
 
 
-def _centroid_far_field(
-    meas: RouteMeasurements, est, array: ArrayGeometry, z: float = UNRESOLVED_Z
-):
+def _centroid_far_field(meas: PathMeasurements, est, array: ArrayGeometry, z: float = UNRESOLVED_Z):
     """``meas`` with every near-field path whose curvature its reported covariance leaves
     unresolved (``kappa < z sigma_kappa``) reported as a far-field path seen from the array's
-    centroid; ``est`` the estimates ``meas`` came from (rows ``meas.index``), ``array`` its
+    centroid; ``est`` the estimates ``meas`` came from (rows ``meas.source``), ``array`` its
     array. Without a reported covariance ``meas`` is returned as it is.
 
     The extraction's model places each path's wave origin ``q`` at ``kappa`` along the direction
@@ -417,13 +411,13 @@ def _centroid_far_field(
     from .._validate import positive
     from ..extraction.estimates import PathEstimates
 
-    instance("meas", meas, RouteMeasurements)
+    instance("meas", meas, PathMeasurements)
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
     z = positive("z", z)
     if meas.cov is None or not len(meas):
         return meas
-    rows = indices("meas", meas.index, len(est.d))
+    rows = indices("meas", meas.source, len(est.d))
     kappa = meas.kappa.copy()
     with np.errstate(invalid="ignore"):
         loose = meas.near_field & np.isfinite(kappa) & ~(kappa >= z * np.sqrt(meas.cov[:, 2, 2]))
@@ -431,14 +425,9 @@ def _centroid_far_field(
         return meas
     c = array.local.mean(axis=0) - array.local[0]
     q = est.kappa[rows[loose], None] * est.direction[rows[loose]] - c
-    u = meas.direction.copy()
-    u[loose] = array.dir_to_world(q / np.linalg.norm(q, axis=1, keepdims=True))
+    u = array.dir_to_world(q / np.linalg.norm(q, axis=1, keepdims=True))
+    phi, psi = meas.phi.copy(), meas.psi.copy()
+    phi[loose] = np.arctan2(u[:, 1], u[:, 0])
+    psi[loose] = np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1]))
     kappa[loose] = np.nan
-    return replace(
-        meas,
-        phi=np.arctan2(u[:, 1], u[:, 0]),
-        psi=np.arctan2(u[:, 2], np.hypot(u[:, 0], u[:, 1])),
-        kappa=kappa,
-        near_field=meas.near_field & ~loose,
-        direction=u,
-    )
+    return replace(meas, phi=phi, psi=psi, kappa=kappa)

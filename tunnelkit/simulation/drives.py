@@ -105,7 +105,8 @@ _DRIVE_SHAPES = {
 
 @dataclass
 class DriveData:
-    """Measurements of one simulated drive (one Monte-Carlo run of one condition).
+    """One simulated drive (one Monte-Carlo run of one condition): a tracker's whole input and
+    the truth to score it; per epoch one :class:`PathMeasurements`, not one epoch's record.
 
     ``epochs[k]`` is the :class:`PathMeasurements` of epoch ``k`` (``None`` if extraction failed),
     ``truth`` (T, 3) / ``velocity`` (T, 3) the ground truth, ``speed`` / ``heading`` the V2X
@@ -302,8 +303,8 @@ FLAGGED = "extraction flagged its own fit (fit_ok = False)"
 
 
 def path_measurements(ep, route: SignalRoute) -> tuple[PathMeasurements | None, str | None]:
-    """The tracker's measurements of one simulated epoch (the one adapter from
-    :class:`tunnelkit.signal_route.RouteMeasurements` to :class:`PathMeasurements`), or ``None`` and
+    """The tracker's measurements of one simulated epoch (``ep.measurements`` through Algorithm 1
+    with ``route.min_d``, ``source`` its rows, the index of ``ep.truth_index``), or ``None`` and
     the reason: a route that reports covariances (``report_covariance``) gives none for a fit
     that failed its own residual test (or whose Fisher information is singular), and such an
     epoch carries no measurement (the tracker predicts only). An extraction that tests its own

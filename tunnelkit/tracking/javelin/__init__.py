@@ -7,9 +7,8 @@ motion) · ``associate`` (eq. 56-59 gated costs, Algorithm 2, global nearest nei
 ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test, initiators) · ``update`` (eq. 64-68,
 Joseph form, joint innovation test) · ``roles`` (:class:`JavelinDesign`: numbers + one object
 per role) · ``designs`` (the named designs as factories) · ``tracker`` (Algorithm 4) ·
-``tenfiloc`` (the snapshot baseline, eq. 69) · ``config`` (section 4.2 numbers) · ``geometric``
-(an exact measurement source for unit tests only). The chi-square gate is
-:class:`tunnelkit.tracking.gating.ChiSquareGate`.
+``tenfiloc`` (the snapshot baseline, eq. 69) · ``config`` (section 4.2 numbers). The
+chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
 """
 
 from __future__ import annotations

@@ -105,10 +105,18 @@ def _bias(bias_cov, cov, sigma_d, n: int):
 
 @dataclass
 class PathMeasurements:
-    """Sanitised path parameters of one epoch (Algorithm 1, lines 4-12).
+    """Sanitised path parameters of one epoch (Algorithm 1, lines 4-12): what the signal route
+    gives (:func:`tunnelkit.signal_route.measurements_from_estimates`) and the trackers take.
 
-    Arrays have one entry per kept path; ``kappa`` is NaN where only the far-field estimate is
-    valid, ``d`` / ``v`` NaN where unknown. ``source`` keeps each kept path's index in the input.
+    Arrays have one entry per kept path: ``phi``/``psi`` azimuth and elevation (eq. 46-47),
+    ``kappa`` the curvature radius (NaN where only the far-field estimate is valid), ``d`` the
+    delay distance with the clock bias and ``v`` the radial speed (NaN where unknown). ``source``
+    keeps each kept path's row in the input (the raw
+    :class:`tunnelkit.extraction.PathEstimates` on the signal route, the arrays given to
+    :meth:`from_arrays`). ``origin`` (3,): the world position the angles are seen from (the
+    array's reference antenna on the signal route; ``None`` when the caller did not say). The
+    route sorts the paths by ``d`` (path 0 the earliest arrival); ``delta_d``, ``z`` (eq. 52,
+    54), ``near_field``, ``direction`` and ``wave_origins`` are derived from the fields.
 
     Optionally the extraction reports its own uncertainty per path (ours, not in the paper):
     ``cov`` (n, 3, 3) the covariance of ``(phi, psi, kappa)`` [rad^2, rad m, m^2] and ``sigma_d``
@@ -117,8 +125,18 @@ class PathMeasurements:
     ``measurement_noise="reported"`` uses them instead of its fixed sigmas. ``bias_cov``
     (n, 4, 4), with a reported covariance only: the share of it over ``(phi, psi, kappa, d)``
     that repeats from one epoch to the next (a calibration error drawn once per array, a bias of
-    the estimator's model), which a bias-aware tracker (:class:`~.noise.ConsiderNoise`) keeps
-    apart from the white share ``cov - bias_cov``.
+    the estimator's model, :func:`~tunnelkit.signal_route.judging.apply_budget`), which a
+    bias-aware tracker (:class:`~.noise.ConsiderNoise`) keeps apart from the white share
+    ``cov - bias_cov``.
+
+    The one container of kept paths from the extraction to the trackers. Not it: the raw
+    extraction output (:class:`tunnelkit.extraction.PathEstimates`: every path found, in the
+    array's frame, before Algorithm 1), one simulated epoch's record around it
+    (:class:`tunnelkit.signal_route.Epoch`: truth, tensor, estimates and these measurements), a
+    whole drive (:class:`tunnelkit.simulation.DriveData`: one per epoch, with the truth and the
+    V2X messages), the rows one update stacks (:class:`~.update.StackedMeasurement`, eq. 54 of
+    the associated paths) and Halili's per-epoch Doppler and delay series
+    (:class:`tunnelkit.doppler_drive.DopplerToaMeasurements`).
     """
 
     phi: np.ndarray
@@ -130,6 +148,7 @@ class PathMeasurements:
     cov: np.ndarray | None = None
     sigma_d: np.ndarray | None = None
     bias_cov: np.ndarray | None = None
+    origin: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # built directly (not through from_arrays): 1-D float arrays of one length, and a
@@ -159,11 +178,42 @@ class PathMeasurements:
         self.source = src
         self.cov, self.sigma_d = _reported(self.cov, self.sigma_d, n)
         self.bias_cov = _bias(self.bias_cov, self.cov, self.sigma_d, n)
+        if self.origin is not None:
+            self.origin = vector("origin", self.origin, 3)
 
     @property
     def reported(self) -> bool:
         """Whether the extraction reported a covariance for every path."""
         return self.cov is not None
+
+    @property
+    def near_field(self) -> np.ndarray:
+        """Whether each path carries a curvature (a near-field estimate, ``kappa`` not NaN)."""
+        return np.isfinite(self.kappa)
+
+    @property
+    def delta_d(self) -> np.ndarray:
+        """``d - d[0]``: the delay differences to the first path (eq. 52, ``delta_d[0] = 0``)."""
+        return self.d - self.d[0] if self.d.size else self.d.copy()
+
+    @property
+    def z(self) -> np.ndarray:
+        """Eq. 54 stacked vector ``[phi; psi; kappa; delta_d[1:]]`` (kappa NaN for far-field)."""
+        return np.concatenate([self.phi, self.psi, self.kappa, self.delta_d[1:]])
+
+    @property
+    def direction(self) -> np.ndarray:
+        """Unit arrival directions from ``phi``/``psi`` (elevation), shape (n, 3)."""
+        c = np.cos(self.psi)
+        return np.column_stack([c * np.cos(self.phi), c * np.sin(self.phi), np.sin(self.psi)])
+
+    @property
+    def wave_origins(self) -> np.ndarray:
+        """``origin + kappa * direction`` (n, 3), NaN rows for far-field paths (Fig. 5); needs
+        ``origin``."""
+        if self.origin is None:
+            raise ValueError("origin: not given, so the wave origins have no position")
+        return self.origin + self.kappa[:, None] * self.direction
 
     def sanitised(self, min_d: float = 0.0) -> tuple[PathMeasurements, int]:
         """These paths through the checks of Algorithm 1 (idempotent), and how many were dropped.
@@ -181,7 +231,7 @@ class PathMeasurements:
         sub = [None if a is None else a[idx] for a in (self.cov, self.sigma_d, self.bias_cov)]
         clean = unchecked(
             PathMeasurements, self.phi[idx], self.psi[idx], kappa[idx], d[idx], v[idx],
-            self.source[idx], *sub,
+            self.source[idx], *sub, self.origin,
         )  # fmt: skip
         return clean, len(self) - len(clean)
 
@@ -265,16 +315,12 @@ class PathMeasurements:
             None if self.cov is None else self.cov[idx],
             None if self.sigma_d is None else self.sigma_d[idx],
             None if self.bias_cov is None else self.bias_cov[idx],
+            self.origin,
         )
 
     def triples(self) -> np.ndarray:
         """``(phi, psi, kappa)`` per path, shape (n, 3) (NaN kappa where far field)."""
         return np.column_stack([self.phi, self.psi, self.kappa])
-
-    def directions(self) -> np.ndarray:
-        """Unit arrival directions from ``phi``/``psi`` (elevation), shape (n, 3)."""
-        c = np.cos(self.psi)
-        return np.column_stack([c * np.cos(self.phi), c * np.sin(self.phi), np.sin(self.psi)])
 
 
 def track_model(

@@ -130,7 +130,7 @@ class TeNFiLoc:
         if paths is None or len(paths) == 0:
             return TeNFiLocFix(None, "none")
         b = np.asarray(self.base_station)
-        u = paths.directions()
+        u = paths.direction
         j = los_path if los_path is not None else los_test(paths.d, paths.kappa, self.los_gamma)
         no_kappa = not np.isfinite(paths.kappa).any()
         if j is None and (no_kappa or self.assume_los) and np.isfinite(paths.d).any():

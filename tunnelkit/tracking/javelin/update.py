@@ -62,7 +62,9 @@ def state_arguments(x, P, D: int | None = None) -> tuple[np.ndarray, np.ndarray]
 
 @dataclass
 class StackedMeasurement:
-    """``z``, ``h``, ``H`` (K, D), ``R`` (K, K), ``angle`` (K,) bool, row labels and the
+    """One update's stacked rows (eq. 54 of the associated pairs only, with the model and its
+    noise; the epoch's paths themselves are a :class:`~.measurement.PathMeasurements`): ``z``,
+    ``h``, ``H`` (K, D), ``R`` (K, K), ``angle`` (K,) bool, row labels and the
     reference pair of the TDoAs (or ``None``); for a consider filter ``B`` (K, 4 L_hat), the
     rows' sensitivity to every track's normalised bias (``R`` then the white share only)."""
 

@@ -1,4 +1,4 @@
-"""A geometric measurement source for **unit tests only** (not the signal route).
+"""A geometric measurement source for the unit tests (not the signal route).
 
 It evaluates the JAVELIN model exactly (eq. 45-52) from the true UE and its true virtual UEs in a
 set of planar reflectors, then adds Gaussian noise drawn from an explicit ``rng``. The workbook's
@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._checks import items, sign
-from ..._physical import speeds, step_seconds
-from ..._validate import (
+from tunnelkit._checks import items, sign
+from tunnelkit._physical import speeds, step_seconds
+from tunnelkit._validate import (
     boolean,
     finite_array,
     integer,
@@ -23,9 +23,9 @@ from ..._validate import (
     rng_or_error,
     vector,
 )
-from ...budget import check_elements
-from ...geometry import Plane, reflector_point
-from .measurement import PathMeasurements
+from tunnelkit.budget import check_elements
+from tunnelkit.geometry import Plane, reflector_point
+from tunnelkit.tracking.javelin import PathMeasurements
 
 __all__ = ["GeometricTruth", "geometric_paths", "geometric_stream", "toy_drive", "toy_reflectors"]
 
@@ -189,7 +189,7 @@ def geometric_stream(
     """:func:`geometric_paths` for every epoch of a drive; LoS present with ``los_probability``.
 
     Extra keywords (noise sigmas, ``bs``, ``clock_bias`` as a callable ``rng -> float`` or a
-    number) go to :func:`geometric_paths`. For unit tests only.
+    number) go to :func:`geometric_paths`.
     """
     rng = rng_or_error("rng", rng)
     P = finite_array("P", P, shape=(None, 3))
