@@ -159,7 +159,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "points (..., dim): leading axes vectorise (the docstring's contract)",
     ),
     _doc(
-        r"fresnel\.(bounds|exact)\.\w+",
+        r"fresnel\.(bounds|exact|mismatch)\.\w+",
         r"R|W|y_u|z_u|lam|eps|p_v|pv|ps|pos|positions",
         "shape",
         "elementwise in the geometry, points (..., 3): any leading shape broadcasts",
@@ -237,8 +237,18 @@ DOCUMENTED: tuple[Documented, ...] = (
         "empty",
         "a label only; empty for an experiment built by hand (the default)",
     ),
-    _doc(r"evaluation\.match_paths", r"paths", "empty", "no true path: every estimate unmatched"),
-    _doc(r"evaluation\.match_paths", r"clock_bias", "negative", "a clock bias takes any sign"),
+    _doc(
+        r"evaluation\.matching\.match_paths",
+        r"paths",
+        "empty",
+        "no true path: every estimate unmatched",
+    ),
+    _doc(
+        r"evaluation\.matching\.match_paths",
+        r"clock_bias",
+        "negative",
+        "a clock bias takes any sign",
+    ),
     _doc(r"geometry\.line", r"A|B|C", "negative", "a line's coefficients take any sign"),
     _doc(
         r"(geometry\.Tunnel2D|propagation\.surfaces\.Tunnel3D)\.contains",
@@ -627,12 +637,17 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no warning to report",
     ),
     _doc(
-        r"evaluation\.(path_rows|comparison_rows)",
+        r"evaluation\.tables\.(path_rows|comparison_rows)",
         r"paths",
         "empty",
         "no true path: an empty table, or every estimate unmatched",
     ),
-    _doc(r"evaluation\.comparison_rows", r"clock_bias", "negative", "a clock offset: either sign"),
+    _doc(
+        r"evaluation\.tables\.comparison_rows",
+        r"clock_bias",
+        "negative",
+        "a clock offset: either sign",
+    ),
     _doc(
         r"plots\.tunnel3d\.tunnel3d_figure",
         r"arrays|paths",
