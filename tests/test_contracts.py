@@ -318,7 +318,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "states (..., 4): leading axes vectorise (the docstring's contract)",
     ),
     _doc(
-        r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|geometry\.spherical\w*"
+        r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|angles\.\w+"
+        r"|geometry\.spherical\w*"
         r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
         r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation"
         r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim|simulate)",
