@@ -588,7 +588,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN: a run without an estimate there (counted as infinite by the verdict)",
     ),
     _doc(
-        r"design\.fastroute\.BoundRoute",
+        r"design\.trackerfix\.BoundRoute",
         r"min_d",
         "negative",
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
