@@ -202,7 +202,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN: no ratio at that point (a capped exact search), shown blank",
     ),
     _doc(
-        r"schema\.(Key|Table|render_template)",
+        r"schema\.(Key|Table)|schemadoc\.render_template",
         r"unit|doc|header",
         "empty",
         "optional text: a unitless key, an undocumented table, no header",

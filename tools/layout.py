@@ -41,6 +41,7 @@ RANKS = {
     "budget": 0.5,
     "report": 0.5,
     "schema": 0.5,
+    "schemadoc": 0.6,  # the schema written out: TOML templates, the Markdown reference
     "geometry": 1,
     "crlb": 1,
     "metrics": 1,
