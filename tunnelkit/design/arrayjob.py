@@ -150,7 +150,7 @@ class Prepared:
     (``route``, bound mode), the tracker (``design``) and the bounds reported beside them."""
 
     spec: ArraySpec
-    route: object  # fastroute.BoundRoute (bound mode) or None
+    route: object  # trackerfix.BoundRoute (bound mode) or None
     design: object  # tracking.javelin.JavelinDesign
     peb: np.ndarray
     pcrlb: np.ndarray | None

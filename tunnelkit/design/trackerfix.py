@@ -95,7 +95,7 @@ def tracker_weights(route) -> np.ndarray:
     the drive's split, whose repeating share is a correlation over the whole route), with the variance of a curvature
     :func:`bound_drive` does not hand on (reported standard deviation above
     :data:`KAPPA_RESOLVED` of the range) infinite and its covariances zero: the weights of
-    :func:`tunnelkit.design.drivebound.position_error_parts` for the tracker that is run."""
+    :func:`position_error_parts` for the tracker that is run."""
     if isinstance(route, PathErrorModel):
         # the budget of each epoch alone: the report of a drive (its split into white and
         # repeating shares) weighs every epoch by correlations over the whole route, so a
@@ -230,7 +230,7 @@ def position_noise_cov(model: PathErrorModel, geometry, weights) -> np.ndarray:
     least-squares snapshot fix (clock bias estimated) under the model's ideal noise, the joint
     CRLB ``crlb`` of every path: ``G crlb G^T`` with ``G`` the position rows of ``(H^T W H)^-1
     H^T W`` and ``W`` block-diagonal over the paths from ``weights`` (T, P, 4, 4), the
-    covariances the tracker is told (:func:`tunnelkit.design.fastroute.tracker_weights`; an
+    covariances the tracker is told (:func:`tracker_weights`; an
     unresolved curvature as an infinite variance gets no weight). ``W = crlb^-1`` would give
     the PEB's covariance; any other weight gives more (Gauss-Markov), and the tracker that is
     run weighs its paths block by block. Zero at an epoch without a path."""
@@ -256,7 +256,7 @@ def position_error_parts(model: PathErrorModel, geometry, weights=None) -> np.nd
     ``G`` the position rows of ``(H^T W H)^-1 H^T W``. ``weights``: ``None`` for ``W =
     crlb^-1`` (the estimator of :func:`position_information`, which trusts the ideal bound), or
     the per-path covariances (T, P, 4, 4) the tracker is told
-    (:func:`tunnelkit.design.fastroute.tracker_weights`: its error budget, an unresolved
+    (:func:`tracker_weights`: its error budget, an unresolved
     curvature as an infinite variance), ``W`` then block-diagonal over the paths as the tracker
     weighs them. Under a calibration error the ``crlb^-1`` fix trusts the micrometre curvatures
     of a large array, whose calibration bias is centimetres: its bias is up to 40 times the
