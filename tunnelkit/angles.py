@@ -10,7 +10,7 @@ import numpy as np
 
 from ._validate import finite_array
 
-__all__ = ["wrap_angle", "wrap_angle_unchecked"]
+__all__ = ["wrap_angle"]
 
 
 def wrap_angle(a):

@@ -32,7 +32,6 @@ __all__ = [
     "ScenarioError",
     "Table",
     "family_of",
-    "shape_text",
     "validate",
 ]
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._validate import boolean, finite_array, text
 
-__all__ = ["path_difference", "real_input", "signed_mismatch"]
+__all__ = ["real_input", "signed_mismatch"]
 
 
 def real_input(name: str, value, *, pos: bool = False) -> np.ndarray:
