@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from run import Case
 
-from tunnelkit import arrays, crlb
+from tunnelkit import angles, arrays, crlb
 
 
 def cases() -> list[Case]:
@@ -28,7 +28,7 @@ def cases() -> list[Case]:
         ),
         Case(
             "wrap_angle, 4 angles, unchecked",
-            lambda: crlb._wrap(a),
+            lambda: angles.wrap_angle_unchecked(a),
             group="wrap_angle",
             baseline=True,
             number=2000,

@@ -16,7 +16,7 @@ def design_models():
     """Path error model, bounds over the drive, the fast route and its drive, the mode vectors of
     the misspecified bound."""
     from tunnelkit import design
-    from tunnelkit.design import drivebound, errormodel, fastroute, mcrb
+    from tunnelkit.design import drivebound, errormodel, fastroute, mcrb, trackerfix
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
     imp = design.DesignImpairments(phase_error_deg=0.5, gain_error_db=0.2)
@@ -27,12 +27,12 @@ def design_models():
     m.calibration_bias(np.zeros(n), np.zeros(n))
     m.draw(np.random.default_rng(0))
     info = drivebound.position_information(m, g)
-    drivebound.position_error_parts(m, g)
+    trackerfix.position_error_parts(m, g)
     drivebound.position_bias_rms(m, g)
     drivebound.drive_pcrlb(setup, info)
     fastroute.model_truth(g, setup.fc)
     route = fastroute.bound_route(m, setup, "4x4")
-    fastroute.tracker_weights(route)
+    trackerfix.tracker_weights(route)
     fastroute.bound_drive(route, setup, "4x4", np.random.default_rng(0), n_epochs=5)
     del errormodel, mcrb
 

@@ -66,8 +66,7 @@ def test_no_impairment_achievable_is_the_block_weighted_fix_never_below_the_peb(
     told one covariance block per path (``position_noise_cov``), not below the PEB; the
     direct-position weighting (``weights="ideal"``) is the PEB itself."""
     from tunnelkit.design.bounds import route_geometry
-    from tunnelkit.design.drivebound import position_noise_cov
-    from tunnelkit.design.fastroute import tracker_weights
+    from tunnelkit.design.trackerfix import position_noise_cov, tracker_weights
 
     b = predicted_error(setup, "6x6", DesignImpairments(), epochs=EPOCHS)
     peb = design.route_bounds(setup, "6x6", epochs=EPOCHS).peb

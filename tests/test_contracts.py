@@ -159,7 +159,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "points (..., dim): leading axes vectorise (the docstring's contract)",
     ),
     _doc(
-        r"fresnel\.(bounds|exact)\.\w+",
+        r"fresnel\.(bounds|exact|mismatch)\.\w+",
         r"R|W|y_u|z_u|lam|eps|p_v|pv|ps|pos|positions",
         "shape",
         "elementwise in the geometry, points (..., 3): any leading shape broadcasts",
@@ -202,7 +202,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN: no ratio at that point (a capped exact search), shown blank",
     ),
     _doc(
-        r"schema\.(Key|Table|render_template)",
+        r"schema\.(Key|Table)|schemadoc\.render_template",
         r"unit|doc|header",
         "empty",
         "optional text: a unitless key, an undocumented table, no header",
@@ -237,8 +237,18 @@ DOCUMENTED: tuple[Documented, ...] = (
         "empty",
         "a label only; empty for an experiment built by hand (the default)",
     ),
-    _doc(r"evaluation\.match_paths", r"paths", "empty", "no true path: every estimate unmatched"),
-    _doc(r"evaluation\.match_paths", r"clock_bias", "negative", "a clock bias takes any sign"),
+    _doc(
+        r"evaluation\.matching\.match_paths",
+        r"paths",
+        "empty",
+        "no true path: every estimate unmatched",
+    ),
+    _doc(
+        r"evaluation\.matching\.match_paths",
+        r"clock_bias",
+        "negative",
+        "a clock bias takes any sign",
+    ),
     _doc(r"geometry\.line", r"A|B|C", "negative", "a line's coefficients take any sign"),
     _doc(
         r"(geometry\.Tunnel2D|propagation\.surfaces\.Tunnel3D)\.contains",
@@ -308,7 +318,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "states (..., 4): leading axes vectorise (the docstring's contract)",
     ),
     _doc(
-        r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|geometry\.spherical\w*"
+        r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|angles\.\w+"
+        r"|geometry\.spherical\w*"
         r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
         r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation"
         r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim|simulate)",
@@ -559,7 +570,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN: a run without an estimate there (counted as infinite by the verdict)",
     ),
     _doc(
-        r"design\.fastroute\.BoundRoute",
+        r"design\.trackerfix\.BoundRoute",
         r"min_d",
         "negative",
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
@@ -597,12 +608,17 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no warning to report",
     ),
     _doc(
-        r"evaluation\.(path_rows|comparison_rows)",
+        r"evaluation\.tables\.(path_rows|comparison_rows)",
         r"paths",
         "empty",
         "no true path: an empty table, or every estimate unmatched",
     ),
-    _doc(r"evaluation\.comparison_rows", r"clock_bias", "negative", "a clock offset: either sign"),
+    _doc(
+        r"evaluation\.tables\.comparison_rows",
+        r"clock_bias",
+        "negative",
+        "a clock offset: either sign",
+    ),
     _doc(
         r"plots\.tunnel3d\.tunnel3d_figure",
         r"arrays|paths",

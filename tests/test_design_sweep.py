@@ -20,9 +20,10 @@ from tunnelkit.design.drivebound import (
     position_information,
 )
 from tunnelkit.design.errormodel import PathErrorModel
-from tunnelkit.design.fastroute import BoundRoute, bound_drive, bound_route, model_truth
+from tunnelkit.design.fastroute import bound_drive, bound_route, model_truth
 from tunnelkit.design.geometry import trace_route
 from tunnelkit.design.montecarlo import MonteCarloResult, sweep_montecarlo
+from tunnelkit.design.trackerfix import BoundRoute
 
 SCENARIO = "example-rectangular-28ghz"
 
@@ -365,7 +366,7 @@ def test_position_bias_rms_with_the_trackers_weights_is_the_weighted_fix_over_dr
 
 
 def test_tracker_weights_drop_the_curvature_the_bound_route_does_not_hand_on(setup):
-    from tunnelkit.design.fastroute import KAPPA_RESOLVED, tracker_weights
+    from tunnelkit.design.trackerfix import KAPPA_RESOLVED, tracker_weights
 
     m = _diag_model(setup, "4x4", sig=(1e-3, 1e-3, 2.0, 0.01))
     rb = bound_route(m, setup, "4x4")
@@ -506,7 +507,7 @@ def test_position_error_parts_diffuse_is_the_weighted_fix_of_the_excess_covarian
     the paths), the fix weighted by the tracker's blocks, RMS of the position over the draws."""
     from dataclasses import replace
 
-    from tunnelkit.design.drivebound import position_error_parts
+    from tunnelkit.design.trackerfix import position_error_parts
 
     spec = "4x4"
     m0 = _diag_model(setup, spec)
@@ -548,7 +549,7 @@ def test_position_noise_cov_is_the_block_weighted_fix_under_the_joint_crlb(setup
     its inverse is the information ``position_information`` uses with the tracker's weights."""
     from dataclasses import replace
 
-    from tunnelkit.design.drivebound import position_noise_cov
+    from tunnelkit.design.trackerfix import position_noise_cov
 
     spec = "4x4"
     m0 = _diag_model(setup, spec)

@@ -36,10 +36,12 @@ RANKS = {
     "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
     "_parallel": 0.3,  # where trials run (workers or a scheduler address), checked once
     "constants": 0.5,
+    "angles": 0.5,  # angles wrapped to (-pi, pi], the bearings' innovations
     "solutions": 0.5,  # the notebooks' solution cells (an IPython magic), imports nothing of ours
     "budget": 0.5,
     "report": 0.5,
     "schema": 0.5,
+    "schemadoc": 0.6,  # the schema written out: TOML templates, the Markdown reference
     "geometry": 1,
     "crlb": 1,
     "metrics": 1,

@@ -25,6 +25,7 @@ import numpy as np
 
 from ._physical import MIN_SIGMA
 from ._validate import callable_, finite_array, integer, positive, spd_matrix, text
+from .angles import wrap_angle, wrap_angle_unchecked
 from .budget import check_elements
 
 __all__ = [
@@ -38,28 +39,6 @@ __all__ = [
     "toa_doa_jacobian",
     "wrap_angle",
 ]
-
-
-def wrap_angle(a):
-    """Wrap angle(s) to ``(-pi, pi]``; ``a`` must be finite and real."""
-    return _wrap(finite_array("a", a))
-
-
-def _wrap(a: np.ndarray) -> np.ndarray:
-    """:func:`wrap_angle` without the input check (inner loops that already hold floats).
-
-    ``pi - mod(pi - a, 2 pi)``; ``mod`` returns its argument unchanged where it already lies in
-    ``[0, 2 pi)`` (most residuals), so the slow floating-point ``mod`` runs only on the others:
-    the result is bit for bit the same.
-    """
-    b = np.pi - a
-    if b.size < 64:  # a few angles: the plain formula is quicker than the test
-        return np.pi - np.mod(b, 2.0 * np.pi)
-    out = np.pi - b
-    far = (b < 0.0) | (b >= 2.0 * np.pi)
-    if far.any():
-        out[far] = np.pi - np.mod(b[far], 2.0 * np.pi)
-    return out
 
 
 def _points_and_stations(p, stations) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -190,7 +169,7 @@ def numeric_jacobian(
                 f"h: fails on p of shape {p.shape} ({type(exc).__name__}: {exc})"
             ) from None
         if angle_mask is not None:
-            diff = np.where(mask, _wrap(diff), diff)
+            diff = np.where(mask, wrap_angle_unchecked(diff), diff)
         cols.append(diff / (2.0 * step))
     J = np.stack(cols, axis=-1)
     if not np.isfinite(J).all():

@@ -9,8 +9,9 @@ A scenario file belongs to one *family*, chosen by its ``paper`` key:
   horseshoe tunnel, a base station with ULAs/URAs, a radio and a lane or slalom trajectory.
 
 Each family is a :class:`Table` of :class:`Key` s (type, unit, range, default, doc string). The same
-spec validates a file (:func:`validate`), writes a commented template (:func:`render_template`) and
-documents the schema (:func:`to_markdown`, printed by ``tunnelkit scenarios doc``), so the three never drift apart. Validation is strict:
+spec validates a file (:func:`validate`), writes a commented template and documents the schema
+(:mod:`tunnelkit.schemadoc`: ``render_template``, ``to_markdown``, printed by ``tunnelkit scenarios
+doc``), so the three never drift apart. Validation is strict:
 ``shape = [10.5, 10]``, a bool or a string where a number is expected, NaN, a value out of range,
 a missing required key and an unknown key (reported with the nearest valid name) are all a
 :class:`ScenarioError` naming the file, the section and the key.
@@ -31,8 +32,6 @@ __all__ = [
     "ScenarioError",
     "Table",
     "family_of",
-    "render_template",
-    "to_markdown",
     "validate",
 ]
 
@@ -152,18 +151,18 @@ def _check_nested(where: str, full: str, key: Key, v, shape, integral: bool, idx
         _check_number(where, full + idx, key, v, integral)
         return
     if not isinstance(v, list):
-        _fail(where, f"'{full}{idx}' must be a list of shape {_shape_text(key.shape)}, got {v!r}")
+        _fail(where, f"'{full}{idx}' must be a list of shape {shape_text(key.shape)}, got {v!r}")
     n = shape[0]
     if n is not None and len(v) != n:
         _fail(
             where,
-            f"'{full}' must have shape {_shape_text(key.shape)}, got {len(v)} items at '{full}{idx}'",
+            f"'{full}' must have shape {shape_text(key.shape)}, got {len(v)} items at '{full}{idx}'",
         )
     for i, item in enumerate(v):
         _check_nested(where, full, key, item, shape[1:], integral, f"{idx}[{i}]")
 
 
-def _shape_text(shape) -> str:
+def shape_text(shape) -> str:
     return (
         "("
         + ", ".join("n" if s is None else str(s) for s in shape)
@@ -944,162 +943,3 @@ FAMILIES: dict[str, Table] = {
     "halili2022": HALILI,
     "user": USER,
 }
-
-
-# --- templates and documentation ----------------------------------------------------------------
-
-
-def _fmt(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if v != 0 and (abs(v) >= 1e5 or abs(v) < 1e-3):
-            m, e = f"{v:.12e}".split("e")
-            return f"{m.rstrip('0').rstrip('.')}e{int(e)}"
-        s = repr(v)
-        return s if any(c in s for c in ".e") else s + ".0"
-    if isinstance(v, list):
-        return "[" + ", ".join(_fmt(x) for x in v) + "]"
-    raise TypeError(f"cannot write {v!r} to TOML")  # pragma: no cover
-
-
-def key_comment(key: Key) -> str:
-    """One-line description: doc, unit, range, choices and default."""
-    bits = [key.doc]
-    if key.unit:
-        bits.append(f"[{key.unit}]")
-    r = key.range_text()
-    if r:
-        bits.append(f"range {r}")
-    if key.choices and len(key.choices) > 1:
-        bits.append("one of " + ", ".join(key.choices))
-    if key.required:
-        bits.append("required")
-    elif key.has_default and key.type not in ("table",):
-        bits.append(f"default {_fmt(key.default)}")
-    else:
-        bits.append("optional")
-    return "; ".join([bits[0], *bits[1:]]) if len(bits) > 1 else bits[0]
-
-
-def _render_absent(lines: list[str], spec: Table, full: str, indent: str = "#   ") -> None:
-    """Document the keys of a table the template leaves out (commented, one line each)."""
-    for k in spec.keys:
-        lines.append(f"{indent}{k.name}: {key_comment(k)}")
-        if k.table is not None:
-            _render_absent(lines, k.table, f"{full}.{k.name}", indent + "  ")
-    for v, ks in spec.variants.items():
-        for k in ks:
-            lines.append(f"{indent}{k.name} (kind = {v!r}): {key_comment(k)}")
-
-
-def _render(lines: list[str], spec: Table, values: dict, path: str) -> None:
-    kind = values.get("kind") if spec.variants else None
-    scalars = [k for k in spec.allowed(kind) if k.type not in ("table", "tables")]
-    subs = [k for k in spec.allowed(kind) if k.type in ("table", "tables")]
-    for k in scalars:
-        lines.append(f"# {key_comment(k)}")
-        if k.name in values:
-            lines.append(f"{k.name} = {_fmt(values[k.name])}")
-        elif k.has_default:
-            lines.append(f"# {k.name} = {_fmt(k.default)}")
-        else:
-            lines.append(f"# {k.name} = ")
-    for v, ks in spec.variants.items():
-        if v != kind and ks:
-            lines.append(f"# with kind = {v!r} also:")
-            lines += [f"#   {k.name}: {key_comment(k)}" for k in ks]
-    for k in subs:
-        full = f"{path}.{k.name}" if path else k.name
-        v = values.get(k.name)
-        if k.type == "table":
-            if v is None and not k.required:
-                lines += ["", f"# [{full}]  {key_comment(k)}; keys:"]
-                _render_absent(lines, k.table, full)
-                continue
-            lines += ["", f"# {key_comment(k)}", f"[{full}]"]
-            _render(lines, k.table, v or {}, full)
-        else:
-            lines += ["", f"# [[{full}]]  {key_comment(k)}; one table per item"]
-            if not v:
-                lines[-1] += ", keys:"
-                _render_absent(lines, k.table, full)
-            for j, item in enumerate(v or []):
-                lines += [""] * (j > 0) + [f"[[{full}]]"]
-                _render(lines, k.table, item, full)
-
-
-def render_template(family: str, values: dict, header: str = "") -> str:
-    """A commented TOML file of ``family`` holding ``values``, every key documented from the spec."""
-    if not isinstance(family, str) or family not in FAMILIES:
-        raise ValueError(f"family: expected one of {list(FAMILIES)}, got {family!r}")
-    if not isinstance(values, dict):
-        raise TypeError(
-            f"values: expected a dict of the file's tables, got {type(values).__name__}"
-        )
-    if not isinstance(header, str):
-        raise TypeError(f"header: expected text, got {type(header).__name__}")
-    spec = FAMILIES[family]
-    lines = [f"# {ln}" if ln else "#" for ln in header.splitlines()]
-    lines.append(
-        f"# Schema: {spec.doc}. Keys marked 'required' must be present; unknown keys are errors."
-    )
-    lines.append("")
-    _render(lines, spec, values, "")
-    return "\n".join(lines) + "\n"
-
-
-def _md_rows(rows: list[str], spec: Table, path: str) -> None:
-    for k in spec.keys:
-        full = f"{path}.{k.name}" if path else k.name
-        if k.type in ("table", "tables"):
-            continue
-        rows.append(_md_row(full, k, ""))
-    for v, ks in spec.variants.items():
-        for k in ks:
-            rows.append(_md_row(f"{path}.{k.name}", k, f"kind = {v!r}: "))
-    for k in spec.keys:
-        if k.type in ("table", "tables"):
-            full = f"{path}.{k.name}" if path else k.name
-            rows.append(_md_row(full, k, ""))
-            _md_rows(rows, k.table, full + ("[]" if k.type == "tables" else ""))
-
-
-def _md_row(full: str, k: Key, prefix: str) -> str:
-    typ = {
-        "floats": "numbers",
-        "ints": "integers",
-        "strs": "strings",
-        "tables": "array of tables",
-    }.get(k.type, k.type)
-    if k.shape:
-        typ += " " + _shape_text(k.shape)
-    if k.choices:
-        typ += ": " + " \\| ".join(f"`{c}`" for c in k.choices)
-    need = (
-        "required"
-        if k.required
-        else (f"`{_fmt(k.default)}`" if k.has_default and k.type != "table" else "optional")
-    )
-    return f"| `{full}` | {typ} | {k.unit} | {k.range_text()} | {need} | {prefix}{k.doc} |"
-
-
-def to_markdown() -> str:
-    """The schema of every family as Markdown tables (``data/scenarios/README.md``)."""
-    out = []
-    for fam in ("user", "italiano2026", "jiang2023", "halili2022"):
-        spec = FAMILIES[fam]
-        title = "`user` (no `paper` key)" if fam == "user" else f'`paper = "{fam}"`'
-        out += [f"### {title}: {spec.doc}", ""]
-        out += [
-            "| key | type | unit | range | default | meaning |",
-            "| --- | --- | --- | --- | --- | --- |",
-        ]
-        rows: list[str] = []
-        _md_rows(rows, spec, "")
-        out += [*rows, ""]
-    return "\n".join(out)

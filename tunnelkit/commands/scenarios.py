@@ -60,7 +60,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"wrote {path} (from {args.preset}); edit it, then: tunnelkit scenarios {path}")
         return 0
     if words == ["doc"]:
-        from ..schema import to_markdown
+        from ..schemadoc import to_markdown
 
         print(to_markdown())
         return 0

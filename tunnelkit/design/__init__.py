@@ -26,7 +26,8 @@ reaches the required yield with 95 % confidence. One job per module:
 * :mod:`~tunnelkit.design.montecarlo` (with :mod:`~tunnelkit.design.arrayjob`, what one array's
   drives share and one drive): JAVELIN on the design, every array x drive of a batch as one
   task set on the full signal chain or the bound-driven route (:func:`sweep_montecarlo`,
-  :class:`MonteCarloResult`); :mod:`~tunnelkit.design.fastroute`: the bound-driven drive;
+  :class:`MonteCarloResult`); :mod:`~tunnelkit.design.fastroute`: the bound-driven drive
+  (how it weighs the paths and the error that follows: :mod:`~tunnelkit.design.trackerfix`);
   :mod:`~tunnelkit.design.traced`: the channel route on the ray-traced channel;
 * :mod:`~tunnelkit.design.units`: manufactured units (their generators) and the unit yield
   with its Wilson interval; :mod:`~tunnelkit.design.verdict`: the criterion, the error quantile
@@ -59,14 +60,14 @@ _EXPORTS = {
     "ConfirmedReport": "confirm",
     "confirm_on_channel": "confirm",
     "confirmation_candidates": "confirm",
-    "START_SIGMA_M": "drivebound",
+    "START_SIGMA_M": "trackerfix",
     "drive_bound": "drivebound",
     "drive_pcrlb": "drivebound",
     "position_bias_rms": "drivebound",
     "position_information": "drivebound",
     "unit_pcrlb": "drivebound",
     "PathErrorModel": "errormodel",
-    "BoundRoute": "fastroute",
+    "BoundRoute": "trackerfix",
     "bound_drive": "fastroute",
     "bound_route": "fastroute",
     "KINDS": "geometry",
@@ -75,7 +76,7 @@ _EXPORTS = {
     "DesignImpairments": "impairments",
     "preset_impairments": "impairments",
     "IMPAIRMENT_PRESETS": "impairments:PRESETS",
-    "MODES": "fastroute",
+    "MODES": "trackerfix",
     "MonteCarloResult": "montecarlo",
     "SETTLE_S": "montecarlo",
     "STARTS": "montecarlo",

@@ -64,7 +64,9 @@ from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .impairments import DesignImpairments
 from .mcrb import EtaModes, scaled_inverse
+from .records import over_target
 from .setup import ArraySpec, DesignSetup, parse_array
+from .trackerfix import fix_identifiable, position_error_parts, position_noise_cov, tracker_weights
 
 __all__ = [
     "WEIGHTS",
@@ -378,8 +380,6 @@ def path_error_model(
 def _ranges(x: np.ndarray, hit: np.ndarray) -> str:
     """``"x = 80.3..100.2 m, 120.0 m"``: the runs of consecutive epochs where ``hit``, worded
     as the report words the stretches above a target (:func:`~tunnelkit.design.records.over_target`)."""
-    from .records import over_target
-
     return "x = " + over_target(x, np.asarray(hit, float), 0.5)
 
 
@@ -460,7 +460,7 @@ class PredictedError:
 
 #: whose error :func:`predicted_error` maps to the position: ``"tracker"`` the design's tracker
 #: (each path weighted by the error budget it is told, block by block, a curvature it is not
-#: handed left out: :func:`tunnelkit.design.fastroute.tracker_weights`), ``"ideal"`` the
+#: handed left out: :func:`tunnelkit.design.trackerfix.tracker_weights`), ``"ideal"`` the
 #: direct-position ML estimator that assumes eq. 1 (the misspecified bound of the whole
 #: channel, which weighs every path by the ideal Fisher information)
 WEIGHTS = ("tracker", "ideal")
@@ -481,7 +481,7 @@ def predicted_error(
 
     ``weights`` (:data:`WEIGHTS`): ``"tracker"`` (default) maps the per-path error model
     (:func:`path_error_model`) to the position as the design's tracker weighs its paths
-    (:func:`tunnelkit.design.drivebound.position_error_parts`); ``"ideal"`` maps the channel's
+    (:func:`tunnelkit.design.trackerfix.position_error_parts`); ``"ideal"`` maps the channel's
     misspecified score through the ideal Fisher information of the position. The ideal
     weighting trusts a large array's micrometre curvatures, whose calibration and wideband
     biases are centimetres: on the 28 GHz example with the wideband term and 0.2 dB of gain
@@ -491,7 +491,7 @@ def predicted_error(
     is a gap (``inf`` there, ``valid`` False, ``reason`` naming the cause and where); every
     epoch is evaluated on its own, whatever the rest of the route holds. With the tracker's weights the noise
     part is the covariance of the fix weighted block by block as the tracker is told
-    (:func:`tunnelkit.design.drivebound.position_noise_cov`), not the PEB: never below it, and
+    (:func:`tunnelkit.design.trackerfix.position_noise_cov`), not the PEB: never below it, and
     above it where the joint CRLB correlates paths (small arrays, paths close in angle and
     delay)."""
     imp = DesignImpairments() if impairments is None else impairments
@@ -551,8 +551,6 @@ def predicted_error(
 
 def _tracker_bound(setup, spec, imp, g, peb) -> PredictedError:
     """:func:`predicted_error` with the tracker's weights."""
-    from .drivebound import fix_identifiable, position_error_parts, position_noise_cov
-    from .fastroute import tracker_weights
 
     T = peb.shape[0]
     m = path_error_model(setup, spec, imp, geometry=g)

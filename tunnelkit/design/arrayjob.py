@@ -150,7 +150,7 @@ class Prepared:
     (``route``, bound mode), the tracker (``design``) and the bounds reported beside them."""
 
     spec: ArraySpec
-    route: object  # fastroute.BoundRoute (bound mode) or None
+    route: object  # trackerfix.BoundRoute (bound mode) or None
     design: object  # tracking.javelin.JavelinDesign
     peb: np.ndarray
     pcrlb: np.ndarray | None
@@ -209,7 +209,7 @@ class ArrayJob:
             # channel route the extraction reports its CRLB)
             w = None
             if route is not None:
-                from .fastroute import tracker_weights
+                from .trackerfix import tracker_weights
 
                 w = tracker_weights(route)[: self.T]
             pc_w = drive_pcrlb(self.setup, position_information(head, g, w), sigma_p0=sp0)

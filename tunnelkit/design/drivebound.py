@@ -21,55 +21,22 @@ from .._physical import start_spread
 from .._validate import finite_array, instance
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
+from .trackerfix import (
+    START_SIGMA_M,
+    check_geometry,
+    position_error_parts,
+    position_noise_cov,
+    position_rows,
+)
 
 __all__ = [
-    "START_SIGMA_M",
     "drive_bound",
     "drive_motion",
     "drive_pcrlb",
-    "fix_identifiable",
     "position_bias_rms",
-    "position_error_parts",
     "position_information",
-    "position_noise_cov",
     "unit_pcrlb",
 ]
-
-#: the open-sky fix's standard deviation per axis [m], the design's default entry fix
-#: (``start_sigma`` of :func:`tunnelkit.design.montecarlo.sweep_montecarlo`): the tracker's
-#: ``sigma_p0_ue`` and the prior of the bounds over the drive (:func:`drive_pcrlb`)
-START_SIGMA_M = 1.0
-
-
-def _position_rows(model: PathErrorModel, geometry, k: int):
-    """Epoch ``k``: the rows of the existing paths in ``z`` and ``H`` (4n, 3), the map of the
-    UE's horizontal position and ``c b`` into them (``None`` without a path)."""
-    from ..geometry import spherical_jacobian
-
-    j = np.flatnonzero(model.exists[k] & geometry.exists[k])
-    if not j.size:
-        return None, None, j
-    rel = geometry.source[k, j] - geometry.origin[k]
-    Js = spherical_jacobian(rel) @ geometry.mirror[j]  # (n, 3, 3) d(phi,psi,r)/d UE
-    H = np.zeros((j.size, 4, 3))
-    H[:, :3, :2] = Js[:, :, :2]
-    H[:, 3, :2] = Js[:, 2, :2]
-    H[:, 3, 2] = 1.0  # c b in every delay distance
-    rows = (4 * j[:, None] + np.arange(4)).ravel()
-    return rows, H.reshape(-1, 3), j
-
-
-def _check_geometry(model, geometry) -> None:
-    from .geometry import RouteGeometry
-
-    instance("geometry", geometry, RouteGeometry)
-    if not isinstance(model, PathErrorModel):
-        raise TypeError(f"model: expected a design.PathErrorModel, got {type(model).__name__}")
-    if geometry.exists.shape != model.exists.shape:
-        raise ValueError(
-            f"geometry: expected {model.exists.shape[0]} epochs and {model.exists.shape[1]} "
-            "path slots like the model"
-        )
 
 
 def position_information(model: PathErrorModel, geometry, weights=None) -> np.ndarray:
@@ -80,12 +47,12 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
     (the UE, or its mirror image in the known surface: ``geometry.mirror``).
 
     ``weights`` (T, P, 4, 4): the per-path covariances a tracker is told
-    (:func:`tunnelkit.design.fastroute.tracker_weights`); the information is then the inverse
+    (:func:`tunnelkit.design.trackerfix.tracker_weights`); the information is then the inverse
     of the covariance of the fix that weighs the paths by them (:func:`position_noise_cov`):
     a tracker told one block per path cannot use the correlation of the joint CRLB between
     paths (at 4 x 4 in the paper's tunnel up to 0.9 between the LoS and the ceiling path,
     which the joint bound turns into half the position error)."""
-    _check_geometry(model, geometry)
+    check_geometry(model, geometry)
     T = model.exists.shape[0]
     out = np.zeros((T, 2, 2))
     if weights is not None:
@@ -96,7 +63,7 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
                 out[k] = 0.5 * (out[k] + out[k].T)
         return out
     for k in range(T):
-        rows, H, _ = _position_rows(model, geometry, k)
+        rows, H, _ = position_rows(model, geometry, k)
         if rows is None:
             continue
         R = model.crlb[k][np.ix_(rows, rows)]
@@ -107,154 +74,6 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
         else:
             J = J[:2, :2]
         out[k] = 0.5 * (J + J.T)
-    return out
-
-
-def _block_weights(blocks: np.ndarray) -> np.ndarray:
-    """Block-diagonal weight ``W`` (4n, 4n) from per-path covariances (n, 4, 4); a row whose
-    variance is infinite (a quantity the tracker is not handed, e.g. an unresolved curvature)
-    gets no weight."""
-    n = blocks.shape[0]
-    W = np.zeros((4 * n, 4 * n))
-    for i in range(n):
-        B = blocks[i]
-        on = np.isfinite(np.diag(B))
-        Bi = 0.5 * (B[np.ix_(on, on)] + B[np.ix_(on, on)].T)
-        w = np.zeros((4, 4))
-        w[np.ix_(on, on)] = np.linalg.pinv(Bi, rcond=1e-15, hermitian=True)
-        W[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] = w
-    return W
-
-
-def _check_weights(model: PathErrorModel, weights) -> np.ndarray:
-    """Per-path covariances (T, P, 4, 4): numbers, ``inf`` allowed (a quantity not handed on)."""
-    T, P = model.exists.shape
-    if isinstance(weights, str | bytes):
-        raise TypeError("weights: expected per-path covariances (T, P, 4, 4), got text")
-    try:
-        weights = np.asarray(weights, float)
-    except (TypeError, ValueError):
-        raise TypeError(f"weights: expected numbers, got {type(weights).__name__}") from None
-    if weights.shape != (T, P, 4, 4):
-        raise ValueError(f"weights: expected shape {(T, P, 4, 4)}, got {weights.shape}")
-    if np.isnan(weights).any():
-        raise ValueError("weights: NaN (an infinite variance marks a quantity not handed on)")
-    return weights
-
-
-def _fix_weights(model, geometry, k: int, weights):
-    """Epoch ``k``: the rows, ``H`` (4n, 3) and the weight ``W`` of the weighted least-squares
-    fix (the inverse of the ideal CRLB, or block-diagonal from ``weights``); ``(None, None,
-    None)`` without a path."""
-    rows, H, j = _position_rows(model, geometry, k)
-    if rows is None:
-        return None, None, None
-    if weights is None:
-        R = model.crlb[k][np.ix_(rows, rows)]
-        return rows, H, np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True)
-    return rows, H, _block_weights(weights[k, j])
-
-
-def _weighted_gain(model, geometry, k: int, weights):
-    """Epoch ``k``: the rows, the position rows ``G`` (2, 4n) of the weighted least-squares
-    fix ``(H^T W H)^-1 H^T W`` (clock bias estimated; ``W`` the inverse of the ideal CRLB or
-    block-diagonal from ``weights``), or ``(None, None)`` without a path."""
-    rows, H, W = _fix_weights(model, geometry, k, weights)
-    if rows is None:
-        return None, None
-    J = H.T @ W @ H
-    G = (np.linalg.pinv(0.5 * (J + J.T), rcond=1e-15, hermitian=True) @ H.T @ W)[:2]
-    return rows, G
-
-
-def fix_identifiable(model: PathErrorModel, geometry, weights=None, rcond: float = 1e-12):
-    """Per epoch (T,) bool: the weighted least-squares fix of :func:`position_noise_cov`
-    (``weights`` as there) determines the horizontal position and the clock bias, i.e.
-    ``H^T W H`` is regular (Jacobi-scaled smallest eigenvalue above ``rcond`` times the
-    largest). False at an epoch without a path, or where the paths left (e.g. one path whose
-    curvature is not handed on) fix a direction but not a range: there the pseudo-inverse the
-    fix is computed with would report a finite, meaningless covariance."""
-    from .._validate import positive
-
-    _check_geometry(model, geometry)
-    rcond = positive("rcond", rcond)
-    if weights is not None:
-        weights = _check_weights(model, weights)
-    T = model.exists.shape[0]
-    out = np.zeros(T, bool)
-    for k in range(T):
-        rows, H, W = _fix_weights(model, geometry, k, weights)
-        if rows is None:
-            continue
-        J = H.T @ W @ H
-        d = np.diag(J)
-        if np.any(d <= 0) or not np.all(np.isfinite(J)):
-            continue
-        w = np.linalg.eigvalsh(J / np.sqrt(np.outer(d, d)))
-        out[k] = w[0] > rcond * w[-1]
-    return out
-
-
-def position_noise_cov(model: PathErrorModel, geometry, weights) -> np.ndarray:
-    """Per epoch (T, 2, 2) [m^2] the covariance of the horizontal position of the weighted
-    least-squares snapshot fix (clock bias estimated) under the model's ideal noise, the joint
-    CRLB ``crlb`` of every path: ``G crlb G^T`` with ``G`` the position rows of ``(H^T W H)^-1
-    H^T W`` and ``W`` block-diagonal over the paths from ``weights`` (T, P, 4, 4), the
-    covariances the tracker is told (:func:`tunnelkit.design.fastroute.tracker_weights`; an
-    unresolved curvature as an infinite variance gets no weight). ``W = crlb^-1`` would give
-    the PEB's covariance; any other weight gives more (Gauss-Markov), and the tracker that is
-    run weighs its paths block by block. Zero at an epoch without a path."""
-    _check_geometry(model, geometry)
-    weights = _check_weights(model, weights)
-    T = model.exists.shape[0]
-    out = np.zeros((T, 2, 2))
-    for k in range(T):
-        rows, G = _weighted_gain(model, geometry, k, weights)
-        if rows is None:
-            continue
-        C = G @ model.crlb[k][np.ix_(rows, rows)] @ G.T
-        out[k] = 0.5 * (C + C.T)
-    return out
-
-
-def position_error_parts(model: PathErrorModel, geometry, weights=None) -> np.ndarray:
-    """Per epoch (T, 3) [m] the horizontal position error a weighted least-squares snapshot fix
-    (clock bias estimated) takes from the model's impairments: the RMS over the calibration
-    draw of its calibration bias ``sqrt(sigma_phi^2 ||G K_phase||_F^2 + sigma_g^2
-    ||G K_gain||_F^2)``, the norm of its deterministic bias ``|G b|`` (the wideband term) and
-    the standard deviation the diffuse multipath adds, ``sqrt(tr G (cov - crlb) G^T)``, with
-    ``G`` the position rows of ``(H^T W H)^-1 H^T W``. ``weights``: ``None`` for ``W =
-    crlb^-1`` (the estimator of :func:`position_information`, which trusts the ideal bound), or
-    the per-path covariances (T, P, 4, 4) the tracker is told
-    (:func:`tunnelkit.design.fastroute.tracker_weights`: its error budget, an unresolved
-    curvature as an infinite variance), ``W`` then block-diagonal over the paths as the tracker
-    weighs them. Under a calibration error the ``crlb^-1`` fix trusts the micrometre curvatures
-    of a large array, whose calibration bias is centimetres: its bias is up to 40 times the
-    tracker's (28 GHz example, 32 x 32, wideband term and 0.2 dB gain error). Zero for an ideal
-    model."""
-    _check_geometry(model, geometry)
-    T, P = model.exists.shape
-    if weights is not None:
-        weights = _check_weights(model, weights)
-    out = np.zeros((T, 3))
-    b_all = np.asarray(model.bias).reshape(T, 4 * P)
-    ks = [
-        (np.asarray(K).reshape(T, 4 * P, -1), sig)
-        for K, sig in ((model.k_phase, model.phase_sigma_rad), (model.k_gain, model.gain_sigma_db))
-        if K is not None and sig > 0
-    ]
-    excess = np.asarray(model.cov) - np.asarray(model.crlb)
-    diffuse = bool(np.any(excess))
-    for k in range(T):
-        rows, G = _weighted_gain(model, geometry, k, weights)
-        if rows is None:
-            continue
-        cal = sum(sig**2 * float(np.sum((G @ K[k, rows]) ** 2)) for K, sig in ks)
-        out[k, 0] = np.sqrt(cal)
-        out[k, 1] = np.linalg.norm(G @ b_all[k, rows])
-        if diffuse:
-            E = excess[k][np.ix_(rows, rows)]
-            out[k, 2] = np.sqrt(max(float(np.trace(G @ E @ G.T)), 0.0))
     return out
 
 
@@ -275,7 +94,7 @@ def drive_bound(pcrlb: np.ndarray, bias_rms: np.ndarray) -> np.ndarray:
     not average down (:func:`position_bias_rms`, the array's one calibration draw and the
     deterministic wideband bias) added in quadrature, ``sqrt(pcrlb^2 + bias_rms^2)``. The bias
     part is that of a snapshot fix weighted as the tracker weighs its paths (the design's
-    sweep passes :func:`tunnelkit.design.fastroute.tracker_weights`), not minimised over the
+    sweep passes :func:`tunnelkit.design.trackerfix.tracker_weights`), not minimised over the
     drive: the error of the tracker that is run, not a strict lower bound."""
     p = bound_array("pcrlb", pcrlb)
     b = bound_array("bias_rms", bias_rms)
@@ -324,7 +143,7 @@ def drive_motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
     respect to (speed, heading), the noise covariance of (speed, heading) from ``sig_nu`` [m/s]
     and ``sig_th`` [rad], and ``dt`` (T,) [s]. The message of epoch ``k-1`` drives the
     prediction into epoch ``k`` (Algorithm 4, line 7)."""
-    from .._validate import instance, integer, positive
+    from .._validate import integer, positive
 
     setup = instance("setup", setup, DesignSetup)
     traj = setup.trajectory
@@ -376,7 +195,7 @@ def unit_pcrlb(
     from .._validate import boolean
     from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
 
-    _check_geometry(model, geometry)
+    check_geometry(model, geometry)
     sigma_p0 = start_spread("sigma_p0", sigma_p0)
     calibration = boolean("calibration", calibration)
     T, P = model.exists.shape
@@ -400,7 +219,7 @@ def unit_pcrlb(
     for k in range(T):
         if k:
             Pm[:2, :2] += Q[k]
-        rows, H, _ = _position_rows(model, geometry, k)
+        rows, H, _ = position_rows(model, geometry, k)
         if rows is not None:
             R = np.asarray(model.cov[k])[np.ix_(rows, rows)]
             A = np.concatenate([H[:, :2], *(K[k, rows] for K, _ in ks)], axis=1)

@@ -44,39 +44,23 @@ and, under impairments, the misspecified covariance, bias and calibration sensit
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from .._physical import carrier
-from .._validate import choice, instance, nonnegative, record, rng_or_error
+from .._validate import choice, instance, nonnegative, rng_or_error
 from ..constants import C
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .setup import DesignSetup, parse_array
+from .trackerfix import KAPPA_RESOLVED, REPORTS, BoundRoute
 
 __all__ = [
-    "KAPPA_RESOLVED",
-    "MODES",
-    "REPORTS",
     "SIGMA_V",
-    "BoundRoute",
     "bound_drive",
     "bound_route",
     "model_truth",
-    "tracker_weights",
 ]
 
-#: the design's measurement routes: this one (``"bound"``) and the channel route (``"channel"``),
-#: what :func:`tunnelkit.design.montecarlo.sweep_montecarlo` runs the tracker on
-MODES = ("bound", "channel")
-
-#: a curvature is reported only where its reported standard deviation is below this share of the
-#: path's range (otherwise the path goes on as far field, as a plane-wave fit would report it)
-KAPPA_RESOLVED = 0.1
-
-#: what the bound route reports to the tracker (:func:`bound_drive`)
-REPORTS = ("auto", "crlb", "budget")
 
 #: standard deviation [m/s] of the radial speed handed to the tracker on the bound route
 SIGMA_V = 0.05
@@ -96,33 +80,6 @@ def model_truth(g, fc: float) -> tuple[np.ndarray, np.ndarray]:
     return z, v
 
 
-@dataclass(frozen=True)
-class BoundRoute:
-    """What every drive of one array on the bound route shares (:func:`bound_route`): the
-    ``model``, the ``report`` it hands the tracker, the reported per-path blocks (T, P, 4, 4),
-    the square root of the model's ``cov`` (T, 4P, 4P) the draws multiply, the array's
-    reference antenna per epoch ``origin`` (T, 3), Algorithm 1's ``min_d`` and ``repeating``
-    (T, P, 4, 4): the share of the reported blocks that repeats every epoch (``None`` for the
-    CRLB report; :meth:`PathErrorModel.split` for the budget, whose two shares the blocks
-    add). Computed once
-    per array, so a drive costs its random draws and nothing else."""
-
-    model: PathErrorModel
-    label: str
-    report: str
-    blocks: np.ndarray
-    noise_sqrt: np.ndarray
-    origin: np.ndarray
-    min_d: float
-    repeating: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        blocks = ("T", "P", 4, 4)
-        record(self, shapes={"blocks": blocks, "noise_sqrt": ("T", None, None),
-                             "origin": ("T", 3), "repeating": blocks})  # fmt: skip
-        choice("report", self.report, REPORTS)
-
-
 def _reported_blocks(model: PathErrorModel, report: str) -> tuple[np.ndarray, np.ndarray | None]:
     T, P = model.exists.shape
     ideal = model.phase_sigma_rad == 0 and model.gain_sigma_db == 0
@@ -132,17 +89,6 @@ def _reported_blocks(model: PathErrorModel, report: str) -> tuple[np.ndarray, np
         return np.moveaxis(model.crlb.reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1), None
     white, repeating = model.split()
     return white + repeating, repeating
-
-
-def _snapshot_blocks(model: PathErrorModel) -> np.ndarray:
-    """The per-path blocks (T, P, 4, 4) of each epoch on its own: the CRLB for an ideal model,
-    the error budget (:meth:`PathErrorModel.budget`) otherwise."""
-    T, P = model.exists.shape
-    ideal = model.phase_sigma_rad == 0 and model.gain_sigma_db == 0
-    if ideal and not np.any(model.bias) and np.array_equal(model.cov, model.crlb):
-        idx = np.arange(P)
-        return np.moveaxis(model.crlb.reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1)
-    return model.budget()
 
 
 def bound_route(
@@ -181,33 +127,6 @@ def bound_route(
         float(setup.signal_route(spec).min_d),
         repeating,
     )
-
-
-def tracker_weights(route) -> np.ndarray:
-    """The per-path covariances (T, P, 4, 4) the tracker is told on the bound route: ``route``
-    a :class:`BoundRoute` (its ``blocks``) or a :class:`PathErrorModel` (each epoch on its own:
-    the CRLB for an ideal model, the error budget :meth:`PathErrorModel.budget` otherwise, not
-    the drive's split, whose repeating share is a correlation over the whole route), with the variance of a curvature
-    :func:`bound_drive` does not hand on (reported standard deviation above
-    :data:`KAPPA_RESOLVED` of the range) infinite and its covariances zero: the weights of
-    :func:`tunnelkit.design.drivebound.position_error_parts` for the tracker that is run."""
-    if isinstance(route, PathErrorModel):
-        # the budget of each epoch alone: the report of a drive (its split into white and
-        # repeating shares) weighs every epoch by correlations over the whole route, so a
-        # snapshot fix at one position would depend on the rest of the route
-        model, blocks = route, _snapshot_blocks(route)
-    elif isinstance(route, BoundRoute):
-        model, blocks = route.model, route.blocks
-    else:
-        raise TypeError(
-            f"route: expected a design.BoundRoute or PathErrorModel, got {type(route).__name__}"
-        )
-    b = np.array(blocks, float)
-    drop = np.sqrt(b[..., 2, 2]) > KAPPA_RESOLVED * np.abs(model.truth[..., 3])
-    b[..., 2, :] = np.where(drop[..., None], 0.0, b[..., 2, :])
-    b[..., :, 2] = np.where(drop[..., None], 0.0, b[..., :, 2])
-    b[..., 2, 2] = np.where(drop, np.inf, b[..., 2, 2])
-    return b
 
 
 def bound_drive(

@@ -65,9 +65,8 @@ from .arrayjob import (
     load_tracker,
     prepared_summary,
 )
-from .drivebound import START_SIGMA_M
-from .fastroute import MODES
 from .setup import ArraySpec, DesignSetup, parse_array
+from .trackerfix import MODES, START_SIGMA_M
 from .units import drive_streams, unit_seeds
 
 __all__ = [

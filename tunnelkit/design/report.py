@@ -48,8 +48,6 @@ from ..budget import check_bytes, check_elements
 from ..metrics import SETTLE_S
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
-from .drivebound import START_SIGMA_M
-from .fastroute import MODES
 from .impairments import (
     CALIBRATED_GAIN_ERROR_DB,
     CALIBRATED_PHASE_ERROR_DEG,
@@ -62,6 +60,7 @@ from .impairments import (
 from .impairments import PRESETS as IMPAIRMENT_PRESETS
 from .records import DesignReport, DesignRow, over_target
 from .setup import ArraySpec, DesignSetup, parse_array
+from .trackerfix import MODES, START_SIGMA_M
 from .units import DRIVES_PER_UNIT, MAX_UNITS, REQUIRED_YIELD, unit_quantiles, unit_yield
 from .verdict import (
     CRITERIA,

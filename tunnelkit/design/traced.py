@@ -53,6 +53,7 @@ from .._validate import boolean, instance, integer, positive, rng_or_error
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
 from .setup import DesignSetup, parse_array
+from .trackerfix import START_SIGMA_M
 
 __all__ = [
     "ERROR_RUNS",
@@ -555,10 +556,10 @@ def traced_bounds(
     :func:`traced_javelin`), every first-order path measured with independent Gaussian errors of
     those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive)`` (T,) [m] as the design's
     Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` from a start of
-    ``sigma_p0`` [m] per axis, default :data:`~tunnelkit.design.drivebound.START_SIGMA_M`;
+    ``sigma_p0`` [m] per axis, default :data:`~tunnelkit.design.trackerfix.START_SIGMA_M`;
     ``drive`` the same with no bias). What the told sigmas allow: the traced
     errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
-    from .drivebound import START_SIGMA_M, drive_bound, drive_pcrlb, position_information
+    from .drivebound import drive_bound, drive_pcrlb, position_information
 
     instance("setup", setup, DesignSetup)
     spec = parse_array(spec)

@@ -18,7 +18,8 @@ What is here:
 * the exact mismatch, no expansion: :func:`signed_mismatch`, :func:`mismatch_profile`,
   :func:`phase_mismatch` (ULA), :func:`phase_mismatch_ura` (the URA of section 4.1) and the
   largest admissible array :func:`mmax_exact`, :func:`mmax_exact_grid`, :func:`mmax_exact_ura`
-  (:mod:`~tunnelkit.fresnel.exact`, with the proof term by term, :func:`aperture_profile`);
+  (:mod:`~tunnelkit.fresnel.exact`, with the proof term by term, :func:`aperture_profile`;
+  :func:`signed_mismatch` alone in :mod:`~tunnelkit.fresnel.mismatch`, all a design needs);
 * the corrected second-order bound :func:`mmax_nonparaxial`: eq. 41 with the SR model's own
   wavefront curvature kept (eq. 41 as printed drops it) and without the paraxial assumption
   ``|2W - y_u| << R`` behind eq. 28 and eq. 31;
@@ -56,7 +57,7 @@ _EXPORTS = {
     "mmax_exact_ura": "exact",
     "phase_mismatch": "exact",
     "phase_mismatch_ura": "exact",
-    "signed_mismatch": "exact",
+    "signed_mismatch": "mismatch",
     "FC_PRESETS": "summary",
     "MmaxSummary": "summary",
     "design_report": "summary",

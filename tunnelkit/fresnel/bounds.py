@@ -6,7 +6,7 @@ tunnel axis along x, the reflecting wall ``y = W``, the UE at ``(R, y_u, z_u)`` 
 (:func:`ula_positions`, :func:`ura_positions`). The bounds: :func:`mmax_2d` (eq. 25),
 :func:`mmax_3d` (eq. 37), the corrected second-order :func:`mmax_nonparaxial` and the classical
 Fraunhofer distance (:func:`fraunhofer_distance`, :func:`mmax_fraunhofer`). The input checks
-(:func:`real_input`, :func:`wall_geometry`, :func:`carrier_tolerance`) are shared with the exact
+(:func:`~tunnelkit.fresnel.mismatch.real_input`, :func:`wall_geometry`, :func:`carrier_tolerance`) are shared with the exact
 search of :mod:`tunnelkit.fresnel.exact`.
 """
 
@@ -18,9 +18,10 @@ import numpy as np
 
 from .. import arrays
 from .._physical import carrier, distances, phase_tolerance
-from .._validate import boolean, finite_array, integer, text
+from .._validate import integer
 from ..budget import check_elements
 from ..constants import C, wavelength
+from .mismatch import real_input
 
 __all__ = [
     "SECTION_4_1_TILT",
@@ -32,7 +33,6 @@ __all__ = [
     "mmax_fraunhofer",
     "mmax_nonparaxial",
     "paraxial_ratio",
-    "real_input",
     "reference_specular_point",
     "second_order_mmax",
     "ula_positions",
@@ -45,21 +45,6 @@ __all__ = [
 SECTION_4_1_TILT = math.radians(30.0)
 
 # input checks
-
-
-def real_input(name: str, value, *, pos: bool = False) -> np.ndarray:
-    """``value`` as a finite real scalar or array (bools and text refused, errors naming
-    ``name``); ``pos`` insists on > 0 everywhere. The input check of every function here."""
-    text("name", name)
-    pos = boolean("pos", pos)
-    if isinstance(value, bool | np.bool_):
-        raise TypeError(f"{name}: expected a real number, got {value!r}")
-    if isinstance(value, str | bytes):
-        raise TypeError(f"{name}: expected a real number, got {type(value).__name__}")
-    arr = finite_array(name, value)
-    if pos and np.any(arr <= 0):
-        raise ValueError(f"{name}: must be > 0, got {float(np.min(arr))}")
-    return arr
 
 
 def wall_geometry(R, W, y_u, z_u=0.0) -> tuple[np.ndarray, ...]:

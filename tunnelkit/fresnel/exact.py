@@ -1,12 +1,12 @@
 """The exact SR-NF phase mismatch, no expansion, and the largest array that keeps it small.
 
-:func:`signed_mismatch` is the mismatch between the true wavefront (centred on the VUE) and the
-SR-NF model's (centred on the reference specular point) at each antenna;
 :func:`mismatch_profile`, :func:`phase_mismatch` (ULA) and :func:`phase_mismatch_ura` (the URA of
-section 4.1) evaluate it in the theorem's geometry; the brute-force searches :func:`mmax_exact`,
-:func:`mmax_exact_grid` and :func:`mmax_exact_ura` find the largest admissible array, starting
-from the second-order guess of :mod:`tunnelkit.fresnel.bounds`. :func:`aperture_profile` lays the
-proof of Theorem 3.1 out term by term, exact beside the expansions.
+section 4.1) evaluate the exact mismatch of each antenna
+(:func:`~tunnelkit.fresnel.mismatch.signed_mismatch`) in the theorem's geometry; the
+brute-force searches :func:`mmax_exact`, :func:`mmax_exact_grid` and :func:`mmax_exact_ura` find
+the largest admissible array, starting from the second-order guess of
+:mod:`tunnelkit.fresnel.bounds`. :func:`aperture_profile` lays the proof of Theorem 3.1 out term
+by term, exact beside the expansions.
 """
 
 from __future__ import annotations
@@ -19,13 +19,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._physical import carrier
-from .._validate import finite_array, integer, record
+from .._validate import integer, record
 from ..budget import check_elements
 from ..constants import C, wavelength
 from .bounds import (
     SECTION_4_1_TILT,
     carrier_tolerance,
-    real_input,
     reference_specular_point,
     second_order_mmax,
     ula_positions,
@@ -33,6 +32,7 @@ from .bounds import (
     vue,
     wall_geometry,
 )
+from .mismatch import path_difference, real_input, signed_mismatch
 
 __all__ = [
     "M_LIMIT",
@@ -45,7 +45,6 @@ __all__ = [
     "mmax_exact_ura",
     "phase_mismatch",
     "phase_mismatch_ura",
-    "signed_mismatch",
 ]
 
 #: the exact search stops here (an array this long is kilometres wide; see mmax_exact)
@@ -56,43 +55,9 @@ M_LIMIT_URA = 1024
 # exact mismatch
 
 
-def _delta(src: np.ndarray, pos: np.ndarray) -> np.ndarray:
-    """``|src - p| - |src|`` without cancellation: ``(|p|^2 - 2 src.p) / (|src - p| + |src|)``.
-
-    ``src`` (..., 3) broadcast against ``pos`` (..., 3); the path difference of eq. 2 / eq. 27.
-    """
-    num = np.sum(pos * pos, axis=-1) - 2.0 * np.sum(src * pos, axis=-1)
-    den = np.linalg.norm(src - pos, axis=-1) + np.linalg.norm(src, axis=-1)
-    return num / den
-
-
-def signed_mismatch(pv, ps, pos, lam) -> np.ndarray:
-    """Signed exact phase mismatch ``2 pi / lambda (delta*_m - delta^SR_m)`` [rad], no expansion.
-
-    ``pv`` (..., 3): the true wavefront's centre (the VUE); ``ps`` (..., 3): the SR-NF model's
-    (the reference antenna's specular point); ``pos`` (..., 3): the antennas; all relative to the
-    reference antenna and broadcast against each other; ``lam`` [m] the wavelength. Each path
-    difference ``|c - p| - |c|`` is evaluated in the cancellation-free form
-    ``(|p|^2 - 2 c.p) / (|c - p| + |c|)``, so a mismatch of micro-radians over a metre-long path
-    keeps its digits. Used by :func:`mismatch_profile` and by the design's SR-NF check of every
-    path along a route (:func:`tunnelkit.design.route_bounds`).
-    """
-    pv, ps, pos = (finite_array(k, v) for k, v in (("pv", pv), ("ps", ps), ("pos", pos)))
-    for k, v in (("pv", pv), ("ps", ps), ("pos", pos)):
-        if v.ndim == 0 or v.shape[-1] != 3:
-            raise ValueError(f"{k}: expected 3 coordinates in the last axis, got shape {v.shape}")
-    try:
-        np.broadcast_shapes(pv.shape, ps.shape, pos.shape)
-    except ValueError:
-        raise ValueError(
-            f"pv, ps, pos: shapes {pv.shape}, {ps.shape}, {pos.shape} do not broadcast"
-        ) from None
-    lam = real_input("lam", lam, pos=True)
-    return (2.0 * np.pi / lam) * (_delta(pv, pos) - _delta(ps, pos))
-
-
 def _delta_ula(src: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """:func:`_delta` for antennas on the y axis, ``p = (0, y, 0)``; ``src`` (n, 3), ``y`` (n, K)."""
+    """:func:`~tunnelkit.fresnel.mismatch.path_difference` for antennas on the y axis,
+    ``p = (0, y, 0)``; ``src`` (n, 3), ``y`` (n, K)."""
     sx2z2 = (src[:, 0] ** 2 + src[:, 2] ** 2)[:, None]
     sy = src[:, 1][:, None]
     return (y * y - 2.0 * sy * y) / (np.sqrt(sx2z2 + (sy - y) ** 2) + np.sqrt(sx2z2 + sy * sy))
@@ -371,7 +336,7 @@ def aperture_profile(M: int, R: float, W: float, y_u: float, fc: float) -> Apert
     pos = np.zeros((M, 3))
     pos[:, 1] = y
     pv, ps = np.array([R, a, 0.0]), np.array([x_p0, W, 0.0])
-    d_star, d_sr = _delta(pv, pos), _delta(ps, pos)
+    d_star, d_sr = path_difference(pv, pos), path_difference(ps, pos)
     rho = math.hypot(R, a)
     k = 2.0 * np.pi / lam
     return ApertureProfile(

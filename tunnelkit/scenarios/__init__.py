@@ -23,12 +23,14 @@ they build and register themselves on import:
 - :mod:`.model` — :class:`Scenario`, a loaded file and the objects its builders make;
 - :mod:`.files` — finding, reading and validating files (:func:`load_scenario`, :func:`with_values`);
 - :mod:`.checks` — sizes and placement checked on load;
-- :mod:`.templates` — commented templates of your own tunnel (:func:`template`);
+- :mod:`.templates` — commented templates of your own tunnel (:func:`template`, loaded on first
+  use);
 - :mod:`.jiang` — the builders of Jiang et al. (2023)'s 2-D scenarios.
 """
 
 from __future__ import annotations
 
+from .._lazy import lazy_exports
 from ..schema import ScenarioError
 from .checks import MAX_ELEMENTS, MAX_SAMPLES, MAX_TENSOR_BYTES
 from .files import (
@@ -49,7 +51,9 @@ from .registry import (
     register_trajectory,
     register_tunnel,
 )
-from .templates import template
+
+#: loaded on first use (:mod:`tunnelkit._lazy`): a loaded scenario needs no template writer
+_EXPORTS = {"template": "templates"}
 
 __all__ = [
     "ALLOWED_REQUIRES",
@@ -72,3 +76,4 @@ __all__ = [
     "template",
     "with_values",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

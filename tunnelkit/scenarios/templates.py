@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 
-from ..schema import render_template
+from ..schemadoc import render_template
 from .files import MAX_NAME_LENGTH, NAME_RE, load_scenario
 
 __all__ = ["template"]

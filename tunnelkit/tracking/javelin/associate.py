@@ -18,7 +18,7 @@ from scipy.optimize import linear_sum_assignment
 
 from ..._checks import unchecked
 from ..._validate import finite_array, instance, record
-from ...crlb import wrap_angle
+from ...angles import wrap_angle
 from ..gating import ChiSquareGate, mahalanobis2
 from .measurement import PathMeasurements, check_track_model
 

@@ -36,7 +36,7 @@ from scipy.linalg import cho_factor, cho_solve
 
 from ..._checks import unchecked
 from ..._validate import finite_array, instance, integer, probability, record, sequence
-from ...crlb import wrap_angle
+from ...angles import wrap_angle
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
 from .measurement import KAPPA, PHI, PSI, RANGE, PathMeasurements, check_track_model

@@ -1,105 +1,26 @@
-"""Estimates against the truth (notebook 03, benchmarks): matching, tables, RMSE studies with bounds."""
+"""Estimates against the truth in tables: errors in units of the CRLB, rows per path, RMSE
+studies with their bounds (notebook 03, benchmarks).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ._checks import attributes
-from ._physical import speeds as check_speeds
-from ._validate import boolean, finite_array, instance, integer, positive, real, sequence
-from .arrays import ArrayGeometry
-from .budget import check_elements
-from .constants import C
+from .._checks import attributes
+from .._validate import boolean, finite_array, instance, integer, real, sequence
+from ..arrays import ArrayGeometry
+from ..constants import C
+from ..extraction import MIN_SIGNIFICANCE, path_crlb
+from ..extraction.estimates import PathEstimates
+from ..montecarlo import spawn_rngs
+from .matching import match_paths, match_points
 
-__all__ = [
-    "Scene",
-    "bound_errors",
-    "comparison_rows",
-    "match_paths",
-    "match_points",
-    "normalized_errors",
-    "path_rows",
-    "random_scene",
-    "rmse_study",
-]
-
-
-def _ranges_directions(d_name: str, d, u_name: str, u) -> tuple[np.ndarray, np.ndarray]:
-    """Distances (N,) and unit directions (N, 3), checked and named."""
-    d = np.atleast_1d(finite_array(d_name, d))
-    if d.ndim != 1:
-        raise ValueError(f"{d_name}: expected 1-D distances, got shape {d.shape}")
-    u = finite_array(u_name, u)
-    if not (u.size == 0 and d.size == 0) and u.shape != (d.shape[0], 3):
-        raise ValueError(f"{u_name}: expected shape ({d.shape[0]}, 3), got {u.shape}")
-    return d, u.reshape(d.shape[0], 3)
-
-
-def match_paths(
-    d_est,
-    dir_est,
-    paths,
-    *,
-    clock_bias: float = 0.0,
-    direction_scale: float = 0.1,
-    range_scale: float = 1.0,
-) -> np.ndarray:
-    """Assign estimates to true paths (Hungarian on range and direction); -1 where unmatched.
-
-    Cost: ``|d_est - (length + c b)| / range_scale + ||u_est - u_true|| / direction_scale``;
-    assignments costing more than 10 are refused.
-    """
-    d_est, dir_est = _ranges_directions("d_est", d_est, "dir_est", dir_est)
-    if isinstance(paths, str | bytes) or not hasattr(paths, "__len__"):
-        raise TypeError(f"paths: expected a list of traced paths, got {type(paths).__name__}")
-    if any(not hasattr(p, "length") or not hasattr(p, "direction") for p in paths):
-        raise TypeError("paths: expected traced paths (with .length and .direction)")
-    clock_bias = real("clock_bias", clock_bias)
-    direction_scale = positive("direction_scale", direction_scale)
-    range_scale = positive("range_scale", range_scale)
-    if not len(paths) or not d_est.size:
-        return -np.ones(d_est.shape[0], dtype=int)
-    d_true = np.array([p.length for p in paths]) + C * clock_bias
-    u_true = np.stack([p.direction for p in paths])
-    return match_points(
-        d_est,
-        dir_est,
-        d_true,
-        u_true,
-        direction_scale=direction_scale,
-        range_scale=range_scale,
-    )
-
-
-def match_points(
-    d_est, dir_est, d_true, dir_true, *, direction_scale: float = 0.1, range_scale: float = 1.0
-) -> np.ndarray:
-    """:func:`match_paths` on plain arrays (distances and unit directions in one frame)."""
-    from scipy.optimize import linear_sum_assignment
-
-    d_est, dir_est = _ranges_directions("d_est", d_est, "dir_est", dir_est)
-    d_true, dir_true = _ranges_directions("d_true", d_true, "dir_true", dir_true)
-    direction_scale = positive("direction_scale", direction_scale)
-    range_scale = positive("range_scale", range_scale)
-    out = -np.ones(d_est.shape[0], dtype=int)
-    if not d_true.size or not d_est.size:
-        return out
-    cost = (
-        np.abs(d_est[:, None] - d_true[None, :]) / range_scale
-        + np.linalg.norm(dir_est[:, None, :] - dir_true[None], axis=-1) / direction_scale
-    )
-    r, c = linear_sum_assignment(cost)
-    ok = cost[r, c] < 10.0
-    out[r[ok]] = c[ok]
-    return out
+__all__ = ["bound_errors", "comparison_rows", "normalized_errors", "path_rows", "rmse_study"]
 
 
 def _truth_and_bound(est, d_true, v_true, sources, bound):
     """The checked inputs of :func:`normalized_errors` / :func:`bound_errors`: ``sources``
     (L, 3) finite, ``d_true`` and ``v_true`` (L,) finite, ``bound`` a dict of (L,) arrays."""
-    from .extraction.estimates import PathEstimates
 
     instance("est", est, PathEstimates)
     src = np.atleast_2d(finite_array("sources", sources))
@@ -133,8 +54,6 @@ def normalized_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     if est.significance is None:  # every estimate of the route (not Algorithm 1's d >= 0)
         keep = np.arange(len(est))
     else:  # the ML route: the paths that stand above the noise
-        from .extraction import MIN_SIGNIFICANCE
-
         keep = np.flatnonzero(est.significance >= MIN_SIGNIFICANCE)
     match = match_points(est.d[keep], est.direction[keep], d_true, u)
     for i, j in zip(keep, match):
@@ -170,8 +89,6 @@ def bound_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     if est.significance is None:
         keep = np.arange(len(est))
     else:
-        from .extraction import MIN_SIGNIFICANCE
-
         keep = np.flatnonzero(est.significance >= MIN_SIGNIFICANCE)
     if not keep.size:
         return out
@@ -196,120 +113,6 @@ def bound_errors(est, d_true, v_true, sources, bound) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True)
-class Scene:
-    """A free-space scene in front of one array: point sources (wave origins) in the local
-    frame, their gains (incl. ``sqrt(P_t)``), delay-distances ``d`` [m] and speeds ``v`` [m/s];
-    the radio of ``config`` (tones, symbols, noise power)."""
-
-    sources: np.ndarray
-    alpha: np.ndarray
-    d: np.ndarray
-    v: np.ndarray
-    element_positions: np.ndarray
-    config: object
-
-    def __post_init__(self) -> None:
-        from ._validate import instance, record
-        from .channel import SRSConfig
-
-        shapes = {
-            "sources": ("L", 3),
-            "alpha": ("L",),
-            "d": ("L",),
-            "v": ("L",),
-            "element_positions": (None, 3),
-        }
-        record(self, shapes=shapes, positive=("d",))
-        instance("config", self.config, SRSConfig)
-
-    @property
-    def mu_f(self) -> np.ndarray:
-        return -2 * np.pi * self.config.tone_spacing * self.d / C
-
-    @property
-    def mu_t(self) -> np.ndarray:
-        return 2 * np.pi * self.config.fc * self.config.symbol_period * self.v / C
-
-    def tensor(self, rng: np.random.Generator | None = None) -> np.ndarray:
-        """Eq. 1 for the sources, plus ``CN(0, noise_power)`` noise when ``rng`` is given."""
-        from .channel import add_noise
-        from .extraction.coherent import spherical_steering
-
-        cfg = self.config
-        a = spherical_steering(self.sources, self.element_positions, cfg.fc)
-        f = np.exp(1j * np.arange(cfg.n_tones)[:, None] * self.mu_f[None, :])
-        t = np.exp(1j * np.arange(cfg.n_symbols)[:, None] * self.mu_t[None, :])
-        H = np.einsum("ml,sl,kl->msk", a * self.alpha[None, :], f, t, optimize=True)
-        return H if rng is None else add_noise(H, cfg.noise_power, rng)
-
-    def crlb(self, spatial: str = "structured") -> dict:
-        """Standard deviations ``d`` [m], ``v`` [m/s], ``direction`` [rad], ``kappa`` [m]."""
-        from .extraction.bounds import in_path_units, source_crlb
-
-        cfg = self.config
-        b = source_crlb(
-            self.alpha,
-            self.sources,
-            self.element_positions,
-            self.mu_f,
-            self.mu_t,
-            cfg.fc,
-            cfg.n_tones,
-            cfg.n_symbols,
-            cfg.noise_power,
-            spatial=spatial,
-        )
-        return in_path_units(b, cfg)
-
-
-def random_scene(
-    rng: np.random.Generator,
-    n_paths: int = 3,
-    *,
-    element_positions=None,
-    config=None,
-    ranges=(2.0, 8.0),
-    max_sine: float = 0.8,
-    snr_db=(-10.0, 10.0),
-    spread_d: float = 30.0,
-    speeds=(-20.0, 20.0),
-) -> Scene:
-    """Random near-field scene: ``n_paths`` sources at ``ranges`` [m] from the reference antenna
-    of a 10 x 10 half-wavelength URA (default), directions with ``|u_xy| < max_sine``, per-sample
-    SNR uniform in ``snr_db`` (the noise power of ``config``, default :class:`SRSConfig`), delay
-    distances ``range + U(0, spread_d)`` (a clock bias and extra path length), speeds uniform."""
-    from ._validate import instance, integer, interval, nonnegative, real, rng_or_error
-    from .arrays import check_element_positions, ura
-    from .channel import SRSConfig
-    from .constants import wavelength
-
-    rng = rng_or_error("rng", rng)
-    L = integer("n_paths", n_paths, minimum=1)
-    check_elements("n_paths", 16 * L, what=f"{L} paths' parameters")
-    cfg = SRSConfig() if config is None else instance("config", config, SRSConfig)
-    ranges = interval("ranges", ranges, lower=1e-3)
-    max_sine = real("max_sine", max_sine)
-    if not 0 < max_sine <= 1:
-        raise ValueError(f"max_sine: must lie in (0, 1], got {max_sine}")
-    snr_db = interval("snr_db", snr_db)
-    spread_d = nonnegative("spread_d", spread_d)
-    speeds = tuple(check_speeds("speeds", interval("speeds", speeds), vectors=False))
-    pos = ura(10, 10, wavelength(cfg.fc) / 2) if element_positions is None else element_positions
-    if element_positions is not None:
-        pos = check_element_positions("element_positions", element_positions)
-    pos = np.asarray(pos, float)
-    r = rng.uniform(*ranges, L)
-    rad = max_sine * np.sqrt(rng.uniform(0, 1, L))
-    ang = rng.uniform(0, 2 * np.pi, L)
-    u = np.column_stack([rad * np.cos(ang), rad * np.sin(ang), np.sqrt(1 - rad**2)])
-    amp = np.sqrt(cfg.noise_power * 10 ** (rng.uniform(*snr_db, L) / 10))
-    alpha = amp * np.exp(2j * np.pi * rng.uniform(0, 1, L))
-    d = r + rng.uniform(0, spread_d, L)
-    v = rng.uniform(*speeds, L)
-    return Scene(u * r[:, None], alpha, d, v, pos, cfg)
-
-
 def path_rows(paths) -> list[dict]:
     """One table row per true path: family, surface, length, angles [deg], Doppler, gain, kappa."""
     paths = sequence("paths", paths, empty=True)  # no path: an empty table
@@ -331,7 +134,6 @@ def path_rows(paths) -> list[dict]:
 
 def comparison_rows(est, paths, array: ArrayGeometry, clock_bias: float) -> list[dict]:
     """Extracted vs true parameters, one row per estimate matched to a true path."""
-    from .extraction.estimates import PathEstimates
 
     instance("est", est, PathEstimates)
     paths = sequence("paths", paths, empty=True)  # no true path: every estimate unmatched
@@ -385,8 +187,6 @@ def rmse_study(
     progress = boolean("progress", progress)
     if spatial is None:
         spatial = "free" if refine in ("joint", "column", "none") else "structured"
-    from .extraction import path_crlb
-    from .montecarlo import spawn_rngs
 
     arr, paths = route.paths(k)
     cfg = route.config
