@@ -173,6 +173,11 @@ def javelin_studies():
     simulation.path_errors([drive])
     simulation.extraction_errors([routes["ml"]])
     simulation.error_correlations([routes["ml"]])
+    samples = simulation.error_samples([routes["ml"]])
+    from tunnelkit.studies import robust_errors
+
+    robust_errors.robust_rows(samples)
+    robust_errors.robust_design(samples)
     simulation.ablation({"L": [drive]}, separated={"L": [routes["coherent"]]})
     pjv.epoch_figure(ev.run.reports[0], truth=drive.truth[0])
     wj.epoch_view(drive, ev, 0)

@@ -14,6 +14,7 @@ from .._lazy import lazy_exports
 _EXPORTS = {
     "ablation": "analysis",
     "error_correlations": "analysis",
+    "error_samples": "analysis",
     "extraction_errors": "analysis",
     "path_errors": "analysis",
     "vue_prediction_errors": "analysis",
@@ -61,6 +62,7 @@ __all__ = [
     "collect_drives",
     "collect_routes",
     "error_correlations",
+    "error_samples",
     "error_metrics",
     "evaluate",
     "extraction_errors",

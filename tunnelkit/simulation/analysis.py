@@ -19,6 +19,7 @@ __all__ = [
     "ERROR_QUANTITIES",
     "ablation",
     "error_correlations",
+    "error_samples",
     "extraction_errors",
     "path_errors",
     "vue_prediction_errors",
@@ -157,20 +158,19 @@ def _matched_errors(drive: DriveData, k: int):
     return out
 
 
-def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
-    """RMS error of what the tracker is fed, per kind of path, over ``drives``.
-
-    For every measurement matched to a true path: azimuth and elevation against the true
-    arrival direction (world frame) [deg], curvature against the distance of the true wave
-    source (the UE for the LoS, the VUE for a reflection: the radius of the exact wavefront)
-    [m], and the TDoA ``Delta d`` of eq. 52 against the true one [m] (each epoch's earliest
-    matched path is the reference, so the clock bias cancels; the reference itself has none).
-    Rows per kind and a last row ``"all"`` pooling every path; columns: kind, matched
-    measurements, RMS of phi, psi, kappa, Delta d, and how many matched paths had no curvature.
-    """
+def error_samples(drives: list[DriveData]) -> dict[str, dict[str, np.ndarray | int]]:
+    """Every error of what the tracker is fed, per kind of path, over ``drives``: the samples
+    :func:`extraction_errors` summarises. For every measurement matched to a true path: azimuth
+    and elevation against the true arrival direction (world frame) [deg], curvature against the
+    distance of the true wave source (the UE for the LoS, the VUE for a reflection: the radius of
+    the exact wavefront) [m], and the TDoA ``Delta d`` of eq. 52 against the true one [m] (each
+    epoch's earliest matched path is the reference, so the clock bias cancels; the reference
+    itself has none). Returns ``{kind: {"phi", "psi", "kappa", "delta_d": 1-D arrays, "far":
+    matched paths without curvature}}``, kinds in the order first met."""
     drives = sequence("drives", drives)
     acc: dict[str, dict[str, list]] = {}
     for drive in drives:
+        instance("drives[i]", drive, DriveData)
         for k in range(len(drive.epochs)):
             for kind, _, dphi, dpsi, dkap, ddd in _matched_errors(drive, k):
                 a = acc.setdefault(kind, {"phi": [], "psi": [], "kappa": [], "dd": [], "far": 0})
@@ -184,28 +184,36 @@ def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
                     a["dd"].append(ddd)
     if not acc:
         raise ValueError("drives: no measurement matched to a true path")
+    return {
+        kind: {
+            "phi": np.asarray(a["phi"], float),
+            "psi": np.asarray(a["psi"], float),
+            "kappa": np.asarray(a["kappa"], float),
+            "delta_d": np.asarray(a["dd"], float),
+            "far": a["far"],
+        }
+        for kind, a in acc.items()
+    }
+
+
+def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
+    """RMS error of what the tracker is fed, per kind of path, over ``drives`` (the samples of
+    :func:`error_samples`). Rows per kind and a last row ``"all"`` pooling every path; columns:
+    kind, matched measurements, RMS of phi, psi, kappa, Delta d, and how many matched paths had
+    no curvature.
+    """
+    samples = error_samples(drives)
 
     def rms(x):
-        x = np.asarray(x, float)
         return float(np.sqrt(np.mean(x**2))) if x.size else None
 
+    quantities = ERROR_QUANTITIES
     rows = []
-    pooled = {"phi": [], "psi": [], "kappa": [], "dd": [], "far": 0}
-    for kind, a in acc.items():
-        rows.append(
-            [kind, len(a["phi"]), *(rms(a[q]) for q in ("phi", "psi", "kappa", "dd")), a["far"]]
-        )
-        for q in ("phi", "psi", "kappa", "dd"):
-            pooled[q] += a[q]
-        pooled["far"] += a["far"]
-    rows.append(
-        [
-            "all",
-            len(pooled["phi"]),
-            *(rms(pooled[q]) for q in ("phi", "psi", "kappa", "dd")),
-            pooled["far"],
-        ]
-    )
+    for kind, a in samples.items():
+        rows.append([kind, len(a["phi"]), *(rms(a[q]) for q in quantities), a["far"]])
+    pooled = {q: np.concatenate([a[q] for a in samples.values()]) for q in quantities}
+    far = sum(a["far"] for a in samples.values())
+    rows.append(["all", len(pooled["phi"]), *(rms(pooled[q]) for q in quantities), far])
     cols = ["path", "matched", "phi [deg]", "psi [deg]", "kappa [m]", "Delta d [m]", "no kappa"]
     return cols, rows
 

@@ -13,6 +13,9 @@ core never imports it (``tests/test_layout.py``):
 - :mod:`.attribution` — what eq. 1 misses on the traced channel: each mechanism of the ray
   tracer switched off in turn, its pseudo-true bias, extraction error and position cost
   (``docs/results/traced-attribution.md``).
+- :mod:`.robust_errors` — errors the tracker can trust: robust statistics of the traced
+  per-path errors (median, MAD, gross errors apart) and the traced design told them
+  (``docs/results/traced-robust.md``).
 
 The papers' tables (``tunnelkit reproduce``) are :mod:`tunnelkit.reproduce`, the other package of
 this layer.
