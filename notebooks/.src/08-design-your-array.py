@@ -32,8 +32,8 @@
 #   the entry fix and the odometry increments acting as measurements beside the radio's (per
 #   unit, and pooled over units with the calibration random): a bound for trackers that are
 #   (nearly) unbiased for the route, such as this one, which knows nothing of it. An oracle that
-#   knows the route beats it, as notebook 05's filters beat theirs
-#   ([PCRLB](GLOSSARY.md#pcrlb));
+#   knows the route beats it (notebook 05's point: its filter started at the truth gets
+#   centimetres; [PCRLB](GLOSSARY.md#pcrlb));
 # - what the same question gets on a ray-traced channel (Sionna RT, diffuse scattering on), where
 #   eq. 1 is no longer the channel;
 # - an explorer whose impairment sliders move the predicted-error curve.
@@ -262,7 +262,8 @@ route_figure(
 # %% [markdown]
 # The ideal bound of an 8 × 8 array is millimetres; half a degree of phase error per element
 # (with 0.2 dB of gain error) lifts the predicted error by the factor printed above
-# (`ratio_cal`), to centimetres (its median printed above). That factor, not the PEB, is what an engineer must expect; whether the tracker
+# (`ratio_cal`), to centimetres (its median printed above). That factor, not the PEB, is what
+# an engineer must expect; whether the tracker
 # does better or worse is for the Monte-Carlo of section 6 to say. Where a term is *known* (the
 # spatial wideband delay follows from the geometry the fit estimates anyway) it can be put in
 # the model and stops costing; an unknown calibration error cannot.
@@ -289,9 +290,9 @@ route_figure(
 # (sections 3.2–3.5) with each path's wavefront centred on its VUE (the exact wavefront of a
 # specular path) and each path weighed by the covariance the extraction reports
 # (`tracking.javelin.designs.array_design`; notebook 04b sets the VUE-centred curvature against
-# eq. 51 in the paper's own design). It does not need SR-NF, so the design reports SR-NF per surface as information
-# (`criterion="achievable"`, the default) and gates on it only for an eq. 51 route
-# (`criterion="srnf"`). Under a ceiling 20 cm away the ceiling decides:
+# eq. 51 in the paper's own design). It does not need SR-NF, so the design reports SR-NF per
+# surface as information (`criterion="achievable"`, the default) and gates on it only for an
+# eq. 51 route (`criterion="srnf"`). Under a ceiling 20 cm away the ceiling decides:
 
 # %%
 srnf8 = b8.surface_validity()
@@ -494,13 +495,13 @@ design_answer_figure(answers["0.5°"]).show()
 # candidate meets 10 cm, and the tracker's error sits within a small factor of the PEB; with
 # half a degree of phase error (and 0.2 dB of gain error) the median error rises to several
 # times the PEB (3 to 10 times, by array) and the smallest array's yield drops; with 2° it drops
-# further, and an array that every unit passed at 0.5° loses units: **0.5° against 2° of
-# calibration changes the yield**, never the PEB. The recommendation (printed above each table)
-# follows the calibration: never a smaller array with worse calibration, and with the full
-# counts a larger array at 2° than for an ideal array. (Whether 0.5° and 2° get different
-# recommendations depends on the counts; the Checks do not claim it.) The whole-route p90 lies
-# above the settled one: the first second, from the 1 m entry fix, is left out of the verdict
-# (`settle`).
+# further, and an array that passed 99 % or more of its units at 0.5° loses units: **0.5°
+# against 2° of calibration changes the yield**, never the PEB. The recommendation (printed
+# above each table) follows the calibration: never a smaller array with worse calibration, and
+# with the full counts a larger array at 2° than at 0.5°, and at 0.5° than for an ideal array.
+# Quick mode's four units per array decide nothing, so there the recommendations are all
+# "none". The whole-route p90 lies above the settled one: the first second, from the 1 m entry
+# fix, is left out of the verdict (`settle`).
 #
 # **What these verdicts rest on.** Every drive above ran on the bound-driven route: the tracker
 # never saw a tensor, only path parameters drawn from the first-order error model of section 4
@@ -519,7 +520,7 @@ design_answer_figure(answers["0.5°"]).show()
 # fix and the odometry increments acting as measurements beside the radio's. It bounds the
 # mean-square error of trackers that are (nearly) unbiased for the route, such as JAVELIN with
 # VUE-centred curvature, which knows nothing of the route; an oracle that knows the route is
-# biased for every other route and beats it (notebook 05's point). At epoch $k$ it is a
+# biased for every other route and beats it (notebook 05's oracle). At epoch $k$ it is a
 # filtering bound: it uses the data up to epoch $k$, as the tracker does.
 #
 # - `pcrlb_rms_m` (the table's "PCRLB"): **every unit's** bound, the unit's calibration draw
@@ -595,10 +596,10 @@ print("error p90 below the snapshot prediction's p90:", snap_beaten)
 # tracker is further compared with the **posterior CRLB** over the drive (the Tichavský
 # recursion with the tracker's motion model, `MonteCarloResult.pcrlb`, every unit's bound of
 # section 6: the CRLB of the fixed route, for trackers (nearly) unbiased for it), a bound of the
-# tracker's mean-square error, which the PEB of one snapshot is not. The ideal array has no calibration draw,
-# so one drive is one unit here (`sweep_montecarlo`'s `drives_per_unit=1`). Quick mode drives the
-# first 12 epochs, twice on the bound route and once on the channel route (whose synthesis and
-# extraction are what cost).
+# tracker's mean-square error, which the PEB of one snapshot is not. The ideal array has no
+# calibration draw, so one drive is one unit here (`sweep_montecarlo`'s `drives_per_unit=1`).
+# Quick mode drives the first 12 epochs, twice on the bound route and once on the channel route
+# (whose synthesis and extraction are what cost).
 
 # %%
 n_ep = 12 if tk.quick_mode() else None
@@ -766,9 +767,10 @@ print("the radio's gain over dead reckoning's bound:", {a: f"{g:.0%}" for a, g i
 # The route carries no calibration draw, so a unit is one drive (`drives_per_unit=1`). Quick
 # mode runs the 4 × 4 array and one unit (its verdicts "undecided"), and on the traced channel
 # the first 12 epochs of the route only (`n_epochs`: 1.1 s at 0.1 s a step, so its verdict
-# counts the two epochs from the first second on, `k_quick`); its tracker is then told the errors measured the same way on the
-# first 12 epochs of the same three drives of seed 0 (a record of its own, shipped beside the
-# others: a record is used only on drives of the epochs it was measured on). Quick mode's traced
+# counts the two epochs from the first second on, `k_quick`); its tracker is then told the
+# errors measured the same way on the first 12 epochs of the same three drives of seed 0 (a
+# record of its own, shipped beside the others: a record is used only on drives of the epochs it
+# was measured on). Quick mode's traced
 # drive itself, whose every epoch's ML extraction is what costs (about a second of CPU per
 # epoch), is stored too: its 12 epochs' measurements after the pre-filter, the tracker's input
 # (`data/rt/design/italiano2026-straight-4x4-T12-drive.json`, written by `tools/traced_drive.py`
@@ -1108,7 +1110,7 @@ assert rank == sorted(rank), recs
 assert all(rep.settings["settle_s"] == 1.0 for rep in answers.values())  # the quoted 1 s
 if not tk.quick_mode():
     assert n_decide == 80, batches
-    assert recs["ideal"] == "4x4" and rank[2] > rank[0], recs
+    assert recs["ideal"] == "4x4" and rank[0] < rank[1] < rank[2], recs
     rows_ideal = {r.array: r for r in answers["ideal"].rows}
     assert rows_ideal["4x4"].status == "met" and rows_ideal["4x4"].units == 80
 else:  # a cap of 4 units: below 10 no interval decides, and the sweep says so
@@ -1117,11 +1119,11 @@ else:  # a cap of 4 units: below 10 no interval decides, and the sweep says so
     assert n_decide is None and all(r.status == "undecided" for r in answers["0.5°"].rows)
     assert any("units" in w for w in answers["0.5°"].warnings)
 # the yields: every unit meets with an ideal array; calibration lowers the yield, 2 deg below
-# 0.5 deg (the smallest array's drops; an array all of whose units pass at 0.5 deg loses some)
+# 0.5 deg (the smallest array's drops; an array passing 99 % or more at 0.5 deg loses some)
 assert all(y == 1.0 for y in yields["ideal"].values()), yields
 assert all(yields["0.5°"][a] >= yields["2°"][a] for a in candidates), yields
 assert yields["0.5°"]["4x4"] < 1.0 and yields["2°"]["4x4"] < yields["0.5°"]["4x4"], yields
-assert any(yields["0.5°"][a] == 1.0 > yields["2°"][a] for a in candidates), yields
+assert any(yields["0.5°"][a] >= 0.99 > yields["2°"][a] for a in candidates), yields
 # section 6's reading: ideal, the tracker within a small factor of the PEB; at 0.5 deg several
 # times the PEB (3 to 10) and within a small factor of the predicted error
 for r in answers["ideal"].rows:

@@ -392,7 +392,8 @@ def design_answer_figure(report) -> go.Figure:
                     "x %{x:.1f} m: %{y:.3g} cm<br>"
                     f"pooled {pooled} (settled route, 95 % CI)<br>"
                     f"RMSE {_cm_text(r.rmse_m)}; PCRLB {_cm_text(r.pcrlb_rms_m)}, hybrid bound "
-                    f"{_cm_text(r.hybrid_bound_rms_m)} (lower bounds of the RMSE)<extra></extra>"
+                    f"{_cm_text(r.hybrid_bound_rms_m)} (lower bounds of the RMSE of trackers "
+                    "unbiased for the route)<extra></extra>"
                 ),
                 **group,
                 row=1,
