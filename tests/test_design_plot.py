@@ -1,6 +1,8 @@
 """The answer of a design sweep as a figure (:func:`tunnelkit.plots.design.design_answer_figure`)
 and ``tunnelkit design --plot``: traces, styles and meta from a small real sweep, a bounds-only
-report, a bad report refused, the HTML written and a missing directory refused naming ``plot``."""
+report, a bad report refused, the HTML written and a missing directory refused naming ``plot``;
+the size figure's labels (:func:`tunnelkit.plots.design.size_figure`): the PEB a reference, the
+PCRLB the bound beside the tracker's RMSE."""
 
 from __future__ import annotations
 
@@ -13,10 +15,11 @@ import pytest
 from tunnelkit import design
 from tunnelkit.cli import main
 from tunnelkit.plots.design import __all__ as plots_all
-from tunnelkit.plots.design import design_answer_figure
+from tunnelkit.plots.design import design_answer_figure, size_figure
 
 SCENARIO = "example-rectangular-28ghz"
 ARRAYS = ["4x4", "8x8"]
+PEB_NAME = "PEB (one epoch's bound, a reference)"
 
 
 @pytest.fixture(scope="module")
@@ -77,7 +80,7 @@ def test_figure_of_a_monte_carlo_sweep(report):
         assert med.legendgroup == peb.legendgroup == pred.legendgroup == r.array
         assert med.line.dash is None and "median" in med.name
         assert f"{100 * r.error_p90_m:.3g} cm" in med.name  # the pooled p90 in the legend
-        assert peb.line.dash == "dot" and peb.name == f"{r.array} PEB (snapshot bound)"
+        assert peb.line.dash == "dot" and peb.name == f"{r.array} {PEB_NAME}"
         assert pred.line.dash == "dash" and pred.name == f"{r.array} predicted (not a bound)"
         np.testing.assert_allclose(_cm(med.y), r.error_median_epoch_m, rtol=1e-12)
         np.testing.assert_allclose(_cm(peb.y), r.peb_m, rtol=1e-12)
@@ -103,12 +106,25 @@ def test_bounds_only_report_shows_bounds_and_predictions(bounds_only):
     fig = design_answer_figure(bounds_only)
     top = _top(fig)
     assert [t.name for t in top] == [
-        f"{a} {k}" for a in ARRAYS for k in ("PEB (snapshot bound)", "predicted (not a bound)")
+        f"{a} {k}" for a in ARRAYS for k in (PEB_NAME, "predicted (not a bound)")
     ] + ["target 10 cm"]
     assert len({t.name for t in top}) == len(top)  # no legend entry repeated
     assert not any("median" in (t.name or "") for t in fig.data)
     assert fig.layout.meta["unit_yield"] == [None, None]
     assert any("no Monte-Carlo" in a.text for a in fig.layout.annotations)
+
+
+def test_size_figure_labels_the_peb_a_reference_and_plots_the_bound(report, bounds_only):
+    fig = size_figure(report.rows, mark=None)
+    by_name = {t.name: t for t in fig.data}
+    assert "PEB median (a reference)" in by_name and "PEB 90th pct (a reference)" in by_name
+    rmse, pcrlb = by_name["tracker RMSE (95 % CI)"], by_name["PCRLB (bound of the RMSE)"]
+    np.testing.assert_allclose(_cm(rmse.y), [r.rmse_m for r in report.rows], rtol=1e-12)
+    np.testing.assert_allclose(_cm(pcrlb.y), [r.pcrlb_rms_m for r in report.rows], rtol=1e-12)
+    assert not any("bound" in t.name for t in fig.data if "PEB" in t.name)
+    # without Monte-Carlo: no tracker, no PCRLB
+    names = [t.name for t in size_figure(bounds_only.rows, mark=None).data]
+    assert not any("RMSE" in n for n in names), names
 
 
 @pytest.mark.parametrize("bad", [None, {"rows": []}, "report", []])
@@ -136,7 +152,7 @@ def test_cli_writes_the_figure_without_monte_carlo(tmp_path, capsys):
     argv += ["--settle", "0.5"]
     assert main([*argv, "--plot", str(out)]) == 0
     assert "figure written to" in capsys.readouterr().err
-    assert "PEB (snapshot bound)" in out.read_text()
+    assert "PEB (one epoch" in out.read_text()
 
 
 def test_cli_missing_directory_names_plot(tmp_path, capsys):

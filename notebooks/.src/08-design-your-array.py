@@ -1,9 +1,11 @@
 # %% [markdown]
 # # 08 · Design your array: how many antennas for *your* tunnel?
 #
-# *Italiano et al. (2026), eq. 1 (the channel tensor), section 3.1 (the SR-NF validity condition) and
-# section 4 (JAVELIN); the position error bound is ours, built from the same model. Further
-# reading: the measurements behind the unit yield and its bounds,
+# *Italiano et al. (2026), eq. 1 (the channel) and its tensor form, eqs. 3 and 8; section 3.1 (the
+# SR-NF model and its validity condition, eq. 25); sections 3.2–3.5 (JAVELIN, Algorithm 4), here
+# in the workbook's variant **JAVELIN with VUE-centred curvature** (section 5 says what differs);
+# the position error bound is ours, built from the same model. Further reading: the measurements
+# behind the unit yield and its bounds,
 # [docs/results/design-units.md](../docs/results/design-units.md).*
 #
 # **What you will learn**
@@ -13,7 +15,7 @@
 #   sub-decimetre positioning over the last 55 m?"* — and get an answer you can act on, in one
 #   call (and one command, `tunnelkit design`);
 # - the **position error bound** (PEB): the Fisher information of every path in the tensor of
-#   eq. 1, mapped to the vehicle's position through the image method. It bounds the RMS error of
+#   eq. 3, mapped to the vehicle's position through the image method. It bounds the RMS error of
 #   any unbiased fix from *one* epoch of an ideal, perfectly calibrated array; a tracker, which
 #   fuses epochs, can go below it, and a real array does not reach it;
 # - the **predicted error**: a first-order prediction, from the misspecified Cramér–Rao
@@ -21,15 +23,17 @@
 #   per-element calibration error, the spatial wideband term, diffuse multipath — which the
 #   estimator does not model. It is a *prediction*, not a bound: the tracker can beat it;
 # - SR-NF validity as the condition of one estimator (eq. 51), not of the design;
-# - the **recommendation from what the tracker achieves on manufactured units**: JAVELIN over
-#   Monte-Carlo units x drives (one calibration draw per unit), the **unit yield** with its
-#   Wilson interval against a required yield, and how the answer changes with calibration
-#   quality; beside it the true bounds over the drive (posterior CRLB per unit, and the
-#   augmented-state PCRLB pooled over units): lower bounds of the tracker's mean-square error
-#   on this fixed route, on average over what every drive draws afresh — the V2X odometry noise,
-#   which is the motion model's $\mathbf Q$, and the measurement noise (unlike notebook 05,
-#   whose $\mathbf Q$ modelled a randomness of the truth its preset lacked;
-#   [PCRLB](GLOSSARY.md#pcrlb));
+# - the **recommendation from what the tracker achieves on manufactured units**: JAVELIN with
+#   VUE-centred curvature over Monte-Carlo units x drives (one calibration draw per unit), the
+#   **unit yield** with its Wilson interval against a required yield, and how the answer changes
+#   with calibration quality; beside it the bounds over the drive. The route is fixed; what every
+#   drive draws afresh is the data: the entry fix, the V2X odometry (the motion model's
+#   $\mathbf Q$) and the radio's noise. The recursion is therefore the CRLB of this one route,
+#   the entry fix and the odometry increments acting as measurements beside the radio's (per
+#   unit, and pooled over units with the calibration random): a bound for trackers that are
+#   (nearly) unbiased for the route, such as this one, which knows nothing of it. An oracle that
+#   knows the route beats it (notebook 05's point: its filter started at the truth gets
+#   centimetres; [PCRLB](GLOSSARY.md#pcrlb));
 # - what the same question gets on a ray-traced channel (Sionna RT, diffuse scattering on), where
 #   eq. 1 is no longer the channel;
 # - an explorer whose impairment sliders move the predicted-error curve.
@@ -37,12 +41,15 @@
 # %%
 import os
 from itertools import pairwise
+from math import comb
 
 import numpy as np
 
 import tunnelkit as tk
 from tunnelkit import design, propagation
 from tunnelkit.design import traced
+from tunnelkit.design.drivebound import position_noise_cov
+from tunnelkit.design.fastroute import tracker_weights
 from tunnelkit.plots.design import route_figure, size_figure
 from tunnelkit.rt.cache import CACHE_ENV
 from tunnelkit.widgets.design import design_explorer, design_figure
@@ -78,7 +85,8 @@ print(
 # %% [markdown]
 # ## 2. What one path says about the vehicle
 #
-# The tensor of eq. 1 is a sum of rank-1 terms, one per path $\ell$:
+# The channel of eq. 1, written as the tensor of eq. 3 (eq. 8 with the noise), is a sum of
+# rank-1 terms, one per path $\ell$:
 #
 # $$H[m,s,k] = \sum_\ell \alpha_\ell\, a_m(\mathbf s_\ell)\, e^{j s \mu_{f,\ell}}\,
 #   e^{j k \mu_{t,\ell}}, \qquad a_m(\mathbf s) = e^{j \frac{2\pi}{\lambda}
@@ -126,9 +134,10 @@ for kind in ("los", "wall", "ceiling", "road", "rrm"):
 # its velocity), and so is the clock bias: delays only count as differences, as in JAVELIN's
 # $\Delta d$. We bound the horizontal position with the antenna height known (JAVELIN's setting).
 # *Without curvature* every wavefront radius becomes one more nuisance: the array then measures
-# directions only. (This closed form agrees with a brute-force Fisher information: perturb the
-# UE, re-trace, re-synthesise the tensor with `tk.channel`, $\frac{2}{N_0}\Re(\mathbf J^H\mathbf
-# J)$.)
+# directions only. (The package's tests check this closed form against a brute-force Fisher
+# information, to a relative $10^{-4}$ on six cases, `tests/test_design.py`: perturb the UE,
+# re-trace, re-synthesise the tensor with `tk.channel`, $\frac{2}{N_0}\Re(\mathbf J^H\mathbf
+# J)$. The notebook does not repeat that check.)
 
 # %%
 b8 = design.route_bounds(setup, "8x8")
@@ -161,16 +170,19 @@ print(
 #   \mathbf B = \tfrac{2}{N_0^2}\Re\,\mathbf D^H\mathbf C\mathbf D .$$
 #
 # These are the glossary's $\mathbf A$ and $\mathbf B$ ([MCRB](GLOSSARY.md#mcrb)), the same as
-# notebook 07 section 8's: $\mathbf A$ minus the expected Hessian of the assumed model's
-# log-likelihood at the pseudo-true parameter (here to first order: the residual term notebook
-# 07 keeps is dropped, since $\boldsymbol\delta$ is small), $\mathbf B$ the covariance of its
-# score under the true distribution (here carrying the diffuse covariance $\mathbf C_D$).
+# notebook 07 section 8's: $\mathbf A = -\mathrm E_p[\nabla^2_{\boldsymbol\eta} \ln\tilde
+# p(\mathbf y; \boldsymbol\eta_0)]$, the negated expected Hessian of the assumed model's
+# log-likelihood $\ln\tilde p$ at the pseudo-true parameter (here to first order: the residual
+# term notebook 07 keeps is dropped, since $\boldsymbol\delta$ is small), $\mathbf B$ the
+# covariance of its score under the true distribution $p$ (here carrying the diffuse covariance
+# $\mathbf C_D$).
 #
 # Per path this gives the extraction's bias and covariance in the tracker's measurement space
 # (`design.path_error_model`; its closed forms agree with finite differences, with an exact
-# nonlinear fit and with Monte-Carlo of the ML extraction). The **predicted error** maps them to
-# the position *as the design's tracker weighs its paths* (each path by the error budget it is
-# told, section 6):
+# nonlinear fit and with Monte-Carlo of the ML extraction). The **predicted error** (the
+# *snapshot prediction*, to tell it from section 6's drive prediction) maps them to the position
+# *as the design's tracker weighs its paths* (each path by the error budget it is told,
+# section 6):
 #
 # $$e_{\mathrm{pred}} = \sqrt{\mathrm{tr}\,\mathbf G\,\mathrm{CRLB}\,\mathbf G^T
 #   + \mathrm E\|\mathbf G\mathbf b\|^2 + \mathrm{tr}\,\mathbf G(\mathrm{MCRB} -
@@ -180,21 +192,26 @@ print(
 # draw in closed form. **It is a prediction, not a bound.** The MCRB bounds the covariance of a
 # misspecified-unbiased *snapshot* estimator around its pseudo-true parameter (not its error
 # around the true one); this is a first-order approximation of it, for one weighted fix of one
-# epoch. The tracker fuses epochs and carries a prior, so it can
-# do better, and it does (section 6 shows it beaten). It decides nothing in the design; it
-# says *where to look* (`design.predicted_error`, its curve `.predicted`). Weighing by the
-# ideal information
-# instead (`weights="ideal"`, the direct-position estimator that trusts eq. 1) lets a large
-# array's micrometre curvatures carry their centimetres of calibration and wideband bias into
-# the position: a prediction several times above what the tracker achieves predicts another
-# estimator. With no impairment the first term alone remains, and it is not quite the PEB: the
-# joint CRLB correlates the paths' errors (paths close in angle and delay share the same
-# samples), while the extraction reports, and the tracker weighs, one block per path, so the
-# ideal predicted error sits above the PEB by the factor printed below (never below it: the PEB
-# *is* a bound of any unbiased snapshot fix, and any other weighting loses information). Below,
-# the 8 × 8 array at three calibration qualities
-# (phase error per element, with 0.2 dB of gain error); the spatial wideband term and diffuse
-# power are left to exercise 3, so that what moves here is the calibration alone:
+# epoch. The tracker fuses epochs and carries a prior, so it can do better than this snapshot
+# prediction: section 6 counts the rows where its error p90 lies below the snapshot prediction's
+# p90 (`snap_beaten`). Section 6 also sets the tracker beside a second prediction, the *drive
+# prediction* `predicted_drive_rms_m` (a posterior CRLB plus the calibration's bias, over the
+# drive), a different quantity. Neither decides anything in the design; the snapshot
+# prediction says *where to look* (`design.predicted_error`, its curve `.predicted`). Weighing
+# by the ideal information instead (`weights="ideal"`, the direct-position estimator that
+# trusts eq. 1) lets a large array's micrometre curvatures carry their centimetres of
+# calibration and wideband bias into the position: for the 32 × 32 with the spatial wideband
+# term, that prediction is several times the tracker weighting's (`ideal_over_tracker`,
+# printed below), a prediction for another estimator. With no impairment the first term alone
+# remains, and it is not quite the PEB: the joint CRLB correlates the paths' errors (paths
+# close in angle and delay share the same samples), while the extraction reports, and the
+# tracker weighs, one block per path, so the ideal predicted error sits above the PEB by the
+# factor printed below (`ratio_blocks`, computed before the package lifts the prediction to the
+# PEB wherever numerics would put it below; never below it in theory: the PEB *is* a bound of
+# any unbiased snapshot fix, and any other weighting loses information). Below, the 8 × 8 array
+# at three calibration qualities (phase error per element, with 0.2 dB of gain error); the
+# spatial wideband term and diffuse power are left to exercise 3, so that what moves here is the
+# calibration alone:
 
 # %%
 levels = {"ideal": 0.0, "0.5°": 0.5, "2°": 2.0}
@@ -202,7 +219,8 @@ imps = {
     k: design.DesignImpairments(phase_error_deg=v, gain_error_db=0.2 if v else 0.0)
     for k, v in levels.items()
 }
-pred8 = {k: design.predicted_error(setup, "8x8", imp) for k, imp in imps.items()}  # predictions
+g8 = design.route_geometry(setup, "8x8")  # traced once, shared by the three predictions
+pred8 = {k: design.predicted_error(setup, "8x8", imp, geometry=g8) for k, imp in imps.items()}
 for k, a in pred8.items():
     print(
         f"8x8 {k:6s}: median PEB {100 * np.median(a.peb):.3g} cm, predicted error "
@@ -210,9 +228,25 @@ for k, a in pred8.items():
         f" wideband {100 * np.median(a.wideband):.3g} cm)"
     )
 ratio_cal = np.median(pred8["0.5°"].predicted) / np.median(pred8["ideal"].peb)
-ratio_blocks = np.median(pred8["ideal"].predicted / pred8["ideal"].peb)
+# the block-weighted fix's noise before the package lifts it to the PEB (np.maximum)
+m_ideal = design.path_error_model(setup, "8x8", imps["ideal"], geometry=g8)
+cov_blocks = position_noise_cov(m_ideal, g8, tracker_weights(m_ideal))
+blocks_over_peb = np.sqrt(np.trace(cov_blocks, axis1=1, axis2=2)) / pred8["ideal"].peb
+ratio_blocks = np.median(blocks_over_peb)
 print(f"ideal: one block per path puts the prediction {ratio_blocks:.2g} times the PEB (median)")
 print(f"0.5° and 0.2 dB lift the median predicted error {ratio_cal:.2g}-fold over the PEB")
+
+# %%
+# the ideal weighting against the tracker's: 32 x 32, 0.5 deg and 0.2 dB, spatial wideband on
+imp_wb = design.DesignImpairments(phase_error_deg=0.5, gain_error_db=0.2, spatial_wideband=True)
+g32 = design.route_geometry(setup, "32x32")
+med32 = {
+    w: np.median(design.predicted_error(setup, "32x32", imp_wb, geometry=g32, weights=w).predicted)
+    for w in ("tracker", "ideal")
+}
+ideal_over_tracker = med32["ideal"] / med32["tracker"]
+print(f"32x32: {100 * med32['tracker']:.3g} cm weighted as the tracker, {100 * med32['ideal']:.3g}"
+      f" cm weighted by the ideal information ({ideal_over_tracker:.2g} times)")  # fmt: skip
 
 # %%
 # a "# headline:" line names a figure for the slides (tools/figures.py); it does nothing here
@@ -227,8 +261,9 @@ route_figure(
 
 # %% [markdown]
 # The ideal bound of an 8 × 8 array is millimetres; half a degree of phase error per element
-# (with 0.2 dB of gain error) lifts the predicted error by the factor printed above, to
-# centimetres. That factor, not the PEB, is what an engineer must expect; whether the tracker
+# (with 0.2 dB of gain error) lifts the predicted error by the factor printed above
+# (`ratio_cal`), to centimetres (its median printed above). That factor, not the PEB, is what
+# an engineer must expect; whether the tracker
 # does better or worse is for the Monte-Carlo of section 6 to say. Where a term is *known* (the
 # spatial wideband delay follows from the geometry the fit estimates anyway) it can be put in
 # the model and stops costing; an unknown calibration error cannot.
@@ -245,15 +280,24 @@ route_figure(
 #   \mathbf p_0\|) - (\|\mathbf r - \mathbf p_m\| - \|\mathbf r - \mathbf p_0\|)\right|
 #   \le \varepsilon_\Phi ,$$
 #
-# with $\mathbf r$ the reflection point. It is the condition of an estimator that *uses* eq. 51.
-# The design's tracker models each wavefront as centred on its VUE and does not need it, so the
-# design reports it per surface as information (`criterion="achievable"`, the default) and gates
-# on it only for an eq. 51 route (`criterion="srnf"`). Under a ceiling 20 cm away the ceiling
-# decides:
+# with $\mathbf r$ the reflection point and $\varepsilon_\Phi$ = 0.15 rad, the paper's tolerance
+# (section 4.2; printed below). It is the condition of an estimator that *uses* eq. 51.
+#
+# **Which tracker.** The paper adopts the SR-NF channel model (section 3.1) and its JAVELIN
+# measures a reflection's curvature by eq. 51, $\kappa_\ell = \|\mathbf p_{r,\ell}\|$, the
+# distance to the reflection point. The design's tracker is the workbook's variant, **JAVELIN
+# with VUE-centred curvature**: JAVELIN's state, association, track management and filter
+# (sections 3.2–3.5) with each path's wavefront centred on its VUE (the exact wavefront of a
+# specular path) and each path weighed by the covariance the extraction reports
+# (`tracking.javelin.designs.array_design`; notebook 04b sets the VUE-centred curvature against
+# eq. 51 in the paper's own design). It does not need SR-NF, so the design reports SR-NF per
+# surface as information (`criterion="achievable"`, the default) and gates on it only for an
+# eq. 51 route (`criterion="srnf"`). Under a ceiling 20 cm away the ceiling decides:
 
 # %%
 srnf8 = b8.surface_validity()
 print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.items()})
+print(f"tolerance eps_Phi = {b8.eps_phi:g} rad")
 
 # %% [markdown]
 # ## 6. The answer: manufactured units, their yield, and calibration
@@ -265,7 +309,8 @@ print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.i
 # calibration error once, and its `drives_per_unit` drives (2 by default; each its own noise and
 # entry fix) share it.
 #
-# **The drives.** They run JAVELIN (our design) on the **bound-driven route**: each epoch's path
+# **The drives.** They run JAVELIN with VUE-centred curvature (section 5) on the
+# **bound-driven route**: each epoch's path
 # parameters are drawn from the error model of section 4 (the unit's calibration error; the
 # noise and diffuse term per epoch) and reported to the tracker with the **error budget** of the
 # stated impairments (the CRLB plus the covariance of the calibration tolerance and the bias of
@@ -284,12 +329,20 @@ print("8x8, SR-NF valid share per surface:", {k: round(v, 2) for k, v in srnf8.i
 # the 90th percentile (the `share`) of its 2-D errors pooled over its drives and the settled
 # epochs (those at least `settle` = 1 s after the start, `design.counted_epochs`). Of $U$ units
 # $k$ meet it; the **unit yield** is $\hat Y = k/U$, and its 95 % interval is Wilson's score
-# interval (`design.wilson_interval`; it stays inside $[0, 1]$ and keeps its coverage down to a
-# few units, where the normal interval does not), with $z = 1.96$:
+# interval (`design.wilson_interval`; it stays inside $[0, 1]$ and covers far better than the
+# normal interval at few units, but it is an approximation: its coverage oscillates with $U$
+# and the true yield and dips below 95 % near a yield of 95 %, computed below), with
+# $z = 1.96$:
 #
 # $$q_u \le \tau \;\text{for}\; k \;\text{of}\; U \;\text{units}, \qquad
 #   \frac{\hat Y + \frac{z^2}{2U} \pm z\sqrt{\frac{\hat Y(1 - \hat Y)}{U} + \frac{z^2}{4U^2}}}
 #   {1 + \frac{z^2}{U}} .$$
+#
+# With two drives, $q_u$ is itself a noisy estimate of the unit's long-run quantile: a unit
+# close to the target meets on one pair of drives and misses on another. The unit yield is
+# therefore the probability that a unit passes a *two-drive* test, $P(q_u \le \tau)$, which
+# mixes the drive-to-drive noise with the spread between units; it is not the share of units
+# whose long-run p90 meets the target.
 #
 # **The verdict and the sequential rule.** A candidate is **met** when the interval's lower end
 # reaches the required yield $Y^\ast$ (`required_yield`, 95 %), **not met** when its upper end
@@ -320,8 +373,59 @@ print(f"a pass at {required:.0%} needs every unit of at least {n_prove} meeting;
 # So ten units that all pass are not yet proof of 95 % (the lower end is 72 %): a pass takes at
 # least 73 units all meeting (`n_prove`); from the default first batch of 20 that is the batch
 # that reaches 80 units, 160 drives. A failing array is decided sooner: one failure in 20 units
-# leaves the question open, three (`n_fail`) put the upper end below 95 %. The same from a
-# shell:
+# leaves the question open, three (`n_fail`) put the upper end below 95 %.
+#
+# **What the 95 % does and does not promise.** Each interval is a 95 % interval for a fixed
+# number of units looked at once. The sequential rule looks up to five times (20, 40, 80, 160
+# and 200 units with the command's defaults) and stops as soon as the interval lies on one
+# side: the chance that *some* look puts it on the wrong side is larger than at one look
+# (optional stopping). The exact binomial arithmetic below, at a true yield of exactly 95 %:
+# Wilson's interval at 20 units covers about 92 % (`cov20`); one look at 20 units declares
+# "not met" with a probability of about 7.5 % (`p_one`), and the whole sequential rule with
+# about 13.5 % (`p_seq`), where one side of a 95 % interval promises 2.5 %. The overall error
+# rate of the verdict is therefore above 5 %; holding it at 5 % would take a group-sequential
+# correction (a wider interval at every look), which the verdict does not apply. The coverage
+# measured in [docs/results/design-units.md](../docs/results/design-units.md) (0.90–0.98, on
+# blocks of a fixed 20 units at reference yields of 17 %, 85 % and above 99 %) checks single
+# looks at a fixed count, far from 95 %: it measures neither the sequential rule's error rate
+# nor the coverage near the required yield, where Wilson's is lowest.
+
+
+# %%
+def binom_pmf(k, n, p):
+    return comb(n, k) * p**k * (1 - p) ** (n - k)
+
+
+def wilson_covers(n, p):  # the exact coverage of Wilson's interval at a true yield p
+    ci = [design.wilson_interval(k, n) for k in range(n + 1)]
+    return sum(binom_pmf(k, n, p) for k, (lo, hi) in enumerate(ci) if lo <= p <= hi)
+
+
+def p_not_met(p, looks):  # probability that the sequential rule says "not met" at a true yield p
+    undecided, n, out = {0: 1.0}, 0, 0.0  # failures so far -> probability, still undecided
+    for m in looks:
+        step = {}
+        for f, w in undecided.items():
+            for g in range(m - n + 1):
+                step[f + g] = step.get(f + g, 0.0) + w * binom_pmf(g, m - n, 1 - p)
+        n, undecided = m, {}
+        for f, w in step.items():
+            lo, hi = design.wilson_interval(n - f, n)
+            out += w if hi < required else 0.0
+            undecided.update({f: w} if lo < required <= hi else {})
+    return out
+
+
+looks_cli = [20]  # the command's batches: --units 20, doubled up to --max-units 200
+while looks_cli[-1] < 200:
+    looks_cli.append(min(2 * looks_cli[-1], 200))
+cov20 = wilson_covers(20, required)
+p_one, p_seq = p_not_met(required, looks_cli[:1]), p_not_met(required, looks_cli)
+print(f"true yield {required:.0%}: Wilson at 20 units covers {cov20:.1%}; 'not met' after one "
+      f"look {p_one:.1%}, after the looks {looks_cli} {p_seq:.1%}")  # fmt: skip
+
+# %% [markdown]
+# The same from a shell:
 #
 #     tunnelkit design example-rectangular-28ghz --arrays 4x4 8x8 16x16 32x32 --target 0.1 \
 #         --units 20 --max-units 200 --yield 0.95 --phase-error-deg 0.5 --gain-error-db 0.2
@@ -367,14 +471,19 @@ print(answers["0.5°"].to_table())
 # %%
 # headline: error-vs-size-28ghz
 size_figure(
-    answers["0.5°"].rows, mark=None, title="28 GHz, 0.5° calibration: bounds and tracker error"
+    answers["0.5°"].rows,
+    mark=None,
+    title="28 GHz, 0.5° calibration: tracker RMSE and its PCRLB; the snapshot PEB, a reference",
 ).show()
 
 # %% [markdown]
-# The same answer as one figure (what `tunnelkit design ... --plot answer.html` writes): each
-# array's median error along the route beside its PEB (dotted, a bound) and its prediction
-# (dashed, not a bound), and below, the unit yield with its Wilson interval against the required
-# yield.
+# In that figure only the PCRLB (triangles) is a bound of the quantity beside it, the tracker's
+# RMSE. The PEB bounds one epoch's unbiased fix, not the tracker, which fuses epochs and may go
+# below it; its 90th percentile over the route bounds no percentile of an error: both PEB
+# curves are a reference. The same answer as one figure (what `tunnelkit design ... --plot
+# answer.html` writes): each array's median error along the route beside its snapshot PEB
+# (dotted, the same reference, not the tracker's bound) and its snapshot prediction (dashed,
+# not a bound), and below, the unit yield with its Wilson interval against the required yield.
 
 # %%
 from tunnelkit.plots.design import design_answer_figure
@@ -385,11 +494,14 @@ design_answer_figure(answers["0.5°"]).show()
 # Read the yields across the three calibrations. With an ideal array every unit of every
 # candidate meets 10 cm, and the tracker's error sits within a small factor of the PEB; with
 # half a degree of phase error (and 0.2 dB of gain error) the median error rises to several
-# times the PEB (3 to 10 times, by array) and the smallest array's yield drops; with 2° it drops further, and an array that every unit
-# passed at 0.5° loses units: **0.5° against 2° of calibration changes the yield**, and with it
-# the recommendation (printed above each table; with the full counts it is a larger array at 2°
-# than for an ideal array), never the PEB. The whole-route p90 lies above the settled one: the
-# first second, from the 1 m entry fix, is left out of the verdict (`settle`).
+# times the PEB (3 to 10 times, by array) and the smallest array's yield drops; with 2° it drops
+# further, and an array that passed 99 % or more of its units at 0.5° loses units: **0.5°
+# against 2° of calibration changes the yield**, never the PEB. The recommendation (printed
+# above each table) follows the calibration: never a smaller array with worse calibration, and
+# with the full counts a larger array at 2° than at 0.5°, and at 0.5° than for an ideal array.
+# Quick mode's four units per array decide nothing, so there the recommendations are all
+# "none". The whole-route p90 lies above the settled one: the first second, from the 1 m entry
+# fix, is left out of the verdict (`settle`).
 #
 # **What these verdicts rest on.** Every drive above ran on the bound-driven route: the tracker
 # never saw a tensor, only path parameters drawn from the first-order error model of section 4
@@ -401,23 +513,33 @@ design_answer_figure(answers["0.5°"]).show()
 # check the model's scale, not the tails a 95 % yield depends on.
 #
 # **Bounds below the tracker, a prediction beside it.** Each row also sets the tracker's RMSE
-# over the settled epochs beside two true **bounds** over the drive, both posterior CRLBs
-# (Tichavský's recursion with JAVELIN's motion model, from the noise the model draws:
-# `design.unit_pcrlb`):
+# over the settled epochs beside two **bounds** over the drive, both from Tichavský's recursion
+# with the tracker's motion model, fed the noise the model draws (`design.unit_pcrlb`). The route
+# is the same in every drive; what is random is the data: the entry fix, the V2X odometry and
+# the radio's noise. So the recursion is the classical CRLB of this one trajectory, the entry
+# fix and the odometry increments acting as measurements beside the radio's. It bounds the
+# mean-square error of trackers that are (nearly) unbiased for the route, such as JAVELIN with
+# VUE-centred curvature, which knows nothing of the route; an oracle that knows the route is
+# biased for every other route and beats it (notebook 05's oracle). At epoch $k$ it is a
+# filtering bound: it uses the data up to epoch $k$, as the tracker does.
 #
-# - `pcrlb_rms_m`: **every unit's** bound, the unit's calibration draw known to it. The model is
-#   linear in the draw, so the bias it causes only shifts the mean: the bound is the same for
-#   every unit, and each unit's expected mean-square error lies above it (one unit's RMSE from
-#   two drives is itself a noisy estimate of that expectation, so the check here is on the
-#   pooled RMSE);
-# - the **augmented-state PCRLB**: the calibration a **random static state** of the drive
-#   (drawn once per unit, with its prior) beside the position, every parameter random (a
-#   [Bayesian bound](GLOSSARY.md#pcrlb)): the bound of the RMSE **pooled over units**, never
-#   below the first.
+# - `pcrlb_rms_m` (the table's "PCRLB"): **every unit's** bound, the unit's calibration draw
+#   known to it. The model is linear in the draw, so the bias it causes only shifts the mean:
+#   the bound is the same for every unit, and each unit's expected mean-square error lies above
+#   it (one unit's RMSE from two drives is itself a noisy estimate of that expectation, so the
+#   check here is on the pooled RMSE);
+# - `hybrid_bound_rms_m` (the table's "hybrid", the ratio `rmse_over_hybrid_bound`; called the
+#   **augmented-state bound** below): the calibration a **random static state** (drawn once per
+#   unit, with its prior) carried beside the position, and learnt along the drive. It is random
+#   where the route is fixed: Bayesian in the calibration, classical in the route, a *hybrid*
+#   bound, hence the field's name (`unit_pcrlb`'s docstring: "a hybrid / consider bound";
+#   [glossary](GLOSSARY.md#pcrlb)). It bounds the RMSE **pooled over units**, never below the
+#   first.
 #
-# Against them stands the **prediction** `predicted_drive_rms_m`: the posterior CRLB of the
-# tracker's weighting with the calibration's position bias added, to first order. It is no
-# bound, and the tracker may beat it:
+# Against them stands the **drive prediction** `predicted_drive_rms_m` (not section 4's snapshot
+# prediction): the posterior CRLB of the tracker's weighting with the calibration's position
+# bias added, to first order. It is no bound, and the tracker may beat it. Each ratio to a bound
+# carries a Monte-Carlo standard error (SE, from the RMSE's 95 % interval over units):
 
 # %%
 rows_mc = [(k, r) for k, rep in answers.items() for r in rep.rows if r.units]
@@ -425,23 +547,44 @@ for k, r in rows_mc:
     print(f"{k:5s} {r.array:6s} RMSE {100 * r.rmse_m:.3g} cm = {r.rmse_over_pcrlb:.3g} x PCRLB, "
           f"{r.rmse_over_hybrid_bound:.3g} x augmented, {r.rmse_over_predicted_drive:.2g} x "
           "predicted")  # fmt: skip
+
+
+def ratio_z(ratio, rmse_ci, bound):  # (RMSE / bound - 1) in Monte-Carlo standard errors
+    se = (rmse_ci[1] - rmse_ci[0]) / (2 * 1.96) / bound
+    return (ratio - 1) / se
+
+
+z_min = min(
+    ratio_z(ratio, r.rmse_ci95_m, bound)
+    for _, r in rows_mc
+    for ratio, bound in ((r.rmse_over_pcrlb, r.pcrlb_rms_m),
+                         (r.rmse_over_hybrid_bound, r.hybrid_bound_rms_m))
+)  # fmt: skip
 bound_min = min(min(r.rmse_over_pcrlb, r.rmse_over_hybrid_bound) for _, r in rows_mc)
 pred_min = min(r.rmse_over_predicted_drive for _, r in rows_mc)
 cal_gap = min(r.rmse_over_hybrid_bound for k, r in rows_mc if k != "ideal")
-print(f"RMSE over a bound: at least {bound_min:.3g}; over the prediction: down to {pred_min:.2g}")
+snap_beaten = [(k, r.array) for k, r in rows_mc if r.error_p90_m < r.predicted_p90_m]
+print(f"RMSE over a bound: at least {bound_min:.3g}, (ratio - 1) / SE at least {z_min:.2g}; "
+      f"over the drive prediction: down to {pred_min:.2g}")  # fmt: skip
 print(f"with calibration error, RMSE over the augmented-state bound: at least {cal_gap:.2g}")
+print("error p90 below the snapshot prediction's p90:", snap_beaten)
 
 # %% [markdown]
-# The tracker's RMSE lies above both bounds on every row (`bound_min` ≥ 1), while the prediction is
-# beaten on some (`pred_min` below 1): the prediction is a first-order guess of where the tracker
-# lands, the bounds are what no tracker can beat on average over drives. They hold here because
-# their $\mathbf Q$ is the V2X odometry noise (`tk.simulation.SIGMA_SPEED`, `SIGMA_HEADING`), drawn
-# afresh in every drive: they bound this fixed route driven with random odometry, which is what
-# every simulated drive is. (Notebook 05's $\mathbf Q$ modelled randomness of the truth itself,
-# which its straight preset lacked, and its filters went below.) Under calibration error the tracker
-# sits several times above the augmented-state bound (`cal_gap`): the bound learns each unit's draw
-# from the whole drive, JAVELIN only tolerates it. That gap is the most a tracker that estimated its
-# array's calibration on the road could recover.
+# The tracker's RMSE lies above both bounds on every row within the Monte-Carlo scatter: every
+# ratio is at least 1 − 2 SE (`z_min` ≥ −2; a ratio a little below 1 on few units would be
+# scatter, since each bound is of an expected mean-square error). The drive prediction is beaten
+# on some rows (`pred_min` below 1), and so is the snapshot prediction (`snap_beaten`, the rows
+# whose error p90 lies below their "pred p90"): a prediction is a first-order guess of where the
+# tracker lands, a bound is what no (nearly) unbiased tracker beats on average over drives. The
+# bounds hold here because the route is fixed and their $\mathbf Q$ is the V2X odometry noise
+# (`tk.simulation.SIGMA_SPEED`, `SIGMA_HEADING`), drawn afresh in every drive: every simulated
+# drive is this route with fresh odometry, entry fix and radio noise. (Notebook 05's
+# $\mathbf Q$ modelled randomness of the truth itself, which its straight preset lacked, and its
+# filters went below.) Under calibration error the tracker sits several times above the
+# augmented-state bound (`cal_gap`): that bound's estimator learns each unit's draw as it
+# drives, from the data up to each epoch, while JAVELIN with VUE-centred curvature only
+# tolerates the draw (a consider parameter, never estimated). That gap is the most a tracker
+# that estimated its array's calibration on the road could recover.
 
 # %% [markdown]
 # ## 7. Does the tracker reach its bound? Two routes and a posterior bound
@@ -451,12 +594,12 @@ print(f"with calibration error, RMSE over the augmented-state bound: at least {c
 # chain (synthesis, noise, clock bias, the maximum-likelihood extraction of notebook 03) for one
 # case, the ideal 6 × 6 (exercise 5 adds the 6 × 6 at 0.5°: the impaired chain is slower). A
 # tracker is further compared with the **posterior CRLB** over the drive (the Tichavský
-# recursion with JAVELIN's motion model, `MonteCarloResult.pcrlb`, every unit's bound of section
-# 6, beside the augmented-state bound pooled over units and the prediction), a bound that needs no
-# unbiasedness and that the PEB of one snapshot is not. The ideal array has no calibration draw,
-# so one drive is one unit here (`sweep_montecarlo`'s `drives_per_unit=1`). Quick mode drives the
-# first 12 epochs, twice on the bound route and once on the channel route (whose synthesis and
-# extraction are what cost).
+# recursion with the tracker's motion model, `MonteCarloResult.pcrlb`, every unit's bound of
+# section 6: the CRLB of the fixed route, for trackers (nearly) unbiased for it), a bound of the
+# tracker's mean-square error, which the PEB of one snapshot is not. The ideal array has no
+# calibration draw, so one drive is one unit here (`sweep_montecarlo`'s `drives_per_unit=1`).
+# Quick mode drives the first 12 epochs, twice on the bound route and once on the channel route
+# (whose synthesis and extraction are what cost).
 
 # %%
 n_ep = 12 if tk.quick_mode() else None
@@ -472,34 +615,52 @@ for mode, r in val.items():
         + ("drives" if r.runs > 1 else "drive")
     )
 bound6 = val["bound"]
-pc_ratio = np.sqrt(np.mean(bound6.errors[:, bound6.settled] ** 2)) / np.sqrt(
-    np.mean(bound6.pcrlb[bound6.settled] ** 2)
-)
-print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g}")
+mse_drive = np.mean(bound6.errors[:, bound6.settled] ** 2, axis=1)  # one per drive
+pc_ratio = np.sqrt(np.mean(mse_drive) / np.mean(bound6.pcrlb[bound6.settled] ** 2))
+# its Monte-Carlo standard error: the spread of the drives' MSEs (an RMSE's relative SE is half
+# its MSE's)
+pc_se = pc_ratio * np.std(mse_drive, ddof=1) / np.sqrt(mse_drive.size) / (2 * np.mean(mse_drive))
+print(f"settled RMSE / RMS posterior CRLB on the bound route: {pc_ratio:.2g} (SE {pc_se:.2g})")
 
 # %% [markdown]
 # Compare the two printed medians: where the extraction is above its threshold (notebook 03,
 # section 11), as for this 6 × 6 array, the two routes agree within the spread of a few drives.
 # Where it is not — a 4 × 4 array 60 m away — the channel route loses epochs that the bound route
 # cannot lose, so the fast route is trusted only above the threshold. The tracker's settled RMSE
-# against the posterior bound is the printed ratio: JAVELIN estimates each reflection's VUE as an
-# unknown, where the bound knows the surfaces. (A ratio a little below 1 on a few drives would be
-# Monte-Carlo scatter: the bound is an average over random drives.)
+# against the posterior bound is the printed ratio: the tracker estimates each reflection's VUE
+# as an unknown, where the bound knows the surfaces. As in section 6, the ratio is checked
+# against 1 − 2 SE, here with the SE from the spread of the drives' mean-square errors: a ratio
+# a little below 1 on a few drives would be Monte-Carlo scatter, since the bound is of the
+# expected mean-square error over drives.
 
 # %% [markdown]
 # ## 8. The paper's tunnel, 4 × 4 to 10 × 10, and the SR-NF criterion
 #
-# The JAVELIN tunnel (semicircular, 10 m × 5 m, 5.9 GHz, 100 MHz), its arrays hung inside the
-# faceted ceiling. The scenario file places each array by its reference antenna (element 0, a
-# corner); the design centres every candidate on the centre of the file's array, so the paper's
-# 10 × 10 sits exactly where the file puts it. It is not the largest square array that fits there:
-# an 11 × 11 still does, a 12 × 12 reaches through the ceiling, and a 32 × 32 (0.8 m on a side) by
-# far (`setup.arrays` refuses both, naming the elements outside). Below, the PEB and the prediction
-# at 0.5° of calibration error under the SR-NF criterion (`criterion="srnf"`, an eq. 51 route):
-# SR-NF gates, the ceiling breaks it on every epoch, and no epoch of any array is left where the
-# gated prediction meets the target ("met share" 0) — the estimator's criterion, not the array's
-# accuracy, rules the eq. 51 route out. With `units=0` (no Monte-Carlo) the sweep recommends nothing
-# in any case: bounds and predictions decide nothing.
+# The paper's tunnel (semicircular, 10 m × 5 m, 5.9 GHz, 100 MHz; the anchor at 4.8 m, 20 cm
+# under the crown). **What is the paper's and what is ours.** The paper sizes its array from the
+# wall condition of Theorem 3.1: eq. 25 with $R$ = 3.5 m, $W$ = 3 m, $y_u$ = 2.5 m and
+# $\varepsilon_\Phi$ = 0.15 rad gives $M_{\max}$ = 9.88, hence 10 × 10 (section 4.2; computed
+# below). It does not check the ceiling. Its tunnel is a semicylinder; the 12 planar facets
+# that approximate it and the arrays' mount 5 cm under the anchor are this workbook's
+# reconstruction (`data/scenarios/italiano2026-straight.toml`), so what the ceiling does below
+# is a finding on that reconstruction, not a statement of the paper.
+#
+# The scenario file places each array by its reference antenna (element 0, a corner); the
+# design centres every candidate on the centre of the file's array, so the paper's 10 × 10 sits
+# exactly where the file puts it. It is not the largest square array that fits there: an
+# 11 × 11 still does, a 12 × 12 reaches through the ceiling, and a 32 × 32 (0.8 m on a side) by
+# far (`setup.arrays` refuses both, naming the elements outside). Below, the PEB and the
+# snapshot prediction at 0.5° of calibration error under the SR-NF criterion
+# (`criterion="srnf"`: an estimator that uses eq. 51, as the paper's JAVELIN does): SR-NF gates,
+# the ceiling facets break it on every epoch, and no epoch of any array is left where the gated
+# prediction meets the target ("met share" 0). On this reconstruction it is the estimator's
+# criterion, not the array's accuracy, that rules out an eq. 51 estimator. With `units=0` (no
+# Monte-Carlo) the sweep recommends nothing in any case: bounds and predictions decide nothing.
+#
+# The target here is 0.2 m, not the 0.1 m of the 28 GHz example: the workbook's choice for the
+# paper's radio, whose 100 MHz is a quarter of the example's band (the paper reports its
+# accuracy but states no target). Section 9 uses the same 0.2 m; its traced errors miss either
+# target by far.
 
 # %%
 paper = design.DesignSetup.from_scenario("italiano2026-straight")
@@ -509,9 +670,15 @@ sweep = design.design_sweep(
 )
 # headline: peb-srnf-vs-size-paper
 size_figure(
-    sweep.rows, mark="10x10", title="Paper's tunnel, 5.9 GHz: bounds and SR-NF share"
+    sweep.rows, mark="10x10", title="Paper's tunnel, 5.9 GHz: snapshot PEB and SR-NF share"
 ).show()
 print(sweep.to_table())
+# the paper's sizing: eq. 25 (Theorem 3.1, a wall at W) at its section 4.2 values
+m_max_paper = tk.fresnel.mmax_2d(3.5, 3.0, 2.5, paper.fc, 0.15)
+paper_file = tk.scenarios.load_scenario("italiano2026-straight")
+print(f"eq. 25: M_max = {m_max_paper:.3g} -> {int(np.ceil(m_max_paper))} x "
+      f"{int(np.ceil(m_max_paper))}; the file's tunnel: "
+      f"{paper_file.section('tunnel')['n_facets']} facets")  # fmt: skip
 
 # %% [markdown]
 # ## 9. The paper's tunnel on a ray-traced channel: when the model is not the channel
@@ -588,19 +755,22 @@ print(
     "told-sigma PCRLB (a prediction here), settled RMS:",
     {a: f"{b:.3g} m" for a, b in bound_rt.items()},
 )
+gain_rt = {a: 1 - b / no_radio for a, b in bound_rt.items()}  # the radio's share, 1 m entry fix
 print(
     f"dead reckoning's bound (no radio): {no_radio:.3g} m; largest bound / smallest {bound_ratio:.3g}"
 )
+print("the radio's gain over dead reckoning's bound:", {a: f"{g:.0%}" for a, g in gain_rt.items()})
 
 # %% [markdown]
 # Now the tracker itself, on both channels, on a seed the traced errors were not measured on,
 # with an ideal array on both (`impairments="ideal"`: the traced errors were measured on one).
 # The route carries no calibration draw, so a unit is one drive (`drives_per_unit=1`). Quick
 # mode runs the 4 × 4 array and one unit (its verdicts "undecided"), and on the traced channel
-# the first 12 epochs of the route only (`n_epochs`: 1.1 s, so its verdict counts the two epochs
-# after the first second); its tracker is then told the errors measured the same way on the
-# first 12 epochs of the same three drives of seed 0 (a record of its own, shipped beside the
-# others: a record is used only on drives of the epochs it was measured on). Quick mode's traced
+# the first 12 epochs of the route only (`n_epochs`: 1.1 s at 0.1 s a step, so its verdict
+# counts the two epochs from the first second on, `k_quick`); its tracker is then told the
+# errors measured the same way on the first 12 epochs of the same three drives of seed 0 (a
+# record of its own, shipped beside the others: a record is used only on drives of the epochs it
+# was measured on). Quick mode's traced
 # drive itself, whose every epoch's ML extraction is what costs (about a second of CPU per
 # epoch), is stored too: its 12 epochs' measurements after the pre-filter, the tracker's input
 # (`data/rt/design/italiano2026-straight-4x4-T12-drive.json`, written by `tools/traced_drive.py`
@@ -623,6 +793,7 @@ rt_arrays = ["4x4"] if tk.quick_mode() else rt_sizes
 rt_units = tk.mc_count(10, 1)
 rt_mc = {"units": rt_units, "max_units": rt_units, "drives_per_unit": 1, "mode": "channel"}
 rt_epochs = 12 if tk.quick_mode() else None  # quick mode: the traced drive's first 12 epochs
+k_quick = design.counted_epochs(paper_rt.trajectory.t[:12])  # the epochs quick mode counts
 on = {
     ch: design.design_sweep(st, rt_arrays, target=0.2, **rt_mc, seed=20261202,
                             impairments="ideal", dead_reckoning=ch == "sionna", progress=True,
@@ -647,13 +818,14 @@ print("error p90, ray-traced over image channel:", {a: f"{g:.3g}" for a, g in ga
 #   hundred times the image channel's (the printed ratio; in quick mode more than 30 times: its
 #   traced drive ends 1.1 s after the entry fix, before the error has grown to its metres, and
 #   its single image drive has not settled to millimetres). The told-sigma PCRLB is
-#   above the target for every array. The RMS errors fall with the array (printed above); the
-#   told sigmas need not, since an array whose errors repeat more from epoch to epoch is told
-#   more (the 8 × 8's azimuth errors have the largest lag-1 correlation). It follows the
-#   told sigmas and barely moves: the largest over the smallest is the printed factor. At these sigmas
-#   the radio adds little to the odometry, whatever the array. It lies below dead
-#   reckoning's: under the told-sigma model the radio adds information, too little to correct
-#   a 1 m entry fix to 0.2 m.
+#   above the target for every array. The RMS errors of azimuth, curvature and delay fall with
+#   the array (the records' "all" rows; the elevation's does not quite); the told sigmas need
+#   not, since an array whose errors repeat more from epoch to epoch is told more (the 8 × 8's
+#   azimuth errors have the largest lag-1 correlation). The told-sigma PCRLB follows the told
+#   sigmas and barely moves: the largest over the smallest is the printed factor. It lies below
+#   dead reckoning's, by a fifth to a quarter from the 1 m entry fix (`gain_rt`, printed below),
+#   whatever the array: under the told-sigma model the radio adds information, too little to
+#   correct a 1 m entry fix to 0.2 m.
 #
 # This PCRLB is what the told sigmas allow as independent Gaussian errors, not what the channel
 # allows. The traced errors are neither, so a tracker can even beat it where the true errors are
@@ -662,8 +834,9 @@ print("error p90, ray-traced over image channel:", {a: f"{g:.3g}" for a, g in ga
 # %% [markdown]
 # Two things follow for an engineer:
 #
-# - **A design from eq. 1 alone is optimistic by orders of magnitude.** Every array passes on the
-#   image channel (full mode); on the traced one none does.
+# - **A design from eq. 1 alone is optimistic by orders of magnitude.** On the image channel
+#   every unit of every array meets 0.2 m (10 of 10 in full mode), and the verdict stays
+#   "undecided" (ten units cannot show 95 %); on the traced one no unit does.
 # - **The lever is not the array size.** More elements hardly move the told-sigma PCRLB (a prediction here). What could:
 #   a better entry fix (explored next), better odometry, an extraction that models the diffuse
 #   power and the higher-order bounces, or a second base station (the last two are not built
@@ -688,11 +861,20 @@ calm = settled_rms(design.drive_pcrlb(
     sigma_speed=tk.simulation.SIGMA_SPEED / 10, sigma_heading=tk.simulation.SIGMA_HEADING / 10,
 ))  # fmt: skip
 print(f"dead reckoning from {fixes[-1]} m, V2X speed and heading 10x better: {calm:.3g} m")
+fix_2d = np.sqrt(2) * fixes[-1]  # the entry fix's 2-D RMS (sigma per axis)
+drift = np.sqrt(by_fix[fixes[-1]][1] ** 2 - fix_2d**2)  # the odometry's share, in quadrature
+print(f"from {fixes[-1]} m: entry fix {100 * fix_2d:.2g} cm, drift {100 * drift:.3g} cm RMS; "
+      f"with 10x better messages sqrt(fix^2 + (drift/10)^2) = "
+      f"{100 * np.hypot(fix_2d, drift / 10):.3g} cm against {100 * calm:.3g} cm")  # fmt: skip
 
 # %% [markdown]
 # The radio's gain over dead reckoning shrinks with the entry fix, to about one per cent at
-# 0.1 m. The PCRLB's floor is the drift of the odometry over the drive: ten times better
-# messages lower it about threefold (the last line). Now the tracker once more on the traced
+# 0.1 m. What is left without the radio is the entry fix itself plus the odometry's drift over
+# the drive, and the two add in mean square (the recursion is linear in both): from 0.03 m per
+# axis the fix contributes 4.2 cm in 2-D and the drift about 14 cm RMS (`drift`, printed
+# below). Ten times better V2X messages cut the drift tenfold, to about 1.4 cm, and leave the
+# fix: the floor drops only about threefold (the last line), and it is now the entry fix, not
+# the odometry. Now the tracker once more on the traced
 # channel, from a 0.1 m entry fix (quick mode: 4 × 4, one drive of 12 epochs, as above). Same
 # seed, same drives: the entry fix is drawn after the drive, so each drive's measurements are
 # those above, kept from the first sweep (`design.traced.design_drive`), and only the tracker
@@ -708,8 +890,9 @@ p90_fine = {r.array: r.error_p90_m for r in fine_fix.rows}
 # %% [markdown]
 # A better fix brings the tracker and its told-sigma PCRLB (its prediction) down together: compare the line "posterior CRLB
 # of the sigmas the tracker is told" under each array with the table above. Compare also the "dead
-# reckoning" lines: the radio's gain is small from 1 m and vanishes from 0.1 m, where dead
-# reckoning alone misses 0.2 m too (in full mode). On this channel the single base station's
+# reckoning" lines: the table prints the radio's gain in RMSE from 1 m under each array, and
+# from 0.1 m the gain vanishes (under 5 %), where dead reckoning alone misses 0.2 m too (in full
+# mode). On this channel the single base station's
 # first-order extraction corrects a poor entry fix a little; it does not position the vehicle.
 # The design question becomes *which entry fix and which odometry*, or an extraction that
 # models what the traced channel holds.
@@ -768,6 +951,15 @@ for name, st in (("5.8 m", setup), ("5.0 m", low)):
 # the lower mount: SR-NF holds for the ceiling on more of the route; the prediction hardly moves
 assert sol1["5.0 m"][0] > sol1["5.8 m"][0] + 0.3, sol1
 assert abs(sol1["5.0 m"][1] / sol1["5.8 m"][1] - 1) < 0.2, sol1
+# what the tracker achieves: the same units (one drive each, the same seed) at both mounts
+n1, sol1_rmse = tk.mc_count(8, 4), {}
+for name, st in (("5.8 m", setup), ("5.0 m", low)):
+    r1 = design.sweep_montecarlo(st, ["8x8"], n1, 7, impairments=imps["0.5°"])["8x8"]
+    sol1_rmse[name] = float(np.sqrt(np.mean(r1.errors[:, r1.settled] ** 2)))
+    print(f"{name}: the tracker's settled RMSE {100 * sol1_rmse[name]:.3g} cm over {n1} units")
+ratio1 = sol1_rmse["5.0 m"] / sol1_rmse["5.8 m"]
+print(f"RMSE 5.0 m / 5.8 m: {ratio1:.2g}")
+assert 2 / 3 < ratio1 < 1.5, sol1_rmse  # within a few units' spread
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # %%solution 08.2
@@ -813,7 +1005,10 @@ for report in ("budget", "crlb"):
     sol4[report] = float(np.median(errs))
     print(f"reported {report:6s}: median settled RMSE {100 * sol4[report]:.3g} cm over 2 drives")
 print(f"factor: {sol4['crlb'] / sol4['budget']:.2g}")
+pred8_med = float(np.median(pred8["0.5°"].predicted))  # section 4's snapshot prediction
+print(f"told the budget: {sol4['budget'] / pred8_med:.2g} x the median predicted error")
 assert sol4["crlb"] > sol4["budget"], sol4  # what the extraction reports matters
+assert 0.25 < sol4["budget"] / pred8_med < 4, (sol4, pred8_med)  # within a small factor
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # %%solution 08.5
@@ -834,8 +1029,10 @@ assert 0.5 < sol5["channel"] / sol5["bound"] < 2.0, sol5  # within the drives' s
 # <details><summary>What to read in the solutions</summary>
 #
 # 1. A lower mount moves the ceiling's reflection point away from the array, so SR-NF holds on
-#    more of the route — which matters to an eq. 51 estimator only; the predicted error of the
-#    design's tracker hardly depends on it.
+#    more of the route — which matters to an eq. 51 estimator only. The design's tracker does
+#    not notice: its predicted error hardly moves, and its settled RMSE on the same units at the
+#    two mounts agrees within the spread of a few units (the printed ratio; the solution asserts
+#    a factor 1.5 either way).
 # 2. The printed array and the share of the route it meets (at least the 90 % asked); at 5.9 GHz an
 #    array of the same element count is 4.7 times larger, so curvature and direction improve, the
 #    band is four times narrower and the delays worse. It is not an answer: a prediction, first
@@ -844,8 +1041,9 @@ assert 0.5 < sol5["channel"] / sol5["bound"] < 2.0, sol5  # within the drives' s
 #    is largest is what the 16 × 16 array must be protected against first.
 # 4. Told only its CRLB the tracker trusts micrometres and weighs centimetres of calibration bias
 #    as exact: its error is larger (the second line against the first, by the printed factor);
-#    told the budget it stays within a small factor of the predicted error. What the extraction
-#    reports is part of the design.
+#    told the budget it stays within a small factor of section 4's predicted error (the last
+#    line; the solution asserts a factor 4 either way). What the extraction reports is part of
+#    the design.
 # 5. The two medians agree within the spread from drive to drive (the ratio printed; a factor
 #    of 2 either way is what the solution asserts): at this size and calibration the first-order
 #    model has the right scale. A few drives say nothing of the tails a 95 % yield rests on, nor
@@ -865,13 +1063,22 @@ bs_file = tk.scenarios.load_scenario(setup.name).section("base_station")
 assert [a["tilt_deg"] for a in bs_file["arrays"]] == [20.0, 20.0], bs_file
 assert x_route[0] == 60.0 and 0 <= x_route[-1] - 5.0 < x_route[0] - x_route[1], x_route[[0, -1]]
 # the ideal PEB is millimetres; with no impairment the predicted error is the tracker's
-# block-weighted fix, never below the PEB and within a small factor of it (ratio_blocks)
-assert np.all(pred8["ideal"].predicted >= pred8["ideal"].peb * (1 - 1e-9))
+# block-weighted fix: before the package's lift to the PEB, never below it (Gauss-Markov) and
+# within a small factor of it (ratio_blocks)
+fin8 = np.isfinite(pred8["ideal"].peb)
+assert fin8.any() and np.all(blocks_over_peb[fin8] >= 1 - 1e-9), np.min(blocks_over_peb[fin8])
 assert 1.0 <= ratio_blocks < 2.0, ratio_blocks
 assert np.median(pred8["ideal"].peb) < 0.01
-# calibration lifts the predicted error several-fold (the printed ratio_cal)
+# calibration lifts the predicted error several-fold (the printed ratio_cal), to centimetres,
+# and more with 2 deg than with 0.5 deg
 assert ratio_cal > 5, ratio_cal
-assert np.all(pred8["2°"].predicted >= pred8["ideal"].peb * (1 - 1e-9))
+assert 0.01 <= np.median(pred8["0.5°"].predicted) < 0.1, np.median(pred8["0.5°"].predicted)
+med8 = [np.median(pred8[k].predicted) for k in levels]
+assert med8[0] < med8[1] < med8[2], med8
+# the ideal weighting on the 32 x 32 with the wideband term: several times the tracker's
+assert ideal_over_tracker > 3, ideal_over_tracker
+# SR-NF's tolerance: the paper's 0.15 rad
+assert b8.eps_phi == 0.15, b8.eps_phi
 # SR-NF: the ceiling binds for 8x8 under the ceiling, and the default criterion does not gate on it
 assert srnf8["ceiling"] == 0.0
 assert all(rep.criterion == "achievable" for rep in answers.values())
@@ -880,6 +1087,10 @@ assert all(rep.criterion == "achievable" for rep in answers.values())
 assert round(100 * design.wilson_interval(10, 10)[0]) == 72
 assert n_prove == 73 and n_fail == 3, (n_prove, n_fail)
 assert round(100 * design.wilson_interval(0, 10)[1]) == 28
+# the verdict's limits at a true yield of 95 %: Wilson at 20 units covers about 92 %; "not met"
+# after one look about 7.5 %, after the command's five looks about 13.5 % (2.5 % nominal)
+assert looks_cli == [20, 40, 80, 160, 200], looks_cli
+assert 0.91 < cov20 < 0.94 and 0.07 < p_one < 0.08 and 0.13 < p_seq < 0.14, (cov20, p_one, p_seq)
 # the sweep: units x drives, no pre-screen (no "hopeless", every array gets its units), the
 # verdict by the unit yield's interval against the required yield, the sequential rule's counts
 for rep in answers.values():
@@ -899,7 +1110,7 @@ assert rank == sorted(rank), recs
 assert all(rep.settings["settle_s"] == 1.0 for rep in answers.values())  # the quoted 1 s
 if not tk.quick_mode():
     assert n_decide == 80, batches
-    assert recs["ideal"] == "4x4" and rank[2] > rank[0], recs
+    assert recs["ideal"] == "4x4" and rank[0] < rank[1] < rank[2], recs
     rows_ideal = {r.array: r for r in answers["ideal"].rows}
     assert rows_ideal["4x4"].status == "met" and rows_ideal["4x4"].units == 80
 else:  # a cap of 4 units: below 10 no interval decides, and the sweep says so
@@ -908,11 +1119,11 @@ else:  # a cap of 4 units: below 10 no interval decides, and the sweep says so
     assert n_decide is None and all(r.status == "undecided" for r in answers["0.5°"].rows)
     assert any("units" in w for w in answers["0.5°"].warnings)
 # the yields: every unit meets with an ideal array; calibration lowers the yield, 2 deg below
-# 0.5 deg (the smallest array's drops; an array all of whose units pass at 0.5 deg loses some)
+# 0.5 deg (the smallest array's drops; an array passing 99 % or more at 0.5 deg loses some)
 assert all(y == 1.0 for y in yields["ideal"].values()), yields
 assert all(yields["0.5°"][a] >= yields["2°"][a] for a in candidates), yields
 assert yields["0.5°"]["4x4"] < 1.0 and yields["2°"]["4x4"] < yields["0.5°"]["4x4"], yields
-assert any(yields["0.5°"][a] == 1.0 > yields["2°"][a] for a in candidates), yields
+assert any(yields["0.5°"][a] >= 0.99 > yields["2°"][a] for a in candidates), yields
 # section 6's reading: ideal, the tracker within a small factor of the PEB; at 0.5 deg several
 # times the PEB (3 to 10) and within a small factor of the predicted error
 for r in answers["ideal"].rows:
@@ -920,16 +1131,18 @@ for r in answers["ideal"].rows:
 for r in answers["0.5°"].rows:
     assert 3 * r.peb_median_m < r.error_median_m < 10 * r.peb_median_m, r.array
     assert r.error_median_m < 4 * r.predicted_median_m, r.array
-# bounds below the tracker (every unit's PCRLB, the augmented-state bound pooled over units,
-# never below the PCRLB); the prediction beaten on some row; with calibration error the tracker
-# several times above the augmented-state bound
-assert bound_min >= 1.0, bound_min
+# bounds below the tracker within Monte-Carlo scatter (every ratio at least 1 - 2 SE; the
+# augmented-state bound never below every unit's PCRLB); the drive prediction and the snapshot
+# prediction each beaten on some row; with calibration error the tracker several times above
+# the augmented-state bound
+assert z_min >= -2, z_min
 assert all(r.hybrid_bound_rms_m >= r.pcrlb_rms_m * (1 - 1e-9) for _, r in rows_mc)
 assert pred_min < 1.0, pred_min
+assert snap_beaten, [(k, r.error_p90_m, r.predicted_p90_m) for k, r in rows_mc]
 assert cal_gap > 3, cal_gap
 # the bound-driven route and the posterior bound
 assert all(np.all(np.isfinite(r.errors)) for r in val.values())
-assert 0.8 < pc_ratio < 5, pc_ratio
+assert 1 - 2 * pc_se <= pc_ratio < 5, (pc_ratio, pc_se)  # the tolerance of section 6
 med_b, med_c = (np.median(r.errors[:, r.settled]) for r in (val["bound"], val["channel"]))
 assert 1 / 3 < med_b / med_c < 3, (med_b, med_c)  # the two routes agree above the threshold
 # the paper's tunnel under the SR-NF criterion
@@ -941,6 +1154,15 @@ assert all(r.srnf_valid_share_by_surface["ceiling"] == 0.0 for r in sweep.rows)
 peb_paper = [r.peb_median_m for r in sweep.rows]
 assert np.all(np.diff(peb_paper) < 0)  # PEB falls with size
 assert sweep.rows[0].srnf_valid_share >= sweep.rows[-1].srnf_valid_share
+# the paper's sizing (eq. 25 at its values: 9.88, so 10 x 10, the file's arrays) and what the
+# workbook reconstructs: a 12-facet semicircle, the anchor 20 cm under the crown, the arrays'
+# reference antennas 5 cm below it; the paper's target here 0.2 m, the example's 0.1 m
+assert round(m_max_paper, 2) == 9.88 and int(np.ceil(m_max_paper)) == 10, m_max_paper
+tun_file, bs_paper = paper_file.section("tunnel"), paper_file.section("base_station")
+assert (tun_file["kind"], tun_file["n_facets"]) == ("semicircular3d", 12), tun_file
+assert abs(tun_file["height"] - bs_paper["position"][2] - 0.2) < 1e-9, bs_paper
+assert all(a["shape"] == [10, 10] and a["offset"][2] == -0.05 for a in bs_paper["arrays"])
+assert sweep.settings["target"] == 0.2 and answers["0.5°"].settings["target"] == 0.1
 # numbers the prose quotes: the radio (792 tones x 12 symbols), the base station 20 cm under
 # the ceiling, a 32 x 32 URA 0.8 m on a side at 5.9 GHz that does not fit, exercise 2's 4.7 and 4
 assert cfg.n_tones == 792 and cfg.n_symbols == 12
@@ -962,7 +1184,7 @@ assert np.allclose(
     propagation.scenario_arrays(tk.scenarios.load_scenario("italiano2026-straight"))[0].world,
     atol=1e-9,
 )
-assert round(28e9 / 5.9e9, 1) == 4.7 and 400e6 / 100e6 == 4
+assert round(cfg.fc / paper.fc, 1) == 4.7 and cfg.bandwidth / paper.config.bandwidth == 4
 # the command's calibrated default: 1.5 deg and 0.25 dB per element, 5.6 % of the power diffuse
 cal = design.preset_impairments("calibrated", setup, candidates)
 assert (cal.phase_error_deg, cal.gain_error_db) == (1.5, 0.25), cal
@@ -981,8 +1203,13 @@ for a in rt_sizes:
                          ("delta_d", told[a].sigma_delta_d, rms[5])):  # fmt: skip
         r = min(max(corr[q]["r"], 0.0), 0.9)
         assert np.isclose(got, want * np.sqrt((1 + r) / (1 - r)), rtol=1e-9), (a, q)
-rms_phi = [{r[0]: r for r in records[a]["rows"]}["all"][2] for a in rt_sizes]
-assert all(x > y for x, y in pairwise(rms_phi)), rms_phi
+# the RMS errors of azimuth [2], curvature [4] and delay [5] fall with the array
+for col in (2, 4, 5):
+    rms_q = [{r[0]: r for r in records[a]["rows"]}["all"][col] for a in rt_sizes]
+    assert all(x > y for x, y in pairwise(rms_q)), (col, rms_q)
+# quick mode's 12 traced epochs: 1.1 s at 0.1 s a step, two of them counted
+t_rt = paper_rt.trajectory.t
+assert np.isclose(t_rt[11] - t_rt[0], 1.1) and k_quick.size == 2, (t_rt[:12], k_quick)
 most = max(rt_sizes, key=lambda a: told[a].sigma_phi)
 assert most == "8x8" == max(rt_sizes, key=lambda a: records[a]["correlation"]["phi"]["r"]), most
 # the told-sigma PCRLB: above 0.2 m for every array, barely moving with the array (the
@@ -991,6 +1218,7 @@ assert design.START_SIGMA_M == 1.0
 assert min(bound_rt.values()) > 0.2, bound_rt
 assert bound_ratio < 1.25 and max(bound_rt, key=bound_rt.get) == most, bound_rt
 assert max(bound_rt.values()) < no_radio, (bound_rt, no_radio)
+assert all(0.15 < g < 0.3 for g in gain_rt.values()), gain_rt  # a fifth to a quarter
 # the trackers: millimetres on the image channel, within a small factor of the predicted p90,
 # every unit meeting; above the target on the traced one, by two orders of magnitude (quick
 # mode's 12 traced epochs: more than 30 times), no unit
@@ -1010,21 +1238,29 @@ for r in on["sionna"].rows:
 if not tk.quick_mode():  # ten passing units cannot show 95 % (73 needed); ten failing ones can
     assert all(r.status == "undecided" and r.units == 10 for r in on["image"].rows)
     assert all(r.status == "not met" for r in on["sionna"].rows), on["sionna"].to_table()
-    # from the 0.1 m fix dead reckoning misses 0.2 m too, and the radio's gain is < 5 %
+    # from the 0.1 m fix dead reckoning misses 0.2 m too
     for r in fine_fix.rows:
         assert r.dead_reckoning_p90_m > 0.2, r.array
-        assert abs(1 - r.rmse_m / r.dead_reckoning_rmse_m) < 0.05, r.array
 else:
     assert all(r.status == "undecided" for rep in (*on.values(), fine_fix) for r in rep.rows)
+# from the 0.1 m fix the radio's gain in RMSE vanishes (under 5 %)
+for r in fine_fix.rows:
+    assert abs(1 - r.rmse_m / r.dead_reckoning_rmse_m) < 0.05, r.array
 # the entry fix: the bound falls with it (the 1 m row is the default's), stays at or below dead
-# reckoning's, the radio's gain shrinks at every step to about 1 % at 0.1 m; the odometry's
-# drift is the floor (ten times better messages: about threefold lower)
+# reckoning's, the radio's gain shrinks at every step to about 1 % at 0.1 m
 gains = {sp: 1 - r / a for sp, (r, a) in by_fix.items()}
 assert np.isclose(by_fix[1.0][0], bound_rt["8x8"], rtol=1e-12), (by_fix, bound_rt)
 assert all(r <= a * (1 + 1e-9) for r, a in by_fix.values()), by_fix
 assert all(by_fix[x][0] > by_fix[y][0] for x, y in pairwise(fixes)), by_fix
 assert all(gains[x] > gains[y] for x, y in pairwise(fixes)), gains
 assert gains[1.0] > 0.1 and 0.005 < gains[0.1] < 0.02, gains
+# without the radio: the entry fix and the odometry's drift add in mean square (the drift the
+# same from the 0.1 m and the 0.03 m fix); from 0.03 m per axis, 4.2 cm of fix and about 14 cm
+# of drift; ten times better messages cut the drift tenfold (to about 1.4 cm) and leave the fix:
+# the floor about threefold lower
+assert abs(fix_2d - 0.042) < 0.001 and 0.12 < drift < 0.16, (fix_2d, drift)
+assert np.isclose(np.sqrt(by_fix[0.1][1] ** 2 - 2 * 0.1**2), drift, rtol=0.02), (by_fix, drift)
+assert np.isclose(calm, np.hypot(fix_2d, drift / 10), rtol=0.02), (calm, fix_2d, drift)
 assert 2.5 < by_fix[fixes[-1]][1] / calm < 4, (calm, by_fix)
 # from the 0.1 m fix the tracker and its told-sigma PCRLB come down together
 for rf, rc in zip(fine_fix.rows, on["sionna"].rows, strict=True):

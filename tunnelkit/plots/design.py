@@ -195,7 +195,13 @@ def route_figure(
 
 
 def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figure:
-    """PEB (median, 90th percentile) and SR-NF valid share against the number of elements.
+    """The snapshot PEB (median, 90th percentile over the route) and the SR-NF valid share
+    against the number of elements; with Monte-Carlo rows, the tracker's RMSE (with its 95 %
+    interval) and its bound, every unit's posterior CRLB over the drive (``pcrlb_rms_m``).
+
+    The PEB bounds one epoch's unbiased fix, not the tracker (which fuses epochs and may go below
+    it), and its percentile over the route bounds no error percentile: its traces are labelled
+    a reference. Only the PCRLB is a bound of the RMSE beside it.
 
     ``rows``: :class:`tunnelkit.design.DesignRow` list (one sweep). ``mark`` highlights one
     array label (the paper's 10 x 10) when present.
@@ -212,9 +218,15 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
     p90 = 100 * np.array([r.peb_p90_m for r in rows])
     share = 100 * np.array([r.srnf_valid_share for r in rows])
     traces = [
-        go.Scatter(x=n, y=_finite(med), mode="lines+markers", name="PEB median", text=labels),
         go.Scatter(
-            x=n, y=_finite(p90), mode="lines+markers", name="PEB 90th pct", line={"dash": "dash"}
+            x=n, y=_finite(med), mode="lines+markers", name="PEB median (a reference)", text=labels
+        ),
+        go.Scatter(
+            x=n,
+            y=_finite(p90),
+            mode="lines+markers",
+            name="PEB 90th pct (a reference)",
+            line={"dash": "dash"},
         ),
         go.Scatter(
             x=n,
@@ -235,7 +247,7 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
                 x=n,
                 y=y,
                 mode="markers",
-                name="JAVELIN RMSE (95 % CI)",
+                name="tracker RMSE (95 % CI)",
                 marker={"symbol": "diamond", "size": 9, "color": "black"},
                 error_y={
                     "type": "data",
@@ -245,6 +257,16 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
                         100 * (v - lo_) if v is not None else None for v, lo_ in zip(rm, lo)
                     ],
                 },
+            )
+        )
+        pc = [r.pcrlb_rms_m for r in rows]
+        traces.append(
+            go.Scatter(
+                x=n,
+                y=[100 * v if v is not None else None for v in pc],
+                mode="markers",
+                name="PCRLB (bound of the RMSE)",
+                marker={"symbol": "triangle-up", "size": 9, "color": "grey"},
             )
         )
     shapes = []
@@ -267,7 +289,7 @@ def size_figure(rows, *, mark: str | None = "10x10", title: str = "") -> go.Figu
         "autosize": True,
         "margin": {"l": 70, "r": 80, "t": 60, "b": 50},
         "xaxis": {"type": "log", "title": {"text": "number of elements M"}},
-        "yaxis": {"type": "log", "title": {"text": "position error [cm]"}},
+        "yaxis": {"type": "log", "title": {"text": "position error, bound [cm]"}},
         "yaxis2": {
             "overlaying": "y",
             "side": "right",
@@ -314,8 +336,9 @@ def design_answer_figure(report) -> go.Figure:
     Top, per array along the route (log, cm): the tracker's median 2-D error per epoch over the
     Monte-Carlo drives (solid; its legend entry states the pooled ``share``-quantile over the
     settled route with its bootstrap 95 % interval), the ideal snapshot PEB (dotted, a lower
-    bound of one epoch's fix, which the tracker, fusing epochs, may go below) and the first-order predicted error under the impairments (dashed, a prediction, not a
-    bound), and the target. Rows without Monte-Carlo (``--units 0``) show the PEB and the
+    bound of one epoch's fix, which the tracker, fusing epochs, may go below: a reference, not
+    the tracker's bound) and the first-order predicted error under the impairments (dashed, a
+    prediction, not a bound), and the target. Rows without Monte-Carlo (``--units 0``) show the PEB and the
     prediction only. Bottom: the unit yield per array (the share of manufactured units that meet
     the target on their own) with its Wilson 95 % interval, and the required yield; the verdict
     is in the hover.
@@ -369,14 +392,15 @@ def design_answer_figure(report) -> go.Figure:
                     "x %{x:.1f} m: %{y:.3g} cm<br>"
                     f"pooled {pooled} (settled route, 95 % CI)<br>"
                     f"RMSE {_cm_text(r.rmse_m)}; PCRLB {_cm_text(r.pcrlb_rms_m)}, hybrid bound "
-                    f"{_cm_text(r.hybrid_bound_rms_m)} (lower bounds of the RMSE)<extra></extra>"
+                    f"{_cm_text(r.hybrid_bound_rms_m)} (lower bounds of the RMSE of trackers "
+                    "unbiased for the route)<extra></extra>"
                 ),
                 **group,
                 row=1,
                 col=1,
             )
         for name, y, dash in (
-            (f"{r.array} PEB (snapshot bound)", r.peb_m, "dot"),
+            (f"{r.array} PEB (one epoch's bound, a reference)", r.peb_m, "dot"),
             (f"{r.array} predicted (not a bound)", r.predicted_m, "dash"),
         ):
             if y is not None:
@@ -465,8 +489,8 @@ def design_answer_figure(report) -> go.Figure:
         title={
             "text": title,
             "subtitle": {
-                "text": "solid: tracker's median; dotted: PEB (one epoch's bound); dashed: "
-                "prediction (not a bound)"
+                "text": "solid: tracker's median; dotted: PEB (one epoch's bound, not the "
+                "tracker's); dashed: prediction (not a bound)"
             },
             "x": 0.01,
             "xanchor": "left",
