@@ -48,8 +48,7 @@ import numpy as np
 import tunnelkit as tk
 from tunnelkit import design, propagation
 from tunnelkit.design import traced
-from tunnelkit.design.drivebound import position_noise_cov
-from tunnelkit.design.fastroute import tracker_weights
+from tunnelkit.design.trackerfix import position_noise_cov, tracker_weights
 from tunnelkit.plots.design import route_figure, size_figure
 from tunnelkit.rt.cache import CACHE_ENV
 from tunnelkit.widgets.design import design_explorer, design_figure

@@ -181,7 +181,8 @@ def unit_pcrlb(
     * ``calibration=True``: ``e`` a **fixed unknown of the drive** with its prior ``N(0,
       diag(sigma_phase^2 I, sigma_gain^2 I))`` (one draw per manufactured unit), carried as a
       static state beside the position (a hybrid / consider bound, Van Trees over the drive and
-      the unit): a lower bound of the MSE **pooled over units** of any tracker;
+      the unit): a lower bound of the MSE **pooled over units** of any tracker (nearly) unbiased
+      for the route (the route is fixed: an oracle that knew it could go below);
     * ``calibration=False``: ``e`` known to the bound (conditioned on the unit's draw, whose
       bias ``K e`` then carries no information and only shifts the mean): the bound of **every
       unit**, the same for every draw (the model is linear in ``e``).

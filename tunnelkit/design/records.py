@@ -243,8 +243,8 @@ class DesignReport:
         lines.append(
             f"Bounds: PEB the ideal snapshot position error bound (of one epoch's fix; the "
             f"tracker fuses epochs and may go below it, and a bound's p90 bounds no error's p90); "
-            f"the tracker's lower bounds, checked by Monte-Carlo: PCRLB every unit's posterior "
-            f"CRLB over the drive (settled RMS), hybrid the same pooled over units, the "
+            f"the tracker's lower bounds (of trackers nearly unbiased for the fixed route), checked "
+            f"by Monte-Carlo: PCRLB every unit's posterior CRLB over the drive (settled RMS), hybrid the same pooled over units, the "
             f"calibration a fixed unknown per unit (both beside RMSE). Prediction (not a bound, decides nothing): pred, "
             f"the first-order RMS error of the tracker's fix under the impairments. err: "
             f"Monte-Carlo 2-D error, {q} its {s['share']:g}-quantile pooled over units on the "

@@ -335,7 +335,7 @@ def design_answer_figure(report) -> go.Figure:
 
     Top, per array along the route (log, cm): the tracker's median 2-D error per epoch over the
     Monte-Carlo drives (solid; its legend entry states the pooled ``share``-quantile over the
-    settled route with its bootstrap 95 % interval), the ideal snapshot PEB (dotted, a lower
+    settled route with its 95 % interval, Woodruff's over units), the ideal snapshot PEB (dotted, a lower
     bound of one epoch's fix, which the tracker, fusing epochs, may go below: a reference, not
     the tracker's bound) and the first-order predicted error under the impairments (dashed, a
     prediction, not a bound), and the target. Rows without Monte-Carlo (``--units 0``) show the PEB and the
