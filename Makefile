@@ -20,7 +20,7 @@ APT_LOCKED = flock -w 1800 $(APT_LOCK_FILE) apt-get -o DPkg::Lock::Timeout=600
 # pip --quiet still relays setuptools' build warnings and a site-wide config's "is ignored" notes
 PIP_FILTER := sed '/is ignored\|BuildBackendWarning\|^ *!!\|^ *\*\*\*\|^ *$$\|Please be careful\|name as your package\|take precedence during\|with strategy, WheelFile\|warnings.warn(/d'
 
-.PHONY: help install hooks lab test lint format unit notebooks lessons bench clean
+.PHONY: help install hooks lab test lint format unit notebooks bench clean
 
 .DEFAULT_GOAL := help
 include make/lecture.mk
@@ -85,15 +85,11 @@ notebooks: install rt-deps
 	TUNNELKIT_QUICK=1 TUNNELKIT_SOLUTIONS=1 $(PY) -m pytest -q -n 2 -p tools.nbmake_cache \
 	  --nbmake --nbmake-timeout=900 notebooks
 
-# The unit tests run beside the lessons (the notebooks, then the browser tests, whose site build
-# renders those runs): the two stages share the two cores instead of one waiting for the other.
-# Each stage's output is printed whole when it ends (--output-sync); either failing fails the run.
-test: lint
-	$(MAKE) --no-print-directory -j2 --output-sync=target unit lessons
-
-# the notebooks, then the browser tests on their runs (`make test`'s second stage)
-lessons: notebooks chromium
-	$(BROWSER_TESTS)
+# The notebooks first (their runs are what the browser tests' site renders), then the unit tests
+# beside the browser tests, which wait on pages and servers more than they compute: the two share
+# the two cores. Each prints its output whole when it ends (--output-sync); either failing fails.
+test: lint notebooks
+	$(MAKE) --no-print-directory -j2 --output-sync=target unit browser
 
 bench: install
 	$(PY) benchmarks/run.py

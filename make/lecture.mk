@@ -29,10 +29,8 @@ site: install
 figures: install chromium
 	$(PY) tools/figures.py $(LECTURE_QUICK)
 
-BROWSER_TESTS = TUNNELKIT_BROWSER=1 $(PY) -m pytest -q -p no:xdist -p no:cacheprovider tests/browser
-
 browser: install chromium
-	$(BROWSER_TESTS)
+	TUNNELKIT_BROWSER=1 $(PY) -m pytest -q -p no:xdist -p no:cacheprovider tests/browser
 
 chromium:
 	@if [ -x $(CHROMIUM) ]; then \

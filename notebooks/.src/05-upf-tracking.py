@@ -344,8 +344,8 @@ print(
 bound_ratio_figure(
     exp.times,
     {
-        "the preset, q = 0.1 figure (no bound here)": ({n: rmse_t[n] for n in rmse_mm}, bound),
-        "the preset, its bound (q -> 0)": ({n: rmse_t[n] for n in rmse_mm}, bound0),
+        "preset: q = 0.1, no bound": ({n: rmse_t[n] for n in rmse_mm}, bound),
+        "preset: its bound, q -> 0": ({n: rmse_t[n] for n in rmse_mm}, bound0),
         f"truths from the model ({RUNS_MM}), q = 0.1": (rmse_mm, bound_mm),
     },
     title="RMSE / sqrt(PCRLB) per epoch: the q = 0.1 figure assumes a truth that wanders",
