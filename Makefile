@@ -85,11 +85,10 @@ notebooks: install rt-deps
 	TUNNELKIT_QUICK=1 TUNNELKIT_SOLUTIONS=1 $(PY) -m pytest -q -n 2 -p tools.nbmake_cache \
 	  --nbmake --nbmake-timeout=900 notebooks
 
-# The notebooks first (their runs are what the browser tests' site renders), then the unit tests
-# beside the browser tests, which wait on pages and servers more than they compute: the two share
-# the two cores. Each prints its output whole when it ends (--output-sync); either failing fails.
-test: lint notebooks
-	$(MAKE) --no-print-directory -j2 --output-sync=target unit browser
+# One stage after the other: running the unit tests beside the lessons measured no faster on an
+# idle machine (521-530 s against 510-538 s) and slower beside a second `make test` (1,194 /
+# 1,205 s against 929 / 1,026 s): the unit tests keep both cores busy (docs/runtimes.md).
+test: lint unit notebooks browser
 
 bench: install
 	$(PY) benchmarks/run.py
