@@ -410,8 +410,9 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a user scene's shape that references no material",
     ),
     _doc(
-        r"tracking\.javelin\.(measurement\.(DelayCheck|PathMeasurements\.(from_arrays|sanitised))"
-        r"|designs\.array_design)|design\.montecarlo\.javelin_config",
+        r"tracking\.javelin\.(measurement\.DelayCheck|designs\.array_design)"
+        r"|tracking\.measurements\.PathMeasurements\.(from_arrays|sanitised)"
+        r"|design\.montecarlo\.javelin_config",
         r"min_d",
         "negative",
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
@@ -454,7 +455,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a measured (V2X) speed carries noise: it dips below zero near a standstill",
     ),
     _doc(
-        r"tracking\.javelin\.measurement\.PathMeasurements(\.from_arrays)?",
+        r"tracking\.measurements\.PathMeasurements(\.from_arrays)?",
         r"phi|psi|kappa|d|v",
         "nan",
         "NaN kappa: far field; NaN d, v: unknown; a NaN angle is dropped by Algorithm 1 "
@@ -681,7 +682,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "share 1: a calibration error that large leaves no received power to the model",
     ),
     _doc(
-        r"tracking\.javelin\.measurement\.PathMeasurements\.subset",
+        r"tracking\.measurements\.PathMeasurements\.subset",
         r"idx",
         "empty",
         "no row kept: measurements of no path (the route's own case of an empty epoch)",

@@ -153,7 +153,7 @@ def drive_from_record(rec: dict, route, where: str, rng_kind: str):
     generator's state after the drive, checked as a ``rng_kind`` state. ``where`` names the file
     in every refusal (``ValueError``)."""
     from ..simulation.drives import DriveData
-    from ..tracking.javelin.measurement import PathMeasurements
+    from ..tracking.measurements import PathMeasurements
 
     rec = _keys(where, rec, _DRIVE_KEYS)
     traj = route.trajectory

@@ -149,7 +149,7 @@ def bound_drive(
     (:meth:`PathErrorModel.draw_calibration`; ``None``: drawn from ``rng``, a unit per drive)."""
     from ..channel import sample_clock_bias
     from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
-    from ..tracking.javelin.measurement import PathMeasurements
+    from ..tracking.measurements import PathMeasurements
 
     choice("report", report, REPORTS)
     if isinstance(model, BoundRoute):

@@ -73,7 +73,7 @@ from .._physical import carrier
 from .._validate import finite_array, instance, integer, nonnegative, positive, record, sequence
 from ..channel import Impairments
 from ..evaluation import match_points
-from ..tracking.javelin.measurement import PathMeasurements
+from ..tracking.measurements import PathMeasurements
 
 __all__ = [
     "FLOOR_FALSE_ALARM",

@@ -14,7 +14,7 @@ from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
 from ..evaluation import match_paths
-from ..tracking.javelin.measurement import PathMeasurements
+from ..tracking.measurements import PathMeasurements
 
 __all__ = [
     "Epoch",

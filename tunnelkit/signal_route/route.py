@@ -20,7 +20,7 @@ from .._validate import (
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
 from ..constants import C
-from ..tracking.javelin.measurement import PathMeasurements
+from ..tracking.measurements import PathMeasurements
 from .measurements import Epoch, measure_epoch
 from .options import MAX_SECOND_ORDER, RouteOptions
 

@@ -41,7 +41,7 @@ from ..extraction.ml import ml_paths
 from ..metrics import SETTLE_S, settled
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
-from ..tracking.javelin.measurement import PathMeasurements
+from ..tracking.measurements import PathMeasurements
 
 __all__ = [
     "CONDITIONS",

@@ -21,7 +21,7 @@ from .._validate import boolean, finite_array, instance
 from ..consistency import plane_kinds
 from ..path_consistency import epoch_consistency
 from ..signal_route import Epoch, SignalRoute
-from ..tracking.javelin.measurement import PathMeasurements
+from ..tracking.measurements import PathMeasurements
 from .drives import scenario_route
 
 __all__ = [

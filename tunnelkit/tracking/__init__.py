@@ -10,6 +10,7 @@ Every filter follows one protocol (:mod:`tunnelkit.tracking.protocol`): ``predic
 ``update(z)``, ``step`` (both), and an inspectable ``x`` and ``P``.
 """
 
+from .._lazy import lazy_exports
 from . import registry
 from .protocol import Filter
 
@@ -20,3 +21,8 @@ registry.provide("halili2022", "tunnelkit.tracking.doppler")  # KF/EKF on Dopple
 registry.provide("italiano2026", "tunnelkit.tracking.javelin")  # JAVELIN, TeNFiLoc
 
 __all__ = ["Filter", "registry"]
+
+# a subpackage by its own name (``tk.tracking.javelin``) loads on first use: building a signal
+# route reads the measurement container (``tracking.measurements``) without loading a tracker
+_EXPORTS: dict[str, str] = {}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
