@@ -90,6 +90,14 @@ notebooks: install rt-deps
 # 1,205 s against 929 / 1,026 s): the unit tests keep both cores busy (docs/runtimes.md).
 test: lint unit notebooks browser
 
+# One BLAS thread per process in the test stages: two pytest workers (or notebook kernels) on two
+# cores, each with OpenBLAS's default two threads, spin four threads on two cores. Measured beside
+# other work: three unit-test files took 222 s with the default threads, 24 s with one
+# (docs/runtimes.md). A value set in the environment wins.
+unit notebooks browser: export OMP_NUM_THREADS ?= 1
+unit notebooks browser: export OPENBLAS_NUM_THREADS ?= 1
+unit notebooks browser: export MKL_NUM_THREADS ?= 1
+
 bench: install
 	$(PY) benchmarks/run.py
 
