@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +31,13 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.runner import run_trials
-from tunnelkit.simulation import HELD_OUT_SEED, error_correlations, error_samples, evaluate
+from tunnelkit.simulation import (
+    HELD_OUT_SEED,
+    error_correlations,
+    error_samples,
+    evaluate,
+    without_radio,
+)
 from tunnelkit.simulation.analysis import extraction_errors
 from tunnelkit.simulation.prefilter import NUISANCE, SIGMA_SCENARIO
 from tunnelkit.studies.robust_errors import robust_design, robust_rows
@@ -120,7 +125,7 @@ def main(argv=None) -> int:
             for d in drives:
                 res["rms"].append(evaluate(d, rms_design).metrics["rmse_2d_m"])
                 res["robust"].append(evaluate(d, rob_design).metrics["rmse_2d_m"])
-                none = replace(d, epochs=[None] * len(d.epochs))
+                none = without_radio(d)
                 res["dr"].append(evaluate(none, rms_design).metrics["rmse_2d_m"])
             m = {k: float(np.mean(v)) for k, v in res.items()}
             print(

@@ -169,6 +169,7 @@ def javelin_studies():
     ev = simulation.evaluate(drive, designs.ours(), keep_reports=True)
     simulation.settled_errors(ev, drive)
     simulation.tenfiloc_track(drive)
+    simulation.without_radio(drive)
     simulation.vue_prediction_errors(drive, "mirror")
     simulation.path_errors([drive])
     simulation.extraction_errors([routes["ml"]])

@@ -74,7 +74,7 @@ class SweepTrial:
     dead_reckoning: bool = False
 
     def __call__(self, item: tuple, rng: np.random.Generator) -> np.ndarray:
-        from ..simulation import evaluate, simulate_drive
+        from ..simulation import evaluate, simulate_drive, without_radio
         from ..tracking.javelin import draw_start
 
         prep, unit_seed = item  # the array's shared part, the unit's calibration seed
@@ -118,7 +118,7 @@ class SweepTrial:
         if not self.dead_reckoning:
             return err
         # the same tracker, start and V2X messages with every measurement dropped
-        alone = replace(drive, epochs=[None] * len(drive.epochs))
+        alone = without_radio(drive)
         ev = evaluate(alone, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
         return np.stack([err, _trial_errors(ev.estimates, drive.truth)])
 

@@ -14,7 +14,6 @@ extraction error), and the paper's published number.
 from __future__ import annotations
 
 import functools
-from dataclasses import replace
 
 import numpy as np
 
@@ -22,7 +21,7 @@ from .._validate import boolean, instance, integer, sequence, text
 from ..reference import load as load_reference
 from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
 from ..simulation.drives import FLAGGED, HELD_OUT_SEED, TUNING_SEEDS, drive_variant
-from ..simulation.scoring import evaluate
+from ..simulation.scoring import evaluate, without_radio
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from . import Report, register
@@ -118,7 +117,7 @@ def score_drive(
             if key not in cache:
                 drive = drives[route]
                 if method == DEAD_RECKONING:
-                    drive, method = replace(drive, epochs=[None] * len(drive.epochs)), "JAVELIN"
+                    drive, method = without_radio(drive), "JAVELIN"
                 cache[key] = evaluate(drive, table_designs.get(dname), method=method).metrics
             out[(name, label)] = cache[key]
     return out

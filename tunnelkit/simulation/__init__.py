@@ -44,6 +44,7 @@ _EXPORTS = {
     "settled": "scoring",
     "settled_errors": "scoring",
     "tenfiloc_track": "scoring",
+    "without_radio": "scoring",
 }
 
 
@@ -80,5 +81,6 @@ __all__ = [
     "simulate_routes",
     "tenfiloc_track",
     "vue_prediction_errors",
+    "without_radio",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -9,7 +9,7 @@ the VUE tracks born over the first epochs); :func:`settled` selects the epochs a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,6 +31,7 @@ __all__ = [
     "settled",
     "settled_errors",
     "tenfiloc_track",
+    "without_radio",
 ]
 
 
@@ -45,6 +46,20 @@ def tenfiloc_track(
     if not isinstance(tf, TeNFiLoc):
         raise TypeError(f"baseline: expected a TeNFiLoc, got {type(tf).__name__}")
     return tf.track(drive)
+
+
+def without_radio(drive: DriveData) -> DriveData:
+    """The same drive with every radio measurement dropped: a tracker run on it predicts on the
+    V2X speed and heading messages alone, from the same start (dead reckoning, the baseline the
+    radio must beat). Copies no array; draws nothing.
+
+    >>> without_radio("a drive")
+    Traceback (most recent call last):
+    ...
+    TypeError: drive: expected a simulation.drives.DriveData, got str
+    """
+    drive = instance("drive", drive, DriveData)
+    return replace(drive, epochs=[None] * len(drive.epochs))
 
 
 def error_metrics(estimates, truth) -> dict[str, float]:
