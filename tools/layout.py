@@ -43,6 +43,7 @@ RANKS = {
     "schema": 0.5,
     "schemadoc": 0.6,  # the schema written out: TOML templates, the Markdown reference
     "geometry": 1,
+    "odometry": 1,  # the V2X odometry messages as a model, dead reckoning and its bound
     "crlb": 1,
     "metrics": 1,
     "montecarlo": 1,
