@@ -186,3 +186,29 @@ def test_the_bound_without_a_pattern_is_the_schedule_s():
     # on a straight drive at constant speed a lost message only loses information
     lossy = np.random.default_rng(0).random((5, t.size)) > 0.3
     assert np.all(dead_reckoning_bound(t, v, th, AUTOMOTIVE, arrived=lossy) >= full - 1e-12)
+
+
+def test_a_drive_with_lost_messages_runs_and_scores():
+    """The drive simulator draws through the model; JAVELIN predicts over a lost message with
+    the last one (NaN: missing) and the drive scores."""
+    from tunnelkit import simulation
+    from tunnelkit.simulation.scoring import evaluate
+
+    kw = {"condition": "L", "n_epochs": 10}
+    odo = Odometry(rate=5.0, dropout=0.4, heading_bias=0.02, speed_scale=0.01)
+    d = simulation.simulate_drive(
+        "italiano2026-straight", np.random.default_rng(8), odometry=odo, **kw
+    )
+    assert np.isnan(d.speed).sum() >= 5 and np.isnan(d.speed[0])  # the first one lost too
+    ev = evaluate(d)
+    assert np.isfinite(ev.estimates).all() and np.isfinite(ev.metrics["rmse_2d_m"])
+    white = simulation.simulate_drive("italiano2026-straight", np.random.default_rng(8), **kw)
+    same = simulation.simulate_drive(
+        "italiano2026-straight", np.random.default_rng(8), odometry=WHITE, **kw
+    )
+    assert white.speed.tobytes() == same.speed.tobytes()
+    assert white.heading.tobytes() == same.heading.tobytes()
+    with pytest.raises(ValueError, match="odometry, sigma_speed"):
+        simulation.simulate_drive(
+            "italiano2026-straight", np.random.default_rng(8), odometry=odo, sigma_speed=0.3, **kw
+        )

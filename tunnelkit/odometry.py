@@ -38,6 +38,7 @@ __all__ = [
     "Odometry",
     "dead_reckoning",
     "dead_reckoning_bound",
+    "resolve",
 ]
 
 #: V2X message noise of section 4.2: speed [m/s] and heading [rad]
@@ -167,6 +168,28 @@ AUTOMOTIVE = Odometry(
     rate=10.0,
     dropout=0.1,
 )
+
+
+def resolve(
+    odometry: Odometry | None,
+    sigma_speed: float = SIGMA_SPEED,
+    sigma_heading: float = SIGMA_HEADING,
+) -> Odometry:
+    """The model a simulator draws the messages with: ``odometry``, or without one the white
+    model of ``sigma_speed`` [m/s] / ``sigma_heading`` [rad]; both a model and sigmas other than
+    the paper's are refused (the model holds its own noise)."""
+    sigma_speed = nonnegative("sigma_speed", sigma_speed)
+    sigma_heading = nonnegative("sigma_heading", sigma_heading)
+    if odometry is None:
+        return Odometry.white(sigma_speed, sigma_heading)
+    if not isinstance(odometry, Odometry):
+        raise TypeError(f"odometry: expected an Odometry or None, got {type(odometry).__name__}")
+    if (sigma_speed, sigma_heading) != (SIGMA_SPEED, SIGMA_HEADING):
+        raise ValueError(
+            "odometry, sigma_speed / sigma_heading: give the messages' model or the white "
+            "noise's sigmas, not both"
+        )
+    return odometry
 
 
 def _times(t) -> np.ndarray:
