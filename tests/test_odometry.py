@@ -8,17 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tunnelkit.odometry import (
-    AUTOMOTIVE,
-    SIGMA_HEADING,
-    SIGMA_SPEED,
-    WHITE,
-    Odometry,
-    _step,
-    _transition,
-    dead_reckoning,
-    dead_reckoning_bound,
-)
+from tunnelkit.odometry import AUTOMOTIVE, SIGMA_HEADING, SIGMA_SPEED, WHITE, Odometry
+from tunnelkit.reckoning import _step, _transition, dead_reckoning, dead_reckoning_bound
 
 DT = 0.1
 N_MC = 2000
@@ -212,3 +203,21 @@ def test_a_drive_with_lost_messages_runs_and_scores():
         simulation.simulate_drive(
             "italiano2026-straight", np.random.default_rng(8), odometry=odo, sigma_speed=0.3, **kw
         )
+
+
+def test_the_study_reports_the_drift_beside_the_bound():
+    from tunnelkit.studies.odometry import MODELS, drift, drift_rows, drift_table
+
+    d = drift(WHITE, n_drives=400, seed=0, length=2000.0)
+    mse = d.rmse**2
+    assert np.all(np.abs(mse - d.bound**2) <= 4.5 * d.mse_se + d.along**2 + 1e-12)
+    # the cosine of the heading noise: every step short by sigma^2 / 2 on average
+    short = -(1.0 - np.exp(-(SIGMA_HEADING**2) / 2)) * d.distance[-1]
+    assert abs(d.along[-1] - short) < 0.25 * abs(short)
+    rows = drift_rows(n_drives=50, seed=1, distances=(40.0, 100.0), speed=13.89)
+    assert [r["distance"] for r in rows] == [40.0, 100.0]
+    assert all(r["automotive_bound"] > r["white_bound"] > 0 for r in rows)
+    table = drift_table(rows).splitlines()
+    assert len(table) == 4 and all(m in table[0] for m in MODELS)
+    with pytest.raises(ValueError, match="distances"):
+        d.at([2500.0])
