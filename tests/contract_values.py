@@ -627,6 +627,30 @@ def _traced():
     traced_pcrlb("italiano2026-straight")
 
 
+def _odometry():
+    """The odometry model, dead reckoning and its bound on a 46-epoch drive; the drift study on
+    four drives of 100 m."""
+    from tunnelkit.odometry import Odometry, resolve
+    from tunnelkit.reckoning import dead_reckoning, dead_reckoning_bound
+    from tunnelkit.studies.odometry import drift, drift_rows, drift_table
+
+    t = np.arange(46) * 0.1
+    v, th = np.full(46, 22.0), 0.01 * t
+    odo = Odometry(
+        speed_scale=0.01, heading_bias=0.02, heading_drift=1e-4, yaw_rate_bias=5e-5, rate=10.0,
+        dropout=0.1,
+    )  # fmt: skip
+    Odometry.white(0.2, 0.02)
+    resolve(None, 0.2, 0.02)
+    odo.schedule(t)
+    s, h = odo.draw(t, v, th, np.random.default_rng(0))
+    dead_reckoning(t, s, h, np.zeros(2))
+    dead_reckoning_bound(t, v, th, odo, 0.5, np.isfinite(s))
+    d = drift(odo, n_drives=4, seed=0, length=100.0, speed=22.0, epoch_rate=10.0)
+    d.at([40.0, 100.0])
+    drift_table(drift_rows(4, 0, (40.0, 100.0)))
+
+
 def _trial(rng):
     """A Monte-Carlo trial for the runner's contract (module level: picklable)."""
     return float(rng.random())
@@ -638,6 +662,7 @@ DRIVERS = (
     _widgets,
     _signal_route,
     _studies,
+    _odometry,
     _doppler,
     _fresnel,
     _design,

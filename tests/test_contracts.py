@@ -55,6 +55,19 @@ def _doc(target, param, kinds, reason):
 ANY = r"(tunnelkit\.)?.*"
 DOCUMENTED: tuple[Documented, ...] = (
     _doc(
+        r"reckoning\.dead_reckoning|simulation\.drives\.DriveData",
+        r"speed_msg|heading_msg|speed|heading",
+        "nan",
+        "NaN marks a V2X message lost: dead reckoning holds the last one (the docstring's "
+        "contract), the tracker predicts with the last one",
+    ),
+    _doc(
+        r"reckoning\.dead_reckoning",
+        r"start|speed_msg|heading_msg",
+        "shape",
+        "leading axes are drives (the docstring's contract), each integrated alone",
+    ),
+    _doc(
         r"studies\.attribution\.(AttributionRow|ConfigSummary)",
         r".*_(deg|m|share|s)",
         "nan",

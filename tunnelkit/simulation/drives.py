@@ -29,7 +29,6 @@ from .._validate import (
     choice,
     instance,
     integer,
-    nonnegative,
     positive,
     probability,
     record,
@@ -39,6 +38,7 @@ from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..metrics import SETTLE_S, settled
+from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry, resolve
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.measurements import PathMeasurements
@@ -63,9 +63,6 @@ __all__ = [
     "simulate_drive",
     "simulate_routes",
 ]
-
-#: V2X message noise of section 4.2: speed [m/s] and heading [rad]
-SIGMA_SPEED, SIGMA_HEADING = 0.2, float(np.radians(1.0))
 
 
 @dataclass(frozen=True)
@@ -110,7 +107,7 @@ class DriveData:
 
     ``epochs[k]`` is the :class:`PathMeasurements` of epoch ``k`` (``None`` if extraction failed),
     ``truth`` (T, 3) / ``velocity`` (T, 3) the ground truth, ``speed`` / ``heading`` the V2X
-    messages, ``los`` whether the LoS path existed, ``n_true`` the traced path count,
+    messages (NaN: lost), ``los`` whether the LoS path existed, ``n_true`` the traced path count,
     ``base_station`` the reference antenna, ``truth_index`` per epoch the matched true path of
     each measurement (-1: none), ``kinds`` per epoch the surface kind of each true path and
     ``sources`` its true wave source (the UE or a VUE), shape (n, 3), ``extraction`` the
@@ -144,6 +141,7 @@ class DriveData:
             self,
             shapes=_DRIVE_SHAPES,
             positive=("clock_bias_limit",),
+            allow_nan=("speed", "heading"),  # a V2X message lost
             may_be_empty=("truth_index", "kinds", "faults", "sources"),
         )
         speeds("velocity", self.velocity)
@@ -355,6 +353,7 @@ def simulate_drive(
     n_epochs: int | None = None,
     channel: str | None = None,
     nuisance: dict | None = None,
+    odometry: Odometry | None = None,
 ) -> DriveData:
     """Drive ``route`` (a :class:`SignalRoute` or a scenario name, built with ``model``) under
     ``condition`` and measure every epoch through ``extraction`` (``rng`` explicit).
@@ -370,7 +369,8 @@ def simulate_drive(
     :meth:`SignalRoute.epoch`). An extraction failure leaves ``None`` (the tracker then predicts
     only) and is recorded in ``faults``. ``channel``: the route's channel source
     (:func:`scenario_route`; "sionna" is the ray-traced channel); ``nuisance`` the route's
-    ``second_order`` / ``diffuse_floor`` (:func:`scenario_route`).
+    ``second_order`` / ``diffuse_floor`` (:func:`scenario_route`); ``odometry`` the V2X messages'
+    model (:func:`simulate_routes`).
     """
     return simulate_routes(
         route,
@@ -383,6 +383,7 @@ def simulate_drive(
         n_epochs=n_epochs,
         channel=channel,
         nuisance=nuisance,
+        odometry=odometry,
     )[route_name(extraction)]
 
 
@@ -483,6 +484,7 @@ def simulate_routes(
     channel: str | None = None,
     nuisance: dict | None = None,
     adapters: dict | None = None,
+    odometry: Odometry | None = None,
 ) -> dict[str, DriveData]:
     """One drive (:func:`simulate_drive`) measured through every route in ``extractions``.
 
@@ -495,12 +497,13 @@ def simulate_routes(
     the epoch of ``extraction`` (one of ``extractions``) into the tracker's measurements instead
     of :func:`path_measurements` (no extra draw, the other routes unchanged); the drive's
     ``extraction`` field is that extraction. Returns ``{extraction: DriveData}``, the adapters'
-    names after the extractions.
+    names after the extractions. ``odometry``: the model of the V2X messages
+    (:class:`tunnelkit.odometry.Odometry`, NaN for a message lost); ``None``, the paper's white
+    model with ``sigma_speed`` / ``sigma_heading``, which may not be changed beside a model.
     """
     rng = rng_or_error("rng", rng)
     cond = _condition(condition)
-    sigma_speed = nonnegative("sigma_speed", sigma_speed)
-    sigma_heading = nonnegative("sigma_heading", sigma_heading)
+    odometry = resolve(odometry, sigma_speed, sigma_heading)
     if channel is not None:
         choice("channel", channel, CHANNELS)
     if n_epochs is not None:
@@ -565,8 +568,8 @@ def simulate_routes(
     if bs is None:
         bs = route.arrays[0].origin.copy()
     vel = traj.velocity[:T]
-    speed = np.linalg.norm(vel[:, :2], axis=1) + sigma_speed * rng.standard_normal(T)
-    heading = np.arctan2(vel[:, 1], vel[:, 0]) + sigma_heading * rng.standard_normal(T)
+    truth = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
+    speed, heading = odometry.draw(traj.t[:T], *truth, rng)
     return {
         name: DriveData(
             label,

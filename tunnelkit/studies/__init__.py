@@ -16,6 +16,8 @@ core never imports it (``tests/test_layout.py``):
 - :mod:`.robust_errors` — errors the tracker can trust: robust statistics of the traced
   per-path errors (median, MAD, gross errors apart) and the traced design told them
   (``docs/results/traced-robust.md``).
+- :mod:`.odometry` — dead reckoning's drift against distance driven under the paper's white
+  odometry and an automotive model, beside its posterior CRLB (``docs/results/odometry.md``).
 
 The papers' tables (``tunnelkit reproduce``) are :mod:`tunnelkit.reproduce`, the other package of
 this layer.
