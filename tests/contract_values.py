@@ -630,7 +630,7 @@ def _traced():
 def _odometry():
     """The odometry model, dead reckoning and its bound on a 46-epoch drive; the drift study on
     four drives of 100 m."""
-    from tunnelkit.odometry import Odometry, resolve
+    from tunnelkit.odometry import Odometry
     from tunnelkit.reckoning import dead_reckoning, dead_reckoning_bound
     from tunnelkit.studies.odometry import drift, drift_rows, drift_table
 
@@ -641,7 +641,6 @@ def _odometry():
         dropout=0.1,
     )  # fmt: skip
     Odometry.white(0.2, 0.02)
-    resolve(None, 0.2, 0.02)
     odo.schedule(t)
     s, h = odo.draw(t, v, th, np.random.default_rng(0))
     dead_reckoning(t, s, h, np.zeros(2))

@@ -199,9 +199,9 @@ def test_a_drive_with_lost_messages_runs_and_scores():
     )
     assert white.speed.tobytes() == same.speed.tobytes()
     assert white.heading.tobytes() == same.heading.tobytes()
-    with pytest.raises(ValueError, match="odometry, sigma_speed"):
+    with pytest.raises(TypeError, match="odometry: expected"):
         simulation.simulate_drive(
-            "italiano2026-straight", np.random.default_rng(8), odometry=odo, sigma_speed=0.3, **kw
+            "italiano2026-straight", np.random.default_rng(8), odometry=0.3, **kw
         )
 
 

@@ -24,7 +24,6 @@ __all__ = [
     "WHITE",
     "Odometry",
     "epoch_times",
-    "resolve",
 ]
 
 #: V2X message noise of section 4.2: speed [m/s] and heading [rad]
@@ -141,22 +140,6 @@ AUTOMOTIVE = Odometry(
     speed_scale=0.01, heading_bias=float(np.radians(1.0)), heading_drift=float(np.radians(0.3) / 60),
     yaw_rate_bias=float(np.radians(10.0) / 3600), rate=10.0, dropout=0.1,
 )  # fmt: skip
-
-
-def resolve(odometry: Odometry | None, sigma_speed=SIGMA_SPEED, sigma_heading=SIGMA_HEADING):
-    """The model a simulator draws the messages with: ``odometry``, or without one the white
-    model of ``sigma_speed`` [m/s] / ``sigma_heading`` [rad]; both a model and sigmas other than
-    the paper's are refused (the model holds its own noise)."""
-    sigma_speed = nonnegative("sigma_speed", sigma_speed)
-    sigma_heading = nonnegative("sigma_heading", sigma_heading)
-    if odometry is None:
-        return Odometry.white(sigma_speed, sigma_heading)
-    if not isinstance(odometry, Odometry):
-        raise TypeError(f"odometry: expected an Odometry or None, got {type(odometry).__name__}")
-    if (sigma_speed, sigma_heading) != (SIGMA_SPEED, SIGMA_HEADING):
-        msg = "give the messages' model or the white noise's sigmas, not both"
-        raise ValueError(f"odometry, sigma_speed / sigma_heading: {msg}")
-    return odometry
 
 
 def epoch_times(t) -> np.ndarray:

@@ -38,7 +38,7 @@ from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..metrics import SETTLE_S, settled
-from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry, resolve
+from ..odometry import SIGMA_HEADING, SIGMA_SPEED, WHITE, Odometry
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.measurements import PathMeasurements
@@ -348,8 +348,6 @@ def simulate_drive(
     condition: str | Condition | None = "L",
     extraction: str = "paper",
     model: str = "exact",
-    sigma_speed: float = SIGMA_SPEED,
-    sigma_heading: float = SIGMA_HEADING,
     n_epochs: int | None = None,
     channel: str | None = None,
     nuisance: dict | None = None,
@@ -378,8 +376,6 @@ def simulate_drive(
         condition=condition,
         extractions=(extraction,),
         model=model,
-        sigma_speed=sigma_speed,
-        sigma_heading=sigma_heading,
         n_epochs=n_epochs,
         channel=channel,
         nuisance=nuisance,
@@ -478,8 +474,6 @@ def simulate_routes(
     condition: str | Condition | None = "L",
     extractions: tuple[str, ...] = ("paper", "coherent", "ml"),
     model: str = "exact",
-    sigma_speed: float = SIGMA_SPEED,
-    sigma_heading: float = SIGMA_HEADING,
     n_epochs: int | None = None,
     channel: str | None = None,
     nuisance: dict | None = None,
@@ -498,12 +492,12 @@ def simulate_routes(
     of :func:`path_measurements` (no extra draw, the other routes unchanged); the drive's
     ``extraction`` field is that extraction. Returns ``{extraction: DriveData}``, the adapters'
     names after the extractions. ``odometry``: the model of the V2X messages
-    (:class:`tunnelkit.odometry.Odometry`, NaN for a message lost); ``None``, the paper's white
-    model with ``sigma_speed`` / ``sigma_heading``, which may not be changed beside a model.
+    (:class:`tunnelkit.odometry.Odometry`, NaN for a message lost); ``None``: the paper's white
+    model (:data:`tunnelkit.odometry.WHITE`).
     """
     rng = rng_or_error("rng", rng)
     cond = _condition(condition)
-    odometry = resolve(odometry, sigma_speed, sigma_heading)
+    odometry = WHITE if odometry is None else instance("odometry", odometry, Odometry)
     if channel is not None:
         choice("channel", channel, CHANNELS)
     if n_epochs is not None:
