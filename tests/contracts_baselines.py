@@ -191,6 +191,12 @@ def javelin_studies():
     simulation.collect_drives(SCENARIO, ("L",), 1, 0, n_epochs=1)
     simulation.collect_routes(SCENARIO, ("L",), 1, 0, n_epochs=1, extractions=("paper",))
     jt.javelin_table(SCENARIO, "italiano2026_table1", ("L",), 1, 0, False, ("paper",), 1)
+    from tunnelkit.reproduce import javelin_notes as jn
+
+    jn.seed_note(0)
+    jn.odometry_note("automotive")
+    jn.gain_note({"JAVELIN-L": {"our design, ML route": 1.5}})
+    jn.nuisance_note({"second_order": 2})
     reproduce.Target("contract-target", "a target", 1, lambda **kw: None)
     reproduce.register("contract-target", help="a target", default_runs=1)
     reproduce.run("jiang-crlb", runs=2)

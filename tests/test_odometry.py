@@ -221,3 +221,31 @@ def test_the_study_reports_the_drift_beside_the_bound():
     assert len(table) == 4 and all(m in table[0] for m in MODELS)
     with pytest.raises(ValueError, match="distances"):
         d.at([2500.0])
+
+
+def test_the_javelin_tables_take_a_named_odometry_and_say_so(capsys):
+    from tunnelkit.cli import main
+    from tunnelkit.reproduce import run
+
+    with pytest.raises(ValueError, match="odometry"):
+        run("jiang-crlb", runs=10, odometry="automotive")
+    with pytest.raises(ValueError, match="odometry"):
+        run("javelin-table1", runs=1, odometry="gyro")
+    assert main(["reproduce", "halili", "--runs", "1", "--odometry", "automotive"]) == 2
+    assert "--odometry" in capsys.readouterr().err
+    from tunnelkit.reproduce.javelin_tables import javelin_table
+
+    kw = {"extractions": ("ml",), "n_epochs": 12}
+    white = javelin_table("italiano2026-straight", "italiano2026_table1", ("L",), 1, 3, False, **kw)
+    auto = javelin_table(
+        "italiano2026-straight", "italiano2026_table1", ("L",), 1, 3, False,
+        odometry="automotive", **kw,
+    )  # fmt: skip
+    assert "odometry" not in white.meta and auto.meta["odometry"] == "automotive"
+    assert any("automotive odometry model" in n for n in auto.notes)
+    assert "automotive odometry" in auto.title
+    dr = (
+        {r[0]: r for r in white.rows}["dead reckoning-L"],
+        {r[0]: r for r in auto.rows}["dead reckoning-L"],
+    )
+    assert dr[0][2] != dr[1][2]  # other messages, another dead reckoning

@@ -19,6 +19,7 @@ from ._validate import finite_array, nonnegative, positive, record, rng_or_error
 
 __all__ = [
     "AUTOMOTIVE",
+    "MODELS",
     "SIGMA_HEADING",
     "SIGMA_SPEED",
     "WHITE",
@@ -140,6 +141,10 @@ AUTOMOTIVE = Odometry(
     speed_scale=0.01, heading_bias=float(np.radians(1.0)), heading_drift=float(np.radians(0.3) / 60),
     yaw_rate_bias=float(np.radians(10.0) / 3600), rate=10.0, dropout=0.1,
 )  # fmt: skip
+
+
+#: the named models (``tunnelkit reproduce javelin-table1|2 --odometry NAME``)
+MODELS = {"white": WHITE, "automotive": AUTOMOTIVE}
 
 
 def epoch_times(t) -> np.ndarray:

@@ -1,5 +1,6 @@
 """``tunnelkit reproduce TARGET [--runs N] [--seed S] [--channel image|sionna]
-[--second-order N] [--diffuse-floor] [--length METRES] [--workers N | --scheduler ADDRESS] [--format table|json]``."""
+[--second-order N] [--diffuse-floor] [--length METRES] [--odometry white|automotive]
+[--workers N | --scheduler ADDRESS] [--format table|json]``."""
 
 from __future__ import annotations
 
@@ -50,6 +51,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="METRES",
         help="drive over this many metres, ending where the preset's drive ends (e.g. 120: UE "
         "ranges 5-125 m in a lengthened tunnel; javelin-table1 only, image channel)",
+    )
+    p.add_argument(
+        "--odometry",
+        choices=["white", "automotive"],
+        default="white",
+        help="the V2X speed and heading messages' model: the paper's white noise (default) or "
+        "automotive odometry (a wheel-speed scale error, a drifting gyro heading bias, 10 Hz, "
+        "10 %% lost; tunnelkit.odometry); javelin-table1|2 only",
     )
     add_parallel_arguments(p)
 
@@ -140,6 +149,13 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.odometry != "white" and not targets()[args.target].odometries:
+        print(
+            f"tunnelkit reproduce: error: --odometry: {args.target} has no V2X messages to model "
+            "(javelin-table1|2 only)",
+            file=sys.stderr,
+        )
+        return 2
     try:
         rep = run(
             args.target,
@@ -149,6 +165,7 @@ def main(args: argparse.Namespace) -> int:
             channel=args.channel,
             nuisance=nuisance or None,
             length=args.length,
+            odometry=args.odometry,
             **parallel_kwargs(args),
         )
     except (TrialLost, RTUnavailableError) as exc:

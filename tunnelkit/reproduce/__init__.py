@@ -21,9 +21,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from .._checks import items
-from .._validate import boolean, integer, positive, record, text
+from .._validate import boolean, choice, integer, positive, record, text
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
+from ..odometry import MODELS
 from ..report import Report
 from ..runner import CONNECT_TIMEOUT_S, parallel_options
 
@@ -41,6 +42,7 @@ class Target:
     bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
     channels: tuple[str, ...] = ("image",)  #: channel sources it runs on (``fn(channel=...)``)
     lengths: bool = False  #: its drive can be lengthened (``fn(length=...)``)
+    odometries: bool = False  #: its V2X messages take a named model (``fn(odometry=...)``)
 
     def __post_init__(self) -> None:
         record(self, positive=("default_runs", "bytes_per_run"))
@@ -68,6 +70,7 @@ def register(
     bytes_per_run: int = RUN_BYTES,
     channels: tuple[str, ...] = ("image",),
     lengths: bool = False,
+    odometries: bool = False,
 ):
     """Decorator registering a reproduction target under ``name``.
 
@@ -75,9 +78,11 @@ def register(
     ``runs * bytes_per_run`` is checked against :mod:`tunnelkit.budget` before anything runs.
     ``channels``: the channel sources the target runs on; with more than "image" its function
     takes ``channel=``. ``lengths``: its drive can be lengthened (its function takes
-    ``length=``, metres).
+    ``length=``, metres). ``odometries``: its drives' V2X messages take a named model of
+    :data:`tunnelkit.odometry.MODELS` (its function takes ``odometry=``).
     """
     text("name", name), text("help", help), boolean("lengths", lengths)
+    boolean("odometries", odometries)
     integer("default_runs", default_runs, minimum=1)
     integer("bytes_per_run", bytes_per_run, minimum=1)
     [text(f"channels[{i}]", c) for i, c in enumerate(items("channels", channels, str))]
@@ -86,7 +91,14 @@ def register(
         if name in _REGISTRY:
             raise ValueError(f"name: reproduce target {name!r} registered twice")
         _REGISTRY[name] = Target(
-            name, help, default_runs, fn, bytes_per_run, tuple(channels), bool(lengths)
+            name,
+            help,
+            default_runs,
+            fn,
+            bytes_per_run,
+            tuple(channels),
+            bool(lengths),
+            bool(odometries),
         )
         return fn
 
@@ -115,6 +127,7 @@ def run(
     channel: str = "image",
     nuisance: dict | None = None,
     length: float | None = None,
+    odometry: str = "white",
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
@@ -123,7 +136,9 @@ def run(
     ``nuisance`` (those targets only): the route's ``second_order`` / ``diffuse_floor``
     (:class:`tunnelkit.signal_route.SignalRoute`). ``length`` (the targets whose drive can be
     lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
-    (:func:`tunnelkit.simulation.drives.drive_variant`, e.g. 120)."""
+    (:func:`tunnelkit.simulation.drives.drive_variant`, e.g. 120). ``odometry`` (the targets with
+    a drive: javelin-table1|2): the V2X messages' model, a name of
+    :data:`tunnelkit.odometry.MODELS` ("white", the paper's, by default; "automotive")."""
     if isinstance(name, str) and name in TARGET_MODULES:
         importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
     reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()
@@ -151,6 +166,13 @@ def run(
                 f"length: target {name!r} drives its preset only (javelin-table1 takes a length)"
             )
         on["length"] = positive("length", length)
+    if odometry != "white":
+        choice("odometry", odometry, tuple(MODELS))
+        if not tgt.odometries:
+            raise ValueError(
+                f"odometry: target {name!r} has no V2X messages to model (javelin-table1|2 do)"
+            )
+        on["odometry"] = odometry
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
     check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")

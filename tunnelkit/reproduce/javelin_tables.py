@@ -17,14 +17,23 @@ import functools
 
 import numpy as np
 
-from .._validate import boolean, instance, integer, sequence, text
+from .._validate import boolean, choice, instance, integer, sequence, text
+from ..odometry import MODELS
 from ..reference import load as load_reference
 from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
-from ..simulation.drives import FLAGGED, HELD_OUT_SEED, TUNING_SEEDS, drive_variant
+from ..simulation.drives import FLAGGED, drive_variant
 from ..simulation.scoring import evaluate, without_radio
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from . import Report, register
+from .javelin_notes import (
+    NOTES,
+    RT_NOTES,
+    gain_note,
+    nuisance_note,
+    odometry_note,
+    seed_note,
+)
 
 __all__ = [
     "COLUMNS",
@@ -175,65 +184,36 @@ def table_rows(
     return _rows(scores, reference, columns)
 
 
-NOTES = [
-    "ours: mean over runs of per-run metrics; each run is one drive through the signal route, "
-    "measured through every route from the same tensors.",
-    "route 'paper': CPD and eq. 11-24 as published (extract_paths(refine='joint')); 'ML': the "
-    "joint maximum-likelihood fit of eq. 1 (refine='ml', at the CRLB); 'coherent': the paper's "
-    "route with coherent paths separated by the array (refine='coherent').",
-    "design 'paper': section 4.2 as printed (sigma_phi = sigma_psi = 2 deg, sigma_kappa = "
-    "sigma_dd = 1.5 m, sigma_nu = 0.2 m/s, sigma_theta = 1 deg, sigma_P = 10 m, p = 0.99, "
-    "zeta = 1, gamma = 0.2, curvature of a reflection = distance to the reflection point, eq. 51). "
-    "'paper design + VUE curvature': the same parameters, the curvature of a reflection modelled "
-    "as the distance to its VUE (the exact wavefront's radius, what the ML route measures).",
-    "design 'ours' on the ML route (designs.ours_ml): Doppler clutter rejection, global "
-    "nearest neighbour, mirrored VUE motion, no update at birth, curvature centred on the VUE, "
-    "measurement noise = the RMS extraction error of the ML route measured on seed 0 drives.",
-    "Both designs start from the true first position with 1 m uncertainty (the paper's open-sky fix).",
-    "NoRRMs: road markings removed with the LoS blocked (our reading of the paper).",
-    "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails, uses its curvature only when "
-    "plausible (|d - kappa| within the clock-bias support, range within 200 m), else its delay "
-    "distance, and holds its last fix on epochs without one.",
-    f"Seeds: designs were chosen on the tuning seeds {TUNING_SEEDS} (simulation.TUNING_SEEDS); "
-    f"simulation.HELD_OUT_SEED ({HELD_OUT_SEED}) was never looked at while choosing anything.",
-]
-
-
-def seed_note(seed: int) -> str:
-    """Which kind of seed a table ran on: the held-out seed, a tuning seed (our design's column
-    is then scored on drives its choices were made on), or another seed."""
-    seed = integer("seed", seed, minimum=0)
-    if seed == HELD_OUT_SEED:
-        return f"This table: seed {seed}, the held-out seed: no design choice saw its drives."
-    if seed in TUNING_SEEDS:
-        return (
-            f"This table: seed {seed}, a tuning seed: choices of our design were made on its "
-            "drives, so the 'our design' column is not a held-out result (the held-out seed: "
-            f"--seed {HELD_OUT_SEED})."
-        )
-    return (
-        f"This table: seed {seed}, neither a tuning seed {TUNING_SEEDS} nor the held-out seed "
-        f"({HELD_OUT_SEED}): no design choice saw its drives."
-    )
-
-
 def _simulate_and_score(
-    scenario, n_epochs, extractions, columns, cond, rng, channel="image", nuisance=None, length=None
+    scenario,
+    n_epochs,
+    extractions,
+    columns,
+    cond,
+    rng,
+    channel="image",
+    nuisance=None,
+    length=None,
+    odometry="white",
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count. ``length``: the drive of :func:`~tunnelkit.simulation.drives.drive_variant` instead of
-    the preset's (built on the worker, once per process)."""
+    the preset's (built on the worker, once per process); ``odometry`` a name of
+    :data:`tunnelkit.odometry.MODELS`."""
     route = scenario if length is None else drive_variant(scenario, length)
+    odo = MODELS[odometry]
     if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced column: one more adapter
         drives = simulate_traced(
-            route, rng, condition=cond, n_epochs=n_epochs, channel=channel, nuisance=nuisance
-        )
+            route, rng, condition=cond, n_epochs=n_epochs, channel=channel, nuisance=nuisance,
+            odometry=odo,
+        )  # fmt: skip
         drives = {e: drives[e] for e in (*extractions, TRACED_COLUMN[1])}
     else:
         drives = simulate_condition(
-            route, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance
-        )
+            route, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance,
+            odometry=odo,
+        )  # fmt: skip
     faults = {
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
@@ -253,6 +233,7 @@ def javelin_table(
     channel: str = "image",
     nuisance: dict | None = None,
     length: float | None = None,
+    odometry: str = "white",
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -270,8 +251,10 @@ def javelin_table(
     against noise + diffuse power), :class:`~tunnelkit.signal_route.SignalRoute`. ``length``
     (image channel, straight lane): the drive lengthened to ``length`` metres ending where the
     preset's ends (:func:`~tunnelkit.simulation.drives.drive_variant`; 120 m: UE ranges 5-125 m);
-    ``None`` the preset's drive."""
+    ``None`` the preset's drive. ``odometry``: the V2X messages' model, a name of
+    :data:`tunnelkit.odometry.MODELS` (the paper's "white" by default)."""
     sequence("conditions", conditions)
+    choice("odometry", odometry, tuple(MODELS))
     integer("runs", runs, minimum=1)
     sequence("extractions", extractions)
     if length is not None:
@@ -299,6 +282,7 @@ def javelin_table(
             channel=channel,
             nuisance=nuisance,
             length=length,
+            odometry=odometry,
         ),
         **parallel,
     )
@@ -313,6 +297,7 @@ def javelin_table(
         length,
         rt_info,
         seed=seed,
+        odometry=odometry,
     )
 
 
@@ -325,7 +310,17 @@ def _traced_routes(extractions: tuple[str, ...], channel: str) -> tuple[str, ...
 
 
 def _report(
-    scenario, reference, conditions, extractions, done, channel, nuisance, length, rt_info, seed
+    scenario,
+    reference,
+    conditions,
+    extractions,
+    done,
+    channel,
+    nuisance,
+    length,
+    rt_info,
+    seed,
+    odometry="white",
 ):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
     (scores, faults)), ...]`` in drive order (also from a subset of whole runs); ``seed`` the
@@ -352,6 +347,8 @@ def _report(
     if length is not None:
         traj = drive_variant(scenario, length).trajectory.position
         on += f", {length:g} m drive (x = {traj[0, 0]:g} m to {traj[-1, 0]:g} m)"
+    if odometry != "white":
+        on += f", {odometry} odometry"
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}{on}: JAVELIN vs "
         "TeNFiLoc",
@@ -366,15 +363,17 @@ def _report(
             **({"drive_length_m": length} if length is not None else {}),
             **({"channel": channel, **rt_info} if channel != "image" else {}),
             **({"nuisance": dict(nuisance)} if nuisance else {}),
+            **({"odometry": odometry} if odometry != "white" else {}),
             "radio_gain": gains,
         },
         notes=[
             *NOTES,
             seed_note(seed),
-            _gain_note(gains),
-            *(_RT_NOTES if channel == "sionna" else []),
+            gain_note(gains),
+            *(RT_NOTES if channel == "sionna" else []),
             *([_traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
-            *([_nuisance_note(nuisance)] if nuisance else []),
+            *([nuisance_note(nuisance)] if nuisance else []),
+            *([odometry_note(odometry)] if odometry != "white" else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
             "(the tracker predicts only); flagged epochs per route: "
@@ -401,30 +400,6 @@ def radio_gains(columns: list[str], rows: list[list]) -> dict[str, dict[str, flo
             for label, v, b in zip(columns[2:-1], values, base, strict=True)
         }
     return out
-
-
-def _gain_note(gains: dict) -> str:
-    parts = [
-        f"{name}: " + ", ".join("-" if g is None else f"{g:.2f}x" for g in by_col.values())
-        for name, by_col in gains.items()
-    ]
-    return (
-        "Dead reckoning: the column's JAVELIN on the same drives, start and V2X speed/heading "
-        "messages with every radio measurement dropped. The radio's gain (dead reckoning's "
-        "2-D RMSE / JAVELIN's, above 1 the radio helps), columns in order: "
-        + ("; ".join(parts) if parts else "none measured")
-        + "."
-    )
-
-
-_RT_NOTES = [
-    "Ray-traced channel: each epoch's tensor is every path Sionna RT 2.2 traces per antenna "
-    "element (LoS, specular up to the scenario's max_depth, diffuse scattering; ITU concrete "
-    "shell, asphalt road as ITU very_dry_ground, metal RRMs; tunnelkit.rt.settings), in eq. 1's "
-    "sign convention (tunnelkit.rt.elements); noise and clock bias drawn per run. The number of "
-    "paths to extract and the truth are the image method's first-order specular paths; "
-    "the image channel's designs are unchanged (chosen on the image channel).",
-]
 
 
 def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
@@ -477,19 +452,6 @@ def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
     )
 
 
-def _nuisance_note(nuisance: dict) -> str:
-    n2, floor = nuisance.get("second_order", 0), nuisance.get("diffuse_floor", False)
-    return (
-        f"Route model: the first-order paths plus up to {n2} strongest second-order specular "
-        "paths the image method predicts (fitted, then left out of the tracker's measurements)"
-        + (
-            "; the ML fit tested against noise + the epoch's diffuse power (ray tracer)."
-            if floor
-            else "."
-        )
-    )
-
-
 def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     """Trace the epochs a ray-traced table needs into the cache (nothing for the image channel);
     returns the cache's numbers for the report's meta."""
@@ -526,6 +488,7 @@ def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
     bytes_per_run=1024 * 1024,
     channels=("image", "sionna"),
     lengths=True,
+    odometries=True,
 )
 def javelin_table1(
     runs: int,
@@ -534,11 +497,12 @@ def javelin_table1(
     channel: str = "image",
     nuisance: dict | None = None,
     length: float | None = None,
+    odometry: str = "white",
     **parallel,
 ) -> Report:
-    """Table 1 (straight trajectory); ``nuisance`` and ``length`` (the drive lengthened, e.g.
-    120 m: UE ranges 5-125 m; ``tunnelkit reproduce javelin-table1 --length 120``) as in
-    :func:`javelin_table`."""
+    """Table 1 (straight trajectory); ``nuisance``, ``length`` (the drive lengthened, e.g.
+    120 m: UE ranges 5-125 m; ``tunnelkit reproduce javelin-table1 --length 120``) and
+    ``odometry`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-straight",
         "italiano2026_table1",
@@ -549,6 +513,7 @@ def javelin_table1(
         channel=channel,
         nuisance=nuisance,
         length=length,
+        odometry=odometry,
         **parallel,
     )
 
@@ -560,6 +525,7 @@ def javelin_table1(
     default_runs=20,
     bytes_per_run=1024 * 1024,
     channels=("image", "sionna"),
+    odometries=True,
 )
 def javelin_table2(
     runs: int,
@@ -567,9 +533,10 @@ def javelin_table2(
     progress: bool,
     channel: str = "image",
     nuisance: dict | None = None,
+    odometry: str = "white",
     **parallel,
 ) -> Report:
-    """Table 2 (slalom trajectory); ``nuisance`` as in :func:`javelin_table`."""
+    """Table 2 (slalom trajectory); ``nuisance`` and ``odometry`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-slalom",
         "italiano2026_table2",
@@ -579,5 +546,6 @@ def javelin_table2(
         progress,
         channel=channel,
         nuisance=nuisance,
+        odometry=odometry,
         **parallel,
     )

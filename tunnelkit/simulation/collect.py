@@ -29,12 +29,14 @@ def simulate_condition(
     *,
     channel: str = "image",
     nuisance: dict | None = None,
+    odometry=None,
 ):
     """One drive of condition ``cond`` of ``scenario`` through the signal route on ``channel``
     ("image" or "sionna"), measured through every route in ``extractions``
     (:func:`~tunnelkit.simulation.drives.simulate_routes`); the argument order suits
     ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``; ``nuisance`` the route's
-    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.simulation.drives.scenario_route`)."""
+    ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.simulation.drives.scenario_route`);
+    ``odometry`` the V2X messages' model (:class:`tunnelkit.odometry.Odometry`, None: white)."""
     if cond is not None:
         text("cond", cond)
     return simulate_routes(
@@ -45,6 +47,7 @@ def simulate_condition(
         extractions=extractions,
         channel=channel,
         nuisance=nuisance,
+        odometry=odometry,
     )
 
 

@@ -17,16 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import finite_array, instance, integer, positive, positive_array, record, sequence
-from ..odometry import AUTOMOTIVE, WHITE, Odometry
+from ..odometry import MODELS, Odometry
 from ..reckoning import dead_reckoning, dead_reckoning_bound
 
 __all__ = ["DISTANCES_M", "MODELS", "Drift", "drift", "drift_rows", "drift_table"]
 
 #: the distances [m] the table reports (40 m: the shortest drive of the paper's scenarios)
 DISTANCES_M = (40.0, 100.0, 250.0, 500.0, 1000.0, 2000.0, 3000.0)
-
-#: the models compared, by name
-MODELS = {"white": WHITE, "automotive": AUTOMOTIVE}
 
 
 @dataclass(frozen=True)

@@ -103,13 +103,15 @@ def simulate_traced(
     channel: str | None = None,
     nuisance: dict | None = None,
     floors=FLOORS,
+    odometry=None,
 ) -> dict[str, DriveData]:
     """One drive of ``route`` (a :class:`SignalRoute` or a scenario name, :func:`scenario_route`
     with ``channel`` / ``nuisance``) under ``condition`` (a name of :data:`CONDITIONS`), measured
     through the paper's and the ML route as :func:`~tunnelkit.simulation.drives.simulate_routes`
     measures them (same draws, same ``"paper"`` and ``"ml"`` drives), plus ``"ml-all"`` (the ML
     route's measurements of every epoch, its fit test ignored) and ``"ml-traced"`` (those the
-    geometry pre-filter keeps, :func:`traced_measurements` with ``floors``)."""
+    geometry pre-filter keeps, :func:`traced_measurements` with ``floors``); ``odometry`` the V2X
+    messages' model (:class:`tunnelkit.odometry.Odometry`, default the paper's white model)."""
     rng = rng_or_error("rng", rng)
     if condition not in CONDITIONS:
         raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
@@ -125,6 +127,7 @@ def simulate_traced(
         n_epochs=n_epochs,
         channel=channel,
         nuisance=nuisance,
+        odometry=odometry,
         adapters={
             "ml-all": ("ml", partial(traced_measurements, floors=floors, prefilter=False)),
             "ml-traced": ("ml", partial(traced_measurements, floors=floors)),
