@@ -239,6 +239,8 @@ def _indexed_drive(
         los[k] = bool(ex[k, 0]) and model.kinds[0] == "los"
     origin = prepared.origin[:T] if origin is None else origin[:T]
     vel = traj.velocity[:T]
+    # the V2X messages of every bound-route drive (one site or a row of sites): the white model
+    # of simulation.drives (SIGMA_SPEED, SIGMA_HEADING); an odometry model plugs in here
     speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
     heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
     return DriveData(

@@ -12,7 +12,9 @@ on the same drive, start and V2X messages, dead reckoning (every measurement dro
 
 Per (array, spacing) over the settled epochs (:func:`tunnelkit.metrics.settled`) of all runs:
 the 2-D error's p90 and RMSE, the p90 at the worst point between sites (the UE's position
-relative to its serving site binned every ``bin_m`` metres; the bin of the largest p90), dead
+relative to its serving site, within half a spacing of it, binned every ``bin_m`` metres; the
+bin of the largest p90, NaN when no epoch lies that close; ``worst_offset`` its
+centre, negative towards -x), dead
 reckoning's p90 and RMSE, the radio's gain (dead reckoning's p90 over JAVELIN's) and whether
 the p90 meets ``target``. Monte-Carlo figures of the tracker, not bounds. The V2X messages are
 white (``SIGMA_SPEED``, ``SIGMA_HEADING``): the optimistic case for dead reckoning.
@@ -25,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import instance, integer, positive, sequence
+from .._validate import instance, integer, nonnegative, positive, sequence
 from ..metrics import settled
 from .arrayjob import START_HEIGHT_SIGMA_M, _median_sigmas, design_planes, javelin_config
 from .setup import DesignSetup, parse_array
@@ -46,10 +48,24 @@ class LongTunnelTrial:
     designs: tuple
     start_sigma: float = START_SIGMA_M
 
+    def __post_init__(self) -> None:
+        from ..tracking.javelin import JavelinDesign
+
+        n = len(sequence("rows", self.rows))
+        for name, cls in (("rows", SiteRow), ("routes", SiteRoute), ("designs", JavelinDesign)):
+            items = sequence(name, getattr(self, name))
+            if len(items) != n:
+                raise ValueError(f"{name}: expected {n} entries (one per row), got {len(items)}")
+            for i, x in enumerate(items):
+                if not (x is None and name == "designs"):  # None: the paper's tracker
+                    instance(f"{name}[{i}]", x, cls)
+        positive("start_sigma", self.start_sigma)
+
     def __call__(self, c: int, rng: np.random.Generator) -> np.ndarray:
         from ..simulation import evaluate, without_radio
         from ..tracking.javelin import draw_start
 
+        c = integer("c", c, minimum=0, maximum=len(self.rows) - 1)
         row, route, design = self.rows[c], self.routes[c], self.designs[c]
         drive = site_drive(row, route, rng)
         sh, s = START_HEIGHT_SIGMA_M, self.start_sigma
@@ -59,6 +75,13 @@ class LongTunnelTrial:
             ev = evaluate(d, design, sigma_p0_ue=s, start=p0, sigma_p0_height=sh)
             out.append(np.linalg.norm(ev.estimates[:, :2] - drive.truth[:, :2], axis=1))
         return np.stack(out)
+
+
+#: the keys of a row of :class:`LongTunnelResult`
+_KEYS = frozenset(
+    ("array", "spacing", "sites", "p90", "rmse", "worst_offset", "worst_p90", "dr_p90",
+     "dr_rmse", "gain", "meets")
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -73,6 +96,14 @@ class LongTunnelResult:
     runs: int
     seed: int
     wall_s: float
+
+    def __post_init__(self) -> None:
+        for i, r in enumerate(sequence("rows", self.rows)):
+            if not isinstance(r, dict) or not _KEYS <= set(r):
+                raise TypeError(f"rows[{i}]: expected a dict with keys {sorted(_KEYS)}")
+        positive("target", self.target), positive("length", self.length)
+        integer("runs", self.runs, minimum=1), integer("seed", self.seed, minimum=0)
+        nonnegative("wall_s", self.wall_s)
 
     def meeting(self) -> list[tuple[str, float]]:
         """The (array, spacing) pairs whose p90 meets the target."""
@@ -100,10 +131,15 @@ def _summary(err: np.ndarray, row: SiteRow, route: SiteRoute, bin_m: float) -> d
     """``err`` (runs, 2, T) of one configuration -> the row of :class:`LongTunnelResult`."""
     idx = settled(row.setup.trajectory.t)
     e, dr = err[:, 0, idx], err[:, 1, idx]
-    bins = np.floor(route.offset[idx] / bin_m).astype(int)
+    # between two sites: the UE no farther from its serving site than half a spacing (the
+    # stretches beyond the first and the last site are not "between sites")
+    off = route.offset[idx]
+    inner = np.abs(off) <= 0.5 * row.spacing
+    bins = np.floor(off / bin_m).astype(int)
     worst = max(
-        ((float(np.quantile(e[:, bins == b], 0.9)), b) for b in np.unique(bins)),
+        ((float(np.quantile(e[:, inner & (bins == b)], 0.9)), b) for b in np.unique(bins[inner])),
         key=lambda x: x[0],
+        default=(float("nan"), 0),
     )
     p90 = float(np.quantile(e, 0.9))
     dr_p90 = float(np.quantile(dr, 0.9))

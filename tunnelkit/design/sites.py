@@ -34,7 +34,16 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._validate import instance, integer, nonnegative, positive, record, rng_or_error
+from .._validate import (
+    finite_array,
+    instance,
+    integer,
+    nonnegative,
+    positive,
+    real,
+    record,
+    rng_or_error,
+)
 from .fastroute import SIGMA_V, _indexed_drive, bound_route
 from .setup import DesignSetup, Mount, parse_array
 from .trackerfix import REPORTS, BoundRoute
@@ -170,7 +179,7 @@ class SiteRow:
         )
         centre = float(np.mean([m.centre[0] for m in setup.mounts]))
         x0 = -half + min(0.5 * positive("spacing", spacing), half) if first is None else first
-        x0 = float(np.asarray(x0, float))
+        x0 = real("first", x0)
         if not -half < x0 < half:
             raise ValueError(f"first: x = {x0:g} m lies outside the tunnel ({-half:g}..{half:g} m)")
         mounts = []
@@ -192,7 +201,7 @@ class SiteRow:
     def serving(self, position) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """For UE positions (T, 3): the nearest site's index (T,), its distance along the axis
         (T,) [m] and whether it serves (within ``max_range``) (T,)."""
-        p = np.asarray(position, float).reshape(-1, 3)
+        p = finite_array("position", position, shape=(None, 3))
         dist = np.abs(p[:, :1] - self.centres[None, :])
         idx = np.argmin(dist, axis=1)
         d = dist[np.arange(len(p)), idx]
