@@ -3,7 +3,8 @@ wall time, and the cost per epoch of a multi-site drive against a single-site on
 
 Part ``study``: :func:`tunnelkit.design.longtunnel.long_tunnel_study` on the 28 GHz example
 tunnel, 4x4 / 8x8 / 16x16 x 100 / 200 / 400 / 800 m x ``--runs`` drives of ``--length`` m,
-``--workers`` processes; prints the Markdown table, the configurations meeting the target and
+``--workers`` processes, ``--impairments ideal`` (default) or ``calibrated`` (the design's
+default impairment set, :func:`tunnelkit.design.impairments.preset_impairments`); prints the Markdown table, the configurations meeting the target and
 the wall time. Part ``cost``: per epoch, the median over ``--repeats`` of (a) the drawn drive
 and (b) JAVELIN on it, for the preset's single-site bound drive (:func:`bound_drive`, its own
 route) and for a drive along a 200 m row (:func:`site_drive`), plus the one-off cost of each
@@ -65,12 +66,24 @@ def cost(repeats: int, spec: str = "8x8", spacing: float = 200.0, length: float 
         )
 
 
-def study(runs: int, workers: int | None, seed: int, length: float, target: float):
+def study(runs: int, workers: int | None, seed: int, length: float, target: float, imp: str):
+    from tunnelkit.design.impairments import preset_impairments
+
     setup = DesignSetup.from_scenario(SCENARIO)
+    arrays = ("4x4", "8x8", "16x16")
     res = long_tunnel_study(
-        setup, length=length, runs=runs, seed=seed, workers=workers, target=target
+        setup,
+        arrays,
+        length=length,
+        runs=runs,
+        seed=seed,
+        workers=workers,
+        target=target,
+        impairments=preset_impairments(imp, setup, arrays),
     )
-    print(f"{SCENARIO}, {length:g} m at 80 km/h, {runs} runs, seed {seed}, workers {workers}\n")
+    print(
+        f"{SCENARIO}, {imp}, {length:g} m at 80 km/h, {runs} runs, seed {seed}, workers {workers}\n"
+    )
     print(res.table())
     print(f"\nmeeting p90 <= {target:g} m: {res.meeting()}")
     print(f"wall time: {res.wall_s:.1f} s")
@@ -85,11 +98,12 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--length", type=float, default=2000.0)
     ap.add_argument("--target", type=float, default=1.0)
+    ap.add_argument("--impairments", choices=("ideal", "calibrated"), default="ideal")
     a = ap.parse_args()
     if a.part == "cost":
         cost(a.repeats)
     else:
-        study(a.runs, a.workers, a.seed, a.length, a.target)
+        study(a.runs, a.workers, a.seed, a.length, a.target, a.impairments)
 
 
 if __name__ == "__main__":

@@ -151,3 +151,28 @@ def test_long_tunnel_study_rows():
         [("4x4", 100.0)] if r["meets"] else []
     )
     assert "| 4x4 | 100 |" in res.table()
+
+
+def test_each_site_is_a_unit_of_its_own():
+    from tunnelkit.design import DesignImpairments
+
+    imp = DesignImpairments(phase_error_deg=1.5, gain_error_db=0.25)
+    # one site: the unit drawn first, as bound_drive draws it
+    setup = _setup("italiano2026-straight")
+    row1 = SiteRow(setup, 100.0)
+    a = site_drive(row1, site_route(row1, "4x4", imp), np.random.default_rng(2))
+    m = path_error_model(setup, "4x4", imp)
+    b = bound_drive(m, setup, "4x4", np.random.default_rng(2))
+    assert all(np.array_equal(x.phi, y.phi) for x, y in zip(a.epochs, b.epochs, strict=True))
+    # a row: each site's own draw moves only the epochs that site serves
+    row = _row()
+    route = site_route(row, "4x4", imp)
+    model = route.route.model
+    units = [model.draw_calibration(np.random.default_rng(10 + i)) for i in range(row.count)]
+    same = [units[0]] * row.count
+    d1 = site_drive(row, route, np.random.default_rng(3), calibration=units)
+    d0 = site_drive(row, route, np.random.default_rng(3), calibration=same)
+    moved = np.array([not np.array_equal(x.phi, y.phi) for x, y in zip(d1.epochs, d0.epochs)])
+    assert not moved[route.site == 0].any() and moved[route.site != 0].all()
+    with pytest.raises(TypeError, match="calibration"):
+        site_drive(row, route, np.random.default_rng(3), calibration=units[:1])

@@ -180,13 +180,16 @@ def _indexed_drive(
     rows: np.ndarray | None = None,
     origin: np.ndarray | None = None,
     served: np.ndarray | None = None,
+    units: np.ndarray | None = None,
 ):
     """:func:`bound_drive` on checked arguments, its first ``T`` epochs. ``rows`` (T,): the row
     of ``prepared`` (its model's epoch) each epoch of the drive draws from (``None``: epoch
     ``k`` from row ``k``); ``origin`` (T, 3): each epoch's reference antenna, then handed to the
     tracker as the epoch's ``PathMeasurements.site``; ``served`` (T,) bool: the epochs that
-    carry a measurement (the others ``None``: no site in range). A row of sites draws its
-    measurements this way from the model of one site (:mod:`tunnelkit.design.sites`)."""
+    carry a measurement (the others ``None``: no site in range); ``units`` (T,): the array unit
+    that measures each epoch, ``calibration`` then a list of every unit's draw (one per site).
+    A row of sites draws its measurements this way from the model of one site
+    (:mod:`tunnelkit.design.sites`)."""
     from ..channel import sample_clock_bias
     from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
     from ..tracking.measurements import PathMeasurements
@@ -199,7 +202,7 @@ def _indexed_drive(
         model_rows = slice(0, T)
     else:
         model_rows = rows = np.asarray(rows)[:T]
-        z = _draw_rows(model, prepared.noise_sqrt, rows, rng, calibration)
+        z = _draw_rows(model, prepared.noise_sqrt, rows, rng, calibration, units)
     ex = model.exists[model_rows]
     P = ex.shape[1]
     bias = sample_clock_bias(rng, cfg.clock_bias_sigma, cfg.clock_bias_limit, size=T)
@@ -265,13 +268,18 @@ def _indexed_drive(
     )
 
 
-def _draw_rows(model: PathErrorModel, noise_sqrt, rows, rng, calibration) -> np.ndarray:
+def _draw_rows(model: PathErrorModel, noise_sqrt, rows, rng, calibration, units=None) -> np.ndarray:
     """:meth:`PathErrorModel.draw` of the model's epochs ``rows`` (one per drive epoch, a row
     may repeat): the same order of draws (the calibration first when not given, then one
-    standard normal vector per drive epoch), so ``rows = arange(T)`` draws what ``draw`` does."""
+    standard normal vector per drive epoch), so ``rows = arange(T)`` draws what ``draw`` does.
+    ``units`` (T,): each epoch's array unit, ``calibration`` a list of their draws."""
     P = model.exists.shape[1]
-    phase, gain = model.draw_calibration(rng) if calibration is None else calibration
+    if units is None:
+        phase, gain = model.draw_calibration(rng) if calibration is None else calibration
+        cal = model.calibration_bias(phase, gain)[rows]
+    else:
+        cal = np.stack([model.calibration_bias(*c) for c in calibration])[units, rows]
     e = rng.standard_normal((len(rows), 4 * P, 1))
     noise = (noise_sqrt[rows] @ e)[..., 0].reshape(len(rows), P, 4)
-    z = (model.truth + model.bias + model.calibration_bias(phase, gain))[rows] + noise
+    z = (model.truth + model.bias)[rows] + cal + noise
     return np.where(model.exists[rows][..., None], z, np.nan)

@@ -16,7 +16,8 @@ relative to its serving site, within half a spacing of it, binned every ``bin_m`
 bin of the largest p90, NaN when no epoch lies that close; ``worst_offset`` its
 centre, negative towards -x), dead
 reckoning's p90 and RMSE, the radio's gain (dead reckoning's p90 over JAVELIN's) and whether
-the p90 meets ``target``. Monte-Carlo figures of the tracker, not bounds. The V2X messages are
+the p90 meets ``target``. Monte-Carlo figures of the tracker, not bounds. Under impairments
+each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.design.sites.site_drive`). The V2X messages are
 white (``SIGMA_SPEED``, ``SIGMA_HEADING``): the optimistic case for dead reckoning.
 """
 

@@ -292,8 +292,10 @@ def site_drive(
     :class:`tunnelkit.simulation.DriveData` of the bound route (as
     :func:`~tunnelkit.design.fastroute.bound_drive`: reported covariances, the clock bias per
     epoch, the V2X messages), each epoch's paths drawn from its row and carrying its serving
-    site (``PathMeasurements.site``); ``None`` where no site is in range. ``calibration``: the
-    unit's draw (every site's array the same unit; ``None``: drawn from ``rng``)."""
+    site (``PathMeasurements.site``); ``None`` where no site is in range. Every site's array is
+    a unit of its own: ``calibration`` a list of one
+    :meth:`~tunnelkit.design.errormodel.PathErrorModel.draw_calibration` per site (``None``:
+    drawn from ``rng``, site by site, before the drive's other draws)."""
     instance("row", row, SiteRow)
     instance("route", route, SiteRoute)
     rng = rng_or_error("rng", rng)
@@ -303,6 +305,14 @@ def site_drive(
         raise ValueError(f"route: built for {route.rows.size} epochs, the row drives {T}")
     if n_epochs is not None:
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
+    model = route.route.model
+    if calibration is None:
+        calibration = [model.draw_calibration(rng) for _ in range(row.count)]
+    elif not isinstance(calibration, list | tuple) or len(calibration) != row.count:
+        raise TypeError(
+            f"calibration: expected a list of {row.count} (phase_rad, gain_db) draws, one per "
+            "site (PathErrorModel.draw_calibration)"
+        )
     return _indexed_drive(
         route.route,
         row.setup,
@@ -313,4 +323,5 @@ def site_drive(
         rows=route.rows,
         origin=route.origin,
         served=route.served,
+        units=route.site,
     )
