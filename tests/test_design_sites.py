@@ -176,3 +176,20 @@ def test_each_site_is_a_unit_of_its_own():
     assert not moved[route.site == 0].any() and moved[route.site != 0].all()
     with pytest.raises(TypeError, match="calibration"):
         site_drive(row, route, np.random.default_rng(3), calibration=units[:1])
+
+
+def test_long_tunnel_command(capsys):
+    import json
+
+    from tunnelkit.cli import main
+
+    args = ["long-tunnel", "example-rectangular-28ghz", "--arrays", "4x4", "8x8"]
+    args += ["--spacings", "100", "--length", "250", "--runs", "1", "--format", "json"]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["impairments"] == "calibrated" and [r["array"] for r in out["rows"]] == [
+        "4x4",
+        "8x8",
+    ]
+    # every array and spacing on the same random numbers: dead reckoning the same in every row
+    assert out["rows"][0]["dr_p90"] == out["rows"][1]["dr_p90"]

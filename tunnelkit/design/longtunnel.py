@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._physical import start_spread
 from .._validate import instance, integer, nonnegative, positive, sequence
 from ..metrics import settled
 from .arrayjob import START_HEIGHT_SIGMA_M, _median_sigmas, design_planes, javelin_config
@@ -60,7 +61,7 @@ class LongTunnelTrial:
             for i, x in enumerate(items):
                 if not (x is None and name == "designs"):  # None: the paper's tracker
                     instance(f"{name}[{i}]", x, cls)
-        positive("start_sigma", self.start_sigma)
+        start_spread("start_sigma", self.start_sigma)
 
     def __call__(self, c: int, rng: np.random.Generator) -> np.ndarray:
         from ..simulation import evaluate, without_radio
@@ -68,7 +69,11 @@ class LongTunnelTrial:
 
         c = integer("c", c, minimum=0, maximum=len(self.rows) - 1)
         row, route, design = self.rows[c], self.routes[c], self.designs[c]
-        drive = site_drive(row, route, rng)
+        # the sites' units from a stream of their own (spawned: the run's stream does not move),
+        # so every array and spacing sees the same noise, clock biases and V2X messages
+        units = rng.spawn(1)[0]
+        cal = [route.route.model.draw_calibration(units) for _ in range(row.count)]
+        drive = site_drive(row, route, rng, calibration=cal)
         sh, s = START_HEIGHT_SIGMA_M, self.start_sigma
         p0 = draw_start(drive.truth[0], s, rng, sh)  # after the drive, as the design's sweep
         out = []
@@ -109,6 +114,20 @@ class LongTunnelResult:
     def meeting(self) -> list[tuple[str, float]]:
         """The (array, spacing) pairs whose p90 meets the target."""
         return [(r["array"], r["spacing"]) for r in self.rows if r["meets"]]
+
+    def to_json(self) -> dict:
+        """The result as plain JSON types."""
+        return {
+            "rows": [
+                {k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in r.items()}
+                for r in self.rows
+            ],
+            "target_m": self.target,
+            "length_m": self.length,
+            "runs": self.runs,
+            "seed": self.seed,
+            "wall_s": self.wall_s,
+        }
 
     def table(self) -> str:
         """The rows as a Markdown table."""
@@ -171,11 +190,12 @@ def long_tunnel_study(
     bin_m: float = 10.0,
     workers: int | None = None,
     scheduler: str | None = None,
+    timeout: float | None = None,
 ) -> LongTunnelResult:
     """JAVELIN and dead reckoning along a row of ``setup``'s sites for every array x spacing
     (module docstring): ``runs`` drives of ``length`` [m] at ``speed`` [m/s] each, the error
     model under ``impairments`` (default none), ``target`` [m] the p90 to meet, ``bin_m`` [m]
-    the bins of the worst point between sites; ``workers`` / ``scheduler`` as
+    the bins of the worst point between sites; ``workers`` / ``scheduler`` / ``timeout`` as
     :func:`tunnelkit.runner.run_trials`. Returns a :class:`LongTunnelResult`."""
     from ..runner import run_trials
 
@@ -184,7 +204,11 @@ def long_tunnel_study(
     gaps = [positive("spacings", s) for s in sequence("spacings", spacings)]
     if not specs or not gaps:
         raise ValueError("arrays, spacings: give at least one of each")
+    from ..budget import check_bytes
+    from ..montecarlo import RUN_BYTES
+
     runs, seed = integer("runs", runs, minimum=1), integer("seed", seed, minimum=0)
+    check_bytes("runs", runs * len(specs) * len(gaps) * RUN_BYTES, f"{runs} runs per row")
     target, bin_m = positive("target", target), positive("bin_m", bin_m)
     t0 = time.perf_counter()
     rows, routes, designs, keys = [], [], [], []
@@ -210,6 +234,7 @@ def long_tunnel_study(
         workers=workers,
         scheduler=scheduler,
         desc="long tunnel",
+        **({} if timeout is None else {"timeout": timeout}),
     )
     out = []
     for c in range(C):

@@ -150,7 +150,14 @@ class SiteRow:
         from ..propagation import lane_trajectory
 
         instance("setup", setup, DesignSetup)
-        length, speed = positive("length", length), positive("speed", speed)
+        from .._physical import MAX_RANGE_M, speeds
+
+        length = positive("length", length)
+        if length > MAX_RANGE_M:
+            raise ValueError(f"length: at most {MAX_RANGE_M:g} m, got {length:g}")
+        speed = float(speeds("speed", speed))
+        if speed <= 0:
+            raise ValueError(f"speed: must be > 0, got {speed:g}")
         half = 0.5 * length + END_MARGIN_M
         tun = setup.tunnel.without_plates().with_blockers()
         lo, hi = (float(x) for x in tun.x_range)
