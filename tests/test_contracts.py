@@ -114,6 +114,12 @@ DOCUMENTED: tuple[Documented, ...] = (
         "the tunnel's length",
     ),
     _doc(
+        r"(tunnelkit\.)?design\.sites\.SiteRow\.along",
+        r"first",
+        "negative zero",
+        "the first site's x [m], a coordinate along the tunnel: any sign, checked inside it",
+    ),
+    _doc(
         r"(tunnelkit\.)?design\.longtunnel\.LongTunnelResult",
         r"runs",
         "physical",

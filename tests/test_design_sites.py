@@ -174,6 +174,9 @@ def test_each_site_is_a_unit_of_its_own():
     d0 = site_drive(row, route, np.random.default_rng(3), calibration=same)
     moved = np.array([not np.array_equal(x.phi, y.phi) for x, y in zip(d1.epochs, d0.epochs)])
     assert not moved[route.site == 0].any() and moved[route.site != 0].all()
+    short = site_drive(row, route, np.random.default_rng(3), calibration=units, n_epochs=7)
+    assert len(short.epochs) == 7
+    assert all(np.array_equal(x.phi, y.phi) for x, y in zip(short.epochs, d1.epochs[:7]))
     with pytest.raises(TypeError, match="calibration"):
         site_drive(row, route, np.random.default_rng(3), calibration=units[:1])
 

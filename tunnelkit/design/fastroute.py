@@ -202,6 +202,7 @@ def _indexed_drive(
         model_rows = slice(0, T)
     else:
         model_rows = rows = np.asarray(rows)[:T]
+        units = None if units is None else np.asarray(units)[:T]
         z = _draw_rows(model, prepared.noise_sqrt, rows, rng, calibration, units)
     ex = model.exists[model_rows]
     P = ex.shape[1]
