@@ -23,7 +23,7 @@ import numpy as np
 
 from tunnelkit.design import DesignSetup
 from tunnelkit.design.achievable import path_error_model
-from tunnelkit.design.arrayjob import _median_sigmas, design_planes, javelin_config
+from tunnelkit.design.arrayjob import design_planes, javelin_config, median_sigmas
 from tunnelkit.design.fastroute import bound_drive, bound_route
 from tunnelkit.design.longtunnel import long_tunnel_study
 from tunnelkit.design.sites import SiteRow, site_drive, site_route
@@ -57,7 +57,7 @@ def cost(repeats: int, spec: str = "8x8", spacing: float = 200.0, length: float 
          lambda rng: site_drive(row, route2, rng)),
     )  # fmt: skip
     for name, s, r, t_model, draw in cases:
-        design = javelin_config(_median_sigmas(r.model), r.min_d, design_planes(s))
+        design = javelin_config(median_sigmas(r.model), r.min_d, design_planes(s))
         T = len(s.trajectory)
         t_drive, drive = _timed(lambda draw=draw: draw(np.random.default_rng(0)), repeats)
         t_trk, _ = _timed(lambda d=drive, g=design: evaluate(d, g), repeats)

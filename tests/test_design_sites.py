@@ -93,14 +93,14 @@ def test_no_site_in_range_leaves_the_epoch_without_measurement():
 
 
 def test_the_tracker_needs_the_serving_site():
-    from tunnelkit.design.arrayjob import _median_sigmas, design_planes, javelin_config
+    from tunnelkit.design.arrayjob import design_planes, javelin_config, median_sigmas
     from tunnelkit.simulation import evaluate
 
     row = _row(length=250.0)
     route = site_route(row, "4x4")
     drive = site_drive(row, route, np.random.default_rng(1))
     design = javelin_config(
-        _median_sigmas(route.route.model), route.route.min_d, design_planes(row.setup)
+        median_sigmas(route.route.model), route.route.min_d, design_planes(row.setup)
     )
     err = np.linalg.norm(evaluate(drive, design).estimates[:, :2] - drive.truth[:, :2], axis=1)
     for e in drive.epochs:

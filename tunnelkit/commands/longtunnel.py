@@ -18,7 +18,7 @@ import argparse
 import json
 
 from .._physical import MAX_RANGE_M, MAX_SPEED
-from .design import _count, _positive
+from .design import count_arg, positive_arg
 
 NAME = "long-tunnel"
 HELP = "a long tunnel served by a row of sites: which array and how far apart the sites"
@@ -37,27 +37,27 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--spacings",
         nargs="+",
-        type=_positive("spacings", MAX_LENGTH_M),
+        type=positive_arg("spacings", MAX_LENGTH_M),
         default=[100.0, 200.0, 400.0, 800.0],
         help="distances between sites [m] (100 200 400 800)",
     )
     p.add_argument(
         "--length",
-        type=_positive("length", MAX_LENGTH_M),
+        type=positive_arg("length", MAX_LENGTH_M),
         default=2000.0,
         help="the drive [m] (2000)",
     )
     p.add_argument(
         "--speed-kmh",
-        type=_positive("speed_kmh", 3.6 * MAX_SPEED),
+        type=positive_arg("speed_kmh", 3.6 * MAX_SPEED),
         default=80.0,
         help="the drive's constant speed [km/h] (80)",
     )
-    p.add_argument("--runs", type=_count("runs", 1), default=20, help="drives per row (20)")
-    p.add_argument("--seed", type=_count("seed", 0), default=0, help="random seed (0)")
+    p.add_argument("--runs", type=count_arg("runs", 1), default=20, help="drives per row (20)")
+    p.add_argument("--seed", type=count_arg("seed", 0), default=0, help="random seed (0)")
     p.add_argument(
         "--target",
-        type=_positive("target", MAX_RANGE_M),
+        type=positive_arg("target", MAX_RANGE_M),
         default=1.0,
         help="the p90 of the 2-D error to meet [m] (1)",
     )

@@ -167,10 +167,10 @@ def bound_drive(
         from .._validate import integer
 
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
-    return _indexed_drive(prepared, setup, rng, T, sigma_v, calibration)
+    return indexed_drive(prepared, setup, rng, T, sigma_v, calibration)
 
 
-def _indexed_drive(
+def indexed_drive(
     prepared: BoundRoute,
     setup: DesignSetup,
     rng: np.random.Generator,

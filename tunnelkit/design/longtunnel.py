@@ -31,7 +31,7 @@ import numpy as np
 from .._physical import start_spread
 from .._validate import instance, integer, nonnegative, positive, sequence
 from ..metrics import settled
-from .arrayjob import START_HEIGHT_SIGMA_M, _median_sigmas, design_planes, javelin_config
+from .arrayjob import START_HEIGHT_SIGMA_M, design_planes, javelin_config, median_sigmas
 from .setup import DesignSetup, parse_array
 from .sites import LONG_DRIVE_SPEED, SiteRoute, SiteRow, site_drive, site_route
 from .trackerfix import START_SIGMA_M
@@ -217,7 +217,7 @@ def long_tunnel_study(
         planes = design_planes(row.setup)
         for spec in specs:
             route = site_route(row, spec, impairments)
-            crlb = _median_sigmas(route.route.model)
+            crlb = median_sigmas(route.route.model)
             rows.append(row)
             routes.append(route)
             designs.append(javelin_config(crlb, route.route.min_d, planes))

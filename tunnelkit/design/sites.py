@@ -25,7 +25,7 @@ its virtual UEs (the UE mirrored in the surfaces) do not depend on the site.
 The RRM plates and blockers of a scenario are local features, not a property of the row: a row
 of more than one site refuses a setup that has them (:meth:`SiteRow.along` drops them). The
 V2X messages are the white model of :func:`tunnelkit.design.fastroute.bound_drive` (the one
-place an odometry model plugs in is :func:`~tunnelkit.design.fastroute._indexed_drive`).
+place an odometry model plugs in is :func:`~tunnelkit.design.fastroute.indexed_drive`).
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ from .._validate import (
     record,
     rng_or_error,
 )
-from .fastroute import SIGMA_V, _indexed_drive, bound_route
+from .fastroute import SIGMA_V, bound_route, indexed_drive
 from .setup import DesignSetup, Mount, parse_array
 from .trackerfix import REPORTS, BoundRoute
 
@@ -320,7 +320,7 @@ def site_drive(
             f"calibration: expected a list of {row.count} (phase_rad, gain_db) draws, one per "
             "site (PathErrorModel.draw_calibration)"
         )
-    return _indexed_drive(
+    return indexed_drive(
         route.route,
         row.setup,
         rng,
