@@ -157,4 +157,27 @@ def tracking_pieces():
     vs.VsTSWLS(exp.model, x0, P0).update(Z[0, 0])
 
 
-DRIVERS = (design_models, design_modes, design_sweep, design_traced, tracking_pieces)
+def design_sites():
+    """A row of sites along a short long-tunnel drive, its route and drive, the study on one
+    array and spacing with one run, and JAVELIN on a drive whose epochs name their site."""
+    from tunnelkit import design
+    from tunnelkit.design import longtunnel, sites
+
+    setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
+    row = sites.SiteRow.along(setup, 100.0, 150.0, speed=sites.LONG_DRIVE_SPEED)
+    sites.SiteRow(row.setup, 100.0, count=1, max_range=60.0)
+    row.serving(row.setup.trajectory.position[:3])
+    route = sites.site_route(row, "4x4", report="auto")
+    sites.SiteRoute(route.route, route.rows, route.site, route.origin, route.served, route.offset)
+    drive = sites.site_drive(row, route, np.random.default_rng(0), n_epochs=5)
+    res = longtunnel.long_tunnel_study(
+        setup, ("4x4",), (100.0,), length=150.0, runs=1, seed=0, target=1.0, bin_m=10.0
+    )
+    res.table(), res.meeting()
+    longtunnel.LongTunnelResult(res.rows, 1.0, 150.0, 1, 0, 1.0)
+    trial = longtunnel.LongTunnelTrial((row,), (route,), (None,))
+    trial(0, np.random.default_rng(0))
+    del drive
+
+
+DRIVERS = (design_models, design_modes, design_sweep, design_traced, design_sites, tracking_pieces)

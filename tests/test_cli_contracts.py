@@ -28,6 +28,7 @@ POSITIONALS = {
     "design": ["example-rectangular-28ghz"],
     "reproduce": ["jiang-crlb"],
     "mmax": [],
+    "long-tunnel": ["example-rectangular-28ghz"],
     "scenarios": [],
 }
 #: seconds a probe may take to be refused (validation is at the boundary; the first probe of a

@@ -120,6 +120,25 @@ DOCUMENTED: tuple[Documented, ...] = (
         "the drive's sample spacing [m] (not an element spacing), checked against its length",
     ),
     _doc(
+        r"(tunnelkit\.)?design\.sites\.SiteRow(\.along)?",
+        r"spacing",
+        "physical",
+        "the spacing of the sites along the tunnel [m] (not an element spacing), checked against "
+        "the tunnel's length",
+    ),
+    _doc(
+        r"(tunnelkit\.)?design\.sites\.SiteRow\.along",
+        r"first",
+        "negative zero",
+        "the first site's x [m], a coordinate along the tunnel: any sign, checked inside it",
+    ),
+    _doc(
+        r"(tunnelkit\.)?design\.longtunnel\.LongTunnelResult",
+        r"runs",
+        "physical",
+        "a count reported, nothing allocated from it",
+    ),
+    _doc(
         r"design\.verdict\.recommend",
         r"rows",
         "empty",

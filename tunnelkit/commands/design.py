@@ -61,7 +61,7 @@ def _frequency(param: str):
     return parse
 
 
-def _positive(param: str, upper: float = float("inf")):
+def positive_arg(param: str, upper: float = float("inf")):
     """argparse type: a number > 0 and finite (at most ``upper``); errors name ``param``."""
 
     def parse(text: str) -> float:
@@ -121,7 +121,7 @@ def _share(param: str):
     return parse
 
 
-def _count(param: str, minimum: int):
+def count_arg(param: str, minimum: int):
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -200,7 +200,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="candidate arrays: N (a ULA) or NxM (a URA), e.g. 4x4 8x8 16x16",
     )
     geo.add_argument(
-        "--spacing", type=_positive("spacing"), default=0.5, help="[wavelengths] (0.5)"
+        "--spacing", type=positive_arg("spacing"), default=0.5, help="[wavelengths] (0.5)"
     )
     p.add_argument("--fc", type=_frequency("fc"), default=None, help="carrier, e.g. 28GHz")
     p.add_argument("--bandwidth", type=_frequency("bandwidth"), default=None, help="e.g. 400MHz")
@@ -215,7 +215,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--target",
-        type=_positive("target", MAX_RANGE_M),
+        type=positive_arg("target", MAX_RANGE_M),
         default=0.2,
         help="position error target [m] (0.2)",
     )
@@ -272,20 +272,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "srnf: an eq. 51 estimator, SR-NF validity a gate",
     )
     rt.add_argument(
-        "--eps", type=_positive("eps", math.pi), default=0.15, help="eps_phi [rad] (0.15)"
+        "--eps", type=positive_arg("eps", math.pi), default=0.15, help="eps_phi [rad] (0.15)"
     )
     p.add_argument(
         "--units",
         "--runs",
         dest="units",
-        type=_count("units", 0),
+        type=count_arg("units", 0),
         default=0,
         help="units of the first batch (0: bounds and predictions only, no recommendation; 20 "
         "to decide); undecided arrays then get as many again until decided or --max-units",
     )
     mc.add_argument(
         "--drives-per-unit",
-        type=_count("drives_per_unit", 1),
+        type=count_arg("drives_per_unit", 1),
         default=2,
         help="drives per unit (2): a unit's own quantile pools its drives",
     )
@@ -299,7 +299,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     mc.add_argument(
         "--max-units",
-        type=_count("max_units", 1),
+        type=count_arg("max_units", 1),
         default=200,
         help="cap of the sequential rule: units per array at most (200)",
     )
@@ -342,12 +342,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "measured on that channel, not the reported CRLB; no impairments)",
     )
     mc.add_argument(
-        "--n-epochs", type=_count("n_epochs", 1), default=None, help="first N epochs of the route"
+        "--n-epochs",
+        type=count_arg("n_epochs", 1),
+        default=None,
+        help="first N epochs of the route",
     )
-    p.add_argument("--seed", type=_count("seed", 0), default=0, help="Monte-Carlo seed (0)")
+    p.add_argument("--seed", type=count_arg("seed", 0), default=0, help="Monte-Carlo seed (0)")
     mc.add_argument(
         "--start-sigma",
-        type=_positive("start_sigma"),
+        type=positive_arg("start_sigma"),
         default=None,
         help="the entry fix's standard deviation per axis [m]: the tracker's start and the prior "
         "of the bounds over the drive (default 1, an open-sky fix)",

@@ -216,7 +216,7 @@ class ArrayJob:
             drive = drive_bound(pc_w, position_bias_rms(head, g, w))
         crlb = None if self.crlbs is None else self.crlbs.get(spec.label)
         if crlb is None and m is not None:
-            crlb = _median_sigmas(m)
+            crlb = median_sigmas(m)
         if crlb is None:  # the paths the array resolves (an unresolved one is a gap)
             pb = path_bounds(self.setup, spec)
             ok = np.all([np.isfinite(pb[k]) for k in ("d", "direction", "kappa")], axis=0)
@@ -261,7 +261,7 @@ def prepared_summary(prep: Prepared) -> tuple:
     return prep.summary()
 
 
-def _median_sigmas(m: PathErrorModel) -> dict[str, float]:
+def median_sigmas(m: PathErrorModel) -> dict[str, float]:
     """Route-median standard deviations of ``d`` [m], direction [rad] and ``kappa`` [m] in a
     model's reported bound (what :func:`path_bounds` gives, without evaluating it again)."""
     T, P = m.exists.shape

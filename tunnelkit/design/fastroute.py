@@ -147,10 +147,6 @@ def bound_drive(
     array; its own ``report`` then applies): the same drive, without recomputing the array's
     share of it. ``calibration``: the unit's calibration draw
     (:meth:`PathErrorModel.draw_calibration`; ``None``: drawn from ``rng``, a unit per drive)."""
-    from ..channel import sample_clock_bias
-    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
-    from ..tracking.measurements import PathMeasurements
-
     choice("report", report, REPORTS)
     if isinstance(model, BoundRoute):
         prepared = model
@@ -162,25 +158,59 @@ def bound_drive(
             raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
     else:
         prepared = bound_route(model, setup, spec, report=report)
-    model = prepared.model
     rng = rng_or_error("rng", rng)
     sigma_v = nonnegative("sigma_v", sigma_v)
-    traj, cfg = setup.trajectory, setup.config
-    T = model.exists.shape[0]
-    if T != len(traj):
-        raise ValueError(f"model: expected {len(traj)} epochs (the route's), got {T}")
+    T = prepared.model.exists.shape[0]
+    if T != len(setup.trajectory):
+        raise ValueError(f"model: expected {len(setup.trajectory)} epochs (the route's), got {T}")
     if n_epochs is not None:
         from .._validate import integer
 
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
+    return indexed_drive(prepared, setup, rng, T, sigma_v, calibration)
+
+
+def indexed_drive(
+    prepared: BoundRoute,
+    setup: DesignSetup,
+    rng: np.random.Generator,
+    T: int,
+    sigma_v: float,
+    calibration: tuple | None,
+    rows: np.ndarray | None = None,
+    origin: np.ndarray | None = None,
+    served: np.ndarray | None = None,
+    units: np.ndarray | None = None,
+):
+    """:func:`bound_drive` on checked arguments, its first ``T`` epochs. ``rows`` (T,): the row
+    of ``prepared`` (its model's epoch) each epoch of the drive draws from (``None``: epoch
+    ``k`` from row ``k``); ``origin`` (T, 3): each epoch's reference antenna, then handed to the
+    tracker as the epoch's ``PathMeasurements.site``; ``served`` (T,) bool: the epochs that
+    carry a measurement (the others ``None``: no site in range); ``units`` (T,): the array unit
+    that measures each epoch, ``calibration`` then a list of every unit's draw (one per site).
+    A row of sites draws its measurements this way from the model of one site
+    (:mod:`tunnelkit.design.sites`)."""
+    from ..channel import sample_clock_bias
+    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
+    from ..tracking.measurements import PathMeasurements
+
+    model = prepared.model
+    traj, cfg = setup.trajectory, setup.config
     min_d = prepared.min_d
-    z = model.draw(rng, noise_sqrt=prepared.noise_sqrt, calibration=calibration)[:T]
-    ex = model.exists[:T]
+    if rows is None:
+        z = model.draw(rng, noise_sqrt=prepared.noise_sqrt, calibration=calibration)[:T]
+        model_rows = slice(0, T)
+    else:
+        model_rows = rows = np.asarray(rows)[:T]
+        units = None if units is None else np.asarray(units)[:T]
+        z = _draw_rows(model, prepared.noise_sqrt, rows, rng, calibration, units)
+    ex = model.exists[model_rows]
     P = ex.shape[1]
     bias = sample_clock_bias(rng, cfg.clock_bias_sigma, cfg.clock_bias_limit, size=T)
-    v = model.v[:T] + sigma_v * rng.standard_normal((T, P))
-    per_path = prepared.blocks[:T]
-    rep = None if prepared.repeating is None else prepared.repeating[:T]
+    v = model.v[model_rows] + sigma_v * rng.standard_normal((T, P))
+    per_path = prepared.blocks[model_rows]
+    rep = None if prepared.repeating is None else prepared.repeating[model_rows]
+    truth = model.truth[model_rows]
     epochs, tidx, kinds, los = [], [], [], np.zeros(T, bool)
     n_true = ex.sum(axis=1)
     for k in range(T):
@@ -190,9 +220,7 @@ def bound_drive(
         d = z[k, o, 3] + C * bias[k]
         blocks = per_path[k, o]  # (n, 4, 4)
         kap = z[k, o, 2]
-        kap = np.where(
-            np.sqrt(blocks[:, 2, 2]) <= KAPPA_RESOLVED * model.truth[k, o, 3], kap, np.nan
-        )
+        kap = np.where(np.sqrt(blocks[:, 2, 2]) <= KAPPA_RESOLVED * truth[k, o, 3], kap, np.nan)
         pm = PathMeasurements.from_arrays(
             z[k, o, 0],
             z[k, o, 1],
@@ -205,12 +233,18 @@ def bound_drive(
             min_d=min_d,
             bias_cov=None if rep is None else rep[k, o],
         )
+        if origin is not None:
+            pm.site = origin[k].copy()  # the serving site's reference antenna (checked: (3,))
+        if served is not None and not served[k]:
+            pm = None  # no site in range: the tracker predicts only
         epochs.append(pm)
-        tidx.append(o[pm.source])
+        tidx.append(o[pm.source] if pm is not None else np.zeros(0, dtype=int))
         kinds.append([model.kinds[p] for p in o])
         los[k] = bool(ex[k, 0]) and model.kinds[0] == "los"
-    origin = prepared.origin[:T]
+    origin = prepared.origin[:T] if origin is None else origin[:T]
     vel = traj.velocity[:T]
+    # the V2X messages of every bound-route drive (one site or a row of sites): the white model
+    # of simulation.drives (SIGMA_SPEED, SIGMA_HEADING); an odometry model plugs in here
     speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
     heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
     return DriveData(
@@ -233,3 +267,20 @@ def bound_drive(
         cfg.clock_bias_limit,
         True,
     )
+
+
+def _draw_rows(model: PathErrorModel, noise_sqrt, rows, rng, calibration, units=None) -> np.ndarray:
+    """:meth:`PathErrorModel.draw` of the model's epochs ``rows`` (one per drive epoch, a row
+    may repeat): the same order of draws (the calibration first when not given, then one
+    standard normal vector per drive epoch), so ``rows = arange(T)`` draws what ``draw`` does.
+    ``units`` (T,): each epoch's array unit, ``calibration`` a list of their draws."""
+    P = model.exists.shape[1]
+    if units is None:
+        phase, gain = model.draw_calibration(rng) if calibration is None else calibration
+        cal = model.calibration_bias(phase, gain)[rows]
+    else:
+        cal = np.stack([model.calibration_bias(*c) for c in calibration])[units, rows]
+    e = rng.standard_normal((len(rows), 4 * P, 1))
+    noise = (noise_sqrt[rows] @ e)[..., 0].reshape(len(rows), P, 4)
+    z = (model.truth + model.bias)[rows] + cal + noise
+    return np.where(model.exists[rows][..., None], z, np.nan)

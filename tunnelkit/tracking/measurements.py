@@ -93,7 +93,11 @@ class PathMeasurements:
     keeps each kept path's row in the input (the raw
     :class:`tunnelkit.extraction.PathEstimates` on the signal route, the arrays given to
     :meth:`from_arrays`). ``origin`` (3,): the world position the angles are seen from (the
-    array's reference antenna on the signal route; ``None`` when the caller did not say). The
+    array's reference antenna on the signal route; ``None`` when the caller did not say).
+    ``site`` (3,): the position the tracker evaluates this epoch's measurement model from (the
+    serving site's reference antenna on a drive along a row of sites,
+    :mod:`tunnelkit.design.sites`); ``None``: the tracker's own base station
+    (``JavelinConfig.base_station``), as on every single-site route. The
     route sorts the paths by ``d`` (path 0 the earliest arrival); ``delta_d``, ``z`` (eq. 52,
     54), ``near_field``, ``direction`` and ``wave_origins`` are derived from the fields.
 
@@ -128,6 +132,7 @@ class PathMeasurements:
     sigma_d: np.ndarray | None = None
     bias_cov: np.ndarray | None = None
     origin: np.ndarray | None = None
+    site: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # built directly (not through from_arrays): 1-D float arrays of one length, and a
@@ -159,6 +164,8 @@ class PathMeasurements:
         self.bias_cov = _bias(self.bias_cov, self.cov, self.sigma_d, n)
         if self.origin is not None:
             self.origin = vector("origin", self.origin, 3)
+        if self.site is not None:
+            self.site = vector("site", self.site, 3)
 
     @property
     def reported(self) -> bool:
@@ -210,7 +217,7 @@ class PathMeasurements:
         sub = [None if a is None else a[idx] for a in (self.cov, self.sigma_d, self.bias_cov)]
         clean = unchecked(
             PathMeasurements, self.phi[idx], self.psi[idx], kappa[idx], d[idx], v[idx],
-            self.source[idx], *sub, self.origin,
+            self.source[idx], *sub, self.origin, self.site,
         )  # fmt: skip
         return clean, len(self) - len(clean)
 
@@ -295,6 +302,7 @@ class PathMeasurements:
             None if self.sigma_d is None else self.sigma_d[idx],
             None if self.bias_cov is None else self.bias_cov[idx],
             self.origin,
+            self.site,
         )
 
     def triples(self) -> np.ndarray:

@@ -102,6 +102,7 @@ class Javelin:
         self.k = 0
         self._last_motion: tuple[float, float] | None = None
         self._predicted: tuple | None = None  # what the last predict left for the update
+        self._sites: dict[tuple, object] = {}  # the config of each serving site seen so far
 
     # -- the family protocol (tunnelkit.tracking.registry, "italiano2026") ----------------------
     @classmethod
@@ -212,12 +213,27 @@ class Javelin:
                 n_clutter += n
         return meas, n_clutter
 
-    def _fix(self, meas: PathMeasurements, j: int):
+    def _epoch_config(self, meas: PathMeasurements):
+        """The config this epoch's measurement model is evaluated with: the tracker's own, its
+        base station replaced by the epoch's serving site where the measurements name one
+        (``PathMeasurements.site``, a drive along a row of sites). The state does not change
+        with the site: a virtual UE is the UE mirrored in a surface, whichever site sees it."""
+        if meas.site is None:
+            return self.config
+        key = tuple(float(v) for v in meas.site)
+        if key == self.config.base_station:
+            return self.config
+        if key not in self._sites:
+            self._sites[key] = self.config.with_(base_station=key)
+        return self._sites[key]
+
+    def _fix(self, meas: PathMeasurements, j: int, cfg):
         """The UE's prior updated with path ``j``'s angles as its LoS by an iterated EKF
         (relinearised at its own estimate until it settles): ``(x, P, C)``. The curvature is
         left out: an extraction near its threshold reports it metres off with a sigma that
-        does not say so, and the height prior and the angles place the UE on the ray."""
-        st, cfg, roles = self.state, self.config, self.design
+        does not say so, and the height prior and the angles place the UE on the ray. ``cfg``:
+        the epoch's (:meth:`_epoch_config`)."""
+        st, roles = self.state, self.design
         kap = meas.kappa.copy()
         kap[j] = np.nan
         meas = replace(meas, kappa=kap)
@@ -234,7 +250,7 @@ class Javelin:
                 break
         return out[0], out[1], (out[3] if len(out) == 4 else st.C)
 
-    def _iterate(self, out: tuple, meas: PathMeasurements, m, los_path, C0) -> tuple:
+    def _iterate(self, out: tuple, meas: PathMeasurements, m, los_path, C0, cfg) -> tuple:
         """The epoch's update relinearised at its own estimate until it settles (an iterated
         EKF: Gauss-Newton on the prior and the epoch's rows, Bell & Cathey 1993). ``out`` is
         the update linearised at the prior (``(x, P, nis[, C])``), ``m`` its stacked
@@ -249,8 +265,9 @@ class Javelin:
         then fails the joint innovation test with true pairs for many epochs. Stops after
         ``update_iterations`` (:class:`~.config.JavelinConfig`; the array design's) or when an
         iteration moves the UE by less than :data:`UPDATE_TOLERANCE` of its posterior
-        standard deviation; the NIS stays the prior's (what the tests and the report use)."""
-        st, cfg, roles = self.state, self.config, self.design
+        standard deviation; the NIS stays the prior's (what the tests and the report use).
+        ``cfg``: the epoch's (:meth:`_epoch_config`)."""
+        st, roles = self.state, self.design
         pairs = list(dict.fromkeys((i, j) for _, i, j in m.labels))
         x0, P0 = st.x, st.P
         for _ in range(cfg.update_iterations):
@@ -268,7 +285,7 @@ class Javelin:
                 break
         return out
 
-    def _acquire(self, meas: PathMeasurements, faults: list[str]) -> int | None:
+    def _acquire(self, meas: PathMeasurements, faults: list[str], cfg) -> int | None:
         """The first fix (ours; an initiator with ``acquire``, :class:`~.surfaces.GeometricBirth`):
         before anything is associated or born, every path is tried as the LoS (:meth:`_fix`) and
         the hypothesis kept that the known surfaces explain best: a UE inside the tunnel, the
@@ -277,8 +294,9 @@ class Javelin:
         does). An open-sky fix a metre off puts the UE's prior where a reflection's wavefront is
         as likely as the LoS's, the LoS and the ceiling path differ by millimetres in delay, and
         the micro-radian angles of a large array leave a one-step EKF far from the ray. Returns
-        the path used (the epoch's update leaves it out, so it counts once), or ``None``."""
-        st, cfg, init = self.state, self.config, self.design.initiator
+        the path used (the epoch's update leaves it out, so it counts once), or ``None``.
+        ``cfg``: the epoch's (:meth:`_epoch_config`)."""
+        st, init = self.state, self.design.initiator
         if st.n_vue or not len(meas):
             return None
         x0, P0 = st.x.copy(), st.P.copy()
@@ -286,7 +304,7 @@ class Javelin:
         best = None
         for j in range(len(meas)):
             try:
-                x, P, C = self._fix(meas, j)
+                x, P, C = self._fix(meas, j, cfg)
             except (ValueError, np.linalg.LinAlgError):
                 continue
             if not init.inside(x[:3], cfg.bs):
@@ -357,7 +375,7 @@ class Javelin:
         return self._update(paths)
 
     def _update(self, paths) -> StepReport:  # warnings point at the caller of update or step
-        cfg, roles = self.config, self.design
+        roles = self.design
         nu, theta, sig_nu, motion_faults = self._predicted or (None, None, None, [])
         self._predicted = None
         faults: list[str] = []
@@ -365,9 +383,10 @@ class Javelin:
         faults += motion_faults  # the path faults first, then the motion's (as one step reports)
         known = nu is not None and sig_nu is None
         meas, n_clutter = self._prefilter(meas, nu if known else None)
+        cfg = self._epoch_config(meas)  # the serving site's measurement model
         used = None
         if self.k == 0 and getattr(roles.initiator, "acquire", False) and len(meas):
-            used = self._acquire(meas, faults)
+            used = self._acquire(meas, faults, cfg)
         st = self.state
         prior_pos, prior_ids = st.positions(), list(st.ids)
         prior_cov = [st.P[track_slice(i), track_slice(i)].copy() for i in range(st.n_tracks)]
@@ -404,7 +423,7 @@ class Javelin:
                 n_rows = m.z.size
                 out = roles.updater.update(st.x, st.P, m, st.C)
                 if n_rows and cfg.update_iterations:
-                    out = self._iterate(out, meas, m, mres.los_path, st.C)
+                    out = self._iterate(out, meas, m, mres.los_path, st.C, cfg)
                 x_new, P_new, nis = out[:3]
                 C_new = out[3] if len(out) == 4 else st.C
                 if not (np.all(np.isfinite(x_new)) and np.all(np.isfinite(P_new))):

@@ -1,0 +1,198 @@
+"""A row of sites along a long tunnel (tunnelkit.design.sites) and the study on it
+(tunnelkit.design.longtunnel)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from functools import cache
+
+import numpy as np
+import pytest
+
+from tunnelkit.design import DesignSetup
+from tunnelkit.design.achievable import path_error_model
+from tunnelkit.design.fastroute import bound_drive
+from tunnelkit.design.setup import Mount
+from tunnelkit.design.sites import SiteRow, site_drive, site_route
+from tunnelkit.scenarios import Trajectory
+
+
+@cache
+def _setup(name: str = "example-rectangular-28ghz") -> DesignSetup:
+    return DesignSetup.from_scenario(name)
+
+
+@cache
+def _row(spacing: float = 100.0, length: float = 400.0, max_range=None) -> SiteRow:
+    return SiteRow.along(_setup(), spacing, length, max_range=max_range)
+
+
+def test_one_site_row_draws_what_bound_drive_draws():
+    setup = _setup("italiano2026-straight")
+    row = SiteRow(setup, 100.0)  # the next site would stand outside the 100 m tunnel
+    assert row.count == 1
+    route = site_route(row, "8x8")
+    assert np.array_equal(route.rows, np.arange(len(setup.trajectory)))
+    a = site_drive(row, route, np.random.default_rng(5))
+    b = bound_drive(path_error_model(setup, "8x8"), setup, "8x8", np.random.default_rng(5))
+    for x, y in zip(a.epochs, b.epochs, strict=True):
+        for f in ("phi", "psi", "kappa", "d", "v", "cov", "sigma_d"):
+            assert np.array_equal(getattr(x, f), getattr(y, f), equal_nan=True), f
+        assert y.site is None and np.array_equal(x.site, b.base_station)
+    assert np.array_equal(a.speed, b.speed) and np.array_equal(a.heading, b.heading)
+
+
+def test_rows_repeat_every_spacing_and_match_a_model_of_the_moved_site():
+    row = _row()
+    traj = row.setup.trajectory
+    step = float(np.linalg.norm(traj.velocity[0]) * traj.period)
+    route = site_route(row, "4x4")
+    n_rows = route.route.model.exists.shape[0]
+    # 100 m at 80 km/h and 0.1 s is 45 steps: one spacing's positions, plus the stretches
+    # before the first and after the last site
+    assert row.count == 4 and np.isclose(100.0 / step, 45.0)
+    assert n_rows < 45 + 2 * (0.5 * 100.0 + 25.0) / step + 2
+    assert n_rows < len(traj) / 2
+    k = int(np.flatnonzero(route.site == 2)[10])
+    same = np.flatnonzero(route.rows == route.rows[k])
+    assert set(route.site[same]) >= {1, 2}  # the same row serves the same offset at two sites
+    # the row of epoch k against the model of the site moved to site 2, at that epoch alone
+    shift = np.array([2 * row.spacing, 0.0, 0.0])
+    mounts = tuple(
+        Mount(m.name, m.centre + shift, m.azimuth, m.elevation) for m in row.setup.mounts
+    )
+    one = Trajectory(t=traj.t[k : k + 1], position=traj.position[k : k + 1],
+                     velocity=traj.velocity[k : k + 1])  # fmt: skip
+    direct = path_error_model(replace(row.setup, mounts=mounts, trajectory=one), "4x4")
+    m, r = route.route.model, route.rows[k]
+    assert np.array_equal(direct.exists[0], m.exists[r])
+    ex = m.exists[r]
+    assert np.allclose(direct.truth[0][ex], m.truth[r][ex], rtol=1e-9, atol=1e-9)
+    assert np.allclose(direct.crlb[0], m.crlb[r], rtol=1e-6, atol=1e-15)
+    a0 = row.setup.arrays("4x4")
+    assert any(np.allclose(route.origin[k], a.origin + shift) for a in a0)
+
+
+def test_the_drive_carries_each_epochs_serving_site():
+    row = _row()
+    route = site_route(row, "4x4")
+    drive = site_drive(row, route, np.random.default_rng(0))
+    sites = [e.site for e in drive.epochs]
+    assert np.allclose(np.array(sites), route.origin)
+    assert len({round(float(s[0])) for s in sites}) >= row.count
+
+
+def test_no_site_in_range_leaves_the_epoch_without_measurement():
+    row = _row(max_range=30.0)
+    route = site_route(row, "4x4")
+    drive = site_drive(row, route, np.random.default_rng(0))
+    gone = np.array([e is None for e in drive.epochs])
+    assert np.array_equal(gone, ~route.served)
+    _, dist, _ = row.serving(row.setup.trajectory.position)
+    assert np.array_equal(gone, dist > 30.0) and 0 < gone.sum() < gone.size
+
+
+def test_the_tracker_needs_the_serving_site():
+    from tunnelkit.design.arrayjob import design_planes, javelin_config, median_sigmas
+    from tunnelkit.simulation import evaluate
+
+    row = _row(length=250.0)
+    route = site_route(row, "4x4")
+    drive = site_drive(row, route, np.random.default_rng(1))
+    design = javelin_config(
+        median_sigmas(route.route.model), route.route.min_d, design_planes(row.setup)
+    )
+    err = np.linalg.norm(evaluate(drive, design).estimates[:, :2] - drive.truth[:, :2], axis=1)
+    for e in drive.epochs:
+        e.site = None  # every epoch measured from the drive's last site instead
+    wrong = evaluate(drive, design).estimates
+    err_wrong = np.linalg.norm(wrong[:, :2] - drive.truth[:, :2], axis=1)
+    assert np.quantile(err, 0.9) < 0.2
+    assert np.quantile(err_wrong, 0.9) > 5 * np.quantile(err, 0.9)
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [
+        ({"spacing": 0.0}, "spacing"),
+        ({"spacing": -5.0}, "spacing"),
+        ({"spacing": 1e4}, "spacing: .* longer than the tunnel"),
+        ({"spacing": 0.01}, "spacing: .* overlap"),
+        ({"spacing": 100.0, "count": 9}, "count"),
+        ({"spacing": 100.0, "max_range": 0.0}, "max_range"),
+    ],
+)
+def test_row_refusals_name_the_parameter(kw, match):
+    setup = _row().setup
+    with pytest.raises(ValueError, match=match):
+        SiteRow(setup, **kw)
+
+
+def test_row_refuses_local_features_and_sites_outside():
+    setup = _setup("italiano2026-straight")
+    with pytest.raises(ValueError, match=r"setup: .*plates"):
+        SiteRow(setup, 40.0)  # two sites over a tunnel with RRM plates
+    with pytest.raises(ValueError, match="first"):
+        SiteRow.along(_setup(), 100.0, 400.0, first=1e3)
+    with pytest.raises(ValueError, match=r"spacing: .* 16x16 arrays .* overlap"):
+        site_route(SiteRow(_row().setup, 0.03, count=3), "16x16")
+
+
+def test_long_tunnel_study_rows():
+    from tunnelkit.design.longtunnel import long_tunnel_study
+
+    res = long_tunnel_study(_setup(), ("4x4",), (100.0,), length=250.0, runs=2, target=0.5)
+    (r,) = res.rows
+    assert r["array"] == "4x4" and r["spacing"] == 100.0 and r["sites"] == _row(length=250.0).count
+    assert r["p90"] > 0 and r["worst_p90"] > 0 and r["rmse"] > 0
+    assert abs(r["worst_offset"]) <= 50.0 + 10.0  # within half a spacing of its site
+    assert np.isclose(r["gain"], r["dr_p90"] / r["p90"])
+    assert r["meets"] == (r["p90"] <= 0.5) and res.meeting() == (
+        [("4x4", 100.0)] if r["meets"] else []
+    )
+    assert "| 4x4 | 100 |" in res.table()
+
+
+def test_each_site_is_a_unit_of_its_own():
+    from tunnelkit.design import DesignImpairments
+
+    imp = DesignImpairments(phase_error_deg=1.5, gain_error_db=0.25)
+    # one site: the unit drawn first, as bound_drive draws it
+    setup = _setup("italiano2026-straight")
+    row1 = SiteRow(setup, 100.0)
+    a = site_drive(row1, site_route(row1, "4x4", imp), np.random.default_rng(2))
+    m = path_error_model(setup, "4x4", imp)
+    b = bound_drive(m, setup, "4x4", np.random.default_rng(2))
+    assert all(np.array_equal(x.phi, y.phi) for x, y in zip(a.epochs, b.epochs, strict=True))
+    # a row: each site's own draw moves only the epochs that site serves
+    row = _row()
+    route = site_route(row, "4x4", imp)
+    model = route.route.model
+    units = [model.draw_calibration(np.random.default_rng(10 + i)) for i in range(row.count)]
+    same = [units[0]] * row.count
+    d1 = site_drive(row, route, np.random.default_rng(3), calibration=units)
+    d0 = site_drive(row, route, np.random.default_rng(3), calibration=same)
+    moved = np.array([not np.array_equal(x.phi, y.phi) for x, y in zip(d1.epochs, d0.epochs)])
+    assert not moved[route.site == 0].any() and moved[route.site != 0].all()
+    short = site_drive(row, route, np.random.default_rng(3), calibration=units, n_epochs=7)
+    assert len(short.epochs) == 7
+    assert all(np.array_equal(x.phi, y.phi) for x, y in zip(short.epochs, d1.epochs[:7]))
+    with pytest.raises(TypeError, match="calibration"):
+        site_drive(row, route, np.random.default_rng(3), calibration=units[:1])
+
+
+def test_long_tunnel_command(capsys):
+    import json
+
+    from tunnelkit.cli import main
+
+    args = ["long-tunnel", "example-rectangular-28ghz", "--arrays", "4x4", "8x8"]
+    args += ["--spacings", "100", "--length", "250", "--runs", "1", "--format", "json"]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["impairments"] == "calibrated" and [r["array"] for r in out["rows"]] == [
+        "4x4",
+        "8x8",
+    ]
+    # every array and spacing on the same random numbers: dead reckoning the same in every row
+    assert out["rows"][0]["dr_p90"] == out["rows"][1]["dr_p90"]
