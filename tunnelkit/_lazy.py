@@ -2,11 +2,11 @@
 
 A package ``__init__`` lists what it re-exports in a table, name -> defining submodule
 (``"route_bounds": "bounds"``; ``"PRESETS_ALIAS": "impairments:PRESETS"`` for a name exported
-under another), keeps its ``__all__`` and takes its module ``__getattr__`` and ``__dir__`` from
-:func:`lazy_exports`::
+under another), its ``__all__`` the table's names (one list, not two) and takes its module
+``__getattr__`` and ``__dir__`` from :func:`lazy_exports`::
 
     _EXPORTS = {"DesignSetup": "setup", "route_bounds": "bounds"}
-    __all__ = ["DesignSetup", "route_bounds"]
+    __all__ = sorted(_EXPORTS)
     __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 ``pkg.route_bounds`` and ``from pkg import route_bounds`` import ``pkg.bounds`` the first time and

@@ -23,15 +23,5 @@ _EXPORTS = {
     "rmse_study": "tables",
 }
 
-__all__ = [
-    "Scene",
-    "bound_errors",
-    "comparison_rows",
-    "match_paths",
-    "match_points",
-    "normalized_errors",
-    "path_rows",
-    "random_scene",
-    "rmse_study",
-]
+__all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

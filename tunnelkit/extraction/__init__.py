@@ -58,33 +58,5 @@ _EXPORTS = {
 }
 
 
-__all__ = [
-    "MIN_SIGNIFICANCE",
-    "ROUTES",
-    "CPDConvergenceWarning",
-    "CPDResult",
-    "PathEstimates",
-    "algorithm1",
-    "angles_from_solution",
-    "check_rank",
-    "check_tensor",
-    "cp_rel_error",
-    "cpd",
-    "crlb_paths",
-    "estimate_crlb",
-    "extract_paths",
-    "kruskal_rank",
-    "max_identifiable_rank",
-    "ml_truth",
-    "normalize_factors",
-    "paper_route",
-    "path_crlb",
-    "path_estimates",
-    "refine_joint",
-    "refine_roots",
-    "solve_far_field",
-    "solve_near_field",
-    "unwrap_spatial",
-    "vandermonde_roots",
-]
+__all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

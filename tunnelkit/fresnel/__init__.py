@@ -65,33 +65,5 @@ _EXPORTS = {
 }
 
 
-__all__ = [
-    "FC_PRESETS",
-    "M_LIMIT",
-    "M_LIMIT_URA",
-    "SECTION_4_1_TILT",
-    "ApertureProfile",
-    "MmaxSummary",
-    "aperture",
-    "aperture_profile",
-    "design_report",
-    "fraunhofer_distance",
-    "mismatch_profile",
-    "mmax_2d",
-    "mmax_3d",
-    "mmax_exact",
-    "mmax_exact_grid",
-    "mmax_exact_ura",
-    "mmax_fraunhofer",
-    "mmax_nonparaxial",
-    "mmax_summary",
-    "paraxial_ratio",
-    "phase_mismatch",
-    "phase_mismatch_ura",
-    "reference_specular_point",
-    "signed_mismatch",
-    "ula_positions",
-    "ura_positions",
-    "vue",
-]
+__all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -48,39 +48,5 @@ _EXPORTS = {
 }
 
 
-__all__ = [
-    "CONDITIONS",
-    "EXTRACTIONS",
-    "HELD_OUT_SEED",
-    "SETTLE_S",
-    "SIGMA_HEADING",
-    "SIGMA_SPEED",
-    "TUNING_SEEDS",
-    "Condition",
-    "DriveData",
-    "Evaluation",
-    "ablation",
-    "collect_drives",
-    "collect_routes",
-    "error_correlations",
-    "error_metrics",
-    "error_samples",
-    "evaluate",
-    "extraction_errors",
-    "ml_epoch",
-    "path_errors",
-    "path_measurements",
-    "per_drive",
-    "route_name",
-    "scenario_route",
-    "separate_epoch",
-    "settled",
-    "settled_errors",
-    "simulate_condition",
-    "simulate_drive",
-    "simulate_routes",
-    "tenfiloc_track",
-    "vue_prediction_errors",
-    "without_radio",
-]
+__all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

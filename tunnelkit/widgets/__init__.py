@@ -28,22 +28,5 @@ _EXPORTS = {
 }
 
 
-__all__ = [
-    "Explorer",
-    "cpd_explorer",
-    "crlb_explorer",
-    "crlb_figure",
-    "curvature_figure",
-    "curvature_study",
-    "design_explorer",
-    "design_figure",
-    "doppler_explorer",
-    "doppler_figure",
-    "epoch_explorer",
-    "epoch_view",
-    "mmax_explorer",
-    "mmax_figure",
-    "upf_explorer",
-    "upf_figure",
-]
+__all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
