@@ -196,3 +196,27 @@ def test_long_tunnel_command(capsys):
     ]
     # every array and spacing on the same random numbers: dead reckoning the same in every row
     assert out["rows"][0]["dr_p90"] == out["rows"][1]["dr_p90"]
+
+
+def test_the_messages_follow_the_odometry_model():
+    from tunnelkit.design.longtunnel import long_tunnel_study
+    from tunnelkit.odometry import AUTOMOTIVE, WHITE
+
+    row = _row(length=250.0)
+    route = site_route(row, "4x4")
+    plain = site_drive(row, route, np.random.default_rng(3))
+    white = site_drive(row, route, np.random.default_rng(3), odometry=WHITE)
+    assert np.array_equal(plain.speed, white.speed) and np.array_equal(plain.heading, white.heading)
+    car = site_drive(row, route, np.random.default_rng(3), odometry=AUTOMOTIVE)
+    assert np.isnan(car.speed).any() and not np.isnan(white.speed).any()  # 10 % of them lost
+    with pytest.raises(TypeError, match="odometry"):
+        site_drive(row, route, np.random.default_rng(3), odometry="automotive")
+    kw = {"length": 400.0, "runs": 2, "seed": 1}
+    res = {
+        o: long_tunnel_study(_setup(), ("8x8",), (200.0,), odometry=o, **kw).rows[0]
+        for o in ("white", "automotive")
+    }
+    # over 400 m a car's odometry drifts several times further than the paper's white messages
+    assert res["automotive"]["dr_p90"] > 2 * res["white"]["dr_p90"], res
+    with pytest.raises(ValueError, match="odometry"):
+        long_tunnel_study(_setup(), ("8x8",), (200.0,), odometry="gyro", **kw)

@@ -1,6 +1,6 @@
 """``tunnelkit long-tunnel SCENARIO [--arrays 4x4 8x8 16x16] [--spacings 100 200 400 800]
 [--length 2000] [--speed-kmh 80] [--runs 20] [--seed 0] [--target 1] [--ideal]
-[--workers N | --scheduler A] [--format table|json]``.
+[--odometry white|automotive] [--workers N | --scheduler A] [--format table|json]``.
 
 Which array and how far apart the sites, for a long tunnel: the scenario's site repeated every
 spacing along a drive of ``--length`` metres (:mod:`tunnelkit.design.sites`), JAVELIN and dead
@@ -9,7 +9,7 @@ reckoning on ``--runs`` drives per array and spacing on the design's bound route
 p90 and RMSE, the p90 at the worst point between sites, dead reckoning's, the radio's gain and
 whether the p90 meets ``--target``. The arrays are calibrated as ``tunnelkit design``'s default
 (``--ideal``: no impairment, the optimistic case); the V2X messages are white (the optimistic
-case for dead reckoning).
+case for dead reckoning) or, with ``--odometry automotive``, a car's odometry.
 """
 
 from __future__ import annotations
@@ -66,6 +66,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="ideal arrays (no impairment: the optimistic case) instead of calibrated ones",
     )
+    p.add_argument(
+        "--odometry",
+        choices=["white", "automotive"],
+        default="white",
+        help="the V2X speed and heading messages: the paper's white noise (default) or a car's "
+        "odometry (a wheel-speed scale error, a drifting gyro heading bias, 10 Hz, 10 %% lost)",
+    )
     p.add_argument("--format", choices=["table", "json"], default="table")
     add_parallel_arguments(p)
 
@@ -89,13 +96,15 @@ def main(args: argparse.Namespace) -> int:
         seed=args.seed,
         target=args.target,
         impairments=preset_impairments(preset, setup, specs),
+        odometry=args.odometry,
         **parallel_kwargs(args),
     )
     if args.format == "json":
         print(json.dumps({"impairments": preset, **res.to_json()}, indent=2))
         return 0
     print(
-        f"{setup.name}, {preset} arrays, a {res.length:g} m drive at {args.speed_kmh:g} km/h, "
+        f"{setup.name}, {preset} arrays, {res.odometry} odometry, a {res.length:g} m drive at "
+        f"{args.speed_kmh:g} km/h, "
         f"{res.runs} runs, seed {res.seed} (wall {res.wall_s:.0f} s)\n"
     )
     print(res.table())

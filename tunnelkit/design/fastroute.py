@@ -181,6 +181,7 @@ def indexed_drive(
     origin: np.ndarray | None = None,
     served: np.ndarray | None = None,
     units: np.ndarray | None = None,
+    odometry=None,
 ):
     """:func:`bound_drive` on checked arguments, its first ``T`` epochs. ``rows`` (T,): the row
     of ``prepared`` (its model's epoch) each epoch of the drive draws from (``None``: epoch
@@ -189,9 +190,11 @@ def indexed_drive(
     carry a measurement (the others ``None``: no site in range); ``units`` (T,): the array unit
     that measures each epoch, ``calibration`` then a list of every unit's draw (one per site).
     A row of sites draws its measurements this way from the model of one site
-    (:mod:`tunnelkit.design.sites`)."""
+    (:mod:`tunnelkit.design.sites`). ``odometry``: the V2X messages' model
+    (:class:`tunnelkit.odometry.Odometry`, checked; ``None``: the paper's white model)."""
     from ..channel import sample_clock_bias
-    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED, DriveData
+    from ..odometry import WHITE
+    from ..simulation.drives import DriveData
     from ..tracking.measurements import PathMeasurements
 
     model = prepared.model
@@ -243,10 +246,10 @@ def indexed_drive(
         los[k] = bool(ex[k, 0]) and model.kinds[0] == "los"
     origin = prepared.origin[:T] if origin is None else origin[:T]
     vel = traj.velocity[:T]
-    # the V2X messages of every bound-route drive (one site or a row of sites): the white model
-    # of simulation.drives (SIGMA_SPEED, SIGMA_HEADING); an odometry model plugs in here
-    speed = np.linalg.norm(vel[:, :2], axis=1) + SIGMA_SPEED * rng.standard_normal(T)
-    heading = np.arctan2(vel[:, 1], vel[:, 0]) + SIGMA_HEADING * rng.standard_normal(T)
+    # the V2X messages of every bound-route drive (one site or a row of sites), drawn as the
+    # drive simulator draws them (the white model: the same draws as simulation.drives)
+    truth_motion = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
+    speed, heading = (WHITE if odometry is None else odometry).draw(traj.t[:T], *truth_motion, rng)
     return DriveData(
         setup.name,
         None,

@@ -17,8 +17,10 @@ bin of the largest p90, NaN when no epoch lies that close; ``worst_offset`` its
 centre, negative towards -x), dead
 reckoning's p90 and RMSE, the radio's gain (dead reckoning's p90 over JAVELIN's) and whether
 the p90 meets ``target``. Monte-Carlo figures of the tracker, not bounds. Under impairments
-each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.design.sites.site_drive`). The V2X messages are
-white (``SIGMA_SPEED``, ``SIGMA_HEADING``): the optimistic case for dead reckoning.
+each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.design.sites.site_drive`). The V2X messages follow
+``odometry`` (a name of :data:`tunnelkit.odometry.MODELS`): the paper's white model by default,
+the optimistic case for dead reckoning, or ``"automotive"`` (a scale error and a drifting heading
+bias: dead reckoning drifts with the distance). JAVELIN is told the white noise either way.
 """
 
 from __future__ import annotations
@@ -29,8 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._physical import start_spread
-from .._validate import instance, integer, nonnegative, positive, sequence
+from .._validate import choice, instance, integer, nonnegative, positive, sequence
 from ..metrics import settled
+from ..odometry import MODELS, Odometry
 from .arrayjob import START_HEIGHT_SIGMA_M, design_planes, javelin_config, median_sigmas
 from .setup import DesignSetup, parse_array
 from .sites import LONG_DRIVE_SPEED, SiteRoute, SiteRow, site_drive, site_route
@@ -49,10 +52,12 @@ class LongTunnelTrial:
     routes: tuple
     designs: tuple
     start_sigma: float = START_SIGMA_M
+    odometry: Odometry = MODELS["white"]
 
     def __post_init__(self) -> None:
         from ..tracking.javelin import JavelinDesign
 
+        instance("odometry", self.odometry, Odometry)
         n = len(sequence("rows", self.rows))
         for name, cls in (("rows", SiteRow), ("routes", SiteRoute), ("designs", JavelinDesign)):
             items = sequence(name, getattr(self, name))
@@ -73,7 +78,7 @@ class LongTunnelTrial:
         # so every array and spacing sees the same noise, clock biases and V2X messages
         units = rng.spawn(1)[0]
         cal = [route.route.model.draw_calibration(units) for _ in range(row.count)]
-        drive = site_drive(row, route, rng, calibration=cal)
+        drive = site_drive(row, route, rng, calibration=cal, odometry=self.odometry)
         sh, s = START_HEIGHT_SIGMA_M, self.start_sigma
         p0 = draw_start(drive.truth[0], s, rng, sh)  # after the drive, as the design's sweep
         out = []
@@ -102,6 +107,7 @@ class LongTunnelResult:
     runs: int
     seed: int
     wall_s: float
+    odometry: str = "white"
 
     def __post_init__(self) -> None:
         for i, r in enumerate(sequence("rows", self.rows)):
@@ -110,6 +116,7 @@ class LongTunnelResult:
         positive("target", self.target), positive("length", self.length)
         integer("runs", self.runs, minimum=1), integer("seed", self.seed, minimum=0)
         nonnegative("wall_s", self.wall_s)
+        choice("odometry", self.odometry, tuple(MODELS))
 
     def meeting(self) -> list[tuple[str, float]]:
         """The (array, spacing) pairs whose p90 meets the target."""
@@ -127,6 +134,7 @@ class LongTunnelResult:
             "runs": self.runs,
             "seed": self.seed,
             "wall_s": self.wall_s,
+            "odometry": self.odometry,
         }
 
     def table(self) -> str:
@@ -191,12 +199,14 @@ def long_tunnel_study(
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float | None = None,
+    odometry: str = "white",
 ) -> LongTunnelResult:
     """JAVELIN and dead reckoning along a row of ``setup``'s sites for every array x spacing
     (module docstring): ``runs`` drives of ``length`` [m] at ``speed`` [m/s] each, the error
     model under ``impairments`` (default none), ``target`` [m] the p90 to meet, ``bin_m`` [m]
     the bins of the worst point between sites; ``workers`` / ``scheduler`` / ``timeout`` as
-    :func:`tunnelkit.runner.run_trials`. Returns a :class:`LongTunnelResult`."""
+    :func:`tunnelkit.runner.run_trials`; ``odometry`` the V2X messages' model, a name of
+    :data:`tunnelkit.odometry.MODELS`. Returns a :class:`LongTunnelResult`."""
     from ..runner import run_trials
 
     instance("setup", setup, DesignSetup)
@@ -210,6 +220,7 @@ def long_tunnel_study(
     runs, seed = integer("runs", runs, minimum=1), integer("seed", seed, minimum=0)
     check_bytes("runs", runs * len(specs) * len(gaps) * RUN_BYTES, f"{runs} runs per row")
     target, bin_m = positive("target", target), positive("bin_m", bin_m)
+    odometry = choice("odometry", odometry, tuple(MODELS))
     t0 = time.perf_counter()
     rows, routes, designs, keys = [], [], [], []
     for s in gaps:
@@ -223,7 +234,7 @@ def long_tunnel_study(
             designs.append(javelin_config(crlb, route.route.min_d, planes))
             keys.append(spec.label)
     C = len(rows)
-    trial = LongTunnelTrial(tuple(rows), tuple(routes), tuple(designs))
+    trial = LongTunnelTrial(tuple(rows), tuple(routes), tuple(designs), odometry=MODELS[odometry])
     res = run_trials(
         trial,
         C * runs,
@@ -244,4 +255,4 @@ def long_tunnel_study(
         out.append(r)
     out.sort(key=lambda r: (parse_array(r["array"]).n_elements, r["spacing"]))
     wall = time.perf_counter() - t0
-    return LongTunnelResult(tuple(out), target, float(length), runs, seed, wall)
+    return LongTunnelResult(tuple(out), target, float(length), runs, seed, wall, odometry)

@@ -44,6 +44,7 @@ from .._validate import (
     record,
     rng_or_error,
 )
+from ..odometry import Odometry
 from .fastroute import SIGMA_V, bound_route, indexed_drive
 from .setup import DesignSetup, Mount, parse_array
 from .trackerfix import REPORTS, BoundRoute
@@ -294,6 +295,7 @@ def site_drive(
     n_epochs: int | None = None,
     sigma_v: float = SIGMA_V,
     calibration: tuple | None = None,
+    odometry=None,
 ):
     """One drive along ``row`` measured through ``route`` (:func:`site_route`): a
     :class:`tunnelkit.simulation.DriveData` of the bound route (as
@@ -302,8 +304,11 @@ def site_drive(
     site (``PathMeasurements.site``); ``None`` where no site is in range. Every site's array is
     a unit of its own: ``calibration`` a list of one
     :meth:`~tunnelkit.design.errormodel.PathErrorModel.draw_calibration` per site (``None``:
-    drawn from ``rng``, site by site, before the drive's other draws)."""
+    drawn from ``rng``, site by site, before the drive's other draws). ``odometry``: the V2X
+    messages' model (:class:`tunnelkit.odometry.Odometry`; ``None``: the paper's white model)."""
     instance("row", row, SiteRow)
+    if odometry is not None:
+        instance("odometry", odometry, Odometry)
     instance("route", route, SiteRoute)
     rng = rng_or_error("rng", rng)
     sigma_v = nonnegative("sigma_v", sigma_v)
@@ -331,4 +336,5 @@ def site_drive(
         origin=route.origin,
         served=route.served,
         units=route.site,
+        odometry=odometry,
     )
