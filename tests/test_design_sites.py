@@ -151,6 +151,12 @@ def test_long_tunnel_study_rows():
         [("4x4", 100.0)] if r["meets"] else []
     )
     assert "| 4x4 | 100 |" in res.table()
+    # the yield: the share of the two runs whose own p90 meets the target, in its interval
+    assert r["yield"] in (0.0, 0.5, 1.0) and r["yield_ci"][0] <= r["yield"] <= r["yield_ci"][1]
+    kw = {"length": 250.0, "runs": 2}
+    easy = long_tunnel_study(_setup(), ("4x4",), (100.0,), target=1e3, **kw).rows[0]
+    hard = long_tunnel_study(_setup(), ("4x4",), (100.0,), target=1e-6, **kw).rows[0]
+    assert easy["yield"] == 1.0 and hard["yield"] == 0.0 and easy["p90"] == r["p90"]
 
 
 def test_each_site_is_a_unit_of_its_own():
