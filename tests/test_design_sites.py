@@ -226,3 +226,16 @@ def test_the_messages_follow_the_odometry_model():
     assert res["automotive"]["dr_p90"] > 2 * res["white"]["dr_p90"], res
     with pytest.raises(ValueError, match="odometry"):
         long_tunnel_study(_setup(), ("8x8",), (200.0,), odometry="gyro", **kw)
+
+
+def test_a_ue_half_a_spacing_before_a_site_maps_inside_the_first_sites_frame():
+    """At 70 km/h on the Mont Blanc preset a UE lies exactly half a spacing before a site; seen
+    from the first site that is the row's -x end. The first site's frame has room beyond it."""
+    setup = _setup("mont-blanc-28ghz")
+    row = SiteRow.along(setup, 100.0, 2000.0, speed=70.0 / 3.6)
+    route = site_route(row, "4x4")
+    assert route.rows.size == len(row.setup.trajectory) and route.served.all()
+    inner = (row.centres[0] < row.setup.trajectory.position[:, 0]) & (
+        row.setup.trajectory.position[:, 0] < row.centres[-1]
+    )
+    assert np.all(np.abs(route.offset[inner]) <= 50.0 + 1e-9)  # between sites: the nearest

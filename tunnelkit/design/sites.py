@@ -160,22 +160,7 @@ class SiteRow:
         if speed <= 0:
             raise ValueError(f"speed: must be > 0, got {speed:g}")
         half = 0.5 * length + END_MARGIN_M
-        tun = setup.tunnel.without_plates().with_blockers()
-        lo, hi = (float(x) for x in tun.x_range)
-        facets = []
-        for f in tun.facets:
-            a, b = _x_extent(f)
-            if a > lo + 1e-9 or b < hi - 1e-9:
-                raise ValueError(f"setup: facet {f.name!r} does not span the tunnel's length")
-            u, v = (np.array(e, float) for e in (f.edge_u, f.edge_v))
-            along_u = abs(u[0]) > abs(v[0])
-            e = u if along_u else v
-            scale = 2 * half / abs(e[0])
-            corner = f.corner.copy()
-            corner[0] = -half if e[0] > 0 else half
-            kw = {"edge_u": u * scale} if along_u else {"edge_v": v * scale}
-            facets.append(replace(f, corner=corner, **kw))
-        tun = replace(tun, facets=tuple(facets), x_range=(-half, half))
+        tun = _lengthened(setup.tunnel.without_plates().with_blockers(), half)
         y, h = (float(c) for c in setup.trajectory.position[0, 1:])
         traj = lane_trajectory(
             x_start=half - END_MARGIN_M,
@@ -215,6 +200,25 @@ class SiteRow:
         d = dist[np.arange(len(p)), idx]
         served = np.ones(len(p), bool) if self.max_range is None else d <= self.max_range
         return idx, d, served
+
+
+def _lengthened(tun, half: float):
+    """``tun`` (a tunnel whose facets all span its length) over x in ``(-half, half)``."""
+    lo, hi = (float(x) for x in tun.x_range)
+    facets = []
+    for f in tun.facets:
+        a, b = _x_extent(f)
+        if a > lo + 1e-9 or b < hi - 1e-9:
+            raise ValueError(f"setup: facet {f.name!r} does not span the tunnel's length")
+        u, v = (np.array(e, float) for e in (f.edge_u, f.edge_v))
+        along_u = abs(u[0]) > abs(v[0])
+        e = u if along_u else v
+        scale = 2 * half / abs(e[0])
+        corner = f.corner.copy()
+        corner[0] = -half if e[0] > 0 else half
+        kw = {"edge_u": u * scale} if along_u else {"edge_v": v * scale}
+        facets.append(replace(f, corner=corner, **kw))
+    return replace(tun, facets=tuple(facets), x_range=(-half, half))
 
 
 def _inside(setup: DesignSetup, shift: float) -> bool:
@@ -276,8 +280,14 @@ def site_route(row: SiteRow, spec, impairments=None, *, report: str = "auto") ->
     rank[order] = np.arange(order.size)
     rows = rank[np.asarray(inverse).reshape(-1)]
     rep = first[order]
+    # the first site's frame: the row's tunnel with a spacing more on each end, so that a UE
+    # half a spacing before the first site (a UE between two sites, seen from the one behind it)
+    # lies inside the tunnel rather than on its end; a path's reflection points lie between the
+    # UE and the array, so no path of a position inside the row's tunnel changes
+    half = 0.5 * float(np.ptp(row.setup.tunnel.x_range)) + row.spacing
     local = replace(
         row.setup,
+        tunnel=_lengthened(row.setup.tunnel, half),
         trajectory=Trajectory(t=traj.t[rep], position=rel[rep], velocity=traj.velocity[rep]),
     )
     model = path_error_model(local, spec, impairments)
