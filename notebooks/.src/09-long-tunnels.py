@@ -158,7 +158,7 @@ print(f"automotive RMSE passes a lane width (3.5 m) after {over_lane:.0f} m; at 
 #   leave wider standard errors). With only the messages, integrating them is as good as it gets;
 #   the biases cannot be estimated without an absolute fix. That is what a site's radio adds.
 # - **The white model's RMSE leaves its bound beyond about a kilometre**, above it by a few per
-#   cent at 3 km: every heading error $\delta\theta$ shortens a step by $v\,\Delta t\,(1 -
+#   cent at 3 km in full mode (quick mode's fewer drives cannot resolve it): every heading error $\delta\theta$ shortens a step by $v\,\Delta t\,(1 -
 #   \cos\delta\theta) \approx v\,\Delta t\,\delta\theta^2/2$, a bias along the track (printed
 #   above, about half a metre at 3 km) that the linearised bound does not hold. It is not
 #   a failure of the bound: the bound is for unbiased estimators, and dead reckoning is biased
@@ -218,9 +218,9 @@ print(f"dead reckoning alone: p90 {lt.rows[0]['dr_p90']:.1f} m over the drive")
 # hundreds; the odometry only has to bridge one epoch. As the spacing grows the UE spends more
 # of the drive far from every site, where the paths' errors grow (notebook 08), and the tracker
 # leans on the messages between sites — with a car's odometry that is where the track is lost,
-# and at the widest spacing the radio adds little over dead reckoning. The answer to the
-# operator's question is the widest spacing that still meets the target (printed above): a larger
-# array buys a wider spacing. With the paper's white messages dead reckoning would look several
+# and at the widest spacing the radio's gain over dead reckoning falls to a few (at most about
+# ten). The answer to the operator's question is the widest spacing that still meets the target
+# (printed above): a larger array buys a wider spacing (never a narrower one). With the paper's white messages dead reckoning would look several
 # times better (section 2) and a sparse row would seem to suffice; the realistic odometry is the
 # case to design for. The last column is the yield: the share of runs — each a drive of its own
 # with its own draw of every site's calibration error — whose own p90 meets the target, with its
@@ -292,16 +292,20 @@ assert np.all(np.abs(ratio["automotive"] - 1.0) < 4 * se["automotive"] + 1e-3), 
 # the white model on its bound up to 1 km, above it (the along-track bias) beyond, by a few %
 assert np.all(np.abs(ratio["white"][~far] - 1.0) < 4 * se["white"][~far] + 0.01)
 assert 0.3 < -drifts["white"].along[-1] < 0.7, drifts["white"].along[-1]
+if not tk.quick_mode():  # a few per cent above the bound at 3 km (2,000 drives resolve it)
+    assert 1.02 < ratio["white"][-1] < 1.1, ratio["white"][-1]
 # several times the white model at 40 m; past a lane width within a few hundred metres; tens of
 # metres at 3 km (about 2 % of the distance)
 assert ratio_40 > 3.0, ratio_40
 assert 100.0 < over_lane < 400.0, over_lane
 assert 0.01 < at["automotive"]["rmse"][-1] / 3000.0 < 0.03, at["automotive"]["rmse"]
-# section 3: the densest row of every array beats dead reckoning by far (a gain above 5), the
-# widest by less; dead reckoning on a car's odometry is metres off over the drive; some row meets
+# section 3: the densest row of every array beats dead reckoning by far (a gain above 10), the
+# widest by less (a few, under 15); dead reckoning on a car's odometry is metres off over the drive; some row meets
 # the 1 m target
-assert all(g > 5.0 for g in dense_gain.values()), dense_gain
-assert all(sparse_gain[a] < dense_gain[a] for a in arrays_lt), (sparse_gain, dense_gain)
+assert all(g > 10.0 for g in dense_gain.values()), dense_gain  # tens to hundreds
+assert all(sparse_gain[a] < min(dense_gain[a], 15.0) for a in arrays_lt), (sparse_gain, dense_gain)
+spans = [widest[a] or 0.0 for a in arrays_lt]  # arrays in order of size
+assert spans == sorted(spans), widest  # a larger array never needs a narrower spacing
 assert lt.rows[0]["dr_p90"] > 3.0 and lt.odometry == "automotive", lt.rows[0]
 assert any(w is not None for w in widest.values()), widest
 assert all(r["yield_ci"][0] <= r["yield"] <= r["yield_ci"][1] for r in lt.rows)

@@ -49,6 +49,7 @@ import numpy as np
 from .._physical import carrier
 from .._validate import choice, instance, nonnegative, rng_or_error
 from ..constants import C
+from ..odometry import WHITE
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .setup import DesignSetup, parse_array
@@ -193,7 +194,6 @@ def indexed_drive(
     (:mod:`tunnelkit.design.sites`). ``odometry``: the V2X messages' model
     (:class:`tunnelkit.odometry.Odometry`, checked; ``None``: the paper's white model)."""
     from ..channel import sample_clock_bias
-    from ..odometry import WHITE
     from ..simulation.drives import DriveData
     from ..tracking.measurements import PathMeasurements
 
