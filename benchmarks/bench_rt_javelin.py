@@ -36,6 +36,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.montecarlo import spawn_rngs
+from tunnelkit.odometry import MODELS
 from tunnelkit.reproduce import javelin_tables as jt
 from tunnelkit.simulation.drives import FLAGGED
 from tunnelkit.studies.traced import simulate_traced
@@ -56,8 +57,9 @@ def _score(drives: dict, cond: str) -> dict:
         return jt.score_drive({e: drives[e] for e in routes}, cond, jt.table_columns(routes))
 
 
-def drive(table: str, seed: int, i: int, n_epochs: int | None = None):
-    """Drive ``i`` of ``table`` at ``seed``: ``((cond, (scores, faults)), drives)``."""
+def drive(table: str, seed: int, i: int, n_epochs: int | None = None, odometry: str = "white"):
+    """Drive ``i`` of ``table`` at ``seed`` on the V2X messages' model ``odometry`` (a name of
+    :data:`tunnelkit.odometry.MODELS`): ``((cond, (scores, faults)), drives)``."""
     scenario, _, conds = TABLES[table]
     rng = spawn_rngs(seed, i + 1)[i]
     cond = conds[i % len(conds)]
@@ -65,7 +67,13 @@ def drive(table: str, seed: int, i: int, n_epochs: int | None = None):
     with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         drives = simulate_traced(
-            scenario, rng, condition=cond, n_epochs=n_epochs, channel="sionna", nuisance=NUISANCE
+            scenario,
+            rng,
+            condition=cond,
+            n_epochs=n_epochs,
+            channel="sionna",
+            nuisance=NUISANCE,
+            odometry=MODELS[odometry],
         )
     scores = _score(drives, cond)
     faults = {
@@ -76,7 +84,7 @@ def drive(table: str, seed: int, i: int, n_epochs: int | None = None):
     return (cond, (scores, faults)), drives
 
 
-def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None) -> None:
+def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None, odometry="white") -> None:
     for r in range(runs):
         for t in tables:
             conds = TABLES[t][2]
@@ -91,7 +99,7 @@ def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None) -> None:
                     if f.exists():
                         continue
                     t0, c0 = time.perf_counter(), time.process_time()
-                    res, drives = drive(t, s, i, n_epochs)
+                    res, drives = drive(t, s, i, n_epochs, odometry)
                     tmp = f.with_suffix(".tmp")
                     tmp.write_bytes(pickle.dumps({"result": res, "drives": drives}))
                     tmp.rename(f)
@@ -123,7 +131,9 @@ def rescore(tables, seeds, conditions, src: Path, out: Path) -> None:
                 print(f"table {t} seed {s} drive {i} ({cond}) rescored", flush=True)
 
 
-def report(table: str, seed: int, conditions, out: Path, fmt: str = "text") -> str:
+def report(
+    table: str, seed: int, conditions, out: Path, fmt: str = "text", odometry: str = "white"
+) -> str:
     scenario, ref, conds = TABLES[table]
     conds = tuple(c for c in conds if c in conditions)
     n = len(TABLES[table][2])
@@ -137,7 +147,9 @@ def report(table: str, seed: int, conditions, out: Path, fmt: str = "text") -> s
         r += 1
     if not done:
         return f"table {table} seed {seed}: no whole run saved yet in {d}"
-    rep = jt._report(scenario, ref, conds, EXTRACTIONS, done, "sionna", NUISANCE, None, {})
+    rep = jt._report(
+        scenario, ref, conds, EXTRACTIONS, done, "sionna", NUISANCE, None, {}, seed, odometry
+    )
     rep.meta = {"target": f"javelin-table{table}", "runs": r, "seed": seed, **rep.meta}
     return rep.to_json() if fmt == "json" else rep.to_table() + "\n" + json.dumps(rep.meta)
 
@@ -154,6 +166,8 @@ if __name__ == "__main__":
     ap.add_argument("--rescore", metavar="OUT", default=None,
                     help="score the drives saved in --dir again with the current designs, into OUT")  # fmt: skip
     ap.add_argument("--format", default="text", choices=("text", "json"))
+    ap.add_argument("--odometry", default="white", choices=sorted(MODELS),
+                    help="the V2X messages' model (one --dir per model)")  # fmt: skip
     a = ap.parse_args()
     out = Path(a.dir)
     if a.rescore:
@@ -161,6 +175,6 @@ if __name__ == "__main__":
     elif a.report:
         for t in a.tables:
             for s in a.seeds:
-                print(report(t, s, a.conditions, out, a.format))
+                print(report(t, s, a.conditions, out, a.format, a.odometry))
     else:
-        simulate(a.tables, a.seeds, a.runs, a.conditions, out, a.n_epochs)
+        simulate(a.tables, a.seeds, a.runs, a.conditions, out, a.n_epochs, a.odometry)

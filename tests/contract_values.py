@@ -262,6 +262,33 @@ def _studies():
     rng_ = np.linalg.norm(rel, axis=1)
     phi, psi = np.arctan2(rel[:, 1], rel[:, 0]), np.arcsin(rel[:, 2] / rng_)
     one_epoch_fix(phi, psi, rng_, paths, route.trajectory.position[10], arr.origin)
+    # paths against their truth, the amplitude profile and its study (the traced part of the
+    # study traces the scene: tests/test_aperture.py)
+    from tunnelkit.studies import aperture, nuisance, truth
+
+    tru = truth.path_truth(paths, arr)
+    truth.world_angles(np.stack([p.direction for p in paths]))
+    from tunnelkit.extraction import ml_truth
+
+    th, mf, mt = ml_truth(paths, arr, route.config)
+    est = truth.angles_of_theta(th, mf, arr, route.config)
+    idx = np.arange(len(paths))
+    truth.path_differences(est, tru, idx, idx, 0.0)
+    aperture.taper_basis(arr.local, 1)
+    from tunnelkit.channel import channel_tensor
+
+    H = channel_tensor(paths, route.config)[:, :40, :4]
+    prob = aperture.ApertureProblem(H, arr.local, route.config.fc, 1)
+    beta = np.zeros((len(paths), prob.K))
+    prob.profile(beta)
+    prob.evaluate_profile(th, mf, mt, beta, derivatives=True)
+    prob.fit(th, mf, mt, route.config.noise_power, beta=beta, max_iter=2)
+    nuisance.ModelRow("eq1", "bias", "los", 3, *[0.1] * 6, 0.05)
+    nuisance.CostRow(1, 5, 0.0, 0.0, 1.2, 1.3, 1.4, 1.0, 1.0, 1.1, 1.1)
+    nuisance.eq1_cost(
+        "italiano2026-straight", array=(4, 4), epochs=(10,), orders=(1,), draws=1,
+        rng=np.random.default_rng(0),
+    )  # fmt: skip
 
 
 def _doppler():

@@ -74,6 +74,18 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN is 'nothing measured' (no path of that kind, no noisy draw): the record's docstring",
     ),
     _doc(
+        r"studies\.nuisance\.(ModelRow|CostRow)",
+        r"(az|el|d)_(med|rms)|residual_share|bias_.*|crlb_ratio_.*|.*_over_crlb_.*",
+        "nan",
+        "NaN is 'nothing measured' (no path of that kind, no noisy draw): the record's docstring",
+    ),
+    _doc(
+        r"studies\.aperture\.(ApertureProblem|taper_basis)",
+        r"order",
+        "zero",
+        "order 0 is eq. 1 itself, the reference the profile is tested against (number for number)",
+    ),
+    _doc(
         ANY,
         r"x|y|z|y_u|z_u|x_start|x_end|start|stop|lane|offset|x_center|y_center|origin"
         r"|x0|y_right|lane_y|tx_y",

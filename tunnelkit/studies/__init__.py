@@ -13,6 +13,10 @@ core never imports it (``tests/test_layout.py``):
 - :mod:`.attribution` — what eq. 1 misses on the traced channel: each mechanism of the ray
   tracer switched off in turn, its pseudo-true bias, extraction error and position cost
   (``docs/results/traced-attribution.md``).
+- :mod:`.nuisance` — a model that absorbs what eq. 1 misses: the first-order pseudo-true bias on
+  the traced channel under eq. 1, an amplitude profile across the aperture (:mod:`.aperture`)
+  and second-order nuisance atoms, and the profile's cost where eq. 1 holds
+  (``docs/results/traced-models.md``); :mod:`.truth` compares paths with their truth;
 - :mod:`.robust_errors` — errors the tracker can trust: robust statistics of the traced
   per-path errors (median, MAD, gross errors apart) and the traced design told them
   (``docs/results/traced-robust.md``).

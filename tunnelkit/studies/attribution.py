@@ -56,6 +56,7 @@ from .._validate import (
     text,
 )
 from ..constants import C
+from .truth import angles_of_theta, path_differences, path_truth, world_angles
 
 __all__ = [
     "CONFIGURATIONS",
@@ -299,45 +300,6 @@ def config_settings(base, name: str):
     return dataclasses.replace(base, **CONFIGURATIONS[name][1])
 
 
-def _angles(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    u = np.atleast_2d(u)
-    return np.arctan2(u[:, 1], u[:, 0]), np.arcsin(np.clip(u[:, 2], -1.0, 1.0))
-
-
-def _truth(paths, arr) -> dict:
-    """World azimuth, elevation [rad], ``d`` [m] and ``kappa`` [m] of the true paths."""
-    phi, psi = _angles(np.stack([p.direction for p in paths]))
-    kap = np.array([np.linalg.norm(p.source - arr.origin) for p in paths])
-    return {"phi": phi, "psi": psi, "d": np.array([p.length for p in paths]), "kappa": kap}
-
-
-def _from_theta(theta, mu_f, arr, cfg) -> dict:
-    """The same from the ML parametrisation (local direction cosines, curvature, ``mu_f``)."""
-    ux, uy = theta[:, 0], theta[:, 1]
-    u = np.column_stack([ux, uy, np.sqrt(np.clip(1 - ux**2 - uy**2, 0, 1))])
-    phi, psi = _angles(arr.dir_to_world(u))
-    with np.errstate(divide="ignore"):
-        kap = np.where(theta[:, 2] > 0, 1.0 / theta[:, 2], np.inf)
-    return {"phi": phi, "psi": psi, "d": -C * mu_f / (2 * np.pi * cfg.tone_spacing), "kappa": kap}
-
-
-def _wrap(x):
-    return np.angle(np.exp(1j * np.asarray(x)))
-
-
-def _differences(est: dict, tru: dict, rows, cols, d_offset: float = 0.0) -> np.ndarray:
-    """(n, 4) errors of estimates ``rows`` against truths ``cols``: azimuth, elevation [deg],
-    ``d - d_offset`` [m], ``kappa`` [m] (inf where the estimate is a far-field wave)."""
-    return np.column_stack(
-        [
-            np.degrees(_wrap(est["phi"][rows] - tru["phi"][cols])),
-            np.degrees(est["psi"][rows] - tru["psi"][cols]),
-            est["d"][rows] - d_offset - tru["d"][cols],
-            est["kappa"][rows] - tru["kappa"][cols],
-        ]
-    )
-
-
 def _check_sigmas(sigmas) -> np.ndarray:
     sig = finite_array("sigmas", sigmas, shape=(3,))
     if np.any(sig <= 0):
@@ -377,7 +339,7 @@ def one_epoch_fix(phi, psi, d, paths, ue, origin, sigmas=FIX_SIGMAS) -> np.ndarr
             r = float(np.linalg.norm(rel))
             a, e = math.atan2(rel[1], rel[0]), math.asin(rel[2] / r)
             out += [
-                float(_wrap(phi[j] - a)) / sig[0],
+                float(np.angle(np.exp(1j * (phi[j] - a)))) / sig[0],
                 (psi[j] - e) / sig[1],
                 (d[j] - r - x[2]) / sig[2],
             ]
@@ -440,13 +402,13 @@ def _measure(name, label, route, epochs, draws, rng, tensor_of, sigmas, progress
     for k in epochs:
         arr, paths = route.paths(k)
         H0, draw = tensor_of(k, arr, paths)
-        tru = _truth(paths, arr)
+        tru = path_truth(paths, arr)
         kinds = [p.surface_kind for p in paths]
         pt = pseudo_true(H0, arr.local, cfg.fc, ml_truth(paths, arr, cfg),
                          noise_power=cfg.noise_power)  # fmt: skip
-        est = _from_theta(pt["theta"], pt["mu_f"], arr, cfg)
+        est = angles_of_theta(pt["theta"], pt["mu_f"], arr, cfg)
         idx = np.arange(len(paths))
-        for j, e in enumerate(_differences(est, tru, idx, idx)):
+        for j, e in enumerate(path_differences(est, tru, idx, idx)):
             bias.append((kinds[j], e))
         shares.append(pt["residual_power"] / float(np.mean(np.abs(H0) ** 2)))
         conv.append(bool(pt["converged"]))
@@ -457,12 +419,12 @@ def _measure(name, label, route, epochs, draws, rng, tensor_of, sigmas, progress
             snap = draw(rng)
             fit = _extract(route, snap.H, arr, len(paths))
             u = arr.dir_to_world(fit.direction)
-            phi, psi = _angles(u)
+            phi, psi = world_angles(u)
             e = {"phi": phi, "psi": psi, "d": np.asarray(fit.d, float),
                  "kappa": np.where(np.isfinite(fit.kappa), fit.kappa, np.inf)}  # fmt: skip
             t = match_paths(fit.d, u, paths, clock_bias=snap.clock_bias)
             rows = np.flatnonzero(t >= 0)
-            for r, x in zip(rows, _differences(e, tru, rows, t[rows], C * snap.clock_bias),
+            for r, x in zip(rows, path_differences(e, tru, rows, t[rows], C * snap.clock_bias),
                             strict=True):  # fmt: skip
                 errs.append((kinds[t[r]], x))
             sel = [paths[t[r]] for r in rows]
