@@ -283,7 +283,7 @@ def _studies():
     prob.profile(beta)
     prob.evaluate_profile(th, mf, mt, beta, derivatives=True)
     prob.fit(th, mf, mt, route.config.noise_power, beta=beta, max_iter=2)
-    nuisance.ModelRow("eq1", "bias", "los", 3, *[0.1] * 6, 0.05)
+    nuisance.ModelRow("eq1", "error", "all", 3, *[0.1] * 6, 0.05, 1.0, 2.0, 0.5)
     nuisance.CostRow(1, 5, 0.0, 0.0, 1.2, 1.3, 1.4, 1.0, 1.0, 1.1, 1.1)
     nuisance.eq1_cost(
         "italiano2026-straight", array=(4, 4), epochs=(10,), orders=(1,), draws=1,

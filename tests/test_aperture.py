@@ -131,3 +131,5 @@ def test_traced_bias_tiny_case(tmp_path):
     assert set(errors) == {"eq1", "aperture-1", "second-order-2"}
     # every model's error rows are errors of matched first-order paths: finite, under 90 deg
     assert all(0 <= r.az_med < 90 and 0 <= r.d_med < 50 for r in errors.values())
+    # the one-epoch fix is reported on the pooled rows only
+    assert all(np.isfinite(r.fix_med_m) == (r.kind == "all") for r in rows)

@@ -75,7 +75,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(
         r"studies\.nuisance\.(ModelRow|CostRow)",
-        r"(az|el|d)_(med|rms)|residual_share|bias_.*|crlb_ratio_.*|.*_over_crlb_.*",
+        r"(az|el|d)_(med|rms)|residual_share|fix_(med|rms)_m|extract_s|bias_.*|crlb_ratio_.*|.*_over_crlb_.*",
         "nan",
         "NaN is 'nothing measured' (no path of that kind, no noisy draw): the record's docstring",
     ),

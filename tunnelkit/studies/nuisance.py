@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -42,7 +43,7 @@ from ..extraction.ml import Problem, fit_problem, start_from_estimates
 from ..propagation import SECOND_ORDER
 from ..signal_route import SignalRoute
 from .aperture import MAX_ORDER, ApertureProblem
-from .attribution import KINDS, scenario_with_array
+from .attribution import KINDS, one_epoch_fix, scenario_with_array
 from .misspecified import pseudo_true
 from .truth import angles_of_theta, path_differences, path_truth
 
@@ -58,7 +59,12 @@ class ModelRow:
     RMS of |x| in world azimuth and elevation [deg] and the delay distance ``d`` [m], ``x`` the
     pseudo-true bias (``measure = "bias"``) or the noisy extraction's error (``"error"``), and
     the median share of the tensor's power the model leaves at its pseudo-true parameters (over
-    all epochs, the same in every kind and measure)."""
+    all epochs, the same in every kind and measure). Rows of kind ``"all"`` also give the
+    horizontal error [m] of a one-epoch fix (:func:`~.attribution.one_epoch_fix`, its weights,
+    the oracle association of the attribution study) from the pseudo-true parameters (``bias``)
+    or from each noisy extraction (``error``): median and RMS over epochs and draws; NaN in the
+    other rows. ``extract_s``: the median wall time [s] of one noisy extraction under the model
+    (``error`` rows; NaN for ``bias``)."""
 
     model: str
     measure: str
@@ -71,6 +77,9 @@ class ModelRow:
     d_med: float
     d_rms: float
     residual_share: float
+    fix_med_m: float
+    fix_rms_m: float
+    extract_s: float
 
     def __post_init__(self) -> None:
         choice("model", self.model, MODELS)
@@ -87,13 +96,22 @@ def _measured(rec, counts: tuple[str, ...]) -> None:
     record(rec, allow_nan=floats, nonnegative=(*floats, *counts))
 
 
-def _rows(model: str, measure: str, errs: list, shares: list) -> list[ModelRow]:
+def _rows(
+    model: str, measure: str, errs: list, shares: list, fixes: list, secs=()
+) -> list[ModelRow]:
     out = []
     for kind in [k for k in KINDS if any(e[0] == k for e in errs)] + ["all"]:
         e = np.abs(np.array([x[1][:3] for x in errs if kind in ("all", x[0])]))
         med, rms = np.median(e, 0), np.sqrt(np.mean(e**2, 0))
+        f = np.array(fixes if kind == "all" else [np.nan], float)
+        fix = (
+            (np.nanmedian(f), np.sqrt(np.nanmean(f**2)))
+            if np.any(np.isfinite(f))
+            else (np.nan,) * 2
+        )
         out.append(ModelRow(model, measure, kind, len(e), med[0], rms[0], med[1], rms[1], med[2], rms[2],
-                           float(np.median(shares))))  # fmt: skip
+                           float(np.median(shares)), *map(float, fix),
+                           float(np.median(secs)) if len(secs) else float("nan")))  # fmt: skip
     return out
 
 
@@ -164,11 +182,15 @@ def traced_bias(
     errs = {m: [] for m in models}
     noisy = {m: [] for m in models}
     shares = {m: [] for m in models}
+    fix_bias = {m: [] for m in models}
+    fix_err = {m: [] for m in models}
+    secs = {m: [] for m in models}
     for k in ks:
         arr, paths = route.paths(k)
         H = amp * route.raytraced.tensor(k)[1]
         h2 = float(np.vdot(H, H).real)
         tru, idx = path_truth(paths, arr), np.arange(len(paths))
+        ue = route.trajectory.position[k]
         extras = {}
         for m in models:
             extra = []
@@ -180,25 +202,34 @@ def traced_bias(
                     if p.kind == SECOND_ORDER
                 ]
             theta, mu_f, cost = _fit(m, H, arr, route.config, paths, extra)
-            e = path_differences(angles_of_theta(theta, mu_f, arr, route.config), tru, idx, idx)
+            est = angles_of_theta(theta, mu_f, arr, route.config)
+            e = path_differences(est, tru, idx, idx)
             errs[m] += [(p.surface_kind, x) for p, x in zip(paths, e, strict=True)]
+            dx = one_epoch_fix(est["phi"], est["psi"], est["d"], paths, ue, arr.origin)
+            fix_bias[m].append(float(np.hypot(*dx)))
             shares[m].append(cost / h2)
             extras[m] = len(extra)
         for _ in range(draws):
             snap = route.draw(k, rng)[2]
             for m in models:
-                noisy[m] += _errors(m, snap, arr, route.config, paths, tru, extras[m])
+                t0 = time.perf_counter()
+                e, fix = _errors(m, snap, arr, route.config, paths, tru, extras[m], ue)
+                secs[m].append(time.perf_counter() - t0)
+                noisy[m] += e
+                fix_err[m].append(fix)
         if progress:
             print(f"  epoch {k}: " + ", ".join(f"{m} {shares[m][-1]:.4f}" for m in models))
-    rows = [r for m in models for r in _rows(m, "bias", errs[m], shares[m])]
+    rows = [r for m in models for r in _rows(m, "bias", errs[m], shares[m], fix_bias[m])]
     if draws:
-        rows += [r for m in models for r in _rows(m, "error", noisy[m], shares[m])]
+        rows += [
+            r for m in models for r in _rows(m, "error", noisy[m], shares[m], fix_err[m], secs[m])
+        ]
     return rows
 
 
-def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int) -> list:
+def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int, ue) -> tuple[list, float]:
     """``(kind, (4,) error)`` of the first-order paths one noisy snapshot gives under ``model``
-    (:func:`traced_bias`)."""
+    and the horizontal error [m] of their one-epoch fix (:func:`traced_bias`)."""
     L = len(paths)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fit's own test flags every traced epoch
@@ -214,7 +245,10 @@ def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int) -> list:
     t = match_paths(e["d"], u, paths, clock_bias=snap.clock_bias)
     rows = np.flatnonzero(t >= 0)
     diff = path_differences(e, tru, rows, t[rows], C * snap.clock_bias)
-    return [(paths[t[r]].surface_kind, x) for r, x in zip(rows, diff, strict=True)]
+    sel = [paths[t[r]] for r in rows]
+    dx = one_epoch_fix(e["phi"][rows], e["psi"][rows], e["d"][rows], sel, ue, arr.origin)
+    kinds = [p.surface_kind for p in sel]
+    return list(zip(kinds, diff, strict=True)), float(np.hypot(*dx))
 
 
 @dataclass(frozen=True)
