@@ -18,7 +18,7 @@ import numpy as np
 
 from .._checks import bound_array
 from .._physical import start_spread
-from .._validate import finite_array, instance
+from .._validate import boolean, finite_array, instance
 from ..odometry import Odometry
 from ..reckoning import posterior_bound
 from .errormodel import PathErrorModel
@@ -41,7 +41,9 @@ __all__ = [
 ]
 
 
-def position_information(model: PathErrorModel, geometry, weights=None) -> np.ndarray:
+def position_information(
+    model: PathErrorModel, geometry, weights=None, *, drawn: bool = False
+) -> np.ndarray:
     """Fisher information (T, 2, 2) [1/m^2] of the UE's horizontal position (height known, as
     JAVELIN and the PEB) in what the extraction reports: ``H^T crlb^-1 H`` over the existing
     paths' ``z = [phi, psi, kappa, d]``, with the clock bias (common to every ``d``) a nuisance
@@ -53,8 +55,13 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
     of the covariance of the fix that weighs the paths by them (:func:`position_noise_cov`):
     a tracker told one block per path cannot use the correlation of the joint CRLB between
     paths (at 4 x 4 in the paper's tunnel up to 0.9 between the LoS and the ceiling path,
-    which the joint bound turns into half the position error)."""
+    which the joint bound turns into half the position error).
+
+    ``drawn``: the information of what the model draws, its ``cov`` (diffuse power included)
+    instead of the reported ``crlb`` (the noise of :func:`unit_pcrlb`; no ``weights``)."""
     check_geometry(model, geometry)
+    if boolean("drawn", drawn) and weights is not None:
+        raise ValueError("weights: the information of the drawn noise takes no weights")
     T = model.exists.shape[0]
     out = np.zeros((T, 2, 2))
     if weights is not None:
@@ -68,7 +75,7 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
         rows, H, _ = position_rows(model, geometry, k)
         if rows is None:
             continue
-        R = model.crlb[k][np.ix_(rows, rows)]
+        R = np.asarray(model.cov[k] if drawn else model.crlb[k])[np.ix_(rows, rows)]
         J = H.T @ np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True) @ H
         J = 0.5 * (J + J.T)
         if J[2, 2] > 0:
