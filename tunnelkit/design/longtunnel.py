@@ -128,6 +128,7 @@ class LongTunnelResult:
         integer("runs", self.runs, minimum=1), integer("seed", self.seed, minimum=0)
         nonnegative("wall_s", self.wall_s)
         choice("odometry", self.odometry, tuple(MODELS))
+        boolean("told_odometry", self.told_odometry)
 
     def meeting(self) -> list[tuple[str, float]]:
         """The (array, spacing) pairs whose p90 meets the target."""

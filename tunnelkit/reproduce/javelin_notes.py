@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import choice, instance, integer
+from .._validate import boolean, choice, instance, integer
 from ..odometry import MODELS
 from ..simulation.drives import HELD_OUT_SEED, TUNING_SEEDS
 
@@ -57,6 +57,7 @@ def seed_note(seed: int) -> str:
 def odometry_note(odometry: str, told: bool = False) -> str:
     """What the V2X messages of the named model (:data:`tunnelkit.odometry.MODELS`) carry, and
     whether JAVELIN is ``told`` it."""
+    told = boolean("told", told)
     m = MODELS[choice("odometry", odometry, tuple(MODELS))]
     return (
         f"V2X messages of the {odometry} odometry model (tunnelkit.odometry): speed scale error "

@@ -234,6 +234,8 @@ class Javelin:
         """The curvature role's per-track predictions and Jacobians at the state ``x``
         (:func:`~.measurement.track_model`), the odometry states' columns zero."""
         n = self.state.n_odo
+        if not n:  # the paper's state
+            return self.design.curvature.predict(x, cfg.bs)
         pred, J = self.design.curvature.predict(kinematic(x, n), cfg.bs)
         return pred, odometry_columns(J, n)
 
