@@ -162,6 +162,7 @@ def design_sites():
     array and spacing with one run, and JAVELIN on a drive whose epochs name their site."""
     from tunnelkit import design
     from tunnelkit.design import longtunnel, sites
+    from tunnelkit.odometry import AUTOMOTIVE
 
     setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
     row = sites.SiteRow.along(setup, 100.0, 150.0, speed=sites.LONG_DRIVE_SPEED)
@@ -170,6 +171,7 @@ def design_sites():
     route = sites.site_route(row, "4x4", report="auto")
     sites.SiteRoute(route.route, route.rows, route.site, route.origin, route.served, route.offset)
     drive = sites.site_drive(row, route, np.random.default_rng(0), n_epochs=5)
+    sites.row_pcrlb(row, route, AUTOMOTIVE, 1.0)
     res = longtunnel.long_tunnel_study(
         setup, ("4x4",), (100.0,), length=150.0, runs=1, seed=0, target=1.0, bin_m=10.0
     )

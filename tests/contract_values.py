@@ -655,11 +655,14 @@ def _traced():
 
 
 def _odometry():
-    """The odometry model, dead reckoning and its bound on a 46-epoch drive; the drift study on
-    four drives of 100 m."""
+    """The odometry model, dead reckoning and its bound on a 46-epoch drive (and with a radio's
+    information); a tracker's state told the model; the drift study on four drives of 100 m."""
     from tunnelkit.odometry import Odometry
-    from tunnelkit.reckoning import dead_reckoning, dead_reckoning_bound
+    from tunnelkit.reckoning import dead_reckoning, dead_reckoning_bound, posterior_bound
     from tunnelkit.studies.odometry import drift, drift_rows, drift_table
+    from tunnelkit.tracking.javelin import JavelinConfig, JavelinState
+    from tunnelkit.tracking.javelin.motion import odometry_transition
+    from tunnelkit.tracking.javelin.state import first_vue, kinematic, odometry_columns
 
     t = np.arange(46) * 0.1
     v, th = np.full(46, 22.0), 0.01 * t
@@ -672,6 +675,12 @@ def _odometry():
     s, h = odo.draw(t, v, th, np.random.default_rng(0))
     dead_reckoning(t, s, h, np.zeros(2))
     dead_reckoning_bound(t, v, th, odo, 0.5, np.isfinite(s))
+    posterior_bound(t, v, th, odo, np.tile(np.eye(2), (46, 1, 1)), 0.5, np.isfinite(s))
+    cfg = JavelinConfig().told(odo)
+    st = JavelinState.initial([-30.0, 1.0, 1.0], 1.0, odometry=cfg.odometry_sigmas)
+    st.append([2.0, 1.0], np.eye(2))
+    first_vue(3), kinematic(st.x, 3), odometry_columns(np.zeros((2, 4, 5)), 3)
+    odometry_transition(st, 10.0, 0.1, 0.1)
     d = drift(odo, n_drives=4, seed=0, length=100.0, speed=22.0, epoch_rate=10.0)
     d.at([40.0, 100.0])
     drift_table(drift_rows(4, 0, (40.0, 100.0)))

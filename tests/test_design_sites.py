@@ -239,3 +239,37 @@ def test_a_ue_half_a_spacing_before_a_site_maps_inside_the_first_sites_frame():
         row.setup.trajectory.position[:, 0] < row.centres[-1]
     )
     assert np.all(np.abs(route.offset[inner]) <= 50.0 + 1e-9)  # between sites: the nearest
+
+
+def test_the_row_bound_and_the_tracker_told_the_odometry():
+    """Along a row of sites on a car's odometry: the posterior CRLB of the drive
+    (:func:`~tunnelkit.design.sites.row_pcrlb`) lies below dead reckoning's bound (the sites'
+    information) and reduces to it with no site in range; JAVELIN told the model and not told it
+    both stay above it (Monte-Carlo noise allowed), the told one no worse than the untold."""
+    from tunnelkit.design.longtunnel import long_tunnel_study
+    from tunnelkit.design.sites import row_pcrlb
+    from tunnelkit.odometry import AUTOMOTIVE
+    from tunnelkit.reckoning import dead_reckoning_bound
+
+    row = _row(200.0, 600.0)
+    route = site_route(row, "8x8")
+    traj = row.setup.trajectory
+    v = np.linalg.norm(traj.velocity[:, :2], axis=1)
+    th = np.arctan2(traj.velocity[:, 1], traj.velocity[:, 0])
+    dr = dead_reckoning_bound(traj.t, v, th, AUTOMOTIVE, sigma_start=1.0)
+    bound = row_pcrlb(row, route, AUTOMOTIVE, 1.0)
+    assert np.all(bound <= dr * (1 + 1e-9)) and bound[-1] < 0.2 * dr[-1]
+    off = replace(route, served=np.zeros_like(route.served))
+    np.testing.assert_allclose(row_pcrlb(row, off, AUTOMOTIVE, 1.0), dr, rtol=1e-12)
+    with pytest.raises(ValueError, match="geometry"):
+        row_pcrlb(row, replace(route, geometry=None), AUTOMOTIVE)
+    kw = {"length": 600.0, "runs": 3, "seed": 4, "odometry": "automotive"}
+    told, untold = (
+        long_tunnel_study(_setup(), ("8x8",), (200.0,), told_odometry=t, **kw)
+        for t in (True, False)
+    )
+    a, b = told.rows[0], untold.rows[0]
+    assert told.told_odometry and not untold.told_odometry and a["bound"] == b["bound"]
+    assert a["rmse"] >= 0.7 * a["bound"] and b["rmse"] >= 0.7 * b["bound"]
+    assert a["rmse"] <= b["rmse"] and a["dr_rmse"] == b["dr_rmse"]
+    assert "| 8x8 | 200 | 3 |" in told.table() and told.to_json()["told_odometry"]

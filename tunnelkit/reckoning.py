@@ -2,7 +2,9 @@
 
 :func:`dead_reckoning` integrates the messages from a start (a lost message holds the last
 one); :func:`dead_reckoning_bound` is the posterior CRLB (Tichavský et al. 1998) of that position
-given the messages alone, with the scale factor and the heading biases as states.
+given the messages alone, with the scale factor and the heading biases as states;
+:func:`posterior_bound` the same recursion with a radio's position information per epoch beside
+the messages (the bound over a drive of a tracker told the odometry model).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from ._physical import speeds
 from ._validate import finite_array, nonnegative
 from .odometry import Odometry, epoch_times
 
-__all__ = ["dead_reckoning", "dead_reckoning_bound"]
+__all__ = ["dead_reckoning", "dead_reckoning_bound", "posterior_bound"]
 
 #: the order of the bound's state: position error (2), scale, heading bias, yaw-rate bias, and the
 #: errors of the message held (speed [m/s], heading [rad])
@@ -120,6 +122,24 @@ def dead_reckoning_bound(
     pattern per drive, result (N, T)); ``None``: the odometry's schedule with no loss. Epoch 0
     counts as arrived (dead reckoning starts from the first message). A message held over epochs
     where the truth turns adds a model error the bound does not hold."""
+    return posterior_bound(t, speed, heading, odometry, None, sigma_start, arrived)
+
+
+def posterior_bound(
+    t, speed, heading, odometry: Odometry, info=None, sigma_start: float = 0.0, arrived=None
+) -> np.ndarray:
+    """2-D position RMSE bound [m] (T,) (or (N, T), ``arrived`` as in
+    :func:`dead_reckoning_bound`) of any estimator of the position from the odometry messages
+    and a measurement whose Fisher information about the horizontal position at epoch ``k`` is
+    ``info[k]`` (T, 2, 2) [1/m^2] (a radio's fixes; zero where it has none): the posterior CRLB
+    (Tichavský et al. 1998) of :func:`dead_reckoning_bound`'s error state with the measurement
+    entering its position block, ``J_k = (F_k J_{k-1}^-1 F_k^T + G_k Q_k G_k^T)^-1 + I_k``,
+    computed in covariance form ``P_k = (I + P_k^- I_k)^-1 P_k^-`` (``Q`` and ``I_k`` may be
+    singular), epoch 0 updated too. The scale factor and the heading biases are states the
+    measurement makes observable: a tracker told the model can learn them. ``info=None``: no
+    measurement (:func:`dead_reckoning_bound`). The bound of the message schedule without
+    losses (``arrived=None``) lies below that of any loss pattern: a lower bound with losses
+    too."""
     if not isinstance(odometry, Odometry):
         raise TypeError(f"odometry: expected an Odometry, got {type(odometry).__name__}")
     t = epoch_times(t)
@@ -127,6 +147,13 @@ def dead_reckoning_bound(
     v = speeds("speed", finite_array("speed", speed, shape=(T,)), vectors=False)
     th = finite_array("heading", heading, shape=(T,))
     sigma_start = nonnegative("sigma_start", sigma_start)
+    if info is not None:
+        info = finite_array("info", info, shape=(T, 2, 2))
+        if np.any(
+            np.linalg.eigvalsh(0.5 * (info + np.swapaxes(info, 1, 2)))
+            < -1e-9 * (1.0 + np.abs(info).max())
+        ):
+            raise ValueError("info: expected positive semi-definite information matrices")
     if arrived is None:
         fresh = odometry.schedule(t)
     else:
@@ -145,11 +172,16 @@ def dead_reckoning_bound(
     P[..., _EV, _S] = P[..., _S, _EV] = o.speed_scale**2 * v[0]
     P[..., _ET, _B] = P[..., _B, _ET] = o.heading_bias**2
     out = np.empty(fresh.shape)
-    out[..., 0] = np.sqrt(P[..., _X, _X] + P[..., _Y, _Y])
-    for k in range(1, T):
-        dt = float(t[k] - t[k - 1])
-        F, G = _transition(dt, float(v[k - 1]), float(th[k - 1]), float(v[k]), fresh[..., k])
-        Q = np.diag([o.heading_drift**2 * dt, o.speed_noise**2, o.heading_noise**2])
-        P = F @ P @ np.swapaxes(F, -1, -2) + G @ Q @ np.swapaxes(G, -1, -2)
+    for k in range(T):
+        if k:
+            dt = float(t[k] - t[k - 1])
+            F, G = _transition(dt, float(v[k - 1]), float(th[k - 1]), float(v[k]), fresh[..., k])
+            Q = np.diag([o.heading_drift**2 * dt, o.speed_noise**2, o.heading_noise**2])
+            P = F @ P @ np.swapaxes(F, -1, -2) + G @ Q @ np.swapaxes(G, -1, -2)
+        if info is not None and np.any(info[k]):
+            M = np.zeros((_N, _N))
+            M[:2, :2] = 0.5 * (info[k] + info[k].T)
+            P = np.linalg.solve(np.eye(_N) + P @ M, P)
+            P = 0.5 * (P + np.swapaxes(P, -1, -2))
         out[..., k] = np.sqrt(np.maximum(P[..., _X, _X] + P[..., _Y, _Y], 0.0))
     return out

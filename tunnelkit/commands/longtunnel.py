@@ -1,6 +1,6 @@
 """``tunnelkit long-tunnel SCENARIO [--arrays 4x4 8x8 16x16] [--spacings 100 200 400 800]
 [--length 2000] [--speed-kmh 80] [--runs 20] [--seed 0] [--target 1] [--ideal]
-[--odometry white|automotive] [--workers N | --scheduler A] [--format table|json]``.
+[--odometry white|automotive] [--told-odometry] [--workers N | --scheduler A] [--format table|json]``.
 
 Which array and how far apart the sites, for a long tunnel: the scenario's site repeated every
 spacing along a drive of ``--length`` metres (:mod:`tunnelkit.design.sites`), JAVELIN and dead
@@ -73,6 +73,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="the V2X speed and heading messages: the paper's white noise (default) or a car's "
         "odometry (a wheel-speed scale error, a drifting gyro heading bias, 10 Hz, 10 %% lost)",
     )
+    p.add_argument(
+        "--told-odometry",
+        action="store_true",
+        help="JAVELIN is told the --odometry model (its scale factor and heading biases as states)",
+    )
     p.add_argument("--format", choices=["table", "json"], default="table")
     add_parallel_arguments(p)
 
@@ -97,13 +102,15 @@ def main(args: argparse.Namespace) -> int:
         target=args.target,
         impairments=preset_impairments(preset, setup, specs),
         odometry=args.odometry,
+        told_odometry=args.told_odometry,
         **parallel_kwargs(args),
     )
     if args.format == "json":
         print(json.dumps({"impairments": preset, **res.to_json()}, indent=2))
         return 0
     print(
-        f"{setup.name}, {preset} arrays, {res.odometry} odometry, a {res.length:g} m drive at "
+        f"{setup.name}, {preset} arrays, {res.odometry} odometry"
+        f"{' (JAVELIN told it)' if res.told_odometry else ''}, a {res.length:g} m drive at "
         f"{args.speed_kmh:g} km/h, "
         f"{res.runs} runs, seed {res.seed} (wall {res.wall_s:.0f} s)\n"
     )

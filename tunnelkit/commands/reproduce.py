@@ -1,6 +1,6 @@
 """``tunnelkit reproduce TARGET [--runs N] [--seed S] [--channel image|sionna]
 [--second-order N] [--diffuse-floor] [--length METRES] [--odometry white|automotive]
-[--workers N | --scheduler ADDRESS] [--format table|json]``."""
+[--told-odometry] [--workers N | --scheduler ADDRESS] [--format table|json]``."""
 
 from __future__ import annotations
 
@@ -59,6 +59,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="the V2X speed and heading messages' model: the paper's white noise (default) or "
         "automotive odometry (a wheel-speed scale error, a drifting gyro heading bias, 10 Hz, "
         "10 %% lost; tunnelkit.odometry); javelin-table1|2 only",
+    )
+    p.add_argument(
+        "--told-odometry",
+        action="store_true",
+        help="JAVELIN is told the --odometry model (the scale factor and heading biases as "
+        "states of its filter); javelin-table1|2 with --odometry automotive only",
     )
     add_parallel_arguments(p)
 
@@ -149,6 +155,13 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.told_odometry and args.odometry == "white":
+        print(
+            "tunnelkit reproduce: error: --told-odometry: needs --odometry automotive (JAVELIN is "
+            "told the white model by default)",
+            file=sys.stderr,
+        )
+        return 2
     if args.odometry != "white" and not targets()[args.target].odometries:
         print(
             f"tunnelkit reproduce: error: --odometry: {args.target} has no V2X messages to model "
@@ -166,6 +179,7 @@ def main(args: argparse.Namespace) -> int:
             nuisance=nuisance or None,
             length=args.length,
             odometry=args.odometry,
+            told_odometry=args.told_odometry,
             **parallel_kwargs(args),
         )
     except (TrialLost, RTUnavailableError) as exc:

@@ -18,7 +18,9 @@ import numpy as np
 
 from .._checks import bound_array
 from .._physical import start_spread
-from .._validate import finite_array, instance
+from .._validate import boolean, finite_array, instance
+from ..odometry import Odometry
+from ..reckoning import posterior_bound
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
 from .trackerfix import (
@@ -39,7 +41,9 @@ __all__ = [
 ]
 
 
-def position_information(model: PathErrorModel, geometry, weights=None) -> np.ndarray:
+def position_information(
+    model: PathErrorModel, geometry, weights=None, *, drawn: bool = False
+) -> np.ndarray:
     """Fisher information (T, 2, 2) [1/m^2] of the UE's horizontal position (height known, as
     JAVELIN and the PEB) in what the extraction reports: ``H^T crlb^-1 H`` over the existing
     paths' ``z = [phi, psi, kappa, d]``, with the clock bias (common to every ``d``) a nuisance
@@ -51,8 +55,13 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
     of the covariance of the fix that weighs the paths by them (:func:`position_noise_cov`):
     a tracker told one block per path cannot use the correlation of the joint CRLB between
     paths (at 4 x 4 in the paper's tunnel up to 0.9 between the LoS and the ceiling path,
-    which the joint bound turns into half the position error)."""
+    which the joint bound turns into half the position error).
+
+    ``drawn``: the information of what the model draws, its ``cov`` (diffuse power included)
+    instead of the reported ``crlb`` (the noise of :func:`unit_pcrlb`; no ``weights``)."""
     check_geometry(model, geometry)
+    if boolean("drawn", drawn) and weights is not None:
+        raise ValueError("weights: the information of the drawn noise takes no weights")
     T = model.exists.shape[0]
     out = np.zeros((T, 2, 2))
     if weights is not None:
@@ -66,7 +75,7 @@ def position_information(model: PathErrorModel, geometry, weights=None) -> np.nd
         rows, H, _ = position_rows(model, geometry, k)
         if rows is None:
             continue
-        R = model.crlb[k][np.ix_(rows, rows)]
+        R = np.asarray(model.cov[k] if drawn else model.crlb[k])[np.ix_(rows, rows)]
         J = H.T @ np.linalg.pinv(0.5 * (R + R.T), rcond=1e-15, hermitian=True) @ H
         J = 0.5 * (J + J.T)
         if J[2, 2] > 0:
@@ -110,17 +119,31 @@ def drive_pcrlb(
     sigma_p0: float = START_SIGMA_M,
     sigma_speed: float | None = None,
     sigma_heading: float | None = None,
+    odometry: Odometry | None = None,
 ) -> np.ndarray:
     """Posterior CRLB (T,) [m] of the 2-D position along ``setup``'s drive
     (:func:`tunnelkit.tracking.pcrlb.pcrlb`, Tichavsky et al. 1998): JAVELIN's motion model
     (``x_k = x_{k-1} + dt nu (cos theta, sin theta)`` driven by the V2X speed and heading with
     noise ``sigma_speed`` / ``sigma_heading``, default the messages' own: 0.2 m/s, 1 deg), the
     start from an open-sky fix of ``sigma_p0`` [m] (as the studies start JAVELIN), and ``info``
-    (T, 2, 2) the position information per epoch (:func:`position_information`)."""
+    (T, 2, 2) the position information per epoch (:func:`position_information`).
+
+    ``odometry`` (:class:`tunnelkit.odometry.Odometry`, instead of the two sigmas): the messages'
+    model with its repeating errors, the scale factor and the heading biases as states of the
+    bound beside the position (:func:`tunnelkit.reckoning.posterior_bound`, its message schedule
+    without losses); the paper's white model gives the bound of the two sigmas."""
     from .._validate import positive
     from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
     from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
 
+    if odometry is not None:
+        instance("odometry", odometry, Odometry)
+        if sigma_speed is not None or sigma_heading is not None:
+            raise ValueError("sigma_speed, sigma_heading: give an odometry model or the sigmas")
+        info = finite_array("info", info, shape=(None, 2, 2))
+        t, nu, th = _drive_truth(setup, info.shape[0])
+        sigma_p0 = start_spread("sigma_p0", sigma_p0)
+        return posterior_bound(t, nu, th, odometry, info, sigma_start=sigma_p0)
     sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
     sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
     sigma_p0 = start_spread("sigma_p0", sigma_p0)
@@ -128,6 +151,17 @@ def drive_pcrlb(
     Q = _motion_noise(setup, info.shape[0], sig_nu, sig_th)
     B = pcrlb(np.eye(2), Q, sigma_p0**2 * np.eye(2), info)
     return pcrlb_position_rmse(B)
+
+
+def _drive_truth(setup: DesignSetup, T: int):
+    """Times (T,) [s], true speed [m/s] and heading [rad] (T,) of ``setup``'s first ``T``
+    epochs."""
+    from .._validate import integer
+
+    traj = instance("setup", setup, DesignSetup).trajectory
+    T = integer("T", T, minimum=1, maximum=len(traj.t))
+    vel = traj.velocity[:T]
+    return traj.t[:T], np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
 
 
 def _motion_noise(setup: DesignSetup, T: int, sig_nu: float, sig_th: float) -> np.ndarray:

@@ -17,11 +17,16 @@ bin of the largest p90, NaN when no epoch lies that close; ``worst_offset`` its
 centre, negative towards -x), dead
 reckoning's p90 and RMSE, the radio's gain (dead reckoning's p90 over JAVELIN's) and whether
 the p90 meets ``target``, and the yield: the share of runs (each site a unit of its own, drawn
-per run) whose own p90 meets it. Monte-Carlo figures of the tracker, not bounds. Under impairments
+per run) whose own p90 meets it. Monte-Carlo figures of the tracker, not bounds; beside them
+``bound``, the root mean square over the settled epochs of the posterior CRLB of the drive
+(:func:`~tunnelkit.design.sites.row_pcrlb`: the messages' model with its biases as states, the
+serving sites' information), below which no tracker's RMSE lies beyond Monte-Carlo noise. Under impairments
 each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.design.sites.site_drive`). The V2X messages follow
 ``odometry`` (a name of :data:`tunnelkit.odometry.MODELS`): the paper's white model by default,
 the optimistic case for dead reckoning, or ``"automotive"`` (a scale error and a drifting heading
-bias: dead reckoning drifts with the distance). JAVELIN is told the white noise either way.
+bias: dead reckoning drifts with the distance). JAVELIN is told the white noise, or with
+``told_odometry`` the messages' model (its bias states,
+:meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`).
 """
 
 from __future__ import annotations
@@ -32,12 +37,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._physical import start_spread
-from .._validate import choice, instance, integer, nonnegative, positive, sequence
+from .._validate import boolean, choice, instance, integer, nonnegative, positive, sequence
 from ..metrics import settled
 from ..odometry import MODELS, Odometry
 from .arrayjob import START_HEIGHT_SIGMA_M, design_planes, javelin_config, median_sigmas
 from .setup import DesignSetup, parse_array
-from .sites import LONG_DRIVE_SPEED, SiteRoute, SiteRow, site_drive, site_route
+from .sites import LONG_DRIVE_SPEED, SiteRoute, SiteRow, row_pcrlb, site_drive, site_route
 from .trackerfix import START_SIGMA_M
 from .units import unit_yield
 
@@ -92,7 +97,7 @@ class LongTunnelTrial:
 
 #: the keys of a row of :class:`LongTunnelResult`
 _KEYS = frozenset(
-    ("array", "spacing", "sites", "p90", "rmse", "worst_offset", "worst_p90", "dr_p90",
+    ("array", "spacing", "sites", "p90", "rmse", "bound", "worst_offset", "worst_p90", "dr_p90",
      "dr_rmse", "gain", "meets", "yield", "yield_ci")
 )  # fmt: skip
 
@@ -100,7 +105,8 @@ _KEYS = frozenset(
 @dataclass(frozen=True)
 class LongTunnelResult:
     """:func:`long_tunnel_study`'s answer: one dict per (array, spacing) in ``rows`` (keys
-    ``array``, ``spacing``, ``sites``, ``p90``, ``rmse``, ``worst_offset``, ``worst_p90``,
+    ``array``, ``spacing``, ``sites``, ``p90``, ``rmse``, ``bound`` (the posterior CRLB's RMS over
+    the settled epochs), ``worst_offset``, ``worst_p90``,
     ``dr_p90``, ``dr_rmse``, ``gain``, ``meets``, ``yield`` and its 95 % Wilson interval
     ``yield_ci``: the share of runs, each its own drive and its own draw of every site's unit,
     whose own p90 meets the target), the inputs, and the wall time [s]."""
@@ -112,6 +118,7 @@ class LongTunnelResult:
     seed: int
     wall_s: float
     odometry: str = "white"
+    told_odometry: bool = False
 
     def __post_init__(self) -> None:
         for i, r in enumerate(sequence("rows", self.rows)):
@@ -121,6 +128,7 @@ class LongTunnelResult:
         integer("runs", self.runs, minimum=1), integer("seed", self.seed, minimum=0)
         nonnegative("wall_s", self.wall_s)
         choice("odometry", self.odometry, tuple(MODELS))
+        boolean("told_odometry", self.told_odometry)
 
     def meeting(self) -> list[tuple[str, float]]:
         """The (array, spacing) pairs whose p90 meets the target."""
@@ -139,21 +147,22 @@ class LongTunnelResult:
             "seed": self.seed,
             "wall_s": self.wall_s,
             "odometry": self.odometry,
+            "told_odometry": self.told_odometry,
         }
 
     def table(self) -> str:
         """The rows as a Markdown table."""
         head = (
-            "| array | spacing [m] | sites | p90 [m] | RMSE [m] | worst point: offset [m] | "
-            "worst p90 [m] | DR p90 [m] | DR RMSE [m] | gain (DR p90 / p90) | "
+            "| array | spacing [m] | sites | p90 [m] | RMSE [m] | bound [m] | worst point: offset "
+            "[m] | worst p90 [m] | DR p90 [m] | DR RMSE [m] | gain (DR p90 / p90) | "
             f"p90 <= {self.target:g} m | yield [95 % CI] |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
         )
         lines = [head]
         for r in self.rows:
             lines.append(
                 f"| {r['array']} | {r['spacing']:g} | {r['sites']} | {r['p90']:.3f} | "
-                f"{r['rmse']:.3f} | {r['worst_offset']:+.0f} | {r['worst_p90']:.3f} | "
+                f"{r['rmse']:.3f} | {r['bound']:.3f} | {r['worst_offset']:+.0f} | {r['worst_p90']:.3f} | "
                 f"{r['dr_p90']:.3f} | {r['dr_rmse']:.3f} | {r['gain']:.1f} | "
                 f"{'yes' if r['meets'] else 'no'} | {r['yield']:.2f} "
                 f"[{r['yield_ci'][0]:.2f}, {r['yield_ci'][1]:.2f}] |"
@@ -161,8 +170,11 @@ class LongTunnelResult:
         return "\n".join(lines)
 
 
-def _summary(err: np.ndarray, row: SiteRow, route: SiteRoute, bin_m: float, target: float) -> dict:
-    """``err`` (runs, 2, T) of one configuration -> the row of :class:`LongTunnelResult`."""
+def _summary(
+    err: np.ndarray, row: SiteRow, route: SiteRoute, bin_m: float, target: float, bound
+) -> dict:
+    """``err`` (runs, 2, T) of one configuration and its ``bound`` (T,) -> the row of
+    :class:`LongTunnelResult`."""
     idx = settled(row.setup.trajectory.t)
     e, dr = err[:, 0, idx], err[:, 1, idx]
     # the yield: the share of runs (each its own drive and its own draw of every site's unit)
@@ -185,6 +197,7 @@ def _summary(err: np.ndarray, row: SiteRow, route: SiteRoute, bin_m: float, targ
         "sites": row.count,
         "p90": p90,
         "rmse": float(np.sqrt(np.mean(e**2))),
+        "bound": float(np.sqrt(np.mean(bound[idx] ** 2))),
         "worst_offset": (worst[1] + 0.5) * bin_m,
         "worst_p90": worst[0],
         "dr_p90": dr_p90,
@@ -212,13 +225,15 @@ def long_tunnel_study(
     scheduler: str | None = None,
     timeout: float | None = None,
     odometry: str = "white",
+    told_odometry: bool = False,
 ) -> LongTunnelResult:
     """JAVELIN and dead reckoning along a row of ``setup``'s sites for every array x spacing
     (module docstring): ``runs`` drives of ``length`` [m] at ``speed`` [m/s] each, the error
     model under ``impairments`` (default none), ``target`` [m] the p90 to meet, ``bin_m`` [m]
     the bins of the worst point between sites; ``workers`` / ``scheduler`` / ``timeout`` as
     :func:`tunnelkit.runner.run_trials`; ``odometry`` the V2X messages' model, a name of
-    :data:`tunnelkit.odometry.MODELS`. Returns a :class:`LongTunnelResult`."""
+    :data:`tunnelkit.odometry.MODELS`, which JAVELIN is told with ``told_odometry``. Returns a
+    :class:`LongTunnelResult`."""
     from ..runner import run_trials
 
     instance("setup", setup, DesignSetup)
@@ -233,6 +248,7 @@ def long_tunnel_study(
     check_bytes("runs", runs * len(specs) * len(gaps) * RUN_BYTES, f"{runs} runs per row")
     target, bin_m = positive("target", target), positive("bin_m", bin_m)
     odometry = choice("odometry", odometry, tuple(MODELS))
+    told = MODELS[odometry] if boolean("told_odometry", told_odometry) else None
     t0 = time.perf_counter()
     rows, routes, designs, keys = [], [], [], []
     for s in gaps:
@@ -243,7 +259,8 @@ def long_tunnel_study(
             crlb = median_sigmas(route.route.model)
             rows.append(row)
             routes.append(route)
-            designs.append(javelin_config(crlb, route.route.min_d, planes))
+            d = javelin_config(crlb, route.route.min_d, planes)
+            designs.append(d if told is None else d.with_(config=d.config.told(told)))
             keys.append(spec.label)
     C = len(rows)
     trial = LongTunnelTrial(tuple(rows), tuple(routes), tuple(designs), odometry=MODELS[odometry])
@@ -262,7 +279,11 @@ def long_tunnel_study(
     out = []
     for c in range(C):
         err = np.stack(res[c * runs : (c + 1) * runs])
-        out.append({"array": keys[c], **_summary(err, rows[c], routes[c], bin_m, target)})
+        bound = row_pcrlb(rows[c], routes[c], MODELS[odometry], trial.start_sigma)
+        summary = _summary(err, rows[c], routes[c], bin_m, target, bound)
+        out.append({"array": keys[c], **summary})
     out.sort(key=lambda r: (parse_array(r["array"]).n_elements, r["spacing"]))
     wall = time.perf_counter() - t0
-    return LongTunnelResult(tuple(out), target, float(length), runs, seed, wall, odometry)
+    return LongTunnelResult(
+        tuple(out), target, float(length), runs, seed, wall, odometry, told is not None
+    )

@@ -45,15 +45,20 @@ from .._validate import (
     rng_or_error,
 )
 from ..odometry import Odometry
+from ..reckoning import posterior_bound
+from .bounds import route_geometry
+from .drivebound import position_information
 from .fastroute import SIGMA_V, bound_route, indexed_drive
+from .geometry import RouteGeometry
 from .setup import DesignSetup, Mount, parse_array
-from .trackerfix import REPORTS, BoundRoute
+from .trackerfix import REPORTS, START_SIGMA_M, BoundRoute
 
 __all__ = [
     "LONG_DRIVE_SPEED",
     "OFFSET_RESOLUTION_M",
     "SiteRoute",
     "SiteRow",
+    "row_pcrlb",
     "site_drive",
     "site_route",
 ]
@@ -232,7 +237,9 @@ class SiteRoute:
     ``route`` the bound route of the first site over the drive's distinct relative positions,
     ``rows`` (T,) the row each epoch draws from, ``site`` (T,) its serving site, ``origin``
     (T, 3) that site's reference antenna (of the array facing the UE), ``served`` (T,) whether
-    a site is in range, ``offset`` (T,) the UE's x relative to its serving site's centre [m]."""
+    a site is in range, ``offset`` (T,) the UE's x relative to its serving site's centre [m],
+    ``geometry`` the route geometry of the first site's frame the model was built on
+    (:func:`~tunnelkit.design.bounds.route_geometry`, one epoch per row; ``None``: not kept)."""
 
     route: BoundRoute
     rows: np.ndarray
@@ -240,6 +247,7 @@ class SiteRoute:
     origin: np.ndarray
     served: np.ndarray
     offset: np.ndarray
+    geometry: RouteGeometry | None = None
 
     def __post_init__(self) -> None:
         record(self, shapes={"rows": ("T",), "site": ("T",), "origin": ("T", 3),
@@ -290,11 +298,37 @@ def site_route(row: SiteRow, spec, impairments=None, *, report: str = "auto") ->
         tunnel=_lengthened(row.setup.tunnel, half),
         trajectory=Trajectory(t=traj.t[rep], position=rel[rep], velocity=traj.velocity[rep]),
     )
-    model = path_error_model(local, spec, impairments)
+    geometry = route_geometry(local, spec)
+    model = path_error_model(local, spec, impairments, geometry=geometry)
     prepared = bound_route(model, local, spec, report=report)
     origin = prepared.origin[rows] + shift[:, None] * np.array([1.0, 0.0, 0.0])
     offset = traj.position[:, 0] - row.centres[site]
-    return SiteRoute(prepared, rows, site, origin, served, offset)
+    return SiteRoute(prepared, rows, site, origin, served, offset, geometry)
+
+
+def row_pcrlb(
+    row: SiteRow, route: SiteRoute, odometry: Odometry, sigma_start: float = START_SIGMA_M
+) -> np.ndarray:
+    """Posterior CRLB (T,) [m] of the 2-D position along ``row``'s drive measured through
+    ``route`` (:func:`site_route`) on the V2X messages of ``odometry``, from a start known to
+    ``sigma_start`` [m] per axis: :func:`tunnelkit.reckoning.posterior_bound` with the scale
+    factor and the heading biases as states and, per epoch, the serving site's information
+    about the horizontal position in what the model draws
+    (:func:`~tunnelkit.design.drivebound.position_information` of its ``cov``, the clock bias
+    eliminated; none where no site is in range). The sites' calibration draws are known to the
+    bound (the bound of every unit, as :func:`~tunnelkit.design.drivebound.unit_pcrlb` with
+    ``calibration=False``) and the messages arrive on schedule: lower than with losses."""
+    instance("row", row, SiteRow)
+    instance("route", route, SiteRoute)
+    instance("odometry", odometry, Odometry)
+    if route.geometry is None:
+        raise ValueError("route: built without its geometry (site_route keeps it)")
+    info = position_information(route.route.model, route.geometry, drawn=True)[route.rows]
+    info[~route.served] = 0.0
+    traj = row.setup.trajectory
+    v = np.linalg.norm(traj.velocity[:, :2], axis=1)
+    th = np.arctan2(traj.velocity[:, 1], traj.velocity[:, 0])
+    return posterior_bound(traj.t, v, th, odometry, info, sigma_start=sigma_start)
 
 
 def site_drive(

@@ -128,6 +128,7 @@ def run(
     nuisance: dict | None = None,
     length: float | None = None,
     odometry: str = "white",
+    told_odometry: bool = False,
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
@@ -138,7 +139,8 @@ def run(
     lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
     (:func:`tunnelkit.simulation.drives.drive_variant`, e.g. 120). ``odometry`` (the targets with
     a drive: javelin-table1|2): the V2X messages' model, a name of
-    :data:`tunnelkit.odometry.MODELS` ("white", the paper's, by default; "automotive")."""
+    :data:`tunnelkit.odometry.MODELS` ("white", the paper's, by default; "automotive");
+    ``told_odometry``: JAVELIN is told that model (its bias states; a model other than white)."""
     if isinstance(name, str) and name in TARGET_MODULES:
         importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
     reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()
@@ -173,6 +175,10 @@ def run(
                 f"odometry: target {name!r} has no V2X messages to model (javelin-table1|2 do)"
             )
         on["odometry"] = odometry
+    if told_odometry:
+        if odometry == "white":
+            raise ValueError("told_odometry: needs an odometry model other than the white one")
+        on["told_odometry"] = True
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
     check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")

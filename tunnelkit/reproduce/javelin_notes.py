@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import choice, instance, integer
+from .._validate import boolean, choice, instance, integer
 from ..odometry import MODELS
 from ..simulation.drives import HELD_OUT_SEED, TUNING_SEEDS
 
@@ -54,9 +54,10 @@ def seed_note(seed: int) -> str:
     )
 
 
-def odometry_note(odometry: str) -> str:
+def odometry_note(odometry: str, told: bool = False) -> str:
     """What the V2X messages of the named model (:data:`tunnelkit.odometry.MODELS`) carry, and
-    that JAVELIN is not told it."""
+    whether JAVELIN is ``told`` it."""
+    told = boolean("told", told)
     m = MODELS[choice("odometry", odometry, tuple(MODELS))]
     return (
         f"V2X messages of the {odometry} odometry model (tunnelkit.odometry): speed scale error "
@@ -65,7 +66,13 @@ def odometry_note(odometry: str) -> str:
         f"{np.degrees(m.heading_drift) * 60:g} deg/sqrt(h), "
         f"{'a message every epoch' if m.rate is None else f'{m.rate:g} Hz'}, "
         f"{100 * m.dropout:g} % lost (the last one held); the paper draws white noise only. "
-        "JAVELIN is not told the model: its motion noise stays the white 0.2 m/s and 1 deg."
+        + (
+            "JAVELIN is told the model: the speed scale factor, the heading bias and the yaw-rate "
+            "bias are states of its filter, with the model's priors and the heading bias's random "
+            "walk (JavelinConfig.told)."
+            if told
+            else "JAVELIN is not told the model: its motion noise stays the white 0.2 m/s and 1 deg."
+        )
     )
 
 

@@ -18,7 +18,7 @@ import functools
 import numpy as np
 
 from .._validate import boolean, choice, instance, integer, sequence, text
-from ..odometry import MODELS
+from ..odometry import MODELS, Odometry
 from ..reference import load as load_reference
 from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
 from ..simulation.drives import FLAGGED, drive_variant
@@ -102,18 +102,24 @@ def table_columns(
 
 
 def score_drive(
-    drives: dict, cond: str, columns: tuple[tuple[str, str, str], ...]
+    drives: dict, cond: str, columns: tuple[tuple[str, str, str], ...], told=None
 ) -> dict[tuple[str, str], dict[str, float]]:
     """One drive of condition ``cond``, measured through each route (``{route: DriveData}``),
     scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
     column's design; TeNFiLoc (no design of its own) on LoS drives, in the paper design's
     columns; dead reckoning (:data:`DEAD_RECKONING`: the column's JAVELIN, start and V2X
     messages with every measurement dropped) in every column, the baseline the radio must beat.
-    Each (route, method, design) is evaluated once. Draws no random numbers."""
+    Each (route, method, design) is evaluated once. Draws no random numbers. ``told`` (an
+    :class:`~tunnelkit.odometry.Odometry`): every JAVELIN is told that odometry model
+    (:meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`: its bias states); ``None`` the
+    designs as they are (the paper's white motion noise)."""
     instance("drives", drives, dict, "drives per route (a dict)")
     text("cond", cond)
     sequence("columns", columns)
     table_designs = _designs(traced=any(c[2] == "traced" for c in columns))
+    if told is not None:
+        instance("told", told, Odometry)
+        table_designs = {k: d.with_(config=d.config.told(told)) for k, d in table_designs.items()}
     cache: dict[tuple[str, str, str], dict[str, float]] = {}
     out = {}
     for label, route, design in columns:
@@ -195,12 +201,13 @@ def _simulate_and_score(
     nuisance=None,
     length=None,
     odometry="white",
+    told=False,
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count. ``length``: the drive of :func:`~tunnelkit.simulation.drives.drive_variant` instead of
     the preset's (built on the worker, once per process); ``odometry`` a name of
-    :data:`tunnelkit.odometry.MODELS`."""
+    :data:`tunnelkit.odometry.MODELS`; ``told``: JAVELIN is told that model (:func:`score_drive`)."""
     route = scenario if length is None else drive_variant(scenario, length)
     odo = MODELS[odometry]
     if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced column: one more adapter
@@ -218,7 +225,7 @@ def _simulate_and_score(
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
     }
-    return score_drive(drives, cond, columns), faults
+    return score_drive(drives, cond, columns, odo if told else None), faults
 
 
 def javelin_table(
@@ -234,6 +241,7 @@ def javelin_table(
     nuisance: dict | None = None,
     length: float | None = None,
     odometry: str = "white",
+    told_odometry: bool = False,
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -252,9 +260,12 @@ def javelin_table(
     (image channel, straight lane): the drive lengthened to ``length`` metres ending where the
     preset's ends (:func:`~tunnelkit.simulation.drives.drive_variant`; 120 m: UE ranges 5-125 m);
     ``None`` the preset's drive. ``odometry``: the V2X messages' model, a name of
-    :data:`tunnelkit.odometry.MODELS` (the paper's "white" by default)."""
+    :data:`tunnelkit.odometry.MODELS` (the paper's "white" by default); ``told_odometry``:
+    JAVELIN is told that model (its bias states, :func:`score_drive`; a model other than white)."""
     sequence("conditions", conditions)
     choice("odometry", odometry, tuple(MODELS))
+    if boolean("told_odometry", told_odometry) and odometry == "white":
+        raise ValueError("told_odometry: the tracker is told the white model already (default)")
     integer("runs", runs, minimum=1)
     sequence("extractions", extractions)
     if length is not None:
@@ -283,6 +294,7 @@ def javelin_table(
             nuisance=nuisance,
             length=length,
             odometry=odometry,
+            told=told_odometry,
         ),
         **parallel,
     )
@@ -298,6 +310,7 @@ def javelin_table(
         rt_info,
         seed=seed,
         odometry=odometry,
+        told=told_odometry,
     )
 
 
@@ -321,6 +334,7 @@ def _report(
     rt_info,
     seed,
     odometry="white",
+    told=False,
 ):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
     (scores, faults)), ...]`` in drive order (also from a subset of whole runs); ``seed`` the
@@ -348,7 +362,7 @@ def _report(
         traj = drive_variant(scenario, length).trajectory.position
         on += f", {length:g} m drive (x = {traj[0, 0]:g} m to {traj[-1, 0]:g} m)"
     if odometry != "white":
-        on += f", {odometry} odometry"
+        on += f", {odometry} odometry" + (" (JAVELIN told it)" if told else "")
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}{on}: JAVELIN vs "
         "TeNFiLoc",
@@ -364,6 +378,7 @@ def _report(
             **({"channel": channel, **rt_info} if channel != "image" else {}),
             **({"nuisance": dict(nuisance)} if nuisance else {}),
             **({"odometry": odometry} if odometry != "white" else {}),
+            **({"told_odometry": True} if told else {}),
             "radio_gain": gains,
         },
         notes=[
@@ -373,7 +388,7 @@ def _report(
             *(RT_NOTES if channel == "sionna" else []),
             *([_traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
             *([nuisance_note(nuisance)] if nuisance else []),
-            *([odometry_note(odometry)] if odometry != "white" else []),
+            *([odometry_note(odometry, told)] if odometry != "white" else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
             "(the tracker predicts only); flagged epochs per route: "
@@ -498,11 +513,12 @@ def javelin_table1(
     nuisance: dict | None = None,
     length: float | None = None,
     odometry: str = "white",
+    told_odometry: bool = False,
     **parallel,
 ) -> Report:
     """Table 1 (straight trajectory); ``nuisance``, ``length`` (the drive lengthened, e.g.
-    120 m: UE ranges 5-125 m; ``tunnelkit reproduce javelin-table1 --length 120``) and
-    ``odometry`` as in :func:`javelin_table`."""
+    120 m: UE ranges 5-125 m; ``tunnelkit reproduce javelin-table1 --length 120``),
+    ``odometry`` and ``told_odometry`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-straight",
         "italiano2026_table1",
@@ -514,6 +530,7 @@ def javelin_table1(
         nuisance=nuisance,
         length=length,
         odometry=odometry,
+        told_odometry=told_odometry,
         **parallel,
     )
 
@@ -534,9 +551,11 @@ def javelin_table2(
     channel: str = "image",
     nuisance: dict | None = None,
     odometry: str = "white",
+    told_odometry: bool = False,
     **parallel,
 ) -> Report:
-    """Table 2 (slalom trajectory); ``nuisance`` and ``odometry`` as in :func:`javelin_table`."""
+    """Table 2 (slalom trajectory); ``nuisance``, ``odometry`` and ``told_odometry`` as in
+    :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-slalom",
         "italiano2026_table2",
@@ -547,5 +566,6 @@ def javelin_table2(
         channel=channel,
         nuisance=nuisance,
         odometry=odometry,
+        told_odometry=told_odometry,
         **parallel,
     )

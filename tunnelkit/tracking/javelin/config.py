@@ -16,7 +16,8 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..._physical import start_spread
-from ..._validate import integer, positive, probability, vector
+from ..._validate import integer, nonnegative, positive, probability, vector
+from ...odometry import Odometry
 
 __all__ = ["JavelinConfig"]
 
@@ -34,6 +35,9 @@ _SIGMAS = (
     "doppler_tolerance",
     "sigma_speed_missing",
 )
+
+#: the odometry's repeating errors a tracker can be told (:meth:`JavelinConfig.told`)
+_ODOMETRY = ("sigma_speed_scale", "sigma_heading_bias", "heading_drift", "sigma_yaw_rate_bias")
 
 
 @dataclass(frozen=True)
@@ -58,7 +62,12 @@ class JavelinConfig:
     - ``base_station``: reference-antenna position [m] (the paper's origin);
     - ours: ``update_iterations`` the relinearisations of each epoch's update at most (an
       iterated EKF, :meth:`~tunnelkit.tracking.javelin.tracker.Javelin._iterate`; default 0:
-      the paper's one EKF step).
+      the paper's one EKF step);
+    - ours, the odometry's repeating errors the tracker is told (:meth:`told`; default 0: the
+      paper's white messages): ``sigma_speed_scale`` the sigma of the speed scale factor,
+      ``sigma_heading_bias`` [rad] of the heading bias at the start, ``heading_drift``
+      [rad/sqrt(s)] its random walk, ``sigma_yaw_rate_bias`` [rad/s] of the yaw-rate bias; any
+      of them above 0 adds the odometry states to the state (:attr:`n_odo`).
     """
 
     gate_probability: float = 0.99
@@ -79,6 +88,10 @@ class JavelinConfig:
     sigma_p0_height: float | None = None
     base_station: tuple[float, float, float] = (0.0, 0.0, 0.0)
     update_iterations: int = 0
+    sigma_speed_scale: float = 0.0
+    sigma_heading_bias: float = 0.0
+    heading_drift: float = 0.0
+    sigma_yaw_rate_bias: float = 0.0
 
     def __post_init__(self) -> None:
         probability("gate_probability", self.gate_probability)
@@ -94,6 +107,41 @@ class JavelinConfig:
         bs = vector("base_station", self.base_station, 3)
         object.__setattr__(self, "base_station", tuple(float(v) for v in bs))
         integer("update_iterations", self.update_iterations, minimum=0)
+        for name in _ODOMETRY:
+            nonnegative(name, getattr(self, name))
+        if self.sigma_speed_scale >= 1.0:
+            raise ValueError(f"sigma_speed_scale: a fraction below 1, got {self.sigma_speed_scale}")
+
+    @property
+    def n_odo(self) -> int:
+        """The odometry states the tracker carries: 3 (:data:`~.state.ODOMETRY_STATES`) when it
+        is told any repeating odometry error, else 0 (the paper's state)."""
+        return 3 if any(getattr(self, name) for name in _ODOMETRY) else 0
+
+    @property
+    def odometry_sigmas(self) -> tuple[float, float, float] | None:
+        """The prior sigmas of the odometry states (``None`` without them)."""
+        if not self.n_odo:
+            return None
+        return (self.sigma_speed_scale, self.sigma_heading_bias, self.sigma_yaw_rate_bias)
+
+    def told(self, odometry) -> JavelinConfig:
+        """A copy told the odometry model ``odometry`` (:class:`tunnelkit.odometry.Odometry`):
+        its white speed and heading noise and its repeating errors (the scale factor, the heading
+        bias, its random walk and the yaw-rate bias). Told the paper's white model it is the
+        paper's config with that white noise. The message rate and losses are not numbers of
+        the config: a missing message is the tracker's to handle (the last one, inflated)."""
+        if not isinstance(odometry, Odometry):
+            raise TypeError(f"odometry: expected an Odometry, got {type(odometry).__name__}")
+        o = odometry
+        return self.with_(
+            sigma_speed=o.speed_noise,
+            sigma_heading=o.heading_noise,
+            sigma_speed_scale=o.speed_scale,
+            sigma_heading_bias=o.heading_bias,
+            heading_drift=o.heading_drift,
+            sigma_yaw_rate_bias=o.yaw_rate_bias,
+        )
 
     @property
     def bs(self) -> np.ndarray:

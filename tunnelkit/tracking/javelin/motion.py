@@ -10,6 +10,15 @@ random walk, ``Q_v = sigma_w^2 T I_2`` (the paper's choice, section 3.5).
 that surface, so it moves by the mirrored UE displacement ``Delta_v = Delta_u - 2 (n . Delta_u) n``
 with ``n`` the unit vector from UE to VUE. The same speed/heading noise then drives UE and VUEs,
 correlated through one ``G``; the random walk stays on top for curved surfaces.
+
+Told an odometry model with repeating errors (ours, :meth:`~.config.JavelinConfig.told`), the
+state carries the speed scale factor ``s``, the heading bias ``b`` and the yaw-rate bias ``r``
+(:data:`~.state.ODOMETRY_STATES`) and the message is corrected by them as
+:meth:`tunnelkit.odometry.Odometry.draw` forms it (``nu = (1 + s) v + n_v``, ``theta_msg =
+theta + b + n_theta``): the UE moves by ``T nu / (1 + s) [cos(theta_msg - b), sin(theta_msg -
+b), 0]``, ``b`` by ``r T`` plus its random walk (``heading_drift^2 T``), ``s`` and ``r`` stay.
+``F`` is then ``I`` plus the displacement's sensitivity to ``s`` and ``b``
+(:func:`odometry_transition`) and ``P = F P F^T + Q``.
 """
 
 from __future__ import annotations
@@ -21,9 +30,9 @@ import numpy as np
 from ..._physical import speeds, step_seconds
 from ..._validate import choice, instance, positive, real
 from .config import JavelinConfig
-from .state import JavelinState
+from .state import JavelinState, first_vue
 
-__all__ = ["motion_increment", "predict", "ue_velocity"]
+__all__ = ["motion_increment", "odometry_transition", "predict", "ue_velocity"]
 
 #: the VUE motion models (:class:`RandomWalk`, :class:`MirrorMotion`)
 VUE_MOTIONS = ("random_walk", "mirror")
@@ -38,7 +47,8 @@ def ue_velocity(speed: float, heading: float) -> np.ndarray:
 def motion_increment(
     state: JavelinState, speed: float, heading: float, dt: float, vue_motion: str = "random_walk"
 ) -> tuple[np.ndarray, np.ndarray]:
-    """State increment ``f(s) - s`` (D,) and its sensitivity ``G`` (D, 2) to ``(nu, theta)``."""
+    """State increment ``f(s) - s`` (D,) and its sensitivity ``G`` (D, 2) to ``(nu, theta)``
+    (the motion of the UE and the VUEs; the odometry states' rows are zero)."""
     instance("state", state, JavelinState)
     speeds("speed", speed), real("heading", heading), step_seconds("dt", dt)
     choice("vue_motion", vue_motion, VUE_MOTIONS)
@@ -55,18 +65,46 @@ def motion_increment(
     G = np.zeros((D, 2))
     inc[:3] = du
     G[:3] = Gu
+    o = first_vue(state.n_odo)
     if vue_motion == "mirror" and state.n_vue:
-        yz = state.x[3:].reshape(-1, 2)
+        yz = state.x[o:].reshape(-1, 2)
         w = yz - state.x[1:3]
         nrm = np.linalg.norm(w, axis=1, keepdims=True)
         n = np.where(nrm > 1e-9, w / np.maximum(nrm, 1e-12), 0.0)  # (n, 2), x component is 0
         # mirrored displacement: the yz part of du - 2 (n . du) n
         dv = du[1:] - 2.0 * (n @ du[1:])[:, None] * n
-        inc[3:] = dv.ravel()
+        inc[o:] = dv.ravel()
         # same map applied to the columns of Gu (linear in du)
         Gv = Gu[None, 1:, :] - 2.0 * n[:, :, None] * np.einsum("nk,kc->nc", n, Gu[1:])[:, None, :]
-        G[3:] = Gv.reshape(-1, 2)
+        G[o:] = Gv.reshape(-1, 2)
     return inc, G
+
+
+def odometry_transition(
+    state: JavelinState, speed: float, heading: float, dt: float, vue_motion: str = "random_walk"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The prediction of a state with odometry states (module docstring): the increment (D,),
+    ``F`` (D, D) and the sensitivity ``G`` (D, 2) to the message's white noise ``(n_v,
+    n_theta)``, for the message ``speed`` [m/s], ``heading`` [rad] over ``dt`` [s]. With
+    ``nu_c = speed / (1 + s)`` and ``theta_c = heading - b`` the motion of
+    :func:`motion_increment` at ``(nu_c, theta_c)``: ``d/ds = -G_c[:, 0] speed / (1 + s)^2``,
+    ``d/db = -G_c[:, 1]``, ``d/dn_v = G_c[:, 0] / (1 + s)``; ``b`` grows by ``r dt``."""
+    instance("state", state, JavelinState)
+    if state.n_odo != 3:
+        raise ValueError(f"state: expected the odometry states (n_odo = 3), got {state.n_odo}")
+    speeds("speed", speed), real("heading", heading)
+    i_s, i_b, i_r = range(3, 6)
+    s, b, r = state.x[i_s], state.x[i_b], state.x[i_r]
+    if not s > -1.0:
+        raise ValueError(f"state: the speed scale factor must exceed -1, got {s}")
+    inc, Gc = motion_increment(state, speed / (1.0 + s), heading - b, dt, vue_motion)
+    inc[i_b] = r * dt
+    F = np.eye(state.dim)
+    F[:, i_s] -= Gc[:, 0] * speed / (1.0 + s) ** 2
+    F[:, i_b] -= Gc[:, 1]
+    F[i_b, i_r] = dt
+    G = Gc * np.array([1.0 / (1.0 + s), 1.0])
+    return inc, F, G
 
 
 def predict(
@@ -79,7 +117,9 @@ def predict(
     vue_motion: str = "random_walk",
     sigma_speed: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Predicted ``(x, P)`` (eq. 62-63) with ``F = I`` (the motion enters as a known input).
+    """Predicted ``(x, P)`` (eq. 62-63) with ``F = I`` (the motion enters as a known input);
+    with odometry states (``state.n_odo``), ``F`` of :func:`odometry_transition` and the heading
+    bias's random walk (``config.heading_drift``).
 
     ``vue_motion`` as in :func:`motion_increment`; ``sigma_speed`` overrides the configured speed
     noise (used while the V2X message is missing and the last one is reused).
@@ -89,14 +129,21 @@ def predict(
     instance("config", config, JavelinConfig)
     if sigma_speed is not None:
         positive("sigma_speed", sigma_speed)
-    inc, G = motion_increment(state, speed, heading, dt, vue_motion)
+    if state.n_odo:
+        inc, F, G = odometry_transition(state, speed, heading, dt, vue_motion)
+    else:
+        inc, G = motion_increment(state, speed, heading, dt, vue_motion)
     s_nu = config.sigma_speed if sigma_speed is None else sigma_speed
     Q = G @ np.diag([s_nu**2, config.sigma_heading**2]) @ G.T
     Q[2, 2] += config.sigma_height**2 * dt
-    idx = np.arange(3, state.dim)
+    idx = np.arange(first_vue(state.n_odo), state.dim)
     Q[idx, idx] += config.sigma_vue_walk**2 * dt
     x = state.x + inc
-    P = state.P + Q
+    if state.n_odo:
+        Q[4, 4] += config.heading_drift**2 * dt
+        P = F @ state.P @ F.T + Q
+    else:
+        P = state.P + Q
     return x, 0.5 * (P + P.T)
 
 

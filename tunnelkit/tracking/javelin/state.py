@@ -11,6 +11,13 @@ A bias-aware tracker (:class:`~tunnelkit.tracking.javelin.noise.ConsiderNoise`) 
 ``u_i`` (4,: ``phi, psi, kappa, d``; columns ``4 i : 4 i + 4``, :func:`bias_slice`). The biases
 are consider parameters: never estimated, their own covariance stays ``I``, so ``C`` is all the
 filter has to carry about them.
+
+A tracker told an odometry model with repeating errors (:meth:`~.config.JavelinConfig.told`)
+carries its error states right after the UE: ``s = [x_u, y_u, z_u, s, b, r, y_v1, z_v1, ...]``
+(:data:`ODOMETRY_STATES`: the speed scale factor, the heading bias and the yaw-rate bias;
+``n_odo = 3``, or 0 for the paper's white messages: the paper's state exactly). The VUEs then
+start at :func:`first_vue`; the measurement model does not depend on the odometry states
+(:func:`kinematic`, :func:`odometry_columns`).
 """
 
 from __future__ import annotations
@@ -21,16 +28,62 @@ import numpy as np
 
 from ..._validate import boolean, finite_array, integer, positive, record, sequence, vector
 
-__all__ = ["JavelinState", "bias_slice", "track_slice"]
+__all__ = [
+    "ODOMETRY_STATES",
+    "JavelinState",
+    "bias_slice",
+    "first_vue",
+    "kinematic",
+    "odometry_columns",
+    "track_slice",
+]
+
+#: the odometry error states a told tracker carries after the UE, in order (the speed scale
+#: factor, the heading bias [rad], the yaw-rate bias [rad/s]; :class:`~tunnelkit.odometry.Odometry`)
+ODOMETRY_STATES = ("speed_scale", "heading_bias", "yaw_rate_bias")
 
 
-def track_slice(i: int) -> slice:
-    """State indices of track ``i``: ``0:3`` for the UE, ``3 + 2(i-1) : 5 + 2(i-1)`` for VUE i."""
+def first_vue(n_odo: int = 0) -> int:
+    """Index of the first VUE coordinate: after the UE (3) and ``n_odo`` odometry states."""
+    if type(n_odo) is not int or n_odo not in (0, len(ODOMETRY_STATES)):
+        raise ValueError(f"n_odo: expected 0 or {len(ODOMETRY_STATES)}, got {n_odo!r}")
+    return 3 + n_odo
+
+
+def track_slice(i: int, n_odo: int = 0) -> slice:
+    """State indices of track ``i``: ``0:3`` for the UE, ``o + 2(i-1) : o + 2 + 2(i-1)`` for VUE
+    i, ``o = first_vue(n_odo)``."""
     if type(i) is not int or i < 0:
         i = integer("i", i, minimum=0)
+    o = first_vue(n_odo)
     if i == 0:
         return slice(0, 3)
-    return slice(3 + 2 * (i - 1), 5 + 2 * (i - 1))
+    return slice(o + 2 * (i - 1), o + 2 + 2 * (i - 1))
+
+
+def kinematic(x: np.ndarray, n_odo: int = 0) -> np.ndarray:
+    """The state vector ``x`` without its odometry states: ``[x_u, y_u, z_u, y_v1, ...]`` of
+    eq. 43, what the measurement model reads (``x`` itself when ``n_odo = 0``)."""
+    o = first_vue(n_odo)
+    x = finite_array("x", x, ndim=1)
+    if x.size < o:
+        raise ValueError(f"x: expected at least {o} entries (UE and odometry states), got {x.size}")
+    return x if o == 3 else np.concatenate([x[:3], x[o:]])
+
+
+def odometry_columns(J: np.ndarray, n_odo: int = 0) -> np.ndarray:
+    """A measurement Jacobian (..., D_kin) of :func:`kinematic`'s state with ``n_odo`` zero
+    columns inserted after the UE (no measurement depends on the odometry states): ``J`` (L, 4,
+    D_kin) as :func:`~.measurement.track_model` gives it (only a curvature row may be NaN)."""
+    first_vue(n_odo)
+    if isinstance(J, str | bytes) or np.asarray(J).dtype.kind not in "iuf":
+        raise TypeError(f"J: expected a real array (L, 4, D) from track_model, got {J!r:.40}")
+    J = np.asarray(J, dtype=float)
+    if J.ndim != 3 or J.shape[1] != 4 or J.shape[2] < 3:
+        raise ValueError(f"J: expected shape (L, 4, D >= 3) (track_model), got {J.shape}")
+    if not np.isfinite(J[:, [0, 1, 3]]).all():  # phi, psi and the range rows
+        raise ValueError("J: the angle and delay rows must be finite")
+    return J if not n_odo else np.insert(J, [3] * n_odo, 0.0, axis=-1)
 
 
 def bias_slice(i: int) -> slice:
@@ -39,9 +92,9 @@ def bias_slice(i: int) -> slice:
     return slice(4 * i, 4 * i + 4)
 
 
-def vue_positions(x: np.ndarray) -> np.ndarray:
+def vue_positions(x: np.ndarray, n_odo: int = 0) -> np.ndarray:
     """3-D VUE positions ``[x_u, y_v, z_v]`` (n_vue, 3) of a state vector ``x`` (eq. 43)."""
-    yz = x[3:].reshape(-1, 2)
+    yz = x[first_vue(n_odo) :].reshape(-1, 2)
     return np.column_stack([np.full(len(yz), x[0]), yz])
 
 
@@ -57,23 +110,38 @@ class JavelinState:
     ue_misses: int = 0
     next_id: int = 1
     C: np.ndarray | None = None
+    n_odo: int = 0
 
     @classmethod
-    def initial(cls, position, sigma: float, sigma_height: float | None = None) -> JavelinState:
+    def initial(
+        cls, position, sigma: float, sigma_height: float | None = None, odometry=None
+    ) -> JavelinState:
         """UE only, at ``position`` (3,) with covariance ``sigma^2 I_3`` (``P_0|0`` of sec. 4.2);
-        ``sigma_height`` (default ``sigma``) replaces the height's standard deviation."""
+        ``sigma_height`` (default ``sigma``) replaces the height's standard deviation.
+        ``odometry`` (3,): the prior sigmas of the odometry states (:data:`ODOMETRY_STATES`,
+        zero mean, uncorrelated with the start); ``None``: no odometry states."""
         p = vector("position", position, 3)
         s = positive("sigma", sigma)
         sh = s if sigma_height is None else positive("sigma_height", sigma_height)
-        return cls(x=p.copy(), P=np.diag([s * s, s * s, sh * sh]))
+        if odometry is None:
+            return cls(x=p.copy(), P=np.diag([s * s, s * s, sh * sh]))
+        so = vector("odometry", odometry, len(ODOMETRY_STATES))
+        if np.any(so < 0):
+            raise ValueError(f"odometry: expected sigmas >= 0, got {so}")
+        x = np.concatenate([p, np.zeros(so.size)])
+        return cls(x=x, P=np.diag([s * s, s * s, sh * sh, *(so**2)]), n_odo=so.size)
 
     def __post_init__(self) -> None:
         record(self, skip=("x", "P", "C"), may_be_empty=("ids", "misses", "transient"),
-               nonnegative=("ue_misses",), positive=("next_id",))  # fmt: skip
+               nonnegative=("ue_misses", "n_odo"), positive=("next_id",))  # fmt: skip
         self.x = finite_array("x", self.x, ndim=1)
         self.P = finite_array("P", self.P, shape=(self.x.size, self.x.size))
-        if self.x.size < 3 or (self.x.size - 3) % 2:
-            raise ValueError(f"x: expected 3 + 2 n entries (eq. 43), got {self.x.size}")
+        o = first_vue(self.n_odo)
+        if self.x.size < o or (self.x.size - o) % 2:
+            raise ValueError(
+                f"x: expected {o} + 2 n entries (eq. 43, {self.n_odo} odometry states), "
+                f"got {self.x.size}"
+            )
         n = self.n_vue
         if self.C is not None:
             self.C = finite_array("C", self.C, shape=(self.x.size, 4 * (n + 1)))
@@ -85,13 +153,18 @@ class JavelinState:
 
     @property
     def dim(self) -> int:
-        """State dimension D = 3 + 2 n_vue."""
+        """State dimension D = 3 + n_odo + 2 n_vue."""
         return self.x.size
 
     @property
     def n_vue(self) -> int:
         """Number of tracked VUEs (L_hat - 1)."""
-        return (self.x.size - 3) // 2
+        return (self.x.size - first_vue(self.n_odo)) // 2
+
+    @property
+    def odometry(self) -> slice:
+        """State indices of the odometry states (:data:`ODOMETRY_STATES`; empty without)."""
+        return slice(3, first_vue(self.n_odo))
 
     @property
     def n_tracks(self) -> int:
@@ -108,12 +181,12 @@ class JavelinState:
         i = integer("i", i, minimum=0, maximum=self.n_vue)
         if i == 0:
             return self.ue
-        yz = self.x[track_slice(i)]
+        yz = self.x[track_slice(i, self.n_odo)]
         return np.array([self.x[0], yz[0], yz[1]])
 
     def positions(self) -> np.ndarray:
         """All track positions, shape (L_hat, 3), UE first."""
-        return np.vstack([self.x[:3], vue_positions(self.x)])
+        return np.vstack([self.x[:3], vue_positions(self.x, self.n_odo)])
 
     def copy(self) -> JavelinState:
         """A deep copy."""
@@ -126,6 +199,7 @@ class JavelinState:
             self.ue_misses,
             self.next_id,
             None if self.C is None else self.C.copy(),
+            self.n_odo,
         )
 
     def remove(self, tracks) -> list[int]:
@@ -141,7 +215,7 @@ class JavelinState:
             return []
         if tracks[0] < 1 or tracks[-1] > self.n_vue:
             raise ValueError(f"tracks: VUE indices must lie in 1..{self.n_vue}, got {tracks}")
-        drop = np.concatenate([np.arange(self.dim)[track_slice(i)] for i in tracks])
+        drop = np.concatenate([np.arange(self.dim)[track_slice(i, self.n_odo)] for i in tracks])
         keep = np.setdiff1d(np.arange(self.dim), drop)
         gone = [self.ids[i - 1] for i in tracks]
         self.x = self.x[keep]

@@ -26,7 +26,7 @@ from .manage import ManageResult, manage_tracks
 from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
 from .motion import predict, ue_velocity
 from .roles import JavelinDesign
-from .state import JavelinState, track_slice
+from .state import JavelinState, kinematic, odometry_columns, track_slice
 from .update import stack_measurement
 
 #: iterations of the first fix's iterated EKF at most (:meth:`Javelin._acquire`)
@@ -95,9 +95,12 @@ class Javelin:
             )
         self.config = self.design.config
         p0 = vector("initial_position", initial_position, 3)
-        self.state = JavelinState.initial(p0, self.config.sigma_p0_ue, self.config.sigma_p0_height)
-        if getattr(self.design.noise, "consider", False):
-            self.state.C = np.zeros((3, 4))  # the UE's bias, uncorrelated with the start
+        cfg = self.config
+        self.state = JavelinState.initial(
+            p0, cfg.sigma_p0_ue, cfg.sigma_p0_height, odometry=cfg.odometry_sigmas
+        )
+        if getattr(self.design.noise, "consider", False):  # the UE's bias, uncorrelated
+            self.state.C = np.zeros((self.state.dim, 4))
         self.gate = ChiSquareGate(self.config.gate_probability)
         self.k = 0
         self._last_motion: tuple[float, float] | None = None
@@ -227,6 +230,15 @@ class Javelin:
             self._sites[key] = self.config.with_(base_station=key)
         return self._sites[key]
 
+    def _model(self, x: np.ndarray, cfg) -> tuple[np.ndarray, np.ndarray]:
+        """The curvature role's per-track predictions and Jacobians at the state ``x``
+        (:func:`~.measurement.track_model`), the odometry states' columns zero."""
+        n = self.state.n_odo
+        if not n:  # the paper's state
+            return self.design.curvature.predict(x, cfg.bs)
+        pred, J = self.design.curvature.predict(kinematic(x, n), cfg.bs)
+        return pred, odometry_columns(J, n)
+
     def _fix(self, meas: PathMeasurements, j: int, cfg):
         """The UE's prior updated with path ``j``'s angles as its LoS by an iterated EKF
         (relinearised at its own estimate until it settles): ``(x, P, C)``. The curvature is
@@ -240,7 +252,7 @@ class Javelin:
         x0, P0, C0 = st.x.copy(), st.P.copy(), None if st.C is None else st.C.copy()
         xi = x0.copy()
         for _ in range(ACQUIRE_ITERATIONS):
-            pred, J = roles.curvature.predict(xi, cfg.bs)
+            pred, J = self._model(xi, cfg)
             m = stack_measurement(pred, J, meas, [(0, j)], cfg, j, roles.noise, C0)
             m.h = m.h + m.H @ (x0 - xi)  # linearised at xi, the prior at x0
             out = roles.updater.update(x0, P0, m, C0)
@@ -273,7 +285,7 @@ class Javelin:
         for _ in range(cfg.update_iterations):
             xi = out[0]
             sd = np.sqrt(max(float(np.linalg.eigvalsh(out[1][:3, :3])[0]), 0.0))
-            pred, J = roles.curvature.predict(xi, cfg.bs)
+            pred, J = self._model(xi, cfg)
             mi = stack_measurement(pred, J, meas, pairs, cfg, los_path, roles.noise, C0)
             mi.h = mi.h + mi.H @ (x0 - xi)
             new = roles.updater.update(x0, P0, mi, C0)
@@ -311,7 +323,7 @@ class Javelin:
                 continue
             dx = x - x0
             score = float(dx @ np.linalg.solve(P0, dx))
-            trial = JavelinState(x, P)
+            trial = JavelinState(x, P, n_odo=st.n_odo)
             for k in range(len(meas)):
                 if k != j:
                     d2 = init.match_distance(trial, meas, k, cfg, self.design.noise, j)[1]
@@ -330,7 +342,8 @@ class Javelin:
     # -- Algorithm 4: the tracking protocol (predict, update; step does both) ----------------
     @property
     def x(self) -> np.ndarray:
-        """The state: the UE's position, then every virtual UE's (3 each) [m]."""
+        """The state: the UE's position, the odometry states when told them
+        (:data:`~.state.ODOMETRY_STATES`), then every virtual UE's ``(y, z)`` [m]."""
         return self.state.x
 
     @property
@@ -389,12 +402,13 @@ class Javelin:
             used = self._acquire(meas, faults, cfg)
         st = self.state
         prior_pos, prior_ids = st.positions(), list(st.ids)
-        prior_cov = [st.P[track_slice(i), track_slice(i)].copy() for i in range(st.n_tracks)]
+        sl = [track_slice(i, st.n_odo) for i in range(st.n_tracks)]
+        prior_cov = [st.P[i, i].copy() for i in sl]
         costs, assoc, mres, nis, n_rows = None, [], None, 0.0, 0
         geometry_ok = True
         if len(meas):
             try:
-                pred, J = roles.curvature.predict(st.x, cfg.bs)
+                pred, J = self._model(st.x, cfg)
             except ValueError as exc:  # a track on the base station's axis: azimuth undefined
                 geometry_ok = False
                 faults.append(f"measurement model undefined ({exc}): predict only")
@@ -413,7 +427,7 @@ class Javelin:
             # Update (eq. 64-68); the first fix's path has been used (counted once)
             if used is not None:
                 mres.pairs = [(i, j) for i, j in mres.pairs if (i, j) != (0, used)]
-            pred, J = roles.curvature.predict(st.x, cfg.bs)
+            pred, J = self._model(st.x, cfg)
             try:
                 m, left_out = roles.updater.stack(
                     st.x, st.P, pred, J, meas, mres.pairs, cfg, mres.los_path, noise, st.C
