@@ -49,12 +49,13 @@ EXTRACTIONS = ("paper", "ml")
 NUISANCE = {"diffuse_floor": True}
 
 
-def _score(drives: dict, cond: str) -> dict:
-    """One drive's routes scored in every column of the traced table (one BLAS thread)."""
+def _score(drives: dict, cond: str, told=None) -> dict:
+    """One drive's routes scored in every column of the traced table (one BLAS thread), every
+    JAVELIN told the odometry model ``told`` (None: the white model)."""
     routes = jt._traced_routes(EXTRACTIONS, "sionna")
     with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return jt.score_drive({e: drives[e] for e in routes}, cond, jt.table_columns(routes))
+        return jt.score_drive({e: drives[e] for e in routes}, cond, jt.table_columns(routes), told)
 
 
 def drive(table: str, seed: int, i: int, n_epochs: int | None = None, odometry: str = "white"):
@@ -110,10 +111,10 @@ def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None, odometry
                     )
 
 
-def rescore(tables, seeds, conditions, src: Path, out: Path) -> None:
+def rescore(tables, seeds, conditions, src: Path, out: Path, told=None) -> None:
     """Every drive saved in ``src`` scored again with the current designs (the traced design
     reads the stored record now), no drive simulated again; written to ``out`` in the same
-    layout, so ``--report --dir OUT`` tables them."""
+    layout, so ``--report --dir OUT`` tables them; ``told`` as in :func:`_score`."""
     for t in tables:
         conds = TABLES[t][2]
         for s in seeds:
@@ -125,14 +126,20 @@ def rescore(tables, seeds, conditions, src: Path, out: Path) -> None:
                 if cond not in conditions:
                     continue
                 saved = pickle.loads(f.read_bytes())
-                res = (cond, (_score(saved["drives"], cond), saved["result"][1][1]))
+                res = (cond, (_score(saved["drives"], cond, told), saved["result"][1][1]))
                 saved = {"result": res, "drives": saved["drives"]}
                 (d_out / f.name).write_bytes(pickle.dumps(saved))
                 print(f"table {t} seed {s} drive {i} ({cond}) rescored", flush=True)
 
 
 def report(
-    table: str, seed: int, conditions, out: Path, fmt: str = "text", odometry: str = "white"
+    table: str,
+    seed: int,
+    conditions,
+    out: Path,
+    fmt: str = "text",
+    odometry: str = "white",
+    told: bool = False,
 ) -> str:
     scenario, ref, conds = TABLES[table]
     conds = tuple(c for c in conds if c in conditions)
@@ -148,7 +155,7 @@ def report(
     if not done:
         return f"table {table} seed {seed}: no whole run saved yet in {d}"
     rep = jt._report(
-        scenario, ref, conds, EXTRACTIONS, done, "sionna", NUISANCE, None, {}, seed, odometry
+        scenario, ref, conds, EXTRACTIONS, done, "sionna", NUISANCE, None, {}, seed, odometry, told
     )
     rep.meta = {"target": f"javelin-table{table}", "runs": r, "seed": seed, **rep.meta}
     return rep.to_json() if fmt == "json" else rep.to_table() + "\n" + json.dumps(rep.meta)
@@ -168,13 +175,18 @@ if __name__ == "__main__":
     ap.add_argument("--format", default="text", choices=("text", "json"))
     ap.add_argument("--odometry", default="white", choices=sorted(MODELS),
                     help="the V2X messages' model (one --dir per model)")  # fmt: skip
+    ap.add_argument("--told-odometry", action="store_true",
+                    help="JAVELIN told the --odometry model (with --rescore, then --report)")  # fmt: skip
     a = ap.parse_args()
+    if a.told_odometry and a.odometry == "white":
+        ap.error("--told-odometry: the tracker is told the white model already")
+    told = MODELS[a.odometry] if a.told_odometry else None
     out = Path(a.dir)
     if a.rescore:
-        rescore(a.tables, a.seeds, a.conditions, out, Path(a.rescore))
+        rescore(a.tables, a.seeds, a.conditions, out, Path(a.rescore), told)
     elif a.report:
         for t in a.tables:
             for s in a.seeds:
-                print(report(t, s, a.conditions, out, a.format, a.odometry))
+                print(report(t, s, a.conditions, out, a.format, a.odometry, a.told_odometry))
     else:
         simulate(a.tables, a.seeds, a.runs, a.conditions, out, a.n_epochs, a.odometry)
