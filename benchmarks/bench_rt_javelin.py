@@ -58,9 +58,22 @@ def _score(drives: dict, cond: str, told=None) -> dict:
         return jt.score_drive({e: drives[e] for e in routes}, cond, jt.table_columns(routes), told)
 
 
-def drive(table: str, seed: int, i: int, n_epochs: int | None = None, odometry: str = "white"):
+def _nuisance(second_order: int = 0) -> dict:
+    """The route's model: the diffuse floor, and ``second_order`` second-order nuisance atoms."""
+    return {**NUISANCE, "second_order": second_order} if second_order else NUISANCE
+
+
+def drive(
+    table: str,
+    seed: int,
+    i: int,
+    n_epochs: int | None = None,
+    odometry: str = "white",
+    second_order: int = 0,
+):
     """Drive ``i`` of ``table`` at ``seed`` on the V2X messages' model ``odometry`` (a name of
-    :data:`tunnelkit.odometry.MODELS`): ``((cond, (scores, faults)), drives)``."""
+    :data:`tunnelkit.odometry.MODELS`), the route's model with ``second_order`` second-order
+    nuisance atoms: ``((cond, (scores, faults)), drives)``."""
     scenario, _, conds = TABLES[table]
     rng = spawn_rngs(seed, i + 1)[i]
     cond = conds[i % len(conds)]
@@ -73,7 +86,7 @@ def drive(table: str, seed: int, i: int, n_epochs: int | None = None, odometry: 
             condition=cond,
             n_epochs=n_epochs,
             channel="sionna",
-            nuisance=NUISANCE,
+            nuisance=_nuisance(second_order),
             odometry=MODELS[odometry],
         )
     scores = _score(drives, cond)
@@ -85,7 +98,9 @@ def drive(table: str, seed: int, i: int, n_epochs: int | None = None, odometry: 
     return (cond, (scores, faults)), drives
 
 
-def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None, odometry="white") -> None:
+def simulate(
+    tables, seeds, runs, conditions, out: Path, n_epochs=None, odometry="white", second_order=0
+) -> None:
     for r in range(runs):
         for t in tables:
             conds = TABLES[t][2]
@@ -100,7 +115,7 @@ def simulate(tables, seeds, runs, conditions, out: Path, n_epochs=None, odometry
                     if f.exists():
                         continue
                     t0, c0 = time.perf_counter(), time.process_time()
-                    res, drives = drive(t, s, i, n_epochs, odometry)
+                    res, drives = drive(t, s, i, n_epochs, odometry, second_order)
                     tmp = f.with_suffix(".tmp")
                     tmp.write_bytes(pickle.dumps({"result": res, "drives": drives}))
                     tmp.rename(f)
@@ -140,6 +155,7 @@ def report(
     fmt: str = "text",
     odometry: str = "white",
     told: bool = False,
+    second_order: int = 0,
 ) -> str:
     scenario, ref, conds = TABLES[table]
     conds = tuple(c for c in conds if c in conditions)
@@ -155,7 +171,18 @@ def report(
     if not done:
         return f"table {table} seed {seed}: no whole run saved yet in {d}"
     rep = jt._report(
-        scenario, ref, conds, EXTRACTIONS, done, "sionna", NUISANCE, None, {}, seed, odometry, told
+        scenario,
+        ref,
+        conds,
+        EXTRACTIONS,
+        done,
+        "sionna",
+        _nuisance(second_order),
+        None,
+        {},
+        seed,
+        odometry,
+        told,
     )
     rep.meta = {"target": f"javelin-table{table}", "runs": r, "seed": seed, **rep.meta}
     return rep.to_json() if fmt == "json" else rep.to_table() + "\n" + json.dumps(rep.meta)
@@ -177,6 +204,8 @@ if __name__ == "__main__":
                     help="the V2X messages' model (one --dir per model)")  # fmt: skip
     ap.add_argument("--told-odometry", action="store_true",
                     help="JAVELIN told the --odometry model (with --rescore, then --report)")  # fmt: skip
+    ap.add_argument("--second-order", type=int, default=0,
+                    help="second-order nuisance atoms in the route's model (one --dir per value)")  # fmt: skip
     a = ap.parse_args()
     if a.told_odometry and a.odometry == "white":
         ap.error("--told-odometry: the tracker is told the white model already")
@@ -187,6 +216,8 @@ if __name__ == "__main__":
     elif a.report:
         for t in a.tables:
             for s in a.seeds:
-                print(report(t, s, a.conditions, out, a.format, a.odometry, a.told_odometry))
+                print(report(t, s, a.conditions, out, a.format, a.odometry, a.told_odometry,
+                             a.second_order))  # fmt: skip
     else:
-        simulate(a.tables, a.seeds, a.runs, a.conditions, out, a.n_epochs, a.odometry)
+        simulate(a.tables, a.seeds, a.runs, a.conditions, out, a.n_epochs, a.odometry,
+                 a.second_order)  # fmt: skip
