@@ -18,7 +18,8 @@ parameters: eq. 1's by :func:`~.misspecified.pseudo_true` from the true paths, t
 :meth:`ApertureProblem.fit <.aperture.ApertureProblem.fit>` from eq. 1's, the second-order
 model's by ``pseudo_true`` from the true first- and second-order paths: the most favourable
 start, an oracle) and reports each first-order path's bias against the image method's geometry,
-by kind. :func:`eq1_cost` does the same on eq. 1's own tensor, where every model must be
+by kind; with noisy draws also each model's extraction errors (not started at the truth) and a
+one-epoch position fix from either. :func:`eq1_cost` does the same on eq. 1's own tensor, where every model must be
 unbiased, and gives the profile's Cramer-Rao bound against eq. 1's (the price of ``K`` more
 parameters per path) with the Monte-Carlo RMSE of both fits.
 """
