@@ -319,6 +319,12 @@ print(f"told, JAVELIN's RMSE is {told_gain:.1f} times lower than not told, "
 #    at 1 km (`dead_reckoning_bound` on the straight drive, no lost messages).
 # 2. A better gyro: with a yaw-rate bias ten times smaller (1°/h, a tactical-grade gyro), how far
 #    can the car drive before dead reckoning's bound reaches 1 m?
+# 3. Which told state matters most along section 4's row? Tell the tracker the automotive model
+#    with one repeating term 100 times smaller than the messages carry, so that its state hardly
+#    leaves zero (`long_tunnel_study(..., told_odometry=dataclasses.replace(AUTOMOTIVE,
+#    speed_scale=AUTOMOTIVE.speed_scale / 100))`; likewise `heading_bias`, the heading bias at
+#    the start, and `yaw_rate_bias`), and compare the RMSE with the fully told tracker's and the
+#    untold one's.
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # %%solution 09.1
@@ -357,6 +363,34 @@ for name, m in (("automotive", AUTOMOTIVE), ("1 deg/h gyro", gyro)):
 # start (1 deg: 1.7 cm per metre driven) and the scale factor (1 cm per metre) reach a metre long
 # before the yaw-rate bias has grown (10 deg/h over 2.3 s: 0.006 deg)
 assert abs(reach["automotive"] - reach["1 deg/h gyro"]) < 5.0 and reach["automotive"] < 100.0
+
+# %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
+# %%solution 09.3
+import dataclasses
+
+from tunnelkit.design.impairments import preset_impairments
+from tunnelkit.design.longtunnel import long_tunnel_study
+from tunnelkit.odometry import AUTOMOTIVE
+
+dropped = {}
+for term in ("speed_scale", "heading_bias", "yaw_rate_bias"):
+    res = long_tunnel_study(
+        setup_lt, ("8x8",), (spacing_told,), length=length_told, speed=speed_lt,
+        runs=told_lt[True].runs, target=1.0,
+        impairments=preset_impairments("calibrated", setup_lt, ("8x8",)),
+        odometry="automotive",
+        told_odometry=dataclasses.replace(AUTOMOTIVE, **{term: getattr(AUTOMOTIVE, term) / 100}),
+    )  # fmt: skip
+    dropped[term] = res.rows[0]["rmse"]
+print(f"RMSE [m] told everything {r_told['rmse']:.3f}, not told {r_not['rmse']:.3f}; told "
+      "one term 100 times smaller:", {k: round(v, 3) for k, v in dropped.items()})  # fmt: skip
+worst = max(dropped, key=dropped.get)
+print(f"the told state that matters most: {worst}")
+# the scale factor: without its state the tracker is nearly back to the untold one; the heading
+# bias at the start costs a few tens of per cent; the yaw-rate state changes the RMSE by ~1 %
+assert worst == "speed_scale" and dropped["speed_scale"] > 0.8 * r_not["rmse"], dropped
+assert 1.1 * r_told["rmse"] < dropped["heading_bias"] < 2.0 * r_told["rmse"], dropped
+assert abs(dropped["yaw_rate_bias"] / r_told["rmse"] - 1.0) < 0.1, dropped
 
 # %% [markdown]
 # ## Checks
