@@ -386,8 +386,9 @@ print(f"RMSE [m] told everything {r_told['rmse']:.3f}, not told {r_not['rmse']:.
       "one term 100 times smaller:", {k: round(v, 3) for k, v in dropped.items()})  # fmt: skip
 worst = max(dropped, key=dropped.get)
 print(f"the told state that matters most: {worst}")
-# the scale factor: without its state the tracker is nearly back to the untold one; the heading
-# bias at the start costs a few tens of per cent; the yaw-rate state changes the RMSE by ~1 %
+# the scale factor: with its state frozen the tracker is nearly back to the untold one (within
+# 20 %); the heading bias at the start costs 10-100 %; the yaw-rate state changes the RMSE by
+# less than 10 %
 assert worst == "speed_scale" and dropped["speed_scale"] > 0.8 * r_not["rmse"], dropped
 assert 1.1 * r_told["rmse"] < dropped["heading_bias"] < 2.0 * r_told["rmse"], dropped
 assert abs(dropped["yaw_rate_bias"] / r_told["rmse"] - 1.0) < 0.1, dropped
