@@ -273,3 +273,28 @@ def test_the_row_bound_and_the_tracker_told_the_odometry():
     assert a["rmse"] >= 0.7 * a["bound"] and b["rmse"] >= 0.7 * b["bound"]
     assert a["rmse"] <= b["rmse"] and a["dr_rmse"] == b["dr_rmse"]
     assert "| 8x8 | 200 | 3 |" in told.table() and told.to_json()["told_odometry"]
+
+
+def test_the_tracker_told_a_model_of_its_own():
+    """``told_odometry`` an Odometry: JAVELIN is told that model instead of the messages' (the
+    messages, dead reckoning and the bound unchanged); told the messages' own model it is
+    ``told_odometry=True``, told one with a heading bias at the start 100 times smaller another
+    tracker."""
+    from tunnelkit.design.longtunnel import long_tunnel_study
+    from tunnelkit.odometry import AUTOMOTIVE
+
+    kw = {"length": 600.0, "runs": 2, "seed": 4, "odometry": "automotive"}
+    runs = {
+        k: long_tunnel_study(_setup(), ("8x8",), (200.0,), told_odometry=t, **kw).rows[0]
+        for k, t in (
+            ("true", True),
+            ("same", AUTOMOTIVE),
+            ("no b0", replace(AUTOMOTIVE, heading_bias=AUTOMOTIVE.heading_bias / 100)),
+        )
+    }
+    assert runs["same"] == runs["true"]
+    other = runs["no b0"]
+    assert other["rmse"] != runs["true"]["rmse"]
+    assert other["bound"] == runs["true"]["bound"] and other["dr_rmse"] == runs["true"]["dr_rmse"]
+    with pytest.raises(TypeError):
+        long_tunnel_study(_setup(), ("8x8",), (200.0,), told_odometry="automotive", **kw)

@@ -26,7 +26,9 @@ each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.desig
 the optimistic case for dead reckoning, or ``"automotive"`` (a scale error and a drifting heading
 bias: dead reckoning drifts with the distance). JAVELIN is told the white noise, or with
 ``told_odometry`` the messages' model (its bias states,
-:meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`).
+:meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`), or a model of its own (an
+:class:`~tunnelkit.odometry.Odometry`: a tracker told other figures than the messages carry,
+e.g. one repeating term set to zero).
 """
 
 from __future__ import annotations
@@ -225,14 +227,15 @@ def long_tunnel_study(
     scheduler: str | None = None,
     timeout: float | None = None,
     odometry: str = "white",
-    told_odometry: bool = False,
+    told_odometry: bool | Odometry = False,
 ) -> LongTunnelResult:
     """JAVELIN and dead reckoning along a row of ``setup``'s sites for every array x spacing
     (module docstring): ``runs`` drives of ``length`` [m] at ``speed`` [m/s] each, the error
     model under ``impairments`` (default none), ``target`` [m] the p90 to meet, ``bin_m`` [m]
     the bins of the worst point between sites; ``workers`` / ``scheduler`` / ``timeout`` as
     :func:`tunnelkit.runner.run_trials`; ``odometry`` the V2X messages' model, a name of
-    :data:`tunnelkit.odometry.MODELS`, which JAVELIN is told with ``told_odometry``. Returns a
+    :data:`tunnelkit.odometry.MODELS`, which JAVELIN is told with ``told_odometry`` (``True``;
+    an :class:`~tunnelkit.odometry.Odometry`: that model told instead). Returns a
     :class:`LongTunnelResult`."""
     from ..runner import run_trials
 
@@ -248,7 +251,10 @@ def long_tunnel_study(
     check_bytes("runs", runs * len(specs) * len(gaps) * RUN_BYTES, f"{runs} runs per row")
     target, bin_m = positive("target", target), positive("bin_m", bin_m)
     odometry = choice("odometry", odometry, tuple(MODELS))
-    told = MODELS[odometry] if boolean("told_odometry", told_odometry) else None
+    if isinstance(told_odometry, Odometry):
+        told = told_odometry
+    else:
+        told = MODELS[odometry] if boolean("told_odometry", told_odometry) else None
     t0 = time.perf_counter()
     rows, routes, designs, keys = [], [], [], []
     for s in gaps:
