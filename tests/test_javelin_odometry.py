@@ -209,3 +209,22 @@ def test_the_told_tracker_is_not_below_the_posterior_bound():
         np.mean(bound**2)
     )
     assert rmse[-1] <= 1.4 * bound[-1]
+
+
+def test_a_told_term_of_zero_is_a_known_state():
+    """A repeating term told as zero leaves its state's prior variance zero (the state is known):
+    our design's first fix (every path tried as the LoS, scored by its prior distance) must not
+    need the inverse of that covariance (it raised LinAlgError: singular matrix), here along a
+    row of sites on a car's odometry."""
+    from dataclasses import replace
+
+    from tunnelkit.design import DesignSetup
+    from tunnelkit.design.longtunnel import long_tunnel_study
+
+    setup = DesignSetup.from_scenario("mont-blanc-28ghz")
+    for term in ("speed_scale", "heading_bias", "yaw_rate_bias"):
+        res = long_tunnel_study(setup, ("8x8",), (400.0,), length=800.0, runs=1, speed=19.44,
+                                odometry="automotive",
+                                told_odometry=replace(AUTOMOTIVE, **{term: 0.0}))  # fmt: skip
+        row = res.rows[0]
+        assert np.isfinite(row["rmse"]) and row["rmse"] < row["dr_rmse"], (term, row)

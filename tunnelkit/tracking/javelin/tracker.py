@@ -322,7 +322,10 @@ class Javelin:
             if not init.inside(x[:3], cfg.bs):
                 continue
             dx = x - x0
-            score = float(dx @ np.linalg.solve(P0, dx))
+            try:
+                score = float(dx @ np.linalg.solve(P0, dx))
+            except np.linalg.LinAlgError:  # a told odometry term of zero: its state is known
+                score = float(dx @ np.linalg.pinv(P0) @ dx)
             trial = JavelinState(x, P, n_odo=st.n_odo)
             for k in range(len(meas)):
                 if k != j:
