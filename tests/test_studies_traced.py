@@ -277,3 +277,25 @@ def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypat
         traced_pcrlb(array=4)
     with pytest.raises(ValueError, match="array"):
         traced_pcrlb(array="4y4")
+
+
+def test_the_traced_pcrlb_with_a_cars_odometry():
+    """With the odometry's repeating errors as states the traced bound is the design's drive
+    bound with that model, and a car's odometry allows less than the paper's white messages
+    (the same sigmas, a known start); without paths it is dead reckoning's bound."""
+    from tunnelkit.design import DesignSetup, drive_pcrlb
+    from tunnelkit.odometry import AUTOMOTIVE
+    from tunnelkit.studies.traced_bound import traced_pcrlb
+
+    rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
+    white = traced_pcrlb(rows=rows, sigma_p0=1e-3)
+    car = traced_pcrlb(rows=rows, sigma_p0=1e-3, odometry=AUTOMOTIVE)
+    assert np.all(car >= white - 1e-12) and car.mean() > 1.5 * white.mean()
+    setup = DesignSetup.from_scenario("italiano2026-straight")
+    huge = traced_pcrlb(
+        rows=[["all", 9, 1e6, 1e6, 1e9, 1e9, 1]], sigma_p0=1e-3, odometry=AUTOMOTIVE
+    )
+    dr = drive_pcrlb(setup, np.zeros((len(car), 2, 2)), sigma_p0=1e-3, odometry=AUTOMOTIVE)
+    np.testing.assert_allclose(huge, dr, rtol=1e-6)
+    with pytest.raises(TypeError, match="odometry"):
+        traced_pcrlb(rows=rows, odometry="automotive")

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array
+from .._validate import finite_array, instance
+from ..odometry import Odometry
 from ..simulation.prefilter import SIGMA_SCENARIO
 from .traced import traced_errors
 
@@ -25,6 +26,7 @@ def traced_pcrlb(
     rows=None,
     array: str = "10x10",
     sigma_p0: float = 1.0,
+    odometry: Odometry | None = None,
 ) -> np.ndarray:
     """The posterior CRLB (T,) [m] of the 2-D position along ``scenario``'s drive when every
     first-order path (LoS, walls, ceiling, road, RRMs; the image method's, known reflectors) is
@@ -33,7 +35,9 @@ def traced_pcrlb(
     default the stored record, :func:`~tunnelkit.studies.traced.traced_errors`), ``kappa`` as a range and ``d`` with the
     clock bias removed (:func:`tunnelkit.design.position_information`), JAVELIN's motion model
     on the V2X messages and a start of ``sigma_p0`` [m] (:func:`tunnelkit.design.drive_pcrlb`).
-    ``array`` is the candidate mounted as the design mounts it (the paper's 10 x 10 by default).
+    ``array`` is the candidate mounted as the design mounts it (the paper's 10 x 10 by default);
+    ``odometry`` the messages' model with its repeating errors as states
+    (:func:`tunnelkit.design.drive_pcrlb`; None: the paper's white sigmas).
 
     A bound for a tracker told the reflectors; the traced errors are neither Gaussian nor
     independent between epochs (repeating biases of the bounces), so it is what the sigmas
@@ -63,4 +67,6 @@ def traced_pcrlb(
         raise ValueError(f"array: {exc}") from None
     setup = DesignSetup.from_scenario(scenario)
     model, g = sigma_error_model(setup, spec, dict(zip(("phi", "psi", "kappa", "d"), sig)))
-    return drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
+    if odometry is not None:
+        instance("odometry", odometry, Odometry)
+    return drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0, odometry=odometry)
