@@ -131,9 +131,9 @@ KINDS = ("los", "ceiling", "road", "rrm", "wall")
 FIX_SIGMAS = (math.radians(10.0), math.radians(10.0), 1.0)
 
 
-def _measured(rec, counts: tuple[str, ...] = ()) -> None:
-    """A record of RMS / median / share values: each >= 0 or NaN (nothing measured); ``counts``
-    integers >= 0."""
+def measured_record(rec, counts: tuple[str, ...] = ()) -> None:
+    """Check a record of measured magnitudes (RMS, median, share, time): every float field >= 0
+    or NaN (nothing measured); ``counts`` integers >= 0 (the studies' records)."""
     floats = tuple(f.name for f in dataclasses.fields(rec) if f.type == "float")
     record(rec, allow_nan=floats, nonnegative=(*floats, *counts))
 
@@ -169,7 +169,7 @@ class AttributionRow:
     med_kappa_m: float
 
     def __post_init__(self) -> None:
-        _measured(self, counts=("n_bias", "far_field", "n_err"))
+        measured_record(self, counts=("n_bias", "far_field", "n_err"))
 
 
 @dataclass(frozen=True)
@@ -193,7 +193,7 @@ class ConfigSummary:
     trace_s: float
 
     def __post_init__(self) -> None:
-        _measured(self)
+        measured_record(self)
 
 
 @dataclass

@@ -26,7 +26,6 @@ parameters per path) with the Monte-Carlo RMSE of both fits.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 import time
@@ -35,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import boolean, choice, integer, record, sequence
+from .._validate import boolean, choice, integer, sequence
 from ..channel import channel_tensor
 from ..constants import C
 from ..evaluation import match_paths
@@ -44,7 +43,7 @@ from ..extraction.ml import Problem, fit_problem, start_from_estimates
 from ..propagation import SECOND_ORDER
 from ..signal_route import SignalRoute
 from .aperture import MAX_ORDER, ApertureProblem
-from .attribution import KINDS, one_epoch_fix, scenario_with_array
+from .attribution import KINDS, measured_record, one_epoch_fix, scenario_with_array
 from .misspecified import pseudo_true
 from .truth import angles_of_theta, path_differences, path_truth
 
@@ -86,15 +85,8 @@ class ModelRow:
         choice("model", self.model, MODELS)
         choice("measure", self.measure, ("bias", "error"))
         choice("kind", self.kind, (*KINDS, "all"))
-        _measured(self, ("n",))
+        measured_record(self, ("n",))
         integer("n", self.n, minimum=1)
-
-
-def _measured(rec, counts: tuple[str, ...]) -> None:
-    """A record of measured magnitudes: every float >= 0 or NaN (nothing measured), ``counts``
-    integers >= 0."""
-    floats = tuple(f.name for f in dataclasses.fields(rec) if f.type == "float")
-    record(rec, allow_nan=floats, nonnegative=(*floats, *counts))
 
 
 def _rows(
@@ -186,6 +178,12 @@ def traced_bias(
     fix_bias = {m: [] for m in models}
     fix_err = {m: [] for m in models}
     secs = {m: [] for m in models}
+    # the route of each second-order model (its image-method paths), built once
+    with_second = {
+        m: route.with_options(second_order=int(m.rsplit("-", 1)[1]))
+        for m in models
+        if m.startswith("second-order")
+    }
     for k in ks:
         arr, paths = route.paths(k)
         H = amp * route.raytraced.tensor(k)[1]
@@ -195,13 +193,8 @@ def traced_bias(
         extras = {}
         for m in models:
             extra = []
-            if m.startswith("second-order"):
-                n2 = int(m.rsplit("-", 1)[1])
-                extra = [
-                    p
-                    for p in route.with_options(second_order=n2).paths(k)[1]
-                    if p.kind == SECOND_ORDER
-                ]
+            if m in with_second:
+                extra = [p for p in with_second[m].paths(k)[1] if p.kind == SECOND_ORDER]
             theta, mu_f, cost = _fit(m, H, arr, route.config, paths, extra)
             est = angles_of_theta(theta, mu_f, arr, route.config)
             e = path_differences(est, tru, idx, idx)
@@ -212,10 +205,10 @@ def traced_bias(
             extras[m] = len(extra)
         for _ in range(draws):
             snap = route.draw(k, rng)[2]
+            eq1 = {}  # eq. 1's extraction of this snapshot, shared by eq1 and the profiles
             for m in models:
-                t0 = time.perf_counter()
-                e, fix = _errors(m, snap, arr, route.config, paths, tru, extras[m], ue)
-                secs[m].append(time.perf_counter() - t0)
+                (e, fix), sec = _errors(m, snap, arr, route.config, paths, tru, extras[m], ue, eq1)
+                secs[m].append(sec)
                 noisy[m] += e
                 fix_err[m].append(fix)
         if progress:
@@ -228,18 +221,35 @@ def traced_bias(
     return rows
 
 
-def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int, ue) -> tuple[list, float]:
-    """``(kind, (4,) error)`` of the first-order paths one noisy snapshot gives under ``model``
-    and the horizontal error [m] of their one-epoch fix (:func:`traced_bias`)."""
-    L = len(paths)
+def _extract(snap, n_paths: int, arr, cfg) -> tuple:
+    """``(theta, mu_f, mu_t)`` of the extraction's default route with ``n_paths`` paths."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fit's own test flags every traced epoch
-        est = extract_paths(snap.H, L + (n_extra if model.startswith("second") else 0), arr, cfg)
-        theta, mu_f, mu_t = start_from_estimates(est)
+        return start_from_estimates(extract_paths(snap.H, n_paths, arr, cfg))
+
+
+def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int, ue, eq1: dict) -> tuple:
+    """``((kind, (4,) error) list, fix error [m]), seconds``: the first-order paths one noisy
+    snapshot gives under ``model``, the horizontal error of their one-epoch fix and the time of
+    the model's extraction (:func:`traced_bias`). ``eq1`` holds eq. 1's extraction of the
+    snapshot once made (``"fit"``, ``"s"``): the profiles refine it, so they are timed with it."""
+    L = len(paths)
+    t0 = time.perf_counter()
+    if model.startswith("second"):
+        theta, mu_f, _ = _extract(snap, L + n_extra, arr, cfg)
+        sec = time.perf_counter() - t0
+    else:
+        if "fit" not in eq1:
+            eq1["fit"] = _extract(snap, L, arr, cfg)
+            eq1["s"] = time.perf_counter() - t0
+        theta, mu_f, mu_t = eq1["fit"]
+        sec = eq1["s"]
         if model.startswith("aperture"):
+            t1 = time.perf_counter()
             prob = ApertureProblem(snap.H, arr.local, cfg.fc, order=int(model.rsplit("-", 1)[1]))
             f = prob.fit(theta, mu_f, mu_t, cfg.noise_power)
             theta, mu_f = f["theta"], f["mu_f"]
+            sec += time.perf_counter() - t1
     e = angles_of_theta(theta, mu_f, arr, cfg)
     u = np.column_stack([np.cos(e["psi"]) * np.cos(e["phi"]), np.cos(e["psi"]) * np.sin(e["phi"]),
                          np.sin(e["psi"])])  # fmt: skip
@@ -249,7 +259,7 @@ def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int, ue) -> tuple[l
     sel = [paths[t[r]] for r in rows]
     dx = one_epoch_fix(e["phi"][rows], e["psi"][rows], e["d"][rows], sel, ue, arr.origin)
     kinds = [p.surface_kind for p in sel]
-    return list(zip(kinds, diff, strict=True)), float(np.hypot(*dx))
+    return (list(zip(kinds, diff, strict=True)), float(np.hypot(*dx))), sec
 
 
 @dataclass(frozen=True)
@@ -273,7 +283,7 @@ class CostRow:
     rmse_over_crlb_d: float
 
     def __post_init__(self) -> None:
-        _measured(self, ("order", "n_paths"))
+        measured_record(self, ("order", "n_paths"))
         integer("order", self.order, minimum=1, maximum=MAX_ORDER)
         integer("n_paths", self.n_paths, minimum=1, maximum=100_000)
 
@@ -282,6 +292,13 @@ def _crlb(A, sigma2: float, n: int) -> np.ndarray:
     """(L, n) standard deviations of the per-path parameters from ``A`` = Re J^H J (the
     concentrated Fisher information is ``2 A / sigma2``)."""
     return np.sqrt(np.diag(np.linalg.inv(A)) * sigma2 / 2).reshape(-1, n)
+
+
+def _over_bound(theta, mu_f, th, mf, sd) -> np.ndarray:
+    """(L, 3) errors of ``u_x``, ``u_y`` and ``mu_f`` against the truth ``th``, ``mf`` over the
+    standard deviations ``sd`` (L, >= 4: columns 0, 1 and 3)."""
+    du = (theta[:, :2] - th[:, :2]) / sd[:, :2]
+    return np.column_stack([du, np.angle(np.exp(1j * (mu_f - mf))) / sd[:, 3]])
 
 
 def eq1_cost(
@@ -308,7 +325,8 @@ def eq1_cost(
     T = len(route.trajectory.t)
     ks = [integer("epochs", k, minimum=0, maximum=T - 1) for k in sequence("epochs", epochs)]
     d_per_mu = C / (2 * np.pi * cfg.tone_spacing)
-    acc = {o: {"bias": [], "ratio": [], "e1": [], "e": []} for o in orders}
+    acc = {o: {"bias": [], "ratio": [], "e": []} for o in orders}
+    e1 = []  # eq. 1's errors over its bound, the same beside every order
     for k in ks:
         arr, paths = route.paths(k)
         H0 = channel_tensor(paths, cfg)
@@ -321,6 +339,7 @@ def eq1_cost(
             warnings.simplefilter("ignore")
             fits1 = [fit_problem(Problem(H, arr.local, cfg.fc), (th, mf, mt), noise_power=s2,
                                  n_reseed=0, search="basic") for H in noisy]  # fmt: skip
+        e1 += [_over_bound(f.theta, f.mu_f, th, mf, sd1) for f in fits1]
         for o in orders:
             prob = ApertureProblem(H0, arr.local, cfg.fc, order=o)
             n = 5 + prob.K
@@ -332,17 +351,13 @@ def eq1_cost(
             for H, f1 in zip(noisy, fits1, strict=True):
                 fa = ApertureProblem(H, arr.local, cfg.fc, order=o).fit(f1.theta, f1.mu_f,
                                                                         f1.mu_t, s2)  # fmt: skip
-                for fit, key, s in ((f1, "e1", sd1), (fa, "e", sd)):
-                    th_f = fit["theta"] if isinstance(fit, dict) else fit.theta
-                    mf_f = fit["mu_f"] if isinstance(fit, dict) else fit.mu_f
-                    du = (th_f[:, :2] - th[:, :2]) / s[:, :2]
-                    dd = np.angle(np.exp(1j * (mf_f - mf))) / s[:, 3]
-                    acc[o][key].append(np.column_stack([du, dd]))
+                acc[o]["e"].append(_over_bound(fa["theta"], fa["mu_f"], th, mf, sd))
+    e1 = np.concatenate(e1)
     rows = []
     for o in orders:
         bias = np.concatenate(acc[o]["bias"])
         ratio = np.median(np.concatenate(acc[o]["ratio"]), 0)
-        e1, e = np.concatenate(acc[o]["e1"]), np.concatenate(acc[o]["e"])
+        e = np.concatenate(acc[o]["e"])
 
         def rms(x):
             return float(np.sqrt(np.mean(x**2)))

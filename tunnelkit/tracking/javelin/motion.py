@@ -30,10 +30,12 @@ import numpy as np
 from ..._physical import speeds, step_seconds
 from ..._validate import choice, instance, positive, real
 from .config import JavelinConfig
-from .state import JavelinState, first_vue
+from .state import ODOMETRY_STATES, JavelinState, first_vue
 
 __all__ = ["motion_increment", "odometry_transition", "predict", "ue_velocity"]
 
+#: state indices of the odometry states (:data:`~.state.ODOMETRY_STATES`, after the UE)
+I_SCALE, I_BIAS, I_RATE = range(3, 3 + len(ODOMETRY_STATES))
 #: the VUE motion models (:class:`RandomWalk`, :class:`MirrorMotion`)
 VUE_MOTIONS = ("random_walk", "mirror")
 
@@ -93,7 +95,7 @@ def odometry_transition(
     if state.n_odo != 3:
         raise ValueError(f"state: expected the odometry states (n_odo = 3), got {state.n_odo}")
     speeds("speed", speed), real("heading", heading)
-    i_s, i_b, i_r = range(3, 6)
+    i_s, i_b, i_r = I_SCALE, I_BIAS, I_RATE
     s, b, r = state.x[i_s], state.x[i_b], state.x[i_r]
     if not s > -1.0:
         raise ValueError(f"state: the speed scale factor must exceed -1, got {s}")
@@ -140,7 +142,7 @@ def predict(
     Q[idx, idx] += config.sigma_vue_walk**2 * dt
     x = state.x + inc
     if state.n_odo:
-        Q[4, 4] += config.heading_drift**2 * dt
+        Q[I_BIAS, I_BIAS] += config.heading_drift**2 * dt
         P = F @ state.P @ F.T + Q
     else:
         P = state.P + Q
