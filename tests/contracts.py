@@ -417,7 +417,13 @@ class _TimeBox(BaseException):
     pass
 
 
+#: whether the running call's time box went off (a library that runs Python callbacks, such as
+#: Dr.Jit's loops under the ray tracer, may catch the _TimeBox and raise its own error instead)
+_FIRED = [False]
+
+
 def _alarm(signum, frame):
+    _FIRED[0] = True
     raise _TimeBox
 
 
@@ -425,6 +431,7 @@ def classify(call: Callable[[], object], param: str, aliases=()) -> tuple[str, s
     """(outcome, detail) of one call, time-boxed; an error naming ``param`` or one of
     ``aliases`` is clear."""
     old = signal.signal(signal.SIGALRM, _alarm)
+    _FIRED[0] = False
     signal.setitimer(signal.ITIMER_REAL, CALL_TIMEOUT_S)
     try:
         with warnings.catch_warnings():
@@ -439,6 +446,8 @@ def classify(call: Callable[[], object], param: str, aliases=()) -> tuple[str, s
             return "clear", f"{type(exc).__name__}: {msg[:160]}"
         return "unclear", f"{type(exc).__name__}: {msg[:160]}"
     except Exception as exc:
+        if _FIRED[0]:  # the time box went off inside a library that wrapped it
+            return "hang", f"still running after {CALL_TIMEOUT_S:g} s ({type(exc).__name__})"
         return "crash", f"{type(exc).__name__}: {str(exc)[:160]}"
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)

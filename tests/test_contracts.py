@@ -246,13 +246,13 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN: no ratio at that point (a capped exact search), shown blank",
     ),
     _doc(
-        r"schema\.(Key|Table)|schemadoc\.render_template",
+        r"schema\.(spec\.)?(Key|Table)|schemadoc\.render_template",
         r"unit|doc|header",
         "empty",
         "optional text: a unitless key, an undocumented table, no header",
     ),
     _doc(
-        r"schema\.Key",
+        r"schema\.(spec\.)?Key",
         r"default",
         "type",
         "any default value: the key's type is checked where a file is read",
@@ -348,7 +348,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "negative",
         "a slider's range may reach below zero",
     ),
-    _doc(r"schema\.Key", r"gt|ge|lt|le", "negative", "a range bound takes any sign"),
+    _doc(r"schema\.(spec\.)?Key", r"gt|ge|lt|le", "negative", "a range bound takes any sign"),
     _doc(
         r"runner\.TrialPool\.(map|prepare|gather)",
         r"items|handles",

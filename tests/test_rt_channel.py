@@ -16,11 +16,12 @@ import numpy as np
 import pytest
 
 import tunnelkit as tk
-from tunnelkit import channel, propagation, rt, schema
+from tunnelkit import channel, propagation, rt
 from tunnelkit.arrays import make_array
 from tunnelkit.rt.elements import ElementPaths, element_tensor
 from tunnelkit.rt.settings import MATERIALS, RTSettings
 from tunnelkit.scenarios import ScenarioError
+from tunnelkit.schema import tunnel3d
 from tunnelkit.signal_route import SignalRoute
 
 SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
@@ -58,10 +59,10 @@ def test_settings_materials_by_kind():
 
 def test_schema_matches_settings():
     """The scenario's [raytracing] keys have RTSettings' names, defaults and material names."""
-    table = schema._RAYTRACING
+    table = tunnel3d.RAYTRACING
     fields = {f.name: f.default for f in dataclasses.fields(RTSettings)}
     assert {k.name: k.default for k in table.keys} == fields
-    assert set(schema._RT_MATERIALS) == set(MATERIALS)
+    assert set(tunnel3d.RT_MATERIALS) == set(MATERIALS)
 
 
 def _scenario_with(tmp_path, text: str):

@@ -124,6 +124,7 @@ from pathlib import Path  # noqa: E402
 from tunnelkit import cli, schema, schemadoc  # noqa: E402
 from tunnelkit import doppler_drive as drive  # noqa: E402
 from tunnelkit import scenarios as S  # noqa: E402
+from tunnelkit.schema import spec as schema_spec  # noqa: E402
 
 PRESETS = Path(__file__).resolve().parent.parent / "data" / "scenarios"
 
@@ -488,7 +489,7 @@ def test_every_key_has_a_doc_and_sane_spec():
             if k.table is not None:
                 walk(k.table, path + k.name + ".")
             if k.has_default and k.type in ("float", "int"):
-                schema._check_number("spec", path + k.name, k, k.default, k.type == "int")
+                schema_spec._check_number("spec", path + k.name, k, k.default, k.type == "int")
 
     for fam in schema.FAMILIES.values():
         walk(fam, "")

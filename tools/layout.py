@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = "tunnelkit"
 MAX_LINES = 600
 #: declarative tables, exempt from the size limit
-SIZE_EXEMPT = {"tunnelkit.schema"}
+SIZE_EXEMPT: set[str] = set()
 #: the table of names a package ``__init__`` re-exports lazily, name -> submodule
 LAZY_TABLE = "_EXPORTS"
 
@@ -279,7 +279,7 @@ def main(argv=None) -> int:
     for p in r["private_imports"]:
         print("   ", p)
     print(f"function-local imports: {r['function_local_imports']}")
-    print(f"modules over {MAX_LINES} lines (schema aside): {len(r['over_limit'])}")
+    print(f"modules over {MAX_LINES} lines: {len(r['over_limit'])}")
     for n, s in r["over_limit"].items():
         print(f"    {n}: {s}")
     if r["unranked"]:

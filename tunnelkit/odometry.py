@@ -10,11 +10,11 @@ and drifts with its angle random walk), messages come at a rate and some are los
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ._physical import speeds
+from ._physical import MAX_SPEED, speeds
 from ._validate import finite_array, nonnegative, positive, record, rng_or_error
 
 __all__ = [
@@ -26,6 +26,9 @@ __all__ = [
     "Odometry",
     "epoch_times",
 ]
+
+#: the most messages per second a model may send (a CAM is sent at 1-10 Hz)
+MAX_RATE_HZ = 10_000.0
 
 #: V2X message noise of section 4.2: speed [m/s] and heading [rad]
 SIGMA_SPEED, SIGMA_HEADING = 0.2, float(np.radians(1.0))
@@ -75,10 +78,28 @@ class Odometry:
             "heading_noise",
         ):
             nonnegative(name, getattr(self, name))
+        if self.speed_noise >= MAX_SPEED:
+            raise ValueError(
+                f"speed_noise: a speed error of {self.speed_noise:g} m/s is no car's odometry "
+                f"(at most {MAX_SPEED:g} m/s, faster than any road vehicle)"
+            )
+        for name, unit in (
+            ("heading_bias", "rad"),
+            ("heading_noise", "rad"),
+            ("heading_drift", "rad/sqrt(s)"),
+            ("yaw_rate_bias", "rad/s"),
+        ):
+            if getattr(self, name) > np.pi:
+                raise ValueError(
+                    f"{name}: a sigma of at most pi {unit} (half a turn), got "
+                    f"{getattr(self, name):g} (radians, not degrees?)"
+                )
         if not 0.0 <= self.speed_scale < 1.0:
             raise ValueError(f"speed_scale: a sigma in [0, 1) (a fraction), got {self.speed_scale}")
-        if self.rate is not None:
-            positive("rate", self.rate)
+        if self.rate is not None and positive("rate", self.rate) > MAX_RATE_HZ:
+            raise ValueError(
+                f"rate: at most {MAX_RATE_HZ:g} messages per second, got {self.rate:g}"
+            )
         if not 0.0 <= self.dropout < 1.0:
             raise ValueError(f"dropout: a probability in [0, 1) per message, got {self.dropout}")
 
@@ -86,6 +107,33 @@ class Odometry:
     def white(cls, speed_noise: float = SIGMA_SPEED, heading_noise: float = SIGMA_HEADING):
         """The paper's model: white noise only (0.2 m/s, 1 deg by default), a message per epoch."""
         return cls(speed_noise=speed_noise, heading_noise=heading_noise)
+
+    @classmethod
+    def from_scenario(cls, scenario) -> Odometry:
+        """The scenario's ``[odometry]`` section: its ``model`` (:data:`MODELS`, "automotive" when
+        the section names none) with the terms it gives replaced (angles in degrees, the drift
+        in deg/sqrt(h), the yaw-rate bias in deg/h, ``rate_hz = 0`` a message per epoch); a
+        scenario without the section drives on the paper's white model (:data:`WHITE`)."""
+        sections = getattr(scenario, "sections", None)
+        if not isinstance(sections, dict):
+            raise TypeError(
+                f"scenario: expected a loaded scenarios.Scenario, got {type(scenario).__name__}"
+            )
+        sec = sections.get("odometry")
+        if sec is None:
+            return WHITE
+        kw = {}
+        for key, (name, scale) in _FILE_KEYS.items():
+            if key in sec:
+                kw[name] = float(sec[key]) * scale
+        if "rate" in kw and kw["rate"] == 0.0:
+            kw["rate"] = None
+        return replace(MODELS[sec.get("model", "automotive")], **kw)
+
+    @property
+    def label(self) -> str:
+        """The name of :data:`MODELS` this model is, or ``"custom"``."""
+        return next((name for name, m in MODELS.items() if m == self), "custom")
 
     @property
     def is_white(self) -> bool:
@@ -145,6 +193,19 @@ AUTOMOTIVE = Odometry(
 
 #: the named models (``tunnelkit reproduce javelin-table1|2 --odometry NAME``)
 MODELS = {"white": WHITE, "automotive": AUTOMOTIVE}
+
+
+#: a scenario file's ``[odometry]`` keys: the :class:`Odometry` field each sets, and its unit
+_FILE_KEYS = {
+    "speed_scale": ("speed_scale", 1.0),
+    "speed_noise": ("speed_noise", 1.0),
+    "heading_bias_deg": ("heading_bias", float(np.radians(1.0))),
+    "heading_drift_deg_per_sqrt_h": ("heading_drift", float(np.radians(1.0) / 60.0)),
+    "yaw_rate_bias_deg_per_h": ("yaw_rate_bias", float(np.radians(1.0) / 3600.0)),
+    "heading_noise_deg": ("heading_noise", float(np.radians(1.0))),
+    "rate_hz": ("rate", 1.0),
+    "dropout": ("dropout", 1.0),
+}
 
 
 def epoch_times(t) -> np.ndarray:

@@ -6,7 +6,8 @@ README), both from the one spec of :mod:`tunnelkit.schema` that validates the fi
 
 from __future__ import annotations
 
-from .schema import FAMILIES, Key, Table, shape_text
+from .schema import FAMILIES, Key, Table
+from .schema.spec import shape_text
 
 __all__ = ["render_template", "to_markdown"]
 

@@ -86,6 +86,18 @@ table(["term", *models], rows, title="The two odometry models (tunnelkit.odometr
 # gyro inside it).
 
 # %% [markdown]
+# A scenario file says which odometry its car has: the optional `[odometry]` section names a
+# model (`"automotive"` or the paper's `"white"`) and replaces any term in a data sheet's units,
+# e.g. `speed_scale = 0.005` or `heading_drift_deg_per_sqrt_h = 0.1` (`data/scenarios/README.md`).
+# The drive carries the model (`trajectory.odometry`); the drive simulator, the design and
+# `tunnelkit long-tunnel` use it unless told another. The paper's presets have no such section
+# (their drives keep the paper's white noise); the Mont Blanc preset of section 3 declares a car's:
+
+# %%
+odo_file = tk.load_scenario("mont-blanc-28ghz")
+print(odo_file.section("odometry"), "->", odo_file.odometry().label)
+
+# %% [markdown]
 # ## 2. Dead reckoning and its bound
 #
 # Dead reckoning integrates the messages from a known start:
@@ -402,6 +414,9 @@ assert WHITE.speed_noise == 0.2 and abs(np.degrees(WHITE.heading_noise) - 1.0) <
 assert WHITE.is_white and not AUTOMOTIVE.is_white and set(MODELS) == {"white", "automotive"}
 assert np.allclose(model_row(AUTOMOTIVE)[:4], [1.0, 1.0, 10.0, 0.3])
 assert model_row(AUTOMOTIVE)[6:] == [10.0, 10.0] and model_row(WHITE)[6] == "every epoch"
+# the scenario file's odometry: Mont Blanc declares a car's, the paper's preset has none (white)
+assert odo_file.odometry() == AUTOMOTIVE and odo_file.trajectory().odometry == AUTOMOTIVE
+assert tk.load_scenario("italiano2026-straight").odometry() == WHITE
 # section 2: dead reckoning of the true messages is the truth (the integrator has no error of
 # its own), every error finite
 truth = dead_reckoning(np.arange(5) * 0.1, np.full(5, 22.0), np.zeros(5), np.zeros(2))
@@ -426,7 +441,7 @@ assert all(g > 10.0 for g in dense_gain.values()), dense_gain  # tens to hundred
 assert all(sparse_gain[a] < min(dense_gain[a], 15.0) for a in arrays_lt), (sparse_gain, dense_gain)
 spans = [widest[a] or 0.0 for a in arrays_lt]  # arrays in order of size
 assert spans == sorted(spans), widest  # a larger array never needs a narrower spacing
-assert lt.rows[0]["dr_p90"] > 3.0 and lt.odometry == "automotive", lt.rows[0]
+assert lt.rows[0]["dr_p90"] > 3.0 and lt.odometry.label == "automotive", lt.rows[0]
 assert any(w is not None for w in widest.values()), widest
 assert all(r["yield_ci"][0] <= r["yield"] <= r["yield_ci"][1] for r in lt.rows)
 # a row whose pooled p90 meets the target has at least one run that meets it on its own

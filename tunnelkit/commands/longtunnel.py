@@ -9,7 +9,8 @@ reckoning on ``--runs`` drives per array and spacing on the design's bound route
 p90 and RMSE, the p90 at the worst point between sites, dead reckoning's, the radio's gain and
 whether the p90 meets ``--target``. The arrays are calibrated as ``tunnelkit design``'s default
 (``--ideal``: no impairment, the optimistic case); the V2X messages are white (the optimistic
-case for dead reckoning) or, with ``--odometry automotive``, a car's odometry.
+case for dead reckoning) or, with ``--odometry automotive``, a car's odometry; by default the
+scenario's ``[odometry]`` section says which (white where it has none).
 """
 
 from __future__ import annotations
@@ -69,9 +70,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--odometry",
         choices=["white", "automotive"],
-        default="white",
-        help="the V2X speed and heading messages: the paper's white noise (default) or a car's "
-        "odometry (a wheel-speed scale error, a drifting gyro heading bias, 10 Hz, 10 %% lost)",
+        default=None,
+        help="the V2X speed and heading messages: the paper's white noise or a car's odometry (a "
+        "wheel-speed scale error, a drifting gyro heading bias, 10 Hz, 10 %% lost); default: the "
+        "scenario's [odometry] section (the paper's white noise where it has none)",
     )
     p.add_argument(
         "--told-odometry",
@@ -109,7 +111,7 @@ def main(args: argparse.Namespace) -> int:
         print(json.dumps({"impairments": preset, **res.to_json()}, indent=2))
         return 0
     print(
-        f"{setup.name}, {preset} arrays, {res.odometry} odometry"
+        f"{setup.name}, {preset} arrays, {res.odometry.label} odometry"
         f"{' (JAVELIN told it)' if res.told_odometry else ''}, a {res.length:g} m drive at "
         f"{args.speed_kmh:g} km/h, "
         f"{res.runs} runs, seed {res.seed} (wall {res.wall_s:.0f} s)\n"

@@ -124,18 +124,23 @@ def drive_pcrlb(
     """Posterior CRLB (T,) [m] of the 2-D position along ``setup``'s drive
     (:func:`tunnelkit.tracking.pcrlb.pcrlb`, Tichavsky et al. 1998): JAVELIN's motion model
     (``x_k = x_{k-1} + dt nu (cos theta, sin theta)`` driven by the V2X speed and heading with
-    noise ``sigma_speed`` / ``sigma_heading``, default the messages' own: 0.2 m/s, 1 deg), the
+    noise ``sigma_speed`` / ``sigma_heading``, default the white noise of the drive's messages,
+    ``setup.trajectory.odometry``: 0.2 m/s, 1 deg unless the scenario says otherwise), the
     start from an open-sky fix of ``sigma_p0`` [m] (as the studies start JAVELIN), and ``info``
     (T, 2, 2) the position information per epoch (:func:`position_information`).
 
     ``odometry`` (:class:`tunnelkit.odometry.Odometry`, instead of the two sigmas): the messages'
     model with its repeating errors, the scale factor and the heading biases as states of the
     bound beside the position (:func:`tunnelkit.reckoning.posterior_bound`, its message schedule
-    without losses); the paper's white model gives the bound of the two sigmas."""
+    without losses); the paper's white model gives the bound of the two sigmas. Without
+    ``odometry`` and the sigmas, a drive whose messages have repeating errors (the scenario's
+    ``[odometry]``) is bounded with them as states."""
     from .._validate import positive
-    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
     from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
 
+    own = instance("setup", setup, DesignSetup).trajectory.odometry
+    if odometry is None and sigma_speed is None and sigma_heading is None and not own.is_white:
+        odometry = own
     if odometry is not None:
         instance("odometry", odometry, Odometry)
         if sigma_speed is not None or sigma_heading is not None:
@@ -144,8 +149,10 @@ def drive_pcrlb(
         t, nu, th = _drive_truth(setup, info.shape[0])
         sigma_p0 = start_spread("sigma_p0", sigma_p0)
         return posterior_bound(t, nu, th, odometry, info, sigma_start=sigma_p0)
-    sig_nu = positive("sigma_speed", SIGMA_SPEED if sigma_speed is None else sigma_speed)
-    sig_th = positive("sigma_heading", SIGMA_HEADING if sigma_heading is None else sigma_heading)
+    sig_nu = positive("sigma_speed", own.speed_noise if sigma_speed is None else sigma_speed)
+    sig_th = positive(
+        "sigma_heading", own.heading_noise if sigma_heading is None else sigma_heading
+    )
     sigma_p0 = start_spread("sigma_p0", sigma_p0)
     info = finite_array("info", info, shape=(None, 2, 2))
     Q = _motion_noise(setup, info.shape[0], sig_nu, sig_th)
@@ -223,13 +230,13 @@ def unit_pcrlb(
 
     The noise is the model's ``cov`` (what is drawn, diffuse power included), not the reported
     ``crlb``; the clock bias is eliminated per epoch with a flat prior (as the PEB), the
-    motion is JAVELIN's driven by the V2X messages (:func:`drive_pcrlb`, which this equals for
-    ``calibration=False``), the start an open-sky fix of ``sigma_p0`` [m]. Computed in
+    motion is JAVELIN's driven by the V2X messages' white noise (:func:`drive_pcrlb`, which this
+    equals for ``calibration=False`` on white messages; the repeating errors of a scenario's
+    ``[odometry]`` are no states here, which leaves it lower than the bound with them, still a
+    bound), the start an open-sky fix of ``sigma_p0`` [m]. Computed in
     covariance form, each epoch a low-rank update (Woodbury), so the cost grows as ``M^2`` per
     epoch, not ``M^3``."""
-    from .._validate import boolean
-    from ..simulation.drives import SIGMA_HEADING, SIGMA_SPEED
-
+    odo = instance("setup", setup, DesignSetup).trajectory.odometry
     check_geometry(model, geometry)
     sigma_p0 = start_spread("sigma_p0", sigma_p0)
     calibration = boolean("calibration", calibration)
@@ -245,7 +252,8 @@ def unit_pcrlb(
             if K is not None and sig > 0
         ]
     m = sum(K.shape[-1] for K, _ in ks)
-    Q = _motion_noise(setup, T, SIGMA_SPEED, SIGMA_HEADING)
+    # the messages' white noise: their repeating terms, no states here, would only raise it
+    Q = _motion_noise(setup, T, odo.speed_noise, odo.heading_noise)
     Pm = np.zeros((2 + m, 2 + m))
     Pm[:2, :2] = sigma_p0**2 * np.eye(2)
     if m:

@@ -49,7 +49,6 @@ import numpy as np
 from .._physical import carrier
 from .._validate import choice, instance, nonnegative, rng_or_error
 from ..constants import C
-from ..odometry import WHITE
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .setup import DesignSetup, parse_array
@@ -192,7 +191,8 @@ def indexed_drive(
     that measures each epoch, ``calibration`` then a list of every unit's draw (one per site).
     A row of sites draws its measurements this way from the model of one site
     (:mod:`tunnelkit.design.sites`). ``odometry``: the V2X messages' model
-    (:class:`tunnelkit.odometry.Odometry`, checked; ``None``: the paper's white model)."""
+    (:class:`tunnelkit.odometry.Odometry`, checked; ``None``: the setup's trajectory's, its
+    scenario's ``[odometry]``)."""
     from ..channel import sample_clock_bias
     from ..simulation.drives import DriveData
     from ..tracking.measurements import PathMeasurements
@@ -249,7 +249,8 @@ def indexed_drive(
     # the V2X messages of every bound-route drive (one site or a row of sites), drawn as the
     # drive simulator draws them (the white model: the same draws as simulation.drives)
     truth_motion = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
-    speed, heading = (WHITE if odometry is None else odometry).draw(traj.t[:T], *truth_motion, rng)
+    odometry = traj.odometry if odometry is None else odometry
+    speed, heading = odometry.draw(traj.t[:T], *truth_motion, rng)
     return DriveData(
         setup.name,
         None,

@@ -22,7 +22,8 @@ per run) whose own p90 meets it. Monte-Carlo figures of the tracker, not bounds;
 (:func:`~tunnelkit.design.sites.row_pcrlb`: the messages' model with its biases as states, the
 serving sites' information), below which no tracker's RMSE lies beyond Monte-Carlo noise. Under impairments
 each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.design.sites.site_drive`). The V2X messages follow
-``odometry`` (a name of :data:`tunnelkit.odometry.MODELS`): the paper's white model by default,
+``odometry`` (a name of :data:`tunnelkit.odometry.MODELS`, a model, or by default the scenario's
+``[odometry]``): the paper's white model where the scenario has none,
 the optimistic case for dead reckoning, or ``"automotive"`` (a scale error and a drifting heading
 bias: dead reckoning drifts with the distance). JAVELIN is told the white noise, or with
 ``told_odometry`` the messages' model (its bias states,
@@ -34,7 +35,7 @@ e.g. one repeating term set to zero).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -119,7 +120,7 @@ class LongTunnelResult:
     runs: int
     seed: int
     wall_s: float
-    odometry: str = "white"
+    odometry: Odometry = MODELS["white"]
     told_odometry: bool = False
 
     def __post_init__(self) -> None:
@@ -129,7 +130,7 @@ class LongTunnelResult:
         positive("target", self.target), positive("length", self.length)
         integer("runs", self.runs, minimum=1), integer("seed", self.seed, minimum=0)
         nonnegative("wall_s", self.wall_s)
-        choice("odometry", self.odometry, tuple(MODELS))
+        instance("odometry", self.odometry, Odometry)
         boolean("told_odometry", self.told_odometry)
 
     def meeting(self) -> list[tuple[str, float]]:
@@ -148,7 +149,8 @@ class LongTunnelResult:
             "runs": self.runs,
             "seed": self.seed,
             "wall_s": self.wall_s,
-            "odometry": self.odometry,
+            "odometry": self.odometry.label,
+            "odometry_figures": asdict(self.odometry),
             "told_odometry": self.told_odometry,
         }
 
@@ -226,7 +228,7 @@ def long_tunnel_study(
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float | None = None,
-    odometry: str = "white",
+    odometry: str | Odometry | None = None,
     told_odometry: bool | Odometry = False,
 ) -> LongTunnelResult:
     """JAVELIN and dead reckoning along a row of ``setup``'s sites for every array x spacing
@@ -234,7 +236,8 @@ def long_tunnel_study(
     model under ``impairments`` (default none), ``target`` [m] the p90 to meet, ``bin_m`` [m]
     the bins of the worst point between sites; ``workers`` / ``scheduler`` / ``timeout`` as
     :func:`tunnelkit.runner.run_trials`; ``odometry`` the V2X messages' model, a name of
-    :data:`tunnelkit.odometry.MODELS`, which JAVELIN is told with ``told_odometry`` (``True``;
+    :data:`tunnelkit.odometry.MODELS` or an :class:`~tunnelkit.odometry.Odometry` (``None``: the
+    setup's scenario's ``[odometry]``, the paper's white model where it has none), which JAVELIN is told with ``told_odometry`` (``True``;
     an :class:`~tunnelkit.odometry.Odometry`: that model told instead). Returns a
     :class:`LongTunnelResult`."""
     from ..runner import run_trials
@@ -250,11 +253,14 @@ def long_tunnel_study(
     runs, seed = integer("runs", runs, minimum=1), integer("seed", seed, minimum=0)
     check_bytes("runs", runs * len(specs) * len(gaps) * RUN_BYTES, f"{runs} runs per row")
     target, bin_m = positive("target", target), positive("bin_m", bin_m)
-    odometry = choice("odometry", odometry, tuple(MODELS))
+    if odometry is None:
+        odometry = setup.trajectory.odometry
+    elif not isinstance(odometry, Odometry):
+        odometry = MODELS[choice("odometry", odometry, tuple(MODELS))]
     if isinstance(told_odometry, Odometry):
         told = told_odometry
     else:
-        told = MODELS[odometry] if boolean("told_odometry", told_odometry) else None
+        told = odometry if boolean("told_odometry", told_odometry) else None
     t0 = time.perf_counter()
     rows, routes, designs, keys = [], [], [], []
     for s in gaps:
@@ -269,7 +275,7 @@ def long_tunnel_study(
             designs.append(d if told is None else d.with_(config=d.config.told(told)))
             keys.append(spec.label)
     C = len(rows)
-    trial = LongTunnelTrial(tuple(rows), tuple(routes), tuple(designs), odometry=MODELS[odometry])
+    trial = LongTunnelTrial(tuple(rows), tuple(routes), tuple(designs), odometry=odometry)
     res = run_trials(
         trial,
         C * runs,
@@ -285,7 +291,7 @@ def long_tunnel_study(
     out = []
     for c in range(C):
         err = np.stack(res[c * runs : (c + 1) * runs])
-        bound = row_pcrlb(rows[c], routes[c], MODELS[odometry], trial.start_sigma)
+        bound = row_pcrlb(rows[c], routes[c], odometry, trial.start_sigma)
         summary = _summary(err, rows[c], routes[c], bin_m, target, bound)
         out.append({"array": keys[c], **summary})
     out.sort(key=lambda r: (parse_array(r["array"]).n_elements, r["spacing"]))

@@ -175,6 +175,7 @@ class SiteRow:
             y=y,
             height=h,
         )
+        traj = replace(traj, odometry=setup.trajectory.odometry)  # the same car
         centre = float(np.mean([m.centre[0] for m in setup.mounts]))
         x0 = -half + min(0.5 * positive("spacing", spacing), half) if first is None else first
         x0 = real("first", x0)
@@ -264,7 +265,6 @@ def site_route(row: SiteRow, spec, impairments=None, *, report: str = "auto") ->
     site (module docstring), its bound route (``report`` as :func:`~.fastroute.bound_route`)
     and each epoch's row, site and reference antenna. ``impairments``: as
     :func:`~tunnelkit.design.achievable.path_error_model` (default none)."""
-    from ..scenarios import Trajectory
     from .achievable import path_error_model
 
     instance("row", row, SiteRow)
@@ -296,7 +296,7 @@ def site_route(row: SiteRow, spec, impairments=None, *, report: str = "auto") ->
     local = replace(
         row.setup,
         tunnel=_lengthened(row.setup.tunnel, half),
-        trajectory=Trajectory(t=traj.t[rep], position=rel[rep], velocity=traj.velocity[rep]),
+        trajectory=replace(traj, t=traj.t[rep], position=rel[rep], velocity=traj.velocity[rep]),
     )
     geometry = route_geometry(local, spec)
     model = path_error_model(local, spec, impairments, geometry=geometry)
@@ -349,7 +349,8 @@ def site_drive(
     a unit of its own: ``calibration`` a list of one
     :meth:`~tunnelkit.design.errormodel.PathErrorModel.draw_calibration` per site (``None``:
     drawn from ``rng``, site by site, before the drive's other draws). ``odometry``: the V2X
-    messages' model (:class:`tunnelkit.odometry.Odometry`; ``None``: the paper's white model)."""
+    messages' model (:class:`tunnelkit.odometry.Odometry`; ``None``: the row's trajectory's, its
+    scenario's ``[odometry]``)."""
     instance("row", row, SiteRow)
     if odometry is not None:
         instance("odometry", odometry, Odometry)

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .._validate import record, text
+from ..odometry import Odometry
 from ..schema import ScenarioError
 from .registry import ARRAYS, TRAJECTORIES, TUNNELS, Trajectory, getter
 
@@ -70,7 +71,8 @@ class Scenario:
         return ARRAYS.lookup(self.family, self.path.name)(self)
 
     def trajectory(self, tunnel=None) -> Trajectory:
-        """Ground-truth trajectory built from ``[trajectory]`` by the builder of its ``kind``."""
+        """The drive built from ``[trajectory]`` by the builder of its ``kind``, with the
+        scenario's :meth:`odometry`."""
         if tunnel is not None and not callable(getattr(tunnel, "contains", None)):
             raise TypeError(
                 f"tunnel: expected a tunnel (geometry.Tunnel2D or propagation.Tunnel3D), got "
@@ -83,7 +85,13 @@ class Scenario:
             kind, self.path.name
         )  # an unknown kind fails before the tunnel is built
         tun = self.tunnel() if tunnel is None else tunnel
-        return TRAJECTORIES.build(kind, self.path.name, sec, get, tun)
+        traj = TRAJECTORIES.build(kind, self.path.name, sec, get, tun)
+        return replace(traj, odometry=self.odometry())
+
+    def odometry(self) -> Odometry:
+        """The model of the vehicle's speed and heading messages from ``[odometry]``
+        (:meth:`tunnelkit.odometry.Odometry.from_scenario`; without it the paper's white model)."""
+        return Odometry.from_scenario(self)
 
     def noise_levels(self) -> list[tuple[float, float]]:
         """``[(sigma_theta [rad], sigma_d [m]), ...]`` from ``[noise] levels`` given in (deg, m)."""

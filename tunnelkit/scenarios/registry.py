@@ -29,6 +29,7 @@ import numpy as np
 
 from .._physical import speeds
 from .._validate import callable_, record, text
+from ..odometry import WHITE, Odometry
 from ..schema import ScenarioError
 
 __all__ = [
@@ -51,11 +52,15 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Trajectory:
-    """Sampled ground truth: ``t`` (T,), ``position`` (T, dim), ``velocity`` (T, dim)."""
+    """The vehicle's drive: its sampled ground truth ``t`` (T,), ``position`` (T, dim),
+    ``velocity`` (T, dim), and ``odometry``, the model of the speed and heading messages the
+    vehicle sends of it (:class:`tunnelkit.odometry.Odometry`; the scenario's ``[odometry]``, the
+    paper's white model by default)."""
 
     t: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
+    odometry: Odometry = WHITE
 
     def __post_init__(self) -> None:
         record(self, shapes={"t": ("T",), "position": ("T", "D"), "velocity": ("T", "D")})

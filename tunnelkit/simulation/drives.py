@@ -38,7 +38,7 @@ from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..metrics import SETTLE_S, settled
-from ..odometry import SIGMA_HEADING, SIGMA_SPEED, WHITE, Odometry
+from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.measurements import PathMeasurements
@@ -492,12 +492,14 @@ def simulate_routes(
     of :func:`path_measurements` (no extra draw, the other routes unchanged); the drive's
     ``extraction`` field is that extraction. Returns ``{extraction: DriveData}``, the adapters'
     names after the extractions. ``odometry``: the model of the V2X messages
-    (:class:`tunnelkit.odometry.Odometry`, NaN for a message lost); ``None``: the paper's white
-    model (:data:`tunnelkit.odometry.WHITE`).
+    (:class:`tunnelkit.odometry.Odometry`, NaN for a message lost); ``None``: the route's
+    (``route.trajectory.odometry``: its scenario's ``[odometry]``, the paper's white model
+    :data:`tunnelkit.odometry.WHITE` where the scenario has none).
     """
     rng = rng_or_error("rng", rng)
     cond = _condition(condition)
-    odometry = WHITE if odometry is None else instance("odometry", odometry, Odometry)
+    if odometry is not None:
+        instance("odometry", odometry, Odometry)
     if channel is not None:
         choice("channel", channel, CHANNELS)
     if n_epochs is not None:
@@ -519,6 +521,7 @@ def simulate_routes(
     no_los = replace(route, kinds=tuple(k for k in kinds_all if k != "los"))
     tunnel = route.tunnel if cond is None or cond.rrms else route.tunnel.without_plates()
     traj = route.trajectory
+    odometry = traj.odometry if odometry is None else odometry
     T = len(traj) if n_epochs is None else min(int(n_epochs), len(traj))
     measure = {e: (e, path_measurements) for e in extractions} | adapters
     acc = {e: _accumulator(T) for e in measure}
