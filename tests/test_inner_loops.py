@@ -264,3 +264,38 @@ def test_damped_system_and_solve_are_damped_step_in_two_parts():
         nm.damped_solve(system, -1.0)
     with pytest.raises(TypeError, match="system"):
         nm.damped_solve((A, g), 0.1)
+
+
+def test_free_newton_holds_a_negative_curvature_of_a_degenerate_fit():
+    """Two paths merging make the Gram matrix of the fit's atoms near singular and its Schur
+    complement ``A`` lose its positive diagonal to rounding (seen on the ray-traced slalom: -1.3e16
+    beside 9e17). Such a coordinate is held: the decrement stays finite and LAPACK is never handed
+    an overflowed matrix (it printed "DLASCL parameter number 4 had an illegal value")."""
+    import warnings
+
+    from tunnelkit.extraction import numerics as nm
+
+    rng = np.random.default_rng(11)
+    n = 10
+    J = rng.normal(size=(3 * n, n))
+    A = J.T @ J
+    bad = [3, 7]
+    for i in bad:  # a rounding-ruined row: a negative diagonal, huge entries around it
+        A[i, :] = A[:, i] = 1e16 * rng.normal(size=n)
+        A[i, i] = -1.3e16
+    A[3, 7] = A[7, 3] = 1.4e16
+    g = rng.normal(size=n)
+    none = np.zeros(n, bool)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow, no invalid value
+        free, dec = nm.free_newton(A, g, none, none)
+        step = nm.damped_step(A, g, free, 1e-3)
+    assert not free[bad].any() and free.sum() == n - len(bad)
+    assert np.isfinite(dec) and dec > 0 and np.all(np.isfinite(step)) and not step[bad].any()
+    # the held coordinates aside, it is the Newton step of the rest
+    keep = np.setdiff1d(np.arange(n), bad)
+    want = g[keep] @ np.linalg.solve(A[np.ix_(keep, keep)], g[keep])
+    assert dec == pytest.approx(want, rel=1e-9)
+    # a positive semi-definite A is untouched: every coordinate free, as before
+    f2, d2 = nm.free_newton(J.T @ J, g, none, none)
+    assert f2.all() and np.isfinite(d2)

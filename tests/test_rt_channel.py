@@ -226,6 +226,11 @@ def test_route_channel_switch_validates():
     assert isinstance(rs.raytraced, rt.RayTracedChannel)
     with pytest.raises(ValueError, match="dmc"):
         dataclasses.replace(rs, impairments=channel.Impairments(dmc=channel.DiffuseSpec(0.1)))
+    # a model option of one channel on the other is refused naming both
+    with pytest.raises(ValueError, match=r"model: 'srnf'.*channel='image'.*channel='sionna'"):
+        rs.with_options(model="srnf")
+    with pytest.raises(ValueError, match=r"diffuse_floor: .*channel='sionna'"):
+        route.with_options(diffuse_floor=True)
 
 
 def test_reproduce_refuses_a_channel_the_target_lacks():

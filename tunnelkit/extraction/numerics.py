@@ -114,11 +114,17 @@ def _free_block(A, free, every: bool):
 
 
 def free_newton_unchecked(A, g, lower, upper) -> tuple[np.ndarray, float]:
-    """:func:`free_newton` without the checks (the fits' inner loops, on their own arrays)."""
-    free = np.ones(g.size, bool)
-    for i in range(3):
-        sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
-        As = sc[:, None] * _free_block(A, free, i == 0) * sc[None, :]
+    """:func:`free_newton` without the checks (the fits' inner loops, on their own arrays).
+
+    A coordinate with a negative curvature ``A[i, i] < 0`` is held: ``A`` is a Schur complement,
+    positive semi-definite, and a negative diagonal is rounding where the fit has become
+    degenerate (two paths merging: their Gram matrix near singular), whose scaling would
+    overflow and hand LAPACK non-finite numbers."""
+    d = np.diag(A)
+    free = d >= 0.0
+    for _ in range(3):
+        sc = 1.0 / np.sqrt(np.maximum(d[free], 1e-300))
+        As = sc[:, None] * _free_block(A, free, bool(free.all())) * sc[None, :]
         gs = sc * g[free]
         newton = np.zeros(g.size)
         newton[free] = sc * np.linalg.lstsq(As, gs, rcond=1e-12)[0]

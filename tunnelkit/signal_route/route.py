@@ -127,9 +127,16 @@ class SignalRoute:
                     "impairments: dmc (synthetic diffuse multipath) cannot be added to the "
                     "ray-traced channel, which has its own diffuse power"
                 )
+            if opts.model != "exact":
+                raise ValueError(
+                    f"model: {opts.model!r} is a synthesis model of the image channel "
+                    "(channel='image'); the ray-traced channel (channel='sionna') synthesises "
+                    "every epoch from the tracer's paths"
+                )
         elif opts.diffuse_floor:
             raise ValueError(
-                "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse power"
+                "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse "
+                "power, not the image channel (channel='image')"
             )
 
     @property
