@@ -11,6 +11,7 @@ one session of a user's.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 import os
@@ -24,6 +25,7 @@ import pytest
 
 from tunnelkit import design
 from tunnelkit.design import traced
+from tunnelkit.odometry import AUTOMOTIVE
 from tunnelkit.rt.cache import CACHE_ENV
 from tunnelkit.simulation import drives, simulate_routes
 from tunnelkit.simulation.prefilter import geometry_keep
@@ -276,6 +278,15 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
             RuntimeWarning, match=f"{re.escape(str(p))} holds this drive made with other {field}"
         ):
             assert load({**stored, "key": {**stored["key"], field: value}}) is None
+    # a car's odometry (the scenario's [odometry]): the stored white messages are not its drive
+    car = dataclasses.replace(
+        setup, trajectory=dataclasses.replace(setup.trajectory, odometry=AUTOMOTIVE)
+    )
+    p.write_text(json.dumps(stored))
+    with pytest.warns(RuntimeWarning, match="made with other odometry"):
+        assert (
+            traced.stored_drive(car, array, tool.case_rng(seed, stream), n_epochs, path=p) is None
+        )
     # design_drive: the stored drive of its key read (no driving, the generator moved to the
     # drive's end), a foreign one driven
     driven = []

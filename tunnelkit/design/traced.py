@@ -43,6 +43,7 @@ from __future__ import annotations
 import copy
 import json
 from collections import OrderedDict
+from dataclasses import asdict
 from functools import partial
 from pathlib import Path
 
@@ -185,7 +186,8 @@ def drive_key(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None)
     """What a stored drive must match to be read for :func:`design_drive` (``setup``, ``spec``,
     ``rng`` at the start, ``n_epochs``): the record format, the procedure, scenario, array,
     epochs (None: the whole route), nuisance, the ray tracer's settings and the trace cache's
-    key (scene, arrays, trajectory, radio, sionna-rt version) and the generator's state."""
+    key (scene, arrays, trajectory, radio, sionna-rt version), the odometry model the drive's
+    messages are drawn from and the generator's state."""
     from ._drivestore import FORMAT
 
     setup = _setup(setup)
@@ -196,6 +198,7 @@ def drive_key(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None)
         "format": FORMAT,
         **_provenance(setup, spec, n_epochs),
         "procedure": DRIVE_PROCEDURE,
+        "odometry": asdict(setup.trajectory.odometry),  # the drive's V2X messages are drawn
         "rng_start": copy.deepcopy(rng.bit_generator.state),
     }
 
