@@ -684,6 +684,13 @@ def _odometry():
     d = drift(odo, n_drives=4, seed=0, length=100.0, speed=22.0, epoch_rate=10.0)
     d.at([40.0, 100.0])
     drift_table(drift_rows(4, 0, (40.0, 100.0)))
+    # a scenario's [odometry] (the Mont Blanc preset declares a car's), and a design told it
+    from tunnelkit.design.arrayjob import javelin_config
+    from tunnelkit.scenarios import load_scenario
+
+    car = Odometry.from_scenario(load_scenario("mont-blanc-28ghz"))
+    assert car.label == "automotive"
+    javelin_config({"d": 0.01, "direction": 0.001, "kappa": 1.0}, 0.0, None, car)
 
 
 def _trial(rng):

@@ -296,6 +296,14 @@ def test_free_newton_holds_a_negative_curvature_of_a_degenerate_fit():
     keep = np.setdiff1d(np.arange(n), bad)
     want = g[keep] @ np.linalg.solve(A[np.ix_(keep, keep)], g[keep])
     assert dec == pytest.approx(want, rel=1e-9)
+    # a zero curvature beside a coupling is held too; a zero row (a path of zero gain) is free
+    Z = np.array([[0.0, 1e16, 0.0], [1e16, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    Z[2, 2] = 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fz, dz = nm.free_newton(np.pad(Z, ((0, 1), (0, 1))) + np.diag([0, 0, 0, 2.0]),
+                                np.ones(4), np.zeros(4, bool), np.zeros(4, bool))  # fmt: skip
+    assert fz.tolist() == [False, False, True, True] and dz == pytest.approx(0.5)
     # a positive semi-definite A is untouched: every coordinate free, as before
     f2, d2 = nm.free_newton(J.T @ J, g, none, none)
     assert f2.all() and np.isfinite(d2)

@@ -39,7 +39,8 @@ def test_the_mont_blanc_preset_drives_on_a_cars_odometry():
 
 def test_the_section_names_a_model_and_replaces_terms_in_data_sheet_units(tmp_path):
     sec = (
-        "\n[odometry]\nspeed_scale = 0.005\nspeed_noise = 0.1\nheading_bias_deg = 2.0\n"
+        '\n[odometry]\nmodel = "automotive"\n'
+        "speed_scale = 0.005\nspeed_noise = 0.1\nheading_bias_deg = 2.0\n"
         "heading_drift_deg_per_sqrt_h = 0.6\nyaw_rate_bias_deg_per_h = 36.0\n"
         "heading_noise_deg = 0.5\nrate_hz = 20.0\ndropout = 0.25\n"
     )
@@ -53,8 +54,11 @@ def test_the_section_names_a_model_and_replaces_terms_in_data_sheet_units(tmp_pa
     for field in want.__dataclass_fields__:
         assert getattr(odo, field) == pytest.approx(getattr(want, field), rel=1e-12), field
     assert odo.label == "custom"
-    # a section alone is the automotive model; "white" with a term is white plus that term
-    assert load_scenario(str(_file(tmp_path, "\n[odometry]\n", "a"))).odometry() == AUTOMOTIVE
+    # a section names its model (no silent default); "white" with a term is white plus that term
+    auto = '\n[odometry]\nmodel = "automotive"\n'
+    assert load_scenario(str(_file(tmp_path, auto, "a"))).odometry() == AUTOMOTIVE
+    with pytest.raises(ScenarioError, match=r"odometry\.model"):
+        load_scenario(str(_file(tmp_path, "\n[odometry]\nspeed_scale = 0.01\n", "m")))
     w = load_scenario(str(_file(tmp_path, '\n[odometry]\nmodel = "white"\n', "w"))).odometry()
     assert w == WHITE and w.label == "white"
     ws = '\n[odometry]\nmodel = "white"\nspeed_scale = 0.01\n'
@@ -62,7 +66,8 @@ def test_the_section_names_a_model_and_replaces_terms_in_data_sheet_units(tmp_pa
         WHITE, speed_scale=0.01
     )
     # a message per epoch: rate 0
-    r0 = load_scenario(str(_file(tmp_path, "\n[odometry]\nrate_hz = 0\n", "r0"))).odometry()
+    r0s = '\n[odometry]\nmodel = "automotive"\nrate_hz = 0\n'
+    r0 = load_scenario(str(_file(tmp_path, r0s, "r0"))).odometry()
     assert r0.rate is None and r0 == replace(AUTOMOTIVE, rate=None)
 
 
@@ -77,12 +82,15 @@ def test_the_section_names_a_model_and_replaces_terms_in_data_sheet_units(tmp_pa
         ("rate_hz = -10", "odometry.rate_hz"),
         ('model = "gps"', "odometry.model"),
         ("speed_noise = 400.0", "odometry.speed_noise"),  # a speed error faster than sound
+        ("speed_noise = 0.0", "odometry.speed_noise"),  # a perfect sensor
+        ("heading_noise_deg = 0", "odometry.heading_noise_deg"),
         ("scale = 0.01", "odometry.scale"),
     ],
 )
 def test_the_section_refuses_what_no_odometry_does_naming_the_key(tmp_path, line, key):
     with pytest.raises(ScenarioError, match=key.replace(".", r"\.")):
-        load_scenario(str(_file(tmp_path, f"\n[odometry]\n{line}\n")))
+        body = line if line.startswith("model") else f'model = "automotive"\n{line}'
+        load_scenario(str(_file(tmp_path, f"\n[odometry]\n{body}\n")))
 
 
 def test_the_drive_simulator_draws_the_drives_model_unless_told_another():
@@ -134,3 +142,32 @@ def test_the_long_tunnel_study_drives_on_the_scenarios_model_by_default():
     assert own.to_json()["odometry_figures"]["speed_scale"] == AUTOMOTIVE.speed_scale
     with pytest.raises(ValueError, match="odometry"):
         long_tunnel_study(setup, ("4x4",), (200.0,), odometry="gyro", **kw)
+
+
+def test_the_designs_tracker_is_told_the_drives_white_noise():
+    from tunnelkit.design.arrayjob import javelin_config
+    from tunnelkit.tracking.javelin.designs import array_design
+
+    crlb = {"d": 0.01, "direction": 0.001, "kappa": 1.0}
+    paper = array_design(crlb, 0.0, None)
+    assert javelin_config(crlb, 0.0, None, WHITE) == paper == javelin_config(crlb, 0.0, None)
+    quiet = Odometry.white(0.05, float(np.radians(0.25)))
+    cfg = javelin_config(crlb, 0.0, None, replace(AUTOMOTIVE, speed_noise=0.05)).config
+    assert cfg.sigma_speed == 0.05 and cfg.sigma_heading == AUTOMOTIVE.heading_noise
+    cfg = javelin_config(crlb, 0.0, None, quiet).config
+    assert (cfg.sigma_speed, cfg.sigma_heading) == (0.05, quiet.heading_noise)
+
+
+def test_the_drive_bound_of_messages_without_white_noise_of_one_kind():
+    """A drive whose messages carry no white noise of one kind (a model built in code; a file
+    refuses it) is bounded by the bias-state recursion, which takes a zero, not refused."""
+    from tunnelkit.design import DesignSetup, drive_pcrlb
+
+    setup = DesignSetup.from_scenario("example-rectangular-28ghz")
+    T = 20
+    info = np.broadcast_to(np.eye(2) / 0.1**2, (T, 2, 2))
+    for odo in (replace(WHITE, heading_noise=0.0), replace(AUTOMOTIVE, speed_noise=0.0)):
+        quiet = replace(setup, trajectory=replace(setup.trajectory, odometry=odo))
+        b = drive_pcrlb(quiet, info)
+        np.testing.assert_array_equal(b, drive_pcrlb(quiet, info, odometry=odo))
+        assert np.all(np.isfinite(b)) and np.all(b > 0)

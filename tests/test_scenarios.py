@@ -152,7 +152,7 @@ MALFORMED = [
         r"'base_station\.arrays\[0\]\.shape\[0\]' must be >= 1",
     ),
     (JAV, "comb = 8 ", "comb = 0 ", r"'radio\.comb' must be >= 1"),
-    (JAV, "fc = 5.9e9", "fc = -5.9e9", r"'radio\.fc' must be > 0"),
+    (JAV, "fc = 5.9e9", "fc = -5.9e9", r"'radio\.fc' must be >= 1e\+08 Hz"),
     (
         JAV,
         "elevation_deg = -30.0",
@@ -387,7 +387,7 @@ def test_with_values_revalidates():
     s2 = S.with_values(sc, {"radio.fc": 5.9e9, "base_station.arrays[*].shape": [4, 4]})
     assert s2.get("radio.fc") == 5.9e9 and [a.M for a in s2.arrays()] == [16, 16]
     assert sc.get("radio.fc") == 28e9  # the original is untouched
-    with pytest.raises(S.ScenarioError, match=r"'radio\.fc' must be > 0"):
+    with pytest.raises(S.ScenarioError, match=r"'radio\.fc' must be >= 1e\+08 Hz"):
         S.with_values(sc, {"radio.fc": 0.0})
     with pytest.raises(S.ScenarioError, match="arrays has 2 tables"):
         S.with_values(sc, {"base_station.arrays[5].shape": [4, 4]})
@@ -464,7 +464,7 @@ def test_cli_new_writes_a_template_and_refuses_to_overwrite(tmp_path, capsys):
     r = subprocess.run(
         [sys.executable, "-m", "tunnelkit", "scenarios", str(bad)], capture_output=True, text=True
     )
-    assert r.returncode == 1 and "'radio.fc' must be > 0" in r.stderr
+    assert r.returncode == 1 and "'radio.fc' must be >= 1e+08 Hz" in r.stderr
 
 
 def test_schema_documentation_is_current():

@@ -81,7 +81,7 @@ class Odometry:
         if self.speed_noise >= MAX_SPEED:
             raise ValueError(
                 f"speed_noise: a speed error of {self.speed_noise:g} m/s is no car's odometry "
-                f"(at most {MAX_SPEED:g} m/s, faster than any road vehicle)"
+                f"(below {MAX_SPEED:g} m/s, faster than any road vehicle)"
             )
         for name, unit in (
             ("heading_bias", "rad"),
@@ -110,8 +110,8 @@ class Odometry:
 
     @classmethod
     def from_scenario(cls, scenario) -> Odometry:
-        """The scenario's ``[odometry]`` section: its ``model`` (:data:`MODELS`, "automotive" when
-        the section names none) with the terms it gives replaced (angles in degrees, the drift
+        """The scenario's ``[odometry]`` section: its ``model`` (a name of :data:`MODELS`) with the
+        terms it gives replaced (angles in degrees, the drift
         in deg/sqrt(h), the yaw-rate bias in deg/h, ``rate_hz = 0`` a message per epoch); a
         scenario without the section drives on the paper's white model (:data:`WHITE`)."""
         sections = getattr(scenario, "sections", None)
@@ -128,7 +128,7 @@ class Odometry:
                 kw[name] = float(sec[key]) * scale
         if "rate" in kw and kw["rate"] == 0.0:
             kw["rate"] = None
-        return replace(MODELS[sec.get("model", "automotive")], **kw)
+        return replace(MODELS[sec["model"]], **kw)
 
     @property
     def label(self) -> str:

@@ -14,6 +14,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._validate import instance
+from ..odometry import Odometry
 from .bounds import path_bounds, route_bounds, route_geometry
 from .channelbudget import channel_route_budget
 from .drivebound import (
@@ -34,15 +36,24 @@ __all__ = ["START_HEIGHT_SIGMA_M", "design_planes", "javelin_config"]
 START_HEIGHT_SIGMA_M = 0.05
 
 
-def javelin_config(crlb: dict, min_d: float = 0.0, planes=None):
+def javelin_config(crlb: dict, min_d: float = 0.0, planes=None, odometry=None):
     """The design's JAVELIN: :func:`tunnelkit.tracking.javelin.designs.array_design` (reported
     covariances, likelihood cost, measured births, the joint innovation test; ``crlb`` sets
     only the fixed fallback sigmas, ``min_d`` Algorithm 1's delay check; ``planes`` the
-    tunnel's surfaces when the VUEs come from the known geometry)."""
+    tunnel's surfaces when the VUEs come from the known geometry), told the white noise of the
+    drive's messages (``odometry``, the drive's model; None: the paper's 0.2 m/s and 1 deg)."""
     # the tracker and the drive simulator load on the first Monte-Carlo, not with the bounds
     from ..tracking.javelin.designs import array_design
 
-    return array_design(crlb, min_d, planes)
+    if odometry is not None:
+        instance("odometry", odometry, Odometry)
+    design = array_design(crlb, min_d, planes)
+    if odometry is None:
+        return design
+    noise = {"sigma_speed": odometry.speed_noise, "sigma_heading": odometry.heading_noise}
+    if all(getattr(design.config, k) == v for k, v in noise.items()):
+        return design  # the paper's white noise: the design as it is
+    return design.with_(config=design.config.with_(**noise))
 
 
 def design_planes(setup: DesignSetup) -> list:
@@ -227,7 +238,10 @@ class ArrayJob:
                 )
             crlb = {k: float(np.median(pb[k][ok])) for k in ("d", "direction", "kappa")}
         design = javelin_config(
-            crlb, self.setup.signal_route(spec).min_d, design_planes(self.setup)
+            crlb,
+            self.setup.signal_route(spec).min_d,
+            design_planes(self.setup),
+            self.setup.trajectory.odometry,
         )
         imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired
         budget = channel_route_budget(self.setup, spec, imp)

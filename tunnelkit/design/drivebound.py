@@ -139,8 +139,10 @@ def drive_pcrlb(
     from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
 
     own = instance("setup", setup, DesignSetup).trajectory.odometry
-    if odometry is None and sigma_speed is None and sigma_heading is None and not own.is_white:
-        odometry = own
+    perfect = own.speed_noise == 0.0 or own.heading_noise == 0.0  # no white noise of one kind
+    if odometry is None and sigma_speed is None and sigma_heading is None:
+        if not own.is_white or perfect:
+            odometry = own
     if odometry is not None:
         instance("odometry", odometry, Odometry)
         if sigma_speed is not None or sigma_heading is not None:

@@ -25,7 +25,7 @@ each site's array is a unit of its own, drawn per drive (:func:`~tunnelkit.desig
 ``odometry`` (a name of :data:`tunnelkit.odometry.MODELS`, a model, or by default the scenario's
 ``[odometry]``): the paper's white model where the scenario has none,
 the optimistic case for dead reckoning, or ``"automotive"`` (a scale error and a drifting heading
-bias: dead reckoning drifts with the distance). JAVELIN is told the white noise, or with
+bias: dead reckoning drifts with the distance). JAVELIN is told the messages' white noise, or with
 ``told_odometry`` the messages' model (its bias states,
 :meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`), or a model of its own (an
 :class:`~tunnelkit.odometry.Odometry`: a tracker told other figures than the messages carry,
@@ -271,7 +271,7 @@ def long_tunnel_study(
             crlb = median_sigmas(route.route.model)
             rows.append(row)
             routes.append(route)
-            d = javelin_config(crlb, route.route.min_d, planes)
+            d = javelin_config(crlb, route.route.min_d, planes, odometry)
             designs.append(d if told is None else d.with_(config=d.config.told(told)))
             keys.append(spec.label)
     C = len(rows)

@@ -24,8 +24,9 @@ its virtual UEs (the UE mirrored in the surfaces) do not depend on the site.
 
 The RRM plates and blockers of a scenario are local features, not a property of the row: a row
 of more than one site refuses a setup that has them (:meth:`SiteRow.along` drops them). The
-V2X messages are the white model of :func:`tunnelkit.design.fastroute.bound_drive` (the one
-place an odometry model plugs in is :func:`~tunnelkit.design.fastroute.indexed_drive`).
+V2X messages are drawn from the drive's odometry model (the setup's scenario's ``[odometry]``,
+the paper's white model where it has none) or the one given, in
+:func:`~tunnelkit.design.fastroute.indexed_drive`.
 """
 
 from __future__ import annotations

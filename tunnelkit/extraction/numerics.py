@@ -116,12 +116,16 @@ def _free_block(A, free, every: bool):
 def free_newton_unchecked(A, g, lower, upper) -> tuple[np.ndarray, float]:
     """:func:`free_newton` without the checks (the fits' inner loops, on their own arrays).
 
-    A coordinate with a negative curvature ``A[i, i] < 0`` is held: ``A`` is a Schur complement,
-    positive semi-definite, and a negative diagonal is rounding where the fit has become
-    degenerate (two paths merging: their Gram matrix near singular), whose scaling would
-    overflow and hand LAPACK non-finite numbers."""
+    A coordinate with a negative curvature ``A[i, i] < 0``, or a zero one beside a non-zero
+    coupling, is held: ``A`` is a Schur complement, positive semi-definite, and such a diagonal
+    is rounding where the fit has become degenerate (two paths merging: their Gram matrix near
+    singular), whose scaling would overflow and hand LAPACK non-finite numbers. A zero row (a
+    path of zero gain) stays free, its Newton step zero."""
     d = np.diag(A)
-    free = d >= 0.0
+    free = d > 0.0
+    zero = d == 0.0
+    if zero.any():
+        free[zero] = ~A[zero].any(axis=1)
     for _ in range(3):
         sc = 1.0 / np.sqrt(np.maximum(d[free], 1e-300))
         As = sc[:, None] * _free_block(A, free, bool(free.all())) * sc[None, :]

@@ -86,7 +86,7 @@ class Scenario:
         )  # an unknown kind fails before the tunnel is built
         tun = self.tunnel() if tunnel is None else tunnel
         traj = TRAJECTORIES.build(kind, self.path.name, sec, get, tun)
-        return replace(traj, odometry=self.odometry())
+        return replace(traj, odometry=self.odometry()) if "odometry" in self.sections else traj
 
     def odometry(self) -> Odometry:
         """The model of the vehicle's speed and heading messages from ``[odometry]``

@@ -21,7 +21,29 @@ spec, imported when a file of that family is first read: :mod:`.jiang`, :mod:`.h
 :mod:`.tunnel3d` (the JAVELIN tunnel and your own, which share their tables).
 """
 
+import importlib
+
 from .spec import FAMILIES, Key, ScenarioError, Table, family_of, validate
+
+#: names this package held when it was one module, each loaded from its module when asked for
+#: (a family's spec only then: a file of one family loads that family's spec alone)
+_MOVED = {
+    "KEY_TYPES": "spec",
+    "shape_text": "spec",
+    "validate_table": "spec",
+    "JIANG": "jiang",
+    "HALILI": "halili",
+    "ITALIANO": "tunnel3d",
+    "USER": "tunnel3d",
+    "USER_SHAPES": "tunnel3d",
+}
+
+
+def __getattr__(name: str):
+    if name in _MOVED:
+        return getattr(importlib.import_module(f"{__name__}.{_MOVED[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "FAMILIES",

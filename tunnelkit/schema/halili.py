@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from .._physical import CARRIER_HZ
 from .spec import Table, header, key_float, key_int, key_table
 
 HALILI = Table(
@@ -66,7 +67,14 @@ HALILI = Table(
             "radio",
             Table(
                 (
-                    key_float("fc", "carrier frequency", "Hz", gt=0.0, le=3e11, default=1.35e9),
+                    key_float(
+                        "fc",
+                        "carrier frequency",
+                        "Hz",
+                        ge=CARRIER_HZ[0],
+                        le=CARRIER_HZ[1],
+                        default=1.35e9,
+                    ),
                     key_float("bandwidth", "sounder bandwidth", "Hz", gt=0.0, default=80e6),
                     key_float(
                         "snapshot_period", "snapshot period t_s", "s", gt=0.0, default=975.3e-6

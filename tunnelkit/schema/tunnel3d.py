@@ -4,6 +4,7 @@ blockers, radio, ray-tracing, odometry and lane tables."""
 
 from __future__ import annotations
 
+from .._physical import CARRIER_HZ
 from .spec import Key, Table, header, key_float, key_floats, key_int, key_str, key_table, key_tables
 
 PLATE = Table(
@@ -63,7 +64,7 @@ ITALIANO_ARRAY = Table(
 def radio(user: bool) -> Table:
     return Table(
         (
-            key_float("fc", "carrier frequency", "Hz", gt=0.0, le=3e11),
+            key_float("fc", "carrier frequency", "Hz", ge=CARRIER_HZ[0], le=CARRIER_HZ[1]),
             key_float("bandwidth", "channel bandwidth", "Hz", gt=0.0),
             key_float("scs", "subcarrier spacing", "Hz", gt=0.0),
             key_int("comb", "SRS comb: one tone in `comb` is used", ge=1, le=64),
@@ -185,28 +186,70 @@ ODOMETRY = Table(
         key_str(
             "model",
             "the model the other keys start from: 'automotive' (published automotive figures, "
-            "REFERENCES.md) or 'white' (the paper's white noise, section 4.2); a section without "
-            "this key is 'automotive'",
+            "REFERENCES.md) or 'white' (the paper's white noise, section 4.2)",
             choices=("automotive", "white"),
-            default="automotive",
         ),
-        key_float("speed_scale", "sigma of the wheel-speed scale factor, one draw per drive", ge=0.0,
-           lt=1.0, optional=True),
-        key_float("speed_noise", "white speed noise per message", "m/s", ge=0.0, le=100.0, optional=True),
-        key_float("heading_bias_deg", "sigma of the heading bias at the start", "deg", ge=0.0, le=180.0,
-           optional=True),
-        key_float("heading_drift_deg_per_sqrt_h", "the heading bias's random walk (a gyro's angle random "
-           "walk)", "deg/sqrt(h)", ge=0.0, le=3600.0, optional=True),
-        key_float("yaw_rate_bias_deg_per_h", "sigma of a constant yaw-rate bias, one draw per drive",
-           "deg/h", ge=0.0, le=360_000.0, optional=True),
-        key_float("heading_noise_deg", "white heading noise per message", "deg", ge=0.0, le=180.0,
-           optional=True),
-        key_float("rate_hz", "messages per second (0: one per epoch)", "Hz", ge=0.0, le=10_000.0,
-           optional=True),
+        key_float(
+            "speed_scale",
+            "sigma of the wheel-speed scale factor, one draw per drive",
+            ge=0.0,
+            lt=1.0,
+            optional=True,
+        ),
+        key_float(
+            "speed_noise",
+            "white speed noise per message (> 0: no sensor is perfect)",
+            "m/s",
+            gt=0.0,
+            le=100.0,
+            optional=True,
+        ),
+        key_float(
+            "heading_bias_deg",
+            "sigma of the heading bias at the start",
+            "deg",
+            ge=0.0,
+            le=180.0,
+            optional=True,
+        ),
+        key_float(
+            "heading_drift_deg_per_sqrt_h",
+            "the heading bias's random walk (a gyro's angle random walk)",
+            "deg/sqrt(h)",
+            ge=0.0,
+            le=3600.0,
+            optional=True,
+        ),
+        key_float(
+            "yaw_rate_bias_deg_per_h",
+            "sigma of a constant yaw-rate bias, one draw per drive",
+            "deg/h",
+            ge=0.0,
+            le=360_000.0,
+            optional=True,
+        ),
+        key_float(
+            "heading_noise_deg",
+            "white heading noise per message (> 0)",
+            "deg",
+            gt=0.0,
+            le=180.0,
+            optional=True,
+        ),
+        key_float(
+            "rate_hz",
+            "messages per second (0: one per epoch)",
+            "Hz",
+            ge=0.0,
+            le=10_000.0,
+            optional=True,
+        ),
         key_float("dropout", "probability that a message is lost", ge=0.0, lt=1.0, optional=True),
     ),
-    "the V2X speed and heading messages (odometry); without this section the paper's white model",
-)  # fmt: skip
+    "the V2X speed and heading messages (odometry): a named model, then any of its terms "
+    "replaced; without this section the paper's white model",
+)
+
 
 LANE_KEYS = (
     key_float("x_start", "where the vehicle starts along the tunnel", "m"),

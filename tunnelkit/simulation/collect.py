@@ -36,7 +36,8 @@ def simulate_condition(
     (:func:`~tunnelkit.simulation.drives.simulate_routes`); the argument order suits
     ``functools.partial`` and :func:`per_drive`'s ``(cond, rng)``; ``nuisance`` the route's
     ``second_order`` / ``diffuse_floor`` (:func:`~tunnelkit.simulation.drives.scenario_route`);
-    ``odometry`` the V2X messages' model (:class:`tunnelkit.odometry.Odometry`, None: white)."""
+    ``odometry`` the V2X messages' model (:class:`tunnelkit.odometry.Odometry`, None: the
+    drive's own, its scenario's ``[odometry]``)."""
     if cond is not None:
         text("cond", cond)
     return simulate_routes(

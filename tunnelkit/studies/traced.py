@@ -111,7 +111,8 @@ def simulate_traced(
     measures them (same draws, same ``"paper"`` and ``"ml"`` drives), plus ``"ml-all"`` (the ML
     route's measurements of every epoch, its fit test ignored) and ``"ml-traced"`` (those the
     geometry pre-filter keeps, :func:`traced_measurements` with ``floors``); ``odometry`` the V2X
-    messages' model (:class:`tunnelkit.odometry.Odometry`, default the paper's white model)."""
+    messages' model (:class:`tunnelkit.odometry.Odometry`, default the drive's own: its
+    scenario's ``[odometry]``, the paper's white model where it has none)."""
     rng = rng_or_error("rng", rng)
     if condition not in CONDITIONS:
         raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")

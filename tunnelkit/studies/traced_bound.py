@@ -37,7 +37,8 @@ def traced_pcrlb(
     on the V2X messages and a start of ``sigma_p0`` [m] (:func:`tunnelkit.design.drive_pcrlb`).
     ``array`` is the candidate mounted as the design mounts it (the paper's 10 x 10 by default);
     ``odometry`` the messages' model with its repeating errors as states
-    (:func:`tunnelkit.design.drive_pcrlb`; None: the paper's white sigmas).
+    (:func:`tunnelkit.design.drive_pcrlb`; None: the drive's own, its scenario's ``[odometry]``,
+    the paper's white sigmas where it has none).
 
     A bound for a tracker told the reflectors; the traced errors are neither Gaussian nor
     independent between epochs (repeating biases of the bounces), so it is what the sigmas
