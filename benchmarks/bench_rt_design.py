@@ -87,12 +87,13 @@ def _m(v) -> str:
 
 def table(reps: dict, costs: dict) -> str:
     lines = [
-        "bound: on the traced route the posterior CRLB of the sigmas its tracker is told (settled "
-        "RMS); none on the image channel's channel route; DR p90: the same drives with every "
-        "measurement dropped (--dead-reckoning)",
+        "pred p90: the design's prediction (eq. 1, not a bound); told RMS: on the traced route the "
+        "posterior CRLB of the sigmas its tracker is told as independent Gaussian errors (settled "
+        "RMS; a prediction, not a bound on the traced channel); DR: the same drives with every "
+        "measurement dropped (--dead-reckoning), gain = DR RMSE / RMSE",
         f"{'channel':12s} {'array':6s} {'runs':>4s} {'median':>9s} {'p90':>9s} {'95% CI of p90':>22s} "
-        f"{'PEB p90':>9s} {'ach. p90':>9s} {'bound':>9s} {'DR p90':>9s} {'verdict':10s} "
-        "noise model / trace cost",
+        f"{'RMSE':>9s} {'PEB p90':>9s} {'pred p90':>9s} {'told RMS':>9s} {'DR p90':>9s} "
+        f"{'DR RMSE':>9s} {'gain':>5s} {'verdict':10s} noise model / trace cost",
     ]
     for ch, rep in reps.items():
         for a in rep["arrays"]:
@@ -109,11 +110,14 @@ def table(reps: dict, costs: dict) -> str:
             if ch.startswith("sionna") and c:
                 note += (f"; trace {c['median_s']:.2f} s/epoch (max {c['max_s']:.2f}), cache "
                          f"{c['bytes'] / 1e6:.0f} MB")  # fmt: skip
+            dr = a.get("dead_reckoning_rmse_m")
+            gain = f"{dr / a['rmse_m']:.2f}" if dr and a.get("rmse_m") else "-"
             lines.append(
                 f"{ch:12s} {a['array']:6s} {a['runs']:4d} {_m(a['error_median_m']):>9s} "
-                f"{_m(a['error_p90_m']):>9s} {cis:>22s} {_m(a['peb_p90_m']):>9s} "
-                f"{_m(a['achievable_p90_m']):>9s} {_m(a.get('drive_bound_known_rms_m')):>9s} "
-                f"{_m(a.get('dead_reckoning_p90_m')):>9s} "
+                f"{_m(a['error_p90_m']):>9s} {cis:>22s} {_m(a.get('rmse_m')):>9s} "
+                f"{_m(a['peb_p90_m']):>9s} {_m(a['predicted_p90_m']):>9s} "
+                f"{_m(a.get('predicted_drive_rms_m')):>9s} "
+                f"{_m(a.get('dead_reckoning_p90_m')):>9s} {_m(dr):>9s} {gain:>5s} "
                 f"{a['status']:10s} {note}"
             )
         lines.append(
