@@ -111,9 +111,9 @@ class Odometry:
     @classmethod
     def from_scenario(cls, scenario) -> Odometry:
         """The scenario's ``[odometry]`` section: its ``model`` (a name of :data:`MODELS`) with the
-        terms it gives replaced (angles in degrees, the drift
-        in deg/sqrt(h), the yaw-rate bias in deg/h, ``rate_hz = 0`` a message per epoch); a
-        scenario without the section drives on the paper's white model (:data:`WHITE`)."""
+        terms it gives replaced (angles in degrees, the drift in deg/sqrt(h), the yaw-rate bias
+        in deg/h, ``rate_hz = 0`` a message per epoch); a scenario without the section drives
+        on the paper's white model (:data:`WHITE`)."""
         sections = getattr(scenario, "sections", None)
         if not isinstance(sections, dict):
             raise TypeError(

@@ -237,9 +237,9 @@ def long_tunnel_study(
     the bins of the worst point between sites; ``workers`` / ``scheduler`` / ``timeout`` as
     :func:`tunnelkit.runner.run_trials`; ``odometry`` the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` or an :class:`~tunnelkit.odometry.Odometry` (``None``: the
-    setup's scenario's ``[odometry]``, the paper's white model where it has none), which JAVELIN is told with ``told_odometry`` (``True``;
-    an :class:`~tunnelkit.odometry.Odometry`: that model told instead). Returns a
-    :class:`LongTunnelResult`."""
+    setup's scenario's ``[odometry]``, the paper's white model where it has none), which JAVELIN
+    is told with ``told_odometry`` (``True``; an :class:`~tunnelkit.odometry.Odometry`: that
+    model told instead). Returns a :class:`LongTunnelResult`."""
     from ..runner import run_trials
 
     instance("setup", setup, DesignSetup)
