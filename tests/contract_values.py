@@ -233,12 +233,15 @@ def _signal_route():
 def _studies():
     from tunnelkit import simulation
 
-    simulation.simulate_routes(
+    drives = simulation.simulate_routes(
         "italiano2026-straight",
         np.random.default_rng(0),
         extractions=("paper",),
         n_epochs=3,
     )
+    from tunnelkit.studies.los_only import los_only
+
+    los_only(drives["paper"], 0.3)
     from tunnelkit.simulation.drives import drive_variant
 
     drive_variant("italiano2026-straight", 120.0)
@@ -687,7 +690,10 @@ def _odometry():
     # a scenario's [odometry] (the Mont Blanc preset declares a car's), and a design told it
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.scenarios import load_scenario
+    from tunnelkit.studies.los_only import los_angle_information, los_path
 
+    los_angle_information(np.array([[20.0, -1.5, 1.5]]), np.array([0.0, 0.0, 6.0]), 0.02)
+    los_path(np.array([10.4, 10.1]), np.array([0.1, -0.1]), 0.3)
     car = Odometry.from_scenario(load_scenario("mont-blanc-28ghz"))
     assert car.label == "automotive"
     javelin_config({"d": 0.01, "direction": 0.001, "kappa": 1.0}, 0.0, None, car)

@@ -299,3 +299,56 @@ def test_the_traced_pcrlb_with_a_cars_odometry():
     np.testing.assert_allclose(huge, dr, rtol=1e-6)
     with pytest.raises(TypeError, match="odometry"):
         traced_pcrlb(rows=rows, odometry="automotive")
+
+
+def test_the_line_of_sight_study_picks_without_truth_and_its_information_is_the_angles():
+    """:mod:`tunnelkit.studies.los_only`: the path taken for the line of sight is the lowest in
+    elevation among the arrivals within the window of the earliest (the ceiling's image lies
+    above it); a drive keeps one path per epoch and nothing else changes; the angles' position
+    information equals J^T J / sigma^2 with J by central differences."""
+    from dataclasses import replace as dc_replace
+
+    from tunnelkit.studies.los_only import los_angle_information, los_only, los_path
+
+    d = np.array([10.40, 10.12, 10.05, 14.0])
+    psi = np.array([-0.30, 0.20, 0.10, -0.50])
+    assert los_path(d, psi) == 2  # within 0.3 m of the earliest: 10.05 and 10.12; 10.40 is not
+    assert los_path(d, psi, window=0.0) == 2 and los_path(d, psi, window=0.3) == 2
+    assert los_path(d, psi, window=0.4) == 0 and los_path(d, psi, window=5.0) == 3
+    with pytest.raises(ValueError, match="d"):
+        los_path([], [])
+    with pytest.raises(ValueError, match="psi"):
+        los_path(d, psi[:2])
+    # a drive: one path per epoch, the chosen one, everything else the same
+    from tunnelkit.simulation import simulate_drive
+
+    drive = simulate_drive("italiano2026-straight", np.random.default_rng(2), extraction="ml",
+                           n_epochs=4)  # fmt: skip
+    one = los_only(drive)
+    for a, b in zip(drive.epochs, one.epochs, strict=True):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert len(b) == 1 and b.d[0] == a.d[los_path(a.d, a.psi)]
+    np.testing.assert_array_equal(one.speed, drive.speed)
+    assert los_only(dc_replace(drive, epochs=[None] * len(drive.epochs))).epochs[0] is None
+    with pytest.raises(ValueError, match="window"):
+        los_only(drive, window=-1.0)
+    # the information against central differences of the two angles
+    bs = np.array([0.0, 0.0, 6.0])
+    ue = np.array([[20.0, -1.5, 1.5], [5.0, 2.0, 1.5], [-40.0, 0.5, 1.5]])
+    sigma = np.radians(1.0)
+
+    def angles(p):
+        v = p - bs
+        return np.array([np.arctan2(v[1], v[0]), np.arctan2(v[2], np.hypot(v[0], v[1]))])
+
+    info = los_angle_information(ue, bs, sigma)
+    for k, p in enumerate(ue):
+        J = np.empty((2, 2))
+        for j in range(2):
+            h = np.zeros(3)
+            h[j] = 1e-6
+            J[:, j] = (angles(p + h) - angles(p - h)) / 2e-6
+        np.testing.assert_allclose(info[k], J.T @ J / sigma**2, rtol=1e-6)
+    with pytest.raises(ValueError, match="ue"):
+        los_angle_information(np.array([[0.0, 0.0, 1.0]]), bs, sigma)

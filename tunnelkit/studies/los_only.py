@@ -1,0 +1,96 @@
+"""The line of sight alone on the ray-traced channel: JAVELIN fed each epoch's earliest arrival.
+
+On the traced channel the reflections' estimates are biased by degrees per kind of path and the
+bias repeats from epoch to epoch, while the line of sight's angles are nearly unbiased (median
+-0.15 / 0.10 deg azimuth / elevation, robust sigma 1.0 / 1.8 deg; ``docs/results/traced-robust.md``).
+This study keeps, of every epoch's ML measurements (``"ml-all"`` of
+:func:`tunnelkit.studies.traced.simulate_traced`), one path taken for the line of sight and tells
+JAVELIN a plain angle sigma for it: :func:`los_only`, :func:`los_design`. The line of sight
+arrives first, but under a ceiling-mounted site the ceiling's reflection follows within
+centimetres and the delay errors swap them (the earliest arrival is the true line of sight in
+62-64 % of the epochs); the ceiling's image lies above the array, so of the arrivals within
+``window`` of the earliest the lowest in elevation is taken (87-89 %, window 0.3 m chosen on
+seed 0 among 0.3 / 0.6 / 1.0 m). No truth is used to pick it. :func:`los_angle_information` is the position
+information the line of sight's two angles would carry as independent Gaussian errors of that
+sigma, for the drive's posterior CRLB beside the tracker (a reference figure of the told model,
+not a bound on the traced channel, whose errors are neither). ``benchmarks/bench_rt_los.py``
+runs it beside the traced design and dead reckoning.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .._validate import finite_array, instance, nonnegative, positive
+
+__all__ = ["LOS_WINDOW_M", "los_angle_information", "los_design", "los_only", "los_path"]
+
+
+#: the arrivals within this delay distance of the earliest are candidates for the LoS [m]
+LOS_WINDOW_M = 0.3
+
+
+def los_path(d, psi, window: float = LOS_WINDOW_M) -> int:
+    """The index of the path taken for the line of sight among delay distances ``d`` (L,) [m]
+    and elevations ``psi`` (L,) [rad]: of the arrivals within ``window`` [m] of the earliest, the
+    lowest in elevation (``window = 0``: the earliest)."""
+    d = finite_array("d", d, ndim=1)
+    psi = finite_array("psi", psi, shape=d.shape)
+    window = nonnegative("window", window)
+    if d.size == 0:
+        raise ValueError("d: no path to choose from")
+    near = np.flatnonzero(d <= d.min() + float(window))
+    return int(near[np.argmin(psi[near])])
+
+
+def los_only(drive, window: float = LOS_WINDOW_M):
+    """``drive`` (a :class:`tunnelkit.simulation.DriveData`) with each epoch's measurements cut
+    to the path :func:`los_path` takes for the line of sight (an epoch without measurements
+    stays ``None``). Draws nothing, uses no truth."""
+    from ..simulation import DriveData
+
+    drive = instance("drive", drive, DriveData)
+    window = nonnegative("window", window)  # checked here once for every epoch
+    epochs = [
+        None
+        if ep is None or len(ep) == 0
+        else ep.subset(np.array([los_path(ep.d, ep.psi, window)]))
+        for ep in drive.epochs
+    ]
+    return replace(drive, epochs=epochs)
+
+
+def los_design(sigma_angle: float, base=None):
+    """``base`` (default the traced design, :func:`tunnelkit.studies.traced.traced_design`) told
+    ``sigma_angle`` [rad] for both angles of the path it is fed (the other sigmas unchanged)."""
+    from .traced import traced_design
+
+    sigma_angle = positive("sigma_angle", sigma_angle)
+    if sigma_angle > np.pi:
+        raise ValueError(f"sigma_angle: at most pi rad (half a turn), got {sigma_angle:g}")
+    from ..tracking.javelin import JavelinDesign
+
+    base = traced_design() if base is None else instance("base", base, JavelinDesign)
+    return base.with_(sigma_phi=sigma_angle, sigma_psi=sigma_angle)
+
+
+def los_angle_information(ue, station, sigma_angle: float) -> np.ndarray:
+    """Position information (T, 2, 2) [1/m^2] of the line of sight's azimuth and elevation seen
+    from ``station`` (3,), for the UE at ``ue`` (T, 3), each angle with an independent Gaussian
+    error of ``sigma_angle`` [rad]: ``J^T J / sigma^2`` with ``J`` the angles' Jacobian in the
+    road plane (the height known)."""
+    ue = finite_array("ue", ue, shape=(None, 3))
+    station = finite_array("station", station, shape=(3,))
+    sigma_angle = positive("sigma_angle", sigma_angle)
+    dx, dy, dz = (ue - station).T
+    rho2 = dx**2 + dy**2
+    if np.any(rho2 <= 0.0):
+        raise ValueError("ue: a position straight below or above the station has no azimuth")
+    r2 = rho2 + dz**2
+    rho = np.sqrt(rho2)
+    jac = np.empty((ue.shape[0], 2, 2))
+    jac[:, 0] = np.stack([-dy / rho2, dx / rho2], axis=1)  # azimuth atan2(dy, dx)
+    jac[:, 1] = np.stack([-dz * dx / (rho * r2), -dz * dy / (rho * r2)], axis=1)  # elevation
+    return np.swapaxes(jac, 1, 2) @ jac / sigma_angle**2
