@@ -24,6 +24,7 @@ from dataclasses import replace
 import numpy as np
 
 from .._validate import finite_array, instance, nonnegative, positive
+from ..geometry import spherical_jacobian
 
 __all__ = ["LOS_WINDOW_M", "los_angle_information", "los_design", "los_only", "los_path"]
 
@@ -80,17 +81,14 @@ def los_angle_information(ue, station, sigma_angle: float) -> np.ndarray:
     """Position information (T, 2, 2) [1/m^2] of the line of sight's azimuth and elevation seen
     from ``station`` (3,), for the UE at ``ue`` (T, 3), each angle with an independent Gaussian
     error of ``sigma_angle`` [rad]: ``J^T J / sigma^2`` with ``J`` the angles' Jacobian in the
-    road plane (the height known)."""
+    road plane (the height known; :func:`tunnelkit.geometry.spherical_jacobian`)."""
     ue = finite_array("ue", ue, shape=(None, 3))
     station = finite_array("station", station, shape=(3,))
     sigma_angle = positive("sigma_angle", sigma_angle)
-    dx, dy, dz = (ue - station).T
-    rho2 = dx**2 + dy**2
-    if np.any(rho2 <= 0.0):
-        raise ValueError("ue: a position straight below or above the station has no azimuth")
-    r2 = rho2 + dz**2
-    rho = np.sqrt(rho2)
-    jac = np.empty((ue.shape[0], 2, 2))
-    jac[:, 0] = np.stack([-dy / rho2, dx / rho2], axis=1)  # azimuth atan2(dy, dx)
-    jac[:, 1] = np.stack([-dz * dx / (rho * r2), -dz * dy / (rho * r2)], axis=1)  # elevation
+    try:
+        jac = spherical_jacobian(ue - station)[:, :2, :2]  # (azimuth, elevation) by (x, y)
+    except ValueError:
+        raise ValueError(
+            "ue: a position straight below or above the station has no azimuth"
+        ) from None
     return np.swapaxes(jac, 1, 2) @ jac / sigma_angle**2
