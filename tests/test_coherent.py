@@ -18,22 +18,17 @@ def _theta(u, kappa):
     return [u[0], u[1], 1.0 / kappa]
 
 
-def test_steering_jacobian_matches_finite_differences():
+def test_the_fits_steering_is_the_spherical_steering():
+    """The source fit's model (``exp(j psi)``, the shared spatial phase whose derivatives
+    tests/test_ml.py checks by central differences) is :func:`coherent.spherical_steering`."""
     th = np.array([[0.12, -0.31, 1 / 7.0], [-0.4, 0.2, 1 / 40.0]])
     k0 = 2 * np.pi * FC / 299792458.0
-    S, dS = coherent._steering_and_jacobian(th, POS, k0)
-    np.testing.assert_allclose(S, coherent.spherical_steering(coherent.source_points(th), POS, FC))
-    h = np.array([1e-6, 1e-6, 1e-6])  # phases are ~1e3 rad: smaller steps drown in round-off
-    for n in range(2):
-        for p in range(3):
-            tp, tm = th.copy(), th.copy()
-            tp[n, p] += h[p]
-            tm[n, p] -= h[p]
-            fd = (
-                coherent.spherical_steering(coherent.source_points(tp), POS, FC)[:, n]
-                - coherent.spherical_steering(coherent.source_points(tm), POS, FC)[:, n]
-            ) / (2 * h[p])
-            np.testing.assert_allclose(dS[:, n, p], fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max())
+    psi = extraction.numerics.spatial_phase(th, POS, k0)[0]
+    np.testing.assert_allclose(
+        np.exp(1j * psi),
+        coherent.spherical_steering(coherent.source_points(th), POS, FC),
+        atol=1e-9,
+    )
 
 
 def test_steering_is_the_channel_spatial_factor():

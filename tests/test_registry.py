@@ -91,3 +91,21 @@ def test_unknown_family_and_member_name_the_parameter():
         registry.family("nobody2000")
     with pytest.raises(ValueError, match=r"^name"):
         registry.get("jiang2023", "nothing")
+
+
+def test_get_loads_only_the_modules_it_needs():
+    """Looking up JAVELIN imports its tracker, not the TeNFiLoc baseline beside it; the family
+    lists both (a fresh process, so nothing else has loaded them)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from tunnelkit.tracking import registry\n"
+        "j = registry.get('italiano2026', 'JAVELIN')\n"
+        "print(j.__name__, 'tunnelkit.tracking.javelin.tenfiloc' in sys.modules)\n"
+        "print(list(registry.family('italiano2026')))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    first, second = out.stdout.splitlines()
+    assert first == "Javelin False"
+    assert second == "['JAVELIN', 'TeNFiLoc']"

@@ -105,29 +105,6 @@ def spherical_steering(sources, element_positions, fc: float) -> np.ndarray:
     return np.exp(1j * k0 * (dist - np.linalg.norm(q, axis=1)[None, :]))
 
 
-def _steering_and_jacobian(theta, p, k0):
-    """Steering (M, n) and its derivatives (M, n, 3) with respect to ``(u_x, u_y, w)``."""
-    th = np.asarray(theta, float).reshape(-1, 3)
-    q = source_points(th)
-    diff = q[None, :, :] - p[:, None, :]
-    dist = np.linalg.norm(diff, axis=-1)
-    rq = np.linalg.norm(q, axis=1)
-    S = np.exp(1j * k0 * (dist - rq[None, :]))
-    grad_q = k0 * (diff / dist[..., None] - (q / rq[:, None])[None])  # d phase / d q, (M, n, 3)
-    ux, uy, w = th[:, 0], th[:, 1], th[:, 2]
-    uz = q[:, 2] * w
-    dq = np.stack(
-        [
-            np.column_stack([1 / w, np.zeros_like(w), -ux / (uz * w)]),
-            np.column_stack([np.zeros_like(w), 1 / w, -uy / (uz * w)]),
-            -q / w[:, None],
-        ],
-        axis=1,
-    )  # (n, 3 params, 3 coords)
-    dphase = np.einsum("mnc,npc->mnp", grad_q, dq)
-    return S, 1j * S[..., None] * dphase
-
-
 def fit_sources(
     b, theta0, element_positions, fc: float, *, max_nfev: int = 40
 ) -> tuple[np.ndarray, np.ndarray, float]:

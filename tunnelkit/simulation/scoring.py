@@ -10,18 +10,21 @@ the VUE tracks born over the first epochs); :func:`settled` selects the epochs a
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._checks import attributes
-from .._validate import finite_array, instance, record
+from .._validate import finite_array, instance, record, text
 from ..metrics import SETTLE_S, settled
 from ..tracking import registry
 from ..tracking.javelin.designs import paper
 from ..tracking.javelin.roles import JavelinDesign
-from ..tracking.javelin.tenfiloc import TeNFiLoc
 from ..tracking.javelin.tracker import JavelinRun
 from .drives import DriveData
+
+if TYPE_CHECKING:  # the baseline's class, loaded from the registry when a drive asks for it
+    from ..tracking.javelin.tenfiloc import TeNFiLoc
 
 __all__ = [
     "SETTLE_S",
@@ -42,8 +45,9 @@ def tenfiloc_track(
     baseline defaults to :meth:`TeNFiLoc.for_drive`)."""
     if not isinstance(drive, DriveData):
         raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
-    tf = TeNFiLoc.for_drive(drive) if baseline is None else baseline
-    if not isinstance(tf, TeNFiLoc):
+    cls = registry.get("italiano2026", "TeNFiLoc")
+    tf = cls.for_drive(drive) if baseline is None else baseline
+    if not isinstance(tf, cls):
         raise TypeError(f"baseline: expected a TeNFiLoc, got {type(tf).__name__}")
     return tf.track(drive)
 
@@ -111,9 +115,11 @@ def evaluate(
     """
     if not isinstance(drive, DriveData):
         raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
-    if method not in registry.family("italiano2026"):
-        raise ValueError(f"method: expected 'JAVELIN' or 'TeNFiLoc', got {method!r}")
-    cls = registry.get("italiano2026", method)
+    try:
+        cls = registry.get("italiano2026", text("method", method))
+    except ValueError:
+        members = list(registry.family("italiano2026"))
+        raise ValueError(f"method: expected one of {members}, got {method!r}") from None
     if method == "TeNFiLoc":
         if start is not None:
             raise ValueError("start: TeNFiLoc is a snapshot method and takes no start")

@@ -18,7 +18,8 @@ from .protocol import Filter
 registry.provide("jiang2023", "tunnelkit.tracking.virtual_station")  # TSWLS, EKF, UKF
 registry.provide("jiang2023", "tunnelkit.tracking.upf")  # UPF
 registry.provide("halili2022", "tunnelkit.tracking.doppler")  # KF/EKF on Doppler and ToA
-registry.provide("italiano2026", "tunnelkit.tracking.javelin")  # JAVELIN, TeNFiLoc
+registry.provide("italiano2026", "tunnelkit.tracking.javelin.tracker")  # JAVELIN
+registry.provide("italiano2026", "tunnelkit.tracking.javelin.tenfiloc")  # TeNFiLoc
 
 __all__ = ["Filter", "registry"]
 

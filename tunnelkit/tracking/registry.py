@@ -98,7 +98,12 @@ def family(family_name: str) -> dict[str, Callable[..., Any]]:
 
 
 def get(family_name: str, name: str) -> Callable[..., Any]:
-    """One member, e.g. ``get("jiang2023", "UPF")``."""
+    """One member, e.g. ``get("jiang2023", "UPF")``; imports the family's modules only until one
+    has registered ``name``."""
+    for mod in _PROVIDERS.get(family_name, []):
+        if name in _REG.get(family_name, {}):
+            return _REG[family_name][name]
+        importlib.import_module(mod)
     fam = family(family_name)
     if name not in fam:
         raise ValueError(f"name: {name!r} is not in family {family_name!r}; members: {list(fam)}")

@@ -13,66 +13,42 @@ chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
 
 from __future__ import annotations
 
-from ..gating import ChiSquareGate
-from ..registry import register
-from . import designs
-from .associate import global_nearest_neighbour, greedy_nearest_neighbour
-from .config import JavelinConfig
-from .measurement import JavelinWarning, PathMeasurements, measurement_model, track_model
-from .roles import (
-    Associator,
-    ConsiderNoise,
-    DelayCheck,
-    DopplerClutter,
-    FixedBirth,
-    FixedNoise,
-    JavelinDesign,
-    JointTestUpdater,
-    JosephUpdater,
-    MeasuredBirth,
-    MirrorMotion,
-    RandomWalk,
-    ReflectorCurvature,
-    ReportedNoise,
-    VueCurvature,
-)
-from .state import JavelinState
-from .tenfiloc import TeNFiLoc
-from .tracker import Javelin, JavelinRun, StepReport, draw_start, run_javelin
+from ..._lazy import lazy_exports
+from ..gating import ChiSquareGate as ChiSquareGate
 
-__all__ = [
-    "Associator",
-    "ChiSquareGate",
-    "ConsiderNoise",
-    "DelayCheck",
-    "DopplerClutter",
-    "FixedBirth",
-    "FixedNoise",
-    "Javelin",
-    "JavelinConfig",
-    "JavelinDesign",
-    "JavelinRun",
-    "JavelinState",
-    "JavelinWarning",
-    "JointTestUpdater",
-    "JosephUpdater",
-    "MeasuredBirth",
-    "MirrorMotion",
-    "PathMeasurements",
-    "RandomWalk",
-    "ReflectorCurvature",
-    "ReportedNoise",
-    "StepReport",
-    "TeNFiLoc",
-    "VueCurvature",
-    "designs",
-    "draw_start",
-    "global_nearest_neighbour",
-    "greedy_nearest_neighbour",
-    "measurement_model",
-    "run_javelin",
-    "track_model",
-]
-
-register("italiano2026", "JAVELIN")(Javelin)
-register("italiano2026", "TeNFiLoc")(TeNFiLoc)
+# name -> defining submodule, loaded on first use: running JAVELIN loads neither the TeNFiLoc
+# baseline nor the designs' geometric initiator unless a caller asks for them. The trackers
+# register themselves (``tracker``: JAVELIN, ``tenfiloc``: TeNFiLoc) in the "italiano2026" family.
+_EXPORTS: dict[str, str] = {
+    "global_nearest_neighbour": "associate",
+    "greedy_nearest_neighbour": "associate",
+    "JavelinConfig": "config",
+    "JavelinWarning": "measurement",
+    "PathMeasurements": "measurement",
+    "measurement_model": "measurement",
+    "track_model": "measurement",
+    "Associator": "roles",
+    "ConsiderNoise": "roles",
+    "DelayCheck": "roles",
+    "DopplerClutter": "roles",
+    "FixedBirth": "roles",
+    "FixedNoise": "roles",
+    "JavelinDesign": "roles",
+    "JointTestUpdater": "roles",
+    "JosephUpdater": "roles",
+    "MeasuredBirth": "roles",
+    "MirrorMotion": "roles",
+    "RandomWalk": "roles",
+    "ReflectorCurvature": "roles",
+    "ReportedNoise": "roles",
+    "VueCurvature": "roles",
+    "JavelinState": "state",
+    "TeNFiLoc": "tenfiloc",
+    "Javelin": "tracker",
+    "JavelinRun": "tracker",
+    "StepReport": "tracker",
+    "draw_start": "tracker",
+    "run_javelin": "tracker",
+}
+__all__ = sorted([*_EXPORTS, "ChiSquareGate", "designs"])
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -33,6 +33,7 @@ from scipy.optimize import least_squares
 from ..._checks import attributes, real_array
 from ..._validate import choice, instance, integer, positive, record, vector
 from ...constants import C
+from ..registry import register
 from .manage import los_test
 from .measurement import PathMeasurements
 
@@ -57,6 +58,7 @@ class TeNFiLocFix:
 
 
 @dataclass
+@register("italiano2026", "TeNFiLoc")
 class TeNFiLoc:
     """Snapshot localisation from one epoch's paths (LoS tuple, else eq. 69).
 

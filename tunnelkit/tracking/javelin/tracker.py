@@ -21,6 +21,7 @@ from ..._checks import attributes, optional_real, unchecked
 from ..._physical import speeds, step_seconds
 from ..._validate import boolean, finite_array, positive, record, rng_or_error, vector
 from ..gating import ChiSquareGate
+from ..registry import register
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
 from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
@@ -76,6 +77,7 @@ class StepReport:
                nonnegative=("k", "n_paths", "n_rows", "nis", "clutter"), may_be_empty=lists)  # fmt: skip
 
 
+@register("italiano2026", "JAVELIN")
 class Javelin:
     """Variable-dimension EKF over the UE and its virtual UEs (Algorithm 4), built from the
     roles of a :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign` (default: the paper's).
