@@ -1,20 +1,10 @@
 """Antenna arrays: URA/ULA element positions, orientation and the array's local frame.
 
-Italiano et al. (2026), eq. 17-19, solve for the wave origin in a *local* frame in which the
-array lies in its xy-plane (``z_m = 0``) with the reference antenna (``m = 0``) at the origin. This
-module builds that frame and moves points and directions between it and the world frame
-(x along the tunnel, y across, z up).
-
-Local frame convention (right-handed, pinned by tests):
-
-* local ``z`` is the **boresight** (array normal) pointing at azimuth ``az`` (from world +x towards
-  +y) and elevation ``el`` (above the horizontal): ``(cos el cos az, cos el sin az, sin el)``;
-* local ``x`` is horizontal, to the left of the boresight: ``(-sin az, cos az, 0)``;
-* local ``y = z × x`` ("up" on the array face).
-
-A wave origin in front of the array has a positive local z. In this frame eq. 19 reads
-``p = kappa (cos phi sin psi, sin phi sin psi, cos psi)``: ``psi`` is the polar angle from the
-boresight (see :mod:`tunnelkit.extraction` for the eq. 19 / eq. 22 discrepancy).
+:func:`make_array` builds an :class:`ArrayGeometry` (elements from :func:`ura` or :func:`ula`)
+in the local frame of Italiano et al. (2026), eq. 17-19: the array in its xy-plane, the reference
+antenna (``m = 0``) at the origin, local ``z`` the boresight; it moves points and directions
+between that frame and the world frame (:func:`rotation`). How it works:
+docs/internals/channel-and-propagation.md.
 
     >>> from tunnelkit import arrays
     >>> arr = arrays.make_array(10, 10, fc=5.9e9, azimuth=0.0, elevation=np.radians(-30),

@@ -1,59 +1,12 @@
 """The 5G uplink SRS channel tensor of Italiano et al. (2026), eq. 1-10: synthesis only.
 
-The whole route (paths -> noisy tensor -> extraction -> Algorithm 1 measurements) is
-:mod:`tunnelkit.signal_route`; estimates are scored against the truth in :mod:`tunnelkit.evaluation`.
+:func:`channel_tensor` follows eq. 1 exactly as printed, signs included (:class:`SRSConfig` the
+radio); :func:`synthesize` adds the UE clock bias (:func:`sample_clock_bias`) and the noise of
+section 4.2 (:func:`add_noise`). Three impairments eq. 1 leaves out, off by default: calibration
+error (:func:`draw_calibration`), the spatial-wideband term (``spatial_wideband=True``) and dense
+diffuse multipath (:class:`DiffuseSpec`); :class:`Impairments` bundles them for the signal route.
 
-The tensor follows eq. 1 exactly as printed, signs included::
-
-    H[m, s, k] = sqrt(P_t) sum_l alpha_l exp(+j 2 pi fc/c delta_lm) exp(-j 2 pi s Df tau_l)
-                 exp(+j 2 pi k f_d,l T0)
-
-with ``s`` the SRS tone index (tone spacing ``Df = comb * scs``), ``k`` the symbol index,
-``T0`` the OFDM symbol period (cyclic prefix included) and ``tau_l = d_l / c + b`` where ``b`` is
-the UE clock bias (truncated Gaussian, section 4.2). Noise is ``CN(0, N0)`` per element with
-``N0 = k_B BW T_e``, ``T_e = T_ant + 290 (NF - 1)`` (section 4.2, taken literally: the noise of the
-whole band on every tensor element). ``model="srnf"`` synthesises the SR-NF channel (wavefront
-centred on the reflection point) instead of the exact physics (centred on the VUE).
-
-Two impairments eq. 1 leaves out, both off by default (the tensor is then bit-identical to eq. 1):
-
-- **calibration error** of the array: element ``m`` multiplies everything it receives by
-  ``g_m = 10^(e_m / 20) exp(j phi_m)``, gain error ``e_m ~ N(0, sigma_dB^2)`` [dB] and phase error
-  ``phi_m ~ N(0, sigma_deg^2)`` [deg], drawn once per array (:func:`draw_calibration`, or passed
-  explicitly as ``calibration=``);
-- **spatial wideband**: eq. 1 gives every element the delay of the reference antenna; the wave
-  reaches element ``m`` ``delta_lm / c`` later, so the phase of tone ``s`` depends on the
-  element. The carrier ``fc`` is the centre of the band (as :class:`SRSConfig` checks it), tone
-  ``s`` lies at ``f_s = fc + (s - s_c) Df``, ``s_c = (Nf - 1) / 2``; eq. 1's spatial factor is
-  the phase of ``delta_lm`` at ``fc``, and the term adds its phase at ``f_s - fc``:
-  ``exp(-j 2 pi s Df tau_l) exp(-j 2 pi (s - s_c) Df delta_lm / c)``
-  (``spatial_wideband=True``): element ``m``'s delay is ``tau_l + delta_lm / c``. Across the
-  100 MHz band and a 23 cm aperture that is up to about 0.2 rad at the band edges. (The delay
-  follows the geometry; the carrier's spatial phase keeps eq. 1's printed sign.) Measured from
-  the lowest tone instead (``f_0 = fc``, as this term was first written), the term would carry
-  ``exp(-j 2 pi s_c Df delta_lm / c)``: a carrier ``s_c Df`` off ``fc``, which scales every
-  direction cosine by ``1 - s_c Df / fc`` (0.68 % at 28 GHz / 380 MHz) and biases the position
-  by centimetres whatever the array size.
-
-A third term is random per slot, off by default:
-
-- **dense diffuse multipath (DMC)** (``dmc=DiffuseSpec(share, decay_s)``): the power a rough
-  tunnel scatters in every direction, as a sum of taps on a delay grid ``dtau = 1 / (K Nf Df)``
-  (``K = oversample``, finer than the resolution ``1 / (Nf Df)``) starting at the first path's
-  delay ``tau_0`` with an exponential power-delay profile ``w_p ~ exp(-p dtau / decay_s)``
-  (``sum w_p = 1``, ``span`` decays long, at most one unambiguous delay ``1 / Df``). Spatially
-  white (independent over elements), constant over the slot's symbols::
-
-      D[m, s, k] = exp(-j 2 pi s Df tau_0) sum_p beta_mp exp(-j 2 pi s p / (K Nf)),
-      beta_mp ~ CN(0, P_D w_p),   P_D = share / (1 - share) sum_l |sqrt(P_t) alpha_l|^2,
-
-  so that the diffuse power is ``share`` of the received power (specular plus diffuse) per
-  element. Its covariance is ``E[D D^H] = P_D I_M (x) R_f (x) 1 1^T`` with
-  ``R_f[s, s'] = sum_p w_p exp(-j 2 pi (s - s') Df (tau_0 + p dtau))``
-  (:meth:`DiffuseSpec.tone_covariance`). The sum over taps is one zero-padded FFT of length
-  ``K Nf`` per element. The calibration error multiplies it like everything an element receives.
-
-:class:`Impairments` bundles the three for :class:`tunnelkit.signal_route.SignalRoute`.
+How it works (the "module docstring" cited below): docs/internals/channel-and-propagation.md.
 """
 
 from __future__ import annotations

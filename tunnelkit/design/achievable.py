@@ -1,52 +1,11 @@
-"""What an array achieves, not only what it could: impairments as design inputs, the per-path
-error model of the extraction and the predicted error of the position (a first-order
-prediction from the misspecified model, not a bound).
+"""What an array achieves, not only what it could: impairments as design inputs
+(:class:`DesignImpairments`), the per-path error model of the extraction along the route
+(:func:`path_error_model`) and the predicted error of the position beside the ideal PEB
+(:func:`predicted_error`: a first-order prediction from the misspecified model of
+:mod:`tunnelkit.design.mcrb`, not a bound).
 
-* :class:`DesignImpairments`: per-element calibration error (phase [deg], gain [dB]), the
-  spatial-wideband term and dense diffuse multipath (share of the received power, exponential
-  power-delay profile, spatially white), as the design takes them;
-* :func:`path_error_model`: per epoch and candidate path of the route, the truth in the
-  tracker's measurement space ``z = [phi, psi, kappa, d]`` and the error of the joint ML
-  extraction under the impairments (:class:`~tunnelkit.design.errormodel.PathErrorModel`:
-  ideal CRLB, misspecified covariance, bias, calibration sensitivities);
-* :func:`predicted_error`: the ideal PEB of :func:`~tunnelkit.design.bounds.route_bounds`
-  beside ``sqrt(E ||position bias||^2 + trace(position MCRB))``, mapped to the position exactly
-  as the PEB (horizontal position, antenna height known, clock bias and per-path gains and
-  Dopplers nuisances). With the tracker's weights (the default) the noise part too is that of
-  the fix the tracker makes, which is told one covariance block per path: the joint CRLB's
-  correlation between paths, which the PEB uses, is not reported by the extraction and not
-  used by the tracker (italiano2026-straight, ideal channel, RMS over the settled epochs: the
-  block-weighted fix 1.8 times the PEB on 4 x 4, 1.3 on 8 x 8, 1.1 on 16 x 16).
-
-The misspecified bound and its factorised evaluation are :mod:`tunnelkit.design.mcrb`. The
-calibration bias is linear in the per-element errors, ``b = K_phi phi + K_g e``; averaged over
-the calibration draw (independent, ``N(0, sigma^2)`` per element) it contributes
-``sigma_phi^2 ||K_phi||_F^2 + sigma_g^2 ||K_g||_F^2`` to ``E ||b||^2``. All linearised. Measured against Monte-Carlo of the ML extraction
-(``benchmarks/bench_achievable.py``, ``tests/test_achievable.py``): azimuth, elevation and delay
-distance within [0.5, 2] of the prediction wherever the extraction has no gross error; the
-wavefront radius only where the array resolves it (predicted RMSE below about a tenth of the
-range). Beyond that (0.5 deg and more of calibration error, or diffuse multipath, on 8 x 8 at
-28 GHz) the linear prediction of ``kappa`` is meaningless: the fit's feasible set
-(``kappa >= 0.5 m``, far field beyond 1 km) bounds the error, and the angles correlated with it
-come out up to 2-3 times better than predicted (conservative).
-
-The spatial-wideband term (:func:`tunnelkit.channel.channel_tensor`: tones around the band
-centre ``fc``) biases eq. 1's fit in two ways: the delay distance is measured to the array's
-centre rather than to its reference antenna (a corner element), a bias equal to the mean
-path-length offset over the elements that grows with the aperture (0.3-0.5 cm on 4 x 4,
-0.6-1.2 cm on 8 x 8, 1.3-2.6 cm on 16 x 16, 2.6-5.3 cm on 32 x 32 at the 28 GHz example's near
-end), and angle biases that shrink with it (up to 3.5, 0.6 and 0.3 mrad on 4 x 4 ... 16 x 16
-there). The position, which the larger arrays take more and more from the angles and the
-curvature (the clock bias absorbs the delays' common part), moves less. Along that route
-(``benchmarks/bench_wideband.py``, 28 GHz / 380 MHz) the position bias has median 2.0 cm
-(4 x 4), 2.5 cm (8 x 8), 1.6 cm (16 x 16), 1.1 cm (32 x 32) and p90 8.0, 6.6, 6.0, 3.4 cm:
-above the ideal PEB at every size (median 0.9, 0.2, 0.06, 0.01 cm). (Tones counted from ``fc`` instead, as the term was first
-written, put a carrier ``s_c Df`` = 190 MHz off ``fc`` in every element's phase: direction
-cosines scaled by ``1 - s_c Df / fc``, 0.68 %, a bias of 2.7-5.0 cm whatever the size.) An
-estimator that models the term (``wideband_model``: ``ml_paths(..., wideband=True)``) has no
-such bias; its Fisher information is eq. 1's to within 1 % (the term changes the phase of tone
-``s`` by a fraction ``(s - s_c) Df / fc`` of the carrier's, ``tests/test_achievable.py``), so
-its bound is the ideal one (with the other impairments' parts).
+How it works, and how well the prediction matches the Monte-Carlo of the extraction (with the
+measured biases of the spatial-wideband term): docs/internals/design.md.
 """
 
 from __future__ import annotations

@@ -1,31 +1,10 @@
-"""Bounds of a candidate array along the route: exact SR-NF validity, per-path CRLBs and the
-position error bound (PEB).
+"""Bounds of a candidate array along the route: exact SR-NF validity for every surface a path
+reflects on, per-path CRLBs (:func:`path_bounds`) and the position error bound (PEB) from the
+joint Fisher information of the eq. 1 tensor, all in :func:`route_bounds` (a
+:class:`RouteBounds`; the traced route: :func:`route_geometry`).
 
-* **SR-NF validity for every surface a path reflects on** (walls, ceiling/roof facets, road,
-  markings): the exact phase mismatch of :mod:`tunnelkit.fresnel`
-  (:func:`tunnelkit.fresnel.signed_mismatch`) between the true wavefront (centred on the virtual
-  UE) and the SR-NF model's (centred on the reflection point), across the whole array; an epoch
-  is valid when every path it uses stays below ``eps_phi``;
-* **per-path CRLBs** of delay distance, direction and curvature
-  (:func:`tunnelkit.extraction.crlb_paths`, structured eq. 1 model; :func:`path_bounds`);
-* a **position error bound (PEB)**: the Fisher information of the eq. 1 tensor over each path's
-  parameters ``eta_l = [Re alpha, Im alpha, mu_f, mu_t, wave origin (3)]`` (all paths jointly,
-  cross terms included), mapped through the known geometry ``theta -> eta`` and reduced to the UE
-  position by the Schur complement::
-
-      J_theta = T^T J_eta T,      PEB = sqrt(trace([J_theta^-1]_pos))
-
-  ``theta`` holds the UE position (x, y; and z unless ``height_known``), the clock bias (the
-  channel adds one bias ``b`` to every path's delay, ``tau_l = d_l / c + b``; a nuisance unless
-  ``clock_bias="known"``) and per-path nuisances (complex gain, Doppler ``mu_t``). The wave
-  origin of the LoS path is the UE; of a specular path the UE mirrored in the known plane
-  (``S_l = I - 2 n n^T``); the delay distance is ``||origin - p_0||``. *Without curvature* the
-  wavefront radius of each path is one more nuisance (the array then gives directions only);
-  *without markings* the RRM paths are left out.
-
-The tensor sums are evaluated from the rank-1 structure (inner products factorise over array,
-tones and symbols) and vectorised over epochs, so a whole route takes milliseconds: notebook 08's
-explorer redraws from :func:`route_bounds` alone.
+Evaluated from the tensor's rank-one structure and vectorised over epochs: a whole route takes
+milliseconds. How it works: docs/internals/design.md.
 """
 
 from __future__ import annotations

@@ -1,26 +1,12 @@
 """What an extraction measures along a route, as a statistical model: the design's fast
 measurement route.
 
-A :class:`PathErrorModel` holds, for every epoch ``t`` and candidate path slot ``p`` of a
-:class:`~tunnelkit.design.geometry.RouteGeometry`, the true path parameters in the tracker's
-measurement space ``z = [phi, psi, kappa, d]`` (world-frame azimuth and elevation seen from the
-array's reference antenna, wavefront radius, delay distance without clock bias) and the radial
-speed ``v``, and the error of an estimator of them:
+A :class:`PathErrorModel` holds, per epoch and candidate path slot, the true path parameters in
+the tracker's measurement space ``z = [phi, psi, kappa, d]`` and the error of an estimator of
+them (``crlb``, ``cov``, ``bias``, ``k_phase`` / ``k_gain``); :meth:`PathErrorModel.draw` turns
+it into one drive's measurements. :func:`psd_sqrt` is its matrix square root.
 
-* ``crlb`` (T, 4P, 4P): the ideal bound's covariance of all paths' ``z`` jointly; this is what
-  an efficient extraction *reports* (it does not know the impairments);
-* ``cov`` (T, 4P, 4P): the covariance the estimator actually has under the channel's random
-  terms (noise, and diffuse multipath when present): a misspecified (sandwich) bound;
-* ``bias`` (T, P, 4): the deterministic bias of the misspecified estimator (e.g. the
-  spatial-wideband term it does not model);
-* ``k_phase`` / ``k_gain`` (T, P, 4, M): the bias per radian of each element's phase error and
-  per dB of its gain error (linearised), so that one drawn calibration vector gives one array's
-  bias along the whole drive.
-
-:meth:`PathErrorModel.draw` turns it into one drive's measurements: the calibration error is
-drawn once (it belongs to the array), the Gaussian error per epoch. The joint covariances keep
-the correlation between paths (two paths a few centimetres apart at long range are estimated
-with correlated errors). Absent slots (``exists`` False) carry zeros and are never drawn.
+How it works, field by field: docs/internals/design.md.
 """
 
 from __future__ import annotations

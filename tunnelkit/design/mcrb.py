@@ -1,39 +1,13 @@
-"""The misspecified bound of eq. 1, in the factorised form the design's bounds use.
+"""The misspecified bound of eq. 1, in the factorised form the design's bounds use (Richmond &
+Horowitz 2015; Fortunati et al. 2017): the first-order bias and the sandwich covariance of an
+estimator that fits eq. 1 to data with a calibration error, the spatial-wideband term or dense
+diffuse multipath.
 
-An estimator fits the eq. 1 model ``f(eta)`` (per path ``eta_l = [Re a, Im a, mu_f, mu_t,
-s (3, local)]``, as :mod:`tunnelkit.design.bounds`) to data whose mean is ``f(eta) + delta`` and
-whose covariance is ``C = sigma^2 I + C_D``. To first order (Richmond & Horowitz 2015;
-Fortunati et al. 2017) it converges to the pseudo-true parameter
+:class:`EtaModes` holds the Jacobian's three modes (array, tones, symbols) and each
+perturbation's scores; :func:`scaled_inverse` (Jacobi-scaled inverses of stacked information
+matrices) and :func:`radial_basis` (azimuth, elevation and range directions) are its helpers.
 
-    eta_0 - eta = (Re J^H J)^-1 Re J^H delta = A^-1 s,        s = (2 / sigma^2) Re J^H delta
-
-(one Gauss-Newton step from the truth: the bias), with the sandwich covariance
-
-    A^-1 B A^-1,    A = (2 / sigma^2) Re J^H J,    B = (2 / sigma^4) Re J^H C J
-                  = A^-1 + A^-1 E A^-1,          E = (2 / sigma^4) Re J^H C_D J.
-
-``A`` drops the second-order term ``-(2 / sigma^2) Re sum r^* d^2 f`` of the Hessian (``r`` the
-residual at ``eta_0``, the part of ``delta`` the model cannot absorb). It does not depend on the
-SNR but grows with the impairment, fastest for the parameters the array resolves weakly (the
-wavefront radius): on 4 x 4 elements at 28 GHz and 1.5-2.5 m (``tests/test_achievable.py``) it
-moves the sandwich's largest standard deviation by 0.3 % at 0.005 deg calibration error, 21 %
-at 0.05 deg and 66 % at 0.5 deg, where the first-order bias is itself 25 % off the exact fit.
-``J``'s columns are rank-one tensors ``coef_i x_i (x) y_i (x) z_i`` (array,
-tones, symbols), so every inner product above is a Hadamard product of the three modes' inner
-products, and each perturbation is written as a (short) sum of rank-one terms too:
-
-* **calibration**: element ``m`` multiplies what it receives by ``1 + j phi_m + (ln 10 / 20)
-  e_m`` to first order: ``delta = sum_m (j phi_m + ln10/20 e_m) e_m (x) H_m`` is linear in the
-  errors; :meth:`EtaModes.calibration_scores` gives ``Re J^H`` of each element's unit term;
-* **spatial wideband** (:func:`tunnelkit.channel.channel_tensor`: ``fc`` the band centre):
-  ``delta_l = alpha_l a_l f_l t_l (exp(-j (s - s_c) eps_lm) - 1)`` with
-  ``eps_lm = 2 pi Df delta_lm / c`` and ``s_c = (Nf - 1) / 2``;
-  ``exp(-j (s - s_c) eps) = sum_n (-j (s - s_c) eps)^n / n!``: the series keeps every
-  term separable, truncated where the next term is below ``WB_TOL`` (checked against the exact
-  sum in the tests);
-* **dense diffuse multipath** (:class:`tunnelkit.channel.DiffuseSpec`, spatially white):
-  ``C_D = P_D I_M (x) R_f (x) 1 1^T`` with ``R_f = V diag(w) V^H``, the taps on the delay grid
-  ``1 / (K Nf Df)``, so ``F^H V`` is one zero-padded FFT per frequency atom.
+How it works: docs/internals/design.md.
 """
 
 from __future__ import annotations

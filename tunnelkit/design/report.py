@@ -1,28 +1,12 @@
 """A design sweep and its recommendation: one row per candidate array, decided by the share of
 manufactured units that meet the target.
 
-:func:`design_sweep` evaluates every candidate along the route:
+:func:`design_sweep` places every candidate, computes its ideal PEB and predicted error, runs
+the Monte-Carlo over manufactured units and gives the verdict; :class:`DesignReport` holds the
+rows, the recommendation, every input and the warnings (JSON or a text table);
+:func:`smallest_meeting` is the explorer's quick look (a prediction, not an answer).
 
-1. it is placed on the mount (an array with an element outside the cross-section is refused,
-   per array, with the reason: :meth:`DesignSetup.arrays`);
-2. the **ideal PEB** (a bound) and the **predicted error** of the design's tracker under the
-   stated impairments (:func:`tunnelkit.design.achievable.predicted_error`: each path's error
-   mapped to the position as the tracker weighs it, one block per path; a first-order
-   prediction, not a bound), SR-NF validity per surface (information under
-   ``criterion="achievable"``, a gate under ``"srnf"``); an epoch where the array cannot fix
-   the position is a gap of that epoch (the row's ``gaps``);
-3. the **Monte-Carlo** of the design's tracker over manufactured units, one calibration draw
-   each (:mod:`tunnelkit.design.units`), all arrays x drives of a batch as one task set
-   (:func:`tunnelkit.design.montecarlo.sweep_montecarlo`), more units for the arrays still
-   undecided (:func:`_sequential`), and the verdict of :mod:`tunnelkit.design.verdict` (the unit
-   yield with its Wilson interval against the required yield), the bounds over the drive set
-   beside the tracker's RMSE. Nothing is skipped on a bound or a prediction.
-
-:class:`DesignReport` holds the rows, the recommendation, every input and the warnings (an
-implausible input, an ideal array, a radio numerology that is not NR's), as JSON
-(:meth:`DesignReport.to_json`) or a text table (:meth:`DesignReport.to_table`).
-:func:`smallest_meeting` is the explorer's quick look: the smallest array *predicted* to meet
-the target (or, under ``criterion="srnf"``, with the PEB and SR-NF), a prediction, not an answer.
+How it works, step by step: docs/internals/design.md.
 """
 
 from __future__ import annotations

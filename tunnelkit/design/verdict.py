@@ -1,39 +1,12 @@
-"""Deciding a candidate array from what the system achieves: the criterion, the error quantile
-with its interval, the verdict per array by the unit yield, and the recommendation.
+"""Deciding a candidate array from what the system achieves, on plain arrays of errors (the same
+for the bound-driven and the channel Monte-Carlo).
 
-Everything here works on plain arrays, so it is the same whether the errors come from the
-bound-driven or the channel Monte-Carlo.
+The counted epochs (:func:`counted_epochs`), the criterion (:data:`CRITERIA`, :func:`gate`), the
+error quantile (:func:`share_quantile`) with its 95 % interval (:func:`cluster_quantile_ci`),
+the verdict per array by the unit yield (:func:`judge`) and the recommendation
+(:func:`recommend`). Bounds and predictions never decide.
 
-* **Counted epochs** (:func:`counted_epochs`): the epochs at least ``settle`` seconds after the
-  start (default :data:`~tunnelkit.metrics.SETTLE_S`: the tracker's start-up from the entry fix
-  is not the array's accuracy), a design input stated in the report; a window that leaves no
-  epoch is refused, never silently replaced by the whole route. The report shows the
-  whole-route quantile beside the settled one.
-* **The criterion** says which epochs can count as met. ``"achievable"`` (the design's
-  tracker, which models a reflection's wavefront on its virtual UE) scores every counted epoch;
-  SR-NF validity is reported as information. ``"srnf"`` (a route that uses eq. 51, the
-  wavefront centred on the reflection point) also requires SR-NF validity: an epoch where a
-  used path breaks it counts as an infinite error (:func:`gate`).
-* **The error quantile** (:func:`share_quantile`): the ``share``-quantile
-  (``method="inverted_cdf"``, an observed value: it is <= the target exactly when the share of
-  values <= the target is >= ``share``) of the per-epoch 2-D error, pooled over runs and over the
-  counted epochs. A non-finite error (no estimate) counts as infinite. This is the ``*_p90_m`` of
-  the report at the default ``share = 0.9``.
-* **Its 95 % interval** (:func:`cluster_quantile_ci`): Woodruff's interval with one cluster per
-  manufactured unit (all its drives), since a unit's drives share its calibration draw and the
-  epochs of one drive are correlated: deterministic; on synthetic clustered errors it covers
-  where the percentile bootstrap over units (:func:`bootstrap_quantile_ci`, kept for the
-  comparison) under-covers, and on the design's Monte-Carlo 90-98 % (its docstring): the yield
-  decides, the interval informs.
-* **The verdict** (:func:`judge`) is by the **unit yield** (:mod:`tunnelkit.design.units`): the
-  share of units whose own quantile meets the target, with its Wilson 95 % interval.
-  ``"met"`` when the interval's lower end reaches the required yield, ``"not met"`` when its
-  upper end is below it, ``"undecided"`` between, or with fewer than :data:`MIN_RUNS_CI`
-  units; ``"bound only"`` with no Monte-Carlo. Bounds and predictions never decide and never
-  skip a Monte-Carlo: a bound of the RMSE is not a bound of a quantile, and a prediction can be
-  beaten by the tracker.
-* **The recommendation** (:func:`recommend`): the smallest candidate (fewest elements, then
-  aperture) that is met; with bounds only, none.
+How it works: docs/internals/design.md.
 """
 
 from __future__ import annotations

@@ -1,37 +1,13 @@
 """Coherent paths inside one CPD component: spatial separation (ours, beyond Italiano et al. 2026).
 
-In the JAVELIN tunnel every path of an epoch arrives within about a metre of the LoS (the 100 MHz
-SRS resolves 3 m) and within a fraction of a metre per second in Doppler (12 symbols resolve
-about 140 m/s). The ceiling bounce, 0.2 m above the base station, is only centimetres longer than
-the LoS. Such paths have (nearly) the same frequency and time factors, so their sum is a rank-one
-term of the tensor. The CPD of eq. 11 then returns them as **one** component, whose spatial factor
-is a mixture ``a_1 s(q_1) + a_2 s(q_2)``; eq. 16-18 read one biased angle from it, and another
-component of the rank-``L`` fit is spent on noise.
+Paths with (nearly) the same delay and Doppler are one CPD component whose spatial factor is a
+mixture; the array separates them by fitting one, two or three point sources (spherical
+wavefront, eq. 2): :func:`split_component` per component, :func:`resolve_coherent` for the
+whole estimate (:func:`fit_sources`, :func:`spherical_steering`, :func:`source_points` under
+them). The result reads like :func:`~tunnelkit.extraction.extract_paths`'s and starts the
+maximum-likelihood stage (:mod:`.ml`).
 
-The array still separates them: the steering vectors of sources ``q`` (local frame) are known in
-closed form (spherical wavefront, eq. 2), so a mixture is fitted with one, two or three sources by
-nonlinear least squares (the complex gains enter linearly). Steps:
-
-1. :func:`split_component` — for each CPD component, fit one source (started at eq. 16-24's
-   answer); while the relative residual stays above ``tol``, start one more source at the
-   far-field beam-scan peak of the residual and refit all together (RELAX-like); a split is kept
-   only if it halves the residual, its gains stay bounded and its sources are distinct.
-2. :func:`resolve_coherent` — a split component becomes one path per source, each with its own
-   delay and Doppler from the tensor, less the other components, beamformed onto the sources'
-   steering vectors; any other component takes its single-source fit (the maximum-likelihood
-   direction of one point source). The same path seen in two components (same direction, same delay and Doppler bin) is kept
-   once, the ``L`` strongest are kept (``L`` known, as in the paper), and their gains, delays
-   and Doppler shifts are re-estimated together from ``S^+ H`` wherever the array can tell
-   their steering vectors apart.
-
-The returned :class:`~tunnelkit.extraction.PathEstimates` reads like :func:`extract_paths`'s, so
-Algorithm 1, the measurements and the trackers take it unchanged. Its ``rel_error`` is the fit
-of this point-source model to ``H``, larger than the unconstrained CPD's (which also fits noise
-and mixtures with free spatial factors). Its directions are within a degree, its curvatures
-within tens of metres: each source is fitted to one CPD factor, not to the tensor. They are the
-start of the joint maximum-likelihood stage (:mod:`.ml`), which measures both at the
-Cramér-Rao bound (direction to a thousandth of a degree, ``kappa`` to centimetres at 30 m with
-a 23 cm array).
+How it works (the "module text" cited below): docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations
@@ -286,30 +262,15 @@ def resolve_coherent(
     min_power: float = 0.01,
     max_coherence: float = 0.95,
 ) -> PathEstimates:
-    """Separate coherent paths merged in the CPD components of ``est`` (see the module text).
+    """Separate coherent paths merged in the CPD components of ``est``: each component split into one
+    to three point sources, one path per source.
 
     ``H`` is the tensor ``est`` was extracted from, ``array`` and ``srs`` its array and SRS
     configuration (as in :func:`~tunnelkit.extraction.extract_paths`), ``n_paths`` the number of
-    paths to return (default ``len(est)``, at most the number of antennas). Per CPD component:
-
-    - split into two or three sources: each source is a path with its own direction and
-      curvature (NaN = far field when the fit sits on the ``KAPPA_MAX`` bound), and its own
-      delay, Doppler and gain from ``S^+ R``, where ``R`` is ``H`` minus the other components'
-      CPD terms and ``S`` the split sources' steering vectors;
-    - otherwise one source: its direction and curvature (the single-source maximum-likelihood
-      fit; for a mixture the split could not resolve, the best single point source), the
-      component's delay and Doppler.
-
-    Components weaker than ``min_power`` times the strongest (in amplitude) are not split: at
-    that level they are the noise a rank-``L`` fit spends its spare components on. Two
-    candidates closer than ``min_separation`` in ``(u_x, u_y)`` *and* within one bin in delay
-    and in Doppler are one path seen twice; the stronger is kept. If fewer than ``n_paths``
-    candidates remain, the result is shorter and a ``RuntimeWarning`` says so.
-
-    Finally the gains, delays and Doppler shifts of all kept paths are re-estimated together
-    from ``S^+ H`` (``S`` their steering vectors), except for paths whose
-    steering vector is more coherent than ``max_coherence`` with another one (the same direction
-    at two delays): those keep the values of their own component.
+    paths to return (default ``len(est)``, at most the number of antennas); ``max_sources``,
+    ``tol``, ``min_separation``, ``min_power`` and ``max_coherence`` are the split's thresholds. If
+    fewer than ``n_paths`` candidates remain, the result is shorter and a ``RuntimeWarning`` says
+    so. The algorithm, step by step: docs/internals/extraction-ml.md.
     """
     if not isinstance(est, PathEstimates):
         raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")

@@ -42,31 +42,22 @@ def extract_paths(
     srs : a :class:`tunnelkit.channel.SRSConfig`: the carrier ``fc``, the spacing ``Delta f`` of
         the tones along axis 1 (``tone_spacing``) and the period ``T0`` of the samples along
         axis 2 (``symbol_period``).
-    refine : the route.
-
-        - "ml" (default) — the joint maximum-likelihood fit of the exact eq. 1 model, started from
-          the CPD and the coherent split, with SAGE-like re-seeding (:mod:`.ml`): efficient (at
-          the structured CRLB, :func:`path_crlb`) in direction, curvature, delay and Doppler;
-        - "coherent" — "joint", then the coherent split (:func:`.coherent.resolve_coherent`);
-        - the paper's route (eq. 13-24, :func:`.paper.paper_route`): "joint" — after eq. 13,
-          maximum-likelihood refinement of all roots together with free spatial factors
-          (:func:`refine_joint`); "column" — each root to the periodogram peak of its own factor
-          column (:func:`refine_roots`); "none" — the paper's eq. 13 roots and eq. 12 gains as
-          they are.
+    refine : the route: "ml" (default; the joint maximum-likelihood fit, :mod:`.ml`), "coherent"
+        (:func:`.coherent.resolve_coherent`), or the paper's route (:func:`.paper.paper_route`)
+        with "joint", "column" or "none" refinement of the eq. 13 roots.
     method : "fast" (compressed, ESPRIT-initialised) or "plain" (``parafac(init='svd')``).
     polish : ALS sweeps on the full tensor after the compressed CPD (default 2, or 0 with
         ``refine="joint"``, which supersedes them).
     noise_power : noise power per sample for the "ml" route (default: estimated from ``H``).
-    search : the "ml" route's search: "residual" (default: re-initialisation on the residual's
-        periodogram peak until the residual test passes) or "basic" (re-seeding on the residual
-        energy alone, the route before the pair search and the residual test, kept for comparison); see
+    search : the "ml" route's search, "residual" (default) or "basic"; see
         :func:`.ml.fitting.fit_problem`.
-    wideband : the "ml" route's model carries the spatial-wideband term (each element its own
-        delay across the band, :mod:`.ml.wideband`); off by default (eq. 1).
+    wideband : the "ml" route's model carries the spatial-wideband term (:mod:`.ml.wideband`); off
+        by default (eq. 1).
 
     Returns a :class:`PathEstimates` (``alpha, d, v, direction, kappa, near_field`` and more); it
     also supports ``est["d"]``. On the "ml" route see :func:`.ml.ml_paths` for what each field
     holds (``kappa`` is finite for every near-field wave; ``fit`` has the noise floor test).
+    Each route and search in full: docs/internals/extraction-ml.md.
     """
     H = check_tensor(H)
     L = check_rank(H.shape, n_paths)

@@ -1,25 +1,13 @@
-"""Stage 2 of the extraction: the paper's route from CPD factors to path parameters (Italiano et al. 2026, eq. 13-24, Algorithm 1).
+"""Stage 2 of the extraction: the paper's route from CPD factors to path parameters (Italiano et
+al. 2026, eq. 13-24, Algorithm 1).
 
-1. :func:`vandermonde_roots` — eq. 13 shift-invariance roots, then eq. 14 (``d``) and eq. 15
-   (``v``). Eq. 13 is unbiased but not efficient for long factors (its error telescopes to the end
-   samples); :func:`refine_roots` polishes each root to the periodogram peak of its column (the
-   single-tone maximum-likelihood estimate); :func:`refine_joint` refines all roots together with
-   free spatial factors.
-2. :func:`unwrap_spatial` — eq. 16: phase of the spatial factor unwrapped in 2-D on a URA grid
-   (``skimage.restoration.unwrap_phase``, Herráez et al. 2002, the paper's ref. 25), along a
-   minimum spanning tree otherwise.
-3. :func:`solve_near_field` (TLS of eq. 17-18) and :func:`solve_far_field` (LS).
-4. :func:`angles_from_solution` — eq. 19-24. **Convention**: eq. 19 writes the wave origin as
-   ``kappa (cos phi sin psi, sin phi sin psi, .)`` so ``psi`` is the *polar angle from the array
-   normal*; eq. 22/24 instead return ``acos(rho / kappa)``, which is the angle *above the array
-   plane* (``pi/2 - psi``). We follow eq. 19 (``psi = asin(rho / kappa)``) and report an unambiguous
-   unit ``direction`` in the local frame (front half-space, local z > 0).
-5. :func:`algorithm1` — ExtractMeas' consistency checks: discard ``d < 0``; far-field when
-   ``kappa < 0``; near-field otherwise.
-6. :func:`paper_route` — steps 1-4 from a CPD to :class:`~tunnelkit.extraction.PathEstimates`.
+:func:`vandermonde_roots` (eq. 13-15; :func:`refine_roots`, :func:`refine_joint`),
+:func:`unwrap_spatial` (eq. 16), :func:`solve_near_field` and :func:`solve_far_field` (eq.
+17-18), :func:`angles_from_solution` (eq. 19-24, ``psi`` the polar angle of eq. 19),
+:func:`algorithm1` (ExtractMeas' checks) and :func:`paper_route` (steps 1-4 to a
+:class:`~tunnelkit.extraction.PathEstimates`). ``H`` follows eq. 1 exactly as printed.
 
-``H`` follows eq. 1 exactly as printed (spatial phase ``+2 pi fc/c delta``, frequency phase
-``-2 pi s Df tau``, time phase ``+2 pi k f_d T0``).
+How it works, with the eq. 19 / eq. 22 convention: docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations

@@ -23,46 +23,21 @@ class RouteOptions:
     """A route's switches (all off by default).
 
     ``model``: the image channel's synthesis model, ``"exact"`` (eq. 1, default) or ``"srnf"``
-    (the paper's SR-NF approximation, :func:`tunnelkit.channel.synthesize`).
-    ``second_order`` (0: the first-order model): the route's model also carries the
-    ``second_order`` strongest second-order specular paths the image method predicts at each
-    epoch (:func:`tunnelkit.propagation.second_order_paths`, by ``|gain|`` at the reference
-    antenna; fewer when fewer exist). They are in ``Epoch.paths`` after the first-order ones, so
-    the extraction fits them (``L`` = first-order + second-order paths) and, on the image
-    channel, they are synthesised too; they are nuisance paths for the tracker: the estimates
-    matched to them (by range and direction, :func:`tunnelkit.evaluation.match_paths`, against
-    the geometry's prediction, as ``L`` itself is) are left out of the measurements.
-    ``report_covariance``: each epoch's measurements carry the CRLB at the estimate
-    (:func:`~tunnelkit.signal_route.measurements.reported_covariance`), what the ML route's error
-    follows.
-    ``bias_aware_delay_check``: Algorithm 1 drops only ``d < -c b_max`` (the clock bias's
-    support) instead of the printed ``d < 0`` (:func:`tunnelkit.extraction.algorithm1`).
-    ``wideband_model``: the extraction models the spatial-wideband term (the ML route's
-    ``wideband=True``, :func:`tunnelkit.extraction.extract_paths`) in every epoch.
-    ``diffuse_floor`` (ray-traced channel only): the ML extraction judges its own fit
-    (``fit_ok``: residual, periodogram peak, significance) against the noise power plus the
-    epoch's diffuse power (the ray tracer's mean power per element of the paths with a diffuse
-    interaction, times the transmit power; :meth:`SignalRoute.ml_noise_power`) instead of the
-    noise alone: the diffuse paths as a known noise-like nuisance. The fitted parameters are the
-    same least-squares fit; only the tests and the re-seeding they trigger change.
-    ``model_error_floor``: an ML fit that fails its white-noise test (``fit_ok = False``) is
-    judged again against noise plus the impairment power the route was told about (its
-    ``impairments``: the diffuse share and the calibration levels'
-    :func:`~tunnelkit.signal_route.judging.calibration_floor`, the share one drawn array leaves at
-    a 1 % false-alarm rate over the draw; nothing to re-judge when
-    :func:`~tunnelkit.signal_route.judging.impairment_share` is zero, nor when the extraction
-    models the wideband term), ``Epoch.rejudged`` the test and ``Epoch.fit_ok`` its verdict; a
-    fit that passes it reports the CRLB at its estimate
-    (:func:`~tunnelkit.signal_route.measurements.reported_covariance` with ``judged=False``).
-    ``bias_budget`` (a :class:`~tunnelkit.signal_route.judging.BiasBudget` over the route's
-    epochs, None by default): every epoch's reported covariances get the budget of the slot
-    each estimate matches (:func:`~tunnelkit.signal_route.judging.apply_budget`; by direction
-    and delay) and its repeating share as ``bias_cov``.
-    ``centroid_unresolved`` (with ``report_covariance``): a path whose curvature its reported
-    covariance (the budget included) leaves unresolved is reported as a far-field path seen from
-    the array's centroid (under a calibration error an unresolved curvature is biased the same
-    way every epoch and, seen from the reference antenna at the array's corner, moves every
-    direction with it; :func:`tunnelkit.signal_route.route._centroid_far_field`).
+    (:func:`tunnelkit.channel.synthesize`).
+    ``second_order``: how many of the strongest second-order specular paths the route's model adds
+    at each epoch (0: the first-order model); nuisance paths, left out of the measurements.
+    ``report_covariance``: each epoch's measurements carry the CRLB at the estimate.
+    ``bias_aware_delay_check``: Algorithm 1 drops only ``d < -c b_max`` instead of ``d < 0``.
+    ``wideband_model``: the extraction models the spatial-wideband term in every epoch.
+    ``diffuse_floor`` (ray-traced channel only): the ML fit is judged against the noise plus the
+    epoch's diffuse power.
+    ``model_error_floor``: a fit that fails its white-noise test is judged again against the noise
+    plus the impairment power the route was told about.
+    ``bias_budget`` (a :class:`~tunnelkit.signal_route.judging.BiasBudget`): its repeating share
+    goes into each reported covariance as ``bias_cov``.
+    ``centroid_unresolved`` (with ``report_covariance``): a path with an unresolved curvature is
+    reported as a far-field path seen from the array's centroid.
+    What each switch does, in full: docs/internals/scenarios.md.
 
     >>> RouteOptions(second_order=-1)
     Traceback (most recent call last):

@@ -90,36 +90,15 @@ class PathMeasurements:
     Arrays have one entry per kept path: ``phi``/``psi`` azimuth and elevation (eq. 46-47),
     ``kappa`` the curvature radius (NaN where only the far-field estimate is valid), ``d`` the
     delay distance with the clock bias and ``v`` the radial speed (NaN where unknown). ``source``
-    keeps each kept path's row in the input (the raw
-    :class:`tunnelkit.extraction.PathEstimates` on the signal route, the arrays given to
-    :meth:`from_arrays`). ``origin`` (3,): the world position the angles are seen from (the
-    array's reference antenna on the signal route; ``None`` when the caller did not say).
-    ``site`` (3,): the position the tracker evaluates this epoch's measurement model from (the
-    serving site's reference antenna on a drive along a row of sites,
-    :mod:`tunnelkit.design.sites`); ``None``: the tracker's own base station
-    (``JavelinConfig.base_station``), as on every single-site route. The
-    route sorts the paths by ``d`` (path 0 the earliest arrival); ``delta_d``, ``z`` (eq. 52,
-    54), ``near_field``, ``direction`` and ``wave_origins`` are derived from the fields.
+    keeps each kept path's row in the input. ``origin`` (3,): the world position the angles are
+    seen from (``None``: not said); ``site`` (3,): the position the tracker evaluates the measurement
+    model from (``None``: the tracker's own base station). The route sorts the paths by ``d``;
+    ``delta_d``, ``z`` (eq. 52, 54), ``near_field``, ``direction`` and ``wave_origins`` are derived.
 
-    Optionally the extraction reports its own uncertainty per path (ours, not in the paper):
-    ``cov`` (n, 3, 3) the covariance of ``(phi, psi, kappa)`` [rad^2, rad m, m^2] and ``sigma_d``
-    (n,) [m] the standard deviation of ``d``, e.g. the CRLB at the estimate of an efficient
-    estimator (:func:`tunnelkit.extraction.estimate_crlb`). Both or neither; a tracker with
-    ``measurement_noise="reported"`` uses them instead of its fixed sigmas. ``bias_cov``
-    (n, 4, 4), with a reported covariance only: the share of it over ``(phi, psi, kappa, d)``
-    that repeats from one epoch to the next (a calibration error drawn once per array, a bias of
-    the estimator's model, :func:`~tunnelkit.signal_route.judging.apply_budget`), which a
-    bias-aware tracker (:class:`~.noise.ConsiderNoise`) keeps apart from the white share
-    ``cov - bias_cov``.
-
-    The one container of kept paths from the extraction to the trackers. Not it: the raw
-    extraction output (:class:`tunnelkit.extraction.PathEstimates`: every path found, in the
-    array's frame, before Algorithm 1), one simulated epoch's record around it
-    (:class:`tunnelkit.signal_route.Epoch`: truth, tensor, estimates and these measurements), a
-    whole drive (:class:`tunnelkit.simulation.DriveData`: one per epoch, with the truth and the
-    V2X messages), the rows one update stacks (:class:`~.update.StackedMeasurement`, eq. 54 of
-    the associated paths) and Halili's per-epoch Doppler and delay series
-    (:class:`tunnelkit.doppler_drive.DopplerToaMeasurements`).
+    Optional (ours): ``cov`` (n, 3, 3) of ``(phi, psi, kappa)`` and ``sigma_d`` (n,), both or
+    neither, used by ``measurement_noise="reported"``; ``bias_cov`` (n, 4, 4), with them only, their
+    share over ``(phi, psi, kappa, d)`` that repeats from epoch to epoch. Field by field, and what
+    this container is not: docs/internals/tracking.md.
     """
 
     phi: np.ndarray

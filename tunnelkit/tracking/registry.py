@@ -1,45 +1,12 @@
-"""Registry of interchangeable estimators, grouped by family (``"jiang2023"``, ``"halili2022"``, ...).
+"""Registry of interchangeable estimators, grouped by family (``"jiang2023"``, ``"halili2022"``,
+``"italiano2026"``).
 
-Register a factory (a class or a function returning a configured estimator) with::
-
-    @register("jiang2023", "UKF")
-    class VsUKF: ...
-
-and loop with ``family("jiang2023")`` -> ``{"TSWLS": ..., "EKF": ..., "UKF": ..., "UPF": ...}`` in
-registration order. Modules that register are imported on first lookup of their family.
-
-**One call protocol per family.** Every member of a family is built and run the same way, so a
-loop over ``family(...)`` needs no case for any member (``tests/test_registry.py`` builds and runs
-every member through it). Each member's ``name`` attribute is its registered name.
-
-``"jiang2023"`` (virtual-station ranges and bearings; :mod:`tunnelkit.tracking.virtual_station`,
-:mod:`tunnelkit.tracking.upf`)
-    Members are :class:`~tunnelkit.tracking.virtual_station.EstimatorBase` subclasses. One track:
-    ``est = cls(model, x0, P0, rng=rng, **options)`` with a ``VsModel``, the prior mean ``x0``
-    (4,) and covariance ``P0`` (4, 4) and a ``numpy.random.Generator`` (the UPF draws from it,
-    the others accept and ignore it); then ``est.step(z, first=(k == 0))`` per epoch -> the
-    state (4,) (``z`` (2N,), or ``None`` / NaN for a missed epoch), or ``est.predict()`` and
-    ``est.update(z)``; ``est.x``, ``est.P``, ``est.position``. Many runs at once:
-    ``cls.run(model, Z, x0, P0, rng=rng, **options)`` -> estimates (R, T, 4) for ``Z``
-    (R, T, 2N) and ``x0`` (R, 4) (``virtual_station.run_estimator`` checks the inputs first).
-
-``"halili2022"`` (Doppler and ToA from one roadside unit; :mod:`tunnelkit.tracking.doppler`)
-    ``trk = cls(setup, fix, sigma_hz=..., q=..., adaptive=..., **kw)`` with a ``DopplerSetup``
-    and a ``GnssFix``; keywords a member does not use are ignored, so one set of keywords serves
-    the whole family (``doppler.run_approaches``). ``trk.run(meas)`` -> ``Track`` over a whole
-    ``DopplerToaMeasurements`` stream (epoch 0 is the GNSS fix), or ``trk.step(doppler, toa)`` -> the
-    position (2,) of one further epoch; ``trk.speed()``, ``trk.n_rejected``.
-
-``"italiano2026"`` (JAVELIN, TeNFiLoc; :mod:`tunnelkit.tracking.javelin`)
-    Build for a simulated drive with ``cls.for_drive(drive, design=None)`` (JAVELIN takes a
-    :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign`, TeNFiLoc none), run with
-    ``trk.track(drive)`` -> ``(estimates (T, 3), details)`` (the ``JavelinRun``, or which epochs
-    had a fix). ``Javelin.step(paths, speed, heading, dt)`` (``predict(speed, heading, dt)``
-    then ``update(paths)``) and ``TeNFiLoc.locate(paths)`` are the per-epoch calls under it.
-
-Under the families, every filter (Jiang's, Halili's Doppler and range filters, JAVELIN) follows
-the one filter protocol of :mod:`tunnelkit.tracking.protocol`: ``predict(*inputs)``,
-``update(z)``, ``step`` (both), ``x`` and ``P``.
+``@register(family_name, name)`` registers a factory (a class or a function returning a
+configured estimator); ``family(family_name)`` gives ``{name: factory}`` in registration order,
+:func:`get` one member and :func:`families` the names; modules declared with :func:`provide` are
+imported on the first lookup of their family. One call protocol per family: every member is
+built and run the same way (``tests/test_registry.py`` runs each through it) and its ``name`` is
+its registered name. Each family's protocol in full: docs/internals/tracking.md.
 """
 
 from __future__ import annotations

@@ -2,45 +2,12 @@
 single-path periodogram against its noise-only distribution (:func:`residual_peak`,
 :func:`peak_threshold`).
 
-At the maximum-likelihood estimate of the right model the residual ``r = P_perp h`` is noise
-(less ``5 L`` of its ``2 N`` real dimensions). Its single-path periodogram
+The statistic is also the GLRT of one path more. The threshold the fit uses is calibrated by
+simulation on noise-only tensors of the same array and shape (:func:`peak_null`,
+:func:`calibrated_threshold`, at ``FALSE_ALARM``); the notebooks' calibrations are stored in
+:data:`STORE` (:func:`calibration_store`).
 
-    P(u, mu_f, mu_t) = |<x(u, mu_f, mu_t), r>|^2 / (N sigma^2),   x = a_far(u) o f(mu_f) o t(mu_t),
-
-(``||x||^2 = N``, far-field steering vector ``a_far``) is then exponential with mean 1 at every
-point; the ``N = M Nf Nt`` points of the DFT grid are independent, so the largest of them exceeds
-``t`` with probability ``1 - (1 - e^{-t})^N ~ N e^{-t}``. A path the search missed, two paths
-fitted as one, or a path in a wrong basin (a few standard deviations or more from its maximum of
-the likelihood) leave a structured residual whose periodogram peaks far above that: ``c_l``
-times the difference of two atoms puts a share of its energy, thousands of noise powers in the
-failures this test was built on, into one beam, delay and Doppler cell. The total residual energy
-(``rho``) spreads the same energy over ``N`` dimensions and misses it.
-
-The peak is sought on a grid oversampled twice in delay and Doppler (FFT), the ``n_cells``
-delay-Doppler cells with the most spatial energy, and for each of them the far-field beam scan
-of :func:`tunnelkit.extraction.numerics.scan_peak` (a beam an eighth of a beamwidth apart or
-closer); the oversampled maximum runs above the maximum over the ``N`` independent grid points,
-so the closed form :func:`peak_threshold` takes ``OVERSAMPLING_CELLS`` times more cells (an
-upper bound: its false-alarm rate stays below the stated one, far below at the paper's size).
-
-The statistic is also the generalised likelihood-ratio test (GLRT) of one path more: the cost
-decrease of adding the best grid atom with its best gain is ``peak sigma^2``. Its noise-only
-distribution depends on the array, the tensor's shape and ``n_cells`` (the scan looks at the
-``n_cells`` delay-Doppler cells with the most energy, not at every cell), so the threshold the
-fit uses is calibrated by simulation (:func:`peak_null`, :func:`calibrated_threshold`):
-``CALIBRATION_DRAWS`` noise-only tensors of that shape at that array, the largest peak of each,
-an exponential tail fitted above their upper quartile ``x_q`` (the largest of many
-near-exponential cells has an exponential upper tail; its scale ``s`` the mean excess), and
-``t = x_q + s ln(TAIL_SHARE / false_alarm)``. The tests check
-that noise-only residuals exceed it at the stated rate (within the binomial interval).
-
-A calibration costs ``CALIBRATION_DRAWS`` FFTs of the tensor (seconds for a 6 x 6 array at
-28 GHz), once per process. The calibrations of the notebooks' arrays are stored in
-``data/extraction/residual-null.json`` (:data:`STORE`, written by ``tools/residual_null.py``):
-an entry is used only when its draws, seed, tail share and cells are the current ones and the
-first of its noise-only draws, drawn and scanned again now, gives its stored peak bit for bit
-(the generator, the scan and the array are those it was made with); otherwise the calibration
-runs.
+How it works: docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations

@@ -1,69 +1,12 @@
-"""The statistical resolution limit of the maximum-likelihood stage: how far each path lies from
-the others in standard deviations of their difference (:func:`separations`,
-:func:`pair_separation`), each path's log-likelihood ratio against noise (:func:`significance`),
-and the per-path verdict :func:`resolvable` that defines the estimator's threshold region.
+"""The statistical resolution limit of the maximum-likelihood stage (Smith 2005; Liu & Nehorai 2007)
+and its threshold in SNR (the method of interval errors, Van Trees 2001 sec. 2.4).
 
-Criterion (Smith 2005; Liu & Nehorai 2007): two paths ``i, j`` with parameters ``x = (u_x, u_y,
-w, mu_f, mu_t)`` are resolvable when the test of ``Delta = x_i - x_j = 0`` (one path) against
-``Delta != 0`` (two) has power: its statistic ``Delta^T S^-1 Delta`` with ``S = Sigma_ii +
-Sigma_jj - Sigma_ij - Sigma_ji`` (``Sigma`` the inverse Fisher information of the concentrated
-model, ``(sigma^2 / 2) (Re J^H J)^-1``) is a non-central chi-square with 5 degrees of freedom
-and non-centrality ``z^2 = Delta^T S^-1 Delta``. ``z >= RESOLVE_Z = 5`` (non-centrality 25)
-detects the pair at a 1 % false-alarm rate with probability 0.87; below it the likelihood has no
-separate peak for each path and the errors leave the local bound however well the search does.
-A path is resolvable when it is that far from every other and its own log-likelihood ratio
-against noise passes the detection test of one path (the residual test's threshold at its
-false-alarm rate, :func:`~.residual.calibrated_threshold`). Evaluated at the truth this is a
-property of the snapshot (its geometry, gains and noise power), not of the search: the
-threshold region is the set of snapshots with a path not resolvable there.
-
-The threshold in SNR (:func:`snr_threshold`, :func:`outlier_probability`; the method of
-interval errors, Van Trees 2001 sec. 2.4, Richmond 2006): the concentrated likelihood of one
-path is its periodogram ``|x^H h|^2``. At the true cell it is ``|sqrt(gamma) + n_0|^2`` (in noise
-powers, ``gamma = E / sigma^2`` the path's post-integration SNR, its energy ``E`` over the noise
-power: :func:`significance`), at a cell orthogonal to it ``|n_1|^2``, ``n ~ CN(0, 1)``
-independent; the wrong cell wins with probability ``P(|n_1|^2 > |sqrt(gamma) + n_0|^2) = e^{-gamma
-/ 2} / 2`` (non-coherent orthogonal signalling). The ``N = M Nf Nt`` cells of the DFT grid in
-direction, delay and Doppler are orthogonal, so the union bound gives the outlier (interval
-error) probability ``P_out <= (N - 1) e^{-gamma / 2} / 2``; exactly, ``P_out = P(max of N - 1
-unit exponentials > |sqrt(gamma) + n_0|^2)``, one integral over the path cell's non-central
-chi-square density (:func:`outlier_probability`).
-The method of interval errors writes the mean-square error as ``(1 - P_out) CRLB + P_out
-sigma_prior^2``: an outlier lands anywhere in the search space, thousands of standard deviations
-away, so the estimate leaves the bound where ``P_out`` stops being negligible. The threshold
-SNR ``gamma_th`` is where ``P_out = OUTLIER_RATE`` (1 %): 28.5 (14.5 dB) for the paper's tensor
-(``M = 100``, ``Nf = 410``, ``Nt = 12``; the union bound's root ``2 ln((N - 1) / (2
-OUTLIER_RATE))`` is 34, loose because the events share the path cell). A path is in the
-threshold region (:func:`below_threshold`) when its SNR is below ``gamma_th`` or it lies fewer
-than ``RESOLVE_Z`` standard deviations from another path.
-
-The resolution verdict of a fit (:func:`pair_test`): the Fisher-information distance above is a
-Wald statistic evaluated at the fit, and where a path has been fitted as two it is not what it
-claims: a single path fitted as a close pair (the null) puts the two halves a median 5.4-6.4
-standard deviations apart by that measure (``benchmarks/bench_stress_pairs.py``, the paper's
-tensor), above ``RESOLVE_Z``. The test channel sounding uses instead is the generalised
-likelihood-ratio test of one path against two: for each pair of the fit closer than
-``PAIR_TEST_Z`` standard deviations, the two are merged (started at their ``|c|^2``-weighted
-centroid and at each of the two, the most likely fitted to convergence with every other path)
-and the statistic is the cost the merge adds, ``llr = (cost_merged - cost) / sigma^2``. Its null
-distribution is not chi-square (the second path's parameters are not identified under it) but
-does not depend on the SNR: by Monte-Carlo, one path of post-integration SNR 100 and 10^4 at the
-paper's tensor fitted as the best close pair, 300 draws each (seed 23), ``llr`` has median 6.8
-and 6.6, 95 % quantile 10.6 and 10.7, 99 % quantile 13.0 and 13.0. ``PAIR_LLR = 13`` is the
-threshold at the false-alarm rate ``PAIR_FALSE_ALARM`` = 1 % (one path reported as two resolved
-ones); ``tests/test_ml_pairs.py`` checks the rate on a smaller tensor. A pair below it holds one
-path's worth of information (``fit_ok`` False, reason ``"pair not resolved"``).
-
-Passing the test says two paths are there, not that their parameters can be estimated to the
-bound: detecting a split needs less SNR than estimating it (on the design seed of the stress
-matrix, ``benchmarks/bench_stress.py --seed 23``, both snapshots whose maximum of the likelihood
-lies beyond 6 standard deviations of the two-path CRLB pass it, ``llr`` 16 and 30, with their
-pair 4.5 and 2.4 standard deviations apart at the estimate). The verdict of a pair, whether the
-CRLB of the two resolved paths is a bound the estimate can reach, is therefore both tests: a pair
-is *unresolved* (:func:`unresolved_partners`; ``MLFit.unresolved``, ``PathEstimates.unresolved``)
-when one path explains it (``llr < PAIR_LLR``) or when its two paths lie fewer than
-``RESOLVE_Z`` standard deviations of their difference apart at the fit (the threshold region of
-the pair: the likelihood has no separate peak for each, reason ``"unresolved pair"``).
+Per path: its distance from the others in standard deviations of their difference
+(:func:`separations`, :func:`pair_separation`), its significance (:func:`significance`), the
+verdict :func:`resolvable` and the threshold region :func:`below_threshold`
+(:func:`snr_threshold`, :func:`outlier_probability`). Per fit: the pair test :func:`pair_test`
+and :func:`unresolved_partners`. How it works (the "module text" cited below):
+docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations

@@ -1,30 +1,11 @@
 """The maximum-likelihood model with the spatial-wideband term: :class:`WidebandProblem`.
 
-Eq. 1 gives every element the reference antenna's delay. The wave reaches element ``m``
-``delta_m / c`` later (``delta_m = ||q - p_m|| - ||q||``, the path-length offset whose carrier
-phase ``psi_m = k0 delta_m`` is eq. 1's spatial phase), so tone ``s``, at ``f_s = fc + (s - s_c)
-Df`` around the band centre ``fc`` (``s_c = (Nf - 1) / 2``), sees the extra phase
-``-2 pi (s - s_c) Df delta_m / c = -rho (s - s_c) psi_m`` with ``rho = Df / fc``
-(:func:`tunnelkit.channel.channel_tensor` with ``spatial_wideband=True``). The atom of a path is
-then no longer rank one in (element, tone):
-
-    X_l[m, s, k] = exp(j psi_m g_s) exp(j s mu_f) exp(j k mu_t),     g_s = 1 - rho (s - s_c),
-
-the same five parameters per path ``(u_x, u_y, w, mu_f, mu_t)`` and the same gains: the term
-follows from the geometry the fit estimates anyway, nothing is added to the parameter vector.
-The derivatives are ``j g_s dpsi_m / d(u_x, u_y, w)`` times the atom for the spatial parameters,
-``j s`` for ``mu_f`` and ``j k`` for ``mu_t`` (eq. 1's with ``g_s = 1``).
-
-The variable projection and Kaufman's Gauss-Newton model are eq. 1's (package text of
-:mod:`tunnelkit.extraction.ml`); only the inner products change: the atoms still factorise into
-an (element x tone) matrix and a symbol vector, so every Gram entry is the product of an inner
-product over ``M Nf`` and one over ``Nt``, and ``H`` meets the ``2L`` symbol vectors first (one
-BLAS product). An iteration costs about ``(6L)^2 M Nf`` products (eq. 1's: ``M Nf Nt 2L``),
-and the ``(M Nf) x 6L`` atom matrix is formed (25 MB for 8 x 8 elements, 792 tones, 5 paths).
-
+Each element gets its own delay across the band (:func:`tunnelkit.channel.channel_tensor` with
+``spatial_wideband=True``), with the same five parameters per path and the same gains as eq. 1.
 :class:`WidebandProblem` is a :class:`~.model.Problem`: :func:`~.fitting.fit_problem` runs on it
-unchanged. :func:`~.paths.ml_paths` with ``wideband=True`` fits eq. 1 first (its search, its
-re-seedings) and then refines that fit on this model.
+unchanged, and :func:`~.paths.ml_paths` with ``wideband=True`` refines its eq. 1 fit on it.
+
+How it works (the "module docstring" cited below): docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations

@@ -1,24 +1,12 @@
 """Prediction step (eq. 62-63): velocity-sensor UE model and VUE random walk (or mirror motion).
 
-The UE moves by the speed ``nu`` and heading ``theta`` shared over V2X:
-``p_u,k = p_u,k-1 + T nu [cos theta, sin theta, 0]``. The sensor noise (``sigma_nu``,
-``sigma_theta``) enters through ``G = d(displacement)/d(nu, theta)``:
-``Q_u = T^2 G diag(sigma_nu^2, sigma_theta^2) G^T`` plus a small height drift. A VUE follows a
-random walk, ``Q_v = sigma_w^2 T I_2`` (the paper's choice, section 3.5).
+:func:`predict` moves the state by the V2X speed and heading (:func:`ue_velocity`,
+:func:`motion_increment`) with the sensor noise; a VUE follows a random walk (the paper's
+:class:`RandomWalk`) or the mirrored UE displacement (ours, :class:`MirrorMotion`). Told an
+odometry model with repeating errors, the state also carries its biases
+(:func:`odometry_transition`).
 
-``vue_motion="mirror"`` (ours): a VUE of a surface running along the tunnel is the UE mirrored in
-that surface, so it moves by the mirrored UE displacement ``Delta_v = Delta_u - 2 (n . Delta_u) n``
-with ``n`` the unit vector from UE to VUE. The same speed/heading noise then drives UE and VUEs,
-correlated through one ``G``; the random walk stays on top for curved surfaces.
-
-Told an odometry model with repeating errors (ours, :meth:`~.config.JavelinConfig.told`), the
-state carries the speed scale factor ``s``, the heading bias ``b`` and the yaw-rate bias ``r``
-(:data:`~.state.ODOMETRY_STATES`) and the message is corrected by them as
-:meth:`tunnelkit.odometry.Odometry.draw` forms it (``nu = (1 + s) v + n_v``, ``theta_msg =
-theta + b + n_theta``): the UE moves by ``T nu / (1 + s) [cos(theta_msg - b), sin(theta_msg -
-b), 0]``, ``b`` by ``r T`` plus its random walk (``heading_drift^2 T``), ``s`` and ``r`` stay.
-``F`` is then ``I`` plus the displacement's sensitivity to ``s`` and ``b``
-(:func:`odometry_transition`) and ``P = F P F^T + Q``.
+How it works: docs/internals/tracking.md.
 """
 
 from __future__ import annotations

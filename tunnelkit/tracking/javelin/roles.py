@@ -1,32 +1,11 @@
 """The swappable roles of JAVELIN (Italiano et al. 2026, sections 3.2-3.5), one small class each.
 
-A tracker is :class:`~tunnelkit.tracking.javelin.config.JavelinConfig` (numbers only: gate
-probability, sigmas, misses) plus one object per role, held together by :class:`JavelinDesign`:
+A tracker is :class:`~tunnelkit.tracking.javelin.config.JavelinConfig` (numbers only) plus one
+object per role (measurement noise, associator, initiator, VUE motion, curvature model, updater,
+pre-filters), held together by :class:`JavelinDesign`, which refuses a combination that cannot
+work. The named designs are in :mod:`~tunnelkit.tracking.javelin.designs`.
 
-====================  ========================================  =================================
-role                  the paper (section 4.2)                   ours
-====================  ========================================  =================================
-measurement noise     :class:`FixedNoise` (one sigma per        :class:`FixedNoise` with
-                      quantity, diagonal TDoAs)                 ``correlated_delta_d``;
-                                                                :class:`ReportedNoise`
-                                                                (each path's reported
-                                                                covariance)
-associator            :class:`Associator` (greedy, ``eta^2``)   global nearest neighbour,
-                                                                ``eta^2 + ln det S``
-initiator             :class:`FixedBirth` (``sigma_P^2 I``,     :class:`MeasuredBirth` (the
-                      the new track updates at birth)           angles' covariance), no update
-                                                                at birth
-VUE motion            :class:`RandomWalk`                       :class:`MirrorMotion`
-curvature model       :class:`ReflectorCurvature` (eq. 51)      :class:`VueCurvature`
-updater               :class:`JosephUpdater` (eq. 64-68)        :class:`JointTestUpdater`
-pre-filters           :class:`DelayCheck` (Algorithm 1,         ``DelayCheck(min_d=-c b_max)``,
-                      ``d >= 0``)                               :class:`DopplerClutter`
-====================  ========================================  =================================
-
-Every role is a frozen dataclass whose arguments are validated at construction; a combination
-that cannot work is refused by :class:`JavelinDesign` with a message naming both roles. The
-named designs (the paper's, ours, the array design's) are factory functions in
-:mod:`~tunnelkit.tracking.javelin.designs`.
+The paper's role and ours, side by side: docs/internals/tracking.md.
 """
 
 from __future__ import annotations

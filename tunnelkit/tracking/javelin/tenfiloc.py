@@ -1,25 +1,12 @@
 """TeNFiLoc, the snapshot baseline of Italiano et al. 2026 (section 4.3, after their ref. 13).
 
-Per epoch, without memory:
+Per epoch, without memory (:meth:`TeNFiLoc.locate`, a :class:`TeNFiLocFix`): the LoS path's
+``(phi, psi, kappa)`` gives the fix; without a LoS path, the least-squares solution of eq. 69
+(ours: squared residuals, optionally the clock bias as a fourth unknown). Every branch refuses a
+fix farther than ``max_range`` from the base station; the tracking loop then holds the previous
+fix.
 
-- LoS: the tuple ``(phi, psi, kappa)`` of the LoS path gives ``p_u = b + kappa u(phi, psi)``;
-  without a curvature the delay distance ``d`` (carrying the clock bias) replaces ``kappa``.
-  Ours: a curvature is used only if it is *plausible* — positive, within ``max_range``, and
-  consistent with the delay, ``|d - kappa| <= bias_limit`` (on the LoS, ``d - kappa`` is the clock
-  bias times c, whose support is ``[-bias_limit, bias_limit]``); otherwise ``d`` replaces it, as
-  the paper does without a curvature. The paper does not say what TeNFiLoc does with a curvature
-  of kilometres on a 45 m path; taken as is it puts the fix kilometres away;
-- NLoS: minimise eq. 69 over ``p_u``. The paper prints a plain sum of residuals
-  ``sum_l w_l (||p_u - p_s,l|| - d_l + kappa_l)``: with positive weights it is convex, its
-  minimum the weighted geometric median of the reflectors, where ``d_l`` and ``kappa_l`` enter
-  as constants and play no role (the paper leaves eq. 69 out of its results, section 4.3); we
-  minimise the sum of *squared* residuals (least squares, the form the paper's "LS algorithm" needs) and, ours,
-  optionally solve for the clock bias as a fourth unknown (``d_l = kappa_l + ||p_u - p_s,l|| + beta``)
-  instead of assuming perfect synchronisation. ``p_s,l = b + kappa_l u_l`` is the reflector of
-  eq. 19. A fitted bias outside the support (``|beta| > bias_limit``) refuses the fix.
-
-Every branch refuses a fix farther than ``max_range`` from the base station (``mode="none"``);
-the tracking loop then holds the previous fix.
+How it works, and where it departs from the paper: docs/internals/tracking.md.
 """
 
 from __future__ import annotations

@@ -1,30 +1,11 @@
 """The variable-dimension EKF update (eq. 64-68) with the Joseph-form covariance.
 
-From the pairs (track, path) left by association and track management we stack, per pair, the
-rows ``phi, psi`` and ``kappa`` (if the path has a near-field curvature), and the TDoA rows
-``Delta d_j = d_j - d_ref`` against a reference path (the LoS path when there is one, as in eq. 52
-and Algorithm 1 line 13; otherwise, ours, the shortest associated path, since TDoAs between
-reflections are clock-bias free too). The stacked vector is the sorted ``z`` of eq. 54.
+:func:`stack_measurement` stacks the associated pairs into the sorted ``z`` of eq. 54
+(:class:`StackedMeasurement`); :func:`joseph_update` updates; a bias-aware tracker (ours) updates
+as a Schmidt-Kalman consider filter (:func:`consider_update`, :func:`schmidt_update`);
+:class:`JosephUpdater` and :class:`JointTestUpdater` are the updater roles.
 
-A bias-aware tracker (ours, :class:`~tunnelkit.tracking.javelin.noise.ConsiderNoise`) updates
-as a Schmidt-Kalman *consider* filter (:func:`consider_update`, :func:`schmidt_update`): the
-error a path's measurement repeats from epoch to epoch (one array's calibration draw, the
-estimator's model bias) is ``L_j u_i`` with ``u_i`` a normalised bias per track, carried through
-its cross-covariance ``C`` with the state and never estimated.
-
-Why consider and not estimate (augmented states). A path's bias is observable only through the
-change of the geometry over the drive: at one epoch a bias in ``phi`` of the LoS is the same
-measurement as a UE moved across the tunnel, and the odometry that could tell them apart drifts
-by about as much as the bias moves the fix. Over the few seconds a design drives (40 epochs,
-55 m), the angles of a path seen from tens of metres change by degrees and its delay by tens of
-metres, so four bias states per track (six to eight tracks) would be estimated from a weak
-difference, through a linearised model, by tracks that are born and die (each birth a new,
-unobserved bias): an augmented EKF turns such weakly observable states into position error
-and into gates that accept the wrong paths. The consider filter needs none of it: its gain is
-the best linear gain among filters that leave the bias alone (it knows the bias repeats, so it
-neither averages it down nor ends confident of a biased track), its covariance is the true
-one of its estimate, and it carries ``C`` (D, 4 L_hat) only, because the biases' own covariance
-stays ``I`` (tests: ``tests/test_javelin_consider.py``, against the batch solutions).
+How it works, and why consider rather than estimate the biases: docs/internals/tracking.md.
 """
 
 from __future__ import annotations
