@@ -16,6 +16,7 @@ a bound on the traced channel. Also the share of epochs whose path taken for the
     python benchmarks/bench_rt_los.py --runs 12 --workers 2
     python benchmarks/bench_rt_los.py --runs 12 --workers 2 --scenario italiano2026-slalom --sigmas 1
     python benchmarks/bench_rt_los.py --runs 12 --workers 2 --array 8x8 --sigmas 1
+    python benchmarks/bench_rt_los.py --bound-grid 1 1/1.8 0.5/1.8 1/1.3 1/0.5
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def score(drives, seed, sigmas, start_sigma) -> dict:
     """Mean RMSE per tracker over ``drives`` (the starts from a stream of their own)."""
     rng = np.random.default_rng([seed, 1])
     td = traced_design()
-    designs = {f"LoS only, {s:g} deg": los_design(float(np.radians(s)), td) for s in sigmas}
+    designs = {f"LoS only, {s} deg": los_design(*np.radians(_pair(s)), td) for s in sigmas}
     out = {"traced design": [], "dead reckoning": [], **{k: [] for k in designs}}
     los_share = []
     for dd in drives:
@@ -86,18 +87,51 @@ def score(drives, seed, sigmas, start_sigma) -> dict:
             if ep is not None and len(ep):
                 los_share.append(int(ti[los_path(ep.d, ep.psi)]) == 0)
     res = {k: float(np.mean(v)) for k, v in out.items()}
+    # the root mean square over the drives: the statistic a posterior CRLB bounds
+    res["_rms"] = {k: float(np.sqrt(np.mean(np.square(v)))) for k, v in out.items()}
     res["_los_share"] = float(np.mean(los_share)) if los_share else float("nan")
     return res
 
 
+def _pair(text: str) -> tuple[float, float]:
+    """``"1"`` or ``"1/1.8"``: the azimuth's and the elevation's sigma [deg]."""
+    az, _, el = text.partition("/")
+    return float(az), float(el or az)
+
+
 def reference(drive, sigma_deg, start_sigma, scenario=SCENARIO) -> float:
-    """Settled RMS of the drive's posterior CRLB of the LoS angles at ``sigma_deg``."""
+    """Settled RMS of the drive's posterior CRLB of the LoS angles at ``sigma_deg`` ("az[/el]")."""
     setup = DesignSetup.from_scenario(scenario)
     T = len(drive.truth)
-    info = los_angle_information(drive.truth, drive.base_station, float(np.radians(sigma_deg)))
+    info = los_angle_information(drive.truth, drive.base_station, *np.radians(_pair(sigma_deg)))
     b = drive_pcrlb(setup, info[:T], sigma_p0=start_sigma)
     idx = settled(drive.t)
     return float(np.sqrt(np.mean(b[idx] ** 2)))
+
+
+def bound_grid(scenario, pairs, start_sigma) -> None:
+    """The told model's posterior CRLB over the preset's drive for each "az/el" of ``pairs``
+    beside dead reckoning's (the same recursion, no radio): the largest gain a tracker told
+    Gaussian LoS angles of those sigmas can show over dead reckoning. Drives nothing."""
+    setup = DesignSetup.from_scenario(scenario)
+    ue = setup.trajectory.position
+    T = len(ue)
+    idx = settled(setup.trajectory.t[:T])
+    bs = SignalRoute.from_scenario(scenario).arrays[0].origin
+
+    def rms(info):
+        b = drive_pcrlb(setup, info, sigma_p0=start_sigma)
+        return float(np.sqrt(np.mean(b[idx] ** 2)))
+
+    dr = rms(np.zeros((T, 2, 2)))
+    print(f"\n{scenario}: told model, entry fix {start_sigma:g} m, {idx.size} settled epochs; "
+          f"dead reckoning's posterior CRLB {dr:.3f} m")  # fmt: skip
+    print(
+        "| azimuth / elevation sigma [deg] | posterior CRLB [m] | largest gain |\n| --- | --- | --- |"
+    )
+    for s in pairs:
+        b = rms(los_angle_information(ue, bs, *np.radians(_pair(s))))
+        print(f"| {s} | {b:.3f} | {dr / b:.2f}x |")
 
 
 def main() -> None:
@@ -105,10 +139,24 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=12)
     ap.add_argument("--scenario", default=SCENARIO, help="a preset with a ray-traced channel")
     ap.add_argument("--array", default=None, help="replace the preset's arrays, e.g. 8x8")
-    ap.add_argument("--sigmas", type=float, nargs="+", default=[0.5, 1.0, 2.0, 4.0, 8.0])
+    ap.add_argument(
+        "--sigmas",
+        nargs="+",
+        default=["0.5", "1", "2", "4", "8"],
+        help="told angle sigmas [deg], each 'az' (both angles) or 'az/el'",
+    )
     ap.add_argument("--start-sigma", type=float, default=1.0)
     ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument(
+        "--bound-grid",
+        nargs="+",
+        default=None,
+        help="print the told model's bound for these 'az/el' sigmas [deg] and stop (no driving)",
+    )
     a = ap.parse_args()
+    if a.bound_grid:
+        bound_grid(a.scenario, a.bound_grid, a.start_sigma)
+        return
     chosen = None
     for seed in (0, HELD_OUT_SEED):
         t0 = time.perf_counter()
@@ -117,20 +165,21 @@ def main() -> None:
         sigmas = a.sigmas if chosen is None else [chosen]
         res = score(drives, seed, sigmas, a.start_sigma)
         if chosen is None:  # chosen on seed 0, the lowest mean RMSE of the grid
-            chosen = min(sigmas, key=lambda s: res[f"LoS only, {s:g} deg"])
+            chosen = min(sigmas, key=lambda s: res[f"LoS only, {s} deg"])
         ref = reference(drives[0]["ml-traced"], chosen, a.start_sigma, a.scenario)
         dr = res["dead reckoning"]
         arrays = "" if a.array is None else f" with {a.array} arrays"
         print(f"\nseed {seed}: {a.runs} drives of {a.scenario}{arrays}, traced channel, L, entry fix "
               f"{a.start_sigma:g} m ({time.perf_counter() - t0:.0f} s); path taken = the "
               f"true LoS in {100 * res['_los_share']:.1f} % of the epochs")  # fmt: skip
-        print("| tracker | RMSE [m] | gain over dead reckoning |\n| --- | --- | --- |")
+        print("| tracker | RMSE, mean over drives [m] | gain over dead reckoning | RMS over drives "
+              "[m] |\n| --- | --- | --- | --- |")  # fmt: skip
         for k, v in res.items():
             if not k.startswith("_"):
-                print(f"| {k} | {v:.3f} | {dr / v:.2f}x |")
-        print(f"| posterior CRLB of the LoS angles at {chosen:g} deg (told model, first drive) "
+                print(f"| {k} | {v:.3f} | {dr / v:.2f}x | {res['_rms'][k]:.3f} |")
+        print(f"| posterior CRLB of the LoS angles at {chosen} deg (told model, first drive) "
               f"| {ref:.3f} | |")  # fmt: skip
-    print(f"\nangle sigma chosen on seed 0: {chosen:g} deg")
+    print(f"\nangle sigma chosen on seed 0: {chosen} deg")
 
 
 if __name__ == "__main__":

@@ -350,5 +350,11 @@ def test_the_line_of_sight_study_picks_without_truth_and_its_information_is_the_
             h[j] = 1e-6
             J[:, j] = (angles(p + h) - angles(p - h)) / 2e-6
         np.testing.assert_allclose(info[k], J.T @ J / sigma**2, rtol=1e-6)
+        # separate sigmas: J^T R^-1 J with R = diag(sigma_az^2, sigma_el^2)
+        R = np.diag([sigma**2, (1.8 * sigma) ** 2])
+        two = los_angle_information(ue, bs, sigma, 1.8 * sigma)[k]
+        np.testing.assert_allclose(two, J.T @ np.linalg.inv(R) @ J, rtol=1e-6)
     with pytest.raises(ValueError, match="ue"):
         los_angle_information(np.array([[0.0, 0.0, 1.0]]), bs, sigma)
+    with pytest.raises(ValueError, match="sigma_elevation"):
+        los_angle_information(ue, bs, sigma, 4.0)

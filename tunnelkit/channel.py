@@ -6,7 +6,7 @@ section 4.2 (:func:`add_noise`). Three impairments eq. 1 leaves out, off by defa
 error (:func:`draw_calibration`), the spatial-wideband term (``spatial_wideband=True``) and dense
 diffuse multipath (:class:`DiffuseSpec`); :class:`Impairments` bundles them for the signal route.
 
-How it works (the "module docstring" cited below): docs/internals/channel-and-propagation.md.
+How it works: docs/internals/channel-and-propagation.md.
 """
 
 from __future__ import annotations
@@ -213,7 +213,7 @@ def draw_calibration(
 
 @dataclass(frozen=True)
 class DiffuseSpec:
-    """Dense diffuse multipath (module docstring): ``share`` in [0, 1) of the received power,
+    """Dense diffuse multipath (docs/internals): ``share`` in [0, 1) of the received power,
     exponential power-delay profile with time constant ``decay_s`` [s] (20 ns by default, a
     short concrete tunnel), taps ``oversample`` times finer than the delay resolution, ``span``
     time constants long."""
@@ -284,7 +284,7 @@ def diffuse_tensor(
 
 @dataclass(frozen=True)
 class Impairments:
-    """What a real array adds to eq. 1 (module docstring): per-element calibration error with
+    """What a real array adds to eq. 1 (docs/internals): per-element calibration error with
     ``phase_sigma_deg`` [deg] and ``gain_sigma_db`` [dB], the ``spatial_wideband`` term and
     dense diffuse multipath ``dmc`` (a :class:`DiffuseSpec`, drawn per slot). All zero / False /
     None (the default) is eq. 1 exactly."""
@@ -361,7 +361,7 @@ def channel_tensor(
     Amplitudes include ``sqrt(P_t)`` (so ``|H|^2`` is a received power in W). ``model`` is
     "exact" (spherical wavefront from the VUE, eq. 2) or "srnf" (from the reflection point).
     ``n_tones`` / ``n_symbols`` override the configuration (small tensors for tests and sliders).
-    Impairments (module docstring), off by default: ``calibration`` (M,) complex per-element
+    Impairments (docs/internals), off by default: ``calibration`` (M,) complex per-element
     gains (:func:`draw_calibration`); ``spatial_wideband`` the per-element delay
     ``tau_l + delta_lm / c`` in the frequency phase; ``dmc`` a :class:`DiffuseSpec` whose
     realisation (:func:`diffuse_tensor`, from ``rng``, starting at the first path's delay) is

@@ -232,7 +232,7 @@ def path_error_model(
     geometry: RouteGeometry | None = None,
 ) -> PathErrorModel:
     """The joint ML extraction's per-path error along ``setup``'s route for array ``spec`` under
-    ``impairments`` (module docstring; fields in :class:`PathErrorModel`).
+    ``impairments`` (docs/internals; fields in :class:`PathErrorModel`).
 
     Every existing path of the route geometry (``geometry``, or traced at ``epochs``: not both) enters
     the joint model. ``crlb`` is the ideal bound of all paths' ``z`` (gains and Dopplers
@@ -435,7 +435,7 @@ def predicted_error(
     weights: str = "tracker",
 ) -> PredictedError:
     """The ideal PEB and the predicted error (a first-order prediction, not a bound) of ``spec`` along
-    ``setup``'s route under ``impairments`` (module docstring); ``geometry`` reuses a traced
+    ``setup``'s route under ``impairments`` (docs/internals); ``geometry`` reuses a traced
     route, ``epochs`` (indices) subsamples it.
 
     ``weights`` (:data:`WEIGHTS`): ``"tracker"`` (default) maps the per-path error model

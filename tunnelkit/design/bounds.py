@@ -150,7 +150,7 @@ def _position_covariance(G: np.ndarray, n_pos: int, rcond: float = 1e-12) -> np.
 
 
 def theta_jacobian(cfg, s_loc, d0, src, a0, R, g, idx, mask, clock_bias, height_known, curvature):
-    """``T = d eta / d theta`` (T, 7L, n_theta) of :func:`route_bounds` (module docstring) and
+    """``T = d eta / d theta`` (T, 7L, n_theta) of :func:`route_bounds` (docs/internals) and
     the number of position coordinates ``n_pos``, the nuisances per path ``n_nui`` and the
     index ``base`` of the first path nuisance: ``theta = [UE position, (clock bias c b), per
     path: Re a, Im a, mu_t, (radius)]``."""
@@ -246,7 +246,7 @@ def route_bounds(
     epochs=None,
     peb: bool = True,
 ) -> RouteBounds:
-    """PEB and exact SR-NF validity of ``spec`` along ``setup``'s route (module docstring).
+    """PEB and exact SR-NF validity of ``spec`` along ``setup``'s route (docs/internals).
 
     ``markings=False`` leaves the RRM paths out; ``curvature=False`` makes each path's wavefront
     radius a nuisance; ``clock_bias="known"`` drops the common delay bias; ``height_known``

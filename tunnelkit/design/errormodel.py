@@ -56,7 +56,7 @@ def _repetition(exists: np.ndarray, k: np.ndarray, normalise: bool = True) -> np
 
 @dataclass(frozen=True)
 class PathErrorModel:
-    """Per-epoch, per-path truth and estimator error along a route (module docstring).
+    """Per-epoch, per-path truth and estimator error along a route (docs/internals).
 
     Shapes: ``t`` (T,) [s]; ``exists`` (T, P) bool; ``kinds`` (P,); ``truth`` (T, P, 4) ``z``;
     ``v`` (T, P) [m/s]; ``crlb`` and ``cov`` (T, 4P, 4P) ordered path-major

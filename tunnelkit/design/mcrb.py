@@ -114,7 +114,7 @@ def _check_modes(s_loc, pos, alpha, mu_f, mu_t, mask, fc, n_tones, n_symbols) ->
 
 
 class EtaModes:
-    """The mode vectors of ``J`` for a stack of epochs (module docstring).
+    """The mode vectors of ``J`` for a stack of epochs (docs/internals).
 
     ``s_loc`` (T, L, 3) wave origins (local frame), ``pos`` (M, 3) elements, ``alpha`` (T, L)
     gains with ``sqrt(P_t)``, ``mu_f`` / ``mu_t`` (T, L), ``mask`` (T, L) the real paths (the
@@ -249,7 +249,7 @@ class EtaModes:
 
     def diffuse_gram(self, spec: DiffuseSpec, tone_spacing: float, tau0) -> np.ndarray:
         """``J^H C_D J / P_D`` (T, 7L, 7L) complex for unit diffuse power starting at delay
-        ``tau0`` (T,) [s] (module docstring)."""
+        ``tau0`` (T,) [s] (docs/internals)."""
         instance("spec", spec, DiffuseSpec), tone_step("tone_spacing", tone_spacing)
         finite_array("tau0", tau0, shape=(self.X.shape[0],))
         _, w = spec.taps(tone_spacing, self.n_tones)

@@ -324,7 +324,7 @@ def design_sweep(
     start_sigma: float = START_SIGMA_M,
     dead_reckoning: bool = False,
 ) -> DesignReport:
-    """Every candidate of ``arrays`` evaluated and judged (module docstring).
+    """Every candidate of ``arrays`` evaluated and judged (docs/internals).
 
     ``target`` [m] on ``share`` of the settled route (the epochs at least ``settle`` [s] after
     the start, default :data:`~tunnelkit.metrics.SETTLE_S`); ``criterion`` ``"achievable"``

@@ -176,7 +176,7 @@ def judge(
     share: float = 0.9,
     cap: int | None = None,
 ) -> tuple[str, str]:
-    """``(status, reason)`` of one candidate (module docstring) from its unit yield ``yield_``
+    """``(status, reason)`` of one candidate (docs/internals) from its unit yield ``yield_``
     and the yield's 95 % interval ``ci`` over ``units`` units (``units = 0``: no Monte-Carlo,
     ``"bound only"``); ``cap`` the sequential rule's cap (``None``: no cap stated)."""
     target = positive("target", target)

@@ -7,7 +7,7 @@ whole estimate (:func:`fit_sources`, :func:`spherical_steering`, :func:`source_p
 them). The result reads like :func:`~tunnelkit.extraction.extract_paths`'s and starts the
 maximum-likelihood stage (:mod:`.ml`).
 
-How it works (the "module text" cited below): docs/internals/extraction-ml.md.
+How it works: docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations

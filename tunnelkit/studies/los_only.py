@@ -63,32 +63,48 @@ def los_only(drive, window: float = LOS_WINDOW_M):
     return replace(drive, epochs=epochs)
 
 
-def los_design(sigma_angle: float, base=None):
+def _angle_sigma(name: str, value: float) -> float:
+    value = positive(name, value)
+    if value > np.pi:
+        raise ValueError(f"{name}: at most pi rad (half a turn), got {value:g}")
+    return value
+
+
+def los_design(sigma_angle: float, base=None, sigma_elevation: float | None = None):
     """``base`` (default the traced design, :func:`tunnelkit.studies.traced.traced_design`) told
-    ``sigma_angle`` [rad] for both angles of the path it is fed (the other sigmas unchanged)."""
+    ``sigma_angle`` [rad] for the azimuth of the path it is fed and ``sigma_elevation`` [rad]
+    (default ``sigma_angle``) for its elevation (the other sigmas unchanged)."""
     from .traced import traced_design
 
-    sigma_angle = positive("sigma_angle", sigma_angle)
-    if sigma_angle > np.pi:
-        raise ValueError(f"sigma_angle: at most pi rad (half a turn), got {sigma_angle:g}")
+    sigma_angle = _angle_sigma("sigma_angle", sigma_angle)
+    el = (
+        sigma_angle if sigma_elevation is None else _angle_sigma("sigma_elevation", sigma_elevation)
+    )
     from ..tracking.javelin import JavelinDesign
 
     base = traced_design() if base is None else instance("base", base, JavelinDesign)
-    return base.with_(sigma_phi=sigma_angle, sigma_psi=sigma_angle)
+    return base.with_(sigma_phi=sigma_angle, sigma_psi=el)
 
 
-def los_angle_information(ue, station, sigma_angle: float) -> np.ndarray:
+def los_angle_information(
+    ue, station, sigma_angle: float, sigma_elevation: float | None = None
+) -> np.ndarray:
     """Position information (T, 2, 2) [1/m^2] of the line of sight's azimuth and elevation seen
-    from ``station`` (3,), for the UE at ``ue`` (T, 3), each angle with an independent Gaussian
-    error of ``sigma_angle`` [rad]: ``J^T J / sigma^2`` with ``J`` the angles' Jacobian in the
-    road plane (the height known; :func:`tunnelkit.geometry.spherical_jacobian`)."""
+    from ``station`` (3,), for the UE at ``ue`` (T, 3), the angles with independent Gaussian
+    errors of ``sigma_angle`` (azimuth) and ``sigma_elevation`` (default ``sigma_angle``) [rad]:
+    ``J^T R^-1 J`` with ``J`` the angles' Jacobian in the road plane (the height known;
+    :func:`tunnelkit.geometry.spherical_jacobian`)."""
     ue = finite_array("ue", ue, shape=(None, 3))
     station = finite_array("station", station, shape=(3,))
-    sigma_angle = positive("sigma_angle", sigma_angle)
+    sigma_angle = _angle_sigma("sigma_angle", sigma_angle)
+    el = (
+        sigma_angle if sigma_elevation is None else _angle_sigma("sigma_elevation", sigma_elevation)
+    )
     try:
         jac = spherical_jacobian(ue - station)[:, :2, :2]  # (azimuth, elevation) by (x, y)
     except ValueError:
         raise ValueError(
             "ue: a position straight below or above the station has no azimuth"
         ) from None
-    return np.swapaxes(jac, 1, 2) @ jac / sigma_angle**2
+    jac = jac / np.array([sigma_angle, el])[None, :, None]  # whitened rows
+    return np.swapaxes(jac, 1, 2) @ jac

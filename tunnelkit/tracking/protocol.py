@@ -17,7 +17,7 @@ __all__ = ["Filter"]
 
 @runtime_checkable
 class Filter(Protocol):
-    """``predict`` / ``update`` / ``step`` with an inspectable ``x`` and ``P`` (module docstring)."""
+    """``predict`` / ``update`` / ``step`` with an inspectable ``x`` and ``P`` (docs/internals)."""
 
     @property
     def x(self) -> Any: ...

@@ -7,7 +7,7 @@ verdict), :class:`Problem` and :class:`WidebandProblem` (the models), the residu
 (:func:`residual_peak`, :func:`calibrated_threshold`) and the resolution tests
 (:func:`separations`, :func:`pair_test`, :func:`snr_threshold`, :func:`below_threshold`).
 
-How it works (the "package text" the modules here cite): docs/internals/extraction-ml.md.
+How it works: docs/internals/extraction-ml.md.
 """
 
 from ..numerics import spatial_phase

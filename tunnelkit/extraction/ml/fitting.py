@@ -1,6 +1,5 @@
 """The fit of the maximum-likelihood stage: Levenberg-Marquardt on the concentrated cost, the
-stopping rule, the basin test and the SAGE-like re-seedings (package text of
-:mod:`tunnelkit.extraction.ml`), in :func:`fit_problem` (on a :class:`~.model.Problem`) and
+stopping rule, the basin test and the SAGE-like re-seedings (docs/internals/extraction-ml.md), in :func:`fit_problem` (on a :class:`~.model.Problem`) and
 :func:`fit_ml` (on a tensor); the result is an :class:`MLFit`."""
 
 from __future__ import annotations
@@ -356,7 +355,7 @@ def _coherent_pair(ev):
 
 
 def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
-    """The re-seedings on the residual energy (package text): while the cost is above
+    """The re-seedings on the residual energy (docs/internals/extraction-ml.md): while the cost is above
     ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
     and the weakest path re-sought, each kept if the likelihood rises. Returns the fit, the
     iterations spent and the number of kept moves."""
@@ -415,8 +414,8 @@ def fit_ml(
     ``mu_f``, ``mu_t`` (L,) the Vandermonde frequencies. ``noise_power`` per sample (default:
     estimated, :func:`~.model.noise_floor`). ``n_reseed`` bounds the SAGE-like re-seedings (default
     ``L``; 0 = local fit only), ``search`` as in :func:`fit_problem`. ``array`` and ``srs`` as in
-    :func:`~tunnelkit.extraction.extract_paths` (only the carrier of ``srs`` enters). See the
-    package text for the algorithm.
+    :func:`~tunnelkit.extraction.extract_paths` (only the carrier of ``srs`` enters). See
+    docs/internals/extraction-ml.md for the algorithm.
     """
     H = check_tensor(H)
     pos = check_array(array, m=H.shape[0])

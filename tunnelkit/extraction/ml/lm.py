@@ -1,5 +1,4 @@
-"""Levenberg-Marquardt on the concentrated cost of a :class:`~.model.Problem` (package text of
-:mod:`tunnelkit.extraction.ml`: the damped Gauss-Newton step, the stopping rule on the Newton
+"""Levenberg-Marquardt on the concentrated cost of a :class:`~.model.Problem` (docs/internals/extraction-ml.md: the damped Gauss-Newton step, the stopping rule on the Newton
 decrement), shared by the fit (:mod:`.fitting`) and the resolution test (:mod:`.resolution`)."""
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The model of the maximum-likelihood stage: the concentrated cost of eq. 1 and its Gauss-Newton
 model (:class:`Problem`), the feasible set (:func:`project_feasible`) and the model-free noise
 floor (:func:`noise_floor`). The parametrisation and the variable projection are described in
-the package text (:mod:`tunnelkit.extraction.ml`)."""
+docs/internals/extraction-ml.md."""
 
 from __future__ import annotations
 
@@ -57,7 +57,8 @@ def check_paths(theta, mu_f, mu_t) -> None:
 
 class Problem:
     """The tensor ``H`` (M, Nf, Nt), the array (local positions (M, 3)) and the carrier ``fc``:
-    the evaluation of the concentrated cost and its Gauss-Newton model (package text).
+    the evaluation of the concentrated cost and its Gauss-Newton model
+    (docs/internals/extraction-ml.md).
 
     Attributes used by the fit: ``H``, ``pos``, ``k0 = 2 pi fc / c``, ``h2 = ||H||^2``, ``N``
     the number of samples; :meth:`evaluate`, :meth:`model` and :meth:`noise_floor`."""
@@ -176,7 +177,7 @@ def _solve_gains(G, b, h2):
 
 
 def noise_floor(H, n_paths: int) -> float:
-    """Noise power per sample estimated without the model (package text)."""
+    """Noise power per sample estimated without the model (docs/internals/extraction-ml.md)."""
     return _noise_floor(check_tensor(H), integer("n_paths", n_paths, minimum=0))
 
 

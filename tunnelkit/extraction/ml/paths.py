@@ -126,7 +126,7 @@ def ml_paths(
     search: str = "residual",
     wideband: bool = False,
 ) -> PathEstimates:
-    """Joint maximum-likelihood extraction (package text of :mod:`tunnelkit.extraction.ml`); the
+    """Joint maximum-likelihood extraction (docs/internals/extraction-ml.md); the
     default route of :func:`~tunnelkit.extraction.extract_paths`.
 
     ``search``: ``"residual"`` (default) or ``"basic"`` (:func:`~.fitting.fit_problem`).

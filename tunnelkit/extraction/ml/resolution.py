@@ -5,7 +5,7 @@ Per path: its distance from the others in standard deviations of their differenc
 (:func:`separations`, :func:`pair_separation`), its significance (:func:`significance`), the
 verdict :func:`resolvable` and the threshold region :func:`below_threshold`
 (:func:`snr_threshold`, :func:`outlier_probability`). Per fit: the pair test :func:`pair_test`
-and :func:`unresolved_partners`. How it works (the "module text" cited below):
+and :func:`unresolved_partners`. How it works:
 docs/internals/extraction-ml.md.
 """
 
@@ -39,13 +39,13 @@ __all__ = [
     "snr_threshold",
 ]
 
-#: outlier (interval-error) probability of a path at the threshold SNR (module text)
+#: outlier (interval-error) probability of a path at the threshold SNR (docs/internals)
 OUTLIER_RATE = 0.01
 #: cap on ``n_cells``: a tensor of 10^11 samples (1.6 TB) is beyond any snapshot's memory budget
 MAX_CELLS = 10**11
 
 #: resolution test: two paths closer than this many standard deviations of their difference are
-#: in the threshold region of resolution (module text: non-centrality 25 of the 5-parameter test)
+#: in the threshold region of resolution (docs/internals: non-centrality 25 of the 5-parameter test)
 RESOLVE_Z = 5.0
 
 
@@ -82,7 +82,7 @@ def _separations(prob: Problem, theta, mu_f, mu_t, sigma2, ev=None) -> np.ndarra
 
 def separations(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> np.ndarray:
     """Per path (L,): its smallest distance to another path in standard deviations of their
-    difference (module text; ``inf`` for a single path)."""
+    difference (docs/internals; ``inf`` for a single path)."""
     theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
     return _separations(prob, theta, mu_f, mu_t, sigma2)
 
@@ -115,7 +115,7 @@ def resolvable(prob: Problem, theta, mu_f, mu_t, noise_power: float, detect: flo
     """Per path (L,) bool: at least ``RESOLVE_Z`` standard deviations from every other path and
     its log-likelihood ratio against noise at least ``detect`` (the detection threshold of one
     path, e.g. :func:`~.residual.calibrated_threshold`). At the true parameters: the path is
-    outside the estimator's threshold region (module text)."""
+    outside the estimator's threshold region (docs/internals)."""
     theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
     detect = positive("detect", detect)
     ev = prob.evaluate(theta, mu_f, mu_t)
@@ -123,14 +123,14 @@ def resolvable(prob: Problem, theta, mu_f, mu_t, noise_power: float, detect: flo
     return (z >= RESOLVE_Z) & (significance(ev, sigma2) >= detect)
 
 
-#: the pair test (module text): rate at which one path is reported as two resolved ones
+#: the pair test (docs/internals): rate at which one path is reported as two resolved ones
 PAIR_FALSE_ALARM = 0.01
 #: pairs fewer than this many standard deviations of their difference apart are tested; further
 #: apart the log-likelihood ratio of the two against one, about ``z^2 / 2`` (50 here), is far
 #: above ``PAIR_LLR``
 PAIR_TEST_Z = 10.0
 #: the pair test's threshold on ``(cost_merged - cost) / sigma^2``: the ``1 - PAIR_FALSE_ALARM``
-#: quantile of its null distribution (one path fitted as a close pair; module text)
+#: quantile of its null distribution (one path fitted as a close pair; docs/internals)
 PAIR_LLR = 13.0
 #: Levenberg-Marquardt iterations each start of the merged fit gets before they are ranked
 _MERGE_RANK_ITER = 8
@@ -183,7 +183,7 @@ def pair_tests_at(prob: Problem, theta, mu_f, mu_t, sigma2: float, ev: dict, max
 
 def _pair_z(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> np.ndarray:
     """Per pair ``(i < j)`` in ``np.triu_indices`` order: their distance in standard deviations
-    of their difference (module text)."""
+    of their difference (docs/internals)."""
     L = theta.shape[0]
     cov = (0.5 * sigma2) * np.linalg.pinv(ev["A"])
     C5 = cov.reshape(L, 5, L, 5).transpose(0, 2, 1, 3)
@@ -205,7 +205,7 @@ def pair_test(
     max_iter: int = 60,
     z_max: float = PAIR_TEST_Z,
 ) -> np.ndarray:
-    """The resolution test of each close pair of a fit (module text): for every two paths fewer
+    """The resolution test of each close pair of a fit (docs/internals): for every two paths fewer
     than ``z_max`` (default ``PAIR_TEST_Z``) standard deviations of their difference apart, the generalised
     likelihood-ratio test of one path (the two merged, all ``L - 1`` fitted again) against two:
     rows ``(i, j, z_ij, llr_ij)``, ``llr = (cost_merged - cost) / sigma^2``; the pair is resolved
@@ -221,7 +221,7 @@ def pair_test(
 
 
 def unresolved_partners(tests: np.ndarray, L: int) -> np.ndarray:
-    """Per path (L,): the path it is not resolved from (module text: the pair test's ``llr``
+    """Per path (L,): the path it is not resolved from (docs/internals: the pair test's ``llr``
     below ``PAIR_LLR``, one path explains the two, or their separation ``z`` below
     ``RESOLVE_Z``, two paths whose difference the data cannot estimate to the bound; of several,
     the one with the lowest ``llr``), ``-1`` when resolved from all."""
@@ -256,7 +256,7 @@ def _outlier(gamma: float, K: int) -> float:
 def outlier_probability(snr, n_cells: int) -> np.ndarray:
     """The probability that the maximum-likelihood search puts a path of post-integration SNR
     ``snr`` (``E / sigma^2``, linear; array) in a wrong one of ``n_cells`` orthogonal cells
-    (module text): ``P(max of n_cells - 1 unit exponentials > |sqrt(snr) + n_0|^2)``, ``n_0 ~
+    (docs/internals): ``P(max of n_cells - 1 unit exponentials > |sqrt(snr) + n_0|^2)``, ``n_0 ~
     CN(0, 1)``, by quadrature (the union bound ``(n_cells - 1) e^{-snr / 2} / 2`` is its first
     term)."""
     snr = finite_array("snr", snr)
@@ -286,7 +286,7 @@ def snr_threshold(n_cells: int, outlier: float = OUTLIER_RATE) -> float:
 
 
 def below_threshold(significance, resolution, n_cells: int) -> np.ndarray:
-    """Per path (L,) bool: in the estimator's threshold region (module text), its SNR
+    """Per path (L,) bool: in the estimator's threshold region (docs/internals), its SNR
     ``significance`` (L,) below :func:`snr_threshold` of ``n_cells`` (the tensor's ``M Nf
     Nt``) or its ``resolution`` (L,, :func:`separations`; ``inf`` alone) below ``RESOLVE_Z``."""
     sig = finite_array("significance", significance, shape=(None,))

@@ -5,7 +5,7 @@ Each element gets its own delay across the band (:func:`tunnelkit.channel.channe
 :class:`WidebandProblem` is a :class:`~.model.Problem`: :func:`~.fitting.fit_problem` runs on it
 unchanged, and :func:`~.paths.ml_paths` with ``wideband=True`` refines its eq. 1 fit on it.
 
-How it works (the "module docstring" cited below): docs/internals/extraction-ml.md.
+How it works: docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ __all__ = ["WidebandProblem"]
 
 
 class WidebandProblem(Problem):
-    """:class:`~.model.Problem` of the model with the spatial-wideband term (module docstring):
+    """:class:`~.model.Problem` of the model with the spatial-wideband term (docs/internals):
     the tensor ``H`` (M, Nf, Nt), the array (local positions (M, 3)), the band centre ``fc`` and
     the tone spacing ``tone_spacing`` [Hz]."""
 

@@ -73,7 +73,7 @@ def motion_increment(
 def odometry_transition(
     state: JavelinState, speed: float, heading: float, dt: float, vue_motion: str = "random_walk"
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The prediction of a state with odometry states (module docstring): the increment (D,),
+    """The prediction of a state with odometry states (docs/internals): the increment (D,),
     ``F`` (D, D) and the sensitivity ``G`` (D, 2) to the message's white noise ``(n_v,
     n_theta)``, for the message ``speed`` [m/s], ``heading`` [rad] over ``dt`` [s]. With
     ``nu_c = speed / (1 + s)`` and ``theta_c = heading - b`` the motion of

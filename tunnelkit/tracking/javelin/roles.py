@@ -53,7 +53,7 @@ _ROLE_TYPES = {
 
 @dataclass(frozen=True)
 class JavelinDesign:
-    """A JAVELIN tracker: its numbers (``config``) and one object per role (module docstring).
+    """A JAVELIN tracker: its numbers (``config``) and one object per role (docs/internals).
 
     ``prefilters`` run in order on every epoch's paths before association; Algorithm 1's
     :class:`DelayCheck` comes first in every design. The defaults are the paper's design.

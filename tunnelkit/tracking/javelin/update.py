@@ -213,7 +213,7 @@ def consider_update(
     x: np.ndarray, P: np.ndarray, C: np.ndarray, m: StackedMeasurement
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """The Schmidt-Kalman update of the JAVELIN state with the tracks' normalised biases as
-    consider parameters (module docstring): the augmented covariance ``[[P, C], [C^T, I]]``, the
+    consider parameters (docs/internals): the augmented covariance ``[[P, C], [C^T, I]]``, the
     rows ``z = h(x) + B u + w`` (``m.B``, white ``m.R``), :func:`schmidt_update` with the state
     estimated. Returns ``(x, P, C, nis)``; the biases' block stays ``I``."""
     x = finite_array("x", x, ndim=1)
