@@ -454,7 +454,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a user scene's shape that references no material",
     ),
     _doc(
-        r"tracking\.javelin\.(measurement\.DelayCheck|designs\.array_design)"
+        r"tracking\.javelin\.(measurement\.DelayCheck|arraydesign\.array_design)"
         r"|tracking\.measurements\.PathMeasurements\.(from_arrays|sanitised)"
         r"|design\.montecarlo\.javelin_config",
         r"min_d",

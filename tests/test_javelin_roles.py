@@ -25,6 +25,7 @@ from tunnelkit.tracking.javelin import (
     ReflectorCurvature,
     ReportedNoise,
     VueCurvature,
+    arraydesign,
     designs,
     run_javelin,
 )
@@ -182,14 +183,14 @@ def test_named_designs():
     assert isinstance(designs.paper_vue().curvature, VueCurvature)
     assert designs.ours_ml().config.sigma_kappa == designs.ML_ERRORS_SEED0["kappa_m"]
     assert designs.ours_ml().updater == JointTestUpdater(0.999)
-    a = designs.array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.01}, min_d=-30.0)
+    a = arraydesign.array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.01}, min_d=-30.0)
     assert a.requires_reported_covariance() and a.min_d == -30.0
     assert isinstance(a.updater, JointTestUpdater) and isinstance(a.initiator, MeasuredBirth)
     assert a.associator.cost == "likelihood" and a.config.sigma_delta_d == pytest.approx(
         np.sqrt(2) * 1e-3
     )
     with pytest.raises(ValueError, match=r"^crlb"):
-        designs.array_design({"d": np.nan, "direction": 1.0, "kappa": 1.0})
+        arraydesign.array_design({"d": np.nan, "direction": 1.0, "kappa": 1.0})
     # numbers go to the config, roles replace roles
     assert designs.paper(sigma_kappa=3.0).config.sigma_kappa == 3.0
     with pytest.raises(ValueError, match=r"^zeta"):

@@ -6,7 +6,7 @@ from javelin_geometric import geometric_paths, geometric_stream, toy_drive
 
 from tunnelkit.geometry import Plane
 from tunnelkit.tracking.javelin import Javelin, JavelinState, draw_start
-from tunnelkit.tracking.javelin.designs import array_design
+from tunnelkit.tracking.javelin.arraydesign import array_design
 from tunnelkit.tracking.javelin.measurement import PathMeasurements
 from tunnelkit.tracking.javelin.noise import ReportedNoise
 from tunnelkit.tracking.javelin.surfaces import GeometricBirth, mirror_vue

@@ -146,7 +146,7 @@ def test_the_long_tunnel_study_drives_on_the_scenarios_model_by_default():
 
 def test_the_designs_tracker_is_told_the_drives_white_noise():
     from tunnelkit.design.arrayjob import javelin_config
-    from tunnelkit.tracking.javelin.designs import array_design
+    from tunnelkit.tracking.javelin.arraydesign import array_design
 
     crlb = {"d": 0.01, "direction": 0.001, "kappa": 1.0}
     paper = array_design(crlb, 0.0, None)

@@ -100,7 +100,7 @@ def test_a_plane_with_huge_coefficients_keeps_its_normal():
 
 def test_a_tracker_step_at_light_speed_or_of_a_lifetime_is_refused():
     from tunnelkit.tracking.javelin import Javelin
-    from tunnelkit.tracking.javelin.designs import array_design
+    from tunnelkit.tracking.javelin.arraydesign import array_design
 
     design = array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.05})
     trk = Javelin(np.array([-30.0, -3.0, 1.2]), design)

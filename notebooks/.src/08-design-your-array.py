@@ -288,7 +288,7 @@ route_figure(
 # with VUE-centred curvature**: JAVELIN's state, association, track management and filter
 # (sections 3.2–3.5) with each path's wavefront centred on its VUE (the exact wavefront of a
 # specular path) and each path weighed by the covariance the extraction reports
-# (`tracking.javelin.designs.array_design`; notebook 04b sets the VUE-centred curvature against
+# (`tracking.javelin.arraydesign.array_design`; notebook 04b sets the VUE-centred curvature against
 # eq. 51 in the paper's own design). It does not need SR-NF, so the design reports SR-NF per
 # surface as information (`criterion="achievable"`, the default) and gates on it only for an
 # eq. 51 route (`criterion="srnf"`). Under a ceiling 20 cm away the ceiling decides:

@@ -37,13 +37,13 @@ START_HEIGHT_SIGMA_M = 0.05
 
 
 def javelin_config(crlb: dict, min_d: float = 0.0, planes=None, odometry=None):
-    """The design's JAVELIN: :func:`tunnelkit.tracking.javelin.designs.array_design` (reported
+    """The design's JAVELIN: :func:`tunnelkit.tracking.javelin.arraydesign.array_design` (reported
     covariances, likelihood cost, measured births, the joint innovation test; ``crlb`` sets
     only the fixed fallback sigmas, ``min_d`` Algorithm 1's delay check; ``planes`` the
     tunnel's surfaces when the VUEs come from the known geometry), told the white noise of the
     drive's messages (``odometry``, the drive's model; None: the paper's 0.2 m/s and 1 deg)."""
     # the tracker and the drive simulator load on the first Monte-Carlo, not with the bounds
-    from ..tracking.javelin.designs import array_design
+    from ..tracking.javelin.arraydesign import array_design
 
     if odometry is not None:
         instance("odometry", odometry, Odometry)

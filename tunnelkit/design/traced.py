@@ -452,7 +452,8 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     the record carries the errors' lag-1 correlation, as the shipped records do; the RMS as it
     is for a record without it) in place of each path's reported CRLB, which on this channel is thousands of times too
     small."""
-    from ..tracking.javelin.designs import array_design, design_from_errors
+    from ..tracking.javelin.arraydesign import array_design
+    from ..tracking.javelin.designs import design_from_errors
     from .geometry import KINDS
 
     setup = _setup(setup)

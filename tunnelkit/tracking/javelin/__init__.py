@@ -6,7 +6,8 @@ pre-filters) · ``noise`` (fixed or reported measurement noise) · ``motion`` (e
 motion) · ``associate`` (eq. 56-59 gated costs, Algorithm 2, global nearest neighbour) ·
 ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test, initiators) · ``update`` (eq. 64-68,
 Joseph form, joint innovation test) · ``roles`` (:class:`JavelinDesign`: numbers + one object
-per role) · ``designs`` (the named designs as factories) · ``tracker`` (Algorithm 4) ·
+per role) · ``designs`` (the named designs as factories) · ``arraydesign`` (the array design's
+tracker) · ``surfaces`` (VUEs born from known planes) · ``tracker`` (Algorithm 4) ·
 ``tenfiloc`` (the snapshot baseline, eq. 69) · ``config`` (section 4.2 numbers). The
 chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
 """
