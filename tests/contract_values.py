@@ -465,6 +465,7 @@ def _baselines():
     javelin_config({"d": 0.05, "direction": 0.01, "kappa": 2.0})
     cv.simulate_cv(np.array([0.0, 0.0, 10.0, 0.0]), 0.1, 0.5, 20, rng)
     gating.ChiSquareGate(0.99).accepts(np.array([1.0, 30.0]), 2)
+    gating.squared_distances(np.array([1.0, 30.0]))
     measurement_model(np.array([0.0, 1.0, 1.5, 2.0, 3.0]), (0.0, 0.0, 4.8))
     common.cdf_figure({"a": e})
     tables.table(["x", "y"], [[1, 2.5], [2, 3.5]])

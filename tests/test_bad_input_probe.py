@@ -76,7 +76,7 @@ def _child(case, heavy: bool, conn) -> None:
 _WARM = (
     "constants geometry crlb positioning fresnel arrays propagation metrics montecarlo doppler_drive "
     "scenarios channel tracking.doppler tracking.upf tracking.pcrlb tracking.cv "
-    "tracking.virtual_station tracking.gating"
+    "tracking.virtual_station tracking.gating tracking.reopening"
 ).split()
 
 

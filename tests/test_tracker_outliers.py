@@ -21,7 +21,7 @@ from scipy.stats import chi2
 from tunnelkit import doppler_drive as dv
 from tunnelkit.constants import C
 from tunnelkit.tracking import doppler as dp
-from tunnelkit.tracking import gating, registry
+from tunnelkit.tracking import registry, reopening
 from tunnelkit.tracking import virtual_station as vs
 
 
@@ -67,36 +67,36 @@ def _dev(a, b) -> np.ndarray:
 
 
 def test_gate_thresholds_are_chi_square_quantiles():
-    g = gating.InnovationGate(0.999)
+    g = reopening.InnovationGate(0.999)
     assert g.threshold(1) == pytest.approx(10.8276, abs=1e-4)
     assert g.threshold(4) == pytest.approx(18.4668, abs=1e-4)
     assert g.threshold(6) == pytest.approx(chi2.ppf(0.999, 6), rel=1e-12)
-    assert gating.InnovationGate(None).threshold(3) == np.inf
+    assert reopening.InnovationGate(None).threshold(3) == np.inf
     with pytest.raises(ValueError, match="gate"):
-        gating.InnovationGate(1.5)
+        reopening.InnovationGate(1.5)
     with pytest.raises(ValueError, match="reopen_after"):
-        gating.InnovationGate(0.99, reopen_after=0)
+        reopening.InnovationGate(0.99, reopen_after=0)
 
 
 def test_gate_rejects_then_reopens_after_a_streak():
-    g = gating.InnovationGate(0.99, reopen_after=3)
+    g = reopening.InnovationGate(0.99, reopen_after=3)
     far = 100.0
     verdicts = [int(g.judge(far, 1)) for _ in range(4)] + [int(g.judge(0.5, 1))]
-    assert verdicts == [gating.REJECT] * 3 + [gating.REOPEN, gating.ACCEPT]
+    assert verdicts == [reopening.REJECT] * 3 + [reopening.REOPEN, reopening.ACCEPT]
     assert g.n_rejected == 3 and g.n_reopened == 1
     # one measurement: y^2 = chi2_1(p) (alpha A + R) exactly, A = S - R
     S, R = np.array([[5.0]]), np.array([[1.0]])
     alpha = float(g.inflation(far, 1, S, R))
     assert far * 5.0 == pytest.approx(chi2.ppf(0.99, 1) * (alpha * 4.0 + 1.0))
     # a good measurement between outliers resets the streak
-    g = gating.InnovationGate(0.99, reopen_after=2)
+    g = reopening.InnovationGate(0.99, reopen_after=2)
     seq = [far, 0.1, far, far, 0.1]
     assert [int(g.judge(d, 1)) for d in seq] == [1, 0, 1, 1, 0]
     # batched counters, one set per run
-    gb = gating.InnovationGate(0.99, reopen_after=1, batch=3)
+    gb = reopening.InnovationGate(0.99, reopen_after=1, batch=3)
     v = gb.judge(np.array([far, 0.1]), 2, rows=np.array([0, 2]))
-    assert list(v) == [gating.REJECT, gating.ACCEPT] and list(gb.n_rejected) == [1, 0, 0]
-    assert list(gb.judge(np.array([far, far, far]), 2)) == [gating.REOPEN, 1, 1]
+    assert list(v) == [reopening.REJECT, reopening.ACCEPT] and list(gb.n_rejected) == [1, 0, 0]
+    assert list(gb.judge(np.array([far, far, far]), 2)) == [reopening.REOPEN, 1, 1]
 
 
 def test_gated_update_is_filterpys_update_or_a_missed_epoch():
@@ -111,15 +111,15 @@ def test_gated_update_is_filterpys_update_or_a_missed_epoch():
         return f
 
     a, b = kf(), kf()
-    g = gating.InnovationGate(0.999)
-    assert gating.gated_filterpy_update(a, lambda: a.update(np.array([[2.0]])), g) == 0
+    g = reopening.InnovationGate(0.999)
+    assert reopening.gated_filterpy_update(a, lambda: a.update(np.array([[2.0]])), g) == 0
     b.update(np.array([[2.0]]))
     assert np.array_equal(a.x, b.x) and np.array_equal(a.P, b.P)
     c = kf()
     y = 8.0 - 1.0  # S = 4 + 1, d2 = 49 / 5 = 9.8 < 10.83: accepted; 9.0 gives 12.8: rejected
-    assert gating.gated_filterpy_update(c, lambda: c.update(np.array([[1.0 + y]])), g) == 0
+    assert reopening.gated_filterpy_update(c, lambda: c.update(np.array([[1.0 + y]])), g) == 0
     d = kf()
-    assert gating.gated_filterpy_update(d, lambda: d.update(np.array([[9.0]])), g) == 1
+    assert reopening.gated_filterpy_update(d, lambda: d.update(np.array([[9.0]])), g) == 1
     assert np.array_equal(d.x, kf().x) and np.array_equal(d.P, kf().P)
     assert np.array_equal(d.x_post, d.x) and g.n_rejected == 1
 

@@ -108,7 +108,7 @@ print("LOS stations:\n", vs.model_from_scenario("jiang2023-straight", los=True).
 # A consistent filter rejects a good vector once in a thousand epochs (that is what the 0.999
 # quantile means): on clean runs the gate changes the EKF's RMSE by less than a per cent (printed
 # below). After five rejections in a row the gate takes the next measurement with an inflated
-# covariance, so a real change is never locked out (`tunnelkit.tracking.gating`). `gate=None`
+# covariance, so a real change is never locked out (`tunnelkit.tracking.reopening`). `gate=None`
 # gives the paper's filters.
 #
 # One run, all four on the same measurements; drag the slider (or press play) to follow them.

@@ -400,7 +400,7 @@ print(f"EKF DS at 32.79 Hz on the default drive: plain {plain:.2f} m, gated {gat
 # glitch) in the middle of the drive, against the same drive without it: the paper's EKF is
 # thrown off for good, the gated one loses one epoch. A gate must also let a *real* change back
 # in: while it rejects, $P$ grows with $Q$, and after five rejections in a row the next
-# measurement is taken with the covariance inflated to match it (`tunnelkit.tracking.gating`),
+# measurement is taken with the covariance inflated to match it (`tunnelkit.tracking.reopening`),
 # so a gate never stays shut.
 
 # %%

@@ -51,8 +51,8 @@ from .._validate import (
 from .._validate import weights as check_weights
 from ..budget import check_elements
 from .cv import STATE_DIM
-from .gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, REJECT, REOPEN, InnovationGate
 from .registry import register
+from .reopening import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, REJECT, REOPEN, InnovationGate
 from .virtual_station.filters import EstimatorBase, VsUKF
 from .virtual_station.model import FAMILY, VsModel, check_model, check_prior, regularized_cholesky
 

@@ -32,7 +32,7 @@ from ..._validate import (
 from ...constants import C
 from ...doppler_drive import Drive, GnssFix
 from ..cv import cv_process_noise, cv_transition
-from ..gating import (
+from ..reopening import (
     DEFAULT_GATE,
     DEFAULT_REOPEN_AFTER,
     REJECT,

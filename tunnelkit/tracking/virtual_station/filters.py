@@ -17,8 +17,8 @@ from filterpy.kalman import ExtendedKalmanFilter, MerweScaledSigmaPoints, Unscen
 from ... import positioning
 from ..._validate import finite_array, nonnegative, positive, real, rng_or_error
 from ..cv import STATE_DIM
-from ..gating import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, InnovationGate, gated_filterpy_update
 from ..registry import get, register
+from ..reopening import DEFAULT_GATE, DEFAULT_REOPEN_AFTER, InnovationGate, gated_filterpy_update
 from .model import FAMILY, VsModel, check_model, check_prior, measurement_ok, regularized_cholesky
 
 
