@@ -71,7 +71,10 @@ def score(drives, seed, sigmas, start_sigma) -> dict:
     """Mean RMSE per tracker over ``drives`` (the starts from a stream of their own)."""
     rng = np.random.default_rng([seed, 1])
     td = traced_design()
-    designs = {f"LoS only, {s} deg": los_design(*np.radians(_pair(s)), td) for s in sigmas}
+    designs = {}
+    for s in sigmas:
+        az, el = np.radians(_pair(s))
+        designs[f"LoS only, {s} deg"] = los_design(float(az), td, sigma_elevation=float(el))
     out = {"traced design": [], "dead reckoning": [], **{k: [] for k in designs}}
     los_share = []
     for dd in drives:
