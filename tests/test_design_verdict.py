@@ -10,6 +10,7 @@ import pytest
 
 from tunnelkit import design
 from tunnelkit.design import report as rep_mod
+from tunnelkit.design import unitsweep
 from tunnelkit.design import verdict as v
 
 
@@ -176,10 +177,10 @@ def fake(monkeypatch):
     def join(a, b):
         return SimpleNamespace(**{**vars(a), "errors": np.concatenate([a.errors, b.errors])})
 
-    monkeypatch.setattr(rep_mod, "_joined", join)
+    monkeypatch.setattr(unitsweep, "_joined", join)
 
     def use(levels, calls, fail=()):
-        monkeypatch.setattr(rep_mod, "_sweep_montecarlo", _fake_montecarlo(levels, calls, fail))
+        monkeypatch.setattr(unitsweep, "_sweep_montecarlo", _fake_montecarlo(levels, calls, fail))
 
     return use
 

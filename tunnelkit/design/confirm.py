@@ -53,8 +53,9 @@ from dataclasses import dataclass, field
 from .._validate import instance, integer, record, sequence
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
-from .report import DesignReport, score_row
+from .report import DesignReport
 from .setup import DesignSetup, parse_array
+from .unitsweep import score_row
 from .verdict import MIN_RUNS_CI, recommend
 
 __all__ = ["ConfirmedReport", "confirm_on_channel", "confirmation_candidates", "next_candidate"]
