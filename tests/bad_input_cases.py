@@ -175,14 +175,14 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "virtual_stations[base_station=nan]",
-            lambda: _mod("geometry").virtual_stations([NAN, 0.0], [wall()]),
+            lambda: _mod("tunnel2d").virtual_stations([NAN, 0.0], [wall()]),
             ("base_station",),
         )
     )
     c.append(
         Case(
             "virtual_stations[walls=[]]",
-            lambda: _mod("geometry").virtual_stations([0.0, 0.0], []),
+            lambda: _mod("tunnel2d").virtual_stations([0.0, 0.0], []),
             ("walls",),
         )
     )
@@ -210,14 +210,14 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "Tunnel2D.from_lines[nan]",
-            lambda: _mod("geometry").Tunnel2D.from_lines((0, 1, -5), (0, 1, NAN)),
+            lambda: _mod("tunnel2d").Tunnel2D.from_lines((0, 1, -5), (0, 1, NAN)),
             ("line1", "C", "line coefficients (A, B, C)", "offset"),
         )
     )
     c.append(
         Case(
             "Tunnel2D.from_lines[coincide]",
-            lambda: _mod("geometry").Tunnel2D.from_lines((0, 1, -5), (0, 1, -5)),
+            lambda: _mod("tunnel2d").Tunnel2D.from_lines((0, 1, -5), (0, 1, -5)),
             ("walls",),
         )
     )

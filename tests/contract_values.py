@@ -120,14 +120,14 @@ def capture(targets: list[Target], drivers) -> dict[str, tuple[object, dict]]:
 
 def _jiang():
     import tunnelkit as tk
-    from tunnelkit import crlb, geometry, metrics, positioning
+    from tunnelkit import crlb, metrics, positioning, tunnel2d
     from tunnelkit.tracking import virtual_station as vs
 
     sc = tk.load_scenario("jiang2023-straight")
     tunnel = sc.tunnel()
     bs = sc.base_station()
     st = tunnel.virtual_stations(bs)
-    geometry.virtual_stations(bs, list(tunnel.walls))
+    tunnel2d.virtual_stations(bs, list(tunnel.walls))
     p = np.array([30.0, 2.0])
     crlb.crlb_rmse(p, st, 0.01, 0.5)
     crlb.toa_doa(p, st)

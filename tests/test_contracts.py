@@ -197,7 +197,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "elementwise: one probability per SNR, of the same shape (none for none)",
     ),
     _doc(
-        r"geometry\.(Plane|Tunnel2D)\.\w+|geometry\.(mirror|reflector_point|specular_point)",
+        r"geometry\.Plane\.\w+|tunnel2d\.Tunnel2D\.\w+|geometry\.(mirror|reflector_point|specular_point)",
         r"p|point|target|q|p_u|p_v",
         "shape",
         "points (..., dim): leading axes vectorise (the docstring's contract)",
@@ -295,7 +295,7 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(r"geometry\.line", r"A|B|C", "negative", "a line's coefficients take any sign"),
     _doc(
-        r"(geometry\.Tunnel2D|propagation\.surfaces\.Tunnel3D)\.contains",
+        r"(tunnel2d\.Tunnel2D|propagation\.surfaces\.Tunnel3D)\.contains",
         r"margin",
         "negative",
         "a negative margin also counts points just outside the walls",

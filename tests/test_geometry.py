@@ -3,8 +3,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tunnelkit import geometry
-from tunnelkit.geometry import Plane, Tunnel2D, line
+from tunnelkit import geometry, tunnel2d
+from tunnelkit.geometry import Plane, line
+from tunnelkit.tunnel2d import Tunnel2D
 
 coord = st.floats(-100, 100, allow_nan=False)
 
@@ -84,7 +85,7 @@ def test_reflector_point_eq45_on_bisector_and_on_bs_vue_line():
         (lambda: geometry.specular_point([0, 0], [0, 1], line(0, 1, 0)), "source: lies on"),
         (lambda: geometry.reflector_point([1.0, 2.0, 3.0], [1.0, 2.0, 3.0]), "coincides"),
         (lambda: line(1, 0, 0).mirror([1.0, 2.0, 3.0]), "p: expected points with 2"),
-        (lambda: geometry.virtual_stations([0, 0], []), "walls: need"),
+        (lambda: tunnel2d.virtual_stations([0, 0], []), "walls: need"),
     ],
 )
 def test_bad_geometry_input_names_the_parameter(call, match):

@@ -506,10 +506,10 @@ def test_bias_budget_refuses_complex_blocks_and_a_real_mask():
 def test_geometry_virtual_stations_with_the_base_station_outside(jiang, across):
     tunnel = jiang["tunnel"]
     inside = tunnel.from_tunnel_frame(np.array([10.0, 0.5 * tunnel.width]))
-    vs = tk.geometry.virtual_stations(inside, list(tunnel.walls))
+    vs = tk.tunnel2d.virtual_stations(inside, list(tunnel.walls))
     np.testing.assert_allclose(vs, tunnel.virtual_stations(inside))
     outside = tunnel.from_tunnel_frame(np.array([10.0, across]))
-    _raises(ValueError, r"^base_station: .* outside", tk.geometry.virtual_stations, outside,
+    _raises(ValueError, r"^base_station: .* outside", tk.tunnel2d.virtual_stations, outside,
             list(tunnel.walls))  # fmt: skip
 
 

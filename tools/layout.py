@@ -43,6 +43,7 @@ RANKS = {
     "schema": 0.5,
     "schemadoc": 0.6,  # the schema written out: TOML templates, the Markdown reference
     "geometry": 1,
+    "tunnel2d": 1.05,  # Jiang's 2-D tunnel and its virtual stations, on geometry's lines
     "odometry": 1,  # the V2X odometry messages as a model
     "reckoning": 1.1,  # dead reckoning on the odometry messages and its bound
     "crlb": 1,

@@ -3,7 +3,7 @@
 A small package under a sequence of notebooks (``notebooks/01-...`` to ``06-...``). Submodules
 mirror the notebooks and load on first use, so ``import tunnelkit as tk`` stays fast:
 
-``constants, geometry, crlb, positioning`` (01) · ``fresnel`` (02) · ``arrays, propagation,
+``constants, geometry, tunnel2d, crlb, positioning`` (01) · ``fresnel`` (02) · ``arrays, propagation,
 channel, extraction, signal_route, evaluation`` (03) · ``tracking`` (04-06) · ``scenarios, metrics, montecarlo, plots,
 widgets, reference, reproduce`` (all).
 """

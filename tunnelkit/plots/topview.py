@@ -6,7 +6,8 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .._validate import finite_array, interval, text, vector
-from ..geometry import Tunnel2D, specular_point
+from ..geometry import specular_point
+from ..tunnel2d import Tunnel2D
 from .common import COLORS
 
 __all__ = ["tunnel_topview"]
@@ -29,7 +30,7 @@ def tunnel_topview(
     """Walls over an ``along`` range, the base station, both virtual stations and, for a vehicle,
     the two wall-reflected paths (solid) with their virtual-station equivalents (dotted)."""
     if not isinstance(tunnel, Tunnel2D):
-        raise TypeError(f"tunnel: expected a geometry.Tunnel2D, got {type(tunnel).__name__}")
+        raise TypeError(f"tunnel: expected a tunnel2d.Tunnel2D, got {type(tunnel).__name__}")
     bs = vector("base_station", base_station, 2)
     a = np.asarray(interval("along", along))
     if vehicle is not None:

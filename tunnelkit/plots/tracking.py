@@ -35,7 +35,7 @@ def tracks_figure(
 ) -> go.Figure:
     """Top view with the true track and each estimator's track; a slider (and play button) moves
     one marker per estimator along time. ``truth`` (T, >=2), ``estimates`` name -> (T, >=2)."""
-    attributes("tunnel", tunnel, ("to_tunnel_frame",), "a tunnel (geometry.Tunnel2D)")
+    attributes("tunnel", tunnel, ("to_tunnel_frame",), "a tunnel (tunnel2d.Tunnel2D)")
     truth = finite_array("truth", truth, ndim=2)
     figure_inputs(texts={"title": title}, mappings={"estimates": estimates})
     period = positive("period", period)

@@ -8,8 +8,8 @@ import itertools
 
 import numpy as np
 
-from ..geometry import Tunnel2D
 from ..schema import ScenarioError
+from ..tunnel2d import Tunnel2D
 from .registry import Trajectory, register_trajectory, register_tunnel
 
 __all__: list[str] = []

@@ -75,7 +75,7 @@ class Scenario:
         scenario's :meth:`odometry`."""
         if tunnel is not None and not callable(getattr(tunnel, "contains", None)):
             raise TypeError(
-                f"tunnel: expected a tunnel (geometry.Tunnel2D or propagation.Tunnel3D), got "
+                f"tunnel: expected a tunnel (tunnel2d.Tunnel2D or propagation.Tunnel3D), got "
                 f"{type(tunnel).__name__}"
             )
         sec = self.section("trajectory")

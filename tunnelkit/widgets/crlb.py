@@ -9,8 +9,8 @@ import plotly.graph_objects as go
 from .. import crlb
 from .._validate import boolean, finite_array, integer, positive
 from ..budget import check_elements
-from ..geometry import Tunnel2D
 from ..scenarios import load_scenario
+from ..tunnel2d import Tunnel2D
 from .base import Explorer, float_slider
 
 __all__ = ["crlb_explorer", "crlb_figure", "crlb_map"]
@@ -31,7 +31,7 @@ def crlb_map(
     Returns ``(along, across, rmse)`` with ``rmse`` of shape (n_across, n_along).
     """
     if not isinstance(tunnel, Tunnel2D):
-        raise TypeError(f"tunnel: expected a geometry.Tunnel2D, got {type(tunnel).__name__}")
+        raise TypeError(f"tunnel: expected a tunnel2d.Tunnel2D, got {type(tunnel).__name__}")
     along = finite_array("along", along, shape=(2,))
     n_along = integer("n_along", n_along, minimum=2)
     n_across = integer("n_across", n_across, minimum=2)
