@@ -221,7 +221,8 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a stack (..., n, n) of covariances is factored matrix by matrix",
     ),
     _doc(
-        r"tracking\.gating\.(ChiSquareGate\.accepts|InnovationGate\.judge)",
+        r"tracking\.gating\.(ChiSquareGate\.accepts|squared_distances)"
+        r"|tracking\.reopening\.InnovationGate\.judge",
         r"d2",
         "nan",
         "a non-finite d2 is rejected by the gate (the docstring's contract)",
@@ -365,7 +366,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         r"metrics\.(position_errors|rmse|error_stats|ecdf)|crlb\.\w+|angles\.\w+"
         r"|geometry\.spherical\w*"
         r"|positioning\.(simulate_toa_doa|toa_only_candidates)|arrays\.ArrayGeometry\.\w+"
-        r"|tracking\.pcrlb\.\w+|tracking\.gating\.InnovationGate\.inflation"
+        r"|tracking\.pcrlb\.\w+|tracking\.reopening\.InnovationGate\.inflation"
         r"|tracking\.virtual_station\.model\.VsModel\.(hx|jacobian|position_fim|simulate)",
         r"p|q|u|a|x|F|errors|estimate|truth|d_hat|jacobians|bounds|S|positions",
         "shape",
