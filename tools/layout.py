@@ -35,9 +35,11 @@ RANKS = {
     "_checks": 0.25,  # more checks of the validation layer, built on _validate
     "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
     "_parallel": 0.3,  # where trials run (workers or a scheduler address), checked once
+    "_version": 0,  # the package version, imports nothing
     "constants": 0.5,
     "angles": 0.5,  # angles wrapped to (-pi, pi], the bearings' innovations
     "solutions": 0.5,  # the notebooks' solution cells (an IPython magic), imports nothing of ours
+    "notebook": 1.2,  # the notebooks' own calls (setup, solutions, build dir), on montecarlo
     "budget": 0.5,
     "report": 0.5,
     "schema": 0.5,

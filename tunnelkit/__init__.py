@@ -11,10 +11,10 @@ widgets, reference, reproduce`` (all).
 from __future__ import annotations
 
 import importlib
-from pathlib import Path
 from typing import Any
 
 from . import scenarios
+from ._version import __version__
 from .montecarlo import QUICK, mc_count, quick_mode
 from .scenarios import list_scenarios, load_scenario
 
@@ -22,7 +22,6 @@ from .scenarios import list_scenarios, load_scenario
 # objects and register themselves on import; the first lookup of a built-in kind imports its module
 scenarios.registry.set_loader(importlib.import_module)
 
-__version__ = "0.15.0"
 
 __all__ = [
     "QUICK",
@@ -37,10 +36,19 @@ __all__ = [
 ]
 
 
+#: the notebooks' own calls, in :mod:`tunnelkit.notebook` (loaded by the first of them)
+_NOTEBOOK_CALLS = ("build_dir", "setup_notebook", "solution")
+
+
 def __getattr__(name: str) -> Any:
-    """Load submodules lazily: ``tk.fresnel`` imports ``tunnelkit.fresnel`` on first access."""
+    """Load submodules lazily: ``tk.fresnel`` imports ``tunnelkit.fresnel`` on first access; the
+    notebooks' calls (``tk.setup_notebook()``) load :mod:`tunnelkit.notebook`."""
     if name.startswith("_"):
         raise AttributeError(name)
+    if name in _NOTEBOOK_CALLS:
+        value = getattr(importlib.import_module(".notebook", __name__), name)
+        globals()[name] = value
+        return value
     try:
         module = importlib.import_module(f".{name}", __name__)
     except ModuleNotFoundError as exc:
@@ -49,57 +57,3 @@ def __getattr__(name: str) -> Any:
         raise
     globals()[name] = module
     return module
-
-
-def setup_notebook(*, renderer: str | None = None) -> None:
-    """The one setup call every notebook makes after ``import tunnelkit as tk``.
-
-    Sets a plotly renderer that works both in JupyterLab and when the notebook is executed
-    headless (CI, static site), registers the ``%%solution`` magic of exercise solution cells
-    (:mod:`tunnelkit.solutions`: run on demand, or at once with ``TUNNELKIT_SOLUTIONS=1``) and
-    prints one line: the package version and whether quick mode
-    is on. Returns None, so the call is not echoed as a cell result.
-    """
-    # the type and emptiness first: the first look at plotly's renderer registry loads it (seconds)
-    if renderer is not None and not isinstance(renderer, str):
-        raise TypeError(f"renderer: expected a plotly renderer name, got {type(renderer).__name__}")
-    if renderer == "":
-        raise ValueError("renderer: must not be empty (None keeps the default renderer)")
-    import plotly.io as pio
-
-    if renderer is not None and renderer not in pio.renderers:
-        raise ValueError(
-            f"renderer: expected one of plotly's renderers ({', '.join(list(pio.renderers)[:6])}, "
-            f"...), got {renderer!r}"
-        )
-    if renderer is not None:
-        pio.renderers.default = renderer
-    elif pio.renderers.default in (None, "", "browser"):
-        pio.renderers.default = "notebook_connected+plotly_mimetype"
-    pio.templates.default = "plotly_white"
-    from .solutions import install
-
-    install()  # exercise solutions: run when asked for (tunnelkit.solutions)
-    mode = "quick (TUNNELKIT_QUICK=1: Monte-Carlo counts shrunk for CI)" if quick_mode() else "full"
-    print(f"tunnelkit {__version__} · mode: {mode}")
-
-
-def solution(sid: str) -> None:
-    """Run an exercise's solution in this notebook once you have tried: ``tk.solution("03.2")``
-    (notebook 03, exercise 2), as the button under its cell does (:mod:`tunnelkit.solutions`)."""
-    from .solutions import run
-
-    run(sid)
-
-
-def build_dir(*parts: str) -> Path:
-    """A directory under the repository's ``build/`` (created), for files a notebook writes.
-
-    The repository is the nearest directory at or above the working directory that holds
-    ``pyproject.toml`` (a notebook runs in ``notebooks/``); elsewhere ``./build``.
-    """
-    here = Path.cwd().resolve()
-    root = next((p for p in (here, *here.parents) if (p / "pyproject.toml").is_file()), here)
-    out = root.joinpath("build", *parts)
-    out.mkdir(parents=True, exist_ok=True)
-    return out
