@@ -651,3 +651,20 @@ def test_unit_pcrlb_is_the_drive_pcrlb_without_calibration_and_grows_with_it(set
     assert fine[0] < pooled[0]  # the entry fix is the bound's prior
     with pytest.raises(TypeError, match="calibration"):
         unit_pcrlb(setup, m, g, calibration="yes")
+
+
+def test_load_tracker_loads_the_tracker_modules_a_worker_unpickles():
+    """A Dask worker runs ``load_tracker`` before a sweep's tasks, so that no task imports a tracker
+    module while another thread unpickles one (the import locks deadlock): in a fresh process it
+    must load the modules themselves, not only the lazy package shells."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from tunnelkit.design.arrayjob import load_tracker; load_tracker()\n"
+        "need = ['tunnelkit.tracking.javelin.' + m for m in ('tracker', 'arraydesign', "
+        "'designs', 'update', 'manage', 'surfaces')] + ['tunnelkit.simulation.drives']\n"
+        "print([m for m in need if m not in sys.modules])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

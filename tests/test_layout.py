@@ -154,7 +154,7 @@ def test_every_lazy_table_holds():
 #: file loads its own family's spec only (the Jiang and Halili specs apart, 200 lines fewer; the
 #: [odometry] section and the schema's old names kept loadable, 140 more), 18,849 since the
 #: derivations and design notes went from the docstrings to docs/internals (1,000 lines) and the
-#: TeNFiLoc baseline loads when asked for (180), 18,051 since the array design's tracker, the
+#: TeNFiLoc baseline loads when asked for (180), 18,070 since the array design's tracker, the
 #: filters' reopening gate, the design's Monte-Carlo by units, Jiang's 2-D tunnel and the
 #: notebooks' own calls have modules of their own (800); an eager package namespace, the
 #: Monte-Carlo of a sweep without units, or a module the verbs do not run (the evaluation tables,

@@ -105,6 +105,14 @@ def test_get_loads_only_the_modules_it_needs():
         "print(j.__name__, 'tunnelkit.tracking.javelin.tenfiloc' in sys.modules)\n"
         "print(list(registry.family('italiano2026')))\n"
     )
+    # the family's order is its providers', whichever module was imported first
+    late = (
+        "import tunnelkit.tracking.javelin.tenfiloc, tunnelkit.tracking.upf\n"
+        "from tunnelkit.tracking import registry\n"
+        "print(list(registry.family('italiano2026')), list(registry.family('jiang2023')))\n"
+    )
+    got = subprocess.run([sys.executable, "-c", late], capture_output=True, text=True, check=True)
+    assert got.stdout.strip() == "['JAVELIN', 'TeNFiLoc'] ['TSWLS', 'EKF', 'UKF', 'UPF']"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     first, second = out.stdout.splitlines()
     assert first == "Javelin False"

@@ -3,9 +3,10 @@
 A small package under a sequence of notebooks (``notebooks/01-...`` to ``06-...``). Submodules
 mirror the notebooks and load on first use, so ``import tunnelkit as tk`` stays fast:
 
-``constants, geometry, tunnel2d, crlb, positioning`` (01) · ``fresnel`` (02) · ``arrays, propagation,
-channel, extraction, signal_route, evaluation`` (03) · ``tracking`` (04-06) · ``scenarios, metrics, montecarlo, plots,
-widgets, reference, reproduce`` (all).
+``constants, geometry, tunnel2d, crlb, positioning`` (01) · ``fresnel`` (02) · ``arrays,
+propagation, channel, extraction, signal_route, evaluation`` (03) · ``tracking`` (04-06) ·
+``scenarios, metrics, montecarlo, plots, widgets, reference, reproduce`` (all) · ``notebook``
+(``tk.setup_notebook()``, ``tk.solution``, ``tk.build_dir``) · ``_version``.
 """
 
 from __future__ import annotations
@@ -38,6 +39,11 @@ __all__ = [
 
 #: the notebooks' own calls, in :mod:`tunnelkit.notebook` (loaded by the first of them)
 _NOTEBOOK_CALLS = ("build_dir", "setup_notebook", "solution")
+
+
+def __dir__() -> list[str]:
+    """The package's names with the notebooks' calls (loaded on first use)."""
+    return sorted(set(globals()) | set(__all__))
 
 
 def __getattr__(name: str) -> Any:

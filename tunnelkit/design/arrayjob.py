@@ -267,8 +267,19 @@ def load_tracker() -> None:
     """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
     a worker that imports them in a task while another thread unpickles a tracker sent from
     another worker deadlocks on the package's import locks)."""
-    from .. import simulation  # noqa: F401
-    from ..tracking import javelin  # noqa: F401
+    # the modules themselves: the packages load their names on first use
+    from ..simulation import drives, scoring  # noqa: F401
+    from ..tracking.javelin import (  # noqa: F401
+        arraydesign,
+        designs,
+        manage,
+        measurement,
+        noise,
+        roles,
+        state,
+        tracker,
+        update,
+    )
 
 
 def prepared_summary(prep: Prepared) -> tuple:

@@ -2,8 +2,9 @@
 manufactured units that meet the target.
 
 :func:`design_sweep` places every candidate, computes its ideal PEB and predicted error, runs
-the Monte-Carlo over manufactured units (:mod:`tunnelkit.design.unitsweep`) and gives the verdict; :class:`DesignReport` holds the
-rows, the recommendation, every input and the warnings (JSON or a text table);
+the Monte-Carlo over manufactured units (:mod:`tunnelkit.design.unitsweep`) and gives the
+verdict; :class:`DesignReport` holds the rows, the recommendation, every input and the warnings
+(JSON or a text table);
 :func:`smallest_meeting` is the explorer's quick look (a prediction, not an answer).
 
 How it works, step by step: docs/internals/design.md.

@@ -1,8 +1,8 @@
 """Paths by the image method: LoS plus one specular reflection per surface, with the exact length
-to every antenna and the SR-NF lengths for comparison (see the package docstring for the model
-and the sign conventions), and, on request (``order=2``), the second-order specular paths: the
-UE mirrored in one surface, then that image mirrored in another (ceiling then road, wall then
-wall, ...), each bounce checked inside its finite surface."""
+to every antenna and the SR-NF lengths for comparison (the model and the sign conventions:
+docs/internals/channel-and-propagation.md), and, on request (``order=2``), the second-order specular
+paths: the UE mirrored in one surface, then that image mirrored in another (ceiling then road, wall
+then wall, ...), each bounce checked inside its finite surface."""
 
 from __future__ import annotations
 

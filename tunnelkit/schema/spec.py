@@ -1,5 +1,5 @@
 """The scenario schema's machinery: :class:`Key`, :class:`Table`, validation and the
-families' tables by name (:data:`FAMILIES`); the package docstring says what is checked."""
+families' tables by name (:data:`FAMILIES`); what is checked: docs/internals/scenarios.md."""
 
 from __future__ import annotations
 

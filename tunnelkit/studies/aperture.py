@@ -15,9 +15,10 @@ complex linear profile ``1 + j k0 du x`` is, to first order, the path's phase fr
 ``du``, so a complex taper would take the direction away from the geometry and the angles would
 no longer be identifiable; an amplitude cannot turn a phase front.
 
-The gains stay linear and are projected out as in eq. 1's fit (docs/internals/extraction-ml.md, Kaufman's Gauss-Newton model); the ``beta`` are ``K`` more
-nonlinear parameters per path, with derivative atoms ``exp(j psi_l) w_j`` (no ``h``), and every
-atom still factorises into (element) x (tone) x (symbol). With ``order = 0`` the problem is eq.
+The gains stay linear and are projected out as in eq. 1's fit (docs/internals/extraction-ml.md,
+Kaufman's Gauss-Newton model); the ``beta`` are ``K`` more nonlinear parameters per path, with
+derivative atoms ``exp(j psi_l) w_j`` (no ``h``), and every atom still factorises into (element) x
+(tone) x (symbol). With ``order = 0`` the problem is eq.
 1's :class:`~tunnelkit.extraction.ml.model.Problem`, number for number (tested).
 :meth:`ApertureProblem.fit` is Levenberg-Marquardt over all ``(5 + K) L`` parameters from a
 start (normally eq. 1's fit with ``beta = 0``). Measured in ``docs/results/traced-models.md``

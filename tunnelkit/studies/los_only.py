@@ -1,20 +1,20 @@
 """The line of sight alone on the ray-traced channel: JAVELIN fed each epoch's earliest arrival.
 
-On the traced channel the reflections' estimates are biased by degrees per kind of path and the
-bias repeats from epoch to epoch, while the line of sight's angles are nearly unbiased (median
--0.15 / 0.10 deg azimuth / elevation, robust sigma 1.0 / 1.8 deg; ``docs/results/traced-robust.md``).
-This study keeps, of every epoch's ML measurements (``"ml-all"`` of
+On the traced channel the reflections' estimates are biased by degrees per kind of path and the bias
+repeats from epoch to epoch, while the line of sight's angles are nearly unbiased (median -0.15 /
+0.10 deg azimuth / elevation, robust sigma 1.0 / 1.8 deg; ``docs/results/traced-robust.md``). This
+study keeps, of every epoch's ML measurements (``"ml-all"`` of
 :func:`tunnelkit.studies.traced.simulate_traced`), one path taken for the line of sight and tells
-JAVELIN a plain angle sigma for it: :func:`los_only`, :func:`los_design`. The line of sight
-arrives first, but under a ceiling-mounted site the ceiling's reflection follows within
-centimetres and the delay errors swap them (the earliest arrival is the true line of sight in
-62-64 % of the epochs); the ceiling's image lies above the array, so of the arrivals within
-``window`` of the earliest the lowest in elevation is taken (87-89 %, window 0.3 m chosen on
-seed 0 among 0.3 / 0.6 / 1.0 m). No truth is used to pick it. :func:`los_angle_information` is the position
-information the line of sight's two angles would carry as independent Gaussian errors of that
-sigma, for the drive's posterior CRLB beside the tracker (a reference figure of the told model,
-not a bound on the traced channel, whose errors are neither). ``benchmarks/bench_rt_los.py``
-runs it beside the traced design and dead reckoning.
+JAVELIN an angle sigma for it (one for both angles, or the azimuth's and the elevation's):
+:func:`los_only`, :func:`los_design`. The line of sight arrives first, but under a ceiling-mounted
+site the ceiling's reflection follows within centimetres and the delay errors swap them (the
+earliest arrival is the true line of sight in 62-64 % of the epochs); the ceiling's image lies above
+the array, so of the arrivals within ``window`` of the earliest the lowest in elevation is taken
+(87-89 %, window 0.3 m chosen on seed 0 among 0.3 / 0.6 / 1.0 m). No truth is used to pick it.
+:func:`los_angle_information` is the position information the line of sight's two angles would carry
+as independent Gaussian errors of that sigma, for the drive's posterior CRLB beside the tracker (a
+reference figure of the told model, not a bound on the traced channel, whose errors are neither).
+``benchmarks/bench_rt_los.py`` runs it beside the traced design and dead reckoning.
 """
 
 from __future__ import annotations

@@ -57,11 +57,21 @@ def families() -> list[str]:
 
 
 def family(family_name: str) -> dict[str, Callable[..., Any]]:
-    """All members of a family, in registration order."""
+    """All members of a family: those of its providers in the order they were declared (each
+    module's in its registration order), then any registered directly; the same order whichever
+    module was imported first."""
     _load(family_name)
     if family_name not in _REG:
         raise ValueError(f"family_name: unknown family {family_name!r}; known: {families()}")
-    return dict(_REG[family_name])
+    mods = _PROVIDERS.get(family_name, [])
+    members = list(_REG[family_name].items())
+
+    def rank(item) -> int:
+        mod = getattr(item[1], "__module__", "") or ""
+        hits = [k for k, p in enumerate(mods) if mod == p or mod.startswith(p + ".")]
+        return hits[0] if hits else len(mods)
+
+    return dict(sorted(members, key=rank))  # a stable sort keeps each module's own order
 
 
 def get(family_name: str, name: str) -> Callable[..., Any]:

@@ -1,4 +1,5 @@
-"""The filters' gate (EKF, UKF, UPF, Doppler KF): an outlier becomes a missed epoch, and the gate reopens.
+"""The filters' gate (EKF, UKF, UPF, Doppler KF): an outlier becomes a missed epoch, and the
+gate reopens.
 
 A measurement ``z`` with innovation ``y = z - h(x_prior)`` (bearings wrapped) and innovation
 covariance ``S`` (``H P H^T + R`` for the (E)KF, the unscented ``S`` for the UKF and UPF) passes

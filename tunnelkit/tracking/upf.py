@@ -14,7 +14,7 @@ Every particle ``i`` carries a state sample ``X^i`` and its own covariance ``P^i
 6. output (eq. 62-63): weighted mean and spread of the particles.
 
 Not in the paper, on by default: before step 3 the measurement passes a chi-square gate
-(:mod:`tunnelkit.tracking.gating`) on the innovation of the particle mixture, ``y = Z - z_bar``
+(:mod:`tunnelkit.tracking.reopening`) on the innovation of the particle mixture, ``y = Z - z_bar``
 with ``z_bar = sum_i w^i z_hat^i`` and ``S = sum_i w^i (Pzz^i + (z_hat^i - z_bar)(.)^T)`` (law of
 total covariance over the particles' UKF predictions). A rejected measurement is a missed epoch
 (particles drawn from the transition, weights unchanged). A reopened one (after ``reopen_after``

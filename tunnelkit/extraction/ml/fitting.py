@@ -1,6 +1,7 @@
 """The fit of the maximum-likelihood stage: Levenberg-Marquardt on the concentrated cost, the
-stopping rule, the basin test and the SAGE-like re-seedings (docs/internals/extraction-ml.md), in :func:`fit_problem` (on a :class:`~.model.Problem`) and
-:func:`fit_ml` (on a tensor); the result is an :class:`MLFit`."""
+stopping rule, the basin test and the SAGE-like re-seedings (docs/internals/extraction-ml.md),
+in :func:`fit_problem` (on a :class:`~.model.Problem`) and :func:`fit_ml` (on a tensor); the
+result is an :class:`MLFit`."""
 
 from __future__ import annotations
 
@@ -355,8 +356,8 @@ def _coherent_pair(ev):
 
 
 def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
-    """The re-seedings on the residual energy (docs/internals/extraction-ml.md): while the cost is above
-    ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
+    """The re-seedings on the residual energy (docs/internals/extraction-ml.md): while the cost is
+    above ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
     and the weakest path re-sought, each kept if the likelihood rises. Returns the fit, the
     iterations spent and the number of kept moves."""
     tried: set = set()

@@ -1,4 +1,5 @@
-"""Levenberg-Marquardt on the concentrated cost of a :class:`~.model.Problem` (docs/internals/extraction-ml.md: the damped Gauss-Newton step, the stopping rule on the Newton
+"""Levenberg-Marquardt on the concentrated cost of a :class:`~.model.Problem`
+(docs/internals/extraction-ml.md: the damped Gauss-Newton step, the stopping rule on the Newton
 decrement), shared by the fit (:mod:`.fitting`) and the resolution test (:mod:`.resolution`)."""
 
 from __future__ import annotations

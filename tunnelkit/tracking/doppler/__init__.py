@@ -15,7 +15,7 @@ Every tracker has ``step(doppler, toa) -> position`` and ``run(measurements) -> 
 ``None`` measurement is a dropped epoch (predict only, with a :class:`MeasurementWarning`).
 
 Not in the paper, on by default: every Kalman filter here gates its measurement
-(:mod:`tunnelkit.tracking.gating`, chi-square with one degree of freedom at ``gate = 0.999``): a
+(:mod:`tunnelkit.tracking.reopening`, chi-square with one degree of freedom at ``gate = 0.999``): a
 Doppler locked on a moving scatterer or a ToA off by a gross NLOS excess is a missed epoch,
 counted in ``n_rejected``. ``gate=None`` gives the paper's filters. The KF on ToA calibrates the
 clock offset on a robust statistic of its first ToAs (not on one sample), and eq. 16 keeps the

@@ -211,7 +211,7 @@ class DopplerEKF(_KalmanState):
     Doppler whose squared normalised innovation ``y^2 / S`` exceeds the chi-square quantile with
     one degree of freedom is treated as an outlier (a moving scatterer) and skipped (predict
     only); ``n_rejected`` counts them. After ``reopen_after`` consecutive rejections the next
-    Doppler is taken with an inflated covariance (:mod:`tunnelkit.tracking.gating`).
+    Doppler is taken with an inflated covariance (:mod:`tunnelkit.tracking.reopening`).
     """
 
     def __init__(
@@ -434,7 +434,7 @@ class RangeKF(_KalmanState):
     unchecked single-sample calibration.
 
     Every later ToA passes a chi-square gate (``gate``, ``reopen_after``; see
-    :mod:`tunnelkit.tracking.gating`); ``n_rejected`` counts the rejected ToAs (gate and
+    :mod:`tunnelkit.tracking.reopening`); ``n_rejected`` counts the rejected ToAs (gate and
     calibration). A ToA implying a distance below ``d_min`` (the transmitter's height above the
     antenna) is physically impossible and is rejected with a warning.
     """

@@ -133,10 +133,10 @@ class ConsiderNoise(ReportedNoise):
     """Reported covariances split into a white share, drawn afresh every epoch, and a repeating
     share (``PathMeasurements.bias_cov``: one array's calibration error, the bias of the terms
     the estimator's model leaves out), which the tracker carries as consider parameters of the
-    path's track instead of averaging it down (ours; the tracker's module docstring of
-    :func:`~tunnelkit.tracking.javelin.update.consider_update` says why consider and not
-    estimate). Each track's normalised bias ``u`` (4,: one per ``phi, psi, kappa, d``, prior
-    ``N(0, I)``) enters a measurement of path ``j`` as ``L_j u`` (:func:`bias_factors`), and
+    path's track instead of averaging it down (ours; docs/internals/tracking.md, the section on
+    :mod:`tunnelkit.tracking.javelin.update`, says why consider and not estimate). Each track's
+    normalised bias ``u`` (4,: one per ``phi, psi, kappa, d``, prior ``N(0, I)``) enters a
+    measurement of path ``j`` as ``L_j u`` (:func:`bias_factors`), and
     decorrelates as a first-order Gauss-Markov process with time constant ``tau_s`` [s]
     (``inf``, the default: the same draw the whole drive). Association and births see the whole
     reported covariance (:meth:`covariances`); the update the white share

@@ -24,7 +24,7 @@ bearing near +-pi does not average to zero.
 
 Not in the paper, on by default: the EKF, UKF and UPF gate each measurement vector on the squared
 Mahalanobis distance of its innovation against ``chi2_2N(gate)`` (``gate = 0.999``,
-:mod:`tunnelkit.tracking.gating`); a rejected vector (a gross range or bearing outlier) is a
+:mod:`tunnelkit.tracking.reopening`); a rejected vector (a gross range or bearing outlier) is a
 missed epoch, counted in ``n_rejected``; ``gate=None`` gives the paper's filters.
 
 The package holds three parts: :mod:`.model` (the measurement model, priors and input checks),

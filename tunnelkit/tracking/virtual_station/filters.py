@@ -211,7 +211,7 @@ class _FilterpyEstimator(EstimatorBase):
 @register(FAMILY, "EKF")
 class VsEKF(_FilterpyEstimator):
     """filterpy ``ExtendedKalmanFilter`` on eq. 40-45 with the analytic Jacobian and wrapped
-    bearing residuals; ``gate``/``reopen_after`` as in :mod:`tunnelkit.tracking.gating`."""
+    bearing residuals; ``gate``/``reopen_after`` as in :mod:`tunnelkit.tracking.reopening`."""
 
     name = "EKF"
 
@@ -258,7 +258,7 @@ class VsUKF(_FilterpyEstimator):
     ``alpha, beta, kappa`` are the scaling parameters of eq. 47-50. The square root of the
     sigma-point covariance is a regularised Cholesky factor (warns instead of failing). Bearings
     use the wrapped residual and reference-based mean of :class:`VsModel`. ``gate`` and
-    ``reopen_after`` as in :mod:`tunnelkit.tracking.gating` (a reopened measurement redraws the
+    ``reopen_after`` as in :mod:`tunnelkit.tracking.reopening` (a reopened measurement redraws the
     sigma points from the inflated prior).
     """
 
