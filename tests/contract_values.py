@@ -645,6 +645,9 @@ def _traced():
     pre.geometry_labels(ep, route)
     pre.geometry_keep(ep, route)
     pre.traced_measurements(ep, route)
+    from tunnelkit.studies.los_only import flagged_los
+
+    flagged_los(ep, route)
     from tunnelkit.consistency import plane_kinds
 
     plane_kinds(route.tunnel)

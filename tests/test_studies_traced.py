@@ -358,3 +358,32 @@ def test_the_line_of_sight_study_picks_without_truth_and_its_information_is_the_
         los_angle_information(np.array([[0.0, 0.0, 1.0]]), bs, sigma)
     with pytest.raises(ValueError, match="sigma_elevation"):
         los_angle_information(ue, bs, sigma, 4.0)
+
+
+def test_the_flagged_line_of_sight_is_the_picked_path_unless_the_fit_flags_it():
+    """``flagged_los``: the path ``los_path`` takes among the epoch's ML measurements, or none
+    where the fit puts that path in its threshold region (its own verdict, no truth)."""
+    from dataclasses import replace as dc_replace
+
+    from tunnelkit.simulation.drives import scenario_route
+    from tunnelkit.studies.los_only import flagged_los, los_path
+
+    route = scenario_route("italiano2026-straight")
+    ep = route.epoch(10, np.random.default_rng(0), refine="ml")
+    m = ep.measurements
+    keep, why = flagged_los(ep, route)
+    j = los_path(m.d, m.psi)
+    flags = ep.estimates.below_threshold
+    if flags is not None and flags[m.source[j]]:
+        assert keep is None and "threshold" in why
+    else:
+        assert why is None and len(keep) == 1 and keep.d[0] == m.d[j] and keep.psi[0] == m.psi[j]
+    flagged = np.zeros(len(ep.estimates.d), bool)
+    flagged[m.source[j]] = True
+    ep2 = dc_replace(ep, estimates=dc_replace(ep.estimates, below_threshold=flagged))
+    none, why = flagged_los(ep2, route)
+    assert none is None and "threshold region" in why
+    with pytest.raises(TypeError, match=r"^ep"):
+        flagged_los("an epoch", route)
+    with pytest.raises(ValueError, match="window"):
+        flagged_los(ep, route, window=-1.0)

@@ -26,7 +26,14 @@ import numpy as np
 from .._validate import finite_array, instance, nonnegative, positive
 from ..geometry import spherical_jacobian
 
-__all__ = ["LOS_WINDOW_M", "los_angle_information", "los_design", "los_only", "los_path"]
+__all__ = [
+    "LOS_WINDOW_M",
+    "flagged_los",
+    "los_angle_information",
+    "los_design",
+    "los_only",
+    "los_path",
+]
 
 
 #: the arrivals within this delay distance of the earliest are candidates for the LoS [m]
@@ -68,6 +75,31 @@ def _angle_sigma(name: str, value: float) -> float:
     if value > np.pi:
         raise ValueError(f"{name}: at most pi rad (half a turn), got {value:g}")
     return value
+
+
+def flagged_los(ep, route, window: float = LOS_WINDOW_M):
+    """A drive adapter (:func:`tunnelkit.simulation.simulate_routes`, ``adapters=``): of the
+    epoch's ML measurements (every row, as ``"ml-all"``), the path :func:`los_path` takes for the
+    line of sight, kept only where the fit does not flag it: ``(None, reason)`` when the fit put
+    that path in its threshold region (``PathEstimates.below_threshold``: its SNR below the
+    threshold of the method of interval errors, or unresolved from another path, where its
+    errors leave the bound). Uses the fit's own verdict, no truth."""
+    from ..signal_route import Epoch, SignalRoute
+    from ..tracking.measurements import PathMeasurements
+
+    ep, route = instance("ep", ep, Epoch), instance("route", route, SignalRoute)
+    window = nonnegative("window", window)
+    m = ep.measurements
+    pm = PathMeasurements.from_arrays(
+        m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d
+    )
+    if len(pm) == 0:
+        return None, "no path"
+    j = los_path(pm.d, pm.psi, window)
+    flags = ep.estimates.below_threshold
+    if flags is not None and bool(flags[m.source[pm.source[j]]]):
+        return None, "the path taken for the line of sight is in the fit's threshold region"
+    return pm.subset(np.array([j])), None
 
 
 def los_design(sigma_angle: float, base=None, sigma_elevation: float | None = None):

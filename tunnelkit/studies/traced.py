@@ -47,7 +47,7 @@ from functools import partial
 
 import numpy as np
 
-from .._validate import boolean, integer, rng_or_error
+from .._validate import boolean, instance, integer, rng_or_error
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
 from ..scenarios import data_dir
@@ -104,6 +104,7 @@ def simulate_traced(
     nuisance: dict | None = None,
     floors=FLOORS,
     odometry=None,
+    adapters: dict | None = None,
 ) -> dict[str, DriveData]:
     """One drive of ``route`` (a :class:`SignalRoute` or a scenario name, :func:`scenario_route`
     with ``channel`` / ``nuisance``) under ``condition`` (a name of :data:`CONDITIONS`), measured
@@ -112,7 +113,8 @@ def simulate_traced(
     route's measurements of every epoch, its fit test ignored) and ``"ml-traced"`` (those the
     geometry pre-filter keeps, :func:`traced_measurements` with ``floors``); ``odometry`` the V2X
     messages' model (:class:`tunnelkit.odometry.Odometry`, default the drive's own: its
-    scenario's ``[odometry]``, the paper's white model where it has none)."""
+    scenario's ``[odometry]``, the paper's white model where it has none); ``adapters``: more
+    drives of the ML route's epochs, name -> adapter as :func:`simulate_routes` takes them."""
     rng = rng_or_error("rng", rng)
     if condition not in CONDITIONS:
         raise ValueError(f"condition: expected one of {list(CONDITIONS)}, got {condition!r}")
@@ -120,6 +122,7 @@ def simulate_traced(
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     floors = check_floors(floors)
+    more = {} if adapters is None else instance("adapters", adapters, dict)
     return simulate_routes(
         route,
         rng,
@@ -132,6 +135,7 @@ def simulate_traced(
         adapters={
             "ml-all": ("ml", partial(traced_measurements, floors=floors, prefilter=False)),
             "ml-traced": ("ml", partial(traced_measurements, floors=floors)),
+            **{name: ("ml", adapter) for name, adapter in more.items()},
         },
     )
 
