@@ -120,14 +120,23 @@ def _pair(text: str) -> tuple[float, float]:
     return float(az), float(el or az)
 
 
-def reference(drive, sigma_deg, start_sigma, scenario=SCENARIO) -> float:
-    """Settled RMS of the drive's posterior CRLB of the LoS angles at ``sigma_deg`` ("az[/el]")."""
-    setup = DesignSetup.from_scenario(scenario)
-    T = len(drive.truth)
-    info = los_angle_information(drive.truth, drive.base_station, *np.radians(_pair(sigma_deg)))
-    b = drive_pcrlb(setup, info[:T], sigma_p0=start_sigma)
-    idx = settled(drive.t)
+def settled_bound(setup, ue, station, t, sigma_deg, start_sigma) -> float:
+    """Settled RMS of the posterior CRLB over ``setup``'s drive of the LoS angles at
+    ``sigma_deg`` ("az[/el]"; ``None``: no radio, dead reckoning's) seen from ``station``."""
+    T = len(ue)
+    if sigma_deg is None:
+        info = np.zeros((T, 2, 2))
+    else:
+        info = los_angle_information(ue, station, *np.radians(_pair(sigma_deg)))
+    b = drive_pcrlb(setup, info, sigma_p0=start_sigma)
+    idx = settled(t[:T])
     return float(np.sqrt(np.mean(b[idx] ** 2)))
+
+
+def reference(drive, sigma_deg, start_sigma, scenario=SCENARIO) -> float:
+    """:func:`settled_bound` of ``drive`` (its truth and its reference antenna)."""
+    setup = DesignSetup.from_scenario(scenario)
+    return settled_bound(setup, drive.truth, drive.base_station, drive.t, sigma_deg, start_sigma)
 
 
 def bound_grid(scenario, pairs, start_sigma) -> None:
@@ -136,23 +145,15 @@ def bound_grid(scenario, pairs, start_sigma) -> None:
     tracker fed Gaussian LoS angles of those sigmas shows over dead reckoning on average (RMS).
     Drives nothing."""
     setup = DesignSetup.from_scenario(scenario)
-    ue = setup.trajectory.position
-    T = len(ue)
-    idx = settled(setup.trajectory.t[:T])
+    ue, t = setup.trajectory.position, setup.trajectory.t
     bs = SignalRoute.from_scenario(scenario).arrays[0].origin
-
-    def rms(info):
-        b = drive_pcrlb(setup, info, sigma_p0=start_sigma)
-        return float(np.sqrt(np.mean(b[idx] ** 2)))
-
-    dr = rms(np.zeros((T, 2, 2)))
-    print(f"\n{scenario}: told model, entry fix {start_sigma:g} m, {idx.size} settled epochs; "
-          f"dead reckoning's posterior CRLB {dr:.3f} m")  # fmt: skip
-    print(
-        "| azimuth / elevation sigma [deg] | posterior CRLB [m] | ratio to dead reckoning's |\n| --- | --- | --- |"
-    )
+    dr = settled_bound(setup, ue, bs, t, None, start_sigma)
+    print(f"\n{scenario}: told model, entry fix {start_sigma:g} m, {settled(t).size} settled "
+          f"epochs; dead reckoning's posterior CRLB {dr:.3f} m")  # fmt: skip
+    print("| azimuth / elevation sigma [deg] | posterior CRLB [m] | ratio to dead reckoning's |\n"
+          "| --- | --- | --- |")  # fmt: skip
     for s in pairs:
-        b = rms(los_angle_information(ue, bs, *np.radians(_pair(s))))
+        b = settled_bound(setup, ue, bs, t, s, start_sigma)
         print(f"| {s} | {b:.3f} | {dr / b:.2f}x |")
 
 

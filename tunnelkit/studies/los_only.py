@@ -84,17 +84,13 @@ def flagged_los(ep, route, window: float = LOS_WINDOW_M):
     that path in its threshold region (``PathEstimates.below_threshold``: its SNR below the
     threshold of the method of interval errors, or unresolved from another path, where its
     errors leave the bound). Uses the fit's own verdict, no truth."""
-    from ..signal_route import Epoch, SignalRoute
-    from ..tracking.measurements import PathMeasurements
+    from ..simulation.prefilter import traced_measurements
 
-    ep, route = instance("ep", ep, Epoch), instance("route", route, SignalRoute)
     window = nonnegative("window", window)
-    m = ep.measurements
-    pm = PathMeasurements.from_arrays(
-        m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d
-    )
+    pm, _ = traced_measurements(ep, route, prefilter=False)  # checks ep and route
     if len(pm) == 0:
         return None, "no path"
+    m = ep.measurements
     j = los_path(pm.d, pm.psi, window)
     flags = ep.estimates.below_threshold
     if flags is not None and bool(flags[m.source[pm.source[j]]]):
