@@ -648,6 +648,15 @@ def _traced():
     from tunnelkit.studies.los_only import flagged_los
 
     flagged_los(ep, route)
+    from tunnelkit.studies.robust_update import HuberUpdater, huber_weights
+    from tunnelkit.tracking.javelin.update import StackedMeasurement
+
+    m = StackedMeasurement(
+        np.array([0.1, 3.0]), np.zeros(2), np.eye(2), np.diag([0.01, 0.01]),
+        np.array([True, False]), [("phi", 0, 0), ("psi", 0, 0)], None,
+    )  # fmt: skip
+    HuberUpdater(1.345).update(np.zeros(2), np.eye(2), m)
+    huber_weights(m.z, m.H, np.eye(2), m.R, 1.345)
     from tunnelkit.consistency import plane_kinds
 
     plane_kinds(route.tunnel)
