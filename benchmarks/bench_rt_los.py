@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import json
 import sys
 import time
 from pathlib import Path
@@ -38,6 +39,12 @@ from tunnelkit.runner import run_trials
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.simulation import HELD_OUT_SEED, evaluate, without_radio
 from tunnelkit.studies.attribution import scenario_with_array
+from tunnelkit.studies.los_elevation import (
+    ElevationSigmas,
+    elevation_sigmas,
+    los_errors,
+    told_by_elevation,
+)
 from tunnelkit.studies.los_only import (
     flagged_los,
     los_angle_information,
@@ -45,8 +52,9 @@ from tunnelkit.studies.los_only import (
     los_only,
     los_path,
 )
+from tunnelkit.studies.robust_update import HuberUpdater
 from tunnelkit.studies.traced import simulate_traced, traced_design
-from tunnelkit.tracking.javelin import draw_start
+from tunnelkit.tracking.javelin import ReportedNoise, draw_start
 
 SCENARIO = "italiano2026-straight"
 START_HEIGHT = 0.05
@@ -75,8 +83,21 @@ def _rmse(drive, truth, design, p0, sigma, idx) -> float:
     return float(np.sqrt(np.mean(e**2)))
 
 
-def score(drives, seed, sigmas, start_sigma, los_gammas=(), flags=False) -> dict:
-    """Mean RMSE per tracker over ``drives`` (the starts from a stream of their own)."""
+def score(
+    drives,
+    seed,
+    sigmas,
+    start_sigma,
+    los_gammas=(),
+    flags=False,
+    starts=1,
+    tables=None,
+    huber=False,
+) -> dict:
+    """Mean RMSE per tracker over ``drives`` x ``starts`` entry fixes (the starts from a stream of
+    their own, ``starts`` per drive in turn); ``tables``: {label: ElevationSigmas} for the chosen
+    first sigma's design told each epoch's sigmas from the table (its kappa and d sigmas kept);
+    ``huber``: each sigma also with the Huber-weighted update."""
     rng = np.random.default_rng([seed, 1])
     td = traced_design()
     designs = {}
@@ -87,21 +108,39 @@ def score(drives, seed, sigmas, start_sigma, los_gammas=(), flags=False) -> dict
         for g in los_gammas:
             d = designs[f"LoS only, {s} deg"].with_(los_gamma=float(g))
             designs[f"LoS only, {s} deg, gamma {g:g}"] = d
+        if huber:
+            d = designs[f"LoS only, {s} deg"].with_(updater=HuberUpdater())
+            designs[f"LoS only, {s} deg, Huber update"] = d
     plain = list(designs)
     flagged = [f"{k}, fit flags" for k in plain] if flags else []
-    out = {"traced design": [], "dead reckoning": [], **{k: [] for k in plain + flagged}}
+    tables = tables or {}
+    told = designs[f"LoS only, {sigmas[0]} deg"].with_(noise=ReportedNoise())
+    ranged = [f"LoS only, sigmas by elevation ({k})" for k in tables]
+    out = {"traced design": [], "dead reckoning": [], **{k: [] for k in plain + flagged + ranged}}
     los_share, kept = [], []
     for dd in drives:
         tr, every = dd["ml-traced"], dd["ml-all"]
-        p0 = draw_start(tr.truth[0], start_sigma, rng, START_HEIGHT)
         idx = settled(tr.t)
-        out["traced design"].append(_rmse(tr, tr.truth, td, p0, start_sigma, idx))
-        out["dead reckoning"].append(_rmse(without_radio(tr), tr.truth, td, p0, start_sigma, idx))
         los = los_only(every)
-        for k, d in designs.items():
-            out[k].append(_rmse(los, tr.truth, d, p0, start_sigma, idx))
-            if flags:  # the same path, dropped in the epochs where the fit flags it
-                out[f"{k}, fit flags"].append(_rmse(dd["flags"], tr.truth, d, p0, start_sigma, idx))
+        by_el = [
+            told_by_elevation(
+                los, t, told.config.sigma_kappa, told.config.sigma_delta_d / np.sqrt(2)
+            )
+            for t in tables.values()
+        ]
+        for _ in range(starts):
+            p0 = draw_start(tr.truth[0], start_sigma, rng, START_HEIGHT)
+            out["traced design"].append(_rmse(tr, tr.truth, td, p0, start_sigma, idx))
+            out["dead reckoning"].append(
+                _rmse(without_radio(tr), tr.truth, td, p0, start_sigma, idx)
+            )
+            for k, d in designs.items():
+                out[k].append(_rmse(los, tr.truth, d, p0, start_sigma, idx))
+                if flags:  # the same path, dropped in the epochs where the fit flags it
+                    r = _rmse(dd["flags"], tr.truth, d, p0, start_sigma, idx)
+                    out[f"{k}, fit flags"].append(r)
+            for k, drive in zip(ranged, by_el, strict=True):
+                out[k].append(_rmse(drive, tr.truth, told, p0, start_sigma, idx))
         kept += [ep is not None for ep in dd["flags"].epochs]
         for ep, ti in zip(every.epochs, every.truth_index, strict=True):
             if ep is not None and len(ep):
@@ -109,8 +148,23 @@ def score(drives, seed, sigmas, start_sigma, los_gammas=(), flags=False) -> dict
     res = {k: float(np.mean(v)) for k, v in out.items()}
     # the root mean square over the drives: the statistic a posterior CRLB bounds
     res["_rms"] = {k: float(np.sqrt(np.mean(np.square(v)))) for k, v in out.items()}
+    res["_gain_interval"] = _gain_interval(out, len(drives), starts)
     res["_los_share"] = float(np.mean(los_share)) if los_share else float("nan")
     res["_kept"] = float(np.mean(kept)) if kept else float("nan")
+    return res
+
+
+def _gain_interval(out, n_drives, starts, level=0.9) -> dict:
+    """Per tracker the ``level`` interval of the gain (mean dead reckoning over mean tracker)
+    from a bootstrap over the drives (the independent unit: a drive's starts share its
+    measurements), 2,000 resamples."""
+    boot = np.random.default_rng(7).integers(0, n_drives, (2000, n_drives))
+    dr = np.reshape(out["dead reckoning"], (n_drives, starts)).mean(axis=1)[boot].mean(axis=1)
+    lo, hi = (1 - level) / 2, (1 + level) / 2
+    res = {}
+    for k, v in out.items():
+        g = dr / np.reshape(v, (n_drives, starts)).mean(axis=1)[boot].mean(axis=1)
+        res[k] = (float(np.quantile(g, lo)), float(np.quantile(g, hi)))
     return res
 
 
@@ -188,36 +242,74 @@ def main() -> None:
         default=None,
         help="print the told model's bound for these 'az/el' sigmas [deg] and stop (no driving)",
     )
+    ap.add_argument(
+        "--starts", type=int, default=1, help="entry fixes drawn per drive (the tracker is cheap)"
+    )
+    ap.add_argument(
+        "--huber", action="store_true", help="also each sigma with the Huber-weighted update"
+    )
+    ap.add_argument(
+        "--by-elevation",
+        type=int,
+        nargs="+",
+        default=None,
+        metavar="BINS",
+        help="also the first sigma's design told each epoch's sigmas from a table of the LoS "
+        "errors by measured elevation, built on seed 0's drives with each of these bin counts "
+        "(the count chosen on seed 0)",
+    )
+    ap.add_argument("--table", default=None, help="use this table (JSON) instead of building one")
+    ap.add_argument("--write-table", default=None, help="write the chosen table (JSON) here")
     a = ap.parse_args()
     if a.bound_grid:
         bound_grid(a.scenario, a.bound_grid, a.start_sigma)
         return
-    chosen = None
+    chosen, tables = None, None
+    if a.table:
+        tables = {f"table {Path(a.table).name}": ElevationSigmas.from_dict(
+            json.loads(Path(a.table).read_text())["table"])}  # fmt: skip
     for seed in (0, HELD_OUT_SEED):
         t0 = time.perf_counter()
         case = (a.scenario, a.array)
         drives = run_trials(_drive, a.runs, seed, inputs=[case] * a.runs, workers=a.workers)
         sigmas = a.sigmas if chosen is None else [chosen]
-        res = score(drives, seed, sigmas, a.start_sigma, a.los_gamma, a.fit_flags)
+        if tables is None and a.by_elevation:  # built on seed 0's drives, with their truth
+            errors = los_errors([dd["ml-all"] for dd in drives])
+            tables = {f"{b} bins, seed 0": elevation_sigmas(errors, b) for b in a.by_elevation}
+        res = score(drives, seed, sigmas, a.start_sigma, a.los_gamma, a.fit_flags, a.starts,
+                    tables, a.huber)  # fmt: skip
         if chosen is None:  # chosen on seed 0, the lowest mean RMSE of the grid
             chosen = min(sigmas, key=lambda s: res[f"LoS only, {s} deg"])
             # (a widened eq. 61 is reported beside the chosen sigma, not chosen among)
+            if tables and len(tables) > 1:
+                best = min(tables, key=lambda k: res[f"LoS only, sigmas by elevation ({k})"])
+                tables = {best: tables[best]}
         ref = reference(drives[0]["ml-traced"], chosen, a.start_sigma, a.scenario)
         dr = res["dead reckoning"]
         arrays = "" if a.array is None else f" with {a.array} arrays"
-        print(f"\nseed {seed}: {a.runs} drives of {a.scenario}{arrays}, traced channel, L, entry fix "
-              f"{a.start_sigma:g} m ({time.perf_counter() - t0:.0f} s); path taken = the "
+        print(f"\nseed {seed}: {a.runs} drives x {a.starts} entry fixes of {a.scenario}{arrays}, "
+              f"traced channel, L, entry fix {a.start_sigma:g} m "
+              f"({time.perf_counter() - t0:.0f} s); path taken = the "
               f"true LoS in {100 * res['_los_share']:.1f} % of the epochs; none kept (fit "
               f"flags, no path) in "
               f"{100 * (1 - res['_kept']):.1f} %")  # fmt: skip
-        print("| tracker | RMSE, mean over drives [m] | gain over dead reckoning | RMS over drives "
+        print("| tracker | RMSE, mean [m] | gain over dead reckoning (90 % over drives) | RMS "
               "[m] |\n| --- | --- | --- | --- |")  # fmt: skip
         for k, v in res.items():
             if not k.startswith("_"):
-                print(f"| {k} | {v:.3f} | {dr / v:.2f}x | {res['_rms'][k]:.3f} |")
+                lo, hi = res["_gain_interval"][k]
+                print(f"| {k} | {v:.3f} | {dr / v:.2f}x ({lo:.2f}-{hi:.2f}) | "
+                      f"{res['_rms'][k]:.3f} |")  # fmt: skip
         print(f"| told model's figure (not a bound here): posterior CRLB of Gaussian LoS angles "
               f"at {chosen} deg, every epoch, first drive | {ref:.3f} | |")  # fmt: skip
     print(f"\nangle sigma chosen on seed 0: {chosen} deg")
+    if tables:
+        name, table = next(iter(tables.items()))
+        print(f"elevation table ({name}) [deg]: {table.as_dict()}")
+        if a.write_table:
+            Path(a.write_table).write_text(json.dumps(
+                {"scenario": a.scenario, "array": a.array, "runs": a.runs, "built": name,
+                 "table": table.as_dict()}, indent=1))  # fmt: skip
 
 
 if __name__ == "__main__":

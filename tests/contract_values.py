@@ -660,7 +660,18 @@ def _traced():
     from tunnelkit.consistency import plane_kinds
 
     plane_kinds(route.tunnel)
-    tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=1)
+    every = tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=3)
+    from tunnelkit.studies.los_elevation import (
+        ElevationSigmas,
+        elevation_sigmas,
+        los_errors,
+        told_by_elevation,
+    )
+
+    err = los_errors([every["ml-all"]])
+    table = elevation_sigmas(np.vstack([err, err]), 2)
+    ElevationSigmas.from_dict(table.as_dict()).at(np.array([-0.1]))
+    told_by_elevation(every["ml-all"], table, 1.5, 1.0)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()
     cur = pre.scene_provenance()

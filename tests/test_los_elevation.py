@@ -1,0 +1,83 @@
+"""The line of sight's sigmas by measured elevation (tunnelkit.studies.los_elevation)."""
+
+import numpy as np
+import pytest
+
+import tunnelkit as tk
+from tunnelkit.studies.los_elevation import (
+    ElevationSigmas,
+    elevation_sigmas,
+    los_errors,
+    told_by_elevation,
+)
+from tunnelkit.studies.los_only import los_design, los_only
+
+
+def test_table_is_the_rms_in_equal_count_bins_of_the_measured_elevation():
+    rng = np.random.default_rng(4)
+    psi = rng.uniform(-0.4, 0.0, 400)
+    scale = np.where(psi < -0.2, 0.002, 0.03)  # steep: accurate; shallow: degrees off
+    err = np.c_[psi, scale * rng.standard_normal(400), 2 * scale * rng.standard_normal(400)]
+    t = elevation_sigmas(err, 4)
+    order = np.argsort(psi)
+    for b, chunk in enumerate(np.array_split(order, 4)):  # brute force: sorted, cut in four
+        np.testing.assert_allclose(t.sigma_azimuth[b], np.sqrt(np.mean(err[chunk, 1] ** 2)))
+        np.testing.assert_allclose(t.sigma_elevation[b], np.sqrt(np.mean(err[chunk, 2] ** 2)))
+        assert psi[chunk].min() <= t.elevation[b] <= psi[chunk].max()
+    assert t.sigma_elevation[0] < 0.2 * t.sigma_elevation[-1]
+
+
+def test_table_reads_between_and_beyond_its_bins_and_round_trips():
+    t = ElevationSigmas(np.radians([-20.0, -10.0, 0.0]), np.radians([0.2, 1.0, 3.0]),
+                        np.radians([0.3, 2.0, 4.0]))  # fmt: skip
+    az, el = t.at(np.radians([-30.0, -15.0, -10.0, 5.0]))
+    np.testing.assert_allclose(np.degrees(az), [0.2, 0.6, 1.0, 3.0])
+    np.testing.assert_allclose(np.degrees(el), [0.3, 1.15, 2.0, 4.0])
+    back = ElevationSigmas.from_dict(t.as_dict())
+    np.testing.assert_allclose(back.sigma_elevation, t.sigma_elevation)
+
+
+def test_bad_tables_are_refused_by_name():
+    with pytest.raises(ValueError, match="elevation"):
+        ElevationSigmas(np.array([0.1, 0.0]), np.ones(2) * 0.01, np.ones(2) * 0.01)
+    with pytest.raises(ValueError, match="sigma_azimuth"):
+        ElevationSigmas(np.array([0.0, 0.1]), np.array([0.01, -0.01]), np.ones(2) * 0.01)
+    with pytest.raises(ValueError, match="sigma_elevation"):
+        ElevationSigmas(np.array([0.0, 0.1]), np.ones(2) * 0.01, np.array([0.01, 4.0]))
+    with pytest.raises(ValueError, match="table"):
+        ElevationSigmas.from_dict({"elevation": [0.0]})
+    with pytest.raises(ValueError, match="errors"):
+        elevation_sigmas(np.zeros((5, 3)), 4)
+    with pytest.raises(ValueError, match="bins"):
+        elevation_sigmas(np.ones((10, 3)), 0)
+    with pytest.raises(ValueError, match="drives"):
+        los_errors([])
+
+
+@pytest.fixture(scope="module")
+def drive():
+    route = tk.signal_route.SignalRoute.from_scenario("italiano2026-straight")
+    rng = np.random.default_rng(3)
+    return tk.simulation.simulate_drive(route, rng, condition="L", extraction="ml", n_epochs=4)
+
+
+def test_errors_on_the_image_channel_are_small_and_the_drive_is_told_them(drive):
+    e = los_errors([drive])  # eq. 1's own tensor: the ML fit at its bound, millidegrees
+    assert e.shape == (4, 3) and np.all(np.abs(np.degrees(e[:, 1:])) < 0.1)
+    assert np.all(e[:, 0] < 0)  # the site above the road: the line of sight arrives from below
+    t = ElevationSigmas(np.array([-0.3, 0.0]), np.radians([0.1, 2.0]), np.radians([0.2, 3.0]))
+    los = los_only(drive)
+    told = told_by_elevation(los, t, 1.5, 0.5)
+    assert told.reports_covariance
+    for ep in told.epochs:
+        saz, sel = t.at(ep.psi)
+        np.testing.assert_allclose(ep.cov[:, 0, 0], saz**2)
+        np.testing.assert_allclose(ep.cov[:, 1, 1], sel**2)
+        np.testing.assert_allclose(ep.sigma_d, 0.5)
+    design = los_design(np.radians(1.0)).with_(noise=tk.tracking.javelin.ReportedNoise())
+    ev = tk.simulation.evaluate(told, design)
+    assert np.all(np.isfinite(ev.estimates))
+    with pytest.raises(ValueError, match="sigma_kappa"):
+        told_by_elevation(los, t, -1.0, 0.5)
+    with pytest.raises(TypeError, match="table"):
+        told_by_elevation(los, {"elevation": [0.0]}, 1.0, 0.5)
