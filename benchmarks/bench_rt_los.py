@@ -17,6 +17,13 @@ a bound on the traced channel. Also the share of epochs whose path taken for the
     python benchmarks/bench_rt_los.py --runs 12 --workers 2 --scenario italiano2026-slalom --sigmas 1
     python benchmarks/bench_rt_los.py --runs 12 --workers 2 --array 8x8 --sigmas 1
     python benchmarks/bench_rt_los.py --bound-grid 1 1/1.8 0.5/1.8 1/1.3 1/0.5
+
+``--starts N`` tracks every drive from ``N`` entry fixes (the gain's 90 % interval is a bootstrap
+over the drives); ``--by-elevation BINS`` adds the first sigma's design told each epoch's sigmas
+by the measured elevation (:mod:`tunnelkit.studies.los_elevation`, the table built on seed 0's
+drives), ``--table FILE`` one built elsewhere (``--write-table``); ``--huber`` each sigma with
+the Huber-weighted update (:mod:`tunnelkit.studies.robust_update`); ``--cost`` the tracking time
+per epoch; ``--drives-cache DIR`` keeps the drives to score them again.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import pickle
 import sys
 import time
 from pathlib import Path
@@ -77,6 +85,22 @@ def _drive(case, rng):
     return {k: d[k] for k in ("ml-all", "ml-traced", "flags")}
 
 
+def _drives(case, runs, seed, workers, cache) -> list:
+    """The ``runs`` drives of ``case`` from ``seed`` (:func:`_drive`), read from or written to
+    ``cache`` (a folder, or ``None``): a pickle per case, count and seed, for re-scoring."""
+    scenario, array = case
+    path = (
+        None if cache is None else Path(cache) / f"{scenario}-{array or 'preset'}-{runs}-{seed}.pkl"
+    )
+    if path is not None and path.is_file():
+        return pickle.loads(path.read_bytes())
+    drives = run_trials(_drive, runs, seed, inputs=[case] * runs, workers=workers)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(pickle.dumps(drives))
+    return drives
+
+
 def _rmse(drive, truth, design, p0, sigma, idx) -> float:
     ev = evaluate(drive, design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=START_HEIGHT)
     e = np.linalg.norm(ev.estimates[:, :2] - truth[:, :2], axis=1)[idx]
@@ -122,12 +146,7 @@ def score(
         tr, every = dd["ml-traced"], dd["ml-all"]
         idx = settled(tr.t)
         los = los_only(every)
-        by_el = [
-            told_by_elevation(
-                los, t, told.config.sigma_kappa, told.config.sigma_delta_d / np.sqrt(2)
-            )
-            for t in tables.values()
-        ]
+        by_el = [_told(los, t, told) for t in tables.values()]
         for _ in range(starts):
             p0 = draw_start(tr.truth[0], start_sigma, rng, START_HEIGHT)
             out["traced design"].append(_rmse(tr, tr.truth, td, p0, start_sigma, idx))
@@ -168,6 +187,45 @@ def _gain_interval(out, n_drives, starts, level=0.9) -> dict:
     return res
 
 
+def _told(los, table, design):
+    """``los`` told its sigmas by elevation from ``table``, ``design``'s curvature sigma and its
+    TDoA sigma shared as two paths' delay sigmas."""
+    c = design.config
+    return told_by_elevation(los, table, c.sigma_kappa, c.sigma_delta_d / np.sqrt(2))
+
+
+def tracker_cost(drives, table, repeats=5) -> dict:
+    """Median over ``repeats`` of the tracking time per epoch [ms] of each tracker on ``drives``
+    (from the truth's first point; the extraction's cost is the drive's, the same for all)."""
+    td = traced_design()
+    one = los_design(float(np.radians(0.75)), td, sigma_elevation=float(np.radians(1.5)))
+    cases = {
+        "traced design": (lambda dd: dd["ml-traced"], td),
+        "LoS only, 0.75/1.5 deg": (lambda dd: los_only(dd["ml-all"]), one),
+        "the same, Huber update": (
+            lambda dd: los_only(dd["ml-all"]),
+            one.with_(updater=HuberUpdater()),
+        ),
+    }
+    if table is not None:
+        cases["LoS only, sigmas by elevation"] = (
+            lambda dd: _told(los_only(dd["ml-all"]), table, one),
+            one.with_(noise=ReportedNoise()),
+        )
+    out = {}
+    for name, (prepare, design) in cases.items():
+        runs = []
+        for _ in range(repeats):
+            t0, n = time.perf_counter(), 0
+            for dd in drives:
+                drive = prepare(dd)
+                evaluate(drive, design, sigma_p0_ue=1.0, start=drive.truth[0])
+                n += len(drive.t)
+            runs.append(1e3 * (time.perf_counter() - t0) / n)
+        out[name] = float(np.median(runs))
+    return out
+
+
 def _pair(text: str) -> tuple[float, float]:
     """``"1"`` or ``"1/1.8"``: the azimuth's and the elevation's sigma [deg]."""
     az, _, el = text.partition("/")
@@ -191,6 +249,20 @@ def reference(drive, sigma_deg, start_sigma, scenario=SCENARIO) -> float:
     """:func:`settled_bound` of ``drive`` (its truth and its reference antenna)."""
     setup = DesignSetup.from_scenario(scenario)
     return settled_bound(setup, drive.truth, drive.base_station, drive.t, sigma_deg, start_sigma)
+
+
+def table_reference(drive, table, start_sigma, scenario=SCENARIO) -> float:
+    """:func:`settled_bound`'s figure with each epoch's sigmas read from ``table`` at the true
+    line of sight's elevation (the told model of a design told the table)."""
+    setup = DesignSetup.from_scenario(scenario)
+    v = drive.truth - drive.base_station
+    saz, sel = table.at(np.arctan2(v[:, 2], np.hypot(v[:, 0], v[:, 1])))
+    info = np.concatenate([
+        los_angle_information(drive.truth[k : k + 1], drive.base_station, saz[k], sel[k])
+        for k in range(len(drive.truth))
+    ])  # fmt: skip
+    b = drive_pcrlb(setup, info, sigma_p0=start_sigma)
+    return float(np.sqrt(np.mean(b[settled(drive.t[: len(b)])] ** 2)))
 
 
 def bound_grid(scenario, pairs, start_sigma) -> None:
@@ -258,6 +330,12 @@ def main() -> None:
         "errors by measured elevation, built on seed 0's drives with each of these bin counts "
         "(the count chosen on seed 0)",
     )
+    ap.add_argument(
+        "--drives-cache", default=None, help="keep the drives here (a folder) to score them again"
+    )
+    ap.add_argument(
+        "--cost", action="store_true", help="also time each tracker per epoch on each seed's drives"
+    )
     ap.add_argument("--table", default=None, help="use this table (JSON) instead of building one")
     ap.add_argument("--write-table", default=None, help="write the chosen table (JSON) here")
     a = ap.parse_args()
@@ -271,7 +349,7 @@ def main() -> None:
     for seed in (0, HELD_OUT_SEED):
         t0 = time.perf_counter()
         case = (a.scenario, a.array)
-        drives = run_trials(_drive, a.runs, seed, inputs=[case] * a.runs, workers=a.workers)
+        drives = _drives(case, a.runs, seed, a.workers, a.drives_cache)
         sigmas = a.sigmas if chosen is None else [chosen]
         if tables is None and a.by_elevation:  # built on seed 0's drives, with their truth
             errors = los_errors([dd["ml-all"] for dd in drives])
@@ -302,6 +380,14 @@ def main() -> None:
                       f"{res['_rms'][k]:.3f} |")  # fmt: skip
         print(f"| told model's figure (not a bound here): posterior CRLB of Gaussian LoS angles "
               f"at {chosen} deg, every epoch, first drive | {ref:.3f} | |")  # fmt: skip
+        for name, table in (tables or {}).items():
+            tref = table_reference(drives[0]["ml-traced"], table, a.start_sigma, a.scenario)
+            print(f"| told model's figure (not a bound here): the same, sigmas by elevation "
+                  f"({name}) | {tref:.3f} | |")  # fmt: skip
+        if a.cost:
+            table = next(iter(tables.values())) if tables else None
+            for name, ms in tracker_cost(drives, table).items():
+                print(f"tracking cost, {name}: {ms:.2f} ms per epoch (median of 5)")
     print(f"\nangle sigma chosen on seed 0: {chosen} deg")
     if tables:
         name, table = next(iter(tables.items()))
