@@ -407,7 +407,7 @@ def _baselines():
     import tunnelkit as tk
     from tunnelkit import budget, crlb, geometry, metrics, propagation
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
-    from tunnelkit.design import errormodel, mcrb, report, verdict
+    from tunnelkit.design import errormodel, mcrb, render, verdict
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.design.drivebound import drive_bound
     from tunnelkit.extraction.decomposition import kruskal_rank
@@ -460,7 +460,7 @@ def _baselines():
     units.unit_yield(np.array([0.05, 0.2, 0.08]), 0.1)
     units.unit_seeds(3, 2, 2)
     units.drive_streams(2, 3, 2)
-    report.over_target(np.arange(5.0), np.array([0.1, 0.3, 0.25, 0.1, 0.4]), 0.2)
+    render.over_target(np.arange(5.0), np.array([0.1, 0.3, 0.25, 0.1, 0.4]), 0.2)
     drive_bound(np.full(5, 0.1), np.full(5, 0.02))
     javelin_config({"d": 0.05, "direction": 0.01, "kappa": 2.0})
     cv.simulate_cv(np.array([0.0, 0.0, 10.0, 0.0]), 0.1, 0.5, 20, rng)

@@ -539,7 +539,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "values of any shape pooled / (..., T) gated epoch by epoch (each docstring's contract)",
     ),
     _doc(
-        r"design\.(report|records)\.over_target",
+        r"design\.render\.over_target",
         r"y",
         "nan",
         "a non-finite value counts as over the target (the docstring's contract)",

@@ -54,7 +54,7 @@ _EXPORTS = {
     "sweep_montecarlo": "montecarlo",
     "DesignReport": "records",
     "DesignRow": "records",
-    "over_target": "records",
+    "over_target": "render",
     "design_sweep": "report",
     "smallest_meeting": "report",
     "ArraySpec": "setup",

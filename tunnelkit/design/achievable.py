@@ -23,7 +23,6 @@ from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .impairments import DesignImpairments
 from .mcrb import EtaModes, scaled_inverse
-from .records import over_target
 from .setup import ArraySpec, DesignSetup, parse_array
 from .trackerfix import fix_identifiable, position_error_parts, position_noise_cov, tracker_weights
 
@@ -338,7 +337,9 @@ def path_error_model(
 
 def _ranges(x: np.ndarray, hit: np.ndarray) -> str:
     """``"x = 80.3..100.2 m, 120.0 m"``: the runs of consecutive epochs where ``hit``, worded
-    as the report words the stretches above a target (:func:`~tunnelkit.design.records.over_target`)."""
+    as the report words the stretches above a target (:func:`~tunnelkit.design.render.over_target`)."""
+    from .render import over_target  # the wording loaded when an array leaves a path unresolved
+
     return "x = " + over_target(x, np.asarray(hit, float), 0.5)
 
 

@@ -43,7 +43,7 @@ from .impairments import (
     wideband_cycles,
 )
 from .impairments import PRESETS as IMPAIRMENT_PRESETS
-from .records import DesignReport, DesignRow, over_target
+from .records import DesignReport, DesignRow
 from .setup import ArraySpec, DesignSetup, parse_array
 from .trackerfix import MODES, START_SIGMA_M
 from .units import DRIVES_PER_UNIT, MAX_UNITS, REQUIRED_YIELD
@@ -57,7 +57,7 @@ from .verdict import (
     share_quantile,
 )
 
-__all__ = ["DesignReport", "DesignRow", "design_sweep", "over_target", "smallest_meeting"]
+__all__ = ["DesignReport", "DesignRow", "design_sweep", "smallest_meeting"]
 
 
 def smallest_meeting(
