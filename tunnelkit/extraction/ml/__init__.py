@@ -5,86 +5,57 @@ test (the GLRT of one path more) and SAGE / RIMAX-like re-seedings.
 Main names: :func:`ml_paths` (the extraction), :func:`fit_ml` and :class:`MLFit` (one fit and its
 verdict), :class:`Problem` and :class:`WidebandProblem` (the models), the residual test
 (:func:`residual_peak`, :func:`calibrated_threshold`) and the resolution tests
-(:func:`separations`, :func:`pair_test`, :func:`snr_threshold`, :func:`below_threshold`).
+(:func:`separations`, :func:`pair_test`, :func:`snr_threshold`, :func:`below_threshold`);
+every name loads on first use (the wideband model only where it is asked for).
 
 How it works: docs/internals/extraction-ml.md.
 """
 
-from ..numerics import spatial_phase
-from .fitting import (
-    MAX_ITER,
-    SEARCHES,
-    MLConvergenceWarning,
-    MLDetectionWarning,
-    MLFit,
-    fit_ml,
-    fit_problem,
-    pair_separation,
-)
-from .model import Problem, noise_floor, project_feasible
-from .paths import estimates_from_fit, ml_order, ml_paths, physical
-from .residual import FALSE_ALARM, calibrated_threshold, peak_null, peak_threshold, residual_peak
-from .resolution import (
-    OUTLIER_RATE,
-    PAIR_FALSE_ALARM,
-    PAIR_LLR,
-    PAIR_TEST_Z,
-    RESOLVE_Z,
-    below_threshold,
-    closest_pair,
-    outlier_probability,
-    pair_test,
-    resolvable,
-    separations,
-    snr_threshold,
-)
-from .search import (
-    check_start,
-    complete_paths,
-    path_from_peak,
-    search_path,
-    start_from_estimates,
-)
-from .wideband import WidebandProblem
+from __future__ import annotations
 
-__all__ = [
-    "FALSE_ALARM",
-    "MAX_ITER",
-    "OUTLIER_RATE",
-    "PAIR_FALSE_ALARM",
-    "PAIR_LLR",
-    "PAIR_TEST_Z",
-    "RESOLVE_Z",
-    "SEARCHES",
-    "MLConvergenceWarning",
-    "MLDetectionWarning",
-    "MLFit",
-    "Problem",
-    "WidebandProblem",
-    "below_threshold",
-    "calibrated_threshold",
-    "check_start",
-    "closest_pair",
-    "complete_paths",
-    "estimates_from_fit",
-    "fit_ml",
-    "fit_problem",
-    "ml_order",
-    "ml_paths",
-    "noise_floor",
-    "outlier_probability",
-    "pair_separation",
-    "pair_test",
-    "path_from_peak",
-    "peak_null",
-    "peak_threshold",
-    "physical",
-    "project_feasible",
-    "residual_peak",
-    "resolvable",
-    "search_path",
-    "separations",
-    "snr_threshold",
-    "spatial_phase",
-    "start_from_estimates",
-]
+from ..._lazy import lazy_exports
+
+_EXPORTS = {
+    "MAX_ITER": "fitting",
+    "MLConvergenceWarning": "fitting",
+    "MLDetectionWarning": "fitting",
+    "MLFit": "fitting",
+    "SEARCHES": "fitting",
+    "fit_ml": "fitting",
+    "fit_problem": "fitting",
+    "pair_separation": "fitting",
+    "Problem": "model",
+    "noise_floor": "model",
+    "project_feasible": "model",
+    "estimates_from_fit": "paths",
+    "ml_order": "paths",
+    "ml_paths": "paths",
+    "physical": "paths",
+    "FALSE_ALARM": "residual",
+    "calibrated_threshold": "residual",
+    "peak_null": "residual",
+    "peak_threshold": "residual",
+    "residual_peak": "residual",
+    "OUTLIER_RATE": "resolution",
+    "PAIR_FALSE_ALARM": "resolution",
+    "PAIR_LLR": "resolution",
+    "PAIR_TEST_Z": "resolution",
+    "RESOLVE_Z": "resolution",
+    "below_threshold": "resolution",
+    "closest_pair": "resolution",
+    "outlier_probability": "resolution",
+    "pair_test": "resolution",
+    "resolvable": "resolution",
+    "separations": "resolution",
+    "snr_threshold": "resolution",
+    "check_start": "search",
+    "complete_paths": "search",
+    "path_from_peak": "search",
+    "search_path": "search",
+    "start_from_estimates": "search",
+    "WidebandProblem": "wideband",
+}
+
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

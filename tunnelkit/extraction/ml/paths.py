@@ -21,7 +21,6 @@ from .fitting import MAX_ITER, SEARCHES, MLDetectionWarning, MLFit, fit_problem
 from .model import W_FAR, W_MAX, Problem
 from .resolution import below_threshold
 from .search import check_start, complete_paths, start_from_estimates
-from .wideband import WidebandProblem
 
 __all__ = ["estimates_from_fit", "ml_order", "ml_paths", "physical"]
 
@@ -193,6 +192,8 @@ def ml_paths(
         prob, start, noise_power=noise_power, max_iter=max_iter, n_reseed=n_reseed, search=search
     )
     if wideband:  # the eq. 1 fit refined on the model with the spatial-wideband term
+        from .wideband import WidebandProblem  # the model loaded when asked for
+
         prob = WidebandProblem(H, pos, srs.fc, srs.tone_spacing)
         fit = fit_problem(
             prob,
