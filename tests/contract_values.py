@@ -407,7 +407,7 @@ def _baselines():
     import tunnelkit as tk
     from tunnelkit import budget, crlb, geometry, metrics, propagation
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
-    from tunnelkit.design import errormodel, mcrb, render, verdict
+    from tunnelkit.design import errormodel, intervals, mcrb, render, verdict
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.design.drivebound import drive_bound
     from tunnelkit.extraction.decomposition import kruskal_rank
@@ -447,8 +447,8 @@ def _baselines():
     mcrb.scaled_inverse(np.array([[[2.0, 0.5], [0.5, 1.0]]]))
     e = np.abs(rng.standard_normal(50))
     verdict.share_quantile(e, 0.9)
-    verdict.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
-    verdict.cluster_quantile_ci(e[None, :].repeat(3, 0), 0.9)
+    intervals.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
+    intervals.cluster_quantile_ci(e[None, :].repeat(3, 0), 0.9)
     verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
     verdict.gate(e, np.ones(50, bool), "achievable")
     verdict.judge(0.1, units=20, yield_=0.9, ci=[0.7, 0.97], cap=200)

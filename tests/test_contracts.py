@@ -527,7 +527,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "delay is not compared",
     ),
     _doc(
-        r"design\.verdict\.(share_quantile|gate|bootstrap_quantile_ci|cluster_quantile_ci)",
+        r"design\.(verdict\.(share_quantile|gate)|intervals\.(bootstrap|cluster)_quantile_ci)",
         r"values|errors",
         "nan",
         "a non-finite error (no estimate) counts as infinite (the module's contract)",

@@ -241,7 +241,7 @@ def test_every_public_name_resolves():
     for name in design.__all__:
         assert getattr(tk.design, name) is getattr(design, name), name
     # every submodule's public names are re-exported by the package
-    for sub in ("setup", "geometry", "bounds", "report", "montecarlo", "verdict"):
+    for sub in ("setup", "geometry", "bounds", "report", "montecarlo", "verdict", "intervals"):
         mod = importlib.import_module(f"tunnelkit.design.{sub}")
         for name in mod.__all__:
             assert name in design.__all__ and getattr(design, name) is getattr(mod, name), name

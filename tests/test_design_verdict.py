@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tunnelkit import design
+from tunnelkit.design import intervals, unitsweep
 from tunnelkit.design import report as rep_mod
-from tunnelkit.design import unitsweep
 from tunnelkit.design import verdict as v
 
 
@@ -34,17 +34,17 @@ def test_share_quantile_matches_order_statistic(share):
 def test_bootstrap_interval_matches_a_loop_and_brackets_the_estimate():
     rng = np.random.default_rng(2)
     e = rng.exponential(0.05, size=(12, 40)) * rng.uniform(0.5, 2.0, size=(12, 1))
-    ci = v.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(7), n_boot=300)
+    ci = intervals.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(7), n_boot=300)
     # the same resamples by hand
     draws = np.random.default_rng(7).integers(0, 12, size=(300, 12))
     qs = [_brute_quantile(e[d], 0.9) for d in draws]
     assert ci == pytest.approx(list(np.quantile(qs, [0.025, 0.975])))
     assert ci[0] <= v.share_quantile(e, 0.9) <= ci[1]
     # reproducible from the Generator, and narrower with more runs of the same law
-    assert ci == v.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(7), n_boot=300)
-    wide = v.bootstrap_quantile_ci(e[:3], 0.9, np.random.default_rng(7), n_boot=300)
+    assert ci == intervals.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(7), n_boot=300)
+    wide = intervals.bootstrap_quantile_ci(e[:3], 0.9, np.random.default_rng(7), n_boot=300)
     big = rng.exponential(0.05, size=(120, 40)) * rng.uniform(0.5, 2.0, size=(120, 1))
-    narrow = v.bootstrap_quantile_ci(big, 0.9, np.random.default_rng(7), n_boot=300)
+    narrow = intervals.bootstrap_quantile_ci(big, 0.9, np.random.default_rng(7), n_boot=300)
     assert narrow[1] - narrow[0] < wide[1] - wide[0]
 
 
@@ -55,7 +55,7 @@ def test_bootstrap_interval_covers_the_true_quantile():
     hit = 0
     for k in range(150):
         e = np.random.default_rng(100 + k).exponential(1.0, size=(runs, T))
-        lo, hi = v.bootstrap_quantile_ci(e, share, np.random.default_rng(k), n_boot=200)
+        lo, hi = intervals.bootstrap_quantile_ci(e, share, np.random.default_rng(k), n_boot=200)
         hit += lo <= true_q <= hi
     assert hit / 150 >= 0.85
 
@@ -63,19 +63,19 @@ def test_bootstrap_interval_covers_the_true_quantile():
 def test_bootstrap_with_failures_and_one_run():
     e = np.full((4, 10), 0.01)
     e[:, :2] = np.inf  # 20 % of every drive lost: the 0.9-quantile is infinite
-    assert v.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(0), n_boot=100) == [
+    assert intervals.bootstrap_quantile_ci(e, 0.9, np.random.default_rng(0), n_boot=100) == [
         np.inf,
         np.inf,
     ]
     one = np.array([[0.01, 0.02, 0.03]])
-    lo, hi = v.bootstrap_quantile_ci(one, 0.5, np.random.default_rng(0), n_boot=100)
+    lo, hi = intervals.bootstrap_quantile_ci(one, 0.5, np.random.default_rng(0), n_boot=100)
     assert lo == hi == 0.02  # one run: degenerate, never decides (judge below)
     with pytest.raises(ValueError, match="errors"):
-        v.bootstrap_quantile_ci(np.zeros(3), 0.9, np.random.default_rng(0))
+        intervals.bootstrap_quantile_ci(np.zeros(3), 0.9, np.random.default_rng(0))
     with pytest.raises(ValueError, match="errors"):
-        v.bootstrap_quantile_ci(-np.ones((2, 2)), 0.9, np.random.default_rng(0))
+        intervals.bootstrap_quantile_ci(-np.ones((2, 2)), 0.9, np.random.default_rng(0))
     with pytest.raises(TypeError, match="rng"):
-        v.bootstrap_quantile_ci(one, 0.9, 3)
+        intervals.bootstrap_quantile_ci(one, 0.9, 3)
 
 
 def test_gate_applies_the_criterion():

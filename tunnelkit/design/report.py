@@ -46,10 +46,12 @@ from .impairments import PRESETS as IMPAIRMENT_PRESETS
 from .records import DesignReport, DesignRow
 from .setup import ArraySpec, DesignSetup, parse_array
 from .trackerfix import MODES, START_SIGMA_M
-from .units import DRIVES_PER_UNIT, MAX_UNITS, REQUIRED_YIELD
 from .verdict import (
     CRITERIA,
+    DRIVES_PER_UNIT,
+    MAX_UNITS,
     MIN_RUNS_CI,
+    REQUIRED_YIELD,
     counted_epochs,
     gate,
     judge,

@@ -29,9 +29,6 @@ from .._validate import finite_array, integer, positive, probability
 from ..budget import check_elements
 
 __all__ = [
-    "DRIVES_PER_UNIT",
-    "MAX_UNITS",
-    "REQUIRED_YIELD",
     "drive_streams",
     "unit_quantiles",
     "unit_seeds",
@@ -39,12 +36,6 @@ __all__ = [
     "wilson_interval",
 ]
 
-#: the default share of manufactured units that must meet the target on their own
-REQUIRED_YIELD = 0.95
-#: the default cap of the sequential rule: units per array at most
-MAX_UNITS = 200
-#: the default drives per unit (a unit's own quantile pools its drives' settled epochs)
-DRIVES_PER_UNIT = 2
 #: the spawn-key tag that sets the units' calibration streams apart from the drives'
 _UNIT_TAG = 0x0417CA1
 

@@ -12,9 +12,10 @@ from dataclasses import replace
 import numpy as np
 
 from ..metrics import SETTLE_S
+from .intervals import cluster_quantile_ci
 from .montecarlo import sweep_montecarlo
-from .units import REQUIRED_YIELD, unit_quantiles, unit_yield
-from .verdict import cluster_quantile_ci, counted_epochs, gate, judge, share_quantile
+from .units import unit_quantiles, unit_yield
+from .verdict import REQUIRED_YIELD, counted_epochs, gate, judge, share_quantile
 
 #: nothing exported: the sweep's own steps, on the arguments :func:`tunnelkit.design.design_sweep`
 #: (and :func:`tunnelkit.design.confirm.confirm_on_channel`) checked at their boundary
