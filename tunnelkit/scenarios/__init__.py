@@ -26,7 +26,6 @@ from .files import (
     load_scenario,
     scenario_from_dict,
     scenario_path,
-    with_values,
 )
 from .model import Scenario
 from .registry import (
@@ -37,8 +36,9 @@ from .registry import (
     register_tunnel,
 )
 
-#: loaded on first use (:mod:`tunnelkit._lazy`): a loaded scenario needs no template writer
-_EXPORTS = {"template": "templates"}
+#: loaded on first use (:mod:`tunnelkit._lazy`): a loaded scenario needs no template writer and
+#: no editor
+_EXPORTS = {"template": "templates", "with_values": "edit"}
 
 __all__ = [
     "ALLOWED_REQUIRES",
