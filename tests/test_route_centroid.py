@@ -1,5 +1,5 @@
 """A path whose curvature is unresolved is reported from the array's centroid
-(:func:`tunnelkit.signal_route.route._centroid_far_field`)."""
+(:func:`tunnelkit.signal_route.farfield.centroid_far_field`)."""
 
 from dataclasses import replace
 
@@ -8,8 +8,8 @@ import pytest
 
 from tunnelkit import arrays
 from tunnelkit.extraction import PathEstimates
+from tunnelkit.signal_route.farfield import UNRESOLVED_Z, centroid_far_field
 from tunnelkit.signal_route.measurements import measurements_from_estimates
-from tunnelkit.signal_route.route import UNRESOLVED_Z, _centroid_far_field
 
 FC = 28e9
 
@@ -61,7 +61,7 @@ def test_unresolved_curvature_is_reported_from_the_centroid():
     cov = np.zeros((2, 3, 3))
     cov[:, :2, :2] = np.eye(2) * 1e-5
     cov[:, 2, 2] = 200.0**2
-    loose = _centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr)
+    loose = centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr)
     err = np.linalg.norm(loose.direction - truth, axis=1)
     assert np.all(err < np.linalg.norm(c) / 80.0 + 1e-9)  # the far-field limit's model error
     assert np.all(err < 0.1 * off)
@@ -72,7 +72,7 @@ def test_unresolved_curvature_is_reported_from_the_centroid():
     np.testing.assert_array_equal(loose.cov, cov)
 
     cov[0, 2, 2] = 0.1**2  # path 0 resolved (4 m >= 3 x 0.1 m), path 1 not
-    mixed = _centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr)
+    mixed = centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr)
     np.testing.assert_array_equal(mixed.direction[0], meas.direction[0])
     assert mixed.kappa[0] == meas.kappa[0] and mixed.near_field[0]
     assert np.isnan(mixed.kappa[1]) and err[1] == pytest.approx(
@@ -82,11 +82,11 @@ def test_unresolved_curvature_is_reported_from_the_centroid():
     at = 4.0 / UNRESOLVED_Z
     cov[0, 2, 2] = (at * 1.001) ** 2
     assert np.isnan(
-        _centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr).kappa[0]
+        centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr).kappa[0]
     )
     cov[0, 2, 2] = (at * 0.999) ** 2
     assert not np.isnan(
-        _centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr).kappa[0]
+        centroid_far_field(replace(meas, cov=cov, sigma_d=np.ones(2)), est, arr).kappa[0]
     )
 
 
@@ -96,11 +96,11 @@ def test_centroid_far_field_without_covariance_and_bad_input():
     arr = arrays.make_array(4, 4, fc=FC, azimuth=0.0, elevation=0.0)
     est = _estimates(arr, np.array([[0.1, 0.0, 3.0]]), [3.0])
     meas = measurements_from_estimates(est, arr)
-    assert _centroid_far_field(meas, est, arr) is meas
+    assert centroid_far_field(meas, est, arr) is meas
     with pytest.raises(ValueError, match="z"):
-        _centroid_far_field(meas, est, arr, z=0.0)
+        centroid_far_field(meas, est, arr, z=0.0)
     with pytest.raises(TypeError, match="est"):
-        _centroid_far_field(meas, "est", arr)
+        centroid_far_field(meas, "est", arr)
 
 
 def test_route_flag_is_checked():
