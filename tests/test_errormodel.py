@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from tunnelkit.design.errormodel import PathErrorModel, _repetition, psd_sqrt
+from tunnelkit.design.errordraws import _repetition
+from tunnelkit.design.errormodel import PathErrorModel, psd_sqrt
 
 
 def _model(T=2, P=2, M=3, **kw):
