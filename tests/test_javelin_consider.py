@@ -6,7 +6,7 @@ import pytest
 
 from tunnelkit.tracking.javelin import ConsiderNoise, PathMeasurements, ReportedNoise
 from tunnelkit.tracking.javelin.config import JavelinConfig
-from tunnelkit.tracking.javelin.noise import bias_factors
+from tunnelkit.tracking.javelin.consider import bias_factors
 from tunnelkit.tracking.javelin.update import consider_update, schmidt_update, stack_measurement
 
 NX, NB, STEPS = 2, 2, 8

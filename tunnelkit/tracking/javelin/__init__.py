@@ -1,14 +1,14 @@
 """JAVELIN (Italiano et al. 2026, sections 3.2-3.5): single-base-station tracking of a vehicle and
 its virtual UEs, in small roles.
 
-``state`` (eq. 43) · ``measurement`` (eq. 44-52, Algorithm 1 checks, curvature models,
-pre-filters) · ``noise`` (fixed or reported measurement noise) · ``motion`` (eq. 62-63, VUE
-motion) · ``associate`` (eq. 56-59 gated costs, Algorithm 2, global nearest neighbour) ·
-``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test, initiators) · ``update`` (eq. 64-68,
-Joseph form, joint innovation test) · ``roles`` (:class:`JavelinDesign`: numbers + one object
-per role) · ``designs`` (the named designs as factories) · ``arraydesign`` (the array design's
-tracker) · ``surfaces`` (VUEs born from known planes) · ``tracker`` (Algorithm 4) ·
-``tenfiloc`` (the snapshot baseline, eq. 69) · ``config`` (section 4.2 numbers). The
+``state`` (eq. 43) · ``measurement`` (eq. 44-52, Algorithm 1 checks, curvature models, pre-filters)
+· ``noise`` (fixed or reported measurement noise) · ``consider`` (the bias-aware tracker's noise) ·
+``motion`` (eq. 62-63, VUE motion) · ``associate`` (eq. 56-59 gated costs, Algorithm 2, global
+nearest neighbour) · ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test, initiators) ·
+``update`` (eq. 64-68, Joseph form, joint innovation test) · ``roles`` (:class:`JavelinDesign`:
+numbers + one object per role) · ``designs`` (the named designs as factories) · ``arraydesign``
+(the array design's tracker) · ``surfaces`` (VUEs born from known planes) · ``tracker`` (Algorithm
+4) · ``tenfiloc`` (the snapshot baseline, eq. 69) · ``config`` (section 4.2 numbers). The
 chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
 """
 
@@ -18,7 +18,7 @@ from ..._lazy import lazy_exports
 from ..gating import ChiSquareGate as ChiSquareGate
 
 # name -> defining submodule, loaded on first use: running JAVELIN loads neither the TeNFiLoc
-# baseline nor the designs' geometric initiator unless a caller asks for them. The trackers
+# baseline, the designs' geometric initiator nor the bias-aware noise unless a caller asks for them. The trackers
 # register themselves (``tracker``: JAVELIN, ``tenfiloc``: TeNFiLoc) in the "italiano2026" family.
 _EXPORTS: dict[str, str] = {
     "global_nearest_neighbour": "associate",
@@ -28,8 +28,8 @@ _EXPORTS: dict[str, str] = {
     "PathMeasurements": "measurement",
     "measurement_model": "measurement",
     "track_model": "measurement",
+    "ConsiderNoise": "consider",
     "Associator": "roles",
-    "ConsiderNoise": "roles",
     "DelayCheck": "roles",
     "DopplerClutter": "roles",
     "FixedBirth": "roles",

@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 
 from .associate import Associator
+from .consider import ConsiderNoise
 from .designs import ours
 from .manage import MeasuredBirth
 from .measurement import DelayCheck, VueCurvature
-from .noise import ConsiderNoise
 from .roles import JavelinDesign
 from .surfaces import GeometricBirth
 from .update import JointTestUpdater

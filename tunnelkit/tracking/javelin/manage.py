@@ -103,7 +103,7 @@ def birth_bias_cross(
     state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig, noise
 ) -> np.ndarray:
     """The cross-covariance (2, 4 L_hat + 4) of a VUE born from path ``j`` with every track's
-    normalised bias (consider parameters, :class:`~.noise.ConsiderNoise`), the new track's own
+    normalised bias (consider parameters, :class:`~.consider.ConsiderNoise`), the new track's own
     last: through the UE's ``x`` (``f C[0]``) and through the path's angles, whose repeating
     error is ``L_j[:2] u_new`` (``F_z L_j[:2]``), as :func:`birth_covariance` linearises
     :func:`intersection`."""

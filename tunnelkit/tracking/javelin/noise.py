@@ -4,9 +4,9 @@
 takes each path's covariance as the extraction reports it (ours). Both answer the same two
 questions: the (n, 3, 3) covariance of each path's ``(phi, psi, kappa)``
 (:meth:`~FixedNoise.covariances`) and the covariance of the TDoA rows ``d_j - d_ref``
-(:meth:`~FixedNoise.tdoa_covariance`). :class:`ConsiderNoise` (ours) also splits each reported
-covariance into its white share and its repeating share (``PathMeasurements.bias_cov``), which
-the tracker carries as consider parameters (:func:`~tunnelkit.tracking.javelin.update.consider_update`).
+(:meth:`~FixedNoise.tdoa_covariance`). The bias-aware tracker's noise, which also splits each
+reported covariance into a white and a repeating share, is
+:class:`~tunnelkit.tracking.javelin.consider.ConsiderNoise`.
 """
 
 from __future__ import annotations
@@ -16,16 +16,16 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..._physical import step_seconds
-from ..._validate import finite_array, instance, integer, positive
+from ..._validate import instance, integer
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 
-__all__ = ["ConsiderNoise", "FixedNoise", "ReportedNoise", "bias_factors"]
+__all__ = ["FixedNoise", "ReportedNoise"]
 
 
-def _tdoa_rows(meas, others, reference: int, config) -> tuple[list[int], int]:
-    """The checked arguments of a ``tdoa_covariance``: path indices of ``meas``."""
+def check_tdoa_rows(meas, others, reference: int, config) -> tuple[list[int], int]:
+    """The checked arguments of a ``tdoa_covariance`` (this module's and
+    :class:`~tunnelkit.tracking.javelin.consider.ConsiderNoise`'s): path indices of ``meas``."""
     instance("meas", meas, PathMeasurements)
     instance("config", config, JavelinConfig)
     n = len(meas)
@@ -62,7 +62,7 @@ class FixedNoise:
         self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
     ) -> np.ndarray:
         """Covariance of the TDoA rows ``d_j - d_ref`` for the paths ``others``."""
-        others, reference = _tdoa_rows(meas, others, reference, config)
+        others, reference = check_tdoa_rows(meas, others, reference, config)
         nd = len(others)
         s2 = config.sigma_delta_d**2
         if self.correlated_delta_d:
@@ -96,85 +96,7 @@ class ReportedNoise:
         self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
     ) -> np.ndarray:
         """``Delta d_j = d_j - d_ref``: ``var = s_j^2 + s_ref^2``, the reference shared."""
-        others, reference = _tdoa_rows(meas, others, reference, config)
+        others, reference = check_tdoa_rows(meas, others, reference, config)
         if not meas.reported:
             return self.fallback.tdoa_covariance(meas, others, reference, config)
         return np.diag(meas.sigma_d[others] ** 2) + meas.sigma_d[reference] ** 2
-
-
-def bias_factors(bias_cov: np.ndarray) -> np.ndarray:
-    """A lower-triangular factor ``L`` (n, 4, 4) with ``L L^T = bias_cov`` of every path's
-    repeating error: the Cholesky factor of ``bias_cov`` (a tiny ridge keeps a singular block
-    factorisable; rows of a zero block stay zero). Lower-triangular, so the factor of a bias
-    covariance that changes smoothly along the drive changes smoothly too (an eigenvector
-    factor may flip its signs from one epoch to the next)."""
-    b = finite_array("bias_cov", bias_cov, ndim=3)
-    if b.shape[1:] != (4, 4):
-        raise ValueError(f"bias_cov: expected shape (n, 4, 4), got {b.shape}")
-    n = b.shape[0]
-    out = np.zeros((n, 4, 4))
-    sd = np.sqrt(np.clip(np.diagonal(b, axis1=1, axis2=2), 0.0, None))  # (n, 4)
-    ons = sd > 0
-    full = ons.all(axis=1)
-    if full.any():  # every component repeats: the blocks factorised together
-        s = sd[full]
-        Lc = np.linalg.cholesky(b[full] / (s[:, :, None] * s[:, None, :]) + 1e-12 * np.eye(4))
-        out[full] = s[:, :, None] * Lc
-    for k in np.flatnonzero(ons.any(axis=1) & ~full):  # some components only
-        s, on = sd[k], ons[k]
-        c = b[k][np.ix_(on, on)] / np.outer(s[on], s[on])
-        Lc = np.linalg.cholesky(c + 1e-12 * np.eye(int(on.sum())))
-        out[k][np.ix_(on, on)] = s[on][:, None] * Lc
-    return out
-
-
-@dataclass(frozen=True)
-class ConsiderNoise(ReportedNoise):
-    """Reported covariances split into a white share, drawn afresh every epoch, and a repeating
-    share (``PathMeasurements.bias_cov``: one array's calibration error, the bias of the terms
-    the estimator's model leaves out), which the tracker carries as consider parameters of the
-    path's track instead of averaging it down (ours; docs/internals/tracking.md, the section on
-    :mod:`tunnelkit.tracking.javelin.update`, says why consider and not estimate). Each track's
-    normalised bias ``u`` (4,: one per ``phi, psi, kappa, d``, prior ``N(0, I)``) enters a
-    measurement of path ``j`` as ``L_j u`` (:func:`bias_factors`), and
-    decorrelates as a first-order Gauss-Markov process with time constant ``tau_s`` [s]
-    (``inf``, the default: the same draw the whole drive). Association and births see the whole
-    reported covariance (:meth:`covariances`); the update the white share
-    (:meth:`white_covariances`) plus ``L_j u``. Without ``bias_cov`` it is :class:`ReportedNoise`."""
-
-    tau_s: float = float("inf")
-    consider: ClassVar[bool] = True
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        t = self.tau_s
-        if not (isinstance(t, float) and t == float("inf")):
-            positive("tau_s", t)  # a finite time constant [s] (inf: the same draw all drive)
-
-    def decay(self, dt: float) -> float:
-        """``exp(-dt / tau_s)``: how much of the normalised bias survives ``dt`` [s]."""
-        return float(np.exp(-step_seconds("dt", dt) / self.tau_s))
-
-    def white_covariances(self, meas: PathMeasurements, config: JavelinConfig) -> np.ndarray:
-        """The white share (n, 3, 3) of each path's reported ``(phi, psi, kappa)`` covariance."""
-        cov = self.covariances(meas, config)
-        if meas.reported and meas.bias_cov is not None:
-            return cov - meas.bias_cov[:, :3, :3]
-        return cov
-
-    def white_tdoa_covariance(
-        self, meas: PathMeasurements, others, reference: int, config: JavelinConfig
-    ) -> np.ndarray:
-        """The white share of :meth:`tdoa_covariance`."""
-        others, reference = _tdoa_rows(meas, others, reference, config)
-        if not (meas.reported and meas.bias_cov is not None):
-            return self.tdoa_covariance(meas, others, reference, config)
-        var = meas.sigma_d**2 - meas.bias_cov[:, 3, 3]
-        return np.diag(var[others]) + var[reference]
-
-    def factors(self, meas: PathMeasurements) -> np.ndarray:
-        """``L`` (n, 4, 4) of every path's repeating share (zeros without ``bias_cov``)."""
-        instance("meas", meas, PathMeasurements)
-        if not (meas.reported and meas.bias_cov is not None):
-            return np.zeros((len(meas), 4, 4))
-        return bias_factors(meas.bias_cov)

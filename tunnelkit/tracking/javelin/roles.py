@@ -18,12 +18,11 @@ from .config import JavelinConfig
 from .manage import FixedBirth, MeasuredBirth
 from .measurement import DelayCheck, DopplerClutter, ReflectorCurvature, VueCurvature
 from .motion import MirrorMotion, RandomWalk
-from .noise import ConsiderNoise, FixedNoise, ReportedNoise
+from .noise import FixedNoise, ReportedNoise
 from .update import JointTestUpdater, JosephUpdater
 
 __all__ = [
     "Associator",
-    "ConsiderNoise",
     "DelayCheck",
     "DopplerClutter",
     "FixedBirth",

@@ -6,7 +6,7 @@ the UE's because the reflecting surfaces run along the tunnel). Track 0 is the U
 VUEs, each with a persistent id, a misses counter (zeta of Algorithm 3) and a ``transient`` flag
 for paths from dynamic reflectors (used for one epoch only).
 
-A bias-aware tracker (:class:`~tunnelkit.tracking.javelin.noise.ConsiderNoise`) also keeps ``C``
+A bias-aware tracker (:class:`~tunnelkit.tracking.javelin.consider.ConsiderNoise`) also keeps ``C``
 (D, 4 L_hat): the cross-covariance of the state with every track's normalised measurement bias
 ``u_i`` (4,: ``phi, psi, kappa, d``; columns ``4 i : 4 i + 4``, :func:`bias_slice`). The biases
 are consider parameters: never estimated, their own covariance stays ``I``, so ``C`` is all the

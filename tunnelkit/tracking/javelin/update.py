@@ -88,7 +88,7 @@ def stack_measurement(
     ``noise`` the measurement-noise role (:mod:`~tunnelkit.tracking.javelin.roles`; default the
     paper's fixed sigmas) gives the covariance of every row. With a consider cross-covariance
     ``C`` (D, 4 L_hat) and a noise role that splits off the repeating share
-    (:class:`~.noise.ConsiderNoise`), ``R`` is the white share and ``B`` the rows' map of the
+    (:class:`~.consider.ConsiderNoise`), ``R`` is the white share and ``B`` the rows' map of the
     tracks' normalised biases (a TDoA row ``L_j[d] u_i - L_ref[d] u_ref``)."""
     pred, J = check_track_model(pred, J)
     sequence("pairs", pairs, empty=True)
