@@ -169,7 +169,7 @@ TWINS = {
         "solve",
         "spatial_phase",
     ),
-    "tunnelkit.extraction.paper": ("contract",),
+    "tunnelkit.extraction.joint": ("contract",),
 }
 
 

@@ -117,7 +117,7 @@ def test_the_tracer_s_unchecked_surface_tests_equal_the_checked_ones():
 
 
 def test_the_extraction_numerics_unchecked_twins_equal_the_checked_functions():
-    """The fits (ml.fitting, ml.model, coherent, paper.refine_joint) call the unchecked twins of
+    """The fits (ml.fitting, ml.model, coherent, joint.refine_joint) call the unchecked twins of
     ``extraction.numerics``: same bytes as the checked public forms, including the singular
     fall-back of ``solve``, the held coordinates of ``free_newton`` and ``damped_step``'s None."""
     from tunnelkit.extraction import numerics as nm

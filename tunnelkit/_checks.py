@@ -19,6 +19,7 @@ __all__ = [
     "bound_array",
     "indices",
     "items",
+    "numeric_array",
     "optional_real",
     "real_array",
     "series",
@@ -56,6 +57,23 @@ def series(name: str, value, *, finite: bool = False) -> np.ndarray:
     if finite and not np.isfinite(arr).all():
         raise ValueError(f"{name}: contains NaN or infinite values")
     return arr.reshape(-1)
+
+
+def numeric_array(name: str, value, ndim: tuple[int, ...], last: int | None = None) -> np.ndarray:
+    """``value`` as a numeric (real or complex) array with ``ndim`` in ``ndim`` and, when given,
+    ``last`` entries in the last axis, finite (NaN or inf is refused: a root, a factor or a
+    tensor entry that is not a number has no path behind it). Errors name ``name``."""
+    if value is None or isinstance(value, str | bytes):
+        raise TypeError(f"{name}: expected a numeric array, got {type(value).__name__}")
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "iufc":
+        raise TypeError(f"{name}: expected numbers, got dtype {arr.dtype}")
+    if arr.ndim not in ndim or (last is not None and arr.shape[-1] != last):
+        want = " or ".join(f"{d}-D" for d in ndim) + (f" with {last} columns" if last else "")
+        raise ValueError(f"{name}: expected {want}, got shape {arr.shape}")
+    if arr.dtype.kind in "fc" and not np.isfinite(arr).all():
+        raise ValueError(f"{name}: contains NaN or infinite values")
+    return arr
 
 
 def optional_real(name: str, value) -> float | None:

@@ -36,7 +36,7 @@ _EXPORTS = {
     "algorithm1": "paper",
     "angles_from_solution": "paper",
     "paper_route": "paper",
-    "refine_joint": "paper",
+    "refine_joint": "joint",
     "refine_roots": "paper",
     "solve_far_field": "paper",
     "solve_near_field": "paper",

@@ -1,7 +1,8 @@
 """Stage 2 of the extraction: the paper's route from CPD factors to path parameters (Italiano et
 al. 2026, eq. 13-24, Algorithm 1).
 
-:func:`vandermonde_roots` (eq. 13-15; :func:`refine_roots`, :func:`refine_joint`),
+:func:`vandermonde_roots` (eq. 13-15; :func:`refine_roots`; the joint refinement:
+:func:`~tunnelkit.extraction.joint.refine_joint`),
 :func:`unwrap_spatial` (eq. 16), :func:`solve_near_field` and :func:`solve_far_field` (eq.
 17-18), :func:`angles_from_solution` (eq. 19-24, ``psi`` the polar angle of eq. 19),
 :func:`algorithm1` (ExtractMeas' checks) and :func:`paper_route` (steps 1-4 to a
@@ -14,18 +15,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import numeric_array
 from .._validate import finite_array, integer
 from ..constants import C
 from .decomposition import check_rank, check_tensor, cpd, normalize_factors
 from .estimates import PathEstimates, path_estimates
-from .numerics import MIN_SIGNIFICANCE, contract_unchecked, grid_index
+from .numerics import MIN_SIGNIFICANCE, grid_index
 from .radio import check_array, check_srs
 
 __all__ = [
     "algorithm1",
     "angles_from_solution",
     "paper_route",
-    "refine_joint",
     "refine_roots",
     "solve_far_field",
     "solve_near_field",
@@ -44,33 +45,16 @@ def vandermonde_roots(B) -> np.ndarray:
     return np.angle(np.sum(B[:-1].conj() * B[1:], axis=0))
 
 
-def _numeric(name: str, value, ndim: tuple[int, ...], last: int | None = None) -> np.ndarray:
-    """``value`` as a numeric (real or complex) array with ``ndim`` in ``ndim`` and, when given,
-    ``last`` entries in the last axis, finite (NaN or inf is refused: a root, a factor or a
-    tensor entry that is not a number has no path behind it). Errors name ``name``."""
-    if value is None or isinstance(value, str | bytes):
-        raise TypeError(f"{name}: expected a numeric array, got {type(value).__name__}")
-    arr = np.asarray(value)
-    if arr.dtype.kind not in "iufc":
-        raise TypeError(f"{name}: expected numbers, got dtype {arr.dtype}")
-    if arr.ndim not in ndim or (last is not None and arr.shape[-1] != last):
-        want = " or ".join(f"{d}-D" for d in ndim) + (f" with {last} columns" if last else "")
-        raise ValueError(f"{name}: expected {want}, got shape {arr.shape}")
-    if arr.dtype.kind in "fc" and not np.isfinite(arr).all():
-        raise ValueError(f"{name}: contains NaN or infinite values")
-    return arr
-
-
 def refine_roots(B, mu, n_steps: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """Newton steps to the peak of ``|sum_n B[n] exp(-j mu n)|^2`` per column (single-tone ML).
 
     Returns the refined roots and the fitted amplitude ``beta = mean_n B[n] exp(-j mu n)`` (1 for
     a perfect normalised Vandermonde column). Steps are limited to a quarter of a bin.
     """
-    B = _numeric("B", B, (2,))
+    B = numeric_array("B", B, (2,))
     N = B.shape[0]
     n = np.arange(N)[:, None]
-    mu = _numeric("mu", mu, (1,))
+    mu = numeric_array("mu", mu, (1,))
     if mu.shape[0] != B.shape[1] or mu.dtype.kind == "c":
         raise ValueError(
             f"mu: expected {B.shape[1]} real roots (one per column of B), got {mu.shape}"
@@ -88,76 +72,6 @@ def refine_roots(B, mu, n_steps: int = 4) -> tuple[np.ndarray, np.ndarray]:
         mu = mu + np.clip(step, -np.pi / (2 * N), np.pi / (2 * N))
     beta = np.mean(B * np.exp(-1j * n * mu[None, :]), axis=0)
     return np.angle(np.exp(1j * mu)), beta
-
-
-def refine_joint(H, mu_f, mu_t, n_steps: int = 6):
-    """Joint ML refinement of all roots with free spatial factors (variable projection).
-
-    Model ``H[m, s, k] = sum_l A[m, l] exp(j mu_f,l s) exp(j mu_t,l k)``: for fixed roots the
-    spatial factors ``A`` are linear least squares; the roots take damped Gauss-Newton steps with
-    the Kaufman Jacobian ``a_l o P_perp dw_l/dmu`` (``w_l = f_l kron t_l``). All Gram matrices
-    factorise over the two Vandermonde modes, so one step costs three contractions of ``H``. This
-    is the maximum-likelihood estimate of the model a CPD fits plus the Vandermonde structure; it
-    approaches ``crlb_paths(spatial="free")`` where per-column estimates (eq. 13) do not.
-    Returns ``(mu_f, mu_t, A)``.
-    """
-    H = _numeric("H", H, (3,))
-    for name, m in (("mu_f", mu_f), ("mu_t", mu_t)):
-        if _numeric(name, m, (1,)).shape != np.shape(mu_f):
-            raise ValueError(f"{name}: mu_f and mu_t need one root per path each")
-    n_steps = integer("n_steps", n_steps, minimum=0, maximum=1000)
-    M, nf, nt = H.shape
-    s = np.arange(nf)[:, None]
-    k = np.arange(nt)[:, None]
-    mu = np.concatenate([np.asarray(mu_f, float), np.asarray(mu_t, float)])
-    L = mu.size // 2
-    x2 = float(np.vdot(H, H).real)
-    Hm = H.reshape(M * nf, nt)
-
-    def fit(m):
-        F, T = np.exp(1j * s * m[None, :L]), np.exp(1j * k * m[None, L:])
-        G = (F.conj().T @ F) * (T.conj().T @ T)  # W^H W
-        HT = (Hm @ T.conj()).reshape(M, nf, L)  # reused by the next gradient
-        B = np.einsum("msl,sl->ml", HT, F.conj())  # X conj(W)
-        A = np.linalg.solve(G, B.T).T
-        return F, T, G, A, HT, x2 - float(np.sum(np.real(A.conj() * B)))
-
-    F, T, G, A, HT, cost = fit(mu)
-    max_step = np.concatenate([np.full(L, np.pi / (2 * nf)), np.full(L, np.pi / (2 * nt))])
-    lam = 1e-6
-    for _ in range(n_steps):
-        Fs, Tk = s * F, k * T
-        FF, TT = F.conj().T @ F, T.conj().T @ T
-        WD = np.concatenate([1j * (F.conj().T @ Fs) * TT, 1j * FF * (T.conj().T @ Tk)], axis=1)
-        XD = -1j * np.concatenate(
-            [np.einsum("msl,sl->ml", HT, Fs.conj()), contract_unchecked(H, F.conj(), Tk.conj())],
-            axis=1,
-        )
-        RD = XD - A @ WD.conj()  # R conj(D)
-        Aa = np.concatenate([A, A], axis=1)
-        grad = np.real(np.sum(Aa.conj() * RD, axis=0))
-        Dff = (Fs.conj().T @ Fs) * TT
-        Dft = (Fs.conj().T @ F) * (T.conj().T @ Tk)
-        Dtt = FF * (Tk.conj().T @ Tk)
-        DD = np.block([[Dff, Dft], [Dft.conj().T, Dtt]])
-        PP = DD - WD.conj().T @ np.linalg.solve(G, WD)
-        JtJ = np.real((Aa.conj().T @ Aa) * PP)
-        improved = done = False
-        for _ in range(10):
-            step = np.linalg.solve(JtJ + lam * np.diag(np.diag(JtJ)), grad)
-            step = np.clip(step, -max_step, max_step)  # trust region: a quarter of a bin
-            out = fit(mu + step)
-            if out[-1] <= cost:
-                mu = mu + step
-                F, T, G, A, HT, new = out
-                # converged when the step is far below the noise-limited precision of the roots
-                done = np.max(np.abs(step)) < 1e-9 or cost - new <= 1e-12 * cost
-                cost, lam, improved = new, max(lam / 10, 1e-12), True
-                break
-            lam *= 10
-        if not improved or done:
-            break
-    return mu[:L], mu[L:], A
 
 
 def unwrap_spatial(b, element_positions) -> np.ndarray:
@@ -219,7 +133,7 @@ def _line_direction(p: np.ndarray, rtol: float = 1e-12):
 
 def _delta_positions(delta, element_positions) -> tuple[np.ndarray, np.ndarray]:
     """``delta`` as (M, L) real (NaN allowed) and the (M, 3) element positions, M matching."""
-    delta = _numeric("delta", delta, (1, 2))
+    delta = numeric_array("delta", delta, (1, 2))
     if delta.dtype.kind == "c":
         raise TypeError("delta: expected real phase distances, got complex numbers")
     delta = np.atleast_2d(np.asarray(delta, float).T).T
@@ -282,8 +196,8 @@ def angles_from_solution(x_nf, u_ff):
     ``direction = (x, y, sqrt(kappa^2 - rho^2)) / kappa``. FF: ``direction = (u_x, u_y,
     sqrt(1 - |u|^2))``. Ratios above 1 (noise) are clipped to 1.
     """
-    x_nf = np.atleast_2d(_numeric("x_nf", x_nf, (1, 2), last=3))
-    u_ff = np.atleast_2d(_numeric("u_ff", u_ff, (1, 2), last=2))
+    x_nf = np.atleast_2d(numeric_array("x_nf", x_nf, (1, 2), last=3))
+    u_ff = np.atleast_2d(numeric_array("u_ff", u_ff, (1, 2), last=2))
     if x_nf.shape[0] != u_ff.shape[0]:
         raise ValueError(
             f"u_ff: expected {x_nf.shape[0]} rows (one per row of x_nf), got {u_ff.shape[0]}"
@@ -355,7 +269,7 @@ def paper_route(
     ``array`` (:class:`~tunnelkit.arrays.ArrayGeometry` or (M, 3) local positions) and ``srs``
     (:class:`~tunnelkit.channel.SRSConfig`) as in :func:`~tunnelkit.extraction.extract_paths`.
     ``refine``: "joint" — after eq. 13, maximum-likelihood refinement of all roots together with
-    free spatial factors (:func:`refine_joint`); "column" — each root to the periodogram peak of
+    free spatial factors (:func:`~tunnelkit.extraction.joint.refine_joint`); "column" — each root to the periodogram peak of
     its own factor column (:func:`refine_roots`); "none" — eq. 13 roots and eq. 12 gains as
     they are. ``method``, ``n_iter_max``, ``tol`` go to :func:`~tunnelkit.extraction.cpd`;
     ``polish`` ALS sweeps on the full tensor after the compressed CPD (default 2, or 0 with
@@ -382,6 +296,8 @@ def paper_route(
     if refine == "joint":
         # project the spatial mode on the span of the CPD's spatial factors first: the roots'
         # information lies there, and each Gauss-Newton step gets M / L times cheaper
+        from .joint import refine_joint  # loaded when the step runs
+
         Q, _ = np.linalg.qr(res.factors[0])
         mu_f, mu_t, Ac = refine_joint(np.tensordot(Q.conj(), H, axes=(0, 0)), mu_f, mu_t)
         A = Q @ Ac
