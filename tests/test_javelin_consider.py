@@ -6,8 +6,8 @@ import pytest
 
 from tunnelkit.tracking.javelin import ConsiderNoise, PathMeasurements, ReportedNoise
 from tunnelkit.tracking.javelin.config import JavelinConfig
-from tunnelkit.tracking.javelin.consider import bias_factors
-from tunnelkit.tracking.javelin.update import consider_update, schmidt_update, stack_measurement
+from tunnelkit.tracking.javelin.consider import bias_factors, consider_update, schmidt_update
+from tunnelkit.tracking.javelin.update import stack_measurement
 
 NX, NB, STEPS = 2, 2, 8
 

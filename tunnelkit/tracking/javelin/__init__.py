@@ -2,14 +2,14 @@
 its virtual UEs, in small roles.
 
 ``state`` (eq. 43) · ``measurement`` (eq. 44-52, Algorithm 1 checks, curvature models, pre-filters)
-· ``noise`` (fixed or reported measurement noise) · ``consider`` (the bias-aware tracker's noise) ·
-``motion`` (eq. 62-63, VUE motion) · ``associate`` (eq. 56-59 gated costs, Algorithm 2, global
-nearest neighbour) · ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test, initiators) ·
-``update`` (eq. 64-68, Joseph form, joint innovation test) · ``roles`` (:class:`JavelinDesign`:
-numbers + one object per role) · ``designs`` (the named designs as factories) · ``arraydesign``
-(the array design's tracker) · ``surfaces`` (VUEs born from known planes) · ``tracker`` (Algorithm
-4) · ``tenfiloc`` (the snapshot baseline, eq. 69) · ``config`` (section 4.2 numbers). The
-chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
+· ``noise`` (fixed or reported measurement noise) · ``consider`` (the bias-aware tracker's noise
+and update) · ``motion`` (eq. 62-63, VUE motion) · ``associate`` (eq. 56-59 gated costs, Algorithm
+2, global nearest neighbour) · ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test,
+initiators) · ``update`` (eq. 64-68, Joseph form, joint innovation test) · ``roles``
+(:class:`JavelinDesign`: numbers + one object per role) · ``designs`` (the named designs as
+factories) · ``arraydesign`` (the array design's tracker) · ``surfaces`` (VUEs born from known
+planes) · ``tracker`` (Algorithm 4) · ``tenfiloc`` (the snapshot baseline, eq. 69) · ``config``
+(section 4.2 numbers). The chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
 """
 
 from __future__ import annotations

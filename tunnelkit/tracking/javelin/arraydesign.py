@@ -67,7 +67,7 @@ def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> Ja
     the share of it that repeats every epoch (a calibration error, a model bias:
     ``PathMeasurements.bias_cov``) is carried as a consider parameter of the path's track, not
     averaged down (:class:`ConsiderNoise`, a Schmidt-Kalman update:
-    :func:`~.update.consider_update`); pairs are ranked by ``eta^2 + ln det S`` (``Associator(cost="likelihood")``),
+    :func:`~.consider.consider_update`); pairs are ranked by ``eta^2 + ln det S`` (``Associator(cost="likelihood")``),
     so a new, wide track cannot take a path an established track predicts to a millimetre; a VUE
     is born with the covariance of the angles that placed it (:class:`MeasuredBirth`), so two new
     tracks a few degrees apart cannot swap their paths in the next epoch; and pairs whose stacked

@@ -2,8 +2,9 @@
 
 :func:`stack_measurement` stacks the associated pairs into the sorted ``z`` of eq. 54
 (:class:`StackedMeasurement`); :func:`joseph_update` updates; a bias-aware tracker (ours) updates
-as a Schmidt-Kalman consider filter (:func:`consider_update`, :func:`schmidt_update`);
-:class:`JosephUpdater` and :class:`JointTestUpdater` are the updater roles.
+as a Schmidt-Kalman consider filter (:mod:`tunnelkit.tracking.javelin.consider`, loaded when a
+tracker carries biases); :class:`JosephUpdater` and :class:`JointTestUpdater` are the updater
+roles.
 
 How it works, and why consider rather than estimate the biases: docs/internals/tracking.md.
 """
@@ -25,10 +26,8 @@ from .noise import FixedNoise
 
 __all__ = [
     "StackedMeasurement",
-    "consider_update",
     "exclude_inconsistent",
     "joseph_update",
-    "schmidt_update",
     "stack_measurement",
 ]
 
@@ -170,69 +169,6 @@ def stack_measurement(
     )
 
 
-def schmidt_update(
-    x: np.ndarray,
-    P: np.ndarray,
-    H: np.ndarray,
-    R: np.ndarray,
-    y: np.ndarray,
-    n_est: int | None = None,
-    gain: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """The linear update of a state ``x`` (N,) whose first ``n_est`` entries are estimated and
-    the rest are consider parameters (Schmidt 1966): the gain's rows of the consider parameters
-    are zero, so they keep their mean and covariance, and the estimated rows take the best gain
-    under that constraint, ``K = (P H^T S^-1)[:n_est]`` with ``S = H P H^T + R``. Returns
-    ``(x, P, K, nis)``, ``P`` in the Joseph form ``(I - K H) P (I - K H)^T + K R K^T``, which is
-    the true covariance for *any* gain: ``gain`` (n_est, K) replaces the optimal one (to
-    evaluate a filter that ignores the consider parameters). ``n_est = N`` (default) is the
-    Kalman filter on the whole state."""
-    x = finite_array("x", x, ndim=1)
-    N = x.size
-    P = finite_array("P", P, shape=(N, N))
-    y = finite_array("y", y, ndim=1)
-    H = finite_array("H", H, shape=(y.size, N))
-    R = finite_array("R", R, shape=(y.size, y.size))
-    n_est = N if n_est is None else integer("n_est", n_est, minimum=1, maximum=N)
-    S = H @ P @ H.T + R
-    S = 0.5 * (S + S.T)
-    cf = cho_factor(S, lower=True)
-    Ka = np.zeros((N, y.size))
-    if gain is None:
-        Ka[:n_est] = cho_solve(cf, H @ P[:, :n_est]).T
-    else:
-        Ka[:n_est] = finite_array("gain", gain, shape=(n_est, y.size))
-    x_new = x + Ka @ y
-    IKH = np.eye(N) - Ka @ H
-    P_new = IKH @ P @ IKH.T + Ka @ R @ Ka.T
-    nis = float(y @ cho_solve(cf, y))
-    return x_new, 0.5 * (P_new + P_new.T), Ka[:n_est], nis
-
-
-def consider_update(
-    x: np.ndarray, P: np.ndarray, C: np.ndarray, m: StackedMeasurement
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """The Schmidt-Kalman update of the JAVELIN state with the tracks' normalised biases as
-    consider parameters (docs/internals): the augmented covariance ``[[P, C], [C^T, I]]``, the
-    rows ``z = h(x) + B u + w`` (``m.B``, white ``m.R``), :func:`schmidt_update` with the state
-    estimated. Returns ``(x, P, C, nis)``; the biases' block stays ``I``."""
-    x = finite_array("x", x, ndim=1)
-    D = x.size
-    P = finite_array("P", P, shape=(D, D))
-    C = finite_array("C", C, ndim=2)
-    if C.shape[0] != D:
-        raise ValueError(f"C: expected {D} rows (one per state entry), got {C.shape[0]}")
-    instance("m", m, StackedMeasurement)
-    if m.z.size == 0:
-        return x.copy(), P.copy(), C.copy(), 0.0
-    Lc = C.shape[1]
-    Pa = np.block([[P, C], [C.T, np.eye(Lc)]])
-    xa = np.concatenate([x, np.zeros(Lc)])
-    Ha = np.hstack([m.H, m.B])
-    xa, Pa, _, nis = schmidt_update(xa, Pa, Ha, m.R, m.residual(), n_est=D)
-    return xa[:D], Pa[:D, :D], Pa[:D, D:], nis
-
-
 def joseph_update(
     x: np.ndarray, P: np.ndarray, m: StackedMeasurement
 ) -> tuple[np.ndarray, np.ndarray, float]:
@@ -324,12 +260,15 @@ class JosephUpdater:
 
     def update(self, x, P, m: StackedMeasurement, C=None):
         """``(x, P, nis)`` after the update (:func:`~.update.joseph_update`); with a consider
-        cross-covariance ``C`` and ``m.B``, ``(x, P, nis, C)`` (:func:`consider_update`)."""
+        cross-covariance ``C`` and ``m.B``, ``(x, P, nis, C)``
+        (:func:`~tunnelkit.tracking.javelin.consider.consider_update`)."""
         instance("m", m, StackedMeasurement)  # x and P: checked by the update that runs
         if C is not None:
             state_arguments(x, P, m.H.shape[1] if m.z.size else None)
             C = finite_array("C", C, ndim=2)
         if C is not None and m.B is not None and (np.any(m.B) or np.any(C)):
+            from .consider import consider_update  # loaded when the tracker carries biases
+
             x, P, C, nis = consider_update(x, P, C, m)
             return x, P, nis, C
         # no bias anywhere (C = 0, B = 0): the consider update is the Joseph update exactly
