@@ -69,7 +69,7 @@ def design_sweep():
     """The Monte-Carlo and the sweep on a few epochs, one run (a channel-route
     Monte-Carlo of at least two drives, takes seconds)."""
     from tunnelkit import design
-    from tunnelkit.design import montecarlo, report
+    from tunnelkit.design import explore, montecarlo
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
     res = montecarlo.sweep_montecarlo(
@@ -77,7 +77,7 @@ def design_sweep():
     )
     r = next(iter(res.values()))
     r.settled_rms(np.full(len(r.t), 0.1))
-    report.smallest_meeting(setup, ["4x4"], epochs=[5, 10])
+    explore.smallest_meeting(setup, ["4x4"], epochs=[5, 10])
     setup.signal_route("4x4")
 
 

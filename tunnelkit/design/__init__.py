@@ -56,7 +56,7 @@ _EXPORTS = {
     "DesignRow": "records",
     "over_target": "render",
     "design_sweep": "report",
-    "smallest_meeting": "report",
+    "smallest_meeting": "explore",
     "ArraySpec": "setup",
     "DesignSetup": "setup",
     "Mount": "setup",

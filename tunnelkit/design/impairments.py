@@ -176,6 +176,29 @@ def preset_impairments(name: str, setup, specs) -> DesignImpairments:
     )
 
 
+def design_impairments(impairments, setup, specs) -> DesignImpairments:
+    """``impairments`` (a preset's name, :data:`PRESETS`, a dict of fields or a
+    ``DesignImpairments``) as the object the prediction and the error model take: the argument
+    of :func:`~tunnelkit.design.design_sweep` and :func:`~tunnelkit.design.smallest_meeting`,
+    checked by them."""
+    if isinstance(impairments, str):
+        if impairments not in PRESETS:
+            raise ValueError(
+                f"impairments: expected one of {', '.join(PRESETS)}, a "
+                f"design.DesignImpairments or a dict of its fields, got {impairments!r}"
+            )
+        return preset_impairments(impairments, setup, specs)
+    if isinstance(impairments, dict):
+        return DesignImpairments(**impairments)
+    if not isinstance(impairments, DesignImpairments):
+        raise TypeError(
+            f"impairments: expected 'calibrated', 'ideal', a design.DesignImpairments or a dict "
+            f"of its fields, got "
+            f"{type(impairments).__name__}"
+        )
+    return impairments
+
+
 def implausible_impairments(imp: DesignImpairments) -> list[str]:
     """Warnings for valid but unusual impairments (``imp`` a checked
     :class:`DesignImpairments`): a diffuse share more than three standard deviations above the

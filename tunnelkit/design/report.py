@@ -4,8 +4,7 @@ manufactured units that meet the target.
 :func:`design_sweep` places every candidate, computes its ideal PEB and predicted error, runs
 the Monte-Carlo over manufactured units (:mod:`tunnelkit.design.unitsweep`) and gives the
 verdict; :class:`DesignReport` holds the rows, the recommendation, every input and the warnings
-(JSON or a text table);
-:func:`smallest_meeting` is the explorer's quick look (a prediction, not an answer).
+(JSON or a text table). The explorer's quick look is :mod:`tunnelkit.design.explore`'s.
 
 How it works, step by step: docs/internals/design.md.
 """
@@ -22,7 +21,6 @@ from .._physical import start_spread
 from .._validate import (
     boolean,
     choice,
-    finite_array,
     integer,
     nonnegative,
     positive,
@@ -38,11 +36,10 @@ from .impairments import (
     CALIBRATED_PHASE_ERROR_DEG,
     MEASURED_DIFFUSE_SHARE,
     WIDEBAND_CYCLES,
+    design_impairments,
     implausible_impairments,
-    preset_impairments,
     wideband_cycles,
 )
-from .impairments import PRESETS as IMPAIRMENT_PRESETS
 from .records import DesignReport, DesignRow
 from .setup import ArraySpec, DesignSetup, parse_array
 from .trackerfix import MODES, START_SIGMA_M
@@ -59,53 +56,7 @@ from .verdict import (
     share_quantile,
 )
 
-__all__ = ["DesignReport", "DesignRow", "design_sweep", "smallest_meeting"]
-
-
-def smallest_meeting(
-    setup: DesignSetup,
-    arrays,
-    *,
-    target: float = 0.2,
-    share: float = 0.9,
-    criterion: str = "achievable",
-    impairments="calibrated",
-    eps_phi: float = 0.15,
-    epochs=None,
-) -> tuple[ArraySpec | None, float]:
-    """The first array of ``arrays`` (in the order given) whose **predicted error** meets
-    ``target`` on ``share`` of the route, and its met share; ``(None, best share)`` if none.
-
-    A prediction for the explorer, not an answer (the answer is :func:`design_sweep` with
-    units): with ``criterion="achievable"`` (default) the predicted error under ``impairments``
-    (as :func:`design_sweep`'s; ``"ideal"``: the PEB), SR-NF only information; with ``"srnf"`` (an eq. 51 estimator) an epoch
-    where SR-NF fails counts as missed. Arrays that do not fit are skipped; ``epochs``
-    subsamples the route."""
-    sequence("arrays", arrays), epochs is None or finite_array("epochs", epochs, ndim=1)
-    target = positive("target", target)
-    share = probability("share", share, open_interval=False)
-    if share == 0:
-        raise ValueError("share: expected a share in (0, 1], got 0")
-    if not isinstance(setup, DesignSetup):
-        raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
-    criterion = choice("criterion", criterion, CRITERIA)
-    specs = [parse_array(a) for a in arrays]
-    imp = _design_impairments(impairments, setup, specs) if specs else None
-    best = 0.0
-    for spec in specs:
-        try:
-            g = route_geometry(setup, spec, epochs=epochs)
-        except ValueError:
-            continue
-        b = route_bounds(setup, spec, eps_phi=eps_phi, geometry=g, peb=False)
-        if criterion == "srnf" and b.srnf_valid.mean() < share:
-            continue
-        a = predicted_error(setup, spec, imp, geometry=g)
-        met = float(np.mean(gate(a.predicted, b.srnf_valid, criterion) <= target))
-        if met >= share:
-            return spec, met
-        best = max(best, met)
-    return None, best
+__all__ = ["DesignReport", "DesignRow", "design_sweep"]
 
 
 # --- the sweep ------------------------------------------------------------------------------
@@ -114,28 +65,6 @@ def smallest_meeting(
 def _impairment_fields(imp: DesignImpairments) -> dict:
     """The impairment settings as plain values (the report's inputs)."""
     return {k: (v if isinstance(v, (bool, str)) else float(v)) for k, v in asdict(imp).items()}
-
-
-def _design_impairments(impairments, setup, specs) -> DesignImpairments:
-    """``impairments`` (a preset's name, :data:`~tunnelkit.design.impairments.PRESETS`, a dict
-    of fields or a ``DesignImpairments``) as the object the prediction and the error model
-    take."""
-    if isinstance(impairments, str):
-        if impairments not in IMPAIRMENT_PRESETS:
-            raise ValueError(
-                f"impairments: expected one of {', '.join(IMPAIRMENT_PRESETS)}, a "
-                f"design.DesignImpairments or a dict of its fields, got {impairments!r}"
-            )
-        return preset_impairments(impairments, setup, specs)
-    if isinstance(impairments, dict):
-        return DesignImpairments(**impairments)
-    if not isinstance(impairments, DesignImpairments):
-        raise TypeError(
-            f"impairments: expected 'calibrated', 'ideal', a design.DesignImpairments or a dict "
-            f"of its fields, got "
-            f"{type(impairments).__name__}"
-        )
-    return impairments
 
 
 def _error_models(impairments: DesignImpairments, mode: str):
@@ -270,7 +199,7 @@ def design_sweep(
     traced_array = setup.channel != "image" and impairments == "calibrated"
     if traced_array:  # the traced route's tracker is told errors measured on an ideal array
         impairments = "ideal"
-    imp = _design_impairments(impairments, setup, specs)
+    imp = design_impairments(impairments, setup, specs)
     fields = _impairment_fields(imp)
     T = len(setup.trajectory)
     T = T if n_epochs is None else n_epochs
