@@ -49,6 +49,7 @@ RANKS = {
     "odometry": 1,  # the V2X odometry messages as a model
     "reckoning": 1.1,  # dead reckoning on the odometry messages and its bound
     "crlb": 1,
+    "settling": 0.9,  # the settled epochs of a drive (the tracker's start-up left out)
     "metrics": 1,
     "montecarlo": 1,
     "runner": 1.1,  # the Monte-Carlo runner (serial or Dask) over montecarlo's seeds

@@ -1,4 +1,5 @@
-"""Error metrics used across the notebooks and the ``reproduce`` command."""
+"""Error metrics used across the notebooks and the ``reproduce`` command; the settled epochs they
+are taken over are :mod:`tunnelkit.settling`'s (re-exported here)."""
 
 from __future__ import annotations
 
@@ -6,20 +7,9 @@ import numpy as np
 from numpy.lib.array_utils import normalize_axis_tuple
 
 from ._validate import finite_array
+from .settling import SETTLE_S, settled
 
 __all__ = ["SETTLE_S", "ecdf", "error_stats", "position_errors", "rmse", "settled"]
-
-#: the first second of a drive is a tracker's start-up (an open-sky fix with 1 m of uncertainty,
-#: the VUE tracks born over the first epochs): the settled errors leave it out
-SETTLE_S = 1.0
-
-
-def settled(t) -> np.ndarray:
-    """Indices of the epochs of ``t`` [s] at least :data:`SETTLE_S` after its start."""
-    t = finite_array("t", t, ndim=1)
-    if not t.size:
-        raise ValueError("t: expected at least one epoch time")
-    return np.flatnonzero(t - t[0] >= SETTLE_S - 1e-9)
 
 
 def position_errors(estimate, truth) -> np.ndarray:

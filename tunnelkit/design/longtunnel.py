@@ -10,7 +10,7 @@ on the same drive, start and V2X messages, dead reckoning (every measurement dro
 :func:`tunnelkit.runner.run_trials` call; run ``r`` of every configuration uses child generator
 ``r`` of ``seed`` (common random numbers, as the design's sweep).
 
-Per (array, spacing) over the settled epochs (:func:`tunnelkit.metrics.settled`) of all runs:
+Per (array, spacing) over the settled epochs (:func:`tunnelkit.settling.settled`) of all runs:
 the 2-D error's p90 and RMSE, the p90 at the worst point between sites (the UE's position
 relative to its serving site, within half a spacing of it, binned every ``bin_m`` metres; the
 bin of the largest p90, NaN when no epoch lies that close; ``worst_offset`` its
@@ -41,8 +41,8 @@ import numpy as np
 
 from .._physical import start_spread
 from .._validate import boolean, choice, instance, integer, nonnegative, positive, sequence
-from ..metrics import settled
 from ..odometry import MODELS, Odometry
+from ..settling import settled
 from .arrayjob import START_HEIGHT_SIGMA_M, design_planes, javelin_config, median_sigmas
 from .setup import DesignSetup, parse_array
 from .sites import LONG_DRIVE_SPEED, SiteRoute, SiteRow, row_pcrlb, site_drive, site_route

@@ -54,9 +54,9 @@ from .._checks import bound_array
 from .._physical import start_spread
 from .._validate import boolean, choice, instance, integer, record
 from ..budget import check_bytes
-from ..metrics import SETTLE_S, settled
 from ..montecarlo import RUN_BYTES
 from ..runner import TRIAL_TIMEOUT_S, TrialPool, run_trials, trial_pool
+from ..settling import SETTLE_S, settled
 from .arrayjob import (
     START_HEIGHT_SIGMA_M,
     ArrayJob,
@@ -99,7 +99,7 @@ class MonteCarloResult:
     each other: :mod:`tunnelkit.design.units`); ``rmse_runs`` (runs,) each run's RMSE over the
     settled epochs (NaN when the drive is shorter than :data:`SETTLE_S`: nothing settled, and
     the settled statistics refuse); ``settled`` the
-    indices of the settled epochs (:func:`tunnelkit.metrics.settled`); ``mode`` the
+    indices of the settled epochs (:func:`tunnelkit.settling.settled`); ``mode`` the
     measurement route; ``peb`` (T,) [m] the snapshot PEB; ``sigmas`` the tracker's fallback
     sigmas. Two **bounds** over the drive (with a model: the bound route, or given models),
     each a lower bound of what it is shown beside (:func:`~tunnelkit.design.drivebound.unit_pcrlb`):
@@ -155,7 +155,7 @@ class MonteCarloResult:
         if not self.settled.size:
             raise ValueError(
                 f"settled: a {self.t[-1] - self.t[0]:.3g} s route has no epoch after the tracker's "
-                f"{SETTLE_S:g} s start-up (metrics.SETTLE_S): nothing settled to score"
+                f"{SETTLE_S:g} s start-up (settling.SETTLE_S): nothing settled to score"
             )
         return self.settled
 

@@ -28,7 +28,7 @@ from .._validate import (
     sequence,
 )
 from ..budget import check_bytes, check_elements
-from ..metrics import SETTLE_S
+from ..settling import SETTLE_S
 from .achievable import DesignImpairments, path_error_model, predicted_error
 from .bounds import route_bounds, route_geometry
 from .impairments import (
@@ -147,7 +147,7 @@ def design_sweep(
     """Every candidate of ``arrays`` evaluated and judged (docs/internals).
 
     ``target`` [m] on ``share`` of the settled route (the epochs at least ``settle`` [s] after
-    the start, default :data:`~tunnelkit.metrics.SETTLE_S`); ``criterion`` ``"achievable"``
+    the start, default :data:`~tunnelkit.settling.SETTLE_S`); ``criterion`` ``"achievable"``
     (default, the design's VUE-curvature tracker) or ``"srnf"`` (an eq. 51 route: SR-NF a
     gate); ``impairments``: ``"calibrated"`` (default: a calibrated manufactured array in a
     tunnel's measured diffuse power, :mod:`tunnelkit.design.impairments`), ``"ideal"``, a

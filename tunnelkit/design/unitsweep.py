@@ -11,7 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..metrics import SETTLE_S
+from ..settling import SETTLE_S
 from .intervals import cluster_quantile_ci
 from .montecarlo import sweep_montecarlo
 from .units import unit_quantiles, unit_yield

@@ -23,7 +23,7 @@ from .._validate import (
     probability,
     sequence,
 )
-from ..metrics import SETTLE_S
+from ..settling import SETTLE_S
 
 __all__ = [
     "CRITERIA",

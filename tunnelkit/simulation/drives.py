@@ -37,8 +37,8 @@ from .._validate import (
 from ..channel import SRSConfig
 from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
-from ..metrics import SETTLE_S, settled
 from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry
+from ..settling import SETTLE_S, settled
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.measurements import PathMeasurements
@@ -290,7 +290,7 @@ def drive_variant(scenario: str, length: float) -> SignalRoute:
         if not settled(route.trajectory.t).size:  # nothing to score, never an RMSE of 0
             raise ValueError(
                 f"length: a {length:g} m drive ends within the tracker's {SETTLE_S:g} s start-up "
-                "(metrics.SETTLE_S): nothing settled to score; give a longer drive"
+                "(settling.SETTLE_S): nothing settled to score; give a longer drive"
             )
         _VARIANTS[key] = route
     return _VARIANTS[key]

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._checks import attributes
 from .._validate import finite_array, instance, record, text
-from ..metrics import SETTLE_S, settled
+from ..settling import SETTLE_S, settled
 from ..tracking import registry
 from ..tracking.javelin.designs import paper
 from ..tracking.javelin.roles import JavelinDesign
