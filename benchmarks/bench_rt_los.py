@@ -117,11 +117,12 @@ def score(
     starts=1,
     tables=None,
     huber=False,
+    told_sigma=None,
 ) -> dict:
     """Mean RMSE per tracker over ``drives`` x ``starts`` entry fixes (the starts from a stream of
-    their own, ``starts`` per drive in turn); ``tables``: {label: ElevationSigmas} for the chosen
-    first sigma's design told each epoch's sigmas from the table (its kappa and d sigmas kept);
-    ``huber``: each sigma also with the Huber-weighted update."""
+    their own, ``starts`` per drive in turn); ``tables``: {label: ElevationSigmas}, the
+    ``told_sigma`` design (default the first sigma's; its kappa and d sigmas kept) told each
+    epoch's sigmas from each table; ``huber``: each sigma also with the Huber-weighted update."""
     rng = np.random.default_rng([seed, 1])
     td = traced_design()
     designs = {}
@@ -138,7 +139,8 @@ def score(
     plain = list(designs)
     flagged = [f"{k}, fit flags" for k in plain] if flags else []
     tables = tables or {}
-    told = designs[f"LoS only, {sigmas[0]} deg"].with_(noise=ReportedNoise())
+    az, el = np.radians(_pair(told_sigma or sigmas[0]))  # the kappa and d sigmas of its design
+    told = los_design(float(az), td, sigma_elevation=float(el)).with_(noise=ReportedNoise())
     ranged = [f"LoS only, sigmas by elevation ({k})" for k in tables]
     out = {"traced design": [], "dead reckoning": [], **{k: [] for k in plain + flagged + ranged}}
     los_share, kept = [], []
@@ -334,11 +336,22 @@ def main() -> None:
         "--drives-cache", default=None, help="keep the drives here (a folder) to score them again"
     )
     ap.add_argument(
+        "--every-sigma",
+        action="store_true",
+        help="report every sigma on the held-out seed too (the choice still made on seed 0)",
+    )
+    ap.add_argument(
         "--cost", action="store_true", help="also time each tracker per epoch on each seed's drives"
     )
     ap.add_argument("--table", default=None, help="use this table (JSON) instead of building one")
     ap.add_argument("--write-table", default=None, help="write the chosen table (JSON) here")
     a = ap.parse_args()
+    if a.table and a.by_elevation:
+        ap.error("--table and --by-elevation: give one (a table built elsewhere, or built here)")
+    if a.write_table and not (a.table or a.by_elevation):
+        ap.error("--write-table: no table to write (give --by-elevation)")
+    if a.write_table and a.table:
+        ap.error("--write-table: the table given by --table is written already")
     if a.bound_grid:
         bound_grid(a.scenario, a.bound_grid, a.start_sigma)
         return
@@ -350,12 +363,12 @@ def main() -> None:
         t0 = time.perf_counter()
         case = (a.scenario, a.array)
         drives = _drives(case, a.runs, seed, a.workers, a.drives_cache)
-        sigmas = a.sigmas if chosen is None else [chosen]
+        sigmas = a.sigmas if chosen is None or a.every_sigma else [chosen]
         if tables is None and a.by_elevation:  # built on seed 0's drives, with their truth
             errors = los_errors([dd["ml-all"] for dd in drives])
             tables = {f"{b} bins, seed 0": elevation_sigmas(errors, b) for b in a.by_elevation}
         res = score(drives, seed, sigmas, a.start_sigma, a.los_gamma, a.fit_flags, a.starts,
-                    tables, a.huber)  # fmt: skip
+                    tables, a.huber, a.sigmas[0])  # fmt: skip
         if chosen is None:  # chosen on seed 0, the lowest mean RMSE of the grid
             chosen = min(sigmas, key=lambda s: res[f"LoS only, {s} deg"])
             # (a widened eq. 61 is reported beside the chosen sigma, not chosen among)

@@ -104,8 +104,10 @@ def los_errors(drives, window: float = LOS_WINDOW_M) -> np.ndarray:
 
 def elevation_sigmas(errors, bins: int = 8) -> ElevationSigmas:
     """The table of ``errors`` (N, 3) of :func:`los_errors`: ``bins`` bins of the measured
-    elevation with equal counts, in each the RMS of the azimuth's and the elevation's errors
-    (gross errors included: the tracker meets them too), at the bin's mid-point."""
+    elevation with nearly equal counts (cut at its quantiles), in each the RMS of the azimuth's
+    and the elevation's errors (gross errors included: the tracker meets them too), at the
+    mid-point of the bin's edges (the end bins' outer edges are the extreme measurements, so an
+    outlying elevation moves their centres)."""
     errors = finite_array("errors", errors, shape=(None, 3))
     bins = integer("bins", bins, minimum=1)
     if errors.shape[0] < 2 * bins:
@@ -113,6 +115,13 @@ def elevation_sigmas(errors, bins: int = 8) -> ElevationSigmas:
     psi = errors[:, 0]
     edges = np.quantile(psi, np.linspace(0.0, 1.0, bins + 1))
     which = np.clip(np.searchsorted(edges, psi, side="right") - 1, 0, bins - 1)
+    counts = np.bincount(which, minlength=bins)
+    if counts.min() < 2:
+        b = int(np.argmin(counts))
+        raise ValueError(
+            f"errors: tied measured elevations leave bin {b} with {counts[b]} rows (at least 2 "
+            "per bin); use fewer bins"
+        )
     rms = np.array([np.sqrt(np.mean(errors[which == b, 1:] ** 2, axis=0)) for b in range(bins)])
     if np.any(rms <= 0):
         raise ValueError("errors: a bin without any error (all zero): not a measured record")
