@@ -98,14 +98,14 @@ def report() -> str:
     lines = []
     if _SWEEPS:
         lines.append(
-            "design sweep (bound route, seed 0): settled RMSE / PEB / posterior bound / bound "
+            "design sweep (bound route, seed 0): settled RMSE / PEB / posterior CRLB / predicted "
             "over the drive [mm]"
         )
         first = next(iter(_SWEEPS.values()))
         for a, r in first.items():
             lines.append(
                 f"  {a:6s} {r.rmse_settled * 1e3:8.3f} / {r.settled_rms(r.peb) * 1e3:7.3f} / "
-                f"{r.settled_rms(r.pcrlb) * 1e3:7.3f} / {r.settled_rms(r.drive) * 1e3:7.3f}"
+                f"{r.settled_rms(r.pcrlb) * 1e3:7.3f} / {r.settled_rms(r.predicted) * 1e3:7.3f}"
             )
         if len(_SWEEPS) > 1:
             lines.append(f"  serial, 1 and 2 workers identical: {_identical(_SWEEPS)}")
@@ -227,7 +227,7 @@ def _as_json(res: dict) -> str:
                 "rmse_runs": arr(r.rmse_runs),
                 "peb": arr(r.peb),
                 "pcrlb": arr(r.pcrlb),
-                "drive": arr(r.drive),
+                "predicted": arr(r.predicted),
                 "sigmas": r.sigmas,
             }
             for a, r in res.items()
