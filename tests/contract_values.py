@@ -410,7 +410,7 @@ def _baselines():
     from tunnelkit.design import errormodel, intervals, mcrb, render, verdict
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.design.drivebound import drive_bound
-    from tunnelkit.extraction.decomposition import kruskal_rank
+    from tunnelkit.extraction.krank import kruskal_rank
     from tunnelkit.fresnel.bounds import fraunhofer_distance
     from tunnelkit.plots import common, tables, topview
     from tunnelkit.tracking import cv, gating

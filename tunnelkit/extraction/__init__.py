@@ -25,7 +25,7 @@ _EXPORTS = {
     "check_tensor": "decomposition",
     "cp_rel_error": "decomposition",
     "cpd": "decomposition",
-    "kruskal_rank": "decomposition",
+    "kruskal_rank": "krank",
     "max_identifiable_rank": "decomposition",
     "normalize_factors": "decomposition",
     "PathEstimates": "estimates",

@@ -32,7 +32,6 @@ __all__ = [
     "check_tensor",
     "cp_rel_error",
     "cpd",
-    "kruskal_rank",
     "max_identifiable_rank",
     "normalize_factors",
 ]
@@ -114,41 +113,6 @@ def check_rank(shape, n_paths) -> int:
             f"Kruskal's condition kr(Bs)+kr(Bf)+kr(Bt) >= 2L+2 allows at most L = {top}"
         )
     return n
-
-
-def kruskal_rank(B, tol: float = 1e-6) -> int:
-    """Kruskal rank of ``B`` (brute force): the largest k such that every k columns are independent.
-
-    A column set counts as independent when its smallest singular value exceeds ``tol`` times the
-    largest one (columns normalised first), so nearly collinear columns lower the rank.
-    """
-    from itertools import combinations
-
-    B = finite_array("B", B, ndim=2, dtype=complex)
-    tol = positive("tol", tol)
-    B = B / np.maximum(np.linalg.norm(B, axis=0, keepdims=True), 1e-300)
-    L = B.shape[1]
-    if 0 < L <= B.shape[0]:
-        # polynomial shortcut: singular values of a column subset interlace the full set's, so a
-        # well-conditioned full set makes every subset independent (k-rank = L)
-        s = np.linalg.svd(B, compute_uv=False)
-        if s[-1] > tol * s[0]:
-            return L
-    from math import comb
-
-    if sum(comb(L, k) for k in range(1, min(L, B.shape[0]) + 1)) > 200_000:
-        raise ValueError(
-            f"B: {L} dependent columns: the exact Kruskal rank would test over 200,000 column "
-            "subsets (drop dependent columns or pass fewer)"
-        )
-    kr = 0
-    for k in range(1, min(L, B.shape[0]) + 1):
-        for cols in combinations(range(L), k):
-            s = np.linalg.svd(B[:, cols], compute_uv=False)
-            if s[-1] <= tol * s[0]:
-                return kr
-        kr = k
-    return kr
 
 
 @dataclass(frozen=True)
