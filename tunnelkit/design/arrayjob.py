@@ -16,7 +16,7 @@ import numpy as np
 
 from .._validate import instance
 from ..odometry import Odometry
-from .bounds import path_bounds, route_bounds, route_geometry
+from .bounds import route_bounds, route_geometry
 from .channelbudget import channel_route_budget
 from .drivebound import (
     START_SIGMA_M,
@@ -27,6 +27,7 @@ from .drivebound import (
     unit_pcrlb,
 )
 from .errormodel import PathErrorModel
+from .pathbounds import path_bounds
 from .setup import ArraySpec, DesignSetup
 
 __all__ = ["START_HEIGHT_SIGMA_M", "design_planes", "javelin_config"]
