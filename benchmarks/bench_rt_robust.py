@@ -43,6 +43,7 @@ from tunnelkit.simulation.prefilter import NUISANCE, SIGMA_SCENARIO
 from tunnelkit.studies.robust_errors import robust_design, robust_rows
 from tunnelkit.studies.traced import simulate_traced, traced_errors
 from tunnelkit.tracking.javelin import designs
+from tunnelkit.tracking.javelin.measured import design_from_errors
 
 TABLES = {"straight": "italiano2026-straight", "slalom": "italiano2026-slalom"}
 
@@ -102,7 +103,7 @@ def main(argv=None) -> int:
     rcols, rrows, _ = robust_rows(samples)
     print("robust rows (median, robust sigma = 1.4826 MAD, gross beyond 3 sigma, RMS of the rest):")
     _print_rows(rcols, rrows)
-    rms_design = designs.design_from_errors(rms_rows, base=designs.ours_ml(), correlation=corr)
+    rms_design = design_from_errors(rms_rows, base=designs.ours_ml(), correlation=corr)
     rob_design = robust_design(samples, correlation=corr)
     print(f"told, RMS design   : {_sigmas(rms_design)}")
     print(f"told, robust design: {_sigmas(rob_design)}")

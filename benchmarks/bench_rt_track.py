@@ -16,7 +16,7 @@ flagged epochs pass there) are measured once; the same measurements are then sco
 * ``no curvature``: every path's curvature removed (far-field: angles and delay only);
 * ``all-path sigmas`` / ``kept-path sigmas``: the design's measurement noise set to the RMS
   extraction error on these traced drives (:func:`tunnelkit.simulation.analysis.extraction_errors`,
-  :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`) of every matched path, or of
+  :func:`~tunnelkit.tracking.javelin.measured.design_from_errors`) of every matched path, or of
   the paths the geometry test keeps; in-sample unless ``--sigmas`` / ``--sigmas-kept`` give them
   (measured on another drive or seed), alone and with the geometry test;
 * ``sigmas x S``: the design's measurement sigmas scaled by ``S`` (``--scale``).
@@ -54,7 +54,7 @@ from tunnelkit.simulation import drives, evaluate
 from tunnelkit.simulation.analysis import extraction_errors
 from tunnelkit.simulation.collect import simulate_condition
 from tunnelkit.tracking.javelin import designs
-from tunnelkit.tracking.javelin.designs import design_from_errors
+from tunnelkit.tracking.javelin.measured import design_from_errors
 
 SIGMAS = ("sigma_phi", "sigma_psi", "sigma_kappa", "sigma_delta_d")
 

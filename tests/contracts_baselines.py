@@ -152,6 +152,7 @@ def javelin_studies():
     from tunnelkit.reproduce import javelin_tables as jt
     from tunnelkit.signal_route import SignalRoute
     from tunnelkit.tracking.javelin import designs
+    from tunnelkit.tracking.javelin.measured import design_from_errors
     from tunnelkit.widgets import javelin as wj
 
     rng = np.random.default_rng(0)
@@ -184,7 +185,7 @@ def javelin_studies():
     wj.epoch_view(drive, ev, 0)
     wj.epoch_explorer(drive, ev)
     _, erows = simulation.extraction_errors([routes["ml"]])
-    designs.design_from_errors(erows)
+    design_from_errors(erows)
     by_route = {"paper": {"L": [drive]}}
     jt.table_columns(by_route)
     jt.table_rows(by_route, "italiano2026_table1")

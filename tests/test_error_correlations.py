@@ -10,6 +10,7 @@ import pytest
 from tunnelkit.simulation.analysis import error_correlations, extraction_errors
 from tunnelkit.simulation.drives import DriveData
 from tunnelkit.tracking.javelin import PathMeasurements, designs
+from tunnelkit.tracking.javelin.measured import design_from_errors
 
 
 def _ar1(rng, r, sigma, n):
@@ -86,9 +87,9 @@ ROWS = [["los", 80, 2.0, 2.5, 40.0, 0.2, 3], ["all", 164, 9.0, 8.0, 33.0, 1.1, 8
 
 def test_the_sigmas_take_the_long_run_inflation():
     base = designs.ours_ml()
-    white = designs.design_from_errors(ROWS, base=base).config
+    white = design_from_errors(ROWS, base=base).config
     corr = {"phi": 0.6, "psi": {"r": -0.2, "pairs": 10}, "kappa": 0.99, "delta_d": float("nan")}
-    got = designs.design_from_errors(ROWS, base=base, correlation=corr).config
+    got = design_from_errors(ROWS, base=base, correlation=corr).config
     assert got.sigma_phi == pytest.approx(white.sigma_phi * 2.0)  # sqrt(1.6 / 0.4)
     assert got.sigma_psi == pytest.approx(white.sigma_psi)  # negative: white
     assert got.sigma_kappa == pytest.approx(white.sigma_kappa * np.sqrt(1.9 / 0.1))  # clipped
@@ -106,4 +107,4 @@ def test_the_sigmas_take_the_long_run_inflation():
 )
 def test_bad_correlations_are_named(corr, exc, match):
     with pytest.raises(exc, match=match):
-        designs.design_from_errors(ROWS, base=designs.ours_ml(), correlation=corr)
+        design_from_errors(ROWS, base=designs.ours_ml(), correlation=corr)

@@ -17,6 +17,7 @@ from tunnelkit.reproduce.javelin_tables import (
     table_rows,
 )
 from tunnelkit.tracking.javelin import designs
+from tunnelkit.tracking.javelin.measured import design_from_errors
 from tunnelkit.widgets.javelin import epoch_explorer, epoch_view
 
 BS = np.array([0.0, 0.0, 4.8])
@@ -246,7 +247,7 @@ def test_separated_drive_uses_the_same_tensors():
     _, erows_b = ex.extraction_errors([b])
     los_b = {r[0]: r for r in erows_b}["los"]
     assert err["los"]["phi [deg]"] < los_b[2] and err["los"]["kappa [m]"] < los_b[4]
-    cfg = designs.design_from_errors(erows)
+    cfg = design_from_errors(erows)
     assert cfg.config.sigma_kappa == pytest.approx(err["all"]["kappa [m]"])
     assert cfg.config.sigma_phi == pytest.approx(np.radians(err["all"]["phi [deg]"]))
     assert cfg.curvature == designs.ours_coherent().curvature

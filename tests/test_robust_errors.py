@@ -8,6 +8,7 @@ import pytest
 
 from tunnelkit.studies.robust_errors import MAD_TO_SIGMA, robust_design, robust_rows
 from tunnelkit.tracking.javelin import designs
+from tunnelkit.tracking.javelin.measured import design_from_errors
 
 QUANTITIES = ("phi", "psi", "kappa", "delta_d")
 
@@ -60,12 +61,12 @@ def test_robust_sigma_sees_the_core_and_counts_the_gross_apart():
     assert sigma_rows[-1][0] == "all" and sigma_rows[-1][1] == 6000 and sigma_rows[-1][-1] == 8
     assert sigma_rows[-1][3] == pytest.approx(MAD_TO_SIGMA * np.median(np.abs(allx - med_all)))
     d = robust_design(samples)
-    expect = designs.design_from_errors(sigma_rows, base=designs.ours_ml())
+    expect = design_from_errors(sigma_rows, base=designs.ours_ml())
     assert d.config.sigma_phi == pytest.approx(expect.config.sigma_phi)
     assert d.config.sigma_phi == pytest.approx(np.radians(sigma_rows[-1][2]))
     assert (
         d.config.sigma_phi
-        < designs.design_from_errors(
+        < design_from_errors(
             [
                 [
                     "all",

@@ -46,6 +46,7 @@ from tunnelkit.plots import (
 from tunnelkit.signal_route import SignalRoute, measurements_from_estimates
 from tunnelkit.simulation import collect_routes
 from tunnelkit.tracking.javelin import TeNFiLoc, designs, measurement_model
+from tunnelkit.tracking.javelin.measured import design_from_errors
 from tunnelkit.widgets import epoch_explorer
 
 tk.setup_notebook()
@@ -299,7 +300,7 @@ javelin_table_figure(ecols, erows, title="ML route: RMS measurement error per pa
 # our ML-route design assumes:
 
 # %%
-measured = designs.design_from_errors(erows)
+measured = design_from_errors(erows)
 sig = {}
 for name, d in (
     ("the paper (section 4.2)", designs.paper()),

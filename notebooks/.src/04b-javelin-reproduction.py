@@ -34,6 +34,7 @@ from tunnelkit.reproduce.javelin_tables import DEAD_RECKONING, radio_gains, tabl
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.simulation import collect_routes
 from tunnelkit.tracking.javelin import designs
+from tunnelkit.tracking.javelin.measured import design_from_errors
 
 tk.setup_notebook()
 
@@ -352,7 +353,7 @@ print(
 #    Does every step of our design help there too?
 # 2. Our ML-route design (`designs.ours_ml()`) took its measurement noise from a few LoS drives
 #    of a tuning seed. Set it instead from all the LoS drives of section 1
-#    (`designs.design_from_errors` on the table of section 5) and score JAVELIN-L on both
+#    (`design_from_errors` on the table of section 5) and score JAVELIN-L on both
 #    trajectories with both designs. Does more calibration data change the result? Mind what
 #    the comparison is: the refit is fitted on the very held-out drives it is scored on, which
 #    favours it — and a design chosen that way would leave the seed held out no longer.
@@ -381,7 +382,7 @@ assert sl_rows[2][1] < 0.5 * sl_rows[0][1], sl_rows
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
 # %%solution 04b.2
 # Solution 2
-refit = designs.design_from_errors(erows)
+refit = design_from_errors(erows)
 sol2 = {}
 for name, by_cond in (("straight", straight_ml), ("slalom", slalom_ml)):
     scores = sol2[name] = {

@@ -448,12 +448,12 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     """The design's tracker (:func:`~tunnelkit.design.montecarlo.javelin_config`: VUEs from the
     known surfaces, likelihood association, joint innovation test) with the measurement noise of
     ``record`` (:func:`design_errors`): fixed sigmas (the ``"all"`` row:
-    :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`, at their long-run value when
+    :func:`~tunnelkit.tracking.javelin.measured.design_from_errors`, at their long-run value when
     the record carries the errors' lag-1 correlation, as the shipped records do; the RMS as it
     is for a record without it) in place of each path's reported CRLB, which on this channel is thousands of times too
     small."""
     from ..tracking.javelin.arraydesign import array_design
-    from ..tracking.javelin.designs import design_from_errors
+    from ..tracking.javelin.measured import design_from_errors
     from .geometry import KINDS
 
     setup = _setup(setup)

@@ -9,6 +9,7 @@ from tqdm.auto import tqdm
 
 from .._validate import boolean, instance, sequence
 from ..tracking.javelin import designs
+from ..tracking.javelin.measured import CORRELATED
 from ..tracking.javelin.motion import motion_increment
 from ..tracking.javelin.roles import JavelinDesign
 from ..tracking.javelin.state import JavelinState
@@ -220,7 +221,7 @@ def extraction_errors(drives: list[DriveData]) -> tuple[list[str], list[list]]:
 
 #: the quantities of :func:`error_correlations` (the columns of :func:`extraction_errors`; the
 #: names ``design_from_errors(correlation=)`` reads)
-ERROR_QUANTITIES = designs.CORRELATED
+ERROR_QUANTITIES = CORRELATED
 
 
 def error_correlations(drives: list[DriveData]) -> dict[str, dict[str, float]]:
@@ -232,7 +233,7 @@ def error_correlations(drives: list[DriveData]) -> dict[str, dict[str, float]]:
     Returns ``{quantity: {"r": r, "pairs": n}}`` (``r`` NaN without pairs). An AR(1) error with
     this ``r`` averages over epochs as white noise of ``(1 + r) / (1 - r)`` times its variance
     (the long-run variance), which is what a tracker that takes the errors as white should be
-    told (:func:`~tunnelkit.tracking.javelin.designs.design_from_errors` ``correlation=``)."""
+    told (:func:`~tunnelkit.tracking.javelin.measured.design_from_errors` ``correlation=``)."""
     drives = sequence("drives", drives)
     sums = {q: np.zeros(4) for q in ERROR_QUANTITIES}  # sum xy, sum xx, sum yy, pairs
     for drive in drives:

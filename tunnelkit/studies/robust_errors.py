@@ -31,6 +31,7 @@ import numpy as np
 from .._validate import positive
 from ..simulation.analysis import ERROR_QUANTITIES
 from ..tracking.javelin import designs
+from ..tracking.javelin.measured import design_from_errors
 
 __all__ = ["MAD_TO_SIGMA", "robust_design", "robust_rows"]
 
@@ -69,7 +70,7 @@ def robust_rows(samples: dict, *, threshold: float = 3.0) -> tuple[list[str], li
     returns ``(columns, rows, sigma_rows)``. ``rows``: per kind and a last ``"all"`` row pooling
     every kind, for each quantity its median, robust sigma (``1.4826 MAD``), the number of gross
     errors (further than ``threshold`` robust sigmas from the median) and the RMS of the others.
-    ``sigma_rows``: the table :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`
+    ``sigma_rows``: the table :func:`~tunnelkit.tracking.javelin.measured.design_from_errors`
     reads (the columns of :func:`~tunnelkit.simulation.analysis.extraction_errors`), the robust
     sigma in place of the RMS."""
     samples = _check_samples(samples)
@@ -102,4 +103,4 @@ def robust_design(samples: dict, *, correlation: dict | None = None, threshold: 
     (the ``"all"`` row of :func:`robust_rows`), each inflated by ``correlation``
     (:func:`~tunnelkit.simulation.analysis.error_correlations`) as the traced design is."""
     _, _, sigma_rows = robust_rows(samples, threshold=threshold)
-    return designs.design_from_errors(sigma_rows, base=designs.ours_ml(), correlation=correlation)
+    return design_from_errors(sigma_rows, base=designs.ours_ml(), correlation=correlation)

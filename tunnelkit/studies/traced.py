@@ -62,6 +62,7 @@ from ..simulation.prefilter import (
     traced_measurements,
 )
 from ..tracking.javelin import designs
+from ..tracking.javelin.measured import design_from_errors
 
 __all__ = [
     "SIGMA_RUNS",
@@ -241,9 +242,9 @@ def traced_design(path=None):
     stored traced errors (:func:`traced_errors`, checked against the current scene; the ``"all"``
     row, each sigma inflated by the record's lag-1 error correlation when it has one, the
     long-run standard deviation of an error that repeats from epoch to epoch;
-    :func:`~tunnelkit.tracking.javelin.designs.design_from_errors`); to be fed the
+    :func:`~tunnelkit.tracking.javelin.measured.design_from_errors`); to be fed the
     ``"ml-traced"`` drives of :func:`simulate_traced`."""
     rec = traced_errors(path)
-    return designs.design_from_errors(
+    return design_from_errors(
         rec["rows"], base=designs.ours_ml(), correlation=rec.get("correlation")
     )

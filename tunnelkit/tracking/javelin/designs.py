@@ -18,14 +18,14 @@ factory                       what it is
 ============================  ==================================================================
 
 The array design's tracker (reported covariances, likelihood cost, measured births, the joint
-innovation test) is :func:`tunnelkit.tracking.javelin.arraydesign.array_design`.
+innovation test) is :func:`tunnelkit.tracking.javelin.arraydesign.array_design`; a design whose
+noise is a measured extraction error, :func:`tunnelkit.tracking.javelin.measured.design_from_errors`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import real, sequence
 from .associate import Associator
 from .manage import FixedBirth
 from .measurement import DelayCheck, DopplerClutter, VueCurvature
@@ -34,11 +34,8 @@ from .roles import JavelinDesign
 from .update import JointTestUpdater
 
 __all__ = [
-    "CORRELATED",
-    "MAX_CORRELATION",
     "ML_ERRORS_SEED0",
     "ablation_path",
-    "design_from_errors",
     "ours",
     "ours_coherent",
     "ours_ml",
@@ -113,65 +110,6 @@ def ours_ml(**overrides) -> JavelinDesign:
         sigma_delta_d=e["delta_d_m"],
         updater=JointTestUpdater(0.999),
     ).with_(**overrides)
-
-
-#: the largest lag-1 correlation :func:`design_from_errors` inflates by (a larger one is an
-#: error that hardly changes along the drive: a bias, which no white noise describes)
-MAX_CORRELATION = 0.9
-#: the quantities a ``correlation`` may name, in the order of the sigmas
-CORRELATED = ("phi", "psi", "kappa", "delta_d")
-
-
-def _inflation(correlation) -> np.ndarray:
-    """``sqrt((1 + r) / (1 - r))`` per quantity of :data:`CORRELATED` (1 where not given), ``r``
-    clipped to ``[0, MAX_CORRELATION]``."""
-    f = np.ones(len(CORRELATED))
-    if correlation is None:
-        return f
-    if not isinstance(correlation, dict):
-        raise TypeError(f"correlation: expected a dict quantity -> r, got {correlation!r:.60}")
-    unknown = set(correlation) - set(CORRELATED)
-    if unknown:
-        raise ValueError(f"correlation: unknown quantities {sorted(unknown)}; known {CORRELATED}")
-    for i, q in enumerate(CORRELATED):
-        r = correlation.get(q)
-        r = r.get("r") if isinstance(r, dict) else r
-        if r is None or (isinstance(r, float) and np.isnan(r)):
-            continue
-        r = float(real(f"correlation[{q!r}]", r))
-        if not -1.0 < r < 1.0:
-            raise ValueError(f"correlation[{q!r}]: a correlation lies in (-1, 1), got {r}")
-        r = min(max(r, 0.0), MAX_CORRELATION)
-        f[i] = np.sqrt((1.0 + r) / (1.0 - r))
-    return f
-
-
-def design_from_errors(
-    rows: list[list],
-    base: JavelinDesign | None = None,
-    *,
-    correlation: dict | None = None,
-) -> JavelinDesign:
-    """A design whose measurement noise is the measured extraction error: ``sigma_phi``,
-    ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d`` from the ``"all"`` row of
-    :func:`tunnelkit.simulation.extraction_errors`; every role and other number from ``base``
-    (default :func:`ours_coherent`). ``correlation``: each quantity's lag-1 error correlation ``r``
-    (:func:`tunnelkit.simulation.error_correlations`, ``{"phi", "psi", "kappa", "delta_d"}`` to
-    ``r`` or to ``{"r": r, ...}``): its sigma times ``sqrt((1 + r) / (1 - r))``, the long-run
-    standard deviation of an AR(1) error (what averaging over epochs leaves of it; ``r`` clipped
-    to ``[0, MAX_CORRELATION]``: a white model for a negative one, and a bias is not AR(1))."""
-    base = ours_coherent() if base is None else base
-    if not isinstance(base, JavelinDesign):
-        raise TypeError(f"base: expected a JavelinDesign, got {type(base).__name__}")
-    table = {r[0]: r for r in sequence("rows", rows)}
-    pooled = table.get("all")
-    if pooled is None:
-        raise ValueError("rows: expected the table of extraction_errors (an 'all' row)")
-    f = _inflation(correlation)
-    sig = [float(np.radians(pooled[2])), float(np.radians(pooled[3])), *map(float, pooled[4:6])]
-    sig = [float(v * fi) for v, fi in zip(sig, f, strict=True)]
-    out = base.with_(sigma_phi=sig[0], sigma_psi=sig[1], sigma_kappa=sig[2], sigma_delta_d=sig[3])
-    return out
 
 
 def ablation_path() -> dict[str, JavelinDesign]:
