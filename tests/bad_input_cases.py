@@ -189,21 +189,21 @@ def build_cases() -> list[Case]:
     c.append(
         Case(
             "specular_point[target=inf]",
-            lambda: _mod("geometry").specular_point([0.0, 0.0], [INF, 1.0], wall()),
+            lambda: _mod("reflection").specular_point([0.0, 0.0], [INF, 1.0], wall()),
             ("target",),
         )
     )
     c.append(
         Case(
             "specular_point[target beyond plane]",
-            lambda: _mod("geometry").specular_point([0.0, 0.0], [3.0, 9.0], wall()),
+            lambda: _mod("reflection").specular_point([0.0, 0.0], [3.0, 9.0], wall()),
             ("target",),
         )
     )
     _array_cases(
         c,
         "reflector_point",
-        lambda: _mod("geometry").reflector_point,
+        lambda: _mod("reflection").reflector_point,
         {"p_u": [10.0, 1.0, 1.0], "p_v": [10.0, 9.0, 1.0]},
         ["p_u", "p_v"],
     )

@@ -405,7 +405,7 @@ def _baselines():
     """Short valid calls of callables the teaching workflows do not reach (so their contracts
     are tested at all): geometry, propagation, channel pieces, bounds, verdicts, plots."""
     import tunnelkit as tk
-    from tunnelkit import budget, crlb, geometry, metrics, propagation
+    from tunnelkit import budget, crlb, geometry, metrics, propagation, reflection
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
     from tunnelkit.design import errormodel, intervals, mcrb, render, verdict
     from tunnelkit.design.arrayjob import javelin_config
@@ -434,7 +434,7 @@ def _baselines():
     tunnel.require_inside("p", p)
     tunnel.wall_distances(p)
     geometry.mirror(p, wall)
-    geometry.specular_point(bs, p, wall)
+    reflection.specular_point(bs, p, wall)
     geometry.spherical(np.array([1.0, 2.0, 3.0]))
     metrics.settled(np.arange(0.0, 30.0, 0.5))
     propagation.fresnel_te(5.0 - 0.5j, np.array([0.3, 0.9]))

@@ -24,7 +24,8 @@ from tunnelkit._validate import (
     vector,
 )
 from tunnelkit.budget import check_elements
-from tunnelkit.geometry import Plane, reflector_point
+from tunnelkit.geometry import Plane
+from tunnelkit.reflection import reflector_point
 from tunnelkit.tracking.javelin import PathMeasurements
 
 __all__ = ["GeometricTruth", "geometric_paths", "geometric_stream", "toy_drive", "toy_reflectors"]

@@ -197,7 +197,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "elementwise: one probability per SNR, of the same shape (none for none)",
     ),
     _doc(
-        r"geometry\.Plane\.\w+|tunnel2d\.Tunnel2D\.\w+|geometry\.(mirror|reflector_point|specular_point)",
+        r"geometry\.(Plane\.\w+|mirror)|tunnel2d\.Tunnel2D\.\w+|reflection\.(reflector_point|specular_point)",
         r"p|point|target|q|p_u|p_v",
         "shape",
         "points (..., dim): leading axes vectorise (the docstring's contract)",

@@ -9,7 +9,8 @@ from tunnelkit import doppler_drive as dv
 from tunnelkit.constants import C
 from tunnelkit.doppler_drive import drive as drive_model
 from tunnelkit.doppler_drive import measurement
-from tunnelkit.geometry import Plane, mirror, specular_point
+from tunnelkit.geometry import Plane, mirror
+from tunnelkit.reflection import specular_point
 from tunnelkit.scenarios import ScenarioError
 
 CLEAN = dict(dv.IDEAL)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tunnelkit import cli, fresnel, geometry
+from tunnelkit import cli, fresnel, geometry, reflection
 from tunnelkit.constants import C
 
 PAPER = dict(R=3.5, W=3.0, y_u=2.5, fc=5.9e9, eps_phi=0.15)
@@ -25,14 +25,14 @@ GEOS = [  # (R, W, y_u, z_u, fc)
 
 
 def brute_force_mismatch(pos: np.ndarray, R, W, y_u, z_u, fc) -> np.ndarray:
-    """Independent route: each antenna's own specular point (geometry.specular_point), the path
+    """Independent route: each antenna's own specular point (reflection.specular_point), the path
     UE -> wall -> antenna summed segment by segment; the SR model's reflector is the reference
     antenna's specular point, its path reflector -> antenna."""
     wall = geometry.Plane(np.array([0.0, 1.0, 0.0]), -W)
     ue = np.array([R, y_u, z_u])
-    s = geometry.specular_point(ue, pos, wall)  # (K, 3), one per antenna
+    s = reflection.specular_point(ue, pos, wall)  # (K, 3), one per antenna
     true_len = np.linalg.norm(s - ue, axis=-1) + np.linalg.norm(pos - s, axis=-1)
-    s0 = geometry.specular_point(ue, np.zeros(3), wall)
+    s0 = reflection.specular_point(ue, np.zeros(3), wall)
     sr_len = np.linalg.norm(pos - s0, axis=-1)
     lam = C / fc
     return 2 * np.pi / lam * ((true_len - true_len[0]) - (sr_len - sr_len[0]))
@@ -76,7 +76,7 @@ def test_reference_specular_point_is_eq32_and_geometry():
     assert ps[0] == pytest.approx(3.5 * 3.0 / (2 * 3.0 - 2.5), rel=1e-14)  # eq. 32
     wall = geometry.Plane(np.array([0.0, 1.0, 0.0]), -3.0)
     np.testing.assert_allclose(
-        ps, geometry.specular_point([3.5, 2.5, -1.0], np.zeros(3), wall), atol=1e-12
+        ps, reflection.specular_point([3.5, 2.5, -1.0], np.zeros(3), wall), atol=1e-12
     )
     np.testing.assert_allclose(fresnel.vue(3.5, 3.0, 2.5, -1.0), [3.5, 3.5, -1.0])
 

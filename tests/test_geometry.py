@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tunnelkit import geometry, tunnel2d
+from tunnelkit import reflection, tunnel2d
 from tunnelkit.geometry import Plane, line
 from tunnelkit.tunnel2d import Tunnel2D
 
@@ -48,7 +48,7 @@ def test_specular_path_length_equals_virtual_station_distance(c_bs, c_v, along):
     bs = t.from_tunnel_frame(np.array([0.0, c_bs]))
     veh = t.from_tunnel_frame(np.array([along, c_v]))
     for w in t.walls:
-        r = w.project(geometry.specular_point(bs, veh, w))  # lies on the wall
+        r = w.project(reflection.specular_point(bs, veh, w))  # lies on the wall
         assert abs(w.signed_distance(r)) < 1e-9
         folded = np.linalg.norm(r - bs) + np.linalg.norm(veh - r)
         assert folded == pytest.approx(np.linalg.norm(veh - w.mirror(bs)), rel=1e-12)
@@ -63,7 +63,7 @@ def test_reflector_point_eq45_on_bisector_and_on_bs_vue_line():
     pu = rng.uniform(-5, 5, (50, 3)) + np.array([20.0, 0.0, 1.0])
     wall = Plane(np.array([0.0, 1.0, 0.2]), -5.0)
     pv = wall.mirror(pu)
-    pr = geometry.reflector_point(pu, pv)
+    pr = reflection.reflector_point(pu, pv)
     assert np.all(np.abs(wall.signed_distance(pr)) < 1e-9)  # on the wall (the UE-VUE bisector)
     cross = np.cross(pr, pv)  # collinear with the origin (BS) and the VUE
     assert np.abs(cross).max() < 1e-9
@@ -81,9 +81,9 @@ def test_reflector_point_eq45_on_bisector_and_on_bs_vue_line():
         (lambda: line(1, np.nan, 0), "B: must be finite"),
         (lambda: Tunnel2D.from_lines((1, 0, 0), (0, 1, 0)), "parallel"),
         (lambda: Tunnel2D.from_lines((1, 0, 0), (2, 0, 0)), "zero width"),
-        (lambda: geometry.specular_point([0, 1], [0, -1], line(0, 1, 0)), "same side"),
-        (lambda: geometry.specular_point([0, 0], [0, 1], line(0, 1, 0)), "source: lies on"),
-        (lambda: geometry.reflector_point([1.0, 2.0, 3.0], [1.0, 2.0, 3.0]), "coincides"),
+        (lambda: reflection.specular_point([0, 1], [0, -1], line(0, 1, 0)), "same side"),
+        (lambda: reflection.specular_point([0, 0], [0, 1], line(0, 1, 0)), "source: lies on"),
+        (lambda: reflection.reflector_point([1.0, 2.0, 3.0], [1.0, 2.0, 3.0]), "coincides"),
         (lambda: line(1, 0, 0).mirror([1.0, 2.0, 3.0]), "p: expected points with 2"),
         (lambda: tunnel2d.virtual_stations([0, 0], []), "walls: need"),
     ],

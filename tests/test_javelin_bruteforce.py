@@ -5,7 +5,7 @@ import pytest
 from javelin_geometric import toy_reflectors
 
 from tunnelkit.crlb import numeric_jacobian, wrap_angle
-from tunnelkit.geometry import reflector_point
+from tunnelkit.reflection import reflector_point
 from tunnelkit.tracking.javelin import (
     FixedNoise,
     JavelinConfig,

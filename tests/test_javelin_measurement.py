@@ -3,7 +3,7 @@ import pytest
 from javelin_geometric import geometric_paths, toy_reflectors
 
 from tunnelkit.crlb import numeric_jacobian
-from tunnelkit.geometry import reflector_point
+from tunnelkit.reflection import reflector_point
 from tunnelkit.tracking.javelin import (
     JavelinWarning,
     PathMeasurements,

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import tunnelkit as tk
-from tunnelkit import arrays, geometry, propagation, signal_route, tunnels
+from tunnelkit import arrays, propagation, reflection, signal_route, tunnels
 from tunnelkit import scenarios as S
 from tunnelkit.constants import C
 
@@ -119,7 +119,7 @@ def test_specular_points_lie_on_the_right_surfaces(name, ue):
     # brute force: a surface reflects iff the mirror-image specular point lies on its rectangle
     expected = set()
     for f in tun.facets:
-        pt = geometry.specular_point(a0, ue, f.plane)
+        pt = reflection.specular_point(a0, ue, f.plane)
         if f.contains(pt, tol=1e-9):
             expected.add(f.name)
     assert traced == expected and "road" in expected and len(expected) >= 2

@@ -45,7 +45,8 @@ RANKS = {
     "schema": 0.5,
     "schemadoc": 0.6,  # the schema written out: TOML templates, the Markdown reference
     "geometry": 1,
-    "tunnel2d": 1.05,  # Jiang's 2-D tunnel and its virtual stations, on geometry's lines
+    "tunnel2d": 1.05,
+    "reflection": 1.05,  # where a path reflects off a plane (specular point, eq. 45), on geometry  # Jiang's 2-D tunnel and its virtual stations, on geometry's lines
     "odometry": 1,  # the V2X odometry messages as a model
     "reckoning": 1.1,  # dead reckoning on the odometry messages and its bound
     "crlb": 1,

@@ -24,7 +24,7 @@
 import numpy as np
 
 import tunnelkit as tk
-from tunnelkit import crlb, geometry, positioning
+from tunnelkit import crlb, positioning, reflection
 from tunnelkit.plots import line_figure, report_table, tunnel_topview
 from tunnelkit.widgets import crlb_explorer, crlb_figure
 
@@ -73,7 +73,7 @@ print("max |package - eq. 3| =", np.abs(vs - vs_eq3).max())
 traj = sc.trajectory(tunnel)
 vehicle = traj.position[0]
 for k, wall in enumerate(tunnel.walls):
-    r = geometry.specular_point(bs, vehicle, wall)
+    r = reflection.specular_point(bs, vehicle, wall)
     folded = np.linalg.norm(r - bs) + np.linalg.norm(vehicle - r)
     print(
         f"wall {k + 1}: reflection point {r.round(3)}, BS→wall→vehicle {folded:.6f} m, "

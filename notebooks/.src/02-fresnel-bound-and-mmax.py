@@ -27,7 +27,7 @@
 import numpy as np
 
 import tunnelkit as tk
-from tunnelkit import fresnel, geometry
+from tunnelkit import fresnel, geometry, reflection
 from tunnelkit.constants import C, wavelength
 from tunnelkit.plots import (
     derivation_figure,
@@ -78,7 +78,7 @@ fresnel_topview(10, R, W, y_u, fc).show()
 #
 # $$d_{v,0} = \sqrt{R^2 + (2W - y_u)^2}, \qquad d_{v,m} = \sqrt{R^2 + (2W - y_u - y_m)^2}.$$
 #
-# Check: fold each path at *its own* specular point on the wall (`geometry.specular_point`) and add
+# Check: fold each path at *its own* specular point on the wall (`reflection.specular_point`) and add
 # the two segments UE → wall → antenna; it must equal $d_{v,m}$.
 
 # %%
@@ -87,7 +87,7 @@ prof = fresnel.aperture_profile(M, R, W, y_u, fc)
 ue = np.array([R, y_u])
 ant = np.column_stack([np.zeros(M), prof.y])
 wall = geometry.line(0.0, 1.0, -W)  # y - W = 0
-s = geometry.specular_point(ue, ant, wall)
+s = reflection.specular_point(ue, ant, wall)
 folded = np.linalg.norm(s - ue, axis=1) + np.linalg.norm(ant - s, axis=1)
 err_2627 = np.abs(folded - prof.d_v).max()
 print(f"max |folded path - d_v,m| over {M} antennas: {err_2627:.2e} m")
@@ -127,7 +127,7 @@ for m in (1, 9, 14, 99):
 # $$\delta^{SR}_m = d_{p_0,m} - d_{p_0,0} \approx \frac{y_m^2 - 2W y_m}{2 x_{p_0}}. \tag{31}$$
 
 # %%
-p0 = geometry.specular_point(ue, np.zeros(2), wall)  # reflection point seen by antenna 0
+p0 = reflection.specular_point(ue, np.zeros(2), wall)  # reflection point seen by antenna 0
 print(f"eq. 32: x_p0 = {prof.x_p0:.6f} m, specular point from geometry: {p0.round(6)}")
 err31 = k * (prof.delta_sr_fresnel - prof.delta_sr)
 print("eq. 31 phase error at m = 1, 9, 99:", err31[[1, 9, 99]].round(3), "rad")

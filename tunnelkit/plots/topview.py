@@ -6,7 +6,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .._validate import finite_array, interval, text, vector
-from ..geometry import specular_point
+from ..reflection import specular_point
 from ..tunnel2d import Tunnel2D
 from .common import COLORS
 
