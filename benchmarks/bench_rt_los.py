@@ -23,7 +23,8 @@ over the drives); ``--by-elevation BINS`` adds the first sigma's design told eac
 by the measured elevation (:mod:`tunnelkit.studies.los_elevation`, the table built on seed 0's
 drives), ``--table FILE`` one built elsewhere (``--write-table``); ``--huber`` each sigma with
 the Huber-weighted update (:mod:`tunnelkit.studies.robust_update`); ``--cost`` the tracking time
-per epoch; ``--drives-cache DIR`` keeps the drives to score them again.
+per epoch; ``--drives-cache DIR`` keeps the drives to score them again; ``--errors-out`` writes
+seed 0's error record and ``--pooled-errors`` builds the tables from such records of other runs.
 """
 
 from __future__ import annotations
@@ -345,7 +346,19 @@ def main() -> None:
     )
     ap.add_argument("--table", default=None, help="use this table (JSON) instead of building one")
     ap.add_argument("--write-table", default=None, help="write the chosen table (JSON) here")
+    ap.add_argument(
+        "--errors-out", default=None, help="write seed 0's LoS error record here (.npy)"
+    )
+    ap.add_argument(
+        "--pooled-errors",
+        nargs="+",
+        default=None,
+        help="with --by-elevation: build the tables from these records (--errors-out of other "
+        "runs) instead of this run's drives",
+    )
     a = ap.parse_args()
+    if a.pooled_errors and not a.by_elevation:
+        ap.error("--pooled-errors: give --by-elevation (the bin counts)")
     if a.table and a.by_elevation:
         ap.error("--table and --by-elevation: give one (a table built elsewhere, or built here)")
     if a.write_table and not (a.table or a.by_elevation):
@@ -364,9 +377,14 @@ def main() -> None:
         case = (a.scenario, a.array)
         drives = _drives(case, a.runs, seed, a.workers, a.drives_cache)
         sigmas = a.sigmas if chosen is None or a.every_sigma else [chosen]
-        if tables is None and a.by_elevation:  # built on seed 0's drives, with their truth
-            errors = los_errors([dd["ml-all"] for dd in drives])
-            tables = {f"{b} bins, seed 0": elevation_sigmas(errors, b) for b in a.by_elevation}
+        if seed == 0 and a.errors_out:  # this scene's seed-0 record, to pool with others
+            np.save(a.errors_out, los_errors([dd["ml-all"] for dd in drives]))
+        if tables is None and a.by_elevation:  # built on seed 0's drives (or the pooled records)
+            if a.pooled_errors:
+                errors, src = np.vstack([np.load(f) for f in a.pooled_errors]), "pooled"
+            else:
+                errors, src = los_errors([dd["ml-all"] for dd in drives]), "seed 0"
+            tables = {f"{b} bins, {src}": elevation_sigmas(errors, b) for b in a.by_elevation}
         res = score(drives, seed, sigmas, a.start_sigma, a.los_gamma, a.fit_flags, a.starts,
                     tables, a.huber, a.sigmas[0])  # fmt: skip
         if chosen is None:  # chosen on seed 0, the lowest mean RMSE of the grid
