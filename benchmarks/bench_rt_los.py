@@ -43,6 +43,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.design import DesignSetup, drive_pcrlb
+from tunnelkit.geometry import spherical
 from tunnelkit.metrics import settled
 from tunnelkit.runner import run_trials
 from tunnelkit.signal_route import SignalRoute
@@ -128,8 +129,7 @@ def score(
     td = traced_design()
     designs = {}
     for s in sigmas:
-        az, el = np.radians(_pair(s))
-        designs[f"LoS only, {s} deg"] = los_design(float(az), td, sigma_elevation=float(el))
+        designs[f"LoS only, {s} deg"] = _los(s, td)
         # eq. 61's tolerance widened: the one path taken for the line of sight more often
         for g in los_gammas:
             d = designs[f"LoS only, {s} deg"].with_(los_gamma=float(g))
@@ -140,8 +140,7 @@ def score(
     plain = list(designs)
     flagged = [f"{k}, fit flags" for k in plain] if flags else []
     tables = tables or {}
-    az, el = np.radians(_pair(told_sigma or sigmas[0]))  # the kappa and d sigmas of its design
-    told = los_design(float(az), td, sigma_elevation=float(el)).with_(noise=ReportedNoise())
+    told = _los(told_sigma or sigmas[0], td).with_(noise=ReportedNoise())  # its kappa, d sigmas
     ranged = [f"LoS only, sigmas by elevation ({k})" for k in tables]
     out = {"traced design": [], "dead reckoning": [], **{k: [] for k in plain + flagged + ranged}}
     los_share, kept = [], []
@@ -197,14 +196,15 @@ def _told(los, table, design):
     return told_by_elevation(los, table, c.sigma_kappa, c.sigma_delta_d / np.sqrt(2))
 
 
-def tracker_cost(drives, table, repeats=5) -> dict:
+def tracker_cost(drives, table, sigma, repeats=5) -> dict:
     """Median over ``repeats`` of the tracking time per epoch [ms] of each tracker on ``drives``
-    (from the truth's first point; the extraction's cost is the drive's, the same for all)."""
+    (from the truth's first point; the extraction's cost is the drive's, the same for all), the
+    line of sight told ``sigma`` ("az[/el]" deg)."""
     td = traced_design()
-    one = los_design(float(np.radians(0.75)), td, sigma_elevation=float(np.radians(1.5)))
+    one = _los(sigma, td)
     cases = {
         "traced design": (lambda dd: dd["ml-traced"], td),
-        "LoS only, 0.75/1.5 deg": (lambda dd: los_only(dd["ml-all"]), one),
+        f"LoS only, {sigma} deg": (lambda dd: los_only(dd["ml-all"]), one),
         "the same, Huber update": (
             lambda dd: los_only(dd["ml-all"]),
             one.with_(updater=HuberUpdater()),
@@ -227,6 +227,12 @@ def tracker_cost(drives, table, repeats=5) -> dict:
             runs.append(1e3 * (time.perf_counter() - t0) / n)
         out[name] = float(np.median(runs))
     return out
+
+
+def _los(sigma: str, base):
+    """``base`` told the line of sight's sigmas ``sigma`` ("az[/el]" deg)."""
+    az, el = np.radians(_pair(sigma))
+    return los_design(float(az), base, sigma_elevation=float(el))
 
 
 def _pair(text: str) -> tuple[float, float]:
@@ -258,8 +264,7 @@ def table_reference(drive, table, start_sigma, scenario=SCENARIO) -> float:
     """:func:`settled_bound`'s figure with each epoch's sigmas read from ``table`` at the true
     line of sight's elevation (the told model of a design told the table)."""
     setup = DesignSetup.from_scenario(scenario)
-    v = drive.truth - drive.base_station
-    saz, sel = table.at(np.arctan2(v[:, 2], np.hypot(v[:, 0], v[:, 1])))
+    saz, sel = table.at(spherical(drive.truth - drive.base_station)[:, 1])
     info = np.concatenate([
         los_angle_information(drive.truth[k : k + 1], drive.base_station, saz[k], sel[k])
         for k in range(len(drive.truth))
@@ -417,7 +422,7 @@ def main() -> None:
                   f"({name}) | {tref:.3f} | |")  # fmt: skip
         if a.cost:
             table = next(iter(tables.values())) if tables else None
-            for name, ms in tracker_cost(drives, table).items():
+            for name, ms in tracker_cost(drives, table, a.sigmas[0]).items():
                 print(f"tracking cost, {name}: {ms:.2f} ms per epoch (median of 5)")
     print(f"\nangle sigma chosen on seed 0: {chosen} deg")
     if tables:

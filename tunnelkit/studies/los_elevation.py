@@ -25,6 +25,7 @@ import numpy as np
 
 from .._validate import finite_array, instance, integer, nonnegative, positive, positive_array
 from ..angles import wrap_angle
+from ..geometry import spherical
 from ..simulation import DriveData
 from .los_only import LOS_WINDOW_M, los_only
 
@@ -92,8 +93,7 @@ def los_errors(drives, window: float = LOS_WINDOW_M) -> np.ndarray:
     for i, drive in enumerate(drives):
         instance(f"drives[{i}]", drive, DriveData)
         los = los_only(drive, window)
-        v = los.truth - np.asarray(los.base_station, float)
-        az, el = np.arctan2(v[:, 1], v[:, 0]), np.arctan2(v[:, 2], np.hypot(v[:, 0], v[:, 1]))
+        az, el, _ = spherical(los.truth - np.asarray(los.base_station, float)).T
         for k, ep in enumerate(los.epochs):
             if ep is not None:
                 rows.append((ep.psi[0], wrap_angle(ep.phi[0] - az[k]), ep.psi[0] - el[k]))
