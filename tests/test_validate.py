@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 import tunnelkit as tk
+from tunnelkit import _domains as dom
 from tunnelkit import _validate as v
 
 
@@ -105,23 +106,23 @@ def test_domain_checks():
     np.testing.assert_array_equal(v.cosine("cos_i", [0.0, 1.0]), [0.0, 1.0])
     with pytest.raises(ValueError, match=r"cos_i: must lie in \[0, 1\], got 5.0"):
         v.cosine("cos_i", 5.0)
-    w = v.weights("weights", [[0.0, 1.0], [2.0, 2.0]])
+    w = dom.weights("weights", [[0.0, 1.0], [2.0, 2.0]])
     assert w.shape == (2, 2)
     for bad, match in (([0.5, -0.1], ">= 0"), ([0.0, 0.0], "positive sum"), ([], "at least one")):
         with pytest.raises(ValueError, match=f"weights: .*{match}"):
-            v.weights("weights", bad)
-    v.spd_matrix("F", [[2.0, 0.5], [0.5, 1.0]])
+            dom.weights("weights", bad)
+    dom.spd_matrix("F", [[2.0, 0.5], [0.5, 1.0]])
     for bad, match in (
         (-np.eye(2), "not positive definite"),
         ([[2.0, 1.0], [0.0, 2.0]], "not symmetric"),
         (np.ones((2, 3)), "square"),
     ):
         with pytest.raises(ValueError, match=f"F: .*{match}"):
-            v.spd_matrix("F", bad)
+            dom.spd_matrix("F", bad)
     with pytest.raises(ValueError, match="stations: need at least 2 stations, got 1"):
-        v.distinct_points("stations", [[0.0, 0.0]], dim=2)
+        dom.distinct_points("stations", [[0.0, 0.0]], dim=2)
     with pytest.raises(ValueError, match="stations: need at least 2 distinct stations"):
-        v.distinct_points("stations", [[1.0, 2.0], [1.0, 2.0]], dim=2)
+        dom.distinct_points("stations", [[1.0, 2.0], [1.0, 2.0]], dim=2)
     assert v.choice("kinds", "los", ("los", "wall")) == "los"
     with pytest.raises(TypeError, match="front_only: expected True or False"):
         v.boolean("front_only", "no")
@@ -302,8 +303,8 @@ def test_mmax_json_marks_a_capped_search(capsys, monkeypatch):
 
 
 def test_interval_refuses_nan_reversed_and_wrong_length():
-    assert v.interval("ranges", (2.0, 8.0), lower=1e-3) == (2.0, 8.0)
-    assert v.interval("speeds", np.array([-20, 20])) == (-20.0, 20.0)
+    assert dom.interval("ranges", (2.0, 8.0), lower=1e-3) == (2.0, 8.0)
+    assert dom.interval("speeds", np.array([-20, 20])) == (-20.0, 20.0)
     for bad, exc in [
         ("x", TypeError),
         (3.0, TypeError),
@@ -312,9 +313,9 @@ def test_interval_refuses_nan_reversed_and_wrong_length():
         ((5.0, 1.0), ValueError),
     ]:
         with pytest.raises(exc, match=r"^ranges"):
-            v.interval("ranges", bad)
+            dom.interval("ranges", bad)
     with pytest.raises(ValueError, match=r"^ranges: must be >= 0.001"):
-        v.interval("ranges", (0.0, 1.0), lower=1e-3)
+        dom.interval("ranges", (0.0, 1.0), lower=1e-3)
 
 
 def test_instance_names_the_parameter_and_the_class():

@@ -33,6 +33,7 @@ RANKS = {
     "_validate": 0,
     "_lazy": 0,  # a package's names loaded on first use (PEP 562)
     "_checks": 0.25,  # more checks of the validation layer, built on _validate
+    "_domains": 0.25,  # checks of structured arrays (weights, SPD matrices, ranges), on _validate
     "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
     "_parallel": 0.3,  # where trials run (workers or a scheduler address), checked once
     "_version": 0,  # the package version, imports nothing

@@ -23,8 +23,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ._domains import spd_matrix
 from ._physical import MIN_SIGMA
-from ._validate import callable_, finite_array, integer, positive, spd_matrix, text
+from ._validate import callable_, finite_array, integer, positive, text
 from .angles import wrap_angle, wrap_angle_unchecked
 from .budget import check_elements
 

@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._domains import distinct_points
 from ._physical import MAX_RANGE_M
-from ._validate import distinct_points, finite_array, integer, rng_or_error
+from ._validate import finite_array, integer, rng_or_error
 from .budget import check_elements
 from .crlb import station_sigmas, toa_doa
 

@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._domains import interval
 from .._physical import speeds as check_speeds
-from .._validate import instance, integer, interval, nonnegative, real, record, rng_or_error
+from .._validate import instance, integer, nonnegative, real, record, rng_or_error
 from ..arrays import check_element_positions, ura
 from ..budget import check_elements
 from ..channel import SRSConfig, add_noise

@@ -11,7 +11,8 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .. import fresnel
-from .._validate import finite_array, instance, integer, positive, positive_array, text
+from .._domains import positive_array
+from .._validate import finite_array, instance, integer, positive, text
 from ..constants import wavelength
 from ..fresnel.bounds import carrier_tolerance, wall_geometry
 from .common import COLORS

@@ -9,11 +9,11 @@ import numpy as np
 import plotly.graph_objects as go
 
 from .._checks import attributes
+from .._domains import nonnegative_array
 from .._validate import (
     choice,
     finite_array,
     integer,
-    nonnegative_array,
     sequence,
     text,
     vector,

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
-from .._validate import finite_array, interval, text, vector
+from .._domains import interval
+from .._validate import finite_array, text, vector
 from ..reflection import specular_point
 from ..tunnel2d import Tunnel2D
 from .common import COLORS

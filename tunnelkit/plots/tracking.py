@@ -9,7 +9,8 @@ import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
 from .._checks import attributes
-from .._validate import finite_array, integer, nonnegative_array, positive, sequence, text
+from .._domains import nonnegative_array
+from .._validate import finite_array, integer, positive, sequence, text
 from .common import COLORS, figure_inputs, line_figure, reveal_overlaps
 from .tables import TableFigure, table
 from .topview import tunnel_topview

@@ -10,7 +10,8 @@ import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
 from .._checks import attributes
-from .._validate import finite_array, integer, interval, nonnegative, sequence, text, vector
+from .._domains import interval
+from .._validate import finite_array, integer, nonnegative, sequence, text, vector
 from .common import figure_inputs
 from .tables import TableFigure, table
 

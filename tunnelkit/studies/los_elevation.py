@@ -23,7 +23,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, nonnegative, positive, positive_array
+from .._domains import positive_array
+from .._validate import finite_array, instance, integer, nonnegative, positive
 from ..angles import wrap_angle
 from ..geometry import spherical
 from ..simulation import DriveData

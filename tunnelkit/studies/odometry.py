@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, positive, positive_array, record, sequence
+from .._domains import positive_array
+from .._validate import finite_array, instance, integer, positive, record, sequence
 from ..odometry import MODELS, Odometry
 from ..reckoning import dead_reckoning, dead_reckoning_bound
 

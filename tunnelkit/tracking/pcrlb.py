@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import boolean, finite_array, spd_matrix
+from .._domains import spd_matrix
+from .._validate import boolean, finite_array
 
 __all__ = ["measurement_information", "pcrlb", "pcrlb_position_rmse", "vs_pcrlb"]
 

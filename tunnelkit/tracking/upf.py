@@ -39,6 +39,7 @@ import numpy as np
 from filterpy.kalman import MerweScaledSigmaPoints
 
 from .._checks import real_array
+from .._domains import weights as check_weights
 from .._validate import (
     finite_array,
     integer,
@@ -48,7 +49,6 @@ from .._validate import (
     real,
     rng_or_error,
 )
-from .._validate import weights as check_weights
 from ..budget import check_elements
 from .cv import STATE_DIM
 from .registry import register
