@@ -43,6 +43,7 @@ def design_modes():
     from tunnelkit.channel import DiffuseSpec
     from tunnelkit.constants import C
     from tunnelkit.design.mcrb import EtaModes
+    from tunnelkit.design.wideband import wideband_score, wideband_terms
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
     cfg = setup.config
@@ -61,7 +62,7 @@ def design_modes():
     modes = EtaModes(s_loc, pos, alpha, mu_f, mu_t, mask, cfg.fc, 16, 4)
     modes.fim(cfg.noise_power)
     modes.assemble(*modes.grams)
-    modes.wideband_score(cfg.tone_spacing, modes.wideband_terms(cfg.tone_spacing))
+    wideband_score(modes, cfg.tone_spacing, wideband_terms(modes, cfg.tone_spacing))
     modes.diffuse_gram(DiffuseSpec(0.1), cfg.tone_spacing, np.zeros(T))
 
 

@@ -123,7 +123,9 @@ def _chunks(setup, fr: _Frame, imp: DesignImpairments, frame: str = "cartesian")
             G = md.diffuse_gram(spec, cfg.tone_spacing, tau0).real
             out["E"] = 2.0 / s2**2 * p_d[:, None, None] * G
         if imp.spatial_wideband and not imp.wideband_model:
-            out["s_wb"] = 2.0 / s2 * md.wideband_score(cfg.tone_spacing).real
+            from .wideband import wideband_score  # loaded when the term is in, not modelled
+
+            out["s_wb"] = 2.0 / s2 * wideband_score(md, cfg.tone_spacing).real
         if imp.phase_error_deg > 0 or imp.gain_error_db > 0:
             S = md.calibration_scores()
             out["S_ph"] = 2.0 / s2 * (1j * S).real

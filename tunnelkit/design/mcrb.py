@@ -4,8 +4,9 @@ estimator that fits eq. 1 to data with a calibration error, the spatial-wideband
 diffuse multipath.
 
 :class:`EtaModes` holds the Jacobian's three modes (array, tones, symbols) and each
-perturbation's scores; :func:`scaled_inverse` (Jacobi-scaled inverses of stacked information
-matrices) and :func:`radial_basis` (azimuth, elevation and range directions) are its helpers.
+perturbation's scores (the spatial-wideband term's: :mod:`tunnelkit.design.wideband`);
+:func:`scaled_inverse` (Jacobi-scaled inverses of stacked information matrices) and
+:func:`radial_basis` (azimuth, elevation and range directions) are its helpers.
 
 How it works: docs/internals/design.md.
 """
@@ -21,15 +22,12 @@ from ..budget import check_elements
 from ..channel import DiffuseSpec
 from ..constants import C
 
-__all__ = ["FRAMES", "WB_TOL", "EtaModes", "radial_basis", "scaled_inverse"]
+__all__ = ["FRAMES", "EtaModes", "radial_basis", "scaled_inverse"]
 
 #: the coordinates of each path's wave origin in ``eta`` (:class:`EtaModes`): ``"cartesian"``
 #: the local frame's ``s_x, s_y, s_z``; ``"radial"`` displacements along the path's own
 #: azimuth, elevation and range directions (:func:`radial_basis`)
 FRAMES = ("cartesian", "radial")
-
-#: truncation of the spatial-wideband series (relative size of the first term left out)
-WB_TOL = 1e-13
 
 
 def _pair(mu: np.ndarray, n: int) -> np.ndarray:
@@ -51,7 +49,7 @@ def _mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return out
 
 
-def _gram(X: np.ndarray, Y: np.ndarray | None = None) -> np.ndarray:
+def gram(X: np.ndarray, Y: np.ndarray | None = None) -> np.ndarray:
     """``X[t]^H Y[t]`` for every ``t``."""
     return _mm(np.conj(X).transpose(0, 2, 1), X if Y is None else Y)
 
@@ -171,7 +169,7 @@ class EtaModes:
     def grams(self):
         """``X^H X``, ``F^H F``, ``T^H T`` (cached)."""
         if self._grams is None:
-            self._grams = (_gram(self.X), _gram(self.F2), _gram(self.T2))
+            self._grams = (gram(self.X), gram(self.F2), gram(self.T2))
         return self._grams
 
     def assemble(self, Gs, Gf, Gt) -> np.ndarray:
@@ -203,49 +201,6 @@ class EtaModes:
         Hm = _mm(W, self.a.transpose(0, 2, 1))  # sum_l (...) alpha_l a_lm: (T, 7L, M)
         Xs = np.conj(self.X[:, :, self.si]).transpose(0, 2, 1)  # (T, 7L, M)
         return np.conj(self.coef)[:, :, None] * Xs * Hm
-
-    def wideband_terms(self, tone_spacing: float) -> int:
-        """Number of series terms the spatial-wideband ``delta`` needs (``WB_TOL``)."""
-        tone_step("tone_spacing", tone_spacing)
-        eps = 2 * np.pi * tone_spacing * np.abs(self.offset).max() / C
-        x = 0.5 * (self.n_tones - 1) * eps
-        n, term = 0, 1.0
-        while term > WB_TOL and n < 200:
-            n += 1
-            term *= x / n
-        return n
-
-    def wideband_score(self, tone_spacing: float, n_terms: int | None = None) -> np.ndarray:
-        """``J^H delta`` (T, 7L) complex of the spatial-wideband term (series in the tone's
-        offset from the band centre, ``n_terms`` terms, :meth:`wideband_terms` by default)."""
-        tone_step("tone_spacing", tone_spacing)
-        if n_terms is not None:
-            integer("n_terms", n_terms, minimum=1, maximum=200)
-        N = self.wideband_terms(tone_spacing) if n_terms is None else int(n_terms)
-        sc = 0.5 * (self.n_tones - 1)
-        eps = 2 * np.pi * tone_spacing * self.offset / C  # (T, M, L)
-        n = np.arange(N + 1)
-        fact = np.cumprod(np.concatenate([[1.0], np.arange(1, N + 1)]))
-        # spatial: alpha_l a_lm eps^n; frequency: (-j (s - s_c))^n / n! f_l
-        T, M, L = eps.shape
-        x = np.empty((T, M, L, N + 1), complex)
-        x[..., 0] = self.alpha[:, None, :] * self.a
-        for k in range(1, N + 1):
-            x[..., k] = x[..., k - 1] * eps
-        ds = np.arange(self.n_tones) - sc
-        q = (-1j * ds[:, None]) ** n / fact  # (Nf, N+1)
-        y = self.F2[:, :, 0::2, None] * q[None, :, None, :]  # (T, Nf, L, N+1)
-        # one BLAS product per mode: (X^H x) (T, 4L, L, N+1) and (F^H y) (T, 2L, L, N+1)
-        PX = _gram(self.X, x.reshape(T, M, -1)).reshape(T, -1, L, N + 1)
-        PF = _gram(self.F2, y.reshape(T, self.n_tones, -1)).reshape(T, -1, L, N + 1)
-        col = 2 * np.arange(L)
-        _, Gf, Gt = self.grams
-        # the exact factor minus one: the series less the unperturbed atom
-        PX0 = _gram(self.X, self.alpha[:, None, :] * self.a)
-        S = np.einsum("tiln,tiln->til", PX[:, self.si], PF[:, self.fi])
-        S = S - PX0[:, self.si] * Gf[:, self.fi][:, :, col]
-        S = S * Gt[:, self.ti][:, :, col]
-        return np.conj(self.coef) * S.sum(axis=2)
 
     def diffuse_gram(self, spec: DiffuseSpec, tone_spacing: float, tau0) -> np.ndarray:
         """``J^H C_D J / P_D`` (T, 7L, 7L) complex for unit diffuse power starting at delay
