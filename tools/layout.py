@@ -36,6 +36,7 @@ RANKS = {
     "_domains": 0.25,  # checks of structured arrays (weights, SPD matrices, ranges), on _validate
     "_physical": 0.3,  # the hard physical ranges (a carrier, a vehicle's speed), on _validate
     "_parallel": 0.3,  # where trials run (workers or a scheduler address), checked once
+    "_scheduler": 0.1,  # a running Dask scheduler's address, checked (imports nothing of ours)
     "_version": 0,  # the package version, imports nothing
     "constants": 0.5,
     "angles": 0.5,  # angles wrapped to (-pi, pi], the bearings' innovations

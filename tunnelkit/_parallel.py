@@ -5,8 +5,6 @@ options does not load it."""
 
 from __future__ import annotations
 
-from urllib.parse import urlsplit
-
 from ._validate import integer
 
 __all__ = ["parallel_options"]
@@ -25,38 +23,7 @@ def parallel_options(
     if workers is not None:
         workers = integer("workers", workers, minimum=1)
     if scheduler is not None:
-        scheduler = _scheduler_address(scheduler)
+        from ._scheduler import scheduler_address  # the address parsed when one is given
+
+        scheduler = scheduler_address(scheduler)
     return workers, scheduler
-
-
-_SCHEMES = ("tcp", "tls", "ws", "wss")
-
-
-def _scheduler_address(address) -> str:
-    if not isinstance(address, str):
-        raise TypeError(
-            f"scheduler: expected an address such as 'tcp://HOST:8786', got {address!r}"
-        )
-    text = address.strip()
-    full = text if "://" in text else f"tcp://{text}"
-    bad = ValueError(
-        f"scheduler: expected an address such as 'tcp://HOST:8786' "
-        f"(scheme one of {', '.join(_SCHEMES)}), got {address!r}"
-    )
-    try:
-        parts = urlsplit(full)
-        port = parts.port
-    except ValueError as exc:
-        raise bad from exc
-    if (
-        parts.scheme not in _SCHEMES
-        or not parts.hostname
-        or port is None
-        or port == 0
-        or parts.path not in ("", "/")
-        or parts.query
-        or parts.fragment
-        or parts.username
-    ):
-        raise bad
-    return full.rstrip("/")
