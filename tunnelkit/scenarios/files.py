@@ -10,9 +10,6 @@ import re
 import tomllib
 from pathlib import Path
 
-import numpy as np
-
-from ..constants import wavelength
 from ..schema import ScenarioError, validate
 from .checks import check_placement
 from .model import Scenario
@@ -140,7 +137,9 @@ def scenario_from_dict(raw: dict, path: str | os.PathLike = "<dict>") -> Scenari
     for mod in sections.get("requires", []):
         require(mod, where)
     if family == "user":
-        _derive_user(sections, raw, where)
+        from .userfile import derive_user  # the user family's friendlier keys, for its files only
+
+        derive_user(sections, raw, where)
     sc = Scenario(
         name=sections["name"],
         paper=sections.get("paper", ""),
@@ -166,32 +165,6 @@ def _check_depth(raw: dict, where: str) -> None:
             )
         items = node.values() if isinstance(node, dict) else node
         stack.extend((v, depth + 1) for v in items if isinstance(v, dict | list | tuple))
-
-
-def _derive_user(sec: dict, raw: dict, where: str) -> None:
-    """Fill the keys the shared builders read from a ``user`` file's friendlier ones."""
-    radio = sec["radio"]
-    lam = float(wavelength(radio["fc"]))
-    for i, (arr, given) in enumerate(
-        zip(sec["base_station"]["arrays"], raw["base_station"]["arrays"])
-    ):
-        if "spacing_m" in given and "spacing_wavelengths" in given:
-            raise ScenarioError(
-                f"{where}: 'base_station.arrays[{i}].spacing_m' and '.spacing_wavelengths' both "
-                "given; keep one"
-            )
-        arr["elevation_deg"] = -arr["tilt_deg"]
-        arr["spacing"] = (
-            arr["spacing_m"] if "spacing_m" in arr else arr["spacing_wavelengths"] * lam
-        )
-    if "n_rb" not in radio:
-        n_rb = int(np.floor(0.983 * radio["bandwidth"] / (12 * radio["scs"]) + 1e-9))
-        if n_rb < 1:
-            raise ScenarioError(
-                f"{where}: 'radio.bandwidth' {radio['bandwidth']:g} Hz holds no resource block of "
-                f"12 subcarriers at radio.scs = {radio['scs']:g} Hz"
-            )
-        radio["n_rb"] = n_rb
 
 
 def check_all(paths=None) -> list[tuple[str, str | None]]:
