@@ -714,11 +714,12 @@ def _odometry():
     # a scenario's [odometry] (the Mont Blanc preset declares a car's), and a design told it
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.scenarios import load_scenario
+    from tunnelkit.scenarios.odometry import odometry_from_scenario
     from tunnelkit.studies.los_only import los_angle_information, los_path
 
     los_angle_information(np.array([[20.0, -1.5, 1.5]]), np.array([0.0, 0.0, 6.0]), 0.02)
     los_path(np.array([10.4, 10.1]), np.array([0.1, -0.1]), 0.3)
-    car = Odometry.from_scenario(load_scenario("mont-blanc-28ghz"))
+    car = odometry_from_scenario(load_scenario("mont-blanc-28ghz"))
     assert car.label == "automotive"
     javelin_config({"d": 0.01, "direction": 0.001, "kappa": 1.0}, 0.0, None, car)
 

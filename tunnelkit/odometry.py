@@ -10,7 +10,7 @@ and drifts with its angle random walk), messages come at a rate and some are los
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -108,28 +108,6 @@ class Odometry:
         """The paper's model: white noise only (0.2 m/s, 1 deg by default), a message per epoch."""
         return cls(speed_noise=speed_noise, heading_noise=heading_noise)
 
-    @classmethod
-    def from_scenario(cls, scenario) -> Odometry:
-        """The scenario's ``[odometry]`` section: its ``model`` (a name of :data:`MODELS`) with the
-        terms it gives replaced (angles in degrees, the drift in deg/sqrt(h), the yaw-rate bias
-        in deg/h, ``rate_hz = 0`` a message per epoch); a scenario without the section drives
-        on the paper's white model (:data:`WHITE`)."""
-        sections = getattr(scenario, "sections", None)
-        if not isinstance(sections, dict):
-            raise TypeError(
-                f"scenario: expected a loaded scenarios.Scenario, got {type(scenario).__name__}"
-            )
-        sec = sections.get("odometry")
-        if sec is None:
-            return WHITE
-        kw = {}
-        for key, (name, scale) in _FILE_KEYS.items():
-            if key in sec:
-                kw[name] = float(sec[key]) * scale
-        if "rate" in kw and kw["rate"] == 0.0:
-            kw["rate"] = None
-        return replace(MODELS[sec["model"]], **kw)
-
     @property
     def label(self) -> str:
         """The name of :data:`MODELS` this model is, or ``"custom"``."""
@@ -193,19 +171,6 @@ AUTOMOTIVE = Odometry(
 
 #: the named models (``tunnelkit reproduce javelin-table1|2 --odometry NAME``)
 MODELS = {"white": WHITE, "automotive": AUTOMOTIVE}
-
-
-#: a scenario file's ``[odometry]`` keys: the :class:`Odometry` field each sets, and its unit
-_FILE_KEYS = {
-    "speed_scale": ("speed_scale", 1.0),
-    "speed_noise": ("speed_noise", 1.0),
-    "heading_bias_deg": ("heading_bias", float(np.radians(1.0))),
-    "heading_drift_deg_per_sqrt_h": ("heading_drift", float(np.radians(1.0) / 60.0)),
-    "yaw_rate_bias_deg_per_h": ("yaw_rate_bias", float(np.radians(1.0) / 3600.0)),
-    "heading_noise_deg": ("heading_noise", float(np.radians(1.0))),
-    "rate_hz": ("rate", 1.0),
-    "dropout": ("dropout", 1.0),
-}
 
 
 def epoch_times(t) -> np.ndarray:

@@ -90,8 +90,11 @@ class Scenario:
 
     def odometry(self) -> Odometry:
         """The model of the vehicle's speed and heading messages from ``[odometry]``
-        (:meth:`tunnelkit.odometry.Odometry.from_scenario`; without it the paper's white model)."""
-        return Odometry.from_scenario(self)
+        (:func:`tunnelkit.scenarios.odometry.odometry_from_scenario`; without it the paper's white
+        model)."""
+        from .odometry import odometry_from_scenario  # read for a scenario with the section only
+
+        return odometry_from_scenario(self)
 
     def noise_levels(self) -> list[tuple[float, float]]:
         """``[(sigma_theta [rad], sigma_d [m]), ...]`` from ``[noise] levels`` given in (deg, m)."""

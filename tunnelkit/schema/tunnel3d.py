@@ -179,7 +179,7 @@ RAYTRACING = Table(
 )
 
 
-#: the V2X speed and heading messages' model (``tunnelkit.odometry.Odometry.from_scenario``): a
+#: the V2X speed and heading messages' model (``tunnelkit.scenarios.odometry``): a
 #: named model, then any of its terms replaced; the figures in the units automotive data sheets use
 ODOMETRY = Table(
     (
