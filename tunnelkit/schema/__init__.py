@@ -22,8 +22,8 @@ _MOVED = {
     "JIANG": "jiang",
     "HALILI": "halili",
     "ITALIANO": "tunnel3d",
-    "USER": "tunnel3d",
-    "USER_SHAPES": "tunnel3d",
+    "USER": "user",
+    "USER_SHAPES": "user",
 }
 
 

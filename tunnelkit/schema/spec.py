@@ -319,7 +319,7 @@ _FAMILY_SPECS = {
     "jiang2023": ("jiang", "JIANG"),
     "italiano2026": ("tunnel3d", "ITALIANO"),
     "halili2022": ("halili", "HALILI"),
-    "user": ("tunnel3d", "USER"),
+    "user": ("user", "USER"),
 }
 
 
