@@ -641,7 +641,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "kappa = 3 - n < 0 is the classic choice",
     ),
     _doc(
-        r"channel\.tensor_snapshot|signal_route\.measurements\.measure_epoch"
+        r"signal_route\.(raytraced\.tensor_snapshot|measurements\.measure_epoch)"
         r"|signal_route\.route\.SignalRoute\.raytraced_snapshot",
         r"paths",
         "empty",
