@@ -191,7 +191,7 @@ def _signal_route():
         n0,
         0.1,
     )
-    from tunnelkit.propagation import second_order_paths
+    from tunnelkit.propagation.second_order import second_order_paths
 
     traj = route.trajectory
     second_order_paths(route.tunnel, arr, traj.position[10], traj.velocity[10], fc=route.config.fc)

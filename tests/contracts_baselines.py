@@ -100,12 +100,13 @@ def route_studies():
     from tunnelkit.extraction import extract_paths
     from tunnelkit.plots import efficiency as pef
     from tunnelkit.plots import tunnel3d as t3
+    from tunnelkit.signal_route.raytraced import tensor_snapshot
 
     route = tiny_route()
     rng = np.random.default_rng(0)
     arr, paths = route.paths(6)
     H0 = channel.channel_tensor(paths, route.config)
-    snap = channel.tensor_snapshot(H0, route.config, rng, paths=paths)
+    snap = tensor_snapshot(H0, route.config, rng, paths=paths)
     evaluation.path_rows(paths)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

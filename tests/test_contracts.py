@@ -419,13 +419,13 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no iterations recorded (the default); no failed test (the fit passed)",
     ),
     _doc(
-        r"propagation\.paths\.Path",
+        r"propagation\.path\.Path",
         r"surface",
         "empty",
         "the direct path reflects off no surface",
     ),
     _doc(
-        r"propagation\.paths\.Path",
+        r"propagation\.path\.Path",
         r"range_rate|velocity|doppler",
         "negative",
         "signed: a receding source has a negative velocity and Doppler shift",
@@ -641,7 +641,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "kappa = 3 - n < 0 is the classic choice",
     ),
     _doc(
-        r"channel\.tensor_snapshot|signal_route\.measurements\.measure_epoch"
+        r"signal_route\.(raytraced\.tensor_snapshot|measurements\.measure_epoch)"
         r"|signal_route\.route\.SignalRoute\.raytraced_snapshot",
         r"paths",
         "empty",

@@ -173,7 +173,7 @@ def _epoch(array="10x10", k=3, seed=2026):
 def test_reported_covariance_is_the_bound_at_the_estimate_mapped_to_world_angles():
 
     from tunnelkit.extraction import estimate_crlb, path_crlb
-    from tunnelkit.signal_route import reported_covariance
+    from tunnelkit.signal_route.covariance import reported_covariance
 
     route, ep = _epoch()
     arr, est, m = ep.array, ep.estimates, ep.measurements

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from tunnelkit import channel, propagation, rt
+from tunnelkit.propagation.second_order import second_order_paths
 from tunnelkit.signal_route import RouteOptions, SignalRoute
 from tunnelkit.simulation import drives
 
@@ -14,7 +15,7 @@ def test_second_order_paths_in_the_model():
     k = 12
     base = SignalRoute.from_scenario("italiano2026-straight")
     arr, first = base.paths(k)
-    every = propagation.second_order_paths(
+    every = second_order_paths(
         base.tunnel,
         arr,
         base.trajectory.position[k],

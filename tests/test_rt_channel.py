@@ -23,6 +23,7 @@ from tunnelkit.rt.settings import MATERIALS, RTSettings
 from tunnelkit.scenarios import ScenarioError
 from tunnelkit.schema import tunnel3d
 from tunnelkit.signal_route import SignalRoute
+from tunnelkit.signal_route.raytraced import tensor_snapshot
 
 SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
 needs_sionna = pytest.mark.skipif(SKIP_RT, reason="TUNNELKIT_SKIP_RT=1")
@@ -203,15 +204,15 @@ def test_tensor_snapshot_equals_synthesize():
     paths = propagation.trace_paths(tun, arr, traj.position[3], traj.velocity[3], fc=cfg.fc)
     H0 = channel.channel_tensor(paths, cfg) / np.sqrt(cfg.tx_power)
     a = channel.synthesize(paths, cfg, np.random.default_rng(5), clock_bias=37e-9)
-    b = channel.tensor_snapshot(H0, cfg, np.random.default_rng(5), paths=paths, clock_bias=37e-9)
+    b = tensor_snapshot(H0, cfg, np.random.default_rng(5), paths=paths, clock_bias=37e-9)
     np.testing.assert_allclose(b.H, a.H, rtol=0, atol=1e-9 * np.abs(a.H).max())
     assert b.clock_bias == a.clock_bias and b.noise_power == a.noise_power
     # the clock bias drawn from rng as synthesize draws it
     a = channel.synthesize(paths, cfg, np.random.default_rng(6))
-    b = channel.tensor_snapshot(H0, cfg, np.random.default_rng(6), paths=paths)
+    b = tensor_snapshot(H0, cfg, np.random.default_rng(6), paths=paths)
     assert a.clock_bias == b.clock_bias
     with pytest.raises(ValueError, match="H0"):
-        channel.tensor_snapshot(H0[0], cfg, np.random.default_rng(0))
+        tensor_snapshot(H0[0], cfg, np.random.default_rng(0))
 
 
 # --- the switch ----------------------------------------------------------------------------------

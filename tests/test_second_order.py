@@ -9,6 +9,7 @@ from scipy.optimize import minimize
 import tunnelkit as tk
 from tunnelkit import propagation as pr
 from tunnelkit.constants import C
+from tunnelkit.propagation.second_order import second_order_paths
 
 
 def _setup(k):
@@ -40,7 +41,7 @@ def _shortest_via(s1, s2, ue, a0):
 @pytest.mark.parametrize("k", [0, 12, 25])
 def test_second_order_paths_are_the_shortest_double_bounces(k):
     tun, arr, ue, vel, fc = _setup(k)
-    second = pr.second_order_paths(tun, arr, ue, vel, fc=fc)
+    second = second_order_paths(tun, arr, ue, vel, fc=fc)
     assert len(second) >= 3  # ceiling-road, road-ceiling, an RRM or a wall pair
     by_name = {s.name: s for s in tun.surfaces}
     for p in second:
@@ -81,7 +82,7 @@ def test_second_order_finds_every_double_bounce():
     within 0.1 mm of a surface's edge (a bounce into the corner between two facets) may go
     either way."""
     tun, arr, ue, vel, fc = _setup(12)
-    found = {p.surface for p in pr.second_order_paths(tun, arr, ue, vel, fc=fc)}
+    found = {p.surface for p in second_order_paths(tun, arr, ue, vel, fc=fc)}
     inside, edge = set(), set()
     for s1 in tun.surfaces:
         for s2 in tun.surfaces:
@@ -114,7 +115,7 @@ def test_trace_paths_order_two_keeps_the_first_order_untouched():
     extra = two[len(one) :]
     assert extra and all(p.kind == pr.SECOND_ORDER for p in extra)
     assert [p.surface for p in extra] == [
-        p.surface for p in pr.second_order_paths(tun, arr, ue, vel, fc=fc)
+        p.surface for p in second_order_paths(tun, arr, ue, vel, fc=fc)
     ]
     # kinds filters both bounces
     no_rrm = pr.trace_paths(
@@ -133,4 +134,4 @@ def test_bad_input(kw, name):
         pr.trace_paths(tun, arr, ue, vel, fc=fc, **kw)
     if "kinds" in kw:
         with pytest.raises(ValueError, match=name):
-            pr.second_order_paths(tun, arr, ue, vel, fc=fc, **kw)
+            second_order_paths(tun, arr, ue, vel, fc=fc, **kw)

@@ -24,7 +24,6 @@ from ._validate import (
     positive,
     real,
     rng_or_error,
-    sequence,
 )
 from .budget import check_elements
 from .constants import K_B, C, db2lin, dbm2watt
@@ -40,7 +39,6 @@ __all__ = [
     "draw_calibration",
     "sample_clock_bias",
     "synthesize",
-    "tensor_snapshot",
 ]
 
 _MODELS = ("exact", "srnf")
@@ -157,7 +155,7 @@ class SRSConfig:
         return cls(**kw)
 
 
-def _clock_bias(value, config: SRSConfig) -> float:
+def check_clock_bias(value, config: SRSConfig) -> float:
     """A clock bias [s] the tensor can carry: within the radio's ``clock_bias_limit`` (or, with
     no limit, half the unambiguous delay ``1 / tone_spacing``: beyond it the phase ramp wraps and
     the tensor shows another bias than the one recorded)."""
@@ -318,7 +316,8 @@ class Impairments:
         return draw_calibration(rng, m, self.phase_sigma_deg, self.gain_sigma_db)
 
 
-def _check_calibration(calibration, m: int) -> np.ndarray | None:
+def check_calibration(calibration, m: int) -> np.ndarray | None:
+    """``calibration`` as (M,) complex per-element gains, None if None (none applied)."""
     if calibration is None:
         return None
     g = np.asarray(calibration)
@@ -372,10 +371,10 @@ def channel_tensor(
     if model not in _MODELS:
         raise ValueError(f"model: expected one of {_MODELS}, got {model!r}")
     paths = _check_paths(paths)
-    bias = _clock_bias(clock_bias, config)
+    bias = check_clock_bias(clock_bias, config)
     if not isinstance(spatial_wideband, bool):
         raise TypeError(f"spatial_wideband: expected True or False, got {spatial_wideband!r}")
-    cal = _check_calibration(calibration, paths[0].lengths.shape[0])
+    cal = check_calibration(calibration, paths[0].lengths.shape[0])
     if dmc is not None:
         if not isinstance(dmc, DiffuseSpec):
             raise TypeError(f"dmc: expected a channel.DiffuseSpec, got {type(dmc).__name__}")
@@ -502,39 +501,3 @@ def synthesize(
     return ChannelSnapshot(
         add_noise(H, n0, rng), n0, float(clock_bias), model, tuple(paths), config
     )
-
-
-def tensor_snapshot(
-    H0,
-    config: SRSConfig,
-    rng: np.random.Generator,
-    *,
-    paths=(),
-    clock_bias: float | None = None,
-    snr_offset_db: float = 0.0,
-    calibration=None,
-) -> ChannelSnapshot:
-    """A noisy snapshot from a noiseless tensor ``H0`` (M, Nf, Nt) given for a unit transmit
-    power and no clock bias (a ray-traced channel, :mod:`tunnelkit.rt.cache`): scaled by
-    ``sqrt(P_t)``, the clock bias (drawn from ``rng`` if None, as in :func:`synthesize`) applied
-    as ``exp(-j 2 pi s Df b)`` on tone ``s`` (eq. 1's ``tau_l = d_l / c + b`` for every path),
-    ``calibration`` (M,) per element, then CN(0, N0) noise (``snr_offset_db`` as in
-    :func:`synthesize`). ``paths``: the true paths recorded in the snapshot (model "exact")."""
-    if not isinstance(config, SRSConfig):
-        raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
-    H0 = np.asarray(H0)
-    if H0.ndim != 3 or not np.all(np.isfinite(H0)):
-        raise ValueError(f"H0: expected a finite 3-D tensor, got shape {H0.shape}")
-    rng = rng_or_error("rng", rng)
-    paths = sequence("paths", paths, empty=True)  # empty: no true path recorded (the default)
-    off = float(finite_array("snr_offset_db", snr_offset_db, ndim=0))
-    cal = _check_calibration(calibration, H0.shape[0])
-    if clock_bias is None:
-        clock_bias = sample_clock_bias(rng, config.clock_bias_sigma, config.clock_bias_limit)
-    bias = _clock_bias(clock_bias, config)
-    ramp = np.exp(-2j * np.pi * config.tone_spacing * np.arange(H0.shape[1]) * bias)
-    H = np.sqrt(config.tx_power) * H0 * ramp[None, :, None]
-    if cal is not None:
-        H = cal[:, None, None] * H
-    n0 = config.noise_power / float(db2lin(off))
-    return ChannelSnapshot(add_noise(H, n0, rng), n0, bias, "exact", tuple(paths), config)

@@ -3,7 +3,7 @@
 :func:`tunnelkit.consistency.geometry_consistency` asks whether one snapshot's paths agree with
 one UE position through the tunnel's planes, each residual in standard deviations of a bound.
 Here the bound is the CRLB at the estimate (:func:`bound_sigmas`: world azimuth, elevation and
-range of each kept path, :func:`tunnelkit.signal_route.reported_covariance` computed whatever the
+range of each kept path, :func:`tunnelkit.signal_route.covariance.reported_covariance` computed whatever the
 fit's own residual verdict) and, for the snapshot's statistic, its joint covariance over all
 paths (:func:`joint_bound`, from :func:`joint_fisher`: the ML fit's paths are estimated together,
 so their errors correlate within a path and between paths, up to 0.9 at the presets' epochs;
@@ -25,7 +25,8 @@ from .budget import check_elements
 from .channel import SRSConfig
 from .consistency import geometry_consistency, tunnel_planes
 from .constants import C
-from .signal_route import Epoch, SignalRoute, reported_covariance
+from .signal_route import Epoch, SignalRoute
+from .signal_route.covariance import reported_covariance
 
 __all__ = ["bound_sigmas", "epoch_consistency", "joint_bound", "joint_fisher", "rate_interval"]
 
@@ -51,7 +52,7 @@ def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.
     :class:`tunnelkit.extraction.PathEstimates`) of the world azimuth, elevation [rad] and range
     [m] of the paths ``keep`` (indices into ``est``, in their order; default the paths Algorithm 1
     keeps with its printed check ``d >= 0``, as ``PathMeasurements.source``): the route's
-    reported covariance (:func:`tunnelkit.signal_route.reported_covariance`, ``judged=False``).
+    reported covariance (:func:`tunnelkit.signal_route.covariance.reported_covariance`, ``judged=False``).
     Raises ``numpy.linalg.LinAlgError`` where the Fisher information is singular."""
     from .extraction import PathEstimates, algorithm1
 

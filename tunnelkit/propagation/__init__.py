@@ -18,16 +18,8 @@ docs/internals/channel-and-propagation.md.
 from __future__ import annotations
 
 from .materials import MATERIALS, concrete_permittivity, fresnel_te, reflection_coefficient
-from .paths import (
-    PATH_KINDS,
-    SECOND_ORDER,
-    Path,
-    arrival_angles,
-    as_path_list,
-    second_order_paths,
-    select_array,
-    trace_paths,
-)
+from .path import PATH_KINDS, SECOND_ORDER, Path, arrival_angles, as_path_list
+from .paths import select_array, trace_paths
 from .scenes import lane_trajectory, plate_from_table, scenario_arrays
 from .surfaces import (
     FACET_BYTES,
@@ -59,7 +51,6 @@ __all__ = [
     "reflection_coefficient",
     "road_marking",
     "scenario_arrays",
-    "second_order_paths",
     "select_array",
     "semicircular_tunnel",
     "trace_paths",

@@ -6,7 +6,7 @@ specular of any order, diffuse) and stores the noiseless tensor of eq. 1's form
 (:func:`~tunnelkit.rt.elements.element_tensor`, unit transmit power, no clock bias) without the
 LoS, plus the LoS path per element (so a blocked-LoS epoch drops it), the power per kind of path
 and the trace time. Noise and clock bias are drawn per run on top
-(:func:`tunnelkit.channel.tensor_snapshot`), so a 20-run table traces each epoch once.
+(:func:`tunnelkit.signal_route.raytraced.tensor_snapshot`), so a 20-run table traces each epoch once.
 
 Cache layout: ``<cache_dir>/<label>/<rrms|no-rrms>/meta.json`` and ``epoch-NNN.npz``.
 ``cache_dir`` is ``$TUNNELKIT_RT_CACHE`` if set, else ``~/.cache/tunnelkit/rt``. ``meta.json``

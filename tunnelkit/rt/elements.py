@@ -149,7 +149,7 @@ def element_tensor(
 ) -> np.ndarray:
     """Eq. 1's noiseless tensor (M, Nf, Nt) of the paths ``select`` (an (M, P) mask; all valid
     paths by default), in the module docstring's convention, for a unit transmit power and no
-    clock bias (:func:`tunnelkit.channel.tensor_snapshot` adds both, and the noise).
+    clock bias (:func:`tunnelkit.signal_route.raytraced.tensor_snapshot` adds both, and the noise).
 
     ``method`` (:data:`SYNTHESIS_METHODS`): "nufft" (FINUFFT, relative tolerance ``eps``),
     "direct" (the sum path by path) or "auto" (module docstring)."""

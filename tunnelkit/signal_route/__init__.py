@@ -11,7 +11,7 @@ How it works, with a worked call: docs/internals/scenarios.md.
 
 from __future__ import annotations
 
-from .measurements import Epoch, measurements_from_estimates, reported_covariance
+from .measurements import Epoch, measurements_from_estimates
 from .options import RouteOptions
 from .route import CHANNELS, MAX_SECOND_ORDER, SignalRoute, simulate_epoch
 
@@ -22,6 +22,5 @@ __all__ = [
     "RouteOptions",
     "SignalRoute",
     "measurements_from_estimates",
-    "reported_covariance",
     "simulate_epoch",
 ]

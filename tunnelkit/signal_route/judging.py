@@ -52,7 +52,7 @@ relative spread on 16 x 16 at the presets' 410 tones, more on small arrays and n
 which this floor does not take a quantile of.
 
 **The bias budget** (:class:`BiasBudget`). A re-judged fit's covariance is the CRLB at the
-estimate (:func:`~tunnelkit.signal_route.measurements.reported_covariance`, ``judged=False``),
+estimate (:func:`~tunnelkit.signal_route.covariance.reported_covariance`, ``judged=False``),
 which knows the noise only; the route adds the design's per-path budget of the impairments
 (what :meth:`tunnelkit.design.errormodel.PathErrorModel.split` puts on top of the noise
 covariance) and hands its repeating share on as ``bias_cov`` (the tracker carries it as a bias

@@ -1,6 +1,6 @@
 """Algorithm 1's measurements of one epoch in the world frame (:func:`measurements_from_estimates`,
-a :class:`~tunnelkit.tracking.javelin.PathMeasurements`), the epoch record (:class:`Epoch`) and
-the covariance the extraction reports (:func:`reported_covariance`)."""
+a :class:`~tunnelkit.tracking.javelin.PathMeasurements`) and the epoch record (:class:`Epoch`);
+the covariance the extraction reports: :mod:`tunnelkit.signal_route.covariance`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._checks import indices
 from .._physical import speeds
 from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
@@ -20,7 +19,6 @@ __all__ = [
     "Epoch",
     "measure_epoch",
     "measurements_from_estimates",
-    "reported_covariance",
 ]
 
 
@@ -79,7 +77,7 @@ def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
     """Measurements of ``est`` (Algorithm 1, world frame) and their match to the true paths; the
     estimates matched to a second-order path (a nuisance path the model carries,
     :attr:`RouteOptions.second_order`) are left out of the measurements. ``judged`` as in
-    :func:`reported_covariance`."""
+    :func:`~tunnelkit.signal_route.covariance.reported_covariance`."""
     from ..propagation import SECOND_ORDER
 
     paths = sequence("paths", paths, empty=True)  # empty: no true path recorded
@@ -93,34 +91,6 @@ def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
     return meas, truth
 
 
-def reported_covariance(est, keep, array: ArrayGeometry, config: SRSConfig, judged=True):
-    """The CRLB at the estimate (:func:`tunnelkit.extraction.estimate_crlb`) of the kept paths
-    ``keep`` (their Fisher information jointly) as the covariance of the world-frame ``(phi,
-    psi, kappa)`` (K, 3, 3) and the standard deviation of ``d`` (K,): the wave origin's
-    covariance rotated to the world frame, mapped through d(phi, psi, r)/dq (``spherical_jacobian``).
-    Returns ``(None, None)`` when the Fisher information is singular at the estimate or, if
-    ``judged``, the fit failed its own residual test (``fit.rho > fit.rho_max``: a wrong basin)."""
-    from ..extraction import estimate_crlb
-    from ..extraction.estimates import PathEstimates
-    from ..geometry import spherical_jacobian
-
-    instance("est", est, PathEstimates)
-    instance("array", array, ArrayGeometry)
-    instance("config", config, SRSConfig)
-    keep = indices("keep", keep, len(est.d))
-    fit = getattr(est, "fit", None)
-    if boolean("judged", judged) and fit is not None and not fit.rho <= fit.rho_max:
-        return None, None
-    try:
-        b = estimate_crlb(est, array, config, paths=keep)
-    except np.linalg.LinAlgError:
-        return None, None
-    rot = array.R  # local -> world: u_world = R u_local
-    cov_w = rot @ b["source_cov"] @ rot.T
-    G = spherical_jacobian(array.dir_to_world(b["source"]))
-    return G @ cov_w @ np.swapaxes(G, 1, 2), b["d"]
-
-
 def measurements_from_estimates(
     est,
     array: ArrayGeometry,
@@ -132,7 +102,8 @@ def measurements_from_estimates(
     """Apply Algorithm 1's checks to raw estimates (``min_d``: see
     :func:`tunnelkit.extraction.algorithm1`) and express them in the world frame, seen from the
     array's reference antenna (``origin``; ``source`` the kept rows of ``est``); with
-    ``config``, also the covariance the extraction reports (:func:`reported_covariance`, with
+    ``config``, also the covariance the extraction reports
+    (:func:`~tunnelkit.signal_route.covariance.reported_covariance`, with
     ``judged``: False for a fit the route re-judged and passed)."""
     from ..extraction import algorithm1
     from ..extraction.estimates import PathEstimates
@@ -150,6 +121,8 @@ def measurements_from_estimates(
     d = est.d[keep]
     cov = sigma_d = None
     if config is not None and keep.size:
+        from .covariance import reported_covariance
+
         cov, sigma_d = reported_covariance(est, keep, array, config, judged=judged)
     return PathMeasurements(
         phi, psi, est.kappa[keep], d, est.v[keep], keep, cov, sigma_d, origin=array.origin.copy()

@@ -17,9 +17,9 @@ from .._validate import (
     sequence,
 )
 from ..arrays import ArrayGeometry
-from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize, tensor_snapshot
+from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
 from ..constants import C
-from .measurements import Epoch, measure_epoch
+from .measurements import Epoch
 from .options import MAX_SECOND_ORDER, RouteOptions
 
 __all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute", "simulate_epoch"]
@@ -113,20 +113,9 @@ class SignalRoute:
                 f"{len(self.trajectory)}"
             )
         if self.raytraced is not None:
-            from ..rt.cache import RayTracedChannel  # the ray tracer loads only when asked for
+            from .raytraced import check_raytraced  # the ray tracer loads only when asked for
 
-            instance("raytraced", self.raytraced, RayTracedChannel)
-            if self.impairments.dmc is not None:
-                raise ValueError(
-                    "impairments: dmc (synthetic diffuse multipath) cannot be added to the "
-                    "ray-traced channel, which has its own diffuse power"
-                )
-            if opts.model != "exact":
-                raise ValueError(
-                    f"model: {opts.model!r} is a synthesis model of the image channel "
-                    "(channel='image'); the ray-traced channel (channel='sionna') synthesises "
-                    "every epoch from the tracer's paths"
-                )
+            check_raytraced(self)
         elif opts.diffuse_floor:
             raise ValueError(
                 "diffuse_floor: only the ray-traced channel (channel='sionna') has diffuse "
@@ -242,28 +231,11 @@ class SignalRoute:
     def raytraced_snapshot(
         self, k: int, arr: ArrayGeometry, paths, rng: np.random.Generator, tunnel=None, **kw
     ) -> ChannelSnapshot:
-        """The SRS snapshot of epoch ``k`` on the ray-traced channel (``channel="sionna"``): the
-        cached noiseless tensor (LoS left out unless "los" is in ``kinds``), clock bias, this
-        route's calibration and SNR offset, noise (:func:`tunnelkit.channel.tensor_snapshot`);
-        ``paths`` (the true paths) are recorded in the snapshot."""
-        instance("arr", arr, ArrayGeometry)
-        paths = sequence("paths", paths, empty=True)  # empty: no true path recorded
-        if self.raytraced is None:
-            raise ValueError("channel: this route has no ray-traced channel (channel='image')")
-        name, H0 = self.raytraced.tensor(
-            k, tunnel=self.tunnel if tunnel is None else tunnel, los="los" in self.kinds
-        )
-        if name != arr.name:
-            raise RuntimeError(f"ray-traced epoch {k} is for array {name!r}, not {arr.name!r}")
-        return tensor_snapshot(
-            H0,
-            self.config,
-            rng,
-            paths=paths,
-            snr_offset_db=self.snr_offset_db,
-            calibration=self.calibration.get(arr.name),
-            **kw,
-        )
+        """The SRS snapshot of epoch ``k`` on the ray-traced channel (``channel="sionna"``,
+        :func:`tunnelkit.signal_route.raytraced.raytraced_snapshot`)."""
+        from .raytraced import raytraced_snapshot
+
+        return raytraced_snapshot(self, k, arr, paths, rng, tunnel, **kw)
 
     def ml_noise_power(self, k: int, snapshot: ChannelSnapshot, tunnel=None) -> float | None:
         """The noise power the ML extraction tests its fit against at epoch ``k``: ``None``
@@ -314,63 +286,13 @@ class SignalRoute:
         clock_bias: float | None = None,
         **extract_kw,
     ) -> Epoch:
-        """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1."""
-        arr, paths, snap = self.draw(k, rng, tunnel=tunnel, clock_bias=clock_bias)
-        L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
-        if self.options.wideband_model:
-            extract_kw.setdefault("wideband", True)
-        if self.options.diffuse_floor and extract_kw.get("refine", "ml") == "ml":
-            extract_kw.setdefault("noise_power", self.ml_noise_power(k, snap, tunnel))
-        est = self.extract(snap.H, arr, L, **extract_kw)
-        cfg = self.config if self.options.report_covariance else None
-        rejudged = self.rejudge(est, snap, arr, extract_kw)
-        judged = rejudged is None or not rejudged["passed"]
-        meas, truth = measure_epoch(est, arr, paths, snap, cfg, self.min_d, judged)
-        if self.options.bias_budget is not None:
-            from .judging import apply_budget
+        """Simulate SRS slot ``k``: trace, synthesise (noise, clock bias), extract, Algorithm 1
+        (:func:`tunnelkit.signal_route.epoch.run_epoch`)."""
+        from .epoch import run_epoch
 
-            meas = apply_budget(meas, self.options.bias_budget, k)
-        if self.options.centroid_unresolved:
-            from .farfield import centroid_far_field  # loaded when the option is on
-
-            meas = centroid_far_field(meas, est, arr)
-        return Epoch(
-            k,
-            float(self.trajectory.t[k]),
-            self.trajectory.position[k].copy(),
-            self.trajectory.velocity[k].copy(),
-            arr,
-            paths,
-            snap,
-            est,
-            meas,
-            truth,
-            rejudged,
+        return run_epoch(
+            self, k, rng, n_paths=n_paths, tunnel=tunnel, clock_bias=clock_bias, **extract_kw
         )
-
-    def rejudge(self, est, snap: ChannelSnapshot, arr: ArrayGeometry, extract_kw: dict):
-        """The model-error test of a flagged ML fit (``model_error_floor``; None when there is
-        nothing to re-judge: the floor off or zero, the fit passed or is not an ML fit, the
-        extraction modelled the wideband term)."""
-        from ..extraction.estimates import PathEstimates
-
-        instance("est", est, PathEstimates)
-        instance("snap", snap, ChannelSnapshot)
-        instance("arr", arr, ArrayGeometry)
-        instance("extract_kw", extract_kw, dict)
-        if not self.options.model_error_floor or getattr(est, "fit_ok", None) is not False:
-            return None
-        if getattr(est, "fit", None) is None or extract_kw.get("wideband", False):
-            return None
-        from .judging import impairment_share, rejudge
-
-        imp = self.impairments
-        if impairment_share(imp) <= 0:
-            return None
-        # the diffuse share as it is, the calibration at the draw's false-alarm floor
-        dmc = 0.0 if imp.dmc is None else float(imp.dmc.share)
-        cal = None if imp.calibrated else (imp.phase_sigma_deg, imp.gain_sigma_db)
-        return rejudge(est, snap.H, arr.local, self.config.fc, dmc, calibration=cal)
 
 
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:

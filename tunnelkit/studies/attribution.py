@@ -469,10 +469,11 @@ def attribution(
     ``sigmas`` the one-epoch fix's weights (:func:`one_epoch_fix`)."""
     from pathlib import Path
 
-    from ..channel import channel_tensor, tensor_snapshot
+    from ..channel import channel_tensor
     from ..rt import RTSettings, default_cache_dir
     from ..scenarios import load_scenario
     from ..signal_route import SignalRoute
+    from ..signal_route.raytraced import tensor_snapshot
 
     t0 = time.perf_counter()
     sc = load_scenario(scenario) if isinstance(scenario, str) else scenario

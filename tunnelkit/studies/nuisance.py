@@ -10,8 +10,9 @@ The models (:data:`MODELS`):
   part of the array, the term the attribution found in the LoS and ceiling paths);
 * ``second-order-N``: eq. 1 with the image method's ``N`` strongest second-order specular paths
   as nuisance atoms beside the first-order ones
-  (:func:`tunnelkit.propagation.second_order_paths`, as ``RouteOptions(second_order=N)`` models
-  them; the second-order bounces carry about 20 % of the traced power).
+  (:func:`tunnelkit.propagation.second_order.second_order_paths`, as
+  ``RouteOptions(second_order=N)`` models them; the second-order bounces carry about 20 % of the
+  traced power).
 
 :func:`traced_bias` fits each model noiselessly to the traced tensor of each epoch (the pseudo-true
 parameters: eq. 1's by :func:`~.misspecified.pseudo_true` from the true paths, the profile's by
