@@ -178,7 +178,7 @@ def checked_numerics(fn):
     twins (the route before the twins: the same arithmetic, every call's finiteness checks)."""
     import importlib
 
-    from tunnelkit.extraction import numerics
+    from tunnelkit.extraction import linalg, numerics
 
     saved = []
     try:
@@ -186,7 +186,7 @@ def checked_numerics(fn):
             m = importlib.import_module(mod)
             for n in names:
                 saved.append((m, f"{n}_unchecked", getattr(m, f"{n}_unchecked")))
-                setattr(m, f"{n}_unchecked", getattr(numerics, n))
+                setattr(m, f"{n}_unchecked", getattr(linalg if hasattr(linalg, n) else numerics, n))
         return fn()
     finally:
         for m, n, f in saved:

@@ -27,7 +27,7 @@ def route_fit():
     """The ML fit's pieces on a small tensor, an epoch with other estimates, one-call epochs."""
     from tunnelkit import signal_route
     from tunnelkit.extraction import estimate_crlb, extract_paths
-    from tunnelkit.extraction.ml import fitting, model, paths, search, wideband
+    from tunnelkit.extraction.ml import given_start, model, order, rank_one, wideband
 
     route, arr, trace, _, H = _small_epoch()
     cfg = route.config
@@ -35,12 +35,12 @@ def route_fit():
     est = extract_paths(H, L, arr, cfg)
     estimate_crlb(est, arr, cfg)
     start = (np.column_stack([est.direction[:, :2], np.zeros(L)]), est.mu_f, est.mu_t)
-    fit = fitting.fit_ml(H, start, arr, cfg, max_iter=3, n_reseed=0)
+    fit = given_start.fit_ml(H, start, arr, cfg, max_iter=3, n_reseed=0)
     model.noise_floor(H, L)
-    paths.ml_order(H, arr, cfg, max_paths=2, max_iter=3)
+    order.ml_order(H, arr, cfg, max_paths=2, max_iter=3)
     prob = model.Problem(H, arr.local, cfg.fc)
-    search.search_path(H, prob)
-    search.complete_paths(prob, (fit.theta[:1], fit.mu_f[:1], fit.mu_t[:1]), 2)
+    rank_one.search_path(H, prob)
+    rank_one.complete_paths(prob, (fit.theta[:1], fit.mu_f[:1], fit.mu_t[:1]), 2)
     wb = wideband.WidebandProblem(H, arr.local, cfg.fc, cfg.tone_spacing)
     ev = wb.evaluate(fit.theta, fit.mu_f, fit.mu_t)
     wb.model(fit.theta, fit.mu_f, fit.mu_t, ev["c"])

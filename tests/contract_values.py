@@ -216,13 +216,14 @@ def _signal_route():
     ml.snr_threshold(prob.N, 0.01)
     ml.pair_test(prob, f.theta, f.mu_f, f.mu_t, f.noise_power, z_max=float("inf"))
     # the fits call the numerics' unchecked twins: the checked public forms called directly
+    from tunnelkit.extraction import linalg as la
     from tunnelkit.extraction import numerics as nm
 
     ev = prob.evaluate(f.theta, f.mu_f, f.mu_t)
     held = np.zeros(ev["g"].size, bool)
-    free, _ = nm.free_newton(ev["A"], ev["g"], held, held)
-    nm.damped_step(ev["A"], ev["g"], free, 1e-3)
-    nm.solve(ev["G"], ev["b"])
+    free, _ = la.free_newton(ev["A"], ev["g"], held, held)
+    la.damped_step(ev["A"], ev["g"], free, 1e-3)
+    la.solve(ev["G"], ev["b"])
     nm.spatial_phase(f.theta, arr.local, prob.k0)
     F = np.exp(1j * np.arange(prob.nf)[:, None] * f.mu_f[None, :])
     T = np.exp(1j * np.arange(prob.nt)[:, None] * f.mu_t[None, :])

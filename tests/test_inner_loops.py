@@ -120,6 +120,7 @@ def test_the_extraction_numerics_unchecked_twins_equal_the_checked_functions():
     """The fits (ml.fitting, ml.model, coherent, joint.refine_joint) call the unchecked twins of
     ``extraction.numerics``: same bytes as the checked public forms, including the singular
     fall-back of ``solve``, the held coordinates of ``free_newton`` and ``damped_step``'s None."""
+    from tunnelkit.extraction import linalg as la
     from tunnelkit.extraction import numerics as nm
 
     rng = np.random.default_rng(6)
@@ -127,19 +128,19 @@ def test_the_extraction_numerics_unchecked_twins_equal_the_checked_functions():
         J = rng.normal(size=(3 * n, n)) + 1j * rng.normal(size=(3 * n, n))
         G = J.conj().T @ J
         B = rng.normal(size=(n, 2)) + 1j * rng.normal(size=(n, 2))
-        assert _same(nm.solve_unchecked(G, B), nm.solve(G, B))
-        assert _same(nm.solve_unchecked(G, B[:, 0]), nm.solve(G, B[:, 0]))
+        assert _same(nm.solve_unchecked(G, B), la.solve(G, B))
+        assert _same(nm.solve_unchecked(G, B[:, 0]), la.solve(G, B[:, 0]))
         S = np.outer(J[0], J[0].conj())  # rank one: the least-squares fall-back
-        assert _same(nm.solve_unchecked(S, B), nm.solve(S, B))
+        assert _same(nm.solve_unchecked(S, B), la.solve(S, B))
         A = (J.conj().T @ J).real
         g = rng.normal(size=n)
         lower, upper = rng.random(n) < 0.3, rng.random(n) < 0.3
         upper &= ~lower
         f1, d1 = nm.free_newton_unchecked(A, g, lower, upper)
-        f2, d2 = nm.free_newton(A, g, lower, upper)
+        f2, d2 = la.free_newton(A, g, lower, upper)
         assert _same(f1, f2) and d1 == d2
         for lam in (1e-9, 1e-3, 10.0):
-            assert _same(nm.damped_step_unchecked(A, g, f2, lam), nm.damped_step(A, g, f2, lam))
+            assert _same(nm.damped_step_unchecked(A, g, f2, lam), la.damped_step(A, g, f2, lam))
     Z = np.zeros((3, 3))
     assert nm.damped_step_unchecked(Z, np.ones(3), np.ones(3, bool), 0.0) is None
     p = np.column_stack([rng.normal(size=(16, 2)) * 0.02, np.zeros(16)])
@@ -248,22 +249,22 @@ def test_javelin_step_records_built_unchecked_are_what_the_checked_records_accep
 
 def test_damped_system_and_solve_are_damped_step_in_two_parts():
     """A fit that raises the damping at the same point builds the scaled system once
-    (numerics.damped_system) and solves it per damping (damped_solve): bit for bit the step."""
-    from tunnelkit.extraction import numerics as nm
+    (linalg.damped_system) and solves it per damping (damped_solve): bit for bit the step."""
+    from tunnelkit.extraction import linalg as la
 
     rng = np.random.default_rng(3)
     J = rng.normal(size=(9, 5))
     A, g = J.T @ J, rng.normal(size=5)
     for free in (np.ones(5, bool), np.array([True, False, True, True, False])):
-        system = nm.damped_system(A, g, free)
+        system = la.damped_system(A, g, free)
         for lam in (1e-3, 0.1, 10.0):
             np.testing.assert_array_equal(
-                nm.damped_solve(system, lam), nm.damped_step(A, g, free, lam)
+                la.damped_solve(system, lam), la.damped_step(A, g, free, lam)
             )
     with pytest.raises(ValueError, match="lam"):
-        nm.damped_solve(system, -1.0)
+        la.damped_solve(system, -1.0)
     with pytest.raises(TypeError, match="system"):
-        nm.damped_solve((A, g), 0.1)
+        la.damped_solve((A, g), 0.1)
 
 
 def test_free_newton_holds_a_negative_curvature_of_a_degenerate_fit():
@@ -273,7 +274,7 @@ def test_free_newton_holds_a_negative_curvature_of_a_degenerate_fit():
     an overflowed matrix (it printed "DLASCL parameter number 4 had an illegal value")."""
     import warnings
 
-    from tunnelkit.extraction import numerics as nm
+    from tunnelkit.extraction import linalg as la
 
     rng = np.random.default_rng(11)
     n = 10
@@ -288,8 +289,8 @@ def test_free_newton_holds_a_negative_curvature_of_a_degenerate_fit():
     none = np.zeros(n, bool)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no overflow, no invalid value
-        free, dec = nm.free_newton(A, g, none, none)
-        step = nm.damped_step(A, g, free, 1e-3)
+        free, dec = la.free_newton(A, g, none, none)
+        step = la.damped_step(A, g, free, 1e-3)
     assert not free[bad].any() and free.sum() == n - len(bad)
     assert np.isfinite(dec) and dec > 0 and np.all(np.isfinite(step)) and not step[bad].any()
     # the held coordinates aside, it is the Newton step of the rest
@@ -301,9 +302,9 @@ def test_free_newton_holds_a_negative_curvature_of_a_degenerate_fit():
     Z[2, 2] = 0.0
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        fz, dz = nm.free_newton(np.pad(Z, ((0, 1), (0, 1))) + np.diag([0, 0, 0, 2.0]),
+        fz, dz = la.free_newton(np.pad(Z, ((0, 1), (0, 1))) + np.diag([0, 0, 0, 2.0]),
                                 np.ones(4), np.zeros(4, bool), np.zeros(4, bool))  # fmt: skip
     assert fz.tolist() == [False, False, True, True] and dz == pytest.approx(0.5)
     # a positive semi-definite A is untouched: every coordinate free, as before
-    f2, d2 = nm.free_newton(J.T @ J, g, none, none)
+    f2, d2 = la.free_newton(J.T @ J, g, none, none)
     assert f2.all() and np.isfinite(d2)

@@ -146,7 +146,7 @@ def test_circular_mean_against_the_phasor_sum_and_its_contract():
     """``circular_mean``: the angle of the weighted phasor sum (random draws against the sum by
     hand, shifts by 2 pi change nothing), the heaviest angle when the phasors cancel, and the
     weights and angles refused by name."""
-    from tunnelkit.extraction.numerics import circular_mean
+    from tunnelkit.extraction.ml.merged import circular_mean
 
     rng = np.random.default_rng(4)
     for _ in range(50):
@@ -173,7 +173,7 @@ def test_circular_mean_against_the_phasor_sum_and_its_contract():
 def test_circular_mean_scales_huge_weights_exactly():
     """Weights near the float maximum: no overflow (the weights are scaled by a power of two,
     which leaves the result bit for bit); a -pi and a pi give the same point."""
-    from tunnelkit.extraction.numerics import circular_mean
+    from tunnelkit.extraction.ml.merged import circular_mean
 
     a = np.array([0.1, 0.5])
     assert circular_mean([1e308, 1e308], a) == pytest.approx(0.3)

@@ -11,7 +11,7 @@ from ..budget import check_elements
 from ..channel import SRSConfig
 from ..constants import C, db2lin
 from .estimates import PathEstimates
-from .numerics import circular_mean
+from .ml.merged import circular_mean
 from .radio import check_array, check_srs
 
 __all__ = [
@@ -332,7 +332,7 @@ def merged_path(alpha, sources, mu_f, mu_t, pair) -> dict:
     power-weighted centroid. With weights ``p_k = |alpha_k|^2 / (|alpha_i|^2 + |alpha_j|^2)``
     over the pair ``(i, j)``: the direction ``sum p_k u_k`` normalised, the curvature ``w = sum
     p_k / r_k`` (the wave origin at ``u / w``), ``mu_f`` and ``mu_t`` the weighted means on the
-    circle (delay and Doppler phases, :func:`~tunnelkit.extraction.numerics.circular_mean`, as
+    circle (delay and Doppler phases, :func:`~tunnelkit.extraction.ml.merged.circular_mean`, as
     the ML fit's merged start), and the gain of the summed power, ``sqrt(|alpha_i|^2 +
     |alpha_j|^2)``, with the phase of ``alpha_i + alpha_j`` (of the stronger when they cancel).
 

@@ -1,23 +1,25 @@
 """The numerics every extraction stage shares, below all of them.
 
 - :data:`MIN_SIGNIFICANCE` — the log-likelihood ratio a path needs to stand above the noise;
-- :func:`solve` — a linear solve that falls back to least squares on a singular system;
-- :func:`free_newton` and :func:`damped_step` — the bound-constrained Gauss-Newton decrement and
-  the Levenberg-Marquardt step of the variable-projection fits (:mod:`.coherent`, :mod:`.ml`);
+- ``solve_unchecked``, ``free_newton_unchecked`` and ``damped_step_unchecked`` (in two parts,
+  ``damped_system_unchecked`` and ``damped_solve_unchecked``) — a linear solve that falls back
+  to least squares on a singular system, the bound-constrained Gauss-Newton decrement and the
+  Levenberg-Marquardt step of the variable-projection fits (:mod:`.coherent`, :mod:`.ml`);
+  their checked public forms are :mod:`.linalg`'s;
 - :func:`contract` — ``sum_{s,k} H[m, s, k] F[s, l] T[k, l]``, the contraction of the channel
   tensor with frequency and time vectors;
 - :func:`grid_index` — the rectangular-lattice coordinates of a URA (or ULA) layout;
 - :func:`spatial_phase` — the exact spherical spatial phase of eq. 1 and its derivatives in
   ``(u_x, u_y, w = 1 / kappa)``;
-- :func:`scan_peak` — the far-field beam-scan peak of a spatial vector;
-- :func:`circular_mean` — the weighted mean of phases on the circle (a merged pair's ``mu``).
+- :func:`scan_peak` — the far-field beam-scan peak of a spatial vector.
 
-The fits call :func:`solve`, :func:`free_newton`, :func:`damped_step`, :func:`spatial_phase` and
-:func:`contract` on every iteration with arrays they built themselves; there the finiteness
-checks cost ~2 % of an extraction. Each has an unchecked twin (``solve_unchecked``,
-``free_newton_unchecked``, ``damped_step_unchecked``, ``spatial_phase_unchecked``,
-``contract_unchecked``; not exported) that the fits call on their own arrays: the same
-arithmetic, bit for bit (``tests/test_inner_loops.py``); the checked forms are the public ones.
+The fits call :func:`~.linalg.solve`, :func:`~.linalg.free_newton`, :func:`~.linalg.damped_step`,
+:func:`spatial_phase` and :func:`contract` on every iteration with arrays they built themselves;
+there the finiteness checks cost ~2 % of an extraction. Each has an unchecked twin
+(``solve_unchecked``, ``free_newton_unchecked``, ``damped_step_unchecked``,
+``spatial_phase_unchecked``, ``contract_unchecked``; not exported) that the fits call on their own
+arrays: the same arithmetic, bit for bit (``tests/test_inner_loops.py``); the checked forms are the
+public ones.
 """
 
 from __future__ import annotations
@@ -33,14 +35,10 @@ from ..constants import C
 
 __all__ = [
     "MIN_SIGNIFICANCE",
-    "circular_mean",
     "contract",
-    "damped_step",
-    "free_newton",
     "grid_index",
     "scan_grid",
     "scan_peak",
-    "solve",
     "spatial_phase",
 ]
 
@@ -48,64 +46,13 @@ __all__ = [
 MIN_SIGNIFICANCE = 25.0
 
 
-def _finite(name: str, A) -> np.ndarray:
-    """``A`` as an array of finite numbers (real or complex, not converted: these helpers run
-    inside the fits' iterations, so the check is the cheapest that names ``name``)."""
-    A = np.asarray(A)
-    if A.dtype.kind not in "biufc":
-        raise TypeError(f"{name}: expected numbers, got dtype {A.dtype}")
-    if not np.isfinite(A).all():
-        raise ValueError(f"{name}: contains NaN or infinite values")
-    return A
-
-
-def _square(name: str, A) -> np.ndarray:
-    A = _finite(name, A)
-    if A.ndim != 2 or A.shape[0] != A.shape[1]:
-        raise ValueError(f"{name}: expected a square matrix, got shape {A.shape}")
-    return A
-
-
-def _masks(g, *masks):
-    _finite("g", g)
-    if g.ndim != 1:
-        raise ValueError(f"g: expected a vector, got shape {g.shape}")
-    for name, m in masks:
-        if np.shape(m) != g.shape:
-            raise ValueError(f"{name}: expected shape {g.shape}, got {np.shape(m)}")
-
-
-def solve(G, B) -> np.ndarray:
-    """``G^{-1} B`` for a square ``G`` (n, n) and ``B`` (n,) or (n, k); the least-squares
-    solution when ``G`` is singular."""
-    G = _square("G", G)
-    B = _finite("B", B)
-    if B.ndim not in (1, 2) or B.shape[0] != G.shape[0]:
-        raise ValueError(f"B: expected {G.shape[0]} rows, got shape {B.shape}")
-    return solve_unchecked(G, B)
-
-
 def solve_unchecked(G, B) -> np.ndarray:
-    """:func:`solve` without the checks (the fits' inner loops, on their own finite arrays)."""
+    """:func:`~.linalg.solve` without the checks (the fits' inner loops, on their own finite
+    arrays)."""
     try:
         return np.linalg.solve(G, B)
     except np.linalg.LinAlgError:
         return np.linalg.lstsq(G, B, rcond=None)[0]
-
-
-def free_newton(A, g, lower, upper) -> tuple[np.ndarray, float]:
-    """Coordinates free to move and the Newton decrement ``g^T A^{-1} g`` over them.
-
-    ``A`` (n, n) is the (real) Gauss-Newton matrix, ``g`` (n,) the descent direction, ``lower``
-    and ``upper`` (n,) flag the coordinates at their lower and upper bounds. A coordinate at its
-    lower (upper) bound whose Gauss-Newton step points down (up) is held: the projection would
-    undo its step. ``A`` is Jacobi-scaled before the solve (the parameters differ by orders of
-    magnitude). Returns ``(free (n,) bool, decrement)``.
-    """
-    A = _square("A", A)
-    g = np.asarray(g)
-    _masks(g, ("A", A[0]), ("lower", lower), ("upper", upper))
-    return free_newton_unchecked(A, g, lower, upper)
 
 
 def _free_block(A, free, every: bool):
@@ -114,7 +61,8 @@ def _free_block(A, free, every: bool):
 
 
 def free_newton_unchecked(A, g, lower, upper) -> tuple[np.ndarray, float]:
-    """:func:`free_newton` without the checks (the fits' inner loops, on their own arrays).
+    """:func:`~.linalg.free_newton` without the checks (the fits' inner loops, on their own
+    arrays).
 
     A coordinate with a negative curvature ``A[i, i] < 0``, or a zero one beside a non-zero
     coupling, is held: ``A`` is a Schur complement, positive semi-definite, and such a diagonal
@@ -139,39 +87,14 @@ def free_newton_unchecked(A, g, lower, upper) -> tuple[np.ndarray, float]:
     return free, float(g[free] @ newton[free])
 
 
-def damped_step(A, g, free, lam: float) -> np.ndarray | None:
-    """Levenberg-Marquardt step ``(A_s + lam I)^{-1} g`` on the ``free`` coordinates (n,) bool,
-    with Marquardt's diagonal scaling ``A_s = D^{-1/2} A D^{-1/2}``; zero on the held ones.
-    ``None`` when the damped system is singular (the caller raises ``lam``)."""
-    A = _square("A", A)
-    g = np.asarray(g)
-    _masks(g, ("A", A[0]), ("free", free))
-    return damped_step_unchecked(A, g, free, positive("lam", lam))
-
-
 def damped_step_unchecked(A, g, free, lam: float) -> np.ndarray | None:
-    """:func:`damped_step` without the checks (the fits' inner loops, on their own arrays)."""
+    """:func:`~.linalg.damped_step` without the checks (the fits' inner loops, on their own
+    arrays)."""
     return damped_solve_unchecked(damped_system_unchecked(A, g, free), lam)
 
 
-def damped_system(A, g, free) -> tuple:
-    """The scaled system of :func:`damped_step` on the ``free`` coordinates (n,) bool, for
-    :func:`damped_solve` (checked; the fits call :func:`damped_system_unchecked`)."""
-    A = _square("A", A)
-    g = np.asarray(g)
-    _masks(g, ("A", A[0]), ("free", free))
-    return damped_system_unchecked(A, g, free)
-
-
-def damped_solve(system, lam: float) -> np.ndarray | None:
-    """:func:`damped_step` of a system of :func:`damped_system` at damping ``lam`` (checked)."""
-    if not (isinstance(system, tuple) and len(system) == 5):
-        raise TypeError("system: expected the tuple damped_system returns")
-    return damped_solve_unchecked(system, positive("lam", lam))
-
-
 def damped_system_unchecked(A, g, free) -> tuple:
-    """The scaled system of :func:`damped_step` on the ``free`` coordinates, for
+    """The scaled system of :func:`~.linalg.damped_step` on the ``free`` coordinates, for
     :func:`damped_solve_unchecked` (a fit that raises ``lam`` at the same point builds it once)."""
     sc = 1.0 / np.sqrt(np.maximum(np.diag(A)[free], 1e-300))
     As = sc[:, None] * _free_block(A, free, bool(free.all())) * sc[None, :]
@@ -179,7 +102,8 @@ def damped_system_unchecked(A, g, free) -> tuple:
 
 
 def damped_solve_unchecked(system, lam: float) -> np.ndarray | None:
-    """:func:`damped_step` of a system of :func:`damped_system_unchecked` at damping ``lam``."""
+    """:func:`~.linalg.damped_step` of a system of :func:`damped_system_unchecked` at damping
+    ``lam``."""
     sc, As, eye, gs, free = system
     try:
         sub = sc * np.linalg.solve(As + lam * eye, gs)
@@ -325,22 +249,3 @@ def scan_peak(r, element_positions, fc: float, n_grid: int = 61) -> np.ndarray:
     check_elements("n_grid", n_grid * n_grid * (p.shape[0] + 2), 16, f"a {n_grid} x {n_grid} scan")
     u, A = _scan_grid(p.tobytes(), p.shape[0], carrier("fc", fc), n_grid)
     return u[int(np.argmax(np.abs(np.conj(r) @ A)))]  # |A^H r| without copying A^H
-
-
-def circular_mean(weights, angles) -> float:
-    """The weighted mean of phases on the circle, ``angle(sum_k w_k exp(j a_k))`` [rad], in
-    ``[-pi, pi]``: the ``mu_f`` / ``mu_t`` of a pair of paths merged into one (an arithmetic mean
-    of ``3.1`` and ``-3.1`` gives ``0``, the opposite side of the circle; this gives ``pi``).
-    ``weights`` (K,) non-negative, not all zero; ``angles`` (K,) [rad]. When the weighted
-    phasors cancel the result is the angle of the heaviest one."""
-    a = finite_array("angles", angles, ndim=1)
-    w = finite_array("weights", weights, shape=(a.size,))
-    if a.size == 0:
-        raise ValueError("angles: expected at least one angle")
-    if np.any(w < 0) or not w.max() > 0:
-        raise ValueError("weights: expected non-negative weights, not all zero")
-    w = np.ldexp(w, -int(np.frexp(w.max())[1]))  # by a power of 2: exact, no overflow
-    z = w @ np.exp(1j * a)
-    if not abs(z) > 1e-12 * w.sum():
-        return float(np.angle(np.exp(1j * a[int(np.argmax(w))])))
-    return float(np.angle(z))

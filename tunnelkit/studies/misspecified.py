@@ -42,8 +42,8 @@ from ..arrays import check_element_positions
 from ..constants import C
 from ..extraction.decomposition import check_tensor
 from ..extraction.ml import MAX_ITER, Problem, fit_problem, pair_separation
+from ..extraction.ml.given_start import check_start
 from ..extraction.ml.model import W_MAX, project_feasible
-from ..extraction.ml.search import check_start
 from ..extraction.numerics import spatial_phase
 
 __all__ = [

@@ -1,7 +1,7 @@
 """The fit of the maximum-likelihood stage: Levenberg-Marquardt on the concentrated cost, the
 stopping rule, the basin test and the SAGE-like re-seedings (docs/internals/extraction-ml.md),
-in :func:`fit_problem` (on a :class:`~.model.Problem`) and :func:`fit_ml` (on a tensor); the
-result is an :class:`MLFit`."""
+in :func:`fit_problem` (on a :class:`~.model.Problem`; :func:`~.given_start.fit_ml` on a tensor,
+the re-seedings on the residual energy in :mod:`.rho_reseed`); the result is an :class:`MLFit`."""
 
 from __future__ import annotations
 
@@ -10,25 +10,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import integer, positive, record, sequence
+from ..._validate import integer, positive, record
 from ...constants import C
-from ..decomposition import check_tensor
 from ..numerics import MIN_SIGNIFICANCE, spatial_phase_unchecked
-from ..radio import check_array, check_srs
-from .lm import STEP_TOL, best_of_starts, lm_fit
+from .lm import STEP_TOL, best_of_starts, lm_fit, lm_with
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .resolution import (
+    COUNTED_TWICE,
     PAIR_LLR,
     RESOLVE_Z,
-    closest_pair,
-    pair_separation,
+    coherent_pair,
     pair_tests_at,
     separations,
     unresolved_partners,
 )
 from .resolution import significance as path_significance
-from .search import check_start, path_from_peak, search_path
+from .search import SPLIT_STEPS, path_from_peak
 
 __all__ = [
     "MAX_ITER",
@@ -36,14 +34,11 @@ __all__ = [
     "RHO_Z",
     "SCREEN_ITER",
     "SEARCHES",
-    "SPLIT_STEPS",
     "STEP_TOL",
     "MLConvergenceWarning",
     "MLDetectionWarning",
     "MLFit",
-    "fit_ml",
     "fit_problem",
-    "pair_separation",
 ]
 
 RHO_Z = 6.0  # basin test: sigmas of the chi-square statistic
@@ -80,16 +75,16 @@ class MLFit:
     path more); ``detected`` (L,) each path's GLRT against that threshold (``significance >=
     peak_max``: the path would have been added from the noise with probability below
     ``FALSE_ALARM``); ``separation`` the smallest distance of two paths in standard deviations
-    of their difference (:func:`pair_separation`), ``resolution`` (L,) each path's smallest
-    distance to another (:func:`~.resolution.separations`; below ``RESOLVE_Z`` the path is in
-    the threshold region of resolution); ``fit_ok`` the fit passed every test: the
+    of their difference (:func:`~.resolved.pair_separation`), ``resolution`` (L,) each path's
+    smallest distance to another (:func:`~.resolution.separations`; below ``RESOLVE_Z`` the path
+    is in the threshold region of resolution); ``fit_ok`` the fit passed every test: the
     residual peak and ``rho`` below their thresholds, all ``L`` paths above the noise and every
     two paths resolved (``separation >= RESOLVE_Z``); ``reason`` the tests it failed
     (``"residual peak"``: a path missed or a wrong basin; ``"residual energy"``; ``"path below
     the noise"``; ``"unresolved pair"``: the threshold region of two paths closer than their
     bound can tell; ``"pair not resolved"``: the pair test), ``""`` when it passed; ``pairs``
     (P, 4) the pair test of each pair closer than ``PAIR_TEST_Z`` (rows ``(i, j, z, llr)``,
-    :func:`~.resolution.pair_test`) and ``unresolved`` (L,) each path's partner in a pair whose
+    :func:`~.resolved.pair_test`) and ``unresolved`` (L,) each path's partner in a pair whose
     ``llr`` is below ``PAIR_LLR`` (one path explains the two as well) or closer than
     ``RESOLVE_Z`` (:func:`~.resolution.unresolved_partners`: the CRLB of the two is not a bound
     the estimate can reach), ``-1`` when resolved."""
@@ -125,59 +120,6 @@ class MLFit:
         r, w = np.hypot(self.theta[:, 0], self.theta[:, 1]), self.theta[:, 2]
         if np.any(r > 1) or np.any(w < 0) or np.any(w > W_MAX * (1 + 1e-9)):
             raise ValueError("theta: outside the front half-space |u| <= 1, 0 <= w <= W_MAX")
-
-
-def _lm_with(prob: Problem, theta, mu_f, mu_t, new, sigma2, max_iter):
-    """:func:`_lm` on the ``L`` paths plus one more, ``new = (theta, mu_f, mu_t)`` of it."""
-    th, mf, mt = np.vstack([theta, new[0]]), np.append(mu_f, new[1]), np.append(mu_t, new[2])
-    return _lm(prob, th, mf, mt, sigma2, max_iter)
-
-
-def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
-    """One path more, sought in the pure residual; all ``L + 1`` fitted jointly; the least
-    significant one out and the ``L`` fitted again (a path missed while another was counted
-    twice, or two paths merged, leave a structured residual that this move picks up)."""
-    r = prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
-    big = _lm_with(prob, theta, mu_f, mu_t, search_path(r, prob), sigma2, max_iter)
-    keep = np.arange(theta.shape[0] + 1) != int(np.argmin(path_significance(big[3], sigma2)))
-    res = _lm(prob, big[0][keep], big[1][keep], big[2][keep], sigma2, max_iter)
-    return res, big[4] + res[4]
-
-
-#: coherence ``|G_ij| / sqrt(G_ii G_jj)`` above which two atoms are one path counted twice
-COUNTED_TWICE = 0.9
-#: offsets in (u_x, u_y) of the two halves of a split path (an eighth of a 10 x 10 beamwidth)
-SPLIT_STEPS = ((0.012, 0.0), (0.0, 0.012))
-
-
-def _merge_and_split(
-    prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coherence=COUNTED_TWICE
-):
-    """If two atoms are nearly collinear (one path counted twice, ``|G_ij| / sqrt(G_ii G_jj) >
-    coherence``): drop the weaker, fit the ``L - 1``, then split one of them into two halves
-    ``u -+ SPLIT_STEPS`` (two sources closer than a beamwidth fitted as one) and fit all ``L``;
-    the first split whose cost is below ``cost_ok`` (the basin test), else the best. ``None``
-    when no two atoms are that alike."""
-    i, j, coh = _coherent_pair(ev)
-    if coh < coherence:
-        return None
-    drop = j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i
-    keep = np.arange(theta.shape[0]) != drop
-    th, mf, mt, ev_s, its, _ = _lm(prob, theta[keep], mu_f[keep], mu_t[keep], sigma2, max_iter)
-    best = None
-    for l_ in np.argsort(-np.abs(ev_s["c"])):
-        for du in SPLIT_STEPS:
-            t2 = np.vstack([th, th[l_]])
-            t2[l_, :2] += du
-            t2[-1, :2] -= du
-            mf2, mt2 = np.append(mf, mf[l_]), np.append(mt, mt[l_])
-            res = _lm(prob, project_feasible(t2), mf2, mt2, sigma2, max_iter)
-            its += res[4]
-            if best is None or res[3]["cost"] < best[3]["cost"]:
-                best = res
-            if best[3]["cost"] <= cost_ok:
-                return best, its
-    return best, its
 
 
 def _residual_of(prob: Problem, res):
@@ -219,7 +161,7 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
             break
         theta, mu_f, mu_t, ev = best[:4]
         th_n, mf_n, mt_n = path_from_peak(prob, peak[1], peak[2])
-        big = _lm_with(prob, theta, mu_f, mu_t, (th_n, mf_n, mt_n), sigma2, short)
+        big = lm_with(prob, theta, mu_f, mu_t, (th_n, mf_n, mt_n), sigma2, short)
         n_it += big[4]
         keep = np.arange(L + 1) != int(np.argmin(path_significance(big[3], sigma2)))
         starts = [(big[0][keep], big[1][keep], big[2][keep])]
@@ -310,12 +252,14 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool =
 
 def _split_pairs(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> list[np.ndarray]:
     """The pairs :func:`_split_weak` takes apart: the closest in standard deviations of its
-    difference (:func:`~.resolution.closest_pair`) and, when another pair, the two atoms more
+    difference (:func:`~.resolved.closest_pair`) and, when another pair, the two atoms more
     coherent than :data:`COUNTED_TWICE` (one path counted twice: its large, cancelling gains can
     leave an unrelated pair 0 sd apart, and real paths can be that coherent too)."""
+    from .resolved import closest_pair  # loaded when a split is tried on a pair
+
     a, b, _ = closest_pair(prob, theta, mu_f, mu_t, sigma2)
     out = [np.array([a, b])]
-    i, j, coh = _coherent_pair(ev)
+    i, j, coh = coherent_pair(ev)
     if coh > COUNTED_TWICE and {int(i), int(j)} != {a, b}:
         out.append(np.array([i, j]))
     return out
@@ -340,97 +284,10 @@ def _dirichlet(dmu, n: int) -> np.ndarray:
 def _weakest(ev, sigma2) -> int:
     """The weaker of the two most collinear atoms when two are nearly one (``|G_ij| / sqrt(G_ii
     G_jj) > COUNTED_TWICE``: a path counted twice), else the least significant path."""
-    i, j, coh = _coherent_pair(ev)
+    i, j, coh = coherent_pair(ev)
     if coh > COUNTED_TWICE:
         return int(j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i)
     return int(np.argmin(path_significance(ev, sigma2)))
-
-
-def _coherent_pair(ev):
-    """The two most collinear atoms ``i, j`` and their coherence ``|G_ij| / sqrt(G_ii G_jj)``."""
-    dg = np.sqrt(np.maximum(np.real(np.diag(ev["G"])), 1e-300))
-    coh = np.abs(ev["G"]) / np.outer(dg, dg)
-    np.fill_diagonal(coh, 0.0)
-    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
-    return i, j, coh[i, j]
-
-
-def _rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
-    """The re-seedings on the residual energy (docs/internals/extraction-ml.md): while the cost is
-    above ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
-    and the weakest path re-sought, each kept if the likelihood rises. Returns the fit, the
-    iterations spent and the number of kept moves."""
-    tried: set = set()
-    n_it = kept = 0
-    H, L = prob.H, best[0].shape[0]
-    split_tried = False
-    for attempt in range(n_reseed):
-        theta, mu_f, mu_t, ev = best[:4]
-        if ev["cost"] <= cost_ok:
-            break
-        merged = None
-        if not split_tried:  # one path counted twice: merge it, split another (once)
-            merged = _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok)
-        if merged is not None:
-            cand, its = merged
-            split_tried = True
-        elif attempt % 2 == 0:  # birth and death: a path from the residual, the weakest out
-            cand, its = _birth_death(prob, theta, mu_f, mu_t, ev, sigma2, max_iter)
-        else:  # the weakest path re-sought in the residual plus its own contribution
-            sig = path_significance(ev, sigma2)
-            order = [int(i) for i in np.argsort(sig) if int(i) not in tried]
-            if not order:
-                continue
-            worst = order[0]
-            tried.add(worst)
-            keep = np.arange(L) != worst
-            R = H - prob.model(theta[keep], mu_f[keep], mu_t[keep], ev["c"][keep])
-            th_n, mf_n, mt_n = search_path(R, prob)
-            th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
-            th2[worst], mf2[worst], mt2[worst] = th_n, mf_n, mt_n
-            cand = _lm(prob, th2, mf2, mt2, sigma2, max_iter)
-            its = cand[4]
-        n_it += its
-        history.append(cand[3]["cost"] / (dof * sigma2))
-        if cand[3]["cost"] < ev["cost"]:
-            best, kept = cand, kept + 1
-            tried = set()
-    return best, n_it, kept
-
-
-def fit_ml(
-    H,
-    start,
-    array,
-    srs,
-    *,
-    noise_power: float | None = None,
-    max_iter: int = 60,
-    n_reseed: int | None = None,
-    search: str = "residual",
-) -> MLFit:
-    """Joint maximum-likelihood fit of ``L`` paths started at ``start = (theta, mu_f, mu_t)``.
-
-    ``theta`` (L, 3) is ``(u_x, u_y, 1/kappa)`` per path (local frame, ``|u| < 1``, ``w >= 0``);
-    ``mu_f``, ``mu_t`` (L,) the Vandermonde frequencies. ``noise_power`` per sample (default:
-    estimated, :func:`~.model.noise_floor`). ``n_reseed`` bounds the SAGE-like re-seedings (default
-    ``L``; 0 = local fit only), ``search`` as in :func:`fit_problem`. ``array`` and ``srs`` as in
-    :func:`~tunnelkit.extraction.extract_paths` (only the carrier of ``srs`` enters). See
-    docs/internals/extraction-ml.md for the algorithm.
-    """
-    H = check_tensor(H)
-    pos = check_array(array, m=H.shape[0])
-    srs = check_srs(srs)
-    L = np.atleast_2d(np.asarray(sequence("start", start)[0])).shape[0]
-    start = check_start(start, L)
-    return fit_problem(
-        Problem(H, pos, srs.fc),
-        start,
-        noise_power=noise_power,
-        max_iter=max_iter,
-        n_reseed=n_reseed,
-        search=search,
-    )
 
 
 def fit_problem(
@@ -442,9 +299,9 @@ def fit_problem(
     n_reseed: int | None = None,
     search: str = "residual",
 ) -> MLFit:
-    """:func:`fit_ml` on a :class:`~.model.Problem`, from ``start = (theta (L, 3), mu_f (L,),
-    mu_t (L,))`` on the feasible set (:func:`~.search.check_start`,
-    :func:`~.search.start_from_estimates` or :func:`~.search.complete_paths` give one).
+    """:func:`~.given_start.fit_ml` on a :class:`~.model.Problem`, from ``start = (theta (L, 3),
+    mu_f (L,), mu_t (L,))`` on the feasible set (:func:`~.given_start.check_start`,
+    :func:`~.search.start_from_estimates` or :func:`~.rank_one.complete_paths` give one).
 
     ``search``: ``"residual"`` (default) — after the re-seedings on ``rho``, re-initialisation on
     the residual's periodogram peak while it fails the residual test (:func:`_peak_reseed`);
@@ -524,7 +381,9 @@ def fit_problem(
             break
         peak = _peak_of(prob, best, sigma2)
     if best[3]["cost"] / (dof * sigma2) > rho_max:
-        best, its, n_kept = _rho_reseed(
+        from .rho_reseed import rho_reseed  # loaded when the basin test fails
+
+        best, its, n_kept = rho_reseed(
             prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof
         )
         n_it, kept = n_it + its, kept + n_kept

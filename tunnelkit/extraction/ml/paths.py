@@ -20,9 +20,9 @@ from ..radio import check_array, check_srs
 from .fitting import MAX_ITER, SEARCHES, MLDetectionWarning, MLFit, fit_problem
 from .model import W_FAR, W_MAX, Problem
 from .resolution import below_threshold
-from .search import check_start, complete_paths, start_from_estimates
+from .search import start_from_estimates
 
-__all__ = ["estimates_from_fit", "ml_order", "ml_paths", "physical"]
+__all__ = ["estimates_from_fit", "ml_paths", "physical"]
 
 
 def estimates_from_fit(fit: MLFit, array, srs, nf: int, nt: int, rel_error: float) -> PathEstimates:
@@ -165,6 +165,8 @@ def ml_paths(
         raise ValueError(f"search: expected one of {SEARCHES}, got {search!r}")
     wideband = boolean("wideband", wideband)
     if start is not None and not isinstance(start, PathEstimates):
+        from .given_start import check_start  # a start given as a tuple
+
         start = check_start(start, L)
     if L >= M:
         raise ValueError(
@@ -180,6 +182,8 @@ def ml_paths(
             est0 = resolve_coherent(H, est0, pos, srs, L)
         start = start_from_estimates(est0)
         if len(est0) < L:  # the split found fewer distinct paths: seed the rest from the residual
+            from .rank_one import complete_paths  # loaded when the split falls short
+
             start = complete_paths(prob, start, L)
     elif isinstance(start, PathEstimates):
         if len(start) != L:
@@ -212,31 +216,3 @@ def ml_paths(
             stacklevel=2,
         )
     return estimates_from_fit(fit, pos, srs, nf, nt, fit.cost / max(prob.h2, 1e-300))
-
-
-def ml_order(H, array, srs, *, max_paths: int | None = None, **kwargs) -> PathEstimates:
-    """The model order by a detection test per added path (GLRT): :func:`ml_paths` with
-    ``n_paths = 1, 2, ...`` until the residual holds no path more — the largest peak of its
-    single-path periodogram (the GLRT statistic of one path more) below its threshold at the
-    false-alarm rate ``FALSE_ALARM``, calibrated on noise-only tensors
-    (:func:`~.residual.calibrated_threshold`). A fit whose newest path fails its own GLRT
-    (``MLFit.detected``) stops the count one path earlier. Returns the estimates at the chosen
-    order (``len`` of the result); ``max_paths`` (default ``M - 1``) caps the count. Other
-    keywords go to :func:`ml_paths`."""
-    H = check_tensor(H)
-    M = H.shape[0]
-    cap = M - 1 if max_paths is None else integer("max_paths", max_paths, minimum=1)
-    cap = min(cap, M - 1)
-    if "n_paths" in kwargs:
-        raise TypeError("n_paths: ml_order chooses it; call ml_paths for a given order")
-    prev = None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        for L in range(1, cap + 1):
-            est = ml_paths(H, L, array, srs, **kwargs)
-            if not est.fit.detected.all():
-                return est if prev is None else prev
-            if est.fit.peak <= est.fit.peak_max:
-                return est
-            prev = est
-    return est

@@ -2,11 +2,11 @@
 and its threshold in SNR (the method of interval errors, Van Trees 2001 sec. 2.4).
 
 Per path: its distance from the others in standard deviations of their difference
-(:func:`separations`, :func:`pair_separation`), its significance (:func:`significance`), the
-verdict :func:`resolvable` and the threshold region :func:`below_threshold`
-(:func:`snr_threshold`, :func:`outlier_probability`). Per fit: the pair test :func:`pair_test`
-and :func:`unresolved_partners`. How it works:
-docs/internals/extraction-ml.md.
+(:func:`separations`, :func:`~.resolved.pair_separation`), its significance
+(:func:`significance`), the verdict :func:`~.resolved.resolvable` and the threshold region
+:func:`below_threshold` (:func:`snr_threshold`, :func:`outlier_probability`). Per fit: the pair
+test (:func:`pair_tests_at`; checked, :func:`~.resolved.pair_test`) and
+:func:`unresolved_partners`. How it works: docs/internals/extraction-ml.md.
 """
 
 from __future__ import annotations
@@ -19,9 +19,7 @@ from scipy.optimize import brentq
 from scipy.special import i0e
 
 from ..._validate import finite_array, integer, positive
-from ..numerics import circular_mean
-from .lm import best_of_starts, lm_fit
-from .model import Problem, project_feasible
+from .model import Problem
 
 __all__ = [
     "OUTLIER_RATE",
@@ -30,11 +28,7 @@ __all__ = [
     "PAIR_TEST_Z",
     "RESOLVE_Z",
     "below_threshold",
-    "closest_pair",
     "outlier_probability",
-    "pair_separation",
-    "pair_test",
-    "resolvable",
     "separations",
     "snr_threshold",
 ]
@@ -56,7 +50,21 @@ def significance(ev, sigma2) -> np.ndarray:
     return np.abs(ev["c"]) ** 2 / np.maximum(np.real(np.diag(Gi)), 1e-300) / sigma2
 
 
-def _checked(prob, theta, mu_f, mu_t, noise_power):
+#: coherence ``|G_ij| / sqrt(G_ii G_jj)`` above which two atoms are one path counted twice
+COUNTED_TWICE = 0.9
+
+
+def coherent_pair(ev):
+    """The two most collinear atoms ``i, j`` and their coherence ``|G_ij| / sqrt(G_ii G_jj)``."""
+    dg = np.sqrt(np.maximum(np.real(np.diag(ev["G"])), 1e-300))
+    coh = np.abs(ev["G"]) / np.outer(dg, dg)
+    np.fill_diagonal(coh, 0.0)
+    i, j = np.unravel_index(int(np.argmax(coh)), coh.shape)
+    return i, j, coh[i, j]
+
+
+def check_fit(prob, theta, mu_f, mu_t, noise_power):
+    """``(theta, mu_f, mu_t, sigma2)`` checked, each error naming its parameter."""
     if not isinstance(prob, Problem):
         raise TypeError(f"prob: expected a Problem, got {type(prob).__name__}")
     sigma2 = positive("noise_power", noise_power)
@@ -67,12 +75,13 @@ def _checked(prob, theta, mu_f, mu_t, noise_power):
     return theta, mu_f, mu_t, sigma2
 
 
-def _separations(prob: Problem, theta, mu_f, mu_t, sigma2, ev=None) -> np.ndarray:
+def separations_at(prob: Problem, theta, mu_f, mu_t, sigma2, ev=None) -> np.ndarray:
+    """:func:`separations` on checked arguments (``ev`` the evaluation at the fit, if at hand)."""
     L = theta.shape[0]
     if L < 2:
         return np.full(L, np.inf)
     ev = prob.evaluate(theta, mu_f, mu_t) if ev is None else ev
-    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, ev)
+    z = pair_z(prob, theta, mu_f, mu_t, sigma2, ev)
     i, j = np.triu_indices(L, 1)
     out = np.full(L, np.inf)
     np.minimum.at(out, i, z)
@@ -83,44 +92,8 @@ def _separations(prob: Problem, theta, mu_f, mu_t, sigma2, ev=None) -> np.ndarra
 def separations(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> np.ndarray:
     """Per path (L,): its smallest distance to another path in standard deviations of their
     difference (docs/internals; ``inf`` for a single path)."""
-    theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
-    return _separations(prob, theta, mu_f, mu_t, sigma2)
-
-
-def closest_pair(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> tuple[int, int, float]:
-    """The two paths fewest standard deviations of their difference apart (the pairwise distances
-    of :func:`separations`): ``(i, j, z)`` with ``i < j``; ``(-1, -1, inf)`` for one path."""
-    theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
-    L = theta.shape[0]
-    if L < 2:
-        return -1, -1, float("inf")
-    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, prob.evaluate(theta, mu_f, mu_t))
-    a, b = np.triu_indices(L, 1)
-    k = int(np.argmin(z))
-    return int(a[k]), int(b[k]), float(z[k])
-
-
-def pair_separation(prob: Problem, theta, mu_f, mu_t, noise_power: float) -> float:
-    """The smallest distance between two paths in standard deviations of their difference: for
-    each pair ``(i, j)`` the Mahalanobis length of ``Delta = (u_x, u_y, w, mu_f, mu_t)_i - (...)_j``
-    under the covariance of that difference, ``Sigma_ii + Sigma_jj - Sigma_ij - Sigma_ji``,
-    ``Sigma = (sigma^2 / 2) (Re J^H J)^+`` (the inverse Fisher information of the concentrated
-    model at the fit). ``inf`` for one path. A pair a few standard deviations apart is below the
-    statistical resolution limit: the likelihood has no single peak for it to sit on."""
-    z = separations(prob, theta, mu_f, mu_t, noise_power)
-    return float(np.min(z)) if z.size else float("inf")
-
-
-def resolvable(prob: Problem, theta, mu_f, mu_t, noise_power: float, detect: float) -> np.ndarray:
-    """Per path (L,) bool: at least ``RESOLVE_Z`` standard deviations from every other path and
-    its log-likelihood ratio against noise at least ``detect`` (the detection threshold of one
-    path, e.g. :func:`~.residual.calibrated_threshold`). At the true parameters: the path is
-    outside the estimator's threshold region (docs/internals)."""
-    theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
-    detect = positive("detect", detect)
-    ev = prob.evaluate(theta, mu_f, mu_t)
-    z = _separations(prob, theta, mu_f, mu_t, sigma2, ev)
-    return (z >= RESOLVE_Z) & (significance(ev, sigma2) >= detect)
+    theta, mu_f, mu_t, sigma2 = check_fit(prob, theta, mu_f, mu_t, noise_power)
+    return separations_at(prob, theta, mu_f, mu_t, sigma2)
 
 
 #: the pair test (docs/internals): rate at which one path is reported as two resolved ones
@@ -132,29 +105,9 @@ PAIR_TEST_Z = 10.0
 #: the pair test's threshold on ``(cost_merged - cost) / sigma^2``: the ``1 - PAIR_FALSE_ALARM``
 #: quantile of its null distribution (one path fitted as a close pair; docs/internals)
 PAIR_LLR = 13.0
-#: Levenberg-Marquardt iterations each start of the merged fit gets before they are ranked
-_MERGE_RANK_ITER = 8
 
 
-def _merged_fit(prob: Problem, theta, mu_f, mu_t, c, sigma2, i: int, j: int, max_iter: int):
-    """The ``L - 1`` paths with ``i`` and ``j`` replaced by one: started at their centroid
-    (weights ``|c|^2``, circular means of ``mu``) and at each of the two, every start given a few
-    iterations, the most likely fitted to convergence; returns the fit and the iterations."""
-    L = theta.shape[0]
-    w = np.abs(c[[i, j]]) ** 2
-    w = w / max(w.sum(), 1e-300)
-    keep = np.arange(L) != j
-    starts = []
-    for wi in (w[0], 1.0, 0.0):
-        th, mf, mt = theta.copy(), mu_f.copy(), mu_t.copy()
-        th[i] = wi * theta[i] + (1 - wi) * theta[j]
-        mf[i] = circular_mean([wi, 1 - wi], mu_f[[i, j]])
-        mt[i] = circular_mean([wi, 1 - wi], mu_t[[i, j]])
-        starts.append((project_feasible(th[keep]), mf[keep], mt[keep]))
-    return best_of_starts(lm_fit, prob, starts, sigma2, min(_MERGE_RANK_ITER, max_iter), max_iter)
-
-
-def _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max=PAIR_TEST_Z):
+def pair_test_rows(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max=PAIR_TEST_Z):
     """(P, 4) rows ``(i, j, z_ij, llr_ij)`` for the pairs closer than ``PAIR_TEST_Z``, and the
     iterations spent."""
     L = theta.shape[0]
@@ -165,7 +118,9 @@ def _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max=PAIR_TEST
     for a, b, zab in zip(i, j, z, strict=True):
         if not zab < z_max:
             continue
-        merged, its = _merged_fit(prob, theta, mu_f, mu_t, ev["c"], sigma2, a, b, max_iter)
+        from .merged import merged_fit  # loaded when a pair is close enough to test
+
+        merged, its = merged_fit(prob, theta, mu_f, mu_t, ev["c"], sigma2, a, b, max_iter)
         n_it += its
         rows.append((a, b, zab, (merged[3]["cost"] - ev["cost"]) / sigma2))
     return np.array(rows, float).reshape(-1, 4), n_it
@@ -177,11 +132,11 @@ def pair_tests_at(prob: Problem, theta, mu_f, mu_t, sigma2: float, ev: dict, max
     if theta.shape[0] < 2:
         return np.zeros((0, 4)), 0
     ev = ev if "A" in ev else prob.evaluate(theta, mu_f, mu_t)
-    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, ev)
-    return _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter)
+    z = pair_z(prob, theta, mu_f, mu_t, sigma2, ev)
+    return pair_test_rows(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter)
 
 
-def _pair_z(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> np.ndarray:
+def pair_z(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> np.ndarray:
     """Per pair ``(i < j)`` in ``np.triu_indices`` order: their distance in standard deviations
     of their difference (docs/internals)."""
     L = theta.shape[0]
@@ -193,31 +148,6 @@ def _pair_z(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> np.ndarray:
     D = x[i] - x[j]
     q = np.einsum("pa,pa->p", D, np.linalg.solve(S + 1e-300 * np.eye(5), D[..., None])[..., 0])
     return np.sqrt(np.maximum(q, 0.0))
-
-
-def pair_test(
-    prob: Problem,
-    theta,
-    mu_f,
-    mu_t,
-    noise_power: float,
-    *,
-    max_iter: int = 60,
-    z_max: float = PAIR_TEST_Z,
-) -> np.ndarray:
-    """The resolution test of each close pair of a fit (docs/internals): for every two paths fewer
-    than ``z_max`` (default ``PAIR_TEST_Z``) standard deviations of their difference apart, the generalised
-    likelihood-ratio test of one path (the two merged, all ``L - 1`` fitted again) against two:
-    rows ``(i, j, z_ij, llr_ij)``, ``llr = (cost_merged - cost) / sigma^2``; the pair is resolved
-    when ``llr >= PAIR_LLR`` (false-alarm rate ``PAIR_FALSE_ALARM``). ``theta, mu_f, mu_t``
-    should be a converged fit (the statistic compares two maxima of the likelihood)."""
-    theta, mu_f, mu_t, sigma2 = _checked(prob, theta, mu_f, mu_t, noise_power)
-    max_iter = integer("max_iter", max_iter, minimum=1, maximum=1000)
-    if not (isinstance(z_max, float) and z_max == np.inf):  # inf: every pair tested
-        z_max = positive("z_max", z_max)
-    ev = prob.evaluate(theta, mu_f, mu_t)
-    z = _pair_z(prob, theta, mu_f, mu_t, sigma2, ev) if theta.shape[0] > 1 else np.zeros(0)
-    return _pair_test(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max)[0]
 
 
 def unresolved_partners(tests: np.ndarray, L: int) -> np.ndarray:
