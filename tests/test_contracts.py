@@ -463,7 +463,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
     ),
     _doc(
-        r"tracking\.javelin\.(manage\.(FixedBirth|MeasuredBirth|static_doppler)"
+        r"tracking\.javelin\.(manage\.(FixedBirth|static_doppler)|measuredbirth\.MeasuredBirth"
         r"|surfaces\.GeometricBirth)",
         r"doppler_sign|sign",
         "negative",

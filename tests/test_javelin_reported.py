@@ -222,7 +222,8 @@ def test_design_monte_carlo_settles_near_the_bound():
 def test_measured_birth_covariance_matches_sampling_the_intersection():
     """Linearised birth (angles' covariance and the UE's x through the ray-plane intersection,
     with the cross-covariance) against 200 000 samples pushed through ``intersection``."""
-    from tunnelkit.tracking.javelin.manage import birth_covariance, intersection
+    from tunnelkit.tracking.javelin.manage import intersection
+    from tunnelkit.tracking.javelin.measuredbirth import birth_covariance
     from tunnelkit.tracking.javelin.state import JavelinState
 
     bs = (0.0, 0.0, 4.8)

@@ -37,7 +37,7 @@ _EXPORTS: dict[str, str] = {
     "JavelinDesign": "roles",
     "JointTestUpdater": "roles",
     "JosephUpdater": "roles",
-    "MeasuredBirth": "roles",
+    "MeasuredBirth": "measuredbirth",
     "MirrorMotion": "roles",
     "RandomWalk": "roles",
     "ReflectorCurvature": "roles",
