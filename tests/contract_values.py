@@ -242,7 +242,7 @@ def _studies():
     from tunnelkit.studies.los_only import los_only
 
     los_only(drives["paper"], 0.3)
-    from tunnelkit.simulation.drives import drive_variant
+    from tunnelkit.simulation.variants import drive_variant
 
     drive_variant("italiano2026-straight", 120.0)
     # the attribution study's record (its measurement traces the scene: tests/test_attribution.py)
