@@ -13,6 +13,7 @@ from .._lazy import lazy_exports
 
 _EXPORTS = {
     "ablation": "analysis",
+    "ablation_path": "analysis",
     "error_correlations": "analysis",
     "error_samples": "analysis",
     "extraction_errors": "analysis",
