@@ -486,7 +486,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no associated pair, no birth or death this epoch: the tracker predicts only",
     ),
     _doc(
-        r"tracking\.javelin\.tracker\.(Javelin\.(step|run|predict)|run_javelin)",
+        r"tracking\.javelin\.(tracker\.Javelin\.(step|run|predict)|runs\.run_javelin)",
         r"speed|heading",
         "nan",
         "NaN (or None) is a missing V2X message: the last one is reused with inflated noise "

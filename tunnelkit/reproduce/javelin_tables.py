@@ -20,9 +20,10 @@ import numpy as np
 from .._validate import boolean, choice, instance, integer, sequence, text
 from ..odometry import MODELS, Odometry
 from ..reference import load as load_reference
+from ..simulation.baselines import without_radio
 from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
 from ..simulation.drives import FLAGGED
-from ..simulation.scoring import evaluate, without_radio
+from ..simulation.scoring import evaluate
 from ..simulation.variants import drive_variant
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs

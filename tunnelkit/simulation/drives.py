@@ -33,8 +33,6 @@ from .._validate import (
     record,
     rng_or_error,
 )
-from ..channel import SRSConfig
-from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
@@ -51,11 +49,9 @@ __all__ = [
     "TUNING_SEEDS",
     "Condition",
     "DriveData",
-    "ml_epoch",
     "path_measurements",
     "route_name",
     "scenario_route",
-    "separate_epoch",
     "simulate_drive",
     "simulate_routes",
 ]
@@ -179,24 +175,6 @@ def route_name(extraction: str) -> str:
 
 
 _ROUTES: dict[tuple, SignalRoute] = {}
-
-
-def ml_epoch(ep, config, noise_power: float | None = None):
-    """``ep`` with its estimates and measurements redone by the maximum-likelihood route
-    (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor (``noise_power``:
-    what its fit is tested against, estimated from the tensor by default)."""
-    instance("ep", ep, Epoch)
-    instance("config", config, SRSConfig)
-    return ep.with_estimates(
-        ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config, noise_power=noise_power)
-    )
-
-
-def separate_epoch(ep, config):
-    """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
-    instance("ep", ep, Epoch)
-    instance("config", config, SRSConfig)
-    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
 
 
 def _nuisance(nuisance) -> dict:
@@ -338,7 +316,7 @@ def simulate_drive(
 
 def _ml_only_epoch(route: SignalRoute, k: int, rng: np.random.Generator, tunnel):
     """Epoch ``k`` of a drive measured by the ML route alone: the slot drawn as
-    :meth:`SignalRoute.epoch` draws it, then :func:`ml_epoch`'s extraction and measurements,
+    :meth:`SignalRoute.epoch` draws it, then :func:`~.reextract.ml_epoch`'s extraction and measurements,
     without the paper route's extraction, which the ML route does not use (it starts from its
     own CPD): the same epoch as ``ml_epoch(route.epoch(...), ...)``, the same draws."""
     arr, paths, snap = route.draw(k, rng, tunnel=tunnel)
@@ -351,14 +329,6 @@ def _ml_only_epoch(route: SignalRoute, k: int, rng: np.random.Generator, tunnel)
         k, float(traj.t[k]), traj.position[k].copy(), traj.velocity[k].copy(), arr, paths, snap,
         est, meas, truth,
     )  # fmt: skip
-
-
-def _redo(ep0, e: str, route: SignalRoute, tunnel):
-    if e == "coherent":
-        return separate_epoch(ep0, route.config)
-    if e == "ml":
-        return ml_epoch(ep0, route.config, route.ml_noise_power(ep0.k, ep0.snapshot, tunnel))
-    return ep0
 
 
 def _accumulator(T: int) -> dict:
@@ -495,7 +465,7 @@ def simulate_routes(
                     ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
             except (ValueError, np.linalg.LinAlgError) as exc:
                 ep0, failure = None, exc
-            except FloatingPointError as exc:  # the ML route's failures, as in _redo
+            except FloatingPointError as exc:  # the ML route's failures, as in redo_epoch
                 if not ml_only:
                     raise
                 ep0, failure = None, exc
@@ -503,8 +473,10 @@ def simulate_routes(
             for e in extractions:
                 ep = ep0
                 if ep is not None and e not in ("paper", "route") and not ml_only:
+                    from .reextract import redo_epoch  # the coherent or the ML route
+
                     try:
-                        ep = _redo(ep0, e, r, tunnel)
+                        ep = redo_epoch(ep0, e, r, tunnel)
                     except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
                         ep, failure = None, exc
                 eps[e] = (ep, None if ep is not None else f"extraction failed ({failure})")

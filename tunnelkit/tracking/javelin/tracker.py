@@ -19,7 +19,7 @@ import numpy as np
 
 from ..._checks import attributes, optional_real, unchecked
 from ..._physical import speeds, step_seconds
-from ..._validate import boolean, finite_array, positive, record, rng_or_error, vector
+from ..._validate import boolean, finite_array, record, vector
 from ..gating import ChiSquareGate
 from ..registry import register
 from .associate import AssociationCosts
@@ -33,8 +33,6 @@ __all__ = [
     "Javelin",
     "JavelinRun",
     "StepReport",
-    "draw_start",
-    "run_javelin",
 ]
 
 
@@ -115,7 +113,7 @@ class Javelin:
         the true first position (the open-sky fix the paper assumes), with ``sigma_p0_ue`` [m]
         of uncertainty (``sigma_p0_height`` for the height when given), the base station at the
         drive's reference antenna, the roles of ``design`` (default the paper's). An honest start
-        (its error drawn with the covariance the tracker is told, :func:`draw_start`) is the
+        (its error drawn with the covariance the tracker is told, :func:`~.runs.draw_start`) is the
         caller's to give."""
         attributes(
             "drive", drive, ("truth", "base_station"), "a simulated drive (simulation.DriveData)"
@@ -140,7 +138,7 @@ class Javelin:
         return run.estimates, run
 
     def run(self, epochs, speed, heading, dt: float, *, keep_reports: bool = False) -> JavelinRun:
-        """Step through a measurement stream (:func:`run_javelin`)."""
+        """Step through a measurement stream (:func:`~.runs.run_javelin`)."""
         if isinstance(epochs, str | bytes) or not isinstance(epochs, Sequence | np.ndarray):
             raise TypeError(
                 f"epochs: expected a sequence of PathMeasurements or None, got {type(epochs).__name__}"
@@ -401,19 +399,6 @@ def _check_paths(paths) -> None:
         raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
 
 
-def draw_start(
-    truth, sigma: float, rng: np.random.Generator, sigma_height: float | None = None
-) -> np.ndarray:
-    """An open-sky fix (3,) [m] drawn from ``N(truth, diag(sigma^2, sigma^2, sigma_height^2))``
-    (``sigma_height`` default ``sigma``): the start whose error the tracker's ``P_0``
-    (``sigma_p0_ue``, ``sigma_p0_height``) describes, not the truth itself."""
-    p = vector("truth", truth, 3)
-    s = positive("sigma", sigma)
-    sh = s if sigma_height is None else positive("sigma_height", sigma_height)
-    rng = rng_or_error("rng", rng)
-    return p + np.array([s, s, sh]) * rng.standard_normal(3)
-
-
 def _v2x(name: str, value) -> np.ndarray:
     """A V2X series (one value per epoch, NaN = the message is missing) as a flat float array."""
     if isinstance(value, str | bytes):
@@ -427,24 +412,3 @@ def _v2x(name: str, value) -> np.ndarray:
     if arr.ndim > 1:
         raise ValueError(f"{name}: expected one value per epoch (1-D), got shape {arr.shape}")
     return arr.reshape(-1)
-
-
-def run_javelin(
-    epochs: Sequence[PathMeasurements | None],
-    speed,
-    heading,
-    dt: float,
-    initial_position,
-    design: JavelinDesign | None = None,
-    *,
-    keep_reports: bool = False,
-) -> JavelinRun:
-    """Run :class:`Javelin` (built from ``design``, default the paper's) over a measurement stream.
-
-    ``speed[k]`` / ``heading[k]`` are the V2X message sent at epoch ``k`` (NaN = missing); as in
-    Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k``.
-    Warnings about faults are collected and counted instead of printed.
-    """
-    return Javelin(initial_position, design).run(
-        epochs, speed, heading, dt, keep_reports=keep_reports
-    )
