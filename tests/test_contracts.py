@@ -514,7 +514,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "row labels are for reports only: a hand-built measurement may carry none",
     ),
     _doc(
-        r"tracking\.javelin\.manage\.los_test",
+        r"tracking\.javelin\.lostest\.los_test",
         r"d|kappa",
         "nan",
         "a path without a curvature or a delay cannot be tested (the docstring's contract)",

@@ -1,5 +1,6 @@
 """Track management of Algorithm 3: deaths after zeta misses, births by intersection, the LoS test
-of eq. 60-61 and the Doppler test that tells static from dynamic reflectors."""
+of eq. 60-61 (:mod:`~tunnelkit.tracking.javelin.lostest`) and the Doppler test that tells static
+from dynamic reflectors."""
 
 from __future__ import annotations
 
@@ -7,9 +8,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._checks import series, unchecked
 from ..._checks import sign as check_sign
-from ..._validate import instance, integer, positive, real, record, sequence, vector
+from ..._checks import unchecked
+from ..._validate import instance, integer, real, record, sequence, vector
 from .config import JavelinConfig
 from .measurement import PathMeasurements
 from .state import JavelinState
@@ -18,36 +19,9 @@ __all__ = [
     "FixedBirth",
     "ManageResult",
     "intersection",
-    "los_test",
     "manage_tracks",
     "static_doppler",
 ]
-
-
-def los_test(d, kappa, gamma: float, candidates=None) -> int | None:
-    """Index of the LoS path by eq. 60 (``argmin |d - kappa|``) if it passes eq. 61
-    (``1 - gamma <= d / kappa <= 1 + gamma``), else ``None`` (NLoS).
-
-    ``candidates`` restricts the search (we search only paths no VUE track claimed); paths
-    without a curvature or a delay cannot be tested.
-    """
-    series("d", d), series("kappa", kappa), positive("gamma", gamma)
-    if candidates is not None:
-        for i in sequence("candidates", candidates, empty=True):
-            integer("candidates", i, minimum=0, maximum=np.size(d) - 1)
-    d = np.asarray(d, dtype=float)
-    kappa = np.asarray(kappa, dtype=float)
-    ok = np.isfinite(d) & np.isfinite(kappa) & (kappa > 0)
-    if candidates is not None:
-        mask = np.zeros(d.size, bool)
-        mask[np.asarray(list(candidates), dtype=int)] = True
-        ok &= mask
-    if not ok.any():
-        return None
-    gap = np.where(ok, np.abs(d - kappa), np.inf)
-    j = int(np.argmin(gap))
-    ratio = d[j] / kappa[j]
-    return j if (1.0 - gamma) <= ratio <= (1.0 + gamma) else None
 
 
 def intersection(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.ndarray | None:
@@ -236,6 +210,8 @@ def manage_tracks(
     los_path = next((j for i, j in pairs if i == 0), None)
     free = [j for j in range(len(meas)) if j not in assoc_paths]
     if los_path is None:
+        from .lostest import los_test  # no path associated with the UE
+
         los_path = los_test(meas.d, meas.kappa, config.los_gamma, candidates=free)
         if los_path is not None:
             pairs.append((0, los_path))
