@@ -689,7 +689,8 @@ def _odometry():
     from tunnelkit.studies.odometry import drift, drift_rows, drift_table
     from tunnelkit.tracking.javelin import JavelinConfig, JavelinState
     from tunnelkit.tracking.javelin.motion import odometry_transition
-    from tunnelkit.tracking.javelin.state import first_vue, kinematic, odometry_columns
+    from tunnelkit.tracking.javelin.odometrystates import kinematic, odometry_columns
+    from tunnelkit.tracking.javelin.state import first_vue
 
     t = np.arange(46) * 0.1
     v, th = np.full(46, 22.0), 0.01 * t

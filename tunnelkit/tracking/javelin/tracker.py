@@ -27,7 +27,7 @@ from .manage import ManageResult, manage_tracks
 from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
 from .motion import predict, ue_velocity
 from .roles import JavelinDesign
-from .state import JavelinState, kinematic, odometry_columns, track_slice
+from .state import JavelinState, track_slice
 
 __all__ = [
     "Javelin",
@@ -226,6 +226,8 @@ class Javelin:
         n = self.state.n_odo
         if not n:  # the paper's state
             return self.design.curvature.predict(x, cfg.bs)
+        from .odometrystates import kinematic, odometry_columns  # a tracker told the odometry
+
         pred, J = self.design.curvature.predict(kinematic(x, n), cfg.bs)
         return pred, odometry_columns(J, n)
 
