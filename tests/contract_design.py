@@ -129,7 +129,7 @@ def tracking_pieces():
         TeNFiLoc,
     )
     from tunnelkit.tracking.javelin.associate import AssociationCosts, global_nearest_neighbour
-    from tunnelkit.tracking.javelin.manage import MeasuredBirth
+    from tunnelkit.tracking.javelin.measuredbirth import MeasuredBirth
     from tunnelkit.tracking.javelin.measurement import track_model
     from tunnelkit.tracking.javelin.update import JointTestUpdater
 

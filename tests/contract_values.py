@@ -243,7 +243,7 @@ def _studies():
     from tunnelkit.studies.los_only import los_only
 
     los_only(drives["paper"], 0.3)
-    from tunnelkit.simulation.drives import drive_variant
+    from tunnelkit.simulation.variants import drive_variant
 
     drive_variant("italiano2026-straight", 120.0)
     # the attribution study's record (its measurement traces the scene: tests/test_attribution.py)
@@ -690,7 +690,8 @@ def _odometry():
     from tunnelkit.studies.odometry import drift, drift_rows, drift_table
     from tunnelkit.tracking.javelin import JavelinConfig, JavelinState
     from tunnelkit.tracking.javelin.motion import odometry_transition
-    from tunnelkit.tracking.javelin.state import first_vue, kinematic, odometry_columns
+    from tunnelkit.tracking.javelin.odometrystates import kinematic, odometry_columns
+    from tunnelkit.tracking.javelin.state import first_vue
 
     t = np.arange(46) * 0.1
     v, th = np.full(46, 22.0), 0.01 * t

@@ -463,7 +463,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "min_d = -c b_max: Algorithm 1's delay check widened by the clock bias's support",
     ),
     _doc(
-        r"tracking\.javelin\.(manage\.(FixedBirth|MeasuredBirth|static_doppler)"
+        r"tracking\.javelin\.(manage\.(FixedBirth|static_doppler)|measuredbirth\.MeasuredBirth"
         r"|surfaces\.GeometricBirth)",
         r"doppler_sign|sign",
         "negative",
@@ -486,7 +486,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no associated pair, no birth or death this epoch: the tracker predicts only",
     ),
     _doc(
-        r"tracking\.javelin\.tracker\.(Javelin\.(step|run|predict)|run_javelin)",
+        r"tracking\.javelin\.(tracker\.Javelin\.(step|run|predict)|runs\.run_javelin)",
         r"speed|heading",
         "nan",
         "NaN (or None) is a missing V2X message: the last one is reused with inflated noise "
@@ -514,7 +514,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "row labels are for reports only: a hand-built measurement may carry none",
     ),
     _doc(
-        r"tracking\.javelin\.manage\.los_test",
+        r"tracking\.javelin\.lostest\.los_test",
         r"d|kappa",
         "nan",
         "a path without a curvature or a delay cannot be tested (the docstring's contract)",

@@ -91,7 +91,7 @@ def test_the_traced_drive_is_the_drive_simulator_with_the_traced_adapters(setup)
         assert pa is not None  # the fit's own test ignored
         assert pt is None or (set(pt.source) <= set(pa.source) and len(pt) <= len(pa))
     # the pre-filter is geometry_keep on the same epoch: redo epoch 0 and compare the rows kept
-    from tunnelkit.simulation.drives import ml_epoch
+    from tunnelkit.simulation.reextract import ml_epoch
 
     with warnings.catch_warnings():  # every traced fit fails its own residual test
         warnings.simplefilter("ignore")

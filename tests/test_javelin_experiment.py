@@ -105,9 +105,9 @@ def test_evaluate_tables_and_ablation_on_toy_drives():
     with pytest.raises(ValueError, match=r"^routes"):
         table_rows({"x": drives}, "italiano2026_table1")
     acols, arows = ex.ablation(drives)
-    assert acols == ["design", "L", "N"] and len(arows) == len(designs.ablation_path())
+    assert acols == ["design", "L", "N"] and len(arows) == len(ex.ablation_path())
     _, arows2 = ex.ablation(drives, separated=drives, ml=routes["ml"])
-    assert len(arows2) == len(designs.ablation_path()) + 5
+    assert len(arows2) == len(ex.ablation_path()) + 5
     expect = ex.evaluate(drives["L"][0], designs.ours_coherent()).metrics["rmse_2d_m"]
     assert arows2[-5][1] == pytest.approx(arows[-1][1]) and arows2[-4][1] == pytest.approx(expect)
     assert [r[1] for r in arows2[-3:]] == pytest.approx(row[3:6])
@@ -291,7 +291,7 @@ def test_vue_prediction_skips_the_los_only_when_it_exists():
 
 
 def test_ablation_path_goes_from_the_paper_design_to_ours_one_change_at_a_time():
-    cfgs = list(designs.ablation_path().values())
+    cfgs = list(ex.ablation_path().values())
     assert cfgs[0] == designs.paper() and cfgs[-1] == designs.ours()
     assert len(set(map(repr, cfgs))) == len(cfgs)  # every step changes something
 

@@ -3,7 +3,8 @@ import pytest
 from javelin_geometric import geometric_paths, toy_reflectors
 
 from tunnelkit.tracking.javelin import FixedBirth, JavelinConfig, JavelinState, PathMeasurements
-from tunnelkit.tracking.javelin.manage import intersection, los_test, manage_tracks, static_doppler
+from tunnelkit.tracking.javelin.lostest import los_test
+from tunnelkit.tracking.javelin.manage import intersection, manage_tracks, static_doppler
 
 BS = np.array([0.0, 0.0, 4.8])
 PU = np.array([-25.0, 1.3, 1.0])

@@ -9,12 +9,8 @@ from tunnelkit.crlb import numeric_jacobian
 from tunnelkit.odometry import AUTOMOTIVE, WHITE, Odometry
 from tunnelkit.tracking.javelin import Javelin, JavelinConfig, JavelinState, PathMeasurements
 from tunnelkit.tracking.javelin.motion import odometry_transition, predict
-from tunnelkit.tracking.javelin.state import (
-    first_vue,
-    kinematic,
-    odometry_columns,
-    track_slice,
-)
+from tunnelkit.tracking.javelin.odometrystates import kinematic, odometry_columns
+from tunnelkit.tracking.javelin.state import first_vue, track_slice
 
 
 def _told_state(vues=2):

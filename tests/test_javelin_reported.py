@@ -222,7 +222,8 @@ def test_design_monte_carlo_settles_near_the_bound():
 def test_measured_birth_covariance_matches_sampling_the_intersection():
     """Linearised birth (angles' covariance and the UE's x through the ray-plane intersection,
     with the cross-covariance) against 200 000 samples pushed through ``intersection``."""
-    from tunnelkit.tracking.javelin.manage import birth_covariance, intersection
+    from tunnelkit.tracking.javelin.manage import intersection
+    from tunnelkit.tracking.javelin.measuredbirth import birth_covariance
     from tunnelkit.tracking.javelin.state import JavelinState
 
     bs = (0.0, 0.0, 4.8)
@@ -304,7 +305,7 @@ def test_our_ml_design_leaves_out_a_wrong_los_taken_by_eq61():
     direction is the only free path. With the joint innovation test (``designs.ours_ml``) the UE
     stays on its track; with the plain Joseph update the same pair pulls it metres away."""
     from tunnelkit.tracking.javelin import Javelin, JosephUpdater, designs
-    from tunnelkit.tracking.javelin.manage import los_test
+    from tunnelkit.tracking.javelin.lostest import los_test
 
     bs = np.array([0.0, 0.0, 4.8])
     dt, speed, bias = 0.1, 14.0, 3.0

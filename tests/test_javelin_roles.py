@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
 
+from tunnelkit.simulation.analysis import ablation_path
 from tunnelkit.tracking.javelin import (
     Associator,
     DelayCheck,
@@ -195,7 +196,7 @@ def test_named_designs():
     assert designs.paper(sigma_kappa=3.0).config.sigma_kappa == 3.0
     with pytest.raises(ValueError, match=r"^zeta"):
         designs.paper(zeta=2)
-    steps = list(designs.ablation_path().values())
+    steps = list(ablation_path().values())
     assert steps[0] == designs.paper() and steps[-1] == designs.ours()
 
 

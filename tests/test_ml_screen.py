@@ -10,6 +10,7 @@ from tunnelkit.cli import main
 from tunnelkit.extraction import ml
 from tunnelkit.extraction.ml import fitting
 from tunnelkit.reproduce import run
+from tunnelkit.simulation.variants import drive_variant
 
 SMALL = channel.SRSConfig(n_rb=20, comb=4, n_symbols=6)  # 60 tones x 6 symbols
 
@@ -93,7 +94,7 @@ def test_the_screen_reinitialises_a_crawling_wrong_basin_early():
 
 
 def test_drive_variant_lengthens_the_straight_drive_and_checks_its_arguments():
-    route = simulation.drives.drive_variant("italiano2026-straight", 120.0)
+    route = drive_variant("italiano2026-straight", 120.0)
     pos = route.trajectory.position
     preset = simulation.scenario_route("italiano2026-straight").trajectory.position
     assert pos[0, 0] == pytest.approx(preset[-1, 0] + 120.0, abs=1.5)
@@ -101,13 +102,13 @@ def test_drive_variant_lengthens_the_straight_drive_and_checks_its_arguments():
     np.testing.assert_allclose(pos[:, 1:], preset[:1, 1:].repeat(len(pos), 0))  # same lane
     step = np.diff(pos[:, 0])
     np.testing.assert_allclose(step, np.diff(preset[:, 0])[0], rtol=1e-9)  # same speed x period
-    assert simulation.drives.drive_variant("italiano2026-straight", 120) is route  # kept
+    assert drive_variant("italiano2026-straight", 120) is route  # kept
     with pytest.raises(ValueError, match="length"):
-        simulation.drives.drive_variant("italiano2026-straight", 500.0)
+        drive_variant("italiano2026-straight", 500.0)
     with pytest.raises(ValueError, match="length"):
-        simulation.drives.drive_variant("italiano2026-straight", -1.0)
+        drive_variant("italiano2026-straight", -1.0)
     with pytest.raises(TypeError, match="scenario"):
-        simulation.drives.drive_variant(route, 120.0)
+        drive_variant(route, 120.0)
 
 
 def test_length_is_refused_where_it_does_not_apply(capsys):

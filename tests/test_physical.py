@@ -134,7 +134,7 @@ def test_a_route_shorter_than_the_start_up_scores_nothing():
 
 
 def test_a_drive_of_a_nanometre_is_refused_not_scored_zero():
-    from tunnelkit.simulation.drives import drive_variant
+    from tunnelkit.simulation.variants import drive_variant
 
     with pytest.raises(ValueError, match=r"length: a 1e-09 m drive ends within the tracker.s 1 s"):
         drive_variant("italiano2026-straight", 1e-9)

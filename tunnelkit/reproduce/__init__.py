@@ -137,7 +137,7 @@ def run(
     ``nuisance`` (those targets only): the route's ``second_order`` / ``diffuse_floor``
     (:class:`tunnelkit.signal_route.SignalRoute`). ``length`` (the targets whose drive can be
     lengthened: javelin-table1): the drive over ``length`` metres ending where the preset's ends
-    (:func:`tunnelkit.simulation.drives.drive_variant`, e.g. 120). ``odometry`` (the targets with
+    (:func:`tunnelkit.simulation.variants.drive_variant`, e.g. 120). ``odometry`` (the targets with
     a drive: javelin-table1|2): the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` ("white", the paper's, by default; "automotive");
     ``told_odometry``: JAVELIN is told that model (its bias states; a model other than white)."""

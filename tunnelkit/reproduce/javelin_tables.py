@@ -20,9 +20,11 @@ import numpy as np
 from .._validate import boolean, choice, instance, integer, sequence, text
 from ..odometry import MODELS, Odometry
 from ..reference import load as load_reference
+from ..simulation.baselines import without_radio
 from ..simulation.collect import collect_drives, collect_routes, per_drive, simulate_condition
-from ..simulation.drives import FLAGGED, drive_variant
-from ..simulation.scoring import evaluate, without_radio
+from ..simulation.drives import FLAGGED
+from ..simulation.scoring import evaluate
+from ..simulation.variants import drive_variant
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from . import Report, register
@@ -205,7 +207,7 @@ def _simulate_and_score(
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
-    count. ``length``: the drive of :func:`~tunnelkit.simulation.drives.drive_variant` instead of
+    count. ``length``: the drive of :func:`~tunnelkit.simulation.variants.drive_variant` instead of
     the preset's (built on the worker, once per process); ``odometry`` a name of
     :data:`tunnelkit.odometry.MODELS`; ``told``: JAVELIN is told that model (:func:`score_drive`)."""
     route = scenario if length is None else drive_variant(scenario, length)
@@ -258,7 +260,7 @@ def javelin_table(
     ``second_order`` (second-order paths in the model) and ``diffuse_floor`` (the ML fit tested
     against noise + diffuse power), :class:`~tunnelkit.signal_route.SignalRoute`. ``length``
     (image channel, straight lane): the drive lengthened to ``length`` metres ending where the
-    preset's ends (:func:`~tunnelkit.simulation.drives.drive_variant`; 120 m: UE ranges 5-125 m);
+    preset's ends (:func:`~tunnelkit.simulation.variants.drive_variant`; 120 m: UE ranges 5-125 m);
     ``None`` the preset's drive. ``odometry``: the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` (the paper's "white" by default); ``told_odometry``:
     JAVELIN is told that model (its bias states, :func:`score_drive`; a model other than white)."""

@@ -19,12 +19,33 @@ from .scoring import evaluate
 __all__ = [
     "ERROR_QUANTITIES",
     "ablation",
+    "ablation_path",
     "error_correlations",
     "error_samples",
     "extraction_errors",
     "path_errors",
     "vue_prediction_errors",
 ]
+
+
+def ablation_path() -> dict[str, JavelinDesign]:
+    """The path from the paper's design to :func:`~tunnelkit.tracking.javelin.designs.ours`, one
+    change at a time (each row keeps the changes of the rows above it)."""
+    target = designs.ours()
+    cfg = target.config
+    d = designs.paper()
+    out = {"paper (section 4.2)": d}
+    d = d.with_prefilter(target.prefilters[1])
+    out["+ Doppler clutter rejection"] = d
+    d = d.with_(sigma_phi=cfg.sigma_phi, sigma_psi=cfg.sigma_psi, sigma_kappa=cfg.sigma_kappa)
+    out["+ noise calibrated on the extraction"] = d
+    d = d.with_(associator=target.associator)
+    out["+ global nearest neighbour"] = d
+    d = d.with_(vue_motion=target.vue_motion)
+    out["+ mirrored VUE motion"] = d
+    d = d.with_(initiator=target.initiator)
+    out["+ no update at birth (= ours)"] = d
+    return out
 
 
 def ablation(
@@ -49,7 +70,7 @@ def ablation(
         if value is not None:
             instance(name, value, dict, "a dict")
     boolean("progress", progress)
-    variants = designs.ablation_path() if variants is None else variants
+    variants = ablation_path() if variants is None else variants
     conds = list(drives)
     steps = [(name, cfg, drives) for name, cfg in variants.items()]
     if separated is not None:

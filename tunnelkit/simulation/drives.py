@@ -29,16 +29,12 @@ from .._validate import (
     choice,
     instance,
     integer,
-    positive,
     probability,
     record,
     rng_or_error,
 )
-from ..channel import SRSConfig
-from ..extraction.coherent import resolve_coherent
 from ..extraction.ml import ml_paths
 from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry
-from ..settling import SETTLE_S, settled
 from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.measurements import PathMeasurements
@@ -48,18 +44,14 @@ __all__ = [
     "EXTRACTIONS",
     "FLAGGED",
     "HELD_OUT_SEED",
-    "MAX_DRIVE_LENGTH",
     "SIGMA_HEADING",
     "SIGMA_SPEED",
     "TUNING_SEEDS",
     "Condition",
     "DriveData",
-    "drive_variant",
-    "ml_epoch",
     "path_measurements",
     "route_name",
     "scenario_route",
-    "separate_epoch",
     "simulate_drive",
     "simulate_routes",
 ]
@@ -185,24 +177,6 @@ def route_name(extraction: str) -> str:
 _ROUTES: dict[tuple, SignalRoute] = {}
 
 
-def ml_epoch(ep, config, noise_power: float | None = None):
-    """``ep`` with its estimates and measurements redone by the maximum-likelihood route
-    (:func:`tunnelkit.extraction.ml.ml_paths`, ``L`` known) on the same tensor (``noise_power``:
-    what its fit is tested against, estimated from the tensor by default)."""
-    instance("ep", ep, Epoch)
-    instance("config", config, SRSConfig)
-    return ep.with_estimates(
-        ml_paths(ep.snapshot.H, len(ep.paths), ep.array, config, noise_power=noise_power)
-    )
-
-
-def separate_epoch(ep, config):
-    """``ep`` with its estimates and measurements redone by ``coherent.resolve_coherent``."""
-    instance("ep", ep, Epoch)
-    instance("config", config, SRSConfig)
-    return ep.with_estimates(resolve_coherent(ep.snapshot.H, ep.estimates, ep.array, config))
-
-
 def _nuisance(nuisance) -> dict:
     """``nuisance`` checked: ``None`` or a dict of ``second_order`` (int) / ``diffuse_floor``."""
     from .._validate import boolean
@@ -251,49 +225,6 @@ def scenario_route(
             route, channel=channel or "image", options=RouteOptions(model=model, **nuisance)
         )
     return _ROUTES[key]
-
-
-#: longest drive of :func:`drive_variant` [m] (the 120 m drive of the stress matrix and some room)
-MAX_DRIVE_LENGTH = 200.0
-_VARIANTS: dict[tuple, SignalRoute] = {}
-
-
-def drive_variant(scenario: str, length: float) -> SignalRoute:
-    """The image-channel route of preset ``scenario`` (a straight-lane drive, ``trajectory.kind =
-    "lane3d"``) driven over ``length`` metres: the trajectory from ``x_end + length`` to the
-    preset's ``x_end`` (same lane, speed, epoch period, road markings), the tunnel lengthened to
-    at least ``2 (x_start + 25 m)`` (it is centred on the base station) so the drive starts 25 m
-    inside it. ``length = 120`` is the 120 m variant of ``tunnelkit reproduce javelin-table1
-    --length 120`` (UE ranges up to 125 m, where the images cluster within a few degrees and
-    centimetres of the line of sight). Built once per ``(scenario, length)`` and kept."""
-    from ..scenarios import load_scenario, with_values
-
-    if not isinstance(scenario, str):
-        raise TypeError(f"scenario: expected a preset name, got {type(scenario).__name__}")
-    length = positive("length", length)
-    if length > MAX_DRIVE_LENGTH:
-        raise ValueError(f"length: at most {MAX_DRIVE_LENGTH:g} m, got {length:g}")
-    key = (scenario, float(length))
-    if key not in _VARIANTS:
-        sc = load_scenario(scenario)
-        traj = sc.raw["trajectory"]
-        if traj.get("kind") != "lane3d":
-            raise ValueError(
-                f"scenario: {scenario!r} does not drive a straight lane (trajectory kind "
-                f"{traj.get('kind')!r}); a drive length applies to lane3d trajectories only"
-            )
-        x_end = float(traj["x_end"])
-        x_start = x_end + length
-        tunnel = max(float(sc.raw["tunnel"]["length"]), 2.0 * (x_start + 25.0))
-        sc = with_values(sc, {"trajectory.x_start": x_start, "tunnel.length": tunnel})
-        route = SignalRoute.from_scenario(sc)
-        if not settled(route.trajectory.t).size:  # nothing to score, never an RMSE of 0
-            raise ValueError(
-                f"length: a {length:g} m drive ends within the tracker's {SETTLE_S:g} s start-up "
-                "(settling.SETTLE_S): nothing settled to score; give a longer drive"
-            )
-        _VARIANTS[key] = route
-    return _VARIANTS[key]
 
 
 #: the reason an epoch the extraction flagged itself (``fit_ok = False``) carries no measurement
@@ -385,7 +316,7 @@ def simulate_drive(
 
 def _ml_only_epoch(route: SignalRoute, k: int, rng: np.random.Generator, tunnel):
     """Epoch ``k`` of a drive measured by the ML route alone: the slot drawn as
-    :meth:`SignalRoute.epoch` draws it, then :func:`ml_epoch`'s extraction and measurements,
+    :meth:`SignalRoute.epoch` draws it, then :func:`~.reextract.ml_epoch`'s extraction and measurements,
     without the paper route's extraction, which the ML route does not use (it starts from its
     own CPD): the same epoch as ``ml_epoch(route.epoch(...), ...)``, the same draws."""
     arr, paths, snap = route.draw(k, rng, tunnel=tunnel)
@@ -398,14 +329,6 @@ def _ml_only_epoch(route: SignalRoute, k: int, rng: np.random.Generator, tunnel)
         k, float(traj.t[k]), traj.position[k].copy(), traj.velocity[k].copy(), arr, paths, snap,
         est, meas, truth,
     )  # fmt: skip
-
-
-def _redo(ep0, e: str, route: SignalRoute, tunnel):
-    if e == "coherent":
-        return separate_epoch(ep0, route.config)
-    if e == "ml":
-        return ml_epoch(ep0, route.config, route.ml_noise_power(ep0.k, ep0.snapshot, tunnel))
-    return ep0
 
 
 def _accumulator(T: int) -> dict:
@@ -542,7 +465,7 @@ def simulate_routes(
                     ep0 = r.epoch(k, rng, tunnel=tunnel, refine="joint")
             except (ValueError, np.linalg.LinAlgError) as exc:
                 ep0, failure = None, exc
-            except FloatingPointError as exc:  # the ML route's failures, as in _redo
+            except FloatingPointError as exc:  # the ML route's failures, as in redo_epoch
                 if not ml_only:
                     raise
                 ep0, failure = None, exc
@@ -550,8 +473,10 @@ def simulate_routes(
             for e in extractions:
                 ep = ep0
                 if ep is not None and e not in ("paper", "route") and not ml_only:
+                    from .reextract import redo_epoch  # the coherent or the ML route
+
                     try:
-                        ep = _redo(ep0, e, r, tunnel)
+                        ep = redo_epoch(ep0, e, r, tunnel)
                     except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
                         ep, failure = None, exc
                 eps[e] = (ep, None if ep is not None else f"extraction failed ({failure})")

@@ -1,4 +1,5 @@
-"""Scoring a tracker on simulated drives: error metrics, settled errors, TeNFiLoc fixes.
+"""Scoring a tracker on simulated drives: error metrics, settled errors (the baselines, TeNFiLoc's
+fixes and dead reckoning: :mod:`tunnelkit.simulation.baselines`).
 
 :func:`evaluate` runs JAVELIN (any :class:`~tunnelkit.tracking.javelin.roles.JavelinDesign`) or
 the TeNFiLoc snapshot baseline on a :class:`~tunnelkit.simulation.drives.DriveData` and scores it:
@@ -9,8 +10,7 @@ the VUE tracks born over the first epochs); :func:`settled` selects the epochs a
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,9 +23,6 @@ from ..tracking.javelin.roles import JavelinDesign
 from ..tracking.javelin.tracker import JavelinRun
 from .drives import DriveData
 
-if TYPE_CHECKING:  # the baseline's class, loaded from the registry when a drive asks for it
-    from ..tracking.javelin.tenfiloc import TeNFiLoc
-
 __all__ = [
     "SETTLE_S",
     "Evaluation",
@@ -33,37 +30,7 @@ __all__ = [
     "evaluate",
     "settled",
     "settled_errors",
-    "tenfiloc_track",
-    "without_radio",
 ]
-
-
-def tenfiloc_track(
-    drive: DriveData, baseline: TeNFiLoc | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """TeNFiLoc fixes per epoch (T, 3) and which epochs had a fix (:meth:`TeNFiLoc.track`; the
-    baseline defaults to :meth:`TeNFiLoc.for_drive`)."""
-    if not isinstance(drive, DriveData):
-        raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
-    cls = registry.get("italiano2026", "TeNFiLoc")
-    tf = cls.for_drive(drive) if baseline is None else baseline
-    if not isinstance(tf, cls):
-        raise TypeError(f"baseline: expected a TeNFiLoc, got {type(tf).__name__}")
-    return tf.track(drive)
-
-
-def without_radio(drive: DriveData) -> DriveData:
-    """The same drive with every radio measurement dropped: a tracker run on it predicts on the
-    V2X speed and heading messages alone, from the same start (dead reckoning, the baseline the
-    radio must beat). Copies no array; draws nothing.
-
-    >>> without_radio("a drive")
-    Traceback (most recent call last):
-    ...
-    TypeError: drive: expected a simulation.drives.DriveData, got str
-    """
-    drive = instance("drive", drive, DriveData)
-    return replace(drive, epochs=[None] * len(drive.epochs))
 
 
 def error_metrics(estimates, truth) -> dict[str, float]:

@@ -5,11 +5,14 @@ its virtual UEs, in small roles.
 · ``noise`` (fixed or reported measurement noise) · ``consider`` (the bias-aware tracker's noise
 and update) · ``motion`` (eq. 62-63, VUE motion) · ``associate`` (eq. 56-59 gated costs, Algorithm
 2, global nearest neighbour) · ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test,
-initiators) · ``update`` (eq. 64-68, Joseph form, joint innovation test) · ``roles``
-(:class:`JavelinDesign`: numbers + one object per role) · ``designs`` (the named designs as
-factories) · ``arraydesign`` (the array design's tracker) · ``surfaces`` (VUEs born from known
-planes) · ``tracker`` (Algorithm 4) · ``tenfiloc`` (the snapshot baseline, eq. 69) · ``config``
-(section 4.2 numbers). The chi-square gate is :class:`tunnelkit.tracking.gating.ChiSquareGate`.
+initiators) · ``measuredbirth`` (VUEs born with the covariance of their angles) · ``reflector``
+(eq. 51's reflector curvature) · ``update`` (eq. 64-68, Joseph form, joint innovation test) ·
+``roles`` (:class:`JavelinDesign`: numbers + one object per role) · ``designs`` (the named
+designs as factories) · ``arraydesign`` (the array design's tracker) · ``surfaces`` (VUEs born
+from known planes) · ``tracker`` (Algorithm 4) · ``iterated`` (the first fix and the iterated
+update) · ``runs`` (a start drawn, a stream run in one call) · ``tenfiloc`` (the snapshot
+baseline, eq. 69) · ``config`` (section 4.2 numbers). The chi-square gate is
+:class:`tunnelkit.tracking.gating.ChiSquareGate`.
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ _EXPORTS: dict[str, str] = {
     "JavelinDesign": "roles",
     "JointTestUpdater": "roles",
     "JosephUpdater": "roles",
-    "MeasuredBirth": "roles",
+    "MeasuredBirth": "measuredbirth",
     "MirrorMotion": "roles",
     "RandomWalk": "roles",
     "ReflectorCurvature": "roles",
@@ -48,8 +51,8 @@ _EXPORTS: dict[str, str] = {
     "Javelin": "tracker",
     "JavelinRun": "tracker",
     "StepReport": "tracker",
-    "draw_start": "tracker",
-    "run_javelin": "tracker",
+    "draw_start": "runs",
+    "run_javelin": "runs",
 }
 __all__ = sorted([*_EXPORTS, "ChiSquareGate", "designs"])
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -11,7 +11,7 @@ import numpy as np
 from .associate import Associator
 from .consider import ConsiderNoise
 from .designs import ours
-from .manage import MeasuredBirth
+from .measuredbirth import MeasuredBirth
 from .measurement import DelayCheck, VueCurvature
 from .roles import JavelinDesign
 from .surfaces import GeometricBirth

@@ -61,7 +61,7 @@ class JavelinConfig:
       speed/heading message is missing;
     - ``base_station``: reference-antenna position [m] (the paper's origin);
     - ours: ``update_iterations`` the relinearisations of each epoch's update at most (an
-      iterated EKF, :meth:`~tunnelkit.tracking.javelin.tracker.Javelin._iterate`; default 0:
+      iterated EKF, :func:`~tunnelkit.tracking.javelin.iterated.iterate`; default 0:
       the paper's one EKF step);
     - ours, the odometry's repeating errors the tracker is told (:meth:`told`; default 0: the
       paper's white messages): ``sigma_speed_scale`` the sigma of the speed scale factor,

@@ -35,7 +35,6 @@ from .update import JointTestUpdater
 
 __all__ = [
     "ML_ERRORS_SEED0",
-    "ablation_path",
     "ours",
     "ours_coherent",
     "ours_ml",
@@ -110,23 +109,3 @@ def ours_ml(**overrides) -> JavelinDesign:
         sigma_delta_d=e["delta_d_m"],
         updater=JointTestUpdater(0.999),
     ).with_(**overrides)
-
-
-def ablation_path() -> dict[str, JavelinDesign]:
-    """The path from the paper's design to :func:`ours`, one change at a time (each row keeps the
-    changes of the rows above it)."""
-    target = ours()
-    cfg = target.config
-    d = paper()
-    out = {"paper (section 4.2)": d}
-    d = d.with_prefilter(target.prefilters[1])
-    out["+ Doppler clutter rejection"] = d
-    d = d.with_(sigma_phi=cfg.sigma_phi, sigma_psi=cfg.sigma_psi, sigma_kappa=cfg.sigma_kappa)
-    out["+ noise calibrated on the extraction"] = d
-    d = d.with_(associator=target.associator)
-    out["+ global nearest neighbour"] = d
-    d = d.with_(vue_motion=target.vue_motion)
-    out["+ mirrored VUE motion"] = d
-    d = d.with_(initiator=target.initiator)
-    out["+ no update at birth (= ours)"] = d
-    return out

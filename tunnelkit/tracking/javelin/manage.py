@@ -1,5 +1,6 @@
 """Track management of Algorithm 3: deaths after zeta misses, births by intersection, the LoS test
-of eq. 60-61 and the Doppler test that tells static from dynamic reflectors."""
+of eq. 60-61 (:mod:`~tunnelkit.tracking.javelin.lostest`) and the Doppler test that tells static
+from dynamic reflectors."""
 
 from __future__ import annotations
 
@@ -7,49 +8,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._checks import series, unchecked
 from ..._checks import sign as check_sign
-from ..._validate import instance, integer, positive, real, record, sequence, vector
+from ..._checks import unchecked
+from ..._validate import instance, integer, real, record, sequence, vector
 from .config import JavelinConfig
 from .measurement import PathMeasurements
-from .noise import FixedNoise
 from .state import JavelinState
 
 __all__ = [
     "FixedBirth",
     "ManageResult",
-    "MeasuredBirth",
     "intersection",
-    "los_test",
     "manage_tracks",
     "static_doppler",
 ]
-
-
-def los_test(d, kappa, gamma: float, candidates=None) -> int | None:
-    """Index of the LoS path by eq. 60 (``argmin |d - kappa|``) if it passes eq. 61
-    (``1 - gamma <= d / kappa <= 1 + gamma``), else ``None`` (NLoS).
-
-    ``candidates`` restricts the search (we search only paths no VUE track claimed); paths
-    without a curvature or a delay cannot be tested.
-    """
-    series("d", d), series("kappa", kappa), positive("gamma", gamma)
-    if candidates is not None:
-        for i in sequence("candidates", candidates, empty=True):
-            integer("candidates", i, minimum=0, maximum=np.size(d) - 1)
-    d = np.asarray(d, dtype=float)
-    kappa = np.asarray(kappa, dtype=float)
-    ok = np.isfinite(d) & np.isfinite(kappa) & (kappa > 0)
-    if candidates is not None:
-        mask = np.zeros(d.size, bool)
-        mask[np.asarray(list(candidates), dtype=int)] = True
-        ok &= mask
-    if not ok.any():
-        return None
-    gap = np.where(ok, np.abs(d - kappa), np.inf)
-    j = int(np.argmin(gap))
-    ratio = d[j] / kappa[j]
-    return j if (1.0 - gamma) <= ratio <= (1.0 + gamma) else None
 
 
 def intersection(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.ndarray | None:
@@ -82,31 +54,14 @@ def intersection_jacobian(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)
     )
 
 
-def birth_covariance(
-    state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig, noise=None
-):
-    """The covariance (2, 2) of a VUE born from path ``j`` and its cross-covariance (2, D) with
-    the state, by linearising :func:`intersection` in the path's angles and the UE's ``x``
-    (ours; the initiator ``MeasuredBirth``): ``F_z R F_z^T + f P_xx f^T`` and ``f P_x,:``. ``R``
-    is the path's angle covariance from the measurement-noise role ``noise`` (the reported one
-    under ``ReportedNoise``; default the paper's ``diag(sigma_phi^2, sigma_psi^2)``)."""
-    noise = FixedNoise() if noise is None else noise
-    F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
-    R = noise.covariances(meas, config)[j, :2, :2]
-    f = F[:, 2:3]  # d(y, z) / d x_u
-    cross = f @ state.P[0:1, :]
-    cov = F[:, :2] @ R @ F[:, :2].T + f @ state.P[0:1, 0:1] @ f.T
-    return 0.5 * (cov + cov.T), cross
-
-
 def birth_bias_cross(
     state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig, noise
 ) -> np.ndarray:
     """The cross-covariance (2, 4 L_hat + 4) of a VUE born from path ``j`` with every track's
     normalised bias (consider parameters, :class:`~.consider.ConsiderNoise`), the new track's own
     last: through the UE's ``x`` (``f C[0]``) and through the path's angles, whose repeating
-    error is ``L_j[:2] u_new`` (``F_z L_j[:2]``), as :func:`birth_covariance` linearises
-    :func:`intersection`."""
+    error is ``L_j[:2] u_new`` (``F_z L_j[:2]``), as :func:`~.measuredbirth.birth_covariance`
+    linearises :func:`intersection`."""
     F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
     out = np.zeros((2, state.C.shape[1] + 4))
     out[:, :-4] = F[:, 2:3] @ state.C[0:1, :]
@@ -152,21 +107,9 @@ class FixedBirth:
 
     def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
         """Covariance (2, 2) of the VUE born from path ``j`` and its cross-covariance (or None)."""
-        _birth_arguments(state, meas, j, noise)
+        birth_arguments(state, meas, j, noise)
         instance("config", config, JavelinConfig)
         return np.eye(2) * config.sigma_p0**2, None
-
-
-@dataclass(frozen=True)
-class MeasuredBirth(FixedBirth):
-    """A new VUE with the covariance of the angles that placed it and of the UE's ``x``, carried
-    through the intersection of Algorithm 3 with the cross-covariance (ours:
-    :func:`~tunnelkit.tracking.javelin.manage.birth_covariance`)."""
-
-    def covariance(self, state, meas, j: int, config: JavelinConfig, noise):
-        _birth_arguments(state, meas, j, noise)
-        instance("config", config, JavelinConfig)
-        return birth_covariance(state, meas, j, config, noise)
 
 
 @dataclass
@@ -188,7 +131,7 @@ class ManageResult:
             raise ValueError(f"los: {self.los} disagrees with los_path = {self.los_path}")
 
 
-def _birth_arguments(state, meas, j, noise) -> None:
+def birth_arguments(state, meas, j, noise) -> None:
     """The arguments every initiator's ``covariance`` takes (a path index into ``meas``)."""
     instance("state", state, JavelinState)
     instance("meas", meas, PathMeasurements)
@@ -221,7 +164,8 @@ def manage_tracks(
        claimed (ours: the paper searches all paths; a claimed path already has a track);
     3. births (lines 8-12): every other unassociated path starts a VUE at the intersection of its
        arrival ray with ``x = x_u`` with the covariance the ``initiator`` role gives
-       (``FixedBirth``: ``sigma_P^2 I``, the default; ``MeasuredBirth``: :func:`birth_covariance`
+       (``FixedBirth``: ``sigma_P^2 I``, the default; ``MeasuredBirth``:
+       :func:`~.measuredbirth.birth_covariance`
        with the ``noise`` role's angle covariance; an initiator with a ``place`` method,
        :class:`~.surfaces.GeometricBirth`, puts the VUE at the UE's mirror image in a known
        plane that explains the path instead); with a UE velocity ``v_u``
@@ -266,6 +210,8 @@ def manage_tracks(
     los_path = next((j for i, j in pairs if i == 0), None)
     free = [j for j in range(len(meas)) if j not in assoc_paths]
     if los_path is None:
+        from .lostest import los_test  # no path associated with the UE
+
         los_path = los_test(meas.d, meas.kappa, config.los_gamma, candidates=free)
         if los_path is not None:
             pairs.append((0, los_path))

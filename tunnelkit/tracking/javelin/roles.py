@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, fields, replace
 from ..._validate import instance
 from .associate import Associator
 from .config import JavelinConfig
-from .manage import FixedBirth, MeasuredBirth
+from .manage import FixedBirth
 from .measurement import DelayCheck, DopplerClutter, ReflectorCurvature, VueCurvature
 from .motion import MirrorMotion, RandomWalk
 from .noise import FixedNoise, ReportedNoise
@@ -30,7 +30,6 @@ __all__ = [
     "JavelinDesign",
     "JointTestUpdater",
     "JosephUpdater",
-    "MeasuredBirth",
     "MirrorMotion",
     "RandomWalk",
     "ReflectorCurvature",

@@ -17,7 +17,7 @@ carries its error states right after the UE: ``s = [x_u, y_u, z_u, s, b, r, y_v1
 (:data:`ODOMETRY_STATES`: the speed scale factor, the heading bias and the yaw-rate bias;
 ``n_odo = 3``, or 0 for the paper's white messages: the paper's state exactly). The VUEs then
 start at :func:`first_vue`; the measurement model does not depend on the odometry states
-(:func:`kinematic`, :func:`odometry_columns`).
+(:mod:`~tunnelkit.tracking.javelin.odometrystates`).
 """
 
 from __future__ import annotations
@@ -33,8 +33,6 @@ __all__ = [
     "JavelinState",
     "bias_slice",
     "first_vue",
-    "kinematic",
-    "odometry_columns",
     "track_slice",
 ]
 
@@ -59,31 +57,6 @@ def track_slice(i: int, n_odo: int = 0) -> slice:
     if i == 0:
         return slice(0, 3)
     return slice(o + 2 * (i - 1), o + 2 + 2 * (i - 1))
-
-
-def kinematic(x: np.ndarray, n_odo: int = 0) -> np.ndarray:
-    """The state vector ``x`` without its odometry states: ``[x_u, y_u, z_u, y_v1, ...]`` of
-    eq. 43, what the measurement model reads (``x`` itself when ``n_odo = 0``)."""
-    o = first_vue(n_odo)
-    x = finite_array("x", x, ndim=1)
-    if x.size < o:
-        raise ValueError(f"x: expected at least {o} entries (UE and odometry states), got {x.size}")
-    return x if o == 3 else np.concatenate([x[:3], x[o:]])
-
-
-def odometry_columns(J: np.ndarray, n_odo: int = 0) -> np.ndarray:
-    """A measurement Jacobian (..., D_kin) of :func:`kinematic`'s state with ``n_odo`` zero
-    columns inserted after the UE (no measurement depends on the odometry states): ``J`` (L, 4,
-    D_kin) as :func:`~.measurement.track_model` gives it (only a curvature row may be NaN)."""
-    first_vue(n_odo)
-    if isinstance(J, str | bytes) or np.asarray(J).dtype.kind not in "iuf":
-        raise TypeError(f"J: expected a real array (L, 4, D) from track_model, got {J!r:.40}")
-    J = np.asarray(J, dtype=float)
-    if J.ndim != 3 or J.shape[1] != 4 or J.shape[2] < 3:
-        raise ValueError(f"J: expected shape (L, 4, D >= 3) (track_model), got {J.shape}")
-    if not np.isfinite(J[:, [0, 1, 3]]).all():  # phi, psi and the range rows
-        raise ValueError("J: the angle and delay rows must be finite")
-    return J if not n_odo else np.insert(J, [3] * n_odo, 0.0, axis=-1)
 
 
 def bias_slice(i: int) -> slice:

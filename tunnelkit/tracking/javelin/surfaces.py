@@ -11,7 +11,7 @@ normalised angle innovation, gated at ``probability``) and appends the VUE at
 (``M P_uu M^T``, ``M P_u,:``): the new VUE is tied to the UE, and with ``MirrorMotion`` it moves
 by the mirrored displacement under the same speed/heading noise, so it stays tied (a reduced
 state up to the VUE random walk). A path no known plane explains (a vehicle, a surface missing
-from the model) is born from its angles as :class:`~.manage.MeasuredBirth` does.
+from the model) is born from its angles as :class:`~.measuredbirth.MeasuredBirth` does.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from ..._validate import finite_array, instance, integer, positive, probability,
 from ...geometry import spherical_jacobian
 from ..gating import ChiSquareGate
 from .config import JavelinConfig
-from .manage import MeasuredBirth
+from .measuredbirth import MeasuredBirth
 from .measurement import PathMeasurements
 from .state import JavelinState
 
@@ -65,7 +65,7 @@ class GeometricBirth(MeasuredBirth):
     a path two planes explain within this difference of ``d2`` is not born until one wins
     (a small array's angles do not tell a wall from a road marking a few degrees away). ``acquire``:
     the tracker's first epoch starts with an iterated fix on the shortest path
-    (:meth:`~.tracker.Javelin._acquire`), so the VUEs are placed from a UE on the LoS ray."""
+    (:func:`~.iterated.first_fix`), so the VUEs are placed from a UE on the LoS ray."""
 
     normals: tuple = ()
     offsets: tuple = ()

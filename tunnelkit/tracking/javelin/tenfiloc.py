@@ -21,7 +21,7 @@ from ..._checks import attributes, real_array
 from ..._validate import choice, instance, integer, positive, record, vector
 from ...constants import C
 from ..registry import register
-from .manage import los_test
+from .lostest import los_test
 from .measurement import PathMeasurements
 
 __all__ = ["TeNFiLoc", "TeNFiLocFix"]

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..._checks import attributes, optional_real, unchecked
 from ..._physical import speeds, step_seconds
-from ..._validate import boolean, finite_array, positive, record, rng_or_error, vector
+from ..._validate import boolean, finite_array, record, vector
 from ..gating import ChiSquareGate
 from ..registry import register
 from .associate import AssociationCosts
@@ -27,24 +27,12 @@ from .manage import ManageResult, manage_tracks
 from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
 from .motion import predict, ue_velocity
 from .roles import JavelinDesign
-from .state import JavelinState, kinematic, odometry_columns, track_slice
-from .update import stack_measurement
-
-#: iterations of the first fix's iterated EKF at most (:meth:`Javelin._acquire`)
-ACQUIRE_ITERATIONS = 20
-
-#: an epoch's iterated update stops when an iteration moves the UE by less than this share of
-#: its posterior standard deviation (the smallest axis): the linearisation point is then
-#: as good as the estimate can tell
-UPDATE_TOLERANCE = 0.01
+from .state import JavelinState, track_slice
 
 __all__ = [
-    "UPDATE_TOLERANCE",
     "Javelin",
     "JavelinRun",
     "StepReport",
-    "draw_start",
-    "run_javelin",
 ]
 
 
@@ -125,7 +113,7 @@ class Javelin:
         the true first position (the open-sky fix the paper assumes), with ``sigma_p0_ue`` [m]
         of uncertainty (``sigma_p0_height`` for the height when given), the base station at the
         drive's reference antenna, the roles of ``design`` (default the paper's). An honest start
-        (its error drawn with the covariance the tracker is told, :func:`draw_start`) is the
+        (its error drawn with the covariance the tracker is told, :func:`~.runs.draw_start`) is the
         caller's to give."""
         attributes(
             "drive", drive, ("truth", "base_station"), "a simulated drive (simulation.DriveData)"
@@ -150,7 +138,7 @@ class Javelin:
         return run.estimates, run
 
     def run(self, epochs, speed, heading, dt: float, *, keep_reports: bool = False) -> JavelinRun:
-        """Step through a measurement stream (:func:`run_javelin`)."""
+        """Step through a measurement stream (:func:`~.runs.run_javelin`)."""
         if isinstance(epochs, str | bytes) or not isinstance(epochs, Sequence | np.ndarray):
             raise TypeError(
                 f"epochs: expected a sequence of PathMeasurements or None, got {type(epochs).__name__}"
@@ -238,111 +226,10 @@ class Javelin:
         n = self.state.n_odo
         if not n:  # the paper's state
             return self.design.curvature.predict(x, cfg.bs)
+        from .odometrystates import kinematic, odometry_columns  # a tracker told the odometry
+
         pred, J = self.design.curvature.predict(kinematic(x, n), cfg.bs)
         return pred, odometry_columns(J, n)
-
-    def _fix(self, meas: PathMeasurements, j: int, cfg):
-        """The UE's prior updated with path ``j``'s angles as its LoS by an iterated EKF
-        (relinearised at its own estimate until it settles): ``(x, P, C)``. The curvature is
-        left out: an extraction near its threshold reports it metres off with a sigma that
-        does not say so, and the height prior and the angles place the UE on the ray. ``cfg``:
-        the epoch's (:meth:`_epoch_config`)."""
-        st, roles = self.state, self.design
-        kap = meas.kappa.copy()
-        kap[j] = np.nan
-        meas = replace(meas, kappa=kap)
-        x0, P0, C0 = st.x.copy(), st.P.copy(), None if st.C is None else st.C.copy()
-        xi = x0.copy()
-        for _ in range(ACQUIRE_ITERATIONS):
-            pred, J = self._model(xi, cfg)
-            m = stack_measurement(pred, J, meas, [(0, j)], cfg, j, roles.noise, C0)
-            m.h = m.h + m.H @ (x0 - xi)  # linearised at xi, the prior at x0
-            out = roles.updater.update(x0, P0, m, C0)
-            step = np.linalg.norm(out[0] - xi)
-            xi = out[0]
-            if step < 1e-6:
-                break
-        return out[0], out[1], (out[3] if len(out) == 4 else st.C)
-
-    def _iterate(self, out: tuple, meas: PathMeasurements, m, los_path, C0, cfg) -> tuple:
-        """The epoch's update relinearised at its own estimate until it settles (an iterated
-        EKF: Gauss-Newton on the prior and the epoch's rows, Bell & Cathey 1993). ``out`` is
-        the update linearised at the prior (``(x, P, nis[, C])``), ``m`` its stacked
-        measurement; the same rows (``m.labels``: the pairs kept) are stacked again at each
-        iterate, ``h`` shifted back to the prior (``h(x_i) + H_i (x_0 - x_i)``), and the prior's
-        update repeated with them, so the covariance is the Joseph form with the last
-        Jacobian. A one-step EKF is exact only while the correction stays within the range
-        where ``h`` is linear: at the first epoch the fix is a metre off along its ray (the
-        angles alone place it), and the curvature and delay rows then leave the update
-        millimetres off while its covariance says tenths of a millimetre (italiano2026-straight,
-        16 x 16, the first epoch: 3.4 mm RMS against a 0.35 mm bound); the inconsistent state
-        then fails the joint innovation test with true pairs for many epochs. Stops after
-        ``update_iterations`` (:class:`~.config.JavelinConfig`; the array design's) or when an
-        iteration moves the UE by less than :data:`UPDATE_TOLERANCE` of its posterior
-        standard deviation; the NIS stays the prior's (what the tests and the report use).
-        ``cfg``: the epoch's (:meth:`_epoch_config`)."""
-        st, roles = self.state, self.design
-        pairs = list(dict.fromkeys((i, j) for _, i, j in m.labels))
-        x0, P0 = st.x, st.P
-        for _ in range(cfg.update_iterations):
-            xi = out[0]
-            sd = np.sqrt(max(float(np.linalg.eigvalsh(out[1][:3, :3])[0]), 0.0))
-            pred, J = self._model(xi, cfg)
-            mi = stack_measurement(pred, J, meas, pairs, cfg, los_path, roles.noise, C0)
-            mi.h = mi.h + mi.H @ (x0 - xi)
-            new = roles.updater.update(x0, P0, mi, C0)
-            if not (np.all(np.isfinite(new[0])) and np.all(np.isfinite(new[1]))):
-                break
-            step = float(np.linalg.norm(new[0][:3] - xi[:3]))
-            out = (new[0], new[1], out[2], *new[3:])
-            if step <= UPDATE_TOLERANCE * sd:
-                break
-        return out
-
-    def _acquire(self, meas: PathMeasurements, faults: list[str], cfg) -> int | None:
-        """The first fix (ours; an initiator with ``acquire``, :class:`~.surfaces.GeometricBirth`):
-        before anything is associated or born, every path is tried as the LoS (:meth:`_fix`) and
-        the hypothesis kept that the known surfaces explain best: a UE inside the tunnel, the
-        smallest ``(x - x_0)^T P_0^-1 (x - x_0)`` plus, per other path, the normalised angle
-        innovation of the plane whose mirror image explains it (the gate's threshold when none
-        does). An open-sky fix a metre off puts the UE's prior where a reflection's wavefront is
-        as likely as the LoS's, the LoS and the ceiling path differ by millimetres in delay, and
-        the micro-radian angles of a large array leave a one-step EKF far from the ray. Returns
-        the path used (the epoch's update leaves it out, so it counts once), or ``None``.
-        ``cfg``: the epoch's (:meth:`_epoch_config`)."""
-        st, init = self.state, self.design.initiator
-        if st.n_vue or not len(meas):
-            return None
-        x0, P0 = st.x.copy(), st.P.copy()
-        gate = ChiSquareGate(init.probability).threshold(3)
-        best = None
-        for j in range(len(meas)):
-            try:
-                x, P, C = self._fix(meas, j, cfg)
-            except (ValueError, np.linalg.LinAlgError):
-                continue
-            if not init.inside(x[:3], cfg.bs):
-                continue
-            dx = x - x0
-            try:
-                score = float(dx @ np.linalg.solve(P0, dx))
-            except np.linalg.LinAlgError:  # a told odometry term of zero: its state is known
-                score = float(dx @ np.linalg.pinv(P0) @ dx)
-            trial = JavelinState(x, P, n_odo=st.n_odo)
-            for k in range(len(meas)):
-                if k != j:
-                    d2 = init.match_distance(trial, meas, k, cfg, self.design.noise, j)[1]
-                    score += min(d2, gate)
-            if best is None or score < best[0]:
-                best = (score, j, x, P, C)
-        if best is None:
-            faults.append(
-                "first fix failed (no path gives a UE inside the tunnel): open-sky fix kept"
-            )
-            return None
-        _, j, st.x, P, st.C = best
-        st.P = 0.5 * (P + P.T)
-        return j
 
     # -- Algorithm 4: the tracking protocol (predict, update; step does both) ----------------
     @property
@@ -386,7 +273,7 @@ class Javelin:
     def update(self, paths: PathMeasurements | None) -> StepReport:
         """Associate (Algorithm 2), manage tracks (Algorithm 3) and update (eq. 64-68) with the
         epoch's paths (None: predict only). The first epoch of a design whose initiator
-        acquires starts with the first fix (:meth:`_acquire`). Without a :meth:`predict` since
+        acquires starts with the first fix (:func:`~.iterated.first_fix`). Without a :meth:`predict` since
         the last update, the motion is unknown (the Doppler pre-filter and the VUE births then
         go without the UE's velocity)."""
         _check_paths(paths)
@@ -404,7 +291,9 @@ class Javelin:
         cfg = self._epoch_config(meas)  # the serving site's measurement model
         used = None
         if self.k == 0 and getattr(roles.initiator, "acquire", False) and len(meas):
-            used = self._acquire(meas, faults, cfg)
+            from .iterated import first_fix  # an initiator that acquires (the array design's)
+
+            used = first_fix(self.state, roles, meas, faults, cfg, self._model)
         st = self.state
         prior_pos, prior_ids = st.positions(), list(st.ids)
         sl = [track_slice(i, st.n_odo) for i in range(st.n_tracks)]
@@ -442,7 +331,9 @@ class Javelin:
                 n_rows = m.z.size
                 out = roles.updater.update(st.x, st.P, m, st.C)
                 if n_rows and cfg.update_iterations:
-                    out = self._iterate(out, meas, m, mres.los_path, st.C, cfg)
+                    from .iterated import iterate  # an iterated EKF (the array design's)
+
+                    out = iterate(st, roles, out, meas, m, mres.los_path, st.C, cfg, self._model)
                 x_new, P_new, nis = out[:3]
                 C_new = out[3] if len(out) == 4 else st.C
                 if not (np.all(np.isfinite(x_new)) and np.all(np.isfinite(P_new))):
@@ -510,19 +401,6 @@ def _check_paths(paths) -> None:
         raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
 
 
-def draw_start(
-    truth, sigma: float, rng: np.random.Generator, sigma_height: float | None = None
-) -> np.ndarray:
-    """An open-sky fix (3,) [m] drawn from ``N(truth, diag(sigma^2, sigma^2, sigma_height^2))``
-    (``sigma_height`` default ``sigma``): the start whose error the tracker's ``P_0``
-    (``sigma_p0_ue``, ``sigma_p0_height``) describes, not the truth itself."""
-    p = vector("truth", truth, 3)
-    s = positive("sigma", sigma)
-    sh = s if sigma_height is None else positive("sigma_height", sigma_height)
-    rng = rng_or_error("rng", rng)
-    return p + np.array([s, s, sh]) * rng.standard_normal(3)
-
-
 def _v2x(name: str, value) -> np.ndarray:
     """A V2X series (one value per epoch, NaN = the message is missing) as a flat float array."""
     if isinstance(value, str | bytes):
@@ -536,24 +414,3 @@ def _v2x(name: str, value) -> np.ndarray:
     if arr.ndim > 1:
         raise ValueError(f"{name}: expected one value per epoch (1-D), got shape {arr.shape}")
     return arr.reshape(-1)
-
-
-def run_javelin(
-    epochs: Sequence[PathMeasurements | None],
-    speed,
-    heading,
-    dt: float,
-    initial_position,
-    design: JavelinDesign | None = None,
-    *,
-    keep_reports: bool = False,
-) -> JavelinRun:
-    """Run :class:`Javelin` (built from ``design``, default the paper's) over a measurement stream.
-
-    ``speed[k]`` / ``heading[k]`` are the V2X message sent at epoch ``k`` (NaN = missing); as in
-    Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k``.
-    Warnings about faults are collected and counted instead of printed.
-    """
-    return Javelin(initial_position, design).run(
-        epochs, speed, heading, dt, keep_reports=keep_reports
-    )
