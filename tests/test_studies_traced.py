@@ -235,7 +235,7 @@ def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypat
     """traced_pcrlb: the covariance recursion of the linear model (F = I) it states, written out
     (P_k = ((P_{k-1} + Q_k)^-1 + I_k)^-1), gives the same bound; tighter sigmas a tighter bound;
     sigmas so large the paths carry nothing: the dead reckoning's bound; bad rows named."""
-    import tunnelkit.design as design
+    import tunnelkit.studies.traced_bound as traced_bound
     from tunnelkit.design import DesignSetup, drive_pcrlb
     from tunnelkit.design.drivebound import drive_motion
     from tunnelkit.simulation.drives import SIGMA_HEADING, SIGMA_SPEED
@@ -243,13 +243,13 @@ def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypat
 
     rows = [["all", 9, 9.0, 8.0, 33.0, 1.1, 1]]
     seen = {}
-    real = design.position_information
+    real = traced_bound.position_information
 
     def spy(model, geometry, weights=None):
         seen["info"] = real(model, geometry, weights)
         return seen["info"]
 
-    monkeypatch.setattr(design, "position_information", spy)
+    monkeypatch.setattr(traced_bound, "position_information", spy)
     b = traced_pcrlb(rows=rows, sigma_p0=0.5)
     info = seen["info"]
     assert info.shape == (len(b), 2, 2) and np.all(np.linalg.eigvalsh(info) > 0)

@@ -55,7 +55,15 @@ from .._validate import (
     sequence,
     text,
 )
+from ..channel import channel_tensor
 from ..constants import C
+from ..evaluation import match_paths
+from ..extraction import extract_paths, ml_truth
+from ..rt import RTSettings, default_cache_dir
+from ..scenarios import Scenario, load_scenario
+from ..signal_route import SignalRoute
+from ..signal_route.raytraced import tensor_snapshot
+from .misspecified import pseudo_true
 from .truth import angles_of_theta, path_differences, path_truth, world_angles
 
 __all__ = [
@@ -274,7 +282,6 @@ def scenario_with_array(scenario, shape: tuple[int, int]):
     """``scenario`` (a name or a loaded Scenario) with every base-station array of ``shape``
     (rows, columns) elements, mounted as the scenario mounts its own, named
     ``<name>-<rows>x<cols>`` (the ray-tracing cache's label)."""
-    from ..scenarios import Scenario, load_scenario
 
     sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
     instance("scenario", sc, Scenario)
@@ -293,7 +300,6 @@ def scenario_with_array(scenario, shape: tuple[int, int]):
 def config_settings(base, name: str):
     """The :class:`~tunnelkit.rt.settings.RTSettings` of configuration ``name`` (a key of
     :data:`CONFIGURATIONS`): ``base`` with its overrides."""
-    from ..rt import RTSettings
 
     instance("base", base, RTSettings)
     choice("name", name, tuple(CONFIGURATIONS))
@@ -382,7 +388,6 @@ def _rows(config, array, bias: list, errs: list) -> list[AttributionRow]:
 
 
 def _extract(route, H, arr, L):
-    from ..extraction import extract_paths
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fit's own test flags every traced epoch
@@ -393,9 +398,6 @@ def _measure(name, label, route, epochs, draws, rng, tensor_of, sigmas, progress
     """One configuration on one array: rows and summary (module docstring). ``tensor_of(k,
     arr, paths)`` -> the noiseless tensor (transmit power included) and a noisy snapshot
     maker ``rng -> snapshot``."""
-    from ..evaluation import match_paths
-    from ..extraction import ml_truth
-    from .misspecified import pseudo_true
 
     cfg = route.config
     bias, errs, shares, conv, fix_b, fix_e = [], [], [], [], [], []
@@ -468,12 +470,6 @@ def attribution(
     ``attribution/<name>`` under it), ``samples_per_src`` the rays (the scenario's by default),
     ``sigmas`` the one-epoch fix's weights (:func:`one_epoch_fix`)."""
     from pathlib import Path
-
-    from ..channel import channel_tensor
-    from ..rt import RTSettings, default_cache_dir
-    from ..scenarios import load_scenario
-    from ..signal_route import SignalRoute
-    from ..signal_route.raytraced import tensor_snapshot
 
     t0 = time.perf_counter()
     sc = load_scenario(scenario) if isinstance(scenario, str) else scenario

@@ -25,6 +25,10 @@ import numpy as np
 
 from .._validate import finite_array, instance, nonnegative, positive
 from ..geometry import spherical_jacobian
+from ..simulation import DriveData
+from ..simulation.prefilter import traced_measurements
+from ..tracking.javelin import JavelinDesign
+from .traced import traced_design
 
 __all__ = [
     "LOS_WINDOW_M",
@@ -57,7 +61,6 @@ def los_only(drive, window: float = LOS_WINDOW_M):
     """``drive`` (a :class:`tunnelkit.simulation.DriveData`) with each epoch's measurements cut
     to the path :func:`los_path` takes for the line of sight (an epoch without measurements
     stays ``None``). Draws nothing, uses no truth."""
-    from ..simulation import DriveData
 
     drive = instance("drive", drive, DriveData)
     window = nonnegative("window", window)  # checked here once for every epoch
@@ -84,7 +87,6 @@ def flagged_los(ep, route, window: float = LOS_WINDOW_M):
     that path in its threshold region (``PathEstimates.below_threshold``: its SNR below the
     threshold of the method of interval errors, or unresolved from another path, where its
     errors leave the bound). Uses the fit's own verdict, no truth."""
-    from ..simulation.prefilter import traced_measurements
 
     window = nonnegative("window", window)
     pm, _ = traced_measurements(ep, route, prefilter=False)  # checks ep and route
@@ -102,13 +104,11 @@ def los_design(sigma_angle: float, base=None, sigma_elevation: float | None = No
     """``base`` (default the traced design, :func:`tunnelkit.studies.traced.traced_design`) told
     ``sigma_angle`` [rad] for the azimuth of the path it is fed and ``sigma_elevation`` [rad]
     (default ``sigma_angle``) for its elevation (the other sigmas unchanged)."""
-    from .traced import traced_design
 
     sigma_angle = _angle_sigma("sigma_angle", sigma_angle)
     el = (
         sigma_angle if sigma_elevation is None else _angle_sigma("sigma_elevation", sigma_elevation)
     )
-    from ..tracking.javelin import JavelinDesign
 
     base = traced_design() if base is None else instance("base", base, JavelinDesign)
     return base.with_(sigma_phi=sigma_angle, sigma_psi=el)

@@ -50,7 +50,9 @@ import numpy as np
 from .._validate import boolean, instance, integer, rng_or_error
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
+from ..runner import run_trials
 from ..scenarios import data_dir
+from ..simulation.analysis import error_correlations, extraction_errors
 from ..simulation.drives import CONDITIONS, DriveData, scenario_route, simulate_routes
 from ..simulation.prefilter import (
     FLOORS,
@@ -158,8 +160,6 @@ def measure_traced_errors(
     from epoch to epoch (:func:`~tunnelkit.simulation.analysis.error_correlations`). Returns the
     record :func:`write_traced_errors` stores: ``rows`` (the table, its ``"all"`` row the
     sigmas), ``correlation`` (each sigma's inflation) and the procedure's provenance."""
-    from ..runner import run_trials
-    from ..simulation.analysis import error_correlations, extraction_errors
 
     runs = integer("runs", runs, minimum=1)
     check_bytes("runs", runs * RUN_BYTES, f"{runs} traced drives")

@@ -13,6 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import finite_array, instance
+from ..design import DesignSetup, drive_pcrlb, position_information
+from ..design.setup import parse_array
+from ..design.traced import sigma_error_model
 from ..odometry import Odometry
 from ..simulation.prefilter import SIGMA_SCENARIO
 from .traced import traced_errors
@@ -43,9 +46,6 @@ def traced_pcrlb(
     A bound for a tracker told the reflectors; the traced errors are neither Gaussian nor
     independent between epochs (repeating biases of the bounces), so it is what the sigmas
     alone allow, not a bound on what the channel allows."""
-    from ..design import DesignSetup, drive_pcrlb, position_information
-    from ..design.setup import parse_array
-    from ..design.traced import sigma_error_model
 
     if not isinstance(scenario, str) or not scenario:
         raise TypeError(f"scenario: expected a preset name, got {scenario!r}")
