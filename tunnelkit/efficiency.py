@@ -18,12 +18,15 @@ import numpy as np
 
 from ._checks import attributes
 from ._validate import boolean, finite_array, integer, sequence, text
+from .constants import C, db2lin
+from .evaluation import bound_errors, match_paths
+from .extraction import path_crlb
+from .montecarlo import spawn_rngs
 
 __all__ = ["drive_efficiency", "efficiency_rows", "mie_threshold_db", "threshold_study"]
 
 
 def _epoch_errors(route, k, rngs, refines):
-    from .evaluation import match_paths
 
     arr, paths = route.paths(k)
     err = {r: {j: [] for j in range(len(paths))} for r in refines}
@@ -60,8 +63,6 @@ def drive_efficiency(
     ``RMSE dir [deg]``, ``CRLB dir [deg]``, ``RMSE kappa [m]`` (against the distance of the wave
     source, NaN estimates left out and counted in ``no kappa``), ``CRLB kappa [m]``.
     """
-    from .extraction import path_crlb
-    from .montecarlo import spawn_rngs
 
     attributes("route", route, ("paths", "config"), "a signal_route.SignalRoute")
     progress = boolean("progress", progress)
@@ -151,11 +152,6 @@ def threshold_study(
     path beyond 6 sigma or missed) and ``flagged`` (share of snapshots the extraction flagged).
     """
     from dataclasses import replace
-
-    from .constants import C, db2lin
-    from .evaluation import bound_errors
-    from .extraction import path_crlb
-    from .montecarlo import spawn_rngs
 
     attributes("route", route, ("paths", "config"), "a signal_route.SignalRoute")
     progress = boolean("progress", progress)

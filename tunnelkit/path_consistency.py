@@ -19,12 +19,14 @@ from __future__ import annotations
 import numpy as np
 
 from ._physical import carrier
-from ._validate import boolean, finite_array, instance, integer, positive
+from ._validate import boolean, finite_array, instance, integer, positive, probability
 from .arrays import ArrayGeometry
 from .budget import check_elements
 from .channel import SRSConfig
 from .consistency import geometry_consistency, tunnel_planes
 from .constants import C
+from .extraction import PathEstimates, algorithm1
+from .geometry import spherical_jacobian
 from .signal_route import Epoch, SignalRoute
 from .signal_route.covariance import reported_covariance
 
@@ -36,8 +38,6 @@ def rate_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
     events in ``n`` trials (e.g. a test's false alarms in ``n`` snapshots): the rates ``p`` for
     which ``P(X >= k | p)`` and ``P(X <= k | p)`` both exceed ``(1 - level) / 2``."""
     from scipy.stats import beta
-
-    from ._validate import probability
 
     n = integer("n", n, minimum=1)
     k = integer("k", k, minimum=0, maximum=n)
@@ -54,7 +54,6 @@ def bound_sigmas(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.
     keeps with its printed check ``d >= 0``, as ``PathMeasurements.source``): the route's
     reported covariance (:func:`tunnelkit.signal_route.covariance.reported_covariance`, ``judged=False``).
     Raises ``numpy.linalg.LinAlgError`` where the Fisher information is singular."""
-    from .extraction import PathEstimates, algorithm1
 
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
@@ -125,8 +124,6 @@ def joint_bound(est, array: ArrayGeometry, config: SRSConfig, keep=None) -> np.n
     off-diagonal terms are the correlations within a path and between paths. Noise power and
     far-field placement as :func:`tunnelkit.extraction.estimate_crlb`. Raises
     ``numpy.linalg.LinAlgError`` where the Fisher information is singular."""
-    from .extraction import PathEstimates, algorithm1
-    from .geometry import spherical_jacobian
 
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
