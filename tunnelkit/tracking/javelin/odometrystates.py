@@ -1,7 +1,8 @@
-"""The odometry states of a tracker told an odometry model (:data:`~.state.ODOMETRY_STATES`,
-:meth:`~.config.JavelinConfig.told`) kept out of the measurement model, which does not depend on
-them: the state without them (:func:`kinematic`) and a measurement Jacobian with their zero
-columns put back (:func:`odometry_columns`). Their prediction is
+"""The odometry states of a tracker told an odometry model (:data:`~.state.ODOMETRY_STATES`):
+the config told it (:func:`told_config`, what :meth:`~.config.JavelinConfig.told` gives), and
+the states kept out of the measurement model, which does not depend on them: the state without
+them (:func:`kinematic`) and a measurement Jacobian with their zero columns put back
+(:func:`odometry_columns`). Their prediction is
 :func:`~tunnelkit.tracking.javelin.motion.odometry_transition`; the paper's state (``n_odo = 0``)
 needs none of this module.
 """
@@ -11,9 +12,30 @@ from __future__ import annotations
 import numpy as np
 
 from ..._validate import finite_array
+from ...odometry import Odometry
 from .state import first_vue
 
 __all__ = ["kinematic", "odometry_columns"]
+
+
+def told_config(config, odometry):
+    """A copy of the tracker's ``config`` (:class:`~.config.JavelinConfig`) told the odometry
+    model ``odometry`` (:class:`tunnelkit.odometry.Odometry`):
+    its white speed and heading noise and its repeating errors (the scale factor, the heading
+    bias, its random walk and the yaw-rate bias). Told the paper's white model it is the
+    paper's config with that white noise. The message rate and losses are not numbers of
+    the config: a missing message is the tracker's to handle (the last one, inflated)."""
+    if not isinstance(odometry, Odometry):
+        raise TypeError(f"odometry: expected an Odometry, got {type(odometry).__name__}")
+    o = odometry
+    return config.with_(
+        sigma_speed=o.speed_noise,
+        sigma_heading=o.heading_noise,
+        sigma_speed_scale=o.speed_scale,
+        sigma_heading_bias=o.heading_bias,
+        heading_drift=o.heading_drift,
+        sigma_yaw_rate_bias=o.yaw_rate_bias,
+    )
 
 
 def kinematic(x: np.ndarray, n_odo: int = 0) -> np.ndarray:
