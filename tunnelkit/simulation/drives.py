@@ -26,6 +26,7 @@ import numpy as np
 
 from .._physical import speeds
 from .._validate import (
+    boolean,
     choice,
     instance,
     integer,
@@ -35,7 +36,7 @@ from .._validate import (
 )
 from ..extraction.ml import ml_paths
 from ..odometry import SIGMA_HEADING, SIGMA_SPEED, Odometry
-from ..signal_route import CHANNELS, Epoch, RouteOptions, SignalRoute
+from ..signal_route import CHANNELS, MAX_SECOND_ORDER, Epoch, RouteOptions, SignalRoute
 from ..signal_route.measurements import measure_epoch
 from ..tracking.measurements import PathMeasurements
 
@@ -179,9 +180,6 @@ _ROUTES: dict[tuple, SignalRoute] = {}
 
 def _nuisance(nuisance) -> dict:
     """``nuisance`` checked: ``None`` or a dict of ``second_order`` (int) / ``diffuse_floor``."""
-    from .._validate import boolean
-    from ..signal_route import MAX_SECOND_ORDER
-
     if nuisance is None:
         return {}
     if not isinstance(nuisance, dict):

@@ -12,7 +12,6 @@ Every filter follows one protocol (:mod:`tunnelkit.tracking.protocol`): ``predic
 
 from .._lazy import lazy_exports
 from . import registry
-from .protocol import Filter
 
 # families -> modules that register them; imported on first lookup so `import tunnelkit` stays light
 registry.provide("jiang2023", "tunnelkit.tracking.virtual_station")  # TSWLS, EKF, UKF
@@ -21,9 +20,9 @@ registry.provide("halili2022", "tunnelkit.tracking.doppler")  # KF/EKF on Dopple
 registry.provide("italiano2026", "tunnelkit.tracking.javelin.tracker")  # JAVELIN
 registry.provide("italiano2026", "tunnelkit.tracking.javelin.tenfiloc")  # TeNFiLoc
 
-__all__ = ["Filter", "registry"]
-
 # a subpackage by its own name (``tk.tracking.javelin``) loads on first use: building a signal
-# route reads the measurement container (``tracking.measurements``) without loading a tracker
-_EXPORTS: dict[str, str] = {}
+# route reads the measurement container (``tracking.measurements``) without loading a tracker;
+# the protocol (``Filter``) loads when a caller checks a filter against it
+_EXPORTS: dict[str, str] = {"Filter": "protocol"}
+__all__ = sorted([*_EXPORTS, "registry"])
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

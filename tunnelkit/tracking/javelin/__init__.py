@@ -5,7 +5,8 @@ its virtual UEs, in small roles.
 · ``noise`` (fixed or reported measurement noise) · ``consider`` (the bias-aware tracker's noise
 and update) · ``motion`` (eq. 62-63, VUE motion) · ``associate`` (eq. 56-59 gated costs, Algorithm
 2, global nearest neighbour) · ``manage`` (Algorithm 3, LoS test eq. 60-61, Doppler test,
-initiators) · ``measuredbirth`` (VUEs born with the covariance of their angles) · ``reflector``
+initiators) · ``measuredbirth`` (VUEs born with the covariance of their angles) · ``linearbirth``
+(the birth's intersection linearised, a born VUE's cross-covariance with the biases) · ``reflector``
 (eq. 51's reflector curvature) · ``update`` (eq. 64-68, Joseph form, joint innovation test) ·
 ``roles`` (:class:`JavelinDesign`: numbers + one object per role) · ``designs`` (the named
 designs as factories) · ``arraydesign`` (the array design's tracker) · ``surfaces`` (VUEs born

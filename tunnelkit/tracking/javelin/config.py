@@ -17,7 +17,6 @@ import numpy as np
 
 from ..._physical import start_spread
 from ..._validate import integer, nonnegative, positive, probability, vector
-from ...odometry import Odometry
 
 __all__ = ["JavelinConfig"]
 
@@ -126,22 +125,10 @@ class JavelinConfig:
         return (self.sigma_speed_scale, self.sigma_heading_bias, self.sigma_yaw_rate_bias)
 
     def told(self, odometry) -> JavelinConfig:
-        """A copy told the odometry model ``odometry`` (:class:`tunnelkit.odometry.Odometry`):
-        its white speed and heading noise and its repeating errors (the scale factor, the heading
-        bias, its random walk and the yaw-rate bias). Told the paper's white model it is the
-        paper's config with that white noise. The message rate and losses are not numbers of
-        the config: a missing message is the tracker's to handle (the last one, inflated)."""
-        if not isinstance(odometry, Odometry):
-            raise TypeError(f"odometry: expected an Odometry, got {type(odometry).__name__}")
-        o = odometry
-        return self.with_(
-            sigma_speed=o.speed_noise,
-            sigma_heading=o.heading_noise,
-            sigma_speed_scale=o.speed_scale,
-            sigma_heading_bias=o.heading_bias,
-            heading_drift=o.heading_drift,
-            sigma_yaw_rate_bias=o.yaw_rate_bias,
-        )
+        """A copy told the odometry model ``odometry`` (:func:`~.odometrystates.told_config`)."""
+        from .odometrystates import told_config  # a tracker told the odometry
+
+        return told_config(self, odometry)
 
     @property
     def bs(self) -> np.ndarray:

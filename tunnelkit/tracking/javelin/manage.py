@@ -40,35 +40,6 @@ def intersection(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.n
     return p[1:].copy()
 
 
-def intersection_jacobian(phi: float, psi: float, x_u: float, bs=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """d(y, z) / d(phi, psi, x_u) of :func:`intersection` (2, 3): with ``h = x_u - b_x``,
-    ``y = b_y + h tan(phi)`` and ``z = b_z + h tan(psi) / cos(phi)``."""
-    h = x_u - float(np.asarray(bs, dtype=float)[0])
-    c, t = np.cos(phi), np.tan(phi)
-    tp = np.tan(psi)
-    return np.array(
-        [
-            [h / c**2, 0.0, t],
-            [h * tp * t / c, h / (np.cos(psi) ** 2 * c), tp / c],
-        ]
-    )
-
-
-def birth_bias_cross(
-    state: JavelinState, meas: PathMeasurements, j: int, config: JavelinConfig, noise
-) -> np.ndarray:
-    """The cross-covariance (2, 4 L_hat + 4) of a VUE born from path ``j`` with every track's
-    normalised bias (consider parameters, :class:`~.consider.ConsiderNoise`), the new track's own
-    last: through the UE's ``x`` (``f C[0]``) and through the path's angles, whose repeating
-    error is ``L_j[:2] u_new`` (``F_z L_j[:2]``), as :func:`~.measuredbirth.birth_covariance`
-    linearises :func:`intersection`."""
-    F = intersection_jacobian(meas.phi[j], meas.psi[j], state.x[0], config.bs)
-    out = np.zeros((2, state.C.shape[1] + 4))
-    out[:, :-4] = F[:, 2:3] @ state.C[0:1, :]
-    out[:, -4:] = F[:, :2] @ noise.factors(meas)[j, :2, :]
-    return out
-
-
 def static_doppler(p_u, p_v, v_u, bs=(0.0, 0.0, 0.0), sign: float = -1.0) -> float:
     """Radial speed a static reflector would produce: the VUE moves with the UE velocity mirrored
     in the reflecting plane (normal along ``p_v - p_u``); ``p_v = p_u`` means the LoS path.
@@ -244,6 +215,8 @@ def manage_tracks(
             cov, cross = initiator.covariance(state, meas, j, config, noise)
             bias_cross = None
             if state.C is not None and cross is not None and getattr(noise, "consider", False):
+                from .linearbirth import birth_bias_cross  # a bias-aware tracker's measured birth
+
                 bias_cross = birth_bias_cross(state, meas, j, config, noise)
         tid = state.append(yz, cov, transient=transient, cross=cross, bias_cross=bias_cross)
         born.append(tid)

@@ -1,9 +1,9 @@
 """VUE births with a measured covariance (ours, :class:`MeasuredBirth`): the intersection of
 Algorithm 3 (:func:`~.manage.intersection`) linearised in the path's angles and the UE's ``x``
-(:func:`~.manage.intersection_jacobian`) gives the new VUE's covariance and its
-cross-covariance with the state (:func:`birth_covariance`). The paper's births (``FixedBirth``,
-``sigma_P^2 I``), the cross-covariance with a bias-aware tracker's biases
-(:func:`~.manage.birth_bias_cross`) and the track management itself are
+(:func:`~.linearbirth.intersection_jacobian`) gives the new VUE's covariance and its
+cross-covariance with the state (:func:`birth_covariance`). The cross-covariance with a
+bias-aware tracker's biases is :func:`~.linearbirth.birth_bias_cross`; the paper's births
+(``FixedBirth``, ``sigma_P^2 I``) and the track management itself are
 :mod:`~tunnelkit.tracking.javelin.manage`.
 """
 
@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 from ..._validate import instance
 from .config import JavelinConfig
-from .manage import FixedBirth, birth_arguments, intersection_jacobian
+from .linearbirth import intersection_jacobian
+from .manage import FixedBirth, birth_arguments
 from .measurement import PathMeasurements
 from .noise import FixedNoise
 from .state import JavelinState

@@ -18,12 +18,10 @@ import numpy as np
 from ..._physical import speeds, step_seconds
 from ..._validate import choice, instance, positive, real
 from .config import JavelinConfig
-from .state import ODOMETRY_STATES, JavelinState, first_vue
+from .state import I_BIAS, JavelinState, first_vue
 
 __all__ = ["motion_increment", "odometry_transition", "predict", "ue_velocity"]
 
-#: state indices of the odometry states (:data:`~.state.ODOMETRY_STATES`, after the UE)
-I_SCALE, I_BIAS, I_RATE = range(3, 3 + len(ODOMETRY_STATES))
 #: the VUE motion models (:class:`RandomWalk`, :class:`MirrorMotion`)
 VUE_MOTIONS = ("random_walk", "mirror")
 
@@ -73,28 +71,11 @@ def motion_increment(
 def odometry_transition(
     state: JavelinState, speed: float, heading: float, dt: float, vue_motion: str = "random_walk"
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The prediction of a state with odometry states (docs/internals): the increment (D,),
-    ``F`` (D, D) and the sensitivity ``G`` (D, 2) to the message's white noise ``(n_v,
-    n_theta)``, for the message ``speed`` [m/s], ``heading`` [rad] over ``dt`` [s]. With
-    ``nu_c = speed / (1 + s)`` and ``theta_c = heading - b`` the motion of
-    :func:`motion_increment` at ``(nu_c, theta_c)``: ``d/ds = -G_c[:, 0] speed / (1 + s)^2``,
-    ``d/db = -G_c[:, 1]``, ``d/dn_v = G_c[:, 0] / (1 + s)``; ``b`` grows by ``r dt``."""
-    instance("state", state, JavelinState)
-    if state.n_odo != 3:
-        raise ValueError(f"state: expected the odometry states (n_odo = 3), got {state.n_odo}")
-    speeds("speed", speed), real("heading", heading)
-    i_s, i_b, i_r = I_SCALE, I_BIAS, I_RATE
-    s, b, r = state.x[i_s], state.x[i_b], state.x[i_r]
-    if not s > -1.0:
-        raise ValueError(f"state: the speed scale factor must exceed -1, got {s}")
-    inc, Gc = motion_increment(state, speed / (1.0 + s), heading - b, dt, vue_motion)
-    inc[i_b] = r * dt
-    F = np.eye(state.dim)
-    F[:, i_s] -= Gc[:, 0] * speed / (1.0 + s) ** 2
-    F[:, i_b] -= Gc[:, 1]
-    F[i_b, i_r] = dt
-    G = Gc * np.array([1.0 / (1.0 + s), 1.0])
-    return inc, F, G
+    """The prediction of a state with odometry states: the increment (D,), ``F`` (D, D) and
+    ``G`` (D, 2) (:func:`~.odometrystates.odometry_prediction` on :func:`motion_increment`)."""
+    from .odometrystates import odometry_prediction  # a tracker told the odometry
+
+    return odometry_prediction(state, speed, heading, dt, vue_motion, motion_increment)
 
 
 def predict(

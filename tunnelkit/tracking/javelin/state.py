@@ -39,6 +39,8 @@ __all__ = [
 #: the odometry error states a told tracker carries after the UE, in order (the speed scale
 #: factor, the heading bias [rad], the yaw-rate bias [rad/s]; :class:`~tunnelkit.odometry.Odometry`)
 ODOMETRY_STATES = ("speed_scale", "heading_bias", "yaw_rate_bias")
+#: state indices of the odometry states (:data:`ODOMETRY_STATES`, after the UE)
+I_SCALE, I_BIAS, I_RATE = range(3, 3 + len(ODOMETRY_STATES))
 
 
 def first_vue(n_odo: int = 0) -> int:
