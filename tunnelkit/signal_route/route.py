@@ -290,9 +290,7 @@ class SignalRoute:
         (:func:`tunnelkit.signal_route.epoch.run_epoch`)."""
         from .epoch import run_epoch
 
-        return run_epoch(
-            self, k, rng, n_paths=n_paths, tunnel=tunnel, clock_bias=clock_bias, **extract_kw
-        )
+        return run_epoch(self, k, rng, n_paths, tunnel, clock_bias, extract_kw)
 
 
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
