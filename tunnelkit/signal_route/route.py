@@ -9,7 +9,6 @@ import numpy as np
 
 from .._validate import (
     choice,
-    finite_array,
     instance,
     integer,
     real,
@@ -28,9 +27,6 @@ __all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute", "simul
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
 #: ``"sionna"`` (the tensor of every path Sionna RT traces per element, :mod:`tunnelkit.rt.cache`)
 CHANNELS = ("image", "sionna")
-#: the largest element gain error [dB] a route's calibration may hold (far beyond any drawn one:
-#: :func:`tunnelkit.channel.draw_calibration` allows a spread of at most 40 dB)
-MAX_CALIBRATION_DB = 300.0
 
 
 def check_arrays(arrays) -> None:
@@ -92,19 +88,10 @@ class SignalRoute:
         real("snr_offset_db", self.snr_offset_db)
         instance("impairments", self.impairments, Impairments)
         instance("calibration", self.calibration, dict)
-        sizes = {a.name: a.M for a in self.arrays}
-        for name, g in self.calibration.items():
-            if name not in sizes:
-                raise ValueError(f"calibration: {name!r} is not one of the arrays {list(sizes)}")
-            g = finite_array(f"calibration[{name!r}]", g, shape=(sizes[name],), dtype=complex)
-            with np.errstate(divide="ignore"):
-                db = 20 * np.log10(np.abs(g))
-            if not np.all(np.abs(db) <= MAX_CALIBRATION_DB):
-                raise ValueError(
-                    f"calibration[{name!r}]: element gains of {db.min():.3g} to {db.max():.3g} dB; "
-                    f"a calibration error lies within +-{MAX_CALIBRATION_DB:g} dB (a dead element "
-                    "or a unit mistake is not one)"
-                )
+        if self.calibration:
+            from ..calibration import check_route_calibration  # loaded with a calibration
+
+            check_route_calibration(self.calibration, {a.name: a.M for a in self.arrays})
         opts = instance("options", self.options, RouteOptions)
         budget = opts.bias_budget
         if budget is not None and budget.exists.shape[0] != len(self.trajectory):
