@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
+from .. import propagation
 from .._validate import (
     choice,
     instance,
@@ -18,6 +19,8 @@ from .._validate import (
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
 from ..constants import C
+from ..propagation import PATH_KINDS, Tunnel3D
+from ..scenarios import Scenario, Trajectory, load_scenario
 from .measurements import Epoch
 from .options import MAX_SECOND_ORDER, RouteOptions
 
@@ -76,9 +79,6 @@ class SignalRoute:
     options: RouteOptions = field(default_factory=RouteOptions)
 
     def __post_init__(self) -> None:
-        from ..propagation import PATH_KINDS, Tunnel3D
-        from ..scenarios import Trajectory
-
         instance("tunnel", self.tunnel, Tunnel3D)
         check_arrays(self.arrays)
         instance("trajectory", self.trajectory, Trajectory)
@@ -152,9 +152,6 @@ class SignalRoute:
         ``channel="sionna"`` attaches the scenario's ray-traced channel (settings from its
         ``[raytracing]`` section unless ``rt_settings`` is given, cache under ``cache_dir``,
         :mod:`tunnelkit.rt.cache`)."""
-        from .. import propagation
-        from ..scenarios import Scenario, load_scenario
-
         sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
         if not isinstance(sc, Scenario):
             raise TypeError(
@@ -179,8 +176,6 @@ class SignalRoute:
     def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
         """The array facing the vehicle and the true paths at epoch ``k`` (first order, then the
         strongest ``second_order`` second-order paths)."""
-        from .. import propagation
-
         k = integer("k", k, minimum=0)
         if k >= len(self.trajectory):
             raise ValueError(f"k: epoch {k} beyond the trajectory ({len(self.trajectory)} epochs)")
