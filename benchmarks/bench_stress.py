@@ -59,7 +59,7 @@ verdict (``PathEstimates.below_threshold`` at the fit) agrees with the truth's.
 ``python benchmarks/bench_stress.py --seed S --snapshots 30`` prints the table; the
 settings were chosen on seed 23 (the design seed); ``HELD_OUT_SEED`` is a seed the settings
 were never tried on before the final run (the seed 2026 of the session before was seen while
-choosing these; the split of an unresolved pair, ``ml.fitting.PAIR_GAIN``, was chosen on seed 23
+choosing these; the split of an unresolved pair, ``ml.split.PAIR_GAIN``, was chosen on seed 23
 alone and then run once on 8191 and on 4242, a seed never run before; the resolution verdict,
 ``PathEstimates.unresolved`` with ``ml.PAIR_LLR`` from its Monte-Carlo null, was decided on seed
 23 and then run once on 8191, 4242 and 30011, a seed never run before; the split of the closest

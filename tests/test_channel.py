@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from tunnelkit import channel, signal_route
+from tunnelkit import calibration, channel, signal_route
 from tunnelkit import propagation as P
 from tunnelkit.arrays import make_array
 from tunnelkit.constants import K_B, C
@@ -194,7 +194,7 @@ def test_spatial_wideband_matches_a_direct_per_element_computation(small):
 
 def test_calibration_error_has_the_stated_statistics(small):
     arr, paths = small
-    g = channel.draw_calibration(np.random.default_rng(0), 40_000, 3.0, 0.5)
+    g = calibration.draw_calibration(np.random.default_rng(0), 40_000, 3.0, 0.5)
     phase_deg = np.degrees(np.angle(g))
     gain_db = 20 * np.log10(np.abs(g))
     # 40 000 draws: the sample std is within 1.5 % (about 4 standard errors) of sigma
@@ -204,7 +204,7 @@ def test_calibration_error_has_the_stated_statistics(small):
     assert abs(np.corrcoef(phase_deg, gain_db)[0, 1]) < 0.02
     # explicit calibration multiplies each element's slice, nothing else
     cfg = channel.SRSConfig()
-    cal = channel.draw_calibration(np.random.default_rng(1), arr.M, 5.0, 1.0)
+    cal = calibration.draw_calibration(np.random.default_rng(1), arr.M, 5.0, 1.0)
     H0 = channel.channel_tensor(paths, cfg, n_tones=6, n_symbols=2)
     H1 = channel.channel_tensor(paths, cfg, n_tones=6, n_symbols=2, calibration=cal)
     np.testing.assert_allclose(H1, cal[:, None, None] * H0, rtol=1e-14, atol=0)
@@ -224,7 +224,7 @@ def test_impairment_bad_input(small):
     with pytest.raises(ValueError, match=r"^phase_sigma_deg"):
         channel.Impairments(phase_sigma_deg=-1.0)
     with pytest.raises(ValueError, match=r"^gain_sigma_db"):
-        channel.draw_calibration(np.random.default_rng(0), 4, 1.0, float("nan"))
+        calibration.draw_calibration(np.random.default_rng(0), 4, 1.0, float("nan"))
     with pytest.raises(TypeError, match=r"^spatial_wideband"):
         channel.channel_tensor(paths, cfg, n_tones=4, spatial_wideband=1)
     with pytest.raises(ValueError, match=r"^calibration"):
@@ -232,7 +232,7 @@ def test_impairment_bad_input(small):
     with pytest.raises(ValueError, match=r"^calibration"):
         channel.channel_tensor(paths, cfg, n_tones=4, calibration=np.zeros(paths[0].lengths.size))
     with pytest.raises(TypeError, match=r"^rng"):
-        channel.draw_calibration(0, 4, 1.0)
+        calibration.draw_calibration(0, 4, 1.0)
     route = signal_route.SignalRoute.from_scenario("italiano2026-straight")
     with pytest.raises(TypeError, match=r"^impairments"):
         route.with_impairments({"phase_sigma_deg": 1.0}, np.random.default_rng(0))

@@ -160,7 +160,7 @@ def test_calibration_gains_out_of_range(gain_db):
     _raises(
         ValueError,
         r"^gain_sigma_db",
-        tk.channel.draw_calibration,
+        tk.calibration.draw_calibration,
         np.random.default_rng(0),
         4,
         gain_sigma_db=gain_db,
@@ -171,7 +171,7 @@ def test_calibration_gains_out_of_range(gain_db):
 
 
 def test_draw_calibration_beyond_the_memory_budget():
-    _raises(ValueError, r"^m", tk.channel.draw_calibration, np.random.default_rng(0), 10**12)
+    _raises(ValueError, r"^m", tk.calibration.draw_calibration, np.random.default_rng(0), 10**12)
 
 
 def test_drive_config_beyond_the_memory_budget():

@@ -7,7 +7,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tunnelkit.channel import DiffuseSpec, Impairments, draw_calibration
+from tunnelkit.calibration import draw_calibration
+from tunnelkit.channel import DiffuseSpec, Impairments
 from tunnelkit.constants import C
 from tunnelkit.extraction import PathEstimates
 from tunnelkit.extraction.ml import Problem, fit_problem

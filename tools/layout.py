@@ -57,6 +57,7 @@ RANKS = {
     "montecarlo": 1,
     "runner": 1.1,  # the Monte-Carlo runner (serial or Dask) over montecarlo's seeds
     "arrays": 1,
+    "calibration": 1,  # an array's calibration error, drawn and checked (imports nothing of ours above)
     "scenarios": 2,
     "positioning": 2,
     "fresnel": 2,

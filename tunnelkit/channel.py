@@ -3,8 +3,9 @@
 :func:`channel_tensor` follows eq. 1 exactly as printed, signs included (:class:`SRSConfig` the
 radio); :func:`synthesize` adds the UE clock bias (:func:`sample_clock_bias`) and the noise of
 section 4.2 (:func:`add_noise`). Three impairments eq. 1 leaves out, off by default: calibration
-error (:func:`draw_calibration`), the spatial-wideband term (``spatial_wideband=True``) and dense
-diffuse multipath (:class:`DiffuseSpec`); :class:`Impairments` bundles them for the signal route.
+error (:func:`~tunnelkit.calibration.draw_calibration`), the spatial-wideband term
+(``spatial_wideband=True``) and dense diffuse multipath (:class:`DiffuseSpec`); :class:`Impairments`
+bundles them for the signal route.
 
 How it works: docs/internals/channel-and-propagation.md.
 """
@@ -36,7 +37,6 @@ __all__ = [
     "add_noise",
     "channel_tensor",
     "diffuse_tensor",
-    "draw_calibration",
     "sample_clock_bias",
     "synthesize",
 ]
@@ -188,27 +188,6 @@ def sample_clock_bias(
     return float(out[0]) if size is None else out
 
 
-def draw_calibration(
-    rng: np.random.Generator, m: int, phase_sigma_deg: float = 0.0, gain_sigma_db: float = 0.0
-) -> np.ndarray:
-    """Per-element calibration error (M,) complex: ``10^(e/20) exp(j phi)`` with gain error
-    ``e ~ N(0, gain_sigma_db^2)`` [dB] and phase error ``phi ~ N(0, phase_sigma_deg^2)`` [deg],
-    independent over elements (the reference antenna included). Draw it once per array: it is a
-    property of the hardware, not of a snapshot."""
-    rng = rng_or_error("rng", rng)
-    m = integer("m", m, minimum=1)
-    check_elements("m", 4 * m)
-    sp = nonnegative("phase_sigma_deg", phase_sigma_deg)
-    sg = nonnegative("gain_sigma_db", gain_sigma_db)
-    if sg > 40.0:
-        raise ValueError(
-            f"gain_sigma_db: a calibration gain spread of {sg:g} dB (> 40 dB) is not a calibration error"
-        )
-    phase = np.radians(sp) * rng.standard_normal(m)
-    gain_db = sg * rng.standard_normal(m)
-    return 10.0 ** (gain_db / 20.0) * np.exp(1j * phase)
-
-
 @dataclass(frozen=True)
 class DiffuseSpec:
     """Dense diffuse multipath (docs/internals): ``share`` in [0, 1) of the received power,
@@ -308,7 +287,10 @@ class Impairments:
         return self.phase_sigma_deg == 0 and self.gain_sigma_db == 0
 
     def draw(self, rng: np.random.Generator, m: int) -> np.ndarray | None:
-        """One array's calibration vector (:func:`draw_calibration`), ``None`` if calibrated."""
+        """One array's calibration vector (:func:`~tunnelkit.calibration.draw_calibration`),
+        ``None`` if calibrated."""
+        from .calibration import draw_calibration  # loaded when a calibration error is drawn
+
         rng = rng_or_error("rng", rng)
         m = integer("m", m, minimum=1)
         if self.calibrated:
@@ -361,8 +343,8 @@ def channel_tensor(
     "exact" (spherical wavefront from the VUE, eq. 2) or "srnf" (from the reflection point).
     ``n_tones`` / ``n_symbols`` override the configuration (small tensors for tests and sliders).
     Impairments (docs/internals), off by default: ``calibration`` (M,) complex per-element
-    gains (:func:`draw_calibration`); ``spatial_wideband`` the per-element delay
-    ``tau_l + delta_lm / c`` in the frequency phase; ``dmc`` a :class:`DiffuseSpec` whose
+    gains (:func:`~tunnelkit.calibration.draw_calibration`); ``spatial_wideband`` the
+    per-element delay ``tau_l + delta_lm / c`` in the frequency phase; ``dmc`` a :class:`DiffuseSpec` whose
     realisation (:func:`diffuse_tensor`, from ``rng``, starting at the first path's delay) is
     added (the tensor is then random, not noiseless).
     """

@@ -15,17 +15,11 @@ __all__: list[str] = []
 
 
 def run_epoch(
-    route,
-    k: int,
-    rng: np.random.Generator,
-    *,
-    n_paths: int | None = None,
-    tunnel=None,
-    clock_bias: float | None = None,
-    **extract_kw,
+    route, k: int, rng: np.random.Generator, n_paths, tunnel, clock_bias, extract_kw: dict
 ) -> Epoch:
     """Simulate SRS slot ``k`` on ``route``: trace, synthesise (noise, clock bias), extract,
-    Algorithm 1 (what ``SignalRoute.epoch`` runs)."""
+    Algorithm 1 (what ``SignalRoute.epoch`` runs, with its arguments; ``extract_kw`` the
+    extraction options, a dict of its own)."""
     arr, paths, snap = route.draw(k, rng, tunnel=tunnel, clock_bias=clock_bias)
     L = len(paths) if n_paths is None else integer("n_paths", n_paths, minimum=1)
     if route.options.wideband_model:

@@ -12,7 +12,7 @@ diffuse share and :func:`calibration_floor`; :func:`impairment_share` their expe
 
 **The calibration share** (:func:`calibration_share`). One element's calibration gain is
 ``g = 10^(e/20) exp(j phi)``, ``phi ~ N(0, sigma_phi^2)``, ``e ~ N(0, sigma_dB^2)``
-(:func:`tunnelkit.channel.draw_calibration`); with ``s = sigma_dB ln(10) / 20`` the log-gain is
+(:func:`tunnelkit.calibration.draw_calibration`); with ``s = sigma_dB ln(10) / 20`` the log-gain is
 ``N(0, s^2)``, so ``E g = exp(-sigma_phi^2 / 2) exp(s^2 / 2)`` and ``E |g|^2 = exp(2 s^2)``. The
 part of the received power a calibrated model can carry is ``|E g|^2 / E |g|^2``; the rest,
 

@@ -13,6 +13,9 @@ from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
 from ..evaluation import match_paths
+from ..extraction import algorithm1
+from ..extraction.estimates import PathEstimates
+from ..propagation import SECOND_ORDER
 from ..tracking.measurements import PathMeasurements
 
 __all__ = [
@@ -49,8 +52,6 @@ class Epoch:
     rejudged: dict | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        from ..extraction.estimates import PathEstimates
-
         record(self, shapes=_EPOCH_SHAPES, nonnegative=("k", "t"), skip=("rejudged",))
         speeds("velocity", self.velocity)
         instance("estimates", self.estimates, PathEstimates)
@@ -78,8 +79,6 @@ def measure_epoch(est, array, paths, snap, config, min_d, judged=True):
     estimates matched to a second-order path (a nuisance path the model carries,
     :attr:`RouteOptions.second_order`) are left out of the measurements. ``judged`` as in
     :func:`~tunnelkit.signal_route.covariance.reported_covariance`."""
-    from ..propagation import SECOND_ORDER
-
     paths = sequence("paths", paths, empty=True)  # empty: no true path recorded
     instance("snap", snap, ChannelSnapshot)
     meas = measurements_from_estimates(est, array, config, min_d=min_d, judged=judged)
@@ -105,9 +104,6 @@ def measurements_from_estimates(
     ``config``, also the covariance the extraction reports
     (:func:`~tunnelkit.signal_route.covariance.reported_covariance`, with
     ``judged``: False for a fit the route re-judged and passed)."""
-    from ..extraction import algorithm1
-    from ..extraction.estimates import PathEstimates
-
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
     if config is not None:

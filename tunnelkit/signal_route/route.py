@@ -7,9 +7,9 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
+from .. import propagation
 from .._validate import (
     choice,
-    finite_array,
     instance,
     integer,
     real,
@@ -19,6 +19,8 @@ from .._validate import (
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, Impairments, SRSConfig, synthesize
 from ..constants import C
+from ..propagation import PATH_KINDS, Tunnel3D
+from ..scenarios import Scenario, Trajectory, load_scenario
 from .measurements import Epoch
 from .options import MAX_SECOND_ORDER, RouteOptions
 
@@ -28,9 +30,6 @@ __all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute", "simul
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
 #: ``"sionna"`` (the tensor of every path Sionna RT traces per element, :mod:`tunnelkit.rt.cache`)
 CHANNELS = ("image", "sionna")
-#: the largest element gain error [dB] a route's calibration may hold (far beyond any drawn one:
-#: :func:`tunnelkit.channel.draw_calibration` allows a spread of at most 40 dB)
-MAX_CALIBRATION_DB = 300.0
 
 
 def check_arrays(arrays) -> None:
@@ -80,9 +79,6 @@ class SignalRoute:
     options: RouteOptions = field(default_factory=RouteOptions)
 
     def __post_init__(self) -> None:
-        from ..propagation import PATH_KINDS, Tunnel3D
-        from ..scenarios import Trajectory
-
         instance("tunnel", self.tunnel, Tunnel3D)
         check_arrays(self.arrays)
         instance("trajectory", self.trajectory, Trajectory)
@@ -92,19 +88,10 @@ class SignalRoute:
         real("snr_offset_db", self.snr_offset_db)
         instance("impairments", self.impairments, Impairments)
         instance("calibration", self.calibration, dict)
-        sizes = {a.name: a.M for a in self.arrays}
-        for name, g in self.calibration.items():
-            if name not in sizes:
-                raise ValueError(f"calibration: {name!r} is not one of the arrays {list(sizes)}")
-            g = finite_array(f"calibration[{name!r}]", g, shape=(sizes[name],), dtype=complex)
-            with np.errstate(divide="ignore"):
-                db = 20 * np.log10(np.abs(g))
-            if not np.all(np.abs(db) <= MAX_CALIBRATION_DB):
-                raise ValueError(
-                    f"calibration[{name!r}]: element gains of {db.min():.3g} to {db.max():.3g} dB; "
-                    f"a calibration error lies within +-{MAX_CALIBRATION_DB:g} dB (a dead element "
-                    "or a unit mistake is not one)"
-                )
+        if self.calibration:
+            from ..calibration import check_route_calibration  # loaded with a calibration
+
+            check_route_calibration(self.calibration, {a.name: a.M for a in self.arrays})
         opts = instance("options", self.options, RouteOptions)
         budget = opts.bias_budget
         if budget is not None and budget.exists.shape[0] != len(self.trajectory):
@@ -165,9 +152,6 @@ class SignalRoute:
         ``channel="sionna"`` attaches the scenario's ray-traced channel (settings from its
         ``[raytracing]`` section unless ``rt_settings`` is given, cache under ``cache_dir``,
         :mod:`tunnelkit.rt.cache`)."""
-        from .. import propagation
-        from ..scenarios import Scenario, load_scenario
-
         sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
         if not isinstance(sc, Scenario):
             raise TypeError(
@@ -192,8 +176,6 @@ class SignalRoute:
     def paths(self, k: int, tunnel=None) -> tuple[ArrayGeometry, list]:
         """The array facing the vehicle and the true paths at epoch ``k`` (first order, then the
         strongest ``second_order`` second-order paths)."""
-        from .. import propagation
-
         k = integer("k", k, minimum=0)
         if k >= len(self.trajectory):
             raise ValueError(f"k: epoch {k} beyond the trajectory ({len(self.trajectory)} epochs)")
@@ -290,9 +272,7 @@ class SignalRoute:
         (:func:`tunnelkit.signal_route.epoch.run_epoch`)."""
         from .epoch import run_epoch
 
-        return run_epoch(
-            self, k, rng, n_paths=n_paths, tunnel=tunnel, clock_bias=clock_bias, **extract_kw
-        )
+        return run_epoch(self, k, rng, n_paths, tunnel, clock_bias, extract_kw)
 
 
 def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:

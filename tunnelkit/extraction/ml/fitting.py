@@ -13,7 +13,7 @@ import numpy as np
 from ..._validate import integer, positive, record
 from ...constants import C
 from ..numerics import MIN_SIGNIFICANCE, spatial_phase_unchecked
-from .lm import STEP_TOL, best_of_starts, lm_fit, lm_with
+from .lm import STEP_TOL, lm_fit, lm_with
 from .model import W_MAX, Problem, project_feasible
 from .residual import FALSE_ALARM, calibrated_threshold, residual_peak
 from .resolution import (
@@ -199,70 +199,29 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
     return best, peak, n_it, kept
 
 
-#: split steps of :func:`_split_weak`: ``SPLIT_STEPS`` and the same 2.5 times longer (long-range
-#: images lie 1-5 deg, 0.02-0.09 in direction cosine, from the path they merge with)
-WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS))
-#: :func:`_split_weak` on a pair: kept at a cost fall of PAIR_GAIN sigma^2; SPLIT_ROUNDS tries
-PAIR_GAIN, SPLIT_ROUNDS = 1.0, 2
+#: :func:`_split_weak` on a pair: SPLIT_ROUNDS tries (kept at a cost fall of
+#: :data:`~.split.PAIR_GAIN` sigma^2)
+SPLIT_ROUNDS = 2
 
 
 def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool = False):
-    """A path below the noise (``MIN_SIGNIFICANCE``) or two closer than ``RESOLVE_Z``: one path
-    too few elsewhere (two sources merged) while the weak path, or the less significant of the
-    pair (a path counted twice), sits on nothing. It is dropped and each other path in turn split
-    in two (halves ``u -+ WEAK_SPLITS``, same delay and Doppler); each start gets ``RANK_ITER``
-    iterations, the most likely is fitted to convergence and kept if the cost falls by more than
-    ``gain_min`` (a path's detection threshold: structure, not noise) or, for a pair (same model
-    order), ``PAIR_GAIN`` noise powers. Returns the fit, the iterations and whether it was kept.
-
-    ``flagged``: the residual test still fails after the re-initialisation on its peak (a wrong
-    basin the far-field periodogram cannot locate: two paths of a cluster fitted with the wrong
-    curvature, each on a mixture of two sources, leave near-field structure whose grid peak lies
-    nowhere near them). The closest pair is then tried as above whatever its separation; with
-    the most coherent pair's starts ranked beside it (:func:`_split_pairs`)."""
+    """The split move (:func:`~.split.split_weak`) when a path is below the noise
+    (``MIN_SIGNIFICANCE``), two are closer than ``RESOLVE_Z`` or ``flagged`` (the residual test
+    still fails after the re-initialisation on its peak); else ``best`` as it is. Returns the fit,
+    the iterations and whether it was kept."""
     theta, mu_f, mu_t, ev = best[:4]
     L = theta.shape[0]
     if L < 2:
         return best, 0, False
     sig = path_significance(ev, sigma2)
-    weaks = [int(np.argmin(sig))]
-    if sig.min() >= MIN_SIGNIFICANCE:
+    pair = sig.min() >= MIN_SIGNIFICANCE
+    if pair:
         res = ev["resolution"] = separations(prob, theta, mu_f, mu_t, sigma2)  # kept with ev
         if res.min() >= RESOLVE_Z and not flagged:
             return best, 0, False
-        pairs = _split_pairs(prob, theta, mu_f, mu_t, sigma2, ev)
-        weaks = list(dict.fromkeys(int(p[np.argmin(sig[p])]) for p in pairs))
-        gain_min = PAIR_GAIN * sigma2
-    starts = []
-    for weak in weaks:
-        for l_ in np.argsort(-np.abs(ev["c"])):
-            if l_ == weak:
-                continue
-            for du in WEAK_SPLITS:
-                th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
-                th2[weak], mf2[weak], mt2[weak] = theta[l_], mu_f[l_], mu_t[l_]
-                th2[l_, :2] += du
-                th2[weak, :2] -= du
-                starts.append((project_feasible(th2), mf2, mt2))
-    cand, n_it = best_of_starts(_lm, prob, starts, sigma2, min(RANK_ITER, max_iter), max_iter)
-    if cand[3]["cost"] < ev["cost"] - gain_min:
-        return cand, n_it, True
-    return best, n_it, False
+    from .split import split_weak  # loaded when a split is tried
 
-
-def _split_pairs(prob: Problem, theta, mu_f, mu_t, sigma2, ev) -> list[np.ndarray]:
-    """The pairs :func:`_split_weak` takes apart: the closest in standard deviations of its
-    difference (:func:`~.resolved.closest_pair`) and, when another pair, the two atoms more
-    coherent than :data:`COUNTED_TWICE` (one path counted twice: its large, cancelling gains can
-    leave an unrelated pair 0 sd apart, and real paths can be that coherent too)."""
-    from .resolved import closest_pair  # loaded when a split is tried on a pair
-
-    a, b, _ = closest_pair(prob, theta, mu_f, mu_t, sigma2)
-    out = [np.array([a, b])]
-    i, j, coh = coherent_pair(ev)
-    if coh > COUNTED_TWICE and {int(i), int(j)} != {a, b}:
-        out.append(np.array([i, j]))
-    return out
+    return split_weak(prob, best, sigma2, sig, pair, gain_min, min(RANK_ITER, max_iter), max_iter)
 
 
 def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
