@@ -28,7 +28,7 @@ from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
 from ..constants import wavelength
 from ..scenarios import Scenario, Trajectory, load_scenario
-from ..signal_route import CHANNELS, RouteOptions, SignalRoute
+from ..signal_route import CHANNELS
 from .geometry import KINDS
 
 __all__ = ["ArraySpec", "DesignSetup", "Mount", "parse_array"]
@@ -283,29 +283,10 @@ class DesignSetup:
         """The measurement route of ``spec`` on this design as the Monte-Carlo drives it
         (:class:`tunnelkit.signal_route.SignalRoute`): each epoch's paths carry the CRLB at their
         estimate, and Algorithm 1 drops only what no clock bias explains."""
-        spec = parse_array(spec)
-        arrays = self.arrays(spec)
-        raytraced = None
-        if self.channel == "sionna":
-            from ..rt import RayTracedChannel
+        from .channelroute import channel_route  # the route loads when a design drives it
 
-            raytraced = RayTracedChannel(
-                self.tunnel,
-                arrays,
-                self.trajectory,
-                self.config,
-                self.rt_settings,
-                label=f"{self.name}-design-{spec.label}",
-            )
-        return SignalRoute(
-            self.tunnel,
-            arrays,
-            self.trajectory,
-            self.config,
-            kinds=self.kinds,
-            raytraced=raytraced,
-            options=RouteOptions(report_covariance=True, bias_aware_delay_check=True),
-        )
+        spec = parse_array(spec)
+        return channel_route(self, spec, self.arrays(spec))
 
     def arrays(self, spec) -> list[ArrayGeometry]:
         """``spec`` placed, centred, on every mount; refused (``ValueError`` naming ``arrays``,
