@@ -406,7 +406,7 @@ def _baselines():
     """Short valid calls of callables the teaching workflows do not reach (so their contracts
     are tested at all): geometry, propagation, channel pieces, bounds, verdicts, plots."""
     import tunnelkit as tk
-    from tunnelkit import budget, crlb, geometry, metrics, propagation, reflection
+    from tunnelkit import budget, crlb, geometry, metrics, propagation, reflection, sizes
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
     from tunnelkit.design import errordraws, intervals, mcrb, render, verdict
     from tunnelkit.design.arrayjob import javelin_config
@@ -419,6 +419,7 @@ def _baselines():
 
     rng = np.random.default_rng(0)
     budget.set_memory_budget(budget.memory_budget())
+    sizes.format_bytes(1536)
     spec = DiffuseSpec(0.1)
     spec.power(1.0)
     spec.taps(240e3, 16)
