@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._physical import carrier
-from .._validate import choice, instance, nonnegative, rng_or_error
+from .._validate import choice, instance, integer, nonnegative, rng_or_error
 from ..constants import C
 from . import errordraws
 from .errormodel import PathErrorModel
@@ -165,8 +165,6 @@ def bound_drive(
     if T != len(setup.trajectory):
         raise ValueError(f"model: expected {len(setup.trajectory)} epochs (the route's), got {T}")
     if n_epochs is not None:
-        from .._validate import integer
-
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
     return indexed_drive(prepared, setup, rng, T, sigma_v, calibration)
 

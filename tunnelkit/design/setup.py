@@ -233,16 +233,9 @@ class DesignSetup:
         if channel is not None:
             choice("channel", channel, CHANNELS)
             if channel == "sionna" and rts is None:
-                from ..rt import RTSettings
+                from .channelroute import scenario_rt_settings  # the ray tracer's, when asked for
 
-                try:
-                    sc = load_scenario(self.name)
-                except (FileNotFoundError, KeyError, ValueError) as exc:
-                    raise ValueError(
-                        f"channel: 'sionna' needs the ray-tracing settings of scenario "
-                        f"{self.name!r}, which does not load ({exc})"
-                    ) from None
-                rts = RTSettings.from_scenario(sc)
+                rts = scenario_rt_settings(self.name)
         else:
             channel = self.channel
         if mount_height is not None:
