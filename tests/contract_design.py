@@ -16,7 +16,7 @@ def design_models():
     """Path error model, bounds over the drive, the fast route and its drive, the mode vectors of
     the misspecified bound."""
     from tunnelkit import design
-    from tunnelkit.design import drivebound, errormodel, fastroute, mcrb, trackerfix
+    from tunnelkit.design import drivebound, errordraws, errormodel, fastroute, mcrb, trackerfix
 
     setup = design.DesignSetup.from_scenario(SCENARIO)
     imp = design.DesignImpairments(phase_error_deg=0.5, gain_error_db=0.2)
@@ -24,8 +24,8 @@ def design_models():
     g = design.route_geometry(setup, "4x4")
     m = design.path_error_model(setup, "4x4", imp, geometry=g)
     n = m.n_elements
-    m.calibration_bias(np.zeros(n), np.zeros(n))
-    m.draw(np.random.default_rng(0))
+    errordraws.calibration_bias(m, np.zeros(n), np.zeros(n))
+    errordraws.draw(m, np.random.default_rng(0))
     info = drivebound.position_information(m, g)
     trackerfix.position_error_parts(m, g)
     drivebound.position_bias_rms(m, g)

@@ -406,9 +406,9 @@ def _baselines():
     """Short valid calls of callables the teaching workflows do not reach (so their contracts
     are tested at all): geometry, propagation, channel pieces, bounds, verdicts, plots."""
     import tunnelkit as tk
-    from tunnelkit import budget, crlb, geometry, metrics, propagation, reflection
+    from tunnelkit import budget, crlb, geometry, metrics, propagation, reflection, sizes
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
-    from tunnelkit.design import errormodel, intervals, mcrb, render, verdict
+    from tunnelkit.design import errordraws, intervals, mcrb, render, verdict
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.design.drivebound import drive_bound
     from tunnelkit.extraction.krank import kruskal_rank
@@ -419,6 +419,7 @@ def _baselines():
 
     rng = np.random.default_rng(0)
     budget.set_memory_budget(budget.memory_budget())
+    sizes.format_bytes(1536)
     spec = DiffuseSpec(0.1)
     spec.power(1.0)
     spec.taps(240e3, 16)
@@ -444,7 +445,7 @@ def _baselines():
     box.blocks(np.array([-5.0, 0.0, 1.0]), np.array([15.0, 0.0, 1.0]))
     fraunhofer_distance(0.25, 28e9)
     kruskal_rank(rng.standard_normal((6, 3)))
-    errormodel.psd_sqrt(np.array([[2.0, 0.5], [0.5, 1.0]]))
+    errordraws.psd_sqrt(np.array([[2.0, 0.5], [0.5, 1.0]]))
     mcrb.scaled_inverse(np.array([[[2.0, 0.5], [0.5, 1.0]]]))
     e = np.abs(rng.standard_normal(50))
     verdict.share_quantile(e, 0.9)

@@ -11,7 +11,7 @@ from javelin_geometric import geometric_stream, toy_drive, toy_reflectors
 
 from tunnelkit import _checks, design
 from tunnelkit.design import verdict
-from tunnelkit.design.errormodel import psd_sqrt
+from tunnelkit.design.errordraws import psd_sqrt
 from tunnelkit.tracking.javelin import JavelinConfig, JavelinDesign, run_javelin
 
 

@@ -545,7 +545,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "a non-finite value counts as over the target (the docstring's contract)",
     ),
     _doc(
-        r"design\.errormodel\.psd_sqrt|tracking\.upf\.systematic_resample",
+        r"design\.errordraws\.psd_sqrt|tracking\.upf\.systematic_resample",
         r"S|weights",
         "shape",
         "a stack (..., n, n) / a batch (..., N): leading axes vectorise (the docstring's contract)",

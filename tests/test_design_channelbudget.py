@@ -8,6 +8,7 @@ from tunnelkit.design import DesignSetup, parse_array
 from tunnelkit.design.achievable import DesignImpairments, path_error_model
 from tunnelkit.design.bounds import route_geometry
 from tunnelkit.design.channelbudget import channel_budget, channel_route_budget
+from tunnelkit.design.errordraws import split
 from tunnelkit.signal_route.judging import BiasBudget
 
 
@@ -21,7 +22,7 @@ def test_budget_is_the_split_less_the_noise_by_slot(setup):
     imp = DesignImpairments(phase_error_deg=0.5)
     m = path_error_model(setup, spec, imp)
     b = channel_budget(m, setup, spec)
-    white, rep = m.split()
+    white, rep = split(m)
     T = m.exists.shape[0]
     g = route_geometry(setup, spec, epochs=np.arange(T))
     assert np.array_equal(b.source, g.source) and np.array_equal(b.exists, m.exists)

@@ -11,6 +11,7 @@ import pytest
 
 from tunnelkit.design import DesignSetup
 from tunnelkit.design.achievable import path_error_model
+from tunnelkit.design.errordraws import draw_calibration
 from tunnelkit.design.fastroute import bound_drive
 from tunnelkit.design.setup import Mount
 from tunnelkit.design.sites import SiteRow, site_drive, site_route
@@ -174,7 +175,7 @@ def test_each_site_is_a_unit_of_its_own():
     row = _row()
     route = site_route(row, "4x4", imp)
     model = route.route.model
-    units = [model.draw_calibration(np.random.default_rng(10 + i)) for i in range(row.count)]
+    units = [draw_calibration(model, np.random.default_rng(10 + i)) for i in range(row.count)]
     same = [units[0]] * row.count
     d1 = site_drive(row, route, np.random.default_rng(3), calibration=units)
     d0 = site_drive(row, route, np.random.default_rng(3), calibration=same)

@@ -19,6 +19,13 @@ from tunnelkit.design.drivebound import (
     position_bias_rms,
     position_information,
 )
+from tunnelkit.design.errordraws import (
+    calibration_bias,
+    draw,
+    draw_calibration,
+    noise_sqrt,
+    split,
+)
 from tunnelkit.design.errormodel import PathErrorModel
 from tunnelkit.design.fastroute import bound_drive, bound_route, model_truth
 from tunnelkit.design.geometry import trace_route
@@ -239,7 +246,7 @@ def test_a_prepared_route_gives_the_same_drive_and_is_checked(setup):
 
     mb = replace(m, bias=np.where(m.exists[..., None], np.full(m.truth.shape, 0.01), 0.0))
     rb = bound_route(mb, setup, "4x4", report="budget")
-    white, rep = mb.split()
+    white, rep = split(mb)
     assert np.allclose(rb.blocks, white + rep) and np.allclose(rb.repeating, rep)
     drive = bound_drive(rb, setup, "4x4", np.random.default_rng(4), n_epochs=3)
     for pm in drive.epochs:
@@ -457,18 +464,18 @@ def test_a_units_drives_share_its_calibration_and_later_units_extend_the_sweep(s
         sweep_montecarlo(setup, ["4x4"], 3, 7, **kw)
     # serially too, every drive of a unit draws the same calibration error, and the sweep is the
     # same on two workers (each drive makes its own generator from its unit's seed)
-    from tunnelkit.design.errormodel import PathErrorModel
+    from tunnelkit.design import arrayjob
 
     seen = []
-    real = PathErrorModel.draw_calibration
+    real = arrayjob.draw_calibration
 
-    def spy(self, rng):
-        cal = real(self, rng)
+    def spy(model, rng):
+        cal = real(model, rng)
         seen.append(cal[0])
         return cal
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(PathErrorModel, "draw_calibration", spy)
+        mp.setattr(arrayjob, "draw_calibration", spy)
         serial = sweep_montecarlo(setup, ["4x4"], 6, 7, **kw)["4x4"]
     assert len(seen) == 6 and not np.array_equal(seen[0], seen[2])
     for u in range(3):
@@ -481,17 +488,17 @@ def test_a_units_drives_share_its_calibration_and_later_units_extend_the_sweep(s
 
     u = [np.random.default_rng(q) for q in unit_seeds(7, 0, 2)]
     first = np.random.default_rng(unit_seeds(7, 0, 1)[0])  # a unit's seed: the same in any batch
-    assert np.array_equal(m.draw_calibration(u[0])[0],
+    assert np.array_equal(draw_calibration(m, u[0])[0],
                           first.standard_normal(16) * m.phase_sigma_rad)  # fmt: skip
-    cal = m.draw_calibration(u[1])
+    cal = draw_calibration(m, u[1])
     rng = np.random.default_rng(1)
-    z1 = m.draw(np.random.default_rng(1), calibration=cal)
-    z2 = m.draw(np.random.default_rng(2), calibration=cal)
+    z1 = draw(m, np.random.default_rng(1), calibration=cal)
+    z2 = draw(m, np.random.default_rng(2), calibration=cal)
     # the same unit: the calibration bias is common, only the noise differs
-    bias = m.calibration_bias(*cal)
+    bias = calibration_bias(m, *cal)
     assert np.nanmax(np.abs(bias)) > 0 and rng is not None
     noise1, noise2 = z1 - m.truth - m.bias - bias, z2 - m.truth - m.bias - bias
-    ns = m.noise_sqrt()
+    ns = noise_sqrt(m)
     T, P = m.exists.shape
     g1 = np.random.default_rng(1).standard_normal((T, 4 * P, 1))
     np.testing.assert_allclose(

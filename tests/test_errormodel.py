@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from tunnelkit.design.errordraws import _repetition
-from tunnelkit.design.errormodel import PathErrorModel, psd_sqrt
+from tunnelkit.design.errordraws import _repetition, draw, noise_sqrt, psd_sqrt, split
+from tunnelkit.design.errormodel import PathErrorModel
 
 
 def _model(T=2, P=2, M=3, **kw):
@@ -38,7 +38,7 @@ def test_psd_sqrt_reproduces_the_matrix_and_tolerates_singular():
 def test_draw_has_the_stated_mean_and_covariance():
     m = _model(phase_sigma_rad=0.0)
     rng = np.random.default_rng(7)
-    z = np.stack([m.draw(rng) for _ in range(4000)])
+    z = np.stack([draw(m, rng) for _ in range(4000)])
     err = (z - m.truth).reshape(4000, 2, -1)
     emp = np.einsum("nti,ntj->tij", err, err) / 4000
     scale = np.diagonal(m.cov, axis1=1, axis2=2).max()
@@ -48,7 +48,7 @@ def test_draw_has_the_stated_mean_and_covariance():
 def test_calibration_bias_is_drawn_once_per_drive_with_its_variance():
     m = _model(cov=np.zeros((2, 8, 8)), crlb=np.zeros((2, 8, 8)), phase_sigma_rad=0.1)
     rng = np.random.default_rng(3)
-    b = np.stack([m.draw(rng) - m.truth for _ in range(4000)])  # (N, T, P, 4)
+    b = np.stack([draw(m, rng) - m.truth for _ in range(4000)])  # (N, T, P, 4)
     var = b.var(axis=0)
     want = 0.01 * (m.k_phase**2).sum(-1)
     assert np.allclose(var, want, rtol=0.1)
@@ -59,7 +59,7 @@ def test_absent_paths_are_nan_and_may_hold_nan():
     truth = np.random.default_rng(0).standard_normal((2, 2, 4))
     truth[0, 1] = np.nan
     m = _model(exists=ex, truth=truth)
-    z = m.draw(np.random.default_rng(0))
+    z = draw(m, np.random.default_rng(0))
     assert np.all(np.isnan(z[0, 1])) and np.all(np.isfinite(z[1]))
 
 
@@ -81,7 +81,7 @@ def test_bad_fields_are_refused_by_name(kw, param):
 def test_budget_is_the_second_moment_of_the_drawn_error():
     m = _model(phase_sigma_rad=0.1, bias=np.full((2, 2, 4), 0.05))
     rng = np.random.default_rng(11)
-    e = np.stack([m.draw(rng) - m.truth for _ in range(6000)])  # (N, T, P, 4)
+    e = np.stack([draw(m, rng) - m.truth for _ in range(6000)])  # (N, T, P, 4)
     emp = np.einsum("ntpi,ntpj->tpij", e, e) / e.shape[0]
     want = m.budget()
     scale = np.abs(want).max()
@@ -94,13 +94,13 @@ def test_budget_is_the_second_moment_of_the_drawn_error():
 
 def test_draw_with_the_noise_root_computed_once_is_the_same_draw():
     m = _model(phase_sigma_rad=0.1, bias=np.full((2, 2, 4), 0.05))
-    root = m.noise_sqrt()
+    root = noise_sqrt(m)
     assert np.allclose(root @ root.transpose(0, 2, 1), m.cov)
-    a = m.draw(np.random.default_rng(5))
-    b = m.draw(np.random.default_rng(5), noise_sqrt=root)
+    a = draw(m, np.random.default_rng(5))
+    b = draw(m, np.random.default_rng(5), noise_sqrt=root)
     assert np.array_equal(a, b)
     with pytest.raises(ValueError, match="noise_sqrt"):
-        m.draw(np.random.default_rng(5), noise_sqrt=root[:, :4, :4])
+        draw(m, np.random.default_rng(5), noise_sqrt=root[:, :4, :4])
 
 
 def test_repetition_is_the_mean_pairwise_correlation_brute_force():
@@ -127,7 +127,7 @@ def test_repetition_is_the_mean_pairwise_correlation_brute_force():
 
 def test_split_keeps_every_variance_and_repeats_what_one_draw_repeats():
     m = _model(T=4, P=2, phase_sigma_rad=0.1, bias=np.full((4, 2, 4), 0.05))
-    white, rep = m.split()
+    white, rep = split(m)
     budget = m.budget()
     d = np.diagonal
     assert np.allclose(d(white + rep, axis1=-2, axis2=-1), d(budget, axis1=-2, axis2=-1))
@@ -145,8 +145,8 @@ def test_split_keeps_every_variance_and_repeats_what_one_draw_repeats():
         cov=small,
         crlb=small,
     )
-    _, rep1 = const.split()
+    _, rep1 = split(const)
     rng = np.random.default_rng(2)
-    e = np.stack([const.draw(rng) - const.truth for _ in range(6000)])  # (N, T, P, 4)
+    e = np.stack([draw(const, rng) - const.truth for _ in range(6000)])  # (N, T, P, 4)
     cross = np.einsum("npi,npj->pij", e[:, 0], e[:, 2]) / e.shape[0]
     assert np.abs(cross - rep1[0]).max() < 0.06 * np.abs(rep1[0]).max()

@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 
 import tunnelkit as tk
-from tunnelkit.budget import format_bytes, memory_budget, set_memory_budget
+from tunnelkit.budget import memory_budget, set_memory_budget
 from tunnelkit.channel import SRSConfig
 from tunnelkit.extraction import extract_paths
 from tunnelkit.propagation import fresnel_te
+from tunnelkit.sizes import format_bytes
 
 
 @pytest.mark.parametrize(

@@ -149,7 +149,7 @@ def test_smallest_meeting_with_a_nan_target():
 
 
 def test_format_bytes_of_nan():
-    _raises(ValueError, r"^n", tk.budget.format_bytes, NAN)
+    _raises(ValueError, r"^n", tk.sizes.format_bytes, NAN)
 
 
 @pytest.mark.parametrize(

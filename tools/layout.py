@@ -42,6 +42,7 @@ RANKS = {
     "angles": 0.5,  # angles wrapped to (-pi, pi], the bearings' innovations
     "solutions": 0.5,  # the notebooks' solution cells (an IPython magic), imports nothing of ours
     "notebook": 1.2,  # the notebooks' own calls (setup, solutions, build dir), on montecarlo
+    "sizes": 0.4,  # sizes in bytes as text (read and written), for the memory budget
     "budget": 0.5,
     "report": 0.5,
     "schema": 0.5,

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 
 import numpy as np
 
@@ -31,7 +30,6 @@ __all__ = [
     "DEFAULT_BUDGET",
     "check_bytes",
     "check_elements",
-    "format_bytes",
     "memory_budget",
     "set_memory_budget",
 ]
@@ -40,33 +38,7 @@ __all__ = [
 DEFAULT_BUDGET = 2 * 1024**3
 ENV = "TUNNELKIT_MEMORY_BUDGET"
 
-_UNITS = {
-    "": 1,
-    "b": 1,
-    "kb": 10**3,
-    "mb": 10**6,
-    "gb": 10**9,
-    "tb": 10**12,
-    "kib": 2**10,
-    "mib": 2**20,
-    "gib": 2**30,
-    "tib": 2**40,
-}
 _override: int | None = None
-
-
-def _parse(text: str) -> int:
-    m = re.fullmatch(r"\s*([0-9.eE+]+)\s*([A-Za-z]*)\s*", text)
-    unit = m.group(2).lower() if m else ""
-    if not m or unit not in _UNITS:
-        raise ValueError(f"{ENV}: cannot read {text!r} (e.g. 2147483648, 8GiB, 500MB)")
-    try:
-        value = float(m.group(1)) * _UNITS[unit]
-    except ValueError:
-        raise ValueError(f"{ENV}: cannot read {text!r}") from None
-    if not math.isfinite(value) or value <= 0:
-        raise ValueError(f"{ENV}: must be a positive size, got {text!r}")
-    return int(value)
 
 
 def memory_budget() -> int:
@@ -74,7 +46,11 @@ def memory_budget() -> int:
     if _override is not None:
         return _override
     env = os.environ.get(ENV, "").strip()
-    return _parse(env) if env else DEFAULT_BUDGET
+    if not env:
+        return DEFAULT_BUDGET
+    from .sizes import parse_size  # a size in words, read when the variable is set
+
+    return parse_size(ENV, env)
 
 
 def set_memory_budget(nbytes: int | str | None) -> int | None:
@@ -87,7 +63,9 @@ def set_memory_budget(nbytes: int | str | None) -> int | None:
     if nbytes is None:
         _override = None
     elif isinstance(nbytes, str):
-        _override = _parse(nbytes)
+        from .sizes import parse_size  # a size in words, read when one is given
+
+        _override = parse_size(ENV, nbytes)
     else:
         if isinstance(nbytes, bool) or not isinstance(nbytes, int | float):
             raise TypeError(f"nbytes: expected a number of bytes, got {type(nbytes).__name__}")
@@ -103,19 +81,6 @@ def set_memory_budget(nbytes: int | str | None) -> int | None:
             raise ValueError(f"nbytes: must be a positive, finite number of bytes, got {shown}")
         _override = int(nbytes)
     return prev
-
-
-def format_bytes(n: float) -> str:
-    """``1536`` -> ``'1.5 KiB'``; ``n`` a finite size >= 0 [B]."""
-    if isinstance(n, bool) or not isinstance(n, int | float):
-        raise TypeError(f"n: expected a number of bytes, got {type(n).__name__}")
-    if not math.isfinite(n) or n < 0:
-        raise ValueError(f"n: expected a finite number of bytes >= 0, got {n}")
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
-        if n < 1024 or unit == "EiB":
-            return f"{n:.3g} {unit}" if unit != "B" else f"{int(n)} B"
-        n /= 1024
-    return f"{n:.3g} EiB"  # pragma: no cover
 
 
 def _count(n: int) -> str:
@@ -140,6 +105,8 @@ def check_bytes(name: str, nbytes, what: str = "") -> None:
     nbytes = _whole("nbytes", nbytes)
     limit = memory_budget()
     if nbytes > limit:
+        from .sizes import format_bytes  # the sizes in words, for the refusal
+
         detail = f" ({what})" if what else ""
         raise ValueError(
             f"{name}: would need {format_bytes(nbytes)}{detail}, above the memory budget of "

@@ -7,7 +7,7 @@ README), both from the one spec of :mod:`tunnelkit.schema` that validates the fi
 from __future__ import annotations
 
 from .schema import FAMILIES, Key, Table
-from .schema.spec import shape_text
+from .schema.spec import number_text, shape_text
 
 __all__ = ["render_template", "to_markdown"]
 
@@ -30,12 +30,25 @@ def _fmt(v) -> str:
     raise TypeError(f"cannot write {v!r} to TOML")  # pragma: no cover
 
 
+def range_text(key: Key) -> str:
+    """``"> 0"``, ``"[-90, 90]"``, ... (empty if unbounded)."""
+    lo = f"> {number_text(key.gt)}" if key.gt is not None else None
+    lo = f">= {number_text(key.ge)}" if key.ge is not None else lo
+    hi = f"< {number_text(key.lt)}" if key.lt is not None else None
+    hi = f"<= {number_text(key.le)}" if key.le is not None else hi
+    if lo and hi:
+        left = "(" if key.gt is not None else "["
+        right = ")" if key.lt is not None else "]"
+        return f"{left}{number_text(key.gt if key.gt is not None else key.ge)}, {number_text(key.lt if key.lt is not None else key.le)}{right}"
+    return lo or hi or ""
+
+
 def key_comment(key: Key) -> str:
     """One-line description: doc, unit, range, choices and default."""
     bits = [key.doc]
     if key.unit:
         bits.append(f"[{key.unit}]")
-    r = key.range_text()
+    r = range_text(key)
     if r:
         bits.append(f"range {r}")
     if key.choices and len(key.choices) > 1:
@@ -148,7 +161,7 @@ def _md_row(full: str, k: Key, prefix: str) -> str:
         if k.required
         else (f"`{_fmt(k.default)}`" if k.has_default and k.type != "table" else "optional")
     )
-    return f"| `{full}` | {typ} | {k.unit} | {k.range_text()} | {need} | {prefix}{k.doc} |"
+    return f"| `{full}` | {typ} | {k.unit} | {range_text(k)} | {need} | {prefix}{k.doc} |"
 
 
 def to_markdown() -> str:

@@ -314,7 +314,7 @@ print(f"tolerance eps_Phi = {b8.eps_phi:g} rad")
 # noise and diffuse term per epoch) and reported to the tracker with the **error budget** of the
 # stated impairments (the CRLB plus the covariance of the calibration tolerance and the bias of
 # the terms the model leaves out: `PathErrorModel.budget`) and the share of it one unit repeats
-# (`PathErrorModel.split`: what one calibration draw keeps from epoch to epoch, the bias that
+# (`design.errordraws.split`: what one calibration draw keeps from epoch to epoch, the bias that
 # keeps its sign), which the tracker carries as a *consider parameter* of the path's track (a
 # bias it keeps in its covariance without estimating it: a Schmidt–Kalman update,
 # `tracking.javelin.ConsiderNoise`) instead of averaging it down as if it

@@ -39,7 +39,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from ..scenarios import check_all, load_scenario, scenario_from_dict, template
+    from ..scenarios import load_scenario, scenario_from_dict, template
+    from ..scenarios.checkall import check_all
 
     words = list(args.words)
     if words and words[0] == "new":

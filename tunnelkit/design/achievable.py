@@ -18,7 +18,7 @@ from .._checks import bound_array
 from .._validate import choice, instance, record, text
 from ..constants import C
 from ..geometry import spherical_jacobian
-from .bounds import compress_slots, route_bounds, route_geometry, theta_fim, theta_jacobian
+from .bounds import compress_slots, route_bounds, route_geometry
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .impairments import DesignImpairments
@@ -466,39 +466,10 @@ def predicted_error(
     peb = route_bounds(setup, spec, geometry=g).peb
     if weights == "tracker":
         return _tracker_bound(setup, spec, imp, g, peb)
+    from .idealweights import ideal_parts  # loaded when the ideal weighting is asked for
+
     fr = _frame(setup, spec, g)
-    T = fr.idx.shape[0]
-    Tm, n_pos, n_nui, base = theta_jacobian(
-        cfg,
-        fr.s_loc,
-        fr.d0,
-        fr.src,
-        g.origin,
-        g.rotation,
-        g,
-        fr.idx,
-        fr.mask,
-        "unknown",
-        True,
-        True,
-    )
-    sph, sg = np.radians(imp.phase_error_deg), imp.gain_error_db
-    cal2, wb, dif2 = np.zeros(T), np.zeros(T), np.zeros(T)
-    if not imp.ideal:
-        for ch in _chunks(setup, fr, imp):
-            sl = ch["slice"]
-            Tc = Tm[sl]
-            Ginv, sing = scaled_inverse(theta_fim(ch["A"], Tc, fr.mask[sl], n_nui, base))
-            Ginv = np.where(sing[:, None, None], 0.0, Ginv)
-            peb[sl] = np.where(sing, np.inf, peb[sl])
-            Pm = Ginv[:, :n_pos, :] @ Tc.transpose(0, 2, 1)  # d position / d score (n_pos, 7L)
-            if ch["E"] is not None:
-                dif2[sl] = np.trace(Pm @ ch["E"] @ Pm.transpose(0, 2, 1), axis1=1, axis2=2)
-            if ch["s_wb"] is not None:
-                wb[sl] = np.linalg.norm((Pm @ ch["s_wb"][..., None])[..., 0], axis=1)
-            if ch["S_ph"] is not None:
-                cal2[sl] = sph**2 * np.sum((Pm @ ch["S_ph"]) ** 2, axis=(1, 2))
-                cal2[sl] += sg**2 * np.sum((Pm @ ch["S_g"]) ** 2, axis=(1, 2))
+    cal2, wb, dif2 = ideal_parts(cfg, fr, g, imp, peb, _chunks(setup, fr, imp))
     fin = np.isfinite(peb)
     cal = np.where(fin, np.sqrt(np.clip(cal2, 0, None)), np.inf)
     wb = np.where(fin, wb, np.inf)

@@ -26,6 +26,7 @@ from .drivebound import (
     position_information,
     unit_pcrlb,
 )
+from .errordraws import draw_calibration
 from .errormodel import PathErrorModel
 from .pathbounds import path_bounds
 from .setup import ArraySpec, DesignSetup
@@ -95,7 +96,7 @@ class SweepTrial:
         if self.mode == "bound":
             from .fastroute import bound_drive
 
-            cal = prep.route.model.draw_calibration(unit)  # the unit's, every drive the same
+            cal = draw_calibration(prep.route.model, unit)  # the unit's, every drive the same
             drive = bound_drive(
                 prep.route, self.setup, spec, rng, n_epochs=self.n_epochs, calibration=cal
             )

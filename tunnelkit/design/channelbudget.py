@@ -1,7 +1,7 @@
 """The design's impairment budget handed to the channel route (:func:`channel_budget`).
 
 On the bound route (:mod:`tunnelkit.design.fastroute`) the tracker is told each path's error
-budget (:meth:`~tunnelkit.design.errormodel.PathErrorModel.split`: the noise covariance, the
+budget (:func:`~tunnelkit.design.errordraws.split`: the noise covariance, the
 stated calibration tolerance and the bias of the terms the model leaves out) and the share of it
 that repeats. On the channel route the extraction reports the noise share itself (the CRLB at
 its estimate); :func:`channel_budget` gives the rest, per candidate slot of the route geometry
@@ -17,6 +17,7 @@ import numpy as np
 
 from .._validate import instance
 from ..signal_route.judging import BiasBudget
+from .errordraws import split
 from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 
@@ -26,7 +27,7 @@ __all__ = ["channel_budget", "channel_route_budget"]
 def channel_budget(model: PathErrorModel, setup: DesignSetup, spec) -> BiasBudget:
     """The impairment budget of ``model`` (``spec``'s, over ``setup``'s whole route) by slot:
     ``extra`` = the budget's white share less the noise covariance ``cov``, plus its repeating
-    share (:meth:`PathErrorModel.split`), ``repeating`` that share; sources and reference
+    share (:func:`~tunnelkit.design.errordraws.split`), ``repeating`` that share; sources and reference
     antennas from the route geometry the model was built on."""
     from .bounds import route_geometry
 
@@ -40,7 +41,7 @@ def channel_budget(model: PathErrorModel, setup: DesignSetup, spec) -> BiasBudge
     traced = model.exists if model.unresolved is None else model.exists | model.unresolved
     if g.exists.shape != (T, P) or not np.array_equal(g.exists, traced):
         raise ValueError(f"model: not built on {spec.label}'s route geometry (slots differ)")
-    white, rep = model.split()
+    white, rep = split(model)
     idx = np.arange(P)
     noise = np.moveaxis(np.asarray(model.cov).reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1)
     ex = model.exists[..., None, None]

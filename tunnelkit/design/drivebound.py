@@ -18,9 +18,10 @@ import numpy as np
 
 from .._checks import bound_array
 from .._physical import start_spread
-from .._validate import boolean, finite_array, instance
+from .._validate import boolean, finite_array, instance, integer, positive
 from ..odometry import Odometry
 from ..reckoning import posterior_bound
+from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
 from .errormodel import PathErrorModel
 from .setup import DesignSetup
 from .trackerfix import (
@@ -135,9 +136,6 @@ def drive_pcrlb(
     without losses); the paper's white model gives the bound of the two sigmas. Without
     ``odometry`` and the sigmas, a drive whose messages have repeating errors (the scenario's
     ``[odometry]``) is bounded with them as states."""
-    from .._validate import positive
-    from ..tracking.pcrlb import pcrlb, pcrlb_position_rmse
-
     own = instance("setup", setup, DesignSetup).trajectory.odometry
     perfect = own.speed_noise == 0.0 or own.heading_noise == 0.0  # no white noise of one kind
     if odometry is None and sigma_speed is None and sigma_heading is None:
@@ -165,8 +163,6 @@ def drive_pcrlb(
 def _drive_truth(setup: DesignSetup, T: int):
     """Times (T,) [s], true speed [m/s] and heading [rad] (T,) of ``setup``'s first ``T``
     epochs."""
-    from .._validate import integer
-
     traj = instance("setup", setup, DesignSetup).trajectory
     T = integer("T", T, minimum=1, maximum=len(traj.t))
     vel = traj.velocity[:T]
@@ -186,8 +182,6 @@ def drive_motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
     respect to (speed, heading), the noise covariance of (speed, heading) from ``sig_nu`` [m/s]
     and ``sig_th`` [rad], and ``dt`` (T,) [s]. The message of epoch ``k-1`` drives the
     prediction into epoch ``k`` (Algorithm 4, line 7)."""
-    from .._validate import integer, positive
-
     setup = instance("setup", setup, DesignSetup)
     traj = setup.trajectory
     T = integer("T", T, minimum=1, maximum=len(traj.t))

@@ -1,7 +1,8 @@
-"""Drives drawn from a path error model (:class:`~tunnelkit.design.errormodel.PathErrorModel`,
-whose methods call these): one manufactured unit's calibration error (:func:`draw_calibration`),
-one drive's measurements (:func:`draw`) and the share of the error budget a drive repeats
-(:func:`split`, what the bound route's tracker is told).
+"""Drives drawn from a path error model (:class:`~tunnelkit.design.errormodel.PathErrorModel`):
+one manufactured unit's calibration error (:func:`draw_calibration`) and the bias it gives
+(:func:`calibration_bias`), one drive's measurements (:func:`draw`, its noise through
+:func:`noise_sqrt`, the matrix square root :func:`psd_sqrt`) and the share of the error budget a
+drive repeats (:func:`split`, what the bound route's tracker is told).
 
 How it works: docs/internals/design.md.
 """
@@ -10,10 +11,46 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import rng_or_error
+from .._checks import square_matrices
+from .._validate import finite_array, instance, rng_or_error
+from .errormodel import PathErrorModel
 
-#: nothing exported: the bodies of the model's methods, on a model checked at construction
-__all__: list[str] = []
+__all__ = ["calibration_bias", "draw", "draw_calibration", "noise_sqrt", "psd_sqrt", "split"]
+
+
+def psd_sqrt(S: np.ndarray) -> np.ndarray:
+    """A square root ``L`` with ``L L^T = S`` of a stack of symmetric positive semi-definite
+    matrices (..., n, n), through the eigendecomposition (round-off negatives set to 0)."""
+    S = square_matrices("S", S)
+    S = 0.5 * (S + np.swapaxes(S, -1, -2))
+    w, V = np.linalg.eigh(S)
+    return V * np.sqrt(np.clip(w, 0.0, None))[..., None, :]
+
+
+def calibration_bias(model, phase_rad=None, gain_db=None) -> np.ndarray:
+    """The bias (T, P, 4) one array's calibration error gives (linearised)."""
+    instance("model", model, PathErrorModel)
+    T, P = model.exists.shape
+    out = np.zeros((T, P, 4))
+    if phase_rad is not None and model.k_phase is not None:
+        out += model.k_phase @ finite_array("phase_rad", phase_rad, shape=(model.n_elements,))
+    if gain_db is not None and model.k_gain is not None:
+        out += model.k_gain @ finite_array("gain_db", gain_db, shape=(model.n_elements,))
+    return out
+
+
+def noise_sqrt(model) -> np.ndarray:
+    """A square root (T, 4P, 4P) of ``cov`` over the existing paths (absent slots zero):
+    what :func:`draw` multiplies its standard normals by. It depends on the model only, so
+    a Monte-Carlo computes it once per array and hands it to every :func:`draw`."""
+    instance("model", model, PathErrorModel)
+    return _cov_root(model)
+
+
+def _cov_root(model) -> np.ndarray:
+    """:func:`noise_sqrt` of a model already checked."""
+    m = np.repeat(model.exists, 4, axis=1)
+    return psd_sqrt(np.where(m[:, :, None] & m[:, None, :], model.cov, 0.0))
 
 
 def _repetition(exists: np.ndarray, k: np.ndarray, normalise: bool = True) -> np.ndarray:
@@ -55,6 +92,7 @@ def split(model) -> tuple[np.ndarray, np.ndarray]:
     counts the repeating share once per epoch averages it down
     (:class:`tunnelkit.tracking.javelin.ConsiderNoise` carries it as a consider parameter
     instead)."""
+    instance("model", model, PathErrorModel)
     T, P = model.exists.shape
     idx = np.arange(P)
     white = np.asarray(model.cov).reshape(T, P, 4, P, 4)[:, idx, :, idx, :]
@@ -85,6 +123,7 @@ def split(model) -> tuple[np.ndarray, np.ndarray]:
 def draw_calibration(model, rng: np.random.Generator) -> tuple:
     """One manufactured array's calibration error ``(phase_rad, gain_db)``, each (M,) or
     ``None`` where the model has none: drawn once per unit, shared by all its drives."""
+    instance("model", model, PathErrorModel)
     rng = rng_or_error("rng", rng)
     M = model.n_elements
     phase = gain = None
@@ -106,23 +145,24 @@ def draw(
     array's calibration bias and a Gaussian error with covariance ``cov`` per epoch; NaN
     where a path does not exist. ``calibration``: the unit's ``(phase_rad, gain_db)``
     (:func:`draw_calibration`, shared by every drive of one unit); ``None`` draws it from
-    ``rng`` first (a unit of its own). ``noise_sqrt``: :meth:`PathErrorModel.noise_sqrt` computed once
+    ``rng`` first (a unit of its own). ``noise_sqrt``: :func:`noise_sqrt` computed once
     (the same draw, without its cost)."""
+    instance("model", model, PathErrorModel)
     rng = rng_or_error("rng", rng)
     T, P = model.exists.shape
     if noise_sqrt is None:
-        noise_sqrt = model.noise_sqrt()
+        noise_sqrt = _cov_root(model)
     elif np.shape(noise_sqrt) != (T, 4 * P, 4 * P):
         raise ValueError(
             f"noise_sqrt: expected shape {(T, 4 * P, 4 * P)} (the model's noise_sqrt()), "
             f"got {np.shape(noise_sqrt)}"
         )
     if calibration is None:
-        phase, gain = model.draw_calibration(rng)
+        phase, gain = draw_calibration(model, rng)
     elif not isinstance(calibration, tuple) or len(calibration) != 2:
         raise TypeError("calibration: expected (phase_rad, gain_db) from draw_calibration()")
     else:
         phase, gain = calibration
     noise = (noise_sqrt @ rng.standard_normal((T, 4 * P, 1)))[..., 0].reshape(T, P, 4)
-    z = model.truth + model.bias + model.calibration_bias(phase, gain) + noise
+    z = model.truth + model.bias + calibration_bias(model, phase, gain) + noise
     return np.where(model.exists[..., None], z, np.nan)

@@ -3,9 +3,10 @@ measurement route.
 
 A :class:`PathErrorModel` holds, per epoch and candidate path slot, the true path parameters in
 the tracker's measurement space ``z = [phi, psi, kappa, d]`` and the error of an estimator of
-them (``crlb``, ``cov``, ``bias``, ``k_phase`` / ``k_gain``); :meth:`PathErrorModel.draw` turns
-it into one drive's measurements (:mod:`tunnelkit.design.errordraws`, loaded when a drive is
-drawn). :func:`psd_sqrt` is its matrix square root.
+them (``crlb``, ``cov``, ``bias``, ``k_phase`` / ``k_gain``);
+:func:`tunnelkit.design.errordraws.draw` turns it into one drive's measurements
+(:mod:`tunnelkit.design.errordraws`, loaded when a drive is drawn, with the calibration draw, the
+noise's square root and the split of the budget).
 
 How it works, field by field: docs/internals/design.md.
 """
@@ -16,22 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import real_array, square_matrices
+from .._checks import real_array
 from .._validate import finite_array, nonnegative, sequence
 
-__all__ = ["Z_NAMES", "PathErrorModel", "psd_sqrt"]
+__all__ = ["Z_NAMES", "PathErrorModel"]
 
 #: the measured parameters of each path, in this order
 Z_NAMES = ("phi", "psi", "kappa", "d")
-
-
-def psd_sqrt(S: np.ndarray) -> np.ndarray:
-    """A square root ``L`` with ``L L^T = S`` of a stack of symmetric positive semi-definite
-    matrices (..., n, n), through the eigendecomposition (round-off negatives set to 0)."""
-    S = square_matrices("S", S)
-    S = 0.5 * (S + np.swapaxes(S, -1, -2))
-    w, V = np.linalg.eigh(S)
-    return V * np.sqrt(np.clip(w, 0.0, None))[..., None, :]
 
 
 @dataclass(frozen=True)
@@ -118,21 +110,11 @@ class PathErrorModel:
         k = self.k_phase if self.k_phase is not None else self.k_gain
         return None if k is None else int(np.shape(k)[3])
 
-    def calibration_bias(self, phase_rad=None, gain_db=None) -> np.ndarray:
-        """The bias (T, P, 4) one array's calibration error gives (linearised)."""
-        T, P = self.exists.shape
-        out = np.zeros((T, P, 4))
-        if phase_rad is not None and self.k_phase is not None:
-            out += self.k_phase @ finite_array("phase_rad", phase_rad, shape=(self.n_elements,))
-        if gain_db is not None and self.k_gain is not None:
-            out += self.k_gain @ finite_array("gain_db", gain_db, shape=(self.n_elements,))
-        return out
-
     def budget(self) -> np.ndarray:
         """The per-path error budget (T, P, 4, 4): the second moment of the error about the
         truth, ``cov`` plus the calibration covariance over the calibration draw
         (``sigma_phi^2 K_phase K_phase^T + sigma_g^2 K_gain K_gain^T``) plus the deterministic
-        bias' outer product (:meth:`split`: the share of it one drive repeats). What an extraction that knows its array's
+        bias' outer product (:func:`tunnelkit.design.errordraws.split`: the share of it one drive repeats). What an extraction that knows its array's
         calibration tolerance and its model's shortcuts (but not the draw) can report; equal to
         the ``crlb`` blocks for an ideal model."""
         T, P = self.exists.shape
@@ -145,40 +127,3 @@ class PathErrorModel:
         b = np.asarray(self.bias)
         out += b[..., :, None] * b[..., None, :]
         return np.where(self.exists[..., None, None], out, 0.0)
-
-    def split(self) -> tuple[np.ndarray, np.ndarray]:
-        """The per-path error budget split into what one drive repeats and what it draws afresh
-        every epoch, ``(white, repeating)``, each (T, P, 4, 4) and positive semi-definite
-        (:func:`tunnelkit.design.errordraws.split`)."""
-        from .errordraws import split  # loaded with the drives drawn from the model
-
-        return split(self)
-
-    def noise_sqrt(self) -> np.ndarray:
-        """A square root (T, 4P, 4P) of ``cov`` over the existing paths (absent slots zero):
-        what :meth:`draw` multiplies its standard normals by. It depends on the model only, so
-        a Monte-Carlo computes it once per array and hands it to every :meth:`draw`."""
-        m = np.repeat(self.exists, 4, axis=1)
-        return psd_sqrt(np.where(m[:, :, None] & m[:, None, :], self.cov, 0.0))
-
-    def draw_calibration(self, rng: np.random.Generator) -> tuple:
-        """One manufactured array's calibration error ``(phase_rad, gain_db)``, each (M,) or
-        ``None`` where the model has none: drawn once per unit, shared by all its drives."""
-        from .errordraws import draw_calibration  # loaded with the drives drawn from the model
-
-        return draw_calibration(self, rng)
-
-    def draw(
-        self,
-        rng: np.random.Generator,
-        *,
-        noise_sqrt: np.ndarray | None = None,
-        calibration: tuple | None = None,
-    ) -> np.ndarray:
-        """One drive's measured ``z`` (T, P, 4) (:func:`tunnelkit.design.errordraws.draw`):
-        ``calibration`` the unit's ``(phase_rad, gain_db)`` (:meth:`draw_calibration`, shared by
-        every drive of one unit), ``None`` draws it from ``rng`` first; ``noise_sqrt``
-        :meth:`noise_sqrt` computed once."""
-        from .errordraws import draw  # loaded with the drives drawn from the model
-
-        return draw(self, rng, noise_sqrt=noise_sqrt, calibration=calibration)

@@ -7,7 +7,7 @@ cost grows with the array (580 s for two 32 x 32 drives). An efficient extractio
 threshold delivers the true path parameters plus an error the model describes, and *reports*
 the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
 
-* ``z = [phi, psi, kappa, d]`` of every existing path from :meth:`PathErrorModel.draw` (truth,
+* ``z = [phi, psi, kappa, d]`` of every existing path from :func:`~tunnelkit.design.errordraws.draw` (truth,
   bias, one array's calibration error, Gaussian error with the model's ``cov``);
 * the reported covariance: the ``(phi, psi, kappa)`` block and the ``d`` standard deviation of
   the model's ``crlb`` (``report="crlb"``: what an efficient extraction reports when it ignores
@@ -23,7 +23,7 @@ the CRLB at its estimate; :func:`bound_drive` hands the tracker exactly that:
 * the radial speed ``v`` from the truth plus :data:`SIGMA_V` of white noise (the Doppler
   clutter test only compares it with the vehicle speed at metre-per-second level; the ideal
   bound on ``v`` is far smaller, so this is a conservative, documented stand-in);
-* the share of that budget which repeats every epoch (:meth:`PathErrorModel.split`: one
+* the share of that budget which repeats every epoch (:func:`~tunnelkit.design.errordraws.split`: one
   array's calibration error, the bias of the terms the model leaves out, as far as they keep
   their value from one epoch to the next) handed over beside it
   (``PathMeasurements.bias_cov``; the budget report only), so that the tracker carries it as a
@@ -47,8 +47,9 @@ from __future__ import annotations
 import numpy as np
 
 from .._physical import carrier
-from .._validate import choice, instance, nonnegative, rng_or_error
+from .._validate import choice, instance, integer, nonnegative, rng_or_error
 from ..constants import C
+from . import errordraws
 from .errormodel import PathErrorModel
 from .geometry import RouteGeometry
 from .setup import DesignSetup, parse_array
@@ -87,7 +88,7 @@ def _reported_blocks(model: PathErrorModel, report: str) -> tuple[np.ndarray, np
     if report == "crlb" or (report == "auto" and ideal):
         idx = np.arange(P)
         return np.moveaxis(model.crlb.reshape(T, P, 4, P, 4)[:, idx, :, idx, :], 0, 1), None
-    white, repeating = model.split()
+    white, repeating = errordraws.split(model)
     return white + repeating, repeating
 
 
@@ -122,7 +123,7 @@ def bound_route(
         spec.label,
         report,
         blocks,
-        model.noise_sqrt(),
+        errordraws.noise_sqrt(model),
         origin,
         float(setup.signal_route(spec).min_d),
         repeating,
@@ -146,7 +147,7 @@ def bound_drive(
     ``model`` may be a :class:`BoundRoute` of ``spec`` (:func:`bound_route`, computed once per
     array; its own ``report`` then applies): the same drive, without recomputing the array's
     share of it. ``calibration``: the unit's calibration draw
-    (:meth:`PathErrorModel.draw_calibration`; ``None``: drawn from ``rng``, a unit per drive)."""
+    (:func:`~tunnelkit.design.errordraws.draw_calibration`; ``None``: drawn from ``rng``, a unit per drive)."""
     choice("report", report, REPORTS)
     if isinstance(model, BoundRoute):
         prepared = model
@@ -164,8 +165,6 @@ def bound_drive(
     if T != len(setup.trajectory):
         raise ValueError(f"model: expected {len(setup.trajectory)} epochs (the route's), got {T}")
     if n_epochs is not None:
-        from .._validate import integer
-
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
     return indexed_drive(prepared, setup, rng, T, sigma_v, calibration)
 
@@ -201,7 +200,7 @@ def indexed_drive(
     traj, cfg = setup.trajectory, setup.config
     min_d = prepared.min_d
     if rows is None:
-        z = model.draw(rng, noise_sqrt=prepared.noise_sqrt, calibration=calibration)[:T]
+        z = errordraws.draw(model, rng, noise_sqrt=prepared.noise_sqrt, calibration=calibration)[:T]
         model_rows = slice(0, T)
     else:
         model_rows = rows = np.asarray(rows)[:T]
@@ -274,16 +273,18 @@ def indexed_drive(
 
 
 def _draw_rows(model: PathErrorModel, noise_sqrt, rows, rng, calibration, units=None) -> np.ndarray:
-    """:meth:`PathErrorModel.draw` of the model's epochs ``rows`` (one per drive epoch, a row
+    """:func:`~tunnelkit.design.errordraws.draw` of the model's epochs ``rows`` (one per drive epoch, a row
     may repeat): the same order of draws (the calibration first when not given, then one
     standard normal vector per drive epoch), so ``rows = arange(T)`` draws what ``draw`` does.
     ``units`` (T,): each epoch's array unit, ``calibration`` a list of their draws."""
     P = model.exists.shape[1]
     if units is None:
-        phase, gain = model.draw_calibration(rng) if calibration is None else calibration
-        cal = model.calibration_bias(phase, gain)[rows]
+        phase, gain = (
+            errordraws.draw_calibration(model, rng) if calibration is None else calibration
+        )
+        cal = errordraws.calibration_bias(model, phase, gain)[rows]
     else:
-        cal = np.stack([model.calibration_bias(*c) for c in calibration])[units, rows]
+        cal = np.stack([errordraws.calibration_bias(model, *c) for c in calibration])[units, rows]
     e = rng.standard_normal((len(rows), 4 * P, 1))
     noise = (noise_sqrt[rows] @ e)[..., 0].reshape(len(rows), P, 4)
     z = (model.truth + model.bias)[rows] + cal + noise

@@ -44,6 +44,7 @@ from .._validate import boolean, choice, instance, integer, nonnegative, positiv
 from ..odometry import MODELS, Odometry
 from ..settling import settled
 from .arrayjob import START_HEIGHT_SIGMA_M, design_planes, javelin_config, median_sigmas
+from .errordraws import draw_calibration
 from .setup import DesignSetup, parse_array
 from .sites import LONG_DRIVE_SPEED, SiteRoute, SiteRow, row_pcrlb, site_drive, site_route
 from .trackerfix import START_SIGMA_M
@@ -87,7 +88,7 @@ class LongTunnelTrial:
         # the sites' units from a stream of their own (spawned: the run's stream does not move),
         # so every array and spacing sees the same noise, clock biases and V2X messages
         units = rng.spawn(1)[0]
-        cal = [route.route.model.draw_calibration(units) for _ in range(row.count)]
+        cal = [draw_calibration(route.route.model, units) for _ in range(row.count)]
         drive = site_drive(row, route, rng, calibration=cal, odometry=self.odometry)
         sh, s = START_HEIGHT_SIGMA_M, self.start_sigma
         p0 = draw_start(drive.truth[0], s, rng, sh)  # after the drive, as the design's sweep

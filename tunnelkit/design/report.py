@@ -12,7 +12,6 @@ How it works, step by step: docs/internals/design.md.
 from __future__ import annotations
 
 from dataclasses import asdict
-from functools import partial
 
 import numpy as np
 
@@ -29,7 +28,7 @@ from .._validate import (
 )
 from ..budget import check_bytes, check_elements
 from ..settling import SETTLE_S
-from .achievable import DesignImpairments, path_error_model, predicted_error
+from .achievable import DesignImpairments, predicted_error
 from .bounds import route_bounds, route_geometry
 from .impairments import (
     CALIBRATED_GAIN_ERROR_DB,
@@ -65,13 +64,6 @@ __all__ = ["DesignReport", "DesignRow", "design_sweep"]
 def _impairment_fields(imp: DesignImpairments) -> dict:
     """The impairment settings as plain values (the report's inputs)."""
     return {k: (v if isinstance(v, (bool, str)) else float(v)) for k, v in asdict(imp).items()}
-
-
-def _error_models(impairments: DesignImpairments, mode: str):
-    """The bound route's error model per array under ``impairments`` (``None``: the ideal)."""
-    if mode != "bound" or impairments.ideal:
-        return None
-    return partial(path_error_model, impairments=impairments)
 
 
 def _bound_row(setup, spec, impairments, criterion, target, share, eps_phi, epochs, settle):
@@ -232,22 +224,11 @@ def design_sweep(
     warnings += [f"{r.array}: {r.gaps}" for r in rows if r.gaps]
     todo = [s for s, r in zip(specs, rows) if r.status == "bound only"]
     if units and todo:
-        kw = {
-            "mode": mode,
-            "error_models": _error_models(imp, mode),
-            "impairments": None if imp.ideal else imp,
-            "workers": workers,
-            "scheduler": scheduler,
-            "timeout": timeout,
-            "progress": progress,
-            "n_epochs": n_epochs,
-            "start_sigma": start_sigma,
-            "dead_reckoning": dead_reckoning,
-            "drives_per_unit": drives_per_unit,
-        }
-        judged = {"settle": settle, "required": required_yield, "cap": max_units}
-        from .unitsweep import run_units  # the Monte-Carlo by units, loaded when asked for
+        from .unitsweep import run_units, sweep_options  # the Monte-Carlo by units, when asked for
 
+        kw = sweep_options(imp, mode, workers, scheduler, timeout, progress, n_epochs, start_sigma,
+                           dead_reckoning, drives_per_unit)  # fmt: skip
+        judged = {"settle": settle, "required": required_yield, "cap": max_units}
         run_units(setup, rows, todo, units, max_units, seed, kw, warnings,
                   (criterion, target, share, seed, n_boot), judged)  # fmt: skip
     if units == 0:

@@ -28,7 +28,7 @@ from ..arrays import ArrayGeometry, rotation, ura
 from ..channel import SRSConfig
 from ..constants import wavelength
 from ..scenarios import Scenario, Trajectory, load_scenario
-from ..signal_route import CHANNELS, RouteOptions, SignalRoute
+from ..signal_route import CHANNELS
 from .geometry import KINDS
 
 __all__ = ["ArraySpec", "DesignSetup", "Mount", "parse_array"]
@@ -233,16 +233,9 @@ class DesignSetup:
         if channel is not None:
             choice("channel", channel, CHANNELS)
             if channel == "sionna" and rts is None:
-                from ..rt import RTSettings
+                from .channelroute import scenario_rt_settings  # the ray tracer's, when asked for
 
-                try:
-                    sc = load_scenario(self.name)
-                except (FileNotFoundError, KeyError, ValueError) as exc:
-                    raise ValueError(
-                        f"channel: 'sionna' needs the ray-tracing settings of scenario "
-                        f"{self.name!r}, which does not load ({exc})"
-                    ) from None
-                rts = RTSettings.from_scenario(sc)
+                rts = scenario_rt_settings(self.name)
         else:
             channel = self.channel
         if mount_height is not None:
@@ -283,29 +276,10 @@ class DesignSetup:
         """The measurement route of ``spec`` on this design as the Monte-Carlo drives it
         (:class:`tunnelkit.signal_route.SignalRoute`): each epoch's paths carry the CRLB at their
         estimate, and Algorithm 1 drops only what no clock bias explains."""
-        spec = parse_array(spec)
-        arrays = self.arrays(spec)
-        raytraced = None
-        if self.channel == "sionna":
-            from ..rt import RayTracedChannel
+        from .channelroute import channel_route  # the route loads when a design drives it
 
-            raytraced = RayTracedChannel(
-                self.tunnel,
-                arrays,
-                self.trajectory,
-                self.config,
-                self.rt_settings,
-                label=f"{self.name}-design-{spec.label}",
-            )
-        return SignalRoute(
-            self.tunnel,
-            arrays,
-            self.trajectory,
-            self.config,
-            kinds=self.kinds,
-            raytraced=raytraced,
-            options=RouteOptions(report_covariance=True, bias_aware_delay_check=True),
-        )
+        spec = parse_array(spec)
+        return channel_route(self, spec, self.arrays(spec))
 
     def arrays(self, spec) -> list[ArrayGeometry]:
         """``spec`` placed, centred, on every mount; refused (``ValueError`` naming ``arrays``,

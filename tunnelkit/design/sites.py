@@ -49,6 +49,7 @@ from ..odometry import Odometry
 from ..reckoning import posterior_bound
 from .bounds import route_geometry
 from .drivebound import position_information
+from .errordraws import draw_calibration
 from .fastroute import SIGMA_V, bound_route, indexed_drive
 from .geometry import RouteGeometry
 from .setup import DesignSetup, Mount, parse_array
@@ -348,7 +349,7 @@ def site_drive(
     epoch, the V2X messages), each epoch's paths drawn from its row and carrying its serving
     site (``PathMeasurements.site``); ``None`` where no site is in range. Every site's array is
     a unit of its own: ``calibration`` a list of one
-    :meth:`~tunnelkit.design.errormodel.PathErrorModel.draw_calibration` per site (``None``:
+    :func:`~tunnelkit.design.errordraws.draw_calibration` per site (``None``:
     drawn from ``rng``, site by site, before the drive's other draws). ``odometry``: the V2X
     messages' model (:class:`tunnelkit.odometry.Odometry`; ``None``: the row's trajectory's, its
     scenario's ``[odometry]``)."""
@@ -365,11 +366,11 @@ def site_drive(
         T = min(integer("n_epochs", n_epochs, minimum=1), T)
     model = route.route.model
     if calibration is None:
-        calibration = [model.draw_calibration(rng) for _ in range(row.count)]
+        calibration = [draw_calibration(model, rng) for _ in range(row.count)]
     elif not isinstance(calibration, list | tuple) or len(calibration) != row.count:
         raise TypeError(
             f"calibration: expected a list of {row.count} (phase_rad, gain_db) draws, one per "
-            "site (PathErrorModel.draw_calibration)"
+            "site (design.errordraws.draw_calibration)"
         )
     return indexed_drive(
         route.route,

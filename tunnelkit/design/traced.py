@@ -50,9 +50,11 @@ from pathlib import Path
 import numpy as np
 
 from .._physical import start_spread
-from .._validate import boolean, instance, integer, positive, rng_or_error
+from .._validate import boolean, finite_array, instance, integer, positive, rng_or_error
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
+from .bounds import route_geometry
+from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 from .trackerfix import START_SIGMA_M
 
@@ -523,10 +525,6 @@ def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
     each > 0): no bias, no calibration term, the truth and radial speed zero (the bounds over the
     drive use only the geometry's Jacobians and the covariance). Any channel: the geometry is
     the image method's. Returns ``(model, geometry)``."""
-    from .._validate import finite_array
-    from .bounds import route_geometry
-    from .errormodel import PathErrorModel
-
     instance("setup", setup, DesignSetup)
     spec = parse_array(spec)
     if not isinstance(sigmas, dict) or set(sigmas) != {"phi", "psi", "kappa", "d"}:

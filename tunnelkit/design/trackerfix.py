@@ -57,7 +57,7 @@ class BoundRoute:
     the square root of the model's ``cov`` (T, 4P, 4P) the draws multiply, the array's
     reference antenna per epoch ``origin`` (T, 3), Algorithm 1's ``min_d`` and ``repeating``
     (T, P, 4, 4): the share of the reported blocks that repeats every epoch (``None`` for the
-    CRLB report; :meth:`PathErrorModel.split` for the budget, whose two shares the blocks
+    CRLB report; :func:`~tunnelkit.design.errordraws.split` for the budget, whose two shares the blocks
     add). Computed once
     per array, so a drive costs its random draws and nothing else."""
 

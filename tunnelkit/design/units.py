@@ -15,9 +15,10 @@ What procurement asks is the share of units that meet the target on their own:
 * **the unit yield** (:func:`unit_yield`): the share of units whose quantile is at or below the
   target, with the Wilson score interval over units (:func:`wilson_interval`; binomial, the
   units independent);
-* **the verdict** (:func:`tunnelkit.design.verdict.judge`): met when the interval's lower end
-  reaches the required yield, not met when its upper end is below it, undecided between (more
-  units decide it).
+* **the verdict** (:func:`tunnelkit.design.verdict.judge`, by :func:`yield_verdict` here): met
+  when the interval's lower end reaches the required yield, not met when its upper end is below
+  it, undecided between (more units decide it); the recommendation the smallest array met
+  (:func:`yield_recommendation`).
 """
 
 from __future__ import annotations
@@ -117,3 +118,50 @@ def unit_yield(unit_q, target: float, level: float = 0.95) -> tuple[float, list[
     target = positive("target", target)
     k = int(np.sum(q <= target))
     return k / q.size, wilson_interval(k, q.size, level)
+
+
+# the verdict and the recommendation by the unit yield (design.verdict's judge and recommend, on
+# arguments they checked): not exported
+
+
+def yield_verdict(target, units, yield_, ci, required, pct, cap, min_units) -> tuple[str, str]:
+    """:func:`~tunnelkit.design.verdict.judge` once units ran: ``(status, reason)`` from the
+    unit yield ``yield_`` and its interval ``ci = (lo, hi)`` over ``units`` units, ``pct`` the
+    share in words, ``min_units`` the fewest units whose interval decides."""
+    lo, hi = ci
+    head = (
+        f"{100 * yield_:.3g} % of {units} units meet {target:g} m on {pct} of the settled "
+        f"route, 95 % CI [{100 * lo:.3g}, {100 * hi:.3g}] %"
+    )
+    need = f"the required {100 * required:g} %"
+    if units < min_units:
+        return "undecided", f"{head}: too few units for the interval to decide (>= {min_units})"
+    if lo >= required:
+        return "met", f"{head}: at least {need}"
+    if hi < required:
+        return "not met", f"{head}: below {need}"
+    tail = f"the cap of {cap} units reached" if cap is not None and units >= cap else "add units"
+    return "undecided", f"{head} straddles {need}: {tail}"
+
+
+def yield_recommendation(order, target, pct, required) -> dict:
+    """:func:`~tunnelkit.design.verdict.recommend` once units ran: the smallest of the
+    candidates ``order`` (smallest first) whose unit yield reaches ``required``."""
+    met = [r for r in order if r.status == "met"]
+    smaller_open = [
+        r.array
+        for r in order
+        if r.status == "undecided" and (not met or order.index(r) < order.index(met[0]))
+    ]
+    goal = f"{100 * required:g} % of units within {target:g} m on {pct} of the settled route"
+    if met:
+        best = met[0]
+        why = f"the smallest candidate whose unit yield reaches {goal}: {best.reason}"
+        if smaller_open:
+            why += f"; smaller {', '.join(smaller_open)} undecided"
+        return {"array": best.array, "basis": "unit-yield", "reason": why}
+    if smaller_open:
+        why = f"none met yet; undecided: {', '.join(smaller_open)}"
+    else:
+        why = f"no candidate's unit yield reaches {goal}"
+    return {"array": None, "basis": "unit-yield", "reason": why}

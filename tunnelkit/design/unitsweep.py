@@ -8,10 +8,12 @@ for units.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
 from ..settling import SETTLE_S
+from .achievable import DesignImpairments, path_error_model
 from .intervals import cluster_quantile_ci
 from .montecarlo import sweep_montecarlo
 from .units import unit_quantiles, unit_yield
@@ -20,6 +22,32 @@ from .verdict import REQUIRED_YIELD, counted_epochs, gate, judge, share_quantile
 #: nothing exported: the sweep's own steps, on the arguments :func:`tunnelkit.design.design_sweep`
 #: (and :func:`tunnelkit.design.confirm.confirm_on_channel`) checked at their boundary
 __all__: list[str] = []
+
+
+def sweep_options(imp, mode, workers, scheduler, timeout, progress, n_epochs, start_sigma,
+                  dead_reckoning, drives_per_unit) -> dict:  # fmt: skip
+    """The options of a design sweep's Monte-Carlo (:func:`run_units`' ``kw``), the bound
+    route's error model per array under the impairments ``imp`` among them."""
+    return {
+        "mode": mode,
+        "error_models": _error_models(imp, mode),
+        "impairments": None if imp.ideal else imp,
+        "workers": workers,
+        "scheduler": scheduler,
+        "timeout": timeout,
+        "progress": progress,
+        "n_epochs": n_epochs,
+        "start_sigma": start_sigma,
+        "dead_reckoning": dead_reckoning,
+        "drives_per_unit": drives_per_unit,
+    }
+
+
+def _error_models(impairments: DesignImpairments, mode: str):
+    """The bound route's error model per array under ``impairments`` (``None``: the ideal)."""
+    if mode != "bound" or impairments.ideal:
+        return None
+    return partial(path_error_model, impairments=impairments)
 
 
 def _sweep_montecarlo(setup, specs, runs, seed, **kw) -> dict:

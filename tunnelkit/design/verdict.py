@@ -132,19 +132,9 @@ def judge(
         )
     if yield_ is None or ci is None:
         raise ValueError("ci: give the unit yield and its [lo, hi] interval when units > 0")
-    head = (
-        f"{100 * yield_:.3g} % of {units} units meet {target:g} m on {pct} of the settled "
-        f"route, 95 % CI [{100 * lo:.3g}, {100 * hi:.3g}] %"
-    )
-    need = f"the required {100 * required:g} %"
-    if units < MIN_RUNS_CI:
-        return "undecided", f"{head}: too few units for the interval to decide (>= {MIN_RUNS_CI})"
-    if lo >= required:
-        return "met", f"{head}: at least {need}"
-    if hi < required:
-        return "not met", f"{head}: below {need}"
-    tail = f"the cap of {cap} units reached" if cap is not None and units >= cap else "add units"
-    return "undecided", f"{head} straddles {need}: {tail}"
+    from .units import yield_verdict  # the verdict by the unit yield, loaded when units ran
+
+    return yield_verdict(target, units, yield_, (lo, hi), required, pct, cap, MIN_RUNS_CI)
 
 
 def recommend(
@@ -170,24 +160,9 @@ def recommend(
                 "--units to decide by the unit yield"
             ),
         }
-    met = [r for r in order if r.status == "met"]
-    smaller_open = [
-        r.array
-        for r in order
-        if r.status == "undecided" and (not met or order.index(r) < order.index(met[0]))
-    ]
-    goal = f"{100 * required:g} % of units within {target:g} m on {pct} of the settled route"
-    if met:
-        best = met[0]
-        why = f"the smallest candidate whose unit yield reaches {goal}: {best.reason}"
-        if smaller_open:
-            why += f"; smaller {', '.join(smaller_open)} undecided"
-        return {"array": best.array, "basis": "unit-yield", "reason": why}
-    if smaller_open:
-        why = f"none met yet; undecided: {', '.join(smaller_open)}"
-    else:
-        why = f"no candidate's unit yield reaches {goal}"
-    return {"array": None, "basis": "unit-yield", "reason": why}
+    from .units import yield_recommendation  # the choice by the unit yield, when units ran
+
+    return yield_recommendation(order, target, pct, required)
 
 
 def _m(v: float) -> str:

@@ -20,7 +20,6 @@ from ..schema import ScenarioError
 from .checks import MAX_ELEMENTS, MAX_SAMPLES, MAX_TENSOR_BYTES
 from .files import (
     ALLOWED_REQUIRES,
-    check_all,
     data_dir,
     list_scenarios,
     load_scenario,
@@ -36,9 +35,9 @@ from .registry import (
     register_tunnel,
 )
 
-#: loaded on first use (:mod:`tunnelkit._lazy`): a loaded scenario needs no template writer and
-#: no editor
-_EXPORTS = {"template": "templates", "with_values": "edit"}
+#: loaded on first use (:mod:`tunnelkit._lazy`): a loaded scenario needs no template writer, no
+#: editor and no check of every preset
+_EXPORTS = {"template": "templates", "with_values": "edit", "check_all": "checkall"}
 
 __all__ = [
     "ALLOWED_REQUIRES",

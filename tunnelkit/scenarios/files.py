@@ -21,7 +21,6 @@ __all__ = [
     "MAX_FILE_BYTES",
     "MAX_NAME_LENGTH",
     "NAME_RE",
-    "check_all",
     "data_dir",
     "list_scenarios",
     "load_scenario",
@@ -165,17 +164,3 @@ def _check_depth(raw: dict, where: str) -> None:
             )
         items = node.values() if isinstance(node, dict) else node
         stack.extend((v, depth + 1) for v in items if isinstance(v, dict | list | tuple))
-
-
-def check_all(paths=None) -> list[tuple[str, str | None]]:
-    """``[(name, error or None), ...]`` for every preset (or the given names/paths)."""
-    if paths is not None and (isinstance(paths, str | bytes) or not hasattr(paths, "__iter__")):
-        raise TypeError(f"paths: expected a list of scenario names or paths, got {paths!r:.40}")
-    out = []
-    for n in list_scenarios() if paths is None else paths:
-        try:
-            load_scenario(n)
-            out.append((str(n), None))
-        except (ScenarioError, TypeError) as exc:
-            out.append((str(n), str(exc)))
-    return out

@@ -70,18 +70,6 @@ class Key:
     def has_default(self) -> bool:
         return self.default is not _REQUIRED
 
-    def range_text(self) -> str:
-        """``"> 0"``, ``"[-90, 90]"``, ... (empty if unbounded)."""
-        lo = f"> {_num(self.gt)}" if self.gt is not None else None
-        lo = f">= {_num(self.ge)}" if self.ge is not None else lo
-        hi = f"< {_num(self.lt)}" if self.lt is not None else None
-        hi = f"<= {_num(self.le)}" if self.le is not None else hi
-        if lo and hi:
-            left = "(" if self.gt is not None else "["
-            right = ")" if self.lt is not None else "]"
-            return f"{left}{_num(self.gt if self.gt is not None else self.ge)}, {_num(self.lt if self.lt is not None else self.le)}{right}"
-        return lo or hi or ""
-
 
 @dataclass(frozen=True)
 class Table:
@@ -102,7 +90,8 @@ class Table:
         return self.keys + tuple(self.variants.get(kind, ()))
 
 
-def _num(x) -> str:
+def number_text(x) -> str:
+    """A bound as written in a message: ``1.0`` -> ``"1"``, ``3`` -> ``"3"``."""
     return f"{x:g}" if isinstance(x, float) else str(x)
 
 
@@ -129,7 +118,7 @@ def _check_number(where: str, full: str, key: Key, v, integral: bool):
     ):
         if bound is not None and not ok(bound):
             unit = f" {key.unit}" if key.unit else ""
-            _fail(where, f"'{full}' must be {sym} {_num(bound)}{unit}, got {v!r}")
+            _fail(where, f"'{full}' must be {sym} {number_text(bound)}{unit}, got {v!r}")
 
 
 def _check_nested(where: str, full: str, key: Key, v, shape, integral: bool, idx: str = ""):

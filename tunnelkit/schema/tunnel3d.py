@@ -35,10 +35,23 @@ BLOCKER = Table(
 MAX_SIDE = 256
 SHAPE_DOC = "[rows, columns] of the URA (a ULA of n elements is [1, n]); at most 4096 elements"
 
+#: the label and shape of an array, the first keys of every 3-D tunnel's array table
+ARRAY_KEYS = (
+    key_str("name", "label (e.g. '+x')", optional=True),
+    Key("shape", "ints", SHAPE_DOC, shape=(2,), ge=1, le=MAX_SIDE),
+)
+#: an array's reference antenna, the last key of every 3-D tunnel's array table
+ARRAY_OFFSET = key_floats(
+    "offset",
+    "reference antenna relative to base_station.position",
+    "m",
+    shape=(3,),
+    default=[0.0, 0.0, 0.0],
+)
+
 ITALIANO_ARRAY = Table(
     (
-        key_str("name", "label (e.g. '+x')", optional=True),
-        Key("shape", "ints", SHAPE_DOC, shape=(2,), ge=1, le=MAX_SIDE),
+        *ARRAY_KEYS,
         key_float(
             "azimuth_deg", "boresight azimuth from +x towards +y", "deg", ge=-360.0, le=360.0
         ),
@@ -49,13 +62,7 @@ ITALIANO_ARRAY = Table(
             ge=-90.0,
             le=90.0,
         ),
-        key_floats(
-            "offset",
-            "reference antenna relative to base_station.position",
-            "m",
-            shape=(3,),
-            default=[0.0, 0.0, 0.0],
-        ),
+        ARRAY_OFFSET,
     ),
     "one planar array (lambda/2 spacing); the reference antenna sits at position + offset",
 )
@@ -260,6 +267,19 @@ LANE_KEYS = (
     key_float("height", "UE antenna height above the road", "m", gt=0.0),
 )
 
+
+def station_keys(arrays: Table, position: str, doc: str, user: bool = False) -> tuple[Key, ...]:
+    """The ``base_station`` (its ``position`` and ``arrays``), ``radio``, ``raytracing`` and
+    ``odometry`` keys of a 3-D tunnel's file (``user``: your own tunnel's radio)."""
+    station = (key_floats("position", position, "m", shape=(3,)), key_tables("arrays", arrays))
+    return (
+        key_table("base_station", Table(station, doc)),
+        key_table("radio", radio(user)),
+        key_table("raytracing", RAYTRACING, optional=True),
+        key_table("odometry", ODOMETRY, optional=True),
+    )
+
+
 ITALIANO = Table(
     (
         *header("italiano2026"),
@@ -284,21 +304,11 @@ ITALIANO = Table(
                 "the JAVELIN tunnel: a half-ellipse of planar facets plus the road",
             ),
         ),
-        key_table(
-            "base_station",
-            Table(
-                (
-                    key_floats(
-                        "position", "base station (x, y, z), inside the tunnel", "m", shape=(3,)
-                    ),
-                    key_tables("arrays", ITALIANO_ARRAY),
-                ),
-                "the base station and its arrays",
-            ),
+        *station_keys(
+            ITALIANO_ARRAY,
+            "base station (x, y, z), inside the tunnel",
+            "the base station and its arrays",
         ),
-        key_table("radio", radio(False)),
-        key_table("raytracing", RAYTRACING, optional=True),
-        key_table("odometry", ODOMETRY, optional=True),
         key_table(
             "trajectory",
             Table(

@@ -4,24 +4,14 @@ odometry and lane tables of :mod:`tunnelkit.schema.tunnel3d`."""
 
 from __future__ import annotations
 
-from .spec import Key, Table, header, key_float, key_floats, key_int, key_str, key_table, key_tables
-from .tunnel3d import (
-    BLOCKER,
-    LANE_KEYS,
-    MAX_SIDE,
-    ODOMETRY,
-    PLATE,
-    RAYTRACING,
-    SHAPE_DOC,
-    radio,
-)
+from .spec import Table, header, key_float, key_int, key_str, key_table, key_tables
+from .tunnel3d import ARRAY_KEYS, ARRAY_OFFSET, BLOCKER, LANE_KEYS, PLATE, station_keys
 
 USER_SHAPES = ("rectangular", "horseshoe", "semicircular")
 
 USER_ARRAY = Table(
     (
-        key_str("name", "label (e.g. '+x')", optional=True),
-        Key("shape", "ints", SHAPE_DOC, shape=(2,), ge=1, le=MAX_SIDE),
+        *ARRAY_KEYS,
         key_float(
             "azimuth_deg",
             "boresight azimuth from +x (along the tunnel) towards +y",
@@ -53,13 +43,7 @@ USER_ARRAY = Table(
             le=10.0,
             optional=True,
         ),
-        key_floats(
-            "offset",
-            "reference antenna relative to base_station.position",
-            "m",
-            shape=(3,),
-            default=[0.0, 0.0, 0.0],
-        ),
+        ARRAY_OFFSET,
     ),
     "one planar array on the mount; element 0 (a corner) is the reference antenna",
 )
@@ -123,21 +107,12 @@ USER = Table(
                 },
             ),
         ),
-        key_table(
-            "base_station",
-            Table(
-                (
-                    key_floats(
-                        "position", "mount position (x, y, z), inside the tunnel", "m", shape=(3,)
-                    ),
-                    key_tables("arrays", USER_ARRAY),
-                ),
-                "the base-station mount and its arrays (one [[base_station.arrays]] per array)",
-            ),
+        *station_keys(
+            USER_ARRAY,
+            "mount position (x, y, z), inside the tunnel",
+            "the base-station mount and its arrays (one [[base_station.arrays]] per array)",
+            user=True,
         ),
-        key_table("radio", radio(True)),
-        key_table("raytracing", RAYTRACING, optional=True),
-        key_table("odometry", ODOMETRY, optional=True),
         key_table(
             "trajectory",
             Table(

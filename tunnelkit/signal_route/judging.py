@@ -54,7 +54,7 @@ which this floor does not take a quantile of.
 **The bias budget** (:class:`BiasBudget`). A re-judged fit's covariance is the CRLB at the
 estimate (:func:`~tunnelkit.signal_route.covariance.reported_covariance`, ``judged=False``),
 which knows the noise only; the route adds the design's per-path budget of the impairments
-(what :meth:`tunnelkit.design.errormodel.PathErrorModel.split` puts on top of the noise
+(what :func:`tunnelkit.design.errordraws.split` puts on top of the noise
 covariance) and hands its repeating share on as ``bias_cov`` (the tracker carries it as a bias
 of the path's track). A budget is per candidate path (one slot per surface); the estimates are
 matched to the slots by their wave origin's direction and delay (:meth:`BiasBudget.match`:
