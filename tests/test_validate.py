@@ -373,7 +373,7 @@ def test_record_allow_inf_takes_plus_infinity_only():
 
 
 def test_indices_are_integers_in_range_and_name_the_parameter():
-    from tunnelkit._checks import indices
+    from tunnelkit._domains import indices
 
     np.testing.assert_array_equal(indices("keep", [2, 0], 3), [2, 0])
     assert indices("keep", [], 3).shape == (0,)

@@ -16,7 +16,6 @@ from typing import Any
 
 from . import scenarios
 from ._version import __version__
-from .montecarlo import QUICK, mc_count, quick_mode
 from .scenarios import list_scenarios, load_scenario
 
 # the builders of a scenario's tunnel, trajectory and arrays live in the modules that define those
@@ -37,22 +36,31 @@ __all__ = [
 ]
 
 
-#: the notebooks' own calls, in :mod:`tunnelkit.notebook` (loaded by the first of them)
-_NOTEBOOK_CALLS = ("build_dir", "setup_notebook", "solution")
+#: the notebooks' own calls, in :mod:`tunnelkit.notebook` (loaded by the first of them), and
+#: quick mode, in :mod:`tunnelkit.montecarlo`: name -> the module that defines it
+_ON_FIRST_USE = {
+    "build_dir": "notebook",
+    "setup_notebook": "notebook",
+    "solution": "notebook",
+    "QUICK": "montecarlo",
+    "mc_count": "montecarlo",
+    "quick_mode": "montecarlo",
+}
 
 
 def __dir__() -> list[str]:
-    """The package's names with the notebooks' calls (loaded on first use)."""
+    """The package's names with those loaded on first use."""
     return sorted(set(globals()) | set(__all__))
 
 
 def __getattr__(name: str) -> Any:
     """Load submodules lazily: ``tk.fresnel`` imports ``tunnelkit.fresnel`` on first access; the
-    notebooks' calls (``tk.setup_notebook()``) load :mod:`tunnelkit.notebook`."""
+    notebooks' calls (``tk.setup_notebook()``) load :mod:`tunnelkit.notebook`, quick mode
+    (``tk.QUICK``, ``tk.mc_count``) :mod:`tunnelkit.montecarlo`."""
     if name.startswith("_"):
         raise AttributeError(name)
-    if name in _NOTEBOOK_CALLS:
-        value = getattr(importlib.import_module(".notebook", __name__), name)
+    if name in _ON_FIRST_USE:
+        value = getattr(importlib.import_module(f".{_ON_FIRST_USE[name]}", __name__), name)
         globals()[name] = value
         return value
     try:

@@ -17,7 +17,6 @@ __all__ = [
     "attributes",
     "bound",
     "bound_array",
-    "indices",
     "items",
     "numeric_array",
     "optional_real",
@@ -127,22 +126,6 @@ def items(name: str, value, cls: type | tuple[type, ...], *, empty: bool = False
     for i, v in enumerate(out):
         instance(f"{name}[{i}]", v, cls)
     return out
-
-
-def indices(name: str, value, n: int) -> np.ndarray:
-    """A 1-D list or array of integer indices into ``n`` items, each in ``[0, n)``."""
-    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
-        raise TypeError(f"{name}: expected a list of indices, got {type(value).__name__}")
-    arr = np.asarray(value)
-    if arr.size == 0:
-        return np.zeros(0, int)
-    if arr.dtype.kind not in "iu":
-        raise TypeError(f"{name}: expected integer indices, got dtype {arr.dtype}")
-    if arr.ndim != 1:
-        raise ValueError(f"{name}: expected a 1-D list of indices, got shape {arr.shape}")
-    if arr.min() < 0 or arr.max() >= n:
-        raise ValueError(f"{name}: expected indices in [0, {n - 1}], got {arr.tolist()}")
-    return arr.astype(int, copy=False)
 
 
 def attributes(name: str, value, attrs: Sequence[str], what: str):

@@ -1,5 +1,5 @@
 """Input checks of arrays with a structure of their own: signed arrays, particle weights,
-symmetric positive definite matrices, distinct points and (low, high) ranges.
+symmetric positive definite matrices, distinct points, (low, high) ranges and indices.
 
 Built on :mod:`tunnelkit._validate`; each raises ``ValueError`` or ``TypeError`` whose message
 starts with the offending parameter's name.
@@ -15,6 +15,7 @@ from ._validate import finite_array
 
 __all__ = [
     "distinct_points",
+    "indices",
     "interval",
     "nonnegative_array",
     "positive_array",
@@ -105,3 +106,19 @@ def interval(name: str, value, *, lower: float | None = None) -> tuple[float, fl
     if lower is not None and lo < lower:
         raise ValueError(f"{name}: must be >= {lower:g}, got low {lo:g}")
     return lo, hi
+
+
+def indices(name: str, value, n: int) -> np.ndarray:
+    """A 1-D list or array of integer indices into ``n`` items, each in ``[0, n)``."""
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise TypeError(f"{name}: expected a list of indices, got {type(value).__name__}")
+    arr = np.asarray(value)
+    if arr.size == 0:
+        return np.zeros(0, int)
+    if arr.dtype.kind not in "iu":
+        raise TypeError(f"{name}: expected integer indices, got dtype {arr.dtype}")
+    if arr.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D list of indices, got shape {arr.shape}")
+    if arr.min() < 0 or arr.max() >= n:
+        raise ValueError(f"{name}: expected indices in [0, {n - 1}], got {arr.tolist()}")
+    return arr.astype(int, copy=False)

@@ -163,8 +163,3 @@ def recommend(
     from .units import yield_recommendation  # the choice by the unit yield, when units ran
 
     return yield_recommendation(order, target, pct, required)
-
-
-def _m(v: float) -> str:
-    """A length for a sentence: ``inf`` or 3 significant digits in m."""
-    return "inf" if not np.isfinite(v) else f"{v:.3g} m"

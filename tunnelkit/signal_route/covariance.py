@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import indices
+from .._domains import indices
 from .._validate import boolean, instance
 from ..arrays import ArrayGeometry
 from ..channel import SRSConfig

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .._checks import indices
+from .._domains import indices
 from .._validate import instance, positive
 from ..arrays import ArrayGeometry
 from ..extraction.estimates import PathEstimates

@@ -24,7 +24,7 @@ from ..scenarios import Scenario, Trajectory, load_scenario
 from .measurements import Epoch
 from .options import MAX_SECOND_ORDER, RouteOptions
 
-__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute", "simulate_epoch"]
+__all__ = ["CHANNELS", "MAX_SECOND_ORDER", "RouteOptions", "SignalRoute"]
 
 
 #: channel sources of a route: ``"image"`` (eq. 1 from the image method's first-order paths) or
@@ -273,19 +273,3 @@ class SignalRoute:
         from .epoch import run_epoch
 
         return run_epoch(self, k, rng, n_paths, tunnel, clock_bias, extract_kw)
-
-
-def simulate_epoch(scenario, k: int, rng: np.random.Generator, **kw) -> Epoch:
-    """One-call signal route: ``simulate_epoch("italiano2026-straight", 10, rng).measurements``.
-
-    Keyword arguments go to :class:`SignalRoute` (``kinds``, ``snr_offset_db``, ``options``) or
-    to :meth:`SignalRoute.epoch` (``n_paths``, ``tunnel``, ``clock_bias``, extraction options).
-    For loops over epochs build a :class:`SignalRoute` once instead.
-    """
-    moved = sorted(set(kw) & {f.name for f in fields(RouteOptions)})
-    if moved:
-        raise TypeError(
-            f"{', '.join(moved)}: a route option, pass options=RouteOptions({moved[0]}=...)"
-        )
-    route_kw = {key: kw.pop(key) for key in ("kinds", "snr_offset_db", "options") if key in kw}
-    return SignalRoute.from_scenario(scenario, **route_kw).epoch(k, rng, **kw)
