@@ -13,8 +13,6 @@ from .._validate import boolean, instance, real, record, sequence
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot, SRSConfig
 from ..evaluation import match_paths
-from ..extraction import algorithm1
-from ..extraction.estimates import PathEstimates
 from ..propagation import SECOND_ORDER
 from ..tracking.measurements import PathMeasurements
 
@@ -52,6 +50,8 @@ class Epoch:
     rejudged: dict | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
+        from ..extraction.estimates import PathEstimates  # a route that only traces loads none
+
         record(self, shapes=_EPOCH_SHAPES, nonnegative=("k", "t"), skip=("rejudged",))
         speeds("velocity", self.velocity)
         instance("estimates", self.estimates, PathEstimates)
@@ -104,6 +104,9 @@ def measurements_from_estimates(
     ``config``, also the covariance the extraction reports
     (:func:`~tunnelkit.signal_route.covariance.reported_covariance`, with
     ``judged``: False for a fit the route re-judged and passed)."""
+    from ..extraction import algorithm1
+    from ..extraction.estimates import PathEstimates
+
     instance("est", est, PathEstimates)
     instance("array", array, ArrayGeometry)
     if config is not None:
