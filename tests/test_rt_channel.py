@@ -66,6 +66,34 @@ def test_schema_matches_settings():
     assert set(tunnel3d.RT_MATERIALS) == set(MATERIALS)
 
 
+def test_material_bands_are_the_tracers_and_refuse_a_carrier_outside():
+    """MATERIAL_BANDS against Sionna RT's own ITU-R P.2040 table (each material's widest band
+    starting at its lowest frequency); a material is refused at a carrier where its model is not
+    defined, naming the setting, and the 28 GHz presets' roads are modelled at 28 GHz."""
+    itu = pytest.importorskip("sionna.rt.radio_materials.itu")
+    from tunnelkit.rt.settings import MATERIAL_BANDS
+
+    assert set(MATERIAL_BANDS) == set(MATERIALS)
+    for name, (itu_name, _) in MATERIALS.items():
+        bands = sorted(itu.ITU_MATERIALS_PROPERTIES[itu_name])
+        lo, hi = bands[0]
+        assert MATERIAL_BANDS[name] == (lo * 1e9, hi * 1e9), name
+    RTSettings().check_carrier(5.9e9)
+    with pytest.raises(ValueError, match=r"^road_material: 'asphalt' .* 28 GHz"):
+        RTSettings().check_carrier(28e9)
+    with pytest.raises(ValueError, match=r"^wall_material: 'brick' .* 60 GHz"):
+        RTSettings(wall_material="brick").check_carrier(60e9)
+    RTSettings(road_material="asphalt_concrete").check_carrier(28e9)
+    sc = tk.load_scenario("italiano2026-straight")
+    tun, arrays = sc.tunnel(), propagation.scenario_arrays(sc)
+    with pytest.raises(ValueError, match=r"^road_material"):
+        rt.RayTracedChannel(tun, arrays, sc.trajectory(tun), channel.SRSConfig(fc=28e9),
+                            RTSettings())  # fmt: skip
+    for name in ("example-rectangular-28ghz", "mont-blanc-28ghz"):
+        sc = tk.load_scenario(name)
+        rt.RTSettings.from_scenario(sc).check_carrier(channel.SRSConfig.from_scenario(sc).fc)
+
+
 def _scenario_with(tmp_path, text: str):
     src = tk.load_scenario("italiano2026-straight").path.read_text()
     path = tmp_path / "rt.toml"

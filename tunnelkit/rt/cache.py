@@ -129,6 +129,7 @@ class RayTracedChannel:
         settings = RTSettings() if settings is None else settings
         if not isinstance(settings, RTSettings):
             raise TypeError(f"settings: expected an RTSettings, got {type(settings).__name__}")
+        settings.check_carrier(config.fc)
         if not isinstance(label, str) or not _LABEL.fullmatch(label):
             raise ValueError(
                 "label: expected a plain name (letters, digits, '_', '.', '+', '-', not starting "

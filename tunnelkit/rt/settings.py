@@ -5,10 +5,13 @@ defaults, :meth:`RTSettings.from_scenario`). Materials are ITU-R P.2040 models, 
 Sionna RT at the scenario's carrier:
 
 * the tunnel shell (walls and ceiling facets): ``"concrete"`` (ITU concrete, 0.3 m slab);
-* the road: ``"asphalt"``. ITU-R P.2040 has no asphalt; tunnelkit maps it to the ITU
-  ``"very_dry_ground"`` model (relative permittivity 3, conductivity 1.5e-4 f_GHz^2.52 S/m,
-  valid 1-10 GHz; about 0.013 S/m at 5.9 GHz), the nearest of the ITU models to the permittivity
-  of dry asphalt (about 3-6 at 5-6 GHz), on a 0.05 m slab;
+* the road: ``"asphalt"`` maps to the ITU ``"very_dry_ground"`` model (relative permittivity 3,
+  conductivity 1.5e-4 f_GHz^2.52 S/m, valid 1-10 GHz; about 0.013 S/m at 5.9 GHz), the nearest
+  ground model to the permittivity of dry asphalt (about 3-6 at 5-6 GHz), on a 0.05 m slab (the
+  stored traces and records at 5.9 GHz use it); ``"asphalt_concrete"`` is the ITU asphalt
+  concrete model (permittivity 4.83, conductivity 0.0108 f_GHz^1.3969 S/m, valid 1-40 GHz), the
+  road of the 28 GHz presets. A material is refused at a carrier where its model is not defined
+  (:data:`MATERIAL_BANDS`, :meth:`RTSettings.check_carrier`);
 * the road markings (RRMs) and blocker boxes: ``"metal"``.
 
 Diffuse scattering (Sionna's model, Degli-Esposti 2007): a surface with scattering coefficient
@@ -39,12 +42,14 @@ import hashlib
 import json
 from dataclasses import asdict, dataclass
 
+from .._physical import carrier
 from .._validate import choice, instance, integer, nonnegative, text
 
 __all__ = [
     "ANTENNA_PATTERNS",
     "ARRAY_TRACING",
     "MATERIALS",
+    "MATERIAL_BANDS",
     "SCATTERING_PATTERNS",
     "RTSettings",
 ]
@@ -53,12 +58,26 @@ __all__ = [
 MATERIALS: dict[str, tuple[str, float]] = {
     "concrete": ("concrete", 0.3),
     "asphalt": ("very_dry_ground", 0.05),
+    "asphalt_concrete": ("asphalt_concrete", 0.05),
     "metal": ("metal", 0.01),
     "brick": ("brick", 0.2),
     "marble": ("marble", 0.05),
     "glass": ("glass", 0.01),
     "medium_dry_ground": ("medium_dry_ground", 0.1),
     "wet_ground": ("wet_ground", 0.1),
+}
+#: the carriers [Hz] at which each material's ITU-R P.2040 model is defined (its Table 3, as
+#: Sionna RT holds them): the ground models, and so the road's asphalt, only from 1 to 10 GHz
+MATERIAL_BANDS: dict[str, tuple[float, float]] = {
+    "concrete": (1e9, 100e9),
+    "asphalt": (1e9, 10e9),
+    "asphalt_concrete": (1e9, 40e9),
+    "metal": (1e9, 100e9),
+    "brick": (1e9, 40e9),
+    "marble": (1e9, 60e9),
+    "glass": (0.1e9, 100e9),
+    "medium_dry_ground": (1e9, 10e9),
+    "wet_ground": (1e9, 10e9),
 }
 #: Sionna's scattering lobes
 SCATTERING_PATTERNS = ("lambertian", "directive")
@@ -141,6 +160,19 @@ class RTSettings:
         itu, thickness = MATERIALS[name]
         s = self.metal_scattering_coefficient if name == "metal" else self.scattering_coefficient
         return name, itu, thickness, s
+
+    def check_carrier(self, fc: float) -> None:
+        """Refuse a carrier ``fc`` [Hz] at which a material of the scene has no model (the tracer
+        would fail every epoch): ``ValueError`` naming the material's key."""
+        fc = carrier("fc", fc)
+        for key in ("wall_material", "road_material", "rrm_material"):
+            lo, hi = MATERIAL_BANDS[getattr(self, key)]
+            if not lo <= fc <= hi:
+                raise ValueError(
+                    f"{key}: {getattr(self, key)!r} (ITU-R P.2040 {MATERIALS[getattr(self, key)][0]}) "
+                    f"is modelled from {lo / 1e9:g} to {hi / 1e9:g} GHz, not at the carrier "
+                    f"{fc / 1e9:g} GHz; choose one modelled there (MATERIAL_BANDS)"
+                )
 
     def record(self) -> dict:
         """Every setting as a dict, less those added later that hold their earlier value

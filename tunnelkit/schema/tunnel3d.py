@@ -119,6 +119,7 @@ def radio(user: bool) -> Table:
 RT_MATERIALS = (
     "concrete",
     "asphalt",
+    "asphalt_concrete",
     "metal",
     "brick",
     "marble",
@@ -167,7 +168,7 @@ RAYTRACING = Table(
         ),
         key_str(
             "road_material",
-            "material of the road ('asphalt': ITU very_dry_ground, there is no ITU asphalt)",
+            "material of the road ('asphalt': ITU very_dry_ground, 1-10 GHz; 'asphalt_concrete' 1-40 GHz)",
             choices=RT_MATERIALS,
             default="asphalt",
         ),
