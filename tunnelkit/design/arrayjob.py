@@ -269,14 +269,26 @@ def load_tracker() -> None:
     """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
     a worker that imports them in a task while another thread unpickles a tracker sent from
     another worker deadlocks on the package's import locks)."""
-    # the modules themselves: the packages load their names on first use
-    from ..simulation import drives, scoring  # noqa: F401
+    # the modules themselves: the packages load their names on first use, and the branches a
+    # task may take load theirs (the first fix, the measured birth, the odometry states, the
+    # channel route's epoch and the ML fit's moves)
+    from .. import calibration  # noqa: F401
+    from ..extraction.ml import merged, resolved, rho_reseed, split  # noqa: F401
+    from ..signal_route import covariance, epoch  # noqa: F401
+    from ..simulation import baselines, drives, reextract, scoring  # noqa: F401
+    from ..tracking import reported  # noqa: F401
     from ..tracking.javelin import (  # noqa: F401
         arraydesign,
         designs,
+        iterated,
+        linearbirth,
+        lostest,
         manage,
+        measuredbirth,
         measurement,
         noise,
+        odometrystates,
+        reflector,
         roles,
         state,
         tracker,

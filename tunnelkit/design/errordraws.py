@@ -154,7 +154,7 @@ def draw(
         noise_sqrt = _cov_root(model)
     elif np.shape(noise_sqrt) != (T, 4 * P, 4 * P):
         raise ValueError(
-            f"noise_sqrt: expected shape {(T, 4 * P, 4 * P)} (the model's noise_sqrt()), "
+            f"noise_sqrt: expected shape {(T, 4 * P, 4 * P)} (errordraws.noise_sqrt(model)), "
             f"got {np.shape(noise_sqrt)}"
         )
     if calibration is None:

@@ -25,7 +25,7 @@ __all__ = [
     "as_path_list",
 ]
 
-#: the path families :func:`trace_paths` can select
+#: the path families :func:`~tunnelkit.propagation.paths.trace_paths` can select
 PATH_KINDS = ("los", "wall", "ceiling", "road", "rrm")
 #: ``Path.kind`` (and ``surface_kind``) of a second-order specular path
 SECOND_ORDER = "reflection2"

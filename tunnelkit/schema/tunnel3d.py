@@ -32,6 +32,11 @@ BLOCKER = Table(
     "axis-aligned boxes that block rays (trucks)",
 )
 
+#: a semicircular cross-section's facets (the JAVELIN tunnel and your own semicircular tunnel)
+HALF_ELLIPSE_FACETS = key_int(
+    "n_facets", "planar facets approximating the half-ellipse", ge=2, le=360, default=12
+)
+
 MAX_SIDE = 256
 SHAPE_DOC = "[rows, columns] of the URA (a ULA of n elements is [1, n]); at most 4096 elements"
 
@@ -292,13 +297,7 @@ ITALIANO = Table(
                     key_float("length", "length, centred on x = 0", "m", gt=0.0),
                     key_float("width", "width at the road", "m", gt=0.0),
                     key_float("height", "height at the centre", "m", gt=0.0),
-                    key_int(
-                        "n_facets",
-                        "planar facets approximating the half-ellipse",
-                        ge=2,
-                        le=360,
-                        default=12,
-                    ),
+                    HALF_ELLIPSE_FACETS,
                     key_tables("plates", PLATE, optional=True),
                     key_tables("blockers", BLOCKER, optional=True),
                 ),

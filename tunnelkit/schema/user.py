@@ -5,7 +5,15 @@ odometry and lane tables of :mod:`tunnelkit.schema.tunnel3d`."""
 from __future__ import annotations
 
 from .spec import Table, header, key_float, key_int, key_str, key_table, key_tables
-from .tunnel3d import ARRAY_KEYS, ARRAY_OFFSET, BLOCKER, LANE_KEYS, PLATE, station_keys
+from .tunnel3d import (
+    ARRAY_KEYS,
+    ARRAY_OFFSET,
+    BLOCKER,
+    HALF_ELLIPSE_FACETS,
+    LANE_KEYS,
+    PLATE,
+    station_keys,
+)
 
 USER_SHAPES = ("rectangular", "horseshoe", "semicircular")
 
@@ -83,15 +91,7 @@ USER = Table(
                 "your tunnel: a straight tube along x, road at z = 0, centred on y = 0",
                 variants={
                     "rectangular": (),
-                    "semicircular": (
-                        key_int(
-                            "n_facets",
-                            "planar facets approximating the half-ellipse",
-                            ge=2,
-                            le=360,
-                            default=12,
-                        ),
-                    ),
+                    "semicircular": (HALF_ELLIPSE_FACETS,),
                     "horseshoe": (
                         key_int(
                             "n_facets", "planar facets of the arched roof", ge=2, le=360, default=12

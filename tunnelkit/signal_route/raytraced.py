@@ -34,10 +34,11 @@ def tensor_snapshot(
 ) -> ChannelSnapshot:
     """A noisy snapshot from a noiseless tensor ``H0`` (M, Nf, Nt) given for a unit transmit
     power and no clock bias (a ray-traced channel, :mod:`tunnelkit.rt.cache`): scaled by
-    ``sqrt(P_t)``, the clock bias (drawn from ``rng`` if None, as in :func:`synthesize`) applied
+    ``sqrt(P_t)``, the clock bias (drawn from ``rng`` if None, as in
+    :func:`~tunnelkit.channel.synthesize`) applied
     as ``exp(-j 2 pi s Df b)`` on tone ``s`` (eq. 1's ``tau_l = d_l / c + b`` for every path),
     ``calibration`` (M,) per element, then CN(0, N0) noise (``snr_offset_db`` as in
-    :func:`synthesize`). ``paths``: the true paths recorded in the snapshot (model "exact")."""
+    :func:`~tunnelkit.channel.synthesize`). ``paths``: the true paths recorded in the snapshot (model "exact")."""
     if not isinstance(config, SRSConfig):
         raise TypeError(f"config: expected a channel.SRSConfig, got {type(config).__name__}")
     H0 = np.asarray(H0)

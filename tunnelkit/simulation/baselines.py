@@ -23,8 +23,8 @@ __all__ = ["tenfiloc_track", "without_radio"]
 def tenfiloc_track(
     drive: DriveData, baseline: TeNFiLoc | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """TeNFiLoc fixes per epoch (T, 3) and which epochs had a fix (:meth:`TeNFiLoc.track`; the
-    baseline defaults to :meth:`TeNFiLoc.for_drive`)."""
+    """TeNFiLoc fixes per epoch (T, 3) and which epochs had a fix (:meth:`~tunnelkit.tracking.javelin.tenfiloc.TeNFiLoc.track`; the
+    baseline defaults to :meth:`~tunnelkit.tracking.javelin.tenfiloc.TeNFiLoc.for_drive`)."""
     if not isinstance(drive, DriveData):
         raise TypeError(f"drive: expected a DriveData, got {type(drive).__name__}")
     cls = registry.get("italiano2026", "TeNFiLoc")

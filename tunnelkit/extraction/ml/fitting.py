@@ -161,7 +161,7 @@ def _peak_reseed(prob: Problem, best, sigma2, max_iter, peak, peak_max, n_moves,
             break
         theta, mu_f, mu_t, ev = best[:4]
         th_n, mf_n, mt_n = path_from_peak(prob, peak[1], peak[2])
-        big = lm_with(prob, theta, mu_f, mu_t, (th_n, mf_n, mt_n), sigma2, short)
+        big = lm_with(prob, theta, mu_f, mu_t, (th_n, mf_n, mt_n), sigma2, short, _lm)
         n_it += big[4]
         keep = np.arange(L + 1) != int(np.argmin(path_significance(big[3], sigma2)))
         starts = [(big[0][keep], big[1][keep], big[2][keep])]
@@ -221,7 +221,8 @@ def _split_weak(prob: Problem, best, sigma2, max_iter, gain_min, flagged: bool =
             return best, 0, False
     from .split import split_weak  # loaded when a split is tried
 
-    return split_weak(prob, best, sigma2, sig, pair, gain_min, min(RANK_ITER, max_iter), max_iter)
+    short = min(RANK_ITER, max_iter)
+    return split_weak(prob, best, sigma2, sig, pair, gain_min, short, max_iter, fit=_lm)
 
 
 def _nearest_atom(prob: Problem, theta, mu_f, mu_t, th_n, mf_n, mt_n) -> int:
@@ -343,7 +344,7 @@ def fit_problem(
         from .rho_reseed import rho_reseed  # loaded when the basin test fails
 
         best, its, n_kept = rho_reseed(
-            prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof
+            prob, best, sigma2, max_iter, n_reseed, rho_max * dof, history, dof, fit=_lm
         )
         n_it, kept = n_it + its, kept + n_kept
         if n_kept:

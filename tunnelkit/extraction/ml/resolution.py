@@ -127,7 +127,7 @@ def pair_test_rows(prob, theta, mu_f, mu_t, sigma2, ev, z, max_iter, z_max=PAIR_
 
 
 def pair_tests_at(prob: Problem, theta, mu_f, mu_t, sigma2: float, ev: dict, max_iter: int):
-    """:func:`pair_test` at a fit whose evaluation ``ev`` (with derivatives) is at hand, inputs
+    """:func:`~.resolved.pair_test` at a fit whose evaluation ``ev`` (with derivatives) is at hand, inputs
     unchecked (the fit's own call); returns the rows and the iterations spent."""
     if theta.shape[0] < 2:
         return np.zeros((0, 4)), 0

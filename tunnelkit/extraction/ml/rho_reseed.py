@@ -17,22 +17,20 @@ from .search import SPLIT_STEPS
 #: nothing exported: a step of the fit, on the fit's own checked arrays
 __all__: list[str] = []
 
-_lm = lm_fit  # the fit's name for it
 
-
-def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter):
+def _birth_death(prob: Problem, theta, mu_f, mu_t, ev, sigma2, max_iter, fit):
     """One path more, sought in the pure residual; all ``L + 1`` fitted jointly; the least
     significant one out and the ``L`` fitted again (a path missed while another was counted
     twice, or two paths merged, leave a structured residual that this move picks up)."""
     r = prob.H - prob.model(theta, mu_f, mu_t, ev["c"])
-    big = lm_with(prob, theta, mu_f, mu_t, search_path(r, prob), sigma2, max_iter)
+    big = lm_with(prob, theta, mu_f, mu_t, search_path(r, prob), sigma2, max_iter, fit)
     keep = np.arange(theta.shape[0] + 1) != int(np.argmin(path_significance(big[3], sigma2)))
-    res = _lm(prob, big[0][keep], big[1][keep], big[2][keep], sigma2, max_iter)
+    res = fit(prob, big[0][keep], big[1][keep], big[2][keep], sigma2, max_iter)
     return res, big[4] + res[4]
 
 
 def _merge_and_split(
-    prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, coherence=COUNTED_TWICE
+    prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, fit, coherence=COUNTED_TWICE
 ):
     """If two atoms are nearly collinear (one path counted twice, ``|G_ij| / sqrt(G_ii G_jj) >
     coherence``): drop the weaker, fit the ``L - 1``, then split one of them into two halves
@@ -44,7 +42,7 @@ def _merge_and_split(
         return None
     drop = j if abs(ev["c"][i]) >= abs(ev["c"][j]) else i
     keep = np.arange(theta.shape[0]) != drop
-    th, mf, mt, ev_s, its, _ = _lm(prob, theta[keep], mu_f[keep], mu_t[keep], sigma2, max_iter)
+    th, mf, mt, ev_s, its, _ = fit(prob, theta[keep], mu_f[keep], mu_t[keep], sigma2, max_iter)
     best = None
     for l_ in np.argsort(-np.abs(ev_s["c"])):
         for du in SPLIT_STEPS:
@@ -52,7 +50,7 @@ def _merge_and_split(
             t2[l_, :2] += du
             t2[-1, :2] -= du
             mf2, mt2 = np.append(mf, mf[l_]), np.append(mt, mt[l_])
-            res = _lm(prob, project_feasible(t2), mf2, mt2, sigma2, max_iter)
+            res = fit(prob, project_feasible(t2), mf2, mt2, sigma2, max_iter)
             its += res[4]
             if best is None or res[3]["cost"] < best[3]["cost"]:
                 best = res
@@ -61,7 +59,7 @@ def _merge_and_split(
     return best, its
 
 
-def rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof):
+def rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof, fit=lm_fit):
     """The re-seedings on the residual energy (docs/internals/extraction-ml.md): while the cost is
     above ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
     and the weakest path re-sought, each kept if the likelihood rises. Returns the fit, the
@@ -76,12 +74,12 @@ def rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history
             break
         merged = None
         if not split_tried:  # one path counted twice: merge it, split another (once)
-            merged = _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok)
+            merged = _merge_and_split(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, cost_ok, fit)
         if merged is not None:
             cand, its = merged
             split_tried = True
         elif attempt % 2 == 0:  # birth and death: a path from the residual, the weakest out
-            cand, its = _birth_death(prob, theta, mu_f, mu_t, ev, sigma2, max_iter)
+            cand, its = _birth_death(prob, theta, mu_f, mu_t, ev, sigma2, max_iter, fit)
         else:  # the weakest path re-sought in the residual plus its own contribution
             sig = path_significance(ev, sigma2)
             order = [int(i) for i in np.argsort(sig) if int(i) not in tried]
@@ -94,7 +92,7 @@ def rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history
             th_n, mf_n, mt_n = search_path(R, prob)
             th2, mf2, mt2 = theta.copy(), mu_f.copy(), mu_t.copy()
             th2[worst], mf2[worst], mt2[worst] = th_n, mf_n, mt_n
-            cand = _lm(prob, th2, mf2, mt2, sigma2, max_iter)
+            cand = fit(prob, th2, mf2, mt2, sigma2, max_iter)
             its = cand[4]
         n_it += its
         history.append(cand[3]["cost"] / (dof * sigma2))

@@ -24,7 +24,9 @@ WEAK_SPLITS = (*SPLIT_STEPS, *(tuple(2.5 * v for v in du) for du in SPLIT_STEPS)
 PAIR_GAIN = 1.0
 
 
-def split_weak(prob: Problem, best, sigma2, sig, pair: bool, gain_min, short: int, max_iter: int):
+def split_weak(
+    prob: Problem, best, sigma2, sig, pair: bool, gain_min, short: int, max_iter: int, fit=lm_fit
+):
     """A path below the noise (``MIN_SIGNIFICANCE``) or two closer than ``RESOLVE_Z``: one path
     too few elsewhere (two sources merged) while the weak path, or the less significant of the
     pair (a path counted twice), sits on nothing. It is dropped and each other path in turn split
@@ -57,7 +59,7 @@ def split_weak(prob: Problem, best, sigma2, sig, pair: bool, gain_min, short: in
                 th2[l_, :2] += du
                 th2[weak, :2] -= du
                 starts.append((project_feasible(th2), mf2, mt2))
-    cand, n_it = best_of_starts(lm_fit, prob, starts, sigma2, short, max_iter)
+    cand, n_it = best_of_starts(fit, prob, starts, sigma2, short, max_iter)
     if cand[3]["cost"] < ev["cost"] - gain_min:
         return cand, n_it, True
     return best, n_it, False
