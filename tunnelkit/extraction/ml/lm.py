@@ -73,8 +73,9 @@ def lm_fit(prob: Problem, theta, mu_f, mu_t, sigma2, max_iter: int, state: dict 
     return theta, mu_f, mu_t, ev, it, converged
 
 
-def lm_with(prob: Problem, theta, mu_f, mu_t, new, sigma2, max_iter, fit=lm_fit):
-    """``fit`` (``lm_fit``) on the ``L`` paths plus one more, ``new = (theta, mu_f, mu_t)``."""
+def lm_with(prob: Problem, theta, mu_f, mu_t, new, sigma2, max_iter, fit):
+    """``fit`` (the caller's ``lm_fit``) on the ``L`` paths plus one more, ``new = (theta, mu_f,
+    mu_t)``."""
     th, mf, mt = np.vstack([theta, new[0]]), np.append(mu_f, new[1]), np.append(mu_t, new[2])
     return fit(prob, th, mf, mt, sigma2, max_iter)
 

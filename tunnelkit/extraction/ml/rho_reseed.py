@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lm import lm_fit, lm_with
+from .lm import lm_with
 from .model import Problem, project_feasible
 from .rank_one import search_path
 from .resolution import COUNTED_TWICE, coherent_pair
@@ -59,7 +59,7 @@ def _merge_and_split(
     return best, its
 
 
-def rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof, fit=lm_fit):
+def rho_reseed(prob: Problem, best, sigma2, max_iter, n_reseed, cost_ok, history, dof, fit):
     """The re-seedings on the residual energy (docs/internals/extraction-ml.md): while the cost is
     above ``cost_ok`` (the ``rho`` test), merge and split (once), then alternately birth and death
     and the weakest path re-sought, each kept if the likelihood rises. Returns the fit, the

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lm import best_of_starts, lm_fit
+from .lm import best_of_starts
 from .model import Problem, project_feasible
 from .resolution import COUNTED_TWICE, coherent_pair
 from .resolved import closest_pair
@@ -25,7 +25,7 @@ PAIR_GAIN = 1.0
 
 
 def split_weak(
-    prob: Problem, best, sigma2, sig, pair: bool, gain_min, short: int, max_iter: int, fit=lm_fit
+    prob: Problem, best, sigma2, sig, pair: bool, gain_min, short: int, max_iter: int, fit
 ):
     """A path below the noise (``MIN_SIGNIFICANCE``) or two closer than ``RESOLVE_Z``: one path
     too few elsewhere (two sources merged) while the weak path, or the less significant of the
