@@ -6,7 +6,7 @@
 drives of seed 0 and cached in ``data/rt/design/``), then per array and channel: median and p90
 of the settled error with its bootstrap 95 % interval, the verdict, the PEB and achievable bound
 beside it (p90, eq.-1 model), on the traced route the bound of the sigmas its tracker is told
-(settled RMS, :func:`tunnelkit.design.traced.traced_bounds`), with ``--dead-reckoning`` the
+(settled RMS, :func:`tunnelkit.design.tracedbounds.traced_bounds`), with ``--dead-reckoning`` the
 same drives' error p90 with every measurement dropped ("DR p90"), the traced route's measurement
 noise, and the ray tracer's cost (trace time per epoch, median and max, and the cache size of the
 array's drive). ``--start-sigma`` sets the entry fix (the CLI's ``--start-sigma``).

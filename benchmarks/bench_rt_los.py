@@ -20,7 +20,7 @@ a bound on the traced channel. Also the share of epochs whose path taken for the
 
 ``--starts N`` tracks every drive from ``N`` entry fixes (the gain's 90 % interval is a bootstrap
 over the drives); ``--by-elevation BINS`` adds the first sigma's design told each epoch's sigmas
-by the measured elevation (:mod:`tunnelkit.studies.los_elevation`, the table built on seed 0's
+by the measured elevation (:mod:`tunnelkit.design.los`, the table built on seed 0's
 drives), ``--table FILE`` one built elsewhere (``--write-table``); ``--huber`` each sigma with
 the Huber-weighted update (:mod:`tunnelkit.studies.robust_update`); ``--cost`` the tracking time
 per epoch; ``--drives-cache DIR`` keeps the drives to score them again; ``--errors-out`` writes
@@ -43,25 +43,22 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.design import DesignSetup, drive_pcrlb
+from tunnelkit.design.los import (
+    ElevationSigmas,
+    elevation_sigmas,
+    los_angle_information,
+    los_errors,
+    los_only,
+    los_path,
+    told_by_elevation,
+)
 from tunnelkit.geometry import spherical
 from tunnelkit.metrics import settled
 from tunnelkit.runner import run_trials
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.simulation import HELD_OUT_SEED, evaluate, without_radio
 from tunnelkit.studies.attribution import scenario_with_array
-from tunnelkit.studies.los_elevation import (
-    ElevationSigmas,
-    elevation_sigmas,
-    los_errors,
-    told_by_elevation,
-)
-from tunnelkit.studies.los_only import (
-    flagged_los,
-    los_angle_information,
-    los_design,
-    los_only,
-    los_path,
-)
+from tunnelkit.studies.los_only import flagged_los, los_design
 from tunnelkit.studies.robust_update import HuberUpdater
 from tunnelkit.studies.traced import simulate_traced, traced_design
 from tunnelkit.tracking.javelin import ReportedNoise, draw_start
@@ -355,6 +352,14 @@ def main() -> None:
         "--errors-out", default=None, help="write seed 0's LoS error record here (.npy)"
     )
     ap.add_argument(
+        "--survey",
+        type=int,
+        default=None,
+        metavar="N",
+        help="with --by-elevation: build the tables from seed 0's first N drives only (the "
+        "design's survey is 3) and score seed 0 on its other drives",
+    )
+    ap.add_argument(
         "--pooled-errors",
         nargs="+",
         default=None,
@@ -362,6 +367,9 @@ def main() -> None:
         "runs) instead of this run's drives",
     )
     a = ap.parse_args()
+    if a.survey is not None and (not a.by_elevation or a.pooled_errors or a.survey < 1
+                                 or a.survey >= a.runs):  # fmt: skip
+        ap.error("--survey: give --by-elevation, no --pooled-errors, and 1 <= N < --runs")
     if a.pooled_errors and not a.by_elevation:
         ap.error("--pooled-errors: give --by-elevation (the bin counts)")
     if a.table and a.by_elevation:
@@ -388,8 +396,12 @@ def main() -> None:
             if a.pooled_errors:
                 errors, src = np.vstack([np.load(f) for f in a.pooled_errors]), "pooled"
             else:
-                errors, src = los_errors([dd["ml-all"] for dd in drives]), "seed 0"
+                survey = drives if a.survey is None else drives[: a.survey]
+                errors = los_errors([dd["ml-all"] for dd in survey])
+                src = "seed 0" if a.survey is None else f"seed 0's first {a.survey} drives"
             tables = {f"{b} bins, {src}": elevation_sigmas(errors, b) for b in a.by_elevation}
+            if a.survey is not None:  # seed 0 scored on the drives the survey did not see
+                drives = drives[a.survey :]
         res = score(drives, seed, sigmas, a.start_sigma, a.los_gamma, a.fit_flags, a.starts,
                     tables, a.huber, a.sigmas[0])  # fmt: skip
         if chosen is None:  # chosen on seed 0, the lowest mean RMSE of the grid
@@ -401,7 +413,7 @@ def main() -> None:
         ref = reference(drives[0]["ml-traced"], chosen, a.start_sigma, a.scenario)
         dr = res["dead reckoning"]
         arrays = "" if a.array is None else f" with {a.array} arrays"
-        print(f"\nseed {seed}: {a.runs} drives x {a.starts} entry fixes of {a.scenario}{arrays}, "
+        print(f"\nseed {seed}: {len(drives)} drives x {a.starts} entry fixes of {a.scenario}{arrays}, "
               f"traced channel, L, entry fix {a.start_sigma:g} m "
               f"({time.perf_counter() - t0:.0f} s); path taken = the "
               f"true LoS in {100 * res['_los_share']:.1f} % of the epochs; none kept (fit "

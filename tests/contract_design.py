@@ -103,16 +103,29 @@ def design_traced():
         json.dump(traced.drive_record(setup, "4x4", np.random.default_rng(0), n_epochs=1), f)
     traced.stored_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1, path=stored)
     traced.design_errors_path(setup, "4x4", n_epochs=1)
-    rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=1)
+    rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=2)
     path = tempfile.mkdtemp() + "/errors.json"
     with open(path, "w") as fh:
         json.dump(rec, fh, default=str)
-    rec = traced.design_errors(setup, "4x4", n_epochs=1, path=path)
+    rec = traced.design_errors(setup, "4x4", n_epochs=2, path=path)
     d = traced.traced_javelin(setup, "4x4", rec)
     traced.error_model_summary(rec, d.config)
     sig = {"phi": 0.1, "psi": 0.1, "kappa": 30.0, "d": 1.0}
-    traced.sigma_error_model(setup, "4x4", sig, epochs=[0, 1])
-    traced.traced_bounds(setup, "4x4", d.config, 2)
+    from tunnelkit.design import tracedbounds, tracedlos
+    from tunnelkit.design.tracedtracker import checked_tracker
+
+    tracedbounds.sigma_error_model(setup, "4x4", sig, epochs=[0, 1])
+    tracedbounds.traced_bounds(setup, "4x4", d.config, 2)
+    tracedbounds.config_sigmas(d.config)
+    # the line-of-sight tracker: its table from the record's survey, the tracker, a drive told
+    # it, the told model's figure and what the report says
+    table = tracedlos.los_table(rec, 1)
+    los = tracedlos.los_javelin(setup, "4x4", rec)
+    every = traced.design_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1, kind="ml-all")
+    tracedlos.told_los(every, table, los.config)
+    tracedbounds.los_bounds(setup, "4x4", table, 2, sigma_p0=0.5)
+    traced.error_model_summary(rec, los.config, tracedlos.los_summary(rec, table))
+    checked_tracker("los", "channel", "sionna")
 
 
 def tracking_pieces():

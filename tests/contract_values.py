@@ -240,7 +240,7 @@ def _studies():
         extractions=("paper",),
         n_epochs=3,
     )
-    from tunnelkit.studies.los_only import los_only
+    from tunnelkit.design.los import los_only
 
     los_only(drives["paper"], 0.3)
     from tunnelkit.simulation.variants import drive_variant
@@ -663,7 +663,7 @@ def _traced():
 
     plane_kinds(route.tunnel)
     every = tr.simulate_traced("italiano2026-straight", np.random.default_rng(0), n_epochs=3)
-    from tunnelkit.studies.los_elevation import (
+    from tunnelkit.design.los import (
         ElevationSigmas,
         elevation_sigmas,
         los_errors,
@@ -716,11 +716,14 @@ def _odometry():
     drift_table(drift_rows(4, 0, (40.0, 100.0)))
     # a scenario's [odometry] (the Mont Blanc preset declares a car's), and a design told it
     from tunnelkit.design.arrayjob import javelin_config
+    from tunnelkit.design.los import los_angle_information, los_path
     from tunnelkit.scenarios import load_scenario
     from tunnelkit.scenarios.odometry import odometry_from_scenario
-    from tunnelkit.studies.los_only import los_angle_information, los_path
 
     los_angle_information(np.array([[20.0, -1.5, 1.5]]), np.array([0.0, 0.0, 6.0]), 0.02)
+    from tunnelkit.design.los import angle_sigma
+
+    angle_sigma("sigma", 0.02)
     los_path(np.array([10.4, 10.1]), np.array([0.1, -0.1]), 0.3)
     car = odometry_from_scenario(load_scenario("mont-blanc-28ghz"))
     assert car.label == "automotive"

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from tunnelkit import design
-from tunnelkit.design import traced
+from tunnelkit.design import traced, tracedbounds, tracedlos
 from tunnelkit.odometry import AUTOMOTIVE
 from tunnelkit.rt.cache import CACHE_ENV
 from tunnelkit.simulation import drives, simulate_routes
@@ -127,7 +127,7 @@ def test_a_design_drive_is_kept_and_driven_again_only_when_something_differs(set
     def count(route, rng, *, n_epochs=None):
         driven.append(n_epochs)
         rng.random()  # a drive draws from the generator
-        return {"ml-traced": ref}
+        return {"ml-traced": ref, "ml-all": ref}
 
     monkeypatch.setattr(traced, "traced_drive", count)
     g2 = np.random.default_rng(11)
@@ -293,7 +293,7 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
 
     def count(route, rng, *, n_epochs=None):
         driven.append(n_epochs)
-        return {"ml-traced": "driven"}
+        return {"ml-traced": "driven", "ml-all": "driven, every path"}
 
     monkeypatch.setattr(traced, "traced_drive", count)
     monkeypatch.setattr(traced, "stored_drive_path", lambda *a: p)
@@ -395,7 +395,7 @@ def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
     from tunnelkit.tracking.javelin.designs import ours_coherent
 
     sig = {"phi": 0.05, "psi": 0.04, "kappa": 20.0, "d": 0.5}
-    m, _ = traced.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6))
+    m, _ = tracedbounds.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6))
     k, p = np.argwhere(m.exists)[0]
     block = m.cov[k, 4 * p : 4 * p + 4, 4 * p : 4 * p + 4]
     np.testing.assert_allclose(block, np.diag([0.05**2, 0.04**2, 400.0, 0.25]))
@@ -410,19 +410,19 @@ def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
         ).config  # fmt: skip
 
     T = 6
-    pc1, dr1 = traced.traced_bounds(setup, "4x4", cfg(1.0), T)
-    pc3, _ = traced.traced_bounds(setup, "4x4", cfg(3.0), T)
-    pch, _ = traced.traced_bounds(setup, "4x4", cfg(1e6), T)
+    pc1, dr1 = tracedbounds.traced_bounds(setup, "4x4", cfg(1.0), T)
+    pc3, _ = tracedbounds.traced_bounds(setup, "4x4", cfg(3.0), T)
+    pch, _ = tracedbounds.traced_bounds(setup, "4x4", cfg(1e6), T)
     assert pc1.shape == (T,) and np.all(pc3 > pc1)
     np.testing.assert_allclose(dr1, pc1)  # no bias: the prediction is the posterior CRLB
     # the start's prior: a better entry fix, a lower bound; the default is the design's start
-    pc_fine, _ = traced.traced_bounds(setup, "4x4", cfg(1.0), T, sigma_p0=0.1)
+    pc_fine, _ = tracedbounds.traced_bounds(setup, "4x4", cfg(1.0), T, sigma_p0=0.1)
     assert np.all(pc_fine < pc1) and pc_fine[0] < 0.2 < pc1[0]
     np.testing.assert_allclose(
-        traced.traced_bounds(setup, "4x4", cfg(1.0), T, sigma_p0=design.START_SIGMA_M)[0], pc1
+        tracedbounds.traced_bounds(setup, "4x4", cfg(1.0), T, sigma_p0=design.START_SIGMA_M)[0], pc1
     )
     # float epochs (whole numbers, as route_geometry takes them) give the same model
-    mf, _ = traced.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6.0))
+    mf, _ = tracedbounds.sigma_error_model(setup, "4x4", sig, epochs=np.arange(6.0))
     np.testing.assert_array_equal(mf.t, m.t)
     none = drive_pcrlb(setup, np.zeros((T, 2, 2)))
     np.testing.assert_allclose(pch, none, rtol=1e-6)
@@ -437,7 +437,7 @@ def test_the_sweep_reports_the_bound_of_the_told_sigmas(setup):
         kw = {} if fix is None else {"start_sigma": fix}
         rep = design.design_sweep(setup, ["4x4"], seed=0, mode="channel", n_epochs=3, **FEW, **kw)
         row = rep.rows[0]
-        _, drive = traced.traced_bounds(setup, "4x4", d.config, 3, sigma_p0=fix)
+        _, drive = tracedbounds.traced_bounds(setup, "4x4", d.config, 3, sigma_p0=fix)
         # the told sigmas' posterior CRLB: a prediction of the traced tracker, not its bound
         assert row.pcrlb_rms_m is None and row.hybrid_bound_rms_m is None
         assert row.predicted_drive_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
@@ -468,22 +468,26 @@ def test_bad_input(setup):
         traced.traced_drive(image.signal_route("4x4"), np.random.default_rng(0))
     cfg = traced.traced_javelin(setup, "4x4", {"rows": [["all", 1, 9.0, 8.0, 30.0, 1.0, 0]]}).config
     with pytest.raises(ValueError, match="sigmas"):
-        traced.sigma_error_model(setup, "4x4", {"phi": 0.1, "psi": 0.1, "kappa": 1.0})
+        tracedbounds.sigma_error_model(setup, "4x4", {"phi": 0.1, "psi": 0.1, "kappa": 1.0})
     with pytest.raises(ValueError, match="sigmas"):
-        traced.sigma_error_model(setup, "4x4", {"phi": 0.0, "psi": 0.1, "kappa": 1.0, "d": 1.0})
+        tracedbounds.sigma_error_model(
+            setup, "4x4", {"phi": 0.0, "psi": 0.1, "kappa": 1.0, "d": 1.0}
+        )
     with pytest.raises(TypeError, match="config"):
-        traced.traced_bounds(setup, "4x4", {"sigma_phi": 0.1}, 2)
+        tracedbounds.traced_bounds(setup, "4x4", {"sigma_phi": 0.1}, 2)
     with pytest.raises(ValueError, match=r"^T:"):
-        traced.traced_bounds(setup, "4x4", cfg, 0)
+        tracedbounds.traced_bounds(setup, "4x4", cfg, 0)
     with pytest.raises(ValueError, match="sigma_p0"):
-        traced.traced_bounds(setup, "4x4", cfg, 2, sigma_p0=0.0)
+        tracedbounds.traced_bounds(setup, "4x4", cfg, 2, sigma_p0=0.0)
     names = ("sigma_phi", "sigma_psi", "sigma_kappa", "sigma_delta_d")
     told = {k: getattr(cfg, k) for k in names}
     with pytest.raises(ValueError, match=r"^config:"):
-        traced.traced_bounds(setup, "4x4", SimpleNamespace(**{**told, "sigma_phi": 0.0}), 2)
+        tracedbounds.traced_bounds(setup, "4x4", SimpleNamespace(**{**told, "sigma_phi": 0.0}), 2)
     for bad in ("a", True, -1.0, np.nan):
         with pytest.raises((TypeError, ValueError), match=r"sigmas\['phi'\]"):
-            traced.sigma_error_model(setup, "4x4", {"phi": bad, "psi": 0.1, "kappa": 1.0, "d": 1.0})
+            tracedbounds.sigma_error_model(
+                setup, "4x4", {"phi": bad, "psi": 0.1, "kappa": 1.0, "d": 1.0}
+            )
     with pytest.raises(ValueError, match="error_models"):
         design.sweep_montecarlo(setup, ["4x4"], 1, 0, mode="channel", n_epochs=1,
                                 error_models=lambda st, sp: None)  # fmt: skip
@@ -524,3 +528,104 @@ def test_variant_switches_the_channel_source_and_keeps_it_otherwise():
     assert rt.variant(channel="image").channel == "image"
     with pytest.raises(ValueError, match=r"^channel"):
         base.variant(channel="raytrace")
+
+
+def test_both_kinds_of_a_design_drive_come_from_one_extraction(setup, monkeypatch):
+    """design_drive keeps the "ml-all" drive beside the "ml-traced" one: asked for the other
+    kind of a drive it made, it drives nothing and gives what traced_drive gives."""
+    ref = traced.traced_drive(traced.traced_route(setup, "4x4"), np.random.default_rng(31),
+                              n_epochs=1)  # fmt: skip
+    g = np.random.default_rng(31)
+    _same_drive(traced.design_drive(setup, "4x4", g, n_epochs=1), ref["ml-traced"])
+    end = g.bit_generator.state
+    driven = []
+    monkeypatch.setattr(traced, "traced_drive", lambda *a, **k: driven.append(1))
+    g = np.random.default_rng(31)
+    every = traced.design_drive(setup, "4x4", g, n_epochs=1, kind="ml-all")
+    assert driven == [] and g.bit_generator.state == end
+    _same_drive(every, ref["ml-all"])
+    with pytest.raises(ValueError, match=r"^kind"):
+        traced.design_drive(setup, "4x4", np.random.default_rng(31), n_epochs=1, kind="ml")
+
+
+def test_the_line_of_sight_survey_is_in_the_errors_record_and_its_table_is_its_rms(setup):
+    """The errors' record carries the survey of the line of sight on the same drives (seed 0):
+    one row per epoch with a path (measured elevation, azimuth error, elevation error), each the
+    picked path's angles against the true line of sight of that drive; los_table with one bin
+    is their RMS, by default LOS_BINS bins or fewer on a short survey."""
+    from tunnelkit.design.los import LOS_WINDOW_M, los_errors
+    from tunnelkit.runner import run_trials
+
+    rec = traced.design_errors(setup, "4x4", n_epochs=2)
+    rows = np.array(rec["los_rows"])
+    assert rec["los_window_m"] == LOS_WINDOW_M
+    assert rows.shape[1] == 3 and 2 <= rows.shape[0] <= 2 * traced.ERROR_RUNS
+    assert np.all(np.abs(rows[:, 1]) <= np.pi) and np.all(np.abs(rows[:, 0]) <= np.pi / 2)
+    # the same drives as the errors' rows: the survey's "ml-all" drives of seed 0
+    route = traced.traced_route(setup, "4x4")
+    drives = run_trials(lambda _i, rng: traced.traced_drive(route, rng, n_epochs=2)["ml-all"],
+                        traced.ERROR_RUNS, traced.ERROR_SEED,
+                        inputs=[None] * traced.ERROR_RUNS)  # fmt: skip
+    np.testing.assert_allclose(rows, los_errors(drives))
+    table = tracedlos.los_table(rec, bins=1)
+    np.testing.assert_allclose(table.sigma_azimuth, [np.sqrt(np.mean(rows[:, 1] ** 2))])
+    np.testing.assert_allclose(table.sigma_elevation, [np.sqrt(np.mean(rows[:, 2] ** 2))])
+    short = min(tracedlos.LOS_BINS, rows.shape[0] // 2)
+    assert tracedlos.los_table(rec).elevation.size == short
+    with pytest.raises(TypeError, match=r"^record"):
+        tracedlos.los_table({"no": "rows"})
+    with pytest.raises(ValueError, match=r"^record: .*delete it to re-measure"):
+        tracedlos.los_table({k: v for k, v in rec.items() if k != "los_rows"})
+    with pytest.raises(ValueError, match=r"^record: los_rows"):
+        tracedlos.los_table({**rec, "los_rows": [[0.1, 0.2]]})
+    with pytest.raises(ValueError, match=r"^record\['los_rows'\]"):
+        tracedlos.los_table({**rec, "los_rows": [[0.1, np.nan, 0.0]] * 4}, bins=1)
+    with pytest.raises(ValueError, match=r"^record: a survey of at least 2"):
+        tracedlos.los_table({**rec, "los_rows": [[0.1, 0.01, 0.0]]})
+
+
+def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
+    """The sweep with traced_tracker "los": the same drives, entry fixes and messages as the
+    "paths" tracker's (dead reckoning identical), one path an epoch told its sigmas from the
+    survey's table; its prediction is the told model's posterior CRLB (los_bounds), which with a
+    table of one bin is drive_pcrlb of constant angle sigmas; the report names the tracker."""
+    from tunnelkit.design import drive_pcrlb
+    from tunnelkit.design.los import ElevationSigmas, los_angle_information
+    from tunnelkit.tracking.javelin import ReportedNoise
+
+    kw = {"seed": 0, "mode": "channel", "n_epochs": 3, "dead_reckoning": True, **FEW}
+    paths = design.design_sweep(setup, ["4x4"], **kw).rows[0]
+    rep = design.design_sweep(setup, ["4x4"], traced_tracker="los", **kw)
+    los = rep.rows[0]
+    assert los.dead_reckoning_rmse_m == pytest.approx(paths.dead_reckoning_rmse_m, rel=1e-12)
+    em = los.error_model
+    assert em["tracker"] == "los" and paths.error_model["tracker"] == "paths"
+    assert em["los"]["bins"] == min(tracedlos.LOS_BINS, em["los"]["epochs"] // 2)
+    assert rep.to_json()["inputs"]["traced_tracker"] == "los"
+    assert "the line of sight alone (--traced-tracker los)" in rep.to_table()
+    rec = traced.design_errors(setup, "4x4", n_epochs=3)
+    table = tracedlos.los_table(rec)
+    k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
+    _, drive = tracedbounds.los_bounds(setup, "4x4", table, 3)
+    assert los.predicted_drive_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
+    d = tracedlos.los_javelin(setup, "4x4", rec)
+    assert isinstance(d.noise, ReportedNoise)
+    # the told drive: one path an epoch, its covariance the table's at its measured elevation
+    every = traced.design_drive(setup, "4x4", np.random.default_rng(5), n_epochs=3, kind="ml-all")
+    told = tracedlos.told_los(every, table, d.config)
+    for ep in told.epochs:
+        if ep is not None:
+            saz, sel = table.at(ep.psi)
+            assert len(ep) == 1 and told.reports_covariance
+            np.testing.assert_allclose(np.diag(ep.cov[0])[:2], [saz[0] ** 2, sel[0] ** 2])
+            assert ep.cov[0, 2, 2] == pytest.approx(d.config.sigma_kappa**2)
+    # one bin: the constant sigmas' posterior CRLB
+    one = ElevationSigmas(np.array([-0.1]), np.array([0.02]), np.array([0.03]))
+    ue = setup.trajectory.position[:3]
+    bs = setup.signal_route("4x4").arrays[0].origin
+    ref = drive_pcrlb(setup, los_angle_information(ue, bs, 0.02, 0.03))
+    np.testing.assert_allclose(tracedbounds.los_bounds(setup, "4x4", one, 3)[0], ref)
+    with pytest.raises(TypeError, match=r"^table"):
+        tracedbounds.los_bounds(setup, "4x4", {"elevation": [0.0]}, 3)
+    with pytest.raises(TypeError, match=r"^los"):
+        traced.error_model_summary(rec, d.config, {"bins": 4})

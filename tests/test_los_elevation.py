@@ -1,16 +1,17 @@
-"""The line of sight's sigmas by measured elevation (tunnelkit.studies.los_elevation)."""
+"""The line of sight's sigmas by measured elevation (tunnelkit.design.los)."""
 
 import numpy as np
 import pytest
 
 import tunnelkit as tk
-from tunnelkit.studies.los_elevation import (
+from tunnelkit.design.los import (
     ElevationSigmas,
     elevation_sigmas,
     los_errors,
+    los_only,
     told_by_elevation,
 )
-from tunnelkit.studies.los_only import los_design, los_only
+from tunnelkit.studies.los_only import los_design
 
 
 def test_table_is_the_rms_in_equal_count_bins_of_the_measured_elevation():

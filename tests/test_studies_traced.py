@@ -308,7 +308,7 @@ def test_the_line_of_sight_study_picks_without_truth_and_its_information_is_the_
     information equals J^T J / sigma^2 with J by central differences."""
     from dataclasses import replace as dc_replace
 
-    from tunnelkit.studies.los_only import los_angle_information, los_only, los_path
+    from tunnelkit.design.los import los_angle_information, los_only, los_path
 
     d = np.array([10.40, 10.12, 10.05, 14.0])
     psi = np.array([-0.30, 0.20, 0.10, -0.50])
@@ -365,8 +365,9 @@ def test_the_flagged_line_of_sight_is_the_picked_path_unless_the_fit_flags_it():
     where the fit puts that path in its threshold region (its own verdict, no truth)."""
     from dataclasses import replace as dc_replace
 
+    from tunnelkit.design.los import los_path
     from tunnelkit.simulation.drives import scenario_route
-    from tunnelkit.studies.los_only import flagged_los, los_path
+    from tunnelkit.studies.los_only import flagged_los
 
     route = scenario_route("italiano2026-straight")
     ep = route.epoch(10, np.random.default_rng(0), refine="ml")

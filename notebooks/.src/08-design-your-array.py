@@ -47,7 +47,7 @@ import numpy as np
 
 import tunnelkit as tk
 from tunnelkit import design, propagation
-from tunnelkit.design import traced
+from tunnelkit.design import traced, tracedbounds
 from tunnelkit.design.trackerfix import position_noise_cov, tracker_weights
 from tunnelkit.plots.design import route_figure, size_figure
 from tunnelkit.rt.cache import CACHE_ENV
@@ -726,7 +726,7 @@ for a in rt_sizes:
 
 # %% [markdown]
 # Beside the tracker stands the posterior CRLB of those sigmas, the *told-sigma PCRLB*
-# (`design.traced.traced_bounds`): the posterior CRLB over the drive (Tichavský et al. 1998): every first-order path measured at every
+# (`design.tracedbounds.traced_bounds`): the posterior CRLB over the drive (Tichavský et al. 1998): every first-order path measured at every
 # epoch with independent Gaussian errors of $\sigma_q$, and JAVELIN's motion model. That model
 # is the car's **odometry**: each epoch the car broadcasts its speed and heading over V2X, with
 # noise `tk.simulation.SIGMA_SPEED` and `SIGMA_HEADING`, and the tracker integrates them. The
@@ -747,7 +747,7 @@ def settled_rms(bound):
     return float(np.sqrt(np.mean(bound[k_rt] ** 2)))
 
 
-bound_rt = {a: settled_rms(traced.traced_bounds(paper_rt, a, told[a])[0]) for a in rt_sizes}
+bound_rt = {a: settled_rms(tracedbounds.traced_bounds(paper_rt, a, told[a])[0]) for a in rt_sizes}
 no_radio = settled_rms(design.drive_pcrlb(paper_rt, np.zeros((T_rt, 2, 2))))
 bound_ratio = max(bound_rt.values()) / min(bound_rt.values())
 print(
@@ -849,7 +849,7 @@ print("error p90, ray-traced over image channel:", {a: f"{g:.3g}" for a, g in ga
 fixes = [1.0, 0.3, 0.1, 0.03]
 by_fix = {}
 for sp in fixes:
-    radio = settled_rms(traced.traced_bounds(paper_rt, "8x8", told["8x8"], sigma_p0=sp)[0])
+    radio = settled_rms(tracedbounds.traced_bounds(paper_rt, "8x8", told["8x8"], sigma_p0=sp)[0])
     alone = settled_rms(design.drive_pcrlb(paper_rt, np.zeros((T_rt, 2, 2)), sigma_p0=sp))
     by_fix[sp] = (radio, alone)
     print(f"entry fix {sp:5.2f} m: PCRLB {radio:.3g} m with the radio, {alone:.3g} m without "

@@ -3,7 +3,7 @@
 [--wideband-model/--no-wideband-model] [--dmc-share S]
 [--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
 [--settle S] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna]
+[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna [--traced-tracker paths|los]]
 [--start-sigma S] [--no-dead-reckoning] [--format table|json] [--plot FILE.html]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
@@ -341,6 +341,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "measurements pass a geometry pre-filter and the tracker is told the array's errors "
         "measured on that channel, not the reported CRLB; no impairments)",
     )
+    rt.add_argument(
+        "--traced-tracker",
+        choices=["paths", "los"],
+        default="paths",
+        help="with --channel sionna: the tracker on the ray-traced channel, every path the "
+        "geometry pre-filter keeps told the array's RMS errors (paths, default) or the line of "
+        "sight alone, told its angle sigmas by its measured elevation from a survey of 3 drives "
+        "per array (los)",
+    )
     mc.add_argument(
         "--n-epochs",
         type=count_arg("n_epochs", 1),
@@ -407,6 +416,13 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.traced_tracker != "paths" and args.channel != "sionna":
+        print(
+            f"tunnelkit design: error: --traced-tracker {args.traced_tracker} tracks on the "
+            f"ray-traced channel: it needs --channel sionna (got --channel {args.channel})",
+            file=sys.stderr,
+        )
+        return 2
     setup = design.DesignSetup.from_scenario(
         args.scenario,
         fc=args.fc,
@@ -435,6 +451,7 @@ def main(args: argparse.Namespace) -> int:
             n_epochs=args.n_epochs,
             **({} if args.start_sigma is None else {"start_sigma": args.start_sigma}),
             **({"dead_reckoning": True} if args.dead_reckoning and args.units else {}),
+            **({} if args.traced_tracker == "paths" else {"traced_tracker": args.traced_tracker}),
             **parallel_kwargs(args),
             progress=args.units > 0 and args.format == "table" and not args.no_progress,
         )

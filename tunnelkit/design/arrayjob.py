@@ -102,11 +102,18 @@ class SweepTrial:
             )
         elif self.setup.channel == "sionna":
             from .traced import design_drive
+            from .tracedlos import told_los
 
             # the traced treatment (tunnelkit.design.traced): every epoch's ML measurements,
             # the geometry pre-filter; the tracker told this array's measured errors (a drive
-            # of the same setup and seed, driven before in this process, is reused)
-            drive = design_drive(self.setup, spec, rng, n_epochs=self.n_epochs)
+            # of the same setup and seed, driven before in this process, is reused). The
+            # line-of-sight tracker: of every epoch's measurements the line of sight, told its
+            # sigmas by its elevation from this array's survey
+            los = prep.los_table is not None
+            kind = "ml-all" if los else "ml-traced"
+            drive = design_drive(self.setup, spec, rng, n_epochs=self.n_epochs, kind=kind)
+            if los:
+                drive = told_los(drive, prep.los_table, prep.design.config)
         else:
             route = self.setup.signal_route(spec)
             imp = self.impairments
@@ -171,6 +178,7 @@ class Prepared:
     budget: object = None  # signal_route.judging.BiasBudget: the channel route's, impaired
     error_model: dict | None = None  # traced.error_model_summary: the traced route's
     hybrid: np.ndarray | None = None  # the bound pooled over units (drivebound.unit_pcrlb)
+    los_table: object = None  # los.ElevationSigmas: the traced route's line-of-sight tracker
 
     def summary(self) -> tuple:
         """What the sweep's result keeps (not the model and route the drives need)."""
@@ -198,6 +206,7 @@ class ArrayJob:
     crlbs: dict | None
     impairments: object = None
     start_sigma: float = START_SIGMA_M
+    traced_tracker: str = "paths"  # tracedtracker.TRACED_TRACKERS: the ray-traced channel's tracker
 
     def __call__(self, spec: ArraySpec) -> Prepared:
         ep = np.arange(self.T)
@@ -247,22 +256,27 @@ class ArrayJob:
         )
         imp = self.impairments if self.mode == "channel" else None  # its budget: channel, impaired
         budget = channel_route_budget(self.setup, spec, imp)
-        error_model = None
+        error_model = table = None
         if self.mode == "channel" and self.setup.channel == "sionna":
-            from .traced import design_errors, error_model_summary, traced_bounds, traced_javelin
+            from . import traced, tracedbounds, tracedlos
 
             # this array's errors on the traced channel (cached with their provenance)
-            rec = design_errors(self.setup, spec, n_epochs=self.T)
-            design = traced_javelin(self.setup, spec, rec)
-            error_model = error_model_summary(rec, design.config)
+            rec = traced.design_errors(self.setup, spec, n_epochs=self.T)
+            design = traced.traced_javelin(self.setup, spec, rec)
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
             # (a model's posterior CRLB, not a bound of the tracker on the traced channel,
             # whose errors are neither Gaussian nor independent: a prediction)
-            pc = None
-            drive = traced_bounds(
-                self.setup, spec, design.config, self.T, sigma_p0=self.start_sigma
-            )[1]
-        return Prepared(spec, route, design, peb, pc, drive, budget, error_model, hybrid)
+            pc, sp0, los = None, self.start_sigma, None
+            if self.traced_tracker == "los":  # the line of sight, surveyed on the same drives
+                table = tracedlos.los_table(rec)
+                design = tracedlos.los_javelin(self.setup, spec, rec)
+                drive = tracedbounds.los_bounds(self.setup, spec, table, self.T, sigma_p0=sp0)[1]
+                los = tracedlos.los_summary(rec, table)
+            else:
+                drive = tracedbounds.traced_bounds(self.setup, spec, design.config, self.T,
+                                                   sigma_p0=sp0)[1]  # fmt: skip
+            error_model = traced.error_model_summary(rec, design.config, los)
+        return Prepared(spec, route, design, peb, pc, drive, budget, error_model, hybrid, table)
 
 
 def load_tracker() -> None:
@@ -294,6 +308,7 @@ def load_tracker() -> None:
         tracker,
         update,
     )
+    from . import los, tracedlos  # noqa: F401  (the traced route's line-of-sight tracker)
 
 
 def prepared_summary(prep: Prepared) -> tuple:

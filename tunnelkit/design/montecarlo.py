@@ -109,7 +109,7 @@ class MonteCarloResult:
     ``predicted`` (T,) [m] the posterior CRLB of the tracker's weighting with the position bias
     of the calibration draw and the wideband term added (:func:`drive_bound`), the surfaces
     known; on the ray-traced channel's route that of the sigmas the tracker is told
-    (:func:`tunnelkit.design.traced.traced_bounds`) and ``pcrlb`` is ``None``. ``error_model`` the traced
+    (:func:`tunnelkit.design.tracedbounds.traced_bounds`) and ``pcrlb`` is ``None``. ``error_model`` the traced
     route's measurement-noise model (:func:`tunnelkit.design.traced.error_model_summary`;
     ``None`` on the image channel, where each path carries its reported CRLB);
     ``dead_reckoning`` (runs, T) [m] the same drives' errors with every measurement dropped
@@ -192,7 +192,7 @@ def _prepare(pool: TrialPool, job: ArrayJob, specs: list) -> list:
         return pool.prepare(job, specs, desc="design arrays")
     head = (id(job.setup), id(job.error_models), job.mode, job.T, job.with_model,
             json.dumps(job.crlbs, sort_keys=True, default=repr), repr(job.impairments),
-            job.start_sigma)  # fmt: skip
+            job.start_sigma, job.traced_tracker)  # fmt: skip
     out, todo = {}, []
     for spec in specs:
         kept = _PREPARED.get((head, spec.label))
@@ -231,6 +231,7 @@ def sweep_montecarlo(
     dead_reckoning: bool = False,
     drives_per_unit: int = 1,
     first_unit: int = 0,
+    traced_tracker: str = "paths",
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -249,7 +250,7 @@ def sweep_montecarlo(
     extraction without impairments). The bound mode draws from it, and
     both modes take the posterior CRLB from its reported bound (on the image channel's channel
     route only when models are given; the ray-traced channel's route takes the bounds of the
-    sigmas its tracker is told, :func:`tunnelkit.design.traced.traced_bounds`, and refuses
+    sigmas its tracker is told, :func:`tunnelkit.design.tracedbounds.traced_bounds`, and refuses
     models). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
     route-median per-path bounds, from the model when there is one). ``workers`` /
     ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.runner.run_trials` (one cluster for the
@@ -266,7 +267,9 @@ def sweep_montecarlo(
     :data:`START_SIGMA_M`; the entry fix's quality, also the prior of the bounds over the
     drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
     tracker, start and V2X messages: what the radio adds), its errors the result's
-    ``dead_reckoning``.
+    ``dead_reckoning``. ``traced_tracker`` (:data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`,
+    the ray-traced channel's channel route only): ``"paths"`` (default) every path the geometry
+    test keeps, ``"los"`` the line of sight told its sigmas by its elevation.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -300,6 +303,10 @@ def sweep_montecarlo(
                 "impairments: expected a design.DesignImpairments or None, got "
                 f"{type(impairments).__name__}"
             )
+    if traced_tracker != "paths":  # the names load when another is asked for
+        from .tracedtracker import checked_tracker
+
+        traced_tracker = checked_tracker(traced_tracker, mode, setup.channel)
     if mode == "channel" and setup.channel == "sionna":
         if impairments is not None and not impairments.ideal:
             raise ValueError(
@@ -327,7 +334,9 @@ def sweep_montecarlo(
         f"{A} arrays x {runs} drives x {T} epochs of errors and their generators",
     )
     with_model = mode == "bound" or error_models is not None
-    job = ArrayJob(setup, error_models, mode, T, with_model, crlbs, impairments, start_sigma)
+    job = ArrayJob(
+        setup, error_models, mode, T, with_model, crlbs, impairments, start_sigma, traced_tracker
+    )
     kw = {"workers": workers, "scheduler": scheduler, "timeout": timeout}
     kw = {k: v for k, v in kw.items() if v is not None}
     if pool is not None:

@@ -156,7 +156,17 @@ def report_table(report) -> str:
                 if spans:
                     lines.append(f"  {r.array}: {what} above the target at x = {spans}")
         em = r.error_model
-        if em and em.get("kind") == "traced-measured":
+        los = em.get("los") if em else None
+        if los:
+            tab = los["table_deg"]
+            saz, sel = tab["sigma_azimuth"], tab["sigma_elevation"]
+            lines.append(
+                f"  {r.array}: traced route, the line of sight alone (--traced-tracker los), told "
+                f"its angle sigmas by its measured elevation from a survey of {los['runs']} drives "
+                f"of seed {los['seed']} ({los['epochs']} epochs, {los['bins']} bins): azimuth "
+                f"{min(saz):.2g}-{max(saz):.3g} deg, elevation {min(sel):.2g}-{max(sel):.3g} deg"
+            )
+        elif em and em.get("kind") == "traced-measured":
             sg = em["sigmas"]
             lines.append(
                 f"  {r.array}: traced route, noise measured on seed {em['seed']} "
@@ -170,14 +180,14 @@ def report_table(report) -> str:
                     f"{tg['phi_deg']:.3g} / {tg['psi_deg']:.3g} deg, {tg['kappa_m']:.3g} m, "
                     f"{tg['delta_d_m']:.3g} m"
                 )
-            if r.predicted_drive_rms_m is not None:
-                ratio = r.rmse_over_predicted_drive
-                lines.append(
-                    f"  {r.array}: posterior CRLB of the sigmas the tracker is told (settled "
-                    f"RMS; a prediction, the traced errors are not Gaussian) "
-                    f"{r.predicted_drive_rms_m:.3g} m"
-                    + ("" if ratio is None else f", tracker RMSE / it {ratio:.3g}")
-                )
+        if em and em.get("kind") == "traced-measured" and r.predicted_drive_rms_m is not None:
+            ratio = r.rmse_over_predicted_drive
+            lines.append(
+                f"  {r.array}: posterior CRLB of the sigmas the tracker is told (settled "
+                f"RMS; a prediction, the traced errors are not Gaussian) "
+                f"{r.predicted_drive_rms_m:.3g} m"
+                + ("" if ratio is None else f", tracker RMSE / it {ratio:.3g}")
+            )
         if r.dead_reckoning_p90_m is not None:
             gain = None
             if r.rmse_m is not None and r.dead_reckoning_rmse_m:
@@ -185,7 +195,12 @@ def report_table(report) -> str:
             lines.append(
                 f"  {r.array}: dead reckoning on the same drives (every measurement dropped): "
                 f"{q} {r.dead_reckoning_p90_m:.3g} m, RMSE {r.dead_reckoning_rmse_m:.3g} m"
-                + ("" if gain is None else f"; the radio's gain in RMSE {100 * gain:.2g} %")
+                + (
+                    ""
+                    if gain is None or not r.rmse_m
+                    else f"; the radio's gain in RMSE {100 * gain:.2g} % (dead reckoning's RMSE "
+                    f"over the tracker's {r.dead_reckoning_rmse_m / r.rmse_m:.3g}x)"
+                )
             )
     lines.extend(f"warning: {w}" for w in report.warnings)
     return "\n".join(lines)

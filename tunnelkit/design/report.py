@@ -17,15 +17,7 @@ import numpy as np
 
 from .._parallel import parallel_options
 from .._physical import start_spread
-from .._validate import (
-    boolean,
-    choice,
-    integer,
-    nonnegative,
-    positive,
-    probability,
-    sequence,
-)
+from .._validate import boolean, choice, integer, nonnegative, positive, probability, sequence
 from ..budget import check_bytes, check_elements
 from ..settling import SETTLE_S
 from .achievable import DesignImpairments, predicted_error
@@ -135,6 +127,7 @@ def design_sweep(
     n_boot: int = 2000,
     start_sigma: float = START_SIGMA_M,
     dead_reckoning: bool = False,
+    traced_tracker: str = "paths",
 ) -> DesignReport:
     """Every candidate of ``arrays`` evaluated and judged (docs/internals).
 
@@ -153,7 +146,8 @@ def design_sweep(
     resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
     (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
     drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
-    radio adds). An array that does not fit, or whose bound or Monte-Carlo is undefined, is a
+    radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"paths"``, default, or
+    ``"los"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not fit, or whose bound or Monte-Carlo is undefined, is a
     row with status ``"error"`` and the reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -185,6 +179,10 @@ def design_sweep(
     n_boot = integer("n_boot", n_boot, minimum=100)
     start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
+    if traced_tracker != "paths":  # the names load when another is asked for
+        from .tracedtracker import checked_tracker
+
+        traced_tracker = checked_tracker(traced_tracker, mode, setup.channel)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1, maximum=len(setup.trajectory))
     workers, scheduler = parallel_options(workers, scheduler)
@@ -227,7 +225,7 @@ def design_sweep(
         from .unitsweep import run_units, sweep_options  # the Monte-Carlo by units, when asked for
 
         kw = sweep_options(imp, mode, workers, scheduler, timeout, progress, n_epochs, start_sigma,
-                           dead_reckoning, drives_per_unit)  # fmt: skip
+                           dead_reckoning, drives_per_unit, traced_tracker)  # fmt: skip
         judged = {"settle": settle, "required": required_yield, "cap": max_units}
         run_units(setup, rows, todo, units, max_units, seed, kw, warnings,
                   (criterion, target, share, seed, n_boot), judged)  # fmt: skip
@@ -300,6 +298,8 @@ def design_sweep(
         settings["start_sigma_m"] = start_sigma
     if dead_reckoning:
         settings["dead_reckoning"] = True
+    if traced_tracker != "paths":  # (the default's JSON as before)
+        settings["traced_tracker"] = traced_tracker
     usable = [r for r in rows if r.status != "error"]
     rec = recommend(usable, target, share, units, required_yield)
     return DesignReport(setup.name, rows, rec, settings, warnings)

@@ -27,7 +27,7 @@ only. The traced route changes the same two things the traced JAVELIN tables cha
 
 The report's JSON names the error model each array's traced route used
 (:func:`error_model_summary`). Its bounds over the drive are those of the sigmas the tracker is
-told (:func:`traced_bounds`: every first-order path measured at every epoch with independent
+told (:func:`tunnelkit.design.tracedbounds.traced_bounds`: every first-order path measured at every epoch with independent
 Gaussian errors of those sigmas), not the image channel's micrometre CRLBs: what such
 measurements allow a tracker, beside what it achieves.
 
@@ -49,16 +49,20 @@ from pathlib import Path
 
 import numpy as np
 
-from .._physical import start_spread
-from .._validate import boolean, finite_array, instance, integer, positive, rng_or_error
+from .._validate import (
+    boolean,
+    choice,
+    instance,
+    integer,
+    rng_or_error,
+)
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
-from .bounds import route_geometry
-from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
-from .trackerfix import START_SIGMA_M
+from .tracedbounds import config_sigmas
 
 __all__ = [
+    "DRIVE_KINDS",
     "ERROR_RUNS",
     "ERROR_SEED",
     "TRACED_NUISANCE",
@@ -69,10 +73,8 @@ __all__ = [
     "drive_record",
     "error_model_summary",
     "measure_design_errors",
-    "sigma_error_model",
     "stored_drive",
     "stored_drive_path",
-    "traced_bounds",
     "traced_drive",
     "traced_javelin",
     "traced_route",
@@ -83,6 +85,9 @@ __all__ = [
 ERROR_SEED = 0
 #: drives per array the traced errors are measured on (every epoch, every matched path pooled)
 ERROR_RUNS = 3
+#: what :func:`design_drive` keeps of a traced drive: the ML measurements the geometry test
+#: keeps (the ``"paths"`` tracker's) and every epoch's (the line-of-sight tracker picks from them)
+DRIVE_KINDS = ("ml-traced", "ml-all")
 #: the traced route's nuisance: the ML fit judged against noise + the epoch's diffuse power
 TRACED_NUISANCE = {"diffuse_floor": True}
 #: the record's procedure (part of what a stored record must match)
@@ -141,10 +146,16 @@ def traced_drive(route, rng: np.random.Generator, *, n_epochs: int | None = None
 
 
 def design_drive(
-    setup: DesignSetup, spec, rng: np.random.Generator, *, n_epochs: int | None = None
+    setup: DesignSetup,
+    spec,
+    rng: np.random.Generator,
+    *,
+    n_epochs: int | None = None,
+    kind: str = "ml-traced",
 ):
-    """The design sweep's drive of ``spec`` on the ray-traced channel: the ``"ml-traced"`` drive
-    of :func:`traced_drive` on :func:`traced_route`, kept for the process. Its key is ``setup``
+    """The design sweep's drive of ``spec`` on the ray-traced channel: the ``kind`` drive
+    (:data:`DRIVE_KINDS`: ``"ml-traced"``, default, or ``"ml-all"``) of :func:`traced_drive` on
+    :func:`traced_route`, kept for the process (both kinds, from one extraction). Its key is ``setup``
     itself (the object: a frozen setup builds the same route every time), the array,
     ``n_epochs`` and the state of ``rng`` at the start; a drive asked for again (the same setup
     and seed in another sweep: another entry fix, dead reckoning) is a copy of the kept one, and
@@ -153,26 +164,32 @@ def design_drive(
     without the extraction's cost. At most :data:`DRIVES_KEPT` drives are kept, the oldest
     dropped first; an equal setup built anew, or one sent to another process, drives again. A
     drive not kept is read from its stored record when the repository ships one of this key
-    (:func:`stored_drive`: the same numbers, checked on load) and driven otherwise."""
+    (:func:`stored_drive`: the same numbers, checked on load; ``"ml-traced"`` only) and driven
+    otherwise."""
     setup = _setup(setup)
     spec = parse_array(spec)
     rng = rng_or_error("rng", rng)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    kind = choice("kind", kind, DRIVE_KINDS)
     start = json.dumps(rng.bit_generator.state, sort_keys=True, default=str)
     key = (id(setup), spec.label, n_epochs, start)
     kept = _DRIVES.get(key)
-    if kept is not None and kept[0] is setup:  # the entry holds the setup: its id is not reused
+    # the entry holds the setup: its id is not reused
+    if kept is not None and kept[0] is setup and kind in kept[1]:
         _DRIVES.move_to_end(key)
         rng.bit_generator.state = copy.deepcopy(kept[2])
-        return copy.deepcopy(kept[1])
-    drive = stored_drive(setup, spec, rng, n_epochs)
+        return copy.deepcopy(kept[1][kind])
+    drive = stored_drive(setup, spec, rng, n_epochs) if kind == "ml-traced" else None
     if drive is None:
-        drive = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)["ml-traced"]
-    _DRIVES[key] = (setup, copy.deepcopy(drive), copy.deepcopy(rng.bit_generator.state))
+        both = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)
+        drives = {k: both[k] for k in DRIVE_KINDS}
+    else:
+        drives = {"ml-traced": drive}
+    _DRIVES[key] = (setup, copy.deepcopy(drives), copy.deepcopy(rng.bit_generator.state))
     while len(_DRIVES) > DRIVES_KEPT:
         _DRIVES.popitem(last=False)
-    return drive
+    return drives[kind]
 
 
 def stored_drive_path(setup: DesignSetup, spec, n_epochs: int | None = None) -> Path:
@@ -310,9 +327,12 @@ def measure_design_errors(
     channel (drive ``i`` from the ``i``-th child of ``seed``, as run ``i`` of a sweep on
     ``seed``: :func:`~tunnelkit.runner.run_trials`), every epoch's ML measurements
     (``"ml-all"`` of :func:`traced_drive`), their RMS errors per kind of path
-    (:func:`~tunnelkit.simulation.analysis.extraction_errors`, the ``"all"`` row the sigmas).
-    Returns the record (provenance, ``seed``, ``runs``, ``columns``, ``rows``, the wall time)
-    :func:`design_errors` stores."""
+    (:func:`~tunnelkit.simulation.analysis.extraction_errors`, the ``"all"`` row the sigmas),
+    and of the same epochs the path taken for the line of sight against the true one
+    (:func:`~tunnelkit.design.los.los_errors`: ``los_rows``, one per epoch with a path, measured
+    elevation, azimuth error, elevation error [rad]; the line-of-sight tracker's survey,
+    :mod:`tunnelkit.design.tracedlos`). Returns the record (provenance, ``seed``, ``runs``,
+    ``columns``, ``rows``, ``los_rows``, the wall time) :func:`design_errors` stores."""
     import time
 
     from ..runner import run_trials
@@ -334,6 +354,9 @@ def measure_design_errors(
     )  # fmt: skip
     cols, rows = extraction_errors(drives)
     corr = error_correlations(drives)
+    from .los import LOS_WINDOW_M, los_errors
+
+    los = los_errors(drives)
     return {
         **_provenance(setup, spec, n_epochs),
         "seed": seed,
@@ -342,6 +365,8 @@ def measure_design_errors(
         "columns": list(cols),
         "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
         "correlation": corr,
+        "los_window_m": LOS_WINDOW_M,
+        "los_rows": los.tolist(),
     }
 
 
@@ -475,31 +500,25 @@ def traced_javelin(setup: DesignSetup, spec, record: dict):
     return design_from_errors(record["rows"], base=base, correlation=record.get("correlation"))
 
 
-def _config_sigmas(config) -> dict:
-    """``config``'s four sigmas (a JavelinConfig's ``sigma_phi``, ``sigma_psi`` [rad],
-    ``sigma_kappa``, ``sigma_delta_d`` [m]) as ``{"phi", "psi", "kappa", "d"}``."""
-    names = (("phi", "sigma_phi"), ("psi", "sigma_psi"), ("kappa", "sigma_kappa"),
-             ("d", "sigma_delta_d"))  # fmt: skip
-    try:
-        return {k: float(getattr(config, a)) for k, a in names}
-    except (AttributeError, TypeError, ValueError):
-        raise TypeError(f"config: expected a JavelinConfig, got {type(config).__name__}") from None
-
-
-def error_model_summary(record: dict | None, config=None) -> dict:
+def error_model_summary(record: dict | None, config=None, los: dict | None = None) -> dict:
     """What the report's JSON says about an array's measurement-noise model: ``{"kind":
     "reported-crlb"}`` (``record`` None: each path's reported CRLB, the image channel's), or the
     traced record's ``kind`` "traced-measured", sigmas (the RMS errors), the errors' lag-1
     correlation (the tracker's sigmas are the RMS times ``sqrt((1 + r) / (1 - r))``; None for a
     record without it), seed, runs, file and scene key; with ``config`` (the tracker's
-    JavelinConfig, :func:`traced_javelin`) also ``told_sigmas``, the sigmas it is told."""
+    JavelinConfig, :func:`traced_javelin`) also ``told_sigmas``, the sigmas it is told; with
+    ``los`` (the line-of-sight tracker's table and survey,
+    :func:`tunnelkit.design.tracedlos.los_summary`) ``tracker`` "los" and ``los`` (else
+    ``tracker`` "paths")."""
     if record is None:
         return {"kind": "reported-crlb"}
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of design_errors or None")
+    if los is not None and (not isinstance(los, dict) or "table_deg" not in los):
+        raise TypeError(f"los: expected the dict of tracedlos.los_summary or None, got {los!r}")
     told = {}
     if config is not None:
-        c = _config_sigmas(config)
+        c = config_sigmas(config)
         told = {"told_sigmas": {"phi_deg": float(np.degrees(c["phi"])),
                                 "psi_deg": float(np.degrees(c["psi"])),
                                 "kappa_m": c["kappa"], "delta_d_m": c["d"]}}  # fmt: skip
@@ -514,64 +533,6 @@ def error_model_summary(record: dict | None, config=None) -> dict:
         "path": record.get("path"),
         "rt_key": record.get("rt_key"),
         **told,
+        "tracker": "paths" if los is None else "los",
+        **({} if los is None else {"los": los}),
     }
-
-
-def sigma_error_model(setup: DesignSetup, spec, sigmas: dict, *, epochs=None):
-    """A :class:`~tunnelkit.design.errormodel.PathErrorModel` of ``spec``'s route (``epochs``:
-    indices that subsample it, as :func:`~tunnelkit.design.bounds.route_geometry`) in which every
-    first-order path the image method traces is measured at every epoch with independent
-    zero-mean Gaussian errors of ``sigmas`` (``{"phi", "psi"}`` [rad], ``{"kappa", "d"}`` [m],
-    each > 0): no bias, no calibration term, the truth and radial speed zero (the bounds over the
-    drive use only the geometry's Jacobians and the covariance). Any channel: the geometry is
-    the image method's. Returns ``(model, geometry)``."""
-    instance("setup", setup, DesignSetup)
-    spec = parse_array(spec)
-    if not isinstance(sigmas, dict) or set(sigmas) != {"phi", "psi", "kappa", "d"}:
-        raise ValueError(
-            f"sigmas: expected {{'phi', 'psi', 'kappa', 'd'}} to a sigma, got {sigmas!r}"
-        )
-    names = ("phi", "psi", "kappa", "d")
-    sig = np.array([positive(f"sigmas['{k}']", sigmas[k]) for k in names], dtype=float)
-    g = route_geometry(setup, spec, epochs=epochs)
-    t = setup.trajectory.t
-    if epochs is not None:  # route_geometry checked them: whole numbers inside the route
-        t = t[finite_array("epochs", epochs, ndim=1).astype(int)]
-    T, P = g.exists.shape
-    ex4 = np.repeat(g.exists, 4, axis=1)
-    cov = np.where(ex4[:, :, None] & ex4[:, None, :], np.kron(np.eye(P), np.diag(sig**2)), np.nan)
-    zero = np.where(g.exists[..., None], 0.0, np.nan) * np.ones((T, P, 4))
-    model = PathErrorModel(
-        t=np.asarray(t, float), exists=g.exists, kinds=g.kinds, truth=zero,
-        v=np.where(g.exists, 0.0, np.nan), crlb=cov, cov=cov, bias=zero,
-    )  # fmt: skip
-    return model, g
-
-
-def traced_bounds(
-    setup: DesignSetup, spec, config, T: int | None = None, *, sigma_p0: float | None = None
-) -> tuple:
-    """The bounds over the first ``T`` epochs of ``spec``'s drive (default all; a ``T`` beyond
-    the route is the whole route, as the sweep's ``n_epochs``) of a tracker
-    told the sigmas of ``config`` (a :class:`~tunnelkit.tracking.javelin.JavelinConfig`:
-    ``sigma_phi``, ``sigma_psi``, ``sigma_kappa``, ``sigma_delta_d``; the traced design's,
-    :func:`traced_javelin`), every first-order path measured with independent Gaussian errors of
-    those sigmas (:func:`sigma_error_model`): ``(pcrlb, drive)`` (T,) [m] as the design's
-    Monte-Carlo reports them (:func:`~tunnelkit.design.drivebound.drive_pcrlb` from a start of
-    ``sigma_p0`` [m] per axis, default :data:`~tunnelkit.design.trackerfix.START_SIGMA_M`;
-    ``drive`` the same with no bias). What the told sigmas allow: the traced
-    errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
-    from .drivebound import drive_bound, drive_pcrlb, position_information
-
-    instance("setup", setup, DesignSetup)
-    spec = parse_array(spec)
-    n = len(setup.trajectory)
-    T = n if T is None else min(integer("T", T, minimum=1), n)
-    sig = _config_sigmas(config)
-    sigma_p0 = START_SIGMA_M if sigma_p0 is None else start_spread("sigma_p0", sigma_p0)
-    try:
-        model, g = sigma_error_model(setup, spec, sig, epochs=np.arange(T))
-    except ValueError as exc:  # a sigma of the config that is not > 0
-        raise ValueError(f"config: {exc}") from None
-    pc = drive_pcrlb(setup, position_information(model, g), sigma_p0=sigma_p0)
-    return pc, drive_bound(pc, np.zeros_like(pc))

@@ -15,7 +15,7 @@ import numpy as np
 from .._validate import finite_array, instance
 from ..design import DesignSetup, drive_pcrlb, position_information
 from ..design.setup import parse_array
-from ..design.traced import sigma_error_model
+from ..design.tracedbounds import sigma_error_model
 from ..odometry import Odometry
 from ..simulation.prefilter import SIGMA_SCENARIO
 from .traced import traced_errors

@@ -1,20 +1,25 @@
-"""The line of sight's angle errors by its elevation: a table from traced drives, and a drive told it.
+"""The line of sight told its sigmas by its elevation: the traced route's line-of-sight tracker.
 
-On the ray-traced channel the path taken for the line of sight (:func:`~.los_only.los_path`) is
-accurate where it arrives steeply and off by degrees where it arrives at a shallow angle: near the
-site the line of sight and the ceiling's reflection are apart by more than the array resolves, far
-from it they merge and the fit's one atom lies between them (straight drive, 10 x 10, seed 0: RMS
-0.2 deg below 15 m, 2-3 deg beyond 25 m; ``docs/results/traced-robust.md``). One told sigma for
-every epoch under-trusts the near epochs and over-trusts the far ones.
+On the ray-traced channel the reflections' estimates are biased by degrees per kind of path and
+the bias repeats from epoch to epoch, while the line of sight's angles are nearly unbiased
+(``docs/results/traced-robust.md``). The design's line-of-sight tracker on that channel
+(``tunnelkit design --channel sionna --traced-tracker los``) keeps, of every epoch's ML
+measurements, the one path taken for the line of sight and tells JAVELIN its angle sigmas from a
+table measured by the line of sight's elevation:
 
-:func:`los_errors` measures the picked path's azimuth and elevation errors against the true line of
-sight on traced drives (a record, with their truth); :func:`elevation_sigmas` summarises them as an
-:class:`ElevationSigmas` table, the RMS of each error in bins of the *measured* elevation (equal
-counts), so that the tracker can read its sigma from what it measures (the range is not known to
-it; the elevation is, and under a site above the road it falls monotonically with the range);
-:func:`told_by_elevation` gives each epoch of a line-of-sight drive its covariance from the table,
-for a design with :class:`~tunnelkit.tracking.javelin.ReportedNoise`. ``benchmarks/bench_rt_los.py
---by-elevation`` builds the table on seed 0 and reports it on the held-out seed and other scenes.
+* :func:`los_path` picks it without truth: the line of sight arrives first, but under a
+  ceiling-mounted site the ceiling's reflection follows within centimetres and the delay errors
+  swap them, so of the arrivals within ``window`` (:data:`LOS_WINDOW_M`) of the earliest it takes
+  the lowest in elevation (the ceiling's image lies above the array); :func:`los_only` cuts a
+  drive to that path.
+* The picked path is accurate where it arrives steeply and off by degrees where it arrives at a
+  shallow angle (near the site the line of sight and the ceiling's reflection are further apart
+  than the array resolves; far from it they merge). :func:`los_errors` measures its errors
+  against the true line of sight on surveyed drives; :func:`elevation_sigmas` summarises them as
+  an :class:`ElevationSigmas` table, the RMS of each angle in bins of the *measured* elevation
+  (the tracker does not know its range, but under a site above the road the elevation falls
+  monotonically with it); :func:`told_by_elevation` gives every epoch its covariance from the
+  table, read by :class:`~tunnelkit.tracking.javelin.ReportedNoise`.
 """
 
 from __future__ import annotations
@@ -26,11 +31,54 @@ import numpy as np
 from .._domains import positive_array
 from .._validate import finite_array, instance, integer, nonnegative, positive
 from ..angles import wrap_angle
-from ..geometry import spherical
+from ..geometry import spherical, spherical_jacobian
 from ..simulation import DriveData
-from .los_only import LOS_WINDOW_M, los_only
 
-__all__ = ["ElevationSigmas", "elevation_sigmas", "los_errors", "told_by_elevation"]
+__all__ = [
+    "LOS_WINDOW_M",
+    "ElevationSigmas",
+    "angle_sigma",
+    "elevation_sigmas",
+    "los_angle_information",
+    "los_errors",
+    "los_only",
+    "los_path",
+    "told_by_elevation",
+]
+
+
+#: the arrivals within this delay distance of the earliest are candidates for the LoS [m] (chosen
+#: on seed 0 of the straight drive among 0.3 / 0.6 / 1.0 m, docs/results/traced-robust.md)
+LOS_WINDOW_M = 0.3
+
+
+def los_path(d, psi, window: float = LOS_WINDOW_M) -> int:
+    """The index of the path taken for the line of sight among delay distances ``d`` (L,) [m]
+    and elevations ``psi`` (L,) [rad]: of the arrivals within ``window`` [m] of the earliest, the
+    lowest in elevation (``window = 0``: the earliest)."""
+    d = finite_array("d", d, ndim=1)
+    psi = finite_array("psi", psi, shape=d.shape)
+    window = nonnegative("window", window)
+    if d.size == 0:
+        raise ValueError("d: no path to choose from")
+    near = np.flatnonzero(d <= d.min() + float(window))
+    return int(near[np.argmin(psi[near])])
+
+
+def los_only(drive, window: float = LOS_WINDOW_M):
+    """``drive`` (a :class:`tunnelkit.simulation.DriveData`) with each epoch's measurements cut
+    to the path :func:`los_path` takes for the line of sight (an epoch without measurements
+    stays ``None``). Draws nothing, uses no truth."""
+
+    drive = instance("drive", drive, DriveData)
+    window = nonnegative("window", window)  # checked here once for every epoch
+    epochs = [
+        None
+        if ep is None or len(ep) == 0
+        else ep.subset(np.array([los_path(ep.d, ep.psi, window)]))
+        for ep in drive.epochs
+    ]
+    return replace(drive, epochs=epochs)
 
 
 @dataclass(frozen=True)
@@ -148,3 +196,47 @@ def told_by_elevation(drive, table: ElevationSigmas, sigma_kappa: float, sigma_d
         cov[:, 0, 0], cov[:, 1, 1], cov[:, 2, 2] = saz**2, sel**2, sigma_kappa**2
         epochs.append(replace(ep, cov=cov, sigma_d=np.full(len(ep), sigma_d)))
     return replace(drive, epochs=epochs, reports_covariance=True)
+
+
+def angle_sigma(name: str, value: float) -> float:
+    """``value`` checked as an angle's standard deviation [rad]: > 0 and at most pi (half a
+    turn; an error naming ``name``, a parameter's name, otherwise)."""
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"name: expected the parameter's name, got {name!r}")
+    value = positive(name, value)
+    if value > np.pi:
+        raise ValueError(f"{name}: at most pi rad (half a turn), got {value:g}")
+    return value
+
+
+def los_angle_information(ue, station, sigma_angle, sigma_elevation=None) -> np.ndarray:
+    """Position information (T, 2, 2) [1/m^2] of the line of sight's azimuth and elevation seen
+    from ``station`` (3,), for the UE at ``ue`` (T, 3), the angles with independent Gaussian
+    errors of ``sigma_angle`` (azimuth) and ``sigma_elevation`` (default ``sigma_angle``) [rad],
+    each a number or one per epoch (T,) (a table's, :meth:`ElevationSigmas.at`): ``J^T R^-1 J``
+    with ``J`` the angles' Jacobian in the road plane (the height known;
+    :func:`tunnelkit.geometry.spherical_jacobian`). The told model's information, for a drive's
+    posterior CRLB beside a tracker told those sigmas (a reference of that model, not a bound on
+    the ray-traced channel, whose errors are neither Gaussian nor independent)."""
+    ue = finite_array("ue", ue, shape=(None, 3))
+    station = finite_array("station", station, shape=(3,))
+    T = ue.shape[0]
+
+    def sigmas(name, value):
+        if np.ndim(value) == 0:
+            return np.full(T, angle_sigma(name, value))
+        value = positive_array(name, value, shape=(T,))
+        if np.any(value > np.pi):
+            raise ValueError(f"{name}: at most pi rad (half a turn), got {value.max():g}")
+        return value
+
+    az = sigmas("sigma_angle", sigma_angle)
+    el = az if sigma_elevation is None else sigmas("sigma_elevation", sigma_elevation)
+    try:
+        jac = spherical_jacobian(ue - station)[:, :2, :2]  # (azimuth, elevation) by (x, y)
+    except ValueError:
+        raise ValueError(
+            "ue: a position straight below or above the station has no azimuth"
+        ) from None
+    jac = jac / np.stack([az, el], axis=1)[:, :, None]  # whitened rows
+    return np.swapaxes(jac, 1, 2) @ jac

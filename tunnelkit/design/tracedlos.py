@@ -1,0 +1,108 @@
+"""The traced route's line-of-sight tracker: the line of sight alone, told its sigmas by its elevation.
+
+``tunnelkit design --mode channel --channel sionna --traced-tracker los``. On the ray-traced
+channel the reflections' estimates repeat biases of degrees per kind of path, while the line of
+sight's angles are nearly unbiased and their size follows the geometry: tenths of a degree where
+the line of sight arrives steeply near the site, degrees where it merges with the ceiling's
+reflection far from it (``docs/results/traced-robust.md``). This tracker keeps, of every epoch's
+ML measurements (the ``"ml-all"`` drive of :func:`tunnelkit.design.traced.design_drive`), the path
+taken for the line of sight (:func:`tunnelkit.design.los.los_path`, no truth) and tells JAVELIN
+its angle sigmas from a table by measured elevation (:func:`los_table`), surveyed on the same
+drives as the ``"paths"`` tracker's errors (the record's ``los_rows``,
+:func:`tunnelkit.design.traced.measure_design_errors`: the first 3 drives of seed 0, with their
+truth, as a deployment would survey its tunnel once). :func:`told_los` cuts a drive to that path
+and tells it the table; :func:`los_javelin` is the tracker that reads what it is told;
+:func:`los_summary` what the report says. Its bound over the drive is the told model's
+(:func:`tunnelkit.design.tracedbounds.los_bounds`, a prediction).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import finite_array, integer
+from .setup import DesignSetup
+from .tracedbounds import config_sigmas
+
+__all__ = ["LOS_BINS", "los_javelin", "los_summary", "los_table", "told_los"]
+
+#: bins of the measured elevation in the tracker's table (equal counts): four on the survey's
+#: 3 drives, compared with 1 and 2 on the studies' seed-0 drives of three scenes
+#: (docs/results/traced-robust.md, "The design's line-of-sight tracker"); fewer on a survey of
+#: fewer than two epochs per bin (a short route's)
+LOS_BINS = 4
+
+
+def _rows(record) -> np.ndarray:
+    if not isinstance(record, dict) or "rows" not in record:
+        raise TypeError("record: expected the dict of design.traced.design_errors")
+    if "los_rows" not in record:
+        raise ValueError(
+            f"record: {record.get('path', 'the record')} holds no survey of the line of sight "
+            "(los_rows; a record measured before it was kept): delete it to re-measure"
+        )
+    rows = np.asarray(record["los_rows"], dtype=float)
+    if rows.ndim != 2 or rows.shape[1] != 3:
+        raise ValueError("record: los_rows must be rows of three numbers (design.los.los_errors)")
+    return finite_array("record['los_rows']", rows, shape=(None, 3))
+
+
+def los_table(record: dict, bins: int | None = None):
+    """The tracker's table (:class:`~tunnelkit.design.los.ElevationSigmas`) from ``record``
+    (:func:`tunnelkit.design.traced.design_errors`, its ``los_rows``): ``bins`` bins of the
+    measured elevation (:func:`~tunnelkit.design.los.elevation_sigmas`), default
+    :data:`LOS_BINS` (fewer on a survey of fewer than two epochs per bin)."""
+    from .los import elevation_sigmas
+
+    rows = _rows(record)
+    if bins is None:
+        if rows.shape[0] < 2:
+            raise ValueError(
+                f"record: a survey of at least 2 epochs with a line of sight, got {rows.shape[0]}"
+            )
+        bins = min(LOS_BINS, rows.shape[0] // 2)
+    return elevation_sigmas(rows, integer("bins", bins, minimum=1))
+
+
+def los_javelin(setup: DesignSetup, spec, record: dict):
+    """The line-of-sight tracker: :func:`tunnelkit.design.traced.traced_javelin` of ``record``
+    (this array's errors: its curvature and delay sigmas, its fixed sigmas the fallback) reading
+    each measurement's covariance (:class:`~tunnelkit.tracking.javelin.ReportedNoise`): it is fed
+    :func:`told_los`'s drive."""
+    from ..tracking.javelin import ReportedNoise
+    from .traced import traced_javelin
+
+    design = traced_javelin(setup, spec, record)
+    return design.with_(noise=ReportedNoise(fallback=design.noise))
+
+
+def told_los(drive, table, config):
+    """``drive`` (an ``"ml-all"`` drive of :func:`tunnelkit.design.traced.design_drive`) cut to
+    the path taken for the line of sight each epoch (:func:`~tunnelkit.design.los.los_only`) and
+    told its angle sigmas from ``table`` at its measured elevation, the curvature sigma of
+    ``config`` (the tracker's JavelinConfig, :func:`los_javelin`) and half its TDoA variance as
+    the path's delay variance (:func:`~tunnelkit.design.los.told_by_elevation`). Draws nothing,
+    uses no truth."""
+    from .los import los_only, told_by_elevation
+
+    c = config_sigmas(config)
+    return told_by_elevation(los_only(drive), table, c["kappa"], c["d"] / np.sqrt(2))
+
+
+def los_summary(record: dict, table) -> dict:
+    """What the report's JSON says about the tracker's table (``error_model["los"]``): the
+    table [deg], its bins, the survey's epochs, seed, runs, window and file."""
+    from .los import ElevationSigmas
+
+    rows = _rows(record)
+    if not isinstance(table, ElevationSigmas):
+        raise TypeError(f"table: expected a design.los.ElevationSigmas, got {type(table).__name__}")
+    return {
+        "table_deg": table.as_dict(),
+        "bins": int(table.elevation.size),
+        "epochs": int(rows.shape[0]),
+        "seed": record.get("seed"),
+        "runs": record.get("runs"),
+        "window_m": record.get("los_window_m"),
+        "path": record.get("path"),
+    }
