@@ -11,7 +11,7 @@ over the settled epochs, mean over the drives; the angle sigma is chosen on seed
 the line of sight's two angles at the chosen sigma as independent Gaussian errors, the start
 and the V2X messages (:func:`tunnelkit.design.drive_pcrlb`): a reference of the told model, not
 a bound on the traced channel. Also the share of epochs whose path taken for the line of sight
-(:func:`~tunnelkit.studies.los_only.los_path`) is the true one.
+(:func:`~tunnelkit.design.los.los_path`) is the true one.
 
     python benchmarks/bench_rt_los.py --runs 12 --workers 2
     python benchmarks/bench_rt_los.py --runs 12 --workers 2 --scenario italiano2026-slalom --sigmas 1

@@ -120,7 +120,7 @@ def design_traced():
     # the line-of-sight tracker: its table from the record's survey, the tracker, a drive told
     # it, the told model's figure and what the report says
     table = tracedlos.los_table(rec, 1)
-    los = tracedlos.los_javelin(setup, "4x4", rec)
+    los = tracedlos.los_javelin(d)
     every = traced.design_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1, kind="ml-all")
     tracedlos.told_los(every, table, los.config)
     tracedbounds.los_bounds(setup, "4x4", table, 2, sigma_p0=0.5)

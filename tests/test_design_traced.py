@@ -582,6 +582,18 @@ def test_the_line_of_sight_survey_is_in_the_errors_record_and_its_table_is_its_r
         tracedlos.los_table({**rec, "los_rows": [[0.1, np.nan, 0.0]] * 4}, bins=1)
     with pytest.raises(ValueError, match=r"^record: a survey of at least 2"):
         tracedlos.los_table({**rec, "los_rows": [[0.1, 0.01, 0.0]]})
+    # surveyed with another window than the tracker picks with; ragged or impossible rows
+    with pytest.raises(ValueError, match=r"^record: .*picked within 0.6 m"):
+        tracedlos.los_table({**rec, "los_window_m": 0.6})
+    with pytest.raises(ValueError, match=r"^record: los_rows must be rows"):
+        tracedlos.los_table({**rec, "los_rows": [[0.1, 0.2, 0.3], [0.1]]})
+    with pytest.raises(ValueError, match=r"^record: los_rows hold an elevation beyond"):
+        tracedlos.los_table({**rec, "los_rows": [[2.0, 0.01, 0.0]] * 4})
+    with pytest.raises(ValueError, match=r"^bins: 50 bins"):
+        tracedlos.los_table(rec, bins=50)
+    # tied elevations: the default steps down to fewer bins instead of failing
+    tied = {**rec, "los_rows": [[-0.1, 0.01, 0.02]] * 6 + [[-0.2, 0.02, 0.01]] * 2}
+    assert tracedlos.los_table(tied).elevation.size < tracedlos.LOS_BINS
 
 
 def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
@@ -608,7 +620,9 @@ def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
     k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
     _, drive = tracedbounds.los_bounds(setup, "4x4", table, 3)
     assert los.predicted_drive_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
-    d = tracedlos.los_javelin(setup, "4x4", rec)
+    d = tracedlos.los_javelin(traced.traced_javelin(setup, "4x4", rec))
+    with pytest.raises(TypeError, match=r"^design"):
+        tracedlos.los_javelin(d)  # already reading reported covariances
     assert isinstance(d.noise, ReportedNoise)
     # the told drive: one path an epoch, its covariance the table's at its measured elevation
     every = traced.design_drive(setup, "4x4", np.random.default_rng(5), n_epochs=3, kind="ml-all")

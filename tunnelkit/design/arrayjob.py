@@ -262,17 +262,17 @@ class ArrayJob:
 
             # this array's errors on the traced channel (cached with their provenance)
             rec = traced.design_errors(self.setup, spec, n_epochs=self.T)
-            design = traced.traced_javelin(self.setup, spec, rec)
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
             # (a model's posterior CRLB, not a bound of the tracker on the traced channel,
             # whose errors are neither Gaussian nor independent: a prediction)
             pc, sp0, los = None, self.start_sigma, None
             if self.traced_tracker == "los":  # the line of sight, surveyed on the same drives
                 table = tracedlos.los_table(rec)
-                design = tracedlos.los_javelin(self.setup, spec, rec)
+                design = tracedlos.los_javelin(traced.traced_javelin(self.setup, spec, rec))
                 drive = tracedbounds.los_bounds(self.setup, spec, table, self.T, sigma_p0=sp0)[1]
                 los = tracedlos.los_summary(rec, table)
             else:
+                design = traced.traced_javelin(self.setup, spec, rec)
                 drive = tracedbounds.traced_bounds(self.setup, spec, design.config, self.T,
                                                    sigma_p0=sp0)[1]  # fmt: skip
             error_model = traced.error_model_summary(rec, design.config, los)

@@ -3,7 +3,7 @@
 On the ray-traced channel the reflections' estimates are biased by degrees per kind of path and
 the bias repeats from epoch to epoch, while the line of sight's angles are nearly unbiased
 (``docs/results/traced-robust.md``). The design's line-of-sight tracker on that channel
-(``tunnelkit design --channel sionna --traced-tracker los``) keeps, of every epoch's ML
+(``tunnelkit design --mode channel --channel sionna --traced-tracker los``) keeps, of every epoch's ML
 measurements, the one path taken for the line of sight and tells JAVELIN its angle sigmas from a
 table measured by the line of sight's elevation:
 

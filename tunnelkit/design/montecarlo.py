@@ -109,7 +109,8 @@ class MonteCarloResult:
     ``predicted`` (T,) [m] the posterior CRLB of the tracker's weighting with the position bias
     of the calibration draw and the wideband term added (:func:`drive_bound`), the surfaces
     known; on the ray-traced channel's route that of the sigmas the tracker is told
-    (:func:`tunnelkit.design.tracedbounds.traced_bounds`) and ``pcrlb`` is ``None``. ``error_model`` the traced
+    (:mod:`tunnelkit.design.tracedbounds`: ``traced_bounds``, ``los_bounds``) and ``pcrlb`` is
+    ``None``. ``error_model`` the traced
     route's measurement-noise model (:func:`tunnelkit.design.traced.error_model_summary`;
     ``None`` on the image channel, where each path carries its reported CRLB);
     ``dead_reckoning`` (runs, T) [m] the same drives' errors with every measurement dropped
@@ -184,7 +185,7 @@ _PREPARED: OrderedDict = OrderedDict()
 def _prepare(pool: TrialPool, job: ArrayJob, specs: list) -> list:
     """``pool.prepare(job, specs)``; serially, an array prepared before in this process by an
     equal job (the same setup and error-model objects, mode, epochs, fallback sigmas,
-    impairments and entry fix) is that preparation again: a sweep's next batch of units
+    impairments, entry fix and traced tracker) is that preparation again: a sweep's next batch of units
     (:func:`tunnelkit.design.report.design_sweep`'s sequential rule) prepares the same arrays,
     and the preparation draws nothing at random (the drives only read it). At most
     :data:`PREPARED_KEPT` are kept; on a cluster every sweep prepares its arrays."""
@@ -250,7 +251,7 @@ def sweep_montecarlo(
     extraction without impairments). The bound mode draws from it, and
     both modes take the posterior CRLB from its reported bound (on the image channel's channel
     route only when models are given; the ray-traced channel's route takes the bounds of the
-    sigmas its tracker is told, :func:`tunnelkit.design.tracedbounds.traced_bounds`, and refuses
+    sigmas its tracker is told, :mod:`tunnelkit.design.tracedbounds`, and refuses
     models). ``crlbs`` (by label) sets the tracker's fallback sigmas (default: the
     route-median per-path bounds, from the model when there is one). ``workers`` /
     ``scheduler`` / ``timeout`` / ``trial_timeout`` go to :func:`tunnelkit.runner.run_trials` (one cluster for the

@@ -197,9 +197,9 @@ def report_table(report) -> str:
                 f"{q} {r.dead_reckoning_p90_m:.3g} m, RMSE {r.dead_reckoning_rmse_m:.3g} m"
                 + (
                     ""
-                    if gain is None or not r.rmse_m
+                    if gain is None
                     else f"; the radio's gain in RMSE {100 * gain:.2g} % (dead reckoning's RMSE "
-                    f"over the tracker's {r.dead_reckoning_rmse_m / r.rmse_m:.3g}x)"
+                    f"over the tracker's {r.dead_reckoning_rmse_m / r.rmse_m if r.rmse_m else np.inf:.3g}x)"
                 )
             )
     lines.extend(f"warning: {w}" for w in report.warnings)

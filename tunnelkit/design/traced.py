@@ -186,6 +186,8 @@ def design_drive(
         drives = {k: both[k] for k in DRIVE_KINDS}
     else:
         drives = {"ml-traced": drive}
+    if kept is not None and kept[0] is setup:  # a kind kept before stays as it was
+        drives.update(kept[1])
     _DRIVES[key] = (setup, copy.deepcopy(drives), copy.deepcopy(rng.bit_generator.state))
     while len(_DRIVES) > DRIVES_KEPT:
         _DRIVES.popitem(last=False)
@@ -356,7 +358,10 @@ def measure_design_errors(
     corr = error_correlations(drives)
     from .los import LOS_WINDOW_M, los_errors
 
-    los = los_errors(drives)
+    try:
+        los = los_errors(drives).tolist()
+    except ValueError:  # no epoch with a path: no survey (the line-of-sight tracker refuses it)
+        los = []
     return {
         **_provenance(setup, spec, n_epochs),
         "seed": seed,
@@ -366,7 +371,7 @@ def measure_design_errors(
         "rows": [[r[0], *(float(x) if isinstance(x, float) else x for x in r[1:])] for r in rows],
         "correlation": corr,
         "los_window_m": LOS_WINDOW_M,
-        "los_rows": los.tolist(),
+        "los_rows": los,
     }
 
 
@@ -514,7 +519,9 @@ def error_model_summary(record: dict | None, config=None, los: dict | None = Non
         return {"kind": "reported-crlb"}
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of design_errors or None")
-    if los is not None and (not isinstance(los, dict) or "table_deg" not in los):
+    from .tracedlos import SUMMARY_KEYS
+
+    if los is not None and (not isinstance(los, dict) or set(los) != set(SUMMARY_KEYS)):
         raise TypeError(f"los: expected the dict of tracedlos.los_summary or None, got {los!r}")
     told = {}
     if config is not None:
@@ -522,6 +529,8 @@ def error_model_summary(record: dict | None, config=None, los: dict | None = Non
         told = {"told_sigmas": {"phi_deg": float(np.degrees(c["phi"])),
                                 "psi_deg": float(np.degrees(c["psi"])),
                                 "kappa_m": c["kappa"], "delta_d_m": c["d"]}}  # fmt: skip
+        if los is not None:  # its angles are the table's (``los``), these only the fallback
+            told["told_sigmas"] = {k: told["told_sigmas"][k] for k in ("kappa_m", "delta_d_m")}
     return {
         "kind": "traced-measured",
         "sigmas": _sigmas(record),

@@ -20,11 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import finite_array, integer
-from .setup import DesignSetup
+from .._validate import finite_array, instance, integer
 from .tracedbounds import config_sigmas
 
-__all__ = ["LOS_BINS", "los_javelin", "los_summary", "los_table", "told_los"]
+__all__ = ["LOS_BINS", "SUMMARY_KEYS", "los_javelin", "los_summary", "los_table", "told_los"]
 
 #: bins of the measured elevation in the tracker's table (equal counts): four on the survey's
 #: 3 drives, compared with 1 and 2 on the studies' seed-0 drives of three scenes
@@ -34,17 +33,38 @@ LOS_BINS = 4
 
 
 def _rows(record) -> np.ndarray:
+    """The survey's rows, checked: (measured elevation within +-pi/2, azimuth and elevation errors
+    within +-pi) [rad], picked with the window the tracker picks with."""
+    from .los import LOS_WINDOW_M
+
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of design.traced.design_errors")
+    where = record.get("path", "the record")
     if "los_rows" not in record:
         raise ValueError(
-            f"record: {record.get('path', 'the record')} holds no survey of the line of sight "
-            "(los_rows; a record measured before it was kept): delete it to re-measure"
+            f"record: {where} holds no survey of the line of sight (los_rows; a record measured "
+            "before it was kept): delete it to re-measure"
         )
-    rows = np.asarray(record["los_rows"], dtype=float)
-    if rows.ndim != 2 or rows.shape[1] != 3:
+    if record.get("los_window_m") != LOS_WINDOW_M:
+        raise ValueError(
+            f"record: {where} surveyed the line of sight picked within "
+            f"{record.get('los_window_m')!r} m of the earliest arrival, the tracker picks within "
+            f"{LOS_WINDOW_M} m: delete it to re-measure"
+        )
+    try:
+        rows = np.asarray(record["los_rows"], dtype=float).reshape(-1, 3)
+    except (TypeError, ValueError):
+        raise ValueError(
+            "record: los_rows must be rows of three numbers (design.los.los_errors)"
+        ) from None
+    if len(rows) != len(record["los_rows"]):
         raise ValueError("record: los_rows must be rows of three numbers (design.los.los_errors)")
-    return finite_array("record['los_rows']", rows, shape=(None, 3))
+    rows = finite_array("record['los_rows']", rows, shape=(None, 3))
+    if np.any(np.abs(rows[:, 0]) > np.pi / 2) or np.any(np.abs(rows[:, 1:]) > np.pi):
+        raise ValueError(
+            "record: los_rows hold an elevation beyond +-pi/2 or an angle error beyond +-pi rad"
+        )
+    return rows
 
 
 def los_table(record: dict, bins: int | None = None):
@@ -55,24 +75,42 @@ def los_table(record: dict, bins: int | None = None):
     from .los import elevation_sigmas
 
     rows = _rows(record)
-    if bins is None:
-        if rows.shape[0] < 2:
+    if bins is not None:
+        bins = integer("bins", bins, minimum=1)
+        try:
+            return elevation_sigmas(rows, bins)
+        except ValueError as exc:  # too few rows, or tied elevations, for that many bins
             raise ValueError(
-                f"record: a survey of at least 2 epochs with a line of sight, got {rows.shape[0]}"
-            )
-        bins = min(LOS_BINS, rows.shape[0] // 2)
-    return elevation_sigmas(rows, integer("bins", bins, minimum=1))
+                f"bins: {bins} bins of the survey's {len(rows)} epochs: {exc}"
+            ) from None
+    if rows.shape[0] < 2:
+        raise ValueError(
+            f"record: a survey of at least 2 epochs with a line of sight, got {rows.shape[0]}"
+        )
+    b = min(LOS_BINS, rows.shape[0] // 2)
+    while True:  # fewer bins where tied elevations leave one short
+        try:
+            return elevation_sigmas(rows, b)
+        except ValueError as exc:
+            if b == 1:
+                raise ValueError(f"record: los_rows make no table ({exc})") from None
+            b -= 1
 
 
-def los_javelin(setup: DesignSetup, spec, record: dict):
-    """The line-of-sight tracker: :func:`tunnelkit.design.traced.traced_javelin` of ``record``
-    (this array's errors: its curvature and delay sigmas, its fixed sigmas the fallback) reading
-    each measurement's covariance (:class:`~tunnelkit.tracking.javelin.ReportedNoise`): it is fed
-    :func:`told_los`'s drive."""
-    from ..tracking.javelin import ReportedNoise
-    from .traced import traced_javelin
+def los_javelin(design):
+    """The line-of-sight tracker: ``design`` (the array's traced tracker,
+    :func:`tunnelkit.design.traced.traced_javelin` of its record: its curvature and delay sigmas,
+    its fixed sigmas the fallback) reading each measurement's covariance
+    (:class:`~tunnelkit.tracking.javelin.ReportedNoise`): it is fed :func:`told_los`'s drive."""
+    from ..tracking.javelin import JavelinDesign, ReportedNoise
+    from ..tracking.javelin.noise import FixedNoise
 
-    design = traced_javelin(setup, spec, record)
+    instance("design", design, JavelinDesign)
+    if not isinstance(design.noise, FixedNoise):
+        raise TypeError(
+            "design: expected the traced tracker (fixed sigmas, traced.traced_javelin), got noise "
+            f"{type(design.noise).__name__}"
+        )
     return design.with_(noise=ReportedNoise(fallback=design.noise))
 
 
@@ -87,6 +125,10 @@ def told_los(drive, table, config):
 
     c = config_sigmas(config)
     return told_by_elevation(los_only(drive), table, c["kappa"], c["d"] / np.sqrt(2))
+
+
+#: the keys of :func:`los_summary`
+SUMMARY_KEYS = ("table_deg", "bins", "epochs", "seed", "runs", "window_m", "path")
 
 
 def los_summary(record: dict, table) -> dict:

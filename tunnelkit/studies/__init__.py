@@ -20,8 +20,9 @@ core never imports it (``tests/test_layout.py``):
 - :mod:`.robust_errors` — errors the tracker can trust: robust statistics of the traced
   per-path errors (median, MAD, gross errors apart) and the traced design told them
   (``docs/results/traced-robust.md``).
-- :mod:`.los_only` — the line of sight alone on the traced channel: JAVELIN fed the path each
-  epoch takes for it, from an entry fix (``docs/results/traced-robust.md``);
+- :mod:`.los_only` — the line of sight alone on the traced channel, the variants around the
+  design's tracker (the pick and the table are the core's, :mod:`tunnelkit.design.los`): the path
+  dropped where the fit flags it, one constant sigma (``docs/results/traced-robust.md``);
 - :mod:`.odometry` — dead reckoning's drift against distance driven under the paper's white
   odometry and an automotive model, beside its posterior CRLB (``docs/results/odometry.md``).
 
