@@ -102,7 +102,6 @@ class SweepTrial:
             )
         elif self.setup.channel == "sionna":
             from .traced import design_drive
-            from .tracedlos import told_los
 
             # the traced treatment (tunnelkit.design.traced): every epoch's ML measurements,
             # the geometry pre-filter; the tracker told this array's measured errors (a drive
@@ -113,6 +112,8 @@ class SweepTrial:
             kind = "ml-all" if los else "ml-traced"
             drive = design_drive(self.setup, spec, rng, n_epochs=self.n_epochs, kind=kind)
             if los:
+                from .tracedlos import told_los
+
                 drive = told_los(drive, prep.los_table, prep.design.config)
         else:
             route = self.setup.signal_route(spec)
@@ -258,7 +259,7 @@ class ArrayJob:
         budget = channel_route_budget(self.setup, spec, imp)
         error_model = table = None
         if self.mode == "channel" and self.setup.channel == "sionna":
-            from . import traced, tracedbounds, tracedlos
+            from . import traced, tracedbounds
 
             # this array's errors on the traced channel (cached with their provenance)
             rec = traced.design_errors(self.setup, spec, n_epochs=self.T)
@@ -267,6 +268,8 @@ class ArrayJob:
             # whose errors are neither Gaussian nor independent: a prediction)
             pc, sp0, los = None, self.start_sigma, None
             if self.traced_tracker == "los":  # the line of sight, surveyed on the same drives
+                from . import tracedlos
+
                 table = tracedlos.los_table(rec)
                 design = tracedlos.los_javelin(traced.traced_javelin(self.setup, spec, rec))
                 drive = tracedbounds.los_bounds(self.setup, spec, table, self.T, sigma_p0=sp0)[1]

@@ -519,10 +519,11 @@ def error_model_summary(record: dict | None, config=None, los: dict | None = Non
         return {"kind": "reported-crlb"}
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of design_errors or None")
-    from .tracedlos import SUMMARY_KEYS
+    if los is not None:  # the line-of-sight tracker's summary (its module loaded with it)
+        from .tracedlos import SUMMARY_KEYS
 
-    if los is not None and (not isinstance(los, dict) or set(los) != set(SUMMARY_KEYS)):
-        raise TypeError(f"los: expected the dict of tracedlos.los_summary or None, got {los!r}")
+        if not isinstance(los, dict) or set(los) != set(SUMMARY_KEYS):
+            raise TypeError(f"los: expected the dict of tracedlos.los_summary or None, got {los!r}")
     told = {}
     if config is not None:
         c = config_sigmas(config)

@@ -17,7 +17,9 @@ import numpy as np
 
 from .._physical import start_spread
 from .._validate import finite_array, instance, integer, positive
+from ..geometry import spherical
 from .bounds import route_geometry
+from .drivebound import drive_bound, drive_pcrlb, position_information
 from .errormodel import PathErrorModel
 from .setup import DesignSetup, parse_array
 from .trackerfix import START_SIGMA_M
@@ -80,8 +82,6 @@ def traced_bounds(
     ``sigma_p0`` [m] per axis, default :data:`~tunnelkit.design.trackerfix.START_SIGMA_M`;
     ``drive`` the same with no bias). What the told sigmas allow: the traced
     errors are neither Gaussian nor independent, so not a bound on what the channel allows."""
-    from .drivebound import drive_bound, drive_pcrlb, position_information
-
     instance("setup", setup, DesignSetup)
     spec = parse_array(spec)
     n = len(setup.trajectory)
@@ -106,9 +106,7 @@ def los_bounds(
     (:func:`~tunnelkit.design.los.los_angle_information`), from a start of ``sigma_p0`` [m] per
     axis: ``(pcrlb, drive)`` (T,) [m]. A prediction of the told model, not a bound: the traced
     errors are neither Gaussian nor independent, and a tenth of the epochs feed a reflection."""
-    from ..geometry import spherical
-    from .drivebound import drive_bound, drive_pcrlb
-    from .los import ElevationSigmas, los_angle_information
+    from .los import ElevationSigmas, los_angle_information  # the line of sight's, on demand
 
     instance("setup", setup, DesignSetup)
     spec = parse_array(spec)

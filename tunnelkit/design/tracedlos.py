@@ -21,6 +21,15 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import finite_array, instance, integer
+from ..tracking.javelin import JavelinDesign, ReportedNoise
+from ..tracking.javelin.noise import FixedNoise
+from .los import (
+    LOS_WINDOW_M,
+    ElevationSigmas,
+    elevation_sigmas,
+    los_only,
+    told_by_elevation,
+)
 from .tracedbounds import config_sigmas
 
 __all__ = ["LOS_BINS", "SUMMARY_KEYS", "los_javelin", "los_summary", "los_table", "told_los"]
@@ -35,8 +44,6 @@ LOS_BINS = 4
 def _rows(record) -> np.ndarray:
     """The survey's rows, checked: (measured elevation within +-pi/2, azimuth and elevation errors
     within +-pi) [rad], picked with the window the tracker picks with."""
-    from .los import LOS_WINDOW_M
-
     if not isinstance(record, dict) or "rows" not in record:
         raise TypeError("record: expected the dict of design.traced.design_errors")
     where = record.get("path", "the record")
@@ -72,8 +79,6 @@ def los_table(record: dict, bins: int | None = None):
     (:func:`tunnelkit.design.traced.design_errors`, its ``los_rows``): ``bins`` bins of the
     measured elevation (:func:`~tunnelkit.design.los.elevation_sigmas`), default
     :data:`LOS_BINS` (fewer on a survey of fewer than two epochs per bin)."""
-    from .los import elevation_sigmas
-
     rows = _rows(record)
     if bins is not None:
         bins = integer("bins", bins, minimum=1)
@@ -102,9 +107,6 @@ def los_javelin(design):
     :func:`tunnelkit.design.traced.traced_javelin` of its record: its curvature and delay sigmas,
     its fixed sigmas the fallback) reading each measurement's covariance
     (:class:`~tunnelkit.tracking.javelin.ReportedNoise`): it is fed :func:`told_los`'s drive."""
-    from ..tracking.javelin import JavelinDesign, ReportedNoise
-    from ..tracking.javelin.noise import FixedNoise
-
     instance("design", design, JavelinDesign)
     if not isinstance(design.noise, FixedNoise):
         raise TypeError(
@@ -121,8 +123,6 @@ def told_los(drive, table, config):
     ``config`` (the tracker's JavelinConfig, :func:`los_javelin`) and half its TDoA variance as
     the path's delay variance (:func:`~tunnelkit.design.los.told_by_elevation`). Draws nothing,
     uses no truth."""
-    from .los import los_only, told_by_elevation
-
     c = config_sigmas(config)
     return told_by_elevation(los_only(drive), table, c["kappa"], c["d"] / np.sqrt(2))
 
@@ -134,8 +134,6 @@ SUMMARY_KEYS = ("table_deg", "bins", "epochs", "seed", "runs", "window_m", "path
 def los_summary(record: dict, table) -> dict:
     """What the report's JSON says about the tracker's table (``error_model["los"]``): the
     table [deg], its bins, the survey's epochs, seed, runs, window and file."""
-    from .los import ElevationSigmas
-
     rows = _rows(record)
     if not isinstance(table, ElevationSigmas):
         raise TypeError(f"table: expected a design.los.ElevationSigmas, got {type(table).__name__}")
