@@ -49,13 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validate import (
-    boolean,
-    choice,
-    instance,
-    integer,
-    rng_or_error,
-)
+from .._validate import boolean, choice, instance, integer, rng_or_error
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
 from .setup import DesignSetup, parse_array
