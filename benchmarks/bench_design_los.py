@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import pickle
 import sys
 import time
 from pathlib import Path
@@ -29,6 +30,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit import design
+from tunnelkit.design import traced
 from tunnelkit.design.tracedtracker import TRACED_TRACKERS
 from tunnelkit.simulation import HELD_OUT_SEED
 
@@ -42,8 +44,15 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=HELD_OUT_SEED)
     ap.add_argument("--start-sigma", type=float, default=design.START_SIGMA_M)
     ap.add_argument("--json", default=None, help="write the rows here")
+    ap.add_argument(
+        "--drives-cache", default=None,
+        help="a pickle of the sweep's drives: read when it exists (tracking only), written after",
+    )  # fmt: skip
     a = ap.parse_args()
     setup = design.DesignSetup.from_scenario(a.scenario, channel="sionna")
+    cache = Path(a.drives_cache) if a.drives_cache else None
+    if cache is not None and cache.exists():
+        traced.keep_drives(setup, pickle.loads(cache.read_bytes()))
     rows = []
     for tracker in TRACED_TRACKERS:  # "paths" first: it drives, "los" tracks on its drives
         t0 = time.perf_counter()
@@ -57,6 +66,9 @@ def main() -> None:
             rows.append({"tracker": tracker, "wall_s": round(wall, 1), **r.to_json()})
         print(rep.to_table(), flush=True)
         print(f"{tracker}: {wall:.0f} s", flush=True)
+        if cache is not None and tracker == TRACED_TRACKERS[0]:
+            cache.parent.mkdir(parents=True, exist_ok=True)
+            cache.write_bytes(pickle.dumps(traced.kept_drives(setup)))
     print(f"\n{a.scenario}, traced channel, seed {a.seed}, {a.units} units x "
           f"{a.drives_per_unit} drives, entry fix {a.start_sigma:g} m\n")  # fmt: skip
     print(

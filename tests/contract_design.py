@@ -102,6 +102,10 @@ def design_traced():
     with open(stored, "w") as f:
         json.dump(traced.drive_record(setup, "4x4", np.random.default_rng(0), n_epochs=1), f)
     traced.stored_drive(setup, "4x4", np.random.default_rng(0), n_epochs=1, path=stored)
+    traced.stored_drive(
+        setup, "4x4", np.random.default_rng(0), n_epochs=1, path=stored, kind="ml-all"
+    )
+    traced.keep_drives(setup, traced.kept_drives(setup))
     traced.design_errors_path(setup, "4x4", n_epochs=1)
     rec = traced.measure_design_errors(setup, "4x4", 1, 0, n_epochs=2)
     path = tempfile.mkdtemp() + "/errors.json"

@@ -191,8 +191,8 @@ def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
 
     monkeypatch.setattr(drives, "ml_paths", first_only)
     g = tool.case_rng(seed, stream)
-    fresh = traced.traced_drive(traced.traced_route(setup, array), g, n_epochs=n_epochs)
-    fresh = fresh["ml-traced"]
+    both = traced.traced_drive(traced.traced_route(setup, array), g, n_epochs=n_epochs)
+    fresh = both["ml-traced"]
     assert len(extracted) == 12 and g.bit_generator.state == rng.bit_generator.state
     for f in ("speed", "heading", "t", "truth", "velocity", "base_station"):
         np.testing.assert_array_equal(getattr(fresh, f), getattr(got, f), err_msg=f)
@@ -208,6 +208,12 @@ def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
     np.testing.assert_allclose(fresh.sources[0], got.sources[0], rtol=1e-12, atol=0)
     assert (fresh.kinds[0], fresh.los[0], fresh.n_true[0]) == (got.kinds[0], got.los[0],
                                                               got.n_true[0])  # fmt: skip
+    # every epoch's measurements (the line-of-sight tracker's input): the same epoch, every path
+    every = traced.stored_drive(setup, array, tool.case_rng(seed, stream), n_epochs, kind="ml-all")
+    pa, pb = both["ml-all"].epochs[0], every.epochs[0]
+    assert len(pb.phi) >= len(got.epochs[0].phi)
+    for f in ("phi", "psi", "kappa", "d"):
+        np.testing.assert_allclose(getattr(pa, f), getattr(pb, f), rtol=1e-9, atol=0, err_msg=f)
 
 
 def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign(
@@ -227,13 +233,21 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
         return traced.stored_drive(setup, array, tool.case_rng(seed, stream), n_epochs, path=p)
 
     assert load(stored) is not None
+    # a kind missing, or the kinds ending in different generator states: refused
+    one = {**stored, "drives": {"ml-traced": stored["drives"]["ml-traced"]}}
+    with pytest.raises(ValueError, match=f"^path: {re.escape(str(p))} drives: expected one drive"):
+        load(one)
+    apart = json.loads(json.dumps(stored))
+    apart["drives"]["ml-all"]["rng_end"]["state"]["state"] += 1
+    with pytest.raises(ValueError, match="the kinds end in different generator states"):
+        load(apart)
 
     def tampered(change):
         rec = json.loads(json.dumps(stored))
-        change(rec["drive"])
+        change(rec["drives"]["ml-traced"])
         return rec
 
-    ep = next(k for k, e in enumerate(stored["drive"]["epochs"]) if e["measurements"])
+    ep = next(k for k, e in enumerate(stored["drives"]["ml-traced"]["epochs"]) if e["measurements"])
 
     def meas(rec):
         return rec["epochs"][ep]["measurements"]
@@ -273,7 +287,7 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
         assert load(other) is None
     # another scene or record format: passed over, saying what differs
     for field, value in (("rt_key", {**stored["key"]["rt_key"], "scene": "0" * 64}),
-                         ("format", 2), ("n_epochs", 11)):  # fmt: skip
+                         ("format", 1), ("n_epochs", 11)):  # fmt: skip
         with pytest.warns(
             RuntimeWarning, match=f"{re.escape(str(p))} holds this drive made with other {field}"
         ):
@@ -302,7 +316,11 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
     g = tool.case_rng(seed, stream)
     d = traced.design_drive(setup, array, g, n_epochs=n_epochs)
     assert driven == [] and len(d.epochs) == n_epochs
-    assert g.bit_generator.state == stored["drive"]["rng_end"]
+    g = tool.case_rng(seed, stream)  # the other kind: kept from the same read
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())
+    every = traced.design_drive(setup, array, g, n_epochs=n_epochs, kind="ml-all")
+    assert driven == [] and len(every.epochs) == n_epochs
+    assert g.bit_generator.state == stored["drives"]["ml-traced"]["rng_end"]
     p.write_text(json.dumps(other))
     monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())  # none kept in the process
     g = tool.case_rng(seed, stream)
@@ -369,7 +387,9 @@ FEW = {"units": 2, "max_units": 2, "drives_per_unit": 1, "settle": 0.0}
 
 
 def test_the_sweep_and_report_name_the_error_model(setup):
-    rep = design.design_sweep(setup, ["4x4"], seed=0, mode="channel", n_epochs=3, **FEW)
+    rep = design.design_sweep(
+        setup, ["4x4"], seed=0, mode="channel", n_epochs=3, traced_tracker="paths", **FEW
+    )
     row = rep.rows[0]
     assert row.runs == 2 and row.error_p90_m is not None and np.isfinite(row.error_p90_m)
     j = rep.to_json()
@@ -385,6 +405,8 @@ def test_the_sweep_and_report_name_the_error_model(setup):
         n_epochs=2, **FEW,
     ).to_json()  # fmt: skip
     assert "channel" not in img["inputs"] and "error_model" not in img["arrays"][0]
+    assert "traced_tracker" not in img["inputs"]
+    assert j["inputs"]["traced_tracker"] == "paths"
 
 
 def test_the_traced_bounds_are_those_of_the_told_sigmas(setup):
@@ -434,7 +456,7 @@ def test_the_sweep_reports_the_bound_of_the_told_sigmas(setup):
     d = traced.traced_javelin(setup, "4x4", rec)
     k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
     for fix in (None, 0.1):  # the default entry fix and a better one: the bounds' prior follows
-        kw = {} if fix is None else {"start_sigma": fix}
+        kw = {"traced_tracker": "paths", **({} if fix is None else {"start_sigma": fix})}
         rep = design.design_sweep(setup, ["4x4"], seed=0, mode="channel", n_epochs=3, **FEW, **kw)
         row = rep.rows[0]
         _, drive = tracedbounds.traced_bounds(setup, "4x4", d.config, 3, sigma_p0=fix)
@@ -548,6 +570,35 @@ def test_both_kinds_of_a_design_drive_come_from_one_extraction(setup, monkeypatc
         traced.design_drive(setup, "4x4", np.random.default_rng(31), n_epochs=1, kind="ml")
 
 
+def test_kept_drives_go_to_another_process_and_are_tracked_there_without_driving(
+    setup, monkeypatch
+):
+    """kept_drives lists what design_drive keeps for a setup; pickled and given to keep_drives
+    for another setup object of the same scene (another process's), design_drive reads them:
+    the same drive, the generator moved as driving moves it, nothing driven."""
+    import pickle
+
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())
+    g = np.random.default_rng(41)
+    first = traced.design_drive(setup, "4x4", g, n_epochs=1)
+    end = g.bit_generator.state
+    entries = pickle.loads(pickle.dumps(traced.kept_drives(setup)))
+    assert len(entries) == 1 and set(entries[0][1]) == set(traced.DRIVE_KINDS)
+    twin = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    assert traced.kept_drives(twin) == []
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())  # a fresh process
+    monkeypatch.setattr(traced, "traced_drive", lambda *a, **k: pytest.fail("driven"))
+    traced.keep_drives(twin, entries)
+    g = np.random.default_rng(41)
+    _same_drive(traced.design_drive(twin, "4x4", g, n_epochs=1), first)
+    assert g.bit_generator.state == end
+    for bad in ([("4x4", None, "{}")], [(entries[0][0], {"ml": first}, end)], "drives"):
+        with pytest.raises((TypeError, ValueError), match=r"^entries"):
+            traced.keep_drives(twin, bad)
+    with pytest.raises(ValueError, match=r"^setup"):
+        traced.kept_drives(design.DesignSetup.from_scenario(SCENARIO))
+
+
 def test_the_line_of_sight_survey_is_in_the_errors_record_and_its_table_is_its_rms(setup):
     """The errors' record carries the survey of the line of sight on the same drives (seed 0):
     one row per epoch with a path (measured elevation, azimuth error, elevation error), each the
@@ -606,9 +657,16 @@ def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
     from tunnelkit.tracking.javelin import ReportedNoise
 
     kw = {"seed": 0, "mode": "channel", "n_epochs": 3, "dead_reckoning": True, **FEW}
-    paths = design.design_sweep(setup, ["4x4"], **kw).rows[0]
+    paths = design.design_sweep(setup, ["4x4"], traced_tracker="paths", **kw).rows[0]
     rep = design.design_sweep(setup, ["4x4"], traced_tracker="los", **kw)
     los = rep.rows[0]
+    # the default on the traced channel's channel route: the line of sight, the same sweep
+    default = design.design_sweep(setup, ["4x4"], **kw)
+    assert default.to_json() == rep.to_json()
+    # on its bound route, and on the image channel, the default is the paths tracker (no
+    # survey asked for; "los" given by name there is refused: tests/test_design_los.py)
+    bound = design.design_sweep(setup, ["4x4"], seed=0, units=0)
+    assert bound.to_json()["inputs"]["traced_tracker"] == "paths"
     assert los.dead_reckoning_rmse_m == pytest.approx(paths.dead_reckoning_rmse_m, rel=1e-12)
     em = los.error_model
     assert em["tracker"] == "los" and paths.error_model["tracker"] == "paths"

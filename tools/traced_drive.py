@@ -5,7 +5,7 @@ about a second of CPU per epoch: every epoch's ML extraction runs every re-initi
 This script drives each case of :data:`CASES` now (never reading a stored drive: the ray tracer's
 traces come from the cache, ``TUNNELKIT_RT_CACHE``, and are traced where missing) and writes its
 record (:func:`tunnelkit.design.traced.drive_record`: the key, the drive's per-epoch measurements
-after the geometry pre-filter, the V2X messages, the generator's state after it) to
+after the geometry pre-filter and before it, the V2X messages, the generator's state after it) to
 ``data/rt/design/<scenario>-<array>[-T<n>]-drive.json``, which ``design_drive`` reads when a
 sweep asks for that drive (:func:`tunnelkit.design.traced.stored_drive`, checked on load). Each
 file written is read back through that check and compared with the drive it was made from.
@@ -60,14 +60,15 @@ def read_back(case, path: Path) -> None:
 
     scenario, array, n_epochs, seed, stream = case
     setup = design.DesignSetup.from_scenario(scenario, channel="sionna")
-    rng = case_rng(seed, stream)
-    drive = traced.stored_drive(setup, array, rng, n_epochs, path=path)
-    if drive is None:
-        raise SystemExit(f"{path}: not read for its own case (its key does not match)")
-    stored = json.loads(path.read_text())["drive"]
-    if drive_to_record(drive, rng.bit_generator.state) != stored:
-        raise SystemExit(f"{path}: read back, it differs from what was written")
-    np.testing.assert_array_equal(drive.truth, setup.trajectory.position[: len(drive.epochs)])
+    stored = json.loads(path.read_text())["drives"]
+    for kind in traced.DRIVE_KINDS:
+        rng = case_rng(seed, stream)
+        drive = traced.stored_drive(setup, array, rng, n_epochs, path=path, kind=kind)
+        if drive is None:
+            raise SystemExit(f"{path}: not read for its own case (its key does not match)")
+        if drive_to_record(drive, rng.bit_generator.state) != stored[kind]:
+            raise SystemExit(f"{path}: read back, its {kind} drive differs from what was written")
+        np.testing.assert_array_equal(drive.truth, setup.trajectory.position[: len(drive.epochs)])
 
 
 def main(argv=None) -> int:
@@ -90,12 +91,12 @@ def main(argv=None) -> int:
                 bad += 1
                 continue
             read_back(case, path)
-            print(f"{path}: {len(rec['drive']['epochs'])} epochs, as driven now")
+            print(f"{path}: {len(rec['drives']['ml-traced']['epochs'])} epochs, as driven now")
             continue
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(rec, indent=1) + "\n")
         read_back(case, path)
-        print(f"wrote {path}: {len(rec['drive']['epochs'])} epochs")
+        print(f"wrote {path}: {len(rec['drives']['ml-traced']['epochs'])} epochs")
     return 1 if bad else 0
 
 

@@ -344,11 +344,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     rt.add_argument(
         "--traced-tracker",
         choices=["paths", "los"],
-        default="paths",
-        help="with --channel sionna: the tracker on the ray-traced channel, every path the "
-        "geometry pre-filter keeps told the array's RMS errors (paths, default) or the line of "
-        "sight alone, told its angle sigmas by its measured elevation from a survey of 3 drives "
-        "per array (los)",
+        default=None,
+        help="with --channel sionna: the tracker on the ray-traced channel, the line of sight "
+        "alone, told its angle sigmas by its measured elevation from a survey of 3 drives per "
+        "array (los, default), or every path the geometry pre-filter keeps told the array's RMS "
+        "errors (paths)",
     )
     mc.add_argument(
         "--n-epochs",
@@ -416,7 +416,7 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    if args.traced_tracker != "paths" and args.channel != "sionna":
+    if args.traced_tracker == "los" and args.channel != "sionna":
         print(
             f"tunnelkit design: error: --traced-tracker {args.traced_tracker} tracks on the "
             f"ray-traced channel: it needs --channel sionna (got --channel {args.channel})",
@@ -451,7 +451,7 @@ def main(args: argparse.Namespace) -> int:
             n_epochs=args.n_epochs,
             **({} if args.start_sigma is None else {"start_sigma": args.start_sigma}),
             **({"dead_reckoning": True} if args.dead_reckoning and args.units else {}),
-            **({} if args.traced_tracker == "paths" else {"traced_tracker": args.traced_tracker}),
+            **({} if args.traced_tracker is None else {"traced_tracker": args.traced_tracker}),
             **parallel_kwargs(args),
             progress=args.units > 0 and args.format == "table" and not args.no_progress,
         )

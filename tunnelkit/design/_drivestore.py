@@ -6,7 +6,7 @@ channel), while the tracker that reads it costs a few milliseconds. Its measurem
 therefore be stored (:func:`tunnelkit.design.traced.drive_record`, written by
 ``tools/traced_drive.py``) and read back (:func:`tunnelkit.design.traced.stored_drive`). This
 module holds the two halves of that: :func:`drive_to_record` encodes what the drive drew and
-measured (per epoch the tracker's input after the geometry pre-filter, the true paths they were
+measured (per epoch the tracker's input, after the geometry pre-filter or not, the true paths they were
 matched to, the V2X messages, the generator's state after the drive), and
 :func:`drive_from_record` decodes it, refusing (``ValueError`` naming the file) anything that is
 not what an encoded drive holds: a missing or extra field, a wrong length or shape, a number of
@@ -24,8 +24,9 @@ import numpy as np
 
 __all__ = ["FORMAT", "drive_from_record", "drive_to_record", "generator_state"]
 
-#: the record's format (part of a stored drive's key: a record of another format is not read)
-FORMAT = 1
+#: the record's format (part of a stored drive's key: a record of another format is not read);
+#: 2: both kinds of the drive (the geometry pre-filter's measurements and every epoch's)
+FORMAT = 2
 #: the tracker's per-path measurements of one epoch: name -> (trailing shape, NaN allowed)
 _PATH_FIELDS = {
     "phi": ((), False),

@@ -232,7 +232,7 @@ def sweep_montecarlo(
     dead_reckoning: bool = False,
     drives_per_unit: int = 1,
     first_unit: int = 0,
-    traced_tracker: str = "paths",
+    traced_tracker: str | None = None,
 ) -> dict[str, MonteCarloResult]:
     """JAVELIN over ``runs`` drives of every array in ``specs``, all arrays x runs as one task
     set (module docstring); returns ``{label: MonteCarloResult}`` in the order of ``specs``.
@@ -269,8 +269,8 @@ def sweep_montecarlo(
     drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
     tracker, start and V2X messages: what the radio adds), its errors the result's
     ``dead_reckoning``. ``traced_tracker`` (:data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`,
-    the ray-traced channel's channel route only): ``"paths"`` (default) every path the geometry
-    test keeps, ``"los"`` the line of sight told its sigmas by its elevation.
+    the ray-traced channel's channel route only): ``"los"`` (its default) the line of sight told
+    its sigmas by its elevation, ``"paths"`` every path the geometry test keeps.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -304,7 +304,9 @@ def sweep_montecarlo(
                 "impairments: expected a design.DesignImpairments or None, got "
                 f"{type(impairments).__name__}"
             )
-    if traced_tracker != "paths":  # the names load when another is asked for
+    if traced_tracker is None:  # the default: the line of sight on the traced channel's route
+        traced_tracker = "los" if (mode, setup.channel) == ("channel", "sionna") else "paths"
+    elif traced_tracker != "paths":  # the names load when another is asked for
         from .tracedtracker import checked_tracker
 
         traced_tracker = checked_tracker(traced_tracker, mode, setup.channel)

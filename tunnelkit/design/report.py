@@ -127,7 +127,7 @@ def design_sweep(
     n_boot: int = 2000,
     start_sigma: float = START_SIGMA_M,
     dead_reckoning: bool = False,
-    traced_tracker: str = "paths",
+    traced_tracker: str | None = None,
 ) -> DesignReport:
     """Every candidate of ``arrays`` evaluated and judged (docs/internals).
 
@@ -146,8 +146,8 @@ def design_sweep(
     resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
     (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
     drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
-    radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"paths"``, default, or
-    ``"los"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
+    radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"los"``, its default,
+    or ``"paths"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
     fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
     reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
@@ -180,7 +180,9 @@ def design_sweep(
     n_boot = integer("n_boot", n_boot, minimum=100)
     start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
-    if traced_tracker != "paths":  # the names load when another is asked for
+    if traced_tracker is None:  # the default: the line of sight on the traced channel's route
+        traced_tracker = "los" if (mode, setup.channel) == ("channel", "sionna") else "paths"
+    elif traced_tracker != "paths":  # the names load when another is asked for
         from .tracedtracker import checked_tracker
 
         traced_tracker = checked_tracker(traced_tracker, mode, setup.channel)
@@ -294,13 +296,11 @@ def design_sweep(
         "timeout_s": timeout,
     }
     if setup.channel != "image":  # (the image channel's JSON as before)
-        settings["channel"] = setup.channel
+        settings.update(channel=setup.channel, traced_tracker=traced_tracker)
     if start_sigma != START_SIGMA_M:  # (the default's JSON as before)
         settings["start_sigma_m"] = start_sigma
     if dead_reckoning:
         settings["dead_reckoning"] = True
-    if traced_tracker != "paths":  # (the default's JSON as before)
-        settings["traced_tracker"] = traced_tracker
     usable = [r for r in rows if r.status != "error"]
     rec = recommend(usable, target, share, units, required_yield)
     return DesignReport(setup.name, rows, rec, settings, warnings)

@@ -66,6 +66,8 @@ __all__ = [
     "drive_key",
     "drive_record",
     "error_model_summary",
+    "keep_drives",
+    "kept_drives",
     "measure_design_errors",
     "stored_drive",
     "stored_drive_path",
@@ -91,6 +93,7 @@ DRIVE_PROCEDURE = "tunnelkit.design.traced.design_drive"
 #: design drives :func:`design_drive` keeps for the process (the oldest dropped first)
 DRIVES_KEPT = 64
 _DRIVES: OrderedDict = OrderedDict()
+_STORED_FIELDS = {"key", "drives", "made_by"}  # a stored drive's record
 
 
 def _setup(setup) -> DesignSetup:
@@ -158,7 +161,7 @@ def design_drive(
     without the extraction's cost. At most :data:`DRIVES_KEPT` drives are kept, the oldest
     dropped first; an equal setup built anew, or one sent to another process, drives again. A
     drive not kept is read from its stored record when the repository ships one of this key
-    (:func:`stored_drive`: the same numbers, checked on load; ``"ml-traced"`` only) and driven
+    (:func:`stored_drive`: the same numbers, both kinds, checked on load) and driven
     otherwise."""
     setup = _setup(setup)
     spec = parse_array(spec)
@@ -174,18 +177,51 @@ def design_drive(
         _DRIVES.move_to_end(key)
         rng.bit_generator.state = copy.deepcopy(kept[2])
         return copy.deepcopy(kept[1][kind])
-    drive = stored_drive(setup, spec, rng, n_epochs) if kind == "ml-traced" else None
-    if drive is None:
+    drives = _stored(setup, spec, rng, n_epochs)
+    if drives is None:
         both = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)
         drives = {k: both[k] for k in DRIVE_KINDS}
-    else:
-        drives = {"ml-traced": drive}
     if kept is not None and kept[0] is setup:  # a kind kept before stays as it was
         drives.update(kept[1])
     _DRIVES[key] = (setup, copy.deepcopy(drives), copy.deepcopy(rng.bit_generator.state))
     while len(_DRIVES) > DRIVES_KEPT:
         _DRIVES.popitem(last=False)
     return drives[kind]
+
+
+def kept_drives(setup: DesignSetup) -> list:
+    """The drives :func:`design_drive` keeps for ``setup`` (oldest first), each ``(key, drives,
+    end)``: the array's label, ``n_epochs`` and the generator's state at the start (JSON), the
+    kept kinds ``{kind: drive}`` and the generator's state after. To store (pickle) and give to
+    :func:`keep_drives` in another process, which then tracks on them without extracting again
+    (``benchmarks/bench_design_los.py --drives-cache``)."""
+    setup = _setup(setup)
+    return [
+        (key[1:], copy.deepcopy(v[1]), copy.deepcopy(v[2]))
+        for key, v in _DRIVES.items()
+        if v[0] is setup
+    ]
+
+
+def keep_drives(setup: DesignSetup, entries) -> None:
+    """Keep ``entries`` (:func:`kept_drives`' list, from any process) as :func:`design_drive`'s
+    drives of ``setup``: a sweep of the same scene, arrays and seed then reads them instead of
+    driving. Which setup they were driven on is not checked: the caller's to match."""
+    setup = _setup(setup)
+    if not isinstance(entries, list | tuple):
+        raise TypeError(f"entries: expected kept_drives' list, got {type(entries).__name__}")
+    if not entries:
+        raise ValueError("entries: no drive to keep (kept_drives of a setup that drove none)")
+    for e in entries:
+        ok = isinstance(e, tuple) and len(e) == 3 and isinstance(e[0], tuple) and len(e[0]) == 3
+        if not ok or not isinstance(e[1], dict) or not set(e[1]) <= set(DRIVE_KINDS) or not e[1]:
+            raise ValueError(
+                "entries: expected (key, {kind: drive}, state) tuples of kept_drives, "
+                f"kinds from {DRIVE_KINDS}"
+            )
+        _DRIVES[(id(setup), *e[0])] = (setup, copy.deepcopy(e[1]), copy.deepcopy(e[2]))
+    while len(_DRIVES) > DRIVES_KEPT:
+        _DRIVES.popitem(last=False)
 
 
 def stored_drive_path(setup: DesignSetup, spec, n_epochs: int | None = None) -> Path:
@@ -220,40 +256,53 @@ def drive_key(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None)
 
 def drive_record(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None) -> dict:
     """:func:`design_drive`'s drive of ``spec`` from ``rng``, driven now (never read from a
-    store), as the record :func:`stored_drive` reads: ``{"key": drive_key(...), "drive": ...}``
-    (:func:`~tunnelkit.design._drivestore.drive_to_record`). ``rng`` ends where the drive leaves it."""
+    store), as the record :func:`stored_drive` reads: ``{"key": drive_key(...), "drives": {kind:
+    ...}}``, each of :data:`DRIVE_KINDS` (:func:`~tunnelkit.design._drivestore.drive_to_record`).
+    ``rng`` ends where the drive leaves it."""
     from ._drivestore import drive_to_record
 
     setup = _setup(setup)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     key = drive_key(setup, spec, rng, n_epochs)
-    drive = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)["ml-traced"]
-    return {"key": key, "drive": drive_to_record(drive, rng.bit_generator.state)}
+    both = traced_drive(traced_route(setup, spec), rng, n_epochs=n_epochs)
+    end = rng.bit_generator.state
+    return {"key": key, "drives": {k: drive_to_record(both[k], end) for k in DRIVE_KINDS}}
 
 
-def stored_drive(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None, *, path=None):
-    """:func:`design_drive`'s drive read from ``path`` (default :func:`stored_drive_path`), or
-    None: no file, or a file of another key (:func:`drive_key`): another generator state (another
+def stored_drive(
+    setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=None, *, path=None,
+    kind: str = "ml-traced",
+):  # fmt: skip
+    """:func:`design_drive`'s ``kind`` drive (:data:`DRIVE_KINDS`) read from ``path`` (default
+    :func:`stored_drive_path`), or None: no file, or a file of another key (:func:`drive_key`): another generator state (another
     seed or run) silently, anything else (another scene, ray tracer, format) with a warning
     naming what differs; the caller then drives. A file of this key is checked field by field
     (:func:`~tunnelkit.design._drivestore.drive_from_record`: fields, shapes, types, finite
     values, the generator's end state) and refused (``ValueError`` naming it) when anything is
     off, never half-used. On success ``rng`` is moved to the state the drive left it in."""
     import os
-    import warnings
-
-    from ._drivestore import drive_from_record
 
     setup = _setup(setup)
     spec = parse_array(spec)
     rng = rng_or_error("rng", rng)
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
+    kind = choice("kind", kind, DRIVE_KINDS)
+    if path is not None and (not isinstance(path, str | os.PathLike) or not str(path)):
+        raise TypeError(f"path: expected a file path, got {path!r}")
+    drives = _stored(setup, spec, rng, n_epochs, path)
+    return None if drives is None else drives[kind]
+
+
+def _stored(setup, spec, rng, n_epochs, path=None) -> dict | None:
+    """:func:`stored_drive` for checked arguments: every kind, ``{kind: drive}``, or None."""
+    import warnings
+
+    from ._drivestore import drive_from_record
+
     if path is None:
         p = stored_drive_path(setup, spec, n_epochs)
-    elif not isinstance(path, str | os.PathLike) or not str(path):
-        raise TypeError(f"path: expected a file path, got {path!r}")
     else:
         p = Path(path)
     if not p.is_file():
@@ -262,8 +311,8 @@ def stored_drive(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=No
         rec = json.loads(p.read_text())
     except (ValueError, UnicodeDecodeError) as exc:
         raise ValueError(f"path: {p} is not a stored drive ({exc})") from None
-    if not isinstance(rec, dict) or not {"key", "drive"} <= set(rec) <= {"key", "drive", "made_by"}:
-        raise ValueError(f"path: {p} is not a stored drive (expected its key and drive)")
+    if not isinstance(rec, dict) or not {"key", "drives"} <= set(rec) <= _STORED_FIELDS:
+        raise ValueError(f"path: {p} is not a stored drive (expected its key and drives)")
     key, now = rec["key"], drive_key(setup, spec, rng, n_epochs)
 
     def same(a, b):
@@ -282,11 +331,18 @@ def stored_drive(setup: DesignSetup, spec, rng: np.random.Generator, n_epochs=No
             stacklevel=2,
         )
         return None
-    drive, end = drive_from_record(
-        rec["drive"], traced_route(setup, spec), f"path: {p}", now["rng_start"]["bit_generator"]
-    )
-    rng.bit_generator.state = end
-    return drive
+    if not isinstance(rec["drives"], dict) or set(rec["drives"]) != set(DRIVE_KINDS):
+        raise ValueError(f"path: {p} drives: expected one drive of each kind {DRIVE_KINDS}")
+    route, out, ends = traced_route(setup, spec), {}, []
+    for k in DRIVE_KINDS:
+        out[k], end = drive_from_record(
+            rec["drives"][k], route, f"path: {p} {k}", now["rng_start"]["bit_generator"]
+        )
+        ends.append(end)
+    if not same(ends[0], ends[1]):
+        raise ValueError(f"path: {p} drives: the kinds end in different generator states")
+    rng.bit_generator.state = ends[0]
+    return out
 
 
 def _error_trial(route, n_epochs, _input, rng):

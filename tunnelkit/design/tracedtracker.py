@@ -14,7 +14,8 @@ __all__ = ["TRACED_TRACKERS", "checked_tracker"]
 #: the geometry test keeps, told this array's long-run RMS errors
 #: (:func:`tunnelkit.design.traced.traced_javelin`); ``"los"`` the path taken for the line of
 #: sight alone, told its sigmas by its measured elevation from this array's survey
-#: (:func:`tunnelkit.design.tracedlos.los_javelin`, :mod:`tunnelkit.design.los`)
+#: (:func:`tunnelkit.design.tracedlos.los_javelin`, :mod:`tunnelkit.design.los`), the default
+#: there (a sweep's ``traced_tracker=None``; ``"paths"`` on every other route)
 TRACED_TRACKERS = ("paths", "los")
 
 
