@@ -13,14 +13,18 @@ from tunnelkit.design.tracedtracker import TRACED_TRACKERS, checked_tracker
 
 
 def test_the_tracker_is_named_once_and_the_line_of_sight_needs_the_traced_channel():
-    assert TRACED_TRACKERS == ("paths", "los")
+    assert TRACED_TRACKERS == ("paths", "los", "auto")
     assert checked_tracker("los", "channel", "sionna") == "los"
+    assert checked_tracker("auto", "channel", "sionna") == "auto"
     for mode in ("bound", "channel"):
         for channel in ("image", "sionna"):
             assert checked_tracker("paths", mode, channel) == "paths"
     for mode, channel in (("bound", "sionna"), ("channel", "image"), ("bound", "image")):
-        with pytest.raises(ValueError, match=rf"^traced_tracker: .*mode '{mode}'.*'{channel}'"):
-            checked_tracker("los", mode, channel)
+        for name in ("los", "auto"):
+            with pytest.raises(
+                ValueError, match=rf"^traced_tracker: '{name}'.*mode '{mode}'.*'{channel}'"
+            ):
+                checked_tracker(name, mode, channel)
     for bad in ("LOS", "", None, 1):
         with pytest.raises(ValueError, match=r"^traced_tracker"):
             checked_tracker(bad, "channel", "sionna")
@@ -42,6 +46,8 @@ def test_the_cli_refuses_the_line_of_sight_without_the_traced_channel(capsys):
     args = ["design", "italiano2026-straight", "--arrays", "4x4", "--traced-tracker", "los"]
     assert main(args) == 2
     assert "--traced-tracker los" in capsys.readouterr().err
+    assert main([*args[:-1], "auto"]) == 2
+    assert "--traced-tracker auto" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main([*args[:-1], "every"])
 

@@ -660,9 +660,17 @@ def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
     paths = design.design_sweep(setup, ["4x4"], traced_tracker="paths", **kw).rows[0]
     rep = design.design_sweep(setup, ["4x4"], traced_tracker="los", **kw)
     los = rep.rows[0]
-    # the default on the traced channel's channel route: the line of sight, the same sweep
+    # the default on the traced channel's channel route ("auto"): per array the tracker whose
+    # told model predicts the smaller RMS over the route, and then that tracker's very row
     default = design.design_sweep(setup, ["4x4"], **kw)
-    assert default.to_json() == rep.to_json()
+    auto = default.rows[0]
+    by = auto.error_model["chosen_by_predicted_rms_m"]
+    assert default.to_json()["inputs"]["traced_tracker"] == "auto"
+    assert auto.error_model["tracker"] == min(by, key=by.get)
+    named = {"los": los, "paths": paths}[auto.error_model["tracker"]]
+    assert (auto.rmse_m, auto.error_p90_m) == (named.rmse_m, named.error_p90_m)
+    assert f"--traced-tracker auto chose {auto.error_model['tracker']}" in default.to_table()
+    assert "chosen_by_predicted_rms_m" not in los.error_model
     # on its bound route, and on the image channel, the default is the paths tracker (no
     # survey asked for; "los" given by name there is refused: tests/test_design_los.py)
     bound = design.design_sweep(setup, ["4x4"], seed=0, units=0)

@@ -3,7 +3,7 @@
 [--wideband-model/--no-wideband-model] [--dmc-share S]
 [--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
 [--settle S] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna [--traced-tracker paths|los]]
+[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna [--traced-tracker auto|los|paths]]
 [--start-sigma S] [--no-dead-reckoning] [--format table|json] [--plot FILE.html]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array
@@ -343,12 +343,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     rt.add_argument(
         "--traced-tracker",
-        choices=["paths", "los"],
+        choices=["paths", "los", "auto"],
         default=None,
         help="with --channel sionna: the tracker on the ray-traced channel, the line of sight "
         "alone, told its angle sigmas by its measured elevation from a survey of 3 drives per "
-        "array (los, default), or every path the geometry pre-filter keeps told the array's RMS "
-        "errors (paths)",
+        "array (los), every path the geometry pre-filter keeps told the array's RMS errors "
+        "(paths), or per array the one whose told model predicts the smaller error (auto, "
+        "default)",
     )
     mc.add_argument(
         "--n-epochs",
@@ -416,7 +417,7 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    if args.traced_tracker == "los" and args.channel != "sionna":
+    if args.traced_tracker in ("los", "auto") and args.channel != "sionna":
         print(
             f"tunnelkit design: error: --traced-tracker {args.traced_tracker} tracks on the "
             f"ray-traced channel: it needs --channel sionna (got --channel {args.channel})",

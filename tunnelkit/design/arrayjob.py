@@ -266,19 +266,25 @@ class ArrayJob:
             # the bounds of the sigmas the tracker is told, not of the image channel's CRLB
             # (a model's posterior CRLB, not a bound of the tracker on the traced channel,
             # whose errors are neither Gaussian nor independent: a prediction)
-            pc, sp0, los = None, self.start_sigma, None
-            if self.traced_tracker == "los":  # the line of sight, surveyed on the same drives
+            pc, sp0, los, told = None, self.start_sigma, None, {}
+            design = traced.traced_javelin(self.setup, spec, rec)  # "paths"
+            if self.traced_tracker != "los":
+                told["paths"] = tracedbounds.traced_bounds(self.setup, spec, design.config,
+                                                           self.T, sigma_p0=sp0)[1]  # fmt: skip
+            if self.traced_tracker != "paths":  # the line of sight, surveyed on the same drives
                 from . import tracedlos
 
-                table = tracedlos.los_table(rec)
-                design = tracedlos.los_javelin(traced.traced_javelin(self.setup, spec, rec))
-                drive = tracedbounds.los_bounds(self.setup, spec, table, self.T, sigma_p0=sp0)[1]
-                los = tracedlos.los_summary(rec, table)
-            else:
-                design = traced.traced_javelin(self.setup, spec, rec)
-                drive = tracedbounds.traced_bounds(self.setup, spec, design.config, self.T,
-                                                   sigma_p0=sp0)[1]  # fmt: skip
+                t = tracedlos.los_table(rec)
+                told["los"] = tracedbounds.los_bounds(self.setup, spec, t, self.T, sigma_p0=sp0)[1]
+                # "auto": the tracker whose told model predicts the smaller RMS over the route
+                rms = {k: float(np.sqrt(np.mean(v**2))) for k, v in told.items()}
+                if min(rms, key=rms.get) == "los":
+                    table, design = t, tracedlos.los_javelin(design)
+                    los = tracedlos.los_summary(rec, t)
+            drive = told["los" if los else "paths"]
             error_model = traced.error_model_summary(rec, design.config, los)
+            if len(told) == 2:  # what "auto" chose by
+                error_model["chosen_by_predicted_rms_m"] = rms
         return Prepared(spec, route, design, peb, pc, drive, budget, error_model, hybrid, table)
 
 

@@ -269,8 +269,9 @@ def sweep_montecarlo(
     drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
     tracker, start and V2X messages: what the radio adds), its errors the result's
     ``dead_reckoning``. ``traced_tracker`` (:data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`,
-    the ray-traced channel's channel route only): ``"los"`` (its default) the line of sight told
-    its sigmas by its elevation, ``"paths"`` every path the geometry test keeps.
+    the ray-traced channel's channel route only): ``"los"`` the line of sight told its sigmas by
+    its elevation, ``"paths"`` every path the geometry test keeps, ``"auto"`` (its default) per
+    array the one whose told model predicts the smaller error.
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")
@@ -304,8 +305,8 @@ def sweep_montecarlo(
                 "impairments: expected a design.DesignImpairments or None, got "
                 f"{type(impairments).__name__}"
             )
-    if traced_tracker is None:  # the default: the line of sight on the traced channel's route
-        traced_tracker = "los" if (mode, setup.channel) == ("channel", "sionna") else "paths"
+    if traced_tracker is None:  # the default: chosen per array on the traced channel's route
+        traced_tracker = "auto" if (mode, setup.channel) == ("channel", "sionna") else "paths"
     elif traced_tracker != "paths":  # the names load when another is asked for
         from .tracedtracker import checked_tracker
 

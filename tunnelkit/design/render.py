@@ -180,6 +180,13 @@ def report_table(report) -> str:
                     f"{tg['phi_deg']:.3g} / {tg['psi_deg']:.3g} deg, {tg['kappa_m']:.3g} m, "
                     f"{tg['delta_d_m']:.3g} m"
                 )
+        by = em.get("chosen_by_predicted_rms_m") if em else None
+        if by:
+            lines.append(
+                f"  {r.array}: --traced-tracker auto chose {em['tracker']}: its told model "
+                f"predicts the smaller RMS error over the route (los {by['los']:.3g} m, paths "
+                f"{by['paths']:.3g} m)"
+            )
         if em and em.get("kind") == "traced-measured" and r.predicted_drive_rms_m is not None:
             ratio = r.rmse_over_predicted_drive
             lines.append(

@@ -146,8 +146,8 @@ def design_sweep(
     resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
     (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
     drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
-    radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"los"``, its default,
-    or ``"paths"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
+    radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"auto"``, its default,
+    ``"los"`` or ``"paths"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
     fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
     reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):
@@ -180,8 +180,8 @@ def design_sweep(
     n_boot = integer("n_boot", n_boot, minimum=100)
     start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
-    if traced_tracker is None:  # the default: the line of sight on the traced channel's route
-        traced_tracker = "los" if (mode, setup.channel) == ("channel", "sionna") else "paths"
+    if traced_tracker is None:  # the default: chosen per array on the traced channel's route
+        traced_tracker = "auto" if (mode, setup.channel) == ("channel", "sionna") else "paths"
     elif traced_tracker != "paths":  # the names load when another is asked for
         from .tracedtracker import checked_tracker
 

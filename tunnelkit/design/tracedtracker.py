@@ -14,15 +14,17 @@ __all__ = ["TRACED_TRACKERS", "checked_tracker"]
 #: the geometry test keeps, told this array's long-run RMS errors
 #: (:func:`tunnelkit.design.traced.traced_javelin`); ``"los"`` the path taken for the line of
 #: sight alone, told its sigmas by its measured elevation from this array's survey
-#: (:func:`tunnelkit.design.tracedlos.los_javelin`, :mod:`tunnelkit.design.los`), the default
-#: there (a sweep's ``traced_tracker=None``; ``"paths"`` on every other route)
-TRACED_TRACKERS = ("paths", "los")
+#: (:func:`tunnelkit.design.tracedlos.los_javelin`, :mod:`tunnelkit.design.los`); ``"auto"``
+#: per array the one whose told model predicts the smaller RMS error over the route (the
+#: posterior CRLB of what it is told: :mod:`tunnelkit.design.tracedbounds`, a prediction), the
+#: default there (a sweep's ``traced_tracker=None``; ``"paths"`` on every other route)
+TRACED_TRACKERS = ("paths", "los", "auto")
 
 
 def checked_tracker(traced_tracker: str, mode: str, channel: str) -> str:
-    """``traced_tracker`` checked: one of :data:`TRACED_TRACKERS`, and ``"los"`` only on the
-    ray-traced channel's channel route (``mode`` "channel", ``channel`` "sionna"): refused
-    naming both otherwise."""
+    """``traced_tracker`` checked: one of :data:`TRACED_TRACKERS`, and ``"los"`` or ``"auto"``
+    only on the ray-traced channel's channel route (``mode`` "channel", ``channel`` "sionna"):
+    refused naming both otherwise."""
     from ..signal_route.route import CHANNELS
     from .trackerfix import MODES
 
