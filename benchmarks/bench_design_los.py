@@ -1,14 +1,19 @@
-"""The design's two trackers on the ray-traced channel, on the same drives: every path or the line of sight.
+"""The design's trackers on the ray-traced channel, on the same drives: every path, the line of sight, the choice.
 
 ``tunnelkit design SCENARIO --mode channel --channel sionna`` with ``--traced-tracker paths``
-(every path the geometry pre-filter keeps, told the array's long-run RMS errors) and
+(every path the geometry pre-filter keeps, told the array's long-run RMS errors),
 ``--traced-tracker los`` (the path taken for the line of sight, told its angle sigmas by its
-measured elevation from a survey of the first 3 drives of seed 0: :mod:`tunnelkit.design.los`),
-run in one process so that the second sweep tracks on the first one's drives (the extraction,
-which costs seconds per epoch, runs once; :func:`tunnelkit.design.traced.design_drive`). Per
-array and tracker: the tracker's error p90 and RMSE over the settled route, dead reckoning's on
-the same drives, entry fixes and V2X messages, the radio's gain (dead reckoning's RMSE over the
-tracker's) and the told model's posterior CRLB (a prediction on this channel, not a bound).
+measured elevation from a survey of the first 3 drives of seed 0: :mod:`tunnelkit.design.los`)
+and ``--traced-tracker auto`` (the default: per array the one whose told model predicts the
+smaller error), run in one process so that the later sweeps track on the first one's drives
+(the extraction, which costs seconds per epoch, runs once;
+:func:`tunnelkit.design.traced.design_drive`, which keeps at most
+:data:`~tunnelkit.design.traced.DRIVES_KEPT` drives). Per array and tracker: the tracker's error
+p90 and RMSE over the settled route, dead reckoning's on the same drives, entry fixes and V2X
+messages, the radio's gain (dead reckoning's RMSE over the tracker's) and the told model's
+posterior CRLB (a prediction on this channel, not a bound). ``--drives-cache FILE`` stores the
+drives (:func:`~tunnelkit.design.traced.kept_drives`) and, when the file exists, tracks on them
+without extracting.
 
     python benchmarks/bench_design_los.py example-rectangular-28ghz --arrays 4x4 8x8 --units 6
     python benchmarks/bench_design_los.py italiano2026-straight --arrays 4x4 8x8 10x10 --units 6
@@ -54,7 +59,7 @@ def main() -> None:
     if cache is not None and cache.exists():
         traced.keep_drives(setup, pickle.loads(cache.read_bytes()))
     rows = []
-    for tracker in TRACED_TRACKERS:  # "paths" first: it drives, "los" tracks on its drives
+    for tracker in TRACED_TRACKERS:  # "paths" first: it drives, the others track on its drives
         t0 = time.perf_counter()
         rep = design.design_sweep(
             setup, a.arrays, units=a.units, max_units=a.units, drives_per_unit=a.drives_per_unit,

@@ -47,6 +47,7 @@ def run_sweep(
     out: Path,
     start_sigma=None,
     dead_reckoning=False,
+    traced_tracker="paths",
 ) -> dict:
     """The CLI's sweep on ``channel``; its JSON (written to ``out``) with the wall time."""
     cmd = [sys.executable, "-m", "tunnelkit", "design", scenario, "--arrays", *arrays,
@@ -58,6 +59,8 @@ def run_sweep(
         cmd += ["--start-sigma", str(start_sigma)]
     if dead_reckoning:
         cmd += ["--dead-reckoning"]
+    if channel == "sionna":  # the tracker this benchmark's tables measured (docs/results/)
+        cmd += ["--traced-tracker", traced_tracker]
     t0 = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if res.returncode not in (0, 1):
@@ -139,6 +142,8 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--start-sigma", type=float, default=None, help="entry fix [m] per axis")
     ap.add_argument("--dead-reckoning", action="store_true", help="also each drive without radio")
+    ap.add_argument("--traced-tracker", default="paths", choices=["paths", "los", "auto"],
+                    help="the ray-traced channel's tracker (default paths, the tables' own)")  # fmt: skip
     ap.add_argument("--out", default=str(ROOT / "build"))
     ap.add_argument("--from-json", nargs="+", default=None, help="tabulate CLI outputs instead")
     args = ap.parse_args()
@@ -169,6 +174,7 @@ def main() -> None:
                 Path(args.out) / f"design-{ch}-{args.seed}.json",
                 args.start_sigma,
                 args.dead_reckoning,
+                args.traced_tracker,
             )
             for ch in args.channels
         }

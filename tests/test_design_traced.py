@@ -292,6 +292,12 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
             RuntimeWarning, match=f"{re.escape(str(p))} holds this drive made with other {field}"
         ):
             assert load({**stored, "key": {**stored["key"], field: value}}) is None
+    # a record of the previous format (one kind, "drive"): passed over with a warning, before
+    # its fields are read
+    old = {"key": {**stored["key"], "format": 1}, "drive": stored["drives"]["ml-traced"],
+           "made_by": stored["made_by"]}  # fmt: skip
+    with pytest.warns(RuntimeWarning, match="made with other format"):
+        assert load(old) is None
     # a car's odometry (the scenario's [odometry]): the stored white messages are not its drive
     car = dataclasses.replace(
         setup, trajectory=dataclasses.replace(setup.trajectory, odometry=AUTOMOTIVE)
@@ -316,11 +322,17 @@ def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign
     g = tool.case_rng(seed, stream)
     d = traced.design_drive(setup, array, g, n_epochs=n_epochs)
     assert driven == [] and len(d.epochs) == n_epochs
-    g = tool.case_rng(seed, stream)  # the other kind: kept from the same read
-    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())
+    assert g.bit_generator.state == stored["drives"]["ml-traced"]["rng_end"]
+    g = tool.case_rng(seed, stream)  # the other kind: kept from the same read (no file read)
+    monkeypatch.setattr(traced, "stored_drive_path", lambda *a: tmp_path / "none.json")
     every = traced.design_drive(setup, array, g, n_epochs=n_epochs, kind="ml-all")
     assert driven == [] and len(every.epochs) == n_epochs
-    assert g.bit_generator.state == stored["drives"]["ml-traced"]["rng_end"]
+    assert g.bit_generator.state == stored["drives"]["ml-all"]["rng_end"]
+    monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())  # read from the file
+    monkeypatch.setattr(traced, "stored_drive_path", lambda *a: p)
+    every = traced.design_drive(setup, array, tool.case_rng(seed, stream), n_epochs=n_epochs,
+                                kind="ml-all")  # fmt: skip
+    assert driven == [] and len(every.epochs) == n_epochs
     p.write_text(json.dumps(other))
     monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())  # none kept in the process
     g = tool.case_rng(seed, stream)
@@ -592,6 +604,9 @@ def test_kept_drives_go_to_another_process_and_are_tracked_there_without_driving
     g = np.random.default_rng(41)
     _same_drive(traced.design_drive(twin, "4x4", g, n_epochs=1), first)
     assert g.bit_generator.state == end
+    other = design.DesignSetup.from_scenario("example-rectangular-28ghz", channel="sionna")
+    with pytest.raises(ValueError, match=r"^entries: a drive of another route"):
+        traced.keep_drives(other, entries)  # another scene's drives
     for bad in ([("4x4", None, "{}")], [(entries[0][0], {"ml": first}, end)], "drives"):
         with pytest.raises((TypeError, ValueError), match=r"^entries"):
             traced.keep_drives(twin, bad)
@@ -671,16 +686,26 @@ def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
     assert (auto.rmse_m, auto.error_p90_m) == (named.rmse_m, named.error_p90_m)
     assert f"--traced-tracker auto chose {auto.error_model['tracker']}" in default.to_table()
     assert "chosen_by_predicted_rms_m" not in los.error_model
+    # the predictions it compares: the two told models' posterior CRLBs over the route (here
+    # too short to settle: every epoch), computed here on their own
+    rec3 = traced.design_errors(setup, "4x4", n_epochs=3)
+    cfg = traced.traced_javelin(setup, "4x4", rec3).config
+    want = {
+        "paths": tracedbounds.traced_bounds(setup, "4x4", cfg, 3)[1],
+        "los": tracedbounds.los_bounds(setup, "4x4", tracedlos.los_table(rec3), 3)[1],
+    }
+    for name, drive in want.items():
+        assert by[name] == pytest.approx(np.sqrt(np.mean(drive**2)), rel=1e-12), name
     # on its bound route, and on the image channel, the default is the paths tracker (no
     # survey asked for; "los" given by name there is refused: tests/test_design_los.py)
     bound = design.design_sweep(setup, ["4x4"], seed=0, units=0)
-    assert bound.to_json()["inputs"]["traced_tracker"] == "paths"
+    assert bound.to_json()["inputs"]["traced_tracker"] is None  # no traced tracker runs
     assert los.dead_reckoning_rmse_m == pytest.approx(paths.dead_reckoning_rmse_m, rel=1e-12)
     em = los.error_model
     assert em["tracker"] == "los" and paths.error_model["tracker"] == "paths"
     assert em["los"]["bins"] == min(tracedlos.LOS_BINS, em["los"]["epochs"] // 2)
     assert rep.to_json()["inputs"]["traced_tracker"] == "los"
-    assert "the line of sight alone (--traced-tracker los)" in rep.to_table()
+    assert "the line of sight alone (tracker los)" in rep.to_table()
     rec = traced.design_errors(setup, "4x4", n_epochs=3)
     table = tracedlos.los_table(rec)
     k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
@@ -709,3 +734,50 @@ def test_the_line_of_sight_sweep_tracks_the_same_drives_told_its_table(setup):
         tracedbounds.los_bounds(setup, "4x4", {"elevation": [0.0]}, 3)
     with pytest.raises(TypeError, match=r"^los"):
         traced.error_model_summary(rec, d.config, {"bins": 4})
+
+
+def test_auto_keeps_the_paths_tracker_where_its_prediction_is_smaller_or_no_survey(
+    setup, monkeypatch
+):
+    """With "auto" and the line of sight's prediction the larger: the paths tracker, its drives
+    ("ml-traced") and its row, to the digit; with a record that holds no survey: the paths
+    tracker again, the reason in the row's error model and the table (an explicit "los" is
+    refused there)."""
+    from tunnelkit.design import montecarlo
+
+    monkeypatch.setattr(montecarlo, "_PREPARED", type(montecarlo._PREPARED)())  # none kept
+    kw = {"seed": 3, "mode": "channel", "n_epochs": 3, **FEW}
+    paths = design.design_sweep(setup, ["4x4"], traced_tracker="paths", **kw).rows[0]
+    real = tracedbounds.los_bounds
+
+    def worse(*a, **k):  # the line of sight's told model predicting ten times the error
+        pc, drive = real(*a, **k)
+        return pc, 10 * drive
+
+    monkeypatch.setattr(tracedbounds, "los_bounds", worse)
+    kinds = []
+    real_drive = traced.design_drive
+
+    def spy(*a, kind="ml-traced", **k):
+        kinds.append(kind)
+        return real_drive(*a, kind=kind, **k)
+
+    monkeypatch.setattr(traced, "design_drive", spy)
+    auto = design.design_sweep(setup, ["4x4"], **kw)
+    row = auto.rows[0]
+    by = row.error_model["chosen_by_predicted_rms_m"]
+    assert row.error_model["tracker"] == "paths" and by["los"] > by["paths"]
+    assert set(kinds) == {"ml-traced"} and "los" not in row.error_model
+    assert (row.rmse_m, row.error_p90_m) == (paths.rmse_m, paths.error_p90_m)
+    assert "--traced-tracker auto chose paths" in auto.to_table()
+    # a record without the survey: auto keeps paths and says why; "los" refuses it
+    monkeypatch.setattr(tracedbounds, "los_bounds", real)
+    monkeypatch.setattr(montecarlo, "_PREPARED", type(montecarlo._PREPARED)())
+    rec = traced.design_errors(setup, "4x4", n_epochs=3)
+    bare = {k: v for k, v in rec.items() if k != "los_rows"}
+    monkeypatch.setattr(traced, "design_errors", lambda *a, **k: bare)
+    row = design.design_sweep(setup, ["4x4"], **kw).rows[0]
+    assert row.error_model["tracker"] == "paths" and "los_rows" in row.error_model["auto_fallback"]
+    assert list(row.error_model["chosen_by_predicted_rms_m"]) == ["paths"]
+    bad = design.design_sweep(setup, ["4x4"], traced_tracker="los", **kw).rows[0]
+    assert bad.status == "error" and "los_rows" in bad.reason

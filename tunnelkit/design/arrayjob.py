@@ -30,6 +30,7 @@ from .errordraws import draw_calibration
 from .errormodel import PathErrorModel
 from .pathbounds import path_bounds
 from .setup import ArraySpec, DesignSetup
+from .verdict import counted_epochs
 
 __all__ = ["START_HEIGHT_SIGMA_M", "design_planes", "javelin_config"]
 
@@ -271,20 +272,35 @@ class ArrayJob:
             if self.traced_tracker != "los":
                 told["paths"] = tracedbounds.traced_bounds(self.setup, spec, design.config,
                                                            self.T, sigma_p0=sp0)[1]  # fmt: skip
+            fallback = None
             if self.traced_tracker != "paths":  # the line of sight, surveyed on the same drives
                 from . import tracedlos
 
-                t = tracedlos.los_table(rec)
-                told["los"] = tracedbounds.los_bounds(self.setup, spec, t, self.T, sigma_p0=sp0)[1]
-                # "auto": the tracker whose told model predicts the smaller RMS over the route
-                rms = {k: float(np.sqrt(np.mean(v**2))) for k, v in told.items()}
+                try:
+                    t = tracedlos.los_table(rec)
+                except ValueError as exc:  # no survey in the record: "auto" keeps "paths"
+                    if self.traced_tracker == "los":
+                        raise
+                    t, fallback = None, str(exc)
+                if t is not None:
+                    told["los"] = tracedbounds.los_bounds(self.setup, spec, t, self.T,
+                                                          sigma_p0=sp0)[1]  # fmt: skip
+                # "auto": the tracker whose told model predicts the smaller RMS over the
+                # settled route (the row's prediction; a route too short to settle: all of it)
+                try:
+                    k = counted_epochs(self.setup.trajectory.t[: self.T])
+                except ValueError:
+                    k = np.arange(self.T)
+                rms = {n: float(np.sqrt(np.mean(v[k] ** 2))) for n, v in told.items()}
                 if min(rms, key=rms.get) == "los":
                     table, design = t, tracedlos.los_javelin(design)
                     los = tracedlos.los_summary(rec, t)
-            drive = told["los" if los else "paths"]
+            drive = told["los" if los is not None else "paths"]
             error_model = traced.error_model_summary(rec, design.config, los)
-            if len(told) == 2:  # what "auto" chose by
+            if self.traced_tracker == "auto":  # what it chose by
                 error_model["chosen_by_predicted_rms_m"] = rms
+                if fallback is not None:
+                    error_model["auto_fallback"] = fallback
         return Prepared(spec, route, design, peb, pc, drive, budget, error_model, hybrid, table)
 
 

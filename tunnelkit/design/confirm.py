@@ -228,5 +228,7 @@ def confirm_on_channel(
         confirm_units=units,
         model_error_share=share,
         model_error_false_alarm=FLOOR_FALSE_ALARM,
+        # the channel route's tracker on the ray-traced channel: its default, chosen per array
+        **({"confirm_traced_tracker": "auto"} if setup.channel == "sionna" else {}),
     )
     return ConfirmedReport(report.scenario, report.rows, rec, settings, warnings, rows, bound_rec)

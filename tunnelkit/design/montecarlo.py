@@ -269,9 +269,8 @@ def sweep_montecarlo(
     drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
     tracker, start and V2X messages: what the radio adds), its errors the result's
     ``dead_reckoning``. ``traced_tracker`` (:data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`,
-    the ray-traced channel's channel route only): ``"los"`` the line of sight told its sigmas by
-    its elevation, ``"paths"`` every path the geometry test keeps, ``"auto"`` (its default) per
-    array the one whose told model predicts the smaller error.
+    the ray-traced channel's channel route only): ``"los"``, ``"paths"`` or ``"auto"`` (there the
+    default: per array the one whose told model predicts the smaller error).
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")

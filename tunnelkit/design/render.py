@@ -161,7 +161,7 @@ def report_table(report) -> str:
             tab = los["table_deg"]
             saz, sel = tab["sigma_azimuth"], tab["sigma_elevation"]
             lines.append(
-                f"  {r.array}: traced route, the line of sight alone (--traced-tracker los), told "
+                f"  {r.array}: traced route, the line of sight alone (tracker los), told "
                 f"its angle sigmas by its measured elevation from a survey of {los['runs']} drives "
                 f"of seed {los['seed']} ({los['epochs']} epochs, {los['bins']} bins): azimuth "
                 f"{min(saz):.2g}-{max(saz):.3g} deg, elevation {min(sel):.2g}-{max(sel):.3g} deg"
@@ -182,11 +182,13 @@ def report_table(report) -> str:
                 )
         by = em.get("chosen_by_predicted_rms_m") if em else None
         if by:
+            told = ", ".join(f"{k} {v:.3g} m" for k, v in by.items())
             lines.append(
                 f"  {r.array}: --traced-tracker auto chose {em['tracker']}: its told model "
-                f"predicts the smaller RMS error over the route (los {by['los']:.3g} m, paths "
-                f"{by['paths']:.3g} m)"
-            )
+                f"predicts the smaller RMS error over the settled route ({told})"
+                + (f"; no line-of-sight survey: {em['auto_fallback']}" if "auto_fallback" in em
+                   else "")
+            )  # fmt: skip
         if em and em.get("kind") == "traced-measured" and r.predicted_drive_rms_m is not None:
             ratio = r.rmse_over_predicted_drive
             lines.append(

@@ -295,8 +295,8 @@ def design_sweep(
         "scheduler": scheduler,
         "timeout_s": timeout,
     }
-    if setup.channel != "image":  # (the image channel's JSON as before)
-        settings.update(channel=setup.channel, traced_tracker=traced_tracker)
+    if setup.channel != "image":  # (the image channel's JSON as before; a bound sweep: no tracker)
+        settings.update(channel=setup.channel, traced_tracker={"channel": traced_tracker}.get(mode))
     if start_sigma != START_SIGMA_M:  # (the default's JSON as before)
         settings["start_sigma_m"] = start_sigma
     if dead_reckoning:

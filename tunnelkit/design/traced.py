@@ -191,34 +191,32 @@ def design_drive(
 
 def kept_drives(setup: DesignSetup) -> list:
     """The drives :func:`design_drive` keeps for ``setup`` (oldest first), each ``(key, drives,
-    end)``: the array's label, ``n_epochs`` and the generator's state at the start (JSON), the
-    kept kinds ``{kind: drive}`` and the generator's state after. To store (pickle) and give to
-    :func:`keep_drives` in another process, which then tracks on them without extracting again
+    end)``: the array, ``n_epochs``, the generator's start state (JSON), ``{kind: drive}`` and
+    its end state. Pickled, :func:`keep_drives` gives them back in another process
     (``benchmarks/bench_design_los.py --drives-cache``)."""
     setup = _setup(setup)
-    return [
-        (key[1:], copy.deepcopy(v[1]), copy.deepcopy(v[2]))
-        for key, v in _DRIVES.items()
-        if v[0] is setup
-    ]
+    return [(k[1:], copy.deepcopy(v[1]), copy.deepcopy(v[2])) for k, v in _DRIVES.items()
+            if v[0] is setup]  # fmt: skip
 
 
 def keep_drives(setup: DesignSetup, entries) -> None:
-    """Keep ``entries`` (:func:`kept_drives`' list, from any process) as :func:`design_drive`'s
-    drives of ``setup``: a sweep of the same scene, arrays and seed then reads them instead of
-    driving. Which setup they were driven on is not checked: the caller's to match."""
+    """Keep ``entries`` (:func:`kept_drives`' list) as :func:`design_drive`'s drives of
+    ``setup``, which a sweep of the same arrays and seed then reads instead of driving; a drive
+    of another route (its truth not this route's first epochs) is refused."""
+    from ..simulation.drives import DriveData
+
     setup = _setup(setup)
-    if not isinstance(entries, list | tuple):
-        raise TypeError(f"entries: expected kept_drives' list, got {type(entries).__name__}")
-    if not entries:
-        raise ValueError("entries: no drive to keep (kept_drives of a setup that drove none)")
+    if not isinstance(entries, list | tuple) or not entries:
+        raise ValueError(f"entries: expected kept_drives' non-empty list, got {entries!r:.40}")
     for e in entries:
         ok = isinstance(e, tuple) and len(e) == 3 and isinstance(e[0], tuple) and len(e[0]) == 3
-        if not ok or not isinstance(e[1], dict) or not set(e[1]) <= set(DRIVE_KINDS) or not e[1]:
-            raise ValueError(
-                "entries: expected (key, {kind: drive}, state) tuples of kept_drives, "
-                f"kinds from {DRIVE_KINDS}"
-            )
+        ok = ok and isinstance(e[1], dict) and bool(e[1]) and set(e[1]) <= set(DRIVE_KINDS)
+        if not ok or not all(isinstance(d, DriveData) for d in e[1].values()):
+            raise ValueError(f"entries: expected kept_drives' tuples, kinds from {DRIVE_KINDS}")
+        for d in e[1].values():
+            truth = setup.trajectory.position[: len(d.truth)]
+            if not np.array_equal(d.truth, truth):
+                raise ValueError(f"entries: a drive of another route than {setup.name!r}'s")
         _DRIVES[(id(setup), *e[0])] = (setup, copy.deepcopy(e[1]), copy.deepcopy(e[2]))
     while len(_DRIVES) > DRIVES_KEPT:
         _DRIVES.popitem(last=False)
@@ -311,7 +309,7 @@ def _stored(setup, spec, rng, n_epochs, path=None) -> dict | None:
         rec = json.loads(p.read_text())
     except (ValueError, UnicodeDecodeError) as exc:
         raise ValueError(f"path: {p} is not a stored drive ({exc})") from None
-    if not isinstance(rec, dict) or not {"key", "drives"} <= set(rec) <= _STORED_FIELDS:
+    if not isinstance(rec, dict) or "key" not in rec:
         raise ValueError(f"path: {p} is not a stored drive (expected its key and drives)")
     key, now = rec["key"], drive_key(setup, spec, rng, n_epochs)
 
@@ -328,9 +326,11 @@ def _stored(setup, spec, rng, n_epochs, path=None) -> dict | None:
             f"{p} holds this drive made with other {', '.join(differ)} than now: driven again "
             "(tools/traced_drive.py rewrites it)",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
-        return None
+        return None  # (a record of another format is passed over before its fields are read)
+    if not {"key", "drives"} <= set(rec) <= _STORED_FIELDS:
+        raise ValueError(f"path: {p} is not a stored drive (expected its key and drives)")
     if not isinstance(rec["drives"], dict) or set(rec["drives"]) != set(DRIVE_KINDS):
         raise ValueError(f"path: {p} drives: expected one drive of each kind {DRIVE_KINDS}")
     route, out, ends = traced_route(setup, spec), {}, []
