@@ -958,9 +958,9 @@ for a in rt_arrays:
 # one pooled sigma (the printed gains). With this tracker the array size does matter again: in
 # full mode the 4 × 4 gains least, since below the site its wide beam cannot part the line of
 # sight from the ceiling's reflection (its steepest bin above holds tens of degrees: the survey
-# tells the tracker to all but ignore those epochs). On more drives, other seeds and a second
-# tunnel the line of sight's gain exceeds the pooled tracker's on every array
-# (`docs/results/traced-robust.md`, "The design's line-of-sight tracker").
+# tells the tracker to all but ignore those epochs). On more drives and seeds, here and in a
+# second tunnel, the line of sight's gain exceeds the pooled tracker's on every array
+# (`docs/results/traced-robust.md`, "The default: the tracker chosen per array").
 #
 # Two cautions. The survey needs the truth on 3 drives per array and tunnel, as the records
 # above do: a deployment would survey its tunnel once. And the told model's posterior CRLB
