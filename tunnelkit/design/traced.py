@@ -273,8 +273,9 @@ def stored_drive(
     kind: str = "ml-traced",
 ):  # fmt: skip
     """:func:`design_drive`'s ``kind`` drive (:data:`DRIVE_KINDS`) read from ``path`` (default
-    :func:`stored_drive_path`), or None: no file, or a file of another key (:func:`drive_key`): another generator state (another
-    seed or run) silently, anything else (another scene, ray tracer, format) with a warning
+    :func:`stored_drive_path`), or None: no file, or a file of another key (:func:`drive_key`):
+    another generator state (another seed or run) silently, anything else (another scene, ray
+    tracer, format) with a warning
     naming what differs; the caller then drives. A file of this key is checked field by field
     (:func:`~tunnelkit.design._drivestore.drive_from_record`: fields, shapes, types, finite
     values, the generator's end state) and refused (``ValueError`` naming it) when anything is
