@@ -138,16 +138,17 @@ def test_a_design_drive_is_kept_and_driven_again_only_when_something_differs(set
     assert g2.random() == g_ref.random()  # the entry fix drawn after it: the same draw
     # another seed, array, number of epochs or setup object (equal or not): driven again
     twin = design.DesignSetup.from_scenario(SCENARIO, channel="sionna")
+    wide = design.ArraySpec(4, 4, spacing_wl=0.7)  # the same label, another array
     for st, spec, rng, n in ((setup, "4x4", 12, 1), (setup, "8x8", 11, 1), (setup, "4x4", 11, 2),
-                             (twin, "4x4", 11, 1)):  # fmt: skip
+                             (twin, "4x4", 11, 1), (setup, wide, 11, 1)):  # fmt: skip
         traced.design_drive(st, spec, np.random.default_rng(rng), n_epochs=n)
-    assert driven == [1, 1, 2, 1]
+    assert driven == [1, 1, 2, 1, 1]
     # the oldest drives are dropped beyond DRIVES_KEPT
     monkeypatch.setattr(traced, "DRIVES_KEPT", 2)
     monkeypatch.setattr(traced, "_DRIVES", type(traced._DRIVES)())
     for seed in (1, 2, 3, 1):
         traced.design_drive(setup, "4x4", np.random.default_rng(seed), n_epochs=1)
-    assert len(traced._DRIVES) == 2 and driven[4:] == [1, 1, 1, 1]
+    assert len(traced._DRIVES) == 2 and driven[5:] == [1, 1, 1, 1]
     with pytest.raises(TypeError, match="rng"):
         traced.design_drive(setup, "4x4", 3)
     with pytest.raises(ValueError, match="setup"):

@@ -196,18 +196,18 @@ def _prepare(pool: TrialPool, job: ArrayJob, specs: list) -> list:
             job.start_sigma, job.traced_tracker)  # fmt: skip
     out, todo = {}, []
     for spec in specs:
-        kept = _PREPARED.get((head, spec.label))
+        kept = _PREPARED.get((head, spec))
         if kept is not None and kept[0] is job.setup and kept[1] is job.error_models:
-            _PREPARED.move_to_end((head, spec.label))
-            out[spec.label] = kept[2]
+            _PREPARED.move_to_end((head, spec))
+            out[spec] = kept[2]
         else:
             todo.append(spec)
     for spec, prep in zip(todo, pool.prepare(job, todo, desc="design arrays"), strict=True):
-        _PREPARED[(head, spec.label)] = (job.setup, job.error_models, prep)
-        out[spec.label] = prep
+        _PREPARED[(head, spec)] = (job.setup, job.error_models, prep)
+        out[spec] = prep
     while len(_PREPARED) > PREPARED_KEPT:
         _PREPARED.popitem(last=False)
-    return [out[spec.label] for spec in specs]
+    return [out[spec] for spec in specs]
 
 
 def sweep_montecarlo(

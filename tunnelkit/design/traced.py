@@ -170,7 +170,7 @@ def design_drive(
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     kind = choice("kind", kind, DRIVE_KINDS)
     start = json.dumps(rng.bit_generator.state, sort_keys=True, default=str)
-    key = (id(setup), spec.label, n_epochs, start)
+    key = (id(setup), spec, n_epochs, start)  # the spec: its label and spacing
     kept = _DRIVES.get(key)
     # the entry holds the setup: its id is not reused
     if kept is not None and kept[0] is setup and kind in kept[1]:
