@@ -444,10 +444,13 @@ def test_a_serial_sweep_prepares_an_array_once_for_the_same_job(setup, monkeypat
     sweep_montecarlo(other, ["4x4"], 2, 7, n_epochs=12)
     assert calls == [("4x4", 12), ("4x4", 12), ("4x4", 11), ("4x4", 12)]
     # an array of the same label and another spacing is another array: prepared anew
-    from tunnelkit.design import ArraySpec
+    from tunnelkit.design import ArraySpec, design_sweep
 
     sweep_montecarlo(setup, [ArraySpec(4, 4, spacing_wl=0.7)], 2, 7, n_epochs=12)
     assert calls[-1] == ("4x4", 12) and len(calls) == 5
+    # one sweep's rows and results go by label: two spacings of one size are refused there
+    with pytest.raises(ValueError, match=r"^arrays: .*one spacing per size"):
+        design_sweep(setup, [ArraySpec(4, 4), ArraySpec(4, 4, spacing_wl=0.7)], units=0)
 
 
 def test_a_units_drives_share_its_calibration_and_later_units_extend_the_sweep(setup):

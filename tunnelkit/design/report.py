@@ -5,7 +5,6 @@ manufactured units that meet the target.
 the Monte-Carlo over manufactured units (:mod:`tunnelkit.design.unitsweep`) and gives the
 verdict; :class:`DesignReport` holds the rows, the recommendation, every input and the warnings
 (JSON or a text table). The explorer's quick look is :mod:`tunnelkit.design.explore`'s.
-
 How it works, step by step: docs/internals/design.md.
 """
 
@@ -155,8 +154,8 @@ def design_sweep(
     if isinstance(arrays, (str, ArraySpec)):
         arrays = [arrays]
     specs = list(dict.fromkeys(parse_array(a) for a in sequence("arrays", arrays, empty=True)))
-    if not specs:
-        raise ValueError("arrays: give at least one candidate array")
+    if not specs or len({s.label for s in specs}) < len(specs):  # rows and results go by label
+        raise ValueError("arrays: give candidate arrays, at most one spacing per size")
     if timeout is not None:
         timeout = positive("timeout", timeout)
     target = positive("target", target)
