@@ -48,6 +48,7 @@ import numpy as np
 import tunnelkit as tk
 from tunnelkit import design, propagation
 from tunnelkit.design import traced, tracedbounds, tracedlos
+from tunnelkit.design.los import LOS_WINDOW_M
 from tunnelkit.design.trackerfix import position_noise_cov, tracker_weights
 from tunnelkit.plots.design import route_figure, size_figure
 from tunnelkit.rt.cache import CACHE_ENV
@@ -1365,6 +1366,7 @@ for r in fine_fix.rows:
 # on every array, and in full mode the 4 x 4 the least; no unit meets 0.2 m
 assert all(tab.elevation.size == 4 == len(tab.sigma_azimuth) for tab in los_tables.values())
 assert np.degrees(los_tables["4x4"].sigma_azimuth[0]) > 10, los_tables["4x4"]  # tens of degrees
+assert LOS_WINDOW_M == 0.3 and tracedlos.LOS_BINS == 4  # the pick's w, the table's B
 # tenths of a degree near the site for the 10 x 10 only
 steep = {a: np.degrees(tab.sigma_azimuth[0]) for a, tab in los_tables.items()}
 assert steep["10x10"] < 0.5 < min(steep["4x4"], steep["8x8"]), steep
