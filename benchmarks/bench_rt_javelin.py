@@ -23,6 +23,7 @@ current designs (e.g. after the traced record changed) into ``OUT``. Runs are in
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import pickle
 import sys
@@ -38,6 +39,7 @@ sys.path.insert(0, str(ROOT))
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.odometry import MODELS
 from tunnelkit.reproduce import javelin_tables as jt
+from tunnelkit.reproduce.javelin_traced import LOS_COLUMN, los_drive, los_survey
 from tunnelkit.simulation.drives import FLAGGED
 from tunnelkit.studies.traced import simulate_traced
 
@@ -49,13 +51,26 @@ EXTRACTIONS = ("paper", "ml")
 NUISANCE = {"diffuse_floor": True}
 
 
-def _score(drives: dict, cond: str, told=None) -> dict:
+@functools.cache
+def _survey(scenario: str):
+    """The line-of-sight column's table and summary for ``scenario`` (once per process)."""
+    return los_survey(scenario)
+
+
+def _score(drives: dict, cond: str, told=None, motion_step: str = "held") -> dict:
     """One drive's routes scored in every column of the traced table (one BLAS thread), every
-    JAVELIN told the odometry model ``told`` (None: the white model)."""
+    JAVELIN told the odometry model ``told`` (None: the white model) and stepping on the messages
+    as ``motion_step`` says (eq. 62's ``"held"`` or ``"midpoint"``); the line-of-sight column's
+    drive made from the ML route's ``"ml-all"`` here (a drive saved before that column has none)."""
     routes = jt._traced_routes(EXTRACTIONS, "sionna")
+    if LOS_COLUMN[1] not in drives:
+        table = _survey(drives["ml"].scenario)[0]
+        drives = {**drives, LOS_COLUMN[1]: los_drive(drives["ml-all"], table)}
     with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return jt.score_drive({e: drives[e] for e in routes}, cond, jt.table_columns(routes), told)
+        return jt.score_drive(
+            {e: drives[e] for e in routes}, cond, jt.table_columns(routes), told, motion_step
+        )
 
 
 def _nuisance(second_order: int = 0) -> dict:
@@ -89,6 +104,7 @@ def drive(
             nuisance=_nuisance(second_order),
             odometry=MODELS[odometry],
         )
+    drives[LOS_COLUMN[1]] = los_drive(drives["ml-all"], _survey(scenario)[0])
     scores = _score(drives, cond)
     faults = {
         e: (len(drives[e].faults), sum(f.endswith(FLAGGED) for f in drives[e].faults),
@@ -126,10 +142,25 @@ def simulate(
                     )
 
 
-def rescore(tables, seeds, conditions, src: Path, out: Path, told=None) -> None:
+def _faults(saved: dict) -> dict:
+    """A saved drive's fault counts per route, the line-of-sight route's (absent from drives saved
+    before that column) counted from the drive it is cut from (``"ml-all"``)."""
+    faults = dict(saved["result"][1][1])
+    if LOS_COLUMN[1] not in faults:
+        d = saved["drives"]["ml-all"]
+        faults[LOS_COLUMN[1]] = (
+            len(d.faults),
+            sum(f.endswith(FLAGGED) for f in d.faults),
+            len(d.t),
+        )
+    return faults
+
+
+def rescore(tables, seeds, conditions, src: Path, out: Path, told=None, motion_step="held") -> None:
     """Every drive saved in ``src`` scored again with the current designs (the traced design
     reads the stored record now), no drive simulated again; written to ``out`` in the same
-    layout, so ``--report --dir OUT`` tables them; ``told`` as in :func:`_score`."""
+    layout, so ``--report --dir OUT`` tables them; ``told`` and ``motion_step`` as in
+    :func:`_score`."""
     for t in tables:
         conds = TABLES[t][2]
         for s in seeds:
@@ -141,8 +172,8 @@ def rescore(tables, seeds, conditions, src: Path, out: Path, told=None) -> None:
                 if cond not in conditions:
                     continue
                 saved = pickle.loads(f.read_bytes())
-                res = (cond, (_score(saved["drives"], cond, told), saved["result"][1][1]))
-                saved = {"result": res, "drives": saved["drives"]}
+                res = (cond, (_score(saved["drives"], cond, told, motion_step), _faults(saved)))
+                saved = {"result": res, "drives": saved["drives"], "motion_step": motion_step}
                 (d_out / f.name).write_bytes(pickle.dumps(saved))
                 print(f"table {t} seed {s} drive {i} ({cond}) rescored", flush=True)
 
@@ -161,13 +192,17 @@ def report(
     conds = tuple(c for c in conds if c in conditions)
     n = len(TABLES[table][2])
     d = out / f"table{table}-seed{seed}"
-    done, r = [], 0
+    done, r, steps = [], 0, set()
     while True:
         idx = [n * r + TABLES[table][2].index(c) for c in conds]
         if not all((d / f"drive{i}.pkl").exists() for i in idx):
             break
-        done += [pickle.loads((d / f"drive{i}.pkl").read_bytes())["result"] for i in idx]
+        saved = [pickle.loads((d / f"drive{i}.pkl").read_bytes()) for i in idx]
+        done += [x["result"] for x in saved]
+        steps |= {x.get("motion_step", "held") for x in saved}  # a rescore's
         r += 1
+    if len(steps) > 1:
+        return f"table {table} seed {seed}: drives of two motion steps {sorted(steps)} in {d}"
     if not done:
         return f"table {table} seed {seed}: no whole run saved yet in {d}"
     rep = jt._report(
@@ -183,6 +218,8 @@ def report(
         seed,
         odometry,
         told,
+        survey=_survey(scenario)[1],
+        motion_step=steps.pop(),
     )
     rep.meta = {"target": f"javelin-table{table}", "runs": r, "seed": seed, **rep.meta}
     return rep.to_json() if fmt == "json" else rep.to_table() + "\n" + json.dumps(rep.meta)
@@ -202,17 +239,21 @@ if __name__ == "__main__":
     ap.add_argument("--format", default="text", choices=("text", "json"))
     ap.add_argument("--odometry", default="white", choices=sorted(MODELS),
                     help="the V2X messages' model (one --dir per model)")  # fmt: skip
+    ap.add_argument("--motion-step", default="held", choices=["held", "midpoint"],
+                    help="with --rescore: how JAVELIN steps on the messages (eq. 62: held)")  # fmt: skip
     ap.add_argument("--told-odometry", action="store_true",
                     help="JAVELIN told the --odometry model (with --rescore, then --report)")  # fmt: skip
     ap.add_argument("--second-order", type=int, default=0,
                     help="second-order nuisance atoms in the route's model (one --dir per value)")  # fmt: skip
     a = ap.parse_args()
+    if a.motion_step != "held" and not a.rescore:
+        ap.error("--motion-step: with --rescore (the drives are simulated and scored held first)")
     if a.told_odometry and a.odometry == "white":
         ap.error("--told-odometry: the tracker is told the white model already")
     told = MODELS[a.odometry] if a.told_odometry else None
     out = Path(a.dir)
     if a.rescore:
-        rescore(a.tables, a.seeds, a.conditions, out, Path(a.rescore), told)
+        rescore(a.tables, a.seeds, a.conditions, out, Path(a.rescore), told, a.motion_step)
     elif a.report:
         for t in a.tables:
             for s in a.seeds:

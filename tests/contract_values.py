@@ -681,6 +681,12 @@ def _traced():
     from tunnelkit.studies.traced_bound import traced_pcrlb
 
     traced_pcrlb("italiano2026-straight")
+    from tunnelkit.reproduce import javelin_traced as jtr
+
+    los_table, summary = jtr.los_survey("italiano2026-straight")
+    jtr.los_drive(every["ml-all"], los_table)
+    jtr.los_note(summary)
+    jtr.traced_note({"diffuse_floor": True}, {"rt_settings": cur.get("rt_settings")})
 
 
 def _odometry():
@@ -704,6 +710,9 @@ def _odometry():
     odo.schedule(t)
     s, h = odo.draw(t, v, th, np.random.default_rng(0))
     dead_reckoning(t, s, h, np.zeros(2))
+    from tunnelkit.tracking.javelin.steps import midpoint_messages
+
+    midpoint_messages(s, h)
     dead_reckoning_bound(t, v, th, odo, 0.5, np.isfinite(s))
     posterior_bound(t, v, th, odo, np.tile(np.eye(2), (46, 1, 1)), 0.5, np.isfinite(s))
     cfg = JavelinConfig().told(odo)

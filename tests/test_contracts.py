@@ -55,7 +55,8 @@ def _doc(target, param, kinds, reason):
 ANY = r"(tunnelkit\.)?.*"
 DOCUMENTED: tuple[Documented, ...] = (
     _doc(
-        r"reckoning\.dead_reckoning|simulation\.drives\.DriveData",
+        r"reckoning\.dead_reckoning|simulation\.drives\.DriveData|tracking\.javelin\.steps\."
+        r"midpoint_messages",
         r"speed_msg|heading_msg|speed|heading",
         "nan",
         "NaN marks a V2X message lost: dead reckoning holds the last one (the docstring's "

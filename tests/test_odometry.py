@@ -249,3 +249,30 @@ def test_the_javelin_tables_take_a_named_odometry_and_say_so(capsys):
         {r[0]: r for r in auto.rows}["dead reckoning-L"],
     )
     assert dr[0][2] != dr[1][2]  # other messages, another dead reckoning
+
+
+def test_the_javelin_tables_step_on_the_midpoint_when_asked_and_say_so(capsys):
+    """``motion_step="midpoint"``: the table's every JAVELIN (and so its dead reckoning) steps on
+    the mean of two messages; on the slalom that takes most of dead reckoning's error away (the
+    held step lags a turning drive); the report says so; a target without V2X messages and an
+    unknown step are refused naming the option."""
+    from tunnelkit.cli import main
+    from tunnelkit.reproduce import run
+    from tunnelkit.reproduce.javelin_tables import javelin_table
+
+    with pytest.raises(ValueError, match=r"^motion_step: target .jiang-crlb."):
+        run("jiang-crlb", runs=10, motion_step="midpoint")
+    with pytest.raises(ValueError, match=r"^motion_step: "):
+        run("javelin-table2", runs=1, motion_step="euler")
+    assert main(["reproduce", "halili", "--runs", "1", "--motion-step", "midpoint"]) == 2
+    assert "--motion-step" in capsys.readouterr().err
+    kw = {"extractions": ("ml",), "n_epochs": 20}
+    held = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 2, 3, False, **kw)
+    mid = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 2, 3, False,
+                        motion_step="midpoint", **kw)  # fmt: skip
+    assert "motion_step" not in held.meta and mid.meta["motion_step"] == "midpoint"
+    assert "midpoint" in mid.title and any("motion_step='midpoint'" in n for n in mid.notes)
+    dr = [
+        {(r[0], r[1]): r for r in t.rows}[("dead reckoning-L", "rmse_2d_m")][2] for t in (held, mid)
+    ]
+    assert dr[1] < 0.5 * dr[0]

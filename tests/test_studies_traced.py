@@ -185,7 +185,7 @@ def test_stored_sigmas_of_another_scene_are_refused_never_reused(tmp_path):
 
 
 def test_the_traced_note_says_when_the_tables_ray_tracer_differs():
-    from tunnelkit.reproduce.javelin_tables import _traced_note
+    from tunnelkit.reproduce.javelin_traced import traced_note as _traced_note
 
     cur = dict(traced_errors(check=False)["rt_settings"])
     assert "ray tracer differs" not in _traced_note({"diffuse_floor": True}, {"rt_settings": cur})
@@ -208,27 +208,42 @@ def test_the_stored_record_states_its_procedure():
 
 
 @pytest.mark.skipif(os.environ.get("TUNNELKIT_SKIP_RT") == "1", reason="TUNNELKIT_SKIP_RT=1")
-def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive():
-    """``javelin_table(channel="sionna")`` (two epochs, one run) adds the traced column; its
-    JAVELIN-L score is the traced design's on simulate_traced's ``ml-traced`` drive of the same
-    child seed; the image channel's table has no such column."""
+def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive(monkeypatch):
+    """``javelin_table(channel="sionna")`` (two epochs, one run) adds the traced columns; the
+    traced column's JAVELIN-L score is the traced design's on simulate_traced's ``ml-traced``
+    drive of the same child seed, the line-of-sight column's the line-of-sight design's on the
+    ``ml-all`` drive cut to the path taken for the line of sight and told the survey's table,
+    started told 0.1 m (not the other columns' 1 m); the image channel's table has neither."""
     from tunnelkit.montecarlo import spawn_rngs
-    from tunnelkit.reproduce.javelin_tables import TRACED_COLUMN, javelin_table
+    from tunnelkit.reproduce import javelin_tables as jt
+    from tunnelkit.reproduce import javelin_traced as jtr
     from tunnelkit.simulation import evaluate
 
+    # the slalom's survey is measured on first use (3 design drives): the straight's shipped one
+    straight = jtr.los_survey("italiano2026-straight")
+    monkeypatch.setattr(jt, "los_survey", lambda scenario, progress=False: straight)
     nuis = {"diffuse_floor": True}
-    rep = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
-                        extractions=("ml",), n_epochs=2, channel="sionna", nuisance=nuis)  # fmt: skip
-    assert TRACED_COLUMN[0] in rep.columns
-    col = rep.columns.index(TRACED_COLUMN[0])
+    rep = jt.javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
+                           extractions=("ml",), n_epochs=2, channel="sionna", nuisance=nuis)  # fmt: skip
+    assert jt.TRACED_COLUMN[0] in rep.columns and jtr.LOS_COLUMN[0] in rep.columns
     row = next(r for r in rep.rows if r[0] == "JAVELIN-L" and r[1] == "rmse_2d_m")
-    d = simulate_traced("italiano2026-slalom", spawn_rngs(0, 1)[0], n_epochs=2, channel="sionna",
-                        nuisance=nuis)["ml-traced"]  # fmt: skip
-    assert row[col] == pytest.approx(evaluate(d, traced_design()).metrics["rmse_2d_m"], rel=1e-12)
+    drives = simulate_traced("italiano2026-slalom", spawn_rngs(0, 1)[0], n_epochs=2,
+                             channel="sionna", nuisance=nuis)  # fmt: skip
+    col = rep.columns.index(jt.TRACED_COLUMN[0])
+    ev = evaluate(drives["ml-traced"], traced_design())
+    assert row[col] == pytest.approx(ev.metrics["rmse_2d_m"], rel=1e-12)
+    col = rep.columns.index(jtr.LOS_COLUMN[0])
+    los = jtr.los_drive(drives["ml-all"], straight[0])
+    assert sum(ep is not None and len(ep) == 1 for ep in los.epochs) >= 1
+    told = evaluate(los, jtr.los_design(), sigma_p0_ue=jtr.LOS_START_M).metrics["rmse_2d_m"]
+    assert row[col] == pytest.approx(told, rel=1e-12)
+    assert told != pytest.approx(evaluate(los, jtr.los_design()).metrics["rmse_2d_m"], rel=1e-9)
     assert any("traced design" in n for n in rep.notes)
-    img = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
-                        extractions=("ml",), n_epochs=2)  # fmt: skip
-    assert TRACED_COLUMN[0] not in img.columns
+    assert any("line of sight told by elevation" in n and "0.1 m" in n for n in rep.notes)
+    assert rep.meta["los_survey"]["path"] == straight[1]["path"]
+    img = jt.javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
+                           extractions=("ml",), n_epochs=2)  # fmt: skip
+    assert jt.TRACED_COLUMN[0] not in img.columns and jtr.LOS_COLUMN[0] not in img.columns
 
 
 def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypatch):
@@ -388,3 +403,36 @@ def test_the_flagged_line_of_sight_is_the_picked_path_unless_the_fit_flags_it():
         flagged_los("an epoch", route)
     with pytest.raises(ValueError, match="window"):
         flagged_los(ep, route, window=-1.0)
+
+
+def test_the_line_of_sight_columns_survey_is_the_designs_record_of_the_scenes_array(tmp_path):
+    """los_survey reads the array design's record of the preset's array (the shipped 10 x 10 of
+    the straight tunnel) and makes the design's table of it; a scene of two array shapes is
+    refused naming the scenario; los_note quotes the table and the start;
+    a summary without its keys and a table of another type are refused by name."""
+    from tunnelkit.design import DesignSetup
+    from tunnelkit.design.traced import design_errors
+    from tunnelkit.design.tracedlos import los_table
+    from tunnelkit.reproduce import javelin_traced as jtr
+    from tunnelkit.scenarios import data_dir
+
+    table, summary = jtr.los_survey("italiano2026-straight")
+    rec = design_errors(DesignSetup.from_scenario("italiano2026-straight", channel="sionna"),
+                        "10x10", measure=False)  # fmt: skip
+    want = los_table(rec)
+    for k in ("elevation", "sigma_azimuth", "sigma_elevation"):
+        np.testing.assert_array_equal(getattr(table, k), getattr(want, k))
+    assert summary["path"].endswith("data/rt/design/italiano2026-straight-10x10.json")
+    note = jtr.los_note(summary)
+    assert "data/rt/design/italiano2026-straight-10x10.json" in note and "0.1 m" in note
+    assert f"{summary['table_deg']['sigma_azimuth'][0]:.2f}" in note
+    src = (data_dir() / "scenarios" / "italiano2026-straight.toml").read_text()
+    two = src.replace("shape = [10, 10]\nazimuth_deg = 0.0", "shape = [8, 8]\nazimuth_deg = 0.0")
+    assert two != src
+    (tmp_path / "two.toml").write_text(two)
+    with pytest.raises(ValueError, match=r"^scenario: .* 2 shapes"):
+        jtr.los_survey(str(tmp_path / "two.toml"))
+    with pytest.raises(ValueError, match=r"^summary: .*missing"):
+        jtr.los_note({"path": "x"})
+    with pytest.raises(TypeError, match=r"^table: "):
+        jtr.los_drive(None, table.as_dict())

@@ -1,6 +1,7 @@
 """``tunnelkit reproduce TARGET [--runs N] [--seed S] [--channel image|sionna]
 [--second-order N] [--diffuse-floor] [--length METRES] [--odometry white|automotive]
-[--told-odometry] [--workers N | --scheduler ADDRESS] [--format table|json]``."""
+[--told-odometry] [--motion-step held|midpoint] [--workers N | --scheduler ADDRESS]
+[--format table|json]``."""
 
 from __future__ import annotations
 
@@ -65,6 +66,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="JAVELIN is told the --odometry model (the scale factor and heading biases as "
         "states of its filter); javelin-table1|2 with --odometry automotive only",
+    )
+    p.add_argument(
+        "--motion-step",
+        choices=["held", "midpoint"],
+        default="held",
+        help="how JAVELIN steps on the messages: the previous epoch's held over the step (eq. 62, "
+        "the paper's; default) or the mean of the two epochs' (midpoint: the chord of a steady "
+        "turn); javelin-table1|2 only",
     )
     add_parallel_arguments(p)
 
@@ -162,10 +171,12 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    if args.odometry != "white" and not targets()[args.target].odometries:
+    asked = [f for f, on in (("--odometry", args.odometry != "white"),
+                             ("--motion-step", args.motion_step != "held")) if on]  # fmt: skip
+    if asked and not targets()[args.target].odometries:
         print(
-            f"tunnelkit reproduce: error: --odometry: {args.target} has no V2X messages to model "
-            "(javelin-table1|2 only)",
+            f"tunnelkit reproduce: error: {asked[0]}: {args.target} has no V2X messages to model "
+            "or track on (javelin-table1|2 only)",
             file=sys.stderr,
         )
         return 2
@@ -180,6 +191,7 @@ def main(args: argparse.Namespace) -> int:
             length=args.length,
             odometry=args.odometry,
             told_odometry=args.told_odometry,
+            motion_step=args.motion_step,
             **parallel_kwargs(args),
         )
     except (TrialLost, RTUnavailableError) as exc:

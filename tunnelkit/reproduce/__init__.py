@@ -42,7 +42,9 @@ class Target:
     bytes_per_run: int = RUN_BYTES  #: memory one run keeps until the report is built
     channels: tuple[str, ...] = ("image",)  #: channel sources it runs on (``fn(channel=...)``)
     lengths: bool = False  #: its drive can be lengthened (``fn(length=...)``)
-    odometries: bool = False  #: its V2X messages take a named model (``fn(odometry=...)``)
+    #: its V2X messages take a named model and its JAVELIN a motion step (``fn(odometry=...,
+    #: motion_step=...)``)
+    odometries: bool = False
 
     def __post_init__(self) -> None:
         record(self, positive=("default_runs", "bytes_per_run"))
@@ -129,6 +131,7 @@ def run(
     length: float | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
+    motion_step: str = "held",
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
@@ -140,7 +143,9 @@ def run(
     (:func:`tunnelkit.simulation.variants.drive_variant`, e.g. 120). ``odometry`` (the targets with
     a drive: javelin-table1|2): the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` ("white", the paper's, by default; "automotive");
-    ``told_odometry``: JAVELIN is told that model (its bias states; a model other than white)."""
+    ``told_odometry``: JAVELIN is told that model (its bias states; a model other than white);
+    ``motion_step`` (the same targets): how JAVELIN steps on the messages, eq. 62's ``"held"``
+    (default) or ``"midpoint"`` (:data:`tunnelkit.tracking.javelin.config.MOTION_STEPS`)."""
     if isinstance(name, str) and name in TARGET_MODULES:
         importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
     reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()
@@ -179,6 +184,13 @@ def run(
         if odometry == "white":
             raise ValueError("told_odometry: needs an odometry model other than the white one")
         on["told_odometry"] = True
+    if choice("motion_step", motion_step, ("held", "midpoint")) != "held":
+        if not tgt.odometries:
+            raise ValueError(
+                f"motion_step: target {name!r} runs no tracker on V2X messages (javelin-table1|2 "
+                "do)"
+            )
+        on["motion_step"] = motion_step
     runs = tgt.default_runs if runs is None else integer("runs", runs, minimum=1)
     seed = integer("seed", seed, minimum=0)
     check_bytes("runs", runs * tgt.bytes_per_run, f"{runs} runs of about {tgt.bytes_per_run} B")

@@ -14,6 +14,7 @@ extraction error), and the paper's published number.
 from __future__ import annotations
 
 import functools
+from dataclasses import replace
 
 import numpy as np
 
@@ -27,14 +28,26 @@ from ..simulation.scoring import evaluate
 from ..simulation.variants import drive_variant
 from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
+from ..tracking.javelin.config import MOTION_STEPS
 from . import Report, register
 from .javelin_notes import (
+    MIDPOINT_NOTE,
     NOTES,
     RT_NOTES,
     gain_note,
     nuisance_note,
     odometry_note,
     seed_note,
+)
+from .javelin_traced import (
+    LOS_COLUMN,
+    LOS_START_M,
+    TRACED_COLUMN,
+    los_design,
+    los_drive,
+    los_note,
+    los_survey,
+    traced_note,
 )
 
 __all__ = [
@@ -66,10 +79,9 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
 )
 #: the column added when the coherent route was measured too
 COHERENT_COLUMN = ("our design, coherent route", "coherent", "ours-coherent")
-#: the column added on the ray-traced channel: the traced design (measurement noise measured on
-#: that channel, :func:`~tunnelkit.studies.traced.traced_design`) fed the ML route's measurements
-#: of every epoch that the geometry pre-filter keeps (:func:`~tunnelkit.studies.traced.simulate_traced`)
-TRACED_COLUMN = ("traced design + geometry test, ML route", "ml-traced", "traced")
+#: the columns added on the ray-traced channel (:mod:`.javelin_traced`): :data:`TRACED_COLUMN`
+#: and :data:`LOS_COLUMN`; the latter's tracker is told a start of :data:`LOS_START_M`
+_START_M = {LOS_COLUMN[2]: LOS_START_M}
 
 
 def _designs(traced: bool = False) -> dict:
@@ -81,6 +93,7 @@ def _designs(traced: bool = False) -> dict:
     }
     if traced:
         out["traced"] = traced_design()
+        out["los"] = los_design()
     return out
 
 
@@ -96,7 +109,7 @@ def table_columns(
     routes = tuple(routes)
     if columns is None:
         columns = COLUMNS + ((COHERENT_COLUMN,) if "coherent" in routes else ())
-        columns += (TRACED_COLUMN,) if TRACED_COLUMN[1] in routes else ()
+        columns += tuple(c for c in (TRACED_COLUMN, LOS_COLUMN) if c[1] in routes)
     columns = tuple(c for c in columns if c[1] in routes)
     if not columns:
         raise ValueError(f"routes: none of the table's routes present, got {list(routes)}")
@@ -104,7 +117,11 @@ def table_columns(
 
 
 def score_drive(
-    drives: dict, cond: str, columns: tuple[tuple[str, str, str], ...], told=None
+    drives: dict,
+    cond: str,
+    columns: tuple[tuple[str, str, str], ...],
+    told=None,
+    motion_step: str = "held",
 ) -> dict[tuple[str, str], dict[str, float]]:
     """One drive of condition ``cond``, measured through each route (``{route: DriveData}``),
     scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
@@ -114,14 +131,21 @@ def score_drive(
     Each (route, method, design) is evaluated once. Draws no random numbers. ``told`` (an
     :class:`~tunnelkit.odometry.Odometry`): every JAVELIN is told that odometry model
     (:meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`: its bias states); ``None`` the
-    designs as they are (the paper's white motion noise)."""
+    designs as they are (the paper's white motion noise). ``motion_step``: how every JAVELIN
+    steps on the messages (:data:`~tunnelkit.tracking.javelin.config.MOTION_STEPS`; ``"held"``
+    the paper's eq. 62)."""
     instance("drives", drives, dict, "drives per route (a dict)")
     text("cond", cond)
     sequence("columns", columns)
-    table_designs = _designs(traced=any(c[2] == "traced" for c in columns))
+    table_designs = _designs(traced=any(c[2] in ("traced", "los") for c in columns))
     if told is not None:
         instance("told", told, Odometry)
         table_designs = {k: d.with_(config=d.config.told(told)) for k, d in table_designs.items()}
+    if choice("motion_step", motion_step, MOTION_STEPS) != "held":
+        table_designs = {
+            k: d.with_(config=replace(d.config, motion_step=motion_step))
+            for k, d in table_designs.items()
+        }
     cache: dict[tuple[str, str, str], dict[str, float]] = {}
     out = {}
     for label, route, design in columns:
@@ -135,7 +159,10 @@ def score_drive(
                 drive = drives[route]
                 if method == DEAD_RECKONING:
                     drive, method = without_radio(drive), "JAVELIN"
-                cache[key] = evaluate(drive, table_designs.get(dname), method=method).metrics
+                cache[key] = evaluate(
+                    drive, table_designs.get(dname), method=method,
+                    sigma_p0_ue=_START_M.get(dname, 1.0),
+                ).metrics  # fmt: skip
             out[(name, label)] = cache[key]
     return out
 
@@ -204,20 +231,25 @@ def _simulate_and_score(
     length=None,
     odometry="white",
     told=False,
+    los_table=None,
+    motion_step="held",
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
     count. ``length``: the drive of :func:`~tunnelkit.simulation.variants.drive_variant` instead of
     the preset's (built on the worker, once per process); ``odometry`` a name of
-    :data:`tunnelkit.odometry.MODELS`; ``told``: JAVELIN is told that model (:func:`score_drive`)."""
+    :data:`tunnelkit.odometry.MODELS`; ``told``: JAVELIN is told that model (:func:`score_drive`);
+    ``los_table``: the line-of-sight column's table (:func:`.javelin_traced.los_survey`);
+    ``motion_step`` as :func:`score_drive` takes it."""
     route = scenario if length is None else drive_variant(scenario, length)
     odo = MODELS[odometry]
-    if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced column: one more adapter
+    if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced columns: more adapters
         drives = simulate_traced(
             route, rng, condition=cond, n_epochs=n_epochs, channel=channel, nuisance=nuisance,
             odometry=odo,
         )  # fmt: skip
-        drives = {e: drives[e] for e in (*extractions, TRACED_COLUMN[1])}
+        drives[LOS_COLUMN[1]] = los_drive(drives["ml-all"], los_table)
+        drives = {e: drives[e] for e in (*extractions, TRACED_COLUMN[1], LOS_COLUMN[1])}
     else:
         drives = simulate_condition(
             route, n_epochs, extractions, cond, rng, channel=channel, nuisance=nuisance,
@@ -227,7 +259,7 @@ def _simulate_and_score(
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
     }
-    return score_drive(drives, cond, columns, odo if told else None), faults
+    return score_drive(drives, cond, columns, odo if told else None, motion_step), faults
 
 
 def javelin_table(
@@ -244,6 +276,7 @@ def javelin_table(
     length: float | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
+    motion_step: str = "held",
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -263,8 +296,14 @@ def javelin_table(
     preset's ends (:func:`~tunnelkit.simulation.variants.drive_variant`; 120 m: UE ranges 5-125 m);
     ``None`` the preset's drive. ``odometry``: the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` (the paper's "white" by default); ``told_odometry``:
-    JAVELIN is told that model (its bias states, :func:`score_drive`; a model other than white)."""
+    JAVELIN is told that model (its bias states, :func:`score_drive`; a model other than white);
+    ``motion_step``: how every JAVELIN steps on the messages (:func:`score_drive`). On the
+    ray-traced channel the line-of-sight column's table is the array design's survey of the
+    scene's array (:func:`.javelin_traced.los_survey`: read, or measured once on 3 traced drives
+    and cached, before any trial); a scene it cannot survey (arrays of two shapes, a stale
+    record) is refused. :func:`table_rows` scores the image channel's columns."""
     sequence("conditions", conditions)
+    choice("motion_step", motion_step, MOTION_STEPS)
     choice("odometry", odometry, tuple(MODELS))
     if boolean("told_odometry", told_odometry) and odometry == "white":
         raise ValueError("told_odometry: the tracker is told the white model already (default)")
@@ -279,6 +318,9 @@ def javelin_table(
         drive_variant(scenario, length)  # checked (and built) before any trial runs
         length = float(length)
     rt_info = _prepare_channel(scenario, conditions, n_epochs, channel, progress)
+    # the line-of-sight column's table: the array design's survey of the scene's array
+    traced = LOS_COLUMN[1] in _traced_routes(tuple(extractions), channel)
+    table, survey = los_survey(scenario, progress) if traced else (None, None)
     extractions, done = per_drive(
         scenario,
         conditions,
@@ -297,6 +339,8 @@ def javelin_table(
             length=length,
             odometry=odometry,
             told=told_odometry,
+            los_table=table,
+            motion_step=motion_step,
         ),
         **parallel,
     )
@@ -313,14 +357,16 @@ def javelin_table(
         seed=seed,
         odometry=odometry,
         told=told_odometry,
+        survey=survey,
+        motion_step=motion_step,
     )
 
 
 def _traced_routes(extractions: tuple[str, ...], channel: str) -> tuple[str, ...]:
-    """``extractions`` plus the traced column's route on the ray-traced channel (when the ML
-    route is measured: the traced column's drives are its measurements)."""
+    """``extractions`` plus the traced columns' routes on the ray-traced channel (when the ML
+    route is measured: the traced columns' drives are its measurements)."""
     if channel == "sionna" and "ml" in extractions and set(extractions) <= {"paper", "ml"}:
-        return (*extractions, TRACED_COLUMN[1])
+        return (*extractions, TRACED_COLUMN[1], LOS_COLUMN[1])
     return tuple(extractions)
 
 
@@ -337,10 +383,13 @@ def _report(
     seed,
     odometry="white",
     told=False,
+    survey=None,
+    motion_step="held",
 ):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
     (scores, faults)), ...]`` in drive order (also from a subset of whole runs); ``seed`` the
-    seed they were drawn from (:func:`seed_note`)."""
+    seed they were drawn from (:func:`seed_note`); ``survey``: what the line-of-sight column
+    was told (:func:`.javelin_traced.los_survey`'s summary); ``motion_step`` how JAVELIN stepped."""
     extractions = _traced_routes(extractions, channel)
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
@@ -365,6 +414,8 @@ def _report(
         on += f", {length:g} m drive (x = {traj[0, 0]:g} m to {traj[-1, 0]:g} m)"
     if odometry != "white":
         on += f", {odometry} odometry" + (" (JAVELIN told it)" if told else "")
+    if motion_step != "held":
+        on += f", JAVELIN stepping on the {motion_step} of two messages"
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}{on}: JAVELIN vs "
         "TeNFiLoc",
@@ -381,6 +432,8 @@ def _report(
             **({"nuisance": dict(nuisance)} if nuisance else {}),
             **({"odometry": odometry} if odometry != "white" else {}),
             **({"told_odometry": True} if told else {}),
+            **({"los_survey": survey} if survey is not None else {}),
+            **({"motion_step": motion_step} if motion_step != "held" else {}),
             "radio_gain": gains,
         },
         notes=[
@@ -388,9 +441,11 @@ def _report(
             seed_note(seed),
             gain_note(gains),
             *(RT_NOTES if channel == "sionna" else []),
-            *([_traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
+            *([traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
+            *([los_note(survey)] if survey is not None else []),
             *([nuisance_note(nuisance)] if nuisance else []),
             *([odometry_note(odometry, told)] if odometry != "white" else []),
+            *([MIDPOINT_NOTE] if motion_step == "midpoint" else []),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
             "(the tracker predicts only); flagged epochs per route: "
@@ -417,56 +472,6 @@ def radio_gains(columns: list[str], rows: list[list]) -> dict[str, dict[str, flo
             for label, v, b in zip(columns[2:-1], values, base, strict=True)
         }
     return out
-
-
-def _traced_note(nuisance: dict | None, rt_info: dict | None = None) -> str:
-    """The traced column's note, its numbers read from the stored record (checked against the
-    current scene, :func:`~tunnelkit.studies.traced.traced_errors`), and whether the table's
-    route (its nuisance, its ray-tracer settings ``rt_info["rt_settings"]``) is the one they
-    were measured on."""
-    from ..simulation.prefilter import FLOORS
-    from ..studies.traced import traced_errors
-
-    rec = traced_errors()
-    a = {r[0]: r for r in rec["rows"]}["all"]
-    corr = rec.get("correlation") or {}
-    r_txt = ", ".join(f"{q} {v['r']:.2f}" for q, v in corr.items() if np.isfinite(v["r"]))
-    same = dict(nuisance or {}) == rec["nuisance"]
-    mine, theirs = (rt_info or {}).get("rt_settings"), rec.get("rt_settings") or {}
-    other = sorted(k for k in mine or {} if mine[k] != theirs.get(k))
-    return (
-        f"Column '{TRACED_COLUMN[0]}': designs.ours_ml with its measurement noise set to the ML "
-        f"route's RMS error on the ray-traced channel ({a[2]:.3g} deg, {a[3]:.3g} deg, "
-        f"{a[4]:.3g} m, {a[5]:.3g} m over {a[1]} matched paths; {rec['scenario']}, condition "
-        f"{rec['condition']}, seed {rec['seed']}, {rec['runs']} runs: "
-        "studies.traced.measure_traced_errors on children 0.."
-        f"{rec['runs'] - 1} of seed {rec['seed']}, stored in data/rt/traced_errors.json; Table 1's "
-        "JAVELIN-L run 0 at that seed is child 0, one of those drives)"
-        + (
-            f", each sigma times sqrt((1 + r) / (1 - r)) for the lag-1 correlation r of one "
-            f"path's errors from epoch to epoch ({r_txt}; simulation.error_correlations)"
-            if r_txt
-            else ""
-        )
-        + ", fed every epoch's ML "
-        "measurements "
-        "(the fit's own test ignored) that the geometry-consistency test keeps "
-        f"(path_consistency.epoch_consistency, floors {np.degrees(FLOORS[0]):.2g} deg and "
-        f"{FLOORS[1]:.2g} m, chosen on the straight drive at seed 0)."
-        + (
-            ""
-            if same
-            else f" The sigmas were measured on the route with {rec['nuisance']}, this table "
-            f"runs {dict(nuisance or {})} (pass --diffuse-floor for the route they belong to)."
-        )
-        + (
-            " This table's ray tracer differs from the one the sigmas were measured with ("
-            + ", ".join(f"{k}: {theirs.get(k)!r} there, {mine[k]!r} here" for k in other)
-            + "): they are applied as they are, not re-measured."
-            if other
-            else ""
-        )
-    )
 
 
 def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:
@@ -516,11 +521,12 @@ def javelin_table1(
     length: float | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
+    motion_step: str = "held",
     **parallel,
 ) -> Report:
     """Table 1 (straight trajectory); ``nuisance``, ``length`` (the drive lengthened, e.g.
     120 m: UE ranges 5-125 m; ``tunnelkit reproduce javelin-table1 --length 120``),
-    ``odometry`` and ``told_odometry`` as in :func:`javelin_table`."""
+    ``odometry``, ``told_odometry`` and ``motion_step`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-straight",
         "italiano2026_table1",
@@ -533,6 +539,7 @@ def javelin_table1(
         length=length,
         odometry=odometry,
         told_odometry=told_odometry,
+        motion_step=motion_step,
         **parallel,
     )
 
@@ -554,10 +561,11 @@ def javelin_table2(
     nuisance: dict | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
+    motion_step: str = "held",
     **parallel,
 ) -> Report:
-    """Table 2 (slalom trajectory); ``nuisance``, ``odometry`` and ``told_odometry`` as in
-    :func:`javelin_table`."""
+    """Table 2 (slalom trajectory); ``nuisance``, ``odometry``, ``told_odometry`` and
+    ``motion_step`` as in :func:`javelin_table`."""
     return javelin_table(
         "italiano2026-slalom",
         "italiano2026_table2",
@@ -569,5 +577,6 @@ def javelin_table2(
         nuisance=nuisance,
         odometry=odometry,
         told_odometry=told_odometry,
+        motion_step=motion_step,
         **parallel,
     )

@@ -16,25 +16,15 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..._physical import start_spread
-from ..._validate import integer, nonnegative, positive, probability, vector
+from ..._validate import choice, integer, nonnegative, positive, probability, vector
 
-__all__ = ["JavelinConfig"]
+__all__ = ["MOTION_STEPS", "JavelinConfig"]
 
-_SIGMAS = (
-    "sigma_phi",
-    "sigma_psi",
-    "sigma_kappa",
-    "sigma_delta_d",
-    "sigma_speed",
-    "sigma_heading",
-    "sigma_p0",
-    "sigma_p0_ue",
-    "sigma_vue_walk",
-    "sigma_height",
-    "doppler_tolerance",
-    "sigma_speed_missing",
-)
+_SIGMAS = ("sigma_phi", "sigma_psi", "sigma_kappa", "sigma_delta_d", "sigma_speed", "sigma_heading",
+           "sigma_p0", "sigma_p0_ue", "sigma_vue_walk", "sigma_height", "doppler_tolerance",
+           "sigma_speed_missing")  # fmt: skip
 
+MOTION_STEPS = ("held", "midpoint")  #: eq. 62's held message, or the midpoint (:mod:`.steps`)
 #: the odometry's repeating errors a tracker can be told (:meth:`JavelinConfig.told`)
 _ODOMETRY = ("sigma_speed_scale", "sigma_heading_bias", "heading_drift", "sigma_yaw_rate_bias")
 
@@ -66,7 +56,8 @@ class JavelinConfig:
       paper's white messages): ``sigma_speed_scale`` the sigma of the speed scale factor,
       ``sigma_heading_bias`` [rad] of the heading bias at the start, ``heading_drift``
       [rad/sqrt(s)] its random walk, ``sigma_yaw_rate_bias`` [rad/s] of the yaw-rate bias; any
-      of them above 0 adds the odometry states to the state (:attr:`n_odo`).
+      of them above 0 adds the odometry states to the state (:attr:`n_odo`);
+    - ours: ``motion_step``, eq. 62's ``"held"`` message or the ``"midpoint"`` of two (:mod:`.steps`).
     """
 
     gate_probability: float = 0.99
@@ -91,6 +82,7 @@ class JavelinConfig:
     sigma_heading_bias: float = 0.0
     heading_drift: float = 0.0
     sigma_yaw_rate_bias: float = 0.0
+    motion_step: str = "held"
 
     def __post_init__(self) -> None:
         probability("gate_probability", self.gate_probability)
@@ -108,6 +100,7 @@ class JavelinConfig:
         integer("update_iterations", self.update_iterations, minimum=0)
         for name in _ODOMETRY:
             nonnegative(name, getattr(self, name))
+        choice("motion_step", self.motion_step, MOTION_STEPS)
         if self.sigma_speed_scale >= 1.0:
             raise ValueError(f"sigma_speed_scale: a fraction below 1, got {self.sigma_speed_scale}")
 

@@ -43,7 +43,8 @@ def run_javelin(
     """Run :class:`Javelin` (built from ``design``, default the paper's) over a measurement stream.
 
     ``speed[k]`` / ``heading[k]`` are the V2X message sent at epoch ``k`` (NaN = missing); as in
-    Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k``.
+    Algorithm 4, line 7, the message of epoch ``k-1`` drives the prediction into epoch ``k`` (with
+    ``motion_step="midpoint"`` the mean of the messages of ``k-1`` and ``k``: :meth:`Javelin.run`).
     Warnings about faults are collected and counted instead of printed.
     """
     return Javelin(initial_position, design).run(

@@ -138,7 +138,8 @@ class Javelin:
         return run.estimates, run
 
     def run(self, epochs, speed, heading, dt: float, *, keep_reports: bool = False) -> JavelinRun:
-        """Step through a measurement stream (:func:`~.runs.run_javelin`)."""
+        """Step through a measurement stream (:func:`~.runs.run_javelin`): into epoch k on the message
+        of k-1 (eq. 62) or the ``"midpoint"`` of k-1 and k (:mod:`.steps`); a :meth:`step` on its own."""
         if isinstance(epochs, str | bytes) or not isinstance(epochs, Sequence | np.ndarray):
             raise TypeError(
                 f"epochs: expected a sequence of PathMeasurements or None, got {type(epochs).__name__}"
@@ -152,6 +153,11 @@ class Javelin:
                 f"{spd.size} and {hdg.size}"
             )
         finite_array("dt", dt, ndim=0)
+        first = (spd[0], hdg[0]) if n else None  # epoch 0 reads its own message
+        if self.config.motion_step == "midpoint":  # the step into k on the mean of k-1 and k
+            from .steps import midpoint_messages  # loaded when asked for
+
+            spd, hdg = midpoint_messages(spd, hdg)
         est = np.empty((n, 3))
         cov = np.empty((n, 3, 3))
         ntr = np.empty(n, dtype=int)
@@ -159,7 +165,8 @@ class Javelin:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", JavelinWarning)
             for k in range(n):
-                r = self.step(epochs[k], spd[max(k - 1, 0)], hdg[max(k - 1, 0)], dt if k else 0.0)
+                v, th = (spd[k - 1], hdg[k - 1]) if k else first
+                r = self.step(epochs[k], v, th, dt if k else 0.0)
                 est[k], cov[k], ntr[k] = r.estimate, r.cov, len(r.ids) + 1
                 faults += len(r.faults)
                 if keep_reports:
