@@ -241,6 +241,10 @@ def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive(monke
     assert any("traced design" in n for n in rep.notes)
     assert any("line of sight told by elevation" in n and "0.1 m" in n for n in rep.notes)
     assert rep.meta["los_survey"]["path"] == straight[1]["path"]
+    # dead reckoning has no update for the told start to weigh: the column's row is the others'
+    dr = next(r for r in rep.rows if r[0] == "dead reckoning-L" and r[1] == "rmse_2d_m")
+    assert dr[rep.columns.index(jtr.LOS_COLUMN[0])] == dr[rep.columns.index(jt.TRACED_COLUMN[0])]
+    assert rep.meta["epochs"][jtr.LOS_COLUMN[1]] == rep.meta["epochs"]["ml"] == 2
     img = jt.javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
                            extractions=("ml",), n_epochs=2)  # fmt: skip
     assert jt.TRACED_COLUMN[0] not in img.columns and jtr.LOS_COLUMN[0] not in img.columns
