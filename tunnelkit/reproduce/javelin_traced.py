@@ -63,10 +63,10 @@ def los_design():
     return los_javelin(traced_design())
 
 
-def _array_label(scenario) -> str:
-    """The scenario's base-station array as the design names it ("10x10"; the schema's arrays
-    are half-wavelength URAs); its arrays must share one shape (the survey is of one array)."""
-    sc = load_scenario(scenario)
+def _array_label(sc) -> str:
+    """The loaded scenario's base-station array as the design names it ("10x10"; the schema's
+    arrays are half-wavelength URAs); its arrays must share one shape (the survey is of one
+    array)."""
     shapes = {tuple(int(v) for v in t["shape"]) for t in sc.section("base_station")["arrays"]}
     if len(shapes) != 1:
         raise ValueError(
@@ -87,8 +87,9 @@ def los_survey(scenario: str, progress: bool = False):
     if "\0" in text("scenario", scenario):
         raise ValueError("scenario: a name or path holds no null character")
     boolean("progress", progress)
-    setup = DesignSetup.from_scenario(scenario, channel="sionna")
-    record = design_errors(setup, _array_label(scenario), progress=progress)
+    sc = load_scenario(scenario)  # read once: its arrays, then the design's setup
+    setup = DesignSetup.from_scenario(sc, channel="sionna")
+    record = design_errors(setup, _array_label(sc), progress=progress)
     table = los_table(record)
     summary = los_summary(record, table)
     where = Path(str(summary["path"]))
