@@ -57,10 +57,11 @@ def _survey(scenario: str):
     return los_survey(scenario)
 
 
-def _score(drives: dict, cond: str, told=None, motion_step: str = "held") -> dict:
+def _score(drives: dict, cond: str, told=None, motion_step: str | None = None) -> dict:
     """One drive's routes scored in every column of the traced table (one BLAS thread), every
     JAVELIN told the odometry model ``told`` (None: the white model) and stepping on the messages
-    as ``motion_step`` says (eq. 62's ``"held"`` or ``"midpoint"``); the line-of-sight column's
+    as ``motion_step`` says (``None`` each design its own; eq. 62's ``"held"`` or ``"midpoint"``
+    for every design); the line-of-sight column's
     drive made from the ML route's ``"ml-all"`` here (a drive saved before that column has none)."""
     routes = jt._traced_routes(EXTRACTIONS, "sionna")
     if LOS_COLUMN[1] not in drives:
@@ -133,7 +134,9 @@ def simulate(
                     t0, c0 = time.perf_counter(), time.process_time()
                     res, drives = drive(t, s, i, n_epochs, odometry, second_order)
                     tmp = f.with_suffix(".tmp")
-                    tmp.write_bytes(pickle.dumps({"result": res, "drives": drives}))
+                    tmp.write_bytes(
+                        pickle.dumps({"result": res, "drives": drives, "motion_step": None})
+                    )
                     tmp.rename(f)
                     print(
                         f"table {t} seed {s} drive {i} ({cond}): {time.perf_counter() - t0:.0f} s "
@@ -156,7 +159,7 @@ def _faults(saved: dict) -> dict:
     return faults
 
 
-def rescore(tables, seeds, conditions, src: Path, out: Path, told=None, motion_step="held") -> None:
+def rescore(tables, seeds, conditions, src: Path, out: Path, told=None, motion_step=None) -> None:
     """Every drive saved in ``src`` scored again with the current designs (the traced design
     reads the stored record now), no drive simulated again; written to ``out`` in the same
     layout, so ``--report --dir OUT`` tables them; ``told`` and ``motion_step`` as in
@@ -199,10 +202,11 @@ def report(
             break
         saved = [pickle.loads((d / f"drive{i}.pkl").read_bytes()) for i in idx]
         done += [x["result"] for x in saved]
-        steps |= {x.get("motion_step", "held") for x in saved}  # a rescore's
+        # None: each design its own step; drives saved without the key were scored all held
+        steps |= {x.get("motion_step", "held") for x in saved}
         r += 1
     if len(steps) > 1:
-        return f"table {table} seed {seed}: drives of two motion steps {sorted(steps)} in {d}"
+        return f"table {table} seed {seed}: drives of two motion steps {sorted(map(str, steps))} in {d}"
     if not done:
         return f"table {table} seed {seed}: no whole run saved yet in {d}"
     rep = jt._report(
@@ -239,15 +243,19 @@ if __name__ == "__main__":
     ap.add_argument("--format", default="text", choices=("text", "json"))
     ap.add_argument("--odometry", default="white", choices=sorted(MODELS),
                     help="the V2X messages' model (one --dir per model)")  # fmt: skip
-    ap.add_argument("--motion-step", default="held", choices=["held", "midpoint"],
-                    help="with --rescore: how JAVELIN steps on the messages (eq. 62: held)")  # fmt: skip
+    ap.add_argument("--motion-step", default=None, choices=["held", "midpoint"],
+                    help="with --rescore: how every JAVELIN steps on the messages (default: "
+                    "each design its own, the paper's eq. 62, ours the midpoint)")  # fmt: skip
     ap.add_argument("--told-odometry", action="store_true",
                     help="JAVELIN told the --odometry model (with --rescore, then --report)")  # fmt: skip
     ap.add_argument("--second-order", type=int, default=0,
                     help="second-order nuisance atoms in the route's model (one --dir per value)")  # fmt: skip
     a = ap.parse_args()
-    if a.motion_step != "held" and not a.rescore:
-        ap.error("--motion-step: with --rescore (the drives are simulated and scored held first)")
+    if a.motion_step is not None and not a.rescore:
+        ap.error(
+            "--motion-step: with --rescore (the drives are simulated and scored with each "
+            "design's own step first)"
+        )
     if a.told_odometry and a.odometry == "white":
         ap.error("--told-odometry: the tracker is told the white model already")
     told = MODELS[a.odometry] if a.told_odometry else None

@@ -157,21 +157,8 @@ def build_cases() -> list[Case]:
         c, "line", lambda: _mod("geometry").line, {"A": 1.0, "B": 1.0, "C": 0.0}, ["A", "C"]
     )
     wall = lambda: _mod("geometry").line(0.0, 1.0, -5.0)  # noqa: E731
-    c.append(
-        Case(
-            "mirror[point=nan]", lambda: _mod("geometry").mirror([1.0, NAN], wall()), ("point", "p")
-        )
-    )
-    c.append(
-        Case("mirror[plane=str]", lambda: _mod("geometry").mirror([1.0, 1.0], "y=5"), ("plane",))
-    )
-    c.append(
-        Case(
-            "mirror[point=complex]",
-            lambda: _mod("geometry").mirror([1.0, 1j], wall()),
-            ("point", "p"),
-        )
-    )
+    c.append(Case("Plane.mirror[p=nan]", lambda: wall().mirror([1.0, NAN]), ("p",)))
+    c.append(Case("Plane.mirror[p=complex]", lambda: wall().mirror([1.0, 1j]), ("p",)))
     c.append(
         Case(
             "virtual_stations[base_station=nan]",

@@ -435,7 +435,7 @@ def _baselines():
     wall.project(p)
     tunnel.require_inside("p", p)
     tunnel.wall_distances(p)
-    geometry.mirror(p, wall)
+    wall.mirror(p)
     reflection.specular_point(bs, p, wall)
     geometry.spherical(np.array([1.0, 2.0, 3.0]))
     metrics.settled(np.arange(0.0, 30.0, 0.5))
@@ -710,7 +710,7 @@ def _odometry():
     odo.schedule(t)
     s, h = odo.draw(t, v, th, np.random.default_rng(0))
     dead_reckoning(t, s, h, np.zeros(2))
-    from tunnelkit.tracking.javelin.steps import midpoint_messages
+    from tunnelkit.tracking.javelin.motion import midpoint_messages
 
     midpoint_messages(s, h)
     dead_reckoning_bound(t, v, th, odo, 0.5, np.isfinite(s))

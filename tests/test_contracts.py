@@ -55,7 +55,7 @@ def _doc(target, param, kinds, reason):
 ANY = r"(tunnelkit\.)?.*"
 DOCUMENTED: tuple[Documented, ...] = (
     _doc(
-        r"reckoning\.dead_reckoning|simulation\.drives\.DriveData|tracking\.javelin\.steps\."
+        r"reckoning\.dead_reckoning|simulation\.drives\.DriveData|tracking\.javelin\.motion\."
         r"midpoint_messages",
         r"speed_msg|heading_msg|speed|heading",
         "nan",

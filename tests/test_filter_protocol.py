@@ -87,13 +87,19 @@ def test_javelin():
     drive = simulation.simulate_drive(
         "italiano2026-straight", np.random.default_rng(0), condition="L", n_epochs=5
     )
+    from tunnelkit.tracking.javelin.motion import midpoint_messages
+
     design = designs.ours_ml()
+    assert design.config.motion_step == "midpoint"  # steps on the mean of two messages
+    mid = midpoint_messages(drive.speed, drive.heading)
     a, b = (Javelin.for_drive(drive, design) for _ in "ab")
     assert isinstance(a, Filter)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for k, paths in enumerate(drive.epochs):
-            speed, heading = drive.speed[max(k - 1, 0)], drive.heading[max(k - 1, 0)]
+            # the step into k on entry k-1 of the midpoint messages; epoch 0 on its own message
+            j, src = (k - 1, mid) if k else (0, (drive.speed, drive.heading))
+            speed, heading = src[0][j], src[1][j]
             dt = drive.dt if k else 0.0
             ra = a.step(paths, speed, heading, dt)
             b.predict(speed, heading, dt)

@@ -61,7 +61,7 @@ def test_the_midpoint_step_follows_a_steady_turn_where_the_held_one_lags():
     shorter arc; a missing message is held; the tracker configured "midpoint" equals the held
     tracker fed the midpoint messages; another name is refused naming motion_step."""
     from tunnelkit.reckoning import dead_reckoning
-    from tunnelkit.tracking.javelin.steps import midpoint_messages
+    from tunnelkit.tracking.javelin.motion import midpoint_messages
 
     R, v, dt, T = 30.0, 15.0, 0.1, 60
     t = dt * np.arange(T)
@@ -97,7 +97,7 @@ def test_the_midpoint_tracker_is_the_held_one_on_the_midpoint_messages():
 
     from tunnelkit.simulation import evaluate, simulate_drive
     from tunnelkit.tracking.javelin import designs
-    from tunnelkit.tracking.javelin.steps import midpoint_messages
+    from tunnelkit.tracking.javelin.motion import midpoint_messages
 
     drive = simulate_drive("italiano2026-slalom", np.random.default_rng(3), n_epochs=8)
     d = designs.paper_vue()

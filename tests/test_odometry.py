@@ -251,10 +251,11 @@ def test_the_javelin_tables_take_a_named_odometry_and_say_so(capsys):
     assert dr[0][2] != dr[1][2]  # other messages, another dead reckoning
 
 
-def test_the_javelin_tables_step_on_the_midpoint_when_asked_and_say_so(capsys):
-    """``motion_step="midpoint"``: the table's every JAVELIN (and so its dead reckoning) steps on
-    the mean of two messages; on the slalom that takes most of dead reckoning's error away (the
-    held step lags a turning drive); the report says so; a target without V2X messages and an
+def test_the_javelin_tables_step_as_each_design_does_unless_told_and_say_so(capsys):
+    """By default each design takes its own step: the paper's design eq. 62's held message, ours
+    the midpoint of two (and each column's dead reckoning the same); ``motion_step`` makes every
+    JAVELIN take one. On the slalom the midpoint takes most of dead reckoning's error away (the
+    held step lags a turning drive); the report says which; a target without V2X messages and an
     unknown step are refused naming the option."""
     from tunnelkit.cli import main
     from tunnelkit.reproduce import run
@@ -266,13 +267,18 @@ def test_the_javelin_tables_step_on_the_midpoint_when_asked_and_say_so(capsys):
         run("javelin-table2", runs=1, motion_step="euler")
     assert main(["reproduce", "halili", "--runs", "1", "--motion-step", "midpoint"]) == 2
     assert "--motion-step" in capsys.readouterr().err
+    args = ("italiano2026-slalom", "italiano2026_table2", ("L",), 2, 3, False)
     kw = {"extractions": ("ml",), "n_epochs": 20}
-    held = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 2, 3, False, **kw)
-    mid = javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 2, 3, False,
-                        motion_step="midpoint", **kw)  # fmt: skip
-    assert "motion_step" not in held.meta and mid.meta["motion_step"] == "midpoint"
-    assert "midpoint" in mid.title and any("motion_step='midpoint'" in n for n in mid.notes)
-    dr = [
-        {(r[0], r[1]): r for r in t.rows}[("dead reckoning-L", "rmse_2d_m")][2] for t in (held, mid)
-    ]
-    assert dr[1] < 0.5 * dr[0]
+    own, held, mid = (javelin_table(*args, motion_step=s, **kw) for s in (None, "held", "midpoint"))
+    assert "motion_step" not in own.meta and mid.meta["motion_step"] == "midpoint"
+    assert held.meta["motion_step"] == "held" and "held" in held.title
+    assert "midpoint" in mid.title and "midpoint" not in own.title
+    assert any("ours" in n and "eq. 62" in n for n in own.notes if n.startswith("Motion step"))
+    assert any("motion_step='midpoint'" in n for n in mid.notes)
+
+    def dr(t, col):  # dead reckoning in column col (0 the paper's design, 2 ours)
+        return {(r[0], r[1]): r for r in t.rows}[("dead reckoning-L", "rmse_2d_m")][2 + col]
+
+    assert own.columns[4] == "our design, ML route" and own.columns[2].startswith("paper design")
+    assert dr(own, 2) == dr(mid, 2) and dr(own, 0) == dr(held, 0)
+    assert dr(mid, 0) < 0.5 * dr(held, 0) and dr(mid, 2) < 0.5 * dr(held, 2)

@@ -19,6 +19,7 @@ __all__ = [
     "finite_array",
     "instance",
     "integer",
+    "messages",
     "nonnegative",
     "positive",
     "probability",
@@ -69,6 +70,17 @@ def _real_array(name: str, value, dtype=float) -> np.ndarray:
         return arr
     what = _BAD_KINDS.get(kind, f"dtype {raw.dtype}")
     raise TypeError(f"{name}: expected real numbers, got {what}")
+
+
+def messages(name: str, x, *, batched: bool = False) -> np.ndarray:
+    """V2X messages ``x`` checked, as floats: one per epoch (T,), or (..., T) of several drives
+    with ``batched``; NaN where a message is missing, none infinite."""
+    if isinstance(x, str | bytes) or np.asarray(x).dtype.kind not in "iuf":
+        raise TypeError(f"{name}: expected real numbers (NaN: a message lost), got {x!r:.40}")
+    x = np.asarray(x, dtype=float)
+    if x.ndim < 1 or (x.ndim > 1 and not batched) or np.isinf(x).any():
+        raise ValueError(f"{name}: expected one finite message (or NaN) per epoch, got {x!r:.40}")
+    return x
 
 
 def finite_array(

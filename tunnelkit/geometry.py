@@ -18,12 +18,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import finite_array, instance, real, text
+from ._validate import finite_array, real, text
 
 __all__ = [
     "Plane",
     "line",
-    "mirror",
     "spherical",
     "spherical_jacobian",
 ]
@@ -112,10 +111,6 @@ class Plane:
         p = self._points("p", p)
         return p - (p @ self.normal + self.offset)[..., None] * self.normal
 
-    def coefficients(self) -> np.ndarray:
-        """``[A, B, C]`` (2-D) or ``[a, b, c, d]`` (3-D) with a unit normal."""
-        return np.append(self.normal, self.offset)
-
 
 def line(A: float, B: float, C: float, name: str = "") -> Plane:
     """The 2-D line ``A x + B y + C = 0``; raises if ``A = B = 0``."""
@@ -123,10 +118,3 @@ def line(A: float, B: float, C: float, name: str = "") -> Plane:
     if coeffs[0] == 0 and coeffs[1] == 0:
         raise ValueError("A, B: degenerate line, A = B = 0 describes no line")
     return Plane(coeffs[:2], coeffs[2], name=name)
-
-
-def mirror(point, plane: Plane) -> np.ndarray:
-    """Mirror ``point`` in ``plane`` (functional form of :meth:`Plane.mirror`)."""
-    instance("plane", plane, Plane)
-    point = plane._points("point", point)
-    return plane.mirror(point)

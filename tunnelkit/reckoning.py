@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ._physical import speeds
-from ._validate import finite_array, nonnegative
+from ._validate import finite_array, messages, nonnegative
 from .odometry import Odometry, epoch_times
 
 __all__ = ["dead_reckoning", "dead_reckoning_bound", "posterior_bound"]
@@ -28,13 +28,7 @@ _N = 7
 def _held(name: str, x) -> np.ndarray:
     """``x`` (..., T) with every NaN replaced by the last message before it (a missing start by
     the first message)."""
-    if isinstance(x, str | bytes) or np.asarray(x).dtype.kind not in "iuf":
-        raise TypeError(f"{name}: expected real numbers (NaN: a message lost), got {x!r:.40}")
-    x = np.asarray(x, dtype=float)
-    if x.ndim < 1:
-        raise ValueError(f"{name}: expected shape (..., T), got a scalar")
-    if np.isinf(x).any():
-        raise ValueError(f"{name}: contains infinite values (NaN marks a missing message)")
+    x = messages(name, x, batched=True)
     ok = np.isfinite(x)
     if not ok.any(axis=-1).all():
         raise ValueError(f"{name}: a drive without any message: nothing to dead-reckon on")

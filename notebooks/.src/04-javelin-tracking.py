@@ -51,7 +51,7 @@ from tunnelkit.signal_route import SignalRoute, measurements_from_estimates
 from tunnelkit.simulation import collect_routes
 from tunnelkit.tracking.javelin import TeNFiLoc, designs, measurement_model
 from tunnelkit.tracking.javelin.measured import design_from_errors
-from tunnelkit.tracking.javelin.steps import midpoint_messages
+from tunnelkit.tracking.javelin.motion import midpoint_messages
 from tunnelkit.widgets import epoch_explorer
 
 tk.setup_notebook()
@@ -356,7 +356,8 @@ for mode, e in vue_err.items():
 # of the two headings taken along the shorter arc, $\theta_{k-1} + \tfrac12\,
 # \mathrm{wrap}(\theta_k - \theta_{k-1})$ (this drive heads along $-x$, its heading crossing
 # $\pm 180°$, where the plain average of the two angles would point the step backwards). Our
-# option `JavelinConfig(motion_step="midpoint")` steps on that mean. It needs the message of epoch
+# designs step on that mean (`JavelinConfig(motion_step="midpoint")`; the paper's design keeps
+# eq. 62). It needs the message of epoch
 # $k$ when predicting into $k$; the filter has it, since the prediction runs when epoch $k$'s
 # measurements arrive (where that message is missing, the step stays held). Dead reckoning
 # (integrating the messages alone, no radio) along the slalom's whole drive on its true,
@@ -386,9 +387,10 @@ for mode in ("mirror", "mirror, midpoint step"):
 # from one side to the other), so the mean heading is right only to second order. Most of what
 # the mirrored VUE prediction left above was this same lag, copied to the VUEs. The tracker's
 # prediction carries it too, and its process noise $\mathbf Q_u$ does not model it, so on a
-# turning drive part of what the radio corrects is eq. 62's own lag. The reproduced tables keep
-# eq. 62 (the paper's method); `tunnelkit reproduce javelin-table2 --motion-step midpoint` steps
-# on the midpoint (`docs/results/baselines.md` measures both).
+# turning drive part of what the radio corrects is eq. 62's own lag. In the reproduced tables the
+# paper's design keeps eq. 62 and ours steps on the midpoint, each column's dead reckoning as its
+# design; `tunnelkit reproduce javelin-table2 --motion-step held` (or `midpoint`) makes every
+# design take one step (`docs/results/baselines.md` measures both).
 #
 # ## 5. Gate and association (eq. 55–59, Algorithm 2)
 #

@@ -122,9 +122,12 @@ for name, row in (("straight", st), ("slalom", sl)):
 # **The baseline: dead reckoning.** A tracker has to beat what it would do without the radio. Each
 # table's `dead reckoning` rows run the column's JAVELIN on the same drives, from the same start,
 # with the same V2X speed and heading messages and every radio measurement dropped (predict only).
-# They are the same in every column: nothing a route or a design does with the radio reaches
-# them. The radio's gain is dead reckoning's 2-D RMSE over the tracker's (above 1 the radio
-# helps), per condition, in our design's column:
+# Nothing a route does with the radio reaches them, so they are the same in every column of the
+# paper's design. Our design's column has its own: ours steps on the midpoint of two messages
+# where the paper's design holds the previous one (eq. 62; notebook 04, section 4), which on the
+# slalom alone takes most of dead reckoning's error away. The radio's gain is dead reckoning's
+# 2-D RMSE over the tracker's, in the same column (above 1 the radio helps), per condition, in
+# our design's column:
 
 # %%
 ours = cols1[5]  # "our design, ML route"
@@ -254,13 +257,15 @@ for cond in ("N", "NoRRMs"):
 # 1.5 m); (3) global nearest neighbour (scipy's `linear_sum_assignment`) instead of the greedy
 # Algorithm 2; (4) VUEs moved with the mirrored UE displacement instead of eq. 63's random walk
 # (notebook 04, section 4); (5) a newborn track is not used to update in its birth epoch (its
-# position came from the very angles it would update with). Settings (1)–(5) were tuned on the
-# paper's extraction of tuning drives. The last rows change the measurement route: the
-# paper's design on the ML route (eq. 51 as printed, then the curvature centred on the VUE, the
-# radius of the exact wavefront that the ML route measures), and our design on it: (1)–(5), the
-# VUE curvature, a measurement noise set from the extraction error measured on tuning drives,
-# and (6) a joint innovation test: a pair that makes the stacked innovation of the epoch
-# inconsistent is left out of the update. (6) is there because when the LoS is blocked, eq. 61
+# position came from the very angles it would update with); (6) each prediction steps on the
+# midpoint of two V2X messages, not on eq. 62's message held over the step (notebook 04,
+# section 4: the held heading lags a turning drive). Settings (1)–(5) were tuned on the
+# paper's extraction of tuning drives; (6) mends a model error and was not tuned. The last rows
+# change the measurement route: the paper's design on the ML route (eq. 51 as printed, then the
+# curvature centred on the VUE, the radius of the exact wavefront that the ML route measures),
+# and our design on it: (1)–(6), the VUE curvature, a measurement noise set from the extraction
+# error measured on tuning drives, and (7) a joint innovation test: a pair that makes the
+# stacked innovation of the epoch inconsistent is left out of the update. (7) is there because when the LoS is blocked, eq. 61
 # accepts any free path whose delay is within $\gamma$ of its curvature, and a road-marking
 # reflection, its VUE as far from the array as the UE but well off its direction, can pass it
 # and drag the UE towards that direction.
@@ -394,10 +399,9 @@ c_refit = refit.config
 refit_sig = [np.degrees(c_refit.sigma_phi), np.degrees(c_refit.sigma_psi), c_refit.sigma_kappa]
 ratio_sig = np.array(assumed) / np.array([*refit_sig, c_refit.sigma_delta_d])
 print("our ML design's sigmas / the refit's:", ratio_sig.round(1))
-# the refit's sigmas many times narrower; both trajectories lose with them, the slalom by far
+# the refit's sigmas many times narrower; both trajectories lose with them
 assert np.all(ratio_sig > 5), ratio_sig
 assert all(v["refit (all drives)"] > v["OURS_ML (3 drives)"] for v in sol2.values()), sol2
-assert sol2["slalom"]["refit (all drives)"] > 2 * sol2["slalom"]["OURS_ML (3 drives)"], sol2
 
 
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution"]
@@ -441,9 +445,8 @@ assert all(births >= n for n, births in appear), appear  # every appearance a bi
 #    design choice has to be checked on the other as well.
 # 2. More data is not automatically a better design. The pooled RMS over all the LoS drives has
 #    sigmas many times smaller than our ML design's (section 5); with them both trajectories
-#    lose, the slalom by far once a run loses the track (the output: compare the two numbers per
-#    trajectory; with one short run in quick mode they are one draw) — although the refit is
-#    scored on the very drives it was fitted on. The extraction error is heavy-tailed — near
+#    lose (the output: compare the two numbers per trajectory; with one short run in quick mode
+#    they are one draw) — although the refit is scored on the very drives it was fitted on. The extraction error is heavy-tailed — near
 #    the bound in most epochs, off by metres in the few where nearly coincident paths are
 #    swapped or merged — and a Gaussian $\mathbf R$ set to its RMS makes the gate reject the next
 #    good measurement after such an epoch. How wide to make
@@ -485,11 +488,11 @@ assert ml_vue < ml_51  # eq. 51 does not describe the exact channel's wavefront
 assert sl[col_om] < 1.0 and sl[col_om] < sl[col_pp], sl
 assert sl[col_pv] < 1.0 and sl[col_pv] < sl[col_pp], sl
 assert abl_rows[-2][1] < abl_rows[0][1]  # the ML route with the paper's design beats the paper's
-# section 2's baseline: dead reckoning is one number per condition, the same in every column, and
-# each gain is its RMSE over the tracker's
+# section 2's baseline: dead reckoning is one number per condition in the paper design's columns
+# (our design, stepping on the midpoint, has its own), and each gain is its RMSE over the tracker's
 for c, rows in ((cols1, rows1), (cols2, rows2)):
     base = {r[0]: r[2:-1] for r in rows if r[0].startswith(DEAD_RECKONING) and r[1] == "rmse_2d_m"}
-    assert base and all(len(set(v)) == 1 and v[0] > 0 for v in base.values()), base
+    assert base and all(len(set(v[:3])) == 1 and min(v) > 0 for v in base.values()), base
     g = radio_gains(c, rows)["JAVELIN-L"][col_om]
     jl = {r[0]: r for r in rows if r[1] == "rmse_2d_m"}
     assert abs(g - jl[f"{DEAD_RECKONING}-L"][5] / jl["JAVELIN-L"][5]) < 1e-12, g
@@ -518,7 +521,7 @@ assert (
     and c_ours.sigma_kappa == 50.0
 )
 assert abl_rows[0][1] > 1.0 and abl_rows[1][1] > 1.0, abl_rows  # L: metres off before (2)
-drops = np.array([np.subtract(abl_rows[i - 1][1:], abl_rows[i][1:]) for i in range(1, 6)])
+drops = np.array([np.subtract(abl_rows[i - 1][1:], abl_rows[i][1:]) for i in range(1, 7)])
 assert np.all(np.argmax(drops, axis=0) == 1), drops  # (2) the largest drop in every condition
 assert any(a < b for a, b in zip(abl_rows[-2][1:], abl_rows[-1][1:])), abl_rows
 # section 5: the calibrated noise carries the table on the paper's route (JAVELIN-L)

@@ -70,10 +70,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--motion-step",
         choices=["held", "midpoint"],
-        default="held",
-        help="how JAVELIN steps on the messages: the previous epoch's held over the step (eq. 62, "
-        "the paper's; default) or the mean of the two epochs' (midpoint: the chord of a steady "
-        "turn); javelin-table1|2 only",
+        default=None,
+        help="how every JAVELIN steps on the messages: the previous epoch's held over the step "
+        "(eq. 62) or the mean of the two epochs' (midpoint: the chord of a steady turn); by "
+        "default each design its own (the paper's eq. 62, ours the midpoint); "
+        "javelin-table1|2 only",
     )
     add_parallel_arguments(p)
 
@@ -172,7 +173,7 @@ def main(args: argparse.Namespace) -> int:
         )
         return 2
     asked = [f for f, on in (("--odometry", args.odometry != "white"),
-                             ("--motion-step", args.motion_step != "held")) if on]  # fmt: skip
+                             ("--motion-step", args.motion_step is not None)) if on]  # fmt: skip
     if asked and not targets()[args.target].odometries:
         print(
             f"tunnelkit reproduce: error: {asked[0]}: {args.target} has no V2X messages to model "

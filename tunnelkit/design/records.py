@@ -107,11 +107,6 @@ class DesignRow:
                allow_nan=("peb_m", "predicted_m", "error_median_epoch_m"),
                may_be_empty=("reason", "gaps"))  # fmt: skip
 
-    @property
-    def aperture_m(self) -> float:
-        """The aperture's diagonal [m] (largest distance between two elements)."""
-        return self.aperture_diagonal_m
-
     def to_json(self) -> dict:
         """The row as JSON (:func:`tunnelkit.design.render.row_json`)."""
         from .render import row_json  # the writing out loaded when asked for

@@ -131,7 +131,7 @@ def run(
     length: float | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
-    motion_step: str = "held",
+    motion_step: str | None = None,
 ) -> Report:
     """Run target ``name`` with ``runs`` Monte-Carlo runs (its default if None) and ``seed``,
     serially or on Dask (``workers`` local processes, or a running ``scheduler``; see
@@ -144,8 +144,10 @@ def run(
     a drive: javelin-table1|2): the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` ("white", the paper's, by default; "automotive");
     ``told_odometry``: JAVELIN is told that model (its bias states; a model other than white);
-    ``motion_step`` (the same targets): how JAVELIN steps on the messages, eq. 62's ``"held"``
-    (default) or ``"midpoint"`` (:data:`tunnelkit.tracking.javelin.config.MOTION_STEPS`)."""
+    ``motion_step`` (the same targets): how JAVELIN steps on the messages, ``None`` (default)
+    as each design does (the paper's eq. 62, ours the midpoint of two messages), or every design
+    the same, eq. 62's ``"held"`` or ``"midpoint"``
+    (:data:`tunnelkit.tracking.javelin.config.MOTION_STEPS`)."""
     if isinstance(name, str) and name in TARGET_MODULES:
         importlib.import_module(f"{__name__}.{TARGET_MODULES[name]}")
     reg = _REGISTRY if isinstance(name, str) and name in _REGISTRY else targets()
@@ -184,7 +186,8 @@ def run(
         if odometry == "white":
             raise ValueError("told_odometry: needs an odometry model other than the white one")
         on["told_odometry"] = True
-    if choice("motion_step", motion_step, ("held", "midpoint")) != "held":
+    if motion_step is not None:
+        choice("motion_step", motion_step, ("held", "midpoint"))
         if not tgt.odometries:
             raise ValueError(
                 f"motion_step: target {name!r} runs no tracker on V2X messages (javelin-table1|2 "

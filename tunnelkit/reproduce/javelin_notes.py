@@ -9,15 +9,16 @@ import numpy as np
 from .._validate import boolean, choice, instance, integer
 from ..odometry import MODELS
 from ..simulation.drives import HELD_OUT_SEED, TUNING_SEEDS
+from ..tracking.javelin.config import MOTION_STEPS
 
 __all__ = [
-    "MIDPOINT_NOTE",
     "NOTES",
     "RT_NOTES",
     "gain_note",
     "nuisance_note",
     "odometry_note",
     "seed_note",
+    "step_note",
 ]
 
 NOTES = [
@@ -32,8 +33,8 @@ NOTES = [
     "'paper design + VUE curvature': the same parameters, the curvature of a reflection modelled "
     "as the distance to its VUE (the exact wavefront's radius, what the ML route measures).",
     "design 'ours' on the ML route (designs.ours_ml): Doppler clutter rejection, global "
-    "nearest neighbour, mirrored VUE motion, no update at birth, curvature centred on the VUE, "
-    "measurement noise = the RMS extraction error of the ML route measured on seed 0 drives.",
+    "nearest neighbour, mirrored VUE motion, no update at birth, the step on the midpoint of two "
+    "V2X messages, curvature centred on the VUE, measurement noise = the RMS extraction error of the ML route measured on seed 0 drives.",
     "Both designs start from the true first position with 1 m uncertainty (the paper's open-sky fix).",
     "NoRRMs: road markings removed with the LoS blocked (our reading of the paper).",
     "TeNFiLoc-L takes the earliest path as LoS when eq. 61 fails, uses its curvature only when "
@@ -44,15 +45,37 @@ NOTES = [
 ]
 
 
-#: the note of a table whose JAVELIN steps on the midpoint of two messages
-MIDPOINT_NOTE = (
-    "Every JAVELIN here (and so dead reckoning) steps from epoch k-1 into k on the mean of the "
-    "V2X messages of k-1 and k (JavelinConfig(motion_step='midpoint'), tracking.javelin.steps), "
-    "not on the message of k-1 held over the step (eq. 62): on a turning drive the held heading "
-    "lags the chord by half a step, which on the slalom drive alone is 0.33 m RMS of dead "
-    "reckoning's error with noise-free messages (0.027 m stepping on the midpoint). Where either "
-    "message is missing the step is held (every step, with messages slower than the epochs)."
-)
+def step_note(motion_step: str | None = None) -> str:
+    """How a table's JAVELIN stepped on the V2X messages: ``None`` each design its own (the
+    paper's eq. 62, ours the midpoint), or every design made to take ``motion_step`` (a name of
+    :data:`~tunnelkit.tracking.javelin.config.MOTION_STEPS`)."""
+    if motion_step is not None:
+        choice("motion_step", motion_step, MOTION_STEPS)
+    lag = (
+        "on a turning drive the held heading lags the chord by half a step, which on the slalom "
+        "drive alone is 0.33 m RMS of dead reckoning's error with noise-free messages (0.027 m "
+        "stepping on the midpoint). Where either message is missing the midpoint step is held "
+        "(every step, with messages slower than the epochs)."
+    )
+    if motion_step is None:
+        return (
+            "Motion step: the paper's design steps from epoch k-1 into k on the V2X message of "
+            "k-1 held over the step (eq. 62); ours (and the dead reckoning of its columns) on the "
+            "mean of the messages of k-1 and k (JavelinConfig(motion_step='midpoint'), "
+            "tracking.javelin.motion.midpoint_messages): " + lag
+        )
+    if motion_step == "midpoint":
+        return (
+            "Motion step: every JAVELIN here, the paper's design too (and so dead reckoning), "
+            "steps from epoch k-1 into k on the mean of the V2X messages of k-1 and k "
+            "(motion_step='midpoint'), not on the message of k-1 held over the step (eq. 62): "
+            + lag
+        )
+    return (
+        "Motion step: every JAVELIN here, ours too (and so dead reckoning), steps from epoch k-1 "
+        "into k on the V2X message of k-1 held over the step (eq. 62, motion_step='held'), as "
+        "the paper's design does; ours steps on the midpoint of two by default: " + lag
+    )
 
 
 def seed_note(seed: int) -> str:

@@ -31,13 +31,13 @@ from ..tracking.javelin import designs
 from ..tracking.javelin.config import MOTION_STEPS
 from . import Report, register
 from .javelin_notes import (
-    MIDPOINT_NOTE,
     NOTES,
     RT_NOTES,
     gain_note,
     nuisance_note,
     odometry_note,
     seed_note,
+    step_note,
 )
 from .javelin_traced import (
     LOS_COLUMN,
@@ -116,12 +116,17 @@ def table_columns(
     return columns
 
 
+def _step(motion_step: str | None) -> str | None:
+    """``motion_step`` checked: ``None`` (each design its own) or a name of ``MOTION_STEPS``."""
+    return None if motion_step is None else choice("motion_step", motion_step, MOTION_STEPS)
+
+
 def score_drive(
     drives: dict,
     cond: str,
     columns: tuple[tuple[str, str, str], ...],
     told=None,
-    motion_step: str = "held",
+    motion_step: str | None = None,
 ) -> dict[tuple[str, str], dict[str, float]]:
     """One drive of condition ``cond``, measured through each route (``{route: DriveData}``),
     scored in every column: ``{(configuration, column label): metrics}``. JAVELIN runs with the
@@ -131,9 +136,10 @@ def score_drive(
     Each (route, method, design) is evaluated once. Draws no random numbers. ``told`` (an
     :class:`~tunnelkit.odometry.Odometry`): every JAVELIN is told that odometry model
     (:meth:`~tunnelkit.tracking.javelin.JavelinConfig.told`: its bias states); ``None`` the
-    designs as they are (the paper's white motion noise). ``motion_step``: how every JAVELIN
-    steps on the messages (:data:`~tunnelkit.tracking.javelin.config.MOTION_STEPS`; ``"held"``
-    the paper's eq. 62)."""
+    designs as they are (the paper's white motion noise). ``motion_step``: how the designs step
+    on the messages, ``None`` each its own (the paper's design holds the message of the
+    previous epoch, eq. 62; ours step on the midpoint of two), or every JAVELIN the same, a
+    name of :data:`~tunnelkit.tracking.javelin.config.MOTION_STEPS`."""
     instance("drives", drives, dict, "drives per route (a dict)")
     text("cond", cond)
     sequence("columns", columns)
@@ -141,7 +147,7 @@ def score_drive(
     if told is not None:
         instance("told", told, Odometry)
         table_designs = {k: d.with_(config=d.config.told(told)) for k, d in table_designs.items()}
-    if choice("motion_step", motion_step, MOTION_STEPS) != "held":
+    if _step(motion_step) is not None:
         table_designs = {
             k: d.with_(config=replace(d.config, motion_step=motion_step))
             for k, d in table_designs.items()
@@ -232,7 +238,7 @@ def _simulate_and_score(
     odometry="white",
     told=False,
     los_table=None,
-    motion_step="held",
+    motion_step=None,
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
@@ -276,7 +282,7 @@ def javelin_table(
     length: float | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
-    motion_step: str = "held",
+    motion_step: str | None = None,
     **parallel,
 ) -> Report:
     """One table: per configuration and metric, one value per (route, design) column and the
@@ -297,13 +303,14 @@ def javelin_table(
     ``None`` the preset's drive. ``odometry``: the V2X messages' model, a name of
     :data:`tunnelkit.odometry.MODELS` (the paper's "white" by default); ``told_odometry``:
     JAVELIN is told that model (its bias states, :func:`score_drive`; a model other than white);
-    ``motion_step``: how every JAVELIN steps on the messages (:func:`score_drive`). On the
+    ``motion_step``: how JAVELIN steps on the messages, ``None`` as each design does, or the
+    same for every design (:func:`score_drive`). On the
     ray-traced channel the line-of-sight column's table is the array design's survey of the
     scene's array (:func:`.javelin_traced.los_survey`: read, or measured once on 3 traced drives
     and cached, before any trial); a scene it cannot survey (arrays of two shapes, a stale
     record) is refused. :func:`table_rows` scores the image channel's columns."""
     sequence("conditions", conditions)
-    choice("motion_step", motion_step, MOTION_STEPS)
+    _step(motion_step)
     choice("odometry", odometry, tuple(MODELS))
     if boolean("told_odometry", told_odometry) and odometry == "white":
         raise ValueError("told_odometry: the tracker is told the white model already (default)")
@@ -384,12 +391,13 @@ def _report(
     odometry="white",
     told=False,
     survey=None,
-    motion_step="held",
+    motion_step=None,
 ):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
     (scores, faults)), ...]`` in drive order (also from a subset of whole runs); ``seed`` the
     seed they were drawn from (:func:`seed_note`); ``survey``: what the line-of-sight column
-    was told (:func:`.javelin_traced.los_survey`'s summary); ``motion_step`` how JAVELIN stepped."""
+    was told (:func:`.javelin_traced.los_survey`'s summary); ``motion_step`` the step every
+    JAVELIN was made to take (``None``: each design's own)."""
     extractions = _traced_routes(extractions, channel)
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
@@ -414,8 +422,10 @@ def _report(
         on += f", {length:g} m drive (x = {traj[0, 0]:g} m to {traj[-1, 0]:g} m)"
     if odometry != "white":
         on += f", {odometry} odometry" + (" (JAVELIN told it)" if told else "")
-    if motion_step != "held":
-        on += f", JAVELIN stepping on the {motion_step} of two messages"
+    if motion_step is not None:
+        on += ", every JAVELIN stepping on " + (
+            "the midpoint of two messages" if motion_step == "midpoint" else "eq. 62's held message"
+        )
     return Report(
         title=f"Italiano 2026 {reference.split('_')[-1].title()} - {scenario}{on}: JAVELIN vs "
         "TeNFiLoc",
@@ -433,7 +443,7 @@ def _report(
             **({"odometry": odometry} if odometry != "white" else {}),
             **({"told_odometry": True} if told else {}),
             **({"los_survey": survey} if survey is not None else {}),
-            **({"motion_step": motion_step} if motion_step != "held" else {}),
+            **({"motion_step": motion_step} if motion_step is not None else {}),
             "radio_gain": gains,
         },
         notes=[
@@ -445,7 +455,7 @@ def _report(
             *([los_note(survey)] if survey is not None else []),
             *([nuisance_note(nuisance)] if nuisance else []),
             *([odometry_note(odometry, told)] if odometry != "white" else []),
-            *([MIDPOINT_NOTE] if motion_step == "midpoint" else []),
+            step_note(motion_step),
             "Epochs flagged by the ML route's own fit test (fit_ok = False: a path missed, merged "
             "or in a wrong basin, or the snapshot in the threshold region) carry no measurement "
             "(the tracker predicts only); flagged epochs per route: "
@@ -521,7 +531,7 @@ def javelin_table1(
     length: float | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
-    motion_step: str = "held",
+    motion_step: str | None = None,
     **parallel,
 ) -> Report:
     """Table 1 (straight trajectory); ``nuisance``, ``length`` (the drive lengthened, e.g.
@@ -561,7 +571,7 @@ def javelin_table2(
     nuisance: dict | None = None,
     odometry: str = "white",
     told_odometry: bool = False,
-    motion_step: str = "held",
+    motion_step: str | None = None,
     **parallel,
 ) -> Report:
     """Table 2 (slalom trajectory); ``nuisance``, ``odometry``, ``told_odometry`` and

@@ -44,7 +44,9 @@ def ablation_path() -> dict[str, JavelinDesign]:
     d = d.with_(vue_motion=target.vue_motion)
     out["+ mirrored VUE motion"] = d
     d = d.with_(initiator=target.initiator)
-    out["+ no update at birth (= ours)"] = d
+    out["+ no update at birth"] = d
+    d = d.with_(motion_step=cfg.motion_step)
+    out["+ step on the midpoint of two messages (= ours)"] = d
     return out
 
 

@@ -24,7 +24,8 @@ _SIGMAS = ("sigma_phi", "sigma_psi", "sigma_kappa", "sigma_delta_d", "sigma_spee
            "sigma_p0", "sigma_p0_ue", "sigma_vue_walk", "sigma_height", "doppler_tolerance",
            "sigma_speed_missing")  # fmt: skip
 
-MOTION_STEPS = ("held", "midpoint")  #: eq. 62's held message, or the midpoint (:mod:`.steps`)
+#: eq. 62's held message, or the midpoint of two (:func:`.motion.midpoint_messages`)
+MOTION_STEPS = ("held", "midpoint")
 #: the odometry's repeating errors a tracker can be told (:meth:`JavelinConfig.told`)
 _ODOMETRY = ("sigma_speed_scale", "sigma_heading_bias", "heading_drift", "sigma_yaw_rate_bias")
 
@@ -57,7 +58,8 @@ class JavelinConfig:
       ``sigma_heading_bias`` [rad] of the heading bias at the start, ``heading_drift``
       [rad/sqrt(s)] its random walk, ``sigma_yaw_rate_bias`` [rad/s] of the yaw-rate bias; any
       of them above 0 adds the odometry states to the state (:attr:`n_odo`);
-    - ours: ``motion_step``, eq. 62's ``"held"`` message or the ``"midpoint"`` of two (:mod:`.steps`).
+    - ours: ``motion_step``, eq. 62's ``"held"`` message or the ``"midpoint"`` of two
+      (:func:`.motion.midpoint_messages`; :func:`~.designs.ours` steps on the midpoint).
     """
 
     gate_probability: float = 0.99

@@ -11,7 +11,7 @@ factory                       what it is
                               at ``sigma_P^2 I`` that update at once, random-walk VUEs, eq. 51
 :func:`paper_vue`             the paper with one model change: curvature centred on the VUE
 :func:`ours`                  tuned on seed 7 for the CPD route: Doppler clutter rejection, CPD
-                              sigmas, global nearest neighbour, mirrored VUEs, no update at birth
+                              sigmas, global NN, mirrored VUEs, no birth update, midpoint step
 :func:`ours_coherent`         :func:`ours` with the VUE curvature (the coherent route)
 :func:`ours_ml`               :func:`ours_coherent` with the ML route's measured errors and
                               the joint innovation test (a wrong LoS from eq. 61 left out)
@@ -71,14 +71,15 @@ def ours(**overrides) -> JavelinDesign:
     actually delivers (angles ~5 deg, curvature tens of metres off at 5-45 m: the CPD route is far
     from the bound; see :func:`ours_ml` for the ML route), global nearest neighbour, VUEs moved
     with the mirrored UE displacement, births not used in the epoch they are born (their angles
-    already placed them)."""
+    already placed them), and every step on the midpoint of two V2X messages, where eq. 62's
+    held heading lags a turning drive (:func:`.motion.midpoint_messages`)."""
     d = JavelinDesign(
         associator=Associator(solver="gnn"),
         initiator=FixedBirth(update_at_birth=False),
         vue_motion=MirrorMotion(),
         prefilters=(DelayCheck(), DopplerClutter(1.0)),
     ).with_(sigma_phi=float(np.radians(5.0)), sigma_psi=float(np.radians(5.0)), sigma_kappa=50.0)
-    return d.with_(**overrides)
+    return d.with_(motion_step="midpoint", **overrides)
 
 
 def ours_coherent(**overrides) -> JavelinDesign:

@@ -4,7 +4,7 @@
 :func:`motion_increment`) with the sensor noise; a VUE follows a random walk (the paper's
 :class:`RandomWalk`) or the mirrored UE displacement (ours, :class:`MirrorMotion`). Told an
 odometry model with repeating errors, the state also carries its biases
-(:func:`odometry_transition`).
+(:func:`odometry_transition`); a ``"midpoint"`` step takes :func:`midpoint_messages`.
 
 How it works: docs/internals/tracking.md.
 """
@@ -16,11 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._physical import speeds, step_seconds
-from ..._validate import choice, instance, positive, real
+from ..._validate import choice, instance, messages, positive, real
 from .config import JavelinConfig
 from .state import I_BIAS, JavelinState, first_vue
 
-__all__ = ["motion_increment", "odometry_transition", "predict", "ue_velocity"]
+__all__ = ["midpoint_messages", "motion_increment", "odometry_transition", "predict", "ue_velocity"]
 
 #: the VUE motion models (:class:`RandomWalk`, :class:`MirrorMotion`)
 VUE_MOTIONS = ("random_walk", "mirror")
@@ -30,6 +30,23 @@ def ue_velocity(speed: float, heading: float) -> np.ndarray:
     """UE velocity (3,) from speed [m/s] and heading [rad] (angle from +x in the road plane)."""
     speeds("speed", speed), real("heading", heading)
     return float(speed) * np.array([np.cos(heading), np.sin(heading), 0.0])
+
+
+def midpoint_messages(speed, heading) -> tuple[np.ndarray, np.ndarray]:
+    """The V2X messages (``speed`` [m/s], ``heading`` [rad], (T,)) a ``"midpoint"`` step takes:
+    entry ``k`` the mean of those of ``k`` and ``k + 1`` (headings along the shorter arc), read by
+    the step into ``k + 1`` where eq. 62's held heading lags the chord by half the turn (notebook
+    04); the message of ``k`` where either is missing (NaN) and at the last epoch."""
+    v, th = messages("speed", speed), messages("heading", heading)
+    if th.shape != v.shape:
+        raise ValueError(f"speed, heading: expected one shape (T,), got {v.shape} and {th.shape}")
+    speeds("speed", v[np.isfinite(v)], vectors=False)
+    out_v, out_th = v.copy(), th.copy()
+    both = np.isfinite(v[:-1]) & np.isfinite(v[1:]) & np.isfinite(th[:-1]) & np.isfinite(th[1:])
+    half = np.angle(np.exp(1j * (th[1:] - th[:-1]))) / 2  # half the turn, on the shorter arc
+    out_v[:-1] = np.where(both, (v[:-1] + v[1:]) / 2, v[:-1])
+    out_th[:-1] = np.where(both, np.angle(np.exp(1j * (th[:-1] + half))), th[:-1])
+    return out_v, out_th
 
 
 def motion_increment(

@@ -19,13 +19,13 @@ import numpy as np
 
 from ..._checks import attributes, optional_real, unchecked
 from ..._physical import speeds, step_seconds
-from ..._validate import boolean, finite_array, record, vector
+from ..._validate import boolean, finite_array, messages, record, vector
 from ..gating import ChiSquareGate
 from ..registry import register
 from .associate import AssociationCosts
 from .manage import ManageResult, manage_tracks
 from .measurement import DopplerClutter, JavelinWarning, PathMeasurements
-from .motion import predict, ue_velocity
+from .motion import midpoint_messages, predict, ue_velocity
 from .roles import JavelinDesign
 from .state import JavelinState, track_slice
 
@@ -138,15 +138,16 @@ class Javelin:
         return run.estimates, run
 
     def run(self, epochs, speed, heading, dt: float, *, keep_reports: bool = False) -> JavelinRun:
-        """Step through a measurement stream (:func:`~.runs.run_javelin`): into epoch k on the message
-        of k-1 (eq. 62) or the ``"midpoint"`` of k-1 and k (:mod:`.steps`); a :meth:`step` on its own."""
+        """Step through a measurement stream (:func:`~.runs.run_javelin`): into epoch k on the
+        message of k-1 (eq. 62) or the ``"midpoint"`` of k-1 and k
+        (:func:`.motion.midpoint_messages`); a :meth:`step` on its own."""
         if isinstance(epochs, str | bytes) or not isinstance(epochs, Sequence | np.ndarray):
             raise TypeError(
                 f"epochs: expected a sequence of PathMeasurements or None, got {type(epochs).__name__}"
             )
         n = len(epochs)
         keep_reports = boolean("keep_reports", keep_reports)
-        spd, hdg = (_v2x(k, v) for k, v in (("speed", speed), ("heading", heading)))
+        spd, hdg = messages("speed", speed), messages("heading", heading)
         if spd.size != n or hdg.size != n:
             raise ValueError(
                 f"epochs, speed, heading: expected one speed and heading per epoch ({n}), got "
@@ -155,8 +156,6 @@ class Javelin:
         finite_array("dt", dt, ndim=0)
         first = (spd[0], hdg[0]) if n else None  # epoch 0 reads its own message
         if self.config.motion_step == "midpoint":  # the step into k on the mean of k-1 and k
-            from .steps import midpoint_messages  # loaded when asked for
-
             spd, hdg = midpoint_messages(spd, hdg)
         est = np.empty((n, 3))
         cov = np.empty((n, 3, 3))
@@ -406,18 +405,3 @@ def _check_paths(paths) -> None:
     """``paths`` of one epoch: PathMeasurements or None (checked before the state moves)."""
     if paths is not None and not isinstance(paths, PathMeasurements):
         raise TypeError(f"paths: expected PathMeasurements or None, got {type(paths).__name__}")
-
-
-def _v2x(name: str, value) -> np.ndarray:
-    """A V2X series (one value per epoch, NaN = the message is missing) as a flat float array."""
-    if isinstance(value, str | bytes):
-        raise TypeError(f"{name}: expected numbers (one per epoch), got text")
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(
-            f"{name}: expected numbers (one per epoch), got {type(value).__name__}"
-        ) from None
-    if arr.ndim > 1:
-        raise ValueError(f"{name}: expected one value per epoch (1-D), got shape {arr.shape}")
-    return arr.reshape(-1)
