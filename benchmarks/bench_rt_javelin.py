@@ -206,7 +206,12 @@ def report(
         steps |= {x.get("motion_step", "held") for x in saved}
         r += 1
     if len(steps) > 1:
-        return f"table {table} seed {seed}: drives of two motion steps {sorted(map(str, steps))} in {d}"
+        names = sorted("each design's own" if x is None else x for x in steps)
+        return (
+            f"table {table} seed {seed}: drives scored with two motion steps {names} in {d} "
+            "(drives saved before each design took its own step were scored all held): rescore "
+            "the directory (--rescore OUT, with --motion-step held to keep the old scoring)"
+        )
     if not done:
         return f"table {table} seed {seed}: no whole run saved yet in {d}"
     rep = jt._report(

@@ -46,6 +46,9 @@ def main(argv=None) -> int:
     ap.add_argument("--traced-draws", type=int, default=2,
                     help="noisy snapshots per epoch on the traced channel (0: the bias alone)")  # fmt: skip
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--predicted-sigma", type=float, default=0.1,
+                    help="visibility models: the noisy fit starts every atom at the model of a "
+                    "position drawn this far [m] from the truth (a tracker's prediction)")  # fmt: skip
     ap.add_argument("--cache-dir", default=None)
     a = ap.parse_args(argv)
     shape = tuple(int(x) for x in a.array.lower().split("x"))
@@ -55,7 +58,8 @@ def main(argv=None) -> int:
             t0 = time.perf_counter()
             rows = traced_bias(a.scenario, array=shape, epochs=a.epochs, models=a.models,
                                draws=a.traced_draws, rng=np.random.default_rng(a.seed),
-                               cache_dir=a.cache_dir, progress=True)  # fmt: skip
+                               cache_dir=a.cache_dir, progress=True,
+                               predicted_sigma=a.predicted_sigma)  # fmt: skip
             print(f"\n## traced channel, {a.array}, epochs {a.epochs} "
                   f"({time.perf_counter() - t0:.0f} s)\n\n{_table(rows)}\n")  # fmt: skip
         if a.only in (None, "eq1-cost"):

@@ -287,6 +287,14 @@ def _studies():
     prob.profile(beta)
     prob.evaluate_profile(th, mf, mt, beta, derivatives=True)
     prob.fit(th, mf, mt, route.config.noise_power, beta=beta, max_iter=2)
+    from tunnelkit.studies import visibility
+
+    ue, vel = route.trajectory.position[10], route.trajectory.velocity[10]
+    visibility.element_visibility(route.tunnel, route.tunnel.surfaces[0], ue, arr.world)
+    _, mask = visibility.visible_paths(route.tunnel, arr, paths, ue, vel, route.config.fc, 0.25)
+    masked = visibility.MaskedProblem(H, arr.local, route.config.fc, mask[:, : len(paths)])
+    masked.fit(th, mf, mt, route.config.noise_power, max_iter=2)
+    visibility.predicted_model(route, arr, ue, vel, 1)
     nuisance.ModelRow("eq1", "error", "all", 3, *[0.1] * 6, 0.05, 1.0, 2.0, 0.5)
     nuisance.CostRow(1, 5, 0.0, 0.0, 1.2, 1.3, 1.4, 1.0, 1.0, 1.1, 1.1)
     nuisance.eq1_cost(

@@ -81,6 +81,12 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN is 'nothing measured' (no path of that kind, no noisy draw): the record's docstring",
     ),
     _doc(
+        r"studies\.visibility\.predicted_model",
+        r"second_order",
+        "zero",
+        "no second-order atom: the masks and the missing facets alone (model 'visibility')",
+    ),
+    _doc(
         r"studies\.aperture\.(ApertureProblem|taper_basis)",
         r"order",
         "zero",

@@ -181,7 +181,8 @@ def drive_motion(setup: DesignSetup, T: int, sig_nu: float, sig_th: float):
     Jacobian ``G`` (T, 2, 2) of the 2-D position increment ``dt nu (cos theta, sin theta)`` with
     respect to (speed, heading), the noise covariance of (speed, heading) from ``sig_nu`` [m/s]
     and ``sig_th`` [rad], and ``dt`` (T,) [s]. The message of epoch ``k-1`` drives the
-    prediction into epoch ``k`` (Algorithm 4, line 7)."""
+    prediction into epoch ``k`` (Algorithm 4, line 7; eq. 62's held step, the step the array
+    design's tracker takes, not the midpoint of :func:`~tunnelkit.tracking.javelin.designs.ours`)."""
     setup = instance("setup", setup, DesignSetup)
     traj = setup.trajectory
     T = integer("T", T, minimum=1, maximum=len(traj.t))

@@ -12,13 +12,18 @@ The models (:data:`MODELS`):
   as nuisance atoms beside the first-order ones
   (:func:`tunnelkit.propagation.second_order.second_order_paths`, as
   ``RouteOptions(second_order=N)`` models them; the second-order bounces carry about 20 % of the
-  traced power).
+  traced power);
+* ``visibility``: eq. 1 with each first-order path on the elements that see it and an atom for
+  each facet some element sees that the reference element does not (:mod:`.visibility`: masks
+  from the true position); ``visibility-second-order-N`` the same with ``N`` second-order atoms
+  (seen by every element).
 
 :func:`traced_bias` fits each model noiselessly to the traced tensor of each epoch (the pseudo-true
 parameters: eq. 1's by :func:`~.misspecified.pseudo_true` from the true paths, the profile's by
 :meth:`ApertureProblem.fit <.aperture.ApertureProblem.fit>` from eq. 1's, the second-order
-model's by ``pseudo_true`` from the true first- and second-order paths: the most favourable
-start, an oracle) and reports each first-order path's bias against the image method's geometry,
+model's by ``pseudo_true`` from the true first- and second-order paths, the visibility models'
+by :meth:`MaskedProblem.fit <.visibility.MaskedProblem.fit>` from every true path they hold and
+from eq. 1's fit, the better kept: the most favourable start, an oracle) and reports each first-order path's bias against the image method's geometry,
 by kind; with noisy draws also each model's extraction errors (not started at the truth) and a
 one-epoch position fix from either. :func:`eq1_cost` does the same on eq. 1's own tensor, where every model must be
 unbiased, and gives the profile's Cramer-Rao bound against eq. 1's (the price of ``K`` more
@@ -35,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import boolean, choice, integer, sequence
+from .._validate import boolean, choice, integer, positive, sequence
 from ..channel import channel_tensor
 from ..constants import C
 from ..evaluation import match_paths
@@ -47,11 +52,20 @@ from .aperture import MAX_ORDER, ApertureProblem
 from .attribution import KINDS, measured_record, one_epoch_fix, scenario_with_array
 from .misspecified import pseudo_true
 from .truth import angles_of_theta, path_differences, path_truth
+from .visibility import MaskedProblem, predicted_model, visible_paths
 
 __all__ = ["MODELS", "CostRow", "ModelRow", "eq1_cost", "traced_bias"]
 
 #: the models compared (module docstring)
-MODELS = ("eq1", "aperture-1", "aperture-2", "second-order-2", "second-order-4")
+MODELS = (
+    "eq1",
+    "aperture-1",
+    "aperture-2",
+    "second-order-2",
+    "second-order-4",
+    "visibility",
+    "visibility-second-order-4",
+)
 
 
 @dataclass(frozen=True)
@@ -117,9 +131,20 @@ def _shape(array) -> tuple[int, int]:
     return tuple(integer("array", n, minimum=1, maximum=64) for n in shape)
 
 
-def _fit(model: str, H, arr, cfg, paths, extra) -> tuple:
-    """``(theta, mu_f, cost)`` of the first-order paths under ``model`` (module docstring)."""
+def _fit(model: str, H, arr, cfg, paths, extra, mask=None) -> tuple:
+    """``(theta, mu_f, cost, mu_t)`` of the first-order paths under ``model`` (module docstring):
+    ``extra`` its nuisance paths, ``mask`` (visibility models) each path's elements."""
     L = len(paths)
+    if model.startswith("visibility"):  # from every true path, and from eq. 1's fit: the better
+        prob, tol = MaskedProblem(H, arr.local, cfg.fc, mask), 0.01 * cfg.noise_power
+        th, mf, mt = ml_truth(list(paths) + list(extra), arr, cfg)
+        e1 = _fit("eq1", H, arr, cfg, paths, [])
+        f = min(
+            prob.fit(th, mf, mt, tol),
+            prob.fit(np.vstack([e1[0], th[L:]]), np.r_[e1[1], mf[L:]], np.r_[e1[3], mt[L:]], tol),
+            key=lambda r: r["cost"],
+        )
+        return f["theta"][:L], f["mu_f"][:L], f["cost"], f["mu_t"][:L]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fit's tests judge a noisy snapshot
         if model.startswith("second-order"):
@@ -129,10 +154,10 @@ def _fit(model: str, H, arr, cfg, paths, extra) -> tuple:
         pt = pseudo_true(H, arr.local, cfg.fc, start, noise_power=cfg.noise_power,
                          newton_iter=30)  # fmt: skip
     if not model.startswith("aperture"):
-        return pt["theta"][:L], pt["mu_f"][:L], pt["residual_power"] * H.size
+        return pt["theta"][:L], pt["mu_f"][:L], pt["residual_power"] * H.size, pt["mu_t"][:L]
     prob = ApertureProblem(H, arr.local, cfg.fc, order=int(model.rsplit("-", 1)[1]))
     f = prob.fit(pt["theta"], pt["mu_f"], pt["mu_t"], 0.01 * cfg.noise_power)
-    return f["theta"], f["mu_f"], f["cost"]
+    return f["theta"], f["mu_f"], f["cost"], f["mu_t"]
 
 
 def traced_bias(
@@ -145,6 +170,7 @@ def traced_bias(
     rng: np.random.Generator | None = None,
     cache_dir=None,
     progress: bool = False,
+    predicted_sigma: float = 0.1,
 ) -> list[ModelRow]:
     """The first-order pseudo-true bias by model and kind (module docstring) on ``scenario``'s
     traced channel at ``epochs``, with every base-station array ``array`` (rows, columns) mounted
@@ -156,7 +182,12 @@ def traced_bias(
     paths' number (``eq1``), with that number plus the image method's second-order paths
     (``second-order-N``: started as the extraction starts, not at the truth), or eq. 1's then
     refined with the profile (``aperture-K``); estimates matched to the first-order truth
-    (:func:`tunnelkit.evaluation.match_paths`), ``d`` less the drawn clock bias."""
+    (:func:`tunnelkit.evaluation.match_paths`), ``d`` less the drawn clock bias. The visibility
+    models' noisy fit starts every atom at the model of a predicted position
+    (:func:`~.visibility.predicted_model` at the true one moved by ``N(0, predicted_sigma^2)``
+    [m] along x and y, drawn with ``rng`` after each snapshot: a tracker's prediction), the
+    delays shifted by eq. 1's earliest delay less the prediction's shortest path (the clock
+    bias, unknown to the receiver)."""
     models = [m for m in sequence("models", models)]
     for m in models:
         if m not in MODELS:
@@ -165,6 +196,10 @@ def traced_bias(
     draws = integer("draws", draws, minimum=0, maximum=100)
     if draws and not isinstance(rng, np.random.Generator):
         raise TypeError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+    if positive("predicted_sigma", predicted_sigma) > 10.0:
+        raise ValueError(
+            f"predicted_sigma: a tracker's prediction within 10 m, got {predicted_sigma}"
+        )
     if cache_dir is not None and not isinstance(cache_dir, str | os.PathLike):
         raise TypeError(f"cache_dir: expected a directory path, got {type(cache_dir).__name__}")
     sc = scenario_with_array(scenario, _shape(array))
@@ -183,7 +218,7 @@ def traced_bias(
     with_second = {
         m: route.with_options(second_order=int(m.rsplit("-", 1)[1]))
         for m in models
-        if m.startswith("second-order")
+        if "second-order" in m
     }
     for k in ks:
         arr, paths = route.paths(k)
@@ -191,12 +226,20 @@ def traced_bias(
         h2 = float(np.vdot(H, H).real)
         tru, idx = path_truth(paths, arr), np.arange(len(paths))
         ue = route.trajectory.position[k]
-        extras = {}
+        extras, masks = {}, {}
+        if any(m.startswith("visibility") for m in models):
+            vel = route.trajectory.velocity[k]
+            seen = visible_paths(
+                route.tunnel, arr, paths, ue, vel, route.config.fc, kinds=route.kinds
+            )
         for m in models:
             extra = []
             if m in with_second:
                 extra = [p for p in with_second[m].paths(k)[1] if p.kind == SECOND_ORDER]
-            theta, mu_f, cost = _fit(m, H, arr, route.config, paths, extra)
+            if m.startswith("visibility"):  # the missing facets' paths, then second-order ones
+                ones = np.ones((arr.M, len(extra)))
+                extra, masks[m] = seen[0] + extra, np.column_stack([seen[1], ones])
+            theta, mu_f, cost, _ = _fit(m, H, arr, route.config, paths, extra, masks.get(m))
             est = angles_of_theta(theta, mu_f, arr, route.config)
             e = path_differences(est, tru, idx, idx)
             errs[m] += [(p.surface_kind, x) for p, x in zip(paths, e, strict=True)]
@@ -207,8 +250,15 @@ def traced_bias(
         for _ in range(draws):
             snap = route.draw(k, rng)[2]
             eq1 = {}  # eq. 1's extraction of this snapshot, shared by eq1 and the profiles
+            if masks:  # a tracker's prediction of the position
+                ue_hat = ue + np.r_[predicted_sigma * rng.standard_normal(2), 0.0]
+                vel = route.trajectory.velocity[k]
             for m in models:
-                (e, fix), sec = _errors(m, snap, arr, route.config, paths, tru, extras[m], ue, eq1)
+                x = extras[m]
+                if m in masks:  # the atoms of the prediction's model
+                    n2 = int(m.rsplit("-", 1)[1]) if "second-order" in m else 0
+                    x = predicted_model(route, arr, ue_hat, vel, n2)
+                (e, fix), sec = _errors(m, snap, arr, route.config, paths, tru, x, ue, eq1)
                 secs[m].append(sec)
                 noisy[m] += e
                 fix_err[m].append(fix)
@@ -229,11 +279,14 @@ def _extract(snap, n_paths: int, arr, cfg) -> tuple:
         return start_from_estimates(extract_paths(snap.H, n_paths, arr, cfg))
 
 
-def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int, ue, eq1: dict) -> tuple:
+def _errors(model: str, snap, arr, cfg, paths, tru, n_extra, ue, eq1: dict) -> tuple:
     """``((kind, (4,) error) list, fix error [m]), seconds``: the first-order paths one noisy
     snapshot gives under ``model``, the horizontal error of their one-epoch fix and the time of
     the model's extraction (:func:`traced_bias`). ``eq1`` holds eq. 1's extraction of the
-    snapshot once made (``"fit"``, ``"s"``): the profiles refine it, so they are timed with it."""
+    snapshot once made (``"fit"``, ``"s"``): the profiles refine it and the visibility models
+    read its earliest delay, so they are timed with it. ``n_extra``: the number of second-order atoms, or for a
+    visibility model the model of a predicted position (``(paths, masks, n_first)``,
+    :func:`~.visibility.predicted_model`): its atoms start there, not at eq. 1's fit."""
     L = len(paths)
     t0 = time.perf_counter()
     if model.startswith("second"):
@@ -250,6 +303,16 @@ def _errors(model: str, snap, arr, cfg, paths, tru, n_extra: int, ue, eq1: dict)
             prob = ApertureProblem(snap.H, arr.local, cfg.fc, order=int(model.rsplit("-", 1)[1]))
             f = prob.fit(theta, mu_f, mu_t, cfg.noise_power)
             theta, mu_f = f["theta"], f["mu_f"]
+            sec += time.perf_counter() - t1
+        if model.startswith("visibility"):  # from the model of a predicted position
+            t1 = time.perf_counter()
+            hat, mask, L = n_extra
+            th, mf, mt = ml_truth(hat, arr, cfg)
+            d_eq1 = -C * mu_f / (2 * np.pi * cfg.tone_spacing)  # eq. 1's delays, the bias in
+            shift = np.min(d_eq1) - min(p.length for p in hat[:L])
+            mf = mf - 2 * np.pi * cfg.tone_spacing * shift / C
+            f = MaskedProblem(snap.H, arr.local, cfg.fc, mask).fit(th, mf, mt, cfg.noise_power)
+            theta, mu_f = f["theta"][:L], f["mu_f"][:L]
             sec += time.perf_counter() - t1
     e = angles_of_theta(theta, mu_f, arr, cfg)
     u = np.column_stack([np.cos(e["psi"]) * np.cos(e["phi"]), np.cos(e["psi"]) * np.sin(e["phi"]),

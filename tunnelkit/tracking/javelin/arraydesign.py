@@ -84,7 +84,10 @@ def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> Ja
     sigma (a difference of two delays). ``planes`` (the tunnel's known surfaces,
     :class:`tunnelkit.geometry.Plane` or anything with ``normal`` and ``offset``; default none):
     VUEs are born at the UE's mirror image in the plane that explains their path
-    (:class:`~.surfaces.GeometricBirth`) instead of learnt from their angles.
+    (:class:`~.surfaces.GeometricBirth`) instead of learnt from their angles. It steps on eq. 62's
+    held message, not our designs' midpoint: the design's bounds over a drive
+    (:mod:`tunnelkit.design.drivebound`) model that step, and the tracker they are set beside
+    must run the model they bound.
     """
     if not isinstance(crlb, dict):
         raise TypeError(f"crlb: expected a dict of per-path bounds, got {type(crlb).__name__}")
@@ -120,6 +123,7 @@ def array_design(crlb: dict, min_d: float = 0.0, planes=None, **overrides) -> Ja
             sigma_kappa=kap,
             sigma_delta_d=float(np.sqrt(2.0) * d),
             update_iterations=ARRAY_DESIGN_UPDATE_ITERATIONS,
+            motion_step="held",
         )
         .with_prefilter(DelayCheck(float(min_d)))
         .with_(**overrides)
