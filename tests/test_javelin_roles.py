@@ -184,6 +184,9 @@ def test_named_designs():
     assert isinstance(designs.paper_vue().curvature, VueCurvature)
     assert designs.ours_ml().config.sigma_kappa == designs.ML_ERRORS_SEED0["kappa_m"]
     assert designs.ours_ml().updater == JointTestUpdater(0.999)
+    # ours step on the midpoint of two messages, the paper's on eq. 62's held one; either is told
+    assert o.config.motion_step == "midpoint" and p.config.motion_step == "held"
+    assert designs.ours(motion_step="held").config.motion_step == "held"
     a = arraydesign.array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.01}, min_d=-30.0)
     assert a.requires_reported_covariance() and a.min_d == -30.0
     assert isinstance(a.updater, JointTestUpdater) and isinstance(a.initiator, MeasuredBirth)

@@ -131,14 +131,16 @@ def _shape(array) -> tuple[int, int]:
     return tuple(integer("array", n, minimum=1, maximum=64) for n in shape)
 
 
-def _fit(model: str, H, arr, cfg, paths, extra, mask=None) -> tuple:
+def _fit(model: str, H, arr, cfg, paths, extra, mask=None, fits=None) -> tuple:
     """``(theta, mu_f, cost, mu_t)`` of the first-order paths under ``model`` (module docstring):
-    ``extra`` its nuisance paths, ``mask`` (visibility models) each path's elements."""
+    ``extra`` its nuisance paths, ``mask`` (visibility models) each path's elements; ``fits``
+    (a dict) keeps eq. 1's fit of ``H`` once made, which the visibility models start from too."""
+    fits = {} if fits is None else fits
     L = len(paths)
     if model.startswith("visibility"):  # from every true path, and from eq. 1's fit: the better
         prob, tol = MaskedProblem(H, arr.local, cfg.fc, mask), 0.01 * cfg.noise_power
         th, mf, mt = ml_truth(list(paths) + list(extra), arr, cfg)
-        e1 = _fit("eq1", H, arr, cfg, paths, [])
+        e1 = fits.get("eq1") or _fit("eq1", H, arr, cfg, paths, [], fits=fits)
         f = min(
             prob.fit(th, mf, mt, tol),
             prob.fit(np.vstack([e1[0], th[L:]]), np.r_[e1[1], mf[L:]], np.r_[e1[3], mt[L:]], tol),
@@ -153,8 +155,11 @@ def _fit(model: str, H, arr, cfg, paths, extra, mask=None) -> tuple:
             start = ml_truth(paths, arr, cfg)
         pt = pseudo_true(H, arr.local, cfg.fc, start, noise_power=cfg.noise_power,
                          newton_iter=30)  # fmt: skip
+    out = pt["theta"][:L], pt["mu_f"][:L], pt["residual_power"] * H.size, pt["mu_t"][:L]
+    if model == "eq1":
+        fits["eq1"] = out
     if not model.startswith("aperture"):
-        return pt["theta"][:L], pt["mu_f"][:L], pt["residual_power"] * H.size, pt["mu_t"][:L]
+        return out
     prob = ApertureProblem(H, arr.local, cfg.fc, order=int(model.rsplit("-", 1)[1]))
     f = prob.fit(pt["theta"], pt["mu_f"], pt["mu_t"], 0.01 * cfg.noise_power)
     return f["theta"], f["mu_f"], f["cost"], f["mu_t"]
@@ -226,7 +231,7 @@ def traced_bias(
         h2 = float(np.vdot(H, H).real)
         tru, idx = path_truth(paths, arr), np.arange(len(paths))
         ue = route.trajectory.position[k]
-        extras, masks = {}, {}
+        extras, masks, fits = {}, {}, {}
         if any(m.startswith("visibility") for m in models):
             vel = route.trajectory.velocity[k]
             seen = visible_paths(
@@ -239,7 +244,7 @@ def traced_bias(
             if m.startswith("visibility"):  # the missing facets' paths, then second-order ones
                 ones = np.ones((arr.M, len(extra)))
                 extra, masks[m] = seen[0] + extra, np.column_stack([seen[1], ones])
-            theta, mu_f, cost, _ = _fit(m, H, arr, route.config, paths, extra, masks.get(m))
+            theta, mu_f, cost, _ = _fit(m, H, arr, route.config, paths, extra, masks.get(m), fits)
             est = angles_of_theta(theta, mu_f, arr, route.config)
             e = path_differences(est, tru, idx, idx)
             errs[m] += [(p.surface_kind, x) for p, x in zip(paths, e, strict=True)]

@@ -79,7 +79,7 @@ def ours(**overrides) -> JavelinDesign:
         vue_motion=MirrorMotion(),
         prefilters=(DelayCheck(), DopplerClutter(1.0)),
     ).with_(sigma_phi=float(np.radians(5.0)), sigma_psi=float(np.radians(5.0)), sigma_kappa=50.0)
-    return d.with_(motion_step="midpoint", **overrides)
+    return d.with_(**{"motion_step": "midpoint", **overrides})
 
 
 def ours_coherent(**overrides) -> JavelinDesign:
