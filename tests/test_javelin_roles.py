@@ -187,6 +187,11 @@ def test_named_designs():
     # ours step on the midpoint of two messages, the paper's on eq. 62's held one; either is told
     assert o.config.motion_step == "midpoint" and p.config.motion_step == "held"
     assert designs.ours(motion_step="held").config.motion_step == "held"
+    # the array design's tracker runs the held step its bounds over a drive model
+    assert (
+        arraydesign.array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.01}).config.motion_step
+        == "held"
+    )
     a = arraydesign.array_design({"d": 1e-3, "direction": 1e-4, "kappa": 0.01}, min_d=-30.0)
     assert a.requires_reported_covariance() and a.min_d == -30.0
     assert isinstance(a.updater, JointTestUpdater) and isinstance(a.initiator, MeasuredBirth)

@@ -79,7 +79,7 @@ def messages(name: str, x, *, batched: bool = False) -> np.ndarray:
         raise TypeError(f"{name}: expected real numbers (NaN: a message lost), got {x!r:.40}")
     x = np.asarray(x, dtype=float)
     if x.ndim < 1 or (x.ndim > 1 and not batched):
-        raise ValueError(f"{name}: expected one message per epoch (T,), got shape {x.shape}")
+        raise ValueError(f"{name}: expected shape {('(T,)', '(..., T)')[batched]}, got {x.shape}")
     if np.isinf(x).any():
         raise ValueError(f"{name}: contains infinite values (NaN marks a missing message)")
     return x

@@ -15,8 +15,8 @@ The models (:data:`MODELS`):
   traced power);
 * ``visibility``: eq. 1 with each first-order path on the elements that see it and an atom for
   each facet some element sees that the reference element does not (:mod:`.visibility`: masks
-  from the true position); ``visibility-second-order-N`` the same with ``N`` second-order atoms
-  (seen by every element).
+  from the true position for the bias, from a predicted one for the noisy rows);
+  ``visibility-second-order-N`` the same with ``N`` second-order atoms (seen by every element).
 
 :func:`traced_bias` fits each model noiselessly to the traced tensor of each epoch (the pseudo-true
 parameters: eq. 1's by :func:`~.misspecified.pseudo_true` from the true paths, the profile's by

@@ -18,8 +18,9 @@ reference element) leaves out. Here eq. 1 is given that geometry:
   (:class:`~.aperture.ApertureProblem` with its profile fixed instead of fitted: no parameter
   more per path).
 
-The masks need the UE's position: the truth here (a tracker's prediction in practice, which moves
-a mask only where an element's specular point is within the prediction's error of an edge).
+The masks need the UE's position: the truth for the pseudo-true bias, a predicted one
+(:func:`predicted_model`, a tracker's prediction) for the noisy fits; a prediction's error moves
+a mask only where an element's specular point is within it of an edge.
 Measured by :func:`tunnelkit.studies.nuisance.traced_bias` (models ``visibility`` and
 ``visibility-second-order-N``).
 """
