@@ -124,8 +124,9 @@ for name, row in (("straight", st), ("slalom", sl)):
 # with the same V2X speed and heading messages and every radio measurement dropped (predict only).
 # Nothing a route does with the radio reaches them, so they are the same in every column of the
 # paper's design. Our design's column has its own: ours steps on the midpoint of two messages
-# where the paper's design holds the previous one (eq. 62; notebook 04, section 4), which on the
-# slalom alone takes most of dead reckoning's error away. The radio's gain is dead reckoning's
+# where the paper's design holds the previous one (eq. 62), so on a turning drive its dead
+# reckoning is free of the held step's lag (notebook 04, section 4, measures it on noise-free
+# messages). The radio's gain is dead reckoning's
 # 2-D RMSE over the tracker's, in the same column (above 1 the radio helps), per condition, in
 # our design's column:
 
