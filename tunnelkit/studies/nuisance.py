@@ -52,7 +52,7 @@ from .aperture import MAX_ORDER, ApertureProblem
 from .attribution import KINDS, measured_record, one_epoch_fix, scenario_with_array
 from .misspecified import pseudo_true
 from .truth import angles_of_theta, path_differences, path_truth
-from .visibility import MaskedProblem, predicted_model, visible_paths
+from .visibility import MaskedProblem, predicted_model
 
 __all__ = ["MODELS", "CostRow", "ModelRow", "eq1_cost", "traced_bias"]
 
@@ -219,31 +219,23 @@ def traced_bias(
     fix_bias = {m: [] for m in models}
     fix_err = {m: [] for m in models}
     secs = {m: [] for m in models}
-    # the route of each second-order model (its image-method paths), built once
-    with_second = {
-        m: route.with_options(second_order=int(m.rsplit("-", 1)[1]))
-        for m in models
-        if "second-order" in m
-    }
+    # each model's number of second-order atoms; the route of each second-order model, built once
+    n2 = {m: int(m.rsplit("-", 1)[1]) if "second-order" in m else 0 for m in models}
+    with_second = {m: route.with_options(second_order=n2[m]) for m in models if n2[m]}
     for k in ks:
         arr, paths = route.paths(k)
         H = amp * route.raytraced.tensor(k)[1]
         h2 = float(np.vdot(H, H).real)
         tru, idx = path_truth(paths, arr), np.arange(len(paths))
-        ue = route.trajectory.position[k]
+        ue, vel = route.trajectory.position[k], route.trajectory.velocity[k]
         extras, masks, fits = {}, {}, {}
-        if any(m.startswith("visibility") for m in models):
-            vel = route.trajectory.velocity[k]
-            seen = visible_paths(
-                route.tunnel, arr, paths, ue, vel, route.config.fc, kinds=route.kinds
-            )
         for m in models:
             extra = []
-            if m in with_second:
+            if m.startswith("visibility"):  # the true position's model: missing facets, bounces
+                hat, masks[m], n_first = predicted_model(route, arr, ue, vel, n2[m])
+                extra = hat[n_first:]
+            elif m in with_second:
                 extra = [p for p in with_second[m].paths(k)[1] if p.kind == SECOND_ORDER]
-            if m.startswith("visibility"):  # the missing facets' paths, then second-order ones
-                ones = np.ones((arr.M, len(extra)))
-                extra, masks[m] = seen[0] + extra, np.column_stack([seen[1], ones])
             theta, mu_f, cost, _ = _fit(m, H, arr, route.config, paths, extra, masks.get(m), fits)
             est = angles_of_theta(theta, mu_f, arr, route.config)
             e = path_differences(est, tru, idx, idx)
@@ -257,12 +249,10 @@ def traced_bias(
             eq1 = {}  # eq. 1's extraction of this snapshot, shared by eq1 and the profiles
             if masks:  # a tracker's prediction of the position
                 ue_hat = ue + np.r_[predicted_sigma * rng.standard_normal(2), 0.0]
-                vel = route.trajectory.velocity[k]
             for m in models:
                 x = extras[m]
                 if m in masks:  # the atoms of the prediction's model
-                    n2 = int(m.rsplit("-", 1)[1]) if "second-order" in m else 0
-                    x = predicted_model(route, arr, ue_hat, vel, n2)
+                    x = predicted_model(route, arr, ue_hat, vel, n2[m])
                 (e, fix), sec = _errors(m, snap, arr, route.config, paths, tru, x, ue, eq1)
                 secs[m].append(sec)
                 noisy[m] += e
@@ -284,18 +274,18 @@ def _extract(snap, n_paths: int, arr, cfg) -> tuple:
         return start_from_estimates(extract_paths(snap.H, n_paths, arr, cfg))
 
 
-def _errors(model: str, snap, arr, cfg, paths, tru, n_extra, ue, eq1: dict) -> tuple:
+def _errors(model: str, snap, arr, cfg, paths, tru, atoms, ue, eq1: dict) -> tuple:
     """``((kind, (4,) error) list, fix error [m]), seconds``: the first-order paths one noisy
     snapshot gives under ``model``, the horizontal error of their one-epoch fix and the time of
     the model's extraction (:func:`traced_bias`). ``eq1`` holds eq. 1's extraction of the
     snapshot once made (``"fit"``, ``"s"``): the profiles refine it and the visibility models
-    read its earliest delay, so they are timed with it. ``n_extra``: the number of second-order atoms, or for a
-    visibility model the model of a predicted position (``(paths, masks, n_first)``,
-    :func:`~.visibility.predicted_model`): its atoms start there, not at eq. 1's fit."""
+    read its earliest delay, so they are timed with it. ``atoms``: the number of second-order
+    atoms, or for a visibility model the model of a predicted position (``(paths, masks,
+    n_first)``, :func:`~.visibility.predicted_model`): its atoms start there, not at eq. 1's."""
     L = len(paths)
     t0 = time.perf_counter()
     if model.startswith("second"):
-        theta, mu_f, _ = _extract(snap, L + n_extra, arr, cfg)
+        theta, mu_f, _ = _extract(snap, L + atoms, arr, cfg)
         sec = time.perf_counter() - t0
     else:
         if "fit" not in eq1:
@@ -311,7 +301,7 @@ def _errors(model: str, snap, arr, cfg, paths, tru, n_extra, ue, eq1: dict) -> t
             sec += time.perf_counter() - t1
         if model.startswith("visibility"):  # from the model of a predicted position
             t1 = time.perf_counter()
-            hat, mask, L = n_extra
+            hat, mask, L = atoms
             th, mf, mt = ml_truth(hat, arr, cfg)
             d_eq1 = -C * mu_f / (2 * np.pi * cfg.tone_spacing)  # eq. 1's delays, the bias in
             shift = np.min(d_eq1) - min(p.length for p in hat[:L])
