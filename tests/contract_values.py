@@ -303,6 +303,30 @@ def _studies():
     )  # fmt: skip
 
 
+def _direct():
+    from tunnelkit.design.los import ElevationSigmas
+    from tunnelkit.reproduce.javelin_traced import los_design
+    from tunnelkit.signal_route import SignalRoute
+    from tunnelkit.studies import direct, direct_track
+    from tunnelkit.studies.visibility import predicted_model
+
+    route = SignalRoute.from_scenario("italiano2026-straight")
+    arr, _, snap = route.draw(12, np.random.default_rng(3))
+    ue, vel = route.trajectory.position[12], route.trajectory.velocity[12]
+    paths, masks, _ = predicted_model(route, arr, ue, vel, 2)
+    maps = direct.image_maps(route.tunnel, paths)
+    H = snap.H[:, :40, :4]
+    prob = direct.DirectProblem(H, arr, route.config, masks, maps, ue[2], vel)
+    prob.atoms(np.r_[ue[:2], 0.0])
+    prob.cost(np.r_[ue[:2], 0.0, 4.0])
+    prob.residual(np.r_[ue[:2], 0.0])
+    prob.fit_tied(np.r_[ue[:2], 0.0], max_evaluations=5)
+    direct.direct_fix(route, arr, H, ue, vel, second_order=2, speed=True, gate=5.0)
+    table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
+    direct_track.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
+                              speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1)  # fmt: skip
+
+
 def _doppler():
     from tunnelkit import doppler_drive as dv
     from tunnelkit.tracking import doppler as dp
@@ -758,6 +782,7 @@ DRIVERS = (
     _widgets,
     _signal_route,
     _studies,
+    _direct,
     _odometry,
     _doppler,
     _fresnel,

@@ -87,6 +87,27 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no second-order atom: the masks and the missing facets alone (model 'visibility')",
     ),
     _doc(
+        r"studies\.direct\.DirectFix",
+        r"clock_bias|speed|residual|evaluations",
+        "negative huge nan zero",
+        "a fit's record: the clock bias [m] has either sign and its support is the route's; the "
+        "speed NaN when not fitted, zero or negative along the heading when the fit says so; the "
+        "residual share zero on the model's own tensor; the evaluation count any count (the "
+        "physically impossible speeds and shares are refused)",
+    ),
+    _doc(
+        r"studies\.direct_track\.DirectDrive",
+        r"speed_errors",
+        "empty",
+        "no fit of the speed on the drive (the speed not used, or every fit flagged)",
+    ),
+    _doc(
+        r"studies\.direct\.direct_fix|studies\.direct_track\.direct_drive",
+        r"second_order",
+        "zero",
+        "no second-order atom: the direct fit of the first-order paths and the missing facets",
+    ),
+    _doc(
         r"studies\.aperture\.(ApertureProblem|taper_basis)",
         r"order",
         "zero",

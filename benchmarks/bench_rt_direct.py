@@ -1,0 +1,154 @@
+"""The direct fit under the tracker on the ray-traced channel (:mod:`tunnelkit.studies.direct_track`):
+per drive, dead reckoning, the traced tables' line-of-sight column (eq. 1), the direct fix's line
+of sight and, with ``--speed-sigma``, its speed (and that speed alone), on the same messages and
+snapshots (condition L, start at the truth told 0.1 m). Reports each tracker's mean RMSE, its
+ratio to dead reckoning (per drive, mean and 90 % bootstrap interval), the errors each was fed
+and the extraction's cost per epoch.
+
+The direct fix's sigmas by elevation are a table (``--table``, JSON of
+``ElevationSigmas.as_dict``) or one constant pair (``--sigmas AZ/EL`` [deg]); ``--write-table
+PATTERN --bins B ...`` makes tables from this run's errors (choose on one seed, report another).
+
+    python benchmarks/bench_rt_direct.py --seed 0 --runs 6 --sigmas 0.2/0.1 --speed-sigma 0.1 --write-table 'build/direct/straight-{bins}.json' --bins 1 2 4
+    python benchmarks/bench_rt_direct.py --seed 20261202 --runs 10 --table build/direct/straight-2.json --speed-sigma 0.1
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import pickle
+import shlex
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tunnelkit.design.los import ElevationSigmas, elevation_sigmas
+from tunnelkit.montecarlo import spawn_rngs
+from tunnelkit.reproduce.javelin_traced import los_design, los_survey
+from tunnelkit.simulation.drives import scenario_route
+from tunnelkit.studies.direct_track import direct_drive
+
+NUISANCE = {"diffuse_floor": True}  # the traced tables' route
+
+
+@functools.cache
+def _setup(scenario: str):
+    return scenario_route(scenario, "exact", "sionna", NUISANCE), los_survey(scenario)[0]
+
+
+def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma):
+    route, eq1 = _setup(scenario)
+    with threadpool_limits(limits=1, user_api="blas"):
+        t0 = time.perf_counter()
+        r = direct_drive(route, spawn_rngs(seed, runs)[i], los_design(), eq1, table,
+                         speed_sigma=speed_sigma, second_order=second_order,
+                         n_epochs=n_epochs)  # fmt: skip
+    return i, r, time.perf_counter() - t0
+
+
+def _interval(x, rng, n=2000) -> tuple[float, float]:
+    m = np.array([np.mean(x[rng.integers(0, len(x), len(x))]) for _ in range(n)])
+    return tuple(float(v) for v in np.quantile(m, [0.05, 0.95]))
+
+
+def report(res, label: str) -> str:
+    names = list(res[0].estimates)
+    rm = np.array([[r.rmse()[t] for t in names] for r in res])  # (runs, trackers)
+    rng = np.random.default_rng(0)
+    out = [f"### {label}, {len(res)} drives\n",
+           "| tracker | mean RMSE [m] | ratio to dead reckoning (per drive: mean [90 %]) | "
+           "gain (mean DR / mean tracker) | epochs without a measurement |",
+           "| --- | --- | --- | --- | --- |"]  # fmt: skip
+    for j, t in enumerate(names):
+        q = rm[:, j] / rm[:, 0]
+        lo, hi = _interval(q, rng)
+        drop = sum(r.dropped.get(t, 0) for r in res)
+        out.append(f"| {t} | {rm[:, j].mean():.3f} | {q.mean():.2f} [{lo:.2f}, {hi:.2f}] | "
+                   f"{rm[:, 0].mean() / rm[:, j].mean():.2f}x | {drop if j else '-'} |")  # fmt: skip
+    out += ["", "| line of sight fed | n | azimuth error RMS / median abs [deg] | elevation "
+            "error RMS / median abs [deg] | extraction per epoch, median [s] |",
+            "| --- | --- | --- | --- | --- |"]  # fmt: skip
+    for t in ("eq. 1", "direct"):
+        e = np.degrees(np.concatenate([r.los_errors[t] for r in res]))
+        s = np.concatenate([r.seconds[t] for r in res])
+        out.append(
+            f"| {t} | {len(e)} | {np.sqrt(np.mean(e[:, 1] ** 2)):.2f} / "
+            f"{np.median(np.abs(e[:, 1])):.2f} | {np.sqrt(np.mean(e[:, 2] ** 2)):.2f} / "
+            f"{np.median(np.abs(e[:, 2])):.2f} | {np.median(s):.2f} |"
+        )
+    sp = np.concatenate([r.speed_errors for r in res])
+    if sp.size:
+        out.append(f"\ndirect fit's speed error [m/s] ({sp.size} fits): mean {sp.mean():+.3f}, "
+                   f"RMS {np.sqrt(np.mean(sp ** 2)):.3f}, median abs {np.median(np.abs(sp)):.3f}")  # fmt: skip
+    return "\n".join(out) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenario", default="italiano2026-straight")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--runs", type=int, default=6)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--second-order", type=int, default=64)
+    ap.add_argument("--speed-sigma", type=float, default=None,
+                    help="the direct fit's speed told this sigma [m/s] (default: not used)")  # fmt: skip
+    ap.add_argument("--n-epochs", type=int, default=None)
+    g = ap.add_mutually_exclusive_group(required=True)
+    g.add_argument("--table", type=Path, help="the direct fix's sigmas by elevation (JSON)")
+    g.add_argument("--sigmas", help="one azimuth/elevation sigma pair [deg], e.g. 0.3/0.5")
+    ap.add_argument("--sigma-scale", type=float, default=1.0,
+                    help="the direct fix's angle sigmas times this (the table's or --sigmas')")  # fmt: skip
+    ap.add_argument("--write-table", type=Path, default=None)
+    ap.add_argument("--bins", type=int, nargs="+", default=[2],
+                    help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
+    ap.add_argument("--out", type=Path, default=None, help="pickle of the drives")
+    a = ap.parse_args(argv)
+    print("command: python benchmarks/bench_rt_direct.py " + shlex.join(argv or sys.argv[1:]))
+    if a.table is not None:
+        table = ElevationSigmas.from_dict(json.loads(a.table.read_text()))
+    else:
+        az, el = (float(v) for v in a.sigmas.split("/"))
+        table = ElevationSigmas(np.zeros(1), np.radians([az]), np.radians([el]))
+    if a.sigma_scale != 1.0:
+        table = ElevationSigmas(table.elevation, a.sigma_scale * table.sigma_azimuth,
+                                a.sigma_scale * table.sigma_elevation)  # fmt: skip
+    t0 = time.perf_counter()
+    res = [None] * a.runs
+    args = (a.scenario, a.seed, a.runs)
+    with ProcessPoolExecutor(a.workers) as ex:
+        futs = [
+            ex.submit(one, *args, i, table, a.second_order, a.n_epochs, a.speed_sigma)
+            for i in range(a.runs)
+        ]
+        for f in futs:
+            i, r, sec = f.result()
+            res[i] = r
+            print(f"  drive {i}: {sec:.0f} s, " + ", ".join(
+                f"{t} {v:.3f}" for t, v in r.rmse().items()), flush=True)  # fmt: skip
+    told = table.as_dict()
+    print(f"\n{report(res, f'{a.scenario}, seed {a.seed}')}\nthe direct fix told (deg): "
+          f"{told}; {time.perf_counter() - t0:.0f} s\n")  # fmt: skip
+    if a.out is not None:
+        a.out.parent.mkdir(parents=True, exist_ok=True)
+        a.out.write_bytes(pickle.dumps(res))
+    if a.write_table is not None:
+        errors = np.concatenate([r.los_errors["direct"] for r in res])
+        for b in a.bins:
+            new, path = elevation_sigmas(errors, b), Path(str(a.write_table).format(bins=b))
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(new.as_dict(), indent=1) + "\n")
+            print(f"table of {len(errors)} epochs, {b} bins -> {path}: {new.as_dict()}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

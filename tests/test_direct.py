@@ -1,0 +1,198 @@
+"""The direct fit (tunnelkit.studies.direct): the image maps against the traced sources, the tied
+atoms against eq. 1's true parameters, the fit on its own model's tensor (exact without noise, at
+its Cramer-Rao bound with it) and its flag."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from tunnelkit.constants import C
+from tunnelkit.extraction import ml_truth
+from tunnelkit.extraction.numerics import spatial_phase
+from tunnelkit.signal_route import SignalRoute
+from tunnelkit.studies.direct import DirectProblem, direct_fix, image_maps
+from tunnelkit.studies.visibility import predicted_model
+
+NF, NT = 48, 4  # a cut of the tensor: the fits are three parameters whatever its size
+
+
+@pytest.fixture(scope="module")
+def route():
+    return SignalRoute.from_scenario("italiano2026-straight")
+
+
+def _model(route, k, n2=4):
+    arr = route.paths(k)[0]
+    ue, vel = route.trajectory.position[k], route.trajectory.velocity[k]
+    paths, masks, _ = predicted_model(route, arr, ue, vel, n2)
+    return arr, ue, vel, paths, masks
+
+
+@pytest.mark.parametrize("k", [0, 9, 20, 28])
+def test_image_maps_give_every_traced_source(route, k):
+    _, ue, _, paths, _ = _model(route, k)
+    assert any(p.kind == "reflection2" for p in paths)
+    R, t = image_maps(route.tunnel, paths)
+    np.testing.assert_allclose(R @ ue + t, [p.source for p in paths], atol=1e-9)
+    np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.tile(np.eye(3), (len(paths), 1, 1)),
+                               atol=1e-12)  # fmt: skip
+
+
+@pytest.mark.parametrize("k", [3, 25])
+def test_tied_atoms_are_eq1s_true_parameters(route, k):
+    arr, ue, vel, paths, masks = _model(route, k)
+    H = np.zeros((arr.M, NF, NT), complex)
+    prob = DirectProblem(H + 1e-3, arr, route.config, masks, image_maps(route.tunnel, paths),
+                         ue[2], vel)  # fmt: skip
+    b = 1.7
+    theta, mu_f, mu_t = prob.atoms(np.r_[ue[:2], b])
+    th, mf, mt = ml_truth(paths, arr, route.config)
+    np.testing.assert_allclose(theta, th, rtol=1e-10, atol=1e-13)
+    np.testing.assert_allclose(mu_f, mf - 2 * np.pi * route.config.tone_spacing * b / C, rtol=1e-10)
+    np.testing.assert_allclose(mu_t, mt, rtol=1e-8, atol=1e-14)
+
+
+def _tensor(prob, x, gains):
+    """The direct model's own tensor at ``x`` with ``gains`` (masks applied)."""
+    theta, mu_f, mu_t = prob.atoms(x)
+    a = np.exp(1j * spatial_phase(theta, prob.pos, prob.k0)[0]) * prob.mask * gains
+    F = np.exp(1j * prob.s * mu_f[None, :])
+    T = np.exp(1j * prob.kk * mu_t[None, :])
+    return np.einsum("ml,sl,kl->msk", a, F, T)
+
+
+def _setup(route, k, seed):
+    arr, ue, vel, paths, masks = _model(route, k)
+    rng = np.random.default_rng(seed)
+    maps = image_maps(route.tunnel, paths)
+    gains = np.array([abs(p.gain) for p in paths]) * np.exp(2j * np.pi * rng.random(len(paths)))
+    shell = DirectProblem(np.ones((arr.M, NF, NT), complex), arr, route.config, masks, maps,
+                          ue[2], vel)  # fmt: skip
+    x = np.r_[ue[:2], 0.4]
+    return arr, ue, vel, shell, x, gains, rng
+
+
+@pytest.mark.parametrize("k", [6, 22])
+def test_fit_recovers_its_own_model(route, k):
+    """The tensor of the model itself (masks and paths of the true position, the UE at 4.1 m/s
+    where the message says 4.3): from a start 0.3 m off, the tied fit lands on the truth, the
+    speed included; the whole fix from the true position too, and a gate closer than it moved
+    flags it."""
+    arr, ue, _, shell, x, gains, _ = _setup(route, k, 1)
+    told = 4.3 * shell.heading
+    x4 = np.r_[x, 4.1]
+
+    def problem(H):
+        return DirectProblem(H, arr, route.config, shell.mask, (shell.R, shell.t), ue[2], told)
+
+    start = np.r_[ue[0] + 0.3, ue[1] - 0.2, x[2] + 0.2]
+    f = problem(_tensor(shell, np.r_[x, 4.3], gains)).fit_tied(start)  # speed as told
+    assert f["converged"] and f["residual"] < 1e-12
+    np.testing.assert_allclose(f["x"], x, atol=1e-6)
+    prob = problem(_tensor(shell, x4, gains))
+    f = prob.fit_tied(np.r_[start, 4.3])
+    assert f["converged"] and f["residual"] < 1e-12
+    np.testing.assert_allclose(f["x"], x4, atol=1e-6)
+    fix = direct_fix(route, arr, prob.H, ue, told)
+    assert fix.ok and fix.residual < 1e-10
+    np.testing.assert_allclose(np.r_[fix.position[:2], fix.clock_bias, fix.speed], x4, atol=1e-5)
+    assert not direct_fix(route, arr, prob.H, ue + np.array([0.02, 0.0, 0.0]), told, gate=1e-3).ok
+
+
+def _crlb(shell, x, gains, sigma2):
+    """The bound of (x, y, b) with the complex gains unknown: the Fisher information of the real
+    parameters from central differences of the model tensor, the gains' block Schur-eliminated."""
+    cols = []
+    for i in range(3):
+        e = np.zeros(3)
+        e[i] = 1e-5
+        cols.append(((_tensor(shell, x + e, gains) - _tensor(shell, x - e, gains)) / 2e-5).ravel())
+    for j in range(len(gains)):
+        g = np.zeros(len(gains), complex)
+        g[j] = 1.0
+        unit = _tensor(shell, x, g).ravel()
+        cols += [unit, 1j * unit]
+    J = np.column_stack(cols)
+    F = 2.0 / sigma2 * (J.conj().T @ J).real
+    return np.sqrt(np.diag(np.linalg.inv(F))[:3])
+
+
+def test_fit_is_at_its_bound_with_noise(route):
+    """Noise 30 dB below the line of sight's power per cell: the tied fit's RMSE over 40 draws
+    (started 5 cm off) lies within the Monte-Carlo spread of its Cramer-Rao bound in x, y and the
+    clock bias."""
+    arr, ue, vel, shell, x, gains, rng = _setup(route, 14, 5)
+    H0 = _tensor(shell, x, gains)
+    sigma2 = abs(gains[0]) ** 2 * 1e-3
+    bound = _crlb(shell, x, gains, sigma2)
+    err = []
+    for _ in range(40):
+        noise = rng.standard_normal(H0.shape) + 1j * rng.standard_normal(H0.shape)
+        prob = DirectProblem(H0 + np.sqrt(sigma2 / 2) * noise, arr, route.config, shell.mask,
+                             (shell.R, shell.t), ue[2], vel)  # fmt: skip
+        f = prob.fit_tied(x + np.r_[0.05 * rng.standard_normal(2), 0.0])
+        assert f["converged"]
+        err.append(f["x"] - x)
+    rmse = np.sqrt(np.mean(np.square(err), axis=0))
+    # 40 draws: the RMSE of an efficient estimator is within ~25 % of its bound (chi-square, 40 dof)
+    assert np.all(rmse < 1.3 * bound), (rmse, bound)
+    assert np.all(rmse > 0.7 * bound), (rmse, bound)
+
+
+def test_refusals_name_the_parameter(route):
+    arr, ue, vel, shell, x, gains, _ = _setup(route, 10, 2)
+    H = _tensor(shell, x, gains)
+    with pytest.raises(ValueError, match=r"^prediction"):
+        direct_fix(route, arr, H, ue[:2], vel)
+    with pytest.raises(ValueError, match=r"^gate"):
+        direct_fix(route, arr, H, ue, vel, gate=0.0)
+    with pytest.raises(ValueError, match=r"^H"):
+        direct_fix(route, arr, H[:, :, 0], ue, vel)
+    with pytest.raises(ValueError, match=r"^x"):
+        shell.atoms(np.r_[ue[:2]])
+    with pytest.raises(ValueError, match=r"^x0"):
+        shell.fit_tied(np.r_[ue, 0.0, 1.0])
+    with pytest.raises(TypeError, match=r"^speed"):
+        direct_fix(route, arr, H, ue, vel, speed="yes")
+
+
+SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
+
+
+@pytest.mark.skipif(SKIP_RT, reason="TUNNELKIT_SKIP_RT=1")
+def test_direct_drive_tiny_traced_case(tmp_path):
+    """Three epochs of the 4 x 4 on the traced channel: every tracker gives a finite track, dead
+    reckoning is JAVELIN's own run on the same messages with no measurement (the loop steps as
+    Javelin.run does, midpoint included), and the errors fed are recorded per epoch."""
+    from tunnelkit.design.los import ElevationSigmas
+    from tunnelkit.reproduce.javelin_traced import los_design
+    from tunnelkit.studies.attribution import scenario_with_array
+    from tunnelkit.studies.direct_track import TRACKERS, direct_drive
+    from tunnelkit.tracking.javelin import run_javelin
+
+    sc = scenario_with_array("italiano2026-straight", (4, 4))
+    route = SignalRoute.from_scenario(sc, channel="sionna", cache_dir=str(tmp_path))
+    table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
+    design = los_design()
+    out = direct_drive(route, np.random.default_rng(4), design, table, table, speed_sigma=0.1,
+                       n_epochs=3)  # fmt: skip
+    assert set(out.estimates) == set(TRACKERS)
+    assert all(np.all(np.isfinite(x)) and x.shape == (3, 3) for x in out.estimates.values())
+    traj = route.trajectory
+    vel = traj.velocity[:3]
+    truth = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
+    speed, heading = traj.odometry.draw(traj.t[:3], *truth, np.random.default_rng(4))
+    d = design.with_(base_station=tuple(float(v) for v in route.arrays[0].origin),
+                     sigma_p0_ue=0.1, sigma_p0_height=None)  # fmt: skip
+    run = run_javelin([None] * 3, speed, heading, float(traj.t[1] - traj.t[0]), traj.position[0], d)
+    np.testing.assert_allclose(out.estimates["dead reckoning"], run.estimates, atol=1e-12)
+    for name in ("eq. 1", "direct"):
+        assert len(out.los_errors[name]) + out.dropped[name] == 3
+    assert out.speed_errors.size <= 3 and np.all(np.abs(out.speed_errors) < 5.0)
+    with pytest.raises(ValueError, match=r"^speed_sigma"):
+        direct_drive(route, np.random.default_rng(4), design, table, table, speed_sigma=-1.0)
+    with pytest.raises(TypeError, match=r"^route"):
+        direct_drive("italiano2026-straight", np.random.default_rng(4), design, table, table)

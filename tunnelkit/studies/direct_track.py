@@ -1,0 +1,240 @@
+"""The direct fit under the tracker, on the ray-traced channel.
+
+At every epoch JAVELIN predicts with the V2X message, and the direct fit (:func:`~.direct.direct_fix`:
+every atom of the visibility model tied to one UE position, one clock bias and one speed) starts
+from that prediction. Its position goes to the tracker as a line of sight (the fix's angles seen
+from the site, told their sigmas by elevation, :class:`~tunnelkit.design.los.ElevationSigmas`);
+its speed, with ``speed_sigma`` given, is averaged with the next step's V2X speed
+(inverse-variance weights, the tracker told the mean's sigma). The measurement depends on the
+track, so no stored drive can replay this loop.
+
+Beside it on the same messages and snapshots (:func:`direct_drive`): dead reckoning (the same
+JAVELIN, every measurement dropped), the traced tables' line-of-sight column (eq. 1's ML route,
+the path :func:`~tunnelkit.design.los.los_path` takes, its design survey's sigmas) and, with
+``speed_sigma``, dead reckoning on the averaged speed alone (``"direct speed alone"``: the
+direct fits' speeds, no position update), which tells the speed's share from the angles'. No
+truth enters a tracker; it scores them and records the errors each was fed, from which
+:func:`~tunnelkit.design.los.elevation_sigmas` and an RMS make the told sigmas on the drives
+they are chosen on. ``benchmarks/bench_rt_direct.py`` runs it
+(``docs/results/traced-models.md``).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .._validate import finite_array, instance, integer, positive, record, rng_or_error
+from ..angles import wrap_angle
+from ..design.los import LOS_WINDOW_M, ElevationSigmas, los_path
+from ..design.tracedbounds import config_sigmas
+from ..extraction.ml import ml_paths
+from ..geometry import spherical
+from ..signal_route import SignalRoute, measurements_from_estimates
+from ..tracking.javelin import Javelin, JavelinDesign
+from ..tracking.javelin.motion import midpoint_messages, ue_velocity
+from ..tracking.measurements import PathMeasurements
+from .direct import direct_fix
+
+__all__ = ["TRACKERS", "DirectDrive", "direct_drive"]
+
+#: the trackers of one drive (the last only with ``speed_sigma``)
+TRACKERS = ("dead reckoning", "eq. 1", "direct", "direct speed alone")
+
+#: the extraction errors a fit may raise; the epoch is then predicted only
+_FAILURES = (ValueError, np.linalg.LinAlgError, FloatingPointError)
+
+
+@dataclass(frozen=True)
+class DirectDrive:
+    """One drive of :func:`direct_drive`: the true positions ``truth`` (T, 3) [m];
+    ``estimates`` tracker -> (T, 3) [m] (:data:`TRACKERS`); ``los_errors`` ``"eq. 1"`` and
+    ``"direct"`` -> (N, 3) rows ``(measured elevation, azimuth error, elevation error)`` [rad] of
+    the line of sight each was fed; ``speed_errors`` (N,) [m/s] of the direct fits' speeds (the
+    ok ones); ``seconds`` ``"eq. 1"`` / ``"direct"`` -> (T,) [s] of extraction per epoch;
+    ``dropped`` the same keys -> epochs without a measurement (a failed, unconverged or gated fit,
+    or one Algorithm 1 refuses)."""
+
+    truth: np.ndarray
+    estimates: dict = field(repr=False)
+    los_errors: dict = field(repr=False)
+    speed_errors: np.ndarray = field(repr=False)
+    seconds: dict = field(repr=False)
+    dropped: dict
+
+    def __post_init__(self) -> None:
+        record(self, shapes={"truth": (None, 3), "speed_errors": (None,)},
+               may_be_empty=("speed_errors",), skip=("estimates", "los_errors", "seconds",
+                                                      "dropped"))  # fmt: skip
+        T = finite_array("truth", self.truth, shape=(None, 3)).shape[0]
+        finite_array("speed_errors", self.speed_errors, ndim=1)
+        for name in ("estimates", "los_errors", "seconds", "dropped"):
+            instance(name, getattr(self, name), dict)
+        for x in self.estimates.values():
+            finite_array("estimates", x, shape=(T, 3))
+        for x in self.los_errors.values():
+            finite_array("los_errors", x, shape=(None, 3))
+        for x in self.seconds.values():
+            finite_array("seconds", x, shape=(T,))
+
+    def rmse(self) -> dict:
+        """Tracker -> the horizontal RMSE [m] over the drive."""
+        return {
+            name: float(np.sqrt(np.mean(np.sum((x[:, :2] - self.truth[:, :2]) ** 2, axis=1))))
+            for name, x in self.estimates.items()
+        }
+
+
+def _told(pm: PathMeasurements, table: ElevationSigmas, sigma_kappa: float, sigma_d: float):
+    """``pm`` told its angle sigmas from ``table`` at its measured elevation, as
+    :func:`~tunnelkit.design.los.told_by_elevation` tells a drive's."""
+    saz, sel = table.at(pm.psi)
+    cov = np.zeros((len(pm), 3, 3))
+    cov[:, 0, 0], cov[:, 1, 1], cov[:, 2, 2] = saz**2, sel**2, sigma_kappa**2
+    return replace(pm, cov=cov, sigma_d=np.full(len(pm), sigma_d))
+
+
+def _fix_los(fix, origin: np.ndarray, velocity: np.ndarray) -> PathMeasurements:
+    """The line of sight of a direct fix seen from ``origin``: its angles, its range as the
+    curvature, range plus clock bias as the delay, the radial speed of ``velocity``; Algorithm
+    1's checks applied."""
+    q = fix.position - origin
+    phi, psi, r = spherical(q)
+    v = -float(q @ velocity) / r
+    return PathMeasurements.from_arrays([phi], [psi], [r], [r + fix.clock_bias], [v], warn=False)
+
+
+def _eq1_los(route, k: int, arr, snap):
+    """The traced tables' line of sight of one snapshot: eq. 1's ML route (``L`` known, the
+    route's noise power), every row, the path :func:`los_path` takes; None if none."""
+    n1 = route.ml_noise_power(k, snap)
+    est = ml_paths(snap.H, len(route.paths(k)[1]), arr, route.config, noise_power=n1)
+    m = measurements_from_estimates(est, arr)
+    m = PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d)
+    return m.subset(np.array([los_path(m.d, m.psi, LOS_WINDOW_M)])) if len(m) else None
+
+
+def _los_error(pm: PathMeasurements, ue: np.ndarray, origin: np.ndarray) -> tuple:
+    az, el, _ = spherical(ue - origin)
+    return float(pm.psi[0]), float(wrap_angle(pm.phi[0] - az)), float(pm.psi[0] - el)
+
+
+def direct_drive(
+    route: SignalRoute,
+    rng: np.random.Generator,
+    design: JavelinDesign,
+    eq1_table: ElevationSigmas,
+    table: ElevationSigmas,
+    *,
+    speed_sigma: float | None = None,
+    second_order: int = 64,
+    n_epochs: int | None = None,
+    start_sigma: float = 0.1,
+) -> DirectDrive:
+    """One drive of ``route`` (the line of sight always present; the study's channel is the ray
+    tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
+    messages of its trajectory's odometry, then each epoch's snapshot, drawn from ``rng`` in that
+    order; copies of ``design`` (a line-of-sight JAVELIN reading each measurement's covariance,
+    :func:`tunnelkit.design.tracedlos.los_javelin`) started at the true first position told
+    ``start_sigma`` [m] (the traced tables' line-of-sight column), one per :data:`TRACKERS`
+    (module docstring): eq. 1's line of sight told ``eq1_table``, the direct fix's (at most
+    ``second_order`` second-order atoms) ``table``, its speed told ``speed_sigma`` [m/s] (None:
+    the speed not used, no ``"direct speed alone"``). The curvature's and the delay's sigmas are
+    ``design``'s (the delay told half its TDoA variance, as
+    :func:`~tunnelkit.design.tracedlos.told_los`)."""
+    instance("route", route, SignalRoute)
+    rng = rng_or_error("rng", rng)
+    instance("design", design, JavelinDesign)
+    instance("eq1_table", eq1_table, ElevationSigmas)
+    instance("table", table, ElevationSigmas)
+    if speed_sigma is not None and positive("speed_sigma", speed_sigma) > 10.0:
+        raise ValueError(f"speed_sigma: a speed's sigma of at most 10 m/s, got {speed_sigma:g}")
+    n2 = integer("second_order", second_order, minimum=0, maximum=64)
+    if positive("start_sigma", start_sigma) > 1000.0:
+        raise ValueError(f"start_sigma: at most 1000 m, got {start_sigma:g}")
+    traj = route.trajectory
+    T = (
+        len(traj)
+        if n_epochs is None
+        else integer("n_epochs", n_epochs, minimum=1, maximum=len(traj))
+    )
+    vel = traj.velocity[:T]
+    truth = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
+    speed, heading = traj.odometry.draw(traj.t[:T], *truth, rng)
+    d = design.with_(
+        base_station=tuple(float(v) for v in route.arrays[0].origin),
+        sigma_p0_ue=start_sigma,
+        sigma_p0_height=None,
+    )
+    names = TRACKERS if speed_sigma is not None else TRACKERS[:3]
+    designs = dict.fromkeys(names, d)
+    if speed_sigma is not None:  # told the averaged speed's sigma
+        s_msg = d.config.sigma_speed
+        fused = d.with_(sigma_speed=float(1.0 / np.hypot(1.0 / s_msg, 1.0 / speed_sigma)))
+        designs["direct"] = designs["direct speed alone"] = fused
+    trackers = {name: Javelin(traj.position[0], designs[name]) for name in names}
+    c = config_sigmas(d.config)
+    told = {"eq. 1": eq1_table, "direct": table}
+    spd, hdg = (speed, heading) if d.config.motion_step != "midpoint" else midpoint_messages(
+        speed, heading)  # fmt: skip
+    dt = float(traj.t[1] - traj.t[0]) if T > 1 else 0.1  # as DriveData.dt
+    est = {name: np.empty((T, 3)) for name in names}
+    errs, speed_err = {name: [] for name in told}, []
+    secs = {name: np.zeros(T) for name in told}
+    dropped = dict.fromkeys(told, 0)
+    radio = float("nan")  # the last ok fit's speed
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the fits' own tests flag every traced epoch
+        for k in range(T):
+            v, th = (spd[k - 1], hdg[k - 1]) if k else (speed[0], heading[0])
+            for name, jav in trackers.items():
+                u = v
+                if name.startswith("direct") and speed_sigma is not None and np.isfinite(radio):
+                    w = (d.config.sigma_speed / speed_sigma) ** 2
+                    u = (v + w * radio) / (1.0 + w) if np.isfinite(v) else radio
+                jav.predict(u, th, dt if k else 0.0)
+            arr, _, snap = route.draw(k, rng)
+            pm = {}
+            t0 = time.perf_counter()
+            try:
+                pm["eq. 1"] = _eq1_los(route, k, arr, snap)
+            except _FAILURES:
+                pass
+            secs["eq. 1"][k] = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            ok = np.isfinite(speed[k]) and np.isfinite(heading[k])
+            v_msg = ue_velocity(speed[k], heading[k]) if ok else np.zeros(3)
+            try:
+                fix = direct_fix(route, arr, snap.H, trackers["direct"].x[:3], v_msg,
+                                 second_order=n2, speed=speed_sigma is not None and ok)  # fmt: skip
+            except _FAILURES:
+                fix = None
+            radio = float("nan")
+            if fix is not None and fix.ok:
+                pm["direct"] = _fix_los(fix, arr.origin, v_msg)
+                if np.isfinite(fix.speed):
+                    radio = fix.speed
+                    speed_err.append(fix.speed - float(np.linalg.norm(vel[k, :2])))
+            secs["direct"][k] = time.perf_counter() - t0
+            for name, jav in trackers.items():
+                m = pm.get(name)
+                if name in told:
+                    if m is None or not len(m):
+                        dropped[name] += 1
+                        m = None
+                    else:
+                        m = _told(m, told[name], c["kappa"], c["d"] / np.sqrt(2))
+                        errs[name].append(_los_error(m, traj.position[k], arr.origin))
+                jav.update(m)
+                est[name][k] = jav.x[:3]
+    return DirectDrive(
+        traj.position[:T].copy(),
+        est,
+        {n: np.array(r, float).reshape(-1, 3) for n, r in errs.items()},
+        np.array(speed_err, float),
+        secs,
+        dropped,
+    )
