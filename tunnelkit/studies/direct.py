@@ -22,10 +22,10 @@ trade off along the tunnel), is flagged (``DirectFix.ok`` False), never returned
 
 The model is built once, at the prediction: which facets and road markings are seen, and by
 which elements, is the prediction's. On the model's own tensor a prediction 0.1 m off sideways
-changes the masks of up to 57 element-path pairs and the second-order list, and the fit then
-lands up to decimetres off (along the tunnel it changes nothing); rebuilding the model at each
-fit, or holding the paths seen from a ring around the prediction, was tried and did not remove
-it (``docs/results/traced-models.md``). Used under the tracker by :mod:`.direct_track`.
+changed the masks of 5-57 element-path pairs or the second-order list at the epochs checked
+(0.1 m along the tunnel changes fewer: none at two epochs, 5 pairs at two others), and the fit
+then landed up to 1.8 m off; rebuilding the model at each fit, or holding the paths seen from a
+ring around the prediction, was tried and did not remove it (``docs/results/traced-models.md``). Used under the tracker by :mod:`.direct_track`.
 """
 
 from __future__ import annotations
@@ -48,7 +48,8 @@ __all__ = ["DirectFix", "DirectProblem", "direct_fix", "image_maps"]
 
 #: [m] the largest UE height above the road and the largest gate :func:`direct_fix` takes
 MAX_HEIGHT_M, MAX_GATE_M = 20.0, 1000.0
-#: [m] the clock-bias grid's step (a quarter of the delay resolution cell of the paper's 400 MHz)
+#: [m] the clock-bias grid's step (an eighth to a twelfth of the delay cell ``c / B`` of the
+#: presets' 98-400 MHz: 0.75-3 m)
 B_STEP = 0.25
 
 
@@ -93,6 +94,9 @@ class DirectProblem(MaskedProblem):
     def __init__(self, H, array, srs, mask, maps, height: float, velocity):
         instance("array", array, ArrayGeometry)
         self.srs = instance("srs", srs, SRSConfig)
+        if np.ndim(H) != 3 or np.shape(H)[0] != array.M:
+            raise ValueError(f"H: expected ({array.M}, Nf, Nt), the array's elements first, "
+                             f"got shape {np.shape(H)}")  # fmt: skip
         super().__init__(H, array.local, srs.fc, mask)
         if not isinstance(maps, tuple | list) or len(maps) != 2:
             raise TypeError(f"maps: expected image_maps' (R, t), got {type(maps).__name__}")
@@ -192,11 +196,13 @@ def direct_fix(
     (the V2X message's): the visibility model there (:func:`~.visibility.predicted_model`, at most
     ``second_order`` second-order atoms: every one the image method traces by default), the clock
     bias on a grid of :data:`B_STEP` over the route's support, then ``(x, y, b)`` and, with
-    ``speed``, ``(x, y, b, speed)`` by Levenberg-Marquardt; flagged beyond ``gate`` [m] from the
-    prediction or unconverged."""
+    ``speed`` (and a velocity that is not zero), ``(x, y, b, speed)`` by Levenberg-Marquardt;
+    flagged beyond ``gate`` [m] from the prediction or unconverged."""
     if not hasattr(route, "tunnel") or not hasattr(route, "config"):
         raise TypeError(f"route: expected a SignalRoute, got {type(route).__name__}")
-    p0 = finite_array("prediction", prediction, shape=(3,))
+    p0 = route.tunnel.require_inside(
+        "prediction", finite_array("prediction", prediction, shape=(3,))
+    )
     velocity = speeds("velocity", finite_array("velocity", velocity, shape=(3,)))
     gate = positive("gate", gate)
     if gate > MAX_GATE_M:
@@ -211,7 +217,7 @@ def direct_fix(
     b0 = grid[int(np.argmin([prob.cost(np.r_[p0[:2], b]) for b in grid]))]
     f = prob.fit_tied(np.r_[p0[:2], b0])
     evaluations, ok = f["evaluations"], f["converged"]
-    if speed and ok:
+    if speed and ok and np.any(prob.heading):  # a speed along no heading cannot be fitted
         f = prob.fit_tied(np.r_[f["x"], np.linalg.norm(prob.velocity)])
         evaluations, ok = evaluations + f["evaluations"], f["converged"]
     x = f["x"]

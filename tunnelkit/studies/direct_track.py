@@ -12,8 +12,11 @@ Beside it on the same messages and snapshots (:func:`direct_drive`): dead reckon
 JAVELIN, every measurement dropped), the traced tables' line-of-sight column (eq. 1's ML route,
 the path :func:`~tunnelkit.design.los.los_path` takes, its design survey's sigmas) and, with
 ``speed_sigma``, dead reckoning on the averaged speed alone (``"direct speed alone"``: the
-direct fits' speeds, no position update), which tells the speed's share from the angles'. No
-truth enters a tracker; it scores them and records the errors each was fed, from which
+direct fits' speeds, no position update), which tells the speed's share from the angles'. The
+truth starts every tracker (told ``start_sigma``), and the eq. 1 column reads what the traced
+tables' ML route reads (the number of true first-order paths, and with the route's
+``diffuse_floor`` the traced diffuse power in its noise floor); no other truth enters a
+tracker. It scores them and records the errors each was fed, from which
 :func:`~tunnelkit.design.los.elevation_sigmas` and an RMS make the told sigmas on the drives
 they are chosen on. ``benchmarks/bench_rt_direct.py`` runs it
 (``docs/results/traced-models.md``).
@@ -34,7 +37,7 @@ from ..design.tracedbounds import config_sigmas
 from ..extraction.ml import ml_paths
 from ..geometry import spherical
 from ..signal_route import SignalRoute, measurements_from_estimates
-from ..tracking.javelin import Javelin, JavelinDesign
+from ..tracking.javelin import Javelin, JavelinDesign, ReportedNoise
 from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
 from .direct import direct_fix
@@ -97,14 +100,27 @@ def _told(pm: PathMeasurements, table: ElevationSigmas, sigma_kappa: float, sigm
     return replace(pm, cov=cov, sigma_d=np.full(len(pm), sigma_d))
 
 
-def _fix_los(fix, origin: np.ndarray, velocity: np.ndarray) -> PathMeasurements:
+def _fix_los(fix, origin: np.ndarray, velocity: np.ndarray, min_d: float) -> PathMeasurements:
     """The line of sight of a direct fix seen from ``origin``: its angles, its range as the
     curvature, range plus clock bias as the delay, the radial speed of ``velocity``; Algorithm
-    1's checks applied."""
+    1's checks applied (``min_d``: the route's)."""
     q = fix.position - origin
     phi, psi, r = spherical(q)
     v = -float(q @ velocity) / r
-    return PathMeasurements.from_arrays([phi], [psi], [r], [r + fix.clock_bias], [v], warn=False)
+    return PathMeasurements.from_arrays(
+        [phi], [psi], [r], [r + fix.clock_bias], [v], warn=False, min_d=min_d
+    )
+
+
+class _StepSigma(Javelin):
+    """JAVELIN told each step's speed sigma: ``step_sigma`` [m/s] (set before :meth:`predict`;
+    None: the design's) for a speed message that arrived."""
+
+    step_sigma: float | None = None
+
+    def _motion(self, speed, heading, faults):
+        nu, theta, sig = super()._motion(speed, heading, faults)
+        return nu, theta, self.step_sigma if sig is None else sig
 
 
 def _eq1_los(route, k: int, arr, snap):
@@ -148,6 +164,11 @@ def direct_drive(
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
+    if not isinstance(design.noise, ReportedNoise):
+        raise TypeError(
+            "design: expected a line-of-sight JAVELIN reading each measurement's covariance "
+            f"(tracedlos.los_javelin), got noise {type(design.noise).__name__}"
+        )
     instance("eq1_table", eq1_table, ElevationSigmas)
     instance("table", table, ElevationSigmas)
     if speed_sigma is not None and positive("speed_sigma", speed_sigma) > 10.0:
@@ -170,13 +191,10 @@ def direct_drive(
         sigma_p0_height=None,
     )
     names = TRACKERS if speed_sigma is not None else TRACKERS[:3]
-    designs = dict.fromkeys(names, d)
-    if speed_sigma is not None:  # told the averaged speed's sigma
-        s_msg = d.config.sigma_speed
-        fused = d.with_(sigma_speed=float(1.0 / np.hypot(1.0 / s_msg, 1.0 / speed_sigma)))
-        designs["direct"] = designs["direct speed alone"] = fused
-    trackers = {name: Javelin(traj.position[0], designs[name]) for name in names}
+    trackers = {name: _StepSigma(traj.position[0], d) for name in names}
     c = config_sigmas(d.config)
+    if speed_sigma is not None:  # the averaged speed's sigma
+        fused = float(1.0 / np.hypot(1.0 / d.config.sigma_speed, 1.0 / speed_sigma))
     told = {"eq. 1": eq1_table, "direct": table}
     spd, hdg = (speed, heading) if d.config.motion_step != "midpoint" else midpoint_messages(
         speed, heading)  # fmt: skip
@@ -191,10 +209,11 @@ def direct_drive(
         for k in range(T):
             v, th = (spd[k - 1], hdg[k - 1]) if k else (speed[0], heading[0])
             for name, jav in trackers.items():
-                u = v
-                if name.startswith("direct") and speed_sigma is not None and np.isfinite(radio):
+                u, jav.step_sigma = v, None  # the message's speed, told the design's sigma
+                fuse = name.startswith("direct") and speed_sigma is not None
+                if fuse and np.isfinite(radio) and np.isfinite(v):  # averaged with the fit's
                     w = (d.config.sigma_speed / speed_sigma) ** 2
-                    u = (v + w * radio) / (1.0 + w) if np.isfinite(v) else radio
+                    u, jav.step_sigma = (v + w * radio) / (1.0 + w), fused
                 jav.predict(u, th, dt if k else 0.0)
             arr, _, snap = route.draw(k, rng)
             pm = {}
@@ -214,7 +233,7 @@ def direct_drive(
                 fix = None
             radio = float("nan")
             if fix is not None and fix.ok:
-                pm["direct"] = _fix_los(fix, arr.origin, v_msg)
+                pm["direct"] = _fix_los(fix, arr.origin, v_msg, route.min_d)
                 if np.isfinite(fix.speed):
                     radio = fix.speed
                     speed_err.append(fix.speed - float(np.linalg.norm(vel[k, :2])))
