@@ -142,6 +142,8 @@ def export_tunnel(tunnel: Tunnel3D, directory, *, name: str = "tunnel") -> Mitsu
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
         raise ValueError(f"name: expected a plain file stem (letters, digits, _.-), got {name!r}")
     out = FsPath(instance("directory", directory, (str, PathLike), "a directory name"))
+    if not str(directory) or "\0" in str(directory):
+        raise ValueError(f"directory: expected a directory name, got {str(directory)!r}")
     (out / "meshes").mkdir(parents=True, exist_ok=True)
     root = ET.Element("scene", version="2.1.0")
     used_mat: set[str] = set()
