@@ -123,11 +123,11 @@ class _StepSigma(Javelin):
         return nu, theta, self.step_sigma if sig is None else sig
 
 
-def _eq1_los(route, k: int, arr, snap):
-    """The traced tables' line of sight of one snapshot: eq. 1's ML route (``L`` known, the
-    route's noise power), every row, the path :func:`los_path` takes; None if none."""
+def _eq1_los(route, k: int, arr, n_paths: int, snap):
+    """The traced tables' line of sight of one snapshot: eq. 1's ML route (``L = n_paths``
+    known, the route's noise power), every row, the path :func:`los_path` takes; None if none."""
     n1 = route.ml_noise_power(k, snap)
-    est = ml_paths(snap.H, len(route.paths(k)[1]), arr, route.config, noise_power=n1)
+    est = ml_paths(snap.H, n_paths, arr, route.config, noise_power=n1)
     m = measurements_from_estimates(est, arr)
     m = PathMeasurements.from_arrays(m.phi, m.psi, m.kappa, m.d, m.v, warn=False, min_d=route.min_d)
     return m.subset(np.array([los_path(m.d, m.psi, LOS_WINDOW_M)])) if len(m) else None
@@ -215,11 +215,13 @@ def direct_drive(
                     w = (d.config.sigma_speed / speed_sigma) ** 2
                     u, jav.step_sigma = (v + w * radio) / (1.0 + w), fused
                 jav.predict(u, th, dt if k else 0.0)
-            arr, _, snap = route.draw(k, rng)
+            arr, paths, snap = route.draw(
+                k, rng
+            )  # paths: only their number, as the tables' ML route
             pm = {}
             t0 = time.perf_counter()
             try:
-                pm["eq. 1"] = _eq1_los(route, k, arr, snap)
+                pm["eq. 1"] = _eq1_los(route, k, arr, len(paths), snap)
             except _FAILURES:
                 pass
             secs["eq. 1"][k] = time.perf_counter() - t0
