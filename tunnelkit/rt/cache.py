@@ -44,8 +44,9 @@ __all__ = ["CACHE_ENV", "FORMAT", "RayTracedChannel", "default_cache_dir"]
 
 #: environment variable naming the cache directory
 CACHE_ENV = "TUNNELKIT_RT_CACHE"
-#: version of the cache's file format (part of the key)
-FORMAT = 1
+#: version of the cache's file format (part of the key; 2: the tensor's tones centred on the
+#: carrier, :func:`~tunnelkit.rt.elements.element_tensor`)
+FORMAT = 2
 #: a cache label: a plain name (no separator, no leading dot, so no ``..``)
 _LABEL = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}")
 #: the files the cache writes in a directory (all it ever removes)

@@ -11,12 +11,17 @@ carries the carrier phase across the array with the sign opposite to the physica
 (``exp(+j k0 delta_lm)`` with ``delta_lm = d_lm - d_l0``) while its tone and symbol factors keep the
 physical signs (``exp(-j 2 pi s Df tau)``, ``exp(+j 2 pi k f_d T0)``). Conjugating a physical
 tensor reverses all three; reversing the tones and the symbols back gives eq. 1's form. Written
-path by path, that is::
+path by path, with the carrier ``fc`` at the band's centre tone ``s_c = (Nf - 1) / 2``::
 
-    H[m, s, k] = sum_p conj(gain[m, p]) exp(-j 2 pi s Df tau[m, p]) exp(+j 2 pi k f_d[m, p] T0)
+    H[m, s, k] = sum_p conj(gain[m, p]) exp(-j 2 pi (s - s_c) Df tau[m, p]) exp(+j 2 pi k f_d[m, p] T0)
 
-(the tone reversal's constant phase ``exp(j 2 pi (Nf - 1) Df tau)`` is left out: it would be a
-per-element spatial-wideband term of the wrong sign).
+so element ``m``'s phase at tone ``s`` is ``k0 delta_lm (1 - (s - s_c) Df / fc)``: the carrier
+phase at the centre tone, the spatial-wideband term (:func:`~tunnelkit.channel.channel_tensor`
+with ``spatial_wideband=True``) around it. The tone reference matters: measured from tone 0
+instead (the tensor before 2026-12-06), the whole band sat on one side of the carrier, which
+scaled every path's direction cosines by ``1 - s_c Df / fc`` (0.83 % at the paper's 410 tones
+of 240 kHz at 5.9 GHz): a bias of up to 0.2 deg in the line of sight's azimuth at 7 m that no
+physical mechanism makes (``docs/results/traced-models.md``).
 
 The sum costs ``Nf Nt P`` complex products per element (about 1.5e9 per epoch at the paper's
 array with ~3,000 traced paths per element). Per element it is a two-dimensional type-1
@@ -183,8 +188,8 @@ def element_tensor(
         j = np.flatnonzero(sel[m])
         if j.size == 0:
             continue
-        c = np.conj(paths.gain[m, j])
         tau, dop = paths.tau[m, j], paths.doppler[m, j]
+        c = np.conj(paths.gain[m, j]) * np.exp(1j * np.pi * (nf - 1) * df * tau)  # tone s_c
         if fin is None or (method == "auto" and j.size <= NUFFT_MIN_PATHS):
             H[m] = _direct(tau, c, dop, df, nf, T0, nt)
             continue
