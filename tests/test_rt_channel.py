@@ -338,7 +338,7 @@ def test_sionna_tensor_matches_image_method_first_order():
         # the tones measured from tone 0 instead of the carrier's centre tone (the tensor
         # before the carrier was centred): the same paths, each element's phase off by
         # k0 delta_lm s_c Df / fc
-        edge = np.exp(-1j * np.pi * (nf - 1) * cfg.tone_spacing * ep.tau)
+        edge = np.exp(1j * np.pi * (nf - 1) * cfg.tone_spacing * ep.tau)
         res = {}
         for name, e in (("eq. 1", ep), ("unconjugated", dataclasses.replace(ep, gain=np.conj(ep.gain))),
                         ("tone 0", dataclasses.replace(ep, gain=ep.gain * edge))):  # fmt: skip
