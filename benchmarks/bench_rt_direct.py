@@ -45,13 +45,13 @@ def _setup(scenario: str):
     return scenario_route(scenario, "exact", "sionna", NUISANCE), los_survey(scenario)[0]
 
 
-def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma):
+def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element):
     route, eq1 = _setup(scenario)
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
         r = direct_drive(route, spawn_rngs(seed, runs)[i], los_design(), eq1, table,
                          speed_sigma=speed_sigma, second_order=second_order,
-                         n_epochs=n_epochs)  # fmt: skip
+                         n_epochs=n_epochs, element_second_order=by_element)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -102,6 +102,8 @@ def main(argv=None) -> int:
     ap.add_argument("--speed-sigma", type=float, default=None,
                     help="the direct fit's speed told this sigma [m/s] (default: not used)")  # fmt: skip
     ap.add_argument("--n-epochs", type=int, default=None)
+    ap.add_argument("--element-second-order", action="store_true",
+                    help="the second-order atoms each on the elements that see it")  # fmt: skip
     g = ap.add_mutually_exclusive_group(required=True)
     g.add_argument("--table", type=Path, help="the direct fix's sigmas by elevation (JSON)")
     g.add_argument("--sigmas", help="one azimuth/elevation sigma pair [deg], e.g. 0.3/0.5")
@@ -126,7 +128,16 @@ def main(argv=None) -> int:
     args = (a.scenario, a.seed, a.runs)
     with ProcessPoolExecutor(a.workers) as ex:
         futs = [
-            ex.submit(one, *args, i, table, a.second_order, a.n_epochs, a.speed_sigma)
+            ex.submit(
+                one,
+                *args,
+                i,
+                table,
+                a.second_order,
+                a.n_epochs,
+                a.speed_sigma,
+                a.element_second_order,
+            )
             for i in range(a.runs)
         ]
         for f in futs:

@@ -295,6 +295,8 @@ def _studies():
     masked = visibility.MaskedProblem(H, arr.local, route.config.fc, mask[:, : len(paths)])
     masked.fit(th, mf, mt, route.config.noise_power, max_iter=2)
     visibility.predicted_model(route, arr, ue, vel, 1)
+    visibility.predicted_model(route, arr, ue, vel, 1, element_second_order=True)
+    visibility.visible_second_order(route.tunnel, arr, ue, vel, route.config.fc, 2, 0.25)
     nuisance.ModelRow("eq1", "error", "all", 3, *[0.1] * 6, 0.05, 1.0, 2.0, 0.5)
     nuisance.CostRow(1, 5, 0.0, 0.0, 1.2, 1.3, 1.4, 1.0, 1.0, 1.1, 1.1)
     nuisance.eq1_cost(
@@ -321,10 +323,12 @@ def _direct():
     prob.cost(np.r_[ue[:2], 0.0, 4.0])
     prob.residual(np.r_[ue[:2], 0.0])
     prob.fit_tied(np.r_[ue[:2], 0.0], max_evaluations=5)
-    direct.direct_fix(route, arr, H, ue, vel, second_order=2, speed=True, gate=5.0)
+    direct.direct_fix(route, arr, H, ue, vel, second_order=2, speed=True, gate=5.0,
+                      element_second_order=True)  # fmt: skip
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
     direct_track.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
-                              speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1)  # fmt: skip
+                              speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1,
+                              element_second_order=True)  # fmt: skip
 
 
 def _doppler():

@@ -9,12 +9,14 @@ import os
 import numpy as np
 import pytest
 
+from tunnelkit.arrays import ArrayGeometry
 from tunnelkit.constants import C
 from tunnelkit.extraction import ml_truth
 from tunnelkit.extraction.numerics import spatial_phase
+from tunnelkit.propagation import SECOND_ORDER, trace_paths
 from tunnelkit.signal_route import SignalRoute
 from tunnelkit.studies.direct import DirectProblem, direct_fix, image_maps
-from tunnelkit.studies.visibility import predicted_model
+from tunnelkit.studies.visibility import predicted_model, visible_second_order
 
 NF, NT = 48, 4  # a cut of the tensor: the fits are three parameters whatever its size
 
@@ -232,3 +234,28 @@ def test_step_sigma_is_what_the_tracker_is_told(route):
         jav.predict(10.0, 0.1, 0.1)
     np.testing.assert_allclose(told.P, design.P, rtol=1e-12)
     assert not np.allclose(plain.P, told.P)
+
+
+@pytest.mark.parametrize("k", [0, 8, 24])
+def test_second_order_masks_are_the_image_method_at_each_element(route, k):
+    """Each element's mask of the second-order paths is what the image method finds with that
+    element as the reference antenna (brute force, every fifth element); the reference element's
+    paths are among them, and the masks leave out paths part of the array misses."""
+    arr, ue, vel = route.paths(k)[0], route.trajectory.position[k], route.trajectory.velocity[k]
+    fc = route.config.fc
+    paths, masks = visible_second_order(route.tunnel, arr, ue, vel, fc, 64, min_share=0.01)
+    names = [p.surface for p in paths]
+    assert len(set(names)) == len(names) and masks.shape == (arr.M, len(paths))
+    for m in range(0, arr.M, 5):
+        local = np.roll(arr.local - arr.local[m], -m, axis=0)
+        one = ArrayGeometry(local, arr.world[m], arr.azimuth, arr.elevation)
+        seen = {p.surface for p in trace_paths(route.tunnel, one, ue, vel, fc=fc, kinds=route.kinds,
+                                               order=2) if p.kind == SECOND_ORDER}  # fmt: skip
+        assert seen == {n for n, b in zip(names, masks[m], strict=True) if b}, (m, seen)
+    ref = {p.surface for p in trace_paths(route.tunnel, arr, ue, vel, fc=fc, kinds=route.kinds,
+                                          order=2) if p.kind == SECOND_ORDER}  # fmt: skip
+    assert ref == {n for n, b in zip(names, masks[0], strict=True) if b}
+    # the model keeps the n strongest that a quarter of the elements see, with their masks
+    p2, m2, _ = predicted_model(route, arr, ue, vel, 3, element_second_order=True)
+    assert m2.shape == (arr.M, len(p2)) and np.all(m2[:, -3:].mean(axis=0) >= 0.25)
+    assert [p.kind for p in p2[-3:]] == [SECOND_ORDER] * 3

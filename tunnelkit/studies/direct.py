@@ -190,6 +190,7 @@ def direct_fix(
     second_order: int = 64,
     speed: bool = True,
     gate: float = 5.0,
+    element_second_order: bool = False,
 ) -> DirectFix:
     """The direct fit (module docstring) of the tensor ``H`` (M, Nf, Nt) received at ``array``
     on ``route``'s tunnel from the UE's ``prediction`` (3,) [m] moving at ``velocity`` (3,) [m/s]
@@ -197,7 +198,10 @@ def direct_fix(
     ``second_order`` second-order atoms: every one the image method traces by default), the clock
     bias on a grid of :data:`B_STEP` over the route's support, then ``(x, y, b)`` and, with
     ``speed`` (and a velocity that is not zero), ``(x, y, b, speed)`` by Levenberg-Marquardt;
-    flagged beyond ``gate`` [m] from the prediction or unconverged."""
+    flagged beyond ``gate`` [m] from the prediction or unconverged. ``element_second_order``: the
+    second-order atoms each on the elements that see it, whether the reference element does or
+    not (:func:`~.visibility.visible_second_order`), instead of every element on the paths the
+    reference element sees."""
     if not hasattr(route, "tunnel") or not hasattr(route, "config"):
         raise TypeError(f"route: expected a SignalRoute, got {type(route).__name__}")
     p0 = route.tunnel.require_inside(
@@ -209,8 +213,11 @@ def direct_fix(
         raise ValueError(f"gate: at most {MAX_GATE_M:g} m (a tunnel's length), got {gate:g}")
     n2 = integer("second_order", second_order, minimum=0, maximum=64)
     speed = boolean("speed", speed)
+    by_element = boolean("element_second_order", element_second_order)
     cfg = route.config
-    paths, masks, _ = predicted_model(route, array, p0, velocity, n2)  # checks array, velocity
+    paths, masks, _ = predicted_model(  # checks array, velocity
+        route, array, p0, velocity, n2, element_second_order=by_element
+    )
     prob = DirectProblem(H, array, cfg, masks, image_maps(route.tunnel, paths), p0[2], velocity)
     span = C * cfg.clock_bias_limit + 1.0
     grid = np.arange(-span, span + B_STEP, B_STEP)

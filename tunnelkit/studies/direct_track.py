@@ -30,7 +30,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .._validate import finite_array, instance, integer, positive, record, rng_or_error
+from .._validate import boolean, finite_array, instance, integer, positive, record, rng_or_error
 from ..angles import wrap_angle
 from ..design.los import LOS_WINDOW_M, ElevationSigmas, los_path
 from ..design.tracedbounds import config_sigmas
@@ -149,6 +149,7 @@ def direct_drive(
     second_order: int = 64,
     n_epochs: int | None = None,
     start_sigma: float = 0.1,
+    element_second_order: bool = False,
 ) -> DirectDrive:
     """One drive of ``route`` (the line of sight always present; the study's channel is the ray
     tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
@@ -160,7 +161,8 @@ def direct_drive(
     ``second_order`` second-order atoms) ``table``, its speed told ``speed_sigma`` [m/s] (None:
     the speed not used, no ``"direct speed alone"``). The curvature's and the delay's sigmas are
     ``design``'s (the delay told half its TDoA variance, as
-    :func:`~tunnelkit.design.tracedlos.told_los`)."""
+    :func:`~tunnelkit.design.tracedlos.told_los`). ``element_second_order``: the direct fit's
+    second-order atoms each on the elements that see it (:func:`~.direct.direct_fix`)."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -174,6 +176,7 @@ def direct_drive(
     if speed_sigma is not None and positive("speed_sigma", speed_sigma) > 10.0:
         raise ValueError(f"speed_sigma: a speed's sigma of at most 10 m/s, got {speed_sigma:g}")
     n2 = integer("second_order", second_order, minimum=0, maximum=64)
+    by_element = boolean("element_second_order", element_second_order)
     if positive("start_sigma", start_sigma) > 1000.0:
         raise ValueError(f"start_sigma: at most 1000 m, got {start_sigma:g}")
     traj = route.trajectory
@@ -230,7 +233,8 @@ def direct_drive(
             v_msg = ue_velocity(speed[k], heading[k]) if ok else np.zeros(3)
             try:
                 fix = direct_fix(route, arr, snap.H, trackers["direct"].x[:3], v_msg,
-                                 second_order=n2, speed=speed_sigma is not None and ok)  # fmt: skip
+                                 second_order=n2, speed=speed_sigma is not None and ok,
+                                 element_second_order=by_element)  # fmt: skip
             except _FAILURES:
                 fix = None
             radio = float("nan")

@@ -30,13 +30,19 @@ from __future__ import annotations
 import numpy as np
 
 from .._physical import carrier
-from .._validate import finite_array, instance, integer, probability, sequence
+from .._validate import boolean, finite_array, instance, integer, probability, sequence
 from ..arrays import ArrayGeometry
 from ..propagation import PATH_KINDS, SECOND_ORDER, Facet, Path, Tunnel3D, trace_paths
 from ..propagation.path import make_path
 from .aperture import ApertureProblem
 
-__all__ = ["MaskedProblem", "element_visibility", "predicted_model", "visible_paths"]
+__all__ = [
+    "MaskedProblem",
+    "element_visibility",
+    "predicted_model",
+    "visible_paths",
+    "visible_second_order",
+]
 
 
 def element_visibility(tunnel, surface, ue, elements) -> np.ndarray:
@@ -114,7 +120,88 @@ def visible_paths(
     return extra, np.column_stack(masks).astype(float)
 
 
-def predicted_model(route, array, ue, ue_velocity, second_order: int = 0) -> tuple:
+def _visibility2(tunnel, array, s1, s2, ue: np.ndarray, v1: np.ndarray, du: float):
+    """(M,) bool: the elements of ``array`` that receive the second-order path off ``s1`` then
+    ``s2`` (``v1`` the UE's image in ``s1``, ``du`` the UE's distance to it), by the image method
+    at each element, as :func:`~tunnelkit.propagation.second_order_paths` checks it at the
+    reference element (the last bounce in front of the array's face)."""
+    el = array.world
+    p1, p2 = s1.plane, s2.plane
+    da, dv = p2.signed_distance(el), float(p2.signed_distance(v1))
+    if dv <= 0:
+        return np.zeros(len(el), bool)
+    v2 = p2.mirror(v1)
+    front = da > 0
+    a = np.where(front, da, 0.0)
+    q2 = el + (a / (a + dv))[:, None] * (v2 - el)
+    e2 = p1.signed_distance(q2)
+    ok = front & s2.contains(q2) & (e2 > 0)
+    b = np.where(ok, e2, 0.0)
+    q1 = q2 + (b / (b + du))[:, None] * (v1 - q2)
+    ok &= s1.contains(q1) & (p2.signed_distance(q1) > 0)
+    ok &= array.in_front(q2)
+    return ok & ~tunnel.blocked(ue, q1) & ~tunnel.blocked(q1, q2) & ~tunnel.blocked(q2, el)
+
+
+def visible_second_order(
+    tunnel, array, ue, ue_velocity, fc: float, n: int, min_share: float = 0.25, kinds=PATH_KINDS
+) -> tuple[list, np.ndarray]:
+    """The ``n`` strongest second-order specular paths at least ``min_share`` of ``array``'s
+    elements receive, each with the elements that do: ``(paths, masks)``, ``masks`` (M, n) float
+    0/1. Unlike ``trace_paths(order=2)``, which checks each bounce at the reference element only,
+    a path is kept when enough elements see it, whether the reference element does or not (its
+    :class:`~tunnelkit.propagation.Path` then as at the reference element, from its source, the
+    UE mirrored twice); strongest by the magnitude of its two reflection coefficients over its
+    length there."""
+    instance("tunnel", tunnel, Tunnel3D)
+    instance("array", array, ArrayGeometry)
+    ue = finite_array("ue", ue, shape=(3,))
+    vel = finite_array("ue_velocity", ue_velocity, shape=(3,))
+    fc = carrier("fc", fc)
+    n = integer("n", n, minimum=0, maximum=64)
+    min_share = probability("min_share", min_share)
+    kinds = sequence("kinds", kinds)
+    el, a0 = array.world, array.origin
+    surf = [s for s in tunnel.surfaces if s.kind in kinds]
+    found = []
+    for s1 in surf:
+        du = float(s1.plane.signed_distance(ue))
+        if du <= 0:
+            continue
+        v1 = s1.plane.mirror(ue)
+        for s2 in surf:
+            if s2 is s1:
+                continue
+            seen = _visibility2(tunnel, array, s1, s2, ue, v1, du)
+            if seen.mean() < min_share:
+                continue
+            p1, p2 = s1.plane, s2.plane
+            v2 = p2.mirror(v1)
+            da, dv = float(p2.signed_distance(a0)), float(p2.signed_distance(v1))
+            q2 = a0 + max(da, 0.0) / (max(da, 0.0) + dv) * (v2 - a0)
+            e2 = max(float(p1.signed_distance(q2)), 0.0)
+            q1 = q2 + e2 / (e2 + du) * (v1 - q2)
+            leg1, leg2 = float(np.linalg.norm(ue - q1)), float(np.linalg.norm(q1 - q2))
+            g1 = s1.reflection_coefficient(fc, min(du / max(leg1, 1e-9), 1.0))
+            g2 = s2.reflection_coefficient(
+                fc, min(max(float(p2.signed_distance(q1)), 0.0) / max(leg2, 1e-9), 1.0)
+            )
+            vel1 = vel - 2.0 * (vel @ p1.normal) * p1.normal
+            vel2 = vel1 - 2.0 * (vel1 @ p2.normal) * p2.normal
+            path = make_path(SECOND_ORDER, f"{s1.name} > {s2.name}", SECOND_ORDER, v2, q2, ue,
+                             vel2, array, fc, complex(g1 * g2), leg=leg1 + leg2)  # fmt: skip
+            found.append((abs(g1 * g2) / float(np.linalg.norm(v2 - a0)), path, seen))
+    found.sort(key=lambda f: -f[0])
+    found = found[:n]
+    masks = (
+        np.column_stack([f[2] for f in found]).astype(float) if found else np.zeros((len(el), 0))
+    )
+    return [f[1] for f in found], masks
+
+
+def predicted_model(
+    route, array, ue, ue_velocity, second_order: int = 0, *, element_second_order: bool = False
+) -> tuple:
     """The visibility model at a UE position ``ue`` (a tracker's prediction): the first-order paths
     traced there to ``array`` (the route's path kinds), the facets part of the array sees
     (:func:`visible_paths`) and the ``second_order`` strongest second-order paths (seen by every
@@ -123,14 +210,20 @@ def predicted_model(route, array, ue, ue_velocity, second_order: int = 0) -> tup
     if not hasattr(route, "tunnel") or not hasattr(route, "kinds"):
         raise TypeError(f"route: expected a SignalRoute, got {type(route).__name__}")
     n2 = integer("second_order", second_order, minimum=0, maximum=64)
+    by_element = boolean("element_second_order", element_second_order)
     fc = route.config.fc
     every = trace_paths(route.tunnel, array, ue, ue_velocity, fc=fc, kinds=route.kinds,
-                        order=2 if n2 else 1)  # fmt: skip
+                        order=2 if n2 and not by_element else 1)  # fmt: skip
     first = [p for p in every if p.kind != SECOND_ORDER]
-    second = sorted((p for p in every if p.kind == SECOND_ORDER), key=lambda p: -abs(p.gain))[:n2]
     extra, masks = visible_paths(route.tunnel, array, first, ue, ue_velocity, fc, kinds=route.kinds)
-    masks = np.column_stack([masks, np.ones((array.M, len(second)))])
-    return first + extra + second, masks, len(first)
+    if by_element:
+        second, m2 = visible_second_order(route.tunnel, array, ue, ue_velocity, fc, n2,
+                                          kinds=route.kinds)  # fmt: skip
+    else:
+        second = sorted((p for p in every if p.kind == SECOND_ORDER), key=lambda p: -abs(p.gain))
+        second = second[:n2]
+        m2 = np.ones((array.M, len(second)))
+    return first + extra + second, np.column_stack([masks, m2]), len(first)
 
 
 class MaskedProblem(ApertureProblem):
