@@ -151,8 +151,8 @@ def visible_second_order(
     0/1. Unlike ``trace_paths(order=2)``, which checks each bounce at the reference element only,
     a path is kept when enough elements see it, whether the reference element does or not (its
     :class:`~tunnelkit.propagation.Path` then as at the reference element, from its source, the
-    UE mirrored twice); strongest by the magnitude of its two reflection coefficients over its
-    length there."""
+    UE mirrored twice); strongest by the magnitude of that path's gain, as ``trace_paths``'s are
+    ranked by :func:`predicted_model`."""
     instance("tunnel", tunnel, Tunnel3D)
     instance("array", array, ArrayGeometry)
     ue = finite_array("ue", ue, shape=(3,))
@@ -161,6 +161,8 @@ def visible_second_order(
     n = integer("n", n, minimum=0, maximum=64)
     min_share = probability("min_share", min_share)
     kinds = sequence("kinds", kinds)
+    if not set(kinds) <= set(PATH_KINDS):
+        raise ValueError(f"kinds: expected path kinds of {PATH_KINDS}, got {kinds!r}")
     el, a0 = array.world, array.origin
     surf = [s for s in tunnel.surfaces if s.kind in kinds]
     found = []
@@ -190,7 +192,7 @@ def visible_second_order(
             vel2 = vel1 - 2.0 * (vel1 @ p2.normal) * p2.normal
             path = make_path(SECOND_ORDER, f"{s1.name} > {s2.name}", SECOND_ORDER, v2, q2, ue,
                              vel2, array, fc, complex(g1 * g2), leg=leg1 + leg2)  # fmt: skip
-            found.append((abs(g1 * g2) / float(np.linalg.norm(v2 - a0)), path, seen))
+            found.append((abs(path.gain), path, seen))
     found.sort(key=lambda f: -f[0])
     found = found[:n]
     masks = (
@@ -204,9 +206,11 @@ def predicted_model(
 ) -> tuple:
     """The visibility model at a UE position ``ue`` (a tracker's prediction): the first-order paths
     traced there to ``array`` (the route's path kinds), the facets part of the array sees
-    (:func:`visible_paths`) and the ``second_order`` strongest second-order paths (seen by every
-    element, as ``RouteOptions(second_order=N)`` picks them): ``(paths, masks, n_first)``, the
-    paths in that order, ``masks`` (M, len(paths)), ``n_first`` the first-order paths listed."""
+    (:func:`visible_paths`) and the ``second_order`` strongest second-order paths (those the
+    reference element sees, on every element, as ``RouteOptions(second_order=N)`` picks them; with
+    ``element_second_order`` each on the elements that see it, :func:`visible_second_order`):
+    ``(paths, masks, n_first)``, the paths in that order, ``masks`` (M, len(paths)), ``n_first``
+    the first-order paths listed."""
     if not hasattr(route, "tunnel") or not hasattr(route, "kinds"):
         raise TypeError(f"route: expected a SignalRoute, got {type(route).__name__}")
     n2 = integer("second_order", second_order, minimum=0, maximum=64)
