@@ -426,8 +426,8 @@ print("epochs flagged: " + ", ".join(f"{ch} {sum(f)} of {len(f)}" for ch, f in f
 
 # %% [markdown]
 # On the traced channel every path matched on both channels errs more in delay than on the
-# image channel (printed; the line of sight least, about twice in quick mode, the ceiling tens of
-# times): the model, not the noise, sets them. Section 8 says by how much. In full
+# image channel (printed: each at least half again as much, one at least ten times): the model,
+# not the noise, sets them. Section 8 says by how much. In full
 # mode the ML route flags every traced epoch and no image epoch: at this SNR each part the model
 # lacks is detectable, so the residual test is telling the truth about the model.
 #

@@ -1322,6 +1322,9 @@ for a in rt_sizes:
 for col in (2, 5):
     rms_q = [{r[0]: r for r in records[a]["rows"]}["all"][col] for a in rt_sizes]
     assert all(x > y for x, y in pairwise(rms_q)), (col, rms_q)
+for col in (3, 4):  # ... the elevation's [3] and the curvature's [4] do not
+    rms_q = [{r[0]: r for r in records[a]["rows"]}["all"][col] for a in rt_sizes]
+    assert not all(x > y for x, y in pairwise(rms_q)), (col, rms_q)
 # quick mode's 12 traced epochs: 1.1 s at 0.1 s a step, two of them counted
 t_rt = paper_rt.trajectory.t
 assert np.isclose(t_rt[11] - t_rt[0], 1.1) and k_quick.size == 2, (t_rt[:12], k_quick)
