@@ -325,6 +325,7 @@ def _direct():
     prob.fit_tied(np.r_[ue[:2], 0.0], max_evaluations=5)
     direct.direct_fix(route, arr, H, ue, vel, second_order=2, speed=True, gate=5.0,
                       element_second_order=True)  # fmt: skip
+    direct_track.eq1_los(route, 12, arr, 3, snap)
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
     direct_track.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
                               speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1,

@@ -32,6 +32,8 @@ import numpy as np
 
 from .._validate import boolean, finite_array, instance, integer, positive, record, rng_or_error
 from ..angles import wrap_angle
+from ..arrays import ArrayGeometry
+from ..channel import ChannelSnapshot
 from ..design.los import LOS_WINDOW_M, ElevationSigmas, los_path
 from ..design.tracedbounds import config_sigmas
 from ..extraction.ml import ml_paths
@@ -42,7 +44,7 @@ from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
 from .direct import direct_fix
 
-__all__ = ["TRACKERS", "DirectDrive", "direct_drive"]
+__all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los"]
 
 #: the trackers of one drive (the last only with ``speed_sigma``)
 TRACKERS = ("dead reckoning", "eq. 1", "direct", "direct speed alone")
@@ -123,9 +125,18 @@ class _StepSigma(Javelin):
         return nu, theta, self.step_sigma if sig is None else sig
 
 
-def _eq1_los(route, k: int, arr, n_paths: int, snap):
-    """The traced tables' line of sight of one snapshot: eq. 1's ML route (``L = n_paths``
-    known, the route's noise power), every row, the path :func:`los_path` takes; None if none."""
+def eq1_los(route, k: int, arr, n_paths: int, snap):
+    """The traced tables' line of sight of the snapshot ``snap`` (a
+    :class:`~tunnelkit.channel.ChannelSnapshot`) of epoch ``k`` of ``route`` received at ``arr``:
+    eq. 1's ML route (``L = n_paths`` known, the route's noise power), every row, the path
+    :func:`los_path` takes; None if none."""
+    instance("route", route, SignalRoute)
+    k = integer("k", k, minimum=0, maximum=len(route.trajectory) - 1)
+    instance("arr", arr, ArrayGeometry)
+    n_paths = integer("n_paths", n_paths, minimum=1, maximum=arr.M - 1)  # as ml_paths
+    instance("snap", snap, ChannelSnapshot)
+    if snap.H.shape[0] != arr.M:
+        raise ValueError(f"snap: {snap.H.shape[0]} elements, the array arr has {arr.M}")
     n1 = route.ml_noise_power(k, snap)
     est = ml_paths(snap.H, n_paths, arr, route.config, noise_power=n1)
     m = measurements_from_estimates(est, arr)
@@ -224,7 +235,7 @@ def direct_drive(
             pm = {}
             t0 = time.perf_counter()
             try:
-                pm["eq. 1"] = _eq1_los(route, k, arr, len(paths), snap)
+                pm["eq. 1"] = eq1_los(route, k, arr, len(paths), snap)
             except _FAILURES:
                 pass
             secs["eq. 1"][k] = time.perf_counter() - t0

@@ -1,0 +1,78 @@
+"""One epoch's extraction on the ray-traced channel: eq. 1's ML route against the direct fit.
+
+The cost per epoch of what each tracker of ``benchmarks/bench_rt_direct.py`` reads
+(:mod:`tunnelkit.studies.direct_track`): the traced tables' line-of-sight column (eq. 1's ML
+route with the number of first-order paths and the route's diffuse floor, the baseline) and the
+direct fit (:func:`tunnelkit.studies.direct.direct_fix`, with its speed) with the second-order
+atoms on every element or each on the elements that see it, from a prediction 5 cm off. One
+snapshot of epochs 4 and 20 of ``italiano2026-straight`` (the paper's 10 x 10, 410 tones, 12
+symbols) on one BLAS thread; the traces come from the ray tracer's cache (traced on the first
+run, a few seconds per epoch). Left out when the ``rt`` extra is not installed.
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run import Case
+
+from tunnelkit import rt
+from tunnelkit.simulation.drives import scenario_route
+from tunnelkit.studies.direct import direct_fix
+from tunnelkit.studies.direct_track import eq1_los
+from tunnelkit.tracking.javelin.motion import ue_velocity
+
+EPOCHS = (4, 20)
+
+
+def _eq1(route, k, arr, n_paths, snap):
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return eq1_los(route, k, arr, n_paths, snap)
+
+
+def _direct(route, arr, H, prediction, velocity, by_element):
+    with threadpool_limits(1), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return direct_fix(route, arr, H, prediction, velocity, element_second_order=by_element)
+
+
+def cases() -> list[Case]:
+    if not rt.sionna_available():
+        return []
+    route = scenario_route("italiano2026-straight", "exact", "sionna", {"diffuse_floor": True})
+    traj, rng = route.trajectory, np.random.default_rng(20261206)
+    out = []
+    for k in EPOCHS:
+        arr, paths, snap = route.draw(k, rng)
+        vel = traj.velocity[k]
+        v = ue_velocity(float(np.hypot(*vel[:2])), float(np.arctan2(vel[1], vel[0])))
+        p0 = traj.position[k] + np.array([0.05, 0.0, 0.0])
+        r = float(np.linalg.norm(traj.position[k] - arr.origin))
+        g = f"traced_epoch_{k}"
+        eq1 = partial(_eq1, route, k, arr, len(paths), snap)
+        direct = partial(_direct, route, arr, snap.H, p0, v)
+        out += [
+            Case(
+                f"eq. 1 ML route, line of sight, epoch {k} ({r:.0f} m)",
+                eq1,
+                group=g,
+                baseline=True,
+                repeat=5,
+            ),
+            Case(f"direct fit + speed, epoch {k}", partial(direct, False), group=g, repeat=5),
+            Case(
+                f"direct fit + speed, second order per element, epoch {k}",
+                partial(direct, True),
+                group=g,
+                repeat=5,
+            ),
+        ]
+    return out
