@@ -46,13 +46,15 @@ def _setup(scenario: str):
     return scenario_route(scenario, "exact", "sionna", NUISANCE), los_survey(scenario)[0]
 
 
-def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element):
+def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
+        max_unmodelled):  # fmt: skip
     route, eq1 = _setup(scenario)
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
         r = direct_drive(route, spawn_rngs(seed, runs)[i], los_design(), eq1, table,
                          speed_sigma=speed_sigma, second_order=second_order,
-                         n_epochs=n_epochs, element_second_order=by_element)  # fmt: skip
+                         n_epochs=n_epochs, element_second_order=by_element,
+                         max_unmodelled=max_unmodelled)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -90,6 +92,12 @@ def report(res, label: str) -> str:
             f"{np.median(np.abs(e[:, 1])):.2f} | {np.sqrt(np.mean(e[:, 2] ** 2)):.2f} / "
             f"{np.median(np.abs(e[:, 2])):.2f} | {np.median(s):.2f} |"
         )
+    u = np.concatenate([r.unmodelled for r in res])
+    if u.size:
+        q = np.quantile(u, [0.5, 0.9, 0.99])
+        out.append(f"\nthe direct fits' unmodelled share ({u.size} converged fits): median "
+                   f"{100 * q[0]:.2f} %, 90 % {100 * q[1]:.2f} %, 99 % {100 * q[2]:.2f} %, "
+                   f"largest {100 * u.max():.2f} %")  # fmt: skip
     sp = np.concatenate([r.speed_errors for r in res])
     if sp.size:
         out.append(f"\ndirect fit's speed error [m/s] ({sp.size} fits): mean {sp.mean():+.3f}, "
@@ -114,6 +122,8 @@ def main(argv=None) -> int:
     g.add_argument("--sigmas", help="one azimuth/elevation sigma pair [deg], e.g. 0.3/0.5")
     ap.add_argument("--sigma-scale", type=float, default=1.0,
                     help="the direct fix's angle sigmas times this (the table's or --sigmas')")  # fmt: skip
+    ap.add_argument("--max-unmodelled", type=float, default=None,
+                    help="drop a direct fix whose unmodelled share of the power exceeds this")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -142,6 +152,7 @@ def main(argv=None) -> int:
                 a.n_epochs,
                 a.speed_sigma,
                 a.element_second_order,
+                a.max_unmodelled,
             )
             for i in range(a.runs)
         ]

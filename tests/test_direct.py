@@ -110,6 +110,36 @@ def test_fit_recovers_its_own_model(route, k):
     assert not direct_fix(route, arr, prob.H, ue + np.array([0.02, 0.0, 0.0]), told, gate=1e-3).ok
 
 
+def test_unmodelled_share_is_what_the_model_lacks(route):
+    """On the model's own tensor with noise the fix's residual beyond the noise is about zero
+    (the noise's spread, a few parts in 10^4 here); with an interference the model cannot
+    absorb (white, 5 % of the signal's power, 0.4 % noise) it is that share, within 10 %."""
+    from tunnelkit.channel import ChannelSnapshot
+    from tunnelkit.studies.direct_track import unmodelled_share
+
+    arr, ue, vel, shell, x, gains, rng = _setup(route, 12, 7)
+    H0 = _tensor(shell, x, gains)
+    p0 = float(np.mean(np.abs(H0) ** 2))
+    sigma2 = 4e-3 * p0
+
+    def white(power):
+        z = rng.standard_normal(H0.shape) + 1j * rng.standard_normal(H0.shape)
+        return np.sqrt(power / 2) * z
+
+    told = np.linalg.norm(vel) * shell.heading
+    for extra, want in ((0.0, 0.0), (0.05, 0.05 / (1.0 + 0.05 + 4e-3))):
+        H = H0 + white(sigma2) + (white(extra * p0) if extra else 0.0)
+        fix = direct_fix(route, arr, H, ue, told, speed=False)
+        share = unmodelled_share(
+            fix.residual, ChannelSnapshot(H, sigma2, 0.0, "exact", (), route.config)
+        )
+        assert abs(share - want) < max(0.1 * want, 5e-4), (share, want)
+    with pytest.raises(ValueError, match=r"^residual"):
+        unmodelled_share(1.5, ChannelSnapshot(H0, sigma2, 0.0, "exact", (), route.config))
+    with pytest.raises(TypeError, match=r"^snap"):
+        unmodelled_share(0.1, H0)
+
+
 def _crlb(shell, x, gains, sigma2):
     """The bound of (x, y, b) with the complex gains unknown: the Fisher information of the real
     parameters from central differences of the model tensor, the gains' block Schur-eliminated."""
@@ -212,6 +242,16 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
     np.testing.assert_allclose(out.estimates["dead reckoning"], run.estimates, atol=1e-12)
     assert out.dropped["direct"] < 3 and out.speed_errors.size >= 1
     assert not np.allclose(out.estimates["direct"], out.estimates["dead reckoning"])
+    assert out.unmodelled.size == 3 - out.dropped["direct"]  # every converged fix, here all fed
+    # the same drive with every fix past a tiny unmodelled share dropped: the direct tracker is
+    # dead reckoning on the same messages
+    strict = direct_drive(route, np.random.default_rng(4), design, table, table, n_epochs=3,
+                          max_unmodelled=1e-12)  # fmt: skip
+    assert strict.dropped["direct"] == 3 and strict.unmodelled.size >= 1
+    np.testing.assert_allclose(strict.estimates["direct"], strict.estimates["dead reckoning"],
+                               atol=1e-12)  # fmt: skip
+    with pytest.raises(ValueError, match=r"^max_unmodelled"):
+        direct_drive(route, np.random.default_rng(4), design, table, table, max_unmodelled=2.0)
     with pytest.raises(ValueError, match=r"^speed_sigma"):
         direct_drive(route, np.random.default_rng(4), design, table, table, speed_sigma=-1.0)
     with pytest.raises(TypeError, match=r"^route"):

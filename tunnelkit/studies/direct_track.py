@@ -44,7 +44,7 @@ from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
 from .direct import direct_fix
 
-__all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los"]
+__all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los", "unmodelled_share"]
 
 #: the trackers of one drive (the last only with ``speed_sigma``)
 TRACKERS = ("dead reckoning", "eq. 1", "direct", "direct speed alone")
@@ -61,7 +61,9 @@ class DirectDrive:
     the line of sight each was fed; ``speed_errors`` (N,) [m/s] of the direct fits' speeds (the
     ok ones); ``seconds`` ``"eq. 1"`` / ``"direct"`` -> (T,) [s] of extraction per epoch;
     ``dropped`` the same keys -> epochs without a measurement (a failed, unconverged or gated fit,
-    or one Algorithm 1 refuses)."""
+    one past ``max_unmodelled``, or one Algorithm 1 refuses); ``unmodelled`` (K,) the unmodelled
+    share of every converged direct fit's tensor (:func:`unmodelled_share`), whether fed or
+    dropped."""
 
     truth: np.ndarray
     estimates: dict = field(repr=False)
@@ -69,13 +71,16 @@ class DirectDrive:
     speed_errors: np.ndarray = field(repr=False)
     seconds: dict = field(repr=False)
     dropped: dict
+    unmodelled: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
-        record(self, shapes={"truth": (None, 3), "speed_errors": (None,)},
-               may_be_empty=("speed_errors",), skip=("estimates", "los_errors", "seconds",
-                                                      "dropped"))  # fmt: skip
+        record(self, shapes={"truth": (None, 3), "speed_errors": (None,), "unmodelled": (None,)},
+               may_be_empty=("speed_errors", "unmodelled"),
+               skip=("estimates", "los_errors", "seconds", "dropped"))  # fmt: skip
         T = finite_array("truth", self.truth, shape=(None, 3)).shape[0]
         finite_array("speed_errors", self.speed_errors, ndim=1)
+        if np.any(self.unmodelled > 1.0 + 1e-9):
+            raise ValueError("unmodelled: a share of the tensor's power is at most 1")
         for name in ("estimates", "los_errors", "seconds", "dropped"):
             instance(name, getattr(self, name), dict)
         for x in self.estimates.values():
@@ -144,6 +149,18 @@ def eq1_los(route, k: int, arr, n_paths: int, snap):
     return m.subset(np.array([los_path(m.d, m.psi, LOS_WINDOW_M)])) if len(m) else None
 
 
+def unmodelled_share(residual: float, snap: ChannelSnapshot) -> float:
+    """What a fit's ``residual`` (its cost over ``||H||^2`` of the snapshot ``snap``) leaves
+    beyond the noise: ``residual - N0 M Nf Nt / ||H||^2`` with ``N0`` the snapshot's noise power
+    (the receiver's own). About zero where the model holds; the power share of what the model
+    lacks where it does not (negative by the noise's own spread)."""
+    r = float(finite_array("residual", residual, ndim=0))
+    if not 0.0 <= r <= 1.0 + 1e-9:
+        raise ValueError(f"residual: a share of the tensor's power in [0, 1], got {r:g}")
+    instance("snap", snap, ChannelSnapshot)
+    return r - snap.noise_power * snap.H.size / float(np.sum(np.abs(snap.H) ** 2))
+
+
 def _los_error(pm: PathMeasurements, ue: np.ndarray, origin: np.ndarray) -> tuple:
     az, el, _ = spherical(ue - origin)
     return float(pm.psi[0]), float(wrap_angle(pm.phi[0] - az)), float(pm.psi[0] - el)
@@ -161,6 +178,7 @@ def direct_drive(
     n_epochs: int | None = None,
     start_sigma: float = 0.1,
     element_second_order: bool = False,
+    max_unmodelled: float | None = None,
 ) -> DirectDrive:
     """One drive of ``route`` (the line of sight always present; the study's channel is the ray
     tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
@@ -173,7 +191,10 @@ def direct_drive(
     the speed not used, no ``"direct speed alone"``). The curvature's and the delay's sigmas are
     ``design``'s (the delay told half its TDoA variance, as
     :func:`~tunnelkit.design.tracedlos.told_los`). ``element_second_order``: the direct fit's
-    second-order atoms each on the elements that see it (:func:`~.direct.direct_fix`)."""
+    second-order atoms each on the elements that see it (:func:`~.direct.direct_fix`).
+    ``max_unmodelled``: a direct fix whose :func:`unmodelled_share` exceeds it is dropped (the
+    fit's own flag: the model misses that share of the tensor's power; None: every converged fix
+    within the gate is fed)."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -188,6 +209,8 @@ def direct_drive(
         raise ValueError(f"speed_sigma: a speed's sigma of at most 10 m/s, got {speed_sigma:g}")
     n2 = integer("second_order", second_order, minimum=0, maximum=64)
     by_element = boolean("element_second_order", element_second_order)
+    if max_unmodelled is not None and not 0.0 < positive("max_unmodelled", max_unmodelled) <= 1.0:
+        raise ValueError(f"max_unmodelled: a share of the power in (0, 1], got {max_unmodelled:g}")
     if positive("start_sigma", start_sigma) > 1000.0:
         raise ValueError(f"start_sigma: at most 1000 m, got {start_sigma:g}")
     traj = route.trajectory
@@ -214,7 +237,7 @@ def direct_drive(
         speed, heading)  # fmt: skip
     dt = float(traj.t[1] - traj.t[0]) if T > 1 else 0.1  # as DriveData.dt
     est = {name: np.empty((T, 3)) for name in names}
-    errs, speed_err = {name: [] for name in told}, []
+    errs, speed_err, unmodelled = {name: [] for name in told}, [], []
     secs = {name: np.zeros(T) for name in told}
     dropped = dict.fromkeys(told, 0)
     radio = float("nan")  # the last ok fit's speed
@@ -249,7 +272,10 @@ def direct_drive(
             except _FAILURES:
                 fix = None
             radio = float("nan")
-            if fix is not None and fix.ok:
+            share = unmodelled_share(fix.residual, snap) if fix is not None and fix.ok else None
+            if share is not None:
+                unmodelled.append(share)
+            if share is not None and (max_unmodelled is None or share <= max_unmodelled):
                 pm["direct"] = _fix_los(fix, arr.origin, v_msg, route.min_d)
                 if np.isfinite(fix.speed):
                     radio = fix.speed
@@ -273,4 +299,5 @@ def direct_drive(
         np.array(speed_err, float),
         secs,
         dropped,
+        np.array(unmodelled, float),
     )
