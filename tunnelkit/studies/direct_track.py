@@ -142,6 +142,11 @@ def eq1_los(route, k: int, arr, n_paths: int, snap):
     instance("snap", snap, ChannelSnapshot)
     if snap.H.shape[0] != arr.M:
         raise ValueError(f"snap: {snap.H.shape[0]} elements, the array arr has {arr.M}")
+    return _eq1_los(route, k, arr, n_paths, snap)
+
+
+def _eq1_los(route, k, arr, n_paths, snap):
+    """:func:`eq1_los` of checked arguments."""
     n1 = route.ml_noise_power(k, snap)
     est = ml_paths(snap.H, n_paths, arr, route.config, noise_power=n1)
     m = measurements_from_estimates(est, arr)
@@ -157,8 +162,12 @@ def unmodelled_share(residual: float, snap: ChannelSnapshot) -> float:
     r = float(finite_array("residual", residual, ndim=0))
     if not 0.0 <= r <= 1.0 + 1e-9:
         raise ValueError(f"residual: a share of the tensor's power in [0, 1], got {r:g}")
-    instance("snap", snap, ChannelSnapshot)
-    return r - snap.noise_power * snap.H.size / float(np.sum(np.abs(snap.H) ** 2))
+    return _unmodelled(r, instance("snap", snap, ChannelSnapshot))
+
+
+def _unmodelled(residual: float, snap) -> float:
+    """:func:`unmodelled_share` of checked arguments."""
+    return residual - snap.noise_power * snap.H.size / float(np.sum(np.abs(snap.H) ** 2))
 
 
 def _los_error(pm: PathMeasurements, ue: np.ndarray, origin: np.ndarray) -> tuple:
@@ -258,7 +267,7 @@ def direct_drive(
             pm = {}
             t0 = time.perf_counter()
             try:
-                pm["eq. 1"] = eq1_los(route, k, arr, len(paths), snap)
+                pm["eq. 1"] = _eq1_los(route, k, arr, len(paths), snap)
             except _FAILURES:
                 pass
             secs["eq. 1"][k] = time.perf_counter() - t0
@@ -272,7 +281,7 @@ def direct_drive(
             except _FAILURES:
                 fix = None
             radio = float("nan")
-            share = unmodelled_share(fix.residual, snap) if fix is not None and fix.ok else None
+            share = _unmodelled(fix.residual, snap) if fix is not None and fix.ok else None
             if share is not None:
                 unmodelled.append(share)
             if share is not None and (max_unmodelled is None or share <= max_unmodelled):
