@@ -60,7 +60,7 @@ def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_
 
 def _interval(x, rng, n=2000) -> tuple[float, float]:
     """The mean's 90 % percentile-bootstrap interval (``n`` resamples)."""
-    if np.ptp(x) == 0.0:  # dead reckoning's own ratio: every drive 1
+    if len(x) < 2 or np.ptp(x) == 0.0:  # one drive, or dead reckoning's own ratio (every drive 1)
         return float(x[0]), float(x[0])
     ci = bootstrap((x,), np.mean, n_resamples=n, confidence_level=0.9, method="percentile",
                    random_state=rng).confidence_interval  # fmt: skip
