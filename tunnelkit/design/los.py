@@ -186,16 +186,17 @@ def told_by_elevation(drive, table: ElevationSigmas, sigma_kappa: float, sigma_d
     drive = instance("drive", drive, DriveData)
     table = instance("table", table, ElevationSigmas)
     sigma_kappa, sigma_d = positive("sigma_kappa", sigma_kappa), positive("sigma_d", sigma_d)
-    epochs = []
-    for ep in drive.epochs:
-        if ep is None or len(ep) == 0:
-            epochs.append(ep)
-            continue
-        saz, sel = table.at(ep.psi)
-        cov = np.zeros((len(ep), 3, 3))
-        cov[:, 0, 0], cov[:, 1, 1], cov[:, 2, 2] = saz**2, sel**2, sigma_kappa**2
-        epochs.append(replace(ep, cov=cov, sigma_d=np.full(len(ep), sigma_d)))
+    epochs = [ep if ep is None or len(ep) == 0 else told_epoch(ep, table, sigma_kappa, sigma_d)
+              for ep in drive.epochs]  # fmt: skip
     return replace(drive, epochs=epochs, reports_covariance=True)
+
+
+def told_epoch(ep, table: ElevationSigmas, sigma_kappa: float, sigma_d: float):
+    """:func:`told_by_elevation` of one epoch's measured paths ``ep`` (not empty), checked."""
+    saz, sel = table.at(ep.psi)
+    cov = np.zeros((len(ep), 3, 3))
+    cov[:, 0, 0], cov[:, 1, 1], cov[:, 2, 2] = saz**2, sel**2, sigma_kappa**2
+    return replace(ep, cov=cov, sigma_d=np.full(len(ep), sigma_d))
 
 
 def angle_sigma(name: str, value: float) -> float:

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from .._validate import boolean, finite_array, instance, integer, positive, reco
 from ..angles import wrap_angle
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot
-from ..design.los import LOS_WINDOW_M, ElevationSigmas, los_path
+from ..design.los import LOS_WINDOW_M, ElevationSigmas, los_path, told_epoch
 from ..design.tracedbounds import config_sigmas
 from ..extraction.ml import ml_paths
 from ..geometry import spherical
@@ -96,15 +96,6 @@ class DirectDrive:
             name: float(np.sqrt(np.mean(np.sum((x[:, :2] - self.truth[:, :2]) ** 2, axis=1))))
             for name, x in self.estimates.items()
         }
-
-
-def _told(pm: PathMeasurements, table: ElevationSigmas, sigma_kappa: float, sigma_d: float):
-    """``pm`` told its angle sigmas from ``table`` at its measured elevation, as
-    :func:`~tunnelkit.design.los.told_by_elevation` tells a drive's."""
-    saz, sel = table.at(pm.psi)
-    cov = np.zeros((len(pm), 3, 3))
-    cov[:, 0, 0], cov[:, 1, 1], cov[:, 2, 2] = saz**2, sel**2, sigma_kappa**2
-    return replace(pm, cov=cov, sigma_d=np.full(len(pm), sigma_d))
 
 
 def _fix_los(fix, origin: np.ndarray, velocity: np.ndarray, min_d: float) -> PathMeasurements:
@@ -301,7 +292,7 @@ def direct_drive(
                         dropped[name] += 1
                         m = None
                     else:
-                        m = _told(m, told[name], c["kappa"], c["d"] / np.sqrt(2))
+                        m = told_epoch(m, told[name], c["kappa"], c["d"] / np.sqrt(2))
                         errs[name].append(_los_error(m, traj.position[k], arr.origin))
                 jav.update(m)
                 est[name][k] = jav.x[:3]
