@@ -41,57 +41,65 @@ def second_order_paths(
     return trace_second_order(tunnel, array, ue, vel, fc, kinds, front_only)
 
 
+def bounce_points(tunnel, s1, s2, ue: np.ndarray, receivers: np.ndarray) -> tuple:
+    """Where the second-order path off ``s1`` then ``s2`` from ``ue`` (3,) reaches each of the
+    ``receivers`` (N, 3) (unchecked: the tracer's and the visibility study's inner step):
+    ``(ok, q1, q2)``, ``ok`` (N,) the image method's checks of :func:`second_order_paths`
+    (receiver, ``V1`` and UE on the surfaces' inner sides, both bounces inside their rectangles
+    and in front of each other, no leg blocked), ``q1``/``q2`` (N, 3) the bounce points (where a
+    check fails, those of the distances clipped at zero: the reference element's geometry of a
+    path other elements see)."""
+    p1, p2 = s1.plane, s2.plane
+    du, dv = float(p1.signed_distance(ue)), float(p2.signed_distance(p1.mirror(ue)))
+    n = len(receivers)
+    if du <= 0 or dv <= 0:
+        return np.zeros(n, bool), np.tile(ue, (n, 1)), np.tile(ue, (n, 1))
+    v1 = p1.mirror(ue)
+    v2 = p2.mirror(v1)
+    da = p2.signed_distance(receivers)
+    a = np.where(da > 0, da, 0.0)
+    q2 = receivers + (a / (a + dv))[:, None] * (v2 - receivers)  # receiver -> V2 crosses S2
+    e2 = p1.signed_distance(q2)
+    b = np.where(e2 > 0, e2, 0.0)
+    q1 = q2 + (b / (b + du))[:, None] * (v1 - q2)  # P2 -> V1 crosses S1
+    ok = (da > 0) & (e2 > 0) & s2._contains(q2, 1e-9) & s1._contains(q1, 1e-9)
+    ok &= p2.signed_distance(q1) > 0
+    ok &= ~tunnel._blocked(ue, q1) & ~tunnel._blocked(q1, q2) & ~tunnel._blocked(q2, receivers)
+    return ok, q1, q2
+
+
+def second_order_path(s1, s2, ue, vel, q1, q2, array, fc: float) -> Path:
+    """The second-order :class:`Path` off ``s1`` then ``s2`` from ``ue`` moving at ``vel`` with
+    bounce points ``q1`` and ``q2`` (3,) (:func:`bounce_points` at the reference element), to
+    ``array`` at the carrier ``fc`` (unchecked): its source the UE mirrored twice, its
+    reflection coefficient the product of both bounces' at their incidences, its velocity the
+    UE's mirrored twice."""
+    p1, p2 = s1.plane, s2.plane
+    du = float(p1.signed_distance(ue))
+    leg1, leg2 = float(np.linalg.norm(ue - q1)), float(np.linalg.norm(q1 - q2))
+    g1 = s1.reflection_coefficient(fc, min(du / max(leg1, 1e-9), 1.0))
+    g2 = s2.reflection_coefficient(
+        fc, min(max(float(p2.signed_distance(q1)), 0.0) / max(leg2, 1e-9), 1.0)
+    )
+    vel1 = vel - 2.0 * (vel @ p1.normal) * p1.normal
+    vel2 = vel1 - 2.0 * (vel1 @ p2.normal) * p2.normal
+    v2 = p2.mirror(p1.mirror(ue))
+    return make_path(SECOND_ORDER, f"{s1.name} > {s2.name}", SECOND_ORDER, v2, q2, ue, vel2,
+                     array, fc, complex(g1 * g2), leg=leg1 + leg2)  # fmt: skip
+
+
 def trace_second_order(tunnel, array, ue, vel, fc, kinds, front_only) -> list[Path]:
     """:func:`second_order_paths` on checked arguments."""
-    a0 = array.origin
+    a0 = array.origin[None]
     surf = [s for s in tunnel.surfaces if s.kind in kinds]
     out: list[Path] = []
     for s1 in surf:
-        p1 = s1.plane
-        du = float(p1.signed_distance(ue))
-        if du <= 0:
-            continue
-        v1 = p1.mirror(ue)
-        vel1 = vel - 2.0 * (vel @ p1.normal) * p1.normal
         for s2 in surf:
             if s2 is s1:
                 continue
-            p2 = s2.plane
-            da, dv = float(p2.signed_distance(a0)), float(p2.signed_distance(v1))
-            if da <= 0 or dv <= 0:
+            ok, q1, q2 = bounce_points(tunnel, s1, s2, ue, a0)
+            if not ok[0] or (front_only and not array.in_front(q2[0])):
                 continue
-            v2 = p2.mirror(v1)
-            q2 = a0 + da / (da + dv) * (v2 - a0)  # the reference antenna -> V2 crosses S2
-            if not s2._contains(q2, 1e-9):
-                continue
-            e2 = float(p1.signed_distance(q2))
-            if e2 <= 0:
-                continue
-            q1 = q2 + e2 / (e2 + du) * (v1 - q2)  # P2 -> V1 crosses S1
-            if not s1._contains(q1, 1e-9) or float(p2.signed_distance(q1)) <= 0:
-                continue
-            if tunnel._blocked(ue, q1) or tunnel._blocked(q1, q2) or tunnel._blocked(q2, a0):
-                continue
-            if front_only and not array.in_front(q2):
-                continue
-            leg1, leg2 = float(np.linalg.norm(ue - q1)), float(np.linalg.norm(q1 - q2))
-            g1 = s1.reflection_coefficient(fc, min(du / leg1, 1.0))
-            g2 = s2.reflection_coefficient(fc, min(float(p2.signed_distance(q1)) / leg2, 1.0))
-            vel2 = vel1 - 2.0 * (vel1 @ p2.normal) * p2.normal
-            out.append(
-                make_path(
-                    SECOND_ORDER,
-                    f"{s1.name} > {s2.name}",
-                    SECOND_ORDER,
-                    v2,
-                    q2,
-                    ue,
-                    vel2,
-                    array,
-                    fc,
-                    complex(g1 * g2),
-                    leg=leg1 + leg2,
-                )
-            )
+            out.append(second_order_path(s1, s2, ue, vel, q1[0], q2[0], array, fc))
     out.sort(key=lambda p: p.length)
     return out

@@ -34,6 +34,7 @@ from .._validate import boolean, finite_array, instance, integer, probability, s
 from ..arrays import ArrayGeometry
 from ..propagation import PATH_KINDS, SECOND_ORDER, Facet, Path, Tunnel3D, trace_paths
 from ..propagation.path import make_path
+from ..propagation.second_order import bounce_points, second_order_path
 from .aperture import ApertureProblem
 
 __all__ = [
@@ -120,29 +121,6 @@ def visible_paths(
     return extra, np.column_stack(masks).astype(float)
 
 
-def _visibility2(tunnel, array, s1, s2, ue: np.ndarray, v1: np.ndarray, du: float):
-    """(M,) bool: the elements of ``array`` that receive the second-order path off ``s1`` then
-    ``s2`` (``v1`` the UE's image in ``s1``, ``du`` the UE's distance to it), by the image method
-    at each element, as :func:`~tunnelkit.propagation.second_order_paths` checks it at the
-    reference element (the last bounce in front of the array's face)."""
-    el = array.world
-    p1, p2 = s1.plane, s2.plane
-    da, dv = p2.signed_distance(el), float(p2.signed_distance(v1))
-    if dv <= 0:
-        return np.zeros(len(el), bool)
-    v2 = p2.mirror(v1)
-    front = da > 0
-    a = np.where(front, da, 0.0)
-    q2 = el + (a / (a + dv))[:, None] * (v2 - el)
-    e2 = p1.signed_distance(q2)
-    ok = front & s2.contains(q2) & (e2 > 0)
-    b = np.where(ok, e2, 0.0)
-    q1 = q2 + (b / (b + du))[:, None] * (v1 - q2)
-    ok &= s1.contains(q1) & (p2.signed_distance(q1) > 0)
-    ok &= array.in_front(q2)
-    return ok & ~tunnel.blocked(ue, q1) & ~tunnel.blocked(q1, q2) & ~tunnel.blocked(q2, el)
-
-
 def visible_second_order(
     tunnel, array, ue, ue_velocity, fc: float, n: int, min_share: float = 0.25, kinds=PATH_KINDS
 ) -> tuple[list, np.ndarray]:
@@ -163,35 +141,19 @@ def visible_second_order(
     kinds = sequence("kinds", kinds)
     if not set(kinds) <= set(PATH_KINDS):
         raise ValueError(f"kinds: expected path kinds of {PATH_KINDS}, got {kinds!r}")
-    el, a0 = array.world, array.origin
+    el, a0 = array.world, array.origin[None]
     surf = [s for s in tunnel.surfaces if s.kind in kinds]
     found = []
     for s1 in surf:
-        du = float(s1.plane.signed_distance(ue))
-        if du <= 0:
-            continue
-        v1 = s1.plane.mirror(ue)
         for s2 in surf:
             if s2 is s1:
                 continue
-            seen = _visibility2(tunnel, array, s1, s2, ue, v1, du)
+            ok, _, q2 = bounce_points(tunnel, s1, s2, ue, el)
+            seen = ok & array.in_front(q2)
             if seen.mean() < min_share:
                 continue
-            p1, p2 = s1.plane, s2.plane
-            v2 = p2.mirror(v1)
-            da, dv = float(p2.signed_distance(a0)), float(p2.signed_distance(v1))
-            q2 = a0 + max(da, 0.0) / (max(da, 0.0) + dv) * (v2 - a0)
-            e2 = max(float(p1.signed_distance(q2)), 0.0)
-            q1 = q2 + e2 / (e2 + du) * (v1 - q2)
-            leg1, leg2 = float(np.linalg.norm(ue - q1)), float(np.linalg.norm(q1 - q2))
-            g1 = s1.reflection_coefficient(fc, min(du / max(leg1, 1e-9), 1.0))
-            g2 = s2.reflection_coefficient(
-                fc, min(max(float(p2.signed_distance(q1)), 0.0) / max(leg2, 1e-9), 1.0)
-            )
-            vel1 = vel - 2.0 * (vel @ p1.normal) * p1.normal
-            vel2 = vel1 - 2.0 * (vel1 @ p2.normal) * p2.normal
-            path = make_path(SECOND_ORDER, f"{s1.name} > {s2.name}", SECOND_ORDER, v2, q2, ue,
-                             vel2, array, fc, complex(g1 * g2), leg=leg1 + leg2)  # fmt: skip
+            _, q1, q2 = bounce_points(tunnel, s1, s2, ue, a0)
+            path = second_order_path(s1, s2, ue, vel, q1[0], q2[0], array, fc)
             found.append((abs(path.gain), path, seen))
     found.sort(key=lambda f: -f[0])
     found = found[:n]
