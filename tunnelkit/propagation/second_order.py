@@ -41,36 +41,54 @@ def second_order_paths(
     return trace_second_order(tunnel, array, ue, vel, fc, kinds, front_only)
 
 
-def bounce_points(tunnel, s1, s2, ue: np.ndarray, receivers: np.ndarray) -> tuple:
+def bounce_points_unchecked(
+    tunnel, s1, s2, ue: np.ndarray, receivers: np.ndarray, every_point: bool = False
+) -> tuple:
     """Where the second-order path off ``s1`` then ``s2`` from ``ue`` (3,) reaches each of the
     ``receivers`` (N, 3) (unchecked: the tracer's and the visibility study's inner step):
     ``(ok, q1, q2)``, ``ok`` (N,) the image method's checks of :func:`second_order_paths`
     (receiver, ``V1`` and UE on the surfaces' inner sides, both bounces inside their rectangles
     and in front of each other, no leg blocked), ``q1``/``q2`` (N, 3) the bounce points (where a
     check fails, those of the distances clipped at zero: the reference element's geometry of a
-    path other elements see)."""
+    path other elements see, with ``every_point``). With the UE or its image ``V1`` not on the
+    inner sides (no receiver sees the path) ``q1`` and ``q2`` are the UE itself. Without
+    ``every_point`` the checks stop as soon as no receiver is left (the tracer calls it for one
+    receiver per pair of surfaces), and ``q1``/``q2`` of a receiver that fails mean nothing."""
     p1, p2 = s1.plane, s2.plane
-    du, dv = float(p1.signed_distance(ue)), float(p2.signed_distance(p1.mirror(ue)))
-    n = len(receivers)
+    n1, o1, n2, o2 = p1.normal, p1.offset, p2.normal, p2.offset  # Plane's formulas, unchecked
+    du = float(ue @ n1 + o1)
+    v1 = ue - 2.0 * du * n1
+    dv = float(v1 @ n2 + o2)
     if du <= 0 or dv <= 0:
-        return np.zeros(n, bool), np.tile(ue, (n, 1)), np.tile(ue, (n, 1))
-    v1 = p1.mirror(ue)
-    v2 = p2.mirror(v1)
-    da = p2.signed_distance(receivers)
-    a = np.where(da > 0, da, 0.0)
-    q2 = receivers + (a / (a + dv))[:, None] * (v2 - receivers)  # receiver -> V2 crosses S2
-    e2 = p1.signed_distance(q2)
+        at_ue = np.tile(ue, (len(receivers), 1))
+        return np.zeros(len(receivers), bool), at_ue, at_ue
+    da = receivers @ n2 + o2
+    ok = da > 0
+    if not (every_point or ok.any()):
+        return ok, receivers, receivers
+    a = np.where(ok, da, 0.0)
+    q2 = receivers + (a / (a + dv))[:, None] * (v1 - 2.0 * dv * n2 - receivers)  # -> V2 on S2
+    e2 = q2 @ n1 + o1
     b = np.where(e2 > 0, e2, 0.0)
     q1 = q2 + (b / (b + du))[:, None] * (v1 - q2)  # P2 -> V1 crosses S1
-    ok = (da > 0) & (e2 > 0) & s2._contains(q2, 1e-9) & s1._contains(q1, 1e-9)
-    ok &= p2.signed_distance(q1) > 0
-    ok &= ~tunnel._blocked(ue, q1) & ~tunnel._blocked(q1, q2) & ~tunnel._blocked(q2, receivers)
+    ok &= e2 > 0
+    for test in (
+        lambda: s2._contains(q2, 1e-9),
+        lambda: s1._contains(q1, 1e-9),
+        lambda: q1 @ n2 + o2 > 0,
+        lambda: ~tunnel._blocked(ue, q1),
+        lambda: ~tunnel._blocked(q1, q2),
+        lambda: ~tunnel._blocked(q2, receivers),
+    ):
+        if not ok.any():
+            break
+        ok &= test()
     return ok, q1, q2
 
 
-def second_order_path(s1, s2, ue, vel, q1, q2, array, fc: float) -> Path:
+def second_order_path_unchecked(s1, s2, ue, vel, q1, q2, array, fc: float) -> Path:
     """The second-order :class:`Path` off ``s1`` then ``s2`` from ``ue`` moving at ``vel`` with
-    bounce points ``q1`` and ``q2`` (3,) (:func:`bounce_points` at the reference element), to
+    bounce points ``q1`` and ``q2`` (3,) (:func:`bounce_points_unchecked` at the reference element), to
     ``array`` at the carrier ``fc`` (unchecked): its source the UE mirrored twice, its
     reflection coefficient the product of both bounces' at their incidences, its velocity the
     UE's mirrored twice."""
@@ -97,9 +115,9 @@ def trace_second_order(tunnel, array, ue, vel, fc, kinds, front_only) -> list[Pa
         for s2 in surf:
             if s2 is s1:
                 continue
-            ok, q1, q2 = bounce_points(tunnel, s1, s2, ue, a0)
+            ok, q1, q2 = bounce_points_unchecked(tunnel, s1, s2, ue, a0)
             if not ok[0] or (front_only and not array.in_front(q2[0])):
                 continue
-            out.append(second_order_path(s1, s2, ue, vel, q1[0], q2[0], array, fc))
+            out.append(second_order_path_unchecked(s1, s2, ue, vel, q1[0], q2[0], array, fc))
     out.sort(key=lambda p: p.length)
     return out

@@ -34,7 +34,7 @@ from .._validate import boolean, finite_array, instance, integer, probability, s
 from ..arrays import ArrayGeometry
 from ..propagation import PATH_KINDS, SECOND_ORDER, Facet, Path, Tunnel3D, trace_paths
 from ..propagation.path import make_path
-from ..propagation.second_order import bounce_points, second_order_path
+from ..propagation.second_order import bounce_points_unchecked, second_order_path_unchecked
 from .aperture import ApertureProblem
 
 __all__ = [
@@ -148,12 +148,12 @@ def visible_second_order(
         for s2 in surf:
             if s2 is s1:
                 continue
-            ok, _, q2 = bounce_points(tunnel, s1, s2, ue, el)
+            ok, _, q2 = bounce_points_unchecked(tunnel, s1, s2, ue, el)
             seen = ok & array.in_front(q2)
             if seen.mean() < min_share:
                 continue
-            _, q1, q2 = bounce_points(tunnel, s1, s2, ue, a0)
-            path = second_order_path(s1, s2, ue, vel, q1[0], q2[0], array, fc)
+            _, q1, q2 = bounce_points_unchecked(tunnel, s1, s2, ue, a0, every_point=True)
+            path = second_order_path_unchecked(s1, s2, ue, vel, q1[0], q2[0], array, fc)
             found.append((abs(path.gain), path, seen))
     found.sort(key=lambda f: -f[0])
     found = found[:n]
