@@ -47,14 +47,14 @@ def _setup(scenario: str):
 
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
-        max_unmodelled):  # fmt: skip
+        max_unmodelled, diffuse):  # fmt: skip
     route, eq1 = _setup(scenario)
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
         r = direct_drive(route, spawn_rngs(seed, runs)[i], los_design(), eq1, table,
                          speed_sigma=speed_sigma, second_order=second_order,
                          n_epochs=n_epochs, element_second_order=by_element,
-                         max_unmodelled=max_unmodelled)  # fmt: skip
+                         max_unmodelled=max_unmodelled, diffuse=diffuse)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -124,6 +124,8 @@ def main(argv=None) -> int:
                     help="the direct fix's angle sigmas times this (the table's or --sigmas')")  # fmt: skip
     ap.add_argument("--max-unmodelled", type=float, default=None,
                     help="drop a direct fix whose unmodelled share of the power exceeds this")  # fmt: skip
+    ap.add_argument("--diffuse", type=int, default=0,
+                    help="the direct fit admits at most this many diffuse atoms")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -153,6 +155,7 @@ def main(argv=None) -> int:
                 a.speed_sigma,
                 a.element_second_order,
                 a.max_unmodelled,
+                a.diffuse,
             )
             for i in range(a.runs)
         ]

@@ -32,16 +32,17 @@ from tunnelkit.simulation.drives import scenario_route
 from tunnelkit.studies.direct import direct_fix
 
 
-def _row(label, route, arr, H, k) -> str:
+def _row(label, route, arr, H, k, diffuse=0) -> str:
     traj = route.trajectory
     ue, vel = traj.position[k], traj.velocity[k]
-    f = direct_fix(route, arr, H, ue, vel, element_second_order=True)
+    f = direct_fix(route, arr, H, ue, vel, element_second_order=True, diffuse=diffuse,
+                   noise_power=route.config.noise_power)  # fmt: skip
     a0, e0, _ = spherical(ue - arr.origin)
     a1, e1, _ = spherical(f.position - arr.origin)
     dx, dy = f.position[:2] - ue[:2]
     return (f"   {label:18s} residual {100 * f.residual:5.2f} %  along {dx:+.3f} across {dy:+.3f} m"
             f"  azimuth {np.degrees(a1 - a0):+.3f} elevation {np.degrees(e1 - e0):+.3f} deg"
-            f"  speed {f.speed - np.linalg.norm(vel[:2]):+.3f} m/s  ok {f.ok}")  # fmt: skip
+            f"  speed {f.speed - np.linalg.norm(vel[:2]):+.3f} m/s  ok {f.ok}  diffuse {f.diffuse}")  # fmt: skip
 
 
 def main(argv=None) -> int:
@@ -49,6 +50,12 @@ def main(argv=None) -> int:
     ap.add_argument("--scenario", default="italiano2026-slalom")
     ap.add_argument("--epochs", type=int, nargs="+", default=[4, 16, 22])
     ap.add_argument("--remove", nargs="+", choices=COMPONENTS, default=["diffuse"])
+    ap.add_argument(
+        "--diffuse",
+        type=int,
+        default=0,
+        help="also the full tensor fitted with at most this many diffuse atoms",
+    )
     a = ap.parse_args(argv)
     print("command: python benchmarks/bench_rt_direct_parts.py " + shlex.join(argv or sys.argv[1:]))
     route = scenario_route(a.scenario, "exact", "sionna", {"diffuse_floor": True})
@@ -65,6 +72,11 @@ def main(argv=None) -> int:
             x, y = route.trajectory.position[k, :2]
             print(f"{a.scenario} epoch {k} (x {x:.1f}, y {y:.2f} m): power share {shares}")
             print(_row("full", route, arr, full, k), flush=True)
+            if a.diffuse:
+                print(
+                    _row(f"full, diffuse <= {a.diffuse}", route, arr, full, k, a.diffuse),
+                    flush=True,
+                )
             for n in a.remove:
                 print(_row(f"{n} removed", route, arr, full - parts[n], k), flush=True)
     return 0

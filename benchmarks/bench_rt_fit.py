@@ -4,7 +4,8 @@ The cost per epoch of what each tracker of ``benchmarks/bench_rt_direct.py`` rea
 (:mod:`tunnelkit.studies.direct_track`): the traced tables' line-of-sight column (eq. 1's ML
 route with the number of first-order paths and the route's diffuse floor, the baseline) and the
 direct fit (:func:`tunnelkit.studies.direct.direct_fix`, with its speed) with the second-order
-atoms on every element or each on the elements that see it, from a prediction 5 cm off. One
+atoms on every element or each on the elements that see it (and then with at most one diffuse
+atom, the dense multipath's), from a prediction 5 cm off. One
 snapshot of epochs 4 and 20 of ``italiano2026-straight`` (the paper's 10 x 10, 410 tones, 12
 symbols) on one BLAS thread; the traces come from the ray tracer's cache (traced on the first
 run, a few seconds per epoch). Left out when the ``rt`` extra is not installed.
@@ -38,10 +39,11 @@ def _eq1(route, k, arr, n_paths, snap):
         return eq1_los(route, k, arr, n_paths, snap)
 
 
-def _direct(route, arr, H, prediction, velocity, by_element):
+def _direct(route, arr, snap, prediction, velocity, by_element, diffuse=0):
     with threadpool_limits(1), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return direct_fix(route, arr, H, prediction, velocity, element_second_order=by_element)
+        return direct_fix(route, arr, snap.H, prediction, velocity, element_second_order=by_element,
+                          diffuse=diffuse, noise_power=snap.noise_power)  # fmt: skip
 
 
 def cases() -> list[Case]:
@@ -58,7 +60,7 @@ def cases() -> list[Case]:
         r = float(np.linalg.norm(traj.position[k] - arr.origin))
         g = f"traced_epoch_{k}"
         eq1 = partial(_eq1, route, k, arr, len(paths), snap)
-        direct = partial(_direct, route, arr, snap.H, p0, v)
+        direct = partial(_direct, route, arr, snap, p0, v)
         out += [
             Case(
                 f"eq. 1 ML route, line of sight, epoch {k} ({r:.0f} m)",
@@ -71,6 +73,12 @@ def cases() -> list[Case]:
             Case(
                 f"direct fit + speed, second order per element, epoch {k}",
                 partial(direct, True),
+                group=g,
+                repeat=5,
+            ),
+            Case(
+                f"direct fit + speed, second order per element, one diffuse atom, epoch {k}",
+                partial(direct, True, 1),
                 group=g,
                 repeat=5,
             ),

@@ -42,7 +42,7 @@ from ..signal_route import SignalRoute, measurements_from_estimates
 from ..tracking.javelin import Javelin, JavelinDesign, ReportedNoise
 from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
-from .direct import direct_fix
+from .direct import MAX_DIFFUSE, direct_fix
 
 __all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los", "unmodelled_share"]
 
@@ -183,6 +183,7 @@ def direct_drive(
     start_sigma: float = 0.1,
     element_second_order: bool = False,
     max_unmodelled: float | None = None,
+    diffuse: int = 0,
 ) -> DirectDrive:
     """One drive of ``route`` (the line of sight always present; the study's channel is the ray
     tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
@@ -198,7 +199,11 @@ def direct_drive(
     second-order atoms each on the elements that see it (:func:`~.direct.direct_fix`).
     ``max_unmodelled``: a direct fix whose :func:`unmodelled_share` exceeds it is dropped (the
     fit's own flag: the model cannot absorb that share of the tensor's power; None: every ok fix
-    is fed)."""
+    is fed). ``diffuse``: the direct fit admits at most that many diffuse atoms (a delay and a
+    Doppler, a free gain per element; :class:`~.direct.DirectProblem`), tested against the
+    snapshot's noise power; the unmodelled share is then what the tied atoms and those free gains
+    leave, a weaker flag for ``max_unmodelled``, and the told ``table`` does not know whether a
+    fix admitted one."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -215,6 +220,7 @@ def direct_drive(
     by_element = boolean("element_second_order", element_second_order)
     if max_unmodelled is not None and not 0.0 < positive("max_unmodelled", max_unmodelled) <= 1.0:
         raise ValueError(f"max_unmodelled: a share of the power in (0, 1], got {max_unmodelled:g}")
+    n_diffuse = integer("diffuse", diffuse, minimum=0, maximum=MAX_DIFFUSE)
     if positive("start_sigma", start_sigma) > 1000.0:
         raise ValueError(f"start_sigma: at most 1000 m, got {start_sigma:g}")
     traj = route.trajectory
@@ -272,7 +278,8 @@ def direct_drive(
             try:
                 fix = direct_fix(route, arr, snap.H, trackers["direct"].x[:3], v_msg,
                                  second_order=n2, speed=speed_sigma is not None and ok,
-                                 element_second_order=by_element)  # fmt: skip
+                                 element_second_order=by_element, diffuse=n_diffuse,
+                                 noise_power=snap.noise_power)  # fmt: skip
             except _FAILURES:
                 fix = None
             radio = float("nan")
