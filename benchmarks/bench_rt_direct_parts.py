@@ -6,7 +6,10 @@ traced tensor (:meth:`tunnelkit.rt.RayTracedChannel.components`, transmit power 
 on the same tensor with one part of :func:`tunnelkit.rt.tensor_components` removed at a time
 (``--remove``, default ``diffuse``). Prints the part's share of the tensor's power and, per
 tensor, the fit's residual share, its position error along and across the tunnel, the line of
-sight's azimuth and elevation error seen from the site and the speed's error.
+sight's azimuth and elevation error seen from the site and the speed's error. With
+``--diffuse D`` the full tensor is also fitted with at most ``D`` diffuse atoms, each admitted by
+its test against the receiver's noise power (the tensor itself is noiseless, so every atom whose
+drop clears what that noise would give stays).
 
     python benchmarks/bench_rt_direct_parts.py --scenario italiano2026-slalom --epochs 4 12 14 16 22 26
     python benchmarks/bench_rt_direct_parts.py --scenario italiano2026-straight --epochs 4 16 22

@@ -320,9 +320,10 @@ def direct_fix(
     sample, required with ``diffuse``, at most twice the tensor's mean power per sample, which
     holds the noise). An added atom's fit that does not converge is dropped, never returned: the
     search stops and the fix is the last converged model's. Near the delay of a tied atom a
-    diffuse atom's free gains take part of that atom's information (the position's spread grows;
-    on the paper's 10 x 10 tensor about 1.3-2 times at one delay cell or less, ``docs/results/
-    traced-models.md``), which the told sigmas of :mod:`.direct_track` do not know."""
+    diffuse atom's free gains take part of that atom's information (the position's bound grows
+    1.2-4.2 times for an atom 0-3 m past the line of sight on the paper's 10 x 10 tensor, not at
+    all for one 20 m past: ``benchmarks/bench_direct_diffuse_info.py``), which the told sigmas of
+    :mod:`.direct_track` do not know."""
     if not hasattr(route, "tunnel") or not hasattr(route, "config"):
         raise TypeError(f"route: expected a SignalRoute, got {type(route).__name__}")
     p0 = route.tunnel.require_inside(
