@@ -254,7 +254,7 @@ def diffuse_threshold(M: int, nf: int, nt: int) -> float:
     ``N0 / 2`` times a chi-square of 2 M degrees of freedom from the cost (its M free gains;
     tested); the start searches the grid of :func:`diffuse_start` and the fit then moves it, so
     the nominal false alarm :data:`DIFFUSE_FALSE_ALARM` is shared over that grid's points
-    (Bonferroni). Counting the ``Nf Nt`` resolution cells alone let through 10 to 19 times the
+    (Bonferroni). Counting the ``Nf Nt`` resolution cells alone let through 7 to 18 times the
     nominal rate on pure noise; over the grid the rate measured lies below it (tested)."""
     M = integer("M", M, minimum=2, maximum=MAX_TENSOR_SIDE)
     nf = integer("nf", nf, minimum=2, maximum=MAX_TENSOR_SIDE)
