@@ -144,7 +144,6 @@ class DirectProblem(MaskedProblem):
         speed = float(np.linalg.norm(self.velocity))
         self.heading = self.velocity / speed if speed > 0 else np.zeros(3)
         self.origin, self.frame = array.origin, array.R
-        self._beta = np.zeros((L, 0))
 
     def atoms(self, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """eq. 1's ``(theta, mu_f, mu_t)`` of every tied atom at ``x`` (the class docstring)."""
@@ -165,10 +164,7 @@ class DirectProblem(MaskedProblem):
 
     def cost(self, x) -> float:
         """The concentrated cost ``||H - model||^2`` at ``x``."""
-        x = _parameters("x", x, self.diffuse)
-        if not self.diffuse:
-            return float(self._evaluate(*self._atoms(x), self._beta, derivatives=False)["cost"])
-        return self._solve(x)[-1]
+        return float(self._solve(_parameters("x", x, self.diffuse))[-1])
 
     def _solve(self, x: np.ndarray) -> tuple:
         """The model's factors at ``x`` and its gains concentrated out: ``(a, F, T, Fd, Td, c, u,
