@@ -39,7 +39,7 @@ def _row(label, route, arr, H, k, diffuse=0) -> str:
     traj = route.trajectory
     ue, vel = traj.position[k], traj.velocity[k]
     f = direct_fix(route, arr, H, ue, vel, element_second_order=True, diffuse=diffuse,
-                   noise_power=route.config.noise_power)  # fmt: skip
+                   noise_power=route.config.noise_power if diffuse else None)  # fmt: skip
     a0, e0, _ = spherical(ue - arr.origin)
     a1, e1, _ = spherical(f.position - arr.origin)
     dx, dy = f.position[:2] - ue[:2]

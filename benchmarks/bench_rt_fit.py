@@ -43,7 +43,7 @@ def _direct(route, arr, snap, prediction, velocity, by_element, diffuse=0):
     with threadpool_limits(1), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return direct_fix(route, arr, snap.H, prediction, velocity, element_second_order=by_element,
-                          diffuse=diffuse, noise_power=snap.noise_power)  # fmt: skip
+                          diffuse=diffuse, noise_power=snap.noise_power if diffuse else None)  # fmt: skip
 
 
 def cases() -> list[Case]:

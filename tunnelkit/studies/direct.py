@@ -176,9 +176,10 @@ class DirectProblem(MaskedProblem):
         F = np.exp(1j * self.s * mu_f[None, :])
         T = np.exp(1j * self.kk * mu_t[None, :])
         D, L, M = self.diffuse, a.shape[1], self.M
+        G_tied = (a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T)
+        b_tied = np.einsum("ml,ml->l", a.conj(), self._contract(T, F))
         if not D:
-            c, cost = self._gains((a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T),
-                                  np.einsum("ml,ml->l", a.conj(), self._contract(T, F)))  # fmt: skip
+            c, cost = self._gains(G_tied, b_tied)
             return a, F, T, F[:, :0], T[:, :0], c, np.zeros((M, 0), complex), cost
         nu = x[x.size - 2 * D :].reshape(D, 2)
         Fd = np.exp(1j * self.s * nu[None, :, 0])
@@ -186,12 +187,11 @@ class DirectProblem(MaskedProblem):
         # the Gram of the L tied atoms and the D x M diffuse ones (atom j on element m: j M + m)
         g = (F.conj().T @ Fd) * (T.conj().T @ Td)  # (L, D)
         G = np.empty((L + D * M, L + D * M), complex)
-        G[:L, :L] = (a.conj().T @ a) * (F.conj().T @ F) * (T.conj().T @ T)
+        G[:L, :L] = G_tied
         G[:L, L:] = (a.conj().T[:, None, :] * g[:, :, None]).reshape(L, D * M)
         G[L:, :L] = G[:L, L:].conj().T
         G[L:, L:] = np.kron((Fd.conj().T @ Fd) * (Td.conj().T @ Td), np.eye(M))
-        b = np.concatenate([np.einsum("ml,ml->l", a.conj(), self._contract(T, F)),
-                            self._contract(Td, Fd).T.ravel()])  # fmt: skip
+        b = np.concatenate([b_tied, self._contract(Td, Fd).T.ravel()])
         gains, cost = self._gains(G, b)
         return a, F, T, Fd, Td, gains[:L], gains[L:].reshape(D, M).T, cost
 

@@ -279,7 +279,7 @@ def direct_drive(
                 fix = direct_fix(route, arr, snap.H, trackers["direct"].x[:3], v_msg,
                                  second_order=n2, speed=speed_sigma is not None and ok,
                                  element_second_order=by_element, diffuse=n_diffuse,
-                                 noise_power=snap.noise_power)  # fmt: skip
+                                 noise_power=snap.noise_power if n_diffuse else None)  # fmt: skip
             except _FAILURES:
                 fix = None
             radio = float("nan")
