@@ -47,14 +47,15 @@ def _setup(scenario: str):
 
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
-        max_unmodelled, diffuse):  # fmt: skip
+        max_unmodelled, diffuse, diffuse_above):  # fmt: skip
     route, eq1 = _setup(scenario)
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
         r = direct_drive(route, spawn_rngs(seed, runs)[i], los_design(), eq1, table,
                          speed_sigma=speed_sigma, second_order=second_order,
                          n_epochs=n_epochs, element_second_order=by_element,
-                         max_unmodelled=max_unmodelled, diffuse=diffuse)  # fmt: skip
+                         max_unmodelled=max_unmodelled, diffuse=diffuse,
+                         diffuse_above=diffuse_above)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -126,6 +127,9 @@ def main(argv=None) -> int:
                     help="drop a direct fix whose unmodelled share of the power exceeds this")  # fmt: skip
     ap.add_argument("--diffuse", type=int, default=0,
                     help="the direct fit admits at most this many diffuse atoms")  # fmt: skip
+    ap.add_argument("--diffuse-above", type=float, default=0.0,
+                    help="the diffuse atoms tried only where the tied fit's unmodelled share "
+                    "exceeds this")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -156,6 +160,7 @@ def main(argv=None) -> int:
                 a.element_second_order,
                 a.max_unmodelled,
                 a.diffuse,
+                a.diffuse_above,
             )
             for i in range(a.runs)
         ]

@@ -327,14 +327,17 @@ def _direct():
     prob.with_diffuse(1).cost(np.r_[ue[:2], 0.0, -0.1, 0.0])
     direct.diffuse_start(H)
     direct.diffuse_threshold(arr.M, 40, 4)
+    direct.diffuse_share(0.01, 1)
     direct.direct_fix(route, arr, H, ue, vel, second_order=2, speed=True, gate=5.0,
-                      element_second_order=True, diffuse=1, noise_power=snap.noise_power)  # fmt: skip
+                      element_second_order=True, diffuse=1, noise_power=snap.noise_power,
+                      diffuse_above=0.01)  # fmt: skip
     direct_track.eq1_los(route, 12, arr, 3, snap)
     direct_track.unmodelled_share(0.01, snap)
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
     direct_track.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
                               speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1,
-                              element_second_order=True, max_unmodelled=0.5, diffuse=1)  # fmt: skip
+                              element_second_order=True, max_unmodelled=0.5, diffuse=1,
+                              diffuse_above=0.01)  # fmt: skip
 
 
 def _doppler():

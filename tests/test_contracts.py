@@ -102,11 +102,17 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no fit of the speed on the drive (the speed not used, or every fit flagged)",
     ),
     _doc(
-        r"studies\.direct\.(direct_fix|DirectProblem(\.with_diffuse)?|DirectFix)"
+        r"studies\.direct\.(direct_fix|diffuse_share|DirectProblem(\.with_diffuse)?|DirectFix)"
         r"|studies\.direct_track\.direct_drive",
         r"diffuse",
         "zero",
         "no diffuse atom: the tied fit alone (the default)",
+    ),
+    _doc(
+        r"studies\.direct\.(direct_fix|diffuse_share)|studies\.direct_track\.direct_drive",
+        r"diffuse_above",
+        "zero",
+        "the diffuse atoms tried at every fit (the default)",
     ),
     _doc(
         r"studies\.direct\.direct_fix|studies\.direct_track\.direct_drive",

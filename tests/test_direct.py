@@ -316,6 +316,29 @@ def test_unconverged_diffuse_fit_is_never_returned(route, monkeypatch):
     np.testing.assert_array_equal(fix.position, white.position)
 
 
+def test_diffuse_tried_only_above_the_tied_fits_unmodelled_share(route):
+    """``diffuse_above``: the atom is tried where the tied fit leaves more than that share beyond
+    the noise and not where it leaves less; not tried, the fix is the tied fit's."""
+    arr, ue, vel, shell, x, gains, rng = _setup(route, 9, 17)
+    _, D = _diffuse_tensor(shell, ue, rng, 0.6, 0.2 * abs(gains[0]) ** 2)
+    n0 = abs(gains[0]) ** 2 * 1e-3
+    H = _tensor(shell, x, gains) + D
+    H = H + np.sqrt(n0 / 2) * (rng.standard_normal(H.shape) + 1j * rng.standard_normal(H.shape))
+    kw = {"speed": False, "noise_power": n0, "diffuse": 1}
+    tied = direct_fix(route, arr, H, ue, vel, speed=False)
+    share = tied.residual - n0 * H.size / float(np.sum(np.abs(H) ** 2))
+    assert 0.01 < share < 0.5, share  # the atom leaves a clear misfit to the tied fit
+    assert direct_fix(route, arr, H, ue, vel, diffuse_above=0.99 * share, **kw).diffuse == 1
+    above = direct_fix(route, arr, H, ue, vel, diffuse_above=1.01 * share, **kw)
+    assert above.diffuse == 0
+    np.testing.assert_array_equal(above.position, tied.position)
+    for bad in (-0.1, 1.0, np.nan):
+        with pytest.raises(ValueError, match=r"^diffuse_above"):
+            direct_fix(route, arr, H, ue, vel, diffuse_above=bad, **kw)
+    with pytest.raises(ValueError, match=r"^diffuse_above.*without"):
+        direct_fix(route, arr, H, ue, vel, diffuse_above=0.1)
+
+
 def test_refusals_name_the_parameter(route):
     arr, ue, vel, shell, x, gains, _ = _setup(route, 10, 2)
     H = _tensor(shell, x, gains)
@@ -409,6 +432,8 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
         direct_drive(route, np.random.default_rng(4), design, table, table, max_unmodelled=2.0)
     with pytest.raises(ValueError, match=r"^speed_sigma"):
         direct_drive(route, np.random.default_rng(4), design, table, table, speed_sigma=-1.0)
+    with pytest.raises(ValueError, match=r"^diffuse_above.*without"):  # refused, not a failed fit
+        direct_drive(route, np.random.default_rng(4), design, table, table, diffuse_above=0.1)
     with pytest.raises(TypeError, match=r"^route"):
         direct_drive("italiano2026-straight", np.random.default_rng(4), design, table, table)
 

@@ -57,6 +57,7 @@ from .visibility import MaskedProblem, predicted_model
 __all__ = [
     "DirectFix",
     "DirectProblem",
+    "diffuse_share",
     "diffuse_start",
     "diffuse_threshold",
     "direct_fix",
@@ -286,6 +287,18 @@ class DirectFix:
         integer("diffuse", self.diffuse, minimum=0, maximum=MAX_DIFFUSE)
 
 
+def diffuse_share(diffuse_above, diffuse: int) -> float:
+    """The checked ``diffuse_above`` of :func:`direct_fix`: a share of the tensor's power in
+    [0, 1), not above zero without ``diffuse`` atoms (0 to :data:`MAX_DIFFUSE`) to try."""
+    n = integer("diffuse", diffuse, minimum=0, maximum=MAX_DIFFUSE)
+    above = float(finite_array("diffuse_above", diffuse_above, ndim=0))
+    if not 0.0 <= above < 1.0:
+        raise ValueError(f"diffuse_above: a share of the tensor's power in [0, 1), got {above:g}")
+    if above and not n:
+        raise ValueError("diffuse_above: given without diffuse atoms to try")
+    return above
+
+
 def direct_fix(
     route,
     array,
@@ -299,6 +312,7 @@ def direct_fix(
     element_second_order: bool = False,
     diffuse: int = 0,
     noise_power: float | None = None,
+    diffuse_above: float = 0.0,
 ) -> DirectFix:
     """The direct fit (module docstring) of the tensor ``H`` (M, Nf, Nt) received at ``array``
     on ``route``'s tunnel from the UE's ``prediction`` (3,) [m] moving at ``velocity`` (3,) [m/s]
@@ -319,7 +333,9 @@ def direct_fix(
     diffuse atom's free gains take part of that atom's information (the position's bound grows
     1.2-4.2 times for an atom 0-3 m past the line of sight on the paper's 10 x 10 tensor, not at
     all for one 20 m past: ``benchmarks/bench_direct_diffuse_info.py``), which the told sigmas of
-    :mod:`.direct_track` do not know."""
+    :mod:`.direct_track` do not know. ``diffuse_above``: the atoms are tried only where the tied
+    fit leaves more than this share of the tensor's power beyond the noise (its unmodelled share,
+    ``residual - noise_power M Nf Nt / ||H||^2``, in [0, 1)); 0 tries them at every fit."""
     if not hasattr(route, "tunnel") or not hasattr(route, "config"):
         raise TypeError(f"route: expected a SignalRoute, got {type(route).__name__}")
     p0 = route.tunnel.require_inside(
@@ -336,6 +352,7 @@ def direct_fix(
     if n_diffuse and noise_power is None:
         raise ValueError("noise_power: required with diffuse atoms (their test's noise power)")
     n0 = None if noise_power is None else positive("noise_power", noise_power)
+    above = diffuse_share(diffuse_above, n_diffuse)
     cfg = route.config
     paths, masks, _ = predicted_model(  # checks array, velocity
         route, array, p0, velocity, n2, element_second_order=by_element
@@ -355,7 +372,7 @@ def direct_fix(
         f = prob.fit_tied(np.r_[f["x"], np.linalg.norm(prob.velocity)])
         evaluations, ok = evaluations + f["evaluations"], f["converged"]
     used = 0
-    if n_diffuse and ok:
+    if n_diffuse and ok and f["residual"] - n0 * prob.N / prob.h2 > above:
         threshold = n0 * diffuse_threshold(*prob.H.shape)
         while used < n_diffuse:
             more = prob.with_diffuse(used + 1)

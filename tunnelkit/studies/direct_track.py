@@ -42,7 +42,7 @@ from ..signal_route import SignalRoute, measurements_from_estimates
 from ..tracking.javelin import Javelin, JavelinDesign, ReportedNoise
 from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
-from .direct import MAX_DIFFUSE, direct_fix
+from .direct import MAX_DIFFUSE, diffuse_share, direct_fix
 
 __all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los", "unmodelled_share"]
 
@@ -184,6 +184,7 @@ def direct_drive(
     element_second_order: bool = False,
     max_unmodelled: float | None = None,
     diffuse: int = 0,
+    diffuse_above: float = 0.0,
 ) -> DirectDrive:
     """One drive of ``route`` (the line of sight always present; the study's channel is the ray
     tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
@@ -203,7 +204,8 @@ def direct_drive(
     Doppler, a free gain per element; :class:`~.direct.DirectProblem`), tested against the
     snapshot's noise power; the unmodelled share is then what the tied atoms and those free gains
     leave, a weaker flag for ``max_unmodelled``, and the told ``table`` does not know whether a
-    fix admitted one."""
+    fix admitted one; ``diffuse_above``: tried only where the tied fit's unmodelled share exceeds
+    it (:func:`~.direct.direct_fix`)."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -221,6 +223,7 @@ def direct_drive(
     if max_unmodelled is not None and not 0.0 < positive("max_unmodelled", max_unmodelled) <= 1.0:
         raise ValueError(f"max_unmodelled: a share of the power in (0, 1], got {max_unmodelled:g}")
     n_diffuse = integer("diffuse", diffuse, minimum=0, maximum=MAX_DIFFUSE)
+    above = diffuse_share(diffuse_above, n_diffuse)
     if positive("start_sigma", start_sigma) > 1000.0:
         raise ValueError(f"start_sigma: at most 1000 m, got {start_sigma:g}")
     traj = route.trajectory
@@ -279,7 +282,8 @@ def direct_drive(
                 fix = direct_fix(route, arr, snap.H, trackers["direct"].x[:3], v_msg,
                                  second_order=n2, speed=speed_sigma is not None and ok,
                                  element_second_order=by_element, diffuse=n_diffuse,
-                                 noise_power=snap.noise_power if n_diffuse else None)  # fmt: skip
+                                 noise_power=snap.noise_power if n_diffuse else None,
+                                 diffuse_above=above)  # fmt: skip
             except _FAILURES:
                 fix = None
             radio = float("nan")
