@@ -47,7 +47,7 @@ def _setup(scenario: str):
 
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
-        max_unmodelled, diffuse, diffuse_above):  # fmt: skip
+        max_unmodelled, diffuse, diffuse_above, start_height_sigma):  # fmt: skip
     route, eq1 = _setup(scenario)
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
@@ -55,7 +55,8 @@ def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_
                          speed_sigma=speed_sigma, second_order=second_order,
                          n_epochs=n_epochs, element_second_order=by_element,
                          max_unmodelled=max_unmodelled, diffuse=diffuse,
-                         diffuse_above=diffuse_above)  # fmt: skip
+                         diffuse_above=diffuse_above,
+                         start_height_sigma=start_height_sigma)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -130,6 +131,8 @@ def main(argv=None) -> int:
     ap.add_argument("--diffuse-above", type=float, default=0.0,
                     help="the diffuse atoms tried only where the tied fit's unmodelled share "
                     "exceeds this")  # fmt: skip
+    ap.add_argument("--start-height-sigma", type=float, default=None,
+                    help="the start's height told this sigma [m] (default the start's, 0.1 m)")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -161,6 +164,7 @@ def main(argv=None) -> int:
                 a.max_unmodelled,
                 a.diffuse,
                 a.diffuse_above,
+                a.start_height_sigma,
             )
             for i in range(a.runs)
         ]

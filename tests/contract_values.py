@@ -336,8 +336,8 @@ def _direct():
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
     direct_track.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
                               speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1,
-                              element_second_order=True, max_unmodelled=0.5, diffuse=1,
-                              diffuse_above=0.01)  # fmt: skip
+                              start_height_sigma=0.05, element_second_order=True,
+                              max_unmodelled=0.5, diffuse=1, diffuse_above=0.01)  # fmt: skip
 
 
 def _doppler():

@@ -428,6 +428,16 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
     assert strict.dropped["direct"] == 3 and strict.unmodelled.size >= 1
     np.testing.assert_allclose(strict.estimates["direct"], strict.estimates["dead reckoning"],
                                atol=1e-12)  # fmt: skip
+    # the height told known: the fixes move the direct track's position, not its height
+    known = direct_drive(route, np.random.default_rng(4), design, table, table, n_epochs=3,
+                         start_height_sigma=1e-6)  # fmt: skip
+    z0 = traj.position[0, 2]
+    assert np.abs(known.estimates["direct"][:, 2] - z0).max() < 1e-4
+    assert np.abs(out.estimates["direct"][:, 2] - z0).max() > 1e-3  # told 10 cm, it moves
+    for bad in (0.0, -0.1, 25.0):
+        with pytest.raises(ValueError, match=r"^start_height_sigma"):
+            direct_drive(route, np.random.default_rng(4), design, table, table,
+                         start_height_sigma=bad)  # fmt: skip
     with pytest.raises(ValueError, match=r"^max_unmodelled"):
         direct_drive(route, np.random.default_rng(4), design, table, table, max_unmodelled=2.0)
     with pytest.raises(ValueError, match=r"^speed_sigma"):

@@ -42,7 +42,7 @@ from ..signal_route import SignalRoute, measurements_from_estimates
 from ..tracking.javelin import Javelin, JavelinDesign, ReportedNoise
 from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
-from .direct import MAX_DIFFUSE, diffuse_share, direct_fix
+from .direct import MAX_DIFFUSE, MAX_HEIGHT_M, diffuse_share, direct_fix
 
 __all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los", "unmodelled_share"]
 
@@ -181,6 +181,7 @@ def direct_drive(
     second_order: int = 64,
     n_epochs: int | None = None,
     start_sigma: float = 0.1,
+    start_height_sigma: float | None = None,
     element_second_order: bool = False,
     max_unmodelled: float | None = None,
     diffuse: int = 0,
@@ -191,7 +192,11 @@ def direct_drive(
     messages of its trajectory's odometry, then each epoch's snapshot, drawn from ``rng`` in that
     order; copies of ``design`` (a line-of-sight JAVELIN reading each measurement's covariance,
     :func:`tunnelkit.design.tracedlos.los_javelin`) started at the true first position told
-    ``start_sigma`` [m] (the traced tables' line-of-sight column), one per :data:`TRACKERS`
+    ``start_sigma`` [m] (the traced tables' line-of-sight column), its height told
+    ``start_height_sigma`` [m] (None: ``start_sigma``, as the tables; a vehicle's antenna height
+    is known better, the design tells :data:`~tunnelkit.design.START_HEIGHT_SIGMA_M`: a loosely
+    told height takes up a bias of the measured elevations and turns it into an error along the
+    tunnel near the site), one per :data:`TRACKERS`
     (module docstring): eq. 1's line of sight told ``eq1_table``, the direct fix's (at most
     ``second_order`` second-order atoms) ``table``, its speed told ``speed_sigma`` [m/s] (None:
     the speed not used, no ``"direct speed alone"``). The curvature's and the delay's sigmas are
@@ -226,6 +231,12 @@ def direct_drive(
     above = diffuse_share(diffuse_above, n_diffuse)
     if positive("start_sigma", start_sigma) > 1000.0:
         raise ValueError(f"start_sigma: at most 1000 m, got {start_sigma:g}")
+    if start_height_sigma is None:
+        start_height_sigma = start_sigma
+    elif positive("start_height_sigma", start_height_sigma) > MAX_HEIGHT_M:
+        raise ValueError(
+            f"start_height_sigma: at most {MAX_HEIGHT_M:g} m, got {start_height_sigma:g}"
+        )
     traj = route.trajectory
     T = (
         len(traj)
@@ -238,7 +249,7 @@ def direct_drive(
     d = design.with_(
         base_station=tuple(float(v) for v in route.arrays[0].origin),
         sigma_p0_ue=start_sigma,
-        sigma_p0_height=None,
+        sigma_p0_height=start_height_sigma,
     )
     names = TRACKERS if speed_sigma is not None else TRACKERS[:3]
     trackers = {name: _StepSigma(traj.position[0], d) for name in names}
