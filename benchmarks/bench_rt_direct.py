@@ -34,16 +34,15 @@ sys.path.insert(0, str(ROOT))
 
 from tunnelkit.design.los import ElevationSigmas, elevation_sigmas
 from tunnelkit.montecarlo import spawn_rngs
+from tunnelkit.reproduce.javelin_direct import DIRECT_NUISANCE
 from tunnelkit.reproduce.javelin_traced import los_design, los_survey
 from tunnelkit.simulation.drives import scenario_route
 from tunnelkit.studies.direct_track import direct_drive
 
-NUISANCE = {"diffuse_floor": True}  # the traced tables' route
-
 
 @functools.cache
 def _setup(scenario: str):
-    return scenario_route(scenario, "exact", "sionna", NUISANCE), los_survey(scenario)[0]
+    return scenario_route(scenario, "exact", "sionna", DIRECT_NUISANCE), los_survey(scenario)[0]
 
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,

@@ -732,6 +732,11 @@ def _traced():
     jtr.los_drive(every["ml-all"], los_table)
     jtr.los_note(summary)
     jtr.traced_note({"diffuse_floor": True}, {"rt_settings": cur.get("rt_settings")})
+    from tunnelkit.reproduce import javelin_direct as jd
+
+    jd.direct_table("italiano2026-straight")
+    jd.direct_note("italiano2026-straight")
+    jd.direct_scores("italiano2026-straight", 1, np.random.default_rng(0))
 
 
 def _odometry():

@@ -421,6 +421,14 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
     assert out.dropped["direct"] < 3 and out.speed_errors.size >= 1
     assert not np.allclose(out.estimates["direct"], out.estimates["dead reckoning"])
     assert out.unmodelled.size == 3 - out.dropped["direct"]  # every ok fix, here all fed
+    # without eq. 1's tracker (its extraction not run) the same draws give the same direct track
+    alone = direct_drive(route, np.random.default_rng(4), design, None, table, speed_sigma=0.1,
+                         n_epochs=3)  # fmt: skip
+    assert set(alone.estimates) == set(TRACKERS) - {"eq. 1"} and set(alone.seconds) == {"direct"}
+    for name in alone.estimates:
+        np.testing.assert_array_equal(alone.estimates[name], out.estimates[name])
+    with pytest.raises(TypeError, match=r"^eq1_table"):
+        direct_drive(route, np.random.default_rng(4), design, "0.2/0.1", table, n_epochs=1)
     # the same drive with every fix past a tiny unmodelled share dropped: the direct tracker is
     # dead reckoning on the same messages
     strict = direct_drive(route, np.random.default_rng(4), design, table, table, n_epochs=3,
@@ -489,3 +497,38 @@ def test_second_order_masks_are_the_image_method_at_each_element(route, k):
     p2, m2, _ = predicted_model(route, arr, ue, vel, 3, element_second_order=True)
     assert m2.shape == (arr.M, len(p2)) and np.all(m2[:, -3:].mean(axis=0) >= 0.25)
     assert [p.kind for p in p2[-3:]] == [SECOND_ORDER] * 3
+
+
+def test_the_direct_column_reads_the_shipped_table_and_refuses_other_scenes():
+    """The tables' direct column: each paper scene's told table is the shipped survey's (its
+    command in the record); a scene without one has no column; bad names are refused by name."""
+    import json
+
+    from tunnelkit.reproduce import javelin_direct as jd
+    from tunnelkit.reproduce.javelin_tables import _traced_routes
+    from tunnelkit.scenarios import data_dir
+
+    for sc in ("italiano2026-straight", "italiano2026-slalom"):
+        rec = json.loads((data_dir() / "rt" / "direct" / f"{sc}.json").read_text())
+        assert rec["scenario"] == sc and rec["command"].startswith("python benchmarks/")
+        t = jd.direct_table(sc)
+        np.testing.assert_allclose(np.degrees(t.sigma_azimuth),
+                                   np.asarray(rec["table_deg"]["sigma_azimuth"]) * jd.DIRECT_SIGMA_SCALE)  # fmt: skip
+        assert "seed 0" in jd.direct_note(sc)
+    assert jd.direct_table("jiang2023-straight") is None
+    with pytest.raises(ValueError, match=r"^scenario.*ships no"):
+        jd.direct_scores("jiang2023-straight", 1, np.random.default_rng(0))
+    with pytest.raises(ValueError, match=r"^scenario.*ships no"):
+        jd.direct_note("jiang2023-straight")
+    for bad in ("../secrets", "a\0b", ""):
+        with pytest.raises(ValueError, match=r"^scenario"):
+            jd.direct_table(bad)
+    with pytest.raises(TypeError, match=r"^scenario"):
+        jd.direct_table(["italiano2026-straight"])
+    with pytest.raises(ValueError, match=r"^n_epochs"):
+        jd.direct_scores("italiano2026-straight", 0, np.random.default_rng(0))
+    with pytest.raises(TypeError, match=r"^rng"):
+        jd.direct_scores("italiano2026-straight", 1, 7)
+    assert _traced_routes(("paper", "ml"), "sionna", True)[-1] == jd.DIRECT_COLUMN[1]
+    assert jd.DIRECT_COLUMN[1] not in _traced_routes(("paper", "ml"), "sionna")
+    assert _traced_routes(("paper", "ml"), "image", True) == ("paper", "ml")

@@ -245,9 +245,25 @@ def test_the_traced_table_has_the_traced_column_scored_on_the_traced_drive(monke
     dr = next(r for r in rep.rows if r[0] == "dead reckoning-L" and r[1] == "rmse_2d_m")
     assert dr[rep.columns.index(jtr.LOS_COLUMN[0])] == dr[rep.columns.index(jt.TRACED_COLUMN[0])]
     assert rep.meta["epochs"][jtr.LOS_COLUMN[1]] == rep.meta["epochs"]["ml"] == 2
+    # the direct column: its own drive from a generator spawned from the trial's, its dead
+    # reckoning that drive's own (the slalom ships its table)
+    from tunnelkit.reproduce import javelin_direct as jd
+
+    col = rep.columns.index(jd.DIRECT_COLUMN[0])
+    own, (n_drop, n_ep) = jd.direct_scores(
+        "italiano2026-slalom", 2, spawn_rngs(0, 1)[0].spawn(1)[0]
+    )
+    assert row[col] == own["JAVELIN"]["rmse_2d_m"] and dr[col] == own["dead reckoning"]["rmse_2d_m"]
+    assert rep.meta["epochs"][jd.DIRECT_COLUMN[1]] == n_ep == 2
+    assert rep.meta["extraction_failures"][jd.DIRECT_COLUMN[1]] == n_drop
+    assert any(n.startswith(f"Column '{jd.DIRECT_COLUMN[0]}'") for n in rep.notes)
+    assert rep.meta["radio_gain"]["JAVELIN-L"][jd.DIRECT_COLUMN[0]] == pytest.approx(
+        dr[col] / row[col]
+    )
     img = jt.javelin_table("italiano2026-slalom", "italiano2026_table2", ("L",), 1, 0, False,
                            extractions=("ml",), n_epochs=2)  # fmt: skip
     assert jt.TRACED_COLUMN[0] not in img.columns and jtr.LOS_COLUMN[0] not in img.columns
+    assert jd.DIRECT_COLUMN[0] not in img.columns
 
 
 def test_the_traced_pcrlb_is_the_kalman_covariance_of_its_linear_model(monkeypatch):

@@ -30,7 +30,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="channel source: the image method's eq. 1 (default) or the ray-traced channel "
         "(Sionna RT, every path per element, traced once and cached; javelin-table1|2 only; "
         "adds the traced design's column: sigmas measured on that channel, geometry pre-filter; "
-        "its sigmas belong to the route with --diffuse-floor)",
+        "its sigmas belong to the route with --diffuse-floor; the line of sight told by "
+        "elevation; and, condition L, the direct fit under JAVELIN on its own drives)",
     )
     p.add_argument(
         "--second-order",

@@ -6,20 +6,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import boolean, choice, instance, integer
+from .._validate import boolean, choice, instance, integer, sequence
 from ..odometry import MODELS
 from ..simulation.drives import HELD_OUT_SEED, TUNING_SEEDS
 from ..tracking.javelin.config import MOTION_STEPS
 
 __all__ = [
+    "DEAD_RECKONING",
     "NOTES",
     "RT_NOTES",
     "gain_note",
     "nuisance_note",
     "odometry_note",
+    "radio_gains",
     "seed_note",
     "step_note",
 ]
+
+#: the baseline row of every condition: the column's tracker on the same V2X speed and heading
+#: messages, from the same start, with every radio measurement dropped (predict only)
+DEAD_RECKONING = "dead reckoning"
 
 NOTES = [
     "ours: mean over runs of per-run metrics; each run is one drive through the signal route, "
@@ -120,7 +126,7 @@ def odometry_note(odometry: str, told: bool = False) -> str:
 
 def gain_note(gains: dict) -> str:
     """The radio's gain per JAVELIN row and column (``{row: {column: gain or None}}``, as
-    :func:`~tunnelkit.reproduce.javelin_tables.radio_gains` returns it) as one note."""
+    :func:`radio_gains` returns it) as one note."""
     gains = instance("gains", gains, dict, "a dict of rows")
     parts = [
         f"{name}: " + ", ".join("-" if g is None else f"{g:.2f}x" for g in by_col.values())
@@ -158,3 +164,22 @@ def nuisance_note(nuisance: dict) -> str:
             else "."
         )
     )
+
+
+def radio_gains(columns: list[str], rows: list[list]) -> dict[str, dict[str, float | None]]:
+    """The radio's gain per JAVELIN row and column of a table (``columns``, ``rows`` as
+    :func:`~.javelin_tables.table_rows` returns them): dead reckoning's 2-D RMSE over JAVELIN's
+    on the same drives (above 1 the radio helps; None where either is missing)."""
+    sequence("columns", columns), sequence("rows", rows)
+    rmse = {r[0]: r[2:-1] for r in rows if r[1] == "rmse_2d_m"}
+    out: dict[str, dict[str, float | None]] = {}
+    for name, values in rmse.items():
+        cond = name.rpartition("-")[2]
+        base = rmse.get(f"{DEAD_RECKONING}-{cond}")
+        if not name.startswith("JAVELIN-") or base is None:
+            continue
+        out[name] = {
+            label: (b / v if v and b is not None and v is not None else None)
+            for label, v, b in zip(columns[2:-1], values, base, strict=True)
+        }
+    return out

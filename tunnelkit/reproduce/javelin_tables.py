@@ -30,12 +30,15 @@ from ..studies.traced import simulate_traced, traced_design
 from ..tracking.javelin import designs
 from ..tracking.javelin.config import MOTION_STEPS
 from . import Report, register
+from .javelin_direct import DIRECT_COLUMN, direct_note, direct_scores, direct_table
 from .javelin_notes import (
+    DEAD_RECKONING,
     NOTES,
     RT_NOTES,
     gain_note,
     nuisance_note,
     odometry_note,
+    radio_gains,
     seed_note,
     step_note,
 )
@@ -65,10 +68,6 @@ __all__ = [
 ]
 
 _METRICS = ("rmse_2d_m", "mae_2d_m", "y_mae_m")
-
-#: the baseline row of every condition: the column's tracker on the same V2X speed and heading
-#: messages, from the same start, with every radio measurement dropped (predict only)
-DEAD_RECKONING = "dead reckoning"
 
 #: the table's columns: (label, measurement route, design); a design is a name of :func:`_designs`
 COLUMNS: tuple[tuple[str, str, str], ...] = (
@@ -109,7 +108,7 @@ def table_columns(
     routes = tuple(routes)
     if columns is None:
         columns = COLUMNS + ((COHERENT_COLUMN,) if "coherent" in routes else ())
-        columns += tuple(c for c in (TRACED_COLUMN, LOS_COLUMN) if c[1] in routes)
+        columns += tuple(c for c in (TRACED_COLUMN, LOS_COLUMN, DIRECT_COLUMN) if c[1] in routes)
     columns = tuple(c for c in columns if c[1] in routes)
     if not columns:
         raise ValueError(f"routes: none of the table's routes present, got {list(routes)}")
@@ -239,6 +238,7 @@ def _simulate_and_score(
     told=False,
     los_table=None,
     motion_step=None,
+    direct=False,
 ):
     """One trial of :func:`javelin_table`: a drive (:func:`~tunnelkit.simulation.collect.simulate_condition`) scored in every column on
     the worker (:func:`score_drive`), so only the metrics travel back; also each route's fault
@@ -246,7 +246,9 @@ def _simulate_and_score(
     the preset's (built on the worker, once per process); ``odometry`` a name of
     :data:`tunnelkit.odometry.MODELS`; ``told``: JAVELIN is told that model (:func:`score_drive`);
     ``los_table``: the line-of-sight column's table (:func:`.javelin_traced.los_survey`);
-    ``motion_step`` as :func:`score_drive` takes it."""
+    ``motion_step`` as :func:`score_drive` takes it; ``direct``: a condition-L trial also runs
+    the direct column's own drive (:func:`.javelin_direct.direct_scores`) from a generator
+    spawned from ``rng`` (the other columns' draws unchanged)."""
     route = scenario if length is None else drive_variant(scenario, length)
     odo = MODELS[odometry]
     if any(c[1] == TRACED_COLUMN[1] for c in columns):  # the traced columns: more adapters
@@ -265,7 +267,14 @@ def _simulate_and_score(
         e: (len(d.faults), sum(f.endswith(FLAGGED) for f in d.faults), len(d.t))
         for e, d in drives.items()
     }
-    return score_drive(drives, cond, columns, odo if told else None, motion_step), faults
+    scored = tuple(c for c in columns if c != DIRECT_COLUMN)
+    out = score_drive(drives, cond, scored, odo if told else None, motion_step)
+    if direct and cond == "L":
+        one, (n_drop, n_ep) = direct_scores(scenario, n_epochs, rng.spawn(1)[0])
+        out[(f"JAVELIN-{cond}", DIRECT_COLUMN[0])] = one["JAVELIN"]
+        out[(f"{DEAD_RECKONING}-{cond}", DIRECT_COLUMN[0])] = one[DEAD_RECKONING]
+        faults[DIRECT_COLUMN[1]] = (n_drop, 0, n_ep)
+    return out, faults
 
 
 def javelin_table(
@@ -308,7 +317,11 @@ def javelin_table(
     ray-traced channel the line-of-sight column's table is the array design's survey of the
     scene's array (:func:`.javelin_traced.los_survey`: read, or measured once on 3 traced drives
     and cached, before any trial); a scene it cannot survey (arrays of two shapes, a stale
-    record) is refused. :func:`table_rows` scores the image channel's columns."""
+    record) is refused. There too, on a scene that ships the direct fit's table
+    (:func:`.javelin_direct.direct_table`) with the paper's messages and steps (no ``length``,
+    white ``odometry``, no ``motion_step``), every condition-L trial also runs the direct
+    column's own drive (:data:`.javelin_direct.DIRECT_COLUMN`). :func:`table_rows` scores the
+    image channel's columns."""
     sequence("conditions", conditions)
     _step(motion_step)
     choice("odometry", odometry, tuple(MODELS))
@@ -327,6 +340,9 @@ def javelin_table(
     rt_info = _prepare_channel(scenario, conditions, n_epochs, channel, progress)
     # the line-of-sight column's table: the array design's survey of the scene's array
     traced = LOS_COLUMN[1] in _traced_routes(tuple(extractions), channel)
+    # the direct column: the paper's messages and steps on a scene whose table is shipped
+    plain = length is None and odometry == "white" and motion_step is None
+    direct = traced and plain and "L" in conditions and direct_table(scenario) is not None
     table, survey = los_survey(scenario, progress) if traced else (None, None)
     extractions, done = per_drive(
         scenario,
@@ -340,7 +356,7 @@ def javelin_table(
             scenario,
             n_epochs,
             e,
-            table_columns(_traced_routes(e, channel)),
+            table_columns(_traced_routes(e, channel, direct)),
             channel=channel,
             nuisance=nuisance,
             length=length,
@@ -348,6 +364,7 @@ def javelin_table(
             told=told_odometry,
             los_table=table,
             motion_step=motion_step,
+            direct=direct,
         ),
         **parallel,
     )
@@ -366,14 +383,19 @@ def javelin_table(
         told=told_odometry,
         survey=survey,
         motion_step=motion_step,
+        direct=direct,
     )
 
 
-def _traced_routes(extractions: tuple[str, ...], channel: str) -> tuple[str, ...]:
+def _traced_routes(
+    extractions: tuple[str, ...], channel: str, direct: bool = False
+) -> tuple[str, ...]:
     """``extractions`` plus the traced columns' routes on the ray-traced channel (when the ML
-    route is measured: the traced columns' drives are its measurements)."""
+    route is measured: the traced columns' drives are its measurements), and with ``direct``
+    the direct column's (its own drive, :mod:`.javelin_direct`)."""
     if channel == "sionna" and "ml" in extractions and set(extractions) <= {"paper", "ml"}:
-        return (*extractions, TRACED_COLUMN[1], LOS_COLUMN[1])
+        more = (DIRECT_COLUMN[1],) if direct else ()
+        return (*extractions, TRACED_COLUMN[1], LOS_COLUMN[1], *more)
     return tuple(extractions)
 
 
@@ -392,13 +414,15 @@ def _report(
     told=False,
     survey=None,
     motion_step=None,
+    direct=False,
 ):
     """The :class:`Report` of :func:`javelin_table` from its drives' results ``done = [(condition,
     (scores, faults)), ...]`` in drive order (also from a subset of whole runs); ``seed`` the
     seed they were drawn from (:func:`seed_note`); ``survey``: what the line-of-sight column
     was told (:func:`.javelin_traced.los_survey`'s summary); ``motion_step`` the step every
-    JAVELIN was made to take (``None``: each design's own)."""
-    extractions = _traced_routes(extractions, channel)
+    JAVELIN was made to take (``None``: each design's own); ``direct``: the table has the
+    direct column."""
+    extractions = _traced_routes(extractions, channel, direct)
     columns = table_columns(extractions)
     scores: dict[tuple[str, str], list[dict[str, float]]] = {}
     faults = dict.fromkeys(extractions, 0)
@@ -453,6 +477,7 @@ def _report(
             *(RT_NOTES if channel == "sionna" else []),
             *([traced_note(nuisance, rt_info)] if TRACED_COLUMN[1] in extractions else []),
             *([los_note(survey)] if survey is not None else []),
+            *([direct_note(scenario)] if direct else []),
             *([nuisance_note(nuisance)] if nuisance else []),
             *([odometry_note(odometry, told)] if odometry != "white" else []),
             step_note(motion_step),
@@ -463,25 +488,6 @@ def _report(
             + ".",
         ],
     )
-
-
-def radio_gains(columns: list[str], rows: list[list]) -> dict[str, dict[str, float | None]]:
-    """The radio's gain per JAVELIN row and column of a table (``columns``, ``rows`` as
-    :func:`table_rows` returns them): dead reckoning's 2-D RMSE over JAVELIN's on the same
-    drives (above 1 the radio helps; None where either is missing)."""
-    sequence("columns", columns), sequence("rows", rows)
-    rmse = {r[0]: r[2:-1] for r in rows if r[1] == "rmse_2d_m"}
-    out: dict[str, dict[str, float | None]] = {}
-    for name, values in rmse.items():
-        cond = name.rpartition("-")[2]
-        base = rmse.get(f"{DEAD_RECKONING}-{cond}")
-        if not name.startswith("JAVELIN-") or base is None:
-            continue
-        out[name] = {
-            label: (b / v if v and b is not None and v is not None else None)
-            for label, v, b in zip(columns[2:-1], values, base, strict=True)
-        }
-    return out
 
 
 def _prepare_channel(scenario, conditions, n_epochs, channel, progress) -> dict:

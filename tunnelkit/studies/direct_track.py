@@ -46,7 +46,8 @@ from .direct import MAX_DIFFUSE, MAX_HEIGHT_M, diffuse_share, direct_fix
 
 __all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los", "unmodelled_share"]
 
-#: the trackers of one drive (the last only with ``speed_sigma``)
+#: the trackers of one drive (``"eq. 1"`` only with an ``eq1_table``, the last only with
+#: ``speed_sigma``)
 TRACKERS = ("dead reckoning", "eq. 1", "direct", "direct speed alone")
 
 #: the extraction errors a fit may raise; the epoch is then predicted only
@@ -56,8 +57,8 @@ _FAILURES = (ValueError, np.linalg.LinAlgError, FloatingPointError)
 @dataclass(frozen=True)
 class DirectDrive:
     """One drive of :func:`direct_drive`: the true positions ``truth`` (T, 3) [m];
-    ``estimates`` tracker -> (T, 3) [m] (:data:`TRACKERS`); ``los_errors`` ``"eq. 1"`` and
-    ``"direct"`` -> (N, 3) rows ``(measured elevation, azimuth error, elevation error)`` [rad] of
+    ``estimates`` tracker -> (T, 3) [m] (:data:`TRACKERS`); ``los_errors`` ``"eq. 1"`` (when run)
+    and ``"direct"`` -> (N, 3) rows ``(measured elevation, azimuth error, elevation error)`` [rad] of
     the line of sight each was fed; ``speed_errors`` (N,) [m/s] of the direct fits' speeds (the
     ok ones); ``seconds`` ``"eq. 1"`` / ``"direct"`` -> (T,) [s] of extraction per epoch;
     ``dropped`` the same keys -> epochs without a measurement (a failed, unconverged or gated fit,
@@ -174,7 +175,7 @@ def direct_drive(
     route: SignalRoute,
     rng: np.random.Generator,
     design: JavelinDesign,
-    eq1_table: ElevationSigmas,
+    eq1_table: ElevationSigmas | None,
     table: ElevationSigmas,
     *,
     speed_sigma: float | None = None,
@@ -197,7 +198,8 @@ def direct_drive(
     is known better, the design tells :data:`~tunnelkit.design.START_HEIGHT_SIGMA_M`: a loosely
     told height takes up a bias of the measured elevations and turns it into an error along the
     tunnel near the site), one per :data:`TRACKERS`
-    (module docstring): eq. 1's line of sight told ``eq1_table``, the direct fix's (at most
+    (module docstring): eq. 1's line of sight told ``eq1_table`` (None: no ``"eq. 1"`` tracker,
+    its extraction not run), the direct fix's (at most
     ``second_order`` second-order atoms) ``table``, its speed told ``speed_sigma`` [m/s] (None:
     the speed not used, no ``"direct speed alone"``). The curvature's and the delay's sigmas are
     ``design``'s (the delay told half its TDoA variance, as
@@ -219,7 +221,8 @@ def direct_drive(
             "design: expected a line-of-sight JAVELIN reading each measurement's covariance "
             f"(tracedlos.los_javelin), got noise {type(design.noise).__name__}"
         )
-    instance("eq1_table", eq1_table, ElevationSigmas)
+    if eq1_table is not None:
+        instance("eq1_table", eq1_table, ElevationSigmas)
     instance("table", table, ElevationSigmas)
     if speed_sigma is not None and positive("speed_sigma", speed_sigma) > 10.0:
         raise ValueError(f"speed_sigma: a speed's sigma of at most 10 m/s, got {speed_sigma:g}")
@@ -251,12 +254,13 @@ def direct_drive(
         sigma_p0_ue=start_sigma,
         sigma_p0_height=start_height_sigma,
     )
-    names = TRACKERS if speed_sigma is not None else TRACKERS[:3]
+    names = [n for n in TRACKERS if (n != "eq. 1" or eq1_table is not None)
+             and (n != "direct speed alone" or speed_sigma is not None)]  # fmt: skip
     trackers = {name: _StepSigma(traj.position[0], d) for name in names}
     c = config_sigmas(d.config)
     if speed_sigma is not None:  # the averaged speed's sigma
         fused = float(1.0 / np.hypot(1.0 / d.config.sigma_speed, 1.0 / speed_sigma))
-    told = {"eq. 1": eq1_table, "direct": table}
+    told = {"direct": table} if eq1_table is None else {"eq. 1": eq1_table, "direct": table}
     spd, hdg = (speed, heading) if d.config.motion_step != "midpoint" else midpoint_messages(
         speed, heading)  # fmt: skip
     dt = float(traj.t[1] - traj.t[0]) if T > 1 else 0.1  # as DriveData.dt
@@ -280,12 +284,13 @@ def direct_drive(
                 k, rng
             )  # paths: only their number, as the tables' ML route
             pm = {}
-            t0 = time.perf_counter()
-            try:
-                pm["eq. 1"] = _eq1_los(route, k, arr, len(paths), snap)
-            except _FAILURES:
-                pass
-            secs["eq. 1"][k] = time.perf_counter() - t0
+            if eq1_table is not None:
+                t0 = time.perf_counter()
+                try:
+                    pm["eq. 1"] = _eq1_los(route, k, arr, len(paths), snap)
+                except _FAILURES:
+                    pass
+                secs["eq. 1"][k] = time.perf_counter() - t0
             t0 = time.perf_counter()
             ok = np.isfinite(speed[k]) and np.isfinite(heading[k])
             v_msg = ue_velocity(speed[k], heading[k]) if ok else np.zeros(3)
