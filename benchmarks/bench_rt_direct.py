@@ -38,6 +38,7 @@ from tunnelkit.reproduce.javelin_direct import DIRECT_NUISANCE
 from tunnelkit.reproduce.javelin_traced import los_design, los_survey
 from tunnelkit.simulation.drives import scenario_route
 from tunnelkit.studies.direct_track import direct_drive
+from tunnelkit.studies.robust_update import HuberUpdater
 
 
 @functools.cache
@@ -46,11 +47,14 @@ def _setup(scenario: str):
 
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
-        max_unmodelled, diffuse, diffuse_above, start_height_sigma):  # fmt: skip
+        max_unmodelled, diffuse, diffuse_above, start_height_sigma, huber=None):  # fmt: skip
     route, eq1 = _setup(scenario)
+    design = los_design()
+    if huber is not None:  # the update with Huber's loss on the whitened rows
+        design = design.with_(updater=HuberUpdater(huber))
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
-        r = direct_drive(route, spawn_rngs(seed, runs)[i], los_design(), eq1, table,
+        r = direct_drive(route, spawn_rngs(seed, runs)[i], design, eq1, table,
                          speed_sigma=speed_sigma, second_order=second_order,
                          n_epochs=n_epochs, element_second_order=by_element,
                          max_unmodelled=max_unmodelled, diffuse=diffuse,
@@ -132,6 +136,9 @@ def main(argv=None) -> int:
                     "exceeds this")  # fmt: skip
     ap.add_argument("--start-height-sigma", type=float, default=None,
                     help="the start's height told this sigma [m] (default the start's, 0.1 m)")  # fmt: skip
+    ap.add_argument("--huber", type=float, default=None,
+                    help="every tracker updates with Huber's loss at this many sigmas "
+                    "(studies.robust_update.HuberUpdater; default the design's update)")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -164,6 +171,7 @@ def main(argv=None) -> int:
                 a.diffuse,
                 a.diffuse_above,
                 a.start_height_sigma,
+                a.huber,
             )
             for i in range(a.runs)
         ]

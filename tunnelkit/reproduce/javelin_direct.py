@@ -55,9 +55,10 @@ DIRECT_OPTIONS = {
 }
 #: the route the direct drive draws its snapshots from (``benchmarks/bench_rt_direct.py``'s)
 DIRECT_NUISANCE = {"diffuse_floor": True}
-#: the survey's angle sigmas (RMS by elevation) are told times this: the fixes' errors there
-#: include biases held over several epochs, which a filter told their RMS as white trusts too
-#: far (chosen on seed 0 against 1, ``docs/results/traced-models.md``)
+#: the survey's angle sigmas (RMS by elevation) are told times this: the fixes' errors include
+#: biases held over several epochs, which a track told their RMS follows off the road (chosen on
+#: seed 0 against 1; a tighter table, also with Huber's update, lost on seed 1:
+#: ``docs/results/traced-models.md``)
 DIRECT_SIGMA_SCALE = 3.0
 
 
