@@ -520,9 +520,11 @@ def test_the_direct_column_reads_the_shipped_table_and_refuses_other_scenes():
         jd.direct_scores("jiang2023-straight", 1, np.random.default_rng(0))
     with pytest.raises(ValueError, match=r"^scenario.*ships no"):
         jd.direct_note("jiang2023-straight")
-    for bad in ("../secrets", "a\0b", ""):
+    for bad in ("a\0b", ""):
         with pytest.raises(ValueError, match=r"^scenario"):
             jd.direct_table(bad)
+    for path in ("../rt/direct/italiano2026-straight", "data/scenarios/italiano2026-straight.toml"):
+        assert jd.direct_table(path) is None  # a scenario file ships no table
     with pytest.raises(TypeError, match=r"^scenario"):
         jd.direct_table(["italiano2026-straight"])
     with pytest.raises(ValueError, match=r"^n_epochs"):
