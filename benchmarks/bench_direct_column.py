@@ -20,6 +20,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce.javelin_direct import direct_scores
 
 #: the table -> (scenario, its number of conditions per run; condition L first)
@@ -27,11 +28,9 @@ TABLES = {1: ("italiano2026-straight", 4), 2: ("italiano2026-slalom", 3)}
 
 
 def one(scenario: str, n_conditions: int, seed: int, run: int, n_epochs):
-    child = np.random.SeedSequence(seed).spawn(n_conditions * run + 1)[n_conditions * run]
+    trial = spawn_rngs(seed, n_conditions * run + 1)[-1]  # as run_trials draws drive i
     t0 = time.perf_counter()
-    scores, (dropped, epochs) = direct_scores(
-        scenario, n_epochs, np.random.default_rng(child).spawn(1)[0]
-    )
+    scores, (dropped, epochs) = direct_scores(scenario, n_epochs, trial.spawn(1)[0])
     return run, scores, dropped, epochs, time.perf_counter() - t0
 
 

@@ -718,6 +718,7 @@ def _traced():
     err = los_errors([every["ml-all"]])
     table = elevation_sigmas(np.vstack([err, err]), 2)
     ElevationSigmas.from_dict(table.as_dict()).at(np.array([-0.1]))
+    table.describe()
     told_by_elevation(every["ml-all"], table, 1.5, 1.0)
     tr.write_traced_errors(tr.traced_errors(), tempfile.mkdtemp() + "/traced_errors.json")
     tr.traced_design()

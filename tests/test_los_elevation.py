@@ -36,6 +36,8 @@ def test_table_reads_between_and_beyond_its_bins_and_round_trips():
     np.testing.assert_allclose(np.degrees(el), [0.3, 1.15, 2.0, 4.0])
     back = ElevationSigmas.from_dict(t.as_dict())
     np.testing.assert_allclose(back.sigma_elevation, t.sigma_elevation)
+    want = "-20.0 deg: 0.20 / 0.30 deg; -10.0 deg: 1.00 / 2.00 deg; 0.0 deg: 3.00 / 4.00 deg"
+    assert t.describe() == back.describe() == want
 
 
 def test_bad_tables_are_refused_by_name():

@@ -117,6 +117,15 @@ class ElevationSigmas:
         """The table in degrees, for JSON."""
         return {k: np.degrees(getattr(self, k)).round(6).tolist() for k in _FIELDS}
 
+    def describe(self) -> str:
+        """The table as one line of text: ``"<elevation> deg: <azimuth> / <elevation sigma>
+        deg"`` per bin, in degrees (the reports' notes)."""
+        t = self.as_dict()
+        return "; ".join(
+            f"{e:.1f} deg: {a:.2f} / {b:.2f} deg"
+            for e, a, b in zip(*(t[k] for k in _FIELDS), strict=True)
+        )
+
     @classmethod
     def from_dict(cls, table: dict) -> ElevationSigmas:
         """The table of :meth:`as_dict`."""

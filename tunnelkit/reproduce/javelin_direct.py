@@ -130,11 +130,7 @@ def direct_note(scenario: str) -> str:
     rec = _record(scenario)
     if rec is None:
         raise ValueError(f"scenario: {scenario!r} ships no direct fix's table ({_path(scenario)})")
-    t = rec["table_deg"]
-    bins = "; ".join(
-        f"{e:.1f} deg: {a:.2f} / {b:.2f} deg"
-        for e, a, b in zip(t["elevation"], t["sigma_azimuth"], t["sigma_elevation"], strict=True)
-    )
+    bins = ElevationSigmas.from_dict(rec["table_deg"]).describe()
     o = DIRECT_OPTIONS
     return (
         f"Column '{DIRECT_COLUMN[0]}' (condition L only): at every epoch the line-of-sight "

@@ -113,11 +113,7 @@ def los_note(summary: dict) -> str:
     missing = [k for k in SUMMARY_KEYS if k not in summary]
     if missing:
         raise ValueError(f"summary: expected los_survey's summary, missing {missing}")
-    t = summary["table_deg"]
-    bins = "; ".join(
-        f"{e:.1f} deg: {a:.2f} / {b:.2f} deg"
-        for e, a, b in zip(t["elevation"], t["sigma_azimuth"], t["sigma_elevation"], strict=True)
-    )
+    bins = ElevationSigmas.from_dict(summary["table_deg"]).describe()
     return (
         f"Column '{LOS_COLUMN[0]}': the line of sight alone as the array design takes it "
         "(design.tracedlos): of every epoch's ML measurements (the fit's own test ignored) the "
