@@ -102,6 +102,25 @@ def test_same_seed_same_results_serial_and_on_two_workers(cluster):
     assert run_trials(trial, 6, seed=2, inputs=np.array(sizes)) == serial
 
 
+def _busy_where(rng: np.random.Generator) -> str:
+    """A trial of 0.2 s of CPU that returns its worker's address."""
+    from distributed import get_worker
+
+    t = time.process_time()
+    while time.process_time() - t < 0.2:
+        rng.standard_normal(64)
+    return get_worker().address
+
+
+@pytest.mark.parametrize("desc", ["italiano2026-slalom drives", "trials"])
+def test_trials_spread_over_both_workers_whatever_the_description(cluster, desc):
+    """A table's ``desc`` (a hyphen, then words with a space) once put the shared trial in the
+    tasks' own Dask group: every task ran on the worker holding it, none was stolen."""
+    where = run_trials(_busy_where, 24, seed=1, desc=desc, scheduler=cluster.scheduler_address)
+    counts = {a: where.count(a) for a in set(where)}
+    assert len(counts) == 2 and min(counts.values()) >= 6, counts
+
+
 def test_worker_death_reruns_the_trial(cluster, tmp_path):
     marker = str(tmp_path / "died")
     sizes = [4, 1, 5, 6]
