@@ -33,33 +33,51 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.design.los import ElevationSigmas, elevation_sigmas
+from tunnelkit.design.verdict import counted_epochs
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce.javelin_direct import DIRECT_NUISANCE
 from tunnelkit.reproduce.javelin_traced import los_design, los_survey
 from tunnelkit.simulation.drives import scenario_route
 from tunnelkit.studies.direct_track import direct_drive
 from tunnelkit.studies.robust_update import HuberUpdater
+from tunnelkit.tracking.javelin.runs import draw_start
 
 
 @functools.cache
-def _setup(scenario: str):
-    return scenario_route(scenario, "exact", "sionna", DIRECT_NUISANCE), los_survey(scenario)[0]
+def _setup(scenario: str, array: str | None = None):
+    """(route, eq. 1's table, design): the traced tables' (``array`` None) or the design's
+    traced route of ``array`` with its line-of-sight tracker and that array's survey table."""
+    if array is None:
+        route = scenario_route(scenario, "exact", "sionna", DIRECT_NUISANCE)
+        return route, los_survey(scenario)[0], los_design()
+    from tunnelkit.design import DesignSetup, traced, tracedlos
+
+    setup = DesignSetup.from_scenario(scenario, channel="sionna")
+    rec = traced.design_errors(setup, array)
+    design = tracedlos.los_javelin(traced.traced_javelin(setup, array, rec))
+    return traced.traced_route(setup, array), tracedlos.los_table(rec), design
 
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
-        max_unmodelled, diffuse, diffuse_above, start_height_sigma, huber=None):  # fmt: skip
-    route, eq1 = _setup(scenario)
-    design = los_design()
+        max_unmodelled, diffuse, diffuse_above, start_height_sigma, huber=None, array=None,
+        start_sigma=0.1, drawn_start=False, second_start=False):  # fmt: skip
+    route, eq1, design = _setup(scenario, array)
     if huber is not None:  # the update with Huber's loss on the whitened rows
         design = design.with_(updater=HuberUpdater(huber))
+    rng, start = spawn_rngs(seed, runs)[i], None
+    if drawn_start:  # the design's entry fix, drawn from its own generator
+        rng, g = rng.spawn(2)
+        sh = start_sigma if start_height_sigma is None else start_height_sigma
+        start = draw_start(route.trajectory.position[0], start_sigma, g, sh)
     with threadpool_limits(limits=1, user_api="blas"):
         t0 = time.perf_counter()
-        r = direct_drive(route, spawn_rngs(seed, runs)[i], design, eq1, table,
+        r = direct_drive(route, rng, design, eq1, table,
                          speed_sigma=speed_sigma, second_order=second_order,
                          n_epochs=n_epochs, element_second_order=by_element,
                          max_unmodelled=max_unmodelled, diffuse=diffuse,
-                         diffuse_above=diffuse_above,
-                         start_height_sigma=start_height_sigma)  # fmt: skip
+                         diffuse_above=diffuse_above, start_sigma=start_sigma,
+                         start_height_sigma=start_height_sigma, start=start,
+                         second_start=second_start)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -72,20 +90,33 @@ def _interval(x, rng, n=2000) -> tuple[float, float]:
     return float(ci.low), float(ci.high)
 
 
-def report(res, label: str) -> str:
+def _settled_rmse(res, names, settled) -> np.ndarray:
+    """(trackers,) the horizontal RMSE pooled over drives and the ``settled`` epochs (the
+    design's ``rmse_settled``)."""
+    return np.array([
+        np.sqrt(np.mean([np.sum((r.estimates[t][settled, :2] - r.truth[settled, :2]) ** 2, axis=1)
+                         for r in res]))
+        for t in names
+    ])  # fmt: skip
+
+
+def report(res, label: str, settled=None) -> str:
     names = list(res[0].estimates)
     rm = np.array([[r.rmse()[t] for t in names] for r in res])  # (runs, trackers)
     rng = np.random.default_rng(0)
+    pooled = None if settled is None else _settled_rmse(res, names, settled)
+    extra = "" if pooled is None else " settled RMSE, pooled [m] | its gain |"
     out = [f"### {label}, {len(res)} drives\n",
            "| tracker | mean RMSE [m] | ratio to dead reckoning (per drive: mean [90 %]) | "
-           "gain (mean DR / mean tracker) | epochs without a measurement |",
-           "| --- | --- | --- | --- | --- |"]  # fmt: skip
+           "gain (mean DR / mean tracker) | epochs without a measurement |" + extra,
+           "| --- | --- | --- | --- | --- |" + (" --- | --- |" if extra else "")]  # fmt: skip
     for j, t in enumerate(names):
         q = rm[:, j] / rm[:, 0]
         lo, hi = _interval(q, rng)
         drop = sum(r.dropped.get(t, 0) for r in res)
+        tail = "" if pooled is None else f" {pooled[j]:.3f} | {pooled[0] / pooled[j]:.2f}x |"
         out.append(f"| {t} | {rm[:, j].mean():.3f} | {q.mean():.2f} [{lo:.2f}, {hi:.2f}] | "
-                   f"{rm[:, 0].mean() / rm[:, j].mean():.2f}x | {drop if j else '-'} |")  # fmt: skip
+                   f"{rm[:, 0].mean() / rm[:, j].mean():.2f}x | {drop if j else '-'} |" + tail)  # fmt: skip
     out += ["", "| line of sight fed | n | azimuth error RMS / median abs [deg] | elevation "
             "error RMS / median abs [deg] | extraction per epoch, median [s] |",
             "| --- | --- | --- | --- | --- |"]  # fmt: skip
@@ -139,6 +170,17 @@ def main(argv=None) -> int:
     ap.add_argument("--huber", type=float, default=None,
                     help="every tracker updates with Huber's loss at this many sigmas "
                     "(studies.robust_update.HuberUpdater; default the design's update)")  # fmt: skip
+    ap.add_argument("--design-array", default=None,
+                    help="the design's traced route of this array (e.g. 8x8), its line-of-sight "
+                    "tracker and survey table for eq. 1 (default: the traced tables' route)")  # fmt: skip
+    ap.add_argument("--start-sigma", type=float, default=0.1,
+                    help="the entry fix's sigma [m] (the design's: 1)")  # fmt: skip
+    ap.add_argument("--drawn-start", action="store_true",
+                    help="the trackers start from an entry fix drawn with that sigma (as the "
+                    "design's), not at the truth")  # fmt: skip
+    ap.add_argument("--second-start", action="store_true",
+                    help="the direct fit also started from eq. 1's line of sight at the "
+                    "predicted range (direct_drive's second_start)")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -172,6 +214,10 @@ def main(argv=None) -> int:
                 a.diffuse_above,
                 a.start_height_sigma,
                 a.huber,
+                a.design_array,
+                a.start_sigma,
+                a.drawn_start,
+                a.second_start,
             )
             for i in range(a.runs)
         ]
@@ -181,7 +227,13 @@ def main(argv=None) -> int:
             print(f"  drive {i}: {sec:.0f} s, " + ", ".join(
                 f"{t} {v:.3f}" for t, v in r.rmse().items()), flush=True)  # fmt: skip
     told = table.as_dict()
-    print(f"\n{report(res, f'{a.scenario}, seed {a.seed}')}\nthe direct fix told (deg): "
+    route = _setup(a.scenario, a.design_array)[0]
+    try:
+        settled = counted_epochs(route.trajectory.t[: res[0].truth.shape[0]])
+    except ValueError:  # a drive too short to settle: no settled column
+        settled = None
+    label = f"{a.scenario}{'' if a.design_array is None else ', design ' + a.design_array}"
+    print(f"\n{report(res, f'{label}, seed {a.seed}', settled)}\nthe direct fix told (deg): "
           f"{told}; {time.perf_counter() - t0:.0f} s\n")  # fmt: skip
     if a.out is not None:
         a.out.parent.mkdir(parents=True, exist_ok=True)

@@ -97,9 +97,10 @@ DOCUMENTED: tuple[Documented, ...] = (
     ),
     _doc(
         r"studies\.direct_track\.DirectDrive",
-        r"speed_errors",
+        r"speed_errors|unmodelled",
         "empty",
-        "no fit of the speed on the drive (the speed not used, or every fit flagged)",
+        "no fit of the speed on the drive (the speed not used, or every fit flagged); no ok "
+        "direct fit on the drive (every fit unconverged or past its gate)",
     ),
     _doc(
         r"studies\.direct\.(direct_fix|diffuse_share|DirectProblem(\.with_diffuse)?|DirectFix)"

@@ -454,6 +454,35 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
         direct_drive(route, np.random.default_rng(4), design, table, table, diffuse_above=0.1)
     with pytest.raises(TypeError, match=r"^route"):
         direct_drive("italiano2026-straight", np.random.default_rng(4), design, table, table)
+    # an entry fix given (the design's drawn start): every tracker starts there, the draws the
+    # same; dead reckoning is JAVELIN's own run from it
+    p0 = traj.position[0] + np.array([0.7, -0.4, 0.03])
+    moved = direct_drive(route, np.random.default_rng(4), design, None, table, n_epochs=3,
+                         start_sigma=1.0, start_height_sigma=0.05, start=p0)  # fmt: skip
+    d1 = design.with_(base_station=tuple(float(v) for v in route.arrays[0].origin),
+                      sigma_p0_ue=1.0, sigma_p0_height=0.05)  # fmt: skip
+    run = run_javelin([None] * 3, speed, heading, float(traj.t[1] - traj.t[0]), p0, d1)
+    np.testing.assert_allclose(moved.estimates["dead reckoning"], run.estimates, atol=1e-12)
+    assert not np.allclose(moved.estimates["direct"], moved.estimates["dead reckoning"])
+    # the second start: the fit also started from eq. 1's line of sight at the predicted range
+    # (0.8 m off the prediction here on the first epoch); the same draws, the same dead reckoning
+    starts.clear()
+    two = direct_drive(route, np.random.default_rng(4), design, None, table, n_epochs=3,
+                       start_sigma=1.0, start_height_sigma=0.05, start=p0,
+                       second_start=True)  # fmt: skip
+    assert len(starts) > 3 and np.hypot(*(starts[1] - p0)[:2]) > 0.25  # epoch 0 started twice
+    np.testing.assert_array_equal(
+        two.estimates["dead reckoning"], moved.estimates["dead reckoning"]
+    )
+    assert set(two.seconds) == {"direct"} and np.all(two.seconds["direct"] > 0)
+    with pytest.raises(TypeError, match=r"^second_start"):
+        direct_drive(route, np.random.default_rng(4), design, None, table, second_start="yes")
+    with pytest.raises(ValueError, match=r"^start: .*of its told sigmas"):  # 0.6 m, told 5 cm
+        direct_drive(route, np.random.default_rng(4), design, None, table, n_epochs=1,
+                     start_sigma=0.05, start=p0)  # fmt: skip
+    with pytest.raises(ValueError, match=r"^start"):
+        direct_drive(route, np.random.default_rng(4), design, None, table, n_epochs=1,
+                     start=p0[:2])  # fmt: skip
 
 
 def test_step_sigma_is_what_the_tracker_is_told(route):
@@ -534,3 +563,31 @@ def test_the_direct_column_reads_the_shipped_table_and_refuses_other_scenes():
     assert _traced_routes(("paper", "ml"), "sionna", True)[-1] == jd.DIRECT_COLUMN[1]
     assert jd.DIRECT_COLUMN[1] not in _traced_routes(("paper", "ml"), "sionna")
     assert _traced_routes(("paper", "ml"), "image", True) == ("paper", "ml")
+
+
+def test_repointed_keeps_the_range_and_height_and_takes_the_measured_direction():
+    """The second start: a prediction at the true point's range and height but another bearing
+    is moved onto the true point; any prediction lands on the measured azimuth at its own range
+    and height."""
+    from tunnelkit.geometry import spherical
+    from tunnelkit.studies.direct_track import repointed
+    from tunnelkit.tracking.measurements import PathMeasurements
+
+    o = np.array([0.0, -0.5, 4.8])
+    p = np.array([23.0, -2.5, 1.5])
+    phi, psi, r = spherical(p - o)
+    los = PathMeasurements.from_arrays([phi], [psi], [r], [r], [0.0], warn=False)
+    rh, dz = np.hypot(*(p - o)[:2]), p[2] - o[2]
+    a = phi + np.radians(3.0)
+    pred = o + np.array([rh * np.cos(a), rh * np.sin(a), dz])
+    np.testing.assert_allclose(repointed(los, o, pred), p, atol=1e-9)
+    far = np.array([30.0, -1.0, 1.6])
+    q = repointed(los, o, far)
+    assert q[2] == far[2]
+    np.testing.assert_allclose(np.arctan2(q[1] - o[1], q[0] - o[0]), phi, atol=1e-12)
+    with pytest.raises(ValueError, match=r"^prediction: at the origin"):
+        repointed(los, o, o)
+    with pytest.raises(ValueError, match=r"^los: expected one path"):
+        repointed(los.subset(np.array([], int)), o, far)
+    with pytest.raises(TypeError, match=r"^los"):
+        repointed((phi, psi), o, far)

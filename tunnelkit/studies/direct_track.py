@@ -13,10 +13,10 @@ JAVELIN, every measurement dropped), the traced tables' line-of-sight column (eq
 the path :func:`~tunnelkit.design.los.los_path` takes, its design survey's sigmas) and, with
 ``speed_sigma``, dead reckoning on the averaged speed alone (``"direct speed alone"``: the
 direct fits' speeds, no position update), which tells the speed's share from the angles'. The
-truth starts every tracker (told ``start_sigma``), and the eq. 1 column reads what the traced
-tables' ML route reads (the number of true first-order paths, and with the route's
-``diffuse_floor`` the traced diffuse power in its noise floor); no other truth enters a
-tracker. It scores them and records the errors each was fed, from which
+truth starts every tracker (told ``start_sigma``) unless an entry fix is given, and the eq. 1
+column reads what the traced tables' ML route reads (the number of true first-order paths, and
+with the route's ``diffuse_floor`` the traced diffuse power in its noise floor); no other truth
+enters a tracker. It scores them and records the errors each was fed, from which
 :func:`~tunnelkit.design.los.elevation_sigmas` and an RMS make the told sigmas on the drives
 they are chosen on. ``benchmarks/bench_rt_direct.py`` runs it
 (``docs/results/traced-models.md``).
@@ -44,7 +44,15 @@ from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
 from .direct import MAX_DIFFUSE, MAX_HEIGHT_M, diffuse_share, direct_fix
 
-__all__ = ["TRACKERS", "DirectDrive", "direct_drive", "eq1_los", "unmodelled_share"]
+__all__ = [
+    "RESTART_M",
+    "TRACKERS",
+    "DirectDrive",
+    "direct_drive",
+    "eq1_los",
+    "repointed",
+    "unmodelled_share",
+]
 
 #: the trackers of one drive (``"eq. 1"`` only with an ``eq1_table``, the last only with
 #: ``speed_sigma``)
@@ -166,6 +174,58 @@ def _unmodelled(residual: float, snap) -> float:
     return residual - snap.noise_power * snap.H.size / float(np.sum(np.abs(snap.H) ** 2))
 
 
+#: the second start of the direct fit is tried when it lies this far from the prediction [m]
+#: (horizontally; :func:`direct_drive`'s ``second_start``)
+RESTART_M = 0.25
+
+
+def repointed(los: PathMeasurements, origin, prediction) -> np.ndarray:
+    """The point (3,) [m] along the line of sight ``los`` (one path's measured angles, seen from
+    ``origin`` (3,)) at the range of ``prediction`` (3,) from ``origin``, at the prediction's
+    height: the prediction moved onto the measured direction (its range and height kept, where
+    a far line of sight's elevation says little about the range)."""
+    instance("los", los, PathMeasurements)
+    if len(los) != 1:
+        raise ValueError(f"los: expected one path (the line of sight), got {len(los)}")
+    origin = finite_array("origin", origin, shape=(3,))
+    prediction = finite_array("prediction", prediction, shape=(3,))
+    if np.linalg.norm(prediction - origin) == 0.0:
+        raise ValueError("prediction: at the origin, no range to keep")
+    return _repointed(los, origin, prediction)
+
+
+def _repointed(los, origin, prediction) -> np.ndarray:
+    """:func:`repointed` of checked arguments."""
+    r = float(np.linalg.norm(prediction - origin))
+    phi, psi = float(los.phi[0]), float(los.psi[0])
+    q = origin + r * np.array([np.cos(psi) * np.cos(phi), np.cos(psi) * np.sin(phi), np.sin(psi)])
+    return np.array([q[0], q[1], prediction[2]])
+
+
+def _second_start(route, arr, los, pred) -> list:
+    """[the second start] of :func:`direct_drive` (:func:`repointed`), or [] without eq. 1's
+    line of sight, within :data:`RESTART_M` of the prediction, or outside the tunnel."""
+    if los is None or not len(los):
+        return []
+    q = _repointed(los, arr.origin, pred)
+    far = np.hypot(*(q[:2] - pred[:2])) > RESTART_M
+    return [q] if far and bool(route.tunnel.contains(q, 1e-6)) else []
+
+
+def _best_fix(route, arr, snap, starts, velocity, **options):
+    """The direct fit (:func:`~.direct.direct_fix`, ``options``) of ``snap`` from each of
+    ``starts``: the ok fit of smallest residual; else the first fit (not ok); None when every
+    fit raised."""
+    fits = []
+    for p in starts:
+        try:
+            fits.append(direct_fix(route, arr, snap.H, p, velocity, **options))
+        except _FAILURES:
+            pass
+    good = [f for f in fits if f.ok]
+    return min(good, key=lambda f: f.residual) if good else (fits[0] if fits else None)
+
+
 def _los_error(pm: PathMeasurements, ue: np.ndarray, origin: np.ndarray) -> tuple:
     az, el, _ = spherical(ue - origin)
     return float(pm.psi[0]), float(wrap_angle(pm.phi[0] - az)), float(pm.psi[0] - el)
@@ -187,13 +247,18 @@ def direct_drive(
     max_unmodelled: float | None = None,
     diffuse: int = 0,
     diffuse_above: float = 0.0,
+    start: np.ndarray | None = None,
+    second_start: bool = False,
 ) -> DirectDrive:
     """One drive of ``route`` (the line of sight always present; the study's channel is the ray
     tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
     messages of its trajectory's odometry, then each epoch's snapshot, drawn from ``rng`` in that
     order; copies of ``design`` (a line-of-sight JAVELIN reading each measurement's covariance,
     :func:`tunnelkit.design.tracedlos.los_javelin`) started at the true first position told
-    ``start_sigma`` [m] (the traced tables' line-of-sight column), its height told
+    ``start_sigma`` [m] (the traced tables' line-of-sight column; ``start`` (3,) [m] given,
+    every tracker starts there instead: an entry fix drawn by the caller, the design's
+    :func:`~tunnelkit.tracking.javelin.runs.draw_start`, at most 10 ``start_sigma`` from the
+    truth), its height told
     ``start_height_sigma`` [m] (None: ``start_sigma``, as the tables; a vehicle's antenna height
     is known better, the design tells :data:`~tunnelkit.design.START_HEIGHT_SIGMA_M`: a loosely
     told height takes up a bias of the measured elevations and turns it into an error along the
@@ -212,7 +277,12 @@ def direct_drive(
     snapshot's noise power; the unmodelled share is then what the tied atoms and those free gains
     leave, a weaker flag for ``max_unmodelled``, and the told ``table`` does not know whether a
     fix admitted one; ``diffuse_above``: tried only where the tied fit's unmodelled share exceeds
-    it (:func:`~.direct.direct_fix`)."""
+    it (:func:`~.direct.direct_fix`). ``second_start``: the direct fit also started from eq. 1's
+    line of sight of the epoch (:func:`eq1_los`, run for it with or without ``eq1_table``) at
+    the prediction's range and height (:func:`repointed`), where that start lies more than
+    :data:`RESTART_M` from the prediction; of the ok fits the one of smaller residual is kept
+    (a prediction far off, the design's 1 m entry fix, leads a fit started there alone into the
+    wrong basin)."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -228,6 +298,7 @@ def direct_drive(
         raise ValueError(f"speed_sigma: a speed's sigma of at most 10 m/s, got {speed_sigma:g}")
     n2 = integer("second_order", second_order, minimum=0, maximum=64)
     by_element = boolean("element_second_order", element_second_order)
+    restart = boolean("second_start", second_start)
     if max_unmodelled is not None and not 0.0 < positive("max_unmodelled", max_unmodelled) <= 1.0:
         raise ValueError(f"max_unmodelled: a share of the power in (0, 1], got {max_unmodelled:g}")
     n_diffuse = integer("diffuse", diffuse, minimum=0, maximum=MAX_DIFFUSE)
@@ -241,6 +312,15 @@ def direct_drive(
             f"start_height_sigma: at most {MAX_HEIGHT_M:g} m, got {start_height_sigma:g}"
         )
     traj = route.trajectory
+    p0 = traj.position[0]
+    if start is not None:
+        p0 = finite_array("start", start, shape=(3,))
+        off = np.abs(p0 - traj.position[0]) / np.array([start_sigma] * 2 + [start_height_sigma])
+        if np.max(off) > 10.0:
+            raise ValueError(
+                f"start: {np.max(off):.3g} of its told sigmas from the drive's first position "
+                "(at most 10: a fix the told start_sigma / start_height_sigma describe)"
+            )
     T = (
         len(traj)
         if n_epochs is None
@@ -256,7 +336,7 @@ def direct_drive(
     )
     names = [n for n in TRACKERS if (n != "eq. 1" or eq1_table is not None)
              and (n != "direct speed alone" or speed_sigma is not None)]  # fmt: skip
-    trackers = {name: _StepSigma(traj.position[0], d) for name in names}
+    trackers = {name: _StepSigma(p0, d) for name in names}
     c = config_sigmas(d.config)
     if speed_sigma is not None:  # the averaged speed's sigma
         fused = float(1.0 / np.hypot(1.0 / d.config.sigma_speed, 1.0 / speed_sigma))
@@ -283,25 +363,26 @@ def direct_drive(
             arr, paths, snap = route.draw(
                 k, rng
             )  # paths: only their number, as the tables' ML route
-            pm = {}
-            if eq1_table is not None:
+            pm, los1, t_eq = {}, None, 0.0
+            if eq1_table is not None or restart:
                 t0 = time.perf_counter()
                 try:
-                    pm["eq. 1"] = _eq1_los(route, k, arr, len(paths), snap)
+                    los1 = _eq1_los(route, k, arr, len(paths), snap)
                 except _FAILURES:
                     pass
-                secs["eq. 1"][k] = time.perf_counter() - t0
+                t_eq = time.perf_counter() - t0
+                if eq1_table is not None:
+                    pm["eq. 1"], secs["eq. 1"][k], t_eq = los1, t_eq, 0.0
             t0 = time.perf_counter()
             ok = np.isfinite(speed[k]) and np.isfinite(heading[k])
             v_msg = ue_velocity(speed[k], heading[k]) if ok else np.zeros(3)
-            try:
-                fix = direct_fix(route, arr, snap.H, trackers["direct"].x[:3], v_msg,
-                                 second_order=n2, speed=speed_sigma is not None and ok,
-                                 element_second_order=by_element, diffuse=n_diffuse,
-                                 noise_power=snap.noise_power if n_diffuse else None,
-                                 diffuse_above=above)  # fmt: skip
-            except _FAILURES:
-                fix = None
+            pred = trackers["direct"].x[:3]
+            starts = [pred] if not restart else [pred, *_second_start(route, arr, los1, pred)]
+            fix = _best_fix(route, arr, snap, starts, v_msg,
+                            second_order=n2, speed=speed_sigma is not None and ok,
+                            element_second_order=by_element, diffuse=n_diffuse,
+                            noise_power=snap.noise_power if n_diffuse else None,
+                            diffuse_above=above)  # fmt: skip
             radio = float("nan")
             share = _unmodelled(fix.residual, snap) if fix is not None and fix.ok else None
             if share is not None:
@@ -311,7 +392,7 @@ def direct_drive(
                 if np.isfinite(fix.speed):
                     radio = fix.speed
                     speed_err.append(fix.speed - float(np.linalg.norm(vel[k, :2])))
-            secs["direct"][k] = time.perf_counter() - t0
+            secs["direct"][k] = time.perf_counter() - t0 + t_eq  # with eq. 1's for the start
             for name, jav in trackers.items():
                 m = pm.get(name)
                 if name in told:
