@@ -287,6 +287,14 @@ class DirectFix:
         integer("diffuse", self.diffuse, minimum=0, maximum=MAX_DIFFUSE)
 
 
+def beyond_noise_unchecked(residual: float, noise_power: float, n: int, h2: float) -> float:
+    """What a fit's relative ``residual`` (its cost over ``h2``, the tensor's ``||H||^2``) leaves
+    beyond the noise of ``n`` samples of power ``noise_power``: ``residual - noise_power n /
+    h2``, the unmodelled share (checked by its callers: :func:`direct_fix`,
+    :func:`~.direct_track.unmodelled_share`)."""
+    return residual - noise_power * n / h2
+
+
 def diffuse_share(diffuse_above, diffuse: int) -> float:
     """The checked ``diffuse_above`` of :func:`direct_fix`: a share of the tensor's power in
     [0, 1), not above zero without ``diffuse`` atoms (0 to :data:`MAX_DIFFUSE`) to try."""
@@ -372,7 +380,7 @@ def direct_fix(
         f = prob.fit_tied(np.r_[f["x"], np.linalg.norm(prob.velocity)])
         evaluations, ok = evaluations + f["evaluations"], f["converged"]
     used = 0
-    if n_diffuse and ok and f["residual"] - n0 * prob.N / prob.h2 > above:
+    if n_diffuse and ok and beyond_noise_unchecked(f["residual"], n0, prob.N, prob.h2) > above:
         threshold = n0 * diffuse_threshold(*prob.H.shape)
         while used < n_diffuse:
             more = prob.with_diffuse(used + 1)

@@ -42,7 +42,7 @@ from ..signal_route import SignalRoute, measurements_from_estimates
 from ..tracking.javelin import Javelin, JavelinDesign, ReportedNoise
 from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
-from .direct import MAX_DIFFUSE, MAX_HEIGHT_M, diffuse_share, direct_fix
+from .direct import MAX_DIFFUSE, MAX_HEIGHT_M, beyond_noise_unchecked, diffuse_share, direct_fix
 
 __all__ = [
     "RESTART_M",
@@ -171,7 +171,9 @@ def unmodelled_share(residual: float, snap: ChannelSnapshot) -> float:
 
 def _unmodelled(residual: float, snap) -> float:
     """:func:`unmodelled_share` of checked arguments."""
-    return residual - snap.noise_power * snap.H.size / float(np.sum(np.abs(snap.H) ** 2))
+    return beyond_noise_unchecked(
+        residual, snap.noise_power, snap.H.size, float(np.sum(np.abs(snap.H) ** 2))
+    )
 
 
 #: the second start of the direct fit is tried when it lies this far from the prediction [m]
