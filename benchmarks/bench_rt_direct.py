@@ -105,7 +105,13 @@ def report(res, label: str, settled=None) -> str:
     rm = np.array([[r.rmse()[t] for t in names] for r in res])  # (runs, trackers)
     rng = np.random.default_rng(0)
     pooled = None if settled is None else _settled_rmse(res, names, settled)
-    extra = "" if pooled is None else " settled RMSE, pooled [m] | its gain |"
+    if pooled is not None:  # the pooled gain's 90 % bootstrap interval over the drives
+        sq = np.array([[np.mean(np.sum((r.estimates[t][settled, :2] - r.truth[settled, :2]) ** 2,
+                                       axis=1)) for t in names] for r in res])  # fmt: skip
+        draws = np.random.default_rng(1).integers(0, len(res), size=(2000, len(res)))
+        boot = np.sqrt(sq[draws].mean(axis=1))  # (2000, trackers)
+        glo, ghi = np.quantile(boot[:, :1] / boot, [0.05, 0.95], axis=0)
+    extra = "" if pooled is None else " settled RMSE, pooled [m] | its gain [90 %] |"
     out = [f"### {label}, {len(res)} drives\n",
            "| tracker | mean RMSE [m] | ratio to dead reckoning (per drive: mean [90 %]) | "
            "gain (mean DR / mean tracker) | epochs without a measurement |" + extra,
@@ -114,7 +120,8 @@ def report(res, label: str, settled=None) -> str:
         q = rm[:, j] / rm[:, 0]
         lo, hi = _interval(q, rng)
         drop = sum(r.dropped.get(t, 0) for r in res)
-        tail = "" if pooled is None else f" {pooled[j]:.3f} | {pooled[0] / pooled[j]:.2f}x |"
+        tail = "" if pooled is None else (
+            f" {pooled[j]:.3f} | {pooled[0] / pooled[j]:.2f}x [{glo[j]:.2f}, {ghi[j]:.2f}] |")  # fmt: skip
         out.append(f"| {t} | {rm[:, j].mean():.3f} | {q.mean():.2f} [{lo:.2f}, {hi:.2f}] | "
                    f"{rm[:, 0].mean() / rm[:, j].mean():.2f}x | {drop if j else '-'} |" + tail)  # fmt: skip
     out += ["", "| line of sight fed | n | azimuth error RMS / median abs [deg] | elevation "
@@ -185,6 +192,9 @@ def main(argv=None) -> int:
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="pickle of the drives")
+    ap.add_argument("--score", type=Path, default=None,
+                    help="report the drives of this pickle (--out of an earlier run) again "
+                    "without driving; the other options must be that run's")  # fmt: skip
     a = ap.parse_args(argv)
     print("command: python benchmarks/bench_rt_direct.py " + shlex.join(argv or sys.argv[1:]))
     if a.table is not None:
@@ -198,6 +208,8 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     res = [None] * a.runs
     args = (a.scenario, a.seed, a.runs)
+    if a.score is not None:
+        res = pickle.loads(a.score.read_bytes())
     with ProcessPoolExecutor(a.workers) as ex:
         futs = [
             ex.submit(
@@ -220,6 +232,7 @@ def main(argv=None) -> int:
                 a.second_start,
             )
             for i in range(a.runs)
+            if a.score is None
         ]
         for f in futs:
             i, r, sec = f.result()
