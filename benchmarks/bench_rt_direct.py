@@ -90,24 +90,16 @@ def _interval(x, rng, n=2000) -> tuple[float, float]:
     return float(ci.low), float(ci.high)
 
 
-def _settled_rmse(res, names, settled) -> np.ndarray:
-    """(trackers,) the horizontal RMSE pooled over drives and the ``settled`` epochs (the
-    design's ``rmse_settled``)."""
-    return np.array([
-        np.sqrt(np.mean([np.sum((r.estimates[t][settled, :2] - r.truth[settled, :2]) ** 2, axis=1)
-                         for r in res]))
-        for t in names
-    ])  # fmt: skip
-
-
 def report(res, label: str, settled=None) -> str:
     names = list(res[0].estimates)
     rm = np.array([[r.rmse()[t] for t in names] for r in res])  # (runs, trackers)
     rng = np.random.default_rng(0)
-    pooled = None if settled is None else _settled_rmse(res, names, settled)
-    if pooled is not None:  # the pooled gain's 90 % bootstrap interval over the drives
+    pooled = None
+    if settled is not None:  # the horizontal RMSE pooled over drives and settled epochs (the
+        # design's rmse_settled) and its gain's 90 % bootstrap interval over the drives
         sq = np.array([[np.mean(np.sum((r.estimates[t][settled, :2] - r.truth[settled, :2]) ** 2,
                                        axis=1)) for t in names] for r in res])  # fmt: skip
+        pooled = np.sqrt(sq.mean(axis=0))
         draws = np.random.default_rng(1).integers(0, len(res), size=(2000, len(res)))
         boot = np.sqrt(sq[draws].mean(axis=1))  # (2000, trackers)
         glo, ghi = np.quantile(boot[:, :1] / boot, [0.05, 0.95], axis=0)
