@@ -140,6 +140,25 @@ def report(res, label: str, settled=None) -> str:
     return "\n".join(out) + "\n"
 
 
+def _drive_all(a, table) -> list:
+    """The drives of the parsed options ``a`` told ``table``, two processes at a time."""
+    res = [None] * a.runs
+    with ProcessPoolExecutor(a.workers) as ex:
+        futs = [
+            ex.submit(one, a.scenario, a.seed, a.runs, i, table, a.second_order, a.n_epochs,
+                      a.speed_sigma, a.element_second_order, a.max_unmodelled, a.diffuse,
+                      a.diffuse_above, a.start_height_sigma, a.huber, a.design_array,
+                      a.start_sigma, a.drawn_start, a.second_start)
+            for i in range(a.runs)
+        ]  # fmt: skip
+        for f in futs:
+            i, r, sec = f.result()
+            res[i] = r
+            print(f"  drive {i}: {sec:.0f} s, " + ", ".join(
+                f"{t} {v:.3f}" for t, v in r.rmse().items()), flush=True)  # fmt: skip
+    return res
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="italiano2026-straight")
@@ -198,39 +217,7 @@ def main(argv=None) -> int:
         table = ElevationSigmas(table.elevation, a.sigma_scale * table.sigma_azimuth,
                                 a.sigma_scale * table.sigma_elevation)  # fmt: skip
     t0 = time.perf_counter()
-    res = [None] * a.runs
-    args = (a.scenario, a.seed, a.runs)
-    if a.score is not None:
-        res = pickle.loads(a.score.read_bytes())
-    with ProcessPoolExecutor(a.workers) as ex:
-        futs = [
-            ex.submit(
-                one,
-                *args,
-                i,
-                table,
-                a.second_order,
-                a.n_epochs,
-                a.speed_sigma,
-                a.element_second_order,
-                a.max_unmodelled,
-                a.diffuse,
-                a.diffuse_above,
-                a.start_height_sigma,
-                a.huber,
-                a.design_array,
-                a.start_sigma,
-                a.drawn_start,
-                a.second_start,
-            )
-            for i in range(a.runs)
-            if a.score is None
-        ]
-        for f in futs:
-            i, r, sec = f.result()
-            res[i] = r
-            print(f"  drive {i}: {sec:.0f} s, " + ", ".join(
-                f"{t} {v:.3f}" for t, v in r.rmse().items()), flush=True)  # fmt: skip
+    res = pickle.loads(a.score.read_bytes()) if a.score is not None else _drive_all(a, table)
     told = table.as_dict()
     route = _setup(a.scenario, a.design_array)[0]
     try:
