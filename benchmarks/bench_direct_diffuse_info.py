@@ -22,10 +22,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.constants import C
+from tunnelkit.extraction.direct.fit import DirectProblem, image_maps
+from tunnelkit.extraction.direct.visibility import predicted_model
 from tunnelkit.extraction.numerics import spatial_phase
 from tunnelkit.signal_route import SignalRoute
-from tunnelkit.studies.direct import DirectProblem, image_maps
-from tunnelkit.studies.visibility import predicted_model
 
 
 def _hessian(f, x, h=2e-3) -> np.ndarray:

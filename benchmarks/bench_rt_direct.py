@@ -1,4 +1,4 @@
-"""The direct fit under the tracker on the ray-traced channel (:mod:`tunnelkit.studies.direct_track`):
+"""The direct fit under the tracker on the ray-traced channel (:mod:`tunnelkit.design.traceddirect`):
 per drive, dead reckoning, the traced tables' line-of-sight column (eq. 1), the direct fix's line
 of sight and, with ``--speed-sigma``, its speed (and that speed alone), on the same messages and
 snapshots (condition L, start at the truth told 0.1 m). Reports each tracker's mean RMSE, its
@@ -33,12 +33,12 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tunnelkit.design.los import ElevationSigmas, elevation_sigmas
+from tunnelkit.design.traceddirect import direct_drive
 from tunnelkit.design.verdict import counted_epochs
 from tunnelkit.montecarlo import spawn_rngs
 from tunnelkit.reproduce.javelin_direct import DIRECT_NUISANCE
 from tunnelkit.reproduce.javelin_traced import los_design, los_survey
 from tunnelkit.simulation.drives import scenario_route
-from tunnelkit.studies.direct_track import direct_drive
 from tunnelkit.studies.robust_update import HuberUpdater
 from tunnelkit.tracking.javelin.runs import draw_start
 

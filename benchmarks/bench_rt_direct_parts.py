@@ -1,6 +1,6 @@
 """What the direct fit misses on the ray-traced channel, part by part.
 
-Per epoch: the direct fit (:func:`tunnelkit.studies.direct.direct_fix`, second-order atoms on the
+Per epoch: the direct fit (:func:`tunnelkit.extraction.direct.fit.direct_fix`, second-order atoms on the
 elements that see them, with its speed) from the true position and velocity on the noiseless
 traced tensor (:meth:`tunnelkit.rt.RayTracedChannel.components`, transmit power included), then
 on the same tensor with one part of :func:`tunnelkit.rt.tensor_components` removed at a time
@@ -29,10 +29,10 @@ from threadpoolctl import threadpool_limits
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from tunnelkit.extraction.direct.fit import direct_fix
 from tunnelkit.geometry import spherical
 from tunnelkit.rt import COMPONENTS
 from tunnelkit.simulation.drives import scenario_route
-from tunnelkit.studies.direct import direct_fix
 
 
 def _row(label, route, arr, H, k, diffuse=0) -> str:

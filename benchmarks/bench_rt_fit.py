@@ -1,9 +1,9 @@
 """One epoch's extraction on the ray-traced channel: eq. 1's ML route against the direct fit.
 
 The cost per epoch of what each tracker of ``benchmarks/bench_rt_direct.py`` reads
-(:mod:`tunnelkit.studies.direct_track`): the traced tables' line-of-sight column (eq. 1's ML
+(:mod:`tunnelkit.design.traceddirect`): the traced tables' line-of-sight column (eq. 1's ML
 route with the number of first-order paths and the route's diffuse floor, the baseline) and the
-direct fit (:func:`tunnelkit.studies.direct.direct_fix`, with its speed) with the second-order
+direct fit (:func:`tunnelkit.extraction.direct.fit.direct_fix`, with its speed) with the second-order
 atoms on every element or each on the elements that see it (and then with at most one diffuse
 atom, the dense multipath's), from a prediction 5 cm off. One
 snapshot of epochs 4 and 20 of ``italiano2026-straight`` (the paper's 10 x 10, 410 tones, 12
@@ -25,9 +25,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from run import Case
 
 from tunnelkit import rt
+from tunnelkit.design.traceddirect import eq1_los
+from tunnelkit.extraction.direct.fit import direct_fix
 from tunnelkit.simulation.drives import scenario_route
-from tunnelkit.studies.direct import direct_fix
-from tunnelkit.studies.direct_track import eq1_los
 from tunnelkit.tracking.javelin.motion import ue_velocity
 
 EPOCHS = (4, 20)

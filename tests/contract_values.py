@@ -268,7 +268,8 @@ def _studies():
     one_epoch_fix(phi, psi, rng_, paths, route.trajectory.position[10], arr.origin)
     # paths against their truth, the amplitude profile and its study (the traced part of the
     # study traces the scene: tests/test_aperture.py)
-    from tunnelkit.studies import aperture, nuisance, truth
+    from tunnelkit.extraction.direct import aperture
+    from tunnelkit.studies import nuisance, truth
 
     tru = truth.path_truth(paths, arr)
     truth.world_angles(np.stack([p.direction for p in paths]))
@@ -287,7 +288,7 @@ def _studies():
     prob.profile(beta)
     prob.evaluate_profile(th, mf, mt, beta, derivatives=True)
     prob.fit(th, mf, mt, route.config.noise_power, beta=beta, max_iter=2)
-    from tunnelkit.studies import visibility
+    from tunnelkit.extraction.direct import visibility
 
     ue, vel = route.trajectory.position[10], route.trajectory.velocity[10]
     visibility.element_visibility(route.tunnel, route.tunnel.surfaces[0], ue, arr.world)
@@ -306,11 +307,12 @@ def _studies():
 
 
 def _direct():
+    from tunnelkit.design import traceddirect as direct_track
     from tunnelkit.design.los import ElevationSigmas
+    from tunnelkit.extraction.direct import fit as direct
+    from tunnelkit.extraction.direct.visibility import predicted_model
     from tunnelkit.reproduce.javelin_traced import los_design
     from tunnelkit.signal_route import SignalRoute
-    from tunnelkit.studies import direct, direct_track
-    from tunnelkit.studies.visibility import predicted_model
 
     route = SignalRoute.from_scenario("italiano2026-straight")
     arr, _, snap = route.draw(12, np.random.default_rng(3))

@@ -1,5 +1,5 @@
-"""The amplitude profile across the aperture (tunnelkit.studies.aperture), each path on the elements
-that see it (tunnelkit.studies.visibility) and the study that compares them with eq. 1 and with
+"""The amplitude profile across the aperture (tunnelkit.extraction.direct.aperture), each path on the elements
+that see it (tunnelkit.extraction.direct.visibility) and the study that compares them with eq. 1 and with
 second-order nuisance atoms (tunnelkit.studies.nuisance).
 
 The traced cases need the ``rt`` extra (``make test`` installs it) and fails without it unless
@@ -14,18 +14,18 @@ import numpy as np
 import pytest
 
 from tunnelkit.arrays import ArrayGeometry
-from tunnelkit.extraction.ml import Problem
-from tunnelkit.extraction.numerics import spatial_phase
-from tunnelkit.propagation import trace_paths
-from tunnelkit.signal_route import SignalRoute
-from tunnelkit.studies.aperture import ApertureProblem, taper_basis
-from tunnelkit.studies.nuisance import eq1_cost, traced_bias
-from tunnelkit.studies.visibility import (
+from tunnelkit.extraction.direct.aperture import ApertureProblem, taper_basis
+from tunnelkit.extraction.direct.visibility import (
     MaskedProblem,
     element_visibility,
     predicted_model,
     visible_paths,
 )
+from tunnelkit.extraction.ml import Problem
+from tunnelkit.extraction.numerics import spatial_phase
+from tunnelkit.propagation import trace_paths
+from tunnelkit.signal_route import SignalRoute
+from tunnelkit.studies.nuisance import eq1_cost, traced_bias
 
 SKIP_RT = os.environ.get("TUNNELKIT_SKIP_RT") == "1"
 FC = 28e9

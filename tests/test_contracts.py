@@ -81,13 +81,13 @@ DOCUMENTED: tuple[Documented, ...] = (
         "NaN is 'nothing measured' (no path of that kind, no noisy draw): the record's docstring",
     ),
     _doc(
-        r"studies\.visibility\.predicted_model",
+        r"extraction\.direct\.visibility\.predicted_model",
         r"second_order",
         "zero",
         "no second-order atom: the masks and the missing facets alone (model 'visibility')",
     ),
     _doc(
-        r"studies\.direct\.DirectFix",
+        r"extraction\.direct\.fit\.DirectFix",
         r"clock_bias|speed|residual|evaluations",
         "negative huge nan zero",
         "a fit's record: the clock bias [m] has either sign and its support is the route's; the "
@@ -96,33 +96,33 @@ DOCUMENTED: tuple[Documented, ...] = (
         "physically impossible speeds and shares are refused)",
     ),
     _doc(
-        r"studies\.direct_track\.DirectDrive",
+        r"design\.traceddirect\.DirectDrive",
         r"speed_errors|unmodelled",
         "empty",
         "no fit of the speed on the drive (the speed not used, or every fit flagged); no ok "
         "direct fit on the drive (every fit unconverged or past its gate)",
     ),
     _doc(
-        r"studies\.direct\.(direct_fix|diffuse_share|DirectProblem(\.with_diffuse)?|DirectFix)"
-        r"|studies\.direct_track\.direct_drive",
+        r"extraction\.direct\.fit\.(direct_fix|diffuse_share|DirectProblem(\.with_diffuse)?|DirectFix)"
+        r"|design\.traceddirect\.direct_drive",
         r"diffuse",
         "zero",
         "no diffuse atom: the tied fit alone (the default)",
     ),
     _doc(
-        r"studies\.direct\.(direct_fix|diffuse_share)|studies\.direct_track\.direct_drive",
+        r"extraction\.direct\.fit\.(direct_fix|diffuse_share)|design\.traceddirect\.direct_drive",
         r"diffuse_above",
         "zero",
         "the diffuse atoms tried at every fit (the default)",
     ),
     _doc(
-        r"studies\.direct\.direct_fix|studies\.direct_track\.direct_drive",
+        r"extraction\.direct\.fit\.direct_fix|design\.traceddirect\.direct_drive",
         r"second_order",
         "zero",
         "no second-order atom: the direct fit of the first-order paths and the missing facets",
     ),
     _doc(
-        r"studies\.aperture\.(ApertureProblem|taper_basis)",
+        r"extraction\.direct\.aperture\.(ApertureProblem|taper_basis)",
         r"order",
         "zero",
         "order 0 is eq. 1 itself, the reference the profile is tested against (number for number)",

@@ -13,14 +13,14 @@ from tunnelkit.design.tracedtracker import TRACED_TRACKERS, checked_tracker
 
 
 def test_the_tracker_is_named_once_and_the_line_of_sight_needs_the_traced_channel():
-    assert TRACED_TRACKERS == ("paths", "los", "auto")
+    assert TRACED_TRACKERS == ("paths", "los", "auto", "direct")
     assert checked_tracker("los", "channel", "sionna") == "los"
     assert checked_tracker("auto", "channel", "sionna") == "auto"
     for mode in ("bound", "channel"):
         for channel in ("image", "sionna"):
             assert checked_tracker("paths", mode, channel) == "paths"
     for mode, channel in (("bound", "sionna"), ("channel", "image"), ("bound", "image")):
-        for name in ("los", "auto"):
+        for name in ("los", "auto", "direct"):
             with pytest.raises(
                 ValueError, match=rf"^traced_tracker: '{name}'.*mode '{mode}'.*'{channel}'"
             ):
@@ -46,8 +46,9 @@ def test_the_cli_refuses_the_line_of_sight_without_the_traced_channel(capsys):
     args = ["design", "italiano2026-straight", "--arrays", "4x4", "--traced-tracker", "los"]
     assert main(args) == 2
     assert "--traced-tracker los" in capsys.readouterr().err
-    assert main([*args[:-1], "auto"]) == 2
-    assert "--traced-tracker auto" in capsys.readouterr().err
+    for name in ("auto", "direct"):
+        assert main([*args[:-1], name]) == 2
+        assert f"--traced-tracker {name}" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main([*args[:-1], "every"])
 

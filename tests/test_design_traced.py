@@ -782,3 +782,51 @@ def test_auto_keeps_the_paths_tracker_where_its_prediction_is_smaller_or_no_surv
     assert list(row.error_model["chosen_by_predicted_rms_m"]) == ["paths"]
     bad = design.design_sweep(setup, ["4x4"], traced_tracker="los", **kw).rows[0]
     assert bad.status == "error" and "los_rows" in bad.reason
+
+
+def test_the_direct_sweep_is_the_direct_drive_from_the_drawn_fix(setup):
+    """traced_tracker "direct": each drive is traceddirect.direct_drive on the design's traced
+    route (the line of sight's JAVELIN fed the direct fix, told design_table, with
+    DESIGN_OPTIONS), started from the open-sky fix drawn from a generator spawned before the
+    drive's; dead reckoning is the same tracker on that drive's messages; the prediction beside
+    it is the told model's posterior CRLB; the report names the tracker and its told sigmas."""
+    from tunnelkit.design.arrayjob import ArrayJob, SweepTrial
+    from tunnelkit.design.traceddirect import (
+        DESIGN_OPTIONS,
+        DESIGN_SIGMAS_DEG,
+        design_table,
+        direct_drive,
+    )
+    from tunnelkit.tracking.javelin import ReportedNoise, draw_start
+
+    kw = {"seed": 0, "mode": "channel", "n_epochs": 3, "dead_reckoning": True, **FEW}
+    rep = design.design_sweep(setup, ["4x4"], traced_tracker="direct", **kw)
+    row = rep.rows[0]
+    em = row.error_model
+    assert em["tracker"] == "direct" and em["direct"]["options"] == DESIGN_OPTIONS
+    assert tuple(em["direct"]["told_deg"].values()) == DESIGN_SIGMAS_DEG
+    assert set(em["told_sigmas"]) == {"kappa_m", "delta_d_m"}  # the angles are the table's
+    assert rep.to_json()["inputs"]["traced_tracker"] == "direct"
+    assert "the direct fit's line of sight (tracker direct" in rep.to_table()
+    assert np.isfinite(row.rmse_m) and np.isfinite(row.dead_reckoning_rmse_m)
+    k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
+    _, drive = tracedbounds.los_bounds(setup, "4x4", design_table(), 3)
+    assert row.predicted_drive_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
+    # one drive of the sweep's trial, against direct_drive called by hand on the same draws
+    prep = ArrayJob(setup, None, "channel", 3, False, None, traced_tracker="direct")(
+        design.parse_array("4x4")
+    )
+    assert isinstance(prep.design.noise, ReportedNoise)
+    assert prep.direct.as_dict() == design_table().as_dict()
+    trial = SweepTrial(setup, "channel", 3, dead_reckoning=True)
+    got = trial((prep, 7), np.random.default_rng(11))
+    rng, g = np.random.default_rng(11).spawn(2)
+    route = traced.traced_route(setup, "4x4")
+    p0 = draw_start(route.trajectory.position[0], trial.start_sigma, g, 0.05)
+    out = direct_drive(route, rng, prep.design, None, design_table(), n_epochs=3, start=p0,
+                       start_sigma=trial.start_sigma, start_height_sigma=0.05,
+                       **DESIGN_OPTIONS)  # fmt: skip
+    for j, name in enumerate(("direct", "dead reckoning")):
+        want = np.linalg.norm(out.estimates[name][:, :2] - out.truth[:, :2], axis=1)
+        np.testing.assert_array_equal(got[j], want)
+    assert got.shape == (2, 3) and np.all(np.isfinite(got))

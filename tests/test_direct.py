@@ -1,4 +1,4 @@
-"""The direct fit (tunnelkit.studies.direct): the image maps against the traced sources, the tied
+"""The direct fit (tunnelkit.extraction.direct.fit): the image maps against the traced sources, the tied
 atoms against eq. 1's true parameters, the fit on its own model's tensor (exact without noise, at
 its Cramer-Rao bound with it) and its flag."""
 
@@ -12,11 +12,11 @@ import pytest
 from tunnelkit.arrays import ArrayGeometry
 from tunnelkit.constants import C
 from tunnelkit.extraction import ml_truth
+from tunnelkit.extraction.direct.fit import DirectProblem, direct_fix, image_maps
+from tunnelkit.extraction.direct.visibility import predicted_model, visible_second_order
 from tunnelkit.extraction.numerics import spatial_phase
 from tunnelkit.propagation import SECOND_ORDER, trace_paths
 from tunnelkit.signal_route import SignalRoute
-from tunnelkit.studies.direct import DirectProblem, direct_fix, image_maps
-from tunnelkit.studies.visibility import predicted_model, visible_second_order
 
 NF, NT = 48, 4  # a cut of the tensor: the fits are three parameters whatever its size
 
@@ -117,7 +117,7 @@ def test_unmodelled_share_is_what_the_model_lacks(route):
     sample power over 19,200 cells spreads by about 4e-4; without the noise's share subtracted
     both would be 4e-3 off)."""
     from tunnelkit.channel import ChannelSnapshot
-    from tunnelkit.studies.direct_track import unmodelled_share
+    from tunnelkit.design.traceddirect import unmodelled_share
 
     arr, ue, vel, shell, x, gains, rng = _setup(route, 12, 7)
     H0 = _tensor(shell, x, gains)
@@ -243,7 +243,7 @@ def test_diffuse_admission_rate_on_noise(route, monkeypatch):
     see it: at most 15 admitted (binomial: a true rate of 0.2 exceeds it with probability about
     0.003; 2 of 60 were admitted when it was written). Counting only the Nf Nt resolution cells
     admitted 68 % at a nominal 0.1."""
-    import tunnelkit.studies.direct as direct
+    import tunnelkit.extraction.direct.fit as direct
 
     monkeypatch.setattr(direct, "DIFFUSE_FALSE_ALARM", 0.2)
     arr, ue, vel, shell, x, gains, rng = _setup(route, 9, 23)
@@ -367,7 +367,7 @@ def test_refusals_name_the_parameter(route):
     for bad in (0.0, -1.0, np.nan, 1e3 * float(np.mean(np.abs(H) ** 2))):
         with pytest.raises(ValueError, match=r"^noise_power"):
             direct_fix(route, arr, H, ue, vel, diffuse=1, noise_power=bad)
-    from tunnelkit.studies.direct import diffuse_threshold
+    from tunnelkit.extraction.direct.fit import diffuse_threshold
 
     with pytest.raises(ValueError, match=r"^M"):
         diffuse_threshold(1, NF, NT)
@@ -384,16 +384,16 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
     reckoning is JAVELIN's own run on the same messages with no measurement (the loop steps as
     Javelin.run does, midpoint included), and the errors fed are recorded per epoch."""
     from tunnelkit.design.los import ElevationSigmas
+    from tunnelkit.design.traceddirect import TRACKERS, direct_drive
     from tunnelkit.reproduce.javelin_traced import los_design
     from tunnelkit.studies.attribution import scenario_with_array
-    from tunnelkit.studies.direct_track import TRACKERS, direct_drive
     from tunnelkit.tracking.javelin import run_javelin
 
     sc = scenario_with_array("italiano2026-straight", (4, 4))
     route = SignalRoute.from_scenario(sc, channel="sionna", cache_dir=str(tmp_path))
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
     design = los_design()
-    import tunnelkit.studies.direct_track as dt
+    import tunnelkit.design.traceddirect as dt
 
     starts = []
 
@@ -487,8 +487,8 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
 
 def test_step_sigma_is_what_the_tracker_is_told(route):
     """The study's JAVELIN told a step's speed sigma predicts as a design told it would."""
+    from tunnelkit.design.traceddirect import _StepSigma
     from tunnelkit.reproduce.javelin_traced import los_design
-    from tunnelkit.studies.direct_track import _StepSigma
     from tunnelkit.tracking.javelin import Javelin
 
     d = los_design()
@@ -569,8 +569,8 @@ def test_repointed_keeps_the_range_and_height_and_takes_the_measured_direction()
     """The second start: a prediction at the true point's range and height but another bearing
     is moved onto the true point; any prediction lands on the measured azimuth at its own range
     and height."""
+    from tunnelkit.design.traceddirect import repointed
     from tunnelkit.geometry import spherical
-    from tunnelkit.studies.direct_track import repointed
     from tunnelkit.tracking.measurements import PathMeasurements
 
     o = np.array([0.0, -0.5, 4.8])

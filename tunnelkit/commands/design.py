@@ -343,13 +343,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     rt.add_argument(
         "--traced-tracker",
-        choices=["paths", "los", "auto"],
+        choices=["paths", "los", "auto", "direct"],
         default=None,
         help="with --channel sionna: the tracker on the ray-traced channel, the line of sight "
         "alone, told its angle sigmas by its measured elevation from a survey of 3 drives per "
         "array (los), every path the geometry pre-filter keeps told the array's RMS errors "
-        "(paths), or per array the one whose told model predicts the smaller error (auto, "
-        "default)",
+        "(paths), per array the one whose told model predicts the smaller error (auto, "
+        "default), or the line of sight of the direct fit, every atom tied to one UE position "
+        "and started from the track's prediction (direct: seconds per epoch, docs/results/"
+        "traced-models.md)",
     )
     mc.add_argument(
         "--n-epochs",
@@ -417,7 +419,7 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
-    if args.traced_tracker in ("los", "auto") and args.channel != "sionna":
+    if args.traced_tracker not in (None, "paths") and args.channel != "sionna":
         print(
             f"tunnelkit design: error: --traced-tracker {args.traced_tracker} tracks on the "
             f"ray-traced channel: it needs --channel sionna (got --channel {args.channel})",

@@ -101,6 +101,8 @@ class SweepTrial:
             drive = bound_drive(
                 prep.route, self.setup, spec, rng, n_epochs=self.n_epochs, calibration=cal
             )
+        elif self.setup.channel == "sionna" and prep.direct is not None:
+            return self._direct(prep, rng)
         elif self.setup.channel == "sionna":
             from .traced import design_drive
 
@@ -144,6 +146,28 @@ class SweepTrial:
         ev = evaluate(alone, prep.design, sigma_p0_ue=sigma, start=p0, sigma_p0_height=sh)
         return np.stack([err, _trial_errors(ev.estimates, drive.truth)])
 
+    def _direct(self, prep, rng: np.random.Generator) -> np.ndarray:
+        """One drive of the direct tracker (:mod:`tunnelkit.design.traceddirect`): its
+        measurements depend on its own track, so the drive and the tracker run together, dead
+        reckoning on the same messages beside it; the open-sky fix drawn from a generator
+        spawned before the drive's."""
+        from ..tracking.javelin import draw_start
+        from .traced import traced_route
+        from .traceddirect import DESIGN_OPTIONS, direct_drive
+
+        route = traced_route(self.setup, prep.spec)
+        rng, g = rng.spawn(2)
+        sh, sigma = START_HEIGHT_SIGMA_M, self.start_sigma
+        drawn = self.start == "drawn"
+        p0 = draw_start(route.trajectory.position[0], sigma, g, sh) if drawn else None
+        out = direct_drive(route, rng, prep.design, None, prep.direct, n_epochs=self.n_epochs,
+                           start_sigma=sigma, start_height_sigma=sh, start=p0,
+                           **DESIGN_OPTIONS)  # fmt: skip
+        err = _trial_errors(out.estimates["direct"], out.truth)
+        if not self.dead_reckoning:
+            return err
+        return np.stack([err, _trial_errors(out.estimates["dead reckoning"], out.truth)])
+
 
 def _model(setup, spec, error_models, impairments=None) -> PathErrorModel:
     from .achievable import path_error_model
@@ -181,6 +205,7 @@ class Prepared:
     error_model: dict | None = None  # traced.error_model_summary: the traced route's
     hybrid: np.ndarray | None = None  # the bound pooled over units (drivebound.unit_pcrlb)
     los_table: object = None  # los.ElevationSigmas: the traced route's line-of-sight tracker
+    direct: object = None  # los.ElevationSigmas: the direct tracker's told sigmas (traceddirect)
 
     def summary(self) -> tuple:
         """What the sweep's result keeps (not the model and route the drives need)."""
@@ -269,6 +294,8 @@ class ArrayJob:
             # whose errors are neither Gaussian nor independent: a prediction)
             pc, sp0, los, told = None, self.start_sigma, None, {}
             design = traced.traced_javelin(self.setup, spec, rec)  # "paths"
+            if self.traced_tracker == "direct":
+                return self._direct(spec, rec, design, peb, budget, hybrid)
             if self.traced_tracker != "los":
                 told["paths"] = tracedbounds.traced_bounds(self.setup, spec, design.config,
                                                            self.T, sigma_p0=sp0)[1]  # fmt: skip
@@ -303,6 +330,22 @@ class ArrayJob:
                     error_model["auto_fallback"] = fallback
         return Prepared(spec, route, design, peb, pc, drive, budget, error_model, hybrid, table)
 
+    def _direct(self, spec, rec, design, peb, budget, hybrid) -> Prepared:
+        """The direct tracker's preparation (:mod:`tunnelkit.design.traceddirect`): the line of
+        sight's JAVELIN fed the direct fix, told :func:`~.traceddirect.design_table`; the
+        posterior CRLB of that told model beside it (a prediction, not a bound)."""
+        from . import traced, tracedbounds, tracedlos
+        from .traceddirect import design_table, direct_summary
+
+        table = design_table()
+        design = tracedlos.los_javelin(design)
+        drive = tracedbounds.los_bounds(self.setup, spec, table, self.T,
+                                        sigma_p0=self.start_sigma)[1]  # fmt: skip
+        em = traced.error_model_summary(rec, design.config)
+        em["told_sigmas"] = {k: em["told_sigmas"][k] for k in ("kappa_m", "delta_d_m")}
+        em.update(tracker="direct", direct=direct_summary())
+        return Prepared(spec, None, design, peb, None, drive, budget, em, hybrid, None, table)
+
 
 def load_tracker() -> None:
     """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
@@ -333,7 +376,7 @@ def load_tracker() -> None:
         tracker,
         update,
     )
-    from . import los, tracedlos  # noqa: F401  (the traced route's line-of-sight tracker)
+    from . import los, traceddirect, tracedlos  # noqa: F401  (the traced route's trackers)
 
 
 def prepared_summary(prep: Prepared) -> tuple:

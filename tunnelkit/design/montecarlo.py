@@ -269,8 +269,9 @@ def sweep_montecarlo(
     drive). ``dead_reckoning``: each drive also run with every measurement dropped (the same
     tracker, start and V2X messages: what the radio adds), its errors the result's
     ``dead_reckoning``. ``traced_tracker`` (:data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`,
-    the ray-traced channel's channel route only): ``"los"``, ``"paths"`` or ``"auto"`` (there the
-    default: per array the one whose told model predicts the smaller error).
+    the ray-traced channel's channel route only): ``"los"``, ``"paths"``, ``"auto"`` (there the
+    default: per array the one whose told model predicts the smaller error) or ``"direct"``
+    (:mod:`tunnelkit.design.traceddirect`).
     """
     if not isinstance(setup, DesignSetup):
         raise TypeError(f"setup: expected a design.DesignSetup, got {type(setup).__name__}")

@@ -157,7 +157,15 @@ def report_table(report) -> str:
                     lines.append(f"  {r.array}: {what} above the target at x = {spans}")
         em = r.error_model
         los = em.get("los") if em else None
-        if los:
+        direct = em.get("direct") if em else None
+        if direct:
+            told = direct["told_deg"]
+            lines.append(
+                f"  {r.array}: traced route, the direct fit's line of sight (tracker direct: every "
+                f"atom tied to one UE position, started from the track's prediction), told "
+                f"azimuth {told['azimuth']:.3g} deg, elevation {told['elevation']:.3g} deg"
+            )
+        elif los:
             tab = los["table_deg"]
             saz, sel = tab["sigma_azimuth"], tab["sigma_elevation"]
             lines.append(

@@ -146,7 +146,7 @@ def design_sweep(
     (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
     drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
     radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"auto"``, its default,
-    ``"los"`` or ``"paths"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
+    ``"los"``, ``"paths"`` or ``"direct"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
     fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
     reason; the sweep goes on."""
     if not isinstance(setup, DesignSetup):

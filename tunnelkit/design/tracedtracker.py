@@ -17,12 +17,15 @@ __all__ = ["TRACED_TRACKERS", "checked_tracker"]
 #: (:func:`tunnelkit.design.tracedlos.los_javelin`, :mod:`tunnelkit.design.los`); ``"auto"``
 #: per array the one whose told model predicts the smaller RMS error over the route (the
 #: posterior CRLB of what it is told: :mod:`tunnelkit.design.tracedbounds`, a prediction), the
-#: default there (a sweep's ``traced_tracker=None``; ``"paths"`` on every other route)
-TRACED_TRACKERS = ("paths", "los", "auto")
+#: default there (a sweep's ``traced_tracker=None``; ``"paths"`` on every other route);
+#: ``"direct"`` the line of sight's tracker fed the direct fit, every atom of the visibility
+#: model tied to one UE position and started from the tracker's own prediction
+#: (:mod:`tunnelkit.design.traceddirect`; several seconds per epoch, never chosen by ``"auto"``)
+TRACED_TRACKERS = ("paths", "los", "auto", "direct")
 
 
 def checked_tracker(traced_tracker: str, mode: str, channel: str) -> str:
-    """``traced_tracker`` checked: one of :data:`TRACED_TRACKERS`, and ``"los"`` or ``"auto"``
+    """``traced_tracker`` checked: one of :data:`TRACED_TRACKERS`, and any but ``"paths"``
     only on the ray-traced channel's channel route (``mode`` "channel", ``channel`` "sionna"):
     refused naming both otherwise."""
     from ..signal_route.route import CHANNELS

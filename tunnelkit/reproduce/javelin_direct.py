@@ -3,11 +3,11 @@ javelin-table1|2 --channel sionna``).
 
 Eq. 1's paths do not describe the traced tensor (the tables' other columns: the ML route's fit
 test flags every epoch, and the line of sight it takes errs by degrees). The direct fit
-(:func:`~tunnelkit.studies.direct.direct_fix`: every atom of the visibility model tied to one UE
+(:func:`~tunnelkit.extraction.direct.fit.direct_fix`: every atom of the visibility model tied to one UE
 position, one clock bias and one speed) does not fit the paths apart; started at JAVELIN's
 prediction in each epoch, it gives a line of sight of tenths of a degree. Because the
 measurement depends on the track, no stored drive can replay it: the column runs its own drive
-(:func:`~tunnelkit.studies.direct_track.direct_drive`) on each condition-L trial, drawn from a
+(:func:`~tunnelkit.design.traceddirect.direct_drive`) on each condition-L trial, drawn from a
 generator spawned from the trial's (the other columns' draws are unchanged), and its dead
 reckoning is the same JAVELIN on that drive's own V2X messages. Its configuration
 (:data:`DIRECT_OPTIONS`) and its told angle sigmas by elevation (:func:`direct_table`, shipped
@@ -23,10 +23,10 @@ import numpy as np
 
 from .._validate import integer, rng_or_error, text
 from ..design.los import ElevationSigmas
+from ..design.traceddirect import direct_drive
 from ..scenarios import data_dir
 from ..simulation.drives import scenario_route
 from ..simulation.scoring import error_metrics
-from ..studies.direct_track import direct_drive
 from .javelin_traced import LOS_START_M, los_design
 
 __all__ = [
@@ -42,7 +42,7 @@ __all__ = [
 #: the direct fit's column: (label, measurement route, design); its design is the line-of-sight
 #: column's JAVELIN (:func:`~.javelin_traced.los_design`)
 DIRECT_COLUMN = ("direct fit under JAVELIN, line of sight", "direct", "direct")
-#: the direct drive's options (:func:`~tunnelkit.studies.direct_track.direct_drive`): the fit's
+#: the direct drive's options (:func:`~tunnelkit.design.traceddirect.direct_drive`): the fit's
 #: speed told 0.1 m/s, the second-order atoms on the elements that see them, one diffuse atom
 #: tried where the tied fit leaves more than 4 % of the power unmodelled, the start's height
 #: told 1 cm (a vehicle's antenna height is known)
@@ -135,7 +135,7 @@ def direct_note(scenario: str) -> str:
     return (
         f"Column '{DIRECT_COLUMN[0]}' (condition L only): at every epoch the line-of-sight "
         "column's JAVELIN predicts with the V2X message and the direct fit "
-        "(studies.direct.direct_fix: every atom of the visibility model tied to one UE position, "
+        "(extraction.direct.fit.direct_fix: every atom of the visibility model tied to one UE position, "
         "one clock bias and one speed, the second-order atoms on the elements that see them, "
         f"{o['diffuse']} diffuse atom tried where the tied fit leaves more than "
         f"{100 * o['diffuse_above']:g} % of the tensor's power unmodelled) starts from its "
@@ -143,7 +143,7 @@ def direct_note(scenario: str) -> str:
         f"elevation sigmas by its elevation ({bins}, each times {DIRECT_SIGMA_SCALE:g}; "
         f"{rec['source']}), its speed averaged with "
         f"the next message's (told {o['speed_sigma']:g} m/s). The measurement depends on the "
-        "track, so the column runs its own drive (studies.direct_track.direct_drive), drawn "
+        "track, so the column runs its own drive (design.traceddirect.direct_drive), drawn "
         "from a generator spawned from the trial's: its dead reckoning row is the same JAVELIN "
         "on that drive's own messages, not the other columns'. Started at the true position "
         f"told {LOS_START_M:g} m, its height told {100 * o['start_height_sigma']:g} cm (an "

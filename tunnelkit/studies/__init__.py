@@ -14,12 +14,11 @@ core never imports it (``tests/test_layout.py``):
   tracer switched off in turn, its pseudo-true bias, extraction error and position cost
   (``docs/results/traced-attribution.md``).
 - :mod:`.nuisance` — a model that absorbs what eq. 1 misses: the first-order pseudo-true bias on
-  the traced channel under eq. 1, an amplitude profile across the aperture (:mod:`.aperture`)
-  and second-order nuisance atoms, and the profile's cost where eq. 1 holds
-  (``docs/results/traced-models.md``); :mod:`.truth` compares paths with their truth;
-  :mod:`.visibility` each path on the elements that see it; :mod:`.direct` every atom of that
-  model tied to one UE position, clock bias and speed (the direct fit), and :mod:`.direct_track`
-  that fit under the tracker, from the tracker's own prediction;
+  the traced channel under eq. 1, an amplitude profile across the aperture and second-order
+  nuisance atoms, and the profile's cost where eq. 1 holds (``docs/results/traced-models.md``);
+  :mod:`.truth` compares paths with their truth (the models themselves, each path on the elements
+  that see it and the direct fit tying every atom to one UE, are the core's
+  :mod:`tunnelkit.extraction.direct`, under the tracker :mod:`tunnelkit.design.traceddirect`);
 - :mod:`.robust_errors` — errors the tracker can trust: robust statistics of the traced
   per-path errors (median, MAD, gross errors apart) and the traced design told them
   (``docs/results/traced-robust.md``).

@@ -45,14 +45,14 @@ from ..channel import channel_tensor
 from ..constants import C
 from ..evaluation import match_paths
 from ..extraction import extract_paths, ml_truth
+from ..extraction.direct.aperture import MAX_ORDER, ApertureProblem
+from ..extraction.direct.visibility import MaskedProblem, predicted_model
 from ..extraction.ml import Problem, fit_problem, start_from_estimates
 from ..propagation import SECOND_ORDER
 from ..signal_route import SignalRoute
-from .aperture import MAX_ORDER, ApertureProblem
 from .attribution import KINDS, measured_record, one_epoch_fix, scenario_with_array
 from .misspecified import pseudo_true
 from .truth import angles_of_theta, path_differences, path_truth
-from .visibility import MaskedProblem, predicted_model
 
 __all__ = ["MODELS", "CostRow", "ModelRow", "eq1_cost", "traced_bias"]
 

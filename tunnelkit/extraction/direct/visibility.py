@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._physical import carrier
-from .._validate import boolean, finite_array, instance, integer, probability, sequence
-from ..arrays import ArrayGeometry
-from ..propagation import PATH_KINDS, SECOND_ORDER, Facet, Path, Tunnel3D, trace_paths
-from ..propagation.path import make_path
-from ..propagation.second_order import bounce_points_unchecked, second_order_path_unchecked
+from ..._physical import carrier
+from ..._validate import boolean, finite_array, instance, integer, probability, sequence
+from ...arrays import ArrayGeometry
+from ...propagation import PATH_KINDS, SECOND_ORDER, Facet, Path, Tunnel3D, trace_paths
+from ...propagation.path import make_path
+from ...propagation.second_order import bounce_points_unchecked, second_order_path_unchecked
 from .aperture import ApertureProblem
 
 __all__ = [

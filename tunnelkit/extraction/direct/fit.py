@@ -32,7 +32,7 @@ which elements, is the prediction's. On the model's own tensor a prediction 0.1 
 changed the masks of 5-57 element-path pairs or the second-order list at the epochs checked
 (0.1 m along the tunnel changes fewer: none at two epochs, 5 pairs at two others), and the fit
 then landed up to 1.8 m off; rebuilding the model at each fit, or holding the paths seen from a
-ring around the prediction, was tried and did not remove it (``docs/results/traced-models.md``). Used under the tracker by :mod:`.direct_track`.
+ring around the prediction, was tried and did not remove it (``docs/results/traced-models.md``). Used under the tracker by :mod:`tunnelkit.design.traceddirect`.
 """
 
 from __future__ import annotations
@@ -44,14 +44,14 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
-from .._physical import speeds
-from .._validate import boolean, finite_array, instance, integer, positive, record, sequence
-from ..arrays import ArrayGeometry
-from ..channel import SRSConfig
-from ..constants import C
-from ..extraction.decomposition import check_tensor
-from ..extraction.numerics import spatial_phase_unchecked
-from ..propagation import SECOND_ORDER, Path, Tunnel3D
+from ..._physical import speeds
+from ..._validate import boolean, finite_array, instance, integer, positive, record, sequence
+from ...arrays import ArrayGeometry
+from ...channel import SRSConfig
+from ...constants import C
+from ...propagation import SECOND_ORDER, Path, Tunnel3D
+from ..decomposition import check_tensor
+from ..numerics import spatial_phase_unchecked
 from .visibility import MaskedProblem, predicted_model
 
 __all__ = [
@@ -291,7 +291,7 @@ def beyond_noise_unchecked(residual: float, noise_power: float, n: int, h2: floa
     """What a fit's relative ``residual`` (its cost over ``h2``, the tensor's ``||H||^2``) leaves
     beyond the noise of ``n`` samples of power ``noise_power``: ``residual - noise_power n /
     h2``, the unmodelled share (checked by its callers: :func:`direct_fix`,
-    :func:`~.direct_track.unmodelled_share`)."""
+    :func:`~tunnelkit.design.traceddirect.unmodelled_share`)."""
     return residual - noise_power * n / h2
 
 
@@ -341,7 +341,7 @@ def direct_fix(
     diffuse atom's free gains take part of that atom's information (the position's bound grows
     1.2-4.2 times for an atom 0-3 m past the line of sight on the paper's 10 x 10 tensor, not at
     all for one 20 m past: ``benchmarks/bench_direct_diffuse_info.py``), which the told sigmas of
-    :mod:`.direct_track` do not know. ``diffuse_above``: the atoms are tried only where the tied
+    :mod:`tunnelkit.design.traceddirect` do not know. ``diffuse_above``: the atoms are tried only where the tied
     fit leaves more than this share of the tensor's power beyond the noise (its unmodelled share,
     ``residual - noise_power M Nf Nt / ||H||^2``, in [0, 1)); 0 tries them at every fit."""
     if not hasattr(route, "tunnel") or not hasattr(route, "config"):

@@ -22,16 +22,16 @@ derivative atoms ``exp(j psi_l) w_j`` (no ``h``), and every atom still factorise
 1's :class:`~tunnelkit.extraction.ml.model.Problem`, number for number (tested).
 :meth:`ApertureProblem.fit` is Levenberg-Marquardt over all ``(5 + K) L`` parameters from a
 start (normally eq. 1's fit with ``beta = 0``). Measured in ``docs/results/traced-models.md``
-(:mod:`.nuisance`).
+(:mod:`tunnelkit.studies.nuisance`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._validate import boolean, finite_array, integer, positive
-from ..extraction.ml import Problem, project_feasible
-from ..extraction.numerics import solve_unchecked, spatial_phase_unchecked
+from ..._validate import boolean, finite_array, integer, positive
+from ..ml import Problem, project_feasible
+from ..numerics import solve_unchecked, spatial_phase_unchecked
 
 __all__ = ["MAX_ORDER", "ApertureProblem", "taper_basis"]
 
