@@ -307,7 +307,7 @@ def _studies():
 
 
 def _direct():
-    from tunnelkit.design import traceddirect as direct_track
+    from tunnelkit.design import traceddirect
     from tunnelkit.design.los import ElevationSigmas
     from tunnelkit.extraction.direct import fit as direct
     from tunnelkit.extraction.direct.visibility import predicted_model
@@ -333,11 +333,11 @@ def _direct():
     direct.direct_fix(route, arr, H, ue, vel, second_order=2, speed=True, gate=5.0,
                       element_second_order=True, diffuse=1, noise_power=snap.noise_power,
                       diffuse_above=0.01)  # fmt: skip
-    los = direct_track.eq1_los(route, 12, arr, 3, snap)
-    direct_track.repointed(los, arr.origin, ue + np.array([0.5, 0.3, 0.0]))
-    direct_track.unmodelled_share(0.01, snap)
+    los = traceddirect.eq1_los(route, 12, arr, 3, snap)
+    traceddirect.repointed(los, arr.origin, ue + np.array([0.5, 0.3, 0.0]))
+    traceddirect.unmodelled_share(0.01, snap)
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
-    direct_track.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
+    traceddirect.direct_drive(route, np.random.default_rng(0), los_design(), table, table,
                               speed_sigma=0.1, second_order=2, n_epochs=2, start_sigma=0.1,
                               start_height_sigma=0.05, element_second_order=True,
                               max_unmodelled=0.5, diffuse=1, diffuse_above=0.01,

@@ -830,3 +830,28 @@ def test_the_direct_sweep_is_the_direct_drive_from_the_drawn_fix(setup):
         want = np.linalg.norm(out.estimates[name][:, :2] - out.truth[:, :2], axis=1)
         np.testing.assert_array_equal(got[j], want)
     assert got.shape == (2, 3) and np.all(np.isfinite(got))
+
+
+def test_the_direct_drive_is_cut_to_the_route_as_every_drive(setup, monkeypatch):
+    """A sweep's n_epochs beyond the route drives the whole route (as the other trackers'
+    drives), and None drives it all: direct_drive is never asked for more epochs than it has."""
+    from tunnelkit.design import traceddirect
+    from tunnelkit.design.arrayjob import Prepared, SweepTrial
+
+    asked = []
+
+    class Stop(Exception):
+        pass
+
+    def recording(route, rng, design_, eq1_table, table, **kw):
+        asked.append(kw["n_epochs"])
+        raise Stop
+
+    monkeypatch.setattr(traceddirect, "direct_drive", recording)
+    prep = Prepared(design.parse_array("4x4"), None, None, np.zeros(1), None, None,
+                    direct=traceddirect.design_table())  # fmt: skip
+    n = len(setup.trajectory)
+    for n_epochs in (n + 5, n, 2, None):
+        with pytest.raises(Stop):
+            SweepTrial(setup, "channel", n_epochs)((prep, 0), np.random.default_rng(0))
+    assert asked == [n, n, 2, None]

@@ -695,8 +695,9 @@ print(f"eq. 25: M_max = {m_max_paper:.3g} -> {int(np.ceil(m_max_paper))} x "
 # the image channel the tracker weighs each path by the CRLB the extraction reports and drops an
 # epoch whose fit fails its residual test. On the traced channel every fit fails that test, so
 # the design's traced route (`--mode channel --channel sionna`, `design.traced`) offers two
-# trackers. This section runs the one that changes two things, as the traced JAVELIN tables do
-# (`traced_tracker="paths"`); section 9b the other, and the design's default, which chooses:
+# trackers to choose between (a third, `direct`, fits the tensor itself at several seconds an
+# epoch; not run here). This section runs the one that changes two things, as the traced JAVELIN tables do
+# (`traced_tracker="paths"`); section 9b the second, and the design's default, which chooses:
 #
 # - **a geometry pre-filter**: a path is kept when it agrees with one UE position through the
 #   tunnel's planes, whatever the fit's own verdict;

@@ -3,7 +3,7 @@
 [--wideband-model/--no-wideband-model] [--dmc-share S]
 [--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
 [--settle S] [--workers N | --scheduler A] [--mode bound|channel]
-[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna [--traced-tracker auto|los|paths]]
+[--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna [--traced-tracker auto|los|paths|direct]]
 [--start-sigma S] [--no-dead-reckoning] [--format table|json] [--plot FILE.html]``.
 
 Sizes an array for a scenario's tunnel and route (:mod:`tunnelkit.design`): per candidate array

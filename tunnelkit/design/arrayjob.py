@@ -156,11 +156,12 @@ class SweepTrial:
         from .traceddirect import DESIGN_OPTIONS, direct_drive
 
         route = traced_route(self.setup, prep.spec)
+        n = None if self.n_epochs is None else min(self.n_epochs, len(route.trajectory))
         rng, g = rng.spawn(2)
         sh, sigma = START_HEIGHT_SIGMA_M, self.start_sigma
         drawn = self.start == "drawn"
         p0 = draw_start(route.trajectory.position[0], sigma, g, sh) if drawn else None
-        out = direct_drive(route, rng, prep.design, None, prep.direct, n_epochs=self.n_epochs,
+        out = direct_drive(route, rng, prep.design, None, prep.direct, n_epochs=n,
                            start_sigma=sigma, start_height_sigma=sh, start=p0,
                            **DESIGN_OPTIONS)  # fmt: skip
         err = _trial_errors(out.estimates["direct"], out.truth)

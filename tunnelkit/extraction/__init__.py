@@ -3,7 +3,8 @@
 :func:`extract_paths` runs a route: the paper's (:mod:`.paper`, from the CPD of
 :mod:`.decomposition`), the coherent split (:mod:`.coherent`) or, by default, the joint
 maximum-likelihood fit (:mod:`.ml`); every route returns a :class:`PathEstimates`, and
-:mod:`.bounds` holds the Cramér-Rao bounds. Entry points take the radio as
+:mod:`.bounds` holds the Cramér-Rao bounds. :mod:`.direct` fits the ray-traced channel with every
+atom tied to one UE position (the design's direct tracker). Entry points take the radio as
 ``(..., array, srs, ...)``. ``H`` follows eq. 1 exactly as printed (spatial phase
 ``+2 pi fc/c delta``, frequency phase ``-2 pi s Df tau``, time phase ``+2 pi k f_d T0``).
 

@@ -6,7 +6,7 @@ The models (:data:`MODELS`):
 
 * ``eq1``: eq. 1 with the image method's first-order paths (the extraction's model);
 * ``aperture-1`` / ``aperture-2``: each path with a real amplitude profile over the array of
-  that polynomial order (:class:`~.aperture.ApertureProblem`: the visibility of a path to only
+  that polynomial order (:class:`~tunnelkit.extraction.direct.aperture.ApertureProblem`: the visibility of a path to only
   part of the array, the term the attribution found in the LoS and ceiling paths);
 * ``second-order-N``: eq. 1 with the image method's ``N`` strongest second-order specular paths
   as nuisance atoms beside the first-order ones
@@ -14,15 +14,15 @@ The models (:data:`MODELS`):
   ``RouteOptions(second_order=N)`` models them; the second-order bounces carry about 20 % of the
   traced power);
 * ``visibility``: eq. 1 with each first-order path on the elements that see it and an atom for
-  each facet some element sees that the reference element does not (:mod:`.visibility`: masks
+  each facet some element sees that the reference element does not (:mod:`tunnelkit.extraction.direct.visibility`: masks
   from the true position for the bias, from a predicted one for the noisy rows);
   ``visibility-second-order-N`` the same with ``N`` second-order atoms (seen by every element).
 
 :func:`traced_bias` fits each model noiselessly to the traced tensor of each epoch (the pseudo-true
 parameters: eq. 1's by :func:`~.misspecified.pseudo_true` from the true paths, the profile's by
-:meth:`ApertureProblem.fit <.aperture.ApertureProblem.fit>` from eq. 1's, the second-order
+:meth:`ApertureProblem.fit <tunnelkit.extraction.direct.aperture.ApertureProblem.fit>` from eq. 1's, the second-order
 model's by ``pseudo_true`` from the true first- and second-order paths, the visibility models'
-by :meth:`MaskedProblem.fit <.visibility.MaskedProblem.fit>` from every true path they hold and
+by :meth:`MaskedProblem.fit <tunnelkit.extraction.direct.visibility.MaskedProblem.fit>` from every true path they hold and
 from eq. 1's fit, the better kept: the most favourable start, an oracle) and reports each first-order path's bias against the image method's geometry,
 by kind; with noisy draws also each model's extraction errors (not started at the truth) and a
 one-epoch position fix from either. :func:`eq1_cost` does the same on eq. 1's own tensor, where every model must be
@@ -189,7 +189,7 @@ def traced_bias(
     refined with the profile (``aperture-K``); estimates matched to the first-order truth
     (:func:`tunnelkit.evaluation.match_paths`), ``d`` less the drawn clock bias. The visibility
     models' noisy fit starts every atom at the model of a predicted position
-    (:func:`~.visibility.predicted_model` at the true one moved by ``N(0, predicted_sigma^2)``
+    (:func:`~tunnelkit.extraction.direct.visibility.predicted_model` at the true one moved by ``N(0, predicted_sigma^2)``
     [m] along x and y, drawn with ``rng`` after each snapshot: a tracker's prediction), the
     delays shifted by eq. 1's earliest delay less the prediction's shortest path (the clock
     bias, unknown to the receiver)."""
@@ -281,7 +281,7 @@ def _errors(model: str, snap, arr, cfg, paths, tru, atoms, ue, eq1: dict) -> tup
     snapshot once made (``"fit"``, ``"s"``): the profiles refine it and the visibility models
     read its earliest delay, so they are timed with it. ``atoms``: the number of second-order
     atoms, or for a visibility model the model of a predicted position (``(paths, masks,
-    n_first)``, :func:`~.visibility.predicted_model`): its atoms start there, not at eq. 1's."""
+    n_first)``, :func:`~tunnelkit.extraction.direct.visibility.predicted_model`): its atoms start there, not at eq. 1's."""
     L = len(paths)
     t0 = time.perf_counter()
     if model.startswith("second"):
