@@ -69,11 +69,11 @@ __all__ = [
 TRACKERS = ("dead reckoning", "eq. 1", "direct", "direct speed alone")
 
 #: the direct fix's angle sigmas the design's tracker is told, (azimuth, elevation) [deg] at every
-#: elevation (``tunnelkit design --traced-tracker direct``): one constant pair, chosen on seed 3's
-#: four 8 x 8 drives of the design's traced route against the array's survey table told as it is
-#: and three times, and reported on the held-out seeds 20261202 and 1
-#: (``docs/results/traced-models.md``); loose where the fixes are better (the 28 GHz tunnel's
-#: azimuth errs 0.04 deg RMS)
+#: elevation (``tunnelkit design --traced-tracker direct``): one constant pair, chosen on four
+#: 8 x 8 drives of the design's traced route (``benchmarks/bench_rt_direct.py --seed 3``, not a
+#: design sweep's seed-3 drives) against the array's survey table told as it is and three times,
+#: reported on held-out drives (``docs/results/traced-models.md``); loose where the fixes are
+#: better (the 28 GHz tunnel's azimuth errs 0.04 deg RMS)
 DESIGN_SIGMAS_DEG = (2.0, 1.0)
 
 #: :func:`direct_drive`'s options on the design's traced route (chosen with
