@@ -170,6 +170,8 @@ TWINS = {
         "spatial_phase",
     ),
     "tunnelkit.extraction.joint": ("contract",),
+    "tunnelkit.extraction.direct.aperture": ("solve", "spatial_phase"),
+    "tunnelkit.extraction.direct.fit": ("spatial_phase",),
 }
 
 
