@@ -32,6 +32,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .._physical import MAX_RANGE_M
+from ..design.tracedtracker import TRACED_TRACKERS
 
 NAME = "design"
 HELP = (
@@ -343,7 +344,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     rt.add_argument(
         "--traced-tracker",
-        choices=["paths", "los", "auto", "direct"],
+        choices=TRACED_TRACKERS,
         default=None,
         help="with --channel sionna: the tracker on the ray-traced channel, the line of sight "
         "alone, told its angle sigmas by its measured elevation from a survey of 3 drives per "
