@@ -60,8 +60,9 @@ def _setup(scenario: str, array: str | None = None):
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
         max_unmodelled, diffuse, diffuse_above, start_height_sigma, huber=None, array=None,
-        start_sigma=0.1, drawn_start=False, second_start=False):  # fmt: skip
+        start_sigma=0.1, drawn_start=False, second_start=False, with_eq1=True):  # fmt: skip
     route, eq1, design = _setup(scenario, array)
+    eq1 = eq1 if with_eq1 else None
     if huber is not None:  # the update with Huber's loss on the whitened rows
         design = design.with_(updater=HuberUpdater(huber))
     rng, start = spawn_rngs(seed, runs)[i], None
@@ -119,7 +120,7 @@ def report(res, label: str, settled=None) -> str:
     out += ["", "| line of sight fed | n | azimuth error RMS / median abs [deg] | elevation "
             "error RMS / median abs [deg] | extraction per epoch, median [s] |",
             "| --- | --- | --- | --- | --- |"]  # fmt: skip
-    for t in ("eq. 1", "direct"):
+    for t in [t for t in ("eq. 1", "direct") if t in res[0].los_errors]:
         e = np.degrees(np.concatenate([r.los_errors[t] for r in res]))
         s = np.concatenate([r.seconds[t] for r in res])
         out.append(
@@ -148,7 +149,7 @@ def _drive_all(a, table) -> list:
             ex.submit(one, a.scenario, a.seed, a.runs, i, table, a.second_order, a.n_epochs,
                       a.speed_sigma, a.element_second_order, a.max_unmodelled, a.diffuse,
                       a.diffuse_above, a.start_height_sigma, a.huber, a.design_array,
-                      a.start_sigma, a.drawn_start, a.second_start)
+                      a.start_sigma, a.drawn_start, a.second_start, not a.no_eq1)
             for i in range(a.runs)
         ]  # fmt: skip
         for f in futs:
@@ -172,7 +173,8 @@ def main(argv=None) -> int:
     ap.add_argument("--element-second-order", action="store_true",
                     help="the second-order atoms each on the elements that see it")  # fmt: skip
     g = ap.add_mutually_exclusive_group(required=True)
-    g.add_argument("--table", type=Path, help="the direct fix's sigmas by elevation (JSON)")
+    g.add_argument("--table", type=Path, help="the direct fix's sigmas by elevation (JSON: a "
+                   "table, or a record of data/rt/direct/ whose table_deg is told)")  # fmt: skip
     g.add_argument("--sigmas", help="one azimuth/elevation sigma pair [deg], e.g. 0.3/0.5")
     ap.add_argument("--sigma-scale", type=float, default=1.0,
                     help="the direct fix's angle sigmas times this (the table's or --sigmas')")  # fmt: skip
@@ -199,6 +201,9 @@ def main(argv=None) -> int:
     ap.add_argument("--second-start", action="store_true",
                     help="the direct fit also started from eq. 1's line of sight at the "
                     "predicted range (direct_drive's second_start)")  # fmt: skip
+    ap.add_argument("--no-eq1", action="store_true",
+                    help="leave out eq. 1's tracker and its extraction (the direct fit's drive "
+                    "draws the same snapshots)")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip
@@ -209,7 +214,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     print("command: python benchmarks/bench_rt_direct.py " + shlex.join(argv or sys.argv[1:]))
     if a.table is not None:
-        table = ElevationSigmas.from_dict(json.loads(a.table.read_text()))
+        rec = json.loads(a.table.read_text())  # a table, or a shipped record holding one
+        table = ElevationSigmas.from_dict(rec.get("table_deg", rec))
     else:
         az, el = (float(v) for v in a.sigmas.split("/"))
         table = ElevationSigmas(np.zeros(1), np.radians([az]), np.radians([el]))

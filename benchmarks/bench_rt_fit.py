@@ -9,6 +9,13 @@ atom, the dense multipath's), from a prediction 5 cm off. One
 snapshot of epochs 4 and 20 of ``italiano2026-straight`` (the paper's 10 x 10, 410 tones, 12
 symbols) on one BLAS thread; the traces come from the ray tracer's cache (traced on the first
 run, a few seconds per epoch). Left out when the ``rt`` extra is not installed.
+
+The design's traced tracker ``direct`` (``tunnelkit design --traced-tracker direct``) per epoch
+on the design's traced route (its 4 x 4 and 8 x 8): the first two epochs of its drive
+(:func:`~tunnelkit.design.traceddirect.direct_drive` with ``DESIGN_OPTIONS``: the prediction's
+fit, the second start's from eq. 1's line of sight, a diffuse atom where the tied fit misfits;
+tracker updates included) against eq. 1's line of sight of the same two epochs (what the
+``los`` tracker reads), the baseline.
 """
 
 from __future__ import annotations
@@ -25,12 +32,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from run import Case
 
 from tunnelkit import rt
-from tunnelkit.design.traceddirect import eq1_los
+from tunnelkit.design import DesignSetup, traced, tracedlos
+from tunnelkit.design.traceddirect import DESIGN_OPTIONS, design_table, direct_drive, eq1_los
 from tunnelkit.extraction.direct.fit import direct_fix
 from tunnelkit.simulation.drives import scenario_route
 from tunnelkit.tracking.javelin.motion import ue_velocity
 
 EPOCHS = (4, 20)
+#: the design's traced route's arrays timed
+DESIGN_ARRAYS = ("4x4", "8x8")
 
 
 def _eq1(route, k, arr, n_paths, snap):
@@ -82,5 +92,44 @@ def cases() -> list[Case]:
                 group=g,
                 repeat=5,
             ),
+        ]
+    return out + design_cases()
+
+
+class _DesignDrive:
+    """The first two epochs of the design's direct drive on ``array``'s traced route, and eq.
+    1's line of sight of two snapshots of those epochs."""
+
+    def __init__(self, setup, array):
+        rec = traced.design_errors(setup, array)
+        self.design = tracedlos.los_javelin(traced.traced_javelin(setup, array, rec))
+        self.route = traced.traced_route(setup, array)
+        self.snaps = [self.route.draw(k, np.random.default_rng(k)) for k in range(2)]
+
+    def direct(self):
+        with threadpool_limits(1), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return direct_drive(self.route, np.random.default_rng(20261207), self.design, None,
+                                design_table(), n_epochs=2, **DESIGN_OPTIONS)  # fmt: skip
+
+    def eq1(self):
+        return [_eq1(self.route, k, arr, len(paths), snap)
+                for k, (arr, paths, snap) in enumerate(self.snaps)]  # fmt: skip
+
+
+def design_cases() -> list[Case]:
+    setup = DesignSetup.from_scenario("italiano2026-straight", channel="sionna")
+    out = []
+    for array in DESIGN_ARRAYS:
+        d, g = _DesignDrive(setup, array), f"design_direct_{array}"
+        out += [
+            Case(
+                f"eq. 1 line of sight, 2 epochs, design route {array}",
+                d.eq1,
+                group=g,
+                baseline=True,
+                repeat=3,
+            ),
+            Case(f"design's direct drive, 2 epochs, {array}", d.direct, group=g, repeat=3),
         ]
     return out

@@ -683,3 +683,23 @@ def test_load_tracker_loads_the_tracker_modules_a_worker_unpickles():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_load_tracker_loads_the_direct_fit_only_for_a_direct_sweep():
+    """The direct fit's modules are a ``direct`` sweep's alone: ``load_tracker()`` leaves them
+    out, ``load_tracker(True)`` (what a ``traced_tracker="direct"`` sweep runs on its workers)
+    loads the modules themselves."""
+    import subprocess
+    import sys
+
+    direct = ["tunnelkit.design.traceddirect"] + [
+        f"tunnelkit.extraction.direct.{m}" for m in ("fit", "visibility", "aperture")
+    ]
+    for flag, want in (("", direct), ("True", [])):
+        code = (
+            f"import sys; from tunnelkit.design.arrayjob import load_tracker; load_tracker({flag})\n"
+            f"print([m for m in {direct!r} if m not in sys.modules])\n"
+        )
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             check=True)  # fmt: skip
+        assert out.stdout.strip() == str(want)

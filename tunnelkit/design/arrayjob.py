@@ -348,10 +348,11 @@ class ArrayJob:
         return Prepared(spec, None, design, peb, None, drive, budget, em, hybrid, None, table)
 
 
-def load_tracker() -> None:
+def load_tracker(direct: bool = False) -> None:
     """Import the tracker and the drive simulator (run on every worker before a sweep's tasks:
     a worker that imports them in a task while another thread unpickles a tracker sent from
-    another worker deadlocks on the package's import locks)."""
+    another worker deadlocks on the package's import locks); with ``direct`` also the direct
+    fit's (the traced tracker ``"direct"``, :mod:`.traceddirect`), which no other sweep needs."""
     # the modules themselves: the packages load their names on first use, and the branches a
     # task may take load theirs (the first fix, the measured birth, the odometry states, the
     # channel route's epoch and the ML fit's moves)
@@ -377,7 +378,11 @@ def load_tracker() -> None:
         tracker,
         update,
     )
-    from . import los, traceddirect, tracedlos  # noqa: F401  (the traced route's trackers)
+    from . import los, tracedlos  # noqa: F401  (the traced route's trackers)
+
+    if direct:
+        from ..extraction.direct import aperture, fit, visibility  # noqa: F401
+        from . import traceddirect  # noqa: F401
 
 
 def prepared_summary(prep: Prepared) -> tuple:

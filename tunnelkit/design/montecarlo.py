@@ -354,7 +354,7 @@ def sweep_montecarlo(
         # one task set: the per-array work (models, bounds, tracker) and every drive, each drive
         # depending on its array's task only (no barrier; the state goes worker to worker)
         if pool.parallel:
-            pool.client.run(load_tracker)
+            pool.client.run(load_tracker, traced_tracker == "direct")
         handles = _prepare(pool, job, [specs[a] for a in order])
         prepared = [handles[order.index(a)] for a in range(A)]
         n_units = runs // drives_per_unit

@@ -55,11 +55,12 @@ DIRECT_OPTIONS = {
 }
 #: the route the direct drive draws its snapshots from (``benchmarks/bench_rt_direct.py``'s)
 DIRECT_NUISANCE = {"diffuse_floor": True}
-#: the survey's angle sigmas (RMS by elevation) are told times this: the fixes' errors include
-#: biases held over several epochs, which a track told their RMS follows off the road (chosen on
-#: seed 0 against 1; a tighter table, also with Huber's update, lost on seed 1:
+#: the survey's angle sigmas (RMS by elevation) are told times this: the fixes' errors are
+#: heavy-tailed and include biases held over several epochs, which a track told their RMS follows
+#: off the road (chosen on the survey's own seed-0 drives, both paper drives, among 1, 1.5, 2 and
+#: 3, with 4 or 8 bins: 8 bins times 2 was best on both; reported on the tables' held-out seeds:
 #: ``docs/results/traced-models.md``)
-DIRECT_SIGMA_SCALE = 3.0
+DIRECT_SIGMA_SCALE = 2.0
 
 
 def _path(scenario: str):
