@@ -8,9 +8,13 @@ and the extraction's cost per epoch.
 The direct fix's sigmas by elevation are a table (``--table``, JSON of
 ``ElevationSigmas.as_dict``) or one constant pair (``--sigmas AZ/EL`` [deg]); ``--write-table
 PATTERN --bins B ...`` makes tables from this run's errors (choose on one seed, report another).
+``--out`` keeps the drives (their fixes too); ``--replay`` feeds those fixes to the trackers told
+another table, without fitting (seconds instead of minutes; approximate, as the fit starts at
+the track's prediction: the choice is then checked on drives of its own).
 
     python benchmarks/bench_rt_direct.py --seed 0 --runs 6 --sigmas 0.2/0.1 --speed-sigma 0.1 --write-table 'build/direct/straight-{bins}.json' --bins 1 2 4
     python benchmarks/bench_rt_direct.py --seed 20261202 --runs 10 --table build/direct/straight-2.json --speed-sigma 0.1
+    python benchmarks/bench_rt_direct.py --seed 0 --runs 20 --table build/direct/straight-8.json --sigma-scale 2 --speed-sigma 0.1 --element-second-order --diffuse 1 --diffuse-above 0.04 --start-height-sigma 0.01 --replay build/direct/straight-survey.pkl
 """
 
 from __future__ import annotations
@@ -60,9 +64,9 @@ def _setup(scenario: str, array: str | None = None):
 
 def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_element,
         max_unmodelled, diffuse, diffuse_above, start_height_sigma, huber=None, array=None,
-        start_sigma=0.1, drawn_start=False, second_start=False, with_eq1=True):  # fmt: skip
+        start_sigma=0.1, drawn_start=False, second_start=False, with_eq1=True, replay=None):  # fmt: skip
     route, eq1, design = _setup(scenario, array)
-    eq1 = eq1 if with_eq1 else None
+    eq1 = eq1 if with_eq1 and replay is None else None
     if huber is not None:  # the update with Huber's loss on the whitened rows
         design = design.with_(updater=HuberUpdater(huber))
     rng, start = spawn_rngs(seed, runs)[i], None
@@ -78,7 +82,7 @@ def one(scenario, seed, runs, i, table, second_order, n_epochs, speed_sigma, by_
                          max_unmodelled=max_unmodelled, diffuse=diffuse,
                          diffuse_above=diffuse_above, start_sigma=start_sigma,
                          start_height_sigma=start_height_sigma, start=start,
-                         second_start=second_start)  # fmt: skip
+                         second_start=second_start, replay=replay)  # fmt: skip
     return i, r, time.perf_counter() - t0
 
 
@@ -142,14 +146,18 @@ def report(res, label: str, settled=None) -> str:
 
 
 def _drive_all(a, table) -> list:
-    """The drives of the parsed options ``a`` told ``table``, two processes at a time."""
+    """The drives of the parsed options ``a`` told ``table``, two processes at a time (with
+    ``--replay``, that run's fixes fed again)."""
     res = [None] * a.runs
+    again = [None] * a.runs if a.replay is None else pickle.loads(a.replay.read_bytes())
+    if len(again) != a.runs:
+        raise SystemExit(f"--replay: {a.replay} holds {len(again)} drives, --runs is {a.runs}")
     with ProcessPoolExecutor(a.workers) as ex:
         futs = [
             ex.submit(one, a.scenario, a.seed, a.runs, i, table, a.second_order, a.n_epochs,
                       a.speed_sigma, a.element_second_order, a.max_unmodelled, a.diffuse,
                       a.diffuse_above, a.start_height_sigma, a.huber, a.design_array,
-                      a.start_sigma, a.drawn_start, a.second_start, not a.no_eq1)
+                      a.start_sigma, a.drawn_start, a.second_start, not a.no_eq1, again[i])
             for i in range(a.runs)
         ]  # fmt: skip
         for f in futs:
@@ -204,6 +212,11 @@ def main(argv=None) -> int:
     ap.add_argument("--no-eq1", action="store_true",
                     help="leave out eq. 1's tracker and its extraction (the direct fit's drive "
                     "draws the same snapshots)")  # fmt: skip
+    ap.add_argument("--replay", type=Path, default=None,
+                    help="feed the fixes of this pickle's drives (--out of an earlier run with "
+                    "the same scenario, seed, runs and options) to the trackers told --table / "
+                    "--sigmas instead of fitting (direct_drive's replay: seconds, approximate "
+                    "for another table); no eq. 1")  # fmt: skip
     ap.add_argument("--write-table", type=Path, default=None)
     ap.add_argument("--bins", type=int, nargs="+", default=[2],
                     help="one table per count; --write-table then names a pattern with {bins}")  # fmt: skip

@@ -427,6 +427,29 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
     assert set(alone.estimates) == set(TRACKERS) - {"eq. 1"} and set(alone.seconds) == {"direct"}
     for name in alone.estimates:
         np.testing.assert_array_equal(alone.estimates[name], out.estimates[name])
+    # a replay of its fixes told the same table repeats the drive to the last digit, with no
+    # fit; told another table it moves the direct track only (dead reckoning is the messages')
+    assert len(alone.fixes) == 3 and all(f is None or f.ok in (True, False) for f in alone.fixes)
+    monkeypatch.setattr(dt, "direct_fix", None)  # a replay must not fit
+    same = direct_drive(route, np.random.default_rng(4), design, None, table, speed_sigma=0.1,
+                        n_epochs=3, replay=alone)  # fmt: skip
+    for name in alone.estimates:
+        np.testing.assert_array_equal(same.estimates[name], alone.estimates[name])
+    np.testing.assert_array_equal(same.los_errors["direct"], alone.los_errors["direct"])
+    loose = ElevationSigmas(np.zeros(1), np.radians([5.0]), np.radians([5.0]))
+    other = direct_drive(route, np.random.default_rng(4), design, None, loose, speed_sigma=0.1,
+                         n_epochs=3, replay=alone)  # fmt: skip
+    np.testing.assert_array_equal(other.estimates["dead reckoning"],
+                                  alone.estimates["dead reckoning"])  # fmt: skip
+    assert not np.array_equal(other.estimates["direct"], alone.estimates["direct"])
+    with pytest.raises(ValueError, match=r"^replay, eq1_table"):
+        direct_drive(route, np.random.default_rng(4), design, table, table, replay=alone)
+    with pytest.raises(ValueError, match=r"^replay: not a drive of this route"):
+        direct_drive(route, np.random.default_rng(4), design, None, table, n_epochs=4,
+                     replay=alone)  # fmt: skip
+    with pytest.raises(TypeError, match=r"^replay"):
+        direct_drive(route, np.random.default_rng(4), design, None, table, replay=alone.fixes)
+    monkeypatch.setattr(dt, "direct_fix", recording)
     with pytest.raises(TypeError, match=r"^eq1_table"):
         direct_drive(route, np.random.default_rng(4), design, "0.2/0.1", table, n_epochs=1)
     # the same drive with every fix past a tiny unmodelled share dropped: the direct tracker is

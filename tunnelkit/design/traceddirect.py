@@ -37,6 +37,7 @@ from ..channel import ChannelSnapshot
 from ..extraction.direct.fit import (
     MAX_DIFFUSE,
     MAX_HEIGHT_M,
+    DirectFix,
     beyond_noise_unchecked,
     diffuse_share,
     direct_fix,
@@ -116,7 +117,9 @@ class DirectDrive:
     ``dropped`` the same keys -> epochs without a measurement (a failed, unconverged or gated fit,
     one past ``max_unmodelled``, or one Algorithm 1 refuses); ``unmodelled`` (K,) the unmodelled
     share (:func:`unmodelled_share`) of every ok direct fit (converged, within its gate), whether
-    fed or dropped."""
+    fed or dropped; ``fixes`` per epoch the direct fit kept (a
+    :class:`~tunnelkit.extraction.direct.fit.DirectFix`, None where every fit raised), which
+    :func:`direct_drive`'s ``replay`` tells other sigmas."""
 
     truth: np.ndarray
     estimates: dict = field(repr=False)
@@ -125,6 +128,7 @@ class DirectDrive:
     seconds: dict = field(repr=False)
     dropped: dict
     unmodelled: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(0))
+    fixes: tuple = field(repr=False, default=())
 
     def __post_init__(self) -> None:
         record(self, shapes={"truth": (None, 3), "speed_errors": (None,), "unmodelled": (None,)},
@@ -142,6 +146,10 @@ class DirectDrive:
             finite_array("los_errors", x, shape=(None, 3))
         for x in self.seconds.values():
             finite_array("seconds", x, shape=(T,))
+        if len(instance("fixes", self.fixes, tuple)) != T or not all(
+            f is None or isinstance(f, DirectFix) for f in self.fixes
+        ):
+            raise ValueError(f"fixes: expected one DirectFix or None per epoch ({T})")
 
     def rmse(self) -> dict:
         """Tracker -> the horizontal RMSE [m] over the drive."""
@@ -295,6 +303,7 @@ def direct_drive(
     diffuse_above: float = 0.0,
     start: np.ndarray | None = None,
     second_start: bool = False,
+    replay: DirectDrive | None = None,
 ) -> DirectDrive:
     """One drive of ``route`` (the line of sight always present; the study's channel is the ray
     tracer's, on the image channel the direct model is eq. 1's own with masks): the V2X
@@ -328,7 +337,12 @@ def direct_drive(
     the prediction's range and height (:func:`repointed`), where that start lies more than
     :data:`RESTART_M` from the prediction; of the ok fits the one of smaller residual is kept
     (a prediction far off, the design's 1 m entry fix, leads a fit started there alone into the
-    wrong basin)."""
+    wrong basin). ``replay``: an earlier drive of this route from this generator (``rng`` in
+    the same state) whose :attr:`DirectDrive.fixes` are fed instead of fitting (no extraction;
+    not with ``eq1_table``): the trackers told another ``table`` on the same fixes, to choose
+    told sigmas in seconds. The fit starts at the prediction, so a track told other sigmas would
+    have met slightly different fixes: a replay approximates that drive, it does not repeat it
+    (the same sigmas repeat it to the last digit)."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -358,6 +372,11 @@ def direct_drive(
             f"start_height_sigma: at most {MAX_HEIGHT_M:g} m, got {start_height_sigma:g}"
         )
     traj = route.trajectory
+    if replay is not None:
+        instance("replay", replay, DirectDrive)
+        if eq1_table is not None:
+            raise ValueError("replay, eq1_table: a replay feeds the direct fixes only; give no "
+                             "eq1_table")  # fmt: skip
     p0 = traj.position[0]
     if start is not None:
         p0 = finite_array("start", start, shape=(3,))
@@ -372,6 +391,10 @@ def direct_drive(
         if n_epochs is None
         else integer("n_epochs", n_epochs, minimum=1, maximum=len(traj))
     )
+    if replay is not None and (
+        len(replay.truth) < T or not np.array_equal(replay.truth[:T], traj.position[:T])
+    ):
+        raise ValueError(f"replay: not a drive of this route's first {T} epochs")
     vel = traj.velocity[:T]
     truth = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
     speed, heading = traj.odometry.draw(traj.t[:T], *truth, rng)
@@ -394,6 +417,7 @@ def direct_drive(
     errs, speed_err, unmodelled = {name: [] for name in told}, [], []
     secs = {name: np.zeros(T) for name in told}
     dropped = dict.fromkeys(told, 0)
+    fixes = []
     radio = float("nan")  # the last ok fit's speed
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the fits' own tests flag every traced epoch
@@ -410,7 +434,7 @@ def direct_drive(
                 k, rng
             )  # paths: only their number, as the tables' ML route
             pm, los1, t_eq = {}, None, 0.0
-            if eq1_table is not None or restart:
+            if (eq1_table is not None or restart) and replay is None:
                 t0 = time.perf_counter()
                 try:
                     los1 = _eq1_los(route, k, arr, len(paths), snap)
@@ -423,12 +447,16 @@ def direct_drive(
             ok = np.isfinite(speed[k]) and np.isfinite(heading[k])
             v_msg = ue_velocity(speed[k], heading[k]) if ok else np.zeros(3)
             pred = trackers["direct"].x[:3]
-            starts = [pred] if not restart else [pred, *_second_start(route, arr, los1, pred)]
-            fix = _best_fix(route, arr, snap, starts, v_msg,
-                            second_order=n2, speed=speed_sigma is not None and ok,
-                            element_second_order=by_element, diffuse=n_diffuse,
-                            noise_power=snap.noise_power if n_diffuse else None,
-                            diffuse_above=above)  # fmt: skip
+            if replay is not None:
+                fix = replay.fixes[k]
+            else:
+                starts = [pred] if not restart else [pred, *_second_start(route, arr, los1, pred)]
+                fix = _best_fix(route, arr, snap, starts, v_msg,
+                                second_order=n2, speed=speed_sigma is not None and ok,
+                                element_second_order=by_element, diffuse=n_diffuse,
+                                noise_power=snap.noise_power if n_diffuse else None,
+                                diffuse_above=above)  # fmt: skip
+            fixes.append(fix)
             radio = float("nan")
             share = _unmodelled(fix.residual, snap) if fix is not None and fix.ok else None
             if share is not None:
@@ -458,4 +486,5 @@ def direct_drive(
         secs,
         dropped,
         np.array(unmodelled, float),
+        tuple(fixes),
     )
