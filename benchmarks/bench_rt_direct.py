@@ -95,7 +95,7 @@ def _interval(x, rng, n=2000) -> tuple[float, float]:
     return float(ci.low), float(ci.high)
 
 
-def report(res, label: str, settled=None) -> str:
+def report(res, label: str, settled=None, replayed: bool = False) -> str:
     names = list(res[0].estimates)
     rm = np.array([[r.rmse()[t] for t in names] for r in res])  # (runs, trackers)
     rng = np.random.default_rng(0)
@@ -127,10 +127,11 @@ def report(res, label: str, settled=None) -> str:
     for t in [t for t in ("eq. 1", "direct") if t in res[0].los_errors]:
         e = np.degrees(np.concatenate([r.los_errors[t] for r in res]))
         s = np.concatenate([r.seconds[t] for r in res])
+        cost = f"{np.median(s):.2f}" if not replayed else "- (replayed)"
         out.append(
             f"| {t} | {len(e)} | {np.sqrt(np.mean(e[:, 1] ** 2)):.2f} / "
             f"{np.median(np.abs(e[:, 1])):.2f} | {np.sqrt(np.mean(e[:, 2] ** 2)):.2f} / "
-            f"{np.median(np.abs(e[:, 2])):.2f} | {np.median(s):.2f} |"
+            f"{np.median(np.abs(e[:, 2])):.2f} | {cost} |"
         )
     u = np.concatenate([r.unmodelled for r in res])
     if u.size:
@@ -143,6 +144,22 @@ def report(res, label: str, settled=None) -> str:
         out.append(f"\ndirect fit's speed error [m/s] ({sp.size} fits): mean {sp.mean():+.3f}, "
                    f"RMS {np.sqrt(np.mean(sp ** 2)):.3f}, median abs {np.median(np.abs(sp)):.3f}")  # fmt: skip
     return "\n".join(out) + "\n"
+
+
+def _table(arg: str) -> ElevationSigmas:
+    """``--table PATH[:KEY]``: a table (JSON of ``ElevationSigmas.as_dict``) or a record of
+    ``data/rt/direct/`` holding one under ``KEY`` (default ``table_deg``; ``told_deg`` the table
+    its survey drives were told)."""
+    path, _, key = arg.partition(":")
+    rec = json.loads(Path(path).read_text())
+    if not isinstance(rec, dict):
+        raise SystemExit(f"--table: {path} holds no table (a JSON object)")
+    if key or "table_deg" in rec:
+        key = key or "table_deg"
+        if key not in rec:
+            raise SystemExit(f"--table: {path} has no {key!r}")
+        rec = rec[key]
+    return ElevationSigmas.from_dict(rec)
 
 
 def _drive_all(a, table) -> list:
@@ -181,8 +198,8 @@ def main(argv=None) -> int:
     ap.add_argument("--element-second-order", action="store_true",
                     help="the second-order atoms each on the elements that see it")  # fmt: skip
     g = ap.add_mutually_exclusive_group(required=True)
-    g.add_argument("--table", type=Path, help="the direct fix's sigmas by elevation (JSON: a "
-                   "table, or a record of data/rt/direct/ whose table_deg is told)")  # fmt: skip
+    g.add_argument("--table", help="the direct fix's sigmas by elevation: PATH[:KEY], a JSON "
+                   "table or a record of data/rt/direct/ (its KEY, default table_deg)")  # fmt: skip
     g.add_argument("--sigmas", help="one azimuth/elevation sigma pair [deg], e.g. 0.3/0.5")
     ap.add_argument("--sigma-scale", type=float, default=1.0,
                     help="the direct fix's angle sigmas times this (the table's or --sigmas')")  # fmt: skip
@@ -225,10 +242,12 @@ def main(argv=None) -> int:
                     help="report the drives of this pickle (--out of an earlier run) again "
                     "without driving; the other options must be that run's")  # fmt: skip
     a = ap.parse_args(argv)
+    if a.replay is not None and a.score is not None:
+        ap.error("--replay, --score: give one (a replay drives the trackers again, --score "
+                 "re-reports stored drives)")  # fmt: skip
     print("command: python benchmarks/bench_rt_direct.py " + shlex.join(argv or sys.argv[1:]))
     if a.table is not None:
-        rec = json.loads(a.table.read_text())  # a table, or a shipped record holding one
-        table = ElevationSigmas.from_dict(rec.get("table_deg", rec))
+        table = _table(a.table)
     else:
         az, el = (float(v) for v in a.sigmas.split("/"))
         table = ElevationSigmas(np.zeros(1), np.radians([az]), np.radians([el]))
@@ -244,7 +263,7 @@ def main(argv=None) -> int:
     except ValueError:  # a drive too short to settle: no settled column
         settled = None
     label = f"{a.scenario}{'' if a.design_array is None else ', design ' + a.design_array}"
-    print(f"\n{report(res, f'{label}, seed {a.seed}', settled)}\nthe direct fix told (deg): "
+    print(f"\n{report(res, f'{label}, seed {a.seed}', settled, a.replay is not None)}\nthe direct fix told (deg): "
           f"{told}; {time.perf_counter() - t0:.0f} s\n")  # fmt: skip
     if a.out is not None:
         a.out.parent.mkdir(parents=True, exist_ok=True)

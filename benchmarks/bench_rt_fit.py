@@ -11,11 +11,12 @@ symbols) on one BLAS thread; the traces come from the ray tracer's cache (traced
 run, a few seconds per epoch). Left out when the ``rt`` extra is not installed.
 
 The design's traced tracker ``direct`` (``tunnelkit design --traced-tracker direct``) per epoch
-on the design's traced route (its 4 x 4 and 8 x 8): the first two epochs of its drive
-(:func:`~tunnelkit.design.traceddirect.direct_drive` with ``DESIGN_OPTIONS``: the prediction's
-fit, the second start's from eq. 1's line of sight, a diffuse atom where the tied fit misfits;
-tracker updates included) against eq. 1's line of sight of the same two epochs (what the
-``los`` tracker reads), the baseline.
+on the design's traced route (its 4 x 4 and 8 x 8): the first two epochs of its drive as a
+design sweep runs it (:func:`~tunnelkit.design.traceddirect.direct_drive` with ``DESIGN_OPTIONS``
+from an entry fix drawn as the design draws it, 1 m and 5 cm in height: the prediction's fit,
+the second start's from eq. 1's line of sight where the prediction is off, a diffuse atom where
+the tied fit misfits; the snapshots' draws and the tracker's updates included) against eq. 1's
+line of sight of two epochs (what the ``los`` tracker reads, its draws included), the baseline.
 """
 
 from __future__ import annotations
@@ -29,13 +30,15 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_rt_direct import _setup
 from run import Case
 
 from tunnelkit import rt
-from tunnelkit.design import DesignSetup, traced, tracedlos
+from tunnelkit.design import START_HEIGHT_SIGMA_M, START_SIGMA_M
 from tunnelkit.design.traceddirect import DESIGN_OPTIONS, design_table, direct_drive, eq1_los
 from tunnelkit.extraction.direct.fit import direct_fix
 from tunnelkit.simulation.drives import scenario_route
+from tunnelkit.tracking.javelin import draw_start
 from tunnelkit.tracking.javelin.motion import ue_velocity
 
 EPOCHS = (4, 20)
@@ -97,31 +100,35 @@ def cases() -> list[Case]:
 
 
 class _DesignDrive:
-    """The first two epochs of the design's direct drive on ``array``'s traced route, and eq.
-    1's line of sight of two snapshots of those epochs."""
+    """The first two epochs of the design's direct drive on ``array``'s traced route (its
+    tracker ``bench_rt_direct._setup``'s, the design's), and eq. 1's line of sight of two
+    snapshots of those epochs; each call draws from the same generators."""
 
-    def __init__(self, setup, array):
-        rec = traced.design_errors(setup, array)
-        self.design = tracedlos.los_javelin(traced.traced_javelin(setup, array, rec))
-        self.route = traced.traced_route(setup, array)
-        self.snaps = [self.route.draw(k, np.random.default_rng(k)) for k in range(2)]
+    def __init__(self, array):
+        self.route, _, self.design = _setup("italiano2026-straight", array)
 
     def direct(self):
+        rng, g = np.random.default_rng(20261207).spawn(2)  # as the design's sweep
+        p0 = draw_start(self.route.trajectory.position[0], START_SIGMA_M, g, START_HEIGHT_SIGMA_M)
         with threadpool_limits(1), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return direct_drive(self.route, np.random.default_rng(20261207), self.design, None,
-                                design_table(), n_epochs=2, **DESIGN_OPTIONS)  # fmt: skip
+            return direct_drive(self.route, rng, self.design, None, design_table(), n_epochs=2,
+                                start_sigma=START_SIGMA_M, start_height_sigma=START_HEIGHT_SIGMA_M,
+                                start=p0, **DESIGN_OPTIONS)  # fmt: skip
 
     def eq1(self):
-        return [_eq1(self.route, k, arr, len(paths), snap)
-                for k, (arr, paths, snap) in enumerate(self.snaps)]  # fmt: skip
+        rng = np.random.default_rng(20261207).spawn(2)[0]
+        out = []
+        for k in range(2):
+            arr, paths, snap = self.route.draw(k, rng)
+            out.append(_eq1(self.route, k, arr, len(paths), snap))
+        return out
 
 
 def design_cases() -> list[Case]:
-    setup = DesignSetup.from_scenario("italiano2026-straight", channel="sionna")
     out = []
     for array in DESIGN_ARRAYS:
-        d, g = _DesignDrive(setup, array), f"design_direct_{array}"
+        d, g = _DesignDrive(array), f"design_direct_{array}"
         out += [
             Case(
                 f"eq. 1 line of sight, 2 epochs, design route {array}",

@@ -337,14 +337,12 @@ def _direct():
     traceddirect.repointed(los, arr.origin, ue + np.array([0.5, 0.3, 0.0]))
     traceddirect.unmodelled_share(0.01, snap)
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
-    drive = traceddirect.direct_drive(route, np.random.default_rng(0), los_design(), table,
+    traceddirect.direct_drive(route, np.random.default_rng(0), los_design(), table,
                                       table, speed_sigma=0.1, second_order=2, n_epochs=2,
                                       start_sigma=0.1, start_height_sigma=0.05,
                                       element_second_order=True, max_unmodelled=0.5, diffuse=1,
                                       diffuse_above=0.01, start=route.trajectory.position[0] + 0.1,
                                       second_start=True)  # fmt: skip
-    traceddirect.direct_drive(route, np.random.default_rng(0), los_design(), None, table,
-                              speed_sigma=0.1, n_epochs=2, replay=drive)  # fmt: skip
 
 
 def _doppler():

@@ -4,6 +4,7 @@ its Cramer-Rao bound with it) and its flag."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 
 import numpy as np
@@ -429,19 +430,42 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
         np.testing.assert_array_equal(alone.estimates[name], out.estimates[name])
     # a replay of its fixes told the same table repeats the drive to the last digit, with no
     # fit; told another table it moves the direct track only (dead reckoning is the messages')
-    assert len(alone.fixes) == 3 and all(f is None or f.ok in (True, False) for f in alone.fixes)
+    # every ok fix is fed (no max_unmodelled), every other epoch dropped
+    assert len(alone.fixes) == 3
+    assert sum(f is not None and f.ok for f in alone.fixes) == 3 - alone.dropped["direct"]
     monkeypatch.setattr(dt, "direct_fix", None)  # a replay must not fit
     same = direct_drive(route, np.random.default_rng(4), design, None, table, speed_sigma=0.1,
                         n_epochs=3, replay=alone)  # fmt: skip
     for name in alone.estimates:
         np.testing.assert_array_equal(same.estimates[name], alone.estimates[name])
     np.testing.assert_array_equal(same.los_errors["direct"], alone.los_errors["direct"])
+    assert same.fixes == alone.fixes and same.dropped == alone.dropped
+    np.testing.assert_array_equal(same.unmodelled, alone.unmodelled)
+    np.testing.assert_array_equal(same.speed_errors, alone.speed_errors)
     loose = ElevationSigmas(np.zeros(1), np.radians([5.0]), np.radians([5.0]))
     other = direct_drive(route, np.random.default_rng(4), design, None, loose, speed_sigma=0.1,
                          n_epochs=3, replay=alone)  # fmt: skip
-    np.testing.assert_array_equal(other.estimates["dead reckoning"],
-                                  alone.estimates["dead reckoning"])  # fmt: skip
+    for name in ("dead reckoning", "direct speed alone"):
+        np.testing.assert_array_equal(other.estimates[name], alone.estimates[name])
     assert not np.array_equal(other.estimates["direct"], alone.estimates["direct"])
+    # a replay with the second start asked for runs no eq. 1 either (the fixes are given)
+    monkeypatch.setattr(dt, "_eq1_los", None)
+    direct_drive(route, np.random.default_rng(4), design, None, table, speed_sigma=0.1,
+                 n_epochs=3, replay=alone, second_start=True)  # fmt: skip
+    # another generator's, start's or array's drive of the same route is refused, not replayed
+    for rng_, kw in ((np.random.default_rng(5), {}),
+                     (np.random.default_rng(4), {"start": traj.position[0] + 0.05})):  # fmt: skip
+        with pytest.raises(ValueError, match=r"^replay: not a drive of this route, generator"):
+            direct_drive(route, rng_, design, None, table, speed_sigma=0.1, n_epochs=3,
+                         replay=alone, **kw)  # fmt: skip
+    old = dataclasses.replace(alone, fixes=())  # pickled before the fixes were kept
+    with pytest.raises(ValueError, match=r"^replay: holds no fixes"):
+        direct_drive(route, np.random.default_rng(4), design, None, table, n_epochs=3,
+                     replay=old)  # fmt: skip
+    with pytest.raises(TypeError, match=r"^fixes"):
+        dataclasses.replace(alone, fixes=(alone.fixes[0], "fix", None))
+    with pytest.raises(ValueError, match=r"^fixes: expected one per epoch"):
+        dataclasses.replace(alone, fixes=alone.fixes[:2])
     with pytest.raises(ValueError, match=r"^replay, eq1_table"):
         direct_drive(route, np.random.default_rng(4), design, table, table, replay=alone)
     with pytest.raises(ValueError, match=r"^replay: not a drive of this route"):
@@ -449,6 +473,7 @@ def test_direct_drive_tiny_traced_case(tmp_path, monkeypatch):
                      replay=alone)  # fmt: skip
     with pytest.raises(TypeError, match=r"^replay"):
         direct_drive(route, np.random.default_rng(4), design, None, table, replay=alone.fixes)
+    monkeypatch.undo()
     monkeypatch.setattr(dt, "direct_fix", recording)
     with pytest.raises(TypeError, match=r"^eq1_table"):
         direct_drive(route, np.random.default_rng(4), design, "0.2/0.1", table, n_epochs=1)

@@ -6,7 +6,8 @@ from that prediction. Its position goes to the tracker as a line of sight (the f
 from the site, told their sigmas by elevation, :class:`~tunnelkit.design.los.ElevationSigmas`);
 its speed, with ``speed_sigma`` given, is averaged with the next step's V2X speed
 (inverse-variance weights, the tracker told the mean's sigma). The measurement depends on the
-track, so no stored drive can replay this loop.
+track, so a stored drive's fixes told other sigmas (:func:`direct_drive`'s ``replay``) only
+approximate the drive those sigmas would have had.
 
 Beside it on the same messages and snapshots (:func:`direct_drive`): dead reckoning (the same
 JAVELIN, every measurement dropped), the traced tables' line-of-sight column (eq. 1's ML route,
@@ -119,7 +120,8 @@ class DirectDrive:
     share (:func:`unmodelled_share`) of every ok direct fit (converged, within its gate), whether
     fed or dropped; ``fixes`` per epoch the direct fit kept (a
     :class:`~tunnelkit.extraction.direct.fit.DirectFix`, None where every fit raised), which
-    :func:`direct_drive`'s ``replay`` tells other sigmas."""
+    :func:`direct_drive`'s ``replay`` tells other sigmas (empty: not kept, a drive pickled before
+    they were)."""
 
     truth: np.ndarray
     estimates: dict = field(repr=False)
@@ -132,7 +134,7 @@ class DirectDrive:
 
     def __post_init__(self) -> None:
         record(self, shapes={"truth": (None, 3), "speed_errors": (None,), "unmodelled": (None,)},
-               may_be_empty=("speed_errors", "unmodelled"),
+               may_be_empty=("speed_errors", "unmodelled", "fixes"),
                skip=("estimates", "los_errors", "seconds", "dropped"))  # fmt: skip
         T = finite_array("truth", self.truth, shape=(None, 3)).shape[0]
         finite_array("speed_errors", self.speed_errors, ndim=1)
@@ -146,10 +148,11 @@ class DirectDrive:
             finite_array("los_errors", x, shape=(None, 3))
         for x in self.seconds.values():
             finite_array("seconds", x, shape=(T,))
-        if len(instance("fixes", self.fixes, tuple)) != T or not all(
-            f is None or isinstance(f, DirectFix) for f in self.fixes
-        ):
-            raise ValueError(f"fixes: expected one DirectFix or None per epoch ({T})")
+        if len(instance("fixes", self.fixes, tuple)) not in (0, T):
+            raise ValueError(f"fixes: expected one per epoch ({T}) or none, got {len(self.fixes)}")
+        for f in self.fixes:
+            if f is not None:
+                instance("fixes", f, DirectFix)
 
     def rmse(self) -> dict:
         """Tracker -> the horizontal RMSE [m] over the drive."""
@@ -338,11 +341,14 @@ def direct_drive(
     :data:`RESTART_M` from the prediction; of the ok fits the one of smaller residual is kept
     (a prediction far off, the design's 1 m entry fix, leads a fit started there alone into the
     wrong basin). ``replay``: an earlier drive of this route from this generator (``rng`` in
-    the same state) whose :attr:`DirectDrive.fixes` are fed instead of fitting (no extraction;
-    not with ``eq1_table``): the trackers told another ``table`` on the same fixes, to choose
-    told sigmas in seconds. The fit starts at the prediction, so a track told other sigmas would
-    have met slightly different fixes: a replay approximates that drive, it does not repeat it
-    (the same sigmas repeat it to the last digit)."""
+    the same state, the same ``design``, start, ``speed_sigma`` and ``max_unmodelled``: a drive
+    whose dead reckoning or snapshots differ from the replayed one's is refused) whose
+    :attr:`DirectDrive.fixes` are fed instead of fitting (no extraction, so the fit's options
+    ``second_order``, ``element_second_order``, ``diffuse``, ``diffuse_above`` and
+    ``second_start`` play no part; not with ``eq1_table``): the trackers told another ``table``
+    on the same fixes, to choose told sigmas in seconds. The fit starts at the prediction, so a
+    track told other sigmas would have met slightly different fixes: a replay approximates that
+    drive, it does not repeat it (the same sigmas repeat it to the last digit)."""
     instance("route", route, SignalRoute)
     rng = rng_or_error("rng", rng)
     instance("design", design, JavelinDesign)
@@ -395,6 +401,9 @@ def direct_drive(
         len(replay.truth) < T or not np.array_equal(replay.truth[:T], traj.position[:T])
     ):
         raise ValueError(f"replay: not a drive of this route's first {T} epochs")
+    if replay is not None and len(replay.fixes) < T:
+        raise ValueError("replay: holds no fixes (a drive pickled before DirectDrive.fixes); "
+                         "drive it again")  # fmt: skip
     vel = traj.velocity[:T]
     truth = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
     speed, heading = traj.odometry.draw(traj.t[:T], *truth, rng)
@@ -478,6 +487,12 @@ def direct_drive(
                         errs[name].append(_los_error(m, traj.position[k], arr.origin))
                 jav.update(m)
                 est[name][k] = jav.x[:3]
+    if replay is not None and not (
+        np.array_equal(est["dead reckoning"], replay.estimates["dead reckoning"][:T])
+        and np.array_equal(unmodelled, replay.unmodelled[: len(unmodelled)])
+    ):
+        raise ValueError("replay: not a drive of this route, generator, start and design (its "
+                         "dead reckoning or its snapshots differ)")  # fmt: skip
     return DirectDrive(
         traj.position[:T].copy(),
         est,

@@ -6,7 +6,8 @@ test flags every epoch, and the line of sight it takes errs by degrees). The dir
 (:func:`~tunnelkit.extraction.direct.fit.direct_fix`: every atom of the visibility model tied to one UE
 position, one clock bias and one speed) does not fit the paths apart; started at JAVELIN's
 prediction in each epoch, it gives a line of sight of tenths of a degree. Because the
-measurement depends on the track, no stored drive can replay it: the column runs its own drive
+measurement depends on the track (a stored drive's fixes replayed only approximate it), the
+column runs its own drive
 (:func:`~tunnelkit.design.traceddirect.direct_drive`) on each condition-L trial, drawn from a
 generator spawned from the trial's (the other columns' draws are unchanged), and its dead
 reckoning is the same JAVELIN on that drive's own V2X messages. Its configuration
