@@ -380,8 +380,7 @@ def load_tracker(direct: bool = False) -> None:
     )
     from . import los, tracedlos  # noqa: F401  (the traced route's trackers)
 
-    if direct:
-        from ..extraction.direct import aperture, fit, visibility  # noqa: F401
+    if direct:  # with the direct fit's modules (extraction.direct: fit, visibility, aperture)
         from . import traceddirect  # noqa: F401
 
 

@@ -378,11 +378,6 @@ def direct_drive(
             f"start_height_sigma: at most {MAX_HEIGHT_M:g} m, got {start_height_sigma:g}"
         )
     traj = route.trajectory
-    if replay is not None:
-        instance("replay", replay, DirectDrive)
-        if eq1_table is not None:
-            raise ValueError("replay, eq1_table: a replay feeds the direct fixes only; give no "
-                             "eq1_table")  # fmt: skip
     p0 = traj.position[0]
     if start is not None:
         p0 = finite_array("start", start, shape=(3,))
@@ -397,13 +392,16 @@ def direct_drive(
         if n_epochs is None
         else integer("n_epochs", n_epochs, minimum=1, maximum=len(traj))
     )
-    if replay is not None and (
-        len(replay.truth) < T or not np.array_equal(replay.truth[:T], traj.position[:T])
-    ):
-        raise ValueError(f"replay: not a drive of this route's first {T} epochs")
-    if replay is not None and len(replay.fixes) < T:
-        raise ValueError("replay: holds no fixes (a drive pickled before DirectDrive.fixes); "
-                         "drive it again")  # fmt: skip
+    if replay is not None:
+        instance("replay", replay, DirectDrive)
+        if eq1_table is not None:
+            raise ValueError("replay, eq1_table: a replay feeds the direct fixes only; give no "
+                             "eq1_table")  # fmt: skip
+        if len(replay.truth) < T or not np.array_equal(replay.truth[:T], traj.position[:T]):
+            raise ValueError(f"replay: not a drive of this route's first {T} epochs")
+        if len(replay.fixes) < T:
+            raise ValueError("replay: holds no fixes (a drive pickled before DirectDrive.fixes); "
+                             "drive it again")  # fmt: skip
     vel = traj.velocity[:T]
     truth = np.linalg.norm(vel[:, :2], axis=1), np.arctan2(vel[:, 1], vel[:, 0])
     speed, heading = traj.odometry.draw(traj.t[:T], *truth, rng)
