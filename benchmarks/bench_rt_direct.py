@@ -252,8 +252,7 @@ def main(argv=None) -> int:
         az, el = (float(v) for v in a.sigmas.split("/"))
         table = ElevationSigmas(np.zeros(1), np.radians([az]), np.radians([el]))
     if a.sigma_scale != 1.0:
-        table = ElevationSigmas(table.elevation, a.sigma_scale * table.sigma_azimuth,
-                                a.sigma_scale * table.sigma_elevation)  # fmt: skip
+        table = table.scaled(a.sigma_scale)
     t0 = time.perf_counter()
     res = pickle.loads(a.score.read_bytes()) if a.score is not None else _drive_all(a, table)
     told = table.as_dict()

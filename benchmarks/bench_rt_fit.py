@@ -35,7 +35,8 @@ from run import Case
 
 from tunnelkit import rt
 from tunnelkit.design import START_HEIGHT_SIGMA_M, START_SIGMA_M
-from tunnelkit.design.traceddirect import DESIGN_OPTIONS, design_table, direct_drive, eq1_los
+from tunnelkit.design.directsurvey import design_table
+from tunnelkit.design.traceddirect import DESIGN_OPTIONS, direct_drive, eq1_los
 from tunnelkit.extraction.direct.fit import direct_fix
 from tunnelkit.simulation.drives import scenario_route
 from tunnelkit.tracking.javelin import draw_start
@@ -106,13 +107,14 @@ class _DesignDrive:
 
     def __init__(self, array):
         self.route, _, self.design = _setup("italiano2026-straight", array)
+        self.table = design_table("italiano2026-straight", array)  # the design's told table
 
     def direct(self):
         rng, g = np.random.default_rng(20261207).spawn(2)  # as the design's sweep
         p0 = draw_start(self.route.trajectory.position[0], START_SIGMA_M, g, START_HEIGHT_SIGMA_M)
         with threadpool_limits(1), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return direct_drive(self.route, rng, self.design, None, design_table(), n_epochs=2,
+            return direct_drive(self.route, rng, self.design, None, self.table, n_epochs=2,
                                 start_sigma=START_SIGMA_M, start_height_sigma=START_HEIGHT_SIGMA_M,
                                 start=p0, **DESIGN_OPTIONS)  # fmt: skip
 

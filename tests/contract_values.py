@@ -307,7 +307,7 @@ def _studies():
 
 
 def _direct():
-    from tunnelkit.design import traceddirect
+    from tunnelkit.design import directsurvey, traceddirect
     from tunnelkit.design.los import ElevationSigmas
     from tunnelkit.extraction.direct import fit as direct
     from tunnelkit.extraction.direct.visibility import predicted_model
@@ -337,6 +337,11 @@ def _direct():
     traceddirect.repointed(los, arr.origin, ue + np.array([0.5, 0.3, 0.0]))
     traceddirect.unmodelled_share(0.01, snap)
     table = ElevationSigmas(np.zeros(1), np.radians([1.0]), np.radians([1.0]))
+    table.scaled(2.0)
+    directsurvey.design_table("italiano2026-straight", "8x8")
+    directsurvey.direct_summary("italiano2026-straight", "8x8", {"diffuse": 1})
+    directsurvey.surveyed_table(directsurvey.survey_record("italiano2026-straight"))
+    directsurvey.survey_path("italiano2026-straight", "8x8")
     traceddirect.direct_drive(route, np.random.default_rng(0), los_design(), table,
                                       table, speed_sigma=0.1, second_order=2, n_epochs=2,
                                       start_sigma=0.1, start_height_sigma=0.05,
@@ -716,11 +721,13 @@ def _traced():
     from tunnelkit.design.los import (
         ElevationSigmas,
         elevation_sigmas,
+        los_error_rows,
         los_errors,
         told_by_elevation,
     )
 
     err = los_errors([every["ml-all"]])
+    los_error_rows(np.array([0.1]), np.array([-0.2]), np.array([[10.0, 1.0, -4.0]]))
     table = elevation_sigmas(np.vstack([err, err]), 2)
     ElevationSigmas.from_dict(table.as_dict()).at(np.array([-0.1]))
     table.describe()

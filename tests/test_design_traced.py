@@ -168,9 +168,11 @@ def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
     """The shipped drive (tools/traced_drive.py; ``--check`` drives all of it again) is read for
     notebook 08's quick traced drive (its key is the current one). Driven again here from the
     same generator, its first epoch through the ML extraction and the others only drawn (their
-    extraction draws nothing): the first epoch's measurements within floating-point noise (bit
-    for bit on the machine that wrote it), the V2X messages and the generator's end state bit
-    for bit."""
+    extraction draws nothing): the first epoch's measurements within 1 % of the sigmas the
+    tracker reading them is told (bit for bit on the machine that wrote it; on another CPU or
+    BLAS the trace's rounding differs, and the ML fit of two paths 10 cm apart amplifies it:
+    measured 1e-4 rad and 0.3 mm, against told sigmas of degrees and decimetres), the V2X
+    messages and the generator's end state bit for bit."""
     tool = _drive_tool()
     ((scenario, array, n_epochs, seed, stream),) = tool.CASES
     assert scenario == SCENARIO and seed == drives.HELD_OUT_SEED and n_epochs == 12
@@ -182,6 +184,10 @@ def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
     assert stored["key"] == key and key["n_epochs"] == 12 and key["rt_key"]["sionna_rt"]
     got = traced.stored_drive(setup, array, rng, n_epochs)
     assert got is not None and len(got.epochs) == 12
+    # what the tracker reading the drive is told (the array's record of this route)
+    rec = traced.design_errors(setup, array, n_epochs=n_epochs)
+    cfg = traced.traced_javelin(setup, array, rec).config
+    told = {**tracedbounds.config_sigmas(cfg), "v": cfg.sigma_speed}  # v: the nearest, a speed
     extracted, real = [], drives.ml_paths
 
     def first_only(*args, **kwargs):  # epoch 0 extracted, the others fail after their draws
@@ -203,7 +209,8 @@ def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
     assert pa is not None and pb is not None
     np.testing.assert_array_equal(pa.source, pb.source)
     for f in ("phi", "psi", "kappa", "d", "v"):
-        np.testing.assert_allclose(getattr(pa, f), getattr(pb, f), rtol=1e-9, atol=0, err_msg=f)
+        np.testing.assert_allclose(getattr(pa, f), getattr(pb, f), rtol=0, atol=0.01 * told[f],
+                                   err_msg=f)  # fmt: skip
     assert pa.cov is None and pb.cov is None
     np.testing.assert_array_equal(fresh.truth_index[0], got.truth_index[0])
     np.testing.assert_allclose(fresh.sources[0], got.sources[0], rtol=1e-12, atol=0)
@@ -214,7 +221,8 @@ def test_the_stored_drive_is_what_driving_again_gives(setup, monkeypatch):
     pa, pb = both["ml-all"].epochs[0], every.epochs[0]
     assert len(pb.phi) >= len(got.epochs[0].phi)
     for f in ("phi", "psi", "kappa", "d"):
-        np.testing.assert_allclose(getattr(pa, f), getattr(pb, f), rtol=1e-9, atol=0, err_msg=f)
+        np.testing.assert_allclose(getattr(pa, f), getattr(pb, f), rtol=0, atol=0.01 * told[f],
+                                   err_msg=f)  # fmt: skip
 
 
 def test_a_stored_drive_is_checked_refused_when_tampered_and_driven_when_foreign(
@@ -786,17 +794,14 @@ def test_auto_keeps_the_paths_tracker_where_its_prediction_is_smaller_or_no_surv
 
 def test_the_direct_sweep_is_the_direct_drive_from_the_drawn_fix(setup):
     """traced_tracker "direct": each drive is traceddirect.direct_drive on the design's traced
-    route (the line of sight's JAVELIN fed the direct fix, told design_table, with
-    DESIGN_OPTIONS), started from the open-sky fix drawn from a generator spawned before the
-    drive's; dead reckoning is the same tracker on that drive's messages; the prediction beside
-    it is the told model's posterior CRLB; the report names the tracker and its told sigmas."""
+    route (the line of sight's JAVELIN fed the direct fix, told design_table: the array's
+    shipped survey times SURVEY_SCALE, with DESIGN_OPTIONS), started from the open-sky fix drawn
+    from a generator spawned before the drive's; dead reckoning is the same tracker on that
+    drive's messages; the prediction beside it is the told model's posterior CRLB; the report
+    names the tracker and its told sigmas."""
     from tunnelkit.design.arrayjob import ArrayJob, SweepTrial
-    from tunnelkit.design.traceddirect import (
-        DESIGN_OPTIONS,
-        DESIGN_SIGMAS_DEG,
-        design_table,
-        direct_drive,
-    )
+    from tunnelkit.design.directsurvey import SURVEY_SCALE, design_table, survey_record
+    from tunnelkit.design.traceddirect import DESIGN_OPTIONS, direct_drive
     from tunnelkit.tracking.javelin import ReportedNoise, draw_start
 
     kw = {"seed": 0, "mode": "channel", "n_epochs": 3, "dead_reckoning": True, **FEW}
@@ -804,26 +809,32 @@ def test_the_direct_sweep_is_the_direct_drive_from_the_drawn_fix(setup):
     row = rep.rows[0]
     em = row.error_model
     assert em["tracker"] == "direct" and em["direct"]["options"] == DESIGN_OPTIONS
-    assert tuple(em["direct"]["told_deg"].values()) == DESIGN_SIGMAS_DEG
+    table = design_table(setup.name, "4x4")
+    assert em["direct"]["told_deg"] == table.as_dict()
+    rec = survey_record(setup.name, "4x4")  # shipped: the told table is the survey's times 2
+    assert em["direct"]["survey"]["command"] == rec["command"] and rec["array"] == "4x4"
+    np.testing.assert_allclose(np.degrees(table.sigma_azimuth),
+                               SURVEY_SCALE * np.asarray(rec["table_deg"]["sigma_azimuth"]))  # fmt: skip
+    assert "a survey of" in rep.to_table() and f"times {SURVEY_SCALE:g}" in rep.to_table()
     assert set(em["told_sigmas"]) == {"kappa_m", "delta_d_m"}  # the angles are the table's
     assert rep.to_json()["inputs"]["traced_tracker"] == "direct"
     assert "the direct fit's line of sight (tracker direct" in rep.to_table()
     assert np.isfinite(row.rmse_m) and np.isfinite(row.dead_reckoning_rmse_m)
     k = design.counted_epochs(setup.trajectory.t[:3], 0.0)
-    _, drive = tracedbounds.los_bounds(setup, "4x4", design_table(), 3)
+    _, drive = tracedbounds.los_bounds(setup, "4x4", table, 3)
     assert row.predicted_drive_rms_m == pytest.approx(np.sqrt(np.mean(drive[k] ** 2)))
     # one drive of the sweep's trial, against direct_drive called by hand on the same draws
     prep = ArrayJob(setup, None, "channel", 3, False, None, traced_tracker="direct")(
         design.parse_array("4x4")
     )
     assert isinstance(prep.design.noise, ReportedNoise)
-    assert prep.direct.as_dict() == design_table().as_dict()
+    assert prep.direct.as_dict() == table.as_dict()
     trial = SweepTrial(setup, "channel", 3, dead_reckoning=True)
     got = trial((prep, 7), np.random.default_rng(11))
     rng, g = np.random.default_rng(11).spawn(2)
     route = traced.traced_route(setup, "4x4")
     p0 = draw_start(route.trajectory.position[0], trial.start_sigma, g, 0.05)
-    out = direct_drive(route, rng, prep.design, None, design_table(), n_epochs=3, start=p0,
+    out = direct_drive(route, rng, prep.design, None, table, n_epochs=3, start=p0,
                        start_sigma=trial.start_sigma, start_height_sigma=0.05,
                        **DESIGN_OPTIONS)  # fmt: skip
     for j, name in enumerate(("direct", "dead reckoning")):
@@ -837,6 +848,7 @@ def test_the_direct_drive_is_cut_to_the_route_as_every_drive(setup, monkeypatch)
     drives), and None drives it all: direct_drive is never asked for more epochs than it has."""
     from tunnelkit.design import traceddirect
     from tunnelkit.design.arrayjob import Prepared, SweepTrial
+    from tunnelkit.design.directsurvey import design_table
 
     asked = []
 
@@ -849,7 +861,7 @@ def test_the_direct_drive_is_cut_to_the_route_as_every_drive(setup, monkeypatch)
 
     monkeypatch.setattr(traceddirect, "direct_drive", recording)
     prep = Prepared(design.parse_array("4x4"), None, None, np.zeros(1), None, None,
-                    direct=traceddirect.design_table())  # fmt: skip
+                    direct=design_table(setup.name, "4x4"))  # fmt: skip
     n = len(setup.trajectory)
     for n_epochs in (n + 5, n, 2, None):
         with pytest.raises(Stop):

@@ -581,6 +581,7 @@ def test_the_direct_column_reads_the_shipped_table_and_refuses_other_scenes():
     command in the record); a scene without one has no column; bad names are refused by name."""
     import json
 
+    from tunnelkit.design.directsurvey import SURVEY_SCALE
     from tunnelkit.reproduce import javelin_direct as jd
     from tunnelkit.reproduce.javelin_tables import _traced_routes
     from tunnelkit.scenarios import data_dir
@@ -590,7 +591,7 @@ def test_the_direct_column_reads_the_shipped_table_and_refuses_other_scenes():
         assert rec["scenario"] == sc and rec["command"].startswith("python benchmarks/")
         t = jd.direct_table(sc)
         np.testing.assert_allclose(np.degrees(t.sigma_azimuth),
-                                   np.asarray(rec["table_deg"]["sigma_azimuth"]) * jd.DIRECT_SIGMA_SCALE)  # fmt: skip
+                                   np.asarray(rec["table_deg"]["sigma_azimuth"]) * SURVEY_SCALE)  # fmt: skip
         assert "seed 0" in jd.direct_note(sc)
     assert jd.direct_table("jiang2023-straight") is None
     with pytest.raises(ValueError, match=r"^scenario.*ships no"):
@@ -639,3 +640,58 @@ def test_repointed_keeps_the_range_and_height_and_takes_the_measured_direction()
         repointed(los.subset(np.array([], int)), o, far)
     with pytest.raises(TypeError, match=r"^los"):
         repointed((phi, psi), o, far)
+
+
+def test_survey_records_are_checked_and_a_design_route_without_one_is_told_the_constant(
+    tmp_path, monkeypatch
+):
+    """directsurvey: a design route's record (<scenario>-<array>.json) is its survey's RMS times
+    SURVEY_SCALE; a route without one is told DESIGN_SIGMAS_DEG and its summary says so; a
+    record of another route, or without a table, is refused naming the scenario."""
+    import json
+
+    import tunnelkit.scenarios as scenarios
+    from tunnelkit.design import directsurvey as ds
+    from tunnelkit.design.los import ElevationSigmas
+
+    (tmp_path / "rt" / "direct").mkdir(parents=True)
+    monkeypatch.setattr(scenarios, "data_dir", lambda: tmp_path)
+    ds._load.cache_clear()
+    monkeypatch.setattr(ds, "_load", ds._load.__wrapped__)  # no cache across the test's records
+    table = {
+        "elevation": [-20.0, -5.0],
+        "sigma_azimuth": [0.05, 0.3],
+        "sigma_elevation": [0.04, 0.1],
+    }
+    rec = {"scenario": "sc", "array": "8x8", "source": "s", "command": "python x", "seed": 0,
+           "runs": 4, "bins": 2, "told_deg": table, "table_deg": table}  # fmt: skip
+    (tmp_path / "rt" / "direct" / "sc-8x8.json").write_text(json.dumps(rec))
+    t = ds.design_table("sc", "8x8")
+    want = ElevationSigmas.from_dict(table)
+    psi = np.radians([-30.0, -12.0, 0.0])
+    for got, ref in zip(t.at(psi), want.at(psi), strict=True):
+        np.testing.assert_allclose(got, ds.SURVEY_SCALE * ref)
+    s = ds.direct_summary("sc", "8x8", {"a": 1})
+    assert s["survey"]["command"] == "python x" and s["survey"]["scale"] == ds.SURVEY_SCALE
+    assert s["told_deg"] == t.as_dict() and s["options"] == {"a": 1}
+    # another array of the same scene ships nothing: the constant, and the summary says so
+    c = ds.design_table("sc", "4x4")
+    assert np.degrees([c.sigma_azimuth[0], c.sigma_elevation[0]]).tolist() == pytest.approx(
+        list(ds.DESIGN_SIGMAS_DEG)
+    )
+    assert ds.direct_summary("sc", "4x4", {})["survey"] is None
+    assert ds.survey_record("sc") is None  # the tables' route of the scene: none
+    # a record naming another route, or without a table, is refused
+    (tmp_path / "rt" / "direct" / "sc-4x4.json").write_text(json.dumps(rec))
+    with pytest.raises(ValueError, match=r"^scenario:.*array '8x8'"):
+        ds.design_table("sc", "4x4")
+    (tmp_path / "rt" / "direct" / "sc.json").write_text(json.dumps({"scenario": "sc"}))
+    with pytest.raises(ValueError, match=r"^scenario:.*missing"):
+        ds.survey_record("sc")
+    with pytest.raises(ValueError, match=r"^array"):
+        ds.design_table("sc", "8by8")
+    with pytest.raises(TypeError, match=r"^record"):
+        ds.surveyed_table({"table": table})
+    for bad in (0, -1, np.nan):
+        with pytest.raises(ValueError, match=r"^factor"):
+            want.scaled(bad)

@@ -105,3 +105,27 @@ def test_errors_are_measured_against_the_true_direction_at_a_steep_angle(drive):
     np.testing.assert_allclose(e[:, 1], off, atol=1e-12)
     np.testing.assert_allclose(e[:, 2], -off, atol=1e-12)
     np.testing.assert_allclose(e[:, 0], el - off, atol=1e-12)
+
+
+def test_los_error_rows_wrap_the_azimuth_against_the_sight_by_hand():
+    """los_error_rows: (measured elevation, azimuth error wrapped to +-pi, elevation error)
+    against atan2 by hand, across the +-pi seam; one row as the direct drive records it; bad
+    shapes refused by name."""
+    from tunnelkit.design.los import los_error_rows
+
+    rng = np.random.default_rng(5)
+    sight = rng.normal(size=(50, 3)) * [20.0, 20.0, 3.0]
+    az = np.arctan2(sight[:, 1], sight[:, 0])
+    el = np.arctan2(sight[:, 2], np.hypot(sight[:, 0], sight[:, 1]))
+    d_az, d_el = rng.uniform(-0.1, 0.1, (2, 50))
+    phi = az + d_az + np.where(rng.random(50) < 0.5, 2 * np.pi, 0.0)  # some a turn around
+    rows = los_error_rows(phi, el + d_el, sight)
+    np.testing.assert_allclose(rows[:, 0], el + d_el, atol=1e-12)
+    np.testing.assert_allclose(rows[:, 1], d_az, atol=1e-12)
+    np.testing.assert_allclose(rows[:, 2], d_el, atol=1e-12)
+    one = los_error_rows(phi[:1], el[:1] + d_el[:1], [sight[0]])
+    np.testing.assert_array_equal(one, rows[:1])
+    with pytest.raises(ValueError, match=r"^sight"):
+        los_error_rows(phi, el, sight[:3])
+    with pytest.raises(ValueError, match=r"^psi"):
+        los_error_rows(phi, el[:3], sight)

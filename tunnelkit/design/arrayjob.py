@@ -333,18 +333,19 @@ class ArrayJob:
 
     def _direct(self, spec, rec, design, peb, budget, hybrid) -> Prepared:
         """The direct tracker's preparation (:mod:`tunnelkit.design.traceddirect`): the line of
-        sight's JAVELIN fed the direct fix, told :func:`~.traceddirect.design_table`; the
+        sight's JAVELIN fed the direct fix, told :func:`~.directsurvey.design_table`; the
         posterior CRLB of that told model beside it (a prediction, not a bound)."""
         from . import traced, tracedbounds, tracedlos
-        from .traceddirect import design_table, direct_summary
+        from .directsurvey import design_table, direct_summary
+        from .traceddirect import DESIGN_OPTIONS
 
-        table = design_table()
+        table = design_table(self.setup.name, spec)
         design = tracedlos.los_javelin(design)
         drive = tracedbounds.los_bounds(self.setup, spec, table, self.T,
                                         sigma_p0=self.start_sigma)[1]  # fmt: skip
         em = traced.error_model_summary(rec, design.config)
         em["told_sigmas"] = {k: em["told_sigmas"][k] for k in ("kappa_m", "delta_d_m")}
-        em.update(tracker="direct", direct=direct_summary())
+        em.update(tracker="direct", direct=direct_summary(self.setup.name, spec, DESIGN_OPTIONS))
         return Prepared(spec, None, design, peb, None, drive, budget, em, hybrid, None, table)
 
 

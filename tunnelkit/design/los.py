@@ -40,6 +40,7 @@ __all__ = [
     "angle_sigma",
     "elevation_sigmas",
     "los_angle_information",
+    "los_error_rows",
     "los_errors",
     "los_only",
     "los_path",
@@ -113,6 +114,12 @@ class ElevationSigmas:
             np.interp(psi, self.elevation, self.sigma_elevation),
         )
 
+    def scaled(self, factor) -> ElevationSigmas:
+        """The same bins with both sigmas times ``factor`` (> 0): a survey's RMS told with a
+        margin."""
+        k = positive("factor", factor)
+        return ElevationSigmas(self.elevation, k * self.sigma_azimuth, k * self.sigma_elevation)
+
     def as_dict(self) -> dict:
         """The table in degrees, for JSON."""
         return {k: np.degrees(getattr(self, k)).round(6).tolist() for k in _FIELDS}
@@ -139,6 +146,17 @@ class ElevationSigmas:
 _FIELDS = ("elevation", "sigma_azimuth", "sigma_elevation")
 
 
+def los_error_rows(phi, psi, sight) -> np.ndarray:
+    """The survey's rows of measured line-of-sight angles ``phi``, ``psi`` (N,) [rad] against
+    the true line of sight ``sight`` (N, 3) [m] (from the site to the UE): ``(measured
+    elevation, azimuth error, elevation error)`` [rad], the azimuth's wrapped, (N, 3)."""
+    phi = finite_array("phi", phi, ndim=1)
+    psi = finite_array("psi", psi, shape=phi.shape)
+    sight = finite_array("sight", sight, shape=(phi.size, 3))
+    az, el, _ = spherical(sight).T
+    return np.column_stack([psi, wrap_angle(phi - az), psi - el])
+
+
 def los_errors(drives, window: float = LOS_WINDOW_M) -> np.ndarray:
     """The path taken for the line of sight against the true one on ``drives`` (a sequence of
     :class:`~tunnelkit.simulation.DriveData` of every path, ``"ml-all"``): one row per epoch with
@@ -151,13 +169,14 @@ def los_errors(drives, window: float = LOS_WINDOW_M) -> np.ndarray:
     for i, drive in enumerate(drives):
         instance(f"drives[{i}]", drive, DriveData)
         los = los_only(drive, window)
-        az, el, _ = spherical(los.truth - np.asarray(los.base_station, float)).T
-        for k, ep in enumerate(los.epochs):
-            if ep is not None:
-                rows.append((ep.psi[0], wrap_angle(ep.phi[0] - az[k]), ep.psi[0] - el[k]))
+        k = [k for k, ep in enumerate(los.epochs) if ep is not None]
+        if k:
+            sight = los.truth[k] - np.asarray(los.base_station, float)
+            phi, psi = np.array([(los.epochs[j].phi[0], los.epochs[j].psi[0]) for j in k]).T
+            rows.append(los_error_rows(phi, psi, sight))
     if not rows:
         raise ValueError("drives: no epoch with a measurement")
-    return np.array(rows, float)
+    return np.concatenate(rows)
 
 
 def elevation_sigmas(errors, bins: int = 8) -> ElevationSigmas:

@@ -159,11 +159,19 @@ def report_table(report) -> str:
         los = em.get("los") if em else None
         direct = em.get("direct") if em else None
         if direct:
-            told = direct["told_deg"]
+            tab, sv = direct["told_deg"], direct["survey"]
+            saz, sel = tab["sigma_azimuth"], tab["sigma_elevation"]
+            told = (
+                f"told a constant azimuth {saz[0]:.3g} deg, elevation {sel[0]:.3g} deg (no "
+                "survey of this route ships)"
+                if sv is None
+                else f"told its angle sigmas by its measured elevation, a survey of {sv['runs']} "
+                f"drives of seed {sv['seed']} ({sv['bins']} bins) times {sv['scale']:g}: azimuth "
+                f"{min(saz):.2g}-{max(saz):.3g} deg, elevation {min(sel):.2g}-{max(sel):.3g} deg"
+            )
             lines.append(
                 f"  {r.array}: traced route, the direct fit's line of sight (tracker direct: every "
-                f"atom tied to one UE position, started from the track's prediction), told "
-                f"azimuth {told['azimuth']:.3g} deg, elevation {told['elevation']:.3g} deg"
+                f"atom tied to one UE position, started from the track's prediction), {told}"
             )
         elif los:
             tab = los["table_deg"]

@@ -32,7 +32,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._validate import boolean, finite_array, instance, integer, positive, record, rng_or_error
-from ..angles import wrap_angle
 from ..arrays import ArrayGeometry
 from ..channel import ChannelSnapshot
 from ..extraction.direct.fit import (
@@ -49,18 +48,15 @@ from ..signal_route import SignalRoute, measurements_from_estimates
 from ..tracking.javelin import Javelin, JavelinDesign, ReportedNoise
 from ..tracking.javelin.motion import midpoint_messages, ue_velocity
 from ..tracking.measurements import PathMeasurements
-from .los import LOS_WINDOW_M, ElevationSigmas, los_path, told_epoch
+from .los import LOS_WINDOW_M, ElevationSigmas, los_error_rows, los_path, told_epoch
 from .tracedbounds import config_sigmas
 
 __all__ = [
     "DESIGN_OPTIONS",
-    "DESIGN_SIGMAS_DEG",
     "RESTART_M",
     "TRACKERS",
     "DirectDrive",
-    "design_table",
     "direct_drive",
-    "direct_summary",
     "eq1_los",
     "repointed",
     "unmodelled_share",
@@ -70,18 +66,11 @@ __all__ = [
 #: ``speed_sigma``)
 TRACKERS = ("dead reckoning", "eq. 1", "direct", "direct speed alone")
 
-#: the direct fix's angle sigmas the design's tracker is told, (azimuth, elevation) [deg] at every
-#: elevation (``tunnelkit design --traced-tracker direct``): one constant pair, chosen on four
-#: 8 x 8 drives of the design's traced route (``benchmarks/bench_rt_direct.py --seed 3``, not a
-#: design sweep's seed-3 drives) against the array's survey table told as it is and three times,
-#: reported on held-out drives (``docs/results/traced-models.md``); loose where the fixes are
-#: better (the 28 GHz tunnel's azimuth errs 0.04 deg RMS)
-DESIGN_SIGMAS_DEG = (2.0, 1.0)
-
-#: :func:`direct_drive`'s options on the design's traced route (chosen with
-#: :data:`DESIGN_SIGMAS_DEG`): the fix's speed averaged with the V2X message's, told 0.1 m/s; the
-#: second-order atoms each on the elements that see it; one diffuse atom, tried where the tied
-#: fit leaves more than 4 % of the power unmodelled; the second start from eq. 1's line of sight
+#: :func:`direct_drive`'s options on the design's traced route (chosen with the constant told
+#: sigmas, :data:`~tunnelkit.design.directsurvey.DESIGN_SIGMAS_DEG`): the fix's speed averaged
+#: with the V2X message's, told 0.1 m/s; the second-order atoms each on the elements that see
+#: it; one diffuse atom, tried where the tied fit leaves more than 4 % of the power unmodelled;
+#: the second start from eq. 1's line of sight
 DESIGN_OPTIONS = {
     "speed_sigma": 0.1,
     "element_second_order": True,
@@ -89,19 +78,6 @@ DESIGN_OPTIONS = {
     "diffuse_above": 0.04,
     "second_start": True,
 }
-
-
-def design_table() -> ElevationSigmas:
-    """The direct fix's told sigmas on the design's route: :data:`DESIGN_SIGMAS_DEG` at every
-    elevation (one bin)."""
-    return ElevationSigmas(np.zeros(1), *np.radians(np.array(DESIGN_SIGMAS_DEG)[:, None]))
-
-
-def direct_summary() -> dict:
-    """What the design report's JSON says about the direct tracker (``error_model["direct"]``):
-    its told angle sigmas [deg] and :data:`DESIGN_OPTIONS`."""
-    az, el = DESIGN_SIGMAS_DEG
-    return {"told_deg": {"azimuth": az, "elevation": el}, "options": dict(DESIGN_OPTIONS)}
 
 
 #: the extraction errors a fit may raise; the epoch is then predicted only
@@ -281,11 +257,6 @@ def _best_fix(route, arr, snap, starts, velocity, **options):
             pass
     good = [f for f in fits if f.ok]
     return min(good, key=lambda f: f.residual) if good else (fits[0] if fits else None)
-
-
-def _los_error(pm: PathMeasurements, ue: np.ndarray, origin: np.ndarray) -> tuple:
-    az, el, _ = spherical(ue - origin)
-    return float(pm.psi[0]), float(wrap_angle(pm.phi[0] - az)), float(pm.psi[0] - el)
 
 
 def direct_drive(
@@ -482,7 +453,9 @@ def direct_drive(
                         m = None
                     else:
                         m = told_epoch(m, told[name], c["kappa"], c["d"] / np.sqrt(2))
-                        errs[name].append(_los_error(m, traj.position[k], arr.origin))
+                        errs[name].append(
+                            los_error_rows(m.phi[:1], m.psi[:1], [traj.position[k] - arr.origin])[0]
+                        )
                 jav.update(m)
                 est[name][k] = jav.x[:3]
     if replay is not None and not (

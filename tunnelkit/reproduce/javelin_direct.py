@@ -12,20 +12,18 @@ column runs its own drive
 generator spawned from the trial's (the other columns' draws are unchanged), and its dead
 reckoning is the same JAVELIN on that drive's own V2X messages. Its configuration
 (:data:`DIRECT_OPTIONS`) and its told angle sigmas by elevation (:func:`direct_table`, shipped
-per scene in ``data/rt/direct/``) were chosen on seed 0 (``docs/results/traced-models.md``).
+per scene in ``data/rt/direct/``, :mod:`tunnelkit.design.directsurvey`) were chosen on seed 0
+(``docs/results/traced-models.md``).
 """
 
 from __future__ import annotations
 
-import functools
-import json
-
 import numpy as np
 
-from .._validate import integer, rng_or_error, text
+from .._validate import integer, rng_or_error
+from ..design.directsurvey import SURVEY_SCALE, survey_path, survey_record, surveyed_table
 from ..design.los import ElevationSigmas
 from ..design.traceddirect import direct_drive
-from ..scenarios import data_dir
 from ..simulation.drives import scenario_route
 from ..simulation.scoring import error_metrics
 from .javelin_traced import LOS_START_M, los_design
@@ -34,7 +32,6 @@ __all__ = [
     "DIRECT_COLUMN",
     "DIRECT_NUISANCE",
     "DIRECT_OPTIONS",
-    "DIRECT_SIGMA_SCALE",
     "direct_note",
     "direct_scores",
     "direct_table",
@@ -56,49 +53,15 @@ DIRECT_OPTIONS = {
 }
 #: the route the direct drive draws its snapshots from (``benchmarks/bench_rt_direct.py``'s)
 DIRECT_NUISANCE = {"diffuse_floor": True}
-#: the survey's angle sigmas (RMS by elevation) are told times this: the fixes' errors are
-#: heavy-tailed and include biases held over several epochs, which a track told their RMS follows
-#: off the road (chosen on the survey's own seed-0 drives, both paper drives, among 1, 1.5, 2 and
-#: 3, with 4 or 8 bins: 8 bins times 2 was best on both; reported on the tables' held-out seeds:
-#: ``docs/results/traced-models.md``)
-DIRECT_SIGMA_SCALE = 2.0
-
-
-def _path(scenario: str):
-    return data_dir() / "rt" / "direct" / f"{scenario}.json"
-
-
-def _record(scenario: str) -> dict | None:
-    """The shipped record of ``scenario``, None if none (a scenario file's path ships none)."""
-    if "\0" in text("scenario", scenario):
-        raise ValueError("scenario: a name or path holds no null character")
-    if any(c in scenario for c in "/\\") or scenario.startswith("."):
-        return None
-    return _load(scenario)
-
-
-@functools.cache
-def _load(scenario: str) -> dict | None:
-    p = _path(scenario)
-    if not p.is_file():
-        return None
-    rec = json.loads(p.read_text())
-    if rec.get("scenario") != scenario:
-        raise ValueError(f"scenario: {p} records {rec.get('scenario')!r}")
-    return rec
 
 
 def direct_table(scenario: str) -> ElevationSigmas | None:
     """The direct fix's told angle sigmas by measured elevation for ``scenario`` (a preset's
     name): the survey shipped in ``data/rt/direct/<scenario>.json`` (its command in the
-    record) times :data:`DIRECT_SIGMA_SCALE`; None for a scene without one (the column is then
-    not run)."""
-    rec = _record(scenario)
-    if rec is None:
-        return None
-    t = ElevationSigmas.from_dict(rec["table_deg"])
-    k = DIRECT_SIGMA_SCALE
-    return ElevationSigmas(t.elevation, k * t.sigma_azimuth, k * t.sigma_elevation)
+    record) times :data:`~tunnelkit.design.directsurvey.SURVEY_SCALE`; None for a scene without
+    one (the column is then not run)."""
+    rec = survey_record(scenario)
+    return None if rec is None else surveyed_table(rec)
 
 
 def direct_scores(scenario: str, n_epochs: int | None, rng: np.random.Generator) -> tuple:
@@ -110,7 +73,9 @@ def direct_scores(scenario: str, n_epochs: int | None, rng: np.random.Generator)
     (metrics as :func:`~tunnelkit.simulation.scoring.error_metrics`)."""
     table = direct_table(scenario)
     if table is None:
-        raise ValueError(f"scenario: {scenario!r} ships no direct fix's table ({_path(scenario)})")
+        raise ValueError(
+            f"scenario: {scenario!r} ships no direct fix's table ({survey_path(scenario)})"
+        )
     if n_epochs is not None:
         n_epochs = integer("n_epochs", n_epochs, minimum=1)
     rng = rng_or_error("rng", rng)
@@ -129,9 +94,11 @@ def direct_scores(scenario: str, n_epochs: int | None, rng: np.random.Generator)
 
 def direct_note(scenario: str) -> str:
     """The direct column's note: what it runs, what it is told, where its table comes from."""
-    rec = _record(scenario)
+    rec = survey_record(scenario)
     if rec is None:
-        raise ValueError(f"scenario: {scenario!r} ships no direct fix's table ({_path(scenario)})")
+        raise ValueError(
+            f"scenario: {scenario!r} ships no direct fix's table ({survey_path(scenario)})"
+        )
     bins = ElevationSigmas.from_dict(rec["table_deg"]).describe()
     o = DIRECT_OPTIONS
     return (
@@ -142,7 +109,7 @@ def direct_note(scenario: str) -> str:
         f"{o['diffuse']} diffuse atom tried where the tied fit leaves more than "
         f"{100 * o['diffuse_above']:g} % of the tensor's power unmodelled) starts from its "
         "prediction; the fix goes to the tracker as a line of sight told its azimuth / "
-        f"elevation sigmas by its elevation ({bins}, each times {DIRECT_SIGMA_SCALE:g}; "
+        f"elevation sigmas by its elevation ({bins}, each times {SURVEY_SCALE:g}; "
         f"{rec['source']}), its speed averaged with "
         f"the next message's (told {o['speed_sigma']:g} m/s). The measurement depends on the "
         "track, so the column runs its own drive (design.traceddirect.direct_drive), drawn "
