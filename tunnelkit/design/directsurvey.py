@@ -132,5 +132,5 @@ def direct_summary(scenario: str, array, options: dict) -> dict:
     if rec is not None:
         survey = {k: rec[k] for k in ("source", "command", "seed", "runs", "bins")}
         survey["scale"] = SURVEY_SCALE
-    told = design_table(scenario, array).as_dict()
+    told = (_constant() if rec is None else surveyed_table(rec)).as_dict()
     return {"told_deg": told, "survey": survey, "options": dict(options)}
