@@ -642,6 +642,45 @@ def test_repointed_keeps_the_range_and_height_and_takes_the_measured_direction()
         repointed((phi, psi), o, far)
 
 
+def test_every_shipped_design_survey_is_what_its_command_writes():
+    """Each design survey shipped (data/rt/direct/<scenario>-<array>.json) loads checked, and the
+    command it records surveys that route: its scene, array, seed, drive count and bin count,
+    told the constant DESIGN_SIGMAS_DEG, with one finite positive sigma per bin."""
+    import itertools
+    import re
+    import shlex
+
+    from tunnelkit.design import directsurvey as ds
+    from tunnelkit.design.los import ElevationSigmas
+    from tunnelkit.scenarios import data_dir
+
+    routes = [
+        re.fullmatch(r"(.+)-(\d+x\d+)", p.stem)
+        for p in (data_dir() / "rt" / "direct").glob("*.json")
+    ]
+    routes = sorted(m.groups() for m in routes if m)  # the tables' surveys (<scenario>.json) apart
+    assert len(routes) >= 2
+    for scenario, array in routes:
+        p = ds.survey_path(scenario, array)
+        rec = ds.survey_record(scenario, array)
+        argv = shlex.split(rec["command"])
+        assert argv[:2] == ["python", "benchmarks/bench_rt_direct.py"], p.name
+        flags = dict(itertools.pairwise(argv))
+        assert flags.get("--scenario", "italiano2026-straight") == scenario, p.name
+        assert flags["--design-array"] == array and flags["--sigmas"] == "2/1", p.name
+        assert int(flags["--seed"]) == rec["seed"] and int(flags["--runs"]) == rec["runs"], p.name
+        assert str(rec["bins"]) in argv[argv.index("--bins") + 1 :], p.name
+        told = ElevationSigmas.from_dict(rec["told_deg"])
+        assert np.degrees([told.sigma_azimuth[0], told.sigma_elevation[0]]).tolist() == (
+            pytest.approx(list(ds.DESIGN_SIGMAS_DEG))
+        ), p.name
+        t = rec["table_deg"]
+        assert len(t["elevation"]) == rec["bins"] and np.all(np.diff(t["elevation"]) > 0), p.name
+        for key in ("sigma_azimuth", "sigma_elevation"):
+            v = np.asarray(t[key])
+            assert v.shape == (rec["bins"],) and np.all(np.isfinite(v) & (v > 0)), p.name
+
+
 def test_survey_records_are_checked_and_a_design_route_without_one_is_told_the_constant(
     tmp_path, monkeypatch
 ):
