@@ -185,6 +185,9 @@ def test_an_array_that_does_not_fit_is_reported_beside_the_others(capsys):
         (["--yield", "0"], "yield: must be in (0, 1)"),
         (["--max-units", "0"], "max_units: must be >= 1"),
         (["--settle", "-1"], "settle: must be a finite number >= 0"),
+        (["--trial-timeout", "0"], "trial_timeout: must be in (0, 86400] s"),
+        (["--trial-timeout", "nan"], "trial_timeout: must be in (0, 86400] s"),
+        (["--trial-timeout", "forever"], "trial_timeout: expected seconds"),
         (["--criterion", "eq51"], "invalid choice"),
         (["--mode", "fast"], "invalid choice"),
     ],
@@ -270,3 +273,50 @@ def test_start_sigma_reaches_the_json_and_the_table(capsys):
     # without the Monte-Carlo (no --units) there is no drive to reckon: nothing recorded
     assert main([*argv[:4], "--format", "json"]) == 0
     assert "dead_reckoning" not in json.loads(capsys.readouterr().out)["inputs"]
+
+
+def test_the_trial_timeout_reaches_every_batch_and_a_stalled_sweep_exits_cleanly(
+    capsys, monkeypatch
+):
+    """``--trial-timeout`` (seconds, or none) is what each batch of drives is run with
+    (run_trials' ``trial_timeout``; default :data:`TRIAL_TIMEOUT_S`); a sweep it stops exits 1
+    with the runner's message and the option named, not a traceback."""
+    from tunnelkit.design import unitsweep
+    from tunnelkit.runner import TRIAL_TIMEOUT_S, TrialTimeout
+
+    told = []
+
+    def recording(setup, specs, runs, seed, **kw):
+        told.append(kw["trial_timeout"])
+        raise TrialTimeout("trials [0, 1] of 2 (JAVELIN bound 4x4): none finished within 5 s")
+
+    monkeypatch.setattr(unitsweep, "_sweep_montecarlo", recording)
+    argv = ["design", "italiano2026-straight", "--arrays", "4x4", "--units", "1", "--no-progress"]
+    for extra, want in (([], TRIAL_TIMEOUT_S), (["--trial-timeout", "7200"], 7200.0),
+                        (["--trial-timeout", "None"], None)):  # fmt: skip
+        assert main([*argv, *extra]) == 1
+        err = capsys.readouterr().err
+        assert told[-1] == want
+        assert err.startswith("tunnelkit design: error: trials [0, 1] of 2")
+        assert "--trial-timeout" in err and "Traceback" not in err
+    with pytest.raises(ValueError, match="trial_timeout: must be > 0"):
+        design.design_sweep(design.DesignSetup.from_scenario("italiano2026-straight"), "4x4",
+                            trial_timeout=0.0)  # fmt: skip
+
+
+def test_any_command_stopped_by_its_time_limit_exits_1_without_a_traceback(capsys, monkeypatch):
+    """The command line turns a run's TrialTimeout (a TimeoutError) into an error line, status 1,
+    for every command (here ``reproduce``, whose targets run with the runner's default limit)."""
+    import tunnelkit.reproduce as reproduce
+    from tunnelkit.runner import TrialTimeout
+
+    def stalled(*args, **kw):
+        raise TrialTimeout("trial 0 of 1 (jiang): ran longer than trial_timeout = 1800 s")
+
+    monkeypatch.setattr(reproduce, "run", stalled)
+    assert main(["reproduce", "jiang-table2", "--runs", "1", "--format", "json"]) == 1
+    err = capsys.readouterr().err
+    assert (
+        err
+        == "tunnelkit reproduce: error: trial 0 of 1 (jiang): ran longer than trial_timeout = 1800 s\n"
+    )

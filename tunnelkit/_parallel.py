@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from ._validate import integer
 
-__all__ = ["parallel_options"]
+__all__ = ["TRIAL_TIMEOUT_S", "parallel_options"]
+TRIAL_TIMEOUT_S = 1800.0  # run_trials' time limit [s] (tunnelkit.runner: a stalled run stops)
 
 
 def parallel_options(

@@ -146,10 +146,10 @@ def real(name: str, value) -> float:
     return _scalar(name, value)
 
 
-def positive(name: str, value) -> float:
-    """A finite scalar strictly greater than zero."""
-    x = _scalar(name, value)
-    if x <= 0:
+def positive(name: str, value, *, none: bool = False) -> float | None:
+    """A finite scalar strictly greater than zero (or None, where ``none``: not given)."""
+    x = None if none and value is None else _scalar(name, value)
+    if x is not None and x <= 0:
         raise ValueError(f"{name}: must be > 0, got {x}")
     return x
 

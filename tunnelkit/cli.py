@@ -40,6 +40,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, TypeError) as exc:
         print(f"tunnelkit {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except TimeoutError as exc:  # a Monte-Carlo run stopped by its time limit (runner.TrialTimeout)
+        print(f"tunnelkit {args.command}: error: {exc}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -44,13 +44,14 @@ from typing import Any
 import numpy as np
 
 from ._checks import attributes
-from ._parallel import parallel_options
+from ._parallel import TRIAL_TIMEOUT_S, parallel_options
 from ._validate import boolean, callable_, integer, positive, sequence, text
 from .budget import check_bytes
 from .montecarlo import RUN_BYTES, spawn_rngs
 
 __all__ = [
     "CONNECT_TIMEOUT_S",
+    "TRIAL_TIMEOUT_S",
     "SchedulerUnreachable",
     "TrialLost",
     "TrialPool",
@@ -64,11 +65,6 @@ __all__ = [
 
 #: seconds to wait for a scheduler given by address before :class:`SchedulerUnreachable`
 CONNECT_TIMEOUT_S = 10.0
-
-#: the default per-trial time limit [s]: a trial that runs this long is taken as stuck (the
-#: longest trial in the project, a full-mode drive of the channel route with a 16 x 16 array,
-#: takes a few minutes); ``trial_timeout=None`` lifts the limit
-TRIAL_TIMEOUT_S = 1800.0
 
 
 class SchedulerUnreachable(ConnectionError, ValueError):
@@ -127,8 +123,7 @@ def run_trials(
     retries = integer("retries", retries, minimum=0)
     progress, desc = boolean("progress", progress), text("desc", desc)
     timeout = positive("timeout", timeout)
-    if trial_timeout is not None:
-        trial_timeout = positive("trial_timeout", trial_timeout)
+    trial_timeout = positive("trial_timeout", trial_timeout, none=True)
     if pool is not None:
         if not isinstance(pool, TrialPool):
             raise TypeError(f"pool: expected a runner.TrialPool, got {type(pool).__name__}")

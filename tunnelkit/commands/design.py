@@ -2,7 +2,7 @@
 [--ideal] [--phase-error-deg X] [--gain-error-db Y] [--wideband/--no-wideband]
 [--wideband-model/--no-wideband-model] [--dmc-share S]
 [--target T] [--share Q] [--units N] [--drives-per-unit D] [--yield Y] [--max-units C]
-[--settle S] [--workers N | --scheduler A] [--mode bound|channel]
+[--settle S] [--workers N | --scheduler A] [--trial-timeout S|none] [--mode bound|channel]
 [--criterion achievable|srnf] [--confirm [--confirm-units N]] [--channel image|sionna [--traced-tracker auto|los|paths|direct]]
 [--start-sigma S] [--no-dead-reckoning] [--format table|json] [--plot FILE.html]``.
 
@@ -376,9 +376,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "tracker, start and V2X messages) and report its error beside the tracker's, what the "
         "radio adds (on by default; --no-dead-reckoning leaves it out)",
     )
-    from .reproduce import add_parallel_arguments
+    from .reproduce import add_parallel_arguments, add_trial_timeout
 
     add_parallel_arguments(out)
+    add_trial_timeout(out, "drive", "A direct-tracker drive of a 10 x 10 takes 10-15 minutes of "
+                      "one core, longer on a busy machine")  # fmt: skip
     out.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--format", choices=["table", "json"], default="table")
     p.add_argument(
@@ -391,9 +393,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _stopped(exc: Exception) -> int:
+    """A Monte-Carlo run that stopped (a worker lost, or no drive finished in time): the error
+    on stderr, exit status 1."""
+    hint = ""
+    if isinstance(exc, TimeoutError):
+        hint = "; on a busy machine, or for slow drives, give a longer --trial-timeout (or none)"
+    print(f"tunnelkit design: error: {exc}{hint}", file=sys.stderr)
+    return 1
+
+
 def main(args: argparse.Namespace) -> int:
     from .. import design
-    from ..runner import TrialLost
+    from ..runner import TrialLost, TrialTimeout
     from .reproduce import parallel_kwargs
 
     try:
@@ -457,11 +469,11 @@ def main(args: argparse.Namespace) -> int:
             **({"dead_reckoning": True} if args.dead_reckoning and args.units else {}),
             **({} if args.traced_tracker is None else {"traced_tracker": args.traced_tracker}),
             **parallel_kwargs(args),
+            trial_timeout=args.trial_timeout,
             progress=args.units > 0 and args.format == "table" and not args.no_progress,
         )
-    except TrialLost as exc:
-        print(f"tunnelkit design: error: {exc}", file=sys.stderr)
-        return 1
+    except (TrialLost, TrialTimeout) as exc:
+        return _stopped(exc)
     rep.settings.update(
         impairments_preset=preset,
         spacing_wl=args.spacing,
@@ -477,11 +489,11 @@ def main(args: argparse.Namespace) -> int:
                 setup,
                 units=args.confirm_units,
                 **parallel_kwargs(args),
+                trial_timeout=args.trial_timeout,
                 progress=args.format == "table" and not args.no_progress,
             )
-        except TrialLost as exc:
-            print(f"tunnelkit design: error: {exc}", file=sys.stderr)
-            return 1
+        except (TrialLost, TrialTimeout) as exc:
+            return _stopped(exc)
     if all(r.status == "error" for r in rep.rows):
         for r in rep.rows:
             print(f"tunnelkit design: error: {r.reason}", file=sys.stderr)

@@ -123,6 +123,22 @@ def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_trial_timeout(p: argparse.ArgumentParser, trial: str, note: str = "") -> None:
+    """``--trial-timeout SECONDS|none`` (``args.trial_timeout``): how long a run waits for a
+    ``trial`` to finish before it stops (:data:`tunnelkit.runner.TRIAL_TIMEOUT_S`)."""
+    from .._parallel import TRIAL_TIMEOUT_S
+
+    seconds = _seconds("trial_timeout")
+    p.add_argument(
+        "--trial-timeout",
+        type=lambda text: None if text.strip().lower() == "none" else seconds(text),
+        default=TRIAL_TIMEOUT_S,
+        metavar="SECONDS|none",
+        help=f"stop when no {trial} has finished for this long (default {TRIAL_TIMEOUT_S:g} s; "
+        f"none: no limit){'. ' + note if note else ''}",
+    )
+
+
 def parallel_kwargs(args: argparse.Namespace) -> dict:
     """``workers``, ``scheduler`` and ``timeout`` for ``run_trials`` from the parsed arguments."""
     return {"workers": args.workers, "scheduler": args.scheduler, "timeout": args.connect_timeout}

@@ -50,7 +50,8 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 
-from .._validate import instance, integer, record, sequence
+from .._parallel import TRIAL_TIMEOUT_S
+from .._validate import instance, integer, positive, record, sequence
 from ..budget import check_bytes
 from ..montecarlo import RUN_BYTES
 from .report import DesignReport
@@ -131,13 +132,14 @@ def confirm_on_channel(
     workers: int | None = None,
     scheduler: str | None = None,
     timeout: float | None = None,
+    trial_timeout: float | None = TRIAL_TIMEOUT_S,
     progress: bool = False,
 ) -> ConfirmedReport:
     """``report`` (a bound-route :func:`~tunnelkit.design.report.design_sweep` with units) with
     its recommendation re-decided on the channel route (module docstring): the candidates of
     :func:`confirmation_candidates`, ``units`` units each (default the report's), its seed,
     impairments, target, share, criterion and epochs; ``workers`` / ``scheduler`` /
-    ``timeout`` as :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`'s."""
+    ``timeout`` / ``trial_timeout`` as :func:`~tunnelkit.design.montecarlo.sweep_montecarlo`'s."""
     from ..signal_route.judging import FLOOR_FALSE_ALARM, impairment_share
     from .achievable import DesignImpairments
     from .montecarlo import sweep_montecarlo
@@ -150,6 +152,7 @@ def confirm_on_channel(
             "report: expected a bound-route sweep with units (mode 'bound', units > 0)"
         )
     units = s["units"] if units is None else integer("units", units, minimum=1)
+    trial_timeout = positive("trial_timeout", trial_timeout, none=True)
     check_bytes("units", units * RUN_BYTES, f"{units} units' calibration draws")
     d = s["drives_per_unit"]
     labels = confirmation_candidates(report)
@@ -171,6 +174,7 @@ def confirm_on_channel(
             workers=workers,
             scheduler=scheduler,
             timeout=timeout,
+            trial_timeout=trial_timeout,
             progress=progress,
             n_epochs=s["n_epochs"],
             **({"start_sigma": s["start_sigma_m"]} if "start_sigma_m" in s else {}),

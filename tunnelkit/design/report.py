@@ -14,7 +14,7 @@ from dataclasses import asdict
 
 import numpy as np
 
-from .._parallel import parallel_options
+from .._parallel import TRIAL_TIMEOUT_S, parallel_options
 from .._physical import start_spread
 from .._validate import boolean, choice, integer, nonnegative, positive, probability, sequence
 from ..budget import check_bytes, check_elements
@@ -123,6 +123,7 @@ def design_sweep(
     progress: bool = False,
     n_epochs: int | None = None,
     timeout: float | None = None,
+    trial_timeout: float | None = TRIAL_TIMEOUT_S,
     n_boot: int = 2000,
     start_sigma: float = START_SIGMA_M,
     dead_reckoning: bool = False,
@@ -140,9 +141,9 @@ def design_sweep(
     ``"channel"``: synthesis and extraction), seeded by ``seed``: ``units`` in the first batch
     (0: bounds and predictions only), then, for every array still undecided, as many again
     until its unit yield's 95 % interval lies on one side of ``required_yield`` or
-    ``max_units`` is reached (the sequential rule). ``workers`` / ``scheduler`` / ``timeout``
-    go to each batch's task set; ``n_epochs`` truncates the route; ``n_boot`` bootstrap
-    resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
+    ``max_units`` is reached (the sequential rule). ``workers`` / ``scheduler`` / ``timeout`` /
+    ``trial_timeout`` go to each batch's task set; ``n_epochs`` truncates the route; ``n_boot``
+    bootstrap resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
     (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
     drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
     radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"auto"``, its default,
@@ -156,8 +157,8 @@ def design_sweep(
     specs = list(dict.fromkeys(parse_array(a) for a in sequence("arrays", arrays, empty=True)))
     if not specs or len({s.label for s in specs}) < len(specs):  # rows and results go by label
         raise ValueError("arrays: give candidate arrays, at most one spacing per size")
-    if timeout is not None:
-        timeout = positive("timeout", timeout)
+    timeout = positive("timeout", timeout, none=True)
+    trial_timeout = positive("trial_timeout", trial_timeout, none=True)
     target = positive("target", target)
     share = probability("share", share, open_interval=False)
     if share == 0:
@@ -227,7 +228,7 @@ def design_sweep(
         from .unitsweep import run_units, sweep_options  # the Monte-Carlo by units, when asked for
 
         kw = sweep_options(imp, mode, workers, scheduler, timeout, progress, n_epochs, start_sigma,
-                           dead_reckoning, drives_per_unit, traced_tracker)  # fmt: skip
+                           dead_reckoning, drives_per_unit, traced_tracker, trial_timeout)  # fmt: skip
         judged = {"settle": settle, "required": required_yield, "cap": max_units}
         run_units(setup, rows, todo, units, max_units, seed, kw, warnings,
                   (criterion, target, share, seed, n_boot), judged)  # fmt: skip

@@ -25,7 +25,7 @@ __all__: list[str] = []
 
 
 def sweep_options(imp, mode, workers, scheduler, timeout, progress, n_epochs, start_sigma,
-                  dead_reckoning, drives_per_unit, traced_tracker="paths") -> dict:  # fmt: skip
+                  dead_reckoning, drives_per_unit, traced_tracker, trial_timeout) -> dict:  # fmt: skip
     """The options of a design sweep's Monte-Carlo (:func:`run_units`' ``kw``), the bound
     route's error model per array under the impairments ``imp`` among them."""
     return {
@@ -35,6 +35,7 @@ def sweep_options(imp, mode, workers, scheduler, timeout, progress, n_epochs, st
         "workers": workers,
         "scheduler": scheduler,
         "timeout": timeout,
+        "trial_timeout": trial_timeout,
         "progress": progress,
         "n_epochs": n_epochs,
         "start_sigma": start_sigma,

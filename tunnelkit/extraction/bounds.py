@@ -290,8 +290,7 @@ def estimate_crlb(est, array, srs, *, noise_power: float | None = None, paths=No
         raise TypeError(f"est: expected PathEstimates, got {type(est).__name__}")
     p = check_array(array, m=est.delta.shape[1] if est.delta.ndim == 2 else None)
     config = check_srs(srs)
-    if noise_power is not None:
-        noise_power = positive("noise_power", noise_power)
+    noise_power = positive("noise_power", noise_power, none=True)
     if paths is not None and not isinstance(paths, list | tuple | np.ndarray):
         raise TypeError(f"paths: expected indices of paths, got {type(paths).__name__}")
     sel = np.arange(len(est)) if paths is None else np.asarray(paths, int).reshape(-1)

@@ -73,8 +73,7 @@ def extract_paths(
     if polish is not None:
         integer("polish", polish, minimum=0, maximum=MAX_SWEEPS)
     if refine == "ml":
-        if noise_power is not None:
-            noise_power = positive("noise_power", noise_power)
+        noise_power = positive("noise_power", noise_power, none=True)
         return ml_paths(H, L, pos, srs, noise_power=noise_power, search=search, wideband=wideband)
     if noise_power is not None:
         raise ValueError(f"noise_power: only used by refine='ml', not {refine!r}")

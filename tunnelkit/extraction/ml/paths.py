@@ -159,8 +159,7 @@ def ml_paths(
     L = check_rank(H.shape, n_paths)
     pos = check_array(array, m=M)
     srs = check_srs(srs)
-    if noise_power is not None:
-        noise_power = positive("noise_power", noise_power)
+    noise_power = positive("noise_power", noise_power, none=True)
     if search not in SEARCHES:
         raise ValueError(f"search: expected one of {SEARCHES}, got {search!r}")
     wideband = boolean("wideband", wideband)
