@@ -506,6 +506,8 @@ def _baselines():
     verdict.share_quantile(e, 0.9)
     intervals.bootstrap_quantile_ci(e[None, :].repeat(3, 0), 0.9, rng, n_boot=200)
     intervals.cluster_quantile_ci(e[None, :].repeat(3, 0), 0.9)
+    intervals.paired_rmse_ratio(e[:6], e[6:12])
+    intervals.rmse_ci(e[:6])
     verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
     verdict.gate(e, np.ones(50, bool), "achievable")
     verdict.judge(0.1, units=20, yield_=0.9, ci=[0.7, 0.97], cap=200)

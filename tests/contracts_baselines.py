@@ -67,7 +67,7 @@ def design_confirm():
 
     setup = tiny_setup()
     few = {"units": 2, "max_units": 2, "drives_per_unit": 1, "settle": 0.0}
-    rep = report.design_sweep(setup, ["4x4"], n_epochs=1, n_boot=100, **few)
+    rep = report.design_sweep(setup, ["4x4"], n_epochs=1, **few)
     verdict.recommend(rep.rows, 0.2, 0.9, 2)
     confirm.confirmation_candidates(rep)
     confirm.next_candidate(rep, [])

@@ -36,6 +36,7 @@ KEYS = {
     "unit_yield",
     "unit_yield_ci95",
     "unit_p90_m",
+    "unit_rmse_m",
     "pcrlb_rms_m",
     "hybrid_bound_rms_m",
     "rmse_over_pcrlb",
@@ -59,7 +60,8 @@ def test_json_answers_the_28ghz_question(capsys):
     argv += ["8x8"]
     assert main([*argv, "--target", "0.15", "--format", "json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert set(out) == {"scenario", "inputs", "criterion", "arrays", "recommendation", "warnings"}
+    top = {"scenario", "inputs", "criterion", "arrays", "paired", "recommendation", "warnings"}
+    assert set(out) == top and out["paired"] == {}  # no units: nothing to pair
     assert out["scenario"] == "example-rectangular-28ghz" and out["criterion"] == "achievable"
     assert INPUTS | {"seed", "units", "mode", "eps_phi", "spacing_wl"} <= set(out["inputs"])
     assert {"drives_per_unit", "required_yield", "max_units", "settle_s"} <= set(out["inputs"])

@@ -82,7 +82,7 @@ def test_confirmation_escalates_while_none_is_met(monkeypatch, channel, runs_of,
     rep = _report(["met", "met", "met"], "4x4")
     rep.settings.update(
         arrays=["4x4", "8x8", "16x16"], spacing_wl=0.5, impairments={}, seed=0, n_epochs=None,
-        criterion="achievable", target=0.1, share=0.9, n_boot=10,
+        criterion="achievable", target=0.1, share=0.9,
     )  # fmt: skip
     setup = design.DesignSetup.from_scenario("example-rectangular-28ghz")
     conf = design.confirm_on_channel(rep, setup)
@@ -110,7 +110,7 @@ def test_confirmation_keeps_the_sweeps_entry_fix(monkeypatch):
         rep = _report(["met", "met", "met"], "4x4")
         rep.settings.update(
             arrays=["4x4", "8x8", "16x16"], spacing_wl=0.5, impairments={}, seed=0, n_epochs=None,
-            criterion="achievable", target=0.1, share=0.9, n_boot=10, **extra,
+            criterion="achievable", target=0.1, share=0.9, **extra,
         )  # fmt: skip
         design.confirm_on_channel(rep, setup)
         assert seen[-1] == want

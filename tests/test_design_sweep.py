@@ -639,6 +639,33 @@ def test_dead_reckoning_drops_the_radio_and_leaves_the_tracker_run_unchanged(set
         sweep_montecarlo(setup, ["4x4"], 2, 0, dead_reckoning="yes", **kw)
 
 
+def test_a_sweep_pairs_its_arrays_and_dead_reckoning_unit_by_unit(setup):
+    """Every row keeps its per-unit RMSEs (and dead reckoning's): the same drives in every row,
+    so dead reckoning's are identical across arrays; they pool back to the row's RMSE, and the
+    report's ``paired`` ratios are the ratios of those RMSEs (the radio's gain, an array over the
+    next smaller), each with its interval over the units."""
+    from tunnelkit.design import design_sweep
+
+    few = {"units": 3, "max_units": 3, "n_epochs": 8, "settle": 0.5, "seed": 4}
+    rep = design_sweep(setup, ["8x8", "4x4"], dead_reckoning=True, **few)
+    js = rep.to_json()
+    rows = {r["array"]: r for r in js["arrays"]}
+    for r in rows.values():
+        assert len(r["unit_rmse_m"]) == len(r["dead_reckoning_unit_rmse_m"]) == 3
+        assert np.sqrt(np.mean(np.square(r["unit_rmse_m"]))) == pytest.approx(r["rmse_m"])
+        dr = np.sqrt(np.mean(np.square(r["dead_reckoning_unit_rmse_m"])))
+        assert dr == pytest.approx(r["dead_reckoning_rmse_m"])
+        gain = js["paired"][r["array"]]["radio_gain"]
+        assert gain["ratio"] == pytest.approx(r["dead_reckoning_rmse_m"] / r["rmse_m"])
+        assert gain["units"] == 3 and gain["ci95"][0] < gain["ratio"] < gain["ci95"][1]
+    assert rows["4x4"]["dead_reckoning_unit_rmse_m"] == rows["8x8"]["dead_reckoning_unit_rmse_m"]
+    big = js["paired"]["8x8"]["against_smaller"]
+    assert "against_smaller" not in js["paired"]["4x4"] and big["against"] == "4x4"
+    assert big["ratio"] == pytest.approx(rows["8x8"]["rmse_m"] / rows["4x4"]["rmse_m"])
+    assert f"8x8: its RMSE over the 4x4's on the same drives {big['ratio']:.3g}x" in rep.to_table()
+    assert "paired over 3 units" in rep.to_table()
+
+
 def test_unit_pcrlb_is_the_drive_pcrlb_without_calibration_and_grows_with_it(setup):
     """Brute force: with the calibration known (or absent) the covariance recursion of
     ``unit_pcrlb`` is Tichavsky's recursion of ``drive_pcrlb`` on the same position

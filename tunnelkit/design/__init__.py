@@ -72,6 +72,8 @@ _EXPORTS = {
     "STATUSES": "verdict",
     "bootstrap_quantile_ci": "intervals",
     "cluster_quantile_ci": "intervals",
+    "paired_rmse_ratio": "intervals",
+    "rmse_ci": "intervals",
     "counted_epochs": "verdict",
     "gate": "verdict",
     "judge": "verdict",

@@ -195,8 +195,6 @@ def confirm_on_channel(
                 s["criterion"],
                 s["target"],
                 s["share"],
-                s["seed"],
-                s["n_boot"],
                 settle=s["settle_s"],
                 required=s["required_yield"],
             )

@@ -1,7 +1,10 @@
 """The 95 % intervals of the design's pooled error quantile over manufactured units: Woodruff's
 with one cluster per unit (:func:`cluster_quantile_ci`, the report's) and the percentile bootstrap
 over runs (:func:`bootstrap_quantile_ci`, kept for the comparison). Information beside the
-verdict, which the unit yield's Wilson interval decides (:mod:`tunnelkit.design.units`).
+verdict, which the unit yield's Wilson interval decides (:mod:`tunnelkit.design.units`). And the
+RMSE's interval over units (:func:`rmse_ci`) and the ratio of two RMSEs over the same units
+(:func:`paired_rmse_ratio`): an array against another on the same drives, or dead reckoning
+against the tracker (the radio's gain).
 
 How it works: docs/internals/design.md.
 """
@@ -15,7 +18,7 @@ from .._checks import real_array
 from .._validate import integer, probability, rng_or_error
 from ..budget import check_elements
 
-__all__ = ["bootstrap_quantile_ci", "cluster_quantile_ci"]
+__all__ = ["bootstrap_quantile_ci", "cluster_quantile_ci", "paired_rmse_ratio", "rmse_ci"]
 
 
 def _error_rows(errors, expected: str) -> np.ndarray:
@@ -89,3 +92,57 @@ def bootstrap_quantile_ci(
     else:  # inf - inf has no interpolation: the bracketing order statistics
         lo, hi = np.quantile(qs, p[0], method="lower"), np.quantile(qs, p[1], method="higher")
     return [float(lo), float(hi)]
+
+
+def rmse_ci(unit_rmse, *, level: float = 0.95) -> list[float] | None:
+    """The ``level`` interval of the RMSE pooled over units, ``sqrt(mean(unit_rmse**2))``, from
+    each unit's RMSE (a unit's drives share its calibration: the units are the independent
+    draws): the delta method's on the log with Student's t over units, as
+    :func:`paired_rmse_ratio` with nothing in the denominator. The percentile bootstrap over
+    units it replaced covered 69-86 % at 4-6 units (docs/results/design-units.md). ``None``
+    with fewer than two units or a unit not finite (a lost drive: the RMSE is infinite)."""
+    level = probability("level", level)
+    a = _unit_rmse("unit_rmse", unit_rmse)
+    m = np.mean(a**2)
+    if a.size < 2 or not (np.all(np.isfinite(a)) and m > 0):
+        return None
+    return _log_t(float(np.sqrt(m)), 0.5 * a**2 / m, level)
+
+
+def _unit_rmse(name: str, values) -> np.ndarray:
+    """``values`` as a 1-D array of per-unit RMSEs: >= 0, +inf allowed (a lost drive), no NaN."""
+    x = np.asarray(real_array(name, values, ndim=1), float)
+    if not np.all(x >= 0):  # NaN fails too: a lost drive's RMSE is +inf, never NaN
+        raise ValueError(f"{name}: an RMSE is >= 0 (+inf for a lost drive), got {x.min()}")
+    return x
+
+
+def _log_t(value: float, z: np.ndarray, level: float) -> list[float]:
+    """``value * exp(+-t se)``: ``se = sd(z) / sqrt(U)`` the standard error of the log of
+    ``value`` from the units' influences ``z``, Student's t with ``U - 1`` degrees of freedom."""
+    half = stats.t.ppf((1 + level) / 2, z.size - 1) * np.std(z, ddof=1) / np.sqrt(z.size)
+    return [float(value * np.exp(-half)), float(value * np.exp(half))]
+
+
+def paired_rmse_ratio(num, den, *, level: float = 0.95) -> tuple[float, list[float] | None]:
+    """The ratio of two RMSEs pooled over the same units, ``sqrt(mean(num**2) / mean(den**2))``,
+    and its ``level`` interval; ``num`` and ``den`` are per-unit RMSEs (one value per unit, unit
+    ``u`` of both the same drives: an array against another in one sweep, or dead reckoning
+    against the tracker). Pairing removes what the units share (the drive, the odometry).
+
+    The interval is the delta method's on the log ratio with Student's t over units: with
+    ``M = mean(x**2)`` each unit's influence is ``z_u = (num_u**2 / M_num - den_u**2 / M_den) / 2``
+    and ``se = sd(z) / sqrt(U)``, ``ratio * exp(+-t_{U-1} se)`` (coverage measured by
+    Monte-Carlo in ``tests/test_design_verdict.py``). ``None`` for the interval with fewer than
+    two units or a unit not finite (a lost drive); then the ratio is still returned (``inf``
+    when ``den`` is all zero)."""
+    level = probability("level", level)
+    a, b = _unit_rmse("num", num), _unit_rmse("den", den)
+    if a.shape != b.shape or not a.size:
+        raise ValueError(f"num, den: expected one RMSE per unit in both, got {a.shape}, {b.shape}")
+    ma, mb = np.mean(a**2), np.mean(b**2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = float(np.sqrt(ma / mb)) if mb > 0 else np.inf
+    if a.size < 2 or not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and ma > 0 and mb > 0):
+        return ratio, None
+    return ratio, _log_t(ratio, 0.5 * (a**2 / ma - b**2 / mb), level)

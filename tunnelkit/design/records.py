@@ -22,41 +22,39 @@ _ROW_INF = (
     "error_p90_m", "error_p90_route_m", "error_p90_ci95_m", "rmse_m", "rmse_ci95_m", "peb_m",
     "predicted_m", "error_median_epoch_m", "unit_p90_m", "pcrlb_rms_m", "hybrid_bound_rms_m",
     "rmse_over_pcrlb", "rmse_over_hybrid_bound", "unit_rmse_over_pcrlb_min",
-    "predicted_drive_rms_m", "rmse_over_predicted_drive",
-    "rmse_over_predicted", "dead_reckoning_p90_m", "dead_reckoning_rmse_m",
+    "predicted_drive_rms_m", "rmse_over_predicted_drive", "rmse_over_predicted",
+    "dead_reckoning_p90_m", "dead_reckoning_rmse_m", "unit_rmse_m", "dead_reckoning_unit_rmse_m",
 )  # fmt: skip
 _ROW_NONNEGATIVE = ("srnf_valid_share", "met_share", "runs", "units", "drives_per_unit",
                     "unit_yield", "unit_yield_ci95", *_ROW_INF)  # fmt: skip
 _ROW_SHAPES = {"error_p90_ci95_m": (2,), "rmse_ci95_m": (2,), "unit_yield_ci95": (2,),
                "unit_p90_m": (3,), "x_m": ("T",), "peb_m": ("T",), "predicted_m": ("T",),
-               "srnf_valid": ("T",)}  # fmt: skip
+               "srnf_valid": ("T",), "unit_rmse_m": ("U",)}  # fmt: skip
 
 
 @dataclass
 class DesignRow:
     """One candidate array (the JSON entry of ``tunnelkit design``, :meth:`to_json`).
 
-    Statistics are over the counted (settled) epochs unless named ``*_route_*`` (the whole
-    route); ``*_p90_m`` is the ``share``-quantile (the 90th percentile at the default share).
-    ``status`` is a verdict of :func:`tunnelkit.design.verdict.judge` (by the unit yield) or
-    ``"error"`` (``reason`` says why). The Monte-Carlo ran ``units`` manufactured units (one
-    calibration draw each) of ``drives_per_unit`` drives (``runs`` in all): ``unit_yield`` the
-    share of units whose own error quantile meets the target, ``unit_yield_ci95`` its Wilson
-    interval, ``unit_p90_m`` the units' quantiles' [min, median, max]; ``error_p90_m`` the
-    quantile pooled over units with ``error_p90_ci95_m`` Woodruff's interval over units.
+    Statistics are over the counted (settled) epochs unless named ``*_route_*`` (the whole route);
+    ``*_p90_m`` is the ``share``-quantile (the p90 at the default share). ``status`` is a verdict of
+    :func:`tunnelkit.design.verdict.judge` (by the unit yield) or ``"error"`` (``reason`` says why).
+    The Monte-Carlo ran ``units`` manufactured units (one calibration draw each) of
+    ``drives_per_unit`` drives (``runs`` in all): ``unit_yield`` the share of units whose own error
+    quantile meets the target, ``unit_yield_ci95`` its Wilson interval, ``unit_p90_m`` the units'
+    quantiles' [min, median, max], ``unit_rmse_m`` (``dead_reckoning_unit_rmse_m``) each unit's
+    RMSE (a sweep's rows share their drives); ``error_p90_m`` the quantile pooled over units,
+    ``error_p90_ci95_m`` Woodruff's interval.
 
     **Bounds** (lower bounds of what they are set beside, :mod:`tunnelkit.design.drivebound`):
-    ``peb_*`` the snapshot PEB (ideal model, one epoch); ``pcrlb_rms_m`` every unit's posterior
-    CRLB over the drive (a bound of each unit's expected mean-square error), with
-    ``unit_rmse_over_pcrlb_min`` the smallest unit's sample RMSE over it (from that unit's few
-    drives: 1.8-9.7 under phase and gain errors alone, 0.70-1.27 under the calibrated default,
-    ``benchmarks/bench_design_units.py``; a unit's two drives scatter about its expected error,
-    so it is a sample, not the bound's check, which is ``rmse_over_pcrlb``);
-    ``hybrid_bound_rms_m`` the posterior CRLB pooled over units (the calibration draw a fixed
-    unknown of the drive). **Predictions** (first-order, not bounds: the tracker may beat
-    them): ``predicted_*`` the snapshot fix's RMS error under the impairments, weighted as the
-    tracker weighs; ``predicted_drive_rms_m`` the same over the drive. Per-epoch arrays cover the whole route: ``x_m``,
-    ``peb_m``, ``predicted_m`` and, with units, ``error_median_epoch_m`` (median over runs).
+    ``peb_*`` the snapshot PEB (ideal model, one epoch); ``pcrlb_rms_m`` every unit's posterior CRLB
+    over the drive (a bound of each unit's expected mean-square error), with
+    ``unit_rmse_over_pcrlb_min`` the smallest unit's RMSE over it (a sample, not the bound's check,
+    which is ``rmse_over_pcrlb``); ``hybrid_bound_rms_m`` the posterior CRLB pooled over units (the
+    calibration draw a fixed unknown of the drive). **Predictions** (first-order, not bounds: the
+    tracker may beat them): ``predicted_*`` the snapshot fix's RMS error under the impairments,
+    weighted as the tracker weighs; ``predicted_drive_rms_m`` the same over the drive. Per epoch of
+    the whole route: ``x_m``, ``peb_m``, ``predicted_m``, ``error_median_epoch_m`` (over runs).
     """
 
     array: str
@@ -98,6 +96,8 @@ class DesignRow:
     error_model: dict | None = None
     dead_reckoning_p90_m: float | None = None
     dead_reckoning_rmse_m: float | None = None
+    unit_rmse_m: np.ndarray | None = None
+    dead_reckoning_unit_rmse_m: np.ndarray | None = None
     gaps: str = ""
     srnf_valid: np.ndarray | None = field(default=None, repr=False)
 

@@ -58,6 +58,7 @@ def row_json(row) -> dict:
         "rmse_ci95_m": _fins(row.rmse_ci95_m),
         "unit_yield_ci95": _fins(row.unit_yield_ci95),
         "unit_p90_m": _fins(row.unit_p90_m),
+        "unit_rmse_m": _fins(row.unit_rmse_m),
         "runs": int(row.runs),
         "units": int(row.units),
         "drives_per_unit": int(row.drives_per_unit),
@@ -73,6 +74,31 @@ def row_json(row) -> dict:
     if row.dead_reckoning_p90_m is not None:
         out["dead_reckoning_p90_m"] = _fin(row.dead_reckoning_p90_m)
         out["dead_reckoning_rmse_m"] = _fin(row.dead_reckoning_rmse_m)
+        out["dead_reckoning_unit_rmse_m"] = _fins(row.dead_reckoning_unit_rmse_m)
+    return out
+
+
+def paired_ratios(rows) -> dict:
+    """What pairing over units compares in a sweep (its rows share their drives unit by unit),
+    by array: ``radio_gain`` (dead reckoning's RMSE over the tracker's) and
+    ``against_smaller`` (the array's RMSE over the next smaller array's, on their common
+    units), each ``{"against", "units", "ratio", "ci95"}`` from
+    :func:`~tunnelkit.design.intervals.paired_rmse_ratio` (``ci95`` ``None`` below two units)."""
+    from .intervals import paired_rmse_ratio
+
+    def entry(against, num, den):
+        n = min(len(num), len(den))
+        ratio, ci = paired_rmse_ratio(num[:n], den[:n])
+        return {"against": against, "units": n, "ratio": _fin(ratio), "ci95": _fins(ci)}
+
+    out, prev = {}, None
+    for r in sorted((r for r in rows if r.unit_rmse_m is not None), key=lambda r: r.n_elements):
+        e = out.setdefault(r.array, {})
+        if r.dead_reckoning_unit_rmse_m is not None:
+            e["radio_gain"] = entry("dead reckoning", r.dead_reckoning_unit_rmse_m, r.unit_rmse_m)
+        if prev is not None:
+            e["against_smaller"] = entry(prev.array, r.unit_rmse_m, prev.unit_rmse_m)
+        prev = r
     return out
 
 
@@ -84,6 +110,7 @@ def report_json(report) -> dict:
         "inputs": dict(report.settings),
         "criterion": report.criterion,
         "arrays": [row_json(r) for r in report.rows],
+        "paired": paired_ratios(report.rows),
         "recommendation": dict(report.recommendation),
         "warnings": list(report.warnings),
     }
@@ -141,6 +168,7 @@ def report_table(report) -> str:
         f"yield: the share of units whose own {q} meets the target (Wilson interval)."
     )
     lines.append(_CHANNEL_TEXT[s.get("channel", "image")])
+    paired = paired_ratios(report.rows)
     for r in report.rows:
         if r.srnf_valid_share_by_surface:
             per = ", ".join(
@@ -213,6 +241,7 @@ def report_table(report) -> str:
                 f"{r.predicted_drive_rms_m:.3g} m"
                 + ("" if ratio is None else f", tracker RMSE / it {ratio:.3g}")
             )
+        pair = paired.get(r.array, {})
         if r.dead_reckoning_p90_m is not None:
             gain = None
             if r.rmse_m is not None and r.dead_reckoning_rmse_m:
@@ -224,9 +253,13 @@ def report_table(report) -> str:
                     ""
                     if gain is None
                     else f"; the radio's gain in RMSE {100 * gain:.2g} % (dead reckoning's RMSE "
-                    f"over the tracker's {r.dead_reckoning_rmse_m / r.rmse_m if r.rmse_m else np.inf:.3g}x)"
+                    f"over the tracker's {_ratio_text(pair.get('radio_gain'))})"
                 )
             )
+        if "against_smaller" in pair:
+            p = pair["against_smaller"]
+            lines.append(f"  {r.array}: its RMSE over the {p['against']}'s on the same drives "
+                         f"{_ratio_text(p)}")  # fmt: skip
     lines.extend(f"warning: {w}" for w in report.warnings)
     return "\n".join(lines)
 
@@ -272,6 +305,17 @@ _CRITERION_TEXT = {
     ),
     "srnf": ("srnf (an eq. 51 estimator: an epoch counts only where SR-NF holds on every surface)"),
 }
+
+
+def _ratio_text(p) -> str:
+    """``"2.13x [1.71, 2.65] (95 %, paired over 6 units)"``; ``"-"`` when not measured."""
+    if p is None or p["ratio"] is None:
+        return "-"
+    ci = p["ci95"]
+    return f"{p['ratio']:.3g}x" + (
+        f" [{ci[0]:.3g}, {ci[1]:.3g}] (95 %, paired over {p['units']} units)" if ci else
+        f" ({p['units']} unit{'s' if p['units'] != 1 else ''}: no interval)"
+    )  # fmt: skip
 
 
 def _cm(v) -> str:

@@ -124,7 +124,6 @@ def design_sweep(
     n_epochs: int | None = None,
     timeout: float | None = None,
     trial_timeout: float | None = TRIAL_TIMEOUT_S,
-    n_boot: int = 2000,
     start_sigma: float = START_SIGMA_M,
     dead_reckoning: bool = False,
     traced_tracker: str | None = None,
@@ -142,11 +141,10 @@ def design_sweep(
     (0: bounds and predictions only), then, for every array still undecided, as many again
     until its unit yield's 95 % interval lies on one side of ``required_yield`` or
     ``max_units`` is reached (the sequential rule). ``workers`` / ``scheduler`` / ``timeout`` /
-    ``trial_timeout`` go to each batch's task set; ``n_epochs`` truncates the route; ``n_boot``
-    bootstrap resamples (over units); ``start_sigma`` [m] the entry fix's standard deviation per axis
-    (the tracker's start and the prior of the bounds over the drive); ``dead_reckoning``: each
-    drive also run with every measurement dropped, the rows' ``dead_reckoning_*`` (what the
-    radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"auto"``, its default,
+    ``trial_timeout`` go to each batch's task set; ``n_epochs`` truncates the route;
+    ``start_sigma`` [m] the entry fix's standard deviation per axis (the tracker's start and the
+    prior of the bounds over the drive); ``dead_reckoning``: each drive also run with every
+    measurement dropped, the rows' ``dead_reckoning_*`` (what the radio adds); ``traced_tracker`` the ray-traced channel's tracker (``"auto"``, its default,
     ``"los"``, ``"paths"`` or ``"direct"``: :data:`tunnelkit.design.tracedtracker.TRACED_TRACKERS`). An array that does not
     fit, or whose bound or Monte-Carlo is undefined, is a row with status ``"error"`` and the
     reason; the sweep goes on."""
@@ -177,7 +175,6 @@ def design_sweep(
         )
     settle = nonnegative("settle", settle)
     seed = integer("seed", seed, minimum=0)
-    n_boot = integer("n_boot", n_boot, minimum=100)
     start_sigma = start_spread("start_sigma", start_sigma)
     dead_reckoning = boolean("dead_reckoning", dead_reckoning)
     if traced_tracker is None:  # the default: chosen per array on the traced channel's route
@@ -205,7 +202,6 @@ def design_sweep(
             f"{len(specs)} arrays x {max_units} units x {drives_per_unit} drives x {T} epochs "
             "of errors",
         )
-        check_elements("n_boot", n_boot * max_units, what=f"{n_boot} resamples, {max_units} units")
     if mode == "channel" and units:
         # each drive synthesises the largest candidate's tensor and a noise draw of its size:
         # the band's tone count is refused here, before any bound is computed
@@ -231,7 +227,7 @@ def design_sweep(
                            dead_reckoning, drives_per_unit, traced_tracker, trial_timeout)  # fmt: skip
         judged = {"settle": settle, "required": required_yield, "cap": max_units}
         run_units(setup, rows, todo, units, max_units, seed, kw, warnings,
-                  (criterion, target, share, seed, n_boot), judged)  # fmt: skip
+                  (criterion, target, share), judged)  # fmt: skip
     if units == 0:
         warnings.append("no Monte-Carlo (units 0): bounds and predictions only, no recommendation")
     elif units < MIN_RUNS_CI:
@@ -289,7 +285,6 @@ def design_sweep(
         "seed": seed,
         "mode": mode,
         "n_epochs": n_epochs,
-        "n_boot": n_boot,
         "min_units_ci": MIN_RUNS_CI,
         "workers": workers,
         "scheduler": scheduler,

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..settling import SETTLE_S
 from .achievable import DesignImpairments, path_error_model
-from .intervals import cluster_quantile_ci
+from .intervals import cluster_quantile_ci, rmse_ci
 from .montecarlo import sweep_montecarlo
 from .units import unit_quantiles, unit_yield
 from .verdict import REQUIRED_YIELD, counted_epochs, gate, judge, share_quantile
@@ -88,8 +88,6 @@ def score_row(
     criterion,
     target,
     share,
-    seed,
-    n_boot,
     *,
     settle: float = SETTLE_S,
     required: float = REQUIRED_YIELD,
@@ -108,7 +106,6 @@ def score_row(
     lost = np.where(np.isfinite(errors), errors, np.inf)  # no estimate: an infinite error
     gated = gate(lost, valid, criterion)
     e = gated[:, k]
-    rng = np.random.default_rng([0xB007, int(seed), *row.array.encode()])
     row.runs, row.units, row.drives_per_unit = runs, units, d
     row.error_median_epoch_m = np.median(lost, axis=0)
     row.error_median_m = float(np.median(e))
@@ -119,9 +116,8 @@ def score_row(
     sq = np.where(np.isfinite(errors[:, k]), errors[:, k], np.inf) ** 2
     row.rmse_m = float(np.sqrt(sq.mean()))
     unit_ms = sq.reshape(units, -1).mean(axis=1)
-    idx = rng.integers(0, units, size=(n_boot, units))
-    boot = np.sqrt(unit_ms[idx].mean(axis=1))
-    row.rmse_ci95_m = [float(v) for v in np.quantile(boot, [0.025, 0.975], method="inverted_cdf")]
+    row.unit_rmse_m = np.sqrt(unit_ms)
+    row.rmse_ci95_m = rmse_ci(row.unit_rmse_m)  # over units: None below two, or a drive lost
     uq = unit_quantiles(gated, d, k, share)
     row.unit_p90_m = [float(v) for v in np.quantile(uq, [0.0, 0.5, 1.0], method="inverted_cdf")]
     row.unit_yield, row.unit_yield_ci95 = unit_yield(uq, target)
@@ -131,9 +127,10 @@ def score_row(
         dr = np.asarray(dr, float)
         row.dead_reckoning_p90_m = share_quantile(dr[:, k], share)  # never lost: no NaN
         row.dead_reckoning_rmse_m = float(np.sqrt(np.mean(dr[:, k] ** 2)))
+        row.dead_reckoning_unit_rmse_m = np.sqrt((dr[:, k] ** 2).reshape(units, -1).mean(axis=1))
     pred = _rms(row.predicted_m, k)
     row.rmse_over_predicted = row.rmse_m / pred if pred else None
-    _drive_bounds(row, res, k, np.sqrt(unit_ms))
+    _drive_bounds(row, res, k, row.unit_rmse_m)
     row.status, row.reason = judge(
         target,
         units=units,
