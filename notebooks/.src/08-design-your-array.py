@@ -44,6 +44,7 @@ from itertools import pairwise
 from math import comb
 
 import numpy as np
+from scipy import stats
 
 import tunnelkit as tk
 from tunnelkit import design, propagation
@@ -460,7 +461,7 @@ recs = {k: rep.recommendation["array"] for k, rep in answers.items()}
 # %% [markdown]
 # The sweep's own table at 0.5° (what `tunnelkit design` prints): "pred p90" the predicted
 # error, "units" and "unit yield [95% CI]" the verdict's basis, "err p90" the error quantile
-# pooled over all units on the settled route (its interval a bootstrap over whole units, since
+# pooled over all units on the settled route (its interval Woodruff's over whole units, since
 # a unit's drives share its calibration), "route p90" the same over the whole route (the start
 # from the 1 m entry fix included), then the tracker's RMSE beside the two bounds of the next
 # part:
@@ -539,7 +540,8 @@ design_answer_figure(answers["0.5°"]).show()
 # Against them stands the **drive prediction** `predicted_drive_rms_m` (not section 4's snapshot
 # prediction): the posterior CRLB of the tracker's weighting with the calibration's position
 # bias added, to first order. It is no bound, and the tracker may beat it. Each ratio to a bound
-# carries a Monte-Carlo standard error (SE, from the RMSE's 95 % interval over units):
+# carries a Monte-Carlo standard error (SE, of the log of the RMSE, from its 95 % interval over
+# units, Student's t on the log: `tk.design.rmse_ci`):
 
 # %%
 rows_mc = [(k, r) for k, rep in answers.items() for r in rep.rows if r.units]
@@ -549,17 +551,15 @@ for k, r in rows_mc:
           "predicted")  # fmt: skip
 
 
-def ratio_z(ratio, rmse_ci, bound):  # (RMSE / bound - 1) in Monte-Carlo standard errors
-    se = (rmse_ci[1] - rmse_ci[0]) / (2 * 1.96) / bound
-    return (ratio - 1) / se
+def ratio_z(ratio, r):  # log(RMSE / bound) in Monte-Carlo standard errors of log(RMSE)
+    lo, hi = r.rmse_ci95_m  # the t interval over units on log(RMSE): exp(+-t se)
+    se = np.log(hi / lo) / (2 * stats.t.ppf(0.975, r.units - 1))
+    return np.log(ratio) / se
 
 
 z_min = min(
-    ratio_z(ratio, r.rmse_ci95_m, bound)
-    for _, r in rows_mc
-    for ratio, bound in ((r.rmse_over_pcrlb, r.pcrlb_rms_m),
-                         (r.rmse_over_hybrid_bound, r.hybrid_bound_rms_m))
-)  # fmt: skip
+    ratio_z(ratio, r) for _, r in rows_mc for ratio in (r.rmse_over_pcrlb, r.rmse_over_hybrid_bound)
+)
 bound_min = min(min(r.rmse_over_pcrlb, r.rmse_over_hybrid_bound) for _, r in rows_mc)
 pred_min = min(r.rmse_over_predicted_drive for _, r in rows_mc)
 cal_gap = min(r.rmse_over_hybrid_bound for k, r in rows_mc if k != "ideal")
@@ -571,7 +571,7 @@ print("error p90 below the snapshot prediction's p90:", snap_beaten)
 
 # %% [markdown]
 # The tracker's RMSE lies above both bounds on every row within the Monte-Carlo scatter: every
-# ratio is at least 1 − 2 SE (`z_min` ≥ −2; a ratio a little below 1 on few units would be
+# ratio's log is at least −2 SE (`z_min` ≥ −2; a ratio a little below 1 on few units would be
 # scatter, since each bound is of an expected mean-square error). The drive prediction is beaten
 # on some rows (`pred_min` below 1), and so is the snapshot prediction (`snap_beaten`, the rows
 # whose error p90 lies below their "pred p90"): a prediction is a first-order guess of where the
@@ -1247,7 +1247,7 @@ for r in answers["ideal"].rows:
 for r in answers["0.5°"].rows:
     assert 3 * r.peb_median_m < r.error_median_m < 10 * r.peb_median_m, r.array
     assert r.error_median_m < 4 * r.predicted_median_m, r.array
-# bounds below the tracker within Monte-Carlo scatter (every ratio at least 1 - 2 SE; the
+# bounds below the tracker within Monte-Carlo scatter (every ratio's log at least -2 SE; the
 # augmented-state bound never below every unit's PCRLB); the drive prediction and the snapshot
 # prediction each beaten on some row; with calibration error the tracker several times above
 # the augmented-state bound
