@@ -127,12 +127,12 @@ def bound_matrix(
                     "rmse_ci": lo_hi,
                     "hybrid": hy,
                     "r_hy": r.rmse_over_hybrid_bound,
-                    "r_hy_ci": None if hy is None else [v / hy for v in lo_hi],
+                    "r_hy_ci": None if hy is None or lo_hi is None else [v / hy for v in lo_hi],
                     "pcrlb": r.pcrlb_rms_m,
                     "r_pc": r.rmse_over_pcrlb,
                     "r_pc_unit_min": r.unit_rmse_over_pcrlb_min,
                     "r_pc_ci": None
-                    if r.pcrlb_rms_m is None
+                    if r.pcrlb_rms_m is None or lo_hi is None
                     else [v / r.pcrlb_rms_m for v in lo_hi],
                     "r_pred": r.rmse_over_predicted_drive,
                     "p90": r.error_p90_m,

@@ -644,7 +644,7 @@ def test_a_sweep_pairs_its_arrays_and_dead_reckoning_unit_by_unit(setup):
     so dead reckoning's are identical across arrays; they pool back to the row's RMSE, and the
     report's ``paired`` ratios are the ratios of those RMSEs (the radio's gain, an array over the
     next smaller), each with its interval over the units."""
-    from tunnelkit.design import design_sweep
+    from tunnelkit.design import design_sweep, paired_rmse_ratio
 
     few = {"units": 3, "max_units": 3, "n_epochs": 8, "settle": 0.5, "seed": 4}
     rep = design_sweep(setup, ["8x8", "4x4"], dead_reckoning=True, **few)
@@ -657,11 +657,14 @@ def test_a_sweep_pairs_its_arrays_and_dead_reckoning_unit_by_unit(setup):
         assert dr == pytest.approx(r["dead_reckoning_rmse_m"])
         gain = js["paired"][r["array"]]["radio_gain"]
         assert gain["ratio"] == pytest.approx(r["dead_reckoning_rmse_m"] / r["rmse_m"])
-        assert gain["units"] == 3 and gain["ci95"][0] < gain["ratio"] < gain["ci95"][1]
+        want = paired_rmse_ratio(r["dead_reckoning_unit_rmse_m"], r["unit_rmse_m"])[1]
+        assert gain["units"] == 3 and gain["ci95"] == pytest.approx(want)  # num over den
     assert rows["4x4"]["dead_reckoning_unit_rmse_m"] == rows["8x8"]["dead_reckoning_unit_rmse_m"]
     big = js["paired"]["8x8"]["against_smaller"]
     assert "against_smaller" not in js["paired"]["4x4"] and big["against"] == "4x4"
     assert big["ratio"] == pytest.approx(rows["8x8"]["rmse_m"] / rows["4x4"]["rmse_m"])
+    want = paired_rmse_ratio(rows["8x8"]["unit_rmse_m"], rows["4x4"]["unit_rmse_m"])[1]
+    assert big["ci95"] == pytest.approx(want)  # the larger over the smaller, not the reverse
     assert f"8x8: its RMSE over the 4x4's on the same drives {big['ratio']:.3g}x" in rep.to_table()
     assert "paired over 3 units" in rep.to_table()
 

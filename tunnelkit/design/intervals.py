@@ -104,6 +104,8 @@ def rmse_ci(unit_rmse, *, level: float = 0.95) -> list[float] | None:
     finite (a lost drive: the RMSE is infinite)."""
     level = probability("level", level)
     a = _unit_rmse("unit_rmse", unit_rmse)
+    if not a.size:
+        raise ValueError("unit_rmse: expected one RMSE per unit, got none")
     m = np.mean(a**2)
     if a.size < 2 or not (np.all(np.isfinite(a)) and m > 0):
         return None
@@ -137,14 +139,14 @@ def paired_rmse_ratio(num, den, *, level: float = 0.95) -> tuple[float, list[flo
     93-96 % for the radio's gain, 81-89 % for an array over one whose units are heavy-tailed
     (docs/results/design-units.md): approximate there. ``None`` for the interval with fewer than
     two units or a unit not finite (a lost drive); then the ratio is still returned (``inf``
-    when ``den`` is all zero)."""
+    when only ``den`` is all zero, ``nan`` when both are or both are infinite)."""
     level = probability("level", level)
     a, b = _unit_rmse("num", num), _unit_rmse("den", den)
     if a.shape != b.shape or not a.size:
         raise ValueError(f"num, den: expected one RMSE per unit in both, got {a.shape}, {b.shape}")
     ma, mb = np.mean(a**2), np.mean(b**2)
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = float(np.sqrt(ma / mb)) if mb > 0 else np.inf
+        ratio = float(np.sqrt(ma / mb)) if mb > 0 else (np.inf if ma > 0 else np.nan)
     if a.size < 2 or not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and ma > 0 and mb > 0):
         return ratio, None
     return ratio, _log_t(ratio, 0.5 * (a**2 / ma - b**2 / mb), level)

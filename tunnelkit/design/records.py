@@ -29,7 +29,8 @@ _ROW_NONNEGATIVE = ("srnf_valid_share", "met_share", "runs", "units", "drives_pe
                     "unit_yield", "unit_yield_ci95", *_ROW_INF)  # fmt: skip
 _ROW_SHAPES = {"error_p90_ci95_m": (2,), "rmse_ci95_m": (2,), "unit_yield_ci95": (2,),
                "unit_p90_m": (3,), "x_m": ("T",), "peb_m": ("T",), "predicted_m": ("T",),
-               "srnf_valid": ("T",), "unit_rmse_m": ("U",)}  # fmt: skip
+               "srnf_valid": ("T",), "unit_rmse_m": ("U",),
+               "dead_reckoning_unit_rmse_m": ("U",)}  # fmt: skip
 
 
 @dataclass

@@ -42,7 +42,8 @@ def row_json(row) -> dict:
     tracker's measurement-noise model, :func:`tunnelkit.design.traced.error_model_summary`,
     with ``told_sigmas`` the long-run sigmas its tracker is told); with dead reckoning
     measured, ``dead_reckoning_p90_m`` and ``dead_reckoning_rmse_m`` (the same drives,
-    every measurement dropped)."""
+    every measurement dropped); with units, each unit's ``unit_rmse_m`` (and
+    ``dead_reckoning_unit_rmse_m``)."""
     out = {
         "array": row.array,
         "n_elements": int(row.n_elements),
@@ -92,7 +93,8 @@ def paired_ratios(rows) -> dict:
         return {"against": against, "units": n, "ratio": _fin(ratio), "ci95": _fins(ci)}
 
     out, prev = {}, None
-    for r in sorted((r for r in rows if r.unit_rmse_m is not None), key=lambda r: r.n_elements):
+    with_units = (r for r in rows if r.unit_rmse_m is not None)
+    for r in sorted(with_units, key=lambda r: (r.n_elements, r.aperture_diagonal_m)):
         e = out.setdefault(r.array, {})
         if r.dead_reckoning_unit_rmse_m is not None:
             e["radio_gain"] = entry("dead reckoning", r.dead_reckoning_unit_rmse_m, r.unit_rmse_m)
@@ -314,7 +316,7 @@ def _ratio_text(p) -> str:
     ci = p["ci95"]
     return f"{p['ratio']:.3g}x" + (
         f" [{ci[0]:.3g}, {ci[1]:.3g}] (95 %, paired over {p['units']} units)" if ci else
-        f" ({p['units']} unit{'s' if p['units'] != 1 else ''}: no interval)"
+        " (one unit: no interval)" if p["units"] < 2 else " (a drive lost: no interval)"
     )  # fmt: skip
 
 
