@@ -84,7 +84,8 @@ def paired_ratios(rows) -> dict:
     by array: ``radio_gain`` (dead reckoning's RMSE over the tracker's) and
     ``against_smaller`` (the array's RMSE over the next smaller array's, on their common
     units), each ``{"against", "units", "ratio", "ci95"}`` from
-    :func:`~tunnelkit.design.intervals.paired_rmse_ratio` (``ci95`` ``None`` below two units)."""
+    :func:`~tunnelkit.design.intervals.paired_rmse_ratio` (``ci95`` ``None`` below two units or
+    with a drive lost)."""
     from .intervals import paired_rmse_ratio
 
     def entry(against, num, den):
