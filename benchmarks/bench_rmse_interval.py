@@ -28,12 +28,6 @@ SCENARIO = "example-rectangular-28ghz"
 ARRAYS = ("4x4", "8x8")
 
 
-def _unit_rmse(errors, drives: int, k) -> np.ndarray:
-    """Each unit's RMSE over its drives' settled epochs ``k`` (a lost estimate: infinite)."""
-    e = np.where(np.isfinite(errors[:, k]), errors[:, k], np.inf)
-    return np.sqrt((e**2).reshape(-1, drives * e.shape[1]).mean(axis=1))
-
-
 def _boot(ms_num, ms_den, rng, n_boot: int) -> list[float]:
     """The percentile bootstrap over units of ``sqrt(mean ms_num / mean ms_den)`` (the same
     resampled units in both: paired), as the report computed the RMSE's interval before."""
@@ -47,7 +41,7 @@ def study(units=(4, 6, 12), blocks=200, ref_units=1000, drives=2, ref_seed=9001,
     from tunnelkit.design import DesignSetup, path_error_model, preset_impairments, sweep_montecarlo
     from tunnelkit.design.intervals import paired_rmse_ratio, rmse_ci
     from tunnelkit.design.setup import parse_array
-    from tunnelkit.design.units import wilson_interval
+    from tunnelkit.design.units import unit_rmse, wilson_interval
     from tunnelkit.runner import trial_pool
 
     setup = DesignSetup.from_scenario(SCENARIO)
@@ -65,8 +59,8 @@ def study(units=(4, 6, 12), blocks=200, ref_units=1000, drives=2, ref_seed=9001,
     k = ref[big].settled
 
     def per_unit(res, block=None, n=None):
-        u = {a: _unit_rmse(res[a].errors, drives, k) for a in ARRAYS}
-        u["dr"] = _unit_rmse(res[big].dead_reckoning, drives, k)
+        u = {a: unit_rmse(res[a].errors, drives, k) for a in ARRAYS}
+        u["dr"] = unit_rmse(res[big].dead_reckoning, drives, k)
         if block is not None:
             u = {a: v[block * n : (block + 1) * n] for a, v in u.items()}
         return u

@@ -463,7 +463,7 @@ def _baselines():
     import tunnelkit as tk
     from tunnelkit import budget, crlb, geometry, metrics, propagation, reflection, sizes
     from tunnelkit.channel import DiffuseSpec, diffuse_tensor
-    from tunnelkit.design import errordraws, intervals, mcrb, render, verdict
+    from tunnelkit.design import errordraws, intervals, mcrb, render, units, verdict
     from tunnelkit.design.arrayjob import javelin_config
     from tunnelkit.design.drivebound import drive_bound
     from tunnelkit.extraction.krank import kruskal_rank
@@ -508,6 +508,7 @@ def _baselines():
     intervals.cluster_quantile_ci(e[None, :].repeat(3, 0), 0.9)
     intervals.paired_rmse_ratio(e[:6], e[6:12])
     intervals.rmse_ci(e[:6])
+    units.unit_rmse(e.reshape(5, 10), 5, np.arange(10))
     verdict.counted_epochs(np.arange(0.0, 30.0, 0.5))
     verdict.gate(e, np.ones(50, bool), "achievable")
     verdict.judge(0.1, units=20, yield_=0.9, ci=[0.7, 0.97], cap=200)

@@ -721,7 +721,7 @@ DOCUMENTED: tuple[Documented, ...] = (
         "no gap on the route",
     ),
     _doc(
-        r"design\.units\.unit_quantiles",
+        r"design\.units\.unit_(quantiles|rmse)",
         r"errors",
         "nan",
         "no estimate at that epoch (a lost track): counted as an infinite error",

@@ -514,3 +514,19 @@ def test_the_rmse_interval_over_units_covers_where_the_percentile_bootstrap_did_
             lo, hi = intervals.rmse_ci(np.sqrt(rng.lognormal(0, 0.6, n)))
             hit += lo <= true <= hi
         assert 0.87 <= hit / 300 <= 0.99, (n, hit)
+
+
+def test_unit_rmse_is_each_units_rms_over_its_drives_and_counted_epochs():
+    """Brute force: unit u's RMSE is the RMS of rows u*D .. u*D+D-1 at the counted epochs; a
+    lost estimate makes its unit's RMSE infinite and leaves the others."""
+    from tunnelkit.design.units import unit_rmse
+
+    rng = np.random.default_rng(5)
+    e = rng.exponential(0.3, size=(6, 9))
+    e[4, 7] = np.nan
+    k = np.array([2, 3, 7, 8])
+    want = [np.sqrt(np.mean(e[2 * u : 2 * u + 2][:, k] ** 2)) for u in range(3)]
+    got = unit_rmse(e, 2, k)
+    assert got[:2] == pytest.approx(want[:2], rel=1e-12) and got[2] == np.inf
+    with pytest.raises(ValueError, match="drives_per_unit"):
+        unit_rmse(e, 4, k)

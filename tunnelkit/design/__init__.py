@@ -62,6 +62,7 @@ _EXPORTS = {
     "Mount": "setup",
     "parse_array": "setup",
     "unit_quantiles": "units",
+    "unit_rmse": "units",
     "unit_yield": "units",
     "wilson_interval": "units",
     "CRITERIA": "verdict",

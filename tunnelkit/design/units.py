@@ -32,6 +32,7 @@ from ..budget import check_elements
 __all__ = [
     "drive_streams",
     "unit_quantiles",
+    "unit_rmse",
     "unit_seeds",
     "unit_yield",
     "wilson_interval",
@@ -94,8 +95,22 @@ def unit_quantiles(errors, drives_per_unit: int, counted, share: float) -> np.nd
     drives in unit order, :func:`drive_streams`), pooled over its drives and the ``counted``
     epochs; a non-finite error (no estimate) counts as infinite
     (:func:`tunnelkit.design.verdict.share_quantile`)."""
-    d = integer("drives_per_unit", drives_per_unit, minimum=1)
     share = probability("share", share, open_interval=False)
+    return np.quantile(_unit_rows(errors, drives_per_unit, counted), share, axis=1,
+                       method="inverted_cdf")  # fmt: skip
+
+
+def unit_rmse(errors, drives_per_unit: int, counted) -> np.ndarray:
+    """Each unit's RMSE (U,) [m] over its drives and the ``counted`` epochs of ``errors`` (as
+    :func:`unit_quantiles`; a non-finite error counts as infinite, and so does the unit's RMSE):
+    what :func:`tunnelkit.design.intervals.paired_rmse_ratio` pairs across a sweep's rows."""
+    return np.sqrt(np.mean(_unit_rows(errors, drives_per_unit, counted) ** 2, axis=1))
+
+
+def _unit_rows(errors, drives_per_unit, counted) -> np.ndarray:
+    """``errors`` (U * drives_per_unit, T) checked, non-finite as +inf, at the ``counted``
+    epochs, one row per unit (U, drives_per_unit * len(counted))."""
+    d = integer("drives_per_unit", drives_per_unit, minimum=1)
     e = real_array("errors", errors, ndim=2)
     if e.shape[0] % d or not e.size:
         raise ValueError(
@@ -107,8 +122,7 @@ def unit_quantiles(errors, drives_per_unit: int, counted, share: float) -> np.nd
     if not k.size or np.any(k != np.round(k)) or k.min() < 0 or k.max() >= e.shape[1]:
         raise ValueError(f"counted: expected epoch indices in [0, {e.shape[1]}), got {k!r}")
     k = k.astype(int)
-    e = np.where(np.isfinite(e), e, np.inf)[:, k].reshape(e.shape[0] // d, -1)
-    return np.quantile(e, share, axis=1, method="inverted_cdf")
+    return np.where(np.isfinite(e), e, np.inf)[:, k].reshape(e.shape[0] // d, -1)
 
 
 def unit_yield(unit_q, target: float, level: float = 0.95) -> tuple[float, list[float]]:

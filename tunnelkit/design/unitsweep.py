@@ -16,7 +16,7 @@ from ..settling import SETTLE_S
 from .achievable import DesignImpairments, path_error_model
 from .intervals import cluster_quantile_ci, rmse_ci
 from .montecarlo import sweep_montecarlo
-from .units import unit_quantiles, unit_yield
+from .units import unit_quantiles, unit_rmse, unit_yield
 from .verdict import REQUIRED_YIELD, counted_epochs, gate, judge, share_quantile
 
 #: nothing exported: the sweep's own steps, on the arguments :func:`tunnelkit.design.design_sweep`
@@ -115,8 +115,7 @@ def score_row(
     row.error_p90_ci95_m = cluster_quantile_ci(e.reshape(units, -1), share)
     sq = np.where(np.isfinite(errors[:, k]), errors[:, k], np.inf) ** 2
     row.rmse_m = float(np.sqrt(sq.mean()))
-    unit_ms = sq.reshape(units, -1).mean(axis=1)
-    row.unit_rmse_m = np.sqrt(unit_ms)
+    row.unit_rmse_m = unit_rmse(errors, d, k)
     row.rmse_ci95_m = rmse_ci(row.unit_rmse_m)  # over units: None below two, or a drive lost
     uq = unit_quantiles(gated, d, k, share)
     row.unit_p90_m = [float(v) for v in np.quantile(uq, [0.0, 0.5, 1.0], method="inverted_cdf")]
@@ -127,7 +126,7 @@ def score_row(
         dr = np.asarray(dr, float)
         row.dead_reckoning_p90_m = share_quantile(dr[:, k], share)  # never lost: no NaN
         row.dead_reckoning_rmse_m = float(np.sqrt(np.mean(dr[:, k] ** 2)))
-        row.dead_reckoning_unit_rmse_m = np.sqrt((dr[:, k] ** 2).reshape(units, -1).mean(axis=1))
+        row.dead_reckoning_unit_rmse_m = unit_rmse(dr, d, k)
     pred = _rms(row.predicted_m, k)
     row.rmse_over_predicted = row.rmse_m / pred if pred else None
     _drive_bounds(row, res, k, row.unit_rmse_m)
